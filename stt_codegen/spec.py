@@ -1,0 +1,474 @@
+"""Problem specification: one prescribed-time reach-avoid-stay task (Definition 2.1).
+
+A spec is a TOML file with a fixed schema (see the README). :func:`load_spec`
+reads a bundled case by name or a file by path, validates every field and
+returns a frozen :class:`Spec`. Every rejection is a :class:`SpecError` naming
+the field and the reason.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import re
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from .errors import SpecError
+
+NAME_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_-]{0,63}")
+PLANT_MODELS = ("omnidirectional", "single-integrator")
+#: Fraction of the available room used by the default half-widths ``d_0`` and ``d_T``.
+DEFAULT_HALF_WIDTH_FRACTION = 0.8
+#: Largest state dimension accepted (the generated code unrolls per dimension).
+MAX_DIMENSION = 64
+MAX_OBSTACLES = 4096
+
+_TOP_KEYS = {"name", "prescribed_time", "state_space", "initial", "target", "obstacles",
+             "tube", "controller", "plant"}
+_REQUIRED_TOP = ("name", "prescribed_time", "state_space", "initial", "target")
+_TUBE_DEFAULTS = {
+    "delta_b": 0.2,
+    "circumvent_sharpness": 0.01,
+    "theta0": 0.01,
+    "kappa": 5.0,
+    "mu": 1.0,
+    "smoothness": 50.0,
+}
+_CONTROLLER_DEFAULTS: dict[str, float | None] = {"gain": None, "rate_hz": 1000.0}
+_PLANT_DEFAULTS: dict[str, Any] = {"model": "single-integrator", "disturbance_amplitude": 0.1}
+
+
+@dataclass(frozen=True)
+class Box:
+    """An axis-aligned box ``prod_i [lower_i, upper_i]``.
+
+    Attributes
+    ----------
+    lower, upper : tuple of float, length n
+        Corner coordinates, ``lower_i <= upper_i``.
+    """
+
+    lower: tuple[float, ...]
+    upper: tuple[float, ...]
+
+    @property
+    def center(self) -> tuple[float, ...]:
+        return tuple((a + b) / 2 for a, b in zip(self.lower, self.upper))
+
+    def contains_box(self, other: "Box") -> bool:
+        return all(a <= c and d <= b for a, b, c, d in
+                   zip(self.lower, self.upper, other.lower, other.upper))
+
+    def meets(self, other: "Box") -> bool:
+        """Whether the closed boxes intersect (touching counts)."""
+        return all(c <= b and a <= d for a, b, c, d in
+                   zip(self.lower, self.upper, other.lower, other.upper))
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    """One unsafe set ``U^j`` (a box), given on some dimensions.
+
+    Attributes
+    ----------
+    lower, upper : tuple of float, length len(dims)
+        Bounds on the dimensions in ``dims``.
+    dims : tuple of int
+        The state dimensions the bounds apply to; in every other dimension the
+        obstacle spans the whole state space.
+    """
+
+    lower: tuple[float, ...]
+    upper: tuple[float, ...]
+    dims: tuple[int, ...]
+
+    def box(self, state_space: Box) -> Box:
+        """The obstacle as a full-dimensional box inside ``state_space``."""
+        lower = list(state_space.lower)
+        upper = list(state_space.upper)
+        for k, i in enumerate(self.dims):
+            lower[i], upper[i] = self.lower[k], self.upper[k]
+        return Box(tuple(lower), tuple(upper))
+
+
+@dataclass(frozen=True)
+class TubeParameters:
+    """Tube shaping parameters of section III (all positive).
+
+    Attributes
+    ----------
+    delta_b : float
+        ``delta_B`` of eqs. (7)-(8): clearance kept from each obstacle, state units.
+    circumvent_sharpness : float
+        ``k^j`` of eqs. (7)-(8): smoothness of the circumvent bump.
+    theta0 : float
+        ``theta_0`` of eq. (11).
+    kappa : float
+        ``kappa`` of eq. (11): decay rate of ``alpha``, 1/s.
+    mu : float
+        ``mu`` of eq. (11): conflict tolerance, state units.
+    smoothness : float
+        ``nu`` of the smooth max/min in eqs. (9)-(10), 1/state units.
+    """
+
+    delta_b: float
+    circumvent_sharpness: float
+    theta0: float
+    kappa: float
+    mu: float
+    smoothness: float
+
+
+@dataclass(frozen=True)
+class Spec:
+    """A validated prescribed-time reach-avoid-stay task and its design parameters.
+
+    Attributes
+    ----------
+    name : str
+        Identifier, ``[A-Za-z][A-Za-z0-9_-]*`` (at most 64 characters).
+    prescribed_time : float
+        ``t_c`` of Definition 2.1 and eq. (4), seconds.
+    state_space : Box
+        ``X``.
+    initial_set : Box
+        ``X_0``.
+    initial_state : tuple of float
+        ``x(0)``, in the interior of ``X_0``.
+    initial_half_width : tuple of float
+        ``d_0`` of eq. (2); ``x(0) +- d_0`` lies inside ``X_0``.
+    target_set : Box
+        ``T``.
+    target_center : tuple of float
+        ``eta`` of eq. (3).
+    target_half_width : tuple of float
+        ``d_T`` of eq. (3); ``eta +- d_T`` lies inside ``T``.
+    obstacles : tuple of Obstacle
+        The unsafe sets ``U^j``.
+    tube : TubeParameters
+    gain : float or None
+        ``k`` of law (13); ``None`` lets the design choose it.
+    rate_hz : float
+        Sampling rate of the deployed controller, Hz.
+    plant_model : str
+        ``"omnidirectional"`` (eq. (14)) or ``"single-integrator"``; simulation only.
+    disturbance_amplitude : float
+        Bound on ``|w_i|``; simulation only.
+    source_hash : str
+        SHA-256 of the spec file's bytes.
+    """
+
+    name: str
+    prescribed_time: float
+    state_space: Box
+    initial_set: Box
+    initial_state: tuple[float, ...]
+    initial_half_width: tuple[float, ...]
+    target_set: Box
+    target_center: tuple[float, ...]
+    target_half_width: tuple[float, ...]
+    obstacles: tuple[Obstacle, ...]
+    tube: TubeParameters
+    gain: float | None
+    rate_hz: float
+    plant_model: str
+    disturbance_amplitude: float
+    source_hash: str = field(default="", compare=False)
+
+    @property
+    def dimension(self) -> int:
+        """State dimension ``n``."""
+        return len(self.state_space.lower)
+
+    @property
+    def c_name(self) -> str:
+        """The name as a C identifier (``-`` replaced by ``_``)."""
+        return self.name.replace("-", "_")
+
+    def obstacle_boxes(self) -> list[Box]:
+        """Every obstacle as a full-dimensional box."""
+        return [o.box(self.state_space) for o in self.obstacles]
+
+
+# --------------------------------------------------------------------------- loading
+
+
+def bundled_cases() -> list[str]:
+    """Names of the bundled specs, sorted."""
+    folder = resources.files("stt_codegen.cases")
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def load_spec(spec: str | Path) -> Spec:
+    """Load and validate a spec, by bundled name or by file path.
+
+    Parameters
+    ----------
+    spec : str or path
+        A bundled case name (see :func:`bundled_cases`) or a path to a TOML file.
+
+    Returns
+    -------
+    Spec
+
+    Raises
+    ------
+    SpecError
+        The file does not exist or cannot be read, is not valid TOML, or a field
+        is missing, unknown, of the wrong type or fails a rule of the schema.
+    """
+    text = str(spec)
+    if text in bundled_cases() and not Path(text).exists():
+        data = resources.files("stt_codegen.cases").joinpath(text + ".toml").read_bytes()
+    else:
+        path = Path(text)
+        try:
+            data = path.read_bytes()
+        except FileNotFoundError:
+            raise SpecError("", f"no bundled case and no file named {text!r} "
+                                f"(bundled: {', '.join(bundled_cases())})") from None
+        except OSError as exc:
+            raise SpecError("", f"cannot read {text!r}: {exc.strerror or exc}") from None
+    return parse_spec(data)
+
+
+def parse_spec(data: bytes | str) -> Spec:
+    """Validate the text of a spec file; see :func:`load_spec`.
+
+    Raises
+    ------
+    SpecError
+    """
+    raw = data.encode("utf-8") if isinstance(data, str) else bytes(data)
+    try:
+        doc = tomllib.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError as exc:
+        raise SpecError("", f"not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError("", f"malformed TOML: {exc}") from None
+    except RecursionError:
+        raise SpecError("", "malformed TOML: nested too deeply") from None
+    spec = _validate(doc)
+    return _replace_hash(spec, hashlib.sha256(raw).hexdigest())
+
+
+def _replace_hash(spec: Spec, digest: str) -> Spec:
+    from dataclasses import replace
+    return replace(spec, source_hash=digest)
+
+
+# --------------------------------------------------------------------------- field readers
+
+
+def _table(doc: dict, key: str, required: bool, allowed: set[str], where: str = "") -> dict:
+    name = f"{where}{key}"
+    if key not in doc:
+        if required:
+            raise SpecError(name, "missing")
+        return {}
+    value = doc[key]
+    if not isinstance(value, dict):
+        raise SpecError(name, f"must be a table, got {_kind(value)}")
+    _no_unknown(value, allowed, name)
+    return value
+
+
+def _no_unknown(table: dict, allowed: set[str], where: str) -> None:
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        prefix = f"{where}." if where else ""
+        raise SpecError(f"{prefix}{unknown[0]}",
+                        f"unknown key (allowed: {', '.join(sorted(allowed))})")
+
+
+def _kind(value: Any) -> str:
+    return {bool: "a boolean", str: "a string", list: "an array", dict: "a table",
+            int: "an integer", float: "a float"}.get(type(value), type(value).__name__)
+
+
+def _number(value: Any, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise SpecError(name, f"must be a number, got {_kind(value)}")
+    number = float(value)
+    if not math.isfinite(number):
+        raise SpecError(name, f"must be finite, got {value!r}")
+    if abs(number) > 1e12:
+        raise SpecError(name, f"magnitude {value!r} is beyond 1e12")
+    return number
+
+
+def _positive(value: Any, name: str) -> float:
+    number = _number(value, name)
+    if number <= 0:
+        raise SpecError(name, f"must be positive, got {value!r}")
+    return number
+
+
+def _vector(value: Any, name: str, length: int | None) -> tuple[float, ...]:
+    if not isinstance(value, list):
+        raise SpecError(name, f"must be an array of numbers, got {_kind(value)}")
+    if length is not None and len(value) != length:
+        raise SpecError(name, f"must have {length} entries (one per state dimension), "
+                              f"got {len(value)}")
+    if not value:
+        raise SpecError(name, "must not be empty")
+    return tuple(_number(v, f"{name}[{k}]") for k, v in enumerate(value))
+
+
+def _box(table: dict, name: str, length: int | None) -> Box:
+    for key in ("lower", "upper"):
+        if key not in table:
+            raise SpecError(f"{name}.{key}", "missing")
+    lower = _vector(table["lower"], f"{name}.lower", length)
+    upper = _vector(table["upper"], f"{name}.upper", len(lower))
+    for k, (a, b) in enumerate(zip(lower, upper)):
+        if a > b:
+            raise SpecError(f"{name}.lower", f"lower[{k}] = {a!r} exceeds upper[{k}] = {b!r}")
+        if a == b:
+            raise SpecError(f"{name}.lower", f"empty box: lower[{k}] = upper[{k}] = {a!r}")
+    return Box(lower, upper)
+
+
+def _half_width(table: dict, name: str, center: tuple[float, ...], box: Box,
+                label: str) -> tuple[float, ...]:
+    room = tuple(min(c - a, b - c) for c, a, b in zip(center, box.lower, box.upper))
+    if "half_width" not in table:
+        return tuple(DEFAULT_HALF_WIDTH_FRACTION * r for r in room)
+    width = _vector(table["half_width"], f"{name}.half_width", len(center))
+    for k, (d, r) in enumerate(zip(width, room)):
+        if d <= 0:
+            raise SpecError(f"{name}.half_width", f"entry {k} must be positive, got {d!r}")
+        if d > r + 1e-12:
+            raise SpecError(f"{name}.half_width",
+                            f"entry {k} = {d!r} puts the box outside the {label} "
+                            f"(at most {r!r} around the point)")
+    return width
+
+
+# --------------------------------------------------------------------------- validation
+
+
+def _validate(doc: dict) -> Spec:
+    _no_unknown(doc, _TOP_KEYS, "")
+    for key in _REQUIRED_TOP:
+        if key not in doc:
+            raise SpecError(key, "missing")
+
+    name = doc["name"]
+    if not isinstance(name, str):
+        raise SpecError("name", f"must be a string, got {_kind(name)}")
+    if not NAME_PATTERN.fullmatch(name):
+        raise SpecError("name", f"{name!r} is not an identifier: it must match "
+                                "[A-Za-z][A-Za-z0-9_-]* and be at most 64 characters")
+    t_c = _positive(doc["prescribed_time"], "prescribed_time")
+
+    space_t = _table(doc, "state_space", True, {"lower", "upper"})
+    state_space = _box(space_t, "state_space", None)
+    n = len(state_space.lower)
+    if n > MAX_DIMENSION:
+        raise SpecError("state_space.lower", f"{n} dimensions; at most {MAX_DIMENSION}")
+
+    init_t = _table(doc, "initial", True, {"lower", "upper", "state", "half_width"})
+    initial_set = _box(init_t, "initial", n)
+    if not state_space.contains_box(initial_set):
+        raise SpecError("initial", "the initial set is not inside the state space")
+    if "state" in init_t:
+        x0 = _vector(init_t["state"], "initial.state", n)
+    else:
+        x0 = initial_set.center
+    for k, (v, a, b) in enumerate(zip(x0, initial_set.lower, initial_set.upper)):
+        if not a < v < b:
+            raise SpecError("initial.state", f"entry {k} = {v!r} is not in the interior "
+                                             f"({a!r}, {b!r}) of the initial set")
+    d0 = _half_width(init_t, "initial", x0, initial_set, "initial set")
+
+    target_t = _table(doc, "target", True, {"lower", "upper", "center", "half_width"})
+    target_set = _box(target_t, "target", n)
+    if not state_space.contains_box(target_set):
+        raise SpecError("target", "the target set is not inside the state space")
+    eta = (_vector(target_t["center"], "target.center", n) if "center" in target_t
+           else target_set.center)
+    for k, (v, a, b) in enumerate(zip(eta, target_set.lower, target_set.upper)):
+        if not a < v < b:
+            raise SpecError("target.center", f"entry {k} = {v!r} is not in the interior "
+                                             f"({a!r}, {b!r}) of the target set")
+    d_t = _half_width(target_t, "target", eta, target_set, "target set")
+
+    obstacles = _obstacles(doc.get("obstacles", []), state_space)
+    for j, obstacle in enumerate(obstacles):
+        box = obstacle.box(state_space)
+        if box.meets(initial_set):
+            raise SpecError(f"obstacles[{j}]", "meets the initial set")
+        if box.meets(target_set):
+            raise SpecError(f"obstacles[{j}]", "meets the target set")
+
+    tube_t = _table(doc, "tube", False, set(_TUBE_DEFAULTS))
+    tube = TubeParameters(**{key: _positive(tube_t.get(key, default), f"tube.{key}")
+                             for key, default in _TUBE_DEFAULTS.items()})
+
+    ctrl_t = _table(doc, "controller", False, set(_CONTROLLER_DEFAULTS))
+    gain = _positive(ctrl_t["gain"], "controller.gain") if "gain" in ctrl_t else None
+    rate_hz = _positive(ctrl_t.get("rate_hz", _CONTROLLER_DEFAULTS["rate_hz"]),
+                        "controller.rate_hz")
+
+    plant_t = _table(doc, "plant", False, set(_PLANT_DEFAULTS))
+    model = plant_t.get("model", _PLANT_DEFAULTS["model"])
+    if not isinstance(model, str) or model not in PLANT_MODELS:
+        raise SpecError("plant.model", f"must be one of {', '.join(PLANT_MODELS)}, "
+                                       f"got {model!r}")
+    if model == "omnidirectional" and n != 3:
+        raise SpecError("plant.model", f"the omnidirectional robot (eq. 14) has 3 states, "
+                                       f"the state space has {n}")
+    amplitude = _number(plant_t.get("disturbance_amplitude",
+                                    _PLANT_DEFAULTS["disturbance_amplitude"]),
+                        "plant.disturbance_amplitude")
+    if amplitude < 0:
+        raise SpecError("plant.disturbance_amplitude", f"must be non-negative, got {amplitude!r}")
+
+    return Spec(name=name, prescribed_time=t_c, state_space=state_space,
+                initial_set=initial_set, initial_state=x0, initial_half_width=d0,
+                target_set=target_set, target_center=eta, target_half_width=d_t,
+                obstacles=obstacles, tube=tube, gain=gain, rate_hz=rate_hz,
+                plant_model=model, disturbance_amplitude=amplitude)
+
+
+def _obstacles(value: Any, state_space: Box) -> tuple[Obstacle, ...]:
+    n = len(state_space.lower)
+    if not isinstance(value, list):
+        raise SpecError("obstacles", f"must be an array of tables, got {_kind(value)}")
+    if len(value) > MAX_OBSTACLES:
+        raise SpecError("obstacles", f"{len(value)} obstacles; at most {MAX_OBSTACLES}")
+    result = []
+    for j, table in enumerate(value):
+        name = f"obstacles[{j}]"
+        if not isinstance(table, dict):
+            raise SpecError(name, f"must be a table, got {_kind(table)}")
+        _no_unknown(table, {"lower", "upper", "dims"}, name)
+        box = _box(table, name, None)
+        m = len(box.lower)
+        if m > n:
+            raise SpecError(f"{name}.lower", f"{m} entries for a {n}-dimensional state space")
+        if "dims" in table:
+            dims_v = table["dims"]
+            if not isinstance(dims_v, list) or len(dims_v) != m:
+                raise SpecError(f"{name}.dims", f"must be an array of {m} dimension indices")
+            for d in dims_v:
+                if isinstance(d, bool) or not isinstance(d, int) or not 0 <= d < n:
+                    raise SpecError(f"{name}.dims", f"{d!r} is not a dimension index "
+                                                    f"in 0..{n - 1}")
+            if len(set(dims_v)) != m:
+                raise SpecError(f"{name}.dims", "repeats a dimension")
+            dims = tuple(dims_v)
+        else:
+            dims = tuple(range(m))
+        for k, i in enumerate(dims):
+            if box.lower[k] < state_space.lower[i] or box.upper[k] > state_space.upper[i]:
+                raise SpecError(name, f"dimension {i} of the obstacle "
+                                      f"[{box.lower[k]!r}, {box.upper[k]!r}] is not inside "
+                                      "the state space")
+        result.append(Obstacle(box.lower, box.upper, dims))
+    return tuple(result)
