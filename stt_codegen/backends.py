@@ -1,0 +1,90 @@
+"""Controller backends: one object per way of computing the deployed controller step.
+
+Every backend computes the same step, ``(x, t, dt, alpha) -> (u, alpha_next, status)``,
+from a different implementation: the numpy reference, CasADi's own evaluation, or the
+generated code. New backends register a factory with :func:`register_backend`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Protocol
+
+import numpy as np
+
+from . import reference
+from .errors import SpecError
+from .tube import TubeDesign
+
+#: Status codes of a controller step (the generated code uses the same numbers).
+STATUS_OK = 0
+STATUS_OUTSIDE_TUBE = 1
+STATUS_INVALID_INPUT = 2
+
+
+class Controller(Protocol):
+    """A deployed controller step."""
+
+    name: str
+
+    def step(self, x: np.ndarray, t: float, dt: float,
+             alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+        """Return ``u`` (n,), ``alpha_next`` (2n,) and a status code."""
+
+
+class ReferenceController:
+    """The numpy reference (:func:`stt_codegen.reference.controller_step`)."""
+
+    name = "reference"
+
+    def __init__(self, design: TubeDesign) -> None:
+        self.design = design
+
+    def step(self, x, t, dt, alpha):
+        u, alpha_next, inside = reference.controller_step(self.design, x, t, dt, alpha)
+        return u[0], alpha_next[0], STATUS_OK if inside[0] else STATUS_OUTSIDE_TUBE
+
+
+class CasadiController:
+    """CasADi's own evaluation of the model's ``controller_step`` function."""
+
+    name = "casadi"
+
+    def __init__(self, design: TubeDesign) -> None:
+        from .model import build_model
+        self.function = build_model(design)["controller_step"]
+
+    def step(self, x, t, dt, alpha):
+        u, alpha_next, inside = self.function(x, t, dt, alpha)
+        return (np.array(u).ravel(), np.array(alpha_next).ravel(),
+                STATUS_OK if float(inside) else STATUS_OUTSIDE_TUBE)
+
+
+_FACTORIES: dict[str, Callable[[TubeDesign], Controller]] = {
+    "reference": ReferenceController,
+    "casadi": CasadiController,
+}
+
+
+def register_backend(name: str, factory: Callable[[TubeDesign], Controller]) -> None:
+    """Make ``factory(design)`` available as backend ``name``."""
+    _FACTORIES[name] = factory
+
+
+def backend_names() -> list[str]:
+    """The registered backend names, in registration order."""
+    return list(_FACTORIES)
+
+
+def make_controller(name: str, design: TubeDesign) -> Controller:
+    """The controller of backend ``name`` for a design.
+
+    Raises
+    ------
+    SpecError
+        Unknown backend (field ``--backend``).
+    """
+    if name not in _FACTORIES:
+        raise SpecError("--backend", f"unknown backend {name!r} "
+                                     f"(known: {', '.join(_FACTORIES)})")
+    return _FACTORIES[name](design)

@@ -1,0 +1,86 @@
+"""Plant models for closed-loop simulation, as python-control ``NonlinearIOSystem``s.
+
+The controller never sees these: they only stand in for the unknown system (1),
+``x_dot = f(x) + g(x) u + w``, in simulation.
+"""
+
+from __future__ import annotations
+
+import control as ct
+import numpy as np
+
+from .errors import SpecError
+
+#: Number of sinusoids summed in each disturbance component.
+DISTURBANCE_TERMS = 3
+
+
+class Disturbance:
+    """A bounded, smooth, deterministic disturbance ``w(t)``, seeded.
+
+    Each component is ``A sum_k c_k sin(omega_k t + phi_k)`` with ``sum_k c_k = 1``,
+    so ``|w_i(t)| <= A`` for all ``t``; frequencies are drawn in [0.5, 5] rad/s.
+
+    Parameters
+    ----------
+    dimension : int
+        ``n``.
+    amplitude : float
+        ``A >= 0``, the bound on every ``|w_i|``, state units per second.
+    seed : int
+        Seed of ``numpy.random.default_rng``.
+    """
+
+    def __init__(self, dimension: int, amplitude: float, seed: int = 0) -> None:
+        rng = np.random.default_rng(seed)
+        weights = rng.uniform(0.2, 1.0, (dimension, DISTURBANCE_TERMS))
+        self.amplitude = float(amplitude)
+        self.weights = weights / weights.sum(axis=1, keepdims=True)
+        self.frequencies = rng.uniform(0.5, 5.0, (dimension, DISTURBANCE_TERMS))
+        self.phases = rng.uniform(0.0, 2.0 * np.pi, (dimension, DISTURBANCE_TERMS))
+
+    def __call__(self, t: float) -> np.ndarray:
+        """``w(t)``, shape (n,)."""
+        return self.amplitude * np.sum(
+            self.weights * np.sin(self.frequencies * t + self.phases), axis=1)
+
+
+def omnidirectional_robot(disturbance: Disturbance) -> ct.NonlinearIOSystem:
+    """The omnidirectional robot of eq. (14): ``x_dot = R(x3) u + w(t)``.
+
+    States ``[x1, x2, x3]`` (position in m, heading in rad); inputs ``[v1, v2, omega]``
+    in the robot frame (m/s, rad/s); outputs the state.
+    """
+    def rhs(t, x, u, params):
+        c, s = np.cos(x[2]), np.sin(x[2])
+        return np.array([c * u[0] - s * u[1], s * u[0] + c * u[1], u[2]]) + disturbance(t)
+
+    return ct.nlsys(rhs, None, inputs=["v1", "v2", "omega"], states=["x1", "x2", "x3"],
+                    outputs=["x1", "x2", "x3"], name="omnidirectional_robot")
+
+
+def single_integrator(dimension: int, disturbance: Disturbance) -> ct.NonlinearIOSystem:
+    """``x_dot = u + w(t)`` in ``dimension`` states; outputs the state."""
+    def rhs(t, x, u, params):
+        return np.asarray(u, dtype=float) + disturbance(t)
+
+    return ct.nlsys(rhs, None, inputs=dimension, states=dimension, outputs=dimension,
+                    name="single_integrator")
+
+
+def make_plant(model: str, dimension: int, amplitude: float, seed: int = 0) -> ct.NonlinearIOSystem:
+    """The plant named in a spec's ``[plant]`` table.
+
+    Raises
+    ------
+    SpecError
+        Unknown model, or a dimension the model does not have.
+    """
+    disturbance = Disturbance(dimension, amplitude, seed)
+    if model == "omnidirectional":
+        if dimension != 3:
+            raise SpecError("plant.model", "the omnidirectional robot has 3 states")
+        return omnidirectional_robot(disturbance)
+    if model == "single-integrator":
+        return single_integrator(dimension, disturbance)
+    raise SpecError("plant.model", f"unknown model {model!r}")

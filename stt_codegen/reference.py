@@ -1,0 +1,315 @@
+"""Numeric reference: eqs. (2)-(13) of the paper in numpy, the oracle for every backend.
+
+Written directly from the paper's equations and independently of the CasADi model:
+derivatives are written out by hand (not differentiated automatically), the smooth
+max/min uses the paper's log-sum-exp form through ``numpy.logaddexp``, and the implicit
+``alpha`` step is solved by bisection rather than Newton's method.
+
+Shapes: ``t`` is ``(N,)``; ``x`` is ``(N, n)``; ``alpha`` is ``(N, 2n)`` and holds
+``[alpha_L, alpha_U]``; scalars broadcast. Every function returns arrays with a leading
+``N`` axis.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .tube import E_MAX, GAMMA_D_MIN, LOWER, TubeDesign
+
+Array = np.ndarray
+
+
+def _time(t) -> Array:
+    return np.atleast_1d(np.asarray(t, dtype=float))
+
+
+def _rows(value, n_rows: int, width: int) -> Array:
+    return np.broadcast_to(np.asarray(value, dtype=float), (n_rows, width))
+
+
+def tanh_progress(design: TubeDesign, t) -> tuple[Array, Array]:
+    """``s(t) = tanh(t / (t_c - t))`` of eq. (4) and ``ds/dt``; ``s = 1``, ``ds/dt = 0`` for ``t >= t_c``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+    t : array_like, shape (N,)
+        Time, seconds.
+
+    Returns
+    -------
+    s, s_dot : ndarray, shape (N,)
+    """
+    t = _time(t)
+    t_c = design.prescribed_time
+    before = t < t_c
+    gap = np.where(before, t_c - t, 1.0)
+    arg = np.where(before, t / gap, 0.0)
+    s = np.where(before, np.tanh(arg), 1.0)
+    # sech^2(a) = 4 exp(-2a) / (1 + exp(-2a))^2 for a >= 0, written without cancellation.
+    a_abs = np.abs(arg)
+    q = np.exp(-2.0 * a_abs)
+    sech2 = 4.0 * q / (1.0 + q) ** 2
+    s_dot = np.where(before, sech2 * t_c / gap**2, 0.0)
+    return s, s_dot
+
+
+def reach_tube(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
+    """Reachability tube ``rho_L``, ``rho_U`` of eq. (4) and their time derivatives.
+
+    Parameters
+    ----------
+    design : TubeDesign
+    t : array_like, shape (N,)
+
+    Returns
+    -------
+    rho_L, rho_U, rho_L_dot, rho_U_dot : ndarray, shape (N, n)
+        State units and state units per second.
+    """
+    s, s_dot = tanh_progress(design, t)
+    x0_l, x0_u = np.array(design.initial_lower), np.array(design.initial_upper)
+    t_l, t_u = np.array(design.target_lower), np.array(design.target_upper)
+    rho_l = (t_l - x0_l) * s[:, None] + x0_l
+    rho_u = (t_u - x0_u) * s[:, None] + x0_u
+    return rho_l, rho_u, (t_l - x0_l) * s_dot[:, None], (t_u - x0_u) * s_dot[:, None]
+
+
+def bump(t, center: float, radius: float, sharpness: float) -> tuple[Array, Array]:
+    """The bump of eqs. (7)-(8), ``exp(-k (t-m)^2 / (r^2 - (t-m)^2))`` in ``|t-m| < r``, else 0.
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+    center, radius, sharpness : float
+        ``m^j``, ``r^j`` (positive) and ``k^j``.
+
+    Returns
+    -------
+    b, b_dot : ndarray, shape (N,)
+        Value in ``[0, 1]`` and its time derivative, 1/s.
+    """
+    t = _time(t)
+    d = t - center
+    inside = np.abs(d) < radius
+    denom = np.where(inside, radius**2 - d**2, 1.0)
+    b = np.where(inside, np.exp(-sharpness * d**2 / denom), 0.0)
+    b_dot = np.where(inside, b * (-sharpness) * 2.0 * d * radius**2 / denom**2, 0.0)
+    return b, b_dot
+
+
+def smooth_max(values: Array, nu: float, axis: int = -1) -> tuple[Array, Array]:
+    """``(1/nu) ln(sum_j exp(nu a_j))``, the paper's smooth max, and its weights.
+
+    Returns
+    -------
+    value : ndarray
+        ``values`` reduced over ``axis``.
+    weights : ndarray
+        ``d value / d a_j`` (non-negative, summing to 1 over ``axis``).
+    """
+    value = np.logaddexp.reduce(nu * values, axis=axis) / nu
+    weights = np.exp(nu * (values - np.expand_dims(value, axis)))
+    return value, weights
+
+
+def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
+    """Holistic circumvent function ``beta_L``, ``beta_U`` of eq. (9) and derivatives.
+
+    Bumps on the same bound are combined by the smooth max (lower) or min (upper);
+    a bound with no bump is the state-space bound.
+
+    Returns
+    -------
+    beta_L, beta_U, beta_L_dot, beta_U_dot : ndarray, shape (N, n)
+    """
+    t = _time(t)
+    n = design.dimension
+    out = []
+    for side, bounds, sign in ((LOWER, design.state_lower, 1.0),
+                               ("upper", design.state_upper, -1.0)):
+        value = np.tile(np.array(bounds, dtype=float), (t.size, 1))
+        rate = np.zeros((t.size, n))
+        for i in range(n):
+            members = design.circumvents_on(i, side)
+            if not members:
+                continue
+            terms, rates = [], []
+            for c in members:
+                b, b_dot = bump(t, c.center, c.radius, design.circumvent_sharpness)
+                terms.append(sign * (c.base + sign * c.height * b))
+                rates.append(sign * sign * c.height * b_dot)
+            stacked = np.stack(terms, axis=-1)
+            v, w = smooth_max(stacked, design.smoothness)
+            value[:, i] = sign * v
+            rate[:, i] = sign * np.sum(w * np.stack(rates, axis=-1), axis=-1)
+        out.append((value, rate))
+    (beta_l, beta_l_dot), (beta_u, beta_u_dot) = out
+    return beta_l, beta_u, beta_l_dot, beta_u_dot
+
+
+def conflict_distance(design: TubeDesign, t) -> Array:
+    """``psi = [beta_U - rho_L, rho_U - beta_L]`` of eq. (11), shape (N, 2n)."""
+    rho_l, rho_u, _, _ = reach_tube(design, t)
+    beta_l, beta_u, _, _ = circumvent(design, t)
+    return np.concatenate([beta_u - rho_l, rho_u - beta_l], axis=1)
+
+
+def adaptive_law(design: TubeDesign, t, alpha) -> tuple[Array, Array]:
+    """Adaptive law (11): ``alpha_dot = theta / (psi + alpha)^2 - kappa alpha``.
+
+    ``theta = theta0 (1 - tanh(psi - mu))`` (``sign`` approximated by ``tanh``).
+
+    Parameters
+    ----------
+    t : array_like, shape (N,)
+    alpha : array_like, shape (N, 2n)
+        ``[alpha_L, alpha_U]``, valid where ``psi + alpha > 0``.
+
+    Returns
+    -------
+    alpha_dot : ndarray, shape (N, 2n)
+    alpha_dot_jacobian : ndarray, shape (N, 2n)
+        The diagonal of ``d alpha_dot / d alpha``: ``-2 theta / (psi + alpha)^3 - kappa``.
+    """
+    t = _time(t)
+    psi = conflict_distance(design, t)
+    alpha = _rows(alpha, t.size, psi.shape[1])
+    theta = design.theta0 * (1.0 - np.tanh(psi - design.mu))
+    z = psi + alpha
+    return theta / z**2 - design.kappa * alpha, -2.0 * theta / z**3 - design.kappa
+
+
+def adaptive_tube(design: TubeDesign, t, alpha) -> tuple[Array, Array, Array, Array]:
+    """Adaptive tube (10): ``gamma_L = max~(rho_L - alpha_L, beta_L)``, ``gamma_U = min~(rho_U + alpha_U, beta_U)``.
+
+    The derivatives are total time derivatives along the adaptive law (11).
+
+    Returns
+    -------
+    gamma_L, gamma_U, gamma_L_dot, gamma_U_dot : ndarray, shape (N, n)
+    """
+    t = _time(t)
+    n = design.dimension
+    rho_l, rho_u, rho_l_dot, rho_u_dot = reach_tube(design, t)
+    beta_l, beta_u, beta_l_dot, beta_u_dot = circumvent(design, t)
+    alpha = _rows(alpha, t.size, 2 * n)
+    alpha_dot, _ = adaptive_law(design, t, alpha)
+    nu = design.smoothness
+    gamma_l, w_l = smooth_max(np.stack([rho_l - alpha[:, :n], beta_l], -1), nu)
+    neg_u, w_u = smooth_max(np.stack([-(rho_u + alpha[:, n:]), -beta_u], -1), nu)
+    gamma_l_dot = w_l[..., 0] * (rho_l_dot - alpha_dot[:, :n]) + w_l[..., 1] * beta_l_dot
+    gamma_u_dot = w_u[..., 0] * (rho_u_dot + alpha_dot[:, n:]) + w_u[..., 1] * beta_u_dot
+    return gamma_l, -neg_u, gamma_l_dot, gamma_u_dot
+
+
+def error_transform(design: TubeDesign, x, t, alpha) -> tuple[Array, Array, Array, Array]:
+    """Normalized error ``e``, transformed error ``epsilon`` and ``xi`` of section IV.
+
+    ``e = gamma_d^{-1} (2 x - gamma_s)``, ``epsilon_i = ln((1 + e_i) / (1 - e_i))``,
+    ``xi = diag(4 / (gamma_d_i (1 - e_i^2)))`` (the element-wise reading of
+    ``4 gamma_d^{-1} (I - e e^T)^{-1}``, see the design notes).
+
+    Parameters
+    ----------
+    x : array_like, shape (N, n)
+    t : array_like, shape (N,)
+    alpha : array_like, shape (N, 2n)
+
+    Returns
+    -------
+    e, epsilon, xi : ndarray, shape (N, n)
+    epsilon_jacobian : ndarray, shape (N, n, n)
+        ``d epsilon / d x`` written out from the chain rule (diagonal).
+    """
+    t = _time(t)
+    gamma_l, gamma_u, _, _ = adaptive_tube(design, t, alpha)
+    x = _rows(x, t.size, design.dimension)
+    gamma_d = gamma_u - gamma_l
+    e = (2.0 * x - (gamma_u + gamma_l)) / gamma_d
+    epsilon = np.log((1.0 + e) / (1.0 - e))
+    xi = 4.0 / (gamma_d * (1.0 - e**2))
+    d_eps_d_e = 1.0 / (1.0 + e) + 1.0 / (1.0 - e)
+    jac = np.zeros((t.size, design.dimension, design.dimension))
+    idx = np.arange(design.dimension)
+    jac[:, idx, idx] = d_eps_d_e * 2.0 / gamma_d
+    return e, epsilon, xi, jac
+
+
+def control(design: TubeDesign, x, t, alpha) -> Array:
+    """Control law (13): ``u = -k xi epsilon``, shape (N, n)."""
+    _, epsilon, xi, _ = error_transform(design, x, t, alpha)
+    return -design.gain * xi * epsilon
+
+
+def alpha_step(design: TubeDesign, t, dt, alpha) -> Array:
+    """Implicit (backward Euler) step of the adaptive law (11) from ``t`` to ``t + dt``.
+
+    Solves ``a = alpha + dt * alpha_dot(t + dt, a)`` for each component by bisection.
+    With ``c = 1 + kappa dt``, ``A = dt theta`` and ``z = psi + a`` the equation is
+    ``c z^3 - (c psi + alpha) z^2 - A = 0``, whose positive root is unique and lies in
+    ``[max(p/c, 0), max(p/c, 0) + (A/c)^(1/3)]``, ``p = c psi + alpha``; in ``a`` the
+    bracket is also bounded below by ``alpha / c`` and ``-psi``.
+
+    Parameters
+    ----------
+    t, dt : array_like, shape (N,)
+        Seconds; ``dt > 0``.
+    alpha : array_like, shape (N, 2n)
+
+    Returns
+    -------
+    alpha_next : ndarray, shape (N, 2n)
+    """
+    t = _time(t)
+    dt = np.broadcast_to(np.asarray(dt, dtype=float), t.shape)
+    psi = conflict_distance(design, t + dt)
+    alpha = _rows(alpha, t.size, psi.shape[1])
+    theta = design.theta0 * (1.0 - np.tanh(psi - design.mu))
+    h = dt[:, None]
+    c = 1.0 + design.kappa * h
+    a_coef = h * theta
+    z_low = np.maximum((c * psi + alpha) / c, 0.0)
+    lo = np.maximum(np.maximum(alpha / c, -psi), z_low - psi)
+    hi = np.maximum(lo, z_low + np.cbrt(a_coef / c) - psi)
+
+    def residual(a: Array) -> Array:
+        return c * a - alpha - a_coef / (psi + a) ** 2
+
+    for _ in range(2100):  # at most the number of doubles between lo and hi
+        mid = 0.5 * (lo + hi)
+        if np.all((mid == lo) | (mid == hi)):
+            break
+        with np.errstate(divide="ignore"):
+            below = residual(mid) < 0
+        lo = np.where(below, mid, lo)
+        hi = np.where(below, hi, mid)
+    with np.errstate(divide="ignore"):
+        pick_lo = np.abs(residual(lo)) < np.abs(residual(hi))
+    return np.where(pick_lo, lo, hi)
+
+
+def controller_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, Array]:
+    """One step of the deployed controller: ``u`` at ``(x, t, alpha)`` and the next ``alpha``.
+
+    ``u`` follows law (13) with ``e`` clamped to ``[-E_MAX, E_MAX]`` and ``gamma_d``
+    floored at ``GAMMA_D_MIN``, so it is finite outside the tube too.
+
+    Returns
+    -------
+    u : ndarray, shape (N, n)
+    alpha_next : ndarray, shape (N, 2n)
+    inside : ndarray, shape (N,)
+        1.0 where ``|e_i| < 1`` and ``gamma_d_i > 0`` for every ``i``, else 0.0.
+    """
+    t = _time(t)
+    gamma_l, gamma_u, _, _ = adaptive_tube(design, t, alpha)
+    x = _rows(x, t.size, design.dimension)
+    gamma_d = gamma_u - gamma_l
+    width = np.maximum(gamma_d, GAMMA_D_MIN)
+    e = (2.0 * x - (gamma_u + gamma_l)) / width
+    inside = np.all((np.abs(e) < 1.0) & (gamma_d > 0.0), axis=1).astype(float)
+    e_c = np.clip(e, -E_MAX, E_MAX)
+    epsilon = np.log((1.0 + e_c) / (1.0 - e_c))
+    xi = 4.0 / (width * (1.0 - e_c**2))
+    return -design.gain * xi * epsilon, alpha_step(design, t, dt, alpha), inside

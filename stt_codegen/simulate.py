@@ -1,0 +1,192 @@
+"""Closed-loop simulation: a sampled controller on a continuous plant, and Definition 2.1.
+
+The controller runs at ``rate_hz``: at each sampling instant ``t_k`` it reads ``x(t_k)``,
+computes ``u_k`` and its next ``alpha``; ``u_k`` is held until ``t_{k+1}``. The plant, a
+python-control ``NonlinearIOSystem``, is integrated over each hold interval by the
+classical Runge-Kutta method with :data:`SUBSTEPS` steps (its accuracy against an
+adaptive solver at tight tolerance is tested).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from .backends import STATUS_OK, make_controller
+from .spec import Box
+from .plants import make_plant
+from .spec import Spec
+from .tube import TubeDesign
+
+#: Runge-Kutta steps per sampling period.
+SUBSTEPS = 2
+
+
+@dataclass
+class Trajectory:
+    """Sampled closed-loop signals: ``t`` (N,), ``x`` (N, n), ``u`` (N, n), ``alpha`` (N, 2n), ``status`` (N,)."""
+
+    t: np.ndarray
+    x: np.ndarray
+    u: np.ndarray
+    alpha: np.ndarray
+    status: np.ndarray
+
+
+@dataclass
+class SimulationResult:
+    """Outcome of a closed-loop run, judged by Definition 2.1 on ``[0, t_c]``.
+
+    Attributes
+    ----------
+    spec, backend : str
+    satisfied : bool
+        ``reached`` and not ``collision`` and not ``left_state_space``.
+    reached : bool
+        The state entered the target set no later than ``t_c``.
+    reach_time : float or None
+        First sampled instant in the target, seconds.
+    prescribed_time : float
+    collision : bool
+        The state met an obstacle on ``[0, t_c]`` (checked at every integration point).
+    min_obstacle_clearance : float or None
+        Smallest distance from the state to an obstacle box on ``[0, t_c]``, state units
+        (``None`` without obstacles).
+    left_state_space : bool
+    stayed_in_tube : bool
+        Every controller step on ``[0, horizon]`` reported the state inside the tube.
+    max_abs_u : list of float
+        Per input, over the run.
+    steps : int
+        Controller steps taken.
+    """
+
+    spec: str
+    backend: str
+    satisfied: bool
+    reached: bool
+    reach_time: float | None
+    prescribed_time: float
+    collision: bool
+    min_obstacle_clearance: float | None
+    left_state_space: bool
+    stayed_in_tube: bool
+    max_abs_u: list[float]
+    steps: int
+    trajectory: Trajectory | None = field(default=None, repr=False)
+
+    def to_json(self) -> dict:
+        """The result as a JSON-ready dict (without the trajectory)."""
+        data = asdict(self)
+        data.pop("trajectory")
+        return data
+
+
+def point_clearance(points: np.ndarray, box: Box) -> np.ndarray:
+    """Euclidean distance from each point (N, n) to ``box``; minus the depth inside it."""
+    gaps = np.maximum(np.array(box.lower) - points, points - np.array(box.upper))
+    outside = np.sqrt(np.sum(np.maximum(gaps, 0.0) ** 2, axis=1))
+    return np.where(np.any(gaps > 0, axis=1), outside, gaps.max(axis=1))
+
+
+def _rk4(rhs, t: float, x: np.ndarray, u: np.ndarray, h: float) -> np.ndarray:
+    k1 = rhs(t, x, u)
+    k2 = rhs(t + h / 2, x + h / 2 * k1, u)
+    k3 = rhs(t + h / 2, x + h / 2 * k2, u)
+    k4 = rhs(t + h, x + h * k3, u)
+    return x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+
+def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
+             horizon: float | None = None, seed: int = 0) -> SimulationResult:
+    """Run the sampled controller of ``backend`` against the spec's plant.
+
+    Parameters
+    ----------
+    spec : Spec
+    design : TubeDesign
+        From :func:`stt_codegen.design.design_tube`.
+    backend : str
+        A name from :func:`stt_codegen.backends.backend_names`.
+    horizon : float, optional
+        Simulated time, seconds; default ``t_c``. Definition 2.1 is judged on
+        ``[0, min(horizon, t_c)]``; a horizon shorter than ``t_c`` cannot satisfy it.
+    seed : int
+        Seed of the disturbance.
+
+    Returns
+    -------
+    SimulationResult
+
+    Raises
+    ------
+    SpecError
+        Unknown backend, or a non-positive horizon.
+    """
+    from .errors import SpecError
+    t_c = spec.prescribed_time
+    horizon = t_c if horizon is None else float(horizon)
+    if not math.isfinite(horizon) or horizon <= 0:
+        raise SpecError("--horizon", f"must be a positive number of seconds, got {horizon!r}")
+    controller = make_controller(backend, design)
+    plant = make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed)
+
+    def rhs(t, x, u):
+        return plant.dynamics(t, x, u)
+
+    n = spec.dimension
+    dt = 1.0 / design.rate_hz
+    steps = int(math.ceil(horizon * design.rate_hz - 1e-9))
+    boxes = spec.obstacle_boxes()
+    lo, hi = np.array(spec.state_space.lower), np.array(spec.state_space.upper)
+    t_lo, t_hi = np.array(spec.target_set.lower), np.array(spec.target_set.upper)
+
+    ts = np.arange(steps + 1) * dt
+    xs = np.zeros((steps + 1, n))
+    us = np.zeros((steps + 1, n))
+    alphas = np.zeros((steps + 1, 2 * n))
+    status = np.zeros(steps + 1, dtype=int)
+    x = np.array(spec.initial_state, dtype=float)
+    alpha = np.zeros(2 * n)
+    dense = [x[None, :]]
+    dense_t = [np.zeros(1)]
+    for k in range(steps + 1):
+        t = ts[k]
+        xs[k], alphas[k] = x, alpha
+        u, alpha_next, code = controller.step(x, t, dt, alpha)
+        us[k], status[k] = u, code
+        if k == steps:
+            break
+        h = dt / SUBSTEPS
+        points = []
+        for m in range(SUBSTEPS):
+            x = _rk4(rhs, t + m * h, x, u, h)
+            points.append(x)
+        dense.append(np.array(points))
+        dense_t.append(t + h * np.arange(1, SUBSTEPS + 1))
+        alpha = alpha_next
+    path = np.vstack(dense)
+    path_t = np.concatenate(dense_t)
+    judged = path_t <= t_c + 1e-12
+    within = path[judged]
+
+    in_target = np.all((xs >= t_lo) & (xs <= t_hi), axis=1) & (ts <= t_c + 1e-12)
+    reached = bool(in_target.any())
+    reach_time = float(ts[int(np.argmax(in_target))]) if reached else None
+    if boxes:
+        clearance = np.min([point_clearance(within, b) for b in boxes], axis=0)
+        min_clear = float(clearance.min())
+        collision = bool(min_clear <= 0.0)
+    else:
+        min_clear, collision = None, False
+    left = bool(np.any((within < lo) | (within > hi)))
+    satisfied = reached and not collision and not left and horizon >= t_c
+    return SimulationResult(
+        spec=spec.name, backend=backend, satisfied=satisfied, reached=reached,
+        reach_time=reach_time, prescribed_time=t_c, collision=collision,
+        min_obstacle_clearance=min_clear, left_state_space=left,
+        stayed_in_tube=bool(np.all(status == STATUS_OK)),
+        max_abs_u=[float(v) for v in np.abs(us).max(axis=0)], steps=steps,
+        trajectory=Trajectory(ts, xs, us, alphas, status))
