@@ -48,14 +48,14 @@ from __future__ import annotations
 
 import keyword
 import re
-from typing import Callable, Dict, List, Sequence, Set, Union
+from typing import Callable, Dict, List, Sequence, Set, Tuple, Union
 
 import casadi
 
 from .errors import EmitError
 from .instructions import IOSpec, Program, lower
 from .printer import FunctionLike, InstructionPrinter
-from .python_helpers import HELPER_DEPENDENCIES, HELPER_SOURCE, HELPERS
+from .python_helpers import HELPER_DEPENDENCIES, HELPERS
 
 _RESERVED = frozenset({"math", "float", "len", "ValueError"})
 _REGISTER = re.compile(r"^w[0-9]+$")
@@ -147,7 +147,7 @@ class PythonPrinter(InstructionPrinter):
         self._names: Dict[str, str] = {}
 
     # ------------------------------------------------------------------ ops
-    def op_expression(self, op: str, operands) -> str:  # noqa: D102 (see base class)
+    def op_expression(self, op: str, operands: Tuple[str, ...]) -> str:  # noqa: D102
         helper = self.helper_functions.get(op)
         if helper is not None and getattr(self, "_print_op_" + op, None) is None:
             self._use(helper)
@@ -259,7 +259,7 @@ class PythonPrinter(InstructionPrinter):
         """Python name of the generated function (sanitised CasADi name)."""
         return python_identifier(program.name, set())
 
-    def doprint(self, functions) -> str:  # noqa: D102
+    def doprint(self, functions: Union[FunctionLike, Sequence[FunctionLike]]) -> str:  # noqa: D102
         self._helpers = set()
         return super().doprint(functions)
 
