@@ -12,11 +12,43 @@ Shapes: ``t`` is ``(N,)``; ``x`` is ``(N, n)``; ``alpha`` is ``(N, 2n)`` and hol
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .tube import E_MAX, GAMMA_D_MIN, LOWER, TubeDesign
 
 Array = np.ndarray
+
+
+def _libm(function):
+    """Element-wise ``function`` from Python's ``math`` module (the C library's libm).
+
+    numpy's own ``exp``/``log``/``tanh`` use SIMD kernels that differ from libm by an ulp
+    or so; CasADi and the generated C call libm. Using libm here keeps the oracle's
+    rounding identical where the formula is, so comparisons can be tight even where the
+    outputs are ill-conditioned (narrow tubes, ``|e|`` near 1).
+    """
+    vectorized = np.vectorize(function, otypes=[float])
+
+    def apply(x):
+        x = np.asarray(x, dtype=float)
+        return vectorized(x) if x.size else x.copy()
+
+    apply.__name__ = function.__name__
+    return apply
+
+
+def _safe(function, domain):
+    def wrapped(x):
+        return function(x) if domain(x) else math.nan
+    return wrapped
+
+
+exp = _libm(lambda v: math.exp(v) if v < 709.0 else math.inf)
+log = _libm(_safe(math.log, lambda v: v > 0))
+log1p = _libm(_safe(math.log1p, lambda v: v > -1))
+tanh = _libm(math.tanh)
 
 
 def _time(t) -> Array:
@@ -45,10 +77,10 @@ def tanh_progress(design: TubeDesign, t) -> tuple[Array, Array]:
     before = t < t_c
     gap = np.where(before, t_c - t, 1.0)
     arg = np.where(before, t / gap, 0.0)
-    s = np.where(before, np.tanh(arg), 1.0)
+    s = np.where(before, tanh(arg), 1.0)
     # sech^2(a) = 4 exp(-2a) / (1 + exp(-2a))^2 for a >= 0, written without cancellation.
     a_abs = np.abs(arg)
-    q = np.exp(-2.0 * a_abs)
+    q = exp(-2.0 * a_abs)
     sech2 = 4.0 * q / (1.0 + q) ** 2
     s_dot = np.where(before, sech2 * t_c / gap**2, 0.0)
     return s, s_dot
@@ -93,24 +125,39 @@ def bump(t, center: float, radius: float, sharpness: float) -> tuple[Array, Arra
     d = t - center
     inside = np.abs(d) < radius
     denom = np.where(inside, radius**2 - d**2, 1.0)
-    b = np.where(inside, np.exp(-sharpness * d**2 / denom), 0.0)
+    b = np.where(inside, exp(-sharpness * d**2 / denom), 0.0)
     b_dot = np.where(inside, b * (-sharpness) * 2.0 * d * radius**2 / denom**2, 0.0)
     return b, b_dot
 
 
 def smooth_max(values: Array, nu: float, axis: int = -1) -> tuple[Array, Array]:
-    """``(1/nu) ln(sum_j exp(nu a_j))``, the paper's smooth max, and its weights.
+    """The paper's smooth max ``(1/nu) ln(sum_j exp(nu a_j))`` and its weights.
+
+    Evaluated without overflow: ``max(a, b) + log1p(exp(-nu |a - b|)) / nu`` for two
+    values, ``M + ln(sum_j exp(nu (a_j - M))) / nu`` with ``M = max_j a_j`` for more.
 
     Returns
     -------
     value : ndarray
         ``values`` reduced over ``axis``.
     weights : ndarray
-        ``d value / d a_j`` (non-negative, summing to 1 over ``axis``).
+        ``d value / d a_j = exp(nu (a_j - value))`` (non-negative, summing to 1).
     """
-    value = np.logaddexp.reduce(nu * values, axis=axis) / nu
-    weights = np.exp(nu * (values - np.expand_dims(value, axis)))
-    return value, weights
+    values = np.moveaxis(np.asarray(values, dtype=float), axis, -1)
+    count = values.shape[-1]
+    if count == 1:
+        value = values[..., 0]
+    elif count == 2:
+        a, b = values[..., 0], values[..., 1]
+        value = np.maximum(a, b) + log1p(exp(-nu * np.abs(a - b))) / nu
+    else:
+        top = values.max(axis=-1)
+        total = np.zeros_like(top)
+        for j in range(count):
+            total = total + exp(nu * (values[..., j] - top))
+        value = top + log(total) / nu
+    weights = exp(nu * (values - value[..., None]))
+    return value, np.moveaxis(weights, -1, axis)
 
 
 def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
@@ -175,7 +222,7 @@ def adaptive_law(design: TubeDesign, t, alpha) -> tuple[Array, Array]:
     t = _time(t)
     psi = conflict_distance(design, t)
     alpha = _rows(alpha, t.size, psi.shape[1])
-    theta = design.theta0 * (1.0 - np.tanh(psi - design.mu))
+    theta = design.theta0 * (1.0 - tanh(psi - design.mu))
     z = psi + alpha
     return theta / z**2 - design.kappa * alpha, -2.0 * theta / z**3 - design.kappa
 
@@ -227,7 +274,7 @@ def error_transform(design: TubeDesign, x, t, alpha) -> tuple[Array, Array, Arra
     x = _rows(x, t.size, design.dimension)
     gamma_d = gamma_u - gamma_l
     e = (2.0 * x - (gamma_u + gamma_l)) / gamma_d
-    epsilon = np.log((1.0 + e) / (1.0 - e))
+    epsilon = log((1.0 + e) / (1.0 - e))
     xi = 4.0 / (gamma_d * (1.0 - e**2))
     d_eps_d_e = 1.0 / (1.0 + e) + 1.0 / (1.0 - e)
     jac = np.zeros((t.size, design.dimension, design.dimension))
@@ -242,14 +289,49 @@ def control(design: TubeDesign, x, t, alpha) -> Array:
     return -design.gain * xi * epsilon
 
 
-def alpha_step(design: TubeDesign, t, dt, alpha) -> Array:
-    """Implicit (backward Euler) step of the adaptive law (11) from ``t`` to ``t + dt``.
+def implicit_alpha_root(alpha: Array, psi: Array, theta: Array, dt: Array,
+                        kappa: float) -> Array:
+    """Root of the backward-Euler equation of (11), ``a = alpha + dt (theta/(psi+a)^2 - kappa a)``.
 
-    Solves ``a = alpha + dt * alpha_dot(t + dt, a)`` for each component by bisection.
     With ``c = 1 + kappa dt``, ``A = dt theta`` and ``z = psi + a`` the equation is
     ``c z^3 - (c psi + alpha) z^2 - A = 0``, whose positive root is unique and lies in
     ``[max(p/c, 0), max(p/c, 0) + (A/c)^(1/3)]``, ``p = c psi + alpha``; in ``a`` the
-    bracket is also bounded below by ``alpha / c`` and ``-psi``.
+    bracket is also bounded below by ``alpha / c`` and ``-psi``. Solved by bisection to
+    adjacent floating-point numbers.
+
+    Parameters
+    ----------
+    alpha, psi, theta, dt : array_like, broadcastable
+    kappa : float
+
+    Returns
+    -------
+    ndarray
+    """
+    alpha, psi, theta, dt = np.broadcast_arrays(*(np.asarray(v, dtype=float)
+                                                  for v in (alpha, psi, theta, dt)))
+    c = 1.0 + kappa * dt
+    a_coef = dt * theta
+    z_low = np.maximum((c * psi + alpha) / c, 0.0)
+    lo = np.maximum(np.maximum(alpha / c, -psi), z_low - psi)
+    hi = np.maximum(lo, z_low + np.cbrt(a_coef / c) - psi)
+
+    def residual(a: Array) -> Array:
+        with np.errstate(divide="ignore"):
+            return c * a - alpha - a_coef / (psi + a) ** 2
+
+    for _ in range(2100):  # never more than the doubles between lo and hi
+        mid = 0.5 * (lo + hi)
+        if np.all((mid == lo) | (mid == hi)):
+            break
+        below = residual(mid) < 0
+        lo = np.where(below, mid, lo)
+        hi = np.where(below, hi, mid)
+    return np.where(np.abs(residual(lo)) < np.abs(residual(hi)), lo, hi)
+
+
+def alpha_step(design: TubeDesign, t, dt, alpha) -> Array:
+    """Implicit (backward Euler) step of the adaptive law (11) from ``t`` to ``t + dt``.
 
     Parameters
     ----------
@@ -260,33 +342,14 @@ def alpha_step(design: TubeDesign, t, dt, alpha) -> Array:
     Returns
     -------
     alpha_next : ndarray, shape (N, 2n)
+        :func:`implicit_alpha_root` with ``psi`` and ``theta`` at ``t + dt``.
     """
     t = _time(t)
     dt = np.broadcast_to(np.asarray(dt, dtype=float), t.shape)
     psi = conflict_distance(design, t + dt)
     alpha = _rows(alpha, t.size, psi.shape[1])
-    theta = design.theta0 * (1.0 - np.tanh(psi - design.mu))
-    h = dt[:, None]
-    c = 1.0 + design.kappa * h
-    a_coef = h * theta
-    z_low = np.maximum((c * psi + alpha) / c, 0.0)
-    lo = np.maximum(np.maximum(alpha / c, -psi), z_low - psi)
-    hi = np.maximum(lo, z_low + np.cbrt(a_coef / c) - psi)
-
-    def residual(a: Array) -> Array:
-        return c * a - alpha - a_coef / (psi + a) ** 2
-
-    for _ in range(2100):  # at most the number of doubles between lo and hi
-        mid = 0.5 * (lo + hi)
-        if np.all((mid == lo) | (mid == hi)):
-            break
-        with np.errstate(divide="ignore"):
-            below = residual(mid) < 0
-        lo = np.where(below, mid, lo)
-        hi = np.where(below, hi, mid)
-    with np.errstate(divide="ignore"):
-        pick_lo = np.abs(residual(lo)) < np.abs(residual(hi))
-    return np.where(pick_lo, lo, hi)
+    theta = design.theta0 * (1.0 - tanh(psi - design.mu))
+    return implicit_alpha_root(alpha, psi, theta, dt[:, None], design.kappa)
 
 
 def controller_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, Array]:
@@ -310,6 +373,6 @@ def controller_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, 
     e = (2.0 * x - (gamma_u + gamma_l)) / width
     inside = np.all((np.abs(e) < 1.0) & (gamma_d > 0.0), axis=1).astype(float)
     e_c = np.clip(e, -E_MAX, E_MAX)
-    epsilon = np.log((1.0 + e_c) / (1.0 - e_c))
+    epsilon = log((1.0 + e_c) / (1.0 - e_c))
     xi = 4.0 / (width * (1.0 - e_c**2))
     return -design.gain * xi * epsilon, alpha_step(design, t, dt, alpha), inside

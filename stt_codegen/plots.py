@@ -1,0 +1,78 @@
+"""Figures of a closed-loop run, in the manner of the paper's Fig. 3."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.patches import Rectangle  # noqa: E402
+
+from . import reference  # noqa: E402
+from .simulate import SimulationResult  # noqa: E402
+from .spec import Box, Spec  # noqa: E402
+from .tube import TubeDesign  # noqa: E402
+
+
+def _rect(ax, box: Box, dims: tuple[int, int], **style) -> None:
+    i, j = dims
+    ax.add_patch(Rectangle((box.lower[i], box.lower[j]), box.upper[i] - box.lower[i],
+                           box.upper[j] - box.lower[j], **style))
+
+
+def plot_run(spec: Spec, design: TubeDesign, result: SimulationResult, path: str | Path) -> Path:
+    """Write a PNG: the arena with the trajectory, and each dimension's tube against time.
+
+    Parameters
+    ----------
+    spec, design : Spec, TubeDesign
+    result : SimulationResult
+        With its trajectory.
+    path : str or path
+        Output file; its folder must exist.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    traj = result.trajectory
+    n = spec.dimension
+    g_l, g_u, _, _ = reference.adaptive_tube(design, traj.t, traj.alpha)
+    fig = plt.figure(figsize=(11, 2.6 * max(n, 2)), layout="constrained")
+    grid = fig.add_gridspec(n, 2, width_ratios=[1.1, 1.4])
+    if n >= 2:
+        ax = fig.add_subplot(grid[:, 0])
+        dims = (0, 1)
+        _rect(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
+        for j, box in enumerate(spec.obstacle_boxes()):
+            _rect(ax, box, dims, fc="0.55", ec="0.3", label="obstacles" if j == 0 else None)
+            ax.annotate(f"U{j + 1}", box.center[:2], ha="center", va="center", color="white")
+        _rect(ax, spec.initial_set, dims, fc="tab:blue", alpha=0.3, label="initial set")
+        _rect(ax, spec.target_set, dims, fc="tab:green", alpha=0.35, label="target")
+        ax.plot(traj.x[:, 0], traj.x[:, 1], "k--", lw=1.2, label="trajectory")
+        ax.plot(*traj.x[0, :2], "o", color="tab:blue")
+        ax.set_xlabel("$x_1$")
+        ax.set_ylabel("$x_2$")
+        ax.set_aspect("equal")
+        ax.legend(loc="lower right", fontsize=7)
+        verdict = "satisfied" if result.satisfied else "NOT satisfied"
+        ax.set_title(f"{spec.name}: {verdict}, reach {result.reach_time} s")
+    for i in range(n):
+        ax = fig.add_subplot(grid[i, 1])
+        ax.fill_between(traj.t, g_l[:, i], g_u[:, i], color="tab:orange", alpha=0.25,
+                        label=r"tube $[\gamma_L, \gamma_U]$")
+        ax.plot(traj.t, g_l[:, i], color="tab:orange", lw=0.8)
+        ax.plot(traj.t, g_u[:, i], color="tab:orange", lw=0.8)
+        ax.plot(traj.t, traj.x[:, i], "k", lw=1.0, label=f"$x_{i + 1}$")
+        ax.axvline(spec.prescribed_time, color="tab:red", lw=0.8, ls=":", label="$t_c$")
+        ax.set_ylabel(f"$x_{i + 1}$")
+        if i == n - 1:
+            ax.set_xlabel("t [s]")
+        if i == 0:
+            ax.legend(loc="best", fontsize=7)
+    out = Path(path)
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return out
