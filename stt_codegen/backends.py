@@ -60,9 +60,21 @@ class CasadiController:
                 STATUS_OK if float(inside) else STATUS_OUTSIDE_TUBE)
 
 
+def _generated_c(design: TubeDesign) -> Controller:
+    from .codegen.controllers import CController
+    return CController(design)
+
+
+def _generated_python(design: TubeDesign) -> Controller:
+    from .codegen.controllers import GeneratedPythonController
+    return GeneratedPythonController(design)
+
+
 _FACTORIES: dict[str, Callable[[TubeDesign], Controller]] = {
     "reference": ReferenceController,
     "casadi": CasadiController,
+    "c": _generated_c,
+    "python": _generated_python,
 }
 
 

@@ -156,8 +156,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def default_backend() -> str:
     """The backend ``simulate`` and ``demo`` use unless told otherwise."""
-    from .backends import backend_names
-    return "c" if "c" in backend_names() else "reference"
+    return "c"
 
 
 def main(argv: Sequence[str] | None = None) -> int:
