@@ -65,8 +65,16 @@ def _summary_line(result) -> str:
 SUMMARY_HEADER = f"{'case':<22} {'satisfied':<9} {'reach [s]':>9} {'clearance':>9}   max |u|"
 
 
+def _check_output_folder(path: str | None) -> None:
+    if path:
+        folder = Path(path).parent
+        if not folder.is_dir():
+            raise SpecError("--plot", f"folder {str(folder)!r} does not exist")
+
+
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from .simulate import simulate
+    _check_output_folder(args.plot)
     spec, design = _design(args.spec)
     result = simulate(spec, design, backend=args.backend, horizon=args.horizon, seed=args.seed)
     if args.plot:

@@ -1,0 +1,98 @@
+"""The command line: JSON report, exit codes 0/1/2, errors without tracebacks, demo."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REQUIRED_KEYS = {"spec", "backend", "satisfied", "reached", "reach_time", "prescribed_time",
+                 "collision", "min_obstacle_clearance", "left_state_space", "stayed_in_tube",
+                 "max_abs_u", "steps"}
+
+
+def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "stt_codegen.cli", *args], capture_output=True,
+                          text=True, cwd=cwd, timeout=600)
+
+
+def test_cases_lists_bundled_specs():
+    out = run("cases")
+    assert out.returncode == 0
+    assert out.stdout.split() == ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3"]
+
+
+def test_simulate_json_reports_definition_2_1():
+    out = run("simulate", "omnirobot-s3", "--backend", "casadi", "--json")
+    assert out.returncode == 0, out.stderr
+    data = json.loads(out.stdout)
+    assert REQUIRED_KEYS <= set(data)
+    assert data["satisfied"] is True and data["reach_time"] < data["prescribed_time"] == 9.0
+    assert data["backend"] == "casadi" and data["steps"] == 9000
+
+
+def test_simulate_exit_1_when_not_satisfied():
+    out = run("simulate", "omnirobot-s1", "--backend", "casadi", "--horizon", "2", "--json")
+    assert out.returncode == 1
+    assert json.loads(out.stdout)["satisfied"] is False
+
+
+BAD_SPEC = """name = "x"
+prescribed_time = -3
+[state_space]
+lower = [0.0]
+upper = [1.0]
+[initial]
+lower = [0.0]
+upper = [0.2]
+[target]
+lower = [0.8]
+upper = [1.0]
+"""
+
+
+@pytest.mark.parametrize("args, message", [
+    (["simulate", "no-such-case"], "no bundled case and no file named 'no-such-case'"),
+    (["simulate", "omnirobot-s1", "--horizon", "-1"], "--horizon: must be a positive"),
+    (["simulate", "omnirobot-s1", "--horizon", "nan"], "--horizon: must be a positive"),
+    (["simulate", "BADFILE"], "prescribed_time: must be positive"),
+])
+def test_bad_input_exit_2_without_traceback(tmp_path, args, message):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(BAD_SPEC)
+    args = [str(bad) if a == "BADFILE" else a for a in args]
+    out = run(*args)
+    assert out.returncode == 2
+    assert message in out.stderr
+    assert "Traceback" not in out.stderr and out.stderr.startswith("error: ")
+
+
+def test_bad_arguments_exit_2():
+    out = run("simulate", "omnirobot-s1", "--backend", "fortran")
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+
+
+def test_plot_into_missing_folder_fails_before_simulating(tmp_path):
+    out = run("simulate", "omnirobot-s1", "--plot", str(tmp_path / "no" / "x.png"))
+    assert out.returncode == 2 and "does not exist" in out.stderr
+    assert not (tmp_path / "no").exists()
+
+
+def test_plot_is_written(tmp_path):
+    png = tmp_path / "run.png"
+    out = run("simulate", "omnirobot-s2", "--backend", "casadi", "--plot", str(png))
+    assert out.returncode == 0, out.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert [p.name for p in tmp_path.iterdir()] == ["run.png"]   # no temporary left
+
+
+def test_demo_writes_a_plot_per_case(tmp_path):
+    out = run("demo", "--backend", "casadi", "--out", str(tmp_path / "plots"))
+    assert out.returncode == 0, out.stderr
+    for name in ("omnirobot-s1", "omnirobot-s2", "omnirobot-s3"):
+        assert name in out.stdout
+        assert (tmp_path / "plots" / f"{name}.png").stat().st_size > 10_000
+    assert out.stdout.count(" yes ") == 3

@@ -1,0 +1,134 @@
+"""Tube design: windows of eq. (5), the circumvent search, and the design check."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from conftest import designed
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
+from stt_codegen.design import (MAX_MOVE_PER_SAMPLE, base_design, check_tube, design_tube,
+                                overlap_interval, progress_time, sample_tube)
+from stt_codegen.errors import DesignError
+from stt_codegen.spec import Box, load_spec, parse_spec
+
+TWO_D = """
+name = "corridor"
+prescribed_time = 8.0
+[state_space]
+lower = [0.0, 0.0]
+upper = [5.0, 5.0]
+[initial]
+lower = [0.0, 0.0]
+upper = [0.5, 0.5]
+[target]
+lower = [4.5, 4.5]
+upper = [5.0, 5.0]
+"""
+
+
+def literal_window(design, box):
+    """Eq. (5) read literally (valid only when every ratio lies in (0, 1))."""
+    t_c = design.prescribed_time
+    mins, maxs = [], []
+    for i in range(design.dimension):
+        xl, xu = design.initial_lower[i], design.initial_upper[i]
+        tl, tu = design.target_lower[i], design.target_upper[i]
+        ratios = [(box.lower[i] - xl) / (tl - xl), (box.upper[i] - xl) / (tl - xl),
+                  (box.lower[i] - xu) / (tu - xu), (box.upper[i] - xu) / (tu - xu)]
+        bars = [math.atanh(r) / (1 + math.atanh(r)) for r in ratios]
+        mins.append(min(bars))
+        maxs.append(max(bars))
+    return max(mins) * t_c, min(maxs) * t_c
+
+
+@settings(max_examples=200, deadline=None)
+@given(lo=st.tuples(st.floats(0.7, 3.5), st.floats(0.7, 3.5)),
+       size=st.tuples(st.floats(0.1, 0.9), st.floats(0.1, 0.9)))
+def test_robust_window_equals_the_literal_eq5_where_that_is_defined(lo, size):
+    design = base_design(parse_spec(TWO_D))
+    box = Box(lo, tuple(a + b for a, b in zip(lo, size)))
+    assume(all(box.upper[i] < design.target_lower[i] - 1e-3 for i in range(2)))
+    interval = overlap_interval(design, box, 0.0)
+    expected = literal_window(design, box)
+    if expected[0] > expected[1]:
+        assert interval is None
+        return
+    assert interval is not None
+    got = tuple(progress_time(design, s) for s in interval)
+    assert got == pytest.approx(expected, abs=1e-9)
+
+
+def test_window_on_a_degenerate_dimension_has_no_zero_over_zero():
+    """Start and target at the same height: eq. (5) is 0/0 in x2; the robust window is not."""
+    text = TWO_D.replace("[initial]\nlower = [0.0, 0.0]\nupper = [0.5, 0.5]",
+                         "[initial]\nlower = [0.0, 4.5]\nupper = [0.5, 5.0]")
+    design = base_design(parse_spec(text))
+    assert design.initial_lower[1] == design.target_lower[1]
+    wall = Box((1.0, 4.0), (2.0, 5.0))            # the x2 range always overlaps
+    interval = overlap_interval(design, wall, 0.0)
+    assert interval is not None
+    s_lo, s_hi = interval
+    # only x1 decides: rho_U(x1) reaches 1.0 and rho_L(x1) leaves 2.0
+    assert s_lo == pytest.approx((1.0 - 0.45) / 4.5) and s_hi == pytest.approx((2.0 - 0.05) / 4.5)
+    below = Box((1.0, 0.0), (2.0, 1.0))           # never overlaps in x2
+    assert overlap_interval(design, below, 0.0) is None
+
+
+def test_bundled_designs_pass_their_check(case):
+    spec, design, check = designed(case)
+    assert check.passed and check.reason == ""
+    assert check.min_clearance > 0 and check.min_width > 0
+    assert check.max_move_ratio <= MAX_MOVE_PER_SAMPLE
+    assert design.gain > 0 and design.circumvents
+    # the wall O1 is passed underneath from S1 (x2, upper side): the literal eq. (6)
+    # would pick x1 and let the robot cross O1 (design notes, item 6)
+    if case == "omnirobot-s1":
+        c = [c for c in design.circumvents if c.obstacle == 0][0]
+        assert (c.dimension, c.side) == (1, "upper")
+
+
+def test_design_is_deterministic():
+    spec = load_spec("omnirobot-s2")
+    assert design_tube(spec) == design_tube(spec)
+
+
+def test_papers_sharpness_fails_with_a_reason_naming_the_obstacle():
+    spec = load_spec("omnirobot-s1")
+    spec = dataclasses.replace(spec, tube=dataclasses.replace(spec.tube,
+                                                              circumvent_sharpness=0.01))
+    with pytest.raises(DesignError, match=r"obstacle 0: a tube bound moves .* tube widths"):
+        design_tube(spec)
+
+
+def test_check_detects_a_tube_through_an_obstacle():
+    spec, design, _ = designed("omnirobot-s1")
+    bare = dataclasses.replace(design, circumvents=())
+    check = check_tube(bare, spec)
+    assert not check.passed and "meets obstacle 0" in check.reason
+    assert check.min_clearance < 0
+
+
+def test_check_detects_a_tube_outside_the_target_at_t_c():
+    spec, design, _ = designed("omnirobot-s2")
+    wide = dataclasses.replace(design, target_lower=(4.2, 4.55, -0.5))  # T is [4.5, 5]
+    check = check_tube(wide, spec, obstacles=[])
+    assert not check.passed and "not inside the target" in check.reason
+
+
+def test_empty_tube_is_reported():
+    spec, design, _ = designed("omnirobot-s2")
+    blunt = dataclasses.replace(design, smoothness=2.0)   # bias ln2/nu = 0.35 per side
+    check = check_tube(blunt, spec)
+    assert not check.passed
+
+
+def test_sampled_alpha_starts_at_zero_and_stays_valid(case):
+    _, design, _ = designed(case)
+    samples = sample_tube(design)
+    assert np.all(samples.alpha[0] == 0)
+    assert np.all(samples.alpha >= 0)
