@@ -106,6 +106,9 @@ class RunResult:
         counted.
     timed_out : bool
         QEMU was killed after the timeout.
+    stderr : str
+        QEMU's standard error (semihosting ``SYS_WRITE0`` console output, e.g.
+        the fault message of the startup code).
     command : tuple of str
         The QEMU command line.
     """
@@ -114,6 +117,7 @@ class RunResult:
     exit_code: int | None
     instructions: list[int] | None
     timed_out: bool = False
+    stderr: str = ""
     command: tuple[str, ...] = ()
 
 
@@ -386,10 +390,13 @@ def run_qemu(elf: Path, timeout: float = 60.0, *,
                                   timeout=timeout, check=False)
         except subprocess.TimeoutExpired as exc:
             out = exc.stdout.decode(errors="replace") if exc.stdout else ""
-            return RunResult(out, None, None, timed_out=True, command=tuple(cmd))
+            err = exc.stderr.decode(errors="replace") if exc.stderr else ""
+            return RunResult(out, None, None, timed_out=True, stderr=err, command=tuple(cmd))
         stdout = proc.stdout.decode(errors="replace")
-        if proc.stderr and b"qemu-system-arm:" in proc.stderr:
-            raise RunError(f"{' '.join(cmd)}: {proc.stderr.decode(errors='replace')}")
+        stderr = proc.stderr.decode(errors="replace")
+        if any(line.startswith("qemu-system-arm:") and "warning" not in line
+               for line in stderr.splitlines()):
+            raise RunError(f"{' '.join(cmd)}: {stderr}")
         counts = None
         if trace is not None:
             ranges = _function_ranges(elf, tc.nm, ("stt_measure_begin", "stt_measure_end"))
@@ -398,4 +405,4 @@ def run_qemu(elf: Path, timeout: float = 60.0, *,
             with open(trace, encoding="utf-8", errors="replace") as fh:
                 counts = count_region_instructions(fh, ranges["stt_measure_begin"],
                                                    ranges["stt_measure_end"][0])
-    return RunResult(stdout, proc.returncode, counts, command=tuple(cmd))
+    return RunResult(stdout, proc.returncode, counts, stderr=stderr, command=tuple(cmd))
