@@ -18,7 +18,6 @@ wait states, and no DWT cycle counter: ``DWT->CYCCNT`` reads 0 on mps2-an386).
 
 from __future__ import annotations
 
-import os
 import re
 import subprocess
 import tempfile
