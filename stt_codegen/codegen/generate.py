@@ -1,0 +1,155 @@
+"""All generated files for one spec, as ``{relative name: bytes}`` (nothing is written here).
+
+:func:`generate_files` is pure: the same spec, design, options, CasADi and toolkit
+versions give the same bytes (no timestamps, no paths, no set iteration). Files, with
+``P`` the spec's C name:
+
+* C (``--lang c``): ``P.h``, ``P.c`` (typed API + CasADi bodies), ``P_selftest.c`` (the
+  vectors embedded), ``Makefile``;
+* Python (``--lang python``): ``P.py`` (always double: Python floats);
+* always: ``P_vectors.json`` (inputs, reference outputs, tolerances of the precision)
+  and ``manifest.json`` (:data:`MANIFEST`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+
+import casadi
+import numpy as np
+
+from .. import __version__
+from ..emit import lower, python_source
+from ..model import build_model
+from ..spec import Spec
+from ..tube import NEWTON_ITERATIONS, TubeDesign
+from . import tolerance
+from .casadi_c import CODEGEN_OPTIONS, casadi_bodies
+from .functions import deployed_functions
+from .options import Options
+from .render import c_identifier, c_real, render
+from .single import to_single
+from .vectors import test_vectors
+
+MANIFEST = "manifest.json"
+GENERATOR = "stt-codegen"
+
+_TOLERANCE_DOC = {
+    "double": ("max(1e-12 max(1, |ref|), B) with B the first-order rounding bound of "
+               "stt_codegen.codegen.tolerance at unit roundoff 2^-53 (covers a libm a few ulp "
+               "from glibc's on ill-conditioned points near the tube boundary)."),
+    "single": ("B, the rounding bound of stt_codegen.codegen.tolerance at unit roundoff 2^-24: "
+               "tube bounds 64 u S (S = 1 + max |state bound| + max |alpha|); u: the exact "
+               "spread of the law over the error of e; alpha_next 64 u (S + |alpha| + "
+               "|alpha_next|)."),
+}
+
+
+def _json_bytes(data: dict) -> bytes:
+    return (json.dumps(data, indent=1, sort_keys=True, allow_nan=False) + "\n").encode("ascii")
+
+
+def _sha256(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def _c_literal_rows(rows, single: bool):
+    if single:
+        return [[np.format_float_scientific(np.float32(v), unique=True, trim="0") + "f"
+                 for v in row] for row in rows]
+    return [[c_real(v, False) for v in row] for row in rows]
+
+
+def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str, bytes]:
+    """Every file of one generation, keyed by file name (sorted).
+
+    Parameters
+    ----------
+    spec : Spec
+        Its name (validated) and ``source_hash`` are used.
+    design : TubeDesign
+        From :func:`stt_codegen.design.design_tube`.
+    options : Options
+
+    Returns
+    -------
+    dict of str to bytes
+
+    Raises
+    ------
+    SpecError
+        The spec's C name is not a usable identifier.
+    CodegenError
+        CasADi's output has an unexpected shape.
+    """
+    prefix = c_identifier(spec.c_name)
+    single = options.precision == "single"
+    functions = deployed_functions(build_model(design))
+    common = {
+        "spec_name": spec.name, "spec_hash": spec.source_hash, "casadi_version": casadi.__version__,
+        "toolkit_version": __version__, "precision": options.precision, "P": prefix,
+        "U": prefix.upper(), "n": design.dimension, "newton": NEWTON_ITERATIONS,
+        "real": "float" if single else "double",
+    }
+    files: dict[str, str] = {}
+    if "c" in options.langs:
+        bodies = casadi_bodies(functions)
+        text = bodies.text()
+        if single:
+            text = to_single(text)
+        c_ctx = dict(common, bodies=text.rstrip("\n"),
+                     codegen_options=", ".join(f"{k}={v}" for k, v in sorted(
+                         CODEGEN_OPTIONS.items())),
+                     sz_arg=max(w[0] for w in bodies.work.values()),
+                     sz_res=max(w[1] for w in bodies.work.values()),
+                     sz_w=0, guard=f"{prefix.upper()}_H",
+                     t_c=c_real(design.prescribed_time, single),
+                     rate_hz=c_real(design.rate_hz, single),
+                     extra_warnings=" -Wdouble-promotion -Wfloat-conversion" if single else "")
+        for name, template in ((f"{prefix}.h", "c_header.h.j2"), (f"{prefix}.c", "c_source.c.j2"),
+                               ("Makefile", "Makefile.j2")):
+            files[name] = render(template, filename=name, **c_ctx)
+    vectors = test_vectors(design, options.precision)
+    if "c" in options.langs:
+        name = f"{prefix}_selftest.c"
+        tables = [(f"EXP_{k.upper()}", _c_literal_rows(vectors[k], False), len(vectors[k][0]))
+                  for k in ("u", "alpha_next", "gamma_L", "gamma_U")]
+        tables += [(f"TOL_{k[4:].upper()}", _c_literal_rows(vectors[k], False), len(vectors[k][0]))
+                   for k in ("tol_u", "tol_alpha_next", "tol_gamma")]
+        files[name] = render(
+            "c_selftest.c.j2", filename=name, **c_ctx, count=len(vectors["t"]),
+            x=_c_literal_rows(vectors["x"], single), alpha=_c_literal_rows(vectors["alpha"], single),
+            t=_c_literal_rows([vectors["t"]], single)[0], dt=_c_literal_rows([vectors["dt"]], single)[0],
+            status=vectors["status"], tables=tables, tolerance_doc=_TOLERANCE_DOC[options.precision])
+    if "python" in options.langs:
+        name = f"{prefix}.py"
+        programs = [dataclasses.replace(lower(f), name=f"body_{f.name()}") for f in functions]
+        files[name] = render("python_module.py.j2", filename=name, **common,
+                             bodies=python_source(programs).rstrip("\n"),
+                             t_c=repr(float(design.prescribed_time)),
+                             rate_hz=repr(float(design.rate_hz)))
+    vec_name = f"{prefix}_vectors.json"
+    files_bytes = {k: v.encode("ascii") for k, v in files.items()}
+    files_bytes[vec_name] = _json_bytes({
+        "_generated": f"GENERATED FILE, DO NOT EDIT: test vectors of spec {spec.name!r} "
+                      f"from the numpy reference (stt-codegen {__version__}).",
+        "spec": spec.name, "spec_sha256": spec.source_hash, "precision": options.precision,
+        "tolerance": _TOLERANCE_DOC[options.precision], **vectors})
+    files_bytes[MANIFEST] = _json_bytes(manifest(spec, options, files_bytes))
+    return dict(sorted(files_bytes.items()))
+
+
+def manifest(spec: Spec, options: Options, files: dict[str, bytes]) -> dict:
+    """The manifest: versions, spec hash, options and the SHA-256 of every other file."""
+    return {
+        "_generated": "GENERATED FILE, DO NOT EDIT: manifest of an stt-codegen generation.",
+        "generator": GENERATOR,
+        "toolkit_version": __version__,
+        "casadi_version": casadi.__version__,
+        "spec": {"name": spec.name, "sha256": spec.source_hash},
+        "options": options.to_json(),
+        "files": {name: _sha256(data) for name, data in sorted(files.items()) if name != MANIFEST},
+        "tolerance_unit_roundoff": tolerance.unit_roundoff(options.precision),
+    }

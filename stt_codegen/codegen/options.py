@@ -1,0 +1,52 @@
+"""Options of ``stt-codegen generate``: target languages and floating-point precision."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import SpecError
+
+#: Supported languages, in the canonical order used in file lists and manifests.
+LANGUAGES = ("c", "python")
+#: Supported precisions of the C code (the Python module always uses Python floats).
+PRECISIONS = ("double", "single")
+
+
+@dataclass(frozen=True)
+class Options:
+    """What to generate.
+
+    Attributes
+    ----------
+    langs : tuple of str
+        Subset of :data:`LANGUAGES`, canonical order, non-empty.
+    precision : str
+        One of :data:`PRECISIONS`; applies to the C code (and the vectors' tolerances).
+    """
+
+    langs: tuple[str, ...] = LANGUAGES
+    precision: str = "double"
+
+    def to_json(self) -> dict:
+        return {"langs": list(self.langs), "precision": self.precision}
+
+
+def parse_options(langs: str | list | tuple = "c,python", precision: str = "double") -> Options:
+    """Validate ``--lang`` (comma-separated or a list) and ``--precision``.
+
+    Raises
+    ------
+    SpecError
+        Unknown or empty language list (field ``--lang``), unknown precision
+        (``--precision``).
+    """
+    items = [s.strip() for s in langs.split(",")] if isinstance(langs, str) else list(langs)
+    if not items or any(not s for s in items):
+        raise SpecError("--lang", f"expected a comma-separated list of {', '.join(LANGUAGES)}")
+    unknown = [s for s in items if s not in LANGUAGES]
+    if unknown:
+        raise SpecError("--lang", f"unknown language {unknown[0]!r} (known: {', '.join(LANGUAGES)})")
+    if precision not in PRECISIONS:
+        raise SpecError("--precision", f"unknown precision {precision!r} "
+                                       f"(known: {', '.join(PRECISIONS)})")
+    return Options(tuple(s for s in LANGUAGES if s in items), precision)

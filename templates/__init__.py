@@ -1,0 +1,1 @@
+"""Jinja2 templates of the generated code (package data; see stt_codegen.codegen.render)."""
