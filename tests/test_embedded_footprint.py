@@ -7,15 +7,15 @@ from pathlib import Path
 
 import pytest
 
-from stt_codegen.embedded import build_elf, measure, missing_tools, run_qemu
+from stt_codegen.embedded import build_elf, measure, missing_message, run_qemu
 from stt_codegen.embedded.footprint import FootprintError, worst_stack
 
 
 @pytest.fixture(scope="module", autouse=True)
 def _tools() -> None:
-    missing = missing_tools()
-    if missing:
-        pytest.skip("embedded toolchain missing: " + "; ".join(str(m) for m in missing))
+    message = missing_message()
+    if message:
+        pytest.skip("embedded toolchain: " + message)
 
 
 # A "controller": a wrapper calling a body, like the generated code.

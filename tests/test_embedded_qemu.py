@@ -9,15 +9,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stt_codegen.embedded import board, build_elf, missing_tools, run_qemu
+from stt_codegen.embedded import board, build_elf, missing_message, run_qemu
 from stt_codegen.embedded.target import BuildError, count_region_instructions
 
 
 @pytest.fixture(scope="module", autouse=True)
 def _tools() -> None:
-    missing = missing_tools()
-    if missing:
-        pytest.skip("embedded toolchain missing: " + "; ".join(str(m) for m in missing))
+    message = missing_message()
+    if message:
+        pytest.skip("embedded toolchain: " + message)
 
 
 MATH_PROGRAM = r"""

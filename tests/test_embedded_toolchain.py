@@ -5,7 +5,8 @@ from __future__ import annotations
 import pytest
 
 from stt_codegen.embedded import toolchain
-from stt_codegen.embedded.toolchain import MissingTool, find_tool, find_toolchain, missing_tools
+from stt_codegen.embedded.toolchain import (MissingTool, find_tool, find_toolchain,
+                                             missing_message, missing_tools)
 from stt_codegen.errors import SttError
 
 
@@ -31,11 +32,14 @@ def test_empty_path_reports_each_package(monkeypatch: pytest.MonkeyPatch) -> Non
     assert info.value.package == "binutils-arm-none-eabi"
     with pytest.raises(MissingTool):
         find_toolchain()
+    message = missing_message()
+    assert message is not None and message.count("gcc-arm-none-eabi") == 1
+    assert "binutils-arm-none-eabi" in message and "qemu-system-arm" in message
 
 
 def test_installed_toolchain_found() -> None:
-    missing = missing_tools()
-    if missing:
-        pytest.skip("; ".join(str(m) for m in missing))
+    message = missing_message()
+    if message:
+        pytest.skip("embedded toolchain: " + message)
     tc = find_toolchain()
     assert tc.gcc.name == "arm-none-eabi-gcc" and tc.qemu is not None

@@ -8,7 +8,8 @@ types :class:`BuildResult`, :class:`RunResult`, :class:`Footprint`, and
 from stt_codegen.embedded.footprint import Footprint, measure
 from stt_codegen.embedded.target import (BuildError, BuildResult, RunError, RunResult,
                                          build_elf, run_qemu)
-from stt_codegen.embedded.toolchain import MissingTool, find_toolchain, missing_tools
+from stt_codegen.embedded.toolchain import (MissingTool, find_toolchain, missing_message,
+                                            missing_tools)
 
 __all__ = ["BuildError", "BuildResult", "Footprint", "MissingTool", "RunError", "RunResult",
-           "build_elf", "find_toolchain", "measure", "missing_tools", "run_qemu"]
+           "build_elf", "find_toolchain", "measure", "missing_message", "missing_tools", "run_qemu"]

@@ -146,9 +146,7 @@ def find_tool(tool: str) -> Path:
     package = DEBIAN_PACKAGES[tool]
     if tool == "rdimon.specs":
         gcc = shutil.which("arm-none-eabi-gcc")
-        if gcc is None:
-            raise MissingTool("arm-none-eabi-gcc", DEBIAN_PACKAGES["arm-none-eabi-gcc"])
-        if not _has_newlib(gcc):
+        if gcc is None or not _has_newlib(gcc):
             raise MissingTool(tool, package)
         return Path(subprocess.run([gcc, "-print-file-name=rdimon.specs"],
                                    capture_output=True, text=True, check=True).stdout.strip())
@@ -171,13 +169,34 @@ def missing_tools(tools: tuple[str, ...] = BUILD_TOOLS + RUN_TOOLS) -> list[Miss
     list of MissingTool
         One error per missing tool, in the order given.
     """
-    missing: list[MissingTool] = []
+    missing: dict[str, MissingTool] = {}
     for tool in dict.fromkeys(tools):
         try:
             find_tool(tool)
         except MissingTool as err:
-            missing.append(err)
-    return missing
+            missing.setdefault(err.tool, err)
+    return list(missing.values())
+
+
+def missing_message(tools: tuple[str, ...] = BUILD_TOOLS + RUN_TOOLS) -> str | None:
+    """One line naming the missing tools and the Debian packages to install.
+
+    Parameters
+    ----------
+    tools : tuple of str
+        Keys of :data:`DEBIAN_PACKAGES`.
+
+    Returns
+    -------
+    str or None
+        ``None`` when nothing is missing.
+    """
+    missing = missing_tools(tools)
+    if not missing:
+        return None
+    names = ", ".join(m.tool for m in missing)
+    packages = " ".join(dict.fromkeys(m.package for m in missing))
+    return f"missing {names}; install the Debian packages: apt-get install -y {packages}"
 
 
 def find_toolchain(*, need_qemu: bool = True) -> Toolchain:
