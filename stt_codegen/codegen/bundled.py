@@ -1,0 +1,82 @@
+"""The committed output ``generated/``: one folder per bundled case and precision.
+
+Layout: ``generated/<case>/double/`` holds C and Python (``--lang c,python --precision
+double``); ``generated/<case>/single/`` holds C only (``--lang c --precision single``):
+the Python module computes with Python floats whatever the precision, so it is kept once.
+:func:`check_generated` regenerates every folder into memory and compares it byte for
+byte with the committed files.
+"""
+
+from __future__ import annotations
+
+import difflib
+from pathlib import Path
+
+from ..design import design_tube
+from ..spec import bundled_cases, load_spec
+from .generate import generate_files
+from .options import Options
+from .output import write_generation
+
+#: Sub-folder name -> options of the committed generations.
+LAYOUT = {"double": Options(("c", "python"), "double"), "single": Options(("c",), "single")}
+
+
+def expected_tree() -> dict[str, bytes]:
+    """Every committed file, keyed by its path relative to ``generated/`` (POSIX)."""
+    tree: dict[str, bytes] = {}
+    for case in bundled_cases():
+        spec = load_spec(case)
+        design, _ = design_tube(spec)
+        for sub, options in LAYOUT.items():
+            for name, data in generate_files(spec, design, options).items():
+                tree[f"{case}/{sub}/{name}"] = data
+    return tree
+
+
+def actual_tree(root: Path) -> dict[str, bytes]:
+    """Every file under ``root`` (hidden ones too), keyed by relative POSIX path."""
+    if not root.is_dir():
+        return {}
+    return {p.relative_to(root).as_posix(): p.read_bytes()
+            for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def drift(root: Path, expected: dict[str, bytes] | None = None) -> list[str]:
+    """Unified diffs (one string per differing file; empty: identical) of ``root``."""
+    expected = expected_tree() if expected is None else expected
+    actual = actual_tree(root)
+    out = []
+    label = root.as_posix().rstrip("/")
+    for path in sorted(set(expected) | set(actual)):
+        old, new = actual.get(path), expected.get(path)
+        if old == new:
+            continue
+        if old is None:
+            out.append(f"missing: {label}/{path}\n")
+        elif new is None:
+            out.append(f"not generated (stray file): {label}/{path}\n")
+        else:
+            try:
+                a = old.decode("utf-8").splitlines(keepends=True)
+                b = new.decode("utf-8").splitlines(keepends=True)
+            except UnicodeDecodeError:
+                out.append(f"binary files differ: {label}/{path}\n")
+                continue
+            out.append("".join(difflib.unified_diff(
+                a, b, fromfile=f"{label}/{path} (committed)",
+                tofile=f"{label}/{path} (regenerated)")))
+    return out
+
+
+def update_generated(root: Path) -> None:
+    """Regenerate every committed folder under ``root`` (each written atomically)."""
+    tree = expected_tree()
+    folders: dict[str, dict[str, bytes]] = {}
+    for path, data in tree.items():
+        folder, name = path.rsplit("/", 1)
+        folders.setdefault(folder, {})[name] = data
+    root.mkdir(exist_ok=True)
+    for folder, files in folders.items():
+        (root / folder).parent.mkdir(parents=True, exist_ok=True)
+        write_generation(root / folder, files)

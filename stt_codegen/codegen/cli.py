@@ -1,0 +1,63 @@
+"""Subcommands ``generate`` and ``check`` (registered by :func:`register_cli`)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .options import LANGUAGES, PRECISIONS, parse_options
+
+
+def cmd_generate(args: argparse.Namespace) -> int:
+    """``stt-codegen generate SPEC -o DIR [--lang c,python] [--precision double|single]``."""
+    from ..design import design_tube
+    from ..spec import load_spec
+    from .generate import generate_files
+    from .output import write_generation
+    options = parse_options(args.lang, args.precision)
+    spec = load_spec(args.spec)
+    design, _ = design_tube(spec)
+    files = generate_files(spec, design, options)
+    write_generation(Path(args.out), files)
+    print(f"wrote {len(files)} files for {spec.name} ({', '.join(options.langs)}, "
+          f"{options.precision}) into {args.out}")
+    return 0
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """``stt-codegen check [--root generated] [--update]``: 0 identical, 1 drift."""
+    from .bundled import drift, update_generated
+    root = Path(args.root)
+    if args.update:
+        update_generated(root)
+        print(f"regenerated {root}/")
+        return 0
+    diffs = drift(root)
+    if diffs:
+        for text in diffs:
+            sys.stdout.write(text)
+        print(f"drift: {len(diffs)} file(s) under {root}/ differ from a fresh generation "
+              f"(run `stt-codegen check --update` and commit)", file=sys.stderr)
+        return 1
+    print(f"{root}/ is up to date")
+    return 0
+
+
+def register_cli(subparsers) -> None:
+    """Add ``generate`` and ``check`` to the ``stt-codegen`` parser."""
+    p = subparsers.add_parser("generate", help="write the C and Python controllers of a spec")
+    p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
+    p.add_argument("-o", "--out", required=True, metavar="DIR",
+                   help="output folder (created; only files of a previous generation are replaced)")
+    p.add_argument("--lang", default=",".join(LANGUAGES), metavar="LANGS",
+                   help="comma-separated subset of: %(default)s")
+    p.add_argument("--precision", default="double", choices=PRECISIONS,
+                   help="floating-point type of the C code (default: %(default)s)")
+    p.set_defaults(handler=cmd_generate)
+
+    p = subparsers.add_parser("check", help="regenerate generated/ and compare (exit 1 on drift)")
+    p.add_argument("--root", default="generated", metavar="DIR",
+                   help="folder of the committed output (default: %(default)s)")
+    p.add_argument("--update", action="store_true", help="rewrite the folder instead of comparing")
+    p.set_defaults(handler=cmd_check)
