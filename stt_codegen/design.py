@@ -28,18 +28,17 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from . import reference
+from .certificate import Certificate, certify_tube
 from .errors import DesignError
-from .model import alpha_trajectory_function
 from .spec import Box, Spec
 from .tube import LOWER, UPPER, Circumvent, TubeDesign
+from .tube_samples import TubeSamples, sample_tube
 
 #: Largest distance a tube bound may move in one sampling period, as a fraction of the
 #: tube's width there: a sampled controller cannot follow a faster tube.
 MAX_MOVE_PER_SAMPLE = 0.25
 #: Obstacles are inflated by this fraction of ``delta_B`` to compute overlap windows.
 WINDOW_INFLATION = 0.5
-#: The design is checked on ``[0, HORIZON_FACTOR * t_c]``.
-HORIZON_FACTOR = 1.1
 
 
 @dataclass(frozen=True)
@@ -52,12 +51,14 @@ class TubeCheck:
     reason : str
         Empty when passed, else the first failed condition in words.
     min_width : float
-        ``min_t min_i gamma_d_i(t)``, state units.
+        Certified lower bound of ``min_t min_i gamma_d_i(t)``, state units.
     min_clearance : float
-        Smallest distance from the tube box to an obstacle it must avoid (positive:
-        clear), state units; ``inf`` without obstacles.
+        Certified smallest separation of the tube box from an obstacle it must avoid
+        (positive: clear), state units; ``inf`` without obstacles.
     max_move_ratio : float
         Largest ``|gamma_dot| dt / gamma_d`` on the grid.
+    certificate : Certificate
+        The continuous-time certificate behind the verdict.
     """
 
     passed: bool
@@ -65,63 +66,18 @@ class TubeCheck:
     min_width: float
     min_clearance: float
     max_move_ratio: float
-
-
-@dataclass(frozen=True)
-class TubeSamples:
-    """The tube sampled on a grid: ``t`` (N,), ``alpha`` (N, 2n), ``gamma_*`` (N, n)."""
-
-    t: np.ndarray
-    alpha: np.ndarray
-    gamma_lower: np.ndarray
-    gamma_upper: np.ndarray
-    gamma_lower_dot: np.ndarray
-    gamma_upper_dot: np.ndarray
-
-
-def sample_tube(design: TubeDesign, horizon: float | None = None) -> TubeSamples:
-    """The tube at every sampling instant of the deployed controller.
-
-    ``alpha`` follows the deployed implicit step (the same Newton iteration as the
-    generated code), starting from ``alpha(0) = 0``.
-
-    Parameters
-    ----------
-    design : TubeDesign
-    horizon : float, optional
-        End time, seconds; default ``HORIZON_FACTOR * t_c``.
-    """
-    if horizon is None:
-        horizon = HORIZON_FACTOR * design.prescribed_time
-    dt = 1.0 / design.rate_hz
-    steps = int(math.ceil(horizon * design.rate_hz))
-    t = np.arange(steps + 1) * dt
-    psi = reference.conflict_distance(design, t[1:])
-    trajectory = alpha_trajectory_function(design, steps)
-    alpha_tail = np.array(trajectory(np.zeros(2 * design.dimension), psi.T, dt)).T
-    alpha = np.vstack([np.zeros((1, 2 * design.dimension)), alpha_tail])
-    g_l, g_u, g_l_dot, g_u_dot = reference.adaptive_tube(design, t, alpha)
-    return TubeSamples(t, alpha, g_l, g_u, g_l_dot, g_u_dot)
-
-
-def box_distance(lower: np.ndarray, upper: np.ndarray, box: Box) -> np.ndarray:
-    """Signed separation between boxes ``[lower, upper]`` (N, n) and ``box``.
-
-    Positive: the largest gap along one axis (the boxes are disjoint); non-positive:
-    they overlap, by at least that much in every axis.
-    """
-    gaps = np.maximum(np.array(box.lower) - upper, lower - np.array(box.upper))
-    return gaps.max(axis=1)
+    certificate: Certificate
 
 
 def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = None,
                samples: TubeSamples | None = None, final: bool = True) -> TubeCheck:
-    """Check a designed tube on the controller's sampling grid.
+    """Check a designed tube: the continuous-time certificate and the sampling limit.
 
-    Conditions, in order: the width ``gamma_d`` is positive; ``x(0)`` lies strictly in
-    the tube at ``t = 0``; the tube box stays in the state space; it misses every
-    obstacle listed; no bound moves more than ``MAX_MOVE_PER_SAMPLE`` of the tube width
-    in one sampling period; with ``final``, from ``t_c`` on the box lies in the target.
+    Conditions, in order: no bound moves more than ``MAX_MOVE_PER_SAMPLE`` of the tube
+    width in one sampling period; and every property of
+    :func:`~stt_codegen.certificate.certify_tube` (non-empty, ``x(0)`` inside, inside the
+    state space, missing each listed obstacle and, with ``final``, inside the target from
+    ``t_c`` on) holds for all ``t``.
 
     Parameters
     ----------
@@ -130,7 +86,7 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
     obstacles : list of int, optional
         Indices of the obstacles to check against; default all.
     samples : TubeSamples, optional
-        Precomputed :func:`sample_tube` output.
+        Precomputed :func:`~stt_codegen.tube_samples.sample_tube` output.
     final : bool
 
     Returns
@@ -138,51 +94,30 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
     TubeCheck
     """
     s = samples if samples is not None else sample_tube(design)
+    certificate = certify_tube(design, spec, obstacles=obstacles, samples=s)
     dt = 1.0 / design.rate_hz
     width = s.gamma_upper - s.gamma_lower
-    min_width = float(width.min())
     move = np.maximum(np.abs(s.gamma_lower_dot), np.abs(s.gamma_upper_dot)) * dt
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(width > 0, move / width, np.inf)
     max_ratio = float(ratio.max())
-    boxes = spec.obstacle_boxes()
-    indices = range(len(boxes)) if obstacles is None else obstacles
-    clearance = math.inf
-    hit = None
-    for j in indices:
-        dist = box_distance(s.gamma_lower, s.gamma_upper, boxes[j])
-        if dist.min() < clearance:
-            clearance = float(dist.min())
-        if hit is None and dist.min() <= 0:
-            hit = (j, float(s.t[int(np.argmin(dist))]))
+    margins = {m.name: m for m in certificate.margins}
+    clearances = [m.margin for m in certificate.margins if m.name.startswith("avoids")]
 
     def result(reason: str) -> TubeCheck:
-        return TubeCheck(not reason, reason, min_width, clearance, max_ratio)
+        return TubeCheck(not reason, reason, margins["non-empty"].margin,
+                         min(clearances, default=math.inf), max_ratio, certificate)
 
-    if min_width <= 0:
-        k = int(np.argmin(width.min(axis=1)))
-        return result(f"the tube is empty at t = {s.t[k]:.3f} s")
-    x0 = np.array(design.initial_state)
-    if not np.all((s.gamma_lower[0] < x0) & (x0 < s.gamma_upper[0])):
-        return result("x(0) is not inside the tube at t = 0")
-    lo, hi = np.array(design.state_lower), np.array(design.state_upper)
-    outside = (s.gamma_lower < lo - 1e-12) | (s.gamma_upper > hi + 1e-12)
-    if outside.any():
-        k = int(np.argmax(outside.any(axis=1)))
-        return result(f"the tube leaves the state space at t = {s.t[k]:.3f} s")
-    if hit is not None:
-        return result(f"the tube meets obstacle {hit[0]} at t = {hit[1]:.3f} s")
-    if max_ratio > MAX_MOVE_PER_SAMPLE:
+    if max_ratio > MAX_MOVE_PER_SAMPLE:  # first: a tube this fast also fails the rest
         k = int(np.argmax(ratio.max(axis=1)))
         return result(f"a tube bound moves {max_ratio:.2f} tube widths in one sampling "
-                      f"period at t = {s.t[k]:.3f} s (limit {MAX_MOVE_PER_SAMPLE})")
-    if final:
-        late = s.t >= design.prescribed_time
-        t_lo, t_hi = np.array(spec.target_set.lower), np.array(spec.target_set.upper)
-        off = late[:, None] & ((s.gamma_lower < t_lo) | (s.gamma_upper > t_hi))
-        if off.any():
-            k = int(np.argmax(off.any(axis=1)))
-            return result(f"the tube is not inside the target at t = {s.t[k]:.3f} s >= t_c")
+                      f"period at t = {s.t[k]:.3f} s (limit {MAX_MOVE_PER_SAMPLE}; a larger "
+                      "tube.circumvent_sharpness or controller.rate_hz helps)")
+    for margin in certificate.margins:
+        if margin.name == "inside target after t_c" and not final:
+            continue
+        if not margin.passed:
+            return result(f"{margin.name} fails: {margin.detail}")
     return result("")
 
 

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
 from stt_codegen import reference as R
-from stt_codegen.design import sample_tube
+from stt_codegen.tube_samples import sample_tube
 from stt_codegen.model import implicit_alpha_update
 from stt_codegen.tube import NEWTON_ITERATIONS
 

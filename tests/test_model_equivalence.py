@@ -8,7 +8,7 @@ from conftest import designed, model_of
 from sampling import E_LIMIT, random_points
 
 from stt_codegen import reference as R
-from stt_codegen.design import sample_tube
+from stt_codegen.tube_samples import sample_tube
 from stt_codegen.model import FUNCTION_NAMES
 
 POINTS = 10_000

@@ -1,0 +1,52 @@
+"""The tube at the sampling instants of the deployed controller."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import reference
+from .model import alpha_trajectory_function
+from .tube import TubeDesign
+
+#: Default horizon of a sampled tube, as a multiple of ``t_c``.
+HORIZON_FACTOR = 1.1
+
+
+@dataclass(frozen=True)
+class TubeSamples:
+    """The tube sampled on a grid: ``t`` (N,), ``alpha`` (N, 2n), ``gamma_*`` (N, n)."""
+
+    t: np.ndarray
+    alpha: np.ndarray
+    gamma_lower: np.ndarray
+    gamma_upper: np.ndarray
+    gamma_lower_dot: np.ndarray
+    gamma_upper_dot: np.ndarray
+
+
+def sample_tube(design: TubeDesign, horizon: float | None = None) -> TubeSamples:
+    """The tube at every sampling instant of the deployed controller.
+
+    ``alpha`` follows the deployed implicit step (the same Newton iteration as the
+    generated code), starting from ``alpha(0) = 0``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+    horizon : float, optional
+        End time, seconds; default ``HORIZON_FACTOR * t_c``.
+    """
+    if horizon is None:
+        horizon = HORIZON_FACTOR * design.prescribed_time
+    dt = 1.0 / design.rate_hz
+    steps = int(math.ceil(horizon * design.rate_hz))
+    t = np.arange(steps + 1) * dt
+    psi = reference.conflict_distance(design, t[1:])
+    trajectory = alpha_trajectory_function(design, steps)
+    alpha_tail = np.array(trajectory(np.zeros(2 * design.dimension), psi.T, dt)).T
+    alpha = np.vstack([np.zeros((1, 2 * design.dimension)), alpha_tail])
+    g_l, g_u, g_l_dot, g_u_dot = reference.adaptive_tube(design, t, alpha)
+    return TubeSamples(t, alpha, g_l, g_u, g_l_dot, g_u_dot)
