@@ -1,0 +1,164 @@
+"""The generated code as controller backends ``c`` and ``python`` (see :mod:`stt_codegen.backends`).
+
+:class:`CController` generates the C (double) for a design, compiles it into a shared
+library with the system C compiler and loads it with ``ctypes``; builds are cached under
+``$STT_CODEGEN_CACHE`` or ``~/.cache/stt-codegen`` (never the source tree), keyed by the
+SHA-256 of the generated sources and the compiler command.
+:class:`GeneratedPythonController` generates the Python module and imports it from memory.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import hashlib
+import os
+import shutil
+import subprocess
+import tempfile
+import types
+from pathlib import Path
+
+import numpy as np
+
+from ..spec import NAME_PATTERN
+from ..tube import TubeDesign
+from .errors import CodegenError
+from .generate import generate_files
+from .options import Options
+
+#: Flags of the shared-library build (``-ffp-contract=off``: same rounding as CasADi's VM).
+CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fPIC", "-shared", "-Wall", "-Wextra",
+          "-Wpedantic", "-Wshadow", "-Werror")
+
+
+class _DesignSpec:
+    """The two spec attributes code generation reads, for a design without its spec."""
+
+    def __init__(self, design: TubeDesign) -> None:
+        self.name = design.name if NAME_PATTERN.fullmatch(design.name) else "stt"
+        self.c_name = self.name.replace("-", "_")
+        self.source_hash = "design:" + hashlib.sha256(repr(design).encode()).hexdigest()
+
+
+def cache_dir() -> Path:
+    """Folder of compiled controllers: ``$STT_CODEGEN_CACHE`` or ``~/.cache/stt-codegen``."""
+    env = os.environ.get("STT_CODEGEN_CACHE")
+    return Path(env) if env else Path.home() / ".cache" / "stt-codegen"
+
+
+def compiler() -> str:
+    """The C compiler: ``$CC``, else the first of ``cc``, ``gcc``, ``clang`` on ``PATH``."""
+    for name in [os.environ.get("CC")] + ["cc", "gcc", "clang"]:
+        if name and shutil.which(name):
+            return name
+    raise CodegenError("no C compiler found (set CC)")
+
+
+def build_shared(sources: dict[str, bytes], c_file: str, cc: str | None = None,
+                 extra_flags: tuple = ()) -> Path:
+    """Compile ``sources[c_file]`` (with its header) into a cached shared library.
+
+    Returns
+    -------
+    Path
+        The library, under :func:`cache_dir`, named by the content hash.
+
+    Raises
+    ------
+    CodegenError
+        The compiler failed (its output is in the message).
+    """
+    cc = cc or compiler()
+    cmd = [cc, *CFLAGS, *extra_flags]
+    digest = hashlib.sha256(repr(cmd).encode())
+    for name in sorted(sources):
+        digest.update(name.encode() + b"\0" + sources[name] + b"\0")
+    key = digest.hexdigest()[:32]
+    lib = cache_dir() / f"{key}.so"
+    if lib.exists():
+        return lib
+    lib.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="stt-build-") as tmp:
+        for name, data in sources.items():
+            Path(tmp, name).write_bytes(data)
+        out = Path(tmp, "lib.so")
+        proc = subprocess.run(cmd + [c_file, "-o", str(out), "-lm"], cwd=tmp,
+                              capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise CodegenError(f"{cc} failed:\n{proc.stderr}")
+        fd, staged = tempfile.mkstemp(dir=lib.parent, prefix=f".{key}.", suffix=".so")
+        os.close(fd)
+        shutil.copyfile(out, staged)
+        os.replace(staged, lib)
+    return lib
+
+
+class CController:
+    """Backend ``c``: the generated C (double), compiled and loaded with ``ctypes``."""
+
+    name = "c"
+
+    def __init__(self, design: TubeDesign, precision: str = "double", cc: str | None = None) -> None:
+        spec = _DesignSpec(design)
+        files = generate_files(spec, design, Options(("c",), precision))
+        prefix = spec.c_name
+        sources = {k: v for k, v in files.items() if k in (f"{prefix}.c", f"{prefix}.h")}
+        self.library_path = build_shared(sources, f"{prefix}.c", cc)
+        self._lib = ctypes.CDLL(str(self.library_path))
+        real = ctypes.c_double if precision == "double" else ctypes.c_float
+        self._dtype = np.float64 if precision == "double" else np.float32
+        self._real = real
+        self.n = design.dimension
+        ptr = ctypes.POINTER(real)
+        self._step = getattr(self._lib, f"{prefix}_step")
+        self._step.argtypes = [ptr, real, real, ptr, ptr, ptr]
+        self._step.restype = ctypes.c_int
+        self.functions = {}
+        for suffix, args in (("tube", [real, ptr, ptr, ptr, ptr, ptr]),
+                             ("control", [ptr, real, ptr, ptr]),
+                             ("alpha_step", [real, real, ptr, ptr])):
+            f = getattr(self._lib, f"{prefix}_{suffix}")
+            f.argtypes, f.restype = args, ctypes.c_int
+            self.functions[suffix] = f
+        self.functions["step"] = self._step
+
+    def _buf(self, values, size: int) -> np.ndarray:
+        out = np.ascontiguousarray(np.asarray(values, dtype=self._dtype).reshape(size))
+        return out
+
+    def _p(self, arr: np.ndarray):
+        return arr.ctypes.data_as(ctypes.POINTER(self._real))
+
+    def step(self, x, t, dt, alpha):
+        """``(u (n,), alpha_next (2n,), status)``; see the C header."""
+        n = self.n
+        x = self._buf(x, n)
+        a = self._buf(alpha, 2 * n)
+        u = np.zeros(n, self._dtype)
+        nxt = np.zeros(2 * n, self._dtype)
+        status = self._step(self._p(x), t, dt, self._p(a), self._p(u), self._p(nxt))
+        return u.astype(float), nxt.astype(float), int(status)
+
+
+def load_python_module(source: bytes, name: str) -> types.ModuleType:
+    """Execute generated Python source as a module (not added to ``sys.modules``)."""
+    module = types.ModuleType(name)
+    exec(compile(source.decode("ascii"), f"<generated {name}.py>", "exec"), module.__dict__)
+    return module
+
+
+class GeneratedPythonController:
+    """Backend ``python``: the generated Python module, executed from memory."""
+
+    name = "python"
+
+    def __init__(self, design: TubeDesign) -> None:
+        spec = _DesignSpec(design)
+        files = generate_files(spec, design, Options(("python",), "double"))
+        self.module = load_python_module(files[f"{spec.c_name}.py"], spec.c_name)
+
+    def step(self, x, t, dt, alpha):
+        """``(u (n,), alpha_next (2n,), status)``; see the generated module."""
+        u, alpha_next, status = self.module.step(list(np.asarray(x, float)), float(t), float(dt),
+                                                 list(np.asarray(alpha, float)))
+        return np.array(u), np.array(alpha_next), int(status)
