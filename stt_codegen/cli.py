@@ -19,7 +19,8 @@ from pathlib import Path
 from .errors import SpecError, SttError
 
 #: Modules that add subcommands through ``register_cli(subparsers)``.
-COMMAND_MODULES = ("stt_codegen.codegen", "stt_codegen.verify")
+COMMAND_MODULES = ("stt_codegen.codegen", "stt_codegen.verify", "stt_codegen.embedded",
+                   "stt_codegen.bench")
 
 
 def atomic_write_bytes(path: Path, writer) -> None:
