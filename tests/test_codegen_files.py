@@ -12,7 +12,7 @@ from pathlib import Path
 
 import casadi
 import pytest
-from codegen_helpers import files_of
+from test_codegen_support import files_of
 
 from stt_codegen import __version__
 from stt_codegen.cli import main
@@ -73,8 +73,9 @@ def test_casadi_output_reduced_to_static_code():
     with pytest.raises(CodegenError):
         check_no_mutable_state("static int body_x(void) {\n}\nint counter = 0;\n")
     x = casadi.SX.sym("x")
+    same = casadi.Function("f", [x], [casadi.exp(x)])
     with pytest.raises(CodegenError):
-        casadi_bodies([casadi.Function("bad name", [x], [casadi.exp(x)])])
+        casadi_bodies([same, same])  # duplicate names would give ambiguous bodies
     body = casadi_bodies([casadi.Function("f", [x], [casadi.exp(x)])])
     assert list(body.bodies) == ["f"] and "static int body_f(" in body.bodies["f"]
 

@@ -1,4 +1,4 @@
-"""Shared helpers of the codegen tests: generate, compile and load the C of a bundled case."""
+"""Support of the codegen tests (no tests here): generate, compile and load the C of a case."""
 
 from __future__ import annotations
 
