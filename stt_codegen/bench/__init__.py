@@ -1,0 +1,18 @@
+"""Benchmarks: ``stt-codegen bench arenas | step | scaling``.
+
+* :mod:`.arenas` - the seeded random-arena generator (paper's Table I protocol, made explicit);
+* :mod:`.planning`, :mod:`.astar`, :mod:`.rrtstar`, :mod:`.tracker` - the planner-plus-tracker
+  baselines (networkx A*, OMPL RRT*, carrot following);
+* :mod:`.arena_job`, :mod:`.arenas_bench`, :mod:`.parallel` - one arena per job, local
+  processes or a Dask cluster;
+* :mod:`.harness` - a generated C timing harness, compiled, timed and run under callgrind;
+* :mod:`.step`, :mod:`.scaling` - the per-step cost and its growth;
+* :mod:`.report` - statistics, tables and the machine description.
+
+Every benchmark measures what it compares side by side in one run and reports ratios;
+the tests check structure and invariants, never speed.
+"""
+
+from .cli import register_cli
+
+__all__ = ["register_cli"]

@@ -1,0 +1,132 @@
+"""``stt-codegen bench arenas``: the tube controller and two planner-plus-tracker baselines
+on the same random arenas, side by side in one run (the paper's Table I, redone)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from ..errors import SpecError
+from .arena_job import LABELS, METHODS, run_arena
+from .arenas import generate_arenas
+from .parallel import run_parallel
+from .report import machine, machine_line, seconds_text, summarize, table
+from .rrtstar import ompl_available
+
+
+def available_methods() -> tuple[tuple[str, ...], dict[str, str]]:
+    """The methods that can run here, and why the others cannot (method -> reason)."""
+    skipped = {}
+    why = ompl_available()
+    if why:
+        skipped["rrtstar"] = why
+    return tuple(m for m in METHODS if m not in skipped), skipped
+
+
+def write_specs(folder: Path, count: int, seed: int) -> list[Path]:
+    """Write arenas ``0 .. count - 1`` of ``seed`` as spec files ``arena-S-K.toml``.
+
+    Raises
+    ------
+    SpecError
+        The folder does not exist (field ``--specs``).
+    """
+    from ..cli import atomic_write_bytes
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise SpecError("--specs", f"folder {str(folder)!r} does not exist")
+    paths = []
+    for arena in generate_arenas(count, seed):
+        path = folder / f"{arena.name}.toml"
+        text = arena.to_toml().encode("utf-8")
+        atomic_write_bytes(path, lambda tmp, data=text: tmp.write_bytes(data))
+        paths.append(path)
+    return paths
+
+
+def run_arenas_bench(count: int, seed: int, workers: int | None = None,
+                     scheduler: str | None = None, methods: tuple[str, ...] | None = None,
+                     progress: bool = True) -> dict[str, Any]:
+    """Run every available method on ``count`` arenas of ``seed``.
+
+    Parameters
+    ----------
+    count : int
+        Number of arenas, >= 1.
+    seed : int
+        Arena seed, >= 0.
+    workers : int, optional
+        Local processes (default: the usable CPUs).
+    scheduler : str, optional
+        Dask scheduler address; then the jobs run on that cluster.
+    methods : tuple of str, optional
+        Subset of :data:`~.arena_job.METHODS`; default every available one.
+    progress : bool
+        tqdm progress bar on standard error.
+
+    Returns
+    -------
+    dict
+        ``{"count", "seed", "machine", "workers", "scheduler", "skipped" (method ->
+        reason), "methods" (method -> :func:`~.report.summarize`), "arenas" (per-arena
+        results of :func:`~.arena_job.run_arena`)}``.
+
+    Raises
+    ------
+    SpecError
+        Bad count, seed, workers, scheduler, or an unknown method.
+    """
+    generate_arenas(1, seed)  # validates the seed
+    if count < 1:
+        raise SpecError("--count", f"must be at least 1, got {count}")
+    usable, skipped = available_methods()
+    if methods is None:
+        methods = usable
+    for m in methods:
+        if m not in METHODS:
+            raise SpecError("--methods", f"unknown method {m!r} (known: {', '.join(METHODS)})")
+        if m in skipped:
+            raise SpecError("--methods", f"{m} cannot run: {skipped[m]}")
+    calls = [(seed, k, tuple(methods)) for k in range(count)]
+    arenas = run_parallel(run_arena, calls, workers=workers, scheduler=scheduler,
+                          progress=progress, description="arenas")
+    summary = {m: summarize([a["methods"][m] for a in arenas]) for m in methods}
+    return {"count": count, "seed": seed, "machine": machine(),
+            "workers": None if scheduler else workers, "scheduler": scheduler,
+            "skipped": skipped, "methods": summary, "arenas": arenas}
+
+
+def format_arenas_report(report: dict[str, Any]) -> str:
+    """The human-readable table of :func:`run_arenas_bench`'s result."""
+    rows = []
+    for method, s in report["methods"].items():
+        failures = ", ".join(f"{r} {n}" for r, n in s["failures"].items()) or "-"
+        rows.append([LABELS[method], f"{s['successes']}/{s['runs']}",
+                     f"{100 * s['success_rate']:.1f} %", seconds_text(s["time_median_s"]),
+                     seconds_text(s["time_p95_s"]), failures])
+    lines = [f"{report['count']} arenas (seed {report['seed']}): 5 m x 5 m, four 1 m x 1 m "
+             "obstacles, t_c = 9 s, single integrator, |w_i| <= 0.1 m/s, 1 kHz",
+             table(["method", "satisfied", "rate", "time median", "time p95",
+                    "failures by reason"], rows),
+             "time: STT = design_tube (search + continuous-time certificate); "
+             "baselines = planning (grid/planner construction + search)."]
+    for method, why in report["skipped"].items():
+        lines.append(f"skipped {LABELS[method]}: {why}")
+    lines.append(machine_line(report["machine"]))
+    return "\n".join(lines)
+
+
+def main_arenas(args) -> int:
+    """Handler of ``bench arenas``; exit 0."""
+    if args.specs:
+        write_specs(Path(args.specs), args.count, args.seed)
+    report = run_arenas_bench(args.count, args.seed, workers=args.workers,
+                              scheduler=args.scheduler,
+                              methods=tuple(args.methods.split(",")) if args.methods else None,
+                              progress=not args.no_progress)
+    if args.json:
+        print(json.dumps(report, indent=1, sort_keys=True, allow_nan=False))
+    else:
+        print(format_arenas_report(report))
+    return 0

@@ -1,0 +1,90 @@
+"""Summaries, tables and machine description shared by the ``bench`` subcommands."""
+
+from __future__ import annotations
+
+import os
+import platform
+import subprocess
+from collections import Counter
+from typing import Any
+
+import numpy as np
+
+
+def machine() -> dict[str, Any]:
+    """The machine a benchmark ran on: CPU model, CPUs usable, OS, Python, C compiler."""
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    cpu = line.split(":", 1)[1].strip()
+                    break
+    except OSError:  # pragma: no cover - not Linux
+        pass
+    try:
+        cpus = len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover
+        cpus = os.cpu_count() or 1
+    try:
+        cc = subprocess.run(["cc", "--version"], capture_output=True, text=True,
+                            timeout=10).stdout.splitlines()[0]
+    except (OSError, IndexError, subprocess.SubprocessError):
+        cc = "unknown"
+    return {"cpu": cpu, "cpus": cpus, "system": f"{platform.system()} {platform.release()}",
+            "python": platform.python_version(), "cc": cc}
+
+
+def machine_line(info: dict[str, Any]) -> str:
+    """One line describing :func:`machine`'s output."""
+    return (f"machine: {info['cpu']}, {info['cpus']} CPUs, {info['system']}, "
+            f"Python {info['python']}, {info['cc']}")
+
+
+def summarize(outcomes: list[dict[str, Any]]) -> dict[str, Any]:
+    """Success rate, time statistics and failures by reason of one method.
+
+    Parameters
+    ----------
+    outcomes : list of dict
+        Per arena, ``{"success": bool, "seconds": float, "reason": str}``.
+
+    Returns
+    -------
+    dict
+        ``runs``, ``successes``, ``success_rate`` (0..1), ``time_median_s`` and
+        ``time_p95_s`` (design or planning time over all runs, failed ones included,
+        seconds) and ``failures`` (reason -> count, most frequent first).
+    """
+    seconds = np.array([o["seconds"] for o in outcomes], dtype=float)
+    successes = sum(bool(o["success"]) for o in outcomes)
+    failures = Counter(o["reason"] for o in outcomes if not o["success"])
+    return {
+        "runs": len(outcomes),
+        "successes": successes,
+        "success_rate": successes / len(outcomes) if outcomes else 0.0,
+        "time_median_s": float(np.median(seconds)) if len(seconds) else None,
+        "time_p95_s": float(np.percentile(seconds, 95)) if len(seconds) else None,
+        "failures": dict(sorted(failures.items(), key=lambda kv: (-kv[1], kv[0]))),
+    }
+
+
+def table(header: list[str], rows: list[list[str]]) -> str:
+    """A plain-text table with columns padded to their widest cell (Markdown-compatible)."""
+    widths = [max(len(str(c)) for c in column) for column in zip(header, *rows)]
+
+    def line(cells):
+        return "| " + " | ".join(str(c).ljust(w) for c, w in zip(cells, widths)) + " |"
+
+    sep = "|" + "|".join("-" * (w + 2) for w in widths) + "|"
+    return "\n".join([line(header), sep] + [line(r) for r in rows])
+
+
+def seconds_text(value: float | None) -> str:
+    """A duration with a sensible unit (ns, us, ms, s)."""
+    if value is None:
+        return "-"
+    for unit, scale in (("s", 1.0), ("ms", 1e-3), ("us", 1e-6)):
+        if abs(value) >= scale:
+            return f"{value / scale:.3g} {unit}"
+    return f"{value / 1e-9:.3g} ns"
