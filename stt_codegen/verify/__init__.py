@@ -1,0 +1,39 @@
+"""Symbolic and numeric verification of the paper's formulas (``stt-codegen verify``).
+
+Every check returns a :class:`Check`. The modules:
+
+* :mod:`.lemma` -- Lemma 3.3 pieces: smoothness of the tubes (4), (7)-(8),
+  (9)-(10) and explicit rate bounds;
+* :mod:`.transform` -- error transform and the Lyapunov derivative of the proof
+  of Theorem 4.1;
+* :mod:`.assumption` -- Assumption 2 for a plant's input matrix;
+* :mod:`.adaptive` -- non-negativity and an explicit bound of the adaptive law (11).
+"""
+
+from .check import Check, all_passed, format_report
+from .lemma import (
+    bump_rate_bound,
+    check_bump_flat_all_orders,
+    check_bump_flatness,
+    check_reach_continuity,
+    check_reach_flat_all_orders,
+    check_smooth_max,
+    lemma_checks,
+    reach_rate_bound,
+    reach_rate_constant,
+)
+
+__all__ = [
+    "Check",
+    "all_passed",
+    "format_report",
+    "bump_rate_bound",
+    "check_bump_flat_all_orders",
+    "check_bump_flatness",
+    "check_reach_continuity",
+    "check_reach_flat_all_orders",
+    "check_smooth_max",
+    "lemma_checks",
+    "reach_rate_bound",
+    "reach_rate_constant",
+]
