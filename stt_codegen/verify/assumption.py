@@ -1,0 +1,150 @@
+"""Assumption 2: uniform positive definiteness of ``g_s(x) = (g(x) + g(x)^T)/2``.
+
+The proof of Theorem 4.1 uses ``lambda_min(g_s(x)) >= g_lower > 0`` (Rayleigh-
+Ritz). Since the controller keeps ``x`` inside the tube, it suffices that this
+holds on the box the tube can visit; the caller supplies the range of each
+state variable the eigenvalues depend on (e.g. the heading range
+``[min gamma_L3, max gamma_U3]`` of the tube, or of the state space).
+"""
+
+from __future__ import annotations
+
+from typing import Mapping, Sequence
+
+import sympy as sp
+
+from .check import Check
+from .formulas import omnidirectional_g, single_integrator_g
+
+__all__ = [
+    "symmetric_part",
+    "check_assumption2",
+    "assumption2_omnidirectional",
+    "assumption2_single_integrator",
+]
+
+#: A range endpoint closer than this to a zero of an eigenvalue counts as
+#: reaching it (``np.pi/2`` is a double below pi/2, with ``cos`` = 6e-17).
+TOUCH_TOL = 1e-12
+
+
+def symmetric_part(g: sp.Matrix) -> sp.Matrix:
+    """``g_s = (g + g^T)/2``, simplified entrywise."""
+    return ((g + g.T) / 2).applyfunc(sp.simplify)
+
+
+def _finite_points(s: sp.Set) -> list[sp.Expr] | None:
+    if isinstance(s, sp.FiniteSet):
+        return sorted(s, key=lambda p: float(p))
+    if s is sp.S.EmptySet:
+        return []
+    return None
+
+
+def check_assumption2(
+    g: sp.Matrix,
+    ranges: Mapping[sp.Symbol, tuple[float, float]],
+    name: str = "assumption2",
+) -> Check:
+    """Prove ``lambda_min(g_s(x)) >= g_lower > 0`` on a box of states.
+
+    The eigenvalues of ``g_s`` are computed symbolically. Each must be constant
+    or depend on a single state variable ``v`` with a given range
+    ``[lo, hi]``; its minimum there is taken over the endpoints and the
+    stationary points (``solveset`` of ``d lambda/dv = 0`` in the interval).
+    PASS with ``g_lower`` = the least of these minima when it is positive;
+    otherwise FAIL naming the points of ``[lo, hi]`` where the eigenvalue
+    vanishes (within :data:`TOUCH_TOL`), i.e. where the guarantee is lost.
+
+    Parameters
+    ----------
+    g : sympy.Matrix
+        Input matrix ``g(x)`` of the control-affine system (1), square.
+    ranges : mapping
+        ``{state_symbol: (lo, hi)}`` for every variable the eigenvalues use.
+    name : str
+        Name of the returned check.
+    """
+    gs = symmetric_part(g)
+    eig = gs.eigenvals()
+    data: dict[str, object] = {"g_s": str(gs.tolist()),
+                               "eigenvalues": {str(k): int(v) for k, v in eig.items()}}
+    lower = sp.oo
+    where: dict[str, object] = {}
+    for lam in eig:
+        free = sorted(lam.free_symbols, key=str)
+        if not free:
+            val = sp.nsimplify(lam)
+            if val < lower:
+                lower, where = val, {"eigenvalue": str(lam), "at": "everywhere"}
+            continue
+        if len(free) > 1:
+            return Check(name, False,
+                         f"eigenvalue {lam} of g_s depends on {free}: only single-variable "
+                         "eigenvalues are handled, no bound derived", data)
+        v = free[0]
+        if v not in ranges:
+            return Check(name, False,
+                         f"eigenvalue {lam} of g_s depends on {v}, for which no range was "
+                         "given: not uniformly positive over all reals", data)
+        lo, hi = (sp.Float(float(b), 30) for b in ranges[v])
+        if lo > hi:
+            return Check(name, False, f"empty range [{lo}, {hi}] for {v}", data)
+        zeros = _finite_points(sp.solveset(lam, v, sp.Interval(lo - TOUCH_TOL,
+                                                                hi + TOUCH_TOL)))
+        crit = [] if lo == hi else _finite_points(
+            sp.solveset(sp.diff(lam, v), v, sp.Interval(lo, hi)))
+        if crit is None or zeros is None:
+            return Check(name, False,
+                         f"could not enumerate the critical points or zeros of {lam} on "
+                         f"[{float(lo)}, {float(hi)}]", data)
+        cands = [lo, hi, *crit]
+        vals = [(sp.N(lam.subs(v, c), 30), c) for c in cands]
+        m, arg = min(vals, key=lambda p: p[0])
+        if zeros or m <= 0:
+            lost = [float(z) for z in zeros] or [float(arg)]
+            data.update({"lost_at": lost, "lost_at_exact": [str(z) for z in zeros],
+                         "variable": str(v), "range": [float(lo), float(hi)],
+                         "min_value": float(m), "argmin": float(arg)})
+            if zeros:
+                pts = ", ".join(f"{v} = {z} ({float(z):.12g})" for z in zeros)
+                how = f"reaches 0 at {pts}"
+            else:
+                how = "is <= 0 on the whole range (no zero inside)"
+            return Check(name, False,
+                         f"g_s is not uniformly positive definite: eigenvalue {lam} "
+                         f"{how} within [{float(lo):.12g}, {float(hi):.12g}]"
+                         f"; min {lam} = {float(m):.6g} at {v} = {float(arg):.12g}",
+                         data)
+        if m < lower:
+            lower, where = m, {"eigenvalue": str(lam), "at": f"{v} = {float(arg):.12g}"}
+    data.update({"g_lower": float(lower), "where": where})
+    return Check(name, True,
+                 f"g_s = {gs.tolist()} has eigenvalues {list(map(str, eig))}; "
+                 f"lambda_min(g_s) >= g_lower = {float(lower):.12g} (eigenvalue "
+                 f"{where.get('eigenvalue')} at {where.get('at')}) on the given ranges",
+                 data)
+
+
+def assumption2_omnidirectional(heading_range: Sequence[float]) -> Check:
+    """Assumption 2 for the omnidirectional robot (14) on a heading range.
+
+    ``g = R(x3)`` gives ``g_s = diag(cos x3, cos x3, 1)`` (the ``sin`` terms
+    cancel), eigenvalues ``{cos x3 (double), 1}``. PASS with
+    ``g_lower = min(1, min_{x3 in [lo, hi]} cos x3)`` when positive; FAIL with
+    the point (e.g. ``x3 = pi/2``) where the range reaches a zero of ``cos``.
+
+    Parameters
+    ----------
+    heading_range : (lo, hi)
+        Range of ``x3`` the tube (or the state space) allows, in radians.
+    """
+    x3 = sp.Symbol("x3", real=True)
+    return check_assumption2(omnidirectional_g(x3), {x3: tuple(heading_range)},
+                             name="assumption2.omnidirectional")
+
+
+def assumption2_single_integrator(n: int) -> Check:
+    """Assumption 2 for ``x_dot = u + w``: ``g_s = I``, ``g_lower = 1``."""
+    return check_assumption2(single_integrator_g(n), {},
+                             name="assumption2.single_integrator")

@@ -1,0 +1,182 @@
+"""Error transform of section IV and the Lyapunov derivative of Theorem 4.1.
+
+``e_i = (2 x_i - gamma_s_i)/gamma_d_i``, ``epsilon_i = ln((1+e_i)/(1-e_i))``,
+``xi = diag(4/(gamma_d_i (1 - e_i^2)))``. The paper writes
+``xi = 4 gamma_d^{-1} (I - e e^T)^{-1}``; read as an outer product this is not
+the Jacobian of ``epsilon`` for ``n >= 2`` (paper-notes item 2).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import sympy as sp
+
+from .check import Check
+
+__all__ = [
+    "xi_diagonal",
+    "xi_outer_product",
+    "check_epsilon_jacobian",
+    "outer_product_difference",
+    "check_lyapunov_derivative",
+    "error_transform_checks",
+]
+
+XiBuilder = Callable[[sp.Matrix, sp.Matrix], sp.Matrix]
+
+
+def xi_diagonal(e: sp.Matrix, gamma_d: sp.Matrix) -> sp.Matrix:
+    """``xi = diag(4/(gamma_d_i (1 - e_i^2)))`` (the toolkit's reading of (13))."""
+    return sp.diag(*[4 / (gamma_d[i] * (1 - e[i] ** 2)) for i in range(len(e))])
+
+
+def xi_outer_product(e: sp.Matrix, gamma_d: sp.Matrix) -> sp.Matrix:
+    """``xi = 4 gamma_d^{-1} (I - e e^T)^{-1}`` with ``e e^T`` the outer product."""
+    n = len(e)
+    return 4 * sp.diag(*[1 / g for g in gamma_d]) * (sp.eye(n) - e * e.T).inv()
+
+
+def _symbols(n: int) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
+    x = sp.Matrix(sp.symbols(f"x1:{n + 1}", real=True))
+    gs = sp.Matrix(sp.symbols(f"gamma_s1:{n + 1}", real=True))
+    gd = sp.Matrix(sp.symbols(f"gamma_d1:{n + 1}", positive=True))
+    return x, gs, gd
+
+
+def _transform(x: sp.Matrix, gs: sp.Matrix, gd: sp.Matrix) -> tuple[sp.Matrix, sp.Matrix]:
+    e = sp.Matrix([(2 * x[i] - gs[i]) / gd[i] for i in range(len(x))])
+    eps = sp.Matrix([sp.log((1 + ei) / (1 - ei)) for ei in e])
+    return e, eps
+
+
+def check_epsilon_jacobian(n: int, xi: XiBuilder | None = None) -> Check:
+    """Prove ``d epsilon/d x = xi(x, t)`` for dimension ``n``.
+
+    The structural argument for every ``n``: ``epsilon_i`` depends on ``x``
+    only through ``x_i``, so the Jacobian is diagonal, and its ``i``-th entry is
+    the scalar derivative ``d/dx ln((1+e)/(1-e)) = (2/gamma_d) 2/(1-e^2)``. Here
+    the full ``n x n`` Jacobian is computed with symbols ``x_i``,
+    ``gamma_s_i`` (real), ``gamma_d_i > 0`` and compared entry by entry.
+
+    Parameters
+    ----------
+    n : int
+        State dimension (1, 2, 3 are cheap).
+    xi : callable, optional
+        ``xi(e, gamma_d) -> Matrix``; default :func:`xi_diagonal`. Pass
+        :func:`xi_outer_product` to see the paper's literal reading fail.
+    """
+    xi = xi or xi_diagonal
+    x, gs, gd = _symbols(n)
+    e, eps = _transform(x, gs, gd)
+    es = sp.Matrix(sp.symbols(f"e1:{n + 1}", real=True))
+    # evaluate in e-coordinates: x_i = (gamma_d_i e_i + gamma_s_i)/2 (a bijection)
+    back = {x[i]: (gd[i] * es[i] + gs[i]) / 2 for i in range(n)}
+    jac = eps.jacobian(x).subs(back)
+    diff = (jac - xi(es, gd)).applyfunc(lambda v: sp.factor(sp.cancel(sp.together(v))))
+    name = f"theorem4.1.epsilon_jacobian.n{n}"
+    if diff.is_zero_matrix:
+        return Check(name, True,
+                     f"d epsilon/dx = xi exactly for n = {n} (entrywise, symbolic x, "
+                     "gamma_s, gamma_d > 0); off-diagonal entries 0",
+                     {"n": n})
+    bad = [(i, j) for i in range(n) for j in range(n) if diff[i, j] != 0]
+    i, j = bad[0]
+    return Check(name, False,
+                 f"d epsilon/dx - xi is not 0 for n = {n}: entry ({i + 1},{j + 1}) = "
+                 f"{diff[i, j]} (e_i = (2 x_i - gamma_s_i)/gamma_d_i)",
+                 {"n": n, "nonzero_entries": [(a + 1, b + 1) for a, b in bad],
+                  "difference": str(diff)})
+
+
+def outer_product_difference(n: int = 2) -> Check:
+    """Explicit ``xi_outer - d epsilon/dx`` in terms of ``e`` (passes when nonzero).
+
+    By Sherman-Morrison, ``(I - e e^T)^{-1} = I + e e^T/(1 - |e|^2)``, so the
+    outer-product reading equals ``4 gamma_d^{-1} (I + e e^T/(1 - |e|^2))``;
+    the check reports the symbolic difference to the Jacobian with ``e_i`` as
+    independent symbols in ``(-1, 1)``. For ``n = 1`` they agree.
+    """
+    es = sp.Matrix(sp.symbols(f"e1:{n + 1}", real=True))
+    gd = sp.Matrix(sp.symbols(f"gamma_d1:{n + 1}", positive=True))
+    diff = (xi_outer_product(es, gd) - xi_diagonal(es, gd)).applyfunc(
+        lambda v: sp.factor(sp.simplify(v)))
+    sm = 4 * sp.diag(*[1 / g for g in gd]) * (sp.eye(n) + es * es.T / (1 - (es.T * es)[0]))
+    sm_ok = (xi_outer_product(es, gd) - sm).applyfunc(sp.simplify).is_zero_matrix
+    differs = not diff.is_zero_matrix
+    expected = n >= 2
+    return Check(
+        f"theorem4.1.outer_product_reading.n{n}",
+        differs == expected and sm_ok,
+        (f"4 gamma_d^-1 (I - e e^T)^-1 - d epsilon/dx = {diff.tolist()} "
+         f"(n = {n}; Sherman-Morrison form verified): the outer-product reading is "
+         + ("NOT the Jacobian" if differs else "the Jacobian")),
+        {"n": n, "difference": str(diff.tolist()), "differs": differs},
+    )
+
+
+def check_lyapunov_derivative(n: int, xi: XiBuilder | None = None) -> Check:
+    """Prove ``V_dot = epsilon^T xi (x_dot - (gamma_s_dot + gamma_d_dot e)/2)``.
+
+    ``V = epsilon^T epsilon/2`` with ``x_i(t)``, ``gamma_s_i(t)``,
+    ``gamma_d_i(t)`` undefined functions of time (proof of Theorem 4.1,
+    step 2; ``gamma_d_dot`` acts elementwise, being diagonal).
+
+    Parameters
+    ----------
+    n : int
+        State dimension.
+    xi : callable, optional
+        As in :func:`check_epsilon_jacobian`.
+    """
+    xi = xi or xi_diagonal
+    t = sp.Symbol("t", real=True)
+    x = sp.Matrix([sp.Function(f"x{i + 1}", real=True)(t) for i in range(n)])
+    gs = sp.Matrix([sp.Function(f"gamma_s{i + 1}", real=True)(t) for i in range(n)])
+    gd = sp.Matrix([sp.Function(f"gamma_d{i + 1}", positive=True)(t) for i in range(n)])
+    e, eps = _transform(x, gs, gd)
+    v = (eps.T * eps)[0] / 2
+    vdot = sp.diff(v, t)
+    rhs = (eps.T * xi(e, gd) * (x.diff(t) - (gs.diff(t) + sp.matrix_multiply_elementwise(
+        gd.diff(t), e)) / 2))[0]
+    # Freeze time: derivatives and functions -> symbols, logs -> symbols L_i, then
+    # x_i -> (gamma_d_i e_i + gamma_s_i)/2. The difference is linear in the L_i.
+    logs = sp.symbols(f"L1:{n + 1}", real=True)
+    es = sp.symbols(f"e1:{n + 1}", real=True)
+    frozen: dict[sp.Expr, sp.Expr] = {}
+    for i in range(n):
+        for name_, f in (("xdot", x[i]), ("gsdot", gs[i]), ("gddot", gd[i])):
+            frozen[f.diff(t)] = sp.Symbol(f"{name_}{i + 1}", real=True)
+    diff = (vdot - rhs).subs(frozen).subs({eps[i]: logs[i] for i in range(n)})
+    plain = {x[i]: sp.Symbol(f"x{i + 1}", real=True) for i in range(n)}
+    plain.update({gs[i]: sp.Symbol(f"gamma_s{i + 1}", real=True) for i in range(n)})
+    plain.update({gd[i]: sp.Symbol(f"gamma_d{i + 1}", positive=True) for i in range(n)})
+    diff = diff.subs(plain)
+    diff = diff.subs({plain[x[i]]: (plain[gd[i]] * es[i] + plain[gs[i]]) / 2
+                      for i in range(n)})
+    diff = sp.expand(diff)
+    coeffs = {str(l_): sp.factor(sp.cancel(sp.together(diff.coeff(l_)))) for l_ in logs}
+    rest = sp.cancel(sp.together(diff - sum(diff.coeff(l_) * l_ for l_ in logs)))
+    if all(c == 0 for c in coeffs.values()) and rest == 0 and not diff.has(sp.log):
+        diff = sp.Integer(0)
+    else:
+        diff = sum(c * sp.Symbol(f"eps{k[1:]}") for k, c in coeffs.items()) + rest
+    name = f"theorem4.1.lyapunov_derivative.n{n}"
+    if diff == 0:
+        return Check(name, True,
+                     f"d/dt (eps^T eps/2) = eps^T xi (x_dot - (gamma_s_dot + gamma_d_dot e)/2) "
+                     f"identically for n = {n} (time-dependent x, gamma_s, gamma_d)",
+                     {"n": n})
+    return Check(name, False,
+                 f"V_dot - eps^T xi (x_dot - (gamma_s_dot + gamma_d_dot e)/2) = {diff} "
+                 f"for n = {n} (frozen time: xdot_i, gsdot_i, gddot_i the rates, eps_i "
+                 "the transformed errors)", {"n": n, "difference": str(diff)})
+
+
+def error_transform_checks(max_n: int = 3) -> list[Check]:
+    """Jacobian (n = 1..max_n), outer-product difference (n = 2), V_dot (n = 1..max_n)."""
+    out = [check_epsilon_jacobian(n) for n in range(1, max_n + 1)]
+    out.append(outer_product_difference(2))
+    out += [check_lyapunov_derivative(n) for n in range(1, max_n + 1)]
+    return out
