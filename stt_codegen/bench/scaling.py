@@ -1,0 +1,255 @@
+"""``stt-codegen bench scaling``: code size, generation time and step cost against the
+number of obstacles and the state dimension, and whether a step pays for every obstacle
+or only for the active ones.
+
+Random specs with hundreds of obstacles do not design (the arena fills up), so the
+designs are built directly (:func:`synthetic_design`): a :class:`~stt_codegen.tube.TubeDesign`
+on ``[0, 5]^n`` from ``x(0) = 0.25`` to the target box ``[4.55, 4.95]^n`` with ``m``
+synthetic :class:`~stt_codegen.tube.Circumvent` s (seeded: dimension and side at random,
+window centre in ``[0.5, 8.5]`` s, half-width in ``[0.3, 1]`` s, height in ``[0.2, 1]`` m),
+the bundled specs' tube parameters and 1 kHz. They are not certified: they only have the
+size and structure of real designs, which is what code size and step cost depend on.
+
+The *active-window* experiment builds three designs with the same ``m`` circumvents that
+differ only in their windows: all open during the whole recorded run ``[0, t_c)``, all
+closed (windows after ``t_c + 10`` s), and the random windows above. If the step's cost
+depended only on the active windows, the closed design would be much cheaper.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import numpy as np
+
+from ..errors import SpecError
+from ..tube import LOWER, UPPER, Circumvent, TubeDesign
+from .harness import BenchError, build_harness
+from .report import machine, machine_line, seconds_text, table
+from .timing import MIN_BATCH_SECONDS
+
+#: Obstacles in the dimension sweep (the case study's count).
+DIMENSION_SWEEP_OBSTACLES = 4
+#: Obstacles of the active-window experiment.
+ACTIVE_EXPERIMENT_OBSTACLES = 100
+REPEATS = 5
+ARENA_SIZE = 5.0
+
+
+def synthetic_design(obstacles: int, dimension: int, windows: str = "random",
+                     seed: int = 0) -> TubeDesign:
+    """A design of the size of a real one, with ``obstacles`` synthetic circumvents.
+
+    Parameters
+    ----------
+    obstacles : int
+        ``m >= 0``.
+    dimension : int
+        ``n >= 1``.
+    windows : {"random", "open", "closed"}
+        ``"open"``: every window is ``[-1, t_c + 1]``; ``"closed"``: every window lies in
+        ``[t_c + 10, t_c + 12]`` (never open before ``t_c``); ``"random"``: see the module
+        docstring. With ``"open"`` and ``"closed"`` the heights are scaled by 0.05 so that
+        the closed loop stays inside the tube (the computation graph is the same).
+    seed : int
+
+    Returns
+    -------
+    TubeDesign
+
+    Raises
+    ------
+    SpecError
+        Negative counts, zero dimension or an unknown ``windows``.
+    """
+    if obstacles < 0:
+        raise SpecError("--obstacles", f"must be non-negative, got {obstacles}")
+    if dimension < 1:
+        raise SpecError("--dimensions", f"must be at least 1, got {dimension}")
+    if windows not in ("random", "open", "closed"):
+        raise SpecError("windows", f"unknown window mode {windows!r}")
+    t_c = 9.0
+    rng = np.random.default_rng([seed, obstacles, dimension])
+    circumvents = []
+    for j in range(obstacles):
+        i = int(rng.integers(dimension))
+        side = LOWER if rng.random() < 0.5 else UPPER
+        center, radius = rng.uniform(0.5, 8.5), rng.uniform(0.3, 1.0)
+        if windows == "open":
+            center, radius = t_c / 2, t_c / 2 + 1.0
+        elif windows == "closed":
+            center, radius = t_c + 11.0, 1.0
+        height = float(rng.uniform(0.2, 1.0))
+        if windows != "random":  # keep x(0) and the run inside the tube: same graph
+            height *= 0.05
+        base = 0.0 if side == LOWER else ARENA_SIZE
+        circumvents.append(Circumvent(j, i, side, float(center - radius),
+                                      float(center + radius), height, base))
+    circumvents.sort(key=lambda c: (c.dimension, c.side, c.obstacle))
+    n = dimension
+    return TubeDesign(
+        name=f"synthetic_m{obstacles}_n{dimension}", prescribed_time=t_c,
+        state_lower=(0.0,) * n, state_upper=(ARENA_SIZE,) * n,
+        initial_lower=(0.05,) * n, initial_upper=(0.45,) * n,
+        target_lower=(4.55,) * n, target_upper=(4.95,) * n, initial_state=(0.25,) * n,
+        circumvents=tuple(circumvents), circumvent_sharpness=0.1, smoothness=50.0,
+        theta0=0.01, kappa=5.0, mu=1.0, gain=0.2, rate_hz=1000.0)
+
+
+def measure(design: TubeDesign, compile_timeout: float, callgrind: bool = True,
+            callgrind_steps: int = 200) -> dict[str, Any]:
+    """Generation time, sizes, time and instructions per step of one design.
+
+    Returns
+    -------
+    dict
+        ``obstacles``, ``dimension``, ``generate_s``, ``compile_s``, ``source_bytes``,
+        ``object_bytes``, ``seconds_per_step`` (median of :data:`REPEATS` compiled-loop
+        runs of about 0.2 s), ``instructions_per_step`` (callgrind, or None),
+        ``operations`` (of the CasADi ``controller_step``), ``outside_tube_inputs``;
+        or, when the build fails, ``error``.
+    """
+    from ..emit import count_operations
+    from ..model import build_model
+    row: dict[str, Any] = {"obstacles": len(design.circumvents), "dimension": design.dimension}
+    try:
+        harness = build_harness(design, compile_timeout=compile_timeout)
+    except BenchError as exc:
+        row["error"] = str(exc).splitlines()[0]
+        return row
+    try:
+        _, _, _, outside = harness.record()
+        probe = harness.time_step(200, 1)[0]
+        steps = max(200, int(MIN_BATCH_SECONDS / max(probe, 1e-9)))
+        counts = count_operations(build_model(design)["controller_step"])
+        row.update({
+            "generate_s": harness.generate_seconds, "compile_s": harness.compile_seconds,
+            "source_bytes": harness.source_bytes, "object_bytes": harness.object_bytes,
+            "seconds_per_step": float(np.median(harness.time_step(steps, REPEATS))),
+            "instructions_per_step": (harness.instructions_per_step(callgrind_steps)
+                                      if callgrind else None),
+            "operations": {"arithmetic": counts.arithmetic,
+                           "transcendental": counts.transcendental, "total": counts.total},
+            "outside_tube_inputs": outside})
+    finally:
+        harness.cleanup()
+    return row
+
+
+def _int_list(text: str, field: str) -> list[int]:
+    try:
+        values = [int(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise SpecError(field, f"expected a comma-separated list of integers, got {text!r}") from None
+    if not values:
+        raise SpecError(field, "empty list")
+    return values
+
+
+def run_scaling_bench(obstacles: list[int], dimensions: list[int],
+                      compile_timeout: float = 900.0, active_obstacles: int | None = None,
+                      callgrind: bool = True) -> dict[str, Any]:
+    """Measure :func:`measure` for every obstacle count (at ``n = 2``), every dimension
+    (at :data:`DIMENSION_SWEEP_OBSTACLES` obstacles) and the active-window experiment.
+
+    Parameters
+    ----------
+    obstacles, dimensions : list of int
+    compile_timeout : float
+        Seconds allowed per compilation; a design that takes longer is reported with an
+        ``error``.
+    active_obstacles : int, optional
+        Circumvents of the active-window experiment (default
+        :data:`ACTIVE_EXPERIMENT_OBSTACLES`; 0 skips it).
+    callgrind : bool
+
+    Returns
+    -------
+    dict
+        ``machine``, ``obstacle_sweep``, ``dimension_sweep``, ``active_windows`` (rows of
+        :func:`measure` with a ``windows`` key) and ``conclusion`` (a sentence).
+    """
+    for m in obstacles:
+        if m < 0:
+            raise SpecError("--obstacles", f"must be non-negative, got {m}")
+    for n in dimensions:
+        if n < 1:
+            raise SpecError("--dimensions", f"must be at least 1, got {n}")
+    active = ACTIVE_EXPERIMENT_OBSTACLES if active_obstacles is None else active_obstacles
+    report: dict[str, Any] = {"machine": machine(), "obstacle_sweep": [],
+                              "dimension_sweep": [], "active_windows": []}
+    for m in obstacles:
+        report["obstacle_sweep"].append(measure(synthetic_design(m, 2), compile_timeout, callgrind))
+    for n in dimensions:
+        report["dimension_sweep"].append(
+            measure(synthetic_design(DIMENSION_SWEEP_OBSTACLES, n), compile_timeout, callgrind))
+    if active:
+        for mode in ("open", "random", "closed"):
+            row = measure(synthetic_design(active, 2, windows=mode), compile_timeout, callgrind)
+            row["windows"] = mode
+            report["active_windows"].append(row)
+    report["conclusion"] = _conclusion(report["active_windows"])
+    return report
+
+
+def _conclusion(rows: list[dict[str, Any]]) -> str:
+    by_mode = {r["windows"]: r for r in rows if "error" not in r}
+    if "open" not in by_mode or "closed" not in by_mode:
+        return "active-window experiment not run"
+    key = ("instructions_per_step" if by_mode["open"].get("instructions_per_step")
+           else "seconds_per_step")
+    ratio = by_mode["closed"][key] / by_mode["open"][key]
+    verdict = ("every circumvent is evaluated at every step whether its window is open "
+               "or not: the cost grows with all obstacles" if ratio > 0.5 else
+               "closed windows are cheaper: the cost depends on the active windows")
+    return (f"with {by_mode['open']['obstacles']} circumvents, all windows closed costs "
+            f"{ratio:.2f} x all windows open ({key.replace('_', ' ')}): {verdict}")
+
+
+def _row_cells(r: dict[str, Any], first: str) -> list[str]:
+    if "error" in r:
+        return [first, "-", "-", "-", "-", "-", "-", "-", r["error"]]
+    ir = r.get("instructions_per_step")
+    ops = r["operations"]
+    return [first, f"{r['generate_s']:.2f} s", f"{r['compile_s']:.2f} s",
+            f"{r['source_bytes'] / 1024:.0f} KiB", f"{r['object_bytes'] / 1024:.0f} KiB",
+            seconds_text(r["seconds_per_step"]), "-" if ir is None else f"{ir:.0f}",
+            f"{ops['arithmetic']} / {ops['transcendental']}",
+            str(r["outside_tube_inputs"])]
+
+
+def format_scaling_report(report: dict[str, Any]) -> str:
+    """The human-readable tables of :func:`run_scaling_bench`'s result."""
+    header = ["{}", "generate", "compile -O2", "C source", "object", "time/step",
+              "instr/step", "arith / transc.", "outside"]
+    out = []
+    for key, label, col in (("obstacle_sweep", "obstacles (n = 2)", "obstacles"),
+                            ("dimension_sweep",
+                             f"state dimension ({DIMENSION_SWEEP_OBSTACLES} obstacles)",
+                             "dimension")):
+        if report[key]:
+            out.append(label)
+            out.append(table([col] + header[1:], [_row_cells(r, str(r[col]))
+                                                  for r in report[key]]))
+    if report["active_windows"]:
+        m = report["active_windows"][0]["obstacles"]
+        out.append(f"active windows ({m} circumvents, n = 2)")
+        out.append(table(["windows"] + header[1:],
+                         [_row_cells(r, r["windows"]) for r in report["active_windows"]]))
+    out.append(report["conclusion"])
+    out.append("generate: CasADi model + C text + test vectors; compile: the generated .c "
+               "alone; object: text + data + bss (all four deployed functions); "
+               "outside: recorded closed-loop inputs (of 9000) outside the synthetic tube")
+    out.append(machine_line(report["machine"]))
+    return "\n".join(out)
+
+
+def main_scaling(args) -> int:
+    """Handler of ``bench scaling``; exit 0."""
+    report = run_scaling_bench(_int_list(args.obstacles, "--obstacles"),
+                               _int_list(args.dimensions, "--dimensions"),
+                               compile_timeout=args.compile_timeout)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_scaling_report(report))
+    return 0
