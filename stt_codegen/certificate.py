@@ -208,15 +208,30 @@ def certify_tube(design: TubeDesign, spec: Spec, horizon: float | None = None,
                           f"min distance to the state-space boundary {m:.6g} at t = {t:.4f} s"))
 
     boxes = spec.obstacle_boxes()
-    for j in (range(len(boxes)) if obstacles is None else obstacles):
-        box = boxes[j]
-        gaps = np.maximum(np.array(box.lower) - enc.upper_max, enc.lower_min - np.array(box.upper))
-        sep = gaps.max(axis=1)
+    selected = range(len(boxes)) if obstacles is None else obstacles
+    by_source: dict[int, list[int]] = {}
+    for b in selected:
+        by_source.setdefault(spec.obstacles[b].source, []).append(b)
+    for j, members in sorted(by_source.items()):
+        # the separation from the union of a shape's covering boxes bounds the separation
+        # from the shape itself (the union contains it)
+        seps, gaps_all = [], []
+        for b in members:
+            box = boxes[b]
+            gaps = np.maximum(np.array(box.lower) - enc.upper_max,
+                              enc.lower_min - np.array(box.upper))
+            seps.append(gaps.max(axis=1))
+            gaps_all.append(gaps)
+        sep = np.min(seps, axis=0)
         m, t, k = _worst(sep, t0)
+        worst_box = int(np.argmin([v[k] for v in seps]))
+        dim = int(np.argmax(gaps_all[worst_box][k]))
+        what = f"obstacle {j}" + (f" (box {members[worst_box]} of its covering)"
+                                  if len(members) > 1 else "")
         margins.append(Margin(f"avoids obstacle {j}", m > ROUNDING_MARGIN, m, t,
-                              f"separation >= {m:.6g} along dimension {int(np.argmax(gaps[k]))} "
+                              f"separation from {what} >= {m:.6g} along dimension {dim} "
                               f"(interval at t = {t:.4f} s)" if m > ROUNDING_MARGIN else
-                              f"the tube may meet obstacle {j} on [{t:.4f}, "
+                              f"the tube may meet {what} on [{t:.4f}, "
                               f"{float(enc.t_end[k]):.4f}] s (separation {m:.3g})"))
 
     late = enc.t_end > design.prescribed_time

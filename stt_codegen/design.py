@@ -252,6 +252,7 @@ def _ordered(circumvents) -> tuple[Circumvent, ...]:
     return tuple(sorted(circumvents, key=lambda c: (c.dimension, c.side, c.obstacle)))
 
 
+
 def default_gain(design: TubeDesign, samples: TubeSamples) -> float:
     """Default ``k`` of law (13): half the sampled-loop stability limit at the narrowest tube.
 
@@ -286,20 +287,33 @@ def design_tube(spec: Spec) -> tuple[TubeDesign, TubeCheck]:
     base = base_design(spec)
     boxes = spec.obstacle_boxes()
     delta_b = spec.tube.delta_b
-    options = {}
-    starts = {}
-    for j, box in enumerate(boxes):
+    # one choice of (dimension, side) per spec obstacle: a ball or polytope covered by
+    # several boxes (Remark 3.1) is passed on one side by all of them
+    groups: dict[int, list[int]] = {}
+    starts: dict[int, float] = {}
+    per_box: dict[int, dict[tuple[int, str], Circumvent]] = {}
+    rank: dict[int, list[tuple[int, str]]] = {}
+    for b, box in enumerate(boxes):
+        j = spec.obstacles[b].source
         interval = overlap_interval(base, box, WINDOW_INFLATION * delta_b)
         if interval is None:
             continue
         if interval[1] >= 1.0:
             raise DesignError(f"obstacle {j} comes within {WINDOW_INFLATION * delta_b:g} of "
                               "the target box eta +- d_T: shrink target.half_width")
-        options[j] = candidates(base, spec, j, delta_b)
-        if not options[j]:
+        found_here = candidates(base, spec, b, delta_b)
+        per_box[b] = {(c.circumvent.dimension, c.circumvent.side): c.circumvent
+                      for c in found_here}
+        groups.setdefault(j, []).append(b)
+        rank.setdefault(j, [(c.circumvent.dimension, c.circumvent.side) for c in found_here])
+        starts[j] = min(starts.get(j, math.inf), progress_time(base, interval[0]))
+    options: dict[int, list[tuple[Circumvent, ...]]] = {}
+    for j, members in groups.items():
+        keys = [key for key in rank[j] if all(key in per_box[b] for b in members)]
+        if not keys:
             raise DesignError(f"obstacle {j} cannot be circumvented: no dimension leaves "
                               f"room of delta_b = {delta_b:g} beside it")
-        starts[j] = progress_time(base, interval[0])
+        options[j] = [tuple(per_box[b][key] for b in members) for key in keys]
     order = sorted(options, key=lambda j: (starts[j], j))
     failures: dict[int, str] = {}
 
@@ -309,14 +323,14 @@ def design_tube(spec: Spec) -> tuple[TubeDesign, TubeCheck]:
             check = check_tube(design, spec)
             return (design, check) if check.passed else None
         j = order[level]
-        done = order[:level + 1]
-        for cand in options[j]:
-            design = replace(base, circumvents=_ordered(chosen + (cand.circumvent,)))
-            check = check_tube(design, spec, obstacles=list(done), final=False)
+        done = [b for k in order[:level + 1] for b in groups[k]]
+        for option in options[j]:
+            design = replace(base, circumvents=_ordered(chosen + option))
+            check = check_tube(design, spec, obstacles=done, final=False)
             if not check.passed:
                 failures.setdefault(j, check.reason)
                 continue
-            found = search(level + 1, chosen + (cand.circumvent,))
+            found = search(level + 1, chosen + option)
             if found is not None:
                 return found
         return None

@@ -71,7 +71,10 @@ class Box:
 
 @dataclass(frozen=True)
 class Obstacle:
-    """One unsafe set ``U^j`` (a box), given on some dimensions.
+    """One box obstacle ``U^j`` the tube design avoids, given on some dimensions.
+
+    A box from the spec is one obstacle; a ball or polytope from the spec becomes the
+    several boxes of its covering (Remark 3.1), all with the same ``source``.
 
     Attributes
     ----------
@@ -80,19 +83,59 @@ class Obstacle:
     dims : tuple of int
         The state dimensions the bounds apply to; in every other dimension the
         obstacle spans the whole state space.
+    source : int
+        Index of the spec's ``[[obstacles]]`` entry it comes from.
     """
 
     lower: tuple[float, ...]
     upper: tuple[float, ...]
     dims: tuple[int, ...]
+    source: int = 0
 
     def box(self, state_space: Box) -> Box:
         """The obstacle as a full-dimensional box inside ``state_space``."""
-        lower = list(state_space.lower)
-        upper = list(state_space.upper)
-        for k, i in enumerate(self.dims):
-            lower[i], upper[i] = self.lower[k], self.upper[k]
-        return Box(tuple(lower), tuple(upper))
+        return _embed(self.lower, self.upper, self.dims, state_space)
+
+
+def _embed(lower, upper, dims, state_space: Box) -> Box:
+    lo, hi = list(state_space.lower), list(state_space.upper)
+    for k, i in enumerate(dims):
+        lo[i], hi[i] = float(lower[k]), float(upper[k])
+    return Box(tuple(lo), tuple(hi))
+
+
+@dataclass(frozen=True)
+class UnsafeSet:
+    """An ``[[obstacles]]`` entry as the user gave it: a box, a ball or a convex polytope.
+
+    Attributes
+    ----------
+    kind : {"box", "ball", "polytope"}
+    dims : tuple of int
+    shape : Box, Ball or Polytope
+        In the coordinates ``dims`` (a ``Box`` of length ``len(dims)`` for boxes).
+    tolerance : float or None
+        Covering tolerance (balls and polytopes), state units.
+    """
+
+    kind: str
+    dims: tuple[int, ...]
+    shape: Any
+    tolerance: float | None = None
+
+    def signed_clearance(self, points) -> "Any":
+        """Distance of each state (N, n) outside the set, minus its depth inside.
+
+        Exact for boxes and balls; for polytopes the distance to the nearest facet's
+        plane, a lower bound of the distance (exact off the edges).
+        """
+        import numpy as np
+        y = np.atleast_2d(points)[:, list(self.dims)]
+        if self.kind == "box":
+            gaps = np.maximum(np.array(self.shape.lower) - y, y - np.array(self.shape.upper))
+            outside = np.sqrt(np.sum(np.maximum(gaps, 0.0) ** 2, axis=1))
+            return np.where(np.any(gaps > 0, axis=1), outside, gaps.max(axis=1))
+        return self.shape.signed_clearance(y)
 
 
 @dataclass(frozen=True)
@@ -148,7 +191,10 @@ class Spec:
     target_half_width : tuple of float
         ``d_T`` of eq. (3); ``eta +- d_T`` lies inside ``T``.
     obstacles : tuple of Obstacle
-        The unsafe sets ``U^j``.
+        The box obstacles the tube avoids: the spec's boxes and the coverings of its
+        balls and polytopes, in the spec's order.
+    unsafe_sets : tuple of UnsafeSet
+        The ``[[obstacles]]`` entries as given (for collision checks and plots).
     tube : TubeParameters
     gain : float or None
         ``k`` of law (13); ``None`` lets the design choose it.
@@ -172,6 +218,7 @@ class Spec:
     target_center: tuple[float, ...]
     target_half_width: tuple[float, ...]
     obstacles: tuple[Obstacle, ...]
+    unsafe_sets: tuple[UnsafeSet, ...]
     tube: TubeParameters
     gain: float | None
     rate_hz: float
@@ -398,13 +445,8 @@ def _validate(doc: dict) -> Spec:
                                              f"({a!r}, {b!r}) of the target set")
     d_t = _half_width(target_t, "target", eta, target_set, "target set")
 
-    obstacles = _obstacles(doc.get("obstacles", []), state_space)
-    for j, obstacle in enumerate(obstacles):
-        box = obstacle.box(state_space)
-        if box.meets(initial_set):
-            raise SpecError(f"obstacles[{j}]", "meets the initial set")
-        if box.meets(target_set):
-            raise SpecError(f"obstacles[{j}]", "meets the target set")
+    unsafe_sets = _unsafe_sets(doc.get("obstacles", []), state_space)
+    obstacles = _cover_all(unsafe_sets, state_space, initial_set, target_set)
 
     tube_t = _table(doc, "tube", False, set(_TUBE_DEFAULTS))
     tube = TubeParameters(**{key: _positive(tube_t.get(key, default), f"tube.{key}")
@@ -432,11 +474,44 @@ def _validate(doc: dict) -> Spec:
     return Spec(name=name, prescribed_time=t_c, state_space=state_space,
                 initial_set=initial_set, initial_state=x0, initial_half_width=d0,
                 target_set=target_set, target_center=eta, target_half_width=d_t,
-                obstacles=obstacles, tube=tube, gain=gain, rate_hz=rate_hz,
+                obstacles=obstacles, unsafe_sets=unsafe_sets, tube=tube, gain=gain,
+                rate_hz=rate_hz,
                 plant_model=model, disturbance_amplitude=amplitude)
 
 
-def _obstacles(value: Any, state_space: Box) -> tuple[Obstacle, ...]:
+#: Default covering tolerance of balls and polytopes, state units.
+DEFAULT_COVERING_TOLERANCE = 0.05
+_BOX_KEYS = {"lower", "upper", "dims"}
+_BALL_KEYS = {"center", "radius", "dims", "tolerance"}
+_POLYTOPE_KEYS = {"vertices", "dims", "tolerance"}
+
+
+def _dims(table: dict, name: str, m: int, n: int, coordinates: str) -> tuple[int, ...]:
+    if m > n:
+        raise SpecError(f"{name}.{coordinates}", f"{m} entries for a {n}-dimensional "
+                                                 "state space")
+    if "dims" not in table:
+        return tuple(range(m))
+    dims_v = table["dims"]
+    if not isinstance(dims_v, list) or len(dims_v) != m:
+        raise SpecError(f"{name}.dims", f"must be an array of {m} dimension indices")
+    for d in dims_v:
+        if isinstance(d, bool) or not isinstance(d, int) or not 0 <= d < n:
+            raise SpecError(f"{name}.dims", f"{d!r} is not a dimension index in 0..{n - 1}")
+    if len(set(dims_v)) != m:
+        raise SpecError(f"{name}.dims", "repeats a dimension")
+    return tuple(dims_v)
+
+
+def _inside(lower, upper, dims, state_space: Box, name: str) -> None:
+    for k, i in enumerate(dims):
+        if lower[k] < state_space.lower[i] or upper[k] > state_space.upper[i]:
+            raise SpecError(name, f"dimension {i} of the obstacle [{lower[k]!r}, {upper[k]!r}] "
+                                  "is not inside the state space")
+
+
+def _unsafe_sets(value: Any, state_space: Box) -> tuple[UnsafeSet, ...]:
+    from .shapes import Ball, make_polytope
     n = len(state_space.lower)
     if not isinstance(value, list):
         raise SpecError("obstacles", f"must be an array of tables, got {_kind(value)}")
@@ -447,28 +522,66 @@ def _obstacles(value: Any, state_space: Box) -> tuple[Obstacle, ...]:
         name = f"obstacles[{j}]"
         if not isinstance(table, dict):
             raise SpecError(name, f"must be a table, got {_kind(table)}")
-        _no_unknown(table, {"lower", "upper", "dims"}, name)
-        box = _box(table, name, None)
-        m = len(box.lower)
-        if m > n:
-            raise SpecError(f"{name}.lower", f"{m} entries for a {n}-dimensional state space")
-        if "dims" in table:
-            dims_v = table["dims"]
-            if not isinstance(dims_v, list) or len(dims_v) != m:
-                raise SpecError(f"{name}.dims", f"must be an array of {m} dimension indices")
-            for d in dims_v:
-                if isinstance(d, bool) or not isinstance(d, int) or not 0 <= d < n:
-                    raise SpecError(f"{name}.dims", f"{d!r} is not a dimension index "
-                                                    f"in 0..{n - 1}")
-            if len(set(dims_v)) != m:
-                raise SpecError(f"{name}.dims", "repeats a dimension")
-            dims = tuple(dims_v)
+        if "vertices" in table:
+            _no_unknown(table, _POLYTOPE_KEYS, name)
+            verts = table["vertices"]
+            if not isinstance(verts, list) or not verts or not all(isinstance(v, list)
+                                                                   for v in verts):
+                raise SpecError(f"{name}.vertices", "must be an array of points (arrays)")
+            if len(verts) > 1024:
+                raise SpecError(f"{name}.vertices", f"{len(verts)} vertices; at most 1024")
+            m = len(verts[0]) if isinstance(verts[0], list) else 0
+            points = [_vector(v, f"{name}.vertices[{k}]", m) for k, v in enumerate(verts)]
+            dims = _dims(table, name, m, n, "vertices")
+            shape = make_polytope([list(p) for p in points], name)
+        elif "center" in table or "radius" in table:
+            _no_unknown(table, _BALL_KEYS, name)
+            for key in ("center", "radius"):
+                if key not in table:
+                    raise SpecError(f"{name}.{key}", "missing")
+            center = _vector(table["center"], f"{name}.center", None)
+            dims = _dims(table, name, len(center), n, "center")
+            shape = Ball(center, _positive(table["radius"], f"{name}.radius"))
         else:
-            dims = tuple(range(m))
-        for k, i in enumerate(dims):
-            if box.lower[k] < state_space.lower[i] or box.upper[k] > state_space.upper[i]:
-                raise SpecError(name, f"dimension {i} of the obstacle "
-                                      f"[{box.lower[k]!r}, {box.upper[k]!r}] is not inside "
-                                      "the state space")
-        result.append(Obstacle(box.lower, box.upper, dims))
+            _no_unknown(table, _BOX_KEYS, name)
+            box = _box(table, name, None)
+            dims = _dims(table, name, len(box.lower), n, "lower")
+            _inside(box.lower, box.upper, dims, state_space, name)
+            result.append(UnsafeSet("box", dims, box))
+            continue
+        _inside(shape.lower, shape.upper, dims, state_space, name)
+        tolerance = _positive(table.get("tolerance", DEFAULT_COVERING_TOLERANCE),
+                              f"{name}.tolerance")
+        result.append(UnsafeSet("ball" if isinstance(shape, Ball) else "polytope", dims,
+                                shape, tolerance))
     return tuple(result)
+
+
+def _cover_all(unsafe_sets: tuple[UnsafeSet, ...], state_space: Box, initial_set: Box,
+               target_set: Box) -> tuple[Obstacle, ...]:
+    """Check each set against ``X0`` and ``T`` and cover balls and polytopes by boxes."""
+    import numpy as np
+
+    from .covering import cover
+    obstacles = []
+    for j, unsafe in enumerate(unsafe_sets):
+        name = f"obstacles[{j}]"
+        dims = list(unsafe.dims)
+        forbidden = [(np.array(b.lower)[dims], np.array(b.upper)[dims])
+                     for b in (initial_set, target_set)]
+        for (lo, hi), label in zip(forbidden, ("initial", "target")):
+            if unsafe.kind == "box":
+                meets = _embed(unsafe.shape.lower, unsafe.shape.upper, unsafe.dims,
+                               state_space).meets(initial_set if label == "initial"
+                                                  else target_set)
+            else:
+                meets = unsafe.shape.meets_box(lo, hi)
+            if meets:
+                raise SpecError(name, f"meets the {label} set")
+        if unsafe.kind == "box":
+            obstacles.append(Obstacle(unsafe.shape.lower, unsafe.shape.upper, unsafe.dims, j))
+            continue
+        for lo, hi in cover(unsafe.shape, unsafe.tolerance, forbidden, name):
+            obstacles.append(Obstacle(tuple(float(v) for v in lo), tuple(float(v) for v in hi),
+                                      unsafe.dims, j))
+    return tuple(obstacles)

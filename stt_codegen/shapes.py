@@ -1,0 +1,179 @@
+"""Convex unsafe sets that are not boxes: balls and convex polytopes (Remark 3.1).
+
+Each shape lives in the subspace of the dimensions it is given on (``k`` of them) and
+spans the state space in the others. All geometry here is in those ``k`` coordinates.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import linprog, minimize
+from scipy.spatial import ConvexHull, QhullError
+
+from .errors import SpecError
+
+
+@dataclass(frozen=True)
+class Ball:
+    """The closed ball ``{y : |y - center| <= radius}``.
+
+    Attributes
+    ----------
+    center : tuple of float, length k
+    radius : float
+        Positive, state units.
+    """
+
+    center: tuple[float, ...]
+    radius: float
+
+    @property
+    def lower(self) -> tuple[float, ...]:
+        return tuple(c - self.radius for c in self.center)
+
+    @property
+    def upper(self) -> tuple[float, ...]:
+        return tuple(c + self.radius for c in self.center)
+
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """Euclidean distance from each point (N, k) to the ball; 0 inside."""
+        d = np.linalg.norm(np.atleast_2d(points) - np.array(self.center), axis=1)
+        return np.maximum(d - self.radius, 0.0)
+
+    def signed_clearance(self, points: np.ndarray) -> np.ndarray:
+        """Distance outside, minus the depth inside, shape (N,)."""
+        return np.linalg.norm(np.atleast_2d(points) - np.array(self.center), axis=1) - self.radius
+
+    def box_hull(self, lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """The smallest box containing ``ball ∩ [lower, upper]``, or ``None`` if empty."""
+        c = np.array(self.center)
+        gap = np.maximum(np.maximum(lower - c, c - upper), 0.0)
+        if np.sum(gap**2) > self.radius**2:
+            return None
+        lo, hi = np.empty_like(c), np.empty_like(c)
+        for i in range(c.size):
+            others = np.sum(gap**2) - gap[i] ** 2
+            reach = math.sqrt(max(self.radius**2 - others, 0.0))
+            lo[i] = max(lower[i], c[i] - reach)
+            hi[i] = min(upper[i], c[i] + reach)
+        return lo, hi
+
+    def meets_box(self, lower: np.ndarray, upper: np.ndarray) -> bool:
+        return self.box_hull(np.asarray(lower, float), np.asarray(upper, float)) is not None
+
+
+@dataclass(frozen=True)
+class Polytope:
+    """The convex hull of a list of vertices, with its facets ``A y <= b``.
+
+    Attributes
+    ----------
+    vertices : tuple of tuple of float
+        At least ``k + 1`` affinely independent points in ``k`` dimensions.
+    """
+
+    vertices: tuple[tuple[float, ...], ...]
+    _a: np.ndarray = field(init=False, repr=False, compare=False)
+    _b: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        points = np.array(self.vertices, dtype=float)
+        k = points.shape[1]
+        if k == 1:
+            a = np.array([[1.0], [-1.0]])
+            b = np.array([points.max(), -points.min()])
+        else:
+            hull = ConvexHull(points)
+            a, b = hull.equations[:, :-1], -hull.equations[:, -1]
+            norms = np.linalg.norm(a, axis=1)
+            a, b = a / norms[:, None], b / norms
+        object.__setattr__(self, "_a", a)
+        object.__setattr__(self, "_b", b)
+
+    @property
+    def lower(self) -> tuple[float, ...]:
+        return tuple(np.array(self.vertices).min(axis=0).tolist())
+
+    @property
+    def upper(self) -> tuple[float, ...]:
+        return tuple(np.array(self.vertices).max(axis=0).tolist())
+
+    def signed_clearance(self, points: np.ndarray) -> np.ndarray:
+        """A lower bound of the distance outside (exact off the facets' edges), minus the depth inside.
+
+        ``max_i (a_i . y - b_i)`` with unit normals: the distance to the nearest facet's
+        plane, which never exceeds the true distance to the polytope.
+        """
+        return np.max(np.atleast_2d(points) @ self._a.T - self._b, axis=1)
+
+    def distance(self, point: np.ndarray) -> float:
+        """Euclidean distance from one point (k,) to the polytope.
+
+        Closed form in one and two dimensions (distance to the nearest edge); a small
+        convex QP (SLSQP) in more.
+        """
+        p = np.asarray(point, dtype=float)
+        if np.all(self._a @ p <= self._b + 1e-12):
+            return 0.0
+        points = np.array(self.vertices, dtype=float)
+        if p.size == 1:
+            return float(max(points.min() - p[0], p[0] - points.max(), 0.0))
+        if p.size == 2:
+            hull = points[ConvexHull(points).vertices]
+            a, b = hull, np.roll(hull, -1, axis=0)
+            ab = b - a
+            s = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.einsum("ij,ij->i", ab, ab), 0, 1)
+            return float(np.min(np.linalg.norm(a + s[:, None] * ab - p, axis=1)))
+        start = np.array(self.vertices, dtype=float).mean(axis=0)
+        res = minimize(lambda y: 0.5 * np.sum((y - p) ** 2), start, jac=lambda y: y - p,
+                       constraints=[{"type": "ineq", "fun": lambda y: self._b - self._a @ y,
+                                     "jac": lambda y: -self._a}],
+                       method="SLSQP", options={"ftol": 1e-14, "maxiter": 200})
+        y = res.x
+        # project residual infeasibility away conservatively: report the larger of the QP
+        # value and the facet lower bound
+        return float(max(np.linalg.norm(y - p), self.signed_clearance(p)[0]))
+
+    def box_hull(self, lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """The smallest box containing ``polytope ∩ [lower, upper]`` (2k LPs), or ``None``."""
+        k = len(lower)
+        bounds = list(zip(lower, upper))
+        lo, hi = np.empty(k), np.empty(k)
+        for i in range(k):
+            for sign, out in ((1.0, lo), (-1.0, hi)):
+                c = np.zeros(k)
+                c[i] = sign
+                res = linprog(c, A_ub=self._a, b_ub=self._b, bounds=bounds, method="highs")
+                if res.status == 2:
+                    return None
+                if res.status != 0:
+                    raise SpecError("obstacles", f"linear program failed: {res.message}")
+                out[i] = res.x[i]
+        return lo, hi
+
+    def meets_box(self, lower: np.ndarray, upper: np.ndarray) -> bool:
+        return self.box_hull(np.asarray(lower, float), np.asarray(upper, float)) is not None
+
+
+def make_polytope(vertices: list, name: str) -> Polytope:
+    """Validate a vertex list and build the polytope.
+
+    Raises
+    ------
+    SpecError
+        Too few vertices, or vertices that do not span the ``k``-dimensional space.
+    """
+    points = np.array(vertices, dtype=float)
+    k = points.shape[1]
+    if points.shape[0] < k + 1:
+        raise SpecError(f"{name}.vertices", f"needs at least {k + 1} vertices in {k} dimensions")
+    if np.linalg.matrix_rank(points[1:] - points[0], tol=1e-9) < k:
+        raise SpecError(f"{name}.vertices", "the vertices are degenerate (their hull has no "
+                                            "interior)")
+    try:
+        return Polytope(tuple(tuple(float(v) for v in p) for p in vertices))
+    except QhullError as exc:  # pragma: no cover - rank check above catches these
+        raise SpecError(f"{name}.vertices", f"no convex hull: {exc}") from None
