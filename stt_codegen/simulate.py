@@ -14,8 +14,9 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
+import control as ct
+
 from .backends import STATUS_OK, make_controller
-from .spec import Box
 from .plants import make_plant
 from .spec import Spec
 from .tube import TubeDesign
@@ -52,8 +53,9 @@ class SimulationResult:
     collision : bool
         The state met an obstacle on ``[0, t_c]`` (checked at every integration point).
     min_obstacle_clearance : float or None
-        Smallest distance from the state to an obstacle box on ``[0, t_c]``, state units
-        (``None`` without obstacles).
+        Smallest distance from the state to an obstacle on ``[0, t_c]`` (negative: depth
+        inside it), state units; exact for boxes and balls, a lower bound for polytopes
+        (distance to the nearest facet's plane). ``None`` without obstacles.
     left_state_space : bool
     stayed_in_tube : bool
         Every controller step on ``[0, horizon]`` reported the state inside the tube.
@@ -84,13 +86,6 @@ class SimulationResult:
         return data
 
 
-def point_clearance(points: np.ndarray, box: Box) -> np.ndarray:
-    """Euclidean distance from each point (N, n) to ``box``; minus the depth inside it."""
-    gaps = np.maximum(np.array(box.lower) - points, points - np.array(box.upper))
-    outside = np.sqrt(np.sum(np.maximum(gaps, 0.0) ** 2, axis=1))
-    return np.where(np.any(gaps > 0, axis=1), outside, gaps.max(axis=1))
-
-
 def _rk4(rhs, t: float, x: np.ndarray, u: np.ndarray, h: float) -> np.ndarray:
     k1 = rhs(t, x, u)
     k2 = rhs(t + h / 2, x + h / 2 * k1, u)
@@ -100,7 +95,8 @@ def _rk4(rhs, t: float, x: np.ndarray, u: np.ndarray, h: float) -> np.ndarray:
 
 
 def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
-             horizon: float | None = None, seed: int = 0) -> SimulationResult:
+             horizon: float | None = None, seed: int = 0,
+             plant: "ct.NonlinearIOSystem | None" = None) -> SimulationResult:
     """Run the sampled controller of ``backend`` against the spec's plant.
 
     Parameters
@@ -115,6 +111,9 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
         ``[0, min(horizon, t_c)]``; a horizon shorter than ``t_c`` cannot satisfy it.
     seed : int
         Seed of the disturbance.
+    plant : control.NonlinearIOSystem, optional
+        The plant to control instead of the spec's ``[plant]`` (``n`` states, inputs and
+        outputs, the state as output); it must include its own disturbance.
 
     Returns
     -------
@@ -131,7 +130,8 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
     if not math.isfinite(horizon) or horizon <= 0:
         raise SpecError("--horizon", f"must be a positive number of seconds, got {horizon!r}")
     controller = make_controller(backend, design)
-    plant = make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed)
+    if plant is None:
+        plant = make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed)
 
     def rhs(t, x, u):
         return plant.dynamics(t, x, u)
@@ -139,7 +139,6 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
     n = spec.dimension
     dt = 1.0 / design.rate_hz
     steps = int(math.ceil(horizon * design.rate_hz - 1e-9))
-    boxes = spec.obstacle_boxes()
     lo, hi = np.array(spec.state_space.lower), np.array(spec.state_space.upper)
     t_lo, t_hi = np.array(spec.target_set.lower), np.array(spec.target_set.upper)
 
@@ -175,8 +174,8 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
     in_target = np.all((xs >= t_lo) & (xs <= t_hi), axis=1) & (ts <= t_c + 1e-12)
     reached = bool(in_target.any())
     reach_time = float(ts[int(np.argmax(in_target))]) if reached else None
-    if boxes:
-        clearance = np.min([point_clearance(within, b) for b in boxes], axis=0)
+    if spec.unsafe_sets:
+        clearance = np.min([u.signed_clearance(within) for u in spec.unsafe_sets], axis=0)
         min_clear = float(clearance.min())
         collision = bool(min_clear <= 0.0)
     else:
