@@ -27,6 +27,10 @@ from ..simulate import SimulationResult
 from .arenas import generate_arena
 
 METHODS = ("stt", "astar", "rrtstar")
+#: Names of the certificate's properties (:mod:`stt_codegen.certificate`), as they appear
+#: in design errors.
+CERTIFICATE_PROPERTIES = ("non-empty", "initial state inside", "inside state space",
+                          "avoids obstacle", "inside target after t_c")
 #: Human-readable method names for tables.
 LABELS = {"stt": "STT (C controller)", "astar": "A* + tracker", "rrtstar": "RRT* + tracker"}
 
@@ -46,10 +50,9 @@ def design_failure(message: str) -> str:
     first = message.split("; ")[0]
     if "moves" in first and "tube widths" in first:
         return "design: bound too fast for the sampling rate"
-    found = re.search(r"(?:obstacle \d+: |check: )?([a-z][a-z_ ]*?)(?: \d+)? fails", first)
-    if found:
-        return f"design: {found.group(1).strip()}"
-    return "design: other"
+    found = re.search(r"(" + "|".join(map(re.escape, CERTIFICATE_PROPERTIES)) + r")[ \d]*fails",
+                      first)
+    return f"design: {found.group(1)}" if found else "design: other"
 
 
 def closed_loop_failure(result: SimulationResult) -> str:

@@ -101,7 +101,7 @@ def format_arenas_report(report: dict[str, Any]) -> str:
     """The human-readable table of :func:`run_arenas_bench`'s result."""
     rows = []
     for method, s in report["methods"].items():
-        failures = ", ".join(f"{r} {n}" for r, n in s["failures"].items()) or "-"
+        failures = ", ".join(f"{r} ({n})" for r, n in s["failures"].items()) or "-"
         rows.append([LABELS[method], f"{s['successes']}/{s['runs']}",
                      f"{100 * s['success_rate']:.1f} %", seconds_text(s["time_median_s"]),
                      seconds_text(s["time_p95_s"]), failures])

@@ -22,6 +22,9 @@ from tqdm import tqdm
 
 from ..errors import SpecError
 
+#: How long to wait for a Dask scheduler to answer.
+CONNECT_TIMEOUT = "10s"
+
 
 def default_workers() -> int:
     """The number of local worker processes by default: the CPUs this process may use."""
@@ -66,39 +69,45 @@ def run_parallel(fn: Callable[..., Any], calls: Sequence[tuple], workers: int | 
         Whatever a job raised (the first one, re-raised here).
     """
     results: list[Any] = [None] * len(calls)
-    bar = tqdm(total=len(calls), desc=description, file=sys.stderr, disable=not progress,
-               unit="job")
-    try:
-        if scheduler:
-            _run_dask(fn, calls, scheduler, results, bar)
-        else:
-            workers = default_workers() if workers is None else workers
-            if workers < 1:
-                raise SpecError("--workers", f"must be at least 1, got {workers}")
-            context = multiprocessing.get_context("spawn")
-            with ProcessPoolExecutor(max_workers=min(workers, max(1, len(calls))),
-                                     mp_context=context) as pool:
-                futures = {pool.submit(fn, *args): k for k, args in enumerate(calls)}
-                for future in local_as_completed(futures):
-                    results[futures[future]] = future.result()
-                    bar.update(1)
-    finally:
-        bar.close()
+    if scheduler:
+        client = _connect(scheduler)
+        try:
+            with _bar(len(calls), description, progress) as bar:
+                _run_dask(client, fn, calls, results, bar)
+        finally:
+            client.close()
+        return results
+    workers = default_workers() if workers is None else workers
+    if workers < 1:
+        raise SpecError("--workers", f"must be at least 1, got {workers}")
+    context = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(max_workers=min(workers, max(1, len(calls))),
+                             mp_context=context) as pool, \
+            _bar(len(calls), description, progress) as bar:
+        futures = {pool.submit(fn, *args): k for k, args in enumerate(calls)}
+        for future in local_as_completed(futures):
+            results[futures[future]] = future.result()
+            bar.update(1)
     return results
 
 
-def _run_dask(fn, calls, scheduler: str, results: list, bar) -> None:
+def _bar(total: int, description: str, progress: bool) -> tqdm:
+    return tqdm(total=total, desc=description, file=sys.stderr, disable=not progress,
+                unit="job")
+
+
+def _connect(scheduler: str):
     from distributed import Client
-    from distributed import as_completed as dask_as_completed
     try:
-        client = Client(scheduler, timeout="10s")
+        return Client(scheduler, timeout=CONNECT_TIMEOUT)
     except (OSError, TimeoutError, ValueError) as exc:
         raise SpecError("--scheduler", f"cannot connect to {scheduler!r}: {exc}") from None
-    try:
-        futures = [client.submit(fn, *args, pure=False) for args in calls]
-        index = {f.key: k for k, f in enumerate(futures)}
-        for future in dask_as_completed(futures):
-            results[index[future.key]] = future.result()
-            bar.update(1)
-    finally:
-        client.close()
+
+
+def _run_dask(client, fn, calls, results: list, bar) -> None:
+    from distributed import as_completed as dask_as_completed
+    futures = [client.submit(fn, *args, pure=False) for args in calls]
+    index = {f.key: k for k, f in enumerate(futures)}
+    for future in dask_as_completed(futures):
+        results[index[future.key]] = future.result()
+        bar.update(1)

@@ -1,0 +1,153 @@
+"""bench arenas: the seeded arena generator, the baselines' planners and tracker, one arena job."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from stt_codegen.bench.arena_job import (closed_loop_failure, design_failure, run_arena)
+from stt_codegen.bench.arenas import (ARENA, OBSTACLE_SIZE, START_SIZE, TARGET, generate_arena,
+                                      generate_arenas)
+from stt_codegen.bench.astar import RESOLUTION, grid_graph, plan_astar
+from stt_codegen.bench.planning import MARGIN, FreeSpace
+from stt_codegen.bench.report import summarize
+from stt_codegen.bench.tracker import track
+from stt_codegen.errors import SpecError
+from stt_codegen.spec import load_spec, parse_spec
+
+WALL_SPEC = """
+name = "wall"
+prescribed_time = 9.0
+[state_space]
+lower = [0.0, 0.0]
+upper = [5.0, 5.0]
+[initial]
+lower = [0.0, 0.0]
+upper = [0.5, 0.5]
+[target]
+lower = [4.5, 4.5]
+upper = [5.0, 5.0]
+[[obstacles]]
+lower = [2.0, 0.0]
+upper = [3.0, OBSTACLE_TOP]
+[plant]
+model = "single-integrator"
+"""
+
+
+def test_arenas_follow_the_protocol():
+    for arena in generate_arenas(20, 7):
+        s = arena.start
+        assert np.allclose(np.subtract(s.upper, s.lower), START_SIZE)
+        assert ARENA.contains_box(s) and not s.meets(TARGET)
+        assert len(arena.obstacles) == 4
+        for o in arena.obstacles:
+            assert np.allclose(np.subtract(o.upper, o.lower), OBSTACLE_SIZE)
+            assert ARENA.contains_box(o) and not o.meets(s) and not o.meets(TARGET)
+
+
+def test_arenas_are_seeded_and_independent_of_count():
+    assert generate_arenas(5, 3)[4] == generate_arena(3, 4) == generate_arenas(9, 3)[4]
+    assert generate_arena(3, 4) != generate_arena(4, 4)
+
+
+def test_arena_spec_files_load(tmp_path):
+    arena = generate_arena(0, 2)
+    path = tmp_path / f"{arena.name}.toml"
+    path.write_text(arena.to_toml())
+    spec = load_spec(str(path))
+    assert spec == arena.to_spec()
+    assert spec.plant_model == "single-integrator" and spec.tube.circumvent_sharpness == 0.1
+    assert spec.prescribed_time == 9.0 and spec.dimension == 2
+
+
+@pytest.mark.parametrize("seed,count", [(-1, 1), (0, 0)])
+def test_bad_seed_or_count(seed, count):
+    with pytest.raises(SpecError):
+        generate_arenas(count, seed)
+
+
+def test_grid_edges_join_free_neighbours_without_cutting_corners():
+    space = FreeSpace.of(generate_arena(0, 1).to_spec())
+    graph, origin = grid_graph(space)
+    nodes = set(graph.nodes)
+    assert space.is_free(origin + RESOLUTION * np.array(sorted(nodes), float)).all()
+    expected = set()
+    for i, j in nodes:
+        for di, dj in ((1, 0), (0, 1), (1, 1), (1, -1)):
+            b = (i + di, j + dj)
+            if b in nodes and (not (di and dj) or ((i + di, j) in nodes and (i, j + dj) in nodes)):
+                expected.add(frozenset([(i, j), b]))
+    assert {frozenset(e) for e in graph.edges} == expected
+
+
+def test_astar_path_keeps_the_margin_and_is_tracked():
+    spec = generate_arena(0, 1).to_spec()
+    plan = plan_astar(spec)
+    assert plan.reason == "" and plan.seconds > 0
+    path = plan.path
+    assert np.allclose(path[0], spec.initial_state) and np.allclose(path[-1], TARGET.center)
+    dense = np.vstack([a + np.linspace(0, 1, 20)[:, None] * (b - a)
+                       for a, b in zip(path[1:-2], path[2:-1])])
+    assert FreeSpace.of(spec).is_free(dense).all()
+    result = track(spec, path, seed=1)
+    assert result.satisfied and result.min_obstacle_clearance > MARGIN / 2
+    assert closed_loop_failure(result) == ""
+
+
+def test_astar_reports_no_path_behind_a_wall():
+    spec = parse_spec(WALL_SPEC.replace("OBSTACLE_TOP", "5.0"))
+    plan = plan_astar(spec)
+    assert plan.path is None and plan.reason == "no path found"
+
+
+def test_tracker_through_an_obstacle_collides():
+    spec = parse_spec(WALL_SPEC.replace("OBSTACLE_TOP", "4.0"))
+    straight = np.array([spec.initial_state, spec.target_set.center])
+    result = track(spec, straight, seed=0)
+    assert not result.satisfied and closed_loop_failure(result) == "collision"
+
+
+@pytest.mark.parametrize("message,category", [
+    ("obstacle 2 comes within 0.1 of the target box eta +- d_T: shrink target.half_width",
+     "design: obstacle next to target"),
+    ("obstacle 1 cannot be circumvented: no dimension leaves room of delta_b = 0.2 beside it",
+     "design: no room beside obstacle"),
+    ("no choice of circumvent dimension and side passes the tube check (obstacle 0: a tube "
+     "bound moves 3.57 tube widths in one sampling period at t = 1 s (limit 0.25))",
+     "design: bound too fast for the sampling rate"),
+    ("no choice of circumvent dimension and side passes the tube check (obstacle 3: avoids "
+     "obstacle 1 fails: margin -0.1 at t = 2; obstacle 4: non-empty fails: x)",
+     "design: avoids obstacle"),
+    ("no choice of circumvent dimension and side passes the tube check (obstacle 0: initial "
+     "state inside fails: x(0) is 0.01 from the tube's boundary)",
+     "design: initial state inside"),
+    ("the reach tube fails its check: inside target after t_c fails: margin -1",
+     "design: inside target after t_c"),
+    ("something new", "design: other"),
+])
+def test_design_failure_categories(message, category):
+    assert design_failure(message) == category
+
+
+def test_summary_statistics():
+    outcomes = [{"success": True, "seconds": float(s), "reason": ""} for s in range(1, 20)]
+    outcomes += [{"success": False, "seconds": 100.0, "reason": "collision"}] * 2
+    outcomes += [{"success": False, "seconds": 0.5, "reason": "no path found"}]
+    s = summarize(outcomes)
+    assert s["runs"] == 22 and s["successes"] == 19
+    assert s["success_rate"] == pytest.approx(19 / 22)
+    assert s["time_median_s"] == pytest.approx(np.median([o["seconds"] for o in outcomes]))
+    assert s["time_median_s"] <= s["time_p95_s"] <= 100.0
+    assert list(s["failures"].items()) == [("collision", 2), ("no path found", 1)]
+
+
+def test_one_arena_job(tmp_path, monkeypatch):
+    monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path / "cache"))
+    result = run_arena(0, 1, ("stt", "astar"))
+    assert result["name"] == "arena-0-1" and set(result["methods"]) == {"stt", "astar"}
+    for outcome in result["methods"].values():
+        assert set(outcome) == {"success", "seconds", "reason", "reach_time", "clearance"}
+        assert outcome["seconds"] > 0 and outcome["success"] == (outcome["reason"] == "")
+        if outcome["success"]:
+            assert 0 < outcome["reach_time"] <= 9.0 and outcome["clearance"] > 0

@@ -1,0 +1,117 @@
+"""bench step and bench scaling: structure and invariants of the reports (never speed)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import pytest
+
+from stt_codegen.bench.harness import build_harness, harness_source
+from stt_codegen.bench.scaling import format_scaling_report, run_scaling_bench, synthetic_design
+from stt_codegen.bench.step import format_step_report, run_step_bench
+from stt_codegen.cli import main
+from stt_codegen.emit import count_operations
+from stt_codegen.errors import SpecError
+from stt_codegen.model import build_model
+
+IMPLEMENTATIONS = ["C, compiled loop", "C via ctypes (from Python)", "generated Python",
+                   "CasADi Function (from Python)", "numpy reference"]
+needs_valgrind = pytest.mark.skipif(shutil.which("valgrind") is None,
+                                    reason="valgrind not installed (Debian package valgrind)")
+
+
+@pytest.fixture(autouse=True)
+def _cache(tmp_path, monkeypatch):
+    monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path / "cache"))
+
+
+@needs_valgrind
+def test_step_report(capsys):
+    assert main(["bench", "step", "omnirobot-s1", "--steps", "2000", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    rows = {r["name"]: r for r in report["implementations"]}
+    assert list(rows) == IMPLEMENTATIONS
+    assert rows["C, compiled loop"]["ratio_to_c"] == 1.0
+    for r in rows.values():
+        assert r["seconds_per_step"] > 0
+        assert r["max_abs_u_difference"] < 1e-9  # the same step is timed everywhere
+    assert report["inputs"] == 9000 and report["outside_tube_inputs"] == 0
+    assert report["instructions_per_step"] > report["operations"]["arithmetic"]
+    assert report["spec"] == "omnirobot-s1"
+    text = format_step_report(report)
+    assert "vs C loop" in text and "callgrind" in text
+
+
+def test_step_operation_counts_are_the_emitters():
+    report = run_step_bench("omnirobot-s2", steps=500, rounds=1, callgrind=False)
+    from stt_codegen.design import design_tube
+    from stt_codegen.spec import load_spec
+    design, _ = design_tube(load_spec("omnirobot-s2"))
+    counts = count_operations(build_model(design)["controller_step"])
+    assert report["operations"] == {"arithmetic": counts.arithmetic,
+                                    "transcendental": counts.transcendental,
+                                    "logic": counts.logic, "total": counts.total}
+    assert report["instructions_per_step"] is None
+
+
+@needs_valgrind
+def test_callgrind_count_is_deterministic_and_per_step():
+    harness = build_harness(synthetic_design(3, 2))
+    try:
+        a, b = harness.instructions_per_step(50), harness.instructions_per_step(50)
+        assert a == b > 100
+        t, x, alpha, outside = harness.record()
+        assert t.shape == (9000,) and x.shape == (9000, 2) and alpha.shape == (9000, 4)
+        assert x[0].tolist() == [0.25, 0.25] and (alpha[0] == 0).all()
+    finally:
+        harness.cleanup()
+    assert not harness.folder.exists()
+
+
+def test_harness_source_names_the_step():
+    design = synthetic_design(1, 3)
+    source = harness_source(design, "synthetic_m1_n3")
+    assert "synthetic_m1_n3_step(" in source and "SYNTHETIC_M1_N3_N_ALPHA" in source
+    assert "RECORD = 9000L" in source
+
+
+def test_synthetic_designs():
+    for mode in ("open", "closed", "random"):
+        d = synthetic_design(12, 3, windows=mode)
+        assert len(d.circumvents) == 12 and d.dimension == 3
+        assert list(d.circumvents) == sorted(d.circumvents,
+                                             key=lambda c: (c.dimension, c.side, c.obstacle))
+        if mode == "open":
+            assert all(c.start < 0 and c.end > d.prescribed_time for c in d.circumvents)
+        if mode == "closed":
+            assert all(c.start > d.prescribed_time for c in d.circumvents)
+    assert synthetic_design(5, 2) == synthetic_design(5, 2)
+    with pytest.raises(SpecError):
+        synthetic_design(-1, 2)
+    with pytest.raises(SpecError):
+        synthetic_design(1, 0)
+
+
+@needs_valgrind
+def test_scaling_report():
+    report = run_scaling_bench([1, 6], [3], active_obstacles=4)
+    sweep = report["obstacle_sweep"]
+    assert [r["obstacles"] for r in sweep] == [1, 6]
+    assert [r["dimension"] for r in report["dimension_sweep"]] == [3]
+    for r in sweep + report["dimension_sweep"] + report["active_windows"]:
+        assert "error" not in r and r["seconds_per_step"] > 0 and r["object_bytes"] > 0
+    # more circumvents: more code, more operations and more instructions per step
+    assert sweep[1]["source_bytes"] > sweep[0]["source_bytes"]
+    assert sweep[1]["operations"]["transcendental"] > sweep[0]["operations"]["transcendental"]
+    assert sweep[1]["instructions_per_step"] > sweep[0]["instructions_per_step"]
+    modes = {r["windows"]: r for r in report["active_windows"]}
+    assert set(modes) == {"open", "random", "closed"}
+    # the operations do not depend on which windows are open (data moves may differ by
+    # a constant or two)
+    for key in ("arithmetic", "transcendental"):
+        assert modes["open"]["operations"][key] == modes["closed"]["operations"][key]
+    assert modes["open"]["outside_tube_inputs"] == modes["closed"]["outside_tube_inputs"] == 0
+    assert "circumvents" in report["conclusion"]
+    text = format_scaling_report(report)
+    assert "obstacles (n = 2)" in text and "active windows" in text
