@@ -275,3 +275,150 @@ def measure(objects: Sequence[Path], su_files: Sequence[Path] = (),
         ram_bytes=sizes["data"] + sizes["bss"],
         stack_bytes=stack, stack_chain=chain, stack_dynamic=dyn, unresolved=unresolved,
         frames=frames)
+
+
+# ---------------------------------------------------------------- linked ELF
+
+_ELF_FUNC = re.compile(r"^([0-9a-f]+) <([^>]+)>:$")
+_ELF_INSN = re.compile(r"^\s*([0-9a-f]+):\s+(?:[0-9a-f]{4}(?: [0-9a-f]{4})?\s+)?(\S+)\s*(.*)$")
+_REGLIST = re.compile(r"\{([^}]*)\}")
+_SP_IMM = re.compile(r"^sp,\s*(?:sp,\s*)?#(\d+)")
+_TARGET = re.compile(r"^[0-9a-f]+ <([^>+]+)>$")
+
+
+def _reg_count(text: str) -> tuple[int, int]:
+    """(number of registers, bytes each) of a register list ``{r4-r7, lr}``/``{s16-s19}``/``{d8}``."""
+    m = _REGLIST.search(text)
+    if not m:
+        return 0, 4
+    count, size = 0, 4
+    for part in m.group(1).split(","):
+        part = part.strip()
+        if part.startswith("d"):
+            size = 8
+        if "-" in part:
+            a, b = part.split("-")
+            count += int(re.sub(r"\D", "", b)) - int(re.sub(r"\D", "", a)) + 1
+        elif part:
+            count += 1
+    return count, size
+
+
+def elf_functions(elf: Path) -> tuple[dict[str, int], dict[str, set[str]]]:
+    """Frame bytes and direct callees of every function of a linked ELF, from its code.
+
+    The frame of a function is the largest stack depth its instructions reach when read
+    in address order (``push``/``stmdb sp!``/``vpush``/``sub sp`` add, ``pop``/``ldmia
+    sp!``/``vpop``/``add sp`` remove): a bound for the straight-line prologue/epilogue
+    code compilers emit (no ``alloca``, no variable ``sub sp, rN``: those raise
+    :class:`FootprintError`). Callees are the targets of ``bl``/``blx`` and of branches
+    (``b``, ``b.w``, ``bcc.w``) to another function's first address (tail calls).
+    """
+    tc = find_toolchain(need_qemu=False)
+    text = run_tool([str(tc.objdump), "-d", "--no-show-raw-insn", str(elf)])
+    frames: dict[str, int] = {}
+    graph: dict[str, set[str]] = {}
+    starts: dict[str, str] = {}
+    current = None
+    depth = peak = 0
+    pending: list[tuple[str, str, str]] = []
+    for line in text.splitlines():
+        m = _ELF_FUNC.match(line)
+        if m:
+            if current is not None:
+                frames[current] = peak
+            current = m.group(2)
+            starts[current] = m.group(1).lstrip("0") or "0"
+            graph.setdefault(current, set())
+            depth = peak = 0
+            continue
+        if current is None:
+            continue
+        i = _ELF_INSN.match(line)
+        if not i:
+            continue
+        op, args = i.group(2), i.group(3).split(";")[0].strip()
+        base = op.split(".")[0]
+        if base in ("push", "vpush") or (base.startswith("stmdb") and args.startswith("sp!")):
+            k, size = _reg_count(args)
+            depth += k * size
+        elif base in ("pop", "vpop") or (base.startswith("ldmia") and args.startswith("sp!")):
+            k, size = _reg_count(args)
+            depth -= k * size
+        elif base in ("sub", "subw") and args.startswith("sp,"):
+            s = _SP_IMM.match(args)
+            if not s:
+                raise FootprintError(f"{current}: variable stack adjustment '{op} {args}'")
+            depth += int(s.group(1))
+        elif base in ("add", "addw") and args.startswith("sp,") and _SP_IMM.match(args):
+            depth -= int(_SP_IMM.match(args).group(1))
+        elif base.startswith("str") and "[sp, #-" in args and args.endswith("]!"):
+            depth += int(re.search(r"#-(\d+)", args).group(1))
+        peak = max(peak, depth)
+        if base in ("bl", "blx") or base.startswith("b"):
+            t = _TARGET.match(args)
+            if t:
+                pending.append((current, base, t.group(1)))
+    if current is not None:
+        frames[current] = peak
+    for caller, base, target in pending:
+        if target == caller:
+            continue
+        if base in ("bl", "blx") or target in starts:
+            graph[caller].add(target)
+    return frames, graph
+
+
+def elf_stack_bound(elf: Path, entry: str) -> dict:
+    """Static worst-case stack of ``entry`` in a linked ELF, library code included.
+
+    Returns
+    -------
+    dict
+        ``bytes``, ``chain`` (the deepest call path) and ``frames`` along it.
+
+    Raises
+    ------
+    FootprintError
+        Unknown entry, recursion, or a variable stack adjustment on the way.
+    """
+    frames, graph = elf_functions(Path(elf))
+    total, chain, _ = worst_stack(entry, frames, graph)
+    return {"bytes": total, "chain": chain, "frames": {f: frames.get(f, 0) for f in chain}}
+
+
+def linked_sizes(map_file: Path, obj: Path) -> dict[str, int]:
+    """Bytes of ``obj``'s input sections the linker kept (after ``--gc-sections``).
+
+    Parsed from the GNU ld map file's memory map (the part after "Linker script and
+    memory map"; discarded sections are listed before it).
+    """
+    text = Path(map_file).read_text(errors="replace")
+    start = text.find("Linker script and memory map")
+    body = text[start:] if start >= 0 else text
+    sizes = {"text": 0, "rodata": 0, "data": 0, "bss": 0}
+    name = None
+    want = str(obj)
+    rx = re.compile(r"^\s+0x([0-9a-f]+)\s+0x([0-9a-f]+)\s+(\S+)$")
+    for line in body.splitlines():
+        m = re.match(r"^ (\.\S+)(.*)$", line)
+        rest = line
+        if m:
+            name = m.group(1)
+            rest = m.group(2)
+            if not rest.strip():
+                continue
+        r = rx.match(rest if m else line)
+        if r and name and r.group(3) == want:
+            size = int(r.group(2), 16)
+            if name.startswith(".text") or name.startswith(".ARM.ex"):
+                sizes["text"] += size
+            elif name.startswith(".rodata"):
+                sizes["rodata"] += size
+            elif name.startswith(".data"):
+                sizes["data"] += size
+            elif name.startswith(".bss"):
+                sizes["bss"] += size
+        if not m:
+            name = name if r is None else None
+    return sizes

@@ -1,0 +1,56 @@
+"""Subcommand ``stt-codegen embedded SPEC [--json]`` (registered by :func:`register_cli`)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+
+def cmd_embedded(args: argparse.Namespace) -> int:
+    """Design, generate single precision, run on QEMU mps2-an386; 0 iff all passed."""
+    from ..design import design_tube
+    from ..errors import SpecError
+    from ..spec import load_spec
+    from .deploy import run_embedded
+    if args.build_dir is not None and not Path(args.build_dir).parent.is_dir():
+        raise SpecError("--build-dir", f"folder {str(Path(args.build_dir).parent)!r} does not exist")
+    spec = load_spec(args.spec)
+    design, _ = design_tube(spec)
+    report = run_embedded(spec, design, args.build_dir, seed=args.seed,
+                          compare_host=not args.no_host)
+    if args.json:
+        print(json.dumps(report, indent=2, sort_keys=True))
+    else:
+        r = report
+        print(f"{r['spec']} on {r['target']}")
+        print(f"  self-test: {r['vectors_passed']} passed, {r['vectors_failed']} failed; "
+              f"max rel. error of u {r['max_rel_error_u']:.3g}; error/bound: "
+              + ", ".join(f"{k} {v:.3g}" for k, v in r["error_to_bound"].items()))
+        print(f"  flash {r['flash_bytes']} B (linked {r['flash_bytes_linked']} B), "
+              f"RAM {r['ram_bytes']} B, stack {r['stack_bytes']} B static "
+              f"({r['stack_bytes_measured']} B measured)")
+        print(f"  {r['instructions_per_step']} instructions per step "
+              f"(counts {r['instructions_detail']['counts']})")
+        clear = "-" if r["min_clearance"] is None else f"{r['min_clearance']:.3f}"
+        reach = "-" if r["reach_time"] is None else f"{r['reach_time']:.3f}"
+        print(f"  closed loop: {'satisfied' if r['closed_loop_satisfied'] else 'NOT satisfied'}"
+              f", reach {reach} s, clearance {clear}, {r['steps']} steps, "
+              f"outside-tube steps {r['outside_tube_steps']}")
+        if "max_state_deviation" in r:
+            print(f"  max |x_target - x_host| = {r['max_state_deviation']:.3g}")
+    return 0 if report["ok"] else 1
+
+
+def register_cli(subparsers) -> None:
+    """Add ``embedded`` to the ``stt-codegen`` parser."""
+    p = subparsers.add_parser(
+        "embedded", help="run the single-precision controller on an emulated Cortex-M4F")
+    p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--seed", type=int, default=0, help="disturbance seed (default: 0)")
+    p.add_argument("--build-dir", default=None, metavar="DIR",
+                   help="keep the generated code, programs and ELFs there (default: temporary)")
+    p.add_argument("--no-host", action="store_true",
+                   help="skip the comparison with the host simulation")
+    p.set_defaults(handler=cmd_embedded)

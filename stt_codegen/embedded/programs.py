@@ -1,0 +1,195 @@
+"""Test programs around a generated controller: the closed loop and the input replay.
+
+Both are rendered from Jinja2 templates (``templates/embedded_closed_loop.c.j2``,
+``templates/embedded_replay.c.j2``) and talk to the host in IEEE-754 bit patterns
+(hex), so that nothing is lost in printing.
+
+* :func:`closed_loop_source`: the controller step at ``rate_hz`` against the spec's plant
+  (omnidirectional eq. (14) or single integrator), integrated in double by RK4 with
+  :data:`stt_codegen.simulate.SUBSTEPS` substeps per period, with the disturbance of
+  :class:`stt_codegen.plants.Disturbance` (same seed, same sinusoids), judged like
+  :func:`stt_codegen.simulate.simulate`.
+* :func:`replay_source`: ``P_step`` and ``P_tube`` at given float inputs; outputs printed
+  as bits. Optionally each step is a measured region (instruction count, painted stack)
+  or the floating-point exception flags of each call are printed (host builds).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..codegen.render import c_identifier, render
+from ..plants import Disturbance
+from ..simulate import SUBSTEPS
+from ..spec import Spec
+from ..tube import TubeDesign
+
+
+def _d(value: float) -> str:
+    """A C double literal that reads back exactly."""
+    text = repr(float(value))
+    if not math.isfinite(float(value)):
+        raise ValueError(f"non-finite constant {value!r}")
+    return text if ("." in text or "e" in text) else text + ".0"
+
+
+def steps_of(spec: Spec, design: TubeDesign) -> int:
+    """Controller periods over ``[0, t_c]``, as :func:`stt_codegen.simulate.simulate` counts."""
+    return int(math.ceil(spec.prescribed_time * design.rate_hz - 1e-9))
+
+
+def _obstacles(spec: Spec) -> list[dict]:
+    out = []
+    for u in spec.unsafe_sets:
+        dims = list(u.dims)
+        if u.kind == "box":
+            faces = [(d, _d(lo), _d(hi)) for d, lo, hi in zip(dims, u.shape.lower, u.shape.upper)]
+            out.append({"kind": "box", "dims": dims, "faces": faces})
+        elif u.kind == "ball":
+            out.append({"kind": "ball", "dims": dims,
+                        "center": [(d, _d(c)) for d, c in zip(dims, u.shape.center)],
+                        "radius": _d(u.shape.radius)})
+        else:
+            facets = [([(d, _d(a)) for d, a in zip(dims, row)], _d(b))
+                      for row, b in zip(u.shape._a, u.shape._b)]
+            out.append({"kind": "polytope", "dims": dims, "facets": facets})
+    return out
+
+
+def closed_loop_source(spec: Spec, design: TubeDesign, *, seed: int = 0, decimate: int = 10,
+                       replay: list[int] = ()) -> str:
+    """The closed-loop C program (see the template's header comment).
+
+    Parameters
+    ----------
+    spec, design
+    seed : int
+        Disturbance seed (as ``simulate(..., seed=seed)``).
+    decimate : int
+        Print the state every ``decimate`` steps (and at the last one).
+    replay : list of int
+        Steps whose controller inputs are printed (``S`` lines), increasing.
+    """
+    prefix = c_identifier(spec.c_name)
+    n = spec.dimension
+    dist = Disturbance(n, spec.disturbance_amplitude, seed)
+    plant_doc = ("x_dot = R(x3) u + w, R the rotation by the heading x3 (eq. (14))"
+                 if spec.plant_model == "omnidirectional" else "x_dot = u + w")
+    return render(
+        "embedded_closed_loop.c.j2", P=prefix, U=prefix.upper(), spec_name=spec.name,
+        real="float", plant=spec.plant_model, plant_doc=plant_doc, n=n,
+        steps=steps_of(spec, design), substeps=SUBSTEPS, decimate=int(decimate),
+        terms=dist.weights.shape[1], seed=int(seed), rate_hz=f"{design.rate_hz:g}",
+        rate_hz_d=_d(design.rate_hz), t_c=_d(spec.prescribed_time),
+        x0=[_d(v) for v in spec.initial_state],
+        ss_lo=[_d(v) for v in spec.state_space.lower], ss_hi=[_d(v) for v in spec.state_space.upper],
+        tg_lo=[_d(v) for v in spec.target_set.lower], tg_hi=[_d(v) for v in spec.target_set.upper],
+        w_amp=_d(dist.amplitude), w_c=[[_d(v) for v in r] for r in dist.weights],
+        w_omega=[[_d(v) for v in r] for r in dist.frequencies],
+        w_phi=[[_d(v) for v in r] for r in dist.phases],
+        replay=[int(k) for k in replay], obstacles=_obstacles(spec),
+        has_obstacles=bool(spec.unsafe_sets))
+
+
+def float_bits(values) -> list[str]:
+    """float32 bit patterns of ``values`` as C literals ``0x...u``."""
+    a = np.asarray(values, dtype=np.float32).ravel()
+    return [f"0x{int(b):08x}u" for b in a.view(np.uint32)]
+
+
+def replay_source(spec: Spec, design: TubeDesign, x, t, dt, alpha, what: str) -> str:
+    """The replay program at float inputs ``x`` (N, n), ``t`` (N,), ``dt`` (N,), ``alpha`` (N, 2n)."""
+    prefix = c_identifier(spec.c_name)
+    x = np.atleast_2d(np.asarray(x, dtype=np.float32))
+    rows = [float_bits(np.concatenate([x[k], [t[k], dt[k]], alpha[k]])) for k in range(len(t))]
+    return render("embedded_replay.c.j2", P=prefix, spec_name=spec.name, real="float",
+                  n=spec.dimension, count=len(rows), rows=rows, what=what)
+
+
+def _f32(word: str) -> float:
+    return float(np.array([int(word, 16)], dtype=np.uint32).view(np.float32)[0])
+
+
+def _f64(word: str) -> float:
+    return float(np.array([int(word, 16)], dtype=np.uint64).view(np.float64)[0])
+
+
+@dataclass
+class ReplayOutput:
+    """Outputs of the replay program: ``status`` (N,), ``u`` (N, n), ``alpha_next`` (N, 2n),
+    ``gamma_L``, ``gamma_U`` (N, n), ``stack`` (N,) painted bytes or ``None``,
+    ``flags`` (N, 2) exception flags (step, tube) or ``None``, ``nonfinite`` (N,) bool."""
+
+    status: np.ndarray
+    u: np.ndarray
+    alpha_next: np.ndarray
+    gamma_L: np.ndarray
+    gamma_U: np.ndarray
+    stack: np.ndarray | None
+    flags: np.ndarray | None
+    nonfinite: np.ndarray | None
+
+
+def parse_replay(stdout: str, n: int) -> ReplayOutput:
+    """Parse the ``R`` (and ``F``) lines of the replay program."""
+    rows, stacks, flags, nonfinite = [], [], [], []
+    for line in stdout.splitlines():
+        parts = line.split()
+        if parts and parts[0] == "R":
+            vals = [_f32(w) for w in parts[3:3 + 5 * n]]
+            rows.append([int(parts[2])] + vals)
+            if "stack" in parts:
+                stacks.append(int(parts[parts.index("stack") + 1]))
+        elif parts and parts[0] == "F":
+            flags.append((int(parts[2]), int(parts[3])))
+            nonfinite.append("nonfinite" in parts)
+    a = np.array(rows, dtype=float).reshape(-1, 1 + 5 * n)
+    return ReplayOutput(
+        status=a[:, 0].astype(int), u=a[:, 1:1 + n], alpha_next=a[:, 1 + n:1 + 3 * n],
+        gamma_L=a[:, 1 + 3 * n:1 + 4 * n], gamma_U=a[:, 1 + 4 * n:1 + 5 * n],
+        stack=np.array(stacks) if stacks else None,
+        flags=np.array(flags).reshape(-1, 2) if flags else None,
+        nonfinite=np.array(nonfinite) if flags else None)
+
+
+_SUMMARY = re.compile(r"^closed loop: (.*)$", re.MULTILINE)
+
+
+@dataclass
+class ClosedLoopOutput:
+    """What the closed-loop program printed: the summary fields, the sampled states
+    ``{k: x}`` and the controller inputs at the replay steps ``{k: (t, alpha, x)}``."""
+
+    summary: dict
+    states: dict
+    replay_inputs: dict
+
+
+def parse_closed_loop(stdout: str, n: int) -> ClosedLoopOutput:
+    """Parse the closed-loop program's output (raises ``ValueError`` without a summary)."""
+    m = _SUMMARY.search(stdout)
+    if m is None:
+        raise ValueError("no 'closed loop:' summary line in the program's output")
+    summary: dict = {}
+    for item in m.group(1).split():
+        key, value = item.split("=", 1)
+        if key == "max_abs_u":
+            summary[key] = [float(v) for v in value.split(",")]
+        elif re.fullmatch(r"-?\d+", value):
+            summary[key] = int(value)
+        else:
+            summary[key] = float(value)
+    states, replay = {}, {}
+    for line in stdout.splitlines():
+        parts = line.split()
+        if parts and parts[0] == "X":
+            states[int(parts[1])] = np.array([_f64(w) for w in parts[2:2 + n]])
+        elif parts and parts[0] == "S":
+            vals = [_f32(w) for w in parts[2:]]
+            replay[int(parts[1])] = (vals[0], np.array(vals[1:1 + 2 * n]),
+                                     np.array(vals[1 + 2 * n:1 + 3 * n]))
+    return ClosedLoopOutput(summary, states, replay)
