@@ -1,8 +1,9 @@
 """The ``stt-codegen`` command line.
 
 Exit codes: 0 success (``simulate``: the task is satisfied), 1 a negative outcome
-(``simulate``: not satisfied; ``check``: drift; ``verify``: a check failed), 2 bad input
-(one line ``error: ...`` on standard error, no traceback).
+(``simulate``: not satisfied; ``check``: drift; ``verify``: a check failed; any command:
+no tube can be designed for the spec), 2 bad input (one line ``error: ...`` on standard
+error, no traceback).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
-from .errors import SpecError, SttError
+from .errors import DesignError, SpecError, SttError
 
 #: Modules that add subcommands through ``register_cli(subparsers)``.
 COMMAND_MODULES = ("stt_codegen.codegen", "stt_codegen.verify", "stt_codegen.embedded",
@@ -174,6 +175,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.handler(args))
+    except DesignError as exc:  # a valid spec the method cannot serve: a negative outcome
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
     except SttError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

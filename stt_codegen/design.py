@@ -108,7 +108,9 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
         return TubeCheck(not reason, reason, margins["non-empty"].margin,
                          min(clearances, default=math.inf), max_ratio, certificate)
 
-    if max_ratio > MAX_MOVE_PER_SAMPLE:  # first: a tube this fast also fails the rest
+    if not margins["non-empty"].passed:  # an empty tube has no meaningful rate
+        return result(f"non-empty fails: {margins['non-empty'].detail}")
+    if max_ratio > MAX_MOVE_PER_SAMPLE:  # next: a tube this fast also fails the rest
         k = int(np.argmax(ratio.max(axis=1)))
         return result(f"a tube bound moves {max_ratio:.2f} tube widths in one sampling "
                       f"period at t = {s.t[k]:.3f} s (limit {MAX_MOVE_PER_SAMPLE}; a larger "

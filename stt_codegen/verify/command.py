@@ -1,0 +1,160 @@
+"""``stt-codegen verify``: every check of a spec's designed tube, with its evidence.
+
+Connects the symbolic checks of this package to a concrete design: the rate bounds of
+Lemma 3.3 for its tube and bumps, Assumption 2 for its plant, the adaptive-law bounds for
+its ``psi``, and the continuous-time tube certificate (:mod:`stt_codegen.certificate`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+
+import numpy as np
+
+from .. import reference
+from ..certificate import _circumvent_range, certify_tube
+from ..design import design_tube
+from ..errors import DesignError, SpecError
+from ..spec import PLANT_MODELS, Spec, load_spec
+from ..tube import TubeDesign
+from ..tube_samples import TubeSamples, sample_tube
+from .adaptive import adaptive_law_checks, alpha_upper_bound
+from .assumption import assumption2_omnidirectional, assumption2_single_integrator
+from .check import Check, all_passed
+from .lemma import bump_rate_bound, lemma_checks, reach_rate_bound
+from .transform import error_transform_checks
+
+#: Dimension names used in check names.
+_SIDES = ("L", "U")
+
+
+@functools.lru_cache(maxsize=None)
+def symbolic_checks(max_n: int) -> tuple[Check, ...]:
+    """The design-independent proofs (Lemma 3.3 limits, smooth max, error transform).
+
+    They take SymPy some seconds and depend on no parameter, so a process proves them once.
+    """
+    return tuple(lemma_checks(orders=3)) + tuple(error_transform_checks(max_n=max_n))
+
+
+def _psi_ranges(design: TubeDesign, samples: TubeSamples) -> tuple[np.ndarray, np.ndarray]:
+    """Certified ``min_t psi`` (over every sampling interval) and ``psi(0)``, shape (2n,) each."""
+    t0, t1 = samples.t[:-1], samples.t[1:]
+    rho_l0, rho_u0, _, _ = reference.reach_tube(design, t0)
+    rho_l1, rho_u1, _, _ = reference.reach_tube(design, t1)
+    (bl_lo, bl_hi), (bu_lo, bu_hi) = _circumvent_range(design, t0, t1)
+    psi_l_min = bu_lo - np.maximum(rho_l0, rho_l1)     # psi_L = beta_U - rho_L
+    psi_u_min = np.minimum(rho_u0, rho_u1) - bl_hi     # psi_U = rho_U - beta_L
+    psi_min = np.concatenate([psi_l_min.min(axis=0), psi_u_min.min(axis=0)])
+    psi0 = reference.conflict_distance(design, 0.0)[0]
+    return psi_min, psi0
+
+
+def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None,
+                  samples: TubeSamples | None = None) -> list[Check]:
+    """Run every check on a designed tube.
+
+    Parameters
+    ----------
+    spec : Spec
+    design : TubeDesign
+    plant : str, optional
+        Plant model for Assumption 2 (one of :data:`stt_codegen.spec.PLANT_MODELS`);
+        default the spec's.
+    samples : TubeSamples, optional
+        The deployed tube; computed when omitted.
+
+    Returns
+    -------
+    list of Check
+        In order: Lemma 3.3, the error transform, Assumption 2, the adaptive law (per
+        component of ``alpha``), and the tube certificate.
+    """
+    model = plant or spec.plant_model
+    s = samples if samples is not None else sample_tube(design)
+    n = design.dimension
+    t_c = design.prescribed_time
+    reach = sorted({(a, b, t_c) for a, b in
+                    zip(design.initial_lower + design.initial_upper,
+                        design.target_lower + design.target_upper) if a != b})
+    bumps = [(design.circumvent_sharpness, c.radius, c.height) for c in design.circumvents]
+    symbolic = symbolic_checks(min(n, 3))
+    reach_checks = [reach_rate_bound(*p) for p in reach]
+    bump_checks = [bump_rate_bound(*p) for p in bumps]
+    checks = [c for c in symbolic if c.name.startswith("lemma")] + reach_checks + bump_checks
+    checks += [c for c in symbolic if not c.name.startswith("lemma")]
+    rho_rate = max((c.data.get("bound", 0.0) for c in reach_checks), default=0.0)
+    bump_rate = {p: chk.data.get("bound", np.inf) for p, chk in zip(bumps, bump_checks)}
+
+    if model == "omnidirectional":
+        checks.append(assumption2_omnidirectional((spec.state_space.lower[2],
+                                                   spec.state_space.upper[2])))
+    else:
+        checks.append(assumption2_single_integrator(n))
+
+    psi_min, psi0 = _psi_ranges(design, s)
+    for c in range(2 * n):
+        i, side = c % n, _SIDES[c // n]
+        other = "upper" if side == "L" else "lower"
+        beta_rate = sum(bump_rate[(design.circumvent_sharpness, b.radius, b.height)]
+                        for b in design.circumvents_on(i, other))
+        label = f"x{i + 1},{side}"
+        for check in adaptive_law_checks(float(psi_min[c]), design.theta0, design.kappa,
+                                         design.mu, float(psi0[c]), rho_rate + beta_rate):
+            if check.name in ("adaptive.parameters", "adaptive.nonnegative"):
+                if c == 0:      # independent of psi: report once
+                    checks.append(check)
+                continue
+            checks.append(Check(f"{check.name}[{label}]", check.passed, check.detail,
+                                check.data))
+        a_max = alpha_upper_bound(float(psi_min[c]), design.theta0, design.kappa, design.mu)
+        peak = float(s.alpha[:, c].max())
+        checks.append(Check(f"adaptive.deployed[{label}]", bool(0 <= s.alpha[:, c].min()
+                                                              and peak <= a_max),
+                            f"the deployed alpha stays in [0, {peak:.6g}] within the bound "
+                            f"{a_max:.6g}", {"peak": peak, "alpha_max": a_max}))
+
+    certificate = certify_tube(design, spec, samples=s)
+    for margin in certificate.margins:
+        checks.append(Check(f"tube.{margin.name.replace(' ', '_')}", margin.passed,
+                            margin.detail, {"margin": margin.margin, "time": margin.time}))
+    return checks
+
+
+def verify_spec(spec: Spec, plant: str | None = None) -> list[Check]:
+    """Design the tube of a spec and run :func:`verify_design`; a design failure is a FAIL."""
+    try:
+        design, _ = design_tube(spec)
+    except DesignError as exc:
+        return [Check("tube.design", False, str(exc))]
+    return verify_design(spec, design, plant)
+
+
+def _cmd_verify(args: argparse.Namespace) -> int:
+    if args.plant is not None and args.plant not in PLANT_MODELS:
+        raise SpecError("--plant", f"must be one of {', '.join(PLANT_MODELS)}")
+    spec = load_spec(args.spec)
+    if args.plant == "omnidirectional" and spec.dimension != 3:
+        raise SpecError("--plant", "the omnidirectional robot has 3 states")
+    checks = verify_spec(spec, args.plant)
+    if args.json:
+        print(json.dumps([{"name": c.name, "passed": c.passed, "detail": c.detail}
+                          for c in checks], indent=2))
+    else:
+        for c in checks:
+            print(f"{'PASS' if c.passed else 'FAIL'}  {c.name}: {c.detail}")
+        failed = sum(not c.passed for c in checks)
+        print(f"{len(checks) - failed} passed, {failed} failed")
+    return 0 if all_passed(checks) else 1
+
+
+def register_cli(subparsers) -> None:
+    """Add the ``verify`` subcommand."""
+    p = subparsers.add_parser("verify", help="check the paper's lemmas and certify the tube")
+    p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
+    p.add_argument("--json", action="store_true", help="print a JSON list of checks")
+    p.add_argument("--plant", default=None, metavar="MODEL",
+                   help=f"plant for Assumption 2 ({', '.join(PLANT_MODELS)}; default: the spec's)")
+    p.set_defaults(handler=_cmd_verify)
