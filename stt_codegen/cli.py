@@ -104,21 +104,24 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
+    from .codegen import Options, generate_files, write_generation
     from .plots import plot_run
     from .simulate import simulate
     from .spec import bundled_cases
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    print(f"Simulating every bundled case with the {args.backend} controller ...")
+    print(f"For every bundled case: design the tube, generate the C and Python controllers "
+          f"into {out}/<case>/, and run the {args.backend} controller in closed loop.")
     print(SUMMARY_HEADER)
     all_ok = True
     for name in bundled_cases():
         spec, design = _design(name)
+        write_generation(out / name, generate_files(spec, design, Options()))
         result = simulate(spec, design, backend=args.backend)
         atomic_write_bytes(out / f"{name}.png", lambda tmp: plot_run(spec, design, result, tmp))
         print(_summary_line(result), flush=True)
         all_ok &= result.satisfied
-    print(f"plots written to {out}/")
+    print(f"generated code in {out}/<case>/, plots in {out}/<case>.png")
     return 0 if all_ok else 1
 
 
@@ -144,7 +147,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(handler=_cmd_simulate)
 
-    p = sub.add_parser("demo", help="simulate every bundled case, print a table, write plots")
+    p = sub.add_parser("demo", help="generate, compile and run the controller of every bundled "
+                                    "case in closed loop; print a table, write code and plots")
     p.add_argument("--out", default="stt-demo", metavar="DIR",
                    help="folder for the plots (default: %(default)s)")
     p.add_argument("--backend", default=default_backend(), choices=backend_names(),

@@ -89,10 +89,16 @@ def test_plot_is_written(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["run.png"]   # no temporary left
 
 
-def test_demo_writes_a_plot_per_case(tmp_path):
-    out = run("demo", "--backend", "casadi", "--out", str(tmp_path / "plots"))
+def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
+    out = run("demo", "--out", str(tmp_path / "demo"))
     assert out.returncode == 0, out.stderr
+    assert "run the c controller" in out.stdout
     for name in ("omnirobot-s1", "omnirobot-s2", "omnirobot-s3"):
         assert name in out.stdout
-        assert (tmp_path / "plots" / f"{name}.png").stat().st_size > 10_000
+        assert (tmp_path / "demo" / f"{name}.png").stat().st_size > 10_000
+        c_name = name.replace("-", "_")
+        for suffix in (".c", ".h", ".py", "_selftest.c"):
+            assert (tmp_path / "demo" / name / f"{c_name}{suffix}").is_file()
     assert out.stdout.count(" yes ") == 3
+    again = run("demo", "--out", str(tmp_path / "demo"))     # its own files: overwritten
+    assert again.returncode == 0, again.stderr
