@@ -85,7 +85,9 @@ def bump(t, center: float, radius: float, sharpness: float):
     """``exp(-k (t-m)^2 / (r^2 - (t-m)^2))`` inside ``|t - m| < r``, 0 outside (eqs. (7)-(8))."""
     d = t - center
     inside = ca.fabs(d) < radius
-    denom = ca.if_else(inside, radius**2 - d**2, 1.0)
+    # (r - |d|)(r + |d|), not r^2 - d^2: rounded separately from the test |d| < r, the
+    # latter can be exactly 0 at the window's edge in float32
+    denom = ca.if_else(inside, (radius - ca.fabs(d)) * (radius + ca.fabs(d)), 1.0)
     return ca.if_else(inside, ca.exp(-sharpness * d**2 / denom), 0.0)
 
 

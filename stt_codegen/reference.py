@@ -124,7 +124,8 @@ def bump(t, center: float, radius: float, sharpness: float) -> tuple[Array, Arra
     t = _time(t)
     d = t - center
     inside = np.abs(d) < radius
-    denom = np.where(inside, radius**2 - d**2, 1.0)
+    # (r - |d|)(r + |d|): strictly positive wherever |d| < r holds in floating point
+    denom = np.where(inside, (radius - np.abs(d)) * (radius + np.abs(d)), 1.0)
     b = np.where(inside, exp(-sharpness * d**2 / denom), 0.0)
     b_dot = np.where(inside, b * (-sharpness) * 2.0 * d * radius**2 / denom**2, 0.0)
     return b, b_dot

@@ -15,6 +15,9 @@ from scipy.spatial import ConvexHull, QhullError
 
 from .errors import SpecError
 
+#: Largest number of coordinates (``dims``) a polytope obstacle may be given on.
+MAX_POLYTOPE_DIMENSION = 4
+
 
 @dataclass(frozen=True)
 class Ball:
@@ -94,6 +97,11 @@ class Polytope:
         object.__setattr__(self, "_b", b)
 
     @property
+    def halfspaces(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(A, b)`` with unit-norm rows: the polytope is ``{y : A y <= b}``."""
+        return self._a.copy(), self._b.copy()
+
+    @property
     def lower(self) -> tuple[float, ...]:
         return tuple(np.array(self.vertices).min(axis=0).tolist())
 
@@ -168,6 +176,11 @@ def make_polytope(vertices: list, name: str) -> Polytope:
     """
     points = np.array(vertices, dtype=float)
     k = points.shape[1]
+    if k > MAX_POLYTOPE_DIMENSION:
+        # the hull of up to 1024 vertices has O(v^(k/2)) facets and the covering checks
+        # 2^k corners per box: bounded work needs a small k
+        raise SpecError(f"{name}.vertices", f"{k} coordinates; a polytope may be given on "
+                                            f"at most {MAX_POLYTOPE_DIMENSION} dimensions")
     if points.shape[0] < k + 1:
         raise SpecError(f"{name}.vertices", f"needs at least {k + 1} vertices in {k} dimensions")
     if np.linalg.matrix_rank(points[1:] - points[0], tol=1e-9) < k:

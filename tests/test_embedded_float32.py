@@ -59,12 +59,9 @@ def _edge_inputs(design, c):
     return {k: (np.array(v) if k != "what" else v) for k, v in rows.items()}
 
 
-@pytest.mark.xfail(strict=True, reason=(
-    "model.bump: the window test |t-m| < r and the denominator r^2 - (t-m)^2 are rounded "
-    "separately, so in float32 the denominator can be exactly 0 inside the window at its "
-    "edge ulp: FE_DIVBYZERO in the step (value still exp(-inf) = 0) and NaN in P_tube's "
-    "gamma_dot (FE_INVALID). Fix in the model: denominator (r - |d|)(r + |d|)."))
 def test_bump_denominator_positive_inside_window(tmp_path) -> None:
+    """Regression: with r^2 - (t-m)^2 the float32 denominator was exactly 0 at the window's
+    edge ulp (FE_DIVBYZERO in the step, NaN gamma_dot); (r - |d|)(r + |d|) is not."""
     spec, design, _ = designed("omnirobot-s1")
     # a radius/centre (found by a float32 scan) where fl(r^2) == fl(d^2) with |d| < fl(r)
     r, m = 5.691208622368032, 3.0031455909313767

@@ -54,8 +54,9 @@ def _obstacles(spec: Spec) -> list[dict]:
                         "center": [(d, _d(c)) for d, c in zip(dims, u.shape.center)],
                         "radius": _d(u.shape.radius)})
         else:
+            a_rows, b_vals = u.shape.halfspaces
             facets = [([(d, _d(a)) for d, a in zip(dims, row)], _d(b))
-                      for row, b in zip(u.shape._a, u.shape._b)]
+                      for row, b in zip(a_rows, b_vals)]
             out.append({"kind": "polytope", "dims": dims, "facets": facets})
     return out
 

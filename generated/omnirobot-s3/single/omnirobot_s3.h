@@ -19,6 +19,18 @@
  * alpha, alpha_next have OMNIROBOT_S3_N_ALPHA = 2 OMNIROBOT_S3_N entries: [alpha_L, alpha_U].
  * Start with alpha = 0 at t = 0 and feed alpha_next back at every step.
  *
+ * Input domain (anything else is INVALID_INPUT):
+ *   t      finite and t >= 0: seconds since the start of the task (alpha = 0 at t = 0).
+ *          The tube is designed and certified for t >= 0 only; t < 0 is not a time of
+ *          the task. Every finite t >= t_c is valid: the tube is then the target tube
+ *          of eq. (4)'s second branch and the "stay" part of the task holds forever.
+ *   dt     OMNIROBOT_S3_DT_MIN <= dt <= OMNIROBOT_S3_DT_MAX: from 2^-20 s (about 1 MHz; a shorter
+ *          step loses the Newton start's offset from the singularity psi + alpha = 0
+ *          to rounding) to the smallest power of two >= t_c.
+ *   x      any finite numbers (far from the tube: OUTSIDE_TUBE, u clamped).
+ *   alpha  every entry in [0, OMNIROBOT_S3_ALPHA_MAX]: the adaptive law (11) keeps alpha >= 0
+ *          from alpha = 0, and far below ALPHA_MAX.
+ *
  * Status codes (return value of every function):
  *   OMNIROBOT_S3_STATUS_OK            0  outputs valid, x strictly inside the tube.
  *   OMNIROBOT_S3_STATUS_OUTSIDE_TUBE  1  x is on or outside the tube (|e_i| >= 1) or the tube
@@ -26,9 +38,13 @@
  *                                  error e is clamped to +-(1 - 2^-20) and the width
  *                                  floored at 1e-6), alpha_next is valid. The
  *                                  prescribed-time guarantee no longer holds.
- *   OMNIROBOT_S3_STATUS_INVALID_INPUT 2  a NULL pointer, a non-finite input, or dt <= 0:
- *                                  u = 0, alpha_next = alpha (when the pointers allow),
- *                                  gamma_* = 0.
+ *   OMNIROBOT_S3_STATUS_INVALID_INPUT 2  a NULL pointer, an input outside the domain above, or
+ *                                  a result that would not be finite (the tube's rates
+ *                                  where psi + alpha <= 0, an alpha no step of the law
+ *                                  reaches at t): u = 0, alpha_next = alpha with each
+ *                                  non-finite entry replaced by 0 (alpha NULL: 0),
+ *                                  gamma_* = 0 (when the pointers allow).
+ * Every number written is finite, whatever the inputs.
  *
  * Aliasing: inputs are copied before any output is written, so an output may alias an
  * input (e.g. alpha_next == alpha for an in-place update).
@@ -56,6 +72,12 @@ typedef float omnirobot_s3_real;
 #define OMNIROBOT_S3_PRESCRIBED_TIME 9.0f
 /** Sampling rate the tube was designed for, Hz (dt = 1 / rate). */
 #define OMNIROBOT_S3_RATE_HZ 1000.0f
+/** Smallest valid dt, seconds: 2^-20 (a sampling rate of about 1 MHz). */
+#define OMNIROBOT_S3_DT_MIN 9.5367431640625e-07f
+/** Largest valid dt, seconds: the smallest power of two >= t_c. */
+#define OMNIROBOT_S3_DT_MAX 16.0f
+/** Largest valid entry of alpha, state units: a power of two >= 1e6 (1 + max |state bound|). */
+#define OMNIROBOT_S3_ALPHA_MAX 8388608.0f
 
 #define OMNIROBOT_S3_STATUS_OK 0
 #define OMNIROBOT_S3_STATUS_OUTSIDE_TUBE 1
@@ -64,8 +86,8 @@ typedef float omnirobot_s3_real;
 /**
  * Tube bounds at time t: gamma_L, gamma_U of eq. (10) and their total time derivatives.
  *
- * t: seconds. alpha: [OMNIROBOT_S3_N_ALPHA]. Outputs: [OMNIROBOT_S3_N] each; gamma_L_dot and
- * gamma_U_dot may be NULL (not computed). Returns OK or INVALID_INPUT (outputs zeroed).
+ * t: seconds, t >= 0. alpha: [OMNIROBOT_S3_N_ALPHA]. Outputs: [OMNIROBOT_S3_N] each; gamma_L_dot and
+ * gamma_U_dot may be NULL (not written). Returns OK or INVALID_INPUT (outputs zeroed).
  */
 int omnirobot_s3_tube(omnirobot_s3_real t, const omnirobot_s3_real alpha[OMNIROBOT_S3_N_ALPHA],
     omnirobot_s3_real gamma_L[OMNIROBOT_S3_N], omnirobot_s3_real gamma_U[OMNIROBOT_S3_N],
@@ -74,7 +96,7 @@ int omnirobot_s3_tube(omnirobot_s3_real t, const omnirobot_s3_real alpha[OMNIROB
 /**
  * Control law (13), u = -k xi(e) epsilon(e), at state x and time t.
  *
- * x: [OMNIROBOT_S3_N]. t: seconds. alpha: [OMNIROBOT_S3_N_ALPHA]. u: [OMNIROBOT_S3_N] (out).
+ * x: [OMNIROBOT_S3_N]. t: seconds, t >= 0. alpha: [OMNIROBOT_S3_N_ALPHA]. u: [OMNIROBOT_S3_N] (out).
  * Returns OK, OUTSIDE_TUBE (u finite, clamped) or INVALID_INPUT (u = 0).
  */
 int omnirobot_s3_control(const omnirobot_s3_real x[OMNIROBOT_S3_N], omnirobot_s3_real t,
@@ -84,8 +106,8 @@ int omnirobot_s3_control(const omnirobot_s3_real x[OMNIROBOT_S3_N], omnirobot_s3
  * Implicit (backward Euler, 8 Newton iterations) step of the adaptive law (11)
  * from t to t + dt.
  *
- * t, dt: seconds, dt > 0. alpha, alpha_next: [OMNIROBOT_S3_N_ALPHA].
- * Returns OK or INVALID_INPUT (alpha_next = alpha).
+ * t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha, alpha_next: [OMNIROBOT_S3_N_ALPHA].
+ * Returns OK or INVALID_INPUT (alpha_next = alpha, non-finite entries 0).
  */
 int omnirobot_s3_alpha_step(omnirobot_s3_real t, omnirobot_s3_real dt,
     const omnirobot_s3_real alpha[OMNIROBOT_S3_N_ALPHA], omnirobot_s3_real alpha_next[OMNIROBOT_S3_N_ALPHA]);
@@ -95,7 +117,7 @@ int omnirobot_s3_alpha_step(omnirobot_s3_real t, omnirobot_s3_real dt,
  * instant t_k = k dt with the measured x(t_k), hold u until t_{k+1}, then pass
  * alpha_next as alpha.
  *
- * x: [OMNIROBOT_S3_N]. t, dt: seconds, dt > 0. alpha: [OMNIROBOT_S3_N_ALPHA].
+ * x: [OMNIROBOT_S3_N]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha: [OMNIROBOT_S3_N_ALPHA].
  * u: [OMNIROBOT_S3_N] (out). alpha_next: [OMNIROBOT_S3_N_ALPHA] (out, may alias alpha).
  * Returns OK, OUTSIDE_TUBE or INVALID_INPUT (u = 0, alpha_next = alpha).
  */
