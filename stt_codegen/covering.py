@@ -24,9 +24,14 @@ MAX_BOXES = 256
 
 
 def _corner_distance(shape, lo: np.ndarray, hi: np.ndarray) -> float:
-    corners = np.array(list(itertools.product(*zip(lo, hi))))
+    """Largest distance from a corner of ``[lo, hi]`` to the shape."""
     if hasattr(shape, "radius"):
-        return float(shape.distance(corners).max())
+        # the farthest corner from the centre, per axis the farther end: O(k), not 2^k
+        # corners (a ball may live in all MAX_DIMENSION dimensions)
+        c = np.array(shape.center)
+        far = np.where(np.abs(lo - c) >= np.abs(hi - c), lo, hi)
+        return float(shape.distance(far[None, :]).max())
+    corners = np.array(list(itertools.product(*zip(lo, hi))))
     return max(shape.distance(c) for c in corners)
 
 

@@ -340,12 +340,20 @@ def _kind(value: Any) -> str:
 def _number(value: Any, name: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise SpecError(name, f"must be a number, got {_kind(value)}")
+    if isinstance(value, int) and abs(value) > 10**12:
+        # before float(): tomllib reads integers of any length, float() overflows
+        raise SpecError(name, f"magnitude {_short(value)} is beyond 1e12")
     number = float(value)
     if not math.isfinite(number):
         raise SpecError(name, f"must be finite, got {value!r}")
     if abs(number) > 1e12:
         raise SpecError(name, f"magnitude {value!r} is beyond 1e12")
     return number
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else f"{text[:20]}...({len(text)} characters)"
 
 
 def _positive(value: Any, name: str) -> float:
