@@ -16,6 +16,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import math
 
 import casadi
 import numpy as np
@@ -87,6 +88,7 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
     prefix = c_identifier(spec.c_name)
     single = options.precision == "single"
     functions = deployed_functions(build_model(design))
+    limits = input_limits(design)
     common = {
         "spec_name": spec.name, "spec_hash": spec.source_hash, "casadi_version": casadi.__version__,
         "toolkit_version": __version__, "precision": options.precision, "P": prefix,
@@ -107,6 +109,9 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
                      sz_w=0, guard=f"{prefix.upper()}_H",
                      t_c=c_real(design.prescribed_time, single),
                      rate_hz=c_real(design.rate_hz, single),
+                     dt_min=c_real(limits["dt_min"], single),
+                     dt_max=c_real(limits["dt_max"], single),
+                     alpha_max=c_real(limits["alpha_max"], single),
                      extra_warnings=" -Wdouble-promotion -Wfloat-conversion" if single else "")
         for name, template in ((f"{prefix}.h", "c_header.h.j2"), (f"{prefix}.c", "c_source.c.j2"),
                                ("Makefile", "Makefile.j2")):
@@ -129,7 +134,10 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
         files[name] = render("python_module.py.j2", filename=name, **common,
                              bodies=python_source(programs).rstrip("\n"),
                              t_c=repr(float(design.prescribed_time)),
-                             rate_hz=repr(float(design.rate_hz)))
+                             rate_hz=repr(float(design.rate_hz)),
+                             dt_min=repr(limits["dt_min"]),
+                             dt_max=repr(limits["dt_max"]),
+                             alpha_max=repr(limits["alpha_max"]))
     vec_name = f"{prefix}_vectors.json"
     files_bytes = {k: v.encode("ascii") for k, v in files.items()}
     files_bytes[vec_name] = _json_bytes({
@@ -139,6 +147,23 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
         "tolerance": _TOLERANCE_DOC[options.precision], **vectors})
     files_bytes[MANIFEST] = _json_bytes(manifest(spec, options, files_bytes))
     return dict(sorted(files_bytes.items()))
+
+
+def input_limits(design: TubeDesign) -> dict[str, float]:
+    """Upper ends of the generated API's input domain (powers of two: exact in float32).
+
+    ``dt_min = 2^-20`` s (about 1 MHz): with a shorter step the Newton start's offset
+    ``delta ~ (dt theta)^(1/3)`` from the singularity ``psi + alpha = 0`` can fall below
+    one ulp of ``psi`` in single precision, and the step divides 0 by 0.
+    ``dt_max``: the smallest power of two ``>= t_c`` (a step longer than the task is a
+    usage error). ``alpha_max``: a power of two ``>= 1e6 (1 + max |state bound|)``; the
+    adaptive law keeps ``alpha`` below about the state space's extent, and below this
+    bound every intermediate of the step stays finite in single precision for specs
+    within the loader's 1e12 limit (kappa alpha and (psi + alpha)^2 stay below 1e37).
+    """
+    scale = 1.0 + max(abs(v) for v in (*design.state_lower, *design.state_upper))
+    return {"dt_min": 2.0 ** -20, "dt_max": 2.0 ** math.ceil(math.log2(design.prescribed_time)),
+            "alpha_max": 2.0 ** math.ceil(math.log2(1e6 * scale))}
 
 
 def manifest(spec: Spec, options: Options, files: dict[str, bytes]) -> dict:

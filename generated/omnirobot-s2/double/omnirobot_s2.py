@@ -38,11 +38,18 @@ STATUS_OUTSIDE_TUBE = 1
 STATUS_INVALID_INPUT = 2
 
 
+def _number(value):
+    # float() would also parse text ("1e3"): only numbers are accepted
+    if isinstance(value, (str, bytes, bytearray)):
+        raise TypeError("not a number")
+    return float(value)
+
+
 def _floats(values, count):
     try:
-        if len(values) != count:
+        if isinstance(values, (str, bytes, bytearray)) or len(values) != count:
             return None
-        return [float(v) for v in values]
+        return [_number(v) for v in values]
     except (TypeError, ValueError, OverflowError):
         return None
 
@@ -58,7 +65,7 @@ def _all_finite(*lists):
 
 def _scalar(value):
     try:
-        value = float(value)
+        value = _number(value)
     except (TypeError, ValueError, OverflowError):
         return None
     return value if math.isfinite(value) else None
