@@ -3,6 +3,7 @@ on the same random arenas, side by side in one run (the paper's Table I, redone)
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
 from typing import Any
@@ -117,7 +118,7 @@ def format_arenas_report(report: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def main_arenas(args) -> int:
+def main_arenas(args: argparse.Namespace) -> int:
     """Handler of ``bench arenas``; exit 0."""
     if args.specs:
         write_specs(Path(args.specs), args.count, args.seed)

@@ -18,6 +18,7 @@ depended only on the active windows, the closed design would be much cheaper.
 
 from __future__ import annotations
 
+import argparse
 import json
 from typing import Any
 
@@ -245,7 +246,7 @@ def format_scaling_report(report: dict[str, Any]) -> str:
     return "\n".join(out)
 
 
-def main_scaling(args) -> int:
+def main_scaling(args: argparse.Namespace) -> int:
     """Handler of ``bench scaling``; exit 0."""
     report = run_scaling_bench(_int_list(args.obstacles, "--obstacles"),
                                _int_list(args.dimensions, "--dimensions"),

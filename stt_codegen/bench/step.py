@@ -18,6 +18,7 @@ the largest ``|u - u_C|`` of each implementation on 64 of the inputs is reported
 
 from __future__ import annotations
 
+import argparse
 import json
 from typing import Any
 
@@ -157,7 +158,7 @@ def format_step_report(report: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def main_step(args) -> int:
+def main_step(args: argparse.Namespace) -> int:
     """Handler of ``bench step``; exit 0."""
     report = run_step_bench(args.spec, steps=args.steps)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
