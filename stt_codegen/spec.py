@@ -328,7 +328,11 @@ def _no_unknown(table: dict, allowed: set[str], where: str) -> None:
     unknown = sorted(set(table) - allowed)
     if unknown:
         prefix = f"{where}." if where else ""
-        raise SpecError(f"{prefix}{unknown[0]}",
+        key = unknown[0]
+        if not re.fullmatch(r"[A-Za-z0-9_-]{1,64}", key):
+            # an empty, long or odd key (newlines...) is quoted: the message names it on one line
+            key = repr(key) if len(key) <= 64 else repr(key[:64]) + "..."
+        raise SpecError(f"{prefix}{key}",
                         f"unknown key (allowed: {', '.join(sorted(allowed))})")
 
 
