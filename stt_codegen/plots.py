@@ -8,7 +8,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.patches import Rectangle  # noqa: E402
+from matplotlib.patches import Circle, Polygon, Rectangle  # noqa: E402
+from scipy.spatial import ConvexHull  # noqa: E402
 
 from . import reference  # noqa: E402
 from .simulate import SimulationResult  # noqa: E402
@@ -20,6 +21,34 @@ def _rect(ax, box: Box, dims: tuple[int, int], **style) -> None:
     i, j = dims
     ax.add_patch(Rectangle((box.lower[i], box.lower[j]), box.upper[i] - box.lower[i],
                            box.upper[j] - box.lower[j], **style))
+
+
+def _draw_unsafe_sets(ax, spec: Spec, dims: tuple[int, int]) -> None:
+    """Obstacles as given (filled) and, for balls and polytopes, their covering boxes."""
+    for j, unsafe in enumerate(spec.unsafe_sets):
+        label = "obstacles" if j == 0 else None
+        if not set(dims) <= set(unsafe.dims):
+            continue  # spans one of the plotted axes: drawn by its boxes below
+        k = [unsafe.dims.index(d) for d in dims]
+        if unsafe.kind == "box":
+            box = unsafe.shape
+            patch = Rectangle((box.lower[k[0]], box.lower[k[1]]), box.upper[k[0]] - box.lower[k[0]],
+                              box.upper[k[1]] - box.lower[k[1]], fc="0.55", ec="0.3", label=label)
+            center = ((box.lower[k[0]] + box.upper[k[0]]) / 2, (box.lower[k[1]] + box.upper[k[1]]) / 2)
+        elif unsafe.kind == "ball":
+            center = (unsafe.shape.center[k[0]], unsafe.shape.center[k[1]])
+            patch = Circle(center, unsafe.shape.radius, fc="0.55", ec="0.3", label=label)
+        else:
+            points = [(v[k[0]], v[k[1]]) for v in unsafe.shape.vertices]
+            hull = ConvexHull(points)
+            patch = Polygon([points[i] for i in hull.vertices], fc="0.55", ec="0.3", label=label)
+            center = tuple(sum(p[i] for p in points) / len(points) for i in (0, 1))
+        ax.add_patch(patch)
+        ax.annotate(f"U{j + 1}", center, ha="center", va="center", color="white")
+    covered = [o for o in spec.obstacles if spec.unsafe_sets[o.source].kind != "box"]
+    for m, obstacle in enumerate(covered):
+        _rect(ax, obstacle.box(spec.state_space), dims, fill=False, ec="tab:red", lw=0.5,
+              ls="--", label="covering boxes" if m == 0 else None)
 
 
 def plot_run(spec: Spec, design: TubeDesign, result: SimulationResult, path: str | Path) -> Path:
@@ -46,9 +75,7 @@ def plot_run(spec: Spec, design: TubeDesign, result: SimulationResult, path: str
         ax = fig.add_subplot(grid[:, 0])
         dims = (0, 1)
         _rect(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
-        for j, box in enumerate(spec.obstacle_boxes()):
-            _rect(ax, box, dims, fc="0.55", ec="0.3", label="obstacles" if j == 0 else None)
-            ax.annotate(f"U{j + 1}", box.center[:2], ha="center", va="center", color="white")
+        _draw_unsafe_sets(ax, spec, dims)
         _rect(ax, spec.initial_set, dims, fc="tab:blue", alpha=0.3, label="initial set")
         _rect(ax, spec.target_set, dims, fc="tab:green", alpha=0.35, label="target")
         ax.plot(traj.x[:, 0], traj.x[:, 1], "k--", lw=1.2, label="trajectory")

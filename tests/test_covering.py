@@ -1,0 +1,153 @@
+"""Obstacles that are not boxes (Remark 3.1): covering by boxes, its guarantees, and use."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from stt_codegen.certificate import certify_tube, enclose_tube
+from stt_codegen.covering import MAX_BOXES, cover
+from stt_codegen.design import design_tube
+from stt_codegen.errors import SpecError
+from stt_codegen.shapes import Ball, make_polytope
+from stt_codegen.simulate import simulate
+from stt_codegen.spec import parse_spec
+from stt_codegen.tube_samples import sample_tube
+
+BESIDE = """
+name = "beside"
+prescribed_time = 9.0
+[state_space]
+lower = [0.0, 0.0]
+upper = [5.0, 5.0]
+[initial]
+lower = [0.0, 0.0]
+upper = [0.5, 0.5]
+[target]
+lower = [4.5, 0.0]
+upper = [5.0, 0.5]
+[tube]
+circumvent_sharpness = 0.1
+"""
+BALL = "[[obstacles]]\ncenter = [1.0, 1.0]\nradius = 0.62\n"
+START = (np.array([0.0, 0.0]), np.array([0.5, 0.5]))
+
+
+def assert_valid_covering(shape, boxes, tolerance, forbidden, rng, inside_points):
+    for lo, hi in boxes:
+        for f_lo, f_hi in forbidden:        # Assumption 3, per box: misses X0 and T
+            assert not (np.all(lo <= f_hi) and np.all(f_lo <= hi))
+        corners = np.array(list(itertools.product(*zip(lo, hi))))
+        worst = (float(np.max(shape.distance(corners))) if isinstance(shape, Ball)
+                 else max(shape.distance(c) for c in corners))
+        assert worst <= tolerance + 1e-12   # within the tolerance of the shape
+    lows = np.array([b[0] for b in boxes])
+    highs = np.array([b[1] for b in boxes])
+    pts = inside_points(rng)
+    covered = np.any(np.all((pts[:, None, :] >= lows - 1e-12) & (pts[:, None, :] <= highs + 1e-12),
+                            axis=2), axis=1)
+    assert covered.all()                     # the union contains the shape
+
+
+def test_ball_whose_bounding_box_meets_the_start_is_split_and_used():
+    as_box = BESIDE + "[[obstacles]]\nlower = [0.38, 0.38]\nupper = [1.62, 1.62]\n"
+    with pytest.raises(SpecError, match="meets the initial set"):
+        parse_spec(as_box)                   # its bounding box violates Assumption 3
+    spec = parse_spec(BESIDE + BALL)
+    assert spec.unsafe_sets[0].kind == "ball" and len(spec.obstacles) > 1
+    rng = np.random.default_rng(0)
+    ball = spec.unsafe_sets[0].shape
+
+    def in_ball(r):
+        d = r.normal(size=(4000, 2))
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        return np.array(ball.center) + d * ball.radius * np.sqrt(r.random((4000, 1)))
+
+    boxes = [(np.array(o.lower), np.array(o.upper)) for o in spec.obstacles]
+    assert_valid_covering(ball, boxes, 0.05, [START, (np.array([4.5, 0.0]), np.array([5.0, 0.5]))],
+                          rng, in_ball)
+    design, check = design_tube(spec)
+    assert check.passed
+    result = simulate(spec, design, "casadi")
+    assert result.satisfied and result.min_obstacle_clearance > 0.1   # against the real ball
+
+
+def test_certificate_margin_bounds_the_distance_to_the_real_shape():
+    spec = parse_spec(BESIDE + BALL)
+    design, _ = design_tube(spec)
+    samples = sample_tube(design)
+    cert = certify_tube(design, spec, samples=samples)
+    margin = next(m for m in cert.margins if m.name == "avoids obstacle 0").margin
+    enc = enclose_tube(design, samples)
+    ball = spec.unsafe_sets[0].shape
+    c = np.array(ball.center)
+    nearest = np.clip(c, enc.lower_min, enc.upper_max)
+    distance = np.linalg.norm(nearest - c, axis=1) - ball.radius
+    assert margin > 0 and distance.min() >= margin - 1e-12
+
+
+@settings(max_examples=12, deadline=None)
+@given(points=st.lists(st.tuples(st.floats(1.0, 4.0), st.floats(1.0, 4.0)), min_size=3,
+                       max_size=8, unique=True),
+       tolerance=st.sampled_from([0.1, 0.3]))
+def test_random_polygons_are_covered_within_tolerance(points, tolerance):
+    pts = np.array(points)
+    if np.linalg.matrix_rank(pts[1:] - pts[0], tol=1e-3) < 2:
+        return
+    shape = make_polytope([list(p) for p in points], "obstacles[0]")
+    forbidden = [START]
+    boxes = cover(shape, tolerance, forbidden)
+    rng = np.random.default_rng(1)
+
+    def in_polygon(r):
+        w = r.dirichlet(np.ones(len(points)), 3000)
+        return w @ pts
+
+    assert_valid_covering(shape, boxes, tolerance, forbidden, rng, in_polygon)
+    again = cover(shape, tolerance, forbidden)          # deterministic
+    assert len(again) == len(boxes) and all(
+        np.array_equal(x[0], y[0]) and np.array_equal(x[1], y[1]) for x, y in zip(again, boxes))
+
+
+def test_covering_is_deterministic():
+    spec_a = parse_spec(BESIDE + BALL)
+    spec_b = parse_spec(BESIDE + BALL)
+    assert spec_a.obstacles == spec_b.obstacles
+
+
+def test_a_shape_that_meets_the_start_cannot_be_covered():
+    touching = BESIDE + "[[obstacles]]\ncenter = [0.9, 0.9]\nradius = 0.6\n"
+    with pytest.raises(SpecError, match=r"obstacles\[0\]: meets the initial set"):
+        parse_spec(touching)
+
+
+def test_no_covering_within_the_box_budget_is_a_clear_error():
+    # 1 micrometre from the start set's corner: boxes that miss it are too many
+    close = BESIDE + ("[[obstacles]]\ncenter = [0.9, 0.9]\nradius = 0.565684\n"
+                      "tolerance = 0.001\n")
+    with pytest.raises(SpecError, match=rf"no covering by at most {MAX_BOXES} boxes"):
+        parse_spec(close)
+
+
+@pytest.mark.parametrize("table, field, reason", [
+    ("center = [1.0, 1.0]\n", "obstacles[0].radius", "missing"),
+    ("center = [1.0, 1.0]\nradius = -1.0\n", "obstacles[0].radius", "must be positive"),
+    ("center = [1.0, 1.0]\nradius = 0.2\ntolerance = 0.0\n", "obstacles[0].tolerance",
+     "must be positive"),
+    ("center = [4.9, 4.0]\nradius = 0.2\n", "obstacles[0]", "not inside the state space"),
+    ("vertices = [[1.0, 1.0], [2.0, 2.0]]\n", "obstacles[0].vertices", "at least 3"),
+    ("vertices = [[1.0, 1.0], [2.0, 2.0], [3.0, 3.0]]\n", "obstacles[0].vertices", "degenerate"),
+    ("vertices = [[1.0, 1.0], [2.0, nan], [3.0, 1.0]]\n", "obstacles[0].vertices[1][1]",
+     "finite"),
+    ("vertices = 3\n", "obstacles[0].vertices", "array of points"),
+    ("vertices = [[1.0, 1.0], [2.0, 1.0], [1.5, 2.0]]\nradius = 1.0\n", "obstacles[0].radius",
+     "unknown key"),
+])
+def test_bad_shapes_name_field_and_reason(table, field, reason):
+    with pytest.raises(SpecError) as info:
+        parse_spec(BESIDE + "[[obstacles]]\n" + table)
+    assert info.value.field == field and reason in info.value.reason, str(info.value)
