@@ -79,4 +79,4 @@ def update_generated(root: Path) -> None:
     root.mkdir(exist_ok=True)
     for folder, files in folders.items():
         (root / folder).parent.mkdir(parents=True, exist_ok=True)
-        write_generation(root / folder, files)
+        write_generation(root / folder, files, replace_edited=True)

@@ -4,9 +4,13 @@ Rules (:func:`write_generation`):
 
 * ``DIR``'s parent must exist; ``DIR`` is created if missing.
 * If ``DIR`` exists it must be empty or hold a ``manifest.json`` of ours; every entry of
-  ``DIR`` must be a file that manifest lists (or the manifest itself). Anything else
-  (a foreign file, a folder, a manifest of another tool) is refused with a
-  :class:`SpecError` and nothing is written.
+  ``DIR`` must be a regular file (not a symlink) that manifest lists (or the manifest
+  itself), with the SHA-256 the manifest records (a file edited since it was generated
+  is not ours any more). Anything else (a foreign file, a folder, a symlink, a
+  manifest of another tool, a manifest naming a path rather than a flat file name) is
+  refused with a :class:`SpecError` and nothing is written.
+* Only entries of ``DIR`` itself are ever replaced or removed: a name from a manifest is
+  used only if it is a flat file name and an entry of ``DIR``.
 * Every file is first written to a temporary folder inside ``DIR``, then moved into
   place with ``os.replace`` (the manifest last); files of the previous generation that
   are no longer generated are removed. On any error the temporary folder is removed and,
@@ -15,6 +19,7 @@ Rules (:func:`write_generation`):
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import shutil
@@ -27,8 +32,25 @@ from .generate import GENERATOR, MANIFEST
 _TMP_PREFIX = ".stt-codegen-tmp-"
 
 
-def previous_files(out_dir: Path) -> list[str]:
-    """Names listed by the manifest of a previous generation in ``out_dir`` (else ``[]``).
+def _flat_name(name) -> bool:
+    return (isinstance(name, str) and bool(name) and "/" not in name and "\\" not in name
+            and "\0" not in name and name not in (".", "..") and not name.startswith("."))
+
+
+def _file_sha256(path: Path) -> str | None:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return None
+
+
+def previous_files(out_dir: Path, check_hashes: bool = True) -> list[str]:
+    """Names of the previous generation's files in ``out_dir`` (else ``[]``).
+
+    Parameters
+    ----------
+    check_hashes : bool
+        Refuse files whose content differs from the SHA-256 the manifest records.
 
     Raises
     ------
@@ -40,24 +62,42 @@ def previous_files(out_dir: Path) -> list[str]:
         return []
     path = out_dir / MANIFEST
     try:
+        if path.is_symlink():
+            raise ValueError("symlink")
         data = json.loads(path.read_text(encoding="utf-8"))
-        listed = sorted(data["files"]) if data.get("generator") == GENERATOR else None
-    except (OSError, ValueError, KeyError, TypeError, AttributeError):
-        listed = None
-    if listed is None:
+        files = data["files"] if data.get("generator") == GENERATOR else None
+        if not isinstance(files, dict):
+            files = None
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, RecursionError):
+        files = None
+    if files is None:
         raise SpecError("-o", f"{str(out_dir)!r} is not empty and has no stt-codegen manifest: "
                               "refusing to overwrite files it did not generate")
-    allowed = set(listed) | {MANIFEST}
-    foreign = [name for name in entries if name not in allowed
+    unsafe = [name for name in files if not _flat_name(name) or name == MANIFEST]
+    if unsafe:
+        raise SpecError("-o", f"the manifest in {str(out_dir)!r} lists {str(unsafe[0])[:80]!r}, "
+                              "not a file name stt-codegen writes: refusing to touch it")
+    foreign = [name for name in entries if name not in files and name != MANIFEST
                or not (out_dir / name).is_file() or (out_dir / name).is_symlink()]
     if foreign:
-        raise SpecError("-o", f"{str(out_dir)!r} holds {foreign[0]!r}, not listed in its "
+        raise SpecError("-o", f"{str(out_dir)!r} holds {foreign[0]!r}, not a file listed in its "
                               "stt-codegen manifest: refusing to overwrite or mix")
-    return listed
+    if check_hashes:
+        edited = [name for name in entries if name != MANIFEST
+                  and _file_sha256(out_dir / name) != files[name]]
+        if edited:
+            raise SpecError("-o", f"{str(out_dir)!r} holds {edited[0]!r}, changed since "
+                                  "stt-codegen generated it: refusing to overwrite it "
+                                  "(move it away to regenerate)")
+    return [name for name in entries if name != MANIFEST]
 
 
-def write_generation(out_dir: str | Path, files: dict[str, bytes]) -> None:
+def write_generation(out_dir: str | Path, files: dict[str, bytes],
+                     replace_edited: bool = False) -> None:
     """Write ``files`` (name -> bytes, flat names) into ``out_dir``; see the module docstring.
+
+    ``replace_edited`` also replaces listed files whose content changed since they were
+    generated (``check --update`` on the version-controlled ``generated/``).
 
     Raises
     ------
@@ -66,7 +106,7 @@ def write_generation(out_dir: str | Path, files: dict[str, bytes]) -> None:
     """
     out_dir = Path(out_dir)
     for name in files:
-        if not name or "/" in name or "\\" in name or name in (".", "..") or name.startswith("."):
+        if not _flat_name(name):
             raise SpecError("-o", f"refusing to write file name {name!r}")
     if out_dir.exists() and not out_dir.is_dir():
         raise SpecError("-o", f"{str(out_dir)!r} exists and is not a folder")
@@ -81,7 +121,7 @@ def write_generation(out_dir: str | Path, files: dict[str, bytes]) -> None:
             raise SpecError("-o", f"cannot create {str(out_dir)!r}: {exc.strerror}") from None
         old: list[str] = []
     else:
-        old = previous_files(out_dir)
+        old = previous_files(out_dir, check_hashes=not replace_edited)
     tmp = None
     try:
         tmp = Path(tempfile.mkdtemp(prefix=_TMP_PREFIX, dir=out_dir))
