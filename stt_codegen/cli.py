@@ -156,15 +156,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(handler=_cmd_demo)
 
     for module_name in COMMAND_MODULES:
-        try:
-            module = importlib.import_module(module_name)
-        except ModuleNotFoundError as exc:
-            if exc.name != module_name:
-                raise
-            continue
-        register = getattr(module, "register_cli", None)  # TODO(lead): strict once all land
-        if register is not None:
-            register(sub)
+        importlib.import_module(module_name).register_cli(sub)
     return parser
 
 
