@@ -108,7 +108,7 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
         return TubeCheck(not reason, reason, margins["non-empty"].margin,
                          min(clearances, default=math.inf), max_ratio, certificate)
 
-    if not margins["non-empty"].passed:  # an empty tube has no meaningful rate
+    if not np.all(width > 0):  # empty at a sample: the rate ratio is meaningless
         return result(f"non-empty fails: {margins['non-empty'].detail}")
     if max_ratio > MAX_MOVE_PER_SAMPLE:  # next: a tube this fast also fails the rest
         k = int(np.argmax(ratio.max(axis=1)))
