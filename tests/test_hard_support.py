@@ -53,3 +53,64 @@ def shape_docs() -> list[dict]:
                                             [3.0, 4.2, -0.5], [3.0, 4.0, 0.5]],
                                "dims": [0, 1, 2], "tolerance": 0.2})
     return docs + [ball, poly, poly3]
+
+
+# --------------------------------------------------------------------------- unknown plants
+
+
+def _skew(v):
+    import numpy as np
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+def random_plant_parameters(rng, f_amp: float, f_lin: float, g_min: float, g_max: float,
+                            skew: float, w_amp: float, n: int = 3) -> dict:
+    """Parameters of ``x_dot = f(x) + g(x) u + w(t)`` (see :func:`unknown_plant`), seeded.
+
+    ``f(x) = f_amp sin(W x + phi) + f_lin L (x - c) / |L|``: a bounded smooth term and a
+    linear term about the state space's middle ``c`` (``|f_lin L/|L||`` is the spectral norm).
+    ``g(x) = D + S + K(x)``: ``D + S`` symmetric with eigenvalues in ``[g_min, g_max]``,
+    ``K(x) = skew * tanh(v . x) * skew-matrix``, skew-symmetric (so the symmetric part of g
+    has ``lambda_min >= g_min``, uniformly in x). ``w_i(t) = w_amp sin(omega_i t + p_i)``.
+    """
+    import numpy as np
+    q, _ = np.linalg.qr(rng.normal(size=(n, n)))
+    eig = rng.uniform(g_min, g_max, n)
+    eig[0], eig[-1] = g_min, g_max                      # the extremes are attained
+    sym = q @ np.diag(eig) @ q.T
+    lin = rng.normal(size=(n, n))
+    lin = lin / np.linalg.norm(lin, 2)
+    axis = rng.normal(size=n)
+    return {"W": rng.normal(size=(n, n)), "phi": rng.uniform(0, 2 * np.pi, n), "f_amp": f_amp,
+            "L": f_lin * lin, "sym": sym, "skew_axis": axis / np.linalg.norm(axis),
+            "skew": skew, "v": rng.normal(size=n), "w_amp": w_amp,
+            "omega": rng.uniform(0.2, 5.0, n), "w_phase": rng.uniform(0, 2 * np.pi, n)}
+
+
+def unknown_plant(p: dict, centre):
+    """A python-control ``NonlinearIOSystem`` (n states, inputs and outputs) from parameters."""
+    import control as ct
+    import numpy as np
+    centre = np.asarray(centre, float)
+    k_mat = _skew(p["skew_axis"])
+
+    def rhs(t, x, u, params):
+        f = p["f_amp"] * np.sin(p["W"] @ x + p["phi"]) + p["L"] @ (x - centre)
+        g = p["sym"] + p["skew"] * np.tanh(p["v"] @ x) * k_mat
+        w = p["w_amp"] * np.sin(p["omega"] * t + p["w_phase"])
+        return f + g @ u + w
+
+    n = len(centre)
+    return ct.nlsys(rhs, None, inputs=n, states=n, outputs=n)
+
+
+def plant_bounds(p: dict, spec) -> dict:
+    """Bounds of the drawn plant over the state space: ``|f|_inf``, ``lambda_min`` and
+    ``lambda_max`` of the symmetric part of g, and ``|g|_2`` (upper bound)."""
+    import numpy as np
+    lo, hi = np.array(spec.state_space.lower), np.array(spec.state_space.upper)
+    centre = (lo + hi) / 2
+    f_bound = p["f_amp"] + np.max(np.abs(p["L"]) @ ((hi - lo) / 2))
+    eig = np.linalg.eigvalsh(p["sym"])
+    return {"f_inf": float(f_bound), "g_sym_min": float(eig[0]), "g_sym_max": float(eig[-1]),
+            "g_norm": float(eig[-1] + p["skew"]), "w_inf": p["w_amp"], "centre": centre}
