@@ -33,7 +33,7 @@ import numpy as np
 from . import reference
 from .tube_samples import TubeSamples, sample_tube
 from .spec import Spec
-from .tube import LOWER, UPPER, TubeDesign
+from .tube import TubeDesign
 
 #: Margins below this (state units) count as failures: rounding in the enclosures.
 ROUNDING_MARGIN = 1e-9
@@ -102,32 +102,17 @@ def _bump_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, center: floa
 
 
 def _circumvent_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
-    """Ranges of ``beta_L`` and ``beta_U`` (eq. (9)) over each interval, shape (K, n) each."""
-    n = design.dimension
-    out = {}
-    for side, bounds in ((LOWER, design.state_lower), (UPPER, design.state_upper)):
-        low = np.tile(np.array(bounds, dtype=float), (t0.size, 1))
-        high = low.copy()
-        for i in range(n):
-            members = design.circumvents_on(i, side)
-            if not members:
-                continue
-            at_low, at_high = [], []
-            for c in members:
-                b_lo, b_hi = _bump_range(design, t0, t1, c.center, c.radius)
-                if side == LOWER:       # base + B b: increasing in b
-                    at_low.append(c.base + c.height * b_lo)
-                    at_high.append(c.base + c.height * b_hi)
-                else:                   # base - B b: decreasing in b
-                    at_low.append(c.base - c.height * b_hi)
-                    at_high.append(c.base - c.height * b_lo)
-            sign = 1.0 if side == LOWER else -1.0
-            for target, values in ((low, at_low), (high, at_high)):
-                combined, _ = reference.smooth_max(sign * np.stack(values, -1),
-                                                   design.smoothness)
-                target[:, i] = sign * combined
-        out[side] = (low, high)
-    return out[LOWER], out[UPPER]
+    """Ranges of ``beta_L`` and ``beta_U`` (eq. (9)) over each interval, shape (K, n) each.
+
+    ``beta_L`` is non-decreasing and ``beta_U`` non-increasing in every bump value, so
+    eq. (9) at the ends of the bumps' ranges gives the ends of theirs.
+    """
+    ranges = [_bump_range(design, t0, t1, c.center, c.radius) for c in design.circumvents]
+    lower_min, upper_max, _ = reference.circumvent_from_bumps(design, [r[0] for r in ranges],
+                                                              t0.size)
+    lower_max, upper_min, _ = reference.circumvent_from_bumps(design, [r[1] for r in ranges],
+                                                              t0.size)
+    return (lower_min, lower_max), (upper_min, upper_max)
 
 
 def enclose_tube(design: TubeDesign, samples: TubeSamples) -> Enclosure:

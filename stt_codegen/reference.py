@@ -161,6 +161,46 @@ def smooth_max(values: Array, nu: float, axis: int = -1) -> tuple[Array, Array]:
     return value, np.moveaxis(weights, -1, axis)
 
 
+def circumvent_from_bumps(design: TubeDesign, bumps: list,
+                          count: int) -> tuple[Array, Array, list]:
+    """Eq. (9) from given bump values: ``beta_L``, ``beta_U`` and each circumvent's weight.
+
+    ``beta_L`` is non-decreasing and ``beta_U`` non-increasing in every bump value.
+
+    Parameters
+    ----------
+    design : TubeDesign
+    bumps : list of ndarray, shape (N,) each
+        The bump value of each of ``design.circumvents``, in that order.
+    count : int
+        ``N``.
+
+    Returns
+    -------
+    beta_L, beta_U : ndarray, shape (N, n)
+    weights : list of ndarray, shape (N,) each
+        ``d beta / d (bound of circumvent j)``, aligned with ``design.circumvents``.
+    """
+    weights: list = [None] * len(design.circumvents)
+    out = []
+    for side, bounds, sign in ((LOWER, design.state_lower, 1.0),
+                               ("upper", design.state_upper, -1.0)):
+        value = np.tile(np.array(bounds, dtype=float), (count, 1))
+        for i in range(design.dimension):
+            members = [j for j, c in enumerate(design.circumvents)
+                       if c.dimension == i and c.side == side]
+            if not members:
+                continue
+            c = design.circumvents
+            terms = [sign * (c[j].base + sign * c[j].height * bumps[j]) for j in members]
+            v, w = smooth_max(np.stack(terms, axis=-1), design.smoothness)
+            value[:, i] = sign * v
+            for k, j in enumerate(members):
+                weights[j] = w[..., k]
+        out.append(value)
+    return out[0], out[1], weights
+
+
 def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
     """Holistic circumvent function ``beta_L``, ``beta_U`` of eq. (9) and derivatives.
 
@@ -173,27 +213,16 @@ def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
     """
     t = _time(t)
     n = design.dimension
-    out = []
-    for side, bounds, sign in ((LOWER, design.state_lower, 1.0),
-                               ("upper", design.state_upper, -1.0)):
-        value = np.tile(np.array(bounds, dtype=float), (t.size, 1))
-        rate = np.zeros((t.size, n))
-        for i in range(n):
-            members = design.circumvents_on(i, side)
-            if not members:
-                continue
-            terms, rates = [], []
-            for c in members:
-                b, b_dot = bump(t, c.center, c.radius, design.circumvent_sharpness)
-                terms.append(sign * (c.base + sign * c.height * b))
-                rates.append(sign * sign * c.height * b_dot)
-            stacked = np.stack(terms, axis=-1)
-            v, w = smooth_max(stacked, design.smoothness)
-            value[:, i] = sign * v
-            rate[:, i] = sign * np.sum(w * np.stack(rates, axis=-1), axis=-1)
-        out.append((value, rate))
-    (beta_l, beta_l_dot), (beta_u, beta_u_dot) = out
-    return beta_l, beta_u, beta_l_dot, beta_u_dot
+    pairs = [bump(t, c.center, c.radius, design.circumvent_sharpness)
+             for c in design.circumvents]
+    beta_l, beta_u, weights = circumvent_from_bumps(design, [b for b, _ in pairs], t.size)
+    rate_l, rate_u = np.zeros((t.size, n)), np.zeros((t.size, n))
+    for c, (_, b_dot), w in zip(design.circumvents, pairs, weights):
+        if c.side == LOWER:
+            rate_l[:, c.dimension] += w * c.height * b_dot
+        else:
+            rate_u[:, c.dimension] -= w * c.height * b_dot
+    return beta_l, beta_u, rate_l, rate_u
 
 
 def conflict_distance(design: TubeDesign, t) -> Array:
