@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,9 +16,10 @@ from stt_codegen.design import design_tube
 from stt_codegen.errors import SpecError
 from stt_codegen.shapes import Ball, make_polytope
 from stt_codegen.simulate import simulate
-from stt_codegen.spec import parse_spec
+from stt_codegen.spec import load_spec, parse_spec
 from stt_codegen.tube_samples import sample_tube
 
+SPECS = Path(__file__).parent / "specs"
 BESIDE = """
 name = "beside"
 prescribed_time = 9.0
@@ -57,7 +59,7 @@ def test_ball_whose_bounding_box_meets_the_start_is_split_and_used():
     as_box = BESIDE + "[[obstacles]]\nlower = [0.38, 0.38]\nupper = [1.62, 1.62]\n"
     with pytest.raises(SpecError, match="meets the initial set"):
         parse_spec(as_box)                   # its bounding box violates Assumption 3
-    spec = parse_spec(BESIDE + BALL)
+    spec = load_spec(SPECS / "ball-beside-start.toml")   # the README's example
     assert spec.unsafe_sets[0].kind == "ball" and len(spec.obstacles) > 1
     rng = np.random.default_rng(0)
     ball = spec.unsafe_sets[0].shape

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import math
-
 import pytest
 
 from stt_codegen.errors import SpecError
@@ -157,4 +155,3 @@ def test_infinite_number_in_array():
     with pytest.raises(SpecError) as info:
         parse_spec(replace("[initial]\nlower = [0.0, 0.0]", "[initial]\nlower = [-inf, 0.0]"))
     assert info.value.field == "initial.lower[0]" and "finite" in info.value.reason
-    assert math.isinf(float("-inf"))

@@ -14,8 +14,8 @@ import json
 import numpy as np
 
 from .. import reference
-from ..certificate import _circumvent_range, certify_tube
-from ..design import design_tube
+from ..certificate import _circumvent_range
+from ..design import MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
 from ..spec import PLANT_MODELS, Spec, load_spec
 from ..tube import TubeDesign
@@ -116,8 +116,13 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None,
                             f"the deployed alpha stays in [0, {peak:.6g}] within the bound "
                             f"{a_max:.6g}", {"peak": peak, "alpha_max": a_max}))
 
-    certificate = certify_tube(design, spec, samples=s)
-    for margin in certificate.margins:
+    check = check_tube(design, spec, samples=s)
+    checks.append(Check("tube.sampling_rate", check.max_move_ratio <= MAX_MOVE_PER_SAMPLE,
+                        f"a tube bound moves at most {check.max_move_ratio:.3g} tube widths in "
+                        f"one sampling period at {design.rate_hz:g} Hz (limit "
+                        f"{MAX_MOVE_PER_SAMPLE}: a sampled controller cannot follow faster)",
+                        {"max_move_ratio": check.max_move_ratio}))
+    for margin in check.certificate.margins:
         checks.append(Check(f"tube.{margin.name.replace(' ', '_')}", margin.passed,
                             margin.detail, {"margin": margin.margin, "time": margin.time}))
     return checks
