@@ -5,7 +5,7 @@ Property (hypothesis, derandomized, 15 examples): for ``x_dot = f(x) + g(x) u + 
 has eigenvalues in ``[g_min, g_max]`` with ``g_max <= 1`` (the default gain's assumption,
 README decision 9) and a state-dependent skew part ``K`` of norm at most ``g_min / 2``,
 and ``|w_i| <= 0.2``, the sampled closed loop of every bundled case stays in the tube
-and satisfies the task. ``tests/test_hard_dynamics_batch.py`` is the larger study (wider
+and satisfies the task. ``tests/study_unknown_dynamics.py`` is the larger study (wider
 ranges, failures classified); its figures are in the README.
 """
 

@@ -1,7 +1,7 @@
 """Issue 7, unknown dynamics: the batch study behind the README figures (a script, not a test).
 
-    python tests/test_hard_dynamics_batch.py [RUNS_PER_CASE] [--out results.json]
-    python tests/test_hard_dynamics_batch.py --sweeps    # 1-D sweeps of lambda(g) and |f|
+    python tests/study_unknown_dynamics.py [RUNS_PER_CASE] [--out results.json]
+    python tests/study_unknown_dynamics.py --sweeps    # 1-D sweeps of lambda(g) and |f|
 
 Draws plants ``x_dot = f(x) + g(x) u + w`` (:func:`test_hard_support.unknown_plant`) over
 wide ranges, runs the generated C controller of each bundled case against them, and
