@@ -59,7 +59,10 @@ def shape_docs() -> list[dict]:
 
 
 def _skew(v):
+    """A unit skew-symmetric matrix: the rotation generator in 2-D, ``v x`` in 3-D."""
     import numpy as np
+    if len(v) == 2:
+        return np.array([[0.0, -1.0], [1.0, 0.0]])
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
 
