@@ -9,10 +9,11 @@ The paper leaves several points open or, read literally, fails (see the README's
   ``t = t_c a / (1 + a)``, ``a = atanh(s)``. No 0/0 on degenerate dimensions.
 * **Dimension and side, eq. (6)**: every valid (dimension, side) of every obstacle is a
   candidate; candidates are tried in a fixed order (longest overlap first) and a design
-  is accepted only if its tube passes :func:`check_tube` on a grid at the controller's
-  sampling period. The search is a depth-first search with backtracking over obstacles
-  in the order of their windows; it fails with a :class:`DesignError` naming the
-  obstacle when no candidate passes.
+  is accepted only if its tube passes :func:`check_tube`: the continuous-time
+  certificate (:mod:`stt_codegen.certificate`) and the sampling-rate limit. The search
+  is a depth-first search with backtracking over obstacles in the order of their
+  windows (one choice per spec obstacle, shared by the boxes of a covering); it fails
+  with a :class:`DesignError` naming the obstacle when no candidate passes.
 * **Bump window**: the active window is widened around the overlap interval so that
   the bump, whose sharpness ``k^j`` the spec fixes, is within ``delta_B / 2`` of its peak
   where the reach tube first and last overlaps the obstacle.
@@ -174,16 +175,8 @@ def progress_time(design: TubeDesign, s: float) -> float:
     return design.prescribed_time * a / (1.0 + a)
 
 
-@dataclass(frozen=True)
-class Candidate:
-    """One way to avoid an obstacle: a circumvent on one bound, and why it ranks where it does."""
-
-    circumvent: Circumvent
-    overlap: float
-
-
-def candidates(design: TubeDesign, spec: Spec, j: int, delta_b: float) -> list[Candidate]:
-    """The circumvents that could avoid obstacle ``j``, best first (deterministic order).
+def candidates(design: TubeDesign, spec: Spec, j: int, delta_b: float) -> list[Circumvent]:
+    """The circumvents that could avoid obstacle box ``j``, best first (deterministic order).
 
     Order: dimensions where the reach tube overlaps the obstacle's projection for the
     longest part of ``[0, 1]`` in ``s`` first, then the side that needs the bound to
@@ -224,8 +217,8 @@ def candidates(design: TubeDesign, spec: Spec, j: int, delta_b: float) -> list[C
             radius = max(0.5 * (t2 - t1), 1e-9) / z
             center = 0.5 * (t1 + t2)
             result.append((-span, move, i, 0 if side == LOWER else 1,
-                           Candidate(Circumvent(j, i, side, center - radius, center + radius,
-                                                height, base), span)))
+                           Circumvent(j, i, side, center - radius, center + radius, height,
+                                      base)))
     result.sort(key=lambda r: r[:4])
     return [r[-1] for r in result]
 
@@ -252,7 +245,6 @@ def base_design(spec: Spec, gain: float = 1.0) -> TubeDesign:
 
 def _ordered(circumvents) -> tuple[Circumvent, ...]:
     return tuple(sorted(circumvents, key=lambda c: (c.dimension, c.side, c.obstacle)))
-
 
 
 def default_gain(design: TubeDesign, samples: TubeSamples) -> float:
@@ -304,10 +296,9 @@ def design_tube(spec: Spec) -> tuple[TubeDesign, TubeCheck]:
             raise DesignError(f"obstacle {j} comes within {WINDOW_INFLATION * delta_b:g} of "
                               "the target box eta +- d_T: shrink target.half_width")
         found_here = candidates(base, spec, b, delta_b)
-        per_box[b] = {(c.circumvent.dimension, c.circumvent.side): c.circumvent
-                      for c in found_here}
+        per_box[b] = {(c.dimension, c.side): c for c in found_here}
         groups.setdefault(j, []).append(b)
-        rank.setdefault(j, [(c.circumvent.dimension, c.circumvent.side) for c in found_here])
+        rank.setdefault(j, [(c.dimension, c.side) for c in found_here])
         starts[j] = min(starts.get(j, math.inf), progress_time(base, interval[0]))
     options: dict[int, list[tuple[Circumvent, ...]]] = {}
     for j, members in groups.items():

@@ -17,6 +17,7 @@ import numpy as np
 import control as ct
 
 from .backends import STATUS_OK, make_controller
+from .errors import SpecError
 from .plants import make_plant
 from .spec import Spec
 from .tube import TubeDesign
@@ -124,7 +125,6 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
     SpecError
         Unknown backend, or a non-positive horizon.
     """
-    from .errors import SpecError
     t_c = spec.prescribed_time
     horizon = t_c if horizon is None else float(horizon)
     if not math.isfinite(horizon) or horizon <= 0:
