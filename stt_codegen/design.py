@@ -38,6 +38,10 @@ from .tube_samples import TubeSamples, sample_tube
 #: Largest distance a tube bound may move in one sampling period, as a fraction of the
 #: tube's width there: a sampled controller cannot follow a faster tube.
 MAX_MOVE_PER_SAMPLE = 0.25
+#: Largest ``|e_i|`` of ``x(0)`` in the tube at ``t = 0``: near the tube's edge law (13)
+#: is so steep that the first sampled step overshoots (measured: at ``|e| ~ 1`` the
+#: first input was 1e8 and the state left the arena in one period).
+MAX_INITIAL_ERROR = 0.5
 #: Obstacles are inflated by this fraction of ``delta_B`` to compute overlap windows.
 WINDOW_INFLATION = 0.5
 
@@ -58,6 +62,8 @@ class TubeCheck:
         (positive: clear), state units; ``inf`` without obstacles.
     max_move_ratio : float
         Largest ``|gamma_dot| dt / gamma_d`` on the grid.
+    initial_error : float
+        ``max_i |e_i|`` of ``x(0)`` in the tube at ``t = 0``.
     certificate : Certificate
         The continuous-time certificate behind the verdict.
     """
@@ -67,6 +73,7 @@ class TubeCheck:
     min_width: float
     min_clearance: float
     max_move_ratio: float
+    initial_error: float
     certificate: Certificate
 
 
@@ -75,7 +82,8 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
     """Check a designed tube: the continuous-time certificate and the sampling limit.
 
     Conditions, in order: no bound moves more than ``MAX_MOVE_PER_SAMPLE`` of the tube
-    width in one sampling period; and every property of
+    width in one sampling period; ``x(0)`` starts with ``|e_i| <= MAX_INITIAL_ERROR``
+    (room for the first sampled steps); and every property of
     :func:`~stt_codegen.certificate.certify_tube` (non-empty, ``x(0)`` inside, inside the
     state space, missing each listed obstacle and, with ``final``, inside the target from
     ``t_c`` on) holds for all ``t``.
@@ -104,10 +112,15 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
     max_ratio = float(ratio.max())
     margins = {m.name: m for m in certificate.margins}
     clearances = [m.margin for m in certificate.margins if m.name.startswith("avoids")]
+    x0 = np.array(design.initial_state)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e0 = (2 * x0 - (s.gamma_upper[0] + s.gamma_lower[0])) / width[0]
+    initial_error = float(np.max(np.abs(e0))) if np.all(width[0] > 0) else math.inf
 
     def result(reason: str) -> TubeCheck:
         return TubeCheck(not reason, reason, margins["non-empty"].margin,
-                         min(clearances, default=math.inf), max_ratio, certificate)
+                         min(clearances, default=math.inf), max_ratio, initial_error,
+                         certificate)
 
     if not np.all(width > 0):  # empty at a sample: the rate ratio is meaningless
         return result(f"non-empty fails: {margins['non-empty'].detail}")
@@ -116,6 +129,10 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
         return result(f"a tube bound moves {max_ratio:.2f} tube widths in one sampling "
                       f"period at t = {s.t[k]:.3f} s (limit {MAX_MOVE_PER_SAMPLE}; a larger "
                       "tube.circumvent_sharpness or controller.rate_hz helps)")
+    if initial_error > MAX_INITIAL_ERROR and margins["initial state inside"].passed:
+        return result(f"x(0) starts at |e| = {initial_error:.3g} of the tube's half-width "
+                      f"at t = 0 (limit {MAX_INITIAL_ERROR}): the first sampled steps would "
+                      "overshoot")
     for margin in certificate.margins:
         if margin.name == "inside target after t_c" and not final:
             continue

@@ -133,3 +133,20 @@ def test_sampled_alpha_starts_at_zero_and_stays_valid(case):
     samples = sample_tube(design)
     assert np.all(samples.alpha[0] == 0)
     assert np.all(samples.alpha >= 0)
+
+
+def test_a_start_at_the_tube_edge_is_rejected():
+    """Random arena 233: its first candidate's window opens before t = 0, so x(0) starts at
+    the edge of the narrowed tube; deployed, the first input was 1e8 and the state left the
+    arena in one period. The check refuses it, and the search finds another design."""
+    from stt_codegen.bench.arenas import generate_arena
+    from stt_codegen.design import MAX_INITIAL_ERROR, candidates
+    spec = generate_arena(0, 233).to_spec()
+    base = base_design(spec)
+    first = candidates(base, spec, 1, spec.tube.delta_b)[0]
+    assert first.start < 0
+    check = check_tube(dataclasses.replace(base, circumvents=(first,)), spec)
+    assert check.initial_error > MAX_INITIAL_ERROR
+    assert not check.passed and "x(0) starts at |e| =" in check.reason
+    design, accepted = design_tube(spec)
+    assert accepted.passed and accepted.initial_error <= MAX_INITIAL_ERROR

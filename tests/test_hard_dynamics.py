@@ -3,7 +3,7 @@
 Property (hypothesis, derandomized, 15 examples): for ``x_dot = f(x) + g(x) u + w`` with
 ``f`` a bounded smooth term plus a linear term, ``g = D + S + K(x)`` whose symmetric part
 has eigenvalues in ``[g_min, g_max]`` with ``g_max <= 1`` (the default gain's assumption,
-README decision 9) and a state-dependent skew part ``K`` of norm at most ``g_min / 2``,
+README decision 10) and a state-dependent skew part ``K`` of norm at most ``g_min / 2``,
 and ``|w_i| <= 0.2``, the sampled closed loop of every bundled case stays in the tube
 and satisfies the task. ``tests/study_unknown_dynamics.py`` is the larger study (wider
 ranges, failures classified); its figures are in the README.

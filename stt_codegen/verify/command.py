@@ -15,7 +15,7 @@ import numpy as np
 
 from .. import reference
 from ..certificate import _circumvent_range
-from ..design import MAX_MOVE_PER_SAMPLE, check_tube, design_tube
+from ..design import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
 from ..spec import PLANT_MODELS, Spec, load_spec
 from ..tube import TubeDesign
@@ -122,6 +122,11 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None,
                         f"one sampling period at {design.rate_hz:g} Hz (limit "
                         f"{MAX_MOVE_PER_SAMPLE}: a sampled controller cannot follow faster)",
                         {"max_move_ratio": check.max_move_ratio}))
+    checks.append(Check("tube.initial_room", check.initial_error <= MAX_INITIAL_ERROR,
+                        f"x(0) starts at |e| = {check.initial_error:.3g} of the tube's "
+                        f"half-width at t = 0 (limit {MAX_INITIAL_ERROR}: closer to the edge "
+                        "the first sampled steps overshoot)",
+                        {"initial_error": check.initial_error}))
     for margin in check.certificate.margins:
         checks.append(Check(f"tube.{margin.name.replace(' ', '_')}", margin.passed,
                             margin.detail, {"margin": margin.margin, "time": margin.time}))
