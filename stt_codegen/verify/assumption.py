@@ -9,6 +9,9 @@ state variable the eigenvalues depend on (e.g. the heading range
 
 from __future__ import annotations
 
+import math
+from fractions import Fraction
+
 from typing import Mapping, Sequence
 
 import sympy as sp
@@ -26,6 +29,8 @@ __all__ = [
 #: A range endpoint closer than this to a zero of an eigenvalue counts as
 #: reaching it (``np.pi/2`` is a double below pi/2, with ``cos`` = 6e-17).
 TOUCH_TOL = 1e-12
+#: Range ends are snapped outward to multiples of 1/SNAP.
+SNAP = 10**15
 
 
 def symmetric_part(g: sp.Matrix) -> sp.Matrix:
@@ -87,13 +92,22 @@ def check_assumption2(
             return Check(name, False,
                          f"eigenvalue {lam} of g_s depends on {v}, for which no range was "
                          "given: not uniformly positive over all reals", data)
-        lo, hi = (sp.Float(float(b), 30) for b in ranges[v])
-        if lo > hi:
-            return Check(name, False, f"empty range [{lo}, {hi}] for {v}", data)
-        zeros = _finite_points(sp.solveset(lam, v, sp.Interval(lo - TOUCH_TOL,
-                                                                hi + TOUCH_TOL)))
-        crit = [] if lo == hi else _finite_points(
-            sp.solveset(sp.diff(lam, v), v, sp.Interval(lo, hi)))
+        raw_lo, raw_hi = (float(b) for b in ranges[v])
+        if raw_lo > raw_hi:
+            return Check(name, False, f"empty range [{raw_lo}, {raw_hi}] for {v}", data)
+        # snap outward, exactly, to a 1e-15 grid of rationals: a superset of the range (so
+        # the bound stays sound) whose comparisons with pi SymPy can decide (a subnormal
+        # width such as [0, 2.2e-309] made it give up)
+        lo = sp.Rational(math.floor(Fraction(raw_lo) * SNAP), SNAP)
+        hi = sp.Rational(math.ceil(Fraction(raw_hi) * SNAP), SNAP)
+        try:
+            zeros = _finite_points(sp.solveset(lam, v, sp.Interval(lo - TOUCH_TOL,
+                                                                    hi + TOUCH_TOL)))
+            crit = [] if lo == hi else _finite_points(
+                sp.solveset(sp.diff(lam, v), v, sp.Interval(lo, hi)))
+        except TypeError as exc:
+            return Check(name, False, f"could not decide the sign of {lam} on "
+                                      f"[{raw_lo}, {raw_hi}]: {exc}", data)
         if crit is None or zeros is None:
             return Check(name, False,
                          f"could not enumerate the critical points or zeros of {lam} on "
