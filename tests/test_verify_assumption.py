@@ -79,3 +79,10 @@ def test_bound_is_min_cos(lo: float, width: float) -> None:
     assert c.passed
     expected = min(math.cos(lo), math.cos(hi))
     assert c.data["g_lower"] == pytest.approx(expected, rel=1e-12)
+
+
+def test_subnormal_width_range_is_decided() -> None:
+    """Regression (found by hypothesis): [0, 2.2e-309] made SymPy raise TypeError when
+    comparing the range's end with pi; the range is now snapped outward exactly."""
+    c = assumption2_omnidirectional((0.0, 2.225073858507203e-309))
+    assert c.passed and c.data["g_lower"] == pytest.approx(1.0, rel=1e-12)
