@@ -150,7 +150,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("demo", help="generate, compile and run the controller of every bundled "
                                     "case in closed loop; print a table, write code and plots")
     p.add_argument("--out", default="stt-demo", metavar="DIR",
-                   help="folder for the plots (default: %(default)s)")
+                   help="folder for the generated code and the plots (default: %(default)s)")
     p.add_argument("--backend", default=default_backend(), choices=backend_names(),
                    help="controller implementation (default: %(default)s)")
     p.set_defaults(handler=_cmd_demo)
