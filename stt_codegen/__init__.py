@@ -3,11 +3,11 @@
 The method is "Prescribed-time Reach-Avoid-Stay Specifications for Unknown Systems: A
 Spatiotemporal Tubes Approach". Main entry points:
 
-* :func:`stt_codegen.spec.load_spec` - read and validate a spec (TOML);
-* :func:`stt_codegen.design.design_tube` - choose windows, circumvents and gain;
-* :func:`stt_codegen.model.build_model` - the CasADi functions of the tube and controller;
-* :mod:`stt_codegen.reference` - the numpy reference of eqs. (2)-(13);
-* :func:`stt_codegen.simulate.simulate` - the sampled closed loop and Definition 2.1.
+* :func:`stt_codegen.spec.loader.load_spec` - read and validate a spec (TOML);
+* :func:`stt_codegen.design.search.design_tube` - choose windows, circumvents and gain;
+* :func:`stt_codegen.tube.model.build_model` - the CasADi functions of the tube and controller;
+* :mod:`stt_codegen.tube.reference` - the numpy reference of eqs. (2)-(13);
+* :func:`stt_codegen.runtime.simulate.simulate` - the sampled closed loop and Definition 2.1.
 """
 
 __version__ = "0.1.0"

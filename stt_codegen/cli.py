@@ -41,15 +41,15 @@ def atomic_write_bytes(path: Path, writer) -> None:
 
 
 def _design(spec_arg: str):
-    from .design import design_tube
-    from .spec import load_spec
+    from .design.search import design_tube
+    from .spec.loader import load_spec
     spec = load_spec(spec_arg)
     design, _ = design_tube(spec)
     return spec, design
 
 
 def _cmd_cases(args: argparse.Namespace) -> int:
-    from .spec import bundled_cases
+    from .spec.loader import bundled_cases
     for name in bundled_cases():
         print(name)
     return 0
@@ -75,12 +75,12 @@ def _check_output_folder(path: str | None) -> None:
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
-    from .simulate import simulate
+    from .runtime.simulate import simulate
     _check_output_folder(args.plot)
     spec, design = _design(args.spec)
     result = simulate(spec, design, backend=args.backend, horizon=args.horizon, seed=args.seed)
     if args.plot:
-        from .plots import plot_run
+        from .runtime.plots import plot_run
         atomic_write_bytes(Path(args.plot), lambda tmp: plot_run(spec, design, result, tmp))
     if args.json:
         data = result.to_json()
@@ -105,9 +105,9 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 def _cmd_demo(args: argparse.Namespace) -> int:
     from .codegen import Options, generate_files, write_generation
-    from .plots import plot_run
-    from .simulate import simulate
-    from .spec import bundled_cases
+    from .runtime.plots import plot_run
+    from .runtime.simulate import simulate
+    from .spec.loader import bundled_cases
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print(f"For every bundled case: design the tube, generate the C and Python controllers "
@@ -127,7 +127,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every subcommand."""
-    from .backends import backend_names
+    from .runtime.backends import backend_names
     parser = argparse.ArgumentParser(
         prog="stt-codegen",
         description="Spatiotemporal-tube controllers for prescribed-time reach-avoid-stay tasks.")

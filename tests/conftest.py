@@ -10,8 +10,8 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from stt_codegen.design import design_tube  # noqa: E402
-from stt_codegen.spec import bundled_cases, load_spec  # noqa: E402
+from stt_codegen.design.search import design_tube  # noqa: E402
+from stt_codegen.spec.loader import bundled_cases, load_spec  # noqa: E402
 
 CASES = ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3"]
 
@@ -26,7 +26,7 @@ def designed(name: str):
 
 @lru_cache(maxsize=None)
 def model_of(name: str):
-    from stt_codegen.model import build_model
+    from stt_codegen.tube.model import build_model
     return build_model(designed(name)[1])
 
 

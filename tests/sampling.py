@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from stt_codegen import reference
-from stt_codegen.tube import TubeDesign
+from stt_codegen.tube import reference
+from stt_codegen.tube.parameters import TubeDesign
 
 #: Largest |e_i| of a sampled point (the acceptance criterion's "strictly inside").
 E_LIMIT = 0.999

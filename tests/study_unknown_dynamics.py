@@ -33,8 +33,8 @@ _CACHE: dict = {}
 
 def _designed(case):
     if case not in _CACHE:
-        from stt_codegen.design import design_tube
-        from stt_codegen.spec import load_spec
+        from stt_codegen.design.search import design_tube
+        from stt_codegen.spec.loader import load_spec
         spec = load_spec(case)
         _CACHE[case] = (spec, design_tube(spec)[0])
     return _CACHE[case]
@@ -49,7 +49,7 @@ def draw(case: str, index: int) -> dict:
 
 
 def run_one(case: str, knobs: dict, rate_factor: float = 1.0, gain_factor: float = 1.0):
-    from stt_codegen.simulate import simulate
+    from stt_codegen.runtime.simulate import simulate
     from test_hard_support import plant_bounds, random_plant_parameters, unknown_plant
     spec, design = _designed(case)
     rng = np.random.default_rng(knobs["seed"])
@@ -97,7 +97,7 @@ def study(args) -> dict:
 
 def sweep_one(args):
     """One point of the 1-D sweeps: ``g = lam I`` (f = 0) or ``f`` constant (g = I)."""
-    from stt_codegen.simulate import simulate
+    from stt_codegen.runtime.simulate import simulate
     from test_hard_support import unknown_plant
     case, kind, value, rate_factor = args
     spec, design = _designed(case)

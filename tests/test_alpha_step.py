@@ -11,10 +11,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
-from stt_codegen import reference as R
-from stt_codegen.tube_samples import sample_tube
-from stt_codegen.model import implicit_alpha_update
-from stt_codegen.tube import NEWTON_ITERATIONS
+from stt_codegen.tube import reference as R
+from stt_codegen.design.samples import sample_tube
+from stt_codegen.tube.model import implicit_alpha_update
+from stt_codegen.tube.parameters import NEWTON_ITERATIONS
 
 _a, _p, _th, _h = (ca.SX.sym(n) for n in ("a", "p", "th", "h"))
 NEWTON = ca.Function("newton", [_a, _p, _th, _h],

@@ -13,7 +13,7 @@ from stt_codegen.bench.planning import MARGIN, FreeSpace
 from stt_codegen.bench.report import summarize
 from stt_codegen.bench.tracker import track
 from stt_codegen.errors import SpecError
-from stt_codegen.spec import load_spec, parse_spec
+from stt_codegen.spec.loader import load_spec, parse_spec
 
 WALL_SPEC = """
 name = "wall"

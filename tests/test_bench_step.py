@@ -11,9 +11,9 @@ from stt_codegen.bench.harness import build_harness, harness_source
 from stt_codegen.bench.scaling import format_scaling_report, run_scaling_bench, synthetic_design
 from stt_codegen.bench.step import format_step_report, run_step_bench
 from stt_codegen.cli import main
-from stt_codegen.emit import count_operations
+from stt_codegen.codegen.emit import count_operations
 from stt_codegen.errors import SpecError
-from stt_codegen.model import build_model
+from stt_codegen.tube.model import build_model
 
 IMPLEMENTATIONS = ["C, compiled loop", "C via ctypes (from Python)", "generated Python",
                    "CasADi Function (from Python)", "numpy reference"]
@@ -45,8 +45,8 @@ def test_step_report(capsys):
 
 def test_step_operation_counts_are_the_emitters():
     report = run_step_bench("omnirobot-s2", steps=500, rounds=1, callgrind=False)
-    from stt_codegen.design import design_tube
-    from stt_codegen.spec import load_spec
+    from stt_codegen.design.search import design_tube
+    from stt_codegen.spec.loader import load_spec
     design, _ = design_tube(load_spec("omnirobot-s2"))
     counts = count_operations(build_model(design)["controller_step"])
     assert report["operations"] == {"arithmetic": counts.arithmetic,

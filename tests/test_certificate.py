@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 from conftest import designed
 
-from stt_codegen import reference as R
-from stt_codegen.certificate import certify_tube, enclose_tube
-from stt_codegen.design import base_design
-from stt_codegen.spec import parse_spec
-from stt_codegen.tube_samples import sample_tube
+from stt_codegen.tube import reference as R
+from stt_codegen.design.certificate import certify_tube, enclose_tube
+from stt_codegen.design.search import base_design
+from stt_codegen.spec.loader import parse_spec
+from stt_codegen.design.samples import sample_tube
 
 
 def test_bundled_tubes_are_certified(case):
@@ -60,7 +60,7 @@ rate_hz = 50.0
 
 def test_an_obstacle_clipped_between_samples_is_caught():
     """A 0.1 mm obstacle that the tube's corner clips for less than one 20 ms period."""
-    from stt_codegen.spec import Box
+    from stt_codegen.spec.loader import Box
     spec = parse_spec(CORNER)
     design = base_design(spec)
     samples = sample_tube(design)

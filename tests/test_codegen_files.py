@@ -20,7 +20,7 @@ from stt_codegen.codegen.bundled import LAYOUT, drift
 from stt_codegen.codegen.casadi_c import casadi_bodies, check_no_mutable_state
 from stt_codegen.codegen.errors import CodegenError
 from stt_codegen.codegen.single import check_single, to_single
-from stt_codegen.spec import load_spec
+from stt_codegen.spec.loader import load_spec
 
 REPO = Path(__file__).resolve().parent.parent
 

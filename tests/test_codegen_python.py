@@ -11,8 +11,8 @@ from conftest import CASES, designed, model_of
 from sampling import random_points
 from test_model_equivalence import casadi_outputs
 
-from stt_codegen import reference as R
-from stt_codegen.codegen.controllers import load_python_module
+from stt_codegen.tube import reference as R
+from stt_codegen.runtime.compiled import load_python_module
 from stt_codegen.codegen.functions import clamped_control
 
 POINTS = 1_500

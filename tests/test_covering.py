@@ -10,14 +10,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from stt_codegen.certificate import certify_tube, enclose_tube
-from stt_codegen.covering import MAX_BOXES, cover
-from stt_codegen.design import design_tube
+from stt_codegen.design.certificate import certify_tube, enclose_tube
+from stt_codegen.spec.covering import MAX_BOXES, cover
+from stt_codegen.design.search import design_tube
 from stt_codegen.errors import SpecError
-from stt_codegen.shapes import Ball, make_polytope
-from stt_codegen.simulate import simulate
-from stt_codegen.spec import load_spec, parse_spec
-from stt_codegen.tube_samples import sample_tube
+from stt_codegen.spec.shapes import Ball, make_polytope
+from stt_codegen.runtime.simulate import simulate
+from stt_codegen.spec.loader import load_spec, parse_spec
+from stt_codegen.design.samples import sample_tube
 
 SPECS = Path(__file__).parent / "specs"
 BESIDE = """

@@ -11,11 +11,11 @@ from conftest import designed
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from stt_codegen.design import (MAX_MOVE_PER_SAMPLE, base_design, check_tube, design_tube,
+from stt_codegen.design.search import (MAX_MOVE_PER_SAMPLE, base_design, check_tube, design_tube,
                                 overlap_interval, progress_time)
-from stt_codegen.tube_samples import sample_tube
+from stt_codegen.design.samples import sample_tube
 from stt_codegen.errors import DesignError
-from stt_codegen.spec import Box, load_spec, parse_spec
+from stt_codegen.spec.loader import Box, load_spec, parse_spec
 
 TWO_D = """
 name = "corridor"
@@ -140,7 +140,7 @@ def test_a_start_at_the_tube_edge_is_rejected():
     the edge of the narrowed tube; deployed, the first input was 1e8 and the state left the
     arena in one period. The check refuses it, and the search finds another design."""
     from stt_codegen.bench.arenas import generate_arena
-    from stt_codegen.design import MAX_INITIAL_ERROR, candidates
+    from stt_codegen.design.search import MAX_INITIAL_ERROR, candidates
     spec = generate_arena(0, 233).to_spec()
     base = base_design(spec)
     first = candidates(base, spec, 1, spec.tube.delta_b)[0]

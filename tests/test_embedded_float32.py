@@ -45,7 +45,7 @@ def test_no_overflow_or_invalid_on_adversarial_inputs(case, tmp_path) -> None:
 def _edge_inputs(design, c):
     n = design.dimension
     rows = {"x": [], "t": [], "dt": [], "alpha": [], "what": []}
-    from stt_codegen import reference as R
+    from stt_codegen.tube import reference as R
     for edge in (c.start, c.end):
         for k in range(-4, 5):
             t = _ulps(edge, k)

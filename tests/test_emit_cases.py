@@ -10,7 +10,7 @@ from typing import Callable, Dict, List
 
 import casadi as ca
 
-from stt_codegen.emit import count_operations
+from stt_codegen.codegen.emit import count_operations
 
 
 def smooth_max() -> ca.Function:

@@ -12,9 +12,9 @@ from pathlib import Path
 import casadi as ca
 import pytest
 
-import stt_codegen.emit.instructions as instructions_module
-import stt_codegen.emit.ops as ops_module
-from stt_codegen.emit import (
+import stt_codegen.codegen.emit.instructions as instructions_module
+import stt_codegen.codegen.emit.ops as ops_module
+from stt_codegen.codegen.emit import (
     Binary,
     Const,
     EmitError,
@@ -228,7 +228,7 @@ _GENERATE = textwrap.dedent(
     import sys
     sys.path.insert(0, {tests!r})
     from test_emit_cases import all_functions
-    from stt_codegen.emit import python_source, lower
+    from stt_codegen.codegen.emit import python_source, lower
     fns = all_functions()
     sys.stdout.write(python_source(fns))
     sys.stdout.write(repr([lower(f) for f in fns]))

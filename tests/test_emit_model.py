@@ -8,10 +8,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from stt_codegen.design import design_tube
-from stt_codegen.emit import count_operations, python_function, python_source
-from stt_codegen.model import build_model
-from stt_codegen.spec import bundled_cases, load_spec
+from stt_codegen.design.search import design_tube
+from stt_codegen.codegen.emit import count_operations, python_function, python_source
+from stt_codegen.tube.model import build_model
+from stt_codegen.spec.loader import bundled_cases, load_spec
 
 from test_emit_python import assert_bit_identical
 

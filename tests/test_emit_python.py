@@ -17,9 +17,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from stt_codegen.emit import count_operations, lower, python_function, python_source
-from stt_codegen.emit.ops import OPS_BY_NAME
-from stt_codegen.emit.python_printer import PythonPrinter
+from stt_codegen.codegen.emit import count_operations, lower, python_function, python_source
+from stt_codegen.codegen.emit.ops import OPS_BY_NAME
+from stt_codegen.codegen.emit.python_printer import PythonPrinter
 
 from test_emit_cases import CASES
 

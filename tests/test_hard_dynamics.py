@@ -19,9 +19,9 @@ from hypothesis import strategies as st
 
 from conftest import CASES, designed
 from stt_codegen.bench.arenas import generate_arena
-from stt_codegen.design import design_tube
+from stt_codegen.design.search import design_tube
 from stt_codegen.errors import DesignError
-from stt_codegen.simulate import simulate
+from stt_codegen.runtime.simulate import simulate
 from test_hard_support import plant_bounds, random_plant_parameters, unknown_plant
 
 PLANTS = settings(derandomize=True, deadline=None, database=None, max_examples=15,

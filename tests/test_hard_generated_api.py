@@ -24,8 +24,8 @@ import numpy as np
 import pytest
 
 from conftest import designed
-from stt_codegen import reference as R
-from stt_codegen.codegen.controllers import load_python_module
+from stt_codegen.tube import reference as R
+from stt_codegen.runtime.compiled import load_python_module
 from stt_codegen.codegen.generate import generate_files, input_limits
 from stt_codegen.codegen.options import Options
 

@@ -21,7 +21,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from stt_codegen.errors import SpecError
-from stt_codegen.spec import Spec, parse_spec
+from stt_codegen.spec.loader import Spec, parse_spec
 from test_hard_support import dumps, shape_docs
 
 DOCS = shape_docs()

@@ -6,7 +6,7 @@ import numpy as np
 from conftest import designed, model_of
 from sampling import random_points
 
-from stt_codegen import reference as R
+from stt_codegen.tube import reference as R
 
 
 def central(f, x, h):

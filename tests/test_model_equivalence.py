@@ -7,9 +7,9 @@ import pytest
 from conftest import designed, model_of
 from sampling import E_LIMIT, random_points
 
-from stt_codegen import reference as R
-from stt_codegen.tube_samples import sample_tube
-from stt_codegen.model import FUNCTION_NAMES
+from stt_codegen.tube import reference as R
+from stt_codegen.design.samples import sample_tube
+from stt_codegen.tube.model import FUNCTION_NAMES
 
 POINTS = 10_000
 TOLERANCE = 1e-12

@@ -7,9 +7,9 @@ import pytest
 from conftest import designed
 from scipy.integrate import solve_ivp
 
-from stt_codegen import backends
-from stt_codegen.plants import Disturbance, make_plant
-from stt_codegen.simulate import SUBSTEPS, _rk4, simulate
+from stt_codegen.runtime import backends
+from stt_codegen.runtime.plants import Disturbance, make_plant
+from stt_codegen.runtime.simulate import SUBSTEPS, _rk4, simulate
 
 
 @pytest.mark.parametrize("backend", ["reference", "casadi"])

@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from stt_codegen.errors import SpecError
-from stt_codegen.spec import load_spec, parse_spec
+from stt_codegen.spec.loader import load_spec, parse_spec
 
 VALID = """
 name = "case-1"

@@ -5,7 +5,7 @@ data, so that it runs unchanged in a local process pool or on a Dask worker.
 
 Methods (:data:`METHODS`):
 
-* ``stt``: :func:`~stt_codegen.design.design_tube` (the design search and its
+* ``stt``: :func:`~stt_codegen.design.search.design_tube` (the design search and its
   continuous-time certificate), then the generated C controller (backend ``c``) in closed
   loop; the time reported is the design's;
 * ``astar``: :func:`~.astar.plan_astar` then :func:`~.tracker.track`;
@@ -13,7 +13,7 @@ Methods (:data:`METHODS`):
   OMPL is installed).
 
 Every method runs on the same arena with the same disturbance (seed = arena index), the
-same sampling rate and the same judge, :func:`stt_codegen.simulate.simulate`.
+same sampling rate and the same judge, :func:`stt_codegen.runtime.simulate.simulate`.
 """
 
 from __future__ import annotations
@@ -23,11 +23,11 @@ import time
 from typing import Any
 
 from ..errors import DesignError
-from ..simulate import SimulationResult
+from ..runtime.simulate import SimulationResult
 from .arenas import generate_arena
 
 METHODS = ("stt", "astar", "rrtstar")
-#: Names of the certificate's properties (:mod:`stt_codegen.certificate`), as they appear
+#: Names of the certificate's properties (:mod:`stt_codegen.design.certificate`), as they appear
 #: in design errors.
 CERTIFICATE_PROPERTIES = ("non-empty", "initial state inside", "inside state space",
                           "avoids obstacle", "inside target after t_c")
@@ -75,8 +75,8 @@ def _outcome(seconds: float, reason: str, result: SimulationResult | None) -> di
 
 
 def _run_stt(spec, index: int) -> dict[str, Any]:
-    from ..design import design_tube
-    from ..simulate import simulate
+    from ..design.search import design_tube
+    from ..runtime.simulate import simulate
     begin = time.perf_counter()
     try:
         design, _ = design_tube(spec)

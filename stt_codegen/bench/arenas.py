@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SpecError
-from ..spec import Box, Spec, parse_spec
+from ..spec.loader import Box, Spec, parse_spec
 
 #: The case study's arena, target, obstacle size and start-set size, metres.
 ARENA = Box((0.0, 0.0), (5.0, 5.0))
@@ -104,7 +104,7 @@ class Arena:
         return f"arena-{self.seed}-{self.index}"
 
     def to_toml(self) -> str:
-        """The arena as a spec file, loadable by :func:`stt_codegen.spec.load_spec`."""
+        """The arena as a spec file, loadable by :func:`stt_codegen.spec.loader.load_spec`."""
         obstacles = "".join(
             f"\n[[obstacles]]\nlower = [{o.lower[0]!r}, {o.lower[1]!r}]\n"
             f"upper = [{o.upper[0]!r}, {o.upper[1]!r}]\n" for o in self.obstacles)
@@ -114,7 +114,7 @@ class Arena:
                                 s2=s.upper[0], s3=s.upper[1], obstacles=obstacles)
 
     def to_spec(self) -> Spec:
-        """The arena's validated :class:`~stt_codegen.spec.Spec` (parsed from :meth:`to_toml`)."""
+        """The arena's validated :class:`~stt_codegen.spec.loader.Spec` (parsed from :meth:`to_toml`)."""
         return parse_spec(self.to_toml())
 
 

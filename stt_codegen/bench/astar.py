@@ -16,7 +16,7 @@ import time
 import networkx as nx
 import numpy as np
 
-from ..spec import Spec
+from ..spec.loader import Spec
 from .planning import FreeSpace, Plan
 
 #: Grid spacing, metres.

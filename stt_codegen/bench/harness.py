@@ -33,12 +33,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ..codegen.controllers import compiler
+from ..runtime.compiled import compiler
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..errors import SttError
-from ..spec import NAME_PATTERN
-from ..tube import TubeDesign
+from ..spec.loader import NAME_PATTERN
+from ..tube.parameters import TubeDesign
 
 #: Compiler flags of the harness and the generated source (those of backend ``c``
 #: without ``-shared -fPIC``).

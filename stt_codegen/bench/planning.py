@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..spec import Spec
+from ..spec.loader import Spec
 
 #: Clearance kept from obstacles and walls by the planners, metres.
 MARGIN = 0.2

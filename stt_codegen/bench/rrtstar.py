@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from ..spec import Spec
+from ..spec.loader import Spec
 from .planning import FreeSpace, Plan
 
 #: RRT* iterations per arena (the first solution typically appears within 100).

@@ -3,9 +3,9 @@ number of obstacles and the state dimension, and whether a step pays for every o
 or only for the active ones.
 
 Random specs with hundreds of obstacles do not design (the arena fills up), so the
-designs are built directly (:func:`synthetic_design`): a :class:`~stt_codegen.tube.TubeDesign`
+designs are built directly (:func:`synthetic_design`): a :class:`~stt_codegen.tube.parameters.TubeDesign`
 on ``[0, 5]^n`` from ``x(0) = 0.25`` to the target box ``[4.55, 4.95]^n`` with ``m``
-synthetic :class:`~stt_codegen.tube.Circumvent` s (seeded: dimension and side at random,
+synthetic :class:`~stt_codegen.tube.parameters.Circumvent` s (seeded: dimension and side at random,
 window centre in ``[0.5, 8.5]`` s, half-width in ``[0.3, 1]`` s, height in ``[0.2, 1]`` m),
 the bundled specs' tube parameters and 1 kHz. They are not certified: they only have the
 size and structure of real designs, which is what code size and step cost depend on.
@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import SpecError
-from ..tube import LOWER, UPPER, Circumvent, TubeDesign
+from ..tube.parameters import LOWER, UPPER, Circumvent, TubeDesign
 from .harness import BenchError, build_harness
 from .report import machine, machine_line, seconds_text, table
 from .timing import MIN_BATCH_SECONDS
@@ -111,8 +111,8 @@ def measure(design: TubeDesign, compile_timeout: float, callgrind: bool = True,
         ``operations`` (of the CasADi ``controller_step``), ``outside_tube_inputs``;
         or, when the build fails, ``error``.
     """
-    from ..emit import count_operations
-    from ..model import build_model
+    from ..codegen.emit import count_operations
+    from ..tube.model import build_model
     row: dict[str, Any] = {"obstacles": len(design.circumvents), "dimension": design.dimension}
     try:
         harness = build_harness(design, compile_timeout=compile_timeout)

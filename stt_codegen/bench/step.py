@@ -7,11 +7,11 @@ by the C harness, see :mod:`.harness`):
 * ``C via ctypes``: the same library called from Python (backend ``c``);
 * ``generated Python``: the generated module's ``step`` on lists of floats;
 * ``CasADi Function``: the model's ``controller_step`` evaluated by CasADi from Python;
-* ``numpy reference``: :func:`stt_codegen.reference.controller_step` on one state.
+* ``numpy reference``: :func:`stt_codegen.tube.reference.controller_step` on one state.
 
 Times are medians over rounds that run every implementation in turn; ratios to the
 compiled C loop are the headline. Also reported: the operation counts of the step
-(:func:`stt_codegen.emit.count_operations`) and the instructions of one C step under
+(:func:`stt_codegen.codegen.emit.count_operations`) and the instructions of one C step under
 ``valgrind --tool=callgrind`` (deterministic). As a check that the same thing is timed,
 the largest ``|u - u_C|`` of each implementation on 64 of the inputs is reported.
 """
@@ -64,14 +64,14 @@ def run_step_bench(spec_arg: str, steps: int | None = None, rounds: int = ROUNDS
     BenchError
         The harness could not be built or run.
     """
-    from ..backends import make_controller
-    from ..codegen.controllers import GeneratedPythonController
-    from ..design import design_tube
-    from ..emit import count_operations
+    from ..runtime.backends import make_controller
+    from ..runtime.compiled import GeneratedPythonController
+    from ..design.search import design_tube
+    from ..codegen.emit import count_operations
     from ..errors import SpecError
-    from ..model import build_model
-    from ..reference import controller_step
-    from ..spec import load_spec
+    from ..tube.model import build_model
+    from ..tube.reference import controller_step
+    from ..spec.loader import load_spec
 
     steps = DEFAULT_STEPS if steps is None else steps
     if steps < 1:

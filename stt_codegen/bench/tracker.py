@@ -8,7 +8,7 @@ along the path and commands ``u = SPEED (carrot - x) / |carrot - x|``. Near the 
 ``t_c = 9`` s; the lookahead is small enough that cutting a right-angle corner stays
 inside the planners' 0.2 m margin.
 
-The closed loop is run by :func:`stt_codegen.simulate.simulate` itself, so that the
+The closed loop is run by :func:`stt_codegen.runtime.simulate.simulate` itself, so that the
 baselines are judged by the very same code as the tube controller: same plant and
 disturbance seed, same sampling rate (the spec's, 1 kHz) and integration, same
 Definition 2.1 on ``[0, t_c]`` (target reached by ``t_c``, no collision at any
@@ -22,11 +22,11 @@ import math
 
 import numpy as np
 
-from ..backends import STATUS_OK, backend_names, register_backend
-from ..design import base_design
-from ..simulate import SimulationResult, simulate
-from ..spec import Spec
-from ..tube import TubeDesign
+from ..runtime.backends import STATUS_OK, backend_names, register_backend
+from ..design.search import base_design
+from ..runtime.simulate import SimulationResult, simulate
+from ..spec.loader import Spec
+from ..tube.parameters import TubeDesign
 
 #: Cruise speed, m/s.
 SPEED = 1.5
@@ -42,7 +42,7 @@ _PATHS: dict[str, np.ndarray] = {}
 
 
 class PathTracker:
-    """Carrot following of a polyline (a :class:`~stt_codegen.backends.Controller`).
+    """Carrot following of a polyline (a :class:`~stt_codegen.runtime.backends.Controller`).
 
     Parameters
     ----------
@@ -101,7 +101,7 @@ class PathTracker:
         return np.array([(cx - px) * SPEED / norm, (cy - py) * SPEED / norm])
 
     def step(self, x, t, dt, alpha):
-        """The :class:`~stt_codegen.backends.Controller` step; ``alpha`` is passed through."""
+        """The :class:`~stt_codegen.runtime.backends.Controller` step; ``alpha`` is passed through."""
         return self.command(np.asarray(x, float)), np.asarray(alpha, float), STATUS_OK
 
 
@@ -123,7 +123,7 @@ def track(spec: Spec, path: np.ndarray, seed: int) -> SimulationResult:
     Returns
     -------
     SimulationResult
-        From :func:`stt_codegen.simulate.simulate`; ``backend`` is ``bench-path-tracker``.
+        From :func:`stt_codegen.runtime.simulate.simulate`; ``backend`` is ``bench-path-tracker``.
     """
     if BACKEND not in backend_names():
         register_backend(BACKEND, _factory)

@@ -12,8 +12,8 @@ from __future__ import annotations
 import difflib
 from pathlib import Path
 
-from ..design import design_tube
-from ..spec import bundled_cases, load_spec
+from ..design.search import design_tube
+from ..spec.loader import bundled_cases, load_spec
 from .generate import generate_files
 from .options import Options
 from .output import write_generation

@@ -11,8 +11,8 @@ from .options import LANGUAGES, PRECISIONS, parse_options
 
 def cmd_generate(args: argparse.Namespace) -> int:
     """``stt-codegen generate SPEC -o DIR [--lang c,python] [--precision double|single]``."""
-    from ..design import design_tube
-    from ..spec import load_spec
+    from ..design.search import design_tube
+    from ..spec.loader import load_spec
     from .generate import generate_files
     from .output import write_generation
     options = parse_options(args.lang, args.precision)

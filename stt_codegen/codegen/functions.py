@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import casadi as ca
 
-from ..model import TubeModel
+from ..tube.model import TubeModel
 from .errors import CodegenError
 
 #: Deployed Function names, in generation order.

@@ -22,10 +22,10 @@ import casadi
 import numpy as np
 
 from .. import __version__
-from ..emit import lower, python_source
-from ..model import build_model
-from ..spec import Spec
-from ..tube import NEWTON_ITERATIONS, TubeDesign
+from .emit import lower, python_source
+from ..tube.model import build_model
+from ..spec.loader import Spec
+from ..tube.parameters import NEWTON_ITERATIONS, TubeDesign
 from . import tolerance
 from .casadi_c import CODEGEN_OPTIONS, casadi_bodies
 from .functions import deployed_functions
@@ -71,7 +71,7 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
     spec : Spec
         Its name (validated) and ``source_hash`` are used.
     design : TubeDesign
-        From :func:`stt_codegen.design.design_tube`.
+        From :func:`stt_codegen.design.search.design_tube`.
     options : Options
 
     Returns

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..tube import E_MAX, GAMMA_D_MIN, TubeDesign
+from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 
 UNIT_DOUBLE = 2.0 ** -53
 UNIT_SINGLE = 2.0 ** -24

@@ -6,7 +6,7 @@ status is the same in single precision, see
 :func:`~stt_codegen.codegen.tolerance.status_certain`), and :data:`OUTSIDE` points with
 ``1.1 <= |e_i| <= 2`` in one dimension (status OUTSIDE_TUBE, ``u`` clamped); times
 cover ``[0, 1.2 t_c]``, so after ``t_c`` too. Expected values are the reference's
-(:mod:`stt_codegen.reference`) at those inputs; tolerances are
+(:mod:`stt_codegen.tube.reference`) at those inputs; tolerances are
 :mod:`~stt_codegen.codegen.tolerance`'s bounds for the chosen precision (double: with the
 floor ``1e-12 max(1, |ref|)``).
 """
@@ -15,9 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import reference as R
-from ..backends import STATUS_OK, STATUS_OUTSIDE_TUBE
-from ..tube import TubeDesign
+from ..tube import reference as R
+from ..tube.parameters import STATUS_OK, STATUS_OUTSIDE_TUBE
+from ..tube.parameters import TubeDesign
 from . import tolerance as T
 
 INSIDE = 48

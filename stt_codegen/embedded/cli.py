@@ -9,9 +9,9 @@ from pathlib import Path
 
 def cmd_embedded(args: argparse.Namespace) -> int:
     """Design, generate single precision, run on QEMU mps2-an386; 0 iff all passed."""
-    from ..design import design_tube
+    from ..design.search import design_tube
     from ..errors import SpecError
-    from ..spec import load_spec
+    from ..spec.loader import load_spec
     from .deploy import run_embedded
     if args.build_dir is not None and not Path(args.build_dir).parent.is_dir():
         raise SpecError("--build-dir", f"folder {str(Path(args.build_dir).parent)!r} does not exist")

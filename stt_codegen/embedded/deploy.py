@@ -36,13 +36,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import reference as R
+from ..tube import reference as R
 from ..codegen import tolerance as T
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..errors import SttError
-from ..spec import Spec
-from ..tube import TubeDesign
+from ..spec.loader import Spec
+from ..tube.parameters import TubeDesign
 from . import board
 from .footprint import elf_stack_bound, linked_sizes, measure
 from .programs import (closed_loop_source, parse_closed_loop, parse_replay, replay_source,
@@ -234,7 +234,7 @@ def run_embedded(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
                    "-singlestep -d exec,nochain trace; not cycles"},
     }
     if compare_host:
-        from ..simulate import simulate
+        from ..runtime.simulate import simulate
         host = simulate(spec, design, backend="c", seed=seed)
         tr = host.trajectory
         dev = max(float(np.max(np.abs(x - tr.x[k]))) for k, x in loop.states.items())

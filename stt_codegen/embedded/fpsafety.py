@@ -26,13 +26,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import reference as R
+from ..tube import reference as R
 from ..codegen import tolerance as T
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..errors import SttError
-from ..spec import Spec
-from ..tube import TubeDesign
+from ..spec.loader import Spec
+from ..tube.parameters import TubeDesign
 from .programs import parse_replay, replay_source
 
 FLAG_NAMES = {1: "FE_OVERFLOW", 2: "FE_INVALID", 4: "FE_DIVBYZERO"}

@@ -6,9 +6,9 @@ Both are rendered from Jinja2 templates (``templates/embedded_closed_loop.c.j2``
 
 * :func:`closed_loop_source`: the controller step at ``rate_hz`` against the spec's plant
   (omnidirectional eq. (14) or single integrator), integrated in double by RK4 with
-  :data:`stt_codegen.simulate.SUBSTEPS` substeps per period, with the disturbance of
-  :class:`stt_codegen.plants.Disturbance` (same seed, same sinusoids), judged like
-  :func:`stt_codegen.simulate.simulate`.
+  :data:`stt_codegen.runtime.simulate.SUBSTEPS` substeps per period, with the disturbance of
+  :class:`stt_codegen.runtime.plants.Disturbance` (same seed, same sinusoids), judged like
+  :func:`stt_codegen.runtime.simulate.simulate`.
 * :func:`replay_source`: ``P_step`` and ``P_tube`` at given float inputs; outputs printed
   as bits. Optionally each step is a measured region (instruction count, painted stack)
   or the floating-point exception flags of each call are printed (host builds).
@@ -23,10 +23,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..codegen.render import c_identifier, render
-from ..plants import Disturbance
-from ..simulate import SUBSTEPS
-from ..spec import Spec
-from ..tube import TubeDesign
+from ..runtime.plants import Disturbance
+from ..runtime.simulate import SUBSTEPS
+from ..spec.loader import Spec
+from ..tube.parameters import TubeDesign
 
 
 def _d(value: float) -> str:
@@ -38,7 +38,7 @@ def _d(value: float) -> str:
 
 
 def steps_of(spec: Spec, design: TubeDesign) -> int:
-    """Controller periods over ``[0, t_c]``, as :func:`stt_codegen.simulate.simulate` counts."""
+    """Controller periods over ``[0, t_c]``, as :func:`stt_codegen.runtime.simulate.simulate` counts."""
     return int(math.ceil(spec.prescribed_time * design.rate_hz - 1e-9))
 
 

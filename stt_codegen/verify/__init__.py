@@ -10,40 +10,17 @@ Every check returns a :class:`Check`. The modules:
 * :mod:`.adaptive` -- non-negativity and an explicit bound of the adaptive law (11).
 """
 
-from .adaptive import (
-    adaptive_law_checks,
-    adversarial_psi_signals,
-    alpha_rate_bound,
-    alpha_upper_bound,
-    check_adaptive_law_numeric,
-    simulate_alpha,
-)
-from .assumption import (
-    assumption2_omnidirectional,
-    assumption2_single_integrator,
-    check_assumption2,
-    symmetric_part,
-)
+from .adaptive import (adaptive_law_checks, adversarial_psi_signals, alpha_rate_bound,
+                       alpha_upper_bound, check_adaptive_law_numeric, simulate_alpha)
+from .assumption import (assumption2_omnidirectional, assumption2_single_integrator,
+                         check_assumption2, symmetric_part)
 from .check import Check, all_passed, format_report
-from .lemma import (
-    bump_rate_bound,
-    check_bump_flat_all_orders,
-    check_bump_flatness,
-    check_reach_continuity,
-    check_reach_flat_all_orders,
-    check_smooth_max,
-    lemma_checks,
-    reach_rate_bound,
-    reach_rate_constant,
-)
-from .transform import (
-    check_epsilon_jacobian,
-    check_lyapunov_derivative,
-    error_transform_checks,
-    outer_product_difference,
-    xi_diagonal,
-    xi_outer_product,
-)
+from .lemma import (bump_rate_bound, check_bump_flat_all_orders, check_bump_flatness,
+                    check_reach_continuity, check_reach_flat_all_orders, check_smooth_max,
+                    lemma_checks, reach_rate_bound, reach_rate_constant)
+from .transform import (check_epsilon_jacobian, check_lyapunov_derivative,
+                        error_transform_checks, outer_product_difference, xi_diagonal,
+                        xi_outer_product)
 
 __all__ = [
     "Check",

@@ -2,7 +2,7 @@
 
 Connects the symbolic checks of this package to a concrete design: the rate bounds of
 Lemma 3.3 for its tube and bumps, Assumption 2 for its plant, the adaptive-law bounds for
-its ``psi``, and the continuous-time tube certificate (:mod:`stt_codegen.certificate`).
+its ``psi``, and the continuous-time tube certificate (:mod:`stt_codegen.design.certificate`).
 """
 
 from __future__ import annotations
@@ -13,13 +13,13 @@ import json
 
 import numpy as np
 
-from .. import reference
-from ..certificate import _circumvent_range
-from ..design import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
+from ..tube import reference
+from ..design.certificate import circumvent_range
+from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
-from ..spec import PLANT_MODELS, Spec, load_spec
-from ..tube import TubeDesign
-from ..tube_samples import TubeSamples, sample_tube
+from ..spec.loader import PLANT_MODELS, Spec, load_spec
+from ..tube.parameters import TubeDesign
+from ..design.samples import TubeSamples, sample_tube
 from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_omnidirectional, assumption2_single_integrator
 from .check import Check, all_passed
@@ -44,7 +44,7 @@ def _psi_ranges(design: TubeDesign, samples: TubeSamples) -> tuple[np.ndarray, n
     t0, t1 = samples.t[:-1], samples.t[1:]
     rho_l0, rho_u0, _, _ = reference.reach_tube(design, t0)
     rho_l1, rho_u1, _, _ = reference.reach_tube(design, t1)
-    (bl_lo, bl_hi), (bu_lo, bu_hi) = _circumvent_range(design, t0, t1)
+    (bl_lo, bl_hi), (bu_lo, bu_hi) = circumvent_range(design, t0, t1)
     psi_l_min = bu_lo - np.maximum(rho_l0, rho_l1)     # psi_L = beta_U - rho_L
     psi_u_min = np.minimum(rho_u0, rho_u1) - bl_hi     # psi_U = rho_U - beta_L
     psi_min = np.concatenate([psi_l_min.min(axis=0), psi_u_min.min(axis=0)])
@@ -61,7 +61,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None,
     spec : Spec
     design : TubeDesign
     plant : str, optional
-        Plant model for Assumption 2 (one of :data:`stt_codegen.spec.PLANT_MODELS`);
+        Plant model for Assumption 2 (one of :data:`stt_codegen.spec.loader.PLANT_MODELS`);
         default the spec's.
     samples : TubeSamples, optional
         The deployed tube; computed when omitted.

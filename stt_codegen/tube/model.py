@@ -1,6 +1,6 @@
 """Symbolic model of the tube and its controller in CasADi.
 
-:func:`build_model` turns a :class:`~stt_codegen.tube.TubeDesign` into CasADi SX
+:func:`build_model` turns a :class:`~stt_codegen.tube.parameters.TubeDesign` into CasADi SX
 ``Function``s with named inputs and outputs (see :data:`FUNCTION_NAMES`). Time
 derivatives and Jacobians are exact (algorithmic differentiation of the SX graph).
 The functions are the single source of every generated controller.
@@ -13,7 +13,7 @@ Numerical decisions (all documented in the README):
 * ``tanh(t / (t_c - t))`` is only evaluated for ``t < t_c`` (eq. (4)'s second branch
   holds after), with a denominator that stays finite in the branch not taken;
 * the circumvent bump is only evaluated inside its window (eqs. (7)-(8));
-* the implicit ``alpha`` step is backward Euler with :data:`~stt_codegen.tube.NEWTON_ITERATIONS`
+* the implicit ``alpha`` step is backward Euler with :data:`~stt_codegen.tube.parameters.NEWTON_ITERATIONS`
   Newton iterations from a start point left of the root (see :func:`implicit_alpha_update`).
 """
 
@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import casadi as ca
 
-from .tube import (E_MAX, GAMMA_D_MIN, LOWER, NEWTON_ITERATIONS, NEWTON_TINY, UPPER,
-                   TubeDesign)
+from .parameters import (E_MAX, GAMMA_D_MIN, LOWER, NEWTON_ITERATIONS, NEWTON_TINY, UPPER,
+                         TubeDesign)
 
 #: The functions of a model, in order.
 FUNCTION_NAMES = ("reach_tube", "circumvent", "tube", "adaptive_law", "error_transform",
@@ -179,7 +179,7 @@ def implicit_alpha_update(alpha, psi, theta, dt, kappa: float,
 
 
 def controller_law(design: TubeDesign, x, gamma_l, gamma_u) -> tuple:
-    """Deployed law (13) with clamps: returns ``(u, inside)`` (see :mod:`stt_codegen.tube`)."""
+    """Deployed law (13) with clamps: returns ``(u, inside)`` (see :mod:`stt_codegen.tube.parameters`)."""
     gamma_d = gamma_u - gamma_l
     width = ca.fmax(gamma_d, GAMMA_D_MIN)
     e = (2.0 * x - (gamma_u + gamma_l)) / width

@@ -8,18 +8,8 @@
 
 from .counts import OperationCounts, count_operations
 from .errors import EmitError, UnsupportedOperation
-from .instructions import (
-    Binary,
-    Const,
-    IfElseZero,
-    Input,
-    Instruction,
-    IOSpec,
-    Output,
-    Program,
-    Unary,
-    lower,
-)
+from .instructions import (Binary, Const, IfElseZero, Input, Instruction, IOSpec, Output,
+                           Program, Unary, lower)
 from .printer import InstructionPrinter
 from .python_printer import PythonPrinter, python_function, python_source
 

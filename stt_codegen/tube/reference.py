@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from .tube import E_MAX, GAMMA_D_MIN, LOWER, TubeDesign
+from .parameters import E_MAX, GAMMA_D_MIN, LOWER, TubeDesign
 
 Array = np.ndarray
 

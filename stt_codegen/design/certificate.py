@@ -30,10 +30,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import reference
-from .tube_samples import TubeSamples, sample_tube
-from .spec import Spec
-from .tube import TubeDesign
+from ..tube import reference
+from .samples import TubeSamples, sample_tube
+from ..spec.loader import Spec
+from ..tube.parameters import TubeDesign
 
 #: Margins below this (state units) count as failures: rounding in the enclosures.
 ROUNDING_MARGIN = 1e-9
@@ -101,7 +101,7 @@ def _bump_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, center: floa
     return low, high
 
 
-def _circumvent_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
+def circumvent_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
     """Ranges of ``beta_L`` and ``beta_U`` (eq. (9)) over each interval, shape (K, n) each.
 
     ``beta_L`` is non-decreasing and ``beta_U`` non-increasing in every bump value, so
@@ -121,7 +121,7 @@ def enclose_tube(design: TubeDesign, samples: TubeSamples) -> Enclosure:
     t0, t1 = samples.t[:-1], samples.t[1:]
     rho_l0, rho_u0, _, _ = reference.reach_tube(design, t0)
     rho_l1, rho_u1, _, _ = reference.reach_tube(design, t1)
-    (bl_lo, bl_hi), (bu_lo, bu_hi) = _circumvent_range(design, t0, t1)
+    (bl_lo, bl_hi), (bu_lo, bu_hi) = circumvent_range(design, t0, t1)
     a0, a1 = samples.alpha[:-1], samples.alpha[1:]
     al_lo, al_hi = np.minimum(a0[:, :n], a1[:, :n]), np.maximum(a0[:, :n], a1[:, :n])
     au_lo, au_hi = np.minimum(a0[:, n:], a1[:, n:]), np.maximum(a0[:, n:], a1[:, n:])

@@ -12,14 +12,12 @@ from typing import Protocol
 
 import numpy as np
 
-from . import reference
-from .errors import SpecError
-from .tube import TubeDesign
+from ..tube import reference
+from ..errors import SpecError
+from ..tube.parameters import STATUS_INVALID_INPUT, STATUS_OK, STATUS_OUTSIDE_TUBE, TubeDesign
 
-#: Status codes of a controller step (the generated code uses the same numbers).
-STATUS_OK = 0
-STATUS_OUTSIDE_TUBE = 1
-STATUS_INVALID_INPUT = 2
+__all__ = ["STATUS_INVALID_INPUT", "STATUS_OK", "STATUS_OUTSIDE_TUBE", "Controller",
+           "backend_names", "make_controller", "register_backend"]
 
 
 class Controller(Protocol):
@@ -33,7 +31,7 @@ class Controller(Protocol):
 
 
 class ReferenceController:
-    """The numpy reference (:func:`stt_codegen.reference.controller_step`)."""
+    """The numpy reference (:func:`stt_codegen.tube.reference.controller_step`)."""
 
     name = "reference"
 
@@ -51,7 +49,7 @@ class CasadiController:
     name = "casadi"
 
     def __init__(self, design: TubeDesign) -> None:
-        from .model import build_model
+        from ..tube.model import build_model
         self.function = build_model(design)["controller_step"]
 
     def step(self, x, t, dt, alpha):
@@ -61,12 +59,12 @@ class CasadiController:
 
 
 def _generated_c(design: TubeDesign) -> Controller:
-    from .codegen.controllers import CController
+    from .compiled import CController
     return CController(design)
 
 
 def _generated_python(design: TubeDesign) -> Controller:
-    from .codegen.controllers import GeneratedPythonController
+    from .compiled import GeneratedPythonController
     return GeneratedPythonController(design)
 
 

@@ -7,9 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import reference
-from .model import alpha_trajectory_function
-from .tube import TubeDesign
+from ..tube import reference
+from ..tube.model import alpha_trajectory_function
+from ..tube.parameters import TubeDesign
 
 #: Default horizon of a sampled tube, as a multiple of ``t_c``.
 HORIZON_FACTOR = 1.1

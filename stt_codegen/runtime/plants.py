@@ -9,7 +9,7 @@ from __future__ import annotations
 import control as ct
 import numpy as np
 
-from .errors import SpecError
+from ..errors import SpecError
 
 #: Number of sinusoids summed in each disturbance component.
 DISTURBANCE_TERMS = 3

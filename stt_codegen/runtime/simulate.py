@@ -17,10 +17,10 @@ import numpy as np
 import control as ct
 
 from .backends import STATUS_OK, make_controller
-from .errors import SpecError
+from ..errors import SpecError
 from .plants import make_plant
-from .spec import Spec
-from .tube import TubeDesign
+from ..spec.loader import Spec
+from ..tube.parameters import TubeDesign
 
 #: Runge-Kutta steps per sampling period.
 SUBSTEPS = 2
@@ -104,9 +104,9 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
     ----------
     spec : Spec
     design : TubeDesign
-        From :func:`stt_codegen.design.design_tube`.
+        From :func:`stt_codegen.design.search.design_tube`.
     backend : str
-        A name from :func:`stt_codegen.backends.backend_names`.
+        A name from :func:`stt_codegen.runtime.backends.backend_names`.
     horizon : float, optional
         Simulated time, seconds; default ``t_c``. Definition 2.1 is judged on
         ``[0, min(horizon, t_c)]``; a horizon shorter than ``t_c`` cannot satisfy it.

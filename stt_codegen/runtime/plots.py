@@ -11,10 +11,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.patches import Circle, Polygon, Rectangle  # noqa: E402
 from scipy.spatial import ConvexHull  # noqa: E402
 
-from . import reference  # noqa: E402
-from .simulate import SimulationResult  # noqa: E402
-from .spec import Box, Spec  # noqa: E402
-from .tube import TubeDesign  # noqa: E402
+from ..tube import reference
+from .simulate import SimulationResult
+from ..spec.loader import Box, Spec
+from ..tube.parameters import TubeDesign
 
 
 def _rect(ax, box: Box, dims: tuple[int, int], **style) -> None:

@@ -1,4 +1,4 @@
-"""The generated code as controller backends ``c`` and ``python`` (see :mod:`stt_codegen.backends`).
+"""The generated code as controller backends ``c`` and ``python`` (see :mod:`stt_codegen.runtime.backends`).
 
 :class:`CController` generates the C (double) for a design, compiles it into a shared
 library with the system C compiler and loads it with ``ctypes``; builds are cached under
@@ -20,11 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..spec import NAME_PATTERN
-from ..tube import TubeDesign
-from .errors import CodegenError
-from .generate import generate_files
-from .options import Options
+from ..spec.loader import NAME_PATTERN
+from ..tube.parameters import TubeDesign
+from ..codegen.errors import CodegenError
+from ..codegen.generate import generate_files
+from ..codegen.options import Options
 
 #: Flags of the shared-library build (``-ffp-contract=off``: same rounding as CasADi's VM).
 CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fPIC", "-shared", "-Wall", "-Wextra",

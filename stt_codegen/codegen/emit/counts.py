@@ -21,7 +21,7 @@ class OperationCounts:
         Count per op name, keys sorted alphabetically.
     by_category : dict of str to int
         Count per category (``"data"``, ``"arithmetic"``, ``"logic"``,
-        ``"transcendental"``; see :mod:`stt_codegen.emit.ops`), all four keys present.
+        ``"transcendental"``; see :mod:`stt_codegen.codegen.emit.ops`), all four keys present.
     """
 
     by_op: Dict[str, int]
@@ -62,7 +62,7 @@ def count_operations(fn: Union[casadi.Function, Program]) -> OperationCounts:
     Raises
     ------
     UnsupportedOperation, EmitError
-        As :func:`stt_codegen.emit.instructions.lower`.
+        As :func:`stt_codegen.codegen.emit.instructions.lower`.
     """
     program = fn if isinstance(fn, Program) else lower(fn)
     by_op: Dict[str, int] = {}

@@ -10,7 +10,7 @@ The paper leaves several points open or, read literally, fails (see the README's
 * **Dimension and side, eq. (6)**: every valid (dimension, side) of every obstacle is a
   candidate; candidates are tried in a fixed order (longest overlap first) and a design
   is accepted only if its tube passes :func:`check_tube`: the continuous-time
-  certificate (:mod:`stt_codegen.certificate`) and the sampling-rate limit. The search
+  certificate (:mod:`stt_codegen.design.certificate`) and the sampling-rate limit. The search
   is a depth-first search with backtracking over obstacles in the order of their
   windows (one choice per spec obstacle, shared by the boxes of a covering); it fails
   with a :class:`DesignError` naming the obstacle when no candidate passes.
@@ -28,12 +28,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from . import reference
+from ..tube import reference
 from .certificate import Certificate, certify_tube
-from .errors import DesignError
-from .spec import Box, Spec
-from .tube import LOWER, UPPER, Circumvent, TubeDesign
-from .tube_samples import TubeSamples, sample_tube
+from ..errors import DesignError
+from ..spec.loader import Box, Spec
+from ..tube.parameters import LOWER, UPPER, Circumvent, TubeDesign
+from .samples import TubeSamples, sample_tube
 
 #: Largest distance a tube bound may move in one sampling period, as a fraction of the
 #: tube's width there: a sampled controller cannot follow a faster tube.
@@ -84,7 +84,7 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
     Conditions, in order: no bound moves more than ``MAX_MOVE_PER_SAMPLE`` of the tube
     width in one sampling period; ``x(0)`` starts with ``|e_i| <= MAX_INITIAL_ERROR``
     (room for the first sampled steps); and every property of
-    :func:`~stt_codegen.certificate.certify_tube` (non-empty, ``x(0)`` inside, inside the
+    :func:`~stt_codegen.design.certificate.certify_tube` (non-empty, ``x(0)`` inside, inside the
     state space, missing each listed obstacle and, with ``final``, inside the target from
     ``t_c`` on) holds for all ``t``.
 
@@ -95,7 +95,7 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
     obstacles : list of int, optional
         Indices of the obstacles to check against; default all.
     samples : TubeSamples, optional
-        Precomputed :func:`~stt_codegen.tube_samples.sample_tube` output.
+        Precomputed :func:`~stt_codegen.design.samples.sample_tube` output.
     final : bool
 
     Returns

@@ -1,8 +1,8 @@
 """A designed spatiotemporal tube: every number the controller needs, and nothing else.
 
-:class:`TubeDesign` is what :func:`stt_codegen.design.design_tube` produces from a spec
-and what every backend consumes: the numpy reference (:mod:`stt_codegen.reference`),
-the CasADi model (:mod:`stt_codegen.model`) and through it the generated code.
+:class:`TubeDesign` is what :func:`stt_codegen.design.search.design_tube` produces from a spec
+and what every backend consumes: the numpy reference (:mod:`stt_codegen.tube.reference`),
+the CasADi model (:mod:`stt_codegen.tube.model`) and through it the generated code.
 """
 
 from __future__ import annotations
@@ -19,6 +19,13 @@ GAMMA_D_MIN = 1e-6
 NEWTON_ITERATIONS = 8
 #: Floor used in the Newton start point to avoid 0/0 (representable in float32).
 NEWTON_TINY = 1e-30
+
+#: Status codes of one controller step, in every backend and in the generated code.
+STATUS_OK = 0
+#: ``x`` is not strictly inside the tube (or the tube is empty): ``u`` is still finite.
+STATUS_OUTSIDE_TUBE = 1
+#: An input is outside the step's domain: ``u = 0``, ``alpha`` kept.
+STATUS_INVALID_INPUT = 2
 
 LOWER = "lower"
 UPPER = "upper"

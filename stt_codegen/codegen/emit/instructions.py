@@ -56,7 +56,7 @@ class Const:
 
 @dataclass(frozen=True)
 class Unary:
-    """``w[dest] = op(w[arg])``; ``op`` is an op name of :mod:`stt_codegen.emit.ops`."""
+    """``w[dest] = op(w[arg])``; ``op`` is an op name of :mod:`stt_codegen.codegen.emit.ops`."""
 
     op: str
     dest: int
@@ -198,7 +198,7 @@ def lower(fn: casadi.Function) -> Program:
     EmitError
         If ``fn`` is not an SX Function.
     UnsupportedOperation
-        If an instruction's op is not in :data:`stt_codegen.emit.ops.OPS` (this
+        If an instruction's op is not in :data:`stt_codegen.codegen.emit.ops.OPS` (this
         includes ``OP_PARAMETER``, i.e. free symbols, and ``OP_CALL``); the message
         names the op and the Function.
     """

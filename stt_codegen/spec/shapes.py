@@ -13,7 +13,7 @@ import numpy as np
 from scipy.optimize import linprog, minimize
 from scipy.spatial import ConvexHull, QhullError
 
-from .errors import SpecError
+from ..errors import SpecError
 
 #: Largest number of coordinates (``dims``) a polytope obstacle may be given on.
 MAX_POLYTOPE_DIMENSION = 4

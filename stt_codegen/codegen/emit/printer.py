@@ -10,7 +10,7 @@ rendered by :meth:`InstructionPrinter.op_expression`, which looks, in this order
 2. ``known_functions[op]``: the op is a call ``name(operands...)``;
 3. ``infix_operators[op]``: the op is ``a <symbol> b``;
 
-and otherwise raises :class:`~stt_codegen.emit.errors.UnsupportedOperation`.
+and otherwise raises :class:`~stt_codegen.codegen.emit.errors.UnsupportedOperation`.
 
 Shared logic lives here: register names (``w<k>``, CasADi's register numbers kept),
 constants (``repr(float)``: shortest text that reads back to the same double, never a
@@ -34,24 +34,14 @@ from typing import Dict, List, Mapping, Optional, Sequence, Tuple, Union
 import casadi
 
 from .errors import EmitError, UnsupportedOperation
-from .instructions import (
-    Binary,
-    Const,
-    IfElseZero,
-    Input,
-    Instruction,
-    IOSpec,
-    Output,
-    Program,
-    Unary,
-    lower,
-)
+from .instructions import (Binary, Const, IfElseZero, Input, Instruction, IOSpec, Output,
+                           Program, Unary, lower)
 
 FunctionLike = Union[casadi.Function, Program]
 
 
 class InstructionPrinter:
-    """Print :class:`~stt_codegen.emit.instructions.Program` s as source code.
+    """Print :class:`~stt_codegen.codegen.emit.instructions.Program` s as source code.
 
     Subclasses set :attr:`language`, :attr:`known_functions`, :attr:`infix_operators`
     and implement the hooks that raise ``NotImplementedError`` here.
@@ -77,7 +67,7 @@ class InstructionPrinter:
         Parameters
         ----------
         functions : casadi.Function or Program, or a sequence of them
-            SX Functions (lowered with :func:`~stt_codegen.emit.instructions.lower`)
+            SX Functions (lowered with :func:`~stt_codegen.codegen.emit.instructions.lower`)
             or already lowered programs; printed in the given order.
 
         Returns
@@ -167,7 +157,7 @@ class InstructionPrinter:
         Parameters
         ----------
         op : str
-            Op name (see :mod:`stt_codegen.emit.ops`).
+            Op name (see :mod:`stt_codegen.codegen.emit.ops`).
         operands : tuple of str
             Printed operands (register names or constants).
 

@@ -17,7 +17,7 @@ import itertools
 
 import numpy as np
 
-from .errors import SpecError
+from ..errors import SpecError
 
 #: At most this many boxes per shape.
 MAX_BOXES = 256
