@@ -29,15 +29,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..tube import reference
-from .certificate import Certificate, certify_tube
+from .certificate import MAX_MOVE_PER_SAMPLE, Certificate, certify_tube
 from ..errors import DesignError
 from ..spec.loader import Box, Spec
 from ..tube.parameters import LOWER, UPPER, Circumvent, TubeDesign, paper_segments
-from .samples import TubeSamples, sample_tube
 
-#: Largest distance a tube bound may move in one sampling period, as a fraction of the
-#: tube's width there: a sampled controller cannot follow a faster tube.
-MAX_MOVE_PER_SAMPLE = 0.25
 #: Largest ``|e_i|`` of ``x(0)`` in the tube at ``t = 0``: near the tube's edge law (13)
 #: is so steep that the first sampled step overshoots (measured: at ``|e| ~ 1`` the
 #: first input was 1e8 and the state left the arena in one period).
@@ -78,66 +74,53 @@ class TubeCheck:
 
 
 def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = None,
-               samples: TubeSamples | None = None, final: bool = True) -> TubeCheck:
+               final: bool = True) -> TubeCheck:
     """Check a designed tube: the continuous-time certificate and the sampling limit.
 
     Conditions, in order: no bound moves more than ``MAX_MOVE_PER_SAMPLE`` of the tube
-    width in one sampling period; ``x(0)`` starts with ``|e_i| <= MAX_INITIAL_ERROR``
-    (room for the first sampled steps); and every property of
-    :func:`~stt_codegen.design.certificate.certify_tube` (non-empty, ``x(0)`` inside, inside the
+    width in one sampling period; the tube is non-empty; ``x(0)`` starts with
+    ``|e_i| <= MAX_INITIAL_ERROR`` (room for the first sampled steps); and every property
+    of :func:`~stt_codegen.design.certificate.certify_tube` (``x(0)`` inside, inside the
     state space, missing each listed obstacle and, with ``final``, inside the target from
-    ``t_c`` on) holds for all ``t``.
+    ``t_c`` on) holds for all ``t >= 0``.
 
     Parameters
     ----------
     design : TubeDesign
     spec : Spec
     obstacles : list of int, optional
-        Indices of the obstacles to check against; default all.
-    samples : TubeSamples, optional
-        Precomputed :func:`~stt_codegen.design.samples.sample_tube` output.
+        Indices of the obstacle boxes to check against; default all.
     final : bool
 
     Returns
     -------
     TubeCheck
     """
-    s = samples if samples is not None else sample_tube(design)
-    certificate = certify_tube(design, spec, obstacles=obstacles, samples=s)
-    dt = 1.0 / design.rate_hz
-    width = s.gamma_upper - s.gamma_lower
-    move = np.maximum(np.abs(s.gamma_lower_dot), np.abs(s.gamma_upper_dot)) * dt
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.where(width > 0, move / width, np.inf)
-    max_ratio = float(ratio.max())
+    certificate = certify_tube(design, spec, obstacles=obstacles, final=final)
     margins = {m.name: m for m in certificate.margins}
     clearances = [m.margin for m in certificate.margins if m.name.startswith("avoids")]
-    x0 = np.array(design.initial_state)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        e0 = (2 * x0 - (s.gamma_upper[0] + s.gamma_lower[0])) / width[0]
-    initial_error = float(np.max(np.abs(e0))) if np.all(width[0] > 0) else math.inf
+    initial_error = certificate.initial_error
+    max_ratio = certificate.max_move_ratio
 
     def result(reason: str) -> TubeCheck:
-        return TubeCheck(not reason, reason, margins["non-empty"].margin,
+        return TubeCheck(not reason, reason, certificate.min_width,
                          min(clearances, default=math.inf), max_ratio, initial_error,
                          certificate)
 
-    if not np.all(width > 0):  # empty at a sample: the rate ratio is meaningless
+    if not margins["sampling rate"].passed:  # first: a tube this fast also fails the rest
+        also = ("" if margins["non-empty"].passed else
+                f"; non-empty fails too: {margins['non-empty'].detail}")
+        return result(f"{margins['sampling rate'].detail}; a larger "
+                      f"tube.circumvent_sharpness or controller.rate_hz helps{also}")
+    if not margins["non-empty"].passed:
         return result(f"non-empty fails: {margins['non-empty'].detail}")
-    if max_ratio > MAX_MOVE_PER_SAMPLE:  # next: a tube this fast also fails the rest
-        k = int(np.argmax(ratio.max(axis=1)))
-        return result(f"a tube bound moves {max_ratio:.2f} tube widths in one sampling "
-                      f"period at t = {s.t[k]:.3f} s (limit {MAX_MOVE_PER_SAMPLE}; a larger "
-                      "tube.circumvent_sharpness or controller.rate_hz helps)")
     if initial_error > MAX_INITIAL_ERROR and margins["initial state inside"].passed:
         return result(f"x(0) starts at |e| = {initial_error:.3g} of the tube's half-width "
                       f"at t = 0 (limit {MAX_INITIAL_ERROR}): the first sampled steps would "
                       "overshoot")
-    for margin in certificate.margins:
-        if margin.name == "inside target after t_c" and not final:
-            continue
-        if not margin.passed:
-            return result(f"{margin.name} fails: {margin.detail}")
+    failure = certificate.first_failure()
+    if failure is not None:
+        return result(f"{failure.name} fails: {failure.detail}")
     return result("")
 
 
@@ -263,16 +246,16 @@ def _ordered(circumvents) -> tuple[Circumvent, ...]:
     return tuple(sorted(circumvents, key=lambda c: (c.dimension, c.side, c.obstacle)))
 
 
-def default_gain(design: TubeDesign, samples: TubeSamples) -> float:
+def default_gain(design: TubeDesign, min_width: float) -> float:
     """Default ``k`` of law (13): half the sampled-loop stability limit at the narrowest tube.
 
     Linearizing the sampled loop of ``x_dot = u`` under law (13) at ``e = 0`` gives
     ``e+ = (1 - 16 k dt / gamma_d^2) e``: stable for ``k < gamma_d^2 / (8 dt)``. The default
-    is ``gamma_d,min^2 / (16 dt)``, where ``gamma_d,min`` is the tube's smallest width.
+    is ``gamma_d,min^2 / (16 dt)``, where ``gamma_d,min`` is the certified lower bound of the
+    tube's width (:attr:`~stt_codegen.design.certificate.Certificate.min_width`).
     """
     dt = 1.0 / design.rate_hz
-    width = float((samples.gamma_upper - samples.gamma_lower).min())
-    return width**2 / (16.0 * dt)
+    return min_width**2 / (16.0 * dt)
 
 
 def design_tube(spec: Spec) -> tuple[TubeDesign, TubeCheck]:
@@ -355,5 +338,4 @@ def design_tube(spec: Spec) -> tuple[TubeDesign, TubeCheck]:
     design, check = found
     if spec.gain is not None:
         return replace(design, gain=spec.gain), check
-    samples = sample_tube(design)
-    return replace(design, gain=default_gain(design, samples)), check
+    return replace(design, gain=default_gain(design, check.min_width)), check
