@@ -149,5 +149,6 @@ def test_a_start_at_the_tube_edge_is_rejected():
     check = check_tube(dataclasses.replace(base, circumvents=(first,)), spec)
     assert check.initial_error > MAX_INITIAL_ERROR
     assert not check.passed and "x(0) starts at |e| =" in check.reason
-    design, accepted = design_tube(spec)
+    found = design_tube(spec)
+    design, accepted = found.tube, found.check
     assert accepted.passed and accepted.initial_error <= MAX_INITIAL_ERROR

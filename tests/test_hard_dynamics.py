@@ -85,7 +85,7 @@ def test_unknown_plants_on_random_arenas(index, seed, f_amp, g_min, w_amp):
     """
     spec = generate_arena(seed=0, index=index).to_spec()
     try:
-        design, _ = design_tube(spec)
+        design = design_tube(spec).tube
     except DesignError:
         assume(False)
     p = random_plant_parameters(np.random.default_rng(seed), f_amp, 0.3, g_min, 1.0,

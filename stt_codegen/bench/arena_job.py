@@ -79,7 +79,7 @@ def _run_stt(spec, index: int) -> dict[str, Any]:
     from ..runtime.simulate import simulate
     begin = time.perf_counter()
     try:
-        design, _ = design_tube(spec)
+        design = design_tube(spec).tube
     except DesignError as exc:
         return _outcome(time.perf_counter() - begin, design_failure(str(exc)), None)
     seconds = time.perf_counter() - begin

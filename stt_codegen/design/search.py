@@ -24,12 +24,15 @@ The paper leaves several points open or, read literally, fails (see the README's
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..tube import reference
 from .certificate import MAX_MOVE_PER_SAMPLE, Certificate, certify_tube
+from .result import METHOD_PAPER, METHOD_VIA, Design
+from .via import via_design
 from ..errors import DesignError
 from ..spec.loader import Box, Spec
 from ..tube.parameters import LOWER, UPPER, Circumvent, TubeDesign, paper_segments
@@ -40,6 +43,19 @@ from ..tube.parameters import LOWER, UPPER, Circumvent, TubeDesign, paper_segmen
 MAX_INITIAL_ERROR = 0.5
 #: Obstacles are inflated by this fraction of ``delta_B`` to compute overlap windows.
 WINDOW_INFLATION = 0.5
+#: Circumvent sharpness values ``k^j`` the automatic choice picks from, sharpest first.
+SHARPNESS_LADDER = (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0)
+#: Ladder values tried per circumvent, from the sharpest that passes the quick estimate.
+AUTO_SHARPNESS_TRIES = 3
+#: The quick estimate's tube width, as a fraction of the reach tube's (the adaptive
+#: tube is narrower where it circumvents).
+AUTO_WIDTH_FRACTION = 0.25
+#: Candidate certificates the paper's search may run before it gives up.
+MAX_CANDIDATE_CHECKS = 80
+#: Default target half-width shrinks by this factor (at most TARGET_SHRINK_STEPS times)
+#: while an obstacle lies within the window inflation of the target box.
+TARGET_SHRINK = 0.5
+TARGET_SHRINK_STEPS = 4
 
 
 @dataclass(frozen=True)
@@ -188,7 +204,6 @@ def candidates(design: TubeDesign, spec: Spec, j: int, delta_b: float) -> list[C
     if interval is None:
         return []
     t1, t2 = (progress_time(design, s) for s in interval)
-    k = spec.tube.circumvent_sharpness
     mid = np.array([0.5 * (t1 + t2)])
     rho_l, rho_u, _, _ = reference.reach_tube(design, mid)
     result = []
@@ -211,16 +226,50 @@ def candidates(design: TubeDesign, spec: Spec, j: int, delta_b: float) -> list[C
                     continue
                 base, height = hi_x, hi_x - peak
                 move = max(0.0, float(rho_u[0, i]) - peak)
-            # widen [t1, t2] so that the bump is within delta_b / 2 of its peak there
-            level = (height - 0.5 * delta_b) / height
-            z = math.sqrt(-math.log(level) / (k - math.log(level)))
-            radius = max(0.5 * (t2 - t1), 1e-9) / z
-            center = 0.5 * (t1 + t2)
-            result.append((-span, move, i, 0 if side == LOWER else 1,
-                           Circumvent(j, i, side, center - radius, center + radius, height,
-                                      base, k)))
-    result.sort(key=lambda r: r[:4])
+            width = float(np.min(rho_u[0] - rho_l[0]))
+            for rank_k, k in enumerate(_sharpness_options(spec, height, delta_b, t1, t2,
+                                                          width, design.rate_hz)):
+                radius, center = _window(height, delta_b, k, t1, t2)
+                result.append((-span, move, i, 0 if side == LOWER else 1, rank_k,
+                               Circumvent(j, i, side, center - radius, center + radius,
+                                          height, base, k)))
+    result.sort(key=lambda r: r[:5])
     return [r[-1] for r in result]
+
+
+def _window(height: float, delta_b: float, k: float, t1: float, t2: float):
+    """Half-width and centre of the bump window: within ``delta_b / 2`` of the peak on [t1, t2]."""
+    level = (height - 0.5 * delta_b) / height
+    z = math.sqrt(-math.log(level) / (k - math.log(level)))
+    return max(0.5 * (t2 - t1), 1e-9) / z, 0.5 * (t1 + t2)
+
+
+def bump_rate_peak(k: float, radius: float) -> float:
+    """``sup_t |b_dot|`` of the bump (7)-(8), 1/s (``verify.lemma.bump_rate_bound``)."""
+    q = ((1.0 - k) + math.sqrt((1.0 - k) ** 2 + 3.0)) / 3.0
+    return 2.0 * k / radius * math.sqrt(q) / (1.0 - q) ** 2 * math.exp(-k * q / (1.0 - q))
+
+
+def _sharpness_options(spec: Spec, height: float, delta_b: float, t1: float, t2: float,
+                       width: float, rate_hz: float) -> list[float]:
+    """``k^j`` values to try, best first: the spec's, or the automatic ladder.
+
+    Automatic: the sharpest value of :data:`SHARPNESS_LADDER` whose bump moves the bound
+    by at most ``MAX_MOVE_PER_SAMPLE`` of :data:`AUTO_WIDTH_FRACTION` of the reach tube's
+    width per sampling period (a quick necessary estimate), then the next
+    :data:`AUTO_SHARPNESS_TRIES` - 1 smoother ones: the certificate's sampling-rate check
+    decides among them.
+    """
+    if spec.tube.circumvent_sharpness is not None:
+        return [spec.tube.circumvent_sharpness]
+    limit = MAX_MOVE_PER_SAMPLE * AUTO_WIDTH_FRACTION * width * rate_hz
+    first = len(SHARPNESS_LADDER) - 1
+    for q, k in enumerate(SHARPNESS_LADDER):
+        radius, _ = _window(height, delta_b, k, t1, t2)
+        if height * bump_rate_peak(k, radius) <= limit:
+            first = q
+            break
+    return list(SHARPNESS_LADDER[first:first + AUTO_SHARPNESS_TRIES])
 
 
 # --------------------------------------------------------------------------- the search
@@ -229,7 +278,7 @@ def candidates(design: TubeDesign, spec: Spec, j: int, delta_b: float) -> list[C
 def base_design(spec: Spec, gain: float = 1.0) -> TubeDesign:
     """The design without circumvents, from the spec's boxes and parameters."""
     x0, d0 = spec.initial_state, spec.initial_half_width
-    eta, d_t = spec.target_center, spec.target_half_width
+    eta, d_t = spec.target_center, target_half_width(spec)
     return TubeDesign(
         name=spec.name, prescribed_time=spec.prescribed_time,
         state_lower=spec.state_space.lower, state_upper=spec.state_space.upper,
@@ -240,6 +289,33 @@ def base_design(spec: Spec, gain: float = 1.0) -> TubeDesign:
         initial_state=x0, circumvents=(),
         smoothness=spec.tube.smoothness, theta0=spec.tube.theta0, kappa=spec.tube.kappa,
         mu=spec.tube.mu, gain=gain, rate_hz=spec.rate_hz)
+
+
+def target_half_width(spec: Spec) -> tuple[float, ...]:
+    """``d_T`` of eq. (3): the spec's, or its default shrunk clear of nearby obstacles.
+
+    When ``target.half_width`` is not set and an obstacle, inflated by
+    ``WINDOW_INFLATION * delta_B``, meets the box ``eta +- d_T``, the default ``d_T`` is
+    halved (at most :data:`TARGET_SHRINK_STEPS` times) until none does.
+    """
+    d_t = spec.target_half_width
+    if spec.target_half_width_given:
+        return d_t
+    margin = WINDOW_INFLATION * spec.tube.delta_b
+    eta = np.array(spec.target_center)
+    boxes = spec.obstacle_boxes()
+    lows = np.array([b.lower for b in boxes]).reshape(-1, len(eta)) - margin
+    highs = np.array([b.upper for b in boxes]).reshape(-1, len(eta)) + margin
+    scale = 1.0
+    for _ in range(TARGET_SHRINK_STEPS + 1):
+        half = np.array(d_t) * scale
+        meets = np.all((eta - half < highs) & (eta + half > lows), axis=1)
+        if not meets.any():
+            break
+        scale *= TARGET_SHRINK
+    else:
+        return d_t
+    return tuple(float(v) for v in np.array(d_t) * scale)
 
 
 def _ordered(circumvents) -> tuple[Circumvent, ...]:
@@ -258,8 +334,12 @@ def default_gain(design: TubeDesign, min_width: float) -> float:
     return min_width**2 / (16.0 * dt)
 
 
-def design_tube(spec: Spec) -> tuple[TubeDesign, TubeCheck]:
-    """Design the spatiotemporal tube of a spec.
+def design_tube(spec: Spec) -> Design:
+    """Design the spatiotemporal tube of a spec and certify it.
+
+    ``spec.tube.method`` picks the reach tube: ``"paper"`` (one ``tanh`` segment, eq. (4),
+    with circumvents (7)-(9), :func:`paper_design`), ``"via"`` (via-point segments,
+    :mod:`stt_codegen.design.via`) or ``"auto"`` (the paper's, else via points).
 
     Parameters
     ----------
@@ -267,25 +347,70 @@ def design_tube(spec: Spec) -> tuple[TubeDesign, TubeCheck]:
 
     Returns
     -------
-    design : TubeDesign
-        With the circumvents chosen and the gain set (the spec's, or :func:`default_gain`).
-    check : TubeCheck
-        The accepted design's check.
+    Design
+        The tube with its gain (the spec's ``controller.gain``, or :func:`default_gain`),
+        the method used, its check and certificate (every ``t >= 0``) and the design's
+        wall time in seconds.
 
     Raises
     ------
     DesignError
-        No choice of circumvents gives a tube that passes :func:`check_tube`.
+        No tube of the allowed methods passes :func:`check_tube`; the message gives the
+        reason (for via points: where the free passage is too narrow).
     """
+    started = time.perf_counter()
     base = base_design(spec)
+    method = spec.tube.method
+    try:
+        if method == METHOD_VIA:
+            raise DesignError("tube.method = 'via'")
+        tube, check = paper_design(spec, base)
+        used = METHOD_PAPER
+    except DesignError as paper_error:
+        if method == METHOD_PAPER:
+            raise
+        try:
+            tube, check = _via(spec, base)
+            used = METHOD_VIA
+        except DesignError as via_error:
+            if method == METHOD_VIA:
+                raise
+            raise DesignError(f"{paper_error}; with via points: {via_error}") from None
+    gain = spec.gain if spec.gain is not None else default_gain(tube, check.min_width)
+    return Design(replace(tube, gain=gain), used, check, time.perf_counter() - started)
+
+
+def _via(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck]:
+    tube = via_design(spec, base)
+    check = check_tube(tube, spec)
+    if not check.passed:
+        raise DesignError(f"the via-point tube fails its check: {check.reason}")
+    return tube, check
+
+
+def paper_design(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck]:
+    """The paper's design: circumvents (7)-(9) on the single reach tube ``base``.
+
+    Returns
+    -------
+    tube : TubeDesign
+        ``base`` with the circumvents chosen (gain not yet set).
+    check : TubeCheck
+
+    Raises
+    ------
+    DesignError
+        No choice of circumvents passes :func:`check_tube` (or :data:`MAX_CANDIDATE_CHECKS`
+        candidates were tried).
+    """
     boxes = spec.obstacle_boxes()
     delta_b = spec.tube.delta_b
-    # one choice of (dimension, side) per spec obstacle: a ball or polytope covered by
-    # several boxes (Remark 3.1) is passed on one side by all of them
+    # one choice of (dimension, side, sharpness) per spec obstacle: a ball or polytope
+    # covered by several boxes (Remark 3.1) is passed on one side by all of them
     groups: dict[int, list[int]] = {}
     starts: dict[int, float] = {}
-    per_box: dict[int, dict[tuple[int, str], Circumvent]] = {}
-    rank: dict[int, list[tuple[int, str]]] = {}
+    per_box: dict[int, dict[tuple, Circumvent]] = {}
+    rank: dict[int, list[tuple]] = {}
     for b, box in enumerate(boxes):
         j = spec.obstacles[b].source
         interval = overlap_interval(base, box, WINDOW_INFLATION * delta_b)
@@ -295,9 +420,9 @@ def design_tube(spec: Spec) -> tuple[TubeDesign, TubeCheck]:
             raise DesignError(f"obstacle {j} comes within {WINDOW_INFLATION * delta_b:g} of "
                               "the target box eta +- d_T: shrink target.half_width")
         found_here = candidates(base, spec, b, delta_b)
-        per_box[b] = {(c.dimension, c.side): c for c in found_here}
+        per_box[b] = {(c.dimension, c.side, q): c for q, c in enumerate(found_here)}
         groups.setdefault(j, []).append(b)
-        rank.setdefault(j, [(c.dimension, c.side) for c in found_here])
+        rank.setdefault(j, list(per_box[b]))
         starts[j] = min(starts.get(j, math.inf), progress_time(base, interval[0]))
     options: dict[int, list[tuple[Circumvent, ...]]] = {}
     for j, members in groups.items():
@@ -308,19 +433,35 @@ def design_tube(spec: Spec) -> tuple[TubeDesign, TubeCheck]:
         options[j] = [tuple(per_box[b][key] for b in members) for key in keys]
     order = sorted(options, key=lambda j: (starts[j], j))
     failures: dict[int, str] = {}
+    budget = [MAX_CANDIDATE_CHECKS]
+
+    def check(design: TubeDesign, **kwargs) -> TubeCheck:
+        if budget[0] <= 0:
+            raise DesignError(f"no certified circumvents within {MAX_CANDIDATE_CHECKS} "
+                              "candidate tubes (" + "; ".join(
+                                  f"obstacle {j}: {r}" for j, r in sorted(failures.items()))
+                              + ")")
+        budget[0] -= 1
+        return check_tube(design, spec, **kwargs)
 
     def search(level: int, chosen: tuple[Circumvent, ...]) -> tuple[TubeDesign, TubeCheck] | None:
         if level == len(order):
             design = replace(base, circumvents=_ordered(chosen))
-            check = check_tube(design, spec)
-            return (design, check) if check.passed else None
+            accepted = check(design)
+            return (design, accepted) if accepted.passed else None
         j = order[level]
         done = [b for k in order[:level + 1] for b in groups[k]]
+        hopeless: set[tuple[int, str]] = set()
         for option in options[j]:
+            side = (option[0].dimension, option[0].side)
+            if side in hopeless:
+                continue
             design = replace(base, circumvents=_ordered(chosen + option))
-            check = check_tube(design, spec, obstacles=done, final=False)
-            if not check.passed:
-                failures.setdefault(j, check.reason)
+            partial = check(design, obstacles=done, final=False)
+            if not partial.passed:
+                failures.setdefault(j, partial.reason)
+                if not partial.reason.startswith("a tube bound moves"):
+                    hopeless.add(side)   # a smoother bump only helps the sampling rate
                 continue
             found = search(level + 1, chosen + option)
             if found is not None:
@@ -330,12 +471,8 @@ def design_tube(spec: Spec) -> tuple[TubeDesign, TubeCheck]:
     found = search(0, ())
     if found is None:
         if not order:
-            check = check_tube(base, spec)
-            raise DesignError(f"the reach tube fails its check: {check.reason}")
+            raise DesignError(f"the reach tube fails its check: {check_tube(base, spec).reason}")
         detail = "; ".join(f"obstacle {j}: {r}" for j, r in sorted(failures.items()))
         raise DesignError("no choice of circumvent dimension and side passes the tube "
                           f"check ({detail or 'the final check failed'})")
-    design, check = found
-    if spec.gain is not None:
-        return replace(design, gain=spec.gain), check
-    return replace(design, gain=default_gain(design, check.min_width)), check
+    return found

@@ -137,7 +137,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> l
 def verify_spec(spec: Spec, plant: str | None = None) -> list[Check]:
     """Design the tube of a spec and run :func:`verify_design`; a design failure is a FAIL."""
     try:
-        design, _ = design_tube(spec)
+        design = design_tube(spec).tube
     except DesignError as exc:
         return [Check("tube.design", False, str(exc))]
     return verify_design(spec, design, plant)
