@@ -100,10 +100,14 @@ def test_design_is_deterministic():
 
 def test_papers_sharpness_fails_with_a_reason_naming_the_obstacle():
     spec = load_spec("omnirobot-s1")
-    spec = dataclasses.replace(spec, tube=dataclasses.replace(spec.tube,
-                                                              circumvent_sharpness=0.01))
+    paper = dataclasses.replace(spec, tube=dataclasses.replace(
+        spec.tube, circumvent_sharpness=0.01, method="paper"))
     with pytest.raises(DesignError, match=r"obstacle 0: a tube bound moves .* tube widths"):
-        design_tube(spec)
+        design_tube(paper)
+    # the default method falls back on via points, whose tube needs no circumvent
+    auto = dataclasses.replace(paper, tube=dataclasses.replace(paper.tube, method="auto"))
+    found = design_tube(auto)
+    assert found.method == "via" and found.certificate.passed and not found.tube.circumvents
 
 
 def test_check_detects_a_tube_through_an_obstacle():

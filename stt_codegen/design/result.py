@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from ..tube.parameters import TubeDesign
@@ -30,13 +30,14 @@ class Design:
         The accepted tube's check (:func:`~stt_codegen.design.search.check_tube`),
         including its :class:`~stt_codegen.design.certificate.Certificate`.
     design_time_s : float
-        In-process wall time of the design and its certificate, seconds.
+        In-process wall time of the design and its certificate, seconds (not compared:
+        two designs of one spec are equal).
     """
 
     tube: TubeDesign
     method: str
     check: Any
-    design_time_s: float
+    design_time_s: float = field(compare=False)
 
     @property
     def certificate(self) -> Certificate:
