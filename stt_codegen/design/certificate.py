@@ -36,7 +36,7 @@ interval (proofs in ``docs/design.md``):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -168,13 +168,20 @@ class Certificate:
     min_width: float
     initial_error: float
     enclosure: Enclosure = field(compare=False, repr=False)
+    #: The final partition and alpha bounds (to resume a related certificate from).
+    state: tuple = field(default=((), [], [], []), compare=False, repr=False)
+    #: A property the tube fails for certain at some instant (refinement stopped there).
+    decisive: str = ""
+
+    def first_failure(self) -> Margin | None:
+        """The decisive failure if there is one, else the first property not proven."""
+        if self.decisive:
+            return next(m for m in self.margins if m.name == self.decisive)
+        return next((m for m in self.margins if not m.passed), None)
 
     @property
     def passed(self) -> bool:
         return all(m.passed for m in self.margins)
-
-    def first_failure(self) -> Margin | None:
-        return next((m for m in self.margins if not m.passed), None)
 
     def margin(self, name: str) -> Margin:
         """The margin called ``name``."""
@@ -340,8 +347,9 @@ def _pieces(design: TubeDesign, t0: np.ndarray, t1: np.ndarray) -> _Pieces:
     return _Pieces(rho_l, rho_u, beta_l, beta_u, rho_rate, beta_rate, psi_lo, psi_hi)
 
 
-def _alpha_ranges(design: TubeDesign, pieces: _Pieces, steps: np.ndarray):
-    """Ranges of the deployed ``alpha`` on each interval, carried from ``alpha(0) = 0``.
+def _alpha_ranges(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
+                  steps: np.ndarray, start: tuple[list, list]):
+    """Ranges of the deployed ``alpha`` on each interval, carried from bounds at the first.
 
     On an interval of ``N`` steps with ``psi`` in ``[psi_lo, psi_hi]``, the deployed
     sequence lies between the constant-coefficient sequences of (``psi_hi``,
@@ -353,30 +361,43 @@ def _alpha_ranges(design: TubeDesign, pieces: _Pieces, steps: np.ndarray):
     ``A`` is never ahead of ``A + N dt f(A)``, nor past ``a*``. ``alpha >= 0`` always.
     At most :data:`EXACT_STEPS` steps follow the extreme implicit steps one by one.
 
+    Parameters
+    ----------
+    psi_lo, psi_hi : ndarray, shape (K, 2n)
+    steps : ndarray, shape (K,)
+        Steps per interval (``inf`` for the tail).
+    start : (list, list)
+        Lower and upper bounds of ``alpha`` at the first interval's start.
+
     Returns
     -------
-    alpha_min, alpha_max : ndarray, shape (K, 2n)
+    rows_lo, rows_hi : list of list of float, (K, 2n)
+        Range of ``alpha`` on each interval.
+    entries : list of (list, list)
+        Bounds of ``alpha`` at each interval's start (to resume from).
     """
     kappa, dt = design.kappa, 1.0 / design.rate_hz
     c = 1.0 + kappa * dt
-    theta_hi = _theta(design, pieces.psi_lo)
-    theta_lo = _theta(design, pieces.psi_hi)
-    star_hi = alpha_fixed_point(pieces.psi_lo, theta_hi, kappa)[1]
-    star_lo = alpha_fixed_point(pieces.psi_hi, theta_lo, kappa)[0]
+    theta_hi = _theta(design, psi_lo)
+    theta_lo = _theta(design, psi_hi)
+    star_hi = alpha_fixed_point(psi_lo, theta_hi, kappa)[1]
+    star_lo = alpha_fixed_point(psi_hi, theta_lo, kappa)[0]
     with np.errstate(divide="ignore", over="ignore", under="ignore", invalid="ignore"):
-        q_lo = 1.0 / (c + 2.0 * dt * theta_lo / (pieces.psi_hi + star_lo) ** 3)
+        q_lo = 1.0 / (c + 2.0 * dt * theta_lo / (psi_hi + star_lo) ** 3)
         decay_lo = np.where(np.isinf(steps)[:, None], 0.0,
                             np.power(q_lo, np.minimum(steps, 1e300)[:, None]))
     decay_lo = np.where(np.isnan(decay_lo), 1.0, decay_lo)   # no rate known: monotone only
     k_count, m = star_hi.shape
-    a_lo, a_hi = [0.0] * m, [0.0] * m
+    a_lo, a_hi = list(start[0]), list(start[1])
     s_lo, s_hi = star_lo.tolist(), star_hi.tolist()
     d_lo, th, ps, n_steps = decay_lo.tolist(), (2.0 * dt * theta_hi).tolist(), \
-        pieces.psi_lo.tolist(), steps.tolist()
+        psi_lo.tolist(), steps.tolist()
     out_lo, out_hi = np.empty((k_count, m)).tolist(), np.empty((k_count, m)).tolist()
-    p_lo, p_hi = pieces.psi_lo.tolist(), pieces.psi_hi.tolist()
+    p_lo, p_hi = psi_lo.tolist(), psi_hi.tolist()
     t_lo, t_hi = theta_lo.tolist(), theta_hi.tolist()
+    entries = []
     for k in range(k_count):
+        entries.append((list(a_lo), list(a_hi)))
         sl, sh, row_lo, row_hi, steps_k = s_lo[k], s_hi[k], out_lo[k], out_hi[k], n_steps[k]
         if steps_k <= EXACT_STEPS:
             # few steps: follow the extreme backward-Euler sequences exactly
@@ -422,7 +443,7 @@ def _alpha_ranges(design: TubeDesign, pieces: _Pieces, steps: np.ndarray):
                     sh[i], hi_i + span * (t_hi[k][i] / (z * z) - kappa * hi_i))
                 row_hi[i] = end
             a_hi[i] = end
-    return np.maximum(np.array(out_lo), 0.0), np.array(out_hi)
+    return out_lo, out_hi, entries
 
 
 def step_root(a: float, psi: float, theta: float, dt: float, c: float) -> tuple[float, float]:
@@ -561,7 +582,8 @@ def _failing(design: TubeDesign, spec: Spec, enc: Enclosure, selected, final: bo
 
 
 def certify_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = None,
-                 final: bool = True) -> Certificate:
+                 final: bool = True, max_intervals: int = MAX_INTERVALS,
+                 resume: tuple[Certificate, float] | None = None) -> Certificate:
     """Prove the tube's safety properties for every ``t >= 0``.
 
     Parameters
@@ -573,6 +595,13 @@ def certify_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = N
         Indices of ``spec.obstacle_boxes()`` to certify against; default all.
     final : bool
         Also prove ``inside target after t_c`` (a partial design of the search skips it).
+    max_intervals : int
+        Refinement budget; when it runs out, the properties not yet proven fail.
+    resume : (Certificate, float), optional
+        The certificate of a design whose tube equals this one before the given time
+        (seconds), e.g. the same circumvents but one whose window opens then: its
+        partition and ``alpha`` bounds before that time are reused (work shared across
+        the candidates of the design search).
 
     Returns
     -------
@@ -583,16 +612,29 @@ def certify_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = N
         widths in one period), each with its smallest margin.
     """
     with reference.numpy_math():
-        return _certify(design, spec, obstacles, final)
+        return _certify(design, spec, obstacles, final, max_intervals, resume)
 
 
-def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool) -> Certificate:
+def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
+             max_intervals: int, resume) -> Certificate:
     selected = list(range(len(spec.obstacle_boxes()))) if obstacles is None else obstacles
     points, end = _breakpoints(design)
     dt = 1.0 / design.rate_hz
     min_steps = max(1, int(MIN_INTERVAL * design.rate_hz))
     t_c = design.prescribed_time
     budget_hit = False
+    decisive = ""
+    m = 2 * design.dimension
+    previous: tuple = ([], [], [], [])      # points, rows_lo, rows_hi, entries
+    if resume is not None:
+        parent, until = resume
+        old = list(parent.state[0])
+        # intervals of the parent that end by `until` (in sample indices) carry over
+        cut = int(np.searchsorted(np.array(old, dtype=float) * dt, until, side="right"))
+        cut = min(cut, len(old) - 1)
+        if cut >= 1 and old[-1] == end:
+            points = sorted(set(old[:cut + 1]) | {p for p in points if p >= old[cut]})
+            previous = parent.state
     while True:
         i0 = np.array(points)
         i1 = np.append(i0[1:], -1)            # -1: the tail [T, inf)
@@ -600,7 +642,18 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool) -> Certific
         t1 = np.where(i1 < 0, np.inf, i1 * dt)
         pieces = _pieces(design, t0, np.where(i1 < 0, t0, t1))
         steps = np.where(i1 < 0, np.inf, (i1 - i0).astype(float))
-        a_min, a_max = _alpha_ranges(design, pieces, steps)
+        # the intervals before the first new cut are unchanged: resume alpha after them
+        old_points, old_lo, old_hi, old_entries = previous
+        same = next((q for q, (a, b) in enumerate(zip(points, old_points)) if a != b),
+                    min(len(points), len(old_points)))
+        keep = max(0, min(same - 1, len(old_entries) - 1))
+        start = old_entries[keep] if keep else ([0.0] * m, [0.0] * m)
+        rows_lo, rows_hi, entries = _alpha_ranges(design, pieces.psi_lo[keep:],
+                                                  pieces.psi_hi[keep:], steps[keep:], start)
+        rows_lo, rows_hi = old_lo[:keep] + rows_lo, old_hi[:keep] + rows_hi
+        entries = old_entries[:keep] + entries
+        previous = (list(points), rows_lo, rows_hi, entries)
+        a_min, a_max = np.maximum(np.array(rows_lo), 0.0), np.array(rows_hi)
         enc = _enclose(design, pieces, a_min, a_max, t0, t1)
         bad = _failing(design, spec, enc, selected, final)
         length = np.where(i1 < 0, 0, i1 - i0)
@@ -616,15 +669,42 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool) -> Certific
         failed = np.flatnonzero(single)
         if failed.size and np.any((failed == 0) | (length[np.maximum(failed - 1, 0)] <= 1)):
             break
+        decisive = _surely_failing(design, spec, t0[bad], a_min[bad], a_max[bad], selected)
+        if decisive:
+            break             # the tube itself fails at an instant: no refinement helps
         if not split.any():
             break
-        if len(points) + int(split.sum()) > MAX_INTERVALS:
+        if len(points) + (SPLIT - 1) * int(split.sum()) > max_intervals:
             budget_hit = True
             break
         cuts = {int(a + (b * q) // SPLIT) for a, b in zip(i0[split], length[split])
                 for q in range(1, SPLIT)}
         points = sorted(set(points) | cuts)
-    return _report(design, spec, enc, selected, final, budget_hit, end * dt)
+    certificate = _report(design, spec, enc, selected, final, budget_hit, end * dt,
+                          max_intervals)
+    return replace(certificate, state=previous, decisive=decisive)
+
+
+def _surely_failing(design: TubeDesign, spec: Spec, t: np.ndarray, a_min: np.ndarray,
+                    a_max: np.ndarray, selected) -> str:
+    """The property the tube certainly fails at one of the instants ``t`` ("" if none).
+
+    With ``alpha`` in ``[a_min, a_max]``, the tube box at ``t`` contains the box for
+    ``a_min`` (``gamma_L`` falls and ``gamma_U`` rises with ``alpha``) and is at most as
+    wide as the box for ``a_max``.
+    """
+    if not t.size:
+        return ""
+    g_l, g_u, _, _ = reference.adaptive_tube(design, t, a_min)
+    w_l, w_u, _, _ = reference.adaptive_tube(design, t, a_max)
+    boxes = spec.obstacle_boxes()
+    for b in selected:
+        lo, hi = np.array(boxes[b].lower), np.array(boxes[b].upper)
+        if np.any(np.all((g_l < hi) & (g_u > lo), axis=1)):
+            return f"avoids obstacle {spec.obstacles[b].source}"
+    if np.any(np.max(w_l - w_u, axis=1) > 0.0):
+        return "non-empty"
+    return ""
 
 
 def _worst(values: np.ndarray, t: np.ndarray) -> tuple[float, float, int]:
@@ -634,11 +714,11 @@ def _worst(values: np.ndarray, t: np.ndarray) -> tuple[float, float, int]:
 
 
 def _report(design: TubeDesign, spec: Spec, enc: Enclosure, selected, final: bool,
-            budget_hit: bool, tail_start: float) -> Certificate:
+            budget_hit: bool, tail_start: float, max_intervals: int) -> Certificate:
     t0 = enc.t_start
     margins = []
     note = (" (the certificate's refinement budget of "
-            f"{MAX_INTERVALS} intervals was exhausted)") if budget_hit else ""
+            f"{max_intervals} intervals was exhausted)") if budget_hit else ""
 
     width = enc.upper_min - enc.lower_max
     m, t, _ = _worst(width, t0)

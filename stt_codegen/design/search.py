@@ -30,7 +30,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..tube import reference
-from .certificate import MAX_MOVE_PER_SAMPLE, Certificate, certify_tube
+from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, Certificate, certify_tube
 from .result import METHOD_PAPER, METHOD_VIA, Design
 from .via import via_design
 from ..errors import DesignError
@@ -51,7 +51,12 @@ AUTO_SHARPNESS_TRIES = 3
 #: tube is narrower where it circumvents).
 AUTO_WIDTH_FRACTION = 0.25
 #: Candidate certificates the paper's search may run before it gives up.
-MAX_CANDIDATE_CHECKS = 80
+MAX_CANDIDATE_CHECKS = 40
+#: The same for the first try of ``tube.method = "auto"`` (via points come next).
+AUTO_CANDIDATE_CHECKS = 12
+#: Refinement budget of a candidate's certificate in the search (intervals): a candidate
+#: that needs more is too thin to keep (the bundled cases need about 500).
+CANDIDATE_INTERVALS = 3000
 #: Default target half-width shrinks by this factor (at most TARGET_SHRINK_STEPS times)
 #: while an obstacle lies within the window inflation of the target box.
 TARGET_SHRINK = 0.5
@@ -90,7 +95,8 @@ class TubeCheck:
 
 
 def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = None,
-               final: bool = True) -> TubeCheck:
+               final: bool = True, max_intervals: int = MAX_INTERVALS,
+               resume: tuple | None = None) -> TubeCheck:
     """Check a designed tube: the continuous-time certificate and the sampling limit.
 
     Conditions, in order: no bound moves more than ``MAX_MOVE_PER_SAMPLE`` of the tube
@@ -107,12 +113,15 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
     obstacles : list of int, optional
         Indices of the obstacle boxes to check against; default all.
     final : bool
+    max_intervals, resume
+        Passed to :func:`~stt_codegen.design.certificate.certify_tube`.
 
     Returns
     -------
     TubeCheck
     """
-    certificate = certify_tube(design, spec, obstacles=obstacles, final=final)
+    certificate = certify_tube(design, spec, obstacles=obstacles, final=final,
+                               max_intervals=max_intervals, resume=resume)
     margins = {m.name: m for m in certificate.margins}
     clearances = [m.margin for m in certificate.margins if m.name.startswith("avoids")]
     initial_error = certificate.initial_error
@@ -123,6 +132,9 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
                          min(clearances, default=math.inf), max_ratio, initial_error,
                          certificate)
 
+    if certificate.decisive:               # fails for certain at some instant
+        failure = certificate.first_failure()
+        return result(f"{failure.name} fails: {failure.detail}")
     if not margins["sampling rate"].passed:  # first: a tube this fast also fails the rest
         also = ("" if margins["non-empty"].passed else
                 f"; non-empty fails too: {margins['non-empty'].detail}")
@@ -361,21 +373,25 @@ def design_tube(spec: Spec) -> Design:
     started = time.perf_counter()
     base = base_design(spec)
     method = spec.tube.method
-    try:
-        if method == METHOD_VIA:
-            raise DesignError("tube.method = 'via'")
-        tube, check = paper_design(spec, base)
-        used = METHOD_PAPER
-    except DesignError as paper_error:
-        if method == METHOD_PAPER:
-            raise
+    # "auto": the paper's search on a short budget, then via points, then the paper's
+    # search on its full budget (a hard arena rarely needs it)
+    stages = {"paper": [(METHOD_PAPER, MAX_CANDIDATE_CHECKS)], "via": [(METHOD_VIA, 0)],
+              "auto": [(METHOD_PAPER, AUTO_CANDIDATE_CHECKS), (METHOD_VIA, 0),
+                       (METHOD_PAPER, MAX_CANDIDATE_CHECKS)]}[method]
+    errors: dict[str, str] = {}
+    for used, budget in stages:
+        if used in errors and "candidate tubes" not in errors[used]:
+            continue          # the paper's search ended for another reason than its budget
         try:
-            tube, check = _via(spec, base)
-            used = METHOD_VIA
-        except DesignError as via_error:
-            if method == METHOD_VIA:
-                raise
-            raise DesignError(f"{paper_error}; with via points: {via_error}") from None
+            tube, check = (_via(spec, base) if used == METHOD_VIA
+                           else paper_design(spec, base, budget))
+            break
+        except DesignError as exc:
+            errors[used] = str(exc)
+    else:
+        if len(errors) == 1:
+            raise DesignError(next(iter(errors.values())))
+        raise DesignError(f"{errors[METHOD_PAPER]}; with via points: {errors[METHOD_VIA]}")
     gain = spec.gain if spec.gain is not None else default_gain(tube, check.min_width)
     return Design(replace(tube, gain=gain), used, check, time.perf_counter() - started)
 
@@ -388,8 +404,17 @@ def _via(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck]:
     return tube, check
 
 
-def paper_design(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck]:
+def paper_design(spec: Spec, base: TubeDesign,
+                 max_checks: int = MAX_CANDIDATE_CHECKS) -> tuple[TubeDesign, TubeCheck]:
     """The paper's design: circumvents (7)-(9) on the single reach tube ``base``.
+
+    Parameters
+    ----------
+    spec : Spec
+    base : TubeDesign
+        The paper's reach tube (:func:`base_design`).
+    max_checks : int
+        Candidate tubes to certify at most.
 
     Returns
     -------
@@ -433,21 +458,24 @@ def paper_design(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck]:
         options[j] = [tuple(per_box[b][key] for b in members) for key in keys]
     order = sorted(options, key=lambda j: (starts[j], j))
     failures: dict[int, str] = {}
-    budget = [MAX_CANDIDATE_CHECKS]
+    budget = [max_checks]
 
     def check(design: TubeDesign, **kwargs) -> TubeCheck:
         if budget[0] <= 0:
-            raise DesignError(f"no certified circumvents within {MAX_CANDIDATE_CHECKS} "
+            raise DesignError(f"no certified circumvents within {max_checks} "
                               "candidate tubes (" + "; ".join(
                                   f"obstacle {j}: {r}" for j, r in sorted(failures.items()))
                               + ")")
         budget[0] -= 1
-        return check_tube(design, spec, **kwargs)
+        return check_tube(design, spec, max_intervals=CANDIDATE_INTERVALS, **kwargs)
 
-    def search(level: int, chosen: tuple[Circumvent, ...]) -> tuple[TubeDesign, TubeCheck] | None:
+    def search(level: int, chosen: tuple[Circumvent, ...],
+               parent: TubeCheck | None) -> tuple[TubeDesign, TubeCheck] | None:
         if level == len(order):
             design = replace(base, circumvents=_ordered(chosen))
-            accepted = check(design)
+            # the same tube as the last partial check: resume all of it
+            accepted = check(design, resume=None if parent is None
+                             else (parent.certificate, math.inf))
             return (design, accepted) if accepted.passed else None
         j = order[level]
         done = [b for k in order[:level + 1] for b in groups[k]]
@@ -457,18 +485,21 @@ def paper_design(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck]:
             if side in hopeless:
                 continue
             design = replace(base, circumvents=_ordered(chosen + option))
-            partial = check(design, obstacles=done, final=False)
+            # before the new windows open the tube is the parent's
+            opens = min(c.start for c in option)
+            partial = check(design, obstacles=done, final=False,
+                            resume=None if parent is None else (parent.certificate, opens))
             if not partial.passed:
                 failures.setdefault(j, partial.reason)
                 if not partial.reason.startswith("a tube bound moves"):
                     hopeless.add(side)   # a smoother bump only helps the sampling rate
                 continue
-            found = search(level + 1, chosen + option)
+            found = search(level + 1, chosen + option, partial)
             if found is not None:
                 return found
         return None
 
-    found = search(0, ())
+    found = search(0, (), None)
     if found is None:
         if not order:
             raise DesignError(f"the reach tube fails its check: {check_tube(base, spec).reason}")

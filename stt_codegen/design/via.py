@@ -106,79 +106,61 @@ def plan_via(spec: Spec, base: TubeDesign) -> ViaPlan:
     start_lo, start_hi = np.array(base.initial_lower), np.array(base.initial_upper)
     goal_lo, goal_hi = np.array(base.target_lower), np.array(base.target_upper)
     grid_dims = [i for i in range(n) if any(b.lower[i] > space[0][i] or b.upper[i] < space[1][i]
-                                            for b in boxes)]
+                                            for b in boxes)] or [0]
     half = min([VIA_HALF_WIDTH] + [0.5 * (start_hi[i] - start_lo[i]) for i in grid_dims]
                + [0.5 * (goal_hi[i] - goal_lo[i]) for i in grid_dims])
     extent = space[1] - space[0]
     step = half
-    while grid_dims and math.prod(int(extent[i] / step) for i in grid_dims) > MAX_CELLS:
+    while math.prod(int(extent[i] / step) for i in grid_dims) > MAX_CELLS:
         step *= 1.25
     counts = [max(int(extent[i] / step), 1) for i in grid_dims]
-    cells = list(product(*[range(c) for c in counts]))
-
-    def box_of(cell, fraction: float) -> tuple[np.ndarray, np.ndarray]:
-        lo = start_lo + (goal_lo - start_lo) * fraction
-        hi = start_hi + (goal_hi - start_hi) * fraction
-        for g, i in enumerate(grid_dims):
-            centre = space[0][i] + (cell[g] + 0.5) * extent[i] / counts[g]
-            lo[i], hi[i] = centre - half, centre + half
-        return lo, hi
-
-    goal_centre = 0.5 * (goal_lo + goal_hi)
+    cells = np.indices(counts).reshape(len(grid_dims), -1).T        # (K, g), C order
     start_centre = 0.5 * (start_lo + start_hi)
-    total = float(np.max(np.abs(goal_centre - start_centre))) or 1.0
-
-    def fraction_of(centre: np.ndarray) -> float:
-        # progress in the other dimensions follows the distance left to the goal
-        if not grid_dims:
-            return 0.5
-        d0 = float(np.max(np.abs(centre[grid_dims] - start_centre[grid_dims])))
-        d1 = float(np.max(np.abs(goal_centre[grid_dims] - centre[grid_dims])))
-        return d0 / (d0 + d1) if d0 + d1 > 0 else 0.5
-
-    nodes: dict = {"start": (start_lo, start_hi), "goal": (goal_lo, goal_hi)}
-    for cell in cells:
-        lo, hi = box_of(cell, 0.5)
-        lo, hi = box_of(cell, fraction_of(0.5 * (lo + hi)))
-        nodes[cell] = (lo, hi)
-    names = list(nodes)
-    lows = np.array([nodes[k][0] for k in names])
-    highs = np.array([nodes[k][1] for k in names])
+    goal_centre = 0.5 * (goal_lo + goal_hi)
+    centre = np.tile(0.5 * (start_centre + goal_centre), (len(cells), 1))
+    for g, i in enumerate(grid_dims):
+        centre[:, i] = space[0][i] + (cells[:, g] + 0.5) * extent[i] / counts[g]
+    # the other dimensions progress with the share of the way done in the grid ones
+    d0 = np.max(np.abs(centre[:, grid_dims] - start_centre[grid_dims]), axis=1)
+    d1 = np.max(np.abs(goal_centre[grid_dims] - centre[:, grid_dims]), axis=1)
+    fraction = np.where(d0 + d1 > 0, d0 / np.maximum(d0 + d1, 1e-300), 0.5)
+    lows = start_lo + (goal_lo - start_lo) * fraction[:, None]
+    highs = start_hi + (goal_hi - start_hi) * fraction[:, None]
+    lows[:, grid_dims] = centre[:, grid_dims] - half
+    highs[:, grid_dims] = centre[:, grid_dims] + half
+    # node 0 is the start box, node 1 the target box, node 2 + q grid cell q
+    lows = np.vstack([start_lo, goal_lo, lows])
+    highs = np.vstack([start_hi, goal_hi, highs])
     free = _free(lows, highs, obstacles, space)
     free[:2] = True   # the spec's own boxes (checked by the loader and the certificate)
-    index = {k: i for i, k in enumerate(names)}
-
-    graph = nx.Graph()
-    graph.add_nodes_from(k for k, ok in zip(names, free) if ok)
+    flat = np.arange(len(cells)).reshape(counts) + 2
     pairs = []
-    offsets = [o for o in product((-1, 0, 1), repeat=len(grid_dims)) if any(o)]
-    for cell in cells:
-        if not free[index[cell]]:
-            continue
-        for o in offsets:
-            other = tuple(c + d for c, d in zip(cell, o))
-            if other in index and other > cell and free[index[other]]:
-                pairs.append((cell, other))
-    ends = [c for c in cells if free[index[c]]]
-    pairs += [("start", c) for c in ends] + [(c, "goal") for c in ends] + [("start", "goal")]
-    if pairs:
-        a = np.array([index[p] for p, _ in pairs])
-        b = np.array([index[q] for _, q in pairs])
-        hull_free = _free(np.minimum(lows[a], lows[b]), np.maximum(highs[a], highs[b]),
-                          obstacles, space)
-        centre = 0.5 * (lows + highs)
-        length = np.max(np.abs(centre[a] - centre[b]), axis=1)
-        for (p, q), ok, w in zip(pairs, hull_free, length):
-            if ok:
-                graph.add_edge(p, q, weight=float(w))
+    for o in product((-1, 0, 1), repeat=len(grid_dims)):
+        if not any(o) or o < (0,) * len(o):
+            continue       # each neighbour pair once
+        src = tuple(slice(max(0, -d), c - max(0, d)) for d, c in zip(o, counts))
+        dst = tuple(slice(max(0, d), c - max(0, -d)) for d, c in zip(o, counts))
+        pairs.append(np.column_stack([flat[src].ravel(), flat[dst].ravel()]))
+    cell_ids = np.flatnonzero(free[2:]) + 2
+    pairs.append(np.column_stack([np.zeros_like(cell_ids), cell_ids]))
+    pairs.append(np.column_stack([np.ones_like(cell_ids), cell_ids]))
+    pairs.append(np.array([[0, 1]]))
+    pairs = np.vstack(pairs)
+    pairs = pairs[free[pairs[:, 0]] & free[pairs[:, 1]]]
+    a, b = pairs[:, 0], pairs[:, 1]
+    ok = _free(np.minimum(lows[a], lows[b]), np.maximum(highs[a], highs[b]), obstacles, space)
+    mids = 0.5 * (lows + highs)
+    length = np.max(np.abs(mids[a] - mids[b]), axis=1)
+    graph = nx.Graph()
+    graph.add_nodes_from(np.flatnonzero(free).tolist())
+    graph.add_weighted_edges_from(zip(a[ok].tolist(), b[ok].tolist(), length[ok].tolist()))
+    nodes = {k: (lows[k], highs[k]) for k in graph.nodes}
     try:
-        path = nx.dijkstra_path(graph, "start", "goal", weight="weight")
+        path = nx.dijkstra_path(graph, 0, 1, weight="weight")
     except nx.NetworkXNoPath:
-        reach = nx.node_connected_component(graph, "start")
-        centre = {k: 0.5 * (nodes[k][0] + nodes[k][1]) for k in reach}
-        near = min(sorted(reach, key=str),
-                   key=lambda k: float(np.max(np.abs(centre[k] - goal_centre))))
-        where = ", ".join(f"{v:.2f}" for v in centre[near])
+        reach = sorted(nx.node_connected_component(graph, 0))
+        near = min(reach, key=lambda k: float(np.max(np.abs(mids[k] - goal_centre))))
+        where = ", ".join(f"{v:.2f}" for v in mids[near])
         raise DesignError(
             f"no via-point path: the free passage reachable from x(0) (via boxes of "
             f"half-width {half:g} with {VIA_MARGIN:g} clearance) comes closest to the target "
