@@ -92,3 +92,10 @@ def test_open_bump_sum_properties(nu):
     bumped = y.copy()
     bumped[:, 1] += 0.01
     assert np.all(R.open_bump_sum(bumped, nu)[0] >= f)
+
+
+def test_open_bump_sum_is_proved_in_verify():
+    from stt_codegen.verify.lemma import check_open_bump_sum, lemma_checks
+    check = check_open_bump_sum()
+    assert check.passed, check.detail
+    assert "design.open_bump_sum" in [c.name for c in lemma_checks(orders=1)]
