@@ -59,9 +59,6 @@ SPLIT = 8
 MIN_INTERVAL = 1e-4
 #: Intervals of at most this many steps follow the extreme implicit steps one by one.
 EXACT_STEPS = 4
-#: ``w*``, the root of ``(1 + w) tanh w = 1``: the tanh profile's rate peaks at
-#: ``tau = w* / (1 + w*)`` (see ``verify.lemma.reach_rate_bound``).
-_W_STAR = 0.7717
 
 #: Certified property names, in report order (``avoids obstacle j`` repeats per obstacle).
 PROPERTIES = ("non-empty", "initial state inside", "inside state space", "avoids obstacle",
@@ -79,6 +76,8 @@ def _tanh_rate_peak() -> float:
     return 0.5 * (lo + hi)
 
 
+#: ``w*``, the root of ``(1 + w) tanh w = 1``: the tanh profile's rate peaks at
+#: ``tau = w* / (1 + w*)`` (see ``verify.lemma.reach_rate_bound``).
 _W_STAR = _tanh_rate_peak()
 
 
