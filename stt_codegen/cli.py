@@ -20,7 +20,7 @@ from pathlib import Path
 from .errors import DesignError, SpecError, SttError
 
 #: Modules that add subcommands through ``register_cli(subparsers)``.
-COMMAND_MODULES = ("stt_codegen.design.cli", "stt_codegen.codegen", "stt_codegen.verify",
+COMMAND_MODULES = ("stt_codegen.design", "stt_codegen.codegen", "stt_codegen.verify",
                    "stt_codegen.embedded", "stt_codegen.bench")
 
 
