@@ -53,7 +53,7 @@ AUTO_WIDTH_FRACTION = 0.25
 #: Candidate certificates the paper's search may run before it gives up.
 MAX_CANDIDATE_CHECKS = 40
 #: The same for the first try of ``tube.method = "auto"`` (via points come next).
-AUTO_CANDIDATE_CHECKS = 12
+AUTO_CANDIDATE_CHECKS = 6
 #: Refinement budget of a candidate's certificate in the search (intervals): a candidate
 #: that needs more is too thin to keep (the bundled cases need about 500).
 CANDIDATE_INTERVALS = 3000
