@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from conftest import designed
 
 from stt_codegen.tube import reference as R
@@ -25,11 +26,13 @@ def test_bundled_tubes_are_certified(case):
     assert cert.enclosure.t_end[-1] == np.inf
 
 
-def test_enclosures_contain_the_deployed_tube(case):
+@pytest.mark.parametrize("resumed", [False, True])
+def test_enclosures_contain_the_deployed_tube(case, resumed):
     """Soundness: the deployed alpha (the controller's own steps) and gamma(t, alpha(t)) at
-    random times, alpha interpolated between samples, lie in the certificate's enclosure."""
-    spec, design, _ = designed(case)
-    enc = certify_tube(design, spec).enclosure
+    random times, alpha interpolated between samples, lie in the certificate's enclosure:
+    a fresh one, and the design search's (resumed from its candidates' certificates)."""
+    spec, design, check = designed(case)
+    enc = check.certificate.enclosure if resumed else certify_tube(design, spec).enclosure
     samples = sample_tube(design, 1.5 * design.prescribed_time)
     rng = np.random.default_rng(0)
     t = rng.uniform(0.0, samples.t[-1], 20_000)

@@ -625,15 +625,17 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
     decisive = ""
     m = 2 * design.dimension
     previous: tuple = ([], [], [], [])      # points, rows_lo, rows_hi, entries
+    reuse_limit = 0                         # intervals of `previous` that may be reused
     if resume is not None:
         parent, until = resume
         old = list(parent.state[0])
-        # intervals of the parent that end by `until` (in sample indices) carry over
+        # the parent's points up to `until`: its intervals that end by then carry over
         cut = int(np.searchsorted(np.array(old, dtype=float) * dt, until, side="right"))
         cut = min(cut, len(old) - 1)
-        if cut >= 1 and old[-1] == end:
-            points = sorted(set(old[:cut + 1]) | {p for p in points if p >= old[cut]})
+        if cut >= 2 and old[-1] == end:
+            points = sorted(set(old[:cut]) | {p for p in points if p > old[cut - 1]})
             previous = parent.state
+            reuse_limit = cut - 1
     while True:
         i0 = np.array(points)
         i1 = np.append(i0[1:], -1)            # -1: the tail [T, inf)
@@ -645,13 +647,14 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
         old_points, old_lo, old_hi, old_entries = previous
         same = next((q for q, (a, b) in enumerate(zip(points, old_points)) if a != b),
                     min(len(points), len(old_points)))
-        keep = max(0, min(same - 1, len(old_entries) - 1))
+        keep = max(0, min(same - 1, len(old_entries) - 1, reuse_limit))
         start = old_entries[keep] if keep else ([0.0] * m, [0.0] * m)
         rows_lo, rows_hi, entries = _alpha_ranges(design, pieces.psi_lo[keep:],
                                                   pieces.psi_hi[keep:], steps[keep:], start)
         rows_lo, rows_hi = old_lo[:keep] + rows_lo, old_hi[:keep] + rows_hi
         entries = old_entries[:keep] + entries
         previous = (list(points), rows_lo, rows_hi, entries)
+        reuse_limit = len(entries)            # from now on `previous` is this tube's own
         a_min, a_max = np.maximum(np.array(rows_lo), 0.0), np.array(rows_hi)
         enc = _enclose(design, pieces, a_min, a_max, t0, t1)
         bad = _failing(design, spec, enc, selected, final)
