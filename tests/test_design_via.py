@@ -6,6 +6,7 @@ import dataclasses
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,25 +21,7 @@ from stt_codegen.runtime.simulate import simulate
 from stt_codegen.spec.loader import Box, parse_spec
 from stt_codegen.tube import reference as R
 
-SERPENTINE = """
-name = "serpentine"
-prescribed_time = 12.0
-[state_space]
-lower = [0.0, 0.0]
-upper = [5.0, 5.0]
-[initial]
-lower = [0.0, 0.0]
-upper = [0.5, 0.5]
-[target]
-lower = [4.5, 4.5]
-upper = [5.0, 5.0]
-[[obstacles]]
-lower = [1.0, 0.0]
-upper = [1.5, 3.8]
-[[obstacles]]
-lower = [2.6, 1.2]
-upper = [3.1, 5.0]
-"""
+SERPENTINE = (Path(__file__).parent / "specs" / "serpentine.toml").read_text()
 WALL = """
 [[obstacles]]
 lower = [2.0, 0.0]
