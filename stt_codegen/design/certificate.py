@@ -620,7 +620,6 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
     points, end = _breakpoints(design)
     dt = 1.0 / design.rate_hz
     min_steps = max(1, int(MIN_INTERVAL * design.rate_hz))
-    t_c = design.prescribed_time
     budget_hit = False
     decisive = ""
     m = 2 * design.dimension
