@@ -20,8 +20,8 @@ from pathlib import Path
 from .errors import DesignError, SpecError, SttError
 
 #: Modules that add subcommands through ``register_cli(subparsers)``.
-COMMAND_MODULES = ("stt_codegen.codegen", "stt_codegen.verify", "stt_codegen.embedded",
-                   "stt_codegen.bench")
+COMMAND_MODULES = ("stt_codegen.design", "stt_codegen.codegen", "stt_codegen.verify",
+                   "stt_codegen.embedded", "stt_codegen.bench")
 
 
 def atomic_write_bytes(path: Path, writer) -> None:
@@ -44,8 +44,7 @@ def _design(spec_arg: str):
     from .design.search import design_tube
     from .spec.loader import load_spec
     spec = load_spec(spec_arg)
-    design, _ = design_tube(spec)
-    return spec, design
+    return spec, design_tube(spec)
 
 
 def _cmd_cases(args: argparse.Namespace) -> int:
@@ -77,18 +76,15 @@ def _check_output_folder(path: str | None) -> None:
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from .runtime.simulate import simulate
     _check_output_folder(args.plot)
-    spec, design = _design(args.spec)
+    spec, designed = _design(args.spec)
+    design = designed.tube
     result = simulate(spec, design, backend=args.backend, horizon=args.horizon, seed=args.seed)
     if args.plot:
         from .runtime.plots import plot_run
         atomic_write_bytes(Path(args.plot), lambda tmp: plot_run(spec, design, result, tmp))
     if args.json:
         data = result.to_json()
-        data["design"] = {
-            "gain": design.gain,
-            "circumvents": [{"obstacle": c.obstacle, "dimension": c.dimension,
-                             "side": c.side, "start": c.start, "end": c.end}
-                            for c in design.circumvents]}
+        data["design"] = designed.to_json(spec.name)
         print(json.dumps(data, indent=2, sort_keys=True))
     else:
         print(SUMMARY_HEADER)
@@ -115,7 +111,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     print(SUMMARY_HEADER)
     all_ok = True
     for name in bundled_cases():
-        spec, design = _design(name)
+        spec, designed = _design(name)
+        design = designed.tube
         write_generation(out / name, generate_files(spec, design, Options()))
         result = simulate(spec, design, backend=args.backend)
         atomic_write_bytes(out / f"{name}.png", lambda tmp: plot_run(spec, design, result, tmp))

@@ -20,7 +20,8 @@ CASES = ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3"]
 def designed(name: str):
     """``(spec, design, check)`` of a bundled case, cached."""
     spec = load_spec(name)
-    design, check = design_tube(spec)
+    found = design_tube(spec)
+    design, check = found.tube, found.check
     return spec, design, check
 
 

@@ -36,7 +36,7 @@ def _designed(case):
         from stt_codegen.design.search import design_tube
         from stt_codegen.spec.loader import load_spec
         spec = load_spec(case)
-        _CACHE[case] = (spec, design_tube(spec)[0])
+        _CACHE[case] = (spec, design_tube(spec).tube)
     return _CACHE[case]
 
 

@@ -47,7 +47,7 @@ def test_step_operation_counts_are_the_emitters():
     report = run_step_bench("omnirobot-s2", steps=500, rounds=1, callgrind=False)
     from stt_codegen.design.search import design_tube
     from stt_codegen.spec.loader import load_spec
-    design, _ = design_tube(load_spec("omnirobot-s2"))
+    design = design_tube(load_spec("omnirobot-s2")).tube
     counts = count_operations(build_model(design)["controller_step"])
     assert report["operations"] == {"arithmetic": counts.arithmetic,
                                     "transcendental": counts.transcendental,

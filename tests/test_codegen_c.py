@@ -14,7 +14,7 @@ from test_model_equivalence import casadi_outputs
 from stt_codegen.tube import reference as R
 from stt_codegen.codegen import tolerance as T
 from stt_codegen.codegen.functions import clamped_control
-from stt_codegen.design.search import sample_tube
+from stt_codegen.design.samples import sample_tube
 
 POINTS = 10_000
 DOUBLE_TOL = 1e-12

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from stt_codegen.design.certificate import certify_tube, enclose_tube
+from stt_codegen.design.certificate import certify_tube
 from stt_codegen.spec.covering import MAX_BOXES, cover
 from stt_codegen.design.search import design_tube
 from stt_codegen.errors import SpecError
@@ -72,7 +72,8 @@ def test_ball_whose_bounding_box_meets_the_start_is_split_and_used():
     boxes = [(np.array(o.lower), np.array(o.upper)) for o in spec.obstacles]
     assert_valid_covering(ball, boxes, 0.05, [START, (np.array([4.5, 0.0]), np.array([5.0, 0.5]))],
                           rng, in_ball)
-    design, check = design_tube(spec)
+    found = design_tube(spec)
+    design, check = found.tube, found.check
     assert check.passed
     result = simulate(spec, design, "casadi")
     assert result.satisfied and result.min_obstacle_clearance > 0.1   # against the real ball
@@ -80,11 +81,10 @@ def test_ball_whose_bounding_box_meets_the_start_is_split_and_used():
 
 def test_certificate_margin_bounds_the_distance_to_the_real_shape():
     spec = parse_spec(BESIDE + BALL)
-    design, _ = design_tube(spec)
-    samples = sample_tube(design)
-    cert = certify_tube(design, spec, samples=samples)
+    design = design_tube(spec).tube
+    cert = certify_tube(design, spec)
     margin = next(m for m in cert.margins if m.name == "avoids obstacle 0").margin
-    enc = enclose_tube(design, samples)
+    enc = cert.enclosure
     ball = spec.unsafe_sets[0].shape
     c = np.array(ball.center)
     nearest = np.clip(c, enc.lower_min, enc.upper_max)

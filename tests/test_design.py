@@ -100,10 +100,14 @@ def test_design_is_deterministic():
 
 def test_papers_sharpness_fails_with_a_reason_naming_the_obstacle():
     spec = load_spec("omnirobot-s1")
-    spec = dataclasses.replace(spec, tube=dataclasses.replace(spec.tube,
-                                                              circumvent_sharpness=0.01))
+    paper = dataclasses.replace(spec, tube=dataclasses.replace(
+        spec.tube, circumvent_sharpness=0.01, method="paper"))
     with pytest.raises(DesignError, match=r"obstacle 0: a tube bound moves .* tube widths"):
-        design_tube(spec)
+        design_tube(paper)
+    # the default method falls back on via points, whose tube needs no circumvent
+    auto = dataclasses.replace(paper, tube=dataclasses.replace(paper.tube, method="auto"))
+    found = design_tube(auto)
+    assert found.method == "via" and found.certificate.passed and not found.tube.circumvents
 
 
 def test_check_detects_a_tube_through_an_obstacle():
@@ -116,7 +120,8 @@ def test_check_detects_a_tube_through_an_obstacle():
 
 def test_check_detects_a_tube_outside_the_target_at_t_c():
     spec, design, _ = designed("omnirobot-s2")
-    wide = dataclasses.replace(design, target_lower=(4.2, 4.55, -0.5))  # T is [4.5, 5]
+    last = dataclasses.replace(design.segments[-1], lower_to=(4.2, 4.55, -0.5))  # T is [4.5, 5]
+    wide = dataclasses.replace(design, segments=design.segments[:-1] + (last,))
     check = check_tube(wide, spec, obstacles=[])
     assert not check.passed and "inside target after t_c fails" in check.reason
 
@@ -148,5 +153,6 @@ def test_a_start_at_the_tube_edge_is_rejected():
     check = check_tube(dataclasses.replace(base, circumvents=(first,)), spec)
     assert check.initial_error > MAX_INITIAL_ERROR
     assert not check.passed and "x(0) starts at |e| =" in check.reason
-    design, accepted = design_tube(spec)
+    found = design_tube(spec)
+    design, accepted = found.tube, found.check
     assert accepted.passed and accepted.initial_error <= MAX_INITIAL_ERROR

@@ -18,7 +18,7 @@ from test_emit_python import assert_bit_identical
 
 @pytest.fixture(scope="module")
 def model():
-    design, _ = design_tube(load_spec(bundled_cases()[0]))
+    design = design_tube(load_spec(bundled_cases()[0])).tube
     return build_model(design)
 
 

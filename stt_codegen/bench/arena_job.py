@@ -5,9 +5,13 @@ data, so that it runs unchanged in a local process pool or on a Dask worker.
 
 Methods (:data:`METHODS`):
 
-* ``stt``: :func:`~stt_codegen.design.search.design_tube` (the design search and its
-  continuous-time certificate), then the generated C controller (backend ``c``) in closed
-  loop; the time reported is the design's;
+* ``stt-paper``: :func:`~stt_codegen.design.search.design_tube` with ``tube.method =
+  "paper"`` (the paper's single reach tube with circumvents, and its continuous-time
+  certificate), then the generated C controller (backend ``c``) in closed loop; the time
+  reported is the design's (:attr:`~stt_codegen.design.result.Design.design_time_s`);
+* ``stt``: the same with the default ``tube.method = "auto"`` (via points when the
+  paper's design fails); when it returns the paper's tube the closed loop is not run
+  twice;
 * ``astar``: :func:`~.astar.plan_astar` then :func:`~.tracker.track`;
 * ``rrtstar``: :func:`~.rrtstar.plan_rrtstar` then :func:`~.tracker.track` (only when
   OMPL is installed).
@@ -26,23 +30,27 @@ from ..errors import DesignError
 from ..runtime.simulate import SimulationResult
 from .arenas import generate_arena
 
-METHODS = ("stt", "astar", "rrtstar")
+METHODS = ("stt-paper", "stt", "astar", "rrtstar")
 #: Names of the certificate's properties (:mod:`stt_codegen.design.certificate`), as they appear
 #: in design errors.
 CERTIFICATE_PROPERTIES = ("non-empty", "initial state inside", "inside state space",
                           "avoids obstacle", "inside target after t_c")
 #: Human-readable method names for tables.
-LABELS = {"stt": "STT (C controller)", "astar": "A* + tracker", "rrtstar": "RRT* + tracker"}
+LABELS = {"stt-paper": "STT paper only (C controller)", "stt": "STT auto (C controller)",
+          "astar": "A* + tracker", "rrtstar": "RRT* + tracker"}
 
 
 def design_failure(message: str) -> str:
     """A short category of a :class:`~stt_codegen.errors.DesignError` message.
 
-    Categories: ``design: obstacle next to target``, ``design: no room beside obstacle``,
+    Categories: ``design: no free passage for via points``,
+    ``design: obstacle next to target``, ``design: no room beside obstacle``,
     ``design: bound too fast for the sampling rate``, ``design: <certificate property>``
     (e.g. ``avoids obstacle``, ``non-empty``, ``inside target after t_c``),
     ``design: other``.
     """
+    if "no via-point path" in message:
+        return "design: no free passage for via points"
     if "comes within" in message:
         return "design: obstacle next to target"
     if "cannot be circumvented" in message:
@@ -74,17 +82,23 @@ def _outcome(seconds: float, reason: str, result: SimulationResult | None) -> di
             "clearance": None if result is None else result.min_obstacle_clearance}
 
 
-def _run_stt(spec, index: int) -> dict[str, Any]:
+def _run_stt(spec, index: int, method: str, runs: dict) -> dict[str, Any]:
+    """Design with ``tube.method = method`` and run the C controller; ``runs`` caches the
+    closed loop of a tube already simulated (same tube, same seed: same run)."""
+    from dataclasses import replace
+
     from ..design.search import design_tube
     from ..runtime.simulate import simulate
+    spec = replace(spec, tube=replace(spec.tube, method=method))
     begin = time.perf_counter()
     try:
-        design, _ = design_tube(spec)
+        design = design_tube(spec)
     except DesignError as exc:
         return _outcome(time.perf_counter() - begin, design_failure(str(exc)), None)
-    seconds = time.perf_counter() - begin
-    result = simulate(spec, design, backend="c", seed=index)
-    return _outcome(seconds, closed_loop_failure(result), result)
+    if design.tube not in runs:
+        runs[design.tube] = simulate(spec, design.tube, backend="c", seed=index)
+    result = runs[design.tube]
+    return _outcome(design.design_time_s, closed_loop_failure(result), result)
 
 
 def _run_baseline(spec, plan, index: int) -> dict[str, Any]:
@@ -115,9 +129,11 @@ def run_arena(seed: int, index: int, methods: tuple[str, ...] = METHODS) -> dict
     arena = generate_arena(seed, index)
     spec = arena.to_spec()
     out: dict[str, Any] = {}
+    runs: dict = {}
     for method in methods:
-        if method == "stt":
-            out[method] = _run_stt(spec, index)
+        if method in ("stt-paper", "stt"):
+            out[method] = _run_stt(spec, index, "paper" if method == "stt-paper" else "auto",
+                                   runs)
         elif method == "astar":
             from .astar import plan_astar
             out[method] = _run_baseline(spec, plan_astar(spec), index)

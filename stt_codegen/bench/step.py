@@ -77,7 +77,7 @@ def run_step_bench(spec_arg: str, steps: int | None = None, rounds: int = ROUNDS
     if steps < 1:
         raise SpecError("--steps", f"must be at least 1, got {steps}")
     spec = load_spec(spec_arg)
-    design, _ = design_tube(spec)
+    design = design_tube(spec).tube
     harness = build_harness(design)
     try:
         t, x, alpha, outside = harness.record()

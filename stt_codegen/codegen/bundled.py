@@ -27,7 +27,7 @@ def expected_tree() -> dict[str, bytes]:
     tree: dict[str, bytes] = {}
     for case in bundled_cases():
         spec = load_spec(case)
-        design, _ = design_tube(spec)
+        design = design_tube(spec).tube
         for sub, options in LAYOUT.items():
             for name, data in generate_files(spec, design, options).items():
                 tree[f"{case}/{sub}/{name}"] = data

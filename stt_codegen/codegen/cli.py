@@ -17,7 +17,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     from .output import write_generation
     options = parse_options(args.lang, args.precision)
     spec = load_spec(args.spec)
-    design, _ = design_tube(spec)
+    design = design_tube(spec).tube
     files = generate_files(spec, design, options)
     write_generation(Path(args.out), files)
     print(f"wrote {len(files)} files for {spec.name} ({', '.join(options.langs)}, "

@@ -1,7 +1,11 @@
-"""Tube design: windows (5), circumvent choices (6)-(9), default gain, and the certificate.
+"""Tube design: reach segments, circumvents (5)-(9), via points, default gain, certificate.
 
 Contract: :func:`.search.design_tube` turns a :class:`~stt_codegen.spec.Spec` into a
-:class:`~stt_codegen.tube.TubeDesign` that passes :mod:`.certificate` (safety of the
-tube for every ``t``) and the sampling checks, or raises
-:class:`~stt_codegen.errors.DesignError` with the reason.
+:class:`.result.Design` whose tube (:class:`~stt_codegen.tube.TubeDesign`) passes
+:mod:`.certificate` (safety of the tube for every ``t >= 0``) and the sampling check, or
+raises :class:`~stt_codegen.errors.DesignError` with the reason. See ``docs/design.md``.
 """
+
+from .cli import register_cli
+
+__all__ = ["register_cli"]

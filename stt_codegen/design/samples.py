@@ -1,4 +1,8 @@
-"""The tube at the sampling instants of the deployed controller."""
+"""The tube at the sampling instants of the deployed controller (per-sample, on a budget).
+
+The design and its certificate never work per sample; the closed-loop simulation and
+the tests that compare backends do, and refuse runs over :data:`STEP_BUDGET` steps.
+"""
 
 from __future__ import annotations
 
@@ -7,12 +11,31 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import SpecError
 from ..tube import reference
 from ..tube.model import alpha_trajectory_function
 from ..tube.parameters import TubeDesign
 
 #: Default horizon of a sampled tube, as a multiple of ``t_c``.
 HORIZON_FACTOR = 1.1
+#: Most controller steps a per-sample computation (:func:`sample_tube`, ``simulate``)
+#: accepts: about 10 minutes of simulated time at 1 kHz, a few hundred MB of arrays.
+STEP_BUDGET = 1_000_000
+
+
+def check_step_budget(steps: int, horizon: float, rate_hz: float) -> None:
+    """Refuse a per-sample run of more than :data:`STEP_BUDGET` steps.
+
+    Raises
+    ------
+    SpecError
+        Naming ``prescribed_time`` and ``controller.rate_hz``, whose product is the count.
+    """
+    if steps > STEP_BUDGET:
+        raise SpecError("prescribed_time", f"a sampled run of {horizon:g} s at controller.rate_hz "
+                        f"= {rate_hz:g} Hz takes {steps:.3g} steps, over the budget of "
+                        f"{STEP_BUDGET} for a per-sample simulation (the design and its "
+                        "certificate have no such limit)")
 
 
 @dataclass(frozen=True)
@@ -38,11 +61,17 @@ def sample_tube(design: TubeDesign, horizon: float | None = None) -> TubeSamples
     design : TubeDesign
     horizon : float, optional
         End time, seconds; default ``HORIZON_FACTOR * t_c``.
+
+    Raises
+    ------
+    SpecError
+        More than :data:`STEP_BUDGET` steps.
     """
     if horizon is None:
         horizon = HORIZON_FACTOR * design.prescribed_time
     dt = 1.0 / design.rate_hz
     steps = int(math.ceil(horizon * design.rate_hz))
+    check_step_budget(steps, horizon, design.rate_hz)
     t = np.arange(steps + 1) * dt
     psi = reference.conflict_distance(design, t[1:])
     trajectory = alpha_trajectory_function(design, steps)

@@ -16,7 +16,7 @@ def cmd_embedded(args: argparse.Namespace) -> int:
     if args.build_dir is not None and not Path(args.build_dir).parent.is_dir():
         raise SpecError("--build-dir", f"folder {str(Path(args.build_dir).parent)!r} does not exist")
     spec = load_spec(args.spec)
-    design, _ = design_tube(spec)
+    design = design_tube(spec).tube
     report = run_embedded(spec, design, args.build_dir, seed=args.seed,
                           compare_host=not args.no_host)
     if args.json:

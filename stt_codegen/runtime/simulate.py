@@ -17,6 +17,7 @@ import numpy as np
 import control as ct
 
 from .backends import STATUS_OK, make_controller
+from ..design.samples import check_step_budget
 from ..errors import SpecError
 from .plants import make_plant
 from ..spec.loader import Spec
@@ -123,12 +124,14 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
     Raises
     ------
     SpecError
-        Unknown backend, or a non-positive horizon.
+        Unknown backend, a non-positive horizon, or a run of more than
+        :data:`~stt_codegen.design.samples.STEP_BUDGET` steps.
     """
     t_c = spec.prescribed_time
     horizon = t_c if horizon is None else float(horizon)
     if not math.isfinite(horizon) or horizon <= 0:
         raise SpecError("--horizon", f"must be a positive number of seconds, got {horizon!r}")
+    check_step_budget(int(math.ceil(horizon * design.rate_hz - 1e-9)), horizon, design.rate_hz)
     controller = make_controller(backend, design)
     if plant is None:
         plant = make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed)

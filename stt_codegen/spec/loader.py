@@ -32,12 +32,13 @@ _TOP_KEYS = {"name", "prescribed_time", "state_space", "initial", "target", "obs
 _REQUIRED_TOP = ("name", "prescribed_time", "state_space", "initial", "target")
 _TUBE_DEFAULTS = {
     "delta_b": 0.2,
-    "circumvent_sharpness": 0.01,
     "theta0": 0.01,
     "kappa": 5.0,
     "mu": 1.0,
     "smoothness": 50.0,
 }
+#: ``tube.method``: the paper's single reach tube, via-point reach tubes, or paper first.
+TUBE_METHODS = ("paper", "via", "auto")
 _CONTROLLER_DEFAULTS: dict[str, float | None] = {"gain": None, "rate_hz": 1000.0}
 _PLANT_DEFAULTS: dict[str, Any] = {"model": "single-integrator", "disturbance_amplitude": 0.1}
 
@@ -146,8 +147,9 @@ class TubeParameters:
     ----------
     delta_b : float
         ``delta_B`` of eqs. (7)-(8): clearance kept from each obstacle, state units.
-    circumvent_sharpness : float
-        ``k^j`` of eqs. (7)-(8): smoothness of the circumvent bump.
+    circumvent_sharpness : float or None
+        ``k^j`` of eqs. (7)-(8): smoothness of the circumvent bump, the same for every
+        obstacle; ``None`` (the key omitted) lets the design choose one per circumvent.
     theta0 : float
         ``theta_0`` of eq. (11).
     kappa : float
@@ -156,14 +158,18 @@ class TubeParameters:
         ``mu`` of eq. (11): conflict tolerance, state units.
     smoothness : float
         ``nu`` of the smooth max/min in eqs. (9)-(10), 1/state units.
+    method : {"paper", "via", "auto"}
+        The reach tube: the paper's single tube (eq. (4)), via-point segments, or the
+        paper's first and via points when it has no certified design (default).
     """
 
     delta_b: float
-    circumvent_sharpness: float
+    circumvent_sharpness: float | None
     theta0: float
     kappa: float
     mu: float
     smoothness: float
+    method: str = "auto"
 
 
 @dataclass(frozen=True)
@@ -206,6 +212,9 @@ class Spec:
         Bound on ``|w_i|``; simulation only.
     source_hash : str
         SHA-256 of the spec file's bytes.
+    target_half_width_given : bool
+        ``target.half_width`` was set in the spec (else the design may shrink the
+        default ``d_T`` to keep an obstacle beside the target out of the target box).
     """
 
     name: str
@@ -225,6 +234,7 @@ class Spec:
     plant_model: str
     disturbance_amplitude: float
     source_hash: str = field(default="", compare=False)
+    target_half_width_given: bool = True
 
     @property
     def dimension(self) -> int:
@@ -460,9 +470,17 @@ def _validate(doc: dict) -> Spec:
     unsafe_sets = _unsafe_sets(doc.get("obstacles", []), state_space)
     obstacles = _cover_all(unsafe_sets, state_space, initial_set, target_set)
 
-    tube_t = _table(doc, "tube", False, set(_TUBE_DEFAULTS))
+    tube_t = _table(doc, "tube", False, set(_TUBE_DEFAULTS) | {"circumvent_sharpness",
+                                                               "method"})
+    method = tube_t.get("method", "auto")
+    if not isinstance(method, str) or method not in TUBE_METHODS:
+        raise SpecError("tube.method", f"must be one of {', '.join(TUBE_METHODS)}, "
+                                       f"got {method!r}")
+    sharpness = (_positive(tube_t["circumvent_sharpness"], "tube.circumvent_sharpness")
+                 if "circumvent_sharpness" in tube_t else None)
     tube = TubeParameters(**{key: _positive(tube_t.get(key, default), f"tube.{key}")
-                             for key, default in _TUBE_DEFAULTS.items()})
+                             for key, default in _TUBE_DEFAULTS.items()},
+                          circumvent_sharpness=sharpness, method=method)
 
     ctrl_t = _table(doc, "controller", False, set(_CONTROLLER_DEFAULTS))
     gain = _positive(ctrl_t["gain"], "controller.gain") if "gain" in ctrl_t else None
@@ -488,7 +506,8 @@ def _validate(doc: dict) -> Spec:
                 target_set=target_set, target_center=eta, target_half_width=d_t,
                 obstacles=obstacles, unsafe_sets=unsafe_sets, tube=tube, gain=gain,
                 rate_hz=rate_hz,
-                plant_model=model, disturbance_amplitude=amplitude)
+                plant_model=model, disturbance_amplitude=amplitude,
+                target_half_width_given="half_width" in target_t)
 
 
 #: Default covering tolerance of balls and polytopes, state units.

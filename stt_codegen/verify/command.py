@@ -14,12 +14,11 @@ import json
 import numpy as np
 
 from ..tube import reference
-from ..design.certificate import circumvent_range
+from ..design.certificate import Certificate
 from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
 from ..spec.loader import PLANT_MODELS, Spec, load_spec
-from ..tube.parameters import TubeDesign
-from ..design.samples import TubeSamples, sample_tube
+from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
 from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_omnidirectional, assumption2_single_integrator
 from .check import Check, all_passed
@@ -39,21 +38,14 @@ def symbolic_checks(max_n: int) -> tuple[Check, ...]:
     return tuple(lemma_checks(orders=3)) + tuple(error_transform_checks(max_n=max_n))
 
 
-def _psi_ranges(design: TubeDesign, samples: TubeSamples) -> tuple[np.ndarray, np.ndarray]:
-    """Certified ``min_t psi`` (over every sampling interval) and ``psi(0)``, shape (2n,) each."""
-    t0, t1 = samples.t[:-1], samples.t[1:]
-    rho_l0, rho_u0, _, _ = reference.reach_tube(design, t0)
-    rho_l1, rho_u1, _, _ = reference.reach_tube(design, t1)
-    (bl_lo, bl_hi), (bu_lo, bu_hi) = circumvent_range(design, t0, t1)
-    psi_l_min = bu_lo - np.maximum(rho_l0, rho_l1)     # psi_L = beta_U - rho_L
-    psi_u_min = np.minimum(rho_u0, rho_u1) - bl_hi     # psi_U = rho_U - beta_L
-    psi_min = np.concatenate([psi_l_min.min(axis=0), psi_u_min.min(axis=0)])
+def _psi_ranges(design: TubeDesign, certificate: Certificate) -> tuple[np.ndarray, np.ndarray]:
+    """Certified ``min_t psi`` (over every ``t >= 0``) and ``psi(0)``, shape (2n,) each."""
+    psi_min = certificate.enclosure.psi_min.min(axis=0)
     psi0 = reference.conflict_distance(design, 0.0)[0]
     return psi_min, psi0
 
 
-def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None,
-                  samples: TubeSamples | None = None) -> list[Check]:
+def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> list[Check]:
     """Run every check on a designed tube.
 
     Parameters
@@ -63,8 +55,6 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None,
     plant : str, optional
         Plant model for Assumption 2 (one of :data:`stt_codegen.spec.loader.PLANT_MODELS`);
         default the spec's.
-    samples : TubeSamples, optional
-        The deployed tube; computed when omitted.
 
     Returns
     -------
@@ -73,19 +63,25 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None,
         component of ``alpha``), and the tube certificate.
     """
     model = plant or spec.plant_model
-    s = samples if samples is not None else sample_tube(design)
+    tube_check = check_tube(design, spec)
+    enclosure = tube_check.certificate.enclosure
     n = design.dimension
-    t_c = design.prescribed_time
-    reach = sorted({(a, b, t_c) for a, b in
-                    zip(design.initial_lower + design.initial_upper,
-                        design.target_lower + design.target_upper) if a != b})
-    bumps = [(design.circumvent_sharpness, c.radius, c.height) for c in design.circumvents]
+    reach = sorted({(a, b, seg.duration) for seg in design.segments if seg.profile == TANH
+                    for a, b in zip(seg.lower_from + seg.upper_from,
+                                    seg.lower_to + seg.upper_to) if a != b})
+    bumps = [(c.sharpness, c.radius, c.height) for c in design.circumvents]
     symbolic = symbolic_checks(min(n, 3))
     reach_checks = [reach_rate_bound(*p) for p in reach]
     bump_checks = [bump_rate_bound(*p) for p in bumps]
     checks = [c for c in symbolic if c.name.startswith("lemma")] + reach_checks + bump_checks
     checks += [c for c in symbolic if not c.name.startswith("lemma")]
-    rho_rate = max((c.data.get("bound", 0.0) for c in reach_checks), default=0.0)
+    # smooth-step segments: sup |d/dt tau^3 (10 - 15 tau + 6 tau^2)| = 30/16 per duration
+    # (at tau = 1/2, where 30 tau^2 (1 - tau)^2 is largest)
+    smooth_rates = [abs(b - a) * 1.875 / seg.duration for seg in design.segments
+                    if seg.profile == SMOOTHSTEP
+                    for a, b in zip(seg.lower_from + seg.upper_from, seg.lower_to + seg.upper_to)]
+    rho_rate = max([c.data.get("bound", 0.0) for c in reach_checks] + smooth_rates,
+                   default=0.0)
     bump_rate = {p: chk.data.get("bound", np.inf) for p, chk in zip(bumps, bump_checks)}
 
     if model == "omnidirectional":
@@ -94,11 +90,11 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None,
     else:
         checks.append(assumption2_single_integrator(n))
 
-    psi_min, psi0 = _psi_ranges(design, s)
+    psi_min, psi0 = _psi_ranges(design, tube_check.certificate)
     for c in range(2 * n):
         i, side = c % n, _SIDES[c // n]
         other = "upper" if side == "L" else "lower"
-        beta_rate = sum(bump_rate[(design.circumvent_sharpness, b.radius, b.height)]
+        beta_rate = sum(bump_rate[(b.sharpness, b.radius, b.height)]
                         for b in design.circumvents_on(i, other))
         label = f"x{i + 1},{side}"
         for check in adaptive_law_checks(float(psi_min[c]), design.theta0, design.kappa,
@@ -110,24 +106,29 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None,
             checks.append(Check(f"{check.name}[{label}]", check.passed, check.detail,
                                 check.data))
         a_max = alpha_upper_bound(float(psi_min[c]), design.theta0, design.kappa, design.mu)
-        peak = float(s.alpha[:, c].max())
-        checks.append(Check(f"adaptive.deployed[{label}]", bool(0 <= s.alpha[:, c].min()
-                                                              and peak <= a_max),
-                            f"the deployed alpha stays in [0, {peak:.6g}] within the bound "
+        peak = float(enclosure.alpha_max[:, c].max())
+        lowest = float(enclosure.alpha_min[:, c].min())
+        # both sides are the same fixed point where psi is constant, each bracketed
+        # outward to ~1e-13: compare within that rounding
+        within = peak <= a_max * (1.0 + 1e-12) + 1e-15
+        checks.append(Check(f"adaptive.deployed[{label}]", bool(0 <= lowest and within),
+                            f"the deployed alpha stays in [0, {peak:.6g}] (certified, every "
+                            f"t >= 0) within the bound "
                             f"{a_max:.6g}", {"peak": peak, "alpha_max": a_max}))
 
-    check = check_tube(design, spec, samples=s)
-    checks.append(Check("tube.sampling_rate", check.max_move_ratio <= MAX_MOVE_PER_SAMPLE,
-                        f"a tube bound moves at most {check.max_move_ratio:.3g} tube widths in "
+    checks.append(Check("tube.sampling_rate", tube_check.max_move_ratio <= MAX_MOVE_PER_SAMPLE,
+                        f"a tube bound moves at most {tube_check.max_move_ratio:.3g} tube widths in "
                         f"one sampling period at {design.rate_hz:g} Hz (limit "
                         f"{MAX_MOVE_PER_SAMPLE}: a sampled controller cannot follow faster)",
-                        {"max_move_ratio": check.max_move_ratio}))
-    checks.append(Check("tube.initial_room", check.initial_error <= MAX_INITIAL_ERROR,
-                        f"x(0) starts at |e| = {check.initial_error:.3g} of the tube's "
+                        {"max_move_ratio": tube_check.max_move_ratio}))
+    checks.append(Check("tube.initial_room", tube_check.initial_error <= MAX_INITIAL_ERROR,
+                        f"x(0) starts at |e| = {tube_check.initial_error:.3g} of the tube's "
                         f"half-width at t = 0 (limit {MAX_INITIAL_ERROR}: closer to the edge "
                         "the first sampled steps overshoot)",
-                        {"initial_error": check.initial_error}))
-    for margin in check.certificate.margins:
+                        {"initial_error": tube_check.initial_error}))
+    for margin in tube_check.certificate.margins:
+        if margin.name == "sampling rate":   # reported above as tube.sampling_rate
+            continue
         checks.append(Check(f"tube.{margin.name.replace(' ', '_')}", margin.passed,
                             margin.detail, {"margin": margin.margin, "time": margin.time}))
     return checks
@@ -136,7 +137,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None,
 def verify_spec(spec: Spec, plant: str | None = None) -> list[Check]:
     """Design the tube of a spec and run :func:`verify_design`; a design failure is a FAIL."""
     try:
-        design, _ = design_tube(spec)
+        design = design_tube(spec).tube
     except DesignError as exc:
         return [Check("tube.design", False, str(exc))]
     return verify_design(spec, design, plant)

@@ -40,6 +40,7 @@ __all__ = [
     "reach_rate_bound",
     "bump_rate_bound",
     "check_smooth_max",
+    "check_open_bump_sum",
     "lemma_checks",
     "T",
     "T_C",
@@ -527,6 +528,60 @@ def check_smooth_max(expr: sp.Expr | None = None, arity: int = 2) -> Check:
     )
 
 
+def check_open_bump_sum(arity: int = 3) -> Check:
+    """Properties of ``F_nu``, the combination of the bumps on one bound in eq. (9).
+
+    ``F_nu(y) = (1/nu) ln(1 + sum_j (e^{nu y_j} - 1))`` (``docs/design.md``). Proves with
+    SymPy: ``F = 0`` at ``y = 0``; a zero argument drops out (``F`` of ``m`` arguments
+    with ``y_m = 0`` is ``F`` of the other ``m - 1``); with one argument ``F = y``; the
+    partials are ``e^{nu (y_j - F)}`` (positive: ``F`` is non-decreasing and C-infinity,
+    the log of a sum ``>= 1``); and the overflow-free form
+    ``M + (1/nu) ln(e^{-nu M} + sum_j (e^{nu (y_j - M)} - e^{-nu M}))`` is equal. The
+    bounds ``max(0, y) <= F <= max(0, y) + ln(m)/nu`` for ``y >= 0``: with
+    ``S = sum_j e^{nu y_j} - (m - 1)`` one has ``e^{nu max} <= S <= m e^{nu max}``
+    (each ``e^{nu y_j} >= 1``); checked numerically on a grid as well.
+    """
+    ys = sp.symbols(f"y_1:{arity + 1}", nonnegative=True)
+    big_m = sp.Symbol("M", nonnegative=True)
+
+    def f(args):
+        return sp.log(1 + sum(sp.exp(_NU * y) - 1 for y in args)) / _NU
+
+    failures: list[str] = []
+    full = f(ys)
+    if sp.simplify(full.subs({y: 0 for y in ys})) != 0:
+        failures.append("F(0) != 0")
+    if sp.simplify(full.subs(ys[-1], 0) - f(ys[:-1])) != 0:
+        failures.append("a zero argument does not drop out")
+    if sp.simplify(f(ys[:1]) - ys[0]) != 0:
+        failures.append("F(y) != y for one argument")
+    for y in ys:
+        if sp.simplify(sp.diff(full, y) - sp.exp(_NU * (y - full))) != 0:
+            failures.append(f"dF/d{y} is not exp(nu ({y} - F))")
+            break
+    shifted = big_m + sp.log(sp.exp(-_NU * big_m) + sum(
+        sp.exp(_NU * (y - big_m)) - sp.exp(-_NU * big_m) for y in ys)) / _NU
+    if sp.simplify(sp.expand_log(sp.exp(_NU * shifted) - sp.exp(_NU * full), force=True)) != 0:
+        failures.append("the overflow-free form differs")
+    grid = np.linspace(0.0, 3.0, 7)
+    worst = 0.0
+    for nu in (0.5, 5.0, 50.0):
+        for point in np.array(np.meshgrid(*[grid] * arity)).reshape(arity, -1).T:
+            value = float(np.log(1.0 + np.sum(np.expm1(nu * point))) / nu)
+            top = float(point.max())
+            worst = max(worst, top - value, value - top - np.log(arity) / nu)
+    if worst > 1e-12:
+        failures.append(f"max(0, y) <= F <= max(0, y) + ln(m)/nu violated by {worst:.3g}")
+    name = "design.open_bump_sum"
+    if failures:
+        return Check(name, False, "; ".join(failures), {})
+    return Check(name, True, f"F_nu of eq. (9) ({arity} arguments): F(0) = 0, a closed window "
+                 "(y_j = 0) drops out exactly, F = y for one argument, dF/dy_j = "
+                 "exp(nu (y_j - F)) > 0 (non-decreasing, C-infinity), the overflow-free "
+                 "form is equal; max(0, y) <= F <= max(0, y) + ln(m)/nu (and on a grid)",
+                 {"arity": arity})
+
+
 # ---------------------------------------------------------------------------
 # bundle
 # ---------------------------------------------------------------------------
@@ -555,6 +610,7 @@ def lemma_checks(
         check_bump_flat_all_orders(orders=orders),
         check_smooth_max(),
         check_smooth_max(arity=3),
+        check_open_bump_sum(),
     ]
     out += [reach_rate_bound(*p) for p in reach]
     out += [bump_rate_bound(*p) for p in bumps]

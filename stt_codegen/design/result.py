@@ -1,0 +1,93 @@
+"""The result of a tube design: the tube, how it was found, its certificate and its cost."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..tube.parameters import TubeDesign
+from .certificate import Certificate
+
+#: The reach-tube methods a design can use (``tube.method`` of the spec picks among them).
+METHOD_PAPER = "paper"
+METHOD_VIA = "via"
+
+
+@dataclass(frozen=True)
+class Design:
+    """A certified spatiotemporal tube for one spec.
+
+    Attributes
+    ----------
+    tube : TubeDesign
+        Every parameter the controller needs (reach segments, circumvents with their
+        sharpness ``k^j``, ``nu``, eq. (11)'s parameters, gain ``k`` of law (13), rate).
+    method : {"paper", "via"}
+        ``"paper"``: one ``tanh`` reach segment (eq. (4)) with circumvents (7)-(9);
+        ``"via"``: ``smoothstep`` segments through via boxes.
+    check : TubeCheck
+        The accepted tube's check (:func:`~stt_codegen.design.search.check_tube`),
+        including its :class:`~stt_codegen.design.certificate.Certificate`.
+    design_time_s : float
+        In-process wall time of the design and its certificate, seconds (not compared:
+        two designs of one spec are equal).
+    """
+
+    tube: TubeDesign
+    method: str
+    check: Any
+    design_time_s: float = field(compare=False)
+
+    @property
+    def certificate(self) -> Certificate:
+        """The continuous-time certificate of :attr:`tube` (every property, its margin)."""
+        return self.check.certificate
+
+    @property
+    def gain(self) -> float:
+        """``k`` of law (13)."""
+        return self.tube.gain
+
+    def to_json(self, spec_name: str) -> dict[str, Any]:
+        """The design as plain JSON types (the ``design`` command's and ``simulate --json``'s).
+
+        Returns
+        -------
+        dict
+            ``spec``, ``method``, ``circumvents`` (spec obstacle index, dimension, side,
+            window start and end in s, height, sharpness), ``via`` (boxes and times;
+            empty for the paper's method), ``gain``, ``certificate`` (each property with
+            its margin and where it is smallest) and ``design_time_s``.
+        """
+        tube = self.tube
+        via = []
+        if self.method != METHOD_PAPER:
+            segs = tube.segments
+            via = [{"time": segs[0].start, "lower": list(segs[0].lower_from),
+                    "upper": list(segs[0].upper_from)}]
+            via += [{"time": s.end, "lower": list(s.lower_to), "upper": list(s.upper_to)}
+                    for s in segs]
+        return {
+            "spec": spec_name,
+            "method": self.method,
+            "circumvents": [{"obstacle": c.obstacle, "dimension": c.dimension,
+                             "side": c.side, "start": c.start, "end": c.end,
+                             "height": c.height, "sharpness": c.sharpness}
+                            for c in tube.circumvents],
+            "via": via,
+            "segments": [{"start": s.start, "end": s.end, "profile": s.profile}
+                         for s in tube.segments],
+            "gain": tube.gain,
+            "certificate": {
+                "passed": self.certificate.passed,
+                "horizon": "inf" if math.isinf(self.certificate.horizon)
+                else self.certificate.horizon,
+                "intervals": self.certificate.intervals,
+                "properties": [{"name": m.name, "passed": m.passed, "margin": m.margin,
+                                "time": m.time, "detail": m.detail}
+                               for m in self.certificate.margins],
+            },
+            "design_time_s": self.design_time_s,
+        }
+

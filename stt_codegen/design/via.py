@@ -1,0 +1,208 @@
+"""Via-point reach tubes: a piecewise reach tube through the free space (beyond the paper).
+
+When the paper's single straight reach tube (eq. (4)) with one circumvent per obstacle
+has no certified design, the reach box can instead move through a short sequence of via
+boxes ``B_0 = X-hat_0, B_1, ..., B_m = T-hat`` (issue 10, design notes item 12):
+
+* **Free boxes.** The state space is cut into a grid of cells of side ``h`` in the
+  dimensions some obstacle restricts (the others interpolate from ``X-hat_0`` to
+  ``T-hat``); a cell's via box is centred in it with half-width ``d_v`` (at most the
+  initial and target half-widths and :data:`VIA_HALF_WIDTH`).
+* **Moves.** Segment ``k`` moves every bound from ``B_k`` to ``B_{k+1}`` by the same
+  smooth step ``sigma(tau)`` in ``[0, 1]`` (``"smoothstep"``), so each intermediate box
+  lies inside the bounding box of ``B_k`` and ``B_{k+1}``. A move is allowed when that
+  bounding box, widened by :data:`VIA_MARGIN`, misses every obstacle: the segment then
+  needs no circumvent.
+* **Path.** Dijkstra over the moves between neighbouring cells (``networkx``, weights
+  the centre distance, ties broken by node order: deterministic), then shortened
+  greedily: from each via box, the farthest later box on the path it can move to
+  directly.
+* **Timing.** Durations in proportion to the centre distance (max norm), the last
+  segment ending at ``t_c`` in the target box; the profile has zero slope at every via
+  point, so ``rho`` and ``rho_dot`` are continuous there.
+
+The tube is then certified like any other (:func:`~stt_codegen.design.certificate.certify_tube`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from itertools import product
+
+import networkx as nx
+import numpy as np
+
+from ..errors import DesignError
+from ..spec.loader import Spec
+from ..tube.parameters import SMOOTHSTEP, ReachSegment, TubeDesign
+
+#: Largest half-width of a via box, state units.
+VIA_HALF_WIDTH = 0.1
+#: Clearance kept between a move's bounding box and every obstacle, state units.
+VIA_MARGIN = 0.05
+#: Most grid cells (the cell side grows until the grid fits).
+MAX_CELLS = 6000
+
+
+@dataclass(frozen=True)
+class ViaPlan:
+    """The via boxes of a piecewise reach tube.
+
+    Attributes
+    ----------
+    lower, upper : tuple of tuple of float
+        Box corners ``B_0 .. B_m``, shape (m + 1, n).
+    times : tuple of float
+        ``t_0 = 0 < t_1 < ... < t_m <= t_c``, seconds: the tube is in ``B_k`` at ``t_k``.
+    """
+
+    lower: tuple[tuple[float, ...], ...]
+    upper: tuple[tuple[float, ...], ...]
+    times: tuple[float, ...]
+
+    def segments(self) -> tuple[ReachSegment, ...]:
+        """The ``"smoothstep"`` reach segments between consecutive via boxes."""
+        return tuple(ReachSegment(self.times[k], self.times[k + 1], self.lower[k],
+                                  self.upper[k], self.lower[k + 1], self.upper[k + 1],
+                                  SMOOTHSTEP) for k in range(len(self.times) - 1))
+
+
+def _free(lower: np.ndarray, upper: np.ndarray, obstacles: np.ndarray,
+          space: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """Boxes (K, n) that lie in the state space and keep VIA_MARGIN from every obstacle."""
+    inside = np.all((lower >= space[0]) & (upper <= space[1]), axis=1)
+    if not len(obstacles):
+        return inside
+    lo, hi = lower[:, None, :] - VIA_MARGIN, upper[:, None, :] + VIA_MARGIN
+    meets = np.all((lo < obstacles[None, :, 1, :]) & (hi > obstacles[None, :, 0, :]), axis=2)
+    return inside & ~meets.any(axis=1)
+
+
+def plan_via(spec: Spec, base: TubeDesign) -> ViaPlan:
+    """Via boxes from ``X-hat_0`` to ``T-hat`` through the free space (see the module notes).
+
+    Parameters
+    ----------
+    spec : Spec
+        State space and obstacles.
+    base : TubeDesign
+        Its first and last reach boxes are ``X-hat_0`` and ``T-hat``.
+
+    Returns
+    -------
+    ViaPlan
+
+    Raises
+    ------
+    DesignError
+        No chain of free moves joins the two boxes; the message says where the free
+        passage reachable from ``x(0)`` comes closest to the target.
+    """
+    n = base.dimension
+    space = (np.array(spec.state_space.lower), np.array(spec.state_space.upper))
+    boxes = spec.obstacle_boxes()
+    obstacles = np.array([[b.lower, b.upper] for b in boxes]).reshape(-1, 2, n)
+    start_lo, start_hi = np.array(base.initial_lower), np.array(base.initial_upper)
+    goal_lo, goal_hi = np.array(base.target_lower), np.array(base.target_upper)
+    grid_dims = [i for i in range(n) if any(b.lower[i] > space[0][i] or b.upper[i] < space[1][i]
+                                            for b in boxes)] or [0]
+    half = min([VIA_HALF_WIDTH] + [0.5 * (start_hi[i] - start_lo[i]) for i in grid_dims]
+               + [0.5 * (goal_hi[i] - goal_lo[i]) for i in grid_dims])
+    extent = space[1] - space[0]
+    step = half
+    while math.prod(int(extent[i] / step) for i in grid_dims) > MAX_CELLS:
+        step *= 1.25
+    counts = [max(int(extent[i] / step), 1) for i in grid_dims]
+    cells = np.indices(counts).reshape(len(grid_dims), -1).T        # (K, g), C order
+    start_centre = 0.5 * (start_lo + start_hi)
+    goal_centre = 0.5 * (goal_lo + goal_hi)
+    centre = np.tile(0.5 * (start_centre + goal_centre), (len(cells), 1))
+    for g, i in enumerate(grid_dims):
+        centre[:, i] = space[0][i] + (cells[:, g] + 0.5) * extent[i] / counts[g]
+    # the other dimensions progress with the share of the way done in the grid ones
+    d0 = np.max(np.abs(centre[:, grid_dims] - start_centre[grid_dims]), axis=1)
+    d1 = np.max(np.abs(goal_centre[grid_dims] - centre[:, grid_dims]), axis=1)
+    fraction = np.where(d0 + d1 > 0, d0 / np.maximum(d0 + d1, 1e-300), 0.5)
+    lows = start_lo + (goal_lo - start_lo) * fraction[:, None]
+    highs = start_hi + (goal_hi - start_hi) * fraction[:, None]
+    lows[:, grid_dims] = centre[:, grid_dims] - half
+    highs[:, grid_dims] = centre[:, grid_dims] + half
+    # node 0 is the start box, node 1 the target box, node 2 + q grid cell q
+    lows = np.vstack([start_lo, goal_lo, lows])
+    highs = np.vstack([start_hi, goal_hi, highs])
+    free = _free(lows, highs, obstacles, space)
+    free[:2] = True   # the spec's own boxes (checked by the loader and the certificate)
+    flat = np.arange(len(cells)).reshape(counts) + 2
+    pairs = []
+    for o in product((-1, 0, 1), repeat=len(grid_dims)):
+        if not any(o) or o < (0,) * len(o):
+            continue       # each neighbour pair once
+        src = tuple(slice(max(0, -d), c - max(0, d)) for d, c in zip(o, counts))
+        dst = tuple(slice(max(0, d), c - max(0, -d)) for d, c in zip(o, counts))
+        pairs.append(np.column_stack([flat[src].ravel(), flat[dst].ravel()]))
+    cell_ids = np.flatnonzero(free[2:]) + 2
+    pairs.append(np.column_stack([np.zeros_like(cell_ids), cell_ids]))
+    pairs.append(np.column_stack([np.ones_like(cell_ids), cell_ids]))
+    pairs.append(np.array([[0, 1]]))
+    pairs = np.vstack(pairs)
+    pairs = pairs[free[pairs[:, 0]] & free[pairs[:, 1]]]
+    a, b = pairs[:, 0], pairs[:, 1]
+    ok = _free(np.minimum(lows[a], lows[b]), np.maximum(highs[a], highs[b]), obstacles, space)
+    mids = 0.5 * (lows + highs)
+    length = np.max(np.abs(mids[a] - mids[b]), axis=1)
+    graph = nx.Graph()
+    graph.add_nodes_from(np.flatnonzero(free).tolist())
+    graph.add_weighted_edges_from(zip(a[ok].tolist(), b[ok].tolist(), length[ok].tolist()))
+    nodes = {k: (lows[k], highs[k]) for k in graph.nodes}
+    try:
+        path = nx.dijkstra_path(graph, 0, 1, weight="weight")
+    except nx.NetworkXNoPath:
+        reach = sorted(nx.node_connected_component(graph, 0))
+        near = min(reach, key=lambda k: float(np.max(np.abs(mids[k] - goal_centre))))
+        where = ", ".join(f"{v:.2f}" for v in mids[near])
+        raise DesignError(
+            f"no via-point path: the free passage reachable from x(0) (via boxes of "
+            f"half-width {half:g} with {VIA_MARGIN:g} clearance) comes closest to the target "
+            f"at ({where}); the passage is too narrow there") from None
+    path = _shortcut(path, nodes, obstacles, space)
+    return _timed(path, nodes, base.prescribed_time)
+
+
+def _shortcut(path: list, nodes: dict, obstacles: np.ndarray, space) -> list:
+    """Greedy shortening: from each box, the farthest later box it can move to directly."""
+    out = [path[0]]
+    k = 0
+    while k < len(path) - 1:
+        lo0, hi0 = nodes[path[k]]
+        later = path[k + 1:]
+        lows = np.array([np.minimum(lo0, nodes[q][0]) for q in later])
+        highs = np.array([np.maximum(hi0, nodes[q][1]) for q in later])
+        ok = _free(lows, highs, obstacles, space)
+        ok[0] = True   # the path's own edge
+        k = k + 1 + int(np.flatnonzero(ok)[-1])
+        out.append(path[k])
+    return out
+
+
+def _timed(path: list, nodes: dict, prescribed_time: float) -> ViaPlan:
+    centres = [0.5 * (nodes[k][0] + nodes[k][1]) for k in path]
+    lengths = [float(np.max(np.abs(b - a))) for a, b in zip(centres, centres[1:])]
+    total = sum(lengths)
+    times = [0.0]
+    for length in lengths:
+        share = length / total if total > 0 else 1.0 / len(lengths)
+        times.append(times[-1] + share * prescribed_time)
+    times[-1] = prescribed_time
+    # a zero-length move (same centre, other size) still needs a positive duration
+    for k in range(1, len(times)):
+        if times[k] <= times[k - 1]:
+            times[k] = math.nextafter(times[k - 1], math.inf)
+    lower = tuple(tuple(float(v) for v in nodes[k][0]) for k in path)
+    upper = tuple(tuple(float(v) for v in nodes[k][1]) for k in path)
+    return ViaPlan(lower, upper, tuple(times))
+
+
+def via_design(spec: Spec, base: TubeDesign) -> TubeDesign:
+    """``base`` with its reach tube replaced by the via-point segments of :func:`plan_via`."""
+    return replace(base, segments=plan_via(spec, base).segments(), circumvents=())

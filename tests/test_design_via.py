@@ -1,0 +1,178 @@
+"""Issue 10 acceptance: via-point tubes, automatic sharpness, the design command, random arenas."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from random_arenas import arena_spec, disc_can_pass
+
+from stt_codegen.design.certificate import MAX_MOVE_PER_SAMPLE, certify_tube
+from stt_codegen.design.samples import sample_tube
+from stt_codegen.design.search import base_design, design_tube
+from stt_codegen.design.via import via_design
+from stt_codegen.errors import DesignError
+from stt_codegen.runtime.simulate import simulate
+from stt_codegen.spec.loader import Box, parse_spec
+from stt_codegen.tube import reference as R
+
+SERPENTINE = (Path(__file__).parent / "specs" / "serpentine.toml").read_text()
+WALL = """
+[[obstacles]]
+lower = [2.0, 0.0]
+upper = [2.5, 5.0]
+"""
+
+
+def serpentine():
+    spec = parse_spec(SERPENTINE)
+    return spec, design_tube(spec)
+
+
+def test_auto_uses_via_points_where_the_papers_tube_has_no_design():
+    spec, design = serpentine()
+    paper = dataclasses.replace(spec, tube=dataclasses.replace(spec.tube, method="paper"))
+    with pytest.raises(DesignError):
+        design_tube(paper)
+    assert design.method == "via" and design.certificate.passed
+    assert len(design.tube.segments) >= 3
+    assert {s.profile for s in design.tube.segments} == {"smoothstep"}
+    assert design.tube.segments[-1].end <= spec.prescribed_time
+    assert design.to_json(spec.name)["via"][0]["time"] == 0.0
+
+
+def test_reach_tube_and_its_rate_are_continuous_at_every_via_point():
+    _, design = serpentine()
+    tube = design.tube
+    scale = max(abs(v) for s in tube.segments for v in s.lower_to + s.upper_to)
+    for seg in tube.segments[:-1]:
+        eps = 1e-7 * seg.end
+        before = R.reach_tube(tube, [seg.end - eps])
+        after = R.reach_tube(tube, [seg.end + eps])
+        for a, b in zip(before, after):
+            assert np.max(np.abs(a - b)) < 1e-5 * scale
+    # the rate is far from zero between via points: a jump would show
+    mid = [0.5 * (s.start + s.end) for s in tube.segments]
+    assert np.max(np.abs(R.reach_tube(tube, mid)[2])) > 0.1
+
+
+def test_a_via_tube_meeting_an_obstacle_between_two_samples_is_rejected():
+    """A 0.1 mm obstacle that the via tube's corner clips for less than one 20 ms period."""
+    spec, design = serpentine()
+    slow = dataclasses.replace(design.tube, rate_hz=50.0)
+    samples = sample_tube(slow, slow.prescribed_time)
+    t = np.arange(0.0, samples.t[-1], 1e-5)
+    alpha = np.column_stack([np.interp(t, samples.t, a) for a in samples.alpha.T])
+    d_l, d_u, _, _ = R.adaptive_tube(slow, t, alpha)
+    first = slow.segments[0]                             # moves up and right, fast
+    i = int(0.5 * (first.start + first.end) * slow.rate_hz)
+    k = int(np.searchsorted(t, samples.t[i] + 0.01))     # midway between two samples
+    # just right of the leading x bound's side, just below the trailing lower y bound
+    corner = (float(d_u[k, 0]) - 2e-4, float(d_l[k, 1]) - 1e-4)
+    box = Box(corner, (corner[0] + 1e-4, corner[1] + 1e-4))
+    hit_dense = np.all((d_l <= box.upper) & (d_u >= box.lower), axis=1)
+    hit_samples = np.all((samples.gamma_lower <= box.upper)
+                         & (samples.gamma_upper >= box.lower), axis=1)
+    assert hit_dense.any() and hit_dense.sum() * 1e-5 < 0.02   # met, for less than a period
+    assert not hit_samples.any()                                # every sample misses it
+    clipped = parse_spec(SERPENTINE + f"""
+[[obstacles]]
+lower = [{box.lower[0]!r}, {box.lower[1]!r}]
+upper = [{box.upper[0]!r}, {box.upper[1]!r}]
+""")
+    failure = certify_tube(slow, clipped).first_failure()       # the certificate catches it
+    assert failure is not None and failure.name == "avoids obstacle 2"
+
+
+def test_no_free_passage_says_where():
+    spec = parse_spec(SERPENTINE.split("[[obstacles]]")[0] + WALL)
+    with pytest.raises(DesignError, match=r"no via-point path: .* comes closest to the target "
+                                          r"at \(.*\); the passage is too narrow there"):
+        via_design(spec, base_design(spec))
+
+
+@pytest.mark.parametrize("index", range(8))
+def test_automatic_sharpness_never_violates_the_sampling_rate_limit(index):
+    """On the random arenas (no [tube] section) every circumvent's k^j is chosen by the
+    design; the deployed tube, sampled independently of the certificate, moves at most
+    MAX_MOVE_PER_SAMPLE tube widths per period."""
+    spec = arena_spec(1, index)
+    assert spec.tube.circumvent_sharpness is None
+    try:
+        design = design_tube(spec)
+    except DesignError:
+        pytest.skip("no design for this arena")
+    assert design.certificate.max_move_ratio <= MAX_MOVE_PER_SAMPLE
+    s = sample_tube(design.tube)
+    width = s.gamma_upper - s.gamma_lower
+    move = np.maximum(np.abs(s.gamma_lower_dot), np.abs(s.gamma_upper_dot)) / design.tube.rate_hz
+    assert np.all(width > 0) and np.max(move / width) <= MAX_MOVE_PER_SAMPLE
+    assert all(c.sharpness > 0 for c in design.tube.circumvents)
+
+
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "stt_codegen.cli", *args],
+                          capture_output=True, text=True, timeout=600)
+
+
+def test_design_json_fields_and_exit_codes(tmp_path):
+    ok = run_cli("design", "omnirobot-s1", "--json")
+    assert ok.returncode == 0, ok.stderr
+    data = json.loads(ok.stdout)
+    assert set(data) >= {"spec", "method", "circumvents", "via", "gain", "certificate",
+                         "design_time_s"}
+    assert data["spec"] == "omnirobot-s1" and data["method"] == "paper" and data["via"] == []
+    c = data["circumvents"][0]
+    assert set(c) == {"obstacle", "dimension", "side", "start", "end", "height", "sharpness"}
+    assert (c["obstacle"], c["dimension"], c["side"], c["sharpness"]) == (0, 1, "upper", 0.1)
+    props = {p["name"]: p for p in data["certificate"]["properties"]}
+    assert props["avoids obstacle 0"]["passed"] and props["avoids obstacle 0"]["margin"] > 0
+    assert data["certificate"]["horizon"] == "inf"
+    assert 0 < data["design_time_s"] < 60 and data["gain"] > 0
+
+    blocked = tmp_path / "wall.toml"
+    blocked.write_text(SERPENTINE.split("[[obstacles]]")[0] + WALL)
+    no = run_cli("design", str(blocked))
+    assert no.returncode == 1 and "Traceback" not in no.stderr
+    assert len(no.stderr.strip().splitlines()) == 1 and "too narrow" in no.stderr
+
+    bad = tmp_path / "bad.toml"
+    bad.write_text(SERPENTINE.replace("[[obstacles]]", "[tube]\nmethod = \"straight\"\n"
+                                      "[[obstacles]]", 1))
+    wrong = run_cli("design", str(bad))
+    assert wrong.returncode == 2 and "tube.method" in wrong.stderr
+    assert "Traceback" not in wrong.stderr
+    assert run_cli("design", "omnirobot-s1", "--plot",
+                   str(tmp_path / "missing" / "x.png")).returncode == 2
+
+
+def test_huge_prescribed_time_designs_and_simulate_refuses_with_exit_2(tmp_path):
+    spec_text = SERPENTINE.replace("prescribed_time = 12.0", "prescribed_time = 1e9")
+    path = tmp_path / "long.toml"
+    path.write_text(spec_text)
+    design = design_tube(parse_spec(spec_text))
+    assert design.certificate.passed and design.certificate.intervals < 5000
+    out = run_cli("simulate", str(path), "--backend", "reference")
+    assert out.returncode == 2 and "prescribed_time" in out.stderr
+    assert "budget" in out.stderr and "Traceback" not in out.stderr
+
+
+ARENAS = range(12)
+
+
+@pytest.mark.parametrize("index", ARENAS)
+def test_random_arena_with_a_corridor_is_satisfied(index):
+    """5-8 random boxes (0.4-1.4 m), random start and target, no [tube] section: wherever
+    a disc of radius 0.15 m can move from x(0) to the target centre, the designed
+    controller (generated C) satisfies the task."""
+    spec = arena_spec(0, index)
+    if not disc_can_pass(spec):
+        pytest.skip("no corridor for a 0.15 m disc")
+    design = design_tube(spec)
+    result = simulate(spec, design.tube, backend="c", seed=index)
+    assert result.satisfied, (design.method, result)
