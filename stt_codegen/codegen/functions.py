@@ -1,58 +1,79 @@
-"""The CasADi Functions that are deployed, in a fixed order, from the model's.
+"""The CasADi Functions whose bodies are deployed, each emitted once, from the model's.
 
-The generated code exposes four functions (C: ``<prefix>_tube``, ``_control``,
-``_alpha_step``, ``_step``; Python: ``tube``, ``control``, ``alpha_step``, ``step``). Their
-numeric bodies are these CasADi SX Functions:
+The generated API (C: ``<prefix>_tube``, ``_control``, ``_alpha_step``, ``_step``; Python:
+``tube``, ``control``, ``alpha_step``, ``step``) is control flow around four bodies:
 
 =================  ========================  ======================================
-name               inputs                    outputs
+body               inputs                    outputs
 =================  ========================  ======================================
-``tube``           t, alpha (2n)             gamma_L, gamma_U, gamma_L_dot, gamma_U_dot
-``control``        x (n), t, alpha (2n)      u (n), inside (1)
-``alpha_step``     t, dt, alpha (2n)         alpha_next (2n)
-``controller_step`` x (n), t, dt, alpha (2n)  u (n), alpha_next (2n), inside (1)
+``gamma``          t, alpha (2n)             gamma_L, gamma_U (eq. (10))
+``gamma_rates``    t, alpha (2n)             gamma_L_dot, gamma_U_dot
+``law``            x (n), gamma_L, gamma_U   u (n), inside (1) (law (13), clamped)
+``alpha_step``     t, dt, alpha (2n)         alpha_next (2n) (implicit step of (11))
 =================  ========================  ======================================
 
-``tube``, ``alpha_step`` and ``controller_step`` are the model's Functions unchanged.
-``control`` is the model's ``controller_step`` restricted to its ``u`` and ``inside``
-outputs (its SX graph, so the same operations as the step: ``e`` clamped to
-``[-E_MAX, E_MAX]``, ``gamma_d`` floored, finite outside the tube), not the model's
-unclamped ``control``, which is NaN outside the tube.
+``tube`` = ``gamma`` + ``gamma_rates``; ``control`` = ``gamma`` + ``law``; ``step`` =
+``gamma`` + ``law`` + ``alpha_step``. No body repeats another: the step's ``u`` and
+``alpha_next`` are the values of the model's ``controller_step`` bit for bit (the same SX
+graph, cut at ``gamma``), and ``control`` is the step's ``u`` (``e`` clamped to
+``[-E_MAX, E_MAX]``, ``gamma_d`` floored: finite outside the tube), not the model's
+unclamped ``control``.
 """
 
 from __future__ import annotations
 
 import casadi as ca
 
-from ..tube.model import TubeModel
-from .errors import CodegenError
+from ..tube.model import TubeModel, adaptive_tube, controller_law
 
-#: Deployed Function names, in generation order.
-DEPLOYED = ("tube", "control", "alpha_step", "controller_step")
+#: Deployed body names, in generation order.
+DEPLOYED = ("gamma", "gamma_rates", "law", "alpha_step")
+
+
+def gamma_function(model: TubeModel) -> ca.Function:
+    """``gamma(t, alpha) -> (gamma_L, gamma_U)``: the tube of eq. (10) at ``t``."""
+    n = model.design.dimension
+    t = ca.SX.sym("t")
+    alpha = ca.SX.sym("alpha", 2 * n)
+    gamma_l, gamma_u = adaptive_tube(model.design, t, alpha)
+    return ca.Function("gamma", [t, alpha], [gamma_l, gamma_u], ["t", "alpha"],
+                       ["gamma_L", "gamma_U"])
+
+
+def gamma_rates_function(model: TubeModel) -> ca.Function:
+    """``gamma_rates(t, alpha) -> (gamma_L_dot, gamma_U_dot)``: the model's ``tube`` rates."""
+    tube = model["tube"]
+    t = ca.SX.sym("t")
+    alpha = ca.SX.sym("alpha", tube.size1_in(1))
+    _, _, rate_l, rate_u = tube(t, alpha)
+    return ca.Function("gamma_rates", [t, alpha], [rate_l, rate_u], ["t", "alpha"],
+                       ["gamma_L_dot", "gamma_U_dot"])
+
+
+def law_function(model: TubeModel) -> ca.Function:
+    """``law(x, gamma_L, gamma_U) -> (u, inside)``: the deployed law (13) with its clamps."""
+    n = model.design.dimension
+    x = ca.SX.sym("x", n)
+    gamma_l = ca.SX.sym("gamma_L", n)
+    gamma_u = ca.SX.sym("gamma_U", n)
+    u, inside = controller_law(model.design, x, gamma_l, gamma_u)
+    return ca.Function("law", [x, gamma_l, gamma_u], [u, inside], ["x", "gamma_L", "gamma_U"],
+                       ["u", "inside"])
 
 
 def clamped_control(model: TubeModel) -> ca.Function:
-    """``control(x, t, alpha) -> (u, inside)``: the ``u`` and ``inside`` of ``controller_step``.
-
-    Raises
-    ------
-    CodegenError
-        If ``u`` or ``inside`` of the step depended on ``dt`` (they must not).
-    """
-    step = model["controller_step"]
+    """``control(x, t, alpha) -> (u, inside)``: ``law`` applied to ``gamma`` (for tests)."""
     n = model.design.dimension
     x = ca.SX.sym("x", n)
     t = ca.SX.sym("t")
-    dt = ca.SX.sym("dt")
     alpha = ca.SX.sym("alpha", 2 * n)
-    u, _, inside = step(x, t, dt, alpha)
-    if ca.depends_on(ca.vertcat(u, inside), dt):
-        raise CodegenError("controller_step's u depends on dt")
+    gamma_l, gamma_u = gamma_function(model)(t, alpha)
+    u, inside = law_function(model)(x, gamma_l, gamma_u)
     return ca.Function("control", [x, t, alpha], [u, inside], ["x", "t", "alpha"],
                        ["u", "inside"])
 
 
 def deployed_functions(model: TubeModel) -> list[ca.Function]:
     """The deployed SX Functions, in the order of :data:`DEPLOYED`."""
-    return [model["tube"], clamped_control(model), model["alpha_step"],
-            model["controller_step"]]
+    return [gamma_function(model), gamma_rates_function(model), law_function(model),
+            model["alpha_step"]]
