@@ -116,7 +116,8 @@ def test_check_detects_a_tube_through_an_obstacle():
 
 def test_check_detects_a_tube_outside_the_target_at_t_c():
     spec, design, _ = designed("omnirobot-s2")
-    wide = dataclasses.replace(design, target_lower=(4.2, 4.55, -0.5))  # T is [4.5, 5]
+    last = dataclasses.replace(design.segments[-1], lower_to=(4.2, 4.55, -0.5))  # T is [4.5, 5]
+    wide = dataclasses.replace(design, segments=design.segments[:-1] + (last,))
     check = check_tube(wide, spec, obstacles=[])
     assert not check.passed and "inside target after t_c fails" in check.reason
 

@@ -112,7 +112,7 @@ def test_parameters_that_make_alpha_unbounded_are_rejected_or_fail():
         parse_spec(SPEC.replace("[tube]", "[tube]\nkappa = 0.0"))
     spec, design, _ = designed("omnirobot-s1")
     early = Circumvent(obstacle=0, dimension=1, side="upper", start=-1.0, end=2.0,
-                       height=1.2, base=5.0)          # beta_U(0) < rho_L(0): a conflict at t=0
+                       height=1.2, base=5.0, sharpness=0.1)          # beta_U(0) < rho_L(0): a conflict at t=0
     broken = dataclasses.replace(design, circumvents=(early,))
     bad = failed(verify_design(spec, broken))
     assert "adaptive.singularity[x2,L]" in bad

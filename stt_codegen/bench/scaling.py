@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import SpecError
-from ..tube.parameters import LOWER, UPPER, Circumvent, TubeDesign
+from ..tube.parameters import LOWER, UPPER, Circumvent, TubeDesign, paper_segments
 from .harness import BenchError, build_harness
 from .report import machine, machine_line, seconds_text, table
 from .timing import MIN_BATCH_SECONDS
@@ -86,15 +86,14 @@ def synthetic_design(obstacles: int, dimension: int, windows: str = "random",
             height *= 0.05
         base = 0.0 if side == LOWER else ARENA_SIZE
         circumvents.append(Circumvent(j, i, side, float(center - radius),
-                                      float(center + radius), height, base))
+                                      float(center + radius), height, base, 0.1))
     circumvents.sort(key=lambda c: (c.dimension, c.side, c.obstacle))
     n = dimension
     return TubeDesign(
         name=f"synthetic_m{obstacles}_n{dimension}", prescribed_time=t_c,
         state_lower=(0.0,) * n, state_upper=(ARENA_SIZE,) * n,
-        initial_lower=(0.05,) * n, initial_upper=(0.45,) * n,
-        target_lower=(4.55,) * n, target_upper=(4.95,) * n, initial_state=(0.25,) * n,
-        circumvents=tuple(circumvents), circumvent_sharpness=0.1, smoothness=50.0,
+        segments=paper_segments((0.05,) * n, (0.45,) * n, (4.55,) * n, (4.95,) * n, t_c),
+        initial_state=(0.25,) * n, circumvents=tuple(circumvents), smoothness=50.0,
         theta0=0.01, kappa=5.0, mu=1.0, gain=0.2, rate_hz=1000.0)
 
 

@@ -91,13 +91,11 @@ class Enclosure:
     upper_max: np.ndarray
 
 
-def _bump_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, center: float,
-                radius: float) -> tuple[np.ndarray, np.ndarray]:
-    k = design.circumvent_sharpness
-    b0, _ = reference.bump(t0, center, radius, k)
-    b1, _ = reference.bump(t1, center, radius, k)
+def _bump_range(c, t0: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    b0, _ = reference.bump(t0, c.center, c.radius, c.sharpness)
+    b1, _ = reference.bump(t1, c.center, c.radius, c.sharpness)
     low = np.minimum(b0, b1)
-    high = np.where((t0 <= center) & (center <= t1), 1.0, np.maximum(b0, b1))
+    high = np.where((t0 <= c.center) & (c.center <= t1), 1.0, np.maximum(b0, b1))
     return low, high
 
 
@@ -107,7 +105,7 @@ def circumvent_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
     ``beta_L`` is non-decreasing and ``beta_U`` non-increasing in every bump value, so
     eq. (9) at the ends of the bumps' ranges gives the ends of theirs.
     """
-    ranges = [_bump_range(design, t0, t1, c.center, c.radius) for c in design.circumvents]
+    ranges = [_bump_range(c, t0, t1) for c in design.circumvents]
     lower_min, upper_max, _ = reference.circumvent_from_bumps(design, [r[0] for r in ranges],
                                                               t0.size)
     lower_max, upper_min, _ = reference.circumvent_from_bumps(design, [r[1] for r in ranges],

@@ -32,7 +32,7 @@ from ..tube import reference
 from .certificate import Certificate, certify_tube
 from ..errors import DesignError
 from ..spec.loader import Box, Spec
-from ..tube.parameters import LOWER, UPPER, Circumvent, TubeDesign
+from ..tube.parameters import LOWER, UPPER, Circumvent, TubeDesign, paper_segments
 from .samples import TubeSamples, sample_tube
 
 #: Largest distance a tube bound may move in one sampling period, as a fraction of the
@@ -205,7 +205,7 @@ def candidates(design: TubeDesign, spec: Spec, j: int, delta_b: float) -> list[C
     if interval is None:
         return []
     t1, t2 = (progress_time(design, s) for s in interval)
-    k = design.circumvent_sharpness
+    k = spec.tube.circumvent_sharpness
     mid = np.array([0.5 * (t1 + t2)])
     rho_l, rho_u, _, _ = reference.reach_tube(design, mid)
     result = []
@@ -235,7 +235,7 @@ def candidates(design: TubeDesign, spec: Spec, j: int, delta_b: float) -> list[C
             center = 0.5 * (t1 + t2)
             result.append((-span, move, i, 0 if side == LOWER else 1,
                            Circumvent(j, i, side, center - radius, center + radius, height,
-                                      base)))
+                                      base, k)))
     result.sort(key=lambda r: r[:4])
     return [r[-1] for r in result]
 
@@ -250,12 +250,11 @@ def base_design(spec: Spec, gain: float = 1.0) -> TubeDesign:
     return TubeDesign(
         name=spec.name, prescribed_time=spec.prescribed_time,
         state_lower=spec.state_space.lower, state_upper=spec.state_space.upper,
-        initial_lower=tuple(a - b for a, b in zip(x0, d0)),
-        initial_upper=tuple(a + b for a, b in zip(x0, d0)),
-        target_lower=tuple(a - b for a, b in zip(eta, d_t)),
-        target_upper=tuple(a + b for a, b in zip(eta, d_t)),
+        segments=paper_segments(tuple(a - b for a, b in zip(x0, d0)),
+                                tuple(a + b for a, b in zip(x0, d0)),
+                                tuple(a - b for a, b in zip(eta, d_t)),
+                                tuple(a + b for a, b in zip(eta, d_t)), spec.prescribed_time),
         initial_state=x0, circumvents=(),
-        circumvent_sharpness=spec.tube.circumvent_sharpness,
         smoothness=spec.tube.smoothness, theta0=spec.tube.theta0, kappa=spec.tube.kappa,
         mu=spec.tube.mu, gain=gain, rate_hz=spec.rate_hz)
 

@@ -7,11 +7,13 @@ The functions are the single source of every generated controller.
 
 Numerical decisions (all documented in the README):
 
-* smooth max ``max~(a, b) = max(a, b) + log1p(exp(-nu |a - b|)) / nu``, the paper's
-  ``(1/nu) ln(e^{nu a} + e^{nu b})`` rewritten so it cannot overflow; with more than two
-  arguments ``M + ln(sum_j exp(nu (a_j - M))) / nu`` with ``M = max_j a_j``;
-* ``tanh(t / (t_c - t))`` is only evaluated for ``t < t_c`` (eq. (4)'s second branch
-  holds after), with a denominator that stays finite in the branch not taken;
+* smooth max of eq. (10) ``max~(a, b) = max(a, b) + log1p(exp(-nu |a - b|)) / nu``, the
+  paper's ``(1/nu) ln(e^{nu a} + e^{nu b})`` rewritten so it cannot overflow;
+* eq. (9) combines the bumps on one bound by ``F_nu`` (:func:`open_bump_sum`), to which a
+  closed window contributes exactly 0;
+* the reach tube is piecewise over ``design.segments``; ``tanh((t - start)/(end - t))``
+  is only evaluated for ``t < end`` (eq. (4)'s second branch holds after), with a
+  denominator that stays finite in the branch not taken;
 * the circumvent bump is only evaluated inside its window (eqs. (7)-(8));
 * the implicit ``alpha`` step is backward Euler with :data:`~stt_codegen.tube.parameters.NEWTON_ITERATIONS`
   Newton iterations from a start point left of the root (see :func:`implicit_alpha_update`).
@@ -23,8 +25,8 @@ from dataclasses import dataclass
 
 import casadi as ca
 
-from .parameters import (E_MAX, GAMMA_D_MIN, LOWER, NEWTON_ITERATIONS, NEWTON_TINY, UPPER,
-                         TubeDesign)
+from .parameters import (E_MAX, GAMMA_D_MIN, LOWER, NEWTON_ITERATIONS, NEWTON_TINY,
+                         SMOOTHSTEP, TANH, UPPER, ReachSegment, TubeDesign)
 
 #: The functions of a model, in order.
 FUNCTION_NAMES = ("reach_tube", "circumvent", "tube", "adaptive_law", "error_transform",
@@ -65,20 +67,43 @@ def smooth_min(values: list, nu: float):
     return -smooth_max([-v for v in values], nu)
 
 
-def tanh_progress(design: TubeDesign, t):
-    """``s(t) = tanh(t / (t_c - t))`` for ``t < t_c``, 1 after (eq. (4))."""
-    t_c = design.prescribed_time
-    before = t < t_c
-    gap = ca.if_else(before, t_c - t, 1.0)
-    return ca.if_else(before, ca.tanh(t / gap), 1.0)
+def segment_progress(segment: ReachSegment, t):
+    """Profile ``p`` of one reach segment as SX: 0 before ``start``, 1 from ``end`` on.
+
+    ``"tanh"``: ``tanh((t - start) / (end - t))`` (eq. (4); only evaluated for
+    ``t < end``, with a denominator that stays finite in the branch not taken);
+    ``"smoothstep"``: ``tau^3 (10 - 15 tau + 6 tau^2)`` with ``tau`` clamped to ``[0, 1]``.
+    """
+    start, end = segment.start, segment.end
+    if segment.profile == TANH:
+        before = t < end
+        gap = ca.if_else(before, end - t, 1.0)
+        elapsed = t - start if start != 0.0 else t
+        return ca.if_else(before, ca.if_else(elapsed < 0.0, 0.0, ca.tanh(elapsed / gap)), 1.0)
+    if segment.profile != SMOOTHSTEP:
+        raise ValueError(f"unknown reach segment profile {segment.profile!r}")
+    tau = ca.fmin(ca.fmax((t - start) / (end - start), 0.0), 1.0)
+    return tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
 
 
 def reach_tube(design: TubeDesign, t) -> tuple:
-    """``rho_L(t)``, ``rho_U(t)`` of eq. (4) as SX column vectors of length n."""
-    s = tanh_progress(design, t)
-    lower = [(tl - xl) * s + xl for xl, tl in zip(design.initial_lower, design.target_lower)]
-    upper = [(tu - xu) * s + xu for xu, tu in zip(design.initial_upper, design.target_upper)]
-    return ca.vertcat(*lower), ca.vertcat(*upper)
+    """``rho_L(t)``, ``rho_U(t)`` of eq. (4), piecewise over ``design.segments``, SX vectors of length n.
+
+    On the first segment whose ``end`` is after ``t`` (the last one after every end):
+    ``rho = from + (to - from) p``, ``p`` from :func:`segment_progress`.
+    """
+    def on(segment):
+        s = segment_progress(segment, t)
+        lower = [(b - a) * s + a for a, b in zip(segment.lower_from, segment.lower_to)]
+        upper = [(b - a) * s + a for a, b in zip(segment.upper_from, segment.upper_to)]
+        return ca.vertcat(*lower), ca.vertcat(*upper)
+
+    rho_l, rho_u = on(design.segments[-1])
+    for segment in reversed(design.segments[:-1]):
+        here_l, here_u = on(segment)
+        sooner = t < segment.end
+        rho_l, rho_u = ca.if_else(sooner, here_l, rho_l), ca.if_else(sooner, here_u, rho_u)
+    return rho_l, rho_u
 
 
 def bump(t, center: float, radius: float, sharpness: float):
@@ -91,8 +116,38 @@ def bump(t, center: float, radius: float, sharpness: float):
     return ca.if_else(inside, ca.exp(-sharpness * d**2 / denom), 0.0)
 
 
+def open_bump_sum(heights: list, nu: float):
+    """``F_nu(y) = (1/nu) ln(1 + sum_j (exp(nu y_j) - 1))`` of eq. (9) (as decided), SX.
+
+    Written ``M + (1/nu) ln(exp(-nu M) + sum_j (exp(nu (y_j - M)) - exp(-nu M)))``,
+    ``M = max(0, max_j y_j)``, which cannot overflow; a closed window (``y_j = 0``) adds
+    exactly 0; one argument is returned unchanged (``F = y``).
+
+    Parameters
+    ----------
+    heights : list of casadi.SX, non-empty
+        ``y_j = B^j b^j(t) >= 0``, state units.
+    nu : float
+        1/state units.
+    """
+    if len(heights) == 1:
+        return heights[0]
+    top = ca.SX(0.0)
+    for y in heights:
+        top = ca.fmax(top, y)
+    floor = ca.exp(-nu * top)
+    total = floor
+    for y in heights:
+        total = total + (ca.exp(nu * (y - top)) - floor)
+    return top + ca.log(total) / nu
+
+
 def circumvent(design: TubeDesign, t) -> tuple:
-    """Holistic circumvent ``beta_L(t)``, ``beta_U(t)`` of eq. (9), SX vectors of length n."""
+    """Holistic circumvent ``beta_L(t)``, ``beta_U(t)`` of eq. (9), SX vectors of length n.
+
+    ``beta_L_i = X_i + F_nu(y)``, ``beta_U_i = X-bar_i - F_nu(y)``, ``y_j = B^j b^j(t)`` over
+    the circumvents on that bound (:func:`open_bump_sum`).
+    """
     lower, upper = [], []
     for i in range(design.dimension):
         for side, out, bound in ((LOWER, lower, design.state_lower[i]),
@@ -101,11 +156,9 @@ def circumvent(design: TubeDesign, t) -> tuple:
             if not members:
                 out.append(ca.SX(bound))
                 continue
-            sign = 1.0 if side == LOWER else -1.0
-            terms = [c.base + sign * c.height *
-                     bump(t, c.center, c.radius, design.circumvent_sharpness) for c in members]
-            out.append(smooth_max(terms, design.smoothness) if side == LOWER
-                       else smooth_min(terms, design.smoothness))
+            heights = [c.height * bump(t, c.center, c.radius, c.sharpness) for c in members]
+            total = open_bump_sum(heights, design.smoothness)
+            out.append(bound + total if side == LOWER else bound - total)
     return ca.vertcat(*lower), ca.vertcat(*upper)
 
 

@@ -30,6 +30,14 @@ STATUS_INVALID_INPUT = 2
 LOWER = "lower"
 UPPER = "upper"
 
+#: Profile of a reach-tube segment: the paper's eq. (4), ``s = tanh(tau / (1 - tau))``.
+TANH = "tanh"
+#: Profile of a reach-tube segment: the quintic smooth step
+#: ``sigma(tau) = tau^3 (10 - 15 tau + 6 tau^2)`` (value and first two derivatives
+#: continuous, zero slope and curvature at both ends).
+SMOOTHSTEP = "smoothstep"
+PROFILES = (TANH, SMOOTHSTEP)
+
 
 @dataclass(frozen=True)
 class Circumvent:
@@ -51,6 +59,10 @@ class Circumvent:
     base : float
         ``X_i`` (lower side) or ``X-bar_i`` (upper side), the state-space bound the
         circumvent departs from.
+    sharpness : float
+        ``k^j`` of eqs. (7)-(8), dimensionless, positive: the larger, the wider the bump's
+        shoulders (the bound moves more slowly and stays near its peak for less of the
+        window).
     """
 
     obstacle: int
@@ -60,6 +72,7 @@ class Circumvent:
     end: float
     height: float
     base: float
+    sharpness: float
 
     @property
     def center(self) -> float:
@@ -78,6 +91,65 @@ class Circumvent:
 
 
 @dataclass(frozen=True)
+class ReachSegment:
+    """One piece of the reachability tube ``rho`` (eq. (4) generalized to several pieces).
+
+    On ``[start, end]`` every bound moves from its ``*_from`` value to its ``*_to`` value by
+    the same scalar profile ``p(tau)`` in ``[0, 1]``, ``tau = (t - start) / (end - start)``:
+    ``rho = from + (to - from) p(tau)``; before ``start`` the bound is ``from``, after ``end``
+    it is ``to``. The paper's tube is one ``"tanh"`` segment from the initial box at
+    ``t = 0`` to the target box at ``t_c``.
+
+    Attributes
+    ----------
+    start, end : float
+        Seconds, ``start < end``.
+    lower_from, upper_from, lower_to, upper_to : tuple of float
+        The boxes at ``start`` and ``end``, state units, length ``n`` each.
+    profile : {"tanh", "smoothstep"}
+        ``"tanh"``: ``p = tanh(tau / (1 - tau))`` for ``tau < 1``, 1 after (eq. (4));
+        ``"smoothstep"``: ``p = tau^3 (10 - 15 tau + 6 tau^2)`` (value, first and second
+        derivatives continuous at both ends, where the slope is zero).
+    """
+
+    start: float
+    end: float
+    lower_from: tuple[float, ...]
+    upper_from: tuple[float, ...]
+    lower_to: tuple[float, ...]
+    upper_to: tuple[float, ...]
+    profile: str = TANH
+
+    @property
+    def duration(self) -> float:
+        """``end - start``, seconds."""
+        return self.end - self.start
+
+
+def paper_segments(initial_lower, initial_upper, target_lower, target_upper,
+                   prescribed_time: float) -> tuple[ReachSegment, ...]:
+    """The paper's reach tube (eq. (4)): one ``"tanh"`` segment from ``X-hat_0`` at 0 to ``T-hat`` at ``t_c``.
+
+    Parameters
+    ----------
+    initial_lower, initial_upper : sequence of float, length n
+        ``x(0) -+ d_0`` (eq. (2)).
+    target_lower, target_upper : sequence of float, length n
+        ``eta -+ d_T`` (eq. (3)).
+    prescribed_time : float
+        ``t_c``, seconds.
+
+    Returns
+    -------
+    tuple of ReachSegment
+        One segment.
+    """
+    return (ReachSegment(0.0, float(prescribed_time), tuple(initial_lower),
+                         tuple(initial_upper), tuple(target_lower), tuple(target_upper),
+                         TANH),)
+
+
+@dataclass(frozen=True)
 class TubeDesign:
     """All parameters of one spatiotemporal tube and its controller.
 
@@ -91,16 +163,15 @@ class TubeDesign:
         ``t_c``, seconds.
     state_lower, state_upper : tuple of float
         ``X`` and ``X-bar``, the state-space box.
-    initial_lower, initial_upper : tuple of float
-        The box ``X-hat_0`` of eq. (2): ``x(0) -+ d_0``.
-    target_lower, target_upper : tuple of float
-        The box ``T-hat`` of eq. (3): ``eta -+ d_T``.
+    segments : tuple of ReachSegment
+        The reachability tube ``rho``, in time order, contiguous (each starts where and
+        when the previous ends); its first box is ``X-hat_0`` of eq. (2), its last the
+        target box ``T-hat`` of eq. (3) (see :attr:`initial_lower`, :attr:`target_lower`).
     initial_state : tuple of float
         ``x(0)``.
     circumvents : tuple of Circumvent
-        In a deterministic order (by dimension, side, then obstacle index).
-    circumvent_sharpness : float
-        ``k^j`` of eqs. (7)-(8) (the same for every obstacle).
+        In a deterministic order (by dimension, side, then obstacle index); each carries
+        its own sharpness ``k^j``.
     smoothness : float
         ``nu`` of the smooth max/min, 1/state units.
     theta0, kappa, mu : float
@@ -115,13 +186,9 @@ class TubeDesign:
     prescribed_time: float
     state_lower: tuple[float, ...]
     state_upper: tuple[float, ...]
-    initial_lower: tuple[float, ...]
-    initial_upper: tuple[float, ...]
-    target_lower: tuple[float, ...]
-    target_upper: tuple[float, ...]
+    segments: tuple[ReachSegment, ...]
     initial_state: tuple[float, ...]
     circumvents: tuple[Circumvent, ...]
-    circumvent_sharpness: float
     smoothness: float
     theta0: float
     kappa: float
@@ -129,10 +196,43 @@ class TubeDesign:
     gain: float
     rate_hz: float
 
+    def __post_init__(self) -> None:
+        if not self.segments:
+            raise ValueError("a tube design needs at least one reach segment")
+        for a, b in zip(self.segments, self.segments[1:]):
+            if (b.start != a.end or b.lower_from != a.lower_to
+                    or b.upper_from != a.upper_to):
+                raise ValueError("reach segments must be contiguous in time and box")
+
     @property
     def dimension(self) -> int:
         """State dimension ``n``."""
         return len(self.state_lower)
+
+    @property
+    def initial_lower(self) -> tuple[float, ...]:
+        """Lower corner of ``X-hat_0`` (eq. (2)), the first box of the reach tube."""
+        return self.segments[0].lower_from
+
+    @property
+    def initial_upper(self) -> tuple[float, ...]:
+        """Upper corner of ``X-hat_0`` (eq. (2))."""
+        return self.segments[0].upper_from
+
+    @property
+    def target_lower(self) -> tuple[float, ...]:
+        """Lower corner of ``T-hat`` (eq. (3)), the last box of the reach tube."""
+        return self.segments[-1].lower_to
+
+    @property
+    def target_upper(self) -> tuple[float, ...]:
+        """Upper corner of ``T-hat`` (eq. (3))."""
+        return self.segments[-1].upper_to
+
+    @property
+    def reach_end(self) -> float:
+        """Time at which the reach tube arrives in the target box, seconds (``<= t_c``)."""
+        return self.segments[-1].end
 
     def circumvents_on(self, dimension: int, side: str) -> tuple[Circumvent, ...]:
         """The circumvents acting on one bound, in design order."""

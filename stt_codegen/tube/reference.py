@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from .parameters import E_MAX, GAMMA_D_MIN, LOWER, TubeDesign
+from .parameters import E_MAX, GAMMA_D_MIN, LOWER, SMOOTHSTEP, TANH, ReachSegment, TubeDesign
 
 Array = np.ndarray
 
@@ -59,35 +59,51 @@ def _rows(value, n_rows: int, width: int) -> Array:
     return np.broadcast_to(np.asarray(value, dtype=float), (n_rows, width))
 
 
-def tanh_progress(design: TubeDesign, t) -> tuple[Array, Array]:
-    """``s(t) = tanh(t / (t_c - t))`` of eq. (4) and ``ds/dt``; ``s = 1``, ``ds/dt = 0`` for ``t >= t_c``.
+def segment_progress(segment: ReachSegment, t) -> tuple[Array, Array]:
+    """Profile ``p(tau)`` of one reach segment and ``dp/dt``; 0 before ``start``, 1 from ``end`` on.
+
+    ``"tanh"``: ``p = tanh((t - start) / (end - t))`` (eq. (4), ``tau / (1 - tau)`` written
+    so that a segment starting at 0 evaluates exactly the paper's ``t / (t_c - t)``);
+    ``"smoothstep"``: ``p = tau^3 (10 - 15 tau + 6 tau^2)``,
+    ``tau = (t - start) / (end - start)``.
 
     Parameters
     ----------
-    design : TubeDesign
+    segment : ReachSegment
     t : array_like, shape (N,)
         Time, seconds.
 
     Returns
     -------
-    s, s_dot : ndarray, shape (N,)
+    p, p_dot : ndarray, shape (N,)
+        Dimensionless and 1/s.
     """
     t = _time(t)
-    t_c = design.prescribed_time
-    before = t < t_c
-    gap = np.where(before, t_c - t, 1.0)
-    arg = np.where(before, t / gap, 0.0)
-    s = np.where(before, tanh(arg), 1.0)
-    # sech^2(a) = 4 exp(-2a) / (1 + exp(-2a))^2 for a >= 0, written without cancellation.
-    a_abs = np.abs(arg)
-    q = exp(-2.0 * a_abs)
-    sech2 = 4.0 * q / (1.0 + q) ** 2
-    s_dot = np.where(before, sech2 * t_c / gap**2, 0.0)
-    return s, s_dot
+    start, end = segment.start, segment.end
+    active = (t >= start) & (t < end)
+    if segment.profile == TANH:
+        gap = np.where(active, end - t, 1.0)
+        arg = np.where(active, (t - start) / gap, 0.0)
+        p = np.where(t >= end, 1.0, np.where(active, tanh(arg), 0.0))
+        # sech^2(a) = 4 exp(-2a) / (1 + exp(-2a))^2 for a >= 0, written without cancellation.
+        q = exp(-2.0 * np.abs(arg))
+        sech2 = 4.0 * q / (1.0 + q) ** 2
+        p_dot = np.where(active, sech2 * (end - start) / gap**2, 0.0)
+        return p, p_dot
+    if segment.profile != SMOOTHSTEP:
+        raise ValueError(f"unknown reach segment profile {segment.profile!r}")
+    duration = end - start
+    tau = np.clip((t - start) / duration, 0.0, 1.0)
+    p = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+    p_dot = 30.0 * tau**2 * (1.0 - tau) ** 2 / duration
+    return p, p_dot
 
 
 def reach_tube(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
-    """Reachability tube ``rho_L``, ``rho_U`` of eq. (4) and their time derivatives.
+    """Reachability tube ``rho_L``, ``rho_U`` (eq. (4), piecewise) and their time derivatives.
+
+    On segment ``k`` (the first whose ``end`` is after ``t``; the last one after every
+    end) ``rho = from + (to - from) p(tau)``, see :func:`segment_progress`.
 
     Parameters
     ----------
@@ -99,12 +115,23 @@ def reach_tube(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
     rho_L, rho_U, rho_L_dot, rho_U_dot : ndarray, shape (N, n)
         State units and state units per second.
     """
-    s, s_dot = tanh_progress(design, t)
-    x0_l, x0_u = np.array(design.initial_lower), np.array(design.initial_upper)
-    t_l, t_u = np.array(design.target_lower), np.array(design.target_upper)
-    rho_l = (t_l - x0_l) * s[:, None] + x0_l
-    rho_u = (t_u - x0_u) * s[:, None] + x0_u
-    return rho_l, rho_u, (t_l - x0_l) * s_dot[:, None], (t_u - x0_u) * s_dot[:, None]
+    t = _time(t)
+    segments = design.segments
+    ends = np.array([seg.end for seg in segments])
+    which = np.minimum(np.searchsorted(ends, t, side="right"), len(segments) - 1)
+    n = design.dimension
+    out = [np.zeros((t.size, n)) for _ in range(4)]
+    for k, seg in enumerate(segments):
+        here = which == k
+        if not here.any():
+            continue
+        s, s_dot = segment_progress(seg, t[here])
+        for pair, (a, b) in enumerate(((seg.lower_from, seg.lower_to),
+                                       (seg.upper_from, seg.upper_to))):
+            a, b = np.array(a), np.array(b)
+            out[pair][here] = (b - a) * s[:, None] + a
+            out[pair + 2][here] = (b - a) * s_dot[:, None]
+    return out[0], out[1], out[2], out[3]
 
 
 def bump(t, center: float, radius: float, sharpness: float) -> tuple[Array, Array]:
@@ -132,7 +159,7 @@ def bump(t, center: float, radius: float, sharpness: float) -> tuple[Array, Arra
 
 
 def smooth_max(values: Array, nu: float, axis: int = -1) -> tuple[Array, Array]:
-    """The paper's smooth max ``(1/nu) ln(sum_j exp(nu a_j))`` and its weights.
+    """The paper's smooth max ``(1/nu) ln(sum_j exp(nu a_j))`` (eq. (10)) and its weights.
 
     Evaluated without overflow: ``max(a, b) + log1p(exp(-nu |a - b|)) / nu`` for two
     values, ``M + ln(sum_j exp(nu (a_j - M))) / nu`` with ``M = max_j a_j`` for more.
@@ -161,10 +188,47 @@ def smooth_max(values: Array, nu: float, axis: int = -1) -> tuple[Array, Array]:
     return value, np.moveaxis(weights, -1, axis)
 
 
+def open_bump_sum(heights: Array, nu: float) -> tuple[Array, Array]:
+    """``F_nu(y) = (1/nu) ln(1 + sum_j (exp(nu y_j) - 1))``, the combination of eq. (9).
+
+    Evaluated without overflow as
+    ``M + (1/nu) ln(exp(-nu M) + sum_j (exp(nu (y_j - M)) - exp(-nu M)))``,
+    ``M = max(0, max_j y_j)``; with one argument ``F = y`` exactly. A closed window
+    (``y_j = 0``) contributes exactly 0. ``F`` is non-decreasing and C-infinity in every
+    ``y_j``, ``F = 0`` when every ``y_j = 0`` and ``max(0, y) <= F <= max(0, y) + ln(m)/nu``.
+
+    Parameters
+    ----------
+    heights : ndarray, shape (..., m)
+        ``y_j = B^j b^j(t) >= 0``, state units, ``m >= 1``.
+    nu : float
+        ``nu``, 1/state units.
+
+    Returns
+    -------
+    value : ndarray, shape (...)
+    weights : ndarray, shape (..., m)
+        ``dF / dy_j = exp(nu (y_j - F))``, in ``(0, 1]``.
+    """
+    y = np.asarray(heights, dtype=float)
+    if y.shape[-1] == 1:
+        value = y[..., 0]
+    else:
+        top = np.maximum(y.max(axis=-1), 0.0)
+        floor = exp(-nu * top)
+        total = floor.copy()
+        for j in range(y.shape[-1]):
+            total = total + (exp(nu * (y[..., j] - top)) - floor)
+        value = top + log(total) / nu
+    return value, exp(nu * (y - value[..., None]))
+
+
 def circumvent_from_bumps(design: TubeDesign, bumps: list,
                           count: int) -> tuple[Array, Array, list]:
     """Eq. (9) from given bump values: ``beta_L``, ``beta_U`` and each circumvent's weight.
 
+    ``beta_L_i = X_i + F_nu(y)`` and ``beta_U_i = X-bar_i - F_nu(y)`` with
+    ``y_j = B^j b^j`` over the circumvents on that bound (:func:`open_bump_sum`), so
     ``beta_L`` is non-decreasing and ``beta_U`` non-increasing in every bump value.
 
     Parameters
@@ -179,7 +243,7 @@ def circumvent_from_bumps(design: TubeDesign, bumps: list,
     -------
     beta_L, beta_U : ndarray, shape (N, n)
     weights : list of ndarray, shape (N,) each
-        ``d beta / d (bound of circumvent j)``, aligned with ``design.circumvents``.
+        ``|d beta / d (B^j b^j)|``, aligned with ``design.circumvents``.
     """
     weights: list = [None] * len(design.circumvents)
     out = []
@@ -192,9 +256,10 @@ def circumvent_from_bumps(design: TubeDesign, bumps: list,
             if not members:
                 continue
             c = design.circumvents
-            terms = [sign * (c[j].base + sign * c[j].height * bumps[j]) for j in members]
-            v, w = smooth_max(np.stack(terms, axis=-1), design.smoothness)
-            value[:, i] = sign * v
+            y = np.stack([c[j].height * np.asarray(bumps[j], dtype=float)
+                          for j in members], axis=-1)
+            f, w = open_bump_sum(y, design.smoothness)
+            value[:, i] = bounds[i] + sign * f
             for k, j in enumerate(members):
                 weights[j] = w[..., k]
         out.append(value)
@@ -204,8 +269,8 @@ def circumvent_from_bumps(design: TubeDesign, bumps: list,
 def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
     """Holistic circumvent function ``beta_L``, ``beta_U`` of eq. (9) and derivatives.
 
-    Bumps on the same bound are combined by the smooth max (lower) or min (upper);
-    a bound with no bump is the state-space bound.
+    Bumps on the same bound are combined by :func:`open_bump_sum`; a bound with no bump
+    is the state-space bound.
 
     Returns
     -------
@@ -213,8 +278,7 @@ def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
     """
     t = _time(t)
     n = design.dimension
-    pairs = [bump(t, c.center, c.radius, design.circumvent_sharpness)
-             for c in design.circumvents]
+    pairs = [bump(t, c.center, c.radius, c.sharpness) for c in design.circumvents]
     beta_l, beta_u, weights = circumvent_from_bumps(design, [b for b, _ in pairs], t.size)
     rate_l, rate_u = np.zeros((t.size, n)), np.zeros((t.size, n))
     for c, (_, b_dot), w in zip(design.circumvents, pairs, weights):

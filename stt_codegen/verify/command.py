@@ -18,7 +18,7 @@ from ..design.certificate import circumvent_range
 from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
 from ..spec.loader import PLANT_MODELS, Spec, load_spec
-from ..tube.parameters import TubeDesign
+from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
 from ..design.samples import TubeSamples, sample_tube
 from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_omnidirectional, assumption2_single_integrator
@@ -75,17 +75,22 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None,
     model = plant or spec.plant_model
     s = samples if samples is not None else sample_tube(design)
     n = design.dimension
-    t_c = design.prescribed_time
-    reach = sorted({(a, b, t_c) for a, b in
-                    zip(design.initial_lower + design.initial_upper,
-                        design.target_lower + design.target_upper) if a != b})
-    bumps = [(design.circumvent_sharpness, c.radius, c.height) for c in design.circumvents]
+    reach = sorted({(a, b, seg.duration) for seg in design.segments if seg.profile == TANH
+                    for a, b in zip(seg.lower_from + seg.upper_from,
+                                    seg.lower_to + seg.upper_to) if a != b})
+    bumps = [(c.sharpness, c.radius, c.height) for c in design.circumvents]
     symbolic = symbolic_checks(min(n, 3))
     reach_checks = [reach_rate_bound(*p) for p in reach]
     bump_checks = [bump_rate_bound(*p) for p in bumps]
     checks = [c for c in symbolic if c.name.startswith("lemma")] + reach_checks + bump_checks
     checks += [c for c in symbolic if not c.name.startswith("lemma")]
-    rho_rate = max((c.data.get("bound", 0.0) for c in reach_checks), default=0.0)
+    # smooth-step segments: sup |d/dt tau^3 (10 - 15 tau + 6 tau^2)| = 30/16 per duration
+    # (at tau = 1/2, where 30 tau^2 (1 - tau)^2 is largest)
+    smooth_rates = [abs(b - a) * 1.875 / seg.duration for seg in design.segments
+                    if seg.profile == SMOOTHSTEP
+                    for a, b in zip(seg.lower_from + seg.upper_from, seg.lower_to + seg.upper_to)]
+    rho_rate = max([c.data.get("bound", 0.0) for c in reach_checks] + smooth_rates,
+                   default=0.0)
     bump_rate = {p: chk.data.get("bound", np.inf) for p, chk in zip(bumps, bump_checks)}
 
     if model == "omnidirectional":
@@ -98,7 +103,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None,
     for c in range(2 * n):
         i, side = c % n, _SIDES[c // n]
         other = "upper" if side == "L" else "lower"
-        beta_rate = sum(bump_rate[(design.circumvent_sharpness, b.radius, b.height)]
+        beta_rate = sum(bump_rate[(b.sharpness, b.radius, b.height)]
                         for b in design.circumvents_on(i, other))
         label = f"x{i + 1},{side}"
         for check in adaptive_law_checks(float(psi_min[c]), design.theta0, design.kappa,
