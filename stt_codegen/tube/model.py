@@ -33,6 +33,12 @@ FUNCTION_NAMES = ("reach_tube", "circumvent", "tube", "adaptive_law", "error_tra
                   "control", "alpha_step", "controller_step")
 
 
+#: Bound on the argument of ``exp`` where it could be large (the smooth max's correction
+#: and the trigger of (11)): ``exp(+-80)`` is a normal number in float32 and float64, so no
+#: step raises an overflow or underflow flag or sets ``errno``.
+EXP_ARGUMENT_BOUND = 80.0
+
+
 def smooth_max(values: list, nu: float):
     """Smooth maximum of SX scalars, the paper's ``max~`` (notation, section II).
 
@@ -46,13 +52,16 @@ def smooth_max(values: list, nu: float):
     -------
     casadi.SX
         ``(1/nu) ln(sum_j exp(nu a_j))`` in a form that does not overflow; a single value
-        is returned unchanged.
+        is returned unchanged. With two values ``max(a, b) + log1p(exp(-nu |a - b|)) / nu``,
+        the exponent clamped at ``-80`` (:data:`EXP_ARGUMENT_BOUND`: no underflow; the
+        correction is then below ``4e-35 / nu``, see :func:`smooth_max_test`).
     """
     if len(values) == 1:
         return values[0]
     if len(values) == 2:
         a, b = values
-        return ca.fmax(a, b) + ca.log1p(ca.exp(-nu * ca.fabs(a - b))) / nu
+        d = ca.fmax(-nu * ca.fabs(a - b), -EXP_ARGUMENT_BOUND)
+        return ca.fmax(a, b) + ca.log1p(ca.exp(d)) / nu
     top = values[0]
     for v in values[1:]:
         top = ca.fmax(top, v)
@@ -65,6 +74,20 @@ def smooth_max(values: list, nu: float):
 def smooth_min(values: list, nu: float):
     """Smooth minimum ``min~(a, b) = -max~(-a, -b)``; see :func:`smooth_max`."""
     return -smooth_max([-v for v in values], nu)
+
+
+def smooth_max_test(a, b, nu: float) -> tuple:
+    """``(max(a, b), needed)``: whether :func:`smooth_max` of two values can differ from the max.
+
+    ``needed`` is 0 when ``nu |a - b| >= 80`` and ``|max| >= 2^54 e^-80 / nu``: the
+    correction ``log1p(e^-80) / nu < e^-80 / nu <= |max| 2^-54`` is then below half an ulp of
+    the max in float64 and float32, so ``smooth_max([a, b]) == max(a, b)`` exactly, and the
+    generated code skips its ``exp`` and ``log1p``.
+    """
+    top = ca.fmax(a, b)
+    sharp = ca.logic_and(nu * ca.fabs(a - b) >= EXP_ARGUMENT_BOUND,
+                         ca.fabs(top) >= 2.0 ** 54 * 1.81e-35 / nu)
+    return top, ca.logic_not(sharp)
 
 
 def segment_progress(segment: ReachSegment, t):
@@ -170,8 +193,15 @@ def conflict_distance(design: TubeDesign, t):
 
 
 def trigger(design: TubeDesign, psi):
-    """``theta = theta0 (1 - tanh(psi - mu))`` of eq. (11) (sign approximated by tanh)."""
-    return design.theta0 * (1.0 - ca.tanh(psi - design.mu))
+    """``theta = theta0 (1 - tanh(psi - mu))`` of eq. (11) (sign approximated by tanh).
+
+    Computed as ``2 theta0 / (1 + exp(y))``, ``y = 2 (psi - mu)`` clamped to
+    ``[-80, 80]`` (:data:`EXP_ARGUMENT_BOUND`): the same function (``1 - tanh(y/2) =
+    2 / (1 + e^y)``), one ``exp`` instead of ``tanh``, exact to the last bit or below
+    ``4e-35 theta0`` where clamped.
+    """
+    y = ca.fmin(ca.fmax(2.0 * (psi - design.mu), -EXP_ARGUMENT_BOUND), EXP_ARGUMENT_BOUND)
+    return (2.0 * design.theta0) / (1.0 + ca.exp(y))
 
 
 def adaptive_law(design: TubeDesign, t, alpha):
@@ -192,6 +222,44 @@ def adaptive_tube(design: TubeDesign, t, alpha) -> tuple:
     return gamma_l, gamma_u
 
 
+def newton_start(alpha, psi, theta, dt, kappa: float) -> tuple:
+    """Quantities of the implicit step and a start that needs no root: ``(a0, c, A, root)``.
+
+    ``c = 1 + kappa dt``, ``A = dt theta``, ``a0 = alpha / c``. ``root`` is 1 when the
+    start of :func:`newton_root_start` is needed, i.e. unless ``z0 = psi + a0 > 0`` and
+    ``2 c z0^3 >= A``: then ``a0 >= -psi + (A / 2c)^(1/3) >= -psi + delta``, so ``a0`` is the
+    start :func:`newton_root_start` would return, without its cube and square roots.
+    Element-wise on SX of any shape.
+    """
+    c = 1.0 + kappa * dt
+    a_coef = dt * theta
+    a0 = alpha / c
+    z0 = psi + a0
+    fast = ca.logic_and(z0 > 0.0, 2.0 * c * (z0 * z0 * z0) >= a_coef)
+    return a0, c, a_coef, ca.logic_not(fast)
+
+
+def newton_root_start(alpha, psi, c, a_coef):
+    """``max(alpha / c, -psi + delta)``, ``delta = min((A / 2c)^(1/3), sqrt(A / 2Q))``,
+    ``Q = max(-c psi - alpha, 0)``: a start left of the root (``g <= 0``, proof in
+    docs/codegen.md), used when ``alpha / c`` is too close to (or beyond) the pole."""
+    q = ca.fmax(-c * psi - alpha, 0.0)
+    delta = ca.fmin((a_coef / (2.0 * c)) ** (1.0 / 3.0),
+                    ca.sqrt(a_coef / (2.0 * ca.fmax(q, NEWTON_TINY))))
+    return ca.fmax(alpha / c, -psi + delta)
+
+
+def newton_iteration(a, alpha, psi, c, a_coef):
+    """One Newton iteration on ``g(a) = c a - alpha - A / (psi + a)^2``, one division.
+
+    ``a - g / g'`` with ``g' = c + 2 A / z^3``, ``z = psi + a``, multiplied through by ``z^3``:
+    ``a - z (z^2 (c a - alpha) - A) / (c z^3 + 2 A)``.
+    """
+    z = psi + a
+    z2 = z * z
+    return a - z * (z2 * (c * a - alpha) - a_coef) / (c * (z2 * z) + 2.0 * a_coef)
+
+
 def implicit_alpha_update(alpha, psi, theta, dt, kappa: float,
                           iterations: int = NEWTON_ITERATIONS):
     """Backward-Euler step of (11): solve ``a = alpha + dt (theta/(psi+a)^2 - kappa a)``.
@@ -199,10 +267,11 @@ def implicit_alpha_update(alpha, psi, theta, dt, kappa: float,
     Component-wise (the Newton system is diagonal). The residual
     ``g(a) = (1 + kappa dt) a - alpha - dt theta / (psi + a)^2`` is increasing and concave
     on ``(-psi, inf)``, so Newton's method started at a point where ``g <= 0`` increases
-    monotonically to the unique root without leaving the domain. The start
-    ``max(alpha / c, -psi + delta)``, ``c = 1 + kappa dt``, with
-    ``delta = min((A / 2c)^(1/3), sqrt(A / 2Q))``, ``A = dt theta``,
-    ``Q = max(-c psi - alpha, 0)``, has ``g <= 0`` (proof in the README).
+    monotonically to the unique root without leaving the domain. The start is
+    ``alpha / c`` (:func:`newton_start`) when it is far enough from the pole, else
+    :func:`newton_root_start`; then ``iterations`` of :func:`newton_iteration`. The
+    generated code runs the same three pieces (the root start only when needed, the
+    iterations in a loop), so it computes exactly this.
 
     Parameters
     ----------
@@ -217,17 +286,10 @@ def implicit_alpha_update(alpha, psi, theta, dt, kappa: float,
     -------
     casadi.SX, shape (m, 1)
     """
-    c = 1.0 + kappa * dt
-    a_coef = dt * theta
-    q = ca.fmax(-c * psi - alpha, 0.0)
-    delta = ca.fmin((a_coef / (2.0 * c)) ** (1.0 / 3.0),
-                    ca.sqrt(a_coef / (2.0 * ca.fmax(q, NEWTON_TINY))))
-    a = ca.fmax(alpha / c, -psi + delta)
+    a0, c, a_coef, root = newton_start(alpha, psi, theta, dt, kappa)
+    a = ca.if_else(root, newton_root_start(alpha, psi, c, a_coef), a0)
     for _ in range(iterations):
-        z = psi + a
-        residual = c * a - alpha - a_coef / z**2
-        slope = c + 2.0 * a_coef / z**3
-        a = a - residual / slope
+        a = newton_iteration(a, alpha, psi, c, a_coef)
     return a
 
 
