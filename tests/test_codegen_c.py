@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 import subprocess
 
 import numpy as np
@@ -164,3 +165,27 @@ def test_invalid_inputs_and_outside_tube(precision, root):
     assert step(lib.ptr(mid), t, dt, lib.ptr(a), None, lib.ptr(nxt)) == 2
     gl, gu = lib.arr(None, n), lib.arr(None, n)
     assert lib.f["tube"](t, lib.ptr(a), lib.ptr(gl), lib.ptr(gu), None, None) == 0
+
+
+@pytest.mark.parametrize("precision", ["double", "single"])
+def test_fast_math_refused_with_a_clear_error(precision, tmp_path):
+    spec, _, _ = designed("omnirobot-s1")
+    folder = write(tmp_path, files_of("omnirobot-s1", precision))
+    for cc in COMPILERS:
+        proc = subprocess.run([cc, "-std=c99", "-Ofast", "-c", f"{spec.c_name}.c"], cwd=folder,
+                              capture_output=True, text=True)
+        assert proc.returncode != 0 and "must not be compiled with -ffast-math" in proc.stderr, (
+            cc, proc.stderr[-1000:])
+
+
+@pytest.mark.skipif(shutil.which("arm-none-eabi-gcc") is None,
+                    reason="arm-none-eabi-gcc missing: install the Debian package gcc-arm-none-eabi")
+@pytest.mark.parametrize("precision", ["double", "single"])
+def test_strict_build_for_cortex_m4(precision, tmp_path):
+    spec, _, _ = designed("omnirobot-s1")
+    folder = write(tmp_path, files_of("omnirobot-s1", precision))
+    proc = subprocess.run(["arm-none-eabi-gcc", *flags(precision), "-mcpu=cortex-m4",
+                           "-mfpu=fpv4-sp-d16", "-mfloat-abi=hard", "-mthumb", "-c",
+                           f"{spec.c_name}.c", f"{spec.c_name}_selftest.c"],
+                          cwd=folder, capture_output=True, text=True)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr

@@ -19,7 +19,14 @@
 
 /* CasADi Function 'gamma_candidates': 85 instructions. */
 static void body_gamma_candidates(const omnirobot_s1_real* t, const omnirobot_s1_real* alpha, omnirobot_s1_real* rho_L_minus_alpha, omnirobot_s1_real* beta_L, omnirobot_s1_real* rho_U_plus_alpha, omnirobot_s1_real* beta_U) {
-  omnirobot_s1_real w0, w1, w2, w3, w4, w5, w6, w7;
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
   w0 = 4.5f;
   w1 = t[0];
   w2 = 9.0f;
@@ -109,7 +116,11 @@ static void body_gamma_candidates(const omnirobot_s1_real* t, const omnirobot_s1
 
 /* CasADi Function 'smooth_max_test': 16 instructions. */
 static void body_smooth_max_test(const omnirobot_s1_real* a, const omnirobot_s1_real* b, omnirobot_s1_real* max, omnirobot_s1_real* needed) {
-  omnirobot_s1_real w0, w1, w2, w3, w4;
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
   w0 = a[0];
   w1 = b[0];
   w2 = (w1 > w0) ? w1 : w0;
@@ -130,7 +141,10 @@ static void body_smooth_max_test(const omnirobot_s1_real* a, const omnirobot_s1_
 
 /* CasADi Function 'smooth_max': 15 instructions. */
 static void body_smooth_max(const omnirobot_s1_real* a, const omnirobot_s1_real* b, omnirobot_s1_real* max) {
-  omnirobot_s1_real w0, w1, w2, w3;
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
   w0 = a[0];
   w1 = b[0];
   w2 = (w1 > w0) ? w1 : w0;
@@ -150,7 +164,11 @@ static void body_smooth_max(const omnirobot_s1_real* a, const omnirobot_s1_real*
 
 /* CasADi Function 'smooth_min_test': 19 instructions. */
 static void body_smooth_min_test(const omnirobot_s1_real* a, const omnirobot_s1_real* b, omnirobot_s1_real* min, omnirobot_s1_real* needed) {
-  omnirobot_s1_real w0, w1, w2, w3, w4;
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
   w0 = a[0];
   w1 = -w0;
   w2 = b[0];
@@ -174,7 +192,10 @@ static void body_smooth_min_test(const omnirobot_s1_real* a, const omnirobot_s1_
 
 /* CasADi Function 'smooth_min': 18 instructions. */
 static void body_smooth_min(const omnirobot_s1_real* a, const omnirobot_s1_real* b, omnirobot_s1_real* min) {
-  omnirobot_s1_real w0, w1, w2, w3;
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
   w0 = a[0];
   w1 = -w0;
   w2 = b[0];
@@ -197,9 +218,37 @@ static void body_smooth_min(const omnirobot_s1_real* a, const omnirobot_s1_real*
 
 /* CasADi Function 'gamma_rates': 471 instructions. */
 static void body_gamma_rates(const omnirobot_s1_real* t, const omnirobot_s1_real* alpha, omnirobot_s1_real* gamma_L_dot, omnirobot_s1_real* gamma_U_dot) {
-  omnirobot_s1_real w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11;
-  omnirobot_s1_real w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23;
-  omnirobot_s1_real w24, w25, w26, w27, w28, w29, w30;
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  omnirobot_s1_real w8;
+  omnirobot_s1_real w9;
+  omnirobot_s1_real w10;
+  omnirobot_s1_real w11;
+  omnirobot_s1_real w12;
+  omnirobot_s1_real w13;
+  omnirobot_s1_real w14;
+  omnirobot_s1_real w15;
+  omnirobot_s1_real w16;
+  omnirobot_s1_real w17;
+  omnirobot_s1_real w18;
+  omnirobot_s1_real w19;
+  omnirobot_s1_real w20;
+  omnirobot_s1_real w21;
+  omnirobot_s1_real w22;
+  omnirobot_s1_real w23;
+  omnirobot_s1_real w24;
+  omnirobot_s1_real w25;
+  omnirobot_s1_real w26;
+  omnirobot_s1_real w27;
+  omnirobot_s1_real w28;
+  omnirobot_s1_real w29;
+  omnirobot_s1_real w30;
   w0 = t[0];
   w1 = 9.0f;
   w2 = (w0 < w1) ? 1.0f : 0.0f;
@@ -675,8 +724,20 @@ static void body_gamma_rates(const omnirobot_s1_real* t, const omnirobot_s1_real
 
 /* CasADi Function 'law': 89 instructions. */
 static void body_law(const omnirobot_s1_real* x, const omnirobot_s1_real* gamma_L, const omnirobot_s1_real* gamma_U, omnirobot_s1_real* u, omnirobot_s1_real* inside) {
-  omnirobot_s1_real w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11;
-  omnirobot_s1_real w12, w13;
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  omnirobot_s1_real w8;
+  omnirobot_s1_real w9;
+  omnirobot_s1_real w10;
+  omnirobot_s1_real w11;
+  omnirobot_s1_real w12;
+  omnirobot_s1_real w13;
   w0 = -0.18168809110361742f;
   w1 = 4.0f;
   w2 = gamma_U[0];
@@ -770,7 +831,17 @@ static void body_law(const omnirobot_s1_real* x, const omnirobot_s1_real* gamma_
 
 /* CasADi Function 'alpha_conflict': 118 instructions. */
 static void body_alpha_conflict(const omnirobot_s1_real* t, const omnirobot_s1_real* dt, omnirobot_s1_real* psi, omnirobot_s1_real* theta) {
-  omnirobot_s1_real w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10;
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  omnirobot_s1_real w8;
+  omnirobot_s1_real w9;
+  omnirobot_s1_real w10;
   w0 = 5.0f;
   w1 = 4.5f;
   w2 = t[0];
@@ -893,7 +964,11 @@ static void body_alpha_conflict(const omnirobot_s1_real* t, const omnirobot_s1_r
 
 /* CasADi Function 'newton_start': 24 instructions. */
 static void body_newton_start(const omnirobot_s1_real* alpha, const omnirobot_s1_real* psi, const omnirobot_s1_real* theta, const omnirobot_s1_real* dt, omnirobot_s1_real* a0, omnirobot_s1_real* c, omnirobot_s1_real* A, omnirobot_s1_real* root) {
-  omnirobot_s1_real w0, w1, w2, w3, w4;
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
   w0 = alpha[0];
   w1 = 1.0f;
   w2 = 5.0f;
@@ -922,7 +997,12 @@ static void body_newton_start(const omnirobot_s1_real* alpha, const omnirobot_s1
 
 /* CasADi Function 'newton_root_start': 23 instructions. */
 static void body_newton_root_start(const omnirobot_s1_real* alpha, const omnirobot_s1_real* psi, const omnirobot_s1_real* c, const omnirobot_s1_real* A, omnirobot_s1_real* a0) {
-  omnirobot_s1_real w0, w1, w2, w3, w4, w5;
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
   w0 = alpha[0];
   w1 = c[0];
   w2 = w0 / w1;
@@ -950,7 +1030,12 @@ static void body_newton_root_start(const omnirobot_s1_real* alpha, const omnirob
 
 /* CasADi Function 'newton_iteration': 19 instructions. */
 static void body_newton_iteration(const omnirobot_s1_real* a, const omnirobot_s1_real* alpha, const omnirobot_s1_real* psi, const omnirobot_s1_real* c, const omnirobot_s1_real* A, omnirobot_s1_real* a_next) {
-  omnirobot_s1_real w0, w1, w2, w3, w4, w5;
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
   w0 = a[0];
   w1 = psi[0];
   w1 = w1 + w0;
@@ -975,7 +1060,8 @@ static void body_newton_iteration(const omnirobot_s1_real* a, const omnirobot_s1
 /* ----------------------------------------------------------------- typed API */
 
 static int omnirobot_s1_finite(const omnirobot_s1_real* v, int count) {
-  int i, ok = 1;
+  int i;
+  int ok = 1;
   for (i = 0; i < count; ++i) {
     if (isfinite(v[i]) == 0) {
       ok = 0;
@@ -986,7 +1072,8 @@ static int omnirobot_s1_finite(const omnirobot_s1_real* v, int count) {
 
 /* alpha in the domain of the adaptive law: every entry finite, in [0, ALPHA_MAX]. */
 static int omnirobot_s1_alpha_valid(const omnirobot_s1_real* a) {
-  int i, ok = 1;
+  int i;
+  int ok = 1;
   for (i = 0; i < OMNIROBOT_S1_N_ALPHA; ++i) {
     if (!((a[i] >= 0.0f) && (a[i] <= OMNIROBOT_S1_ALPHA_MAX))) {
       ok = 0;
@@ -997,12 +1084,20 @@ static int omnirobot_s1_alpha_valid(const omnirobot_s1_real* a) {
 
 /* t in its domain: finite, t >= 0. */
 static int omnirobot_s1_time_valid(omnirobot_s1_real t) {
-  return ((isfinite(t) != 0) && (t >= 0.0f)) ? 1 : 0;
+  int ok = 0;
+  if ((isfinite(t) != 0) && (t >= 0.0f)) {
+    ok = 1;
+  }
+  return ok;
 }
 
 /* dt in its domain: DT_MIN <= dt <= DT_MAX. */
 static int omnirobot_s1_dt_valid(omnirobot_s1_real dt) {
-  return ((dt >= OMNIROBOT_S1_DT_MIN) && (dt <= OMNIROBOT_S1_DT_MAX)) ? 1 : 0;
+  int ok = 0;
+  if ((dt >= OMNIROBOT_S1_DT_MIN) && (dt <= OMNIROBOT_S1_DT_MAX)) {
+    ok = 1;
+  }
+  return ok;
 }
 
 static void omnirobot_s1_copy(const omnirobot_s1_real* from, omnirobot_s1_real* to, int count) {
@@ -1021,8 +1116,8 @@ static void omnirobot_s1_keep_alpha(const omnirobot_s1_real* from, omnirobot_s1_
 }
 
 static void omnirobot_s1_zero(omnirobot_s1_real* v, int count) {
-  int i;
   if (v != NULL) {
+    int i;
     for (i = 0; i < count; ++i) {
       v[i] = 0.0f;
     }
@@ -1033,7 +1128,10 @@ static void omnirobot_s1_zero(omnirobot_s1_real* v, int count) {
    change the max/min */
 static void omnirobot_s1_gamma(omnirobot_s1_real t, const omnirobot_s1_real* a, omnirobot_s1_real* g_l,
     omnirobot_s1_real* g_u) {
-  omnirobot_s1_real lower[OMNIROBOT_S1_N], beta_l[OMNIROBOT_S1_N], upper[OMNIROBOT_S1_N], beta_u[OMNIROBOT_S1_N];
+  omnirobot_s1_real lower[OMNIROBOT_S1_N];
+  omnirobot_s1_real beta_l[OMNIROBOT_S1_N];
+  omnirobot_s1_real upper[OMNIROBOT_S1_N];
+  omnirobot_s1_real beta_u[OMNIROBOT_S1_N];
   omnirobot_s1_real needed;
   int i;
   body_gamma_candidates(&t, a, lower, beta_l, upper, beta_u);
@@ -1052,12 +1150,18 @@ static void omnirobot_s1_gamma(omnirobot_s1_real t, const omnirobot_s1_real* a, 
 int omnirobot_s1_tube(omnirobot_s1_real t, const omnirobot_s1_real alpha[OMNIROBOT_S1_N_ALPHA],
     omnirobot_s1_real gamma_L[OMNIROBOT_S1_N], omnirobot_s1_real gamma_U[OMNIROBOT_S1_N],
     omnirobot_s1_real gamma_L_dot[OMNIROBOT_S1_N], omnirobot_s1_real gamma_U_dot[OMNIROBOT_S1_N]) {
-  omnirobot_s1_real a[OMNIROBOT_S1_N_ALPHA], g_l[OMNIROBOT_S1_N], g_u[OMNIROBOT_S1_N];
-  omnirobot_s1_real g_l_dot[OMNIROBOT_S1_N], g_u_dot[OMNIROBOT_S1_N];
   int status = OMNIROBOT_S1_STATUS_INVALID_INPUT;
-  int rates = ((gamma_L_dot != NULL) || (gamma_U_dot != NULL)) ? 1 : 0;
   if ((gamma_L != NULL) && (gamma_U != NULL)) {
+    omnirobot_s1_real g_l[OMNIROBOT_S1_N];
+    omnirobot_s1_real g_u[OMNIROBOT_S1_N];
+    omnirobot_s1_real g_l_dot[OMNIROBOT_S1_N];
+    omnirobot_s1_real g_u_dot[OMNIROBOT_S1_N];
+    int rates = 0;
+    if ((gamma_L_dot != NULL) || (gamma_U_dot != NULL)) {
+      rates = 1;
+    }
     if ((alpha != NULL) && (omnirobot_s1_time_valid(t) != 0) && (omnirobot_s1_alpha_valid(alpha) != 0)) {
+      omnirobot_s1_real a[OMNIROBOT_S1_N_ALPHA];
       omnirobot_s1_copy(alpha, a, OMNIROBOT_S1_N_ALPHA);
       omnirobot_s1_gamma(t, a, g_l, g_u);
       if (rates != 0) {
@@ -1094,7 +1198,9 @@ int omnirobot_s1_tube(omnirobot_s1_real t, const omnirobot_s1_real alpha[OMNIROB
    INVALID_INPUT when u is not finite. */
 static int omnirobot_s1_law(const omnirobot_s1_real* x, omnirobot_s1_real t, const omnirobot_s1_real* a,
     omnirobot_s1_real* u) {
-  omnirobot_s1_real g_l[OMNIROBOT_S1_N], g_u[OMNIROBOT_S1_N], inside;
+  omnirobot_s1_real g_l[OMNIROBOT_S1_N];
+  omnirobot_s1_real g_u[OMNIROBOT_S1_N];
+  omnirobot_s1_real inside;
   int status;
   omnirobot_s1_gamma(t, a, g_l, g_u);
   body_law(x, g_l, g_u, u, &inside);
@@ -1110,11 +1216,13 @@ static int omnirobot_s1_law(const omnirobot_s1_real* x, omnirobot_s1_real t, con
 
 int omnirobot_s1_control(const omnirobot_s1_real x[OMNIROBOT_S1_N], omnirobot_s1_real t,
     const omnirobot_s1_real alpha[OMNIROBOT_S1_N_ALPHA], omnirobot_s1_real u[OMNIROBOT_S1_N]) {
-  omnirobot_s1_real xc[OMNIROBOT_S1_N], a[OMNIROBOT_S1_N_ALPHA], uc[OMNIROBOT_S1_N];
   int status = OMNIROBOT_S1_STATUS_INVALID_INPUT;
   if (u != NULL) {
+    omnirobot_s1_real uc[OMNIROBOT_S1_N];
     if ((x != NULL) && (alpha != NULL) && (omnirobot_s1_time_valid(t) != 0)
         && (omnirobot_s1_finite(x, OMNIROBOT_S1_N) != 0) && (omnirobot_s1_alpha_valid(alpha) != 0)) {
+      omnirobot_s1_real xc[OMNIROBOT_S1_N];
+      omnirobot_s1_real a[OMNIROBOT_S1_N_ALPHA];
       omnirobot_s1_copy(x, xc, OMNIROBOT_S1_N);
       omnirobot_s1_copy(alpha, a, OMNIROBOT_S1_N_ALPHA);
       status = omnirobot_s1_law(xc, t, a, uc);
@@ -1131,20 +1239,29 @@ int omnirobot_s1_control(const omnirobot_s1_real x[OMNIROBOT_S1_N], omnirobot_s1
 /* implicit step of (11) from t to t + dt, inputs already checked (a: [N_ALPHA]) */
 static void omnirobot_s1_implicit_step(omnirobot_s1_real t, omnirobot_s1_real dt, const omnirobot_s1_real* a,
     omnirobot_s1_real* next) {
-  omnirobot_s1_real psi[OMNIROBOT_S1_N_ALPHA], theta[OMNIROBOT_S1_N_ALPHA], s, s_next, c, big_a, root;
-  int i, k;
+  omnirobot_s1_real psi[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real theta[OMNIROBOT_S1_N_ALPHA];
+  int i;
   body_alpha_conflict(&t, &dt, psi, theta);
   for (i = 0; i < OMNIROBOT_S1_N_ALPHA; ++i) {
+    omnirobot_s1_real s;
+    omnirobot_s1_real s_next;
+    omnirobot_s1_real c;
+    omnirobot_s1_real big_a;
+    omnirobot_s1_real root;
+    int k = 0;
     body_newton_start(&a[i], &psi[i], &theta[i], &dt, &s, &c, &big_a, &root);
     if (root != 0.0f) {
       body_newton_root_start(&a[i], &psi[i], &c, &big_a, &s);
     }
     /* 5 iterations; an iteration that returns its input would return it again,
        so the loop stops there with the same result */
-    for (k = 0; k < 5; ++k) {
+    while (k < 5) {
       body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
       if (s_next == s) {
         k = 5;
+      } else {
+        k = k + 1;
       }
       s = s_next;
     }
@@ -1154,12 +1271,13 @@ static void omnirobot_s1_implicit_step(omnirobot_s1_real t, omnirobot_s1_real dt
 
 int omnirobot_s1_alpha_step(omnirobot_s1_real t, omnirobot_s1_real dt,
     const omnirobot_s1_real alpha[OMNIROBOT_S1_N_ALPHA], omnirobot_s1_real alpha_next[OMNIROBOT_S1_N_ALPHA]) {
-  omnirobot_s1_real a[OMNIROBOT_S1_N_ALPHA], next[OMNIROBOT_S1_N_ALPHA];
   int status = OMNIROBOT_S1_STATUS_INVALID_INPUT;
   if (alpha_next != NULL) {
     if (alpha == NULL) {
       omnirobot_s1_zero(alpha_next, OMNIROBOT_S1_N_ALPHA);
     } else {
+      omnirobot_s1_real a[OMNIROBOT_S1_N_ALPHA];
+      omnirobot_s1_real next[OMNIROBOT_S1_N_ALPHA];
       omnirobot_s1_copy(alpha, a, OMNIROBOT_S1_N_ALPHA);
       if ((omnirobot_s1_time_valid(t) != 0) && (omnirobot_s1_dt_valid(dt) != 0)
           && (omnirobot_s1_alpha_valid(a) != 0)) {
@@ -1181,15 +1299,18 @@ int omnirobot_s1_alpha_step(omnirobot_s1_real t, omnirobot_s1_real dt,
 int omnirobot_s1_step(const omnirobot_s1_real x[OMNIROBOT_S1_N], omnirobot_s1_real t, omnirobot_s1_real dt,
     const omnirobot_s1_real alpha[OMNIROBOT_S1_N_ALPHA], omnirobot_s1_real u[OMNIROBOT_S1_N],
     omnirobot_s1_real alpha_next[OMNIROBOT_S1_N_ALPHA]) {
-  omnirobot_s1_real xc[OMNIROBOT_S1_N], a[OMNIROBOT_S1_N_ALPHA], uc[OMNIROBOT_S1_N], next[OMNIROBOT_S1_N_ALPHA];
   int status = OMNIROBOT_S1_STATUS_INVALID_INPUT;
   if ((u != NULL) && (alpha_next != NULL)) {
+    omnirobot_s1_real uc[OMNIROBOT_S1_N];
     if (alpha == NULL) {
       omnirobot_s1_zero(alpha_next, OMNIROBOT_S1_N_ALPHA);
     } else {
+      omnirobot_s1_real a[OMNIROBOT_S1_N_ALPHA];
+      omnirobot_s1_real next[OMNIROBOT_S1_N_ALPHA];
       omnirobot_s1_copy(alpha, a, OMNIROBOT_S1_N_ALPHA);
       if ((x != NULL) && (omnirobot_s1_time_valid(t) != 0) && (omnirobot_s1_dt_valid(dt) != 0)
           && (omnirobot_s1_finite(x, OMNIROBOT_S1_N) != 0) && (omnirobot_s1_alpha_valid(a) != 0)) {
+        omnirobot_s1_real xc[OMNIROBOT_S1_N];
         omnirobot_s1_copy(x, xc, OMNIROBOT_S1_N);
         status = omnirobot_s1_law(xc, t, a, uc);
         if (status != OMNIROBOT_S1_STATUS_INVALID_INPUT) {

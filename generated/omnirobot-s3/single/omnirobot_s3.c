@@ -19,7 +19,14 @@
 
 /* CasADi Function 'gamma_candidates': 90 instructions. */
 static void body_gamma_candidates(const omnirobot_s3_real* t, const omnirobot_s3_real* alpha, omnirobot_s3_real* rho_L_minus_alpha, omnirobot_s3_real* beta_L, omnirobot_s3_real* rho_U_plus_alpha, omnirobot_s3_real* beta_U) {
-  omnirobot_s3_real w0, w1, w2, w3, w4, w5, w6, w7;
+  omnirobot_s3_real w0;
+  omnirobot_s3_real w1;
+  omnirobot_s3_real w2;
+  omnirobot_s3_real w3;
+  omnirobot_s3_real w4;
+  omnirobot_s3_real w5;
+  omnirobot_s3_real w6;
+  omnirobot_s3_real w7;
   w0 = 0.5f;
   w1 = t[0];
   w2 = 9.0f;
@@ -114,7 +121,11 @@ static void body_gamma_candidates(const omnirobot_s3_real* t, const omnirobot_s3
 
 /* CasADi Function 'smooth_max_test': 16 instructions. */
 static void body_smooth_max_test(const omnirobot_s3_real* a, const omnirobot_s3_real* b, omnirobot_s3_real* max, omnirobot_s3_real* needed) {
-  omnirobot_s3_real w0, w1, w2, w3, w4;
+  omnirobot_s3_real w0;
+  omnirobot_s3_real w1;
+  omnirobot_s3_real w2;
+  omnirobot_s3_real w3;
+  omnirobot_s3_real w4;
   w0 = a[0];
   w1 = b[0];
   w2 = (w1 > w0) ? w1 : w0;
@@ -135,7 +146,10 @@ static void body_smooth_max_test(const omnirobot_s3_real* a, const omnirobot_s3_
 
 /* CasADi Function 'smooth_max': 15 instructions. */
 static void body_smooth_max(const omnirobot_s3_real* a, const omnirobot_s3_real* b, omnirobot_s3_real* max) {
-  omnirobot_s3_real w0, w1, w2, w3;
+  omnirobot_s3_real w0;
+  omnirobot_s3_real w1;
+  omnirobot_s3_real w2;
+  omnirobot_s3_real w3;
   w0 = a[0];
   w1 = b[0];
   w2 = (w1 > w0) ? w1 : w0;
@@ -155,7 +169,11 @@ static void body_smooth_max(const omnirobot_s3_real* a, const omnirobot_s3_real*
 
 /* CasADi Function 'smooth_min_test': 19 instructions. */
 static void body_smooth_min_test(const omnirobot_s3_real* a, const omnirobot_s3_real* b, omnirobot_s3_real* min, omnirobot_s3_real* needed) {
-  omnirobot_s3_real w0, w1, w2, w3, w4;
+  omnirobot_s3_real w0;
+  omnirobot_s3_real w1;
+  omnirobot_s3_real w2;
+  omnirobot_s3_real w3;
+  omnirobot_s3_real w4;
   w0 = a[0];
   w1 = -w0;
   w2 = b[0];
@@ -179,7 +197,10 @@ static void body_smooth_min_test(const omnirobot_s3_real* a, const omnirobot_s3_
 
 /* CasADi Function 'smooth_min': 18 instructions. */
 static void body_smooth_min(const omnirobot_s3_real* a, const omnirobot_s3_real* b, omnirobot_s3_real* min) {
-  omnirobot_s3_real w0, w1, w2, w3;
+  omnirobot_s3_real w0;
+  omnirobot_s3_real w1;
+  omnirobot_s3_real w2;
+  omnirobot_s3_real w3;
   w0 = a[0];
   w1 = -w0;
   w2 = b[0];
@@ -202,9 +223,40 @@ static void body_smooth_min(const omnirobot_s3_real* a, const omnirobot_s3_real*
 
 /* CasADi Function 'gamma_rates': 519 instructions. */
 static void body_gamma_rates(const omnirobot_s3_real* t, const omnirobot_s3_real* alpha, omnirobot_s3_real* gamma_L_dot, omnirobot_s3_real* gamma_U_dot) {
-  omnirobot_s3_real w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11;
-  omnirobot_s3_real w12, w13, w14, w15, w16, w17, w18, w19, w20, w21, w22, w23;
-  omnirobot_s3_real w24, w25, w26, w27, w28, w29, w30, w31, w32, w33;
+  omnirobot_s3_real w0;
+  omnirobot_s3_real w1;
+  omnirobot_s3_real w2;
+  omnirobot_s3_real w3;
+  omnirobot_s3_real w4;
+  omnirobot_s3_real w5;
+  omnirobot_s3_real w6;
+  omnirobot_s3_real w7;
+  omnirobot_s3_real w8;
+  omnirobot_s3_real w9;
+  omnirobot_s3_real w10;
+  omnirobot_s3_real w11;
+  omnirobot_s3_real w12;
+  omnirobot_s3_real w13;
+  omnirobot_s3_real w14;
+  omnirobot_s3_real w15;
+  omnirobot_s3_real w16;
+  omnirobot_s3_real w17;
+  omnirobot_s3_real w18;
+  omnirobot_s3_real w19;
+  omnirobot_s3_real w20;
+  omnirobot_s3_real w21;
+  omnirobot_s3_real w22;
+  omnirobot_s3_real w23;
+  omnirobot_s3_real w24;
+  omnirobot_s3_real w25;
+  omnirobot_s3_real w26;
+  omnirobot_s3_real w27;
+  omnirobot_s3_real w28;
+  omnirobot_s3_real w29;
+  omnirobot_s3_real w30;
+  omnirobot_s3_real w31;
+  omnirobot_s3_real w32;
+  omnirobot_s3_real w33;
   w0 = t[0];
   w1 = 9.0f;
   w2 = (w0 < w1) ? 1.0f : 0.0f;
@@ -728,8 +780,20 @@ static void body_gamma_rates(const omnirobot_s3_real* t, const omnirobot_s3_real
 
 /* CasADi Function 'law': 89 instructions. */
 static void body_law(const omnirobot_s3_real* x, const omnirobot_s3_real* gamma_L, const omnirobot_s3_real* gamma_U, omnirobot_s3_real* u, omnirobot_s3_real* inside) {
-  omnirobot_s3_real w0, w1, w2, w3, w4, w5, w6, w7, w8, w9, w10, w11;
-  omnirobot_s3_real w12, w13;
+  omnirobot_s3_real w0;
+  omnirobot_s3_real w1;
+  omnirobot_s3_real w2;
+  omnirobot_s3_real w3;
+  omnirobot_s3_real w4;
+  omnirobot_s3_real w5;
+  omnirobot_s3_real w6;
+  omnirobot_s3_real w7;
+  omnirobot_s3_real w8;
+  omnirobot_s3_real w9;
+  omnirobot_s3_real w10;
+  omnirobot_s3_real w11;
+  omnirobot_s3_real w12;
+  omnirobot_s3_real w13;
   w0 = -0.42597205434069174f;
   w1 = 4.0f;
   w2 = gamma_U[0];
@@ -823,7 +887,16 @@ static void body_law(const omnirobot_s3_real* x, const omnirobot_s3_real* gamma_
 
 /* CasADi Function 'alpha_conflict': 129 instructions. */
 static void body_alpha_conflict(const omnirobot_s3_real* t, const omnirobot_s3_real* dt, omnirobot_s3_real* psi, omnirobot_s3_real* theta) {
-  omnirobot_s3_real w0, w1, w2, w3, w4, w5, w6, w7, w8, w9;
+  omnirobot_s3_real w0;
+  omnirobot_s3_real w1;
+  omnirobot_s3_real w2;
+  omnirobot_s3_real w3;
+  omnirobot_s3_real w4;
+  omnirobot_s3_real w5;
+  omnirobot_s3_real w6;
+  omnirobot_s3_real w7;
+  omnirobot_s3_real w8;
+  omnirobot_s3_real w9;
   w0 = 5.0f;
   w1 = t[0];
   w2 = dt[0];
@@ -957,7 +1030,11 @@ static void body_alpha_conflict(const omnirobot_s3_real* t, const omnirobot_s3_r
 
 /* CasADi Function 'newton_start': 24 instructions. */
 static void body_newton_start(const omnirobot_s3_real* alpha, const omnirobot_s3_real* psi, const omnirobot_s3_real* theta, const omnirobot_s3_real* dt, omnirobot_s3_real* a0, omnirobot_s3_real* c, omnirobot_s3_real* A, omnirobot_s3_real* root) {
-  omnirobot_s3_real w0, w1, w2, w3, w4;
+  omnirobot_s3_real w0;
+  omnirobot_s3_real w1;
+  omnirobot_s3_real w2;
+  omnirobot_s3_real w3;
+  omnirobot_s3_real w4;
   w0 = alpha[0];
   w1 = 1.0f;
   w2 = 5.0f;
@@ -986,7 +1063,12 @@ static void body_newton_start(const omnirobot_s3_real* alpha, const omnirobot_s3
 
 /* CasADi Function 'newton_root_start': 23 instructions. */
 static void body_newton_root_start(const omnirobot_s3_real* alpha, const omnirobot_s3_real* psi, const omnirobot_s3_real* c, const omnirobot_s3_real* A, omnirobot_s3_real* a0) {
-  omnirobot_s3_real w0, w1, w2, w3, w4, w5;
+  omnirobot_s3_real w0;
+  omnirobot_s3_real w1;
+  omnirobot_s3_real w2;
+  omnirobot_s3_real w3;
+  omnirobot_s3_real w4;
+  omnirobot_s3_real w5;
   w0 = alpha[0];
   w1 = c[0];
   w2 = w0 / w1;
@@ -1014,7 +1096,12 @@ static void body_newton_root_start(const omnirobot_s3_real* alpha, const omnirob
 
 /* CasADi Function 'newton_iteration': 19 instructions. */
 static void body_newton_iteration(const omnirobot_s3_real* a, const omnirobot_s3_real* alpha, const omnirobot_s3_real* psi, const omnirobot_s3_real* c, const omnirobot_s3_real* A, omnirobot_s3_real* a_next) {
-  omnirobot_s3_real w0, w1, w2, w3, w4, w5;
+  omnirobot_s3_real w0;
+  omnirobot_s3_real w1;
+  omnirobot_s3_real w2;
+  omnirobot_s3_real w3;
+  omnirobot_s3_real w4;
+  omnirobot_s3_real w5;
   w0 = a[0];
   w1 = psi[0];
   w1 = w1 + w0;
@@ -1039,7 +1126,8 @@ static void body_newton_iteration(const omnirobot_s3_real* a, const omnirobot_s3
 /* ----------------------------------------------------------------- typed API */
 
 static int omnirobot_s3_finite(const omnirobot_s3_real* v, int count) {
-  int i, ok = 1;
+  int i;
+  int ok = 1;
   for (i = 0; i < count; ++i) {
     if (isfinite(v[i]) == 0) {
       ok = 0;
@@ -1050,7 +1138,8 @@ static int omnirobot_s3_finite(const omnirobot_s3_real* v, int count) {
 
 /* alpha in the domain of the adaptive law: every entry finite, in [0, ALPHA_MAX]. */
 static int omnirobot_s3_alpha_valid(const omnirobot_s3_real* a) {
-  int i, ok = 1;
+  int i;
+  int ok = 1;
   for (i = 0; i < OMNIROBOT_S3_N_ALPHA; ++i) {
     if (!((a[i] >= 0.0f) && (a[i] <= OMNIROBOT_S3_ALPHA_MAX))) {
       ok = 0;
@@ -1061,12 +1150,20 @@ static int omnirobot_s3_alpha_valid(const omnirobot_s3_real* a) {
 
 /* t in its domain: finite, t >= 0. */
 static int omnirobot_s3_time_valid(omnirobot_s3_real t) {
-  return ((isfinite(t) != 0) && (t >= 0.0f)) ? 1 : 0;
+  int ok = 0;
+  if ((isfinite(t) != 0) && (t >= 0.0f)) {
+    ok = 1;
+  }
+  return ok;
 }
 
 /* dt in its domain: DT_MIN <= dt <= DT_MAX. */
 static int omnirobot_s3_dt_valid(omnirobot_s3_real dt) {
-  return ((dt >= OMNIROBOT_S3_DT_MIN) && (dt <= OMNIROBOT_S3_DT_MAX)) ? 1 : 0;
+  int ok = 0;
+  if ((dt >= OMNIROBOT_S3_DT_MIN) && (dt <= OMNIROBOT_S3_DT_MAX)) {
+    ok = 1;
+  }
+  return ok;
 }
 
 static void omnirobot_s3_copy(const omnirobot_s3_real* from, omnirobot_s3_real* to, int count) {
@@ -1085,8 +1182,8 @@ static void omnirobot_s3_keep_alpha(const omnirobot_s3_real* from, omnirobot_s3_
 }
 
 static void omnirobot_s3_zero(omnirobot_s3_real* v, int count) {
-  int i;
   if (v != NULL) {
+    int i;
     for (i = 0; i < count; ++i) {
       v[i] = 0.0f;
     }
@@ -1097,7 +1194,10 @@ static void omnirobot_s3_zero(omnirobot_s3_real* v, int count) {
    change the max/min */
 static void omnirobot_s3_gamma(omnirobot_s3_real t, const omnirobot_s3_real* a, omnirobot_s3_real* g_l,
     omnirobot_s3_real* g_u) {
-  omnirobot_s3_real lower[OMNIROBOT_S3_N], beta_l[OMNIROBOT_S3_N], upper[OMNIROBOT_S3_N], beta_u[OMNIROBOT_S3_N];
+  omnirobot_s3_real lower[OMNIROBOT_S3_N];
+  omnirobot_s3_real beta_l[OMNIROBOT_S3_N];
+  omnirobot_s3_real upper[OMNIROBOT_S3_N];
+  omnirobot_s3_real beta_u[OMNIROBOT_S3_N];
   omnirobot_s3_real needed;
   int i;
   body_gamma_candidates(&t, a, lower, beta_l, upper, beta_u);
@@ -1116,12 +1216,18 @@ static void omnirobot_s3_gamma(omnirobot_s3_real t, const omnirobot_s3_real* a, 
 int omnirobot_s3_tube(omnirobot_s3_real t, const omnirobot_s3_real alpha[OMNIROBOT_S3_N_ALPHA],
     omnirobot_s3_real gamma_L[OMNIROBOT_S3_N], omnirobot_s3_real gamma_U[OMNIROBOT_S3_N],
     omnirobot_s3_real gamma_L_dot[OMNIROBOT_S3_N], omnirobot_s3_real gamma_U_dot[OMNIROBOT_S3_N]) {
-  omnirobot_s3_real a[OMNIROBOT_S3_N_ALPHA], g_l[OMNIROBOT_S3_N], g_u[OMNIROBOT_S3_N];
-  omnirobot_s3_real g_l_dot[OMNIROBOT_S3_N], g_u_dot[OMNIROBOT_S3_N];
   int status = OMNIROBOT_S3_STATUS_INVALID_INPUT;
-  int rates = ((gamma_L_dot != NULL) || (gamma_U_dot != NULL)) ? 1 : 0;
   if ((gamma_L != NULL) && (gamma_U != NULL)) {
+    omnirobot_s3_real g_l[OMNIROBOT_S3_N];
+    omnirobot_s3_real g_u[OMNIROBOT_S3_N];
+    omnirobot_s3_real g_l_dot[OMNIROBOT_S3_N];
+    omnirobot_s3_real g_u_dot[OMNIROBOT_S3_N];
+    int rates = 0;
+    if ((gamma_L_dot != NULL) || (gamma_U_dot != NULL)) {
+      rates = 1;
+    }
     if ((alpha != NULL) && (omnirobot_s3_time_valid(t) != 0) && (omnirobot_s3_alpha_valid(alpha) != 0)) {
+      omnirobot_s3_real a[OMNIROBOT_S3_N_ALPHA];
       omnirobot_s3_copy(alpha, a, OMNIROBOT_S3_N_ALPHA);
       omnirobot_s3_gamma(t, a, g_l, g_u);
       if (rates != 0) {
@@ -1158,7 +1264,9 @@ int omnirobot_s3_tube(omnirobot_s3_real t, const omnirobot_s3_real alpha[OMNIROB
    INVALID_INPUT when u is not finite. */
 static int omnirobot_s3_law(const omnirobot_s3_real* x, omnirobot_s3_real t, const omnirobot_s3_real* a,
     omnirobot_s3_real* u) {
-  omnirobot_s3_real g_l[OMNIROBOT_S3_N], g_u[OMNIROBOT_S3_N], inside;
+  omnirobot_s3_real g_l[OMNIROBOT_S3_N];
+  omnirobot_s3_real g_u[OMNIROBOT_S3_N];
+  omnirobot_s3_real inside;
   int status;
   omnirobot_s3_gamma(t, a, g_l, g_u);
   body_law(x, g_l, g_u, u, &inside);
@@ -1174,11 +1282,13 @@ static int omnirobot_s3_law(const omnirobot_s3_real* x, omnirobot_s3_real t, con
 
 int omnirobot_s3_control(const omnirobot_s3_real x[OMNIROBOT_S3_N], omnirobot_s3_real t,
     const omnirobot_s3_real alpha[OMNIROBOT_S3_N_ALPHA], omnirobot_s3_real u[OMNIROBOT_S3_N]) {
-  omnirobot_s3_real xc[OMNIROBOT_S3_N], a[OMNIROBOT_S3_N_ALPHA], uc[OMNIROBOT_S3_N];
   int status = OMNIROBOT_S3_STATUS_INVALID_INPUT;
   if (u != NULL) {
+    omnirobot_s3_real uc[OMNIROBOT_S3_N];
     if ((x != NULL) && (alpha != NULL) && (omnirobot_s3_time_valid(t) != 0)
         && (omnirobot_s3_finite(x, OMNIROBOT_S3_N) != 0) && (omnirobot_s3_alpha_valid(alpha) != 0)) {
+      omnirobot_s3_real xc[OMNIROBOT_S3_N];
+      omnirobot_s3_real a[OMNIROBOT_S3_N_ALPHA];
       omnirobot_s3_copy(x, xc, OMNIROBOT_S3_N);
       omnirobot_s3_copy(alpha, a, OMNIROBOT_S3_N_ALPHA);
       status = omnirobot_s3_law(xc, t, a, uc);
@@ -1195,20 +1305,29 @@ int omnirobot_s3_control(const omnirobot_s3_real x[OMNIROBOT_S3_N], omnirobot_s3
 /* implicit step of (11) from t to t + dt, inputs already checked (a: [N_ALPHA]) */
 static void omnirobot_s3_implicit_step(omnirobot_s3_real t, omnirobot_s3_real dt, const omnirobot_s3_real* a,
     omnirobot_s3_real* next) {
-  omnirobot_s3_real psi[OMNIROBOT_S3_N_ALPHA], theta[OMNIROBOT_S3_N_ALPHA], s, s_next, c, big_a, root;
-  int i, k;
+  omnirobot_s3_real psi[OMNIROBOT_S3_N_ALPHA];
+  omnirobot_s3_real theta[OMNIROBOT_S3_N_ALPHA];
+  int i;
   body_alpha_conflict(&t, &dt, psi, theta);
   for (i = 0; i < OMNIROBOT_S3_N_ALPHA; ++i) {
+    omnirobot_s3_real s;
+    omnirobot_s3_real s_next;
+    omnirobot_s3_real c;
+    omnirobot_s3_real big_a;
+    omnirobot_s3_real root;
+    int k = 0;
     body_newton_start(&a[i], &psi[i], &theta[i], &dt, &s, &c, &big_a, &root);
     if (root != 0.0f) {
       body_newton_root_start(&a[i], &psi[i], &c, &big_a, &s);
     }
     /* 5 iterations; an iteration that returns its input would return it again,
        so the loop stops there with the same result */
-    for (k = 0; k < 5; ++k) {
+    while (k < 5) {
       body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
       if (s_next == s) {
         k = 5;
+      } else {
+        k = k + 1;
       }
       s = s_next;
     }
@@ -1218,12 +1337,13 @@ static void omnirobot_s3_implicit_step(omnirobot_s3_real t, omnirobot_s3_real dt
 
 int omnirobot_s3_alpha_step(omnirobot_s3_real t, omnirobot_s3_real dt,
     const omnirobot_s3_real alpha[OMNIROBOT_S3_N_ALPHA], omnirobot_s3_real alpha_next[OMNIROBOT_S3_N_ALPHA]) {
-  omnirobot_s3_real a[OMNIROBOT_S3_N_ALPHA], next[OMNIROBOT_S3_N_ALPHA];
   int status = OMNIROBOT_S3_STATUS_INVALID_INPUT;
   if (alpha_next != NULL) {
     if (alpha == NULL) {
       omnirobot_s3_zero(alpha_next, OMNIROBOT_S3_N_ALPHA);
     } else {
+      omnirobot_s3_real a[OMNIROBOT_S3_N_ALPHA];
+      omnirobot_s3_real next[OMNIROBOT_S3_N_ALPHA];
       omnirobot_s3_copy(alpha, a, OMNIROBOT_S3_N_ALPHA);
       if ((omnirobot_s3_time_valid(t) != 0) && (omnirobot_s3_dt_valid(dt) != 0)
           && (omnirobot_s3_alpha_valid(a) != 0)) {
@@ -1245,15 +1365,18 @@ int omnirobot_s3_alpha_step(omnirobot_s3_real t, omnirobot_s3_real dt,
 int omnirobot_s3_step(const omnirobot_s3_real x[OMNIROBOT_S3_N], omnirobot_s3_real t, omnirobot_s3_real dt,
     const omnirobot_s3_real alpha[OMNIROBOT_S3_N_ALPHA], omnirobot_s3_real u[OMNIROBOT_S3_N],
     omnirobot_s3_real alpha_next[OMNIROBOT_S3_N_ALPHA]) {
-  omnirobot_s3_real xc[OMNIROBOT_S3_N], a[OMNIROBOT_S3_N_ALPHA], uc[OMNIROBOT_S3_N], next[OMNIROBOT_S3_N_ALPHA];
   int status = OMNIROBOT_S3_STATUS_INVALID_INPUT;
   if ((u != NULL) && (alpha_next != NULL)) {
+    omnirobot_s3_real uc[OMNIROBOT_S3_N];
     if (alpha == NULL) {
       omnirobot_s3_zero(alpha_next, OMNIROBOT_S3_N_ALPHA);
     } else {
+      omnirobot_s3_real a[OMNIROBOT_S3_N_ALPHA];
+      omnirobot_s3_real next[OMNIROBOT_S3_N_ALPHA];
       omnirobot_s3_copy(alpha, a, OMNIROBOT_S3_N_ALPHA);
       if ((x != NULL) && (omnirobot_s3_time_valid(t) != 0) && (omnirobot_s3_dt_valid(dt) != 0)
           && (omnirobot_s3_finite(x, OMNIROBOT_S3_N) != 0) && (omnirobot_s3_alpha_valid(a) != 0)) {
+        omnirobot_s3_real xc[OMNIROBOT_S3_N];
         omnirobot_s3_copy(x, xc, OMNIROBOT_S3_N);
         status = omnirobot_s3_law(xc, t, a, uc);
         if (status != OMNIROBOT_S3_STATUS_INVALID_INPUT) {

@@ -232,9 +232,9 @@ class CPrinter(InstructionPrinter):
                             if not isinstance(ins, Output)})
         lines = [f"/* CasADi Function {program.name!r}: {len(program.instructions)} instructions. */",
                  self.signature(program) + " {"]
-        for start in range(0, len(registers), 12):
-            names = ", ".join(self.register(r) for r in registers[start:start + 12])
-            lines.append(f"  {self.real} {names};")
+        # one declaration per line (MISRA C:2012 rule 12.3 reads a comma there as the
+        # comma operator)
+        lines += [f"  {self.real} {self.register(r)};" for r in registers]
         for spec in program.inputs:
             if spec.index not in used_inputs:
                 lines.append(f"  (void){self._names['in', spec.index]};")
