@@ -17,7 +17,8 @@ from test_codegen_support import files_of
 from stt_codegen import __version__
 from stt_codegen.cli import main
 from stt_codegen.codegen.bundled import LAYOUT, drift
-from stt_codegen.codegen.functions import DEPLOYED
+from stt_codegen.codegen.functions import deployed_functions
+from conftest import model_of
 from stt_codegen.spec.loader import load_spec
 
 REPO = Path(__file__).resolve().parent.parent
@@ -75,7 +76,8 @@ def test_header_declares_only_the_api_and_source_has_no_casadi_internals():
         assert all(m.startswith("OMNIROBOT_S2_") for m in macros), macros
         # every computation is emitted once: one body per deployed Function
         bodies = re.findall(r"^static void (body_\w+)\(", c, flags=re.MULTILINE)
-        assert bodies == [f"body_{name}" for name in DEPLOYED]
+        expected = [f"body_{f.name()}" for f in deployed_functions(model_of("omnirobot-s2"))]
+        assert bodies == expected and len(set(bodies)) == len(bodies)
         if precision == "single":
             assert "double" not in re.sub(r"/\*.*?\*/", "", c, flags=re.DOTALL)
 

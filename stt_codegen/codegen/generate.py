@@ -31,6 +31,8 @@ from . import tolerance
 from .functions import deployed_functions
 from .options import Options
 from .render import c_identifier, c_real, render
+from .tables import design_table_rows
+from ..tube.pieces import PROFILE_NAMES
 from .vectors import test_vectors
 
 MANIFEST = "manifest.json"
@@ -98,6 +100,8 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
     if "c" in options.langs:
         bodies = CPrinter(options.precision, real=f"{prefix}_real", prefix="body_")
         c_ctx = dict(common, bodies=bodies.doprint(functions).rstrip("\n"),
+                     spec_tables=design_table_rows(design, lambda v: c_real(v, single), single),
+                     profile_codes={name: k for k, name in enumerate(PROFILE_NAMES)},
                      guard=f"{prefix.upper()}_H", zero=c_real(0.0, single),
                      t_c=c_real(design.prescribed_time, single),
                      rate_hz=c_real(design.rate_hz, single),
@@ -125,6 +129,9 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
         programs = [dataclasses.replace(lower(f), name=f"body_{f.name()}") for f in functions]
         files[name] = render("python_module.py.j2", filename=name, **common,
                              bodies=python_source(programs).rstrip("\n"),
+                             spec_tables=design_table_rows(design, lambda v: repr(float(v)),
+                                                           False),
+                             profile_codes={name: k for k, name in enumerate(PROFILE_NAMES)},
                              t_c=repr(float(design.prescribed_time)),
                              rate_hz=repr(float(design.rate_hz)),
                              dt_min=repr(limits["dt_min"]),

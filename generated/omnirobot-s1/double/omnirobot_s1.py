@@ -94,29 +94,126 @@ def _keep_alpha(alpha):
     return [v if math.isfinite(v) else 0.0 for v in a]
 
 
-def _gamma(t, alpha):
+# ------------------------------------------------------------------- spec tables
+# Tube parameters.
+SMOOTHNESS = 50.0  # nu of the smooth max/min and of F_nu (eqs. (9)-(10)), 1/state units
+THETA0 = 0.01  # theta_0 of the trigger (11)
+MU = 1.0  # mu of the trigger (11), state units
+KAPPA = 5.0  # kappa of the adaptive law (11), 1/s
+GAIN = 0.18168809110361742  # k of the control law (13)
+# State-space bounds [X; X-bar], the sign of eq. (9) on each, circumvents on each.
+BOUND = (0.0, 0.0, -1.2, 5.0, 5.0, 1.2)
+SIGN = (1.0, 1.0, 1.0, -1.0, -1.0, -1.0)
+MEMBERS = (0, 0, 0, 0, 1, 0)
+# Reach tube (eq. (4)): (start, end, profile, from [L; U], to [L; U]); profile 0 = tanh,
+# 1 = smoothstep.
+SEGMENTS = (
+    (0.0, 9.0, 0, (0.04999999999999999, 4.55, -0.05, 0.45, 4.95, 0.05), (4.55, 4.55, -0.5, 4.95, 4.95, 0.5)),
+)
+# Circumvents (eqs. (7)-(9)), sorted by start: (start, end, center, radius, sharpness,
+# height, running maximum of the ends, bound index).
+WINDOWS = (
+    (0.3206386657002722, 3.4666055224840955, 1.893622094092184, 1.5729834283919115, 0.1, 1.2000000000000002, 3.4666055224840955, 4),  # obstacle 0
+)
+_PROGRESS = {
+    0: lambda t, start, end: body_progress_tanh([t], [start], [end]),
+}
+
+
+def _reach(t):
+    # rho, rho_dot [L; U] of eq. (4): the first segment whose end is after t
+    k = 0
+    while k < len(SEGMENTS) - 1 and not t < SEGMENTS[k][1]:
+        k += 1
+    start, end, profile, lo, hi = SEGMENTS[k]
+    (p,), (p_dot,) = _PROGRESS[profile](t, start, end)
+    return body_interpolate([p], [p_dot], lo, hi)
+
+
+def _circumvent(t):
+    # beta, beta_dot [L; U] of eq. (9) over the open windows only (a closed one adds 0)
+    lo, hi = 0, len(WINDOWS)
+    while lo < hi:
+        mid = lo + (hi - lo) // 2
+        if WINDOWS[mid][0] < t:
+            lo = mid + 1
+        else:
+            hi = mid
+    first = hi
+    while first > 0 and WINDOWS[first - 1][6] > t:
+        first -= 1
+    top = [0.0] * N_ALPHA
+    opened = []
+    for row in WINDOWS[first:hi]:
+        if t < row[1]:
+            (y,), (y_dot,) = body_bump([t], *([v] for v in row[:6]))
+            opened.append((row[7], y, y_dot))
+            if y > top[row[7]]:
+                top[row[7]] = y
+    total, rate = [0.0] * N_ALPHA, [0.0] * N_ALPHA
+    for b in range(N_ALPHA):
+        if MEMBERS[b] > 0:
+            (total[b],), (rate[b],) = body_fnu_init([top[b]], [SMOOTHNESS])
+    for b, y, y_dot in opened:
+        (total[b],), (rate[b],) = body_fnu_add([total[b]], [rate[b]], [y], [y_dot], [top[b]],
+                                               [SMOOTHNESS])
+    beta, beta_dot = list(BOUND), [0.0] * N_ALPHA
+    for b in range(N_ALPHA):
+        if MEMBERS[b] > 0:
+            (beta[b],), (beta_dot[b],) = body_fnu_finish([BOUND[b]], [SIGN[b]], [top[b]],
+                                                         [total[b]], [rate[b]], [SMOOTHNESS])
+    return beta, beta_dot
+
+
+def _gamma_of(rho, beta, alpha):
     # eq. (10): the smooth max/min's correction only where it can change the max/min
-    lower, beta_l, upper, beta_u = body_gamma_candidates([t], alpha)
+    (c,) = body_candidates(rho, alpha)
     g_l, g_u = [], []
-    for a, b, c, d in zip(lower, beta_l, upper, beta_u):
-        (m,), (needed,) = body_smooth_max_test([a], [b])
-        g_l.append(body_smooth_max([a], [b])[0][0] if needed != 0.0 else m)
-        (m,), (needed,) = body_smooth_min_test([c], [d])
-        g_u.append(body_smooth_min([c], [d])[0][0] if needed != 0.0 else m)
+    for i in range(N):
+        (m,), (needed,) = body_smooth_max_test([c[i]], [beta[i]], [SMOOTHNESS])
+        if needed != 0.0:
+            ((m,),) = body_smooth_max([c[i]], [beta[i]], [SMOOTHNESS])
+        g_l.append(m)
+        (m,), (needed,) = body_smooth_min_test([c[N + i]], [beta[N + i]], [SMOOTHNESS])
+        if needed != 0.0:
+            ((m,),) = body_smooth_min([c[N + i]], [beta[N + i]], [SMOOTHNESS])
+        g_u.append(m)
     return g_l, g_u
 
 
+def _gamma(t, alpha):
+    return _gamma_of(_reach(t)[0], _circumvent(t)[0], alpha)
+
+
+def _gamma_and_rates(t, alpha):
+    # gamma and its total time derivative, alpha moving by (11)
+    rho, rho_dot = _reach(t)
+    beta, beta_dot = _circumvent(t)
+    g_l, g_u = _gamma_of(rho, beta, alpha)
+    psi, theta = body_conflict(rho, beta, [THETA0], [MU])
+    (a_dot,) = body_alpha_rate(alpha, psi, theta, [KAPPA])
+    (c,) = body_candidates(rho, alpha)
+    (c_dot,) = body_candidate_rates(rho_dot, a_dot)
+    g_l_dot = [body_smooth_max_rate([c[i]], [beta[i]], [c_dot[i]], [beta_dot[i]],
+                                    [SMOOTHNESS])[0][0] for i in range(N)]
+    g_u_dot = [body_smooth_min_rate([c[N + i]], [beta[N + i]], [c_dot[N + i]],
+                                    [beta_dot[N + i]], [SMOOTHNESS])[0][0] for i in range(N)]
+    return g_l, g_u, g_l_dot, g_u_dot
+
+
 def _implicit_step(t, dt, alpha):
-    # (11) from t to t + dt: a start (the root start only when needed), then a fixed
-    # number of Newton iterations, per component
-    psi, theta = body_alpha_conflict([t], [dt])
+    # (11) from t to t + dt: a start (the root start only when needed), then at most
+    # 5 Newton iterations (stopping at a fixed point), per component
+    ((t_next,),) = body_later([t], [dt])
+    psi, theta = body_conflict(_reach(t_next)[0], _circumvent(t_next)[0], [THETA0], [MU])
     out = []
     for a_i, psi_i, theta_i in zip(alpha, psi, theta):
-        s, c, big_a, root = (v[0] for v in body_newton_start([a_i], [psi_i], [theta_i], [dt]))
+        s, c, big_a, root = (v[0] for v in body_newton_start([a_i], [psi_i], [theta_i], [dt],
+                                                             [KAPPA]))
         if root != 0.0:
-            (s,) = body_newton_root_start([a_i], [psi_i], [c], [big_a])[0]
+            ((s,),) = body_newton_root_start([a_i], [psi_i], [c], [big_a])
         for _ in range(5):
-            (s_next,) = body_newton_iteration([s], [a_i], [psi_i], [c], [big_a])[0]
+            ((s_next,),) = body_newton_iteration([s], [a_i], [psi_i], [c], [big_a])
             if s_next == s:  # a fixed point: further iterations return it again
                 break
             s = s_next
@@ -128,8 +225,7 @@ def tube(t, alpha):
     """Tube bounds gamma_L, gamma_U (N,) and their time derivatives at time t (seconds)."""
     t_ok, a = _time(t), _alpha(alpha)
     if t_ok is not None and a is not None:
-        g_l, g_u = _gamma(t_ok, a)
-        g_l_dot, g_u_dot = body_gamma_rates([t_ok], a)
+        g_l, g_u, g_l_dot, g_u_dot = _gamma_and_rates(t_ok, a)
         if _all_finite(g_l, g_u, g_l_dot, g_u_dot):
             return g_l, g_u, g_l_dot, g_u_dot, STATUS_OK
     zero = [0.0] * N
@@ -140,7 +236,7 @@ def control(x, t, alpha):
     """Control law (13) at state x (N,) and time t: (u (N,), status)."""
     xs, t_ok, a = _finite(x, N), _time(t), _alpha(alpha)
     if xs is not None and t_ok is not None and a is not None:
-        u, inside = body_law(xs, *_gamma(t_ok, a))
+        u, inside = body_law(xs, *_gamma(t_ok, a), [GAIN])
         if _all_finite(u):
             return u, STATUS_OK if inside[0] != 0.0 else STATUS_OUTSIDE_TUBE
     return [0.0] * N, STATUS_INVALID_INPUT
@@ -160,7 +256,7 @@ def step(x, t, dt, alpha):
     """One controller step: (u (N,), alpha_next (N_ALPHA,), status)."""
     xs, t_ok, dt_ok, a = _finite(x, N), _time(t), _step_size(dt), _alpha(alpha)
     if xs is not None and t_ok is not None and dt_ok is not None and a is not None:
-        u, inside = body_law(xs, *_gamma(t_ok, a))
+        u, inside = body_law(xs, *_gamma(t_ok, a), [GAIN])
         alpha_next = _implicit_step(t_ok, dt_ok, a)
         if _all_finite(u, alpha_next):
             return u, alpha_next, STATUS_OK if inside[0] != 0.0 else STATUS_OUTSIDE_TUBE
@@ -168,7 +264,7 @@ def step(x, t, dt, alpha):
 
 
 # ---------------------------------------------------------------------- emitted bodies
-# Generated by stt_codegen.codegen.emit.PythonPrinter from CasADi 3.8.2 SX Functions: body_gamma_candidates, body_smooth_max_test, body_smooth_max, body_smooth_min_test, body_smooth_min, body_gamma_rates, body_law, body_alpha_conflict, body_newton_start, body_newton_root_start, body_newton_iteration.
+# Generated by stt_codegen.codegen.emit.PythonPrinter from CasADi 3.8.2 SX Functions: body_progress_tanh, body_interpolate, body_bump, body_fnu_init, body_fnu_add, body_fnu_finish, body_candidates, body_candidate_rates, body_smooth_max_test, body_smooth_max, body_smooth_min_test, body_smooth_min, body_smooth_max_rate, body_smooth_min_rate, body_conflict, body_alpha_rate, body_later, body_newton_start, body_newton_root_start, body_newton_iteration, body_law.
 # Do not edit; regenerate. Depends on the standard library's math only.
 import math
 
@@ -262,124 +358,473 @@ def _log1p(x):
         return -math.inf if x == -1.0 else math.nan
 
 
-def body_gamma_candidates(t, alpha):
-    """CasADi Function 'body_gamma_candidates' (85 instructions).
+def body_progress_tanh(t, start, end):
+    """CasADi Function 'body_progress_tanh' (32 instructions).
 
     Parameters
     ----------
     t : sequence of float, length 1 (dense 1x1, column-major)
+    start : sequence of float, length 1 (dense 1x1, column-major)
+    end : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    p : list of float, length 1 (dense 1x1, column-major)
+    p_dot : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(t) != 1:
+        raise ValueError('t: expected 1 values, got %d' % len(t))
+    if len(start) != 1:
+        raise ValueError('start: expected 1 values, got %d' % len(start))
+    if len(end) != 1:
+        raise ValueError('end: expected 1 values, got %d' % len(end))
+    p = [0.0] * 1
+    p_dot = [0.0] * 1
+    w0 = float(t[0])
+    w1 = float(end[0])
+    w2 = 1.0 if w0 < w1 else 0.0
+    w3 = float(start[0])
+    w3 = w0 - w3
+    w4 = 0.0
+    w4 = 1.0 if w3 < w4 else 0.0
+    w4 = 1.0 if w4 == 0.0 else 0.0
+    w1 = w1 - w0
+    w1 = 0.0 if w2 == 0.0 else w1
+    w0 = 1.0 if w2 == 0.0 else 0.0
+    w5 = 1.0
+    w0 = 0.0 if w0 == 0.0 else w5
+    w1 = w1 + w0
+    w3 = _div(w3, w1)
+    w0 = math.tanh(w3)
+    w6 = 0.0 if w4 == 0.0 else w0
+    w6 = 0.0 if w2 == 0.0 else w6
+    w7 = 1.0 if w2 == 0.0 else 0.0
+    w7 = 0.0 if w7 == 0.0 else w5
+    w6 = w6 + w7
+    p[0] = w6
+    w0 = w0 * w0
+    w5 = w5 - w0
+    w0 = _div(1.0, w1)
+    w3 = _div(w3, w1)
+    w3 = 0.0 if w2 == 0.0 else w3
+    w0 = w0 + w3
+    w5 = w5 * w0
+    w4 = 0.0 if w4 == 0.0 else w5
+    w2 = 0.0 if w2 == 0.0 else w4
+    p_dot[0] = w2
+    return (p, p_dot)
+
+
+def body_interpolate(p, p_dot, from_, to):
+    """CasADi Function 'body_interpolate' (56 instructions).
+
+    Parameters
+    ----------
+    p : sequence of float, length 1 (dense 1x1, column-major)
+    p_dot : sequence of float, length 1 (dense 1x1, column-major)
+    from_ : sequence of float, length 6 (dense 6x1, column-major)
+    to : sequence of float, length 6 (dense 6x1, column-major)
+
+    Returns
+    -------
+    rho : list of float, length 6 (dense 6x1, column-major)
+    rho_dot : list of float, length 6 (dense 6x1, column-major)
+    """
+    if len(p) != 1:
+        raise ValueError('p: expected 1 values, got %d' % len(p))
+    if len(p_dot) != 1:
+        raise ValueError('p_dot: expected 1 values, got %d' % len(p_dot))
+    if len(from_) != 6:
+        raise ValueError('from_: expected 6 values, got %d' % len(from_))
+    if len(to) != 6:
+        raise ValueError('to: expected 6 values, got %d' % len(to))
+    rho = [0.0] * 6
+    rho_dot = [0.0] * 6
+    w0 = float(to[0])
+    w1 = float(from_[0])
+    w2 = w0 - w1
+    w3 = float(p[0])
+    w2 = w2 * w3
+    w2 = w2 + w1
+    rho[0] = w2
+    w2 = float(to[1])
+    w4 = float(from_[1])
+    w5 = w2 - w4
+    w5 = w5 * w3
+    w5 = w5 + w4
+    rho[1] = w5
+    w5 = float(to[2])
+    w6 = float(from_[2])
+    w7 = w5 - w6
+    w7 = w7 * w3
+    w7 = w7 + w6
+    rho[2] = w7
+    w7 = float(to[3])
+    w8 = float(from_[3])
+    w9 = w7 - w8
+    w9 = w9 * w3
+    w9 = w9 + w8
+    rho[3] = w9
+    w9 = float(to[4])
+    w10 = float(from_[4])
+    w11 = w9 - w10
+    w11 = w11 * w3
+    w11 = w11 + w10
+    rho[4] = w11
+    w11 = float(to[5])
+    w12 = float(from_[5])
+    w13 = w11 - w12
+    w13 = w13 * w3
+    w13 = w13 + w12
+    rho[5] = w13
+    w0 = w0 - w1
+    w1 = float(p_dot[0])
+    w0 = w0 * w1
+    rho_dot[0] = w0
+    w2 = w2 - w4
+    w2 = w2 * w1
+    rho_dot[1] = w2
+    w5 = w5 - w6
+    w5 = w5 * w1
+    rho_dot[2] = w5
+    w7 = w7 - w8
+    w7 = w7 * w1
+    rho_dot[3] = w7
+    w9 = w9 - w10
+    w9 = w9 * w1
+    rho_dot[4] = w9
+    w11 = w11 - w12
+    w11 = w11 * w1
+    rho_dot[5] = w11
+    return (rho, rho_dot)
+
+
+def body_bump(t, start, end, center, radius, sharpness, height):
+    """CasADi Function 'body_bump' (57 instructions).
+
+    Parameters
+    ----------
+    t : sequence of float, length 1 (dense 1x1, column-major)
+    start : sequence of float, length 1 (dense 1x1, column-major)
+    end : sequence of float, length 1 (dense 1x1, column-major)
+    center : sequence of float, length 1 (dense 1x1, column-major)
+    radius : sequence of float, length 1 (dense 1x1, column-major)
+    sharpness : sequence of float, length 1 (dense 1x1, column-major)
+    height : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    y : list of float, length 1 (dense 1x1, column-major)
+    y_dot : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(t) != 1:
+        raise ValueError('t: expected 1 values, got %d' % len(t))
+    if len(start) != 1:
+        raise ValueError('start: expected 1 values, got %d' % len(start))
+    if len(end) != 1:
+        raise ValueError('end: expected 1 values, got %d' % len(end))
+    if len(center) != 1:
+        raise ValueError('center: expected 1 values, got %d' % len(center))
+    if len(radius) != 1:
+        raise ValueError('radius: expected 1 values, got %d' % len(radius))
+    if len(sharpness) != 1:
+        raise ValueError('sharpness: expected 1 values, got %d' % len(sharpness))
+    if len(height) != 1:
+        raise ValueError('height: expected 1 values, got %d' % len(height))
+    y = [0.0] * 1
+    y_dot = [0.0] * 1
+    w0 = float(start[0])
+    w1 = float(t[0])
+    w0 = 1.0 if w0 < w1 else 0.0
+    w2 = float(end[0])
+    w2 = 1.0 if w1 < w2 else 0.0
+    w0 = 1.0 if w0 != 0.0 and w2 != 0.0 else 0.0
+    w2 = float(center[0])
+    w1 = w1 - w2
+    w2 = math.fabs(w1)
+    w3 = float(radius[0])
+    w2 = 1.0 if w2 < w3 else 0.0
+    w0 = 1.0 if w0 != 0.0 and w2 != 0.0 else 0.0
+    w2 = float(height[0])
+    w4 = float(sharpness[0])
+    w5 = w1 * w1
+    w5 = w4 * w5
+    w6 = math.fabs(w1)
+    w6 = w3 - w6
+    w7 = math.fabs(w1)
+    w3 = w3 + w7
+    w7 = w6 * w3
+    w7 = 0.0 if w0 == 0.0 else w7
+    w8 = 1.0 if w0 == 0.0 else 0.0
+    w9 = 1.0
+    w8 = 0.0 if w8 == 0.0 else w9
+    w7 = w7 + w8
+    w5 = _div(w5, w7)
+    w8 = -w5
+    w9 = -80.0
+    w10 = _fmax(w8, w9)
+    w10 = _exp(w10)
+    w11 = w2 * w10
+    w11 = 0.0 if w0 == 0.0 else w11
+    y[0] = w11
+    w11 = 1.0 if w9 <= w8 else 0.0
+    w8 = 1.0 if w8 <= w9 else 0.0
+    w8 = w11 + w8
+    w11 = _div(w11, w8)
+    w8 = w1 + w1
+    w4 = w4 * w8
+    w4 = _div(w4, w7)
+    w5 = _div(w5, w7)
+    w7 = _sign(w1)
+    w6 = w6 * w7
+    w1 = _sign(w1)
+    w3 = w3 * w1
+    w6 = w6 - w3
+    w5 = w5 * w6
+    w5 = -w5
+    w5 = 0.0 if w0 == 0.0 else w5
+    w4 = w4 + w5
+    w11 = w11 * w4
+    w10 = w10 * w11
+    w2 = w2 * w10
+    w2 = -w2
+    w0 = 0.0 if w0 == 0.0 else w2
+    y_dot[0] = w0
+    return (y, y_dot)
+
+
+def body_fnu_init(top, nu):
+    """CasADi Function 'body_fnu_init' (10 instructions).
+
+    Parameters
+    ----------
+    top : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    total : list of float, length 1 (dense 1x1, column-major)
+    rate : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(top) != 1:
+        raise ValueError('top: expected 1 values, got %d' % len(top))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
+    total = [0.0] * 1
+    rate = [0.0] * 1
+    w0 = float(nu[0])
+    w1 = float(top[0])
+    w0 = w0 * w1
+    w0 = -w0
+    w1 = -80.0
+    w0 = _fmax(w0, w1)
+    w0 = _exp(w0)
+    total[0] = w0
+    w0 = 0.0
+    rate[0] = w0
+    return (total, rate)
+
+
+def body_fnu_add(total, rate, y, y_dot, top, nu):
+    """CasADi Function 'body_fnu_add' (21 instructions).
+
+    Parameters
+    ----------
+    total : sequence of float, length 1 (dense 1x1, column-major)
+    rate : sequence of float, length 1 (dense 1x1, column-major)
+    y : sequence of float, length 1 (dense 1x1, column-major)
+    y_dot : sequence of float, length 1 (dense 1x1, column-major)
+    top : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    total_next : list of float, length 1 (dense 1x1, column-major)
+    rate_next : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(total) != 1:
+        raise ValueError('total: expected 1 values, got %d' % len(total))
+    if len(rate) != 1:
+        raise ValueError('rate: expected 1 values, got %d' % len(rate))
+    if len(y) != 1:
+        raise ValueError('y: expected 1 values, got %d' % len(y))
+    if len(y_dot) != 1:
+        raise ValueError('y_dot: expected 1 values, got %d' % len(y_dot))
+    if len(top) != 1:
+        raise ValueError('top: expected 1 values, got %d' % len(top))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
+    total_next = [0.0] * 1
+    rate_next = [0.0] * 1
+    w0 = float(total[0])
+    w1 = float(nu[0])
+    w2 = float(y[0])
+    w3 = float(top[0])
+    w2 = w2 - w3
+    w2 = w1 * w2
+    w4 = -80.0
+    w2 = _fmax(w2, w4)
+    w2 = _exp(w2)
+    w1 = w1 * w3
+    w1 = -w1
+    w1 = _fmax(w1, w4)
+    w1 = _exp(w1)
+    w1 = w2 - w1
+    w0 = w0 + w1
+    total_next[0] = w0
+    w0 = float(rate[0])
+    w1 = float(y_dot[0])
+    w2 = w2 * w1
+    w0 = w0 + w2
+    rate_next[0] = w0
+    return (total_next, rate_next)
+
+
+def body_fnu_finish(bound, sign, top, total, rate, nu):
+    """CasADi Function 'body_fnu_finish' (15 instructions).
+
+    Parameters
+    ----------
+    bound : sequence of float, length 1 (dense 1x1, column-major)
+    sign : sequence of float, length 1 (dense 1x1, column-major)
+    top : sequence of float, length 1 (dense 1x1, column-major)
+    total : sequence of float, length 1 (dense 1x1, column-major)
+    rate : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    beta : list of float, length 1 (dense 1x1, column-major)
+    beta_dot : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(bound) != 1:
+        raise ValueError('bound: expected 1 values, got %d' % len(bound))
+    if len(sign) != 1:
+        raise ValueError('sign: expected 1 values, got %d' % len(sign))
+    if len(top) != 1:
+        raise ValueError('top: expected 1 values, got %d' % len(top))
+    if len(total) != 1:
+        raise ValueError('total: expected 1 values, got %d' % len(total))
+    if len(rate) != 1:
+        raise ValueError('rate: expected 1 values, got %d' % len(rate))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
+    beta = [0.0] * 1
+    beta_dot = [0.0] * 1
+    w0 = float(bound[0])
+    w1 = float(sign[0])
+    w2 = float(top[0])
+    w3 = float(total[0])
+    w4 = _log(w3)
+    w5 = float(nu[0])
+    w4 = _div(w4, w5)
+    w2 = w2 + w4
+    w2 = w1 * w2
+    w0 = w0 + w2
+    beta[0] = w0
+    w0 = float(rate[0])
+    w0 = _div(w0, w3)
+    w1 = w1 * w0
+    beta_dot[0] = w1
+    return (beta, beta_dot)
+
+
+def body_candidates(rho, alpha):
+    """CasADi Function 'body_candidates' (24 instructions).
+
+    Parameters
+    ----------
+    rho : sequence of float, length 6 (dense 6x1, column-major)
     alpha : sequence of float, length 6 (dense 6x1, column-major)
 
     Returns
     -------
-    rho_L_minus_alpha : list of float, length 3 (dense 3x1, column-major)
-    beta_L : list of float, length 3 (dense 3x1, column-major)
-    rho_U_plus_alpha : list of float, length 3 (dense 3x1, column-major)
-    beta_U : list of float, length 3 (dense 3x1, column-major)
+    c : list of float, length 6 (dense 6x1, column-major)
     """
-    if len(t) != 1:
-        raise ValueError('t: expected 1 values, got %d' % len(t))
+    if len(rho) != 6:
+        raise ValueError('rho: expected 6 values, got %d' % len(rho))
     if len(alpha) != 6:
         raise ValueError('alpha: expected 6 values, got %d' % len(alpha))
-    rho_L_minus_alpha = [0.0] * 3
-    beta_L = [0.0] * 3
-    rho_U_plus_alpha = [0.0] * 3
-    beta_U = [0.0] * 3
-    w0 = 4.5
-    w1 = float(t[0])
-    w2 = 9.0
-    w3 = 1.0 if w1 < w2 else 0.0
-    w4 = 0.0
-    w5 = 1.0 if w1 < w4 else 0.0
-    w5 = 1.0 if w5 == 0.0 else 0.0
-    w2 = w2 - w1
-    w2 = 0.0 if w3 == 0.0 else w2
-    w6 = 1.0 if w3 == 0.0 else 0.0
-    w7 = 1.0
-    w6 = 0.0 if w6 == 0.0 else w7
-    w2 = w2 + w6
-    w2 = _div(w1, w2)
-    w2 = math.tanh(w2)
-    w5 = 0.0 if w5 == 0.0 else w2
-    w5 = 0.0 if w3 == 0.0 else w5
-    w3 = 1.0 if w3 == 0.0 else 0.0
-    w3 = 0.0 if w3 == 0.0 else w7
-    w5 = w5 + w3
-    w3 = w0 * w5
-    w2 = 0.04999999999999999
-    w3 = w3 + w2
-    w2 = float(alpha[0])
-    w3 = w3 - w2
-    rho_L_minus_alpha[0] = w3
-    w3 = 4.55
-    w2 = float(alpha[1])
-    w3 = w3 - w2
-    rho_L_minus_alpha[1] = w3
-    w3 = -0.45
-    w3 = w3 * w5
-    w2 = -0.05
-    w3 = w3 + w2
-    w2 = float(alpha[2])
-    w3 = w3 - w2
-    rho_L_minus_alpha[2] = w3
-    beta_L[0] = w4
-    beta_L[1] = w4
-    w4 = -1.2
-    beta_L[2] = w4
-    w0 = w0 * w5
-    w4 = 0.45
-    w0 = w0 + w4
-    w3 = float(alpha[3])
-    w0 = w0 + w3
-    rho_U_plus_alpha[0] = w0
-    w0 = 4.95
-    w3 = float(alpha[4])
-    w0 = w0 + w3
-    rho_U_plus_alpha[1] = w0
-    w4 = w4 * w5
-    w5 = 0.05
-    w4 = w4 + w5
-    w5 = float(alpha[5])
-    w4 = w4 + w5
-    rho_U_plus_alpha[2] = w4
-    w4 = 5.0
-    beta_U[0] = w4
-    w5 = 1.893622094092184
-    w1 = w1 - w5
-    w5 = math.fabs(w1)
-    w0 = 1.5729834283919115
-    w5 = 1.0 if w5 < w0 else 0.0
-    w3 = 1.2000000000000002
-    w2 = -0.1
-    w6 = w1 * w1
-    w2 = w2 * w6
-    w6 = math.fabs(w1)
-    w6 = w0 - w6
-    w1 = math.fabs(w1)
+    c = [0.0] * 6
+    w0 = float(rho[0])
+    w1 = float(alpha[0])
+    w0 = w0 - w1
+    c[0] = w0
+    w0 = float(rho[1])
+    w1 = float(alpha[1])
+    w0 = w0 - w1
+    c[1] = w0
+    w0 = float(rho[2])
+    w1 = float(alpha[2])
+    w0 = w0 - w1
+    c[2] = w0
+    w0 = float(rho[3])
+    w1 = float(alpha[3])
     w0 = w0 + w1
-    w6 = w6 * w0
-    w6 = 0.0 if w5 == 0.0 else w6
-    w0 = 1.0 if w5 == 0.0 else 0.0
-    w0 = 0.0 if w0 == 0.0 else w7
-    w6 = w6 + w0
-    w2 = _div(w2, w6)
-    w2 = _exp(w2)
-    w3 = w3 * w2
-    w5 = 0.0 if w5 == 0.0 else w3
-    w4 = w4 - w5
-    beta_U[1] = w4
-    w4 = 1.2
-    beta_U[2] = w4
-    return (rho_L_minus_alpha, beta_L, rho_U_plus_alpha, beta_U)
+    c[3] = w0
+    w0 = float(rho[4])
+    w1 = float(alpha[4])
+    w0 = w0 + w1
+    c[4] = w0
+    w0 = float(rho[5])
+    w1 = float(alpha[5])
+    w0 = w0 + w1
+    c[5] = w0
+    return (c,)
 
 
-def body_smooth_max_test(a, b):
-    """CasADi Function 'body_smooth_max_test' (16 instructions).
+def body_candidate_rates(rho_dot, alpha_dot):
+    """CasADi Function 'body_candidate_rates' (24 instructions).
+
+    Parameters
+    ----------
+    rho_dot : sequence of float, length 6 (dense 6x1, column-major)
+    alpha_dot : sequence of float, length 6 (dense 6x1, column-major)
+
+    Returns
+    -------
+    c_dot : list of float, length 6 (dense 6x1, column-major)
+    """
+    if len(rho_dot) != 6:
+        raise ValueError('rho_dot: expected 6 values, got %d' % len(rho_dot))
+    if len(alpha_dot) != 6:
+        raise ValueError('alpha_dot: expected 6 values, got %d' % len(alpha_dot))
+    c_dot = [0.0] * 6
+    w0 = float(rho_dot[0])
+    w1 = float(alpha_dot[0])
+    w0 = w0 - w1
+    c_dot[0] = w0
+    w0 = float(rho_dot[1])
+    w1 = float(alpha_dot[1])
+    w0 = w0 - w1
+    c_dot[1] = w0
+    w0 = float(rho_dot[2])
+    w1 = float(alpha_dot[2])
+    w0 = w0 - w1
+    c_dot[2] = w0
+    w0 = float(rho_dot[3])
+    w1 = float(alpha_dot[3])
+    w0 = w0 + w1
+    c_dot[3] = w0
+    w0 = float(rho_dot[4])
+    w1 = float(alpha_dot[4])
+    w0 = w0 + w1
+    c_dot[4] = w0
+    w0 = float(rho_dot[5])
+    w1 = float(alpha_dot[5])
+    w0 = w0 + w1
+    c_dot[5] = w0
+    return (c_dot,)
+
+
+def body_smooth_max_test(a, b, nu):
+    """CasADi Function 'body_smooth_max_test' (17 instructions).
 
     Parameters
     ----------
     a : sequence of float, length 1 (dense 1x1, column-major)
     b : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
 
     Returns
     -------
@@ -390,6 +835,8 @@ def body_smooth_max_test(a, b):
         raise ValueError('a: expected 1 values, got %d' % len(a))
     if len(b) != 1:
         raise ValueError('b: expected 1 values, got %d' % len(b))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
     max = [0.0] * 1
     needed = [0.0] * 1
     w0 = float(a[0])
@@ -397,27 +844,29 @@ def body_smooth_max_test(a, b):
     w2 = _fmax(w0, w1)
     max[0] = w2
     w3 = 80.0
-    w4 = 50.0
+    w4 = float(nu[0])
     w0 = w0 - w1
     w0 = math.fabs(w0)
-    w4 = w4 * w0
-    w3 = 1.0 if w3 <= w4 else 0.0
-    w4 = 6.521212260432478e-21
+    w0 = w4 * w0
+    w3 = 1.0 if w3 <= w0 else 0.0
+    w0 = 3.260606130216239e-19
+    w0 = _div(w0, w4)
     w2 = math.fabs(w2)
-    w4 = 1.0 if w4 <= w2 else 0.0
-    w3 = 1.0 if w3 != 0.0 and w4 != 0.0 else 0.0
+    w0 = 1.0 if w0 <= w2 else 0.0
+    w3 = 1.0 if w3 != 0.0 and w0 != 0.0 else 0.0
     w3 = 1.0 if w3 == 0.0 else 0.0
     needed[0] = w3
     return (max, needed)
 
 
-def body_smooth_max(a, b):
+def body_smooth_max(a, b, nu):
     """CasADi Function 'body_smooth_max' (15 instructions).
 
     Parameters
     ----------
     a : sequence of float, length 1 (dense 1x1, column-major)
     b : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
 
     Returns
     -------
@@ -427,32 +876,35 @@ def body_smooth_max(a, b):
         raise ValueError('a: expected 1 values, got %d' % len(a))
     if len(b) != 1:
         raise ValueError('b: expected 1 values, got %d' % len(b))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
     max = [0.0] * 1
     w0 = float(a[0])
     w1 = float(b[0])
     w2 = _fmax(w0, w1)
-    w3 = -50.0
+    w3 = float(nu[0])
     w0 = w0 - w1
     w0 = math.fabs(w0)
-    w3 = w3 * w0
-    w0 = -80.0
-    w3 = _fmax(w3, w0)
-    w3 = _exp(w3)
-    w3 = _log1p(w3)
-    w0 = 50.0
-    w3 = w3 / w0
-    w2 = w2 + w3
+    w0 = w3 * w0
+    w0 = -w0
+    w1 = -80.0
+    w0 = _fmax(w0, w1)
+    w0 = _exp(w0)
+    w0 = _log1p(w0)
+    w0 = _div(w0, w3)
+    w2 = w2 + w0
     max[0] = w2
     return (max,)
 
 
-def body_smooth_min_test(a, b):
-    """CasADi Function 'body_smooth_min_test' (19 instructions).
+def body_smooth_min_test(a, b, nu):
+    """CasADi Function 'body_smooth_min_test' (20 instructions).
 
     Parameters
     ----------
     a : sequence of float, length 1 (dense 1x1, column-major)
     b : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
 
     Returns
     -------
@@ -463,6 +915,8 @@ def body_smooth_min_test(a, b):
         raise ValueError('a: expected 1 values, got %d' % len(a))
     if len(b) != 1:
         raise ValueError('b: expected 1 values, got %d' % len(b))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
     min = [0.0] * 1
     needed = [0.0] * 1
     w0 = float(a[0])
@@ -473,27 +927,29 @@ def body_smooth_min_test(a, b):
     w3 = -w1
     min[0] = w3
     w3 = 80.0
-    w4 = 50.0
+    w4 = float(nu[0])
     w2 = w2 - w0
     w2 = math.fabs(w2)
-    w4 = w4 * w2
-    w3 = 1.0 if w3 <= w4 else 0.0
-    w4 = 6.521212260432478e-21
+    w2 = w4 * w2
+    w3 = 1.0 if w3 <= w2 else 0.0
+    w2 = 3.260606130216239e-19
+    w2 = _div(w2, w4)
     w1 = math.fabs(w1)
-    w4 = 1.0 if w4 <= w1 else 0.0
-    w3 = 1.0 if w3 != 0.0 and w4 != 0.0 else 0.0
+    w2 = 1.0 if w2 <= w1 else 0.0
+    w3 = 1.0 if w3 != 0.0 and w2 != 0.0 else 0.0
     w3 = 1.0 if w3 == 0.0 else 0.0
     needed[0] = w3
     return (min, needed)
 
 
-def body_smooth_min(a, b):
+def body_smooth_min(a, b, nu):
     """CasADi Function 'body_smooth_min' (18 instructions).
 
     Parameters
     ----------
     a : sequence of float, length 1 (dense 1x1, column-major)
     b : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
 
     Returns
     -------
@@ -503,637 +959,359 @@ def body_smooth_min(a, b):
         raise ValueError('a: expected 1 values, got %d' % len(a))
     if len(b) != 1:
         raise ValueError('b: expected 1 values, got %d' % len(b))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
     min = [0.0] * 1
     w0 = float(a[0])
     w1 = -w0
     w2 = float(b[0])
     w3 = -w2
     w1 = _fmax(w1, w3)
-    w3 = -50.0
+    w3 = float(nu[0])
     w2 = w2 - w0
     w2 = math.fabs(w2)
-    w3 = w3 * w2
-    w2 = -80.0
-    w3 = _fmax(w3, w2)
-    w3 = _exp(w3)
-    w3 = _log1p(w3)
-    w2 = 50.0
-    w3 = w3 / w2
-    w1 = w1 + w3
+    w2 = w3 * w2
+    w2 = -w2
+    w0 = -80.0
+    w2 = _fmax(w2, w0)
+    w2 = _exp(w2)
+    w2 = _log1p(w2)
+    w2 = _div(w2, w3)
+    w1 = w1 + w2
     w1 = -w1
     min[0] = w1
     return (min,)
 
 
-def body_gamma_rates(t, alpha):
-    """CasADi Function 'body_gamma_rates' (471 instructions).
+def body_smooth_max_rate(a, b, a_dot, b_dot, nu):
+    """CasADi Function 'body_smooth_max_rate' (40 instructions).
 
     Parameters
     ----------
-    t : sequence of float, length 1 (dense 1x1, column-major)
-    alpha : sequence of float, length 6 (dense 6x1, column-major)
+    a : sequence of float, length 1 (dense 1x1, column-major)
+    b : sequence of float, length 1 (dense 1x1, column-major)
+    a_dot : sequence of float, length 1 (dense 1x1, column-major)
+    b_dot : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
 
     Returns
     -------
-    gamma_L_dot : list of float, length 3 (dense 3x1, column-major)
-    gamma_U_dot : list of float, length 3 (dense 3x1, column-major)
+    max_dot : list of float, length 1 (dense 1x1, column-major)
     """
-    if len(t) != 1:
-        raise ValueError('t: expected 1 values, got %d' % len(t))
+    if len(a) != 1:
+        raise ValueError('a: expected 1 values, got %d' % len(a))
+    if len(b) != 1:
+        raise ValueError('b: expected 1 values, got %d' % len(b))
+    if len(a_dot) != 1:
+        raise ValueError('a_dot: expected 1 values, got %d' % len(a_dot))
+    if len(b_dot) != 1:
+        raise ValueError('b_dot: expected 1 values, got %d' % len(b_dot))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
+    max_dot = [0.0] * 1
+    w0 = float(b[0])
+    w1 = float(a[0])
+    w2 = 1.0 if w0 <= w1 else 0.0
+    w3 = 1.0 if w1 <= w0 else 0.0
+    w4 = w2 + w3
+    w2 = _div(w2, w4)
+    w5 = float(nu[0])
+    w1 = w1 - w0
+    w0 = math.fabs(w1)
+    w0 = w5 * w0
+    w0 = -w0
+    w6 = -80.0
+    w7 = _fmax(w0, w6)
+    w7 = _exp(w7)
+    w8 = 1.0 if w6 <= w0 else 0.0
+    w0 = 1.0 if w0 <= w6 else 0.0
+    w0 = w8 + w0
+    w8 = _div(w8, w0)
+    w1 = _sign(w1)
+    w0 = w5 * w1
+    w0 = w8 * w0
+    w0 = w7 * w0
+    w6 = 1.0
+    w6 = w6 + w7
+    w0 = _div(w0, w6)
+    w0 = _div(w0, w5)
+    w2 = w2 - w0
+    w0 = float(a_dot[0])
+    w2 = w2 * w0
+    w3 = _div(w3, w4)
+    w1 = w5 * w1
+    w8 = w8 * w1
+    w7 = w7 * w8
+    w7 = _div(w7, w6)
+    w7 = _div(w7, w5)
+    w3 = w3 + w7
+    w7 = float(b_dot[0])
+    w3 = w3 * w7
+    w2 = w2 + w3
+    max_dot[0] = w2
+    return (max_dot,)
+
+
+def body_smooth_min_rate(a, b, a_dot, b_dot, nu):
+    """CasADi Function 'body_smooth_min_rate' (42 instructions).
+
+    Parameters
+    ----------
+    a : sequence of float, length 1 (dense 1x1, column-major)
+    b : sequence of float, length 1 (dense 1x1, column-major)
+    a_dot : sequence of float, length 1 (dense 1x1, column-major)
+    b_dot : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    min_dot : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(a) != 1:
+        raise ValueError('a: expected 1 values, got %d' % len(a))
+    if len(b) != 1:
+        raise ValueError('b: expected 1 values, got %d' % len(b))
+    if len(a_dot) != 1:
+        raise ValueError('a_dot: expected 1 values, got %d' % len(a_dot))
+    if len(b_dot) != 1:
+        raise ValueError('b_dot: expected 1 values, got %d' % len(b_dot))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
+    min_dot = [0.0] * 1
+    w0 = float(a[0])
+    w1 = -w0
+    w2 = float(b[0])
+    w3 = -w2
+    w4 = 1.0 if w1 <= w3 else 0.0
+    w3 = 1.0 if w3 <= w1 else 0.0
+    w1 = w3 + w4
+    w4 = _div(w4, w1)
+    w5 = float(nu[0])
+    w2 = w2 - w0
+    w0 = math.fabs(w2)
+    w0 = w5 * w0
+    w0 = -w0
+    w6 = -80.0
+    w7 = _fmax(w0, w6)
+    w7 = _exp(w7)
+    w8 = 1.0 if w6 <= w0 else 0.0
+    w0 = 1.0 if w0 <= w6 else 0.0
+    w0 = w8 + w0
+    w8 = _div(w8, w0)
+    w2 = _sign(w2)
+    w0 = w5 * w2
+    w0 = w8 * w0
+    w0 = w7 * w0
+    w6 = 1.0
+    w6 = w6 + w7
+    w0 = _div(w0, w6)
+    w0 = _div(w0, w5)
+    w4 = w4 + w0
+    w0 = float(b_dot[0])
+    w4 = w4 * w0
+    w2 = w5 * w2
+    w8 = w8 * w2
+    w7 = w7 * w8
+    w7 = _div(w7, w6)
+    w7 = _div(w7, w5)
+    w3 = _div(w3, w1)
+    w7 = w7 - w3
+    w3 = float(a_dot[0])
+    w7 = w7 * w3
+    w4 = w4 - w7
+    min_dot[0] = w4
+    return (min_dot,)
+
+
+def body_conflict(rho, beta, theta0, mu):
+    """CasADi Function 'body_conflict' (78 instructions).
+
+    Parameters
+    ----------
+    rho : sequence of float, length 6 (dense 6x1, column-major)
+    beta : sequence of float, length 6 (dense 6x1, column-major)
+    theta0 : sequence of float, length 1 (dense 1x1, column-major)
+    mu : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    psi : list of float, length 6 (dense 6x1, column-major)
+    theta : list of float, length 6 (dense 6x1, column-major)
+    """
+    if len(rho) != 6:
+        raise ValueError('rho: expected 6 values, got %d' % len(rho))
+    if len(beta) != 6:
+        raise ValueError('beta: expected 6 values, got %d' % len(beta))
+    if len(theta0) != 1:
+        raise ValueError('theta0: expected 1 values, got %d' % len(theta0))
+    if len(mu) != 1:
+        raise ValueError('mu: expected 1 values, got %d' % len(mu))
+    psi = [0.0] * 6
+    theta = [0.0] * 6
+    w0 = float(beta[3])
+    w1 = float(rho[0])
+    w0 = w0 - w1
+    psi[0] = w0
+    w1 = float(beta[4])
+    w2 = float(rho[1])
+    w1 = w1 - w2
+    psi[1] = w1
+    w2 = float(beta[5])
+    w3 = float(rho[2])
+    w2 = w2 - w3
+    psi[2] = w2
+    w3 = float(rho[3])
+    w4 = float(beta[0])
+    w3 = w3 - w4
+    psi[3] = w3
+    w4 = float(rho[4])
+    w5 = float(beta[1])
+    w4 = w4 - w5
+    psi[4] = w4
+    w5 = float(rho[5])
+    w6 = float(beta[2])
+    w5 = w5 - w6
+    psi[5] = w5
+    w6 = float(theta0[0])
+    w6 = w6 + w6
+    w7 = 1.0
+    w8 = float(mu[0])
+    w0 = w0 - w8
+    w0 = w0 + w0
+    w9 = -80.0
+    w0 = _fmax(w0, w9)
+    w10 = 80.0
+    w0 = _fmin(w0, w10)
+    w0 = _exp(w0)
+    w0 = w7 + w0
+    w0 = _div(w6, w0)
+    theta[0] = w0
+    w1 = w1 - w8
+    w1 = w1 + w1
+    w1 = _fmax(w1, w9)
+    w1 = _fmin(w1, w10)
+    w1 = _exp(w1)
+    w1 = w7 + w1
+    w1 = _div(w6, w1)
+    theta[1] = w1
+    w2 = w2 - w8
+    w2 = w2 + w2
+    w2 = _fmax(w2, w9)
+    w2 = _fmin(w2, w10)
+    w2 = _exp(w2)
+    w2 = w7 + w2
+    w2 = _div(w6, w2)
+    theta[2] = w2
+    w3 = w3 - w8
+    w3 = w3 + w3
+    w3 = _fmax(w3, w9)
+    w3 = _fmin(w3, w10)
+    w3 = _exp(w3)
+    w3 = w7 + w3
+    w3 = _div(w6, w3)
+    theta[3] = w3
+    w4 = w4 - w8
+    w4 = w4 + w4
+    w4 = _fmax(w4, w9)
+    w4 = _fmin(w4, w10)
+    w4 = _exp(w4)
+    w4 = w7 + w4
+    w4 = _div(w6, w4)
+    theta[4] = w4
+    w5 = w5 - w8
+    w5 = w5 + w5
+    w5 = _fmax(w5, w9)
+    w5 = _fmin(w5, w10)
+    w5 = _exp(w5)
+    w7 = w7 + w5
+    w6 = _div(w6, w7)
+    theta[5] = w6
+    return (psi, theta)
+
+
+def body_alpha_rate(alpha, psi, theta, kappa):
+    """CasADi Function 'body_alpha_rate' (55 instructions).
+
+    Parameters
+    ----------
+    alpha : sequence of float, length 6 (dense 6x1, column-major)
+    psi : sequence of float, length 6 (dense 6x1, column-major)
+    theta : sequence of float, length 6 (dense 6x1, column-major)
+    kappa : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    alpha_dot : list of float, length 6 (dense 6x1, column-major)
+    """
     if len(alpha) != 6:
         raise ValueError('alpha: expected 6 values, got %d' % len(alpha))
-    gamma_L_dot = [0.0] * 3
-    gamma_U_dot = [0.0] * 3
-    w0 = float(t[0])
-    w1 = 9.0
-    w2 = 1.0 if w0 < w1 else 0.0
-    w3 = 0.0
-    w4 = 1.0 if w0 < w3 else 0.0
-    w4 = 1.0 if w4 == 0.0 else 0.0
-    w5 = 4.5
-    w6 = w1 - w0
-    w6 = 0.0 if w2 == 0.0 else w6
-    w7 = 1.0 if w2 == 0.0 else 0.0
-    w8 = 1.0
-    w7 = 0.0 if w7 == 0.0 else w8
-    w6 = w6 + w7
-    w7 = _div(w0, w6)
-    w9 = math.tanh(w7)
-    w10 = 0.0 if w4 == 0.0 else w9
-    w10 = 0.0 if w2 == 0.0 else w10
-    w11 = 1.0 if w2 == 0.0 else 0.0
-    w11 = 0.0 if w11 == 0.0 else w8
-    w10 = w10 + w11
-    w11 = w5 * w10
-    w12 = 0.04999999999999999
-    w11 = w11 + w12
-    w13 = float(alpha[0])
-    w11 = w11 - w13
-    w14 = 1.0 if w3 <= w11 else 0.0
-    w15 = 1.0 if w11 <= w3 else 0.0
-    w15 = w14 + w15
-    w14 = _div(w14, w15)
-    w15 = w9 * w9
-    w15 = w8 - w15
-    w16 = _div(1.0, w6)
-    w17 = _div(w7, w6)
-    w17 = 0.0 if w2 == 0.0 else w17
-    w16 = w16 + w17
-    w15 = w15 * w16
-    w16 = w5 * w15
-    w14 = w14 * w16
-    w17 = 0.02
-    w18 = -50.0
-    w19 = math.fabs(w11)
-    w19 = w18 * w19
-    w20 = -80.0
-    w21 = _fmax(w19, w20)
-    w21 = _exp(w21)
-    w22 = 1.0 if w20 <= w19 else 0.0
-    w23 = 1.0 if w19 <= w20 else 0.0
-    w23 = w22 + w23
-    w22 = _div(w22, w23)
-    w23 = _sign(w11)
-    w23 = w23 * w16
-    w23 = w18 * w23
-    w22 = w22 * w23
-    w22 = w21 * w22
-    w23 = w8 + w21
-    w22 = _div(w22, w23)
-    w22 = w17 * w22
-    w14 = w14 + w22
-    w14 = 0.0 if w4 == 0.0 else w14
-    w14 = 0.0 if w2 == 0.0 else w14
-    w22 = 1.0 if w3 <= w11 else 0.0
-    w23 = 1.0 if w11 <= w3 else 0.0
-    w23 = w22 + w23
-    w22 = _div(w22, w23)
-    w23 = 1.0 if w20 <= w19 else 0.0
-    w19 = 1.0 if w19 <= w20 else 0.0
-    w19 = w23 + w19
-    w23 = _div(w23, w19)
-    w11 = _sign(w11)
-    w11 = w18 * w11
-    w23 = w23 * w11
-    w23 = w21 * w23
-    w21 = w8 + w21
-    w23 = _div(w23, w21)
-    w23 = w17 * w23
-    w22 = w22 + w23
-    w23 = 5.0
-    w21 = 1.0 if w0 < w1 else 0.0
-    w11 = 1.0 if w0 < w3 else 0.0
-    w11 = 1.0 if w11 == 0.0 else 0.0
-    w1 = w1 - w0
-    w1 = 0.0 if w21 == 0.0 else w1
-    w19 = 1.0 if w21 == 0.0 else 0.0
-    w19 = 0.0 if w19 == 0.0 else w8
-    w1 = w1 + w19
-    w1 = _div(w0, w1)
-    w1 = math.tanh(w1)
-    w11 = 0.0 if w11 == 0.0 else w1
-    w11 = 0.0 if w21 == 0.0 else w11
-    w21 = 1.0 if w21 == 0.0 else 0.0
-    w21 = 0.0 if w21 == 0.0 else w8
-    w11 = w11 + w21
-    w21 = w5 * w11
-    w21 = w21 + w12
-    w21 = w23 - w21
-    w12 = w21 - w8
-    w12 = w12 + w12
-    w12 = _fmax(w12, w20)
-    w1 = 80.0
-    w12 = _fmin(w12, w1)
-    w12 = _exp(w12)
-    w12 = w8 + w12
-    w12 = _div(w17, w12)
-    w21 = w21 + w13
-    w21 = w21 * w21
-    w12 = _div(w12, w21)
-    w13 = w23 * w13
-    w12 = w12 - w13
-    w22 = w22 * w12
-    w14 = w14 - w22
-    gamma_L_dot[0] = w14
-    w14 = 4.55
-    w22 = float(alpha[1])
-    w12 = w14 - w22
-    w13 = 1.0 if w3 <= w12 else 0.0
-    w3 = 1.0 if w12 <= w3 else 0.0
-    w3 = w13 + w3
-    w13 = _div(w13, w3)
-    w3 = math.fabs(w12)
-    w3 = w18 * w3
-    w21 = _fmax(w3, w20)
-    w21 = _exp(w21)
-    w19 = 1.0 if w20 <= w3 else 0.0
-    w3 = 1.0 if w3 <= w20 else 0.0
-    w3 = w19 + w3
-    w19 = _div(w19, w3)
-    w12 = _sign(w12)
-    w12 = w18 * w12
-    w19 = w19 * w12
-    w19 = w21 * w19
-    w21 = w8 + w21
-    w19 = _div(w19, w21)
-    w19 = w17 * w19
-    w13 = w13 + w19
-    w19 = 1.893622094092184
-    w21 = w0 - w19
-    w12 = math.fabs(w21)
-    w3 = 1.5729834283919115
-    w12 = 1.0 if w12 < w3 else 0.0
-    w16 = 1.2000000000000002
-    w24 = -0.1
-    w25 = w21 * w21
-    w25 = w24 * w25
-    w26 = math.fabs(w21)
-    w26 = w3 - w26
-    w21 = math.fabs(w21)
-    w21 = w3 + w21
-    w26 = w26 * w21
-    w26 = 0.0 if w12 == 0.0 else w26
-    w21 = 1.0 if w12 == 0.0 else 0.0
-    w21 = 0.0 if w21 == 0.0 else w8
-    w26 = w26 + w21
-    w25 = _div(w25, w26)
-    w25 = _exp(w25)
-    w25 = w16 * w25
-    w12 = 0.0 if w12 == 0.0 else w25
-    w12 = w23 - w12
-    w12 = w12 - w14
-    w14 = w12 - w8
-    w14 = w14 + w14
-    w14 = _fmax(w14, w20)
-    w14 = _fmin(w14, w1)
-    w14 = _exp(w14)
-    w14 = w8 + w14
-    w14 = _div(w17, w14)
-    w12 = w12 + w22
-    w12 = w12 * w12
-    w14 = _div(w14, w12)
-    w22 = w23 * w22
-    w14 = w14 - w22
-    w13 = w13 * w14
-    w13 = -w13
-    gamma_L_dot[1] = w13
-    w13 = -1.2
-    w14 = -0.45
-    w22 = w14 * w10
-    w12 = -0.05
-    w22 = w22 + w12
-    w25 = float(alpha[2])
-    w22 = w22 - w25
-    w26 = 1.0 if w13 <= w22 else 0.0
-    w21 = 1.0 if w22 <= w13 else 0.0
-    w21 = w26 + w21
-    w26 = _div(w26, w21)
-    w15 = w14 * w15
-    w26 = w26 * w15
-    w21 = w22 - w13
-    w27 = math.fabs(w21)
-    w27 = w18 * w27
-    w28 = _fmax(w27, w20)
-    w28 = _exp(w28)
-    w29 = 1.0 if w20 <= w27 else 0.0
-    w30 = 1.0 if w27 <= w20 else 0.0
-    w30 = w29 + w30
-    w29 = _div(w29, w30)
-    w30 = _sign(w21)
-    w30 = w30 * w15
-    w30 = w18 * w30
-    w29 = w29 * w30
-    w29 = w28 * w29
-    w30 = w8 + w28
-    w29 = _div(w29, w30)
-    w29 = w17 * w29
-    w26 = w26 + w29
-    w26 = 0.0 if w4 == 0.0 else w26
-    w26 = 0.0 if w2 == 0.0 else w26
-    w29 = 1.0 if w13 <= w22 else 0.0
-    w22 = 1.0 if w22 <= w13 else 0.0
-    w22 = w29 + w22
-    w29 = _div(w29, w22)
-    w22 = 1.0 if w20 <= w27 else 0.0
-    w27 = 1.0 if w27 <= w20 else 0.0
-    w27 = w22 + w27
-    w22 = _div(w22, w27)
-    w21 = _sign(w21)
-    w21 = w18 * w21
-    w22 = w22 * w21
-    w22 = w28 * w22
-    w28 = w8 + w28
-    w22 = _div(w22, w28)
-    w22 = w17 * w22
-    w29 = w29 + w22
-    w22 = 1.2
-    w14 = w14 * w11
-    w14 = w14 + w12
-    w22 = w22 - w14
-    w14 = w22 - w8
-    w14 = w14 + w14
-    w14 = _fmax(w14, w20)
-    w14 = _fmin(w14, w1)
-    w14 = _exp(w14)
-    w14 = w8 + w14
-    w14 = _div(w17, w14)
-    w22 = w22 + w25
-    w22 = w22 * w22
-    w14 = _div(w14, w22)
-    w25 = w23 * w25
-    w14 = w14 - w25
-    w29 = w29 * w14
-    w26 = w26 - w29
-    gamma_L_dot[2] = w26
-    w26 = w5 * w10
-    w29 = 0.45
-    w26 = w26 + w29
-    w14 = float(alpha[3])
-    w26 = w26 + w14
-    w25 = -5.0
-    w22 = w26 + w25
-    w12 = math.fabs(w22)
-    w12 = w18 * w12
-    w28 = _fmax(w12, w20)
-    w28 = _exp(w28)
-    w21 = 1.0 if w20 <= w12 else 0.0
-    w27 = 1.0 if w12 <= w20 else 0.0
-    w27 = w21 + w27
-    w21 = _div(w21, w27)
-    w27 = _sign(w22)
-    w9 = w9 * w9
-    w9 = w8 - w9
-    w30 = _div(1.0, w6)
-    w7 = _div(w7, w6)
-    w7 = 0.0 if w2 == 0.0 else w7
-    w30 = w30 + w7
-    w9 = w9 * w30
-    w30 = w5 * w9
-    w27 = w27 * w30
-    w27 = w18 * w27
-    w21 = w21 * w27
-    w21 = w28 * w21
-    w27 = w8 + w28
-    w21 = _div(w21, w27)
-    w21 = w17 * w21
-    w26 = -w26
-    w27 = 1.0 if w25 <= w26 else 0.0
-    w7 = 1.0 if w26 <= w25 else 0.0
-    w7 = w27 + w7
-    w27 = _div(w27, w7)
-    w27 = w27 * w30
-    w21 = w21 - w27
-    w21 = -w21
-    w21 = 0.0 if w4 == 0.0 else w21
-    w21 = 0.0 if w2 == 0.0 else w21
-    w27 = 1.0 if w20 <= w12 else 0.0
-    w12 = 1.0 if w12 <= w20 else 0.0
-    w12 = w27 + w12
-    w27 = _div(w27, w12)
-    w22 = _sign(w22)
-    w22 = w18 * w22
-    w27 = w27 * w22
-    w27 = w28 * w27
-    w28 = w8 + w28
-    w27 = _div(w27, w28)
-    w27 = w17 * w27
-    w28 = 1.0 if w25 <= w26 else 0.0
-    w26 = 1.0 if w26 <= w25 else 0.0
-    w26 = w28 + w26
-    w28 = _div(w28, w26)
-    w27 = w27 - w28
-    w5 = w5 * w11
-    w5 = w5 + w29
-    w28 = w5 - w8
-    w28 = w28 + w28
-    w28 = _fmax(w28, w20)
-    w28 = _fmin(w28, w1)
-    w28 = _exp(w28)
-    w28 = w8 + w28
-    w28 = _div(w17, w28)
-    w5 = w5 + w14
-    w5 = w5 * w5
-    w28 = _div(w28, w5)
-    w14 = w23 * w14
-    w28 = w28 - w14
-    w27 = w27 * w28
-    w21 = w21 - w27
-    gamma_U_dot[0] = w21
-    w0 = w0 - w19
-    w19 = math.fabs(w0)
-    w19 = 1.0 if w19 < w3 else 0.0
-    w21 = 4.95
-    w27 = float(alpha[4])
-    w28 = w21 + w27
-    w14 = -w28
-    w5 = w0 * w0
-    w24 = w24 * w5
-    w5 = math.fabs(w0)
-    w5 = w3 - w5
-    w26 = math.fabs(w0)
-    w3 = w3 + w26
-    w26 = w5 * w3
-    w26 = 0.0 if w19 == 0.0 else w26
-    w25 = 1.0 if w19 == 0.0 else 0.0
-    w25 = 0.0 if w25 == 0.0 else w8
-    w26 = w26 + w25
-    w24 = _div(w24, w26)
-    w25 = _exp(w24)
-    w22 = w16 * w25
-    w22 = 0.0 if w19 == 0.0 else w22
-    w22 = w23 - w22
-    w12 = -w22
-    w30 = 1.0 if w14 <= w12 else 0.0
-    w7 = 1.0 if w12 <= w14 else 0.0
-    w7 = w7 + w30
-    w30 = _div(w30, w7)
-    w7 = -0.2
-    w7 = w7 * w0
-    w7 = _div(w7, w26)
-    w24 = _div(w24, w26)
-    w26 = _sign(w0)
-    w5 = w5 * w26
-    w0 = _sign(w0)
-    w3 = w3 * w0
-    w5 = w5 - w3
-    w24 = w24 * w5
-    w24 = -w24
-    w24 = 0.0 if w19 == 0.0 else w24
-    w7 = w7 + w24
-    w25 = w25 * w7
-    w16 = w16 * w25
-    w30 = w30 * w16
-    w22 = w22 - w28
-    w28 = math.fabs(w22)
-    w28 = w18 * w28
-    w25 = _fmax(w28, w20)
-    w25 = _exp(w25)
-    w7 = 1.0 if w20 <= w28 else 0.0
-    w24 = 1.0 if w28 <= w20 else 0.0
-    w24 = w7 + w24
-    w7 = _div(w7, w24)
-    w24 = _sign(w22)
-    w24 = w24 * w16
-    w24 = w18 * w24
-    w7 = w7 * w24
-    w7 = w25 * w7
-    w24 = w8 + w25
-    w7 = _div(w7, w24)
-    w7 = w17 * w7
-    w30 = w30 - w7
-    w30 = -w30
-    w19 = 0.0 if w19 == 0.0 else w30
-    w30 = 1.0 if w12 <= w14 else 0.0
-    w14 = 1.0 if w14 <= w12 else 0.0
-    w14 = w30 + w14
-    w30 = _div(w30, w14)
-    w14 = 1.0 if w20 <= w28 else 0.0
-    w28 = 1.0 if w28 <= w20 else 0.0
-    w28 = w14 + w28
-    w14 = _div(w14, w28)
-    w22 = _sign(w22)
-    w22 = w18 * w22
-    w14 = w14 * w22
-    w14 = w25 * w14
-    w25 = w8 + w25
-    w14 = _div(w14, w25)
-    w14 = w17 * w14
-    w30 = w30 + w14
-    w14 = 7.412122812527931e-06
-    w21 = w21 + w27
-    w21 = w21 * w21
-    w14 = _div(w14, w21)
-    w27 = w23 * w27
-    w14 = w14 - w27
-    w30 = w30 * w14
-    w19 = w19 + w30
-    gamma_U_dot[1] = w19
-    w10 = w29 * w10
-    w19 = 0.05
-    w10 = w10 + w19
-    w30 = float(alpha[5])
-    w10 = w10 + w30
-    w14 = w10 + w13
-    w27 = math.fabs(w14)
-    w27 = w18 * w27
-    w21 = _fmax(w27, w20)
-    w21 = _exp(w21)
-    w25 = 1.0 if w20 <= w27 else 0.0
-    w22 = 1.0 if w27 <= w20 else 0.0
-    w22 = w25 + w22
-    w25 = _div(w25, w22)
-    w22 = _sign(w14)
-    w9 = w29 * w9
-    w22 = w22 * w9
-    w22 = w18 * w22
-    w25 = w25 * w22
-    w25 = w21 * w25
-    w22 = w8 + w21
-    w25 = _div(w25, w22)
-    w25 = w17 * w25
-    w10 = -w10
-    w22 = 1.0 if w13 <= w10 else 0.0
-    w28 = 1.0 if w10 <= w13 else 0.0
-    w28 = w22 + w28
-    w22 = _div(w22, w28)
-    w22 = w22 * w9
-    w25 = w25 - w22
-    w25 = -w25
-    w4 = 0.0 if w4 == 0.0 else w25
-    w2 = 0.0 if w2 == 0.0 else w4
-    w4 = 1.0 if w20 <= w27 else 0.0
-    w27 = 1.0 if w27 <= w20 else 0.0
-    w27 = w4 + w27
-    w4 = _div(w4, w27)
-    w14 = _sign(w14)
-    w18 = w18 * w14
-    w4 = w4 * w18
-    w4 = w21 * w4
-    w21 = w8 + w21
-    w4 = _div(w4, w21)
-    w4 = w17 * w4
-    w21 = 1.0 if w13 <= w10 else 0.0
-    w10 = 1.0 if w10 <= w13 else 0.0
-    w10 = w21 + w10
-    w21 = _div(w21, w10)
-    w4 = w4 - w21
-    w29 = w29 * w11
-    w29 = w29 + w19
-    w29 = w29 - w13
-    w13 = w29 - w8
-    w13 = w13 + w13
-    w13 = _fmax(w13, w20)
-    w13 = _fmin(w13, w1)
-    w13 = _exp(w13)
-    w8 = w8 + w13
-    w17 = _div(w17, w8)
-    w29 = w29 + w30
-    w29 = w29 * w29
-    w17 = _div(w17, w29)
-    w23 = w23 * w30
-    w17 = w17 - w23
-    w4 = w4 * w17
-    w2 = w2 - w4
-    gamma_U_dot[2] = w2
-    return (gamma_L_dot, gamma_U_dot)
-
-
-def body_law(x, gamma_L, gamma_U):
-    """CasADi Function 'body_law' (89 instructions).
-
-    Parameters
-    ----------
-    x : sequence of float, length 3 (dense 3x1, column-major)
-    gamma_L : sequence of float, length 3 (dense 3x1, column-major)
-    gamma_U : sequence of float, length 3 (dense 3x1, column-major)
-
-    Returns
-    -------
-    u : list of float, length 3 (dense 3x1, column-major)
-    inside : list of float, length 1 (dense 1x1, column-major)
-    """
-    if len(x) != 3:
-        raise ValueError('x: expected 3 values, got %d' % len(x))
-    if len(gamma_L) != 3:
-        raise ValueError('gamma_L: expected 3 values, got %d' % len(gamma_L))
-    if len(gamma_U) != 3:
-        raise ValueError('gamma_U: expected 3 values, got %d' % len(gamma_U))
-    u = [0.0] * 3
-    inside = [0.0] * 1
-    w0 = -0.18168809110361742
-    w1 = 4.0
-    w2 = float(gamma_U[0])
-    w3 = float(gamma_L[0])
-    w4 = w2 - w3
-    w5 = 1e-06
-    w6 = _fmax(w4, w5)
-    w7 = 1.0
-    w8 = float(x[0])
-    w8 = w8 + w8
+    if len(psi) != 6:
+        raise ValueError('psi: expected 6 values, got %d' % len(psi))
+    if len(theta) != 6:
+        raise ValueError('theta: expected 6 values, got %d' % len(theta))
+    if len(kappa) != 1:
+        raise ValueError('kappa: expected 1 values, got %d' % len(kappa))
+    alpha_dot = [0.0] * 6
+    w0 = float(theta[0])
+    w1 = float(psi[0])
+    w2 = float(alpha[0])
+    w1 = w1 + w2
+    w1 = w1 * w1
+    w0 = _div(w0, w1)
+    w1 = float(kappa[0])
+    w2 = w1 * w2
+    w0 = w0 - w2
+    alpha_dot[0] = w0
+    w0 = float(theta[1])
+    w2 = float(psi[1])
+    w3 = float(alpha[1])
     w2 = w2 + w3
-    w8 = w8 - w2
-    w8 = _div(w8, w6)
-    w2 = -0.9999990463256836
-    w3 = _fmax(w8, w2)
-    w9 = 0.9999990463256836
-    w3 = _fmin(w3, w9)
-    w10 = w3 * w3
-    w10 = w7 - w10
-    w6 = w6 * w10
-    w6 = _div(w1, w6)
-    w6 = w0 * w6
-    w10 = w7 + w3
-    w3 = w7 - w3
-    w10 = _div(w10, w3)
-    w10 = _log(w10)
-    w6 = w6 * w10
-    u[0] = w6
-    w6 = float(gamma_U[1])
-    w10 = float(gamma_L[1])
-    w3 = w6 - w10
-    w11 = _fmax(w3, w5)
-    w12 = float(x[1])
-    w12 = w12 + w12
-    w6 = w6 + w10
-    w12 = w12 - w6
-    w12 = _div(w12, w11)
-    w6 = _fmax(w12, w2)
-    w6 = _fmin(w6, w9)
-    w10 = w6 * w6
-    w10 = w7 - w10
-    w11 = w11 * w10
-    w11 = _div(w1, w11)
-    w11 = w0 * w11
-    w10 = w7 + w6
-    w6 = w7 - w6
-    w10 = _div(w10, w6)
-    w10 = _log(w10)
-    w11 = w11 * w10
-    u[1] = w11
-    w11 = float(gamma_U[2])
-    w10 = float(gamma_L[2])
-    w6 = w11 - w10
-    w5 = _fmax(w6, w5)
-    w13 = float(x[2])
-    w13 = w13 + w13
-    w11 = w11 + w10
-    w13 = w13 - w11
-    w13 = _div(w13, w5)
-    w2 = _fmax(w13, w2)
-    w2 = _fmin(w2, w9)
-    w9 = w2 * w2
-    w9 = w7 - w9
-    w5 = w5 * w9
-    w1 = _div(w1, w5)
-    w0 = w0 * w1
-    w1 = w7 + w2
-    w2 = w7 - w2
-    w1 = _div(w1, w2)
-    w1 = _log(w1)
-    w0 = w0 * w1
-    u[2] = w0
-    w8 = math.fabs(w8)
-    w8 = 1.0 if w8 < w7 else 0.0
-    w0 = 0.0
-    w4 = 1.0 if w0 < w4 else 0.0
-    w8 = 1.0 if w8 != 0.0 and w4 != 0.0 else 0.0
-    w8 = 1.0 if w7 != 0.0 and w8 != 0.0 else 0.0
-    w12 = math.fabs(w12)
-    w12 = 1.0 if w12 < w7 else 0.0
-    w3 = 1.0 if w0 < w3 else 0.0
-    w12 = 1.0 if w12 != 0.0 and w3 != 0.0 else 0.0
-    w8 = 1.0 if w8 != 0.0 and w12 != 0.0 else 0.0
-    w13 = math.fabs(w13)
-    w13 = 1.0 if w13 < w7 else 0.0
-    w0 = 1.0 if w0 < w6 else 0.0
-    w13 = 1.0 if w13 != 0.0 and w0 != 0.0 else 0.0
-    w8 = 1.0 if w8 != 0.0 and w13 != 0.0 else 0.0
-    inside[0] = w8
-    return (u, inside)
+    w2 = w2 * w2
+    w0 = _div(w0, w2)
+    w3 = w1 * w3
+    w0 = w0 - w3
+    alpha_dot[1] = w0
+    w0 = float(theta[2])
+    w3 = float(psi[2])
+    w2 = float(alpha[2])
+    w3 = w3 + w2
+    w3 = w3 * w3
+    w0 = _div(w0, w3)
+    w2 = w1 * w2
+    w0 = w0 - w2
+    alpha_dot[2] = w0
+    w0 = float(theta[3])
+    w2 = float(psi[3])
+    w3 = float(alpha[3])
+    w2 = w2 + w3
+    w2 = w2 * w2
+    w0 = _div(w0, w2)
+    w3 = w1 * w3
+    w0 = w0 - w3
+    alpha_dot[3] = w0
+    w0 = float(theta[4])
+    w3 = float(psi[4])
+    w2 = float(alpha[4])
+    w3 = w3 + w2
+    w3 = w3 * w3
+    w0 = _div(w0, w3)
+    w2 = w1 * w2
+    w0 = w0 - w2
+    alpha_dot[4] = w0
+    w0 = float(theta[5])
+    w2 = float(psi[5])
+    w3 = float(alpha[5])
+    w2 = w2 + w3
+    w2 = w2 * w2
+    w0 = _div(w0, w2)
+    w1 = w1 * w3
+    w0 = w0 - w1
+    alpha_dot[5] = w0
+    return (alpha_dot,)
 
 
-def body_alpha_conflict(t, dt):
-    """CasADi Function 'body_alpha_conflict' (118 instructions).
+def body_later(t, dt):
+    """CasADi Function 'body_later' (4 instructions).
 
     Parameters
     ----------
@@ -1142,137 +1320,21 @@ def body_alpha_conflict(t, dt):
 
     Returns
     -------
-    psi : list of float, length 6 (dense 6x1, column-major)
-    theta : list of float, length 6 (dense 6x1, column-major)
+    t_next : list of float, length 1 (dense 1x1, column-major)
     """
     if len(t) != 1:
         raise ValueError('t: expected 1 values, got %d' % len(t))
     if len(dt) != 1:
         raise ValueError('dt: expected 1 values, got %d' % len(dt))
-    psi = [0.0] * 6
-    theta = [0.0] * 6
-    w0 = 5.0
-    w1 = 4.5
-    w2 = float(t[0])
-    w3 = float(dt[0])
-    w2 = w2 + w3
-    w3 = 9.0
-    w4 = 1.0 if w2 < w3 else 0.0
-    w5 = 0.0
-    w5 = 1.0 if w2 < w5 else 0.0
-    w5 = 1.0 if w5 == 0.0 else 0.0
-    w3 = w3 - w2
-    w3 = 0.0 if w4 == 0.0 else w3
-    w6 = 1.0 if w4 == 0.0 else 0.0
-    w7 = 1.0
-    w6 = 0.0 if w6 == 0.0 else w7
-    w3 = w3 + w6
-    w3 = _div(w2, w3)
-    w3 = math.tanh(w3)
-    w5 = 0.0 if w5 == 0.0 else w3
-    w5 = 0.0 if w4 == 0.0 else w5
-    w4 = 1.0 if w4 == 0.0 else 0.0
-    w4 = 0.0 if w4 == 0.0 else w7
-    w5 = w5 + w4
-    w4 = w1 * w5
-    w3 = 0.04999999999999999
-    w4 = w4 + w3
-    w4 = w0 - w4
-    psi[0] = w4
-    w3 = 1.893622094092184
-    w2 = w2 - w3
-    w3 = math.fabs(w2)
-    w6 = 1.5729834283919115
-    w3 = 1.0 if w3 < w6 else 0.0
-    w8 = 1.2000000000000002
-    w9 = -0.1
-    w10 = w2 * w2
-    w9 = w9 * w10
-    w10 = math.fabs(w2)
-    w10 = w6 - w10
-    w2 = math.fabs(w2)
-    w6 = w6 + w2
-    w10 = w10 * w6
-    w10 = 0.0 if w3 == 0.0 else w10
-    w6 = 1.0 if w3 == 0.0 else 0.0
-    w6 = 0.0 if w6 == 0.0 else w7
-    w10 = w10 + w6
-    w9 = _div(w9, w10)
-    w9 = _exp(w9)
-    w8 = w8 * w9
-    w3 = 0.0 if w3 == 0.0 else w8
-    w0 = w0 - w3
-    w3 = 4.55
-    w0 = w0 - w3
-    psi[1] = w0
-    w3 = 1.2
-    w8 = -0.45
-    w8 = w8 * w5
-    w9 = -0.05
-    w8 = w8 + w9
-    w3 = w3 - w8
-    psi[2] = w3
-    w1 = w1 * w5
-    w8 = 0.45
-    w1 = w1 + w8
-    psi[3] = w1
-    w9 = 4.95
-    psi[4] = w9
-    w8 = w8 * w5
-    w5 = 0.05
-    w8 = w8 + w5
-    w5 = -1.2
-    w8 = w8 - w5
-    psi[5] = w8
-    w5 = 0.02
-    w4 = w4 - w7
-    w4 = w4 + w4
-    w9 = -80.0
-    w4 = _fmax(w4, w9)
-    w10 = 80.0
-    w4 = _fmin(w4, w10)
-    w4 = _exp(w4)
-    w4 = w7 + w4
-    w4 = _div(w5, w4)
-    theta[0] = w4
-    w0 = w0 - w7
-    w0 = w0 + w0
-    w0 = _fmax(w0, w9)
-    w0 = _fmin(w0, w10)
-    w0 = _exp(w0)
-    w0 = w7 + w0
-    w0 = _div(w5, w0)
-    theta[1] = w0
-    w3 = w3 - w7
-    w3 = w3 + w3
-    w3 = _fmax(w3, w9)
-    w3 = _fmin(w3, w10)
-    w3 = _exp(w3)
-    w3 = w7 + w3
-    w3 = _div(w5, w3)
-    theta[2] = w3
-    w1 = w1 - w7
-    w1 = w1 + w1
-    w1 = _fmax(w1, w9)
-    w1 = _fmin(w1, w10)
-    w1 = _exp(w1)
-    w1 = w7 + w1
-    w1 = _div(w5, w1)
-    theta[3] = w1
-    w1 = 7.412122812527931e-06
-    theta[4] = w1
-    w8 = w8 - w7
-    w8 = w8 + w8
-    w8 = _fmax(w8, w9)
-    w8 = _fmin(w8, w10)
-    w8 = _exp(w8)
-    w7 = w7 + w8
-    w5 = _div(w5, w7)
-    theta[5] = w5
-    return (psi, theta)
+    t_next = [0.0] * 1
+    w0 = float(t[0])
+    w1 = float(dt[0])
+    w0 = w0 + w1
+    t_next[0] = w0
+    return (t_next,)
 
 
-def body_newton_start(alpha, psi, theta, dt):
+def body_newton_start(alpha, psi, theta, dt, kappa):
     """CasADi Function 'body_newton_start' (24 instructions).
 
     Parameters
@@ -1281,6 +1343,7 @@ def body_newton_start(alpha, psi, theta, dt):
     psi : sequence of float, length 1 (dense 1x1, column-major)
     theta : sequence of float, length 1 (dense 1x1, column-major)
     dt : sequence of float, length 1 (dense 1x1, column-major)
+    kappa : sequence of float, length 1 (dense 1x1, column-major)
 
     Returns
     -------
@@ -1297,13 +1360,15 @@ def body_newton_start(alpha, psi, theta, dt):
         raise ValueError('theta: expected 1 values, got %d' % len(theta))
     if len(dt) != 1:
         raise ValueError('dt: expected 1 values, got %d' % len(dt))
+    if len(kappa) != 1:
+        raise ValueError('kappa: expected 1 values, got %d' % len(kappa))
     a0 = [0.0] * 1
     c = [0.0] * 1
     A = [0.0] * 1
     root = [0.0] * 1
     w0 = float(alpha[0])
     w1 = 1.0
-    w2 = 5.0
+    w2 = float(kappa[0])
     w3 = float(dt[0])
     w2 = w2 * w3
     w1 = w1 + w2
@@ -1423,3 +1488,123 @@ def body_newton_iteration(a, alpha, psi, c, A):
     w0 = w0 - w4
     a_next[0] = w0
     return (a_next,)
+
+
+def body_law(x, gamma_L, gamma_U, gain):
+    """CasADi Function 'body_law' (92 instructions).
+
+    Parameters
+    ----------
+    x : sequence of float, length 3 (dense 3x1, column-major)
+    gamma_L : sequence of float, length 3 (dense 3x1, column-major)
+    gamma_U : sequence of float, length 3 (dense 3x1, column-major)
+    gain : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    u : list of float, length 3 (dense 3x1, column-major)
+    inside : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(x) != 3:
+        raise ValueError('x: expected 3 values, got %d' % len(x))
+    if len(gamma_L) != 3:
+        raise ValueError('gamma_L: expected 3 values, got %d' % len(gamma_L))
+    if len(gamma_U) != 3:
+        raise ValueError('gamma_U: expected 3 values, got %d' % len(gamma_U))
+    if len(gain) != 1:
+        raise ValueError('gain: expected 1 values, got %d' % len(gain))
+    u = [0.0] * 3
+    inside = [0.0] * 1
+    w0 = float(gain[0])
+    w1 = 4.0
+    w2 = float(gamma_U[0])
+    w3 = float(gamma_L[0])
+    w4 = w2 - w3
+    w5 = 1e-06
+    w6 = _fmax(w4, w5)
+    w7 = 1.0
+    w8 = float(x[0])
+    w8 = w8 + w8
+    w2 = w2 + w3
+    w8 = w8 - w2
+    w8 = _div(w8, w6)
+    w2 = -0.9999990463256836
+    w3 = _fmax(w8, w2)
+    w9 = 0.9999990463256836
+    w3 = _fmin(w3, w9)
+    w10 = w3 * w3
+    w10 = w7 - w10
+    w6 = w6 * w10
+    w6 = _div(w1, w6)
+    w6 = w0 * w6
+    w10 = w7 + w3
+    w3 = w7 - w3
+    w10 = _div(w10, w3)
+    w10 = _log(w10)
+    w6 = w6 * w10
+    w6 = -w6
+    u[0] = w6
+    w6 = float(gamma_U[1])
+    w10 = float(gamma_L[1])
+    w3 = w6 - w10
+    w11 = _fmax(w3, w5)
+    w12 = float(x[1])
+    w12 = w12 + w12
+    w6 = w6 + w10
+    w12 = w12 - w6
+    w12 = _div(w12, w11)
+    w6 = _fmax(w12, w2)
+    w6 = _fmin(w6, w9)
+    w10 = w6 * w6
+    w10 = w7 - w10
+    w11 = w11 * w10
+    w11 = _div(w1, w11)
+    w11 = w0 * w11
+    w10 = w7 + w6
+    w6 = w7 - w6
+    w10 = _div(w10, w6)
+    w10 = _log(w10)
+    w11 = w11 * w10
+    w11 = -w11
+    u[1] = w11
+    w11 = float(gamma_U[2])
+    w10 = float(gamma_L[2])
+    w6 = w11 - w10
+    w5 = _fmax(w6, w5)
+    w13 = float(x[2])
+    w13 = w13 + w13
+    w11 = w11 + w10
+    w13 = w13 - w11
+    w13 = _div(w13, w5)
+    w2 = _fmax(w13, w2)
+    w2 = _fmin(w2, w9)
+    w9 = w2 * w2
+    w9 = w7 - w9
+    w5 = w5 * w9
+    w1 = _div(w1, w5)
+    w0 = w0 * w1
+    w1 = w7 + w2
+    w2 = w7 - w2
+    w1 = _div(w1, w2)
+    w1 = _log(w1)
+    w0 = w0 * w1
+    w0 = -w0
+    u[2] = w0
+    w8 = math.fabs(w8)
+    w8 = 1.0 if w8 < w7 else 0.0
+    w0 = 0.0
+    w4 = 1.0 if w0 < w4 else 0.0
+    w8 = 1.0 if w8 != 0.0 and w4 != 0.0 else 0.0
+    w8 = 1.0 if w7 != 0.0 and w8 != 0.0 else 0.0
+    w12 = math.fabs(w12)
+    w12 = 1.0 if w12 < w7 else 0.0
+    w3 = 1.0 if w0 < w3 else 0.0
+    w12 = 1.0 if w12 != 0.0 and w3 != 0.0 else 0.0
+    w8 = 1.0 if w8 != 0.0 and w12 != 0.0 else 0.0
+    w13 = math.fabs(w13)
+    w13 = 1.0 if w13 < w7 else 0.0
+    w0 = 1.0 if w0 < w6 else 0.0
+    w13 = 1.0 if w13 != 0.0 and w0 != 0.0 else 0.0
+    w8 = 1.0 if w8 != 0.0 and w13 != 0.0 else 0.0
+    inside[0] = w8
+    return (u, inside)

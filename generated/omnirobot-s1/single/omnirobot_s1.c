@@ -17,8 +17,71 @@
 #error "omnirobot_s1.c must not be compiled with -ffast-math (or -Ofast): it removes the isfinite() input checks and changes the rounding the tolerances assume"
 #endif
 
-/* CasADi Function 'gamma_candidates': 85 instructions. */
-static void body_gamma_candidates(const omnirobot_s1_real* t, const omnirobot_s1_real* alpha, omnirobot_s1_real* rho_L_minus_alpha, omnirobot_s1_real* beta_L, omnirobot_s1_real* rho_U_plus_alpha, omnirobot_s1_real* beta_U) {
+/* ------------------------------------------------------------- spec tables */
+
+/* Tube parameters. */
+typedef struct {
+  omnirobot_s1_real smoothness; /* nu of the smooth max/min and of F_nu (eqs. (9)-(10)), 1/state units */
+  omnirobot_s1_real theta0; /* theta_0 of the trigger (11) */
+  omnirobot_s1_real mu; /* mu of the trigger (11), state units */
+  omnirobot_s1_real kappa; /* kappa of the adaptive law (11), 1/s */
+  omnirobot_s1_real gain; /* k of the control law (13) */
+} omnirobot_s1_parameters;
+
+static const omnirobot_s1_parameters OMNIROBOT_S1_PARAMETERS = {
+  50.0f, /* smoothness */
+  0.01f, /* theta0 */
+  1.0f, /* mu */
+  5.0f, /* kappa */
+  0.18168809110361742f /* gain */
+};
+
+/* State-space bounds [X; X-bar], the sign of eq. (9) on each (+1 lower, -1 upper) and the
+   number of circumvents acting on each. */
+static const omnirobot_s1_real OMNIROBOT_S1_BOUND[OMNIROBOT_S1_N_ALPHA] = { 0.0f, 0.0f, -1.2f, 5.0f, 5.0f, 1.2f };
+static const omnirobot_s1_real OMNIROBOT_S1_SIGN[OMNIROBOT_S1_N_ALPHA] = { 1.0f, 1.0f, 1.0f, -1.0f, -1.0f, -1.0f };
+static const int OMNIROBOT_S1_MEMBERS[OMNIROBOT_S1_N_ALPHA] = { 0, 0, 0, 0, 1, 0 };
+
+/* Reach tube (eq. (4)), one row per segment: rho = from + (to - from) p(t) on
+   [start, end]; profile 0 = tanh (eq. (4)), 1 = smoothstep (quintic). Rows: [L; U]. */
+typedef struct {
+  omnirobot_s1_real start;
+  omnirobot_s1_real end;
+  int profile;
+  omnirobot_s1_real from[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real to[OMNIROBOT_S1_N_ALPHA];
+} omnirobot_s1_segment;
+
+#define OMNIROBOT_S1_N_SEGMENTS 1
+static const omnirobot_s1_segment OMNIROBOT_S1_SEGMENTS[OMNIROBOT_S1_N_SEGMENTS] = {
+  { 0.0f, 9.0f, 0, { 0.04999999999999999f, 4.55f, -0.05f, 0.45f, 4.95f, 0.05f }, { 4.55f, 4.55f, -0.5f, 4.95f, 4.95f, 0.5f } }
+};
+
+/* Circumvents (eqs. (7)-(9)), one row per window, sorted by start: window (start, end),
+   center m, radius r, sharpness k, height B, running maximum of the ends (to find the open
+   windows), bound index (i: lower bound of dimension i, N + i: upper bound). */
+typedef struct {
+  omnirobot_s1_real start;
+  omnirobot_s1_real end;
+  omnirobot_s1_real center;
+  omnirobot_s1_real radius;
+  omnirobot_s1_real sharpness;
+  omnirobot_s1_real height;
+  omnirobot_s1_real max_end;
+  int bound;
+} omnirobot_s1_window;
+
+#define OMNIROBOT_S1_N_WINDOWS 1
+/* most windows open at one time (size of the work arrays) */
+#define OMNIROBOT_S1_MAX_OPEN 1
+static const omnirobot_s1_window OMNIROBOT_S1_WINDOWS[OMNIROBOT_S1_N_WINDOWS] = {
+  { 0.3206386657002722f, 3.4666055224840955f, 1.893622094092184f, 1.5729834283919115f, 0.1f, 1.2000000000000002f, 3.4666055224840955f, 4 } /* obstacle 0 */
+};
+
+/* ------------------------------------------------------------- emitted bodies */
+
+/* CasADi Function 'progress_tanh': 32 instructions. */
+static void body_progress_tanh(const omnirobot_s1_real* t, const omnirobot_s1_real* start, const omnirobot_s1_real* end, omnirobot_s1_real* p, omnirobot_s1_real* p_dot) {
   omnirobot_s1_real w0;
   omnirobot_s1_real w1;
   omnirobot_s1_real w2;
@@ -27,95 +90,320 @@ static void body_gamma_candidates(const omnirobot_s1_real* t, const omnirobot_s1
   omnirobot_s1_real w5;
   omnirobot_s1_real w6;
   omnirobot_s1_real w7;
-  w0 = 4.5f;
-  w1 = t[0];
-  w2 = 9.0f;
-  w3 = (w1 < w2) ? 1.0f : 0.0f;
+  w0 = t[0];
+  w1 = end[0];
+  w2 = (w0 < w1) ? 1.0f : 0.0f;
+  w3 = start[0];
+  w3 = w0 - w3;
   w4 = 0.0f;
-  w5 = (w1 < w4) ? 1.0f : 0.0f;
-  w5 = (w5 == 0.0f) ? 1.0f : 0.0f;
-  w2 = w2 - w1;
-  w2 = (w3 != 0.0f) ? w2 : 0.0f;
-  w6 = (w3 == 0.0f) ? 1.0f : 0.0f;
-  w7 = 1.0f;
-  w6 = (w6 != 0.0f) ? w7 : 0.0f;
-  w2 = w2 + w6;
-  w2 = w1 / w2;
-  w2 = tanhf(w2);
-  w5 = (w5 != 0.0f) ? w2 : 0.0f;
-  w5 = (w3 != 0.0f) ? w5 : 0.0f;
-  w3 = (w3 == 0.0f) ? 1.0f : 0.0f;
-  w3 = (w3 != 0.0f) ? w7 : 0.0f;
-  w5 = w5 + w3;
-  w3 = w0 * w5;
-  w2 = 0.04999999999999999f;
-  w3 = w3 + w2;
-  w2 = alpha[0];
-  w3 = w3 - w2;
-  rho_L_minus_alpha[0] = w3;
-  w3 = 4.55f;
-  w2 = alpha[1];
-  w3 = w3 - w2;
-  rho_L_minus_alpha[1] = w3;
-  w3 = -0.45f;
-  w3 = w3 * w5;
-  w2 = -0.05f;
-  w3 = w3 + w2;
-  w2 = alpha[2];
-  w3 = w3 - w2;
-  rho_L_minus_alpha[2] = w3;
-  beta_L[0] = w4;
-  beta_L[1] = w4;
-  w4 = -1.2f;
-  beta_L[2] = w4;
-  w0 = w0 * w5;
-  w4 = 0.45f;
-  w0 = w0 + w4;
-  w3 = alpha[3];
+  w4 = (w3 < w4) ? 1.0f : 0.0f;
+  w4 = (w4 == 0.0f) ? 1.0f : 0.0f;
+  w1 = w1 - w0;
+  w1 = (w2 != 0.0f) ? w1 : 0.0f;
+  w0 = (w2 == 0.0f) ? 1.0f : 0.0f;
+  w5 = 1.0f;
+  w0 = (w0 != 0.0f) ? w5 : 0.0f;
+  w1 = w1 + w0;
+  w3 = w3 / w1;
+  w0 = tanhf(w3);
+  w6 = (w4 != 0.0f) ? w0 : 0.0f;
+  w6 = (w2 != 0.0f) ? w6 : 0.0f;
+  w7 = (w2 == 0.0f) ? 1.0f : 0.0f;
+  w7 = (w7 != 0.0f) ? w5 : 0.0f;
+  w6 = w6 + w7;
+  p[0] = w6;
+  w0 = w0 * w0;
+  w5 = w5 - w0;
+  w0 = 1.0f / w1;
+  w3 = w3 / w1;
+  w3 = (w2 != 0.0f) ? w3 : 0.0f;
   w0 = w0 + w3;
-  rho_U_plus_alpha[0] = w0;
-  w0 = 4.95f;
-  w3 = alpha[4];
-  w0 = w0 + w3;
-  rho_U_plus_alpha[1] = w0;
-  w4 = w4 * w5;
-  w5 = 0.05f;
-  w4 = w4 + w5;
-  w5 = alpha[5];
-  w4 = w4 + w5;
-  rho_U_plus_alpha[2] = w4;
-  w4 = 5.0f;
-  beta_U[0] = w4;
-  w5 = 1.893622094092184f;
-  w1 = w1 - w5;
-  w5 = fabsf(w1);
-  w0 = 1.5729834283919115f;
-  w5 = (w5 < w0) ? 1.0f : 0.0f;
-  w3 = 1.2000000000000002f;
-  w2 = -0.1f;
-  w6 = w1 * w1;
-  w2 = w2 * w6;
-  w6 = fabsf(w1);
-  w6 = w0 - w6;
-  w1 = fabsf(w1);
-  w0 = w0 + w1;
-  w6 = w6 * w0;
-  w6 = (w5 != 0.0f) ? w6 : 0.0f;
-  w0 = (w5 == 0.0f) ? 1.0f : 0.0f;
-  w0 = (w0 != 0.0f) ? w7 : 0.0f;
-  w6 = w6 + w0;
-  w2 = w2 / w6;
-  w2 = expf(w2);
-  w3 = w3 * w2;
-  w5 = (w5 != 0.0f) ? w3 : 0.0f;
-  w4 = w4 - w5;
-  beta_U[1] = w4;
-  w4 = 1.2f;
-  beta_U[2] = w4;
+  w5 = w5 * w0;
+  w4 = (w4 != 0.0f) ? w5 : 0.0f;
+  w2 = (w2 != 0.0f) ? w4 : 0.0f;
+  p_dot[0] = w2;
 }
 
-/* CasADi Function 'smooth_max_test': 16 instructions. */
-static void body_smooth_max_test(const omnirobot_s1_real* a, const omnirobot_s1_real* b, omnirobot_s1_real* max, omnirobot_s1_real* needed) {
+/* CasADi Function 'interpolate': 56 instructions. */
+static void body_interpolate(const omnirobot_s1_real* p, const omnirobot_s1_real* p_dot, const omnirobot_s1_real* from, const omnirobot_s1_real* to, omnirobot_s1_real* rho, omnirobot_s1_real* rho_dot) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  omnirobot_s1_real w8;
+  omnirobot_s1_real w9;
+  omnirobot_s1_real w10;
+  omnirobot_s1_real w11;
+  omnirobot_s1_real w12;
+  omnirobot_s1_real w13;
+  w0 = to[0];
+  w1 = from[0];
+  w2 = w0 - w1;
+  w3 = p[0];
+  w2 = w2 * w3;
+  w2 = w2 + w1;
+  rho[0] = w2;
+  w2 = to[1];
+  w4 = from[1];
+  w5 = w2 - w4;
+  w5 = w5 * w3;
+  w5 = w5 + w4;
+  rho[1] = w5;
+  w5 = to[2];
+  w6 = from[2];
+  w7 = w5 - w6;
+  w7 = w7 * w3;
+  w7 = w7 + w6;
+  rho[2] = w7;
+  w7 = to[3];
+  w8 = from[3];
+  w9 = w7 - w8;
+  w9 = w9 * w3;
+  w9 = w9 + w8;
+  rho[3] = w9;
+  w9 = to[4];
+  w10 = from[4];
+  w11 = w9 - w10;
+  w11 = w11 * w3;
+  w11 = w11 + w10;
+  rho[4] = w11;
+  w11 = to[5];
+  w12 = from[5];
+  w13 = w11 - w12;
+  w13 = w13 * w3;
+  w13 = w13 + w12;
+  rho[5] = w13;
+  w0 = w0 - w1;
+  w1 = p_dot[0];
+  w0 = w0 * w1;
+  rho_dot[0] = w0;
+  w2 = w2 - w4;
+  w2 = w2 * w1;
+  rho_dot[1] = w2;
+  w5 = w5 - w6;
+  w5 = w5 * w1;
+  rho_dot[2] = w5;
+  w7 = w7 - w8;
+  w7 = w7 * w1;
+  rho_dot[3] = w7;
+  w9 = w9 - w10;
+  w9 = w9 * w1;
+  rho_dot[4] = w9;
+  w11 = w11 - w12;
+  w11 = w11 * w1;
+  rho_dot[5] = w11;
+}
+
+/* CasADi Function 'bump': 57 instructions. */
+static void body_bump(const omnirobot_s1_real* t, const omnirobot_s1_real* start, const omnirobot_s1_real* end, const omnirobot_s1_real* center, const omnirobot_s1_real* radius, const omnirobot_s1_real* sharpness, const omnirobot_s1_real* height, omnirobot_s1_real* y, omnirobot_s1_real* y_dot) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  omnirobot_s1_real w8;
+  omnirobot_s1_real w9;
+  omnirobot_s1_real w10;
+  omnirobot_s1_real w11;
+  w0 = start[0];
+  w1 = t[0];
+  w0 = (w0 < w1) ? 1.0f : 0.0f;
+  w2 = end[0];
+  w2 = (w1 < w2) ? 1.0f : 0.0f;
+  w0 = ((w0 != 0.0f) && (w2 != 0.0f)) ? 1.0f : 0.0f;
+  w2 = center[0];
+  w1 = w1 - w2;
+  w2 = fabsf(w1);
+  w3 = radius[0];
+  w2 = (w2 < w3) ? 1.0f : 0.0f;
+  w0 = ((w0 != 0.0f) && (w2 != 0.0f)) ? 1.0f : 0.0f;
+  w2 = height[0];
+  w4 = sharpness[0];
+  w5 = w1 * w1;
+  w5 = w4 * w5;
+  w6 = fabsf(w1);
+  w6 = w3 - w6;
+  w7 = fabsf(w1);
+  w3 = w3 + w7;
+  w7 = w6 * w3;
+  w7 = (w0 != 0.0f) ? w7 : 0.0f;
+  w8 = (w0 == 0.0f) ? 1.0f : 0.0f;
+  w9 = 1.0f;
+  w8 = (w8 != 0.0f) ? w9 : 0.0f;
+  w7 = w7 + w8;
+  w5 = w5 / w7;
+  w8 = -w5;
+  w9 = -80.0f;
+  w10 = (w9 > w8) ? w9 : w8;
+  w10 = expf(w10);
+  w11 = w2 * w10;
+  w11 = (w0 != 0.0f) ? w11 : 0.0f;
+  y[0] = w11;
+  w11 = (w9 <= w8) ? 1.0f : 0.0f;
+  w8 = (w8 <= w9) ? 1.0f : 0.0f;
+  w8 = w11 + w8;
+  w11 = w11 / w8;
+  w8 = w1 + w1;
+  w4 = w4 * w8;
+  w4 = w4 / w7;
+  w5 = w5 / w7;
+  w7 = (w1 < 0.0f) ? -1.0f : ((w1 > 0.0f) ? 1.0f : w1);
+  w6 = w6 * w7;
+  w1 = (w1 < 0.0f) ? -1.0f : ((w1 > 0.0f) ? 1.0f : w1);
+  w3 = w3 * w1;
+  w6 = w6 - w3;
+  w5 = w5 * w6;
+  w5 = -w5;
+  w5 = (w0 != 0.0f) ? w5 : 0.0f;
+  w4 = w4 + w5;
+  w11 = w11 * w4;
+  w10 = w10 * w11;
+  w2 = w2 * w10;
+  w2 = -w2;
+  w0 = (w0 != 0.0f) ? w2 : 0.0f;
+  y_dot[0] = w0;
+}
+
+/* CasADi Function 'fnu_init': 10 instructions. */
+static void body_fnu_init(const omnirobot_s1_real* top, const omnirobot_s1_real* nu, omnirobot_s1_real* total, omnirobot_s1_real* rate) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  w0 = nu[0];
+  w1 = top[0];
+  w0 = w0 * w1;
+  w0 = -w0;
+  w1 = -80.0f;
+  w0 = (w1 > w0) ? w1 : w0;
+  w0 = expf(w0);
+  total[0] = w0;
+  w0 = 0.0f;
+  rate[0] = w0;
+}
+
+/* CasADi Function 'fnu_add': 21 instructions. */
+static void body_fnu_add(const omnirobot_s1_real* total, const omnirobot_s1_real* rate, const omnirobot_s1_real* y, const omnirobot_s1_real* y_dot, const omnirobot_s1_real* top, const omnirobot_s1_real* nu, omnirobot_s1_real* total_next, omnirobot_s1_real* rate_next) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  w0 = total[0];
+  w1 = nu[0];
+  w2 = y[0];
+  w3 = top[0];
+  w2 = w2 - w3;
+  w2 = w1 * w2;
+  w4 = -80.0f;
+  w2 = (w4 > w2) ? w4 : w2;
+  w2 = expf(w2);
+  w1 = w1 * w3;
+  w1 = -w1;
+  w1 = (w4 > w1) ? w4 : w1;
+  w1 = expf(w1);
+  w1 = w2 - w1;
+  w0 = w0 + w1;
+  total_next[0] = w0;
+  w0 = rate[0];
+  w1 = y_dot[0];
+  w2 = w2 * w1;
+  w0 = w0 + w2;
+  rate_next[0] = w0;
+}
+
+/* CasADi Function 'fnu_finish': 15 instructions. */
+static void body_fnu_finish(const omnirobot_s1_real* bound, const omnirobot_s1_real* sign, const omnirobot_s1_real* top, const omnirobot_s1_real* total, const omnirobot_s1_real* rate, const omnirobot_s1_real* nu, omnirobot_s1_real* beta, omnirobot_s1_real* beta_dot) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  w0 = bound[0];
+  w1 = sign[0];
+  w2 = top[0];
+  w3 = total[0];
+  w4 = logf(w3);
+  w5 = nu[0];
+  w4 = w4 / w5;
+  w2 = w2 + w4;
+  w2 = w1 * w2;
+  w0 = w0 + w2;
+  beta[0] = w0;
+  w0 = rate[0];
+  w0 = w0 / w3;
+  w1 = w1 * w0;
+  beta_dot[0] = w1;
+}
+
+/* CasADi Function 'candidates': 24 instructions. */
+static void body_candidates(const omnirobot_s1_real* rho, const omnirobot_s1_real* alpha, omnirobot_s1_real* c) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  w0 = rho[0];
+  w1 = alpha[0];
+  w0 = w0 - w1;
+  c[0] = w0;
+  w0 = rho[1];
+  w1 = alpha[1];
+  w0 = w0 - w1;
+  c[1] = w0;
+  w0 = rho[2];
+  w1 = alpha[2];
+  w0 = w0 - w1;
+  c[2] = w0;
+  w0 = rho[3];
+  w1 = alpha[3];
+  w0 = w0 + w1;
+  c[3] = w0;
+  w0 = rho[4];
+  w1 = alpha[4];
+  w0 = w0 + w1;
+  c[4] = w0;
+  w0 = rho[5];
+  w1 = alpha[5];
+  w0 = w0 + w1;
+  c[5] = w0;
+}
+
+/* CasADi Function 'candidate_rates': 24 instructions. */
+static void body_candidate_rates(const omnirobot_s1_real* rho_dot, const omnirobot_s1_real* alpha_dot, omnirobot_s1_real* c_dot) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  w0 = rho_dot[0];
+  w1 = alpha_dot[0];
+  w0 = w0 - w1;
+  c_dot[0] = w0;
+  w0 = rho_dot[1];
+  w1 = alpha_dot[1];
+  w0 = w0 - w1;
+  c_dot[1] = w0;
+  w0 = rho_dot[2];
+  w1 = alpha_dot[2];
+  w0 = w0 - w1;
+  c_dot[2] = w0;
+  w0 = rho_dot[3];
+  w1 = alpha_dot[3];
+  w0 = w0 + w1;
+  c_dot[3] = w0;
+  w0 = rho_dot[4];
+  w1 = alpha_dot[4];
+  w0 = w0 + w1;
+  c_dot[4] = w0;
+  w0 = rho_dot[5];
+  w1 = alpha_dot[5];
+  w0 = w0 + w1;
+  c_dot[5] = w0;
+}
+
+/* CasADi Function 'smooth_max_test': 17 instructions. */
+static void body_smooth_max_test(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* nu, omnirobot_s1_real* max, omnirobot_s1_real* needed) {
   omnirobot_s1_real w0;
   omnirobot_s1_real w1;
   omnirobot_s1_real w2;
@@ -126,21 +414,22 @@ static void body_smooth_max_test(const omnirobot_s1_real* a, const omnirobot_s1_
   w2 = (w1 > w0) ? w1 : w0;
   max[0] = w2;
   w3 = 80.0f;
-  w4 = 50.0f;
+  w4 = nu[0];
   w0 = w0 - w1;
   w0 = fabsf(w0);
-  w4 = w4 * w0;
-  w3 = (w3 <= w4) ? 1.0f : 0.0f;
-  w4 = 6.521212260432478e-21f;
+  w0 = w4 * w0;
+  w3 = (w3 <= w0) ? 1.0f : 0.0f;
+  w0 = 3.260606130216239e-19f;
+  w0 = w0 / w4;
   w2 = fabsf(w2);
-  w4 = (w4 <= w2) ? 1.0f : 0.0f;
-  w3 = ((w3 != 0.0f) && (w4 != 0.0f)) ? 1.0f : 0.0f;
+  w0 = (w0 <= w2) ? 1.0f : 0.0f;
+  w3 = ((w3 != 0.0f) && (w0 != 0.0f)) ? 1.0f : 0.0f;
   w3 = (w3 == 0.0f) ? 1.0f : 0.0f;
   needed[0] = w3;
 }
 
 /* CasADi Function 'smooth_max': 15 instructions. */
-static void body_smooth_max(const omnirobot_s1_real* a, const omnirobot_s1_real* b, omnirobot_s1_real* max) {
+static void body_smooth_max(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* nu, omnirobot_s1_real* max) {
   omnirobot_s1_real w0;
   omnirobot_s1_real w1;
   omnirobot_s1_real w2;
@@ -148,22 +437,22 @@ static void body_smooth_max(const omnirobot_s1_real* a, const omnirobot_s1_real*
   w0 = a[0];
   w1 = b[0];
   w2 = (w1 > w0) ? w1 : w0;
-  w3 = -50.0f;
+  w3 = nu[0];
   w0 = w0 - w1;
   w0 = fabsf(w0);
-  w3 = w3 * w0;
-  w0 = -80.0f;
-  w3 = (w0 > w3) ? w0 : w3;
-  w3 = expf(w3);
-  w3 = log1pf(w3);
-  w0 = 50.0f;
-  w3 = w3 / w0;
-  w2 = w2 + w3;
+  w0 = w3 * w0;
+  w0 = -w0;
+  w1 = -80.0f;
+  w0 = (w1 > w0) ? w1 : w0;
+  w0 = expf(w0);
+  w0 = log1pf(w0);
+  w0 = w0 / w3;
+  w2 = w2 + w0;
   max[0] = w2;
 }
 
-/* CasADi Function 'smooth_min_test': 19 instructions. */
-static void body_smooth_min_test(const omnirobot_s1_real* a, const omnirobot_s1_real* b, omnirobot_s1_real* min, omnirobot_s1_real* needed) {
+/* CasADi Function 'smooth_min_test': 20 instructions. */
+static void body_smooth_min_test(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* nu, omnirobot_s1_real* min, omnirobot_s1_real* needed) {
   omnirobot_s1_real w0;
   omnirobot_s1_real w1;
   omnirobot_s1_real w2;
@@ -177,21 +466,22 @@ static void body_smooth_min_test(const omnirobot_s1_real* a, const omnirobot_s1_
   w3 = -w1;
   min[0] = w3;
   w3 = 80.0f;
-  w4 = 50.0f;
+  w4 = nu[0];
   w2 = w2 - w0;
   w2 = fabsf(w2);
-  w4 = w4 * w2;
-  w3 = (w3 <= w4) ? 1.0f : 0.0f;
-  w4 = 6.521212260432478e-21f;
+  w2 = w4 * w2;
+  w3 = (w3 <= w2) ? 1.0f : 0.0f;
+  w2 = 3.260606130216239e-19f;
+  w2 = w2 / w4;
   w1 = fabsf(w1);
-  w4 = (w4 <= w1) ? 1.0f : 0.0f;
-  w3 = ((w3 != 0.0f) && (w4 != 0.0f)) ? 1.0f : 0.0f;
+  w2 = (w2 <= w1) ? 1.0f : 0.0f;
+  w3 = ((w3 != 0.0f) && (w2 != 0.0f)) ? 1.0f : 0.0f;
   w3 = (w3 == 0.0f) ? 1.0f : 0.0f;
   needed[0] = w3;
 }
 
 /* CasADi Function 'smooth_min': 18 instructions. */
-static void body_smooth_min(const omnirobot_s1_real* a, const omnirobot_s1_real* b, omnirobot_s1_real* min) {
+static void body_smooth_min(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* nu, omnirobot_s1_real* min) {
   omnirobot_s1_real w0;
   omnirobot_s1_real w1;
   omnirobot_s1_real w2;
@@ -201,23 +491,23 @@ static void body_smooth_min(const omnirobot_s1_real* a, const omnirobot_s1_real*
   w2 = b[0];
   w3 = -w2;
   w1 = (w3 > w1) ? w3 : w1;
-  w3 = -50.0f;
+  w3 = nu[0];
   w2 = w2 - w0;
   w2 = fabsf(w2);
-  w3 = w3 * w2;
-  w2 = -80.0f;
-  w3 = (w2 > w3) ? w2 : w3;
-  w3 = expf(w3);
-  w3 = log1pf(w3);
-  w2 = 50.0f;
-  w3 = w3 / w2;
-  w1 = w1 + w3;
+  w2 = w3 * w2;
+  w2 = -w2;
+  w0 = -80.0f;
+  w2 = (w0 > w2) ? w0 : w2;
+  w2 = expf(w2);
+  w2 = log1pf(w2);
+  w2 = w2 / w3;
+  w1 = w1 + w2;
   w1 = -w1;
   min[0] = w1;
 }
 
-/* CasADi Function 'gamma_rates': 471 instructions. */
-static void body_gamma_rates(const omnirobot_s1_real* t, const omnirobot_s1_real* alpha, omnirobot_s1_real* gamma_L_dot, omnirobot_s1_real* gamma_U_dot) {
+/* CasADi Function 'smooth_max_rate': 40 instructions. */
+static void body_smooth_max_rate(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* a_dot, const omnirobot_s1_real* b_dot, const omnirobot_s1_real* nu, omnirobot_s1_real* max_dot) {
   omnirobot_s1_real w0;
   omnirobot_s1_real w1;
   omnirobot_s1_real w2;
@@ -227,503 +517,50 @@ static void body_gamma_rates(const omnirobot_s1_real* t, const omnirobot_s1_real
   omnirobot_s1_real w6;
   omnirobot_s1_real w7;
   omnirobot_s1_real w8;
-  omnirobot_s1_real w9;
-  omnirobot_s1_real w10;
-  omnirobot_s1_real w11;
-  omnirobot_s1_real w12;
-  omnirobot_s1_real w13;
-  omnirobot_s1_real w14;
-  omnirobot_s1_real w15;
-  omnirobot_s1_real w16;
-  omnirobot_s1_real w17;
-  omnirobot_s1_real w18;
-  omnirobot_s1_real w19;
-  omnirobot_s1_real w20;
-  omnirobot_s1_real w21;
-  omnirobot_s1_real w22;
-  omnirobot_s1_real w23;
-  omnirobot_s1_real w24;
-  omnirobot_s1_real w25;
-  omnirobot_s1_real w26;
-  omnirobot_s1_real w27;
-  omnirobot_s1_real w28;
-  omnirobot_s1_real w29;
-  omnirobot_s1_real w30;
-  w0 = t[0];
-  w1 = 9.0f;
-  w2 = (w0 < w1) ? 1.0f : 0.0f;
-  w3 = 0.0f;
-  w4 = (w0 < w3) ? 1.0f : 0.0f;
-  w4 = (w4 == 0.0f) ? 1.0f : 0.0f;
-  w5 = 4.5f;
-  w6 = w1 - w0;
-  w6 = (w2 != 0.0f) ? w6 : 0.0f;
-  w7 = (w2 == 0.0f) ? 1.0f : 0.0f;
-  w8 = 1.0f;
-  w7 = (w7 != 0.0f) ? w8 : 0.0f;
-  w6 = w6 + w7;
-  w7 = w0 / w6;
-  w9 = tanhf(w7);
-  w10 = (w4 != 0.0f) ? w9 : 0.0f;
-  w10 = (w2 != 0.0f) ? w10 : 0.0f;
-  w11 = (w2 == 0.0f) ? 1.0f : 0.0f;
-  w11 = (w11 != 0.0f) ? w8 : 0.0f;
-  w10 = w10 + w11;
-  w11 = w5 * w10;
-  w12 = 0.04999999999999999f;
-  w11 = w11 + w12;
-  w13 = alpha[0];
-  w11 = w11 - w13;
-  w14 = (w3 <= w11) ? 1.0f : 0.0f;
-  w15 = (w11 <= w3) ? 1.0f : 0.0f;
-  w15 = w14 + w15;
-  w14 = w14 / w15;
-  w15 = w9 * w9;
-  w15 = w8 - w15;
-  w16 = 1.0f / w6;
-  w17 = w7 / w6;
-  w17 = (w2 != 0.0f) ? w17 : 0.0f;
-  w16 = w16 + w17;
-  w15 = w15 * w16;
-  w16 = w5 * w15;
-  w14 = w14 * w16;
-  w17 = 0.02f;
-  w18 = -50.0f;
-  w19 = fabsf(w11);
-  w19 = w18 * w19;
-  w20 = -80.0f;
-  w21 = (w20 > w19) ? w20 : w19;
-  w21 = expf(w21);
-  w22 = (w20 <= w19) ? 1.0f : 0.0f;
-  w23 = (w19 <= w20) ? 1.0f : 0.0f;
-  w23 = w22 + w23;
-  w22 = w22 / w23;
-  w23 = (w11 < 0.0f) ? -1.0f : ((w11 > 0.0f) ? 1.0f : w11);
-  w23 = w23 * w16;
-  w23 = w18 * w23;
-  w22 = w22 * w23;
-  w22 = w21 * w22;
-  w23 = w8 + w21;
-  w22 = w22 / w23;
-  w22 = w17 * w22;
-  w14 = w14 + w22;
-  w14 = (w4 != 0.0f) ? w14 : 0.0f;
-  w14 = (w2 != 0.0f) ? w14 : 0.0f;
-  w22 = (w3 <= w11) ? 1.0f : 0.0f;
-  w23 = (w11 <= w3) ? 1.0f : 0.0f;
-  w23 = w22 + w23;
-  w22 = w22 / w23;
-  w23 = (w20 <= w19) ? 1.0f : 0.0f;
-  w19 = (w19 <= w20) ? 1.0f : 0.0f;
-  w19 = w23 + w19;
-  w23 = w23 / w19;
-  w11 = (w11 < 0.0f) ? -1.0f : ((w11 > 0.0f) ? 1.0f : w11);
-  w11 = w18 * w11;
-  w23 = w23 * w11;
-  w23 = w21 * w23;
-  w21 = w8 + w21;
-  w23 = w23 / w21;
-  w23 = w17 * w23;
-  w22 = w22 + w23;
-  w23 = 5.0f;
-  w21 = (w0 < w1) ? 1.0f : 0.0f;
-  w11 = (w0 < w3) ? 1.0f : 0.0f;
-  w11 = (w11 == 0.0f) ? 1.0f : 0.0f;
+  w0 = b[0];
+  w1 = a[0];
+  w2 = (w0 <= w1) ? 1.0f : 0.0f;
+  w3 = (w1 <= w0) ? 1.0f : 0.0f;
+  w4 = w2 + w3;
+  w2 = w2 / w4;
+  w5 = nu[0];
   w1 = w1 - w0;
-  w1 = (w21 != 0.0f) ? w1 : 0.0f;
-  w19 = (w21 == 0.0f) ? 1.0f : 0.0f;
-  w19 = (w19 != 0.0f) ? w8 : 0.0f;
-  w1 = w1 + w19;
-  w1 = w0 / w1;
-  w1 = tanhf(w1);
-  w11 = (w11 != 0.0f) ? w1 : 0.0f;
-  w11 = (w21 != 0.0f) ? w11 : 0.0f;
-  w21 = (w21 == 0.0f) ? 1.0f : 0.0f;
-  w21 = (w21 != 0.0f) ? w8 : 0.0f;
-  w11 = w11 + w21;
-  w21 = w5 * w11;
-  w21 = w21 + w12;
-  w21 = w23 - w21;
-  w12 = w21 - w8;
-  w12 = w12 + w12;
-  w12 = (w20 > w12) ? w20 : w12;
-  w1 = 80.0f;
-  w12 = (w1 < w12) ? w1 : w12;
-  w12 = expf(w12);
-  w12 = w8 + w12;
-  w12 = w17 / w12;
-  w21 = w21 + w13;
-  w21 = w21 * w21;
-  w12 = w12 / w21;
-  w13 = w23 * w13;
-  w12 = w12 - w13;
-  w22 = w22 * w12;
-  w14 = w14 - w22;
-  gamma_L_dot[0] = w14;
-  w14 = 4.55f;
-  w22 = alpha[1];
-  w12 = w14 - w22;
-  w13 = (w3 <= w12) ? 1.0f : 0.0f;
-  w3 = (w12 <= w3) ? 1.0f : 0.0f;
-  w3 = w13 + w3;
-  w13 = w13 / w3;
-  w3 = fabsf(w12);
-  w3 = w18 * w3;
-  w21 = (w20 > w3) ? w20 : w3;
-  w21 = expf(w21);
-  w19 = (w20 <= w3) ? 1.0f : 0.0f;
-  w3 = (w3 <= w20) ? 1.0f : 0.0f;
-  w3 = w19 + w3;
-  w19 = w19 / w3;
-  w12 = (w12 < 0.0f) ? -1.0f : ((w12 > 0.0f) ? 1.0f : w12);
-  w12 = w18 * w12;
-  w19 = w19 * w12;
-  w19 = w21 * w19;
-  w21 = w8 + w21;
-  w19 = w19 / w21;
-  w19 = w17 * w19;
-  w13 = w13 + w19;
-  w19 = 1.893622094092184f;
-  w21 = w0 - w19;
-  w12 = fabsf(w21);
-  w3 = 1.5729834283919115f;
-  w12 = (w12 < w3) ? 1.0f : 0.0f;
-  w16 = 1.2000000000000002f;
-  w24 = -0.1f;
-  w25 = w21 * w21;
-  w25 = w24 * w25;
-  w26 = fabsf(w21);
-  w26 = w3 - w26;
-  w21 = fabsf(w21);
-  w21 = w3 + w21;
-  w26 = w26 * w21;
-  w26 = (w12 != 0.0f) ? w26 : 0.0f;
-  w21 = (w12 == 0.0f) ? 1.0f : 0.0f;
-  w21 = (w21 != 0.0f) ? w8 : 0.0f;
-  w26 = w26 + w21;
-  w25 = w25 / w26;
-  w25 = expf(w25);
-  w25 = w16 * w25;
-  w12 = (w12 != 0.0f) ? w25 : 0.0f;
-  w12 = w23 - w12;
-  w12 = w12 - w14;
-  w14 = w12 - w8;
-  w14 = w14 + w14;
-  w14 = (w20 > w14) ? w20 : w14;
-  w14 = (w1 < w14) ? w1 : w14;
-  w14 = expf(w14);
-  w14 = w8 + w14;
-  w14 = w17 / w14;
-  w12 = w12 + w22;
-  w12 = w12 * w12;
-  w14 = w14 / w12;
-  w22 = w23 * w22;
-  w14 = w14 - w22;
-  w13 = w13 * w14;
-  w13 = -w13;
-  gamma_L_dot[1] = w13;
-  w13 = -1.2f;
-  w14 = -0.45f;
-  w22 = w14 * w10;
-  w12 = -0.05f;
-  w22 = w22 + w12;
-  w25 = alpha[2];
-  w22 = w22 - w25;
-  w26 = (w13 <= w22) ? 1.0f : 0.0f;
-  w21 = (w22 <= w13) ? 1.0f : 0.0f;
-  w21 = w26 + w21;
-  w26 = w26 / w21;
-  w15 = w14 * w15;
-  w26 = w26 * w15;
-  w21 = w22 - w13;
-  w27 = fabsf(w21);
-  w27 = w18 * w27;
-  w28 = (w20 > w27) ? w20 : w27;
-  w28 = expf(w28);
-  w29 = (w20 <= w27) ? 1.0f : 0.0f;
-  w30 = (w27 <= w20) ? 1.0f : 0.0f;
-  w30 = w29 + w30;
-  w29 = w29 / w30;
-  w30 = (w21 < 0.0f) ? -1.0f : ((w21 > 0.0f) ? 1.0f : w21);
-  w30 = w30 * w15;
-  w30 = w18 * w30;
-  w29 = w29 * w30;
-  w29 = w28 * w29;
-  w30 = w8 + w28;
-  w29 = w29 / w30;
-  w29 = w17 * w29;
-  w26 = w26 + w29;
-  w26 = (w4 != 0.0f) ? w26 : 0.0f;
-  w26 = (w2 != 0.0f) ? w26 : 0.0f;
-  w29 = (w13 <= w22) ? 1.0f : 0.0f;
-  w22 = (w22 <= w13) ? 1.0f : 0.0f;
-  w22 = w29 + w22;
-  w29 = w29 / w22;
-  w22 = (w20 <= w27) ? 1.0f : 0.0f;
-  w27 = (w27 <= w20) ? 1.0f : 0.0f;
-  w27 = w22 + w27;
-  w22 = w22 / w27;
-  w21 = (w21 < 0.0f) ? -1.0f : ((w21 > 0.0f) ? 1.0f : w21);
-  w21 = w18 * w21;
-  w22 = w22 * w21;
-  w22 = w28 * w22;
-  w28 = w8 + w28;
-  w22 = w22 / w28;
-  w22 = w17 * w22;
-  w29 = w29 + w22;
-  w22 = 1.2f;
-  w14 = w14 * w11;
-  w14 = w14 + w12;
-  w22 = w22 - w14;
-  w14 = w22 - w8;
-  w14 = w14 + w14;
-  w14 = (w20 > w14) ? w20 : w14;
-  w14 = (w1 < w14) ? w1 : w14;
-  w14 = expf(w14);
-  w14 = w8 + w14;
-  w14 = w17 / w14;
-  w22 = w22 + w25;
-  w22 = w22 * w22;
-  w14 = w14 / w22;
-  w25 = w23 * w25;
-  w14 = w14 - w25;
-  w29 = w29 * w14;
-  w26 = w26 - w29;
-  gamma_L_dot[2] = w26;
-  w26 = w5 * w10;
-  w29 = 0.45f;
-  w26 = w26 + w29;
-  w14 = alpha[3];
-  w26 = w26 + w14;
-  w25 = -5.0f;
-  w22 = w26 + w25;
-  w12 = fabsf(w22);
-  w12 = w18 * w12;
-  w28 = (w20 > w12) ? w20 : w12;
-  w28 = expf(w28);
-  w21 = (w20 <= w12) ? 1.0f : 0.0f;
-  w27 = (w12 <= w20) ? 1.0f : 0.0f;
-  w27 = w21 + w27;
-  w21 = w21 / w27;
-  w27 = (w22 < 0.0f) ? -1.0f : ((w22 > 0.0f) ? 1.0f : w22);
-  w9 = w9 * w9;
-  w9 = w8 - w9;
-  w30 = 1.0f / w6;
+  w0 = fabsf(w1);
+  w0 = w5 * w0;
+  w0 = -w0;
+  w6 = -80.0f;
+  w7 = (w6 > w0) ? w6 : w0;
+  w7 = expf(w7);
+  w8 = (w6 <= w0) ? 1.0f : 0.0f;
+  w0 = (w0 <= w6) ? 1.0f : 0.0f;
+  w0 = w8 + w0;
+  w8 = w8 / w0;
+  w1 = (w1 < 0.0f) ? -1.0f : ((w1 > 0.0f) ? 1.0f : w1);
+  w0 = w5 * w1;
+  w0 = w8 * w0;
+  w0 = w7 * w0;
+  w6 = 1.0f;
+  w6 = w6 + w7;
+  w0 = w0 / w6;
+  w0 = w0 / w5;
+  w2 = w2 - w0;
+  w0 = a_dot[0];
+  w2 = w2 * w0;
+  w3 = w3 / w4;
+  w1 = w5 * w1;
+  w8 = w8 * w1;
+  w7 = w7 * w8;
   w7 = w7 / w6;
-  w7 = (w2 != 0.0f) ? w7 : 0.0f;
-  w30 = w30 + w7;
-  w9 = w9 * w30;
-  w30 = w5 * w9;
-  w27 = w27 * w30;
-  w27 = w18 * w27;
-  w21 = w21 * w27;
-  w21 = w28 * w21;
-  w27 = w8 + w28;
-  w21 = w21 / w27;
-  w21 = w17 * w21;
-  w26 = -w26;
-  w27 = (w25 <= w26) ? 1.0f : 0.0f;
-  w7 = (w26 <= w25) ? 1.0f : 0.0f;
-  w7 = w27 + w7;
-  w27 = w27 / w7;
-  w27 = w27 * w30;
-  w21 = w21 - w27;
-  w21 = -w21;
-  w21 = (w4 != 0.0f) ? w21 : 0.0f;
-  w21 = (w2 != 0.0f) ? w21 : 0.0f;
-  w27 = (w20 <= w12) ? 1.0f : 0.0f;
-  w12 = (w12 <= w20) ? 1.0f : 0.0f;
-  w12 = w27 + w12;
-  w27 = w27 / w12;
-  w22 = (w22 < 0.0f) ? -1.0f : ((w22 > 0.0f) ? 1.0f : w22);
-  w22 = w18 * w22;
-  w27 = w27 * w22;
-  w27 = w28 * w27;
-  w28 = w8 + w28;
-  w27 = w27 / w28;
-  w27 = w17 * w27;
-  w28 = (w25 <= w26) ? 1.0f : 0.0f;
-  w26 = (w26 <= w25) ? 1.0f : 0.0f;
-  w26 = w28 + w26;
-  w28 = w28 / w26;
-  w27 = w27 - w28;
-  w5 = w5 * w11;
-  w5 = w5 + w29;
-  w28 = w5 - w8;
-  w28 = w28 + w28;
-  w28 = (w20 > w28) ? w20 : w28;
-  w28 = (w1 < w28) ? w1 : w28;
-  w28 = expf(w28);
-  w28 = w8 + w28;
-  w28 = w17 / w28;
-  w5 = w5 + w14;
-  w5 = w5 * w5;
-  w28 = w28 / w5;
-  w14 = w23 * w14;
-  w28 = w28 - w14;
-  w27 = w27 * w28;
-  w21 = w21 - w27;
-  gamma_U_dot[0] = w21;
-  w0 = w0 - w19;
-  w19 = fabsf(w0);
-  w19 = (w19 < w3) ? 1.0f : 0.0f;
-  w21 = 4.95f;
-  w27 = alpha[4];
-  w28 = w21 + w27;
-  w14 = -w28;
-  w5 = w0 * w0;
-  w24 = w24 * w5;
-  w5 = fabsf(w0);
-  w5 = w3 - w5;
-  w26 = fabsf(w0);
-  w3 = w3 + w26;
-  w26 = w5 * w3;
-  w26 = (w19 != 0.0f) ? w26 : 0.0f;
-  w25 = (w19 == 0.0f) ? 1.0f : 0.0f;
-  w25 = (w25 != 0.0f) ? w8 : 0.0f;
-  w26 = w26 + w25;
-  w24 = w24 / w26;
-  w25 = expf(w24);
-  w22 = w16 * w25;
-  w22 = (w19 != 0.0f) ? w22 : 0.0f;
-  w22 = w23 - w22;
-  w12 = -w22;
-  w30 = (w14 <= w12) ? 1.0f : 0.0f;
-  w7 = (w12 <= w14) ? 1.0f : 0.0f;
-  w7 = w7 + w30;
-  w30 = w30 / w7;
-  w7 = -0.2f;
-  w7 = w7 * w0;
-  w7 = w7 / w26;
-  w24 = w24 / w26;
-  w26 = (w0 < 0.0f) ? -1.0f : ((w0 > 0.0f) ? 1.0f : w0);
-  w5 = w5 * w26;
-  w0 = (w0 < 0.0f) ? -1.0f : ((w0 > 0.0f) ? 1.0f : w0);
-  w3 = w3 * w0;
-  w5 = w5 - w3;
-  w24 = w24 * w5;
-  w24 = -w24;
-  w24 = (w19 != 0.0f) ? w24 : 0.0f;
-  w7 = w7 + w24;
-  w25 = w25 * w7;
-  w16 = w16 * w25;
-  w30 = w30 * w16;
-  w22 = w22 - w28;
-  w28 = fabsf(w22);
-  w28 = w18 * w28;
-  w25 = (w20 > w28) ? w20 : w28;
-  w25 = expf(w25);
-  w7 = (w20 <= w28) ? 1.0f : 0.0f;
-  w24 = (w28 <= w20) ? 1.0f : 0.0f;
-  w24 = w7 + w24;
-  w7 = w7 / w24;
-  w24 = (w22 < 0.0f) ? -1.0f : ((w22 > 0.0f) ? 1.0f : w22);
-  w24 = w24 * w16;
-  w24 = w18 * w24;
-  w7 = w7 * w24;
-  w7 = w25 * w7;
-  w24 = w8 + w25;
-  w7 = w7 / w24;
-  w7 = w17 * w7;
-  w30 = w30 - w7;
-  w30 = -w30;
-  w19 = (w19 != 0.0f) ? w30 : 0.0f;
-  w30 = (w12 <= w14) ? 1.0f : 0.0f;
-  w14 = (w14 <= w12) ? 1.0f : 0.0f;
-  w14 = w30 + w14;
-  w30 = w30 / w14;
-  w14 = (w20 <= w28) ? 1.0f : 0.0f;
-  w28 = (w28 <= w20) ? 1.0f : 0.0f;
-  w28 = w14 + w28;
-  w14 = w14 / w28;
-  w22 = (w22 < 0.0f) ? -1.0f : ((w22 > 0.0f) ? 1.0f : w22);
-  w22 = w18 * w22;
-  w14 = w14 * w22;
-  w14 = w25 * w14;
-  w25 = w8 + w25;
-  w14 = w14 / w25;
-  w14 = w17 * w14;
-  w30 = w30 + w14;
-  w14 = 7.412122812527931e-06f;
-  w21 = w21 + w27;
-  w21 = w21 * w21;
-  w14 = w14 / w21;
-  w27 = w23 * w27;
-  w14 = w14 - w27;
-  w30 = w30 * w14;
-  w19 = w19 + w30;
-  gamma_U_dot[1] = w19;
-  w10 = w29 * w10;
-  w19 = 0.05f;
-  w10 = w10 + w19;
-  w30 = alpha[5];
-  w10 = w10 + w30;
-  w14 = w10 + w13;
-  w27 = fabsf(w14);
-  w27 = w18 * w27;
-  w21 = (w20 > w27) ? w20 : w27;
-  w21 = expf(w21);
-  w25 = (w20 <= w27) ? 1.0f : 0.0f;
-  w22 = (w27 <= w20) ? 1.0f : 0.0f;
-  w22 = w25 + w22;
-  w25 = w25 / w22;
-  w22 = (w14 < 0.0f) ? -1.0f : ((w14 > 0.0f) ? 1.0f : w14);
-  w9 = w29 * w9;
-  w22 = w22 * w9;
-  w22 = w18 * w22;
-  w25 = w25 * w22;
-  w25 = w21 * w25;
-  w22 = w8 + w21;
-  w25 = w25 / w22;
-  w25 = w17 * w25;
-  w10 = -w10;
-  w22 = (w13 <= w10) ? 1.0f : 0.0f;
-  w28 = (w10 <= w13) ? 1.0f : 0.0f;
-  w28 = w22 + w28;
-  w22 = w22 / w28;
-  w22 = w22 * w9;
-  w25 = w25 - w22;
-  w25 = -w25;
-  w4 = (w4 != 0.0f) ? w25 : 0.0f;
-  w2 = (w2 != 0.0f) ? w4 : 0.0f;
-  w4 = (w20 <= w27) ? 1.0f : 0.0f;
-  w27 = (w27 <= w20) ? 1.0f : 0.0f;
-  w27 = w4 + w27;
-  w4 = w4 / w27;
-  w14 = (w14 < 0.0f) ? -1.0f : ((w14 > 0.0f) ? 1.0f : w14);
-  w18 = w18 * w14;
-  w4 = w4 * w18;
-  w4 = w21 * w4;
-  w21 = w8 + w21;
-  w4 = w4 / w21;
-  w4 = w17 * w4;
-  w21 = (w13 <= w10) ? 1.0f : 0.0f;
-  w10 = (w10 <= w13) ? 1.0f : 0.0f;
-  w10 = w21 + w10;
-  w21 = w21 / w10;
-  w4 = w4 - w21;
-  w29 = w29 * w11;
-  w29 = w29 + w19;
-  w29 = w29 - w13;
-  w13 = w29 - w8;
-  w13 = w13 + w13;
-  w13 = (w20 > w13) ? w20 : w13;
-  w13 = (w1 < w13) ? w1 : w13;
-  w13 = expf(w13);
-  w8 = w8 + w13;
-  w17 = w17 / w8;
-  w29 = w29 + w30;
-  w29 = w29 * w29;
-  w17 = w17 / w29;
-  w23 = w23 * w30;
-  w17 = w17 - w23;
-  w4 = w4 * w17;
-  w2 = w2 - w4;
-  gamma_U_dot[2] = w2;
+  w7 = w7 / w5;
+  w3 = w3 + w7;
+  w7 = b_dot[0];
+  w3 = w3 * w7;
+  w2 = w2 + w3;
+  max_dot[0] = w2;
 }
 
-/* CasADi Function 'law': 89 instructions. */
-static void body_law(const omnirobot_s1_real* x, const omnirobot_s1_real* gamma_L, const omnirobot_s1_real* gamma_U, omnirobot_s1_real* u, omnirobot_s1_real* inside) {
+/* CasADi Function 'smooth_min_rate': 42 instructions. */
+static void body_smooth_min_rate(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* a_dot, const omnirobot_s1_real* b_dot, const omnirobot_s1_real* nu, omnirobot_s1_real* min_dot) {
   omnirobot_s1_real w0;
   omnirobot_s1_real w1;
   omnirobot_s1_real w2;
@@ -733,237 +570,218 @@ static void body_law(const omnirobot_s1_real* x, const omnirobot_s1_real* gamma_
   omnirobot_s1_real w6;
   omnirobot_s1_real w7;
   omnirobot_s1_real w8;
-  omnirobot_s1_real w9;
-  omnirobot_s1_real w10;
-  omnirobot_s1_real w11;
-  omnirobot_s1_real w12;
-  omnirobot_s1_real w13;
-  w0 = -0.18168809110361742f;
-  w1 = 4.0f;
-  w2 = gamma_U[0];
-  w3 = gamma_L[0];
-  w4 = w2 - w3;
-  w5 = 1e-06f;
-  w6 = (w5 > w4) ? w5 : w4;
-  w7 = 1.0f;
-  w8 = x[0];
-  w8 = w8 + w8;
-  w2 = w2 + w3;
-  w8 = w8 - w2;
-  w8 = w8 / w6;
-  w2 = -0.9999990463256836f;
-  w3 = (w2 > w8) ? w2 : w8;
-  w9 = 0.9999990463256836f;
-  w3 = (w9 < w3) ? w9 : w3;
-  w10 = w3 * w3;
-  w10 = w7 - w10;
-  w6 = w6 * w10;
-  w6 = w1 / w6;
-  w6 = w0 * w6;
-  w10 = w7 + w3;
-  w3 = w7 - w3;
-  w10 = w10 / w3;
-  w10 = logf(w10);
-  w6 = w6 * w10;
-  u[0] = w6;
-  w6 = gamma_U[1];
-  w10 = gamma_L[1];
-  w3 = w6 - w10;
-  w11 = (w5 > w3) ? w5 : w3;
-  w12 = x[1];
-  w12 = w12 + w12;
-  w6 = w6 + w10;
-  w12 = w12 - w6;
-  w12 = w12 / w11;
-  w6 = (w2 > w12) ? w2 : w12;
-  w6 = (w9 < w6) ? w9 : w6;
-  w10 = w6 * w6;
-  w10 = w7 - w10;
-  w11 = w11 * w10;
-  w11 = w1 / w11;
-  w11 = w0 * w11;
-  w10 = w7 + w6;
-  w6 = w7 - w6;
-  w10 = w10 / w6;
-  w10 = logf(w10);
-  w11 = w11 * w10;
-  u[1] = w11;
-  w11 = gamma_U[2];
-  w10 = gamma_L[2];
-  w6 = w11 - w10;
-  w5 = (w5 > w6) ? w5 : w6;
-  w13 = x[2];
-  w13 = w13 + w13;
-  w11 = w11 + w10;
-  w13 = w13 - w11;
-  w13 = w13 / w5;
-  w2 = (w2 > w13) ? w2 : w13;
-  w2 = (w9 < w2) ? w9 : w2;
-  w9 = w2 * w2;
-  w9 = w7 - w9;
-  w5 = w5 * w9;
-  w1 = w1 / w5;
-  w0 = w0 * w1;
-  w1 = w7 + w2;
-  w2 = w7 - w2;
-  w1 = w1 / w2;
-  w1 = logf(w1);
-  w0 = w0 * w1;
-  u[2] = w0;
-  w8 = fabsf(w8);
-  w8 = (w8 < w7) ? 1.0f : 0.0f;
-  w0 = 0.0f;
-  w4 = (w0 < w4) ? 1.0f : 0.0f;
-  w8 = ((w8 != 0.0f) && (w4 != 0.0f)) ? 1.0f : 0.0f;
-  w8 = ((w7 != 0.0f) && (w8 != 0.0f)) ? 1.0f : 0.0f;
-  w12 = fabsf(w12);
-  w12 = (w12 < w7) ? 1.0f : 0.0f;
-  w3 = (w0 < w3) ? 1.0f : 0.0f;
-  w12 = ((w12 != 0.0f) && (w3 != 0.0f)) ? 1.0f : 0.0f;
-  w8 = ((w8 != 0.0f) && (w12 != 0.0f)) ? 1.0f : 0.0f;
-  w13 = fabsf(w13);
-  w13 = (w13 < w7) ? 1.0f : 0.0f;
-  w0 = (w0 < w6) ? 1.0f : 0.0f;
-  w13 = ((w13 != 0.0f) && (w0 != 0.0f)) ? 1.0f : 0.0f;
-  w8 = ((w8 != 0.0f) && (w13 != 0.0f)) ? 1.0f : 0.0f;
-  inside[0] = w8;
-}
-
-/* CasADi Function 'alpha_conflict': 118 instructions. */
-static void body_alpha_conflict(const omnirobot_s1_real* t, const omnirobot_s1_real* dt, omnirobot_s1_real* psi, omnirobot_s1_real* theta) {
-  omnirobot_s1_real w0;
-  omnirobot_s1_real w1;
-  omnirobot_s1_real w2;
-  omnirobot_s1_real w3;
-  omnirobot_s1_real w4;
-  omnirobot_s1_real w5;
-  omnirobot_s1_real w6;
-  omnirobot_s1_real w7;
-  omnirobot_s1_real w8;
-  omnirobot_s1_real w9;
-  omnirobot_s1_real w10;
-  w0 = 5.0f;
-  w1 = 4.5f;
-  w2 = t[0];
-  w3 = dt[0];
-  w2 = w2 + w3;
-  w3 = 9.0f;
-  w4 = (w2 < w3) ? 1.0f : 0.0f;
-  w5 = 0.0f;
-  w5 = (w2 < w5) ? 1.0f : 0.0f;
-  w5 = (w5 == 0.0f) ? 1.0f : 0.0f;
-  w3 = w3 - w2;
-  w3 = (w4 != 0.0f) ? w3 : 0.0f;
-  w6 = (w4 == 0.0f) ? 1.0f : 0.0f;
-  w7 = 1.0f;
-  w6 = (w6 != 0.0f) ? w7 : 0.0f;
-  w3 = w3 + w6;
-  w3 = w2 / w3;
-  w3 = tanhf(w3);
-  w5 = (w5 != 0.0f) ? w3 : 0.0f;
-  w5 = (w4 != 0.0f) ? w5 : 0.0f;
-  w4 = (w4 == 0.0f) ? 1.0f : 0.0f;
-  w4 = (w4 != 0.0f) ? w7 : 0.0f;
-  w5 = w5 + w4;
-  w4 = w1 * w5;
-  w3 = 0.04999999999999999f;
-  w4 = w4 + w3;
-  w4 = w0 - w4;
-  psi[0] = w4;
-  w3 = 1.893622094092184f;
-  w2 = w2 - w3;
-  w3 = fabsf(w2);
-  w6 = 1.5729834283919115f;
-  w3 = (w3 < w6) ? 1.0f : 0.0f;
-  w8 = 1.2000000000000002f;
-  w9 = -0.1f;
-  w10 = w2 * w2;
-  w9 = w9 * w10;
-  w10 = fabsf(w2);
-  w10 = w6 - w10;
-  w2 = fabsf(w2);
-  w6 = w6 + w2;
-  w10 = w10 * w6;
-  w10 = (w3 != 0.0f) ? w10 : 0.0f;
-  w6 = (w3 == 0.0f) ? 1.0f : 0.0f;
-  w6 = (w6 != 0.0f) ? w7 : 0.0f;
-  w10 = w10 + w6;
-  w9 = w9 / w10;
-  w9 = expf(w9);
-  w8 = w8 * w9;
-  w3 = (w3 != 0.0f) ? w8 : 0.0f;
-  w0 = w0 - w3;
-  w3 = 4.55f;
-  w0 = w0 - w3;
-  psi[1] = w0;
-  w3 = 1.2f;
-  w8 = -0.45f;
-  w8 = w8 * w5;
-  w9 = -0.05f;
-  w8 = w8 + w9;
-  w3 = w3 - w8;
-  psi[2] = w3;
-  w1 = w1 * w5;
-  w8 = 0.45f;
-  w1 = w1 + w8;
-  psi[3] = w1;
-  w9 = 4.95f;
-  psi[4] = w9;
-  w8 = w8 * w5;
-  w5 = 0.05f;
-  w8 = w8 + w5;
-  w5 = -1.2f;
-  w8 = w8 - w5;
-  psi[5] = w8;
-  w5 = 0.02f;
+  w0 = a[0];
+  w1 = -w0;
+  w2 = b[0];
+  w3 = -w2;
+  w4 = (w1 <= w3) ? 1.0f : 0.0f;
+  w3 = (w3 <= w1) ? 1.0f : 0.0f;
+  w1 = w3 + w4;
+  w4 = w4 / w1;
+  w5 = nu[0];
+  w2 = w2 - w0;
+  w0 = fabsf(w2);
+  w0 = w5 * w0;
+  w0 = -w0;
+  w6 = -80.0f;
+  w7 = (w6 > w0) ? w6 : w0;
+  w7 = expf(w7);
+  w8 = (w6 <= w0) ? 1.0f : 0.0f;
+  w0 = (w0 <= w6) ? 1.0f : 0.0f;
+  w0 = w8 + w0;
+  w8 = w8 / w0;
+  w2 = (w2 < 0.0f) ? -1.0f : ((w2 > 0.0f) ? 1.0f : w2);
+  w0 = w5 * w2;
+  w0 = w8 * w0;
+  w0 = w7 * w0;
+  w6 = 1.0f;
+  w6 = w6 + w7;
+  w0 = w0 / w6;
+  w0 = w0 / w5;
+  w4 = w4 + w0;
+  w0 = b_dot[0];
+  w4 = w4 * w0;
+  w2 = w5 * w2;
+  w8 = w8 * w2;
+  w7 = w7 * w8;
+  w7 = w7 / w6;
+  w7 = w7 / w5;
+  w3 = w3 / w1;
+  w7 = w7 - w3;
+  w3 = a_dot[0];
+  w7 = w7 * w3;
   w4 = w4 - w7;
-  w4 = w4 + w4;
-  w9 = -80.0f;
-  w4 = (w9 > w4) ? w9 : w4;
-  w10 = 80.0f;
-  w4 = (w10 < w4) ? w10 : w4;
-  w4 = expf(w4);
-  w4 = w7 + w4;
-  w4 = w5 / w4;
-  theta[0] = w4;
-  w0 = w0 - w7;
+  min_dot[0] = w4;
+}
+
+/* CasADi Function 'conflict': 78 instructions. */
+static void body_conflict(const omnirobot_s1_real* rho, const omnirobot_s1_real* beta, const omnirobot_s1_real* theta0, const omnirobot_s1_real* mu, omnirobot_s1_real* psi, omnirobot_s1_real* theta) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  omnirobot_s1_real w8;
+  omnirobot_s1_real w9;
+  omnirobot_s1_real w10;
+  w0 = beta[3];
+  w1 = rho[0];
+  w0 = w0 - w1;
+  psi[0] = w0;
+  w1 = beta[4];
+  w2 = rho[1];
+  w1 = w1 - w2;
+  psi[1] = w1;
+  w2 = beta[5];
+  w3 = rho[2];
+  w2 = w2 - w3;
+  psi[2] = w2;
+  w3 = rho[3];
+  w4 = beta[0];
+  w3 = w3 - w4;
+  psi[3] = w3;
+  w4 = rho[4];
+  w5 = beta[1];
+  w4 = w4 - w5;
+  psi[4] = w4;
+  w5 = rho[5];
+  w6 = beta[2];
+  w5 = w5 - w6;
+  psi[5] = w5;
+  w6 = theta0[0];
+  w6 = w6 + w6;
+  w7 = 1.0f;
+  w8 = mu[0];
+  w0 = w0 - w8;
   w0 = w0 + w0;
+  w9 = -80.0f;
   w0 = (w9 > w0) ? w9 : w0;
+  w10 = 80.0f;
   w0 = (w10 < w0) ? w10 : w0;
   w0 = expf(w0);
   w0 = w7 + w0;
-  w0 = w5 / w0;
-  theta[1] = w0;
-  w3 = w3 - w7;
-  w3 = w3 + w3;
-  w3 = (w9 > w3) ? w9 : w3;
-  w3 = (w10 < w3) ? w10 : w3;
-  w3 = expf(w3);
-  w3 = w7 + w3;
-  w3 = w5 / w3;
-  theta[2] = w3;
-  w1 = w1 - w7;
+  w0 = w6 / w0;
+  theta[0] = w0;
+  w1 = w1 - w8;
   w1 = w1 + w1;
   w1 = (w9 > w1) ? w9 : w1;
   w1 = (w10 < w1) ? w10 : w1;
   w1 = expf(w1);
   w1 = w7 + w1;
-  w1 = w5 / w1;
-  theta[3] = w1;
-  w1 = 7.412122812527931e-06f;
-  theta[4] = w1;
-  w8 = w8 - w7;
-  w8 = w8 + w8;
-  w8 = (w9 > w8) ? w9 : w8;
-  w8 = (w10 < w8) ? w10 : w8;
-  w8 = expf(w8);
-  w7 = w7 + w8;
-  w5 = w5 / w7;
-  theta[5] = w5;
+  w1 = w6 / w1;
+  theta[1] = w1;
+  w2 = w2 - w8;
+  w2 = w2 + w2;
+  w2 = (w9 > w2) ? w9 : w2;
+  w2 = (w10 < w2) ? w10 : w2;
+  w2 = expf(w2);
+  w2 = w7 + w2;
+  w2 = w6 / w2;
+  theta[2] = w2;
+  w3 = w3 - w8;
+  w3 = w3 + w3;
+  w3 = (w9 > w3) ? w9 : w3;
+  w3 = (w10 < w3) ? w10 : w3;
+  w3 = expf(w3);
+  w3 = w7 + w3;
+  w3 = w6 / w3;
+  theta[3] = w3;
+  w4 = w4 - w8;
+  w4 = w4 + w4;
+  w4 = (w9 > w4) ? w9 : w4;
+  w4 = (w10 < w4) ? w10 : w4;
+  w4 = expf(w4);
+  w4 = w7 + w4;
+  w4 = w6 / w4;
+  theta[4] = w4;
+  w5 = w5 - w8;
+  w5 = w5 + w5;
+  w5 = (w9 > w5) ? w9 : w5;
+  w5 = (w10 < w5) ? w10 : w5;
+  w5 = expf(w5);
+  w7 = w7 + w5;
+  w6 = w6 / w7;
+  theta[5] = w6;
+}
+
+/* CasADi Function 'alpha_rate': 55 instructions. */
+static void body_alpha_rate(const omnirobot_s1_real* alpha, const omnirobot_s1_real* psi, const omnirobot_s1_real* theta, const omnirobot_s1_real* kappa, omnirobot_s1_real* alpha_dot) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  w0 = theta[0];
+  w1 = psi[0];
+  w2 = alpha[0];
+  w1 = w1 + w2;
+  w1 = w1 * w1;
+  w0 = w0 / w1;
+  w1 = kappa[0];
+  w2 = w1 * w2;
+  w0 = w0 - w2;
+  alpha_dot[0] = w0;
+  w0 = theta[1];
+  w2 = psi[1];
+  w3 = alpha[1];
+  w2 = w2 + w3;
+  w2 = w2 * w2;
+  w0 = w0 / w2;
+  w3 = w1 * w3;
+  w0 = w0 - w3;
+  alpha_dot[1] = w0;
+  w0 = theta[2];
+  w3 = psi[2];
+  w2 = alpha[2];
+  w3 = w3 + w2;
+  w3 = w3 * w3;
+  w0 = w0 / w3;
+  w2 = w1 * w2;
+  w0 = w0 - w2;
+  alpha_dot[2] = w0;
+  w0 = theta[3];
+  w2 = psi[3];
+  w3 = alpha[3];
+  w2 = w2 + w3;
+  w2 = w2 * w2;
+  w0 = w0 / w2;
+  w3 = w1 * w3;
+  w0 = w0 - w3;
+  alpha_dot[3] = w0;
+  w0 = theta[4];
+  w3 = psi[4];
+  w2 = alpha[4];
+  w3 = w3 + w2;
+  w3 = w3 * w3;
+  w0 = w0 / w3;
+  w2 = w1 * w2;
+  w0 = w0 - w2;
+  alpha_dot[4] = w0;
+  w0 = theta[5];
+  w2 = psi[5];
+  w3 = alpha[5];
+  w2 = w2 + w3;
+  w2 = w2 * w2;
+  w0 = w0 / w2;
+  w1 = w1 * w3;
+  w0 = w0 - w1;
+  alpha_dot[5] = w0;
+}
+
+/* CasADi Function 'later': 4 instructions. */
+static void body_later(const omnirobot_s1_real* t, const omnirobot_s1_real* dt, omnirobot_s1_real* t_next) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  w0 = t[0];
+  w1 = dt[0];
+  w0 = w0 + w1;
+  t_next[0] = w0;
 }
 
 /* CasADi Function 'newton_start': 24 instructions. */
-static void body_newton_start(const omnirobot_s1_real* alpha, const omnirobot_s1_real* psi, const omnirobot_s1_real* theta, const omnirobot_s1_real* dt, omnirobot_s1_real* a0, omnirobot_s1_real* c, omnirobot_s1_real* A, omnirobot_s1_real* root) {
+static void body_newton_start(const omnirobot_s1_real* alpha, const omnirobot_s1_real* psi, const omnirobot_s1_real* theta, const omnirobot_s1_real* dt, const omnirobot_s1_real* kappa, omnirobot_s1_real* a0, omnirobot_s1_real* c, omnirobot_s1_real* A, omnirobot_s1_real* root) {
   omnirobot_s1_real w0;
   omnirobot_s1_real w1;
   omnirobot_s1_real w2;
@@ -971,7 +789,7 @@ static void body_newton_start(const omnirobot_s1_real* alpha, const omnirobot_s1
   omnirobot_s1_real w4;
   w0 = alpha[0];
   w1 = 1.0f;
-  w2 = 5.0f;
+  w2 = kappa[0];
   w3 = dt[0];
   w2 = w2 * w3;
   w1 = w1 + w2;
@@ -1057,6 +875,116 @@ static void body_newton_iteration(const omnirobot_s1_real* a, const omnirobot_s1
   a_next[0] = w0;
 }
 
+/* CasADi Function 'law': 92 instructions. */
+static void body_law(const omnirobot_s1_real* x, const omnirobot_s1_real* gamma_L, const omnirobot_s1_real* gamma_U, const omnirobot_s1_real* gain, omnirobot_s1_real* u, omnirobot_s1_real* inside) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  omnirobot_s1_real w8;
+  omnirobot_s1_real w9;
+  omnirobot_s1_real w10;
+  omnirobot_s1_real w11;
+  omnirobot_s1_real w12;
+  omnirobot_s1_real w13;
+  w0 = gain[0];
+  w1 = 4.0f;
+  w2 = gamma_U[0];
+  w3 = gamma_L[0];
+  w4 = w2 - w3;
+  w5 = 1e-06f;
+  w6 = (w5 > w4) ? w5 : w4;
+  w7 = 1.0f;
+  w8 = x[0];
+  w8 = w8 + w8;
+  w2 = w2 + w3;
+  w8 = w8 - w2;
+  w8 = w8 / w6;
+  w2 = -0.9999990463256836f;
+  w3 = (w2 > w8) ? w2 : w8;
+  w9 = 0.9999990463256836f;
+  w3 = (w9 < w3) ? w9 : w3;
+  w10 = w3 * w3;
+  w10 = w7 - w10;
+  w6 = w6 * w10;
+  w6 = w1 / w6;
+  w6 = w0 * w6;
+  w10 = w7 + w3;
+  w3 = w7 - w3;
+  w10 = w10 / w3;
+  w10 = logf(w10);
+  w6 = w6 * w10;
+  w6 = -w6;
+  u[0] = w6;
+  w6 = gamma_U[1];
+  w10 = gamma_L[1];
+  w3 = w6 - w10;
+  w11 = (w5 > w3) ? w5 : w3;
+  w12 = x[1];
+  w12 = w12 + w12;
+  w6 = w6 + w10;
+  w12 = w12 - w6;
+  w12 = w12 / w11;
+  w6 = (w2 > w12) ? w2 : w12;
+  w6 = (w9 < w6) ? w9 : w6;
+  w10 = w6 * w6;
+  w10 = w7 - w10;
+  w11 = w11 * w10;
+  w11 = w1 / w11;
+  w11 = w0 * w11;
+  w10 = w7 + w6;
+  w6 = w7 - w6;
+  w10 = w10 / w6;
+  w10 = logf(w10);
+  w11 = w11 * w10;
+  w11 = -w11;
+  u[1] = w11;
+  w11 = gamma_U[2];
+  w10 = gamma_L[2];
+  w6 = w11 - w10;
+  w5 = (w5 > w6) ? w5 : w6;
+  w13 = x[2];
+  w13 = w13 + w13;
+  w11 = w11 + w10;
+  w13 = w13 - w11;
+  w13 = w13 / w5;
+  w2 = (w2 > w13) ? w2 : w13;
+  w2 = (w9 < w2) ? w9 : w2;
+  w9 = w2 * w2;
+  w9 = w7 - w9;
+  w5 = w5 * w9;
+  w1 = w1 / w5;
+  w0 = w0 * w1;
+  w1 = w7 + w2;
+  w2 = w7 - w2;
+  w1 = w1 / w2;
+  w1 = logf(w1);
+  w0 = w0 * w1;
+  w0 = -w0;
+  u[2] = w0;
+  w8 = fabsf(w8);
+  w8 = (w8 < w7) ? 1.0f : 0.0f;
+  w0 = 0.0f;
+  w4 = (w0 < w4) ? 1.0f : 0.0f;
+  w8 = ((w8 != 0.0f) && (w4 != 0.0f)) ? 1.0f : 0.0f;
+  w8 = ((w7 != 0.0f) && (w8 != 0.0f)) ? 1.0f : 0.0f;
+  w12 = fabsf(w12);
+  w12 = (w12 < w7) ? 1.0f : 0.0f;
+  w3 = (w0 < w3) ? 1.0f : 0.0f;
+  w12 = ((w12 != 0.0f) && (w3 != 0.0f)) ? 1.0f : 0.0f;
+  w8 = ((w8 != 0.0f) && (w12 != 0.0f)) ? 1.0f : 0.0f;
+  w13 = fabsf(w13);
+  w13 = (w13 < w7) ? 1.0f : 0.0f;
+  w0 = (w0 < w6) ? 1.0f : 0.0f;
+  w13 = ((w13 != 0.0f) && (w0 != 0.0f)) ? 1.0f : 0.0f;
+  w8 = ((w8 != 0.0f) && (w13 != 0.0f)) ? 1.0f : 0.0f;
+  inside[0] = w8;
+}
+
 /* ----------------------------------------------------------------- typed API */
 
 static int omnirobot_s1_finite(const omnirobot_s1_real* v, int count) {
@@ -1124,26 +1052,161 @@ static void omnirobot_s1_zero(omnirobot_s1_real* v, int count) {
   }
 }
 
-/* gamma_L, gamma_U of eq. (10) at (t, a): the smooth max/min's correction only where it can
-   change the max/min */
-static void omnirobot_s1_gamma(omnirobot_s1_real t, const omnirobot_s1_real* a, omnirobot_s1_real* g_l,
-    omnirobot_s1_real* g_u) {
-  omnirobot_s1_real lower[OMNIROBOT_S1_N];
-  omnirobot_s1_real beta_l[OMNIROBOT_S1_N];
-  omnirobot_s1_real upper[OMNIROBOT_S1_N];
-  omnirobot_s1_real beta_u[OMNIROBOT_S1_N];
+/* ------------------------------------------------------- composition (tables) */
+
+/* rho, rho_dot [L; U] of eq. (4) at t: the first segment whose end is after t (the last one
+   after every end). */
+static void omnirobot_s1_reach(omnirobot_s1_real t, omnirobot_s1_real* rho, omnirobot_s1_real* rho_dot) {
+  omnirobot_s1_real p;
+  omnirobot_s1_real p_dot;
+  int k = OMNIROBOT_S1_N_SEGMENTS - 1;
+  int j;
+  for (j = OMNIROBOT_S1_N_SEGMENTS - 2; j >= 0; --j) {
+    if (t < OMNIROBOT_S1_SEGMENTS[j].end) {
+      k = j;
+    }
+  }
+if (OMNIROBOT_S1_SEGMENTS[k].profile == 0) {
+    body_progress_tanh(&t, &OMNIROBOT_S1_SEGMENTS[k].start, &OMNIROBOT_S1_SEGMENTS[k].end, &p, &p_dot);
+  } else {
+    p = 0.0f;
+    p_dot = 0.0f;
+  }
+  body_interpolate(&p, &p_dot, OMNIROBOT_S1_SEGMENTS[k].from, OMNIROBOT_S1_SEGMENTS[k].to, rho, rho_dot);
+}
+
+/* beta, beta_dot [L; U] of eq. (9) at t, over the open windows only (a closed window adds
+   exactly 0 to F_nu). */
+static void omnirobot_s1_circumvent(omnirobot_s1_real t, omnirobot_s1_real* beta, omnirobot_s1_real* beta_dot) {
+  omnirobot_s1_real top[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real total[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real rate[OMNIROBOT_S1_N_ALPHA];
+  int b;
+  omnirobot_s1_real y[OMNIROBOT_S1_MAX_OPEN];
+  omnirobot_s1_real y_dot[OMNIROBOT_S1_MAX_OPEN];
+  int bound_of[OMNIROBOT_S1_MAX_OPEN];
+  int open = 0;
+  int lo = 0;
+  int hi = OMNIROBOT_S1_N_WINDOWS;
+  int first;
+  int j;
+  for (b = 0; b < OMNIROBOT_S1_N_ALPHA; ++b) {
+    top[b] = 0.0f;
+  }
+  for (j = 0; j < OMNIROBOT_S1_MAX_OPEN; ++j) {
+    y[j] = 0.0f;
+    y_dot[j] = 0.0f;
+    bound_of[j] = 0;
+  }
+  /* rows [0, hi) start before t (binary search); rows before `first` all ended by t */
+  while (lo < hi) {
+    int mid = lo + ((hi - lo) / 2);
+    if (OMNIROBOT_S1_WINDOWS[mid].start < t) {
+      lo = mid + 1;
+    } else {
+      hi = mid;
+    }
+  }
+  first = hi;
+  while ((first > 0) && (OMNIROBOT_S1_WINDOWS[first - 1].max_end > t)) {
+    first = first - 1;
+  }
+  for (j = first; j < hi; ++j) {
+    if ((t < OMNIROBOT_S1_WINDOWS[j].end) && (open < OMNIROBOT_S1_MAX_OPEN)) {
+      const omnirobot_s1_window* w = &OMNIROBOT_S1_WINDOWS[j];
+      body_bump(&t, &w->start, &w->end, &w->center, &w->radius, &w->sharpness, &w->height,
+                &y[open], &y_dot[open]);
+      bound_of[open] = w->bound;
+      if (y[open] > top[w->bound]) {
+        top[w->bound] = y[open];
+      }
+      open = open + 1;
+    }
+  }
+  for (b = 0; b < OMNIROBOT_S1_N_ALPHA; ++b) {
+    if (OMNIROBOT_S1_MEMBERS[b] > 0) {
+      body_fnu_init(&top[b], &OMNIROBOT_S1_PARAMETERS.smoothness, &total[b], &rate[b]);
+    }
+  }
+  for (j = 0; j < open; ++j) {
+    omnirobot_s1_real total_next;
+    omnirobot_s1_real rate_next;
+    b = bound_of[j];
+    body_fnu_add(&total[b], &rate[b], &y[j], &y_dot[j], &top[b], &OMNIROBOT_S1_PARAMETERS.smoothness,
+                 &total_next, &rate_next);
+    total[b] = total_next;
+    rate[b] = rate_next;
+  }
+  for (b = 0; b < OMNIROBOT_S1_N_ALPHA; ++b) {
+    if (OMNIROBOT_S1_MEMBERS[b] > 0) {
+      body_fnu_finish(&OMNIROBOT_S1_BOUND[b], &OMNIROBOT_S1_SIGN[b], &top[b], &total[b], &rate[b],
+                      &OMNIROBOT_S1_PARAMETERS.smoothness, &beta[b], &beta_dot[b]);
+    } else {
+      beta[b] = OMNIROBOT_S1_BOUND[b];
+      beta_dot[b] = 0.0f;
+    }
+  }
+}
+
+/* gamma_L, gamma_U of eq. (10) from rho and beta: the smooth max/min's correction only where
+   it can change the max/min */
+static void omnirobot_s1_gamma_of(const omnirobot_s1_real* rho, const omnirobot_s1_real* beta,
+    const omnirobot_s1_real* a, omnirobot_s1_real* g_l, omnirobot_s1_real* g_u) {
+  omnirobot_s1_real c[OMNIROBOT_S1_N_ALPHA];
   omnirobot_s1_real needed;
   int i;
-  body_gamma_candidates(&t, a, lower, beta_l, upper, beta_u);
+  body_candidates(rho, a, c);
   for (i = 0; i < OMNIROBOT_S1_N; ++i) {
-    body_smooth_max_test(&lower[i], &beta_l[i], &g_l[i], &needed);
+    body_smooth_max_test(&c[i], &beta[i], &OMNIROBOT_S1_PARAMETERS.smoothness, &g_l[i], &needed);
     if (needed != 0.0f) {
-      body_smooth_max(&lower[i], &beta_l[i], &g_l[i]);
+      body_smooth_max(&c[i], &beta[i], &OMNIROBOT_S1_PARAMETERS.smoothness, &g_l[i]);
     }
-    body_smooth_min_test(&upper[i], &beta_u[i], &g_u[i], &needed);
+    body_smooth_min_test(&c[OMNIROBOT_S1_N + i], &beta[OMNIROBOT_S1_N + i], &OMNIROBOT_S1_PARAMETERS.smoothness,
+                         &g_u[i], &needed);
     if (needed != 0.0f) {
-      body_smooth_min(&upper[i], &beta_u[i], &g_u[i]);
+      body_smooth_min(&c[OMNIROBOT_S1_N + i], &beta[OMNIROBOT_S1_N + i], &OMNIROBOT_S1_PARAMETERS.smoothness,
+                      &g_u[i]);
     }
+  }
+}
+
+/* gamma_L, gamma_U of eq. (10) at (t, a) */
+static void omnirobot_s1_gamma(omnirobot_s1_real t, const omnirobot_s1_real* a, omnirobot_s1_real* g_l,
+    omnirobot_s1_real* g_u) {
+  omnirobot_s1_real rho[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real rho_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real beta[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real beta_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_reach(t, rho, rho_dot);
+  omnirobot_s1_circumvent(t, beta, beta_dot);
+  omnirobot_s1_gamma_of(rho, beta, a, g_l, g_u);
+}
+
+/* gamma and its total time derivative (alpha moving by (11)) at (t, a) */
+static void omnirobot_s1_gamma_and_rates(omnirobot_s1_real t, const omnirobot_s1_real* a, omnirobot_s1_real* g_l,
+    omnirobot_s1_real* g_u, omnirobot_s1_real* g_l_dot, omnirobot_s1_real* g_u_dot) {
+  omnirobot_s1_real rho[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real rho_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real beta[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real beta_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real psi[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real theta[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real a_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real c[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real c_dot[OMNIROBOT_S1_N_ALPHA];
+  int i;
+  omnirobot_s1_reach(t, rho, rho_dot);
+  omnirobot_s1_circumvent(t, beta, beta_dot);
+  omnirobot_s1_gamma_of(rho, beta, a, g_l, g_u);
+  body_conflict(rho, beta, &OMNIROBOT_S1_PARAMETERS.theta0, &OMNIROBOT_S1_PARAMETERS.mu, psi, theta);
+  body_alpha_rate(a, psi, theta, &OMNIROBOT_S1_PARAMETERS.kappa, a_dot);
+  body_candidates(rho, a, c);
+  body_candidate_rates(rho_dot, a_dot, c_dot);
+  for (i = 0; i < OMNIROBOT_S1_N; ++i) {
+    body_smooth_max_rate(&c[i], &beta[i], &c_dot[i], &beta_dot[i],
+                         &OMNIROBOT_S1_PARAMETERS.smoothness, &g_l_dot[i]);
+    body_smooth_min_rate(&c[OMNIROBOT_S1_N + i], &beta[OMNIROBOT_S1_N + i], &c_dot[OMNIROBOT_S1_N + i],
+                         &beta_dot[OMNIROBOT_S1_N + i], &OMNIROBOT_S1_PARAMETERS.smoothness, &g_u_dot[i]);
   }
 }
 
@@ -1163,9 +1226,10 @@ int omnirobot_s1_tube(omnirobot_s1_real t, const omnirobot_s1_real alpha[OMNIROB
     if ((alpha != NULL) && (omnirobot_s1_time_valid(t) != 0) && (omnirobot_s1_alpha_valid(alpha) != 0)) {
       omnirobot_s1_real a[OMNIROBOT_S1_N_ALPHA];
       omnirobot_s1_copy(alpha, a, OMNIROBOT_S1_N_ALPHA);
-      omnirobot_s1_gamma(t, a, g_l, g_u);
       if (rates != 0) {
-        body_gamma_rates(&t, a, g_l_dot, g_u_dot);
+        omnirobot_s1_gamma_and_rates(t, a, g_l, g_u, g_l_dot, g_u_dot);
+      } else {
+        omnirobot_s1_gamma(t, a, g_l, g_u);
       }
       /* the rates hold theta / (psi + alpha)^2: infinite where alpha is not one the
          adaptive law reaches at t (psi + alpha <= 0) */
@@ -1203,7 +1267,7 @@ static int omnirobot_s1_law(const omnirobot_s1_real* x, omnirobot_s1_real t, con
   omnirobot_s1_real inside;
   int status;
   omnirobot_s1_gamma(t, a, g_l, g_u);
-  body_law(x, g_l, g_u, u, &inside);
+  body_law(x, g_l, g_u, &OMNIROBOT_S1_PARAMETERS.gain, u, &inside);
   if (omnirobot_s1_finite(u, OMNIROBOT_S1_N) == 0) {
     status = OMNIROBOT_S1_STATUS_INVALID_INPUT;
   } else if (inside != 0.0f) {
@@ -1241,8 +1305,16 @@ static void omnirobot_s1_implicit_step(omnirobot_s1_real t, omnirobot_s1_real dt
     omnirobot_s1_real* next) {
   omnirobot_s1_real psi[OMNIROBOT_S1_N_ALPHA];
   omnirobot_s1_real theta[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real rho[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real rho_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real beta[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real beta_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real t_next;
   int i;
-  body_alpha_conflict(&t, &dt, psi, theta);
+  body_later(&t, &dt, &t_next);
+  omnirobot_s1_reach(t_next, rho, rho_dot);
+  omnirobot_s1_circumvent(t_next, beta, beta_dot);
+  body_conflict(rho, beta, &OMNIROBOT_S1_PARAMETERS.theta0, &OMNIROBOT_S1_PARAMETERS.mu, psi, theta);
   for (i = 0; i < OMNIROBOT_S1_N_ALPHA; ++i) {
     omnirobot_s1_real s;
     omnirobot_s1_real s_next;
@@ -1250,7 +1322,8 @@ static void omnirobot_s1_implicit_step(omnirobot_s1_real t, omnirobot_s1_real dt
     omnirobot_s1_real big_a;
     omnirobot_s1_real root;
     int k = 0;
-    body_newton_start(&a[i], &psi[i], &theta[i], &dt, &s, &c, &big_a, &root);
+    body_newton_start(&a[i], &psi[i], &theta[i], &dt, &OMNIROBOT_S1_PARAMETERS.kappa, &s, &c, &big_a,
+                      &root);
     if (root != 0.0f) {
       body_newton_root_start(&a[i], &psi[i], &c, &big_a, &s);
     }

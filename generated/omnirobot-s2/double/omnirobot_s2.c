@@ -17,8 +17,116 @@
 #error "omnirobot_s2.c must not be compiled with -ffast-math (or -Ofast): it removes the isfinite() input checks and changes the rounding the tolerances assume"
 #endif
 
-/* CasADi Function 'gamma_candidates': 109 instructions. */
-static void body_gamma_candidates(const omnirobot_s2_real* t, const omnirobot_s2_real* alpha, omnirobot_s2_real* rho_L_minus_alpha, omnirobot_s2_real* beta_L, omnirobot_s2_real* rho_U_plus_alpha, omnirobot_s2_real* beta_U) {
+/* ------------------------------------------------------------- spec tables */
+
+/* Tube parameters. */
+typedef struct {
+  omnirobot_s2_real smoothness; /* nu of the smooth max/min and of F_nu (eqs. (9)-(10)), 1/state units */
+  omnirobot_s2_real theta0; /* theta_0 of the trigger (11) */
+  omnirobot_s2_real mu; /* mu of the trigger (11), state units */
+  omnirobot_s2_real kappa; /* kappa of the adaptive law (11), 1/s */
+  omnirobot_s2_real gain; /* k of the control law (13) */
+} omnirobot_s2_parameters;
+
+static const omnirobot_s2_parameters OMNIROBOT_S2_PARAMETERS = {
+  50.0, /* smoothness */
+  0.01, /* theta0 */
+  1.0, /* mu */
+  5.0, /* kappa */
+  0.2664829878855371 /* gain */
+};
+
+/* State-space bounds [X; X-bar], the sign of eq. (9) on each (+1 lower, -1 upper) and the
+   number of circumvents acting on each. */
+static const omnirobot_s2_real OMNIROBOT_S2_BOUND[OMNIROBOT_S2_N_ALPHA] = { 0.0, 0.0, -1.2, 5.0, 5.0, 1.2 };
+static const omnirobot_s2_real OMNIROBOT_S2_SIGN[OMNIROBOT_S2_N_ALPHA] = { 1.0, 1.0, 1.0, -1.0, -1.0, -1.0 };
+static const int OMNIROBOT_S2_MEMBERS[OMNIROBOT_S2_N_ALPHA] = { 0, 0, 0, 1, 1, 0 };
+
+/* Reach tube (eq. (4)), one row per segment: rho = from + (to - from) p(t) on
+   [start, end]; profile 0 = tanh (eq. (4)), 1 = smoothstep (quintic). Rows: [L; U]. */
+typedef struct {
+  omnirobot_s2_real start;
+  omnirobot_s2_real end;
+  int profile;
+  omnirobot_s2_real from[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real to[OMNIROBOT_S2_N_ALPHA];
+} omnirobot_s2_segment;
+
+#define OMNIROBOT_S2_N_SEGMENTS 1
+static const omnirobot_s2_segment OMNIROBOT_S2_SEGMENTS[OMNIROBOT_S2_N_SEGMENTS] = {
+  { 0.0, 9.0, 0, { 0.04999999999999999, 0.04999999999999999, -0.05, 0.45, 0.45, 0.05 }, { 4.55, 4.55, -0.5, 4.95, 4.95, 0.5 } }
+};
+
+/* Circumvents (eqs. (7)-(9)), one row per window, sorted by start: window (start, end),
+   center m, radius r, sharpness k, height B, running maximum of the ends (to find the open
+   windows), bound index (i: lower bound of dimension i, N + i: upper bound). */
+typedef struct {
+  omnirobot_s2_real start;
+  omnirobot_s2_real end;
+  omnirobot_s2_real center;
+  omnirobot_s2_real radius;
+  omnirobot_s2_real sharpness;
+  omnirobot_s2_real height;
+  omnirobot_s2_real max_end;
+  int bound;
+} omnirobot_s2_window;
+
+#define OMNIROBOT_S2_N_WINDOWS 2
+/* most windows open at one time (size of the work arrays) */
+#define OMNIROBOT_S2_MAX_OPEN 2
+static const omnirobot_s2_window OMNIROBOT_S2_WINDOWS[OMNIROBOT_S2_N_WINDOWS] = {
+  { -0.16775736475634573, 3.3665328234729985, 1.5993877293583263, 1.7671450941146722, 0.1, 4.2, 3.3665328234729985, 3 }, /* obstacle 2 */
+  { 2.2988805724241264, 4.6220222122222365, 3.4604513923231814, 1.161570819899055, 0.1, 2.7, 4.6220222122222365, 4 } /* obstacle 1 */
+};
+
+/* ------------------------------------------------------------- emitted bodies */
+
+/* CasADi Function 'progress_tanh': 32 instructions. */
+static void body_progress_tanh(const omnirobot_s2_real* t, const omnirobot_s2_real* start, const omnirobot_s2_real* end, omnirobot_s2_real* p, omnirobot_s2_real* p_dot) {
+  omnirobot_s2_real w0;
+  omnirobot_s2_real w1;
+  omnirobot_s2_real w2;
+  omnirobot_s2_real w3;
+  omnirobot_s2_real w4;
+  omnirobot_s2_real w5;
+  omnirobot_s2_real w6;
+  omnirobot_s2_real w7;
+  w0 = t[0];
+  w1 = end[0];
+  w2 = (w0 < w1) ? 1.0 : 0.0;
+  w3 = start[0];
+  w3 = w0 - w3;
+  w4 = 0.0;
+  w4 = (w3 < w4) ? 1.0 : 0.0;
+  w4 = (w4 == 0.0) ? 1.0 : 0.0;
+  w1 = w1 - w0;
+  w1 = (w2 != 0.0) ? w1 : 0.0;
+  w0 = (w2 == 0.0) ? 1.0 : 0.0;
+  w5 = 1.0;
+  w0 = (w0 != 0.0) ? w5 : 0.0;
+  w1 = w1 + w0;
+  w3 = w3 / w1;
+  w0 = tanh(w3);
+  w6 = (w4 != 0.0) ? w0 : 0.0;
+  w6 = (w2 != 0.0) ? w6 : 0.0;
+  w7 = (w2 == 0.0) ? 1.0 : 0.0;
+  w7 = (w7 != 0.0) ? w5 : 0.0;
+  w6 = w6 + w7;
+  p[0] = w6;
+  w0 = w0 * w0;
+  w5 = w5 - w0;
+  w0 = 1.0 / w1;
+  w3 = w3 / w1;
+  w3 = (w2 != 0.0) ? w3 : 0.0;
+  w0 = w0 + w3;
+  w5 = w5 * w0;
+  w4 = (w4 != 0.0) ? w5 : 0.0;
+  w2 = (w2 != 0.0) ? w4 : 0.0;
+  p_dot[0] = w2;
+}
+
+/* CasADi Function 'interpolate': 56 instructions. */
+static void body_interpolate(const omnirobot_s2_real* p, const omnirobot_s2_real* p_dot, const omnirobot_s2_real* from, const omnirobot_s2_real* to, omnirobot_s2_real* rho, omnirobot_s2_real* rho_dot) {
   omnirobot_s2_real w0;
   omnirobot_s2_real w1;
   omnirobot_s2_real w2;
@@ -29,119 +137,274 @@ static void body_gamma_candidates(const omnirobot_s2_real* t, const omnirobot_s2
   omnirobot_s2_real w7;
   omnirobot_s2_real w8;
   omnirobot_s2_real w9;
-  w0 = 4.5;
-  w1 = t[0];
-  w2 = 9.0;
-  w3 = (w1 < w2) ? 1.0 : 0.0;
-  w4 = 0.0;
-  w5 = (w1 < w4) ? 1.0 : 0.0;
-  w5 = (w5 == 0.0) ? 1.0 : 0.0;
-  w2 = w2 - w1;
-  w2 = (w3 != 0.0) ? w2 : 0.0;
-  w6 = (w3 == 0.0) ? 1.0 : 0.0;
-  w7 = 1.0;
-  w6 = (w6 != 0.0) ? w7 : 0.0;
-  w2 = w2 + w6;
-  w2 = w1 / w2;
-  w2 = tanh(w2);
-  w5 = (w5 != 0.0) ? w2 : 0.0;
-  w5 = (w3 != 0.0) ? w5 : 0.0;
-  w3 = (w3 == 0.0) ? 1.0 : 0.0;
-  w3 = (w3 != 0.0) ? w7 : 0.0;
-  w5 = w5 + w3;
-  w3 = w0 * w5;
-  w2 = 0.04999999999999999;
-  w3 = w3 + w2;
-  w6 = alpha[0];
-  w3 = w3 - w6;
-  rho_L_minus_alpha[0] = w3;
-  w3 = w0 * w5;
-  w3 = w3 + w2;
-  w2 = alpha[1];
-  w3 = w3 - w2;
-  rho_L_minus_alpha[1] = w3;
-  w3 = -0.45;
-  w3 = w3 * w5;
-  w2 = -0.05;
-  w3 = w3 + w2;
-  w2 = alpha[2];
-  w3 = w3 - w2;
-  rho_L_minus_alpha[2] = w3;
-  beta_L[0] = w4;
-  beta_L[1] = w4;
-  w4 = -1.2;
-  beta_L[2] = w4;
-  w4 = w0 * w5;
-  w3 = 0.45;
-  w4 = w4 + w3;
-  w2 = alpha[3];
-  w4 = w4 + w2;
-  rho_U_plus_alpha[0] = w4;
-  w0 = w0 * w5;
-  w0 = w0 + w3;
-  w4 = alpha[4];
-  w0 = w0 + w4;
-  rho_U_plus_alpha[1] = w0;
-  w3 = w3 * w5;
-  w5 = 0.05;
-  w3 = w3 + w5;
-  w5 = alpha[5];
-  w3 = w3 + w5;
-  rho_U_plus_alpha[2] = w3;
-  w3 = 5.0;
-  w5 = 1.5993877293583263;
-  w5 = w1 - w5;
-  w0 = fabs(w5);
-  w4 = 1.7671450941146722;
-  w0 = (w0 < w4) ? 1.0 : 0.0;
-  w2 = 4.2;
-  w6 = -0.1;
-  w8 = w5 * w5;
-  w8 = w6 * w8;
-  w9 = fabs(w5);
-  w9 = w4 - w9;
-  w5 = fabs(w5);
-  w4 = w4 + w5;
-  w9 = w9 * w4;
-  w9 = (w0 != 0.0) ? w9 : 0.0;
-  w4 = (w0 == 0.0) ? 1.0 : 0.0;
-  w4 = (w4 != 0.0) ? w7 : 0.0;
-  w9 = w9 + w4;
-  w8 = w8 / w9;
-  w8 = exp(w8);
-  w2 = w2 * w8;
-  w0 = (w0 != 0.0) ? w2 : 0.0;
-  w0 = w3 - w0;
-  beta_U[0] = w0;
-  w0 = 3.4604513923231814;
-  w1 = w1 - w0;
-  w0 = fabs(w1);
-  w2 = 1.161570819899055;
-  w0 = (w0 < w2) ? 1.0 : 0.0;
-  w8 = 2.7;
-  w9 = w1 * w1;
-  w6 = w6 * w9;
-  w9 = fabs(w1);
-  w9 = w2 - w9;
-  w1 = fabs(w1);
+  omnirobot_s2_real w10;
+  omnirobot_s2_real w11;
+  omnirobot_s2_real w12;
+  omnirobot_s2_real w13;
+  w0 = to[0];
+  w1 = from[0];
+  w2 = w0 - w1;
+  w3 = p[0];
+  w2 = w2 * w3;
   w2 = w2 + w1;
-  w9 = w9 * w2;
-  w9 = (w0 != 0.0) ? w9 : 0.0;
-  w2 = (w0 == 0.0) ? 1.0 : 0.0;
-  w2 = (w2 != 0.0) ? w7 : 0.0;
-  w9 = w9 + w2;
-  w6 = w6 / w9;
-  w6 = exp(w6);
-  w8 = w8 * w6;
-  w0 = (w0 != 0.0) ? w8 : 0.0;
-  w3 = w3 - w0;
-  beta_U[1] = w3;
-  w3 = 1.2;
-  beta_U[2] = w3;
+  rho[0] = w2;
+  w2 = to[1];
+  w4 = from[1];
+  w5 = w2 - w4;
+  w5 = w5 * w3;
+  w5 = w5 + w4;
+  rho[1] = w5;
+  w5 = to[2];
+  w6 = from[2];
+  w7 = w5 - w6;
+  w7 = w7 * w3;
+  w7 = w7 + w6;
+  rho[2] = w7;
+  w7 = to[3];
+  w8 = from[3];
+  w9 = w7 - w8;
+  w9 = w9 * w3;
+  w9 = w9 + w8;
+  rho[3] = w9;
+  w9 = to[4];
+  w10 = from[4];
+  w11 = w9 - w10;
+  w11 = w11 * w3;
+  w11 = w11 + w10;
+  rho[4] = w11;
+  w11 = to[5];
+  w12 = from[5];
+  w13 = w11 - w12;
+  w13 = w13 * w3;
+  w13 = w13 + w12;
+  rho[5] = w13;
+  w0 = w0 - w1;
+  w1 = p_dot[0];
+  w0 = w0 * w1;
+  rho_dot[0] = w0;
+  w2 = w2 - w4;
+  w2 = w2 * w1;
+  rho_dot[1] = w2;
+  w5 = w5 - w6;
+  w5 = w5 * w1;
+  rho_dot[2] = w5;
+  w7 = w7 - w8;
+  w7 = w7 * w1;
+  rho_dot[3] = w7;
+  w9 = w9 - w10;
+  w9 = w9 * w1;
+  rho_dot[4] = w9;
+  w11 = w11 - w12;
+  w11 = w11 * w1;
+  rho_dot[5] = w11;
 }
 
-/* CasADi Function 'smooth_max_test': 16 instructions. */
-static void body_smooth_max_test(const omnirobot_s2_real* a, const omnirobot_s2_real* b, omnirobot_s2_real* max, omnirobot_s2_real* needed) {
+/* CasADi Function 'bump': 57 instructions. */
+static void body_bump(const omnirobot_s2_real* t, const omnirobot_s2_real* start, const omnirobot_s2_real* end, const omnirobot_s2_real* center, const omnirobot_s2_real* radius, const omnirobot_s2_real* sharpness, const omnirobot_s2_real* height, omnirobot_s2_real* y, omnirobot_s2_real* y_dot) {
+  omnirobot_s2_real w0;
+  omnirobot_s2_real w1;
+  omnirobot_s2_real w2;
+  omnirobot_s2_real w3;
+  omnirobot_s2_real w4;
+  omnirobot_s2_real w5;
+  omnirobot_s2_real w6;
+  omnirobot_s2_real w7;
+  omnirobot_s2_real w8;
+  omnirobot_s2_real w9;
+  omnirobot_s2_real w10;
+  omnirobot_s2_real w11;
+  w0 = start[0];
+  w1 = t[0];
+  w0 = (w0 < w1) ? 1.0 : 0.0;
+  w2 = end[0];
+  w2 = (w1 < w2) ? 1.0 : 0.0;
+  w0 = ((w0 != 0.0) && (w2 != 0.0)) ? 1.0 : 0.0;
+  w2 = center[0];
+  w1 = w1 - w2;
+  w2 = fabs(w1);
+  w3 = radius[0];
+  w2 = (w2 < w3) ? 1.0 : 0.0;
+  w0 = ((w0 != 0.0) && (w2 != 0.0)) ? 1.0 : 0.0;
+  w2 = height[0];
+  w4 = sharpness[0];
+  w5 = w1 * w1;
+  w5 = w4 * w5;
+  w6 = fabs(w1);
+  w6 = w3 - w6;
+  w7 = fabs(w1);
+  w3 = w3 + w7;
+  w7 = w6 * w3;
+  w7 = (w0 != 0.0) ? w7 : 0.0;
+  w8 = (w0 == 0.0) ? 1.0 : 0.0;
+  w9 = 1.0;
+  w8 = (w8 != 0.0) ? w9 : 0.0;
+  w7 = w7 + w8;
+  w5 = w5 / w7;
+  w8 = -w5;
+  w9 = -80.0;
+  w10 = (w9 > w8) ? w9 : w8;
+  w10 = exp(w10);
+  w11 = w2 * w10;
+  w11 = (w0 != 0.0) ? w11 : 0.0;
+  y[0] = w11;
+  w11 = (w9 <= w8) ? 1.0 : 0.0;
+  w8 = (w8 <= w9) ? 1.0 : 0.0;
+  w8 = w11 + w8;
+  w11 = w11 / w8;
+  w8 = w1 + w1;
+  w4 = w4 * w8;
+  w4 = w4 / w7;
+  w5 = w5 / w7;
+  w7 = (w1 < 0.0) ? -1.0 : ((w1 > 0.0) ? 1.0 : w1);
+  w6 = w6 * w7;
+  w1 = (w1 < 0.0) ? -1.0 : ((w1 > 0.0) ? 1.0 : w1);
+  w3 = w3 * w1;
+  w6 = w6 - w3;
+  w5 = w5 * w6;
+  w5 = -w5;
+  w5 = (w0 != 0.0) ? w5 : 0.0;
+  w4 = w4 + w5;
+  w11 = w11 * w4;
+  w10 = w10 * w11;
+  w2 = w2 * w10;
+  w2 = -w2;
+  w0 = (w0 != 0.0) ? w2 : 0.0;
+  y_dot[0] = w0;
+}
+
+/* CasADi Function 'fnu_init': 10 instructions. */
+static void body_fnu_init(const omnirobot_s2_real* top, const omnirobot_s2_real* nu, omnirobot_s2_real* total, omnirobot_s2_real* rate) {
+  omnirobot_s2_real w0;
+  omnirobot_s2_real w1;
+  w0 = nu[0];
+  w1 = top[0];
+  w0 = w0 * w1;
+  w0 = -w0;
+  w1 = -80.0;
+  w0 = (w1 > w0) ? w1 : w0;
+  w0 = exp(w0);
+  total[0] = w0;
+  w0 = 0.0;
+  rate[0] = w0;
+}
+
+/* CasADi Function 'fnu_add': 21 instructions. */
+static void body_fnu_add(const omnirobot_s2_real* total, const omnirobot_s2_real* rate, const omnirobot_s2_real* y, const omnirobot_s2_real* y_dot, const omnirobot_s2_real* top, const omnirobot_s2_real* nu, omnirobot_s2_real* total_next, omnirobot_s2_real* rate_next) {
+  omnirobot_s2_real w0;
+  omnirobot_s2_real w1;
+  omnirobot_s2_real w2;
+  omnirobot_s2_real w3;
+  omnirobot_s2_real w4;
+  w0 = total[0];
+  w1 = nu[0];
+  w2 = y[0];
+  w3 = top[0];
+  w2 = w2 - w3;
+  w2 = w1 * w2;
+  w4 = -80.0;
+  w2 = (w4 > w2) ? w4 : w2;
+  w2 = exp(w2);
+  w1 = w1 * w3;
+  w1 = -w1;
+  w1 = (w4 > w1) ? w4 : w1;
+  w1 = exp(w1);
+  w1 = w2 - w1;
+  w0 = w0 + w1;
+  total_next[0] = w0;
+  w0 = rate[0];
+  w1 = y_dot[0];
+  w2 = w2 * w1;
+  w0 = w0 + w2;
+  rate_next[0] = w0;
+}
+
+/* CasADi Function 'fnu_finish': 15 instructions. */
+static void body_fnu_finish(const omnirobot_s2_real* bound, const omnirobot_s2_real* sign, const omnirobot_s2_real* top, const omnirobot_s2_real* total, const omnirobot_s2_real* rate, const omnirobot_s2_real* nu, omnirobot_s2_real* beta, omnirobot_s2_real* beta_dot) {
+  omnirobot_s2_real w0;
+  omnirobot_s2_real w1;
+  omnirobot_s2_real w2;
+  omnirobot_s2_real w3;
+  omnirobot_s2_real w4;
+  omnirobot_s2_real w5;
+  w0 = bound[0];
+  w1 = sign[0];
+  w2 = top[0];
+  w3 = total[0];
+  w4 = log(w3);
+  w5 = nu[0];
+  w4 = w4 / w5;
+  w2 = w2 + w4;
+  w2 = w1 * w2;
+  w0 = w0 + w2;
+  beta[0] = w0;
+  w0 = rate[0];
+  w0 = w0 / w3;
+  w1 = w1 * w0;
+  beta_dot[0] = w1;
+}
+
+/* CasADi Function 'candidates': 24 instructions. */
+static void body_candidates(const omnirobot_s2_real* rho, const omnirobot_s2_real* alpha, omnirobot_s2_real* c) {
+  omnirobot_s2_real w0;
+  omnirobot_s2_real w1;
+  w0 = rho[0];
+  w1 = alpha[0];
+  w0 = w0 - w1;
+  c[0] = w0;
+  w0 = rho[1];
+  w1 = alpha[1];
+  w0 = w0 - w1;
+  c[1] = w0;
+  w0 = rho[2];
+  w1 = alpha[2];
+  w0 = w0 - w1;
+  c[2] = w0;
+  w0 = rho[3];
+  w1 = alpha[3];
+  w0 = w0 + w1;
+  c[3] = w0;
+  w0 = rho[4];
+  w1 = alpha[4];
+  w0 = w0 + w1;
+  c[4] = w0;
+  w0 = rho[5];
+  w1 = alpha[5];
+  w0 = w0 + w1;
+  c[5] = w0;
+}
+
+/* CasADi Function 'candidate_rates': 24 instructions. */
+static void body_candidate_rates(const omnirobot_s2_real* rho_dot, const omnirobot_s2_real* alpha_dot, omnirobot_s2_real* c_dot) {
+  omnirobot_s2_real w0;
+  omnirobot_s2_real w1;
+  w0 = rho_dot[0];
+  w1 = alpha_dot[0];
+  w0 = w0 - w1;
+  c_dot[0] = w0;
+  w0 = rho_dot[1];
+  w1 = alpha_dot[1];
+  w0 = w0 - w1;
+  c_dot[1] = w0;
+  w0 = rho_dot[2];
+  w1 = alpha_dot[2];
+  w0 = w0 - w1;
+  c_dot[2] = w0;
+  w0 = rho_dot[3];
+  w1 = alpha_dot[3];
+  w0 = w0 + w1;
+  c_dot[3] = w0;
+  w0 = rho_dot[4];
+  w1 = alpha_dot[4];
+  w0 = w0 + w1;
+  c_dot[4] = w0;
+  w0 = rho_dot[5];
+  w1 = alpha_dot[5];
+  w0 = w0 + w1;
+  c_dot[5] = w0;
+}
+
+/* CasADi Function 'smooth_max_test': 17 instructions. */
+static void body_smooth_max_test(const omnirobot_s2_real* a, const omnirobot_s2_real* b, const omnirobot_s2_real* nu, omnirobot_s2_real* max, omnirobot_s2_real* needed) {
   omnirobot_s2_real w0;
   omnirobot_s2_real w1;
   omnirobot_s2_real w2;
@@ -152,21 +415,22 @@ static void body_smooth_max_test(const omnirobot_s2_real* a, const omnirobot_s2_
   w2 = (w1 > w0) ? w1 : w0;
   max[0] = w2;
   w3 = 80.0;
-  w4 = 50.0;
+  w4 = nu[0];
   w0 = w0 - w1;
   w0 = fabs(w0);
-  w4 = w4 * w0;
-  w3 = (w3 <= w4) ? 1.0 : 0.0;
-  w4 = 6.521212260432478e-21;
+  w0 = w4 * w0;
+  w3 = (w3 <= w0) ? 1.0 : 0.0;
+  w0 = 3.260606130216239e-19;
+  w0 = w0 / w4;
   w2 = fabs(w2);
-  w4 = (w4 <= w2) ? 1.0 : 0.0;
-  w3 = ((w3 != 0.0) && (w4 != 0.0)) ? 1.0 : 0.0;
+  w0 = (w0 <= w2) ? 1.0 : 0.0;
+  w3 = ((w3 != 0.0) && (w0 != 0.0)) ? 1.0 : 0.0;
   w3 = (w3 == 0.0) ? 1.0 : 0.0;
   needed[0] = w3;
 }
 
 /* CasADi Function 'smooth_max': 15 instructions. */
-static void body_smooth_max(const omnirobot_s2_real* a, const omnirobot_s2_real* b, omnirobot_s2_real* max) {
+static void body_smooth_max(const omnirobot_s2_real* a, const omnirobot_s2_real* b, const omnirobot_s2_real* nu, omnirobot_s2_real* max) {
   omnirobot_s2_real w0;
   omnirobot_s2_real w1;
   omnirobot_s2_real w2;
@@ -174,22 +438,22 @@ static void body_smooth_max(const omnirobot_s2_real* a, const omnirobot_s2_real*
   w0 = a[0];
   w1 = b[0];
   w2 = (w1 > w0) ? w1 : w0;
-  w3 = -50.0;
+  w3 = nu[0];
   w0 = w0 - w1;
   w0 = fabs(w0);
-  w3 = w3 * w0;
-  w0 = -80.0;
-  w3 = (w0 > w3) ? w0 : w3;
-  w3 = exp(w3);
-  w3 = log1p(w3);
-  w0 = 50.0;
-  w3 = w3 / w0;
-  w2 = w2 + w3;
+  w0 = w3 * w0;
+  w0 = -w0;
+  w1 = -80.0;
+  w0 = (w1 > w0) ? w1 : w0;
+  w0 = exp(w0);
+  w0 = log1p(w0);
+  w0 = w0 / w3;
+  w2 = w2 + w0;
   max[0] = w2;
 }
 
-/* CasADi Function 'smooth_min_test': 19 instructions. */
-static void body_smooth_min_test(const omnirobot_s2_real* a, const omnirobot_s2_real* b, omnirobot_s2_real* min, omnirobot_s2_real* needed) {
+/* CasADi Function 'smooth_min_test': 20 instructions. */
+static void body_smooth_min_test(const omnirobot_s2_real* a, const omnirobot_s2_real* b, const omnirobot_s2_real* nu, omnirobot_s2_real* min, omnirobot_s2_real* needed) {
   omnirobot_s2_real w0;
   omnirobot_s2_real w1;
   omnirobot_s2_real w2;
@@ -203,21 +467,22 @@ static void body_smooth_min_test(const omnirobot_s2_real* a, const omnirobot_s2_
   w3 = -w1;
   min[0] = w3;
   w3 = 80.0;
-  w4 = 50.0;
+  w4 = nu[0];
   w2 = w2 - w0;
   w2 = fabs(w2);
-  w4 = w4 * w2;
-  w3 = (w3 <= w4) ? 1.0 : 0.0;
-  w4 = 6.521212260432478e-21;
+  w2 = w4 * w2;
+  w3 = (w3 <= w2) ? 1.0 : 0.0;
+  w2 = 3.260606130216239e-19;
+  w2 = w2 / w4;
   w1 = fabs(w1);
-  w4 = (w4 <= w1) ? 1.0 : 0.0;
-  w3 = ((w3 != 0.0) && (w4 != 0.0)) ? 1.0 : 0.0;
+  w2 = (w2 <= w1) ? 1.0 : 0.0;
+  w3 = ((w3 != 0.0) && (w2 != 0.0)) ? 1.0 : 0.0;
   w3 = (w3 == 0.0) ? 1.0 : 0.0;
   needed[0] = w3;
 }
 
 /* CasADi Function 'smooth_min': 18 instructions. */
-static void body_smooth_min(const omnirobot_s2_real* a, const omnirobot_s2_real* b, omnirobot_s2_real* min) {
+static void body_smooth_min(const omnirobot_s2_real* a, const omnirobot_s2_real* b, const omnirobot_s2_real* nu, omnirobot_s2_real* min) {
   omnirobot_s2_real w0;
   omnirobot_s2_real w1;
   omnirobot_s2_real w2;
@@ -227,23 +492,23 @@ static void body_smooth_min(const omnirobot_s2_real* a, const omnirobot_s2_real*
   w2 = b[0];
   w3 = -w2;
   w1 = (w3 > w1) ? w3 : w1;
-  w3 = -50.0;
+  w3 = nu[0];
   w2 = w2 - w0;
   w2 = fabs(w2);
-  w3 = w3 * w2;
-  w2 = -80.0;
-  w3 = (w2 > w3) ? w2 : w3;
-  w3 = exp(w3);
-  w3 = log1p(w3);
-  w2 = 50.0;
-  w3 = w3 / w2;
-  w1 = w1 + w3;
+  w2 = w3 * w2;
+  w2 = -w2;
+  w0 = -80.0;
+  w2 = (w0 > w2) ? w0 : w2;
+  w2 = exp(w2);
+  w2 = log1p(w2);
+  w2 = w2 / w3;
+  w1 = w1 + w2;
   w1 = -w1;
   min[0] = w1;
 }
 
-/* CasADi Function 'gamma_rates': 581 instructions. */
-static void body_gamma_rates(const omnirobot_s2_real* t, const omnirobot_s2_real* alpha, omnirobot_s2_real* gamma_L_dot, omnirobot_s2_real* gamma_U_dot) {
+/* CasADi Function 'smooth_max_rate': 40 instructions. */
+static void body_smooth_max_rate(const omnirobot_s2_real* a, const omnirobot_s2_real* b, const omnirobot_s2_real* a_dot, const omnirobot_s2_real* b_dot, const omnirobot_s2_real* nu, omnirobot_s2_real* max_dot) {
   omnirobot_s2_real w0;
   omnirobot_s2_real w1;
   omnirobot_s2_real w2;
@@ -253,891 +518,271 @@ static void body_gamma_rates(const omnirobot_s2_real* t, const omnirobot_s2_real
   omnirobot_s2_real w6;
   omnirobot_s2_real w7;
   omnirobot_s2_real w8;
-  omnirobot_s2_real w9;
-  omnirobot_s2_real w10;
-  omnirobot_s2_real w11;
-  omnirobot_s2_real w12;
-  omnirobot_s2_real w13;
-  omnirobot_s2_real w14;
-  omnirobot_s2_real w15;
-  omnirobot_s2_real w16;
-  omnirobot_s2_real w17;
-  omnirobot_s2_real w18;
-  omnirobot_s2_real w19;
-  omnirobot_s2_real w20;
-  omnirobot_s2_real w21;
-  omnirobot_s2_real w22;
-  omnirobot_s2_real w23;
-  omnirobot_s2_real w24;
-  omnirobot_s2_real w25;
-  omnirobot_s2_real w26;
-  omnirobot_s2_real w27;
-  omnirobot_s2_real w28;
-  omnirobot_s2_real w29;
-  omnirobot_s2_real w30;
-  omnirobot_s2_real w31;
-  omnirobot_s2_real w32;
-  omnirobot_s2_real w33;
-  omnirobot_s2_real w34;
-  omnirobot_s2_real w35;
-  omnirobot_s2_real w36;
-  omnirobot_s2_real w37;
-  w0 = t[0];
-  w1 = 9.0;
-  w2 = (w0 < w1) ? 1.0 : 0.0;
-  w3 = 0.0;
-  w4 = (w0 < w3) ? 1.0 : 0.0;
-  w4 = (w4 == 0.0) ? 1.0 : 0.0;
-  w5 = 4.5;
-  w6 = w1 - w0;
-  w6 = (w2 != 0.0) ? w6 : 0.0;
-  w7 = (w2 == 0.0) ? 1.0 : 0.0;
-  w8 = 1.0;
-  w7 = (w7 != 0.0) ? w8 : 0.0;
-  w6 = w6 + w7;
-  w7 = w0 / w6;
-  w9 = tanh(w7);
-  w10 = (w4 != 0.0) ? w9 : 0.0;
-  w10 = (w2 != 0.0) ? w10 : 0.0;
-  w11 = (w2 == 0.0) ? 1.0 : 0.0;
-  w11 = (w11 != 0.0) ? w8 : 0.0;
-  w10 = w10 + w11;
-  w11 = w5 * w10;
-  w12 = 0.04999999999999999;
-  w11 = w11 + w12;
-  w13 = alpha[0];
-  w11 = w11 - w13;
-  w14 = (w3 <= w11) ? 1.0 : 0.0;
-  w15 = (w11 <= w3) ? 1.0 : 0.0;
-  w15 = w14 + w15;
-  w14 = w14 / w15;
-  w15 = w9 * w9;
-  w15 = w8 - w15;
-  w16 = 1.0 / w6;
-  w17 = w7 / w6;
-  w17 = (w2 != 0.0) ? w17 : 0.0;
-  w16 = w16 + w17;
-  w15 = w15 * w16;
-  w16 = w5 * w15;
-  w14 = w14 * w16;
-  w17 = 0.02;
-  w18 = -50.0;
-  w19 = fabs(w11);
-  w19 = w18 * w19;
-  w20 = -80.0;
-  w21 = (w20 > w19) ? w20 : w19;
-  w21 = exp(w21);
-  w22 = (w20 <= w19) ? 1.0 : 0.0;
-  w23 = (w19 <= w20) ? 1.0 : 0.0;
-  w23 = w22 + w23;
-  w22 = w22 / w23;
-  w23 = (w11 < 0.0) ? -1.0 : ((w11 > 0.0) ? 1.0 : w11);
-  w23 = w23 * w16;
-  w23 = w18 * w23;
-  w22 = w22 * w23;
-  w22 = w21 * w22;
-  w23 = w8 + w21;
-  w22 = w22 / w23;
-  w22 = w17 * w22;
-  w14 = w14 + w22;
-  w14 = (w4 != 0.0) ? w14 : 0.0;
-  w14 = (w2 != 0.0) ? w14 : 0.0;
-  w22 = (w3 <= w11) ? 1.0 : 0.0;
-  w23 = (w11 <= w3) ? 1.0 : 0.0;
-  w23 = w22 + w23;
-  w22 = w22 / w23;
-  w23 = (w20 <= w19) ? 1.0 : 0.0;
-  w19 = (w19 <= w20) ? 1.0 : 0.0;
-  w19 = w23 + w19;
-  w23 = w23 / w19;
-  w11 = (w11 < 0.0) ? -1.0 : ((w11 > 0.0) ? 1.0 : w11);
-  w11 = w18 * w11;
-  w23 = w23 * w11;
-  w23 = w21 * w23;
-  w21 = w8 + w21;
-  w23 = w23 / w21;
-  w23 = w17 * w23;
-  w22 = w22 + w23;
-  w23 = 5.0;
-  w21 = 1.5993877293583263;
-  w11 = w0 - w21;
-  w19 = fabs(w11);
-  w16 = 1.7671450941146722;
-  w19 = (w19 < w16) ? 1.0 : 0.0;
-  w24 = 4.2;
-  w25 = -0.1;
-  w26 = w11 * w11;
-  w26 = w25 * w26;
-  w27 = fabs(w11);
-  w27 = w16 - w27;
-  w11 = fabs(w11);
-  w11 = w16 + w11;
-  w27 = w27 * w11;
-  w27 = (w19 != 0.0) ? w27 : 0.0;
-  w11 = (w19 == 0.0) ? 1.0 : 0.0;
-  w11 = (w11 != 0.0) ? w8 : 0.0;
-  w27 = w27 + w11;
-  w26 = w26 / w27;
-  w26 = exp(w26);
-  w26 = w24 * w26;
-  w19 = (w19 != 0.0) ? w26 : 0.0;
-  w19 = w23 - w19;
-  w26 = (w0 < w1) ? 1.0 : 0.0;
-  w27 = (w0 < w3) ? 1.0 : 0.0;
-  w27 = (w27 == 0.0) ? 1.0 : 0.0;
+  w0 = b[0];
+  w1 = a[0];
+  w2 = (w0 <= w1) ? 1.0 : 0.0;
+  w3 = (w1 <= w0) ? 1.0 : 0.0;
+  w4 = w2 + w3;
+  w2 = w2 / w4;
+  w5 = nu[0];
   w1 = w1 - w0;
-  w1 = (w26 != 0.0) ? w1 : 0.0;
-  w11 = (w26 == 0.0) ? 1.0 : 0.0;
-  w11 = (w11 != 0.0) ? w8 : 0.0;
-  w1 = w1 + w11;
-  w1 = w0 / w1;
-  w1 = tanh(w1);
-  w27 = (w27 != 0.0) ? w1 : 0.0;
-  w27 = (w26 != 0.0) ? w27 : 0.0;
-  w26 = (w26 == 0.0) ? 1.0 : 0.0;
-  w26 = (w26 != 0.0) ? w8 : 0.0;
-  w27 = w27 + w26;
-  w26 = w5 * w27;
-  w26 = w26 + w12;
-  w19 = w19 - w26;
-  w26 = w19 - w8;
-  w26 = w26 + w26;
-  w26 = (w20 > w26) ? w20 : w26;
-  w1 = 80.0;
-  w26 = (w1 < w26) ? w1 : w26;
-  w26 = exp(w26);
-  w26 = w8 + w26;
-  w26 = w17 / w26;
-  w19 = w19 + w13;
-  w19 = w19 * w19;
-  w26 = w26 / w19;
-  w13 = w23 * w13;
-  w26 = w26 - w13;
-  w22 = w22 * w26;
-  w14 = w14 - w22;
-  gamma_L_dot[0] = w14;
-  w14 = w5 * w10;
-  w14 = w14 + w12;
-  w22 = alpha[1];
-  w14 = w14 - w22;
-  w26 = (w3 <= w14) ? 1.0 : 0.0;
-  w13 = (w14 <= w3) ? 1.0 : 0.0;
-  w13 = w26 + w13;
-  w26 = w26 / w13;
-  w13 = w5 * w15;
-  w26 = w26 * w13;
-  w19 = fabs(w14);
-  w19 = w18 * w19;
-  w11 = (w20 > w19) ? w20 : w19;
-  w11 = exp(w11);
-  w28 = (w20 <= w19) ? 1.0 : 0.0;
-  w29 = (w19 <= w20) ? 1.0 : 0.0;
-  w29 = w28 + w29;
-  w28 = w28 / w29;
-  w29 = (w14 < 0.0) ? -1.0 : ((w14 > 0.0) ? 1.0 : w14);
-  w29 = w29 * w13;
-  w29 = w18 * w29;
-  w28 = w28 * w29;
-  w28 = w11 * w28;
-  w29 = w8 + w11;
-  w28 = w28 / w29;
-  w28 = w17 * w28;
-  w26 = w26 + w28;
-  w26 = (w4 != 0.0) ? w26 : 0.0;
-  w26 = (w2 != 0.0) ? w26 : 0.0;
-  w28 = (w3 <= w14) ? 1.0 : 0.0;
-  w3 = (w14 <= w3) ? 1.0 : 0.0;
-  w3 = w28 + w3;
-  w28 = w28 / w3;
-  w3 = (w20 <= w19) ? 1.0 : 0.0;
-  w19 = (w19 <= w20) ? 1.0 : 0.0;
-  w19 = w3 + w19;
-  w3 = w3 / w19;
-  w14 = (w14 < 0.0) ? -1.0 : ((w14 > 0.0) ? 1.0 : w14);
-  w14 = w18 * w14;
-  w3 = w3 * w14;
-  w3 = w11 * w3;
-  w11 = w8 + w11;
-  w3 = w3 / w11;
-  w3 = w17 * w3;
-  w28 = w28 + w3;
-  w3 = 3.4604513923231814;
-  w11 = w0 - w3;
-  w14 = fabs(w11);
-  w19 = 1.161570819899055;
-  w14 = (w14 < w19) ? 1.0 : 0.0;
-  w29 = 2.7;
-  w13 = w11 * w11;
-  w13 = w25 * w13;
-  w30 = fabs(w11);
-  w30 = w19 - w30;
-  w11 = fabs(w11);
-  w11 = w19 + w11;
-  w30 = w30 * w11;
-  w30 = (w14 != 0.0) ? w30 : 0.0;
-  w11 = (w14 == 0.0) ? 1.0 : 0.0;
-  w11 = (w11 != 0.0) ? w8 : 0.0;
-  w30 = w30 + w11;
-  w13 = w13 / w30;
-  w13 = exp(w13);
-  w13 = w29 * w13;
-  w14 = (w14 != 0.0) ? w13 : 0.0;
-  w14 = w23 - w14;
-  w13 = w5 * w27;
-  w13 = w13 + w12;
-  w14 = w14 - w13;
-  w13 = w14 - w8;
-  w13 = w13 + w13;
-  w13 = (w20 > w13) ? w20 : w13;
-  w13 = (w1 < w13) ? w1 : w13;
-  w13 = exp(w13);
-  w13 = w8 + w13;
-  w13 = w17 / w13;
-  w14 = w14 + w22;
-  w14 = w14 * w14;
-  w13 = w13 / w14;
-  w22 = w23 * w22;
-  w13 = w13 - w22;
-  w28 = w28 * w13;
-  w26 = w26 - w28;
-  gamma_L_dot[1] = w26;
-  w26 = -1.2;
-  w28 = -0.45;
-  w13 = w28 * w10;
-  w22 = -0.05;
-  w13 = w13 + w22;
-  w14 = alpha[2];
-  w13 = w13 - w14;
-  w12 = (w26 <= w13) ? 1.0 : 0.0;
-  w30 = (w13 <= w26) ? 1.0 : 0.0;
-  w30 = w12 + w30;
-  w12 = w12 / w30;
-  w15 = w28 * w15;
-  w12 = w12 * w15;
-  w30 = w13 - w26;
-  w11 = fabs(w30);
-  w11 = w18 * w11;
-  w31 = (w20 > w11) ? w20 : w11;
-  w31 = exp(w31);
-  w32 = (w20 <= w11) ? 1.0 : 0.0;
-  w33 = (w11 <= w20) ? 1.0 : 0.0;
-  w33 = w32 + w33;
-  w32 = w32 / w33;
-  w33 = (w30 < 0.0) ? -1.0 : ((w30 > 0.0) ? 1.0 : w30);
-  w33 = w33 * w15;
-  w33 = w18 * w33;
-  w32 = w32 * w33;
-  w32 = w31 * w32;
-  w33 = w8 + w31;
-  w32 = w32 / w33;
-  w32 = w17 * w32;
-  w12 = w12 + w32;
-  w12 = (w4 != 0.0) ? w12 : 0.0;
-  w12 = (w2 != 0.0) ? w12 : 0.0;
-  w32 = (w26 <= w13) ? 1.0 : 0.0;
-  w13 = (w13 <= w26) ? 1.0 : 0.0;
-  w13 = w32 + w13;
-  w32 = w32 / w13;
-  w13 = (w20 <= w11) ? 1.0 : 0.0;
-  w11 = (w11 <= w20) ? 1.0 : 0.0;
-  w11 = w13 + w11;
-  w13 = w13 / w11;
-  w30 = (w30 < 0.0) ? -1.0 : ((w30 > 0.0) ? 1.0 : w30);
-  w30 = w18 * w30;
-  w13 = w13 * w30;
-  w13 = w31 * w13;
-  w31 = w8 + w31;
-  w13 = w13 / w31;
-  w13 = w17 * w13;
-  w32 = w32 + w13;
-  w13 = 1.2;
-  w28 = w28 * w27;
-  w28 = w28 + w22;
-  w13 = w13 - w28;
-  w28 = w13 - w8;
-  w28 = w28 + w28;
-  w28 = (w20 > w28) ? w20 : w28;
-  w28 = (w1 < w28) ? w1 : w28;
-  w28 = exp(w28);
-  w28 = w8 + w28;
-  w28 = w17 / w28;
-  w13 = w13 + w14;
-  w13 = w13 * w13;
-  w28 = w28 / w13;
-  w14 = w23 * w14;
-  w28 = w28 - w14;
-  w32 = w32 * w28;
-  w12 = w12 - w32;
-  gamma_L_dot[2] = w12;
-  w21 = w0 - w21;
-  w12 = fabs(w21);
-  w12 = (w12 < w16) ? 1.0 : 0.0;
-  w32 = w21 * w21;
-  w32 = w25 * w32;
-  w28 = fabs(w21);
-  w28 = w16 - w28;
-  w14 = fabs(w21);
-  w16 = w16 + w14;
-  w14 = w28 * w16;
-  w14 = (w12 != 0.0) ? w14 : 0.0;
-  w13 = (w12 == 0.0) ? 1.0 : 0.0;
-  w13 = (w13 != 0.0) ? w8 : 0.0;
-  w14 = w14 + w13;
-  w32 = w32 / w14;
-  w13 = exp(w32);
-  w22 = w24 * w13;
-  w22 = (w12 != 0.0) ? w22 : 0.0;
-  w22 = w23 - w22;
-  w31 = -w22;
-  w30 = w5 * w10;
-  w11 = 0.45;
-  w30 = w30 + w11;
-  w33 = alpha[3];
-  w30 = w30 + w33;
-  w15 = -w30;
-  w34 = (w31 <= w15) ? 1.0 : 0.0;
-  w35 = (w15 <= w31) ? 1.0 : 0.0;
-  w35 = w34 + w35;
-  w34 = w34 / w35;
-  w22 = w22 - w30;
-  w30 = fabs(w22);
-  w30 = w18 * w30;
-  w35 = (w20 > w30) ? w20 : w30;
-  w35 = exp(w35);
-  w36 = (w20 <= w30) ? 1.0 : 0.0;
-  w37 = (w30 <= w20) ? 1.0 : 0.0;
-  w37 = w36 + w37;
-  w36 = w36 / w37;
-  w37 = (w22 < 0.0) ? -1.0 : ((w22 > 0.0) ? 1.0 : w22);
-  w37 = w18 * w37;
-  w36 = w36 * w37;
-  w36 = w35 * w36;
-  w37 = w8 + w35;
-  w36 = w36 / w37;
-  w36 = w17 * w36;
-  w34 = w34 + w36;
-  w36 = w5 * w27;
-  w36 = w36 + w11;
-  w37 = w36 - w8;
-  w37 = w37 + w37;
-  w37 = (w20 > w37) ? w20 : w37;
-  w37 = (w1 < w37) ? w1 : w37;
-  w37 = exp(w37);
-  w37 = w8 + w37;
-  w37 = w17 / w37;
-  w36 = w36 + w33;
-  w36 = w36 * w36;
-  w37 = w37 / w36;
-  w33 = w23 * w33;
-  w37 = w37 - w33;
-  w34 = w34 * w37;
-  w37 = (w31 <= w15) ? 1.0 : 0.0;
-  w15 = (w15 <= w31) ? 1.0 : 0.0;
-  w31 = w37 + w15;
-  w37 = w37 / w31;
-  w9 = w9 * w9;
-  w9 = w8 - w9;
-  w33 = 1.0 / w6;
-  w7 = w7 / w6;
-  w7 = (w2 != 0.0) ? w7 : 0.0;
-  w33 = w33 + w7;
-  w9 = w9 * w33;
-  w33 = w5 * w9;
-  w37 = w37 * w33;
-  w37 = -w37;
-  w37 = (w4 != 0.0) ? w37 : 0.0;
-  w37 = (w2 != 0.0) ? w37 : 0.0;
-  w15 = w15 / w31;
-  w31 = -0.2;
-  w7 = w31 * w21;
-  w7 = w7 / w14;
-  w32 = w32 / w14;
-  w14 = (w21 < 0.0) ? -1.0 : ((w21 > 0.0) ? 1.0 : w21);
-  w28 = w28 * w14;
-  w21 = (w21 < 0.0) ? -1.0 : ((w21 > 0.0) ? 1.0 : w21);
-  w16 = w16 * w21;
-  w28 = w28 - w16;
-  w32 = w32 * w28;
-  w32 = -w32;
-  w32 = (w12 != 0.0) ? w32 : 0.0;
-  w7 = w7 + w32;
-  w13 = w13 * w7;
-  w24 = w24 * w13;
-  w15 = w15 * w24;
-  w15 = (w12 != 0.0) ? w15 : 0.0;
-  w37 = w37 + w15;
-  w15 = (w20 <= w30) ? 1.0 : 0.0;
-  w30 = (w30 <= w20) ? 1.0 : 0.0;
-  w30 = w15 + w30;
-  w15 = w15 / w30;
-  w22 = (w22 < 0.0) ? -1.0 : ((w22 > 0.0) ? 1.0 : w22);
-  w24 = -w24;
-  w12 = (w12 != 0.0) ? w24 : 0.0;
-  w33 = -w33;
-  w33 = (w4 != 0.0) ? w33 : 0.0;
-  w33 = (w2 != 0.0) ? w33 : 0.0;
-  w12 = w12 + w33;
-  w22 = w22 * w12;
-  w22 = w18 * w22;
-  w15 = w15 * w22;
-  w15 = w35 * w15;
-  w35 = w8 + w35;
-  w15 = w15 / w35;
-  w15 = w17 * w15;
-  w37 = w37 + w15;
-  w34 = w34 - w37;
-  gamma_U_dot[0] = w34;
-  w0 = w0 - w3;
-  w3 = fabs(w0);
-  w3 = (w3 < w19) ? 1.0 : 0.0;
-  w34 = w0 * w0;
-  w25 = w25 * w34;
-  w34 = fabs(w0);
-  w34 = w19 - w34;
-  w37 = fabs(w0);
-  w19 = w19 + w37;
-  w37 = w34 * w19;
-  w37 = (w3 != 0.0) ? w37 : 0.0;
-  w15 = (w3 == 0.0) ? 1.0 : 0.0;
-  w15 = (w15 != 0.0) ? w8 : 0.0;
-  w37 = w37 + w15;
-  w25 = w25 / w37;
-  w15 = exp(w25);
-  w35 = w29 * w15;
-  w35 = (w3 != 0.0) ? w35 : 0.0;
-  w35 = w23 - w35;
-  w22 = -w35;
-  w12 = w5 * w10;
-  w12 = w12 + w11;
-  w33 = alpha[4];
-  w12 = w12 + w33;
-  w24 = -w12;
-  w30 = (w22 <= w24) ? 1.0 : 0.0;
-  w13 = (w24 <= w22) ? 1.0 : 0.0;
-  w13 = w30 + w13;
-  w30 = w30 / w13;
-  w35 = w35 - w12;
-  w12 = fabs(w35);
-  w12 = w18 * w12;
-  w13 = (w20 > w12) ? w20 : w12;
-  w13 = exp(w13);
-  w7 = (w20 <= w12) ? 1.0 : 0.0;
-  w32 = (w12 <= w20) ? 1.0 : 0.0;
-  w32 = w7 + w32;
-  w7 = w7 / w32;
-  w32 = (w35 < 0.0) ? -1.0 : ((w35 > 0.0) ? 1.0 : w35);
-  w32 = w18 * w32;
-  w7 = w7 * w32;
-  w7 = w13 * w7;
-  w32 = w8 + w13;
-  w7 = w7 / w32;
-  w7 = w17 * w7;
-  w30 = w30 + w7;
-  w7 = w5 * w27;
-  w7 = w7 + w11;
-  w32 = w7 - w8;
-  w32 = w32 + w32;
-  w32 = (w20 > w32) ? w20 : w32;
-  w32 = (w1 < w32) ? w1 : w32;
-  w32 = exp(w32);
-  w32 = w8 + w32;
-  w32 = w17 / w32;
-  w7 = w7 + w33;
-  w7 = w7 * w7;
-  w32 = w32 / w7;
-  w33 = w23 * w33;
-  w32 = w32 - w33;
-  w30 = w30 * w32;
-  w32 = (w22 <= w24) ? 1.0 : 0.0;
-  w24 = (w24 <= w22) ? 1.0 : 0.0;
-  w22 = w32 + w24;
-  w32 = w32 / w22;
-  w5 = w5 * w9;
-  w32 = w32 * w5;
-  w32 = -w32;
-  w32 = (w4 != 0.0) ? w32 : 0.0;
-  w32 = (w2 != 0.0) ? w32 : 0.0;
-  w24 = w24 / w22;
-  w31 = w31 * w0;
-  w31 = w31 / w37;
-  w25 = w25 / w37;
-  w37 = (w0 < 0.0) ? -1.0 : ((w0 > 0.0) ? 1.0 : w0);
-  w34 = w34 * w37;
-  w0 = (w0 < 0.0) ? -1.0 : ((w0 > 0.0) ? 1.0 : w0);
-  w19 = w19 * w0;
-  w34 = w34 - w19;
-  w25 = w25 * w34;
-  w25 = -w25;
-  w25 = (w3 != 0.0) ? w25 : 0.0;
-  w31 = w31 + w25;
-  w15 = w15 * w31;
-  w29 = w29 * w15;
-  w24 = w24 * w29;
-  w24 = (w3 != 0.0) ? w24 : 0.0;
-  w32 = w32 + w24;
-  w24 = (w20 <= w12) ? 1.0 : 0.0;
-  w12 = (w12 <= w20) ? 1.0 : 0.0;
-  w12 = w24 + w12;
-  w24 = w24 / w12;
-  w35 = (w35 < 0.0) ? -1.0 : ((w35 > 0.0) ? 1.0 : w35);
-  w29 = -w29;
-  w3 = (w3 != 0.0) ? w29 : 0.0;
-  w5 = -w5;
-  w5 = (w4 != 0.0) ? w5 : 0.0;
-  w5 = (w2 != 0.0) ? w5 : 0.0;
-  w3 = w3 + w5;
-  w35 = w35 * w3;
-  w35 = w18 * w35;
-  w24 = w24 * w35;
-  w24 = w13 * w24;
-  w13 = w8 + w13;
-  w24 = w24 / w13;
-  w24 = w17 * w24;
-  w32 = w32 + w24;
-  w30 = w30 - w32;
-  gamma_U_dot[1] = w30;
-  w10 = w11 * w10;
-  w30 = 0.05;
-  w10 = w10 + w30;
-  w32 = alpha[5];
-  w10 = w10 + w32;
-  w24 = w10 + w26;
-  w13 = fabs(w24);
-  w13 = w18 * w13;
-  w35 = (w20 > w13) ? w20 : w13;
-  w35 = exp(w35);
-  w3 = (w20 <= w13) ? 1.0 : 0.0;
-  w5 = (w13 <= w20) ? 1.0 : 0.0;
-  w5 = w3 + w5;
-  w3 = w3 / w5;
-  w5 = (w24 < 0.0) ? -1.0 : ((w24 > 0.0) ? 1.0 : w24);
-  w9 = w11 * w9;
-  w5 = w5 * w9;
-  w5 = w18 * w5;
-  w3 = w3 * w5;
-  w3 = w35 * w3;
-  w5 = w8 + w35;
-  w3 = w3 / w5;
-  w3 = w17 * w3;
-  w10 = -w10;
-  w5 = (w26 <= w10) ? 1.0 : 0.0;
-  w29 = (w10 <= w26) ? 1.0 : 0.0;
-  w29 = w5 + w29;
-  w5 = w5 / w29;
-  w5 = w5 * w9;
-  w3 = w3 - w5;
-  w3 = -w3;
-  w4 = (w4 != 0.0) ? w3 : 0.0;
-  w2 = (w2 != 0.0) ? w4 : 0.0;
-  w4 = (w20 <= w13) ? 1.0 : 0.0;
-  w13 = (w13 <= w20) ? 1.0 : 0.0;
-  w13 = w4 + w13;
-  w4 = w4 / w13;
-  w24 = (w24 < 0.0) ? -1.0 : ((w24 > 0.0) ? 1.0 : w24);
-  w18 = w18 * w24;
-  w4 = w4 * w18;
-  w4 = w35 * w4;
-  w35 = w8 + w35;
-  w4 = w4 / w35;
-  w4 = w17 * w4;
-  w35 = (w26 <= w10) ? 1.0 : 0.0;
-  w10 = (w10 <= w26) ? 1.0 : 0.0;
-  w10 = w35 + w10;
-  w35 = w35 / w10;
-  w4 = w4 - w35;
-  w11 = w11 * w27;
-  w11 = w11 + w30;
-  w11 = w11 - w26;
-  w26 = w11 - w8;
-  w26 = w26 + w26;
-  w26 = (w20 > w26) ? w20 : w26;
-  w26 = (w1 < w26) ? w1 : w26;
-  w26 = exp(w26);
-  w8 = w8 + w26;
-  w17 = w17 / w8;
-  w11 = w11 + w32;
-  w11 = w11 * w11;
-  w17 = w17 / w11;
-  w23 = w23 * w32;
-  w17 = w17 - w23;
-  w4 = w4 * w17;
-  w2 = w2 - w4;
-  gamma_U_dot[2] = w2;
-}
-
-/* CasADi Function 'law': 89 instructions. */
-static void body_law(const omnirobot_s2_real* x, const omnirobot_s2_real* gamma_L, const omnirobot_s2_real* gamma_U, omnirobot_s2_real* u, omnirobot_s2_real* inside) {
-  omnirobot_s2_real w0;
-  omnirobot_s2_real w1;
-  omnirobot_s2_real w2;
-  omnirobot_s2_real w3;
-  omnirobot_s2_real w4;
-  omnirobot_s2_real w5;
-  omnirobot_s2_real w6;
-  omnirobot_s2_real w7;
-  omnirobot_s2_real w8;
-  omnirobot_s2_real w9;
-  omnirobot_s2_real w10;
-  omnirobot_s2_real w11;
-  omnirobot_s2_real w12;
-  omnirobot_s2_real w13;
-  w0 = -0.2664829878855371;
-  w1 = 4.0;
-  w2 = gamma_U[0];
-  w3 = gamma_L[0];
-  w4 = w2 - w3;
-  w5 = 1e-06;
-  w6 = (w5 > w4) ? w5 : w4;
-  w7 = 1.0;
-  w8 = x[0];
-  w8 = w8 + w8;
-  w2 = w2 + w3;
-  w8 = w8 - w2;
-  w8 = w8 / w6;
-  w2 = -0.9999990463256836;
-  w3 = (w2 > w8) ? w2 : w8;
-  w9 = 0.9999990463256836;
-  w3 = (w9 < w3) ? w9 : w3;
-  w10 = w3 * w3;
-  w10 = w7 - w10;
-  w6 = w6 * w10;
-  w6 = w1 / w6;
-  w6 = w0 * w6;
-  w10 = w7 + w3;
-  w3 = w7 - w3;
-  w10 = w10 / w3;
-  w10 = log(w10);
-  w6 = w6 * w10;
-  u[0] = w6;
-  w6 = gamma_U[1];
-  w10 = gamma_L[1];
-  w3 = w6 - w10;
-  w11 = (w5 > w3) ? w5 : w3;
-  w12 = x[1];
-  w12 = w12 + w12;
-  w6 = w6 + w10;
-  w12 = w12 - w6;
-  w12 = w12 / w11;
-  w6 = (w2 > w12) ? w2 : w12;
-  w6 = (w9 < w6) ? w9 : w6;
-  w10 = w6 * w6;
-  w10 = w7 - w10;
-  w11 = w11 * w10;
-  w11 = w1 / w11;
-  w11 = w0 * w11;
-  w10 = w7 + w6;
-  w6 = w7 - w6;
-  w10 = w10 / w6;
-  w10 = log(w10);
-  w11 = w11 * w10;
-  u[1] = w11;
-  w11 = gamma_U[2];
-  w10 = gamma_L[2];
-  w6 = w11 - w10;
-  w5 = (w5 > w6) ? w5 : w6;
-  w13 = x[2];
-  w13 = w13 + w13;
-  w11 = w11 + w10;
-  w13 = w13 - w11;
-  w13 = w13 / w5;
-  w2 = (w2 > w13) ? w2 : w13;
-  w2 = (w9 < w2) ? w9 : w2;
-  w9 = w2 * w2;
-  w9 = w7 - w9;
-  w5 = w5 * w9;
-  w1 = w1 / w5;
-  w0 = w0 * w1;
-  w1 = w7 + w2;
-  w2 = w7 - w2;
-  w1 = w1 / w2;
-  w1 = log(w1);
-  w0 = w0 * w1;
-  u[2] = w0;
-  w8 = fabs(w8);
-  w8 = (w8 < w7) ? 1.0 : 0.0;
-  w0 = 0.0;
-  w4 = (w0 < w4) ? 1.0 : 0.0;
-  w8 = ((w8 != 0.0) && (w4 != 0.0)) ? 1.0 : 0.0;
-  w8 = ((w7 != 0.0) && (w8 != 0.0)) ? 1.0 : 0.0;
-  w12 = fabs(w12);
-  w12 = (w12 < w7) ? 1.0 : 0.0;
-  w3 = (w0 < w3) ? 1.0 : 0.0;
-  w12 = ((w12 != 0.0) && (w3 != 0.0)) ? 1.0 : 0.0;
-  w8 = ((w8 != 0.0) && (w12 != 0.0)) ? 1.0 : 0.0;
-  w13 = fabs(w13);
-  w13 = (w13 < w7) ? 1.0 : 0.0;
-  w0 = (w0 < w6) ? 1.0 : 0.0;
-  w13 = ((w13 != 0.0) && (w0 != 0.0)) ? 1.0 : 0.0;
-  w8 = ((w8 != 0.0) && (w13 != 0.0)) ? 1.0 : 0.0;
-  inside[0] = w8;
-}
-
-/* CasADi Function 'alpha_conflict': 148 instructions. */
-static void body_alpha_conflict(const omnirobot_s2_real* t, const omnirobot_s2_real* dt, omnirobot_s2_real* psi, omnirobot_s2_real* theta) {
-  omnirobot_s2_real w0;
-  omnirobot_s2_real w1;
-  omnirobot_s2_real w2;
-  omnirobot_s2_real w3;
-  omnirobot_s2_real w4;
-  omnirobot_s2_real w5;
-  omnirobot_s2_real w6;
-  omnirobot_s2_real w7;
-  omnirobot_s2_real w8;
-  omnirobot_s2_real w9;
-  omnirobot_s2_real w10;
-  omnirobot_s2_real w11;
-  w0 = 5.0;
-  w1 = t[0];
-  w2 = dt[0];
-  w1 = w1 + w2;
-  w2 = 1.5993877293583263;
-  w2 = w1 - w2;
-  w3 = fabs(w2);
-  w4 = 1.7671450941146722;
-  w3 = (w3 < w4) ? 1.0 : 0.0;
-  w5 = 4.2;
-  w6 = -0.1;
-  w7 = w2 * w2;
-  w7 = w6 * w7;
-  w8 = fabs(w2);
-  w8 = w4 - w8;
-  w2 = fabs(w2);
-  w4 = w4 + w2;
-  w8 = w8 * w4;
-  w8 = (w3 != 0.0) ? w8 : 0.0;
-  w4 = (w3 == 0.0) ? 1.0 : 0.0;
-  w2 = 1.0;
-  w4 = (w4 != 0.0) ? w2 : 0.0;
-  w8 = w8 + w4;
-  w7 = w7 / w8;
-  w7 = exp(w7);
-  w5 = w5 * w7;
-  w3 = (w3 != 0.0) ? w5 : 0.0;
-  w3 = w0 - w3;
-  w5 = 4.5;
-  w7 = 9.0;
-  w8 = (w1 < w7) ? 1.0 : 0.0;
-  w4 = 0.0;
-  w4 = (w1 < w4) ? 1.0 : 0.0;
-  w4 = (w4 == 0.0) ? 1.0 : 0.0;
-  w7 = w7 - w1;
-  w7 = (w8 != 0.0) ? w7 : 0.0;
-  w9 = (w8 == 0.0) ? 1.0 : 0.0;
-  w9 = (w9 != 0.0) ? w2 : 0.0;
-  w7 = w7 + w9;
-  w7 = w1 / w7;
-  w7 = tanh(w7);
-  w4 = (w4 != 0.0) ? w7 : 0.0;
-  w4 = (w8 != 0.0) ? w4 : 0.0;
-  w8 = (w8 == 0.0) ? 1.0 : 0.0;
-  w8 = (w8 != 0.0) ? w2 : 0.0;
-  w4 = w4 + w8;
-  w8 = w5 * w4;
-  w7 = 0.04999999999999999;
-  w8 = w8 + w7;
-  w3 = w3 - w8;
-  psi[0] = w3;
-  w8 = 3.4604513923231814;
-  w1 = w1 - w8;
-  w8 = fabs(w1);
-  w9 = 1.161570819899055;
-  w8 = (w8 < w9) ? 1.0 : 0.0;
-  w10 = 2.7;
-  w11 = w1 * w1;
-  w6 = w6 * w11;
-  w11 = fabs(w1);
-  w11 = w9 - w11;
-  w1 = fabs(w1);
-  w9 = w9 + w1;
-  w11 = w11 * w9;
-  w11 = (w8 != 0.0) ? w11 : 0.0;
-  w9 = (w8 == 0.0) ? 1.0 : 0.0;
-  w9 = (w9 != 0.0) ? w2 : 0.0;
-  w11 = w11 + w9;
-  w6 = w6 / w11;
-  w6 = exp(w6);
-  w10 = w10 * w6;
-  w8 = (w8 != 0.0) ? w10 : 0.0;
-  w0 = w0 - w8;
-  w8 = w5 * w4;
-  w8 = w8 + w7;
-  w0 = w0 - w8;
-  psi[1] = w0;
-  w8 = 1.2;
-  w7 = -0.45;
-  w7 = w7 * w4;
-  w10 = -0.05;
-  w7 = w7 + w10;
-  w8 = w8 - w7;
-  psi[2] = w8;
-  w7 = w5 * w4;
-  w10 = 0.45;
-  w7 = w7 + w10;
-  psi[3] = w7;
-  w5 = w5 * w4;
-  w5 = w5 + w10;
-  psi[4] = w5;
-  w10 = w10 * w4;
-  w4 = 0.05;
-  w10 = w10 + w4;
-  w4 = -1.2;
-  w10 = w10 - w4;
-  psi[5] = w10;
-  w4 = 0.02;
-  w3 = w3 - w2;
-  w3 = w3 + w3;
+  w0 = fabs(w1);
+  w0 = w5 * w0;
+  w0 = -w0;
   w6 = -80.0;
-  w3 = (w6 > w3) ? w6 : w3;
-  w11 = 80.0;
-  w3 = (w11 < w3) ? w11 : w3;
-  w3 = exp(w3);
-  w3 = w2 + w3;
-  w3 = w4 / w3;
-  theta[0] = w3;
-  w0 = w0 - w2;
-  w0 = w0 + w0;
-  w0 = (w6 > w0) ? w6 : w0;
-  w0 = (w11 < w0) ? w11 : w0;
-  w0 = exp(w0);
-  w0 = w2 + w0;
-  w0 = w4 / w0;
-  theta[1] = w0;
-  w8 = w8 - w2;
-  w8 = w8 + w8;
-  w8 = (w6 > w8) ? w6 : w8;
-  w8 = (w11 < w8) ? w11 : w8;
-  w8 = exp(w8);
-  w8 = w2 + w8;
-  w8 = w4 / w8;
-  theta[2] = w8;
-  w7 = w7 - w2;
-  w7 = w7 + w7;
-  w7 = (w6 > w7) ? w6 : w7;
-  w7 = (w11 < w7) ? w11 : w7;
+  w7 = (w6 > w0) ? w6 : w0;
   w7 = exp(w7);
-  w7 = w2 + w7;
-  w7 = w4 / w7;
-  theta[3] = w7;
-  w5 = w5 - w2;
+  w8 = (w6 <= w0) ? 1.0 : 0.0;
+  w0 = (w0 <= w6) ? 1.0 : 0.0;
+  w0 = w8 + w0;
+  w8 = w8 / w0;
+  w1 = (w1 < 0.0) ? -1.0 : ((w1 > 0.0) ? 1.0 : w1);
+  w0 = w5 * w1;
+  w0 = w8 * w0;
+  w0 = w7 * w0;
+  w6 = 1.0;
+  w6 = w6 + w7;
+  w0 = w0 / w6;
+  w0 = w0 / w5;
+  w2 = w2 - w0;
+  w0 = a_dot[0];
+  w2 = w2 * w0;
+  w3 = w3 / w4;
+  w1 = w5 * w1;
+  w8 = w8 * w1;
+  w7 = w7 * w8;
+  w7 = w7 / w6;
+  w7 = w7 / w5;
+  w3 = w3 + w7;
+  w7 = b_dot[0];
+  w3 = w3 * w7;
+  w2 = w2 + w3;
+  max_dot[0] = w2;
+}
+
+/* CasADi Function 'smooth_min_rate': 42 instructions. */
+static void body_smooth_min_rate(const omnirobot_s2_real* a, const omnirobot_s2_real* b, const omnirobot_s2_real* a_dot, const omnirobot_s2_real* b_dot, const omnirobot_s2_real* nu, omnirobot_s2_real* min_dot) {
+  omnirobot_s2_real w0;
+  omnirobot_s2_real w1;
+  omnirobot_s2_real w2;
+  omnirobot_s2_real w3;
+  omnirobot_s2_real w4;
+  omnirobot_s2_real w5;
+  omnirobot_s2_real w6;
+  omnirobot_s2_real w7;
+  omnirobot_s2_real w8;
+  w0 = a[0];
+  w1 = -w0;
+  w2 = b[0];
+  w3 = -w2;
+  w4 = (w1 <= w3) ? 1.0 : 0.0;
+  w3 = (w3 <= w1) ? 1.0 : 0.0;
+  w1 = w3 + w4;
+  w4 = w4 / w1;
+  w5 = nu[0];
+  w2 = w2 - w0;
+  w0 = fabs(w2);
+  w0 = w5 * w0;
+  w0 = -w0;
+  w6 = -80.0;
+  w7 = (w6 > w0) ? w6 : w0;
+  w7 = exp(w7);
+  w8 = (w6 <= w0) ? 1.0 : 0.0;
+  w0 = (w0 <= w6) ? 1.0 : 0.0;
+  w0 = w8 + w0;
+  w8 = w8 / w0;
+  w2 = (w2 < 0.0) ? -1.0 : ((w2 > 0.0) ? 1.0 : w2);
+  w0 = w5 * w2;
+  w0 = w8 * w0;
+  w0 = w7 * w0;
+  w6 = 1.0;
+  w6 = w6 + w7;
+  w0 = w0 / w6;
+  w0 = w0 / w5;
+  w4 = w4 + w0;
+  w0 = b_dot[0];
+  w4 = w4 * w0;
+  w2 = w5 * w2;
+  w8 = w8 * w2;
+  w7 = w7 * w8;
+  w7 = w7 / w6;
+  w7 = w7 / w5;
+  w3 = w3 / w1;
+  w7 = w7 - w3;
+  w3 = a_dot[0];
+  w7 = w7 * w3;
+  w4 = w4 - w7;
+  min_dot[0] = w4;
+}
+
+/* CasADi Function 'conflict': 78 instructions. */
+static void body_conflict(const omnirobot_s2_real* rho, const omnirobot_s2_real* beta, const omnirobot_s2_real* theta0, const omnirobot_s2_real* mu, omnirobot_s2_real* psi, omnirobot_s2_real* theta) {
+  omnirobot_s2_real w0;
+  omnirobot_s2_real w1;
+  omnirobot_s2_real w2;
+  omnirobot_s2_real w3;
+  omnirobot_s2_real w4;
+  omnirobot_s2_real w5;
+  omnirobot_s2_real w6;
+  omnirobot_s2_real w7;
+  omnirobot_s2_real w8;
+  omnirobot_s2_real w9;
+  omnirobot_s2_real w10;
+  w0 = beta[3];
+  w1 = rho[0];
+  w0 = w0 - w1;
+  psi[0] = w0;
+  w1 = beta[4];
+  w2 = rho[1];
+  w1 = w1 - w2;
+  psi[1] = w1;
+  w2 = beta[5];
+  w3 = rho[2];
+  w2 = w2 - w3;
+  psi[2] = w2;
+  w3 = rho[3];
+  w4 = beta[0];
+  w3 = w3 - w4;
+  psi[3] = w3;
+  w4 = rho[4];
+  w5 = beta[1];
+  w4 = w4 - w5;
+  psi[4] = w4;
+  w5 = rho[5];
+  w6 = beta[2];
+  w5 = w5 - w6;
+  psi[5] = w5;
+  w6 = theta0[0];
+  w6 = w6 + w6;
+  w7 = 1.0;
+  w8 = mu[0];
+  w0 = w0 - w8;
+  w0 = w0 + w0;
+  w9 = -80.0;
+  w0 = (w9 > w0) ? w9 : w0;
+  w10 = 80.0;
+  w0 = (w10 < w0) ? w10 : w0;
+  w0 = exp(w0);
+  w0 = w7 + w0;
+  w0 = w6 / w0;
+  theta[0] = w0;
+  w1 = w1 - w8;
+  w1 = w1 + w1;
+  w1 = (w9 > w1) ? w9 : w1;
+  w1 = (w10 < w1) ? w10 : w1;
+  w1 = exp(w1);
+  w1 = w7 + w1;
+  w1 = w6 / w1;
+  theta[1] = w1;
+  w2 = w2 - w8;
+  w2 = w2 + w2;
+  w2 = (w9 > w2) ? w9 : w2;
+  w2 = (w10 < w2) ? w10 : w2;
+  w2 = exp(w2);
+  w2 = w7 + w2;
+  w2 = w6 / w2;
+  theta[2] = w2;
+  w3 = w3 - w8;
+  w3 = w3 + w3;
+  w3 = (w9 > w3) ? w9 : w3;
+  w3 = (w10 < w3) ? w10 : w3;
+  w3 = exp(w3);
+  w3 = w7 + w3;
+  w3 = w6 / w3;
+  theta[3] = w3;
+  w4 = w4 - w8;
+  w4 = w4 + w4;
+  w4 = (w9 > w4) ? w9 : w4;
+  w4 = (w10 < w4) ? w10 : w4;
+  w4 = exp(w4);
+  w4 = w7 + w4;
+  w4 = w6 / w4;
+  theta[4] = w4;
+  w5 = w5 - w8;
   w5 = w5 + w5;
-  w5 = (w6 > w5) ? w6 : w5;
-  w5 = (w11 < w5) ? w11 : w5;
+  w5 = (w9 > w5) ? w9 : w5;
+  w5 = (w10 < w5) ? w10 : w5;
   w5 = exp(w5);
-  w5 = w2 + w5;
-  w5 = w4 / w5;
-  theta[4] = w5;
-  w10 = w10 - w2;
-  w10 = w10 + w10;
-  w10 = (w6 > w10) ? w6 : w10;
-  w10 = (w11 < w10) ? w11 : w10;
-  w10 = exp(w10);
-  w2 = w2 + w10;
-  w4 = w4 / w2;
-  theta[5] = w4;
+  w7 = w7 + w5;
+  w6 = w6 / w7;
+  theta[5] = w6;
+}
+
+/* CasADi Function 'alpha_rate': 55 instructions. */
+static void body_alpha_rate(const omnirobot_s2_real* alpha, const omnirobot_s2_real* psi, const omnirobot_s2_real* theta, const omnirobot_s2_real* kappa, omnirobot_s2_real* alpha_dot) {
+  omnirobot_s2_real w0;
+  omnirobot_s2_real w1;
+  omnirobot_s2_real w2;
+  omnirobot_s2_real w3;
+  w0 = theta[0];
+  w1 = psi[0];
+  w2 = alpha[0];
+  w1 = w1 + w2;
+  w1 = w1 * w1;
+  w0 = w0 / w1;
+  w1 = kappa[0];
+  w2 = w1 * w2;
+  w0 = w0 - w2;
+  alpha_dot[0] = w0;
+  w0 = theta[1];
+  w2 = psi[1];
+  w3 = alpha[1];
+  w2 = w2 + w3;
+  w2 = w2 * w2;
+  w0 = w0 / w2;
+  w3 = w1 * w3;
+  w0 = w0 - w3;
+  alpha_dot[1] = w0;
+  w0 = theta[2];
+  w3 = psi[2];
+  w2 = alpha[2];
+  w3 = w3 + w2;
+  w3 = w3 * w3;
+  w0 = w0 / w3;
+  w2 = w1 * w2;
+  w0 = w0 - w2;
+  alpha_dot[2] = w0;
+  w0 = theta[3];
+  w2 = psi[3];
+  w3 = alpha[3];
+  w2 = w2 + w3;
+  w2 = w2 * w2;
+  w0 = w0 / w2;
+  w3 = w1 * w3;
+  w0 = w0 - w3;
+  alpha_dot[3] = w0;
+  w0 = theta[4];
+  w3 = psi[4];
+  w2 = alpha[4];
+  w3 = w3 + w2;
+  w3 = w3 * w3;
+  w0 = w0 / w3;
+  w2 = w1 * w2;
+  w0 = w0 - w2;
+  alpha_dot[4] = w0;
+  w0 = theta[5];
+  w2 = psi[5];
+  w3 = alpha[5];
+  w2 = w2 + w3;
+  w2 = w2 * w2;
+  w0 = w0 / w2;
+  w1 = w1 * w3;
+  w0 = w0 - w1;
+  alpha_dot[5] = w0;
+}
+
+/* CasADi Function 'later': 4 instructions. */
+static void body_later(const omnirobot_s2_real* t, const omnirobot_s2_real* dt, omnirobot_s2_real* t_next) {
+  omnirobot_s2_real w0;
+  omnirobot_s2_real w1;
+  w0 = t[0];
+  w1 = dt[0];
+  w0 = w0 + w1;
+  t_next[0] = w0;
 }
 
 /* CasADi Function 'newton_start': 24 instructions. */
-static void body_newton_start(const omnirobot_s2_real* alpha, const omnirobot_s2_real* psi, const omnirobot_s2_real* theta, const omnirobot_s2_real* dt, omnirobot_s2_real* a0, omnirobot_s2_real* c, omnirobot_s2_real* A, omnirobot_s2_real* root) {
+static void body_newton_start(const omnirobot_s2_real* alpha, const omnirobot_s2_real* psi, const omnirobot_s2_real* theta, const omnirobot_s2_real* dt, const omnirobot_s2_real* kappa, omnirobot_s2_real* a0, omnirobot_s2_real* c, omnirobot_s2_real* A, omnirobot_s2_real* root) {
   omnirobot_s2_real w0;
   omnirobot_s2_real w1;
   omnirobot_s2_real w2;
@@ -1145,7 +790,7 @@ static void body_newton_start(const omnirobot_s2_real* alpha, const omnirobot_s2
   omnirobot_s2_real w4;
   w0 = alpha[0];
   w1 = 1.0;
-  w2 = 5.0;
+  w2 = kappa[0];
   w3 = dt[0];
   w2 = w2 * w3;
   w1 = w1 + w2;
@@ -1231,6 +876,116 @@ static void body_newton_iteration(const omnirobot_s2_real* a, const omnirobot_s2
   a_next[0] = w0;
 }
 
+/* CasADi Function 'law': 92 instructions. */
+static void body_law(const omnirobot_s2_real* x, const omnirobot_s2_real* gamma_L, const omnirobot_s2_real* gamma_U, const omnirobot_s2_real* gain, omnirobot_s2_real* u, omnirobot_s2_real* inside) {
+  omnirobot_s2_real w0;
+  omnirobot_s2_real w1;
+  omnirobot_s2_real w2;
+  omnirobot_s2_real w3;
+  omnirobot_s2_real w4;
+  omnirobot_s2_real w5;
+  omnirobot_s2_real w6;
+  omnirobot_s2_real w7;
+  omnirobot_s2_real w8;
+  omnirobot_s2_real w9;
+  omnirobot_s2_real w10;
+  omnirobot_s2_real w11;
+  omnirobot_s2_real w12;
+  omnirobot_s2_real w13;
+  w0 = gain[0];
+  w1 = 4.0;
+  w2 = gamma_U[0];
+  w3 = gamma_L[0];
+  w4 = w2 - w3;
+  w5 = 1e-06;
+  w6 = (w5 > w4) ? w5 : w4;
+  w7 = 1.0;
+  w8 = x[0];
+  w8 = w8 + w8;
+  w2 = w2 + w3;
+  w8 = w8 - w2;
+  w8 = w8 / w6;
+  w2 = -0.9999990463256836;
+  w3 = (w2 > w8) ? w2 : w8;
+  w9 = 0.9999990463256836;
+  w3 = (w9 < w3) ? w9 : w3;
+  w10 = w3 * w3;
+  w10 = w7 - w10;
+  w6 = w6 * w10;
+  w6 = w1 / w6;
+  w6 = w0 * w6;
+  w10 = w7 + w3;
+  w3 = w7 - w3;
+  w10 = w10 / w3;
+  w10 = log(w10);
+  w6 = w6 * w10;
+  w6 = -w6;
+  u[0] = w6;
+  w6 = gamma_U[1];
+  w10 = gamma_L[1];
+  w3 = w6 - w10;
+  w11 = (w5 > w3) ? w5 : w3;
+  w12 = x[1];
+  w12 = w12 + w12;
+  w6 = w6 + w10;
+  w12 = w12 - w6;
+  w12 = w12 / w11;
+  w6 = (w2 > w12) ? w2 : w12;
+  w6 = (w9 < w6) ? w9 : w6;
+  w10 = w6 * w6;
+  w10 = w7 - w10;
+  w11 = w11 * w10;
+  w11 = w1 / w11;
+  w11 = w0 * w11;
+  w10 = w7 + w6;
+  w6 = w7 - w6;
+  w10 = w10 / w6;
+  w10 = log(w10);
+  w11 = w11 * w10;
+  w11 = -w11;
+  u[1] = w11;
+  w11 = gamma_U[2];
+  w10 = gamma_L[2];
+  w6 = w11 - w10;
+  w5 = (w5 > w6) ? w5 : w6;
+  w13 = x[2];
+  w13 = w13 + w13;
+  w11 = w11 + w10;
+  w13 = w13 - w11;
+  w13 = w13 / w5;
+  w2 = (w2 > w13) ? w2 : w13;
+  w2 = (w9 < w2) ? w9 : w2;
+  w9 = w2 * w2;
+  w9 = w7 - w9;
+  w5 = w5 * w9;
+  w1 = w1 / w5;
+  w0 = w0 * w1;
+  w1 = w7 + w2;
+  w2 = w7 - w2;
+  w1 = w1 / w2;
+  w1 = log(w1);
+  w0 = w0 * w1;
+  w0 = -w0;
+  u[2] = w0;
+  w8 = fabs(w8);
+  w8 = (w8 < w7) ? 1.0 : 0.0;
+  w0 = 0.0;
+  w4 = (w0 < w4) ? 1.0 : 0.0;
+  w8 = ((w8 != 0.0) && (w4 != 0.0)) ? 1.0 : 0.0;
+  w8 = ((w7 != 0.0) && (w8 != 0.0)) ? 1.0 : 0.0;
+  w12 = fabs(w12);
+  w12 = (w12 < w7) ? 1.0 : 0.0;
+  w3 = (w0 < w3) ? 1.0 : 0.0;
+  w12 = ((w12 != 0.0) && (w3 != 0.0)) ? 1.0 : 0.0;
+  w8 = ((w8 != 0.0) && (w12 != 0.0)) ? 1.0 : 0.0;
+  w13 = fabs(w13);
+  w13 = (w13 < w7) ? 1.0 : 0.0;
+  w0 = (w0 < w6) ? 1.0 : 0.0;
+  w13 = ((w13 != 0.0) && (w0 != 0.0)) ? 1.0 : 0.0;
+  w8 = ((w8 != 0.0) && (w13 != 0.0)) ? 1.0 : 0.0;
+  inside[0] = w8;
+}
+
 /* ----------------------------------------------------------------- typed API */
 
 static int omnirobot_s2_finite(const omnirobot_s2_real* v, int count) {
@@ -1298,26 +1053,161 @@ static void omnirobot_s2_zero(omnirobot_s2_real* v, int count) {
   }
 }
 
-/* gamma_L, gamma_U of eq. (10) at (t, a): the smooth max/min's correction only where it can
-   change the max/min */
-static void omnirobot_s2_gamma(omnirobot_s2_real t, const omnirobot_s2_real* a, omnirobot_s2_real* g_l,
-    omnirobot_s2_real* g_u) {
-  omnirobot_s2_real lower[OMNIROBOT_S2_N];
-  omnirobot_s2_real beta_l[OMNIROBOT_S2_N];
-  omnirobot_s2_real upper[OMNIROBOT_S2_N];
-  omnirobot_s2_real beta_u[OMNIROBOT_S2_N];
+/* ------------------------------------------------------- composition (tables) */
+
+/* rho, rho_dot [L; U] of eq. (4) at t: the first segment whose end is after t (the last one
+   after every end). */
+static void omnirobot_s2_reach(omnirobot_s2_real t, omnirobot_s2_real* rho, omnirobot_s2_real* rho_dot) {
+  omnirobot_s2_real p;
+  omnirobot_s2_real p_dot;
+  int k = OMNIROBOT_S2_N_SEGMENTS - 1;
+  int j;
+  for (j = OMNIROBOT_S2_N_SEGMENTS - 2; j >= 0; --j) {
+    if (t < OMNIROBOT_S2_SEGMENTS[j].end) {
+      k = j;
+    }
+  }
+if (OMNIROBOT_S2_SEGMENTS[k].profile == 0) {
+    body_progress_tanh(&t, &OMNIROBOT_S2_SEGMENTS[k].start, &OMNIROBOT_S2_SEGMENTS[k].end, &p, &p_dot);
+  } else {
+    p = 0.0;
+    p_dot = 0.0;
+  }
+  body_interpolate(&p, &p_dot, OMNIROBOT_S2_SEGMENTS[k].from, OMNIROBOT_S2_SEGMENTS[k].to, rho, rho_dot);
+}
+
+/* beta, beta_dot [L; U] of eq. (9) at t, over the open windows only (a closed window adds
+   exactly 0 to F_nu). */
+static void omnirobot_s2_circumvent(omnirobot_s2_real t, omnirobot_s2_real* beta, omnirobot_s2_real* beta_dot) {
+  omnirobot_s2_real top[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real total[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real rate[OMNIROBOT_S2_N_ALPHA];
+  int b;
+  omnirobot_s2_real y[OMNIROBOT_S2_MAX_OPEN];
+  omnirobot_s2_real y_dot[OMNIROBOT_S2_MAX_OPEN];
+  int bound_of[OMNIROBOT_S2_MAX_OPEN];
+  int open = 0;
+  int lo = 0;
+  int hi = OMNIROBOT_S2_N_WINDOWS;
+  int first;
+  int j;
+  for (b = 0; b < OMNIROBOT_S2_N_ALPHA; ++b) {
+    top[b] = 0.0;
+  }
+  for (j = 0; j < OMNIROBOT_S2_MAX_OPEN; ++j) {
+    y[j] = 0.0;
+    y_dot[j] = 0.0;
+    bound_of[j] = 0;
+  }
+  /* rows [0, hi) start before t (binary search); rows before `first` all ended by t */
+  while (lo < hi) {
+    int mid = lo + ((hi - lo) / 2);
+    if (OMNIROBOT_S2_WINDOWS[mid].start < t) {
+      lo = mid + 1;
+    } else {
+      hi = mid;
+    }
+  }
+  first = hi;
+  while ((first > 0) && (OMNIROBOT_S2_WINDOWS[first - 1].max_end > t)) {
+    first = first - 1;
+  }
+  for (j = first; j < hi; ++j) {
+    if ((t < OMNIROBOT_S2_WINDOWS[j].end) && (open < OMNIROBOT_S2_MAX_OPEN)) {
+      const omnirobot_s2_window* w = &OMNIROBOT_S2_WINDOWS[j];
+      body_bump(&t, &w->start, &w->end, &w->center, &w->radius, &w->sharpness, &w->height,
+                &y[open], &y_dot[open]);
+      bound_of[open] = w->bound;
+      if (y[open] > top[w->bound]) {
+        top[w->bound] = y[open];
+      }
+      open = open + 1;
+    }
+  }
+  for (b = 0; b < OMNIROBOT_S2_N_ALPHA; ++b) {
+    if (OMNIROBOT_S2_MEMBERS[b] > 0) {
+      body_fnu_init(&top[b], &OMNIROBOT_S2_PARAMETERS.smoothness, &total[b], &rate[b]);
+    }
+  }
+  for (j = 0; j < open; ++j) {
+    omnirobot_s2_real total_next;
+    omnirobot_s2_real rate_next;
+    b = bound_of[j];
+    body_fnu_add(&total[b], &rate[b], &y[j], &y_dot[j], &top[b], &OMNIROBOT_S2_PARAMETERS.smoothness,
+                 &total_next, &rate_next);
+    total[b] = total_next;
+    rate[b] = rate_next;
+  }
+  for (b = 0; b < OMNIROBOT_S2_N_ALPHA; ++b) {
+    if (OMNIROBOT_S2_MEMBERS[b] > 0) {
+      body_fnu_finish(&OMNIROBOT_S2_BOUND[b], &OMNIROBOT_S2_SIGN[b], &top[b], &total[b], &rate[b],
+                      &OMNIROBOT_S2_PARAMETERS.smoothness, &beta[b], &beta_dot[b]);
+    } else {
+      beta[b] = OMNIROBOT_S2_BOUND[b];
+      beta_dot[b] = 0.0;
+    }
+  }
+}
+
+/* gamma_L, gamma_U of eq. (10) from rho and beta: the smooth max/min's correction only where
+   it can change the max/min */
+static void omnirobot_s2_gamma_of(const omnirobot_s2_real* rho, const omnirobot_s2_real* beta,
+    const omnirobot_s2_real* a, omnirobot_s2_real* g_l, omnirobot_s2_real* g_u) {
+  omnirobot_s2_real c[OMNIROBOT_S2_N_ALPHA];
   omnirobot_s2_real needed;
   int i;
-  body_gamma_candidates(&t, a, lower, beta_l, upper, beta_u);
+  body_candidates(rho, a, c);
   for (i = 0; i < OMNIROBOT_S2_N; ++i) {
-    body_smooth_max_test(&lower[i], &beta_l[i], &g_l[i], &needed);
+    body_smooth_max_test(&c[i], &beta[i], &OMNIROBOT_S2_PARAMETERS.smoothness, &g_l[i], &needed);
     if (needed != 0.0) {
-      body_smooth_max(&lower[i], &beta_l[i], &g_l[i]);
+      body_smooth_max(&c[i], &beta[i], &OMNIROBOT_S2_PARAMETERS.smoothness, &g_l[i]);
     }
-    body_smooth_min_test(&upper[i], &beta_u[i], &g_u[i], &needed);
+    body_smooth_min_test(&c[OMNIROBOT_S2_N + i], &beta[OMNIROBOT_S2_N + i], &OMNIROBOT_S2_PARAMETERS.smoothness,
+                         &g_u[i], &needed);
     if (needed != 0.0) {
-      body_smooth_min(&upper[i], &beta_u[i], &g_u[i]);
+      body_smooth_min(&c[OMNIROBOT_S2_N + i], &beta[OMNIROBOT_S2_N + i], &OMNIROBOT_S2_PARAMETERS.smoothness,
+                      &g_u[i]);
     }
+  }
+}
+
+/* gamma_L, gamma_U of eq. (10) at (t, a) */
+static void omnirobot_s2_gamma(omnirobot_s2_real t, const omnirobot_s2_real* a, omnirobot_s2_real* g_l,
+    omnirobot_s2_real* g_u) {
+  omnirobot_s2_real rho[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real rho_dot[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real beta[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real beta_dot[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_reach(t, rho, rho_dot);
+  omnirobot_s2_circumvent(t, beta, beta_dot);
+  omnirobot_s2_gamma_of(rho, beta, a, g_l, g_u);
+}
+
+/* gamma and its total time derivative (alpha moving by (11)) at (t, a) */
+static void omnirobot_s2_gamma_and_rates(omnirobot_s2_real t, const omnirobot_s2_real* a, omnirobot_s2_real* g_l,
+    omnirobot_s2_real* g_u, omnirobot_s2_real* g_l_dot, omnirobot_s2_real* g_u_dot) {
+  omnirobot_s2_real rho[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real rho_dot[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real beta[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real beta_dot[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real psi[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real theta[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real a_dot[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real c[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real c_dot[OMNIROBOT_S2_N_ALPHA];
+  int i;
+  omnirobot_s2_reach(t, rho, rho_dot);
+  omnirobot_s2_circumvent(t, beta, beta_dot);
+  omnirobot_s2_gamma_of(rho, beta, a, g_l, g_u);
+  body_conflict(rho, beta, &OMNIROBOT_S2_PARAMETERS.theta0, &OMNIROBOT_S2_PARAMETERS.mu, psi, theta);
+  body_alpha_rate(a, psi, theta, &OMNIROBOT_S2_PARAMETERS.kappa, a_dot);
+  body_candidates(rho, a, c);
+  body_candidate_rates(rho_dot, a_dot, c_dot);
+  for (i = 0; i < OMNIROBOT_S2_N; ++i) {
+    body_smooth_max_rate(&c[i], &beta[i], &c_dot[i], &beta_dot[i],
+                         &OMNIROBOT_S2_PARAMETERS.smoothness, &g_l_dot[i]);
+    body_smooth_min_rate(&c[OMNIROBOT_S2_N + i], &beta[OMNIROBOT_S2_N + i], &c_dot[OMNIROBOT_S2_N + i],
+                         &beta_dot[OMNIROBOT_S2_N + i], &OMNIROBOT_S2_PARAMETERS.smoothness, &g_u_dot[i]);
   }
 }
 
@@ -1337,9 +1227,10 @@ int omnirobot_s2_tube(omnirobot_s2_real t, const omnirobot_s2_real alpha[OMNIROB
     if ((alpha != NULL) && (omnirobot_s2_time_valid(t) != 0) && (omnirobot_s2_alpha_valid(alpha) != 0)) {
       omnirobot_s2_real a[OMNIROBOT_S2_N_ALPHA];
       omnirobot_s2_copy(alpha, a, OMNIROBOT_S2_N_ALPHA);
-      omnirobot_s2_gamma(t, a, g_l, g_u);
       if (rates != 0) {
-        body_gamma_rates(&t, a, g_l_dot, g_u_dot);
+        omnirobot_s2_gamma_and_rates(t, a, g_l, g_u, g_l_dot, g_u_dot);
+      } else {
+        omnirobot_s2_gamma(t, a, g_l, g_u);
       }
       /* the rates hold theta / (psi + alpha)^2: infinite where alpha is not one the
          adaptive law reaches at t (psi + alpha <= 0) */
@@ -1377,7 +1268,7 @@ static int omnirobot_s2_law(const omnirobot_s2_real* x, omnirobot_s2_real t, con
   omnirobot_s2_real inside;
   int status;
   omnirobot_s2_gamma(t, a, g_l, g_u);
-  body_law(x, g_l, g_u, u, &inside);
+  body_law(x, g_l, g_u, &OMNIROBOT_S2_PARAMETERS.gain, u, &inside);
   if (omnirobot_s2_finite(u, OMNIROBOT_S2_N) == 0) {
     status = OMNIROBOT_S2_STATUS_INVALID_INPUT;
   } else if (inside != 0.0) {
@@ -1415,8 +1306,16 @@ static void omnirobot_s2_implicit_step(omnirobot_s2_real t, omnirobot_s2_real dt
     omnirobot_s2_real* next) {
   omnirobot_s2_real psi[OMNIROBOT_S2_N_ALPHA];
   omnirobot_s2_real theta[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real rho[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real rho_dot[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real beta[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real beta_dot[OMNIROBOT_S2_N_ALPHA];
+  omnirobot_s2_real t_next;
   int i;
-  body_alpha_conflict(&t, &dt, psi, theta);
+  body_later(&t, &dt, &t_next);
+  omnirobot_s2_reach(t_next, rho, rho_dot);
+  omnirobot_s2_circumvent(t_next, beta, beta_dot);
+  body_conflict(rho, beta, &OMNIROBOT_S2_PARAMETERS.theta0, &OMNIROBOT_S2_PARAMETERS.mu, psi, theta);
   for (i = 0; i < OMNIROBOT_S2_N_ALPHA; ++i) {
     omnirobot_s2_real s;
     omnirobot_s2_real s_next;
@@ -1424,7 +1323,8 @@ static void omnirobot_s2_implicit_step(omnirobot_s2_real t, omnirobot_s2_real dt
     omnirobot_s2_real big_a;
     omnirobot_s2_real root;
     int k = 0;
-    body_newton_start(&a[i], &psi[i], &theta[i], &dt, &s, &c, &big_a, &root);
+    body_newton_start(&a[i], &psi[i], &theta[i], &dt, &OMNIROBOT_S2_PARAMETERS.kappa, &s, &c, &big_a,
+                      &root);
     if (root != 0.0) {
       body_newton_root_start(&a[i], &psi[i], &c, &big_a, &s);
     }
