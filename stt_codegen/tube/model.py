@@ -112,12 +112,12 @@ def reach_tube(design: TubeDesign, t) -> tuple:
 def circumvent_rates(design: TubeDesign, t) -> tuple:
     """``beta`` and ``beta_dot`` (2n SX vectors ``[L; U]``) of eq. (9).
 
-    Per bound with circumvents: ``top = max(0, y_j)``, ``fnu_init``, ``fnu_add`` over the
-    circumvents in table order, ``fnu_finish``; a bound without circumvent is the state
-    space's bound.
+    Per bound with several circumvents: ``top = max(0, y_j)``, ``fnu_init``, ``fnu_add``
+    over the circumvents in table order, ``fnu_finish``; with one: ``fnu_single``
+    (``F = y``); a bound without circumvent is the state space's bound.
     """
     tables = design_tables(design)
-    init, add, finish = P.fnu_pieces()
+    init, add, finish, single = P.fnu_pieces()
     nu = design.smoothness
     beta, beta_dot = [], []
     for b, (bound, sign) in enumerate(zip(tables.bounds, tables.signs)):
@@ -128,6 +128,11 @@ def circumvent_rates(design: TubeDesign, t) -> tuple:
             continue
         bumps = [P.bump()(t, c.start, c.end, c.center, c.radius, c.sharpness, c.height)
                  for c in members]
+        if len(members) == 1:
+            value, value_dot = single(bound, sign, *bumps[0])
+            beta.append(value)
+            beta_dot.append(value_dot)
+            continue
         top = ca.SX(0.0)
         for y, _ in bumps:
             top = ca.fmax(top, y)

@@ -20,6 +20,7 @@ piece                  inputs                                       outputs
 ``fnu_init``           top, nu                                      total, rate
 ``fnu_add``            total, rate, y, y_dot, top, nu               total, rate
 ``fnu_finish``         bound, sign, top, total, rate, nu            beta, beta_dot (eq. (9))
+``fnu_single``         bound, sign, y, y_dot                        beta, beta_dot (one member)
 ``candidates``         rho (2n), alpha (2n)                         [rho_L - alpha_L;
                                                                     rho_U + alpha_U]
 ``candidate_rates``    rho_dot (2n), alpha_dot (2n)                 their rates
@@ -131,7 +132,7 @@ def bump() -> ca.Function:
 
 @lru_cache(maxsize=None)
 def fnu_pieces() -> tuple:
-    """``fnu_init``, ``fnu_add``, ``fnu_finish``: eq. (9)'s ``F_nu`` over the open bumps.
+    """``fnu_init``, ``fnu_add``, ``fnu_finish``, ``fnu_single``: eq. (9)'s ``F_nu``.
 
     ``F_nu(y) = (1/nu) ln(1 + sum_j (exp(nu y_j) - 1))`` as
     ``top + ln(total) / nu``, ``total = exp(-nu top) + sum_j (exp(nu (y_j - top)) -
@@ -154,7 +155,9 @@ def fnu_pieces() -> tuple:
     finish = ca.Function("fnu_finish", [bound, sign, top, total, rate, nu],
                          [bound + sign * (top + ca.log(total) / nu), sign * (rate / total)],
                          ["bound", "sign", "top", "total", "rate", "nu"], ["beta", "beta_dot"])
-    return init, add, finish
+    single = ca.Function("fnu_single", [bound, sign, y, y_dot], [bound + sign * y, sign * y_dot],
+                         ["bound", "sign", "y", "y_dot"], ["beta", "beta_dot"])
+    return init, add, finish, single
 
 
 @lru_cache(maxsize=None)
@@ -338,8 +341,8 @@ def law(n: int) -> ca.Function:
 def deployed_pieces(n: int, profiles: tuple) -> list:
     """Every piece the generated code of a design of dimension ``n`` calls, in a fixed order
     (``profiles``: the segment profiles it uses, in :data:`PROFILE_NAMES` order)."""
-    init, add, finish = fnu_pieces()
+    init, add, finish, single = fnu_pieces()
     cand, cand_rates = candidates(n)
     return [*(progress(p) for p in PROFILE_NAMES if p in profiles), interpolate(n), bump(),
-            init, add, finish, cand, cand_rates, *smooth_pieces(), conflict(n), alpha_rate(n),
+            init, add, finish, single, cand, cand_rates, *smooth_pieces(), conflict(n), alpha_rate(n),
             later(), *newton_pieces(), law(n)]

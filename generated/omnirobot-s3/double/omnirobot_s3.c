@@ -342,6 +342,22 @@ static void body_fnu_finish(const omnirobot_s3_real* bound, const omnirobot_s3_r
   beta_dot[0] = w1;
 }
 
+/* CasADi Function 'fnu_single': 9 instructions. */
+static void body_fnu_single(const omnirobot_s3_real* bound, const omnirobot_s3_real* sign, const omnirobot_s3_real* y, const omnirobot_s3_real* y_dot, omnirobot_s3_real* beta, omnirobot_s3_real* beta_dot) {
+  omnirobot_s3_real w0;
+  omnirobot_s3_real w1;
+  omnirobot_s3_real w2;
+  w0 = bound[0];
+  w1 = sign[0];
+  w2 = y[0];
+  w2 = w1 * w2;
+  w0 = w0 + w2;
+  beta[0] = w0;
+  w0 = y_dot[0];
+  w1 = w1 * w0;
+  beta_dot[0] = w1;
+}
+
 /* CasADi Function 'candidates': 24 instructions. */
 static void body_candidates(const omnirobot_s3_real* rho, const omnirobot_s3_real* alpha, omnirobot_s3_real* c) {
   omnirobot_s3_real w0;
@@ -1092,6 +1108,8 @@ static void omnirobot_s3_circumvent(omnirobot_s3_real t, omnirobot_s3_real* beta
   int j;
   for (b = 0; b < OMNIROBOT_S3_N_ALPHA; ++b) {
     top[b] = 0.0;
+    beta[b] = OMNIROBOT_S3_BOUND[b];
+    beta_dot[b] = 0.0;
   }
   for (j = 0; j < OMNIROBOT_S3_MAX_OPEN; ++j) {
     y[j] = 0.0;
@@ -1124,7 +1142,7 @@ static void omnirobot_s3_circumvent(omnirobot_s3_real t, omnirobot_s3_real* beta
     }
   }
   for (b = 0; b < OMNIROBOT_S3_N_ALPHA; ++b) {
-    if (OMNIROBOT_S3_MEMBERS[b] > 0) {
+    if (OMNIROBOT_S3_MEMBERS[b] > 1) {
       body_fnu_init(&top[b], &OMNIROBOT_S3_PARAMETERS.smoothness, &total[b], &rate[b]);
     }
   }
@@ -1132,18 +1150,20 @@ static void omnirobot_s3_circumvent(omnirobot_s3_real t, omnirobot_s3_real* beta
     omnirobot_s3_real total_next;
     omnirobot_s3_real rate_next;
     b = bound_of[j];
-    body_fnu_add(&total[b], &rate[b], &y[j], &y_dot[j], &top[b], &OMNIROBOT_S3_PARAMETERS.smoothness,
-                 &total_next, &rate_next);
-    total[b] = total_next;
-    rate[b] = rate_next;
+    if (OMNIROBOT_S3_MEMBERS[b] == 1) {
+      body_fnu_single(&OMNIROBOT_S3_BOUND[b], &OMNIROBOT_S3_SIGN[b], &y[j], &y_dot[j], &beta[b],
+                      &beta_dot[b]);
+    } else {
+      body_fnu_add(&total[b], &rate[b], &y[j], &y_dot[j], &top[b], &OMNIROBOT_S3_PARAMETERS.smoothness,
+                   &total_next, &rate_next);
+      total[b] = total_next;
+      rate[b] = rate_next;
+    }
   }
   for (b = 0; b < OMNIROBOT_S3_N_ALPHA; ++b) {
-    if (OMNIROBOT_S3_MEMBERS[b] > 0) {
+    if (OMNIROBOT_S3_MEMBERS[b] > 1) {
       body_fnu_finish(&OMNIROBOT_S3_BOUND[b], &OMNIROBOT_S3_SIGN[b], &top[b], &total[b], &rate[b],
                       &OMNIROBOT_S3_PARAMETERS.smoothness, &beta[b], &beta_dot[b]);
-    } else {
-      beta[b] = OMNIROBOT_S3_BOUND[b];
-      beta_dot[b] = 0.0;
     }
   }
 }
