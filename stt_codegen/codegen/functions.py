@@ -29,13 +29,17 @@ import casadi as ca
 
 from ..tube import pieces as P
 from ..tube.model import TubeModel
+from ..tube.parameters import LOWER, UPPER
 
 
 def deployed_functions(model: TubeModel) -> list[ca.Function]:
     """The deployed SX Functions of a design, in generation order."""
     design = model.design
     profiles = tuple(sorted({segment.profile for segment in design.segments}))
-    return P.deployed_pieces(design.dimension, profiles)
+    members = [len(design.circumvents_on(i, side)) for i in range(design.dimension)
+               for side in (LOWER, UPPER)]
+    return P.deployed_pieces(design.dimension, profiles, single_bounds=1 in members,
+                             multi_bounds=any(m > 1 for m in members))
 
 
 def clamped_control(model: TubeModel) -> ca.Function:

@@ -338,11 +338,18 @@ def law(n: int) -> ca.Function:
                        ["x", "gamma_L", "gamma_U", "gain"], ["u", "inside"])
 
 
-def deployed_pieces(n: int, profiles: tuple) -> list:
-    """Every piece the generated code of a design of dimension ``n`` calls, in a fixed order
-    (``profiles``: the segment profiles it uses, in :data:`PROFILE_NAMES` order)."""
+def deployed_pieces(n: int, profiles: tuple, single_bounds: bool = True,
+                    multi_bounds: bool = True) -> list:
+    """Every piece the generated code of a design of dimension ``n`` calls, in a fixed order.
+
+    ``profiles``: the segment profiles it uses; ``single_bounds`` / ``multi_bounds``: whether
+    some bound has exactly one / several circumvents (``bump`` is emitted with either, the
+    ``F_nu`` pieces only with several, ``fnu_single`` only with one).
+    """
     init, add, finish, single = fnu_pieces()
     cand, cand_rates = candidates(n)
-    return [*(progress(p) for p in PROFILE_NAMES if p in profiles), interpolate(n), bump(),
-            init, add, finish, single, cand, cand_rates, *smooth_pieces(), conflict(n), alpha_rate(n),
+    circumvents = ([bump()] if single_bounds or multi_bounds else []) + (
+        [init, add, finish] if multi_bounds else []) + ([single] if single_bounds else [])
+    return [*(progress(p) for p in PROFILE_NAMES if p in profiles), interpolate(n),
+            *circumvents, cand, cand_rates, *smooth_pieces(), conflict(n), alpha_rate(n),
             later(), *newton_pieces(), law(n)]

@@ -271,77 +271,6 @@ static void body_bump(const omnirobot_s1_real* t, const omnirobot_s1_real* start
   y_dot[0] = w0;
 }
 
-/* CasADi Function 'fnu_init': 10 instructions. */
-static void body_fnu_init(const omnirobot_s1_real* top, const omnirobot_s1_real* nu, omnirobot_s1_real* total, omnirobot_s1_real* rate) {
-  omnirobot_s1_real w0;
-  omnirobot_s1_real w1;
-  w0 = nu[0];
-  w1 = top[0];
-  w0 = w0 * w1;
-  w0 = -w0;
-  w1 = -80.0f;
-  w0 = (w1 > w0) ? w1 : w0;
-  w0 = expf(w0);
-  total[0] = w0;
-  w0 = 0.0f;
-  rate[0] = w0;
-}
-
-/* CasADi Function 'fnu_add': 21 instructions. */
-static void body_fnu_add(const omnirobot_s1_real* total, const omnirobot_s1_real* rate, const omnirobot_s1_real* y, const omnirobot_s1_real* y_dot, const omnirobot_s1_real* top, const omnirobot_s1_real* nu, omnirobot_s1_real* total_next, omnirobot_s1_real* rate_next) {
-  omnirobot_s1_real w0;
-  omnirobot_s1_real w1;
-  omnirobot_s1_real w2;
-  omnirobot_s1_real w3;
-  omnirobot_s1_real w4;
-  w0 = total[0];
-  w1 = nu[0];
-  w2 = y[0];
-  w3 = top[0];
-  w2 = w2 - w3;
-  w2 = w1 * w2;
-  w4 = -80.0f;
-  w2 = (w4 > w2) ? w4 : w2;
-  w2 = expf(w2);
-  w1 = w1 * w3;
-  w1 = -w1;
-  w1 = (w4 > w1) ? w4 : w1;
-  w1 = expf(w1);
-  w1 = w2 - w1;
-  w0 = w0 + w1;
-  total_next[0] = w0;
-  w0 = rate[0];
-  w1 = y_dot[0];
-  w2 = w2 * w1;
-  w0 = w0 + w2;
-  rate_next[0] = w0;
-}
-
-/* CasADi Function 'fnu_finish': 15 instructions. */
-static void body_fnu_finish(const omnirobot_s1_real* bound, const omnirobot_s1_real* sign, const omnirobot_s1_real* top, const omnirobot_s1_real* total, const omnirobot_s1_real* rate, const omnirobot_s1_real* nu, omnirobot_s1_real* beta, omnirobot_s1_real* beta_dot) {
-  omnirobot_s1_real w0;
-  omnirobot_s1_real w1;
-  omnirobot_s1_real w2;
-  omnirobot_s1_real w3;
-  omnirobot_s1_real w4;
-  omnirobot_s1_real w5;
-  w0 = bound[0];
-  w1 = sign[0];
-  w2 = top[0];
-  w3 = total[0];
-  w4 = logf(w3);
-  w5 = nu[0];
-  w4 = w4 / w5;
-  w2 = w2 + w4;
-  w2 = w1 * w2;
-  w0 = w0 + w2;
-  beta[0] = w0;
-  w0 = rate[0];
-  w0 = w0 / w3;
-  w1 = w1 * w0;
-  beta_dot[0] = w1;
-}
-
 /* CasADi Function 'fnu_single': 9 instructions. */
 static void body_fnu_single(const omnirobot_s1_real* bound, const omnirobot_s1_real* sign, const omnirobot_s1_real* y, const omnirobot_s1_real* y_dot, omnirobot_s1_real* beta, omnirobot_s1_real* beta_dot) {
   omnirobot_s1_real w0;
@@ -1094,9 +1023,6 @@ if (OMNIROBOT_S1_SEGMENTS[k].profile == 0) {
 /* beta, beta_dot [L; U] of eq. (9) at t, over the open windows only (a closed window adds
    exactly 0 to F_nu). */
 static void omnirobot_s1_circumvent(omnirobot_s1_real t, omnirobot_s1_real* beta, omnirobot_s1_real* beta_dot) {
-  omnirobot_s1_real top[OMNIROBOT_S1_N_ALPHA];
-  omnirobot_s1_real total[OMNIROBOT_S1_N_ALPHA];
-  omnirobot_s1_real rate[OMNIROBOT_S1_N_ALPHA];
   int b;
   omnirobot_s1_real y[OMNIROBOT_S1_MAX_OPEN];
   omnirobot_s1_real y_dot[OMNIROBOT_S1_MAX_OPEN];
@@ -1107,7 +1033,6 @@ static void omnirobot_s1_circumvent(omnirobot_s1_real t, omnirobot_s1_real* beta
   int first;
   int j;
   for (b = 0; b < OMNIROBOT_S1_N_ALPHA; ++b) {
-    top[b] = 0.0f;
     beta[b] = OMNIROBOT_S1_BOUND[b];
     beta_dot[b] = 0.0f;
   }
@@ -1135,35 +1060,14 @@ static void omnirobot_s1_circumvent(omnirobot_s1_real t, omnirobot_s1_real* beta
       body_bump(&t, &w->start, &w->end, &w->center, &w->radius, &w->sharpness, &w->height,
                 &y[open], &y_dot[open]);
       bound_of[open] = w->bound;
-      if (y[open] > top[w->bound]) {
-        top[w->bound] = y[open];
-      }
       open = open + 1;
     }
   }
-  for (b = 0; b < OMNIROBOT_S1_N_ALPHA; ++b) {
-    if (OMNIROBOT_S1_MEMBERS[b] > 1) {
-      body_fnu_init(&top[b], &OMNIROBOT_S1_PARAMETERS.smoothness, &total[b], &rate[b]);
-    }
-  }
   for (j = 0; j < open; ++j) {
-    omnirobot_s1_real total_next;
-    omnirobot_s1_real rate_next;
     b = bound_of[j];
     if (OMNIROBOT_S1_MEMBERS[b] == 1) {
       body_fnu_single(&OMNIROBOT_S1_BOUND[b], &OMNIROBOT_S1_SIGN[b], &y[j], &y_dot[j], &beta[b],
                       &beta_dot[b]);
-    } else {
-      body_fnu_add(&total[b], &rate[b], &y[j], &y_dot[j], &top[b], &OMNIROBOT_S1_PARAMETERS.smoothness,
-                   &total_next, &rate_next);
-      total[b] = total_next;
-      rate[b] = rate_next;
-    }
-  }
-  for (b = 0; b < OMNIROBOT_S1_N_ALPHA; ++b) {
-    if (OMNIROBOT_S1_MEMBERS[b] > 1) {
-      body_fnu_finish(&OMNIROBOT_S1_BOUND[b], &OMNIROBOT_S1_SIGN[b], &top[b], &total[b], &rate[b],
-                      &OMNIROBOT_S1_PARAMETERS.smoothness, &beta[b], &beta_dot[b]);
     }
   }
 }
