@@ -189,3 +189,26 @@ def test_strict_build_for_cortex_m4(precision, tmp_path):
                            f"{spec.c_name}.c", f"{spec.c_name}_selftest.c"],
                           cwd=folder, capture_output=True, text=True)
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+
+
+@pytest.mark.parametrize("obstacles", [0, 1, 6])
+def test_strict_build_for_any_number_of_circumvents(obstacles, tmp_path):
+    """No circumvent, one per bound, several per bound: strict build and self-test."""
+    from stt_codegen.bench.scaling import synthetic_design
+    from stt_codegen.codegen.generate import generate_files
+    from stt_codegen.codegen.options import Options
+
+    class _Spec:
+        name, c_name, source_hash = "synthetic", "synthetic", "0" * 64
+
+    design = synthetic_design(obstacles, 2, windows="open")
+    for precision in ("double", "single"):
+        folder = write(tmp_path / precision, generate_files(_Spec(), design,
+                                                            Options(("c",), precision)))
+        exe = folder / "selftest"
+        proc = subprocess.run([COMPILERS[0], *flags(precision), "synthetic.c",
+                               "synthetic_selftest.c", "-o", str(exe), "-lm"], cwd=folder,
+                              capture_output=True, text=True)
+        assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+        run = subprocess.run([str(exe)], capture_output=True, text=True)
+        assert run.returncode == 0 and run.stdout.strip().endswith(" 0 failed"), run.stdout[-2000:]
