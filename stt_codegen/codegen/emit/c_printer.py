@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Dict, List, Sequence, Set, Tuple, Union
+from typing import Dict, List, Sequence, Set, Union
 
 from .errors import EmitError
 from .instructions import Input, IOSpec, Output, Program, lower
@@ -119,7 +119,6 @@ class CPrinter(InstructionPrinter):
 
     language = "C"
     infix_operators: Dict[str, str] = {"add": "+", "sub": "-", "mul": "*", "div": "/"}
-    _comparisons: Dict[str, str] = {"lt": "<", "le": "<=", "eq": "==", "ne": "!="}
 
     def __init__(self, precision: Union[str, Precision] = "double", real: str = "",
                  prefix: str = "") -> None:
@@ -132,7 +131,6 @@ class CPrinter(InstructionPrinter):
         self.real = real or precision.c_type
         self.prefix = prefix
         self.known_functions = precision.math
-        self._names: Dict[Tuple[str, int], str] = {}
 
     # ------------------------------------------------------------------ ops
     def _bool(self, condition: str) -> str:
@@ -142,19 +140,7 @@ class CPrinter(InstructionPrinter):
         return f"({a} != {self.constant(0.0)})"
 
     def _compare(self, op: str, a: str, b: str) -> str:
-        return self._bool(f"{a} {self._comparisons[op]} {b}")
-
-    def _print_op_lt(self, a: str, b: str) -> str:
-        return self._compare("lt", a, b)
-
-    def _print_op_le(self, a: str, b: str) -> str:
-        return self._compare("le", a, b)
-
-    def _print_op_eq(self, a: str, b: str) -> str:
-        return self._compare("eq", a, b)
-
-    def _print_op_ne(self, a: str, b: str) -> str:
-        return self._compare("ne", a, b)
+        return self._bool(f"{a} {self.comparisons[op]} {b}")
 
     def _print_op_not(self, a: str) -> str:
         return self._bool(f"{a} == {self.constant(0.0)}")
@@ -179,9 +165,6 @@ class CPrinter(InstructionPrinter):
         return (f"({a} < {zero}) ? {self.constant(-1.0)} : "
                 f"(({a} > {zero}) ? {self.constant(1.0)} : {a})")
 
-    def _print_op_neg(self, a: str) -> str:
-        return f"-{a}"
-
     # ------------------------------------------------------------- constants
     def _print_float(self, value: float) -> str:
         return repr(value) + self.precision.suffix
@@ -197,10 +180,10 @@ class CPrinter(InstructionPrinter):
         return f"{target} = {expr};"
 
     def _input_ref(self, spec: IOSpec, position: int) -> str:
-        return f"{self._names['in', spec.index]}[{position}]"
+        return f"{self.io_name('in', spec.index)}[{position}]"
 
     def _output_ref(self, spec: IOSpec, position: int) -> str:
-        return f"{self._names['out', spec.index]}[{position}]"
+        return f"{self.io_name('out', spec.index)}[{position}]"
 
     def function_name(self, program: Program) -> str:
         """C name of the generated function: ``prefix`` + the sanitised CasADi name."""
@@ -209,19 +192,13 @@ class CPrinter(InstructionPrinter):
     def print_function(self, program: FunctionLike) -> str:  # noqa: D102
         if not isinstance(program, Program):
             program = lower(program)
-        taken: Set[str] = set()
-        self._names = {}
-        for kind, specs in (("in", program.inputs), ("out", program.outputs)):
-            for spec in specs:
-                ident = c_identifier(spec.name, taken)
-                taken.add(ident)
-                self._names[kind, spec.index] = ident
+        self._name_io(program, c_identifier)
         return super().print_function(program)
 
     def signature(self, program: Program) -> str:
         """``static void name(const real* in..., real* out...)`` (no trailing ``;``)."""
-        params = [f"const {self.real}* {self._names['in', s.index]}" for s in program.inputs]
-        params += [f"{self.real}* {self._names['out', s.index]}" for s in program.outputs]
+        params = [f"const {self.real}* {self.io_name('in', s.index)}" for s in program.inputs]
+        params += [f"{self.real}* {self.io_name('out', s.index)}" for s in program.outputs]
         return f"static void {self.function_name(program)}({', '.join(params) or 'void'})"
 
     def _function_text(self, program: Program, body: List[str]) -> str:
@@ -237,7 +214,7 @@ class CPrinter(InstructionPrinter):
         lines += [f"  {self.real} {self.register(r)};" for r in registers]
         for spec in program.inputs:
             if spec.index not in used_inputs:
-                lines.append(f"  (void){self._names['in', spec.index]};")
+                lines.append(f"  (void){self.io_name('in', spec.index)};")
         for spec in program.outputs:
             for position in range(spec.numel):
                 if (spec.index, position) not in written:
