@@ -100,7 +100,7 @@ int omnirobot_s1_control(const omnirobot_s1_real x[OMNIROBOT_S1_N], omnirobot_s1
     const omnirobot_s1_real alpha[OMNIROBOT_S1_N_ALPHA], omnirobot_s1_real u[OMNIROBOT_S1_N]);
 
 /**
- * Implicit (backward Euler, 5 Newton iterations) step of the adaptive law (11)
+ * Implicit (backward Euler, at most 5 Newton iterations) step of the adaptive law (11)
  * from t to t + dt.
  *
  * t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha, alpha_next: [OMNIROBOT_S1_N_ALPHA].

@@ -100,7 +100,7 @@ int omnirobot_s3_control(const omnirobot_s3_real x[OMNIROBOT_S3_N], omnirobot_s3
     const omnirobot_s3_real alpha[OMNIROBOT_S3_N_ALPHA], omnirobot_s3_real u[OMNIROBOT_S3_N]);
 
 /**
- * Implicit (backward Euler, 5 Newton iterations) step of the adaptive law (11)
+ * Implicit (backward Euler, at most 5 Newton iterations) step of the adaptive law (11)
  * from t to t + dt.
  *
  * t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha, alpha_next: [OMNIROBOT_S3_N_ALPHA].
