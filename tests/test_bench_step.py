@@ -119,7 +119,9 @@ def test_scaling_report():
 
 
 def test_generated_code_is_the_same_for_any_number_of_circumvents():
-    """Only the tables (and their sizes) differ between 10 and 1000 circumvents."""
+    """Only the tables (and their sizes) differ between 40 and 1000 circumvents (both with
+    several circumvents on every bound: the code depends on n, the profiles and whether a
+    bound has one or several circumvents, not on how many)."""
     import re
 
     from stt_codegen.codegen.generate import generate_files
@@ -136,4 +138,4 @@ def test_generated_code_is_the_same_for_any_number_of_circumvents():
         text = re.sub(r"^(static const \w+ \w+\[\w+\] = ).*$", r"\1", text, flags=re.MULTILINE)
         return re.sub(r"^#define SYNTHETIC_(N_WINDOWS|MAX_OPEN) \d+$", "", text, flags=re.MULTILINE)
 
-    assert code(10) == code(1000)
+    assert code(40) == code(1000)
