@@ -88,11 +88,15 @@ def reach_tube_rates(design: TubeDesign, t) -> tuple:
     """``rho`` and ``rho_dot`` (2n SX vectors ``[L; U]``) of eq. (4), piecewise over the
     segments: the first segment whose ``end`` is after ``t`` (the last one after every end)."""
     interpolate = P.interpolate(design.dimension)
+    interpolate_value = P.interpolate(design.dimension, False)
 
     def on(segment):
+        # the value from the value-only pieces (the step's), the rate from the full ones
         p, p_dot = P.progress(segment.profile)(t, segment.start, segment.end)
         lo, hi = segment_rows(design, segment)
-        return interpolate(p, p_dot, ca.DM(lo), ca.DM(hi))
+        _, rate = interpolate(p, p_dot, ca.DM(lo), ca.DM(hi))
+        p_value = P.progress(segment.profile, False)(t, segment.start, segment.end)
+        return interpolate_value(p_value, ca.DM(lo), ca.DM(hi)), rate
 
     rho, rho_dot = on(design.segments[-1])
     for segment in reversed(design.segments[:-1]):
@@ -126,7 +130,8 @@ def circumvent_rates(design: TubeDesign, t) -> tuple:
             beta.append(ca.SX(bound))
             beta_dot.append(ca.SX(0.0))
             continue
-        bumps = [P.bump()(t, c.start, c.end, c.center, c.radius, c.sharpness, c.height)
+        bumps = [(P.bump(False)(t, c.start, c.end, c.center, c.radius, c.sharpness, c.height),
+                  P.bump()(t, c.start, c.end, c.center, c.radius, c.sharpness, c.height)[1])
                  for c in members]
         if len(members) == 1:
             value, value_dot = single(bound, sign, *bumps[0])

@@ -12,11 +12,14 @@ circumvents. A closed circumvent contributes exactly 0 to eq. (9) (:func:`fnu_ad
 =====================  ===========================================  ==========================
 piece                  inputs                                       outputs
 =====================  ===========================================  ==========================
-``progress_tanh``      t, start, end                                p, p_dot (eq. (4))
+``progress_tanh``      t, start, end                                p, p_dot (eq. (4));
+                                                                    ``_value``: p only
 ``progress_smoothstep`` t, start, end                               p, p_dot (quintic)
-``interpolate``        p, p_dot, from (2n), to (2n)                 rho, rho_dot (2n: [L; U])
+``interpolate``        p, p_dot, from (2n), to (2n)                 rho, rho_dot (2n: [L; U]);
+                                                                    ``_value``: rho only
 ``bump``               t, start, end, center, radius, sharpness,    y = B b(t), y_dot
-                       height                                       (eqs. (7)-(8))
+                       height                                       (eqs. (7)-(8));
+                                                                    ``_value``: y only
 ``fnu_init``           top, nu                                      total, rate
 ``fnu_add``            total, rate, y, y_dot, top, nu               total, rate
 ``fnu_finish``         bound, sign, top, total, rate, nu            beta, beta_dot (eq. (9))
@@ -89,30 +92,39 @@ def progress_expression(profile: str, t, start, end):
 
 
 @lru_cache(maxsize=None)
-def progress(profile: str) -> ca.Function:
-    """``progress_<profile>(t, start, end) -> (p, p_dot)``."""
+def progress(profile: str, rates: bool = True) -> ca.Function:
+    """``progress_<profile>(t, start, end) -> (p, p_dot)``; without rates
+    ``progress_<profile>_value(t, start, end) -> p``."""
     t, start, end = _sym("t", "start", "end")
     p = progress_expression(profile, t, start, end)
+    if not rates:
+        return ca.Function(f"progress_{profile}_value", [t, start, end], [p],
+                           ["t", "start", "end"], ["p"])
     return ca.Function(f"progress_{profile}", [t, start, end], [p, ca.jacobian(p, t)],
                        ["t", "start", "end"], ["p", "p_dot"])
 
 
 @lru_cache(maxsize=None)
-def interpolate(n: int) -> ca.Function:
-    """``interpolate(p, p_dot, from, to) -> (rho, rho_dot)``: ``(to - from) p + from``."""
+def interpolate(n: int, rates: bool = True) -> ca.Function:
+    """``interpolate(p, p_dot, from, to) -> (rho, rho_dot)``: ``(to - from) p + from``;
+    without rates ``interpolate_value(p, from, to) -> rho``."""
     p, p_dot = _sym("p", "p_dot")
     lo, hi = ca.SX.sym("from", 2 * n), ca.SX.sym("to", 2 * n)
+    if not rates:
+        return ca.Function("interpolate_value", [p, lo, hi], [(hi - lo) * p + lo],
+                           ["p", "from", "to"], ["rho"])
     return ca.Function("interpolate", [p, p_dot, lo, hi], [(hi - lo) * p + lo, (hi - lo) * p_dot],
                        ["p", "p_dot", "from", "to"], ["rho", "rho_dot"])
 
 
 @lru_cache(maxsize=None)
-def bump() -> ca.Function:
+def bump(rates: bool = True) -> ca.Function:
     """``bump(t, start, end, center, radius, sharpness, height) -> (y, y_dot)``.
 
     ``y = B exp(-k d^2 / ((r - |d|)(r + |d|)))``, ``d = t - m``, inside the open window
     (``start < t < end`` and ``|d| < r``), exactly 0 outside (eqs. (7)-(8)); the exponent
-    is clamped at -80 (no underflow near the edges, where ``y < 2e-35 B``).
+    is clamped at -80 (no underflow near the edges, where ``y < 2e-35 B``). Without rates
+    ``bump_value(...) -> y``.
     """
     t, start, end, center, radius, sharpness, height = _sym(
         "t", "start", "end", "center", "radius", "sharpness", "height")
@@ -124,6 +136,10 @@ def bump() -> ca.Function:
     # the exponent clamped at -80: no underflow at the window's edges (y < 2e-35 B there)
     exponent = ca.fmax(-sharpness * d ** 2 / denom, -EXP_ARGUMENT_BOUND)
     y = ca.if_else(inside, height * ca.exp(exponent), 0.0)
+    if not rates:
+        return ca.Function("bump_value", [t, start, end, center, radius, sharpness, height], [y],
+                           ["t", "start", "end", "center", "radius", "sharpness", "height"],
+                           ["y"])
     return ca.Function("bump", [t, start, end, center, radius, sharpness, height],
                        [y, ca.jacobian(y, t)],
                        ["t", "start", "end", "center", "radius", "sharpness", "height"],
@@ -348,8 +364,10 @@ def deployed_pieces(n: int, profiles: tuple, single_bounds: bool = True,
     """
     init, add, finish, single = fnu_pieces()
     cand, cand_rates = candidates(n)
-    circumvents = ([bump()] if single_bounds or multi_bounds else []) + (
+    circumvents = ([bump(False), bump()] if single_bounds or multi_bounds else []) + (
         [init, add, finish] if multi_bounds else []) + ([single] if single_bounds else [])
-    return [*(progress(p) for p in PROFILE_NAMES if p in profiles), interpolate(n),
+    used = [p for p in PROFILE_NAMES if p in profiles]
+    return [*(progress(p, False) for p in used), *(progress(p) for p in used),
+            interpolate(n, False), interpolate(n),
             *circumvents, cand, cand_rates, *smooth_pieces(), conflict(n), alpha_rate(n),
             later(), *newton_pieces(), law(n)]

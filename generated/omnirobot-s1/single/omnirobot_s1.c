@@ -80,6 +80,38 @@ static const omnirobot_s1_window OMNIROBOT_S1_WINDOWS[OMNIROBOT_S1_N_WINDOWS] = 
 
 /* ------------------------------------------------------------- emitted bodies */
 
+/* CasADi Function 'progress_tanh_value': 22 instructions. */
+static void body_progress_tanh_value(const omnirobot_s1_real* t, const omnirobot_s1_real* start, const omnirobot_s1_real* end, omnirobot_s1_real* p) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  w0 = t[0];
+  w1 = end[0];
+  w2 = (w0 < w1) ? 1.0f : 0.0f;
+  w3 = start[0];
+  w3 = w0 - w3;
+  w4 = 0.0f;
+  w4 = (w3 < w4) ? 1.0f : 0.0f;
+  w4 = (w4 == 0.0f) ? 1.0f : 0.0f;
+  w1 = w1 - w0;
+  w1 = (w2 != 0.0f) ? w1 : 0.0f;
+  w0 = (w2 == 0.0f) ? 1.0f : 0.0f;
+  w5 = 1.0f;
+  w0 = (w0 != 0.0f) ? w5 : 0.0f;
+  w1 = w1 + w0;
+  w3 = w3 / w1;
+  w3 = tanhf(w3);
+  w4 = (w4 != 0.0f) ? w3 : 0.0f;
+  w4 = (w2 != 0.0f) ? w4 : 0.0f;
+  w2 = (w2 == 0.0f) ? 1.0f : 0.0f;
+  w2 = (w2 != 0.0f) ? w5 : 0.0f;
+  w4 = w4 + w2;
+  p[0] = w4;
+}
+
 /* CasADi Function 'progress_tanh': 32 instructions. */
 static void body_progress_tanh(const omnirobot_s1_real* t, const omnirobot_s1_real* start, const omnirobot_s1_real* end, omnirobot_s1_real* p, omnirobot_s1_real* p_dot) {
   omnirobot_s1_real w0;
@@ -122,6 +154,50 @@ static void body_progress_tanh(const omnirobot_s1_real* t, const omnirobot_s1_re
   w4 = (w4 != 0.0f) ? w5 : 0.0f;
   w2 = (w2 != 0.0f) ? w4 : 0.0f;
   p_dot[0] = w2;
+}
+
+/* CasADi Function 'interpolate_value': 37 instructions. */
+static void body_interpolate_value(const omnirobot_s1_real* p, const omnirobot_s1_real* from, const omnirobot_s1_real* to, omnirobot_s1_real* rho) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  w0 = to[0];
+  w1 = from[0];
+  w0 = w0 - w1;
+  w2 = p[0];
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[0] = w0;
+  w0 = to[1];
+  w1 = from[1];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[1] = w0;
+  w0 = to[2];
+  w1 = from[2];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[2] = w0;
+  w0 = to[3];
+  w1 = from[3];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[3] = w0;
+  w0 = to[4];
+  w1 = from[4];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[4] = w0;
+  w0 = to[5];
+  w1 = from[5];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[5] = w0;
 }
 
 /* CasADi Function 'interpolate': 56 instructions. */
@@ -196,6 +272,50 @@ static void body_interpolate(const omnirobot_s1_real* p, const omnirobot_s1_real
   w11 = w11 - w12;
   w11 = w11 * w1;
   rho_dot[5] = w11;
+}
+
+/* CasADi Function 'bump_value': 34 instructions. */
+static void body_bump_value(const omnirobot_s1_real* t, const omnirobot_s1_real* start, const omnirobot_s1_real* end, const omnirobot_s1_real* center, const omnirobot_s1_real* radius, const omnirobot_s1_real* sharpness, const omnirobot_s1_real* height, omnirobot_s1_real* y) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  w0 = start[0];
+  w1 = t[0];
+  w0 = (w0 < w1) ? 1.0f : 0.0f;
+  w2 = end[0];
+  w2 = (w1 < w2) ? 1.0f : 0.0f;
+  w0 = ((w0 != 0.0f) && (w2 != 0.0f)) ? 1.0f : 0.0f;
+  w2 = center[0];
+  w1 = w1 - w2;
+  w2 = fabsf(w1);
+  w3 = radius[0];
+  w2 = (w2 < w3) ? 1.0f : 0.0f;
+  w0 = ((w0 != 0.0f) && (w2 != 0.0f)) ? 1.0f : 0.0f;
+  w2 = height[0];
+  w4 = sharpness[0];
+  w5 = w1 * w1;
+  w4 = w4 * w5;
+  w5 = fabsf(w1);
+  w5 = w3 - w5;
+  w1 = fabsf(w1);
+  w3 = w3 + w1;
+  w5 = w5 * w3;
+  w5 = (w0 != 0.0f) ? w5 : 0.0f;
+  w3 = (w0 == 0.0f) ? 1.0f : 0.0f;
+  w1 = 1.0f;
+  w3 = (w3 != 0.0f) ? w1 : 0.0f;
+  w5 = w5 + w3;
+  w4 = w4 / w5;
+  w4 = -w4;
+  w5 = -80.0f;
+  w4 = (w5 > w4) ? w5 : w4;
+  w4 = expf(w4);
+  w2 = w2 * w4;
+  w0 = (w0 != 0.0f) ? w2 : 0.0f;
+  y[0] = w0;
 }
 
 /* CasADi Function 'bump': 57 instructions. */
@@ -999,11 +1119,11 @@ static void omnirobot_s1_zero(omnirobot_s1_real* v, int count) {
 
 /* ------------------------------------------------------- composition (tables) */
 
-/* rho, rho_dot [L; U] of eq. (4) at t: the first segment whose end is after t (the last one
-   after every end). */
-static void omnirobot_s1_reach(omnirobot_s1_real t, omnirobot_s1_real* rho, omnirobot_s1_real* rho_dot) {
-  omnirobot_s1_real p;
-  omnirobot_s1_real p_dot;
+/* rho [L; U] of eq. (4) at t (and rho_dot when rates != 0): the first segment whose end is
+   after t (the last one after every end). */
+static void omnirobot_s1_reach(omnirobot_s1_real t, int rates, omnirobot_s1_real* rho, omnirobot_s1_real* rho_dot) {
+  omnirobot_s1_real p = 0.0f;
+  omnirobot_s1_real p_dot = 0.0f;
   int k = OMNIROBOT_S1_N_SEGMENTS - 1;
   int j;
   for (j = OMNIROBOT_S1_N_SEGMENTS - 2; j >= 0; --j) {
@@ -1011,18 +1131,24 @@ static void omnirobot_s1_reach(omnirobot_s1_real t, omnirobot_s1_real* rho, omni
       k = j;
     }
   }
-if (OMNIROBOT_S1_SEGMENTS[k].profile == 0) {
-    body_progress_tanh(&t, &OMNIROBOT_S1_SEGMENTS[k].start, &OMNIROBOT_S1_SEGMENTS[k].end, &p, &p_dot);
-  } else {
-    p = 0.0f;
-    p_dot = 0.0f;
+  if (OMNIROBOT_S1_SEGMENTS[k].profile == 0) {
+    if (rates != 0) {
+      body_progress_tanh(&t, &OMNIROBOT_S1_SEGMENTS[k].start, &OMNIROBOT_S1_SEGMENTS[k].end, &p, &p_dot);
+    } else {
+      body_progress_tanh_value(&t, &OMNIROBOT_S1_SEGMENTS[k].start, &OMNIROBOT_S1_SEGMENTS[k].end, &p);
+    }
   }
-  body_interpolate(&p, &p_dot, OMNIROBOT_S1_SEGMENTS[k].from, OMNIROBOT_S1_SEGMENTS[k].to, rho, rho_dot);
+  if (rates != 0) {
+    body_interpolate(&p, &p_dot, OMNIROBOT_S1_SEGMENTS[k].from, OMNIROBOT_S1_SEGMENTS[k].to, rho, rho_dot);
+  } else {
+    body_interpolate_value(&p, OMNIROBOT_S1_SEGMENTS[k].from, OMNIROBOT_S1_SEGMENTS[k].to, rho);
+  }
 }
 
-/* beta, beta_dot [L; U] of eq. (9) at t, over the open windows only (a closed window adds
-   exactly 0 to F_nu). */
-static void omnirobot_s1_circumvent(omnirobot_s1_real t, omnirobot_s1_real* beta, omnirobot_s1_real* beta_dot) {
+/* beta [L; U] of eq. (9) at t (and beta_dot when rates != 0), over the open windows only (a
+   closed window adds exactly 0 to F_nu). */
+static void omnirobot_s1_circumvent(omnirobot_s1_real t, int rates, omnirobot_s1_real* beta,
+    omnirobot_s1_real* beta_dot) {
   int b;
   omnirobot_s1_real y[OMNIROBOT_S1_MAX_OPEN];
   omnirobot_s1_real y_dot[OMNIROBOT_S1_MAX_OPEN];
@@ -1057,8 +1183,13 @@ static void omnirobot_s1_circumvent(omnirobot_s1_real t, omnirobot_s1_real* beta
   for (j = first; j < hi; ++j) {
     if ((t < OMNIROBOT_S1_WINDOWS[j].end) && (open < OMNIROBOT_S1_MAX_OPEN)) {
       const omnirobot_s1_window* w = &OMNIROBOT_S1_WINDOWS[j];
-      body_bump(&t, &w->start, &w->end, &w->center, &w->radius, &w->sharpness, &w->height,
-                &y[open], &y_dot[open]);
+      if (rates != 0) {
+        body_bump(&t, &w->start, &w->end, &w->center, &w->radius, &w->sharpness, &w->height,
+                  &y[open], &y_dot[open]);
+      } else {
+        body_bump_value(&t, &w->start, &w->end, &w->center, &w->radius, &w->sharpness,
+                        &w->height, &y[open]);
+      }
       bound_of[open] = w->bound;
       open = open + 1;
     }
@@ -1101,8 +1232,8 @@ static void omnirobot_s1_gamma(omnirobot_s1_real t, const omnirobot_s1_real* a, 
   omnirobot_s1_real rho_dot[OMNIROBOT_S1_N_ALPHA];
   omnirobot_s1_real beta[OMNIROBOT_S1_N_ALPHA];
   omnirobot_s1_real beta_dot[OMNIROBOT_S1_N_ALPHA];
-  omnirobot_s1_reach(t, rho, rho_dot);
-  omnirobot_s1_circumvent(t, beta, beta_dot);
+  omnirobot_s1_reach(t, 0, rho, rho_dot);
+  omnirobot_s1_circumvent(t, 0, beta, beta_dot);
   omnirobot_s1_gamma_of(rho, beta, a, g_l, g_u);
 }
 
@@ -1119,8 +1250,8 @@ static void omnirobot_s1_gamma_and_rates(omnirobot_s1_real t, const omnirobot_s1
   omnirobot_s1_real c[OMNIROBOT_S1_N_ALPHA];
   omnirobot_s1_real c_dot[OMNIROBOT_S1_N_ALPHA];
   int i;
-  omnirobot_s1_reach(t, rho, rho_dot);
-  omnirobot_s1_circumvent(t, beta, beta_dot);
+  omnirobot_s1_reach(t, 1, rho, rho_dot);
+  omnirobot_s1_circumvent(t, 1, beta, beta_dot);
   omnirobot_s1_gamma_of(rho, beta, a, g_l, g_u);
   body_conflict(rho, beta, &OMNIROBOT_S1_PARAMETERS.theta0, &OMNIROBOT_S1_PARAMETERS.mu, psi, theta);
   body_alpha_rate(a, psi, theta, &OMNIROBOT_S1_PARAMETERS.kappa, a_dot);
@@ -1236,8 +1367,8 @@ static void omnirobot_s1_implicit_step(omnirobot_s1_real t, omnirobot_s1_real dt
   omnirobot_s1_real t_next;
   int i;
   body_later(&t, &dt, &t_next);
-  omnirobot_s1_reach(t_next, rho, rho_dot);
-  omnirobot_s1_circumvent(t_next, beta, beta_dot);
+  omnirobot_s1_reach(t_next, 0, rho, rho_dot);
+  omnirobot_s1_circumvent(t_next, 0, beta, beta_dot);
   body_conflict(rho, beta, &OMNIROBOT_S1_PARAMETERS.theta0, &OMNIROBOT_S1_PARAMETERS.mu, psi, theta);
   for (i = 0; i < OMNIROBOT_S1_N_ALPHA; ++i) {
     omnirobot_s1_real s;
