@@ -57,8 +57,10 @@ from .parameters import E_MAX, GAMMA_D_MIN, NEWTON_TINY, SMOOTHSTEP, TANH
 #: and the trigger of (11)): ``exp(+-80)`` is a normal number in float32 and float64, so no
 #: step raises an overflow or underflow flag or sets ``errno``.
 EXP_ARGUMENT_BOUND = 80.0
-#: ``e^-80`` rounded up (for the exactness test of :func:`smooth_max_test`).
-_EXP_MINUS_BOUND = 1.81e-35
+#: ``nu |a - b|`` from which :func:`smooth_max_needed` may skip the correction, and
+#: ``e^-40`` rounded up (for its exactness test).
+SMOOTH_SKIP_ARGUMENT = 40.0
+_EXP_MINUS_SKIP = 4.25e-18
 
 #: Profile codes of the segment table, in the order of ``PROFILE_NAMES``.
 PROFILE_NAMES = (TANH, SMOOTHSTEP)
@@ -200,13 +202,13 @@ def smooth_max_expression(a, b, nu):
 def smooth_max_needed(a, b, nu):
     """``(max(a, b), needed)``: ``needed`` is 0 where ``max~(a, b) == max(a, b)`` exactly.
 
-    ``needed`` is 0 when ``nu |a - b| >= 80`` and ``|max| >= 2^54 e^-80 / nu``: the
-    correction ``log1p(e^-80) / nu < e^-80 / nu <= |max| 2^-54`` is then below half an ulp of
-    the max in float64 and float32.
+    ``needed`` is 0 when ``nu |a - b| >= 40`` and ``|max| >= 2^54 e^-40 / nu``: the
+    correction ``log1p(e^-nu|a-b|) / nu < e^-40 / nu <= |max| 2^-54`` is then below half an
+    ulp of the max in float64 and float32, so ``max~(a, b) == max(a, b)`` exactly.
     """
     top = ca.fmax(a, b)
-    sharp = ca.logic_and(nu * ca.fabs(a - b) >= EXP_ARGUMENT_BOUND,
-                         ca.fabs(top) >= 2.0 ** 54 * _EXP_MINUS_BOUND / nu)
+    sharp = ca.logic_and(nu * ca.fabs(a - b) >= SMOOTH_SKIP_ARGUMENT,
+                         ca.fabs(top) >= 2.0 ** 54 * _EXP_MINUS_SKIP / nu)
     return top, ca.logic_not(sharp)
 
 

@@ -930,13 +930,13 @@ def body_smooth_max_test(a, b, nu):
     w1 = float(b[0])
     w2 = _fmax(w0, w1)
     max[0] = w2
-    w3 = 80.0
+    w3 = 40.0
     w4 = float(nu[0])
     w0 = w0 - w1
     w0 = math.fabs(w0)
     w0 = w4 * w0
     w3 = 1.0 if w3 <= w0 else 0.0
-    w0 = 3.260606130216239e-19
+    w0 = 0.07656119366529843
     w0 = _div(w0, w4)
     w2 = math.fabs(w2)
     w0 = 1.0 if w0 <= w2 else 0.0
@@ -1013,13 +1013,13 @@ def body_smooth_min_test(a, b, nu):
     w1 = _fmax(w1, w3)
     w3 = -w1
     min[0] = w3
-    w3 = 80.0
+    w3 = 40.0
     w4 = float(nu[0])
     w2 = w2 - w0
     w2 = math.fabs(w2)
     w2 = w4 * w2
     w3 = 1.0 if w3 <= w2 else 0.0
-    w2 = 3.260606130216239e-19
+    w2 = 0.07656119366529843
     w2 = _div(w2, w4)
     w1 = math.fabs(w1)
     w2 = 1.0 if w2 <= w1 else 0.0
