@@ -68,8 +68,14 @@ def _rounded(value: float, single: bool) -> float:
 
 
 def max_open(intervals: list) -> int:
-    """Largest number of closed intervals ``[start, end]`` sharing a point (>= 1)."""
-    events = sorted([(s, 0) for s, _ in intervals] + [(e, 1) for _, e in intervals])
+    """Largest number of intervals ``[start, end]`` sharing a point (>= 1), each widened by
+    ``1e-6`` relative (plus ``1e-30``) on both sides: an upper bound on the windows open at
+    one time even if the compiler rounds a table's decimal to a neighbouring float."""
+    def widen(v: float, sign: float) -> float:
+        return v + sign * (1e-6 * abs(v) + 1e-30)
+
+    events = sorted([(widen(s, -1.0), 0) for s, _ in intervals]
+                    + [(widen(e, 1.0), 1) for _, e in intervals])
     best = count = 0
     for _, kind in events:
         count += 1 if kind == 0 else -1
