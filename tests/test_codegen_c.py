@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 import subprocess
 
 import numpy as np
@@ -123,7 +124,7 @@ def test_no_mutable_state_and_only_libm(precision, tmp_path):
     syms = subprocess.run(["nm", "-u", f"{prefix}.o"], cwd=folder, capture_output=True,
                           text=True, check=True).stdout.split()
     undefined = sorted(s for s in syms if s != "U")
-    libm_d = {"exp", "log", "log1p", "tanh", "pow", "sqrt", "fmax", "fmin", "fabs"}
+    libm_d = {"exp", "log", "log1p", "tanh", "pow", "sqrt", "fabs"}
     allowed = libm_d if precision == "double" else {f + "f" for f in libm_d}
     assert set(undefined) <= allowed, undefined
     defined = subprocess.run(["nm", "-g", "--defined-only", f"{prefix}.o"], cwd=folder,
@@ -164,3 +165,50 @@ def test_invalid_inputs_and_outside_tube(precision, root):
     assert step(lib.ptr(mid), t, dt, lib.ptr(a), None, lib.ptr(nxt)) == 2
     gl, gu = lib.arr(None, n), lib.arr(None, n)
     assert lib.f["tube"](t, lib.ptr(a), lib.ptr(gl), lib.ptr(gu), None, None) == 0
+
+
+@pytest.mark.parametrize("precision", ["double", "single"])
+def test_fast_math_refused_with_a_clear_error(precision, tmp_path):
+    spec, _, _ = designed("omnirobot-s1")
+    folder = write(tmp_path, files_of("omnirobot-s1", precision))
+    for cc in COMPILERS:
+        proc = subprocess.run([cc, "-std=c99", "-Ofast", "-c", f"{spec.c_name}.c"], cwd=folder,
+                              capture_output=True, text=True)
+        assert proc.returncode != 0 and "must not be compiled with -ffast-math" in proc.stderr, (
+            cc, proc.stderr[-1000:])
+
+
+@pytest.mark.skipif(shutil.which("arm-none-eabi-gcc") is None,
+                    reason="arm-none-eabi-gcc missing: install the Debian package gcc-arm-none-eabi")
+@pytest.mark.parametrize("precision", ["double", "single"])
+def test_strict_build_for_cortex_m4(precision, tmp_path):
+    spec, _, _ = designed("omnirobot-s1")
+    folder = write(tmp_path, files_of("omnirobot-s1", precision))
+    proc = subprocess.run(["arm-none-eabi-gcc", *flags(precision), "-mcpu=cortex-m4",
+                           "-mfpu=fpv4-sp-d16", "-mfloat-abi=hard", "-mthumb", "-c",
+                           f"{spec.c_name}.c", f"{spec.c_name}_selftest.c"],
+                          cwd=folder, capture_output=True, text=True)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+
+
+@pytest.mark.parametrize("obstacles", [0, 1, 6])
+def test_strict_build_for_any_number_of_circumvents(obstacles, tmp_path):
+    """No circumvent, one per bound, several per bound: strict build and self-test."""
+    from stt_codegen.bench.scaling import synthetic_design
+    from stt_codegen.codegen.generate import generate_files
+    from stt_codegen.codegen.options import Options
+
+    class _Spec:
+        name, c_name, source_hash = "synthetic", "synthetic", "0" * 64
+
+    design = synthetic_design(obstacles, 2, windows="open")
+    for precision in ("double", "single"):
+        folder = write(tmp_path / precision, generate_files(_Spec(), design,
+                                                            Options(("c",), precision)))
+        exe = folder / "selftest"
+        proc = subprocess.run([COMPILERS[0], *flags(precision), "synthetic.c",
+                               "synthetic_selftest.c", "-o", str(exe), "-lm"], cwd=folder,
+                              capture_output=True, text=True)
+        assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+        run = subprocess.run([str(exe)], capture_output=True, text=True)
+        assert run.returncode == 0 and run.stdout.strip().endswith(" 0 failed"), run.stdout[-2000:]

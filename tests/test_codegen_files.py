@@ -17,9 +17,8 @@ from test_codegen_support import files_of
 from stt_codegen import __version__
 from stt_codegen.cli import main
 from stt_codegen.codegen.bundled import LAYOUT, drift
-from stt_codegen.codegen.casadi_c import casadi_bodies, check_no_mutable_state
-from stt_codegen.codegen.errors import CodegenError
-from stt_codegen.codegen.single import check_single, to_single
+from stt_codegen.codegen.functions import deployed_functions
+from conftest import model_of
 from stt_codegen.spec.loader import load_spec
 
 REPO = Path(__file__).resolve().parent.parent
@@ -64,31 +63,23 @@ def test_manifest_and_banners():
             assert spec.source_hash in text[:600] and casadi.__version__ in text[:600], name
 
 
-def test_casadi_output_reduced_to_static_code():
-    files = files_of("omnirobot-s2", "double")
-    c = files["omnirobot_s2.c"].decode()
-    for word in ("_checkout", "_incref", "_decref", "_release", "casadi_version", "mem_counter",
-                 "sparsity_in"):
-        assert word not in c
-    with pytest.raises(CodegenError):
-        check_no_mutable_state("static int body_x(void) {\n}\nint counter = 0;\n")
-    x = casadi.SX.sym("x")
-    same = casadi.Function("f", [x], [casadi.exp(x)])
-    with pytest.raises(CodegenError):
-        casadi_bodies([same, same])  # duplicate names would give ambiguous bodies
-    body = casadi_bodies([casadi.Function("f", [x], [casadi.exp(x)])])
-    assert list(body.bodies) == ["f"] and "static int body_f(" in body.bodies["f"]
-
-
-def test_single_pass():
-    text = to_single("/* keep 2.5 exp( */\n  a01=9.;\n  a02=exp(a01);\n  a03=(a02?a01:0);"
-                     "\n  a04=(!a03);\n  a05=(a03&&a04);\n  a06=pow(a05,3.3333333333333331e-01);")
-    assert "/* keep 2.5 exp( */" in text
-    assert "a01=9.f;" in text and "expf(a01)" in text and "(a02!=0?a01:0)" in text
-    assert "(a03==0)" in text and "(a03!=0&&a04!=0)" in text and "3.3333333333333331e-01f" in text
-    for bad in ("a=exp(b);", "a=1.5;", "a=strtod(b);"):
-        with pytest.raises(CodegenError):
-            check_single(bad)
+def test_header_declares_only_the_api_and_source_has_no_casadi_internals():
+    for precision in ("double", "single"):
+        files = files_of("omnirobot-s2", precision)
+        c, h = files["omnirobot_s2.c"].decode(), files["omnirobot_s2.h"].decode()
+        for word in ("casadi_", "SZ_ARG", "SZ_RES", "SZ_W", "arg[", "res[", "_checkout"):
+            assert word not in c and word not in h, word
+        code = re.sub(r"/\*.*?\*/", "", h, flags=re.DOTALL)
+        declared = re.findall(r"^\s*int (\w+)\(", code, flags=re.MULTILINE)
+        assert declared == [f"omnirobot_s2_{n}" for n in ("tube", "control", "alpha_step", "step")]
+        macros = re.findall(r"^#define (\w+)", code, flags=re.MULTILINE)
+        assert all(m.startswith("OMNIROBOT_S2_") for m in macros), macros
+        # every computation is emitted once: one body per deployed Function
+        bodies = re.findall(r"^static void (body_\w+)\(", c, flags=re.MULTILINE)
+        expected = [f"body_{f.name()}" for f in deployed_functions(model_of("omnirobot-s2"))]
+        assert bodies == expected and len(set(bodies)) == len(bodies)
+        if precision == "single":
+            assert "double" not in re.sub(r"/\*.*?\*/", "", c, flags=re.DOTALL)
 
 
 def test_output_folder_rules(tmp_path):

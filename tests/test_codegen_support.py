@@ -15,8 +15,9 @@ from stt_codegen.codegen.generate import generate_files
 from stt_codegen.codegen.options import Options
 
 STRICT = ["-std=c99", "-O2", "-ffp-contract=off", "-Wall", "-Wextra", "-Wpedantic", "-Wshadow",
-          "-Werror"]
-SINGLE_EXTRA = ["-Wdouble-promotion", "-Wfloat-conversion"]
+          "-Wconversion", "-Wdouble-promotion", "-Wcast-qual", "-Wstrict-prototypes",
+          "-Wmissing-prototypes", "-Werror"]
+SINGLE_EXTRA: list[str] = []
 COMPILERS = [c for c in ("gcc", "clang") if shutil.which(c)]
 
 

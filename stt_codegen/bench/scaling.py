@@ -12,8 +12,13 @@ size and structure of real designs, which is what code size and step cost depend
 
 The *active-window* experiment builds three designs with the same ``m`` circumvents that
 differ only in their windows: all open during the whole recorded run ``[0, t_c)``, all
-closed (windows after ``t_c + 10`` s), and the random windows above. If the step's cost
-depended only on the active windows, the closed design would be much cheaper.
+closed (windows after ``t_c + 10`` s), and the random windows above. The generated step
+evaluates only the open windows, so the closed design is much cheaper.
+
+The *sparse-window* experiment compares a design with :data:`SPARSE_SMALL` circumvents and
+one with :data:`SPARSE_LARGE`, both with windows spread evenly over ``[0.5, 8.5]`` s so
+that at most :data:`MAX_SIMULTANEOUS` are open at a time: instructions per step (ratio
+large / small) and the size of the object's code (``.text``; only the tables grow).
 """
 
 from __future__ import annotations
@@ -34,6 +39,10 @@ from .timing import MIN_BATCH_SECONDS
 DIMENSION_SWEEP_OBSTACLES = 4
 #: Obstacles of the active-window experiment.
 ACTIVE_EXPERIMENT_OBSTACLES = 100
+#: Circumvents of the sparse-window experiment, and the most windows open at one time.
+SPARSE_SMALL = 10
+SPARSE_LARGE = 1000
+MAX_SIMULTANEOUS = 16
 REPEATS = 5
 ARENA_SIZE = 5.0
 
@@ -48,10 +57,11 @@ def synthetic_design(obstacles: int, dimension: int, windows: str = "random",
         ``m >= 0``.
     dimension : int
         ``n >= 1``.
-    windows : {"random", "open", "closed"}
+    windows : {"random", "open", "closed", "sparse"}
         ``"open"``: every window is ``[-1, t_c + 1]``; ``"closed"``: every window lies in
         ``[t_c + 10, t_c + 12]`` (never open before ``t_c``); ``"random"``: see the module
-        docstring. With ``"open"`` and ``"closed"`` the heights are scaled by 0.05 so that
+        docstring; ``"sparse"``: window ``j`` starts at ``0.5 + 8 j / m`` s and lasts
+        ``min(1, 0.95 * 8 MAX_SIMULTANEOUS / m)`` s (at most :data:`MAX_SIMULTANEOUS` open). With ``"open"`` and ``"closed"`` the heights are scaled by 0.05 so that
         the closed loop stays inside the tube (the computation graph is the same).
     seed : int
 
@@ -68,7 +78,7 @@ def synthetic_design(obstacles: int, dimension: int, windows: str = "random",
         raise SpecError("--obstacles", f"must be non-negative, got {obstacles}")
     if dimension < 1:
         raise SpecError("--dimensions", f"must be at least 1, got {dimension}")
-    if windows not in ("random", "open", "closed"):
+    if windows not in ("random", "open", "closed", "sparse"):
         raise SpecError("windows", f"unknown window mode {windows!r}")
     t_c = 9.0
     rng = np.random.default_rng([seed, obstacles, dimension])
@@ -81,8 +91,11 @@ def synthetic_design(obstacles: int, dimension: int, windows: str = "random",
             center, radius = t_c / 2, t_c / 2 + 1.0
         elif windows == "closed":
             center, radius = t_c + 11.0, 1.0
+        elif windows == "sparse":
+            radius = 0.5 * min(1.0, 0.95 * 8.0 * MAX_SIMULTANEOUS / obstacles)
+            center = 0.5 + 8.0 * j / obstacles + radius
         height = float(rng.uniform(0.2, 1.0))
-        if windows != "random":  # keep x(0) and the run inside the tube: same graph
+        if windows in ("open", "closed"):  # keep x(0) and the run inside the tube
             height *= 0.05
         base = 0.0 if side == LOWER else ARENA_SIZE
         circumvents.append(Circumvent(j, i, side, float(center - radius),
@@ -105,7 +118,7 @@ def measure(design: TubeDesign, compile_timeout: float, callgrind: bool = True,
     -------
     dict
         ``obstacles``, ``dimension``, ``generate_s``, ``compile_s``, ``source_bytes``,
-        ``object_bytes``, ``seconds_per_step`` (median of :data:`REPEATS` compiled-loop
+        ``object_bytes``, ``text_bytes`` (code only), ``seconds_per_step`` (median of :data:`REPEATS` compiled-loop
         runs of about 0.2 s), ``instructions_per_step`` (callgrind, or None),
         ``operations`` (of the CasADi ``controller_step``), ``outside_tube_inputs``;
         or, when the build fails, ``error``.
@@ -126,6 +139,7 @@ def measure(design: TubeDesign, compile_timeout: float, callgrind: bool = True,
         row.update({
             "generate_s": harness.generate_seconds, "compile_s": harness.compile_seconds,
             "source_bytes": harness.source_bytes, "object_bytes": harness.object_bytes,
+            "text_bytes": _text_bytes(harness.folder),
             "seconds_per_step": float(np.median(harness.time_step(steps, REPEATS))),
             "instructions_per_step": (harness.instructions_per_step(callgrind_steps)
                                       if callgrind else None),
@@ -135,6 +149,42 @@ def measure(design: TubeDesign, compile_timeout: float, callgrind: bool = True,
     finally:
         harness.cleanup()
     return row
+
+
+def _text_bytes(folder) -> int | None:
+    """``.text`` of the generated controller's object file in a harness folder (``size -A``)."""
+    import subprocess
+    objects = sorted(p for p in folder.glob("*.o") if p.name != "harness.o")
+    if not objects:
+        return None
+    try:
+        out = subprocess.run(["size", "-A", str(objects[0])], capture_output=True, text=True,
+                             timeout=60).stdout
+    except (OSError, subprocess.SubprocessError):
+        return None
+    sizes = [int(line.split()[1]) for line in out.splitlines()
+             if line.startswith(".text") and len(line.split()) >= 2]
+    return sum(sizes) if sizes else None
+
+
+def sparse_window_experiment(compile_timeout: float = 900.0, callgrind: bool = True,
+                             small: int = SPARSE_SMALL, large: int = SPARSE_LARGE) -> dict:
+    """Step cost and code size of ``small`` vs ``large`` circumvents, at most
+    :data:`MAX_SIMULTANEOUS` windows open at a time (``windows="sparse"``, n = 2).
+
+    Returns
+    -------
+    dict
+        ``rows`` (:func:`measure` of each) and ``instruction_ratio`` (large / small, None
+        without callgrind).
+    """
+    rows = [measure(synthetic_design(m, 2, windows="sparse"), compile_timeout, callgrind)
+            for m in (small, large)]
+    ok = all("error" not in r for r in rows)
+    ratio = None
+    if ok and rows[0].get("instructions_per_step") and rows[1].get("instructions_per_step"):
+        ratio = rows[1]["instructions_per_step"] / rows[0]["instructions_per_step"]
+    return {"rows": rows, "instruction_ratio": ratio}
 
 
 def _int_list(text: str, field: str) -> list[int]:
@@ -149,7 +199,7 @@ def _int_list(text: str, field: str) -> list[int]:
 
 def run_scaling_bench(obstacles: list[int], dimensions: list[int],
                       compile_timeout: float = 900.0, active_obstacles: int | None = None,
-                      callgrind: bool = True) -> dict[str, Any]:
+                      callgrind: bool = True, sparse: tuple | None = None) -> dict[str, Any]:
     """Measure :func:`measure` for every obstacle count (at ``n = 2``), every dimension
     (at :data:`DIMENSION_SWEEP_OBSTACLES` obstacles) and the active-window experiment.
 
@@ -163,12 +213,16 @@ def run_scaling_bench(obstacles: list[int], dimensions: list[int],
         Circumvents of the active-window experiment (default
         :data:`ACTIVE_EXPERIMENT_OBSTACLES`; 0 skips it).
     callgrind : bool
+    sparse : (int, int), optional
+        Circumvent counts of :func:`sparse_window_experiment` (default
+        ``(SPARSE_SMALL, SPARSE_LARGE)``; ``(0, 0)`` skips it).
 
     Returns
     -------
     dict
         ``machine``, ``obstacle_sweep``, ``dimension_sweep``, ``active_windows`` (rows of
-        :func:`measure` with a ``windows`` key) and ``conclusion`` (a sentence).
+        :func:`measure` with a ``windows`` key), ``sparse_windows`` (or None) and
+        ``conclusion`` (a sentence).
     """
     for m in obstacles:
         if m < 0:
@@ -189,6 +243,9 @@ def run_scaling_bench(obstacles: list[int], dimensions: list[int],
             row = measure(synthetic_design(active, 2, windows=mode), compile_timeout, callgrind)
             row["windows"] = mode
             report["active_windows"].append(row)
+    small, large = (SPARSE_SMALL, SPARSE_LARGE) if sparse is None else sparse
+    report["sparse_windows"] = (sparse_window_experiment(compile_timeout, callgrind, small, large)
+                                if small and large else None)
     report["conclusion"] = _conclusion(report["active_windows"])
     return report
 
@@ -222,7 +279,7 @@ def _row_cells(r: dict[str, Any], first: str) -> list[str]:
 def format_scaling_report(report: dict[str, Any]) -> str:
     """The human-readable tables of :func:`run_scaling_bench`'s result."""
     header = ["{}", "generate", "compile -O2", "C source", "object", "time/step",
-              "instr/step", "arith / transc.", "outside"]
+              "instr/step", "model arith / transc.", "outside"]
     out = []
     for key, label, col in (("obstacle_sweep", "obstacles (n = 2)", "obstacles"),
                             ("dimension_sweep",
@@ -238,8 +295,22 @@ def format_scaling_report(report: dict[str, Any]) -> str:
         out.append(table(["windows"] + header[1:],
                          [_row_cells(r, r["windows"]) for r in report["active_windows"]]))
     out.append(report["conclusion"])
+    sparse = report.get("sparse_windows")
+    if sparse:
+        rows = sparse["rows"]
+        out.append(f"sparse windows (at most {MAX_SIMULTANEOUS} open at a time, n = 2)")
+        out.append(table(["circumvents"] + header[1:],
+                         [_row_cells(r, str(r["obstacles"])) for r in rows]))
+        ratio = sparse["instruction_ratio"]
+        texts = [r.get("text_bytes") for r in rows]
+        out.append(f"{rows[1]['obstacles']} vs {rows[0]['obstacles']} circumvents: "
+                   + (f"{ratio:.2f} x the instructions per step" if ratio else
+                      "instructions not measured")
+                   + f"; code (.text) {texts[1]} vs {texts[0]} bytes")
     out.append("generate: CasADi model + C text + test vectors; compile: the generated .c "
-               "alone; object: text + data + bss (all four deployed functions); "
+               "alone; object: text + data + bss (all four API functions, tables included); "
+               "model arith / transc.: operations of the CasADi model's controller_step (every "
+               "circumvent; the generated step evaluates the open ones only); "
                "outside: recorded closed-loop inputs (of 9000) outside the synthetic tube")
     out.append(machine_line(report["machine"]))
     return "\n".join(out)

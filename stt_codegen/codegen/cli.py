@@ -27,13 +27,14 @@ def cmd_generate(args: argparse.Namespace) -> int:
 
 def cmd_check(args: argparse.Namespace) -> int:
     """``stt-codegen check [--root generated] [--update]``: 0 identical, 1 drift."""
-    from .bundled import drift, update_generated
+    from .bundled import drift, update_generated, version_note
     root = Path(args.root)
     if args.update:
         update_generated(root)
         print(f"regenerated {root}/")
         return 0
     diffs = drift(root)
+    print(version_note())
     if diffs:
         for text in diffs:
             sys.stdout.write(text)

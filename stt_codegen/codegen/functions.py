@@ -1,58 +1,54 @@
-"""The CasADi Functions that are deployed, in a fixed order, from the model's.
+"""The CasADi Functions whose bodies are deployed: the pieces of the model, each emitted once.
 
-The generated code exposes four functions (C: ``<prefix>_tube``, ``_control``,
-``_alpha_step``, ``_step``; Python: ``tube``, ``control``, ``alpha_step``, ``step``). Their
-numeric bodies are these CasADi SX Functions:
+The generated API (C: ``<prefix>_tube``, ``_control``, ``_alpha_step``, ``_step``; Python:
+``tube``, ``control``, ``alpha_step``, ``step``) is control flow over the spec's ``const``
+tables (:mod:`stt_codegen.codegen.tables`) around the bodies of the pieces of
+:mod:`stt_codegen.tube.pieces`, whose numbers are inputs:
 
-=================  ========================  ======================================
-name               inputs                    outputs
-=================  ========================  ======================================
-``tube``           t, alpha (2n)             gamma_L, gamma_U, gamma_L_dot, gamma_U_dot
-``control``        x (n), t, alpha (2n)      u (n), inside (1)
-``alpha_step``     t, dt, alpha (2n)         alpha_next (2n)
-``controller_step`` x (n), t, dt, alpha (2n)  u (n), alpha_next (2n), inside (1)
-=================  ========================  ======================================
+* reach tube: find the active segment, ``progress_<profile>``, ``interpolate``;
+* circumvents: find the open windows (binary search on the sorted starts, then back over
+  the running maximum of the ends), ``bump`` for each open one, ``fnu_init``,
+  ``fnu_add``, ``fnu_finish`` per bound (a closed window would add exactly 0);
+* tube (10): ``candidates``, then per dimension ``smooth_max_test`` and, only where the
+  correction can change the max, ``smooth_max`` (likewise ``smooth_min``); rates:
+  ``conflict``, ``alpha_rate``, ``candidate_rates``, ``smooth_max_rate``/``smooth_min_rate``;
+* law (13): ``law``;
+* implicit step of (11): ``later``, reach tube and circumvents at ``t + dt``,
+  ``conflict``, then per component ``newton_start``, ``newton_root_start`` only when
+  needed and ``NEWTON_ITERATIONS`` x ``newton_iteration`` in a loop that stops at a fixed
+  point.
 
-``tube``, ``alpha_step`` and ``controller_step`` are the model's Functions unchanged.
-``control`` is the model's ``controller_step`` restricted to its ``u`` and ``inside``
-outputs (its SX graph, so the same operations as the step: ``e`` clamped to
-``[-E_MAX, E_MAX]``, ``gamma_d`` floored, finite outside the tube), not the model's
-unclamped ``control``, which is NaN outside the tube.
+This is the composition :func:`stt_codegen.tube.model.build_model` makes over every
+segment and circumvent, so the generated code computes the model's Functions bit for bit
+(double precision, ``-ffp-contract=off``).
 """
 
 from __future__ import annotations
 
 import casadi as ca
 
+from ..tube import pieces as P
 from ..tube.model import TubeModel
-from .errors import CodegenError
+from ..tube.parameters import LOWER, UPPER
 
-#: Deployed Function names, in generation order.
-DEPLOYED = ("tube", "control", "alpha_step", "controller_step")
+
+def deployed_functions(model: TubeModel) -> list[ca.Function]:
+    """The deployed SX Functions of a design, in generation order."""
+    design = model.design
+    profiles = tuple(sorted({segment.profile for segment in design.segments}))
+    members = [len(design.circumvents_on(i, side)) for i in range(design.dimension)
+               for side in (LOWER, UPPER)]
+    return P.deployed_pieces(design.dimension, profiles, single_bounds=1 in members,
+                             multi_bounds=any(m > 1 for m in members))
 
 
 def clamped_control(model: TubeModel) -> ca.Function:
-    """``control(x, t, alpha) -> (u, inside)``: the ``u`` and ``inside`` of ``controller_step``.
-
-    Raises
-    ------
-    CodegenError
-        If ``u`` or ``inside`` of the step depended on ``dt`` (they must not).
-    """
+    """``control(x, t, alpha) -> (u, inside)``: the ``u`` and ``inside`` of the model's step."""
     step = model["controller_step"]
     n = model.design.dimension
     x = ca.SX.sym("x", n)
     t = ca.SX.sym("t")
-    dt = ca.SX.sym("dt")
     alpha = ca.SX.sym("alpha", 2 * n)
-    u, _, inside = step(x, t, dt, alpha)
-    if ca.depends_on(ca.vertcat(u, inside), dt):
-        raise CodegenError("controller_step's u depends on dt")
+    u, _, inside = step(x, t, 1e-3, alpha)
     return ca.Function("control", [x, t, alpha], [u, inside], ["x", "t", "alpha"],
                        ["u", "inside"])
-
-
-def deployed_functions(model: TubeModel) -> list[ca.Function]:
-    """The deployed SX Functions, in the order of :data:`DEPLOYED`."""
-    return [model["tube"], clamped_control(model), model["alpha_step"],
-            model["controller_step"]]

@@ -4,8 +4,9 @@
 versions give the same bytes (no timestamps, no paths, no set iteration). Files, with
 ``P`` the spec's C name:
 
-* C (``--lang c``): ``P.h``, ``P.c`` (typed API + CasADi bodies), ``P_selftest.c`` (the
-  vectors embedded), ``Makefile``;
+* C (``--lang c``): ``P.h`` (the API only), ``P.c`` (typed API + bodies printed by
+  :class:`~stt_codegen.codegen.emit.CPrinter`), ``P_selftest.c`` (the vectors embedded),
+  ``Makefile`` and ``CMakeLists.txt``;
 * Python (``--lang python``): ``P.py`` (always double: Python floats);
 * always: ``P_vectors.json`` (inputs, reference outputs, tolerances of the precision)
   and ``manifest.json`` (:data:`MANIFEST`).
@@ -22,16 +23,16 @@ import casadi
 import numpy as np
 
 from .. import __version__
-from .emit import lower, python_source
+from .emit import CPrinter, lower, python_source
 from ..tube.model import build_model
 from ..spec.loader import Spec
 from ..tube.parameters import NEWTON_ITERATIONS, TubeDesign
 from . import tolerance
-from .casadi_c import CODEGEN_OPTIONS, casadi_bodies
 from .functions import deployed_functions
 from .options import Options
 from .render import c_identifier, c_real, render
-from .single import to_single
+from .tables import design_table_rows
+from ..tube.pieces import PROFILE_NAMES
 from .vectors import test_vectors
 
 MANIFEST = "manifest.json"
@@ -82,8 +83,8 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
     ------
     SpecError
         The spec's C name is not a usable identifier.
-    CodegenError
-        CasADi's output has an unexpected shape.
+    UnsupportedOperation
+        The model uses an operation the printers cannot translate.
     """
     prefix = c_identifier(spec.c_name)
     single = options.precision == "single"
@@ -97,24 +98,19 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
     }
     files: dict[str, str] = {}
     if "c" in options.langs:
-        bodies = casadi_bodies(functions)
-        text = bodies.text()
-        if single:
-            text = to_single(text)
-        c_ctx = dict(common, bodies=text.rstrip("\n"),
-                     codegen_options=", ".join(f"{k}={v}" for k, v in sorted(
-                         CODEGEN_OPTIONS.items())),
-                     sz_arg=max(w[0] for w in bodies.work.values()),
-                     sz_res=max(w[1] for w in bodies.work.values()),
-                     sz_w=0, guard=f"{prefix.upper()}_H",
+        bodies = CPrinter(options.precision, real=f"{prefix}_real", prefix="body_")
+        c_ctx = dict(common, bodies=bodies.doprint(functions).rstrip("\n"),
+                     spec_tables=design_table_rows(design, lambda v: c_real(v, single), single),
+                     profile_codes={name: k for k, name in enumerate(PROFILE_NAMES)},
+                     guard=f"{prefix.upper()}_H", zero=c_real(0.0, single),
                      t_c=c_real(design.prescribed_time, single),
                      rate_hz=c_real(design.rate_hz, single),
                      dt_min=c_real(limits["dt_min"], single),
                      dt_max=c_real(limits["dt_max"], single),
-                     alpha_max=c_real(limits["alpha_max"], single),
-                     extra_warnings=" -Wdouble-promotion -Wfloat-conversion" if single else "")
+                     alpha_max=c_real(limits["alpha_max"], single))
         for name, template in ((f"{prefix}.h", "c_header.h.j2"), (f"{prefix}.c", "c_source.c.j2"),
-                               ("Makefile", "Makefile.j2")):
+                               ("Makefile", "Makefile.j2"),
+                               ("CMakeLists.txt", "CMakeLists.txt.j2")):
             files[name] = render(template, filename=name, **c_ctx)
     vectors = test_vectors(design, options.precision)
     if "c" in options.langs:
@@ -133,6 +129,9 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
         programs = [dataclasses.replace(lower(f), name=f"body_{f.name()}") for f in functions]
         files[name] = render("python_module.py.j2", filename=name, **common,
                              bodies=python_source(programs).rstrip("\n"),
+                             spec_tables=design_table_rows(design, lambda v: repr(float(v)),
+                                                           False),
+                             profile_codes={name: k for k, name in enumerate(PROFILE_NAMES)},
                              t_c=repr(float(design.prescribed_time)),
                              rate_hz=repr(float(design.rate_hz)),
                              dt_min=repr(limits["dt_min"]),

@@ -1,20 +1,25 @@
 """Symbolic model of the tube and its controller in CasADi.
 
 :func:`build_model` turns a :class:`~stt_codegen.tube.parameters.TubeDesign` into CasADi SX
-``Function``s with named inputs and outputs (see :data:`FUNCTION_NAMES`). Time
-derivatives and Jacobians are exact (algorithmic differentiation of the SX graph).
-The functions are the single source of every generated controller.
+``Function``s with named inputs and outputs (see :data:`FUNCTION_NAMES`). Each is the
+composition of the pieces of :mod:`stt_codegen.tube.pieces` (small Functions whose numbers
+are inputs) with the design's numbers, over every reach segment and every circumvent, in
+the order of the generated code's tables (:func:`design_tables`); the generated code
+composes the same pieces the same way over ``const`` tables, evaluating only the active
+segment and the open circumvents, so it computes exactly these Functions. Time
+derivatives are exact (algorithmic differentiation of each piece, chain rule across them).
 
-Numerical decisions (all documented in the README):
+Numerical decisions (docs/codegen.md):
 
 * smooth max of eq. (10) ``max~(a, b) = max(a, b) + log1p(exp(-nu |a - b|)) / nu``, the
-  paper's ``(1/nu) ln(e^{nu a} + e^{nu b})`` rewritten so it cannot overflow;
-* eq. (9) combines the bumps on one bound by ``F_nu`` (:func:`open_bump_sum`), to which a
-  closed window contributes exactly 0;
+  paper's ``(1/nu) ln(e^{nu a} + e^{nu b})`` rewritten so it cannot overflow, the exponent
+  clamped at -80 (no underflow);
+* eq. (9) combines the bumps on one bound by ``F_nu`` (:func:`~stt_codegen.tube.pieces.fnu_pieces`),
+  to which a closed window contributes exactly 0;
 * the reach tube is piecewise over ``design.segments``; ``tanh((t - start)/(end - t))``
-  is only evaluated for ``t < end`` (eq. (4)'s second branch holds after), with a
-  denominator that stays finite in the branch not taken;
+  is only evaluated for ``t < end`` (eq. (4)'s second branch holds after);
 * the circumvent bump is only evaluated inside its window (eqs. (7)-(8));
+* the trigger of (11) is ``2 theta0 / (1 + exp(2 (psi - mu)))`` (= ``theta0 (1 - tanh(psi - mu))``);
 * the implicit ``alpha`` step is backward Euler with :data:`~stt_codegen.tube.parameters.NEWTON_ITERATIONS`
   Newton iterations from a start point left of the root (see :func:`implicit_alpha_update`).
 """
@@ -25,171 +30,185 @@ from dataclasses import dataclass
 
 import casadi as ca
 
-from .parameters import (E_MAX, GAMMA_D_MIN, LOWER, NEWTON_ITERATIONS, NEWTON_TINY,
-                         SMOOTHSTEP, TANH, UPPER, ReachSegment, TubeDesign)
+from . import pieces as P
+from .parameters import LOWER, NEWTON_ITERATIONS, TubeDesign
 
 #: The functions of a model, in order.
 FUNCTION_NAMES = ("reach_tube", "circumvent", "tube", "adaptive_law", "error_transform",
                   "control", "alpha_step", "controller_step")
 
 
-def smooth_max(values: list, nu: float):
-    """Smooth maximum of SX scalars, the paper's ``max~`` (notation, section II).
+@dataclass(frozen=True)
+class DesignTables:
+    """The numbers of a design in the order of the generated code's tables.
 
-    Parameters
+    Attributes
     ----------
-    values : list of casadi.SX, non-empty
-    nu : float
-        Sharpness ``nu``, 1/state units.
-
-    Returns
-    -------
-    casadi.SX
-        ``(1/nu) ln(sum_j exp(nu a_j))`` in a form that does not overflow; a single value
-        is returned unchanged.
+    segments : tuple of ReachSegment
+        ``design.segments``, in time order.
+    windows : tuple of (int, Circumvent)
+        ``(bound, circumvent)`` sorted by window start (then design order); ``bound`` is
+        ``i`` for the lower bound of dimension ``i``, ``n + i`` for its upper bound.
+    bounds : tuple of float
+        ``[X; X-bar]`` (2n).
+    signs : tuple of float
+        +1 for the n lower bounds, -1 for the n upper ones.
     """
-    if len(values) == 1:
-        return values[0]
-    if len(values) == 2:
-        a, b = values
-        return ca.fmax(a, b) + ca.log1p(ca.exp(-nu * ca.fabs(a - b))) / nu
-    top = values[0]
-    for v in values[1:]:
-        top = ca.fmax(top, v)
-    total = 0
-    for v in values:
-        total = total + ca.exp(nu * (v - top))
-    return top + ca.log(total) / nu
+
+    segments: tuple
+    windows: tuple
+    bounds: tuple
+    signs: tuple
+
+    def members(self, bound: int) -> tuple:
+        """The circumvents on one bound, in table order."""
+        return tuple(c for b, c in self.windows if b == bound)
 
 
-def smooth_min(values: list, nu: float):
-    """Smooth minimum ``min~(a, b) = -max~(-a, -b)``; see :func:`smooth_max`."""
-    return -smooth_max([-v for v in values], nu)
+def design_tables(design: TubeDesign) -> DesignTables:
+    """The table order of a design's numbers (shared by the model and the generated code)."""
+    n = design.dimension
+    rows = []
+    for index, c in enumerate(design.circumvents):
+        bound = c.dimension if c.side == LOWER else n + c.dimension
+        rows.append((c.start, index, bound, c))
+    windows = tuple((bound, c) for _, _, bound, c in sorted(rows, key=lambda r: (r[0], r[1])))
+    return DesignTables(tuple(design.segments), windows,
+                        tuple(design.state_lower) + tuple(design.state_upper),
+                        (1.0,) * n + (-1.0,) * n)
 
 
-def segment_progress(segment: ReachSegment, t):
-    """Profile ``p`` of one reach segment as SX: 0 before ``start``, 1 from ``end`` on.
+def segment_rows(design: TubeDesign, segment) -> tuple:
+    """``(from, to)`` of a reach segment as 2n lists ``[lower; upper]``."""
+    return (list(segment.lower_from) + list(segment.upper_from),
+            list(segment.lower_to) + list(segment.upper_to))
 
-    ``"tanh"``: ``tanh((t - start) / (end - t))`` (eq. (4); only evaluated for
-    ``t < end``, with a denominator that stays finite in the branch not taken);
-    ``"smoothstep"``: ``tau^3 (10 - 15 tau + 6 tau^2)`` with ``tau`` clamped to ``[0, 1]``.
-    """
-    start, end = segment.start, segment.end
-    if segment.profile == TANH:
-        before = t < end
-        gap = ca.if_else(before, end - t, 1.0)
-        elapsed = t - start if start != 0.0 else t
-        return ca.if_else(before, ca.if_else(elapsed < 0.0, 0.0, ca.tanh(elapsed / gap)), 1.0)
-    if segment.profile != SMOOTHSTEP:
-        raise ValueError(f"unknown reach segment profile {segment.profile!r}")
-    tau = ca.fmin(ca.fmax((t - start) / (end - start), 0.0), 1.0)
-    return tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+
+def reach_tube_rates(design: TubeDesign, t) -> tuple:
+    """``rho`` and ``rho_dot`` (2n SX vectors ``[L; U]``) of eq. (4), piecewise over the
+    segments: the first segment whose ``end`` is after ``t`` (the last one after every end)."""
+    interpolate = P.interpolate(design.dimension)
+    interpolate_value = P.interpolate(design.dimension, False)
+
+    def on(segment):
+        # the value from the value-only pieces (the step's), the rate from the full ones
+        p, p_dot = P.progress(segment.profile)(t, segment.start, segment.end)
+        lo, hi = segment_rows(design, segment)
+        _, rate = interpolate(p, p_dot, ca.DM(lo), ca.DM(hi))
+        p_value = P.progress(segment.profile, False)(t, segment.start, segment.end)
+        return interpolate_value(p_value, ca.DM(lo), ca.DM(hi)), rate
+
+    rho, rho_dot = on(design.segments[-1])
+    for segment in reversed(design.segments[:-1]):
+        here, here_dot = on(segment)
+        sooner = t < segment.end
+        rho, rho_dot = ca.if_else(sooner, here, rho), ca.if_else(sooner, here_dot, rho_dot)
+    return rho, rho_dot
 
 
 def reach_tube(design: TubeDesign, t) -> tuple:
-    """``rho_L(t)``, ``rho_U(t)`` of eq. (4), piecewise over ``design.segments``, SX vectors of length n.
+    """``rho_L(t)``, ``rho_U(t)`` of eq. (4), SX vectors of length n."""
+    n = design.dimension
+    rho, _ = reach_tube_rates(design, t)
+    return rho[:n], rho[n:]
 
-    On the first segment whose ``end`` is after ``t`` (the last one after every end):
-    ``rho = from + (to - from) p``, ``p`` from :func:`segment_progress`.
+
+def circumvent_rates(design: TubeDesign, t) -> tuple:
+    """``beta`` and ``beta_dot`` (2n SX vectors ``[L; U]``) of eq. (9).
+
+    Per bound with several circumvents: ``top = max(0, y_j)``, ``fnu_init``, ``fnu_add``
+    over the circumvents in table order, ``fnu_finish``; with one: ``fnu_single``
+    (``F = y``); a bound without circumvent is the state space's bound.
     """
-    def on(segment):
-        s = segment_progress(segment, t)
-        lower = [(b - a) * s + a for a, b in zip(segment.lower_from, segment.lower_to)]
-        upper = [(b - a) * s + a for a, b in zip(segment.upper_from, segment.upper_to)]
-        return ca.vertcat(*lower), ca.vertcat(*upper)
-
-    rho_l, rho_u = on(design.segments[-1])
-    for segment in reversed(design.segments[:-1]):
-        here_l, here_u = on(segment)
-        sooner = t < segment.end
-        rho_l, rho_u = ca.if_else(sooner, here_l, rho_l), ca.if_else(sooner, here_u, rho_u)
-    return rho_l, rho_u
-
-
-def bump(t, center: float, radius: float, sharpness: float):
-    """``exp(-k (t-m)^2 / (r^2 - (t-m)^2))`` inside ``|t - m| < r``, 0 outside (eqs. (7)-(8))."""
-    d = t - center
-    inside = ca.fabs(d) < radius
-    # (r - |d|)(r + |d|), not r^2 - d^2: rounded separately from the test |d| < r, the
-    # latter can be exactly 0 at the window's edge in float32
-    denom = ca.if_else(inside, (radius - ca.fabs(d)) * (radius + ca.fabs(d)), 1.0)
-    return ca.if_else(inside, ca.exp(-sharpness * d**2 / denom), 0.0)
-
-
-def open_bump_sum(heights: list, nu: float):
-    """``F_nu(y) = (1/nu) ln(1 + sum_j (exp(nu y_j) - 1))`` of eq. (9) (as decided), SX.
-
-    Written ``M + (1/nu) ln(exp(-nu M) + sum_j (exp(nu (y_j - M)) - exp(-nu M)))``,
-    ``M = max(0, max_j y_j)``, which cannot overflow; a closed window (``y_j = 0``) adds
-    exactly 0; one argument is returned unchanged (``F = y``).
-
-    Parameters
-    ----------
-    heights : list of casadi.SX, non-empty
-        ``y_j = B^j b^j(t) >= 0``, state units.
-    nu : float
-        1/state units.
-    """
-    if len(heights) == 1:
-        return heights[0]
-    top = ca.SX(0.0)
-    for y in heights:
-        top = ca.fmax(top, y)
-    floor = ca.exp(-nu * top)
-    total = floor
-    for y in heights:
-        total = total + (ca.exp(nu * (y - top)) - floor)
-    return top + ca.log(total) / nu
+    tables = design_tables(design)
+    init, add, finish, single = P.fnu_pieces()
+    nu = design.smoothness
+    beta, beta_dot = [], []
+    for b, (bound, sign) in enumerate(zip(tables.bounds, tables.signs)):
+        members = tables.members(b)
+        if not members:
+            beta.append(ca.SX(bound))
+            beta_dot.append(ca.SX(0.0))
+            continue
+        bumps = [(P.bump(False)(t, c.start, c.end, c.center, c.radius, c.sharpness, c.height),
+                  P.bump()(t, c.start, c.end, c.center, c.radius, c.sharpness, c.height)[1])
+                 for c in members]
+        if len(members) == 1:
+            value, value_dot = single(bound, sign, *bumps[0])
+            beta.append(value)
+            beta_dot.append(value_dot)
+            continue
+        top = ca.SX(0.0)
+        for y, _ in bumps:
+            top = ca.fmax(top, y)
+        total, rate = init(top, nu)
+        for y, y_dot in bumps:
+            total, rate = add(total, rate, y, y_dot, top, nu)
+        value, value_dot = finish(bound, sign, top, total, rate, nu)
+        beta.append(value)
+        beta_dot.append(value_dot)
+    return ca.vertcat(*beta), ca.vertcat(*beta_dot)
 
 
 def circumvent(design: TubeDesign, t) -> tuple:
-    """Holistic circumvent ``beta_L(t)``, ``beta_U(t)`` of eq. (9), SX vectors of length n.
+    """Holistic circumvent ``beta_L(t)``, ``beta_U(t)`` of eq. (9), SX vectors of length n."""
+    n = design.dimension
+    beta, _ = circumvent_rates(design, t)
+    return beta[:n], beta[n:]
 
-    ``beta_L_i = X_i + F_nu(y)``, ``beta_U_i = X-bar_i - F_nu(y)``, ``y_j = B^j b^j(t)`` over
-    the circumvents on that bound (:func:`open_bump_sum`).
-    """
-    lower, upper = [], []
-    for i in range(design.dimension):
-        for side, out, bound in ((LOWER, lower, design.state_lower[i]),
-                                 (UPPER, upper, design.state_upper[i])):
-            members = design.circumvents_on(i, side)
-            if not members:
-                out.append(ca.SX(bound))
-                continue
-            heights = [c.height * bump(t, c.center, c.radius, c.sharpness) for c in members]
-            total = open_bump_sum(heights, design.smoothness)
-            out.append(bound + total if side == LOWER else bound - total)
-    return ca.vertcat(*lower), ca.vertcat(*upper)
+
+def conflict_and_trigger(design: TubeDesign, t) -> tuple:
+    """``psi`` (eq. (11), ``[beta_U - rho_L; rho_U - beta_L]``) and ``theta`` at ``t``."""
+    rho, _ = reach_tube_rates(design, t)
+    beta, _ = circumvent_rates(design, t)
+    return P.conflict(design.dimension)(rho, beta, design.theta0, design.mu)
 
 
 def conflict_distance(design: TubeDesign, t):
     """``psi = [beta_U - rho_L, rho_U - beta_L]`` of eq. (11), SX vector of length 2n."""
-    rho_l, rho_u = reach_tube(design, t)
-    beta_l, beta_u = circumvent(design, t)
-    return ca.vertcat(beta_u - rho_l, rho_u - beta_l)
+    return conflict_and_trigger(design, t)[0]
 
 
 def trigger(design: TubeDesign, psi):
     """``theta = theta0 (1 - tanh(psi - mu))`` of eq. (11) (sign approximated by tanh)."""
-    return design.theta0 * (1.0 - ca.tanh(psi - design.mu))
+    return P.trigger_expression(psi, design.theta0, design.mu)
 
 
 def adaptive_law(design: TubeDesign, t, alpha):
     """``alpha_dot = theta / (psi + alpha)^2 - kappa alpha``, eq. (11), SX vector of length 2n."""
-    psi = conflict_distance(design, t)
-    return trigger(design, psi) / (psi + alpha) ** 2 - design.kappa * alpha
+    psi, theta = conflict_and_trigger(design, t)
+    return P.alpha_rate(design.dimension)(alpha, psi, theta, design.kappa)
 
 
 def adaptive_tube(design: TubeDesign, t, alpha) -> tuple:
     """``gamma_L``, ``gamma_U`` of eq. (10), SX vectors of length n."""
     n = design.dimension
-    rho_l, rho_u = reach_tube(design, t)
-    beta_l, beta_u = circumvent(design, t)
+    rho, _ = reach_tube_rates(design, t)
+    beta, _ = circumvent_rates(design, t)
+    cand = P.candidates(n)[0](rho, alpha)
+    smooth_max, smooth_min = P.smooth_pieces()[1], P.smooth_pieces()[3]
     nu = design.smoothness
-    gamma_l = ca.vertcat(*[smooth_max([rho_l[i] - alpha[i], beta_l[i]], nu) for i in range(n)])
-    gamma_u = ca.vertcat(*[smooth_min([rho_u[i] + alpha[n + i], beta_u[i]], nu)
-                           for i in range(n)])
+    gamma_l = ca.vertcat(*[smooth_max(cand[i], beta[i], nu) for i in range(n)])
+    gamma_u = ca.vertcat(*[smooth_min(cand[n + i], beta[n + i], nu) for i in range(n)])
     return gamma_l, gamma_u
+
+
+def adaptive_tube_rates(design: TubeDesign, t, alpha) -> tuple:
+    """Total time derivatives ``gamma_L_dot``, ``gamma_U_dot`` (alpha moving by (11))."""
+    n = design.dimension
+    rho, rho_dot = reach_tube_rates(design, t)
+    beta, beta_dot = circumvent_rates(design, t)
+    psi, theta = P.conflict(n)(rho, beta, design.theta0, design.mu)
+    alpha_dot = P.alpha_rate(n)(alpha, psi, theta, design.kappa)
+    cand_fn, rates_fn = P.candidates(n)
+    cand, cand_dot = cand_fn(rho, alpha), rates_fn(rho_dot, alpha_dot)
+    max_rate, min_rate = P.smooth_pieces()[4], P.smooth_pieces()[5]
+    nu = design.smoothness
+    rate_l = ca.vertcat(*[max_rate(cand[i], beta[i], cand_dot[i], beta_dot[i], nu)
+                          for i in range(n)])
+    rate_u = ca.vertcat(*[min_rate(cand[n + i], beta[n + i], cand_dot[n + i], beta_dot[n + i],
+                                   nu) for i in range(n)])
+    return rate_l, rate_u
 
 
 def implicit_alpha_update(alpha, psi, theta, dt, kappa: float,
@@ -199,10 +218,12 @@ def implicit_alpha_update(alpha, psi, theta, dt, kappa: float,
     Component-wise (the Newton system is diagonal). The residual
     ``g(a) = (1 + kappa dt) a - alpha - dt theta / (psi + a)^2`` is increasing and concave
     on ``(-psi, inf)``, so Newton's method started at a point where ``g <= 0`` increases
-    monotonically to the unique root without leaving the domain. The start
-    ``max(alpha / c, -psi + delta)``, ``c = 1 + kappa dt``, with
-    ``delta = min((A / 2c)^(1/3), sqrt(A / 2Q))``, ``A = dt theta``,
-    ``Q = max(-c psi - alpha, 0)``, has ``g <= 0`` (proof in the README).
+    monotonically to the unique root without leaving the domain. The start is
+    ``alpha / c`` when it is far enough from the pole, else the root start; then
+    ``iterations`` Newton iterations with one division each
+    (:func:`stt_codegen.tube.pieces.newton_pieces`). The generated code runs the same
+    pieces (the root start only when needed, the iterations in a loop that stops at a
+    fixed point), so it computes exactly this.
 
     Parameters
     ----------
@@ -217,32 +238,16 @@ def implicit_alpha_update(alpha, psi, theta, dt, kappa: float,
     -------
     casadi.SX, shape (m, 1)
     """
-    c = 1.0 + kappa * dt
-    a_coef = dt * theta
-    q = ca.fmax(-c * psi - alpha, 0.0)
-    delta = ca.fmin((a_coef / (2.0 * c)) ** (1.0 / 3.0),
-                    ca.sqrt(a_coef / (2.0 * ca.fmax(q, NEWTON_TINY))))
-    a = ca.fmax(alpha / c, -psi + delta)
+    a0, c, a_coef, root = P.newton_start_expression(alpha, psi, theta, dt, kappa)
+    a = ca.if_else(root, P.newton_root_start_expression(alpha, psi, c, a_coef), a0)
     for _ in range(iterations):
-        z = psi + a
-        residual = c * a - alpha - a_coef / z**2
-        slope = c + 2.0 * a_coef / z**3
-        a = a - residual / slope
+        a = P.newton_iteration_expression(a, alpha, psi, c, a_coef)
     return a
 
 
 def controller_law(design: TubeDesign, x, gamma_l, gamma_u) -> tuple:
     """Deployed law (13) with clamps: returns ``(u, inside)`` (see :mod:`stt_codegen.tube.parameters`)."""
-    gamma_d = gamma_u - gamma_l
-    width = ca.fmax(gamma_d, GAMMA_D_MIN)
-    e = (2.0 * x - (gamma_u + gamma_l)) / width
-    inside = 1.0
-    for i in range(design.dimension):
-        inside = ca.logic_and(inside, ca.logic_and(ca.fabs(e[i]) < 1.0, gamma_d[i] > 0.0))
-    e_c = ca.fmin(ca.fmax(e, -E_MAX), E_MAX)
-    epsilon = ca.log((1.0 + e_c) / (1.0 - e_c))
-    xi = 4.0 / (width * (1.0 - e_c**2))
-    return -design.gain * xi * epsilon, inside
+    return P.law_expression(x, gamma_l, gamma_u, design.gain, design.dimension)
 
 
 @dataclass(frozen=True)
@@ -281,24 +286,21 @@ def build_model(design: TubeDesign) -> TubeModel:
     alpha = ca.SX.sym("alpha", 2 * n)
     fns: dict[str, ca.Function] = {}
 
-    rho_l, rho_u = reach_tube(design, t)
+    rho, rho_dot = reach_tube_rates(design, t)
     fns["reach_tube"] = ca.Function(
-        "reach_tube", [t], [rho_l, rho_u, ca.jacobian(rho_l, t), ca.jacobian(rho_u, t)],
+        "reach_tube", [t], [rho[:n], rho[n:], rho_dot[:n], rho_dot[n:]],
         ["t"], ["rho_L", "rho_U", "rho_L_dot", "rho_U_dot"])
 
-    beta_l, beta_u = circumvent(design, t)
+    beta, beta_dot = circumvent_rates(design, t)
     fns["circumvent"] = ca.Function(
-        "circumvent", [t], [beta_l, beta_u, ca.jacobian(beta_l, t), ca.jacobian(beta_u, t)],
+        "circumvent", [t], [beta[:n], beta[n:], beta_dot[:n], beta_dot[n:]],
         ["t"], ["beta_L", "beta_U", "beta_L_dot", "beta_U_dot"])
 
     alpha_dot = adaptive_law(design, t, alpha)
     gamma_l, gamma_u = adaptive_tube(design, t, alpha)
-
-    def total_rate(expr):
-        return ca.jacobian(expr, t) + ca.mtimes(ca.jacobian(expr, alpha), alpha_dot)
-
+    rate_l, rate_u = adaptive_tube_rates(design, t, alpha)
     fns["tube"] = ca.Function(
-        "tube", [t, alpha], [gamma_l, gamma_u, total_rate(gamma_l), total_rate(gamma_u)],
+        "tube", [t, alpha], [gamma_l, gamma_u, rate_l, rate_u],
         ["t", "alpha"], ["gamma_L", "gamma_U", "gamma_L_dot", "gamma_U_dot"])
 
     fns["adaptive_law"] = ca.Function(
@@ -317,9 +319,8 @@ def build_model(design: TubeDesign) -> TubeModel:
     fns["control"] = ca.Function("control", [x, t, alpha], [-design.gain * xi * epsilon],
                                  ["x", "t", "alpha"], ["u"])
 
-    psi_next = conflict_distance(design, t + dt)
-    alpha_next = implicit_alpha_update(alpha, psi_next, trigger(design, psi_next), dt,
-                                       design.kappa)
+    psi_next, theta_next = conflict_and_trigger(design, P.later()(t, dt))
+    alpha_next = implicit_alpha_update(alpha, psi_next, theta_next, dt, design.kappa)
     fns["alpha_step"] = ca.Function("alpha_step", [t, dt, alpha], [alpha_next],
                                     ["t", "dt", "alpha"], ["alpha_next"])
 

@@ -3,2719 +3,1462 @@
  * "omnirobot-s1" (SHA-256 d10c8028dd9588e1f368a835014c7bb2cd8e643fc8f661af3185c6fdb55968a7), precision single.
  */
 /*
- * Implementation of omnirobot_s1.h. The bodies body_* and the casadi_* helpers are CasADi's
- * C code generator output (avoid_stack=False, casadi_int=int, casadi_real=double, codegen_scalars=False, cpp=False, include_math=True, indent=2, main=False, mex=False, verbose=False, verbose_runtime=False, with_export=False, with_header=False, with_import=False, with_mem=False), reduced to static
- * functions and rewritten to float maths functions and float
- * literals; the typed API below checks inputs and calls them.
+ * Implementation of omnirobot_s1.h. The functions body_* are printed by the project's C
+ * printer (stt_codegen.codegen.emit.CPrinter, float) from the CasADi SX Functions of
+ * the model, one statement per instruction of CasADi's virtual machine; the API below
+ * checks inputs, calls them and checks their results.
  */
 #include <math.h>
 #include <stddef.h>
 
 #include "omnirobot_s1.h"
 
-#define casadi_real omnirobot_s1_real
-#define casadi_int int
-
-static casadi_real casadi_fmax(casadi_real x, casadi_real y) {
-/* Pre-c99 compatibility */
-#if __STDC_VERSION__ < 199901L
-  return x>y ? x : y;
-#else
-  return fmaxf(x, y);
+#ifdef __FAST_MATH__
+#error "omnirobot_s1.c must not be compiled with -ffast-math (or -Ofast): it removes the isfinite() input checks and changes the rounding the tolerances assume"
 #endif
+
+/* ------------------------------------------------------------- spec tables */
+
+/* Tube parameters. */
+typedef struct {
+  omnirobot_s1_real smoothness; /* nu of the smooth max/min and of F_nu (eqs. (9)-(10)), 1/state units */
+  omnirobot_s1_real theta0; /* theta_0 of the trigger (11) */
+  omnirobot_s1_real mu; /* mu of the trigger (11), state units */
+  omnirobot_s1_real kappa; /* kappa of the adaptive law (11), 1/s */
+  omnirobot_s1_real gain; /* k of the control law (13) */
+} omnirobot_s1_parameters;
+
+static const omnirobot_s1_parameters OMNIROBOT_S1_PARAMETERS = {
+  50.0f, /* smoothness */
+  0.01f, /* theta0 */
+  1.0f, /* mu */
+  5.0f, /* kappa */
+  0.18168809110361742f /* gain */
+};
+
+/* State-space bounds [X; X-bar], the sign of eq. (9) on each (+1 lower, -1 upper) and the
+   number of circumvents acting on each. */
+static const omnirobot_s1_real OMNIROBOT_S1_BOUND[OMNIROBOT_S1_N_ALPHA] = { 0.0f, 0.0f, -1.2f, 5.0f, 5.0f, 1.2f };
+static const omnirobot_s1_real OMNIROBOT_S1_SIGN[OMNIROBOT_S1_N_ALPHA] = { 1.0f, 1.0f, 1.0f, -1.0f, -1.0f, -1.0f };
+static const int OMNIROBOT_S1_MEMBERS[OMNIROBOT_S1_N_ALPHA] = { 0, 0, 0, 0, 1, 0 };
+
+/* Reach tube (eq. (4)), one row per segment: rho = from + (to - from) p(t) on
+   [start, end]; profile 0 = tanh (eq. (4)), 1 = smoothstep (quintic). Rows: [L; U]. */
+typedef struct {
+  omnirobot_s1_real start;
+  omnirobot_s1_real end;
+  int profile;
+  omnirobot_s1_real from[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real to[OMNIROBOT_S1_N_ALPHA];
+} omnirobot_s1_segment;
+
+#define OMNIROBOT_S1_N_SEGMENTS 1
+static const omnirobot_s1_segment OMNIROBOT_S1_SEGMENTS[OMNIROBOT_S1_N_SEGMENTS] = {
+  { 0.0f, 9.0f, 0, { 0.04999999999999999f, 4.55f, -0.05f, 0.45f, 4.95f, 0.05f }, { 4.55f, 4.55f, -0.5f, 4.95f, 4.95f, 0.5f } }
+};
+
+/* Circumvents (eqs. (7)-(9)), one row per window, sorted by start: window (start, end),
+   center m, radius r, sharpness k, height B, running maximum of the ends (to find the open
+   windows), bound index (i: lower bound of dimension i, N + i: upper bound). */
+typedef struct {
+  omnirobot_s1_real start;
+  omnirobot_s1_real end;
+  omnirobot_s1_real center;
+  omnirobot_s1_real radius;
+  omnirobot_s1_real sharpness;
+  omnirobot_s1_real height;
+  omnirobot_s1_real max_end;
+  int bound;
+} omnirobot_s1_window;
+
+#define OMNIROBOT_S1_N_WINDOWS 1
+/* most windows open at one time (size of the work arrays) */
+#define OMNIROBOT_S1_MAX_OPEN 1
+static const omnirobot_s1_window OMNIROBOT_S1_WINDOWS[OMNIROBOT_S1_N_WINDOWS] = {
+  { 0.3206386657002722f, 3.4666055224840955f, 1.893622094092184f, 1.5729834283919115f, 0.1f, 1.2000000000000002f, 3.4666055224840955f, 4 } /* obstacle 0 */
+};
+
+/* ------------------------------------------------------------- emitted bodies */
+
+/* CasADi Function 'progress_tanh_value': 22 instructions. */
+static void body_progress_tanh_value(const omnirobot_s1_real* t, const omnirobot_s1_real* start, const omnirobot_s1_real* end, omnirobot_s1_real* p) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  w0 = t[0];
+  w1 = end[0];
+  w2 = (w0 < w1) ? 1.0f : 0.0f;
+  w3 = start[0];
+  w3 = w0 - w3;
+  w4 = 0.0f;
+  w4 = (w3 < w4) ? 1.0f : 0.0f;
+  w4 = (w4 == 0.0f) ? 1.0f : 0.0f;
+  w1 = w1 - w0;
+  w1 = (w2 != 0.0f) ? w1 : 0.0f;
+  w0 = (w2 == 0.0f) ? 1.0f : 0.0f;
+  w5 = 1.0f;
+  w0 = (w0 != 0.0f) ? w5 : 0.0f;
+  w1 = w1 + w0;
+  w3 = w3 / w1;
+  w3 = tanhf(w3);
+  w4 = (w4 != 0.0f) ? w3 : 0.0f;
+  w4 = (w2 != 0.0f) ? w4 : 0.0f;
+  w2 = (w2 == 0.0f) ? 1.0f : 0.0f;
+  w2 = (w2 != 0.0f) ? w5 : 0.0f;
+  w4 = w4 + w2;
+  p[0] = w4;
 }
 
-static casadi_real casadi_fabs(casadi_real x) {
-/* Pre-c99 compatibility */
-#if __STDC_VERSION__ < 199901L
-  return x>0 ? x : -x;
-#else
-  return fabsf(x);
-#endif
+/* CasADi Function 'progress_tanh': 32 instructions. */
+static void body_progress_tanh(const omnirobot_s1_real* t, const omnirobot_s1_real* start, const omnirobot_s1_real* end, omnirobot_s1_real* p, omnirobot_s1_real* p_dot) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  w0 = t[0];
+  w1 = end[0];
+  w2 = (w0 < w1) ? 1.0f : 0.0f;
+  w3 = start[0];
+  w3 = w0 - w3;
+  w4 = 0.0f;
+  w4 = (w3 < w4) ? 1.0f : 0.0f;
+  w4 = (w4 == 0.0f) ? 1.0f : 0.0f;
+  w1 = w1 - w0;
+  w1 = (w2 != 0.0f) ? w1 : 0.0f;
+  w0 = (w2 == 0.0f) ? 1.0f : 0.0f;
+  w5 = 1.0f;
+  w0 = (w0 != 0.0f) ? w5 : 0.0f;
+  w1 = w1 + w0;
+  w3 = w3 / w1;
+  w0 = tanhf(w3);
+  w6 = (w4 != 0.0f) ? w0 : 0.0f;
+  w6 = (w2 != 0.0f) ? w6 : 0.0f;
+  w7 = (w2 == 0.0f) ? 1.0f : 0.0f;
+  w7 = (w7 != 0.0f) ? w5 : 0.0f;
+  w6 = w6 + w7;
+  p[0] = w6;
+  w0 = w0 * w0;
+  w5 = w5 - w0;
+  w0 = 1.0f / w1;
+  w3 = w3 / w1;
+  w3 = (w2 != 0.0f) ? w3 : 0.0f;
+  w0 = w0 + w3;
+  w5 = w5 * w0;
+  w4 = (w4 != 0.0f) ? w5 : 0.0f;
+  w2 = (w2 != 0.0f) ? w4 : 0.0f;
+  p_dot[0] = w2;
 }
 
-static casadi_real casadi_log1p(casadi_real x) {
-/* Pre-c99 compatibility */
-#if __STDC_VERSION__ < 199901L
-  return logf(1+x);
-#else
-  return log1pf(x);
-#endif
+/* CasADi Function 'interpolate_value': 37 instructions. */
+static void body_interpolate_value(const omnirobot_s1_real* p, const omnirobot_s1_real* from, const omnirobot_s1_real* to, omnirobot_s1_real* rho) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  w0 = to[0];
+  w1 = from[0];
+  w0 = w0 - w1;
+  w2 = p[0];
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[0] = w0;
+  w0 = to[1];
+  w1 = from[1];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[1] = w0;
+  w0 = to[2];
+  w1 = from[2];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[2] = w0;
+  w0 = to[3];
+  w1 = from[3];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[3] = w0;
+  w0 = to[4];
+  w1 = from[4];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[4] = w0;
+  w0 = to[5];
+  w1 = from[5];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[5] = w0;
 }
 
-static casadi_real casadi_sq(casadi_real x) { return x*x;}
-
-static casadi_real casadi_sign(casadi_real x) { return x<0 ? -1 : x>0 ? 1 : x;}
-
-static casadi_real casadi_fmin(casadi_real x, casadi_real y) {
-/* Pre-c99 compatibility */
-#if __STDC_VERSION__ < 199901L
-  return x<y ? x : y;
-#else
-  return fminf(x, y);
-#endif
+/* CasADi Function 'interpolate': 56 instructions. */
+static void body_interpolate(const omnirobot_s1_real* p, const omnirobot_s1_real* p_dot, const omnirobot_s1_real* from, const omnirobot_s1_real* to, omnirobot_s1_real* rho, omnirobot_s1_real* rho_dot) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  omnirobot_s1_real w8;
+  omnirobot_s1_real w9;
+  omnirobot_s1_real w10;
+  omnirobot_s1_real w11;
+  omnirobot_s1_real w12;
+  omnirobot_s1_real w13;
+  w0 = to[0];
+  w1 = from[0];
+  w2 = w0 - w1;
+  w3 = p[0];
+  w2 = w2 * w3;
+  w2 = w2 + w1;
+  rho[0] = w2;
+  w2 = to[1];
+  w4 = from[1];
+  w5 = w2 - w4;
+  w5 = w5 * w3;
+  w5 = w5 + w4;
+  rho[1] = w5;
+  w5 = to[2];
+  w6 = from[2];
+  w7 = w5 - w6;
+  w7 = w7 * w3;
+  w7 = w7 + w6;
+  rho[2] = w7;
+  w7 = to[3];
+  w8 = from[3];
+  w9 = w7 - w8;
+  w9 = w9 * w3;
+  w9 = w9 + w8;
+  rho[3] = w9;
+  w9 = to[4];
+  w10 = from[4];
+  w11 = w9 - w10;
+  w11 = w11 * w3;
+  w11 = w11 + w10;
+  rho[4] = w11;
+  w11 = to[5];
+  w12 = from[5];
+  w13 = w11 - w12;
+  w13 = w13 * w3;
+  w13 = w13 + w12;
+  rho[5] = w13;
+  w0 = w0 - w1;
+  w1 = p_dot[0];
+  w0 = w0 * w1;
+  rho_dot[0] = w0;
+  w2 = w2 - w4;
+  w2 = w2 * w1;
+  rho_dot[1] = w2;
+  w5 = w5 - w6;
+  w5 = w5 * w1;
+  rho_dot[2] = w5;
+  w7 = w7 - w8;
+  w7 = w7 * w1;
+  rho_dot[3] = w7;
+  w9 = w9 - w10;
+  w9 = w9 * w1;
+  rho_dot[4] = w9;
+  w11 = w11 - w12;
+  w11 = w11 * w1;
+  rho_dot[5] = w11;
 }
 
-/* tube:(t,alpha[6])->(gamma_L[3],gamma_U[3],gamma_L_dot[3],gamma_U_dot[3]) */
-static int body_tube(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  (void)iw; (void)w; (void)mem;
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
-  casadi_real a36, a37, a38, a39, a40, a41, a42, a43, a44, a45, a46, a47;
-  casadi_real a48, a49, a50, a51, a52, a53, a54, a55, a56, a57, a58;
-  a00=4.5000000000000000e+00f;
-  a01=arg[0]? arg[0][0] : 0;
-  a02=9.f;
-  a03=(a01<a02);
-  a04=(a02-a01);
-  a04=(a03!=0?a04:0);
-  a05=(a03==0);
-  a06=1.f;
-  a05=(a05!=0?a06:0);
-  a04=(a04+a05);
-  a05=(a01/a04);
-  a07=tanhf(a05);
-  a08=(a03!=0?a07:0);
-  a09=(a03==0);
-  a09=(a09!=0?a06:0);
-  a08=(a08+a09);
-  a09=(a00*a08);
-  a10=4.9999999999999989e-02f;
-  a09=(a09+a10);
-  a11=arg[1]? arg[1][0] : 0;
-  a09=(a09-a11);
-  a12=0.f;
-  a13=casadi_fmax(a09,a12);
-  a14=-50.f;
-  a15=casadi_fabs(a09);
-  a15=(a14*a15);
-  a15=expf(a15);
-  a16=casadi_log1p(a15);
-  a17=50.f;
-  a16=(a16/a17);
-  a13=(a13+a16);
-  if (res[0]!=0) res[0][0]=a13;
-  a13=4.5499999999999998e+00f;
-  a16=arg[1]? arg[1][1] : 0;
-  a18=(a13-a16);
-  a19=casadi_fmax(a18,a12);
-  a20=casadi_fabs(a18);
-  a20=(a14*a20);
-  a20=expf(a20);
-  a21=casadi_log1p(a20);
-  a21=(a21/a17);
-  a19=(a19+a21);
-  if (res[0]!=0) res[0][1]=a19;
-  a19=-4.5000000000000001e-01f;
-  a21=(a19*a08);
-  a22=-5.0000000000000003e-02f;
-  a21=(a21+a22);
-  a23=arg[1]? arg[1][2] : 0;
-  a21=(a21-a23);
-  a24=-1.2000000000000000e+00f;
-  a25=casadi_fmax(a21,a24);
-  a26=(a21-a24);
-  a27=casadi_fabs(a26);
-  a27=(a14*a27);
-  a27=expf(a27);
-  a28=casadi_log1p(a27);
-  a28=(a28/a17);
-  a25=(a25+a28);
-  if (res[0]!=0) res[0][2]=a25;
-  a25=(a00*a08);
-  a28=4.5000000000000001e-01f;
-  a25=(a25+a28);
-  a29=arg[1]? arg[1][3] : 0;
-  a25=(a25+a29);
-  a30=(-a25);
-  a31=-5.f;
-  a32=casadi_fmax(a30,a31);
-  a25=(a25+a31);
-  a33=casadi_fabs(a25);
-  a33=(a14*a33);
-  a33=expf(a33);
-  a34=casadi_log1p(a33);
-  a34=(a34/a17);
-  a32=(a32+a34);
-  a32=(-a32);
-  if (res[1]!=0) res[1][0]=a32;
-  a32=4.9500000000000002e+00f;
-  a34=arg[1]? arg[1][4] : 0;
-  a35=(a32+a34);
-  a36=(-a35);
-  a37=5.f;
-  a38=1.8936220940921840e+00f;
-  a39=(a01-a38);
-  a40=casadi_fabs(a39);
-  a41=1.5729834283919115e+00f;
-  a40=(a40<a41);
-  a42=-1.2000000000000002e+00f;
-  a43=-1.0000000000000001e-01f;
-  a44=casadi_sq(a39);
-  a44=(a43*a44);
-  a45=casadi_fabs(a39);
-  a45=(a41-a45);
-  a46=casadi_fabs(a39);
-  a46=(a41+a46);
-  a47=(a45*a46);
-  a47=(a40!=0?a47:0);
-  a48=(a40==0);
-  a48=(a48!=0?a06:0);
-  a47=(a47+a48);
-  a44=(a44/a47);
-  a48=expf(a44);
-  a49=(a42*a48);
-  a49=(a40!=0?a49:0);
-  a49=(a37+a49);
-  a50=(-a49);
-  a51=casadi_fmax(a36,a50);
-  a49=(a49-a35);
-  a35=casadi_fabs(a49);
-  a35=(a14*a35);
-  a35=expf(a35);
-  a52=casadi_log1p(a35);
-  a52=(a52/a17);
-  a51=(a51+a52);
-  a51=(-a51);
-  if (res[1]!=0) res[1][1]=a51;
-  a08=(a28*a08);
-  a51=5.0000000000000003e-02f;
-  a08=(a08+a51);
-  a52=arg[1]? arg[1][5] : 0;
-  a08=(a08+a52);
-  a53=(-a08);
-  a54=casadi_fmax(a53,a24);
-  a08=(a08+a24);
-  a55=casadi_fabs(a08);
-  a55=(a14*a55);
-  a55=expf(a55);
-  a56=casadi_log1p(a55);
-  a56=(a56/a17);
-  a54=(a54+a56);
-  a54=(-a54);
-  if (res[1]!=0) res[1][2]=a54;
-  a54=(a12<=a09);
-  a56=(a09<=a12);
-  a56=(a54+a56);
-  a54=(a54/a56);
-  a56=casadi_sq(a07);
-  a56=(a06-a56);
-  a17=(1.f/a04);
-  a57=(a05/a04);
-  a57=(a03!=0?a57:0);
-  a17=(a17+a57);
-  a56=(a56*a17);
-  a17=(a00*a56);
-  a54=(a54*a17);
-  a57=2.0000000000000000e-02f;
-  a58=casadi_sign(a09);
-  a58=(a58*a17);
-  a58=(a14*a58);
-  a58=(a15*a58);
-  a17=(a06+a15);
-  a58=(a58/a17);
-  a58=(a57*a58);
-  a54=(a54+a58);
-  a54=(a03!=0?a54:0);
-  a58=(a12<=a09);
-  a17=(a09<=a12);
-  a17=(a58+a17);
-  a58=(a58/a17);
-  a09=casadi_sign(a09);
-  a09=(a14*a09);
-  a09=(a15*a09);
-  a15=(a06+a15);
-  a09=(a09/a15);
-  a09=(a57*a09);
-  a58=(a58+a09);
-  a09=1.0000000000000000e-02f;
-  a15=(a01<a02);
-  a02=(a02-a01);
-  a02=(a15!=0?a02:0);
-  a17=(a15==0);
-  a17=(a17!=0?a06:0);
-  a02=(a02+a17);
-  a02=(a01/a02);
-  a02=tanhf(a02);
-  a02=(a15!=0?a02:0);
-  a15=(a15==0);
-  a15=(a15!=0?a06:0);
-  a02=(a02+a15);
-  a15=(a00*a02);
-  a15=(a15+a10);
-  a15=(a37-a15);
-  a10=(a15-a06);
-  a10=tanhf(a10);
-  a10=(a06-a10);
-  a10=(a09*a10);
-  a15=(a15+a11);
-  a15=casadi_sq(a15);
-  a10=(a10/a15);
-  a11=(a37*a11);
-  a10=(a10-a11);
-  a58=(a58*a10);
-  a54=(a54-a58);
-  if (res[2]!=0) res[2][0]=a54;
-  a54=(a12<=a18);
-  a12=(a18<=a12);
-  a12=(a54+a12);
-  a54=(a54/a12);
-  a18=casadi_sign(a18);
-  a18=(a14*a18);
-  a18=(a20*a18);
-  a20=(a06+a20);
-  a18=(a18/a20);
-  a18=(a57*a18);
-  a54=(a54+a18);
-  a01=(a01-a38);
-  a38=casadi_fabs(a01);
-  a38=(a38<a41);
-  a18=casadi_sq(a01);
-  a43=(a43*a18);
-  a18=casadi_fabs(a01);
-  a18=(a41-a18);
-  a01=casadi_fabs(a01);
-  a41=(a41+a01);
-  a18=(a18*a41);
-  a18=(a38!=0?a18:0);
-  a41=(a38==0);
-  a41=(a41!=0?a06:0);
-  a18=(a18+a41);
-  a43=(a43/a18);
-  a43=expf(a43);
-  a43=(a42*a43);
-  a38=(a38!=0?a43:0);
-  a38=(a37+a38);
-  a38=(a38-a13);
-  a13=(a38-a06);
-  a13=tanhf(a13);
-  a13=(a06-a13);
-  a13=(a09*a13);
-  a38=(a38+a16);
-  a38=casadi_sq(a38);
-  a13=(a13/a38);
-  a16=(a37*a16);
-  a13=(a13-a16);
-  a54=(a54*a13);
-  a54=(-a54);
-  if (res[2]!=0) res[2][1]=a54;
-  a54=(a24<=a21);
-  a13=(a21<=a24);
-  a13=(a54+a13);
-  a54=(a54/a13);
-  a56=(a19*a56);
-  a54=(a54*a56);
-  a13=casadi_sign(a26);
-  a13=(a13*a56);
-  a13=(a14*a13);
-  a13=(a27*a13);
-  a56=(a06+a27);
-  a13=(a13/a56);
-  a13=(a57*a13);
-  a54=(a54+a13);
-  a54=(a03!=0?a54:0);
-  a13=(a24<=a21);
-  a21=(a21<=a24);
-  a21=(a13+a21);
-  a13=(a13/a21);
-  a26=casadi_sign(a26);
-  a26=(a14*a26);
-  a26=(a27*a26);
-  a27=(a06+a27);
-  a26=(a26/a27);
-  a26=(a57*a26);
-  a13=(a13+a26);
-  a26=1.2000000000000000e+00f;
-  a19=(a19*a02);
-  a19=(a19+a22);
-  a26=(a26-a19);
-  a19=(a26-a06);
-  a19=tanhf(a19);
-  a19=(a06-a19);
-  a19=(a09*a19);
-  a26=(a26+a23);
-  a26=casadi_sq(a26);
-  a19=(a19/a26);
-  a23=(a37*a23);
-  a19=(a19-a23);
-  a13=(a13*a19);
-  a54=(a54-a13);
-  if (res[2]!=0) res[2][2]=a54;
-  a54=casadi_sign(a25);
-  a07=casadi_sq(a07);
-  a07=(a06-a07);
-  a13=(1.f/a04);
-  a05=(a05/a04);
-  a05=(a03!=0?a05:0);
-  a13=(a13+a05);
-  a07=(a07*a13);
-  a13=(a00*a07);
-  a54=(a54*a13);
-  a54=(a14*a54);
-  a54=(a33*a54);
-  a05=(a06+a33);
-  a54=(a54/a05);
-  a54=(a57*a54);
-  a05=(a31<=a30);
-  a04=(a30<=a31);
-  a04=(a05+a04);
-  a05=(a05/a04);
-  a05=(a05*a13);
-  a54=(a54-a05);
-  a54=(-a54);
-  a54=(a03!=0?a54:0);
-  a25=casadi_sign(a25);
-  a25=(a14*a25);
-  a25=(a33*a25);
-  a33=(a06+a33);
-  a25=(a25/a33);
-  a25=(a57*a25);
-  a33=(a31<=a30);
-  a30=(a30<=a31);
-  a30=(a33+a30);
-  a33=(a33/a30);
-  a25=(a25-a33);
-  a00=(a00*a02);
-  a00=(a00+a28);
-  a33=(a00-a06);
-  a33=tanhf(a33);
-  a33=(a06-a33);
-  a33=(a09*a33);
-  a00=(a00+a29);
-  a00=casadi_sq(a00);
-  a33=(a33/a00);
-  a29=(a37*a29);
-  a33=(a33-a29);
-  a25=(a25*a33);
-  a54=(a54-a25);
-  if (res[3]!=0) res[3][0]=a54;
-  a54=casadi_sign(a49);
-  a25=-2.0000000000000001e-01f;
-  a25=(a25*a39);
-  a25=(a25/a47);
-  a44=(a44/a47);
-  a47=casadi_sign(a39);
-  a45=(a45*a47);
-  a39=casadi_sign(a39);
-  a46=(a46*a39);
-  a45=(a45-a46);
-  a44=(a44*a45);
-  a44=(-a44);
-  a44=(a40!=0?a44:0);
-  a25=(a25+a44);
-  a48=(a48*a25);
-  a42=(a42*a48);
-  a54=(a54*a42);
-  a54=(a14*a54);
-  a54=(a35*a54);
-  a48=(a06+a35);
-  a54=(a54/a48);
-  a54=(a57*a54);
-  a48=(a36<=a50);
-  a25=(a50<=a36);
-  a25=(a25+a48);
-  a48=(a48/a25);
-  a48=(a48*a42);
-  a54=(a54-a48);
-  a54=(-a54);
-  a40=(a40!=0?a54:0);
-  a54=(a50<=a36);
-  a36=(a36<=a50);
-  a36=(a54+a36);
-  a54=(a54/a36);
-  a49=casadi_sign(a49);
-  a49=(a14*a49);
-  a49=(a35*a49);
-  a35=(a06+a35);
-  a49=(a49/a35);
-  a49=(a57*a49);
-  a54=(a54+a49);
-  a49=7.4121228125278996e-06f;
-  a32=(a32+a34);
-  a32=casadi_sq(a32);
-  a49=(a49/a32);
-  a34=(a37*a34);
-  a49=(a49-a34);
-  a54=(a54*a49);
-  a40=(a40+a54);
-  if (res[3]!=0) res[3][1]=a40;
-  a40=casadi_sign(a08);
-  a07=(a28*a07);
-  a40=(a40*a07);
-  a40=(a14*a40);
-  a40=(a55*a40);
-  a54=(a06+a55);
-  a40=(a40/a54);
-  a40=(a57*a40);
-  a54=(a24<=a53);
-  a49=(a53<=a24);
-  a49=(a54+a49);
-  a54=(a54/a49);
-  a54=(a54*a07);
-  a40=(a40-a54);
-  a40=(-a40);
-  a03=(a03!=0?a40:0);
-  a08=casadi_sign(a08);
-  a14=(a14*a08);
-  a14=(a55*a14);
-  a55=(a06+a55);
-  a14=(a14/a55);
-  a57=(a57*a14);
-  a14=(a24<=a53);
-  a53=(a53<=a24);
-  a53=(a14+a53);
-  a14=(a14/a53);
-  a57=(a57-a14);
-  a28=(a28*a02);
-  a28=(a28+a51);
-  a28=(a28-a24);
-  a24=(a28-a06);
-  a24=tanhf(a24);
-  a06=(a06-a24);
-  a09=(a09*a06);
-  a28=(a28+a52);
-  a28=casadi_sq(a28);
-  a09=(a09/a28);
-  a37=(a37*a52);
-  a09=(a09-a37);
-  a57=(a57*a09);
-  a03=(a03-a57);
-  if (res[3]!=0) res[3][2]=a03;
-  return 0;
+/* CasADi Function 'bump_value': 34 instructions. */
+static void body_bump_value(const omnirobot_s1_real* t, const omnirobot_s1_real* start, const omnirobot_s1_real* end, const omnirobot_s1_real* center, const omnirobot_s1_real* radius, const omnirobot_s1_real* sharpness, const omnirobot_s1_real* height, omnirobot_s1_real* y) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  w0 = start[0];
+  w1 = t[0];
+  w0 = (w0 < w1) ? 1.0f : 0.0f;
+  w2 = end[0];
+  w2 = (w1 < w2) ? 1.0f : 0.0f;
+  w0 = ((w0 != 0.0f) && (w2 != 0.0f)) ? 1.0f : 0.0f;
+  w2 = center[0];
+  w1 = w1 - w2;
+  w2 = fabsf(w1);
+  w3 = radius[0];
+  w2 = (w2 < w3) ? 1.0f : 0.0f;
+  w0 = ((w0 != 0.0f) && (w2 != 0.0f)) ? 1.0f : 0.0f;
+  w2 = height[0];
+  w4 = sharpness[0];
+  w5 = w1 * w1;
+  w4 = w4 * w5;
+  w5 = fabsf(w1);
+  w5 = w3 - w5;
+  w1 = fabsf(w1);
+  w3 = w3 + w1;
+  w5 = w5 * w3;
+  w5 = (w0 != 0.0f) ? w5 : 0.0f;
+  w3 = (w0 == 0.0f) ? 1.0f : 0.0f;
+  w1 = 1.0f;
+  w3 = (w3 != 0.0f) ? w1 : 0.0f;
+  w5 = w5 + w3;
+  w4 = w4 / w5;
+  w4 = -w4;
+  w5 = -80.0f;
+  w4 = (w5 > w4) ? w5 : w4;
+  w4 = expf(w4);
+  w2 = w2 * w4;
+  w0 = (w0 != 0.0f) ? w2 : 0.0f;
+  y[0] = w0;
 }
 
-/* control:(x[3],t,alpha[6])->(u[3],inside) */
-static int body_control(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  (void)iw; (void)w; (void)mem;
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21;
-  a00=-1.8168809110361742e-01f;
-  a01=4.f;
-  a02=4.5000000000000000e+00f;
-  a03=arg[1]? arg[1][0] : 0;
-  a04=9.f;
-  a05=(a03<a04);
-  a04=(a04-a03);
-  a04=(a05!=0?a04:0);
-  a06=(a05==0);
-  a07=1.f;
-  a06=(a06!=0?a07:0);
-  a04=(a04+a06);
-  a04=(a03/a04);
-  a04=tanhf(a04);
-  a04=(a05!=0?a04:0);
-  a05=(a05==0);
-  a05=(a05!=0?a07:0);
-  a04=(a04+a05);
-  a05=(a02*a04);
-  a06=4.5000000000000001e-01f;
-  a05=(a05+a06);
-  a08=arg[2]? arg[2][3] : 0;
-  a05=(a05+a08);
-  a08=(-a05);
-  a09=-5.f;
-  a08=casadi_fmax(a08,a09);
-  a10=-50.f;
-  a05=(a05+a09);
-  a05=casadi_fabs(a05);
-  a05=(a10*a05);
-  a05=expf(a05);
-  a05=casadi_log1p(a05);
-  a09=50.f;
-  a05=(a05/a09);
-  a08=(a08+a05);
-  a02=(a02*a04);
-  a05=4.9999999999999989e-02f;
-  a02=(a02+a05);
-  a05=arg[2]? arg[2][0] : 0;
-  a02=(a02-a05);
-  a05=0.f;
-  a11=casadi_fmax(a02,a05);
-  a02=casadi_fabs(a02);
-  a02=(a10*a02);
-  a02=expf(a02);
-  a02=casadi_log1p(a02);
-  a02=(a02/a09);
-  a11=(a11+a02);
-  a02=(a08+a11);
-  a02=(-a02);
-  a12=9.9999999999999995e-07f;
-  a13=casadi_fmax(a02,a12);
-  a14=arg[0]? arg[0][0] : 0;
-  a14=(2.f*a14);
-  a11=(a11-a08);
-  a14=(a14-a11);
-  a14=(a14/a13);
-  a11=-9.9999904632568359e-01f;
-  a08=casadi_fmax(a14,a11);
-  a15=9.9999904632568359e-01f;
-  a08=casadi_fmin(a08,a15);
-  a16=casadi_sq(a08);
-  a16=(a07-a16);
-  a13=(a13*a16);
-  a13=(a01/a13);
-  a13=(a00*a13);
-  a16=(a07+a08);
-  a08=(a07-a08);
-  a16=(a16/a08);
-  a16=logf(a16);
-  a13=(a13*a16);
-  if (res[0]!=0) res[0][0]=a13;
-  a13=4.9500000000000002e+00f;
-  a16=arg[2]? arg[2][4] : 0;
-  a13=(a13+a16);
-  a16=(-a13);
-  a08=5.f;
-  a17=1.8936220940921840e+00f;
-  a03=(a03-a17);
-  a17=casadi_fabs(a03);
-  a18=1.5729834283919115e+00f;
-  a17=(a17<a18);
-  a19=-1.2000000000000002e+00f;
-  a20=-1.0000000000000001e-01f;
-  a21=casadi_sq(a03);
-  a20=(a20*a21);
-  a21=casadi_fabs(a03);
-  a21=(a18-a21);
-  a03=casadi_fabs(a03);
-  a18=(a18+a03);
-  a21=(a21*a18);
-  a21=(a17!=0?a21:0);
-  a18=(a17==0);
-  a18=(a18!=0?a07:0);
-  a21=(a21+a18);
-  a20=(a20/a21);
-  a20=expf(a20);
-  a19=(a19*a20);
-  a17=(a17!=0?a19:0);
-  a08=(a08+a17);
-  a17=(-a08);
-  a16=casadi_fmax(a16,a17);
-  a08=(a08-a13);
-  a08=casadi_fabs(a08);
-  a08=(a10*a08);
-  a08=expf(a08);
-  a08=casadi_log1p(a08);
-  a08=(a08/a09);
-  a16=(a16+a08);
-  a08=4.5499999999999998e+00f;
-  a13=arg[2]? arg[2][1] : 0;
-  a08=(a08-a13);
-  a13=casadi_fmax(a08,a05);
-  a08=casadi_fabs(a08);
-  a08=(a10*a08);
-  a08=expf(a08);
-  a08=casadi_log1p(a08);
-  a08=(a08/a09);
-  a13=(a13+a08);
-  a08=(a16+a13);
-  a08=(-a08);
-  a17=casadi_fmax(a08,a12);
-  a19=arg[0]? arg[0][1] : 0;
-  a19=(2.f*a19);
-  a13=(a13-a16);
-  a19=(a19-a13);
-  a19=(a19/a17);
-  a13=casadi_fmax(a19,a11);
-  a13=casadi_fmin(a13,a15);
-  a16=casadi_sq(a13);
-  a16=(a07-a16);
-  a17=(a17*a16);
-  a17=(a01/a17);
-  a17=(a00*a17);
-  a16=(a07+a13);
-  a13=(a07-a13);
-  a16=(a16/a13);
-  a16=logf(a16);
-  a17=(a17*a16);
-  if (res[0]!=0) res[0][1]=a17;
-  a06=(a06*a04);
-  a17=5.0000000000000003e-02f;
-  a06=(a06+a17);
-  a17=arg[2]? arg[2][5] : 0;
-  a06=(a06+a17);
-  a17=(-a06);
-  a16=-1.2000000000000000e+00f;
-  a17=casadi_fmax(a17,a16);
-  a06=(a06+a16);
-  a06=casadi_fabs(a06);
-  a06=(a10*a06);
-  a06=expf(a06);
-  a06=casadi_log1p(a06);
-  a06=(a06/a09);
-  a17=(a17+a06);
-  a06=-4.5000000000000001e-01f;
-  a06=(a06*a04);
-  a04=-5.0000000000000003e-02f;
-  a06=(a06+a04);
-  a04=arg[2]? arg[2][2] : 0;
-  a06=(a06-a04);
-  a04=casadi_fmax(a06,a16);
-  a06=(a06-a16);
-  a06=casadi_fabs(a06);
-  a10=(a10*a06);
-  a10=expf(a10);
-  a10=casadi_log1p(a10);
-  a10=(a10/a09);
-  a04=(a04+a10);
-  a10=(a17+a04);
-  a10=(-a10);
-  a12=casadi_fmax(a10,a12);
-  a09=arg[0]? arg[0][2] : 0;
-  a09=(2.f*a09);
-  a04=(a04-a17);
-  a09=(a09-a04);
-  a09=(a09/a12);
-  a11=casadi_fmax(a09,a11);
-  a11=casadi_fmin(a11,a15);
-  a15=casadi_sq(a11);
-  a15=(a07-a15);
-  a12=(a12*a15);
-  a01=(a01/a12);
-  a00=(a00*a01);
-  a01=(a07+a11);
-  a11=(a07-a11);
-  a01=(a01/a11);
-  a01=logf(a01);
-  a00=(a00*a01);
-  if (res[0]!=0) res[0][2]=a00;
-  a14=casadi_fabs(a14);
-  a14=(a14<a07);
-  a02=(a05<a02);
-  a14=(a14!=0&&a02!=0);
-  a14=(a07!=0&&a14!=0);
-  a19=casadi_fabs(a19);
-  a19=(a19<a07);
-  a08=(a05<a08);
-  a19=(a19!=0&&a08!=0);
-  a14=(a14!=0&&a19!=0);
-  a09=casadi_fabs(a09);
-  a09=(a09<a07);
-  a05=(a05<a10);
-  a09=(a09!=0&&a05!=0);
-  a14=(a14!=0&&a09!=0);
-  if (res[1]!=0) res[1][0]=a14;
-  return 0;
+/* CasADi Function 'bump': 57 instructions. */
+static void body_bump(const omnirobot_s1_real* t, const omnirobot_s1_real* start, const omnirobot_s1_real* end, const omnirobot_s1_real* center, const omnirobot_s1_real* radius, const omnirobot_s1_real* sharpness, const omnirobot_s1_real* height, omnirobot_s1_real* y, omnirobot_s1_real* y_dot) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  omnirobot_s1_real w8;
+  omnirobot_s1_real w9;
+  omnirobot_s1_real w10;
+  omnirobot_s1_real w11;
+  w0 = start[0];
+  w1 = t[0];
+  w0 = (w0 < w1) ? 1.0f : 0.0f;
+  w2 = end[0];
+  w2 = (w1 < w2) ? 1.0f : 0.0f;
+  w0 = ((w0 != 0.0f) && (w2 != 0.0f)) ? 1.0f : 0.0f;
+  w2 = center[0];
+  w1 = w1 - w2;
+  w2 = fabsf(w1);
+  w3 = radius[0];
+  w2 = (w2 < w3) ? 1.0f : 0.0f;
+  w0 = ((w0 != 0.0f) && (w2 != 0.0f)) ? 1.0f : 0.0f;
+  w2 = height[0];
+  w4 = sharpness[0];
+  w5 = w1 * w1;
+  w5 = w4 * w5;
+  w6 = fabsf(w1);
+  w6 = w3 - w6;
+  w7 = fabsf(w1);
+  w3 = w3 + w7;
+  w7 = w6 * w3;
+  w7 = (w0 != 0.0f) ? w7 : 0.0f;
+  w8 = (w0 == 0.0f) ? 1.0f : 0.0f;
+  w9 = 1.0f;
+  w8 = (w8 != 0.0f) ? w9 : 0.0f;
+  w7 = w7 + w8;
+  w5 = w5 / w7;
+  w8 = -w5;
+  w9 = -80.0f;
+  w10 = (w9 > w8) ? w9 : w8;
+  w10 = expf(w10);
+  w11 = w2 * w10;
+  w11 = (w0 != 0.0f) ? w11 : 0.0f;
+  y[0] = w11;
+  w11 = (w9 <= w8) ? 1.0f : 0.0f;
+  w8 = (w8 <= w9) ? 1.0f : 0.0f;
+  w8 = w11 + w8;
+  w11 = w11 / w8;
+  w8 = w1 + w1;
+  w4 = w4 * w8;
+  w4 = w4 / w7;
+  w5 = w5 / w7;
+  w7 = (w1 < 0.0f) ? -1.0f : ((w1 > 0.0f) ? 1.0f : w1);
+  w6 = w6 * w7;
+  w1 = (w1 < 0.0f) ? -1.0f : ((w1 > 0.0f) ? 1.0f : w1);
+  w3 = w3 * w1;
+  w6 = w6 - w3;
+  w5 = w5 * w6;
+  w5 = -w5;
+  w5 = (w0 != 0.0f) ? w5 : 0.0f;
+  w4 = w4 + w5;
+  w11 = w11 * w4;
+  w10 = w10 * w11;
+  w2 = w2 * w10;
+  w2 = -w2;
+  w0 = (w0 != 0.0f) ? w2 : 0.0f;
+  y_dot[0] = w0;
 }
 
-/* alpha_step:(t,dt,alpha[6])->(alpha_next[6]) */
-static int body_alpha_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  (void)iw; (void)w; (void)mem;
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19;
-  a00=arg[2]? arg[2][0] : 0;
-  a01=1.f;
-  a02=5.f;
-  a03=arg[1]? arg[1][0] : 0;
-  a04=(a02*a03);
-  a04=(a01+a04);
-  a05=(a00/a04);
-  a06=1.0000000000000000e-02f;
-  a07=4.5000000000000000e+00f;
-  a08=arg[0]? arg[0][0] : 0;
-  a08=(a08+a03);
-  a09=9.f;
-  a10=(a08<a09);
-  a09=(a09-a08);
-  a09=(a10!=0?a09:0);
-  a11=(a10==0);
-  a11=(a11!=0?a01:0);
-  a09=(a09+a11);
-  a09=(a08/a09);
-  a09=tanhf(a09);
-  a09=(a10!=0?a09:0);
-  a10=(a10==0);
-  a10=(a10!=0?a01:0);
-  a09=(a09+a10);
-  a10=(a07*a09);
-  a11=4.9999999999999989e-02f;
-  a10=(a10+a11);
-  a10=(a02-a10);
-  a11=(a10-a01);
-  a11=tanhf(a11);
-  a11=(a01-a11);
-  a11=(a06*a11);
-  a11=(a03*a11);
-  a12=(2.f*a04);
-  a13=(a11/a12);
-  a14=3.3333333333333331e-01f;
-  a13=powf(a13,a14);
-  a15=(a04*a10);
-  a15=(a15+a00);
-  a15=(-a15);
-  a16=0.f;
-  a15=casadi_fmax(a15,a16);
-  a17=1.0000000000000001e-30f;
-  a15=casadi_fmax(a15,a17);
-  a15=(2.f*a15);
-  a15=(a11/a15);
-  a15=sqrtf(a15);
-  a13=casadi_fmin(a13,a15);
-  a13=(a13-a10);
-  a05=casadi_fmax(a05,a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a15=(a10+a05);
-  a18=casadi_sq(a15);
-  a18=(a11/a18);
-  a13=(a13-a18);
-  a18=(2.f*a11);
-  a19=casadi_sq(a15);
-  a15=(a15*a19);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a13=(a13/a18);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a18=(a10+a05);
-  a15=casadi_sq(a18);
-  a15=(a11/a15);
-  a13=(a13-a15);
-  a15=(2.f*a11);
-  a19=casadi_sq(a18);
-  a18=(a18*a19);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a13=(a13/a15);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a15=(a10+a05);
-  a18=casadi_sq(a15);
-  a18=(a11/a18);
-  a13=(a13-a18);
-  a18=(2.f*a11);
-  a19=casadi_sq(a15);
-  a15=(a15*a19);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a13=(a13/a18);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a18=(a10+a05);
-  a15=casadi_sq(a18);
-  a15=(a11/a15);
-  a13=(a13-a15);
-  a15=(2.f*a11);
-  a19=casadi_sq(a18);
-  a18=(a18*a19);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a13=(a13/a15);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a15=(a10+a05);
-  a18=casadi_sq(a15);
-  a18=(a11/a18);
-  a13=(a13-a18);
-  a18=(2.f*a11);
-  a19=casadi_sq(a15);
-  a15=(a15*a19);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a13=(a13/a18);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a18=(a10+a05);
-  a15=casadi_sq(a18);
-  a15=(a11/a15);
-  a13=(a13-a15);
-  a15=(2.f*a11);
-  a19=casadi_sq(a18);
-  a18=(a18*a19);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a13=(a13/a15);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a15=(a10+a05);
-  a18=casadi_sq(a15);
-  a18=(a11/a18);
-  a13=(a13-a18);
-  a18=(2.f*a11);
-  a19=casadi_sq(a15);
-  a15=(a15*a19);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a13=(a13/a18);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a10=(a10+a05);
-  a00=casadi_sq(a10);
-  a00=(a11/a00);
-  a13=(a13-a00);
-  a11=(2.f*a11);
-  a00=casadi_sq(a10);
-  a10=(a10*a00);
-  a11=(a11/a10);
-  a11=(a04+a11);
-  a13=(a13/a11);
-  a05=(a05-a13);
-  if (res[0]!=0) res[0][0]=a05;
-  a05=arg[2]? arg[2][1] : 0;
-  a13=(a05/a04);
-  a11=1.8936220940921840e+00f;
-  a08=(a08-a11);
-  a11=casadi_fabs(a08);
-  a10=1.5729834283919115e+00f;
-  a11=(a11<a10);
-  a00=-1.2000000000000002e+00f;
-  a18=-1.0000000000000001e-01f;
-  a15=casadi_sq(a08);
-  a18=(a18*a15);
-  a15=casadi_fabs(a08);
-  a15=(a10-a15);
-  a08=casadi_fabs(a08);
-  a10=(a10+a08);
-  a15=(a15*a10);
-  a15=(a11!=0?a15:0);
-  a10=(a11==0);
-  a10=(a10!=0?a01:0);
-  a15=(a15+a10);
-  a18=(a18/a15);
-  a18=expf(a18);
-  a00=(a00*a18);
-  a11=(a11!=0?a00:0);
-  a02=(a02+a11);
-  a11=4.5499999999999998e+00f;
-  a02=(a02-a11);
-  a11=(a02-a01);
-  a11=tanhf(a11);
-  a11=(a01-a11);
-  a11=(a06*a11);
-  a11=(a03*a11);
-  a00=(a11/a12);
-  a00=powf(a00,a14);
-  a18=(a04*a02);
-  a18=(a18+a05);
-  a18=(-a18);
-  a18=casadi_fmax(a18,a16);
-  a18=casadi_fmax(a18,a17);
-  a18=(2.f*a18);
-  a18=(a11/a18);
-  a18=sqrtf(a18);
-  a00=casadi_fmin(a00,a18);
-  a00=(a00-a02);
-  a13=casadi_fmax(a13,a00);
-  a00=(a04*a13);
-  a00=(a00-a05);
-  a18=(a02+a13);
-  a15=casadi_sq(a18);
-  a15=(a11/a15);
-  a00=(a00-a15);
-  a15=(2.f*a11);
-  a10=casadi_sq(a18);
-  a18=(a18*a10);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a00=(a00/a15);
-  a13=(a13-a00);
-  a00=(a04*a13);
-  a00=(a00-a05);
-  a15=(a02+a13);
-  a18=casadi_sq(a15);
-  a18=(a11/a18);
-  a00=(a00-a18);
-  a18=(2.f*a11);
-  a10=casadi_sq(a15);
-  a15=(a15*a10);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a00=(a00/a18);
-  a13=(a13-a00);
-  a00=(a04*a13);
-  a00=(a00-a05);
-  a18=(a02+a13);
-  a15=casadi_sq(a18);
-  a15=(a11/a15);
-  a00=(a00-a15);
-  a15=(2.f*a11);
-  a10=casadi_sq(a18);
-  a18=(a18*a10);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a00=(a00/a15);
-  a13=(a13-a00);
-  a00=(a04*a13);
-  a00=(a00-a05);
-  a15=(a02+a13);
-  a18=casadi_sq(a15);
-  a18=(a11/a18);
-  a00=(a00-a18);
-  a18=(2.f*a11);
-  a10=casadi_sq(a15);
-  a15=(a15*a10);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a00=(a00/a18);
-  a13=(a13-a00);
-  a00=(a04*a13);
-  a00=(a00-a05);
-  a18=(a02+a13);
-  a15=casadi_sq(a18);
-  a15=(a11/a15);
-  a00=(a00-a15);
-  a15=(2.f*a11);
-  a10=casadi_sq(a18);
-  a18=(a18*a10);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a00=(a00/a15);
-  a13=(a13-a00);
-  a00=(a04*a13);
-  a00=(a00-a05);
-  a15=(a02+a13);
-  a18=casadi_sq(a15);
-  a18=(a11/a18);
-  a00=(a00-a18);
-  a18=(2.f*a11);
-  a10=casadi_sq(a15);
-  a15=(a15*a10);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a00=(a00/a18);
-  a13=(a13-a00);
-  a00=(a04*a13);
-  a00=(a00-a05);
-  a18=(a02+a13);
-  a15=casadi_sq(a18);
-  a15=(a11/a15);
-  a00=(a00-a15);
-  a15=(2.f*a11);
-  a10=casadi_sq(a18);
-  a18=(a18*a10);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a00=(a00/a15);
-  a13=(a13-a00);
-  a00=(a04*a13);
-  a00=(a00-a05);
-  a02=(a02+a13);
-  a05=casadi_sq(a02);
-  a05=(a11/a05);
-  a00=(a00-a05);
-  a11=(2.f*a11);
-  a05=casadi_sq(a02);
-  a02=(a02*a05);
-  a11=(a11/a02);
-  a11=(a04+a11);
-  a00=(a00/a11);
-  a13=(a13-a00);
-  if (res[0]!=0) res[0][1]=a13;
-  a13=arg[2]? arg[2][2] : 0;
-  a00=(a13/a04);
-  a11=1.2000000000000000e+00f;
-  a02=-4.5000000000000001e-01f;
-  a02=(a02*a09);
-  a05=-5.0000000000000003e-02f;
-  a02=(a02+a05);
-  a11=(a11-a02);
-  a02=(a11-a01);
-  a02=tanhf(a02);
-  a02=(a01-a02);
-  a02=(a06*a02);
-  a02=(a03*a02);
-  a05=(a02/a12);
-  a05=powf(a05,a14);
-  a15=(a04*a11);
-  a15=(a15+a13);
-  a15=(-a15);
-  a15=casadi_fmax(a15,a16);
-  a15=casadi_fmax(a15,a17);
-  a15=(2.f*a15);
-  a15=(a02/a15);
-  a15=sqrtf(a15);
-  a05=casadi_fmin(a05,a15);
-  a05=(a05-a11);
-  a00=casadi_fmax(a00,a05);
-  a05=(a04*a00);
-  a05=(a05-a13);
-  a15=(a11+a00);
-  a18=casadi_sq(a15);
-  a18=(a02/a18);
-  a05=(a05-a18);
-  a18=(2.f*a02);
-  a10=casadi_sq(a15);
-  a15=(a15*a10);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a05=(a05/a18);
-  a00=(a00-a05);
-  a05=(a04*a00);
-  a05=(a05-a13);
-  a18=(a11+a00);
-  a15=casadi_sq(a18);
-  a15=(a02/a15);
-  a05=(a05-a15);
-  a15=(2.f*a02);
-  a10=casadi_sq(a18);
-  a18=(a18*a10);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a05=(a05/a15);
-  a00=(a00-a05);
-  a05=(a04*a00);
-  a05=(a05-a13);
-  a15=(a11+a00);
-  a18=casadi_sq(a15);
-  a18=(a02/a18);
-  a05=(a05-a18);
-  a18=(2.f*a02);
-  a10=casadi_sq(a15);
-  a15=(a15*a10);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a05=(a05/a18);
-  a00=(a00-a05);
-  a05=(a04*a00);
-  a05=(a05-a13);
-  a18=(a11+a00);
-  a15=casadi_sq(a18);
-  a15=(a02/a15);
-  a05=(a05-a15);
-  a15=(2.f*a02);
-  a10=casadi_sq(a18);
-  a18=(a18*a10);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a05=(a05/a15);
-  a00=(a00-a05);
-  a05=(a04*a00);
-  a05=(a05-a13);
-  a15=(a11+a00);
-  a18=casadi_sq(a15);
-  a18=(a02/a18);
-  a05=(a05-a18);
-  a18=(2.f*a02);
-  a10=casadi_sq(a15);
-  a15=(a15*a10);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a05=(a05/a18);
-  a00=(a00-a05);
-  a05=(a04*a00);
-  a05=(a05-a13);
-  a18=(a11+a00);
-  a15=casadi_sq(a18);
-  a15=(a02/a15);
-  a05=(a05-a15);
-  a15=(2.f*a02);
-  a10=casadi_sq(a18);
-  a18=(a18*a10);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a05=(a05/a15);
-  a00=(a00-a05);
-  a05=(a04*a00);
-  a05=(a05-a13);
-  a15=(a11+a00);
-  a18=casadi_sq(a15);
-  a18=(a02/a18);
-  a05=(a05-a18);
-  a18=(2.f*a02);
-  a10=casadi_sq(a15);
-  a15=(a15*a10);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a05=(a05/a18);
-  a00=(a00-a05);
-  a05=(a04*a00);
-  a05=(a05-a13);
-  a11=(a11+a00);
-  a13=casadi_sq(a11);
-  a13=(a02/a13);
-  a05=(a05-a13);
-  a02=(2.f*a02);
-  a13=casadi_sq(a11);
-  a11=(a11*a13);
-  a02=(a02/a11);
-  a02=(a04+a02);
-  a05=(a05/a02);
-  a00=(a00-a05);
-  if (res[0]!=0) res[0][2]=a00;
-  a00=arg[2]? arg[2][3] : 0;
-  a05=(a00/a04);
-  a07=(a07*a09);
-  a02=4.5000000000000001e-01f;
-  a07=(a07+a02);
-  a11=(a07-a01);
-  a11=tanhf(a11);
-  a11=(a01-a11);
-  a11=(a06*a11);
-  a11=(a03*a11);
-  a13=(a11/a12);
-  a13=powf(a13,a14);
-  a18=(a04*a07);
-  a18=(a18+a00);
-  a18=(-a18);
-  a18=casadi_fmax(a18,a16);
-  a18=casadi_fmax(a18,a17);
-  a18=(2.f*a18);
-  a18=(a11/a18);
-  a18=sqrtf(a18);
-  a13=casadi_fmin(a13,a18);
-  a13=(a13-a07);
-  a05=casadi_fmax(a05,a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a18=(a07+a05);
-  a15=casadi_sq(a18);
-  a15=(a11/a15);
-  a13=(a13-a15);
-  a15=(2.f*a11);
-  a10=casadi_sq(a18);
-  a18=(a18*a10);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a13=(a13/a15);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a15=(a07+a05);
-  a18=casadi_sq(a15);
-  a18=(a11/a18);
-  a13=(a13-a18);
-  a18=(2.f*a11);
-  a10=casadi_sq(a15);
-  a15=(a15*a10);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a13=(a13/a18);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a18=(a07+a05);
-  a15=casadi_sq(a18);
-  a15=(a11/a15);
-  a13=(a13-a15);
-  a15=(2.f*a11);
-  a10=casadi_sq(a18);
-  a18=(a18*a10);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a13=(a13/a15);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a15=(a07+a05);
-  a18=casadi_sq(a15);
-  a18=(a11/a18);
-  a13=(a13-a18);
-  a18=(2.f*a11);
-  a10=casadi_sq(a15);
-  a15=(a15*a10);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a13=(a13/a18);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a18=(a07+a05);
-  a15=casadi_sq(a18);
-  a15=(a11/a15);
-  a13=(a13-a15);
-  a15=(2.f*a11);
-  a10=casadi_sq(a18);
-  a18=(a18*a10);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a13=(a13/a15);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a15=(a07+a05);
-  a18=casadi_sq(a15);
-  a18=(a11/a18);
-  a13=(a13-a18);
-  a18=(2.f*a11);
-  a10=casadi_sq(a15);
-  a15=(a15*a10);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a13=(a13/a18);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a18=(a07+a05);
-  a15=casadi_sq(a18);
-  a15=(a11/a15);
-  a13=(a13-a15);
-  a15=(2.f*a11);
-  a10=casadi_sq(a18);
-  a18=(a18*a10);
-  a15=(a15/a18);
-  a15=(a04+a15);
-  a13=(a13/a15);
-  a05=(a05-a13);
-  a13=(a04*a05);
-  a13=(a13-a00);
-  a07=(a07+a05);
-  a00=casadi_sq(a07);
-  a00=(a11/a00);
-  a13=(a13-a00);
-  a11=(2.f*a11);
-  a00=casadi_sq(a07);
-  a07=(a07*a00);
-  a11=(a11/a07);
-  a11=(a04+a11);
-  a13=(a13/a11);
-  a05=(a05-a13);
-  if (res[0]!=0) res[0][3]=a05;
-  a05=arg[2]? arg[2][4] : 0;
-  a13=(a05/a04);
-  a11=-4.9500000000000002e+00f;
-  a07=7.4121228125278996e-06f;
-  a07=(a07*a03);
-  a00=(a07/a12);
-  a00=powf(a00,a14);
-  a15=4.9500000000000002e+00f;
-  a18=(a15*a04);
-  a18=(a18+a05);
-  a18=(-a18);
-  a18=casadi_fmax(a18,a16);
-  a18=casadi_fmax(a18,a17);
-  a18=(2.f*a18);
-  a18=(a07/a18);
-  a18=sqrtf(a18);
-  a00=casadi_fmin(a00,a18);
-  a11=(a11+a00);
-  a13=casadi_fmax(a13,a11);
-  a11=(a04*a13);
-  a11=(a11-a05);
-  a00=(a15+a13);
-  a18=casadi_sq(a00);
-  a18=(a07/a18);
-  a11=(a11-a18);
-  a18=1.4824245625055799e-05f;
-  a10=(a18*a03);
-  a08=casadi_sq(a00);
-  a00=(a00*a08);
-  a10=(a10/a00);
-  a10=(a04+a10);
-  a11=(a11/a10);
-  a13=(a13-a11);
-  a11=(a04*a13);
-  a11=(a11-a05);
-  a10=(a15+a13);
-  a00=casadi_sq(a10);
-  a00=(a07/a00);
-  a11=(a11-a00);
-  a00=(a18*a03);
-  a08=casadi_sq(a10);
-  a10=(a10*a08);
-  a00=(a00/a10);
-  a00=(a04+a00);
-  a11=(a11/a00);
-  a13=(a13-a11);
-  a11=(a04*a13);
-  a11=(a11-a05);
-  a00=(a15+a13);
-  a10=casadi_sq(a00);
-  a10=(a07/a10);
-  a11=(a11-a10);
-  a10=(a18*a03);
-  a08=casadi_sq(a00);
-  a00=(a00*a08);
-  a10=(a10/a00);
-  a10=(a04+a10);
-  a11=(a11/a10);
-  a13=(a13-a11);
-  a11=(a04*a13);
-  a11=(a11-a05);
-  a10=(a15+a13);
-  a00=casadi_sq(a10);
-  a00=(a07/a00);
-  a11=(a11-a00);
-  a00=(a18*a03);
-  a08=casadi_sq(a10);
-  a10=(a10*a08);
-  a00=(a00/a10);
-  a00=(a04+a00);
-  a11=(a11/a00);
-  a13=(a13-a11);
-  a11=(a04*a13);
-  a11=(a11-a05);
-  a00=(a15+a13);
-  a10=casadi_sq(a00);
-  a10=(a07/a10);
-  a11=(a11-a10);
-  a10=(a18*a03);
-  a08=casadi_sq(a00);
-  a00=(a00*a08);
-  a10=(a10/a00);
-  a10=(a04+a10);
-  a11=(a11/a10);
-  a13=(a13-a11);
-  a11=(a04*a13);
-  a11=(a11-a05);
-  a10=(a15+a13);
-  a00=casadi_sq(a10);
-  a00=(a07/a00);
-  a11=(a11-a00);
-  a00=(a18*a03);
-  a08=casadi_sq(a10);
-  a10=(a10*a08);
-  a00=(a00/a10);
-  a00=(a04+a00);
-  a11=(a11/a00);
-  a13=(a13-a11);
-  a11=(a04*a13);
-  a11=(a11-a05);
-  a00=(a15+a13);
-  a10=casadi_sq(a00);
-  a10=(a07/a10);
-  a11=(a11-a10);
-  a10=(a18*a03);
-  a08=casadi_sq(a00);
-  a00=(a00*a08);
-  a10=(a10/a00);
-  a10=(a04+a10);
-  a11=(a11/a10);
-  a13=(a13-a11);
-  a11=(a04*a13);
-  a11=(a11-a05);
-  a15=(a15+a13);
-  a05=casadi_sq(a15);
-  a07=(a07/a05);
-  a11=(a11-a07);
-  a18=(a18*a03);
-  a07=casadi_sq(a15);
-  a15=(a15*a07);
-  a18=(a18/a15);
-  a18=(a04+a18);
-  a11=(a11/a18);
-  a13=(a13-a11);
-  if (res[0]!=0) res[0][4]=a13;
-  a13=arg[2]? arg[2][5] : 0;
-  a11=(a13/a04);
-  a02=(a02*a09);
-  a09=5.0000000000000003e-02f;
-  a02=(a02+a09);
-  a09=-1.2000000000000000e+00f;
-  a02=(a02-a09);
-  a09=(a02-a01);
-  a09=tanhf(a09);
-  a01=(a01-a09);
-  a06=(a06*a01);
-  a03=(a03*a06);
-  a12=(a03/a12);
-  a12=powf(a12,a14);
-  a14=(a04*a02);
-  a14=(a14+a13);
-  a14=(-a14);
-  a14=casadi_fmax(a14,a16);
-  a14=casadi_fmax(a14,a17);
-  a14=(2.f*a14);
-  a14=(a03/a14);
-  a14=sqrtf(a14);
-  a12=casadi_fmin(a12,a14);
-  a12=(a12-a02);
-  a11=casadi_fmax(a11,a12);
-  a12=(a04*a11);
-  a12=(a12-a13);
-  a14=(a02+a11);
-  a17=casadi_sq(a14);
-  a17=(a03/a17);
-  a12=(a12-a17);
-  a17=(2.f*a03);
-  a16=casadi_sq(a14);
-  a14=(a14*a16);
-  a17=(a17/a14);
-  a17=(a04+a17);
-  a12=(a12/a17);
-  a11=(a11-a12);
-  a12=(a04*a11);
-  a12=(a12-a13);
-  a17=(a02+a11);
-  a14=casadi_sq(a17);
-  a14=(a03/a14);
-  a12=(a12-a14);
-  a14=(2.f*a03);
-  a16=casadi_sq(a17);
-  a17=(a17*a16);
-  a14=(a14/a17);
-  a14=(a04+a14);
-  a12=(a12/a14);
-  a11=(a11-a12);
-  a12=(a04*a11);
-  a12=(a12-a13);
-  a14=(a02+a11);
-  a17=casadi_sq(a14);
-  a17=(a03/a17);
-  a12=(a12-a17);
-  a17=(2.f*a03);
-  a16=casadi_sq(a14);
-  a14=(a14*a16);
-  a17=(a17/a14);
-  a17=(a04+a17);
-  a12=(a12/a17);
-  a11=(a11-a12);
-  a12=(a04*a11);
-  a12=(a12-a13);
-  a17=(a02+a11);
-  a14=casadi_sq(a17);
-  a14=(a03/a14);
-  a12=(a12-a14);
-  a14=(2.f*a03);
-  a16=casadi_sq(a17);
-  a17=(a17*a16);
-  a14=(a14/a17);
-  a14=(a04+a14);
-  a12=(a12/a14);
-  a11=(a11-a12);
-  a12=(a04*a11);
-  a12=(a12-a13);
-  a14=(a02+a11);
-  a17=casadi_sq(a14);
-  a17=(a03/a17);
-  a12=(a12-a17);
-  a17=(2.f*a03);
-  a16=casadi_sq(a14);
-  a14=(a14*a16);
-  a17=(a17/a14);
-  a17=(a04+a17);
-  a12=(a12/a17);
-  a11=(a11-a12);
-  a12=(a04*a11);
-  a12=(a12-a13);
-  a17=(a02+a11);
-  a14=casadi_sq(a17);
-  a14=(a03/a14);
-  a12=(a12-a14);
-  a14=(2.f*a03);
-  a16=casadi_sq(a17);
-  a17=(a17*a16);
-  a14=(a14/a17);
-  a14=(a04+a14);
-  a12=(a12/a14);
-  a11=(a11-a12);
-  a12=(a04*a11);
-  a12=(a12-a13);
-  a14=(a02+a11);
-  a17=casadi_sq(a14);
-  a17=(a03/a17);
-  a12=(a12-a17);
-  a17=(2.f*a03);
-  a16=casadi_sq(a14);
-  a14=(a14*a16);
-  a17=(a17/a14);
-  a17=(a04+a17);
-  a12=(a12/a17);
-  a11=(a11-a12);
-  a12=(a04*a11);
-  a12=(a12-a13);
-  a02=(a02+a11);
-  a13=casadi_sq(a02);
-  a13=(a03/a13);
-  a12=(a12-a13);
-  a03=(2.f*a03);
-  a13=casadi_sq(a02);
-  a02=(a02*a13);
-  a03=(a03/a02);
-  a04=(a04+a03);
-  a12=(a12/a04);
-  a11=(a11-a12);
-  if (res[0]!=0) res[0][5]=a11;
-  return 0;
+/* CasADi Function 'fnu_single': 9 instructions. */
+static void body_fnu_single(const omnirobot_s1_real* bound, const omnirobot_s1_real* sign, const omnirobot_s1_real* y, const omnirobot_s1_real* y_dot, omnirobot_s1_real* beta, omnirobot_s1_real* beta_dot) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  w0 = bound[0];
+  w1 = sign[0];
+  w2 = y[0];
+  w2 = w1 * w2;
+  w0 = w0 + w2;
+  beta[0] = w0;
+  w0 = y_dot[0];
+  w1 = w1 * w0;
+  beta_dot[0] = w1;
 }
 
-/* controller_step:(x[3],t,dt,alpha[6])->(u[3],alpha_next[6],inside) */
-static int body_controller_step(const casadi_real** arg, casadi_real** res, casadi_int* iw, casadi_real* w, int mem) {
-  (void)iw; (void)w; (void)mem;
-  casadi_real a00, a01, a02, a03, a04, a05, a06, a07, a08, a09, a10, a11;
-  casadi_real a12, a13, a14, a15, a16, a17, a18, a19, a20, a21, a22, a23;
-  casadi_real a24, a25, a26, a27, a28, a29, a30, a31, a32, a33, a34, a35;
-  casadi_real a36, a37, a38, a39, a40, a41;
-  a00=-1.8168809110361742e-01f;
-  a01=4.f;
-  a02=4.5000000000000000e+00f;
-  a03=arg[1]? arg[1][0] : 0;
-  a04=9.f;
-  a05=(a03<a04);
-  a06=(a04-a03);
-  a06=(a05!=0?a06:0);
-  a07=(a05==0);
-  a08=1.f;
-  a07=(a07!=0?a08:0);
-  a06=(a06+a07);
-  a06=(a03/a06);
-  a06=tanhf(a06);
-  a06=(a05!=0?a06:0);
-  a05=(a05==0);
-  a05=(a05!=0?a08:0);
-  a06=(a06+a05);
-  a05=(a02*a06);
-  a07=4.5000000000000001e-01f;
-  a05=(a05+a07);
-  a09=arg[3]? arg[3][3] : 0;
-  a05=(a05+a09);
-  a10=(-a05);
-  a11=-5.f;
-  a10=casadi_fmax(a10,a11);
-  a12=-50.f;
-  a05=(a05+a11);
-  a05=casadi_fabs(a05);
-  a05=(a12*a05);
-  a05=expf(a05);
-  a05=casadi_log1p(a05);
-  a11=50.f;
-  a05=(a05/a11);
-  a10=(a10+a05);
-  a05=(a02*a06);
-  a13=4.9999999999999989e-02f;
-  a05=(a05+a13);
-  a14=arg[3]? arg[3][0] : 0;
-  a05=(a05-a14);
-  a15=0.f;
-  a16=casadi_fmax(a05,a15);
-  a05=casadi_fabs(a05);
-  a05=(a12*a05);
-  a05=expf(a05);
-  a05=casadi_log1p(a05);
-  a05=(a05/a11);
-  a16=(a16+a05);
-  a05=(a10+a16);
-  a05=(-a05);
-  a17=9.9999999999999995e-07f;
-  a18=casadi_fmax(a05,a17);
-  a19=arg[0]? arg[0][0] : 0;
-  a19=(2.f*a19);
-  a16=(a16-a10);
-  a19=(a19-a16);
-  a19=(a19/a18);
-  a16=-9.9999904632568359e-01f;
-  a10=casadi_fmax(a19,a16);
-  a20=9.9999904632568359e-01f;
-  a10=casadi_fmin(a10,a20);
-  a21=casadi_sq(a10);
-  a21=(a08-a21);
-  a18=(a18*a21);
-  a18=(a01/a18);
-  a18=(a00*a18);
-  a21=(a08+a10);
-  a10=(a08-a10);
-  a21=(a21/a10);
-  a21=logf(a21);
-  a18=(a18*a21);
-  if (res[0]!=0) res[0][0]=a18;
-  a18=4.9500000000000002e+00f;
-  a21=arg[3]? arg[3][4] : 0;
-  a10=(a18+a21);
-  a22=(-a10);
-  a23=5.f;
-  a24=1.8936220940921840e+00f;
-  a25=(a03-a24);
-  a26=casadi_fabs(a25);
-  a27=1.5729834283919115e+00f;
-  a26=(a26<a27);
-  a28=-1.2000000000000002e+00f;
-  a29=-1.0000000000000001e-01f;
-  a30=casadi_sq(a25);
-  a30=(a29*a30);
-  a31=casadi_fabs(a25);
-  a31=(a27-a31);
-  a25=casadi_fabs(a25);
-  a25=(a27+a25);
-  a31=(a31*a25);
-  a31=(a26!=0?a31:0);
-  a25=(a26==0);
-  a25=(a25!=0?a08:0);
-  a31=(a31+a25);
-  a30=(a30/a31);
-  a30=expf(a30);
-  a30=(a28*a30);
-  a26=(a26!=0?a30:0);
-  a26=(a23+a26);
-  a30=(-a26);
-  a22=casadi_fmax(a22,a30);
-  a26=(a26-a10);
-  a26=casadi_fabs(a26);
-  a26=(a12*a26);
-  a26=expf(a26);
-  a26=casadi_log1p(a26);
-  a26=(a26/a11);
-  a22=(a22+a26);
-  a26=4.5499999999999998e+00f;
-  a10=arg[3]? arg[3][1] : 0;
-  a30=(a26-a10);
-  a31=casadi_fmax(a30,a15);
-  a30=casadi_fabs(a30);
-  a30=(a12*a30);
-  a30=expf(a30);
-  a30=casadi_log1p(a30);
-  a30=(a30/a11);
-  a31=(a31+a30);
-  a30=(a22+a31);
-  a30=(-a30);
-  a25=casadi_fmax(a30,a17);
-  a32=arg[0]? arg[0][1] : 0;
-  a32=(2.f*a32);
-  a31=(a31-a22);
-  a32=(a32-a31);
-  a32=(a32/a25);
-  a31=casadi_fmax(a32,a16);
-  a31=casadi_fmin(a31,a20);
-  a22=casadi_sq(a31);
-  a22=(a08-a22);
-  a25=(a25*a22);
-  a25=(a01/a25);
-  a25=(a00*a25);
-  a22=(a08+a31);
-  a31=(a08-a31);
-  a22=(a22/a31);
-  a22=logf(a22);
-  a25=(a25*a22);
-  if (res[0]!=0) res[0][1]=a25;
-  a25=(a07*a06);
-  a22=5.0000000000000003e-02f;
-  a25=(a25+a22);
-  a31=arg[3]? arg[3][5] : 0;
-  a25=(a25+a31);
-  a33=(-a25);
-  a34=-1.2000000000000000e+00f;
-  a33=casadi_fmax(a33,a34);
-  a25=(a25+a34);
-  a25=casadi_fabs(a25);
-  a25=(a12*a25);
-  a25=expf(a25);
-  a25=casadi_log1p(a25);
-  a25=(a25/a11);
-  a33=(a33+a25);
-  a25=-4.5000000000000001e-01f;
-  a06=(a25*a06);
-  a35=-5.0000000000000003e-02f;
-  a06=(a06+a35);
-  a36=arg[3]? arg[3][2] : 0;
-  a06=(a06-a36);
-  a37=casadi_fmax(a06,a34);
-  a06=(a06-a34);
-  a06=casadi_fabs(a06);
-  a12=(a12*a06);
-  a12=expf(a12);
-  a12=casadi_log1p(a12);
-  a12=(a12/a11);
-  a37=(a37+a12);
-  a12=(a33+a37);
-  a12=(-a12);
-  a17=casadi_fmax(a12,a17);
-  a11=arg[0]? arg[0][2] : 0;
-  a11=(2.f*a11);
-  a37=(a37-a33);
-  a11=(a11-a37);
-  a11=(a11/a17);
-  a16=casadi_fmax(a11,a16);
-  a16=casadi_fmin(a16,a20);
-  a20=casadi_sq(a16);
-  a20=(a08-a20);
-  a17=(a17*a20);
-  a01=(a01/a17);
-  a00=(a00*a01);
-  a01=(a08+a16);
-  a16=(a08-a16);
-  a01=(a01/a16);
-  a01=logf(a01);
-  a00=(a00*a01);
-  if (res[0]!=0) res[0][2]=a00;
-  a00=arg[2]? arg[2][0] : 0;
-  a01=(a23*a00);
-  a01=(a08+a01);
-  a16=(a14/a01);
-  a17=1.0000000000000000e-02f;
-  a03=(a03+a00);
-  a20=(a03<a04);
-  a04=(a04-a03);
-  a04=(a20!=0?a04:0);
-  a37=(a20==0);
-  a37=(a37!=0?a08:0);
-  a04=(a04+a37);
-  a04=(a03/a04);
-  a04=tanhf(a04);
-  a04=(a20!=0?a04:0);
-  a20=(a20==0);
-  a20=(a20!=0?a08:0);
-  a04=(a04+a20);
-  a20=(a02*a04);
-  a20=(a20+a13);
-  a20=(a23-a20);
-  a13=(a20-a08);
-  a13=tanhf(a13);
-  a13=(a08-a13);
-  a13=(a17*a13);
-  a13=(a00*a13);
-  a37=(2.f*a01);
-  a33=(a13/a37);
-  a06=3.3333333333333331e-01f;
-  a33=powf(a33,a06);
-  a38=(a01*a20);
-  a38=(a38+a14);
-  a38=(-a38);
-  a38=casadi_fmax(a38,a15);
-  a39=1.0000000000000001e-30f;
-  a38=casadi_fmax(a38,a39);
-  a38=(2.f*a38);
-  a38=(a13/a38);
-  a38=sqrtf(a38);
-  a33=casadi_fmin(a33,a38);
-  a33=(a33-a20);
-  a16=casadi_fmax(a16,a33);
-  a33=(a01*a16);
-  a33=(a33-a14);
-  a38=(a20+a16);
-  a40=casadi_sq(a38);
-  a40=(a13/a40);
-  a33=(a33-a40);
-  a40=(2.f*a13);
-  a41=casadi_sq(a38);
-  a38=(a38*a41);
-  a40=(a40/a38);
-  a40=(a01+a40);
-  a33=(a33/a40);
-  a16=(a16-a33);
-  a33=(a01*a16);
-  a33=(a33-a14);
-  a40=(a20+a16);
-  a38=casadi_sq(a40);
-  a38=(a13/a38);
-  a33=(a33-a38);
-  a38=(2.f*a13);
-  a41=casadi_sq(a40);
-  a40=(a40*a41);
-  a38=(a38/a40);
-  a38=(a01+a38);
-  a33=(a33/a38);
-  a16=(a16-a33);
-  a33=(a01*a16);
-  a33=(a33-a14);
-  a38=(a20+a16);
-  a40=casadi_sq(a38);
-  a40=(a13/a40);
-  a33=(a33-a40);
-  a40=(2.f*a13);
-  a41=casadi_sq(a38);
-  a38=(a38*a41);
-  a40=(a40/a38);
-  a40=(a01+a40);
-  a33=(a33/a40);
-  a16=(a16-a33);
-  a33=(a01*a16);
-  a33=(a33-a14);
-  a40=(a20+a16);
-  a38=casadi_sq(a40);
-  a38=(a13/a38);
-  a33=(a33-a38);
-  a38=(2.f*a13);
-  a41=casadi_sq(a40);
-  a40=(a40*a41);
-  a38=(a38/a40);
-  a38=(a01+a38);
-  a33=(a33/a38);
-  a16=(a16-a33);
-  a33=(a01*a16);
-  a33=(a33-a14);
-  a38=(a20+a16);
-  a40=casadi_sq(a38);
-  a40=(a13/a40);
-  a33=(a33-a40);
-  a40=(2.f*a13);
-  a41=casadi_sq(a38);
-  a38=(a38*a41);
-  a40=(a40/a38);
-  a40=(a01+a40);
-  a33=(a33/a40);
-  a16=(a16-a33);
-  a33=(a01*a16);
-  a33=(a33-a14);
-  a40=(a20+a16);
-  a38=casadi_sq(a40);
-  a38=(a13/a38);
-  a33=(a33-a38);
-  a38=(2.f*a13);
-  a41=casadi_sq(a40);
-  a40=(a40*a41);
-  a38=(a38/a40);
-  a38=(a01+a38);
-  a33=(a33/a38);
-  a16=(a16-a33);
-  a33=(a01*a16);
-  a33=(a33-a14);
-  a38=(a20+a16);
-  a40=casadi_sq(a38);
-  a40=(a13/a40);
-  a33=(a33-a40);
-  a40=(2.f*a13);
-  a41=casadi_sq(a38);
-  a38=(a38*a41);
-  a40=(a40/a38);
-  a40=(a01+a40);
-  a33=(a33/a40);
-  a16=(a16-a33);
-  a33=(a01*a16);
-  a33=(a33-a14);
-  a20=(a20+a16);
-  a14=casadi_sq(a20);
-  a14=(a13/a14);
-  a33=(a33-a14);
-  a13=(2.f*a13);
-  a14=casadi_sq(a20);
-  a20=(a20*a14);
-  a13=(a13/a20);
-  a13=(a01+a13);
-  a33=(a33/a13);
-  a16=(a16-a33);
-  if (res[1]!=0) res[1][0]=a16;
-  a16=(a10/a01);
-  a03=(a03-a24);
-  a24=casadi_fabs(a03);
-  a24=(a24<a27);
-  a33=casadi_sq(a03);
-  a29=(a29*a33);
-  a33=casadi_fabs(a03);
-  a33=(a27-a33);
-  a03=casadi_fabs(a03);
-  a27=(a27+a03);
-  a33=(a33*a27);
-  a33=(a24!=0?a33:0);
-  a27=(a24==0);
-  a27=(a27!=0?a08:0);
-  a33=(a33+a27);
-  a29=(a29/a33);
-  a29=expf(a29);
-  a28=(a28*a29);
-  a24=(a24!=0?a28:0);
-  a23=(a23+a24);
-  a23=(a23-a26);
-  a26=(a23-a08);
-  a26=tanhf(a26);
-  a26=(a08-a26);
-  a26=(a17*a26);
-  a26=(a00*a26);
-  a24=(a26/a37);
-  a24=powf(a24,a06);
-  a28=(a01*a23);
-  a28=(a28+a10);
-  a28=(-a28);
-  a28=casadi_fmax(a28,a15);
-  a28=casadi_fmax(a28,a39);
-  a28=(2.f*a28);
-  a28=(a26/a28);
-  a28=sqrtf(a28);
-  a24=casadi_fmin(a24,a28);
-  a24=(a24-a23);
-  a16=casadi_fmax(a16,a24);
-  a24=(a01*a16);
-  a24=(a24-a10);
-  a28=(a23+a16);
-  a29=casadi_sq(a28);
-  a29=(a26/a29);
-  a24=(a24-a29);
-  a29=(2.f*a26);
-  a33=casadi_sq(a28);
-  a28=(a28*a33);
-  a29=(a29/a28);
-  a29=(a01+a29);
-  a24=(a24/a29);
-  a16=(a16-a24);
-  a24=(a01*a16);
-  a24=(a24-a10);
-  a29=(a23+a16);
-  a28=casadi_sq(a29);
-  a28=(a26/a28);
-  a24=(a24-a28);
-  a28=(2.f*a26);
-  a33=casadi_sq(a29);
-  a29=(a29*a33);
-  a28=(a28/a29);
-  a28=(a01+a28);
-  a24=(a24/a28);
-  a16=(a16-a24);
-  a24=(a01*a16);
-  a24=(a24-a10);
-  a28=(a23+a16);
-  a29=casadi_sq(a28);
-  a29=(a26/a29);
-  a24=(a24-a29);
-  a29=(2.f*a26);
-  a33=casadi_sq(a28);
-  a28=(a28*a33);
-  a29=(a29/a28);
-  a29=(a01+a29);
-  a24=(a24/a29);
-  a16=(a16-a24);
-  a24=(a01*a16);
-  a24=(a24-a10);
-  a29=(a23+a16);
-  a28=casadi_sq(a29);
-  a28=(a26/a28);
-  a24=(a24-a28);
-  a28=(2.f*a26);
-  a33=casadi_sq(a29);
-  a29=(a29*a33);
-  a28=(a28/a29);
-  a28=(a01+a28);
-  a24=(a24/a28);
-  a16=(a16-a24);
-  a24=(a01*a16);
-  a24=(a24-a10);
-  a28=(a23+a16);
-  a29=casadi_sq(a28);
-  a29=(a26/a29);
-  a24=(a24-a29);
-  a29=(2.f*a26);
-  a33=casadi_sq(a28);
-  a28=(a28*a33);
-  a29=(a29/a28);
-  a29=(a01+a29);
-  a24=(a24/a29);
-  a16=(a16-a24);
-  a24=(a01*a16);
-  a24=(a24-a10);
-  a29=(a23+a16);
-  a28=casadi_sq(a29);
-  a28=(a26/a28);
-  a24=(a24-a28);
-  a28=(2.f*a26);
-  a33=casadi_sq(a29);
-  a29=(a29*a33);
-  a28=(a28/a29);
-  a28=(a01+a28);
-  a24=(a24/a28);
-  a16=(a16-a24);
-  a24=(a01*a16);
-  a24=(a24-a10);
-  a28=(a23+a16);
-  a29=casadi_sq(a28);
-  a29=(a26/a29);
-  a24=(a24-a29);
-  a29=(2.f*a26);
-  a33=casadi_sq(a28);
-  a28=(a28*a33);
-  a29=(a29/a28);
-  a29=(a01+a29);
-  a24=(a24/a29);
-  a16=(a16-a24);
-  a24=(a01*a16);
-  a24=(a24-a10);
-  a23=(a23+a16);
-  a10=casadi_sq(a23);
-  a10=(a26/a10);
-  a24=(a24-a10);
-  a26=(2.f*a26);
-  a10=casadi_sq(a23);
-  a23=(a23*a10);
-  a26=(a26/a23);
-  a26=(a01+a26);
-  a24=(a24/a26);
-  a16=(a16-a24);
-  if (res[1]!=0) res[1][1]=a16;
-  a16=(a36/a01);
-  a24=1.2000000000000000e+00f;
-  a25=(a25*a04);
-  a25=(a25+a35);
-  a24=(a24-a25);
-  a25=(a24-a08);
-  a25=tanhf(a25);
-  a25=(a08-a25);
-  a25=(a17*a25);
-  a25=(a00*a25);
-  a35=(a25/a37);
-  a35=powf(a35,a06);
-  a26=(a01*a24);
-  a26=(a26+a36);
-  a26=(-a26);
-  a26=casadi_fmax(a26,a15);
-  a26=casadi_fmax(a26,a39);
-  a26=(2.f*a26);
-  a26=(a25/a26);
-  a26=sqrtf(a26);
-  a35=casadi_fmin(a35,a26);
-  a35=(a35-a24);
-  a16=casadi_fmax(a16,a35);
-  a35=(a01*a16);
-  a35=(a35-a36);
-  a26=(a24+a16);
-  a23=casadi_sq(a26);
-  a23=(a25/a23);
-  a35=(a35-a23);
-  a23=(2.f*a25);
-  a10=casadi_sq(a26);
-  a26=(a26*a10);
-  a23=(a23/a26);
-  a23=(a01+a23);
-  a35=(a35/a23);
-  a16=(a16-a35);
-  a35=(a01*a16);
-  a35=(a35-a36);
-  a23=(a24+a16);
-  a26=casadi_sq(a23);
-  a26=(a25/a26);
-  a35=(a35-a26);
-  a26=(2.f*a25);
-  a10=casadi_sq(a23);
-  a23=(a23*a10);
-  a26=(a26/a23);
-  a26=(a01+a26);
-  a35=(a35/a26);
-  a16=(a16-a35);
-  a35=(a01*a16);
-  a35=(a35-a36);
-  a26=(a24+a16);
-  a23=casadi_sq(a26);
-  a23=(a25/a23);
-  a35=(a35-a23);
-  a23=(2.f*a25);
-  a10=casadi_sq(a26);
-  a26=(a26*a10);
-  a23=(a23/a26);
-  a23=(a01+a23);
-  a35=(a35/a23);
-  a16=(a16-a35);
-  a35=(a01*a16);
-  a35=(a35-a36);
-  a23=(a24+a16);
-  a26=casadi_sq(a23);
-  a26=(a25/a26);
-  a35=(a35-a26);
-  a26=(2.f*a25);
-  a10=casadi_sq(a23);
-  a23=(a23*a10);
-  a26=(a26/a23);
-  a26=(a01+a26);
-  a35=(a35/a26);
-  a16=(a16-a35);
-  a35=(a01*a16);
-  a35=(a35-a36);
-  a26=(a24+a16);
-  a23=casadi_sq(a26);
-  a23=(a25/a23);
-  a35=(a35-a23);
-  a23=(2.f*a25);
-  a10=casadi_sq(a26);
-  a26=(a26*a10);
-  a23=(a23/a26);
-  a23=(a01+a23);
-  a35=(a35/a23);
-  a16=(a16-a35);
-  a35=(a01*a16);
-  a35=(a35-a36);
-  a23=(a24+a16);
-  a26=casadi_sq(a23);
-  a26=(a25/a26);
-  a35=(a35-a26);
-  a26=(2.f*a25);
-  a10=casadi_sq(a23);
-  a23=(a23*a10);
-  a26=(a26/a23);
-  a26=(a01+a26);
-  a35=(a35/a26);
-  a16=(a16-a35);
-  a35=(a01*a16);
-  a35=(a35-a36);
-  a26=(a24+a16);
-  a23=casadi_sq(a26);
-  a23=(a25/a23);
-  a35=(a35-a23);
-  a23=(2.f*a25);
-  a10=casadi_sq(a26);
-  a26=(a26*a10);
-  a23=(a23/a26);
-  a23=(a01+a23);
-  a35=(a35/a23);
-  a16=(a16-a35);
-  a35=(a01*a16);
-  a35=(a35-a36);
-  a24=(a24+a16);
-  a36=casadi_sq(a24);
-  a36=(a25/a36);
-  a35=(a35-a36);
-  a25=(2.f*a25);
-  a36=casadi_sq(a24);
-  a24=(a24*a36);
-  a25=(a25/a24);
-  a25=(a01+a25);
-  a35=(a35/a25);
-  a16=(a16-a35);
-  if (res[1]!=0) res[1][2]=a16;
-  a16=(a09/a01);
-  a02=(a02*a04);
-  a02=(a02+a07);
-  a35=(a02-a08);
-  a35=tanhf(a35);
-  a35=(a08-a35);
-  a35=(a17*a35);
-  a35=(a00*a35);
-  a25=(a35/a37);
-  a25=powf(a25,a06);
-  a24=(a01*a02);
-  a24=(a24+a09);
-  a24=(-a24);
-  a24=casadi_fmax(a24,a15);
-  a24=casadi_fmax(a24,a39);
-  a24=(2.f*a24);
-  a24=(a35/a24);
-  a24=sqrtf(a24);
-  a25=casadi_fmin(a25,a24);
-  a25=(a25-a02);
-  a16=casadi_fmax(a16,a25);
-  a25=(a01*a16);
-  a25=(a25-a09);
-  a24=(a02+a16);
-  a36=casadi_sq(a24);
-  a36=(a35/a36);
-  a25=(a25-a36);
-  a36=(2.f*a35);
-  a23=casadi_sq(a24);
-  a24=(a24*a23);
-  a36=(a36/a24);
-  a36=(a01+a36);
-  a25=(a25/a36);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a09);
-  a36=(a02+a16);
-  a24=casadi_sq(a36);
-  a24=(a35/a24);
-  a25=(a25-a24);
-  a24=(2.f*a35);
-  a23=casadi_sq(a36);
-  a36=(a36*a23);
-  a24=(a24/a36);
-  a24=(a01+a24);
-  a25=(a25/a24);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a09);
-  a24=(a02+a16);
-  a36=casadi_sq(a24);
-  a36=(a35/a36);
-  a25=(a25-a36);
-  a36=(2.f*a35);
-  a23=casadi_sq(a24);
-  a24=(a24*a23);
-  a36=(a36/a24);
-  a36=(a01+a36);
-  a25=(a25/a36);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a09);
-  a36=(a02+a16);
-  a24=casadi_sq(a36);
-  a24=(a35/a24);
-  a25=(a25-a24);
-  a24=(2.f*a35);
-  a23=casadi_sq(a36);
-  a36=(a36*a23);
-  a24=(a24/a36);
-  a24=(a01+a24);
-  a25=(a25/a24);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a09);
-  a24=(a02+a16);
-  a36=casadi_sq(a24);
-  a36=(a35/a36);
-  a25=(a25-a36);
-  a36=(2.f*a35);
-  a23=casadi_sq(a24);
-  a24=(a24*a23);
-  a36=(a36/a24);
-  a36=(a01+a36);
-  a25=(a25/a36);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a09);
-  a36=(a02+a16);
-  a24=casadi_sq(a36);
-  a24=(a35/a24);
-  a25=(a25-a24);
-  a24=(2.f*a35);
-  a23=casadi_sq(a36);
-  a36=(a36*a23);
-  a24=(a24/a36);
-  a24=(a01+a24);
-  a25=(a25/a24);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a09);
-  a24=(a02+a16);
-  a36=casadi_sq(a24);
-  a36=(a35/a36);
-  a25=(a25-a36);
-  a36=(2.f*a35);
-  a23=casadi_sq(a24);
-  a24=(a24*a23);
-  a36=(a36/a24);
-  a36=(a01+a36);
-  a25=(a25/a36);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a09);
-  a02=(a02+a16);
-  a09=casadi_sq(a02);
-  a09=(a35/a09);
-  a25=(a25-a09);
-  a35=(2.f*a35);
-  a09=casadi_sq(a02);
-  a02=(a02*a09);
-  a35=(a35/a02);
-  a35=(a01+a35);
-  a25=(a25/a35);
-  a16=(a16-a25);
-  if (res[1]!=0) res[1][3]=a16;
-  a16=(a21/a01);
-  a25=-4.9500000000000002e+00f;
-  a35=7.4121228125278996e-06f;
-  a35=(a35*a00);
-  a02=(a35/a37);
-  a02=powf(a02,a06);
-  a09=(a18*a01);
-  a09=(a09+a21);
-  a09=(-a09);
-  a09=casadi_fmax(a09,a15);
-  a09=casadi_fmax(a09,a39);
-  a09=(2.f*a09);
-  a09=(a35/a09);
-  a09=sqrtf(a09);
-  a02=casadi_fmin(a02,a09);
-  a25=(a25+a02);
-  a16=casadi_fmax(a16,a25);
-  a25=(a01*a16);
-  a25=(a25-a21);
-  a02=(a18+a16);
-  a09=casadi_sq(a02);
-  a09=(a35/a09);
-  a25=(a25-a09);
-  a09=1.4824245625055799e-05f;
-  a36=(a09*a00);
-  a24=casadi_sq(a02);
-  a02=(a02*a24);
-  a36=(a36/a02);
-  a36=(a01+a36);
-  a25=(a25/a36);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a21);
-  a36=(a18+a16);
-  a02=casadi_sq(a36);
-  a02=(a35/a02);
-  a25=(a25-a02);
-  a02=(a09*a00);
-  a24=casadi_sq(a36);
-  a36=(a36*a24);
-  a02=(a02/a36);
-  a02=(a01+a02);
-  a25=(a25/a02);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a21);
-  a02=(a18+a16);
-  a36=casadi_sq(a02);
-  a36=(a35/a36);
-  a25=(a25-a36);
-  a36=(a09*a00);
-  a24=casadi_sq(a02);
-  a02=(a02*a24);
-  a36=(a36/a02);
-  a36=(a01+a36);
-  a25=(a25/a36);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a21);
-  a36=(a18+a16);
-  a02=casadi_sq(a36);
-  a02=(a35/a02);
-  a25=(a25-a02);
-  a02=(a09*a00);
-  a24=casadi_sq(a36);
-  a36=(a36*a24);
-  a02=(a02/a36);
-  a02=(a01+a02);
-  a25=(a25/a02);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a21);
-  a02=(a18+a16);
-  a36=casadi_sq(a02);
-  a36=(a35/a36);
-  a25=(a25-a36);
-  a36=(a09*a00);
-  a24=casadi_sq(a02);
-  a02=(a02*a24);
-  a36=(a36/a02);
-  a36=(a01+a36);
-  a25=(a25/a36);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a21);
-  a36=(a18+a16);
-  a02=casadi_sq(a36);
-  a02=(a35/a02);
-  a25=(a25-a02);
-  a02=(a09*a00);
-  a24=casadi_sq(a36);
-  a36=(a36*a24);
-  a02=(a02/a36);
-  a02=(a01+a02);
-  a25=(a25/a02);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a21);
-  a02=(a18+a16);
-  a36=casadi_sq(a02);
-  a36=(a35/a36);
-  a25=(a25-a36);
-  a36=(a09*a00);
-  a24=casadi_sq(a02);
-  a02=(a02*a24);
-  a36=(a36/a02);
-  a36=(a01+a36);
-  a25=(a25/a36);
-  a16=(a16-a25);
-  a25=(a01*a16);
-  a25=(a25-a21);
-  a18=(a18+a16);
-  a21=casadi_sq(a18);
-  a35=(a35/a21);
-  a25=(a25-a35);
-  a09=(a09*a00);
-  a35=casadi_sq(a18);
-  a18=(a18*a35);
-  a09=(a09/a18);
-  a09=(a01+a09);
-  a25=(a25/a09);
-  a16=(a16-a25);
-  if (res[1]!=0) res[1][4]=a16;
-  a16=(a31/a01);
-  a07=(a07*a04);
-  a07=(a07+a22);
-  a07=(a07-a34);
-  a34=(a07-a08);
-  a34=tanhf(a34);
-  a34=(a08-a34);
-  a17=(a17*a34);
-  a00=(a00*a17);
-  a37=(a00/a37);
-  a37=powf(a37,a06);
-  a06=(a01*a07);
-  a06=(a06+a31);
-  a06=(-a06);
-  a06=casadi_fmax(a06,a15);
-  a06=casadi_fmax(a06,a39);
-  a06=(2.f*a06);
-  a06=(a00/a06);
-  a06=sqrtf(a06);
-  a37=casadi_fmin(a37,a06);
-  a37=(a37-a07);
-  a16=casadi_fmax(a16,a37);
-  a37=(a01*a16);
-  a37=(a37-a31);
-  a06=(a07+a16);
-  a39=casadi_sq(a06);
-  a39=(a00/a39);
-  a37=(a37-a39);
-  a39=(2.f*a00);
-  a17=casadi_sq(a06);
-  a06=(a06*a17);
-  a39=(a39/a06);
-  a39=(a01+a39);
-  a37=(a37/a39);
-  a16=(a16-a37);
-  a37=(a01*a16);
-  a37=(a37-a31);
-  a39=(a07+a16);
-  a06=casadi_sq(a39);
-  a06=(a00/a06);
-  a37=(a37-a06);
-  a06=(2.f*a00);
-  a17=casadi_sq(a39);
-  a39=(a39*a17);
-  a06=(a06/a39);
-  a06=(a01+a06);
-  a37=(a37/a06);
-  a16=(a16-a37);
-  a37=(a01*a16);
-  a37=(a37-a31);
-  a06=(a07+a16);
-  a39=casadi_sq(a06);
-  a39=(a00/a39);
-  a37=(a37-a39);
-  a39=(2.f*a00);
-  a17=casadi_sq(a06);
-  a06=(a06*a17);
-  a39=(a39/a06);
-  a39=(a01+a39);
-  a37=(a37/a39);
-  a16=(a16-a37);
-  a37=(a01*a16);
-  a37=(a37-a31);
-  a39=(a07+a16);
-  a06=casadi_sq(a39);
-  a06=(a00/a06);
-  a37=(a37-a06);
-  a06=(2.f*a00);
-  a17=casadi_sq(a39);
-  a39=(a39*a17);
-  a06=(a06/a39);
-  a06=(a01+a06);
-  a37=(a37/a06);
-  a16=(a16-a37);
-  a37=(a01*a16);
-  a37=(a37-a31);
-  a06=(a07+a16);
-  a39=casadi_sq(a06);
-  a39=(a00/a39);
-  a37=(a37-a39);
-  a39=(2.f*a00);
-  a17=casadi_sq(a06);
-  a06=(a06*a17);
-  a39=(a39/a06);
-  a39=(a01+a39);
-  a37=(a37/a39);
-  a16=(a16-a37);
-  a37=(a01*a16);
-  a37=(a37-a31);
-  a39=(a07+a16);
-  a06=casadi_sq(a39);
-  a06=(a00/a06);
-  a37=(a37-a06);
-  a06=(2.f*a00);
-  a17=casadi_sq(a39);
-  a39=(a39*a17);
-  a06=(a06/a39);
-  a06=(a01+a06);
-  a37=(a37/a06);
-  a16=(a16-a37);
-  a37=(a01*a16);
-  a37=(a37-a31);
-  a06=(a07+a16);
-  a39=casadi_sq(a06);
-  a39=(a00/a39);
-  a37=(a37-a39);
-  a39=(2.f*a00);
-  a17=casadi_sq(a06);
-  a06=(a06*a17);
-  a39=(a39/a06);
-  a39=(a01+a39);
-  a37=(a37/a39);
-  a16=(a16-a37);
-  a37=(a01*a16);
-  a37=(a37-a31);
-  a07=(a07+a16);
-  a31=casadi_sq(a07);
-  a31=(a00/a31);
-  a37=(a37-a31);
-  a00=(2.f*a00);
-  a31=casadi_sq(a07);
-  a07=(a07*a31);
-  a00=(a00/a07);
-  a01=(a01+a00);
-  a37=(a37/a01);
-  a16=(a16-a37);
-  if (res[1]!=0) res[1][5]=a16;
-  a19=casadi_fabs(a19);
-  a19=(a19<a08);
-  a05=(a15<a05);
-  a19=(a19!=0&&a05!=0);
-  a19=(a08!=0&&a19!=0);
-  a32=casadi_fabs(a32);
-  a32=(a32<a08);
-  a30=(a15<a30);
-  a32=(a32!=0&&a30!=0);
-  a19=(a19!=0&&a32!=0);
-  a11=casadi_fabs(a11);
-  a11=(a11<a08);
-  a15=(a15<a12);
-  a11=(a11!=0&&a15!=0);
-  a19=(a19!=0&&a11!=0);
-  if (res[2]!=0) res[2][0]=a19;
-  return 0;
+/* CasADi Function 'candidates': 24 instructions. */
+static void body_candidates(const omnirobot_s1_real* rho, const omnirobot_s1_real* alpha, omnirobot_s1_real* c) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  w0 = rho[0];
+  w1 = alpha[0];
+  w0 = w0 - w1;
+  c[0] = w0;
+  w0 = rho[1];
+  w1 = alpha[1];
+  w0 = w0 - w1;
+  c[1] = w0;
+  w0 = rho[2];
+  w1 = alpha[2];
+  w0 = w0 - w1;
+  c[2] = w0;
+  w0 = rho[3];
+  w1 = alpha[3];
+  w0 = w0 + w1;
+  c[3] = w0;
+  w0 = rho[4];
+  w1 = alpha[4];
+  w0 = w0 + w1;
+  c[4] = w0;
+  w0 = rho[5];
+  w1 = alpha[5];
+  w0 = w0 + w1;
+  c[5] = w0;
+}
+
+/* CasADi Function 'candidate_rates': 24 instructions. */
+static void body_candidate_rates(const omnirobot_s1_real* rho_dot, const omnirobot_s1_real* alpha_dot, omnirobot_s1_real* c_dot) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  w0 = rho_dot[0];
+  w1 = alpha_dot[0];
+  w0 = w0 - w1;
+  c_dot[0] = w0;
+  w0 = rho_dot[1];
+  w1 = alpha_dot[1];
+  w0 = w0 - w1;
+  c_dot[1] = w0;
+  w0 = rho_dot[2];
+  w1 = alpha_dot[2];
+  w0 = w0 - w1;
+  c_dot[2] = w0;
+  w0 = rho_dot[3];
+  w1 = alpha_dot[3];
+  w0 = w0 + w1;
+  c_dot[3] = w0;
+  w0 = rho_dot[4];
+  w1 = alpha_dot[4];
+  w0 = w0 + w1;
+  c_dot[4] = w0;
+  w0 = rho_dot[5];
+  w1 = alpha_dot[5];
+  w0 = w0 + w1;
+  c_dot[5] = w0;
+}
+
+/* CasADi Function 'smooth_max_test': 17 instructions. */
+static void body_smooth_max_test(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* nu, omnirobot_s1_real* max, omnirobot_s1_real* needed) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  w0 = a[0];
+  w1 = b[0];
+  w2 = (w1 > w0) ? w1 : w0;
+  max[0] = w2;
+  w3 = 40.0f;
+  w4 = nu[0];
+  w0 = w0 - w1;
+  w0 = fabsf(w0);
+  w0 = w4 * w0;
+  w3 = (w3 <= w0) ? 1.0f : 0.0f;
+  w0 = 0.07656119366529843f;
+  w0 = w0 / w4;
+  w2 = fabsf(w2);
+  w0 = (w0 <= w2) ? 1.0f : 0.0f;
+  w3 = ((w3 != 0.0f) && (w0 != 0.0f)) ? 1.0f : 0.0f;
+  w3 = (w3 == 0.0f) ? 1.0f : 0.0f;
+  needed[0] = w3;
+}
+
+/* CasADi Function 'smooth_max': 15 instructions. */
+static void body_smooth_max(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* nu, omnirobot_s1_real* max) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  w0 = a[0];
+  w1 = b[0];
+  w2 = (w1 > w0) ? w1 : w0;
+  w3 = nu[0];
+  w0 = w0 - w1;
+  w0 = fabsf(w0);
+  w0 = w3 * w0;
+  w0 = -w0;
+  w1 = -80.0f;
+  w0 = (w1 > w0) ? w1 : w0;
+  w0 = expf(w0);
+  w0 = log1pf(w0);
+  w0 = w0 / w3;
+  w2 = w2 + w0;
+  max[0] = w2;
+}
+
+/* CasADi Function 'smooth_min_test': 20 instructions. */
+static void body_smooth_min_test(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* nu, omnirobot_s1_real* min, omnirobot_s1_real* needed) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  w0 = a[0];
+  w1 = -w0;
+  w2 = b[0];
+  w3 = -w2;
+  w1 = (w3 > w1) ? w3 : w1;
+  w3 = -w1;
+  min[0] = w3;
+  w3 = 40.0f;
+  w4 = nu[0];
+  w2 = w2 - w0;
+  w2 = fabsf(w2);
+  w2 = w4 * w2;
+  w3 = (w3 <= w2) ? 1.0f : 0.0f;
+  w2 = 0.07656119366529843f;
+  w2 = w2 / w4;
+  w1 = fabsf(w1);
+  w2 = (w2 <= w1) ? 1.0f : 0.0f;
+  w3 = ((w3 != 0.0f) && (w2 != 0.0f)) ? 1.0f : 0.0f;
+  w3 = (w3 == 0.0f) ? 1.0f : 0.0f;
+  needed[0] = w3;
+}
+
+/* CasADi Function 'smooth_min': 18 instructions. */
+static void body_smooth_min(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* nu, omnirobot_s1_real* min) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  w0 = a[0];
+  w1 = -w0;
+  w2 = b[0];
+  w3 = -w2;
+  w1 = (w3 > w1) ? w3 : w1;
+  w3 = nu[0];
+  w2 = w2 - w0;
+  w2 = fabsf(w2);
+  w2 = w3 * w2;
+  w2 = -w2;
+  w0 = -80.0f;
+  w2 = (w0 > w2) ? w0 : w2;
+  w2 = expf(w2);
+  w2 = log1pf(w2);
+  w2 = w2 / w3;
+  w1 = w1 + w2;
+  w1 = -w1;
+  min[0] = w1;
+}
+
+/* CasADi Function 'smooth_max_rate': 40 instructions. */
+static void body_smooth_max_rate(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* a_dot, const omnirobot_s1_real* b_dot, const omnirobot_s1_real* nu, omnirobot_s1_real* max_dot) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  omnirobot_s1_real w8;
+  w0 = b[0];
+  w1 = a[0];
+  w2 = (w0 <= w1) ? 1.0f : 0.0f;
+  w3 = (w1 <= w0) ? 1.0f : 0.0f;
+  w4 = w2 + w3;
+  w2 = w2 / w4;
+  w5 = nu[0];
+  w1 = w1 - w0;
+  w0 = fabsf(w1);
+  w0 = w5 * w0;
+  w0 = -w0;
+  w6 = -80.0f;
+  w7 = (w6 > w0) ? w6 : w0;
+  w7 = expf(w7);
+  w8 = (w6 <= w0) ? 1.0f : 0.0f;
+  w0 = (w0 <= w6) ? 1.0f : 0.0f;
+  w0 = w8 + w0;
+  w8 = w8 / w0;
+  w1 = (w1 < 0.0f) ? -1.0f : ((w1 > 0.0f) ? 1.0f : w1);
+  w0 = w5 * w1;
+  w0 = w8 * w0;
+  w0 = w7 * w0;
+  w6 = 1.0f;
+  w6 = w6 + w7;
+  w0 = w0 / w6;
+  w0 = w0 / w5;
+  w2 = w2 - w0;
+  w0 = a_dot[0];
+  w2 = w2 * w0;
+  w3 = w3 / w4;
+  w1 = w5 * w1;
+  w8 = w8 * w1;
+  w7 = w7 * w8;
+  w7 = w7 / w6;
+  w7 = w7 / w5;
+  w3 = w3 + w7;
+  w7 = b_dot[0];
+  w3 = w3 * w7;
+  w2 = w2 + w3;
+  max_dot[0] = w2;
+}
+
+/* CasADi Function 'smooth_min_rate': 42 instructions. */
+static void body_smooth_min_rate(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* a_dot, const omnirobot_s1_real* b_dot, const omnirobot_s1_real* nu, omnirobot_s1_real* min_dot) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  omnirobot_s1_real w8;
+  w0 = a[0];
+  w1 = -w0;
+  w2 = b[0];
+  w3 = -w2;
+  w4 = (w1 <= w3) ? 1.0f : 0.0f;
+  w3 = (w3 <= w1) ? 1.0f : 0.0f;
+  w1 = w3 + w4;
+  w4 = w4 / w1;
+  w5 = nu[0];
+  w2 = w2 - w0;
+  w0 = fabsf(w2);
+  w0 = w5 * w0;
+  w0 = -w0;
+  w6 = -80.0f;
+  w7 = (w6 > w0) ? w6 : w0;
+  w7 = expf(w7);
+  w8 = (w6 <= w0) ? 1.0f : 0.0f;
+  w0 = (w0 <= w6) ? 1.0f : 0.0f;
+  w0 = w8 + w0;
+  w8 = w8 / w0;
+  w2 = (w2 < 0.0f) ? -1.0f : ((w2 > 0.0f) ? 1.0f : w2);
+  w0 = w5 * w2;
+  w0 = w8 * w0;
+  w0 = w7 * w0;
+  w6 = 1.0f;
+  w6 = w6 + w7;
+  w0 = w0 / w6;
+  w0 = w0 / w5;
+  w4 = w4 + w0;
+  w0 = b_dot[0];
+  w4 = w4 * w0;
+  w2 = w5 * w2;
+  w8 = w8 * w2;
+  w7 = w7 * w8;
+  w7 = w7 / w6;
+  w7 = w7 / w5;
+  w3 = w3 / w1;
+  w7 = w7 - w3;
+  w3 = a_dot[0];
+  w7 = w7 * w3;
+  w4 = w4 - w7;
+  min_dot[0] = w4;
+}
+
+/* CasADi Function 'conflict': 78 instructions. */
+static void body_conflict(const omnirobot_s1_real* rho, const omnirobot_s1_real* beta, const omnirobot_s1_real* theta0, const omnirobot_s1_real* mu, omnirobot_s1_real* psi, omnirobot_s1_real* theta) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  omnirobot_s1_real w8;
+  omnirobot_s1_real w9;
+  omnirobot_s1_real w10;
+  w0 = beta[3];
+  w1 = rho[0];
+  w0 = w0 - w1;
+  psi[0] = w0;
+  w1 = beta[4];
+  w2 = rho[1];
+  w1 = w1 - w2;
+  psi[1] = w1;
+  w2 = beta[5];
+  w3 = rho[2];
+  w2 = w2 - w3;
+  psi[2] = w2;
+  w3 = rho[3];
+  w4 = beta[0];
+  w3 = w3 - w4;
+  psi[3] = w3;
+  w4 = rho[4];
+  w5 = beta[1];
+  w4 = w4 - w5;
+  psi[4] = w4;
+  w5 = rho[5];
+  w6 = beta[2];
+  w5 = w5 - w6;
+  psi[5] = w5;
+  w6 = theta0[0];
+  w6 = w6 + w6;
+  w7 = 1.0f;
+  w8 = mu[0];
+  w0 = w0 - w8;
+  w0 = w0 + w0;
+  w9 = -80.0f;
+  w0 = (w9 > w0) ? w9 : w0;
+  w10 = 80.0f;
+  w0 = (w10 < w0) ? w10 : w0;
+  w0 = expf(w0);
+  w0 = w7 + w0;
+  w0 = w6 / w0;
+  theta[0] = w0;
+  w1 = w1 - w8;
+  w1 = w1 + w1;
+  w1 = (w9 > w1) ? w9 : w1;
+  w1 = (w10 < w1) ? w10 : w1;
+  w1 = expf(w1);
+  w1 = w7 + w1;
+  w1 = w6 / w1;
+  theta[1] = w1;
+  w2 = w2 - w8;
+  w2 = w2 + w2;
+  w2 = (w9 > w2) ? w9 : w2;
+  w2 = (w10 < w2) ? w10 : w2;
+  w2 = expf(w2);
+  w2 = w7 + w2;
+  w2 = w6 / w2;
+  theta[2] = w2;
+  w3 = w3 - w8;
+  w3 = w3 + w3;
+  w3 = (w9 > w3) ? w9 : w3;
+  w3 = (w10 < w3) ? w10 : w3;
+  w3 = expf(w3);
+  w3 = w7 + w3;
+  w3 = w6 / w3;
+  theta[3] = w3;
+  w4 = w4 - w8;
+  w4 = w4 + w4;
+  w4 = (w9 > w4) ? w9 : w4;
+  w4 = (w10 < w4) ? w10 : w4;
+  w4 = expf(w4);
+  w4 = w7 + w4;
+  w4 = w6 / w4;
+  theta[4] = w4;
+  w5 = w5 - w8;
+  w5 = w5 + w5;
+  w5 = (w9 > w5) ? w9 : w5;
+  w5 = (w10 < w5) ? w10 : w5;
+  w5 = expf(w5);
+  w7 = w7 + w5;
+  w6 = w6 / w7;
+  theta[5] = w6;
+}
+
+/* CasADi Function 'alpha_rate': 55 instructions. */
+static void body_alpha_rate(const omnirobot_s1_real* alpha, const omnirobot_s1_real* psi, const omnirobot_s1_real* theta, const omnirobot_s1_real* kappa, omnirobot_s1_real* alpha_dot) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  w0 = theta[0];
+  w1 = psi[0];
+  w2 = alpha[0];
+  w1 = w1 + w2;
+  w1 = w1 * w1;
+  w0 = w0 / w1;
+  w1 = kappa[0];
+  w2 = w1 * w2;
+  w0 = w0 - w2;
+  alpha_dot[0] = w0;
+  w0 = theta[1];
+  w2 = psi[1];
+  w3 = alpha[1];
+  w2 = w2 + w3;
+  w2 = w2 * w2;
+  w0 = w0 / w2;
+  w3 = w1 * w3;
+  w0 = w0 - w3;
+  alpha_dot[1] = w0;
+  w0 = theta[2];
+  w3 = psi[2];
+  w2 = alpha[2];
+  w3 = w3 + w2;
+  w3 = w3 * w3;
+  w0 = w0 / w3;
+  w2 = w1 * w2;
+  w0 = w0 - w2;
+  alpha_dot[2] = w0;
+  w0 = theta[3];
+  w2 = psi[3];
+  w3 = alpha[3];
+  w2 = w2 + w3;
+  w2 = w2 * w2;
+  w0 = w0 / w2;
+  w3 = w1 * w3;
+  w0 = w0 - w3;
+  alpha_dot[3] = w0;
+  w0 = theta[4];
+  w3 = psi[4];
+  w2 = alpha[4];
+  w3 = w3 + w2;
+  w3 = w3 * w3;
+  w0 = w0 / w3;
+  w2 = w1 * w2;
+  w0 = w0 - w2;
+  alpha_dot[4] = w0;
+  w0 = theta[5];
+  w2 = psi[5];
+  w3 = alpha[5];
+  w2 = w2 + w3;
+  w2 = w2 * w2;
+  w0 = w0 / w2;
+  w1 = w1 * w3;
+  w0 = w0 - w1;
+  alpha_dot[5] = w0;
+}
+
+/* CasADi Function 'later': 4 instructions. */
+static void body_later(const omnirobot_s1_real* t, const omnirobot_s1_real* dt, omnirobot_s1_real* t_next) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  w0 = t[0];
+  w1 = dt[0];
+  w0 = w0 + w1;
+  t_next[0] = w0;
+}
+
+/* CasADi Function 'newton_start': 24 instructions. */
+static void body_newton_start(const omnirobot_s1_real* alpha, const omnirobot_s1_real* psi, const omnirobot_s1_real* theta, const omnirobot_s1_real* dt, const omnirobot_s1_real* kappa, omnirobot_s1_real* a0, omnirobot_s1_real* c, omnirobot_s1_real* A, omnirobot_s1_real* root) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  w0 = alpha[0];
+  w1 = 1.0f;
+  w2 = kappa[0];
+  w3 = dt[0];
+  w2 = w2 * w3;
+  w1 = w1 + w2;
+  w0 = w0 / w1;
+  a0[0] = w0;
+  c[0] = w1;
+  w2 = theta[0];
+  w3 = w3 * w2;
+  A[0] = w3;
+  w2 = 0.0f;
+  w4 = psi[0];
+  w4 = w4 + w0;
+  w2 = (w2 < w4) ? 1.0f : 0.0f;
+  w1 = w1 + w1;
+  w0 = w4 * w4;
+  w0 = w0 * w4;
+  w1 = w1 * w0;
+  w3 = (w3 <= w1) ? 1.0f : 0.0f;
+  w2 = ((w2 != 0.0f) && (w3 != 0.0f)) ? 1.0f : 0.0f;
+  w2 = (w2 == 0.0f) ? 1.0f : 0.0f;
+  root[0] = w2;
+}
+
+/* CasADi Function 'newton_root_start': 23 instructions. */
+static void body_newton_root_start(const omnirobot_s1_real* alpha, const omnirobot_s1_real* psi, const omnirobot_s1_real* c, const omnirobot_s1_real* A, omnirobot_s1_real* a0) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  w0 = alpha[0];
+  w1 = c[0];
+  w2 = w0 / w1;
+  w3 = A[0];
+  w4 = w1 + w1;
+  w4 = w3 / w4;
+  w5 = 0.3333333333333333f;
+  w4 = powf(w4, w5);
+  w5 = psi[0];
+  w1 = w1 * w5;
+  w1 = w1 + w0;
+  w1 = -w1;
+  w0 = 0.0f;
+  w1 = (w0 > w1) ? w0 : w1;
+  w0 = 1e-30f;
+  w1 = (w0 > w1) ? w0 : w1;
+  w1 = w1 + w1;
+  w3 = w3 / w1;
+  w3 = sqrtf(w3);
+  w4 = (w3 < w4) ? w3 : w4;
+  w4 = w4 - w5;
+  w2 = (w4 > w2) ? w4 : w2;
+  a0[0] = w2;
+}
+
+/* CasADi Function 'newton_iteration': 19 instructions. */
+static void body_newton_iteration(const omnirobot_s1_real* a, const omnirobot_s1_real* alpha, const omnirobot_s1_real* psi, const omnirobot_s1_real* c, const omnirobot_s1_real* A, omnirobot_s1_real* a_next) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  w0 = a[0];
+  w1 = psi[0];
+  w1 = w1 + w0;
+  w2 = w1 * w1;
+  w3 = c[0];
+  w4 = w3 * w0;
+  w5 = alpha[0];
+  w4 = w4 - w5;
+  w4 = w2 * w4;
+  w5 = A[0];
+  w4 = w4 - w5;
+  w4 = w1 * w4;
+  w2 = w2 * w1;
+  w3 = w3 * w2;
+  w5 = w5 + w5;
+  w3 = w3 + w5;
+  w4 = w4 / w3;
+  w0 = w0 - w4;
+  a_next[0] = w0;
+}
+
+/* CasADi Function 'law': 92 instructions. */
+static void body_law(const omnirobot_s1_real* x, const omnirobot_s1_real* gamma_L, const omnirobot_s1_real* gamma_U, const omnirobot_s1_real* gain, omnirobot_s1_real* u, omnirobot_s1_real* inside) {
+  omnirobot_s1_real w0;
+  omnirobot_s1_real w1;
+  omnirobot_s1_real w2;
+  omnirobot_s1_real w3;
+  omnirobot_s1_real w4;
+  omnirobot_s1_real w5;
+  omnirobot_s1_real w6;
+  omnirobot_s1_real w7;
+  omnirobot_s1_real w8;
+  omnirobot_s1_real w9;
+  omnirobot_s1_real w10;
+  omnirobot_s1_real w11;
+  omnirobot_s1_real w12;
+  omnirobot_s1_real w13;
+  w0 = gain[0];
+  w1 = 4.0f;
+  w2 = gamma_U[0];
+  w3 = gamma_L[0];
+  w4 = w2 - w3;
+  w5 = 1e-06f;
+  w6 = (w5 > w4) ? w5 : w4;
+  w7 = 1.0f;
+  w8 = x[0];
+  w8 = w8 + w8;
+  w2 = w2 + w3;
+  w8 = w8 - w2;
+  w8 = w8 / w6;
+  w2 = -0.9999990463256836f;
+  w3 = (w2 > w8) ? w2 : w8;
+  w9 = 0.9999990463256836f;
+  w3 = (w9 < w3) ? w9 : w3;
+  w10 = w3 * w3;
+  w10 = w7 - w10;
+  w6 = w6 * w10;
+  w6 = w1 / w6;
+  w6 = w0 * w6;
+  w10 = w7 + w3;
+  w3 = w7 - w3;
+  w10 = w10 / w3;
+  w10 = logf(w10);
+  w6 = w6 * w10;
+  w6 = -w6;
+  u[0] = w6;
+  w6 = gamma_U[1];
+  w10 = gamma_L[1];
+  w3 = w6 - w10;
+  w11 = (w5 > w3) ? w5 : w3;
+  w12 = x[1];
+  w12 = w12 + w12;
+  w6 = w6 + w10;
+  w12 = w12 - w6;
+  w12 = w12 / w11;
+  w6 = (w2 > w12) ? w2 : w12;
+  w6 = (w9 < w6) ? w9 : w6;
+  w10 = w6 * w6;
+  w10 = w7 - w10;
+  w11 = w11 * w10;
+  w11 = w1 / w11;
+  w11 = w0 * w11;
+  w10 = w7 + w6;
+  w6 = w7 - w6;
+  w10 = w10 / w6;
+  w10 = logf(w10);
+  w11 = w11 * w10;
+  w11 = -w11;
+  u[1] = w11;
+  w11 = gamma_U[2];
+  w10 = gamma_L[2];
+  w6 = w11 - w10;
+  w5 = (w5 > w6) ? w5 : w6;
+  w13 = x[2];
+  w13 = w13 + w13;
+  w11 = w11 + w10;
+  w13 = w13 - w11;
+  w13 = w13 / w5;
+  w2 = (w2 > w13) ? w2 : w13;
+  w2 = (w9 < w2) ? w9 : w2;
+  w9 = w2 * w2;
+  w9 = w7 - w9;
+  w5 = w5 * w9;
+  w1 = w1 / w5;
+  w0 = w0 * w1;
+  w1 = w7 + w2;
+  w2 = w7 - w2;
+  w1 = w1 / w2;
+  w1 = logf(w1);
+  w0 = w0 * w1;
+  w0 = -w0;
+  u[2] = w0;
+  w8 = fabsf(w8);
+  w8 = (w8 < w7) ? 1.0f : 0.0f;
+  w0 = 0.0f;
+  w4 = (w0 < w4) ? 1.0f : 0.0f;
+  w8 = ((w8 != 0.0f) && (w4 != 0.0f)) ? 1.0f : 0.0f;
+  w8 = ((w7 != 0.0f) && (w8 != 0.0f)) ? 1.0f : 0.0f;
+  w12 = fabsf(w12);
+  w12 = (w12 < w7) ? 1.0f : 0.0f;
+  w3 = (w0 < w3) ? 1.0f : 0.0f;
+  w12 = ((w12 != 0.0f) && (w3 != 0.0f)) ? 1.0f : 0.0f;
+  w8 = ((w8 != 0.0f) && (w12 != 0.0f)) ? 1.0f : 0.0f;
+  w13 = fabsf(w13);
+  w13 = (w13 < w7) ? 1.0f : 0.0f;
+  w0 = (w0 < w6) ? 1.0f : 0.0f;
+  w13 = ((w13 != 0.0f) && (w0 != 0.0f)) ? 1.0f : 0.0f;
+  w8 = ((w8 != 0.0f) && (w13 != 0.0f)) ? 1.0f : 0.0f;
+  inside[0] = w8;
 }
 
 /* ----------------------------------------------------------------- typed API */
 
 static int omnirobot_s1_finite(const omnirobot_s1_real* v, int count) {
   int i;
+  int ok = 1;
   for (i = 0; i < count; ++i) {
-    if (!isfinite(v[i])) return 0;
+    if (isfinite(v[i]) == 0) {
+      ok = 0;
+    }
   }
-  return 1;
+  return ok;
 }
 
 /* alpha in the domain of the adaptive law: every entry finite, in [0, ALPHA_MAX]. */
 static int omnirobot_s1_alpha_valid(const omnirobot_s1_real* a) {
   int i;
+  int ok = 1;
   for (i = 0; i < OMNIROBOT_S1_N_ALPHA; ++i) {
-    if (!(a[i] >= 0 && a[i] <= OMNIROBOT_S1_ALPHA_MAX)) return 0;
+    if (!((a[i] >= 0.0f) && (a[i] <= OMNIROBOT_S1_ALPHA_MAX))) {
+      ok = 0;
+    }
   }
-  return 1;
+  return ok;
 }
 
-/* t and dt in their domain: t >= 0 finite, DT_MIN <= dt <= DT_MAX. */
+/* t in its domain: finite, t >= 0. */
 static int omnirobot_s1_time_valid(omnirobot_s1_real t) {
-  return isfinite(t) && t >= 0;
+  int ok = 0;
+  if ((isfinite(t) != 0) && (t >= 0.0f)) {
+    ok = 1;
+  }
+  return ok;
 }
 
+/* dt in its domain: DT_MIN <= dt <= DT_MAX. */
 static int omnirobot_s1_dt_valid(omnirobot_s1_real dt) {
-  return dt >= OMNIROBOT_S1_DT_MIN && dt <= OMNIROBOT_S1_DT_MAX;
+  int ok = 0;
+  if ((dt >= OMNIROBOT_S1_DT_MIN) && (dt <= OMNIROBOT_S1_DT_MAX)) {
+    ok = 1;
+  }
+  return ok;
 }
 
 static void omnirobot_s1_copy(const omnirobot_s1_real* from, omnirobot_s1_real* to, int count) {
   int i;
-  for (i = 0; i < count; ++i) to[i] = from[i];
+  for (i = 0; i < count; ++i) {
+    to[i] = from[i];
+  }
 }
 
 /* alpha_next on INVALID_INPUT: alpha, with every non-finite entry replaced by 0. */
 static void omnirobot_s1_keep_alpha(const omnirobot_s1_real* from, omnirobot_s1_real* to) {
   int i;
-  for (i = 0; i < OMNIROBOT_S1_N_ALPHA; ++i) to[i] = isfinite(from[i]) ? from[i] : 0;
+  for (i = 0; i < OMNIROBOT_S1_N_ALPHA; ++i) {
+    to[i] = (isfinite(from[i]) != 0) ? from[i] : 0.0f;
+  }
 }
 
 static void omnirobot_s1_zero(omnirobot_s1_real* v, int count) {
+  if (v != NULL) {
+    int i;
+    for (i = 0; i < count; ++i) {
+      v[i] = 0.0f;
+    }
+  }
+}
+
+/* ------------------------------------------------------- composition (tables) */
+
+/* rho [L; U] of eq. (4) at t (and rho_dot when rates != 0): the first segment whose end is
+   after t (the last one after every end). */
+static void omnirobot_s1_reach(omnirobot_s1_real t, int rates, omnirobot_s1_real* rho, omnirobot_s1_real* rho_dot) {
+  omnirobot_s1_real p = 0.0f;
+  omnirobot_s1_real p_dot = 0.0f;
+  int k = OMNIROBOT_S1_N_SEGMENTS - 1;
+  int j;
+  for (j = OMNIROBOT_S1_N_SEGMENTS - 2; j >= 0; --j) {
+    if (t < OMNIROBOT_S1_SEGMENTS[j].end) {
+      k = j;
+    }
+  }
+  if (OMNIROBOT_S1_SEGMENTS[k].profile == 0) {
+    if (rates != 0) {
+      body_progress_tanh(&t, &OMNIROBOT_S1_SEGMENTS[k].start, &OMNIROBOT_S1_SEGMENTS[k].end, &p, &p_dot);
+    } else {
+      body_progress_tanh_value(&t, &OMNIROBOT_S1_SEGMENTS[k].start, &OMNIROBOT_S1_SEGMENTS[k].end, &p);
+    }
+  }
+  if (rates != 0) {
+    body_interpolate(&p, &p_dot, OMNIROBOT_S1_SEGMENTS[k].from, OMNIROBOT_S1_SEGMENTS[k].to, rho, rho_dot);
+  } else {
+    body_interpolate_value(&p, OMNIROBOT_S1_SEGMENTS[k].from, OMNIROBOT_S1_SEGMENTS[k].to, rho);
+  }
+}
+
+/* beta [L; U] of eq. (9) at t (and beta_dot when rates != 0), over the open windows only (a
+   closed window adds exactly 0 to F_nu). */
+static void omnirobot_s1_circumvent(omnirobot_s1_real t, int rates, omnirobot_s1_real* beta,
+    omnirobot_s1_real* beta_dot) {
+  int b;
+  omnirobot_s1_real y[OMNIROBOT_S1_MAX_OPEN];
+  omnirobot_s1_real y_dot[OMNIROBOT_S1_MAX_OPEN];
+  int bound_of[OMNIROBOT_S1_MAX_OPEN];
+  int open = 0;
+  int lo = 0;
+  int hi = OMNIROBOT_S1_N_WINDOWS;
+  int first;
+  int j;
+  for (b = 0; b < OMNIROBOT_S1_N_ALPHA; ++b) {
+    beta[b] = OMNIROBOT_S1_BOUND[b];
+    beta_dot[b] = 0.0f;
+  }
+  for (j = 0; j < OMNIROBOT_S1_MAX_OPEN; ++j) {
+    y[j] = 0.0f;
+    y_dot[j] = 0.0f;
+    bound_of[j] = 0;
+  }
+  /* rows [0, hi) start before t (binary search); rows before `first` all ended by t */
+  while (lo < hi) {
+    int mid = lo + ((hi - lo) / 2);
+    if (OMNIROBOT_S1_WINDOWS[mid].start < t) {
+      lo = mid + 1;
+    } else {
+      hi = mid;
+    }
+  }
+  first = hi;
+  while ((first > 0) && (OMNIROBOT_S1_WINDOWS[first - 1].max_end > t)) {
+    first = first - 1;
+  }
+  for (j = first; j < hi; ++j) {
+    if ((t < OMNIROBOT_S1_WINDOWS[j].end) && (open < OMNIROBOT_S1_MAX_OPEN)) {
+      const omnirobot_s1_window* w = &OMNIROBOT_S1_WINDOWS[j];
+      if (rates != 0) {
+        body_bump(&t, &w->start, &w->end, &w->center, &w->radius, &w->sharpness, &w->height,
+                  &y[open], &y_dot[open]);
+      } else {
+        body_bump_value(&t, &w->start, &w->end, &w->center, &w->radius, &w->sharpness,
+                        &w->height, &y[open]);
+      }
+      bound_of[open] = w->bound;
+      open = open + 1;
+    }
+  }
+  for (j = 0; j < open; ++j) {
+    b = bound_of[j];
+    if (OMNIROBOT_S1_MEMBERS[b] == 1) {
+      body_fnu_single(&OMNIROBOT_S1_BOUND[b], &OMNIROBOT_S1_SIGN[b], &y[j], &y_dot[j], &beta[b],
+                      &beta_dot[b]);
+    }
+  }
+}
+
+/* gamma_L, gamma_U of eq. (10) from rho and beta: the smooth max/min's correction only where
+   it can change the max/min */
+static void omnirobot_s1_gamma_of(const omnirobot_s1_real* rho, const omnirobot_s1_real* beta,
+    const omnirobot_s1_real* a, omnirobot_s1_real* g_l, omnirobot_s1_real* g_u) {
+  omnirobot_s1_real c[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real needed;
   int i;
-  if (v == NULL) return;
-  for (i = 0; i < count; ++i) v[i] = 0;
+  body_candidates(rho, a, c);
+  for (i = 0; i < OMNIROBOT_S1_N; ++i) {
+    body_smooth_max_test(&c[i], &beta[i], &OMNIROBOT_S1_PARAMETERS.smoothness, &g_l[i], &needed);
+    if (needed != 0.0f) {
+      body_smooth_max(&c[i], &beta[i], &OMNIROBOT_S1_PARAMETERS.smoothness, &g_l[i]);
+    }
+    body_smooth_min_test(&c[OMNIROBOT_S1_N + i], &beta[OMNIROBOT_S1_N + i], &OMNIROBOT_S1_PARAMETERS.smoothness,
+                         &g_u[i], &needed);
+    if (needed != 0.0f) {
+      body_smooth_min(&c[OMNIROBOT_S1_N + i], &beta[OMNIROBOT_S1_N + i], &OMNIROBOT_S1_PARAMETERS.smoothness,
+                      &g_u[i]);
+    }
+  }
+}
+
+/* gamma_L, gamma_U of eq. (10) at (t, a) */
+static void omnirobot_s1_gamma(omnirobot_s1_real t, const omnirobot_s1_real* a, omnirobot_s1_real* g_l,
+    omnirobot_s1_real* g_u) {
+  omnirobot_s1_real rho[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real rho_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real beta[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real beta_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_reach(t, 0, rho, rho_dot);
+  omnirobot_s1_circumvent(t, 0, beta, beta_dot);
+  omnirobot_s1_gamma_of(rho, beta, a, g_l, g_u);
+}
+
+/* gamma and its total time derivative (alpha moving by (11)) at (t, a) */
+static void omnirobot_s1_gamma_and_rates(omnirobot_s1_real t, const omnirobot_s1_real* a, omnirobot_s1_real* g_l,
+    omnirobot_s1_real* g_u, omnirobot_s1_real* g_l_dot, omnirobot_s1_real* g_u_dot) {
+  omnirobot_s1_real rho[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real rho_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real beta[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real beta_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real psi[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real theta[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real a_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real c[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real c_dot[OMNIROBOT_S1_N_ALPHA];
+  int i;
+  omnirobot_s1_reach(t, 1, rho, rho_dot);
+  omnirobot_s1_circumvent(t, 1, beta, beta_dot);
+  omnirobot_s1_gamma_of(rho, beta, a, g_l, g_u);
+  body_conflict(rho, beta, &OMNIROBOT_S1_PARAMETERS.theta0, &OMNIROBOT_S1_PARAMETERS.mu, psi, theta);
+  body_alpha_rate(a, psi, theta, &OMNIROBOT_S1_PARAMETERS.kappa, a_dot);
+  body_candidates(rho, a, c);
+  body_candidate_rates(rho_dot, a_dot, c_dot);
+  for (i = 0; i < OMNIROBOT_S1_N; ++i) {
+    body_smooth_max_rate(&c[i], &beta[i], &c_dot[i], &beta_dot[i],
+                         &OMNIROBOT_S1_PARAMETERS.smoothness, &g_l_dot[i]);
+    body_smooth_min_rate(&c[OMNIROBOT_S1_N + i], &beta[OMNIROBOT_S1_N + i], &c_dot[OMNIROBOT_S1_N + i],
+                         &beta_dot[OMNIROBOT_S1_N + i], &OMNIROBOT_S1_PARAMETERS.smoothness, &g_u_dot[i]);
+  }
 }
 
 int omnirobot_s1_tube(omnirobot_s1_real t, const omnirobot_s1_real alpha[OMNIROBOT_S1_N_ALPHA],
     omnirobot_s1_real gamma_L[OMNIROBOT_S1_N], omnirobot_s1_real gamma_U[OMNIROBOT_S1_N],
     omnirobot_s1_real gamma_L_dot[OMNIROBOT_S1_N], omnirobot_s1_real gamma_U_dot[OMNIROBOT_S1_N]) {
-  omnirobot_s1_real a[OMNIROBOT_S1_N_ALPHA], g_l[OMNIROBOT_S1_N], g_u[OMNIROBOT_S1_N];
-  omnirobot_s1_real g_l_dot[OMNIROBOT_S1_N], g_u_dot[OMNIROBOT_S1_N];
-  const casadi_real* arg[OMNIROBOT_S1_SZ_ARG];
-  casadi_real* res[OMNIROBOT_S1_SZ_RES];
-  if (gamma_L == NULL || gamma_U == NULL) return OMNIROBOT_S1_STATUS_INVALID_INPUT;
-  if (alpha == NULL || !omnirobot_s1_time_valid(t) || !omnirobot_s1_alpha_valid(alpha)) {
-    omnirobot_s1_zero(gamma_L, OMNIROBOT_S1_N);
-    omnirobot_s1_zero(gamma_U, OMNIROBOT_S1_N);
-    omnirobot_s1_zero(gamma_L_dot, OMNIROBOT_S1_N);
-    omnirobot_s1_zero(gamma_U_dot, OMNIROBOT_S1_N);
-    return OMNIROBOT_S1_STATUS_INVALID_INPUT;
+  int status = OMNIROBOT_S1_STATUS_INVALID_INPUT;
+  if ((gamma_L != NULL) && (gamma_U != NULL)) {
+    omnirobot_s1_real g_l[OMNIROBOT_S1_N];
+    omnirobot_s1_real g_u[OMNIROBOT_S1_N];
+    omnirobot_s1_real g_l_dot[OMNIROBOT_S1_N];
+    omnirobot_s1_real g_u_dot[OMNIROBOT_S1_N];
+    int rates = 0;
+    if ((gamma_L_dot != NULL) || (gamma_U_dot != NULL)) {
+      rates = 1;
+    }
+    if ((alpha != NULL) && (omnirobot_s1_time_valid(t) != 0) && (omnirobot_s1_alpha_valid(alpha) != 0)) {
+      omnirobot_s1_real a[OMNIROBOT_S1_N_ALPHA];
+      omnirobot_s1_copy(alpha, a, OMNIROBOT_S1_N_ALPHA);
+      if (rates != 0) {
+        omnirobot_s1_gamma_and_rates(t, a, g_l, g_u, g_l_dot, g_u_dot);
+      } else {
+        omnirobot_s1_gamma(t, a, g_l, g_u);
+      }
+      /* the rates hold theta / (psi + alpha)^2: infinite where alpha is not one the
+         adaptive law reaches at t (psi + alpha <= 0) */
+      if ((omnirobot_s1_finite(g_l, OMNIROBOT_S1_N) != 0) && (omnirobot_s1_finite(g_u, OMNIROBOT_S1_N) != 0)
+          && ((rates == 0) || ((omnirobot_s1_finite(g_l_dot, OMNIROBOT_S1_N) != 0)
+                               && (omnirobot_s1_finite(g_u_dot, OMNIROBOT_S1_N) != 0)))) {
+        status = OMNIROBOT_S1_STATUS_OK;
+      }
+    }
+    if (status == OMNIROBOT_S1_STATUS_OK) {
+      omnirobot_s1_copy(g_l, gamma_L, OMNIROBOT_S1_N);
+      omnirobot_s1_copy(g_u, gamma_U, OMNIROBOT_S1_N);
+      if (gamma_L_dot != NULL) {
+        omnirobot_s1_copy(g_l_dot, gamma_L_dot, OMNIROBOT_S1_N);
+      }
+      if (gamma_U_dot != NULL) {
+        omnirobot_s1_copy(g_u_dot, gamma_U_dot, OMNIROBOT_S1_N);
+      }
+    } else {
+      omnirobot_s1_zero(gamma_L, OMNIROBOT_S1_N);
+      omnirobot_s1_zero(gamma_U, OMNIROBOT_S1_N);
+      omnirobot_s1_zero(gamma_L_dot, OMNIROBOT_S1_N);
+      omnirobot_s1_zero(gamma_U_dot, OMNIROBOT_S1_N);
+    }
   }
-  omnirobot_s1_copy(alpha, a, OMNIROBOT_S1_N_ALPHA);
-  arg[0] = &t;
-  arg[1] = a;
-  res[0] = g_l;
-  res[1] = g_u;
-  res[2] = g_l_dot;
-  res[3] = g_u_dot;
-  body_tube(arg, res, 0, 0, 0);
-  /* the rates hold theta / (psi + alpha)^2: infinite where alpha is not one the adaptive
-     law reaches at t (psi + alpha <= 0) */
-  if (!omnirobot_s1_finite(g_l, OMNIROBOT_S1_N) || !omnirobot_s1_finite(g_u, OMNIROBOT_S1_N)
-      || ((gamma_L_dot != NULL || gamma_U_dot != NULL)
-          && (!omnirobot_s1_finite(g_l_dot, OMNIROBOT_S1_N) || !omnirobot_s1_finite(g_u_dot, OMNIROBOT_S1_N)))) {
-    omnirobot_s1_zero(gamma_L, OMNIROBOT_S1_N);
-    omnirobot_s1_zero(gamma_U, OMNIROBOT_S1_N);
-    omnirobot_s1_zero(gamma_L_dot, OMNIROBOT_S1_N);
-    omnirobot_s1_zero(gamma_U_dot, OMNIROBOT_S1_N);
-    return OMNIROBOT_S1_STATUS_INVALID_INPUT;
+  return status;
+}
+
+/* u of law (13) at (x, t, a), x and a already checked; returns OK or OUTSIDE_TUBE, or
+   INVALID_INPUT when u is not finite. */
+static int omnirobot_s1_law(const omnirobot_s1_real* x, omnirobot_s1_real t, const omnirobot_s1_real* a,
+    omnirobot_s1_real* u) {
+  omnirobot_s1_real g_l[OMNIROBOT_S1_N];
+  omnirobot_s1_real g_u[OMNIROBOT_S1_N];
+  omnirobot_s1_real inside;
+  int status;
+  omnirobot_s1_gamma(t, a, g_l, g_u);
+  body_law(x, g_l, g_u, &OMNIROBOT_S1_PARAMETERS.gain, u, &inside);
+  if (omnirobot_s1_finite(u, OMNIROBOT_S1_N) == 0) {
+    status = OMNIROBOT_S1_STATUS_INVALID_INPUT;
+  } else if (inside != 0.0f) {
+    status = OMNIROBOT_S1_STATUS_OK;
+  } else {
+    status = OMNIROBOT_S1_STATUS_OUTSIDE_TUBE;
   }
-  omnirobot_s1_copy(g_l, gamma_L, OMNIROBOT_S1_N);
-  omnirobot_s1_copy(g_u, gamma_U, OMNIROBOT_S1_N);
-  if (gamma_L_dot != NULL) omnirobot_s1_copy(g_l_dot, gamma_L_dot, OMNIROBOT_S1_N);
-  if (gamma_U_dot != NULL) omnirobot_s1_copy(g_u_dot, gamma_U_dot, OMNIROBOT_S1_N);
-  return OMNIROBOT_S1_STATUS_OK;
+  return status;
 }
 
 int omnirobot_s1_control(const omnirobot_s1_real x[OMNIROBOT_S1_N], omnirobot_s1_real t,
     const omnirobot_s1_real alpha[OMNIROBOT_S1_N_ALPHA], omnirobot_s1_real u[OMNIROBOT_S1_N]) {
-  omnirobot_s1_real xc[OMNIROBOT_S1_N], a[OMNIROBOT_S1_N_ALPHA], uc[OMNIROBOT_S1_N], inside;
-  const casadi_real* arg[OMNIROBOT_S1_SZ_ARG];
-  casadi_real* res[OMNIROBOT_S1_SZ_RES];
-  if (u == NULL) return OMNIROBOT_S1_STATUS_INVALID_INPUT;
-  if (x == NULL || alpha == NULL || !omnirobot_s1_time_valid(t) || !omnirobot_s1_finite(x, OMNIROBOT_S1_N)
-      || !omnirobot_s1_alpha_valid(alpha)) {
-    omnirobot_s1_zero(u, OMNIROBOT_S1_N);
-    return OMNIROBOT_S1_STATUS_INVALID_INPUT;
+  int status = OMNIROBOT_S1_STATUS_INVALID_INPUT;
+  if (u != NULL) {
+    omnirobot_s1_real uc[OMNIROBOT_S1_N];
+    if ((x != NULL) && (alpha != NULL) && (omnirobot_s1_time_valid(t) != 0)
+        && (omnirobot_s1_finite(x, OMNIROBOT_S1_N) != 0) && (omnirobot_s1_alpha_valid(alpha) != 0)) {
+      omnirobot_s1_real xc[OMNIROBOT_S1_N];
+      omnirobot_s1_real a[OMNIROBOT_S1_N_ALPHA];
+      omnirobot_s1_copy(x, xc, OMNIROBOT_S1_N);
+      omnirobot_s1_copy(alpha, a, OMNIROBOT_S1_N_ALPHA);
+      status = omnirobot_s1_law(xc, t, a, uc);
+    }
+    if (status == OMNIROBOT_S1_STATUS_INVALID_INPUT) {
+      omnirobot_s1_zero(u, OMNIROBOT_S1_N);
+    } else {
+      omnirobot_s1_copy(uc, u, OMNIROBOT_S1_N);
+    }
   }
-  omnirobot_s1_copy(x, xc, OMNIROBOT_S1_N);
-  omnirobot_s1_copy(alpha, a, OMNIROBOT_S1_N_ALPHA);
-  arg[0] = xc;
-  arg[1] = &t;
-  arg[2] = a;
-  res[0] = uc;
-  res[1] = &inside;
-  body_control(arg, res, 0, 0, 0);
-  if (!omnirobot_s1_finite(uc, OMNIROBOT_S1_N)) {
-    omnirobot_s1_zero(u, OMNIROBOT_S1_N);
-    return OMNIROBOT_S1_STATUS_INVALID_INPUT;
+  return status;
+}
+
+/* implicit step of (11) from t to t + dt, inputs already checked (a: [N_ALPHA]) */
+static void omnirobot_s1_implicit_step(omnirobot_s1_real t, omnirobot_s1_real dt, const omnirobot_s1_real* a,
+    omnirobot_s1_real* next) {
+  omnirobot_s1_real psi[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real theta[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real rho[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real rho_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real beta[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real beta_dot[OMNIROBOT_S1_N_ALPHA];
+  omnirobot_s1_real t_next;
+  int i;
+  body_later(&t, &dt, &t_next);
+  omnirobot_s1_reach(t_next, 0, rho, rho_dot);
+  omnirobot_s1_circumvent(t_next, 0, beta, beta_dot);
+  body_conflict(rho, beta, &OMNIROBOT_S1_PARAMETERS.theta0, &OMNIROBOT_S1_PARAMETERS.mu, psi, theta);
+  for (i = 0; i < OMNIROBOT_S1_N_ALPHA; ++i) {
+    omnirobot_s1_real s;
+    omnirobot_s1_real s_next;
+    omnirobot_s1_real c;
+    omnirobot_s1_real big_a;
+    omnirobot_s1_real root;
+    int k = 0;
+    body_newton_start(&a[i], &psi[i], &theta[i], &dt, &OMNIROBOT_S1_PARAMETERS.kappa, &s, &c, &big_a,
+                      &root);
+    if (root != 0.0f) {
+      body_newton_root_start(&a[i], &psi[i], &c, &big_a, &s);
+    }
+    /* 5 iterations; an iteration that returns its input would return it again,
+       so the loop stops there with the same result */
+    while (k < 5) {
+      body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
+      if (s_next == s) {
+        k = 5;
+      } else {
+        k = k + 1;
+      }
+      s = s_next;
+    }
+    next[i] = s;
   }
-  omnirobot_s1_copy(uc, u, OMNIROBOT_S1_N);
-  return inside != 0 ? OMNIROBOT_S1_STATUS_OK : OMNIROBOT_S1_STATUS_OUTSIDE_TUBE;
 }
 
 int omnirobot_s1_alpha_step(omnirobot_s1_real t, omnirobot_s1_real dt,
     const omnirobot_s1_real alpha[OMNIROBOT_S1_N_ALPHA], omnirobot_s1_real alpha_next[OMNIROBOT_S1_N_ALPHA]) {
-  omnirobot_s1_real a[OMNIROBOT_S1_N_ALPHA], next[OMNIROBOT_S1_N_ALPHA];
-  const casadi_real* arg[OMNIROBOT_S1_SZ_ARG];
-  casadi_real* res[OMNIROBOT_S1_SZ_RES];
-  if (alpha_next == NULL) return OMNIROBOT_S1_STATUS_INVALID_INPUT;
-  if (alpha == NULL) {
-    omnirobot_s1_zero(alpha_next, OMNIROBOT_S1_N_ALPHA);
-    return OMNIROBOT_S1_STATUS_INVALID_INPUT;
+  int status = OMNIROBOT_S1_STATUS_INVALID_INPUT;
+  if (alpha_next != NULL) {
+    if (alpha == NULL) {
+      omnirobot_s1_zero(alpha_next, OMNIROBOT_S1_N_ALPHA);
+    } else {
+      omnirobot_s1_real a[OMNIROBOT_S1_N_ALPHA];
+      omnirobot_s1_real next[OMNIROBOT_S1_N_ALPHA];
+      omnirobot_s1_copy(alpha, a, OMNIROBOT_S1_N_ALPHA);
+      if ((omnirobot_s1_time_valid(t) != 0) && (omnirobot_s1_dt_valid(dt) != 0)
+          && (omnirobot_s1_alpha_valid(a) != 0)) {
+        omnirobot_s1_implicit_step(t, dt, a, next);
+        if (omnirobot_s1_finite(next, OMNIROBOT_S1_N_ALPHA) != 0) {
+          status = OMNIROBOT_S1_STATUS_OK;
+        }
+      }
+      if (status == OMNIROBOT_S1_STATUS_OK) {
+        omnirobot_s1_copy(next, alpha_next, OMNIROBOT_S1_N_ALPHA);
+      } else {
+        omnirobot_s1_keep_alpha(a, alpha_next);
+      }
+    }
   }
-  omnirobot_s1_copy(alpha, a, OMNIROBOT_S1_N_ALPHA);
-  if (!omnirobot_s1_time_valid(t) || !omnirobot_s1_dt_valid(dt) || !omnirobot_s1_alpha_valid(a)) {
-    omnirobot_s1_keep_alpha(a, alpha_next);
-    return OMNIROBOT_S1_STATUS_INVALID_INPUT;
-  }
-  arg[0] = &t;
-  arg[1] = &dt;
-  arg[2] = a;
-  res[0] = next;
-  body_alpha_step(arg, res, 0, 0, 0);
-  if (!omnirobot_s1_finite(next, OMNIROBOT_S1_N_ALPHA)) {
-    omnirobot_s1_keep_alpha(a, alpha_next);
-    return OMNIROBOT_S1_STATUS_INVALID_INPUT;
-  }
-  omnirobot_s1_copy(next, alpha_next, OMNIROBOT_S1_N_ALPHA);
-  return OMNIROBOT_S1_STATUS_OK;
+  return status;
 }
 
 int omnirobot_s1_step(const omnirobot_s1_real x[OMNIROBOT_S1_N], omnirobot_s1_real t, omnirobot_s1_real dt,
     const omnirobot_s1_real alpha[OMNIROBOT_S1_N_ALPHA], omnirobot_s1_real u[OMNIROBOT_S1_N],
     omnirobot_s1_real alpha_next[OMNIROBOT_S1_N_ALPHA]) {
-  omnirobot_s1_real xc[OMNIROBOT_S1_N], a[OMNIROBOT_S1_N_ALPHA], uc[OMNIROBOT_S1_N], next[OMNIROBOT_S1_N_ALPHA], inside;
-  const casadi_real* arg[OMNIROBOT_S1_SZ_ARG];
-  casadi_real* res[OMNIROBOT_S1_SZ_RES];
-  if (u == NULL || alpha_next == NULL) return OMNIROBOT_S1_STATUS_INVALID_INPUT;
-  if (x == NULL || alpha == NULL) {
-    omnirobot_s1_zero(u, OMNIROBOT_S1_N);
+  int status = OMNIROBOT_S1_STATUS_INVALID_INPUT;
+  if ((u != NULL) && (alpha_next != NULL)) {
+    omnirobot_s1_real uc[OMNIROBOT_S1_N];
     if (alpha == NULL) {
       omnirobot_s1_zero(alpha_next, OMNIROBOT_S1_N_ALPHA);
     } else {
-      omnirobot_s1_keep_alpha(alpha, alpha_next);
+      omnirobot_s1_real a[OMNIROBOT_S1_N_ALPHA];
+      omnirobot_s1_real next[OMNIROBOT_S1_N_ALPHA];
+      omnirobot_s1_copy(alpha, a, OMNIROBOT_S1_N_ALPHA);
+      if ((x != NULL) && (omnirobot_s1_time_valid(t) != 0) && (omnirobot_s1_dt_valid(dt) != 0)
+          && (omnirobot_s1_finite(x, OMNIROBOT_S1_N) != 0) && (omnirobot_s1_alpha_valid(a) != 0)) {
+        omnirobot_s1_real xc[OMNIROBOT_S1_N];
+        omnirobot_s1_copy(x, xc, OMNIROBOT_S1_N);
+        status = omnirobot_s1_law(xc, t, a, uc);
+        if (status != OMNIROBOT_S1_STATUS_INVALID_INPUT) {
+          omnirobot_s1_implicit_step(t, dt, a, next);
+          if (omnirobot_s1_finite(next, OMNIROBOT_S1_N_ALPHA) == 0) {
+            status = OMNIROBOT_S1_STATUS_INVALID_INPUT;
+          }
+        }
+      }
+      if (status == OMNIROBOT_S1_STATUS_INVALID_INPUT) {
+        omnirobot_s1_keep_alpha(a, alpha_next);
+      } else {
+        omnirobot_s1_copy(next, alpha_next, OMNIROBOT_S1_N_ALPHA);
+      }
     }
-    return OMNIROBOT_S1_STATUS_INVALID_INPUT;
+    if (status == OMNIROBOT_S1_STATUS_INVALID_INPUT) {
+      omnirobot_s1_zero(u, OMNIROBOT_S1_N);
+    } else {
+      omnirobot_s1_copy(uc, u, OMNIROBOT_S1_N);
+    }
   }
-  omnirobot_s1_copy(alpha, a, OMNIROBOT_S1_N_ALPHA);
-  if (!omnirobot_s1_time_valid(t) || !omnirobot_s1_dt_valid(dt) || !omnirobot_s1_finite(x, OMNIROBOT_S1_N)
-      || !omnirobot_s1_alpha_valid(a)) {
-    omnirobot_s1_zero(u, OMNIROBOT_S1_N);
-    omnirobot_s1_keep_alpha(a, alpha_next);
-    return OMNIROBOT_S1_STATUS_INVALID_INPUT;
-  }
-  omnirobot_s1_copy(x, xc, OMNIROBOT_S1_N);
-  arg[0] = xc;
-  arg[1] = &t;
-  arg[2] = &dt;
-  arg[3] = a;
-  res[0] = uc;
-  res[1] = next;
-  res[2] = &inside;
-  body_controller_step(arg, res, 0, 0, 0);
-  if (!omnirobot_s1_finite(uc, OMNIROBOT_S1_N) || !omnirobot_s1_finite(next, OMNIROBOT_S1_N_ALPHA)) {
-    omnirobot_s1_zero(u, OMNIROBOT_S1_N);
-    omnirobot_s1_keep_alpha(a, alpha_next);
-    return OMNIROBOT_S1_STATUS_INVALID_INPUT;
-  }
-  omnirobot_s1_copy(uc, u, OMNIROBOT_S1_N);
-  omnirobot_s1_copy(next, alpha_next, OMNIROBOT_S1_N_ALPHA);
-  return inside != 0 ? OMNIROBOT_S1_STATUS_OK : OMNIROBOT_S1_STATUS_OUTSIDE_TUBE;
+  return status;
 }

@@ -10,6 +10,8 @@
  *
  * C99, depends on <math.h> only (link with -lm). No allocation, no global or static
  * mutable state: every function is reentrant and thread-safe. Arithmetic: double.
+ * Do not compile with -ffast-math / -Ofast (the source stops with #error): it would
+ * remove the input checks.
  *
  * Units: time t, dt in seconds; x, gamma_L, gamma_U, alpha in state units (the spec's);
  * gamma_*_dot in state units per second; u in state units per second (the input of the
@@ -63,11 +65,6 @@ typedef double omnirobot_s3_real;
 #define OMNIROBOT_S3_N 3
 /** Length of alpha: 2 n. */
 #define OMNIROBOT_S3_N_ALPHA 6
-/** Largest number of CasADi argument / result pointers of a body (stack arrays). */
-#define OMNIROBOT_S3_SZ_ARG 4
-#define OMNIROBOT_S3_SZ_RES 4
-/** CasADi work vector entries of a body (0: the registers are local variables). */
-#define OMNIROBOT_S3_SZ_W 0
 /** Prescribed time t_c, seconds. */
 #define OMNIROBOT_S3_PRESCRIBED_TIME 9.0
 /** Sampling rate the tube was designed for, Hz (dt = 1 / rate). */
@@ -103,7 +100,7 @@ int omnirobot_s3_control(const omnirobot_s3_real x[OMNIROBOT_S3_N], omnirobot_s3
     const omnirobot_s3_real alpha[OMNIROBOT_S3_N_ALPHA], omnirobot_s3_real u[OMNIROBOT_S3_N]);
 
 /**
- * Implicit (backward Euler, 8 Newton iterations) step of the adaptive law (11)
+ * Implicit (backward Euler, at most 5 Newton iterations) step of the adaptive law (11)
  * from t to t + dt.
  *
  * t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha, alpha_next: [OMNIROBOT_S3_N_ALPHA].

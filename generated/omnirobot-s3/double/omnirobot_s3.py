@@ -21,8 +21,9 @@ finite, clamped), STATUS_INVALID_INPUT (2: an input outside the domain, a wrong 
 a value that is not a number, or a result that would not be finite; u = 0, alpha_next =
 alpha with non-finite entries 0, gamma_* = 0). Every number returned is a finite float.
 
-The ``body_*`` functions below are printed by ``stt_codegen.emit.PythonPrinter`` from
-the CasADi SX Functions; they reproduce CasADi's evaluation bit for bit.
+The ``body_*`` functions below are printed by ``stt_codegen.codegen.emit.PythonPrinter``,
+on the CasADi instruction stream the C printer prints too; they reproduce CasADi's
+evaluation bit for bit.
 """
 import math
 
@@ -93,11 +94,150 @@ def _keep_alpha(alpha):
     return [v if math.isfinite(v) else 0.0 for v in a]
 
 
+# ------------------------------------------------------------------- spec tables
+# Tube parameters.
+SMOOTHNESS = 50.0  # nu of the smooth max/min and of F_nu (eqs. (9)-(10)), 1/state units
+THETA0 = 0.01  # theta_0 of the trigger (11)
+MU = 1.0  # mu of the trigger (11), state units
+KAPPA = 5.0  # kappa of the adaptive law (11), 1/s
+GAIN = 0.42597205434069174  # k of the control law (13)
+# State-space bounds [X; X-bar], the sign of eq. (9) on each, circumvents on each.
+BOUND = (0.0, 0.0, -1.2, 5.0, 5.0, 1.2)
+SIGN = (1.0, 1.0, 1.0, -1.0, -1.0, -1.0)
+MEMBERS = (0, 0, 0, 1, 0, 0)
+# Reach tube (eq. (4)): (start, end, profile, from [L; U], to [L; U]); profile 0 = tanh,
+# 1 = smoothstep.
+SEGMENTS = (
+    (0.0, 9.0, 0, (4.05, 0.04999999999999999, -0.05, 4.45, 0.45, 0.05), (4.55, 4.55, -0.5, 4.95, 4.95, 0.5)),
+)
+# Circumvents (eqs. (7)-(9)), sorted by start: (start, end, center, radius, sharpness,
+# height, running maximum of the ends, bound index).
+WINDOWS = (
+    (1.1382535945161503, 3.9711550313632107, 2.5547043129396805, 1.4164507184235302, 0.1, 1.2000000000000002, 3.9711550313632107, 3),  # obstacle 3
+)
+_PROGRESS = {
+    0: (lambda *args: body_progress_tanh_value(*args),
+        lambda *args: body_progress_tanh(*args)),
+}
+
+
+def _reach(t, rates=False):
+    # rho [L; U] of eq. (4) (and rho_dot with rates): the first segment whose end is after t
+    k = 0
+    while k < len(SEGMENTS) - 1 and not t < SEGMENTS[k][1]:
+        k += 1
+    start, end, profile, lo, hi = SEGMENTS[k]
+    value, full = _PROGRESS[profile]
+    if rates:
+        (p,), (p_dot,) = full([t], [start], [end])
+        return body_interpolate([p], [p_dot], lo, hi)
+    ((p,),) = value([t], [start], [end])
+    return body_interpolate_value([p], lo, hi)[0], [0.0] * N_ALPHA
+
+
+def _circumvent(t, rates=False):
+    # beta [L; U] of eq. (9) (and beta_dot with rates) over the open windows only (a closed
+    # one adds exactly 0)
+    lo, hi = 0, len(WINDOWS)
+    while lo < hi:
+        mid = lo + (hi - lo) // 2
+        if WINDOWS[mid][0] < t:
+            lo = mid + 1
+        else:
+            hi = mid
+    first = hi
+    while first > 0 and WINDOWS[first - 1][6] > t:
+        first -= 1
+    top = [0.0] * N_ALPHA
+    opened = []
+    for row in WINDOWS[first:hi]:
+        if t < row[1]:
+            if rates:
+                (y,), (y_dot,) = body_bump([t], *([v] for v in row[:6]))
+            else:
+                ((y,),), y_dot = body_bump_value([t], *([v] for v in row[:6])), 0.0
+            opened.append((row[7], y, y_dot))
+            if y > top[row[7]]:
+                top[row[7]] = y
+    total, rate = [0.0] * N_ALPHA, [0.0] * N_ALPHA
+    beta, beta_dot = list(BOUND), [0.0] * N_ALPHA
+    for b in range(N_ALPHA):
+        if MEMBERS[b] > 1:
+            (total[b],), (rate[b],) = body_fnu_init([top[b]], [SMOOTHNESS])
+    for b, y, y_dot in opened:
+        if MEMBERS[b] == 1:
+            (beta[b],), (beta_dot[b],) = body_fnu_single([BOUND[b]], [SIGN[b]], [y], [y_dot])
+        else:
+            (total[b],), (rate[b],) = body_fnu_add([total[b]], [rate[b]], [y], [y_dot],
+                                                   [top[b]], [SMOOTHNESS])
+    for b in range(N_ALPHA):
+        if MEMBERS[b] > 1:
+            (beta[b],), (beta_dot[b],) = body_fnu_finish([BOUND[b]], [SIGN[b]], [top[b]],
+                                                         [total[b]], [rate[b]], [SMOOTHNESS])
+    return beta, beta_dot
+
+
+def _gamma_of(rho, beta, alpha):
+    # eq. (10): the smooth max/min's correction only where it can change the max/min
+    (c,) = body_candidates(rho, alpha)
+    g_l, g_u = [], []
+    for i in range(N):
+        (m,), (needed,) = body_smooth_max_test([c[i]], [beta[i]], [SMOOTHNESS])
+        if needed != 0.0:
+            ((m,),) = body_smooth_max([c[i]], [beta[i]], [SMOOTHNESS])
+        g_l.append(m)
+        (m,), (needed,) = body_smooth_min_test([c[N + i]], [beta[N + i]], [SMOOTHNESS])
+        if needed != 0.0:
+            ((m,),) = body_smooth_min([c[N + i]], [beta[N + i]], [SMOOTHNESS])
+        g_u.append(m)
+    return g_l, g_u
+
+
+def _gamma(t, alpha):
+    return _gamma_of(_reach(t)[0], _circumvent(t)[0], alpha)
+
+
+def _gamma_and_rates(t, alpha):
+    # gamma and its total time derivative, alpha moving by (11)
+    rho, rho_dot = _reach(t, True)
+    beta, beta_dot = _circumvent(t, True)
+    g_l, g_u = _gamma_of(rho, beta, alpha)
+    psi, theta = body_conflict(rho, beta, [THETA0], [MU])
+    (a_dot,) = body_alpha_rate(alpha, psi, theta, [KAPPA])
+    (c,) = body_candidates(rho, alpha)
+    (c_dot,) = body_candidate_rates(rho_dot, a_dot)
+    g_l_dot = [body_smooth_max_rate([c[i]], [beta[i]], [c_dot[i]], [beta_dot[i]],
+                                    [SMOOTHNESS])[0][0] for i in range(N)]
+    g_u_dot = [body_smooth_min_rate([c[N + i]], [beta[N + i]], [c_dot[N + i]],
+                                    [beta_dot[N + i]], [SMOOTHNESS])[0][0] for i in range(N)]
+    return g_l, g_u, g_l_dot, g_u_dot
+
+
+def _implicit_step(t, dt, alpha):
+    # (11) from t to t + dt: a start (the root start only when needed), then at most
+    # 5 Newton iterations (stopping at a fixed point), per component
+    ((t_next,),) = body_later([t], [dt])
+    psi, theta = body_conflict(_reach(t_next)[0], _circumvent(t_next)[0], [THETA0], [MU])
+    out = []
+    for a_i, psi_i, theta_i in zip(alpha, psi, theta):
+        s, c, big_a, root = (v[0] for v in body_newton_start([a_i], [psi_i], [theta_i], [dt],
+                                                             [KAPPA]))
+        if root != 0.0:
+            ((s,),) = body_newton_root_start([a_i], [psi_i], [c], [big_a])
+        for _ in range(5):
+            ((s_next,),) = body_newton_iteration([s], [a_i], [psi_i], [c], [big_a])
+            if s_next == s:  # a fixed point: further iterations return it again
+                break
+            s = s_next
+        out.append(s)
+    return out
+
+
 def tube(t, alpha):
     """Tube bounds gamma_L, gamma_U (N,) and their time derivatives at time t (seconds)."""
     t_ok, a = _time(t), _alpha(alpha)
     if t_ok is not None and a is not None:
-        g_l, g_u, g_l_dot, g_u_dot = body_tube([t_ok], a)
+        g_l, g_u, g_l_dot, g_u_dot = _gamma_and_rates(t_ok, a)
         if _all_finite(g_l, g_u, g_l_dot, g_u_dot):
             return g_l, g_u, g_l_dot, g_u_dot, STATUS_OK
     zero = [0.0] * N
@@ -108,7 +248,7 @@ def control(x, t, alpha):
     """Control law (13) at state x (N,) and time t: (u (N,), status)."""
     xs, t_ok, a = _finite(x, N), _time(t), _alpha(alpha)
     if xs is not None and t_ok is not None and a is not None:
-        u, inside = body_control(xs, [t_ok], a)
+        u, inside = body_law(xs, *_gamma(t_ok, a), [GAIN])
         if _all_finite(u):
             return u, STATUS_OK if inside[0] != 0.0 else STATUS_OUTSIDE_TUBE
     return [0.0] * N, STATUS_INVALID_INPUT
@@ -118,7 +258,7 @@ def alpha_step(t, dt, alpha):
     """Implicit step of the adaptive law (11) from t to t + dt: (alpha_next, status)."""
     t_ok, dt_ok, a = _time(t), _step_size(dt), _alpha(alpha)
     if t_ok is not None and dt_ok is not None and a is not None:
-        (alpha_next,) = body_alpha_step([t_ok], [dt_ok], a)
+        alpha_next = _implicit_step(t_ok, dt_ok, a)
         if _all_finite(alpha_next):
             return alpha_next, STATUS_OK
     return _keep_alpha(alpha), STATUS_INVALID_INPUT
@@ -128,14 +268,15 @@ def step(x, t, dt, alpha):
     """One controller step: (u (N,), alpha_next (N_ALPHA,), status)."""
     xs, t_ok, dt_ok, a = _finite(x, N), _time(t), _step_size(dt), _alpha(alpha)
     if xs is not None and t_ok is not None and dt_ok is not None and a is not None:
-        u, alpha_next, inside = body_controller_step(xs, [t_ok], [dt_ok], a)
+        u, inside = body_law(xs, *_gamma(t_ok, a), [GAIN])
+        alpha_next = _implicit_step(t_ok, dt_ok, a)
         if _all_finite(u, alpha_next):
             return u, alpha_next, STATUS_OK if inside[0] != 0.0 else STATUS_OUTSIDE_TUBE
     return [0.0] * N, _keep_alpha(alpha), STATUS_INVALID_INPUT
 
 
 # ---------------------------------------------------------------------- emitted bodies
-# Generated by stt_codegen.codegen.emit.PythonPrinter from CasADi 3.8.2 SX Functions: body_tube, body_control, body_alpha_step, body_controller_step.
+# Generated by stt_codegen.codegen.emit.PythonPrinter from CasADi 3.8.2 SX Functions: body_progress_tanh_value, body_progress_tanh, body_interpolate_value, body_interpolate, body_bump_value, body_bump, body_fnu_single, body_candidates, body_candidate_rates, body_smooth_max_test, body_smooth_max, body_smooth_min_test, body_smooth_min, body_smooth_max_rate, body_smooth_min_rate, body_conflict, body_alpha_rate, body_later, body_newton_start, body_newton_root_start, body_newton_iteration, body_law.
 # Do not edit; regenerate. Depends on the standard library's math only.
 import math
 
@@ -229,2607 +370,1328 @@ def _log1p(x):
         return -math.inf if x == -1.0 else math.nan
 
 
-def body_tube(t, alpha):
-    """CasADi Function 'body_tube' (455 instructions).
+def body_progress_tanh_value(t, start, end):
+    """CasADi Function 'body_progress_tanh_value' (22 instructions).
 
     Parameters
     ----------
     t : sequence of float, length 1 (dense 1x1, column-major)
-    alpha : sequence of float, length 6 (dense 6x1, column-major)
+    start : sequence of float, length 1 (dense 1x1, column-major)
+    end : sequence of float, length 1 (dense 1x1, column-major)
 
     Returns
     -------
-    gamma_L : list of float, length 3 (dense 3x1, column-major)
-    gamma_U : list of float, length 3 (dense 3x1, column-major)
-    gamma_L_dot : list of float, length 3 (dense 3x1, column-major)
-    gamma_U_dot : list of float, length 3 (dense 3x1, column-major)
+    p : list of float, length 1 (dense 1x1, column-major)
     """
     if len(t) != 1:
         raise ValueError('t: expected 1 values, got %d' % len(t))
-    if len(alpha) != 6:
-        raise ValueError('alpha: expected 6 values, got %d' % len(alpha))
-    gamma_L = [0.0] * 3
-    gamma_U = [0.0] * 3
-    gamma_L_dot = [0.0] * 3
-    gamma_U_dot = [0.0] * 3
-    w0 = 0.5
+    if len(start) != 1:
+        raise ValueError('start: expected 1 values, got %d' % len(start))
+    if len(end) != 1:
+        raise ValueError('end: expected 1 values, got %d' % len(end))
+    p = [0.0] * 1
+    w0 = float(t[0])
+    w1 = float(end[0])
+    w2 = 1.0 if w0 < w1 else 0.0
+    w3 = float(start[0])
+    w3 = w0 - w3
+    w4 = 0.0
+    w4 = 1.0 if w3 < w4 else 0.0
+    w4 = 1.0 if w4 == 0.0 else 0.0
+    w1 = w1 - w0
+    w1 = 0.0 if w2 == 0.0 else w1
+    w0 = 1.0 if w2 == 0.0 else 0.0
+    w5 = 1.0
+    w0 = 0.0 if w0 == 0.0 else w5
+    w1 = w1 + w0
+    w3 = _div(w3, w1)
+    w3 = math.tanh(w3)
+    w4 = 0.0 if w4 == 0.0 else w3
+    w4 = 0.0 if w2 == 0.0 else w4
+    w2 = 1.0 if w2 == 0.0 else 0.0
+    w2 = 0.0 if w2 == 0.0 else w5
+    w4 = w4 + w2
+    p[0] = w4
+    return (p,)
+
+
+def body_progress_tanh(t, start, end):
+    """CasADi Function 'body_progress_tanh' (32 instructions).
+
+    Parameters
+    ----------
+    t : sequence of float, length 1 (dense 1x1, column-major)
+    start : sequence of float, length 1 (dense 1x1, column-major)
+    end : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    p : list of float, length 1 (dense 1x1, column-major)
+    p_dot : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(t) != 1:
+        raise ValueError('t: expected 1 values, got %d' % len(t))
+    if len(start) != 1:
+        raise ValueError('start: expected 1 values, got %d' % len(start))
+    if len(end) != 1:
+        raise ValueError('end: expected 1 values, got %d' % len(end))
+    p = [0.0] * 1
+    p_dot = [0.0] * 1
+    w0 = float(t[0])
+    w1 = float(end[0])
+    w2 = 1.0 if w0 < w1 else 0.0
+    w3 = float(start[0])
+    w3 = w0 - w3
+    w4 = 0.0
+    w4 = 1.0 if w3 < w4 else 0.0
+    w4 = 1.0 if w4 == 0.0 else 0.0
+    w1 = w1 - w0
+    w1 = 0.0 if w2 == 0.0 else w1
+    w0 = 1.0 if w2 == 0.0 else 0.0
+    w5 = 1.0
+    w0 = 0.0 if w0 == 0.0 else w5
+    w1 = w1 + w0
+    w3 = _div(w3, w1)
+    w0 = math.tanh(w3)
+    w6 = 0.0 if w4 == 0.0 else w0
+    w6 = 0.0 if w2 == 0.0 else w6
+    w7 = 1.0 if w2 == 0.0 else 0.0
+    w7 = 0.0 if w7 == 0.0 else w5
+    w6 = w6 + w7
+    p[0] = w6
+    w0 = w0 * w0
+    w5 = w5 - w0
+    w0 = _div(1.0, w1)
+    w3 = _div(w3, w1)
+    w3 = 0.0 if w2 == 0.0 else w3
+    w0 = w0 + w3
+    w5 = w5 * w0
+    w4 = 0.0 if w4 == 0.0 else w5
+    w2 = 0.0 if w2 == 0.0 else w4
+    p_dot[0] = w2
+    return (p, p_dot)
+
+
+def body_interpolate_value(p, from_, to):
+    """CasADi Function 'body_interpolate_value' (37 instructions).
+
+    Parameters
+    ----------
+    p : sequence of float, length 1 (dense 1x1, column-major)
+    from_ : sequence of float, length 6 (dense 6x1, column-major)
+    to : sequence of float, length 6 (dense 6x1, column-major)
+
+    Returns
+    -------
+    rho : list of float, length 6 (dense 6x1, column-major)
+    """
+    if len(p) != 1:
+        raise ValueError('p: expected 1 values, got %d' % len(p))
+    if len(from_) != 6:
+        raise ValueError('from_: expected 6 values, got %d' % len(from_))
+    if len(to) != 6:
+        raise ValueError('to: expected 6 values, got %d' % len(to))
+    rho = [0.0] * 6
+    w0 = float(to[0])
+    w1 = float(from_[0])
+    w0 = w0 - w1
+    w2 = float(p[0])
+    w0 = w0 * w2
+    w0 = w0 + w1
+    rho[0] = w0
+    w0 = float(to[1])
+    w1 = float(from_[1])
+    w0 = w0 - w1
+    w0 = w0 * w2
+    w0 = w0 + w1
+    rho[1] = w0
+    w0 = float(to[2])
+    w1 = float(from_[2])
+    w0 = w0 - w1
+    w0 = w0 * w2
+    w0 = w0 + w1
+    rho[2] = w0
+    w0 = float(to[3])
+    w1 = float(from_[3])
+    w0 = w0 - w1
+    w0 = w0 * w2
+    w0 = w0 + w1
+    rho[3] = w0
+    w0 = float(to[4])
+    w1 = float(from_[4])
+    w0 = w0 - w1
+    w0 = w0 * w2
+    w0 = w0 + w1
+    rho[4] = w0
+    w0 = float(to[5])
+    w1 = float(from_[5])
+    w0 = w0 - w1
+    w0 = w0 * w2
+    w0 = w0 + w1
+    rho[5] = w0
+    return (rho,)
+
+
+def body_interpolate(p, p_dot, from_, to):
+    """CasADi Function 'body_interpolate' (56 instructions).
+
+    Parameters
+    ----------
+    p : sequence of float, length 1 (dense 1x1, column-major)
+    p_dot : sequence of float, length 1 (dense 1x1, column-major)
+    from_ : sequence of float, length 6 (dense 6x1, column-major)
+    to : sequence of float, length 6 (dense 6x1, column-major)
+
+    Returns
+    -------
+    rho : list of float, length 6 (dense 6x1, column-major)
+    rho_dot : list of float, length 6 (dense 6x1, column-major)
+    """
+    if len(p) != 1:
+        raise ValueError('p: expected 1 values, got %d' % len(p))
+    if len(p_dot) != 1:
+        raise ValueError('p_dot: expected 1 values, got %d' % len(p_dot))
+    if len(from_) != 6:
+        raise ValueError('from_: expected 6 values, got %d' % len(from_))
+    if len(to) != 6:
+        raise ValueError('to: expected 6 values, got %d' % len(to))
+    rho = [0.0] * 6
+    rho_dot = [0.0] * 6
+    w0 = float(to[0])
+    w1 = float(from_[0])
+    w2 = w0 - w1
+    w3 = float(p[0])
+    w2 = w2 * w3
+    w2 = w2 + w1
+    rho[0] = w2
+    w2 = float(to[1])
+    w4 = float(from_[1])
+    w5 = w2 - w4
+    w5 = w5 * w3
+    w5 = w5 + w4
+    rho[1] = w5
+    w5 = float(to[2])
+    w6 = float(from_[2])
+    w7 = w5 - w6
+    w7 = w7 * w3
+    w7 = w7 + w6
+    rho[2] = w7
+    w7 = float(to[3])
+    w8 = float(from_[3])
+    w9 = w7 - w8
+    w9 = w9 * w3
+    w9 = w9 + w8
+    rho[3] = w9
+    w9 = float(to[4])
+    w10 = float(from_[4])
+    w11 = w9 - w10
+    w11 = w11 * w3
+    w11 = w11 + w10
+    rho[4] = w11
+    w11 = float(to[5])
+    w12 = float(from_[5])
+    w13 = w11 - w12
+    w13 = w13 * w3
+    w13 = w13 + w12
+    rho[5] = w13
+    w0 = w0 - w1
+    w1 = float(p_dot[0])
+    w0 = w0 * w1
+    rho_dot[0] = w0
+    w2 = w2 - w4
+    w2 = w2 * w1
+    rho_dot[1] = w2
+    w5 = w5 - w6
+    w5 = w5 * w1
+    rho_dot[2] = w5
+    w7 = w7 - w8
+    w7 = w7 * w1
+    rho_dot[3] = w7
+    w9 = w9 - w10
+    w9 = w9 * w1
+    rho_dot[4] = w9
+    w11 = w11 - w12
+    w11 = w11 * w1
+    rho_dot[5] = w11
+    return (rho, rho_dot)
+
+
+def body_bump_value(t, start, end, center, radius, sharpness, height):
+    """CasADi Function 'body_bump_value' (34 instructions).
+
+    Parameters
+    ----------
+    t : sequence of float, length 1 (dense 1x1, column-major)
+    start : sequence of float, length 1 (dense 1x1, column-major)
+    end : sequence of float, length 1 (dense 1x1, column-major)
+    center : sequence of float, length 1 (dense 1x1, column-major)
+    radius : sequence of float, length 1 (dense 1x1, column-major)
+    sharpness : sequence of float, length 1 (dense 1x1, column-major)
+    height : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    y : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(t) != 1:
+        raise ValueError('t: expected 1 values, got %d' % len(t))
+    if len(start) != 1:
+        raise ValueError('start: expected 1 values, got %d' % len(start))
+    if len(end) != 1:
+        raise ValueError('end: expected 1 values, got %d' % len(end))
+    if len(center) != 1:
+        raise ValueError('center: expected 1 values, got %d' % len(center))
+    if len(radius) != 1:
+        raise ValueError('radius: expected 1 values, got %d' % len(radius))
+    if len(sharpness) != 1:
+        raise ValueError('sharpness: expected 1 values, got %d' % len(sharpness))
+    if len(height) != 1:
+        raise ValueError('height: expected 1 values, got %d' % len(height))
+    y = [0.0] * 1
+    w0 = float(start[0])
     w1 = float(t[0])
-    w2 = 9.0
-    w3 = 1.0 if w1 < w2 else 0.0
-    w4 = w2 - w1
-    w4 = 0.0 if w3 == 0.0 else w4
-    w5 = 1.0 if w3 == 0.0 else 0.0
-    w6 = 1.0
-    w5 = 0.0 if w5 == 0.0 else w6
-    w4 = w4 + w5
-    w5 = _div(w1, w4)
-    w7 = math.tanh(w5)
-    w8 = 0.0 if w3 == 0.0 else w7
-    w9 = 1.0 if w3 == 0.0 else 0.0
-    w9 = 0.0 if w9 == 0.0 else w6
-    w8 = w8 + w9
-    w9 = w0 * w8
-    w10 = 4.05
-    w9 = w9 + w10
-    w11 = float(alpha[0])
-    w9 = w9 - w11
-    w12 = 0.0
-    w13 = _fmax(w9, w12)
-    w14 = -50.0
-    w15 = math.fabs(w9)
-    w15 = w14 * w15
-    w15 = _exp(w15)
-    w16 = _log1p(w15)
-    w17 = 50.0
-    w16 = w16 / w17
-    w13 = w13 + w16
-    gamma_L[0] = w13
-    w13 = 4.5
-    w16 = w13 * w8
-    w18 = 0.04999999999999999
-    w16 = w16 + w18
-    w19 = float(alpha[1])
-    w16 = w16 - w19
-    w20 = _fmax(w16, w12)
-    w21 = math.fabs(w16)
-    w21 = w14 * w21
-    w21 = _exp(w21)
-    w22 = _log1p(w21)
-    w22 = w22 / w17
-    w20 = w20 + w22
-    gamma_L[1] = w20
-    w20 = -0.45
-    w22 = w20 * w8
-    w23 = -0.05
-    w22 = w22 + w23
-    w24 = float(alpha[2])
-    w22 = w22 - w24
-    w25 = -1.2
-    w26 = _fmax(w22, w25)
-    w27 = w22 - w25
-    w28 = math.fabs(w27)
-    w28 = w14 * w28
-    w28 = _exp(w28)
-    w29 = _log1p(w28)
-    w29 = w29 / w17
-    w26 = w26 + w29
-    gamma_L[2] = w26
-    w26 = w0 * w8
-    w29 = 4.45
-    w26 = w26 + w29
-    w30 = float(alpha[3])
-    w26 = w26 + w30
-    w31 = -w26
-    w32 = 5.0
-    w33 = 2.5547043129396805
-    w34 = w1 - w33
-    w35 = math.fabs(w34)
-    w36 = 1.4164507184235302
-    w35 = 1.0 if w35 < w36 else 0.0
-    w37 = -1.2000000000000002
-    w38 = -0.1
-    w39 = w34 * w34
-    w39 = w38 * w39
-    w40 = math.fabs(w34)
-    w40 = w36 - w40
-    w41 = math.fabs(w34)
-    w41 = w36 + w41
-    w42 = w40 * w41
-    w42 = 0.0 if w35 == 0.0 else w42
-    w43 = 1.0 if w35 == 0.0 else 0.0
-    w43 = 0.0 if w43 == 0.0 else w6
-    w42 = w42 + w43
-    w39 = _div(w39, w42)
-    w43 = _exp(w39)
-    w44 = w37 * w43
-    w44 = 0.0 if w35 == 0.0 else w44
-    w44 = w32 + w44
-    w45 = -w44
-    w46 = _fmax(w31, w45)
-    w44 = w44 - w26
-    w26 = math.fabs(w44)
-    w26 = w14 * w26
-    w26 = _exp(w26)
-    w47 = _log1p(w26)
-    w47 = w47 / w17
-    w46 = w46 + w47
-    w46 = -w46
-    gamma_U[0] = w46
-    w46 = w13 * w8
-    w47 = 0.45
-    w46 = w46 + w47
-    w48 = float(alpha[4])
-    w46 = w46 + w48
-    w49 = -w46
-    w50 = -5.0
-    w51 = _fmax(w49, w50)
-    w46 = w46 + w50
-    w52 = math.fabs(w46)
-    w52 = w14 * w52
-    w52 = _exp(w52)
-    w53 = _log1p(w52)
-    w53 = w53 / w17
-    w51 = w51 + w53
-    w51 = -w51
-    gamma_U[1] = w51
-    w8 = w47 * w8
-    w51 = 0.05
-    w8 = w8 + w51
-    w53 = float(alpha[5])
-    w8 = w8 + w53
-    w54 = -w8
-    w55 = _fmax(w54, w25)
-    w8 = w8 + w25
-    w56 = math.fabs(w8)
-    w56 = w14 * w56
-    w56 = _exp(w56)
-    w57 = _log1p(w56)
-    w57 = w57 / w17
-    w55 = w55 + w57
-    w55 = -w55
-    gamma_U[2] = w55
-    w55 = 1.0 if w12 <= w9 else 0.0
-    w57 = 1.0 if w9 <= w12 else 0.0
-    w57 = w55 + w57
-    w55 = _div(w55, w57)
-    w57 = w7 * w7
-    w57 = w6 - w57
-    w17 = _div(1.0, w4)
-    w58 = _div(w5, w4)
-    w58 = 0.0 if w3 == 0.0 else w58
-    w17 = w17 + w58
-    w57 = w57 * w17
-    w17 = w0 * w57
-    w55 = w55 * w17
-    w58 = 0.02
-    w59 = _sign(w9)
-    w59 = w59 * w17
-    w59 = w14 * w59
-    w59 = w15 * w59
-    w17 = w6 + w15
-    w59 = _div(w59, w17)
-    w59 = w58 * w59
-    w55 = w55 + w59
-    w55 = 0.0 if w3 == 0.0 else w55
-    w59 = 1.0 if w12 <= w9 else 0.0
-    w17 = 1.0 if w9 <= w12 else 0.0
-    w17 = w59 + w17
-    w59 = _div(w59, w17)
-    w9 = _sign(w9)
-    w9 = w14 * w9
-    w9 = w15 * w9
-    w15 = w6 + w15
-    w9 = _div(w9, w15)
-    w9 = w58 * w9
-    w59 = w59 + w9
-    w9 = 0.01
-    w33 = w1 - w33
-    w15 = math.fabs(w33)
-    w15 = 1.0 if w15 < w36 else 0.0
-    w17 = w33 * w33
-    w38 = w38 * w17
-    w17 = math.fabs(w33)
-    w17 = w36 - w17
-    w33 = math.fabs(w33)
-    w36 = w36 + w33
-    w17 = w17 * w36
-    w17 = 0.0 if w15 == 0.0 else w17
-    w36 = 1.0 if w15 == 0.0 else 0.0
-    w36 = 0.0 if w36 == 0.0 else w6
-    w17 = w17 + w36
-    w38 = _div(w38, w17)
-    w38 = _exp(w38)
-    w38 = w37 * w38
-    w15 = 0.0 if w15 == 0.0 else w38
-    w15 = w32 + w15
-    w38 = 1.0 if w1 < w2 else 0.0
-    w2 = w2 - w1
-    w2 = 0.0 if w38 == 0.0 else w2
-    w17 = 1.0 if w38 == 0.0 else 0.0
-    w17 = 0.0 if w17 == 0.0 else w6
-    w2 = w2 + w17
-    w1 = _div(w1, w2)
-    w1 = math.tanh(w1)
-    w1 = 0.0 if w38 == 0.0 else w1
-    w38 = 1.0 if w38 == 0.0 else 0.0
-    w38 = 0.0 if w38 == 0.0 else w6
-    w1 = w1 + w38
-    w38 = w0 * w1
-    w38 = w38 + w10
-    w15 = w15 - w38
-    w38 = w15 - w6
-    w38 = math.tanh(w38)
-    w38 = w6 - w38
-    w38 = w9 * w38
-    w15 = w15 + w11
-    w15 = w15 * w15
-    w38 = _div(w38, w15)
-    w11 = w32 * w11
-    w38 = w38 - w11
-    w59 = w59 * w38
-    w55 = w55 - w59
-    gamma_L_dot[0] = w55
-    w55 = 1.0 if w12 <= w16 else 0.0
-    w59 = 1.0 if w16 <= w12 else 0.0
-    w59 = w55 + w59
-    w55 = _div(w55, w59)
-    w59 = w13 * w57
-    w55 = w55 * w59
-    w38 = _sign(w16)
-    w38 = w38 * w59
-    w38 = w14 * w38
-    w38 = w21 * w38
-    w59 = w6 + w21
-    w38 = _div(w38, w59)
-    w38 = w58 * w38
-    w55 = w55 + w38
-    w55 = 0.0 if w3 == 0.0 else w55
-    w38 = 1.0 if w12 <= w16 else 0.0
-    w12 = 1.0 if w16 <= w12 else 0.0
-    w12 = w38 + w12
-    w38 = _div(w38, w12)
-    w16 = _sign(w16)
-    w16 = w14 * w16
-    w16 = w21 * w16
-    w21 = w6 + w21
-    w16 = _div(w16, w21)
-    w16 = w58 * w16
-    w38 = w38 + w16
-    w16 = w13 * w1
-    w16 = w16 + w18
-    w16 = w32 - w16
-    w18 = w16 - w6
-    w18 = math.tanh(w18)
-    w18 = w6 - w18
-    w18 = w9 * w18
-    w16 = w16 + w19
-    w16 = w16 * w16
-    w18 = _div(w18, w16)
-    w19 = w32 * w19
-    w18 = w18 - w19
-    w38 = w38 * w18
-    w55 = w55 - w38
-    gamma_L_dot[1] = w55
-    w55 = 1.0 if w25 <= w22 else 0.0
-    w38 = 1.0 if w22 <= w25 else 0.0
-    w38 = w55 + w38
-    w55 = _div(w55, w38)
-    w57 = w20 * w57
-    w55 = w55 * w57
-    w38 = _sign(w27)
-    w38 = w38 * w57
-    w38 = w14 * w38
-    w38 = w28 * w38
-    w57 = w6 + w28
-    w38 = _div(w38, w57)
-    w38 = w58 * w38
-    w55 = w55 + w38
-    w55 = 0.0 if w3 == 0.0 else w55
-    w38 = 1.0 if w25 <= w22 else 0.0
-    w22 = 1.0 if w22 <= w25 else 0.0
-    w22 = w38 + w22
-    w38 = _div(w38, w22)
-    w27 = _sign(w27)
-    w27 = w14 * w27
-    w27 = w28 * w27
-    w28 = w6 + w28
-    w27 = _div(w27, w28)
-    w27 = w58 * w27
-    w38 = w38 + w27
-    w27 = 1.2
-    w20 = w20 * w1
-    w20 = w20 + w23
-    w27 = w27 - w20
-    w20 = w27 - w6
-    w20 = math.tanh(w20)
-    w20 = w6 - w20
-    w20 = w9 * w20
-    w27 = w27 + w24
-    w27 = w27 * w27
-    w20 = _div(w20, w27)
-    w24 = w32 * w24
-    w20 = w20 - w24
-    w38 = w38 * w20
-    w55 = w55 - w38
-    gamma_L_dot[2] = w55
-    w55 = 1.0 if w45 <= w31 else 0.0
-    w38 = 1.0 if w31 <= w45 else 0.0
-    w38 = w55 + w38
-    w55 = _div(w55, w38)
-    w38 = _sign(w44)
-    w38 = w14 * w38
-    w38 = w26 * w38
-    w20 = w6 + w26
-    w38 = _div(w38, w20)
-    w38 = w58 * w38
-    w55 = w55 + w38
-    w38 = w0 * w1
-    w38 = w38 + w29
-    w29 = w38 - w6
-    w29 = math.tanh(w29)
-    w29 = w6 - w29
-    w29 = w9 * w29
-    w38 = w38 + w30
-    w38 = w38 * w38
-    w29 = _div(w29, w38)
-    w30 = w32 * w30
-    w29 = w29 - w30
-    w55 = w55 * w29
-    w29 = 1.0 if w45 <= w31 else 0.0
-    w31 = 1.0 if w31 <= w45 else 0.0
-    w45 = w29 + w31
-    w29 = _div(w29, w45)
-    w7 = w7 * w7
-    w7 = w6 - w7
-    w30 = _div(1.0, w4)
-    w5 = _div(w5, w4)
-    w5 = 0.0 if w3 == 0.0 else w5
-    w30 = w30 + w5
-    w7 = w7 * w30
-    w0 = w0 * w7
-    w29 = w29 * w0
-    w29 = -w29
-    w29 = 0.0 if w3 == 0.0 else w29
-    w31 = _div(w31, w45)
-    w45 = -0.2
-    w45 = w45 * w34
-    w45 = _div(w45, w42)
-    w39 = _div(w39, w42)
-    w42 = _sign(w34)
-    w40 = w40 * w42
-    w34 = _sign(w34)
-    w41 = w41 * w34
-    w40 = w40 - w41
-    w39 = w39 * w40
-    w39 = -w39
-    w39 = 0.0 if w35 == 0.0 else w39
-    w45 = w45 + w39
-    w43 = w43 * w45
-    w37 = w37 * w43
-    w31 = w31 * w37
-    w31 = -w31
-    w31 = 0.0 if w35 == 0.0 else w31
-    w29 = w29 + w31
-    w44 = _sign(w44)
-    w35 = 0.0 if w35 == 0.0 else w37
-    w0 = -w0
-    w0 = 0.0 if w3 == 0.0 else w0
-    w35 = w35 + w0
-    w44 = w44 * w35
-    w44 = w14 * w44
-    w44 = w26 * w44
-    w26 = w6 + w26
-    w44 = _div(w44, w26)
-    w44 = w58 * w44
-    w29 = w29 + w44
-    w55 = w55 - w29
-    gamma_U_dot[0] = w55
-    w55 = _sign(w46)
-    w29 = w13 * w7
-    w55 = w55 * w29
-    w55 = w14 * w55
-    w55 = w52 * w55
-    w44 = w6 + w52
-    w55 = _div(w55, w44)
-    w55 = w58 * w55
-    w44 = 1.0 if w50 <= w49 else 0.0
-    w26 = 1.0 if w49 <= w50 else 0.0
-    w26 = w44 + w26
-    w44 = _div(w44, w26)
-    w44 = w44 * w29
-    w55 = w55 - w44
-    w55 = -w55
-    w55 = 0.0 if w3 == 0.0 else w55
-    w46 = _sign(w46)
-    w46 = w14 * w46
-    w46 = w52 * w46
-    w52 = w6 + w52
-    w46 = _div(w46, w52)
-    w46 = w58 * w46
-    w52 = 1.0 if w50 <= w49 else 0.0
-    w49 = 1.0 if w49 <= w50 else 0.0
-    w49 = w52 + w49
-    w52 = _div(w52, w49)
-    w46 = w46 - w52
-    w13 = w13 * w1
-    w13 = w13 + w47
-    w52 = w13 - w6
-    w52 = math.tanh(w52)
-    w52 = w6 - w52
-    w52 = w9 * w52
-    w13 = w13 + w48
-    w13 = w13 * w13
-    w52 = _div(w52, w13)
-    w48 = w32 * w48
-    w52 = w52 - w48
-    w46 = w46 * w52
-    w55 = w55 - w46
-    gamma_U_dot[1] = w55
-    w55 = _sign(w8)
-    w7 = w47 * w7
-    w55 = w55 * w7
-    w55 = w14 * w55
-    w55 = w56 * w55
-    w46 = w6 + w56
-    w55 = _div(w55, w46)
-    w55 = w58 * w55
-    w46 = 1.0 if w25 <= w54 else 0.0
-    w52 = 1.0 if w54 <= w25 else 0.0
-    w52 = w46 + w52
-    w46 = _div(w46, w52)
-    w46 = w46 * w7
-    w55 = w55 - w46
-    w55 = -w55
-    w3 = 0.0 if w3 == 0.0 else w55
-    w8 = _sign(w8)
-    w14 = w14 * w8
-    w14 = w56 * w14
-    w56 = w6 + w56
-    w14 = _div(w14, w56)
-    w58 = w58 * w14
-    w14 = 1.0 if w25 <= w54 else 0.0
-    w54 = 1.0 if w54 <= w25 else 0.0
-    w54 = w14 + w54
-    w14 = _div(w14, w54)
-    w58 = w58 - w14
-    w47 = w47 * w1
-    w47 = w47 + w51
-    w47 = w47 - w25
-    w25 = w47 - w6
-    w25 = math.tanh(w25)
-    w6 = w6 - w25
-    w9 = w9 * w6
-    w47 = w47 + w53
-    w47 = w47 * w47
-    w9 = _div(w9, w47)
-    w32 = w32 * w53
-    w9 = w9 - w32
-    w58 = w58 * w9
-    w3 = w3 - w58
-    gamma_U_dot[2] = w3
-    return (gamma_L, gamma_U, gamma_L_dot, gamma_U_dot)
+    w0 = 1.0 if w0 < w1 else 0.0
+    w2 = float(end[0])
+    w2 = 1.0 if w1 < w2 else 0.0
+    w0 = 1.0 if w0 != 0.0 and w2 != 0.0 else 0.0
+    w2 = float(center[0])
+    w1 = w1 - w2
+    w2 = math.fabs(w1)
+    w3 = float(radius[0])
+    w2 = 1.0 if w2 < w3 else 0.0
+    w0 = 1.0 if w0 != 0.0 and w2 != 0.0 else 0.0
+    w2 = float(height[0])
+    w4 = float(sharpness[0])
+    w5 = w1 * w1
+    w4 = w4 * w5
+    w5 = math.fabs(w1)
+    w5 = w3 - w5
+    w1 = math.fabs(w1)
+    w3 = w3 + w1
+    w5 = w5 * w3
+    w5 = 0.0 if w0 == 0.0 else w5
+    w3 = 1.0 if w0 == 0.0 else 0.0
+    w1 = 1.0
+    w3 = 0.0 if w3 == 0.0 else w1
+    w5 = w5 + w3
+    w4 = _div(w4, w5)
+    w4 = -w4
+    w5 = -80.0
+    w4 = _fmax(w4, w5)
+    w4 = _exp(w4)
+    w2 = w2 * w4
+    w0 = 0.0 if w0 == 0.0 else w2
+    y[0] = w0
+    return (y,)
 
 
-def body_control(x, t, alpha):
-    """CasADi Function 'body_control' (211 instructions).
+def body_bump(t, start, end, center, radius, sharpness, height):
+    """CasADi Function 'body_bump' (57 instructions).
 
     Parameters
     ----------
-    x : sequence of float, length 3 (dense 3x1, column-major)
     t : sequence of float, length 1 (dense 1x1, column-major)
+    start : sequence of float, length 1 (dense 1x1, column-major)
+    end : sequence of float, length 1 (dense 1x1, column-major)
+    center : sequence of float, length 1 (dense 1x1, column-major)
+    radius : sequence of float, length 1 (dense 1x1, column-major)
+    sharpness : sequence of float, length 1 (dense 1x1, column-major)
+    height : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    y : list of float, length 1 (dense 1x1, column-major)
+    y_dot : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(t) != 1:
+        raise ValueError('t: expected 1 values, got %d' % len(t))
+    if len(start) != 1:
+        raise ValueError('start: expected 1 values, got %d' % len(start))
+    if len(end) != 1:
+        raise ValueError('end: expected 1 values, got %d' % len(end))
+    if len(center) != 1:
+        raise ValueError('center: expected 1 values, got %d' % len(center))
+    if len(radius) != 1:
+        raise ValueError('radius: expected 1 values, got %d' % len(radius))
+    if len(sharpness) != 1:
+        raise ValueError('sharpness: expected 1 values, got %d' % len(sharpness))
+    if len(height) != 1:
+        raise ValueError('height: expected 1 values, got %d' % len(height))
+    y = [0.0] * 1
+    y_dot = [0.0] * 1
+    w0 = float(start[0])
+    w1 = float(t[0])
+    w0 = 1.0 if w0 < w1 else 0.0
+    w2 = float(end[0])
+    w2 = 1.0 if w1 < w2 else 0.0
+    w0 = 1.0 if w0 != 0.0 and w2 != 0.0 else 0.0
+    w2 = float(center[0])
+    w1 = w1 - w2
+    w2 = math.fabs(w1)
+    w3 = float(radius[0])
+    w2 = 1.0 if w2 < w3 else 0.0
+    w0 = 1.0 if w0 != 0.0 and w2 != 0.0 else 0.0
+    w2 = float(height[0])
+    w4 = float(sharpness[0])
+    w5 = w1 * w1
+    w5 = w4 * w5
+    w6 = math.fabs(w1)
+    w6 = w3 - w6
+    w7 = math.fabs(w1)
+    w3 = w3 + w7
+    w7 = w6 * w3
+    w7 = 0.0 if w0 == 0.0 else w7
+    w8 = 1.0 if w0 == 0.0 else 0.0
+    w9 = 1.0
+    w8 = 0.0 if w8 == 0.0 else w9
+    w7 = w7 + w8
+    w5 = _div(w5, w7)
+    w8 = -w5
+    w9 = -80.0
+    w10 = _fmax(w8, w9)
+    w10 = _exp(w10)
+    w11 = w2 * w10
+    w11 = 0.0 if w0 == 0.0 else w11
+    y[0] = w11
+    w11 = 1.0 if w9 <= w8 else 0.0
+    w8 = 1.0 if w8 <= w9 else 0.0
+    w8 = w11 + w8
+    w11 = _div(w11, w8)
+    w8 = w1 + w1
+    w4 = w4 * w8
+    w4 = _div(w4, w7)
+    w5 = _div(w5, w7)
+    w7 = _sign(w1)
+    w6 = w6 * w7
+    w1 = _sign(w1)
+    w3 = w3 * w1
+    w6 = w6 - w3
+    w5 = w5 * w6
+    w5 = -w5
+    w5 = 0.0 if w0 == 0.0 else w5
+    w4 = w4 + w5
+    w11 = w11 * w4
+    w10 = w10 * w11
+    w2 = w2 * w10
+    w2 = -w2
+    w0 = 0.0 if w0 == 0.0 else w2
+    y_dot[0] = w0
+    return (y, y_dot)
+
+
+def body_fnu_single(bound, sign, y, y_dot):
+    """CasADi Function 'body_fnu_single' (9 instructions).
+
+    Parameters
+    ----------
+    bound : sequence of float, length 1 (dense 1x1, column-major)
+    sign : sequence of float, length 1 (dense 1x1, column-major)
+    y : sequence of float, length 1 (dense 1x1, column-major)
+    y_dot : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    beta : list of float, length 1 (dense 1x1, column-major)
+    beta_dot : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(bound) != 1:
+        raise ValueError('bound: expected 1 values, got %d' % len(bound))
+    if len(sign) != 1:
+        raise ValueError('sign: expected 1 values, got %d' % len(sign))
+    if len(y) != 1:
+        raise ValueError('y: expected 1 values, got %d' % len(y))
+    if len(y_dot) != 1:
+        raise ValueError('y_dot: expected 1 values, got %d' % len(y_dot))
+    beta = [0.0] * 1
+    beta_dot = [0.0] * 1
+    w0 = float(bound[0])
+    w1 = float(sign[0])
+    w2 = float(y[0])
+    w2 = w1 * w2
+    w0 = w0 + w2
+    beta[0] = w0
+    w0 = float(y_dot[0])
+    w1 = w1 * w0
+    beta_dot[0] = w1
+    return (beta, beta_dot)
+
+
+def body_candidates(rho, alpha):
+    """CasADi Function 'body_candidates' (24 instructions).
+
+    Parameters
+    ----------
+    rho : sequence of float, length 6 (dense 6x1, column-major)
     alpha : sequence of float, length 6 (dense 6x1, column-major)
 
     Returns
     -------
-    u : list of float, length 3 (dense 3x1, column-major)
-    inside : list of float, length 1 (dense 1x1, column-major)
+    c : list of float, length 6 (dense 6x1, column-major)
     """
-    if len(x) != 3:
-        raise ValueError('x: expected 3 values, got %d' % len(x))
-    if len(t) != 1:
-        raise ValueError('t: expected 1 values, got %d' % len(t))
+    if len(rho) != 6:
+        raise ValueError('rho: expected 6 values, got %d' % len(rho))
     if len(alpha) != 6:
         raise ValueError('alpha: expected 6 values, got %d' % len(alpha))
-    u = [0.0] * 3
-    inside = [0.0] * 1
-    w0 = -0.42597205434069174
-    w1 = 4.0
-    w2 = 0.5
-    w3 = float(t[0])
-    w4 = 9.0
-    w5 = 1.0 if w3 < w4 else 0.0
-    w4 = w4 - w3
-    w4 = 0.0 if w5 == 0.0 else w4
-    w6 = 1.0 if w5 == 0.0 else 0.0
-    w7 = 1.0
-    w6 = 0.0 if w6 == 0.0 else w7
-    w4 = w4 + w6
-    w4 = _div(w3, w4)
-    w4 = math.tanh(w4)
-    w4 = 0.0 if w5 == 0.0 else w4
-    w5 = 1.0 if w5 == 0.0 else 0.0
-    w5 = 0.0 if w5 == 0.0 else w7
-    w4 = w4 + w5
-    w5 = w2 * w4
-    w6 = 4.45
-    w5 = w5 + w6
-    w6 = float(alpha[3])
-    w5 = w5 + w6
-    w6 = -w5
-    w8 = 5.0
-    w9 = 2.5547043129396805
-    w3 = w3 - w9
-    w9 = math.fabs(w3)
-    w10 = 1.4164507184235302
-    w9 = 1.0 if w9 < w10 else 0.0
-    w11 = -1.2000000000000002
-    w12 = -0.1
-    w13 = w3 * w3
-    w12 = w12 * w13
-    w13 = math.fabs(w3)
-    w13 = w10 - w13
-    w3 = math.fabs(w3)
-    w10 = w10 + w3
-    w13 = w13 * w10
-    w13 = 0.0 if w9 == 0.0 else w13
-    w10 = 1.0 if w9 == 0.0 else 0.0
-    w10 = 0.0 if w10 == 0.0 else w7
-    w13 = w13 + w10
-    w12 = _div(w12, w13)
-    w12 = _exp(w12)
-    w11 = w11 * w12
-    w9 = 0.0 if w9 == 0.0 else w11
-    w8 = w8 + w9
-    w9 = -w8
-    w6 = _fmax(w6, w9)
-    w9 = -50.0
-    w8 = w8 - w5
-    w8 = math.fabs(w8)
-    w8 = w9 * w8
-    w8 = _exp(w8)
-    w8 = _log1p(w8)
-    w5 = 50.0
-    w8 = w8 / w5
-    w6 = w6 + w8
-    w2 = w2 * w4
-    w8 = 4.05
-    w2 = w2 + w8
-    w8 = float(alpha[0])
-    w2 = w2 - w8
-    w8 = 0.0
-    w11 = _fmax(w2, w8)
+    c = [0.0] * 6
+    w0 = float(rho[0])
+    w1 = float(alpha[0])
+    w0 = w0 - w1
+    c[0] = w0
+    w0 = float(rho[1])
+    w1 = float(alpha[1])
+    w0 = w0 - w1
+    c[1] = w0
+    w0 = float(rho[2])
+    w1 = float(alpha[2])
+    w0 = w0 - w1
+    c[2] = w0
+    w0 = float(rho[3])
+    w1 = float(alpha[3])
+    w0 = w0 + w1
+    c[3] = w0
+    w0 = float(rho[4])
+    w1 = float(alpha[4])
+    w0 = w0 + w1
+    c[4] = w0
+    w0 = float(rho[5])
+    w1 = float(alpha[5])
+    w0 = w0 + w1
+    c[5] = w0
+    return (c,)
+
+
+def body_candidate_rates(rho_dot, alpha_dot):
+    """CasADi Function 'body_candidate_rates' (24 instructions).
+
+    Parameters
+    ----------
+    rho_dot : sequence of float, length 6 (dense 6x1, column-major)
+    alpha_dot : sequence of float, length 6 (dense 6x1, column-major)
+
+    Returns
+    -------
+    c_dot : list of float, length 6 (dense 6x1, column-major)
+    """
+    if len(rho_dot) != 6:
+        raise ValueError('rho_dot: expected 6 values, got %d' % len(rho_dot))
+    if len(alpha_dot) != 6:
+        raise ValueError('alpha_dot: expected 6 values, got %d' % len(alpha_dot))
+    c_dot = [0.0] * 6
+    w0 = float(rho_dot[0])
+    w1 = float(alpha_dot[0])
+    w0 = w0 - w1
+    c_dot[0] = w0
+    w0 = float(rho_dot[1])
+    w1 = float(alpha_dot[1])
+    w0 = w0 - w1
+    c_dot[1] = w0
+    w0 = float(rho_dot[2])
+    w1 = float(alpha_dot[2])
+    w0 = w0 - w1
+    c_dot[2] = w0
+    w0 = float(rho_dot[3])
+    w1 = float(alpha_dot[3])
+    w0 = w0 + w1
+    c_dot[3] = w0
+    w0 = float(rho_dot[4])
+    w1 = float(alpha_dot[4])
+    w0 = w0 + w1
+    c_dot[4] = w0
+    w0 = float(rho_dot[5])
+    w1 = float(alpha_dot[5])
+    w0 = w0 + w1
+    c_dot[5] = w0
+    return (c_dot,)
+
+
+def body_smooth_max_test(a, b, nu):
+    """CasADi Function 'body_smooth_max_test' (17 instructions).
+
+    Parameters
+    ----------
+    a : sequence of float, length 1 (dense 1x1, column-major)
+    b : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    max : list of float, length 1 (dense 1x1, column-major)
+    needed : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(a) != 1:
+        raise ValueError('a: expected 1 values, got %d' % len(a))
+    if len(b) != 1:
+        raise ValueError('b: expected 1 values, got %d' % len(b))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
+    max = [0.0] * 1
+    needed = [0.0] * 1
+    w0 = float(a[0])
+    w1 = float(b[0])
+    w2 = _fmax(w0, w1)
+    max[0] = w2
+    w3 = 40.0
+    w4 = float(nu[0])
+    w0 = w0 - w1
+    w0 = math.fabs(w0)
+    w0 = w4 * w0
+    w3 = 1.0 if w3 <= w0 else 0.0
+    w0 = 0.07656119366529843
+    w0 = _div(w0, w4)
     w2 = math.fabs(w2)
-    w2 = w9 * w2
+    w0 = 1.0 if w0 <= w2 else 0.0
+    w3 = 1.0 if w3 != 0.0 and w0 != 0.0 else 0.0
+    w3 = 1.0 if w3 == 0.0 else 0.0
+    needed[0] = w3
+    return (max, needed)
+
+
+def body_smooth_max(a, b, nu):
+    """CasADi Function 'body_smooth_max' (15 instructions).
+
+    Parameters
+    ----------
+    a : sequence of float, length 1 (dense 1x1, column-major)
+    b : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    max : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(a) != 1:
+        raise ValueError('a: expected 1 values, got %d' % len(a))
+    if len(b) != 1:
+        raise ValueError('b: expected 1 values, got %d' % len(b))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
+    max = [0.0] * 1
+    w0 = float(a[0])
+    w1 = float(b[0])
+    w2 = _fmax(w0, w1)
+    w3 = float(nu[0])
+    w0 = w0 - w1
+    w0 = math.fabs(w0)
+    w0 = w3 * w0
+    w0 = -w0
+    w1 = -80.0
+    w0 = _fmax(w0, w1)
+    w0 = _exp(w0)
+    w0 = _log1p(w0)
+    w0 = _div(w0, w3)
+    w2 = w2 + w0
+    max[0] = w2
+    return (max,)
+
+
+def body_smooth_min_test(a, b, nu):
+    """CasADi Function 'body_smooth_min_test' (20 instructions).
+
+    Parameters
+    ----------
+    a : sequence of float, length 1 (dense 1x1, column-major)
+    b : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    min : list of float, length 1 (dense 1x1, column-major)
+    needed : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(a) != 1:
+        raise ValueError('a: expected 1 values, got %d' % len(a))
+    if len(b) != 1:
+        raise ValueError('b: expected 1 values, got %d' % len(b))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
+    min = [0.0] * 1
+    needed = [0.0] * 1
+    w0 = float(a[0])
+    w1 = -w0
+    w2 = float(b[0])
+    w3 = -w2
+    w1 = _fmax(w1, w3)
+    w3 = -w1
+    min[0] = w3
+    w3 = 40.0
+    w4 = float(nu[0])
+    w2 = w2 - w0
+    w2 = math.fabs(w2)
+    w2 = w4 * w2
+    w3 = 1.0 if w3 <= w2 else 0.0
+    w2 = 0.07656119366529843
+    w2 = _div(w2, w4)
+    w1 = math.fabs(w1)
+    w2 = 1.0 if w2 <= w1 else 0.0
+    w3 = 1.0 if w3 != 0.0 and w2 != 0.0 else 0.0
+    w3 = 1.0 if w3 == 0.0 else 0.0
+    needed[0] = w3
+    return (min, needed)
+
+
+def body_smooth_min(a, b, nu):
+    """CasADi Function 'body_smooth_min' (18 instructions).
+
+    Parameters
+    ----------
+    a : sequence of float, length 1 (dense 1x1, column-major)
+    b : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    min : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(a) != 1:
+        raise ValueError('a: expected 1 values, got %d' % len(a))
+    if len(b) != 1:
+        raise ValueError('b: expected 1 values, got %d' % len(b))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
+    min = [0.0] * 1
+    w0 = float(a[0])
+    w1 = -w0
+    w2 = float(b[0])
+    w3 = -w2
+    w1 = _fmax(w1, w3)
+    w3 = float(nu[0])
+    w2 = w2 - w0
+    w2 = math.fabs(w2)
+    w2 = w3 * w2
+    w2 = -w2
+    w0 = -80.0
+    w2 = _fmax(w2, w0)
     w2 = _exp(w2)
     w2 = _log1p(w2)
-    w2 = w2 / w5
-    w11 = w11 + w2
-    w2 = w6 + w11
-    w2 = -w2
-    w12 = 1e-06
-    w13 = _fmax(w2, w12)
-    w10 = float(x[0])
-    w10 = w10 + w10
-    w11 = w11 - w6
-    w10 = w10 - w11
-    w10 = _div(w10, w13)
-    w11 = -0.9999990463256836
-    w6 = _fmax(w10, w11)
-    w3 = 0.9999990463256836
-    w6 = _fmin(w6, w3)
-    w14 = w6 * w6
-    w14 = w7 - w14
-    w13 = w13 * w14
-    w13 = _div(w1, w13)
-    w13 = w0 * w13
-    w14 = w7 + w6
-    w6 = w7 - w6
-    w14 = _div(w14, w6)
-    w14 = _log(w14)
-    w13 = w13 * w14
-    u[0] = w13
-    w13 = 4.5
-    w14 = w13 * w4
-    w6 = 0.45
-    w14 = w14 + w6
-    w15 = float(alpha[4])
-    w14 = w14 + w15
-    w15 = -w14
-    w16 = -5.0
-    w15 = _fmax(w15, w16)
-    w14 = w14 + w16
-    w14 = math.fabs(w14)
-    w14 = w9 * w14
-    w14 = _exp(w14)
-    w14 = _log1p(w14)
-    w14 = w14 / w5
-    w15 = w15 + w14
-    w13 = w13 * w4
-    w14 = 0.04999999999999999
-    w13 = w13 + w14
-    w14 = float(alpha[1])
-    w13 = w13 - w14
-    w14 = _fmax(w13, w8)
-    w13 = math.fabs(w13)
-    w13 = w9 * w13
-    w13 = _exp(w13)
-    w13 = _log1p(w13)
-    w13 = w13 / w5
-    w14 = w14 + w13
-    w13 = w15 + w14
-    w13 = -w13
-    w16 = _fmax(w13, w12)
-    w17 = float(x[1])
-    w17 = w17 + w17
-    w14 = w14 - w15
-    w17 = w17 - w14
-    w17 = _div(w17, w16)
-    w14 = _fmax(w17, w11)
-    w14 = _fmin(w14, w3)
-    w15 = w14 * w14
-    w15 = w7 - w15
-    w16 = w16 * w15
-    w16 = _div(w1, w16)
-    w16 = w0 * w16
-    w15 = w7 + w14
-    w14 = w7 - w14
-    w15 = _div(w15, w14)
-    w15 = _log(w15)
-    w16 = w16 * w15
-    u[1] = w16
-    w6 = w6 * w4
-    w16 = 0.05
-    w6 = w6 + w16
-    w16 = float(alpha[5])
-    w6 = w6 + w16
-    w16 = -w6
-    w15 = -1.2
-    w16 = _fmax(w16, w15)
-    w6 = w6 + w15
-    w6 = math.fabs(w6)
-    w6 = w9 * w6
-    w6 = _exp(w6)
-    w6 = _log1p(w6)
-    w6 = w6 / w5
-    w16 = w16 + w6
-    w6 = -0.45
-    w6 = w6 * w4
-    w4 = -0.05
-    w6 = w6 + w4
-    w4 = float(alpha[2])
-    w6 = w6 - w4
-    w4 = _fmax(w6, w15)
-    w6 = w6 - w15
-    w6 = math.fabs(w6)
-    w9 = w9 * w6
-    w9 = _exp(w9)
-    w9 = _log1p(w9)
-    w9 = w9 / w5
-    w4 = w4 + w9
-    w9 = w16 + w4
-    w9 = -w9
-    w12 = _fmax(w9, w12)
-    w5 = float(x[2])
+    w2 = _div(w2, w3)
+    w1 = w1 + w2
+    w1 = -w1
+    min[0] = w1
+    return (min,)
+
+
+def body_smooth_max_rate(a, b, a_dot, b_dot, nu):
+    """CasADi Function 'body_smooth_max_rate' (40 instructions).
+
+    Parameters
+    ----------
+    a : sequence of float, length 1 (dense 1x1, column-major)
+    b : sequence of float, length 1 (dense 1x1, column-major)
+    a_dot : sequence of float, length 1 (dense 1x1, column-major)
+    b_dot : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    max_dot : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(a) != 1:
+        raise ValueError('a: expected 1 values, got %d' % len(a))
+    if len(b) != 1:
+        raise ValueError('b: expected 1 values, got %d' % len(b))
+    if len(a_dot) != 1:
+        raise ValueError('a_dot: expected 1 values, got %d' % len(a_dot))
+    if len(b_dot) != 1:
+        raise ValueError('b_dot: expected 1 values, got %d' % len(b_dot))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
+    max_dot = [0.0] * 1
+    w0 = float(b[0])
+    w1 = float(a[0])
+    w2 = 1.0 if w0 <= w1 else 0.0
+    w3 = 1.0 if w1 <= w0 else 0.0
+    w4 = w2 + w3
+    w2 = _div(w2, w4)
+    w5 = float(nu[0])
+    w1 = w1 - w0
+    w0 = math.fabs(w1)
+    w0 = w5 * w0
+    w0 = -w0
+    w6 = -80.0
+    w7 = _fmax(w0, w6)
+    w7 = _exp(w7)
+    w8 = 1.0 if w6 <= w0 else 0.0
+    w0 = 1.0 if w0 <= w6 else 0.0
+    w0 = w8 + w0
+    w8 = _div(w8, w0)
+    w1 = _sign(w1)
+    w0 = w5 * w1
+    w0 = w8 * w0
+    w0 = w7 * w0
+    w6 = 1.0
+    w6 = w6 + w7
+    w0 = _div(w0, w6)
+    w0 = _div(w0, w5)
+    w2 = w2 - w0
+    w0 = float(a_dot[0])
+    w2 = w2 * w0
+    w3 = _div(w3, w4)
+    w1 = w5 * w1
+    w8 = w8 * w1
+    w7 = w7 * w8
+    w7 = _div(w7, w6)
+    w7 = _div(w7, w5)
+    w3 = w3 + w7
+    w7 = float(b_dot[0])
+    w3 = w3 * w7
+    w2 = w2 + w3
+    max_dot[0] = w2
+    return (max_dot,)
+
+
+def body_smooth_min_rate(a, b, a_dot, b_dot, nu):
+    """CasADi Function 'body_smooth_min_rate' (42 instructions).
+
+    Parameters
+    ----------
+    a : sequence of float, length 1 (dense 1x1, column-major)
+    b : sequence of float, length 1 (dense 1x1, column-major)
+    a_dot : sequence of float, length 1 (dense 1x1, column-major)
+    b_dot : sequence of float, length 1 (dense 1x1, column-major)
+    nu : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    min_dot : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(a) != 1:
+        raise ValueError('a: expected 1 values, got %d' % len(a))
+    if len(b) != 1:
+        raise ValueError('b: expected 1 values, got %d' % len(b))
+    if len(a_dot) != 1:
+        raise ValueError('a_dot: expected 1 values, got %d' % len(a_dot))
+    if len(b_dot) != 1:
+        raise ValueError('b_dot: expected 1 values, got %d' % len(b_dot))
+    if len(nu) != 1:
+        raise ValueError('nu: expected 1 values, got %d' % len(nu))
+    min_dot = [0.0] * 1
+    w0 = float(a[0])
+    w1 = -w0
+    w2 = float(b[0])
+    w3 = -w2
+    w4 = 1.0 if w1 <= w3 else 0.0
+    w3 = 1.0 if w3 <= w1 else 0.0
+    w1 = w3 + w4
+    w4 = _div(w4, w1)
+    w5 = float(nu[0])
+    w2 = w2 - w0
+    w0 = math.fabs(w2)
+    w0 = w5 * w0
+    w0 = -w0
+    w6 = -80.0
+    w7 = _fmax(w0, w6)
+    w7 = _exp(w7)
+    w8 = 1.0 if w6 <= w0 else 0.0
+    w0 = 1.0 if w0 <= w6 else 0.0
+    w0 = w8 + w0
+    w8 = _div(w8, w0)
+    w2 = _sign(w2)
+    w0 = w5 * w2
+    w0 = w8 * w0
+    w0 = w7 * w0
+    w6 = 1.0
+    w6 = w6 + w7
+    w0 = _div(w0, w6)
+    w0 = _div(w0, w5)
+    w4 = w4 + w0
+    w0 = float(b_dot[0])
+    w4 = w4 * w0
+    w2 = w5 * w2
+    w8 = w8 * w2
+    w7 = w7 * w8
+    w7 = _div(w7, w6)
+    w7 = _div(w7, w5)
+    w3 = _div(w3, w1)
+    w7 = w7 - w3
+    w3 = float(a_dot[0])
+    w7 = w7 * w3
+    w4 = w4 - w7
+    min_dot[0] = w4
+    return (min_dot,)
+
+
+def body_conflict(rho, beta, theta0, mu):
+    """CasADi Function 'body_conflict' (78 instructions).
+
+    Parameters
+    ----------
+    rho : sequence of float, length 6 (dense 6x1, column-major)
+    beta : sequence of float, length 6 (dense 6x1, column-major)
+    theta0 : sequence of float, length 1 (dense 1x1, column-major)
+    mu : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    psi : list of float, length 6 (dense 6x1, column-major)
+    theta : list of float, length 6 (dense 6x1, column-major)
+    """
+    if len(rho) != 6:
+        raise ValueError('rho: expected 6 values, got %d' % len(rho))
+    if len(beta) != 6:
+        raise ValueError('beta: expected 6 values, got %d' % len(beta))
+    if len(theta0) != 1:
+        raise ValueError('theta0: expected 1 values, got %d' % len(theta0))
+    if len(mu) != 1:
+        raise ValueError('mu: expected 1 values, got %d' % len(mu))
+    psi = [0.0] * 6
+    theta = [0.0] * 6
+    w0 = float(beta[3])
+    w1 = float(rho[0])
+    w0 = w0 - w1
+    psi[0] = w0
+    w1 = float(beta[4])
+    w2 = float(rho[1])
+    w1 = w1 - w2
+    psi[1] = w1
+    w2 = float(beta[5])
+    w3 = float(rho[2])
+    w2 = w2 - w3
+    psi[2] = w2
+    w3 = float(rho[3])
+    w4 = float(beta[0])
+    w3 = w3 - w4
+    psi[3] = w3
+    w4 = float(rho[4])
+    w5 = float(beta[1])
+    w4 = w4 - w5
+    psi[4] = w4
+    w5 = float(rho[5])
+    w6 = float(beta[2])
+    w5 = w5 - w6
+    psi[5] = w5
+    w6 = float(theta0[0])
+    w6 = w6 + w6
+    w7 = 1.0
+    w8 = float(mu[0])
+    w0 = w0 - w8
+    w0 = w0 + w0
+    w9 = -80.0
+    w0 = _fmax(w0, w9)
+    w10 = 80.0
+    w0 = _fmin(w0, w10)
+    w0 = _exp(w0)
+    w0 = w7 + w0
+    w0 = _div(w6, w0)
+    theta[0] = w0
+    w1 = w1 - w8
+    w1 = w1 + w1
+    w1 = _fmax(w1, w9)
+    w1 = _fmin(w1, w10)
+    w1 = _exp(w1)
+    w1 = w7 + w1
+    w1 = _div(w6, w1)
+    theta[1] = w1
+    w2 = w2 - w8
+    w2 = w2 + w2
+    w2 = _fmax(w2, w9)
+    w2 = _fmin(w2, w10)
+    w2 = _exp(w2)
+    w2 = w7 + w2
+    w2 = _div(w6, w2)
+    theta[2] = w2
+    w3 = w3 - w8
+    w3 = w3 + w3
+    w3 = _fmax(w3, w9)
+    w3 = _fmin(w3, w10)
+    w3 = _exp(w3)
+    w3 = w7 + w3
+    w3 = _div(w6, w3)
+    theta[3] = w3
+    w4 = w4 - w8
+    w4 = w4 + w4
+    w4 = _fmax(w4, w9)
+    w4 = _fmin(w4, w10)
+    w4 = _exp(w4)
+    w4 = w7 + w4
+    w4 = _div(w6, w4)
+    theta[4] = w4
+    w5 = w5 - w8
     w5 = w5 + w5
-    w4 = w4 - w16
-    w5 = w5 - w4
-    w5 = _div(w5, w12)
-    w11 = _fmax(w5, w11)
-    w11 = _fmin(w11, w3)
-    w3 = w11 * w11
-    w3 = w7 - w3
-    w12 = w12 * w3
-    w1 = _div(w1, w12)
-    w0 = w0 * w1
-    w1 = w7 + w11
-    w11 = w7 - w11
-    w1 = _div(w1, w11)
-    w1 = _log(w1)
-    w0 = w0 * w1
-    u[2] = w0
-    w10 = math.fabs(w10)
-    w10 = 1.0 if w10 < w7 else 0.0
-    w2 = 1.0 if w8 < w2 else 0.0
-    w10 = 1.0 if w10 != 0.0 and w2 != 0.0 else 0.0
-    w10 = 1.0 if w7 != 0.0 and w10 != 0.0 else 0.0
-    w17 = math.fabs(w17)
-    w17 = 1.0 if w17 < w7 else 0.0
-    w13 = 1.0 if w8 < w13 else 0.0
-    w17 = 1.0 if w17 != 0.0 and w13 != 0.0 else 0.0
-    w10 = 1.0 if w10 != 0.0 and w17 != 0.0 else 0.0
-    w5 = math.fabs(w5)
-    w5 = 1.0 if w5 < w7 else 0.0
-    w8 = 1.0 if w8 < w9 else 0.0
-    w5 = 1.0 if w5 != 0.0 and w8 != 0.0 else 0.0
-    w10 = 1.0 if w10 != 0.0 and w5 != 0.0 else 0.0
-    inside[0] = w10
-    return (u, inside)
+    w5 = _fmax(w5, w9)
+    w5 = _fmin(w5, w10)
+    w5 = _exp(w5)
+    w7 = w7 + w5
+    w6 = _div(w6, w7)
+    theta[5] = w6
+    return (psi, theta)
 
 
-def body_alpha_step(t, dt, alpha):
-    """CasADi Function 'body_alpha_step' (825 instructions).
+def body_alpha_rate(alpha, psi, theta, kappa):
+    """CasADi Function 'body_alpha_rate' (55 instructions).
+
+    Parameters
+    ----------
+    alpha : sequence of float, length 6 (dense 6x1, column-major)
+    psi : sequence of float, length 6 (dense 6x1, column-major)
+    theta : sequence of float, length 6 (dense 6x1, column-major)
+    kappa : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    alpha_dot : list of float, length 6 (dense 6x1, column-major)
+    """
+    if len(alpha) != 6:
+        raise ValueError('alpha: expected 6 values, got %d' % len(alpha))
+    if len(psi) != 6:
+        raise ValueError('psi: expected 6 values, got %d' % len(psi))
+    if len(theta) != 6:
+        raise ValueError('theta: expected 6 values, got %d' % len(theta))
+    if len(kappa) != 1:
+        raise ValueError('kappa: expected 1 values, got %d' % len(kappa))
+    alpha_dot = [0.0] * 6
+    w0 = float(theta[0])
+    w1 = float(psi[0])
+    w2 = float(alpha[0])
+    w1 = w1 + w2
+    w1 = w1 * w1
+    w0 = _div(w0, w1)
+    w1 = float(kappa[0])
+    w2 = w1 * w2
+    w0 = w0 - w2
+    alpha_dot[0] = w0
+    w0 = float(theta[1])
+    w2 = float(psi[1])
+    w3 = float(alpha[1])
+    w2 = w2 + w3
+    w2 = w2 * w2
+    w0 = _div(w0, w2)
+    w3 = w1 * w3
+    w0 = w0 - w3
+    alpha_dot[1] = w0
+    w0 = float(theta[2])
+    w3 = float(psi[2])
+    w2 = float(alpha[2])
+    w3 = w3 + w2
+    w3 = w3 * w3
+    w0 = _div(w0, w3)
+    w2 = w1 * w2
+    w0 = w0 - w2
+    alpha_dot[2] = w0
+    w0 = float(theta[3])
+    w2 = float(psi[3])
+    w3 = float(alpha[3])
+    w2 = w2 + w3
+    w2 = w2 * w2
+    w0 = _div(w0, w2)
+    w3 = w1 * w3
+    w0 = w0 - w3
+    alpha_dot[3] = w0
+    w0 = float(theta[4])
+    w3 = float(psi[4])
+    w2 = float(alpha[4])
+    w3 = w3 + w2
+    w3 = w3 * w3
+    w0 = _div(w0, w3)
+    w2 = w1 * w2
+    w0 = w0 - w2
+    alpha_dot[4] = w0
+    w0 = float(theta[5])
+    w2 = float(psi[5])
+    w3 = float(alpha[5])
+    w2 = w2 + w3
+    w2 = w2 * w2
+    w0 = _div(w0, w2)
+    w1 = w1 * w3
+    w0 = w0 - w1
+    alpha_dot[5] = w0
+    return (alpha_dot,)
+
+
+def body_later(t, dt):
+    """CasADi Function 'body_later' (4 instructions).
 
     Parameters
     ----------
     t : sequence of float, length 1 (dense 1x1, column-major)
     dt : sequence of float, length 1 (dense 1x1, column-major)
-    alpha : sequence of float, length 6 (dense 6x1, column-major)
 
     Returns
     -------
-    alpha_next : list of float, length 6 (dense 6x1, column-major)
+    t_next : list of float, length 1 (dense 1x1, column-major)
     """
     if len(t) != 1:
         raise ValueError('t: expected 1 values, got %d' % len(t))
     if len(dt) != 1:
         raise ValueError('dt: expected 1 values, got %d' % len(dt))
-    if len(alpha) != 6:
-        raise ValueError('alpha: expected 6 values, got %d' % len(alpha))
-    alpha_next = [0.0] * 6
+    t_next = [0.0] * 1
+    w0 = float(t[0])
+    w1 = float(dt[0])
+    w0 = w0 + w1
+    t_next[0] = w0
+    return (t_next,)
+
+
+def body_newton_start(alpha, psi, theta, dt, kappa):
+    """CasADi Function 'body_newton_start' (24 instructions).
+
+    Parameters
+    ----------
+    alpha : sequence of float, length 1 (dense 1x1, column-major)
+    psi : sequence of float, length 1 (dense 1x1, column-major)
+    theta : sequence of float, length 1 (dense 1x1, column-major)
+    dt : sequence of float, length 1 (dense 1x1, column-major)
+    kappa : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    a0 : list of float, length 1 (dense 1x1, column-major)
+    c : list of float, length 1 (dense 1x1, column-major)
+    A : list of float, length 1 (dense 1x1, column-major)
+    root : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(alpha) != 1:
+        raise ValueError('alpha: expected 1 values, got %d' % len(alpha))
+    if len(psi) != 1:
+        raise ValueError('psi: expected 1 values, got %d' % len(psi))
+    if len(theta) != 1:
+        raise ValueError('theta: expected 1 values, got %d' % len(theta))
+    if len(dt) != 1:
+        raise ValueError('dt: expected 1 values, got %d' % len(dt))
+    if len(kappa) != 1:
+        raise ValueError('kappa: expected 1 values, got %d' % len(kappa))
+    a0 = [0.0] * 1
+    c = [0.0] * 1
+    A = [0.0] * 1
+    root = [0.0] * 1
     w0 = float(alpha[0])
     w1 = 1.0
-    w2 = 5.0
+    w2 = float(kappa[0])
     w3 = float(dt[0])
-    w4 = w2 * w3
-    w4 = w1 + w4
-    w5 = _div(w0, w4)
-    w6 = 0.01
-    w7 = float(t[0])
-    w7 = w7 + w3
-    w8 = 2.5547043129396805
-    w8 = w7 - w8
-    w9 = math.fabs(w8)
-    w10 = 1.4164507184235302
-    w9 = 1.0 if w9 < w10 else 0.0
-    w11 = -1.2000000000000002
-    w12 = -0.1
-    w13 = w8 * w8
-    w12 = w12 * w13
-    w13 = math.fabs(w8)
-    w13 = w10 - w13
-    w8 = math.fabs(w8)
-    w10 = w10 + w8
-    w13 = w13 * w10
-    w13 = 0.0 if w9 == 0.0 else w13
-    w10 = 1.0 if w9 == 0.0 else 0.0
-    w10 = 0.0 if w10 == 0.0 else w1
-    w13 = w13 + w10
-    w12 = _div(w12, w13)
-    w12 = _exp(w12)
-    w11 = w11 * w12
-    w9 = 0.0 if w9 == 0.0 else w11
-    w9 = w2 + w9
-    w11 = 0.5
-    w12 = 9.0
-    w13 = 1.0 if w7 < w12 else 0.0
-    w12 = w12 - w7
-    w12 = 0.0 if w13 == 0.0 else w12
-    w10 = 1.0 if w13 == 0.0 else 0.0
-    w10 = 0.0 if w10 == 0.0 else w1
-    w12 = w12 + w10
-    w7 = _div(w7, w12)
-    w7 = math.tanh(w7)
-    w7 = 0.0 if w13 == 0.0 else w7
-    w13 = 1.0 if w13 == 0.0 else 0.0
-    w13 = 0.0 if w13 == 0.0 else w1
-    w7 = w7 + w13
-    w13 = w11 * w7
-    w12 = 4.05
-    w13 = w13 + w12
-    w9 = w9 - w13
-    w13 = w9 - w1
-    w13 = math.tanh(w13)
-    w13 = w1 - w13
-    w13 = w6 * w13
-    w13 = w3 * w13
-    w12 = w4 + w4
-    w10 = _div(w13, w12)
-    w8 = 0.3333333333333333
-    w10 = _pow(w10, w8)
-    w14 = w4 * w9
-    w14 = w14 + w0
-    w14 = -w14
-    w15 = 0.0
-    w14 = _fmax(w14, w15)
-    w16 = 1e-30
-    w14 = _fmax(w14, w16)
-    w14 = w14 + w14
-    w14 = _div(w13, w14)
-    w14 = _sqrt(w14)
-    w10 = _fmin(w10, w14)
-    w10 = w10 - w9
-    w5 = _fmax(w5, w10)
-    w10 = w4 * w5
-    w10 = w10 - w0
-    w14 = w9 + w5
-    w17 = w14 * w14
-    w17 = _div(w13, w17)
-    w10 = w10 - w17
-    w17 = w13 + w13
-    w18 = w14 * w14
-    w14 = w14 * w18
-    w17 = _div(w17, w14)
-    w17 = w4 + w17
-    w10 = _div(w10, w17)
-    w5 = w5 - w10
-    w10 = w4 * w5
-    w10 = w10 - w0
-    w17 = w9 + w5
-    w14 = w17 * w17
-    w14 = _div(w13, w14)
-    w10 = w10 - w14
-    w14 = w13 + w13
-    w18 = w17 * w17
-    w17 = w17 * w18
-    w14 = _div(w14, w17)
-    w14 = w4 + w14
-    w10 = _div(w10, w14)
-    w5 = w5 - w10
-    w10 = w4 * w5
-    w10 = w10 - w0
-    w14 = w9 + w5
-    w17 = w14 * w14
-    w17 = _div(w13, w17)
-    w10 = w10 - w17
-    w17 = w13 + w13
-    w18 = w14 * w14
-    w14 = w14 * w18
-    w17 = _div(w17, w14)
-    w17 = w4 + w17
-    w10 = _div(w10, w17)
-    w5 = w5 - w10
-    w10 = w4 * w5
-    w10 = w10 - w0
-    w17 = w9 + w5
-    w14 = w17 * w17
-    w14 = _div(w13, w14)
-    w10 = w10 - w14
-    w14 = w13 + w13
-    w18 = w17 * w17
-    w17 = w17 * w18
-    w14 = _div(w14, w17)
-    w14 = w4 + w14
-    w10 = _div(w10, w14)
-    w5 = w5 - w10
-    w10 = w4 * w5
-    w10 = w10 - w0
-    w14 = w9 + w5
-    w17 = w14 * w14
-    w17 = _div(w13, w17)
-    w10 = w10 - w17
-    w17 = w13 + w13
-    w18 = w14 * w14
-    w14 = w14 * w18
-    w17 = _div(w17, w14)
-    w17 = w4 + w17
-    w10 = _div(w10, w17)
-    w5 = w5 - w10
-    w10 = w4 * w5
-    w10 = w10 - w0
-    w17 = w9 + w5
-    w14 = w17 * w17
-    w14 = _div(w13, w14)
-    w10 = w10 - w14
-    w14 = w13 + w13
-    w18 = w17 * w17
-    w17 = w17 * w18
-    w14 = _div(w14, w17)
-    w14 = w4 + w14
-    w10 = _div(w10, w14)
-    w5 = w5 - w10
-    w10 = w4 * w5
-    w10 = w10 - w0
-    w14 = w9 + w5
-    w17 = w14 * w14
-    w17 = _div(w13, w17)
-    w10 = w10 - w17
-    w17 = w13 + w13
-    w18 = w14 * w14
-    w14 = w14 * w18
-    w17 = _div(w17, w14)
-    w17 = w4 + w17
-    w10 = _div(w10, w17)
-    w5 = w5 - w10
-    w10 = w4 * w5
-    w10 = w10 - w0
-    w9 = w9 + w5
-    w0 = w9 * w9
-    w0 = _div(w13, w0)
-    w10 = w10 - w0
-    w13 = w13 + w13
-    w0 = w9 * w9
-    w9 = w9 * w0
-    w13 = _div(w13, w9)
-    w13 = w4 + w13
-    w10 = _div(w10, w13)
-    w5 = w5 - w10
-    alpha_next[0] = w5
-    w5 = float(alpha[1])
-    w10 = _div(w5, w4)
-    w13 = 4.5
-    w9 = w13 * w7
-    w0 = 0.04999999999999999
-    w9 = w9 + w0
-    w2 = w2 - w9
-    w9 = w2 - w1
-    w9 = math.tanh(w9)
-    w9 = w1 - w9
-    w9 = w6 * w9
-    w9 = w3 * w9
-    w0 = _div(w9, w12)
-    w0 = _pow(w0, w8)
-    w17 = w4 * w2
-    w17 = w17 + w5
-    w17 = -w17
-    w17 = _fmax(w17, w15)
-    w17 = _fmax(w17, w16)
-    w17 = w17 + w17
-    w17 = _div(w9, w17)
-    w17 = _sqrt(w17)
-    w0 = _fmin(w0, w17)
-    w0 = w0 - w2
-    w10 = _fmax(w10, w0)
-    w0 = w4 * w10
-    w0 = w0 - w5
-    w17 = w2 + w10
-    w14 = w17 * w17
-    w14 = _div(w9, w14)
-    w0 = w0 - w14
-    w14 = w9 + w9
-    w18 = w17 * w17
-    w17 = w17 * w18
-    w14 = _div(w14, w17)
-    w14 = w4 + w14
-    w0 = _div(w0, w14)
-    w10 = w10 - w0
-    w0 = w4 * w10
-    w0 = w0 - w5
-    w14 = w2 + w10
-    w17 = w14 * w14
-    w17 = _div(w9, w17)
-    w0 = w0 - w17
-    w17 = w9 + w9
-    w18 = w14 * w14
-    w14 = w14 * w18
-    w17 = _div(w17, w14)
-    w17 = w4 + w17
-    w0 = _div(w0, w17)
-    w10 = w10 - w0
-    w0 = w4 * w10
-    w0 = w0 - w5
-    w17 = w2 + w10
-    w14 = w17 * w17
-    w14 = _div(w9, w14)
-    w0 = w0 - w14
-    w14 = w9 + w9
-    w18 = w17 * w17
-    w17 = w17 * w18
-    w14 = _div(w14, w17)
-    w14 = w4 + w14
-    w0 = _div(w0, w14)
-    w10 = w10 - w0
-    w0 = w4 * w10
-    w0 = w0 - w5
-    w14 = w2 + w10
-    w17 = w14 * w14
-    w17 = _div(w9, w17)
-    w0 = w0 - w17
-    w17 = w9 + w9
-    w18 = w14 * w14
-    w14 = w14 * w18
-    w17 = _div(w17, w14)
-    w17 = w4 + w17
-    w0 = _div(w0, w17)
-    w10 = w10 - w0
-    w0 = w4 * w10
-    w0 = w0 - w5
-    w17 = w2 + w10
-    w14 = w17 * w17
-    w14 = _div(w9, w14)
-    w0 = w0 - w14
-    w14 = w9 + w9
-    w18 = w17 * w17
-    w17 = w17 * w18
-    w14 = _div(w14, w17)
-    w14 = w4 + w14
-    w0 = _div(w0, w14)
-    w10 = w10 - w0
-    w0 = w4 * w10
-    w0 = w0 - w5
-    w14 = w2 + w10
-    w17 = w14 * w14
-    w17 = _div(w9, w17)
-    w0 = w0 - w17
-    w17 = w9 + w9
-    w18 = w14 * w14
-    w14 = w14 * w18
-    w17 = _div(w17, w14)
-    w17 = w4 + w17
-    w0 = _div(w0, w17)
-    w10 = w10 - w0
-    w0 = w4 * w10
-    w0 = w0 - w5
-    w17 = w2 + w10
-    w14 = w17 * w17
-    w14 = _div(w9, w14)
-    w0 = w0 - w14
-    w14 = w9 + w9
-    w18 = w17 * w17
-    w17 = w17 * w18
-    w14 = _div(w14, w17)
-    w14 = w4 + w14
-    w0 = _div(w0, w14)
-    w10 = w10 - w0
-    w0 = w4 * w10
-    w0 = w0 - w5
-    w2 = w2 + w10
-    w5 = w2 * w2
-    w5 = _div(w9, w5)
-    w0 = w0 - w5
-    w9 = w9 + w9
-    w5 = w2 * w2
-    w2 = w2 * w5
-    w9 = _div(w9, w2)
-    w9 = w4 + w9
-    w0 = _div(w0, w9)
-    w10 = w10 - w0
-    alpha_next[1] = w10
-    w10 = float(alpha[2])
-    w0 = _div(w10, w4)
-    w9 = 1.2
-    w2 = -0.45
-    w2 = w2 * w7
-    w5 = -0.05
-    w2 = w2 + w5
-    w9 = w9 - w2
-    w2 = w9 - w1
-    w2 = math.tanh(w2)
-    w2 = w1 - w2
-    w2 = w6 * w2
-    w2 = w3 * w2
-    w5 = _div(w2, w12)
-    w5 = _pow(w5, w8)
-    w14 = w4 * w9
-    w14 = w14 + w10
-    w14 = -w14
-    w14 = _fmax(w14, w15)
-    w14 = _fmax(w14, w16)
-    w14 = w14 + w14
-    w14 = _div(w2, w14)
-    w14 = _sqrt(w14)
-    w5 = _fmin(w5, w14)
-    w5 = w5 - w9
-    w0 = _fmax(w0, w5)
-    w5 = w4 * w0
-    w5 = w5 - w10
-    w14 = w9 + w0
-    w17 = w14 * w14
-    w17 = _div(w2, w17)
-    w5 = w5 - w17
-    w17 = w2 + w2
-    w18 = w14 * w14
-    w14 = w14 * w18
-    w17 = _div(w17, w14)
-    w17 = w4 + w17
-    w5 = _div(w5, w17)
-    w0 = w0 - w5
-    w5 = w4 * w0
-    w5 = w5 - w10
-    w17 = w9 + w0
-    w14 = w17 * w17
-    w14 = _div(w2, w14)
-    w5 = w5 - w14
-    w14 = w2 + w2
-    w18 = w17 * w17
-    w17 = w17 * w18
-    w14 = _div(w14, w17)
-    w14 = w4 + w14
-    w5 = _div(w5, w14)
-    w0 = w0 - w5
-    w5 = w4 * w0
-    w5 = w5 - w10
-    w14 = w9 + w0
-    w17 = w14 * w14
-    w17 = _div(w2, w17)
-    w5 = w5 - w17
-    w17 = w2 + w2
-    w18 = w14 * w14
-    w14 = w14 * w18
-    w17 = _div(w17, w14)
-    w17 = w4 + w17
-    w5 = _div(w5, w17)
-    w0 = w0 - w5
-    w5 = w4 * w0
-    w5 = w5 - w10
-    w17 = w9 + w0
-    w14 = w17 * w17
-    w14 = _div(w2, w14)
-    w5 = w5 - w14
-    w14 = w2 + w2
-    w18 = w17 * w17
-    w17 = w17 * w18
-    w14 = _div(w14, w17)
-    w14 = w4 + w14
-    w5 = _div(w5, w14)
-    w0 = w0 - w5
-    w5 = w4 * w0
-    w5 = w5 - w10
-    w14 = w9 + w0
-    w17 = w14 * w14
-    w17 = _div(w2, w17)
-    w5 = w5 - w17
-    w17 = w2 + w2
-    w18 = w14 * w14
-    w14 = w14 * w18
-    w17 = _div(w17, w14)
-    w17 = w4 + w17
-    w5 = _div(w5, w17)
-    w0 = w0 - w5
-    w5 = w4 * w0
-    w5 = w5 - w10
-    w17 = w9 + w0
-    w14 = w17 * w17
-    w14 = _div(w2, w14)
-    w5 = w5 - w14
-    w14 = w2 + w2
-    w18 = w17 * w17
-    w17 = w17 * w18
-    w14 = _div(w14, w17)
-    w14 = w4 + w14
-    w5 = _div(w5, w14)
-    w0 = w0 - w5
-    w5 = w4 * w0
-    w5 = w5 - w10
-    w14 = w9 + w0
-    w17 = w14 * w14
-    w17 = _div(w2, w17)
-    w5 = w5 - w17
-    w17 = w2 + w2
-    w18 = w14 * w14
-    w14 = w14 * w18
-    w17 = _div(w17, w14)
-    w17 = w4 + w17
-    w5 = _div(w5, w17)
-    w0 = w0 - w5
-    w5 = w4 * w0
-    w5 = w5 - w10
-    w9 = w9 + w0
-    w10 = w9 * w9
-    w10 = _div(w2, w10)
-    w5 = w5 - w10
-    w2 = w2 + w2
-    w10 = w9 * w9
-    w9 = w9 * w10
-    w2 = _div(w2, w9)
-    w2 = w4 + w2
-    w5 = _div(w5, w2)
-    w0 = w0 - w5
-    alpha_next[2] = w0
-    w0 = float(alpha[3])
-    w5 = _div(w0, w4)
-    w11 = w11 * w7
-    w2 = 4.45
-    w11 = w11 + w2
-    w2 = w11 - w1
-    w2 = math.tanh(w2)
-    w2 = w1 - w2
-    w2 = w6 * w2
-    w2 = w3 * w2
-    w9 = _div(w2, w12)
-    w9 = _pow(w9, w8)
-    w10 = w4 * w11
-    w10 = w10 + w0
-    w10 = -w10
-    w10 = _fmax(w10, w15)
-    w10 = _fmax(w10, w16)
-    w10 = w10 + w10
-    w10 = _div(w2, w10)
-    w10 = _sqrt(w10)
-    w9 = _fmin(w9, w10)
-    w9 = w9 - w11
-    w5 = _fmax(w5, w9)
-    w9 = w4 * w5
-    w9 = w9 - w0
-    w10 = w11 + w5
-    w17 = w10 * w10
-    w17 = _div(w2, w17)
-    w9 = w9 - w17
-    w17 = w2 + w2
-    w14 = w10 * w10
-    w10 = w10 * w14
-    w17 = _div(w17, w10)
-    w17 = w4 + w17
-    w9 = _div(w9, w17)
-    w5 = w5 - w9
-    w9 = w4 * w5
-    w9 = w9 - w0
-    w17 = w11 + w5
-    w10 = w17 * w17
-    w10 = _div(w2, w10)
-    w9 = w9 - w10
-    w10 = w2 + w2
-    w14 = w17 * w17
-    w17 = w17 * w14
-    w10 = _div(w10, w17)
-    w10 = w4 + w10
-    w9 = _div(w9, w10)
-    w5 = w5 - w9
-    w9 = w4 * w5
-    w9 = w9 - w0
-    w10 = w11 + w5
-    w17 = w10 * w10
-    w17 = _div(w2, w17)
-    w9 = w9 - w17
-    w17 = w2 + w2
-    w14 = w10 * w10
-    w10 = w10 * w14
-    w17 = _div(w17, w10)
-    w17 = w4 + w17
-    w9 = _div(w9, w17)
-    w5 = w5 - w9
-    w9 = w4 * w5
-    w9 = w9 - w0
-    w17 = w11 + w5
-    w10 = w17 * w17
-    w10 = _div(w2, w10)
-    w9 = w9 - w10
-    w10 = w2 + w2
-    w14 = w17 * w17
-    w17 = w17 * w14
-    w10 = _div(w10, w17)
-    w10 = w4 + w10
-    w9 = _div(w9, w10)
-    w5 = w5 - w9
-    w9 = w4 * w5
-    w9 = w9 - w0
-    w10 = w11 + w5
-    w17 = w10 * w10
-    w17 = _div(w2, w17)
-    w9 = w9 - w17
-    w17 = w2 + w2
-    w14 = w10 * w10
-    w10 = w10 * w14
-    w17 = _div(w17, w10)
-    w17 = w4 + w17
-    w9 = _div(w9, w17)
-    w5 = w5 - w9
-    w9 = w4 * w5
-    w9 = w9 - w0
-    w17 = w11 + w5
-    w10 = w17 * w17
-    w10 = _div(w2, w10)
-    w9 = w9 - w10
-    w10 = w2 + w2
-    w14 = w17 * w17
-    w17 = w17 * w14
-    w10 = _div(w10, w17)
-    w10 = w4 + w10
-    w9 = _div(w9, w10)
-    w5 = w5 - w9
-    w9 = w4 * w5
-    w9 = w9 - w0
-    w10 = w11 + w5
-    w17 = w10 * w10
-    w17 = _div(w2, w17)
-    w9 = w9 - w17
-    w17 = w2 + w2
-    w14 = w10 * w10
-    w10 = w10 * w14
-    w17 = _div(w17, w10)
-    w17 = w4 + w17
-    w9 = _div(w9, w17)
-    w5 = w5 - w9
-    w9 = w4 * w5
-    w9 = w9 - w0
-    w11 = w11 + w5
-    w0 = w11 * w11
-    w0 = _div(w2, w0)
-    w9 = w9 - w0
-    w2 = w2 + w2
-    w0 = w11 * w11
-    w11 = w11 * w0
-    w2 = _div(w2, w11)
-    w2 = w4 + w2
-    w9 = _div(w9, w2)
-    w5 = w5 - w9
-    alpha_next[3] = w5
-    w5 = float(alpha[4])
-    w9 = _div(w5, w4)
-    w13 = w13 * w7
-    w2 = 0.45
-    w13 = w13 + w2
-    w11 = w13 - w1
-    w11 = math.tanh(w11)
-    w11 = w1 - w11
-    w11 = w6 * w11
-    w11 = w3 * w11
-    w0 = _div(w11, w12)
-    w0 = _pow(w0, w8)
-    w17 = w4 * w13
-    w17 = w17 + w5
-    w17 = -w17
-    w17 = _fmax(w17, w15)
-    w17 = _fmax(w17, w16)
-    w17 = w17 + w17
-    w17 = _div(w11, w17)
-    w17 = _sqrt(w17)
-    w0 = _fmin(w0, w17)
-    w0 = w0 - w13
-    w9 = _fmax(w9, w0)
-    w0 = w4 * w9
-    w0 = w0 - w5
-    w17 = w13 + w9
-    w10 = w17 * w17
-    w10 = _div(w11, w10)
-    w0 = w0 - w10
-    w10 = w11 + w11
-    w14 = w17 * w17
-    w17 = w17 * w14
-    w10 = _div(w10, w17)
-    w10 = w4 + w10
-    w0 = _div(w0, w10)
-    w9 = w9 - w0
-    w0 = w4 * w9
-    w0 = w0 - w5
-    w10 = w13 + w9
-    w17 = w10 * w10
-    w17 = _div(w11, w17)
-    w0 = w0 - w17
-    w17 = w11 + w11
-    w14 = w10 * w10
-    w10 = w10 * w14
-    w17 = _div(w17, w10)
-    w17 = w4 + w17
-    w0 = _div(w0, w17)
-    w9 = w9 - w0
-    w0 = w4 * w9
-    w0 = w0 - w5
-    w17 = w13 + w9
-    w10 = w17 * w17
-    w10 = _div(w11, w10)
-    w0 = w0 - w10
-    w10 = w11 + w11
-    w14 = w17 * w17
-    w17 = w17 * w14
-    w10 = _div(w10, w17)
-    w10 = w4 + w10
-    w0 = _div(w0, w10)
-    w9 = w9 - w0
-    w0 = w4 * w9
-    w0 = w0 - w5
-    w10 = w13 + w9
-    w17 = w10 * w10
-    w17 = _div(w11, w17)
-    w0 = w0 - w17
-    w17 = w11 + w11
-    w14 = w10 * w10
-    w10 = w10 * w14
-    w17 = _div(w17, w10)
-    w17 = w4 + w17
-    w0 = _div(w0, w17)
-    w9 = w9 - w0
-    w0 = w4 * w9
-    w0 = w0 - w5
-    w17 = w13 + w9
-    w10 = w17 * w17
-    w10 = _div(w11, w10)
-    w0 = w0 - w10
-    w10 = w11 + w11
-    w14 = w17 * w17
-    w17 = w17 * w14
-    w10 = _div(w10, w17)
-    w10 = w4 + w10
-    w0 = _div(w0, w10)
-    w9 = w9 - w0
-    w0 = w4 * w9
-    w0 = w0 - w5
-    w10 = w13 + w9
-    w17 = w10 * w10
-    w17 = _div(w11, w17)
-    w0 = w0 - w17
-    w17 = w11 + w11
-    w14 = w10 * w10
-    w10 = w10 * w14
-    w17 = _div(w17, w10)
-    w17 = w4 + w17
-    w0 = _div(w0, w17)
-    w9 = w9 - w0
-    w0 = w4 * w9
-    w0 = w0 - w5
-    w17 = w13 + w9
-    w10 = w17 * w17
-    w10 = _div(w11, w10)
-    w0 = w0 - w10
-    w10 = w11 + w11
-    w14 = w17 * w17
-    w17 = w17 * w14
-    w10 = _div(w10, w17)
-    w10 = w4 + w10
-    w0 = _div(w0, w10)
-    w9 = w9 - w0
-    w0 = w4 * w9
-    w0 = w0 - w5
-    w13 = w13 + w9
-    w5 = w13 * w13
-    w5 = _div(w11, w5)
-    w0 = w0 - w5
-    w11 = w11 + w11
-    w5 = w13 * w13
-    w13 = w13 * w5
-    w11 = _div(w11, w13)
-    w11 = w4 + w11
-    w0 = _div(w0, w11)
-    w9 = w9 - w0
-    alpha_next[4] = w9
-    w9 = float(alpha[5])
-    w0 = _div(w9, w4)
-    w2 = w2 * w7
-    w7 = 0.05
-    w2 = w2 + w7
-    w7 = -1.2
-    w2 = w2 - w7
-    w7 = w2 - w1
-    w7 = math.tanh(w7)
-    w1 = w1 - w7
-    w6 = w6 * w1
-    w3 = w3 * w6
-    w12 = _div(w3, w12)
-    w12 = _pow(w12, w8)
-    w8 = w4 * w2
-    w8 = w8 + w9
-    w8 = -w8
-    w8 = _fmax(w8, w15)
-    w8 = _fmax(w8, w16)
-    w8 = w8 + w8
-    w8 = _div(w3, w8)
-    w8 = _sqrt(w8)
-    w12 = _fmin(w12, w8)
-    w12 = w12 - w2
-    w0 = _fmax(w0, w12)
-    w12 = w4 * w0
-    w12 = w12 - w9
-    w8 = w2 + w0
-    w16 = w8 * w8
-    w16 = _div(w3, w16)
-    w12 = w12 - w16
-    w16 = w3 + w3
-    w15 = w8 * w8
-    w8 = w8 * w15
-    w16 = _div(w16, w8)
-    w16 = w4 + w16
-    w12 = _div(w12, w16)
-    w0 = w0 - w12
-    w12 = w4 * w0
-    w12 = w12 - w9
-    w16 = w2 + w0
-    w8 = w16 * w16
-    w8 = _div(w3, w8)
-    w12 = w12 - w8
-    w8 = w3 + w3
-    w15 = w16 * w16
-    w16 = w16 * w15
-    w8 = _div(w8, w16)
-    w8 = w4 + w8
-    w12 = _div(w12, w8)
-    w0 = w0 - w12
-    w12 = w4 * w0
-    w12 = w12 - w9
-    w8 = w2 + w0
-    w16 = w8 * w8
-    w16 = _div(w3, w16)
-    w12 = w12 - w16
-    w16 = w3 + w3
-    w15 = w8 * w8
-    w8 = w8 * w15
-    w16 = _div(w16, w8)
-    w16 = w4 + w16
-    w12 = _div(w12, w16)
-    w0 = w0 - w12
-    w12 = w4 * w0
-    w12 = w12 - w9
-    w16 = w2 + w0
-    w8 = w16 * w16
-    w8 = _div(w3, w8)
-    w12 = w12 - w8
-    w8 = w3 + w3
-    w15 = w16 * w16
-    w16 = w16 * w15
-    w8 = _div(w8, w16)
-    w8 = w4 + w8
-    w12 = _div(w12, w8)
-    w0 = w0 - w12
-    w12 = w4 * w0
-    w12 = w12 - w9
-    w8 = w2 + w0
-    w16 = w8 * w8
-    w16 = _div(w3, w16)
-    w12 = w12 - w16
-    w16 = w3 + w3
-    w15 = w8 * w8
-    w8 = w8 * w15
-    w16 = _div(w16, w8)
-    w16 = w4 + w16
-    w12 = _div(w12, w16)
-    w0 = w0 - w12
-    w12 = w4 * w0
-    w12 = w12 - w9
-    w16 = w2 + w0
-    w8 = w16 * w16
-    w8 = _div(w3, w8)
-    w12 = w12 - w8
-    w8 = w3 + w3
-    w15 = w16 * w16
-    w16 = w16 * w15
-    w8 = _div(w8, w16)
-    w8 = w4 + w8
-    w12 = _div(w12, w8)
-    w0 = w0 - w12
-    w12 = w4 * w0
-    w12 = w12 - w9
-    w8 = w2 + w0
-    w16 = w8 * w8
-    w16 = _div(w3, w16)
-    w12 = w12 - w16
-    w16 = w3 + w3
-    w15 = w8 * w8
-    w8 = w8 * w15
-    w16 = _div(w16, w8)
-    w16 = w4 + w16
-    w12 = _div(w12, w16)
-    w0 = w0 - w12
-    w12 = w4 * w0
-    w12 = w12 - w9
-    w2 = w2 + w0
-    w9 = w2 * w2
-    w9 = _div(w3, w9)
-    w12 = w12 - w9
-    w3 = w3 + w3
-    w9 = w2 * w2
-    w2 = w2 * w9
-    w3 = _div(w3, w2)
-    w4 = w4 + w3
-    w12 = _div(w12, w4)
-    w0 = w0 - w12
-    alpha_next[5] = w0
-    return (alpha_next,)
+    w2 = w2 * w3
+    w1 = w1 + w2
+    w0 = _div(w0, w1)
+    a0[0] = w0
+    c[0] = w1
+    w2 = float(theta[0])
+    w3 = w3 * w2
+    A[0] = w3
+    w2 = 0.0
+    w4 = float(psi[0])
+    w4 = w4 + w0
+    w2 = 1.0 if w2 < w4 else 0.0
+    w1 = w1 + w1
+    w0 = w4 * w4
+    w0 = w0 * w4
+    w1 = w1 * w0
+    w3 = 1.0 if w3 <= w1 else 0.0
+    w2 = 1.0 if w2 != 0.0 and w3 != 0.0 else 0.0
+    w2 = 1.0 if w2 == 0.0 else 0.0
+    root[0] = w2
+    return (a0, c, A, root)
 
 
-def body_controller_step(x, t, dt, alpha):
-    """CasADi Function 'body_controller_step' (1011 instructions).
+def body_newton_root_start(alpha, psi, c, A):
+    """CasADi Function 'body_newton_root_start' (23 instructions).
+
+    Parameters
+    ----------
+    alpha : sequence of float, length 1 (dense 1x1, column-major)
+    psi : sequence of float, length 1 (dense 1x1, column-major)
+    c : sequence of float, length 1 (dense 1x1, column-major)
+    A : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    a0 : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(alpha) != 1:
+        raise ValueError('alpha: expected 1 values, got %d' % len(alpha))
+    if len(psi) != 1:
+        raise ValueError('psi: expected 1 values, got %d' % len(psi))
+    if len(c) != 1:
+        raise ValueError('c: expected 1 values, got %d' % len(c))
+    if len(A) != 1:
+        raise ValueError('A: expected 1 values, got %d' % len(A))
+    a0 = [0.0] * 1
+    w0 = float(alpha[0])
+    w1 = float(c[0])
+    w2 = _div(w0, w1)
+    w3 = float(A[0])
+    w4 = w1 + w1
+    w4 = _div(w3, w4)
+    w5 = 0.3333333333333333
+    w4 = _pow(w4, w5)
+    w5 = float(psi[0])
+    w1 = w1 * w5
+    w1 = w1 + w0
+    w1 = -w1
+    w0 = 0.0
+    w1 = _fmax(w1, w0)
+    w0 = 1e-30
+    w1 = _fmax(w1, w0)
+    w1 = w1 + w1
+    w3 = _div(w3, w1)
+    w3 = _sqrt(w3)
+    w4 = _fmin(w4, w3)
+    w4 = w4 - w5
+    w2 = _fmax(w2, w4)
+    a0[0] = w2
+    return (a0,)
+
+
+def body_newton_iteration(a, alpha, psi, c, A):
+    """CasADi Function 'body_newton_iteration' (19 instructions).
+
+    Parameters
+    ----------
+    a : sequence of float, length 1 (dense 1x1, column-major)
+    alpha : sequence of float, length 1 (dense 1x1, column-major)
+    psi : sequence of float, length 1 (dense 1x1, column-major)
+    c : sequence of float, length 1 (dense 1x1, column-major)
+    A : sequence of float, length 1 (dense 1x1, column-major)
+
+    Returns
+    -------
+    a_next : list of float, length 1 (dense 1x1, column-major)
+    """
+    if len(a) != 1:
+        raise ValueError('a: expected 1 values, got %d' % len(a))
+    if len(alpha) != 1:
+        raise ValueError('alpha: expected 1 values, got %d' % len(alpha))
+    if len(psi) != 1:
+        raise ValueError('psi: expected 1 values, got %d' % len(psi))
+    if len(c) != 1:
+        raise ValueError('c: expected 1 values, got %d' % len(c))
+    if len(A) != 1:
+        raise ValueError('A: expected 1 values, got %d' % len(A))
+    a_next = [0.0] * 1
+    w0 = float(a[0])
+    w1 = float(psi[0])
+    w1 = w1 + w0
+    w2 = w1 * w1
+    w3 = float(c[0])
+    w4 = w3 * w0
+    w5 = float(alpha[0])
+    w4 = w4 - w5
+    w4 = w2 * w4
+    w5 = float(A[0])
+    w4 = w4 - w5
+    w4 = w1 * w4
+    w2 = w2 * w1
+    w3 = w3 * w2
+    w5 = w5 + w5
+    w3 = w3 + w5
+    w4 = _div(w4, w3)
+    w0 = w0 - w4
+    a_next[0] = w0
+    return (a_next,)
+
+
+def body_law(x, gamma_L, gamma_U, gain):
+    """CasADi Function 'body_law' (92 instructions).
 
     Parameters
     ----------
     x : sequence of float, length 3 (dense 3x1, column-major)
-    t : sequence of float, length 1 (dense 1x1, column-major)
-    dt : sequence of float, length 1 (dense 1x1, column-major)
-    alpha : sequence of float, length 6 (dense 6x1, column-major)
+    gamma_L : sequence of float, length 3 (dense 3x1, column-major)
+    gamma_U : sequence of float, length 3 (dense 3x1, column-major)
+    gain : sequence of float, length 1 (dense 1x1, column-major)
 
     Returns
     -------
     u : list of float, length 3 (dense 3x1, column-major)
-    alpha_next : list of float, length 6 (dense 6x1, column-major)
     inside : list of float, length 1 (dense 1x1, column-major)
     """
     if len(x) != 3:
         raise ValueError('x: expected 3 values, got %d' % len(x))
-    if len(t) != 1:
-        raise ValueError('t: expected 1 values, got %d' % len(t))
-    if len(dt) != 1:
-        raise ValueError('dt: expected 1 values, got %d' % len(dt))
-    if len(alpha) != 6:
-        raise ValueError('alpha: expected 6 values, got %d' % len(alpha))
+    if len(gamma_L) != 3:
+        raise ValueError('gamma_L: expected 3 values, got %d' % len(gamma_L))
+    if len(gamma_U) != 3:
+        raise ValueError('gamma_U: expected 3 values, got %d' % len(gamma_U))
+    if len(gain) != 1:
+        raise ValueError('gain: expected 1 values, got %d' % len(gain))
     u = [0.0] * 3
-    alpha_next = [0.0] * 6
     inside = [0.0] * 1
-    w0 = -0.42597205434069174
+    w0 = float(gain[0])
     w1 = 4.0
-    w2 = 0.5
-    w3 = float(t[0])
-    w4 = 9.0
-    w5 = 1.0 if w3 < w4 else 0.0
-    w6 = w4 - w3
-    w6 = 0.0 if w5 == 0.0 else w6
-    w7 = 1.0 if w5 == 0.0 else 0.0
-    w8 = 1.0
-    w7 = 0.0 if w7 == 0.0 else w8
-    w6 = w6 + w7
-    w6 = _div(w3, w6)
-    w6 = math.tanh(w6)
-    w6 = 0.0 if w5 == 0.0 else w6
-    w5 = 1.0 if w5 == 0.0 else 0.0
-    w5 = 0.0 if w5 == 0.0 else w8
-    w6 = w6 + w5
-    w5 = w2 * w6
-    w7 = 4.45
-    w5 = w5 + w7
-    w9 = float(alpha[3])
-    w5 = w5 + w9
-    w10 = -w5
-    w11 = 5.0
-    w12 = 2.5547043129396805
-    w13 = w3 - w12
-    w14 = math.fabs(w13)
-    w15 = 1.4164507184235302
-    w14 = 1.0 if w14 < w15 else 0.0
-    w16 = -1.2000000000000002
-    w17 = -0.1
-    w18 = w13 * w13
-    w18 = w17 * w18
-    w19 = math.fabs(w13)
-    w19 = w15 - w19
-    w13 = math.fabs(w13)
-    w13 = w15 + w13
-    w19 = w19 * w13
-    w19 = 0.0 if w14 == 0.0 else w19
-    w13 = 1.0 if w14 == 0.0 else 0.0
-    w13 = 0.0 if w13 == 0.0 else w8
-    w19 = w19 + w13
-    w18 = _div(w18, w19)
-    w18 = _exp(w18)
-    w18 = w16 * w18
-    w14 = 0.0 if w14 == 0.0 else w18
-    w14 = w11 + w14
-    w18 = -w14
-    w10 = _fmax(w10, w18)
-    w18 = -50.0
-    w14 = w14 - w5
-    w14 = math.fabs(w14)
-    w14 = w18 * w14
-    w14 = _exp(w14)
-    w14 = _log1p(w14)
-    w5 = 50.0
-    w14 = w14 / w5
-    w10 = w10 + w14
-    w14 = w2 * w6
-    w19 = 4.05
-    w14 = w14 + w19
-    w13 = float(alpha[0])
-    w14 = w14 - w13
-    w20 = 0.0
-    w21 = _fmax(w14, w20)
-    w14 = math.fabs(w14)
-    w14 = w18 * w14
-    w14 = _exp(w14)
-    w14 = _log1p(w14)
-    w14 = w14 / w5
-    w21 = w21 + w14
-    w14 = w10 + w21
-    w14 = -w14
-    w22 = 1e-06
-    w23 = _fmax(w14, w22)
-    w24 = float(x[0])
-    w24 = w24 + w24
-    w21 = w21 - w10
-    w24 = w24 - w21
-    w24 = _div(w24, w23)
-    w21 = -0.9999990463256836
-    w10 = _fmax(w24, w21)
-    w25 = 0.9999990463256836
-    w10 = _fmin(w10, w25)
-    w26 = w10 * w10
-    w26 = w8 - w26
-    w23 = w23 * w26
-    w23 = _div(w1, w23)
-    w23 = w0 * w23
-    w26 = w8 + w10
-    w10 = w8 - w10
-    w26 = _div(w26, w10)
-    w26 = _log(w26)
-    w23 = w23 * w26
-    u[0] = w23
-    w23 = 4.5
-    w26 = w23 * w6
-    w10 = 0.45
-    w26 = w26 + w10
-    w27 = float(alpha[4])
-    w26 = w26 + w27
-    w28 = -w26
-    w29 = -5.0
-    w28 = _fmax(w28, w29)
-    w26 = w26 + w29
-    w26 = math.fabs(w26)
-    w26 = w18 * w26
-    w26 = _exp(w26)
-    w26 = _log1p(w26)
-    w26 = w26 / w5
-    w28 = w28 + w26
-    w26 = w23 * w6
-    w29 = 0.04999999999999999
-    w26 = w26 + w29
-    w30 = float(alpha[1])
-    w26 = w26 - w30
-    w31 = _fmax(w26, w20)
-    w26 = math.fabs(w26)
-    w26 = w18 * w26
-    w26 = _exp(w26)
-    w26 = _log1p(w26)
-    w26 = w26 / w5
-    w31 = w31 + w26
-    w26 = w28 + w31
-    w26 = -w26
-    w32 = _fmax(w26, w22)
-    w33 = float(x[1])
-    w33 = w33 + w33
-    w31 = w31 - w28
-    w33 = w33 - w31
-    w33 = _div(w33, w32)
-    w31 = _fmax(w33, w21)
-    w31 = _fmin(w31, w25)
-    w28 = w31 * w31
-    w28 = w8 - w28
-    w32 = w32 * w28
-    w32 = _div(w1, w32)
-    w32 = w0 * w32
-    w28 = w8 + w31
-    w31 = w8 - w31
-    w28 = _div(w28, w31)
-    w28 = _log(w28)
-    w32 = w32 * w28
-    u[1] = w32
-    w32 = w10 * w6
-    w28 = 0.05
-    w32 = w32 + w28
-    w31 = float(alpha[5])
-    w32 = w32 + w31
-    w34 = -w32
-    w35 = -1.2
-    w34 = _fmax(w34, w35)
-    w32 = w32 + w35
-    w32 = math.fabs(w32)
-    w32 = w18 * w32
-    w32 = _exp(w32)
-    w32 = _log1p(w32)
-    w32 = w32 / w5
-    w34 = w34 + w32
-    w32 = -0.45
-    w6 = w32 * w6
-    w36 = -0.05
-    w6 = w6 + w36
-    w37 = float(alpha[2])
-    w6 = w6 - w37
-    w38 = _fmax(w6, w35)
-    w6 = w6 - w35
-    w6 = math.fabs(w6)
-    w18 = w18 * w6
-    w18 = _exp(w18)
-    w18 = _log1p(w18)
-    w18 = w18 / w5
-    w38 = w38 + w18
-    w18 = w34 + w38
-    w18 = -w18
-    w22 = _fmax(w18, w22)
-    w5 = float(x[2])
-    w5 = w5 + w5
-    w38 = w38 - w34
-    w5 = w5 - w38
-    w5 = _div(w5, w22)
-    w21 = _fmax(w5, w21)
-    w21 = _fmin(w21, w25)
-    w25 = w21 * w21
-    w25 = w8 - w25
-    w22 = w22 * w25
-    w1 = _div(w1, w22)
+    w2 = float(gamma_U[0])
+    w3 = float(gamma_L[0])
+    w4 = w2 - w3
+    w5 = 1e-06
+    w6 = _fmax(w4, w5)
+    w7 = 1.0
+    w8 = float(x[0])
+    w8 = w8 + w8
+    w2 = w2 + w3
+    w8 = w8 - w2
+    w8 = _div(w8, w6)
+    w2 = -0.9999990463256836
+    w3 = _fmax(w8, w2)
+    w9 = 0.9999990463256836
+    w3 = _fmin(w3, w9)
+    w10 = w3 * w3
+    w10 = w7 - w10
+    w6 = w6 * w10
+    w6 = _div(w1, w6)
+    w6 = w0 * w6
+    w10 = w7 + w3
+    w3 = w7 - w3
+    w10 = _div(w10, w3)
+    w10 = _log(w10)
+    w6 = w6 * w10
+    w6 = -w6
+    u[0] = w6
+    w6 = float(gamma_U[1])
+    w10 = float(gamma_L[1])
+    w3 = w6 - w10
+    w11 = _fmax(w3, w5)
+    w12 = float(x[1])
+    w12 = w12 + w12
+    w6 = w6 + w10
+    w12 = w12 - w6
+    w12 = _div(w12, w11)
+    w6 = _fmax(w12, w2)
+    w6 = _fmin(w6, w9)
+    w10 = w6 * w6
+    w10 = w7 - w10
+    w11 = w11 * w10
+    w11 = _div(w1, w11)
+    w11 = w0 * w11
+    w10 = w7 + w6
+    w6 = w7 - w6
+    w10 = _div(w10, w6)
+    w10 = _log(w10)
+    w11 = w11 * w10
+    w11 = -w11
+    u[1] = w11
+    w11 = float(gamma_U[2])
+    w10 = float(gamma_L[2])
+    w6 = w11 - w10
+    w5 = _fmax(w6, w5)
+    w13 = float(x[2])
+    w13 = w13 + w13
+    w11 = w11 + w10
+    w13 = w13 - w11
+    w13 = _div(w13, w5)
+    w2 = _fmax(w13, w2)
+    w2 = _fmin(w2, w9)
+    w9 = w2 * w2
+    w9 = w7 - w9
+    w5 = w5 * w9
+    w1 = _div(w1, w5)
     w0 = w0 * w1
-    w1 = w8 + w21
-    w21 = w8 - w21
-    w1 = _div(w1, w21)
+    w1 = w7 + w2
+    w2 = w7 - w2
+    w1 = _div(w1, w2)
     w1 = _log(w1)
     w0 = w0 * w1
+    w0 = -w0
     u[2] = w0
-    w0 = float(dt[0])
-    w1 = w11 * w0
-    w1 = w8 + w1
-    w21 = _div(w13, w1)
-    w22 = 0.01
-    w3 = w3 + w0
-    w12 = w3 - w12
-    w25 = math.fabs(w12)
-    w25 = 1.0 if w25 < w15 else 0.0
-    w38 = w12 * w12
-    w17 = w17 * w38
-    w38 = math.fabs(w12)
-    w38 = w15 - w38
+    w8 = math.fabs(w8)
+    w8 = 1.0 if w8 < w7 else 0.0
+    w0 = 0.0
+    w4 = 1.0 if w0 < w4 else 0.0
+    w8 = 1.0 if w8 != 0.0 and w4 != 0.0 else 0.0
+    w8 = 1.0 if w7 != 0.0 and w8 != 0.0 else 0.0
     w12 = math.fabs(w12)
-    w15 = w15 + w12
-    w38 = w38 * w15
-    w38 = 0.0 if w25 == 0.0 else w38
-    w15 = 1.0 if w25 == 0.0 else 0.0
-    w15 = 0.0 if w15 == 0.0 else w8
-    w38 = w38 + w15
-    w17 = _div(w17, w38)
-    w17 = _exp(w17)
-    w16 = w16 * w17
-    w25 = 0.0 if w25 == 0.0 else w16
-    w25 = w11 + w25
-    w16 = 1.0 if w3 < w4 else 0.0
-    w4 = w4 - w3
-    w4 = 0.0 if w16 == 0.0 else w4
-    w17 = 1.0 if w16 == 0.0 else 0.0
-    w17 = 0.0 if w17 == 0.0 else w8
-    w4 = w4 + w17
-    w3 = _div(w3, w4)
-    w3 = math.tanh(w3)
-    w3 = 0.0 if w16 == 0.0 else w3
-    w16 = 1.0 if w16 == 0.0 else 0.0
-    w16 = 0.0 if w16 == 0.0 else w8
-    w3 = w3 + w16
-    w16 = w2 * w3
-    w16 = w16 + w19
-    w25 = w25 - w16
-    w16 = w25 - w8
-    w16 = math.tanh(w16)
-    w16 = w8 - w16
-    w16 = w22 * w16
-    w16 = w0 * w16
-    w19 = w1 + w1
-    w4 = _div(w16, w19)
-    w17 = 0.3333333333333333
-    w4 = _pow(w4, w17)
-    w38 = w1 * w25
-    w38 = w38 + w13
-    w38 = -w38
-    w38 = _fmax(w38, w20)
-    w15 = 1e-30
-    w38 = _fmax(w38, w15)
-    w38 = w38 + w38
-    w38 = _div(w16, w38)
-    w38 = _sqrt(w38)
-    w4 = _fmin(w4, w38)
-    w4 = w4 - w25
-    w21 = _fmax(w21, w4)
-    w4 = w1 * w21
-    w4 = w4 - w13
-    w38 = w25 + w21
-    w12 = w38 * w38
-    w12 = _div(w16, w12)
-    w4 = w4 - w12
-    w12 = w16 + w16
-    w34 = w38 * w38
-    w38 = w38 * w34
-    w12 = _div(w12, w38)
-    w12 = w1 + w12
-    w4 = _div(w4, w12)
-    w21 = w21 - w4
-    w4 = w1 * w21
-    w4 = w4 - w13
-    w12 = w25 + w21
-    w38 = w12 * w12
-    w38 = _div(w16, w38)
-    w4 = w4 - w38
-    w38 = w16 + w16
-    w34 = w12 * w12
-    w12 = w12 * w34
-    w38 = _div(w38, w12)
-    w38 = w1 + w38
-    w4 = _div(w4, w38)
-    w21 = w21 - w4
-    w4 = w1 * w21
-    w4 = w4 - w13
-    w38 = w25 + w21
-    w12 = w38 * w38
-    w12 = _div(w16, w12)
-    w4 = w4 - w12
-    w12 = w16 + w16
-    w34 = w38 * w38
-    w38 = w38 * w34
-    w12 = _div(w12, w38)
-    w12 = w1 + w12
-    w4 = _div(w4, w12)
-    w21 = w21 - w4
-    w4 = w1 * w21
-    w4 = w4 - w13
-    w12 = w25 + w21
-    w38 = w12 * w12
-    w38 = _div(w16, w38)
-    w4 = w4 - w38
-    w38 = w16 + w16
-    w34 = w12 * w12
-    w12 = w12 * w34
-    w38 = _div(w38, w12)
-    w38 = w1 + w38
-    w4 = _div(w4, w38)
-    w21 = w21 - w4
-    w4 = w1 * w21
-    w4 = w4 - w13
-    w38 = w25 + w21
-    w12 = w38 * w38
-    w12 = _div(w16, w12)
-    w4 = w4 - w12
-    w12 = w16 + w16
-    w34 = w38 * w38
-    w38 = w38 * w34
-    w12 = _div(w12, w38)
-    w12 = w1 + w12
-    w4 = _div(w4, w12)
-    w21 = w21 - w4
-    w4 = w1 * w21
-    w4 = w4 - w13
-    w12 = w25 + w21
-    w38 = w12 * w12
-    w38 = _div(w16, w38)
-    w4 = w4 - w38
-    w38 = w16 + w16
-    w34 = w12 * w12
-    w12 = w12 * w34
-    w38 = _div(w38, w12)
-    w38 = w1 + w38
-    w4 = _div(w4, w38)
-    w21 = w21 - w4
-    w4 = w1 * w21
-    w4 = w4 - w13
-    w38 = w25 + w21
-    w12 = w38 * w38
-    w12 = _div(w16, w12)
-    w4 = w4 - w12
-    w12 = w16 + w16
-    w34 = w38 * w38
-    w38 = w38 * w34
-    w12 = _div(w12, w38)
-    w12 = w1 + w12
-    w4 = _div(w4, w12)
-    w21 = w21 - w4
-    w4 = w1 * w21
-    w4 = w4 - w13
-    w25 = w25 + w21
-    w13 = w25 * w25
-    w13 = _div(w16, w13)
-    w4 = w4 - w13
-    w16 = w16 + w16
-    w13 = w25 * w25
-    w25 = w25 * w13
-    w16 = _div(w16, w25)
-    w16 = w1 + w16
-    w4 = _div(w4, w16)
-    w21 = w21 - w4
-    alpha_next[0] = w21
-    w21 = _div(w30, w1)
-    w4 = w23 * w3
-    w4 = w4 + w29
-    w11 = w11 - w4
-    w4 = w11 - w8
-    w4 = math.tanh(w4)
-    w4 = w8 - w4
-    w4 = w22 * w4
-    w4 = w0 * w4
-    w29 = _div(w4, w19)
-    w29 = _pow(w29, w17)
-    w16 = w1 * w11
-    w16 = w16 + w30
-    w16 = -w16
-    w16 = _fmax(w16, w20)
-    w16 = _fmax(w16, w15)
-    w16 = w16 + w16
-    w16 = _div(w4, w16)
-    w16 = _sqrt(w16)
-    w29 = _fmin(w29, w16)
-    w29 = w29 - w11
-    w21 = _fmax(w21, w29)
-    w29 = w1 * w21
-    w29 = w29 - w30
-    w16 = w11 + w21
-    w25 = w16 * w16
-    w25 = _div(w4, w25)
-    w29 = w29 - w25
-    w25 = w4 + w4
-    w13 = w16 * w16
-    w16 = w16 * w13
-    w25 = _div(w25, w16)
-    w25 = w1 + w25
-    w29 = _div(w29, w25)
-    w21 = w21 - w29
-    w29 = w1 * w21
-    w29 = w29 - w30
-    w25 = w11 + w21
-    w16 = w25 * w25
-    w16 = _div(w4, w16)
-    w29 = w29 - w16
-    w16 = w4 + w4
-    w13 = w25 * w25
-    w25 = w25 * w13
-    w16 = _div(w16, w25)
-    w16 = w1 + w16
-    w29 = _div(w29, w16)
-    w21 = w21 - w29
-    w29 = w1 * w21
-    w29 = w29 - w30
-    w16 = w11 + w21
-    w25 = w16 * w16
-    w25 = _div(w4, w25)
-    w29 = w29 - w25
-    w25 = w4 + w4
-    w13 = w16 * w16
-    w16 = w16 * w13
-    w25 = _div(w25, w16)
-    w25 = w1 + w25
-    w29 = _div(w29, w25)
-    w21 = w21 - w29
-    w29 = w1 * w21
-    w29 = w29 - w30
-    w25 = w11 + w21
-    w16 = w25 * w25
-    w16 = _div(w4, w16)
-    w29 = w29 - w16
-    w16 = w4 + w4
-    w13 = w25 * w25
-    w25 = w25 * w13
-    w16 = _div(w16, w25)
-    w16 = w1 + w16
-    w29 = _div(w29, w16)
-    w21 = w21 - w29
-    w29 = w1 * w21
-    w29 = w29 - w30
-    w16 = w11 + w21
-    w25 = w16 * w16
-    w25 = _div(w4, w25)
-    w29 = w29 - w25
-    w25 = w4 + w4
-    w13 = w16 * w16
-    w16 = w16 * w13
-    w25 = _div(w25, w16)
-    w25 = w1 + w25
-    w29 = _div(w29, w25)
-    w21 = w21 - w29
-    w29 = w1 * w21
-    w29 = w29 - w30
-    w25 = w11 + w21
-    w16 = w25 * w25
-    w16 = _div(w4, w16)
-    w29 = w29 - w16
-    w16 = w4 + w4
-    w13 = w25 * w25
-    w25 = w25 * w13
-    w16 = _div(w16, w25)
-    w16 = w1 + w16
-    w29 = _div(w29, w16)
-    w21 = w21 - w29
-    w29 = w1 * w21
-    w29 = w29 - w30
-    w16 = w11 + w21
-    w25 = w16 * w16
-    w25 = _div(w4, w25)
-    w29 = w29 - w25
-    w25 = w4 + w4
-    w13 = w16 * w16
-    w16 = w16 * w13
-    w25 = _div(w25, w16)
-    w25 = w1 + w25
-    w29 = _div(w29, w25)
-    w21 = w21 - w29
-    w29 = w1 * w21
-    w29 = w29 - w30
-    w11 = w11 + w21
-    w30 = w11 * w11
-    w30 = _div(w4, w30)
-    w29 = w29 - w30
-    w4 = w4 + w4
-    w30 = w11 * w11
-    w11 = w11 * w30
-    w4 = _div(w4, w11)
-    w4 = w1 + w4
-    w29 = _div(w29, w4)
-    w21 = w21 - w29
-    alpha_next[1] = w21
-    w21 = _div(w37, w1)
-    w29 = 1.2
-    w32 = w32 * w3
-    w32 = w32 + w36
-    w29 = w29 - w32
-    w32 = w29 - w8
-    w32 = math.tanh(w32)
-    w32 = w8 - w32
-    w32 = w22 * w32
-    w32 = w0 * w32
-    w36 = _div(w32, w19)
-    w36 = _pow(w36, w17)
-    w4 = w1 * w29
-    w4 = w4 + w37
-    w4 = -w4
-    w4 = _fmax(w4, w20)
-    w4 = _fmax(w4, w15)
-    w4 = w4 + w4
-    w4 = _div(w32, w4)
-    w4 = _sqrt(w4)
-    w36 = _fmin(w36, w4)
-    w36 = w36 - w29
-    w21 = _fmax(w21, w36)
-    w36 = w1 * w21
-    w36 = w36 - w37
-    w4 = w29 + w21
-    w11 = w4 * w4
-    w11 = _div(w32, w11)
-    w36 = w36 - w11
-    w11 = w32 + w32
-    w30 = w4 * w4
-    w4 = w4 * w30
-    w11 = _div(w11, w4)
-    w11 = w1 + w11
-    w36 = _div(w36, w11)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w37
-    w11 = w29 + w21
-    w4 = w11 * w11
-    w4 = _div(w32, w4)
-    w36 = w36 - w4
-    w4 = w32 + w32
-    w30 = w11 * w11
-    w11 = w11 * w30
-    w4 = _div(w4, w11)
-    w4 = w1 + w4
-    w36 = _div(w36, w4)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w37
-    w4 = w29 + w21
-    w11 = w4 * w4
-    w11 = _div(w32, w11)
-    w36 = w36 - w11
-    w11 = w32 + w32
-    w30 = w4 * w4
-    w4 = w4 * w30
-    w11 = _div(w11, w4)
-    w11 = w1 + w11
-    w36 = _div(w36, w11)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w37
-    w11 = w29 + w21
-    w4 = w11 * w11
-    w4 = _div(w32, w4)
-    w36 = w36 - w4
-    w4 = w32 + w32
-    w30 = w11 * w11
-    w11 = w11 * w30
-    w4 = _div(w4, w11)
-    w4 = w1 + w4
-    w36 = _div(w36, w4)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w37
-    w4 = w29 + w21
-    w11 = w4 * w4
-    w11 = _div(w32, w11)
-    w36 = w36 - w11
-    w11 = w32 + w32
-    w30 = w4 * w4
-    w4 = w4 * w30
-    w11 = _div(w11, w4)
-    w11 = w1 + w11
-    w36 = _div(w36, w11)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w37
-    w11 = w29 + w21
-    w4 = w11 * w11
-    w4 = _div(w32, w4)
-    w36 = w36 - w4
-    w4 = w32 + w32
-    w30 = w11 * w11
-    w11 = w11 * w30
-    w4 = _div(w4, w11)
-    w4 = w1 + w4
-    w36 = _div(w36, w4)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w37
-    w4 = w29 + w21
-    w11 = w4 * w4
-    w11 = _div(w32, w11)
-    w36 = w36 - w11
-    w11 = w32 + w32
-    w30 = w4 * w4
-    w4 = w4 * w30
-    w11 = _div(w11, w4)
-    w11 = w1 + w11
-    w36 = _div(w36, w11)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w37
-    w29 = w29 + w21
-    w37 = w29 * w29
-    w37 = _div(w32, w37)
-    w36 = w36 - w37
-    w32 = w32 + w32
-    w37 = w29 * w29
-    w29 = w29 * w37
-    w32 = _div(w32, w29)
-    w32 = w1 + w32
-    w36 = _div(w36, w32)
-    w21 = w21 - w36
-    alpha_next[2] = w21
-    w21 = _div(w9, w1)
-    w2 = w2 * w3
-    w2 = w2 + w7
-    w7 = w2 - w8
-    w7 = math.tanh(w7)
-    w7 = w8 - w7
-    w7 = w22 * w7
-    w7 = w0 * w7
-    w36 = _div(w7, w19)
-    w36 = _pow(w36, w17)
-    w32 = w1 * w2
-    w32 = w32 + w9
-    w32 = -w32
-    w32 = _fmax(w32, w20)
-    w32 = _fmax(w32, w15)
-    w32 = w32 + w32
-    w32 = _div(w7, w32)
-    w32 = _sqrt(w32)
-    w36 = _fmin(w36, w32)
-    w36 = w36 - w2
-    w21 = _fmax(w21, w36)
-    w36 = w1 * w21
-    w36 = w36 - w9
-    w32 = w2 + w21
-    w29 = w32 * w32
-    w29 = _div(w7, w29)
-    w36 = w36 - w29
-    w29 = w7 + w7
-    w37 = w32 * w32
-    w32 = w32 * w37
-    w29 = _div(w29, w32)
-    w29 = w1 + w29
-    w36 = _div(w36, w29)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w9
-    w29 = w2 + w21
-    w32 = w29 * w29
-    w32 = _div(w7, w32)
-    w36 = w36 - w32
-    w32 = w7 + w7
-    w37 = w29 * w29
-    w29 = w29 * w37
-    w32 = _div(w32, w29)
-    w32 = w1 + w32
-    w36 = _div(w36, w32)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w9
-    w32 = w2 + w21
-    w29 = w32 * w32
-    w29 = _div(w7, w29)
-    w36 = w36 - w29
-    w29 = w7 + w7
-    w37 = w32 * w32
-    w32 = w32 * w37
-    w29 = _div(w29, w32)
-    w29 = w1 + w29
-    w36 = _div(w36, w29)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w9
-    w29 = w2 + w21
-    w32 = w29 * w29
-    w32 = _div(w7, w32)
-    w36 = w36 - w32
-    w32 = w7 + w7
-    w37 = w29 * w29
-    w29 = w29 * w37
-    w32 = _div(w32, w29)
-    w32 = w1 + w32
-    w36 = _div(w36, w32)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w9
-    w32 = w2 + w21
-    w29 = w32 * w32
-    w29 = _div(w7, w29)
-    w36 = w36 - w29
-    w29 = w7 + w7
-    w37 = w32 * w32
-    w32 = w32 * w37
-    w29 = _div(w29, w32)
-    w29 = w1 + w29
-    w36 = _div(w36, w29)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w9
-    w29 = w2 + w21
-    w32 = w29 * w29
-    w32 = _div(w7, w32)
-    w36 = w36 - w32
-    w32 = w7 + w7
-    w37 = w29 * w29
-    w29 = w29 * w37
-    w32 = _div(w32, w29)
-    w32 = w1 + w32
-    w36 = _div(w36, w32)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w9
-    w32 = w2 + w21
-    w29 = w32 * w32
-    w29 = _div(w7, w29)
-    w36 = w36 - w29
-    w29 = w7 + w7
-    w37 = w32 * w32
-    w32 = w32 * w37
-    w29 = _div(w29, w32)
-    w29 = w1 + w29
-    w36 = _div(w36, w29)
-    w21 = w21 - w36
-    w36 = w1 * w21
-    w36 = w36 - w9
-    w2 = w2 + w21
-    w9 = w2 * w2
-    w9 = _div(w7, w9)
-    w36 = w36 - w9
-    w7 = w7 + w7
-    w9 = w2 * w2
-    w2 = w2 * w9
-    w7 = _div(w7, w2)
-    w7 = w1 + w7
-    w36 = _div(w36, w7)
-    w21 = w21 - w36
-    alpha_next[3] = w21
-    w21 = _div(w27, w1)
-    w23 = w23 * w3
-    w23 = w23 + w10
-    w36 = w23 - w8
-    w36 = math.tanh(w36)
-    w36 = w8 - w36
-    w36 = w22 * w36
-    w36 = w0 * w36
-    w7 = _div(w36, w19)
-    w7 = _pow(w7, w17)
-    w2 = w1 * w23
-    w2 = w2 + w27
-    w2 = -w2
-    w2 = _fmax(w2, w20)
-    w2 = _fmax(w2, w15)
-    w2 = w2 + w2
-    w2 = _div(w36, w2)
-    w2 = _sqrt(w2)
-    w7 = _fmin(w7, w2)
-    w7 = w7 - w23
-    w21 = _fmax(w21, w7)
-    w7 = w1 * w21
-    w7 = w7 - w27
-    w2 = w23 + w21
-    w9 = w2 * w2
-    w9 = _div(w36, w9)
-    w7 = w7 - w9
-    w9 = w36 + w36
-    w29 = w2 * w2
-    w2 = w2 * w29
-    w9 = _div(w9, w2)
-    w9 = w1 + w9
-    w7 = _div(w7, w9)
-    w21 = w21 - w7
-    w7 = w1 * w21
-    w7 = w7 - w27
-    w9 = w23 + w21
-    w2 = w9 * w9
-    w2 = _div(w36, w2)
-    w7 = w7 - w2
-    w2 = w36 + w36
-    w29 = w9 * w9
-    w9 = w9 * w29
-    w2 = _div(w2, w9)
-    w2 = w1 + w2
-    w7 = _div(w7, w2)
-    w21 = w21 - w7
-    w7 = w1 * w21
-    w7 = w7 - w27
-    w2 = w23 + w21
-    w9 = w2 * w2
-    w9 = _div(w36, w9)
-    w7 = w7 - w9
-    w9 = w36 + w36
-    w29 = w2 * w2
-    w2 = w2 * w29
-    w9 = _div(w9, w2)
-    w9 = w1 + w9
-    w7 = _div(w7, w9)
-    w21 = w21 - w7
-    w7 = w1 * w21
-    w7 = w7 - w27
-    w9 = w23 + w21
-    w2 = w9 * w9
-    w2 = _div(w36, w2)
-    w7 = w7 - w2
-    w2 = w36 + w36
-    w29 = w9 * w9
-    w9 = w9 * w29
-    w2 = _div(w2, w9)
-    w2 = w1 + w2
-    w7 = _div(w7, w2)
-    w21 = w21 - w7
-    w7 = w1 * w21
-    w7 = w7 - w27
-    w2 = w23 + w21
-    w9 = w2 * w2
-    w9 = _div(w36, w9)
-    w7 = w7 - w9
-    w9 = w36 + w36
-    w29 = w2 * w2
-    w2 = w2 * w29
-    w9 = _div(w9, w2)
-    w9 = w1 + w9
-    w7 = _div(w7, w9)
-    w21 = w21 - w7
-    w7 = w1 * w21
-    w7 = w7 - w27
-    w9 = w23 + w21
-    w2 = w9 * w9
-    w2 = _div(w36, w2)
-    w7 = w7 - w2
-    w2 = w36 + w36
-    w29 = w9 * w9
-    w9 = w9 * w29
-    w2 = _div(w2, w9)
-    w2 = w1 + w2
-    w7 = _div(w7, w2)
-    w21 = w21 - w7
-    w7 = w1 * w21
-    w7 = w7 - w27
-    w2 = w23 + w21
-    w9 = w2 * w2
-    w9 = _div(w36, w9)
-    w7 = w7 - w9
-    w9 = w36 + w36
-    w29 = w2 * w2
-    w2 = w2 * w29
-    w9 = _div(w9, w2)
-    w9 = w1 + w9
-    w7 = _div(w7, w9)
-    w21 = w21 - w7
-    w7 = w1 * w21
-    w7 = w7 - w27
-    w23 = w23 + w21
-    w27 = w23 * w23
-    w27 = _div(w36, w27)
-    w7 = w7 - w27
-    w36 = w36 + w36
-    w27 = w23 * w23
-    w23 = w23 * w27
-    w36 = _div(w36, w23)
-    w36 = w1 + w36
-    w7 = _div(w7, w36)
-    w21 = w21 - w7
-    alpha_next[4] = w21
-    w21 = _div(w31, w1)
-    w10 = w10 * w3
-    w10 = w10 + w28
-    w10 = w10 - w35
-    w35 = w10 - w8
-    w35 = math.tanh(w35)
-    w35 = w8 - w35
-    w22 = w22 * w35
-    w0 = w0 * w22
-    w19 = _div(w0, w19)
-    w19 = _pow(w19, w17)
-    w17 = w1 * w10
-    w17 = w17 + w31
-    w17 = -w17
-    w17 = _fmax(w17, w20)
-    w17 = _fmax(w17, w15)
-    w17 = w17 + w17
-    w17 = _div(w0, w17)
-    w17 = _sqrt(w17)
-    w19 = _fmin(w19, w17)
-    w19 = w19 - w10
-    w21 = _fmax(w21, w19)
-    w19 = w1 * w21
-    w19 = w19 - w31
-    w17 = w10 + w21
-    w15 = w17 * w17
-    w15 = _div(w0, w15)
-    w19 = w19 - w15
-    w15 = w0 + w0
-    w22 = w17 * w17
-    w17 = w17 * w22
-    w15 = _div(w15, w17)
-    w15 = w1 + w15
-    w19 = _div(w19, w15)
-    w21 = w21 - w19
-    w19 = w1 * w21
-    w19 = w19 - w31
-    w15 = w10 + w21
-    w17 = w15 * w15
-    w17 = _div(w0, w17)
-    w19 = w19 - w17
-    w17 = w0 + w0
-    w22 = w15 * w15
-    w15 = w15 * w22
-    w17 = _div(w17, w15)
-    w17 = w1 + w17
-    w19 = _div(w19, w17)
-    w21 = w21 - w19
-    w19 = w1 * w21
-    w19 = w19 - w31
-    w17 = w10 + w21
-    w15 = w17 * w17
-    w15 = _div(w0, w15)
-    w19 = w19 - w15
-    w15 = w0 + w0
-    w22 = w17 * w17
-    w17 = w17 * w22
-    w15 = _div(w15, w17)
-    w15 = w1 + w15
-    w19 = _div(w19, w15)
-    w21 = w21 - w19
-    w19 = w1 * w21
-    w19 = w19 - w31
-    w15 = w10 + w21
-    w17 = w15 * w15
-    w17 = _div(w0, w17)
-    w19 = w19 - w17
-    w17 = w0 + w0
-    w22 = w15 * w15
-    w15 = w15 * w22
-    w17 = _div(w17, w15)
-    w17 = w1 + w17
-    w19 = _div(w19, w17)
-    w21 = w21 - w19
-    w19 = w1 * w21
-    w19 = w19 - w31
-    w17 = w10 + w21
-    w15 = w17 * w17
-    w15 = _div(w0, w15)
-    w19 = w19 - w15
-    w15 = w0 + w0
-    w22 = w17 * w17
-    w17 = w17 * w22
-    w15 = _div(w15, w17)
-    w15 = w1 + w15
-    w19 = _div(w19, w15)
-    w21 = w21 - w19
-    w19 = w1 * w21
-    w19 = w19 - w31
-    w15 = w10 + w21
-    w17 = w15 * w15
-    w17 = _div(w0, w17)
-    w19 = w19 - w17
-    w17 = w0 + w0
-    w22 = w15 * w15
-    w15 = w15 * w22
-    w17 = _div(w17, w15)
-    w17 = w1 + w17
-    w19 = _div(w19, w17)
-    w21 = w21 - w19
-    w19 = w1 * w21
-    w19 = w19 - w31
-    w17 = w10 + w21
-    w15 = w17 * w17
-    w15 = _div(w0, w15)
-    w19 = w19 - w15
-    w15 = w0 + w0
-    w22 = w17 * w17
-    w17 = w17 * w22
-    w15 = _div(w15, w17)
-    w15 = w1 + w15
-    w19 = _div(w19, w15)
-    w21 = w21 - w19
-    w19 = w1 * w21
-    w19 = w19 - w31
-    w10 = w10 + w21
-    w31 = w10 * w10
-    w31 = _div(w0, w31)
-    w19 = w19 - w31
-    w0 = w0 + w0
-    w31 = w10 * w10
-    w10 = w10 * w31
-    w0 = _div(w0, w10)
-    w1 = w1 + w0
-    w19 = _div(w19, w1)
-    w21 = w21 - w19
-    alpha_next[5] = w21
-    w24 = math.fabs(w24)
-    w24 = 1.0 if w24 < w8 else 0.0
-    w14 = 1.0 if w20 < w14 else 0.0
-    w24 = 1.0 if w24 != 0.0 and w14 != 0.0 else 0.0
-    w24 = 1.0 if w8 != 0.0 and w24 != 0.0 else 0.0
-    w33 = math.fabs(w33)
-    w33 = 1.0 if w33 < w8 else 0.0
-    w26 = 1.0 if w20 < w26 else 0.0
-    w33 = 1.0 if w33 != 0.0 and w26 != 0.0 else 0.0
-    w24 = 1.0 if w24 != 0.0 and w33 != 0.0 else 0.0
-    w5 = math.fabs(w5)
-    w5 = 1.0 if w5 < w8 else 0.0
-    w20 = 1.0 if w20 < w18 else 0.0
-    w5 = 1.0 if w5 != 0.0 and w20 != 0.0 else 0.0
-    w24 = 1.0 if w24 != 0.0 and w5 != 0.0 else 0.0
-    inside[0] = w24
-    return (u, alpha_next, inside)
+    w12 = 1.0 if w12 < w7 else 0.0
+    w3 = 1.0 if w0 < w3 else 0.0
+    w12 = 1.0 if w12 != 0.0 and w3 != 0.0 else 0.0
+    w8 = 1.0 if w8 != 0.0 and w12 != 0.0 else 0.0
+    w13 = math.fabs(w13)
+    w13 = 1.0 if w13 < w7 else 0.0
+    w0 = 1.0 if w0 < w6 else 0.0
+    w13 = 1.0 if w13 != 0.0 and w0 != 0.0 else 0.0
+    w8 = 1.0 if w8 != 0.0 and w13 != 0.0 else 0.0
+    inside[0] = w8
+    return (u, inside)

@@ -201,6 +201,40 @@ class InstructionPrinter:
     def _print_op_constpow(self, a: str, b: str) -> str:
         return self.op_expression("pow", (a, b))
 
+    #: Comparison op name -> infix symbol (the result is 1 or 0, see :meth:`_compare`).
+    comparisons: Mapping[str, str] = {"lt": "<", "le": "<=", "eq": "==", "ne": "!="}
+
+    def _compare(self, op: str, a: str, b: str) -> str:
+        """Expression that is 1 when ``a comparisons[op] b`` holds, else 0 (per language)."""
+        raise NotImplementedError
+
+    def _print_op_lt(self, a: str, b: str) -> str:
+        return self._compare("lt", a, b)
+
+    def _print_op_le(self, a: str, b: str) -> str:
+        return self._compare("le", a, b)
+
+    def _print_op_eq(self, a: str, b: str) -> str:
+        return self._compare("eq", a, b)
+
+    def _print_op_ne(self, a: str, b: str) -> str:
+        return self._compare("ne", a, b)
+
+    def _name_io(self, program: Program, identifier) -> None:
+        """Name every input and output of ``program`` with ``identifier(name, taken)``
+        (distinct names, inputs first); see :meth:`io_name`."""
+        taken: set = set()
+        self._io_names: Dict[Tuple[str, int], str] = {}
+        for kind, specs in (("in", program.inputs), ("out", program.outputs)):
+            for spec in specs:
+                ident = identifier(spec.name, taken)
+                taken.add(ident)
+                self._io_names[kind, spec.index] = ident
+
+    def io_name(self, kind: str, index: int) -> str:
+        """Name given by :meth:`_name_io` to input (``kind="in"``) or output ``index``."""
+        return self._io_names[kind, index]
+
     # ------------------------------------------------------------------ shared logic
     @property
     def program(self) -> Program:

@@ -139,12 +139,10 @@ class PythonPrinter(InstructionPrinter):
         "atanh": "_atanh",
     }
     infix_operators: Dict[str, str] = {"add": "+", "sub": "-", "mul": "*"}
-    _comparisons: Dict[str, str] = {"lt": "<", "le": "<=", "eq": "==", "ne": "!="}
 
     def __init__(self) -> None:
         super().__init__()
         self._helpers: Set[str] = set()
-        self._names: Dict[str, str] = {}
 
     # ------------------------------------------------------------------ ops
     def op_expression(self, op: str, operands: Tuple[str, ...]) -> str:  # noqa: D102
@@ -167,19 +165,7 @@ class PythonPrinter(InstructionPrinter):
         return f"_div({a}, {b})"
 
     def _compare(self, op: str, a: str, b: str) -> str:
-        return f"1.0 if {a} {self._comparisons[op]} {b} else 0.0"
-
-    def _print_op_lt(self, a: str, b: str) -> str:
-        return self._compare("lt", a, b)
-
-    def _print_op_le(self, a: str, b: str) -> str:
-        return self._compare("le", a, b)
-
-    def _print_op_eq(self, a: str, b: str) -> str:
-        return self._compare("eq", a, b)
-
-    def _print_op_ne(self, a: str, b: str) -> str:
-        return self._compare("ne", a, b)
+        return f"1.0 if {a} {self.comparisons[op]} {b} else 0.0"
 
     def _print_op_not(self, a: str) -> str:
         return f"1.0 if {a} == 0.0 else 0.0"
@@ -205,26 +191,20 @@ class PythonPrinter(InstructionPrinter):
         return f"{target} = {expr}"
 
     def _input_ref(self, spec: IOSpec, position: int) -> str:
-        return f"float({self._names['in', spec.index]}[{position}])"
+        return f"float({self.io_name('in', spec.index)}[{position}])"
 
     def _output_ref(self, spec: IOSpec, position: int) -> str:
-        return f"{self._names['out', spec.index]}[{position}]"
+        return f"{self.io_name('out', spec.index)}[{position}]"
 
     def print_function(self, program: FunctionLike) -> str:  # noqa: D102
         if not isinstance(program, Program):
             program = lower(program)
-        taken: Set[str] = set()
-        self._names = {}
-        for kind, specs in (("in", program.inputs), ("out", program.outputs)):
-            for spec in specs:
-                ident = python_identifier(spec.name, taken)
-                taken.add(ident)
-                self._names[kind, spec.index] = ident
+        self._name_io(program, python_identifier)
         return super().print_function(program)
 
     def _function_text(self, program: Program, body: List[str]) -> str:
-        ins = [self._names["in", s.index] for s in program.inputs]
-        outs = [self._names["out", s.index] for s in program.outputs]
+        ins = [self.io_name("in", s.index) for s in program.inputs]
+        outs = [self.io_name("out", s.index) for s in program.outputs]
         fname = self.function_name(program)
         lines = [f"def {fname}({', '.join(ins)}):"]
         doc = [f'"""CasADi Function {program.name!r} ({len(program.instructions)} instructions).', ""]

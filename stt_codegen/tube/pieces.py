@@ -1,0 +1,375 @@
+"""The tube and controller as small CasADi Functions whose numbers are inputs.
+
+Every formula of the deployed controller is one of these SX ``Function``s; the spec's
+numbers (tube parameters, one row per reach segment, one row per circumvent) are their
+*inputs*, never constants of the graph, so the instruction stream of each piece depends on
+the state dimension ``n`` only. :mod:`stt_codegen.tube.model` composes them over a design
+(the numbers as constants, every segment and circumvent), and the generated code composes
+them the same way over ``const`` tables, evaluating only the active segment and the open
+circumvents. A closed circumvent contributes exactly 0 to eq. (9) (:func:`fnu_add` adds
+``0``, :func:`bump` is ``0``), so skipping it gives the same bits.
+
+=====================  ===========================================  ==========================
+piece                  inputs                                       outputs
+=====================  ===========================================  ==========================
+``progress_tanh``      t, start, end                                p, p_dot (eq. (4));
+                                                                    ``_value``: p only
+``progress_smoothstep`` t, start, end                               p, p_dot (quintic)
+``interpolate``        p, p_dot, from (2n), to (2n)                 rho, rho_dot (2n: [L; U]);
+                                                                    ``_value``: rho only
+``bump``               t, start, end, center, radius, sharpness,    y = B b(t), y_dot
+                       height                                       (eqs. (7)-(8));
+                                                                    ``_value``: y only
+``fnu_init``           top, nu                                      total, rate
+``fnu_add``            total, rate, y, y_dot, top, nu               total, rate
+``fnu_finish``         bound, sign, top, total, rate, nu            beta, beta_dot (eq. (9))
+``fnu_single``         bound, sign, y, y_dot                        beta, beta_dot (one member)
+``candidates``         rho (2n), alpha (2n)                         [rho_L - alpha_L;
+                                                                    rho_U + alpha_U]
+``candidate_rates``    rho_dot (2n), alpha_dot (2n)                 their rates
+``smooth_max_test``    a, b, nu                                     max, needed
+``smooth_max``         a, b, nu                                     max~ (eq. (10))
+``smooth_min_test``    a, b, nu                                     min, needed
+``smooth_min``         a, b, nu                                     min~
+``smooth_max_rate``    a, b, a_dot, b_dot, nu                       d max~ / dt
+``smooth_min_rate``    a, b, a_dot, b_dot, nu                       d min~ / dt
+``conflict``           rho (2n), beta (2n), theta0, mu              psi, theta (eq. (11))
+``alpha_rate``         alpha (2n), psi (2n), theta (2n), kappa      alpha_dot (eq. (11))
+``later``              t, dt                                        t + dt
+``newton_start``       alpha, psi, theta, dt, kappa                 a0, c, A, root
+``newton_root_start``  alpha, psi, c, A                             a0
+``newton_iteration``   a, alpha, psi, c, A                          a (one division)
+``law``                x (n), gamma_L (n), gamma_U (n), gain        u (n), inside (law (13))
+=====================  ===========================================  ==========================
+
+Vectors of length 2n stack the lower bounds then the upper ones (``[L; U]``).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import casadi as ca
+
+from .parameters import E_MAX, GAMMA_D_MIN, NEWTON_TINY, SMOOTHSTEP, TANH
+
+#: Bound on the argument of ``exp`` where it could be large (the smooth max's correction
+#: and the trigger of (11)): ``exp(+-80)`` is a normal number in float32 and float64, so no
+#: step raises an overflow or underflow flag or sets ``errno``.
+EXP_ARGUMENT_BOUND = 80.0
+#: ``nu |a - b|`` from which :func:`smooth_max_needed` may skip the correction, and
+#: ``e^-40`` rounded up (for its exactness test).
+SMOOTH_SKIP_ARGUMENT = 40.0
+_EXP_MINUS_SKIP = 4.25e-18
+
+#: Profile codes of the segment table, in the order of ``PROFILE_NAMES``.
+PROFILE_NAMES = (TANH, SMOOTHSTEP)
+
+
+def _sym(*names: str):
+    return [ca.SX.sym(name) for name in names]
+
+
+def progress_expression(profile: str, t, start, end):
+    """Profile ``p`` of a reach segment (SX): 0 before ``start``, 1 from ``end`` on.
+
+    ``"tanh"``: ``tanh((t - start) / (end - t))`` (eq. (4); only evaluated for
+    ``t < end``, with a denominator that stays finite in the branch not taken);
+    ``"smoothstep"``: ``tau^3 (10 - 15 tau + 6 tau^2)``, ``tau`` clamped to ``[0, 1]``.
+
+    Raises
+    ------
+    ValueError
+        Unknown profile.
+    """
+    if profile == TANH:
+        before = t < end
+        gap = ca.if_else(before, end - t, 1.0)
+        elapsed = t - start
+        return ca.if_else(before, ca.if_else(elapsed < 0.0, 0.0, ca.tanh(elapsed / gap)), 1.0)
+    if profile != SMOOTHSTEP:
+        raise ValueError(f"unknown reach segment profile {profile!r}")
+    tau = ca.fmin(ca.fmax((t - start) / (end - start), 0.0), 1.0)
+    return tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+
+
+@lru_cache(maxsize=None)
+def progress(profile: str, rates: bool = True) -> ca.Function:
+    """``progress_<profile>(t, start, end) -> (p, p_dot)``; without rates
+    ``progress_<profile>_value(t, start, end) -> p``."""
+    t, start, end = _sym("t", "start", "end")
+    p = progress_expression(profile, t, start, end)
+    if not rates:
+        return ca.Function(f"progress_{profile}_value", [t, start, end], [p],
+                           ["t", "start", "end"], ["p"])
+    return ca.Function(f"progress_{profile}", [t, start, end], [p, ca.jacobian(p, t)],
+                       ["t", "start", "end"], ["p", "p_dot"])
+
+
+@lru_cache(maxsize=None)
+def interpolate(n: int, rates: bool = True) -> ca.Function:
+    """``interpolate(p, p_dot, from, to) -> (rho, rho_dot)``: ``(to - from) p + from``;
+    without rates ``interpolate_value(p, from, to) -> rho``."""
+    p, p_dot = _sym("p", "p_dot")
+    lo, hi = ca.SX.sym("from", 2 * n), ca.SX.sym("to", 2 * n)
+    if not rates:
+        return ca.Function("interpolate_value", [p, lo, hi], [(hi - lo) * p + lo],
+                           ["p", "from", "to"], ["rho"])
+    return ca.Function("interpolate", [p, p_dot, lo, hi], [(hi - lo) * p + lo, (hi - lo) * p_dot],
+                       ["p", "p_dot", "from", "to"], ["rho", "rho_dot"])
+
+
+@lru_cache(maxsize=None)
+def bump(rates: bool = True) -> ca.Function:
+    """``bump(t, start, end, center, radius, sharpness, height) -> (y, y_dot)``.
+
+    ``y = B exp(-k d^2 / ((r - |d|)(r + |d|)))``, ``d = t - m``, inside the open window
+    (``start < t < end`` and ``|d| < r``), exactly 0 outside (eqs. (7)-(8)); the exponent
+    is clamped at -80 (no underflow near the edges, where ``y < 2e-35 B``). Without rates
+    ``bump_value(...) -> y``.
+    """
+    t, start, end, center, radius, sharpness, height = _sym(
+        "t", "start", "end", "center", "radius", "sharpness", "height")
+    d = t - center
+    inside = ca.logic_and(ca.logic_and(t > start, t < end), ca.fabs(d) < radius)
+    # (r - |d|)(r + |d|), not r^2 - d^2: rounded separately from the test |d| < r, the
+    # latter can be exactly 0 at the window's edge in float32
+    denom = ca.if_else(inside, (radius - ca.fabs(d)) * (radius + ca.fabs(d)), 1.0)
+    # the exponent clamped at -80: no underflow at the window's edges (y < 2e-35 B there)
+    exponent = ca.fmax(-sharpness * d ** 2 / denom, -EXP_ARGUMENT_BOUND)
+    y = ca.if_else(inside, height * ca.exp(exponent), 0.0)
+    if not rates:
+        return ca.Function("bump_value", [t, start, end, center, radius, sharpness, height], [y],
+                           ["t", "start", "end", "center", "radius", "sharpness", "height"],
+                           ["y"])
+    return ca.Function("bump", [t, start, end, center, radius, sharpness, height],
+                       [y, ca.jacobian(y, t)],
+                       ["t", "start", "end", "center", "radius", "sharpness", "height"],
+                       ["y", "y_dot"])
+
+
+@lru_cache(maxsize=None)
+def fnu_pieces() -> tuple:
+    """``fnu_init``, ``fnu_add``, ``fnu_finish``, ``fnu_single``: eq. (9)'s ``F_nu``.
+
+    ``F_nu(y) = (1/nu) ln(1 + sum_j (exp(nu y_j) - 1))`` as
+    ``top + ln(total) / nu``, ``total = exp(-nu top) + sum_j (exp(nu (y_j - top)) -
+    exp(-nu top))``, ``top = max(0, max_j y_j)`` (cannot overflow); a closed window
+    (``y_j = 0``) adds exactly 0. ``rate = sum_j exp(nu (y_j - top)) y_j_dot`` gives
+    ``F_dot = rate / total``. ``beta = bound + sign F``: ``sign`` is +1 on a lower bound
+    (``beta_L = X + F``), -1 on an upper one (``beta_U = X-bar - F``).
+    """
+    top, nu, total, rate, y, y_dot, bound, sign = _sym(
+        "top", "nu", "total", "rate", "y", "y_dot", "bound", "sign")
+    # exponents clamped at -80 (no underflow; terms below e^-80 change F by < 2e-35 / nu);
+    # a closed window's weight (y = 0) is the floor exactly, clamped alike
+    floor = ca.exp(ca.fmax(nu * (0.0 - top), -EXP_ARGUMENT_BOUND))
+    weight = ca.exp(ca.fmax(nu * (y - top), -EXP_ARGUMENT_BOUND))
+    init = ca.Function("fnu_init", [top, nu], [floor, ca.SX(0.0)], ["top", "nu"],
+                       ["total", "rate"])
+    add = ca.Function("fnu_add", [total, rate, y, y_dot, top, nu],
+                      [total + (weight - floor), rate + weight * y_dot],
+                      ["total", "rate", "y", "y_dot", "top", "nu"], ["total_next", "rate_next"])
+    finish = ca.Function("fnu_finish", [bound, sign, top, total, rate, nu],
+                         [bound + sign * (top + ca.log(total) / nu), sign * (rate / total)],
+                         ["bound", "sign", "top", "total", "rate", "nu"], ["beta", "beta_dot"])
+    single = ca.Function("fnu_single", [bound, sign, y, y_dot], [bound + sign * y, sign * y_dot],
+                         ["bound", "sign", "y", "y_dot"], ["beta", "beta_dot"])
+    return init, add, finish, single
+
+
+@lru_cache(maxsize=None)
+def candidates(n: int) -> tuple:
+    """``candidates(rho, alpha)`` and ``candidate_rates(rho_dot, alpha_dot)`` (2n each)."""
+    rho, alpha = ca.SX.sym("rho", 2 * n), ca.SX.sym("alpha", 2 * n)
+    value = ca.vertcat(rho[:n] - alpha[:n], rho[n:] + alpha[n:])
+    rho_dot, alpha_dot = ca.SX.sym("rho_dot", 2 * n), ca.SX.sym("alpha_dot", 2 * n)
+    rate = ca.vertcat(rho_dot[:n] - alpha_dot[:n], rho_dot[n:] + alpha_dot[n:])
+    return (ca.Function("candidates", [rho, alpha], [value], ["rho", "alpha"], ["c"]),
+            ca.Function("candidate_rates", [rho_dot, alpha_dot], [rate],
+                        ["rho_dot", "alpha_dot"], ["c_dot"]))
+
+
+def smooth_max_expression(a, b, nu):
+    """``max~(a, b) = max(a, b) + log1p(exp(-nu |a - b|)) / nu`` (notation, section II;
+    the paper's ``(1/nu) ln(e^{nu a} + e^{nu b})`` in a form that does not overflow), the
+    exponent clamped at ``-80`` (:data:`EXP_ARGUMENT_BOUND`: no underflow; the correction
+    is then below ``4e-35 / nu``)."""
+    d = ca.fmax(-nu * ca.fabs(a - b), -EXP_ARGUMENT_BOUND)
+    return ca.fmax(a, b) + ca.log1p(ca.exp(d)) / nu
+
+
+def smooth_max_needed(a, b, nu):
+    """``(max(a, b), needed)``: ``needed`` is 0 where ``max~(a, b) == max(a, b)`` exactly.
+
+    ``needed`` is 0 when ``nu |a - b| >= 40`` and ``|max| >= 2^54 e^-40 / nu``: the
+    correction ``log1p(e^-nu|a-b|) / nu < e^-40 / nu <= |max| 2^-54`` is then below half an
+    ulp of the max in float64 and float32, so ``max~(a, b) == max(a, b)`` exactly.
+    """
+    top = ca.fmax(a, b)
+    sharp = ca.logic_and(nu * ca.fabs(a - b) >= SMOOTH_SKIP_ARGUMENT,
+                         ca.fabs(top) >= 2.0 ** 54 * _EXP_MINUS_SKIP / nu)
+    return top, ca.logic_not(sharp)
+
+
+@lru_cache(maxsize=None)
+def smooth_pieces() -> tuple:
+    """``smooth_max_test``, ``smooth_max``, ``smooth_min_test``, ``smooth_min``,
+    ``smooth_max_rate``, ``smooth_min_rate`` (scalars; ``min~(a, b) = -max~(-a, -b)``)."""
+    a, b, nu, a_dot, b_dot = _sym("a", "b", "nu", "a_dot", "b_dot")
+    top, needed = smooth_max_needed(a, b, nu)
+    neg_top, neg_needed = smooth_max_needed(-a, -b, nu)
+    value_max = smooth_max_expression(a, b, nu)
+    value_min = -smooth_max_expression(-a, -b, nu)
+    names = ["a", "b", "nu"]
+    rate_names = ["a", "b", "a_dot", "b_dot", "nu"]
+
+    def rate(value):
+        grad = ca.jacobian(value, ca.vertcat(a, b))
+        return grad[0] * a_dot + grad[1] * b_dot
+
+    return (
+        ca.Function("smooth_max_test", [a, b, nu], [top, needed], names, ["max", "needed"]),
+        ca.Function("smooth_max", [a, b, nu], [value_max], names, ["max"]),
+        ca.Function("smooth_min_test", [a, b, nu], [-neg_top, neg_needed], names,
+                    ["min", "needed"]),
+        ca.Function("smooth_min", [a, b, nu], [value_min], names, ["min"]),
+        ca.Function("smooth_max_rate", [a, b, a_dot, b_dot, nu], [rate(value_max)], rate_names,
+                    ["max_dot"]),
+        ca.Function("smooth_min_rate", [a, b, a_dot, b_dot, nu], [rate(value_min)], rate_names,
+                    ["min_dot"]),
+    )
+
+
+def trigger_expression(psi, theta0, mu):
+    """``theta = theta0 (1 - tanh(psi - mu))`` of eq. (11) as ``2 theta0 / (1 + exp(y))``,
+    ``y = 2 (psi - mu)`` clamped to ``[-80, 80]`` (the same function: ``1 - tanh(y/2) =
+    2 / (1 + e^y)``; one ``exp`` instead of ``tanh``; exact to the last bit, or below
+    ``4e-35 theta0``, where clamped)."""
+    y = ca.fmin(ca.fmax(2.0 * (psi - mu), -EXP_ARGUMENT_BOUND), EXP_ARGUMENT_BOUND)
+    return (2.0 * theta0) / (1.0 + ca.exp(y))
+
+
+@lru_cache(maxsize=None)
+def conflict(n: int) -> ca.Function:
+    """``conflict(rho, beta, theta0, mu) -> (psi, theta)``: ``psi = [beta_U - rho_L;
+    rho_U - beta_L]`` and the trigger of eq. (11)."""
+    rho, beta = ca.SX.sym("rho", 2 * n), ca.SX.sym("beta", 2 * n)
+    theta0, mu = _sym("theta0", "mu")
+    psi = ca.vertcat(beta[n:] - rho[:n], rho[n:] - beta[:n])
+    return ca.Function("conflict", [rho, beta, theta0, mu],
+                       [psi, trigger_expression(psi, theta0, mu)],
+                       ["rho", "beta", "theta0", "mu"], ["psi", "theta"])
+
+
+@lru_cache(maxsize=None)
+def alpha_rate(n: int) -> ca.Function:
+    """``alpha_rate(alpha, psi, theta, kappa) -> theta / (psi + alpha)^2 - kappa alpha``."""
+    alpha, psi, theta = (ca.SX.sym(name, 2 * n) for name in ("alpha", "psi", "theta"))
+    kappa = ca.SX.sym("kappa")
+    return ca.Function("alpha_rate", [alpha, psi, theta, kappa],
+                       [theta / (psi + alpha) ** 2 - kappa * alpha],
+                       ["alpha", "psi", "theta", "kappa"], ["alpha_dot"])
+
+
+@lru_cache(maxsize=None)
+def later() -> ca.Function:
+    """``later(t, dt) -> t + dt``."""
+    t, dt = _sym("t", "dt")
+    return ca.Function("later", [t, dt], [t + dt], ["t", "dt"], ["t_next"])
+
+
+def newton_start_expression(alpha, psi, theta, dt, kappa) -> tuple:
+    """``(a0, c, A, root)`` of the implicit step; see :func:`newton_pieces`."""
+    c = 1.0 + kappa * dt
+    a_coef = dt * theta
+    a0 = alpha / c
+    z0 = psi + a0
+    fast = ca.logic_and(z0 > 0.0, 2.0 * c * (z0 * z0 * z0) >= a_coef)
+    return a0, c, a_coef, ca.logic_not(fast)
+
+
+def newton_root_start_expression(alpha, psi, c, a_coef):
+    """``max(alpha / c, -psi + delta)``, ``delta = min((A / 2c)^(1/3), sqrt(A / 2Q))``,
+    ``Q = max(-c psi - alpha, 0)``."""
+    q = ca.fmax(-c * psi - alpha, 0.0)
+    delta = ca.fmin((a_coef / (2.0 * c)) ** (1.0 / 3.0),
+                    ca.sqrt(a_coef / (2.0 * ca.fmax(q, NEWTON_TINY))))
+    return ca.fmax(alpha / c, -psi + delta)
+
+
+def newton_iteration_expression(a, alpha, psi, c, a_coef):
+    """``a - z (z^2 (c a - alpha) - A) / (c z^3 + 2 A)``, ``z = psi + a``: one Newton
+    iteration on ``g(a) = c a - alpha - A / z^2`` with one division."""
+    z = psi + a
+    z2 = z * z
+    return a - z * (z2 * (c * a - alpha) - a_coef) / (c * (z2 * z) + 2.0 * a_coef)
+
+
+@lru_cache(maxsize=None)
+def newton_pieces() -> tuple:
+    """``newton_start``, ``newton_root_start``, ``newton_iteration`` (scalars).
+
+    ``newton_start``: ``c = 1 + kappa dt``, ``A = dt theta``, ``a0 = alpha / c`` and
+    ``root = 1`` unless ``z0 = psi + a0 > 0`` and ``2 c z0^3 >= A`` (then ``a0 >= -psi +
+    (A / 2c)^(1/3) >= -psi + delta`` is the start ``newton_root_start`` would return,
+    without its roots). Both starts have ``g <= 0`` (proof in docs/codegen.md), so the
+    iterations increase monotonically to the root without leaving ``(-psi, inf)``.
+    """
+    alpha, psi, theta, dt, kappa, a, c, a_coef = _sym(
+        "alpha", "psi", "theta", "dt", "kappa", "a", "c", "A")
+    a0, c_out, a_out, root = newton_start_expression(alpha, psi, theta, dt, kappa)
+    return (
+        ca.Function("newton_start", [alpha, psi, theta, dt, kappa], [a0, c_out, a_out, root],
+                    ["alpha", "psi", "theta", "dt", "kappa"], ["a0", "c", "A", "root"]),
+        ca.Function("newton_root_start", [alpha, psi, c, a_coef],
+                    [newton_root_start_expression(alpha, psi, c, a_coef)],
+                    ["alpha", "psi", "c", "A"], ["a0"]),
+        ca.Function("newton_iteration", [a, alpha, psi, c, a_coef],
+                    [newton_iteration_expression(a, alpha, psi, c, a_coef)],
+                    ["a", "alpha", "psi", "c", "A"], ["a_next"]),
+    )
+
+
+def law_expression(x, gamma_l, gamma_u, gain, n: int) -> tuple:
+    """Deployed law (13) with clamps: ``(u, inside)``; ``e`` clamped to ``[-E_MAX, E_MAX]``
+    and ``gamma_d`` floored at ``GAMMA_D_MIN`` so that ``u`` is finite everywhere."""
+    gamma_d = gamma_u - gamma_l
+    width = ca.fmax(gamma_d, GAMMA_D_MIN)
+    e = (2.0 * x - (gamma_u + gamma_l)) / width
+    inside = 1.0
+    for i in range(n):
+        inside = ca.logic_and(inside, ca.logic_and(ca.fabs(e[i]) < 1.0, gamma_d[i] > 0.0))
+    e_c = ca.fmin(ca.fmax(e, -E_MAX), E_MAX)
+    epsilon = ca.log((1.0 + e_c) / (1.0 - e_c))
+    xi = 4.0 / (width * (1.0 - e_c ** 2))
+    return -gain * xi * epsilon, inside
+
+
+@lru_cache(maxsize=None)
+def law(n: int) -> ca.Function:
+    """``law(x, gamma_L, gamma_U, gain) -> (u, inside)``."""
+    x, gamma_l, gamma_u = (ca.SX.sym(name, n) for name in ("x", "gamma_L", "gamma_U"))
+    gain = ca.SX.sym("gain")
+    u, inside = law_expression(x, gamma_l, gamma_u, gain, n)
+    return ca.Function("law", [x, gamma_l, gamma_u, gain], [u, inside],
+                       ["x", "gamma_L", "gamma_U", "gain"], ["u", "inside"])
+
+
+def deployed_pieces(n: int, profiles: tuple, single_bounds: bool = True,
+                    multi_bounds: bool = True) -> list:
+    """Every piece the generated code of a design of dimension ``n`` calls, in a fixed order.
+
+    ``profiles``: the segment profiles it uses; ``single_bounds`` / ``multi_bounds``: whether
+    some bound has exactly one / several circumvents (``bump`` is emitted with either, the
+    ``F_nu`` pieces only with several, ``fnu_single`` only with one).
+    """
+    init, add, finish, single = fnu_pieces()
+    cand, cand_rates = candidates(n)
+    circumvents = ([bump(False), bump()] if single_bounds or multi_bounds else []) + (
+        [init, add, finish] if multi_bounds else []) + ([single] if single_bounds else [])
+    used = [p for p in PROFILE_NAMES if p in profiles]
+    return [*(progress(p, False) for p in used), *(progress(p) for p in used),
+            interpolate(n, False), interpolate(n),
+            *circumvents, cand, cand_rates, *smooth_pieces(), conflict(n), alpha_rate(n),
+            later(), *newton_pieces(), law(n)]
