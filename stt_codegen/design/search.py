@@ -357,4 +357,5 @@ def design_tube(spec: Spec) -> tuple[TubeDesign, TubeCheck]:
     if spec.gain is not None:
         return replace(design, gain=spec.gain), check
     samples = sample_tube(design)
-    return replace(design, gain=default_gain(design, samples)), check
+    from .gain import derived_gain  # the gain follows from the spec's [assumptions]
+    return replace(design, gain=derived_gain(samples, design.rate_hz, spec.assumptions)), check
