@@ -131,7 +131,8 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
         raise SpecError("--horizon", f"must be a positive number of seconds, got {horizon!r}")
     controller = make_controller(backend, design)
     if plant is None:
-        plant = make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed)
+        plant = make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed,
+                           spec.linear_plant)
 
     def rhs(t, x, u):
         return plant.dynamics(t, x, u)

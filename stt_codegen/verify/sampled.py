@@ -27,6 +27,7 @@ point is skipped.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 
@@ -34,7 +35,8 @@ import numpy as np
 
 from ..design.certificate import enclose_tube
 from ..design.samples import TubeSamples
-from ..spec.loader import Assumptions
+from ..design.gain import RATE_FACTORS, gain_derivation, lowest_rate
+from ..spec.loader import Assumptions, LinearPlant, Spec
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .check import Check
 
@@ -204,3 +206,120 @@ def check_sampled(design: TubeDesign, samples: TubeSamples, assumptions: Assumpt
         top = max(top, max(max(-a, b) for a, b in box))
     data.update({"max_abs_e": top, "margin": worst})
     return SampledCheck(True, top, worst, worst_t, worst_i, "", data)
+
+
+# --------------------------------------------------------------------------- verify
+
+
+def _bounds_words(a: Assumptions) -> str:
+    g_min, g_max = a.input_gain
+    source = "declared" if a.declared else "defaults: declare [assumptions] for your plant"
+    return (f"eig((g + g^T)/2) in [{g_min:g}, {g_max:g}], |skew part| <= "
+            f"{a.input_gain_skew:g}, row coupling <= {a.input_gain_coupling:g}, |f| <= "
+            f"{a.drift_bound:g}, |w| <= {a.disturbance_bound:.3g} ({source})")
+
+
+def sampled_checks(spec: Spec, design: TubeDesign, samples: TubeSamples) -> list[Check]:
+    """The checks of ``stt-codegen verify`` for the sampled closed loop.
+
+    ``sampled.gain``: ``k`` is below the linearized stability limit at the narrowest tube
+    for ``g_max``, with the derivation (:func:`~stt_codegen.design.gain.gain_derivation`)
+    in words. ``sampled.tube_kept``: :func:`check_sampled` for the spec's assumptions;
+    when it fails, the lowest rate that passes (:func:`~stt_codegen.design.gain.lowest_rate`).
+
+    Parameters
+    ----------
+    spec : Spec
+    design : TubeDesign
+        With its gain set (the spec's ``controller.gain`` or the derived one).
+    samples : TubeSamples
+        ``design``'s tube at its sampling instants.
+
+    Returns
+    -------
+    list of Check
+    """
+    a = spec.assumptions
+    derivation = gain_derivation(design, samples, a, spec.gain)
+    gain_ok = derivation["gain"] < derivation["stable_gain_limit"]
+    checks = [Check("sampled.gain", gain_ok, derivation["explanation"]
+                    + ("" if gain_ok else f"; k = {derivation['gain']:.6g} is beyond the "
+                       f"limit at g_max = {a.input_gain[1]:g}"), derivation)]
+    result = check_sampled(design, samples, a)
+    if result.passed:
+        detail = (f"every plant with {_bounds_words(a)} stays strictly inside the tube at "
+                  f"and between samples at {design.rate_hz:g} Hz with k = {design.gain:.6g}:"
+                  f" |e| <= {result.level:.4g} at the samples, room >= {result.margin:.3g} "
+                  f"of the half-width (least at t = {result.time:.4f} s, dimension "
+                  f"{result.dimension})")
+    else:
+        rate, gain = lowest_rate(design, a, spec.gain)
+        need = (f"needs {rate / 1000:.3g} kHz (k = {gain:.4g})" if rate is not None else
+                f"no rate up to {design.rate_hz * RATE_FACTORS[-1] / 1000:g} kHz helps")
+        label = "controller.gain" if spec.gain is not None else "the derived gain"
+        detail = (f"{result.reason}, for plants with {_bounds_words(a)} at "
+                  f"{design.rate_hz:g} Hz and k = {design.gain:.6g} ({label}); the "
+                  f"condition {need} at g_max = {a.input_gain[1]:g}")
+    checks.append(Check("sampled.tube_kept", result.passed, detail,
+                        {**result.data, "level": result.level, "margin": result.margin,
+                         "time": result.time}))
+    return checks
+
+
+def _drift_bound(plant: LinearPlant, space) -> float:
+    """``max_{x in X} |a x + c|``: at a vertex of the box (the norm is convex); for more
+    than 12 dimensions the bound ``|a m + c| + sum_j |a_j| r_j`` (centre m, half-widths r)."""
+    a, c = np.array(plant.a), np.array(plant.c)
+    lo, hi = np.array(space.lower), np.array(space.upper)
+    if lo.size <= 12:
+        corners = np.array(list(itertools.product(*zip(lo, hi))))
+        return float(np.linalg.norm(corners @ a.T + c, axis=1).max())
+    m, r = (lo + hi) / 2, (hi - lo) / 2
+    return float(np.linalg.norm(a @ m + c) + np.linalg.norm(a, axis=0) @ r)
+
+
+def linear_plant_checks(spec: Spec) -> list[Check]:
+    """Assumption 2 for the spec's ``linear`` plant, and whether it meets ``[assumptions]``.
+
+    Returns
+    -------
+    list of Check
+        ``assumption2.linear`` (``lambda_min((g + g^T)/2) > 0``) and
+        ``sampled.plant_within_assumptions`` (the plant's ``g``, skew part, row coupling
+        and ``max |a x + c|`` over the state space against the declared bounds).
+    """
+    plant = spec.linear_plant
+    n = spec.dimension
+    if plant is None:
+        eye = tuple(tuple(float(i == j) for j in range(n)) for i in range(n))
+        plant = LinearPlant(tuple(tuple(0.0 for _ in range(n)) for _ in range(n)), eye,
+                            tuple(0.0 for _ in range(n)))
+    g = np.array(plant.g)
+    sym, skew = (g + g.T) / 2, (g - g.T) / 2
+    eig = np.linalg.eigvalsh(sym)
+    checks = [Check("assumption2.linear", bool(eig[0] > 0),
+                    f"lambda_min((g + g^T)/2) = {eig[0]:.6g} for the linear plant's g"
+                    + ("" if eig[0] > 0 else ": Assumption 2 fails, law (13) cannot hold "
+                       "this plant"), {"lambda_min": float(eig[0])})]
+    off = g - np.diag(np.diag(g))
+    found = {"input_gain": (float(eig[0]), float(eig[-1])),
+             "input_gain_skew": float(np.linalg.norm(skew, 2)),
+             "input_gain_coupling": float(np.linalg.norm(off, axis=1).max()),
+             "drift_bound": _drift_bound(plant, spec.state_space)}
+    a = spec.assumptions
+    tol = 1e-12
+    bad = []
+    if found["input_gain"][0] < a.input_gain[0] - tol or found["input_gain"][1] > a.input_gain[1] + tol:
+        bad.append(f"eig((g + g^T)/2) spans [{found['input_gain'][0]:.6g}, "
+                   f"{found['input_gain'][1]:.6g}], outside input_gain {list(a.input_gain)}")
+    for key in ("input_gain_skew", "input_gain_coupling", "drift_bound"):
+        if found[key] > getattr(a, key) + tol:
+            bad.append(f"{key} is {found[key]:.6g} > {getattr(a, key):g}")
+    checks.append(Check("sampled.plant_within_assumptions", not bad,
+                        "the linear plant meets [assumptions] (eig in "
+                        f"[{found['input_gain'][0]:.6g}, {found['input_gain'][1]:.6g}], skew "
+                        f"{found['input_gain_skew']:.3g}, coupling "
+                        f"{found['input_gain_coupling']:.3g}, max |a x + c| "
+                        f"{found['drift_bound']:.3g})" if not bad else "; ".join(bad),
+                        {k: v for k, v in found.items()}))
+    return checks
