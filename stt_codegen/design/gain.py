@@ -134,10 +134,11 @@ def lowest_rate(design: TubeDesign, assumptions: Assumptions,
 
     # the fastest rate first: when even it fails (coupling beyond what any rate can
     # handle), one check answers instead of all of them
-    if not passes(RATE_FACTORS[-1])[0]:
+    ok, fastest_gain = passes(RATE_FACTORS[-1])
+    if not ok:
         return None, None
-    for factor in RATE_FACTORS:
+    for factor in RATE_FACTORS[:-1]:
         ok, gain = passes(factor)
         if ok:
             return design.rate_hz * factor, gain
-    return None, None  # pragma: no cover - the last factor passed above
+    return design.rate_hz * RATE_FACTORS[-1], fastest_gain
