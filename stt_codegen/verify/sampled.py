@@ -254,12 +254,19 @@ def sampled_checks(spec: Spec, design: TubeDesign, samples: TubeSamples) -> list
                   f"{result.dimension})")
     else:
         rate, gain = lowest_rate(design, a, spec.gain)
-        need = (f"needs {rate / 1000:.3g} kHz (k = {gain:.4g})" if rate is not None else
-                f"no rate up to {design.rate_hz * RATE_FACTORS[-1] / 1000:g} kHz helps")
+        g_max = a.input_gain[1]
+        if rate is not None:
+            need = f"the condition needs {rate / 1000:.3g} kHz (k = {gain:.4g}) at g_max = {g_max:g}"
+        else:
+            need = (f"no rate up to {design.rate_hz * RATE_FACTORS[-1] / 1000:g} kHz passes "
+                    f"the condition at g_max = {g_max:g}")
+            if a.input_gain_coupling > 0:
+                need += (f" (row coupling {a.input_gain_coupling:g} next to g_min = "
+                         f"{a.input_gain[0]:g}: declare a smaller input_gain_coupling if the "
+                         "structure of g allows)")
         label = "controller.gain" if spec.gain is not None else "the derived gain"
         detail = (f"{result.reason}, for plants with {_bounds_words(a)} at "
-                  f"{design.rate_hz:g} Hz and k = {design.gain:.6g} ({label}); the "
-                  f"condition {need} at g_max = {a.input_gain[1]:g}")
+                  f"{design.rate_hz:g} Hz and k = {design.gain:.6g} ({label}); {need}")
     checks.append(Check("sampled.tube_kept", result.passed, detail,
                         {**result.data, "level": result.level, "margin": result.margin,
                          "time": result.time}))
