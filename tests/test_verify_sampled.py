@@ -124,3 +124,13 @@ def test_accepted_bounds_hold_for_several_plants():
             result = simulate(spec, dataclasses.replace(design, gain=gain), backend="c",
                               plant=plant)
             assert result.stayed_in_tube and result.satisfied, (case, seed)
+
+
+def test_worst_case_coupling_is_a_documented_limit_of_the_check():
+    """input_gain = [0.5, 3] without input_gain_coupling implies a row coupling of 1.25:
+    the check fails at every rate it tries and says which bound to refine."""
+    checks = by_name(verify_spec(load_spec(SPECS / "gain-range-s2-coupled.toml")))
+    kept = checks["sampled.tube_kept"]
+    assert not kept.passed and checks["sampled.gain"].passed
+    assert "no rate up to 16 kHz passes" in kept.detail
+    assert "row coupling 1.25" in kept.detail and "input_gain_coupling" in kept.detail
