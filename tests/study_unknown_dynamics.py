@@ -1,14 +1,24 @@
-"""Issue 7, unknown dynamics: the batch study behind the README figures (a script, not a test).
+"""Issues 7 and 13, unknown dynamics: the batch study behind the README figures (a script).
 
     python tests/study_unknown_dynamics.py [RUNS_PER_CASE] [--out results.json]
+    python tests/study_unknown_dynamics.py --declared [RUNS_PER_CASE] [--out results.json]
     python tests/study_unknown_dynamics.py --sweeps    # 1-D sweeps of lambda(g) and |f|
 
-Draws plants ``x_dot = f(x) + g(x) u + w`` (:func:`test_hard_support.unknown_plant`) over
-wide ranges, runs the generated C controller of each bundled case against them, and
-classifies every failure by rerunning it: with ``rate_hz`` doubled and quadrupled
-(sampling-rate limit), with the gain divided by ``|g|_2`` when ``|g|_2 > 1`` (the default
-gain assumes ``lambda_max(g) <= 1``), else a limit of the method. Seeded: the same runs
-every time. Prints a summary; ``--out`` writes every run as JSON.
+Default mode (issue 7, extended by issue 13): draws plants ``x_dot = f(x) + g(x) u + w``
+(:func:`test_hard_support.unknown_plant`) over wide ranges, runs the generated C
+controller of each bundled case (its default gain, 1 kHz) against them, and classifies
+every failure by rerunning it: with ``rate_hz`` doubled and quadrupled (sampling-rate
+limit), with the gain divided by ``|g|_2`` when ``|g|_2 > 1``, else a limit of the method.
+Each run also gets the verdict of the sampled-data check
+(:func:`stt_codegen.verify.sampled.check_sampled`) for the plant's own bounds: a plant
+the check accepts must not fail.
+
+``--declared`` (issue 13): one set of declared bounds, :data:`DECLARED`; for each case the
+gain is derived from them and the rate is the lowest that passes the check
+(:func:`stt_codegen.design.gain.lowest_rate`); plants are drawn within the bounds
+(:func:`test_plants_support.plant_within`). Every run must hold.
+
+Seeded: the same runs every time. Prints a summary; ``--out`` writes every run as JSON.
 """
 
 from __future__ import annotations
@@ -29,6 +39,10 @@ RANGES = {"f_amp": (0.0, 3.0), "f_lin": (0.0, 1.0), "g_min": (0.05, 1.0),
           "g_max_over_min": (1.0, 6.0), "skew": (0.0, 1.0), "w_amp": (0.0, 0.5)}
 
 _CACHE: dict = {}
+#: The bounds declared in ``--declared`` mode (``[assumptions]``): input_gain, skew,
+#: coupling, drift (|f|), disturbance (|w|).
+DECLARED = {"input_gain": (0.5, 2.0), "input_gain_skew": 0.05, "input_gain_coupling": 0.1,
+            "drift_bound": 1.0, "disturbance_bound": 0.3}
 
 
 def _designed(case):
@@ -61,11 +75,44 @@ def run_one(case: str, knobs: dict, rate_factor: float = 1.0, gain_factor: float
         design = dataclasses.replace(design, rate_hz=design.rate_hz * rate_factor,
                                      gain=design.gain * gain_factor)
     result = simulate(spec, design, backend="c", plant=unknown_plant(p, bounds["centre"]))
+    verdict = None
+    if rate_factor == 1.0 and gain_factor == 1.0:
+        verdict = _check_own_bounds(case, p, spec)
     return {"satisfied": bool(result.satisfied), "in_tube": bool(result.stayed_in_tube),
+            "check_accepts": verdict,
             "collision": bool(result.collision), "reached": bool(result.reached),
             "left": bool(result.left_state_space),
             "f_inf": bounds["f_inf"], "g_sym_min": bounds["g_sym_min"],
             "g_sym_max": bounds["g_sym_max"], "g_norm": bounds["g_norm"]}
+
+
+def own_bounds(p: dict, spec):
+    """The declared bounds that fit a drawn plant (:func:`test_hard_support.unknown_plant`)."""
+    from stt_codegen.spec.loader import Assumptions
+    from test_hard_support import _skew
+    n = spec.dimension
+    eig = np.linalg.eigvalsh(p["sym"])
+    k_mat = _skew(p["skew_axis"])
+    off = p["sym"] - np.diag(np.diag(p["sym"]))
+    coupling = float(np.max(np.linalg.norm(off, axis=1)
+                            + p["skew"] * np.linalg.norm(k_mat, axis=1)))
+    half = (np.array(spec.state_space.upper) - np.array(spec.state_space.lower)) / 2
+    drift = p["f_amp"] * np.sqrt(n) + np.linalg.norm(p["L"], 2) * np.linalg.norm(half)
+    return Assumptions((float(eig[0]), float(eig[-1])), float(p["skew"]), coupling,
+                       float(drift), float(p["w_amp"] * np.sqrt(n)))
+
+
+def _check_own_bounds(case, p, spec) -> bool:
+    from stt_codegen.design.samples import sample_tube
+    from stt_codegen.verify.sampled import check_sampled
+    _, design = _designed(case)
+    key = ("samples", case)
+    if key not in _CACHE:
+        _CACHE[key] = sample_tube(design)
+    bounds = own_bounds(p, spec)
+    if bounds.input_gain[0] <= 0:
+        return False
+    return bool(check_sampled(design, _CACHE[key], bounds).passed)
 
 
 def study(args) -> dict:
@@ -129,10 +176,62 @@ def sweeps() -> None:
             print(f"{case} {label}: {' '.join(cells)}")
 
 
+def _declared_setup(case):
+    """``(spec, design at the lowest rate, samples)`` for :data:`DECLARED`, cached."""
+    key = ("declared", case)
+    if key not in _CACHE:
+        from stt_codegen.design.gain import lowest_rate
+        from stt_codegen.spec.loader import Assumptions
+        spec, design = _designed(case)
+        a = Assumptions(DECLARED["input_gain"], DECLARED["input_gain_skew"],
+                        DECLARED["input_gain_coupling"], DECLARED["drift_bound"],
+                        DECLARED["disturbance_bound"])
+        rate, gain = lowest_rate(design, a)
+        if rate is None:
+            raise SystemExit(f"{case}: no rate passes the sampled check for {DECLARED}")
+        spec = dataclasses.replace(spec, rate_hz=rate, assumptions=a)
+        _CACHE[key] = (spec, dataclasses.replace(design, rate_hz=rate, gain=gain))
+    return _CACHE[key]
+
+
+def declared_one(args) -> dict:
+    """One plant within :data:`DECLARED` on one case, at the derived gain and rate."""
+    from stt_codegen.runtime.simulate import simulate
+    from test_plants_support import plant_system, plant_within
+    case, index = args
+    spec, design = _declared_setup(case)
+    rng = np.random.default_rng([CASES.index(case), index, 13])
+    plant = plant_system(plant_within(rng, spec.assumptions, spec.state_space))
+    r = simulate(spec, design, backend="c", plant=plant)
+    return {"case": case, "index": index, "rate_hz": design.rate_hz, "gain": design.gain,
+            "satisfied": bool(r.satisfied), "in_tube": bool(r.stayed_in_tube),
+            "collision": bool(r.collision), "left": bool(r.left_state_space)}
+
+
+def declared(runs: int, out: str | None) -> int:
+    jobs = [(case, i) for case in CASES for i in range(runs)]
+    start = time.perf_counter()
+    for case in CASES:
+        spec, design = _declared_setup(case)
+        print(f"{case}: declared {DECLARED}: rate {design.rate_hz:g} Hz, gain {design.gain:.4g}")
+    with ProcessPoolExecutor() as pool:
+        rows = list(pool.map(declared_one, jobs, chunksize=4))
+    held = sum(r["satisfied"] and r["in_tube"] for r in rows)
+    print(f"{len(rows)} plants within the declared bounds ({runs} per case) in "
+          f"{time.perf_counter() - start:.0f} s: {held} hold, {len(rows) - held} fail")
+    if out:
+        Path(out).write_text(json.dumps(rows, indent=1))
+    return 0 if held == len(rows) else 1
+
+
 def main(argv: list[str]) -> int:
     if "--sweeps" in argv:
         sweeps()
         return 0
+    if "--declared" in argv:
+        rest = [a for a in argv if a != "--declared"]
+        runs = int(rest[0]) if rest and not rest[0].startswith("-") else 100
+        return declared(runs, rest[rest.index("--out") + 1] if "--out" in rest else None)
     runs = int(argv[0]) if argv and not argv[0].startswith("-") else 100
     out = argv[argv.index("--out") + 1] if "--out" in argv else None
     jobs = [(case, i) for case in CASES for i in range(runs)]
@@ -148,6 +247,12 @@ def main(argv: list[str]) -> int:
         classes[r["class"]] = classes.get(r["class"], 0) + 1
     for name, count in sorted(classes.items(), key=lambda kv: -kv[1]):
         print(f"  {count:5d}  {100 * count / total:5.1f} %  {name}")
+    accepted = [r for r in rows if r["check_accepts"]]
+    bad = [r for r in accepted if r["class"] != "ok"]
+    flagged = [r for r in rows if not r["check_accepts"]]
+    print(f"sampled check on each plant's own bounds: accepts {len(accepted)}, of which "
+          f"{len(bad)} fail; flags {len(flagged)}, of which "
+          f"{sum(r['class'] != 'ok' for r in flagged)} fail")
     nominal = [r for r in rows if r["g_norm"] <= 1.0]
     if nominal:
         held = sum(r["class"] == "ok" for r in nominal)

@@ -526,6 +526,31 @@ def _enclose(design: TubeDesign, pieces: _Pieces, alpha_min, alpha_max, t0, t1) 
                      ratio.max(axis=1), pieces.psi_lo, pieces.psi_hi)
 
 
+def enclose_tube(design: TubeDesign, samples) -> Enclosure:
+    """Enclosures of ``gamma_L``, ``gamma_U`` on every sampling interval of ``samples``.
+
+    ``alpha`` is the deployed sequence of ``samples`` (:func:`~.samples.sample_tube`),
+    linearly interpolated, so on ``[t_k, t_{k+1}]`` it lies between ``alpha_k`` and
+    ``alpha_{k+1}``; the other pieces are enclosed as in :func:`certify_tube`. Per sample:
+    for checks that follow the sampled loop step by step (``verify``'s sampled check).
+
+    Parameters
+    ----------
+    design : TubeDesign
+    samples : TubeSamples
+        ``t`` (N,) and ``alpha`` (N, 2n).
+
+    Returns
+    -------
+    Enclosure
+        ``N - 1`` intervals.
+    """
+    t0, t1 = samples.t[:-1], samples.t[1:]
+    a0, a1 = samples.alpha[:-1], samples.alpha[1:]
+    return _enclose(design, _pieces(design, t0, t1), np.minimum(a0, a1), np.maximum(a0, a1),
+                    t0, t1)
+
+
 def _breakpoints(design: TubeDesign) -> tuple[list[int], int]:
     """Initial partition (sample indices) and ``T``'s index, after which ``psi`` is constant."""
     rate = design.rate_hz

@@ -18,7 +18,8 @@ The paper leaves several points open or, read literally, fails (see the README's
   the bump, whose sharpness ``k^j`` the spec fixes, is within ``delta_B / 2`` of its peak
   where the reach tube first and last overlaps the obstacle.
 * **Default gain** of law (13): half the sampled-loop stability limit at the tube's
-  narrowest point (see :func:`default_gain`).
+  narrowest point, for the plants the spec's ``[assumptions]`` declare
+  (:func:`~stt_codegen.design.gain.derived_gain`).
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..tube import reference
+from .gain import derived_gain
 from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, Certificate, certify_tube
 from .result import METHOD_PAPER, METHOD_VIA, Design
 from .via import via_design
@@ -334,18 +336,6 @@ def _ordered(circumvents) -> tuple[Circumvent, ...]:
     return tuple(sorted(circumvents, key=lambda c: (c.dimension, c.side, c.obstacle)))
 
 
-def default_gain(design: TubeDesign, min_width: float) -> float:
-    """Default ``k`` of law (13): half the sampled-loop stability limit at the narrowest tube.
-
-    Linearizing the sampled loop of ``x_dot = u`` under law (13) at ``e = 0`` gives
-    ``e+ = (1 - 16 k dt / gamma_d^2) e``: stable for ``k < gamma_d^2 / (8 dt)``. The default
-    is ``gamma_d,min^2 / (16 dt)``, where ``gamma_d,min`` is the certified lower bound of the
-    tube's width (:attr:`~stt_codegen.design.certificate.Certificate.min_width`).
-    """
-    dt = 1.0 / design.rate_hz
-    return min_width**2 / (16.0 * dt)
-
-
 def design_tube(spec: Spec) -> Design:
     """Design the spatiotemporal tube of a spec and certify it.
 
@@ -360,7 +350,8 @@ def design_tube(spec: Spec) -> Design:
     Returns
     -------
     Design
-        The tube with its gain (the spec's ``controller.gain``, or :func:`default_gain`),
+        The tube with its gain (the spec's ``controller.gain``, or
+        :func:`~stt_codegen.design.gain.derived_gain` at the certified narrowest width),
         the method used, its check and certificate (every ``t >= 0``) and the design's
         wall time in seconds.
 
@@ -392,7 +383,8 @@ def design_tube(spec: Spec) -> Design:
         if len(errors) == 1:
             raise DesignError(next(iter(errors.values())))
         raise DesignError(f"{errors[METHOD_PAPER]}; with via points: {errors[METHOD_VIA]}")
-    gain = spec.gain if spec.gain is not None else default_gain(tube, check.min_width)
+    gain = (spec.gain if spec.gain is not None
+            else derived_gain(check.min_width, tube.rate_hz, spec.assumptions))
     return Design(replace(tube, gain=gain), used, check, time.perf_counter() - started)
 
 

@@ -10,6 +10,7 @@ import control as ct
 import numpy as np
 
 from ..errors import SpecError
+from ..spec.loader import LinearPlant
 
 #: Number of sinusoids summed in each disturbance component.
 DISTURBANCE_TERMS = 3
@@ -68,8 +69,40 @@ def single_integrator(dimension: int, disturbance: Disturbance) -> ct.NonlinearI
                     name="single_integrator")
 
 
-def make_plant(model: str, dimension: int, amplitude: float, seed: int = 0) -> ct.NonlinearIOSystem:
+def linear_plant(a, g, c, disturbance: Disturbance) -> ct.NonlinearIOSystem:
+    """``x_dot = a x + c + g u + w(t)``: the spec's ``model = "linear"``; outputs the state.
+
+    Parameters
+    ----------
+    a, g : array_like, shape (n, n)
+        Drift and input matrices.
+    c : array_like, shape (n,)
+        Constant drift, state units per second.
+    disturbance : Disturbance
+    """
+    a, g, c = (np.array(m, dtype=float) for m in (a, g, c))
+    n = c.size
+
+    def rhs(t, x, u, params):
+        return a @ x + c + g @ np.asarray(u, dtype=float) + disturbance(t)
+
+    return ct.nlsys(rhs, None, inputs=n, states=n, outputs=n, name="linear_plant")
+
+
+def make_plant(model: str, dimension: int, amplitude: float, seed: int = 0,
+               linear: LinearPlant | None = None) -> ct.NonlinearIOSystem:
     """The plant named in a spec's ``[plant]`` table.
+
+    Parameters
+    ----------
+    model : str
+        One of :data:`stt_codegen.spec.loader.PLANT_MODELS`.
+    dimension : int
+    amplitude : float
+        Bound on every ``|w_i|`` (:class:`Disturbance`).
+    seed : int
+    linear : LinearPlant, optional
+        The matrices of the ``linear`` model (default ``a = 0``, ``g = I``, ``c = 0``).
 
     Raises
     ------
@@ -77,6 +110,13 @@ def make_plant(model: str, dimension: int, amplitude: float, seed: int = 0) -> c
         Unknown model, or a dimension the model does not have.
     """
     disturbance = Disturbance(dimension, amplitude, seed)
+    if model == "linear":
+        if linear is None:
+            eye = np.eye(dimension)
+            return linear_plant(0 * eye, eye, np.zeros(dimension), disturbance)
+        if len(linear.c) != dimension:
+            raise SpecError("plant.c", f"has {len(linear.c)} entries for {dimension} states")
+        return linear_plant(linear.a, linear.g, linear.c, disturbance)
     if model == "omnidirectional":
         if dimension != 3:
             raise SpecError("plant.model", "the omnidirectional robot has 3 states")

@@ -134,7 +134,8 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
     check_step_budget(int(math.ceil(horizon * design.rate_hz - 1e-9)), horizon, design.rate_hz)
     controller = make_controller(backend, design)
     if plant is None:
-        plant = make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed)
+        plant = make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed,
+                           spec.linear_plant)
 
     def rhs(t, x, u):
         return plant.dynamics(t, x, u)

@@ -20,7 +20,7 @@ from typing import Any
 from ..errors import SpecError
 
 NAME_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_-]{0,63}")
-PLANT_MODELS = ("omnidirectional", "single-integrator")
+PLANT_MODELS = ("omnidirectional", "single-integrator", "linear")
 #: Fraction of the available room used by the default half-widths ``d_0`` and ``d_T``.
 DEFAULT_HALF_WIDTH_FRACTION = 0.8
 #: Largest state dimension accepted (the generated code unrolls per dimension).
@@ -28,7 +28,7 @@ MAX_DIMENSION = 64
 MAX_OBSTACLES = 4096
 
 _TOP_KEYS = {"name", "prescribed_time", "state_space", "initial", "target", "obstacles",
-             "tube", "controller", "plant"}
+             "tube", "controller", "plant", "assumptions"}
 _REQUIRED_TOP = ("name", "prescribed_time", "state_space", "initial", "target")
 _TUBE_DEFAULTS = {
     "delta_b": 0.2,
@@ -41,6 +41,10 @@ _TUBE_DEFAULTS = {
 TUBE_METHODS = ("paper", "via", "auto")
 _CONTROLLER_DEFAULTS: dict[str, float | None] = {"gain": None, "rate_hz": 1000.0}
 _PLANT_DEFAULTS: dict[str, Any] = {"model": "single-integrator", "disturbance_amplitude": 0.1}
+#: Keys of ``[plant]`` that only the ``linear`` model takes.
+_LINEAR_KEYS = ("a", "g", "c")
+_ASSUMPTION_KEYS = ("input_gain", "input_gain_skew", "input_gain_coupling", "drift_bound",
+                    "disturbance_bound")
 
 
 @dataclass(frozen=True)
@@ -173,6 +177,62 @@ class TubeParameters:
 
 
 @dataclass(frozen=True)
+class Assumptions:
+    """What the controller's designer knows about the unknown plant (1), ``[assumptions]``.
+
+    The plant is ``x_dot = f(x) + g(x) u + w``; every bound holds uniformly over the state
+    space ``X`` (and ``w`` over time). Used to derive the default gain ``k`` of law (13)
+    (:mod:`stt_codegen.design.gain`) and by the sampled-data check
+    (:mod:`stt_codegen.verify.sampled`); the controller itself never sees them.
+
+    Attributes
+    ----------
+    input_gain : tuple of float, (g_min, g_max)
+        Bounds on the eigenvalues of the symmetric part ``(g + g^T) / 2`` of ``g(x)``;
+        Assumption 2 asks ``g_min > 0``. Default ``(1, 1)``: ``g = I`` plus a skew part,
+        the plant the default gain has always assumed.
+    input_gain_skew : float
+        Bound on the spectral norm of the skew part ``(g - g^T) / 2``; default 0.
+    input_gain_coupling : float
+        Bound on the Euclidean norm of the off-diagonal part of every row of ``g(x)``:
+        how strongly one input drives the other states. Default
+        ``(g_max - g_min) / 2 + input_gain_skew``, the bound the two above imply; declare
+        a smaller one when the structure of ``g`` is known (0 for a diagonal ``g``).
+    drift_bound : float
+        Bound on the Euclidean norm ``|f(x)|``, state units per second; default 0.
+    disturbance_bound : float
+        Bound on the Euclidean norm ``|w(t)|``, state units per second; default
+        ``sqrt(n)`` times ``plant.disturbance_amplitude`` (the simulated disturbance).
+    declared : tuple of str
+        The keys the spec set explicitly (the others are defaults).
+    """
+
+    input_gain: tuple[float, float] = (1.0, 1.0)
+    input_gain_skew: float = 0.0
+    input_gain_coupling: float = 0.0
+    drift_bound: float = 0.0
+    disturbance_bound: float = 0.0
+    declared: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class LinearPlant:
+    """The ``linear`` plant of ``[plant]``: ``x_dot = a x + c + g u + w``.
+
+    Attributes
+    ----------
+    a, g : tuple of tuple of float, shape (n, n)
+        Rows of the matrices; defaults zero and the identity.
+    c : tuple of float, length n
+        Constant drift; default zero.
+    """
+
+    a: tuple[tuple[float, ...], ...]
+    g: tuple[tuple[float, ...], ...]
+    c: tuple[float, ...]
+
+
+@dataclass(frozen=True)
 class Spec:
     """A validated prescribed-time reach-avoid-stay task and its design parameters.
 
@@ -207,9 +267,14 @@ class Spec:
     rate_hz : float
         Sampling rate of the deployed controller, Hz.
     plant_model : str
-        ``"omnidirectional"`` (eq. (14)) or ``"single-integrator"``; simulation only.
+        ``"omnidirectional"`` (eq. (14)), ``"single-integrator"`` or ``"linear"``;
+        simulation only.
     disturbance_amplitude : float
         Bound on ``|w_i|``; simulation only.
+    linear_plant : LinearPlant or None
+        The matrices of the ``linear`` model (``None`` for the other models).
+    assumptions : Assumptions
+        The ``[assumptions]`` section, defaults filled in.
     source_hash : str
         SHA-256 of the spec file's bytes.
     target_half_width_given : bool
@@ -233,6 +298,8 @@ class Spec:
     rate_hz: float
     plant_model: str
     disturbance_amplitude: float
+    linear_plant: LinearPlant | None = None
+    assumptions: Assumptions = Assumptions()
     source_hash: str = field(default="", compare=False)
     target_half_width_given: bool = True
 
@@ -487,7 +554,7 @@ def _validate(doc: dict) -> Spec:
     rate_hz = _positive(ctrl_t.get("rate_hz", _CONTROLLER_DEFAULTS["rate_hz"]),
                         "controller.rate_hz")
 
-    plant_t = _table(doc, "plant", False, set(_PLANT_DEFAULTS))
+    plant_t = _table(doc, "plant", False, set(_PLANT_DEFAULTS) | set(_LINEAR_KEYS))
     model = plant_t.get("model", _PLANT_DEFAULTS["model"])
     if not isinstance(model, str) or model not in PLANT_MODELS:
         raise SpecError("plant.model", f"must be one of {', '.join(PLANT_MODELS)}, "
@@ -500,14 +567,79 @@ def _validate(doc: dict) -> Spec:
                         "plant.disturbance_amplitude")
     if amplitude < 0:
         raise SpecError("plant.disturbance_amplitude", f"must be non-negative, got {amplitude!r}")
+    linear = _linear_plant(plant_t, model, n)
+    assumptions = _assumptions(_table(doc, "assumptions", False, set(_ASSUMPTION_KEYS)),
+                               n, amplitude)
 
     return Spec(name=name, prescribed_time=t_c, state_space=state_space,
                 initial_set=initial_set, initial_state=x0, initial_half_width=d0,
                 target_set=target_set, target_center=eta, target_half_width=d_t,
                 obstacles=obstacles, unsafe_sets=unsafe_sets, tube=tube, gain=gain,
                 rate_hz=rate_hz,
-                plant_model=model, disturbance_amplitude=amplitude,
+                plant_model=model, disturbance_amplitude=amplitude, linear_plant=linear,
+                assumptions=assumptions,
                 target_half_width_given="half_width" in target_t)
+
+
+def _matrix(value: Any, name: str, n: int) -> tuple[tuple[float, ...], ...]:
+    """An n x n matrix given as a list of n rows of n numbers."""
+    if not isinstance(value, list) or not all(isinstance(row, list) for row in value):
+        raise SpecError(name, f"must be an array of {n} rows (arrays of {n} numbers), "
+                              f"got {_kind(value)}")
+    if len(value) != n:
+        raise SpecError(name, f"must have {n} rows (one per state dimension), got {len(value)}")
+    return tuple(_vector(row, f"{name}[{k}]", n) for k, row in enumerate(value))
+
+
+def _linear_plant(table: dict, model: str, n: int) -> LinearPlant | None:
+    """The matrices ``a``, ``g``, ``c`` of ``[plant]``; only the ``linear`` model takes them."""
+    given = [key for key in _LINEAR_KEYS if key in table]
+    if model != "linear":
+        if given:
+            raise SpecError(f"plant.{given[0]}", f"only the linear model takes a matrix "
+                                                 f"(plant.model is {model!r})")
+        return None
+    identity = tuple(tuple(1.0 if i == j else 0.0 for j in range(n)) for i in range(n))
+    zero = tuple(tuple(0.0 for _ in range(n)) for _ in range(n))
+    a = _matrix(table["a"], "plant.a", n) if "a" in table else zero
+    g = _matrix(table["g"], "plant.g", n) if "g" in table else identity
+    c = _vector(table["c"], "plant.c", n) if "c" in table else tuple(0.0 for _ in range(n))
+    return LinearPlant(a, g, c)
+
+
+def _non_negative(value: Any, name: str) -> float:
+    number = _number(value, name)
+    if number < 0:
+        raise SpecError(name, f"must be non-negative, got {value!r}")
+    return number
+
+
+def _assumptions(table: dict, n: int, amplitude: float) -> Assumptions:
+    """``[assumptions]`` with its defaults (see :class:`Assumptions`)."""
+    g_min, g_max = 1.0, 1.0
+    if "input_gain" in table:
+        value = table["input_gain"]
+        if not isinstance(value, list) or len(value) != 2:
+            raise SpecError("assumptions.input_gain", "must be an array [g_min, g_max] of two "
+                                                      f"numbers, got {_short(value)}")
+        g_min, g_max = (_number(v, f"assumptions.input_gain[{k}]") for k, v in enumerate(value))
+        if g_min <= 0:
+            raise SpecError("assumptions.input_gain", f"g_min = {g_min!r} must be positive "
+                                                      "(Assumption 2)")
+        if g_min > g_max:
+            raise SpecError("assumptions.input_gain", f"g_min = {g_min!r} exceeds "
+                                                      f"g_max = {g_max!r}")
+    skew = _non_negative(table.get("input_gain_skew", 0.0), "assumptions.input_gain_skew")
+    implied = 0.5 * (g_max - g_min) + skew
+    coupling = _non_negative(table.get("input_gain_coupling", implied),
+                             "assumptions.input_gain_coupling")
+    if coupling > implied:
+        coupling = implied          # the other bounds already imply a smaller one
+    drift = _non_negative(table.get("drift_bound", 0.0), "assumptions.drift_bound")
+    disturbance = _non_negative(table.get("disturbance_bound", math.sqrt(n) * amplitude),
+                                "assumptions.disturbance_bound")
+    return Assumptions((g_min, g_max), skew, coupling, drift, disturbance,
+                       tuple(key for key in _ASSUMPTION_KEYS if key in table))
 
 
 #: Default covering tolerance of balls and polytopes, state units.

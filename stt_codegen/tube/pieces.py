@@ -339,7 +339,9 @@ def law_expression(x, gamma_l, gamma_u, gain, n: int) -> tuple:
     e = (2.0 * x - (gamma_u + gamma_l)) / width
     inside = 1.0
     for i in range(n):
-        inside = ca.logic_and(inside, ca.logic_and(ca.fabs(e[i]) < 1.0, gamma_d[i] > 0.0))
+        # judged with the true width: below the GAMMA_D_MIN floor a state outside the tube
+        # must not be reported inside
+        inside = ca.logic_and(inside, ca.fabs(2.0 * x[i] - (gamma_u[i] + gamma_l[i])) < gamma_d[i])
     e_c = ca.fmin(ca.fmax(e, -E_MAX), E_MAX)
     epsilon = ca.log((1.0 + e_c) / (1.0 - e_c))
     xi = 4.0 / (width * (1.0 - e_c ** 2))

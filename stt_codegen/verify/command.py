@@ -23,6 +23,7 @@ from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_omnidirectional, assumption2_single_integrator
 from .check import Check, all_passed
 from .lemma import bump_rate_bound, lemma_checks, reach_rate_bound
+from .sampled import linear_plant_checks, sampled_checks
 from .transform import error_transform_checks
 
 #: Dimension names used in check names.
@@ -59,8 +60,10 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> l
     Returns
     -------
     list of Check
-        In order: Lemma 3.3, the error transform, Assumption 2, the adaptive law (per
-        component of ``alpha``), and the tube certificate.
+        In order: Lemma 3.3, the error transform, Assumption 2 (and, for the linear
+        plant, whether it meets ``[assumptions]``), the adaptive law (per component of
+        ``alpha``), the tube certificate, and the sampled closed loop
+        (:func:`~stt_codegen.verify.sampled.sampled_checks`).
     """
     model = plant or spec.plant_model
     tube_check = check_tube(design, spec)
@@ -87,6 +90,8 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> l
     if model == "omnidirectional":
         checks.append(assumption2_omnidirectional((spec.state_space.lower[2],
                                                    spec.state_space.upper[2])))
+    elif model == "linear":
+        checks += linear_plant_checks(spec)
     else:
         checks.append(assumption2_single_integrator(n))
 
@@ -131,6 +136,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> l
             continue
         checks.append(Check(f"tube.{margin.name.replace(' ', '_')}", margin.passed,
                             margin.detail, {"margin": margin.margin, "time": margin.time}))
+    checks += sampled_checks(spec, design, s, tube_check.certificate)
     return checks
 
 
