@@ -1579,7 +1579,7 @@ def body_newton_iteration(a, alpha, psi, c, A):
 
 
 def body_law(x, gamma_L, gamma_U, gain):
-    """CasADi Function 'body_law' (92 instructions).
+    """CasADi Function 'body_law' (94 instructions).
 
     Parameters
     ----------
@@ -1612,87 +1612,89 @@ def body_law(x, gamma_L, gamma_U, gain):
     w6 = _fmax(w4, w5)
     w7 = 1.0
     w8 = float(x[0])
-    w8 = w8 + w8
-    w2 = w2 + w3
-    w8 = w8 - w2
-    w8 = _div(w8, w6)
-    w2 = -0.9999990463256836
-    w3 = _fmax(w8, w2)
-    w9 = 0.9999990463256836
-    w3 = _fmin(w3, w9)
-    w10 = w3 * w3
-    w10 = w7 - w10
-    w6 = w6 * w10
+    w9 = w8 + w8
+    w10 = w2 + w3
+    w9 = w9 - w10
+    w9 = _div(w9, w6)
+    w10 = -0.9999990463256836
+    w9 = _fmax(w9, w10)
+    w11 = 0.9999990463256836
+    w9 = _fmin(w9, w11)
+    w12 = w9 * w9
+    w12 = w7 - w12
+    w6 = w6 * w12
     w6 = _div(w1, w6)
     w6 = w0 * w6
-    w10 = w7 + w3
-    w3 = w7 - w3
-    w10 = _div(w10, w3)
-    w10 = _log(w10)
-    w6 = w6 * w10
+    w12 = w7 + w9
+    w9 = w7 - w9
+    w12 = _div(w12, w9)
+    w12 = _log(w12)
+    w6 = w6 * w12
     w6 = -w6
     u[0] = w6
     w6 = float(gamma_U[1])
-    w10 = float(gamma_L[1])
-    w3 = w6 - w10
-    w11 = _fmax(w3, w5)
-    w12 = float(x[1])
-    w12 = w12 + w12
-    w6 = w6 + w10
-    w12 = w12 - w6
-    w12 = _div(w12, w11)
-    w6 = _fmax(w12, w2)
-    w6 = _fmin(w6, w9)
-    w10 = w6 * w6
-    w10 = w7 - w10
-    w11 = w11 * w10
-    w11 = _div(w1, w11)
-    w11 = w0 * w11
-    w10 = w7 + w6
-    w6 = w7 - w6
-    w10 = _div(w10, w6)
-    w10 = _log(w10)
-    w11 = w11 * w10
-    w11 = -w11
-    u[1] = w11
-    w11 = float(gamma_U[2])
-    w10 = float(gamma_L[2])
-    w6 = w11 - w10
-    w5 = _fmax(w6, w5)
-    w13 = float(x[2])
-    w13 = w13 + w13
-    w11 = w11 + w10
-    w13 = w13 - w11
-    w13 = _div(w13, w5)
-    w2 = _fmax(w13, w2)
-    w2 = _fmin(w2, w9)
-    w9 = w2 * w2
-    w9 = w7 - w9
-    w5 = w5 * w9
+    w12 = float(gamma_L[1])
+    w9 = w6 - w12
+    w13 = _fmax(w9, w5)
+    w14 = float(x[1])
+    w15 = w14 + w14
+    w16 = w6 + w12
+    w15 = w15 - w16
+    w15 = _div(w15, w13)
+    w15 = _fmax(w15, w10)
+    w15 = _fmin(w15, w11)
+    w16 = w15 * w15
+    w16 = w7 - w16
+    w13 = w13 * w16
+    w13 = _div(w1, w13)
+    w13 = w0 * w13
+    w16 = w7 + w15
+    w15 = w7 - w15
+    w16 = _div(w16, w15)
+    w16 = _log(w16)
+    w13 = w13 * w16
+    w13 = -w13
+    u[1] = w13
+    w13 = float(gamma_U[2])
+    w16 = float(gamma_L[2])
+    w15 = w13 - w16
+    w5 = _fmax(w15, w5)
+    w17 = float(x[2])
+    w18 = w17 + w17
+    w19 = w13 + w16
+    w18 = w18 - w19
+    w18 = _div(w18, w5)
+    w18 = _fmax(w18, w10)
+    w18 = _fmin(w18, w11)
+    w11 = w18 * w18
+    w11 = w7 - w11
+    w5 = w5 * w11
     w1 = _div(w1, w5)
     w0 = w0 * w1
-    w1 = w7 + w2
-    w2 = w7 - w2
-    w1 = _div(w1, w2)
+    w1 = w7 + w18
+    w18 = w7 - w18
+    w1 = _div(w1, w18)
     w1 = _log(w1)
     w0 = w0 * w1
     w0 = -w0
     u[2] = w0
+    w8 = w8 + w8
+    w2 = w2 + w3
+    w8 = w8 - w2
     w8 = math.fabs(w8)
-    w8 = 1.0 if w8 < w7 else 0.0
-    w0 = 0.0
-    w4 = 1.0 if w0 < w4 else 0.0
-    w8 = 1.0 if w8 != 0.0 and w4 != 0.0 else 0.0
-    w8 = 1.0 if w7 != 0.0 and w8 != 0.0 else 0.0
-    w12 = math.fabs(w12)
-    w12 = 1.0 if w12 < w7 else 0.0
-    w3 = 1.0 if w0 < w3 else 0.0
-    w12 = 1.0 if w12 != 0.0 and w3 != 0.0 else 0.0
-    w8 = 1.0 if w8 != 0.0 and w12 != 0.0 else 0.0
-    w13 = math.fabs(w13)
-    w13 = 1.0 if w13 < w7 else 0.0
-    w0 = 1.0 if w0 < w6 else 0.0
-    w13 = 1.0 if w13 != 0.0 and w0 != 0.0 else 0.0
-    w8 = 1.0 if w8 != 0.0 and w13 != 0.0 else 0.0
-    inside[0] = w8
+    w8 = 1.0 if w8 < w4 else 0.0
+    w7 = 1.0 if w7 != 0.0 and w8 != 0.0 else 0.0
+    w14 = w14 + w14
+    w6 = w6 + w12
+    w14 = w14 - w6
+    w14 = math.fabs(w14)
+    w14 = 1.0 if w14 < w9 else 0.0
+    w7 = 1.0 if w7 != 0.0 and w14 != 0.0 else 0.0
+    w17 = w17 + w17
+    w13 = w13 + w16
+    w17 = w17 - w13
+    w17 = math.fabs(w17)
+    w17 = 1.0 if w17 < w15 else 0.0
+    w7 = 1.0 if w7 != 0.0 and w17 != 0.0 else 0.0
+    inside[0] = w7
     return (u, inside)
