@@ -13,7 +13,7 @@ from stt_codegen.spec.loader import load_spec
 
 def _generate(path):
     spec = load_spec(str(path))
-    design, _ = design_tube(spec)
+    design = design_tube(spec).tube
     return generate_files(spec, design, Options(("c", "python"), "double"))
 
 

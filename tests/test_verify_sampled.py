@@ -89,7 +89,9 @@ def test_g_3_with_the_old_gain_fails_in_simulation_and_in_the_check():
     """The README's limit case (issue 7): flagged before deployment now."""
     spec, design, _ = designed("omnirobot-s2")
     tight = Assumptions((3.0, 3.0), 0.0, 0.0, 0.0, spec.assumptions.disturbance_bound)
-    assert not check_sampled(design, samples_of("omnirobot-s2"), tight).passed
+    s = samples_of("omnirobot-s2")
+    old_gain = sampled_width(s) ** 2 * design.rate_hz / 16.0   # the former default, 0.27
+    assert not check_sampled(design, s, tight, old_gain).passed
 
 
 SOUND = settings(derandomize=True, deadline=None, database=None, max_examples=12,
