@@ -1,15 +1,18 @@
-"""Figures of a closed-loop run, in the manner of the paper's Fig. 3."""
+"""Figures of a closed-loop run, in the manner of the paper's Fig. 3.
+
+The figure is a :class:`matplotlib.figure.Figure` drawn on an explicit Agg canvas: this
+module neither selects matplotlib's global backend nor uses ``pyplot``, so importing it
+(also into a notebook) changes no global state.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.patches import Circle, Polygon, Rectangle  # noqa: E402
-from scipy.spatial import ConvexHull  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle, Polygon, Rectangle
+from scipy.spatial import ConvexHull
 
 from ..tube import reference
 from .simulate import SimulationResult
@@ -69,7 +72,8 @@ def plot_run(spec: Spec, design: TubeDesign, result: SimulationResult, path: str
     traj = result.trajectory
     n = spec.dimension
     g_l, g_u, _, _ = reference.adaptive_tube(design, traj.t, traj.alpha)
-    fig = plt.figure(figsize=(11, 2.6 * max(n, 2)), layout="constrained")
+    fig = Figure(figsize=(11, 2.6 * max(n, 2)), layout="constrained")
+    FigureCanvasAgg(fig)
     grid = fig.add_gridspec(n, 2, width_ratios=[1.1, 1.4])
     if n >= 2:
         ax = fig.add_subplot(grid[:, 0])
@@ -100,6 +104,5 @@ def plot_run(spec: Spec, design: TubeDesign, result: SimulationResult, path: str
         if i == 0:
             ax.legend(loc="best", fontsize=7)
     out = Path(path)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
+    fig.savefig(out, dpi=110, format="png")
     return out

@@ -128,7 +128,7 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
     t_c = spec.prescribed_time
     horizon = t_c if horizon is None else float(horizon)
     if not math.isfinite(horizon) or horizon <= 0:
-        raise SpecError("--horizon", f"must be a positive number of seconds, got {horizon!r}")
+        raise SpecError("horizon", f"must be a positive number of seconds, got {horizon!r}")
     controller = make_controller(backend, design)
     if plant is None:
         plant = make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed)

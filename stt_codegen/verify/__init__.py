@@ -56,9 +56,3 @@ __all__ = [
     "check_adaptive_law_numeric",
     "simulate_alpha",
 ]
-
-
-def register_cli(subparsers) -> None:
-    """Add ``stt-codegen verify`` (see :mod:`.command`)."""
-    from .command import register_cli as _register
-    _register(subparsers)

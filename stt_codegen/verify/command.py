@@ -144,10 +144,10 @@ def verify_spec(spec: Spec, plant: str | None = None) -> list[Check]:
 
 def _cmd_verify(args: argparse.Namespace) -> int:
     if args.plant is not None and args.plant not in PLANT_MODELS:
-        raise SpecError("--plant", f"must be one of {', '.join(PLANT_MODELS)}")
+        raise SpecError("plant", f"must be one of {', '.join(PLANT_MODELS)}")
     spec = load_spec(args.spec)
     if args.plant == "omnidirectional" and spec.dimension != 3:
-        raise SpecError("--plant", "the omnidirectional robot has 3 states")
+        raise SpecError("plant", "the omnidirectional robot has 3 states")
     checks = verify_spec(spec, args.plant)
     if args.json:
         print(json.dumps([{"name": c.name, "passed": c.passed, "detail": c.detail}
@@ -160,9 +160,8 @@ def _cmd_verify(args: argparse.Namespace) -> int:
     return 0 if all_passed(checks) else 1
 
 
-def register_cli(subparsers) -> None:
-    """Add the ``verify`` subcommand."""
-    p = subparsers.add_parser("verify", help="check the paper's lemmas and certify the tube")
+def configure_verify(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen verify``."""
     p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
     p.add_argument("--json", action="store_true", help="print a JSON list of checks")
     p.add_argument("--plant", default=None, metavar="MODEL",
