@@ -14,15 +14,13 @@ def cmd_generate(args: argparse.Namespace) -> int:
     """``stt-codegen generate SPEC -o DIR [--lang c,python] [--precision double|single]``."""
     from ..design.search import design_tube
     from ..spec.loader import load_spec
-    from .generate import generate_files
-    from .output import write_generation
-    options = parse_options(args.languages, args.precision)
+    from .api import generate
+    parse_options(args.languages, args.precision)   # bad options fail before the design
     spec = load_spec(args.spec)
     design, _ = design_tube(spec)
-    files = generate_files(spec, design, options)
-    write_generation(Path(args.out_dir), files)
-    print(f"wrote {len(files)} files for {spec.name} ({', '.join(options.langs)}, "
-          f"{options.precision}) into {args.out_dir}")
+    files = generate(spec, design, Path(args.out_dir), args.languages, args.precision)
+    print(f"wrote {len(files)} files for {spec.name} ({args.languages}, "
+          f"{args.precision}) into {args.out_dir}")
     return 0
 
 

@@ -9,9 +9,11 @@ the field and the reason.
 from __future__ import annotations
 
 import hashlib
+import json
 import math
 import re
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -240,6 +242,38 @@ class Spec:
         """Every obstacle as a full-dimensional box."""
         return [o.box(self.state_space) for o in self.obstacles]
 
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> "Spec":
+        """Validate a spec given as a dictionary, the same document as a TOML file.
+
+        Parameters
+        ----------
+        data : mapping
+            The spec's tables as nested dicts and lists, exactly as :mod:`tomllib` would
+            read the file: ``{"name": ..., "prescribed_time": ..., "state_space":
+            {"lower": [...], "upper": [...]}, ...}`` (see the README's *Spec format*).
+
+        Returns
+        -------
+        Spec
+            ``source_hash`` is the SHA-256 of the validated document as canonical JSON
+            (sorted keys), since there are no file bytes.
+
+        Raises
+        ------
+        SpecError
+            As :func:`load_spec`: the field and the reason.
+        """
+        if not isinstance(data, Mapping):
+            raise SpecError("", f"a spec is a table (dict), got {_kind(data)}")
+        try:
+            doc = _as_document(data)
+        except RecursionError:
+            raise SpecError("", "nested too deeply") from None
+        spec = _validate(doc)
+        canonical = json.dumps(doc, sort_keys=True, default=repr).encode()
+        return _replace_hash(spec, hashlib.sha256(canonical).hexdigest())
+
 
 # --------------------------------------------------------------------------- loading
 
@@ -301,6 +335,15 @@ def parse_spec(data: bytes | str) -> Spec:
         raise SpecError("", "malformed TOML: nested too deeply") from None
     spec = _validate(doc)
     return _replace_hash(spec, hashlib.sha256(raw).hexdigest())
+
+
+def _as_document(value: Any) -> Any:
+    """A Python value as TOML would read it: mappings as dicts, tuples as lists."""
+    if isinstance(value, Mapping):
+        return {k: _as_document(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_as_document(v) for v in value]
+    return value
 
 
 def _replace_hash(spec: Spec, digest: str) -> Spec:
