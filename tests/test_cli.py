@@ -8,6 +8,9 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import CASES
+
+from stt_codegen.spec.loader import bundled_cases
 
 REQUIRED_KEYS = {"spec", "backend", "satisfied", "reached", "reach_time", "prescribed_time",
                  "collision", "min_obstacle_clearance", "left_state_space", "stayed_in_tube",
@@ -23,6 +26,11 @@ def test_cases_lists_bundled_specs():
     out = run("cases")
     assert out.returncode == 0
     assert out.stdout.split() == ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3"]
+
+
+def test_bundled_cases_are_the_paper_cases():
+    """The conftest's CASES (the parameters of the ``case`` fixture) are the bundled specs."""
+    assert bundled_cases() == CASES
 
 
 def test_simulate_json_reports_definition_2_1():
