@@ -17,9 +17,9 @@ checkout/incref functions of CasADi 3.8.2 are empty when ``with_mem`` is false, 
 nothing mutable is lost; the kept code has no file-scope variable at all (checked by
 :func:`check_no_mutable_state`, and by the tests on the compiled object's ``.data``/``.bss``).
 
-The output is tied to the pinned CasADi version (see ``paper-notes.md``): the slicing
-patterns are checked and any surprise raises :class:`CodegenError` rather than
-producing wrong code.
+The output is tied to the pinned CasADi version (see ``docs/design-notes.md``, facts about
+CasADi's code generation): the slicing patterns are checked and any surprise raises
+:class:`CodegenError` rather than producing wrong code.
 """
 
 from __future__ import annotations
