@@ -107,6 +107,27 @@ def test_no_import_cycle_between_the_packages_modules():
     assert find_cycle(import_graph()) is None
 
 
+def test_the_architecture_document_states_the_dependencies():
+    """docs/architecture.md's table "package | imports" is the import graph, by package."""
+    doc = (REPO / "docs" / "architecture.md").read_text()
+    table = doc[doc.index("| package | imports |"):].split("\n\n", 1)[0]
+    stated = {}
+    for row in table.splitlines()[2:]:
+        package, imports = row.strip("|").split("|")
+        name = re.findall(r"`([\w.]+)`", package)[0]
+        stated[name] = set(re.findall(r"`([\w.]+)`", imports.split(";")[0]))
+
+    def package_of(module: str) -> str:
+        parts = module.split(".")
+        return parts[1] if len(parts) > 1 else parts[0]
+
+    actual = {package_of(m): set() for m in MODULES}
+    for module, edges in import_graph().items():
+        actual[package_of(module)] |= {package_of(e) for e in edges} - {package_of(module)}
+    actual.pop("cases")            # data files only
+    assert stated == actual
+
+
 def test_no_module_imports_a_private_name_from_another_module():
     """``from x import _y`` anywhere in the package (functions included) is refused."""
     offenders = []
