@@ -18,12 +18,13 @@ from stt_codegen.spec.loader import load_spec  # noqa: E402
 CASES = ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3"]
 
 # Property tests draw the same examples on every run: a fixed seed (derandomize) and no
-# example database. "ci" is the default and what CI uses; HYPOTHESIS_PROFILE=explore draws
-# fresh random examples for a local bug hunt. A test's own @settings still sets
-# max_examples and deadline; it inherits derandomize from the loaded profile.
+# example database. "ci" is the default and the only profile under CI (CI=true);
+# HYPOTHESIS_PROFILE=explore draws fresh random examples for a local bug hunt. A test's
+# own @settings still sets max_examples and deadline; it inherits derandomize from the
+# loaded profile.
 settings.register_profile("ci", derandomize=True, database=None, print_blob=True)
 settings.register_profile("explore", derandomize=False)
-settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+settings.load_profile("ci" if os.environ.get("CI") else os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 
 @lru_cache(maxsize=None)
