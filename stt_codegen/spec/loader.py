@@ -287,6 +287,12 @@ def bundled_cases() -> list[str]:
 def load_spec(spec: str | Path) -> Spec:
     """Load and validate a spec, by bundled name or by file path.
 
+    A spec is one prescribed-time reach-avoid-stay task (Definition 2.1): the state space
+    ``X``, the initial set ``X_0`` and state ``x(0)``, the target ``T``, the unsafe sets
+    and the prescribed time ``t_c`` (seconds), with the tube's parameters (eqs. (2)-(11)),
+    the controller's gain and rate (law (13)) and the plant used in simulation. The format
+    is the README's *Spec format*; :meth:`Spec.from_dict` takes the same as a dict.
+
     Parameters
     ----------
     spec : str or path
@@ -295,6 +301,7 @@ def load_spec(spec: str | Path) -> Spec:
     Returns
     -------
     Spec
+        Frozen; vectors are tuples of length ``n``, the state dimension.
 
     Raises
     ------
