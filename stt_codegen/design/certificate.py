@@ -3,7 +3,7 @@
 The controller keeps ``x(t)`` strictly inside the box ``[gamma_L(t), gamma_U(t)]``
 (Theorem 4.1), so if that box is non-empty, misses every obstacle, stays in the state
 space and, from ``t_c`` on, lies in the target, then Definition 2.1 holds whatever the
-dynamics (docs/design-notes.md, item 11). This module proves those four properties on
+dynamics (design notes, item 11). This module proves those four properties on
 ``[0, t_end]`` for the tube the deployed controller enforces: ``alpha`` is the sequence
 ``alpha_k`` of the controller's own implicit steps, linearly interpolated between the
 sampling instants.
