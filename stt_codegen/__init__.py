@@ -35,7 +35,7 @@ __version__ = "0.1.0"
 _LAZY: dict[str, str] = {
     "Spec": "stt_codegen.spec.loader",
     "load_spec": "stt_codegen.spec.loader",
-    "bundled_cases": "stt_codegen.spec.loader",
+    "bundled_cases": "stt_codegen.cases",
     "TubeDesign": "stt_codegen.tube.parameters",
     "design_tube": "stt_codegen.design.search",
     "generate": "stt_codegen.codegen.api",
@@ -51,7 +51,8 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .codegen.api import generate
     from .design.search import design_tube
     from .runtime.simulate import SimulationResult, simulate
-    from .spec.loader import Spec, bundled_cases, load_spec
+    from .cases import bundled_cases
+    from .spec.loader import Spec, load_spec
     from .tube.parameters import TubeDesign
     from .verify.check import VerificationReport
     from .verify.command import verify

@@ -49,6 +49,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
                  "stt_codegen.embedded.cli:configure_embedded"),
     "bench": ("benchmarks: random arenas vs planners, step cost, scaling",
               "stt_codegen.bench.cli:configure_bench"),
+    "schema": ("print the JSON Schema of spec files (for editors and tools)",
+               "stt_codegen.cli:configure_schema"),
 }
 
 #: Error kind -> exit code; the first matching row wins.
@@ -85,7 +87,7 @@ def _design(spec_arg: str):
 
 
 def _cmd_cases(args: argparse.Namespace) -> int:
-    from .spec.loader import bundled_cases
+    from .cases import bundled_cases
     for name in bundled_cases():
         print(name)
     return 0
@@ -143,7 +145,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from .codegen import Options, generate_files, write_generation
     from .runtime.plots import plot_run
     from .runtime.simulate import simulate
-    from .spec.loader import bundled_cases
+    from .cases import bundled_cases
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print(f"For every bundled case: design the tube, generate the C and Python controllers "
@@ -164,6 +166,17 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 def configure_cases(p: argparse.ArgumentParser) -> None:
     """Arguments of ``stt-codegen cases`` (none)."""
     p.set_defaults(handler=_cmd_cases)
+
+
+def _cmd_schema(args: argparse.Namespace) -> int:
+    from .spec.schema import json_schema
+    print(json.dumps(json_schema(), indent=2, sort_keys=True))
+    return 0
+
+
+def configure_schema(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen schema`` (none)."""
+    p.set_defaults(handler=_cmd_schema)
 
 
 def _backend_argument(p: argparse.ArgumentParser) -> None:

@@ -87,7 +87,7 @@ def test_library_errors_do_not_name_command_line_flags():
 
 
 HEAVY = ("casadi", "sympy", "matplotlib", "numpy", "scipy", "control", "jinja2", "networkx",
-         "distributed", "ompl")
+         "distributed", "ompl", "pydantic")
 
 
 def _imported_after(code: str) -> dict:

@@ -15,14 +15,15 @@ import re
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from ..cases import bundled_cases, bundled_spec_bytes
 from ..errors import SpecError
+from .schema import (NAME_REGEX, PLANT_MODELS, ControllerTable, PlantTable, TubeTable,
+                     check_document, key_name)
 
-NAME_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_-]{0,63}")
-PLANT_MODELS = ("omnidirectional", "single-integrator")
+NAME_PATTERN = re.compile(NAME_REGEX)
 #: Fraction of the available room used by the default half-widths ``d_0`` and ``d_T``.
 DEFAULT_HALF_WIDTH_FRACTION = 0.8
 #: Largest state dimension accepted (the generated code unrolls per dimension).
@@ -32,16 +33,11 @@ MAX_OBSTACLES = 4096
 _TOP_KEYS = {"name", "prescribed_time", "state_space", "initial", "target", "obstacles",
              "tube", "controller", "plant"}
 _REQUIRED_TOP = ("name", "prescribed_time", "state_space", "initial", "target")
-_TUBE_DEFAULTS = {
-    "delta_b": 0.2,
-    "circumvent_sharpness": 0.01,
-    "theta0": 0.01,
-    "kappa": 5.0,
-    "mu": 1.0,
-    "smoothness": 50.0,
-}
-_CONTROLLER_DEFAULTS: dict[str, float | None] = {"gain": None, "rate_hz": 1000.0}
-_PLANT_DEFAULTS: dict[str, Any] = {"model": "single-integrator", "disturbance_amplitude": 0.1}
+# the defaults are the schema's (spec/schema.py), so that editors show the same ones
+_TUBE_DEFAULTS = {k: f.default for k, f in TubeTable.model_fields.items()}
+_CONTROLLER_DEFAULTS: dict[str, float | None] = {
+    k: f.default for k, f in ControllerTable.model_fields.items()}
+_PLANT_DEFAULTS: dict[str, Any] = {k: f.default for k, f in PlantTable.model_fields.items()}
 
 
 @dataclass(frozen=True)
@@ -278,12 +274,6 @@ class Spec:
 # --------------------------------------------------------------------------- loading
 
 
-def bundled_cases() -> list[str]:
-    """Names of the bundled specs, sorted."""
-    folder = resources.files("stt_codegen.cases")
-    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
-
-
 def load_spec(spec: str | Path) -> Spec:
     """Load and validate a spec, by bundled name or by file path.
 
@@ -311,7 +301,7 @@ def load_spec(spec: str | Path) -> Spec:
     """
     text = str(spec)
     if text in bundled_cases() and not Path(text).exists():
-        data = resources.files("stt_codegen.cases").joinpath(text + ".toml").read_bytes()
+        data = bundled_spec_bytes(text)
     else:
         path = Path(text)
         try:
@@ -378,11 +368,7 @@ def _no_unknown(table: dict, allowed: set[str], where: str) -> None:
     unknown = sorted(set(table) - allowed)
     if unknown:
         prefix = f"{where}." if where else ""
-        key = unknown[0]
-        if not re.fullmatch(r"[A-Za-z0-9_-]{1,64}", key):
-            # an empty, long or odd key (newlines...) is quoted: the message names it on one line
-            key = repr(key) if len(key) <= 64 else repr(key[:64]) + "..."
-        raise SpecError(f"{prefix}{key}",
+        raise SpecError(f"{prefix}{key_name(unknown[0])}",
                         f"unknown key (allowed: {', '.join(sorted(allowed))})")
 
 
@@ -462,6 +448,7 @@ def _half_width(table: dict, name: str, center: tuple[float, ...], box: Box,
 
 
 def _validate(doc: dict) -> Spec:
+    check_document(doc)     # types, known keys, finite numbers (spec/schema.py)
     _no_unknown(doc, _TOP_KEYS, "")
     for key in _REQUIRED_TOP:
         if key not in doc:
