@@ -171,10 +171,14 @@ class SpecDocument(_Table):
     plant: PlantTable = PlantTable()
 
 
+#: The JSON Schema dialect of :func:`json_schema`: draft 7, which TOML language servers
+#: (Taplo, Even Better TOML, Tombi) read; references are JSON pointers into ``$defs``.
+JSON_SCHEMA_DIALECT = "http://json-schema.org/draft-07/schema#"
+
+
 def json_schema() -> dict[str, Any]:
-    """The JSON Schema (draft 2020-12) of a spec document, from :class:`SpecDocument`."""
-    schema = SpecDocument.model_json_schema()
-    return {"$schema": "https://json-schema.org/draft/2020-12/schema", **schema}
+    """The JSON Schema (draft 7) of a spec document, from :class:`SpecDocument`."""
+    return {"$schema": JSON_SCHEMA_DIALECT, **SpecDocument.model_json_schema()}
 
 
 _TABLES: dict[str, type[_Table]] = {
