@@ -13,15 +13,30 @@ import stt_codegen
 DOC = Path(__file__).parent.parent / "docs" / "library.md"
 
 
+def python_blocks_of(markdown: str) -> list[str]:
+    """The ```python fenced blocks of a markdown text, in order."""
+    return re.findall(r"^```python\n(.*?)^```$", markdown, flags=re.S | re.M)
+
+
 def python_blocks(path: Path) -> list[str]:
     """The ```python fenced blocks of a markdown file, in order."""
-    return re.findall(r"^```python\n(.*?)^```$", path.read_text(), flags=re.S | re.M)
+    return python_blocks_of(path.read_text())
 
 
 def test_the_document_has_the_examples():
     blocks = python_blocks(DOC)
     assert len(blocks) == 2
     assert "stt.load_spec" in blocks[0] and "stt.Spec.from_dict" in blocks[1]
+
+
+def test_the_readme_example_is_the_documents():
+    """The README's "Use from Python" shows the first example of docs/library.md, verbatim
+    (so the test below runs the README's code too)."""
+    readme = (DOC.parent.parent / "README.md").read_text()
+    if "## Use from Python" not in readme:
+        pytest.skip("the README has no section 'Use from Python' yet")
+    section = readme.split("## Use from Python", 1)[1].split("\n## ", 1)[0]
+    assert python_blocks_of(section)[0] == python_blocks(DOC)[0]
 
 
 @pytest.mark.parametrize("k", [0, 1])
