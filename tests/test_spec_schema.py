@@ -112,3 +112,17 @@ def test_defaults_are_the_loaders():
     assert spec.rate_hz == document.controller.rate_hz and spec.gain is None
     assert spec.plant_model == document.plant.model
     assert spec.disturbance_amplitude == document.plant.disturbance_amplitude
+
+
+def test_a_spec_from_a_dict_is_the_spec_from_its_file():
+    from stt_codegen import Spec, load_spec
+    for name in bundled_cases():
+        doc = tomllib.loads(bundled_spec_bytes(name).decode())
+        assert Spec.from_dict(doc) == load_spec(name)
+    doc = tomllib.loads(bundled_spec_bytes("omnirobot-s2").decode())
+    doc["state_space"] = {k: tuple(v) for k, v in doc["state_space"].items()}  # tuples work
+    spec = Spec.from_dict(doc)
+    assert spec == load_spec("omnirobot-s2") and len(spec.source_hash) == 64
+    with pytest.raises(SpecError) as info:
+        Spec.from_dict([("name", "x")])
+    assert info.value.field == "" and "table" in info.value.reason
