@@ -20,14 +20,28 @@ from ..spec.loader import Box, Spec
 from ..tube.parameters import TubeDesign
 
 
-def _rect(ax, box: Box, dims: tuple[int, int], **style) -> None:
+def agg_figure(**kwargs) -> Figure:
+    """A :class:`~matplotlib.figure.Figure` on its own Agg canvas (``kwargs`` go to
+    ``Figure``): it can be saved as PNG without pyplot and without touching matplotlib's
+    global backend."""
+    fig = Figure(**kwargs)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def draw_box(ax, box: Box, dims: tuple[int, int], **style) -> None:
+    """Draw the projection of ``box`` on the state dimensions ``dims`` as a rectangle.
+
+    ``style`` goes to :class:`matplotlib.patches.Rectangle` (``fc``, ``ec``, ``label``...).
+    """
     i, j = dims
     ax.add_patch(Rectangle((box.lower[i], box.lower[j]), box.upper[i] - box.lower[i],
                            box.upper[j] - box.lower[j], **style))
 
 
-def _draw_unsafe_sets(ax, spec: Spec, dims: tuple[int, int]) -> None:
-    """Obstacles as given (filled) and, for balls and polytopes, their covering boxes."""
+def draw_unsafe_sets(ax, spec: Spec, dims: tuple[int, int]) -> None:
+    """Draw the spec's obstacles on the state dimensions ``dims``: as given (filled, labelled
+    ``U1``, ``U2``...) and, for balls and polytopes, their covering boxes (dashed)."""
     for j, unsafe in enumerate(spec.unsafe_sets):
         label = "obstacles" if j == 0 else None
         if not set(dims) <= set(unsafe.dims):
@@ -50,7 +64,7 @@ def _draw_unsafe_sets(ax, spec: Spec, dims: tuple[int, int]) -> None:
         ax.annotate(f"U{j + 1}", center, ha="center", va="center", color="white")
     covered = [o for o in spec.obstacles if spec.unsafe_sets[o.source].kind != "box"]
     for m, obstacle in enumerate(covered):
-        _rect(ax, obstacle.box(spec.state_space), dims, fill=False, ec="tab:red", lw=0.5,
+        draw_box(ax, obstacle.box(spec.state_space), dims, fill=False, ec="tab:red", lw=0.5,
               ls="--", label="covering boxes" if m == 0 else None)
 
 
@@ -72,16 +86,15 @@ def plot_run(spec: Spec, design: TubeDesign, result: SimulationResult, path: str
     traj = result.trajectory
     n = spec.dimension
     g_l, g_u, _, _ = reference.adaptive_tube(design, traj.t, traj.alpha)
-    fig = Figure(figsize=(11, 2.6 * max(n, 2)), layout="constrained")
-    FigureCanvasAgg(fig)
+    fig = agg_figure(figsize=(11, 2.6 * max(n, 2)), layout="constrained")
     grid = fig.add_gridspec(n, 2, width_ratios=[1.1, 1.4])
     if n >= 2:
         ax = fig.add_subplot(grid[:, 0])
         dims = (0, 1)
-        _rect(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
-        _draw_unsafe_sets(ax, spec, dims)
-        _rect(ax, spec.initial_set, dims, fc="tab:blue", alpha=0.3, label="initial set")
-        _rect(ax, spec.target_set, dims, fc="tab:green", alpha=0.35, label="target")
+        draw_box(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
+        draw_unsafe_sets(ax, spec, dims)
+        draw_box(ax, spec.initial_set, dims, fc="tab:blue", alpha=0.3, label="initial set")
+        draw_box(ax, spec.target_set, dims, fc="tab:green", alpha=0.35, label="target")
         ax.plot(traj.x[:, 0], traj.x[:, 1], "k--", lw=1.2, label="trajectory")
         ax.plot(*traj.x[0, :2], "o", color="tab:blue")
         ax.set_xlabel("$x_1$")
