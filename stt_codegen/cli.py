@@ -23,8 +23,8 @@ import functools
 import importlib
 import json
 import os
+import secrets
 import sys
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -68,8 +68,9 @@ def atomic_write_bytes(path: Path, writer) -> None:
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise SpecError("output", f"folder {str(folder)!r} does not exist")
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=path.suffix)
-    os.close(fd)
+    # not mkstemp: its 0600 would stay on the file; O_EXCL with 0666 lets the umask decide
+    tmp = folder / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}{path.suffix}"
+    os.close(os.open(tmp, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666))
     try:
         writer(Path(tmp))
         os.replace(tmp, path)
