@@ -265,6 +265,18 @@ def _reason(error: dict) -> str:
     return error["msg"]
 
 
+#: Arrays of arrays: a row that is not an array is reported as the whole array's fault.
+_NESTED = ("vertices", "a", "g")
+
+
+def _row_as_array(error: dict) -> dict:
+    loc = error["loc"]
+    if (error["type"] == "list_type" and len(loc) >= 2 and isinstance(loc[-1], int)
+            and loc[-2] in _NESTED):
+        return {**error, "loc": loc[:-1], "input": [error["input"]]}
+    return error
+
+
 def _order(fields: tuple[str, ...]):
     """Sort key: unknown top-level keys first, then missing ones, then in field order."""
     def key(error: dict) -> tuple[int, int, int]:
@@ -298,8 +310,8 @@ def check_document(doc: Any) -> SpecDocument:
     try:
         return SpecDocument.model_validate(doc)
     except ValidationError as exc:
-        first = sorted(exc.errors(include_url=False),
-                       key=_order(tuple(SpecDocument.model_fields)))[0]
+        first = _row_as_array(sorted(exc.errors(include_url=False),
+                                     key=_order(tuple(SpecDocument.model_fields)))[0])
         raise SpecError(_field(first["loc"]), _reason(first)) from None
     except RecursionError:
         raise SpecError("", "nested too deeply") from None
