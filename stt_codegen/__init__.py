@@ -1,13 +1,76 @@
 """stt-codegen: spatiotemporal-tube controllers for prescribed-time reach-avoid-stay tasks.
 
 The method is "Prescribed-time Reach-Avoid-Stay Specifications for Unknown Systems: A
-Spatiotemporal Tubes Approach". Main entry points:
+Spatiotemporal Tubes Approach". The front door, in the order of the flow (see
+``docs/library.md`` and ``docs/architecture.md``):
 
-* :func:`stt_codegen.spec.loader.load_spec` - read and validate a spec (TOML);
-* :func:`stt_codegen.design.search.design_tube` - choose windows, circumvents and gain;
-* :func:`stt_codegen.tube.model.build_model` - the CasADi functions of the tube and controller;
-* :mod:`stt_codegen.tube.reference` - the numpy reference of eqs. (2)-(13);
-* :func:`stt_codegen.runtime.simulate.simulate` - the sampled closed loop and Definition 2.1.
+* :func:`load_spec` - read and validate a spec (a bundled case name or a TOML file);
+  :meth:`Spec.from_dict` - the same from a dictionary;
+* :func:`design_tube` - choose windows (5), circumvents (6)-(9) and the gain of law (13),
+  and certify the tube (10) for every ``t``;
+* :func:`generate` - write the standalone C and Python controllers into a folder;
+* :func:`simulate` - run a sampled controller in closed loop and judge Definition 2.1;
+* :func:`verify` - the paper's lemmas, the assumptions and the tube certificate, as a
+  :class:`VerificationReport` (``stt_codegen.verify`` is also the package of the checks:
+  the package is callable, ``verify(spec, design)`` is
+  :func:`stt_codegen.verify.command.verify`);
+* the errors, in three kinds: :class:`SpecError` (bad input), :class:`DesignError` (no
+  design, a negative outcome), :class:`ToolchainError` (a tool or an internal step
+  failed); all are :class:`SttError`.
+
+``import stt_codegen`` is cheap: each name is imported on first use (PEP 562), so the
+command line and a notebook pay only for what they call.
 """
 
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+from .errors import DesignError, SpecError, SttError, ToolchainError
+
 __version__ = "0.1.0"
+
+#: Public name -> module that defines it; imported on first attribute access.
+_LAZY: dict[str, str] = {
+    "Spec": "stt_codegen.spec.loader",
+    "load_spec": "stt_codegen.spec.loader",
+    "bundled_cases": "stt_codegen.cases",
+    "TubeDesign": "stt_codegen.tube.parameters",
+    "design_tube": "stt_codegen.design.search",
+    "Design": "stt_codegen.design.result",
+    "generate": "stt_codegen.codegen.api",
+    "simulate": "stt_codegen.runtime.simulate",
+    "SimulationResult": "stt_codegen.runtime.simulate",
+    "VerificationReport": "stt_codegen.verify.check",
+}
+
+__all__ = ["DesignError", "SpecError", "SttError", "ToolchainError", "__version__", "verify",
+           *sorted(_LAZY)]
+
+if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
+    from .codegen.api import generate
+    from .design.result import Design
+    from .design.search import design_tube
+    from .runtime.simulate import SimulationResult, simulate
+    from .cases import bundled_cases
+    from .spec.loader import Spec, load_spec
+    from .tube.parameters import TubeDesign
+    from .verify.check import VerificationReport
+    from .verify.command import verify
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name on first use (PEP 562)."""
+    if name == "verify":  # the subpackage, which is callable: see its docstring
+        return importlib.import_module("stt_codegen.verify")
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'stt_codegen' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY) | {"verify"})

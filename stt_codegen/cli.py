@@ -1,27 +1,67 @@
-"""The ``stt-codegen`` command line.
+"""The ``stt-codegen`` command line: a thin layer over the library.
 
-Exit codes: 0 success (``simulate``: the task is satisfied), 1 a negative outcome
-(``simulate``: not satisfied; ``check``: drift; ``verify``: a check failed; any command:
-no tube can be designed for the spec), 2 bad input (one line ``error: ...`` on standard
-error, no traceback).
+Exit codes (:data:`EXIT_CODES`, the one place that maps error kinds to codes):
+
+* 0 success (``simulate``: the task is satisfied);
+* 1 a negative outcome: ``simulate``: not satisfied; ``check``: drift; ``verify``: a check
+  failed; any command: no tube can be designed for the spec (:class:`DesignError`);
+* 2 bad input (:class:`SpecError`, or an argument argparse rejects);
+* 3 a tool is missing or failed, or an internal failure (:class:`ToolchainError`);
+* 130 interrupted.
+
+Errors are one line ``error: ...`` on standard error, no traceback.
+
+Subcommands are listed in :data:`COMMANDS` with their one-line help and the function that
+configures their arguments; only the chosen command's module is imported, so ``--help``
+and ``cases`` import nothing heavy.
 """
 
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib
 import json
 import os
+import secrets
 import sys
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
-from .errors import DesignError, SpecError, SttError
+from .errors import DesignError, SpecError, SttError, ToolchainError
 
-#: Modules that add subcommands through ``register_cli(subparsers)``.
-COMMAND_MODULES = ("stt_codegen.design", "stt_codegen.codegen", "stt_codegen.verify",
-                   "stt_codegen.embedded", "stt_codegen.bench")
+#: Every subcommand: name -> (one-line help, ``"module:function"``). The function takes the
+#: subcommand's :class:`argparse.ArgumentParser`, adds its arguments and sets
+#: ``handler=fn(args) -> int`` (the exit code). It is imported only when the command runs.
+COMMANDS: dict[str, tuple[str, str]] = {
+    "cases": ("list the bundled specs", "stt_codegen.cli:configure_cases"),
+    "simulate": ("design the tube and simulate the closed loop",
+                 "stt_codegen.cli:configure_simulate"),
+    "demo": ("generate, compile and run the controller of every bundled case in closed "
+             "loop; print a table, write code and plots", "stt_codegen.cli:configure_demo"),
+    "generate": ("write the C and Python controllers of a spec",
+                 "stt_codegen.codegen.cli:configure_generate"),
+    "check": ("regenerate generated/ and compare (exit 1 on drift)",
+              "stt_codegen.codegen.cli:configure_check"),
+    "verify": ("check the paper's lemmas and certify the tube",
+               "stt_codegen.verify.command:configure_verify"),
+    "embedded": ("run the single-precision controller on an emulated Cortex-M4F",
+                 "stt_codegen.embedded.cli:configure_embedded"),
+    "bench": ("benchmarks: random arenas vs planners, step cost, scaling",
+              "stt_codegen.bench.cli:configure_bench"),
+    "design": ("design and certify the tube (no simulation)",
+               "stt_codegen.design.cli:configure_design"),
+    "schema": ("print the JSON Schema of spec files (for editors and tools)",
+               "stt_codegen.cli:configure_schema"),
+}
+
+#: Error kind -> exit code; the first matching row wins.
+EXIT_CODES: tuple[tuple[type[BaseException], int], ...] = (
+    (SpecError, 2),
+    (DesignError, 1),
+    (ToolchainError, 3),
+    (SttError, 3),
+)
 
 
 def atomic_write_bytes(path: Path, writer) -> None:
@@ -30,8 +70,9 @@ def atomic_write_bytes(path: Path, writer) -> None:
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise SpecError("output", f"folder {str(folder)!r} does not exist")
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=f".{path.name}.", suffix=path.suffix)
-    os.close(fd)
+    # not mkstemp: its 0600 would stay on the file; O_EXCL with 0666 lets the umask decide
+    tmp = folder / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}{path.suffix}"
+    os.close(os.open(tmp, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666))
     try:
         writer(Path(tmp))
         os.replace(tmp, path)
@@ -48,7 +89,7 @@ def _design(spec_arg: str):
 
 
 def _cmd_cases(args: argparse.Namespace) -> int:
-    from .spec.loader import bundled_cases
+    from .cases import bundled_cases
     for name in bundled_cases():
         print(name)
     return 0
@@ -103,7 +144,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from .codegen import Options, generate_files, write_generation
     from .runtime.plots import plot_run
     from .runtime.simulate import simulate
-    from .spec.loader import bundled_cases
+    from .cases import bundled_cases
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print(f"For every bundled case: design the tube, generate the C and Python controllers "
@@ -122,21 +163,32 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return 0 if all_ok else 1
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser with every subcommand."""
-    from .runtime.backends import backend_names
-    parser = argparse.ArgumentParser(
-        prog="stt-codegen",
-        description="Spatiotemporal-tube controllers for prescribed-time reach-avoid-stay tasks.")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-
-    p = sub.add_parser("cases", help="list the bundled specs")
+def configure_cases(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen cases`` (none)."""
     p.set_defaults(handler=_cmd_cases)
 
-    p = sub.add_parser("simulate", help="design the tube and simulate the closed loop")
-    p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
+
+def _cmd_schema(args: argparse.Namespace) -> int:
+    from .spec.schema import json_schema
+    print(json.dumps(json_schema(), indent=2, sort_keys=True))
+    return 0
+
+
+def configure_schema(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen schema`` (none)."""
+    p.set_defaults(handler=_cmd_schema)
+
+
+def _backend_argument(p: argparse.ArgumentParser) -> None:
+    from .runtime.backends import backend_names
     p.add_argument("--backend", default=default_backend(), choices=backend_names(),
                    help="controller implementation (default: %(default)s)")
+
+
+def configure_simulate(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen simulate``."""
+    p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
+    _backend_argument(p)
     p.add_argument("--horizon", type=float, default=None, metavar="S",
                    help="simulated time in seconds (default: t_c)")
     p.add_argument("--seed", type=int, default=0, help="disturbance seed (default: 0)")
@@ -144,17 +196,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(handler=_cmd_simulate)
 
-    p = sub.add_parser("demo", help="generate, compile and run the controller of every bundled "
-                                    "case in closed loop; print a table, write code and plots")
+
+def configure_demo(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen demo``."""
     p.add_argument("--out", default="stt-demo", metavar="DIR",
                    help="folder for the generated code and the plots (default: %(default)s)")
-    p.add_argument("--backend", default=default_backend(), choices=backend_names(),
-                   help="controller implementation (default: %(default)s)")
+    _backend_argument(p)
     p.set_defaults(handler=_cmd_demo)
-
-    for module_name in COMMAND_MODULES:
-        importlib.import_module(module_name).register_cli(sub)
-    return parser
 
 
 def default_backend() -> str:
@@ -162,18 +210,83 @@ def default_backend() -> str:
     return "c"
 
 
+class _CommandParser(argparse.ArgumentParser):
+    """An argument parser that remembers the option of each destination, ``flags[dest]``.
+
+    The dictionary is shared with the parsers of nested subcommands (``bench arenas``), so
+    an error about a library parameter (``SpecError("horizon", ...)``) can be reported
+    with the flag the user typed (``--horizon``).
+    """
+
+    def __init__(self, *args, flags: dict[str, str] | None = None, **kwargs) -> None:
+        self.flags: dict[str, str] = {} if flags is None else flags
+        super().__init__(*args, **kwargs)
+
+    def add_argument(self, *args, **kwargs):
+        action = super().add_argument(*args, **kwargs)
+        if action.option_strings:
+            self.flags.setdefault(action.dest, max(action.option_strings, key=len))
+        return action
+
+    def add_subparsers(self, **kwargs):
+        kwargs.setdefault("parser_class", functools.partial(_CommandParser, flags=self.flags))
+        return super().add_subparsers(**kwargs)
+
+
+def _chosen_command(argv: Sequence[str]) -> str | None:
+    """The subcommand named in ``argv``: the first argument that is not an option."""
+    return next((a for a in argv if not a.startswith("-")), None)
+
+
+def _configure(parser: argparse.ArgumentParser, command: str) -> None:
+    module_name, function_name = COMMANDS[command][1].split(":")
+    getattr(importlib.import_module(module_name), function_name)(parser)
+
+
+def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
+    """The argument parser: every subcommand's name and help, and the arguments of the
+    subcommand named in ``argv`` (only its module is imported)."""
+    from . import __version__
+    parser = argparse.ArgumentParser(
+        prog="stt-codegen",
+        description="Spatiotemporal-tube controllers for prescribed-time reach-avoid-stay "
+                    "tasks. Exit codes: 0 success, 1 negative outcome (not satisfied, no "
+                    "design, a check failed, drift), 2 bad input, 3 tool or internal "
+                    "failure.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
+                                parser_class=_CommandParser)
+    chosen = _chosen_command(argv)
+    for name, (help_text, _) in COMMANDS.items():
+        p = sub.add_parser(name, help=help_text)
+        if name == chosen:
+            _configure(p, name)
+            parser.set_defaults(command_parser=p)
+    return parser
+
+
+def exit_code(exc: BaseException) -> int:
+    """The exit code of an error kind (:data:`EXIT_CODES`)."""
+    return next(code for kind, code in EXIT_CODES if isinstance(exc, kind))
+
+
+def _message(exc: SttError, flags: dict[str, str]) -> str:
+    """``exc``'s one-line message; a library parameter is named by its command-line flag."""
+    if isinstance(exc, SpecError) and exc.field in flags:
+        return f"{flags[exc.field]}: {exc.reason}"
+    return str(exc)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``stt-codegen`` console script; returns the exit code."""
-    parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser(argv)
     args = parser.parse_args(argv)
     try:
         return int(args.handler(args))
-    except DesignError as exc:  # a valid spec the method cannot serve: a negative outcome
-        print(f"error: {exc}", file=sys.stderr)
-        return 1
     except SttError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+        print(f"error: {_message(exc, args.command_parser.flags)}", file=sys.stderr)
+        return exit_code(exc)
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return 130

@@ -1,25 +1,47 @@
-"""The toolkit's own exceptions.
+"""The toolkit's own exceptions, in three kinds.
 
-Every error a user can cause with a spec file or a command-line argument is a
-:class:`SpecError` (or a subclass of :class:`SttError`): the command line turns
-it into one line on standard error and exit code 2, without a traceback.
+Every error the toolkit raises on purpose is an :class:`SttError` of one of three kinds.
+The command line turns each into one line ``error: ...`` on standard error, without a
+traceback, and an exit code that says which kind it was:
+
+======================  ===========  =====================================================
+kind                    exit code    meaning
+======================  ===========  =====================================================
+:class:`SpecError`      2            bad input: a spec field, a command-line argument, an
+                                     output folder; the message names the field
+:class:`DesignError`    1            a negative outcome for a valid input: no tube can be
+                                     designed, or a check failed
+:class:`ToolchainError` 3            a tool (compiler, QEMU, valgrind) is missing or
+                                     failed, or the toolkit hit an internal limit
+======================  ===========  =====================================================
+
+The mapping lives in one place, :data:`stt_codegen.cli.EXIT_CODES`. Library code speaks in
+the user's terms (spec fields and function parameters such as ``"horizon"``), never in
+command-line flags: the command line translates a parameter name into its flag.
 """
 
 from __future__ import annotations
 
 
 class SttError(Exception):
-    """Base class of every error the toolkit raises on purpose."""
+    """Base class of every error the toolkit raises on purpose.
+
+    Raise one of the three kinds below; a bare :class:`SttError` is treated as a
+    :class:`ToolchainError` (an internal failure) by the command line.
+    """
 
 
 class SpecError(SttError, ValueError):
-    """A spec file (or a value derived from it) is invalid.
+    """Bad input: a spec field (or a value derived from it, or an argument) is invalid.
+
+    Command line: exit code 2.
 
     Parameters
     ----------
     field : str
         Dotted name of the offending field, e.g. ``"initial.state"`` or
-        ``"obstacles[2].lower"``; ``""`` for the file as a whole.
+        ``"obstacles[2].lower"``, or the name of a function parameter (``"horizon"``);
+        ``""`` for the file as a whole.
     reason : str
         Why the value is rejected, in words.
     """
@@ -31,4 +53,22 @@ class SpecError(SttError, ValueError):
 
 
 class DesignError(SttError):
-    """No spatiotemporal tube satisfying the checks could be designed for a spec."""
+    """No spatiotemporal tube satisfying the checks can be designed for a valid spec.
+
+    A negative outcome, not bad input: the spec is well formed, but the design search
+    (with its continuous-time certificate) finds no acceptable tube. Command line: exit
+    code 1.
+    """
+
+
+class ToolchainError(SttError):
+    """A tool the toolkit drives is missing or failed, or an internal step failed.
+
+    The C compiler, the Cortex-M cross toolchain, QEMU, valgrind, or the code generator
+    meeting output it does not expect. Neither the spec's fault nor a negative outcome.
+    Command line: exit code 3. Subclasses: ``CodegenError``, ``EmitError``,
+    ``BuildError``, ``MissingTool``, ``BenchError``, ...
+    """
+
+
+__all__ = ["DesignError", "SpecError", "SttError", "ToolchainError"]

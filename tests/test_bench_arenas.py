@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import arena_toml
 
 from stt_codegen.bench.arena_job import (closed_loop_failure, design_failure, run_arena)
 from stt_codegen.bench.arenas import (ARENA, OBSTACLE_SIZE, START_SIZE, TARGET, generate_arena,
@@ -15,24 +16,8 @@ from stt_codegen.bench.tracker import track
 from stt_codegen.errors import SpecError
 from stt_codegen.spec.loader import load_spec, parse_spec
 
-WALL_SPEC = """
-name = "wall"
-prescribed_time = 9.0
-[state_space]
-lower = [0.0, 0.0]
-upper = [5.0, 5.0]
-[initial]
-lower = [0.0, 0.0]
-upper = [0.5, 0.5]
-[target]
-lower = [4.5, 4.5]
-upper = [5.0, 5.0]
-[[obstacles]]
-lower = [2.0, 0.0]
-upper = [3.0, OBSTACLE_TOP]
-[plant]
-model = "single-integrator"
-"""
+WALL_SPEC = arena_toml("wall", extra="[[obstacles]]\nlower = [2.0, 0.0]\nupper = [3.0, OBSTACLE_TOP]\n"
+                                    '[plant]\nmodel = "single-integrator"\n')
 
 
 def test_arenas_follow_the_protocol():

@@ -19,7 +19,7 @@ SUMMARY_KEYS = {"runs", "successes", "success_rate", "time_median_s", "time_p95_
 def test_local_pool_keeps_the_order():
     calls = [(k, 10) for k in range(7)]
     assert run_parallel(operator.mul, calls, workers=2, progress=False) == [10 * k for k in range(7)]
-    with pytest.raises(SpecError, match="--workers"):
+    with pytest.raises(SpecError, match="workers"):
         run_parallel(operator.mul, calls, workers=0, progress=False)
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import designed
+from conftest import arena_toml, designed
 
 from stt_codegen.tube import reference as R
 from stt_codegen.design.certificate import certify_tube
@@ -50,21 +50,7 @@ def test_enclosures_contain_the_deployed_tube(case, resumed):
     assert np.median(enc.lower_max - enc.lower_min) < 0.1
 
 
-CORNER = """
-name = "corner"
-prescribed_time = 4.0
-[state_space]
-lower = [0.0, 0.0]
-upper = [5.0, 5.0]
-[initial]
-lower = [0.0, 0.0]
-upper = [0.5, 0.5]
-[target]
-lower = [4.5, 4.5]
-upper = [5.0, 5.0]
-[controller]
-rate_hz = 50.0
-"""
+CORNER = arena_toml("corner", 4.0, "[controller]\nrate_hz = 50.0\n")
 
 
 def test_an_obstacle_clipped_between_samples_is_caught():

@@ -8,6 +8,9 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import CASES
+
+from stt_codegen.spec.loader import bundled_cases
 
 REQUIRED_KEYS = {"spec", "backend", "satisfied", "reached", "reach_time", "prescribed_time",
                  "collision", "min_obstacle_clearance", "left_state_space", "stayed_in_tube",
@@ -23,6 +26,11 @@ def test_cases_lists_bundled_specs():
     out = run("cases")
     assert out.returncode == 0
     assert out.stdout.split() == ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3"]
+
+
+def test_bundled_cases_are_the_paper_cases():
+    """The conftest's CASES (the parameters of the ``case`` fixture) are the bundled specs."""
+    assert bundled_cases() == CASES
 
 
 def test_simulate_json_reports_definition_2_1():
@@ -102,3 +110,25 @@ def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
     assert out.stdout.count(" yes ") == 3
     again = run("demo", "--out", str(tmp_path / "demo"))     # its own files: overwritten
     assert again.returncode == 0, again.stderr
+
+
+def test_atomic_write_leaves_a_normal_file_or_nothing(tmp_path):
+    """The file gets the permissions of any new file (not a temporary file's 0600), and a
+    writer that fails leaves nothing behind."""
+    import os
+
+    from stt_codegen.cli import atomic_write_bytes
+    mask = os.umask(0o022)
+    try:
+        atomic_write_bytes(tmp_path / "a.png", lambda tmp: tmp.write_bytes(b"png"))
+
+        def failing(tmp):
+            tmp.write_bytes(b"half")
+            raise RuntimeError("disk full")
+        with pytest.raises(RuntimeError):
+            atomic_write_bytes(tmp_path / "b.png", failing)
+    finally:
+        os.umask(mask)
+    assert (tmp_path / "a.png").read_bytes() == b"png"
+    assert (tmp_path / "a.png").stat().st_mode & 0o777 == 0o644
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png"]

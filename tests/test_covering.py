@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from hypothesis import given, settings
+from conftest import arena_toml
 from hypothesis import strategies as st
 
 from stt_codegen.design.certificate import certify_tube
@@ -20,21 +21,8 @@ from stt_codegen.spec.loader import load_spec, parse_spec
 from stt_codegen.design.samples import sample_tube
 
 SPECS = Path(__file__).parent / "specs"
-BESIDE = """
-name = "beside"
-prescribed_time = 9.0
-[state_space]
-lower = [0.0, 0.0]
-upper = [5.0, 5.0]
-[initial]
-lower = [0.0, 0.0]
-upper = [0.5, 0.5]
-[target]
-lower = [4.5, 0.0]
-upper = [5.0, 0.5]
-[tube]
-circumvent_sharpness = 0.1
-"""
+BESIDE = arena_toml("beside", extra="[tube]\ncircumvent_sharpness = 0.1\n",
+                    target=((4.5, 0.0), (5.0, 0.5)))
 BALL = "[[obstacles]]\ncenter = [1.0, 1.0]\nradius = 0.62\n"
 START = (np.array([0.0, 0.0]), np.array([0.5, 0.5]))
 

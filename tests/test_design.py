@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import designed
+from conftest import arena_toml, designed
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
@@ -17,19 +17,7 @@ from stt_codegen.design.samples import sample_tube
 from stt_codegen.errors import DesignError
 from stt_codegen.spec.loader import Box, load_spec, parse_spec
 
-TWO_D = """
-name = "corridor"
-prescribed_time = 8.0
-[state_space]
-lower = [0.0, 0.0]
-upper = [5.0, 5.0]
-[initial]
-lower = [0.0, 0.0]
-upper = [0.5, 0.5]
-[target]
-lower = [4.5, 4.5]
-upper = [5.0, 5.0]
-"""
+TWO_D = arena_toml("corridor", 8.0)
 
 
 def literal_window(design, box):
@@ -87,7 +75,7 @@ def test_bundled_designs_pass_their_check(case):
     assert check.max_move_ratio <= MAX_MOVE_PER_SAMPLE
     assert design.gain > 0 and design.circumvents
     # the wall O1 is passed underneath from S1 (x2, upper side): the literal eq. (6)
-    # would pick x1 and let the robot cross O1 (design notes, item 6)
+    # would pick x1 and let the robot cross O1 (docs/design-notes.md, item 6)
     if case == "omnirobot-s1":
         c = [c for c in design.circumvents if c.obstacle == 0][0]
         assert (c.dimension, c.side) == (1, "upper")

@@ -75,12 +75,13 @@ def test_embedded_text_output(capsys, tmp_path) -> None:
     assert "instructions per step" in out
 
 
-def test_embedded_missing_tools_exit_2(monkeypatch, capsys) -> None:
+def test_embedded_missing_tools_exit_3(monkeypatch, capsys) -> None:
+    """A missing tool is a toolchain failure (exit 3), not bad input."""
     import stt_codegen.embedded.deploy as deploy
     monkeypatch.setattr(deploy, "missing_message", lambda: (
         "missing qemu-system-arm; install the Debian packages: apt-get install -y "
         "qemu-system-arm"))
-    assert main(["embedded", "omnirobot-s1"]) == 2
+    assert main(["embedded", "omnirobot-s1"]) == 3
     err = capsys.readouterr().err
     assert err.startswith("error: missing qemu-system-arm") and "apt-get install" in err
 

@@ -3,26 +3,12 @@
 from __future__ import annotations
 
 import pytest
+from conftest import arena_toml
 
 from stt_codegen.errors import SpecError
 from stt_codegen.spec.loader import load_spec, parse_spec
 
-VALID = """
-name = "case-1"
-prescribed_time = 9.0
-[state_space]
-lower = [0.0, 0.0]
-upper = [5.0, 5.0]
-[initial]
-lower = [0.0, 0.0]
-upper = [0.5, 0.5]
-[target]
-lower = [4.5, 4.5]
-upper = [5.0, 5.0]
-[[obstacles]]
-lower = [2.0, 2.0]
-upper = [3.0, 3.0]
-"""
+VALID = arena_toml("case-1", extra="[[obstacles]]\nlower = [2.0, 2.0]\nupper = [3.0, 3.0]\n")
 
 
 def replace(old: str, new: str) -> str:

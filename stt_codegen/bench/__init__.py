@@ -7,12 +7,9 @@
   processes or a Dask cluster;
 * :mod:`.harness` - a generated C timing harness, compiled, timed and run under callgrind;
 * :mod:`.step`, :mod:`.scaling` - the per-step cost and its growth;
-* :mod:`.report` - statistics, tables and the machine description.
+* :mod:`.report` - statistics, tables and the machine description;
+* :mod:`.cli` - the ``bench`` subcommand's arguments.
 
 Every benchmark measures what it compares side by side in one run and reports ratios;
 the tests check structure and invariants, never speed.
 """
-
-from .cli import register_cli
-
-__all__ = ["register_cli"]

@@ -139,10 +139,10 @@ def generate_arena(seed: int, index: int) -> Arena:
     Raises
     ------
     SpecError
-        Negative ``seed`` or ``index`` (fields ``--seed``, ``index``).
+        Negative ``seed`` or ``index`` (fields ``seed``, ``index``).
     """
     if seed < 0:
-        raise SpecError("--seed", f"must be non-negative, got {seed}")
+        raise SpecError("seed", f"must be non-negative, got {seed}")
     if index < 0:
         raise SpecError("index", f"must be non-negative, got {index}")
     rng = np.random.default_rng([seed, index])
@@ -164,8 +164,8 @@ def generate_arenas(count: int, seed: int) -> list[Arena]:
     Raises
     ------
     SpecError
-        ``count < 1`` (field ``--count``) or a negative seed.
+        ``count < 1`` (field ``count``) or a negative seed.
     """
     if count < 1:
-        raise SpecError("--count", f"must be at least 1, got {count}")
+        raise SpecError("count", f"must be at least 1, got {count}")
     return [generate_arena(seed, k) for k in range(count)]

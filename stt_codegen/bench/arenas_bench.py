@@ -31,12 +31,12 @@ def write_specs(folder: Path, count: int, seed: int) -> list[Path]:
     Raises
     ------
     SpecError
-        The folder does not exist (field ``--specs``).
+        The folder does not exist (field ``specs``).
     """
     from ..cli import atomic_write_bytes
     folder = Path(folder)
     if not folder.is_dir():
-        raise SpecError("--specs", f"folder {str(folder)!r} does not exist")
+        raise SpecError("specs", f"folder {str(folder)!r} does not exist")
     paths = []
     for arena in generate_arenas(count, seed):
         path = folder / f"{arena.name}.toml"
@@ -80,15 +80,15 @@ def run_arenas_bench(count: int, seed: int, workers: int | None = None,
     """
     generate_arenas(1, seed)  # validates the seed
     if count < 1:
-        raise SpecError("--count", f"must be at least 1, got {count}")
+        raise SpecError("count", f"must be at least 1, got {count}")
     usable, skipped = available_methods()
     if methods is None:
         methods = usable
     for m in methods:
         if m not in METHODS:
-            raise SpecError("--methods", f"unknown method {m!r} (known: {', '.join(METHODS)})")
+            raise SpecError("methods", f"unknown method {m!r} (known: {', '.join(METHODS)})")
         if m in skipped:
-            raise SpecError("--methods", f"{m} cannot run: {skipped[m]}")
+            raise SpecError("methods", f"{m} cannot run: {skipped[m]}")
     calls = [(seed, k, tuple(methods)) for k in range(count)]
     arenas = run_parallel(run_arena, calls, workers=workers, scheduler=scheduler,
                           progress=progress, description="arenas")

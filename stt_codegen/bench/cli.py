@@ -27,12 +27,10 @@ def _cmd_scaling(args: argparse.Namespace) -> int:
     return main_scaling(args)
 
 
-def register_cli(subparsers) -> None:
-    """Add ``bench arenas``, ``bench step`` and ``bench scaling`` to the CLI."""
-    bench = subparsers.add_parser(
-        "bench", help="benchmarks: random arenas vs planners, step cost, scaling",
-        description="Benchmarks. Every comparison is measured side by side in one run on "
-                    "this machine; ratios, not absolute times, are the result.")
+def configure_bench(bench: argparse.ArgumentParser) -> None:
+    """Sub-subcommands ``bench arenas``, ``bench step`` and ``bench scaling``."""
+    bench.description = ("Benchmarks. Every comparison is measured side by side in one run on "
+                         "this machine; ratios, not absolute times, are the result.")
     sub = bench.add_subparsers(dest="bench_command", required=True, metavar="BENCH")
 
     p = sub.add_parser("arenas", help="STT vs A* and RRT* (plus a tracker) on random arenas")

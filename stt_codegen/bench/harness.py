@@ -36,7 +36,7 @@ import numpy as np
 from ..runtime.compiled import compiler
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
-from ..errors import SttError
+from ..errors import ToolchainError
 from ..spec.loader import NAME_PATTERN
 from ..tube.parameters import TubeDesign
 
@@ -55,7 +55,7 @@ class _GenerationName:
         self.source_hash = "design:" + hashlib.sha256(repr(design).encode()).hexdigest()
 
 
-class BenchError(SttError):
+class BenchError(ToolchainError):
     """A benchmark could not run (compiler or valgrind failure, timeout)."""
 
 

@@ -63,8 +63,8 @@ def run_parallel(fn: Callable[..., Any], calls: Sequence[tuple], workers: int | 
     Raises
     ------
     SpecError
-        ``workers < 1`` (field ``--workers``), or the scheduler cannot be reached
-        (``--scheduler``).
+        ``workers < 1`` (field ``workers``), or the scheduler cannot be reached
+        (field ``scheduler``).
     Exception
         Whatever a job raised (the first one, re-raised here).
     """
@@ -79,7 +79,7 @@ def run_parallel(fn: Callable[..., Any], calls: Sequence[tuple], workers: int | 
         return results
     workers = default_workers() if workers is None else workers
     if workers < 1:
-        raise SpecError("--workers", f"must be at least 1, got {workers}")
+        raise SpecError("workers", f"must be at least 1, got {workers}")
     context = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(max_workers=min(workers, max(1, len(calls))),
                              mp_context=context) as pool, \
@@ -101,7 +101,7 @@ def _connect(scheduler: str):
     try:
         return Client(scheduler, timeout=CONNECT_TIMEOUT)
     except (OSError, TimeoutError, ValueError) as exc:
-        raise SpecError("--scheduler", f"cannot connect to {scheduler!r}: {exc}") from None
+        raise SpecError("scheduler", f"cannot connect to {scheduler!r}: {exc}") from None
 
 
 def _run_dask(client, fn, calls, results: list, bar) -> None:

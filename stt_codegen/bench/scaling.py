@@ -75,9 +75,9 @@ def synthetic_design(obstacles: int, dimension: int, windows: str = "random",
         Negative counts, zero dimension or an unknown ``windows``.
     """
     if obstacles < 0:
-        raise SpecError("--obstacles", f"must be non-negative, got {obstacles}")
+        raise SpecError("obstacles", f"must be non-negative, got {obstacles}")
     if dimension < 1:
-        raise SpecError("--dimensions", f"must be at least 1, got {dimension}")
+        raise SpecError("dimensions", f"must be at least 1, got {dimension}")
     if windows not in ("random", "open", "closed", "sparse"):
         raise SpecError("windows", f"unknown window mode {windows!r}")
     t_c = 9.0
@@ -226,10 +226,10 @@ def run_scaling_bench(obstacles: list[int], dimensions: list[int],
     """
     for m in obstacles:
         if m < 0:
-            raise SpecError("--obstacles", f"must be non-negative, got {m}")
+            raise SpecError("obstacles", f"must be non-negative, got {m}")
     for n in dimensions:
         if n < 1:
-            raise SpecError("--dimensions", f"must be at least 1, got {n}")
+            raise SpecError("dimensions", f"must be at least 1, got {n}")
     active = ACTIVE_EXPERIMENT_OBSTACLES if active_obstacles is None else active_obstacles
     report: dict[str, Any] = {"machine": machine(), "obstacle_sweep": [],
                               "dimension_sweep": [], "active_windows": []}
@@ -318,8 +318,8 @@ def format_scaling_report(report: dict[str, Any]) -> str:
 
 def main_scaling(args: argparse.Namespace) -> int:
     """Handler of ``bench scaling``; exit 0."""
-    report = run_scaling_bench(_int_list(args.obstacles, "--obstacles"),
-                               _int_list(args.dimensions, "--dimensions"),
+    report = run_scaling_bench(_int_list(args.obstacles, "obstacles"),
+                               _int_list(args.dimensions, "dimensions"),
                                compile_timeout=args.compile_timeout)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_scaling_report(report))

@@ -75,7 +75,7 @@ def run_step_bench(spec_arg: str, steps: int | None = None, rounds: int = ROUNDS
 
     steps = DEFAULT_STEPS if steps is None else steps
     if steps < 1:
-        raise SpecError("--steps", f"must be at least 1, got {steps}")
+        raise SpecError("steps", f"must be at least 1, got {steps}")
     spec = load_spec(spec_arg)
     design = design_tube(spec).tube
     harness = build_harness(design)

@@ -1,0 +1,17 @@
+"""The bundled specs: the paper's case study (section V), one TOML file per start set."""
+
+from __future__ import annotations
+
+from importlib import resources
+
+
+def bundled_cases() -> list[str]:
+    """Names of the bundled specs (``omnirobot-s1``, ...), sorted; load one with
+    :func:`stt_codegen.load_spec`."""
+    folder = resources.files(__name__)
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def bundled_spec_bytes(name: str) -> bytes:
+    """The bytes of the bundled spec ``name`` (one of :func:`bundled_cases`)."""
+    return resources.files(__name__).joinpath(name + ".toml").read_bytes()

@@ -5,12 +5,11 @@
 * :mod:`.bundled` - the committed ``generated/`` folder and its drift check;
 * :class:`~.controllers.CController`, :class:`~.controllers.GeneratedPythonController` -
   the generated code as backends ``c`` and ``python``;
-* :func:`register_cli` - the ``generate`` and ``check`` subcommands.
+* :mod:`.cli` - the ``generate`` and ``check`` subcommands' arguments.
 """
 
-from .cli import register_cli
 from .generate import generate_files
 from .options import Options, parse_options
 from .output import write_generation
 
-__all__ = ["Options", "generate_files", "parse_options", "register_cli", "write_generation"]
+__all__ = ["Options", "generate_files", "parse_options", "write_generation"]

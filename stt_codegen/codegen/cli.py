@@ -1,4 +1,5 @@
-"""Subcommands ``generate`` and ``check`` (registered by :func:`register_cli`)."""
+"""Subcommands ``generate`` and ``check`` (configured by :func:`configure_generate` and
+:func:`configure_check`, listed in :data:`stt_codegen.cli.COMMANDS`)."""
 
 from __future__ import annotations
 
@@ -13,15 +14,13 @@ def cmd_generate(args: argparse.Namespace) -> int:
     """``stt-codegen generate SPEC -o DIR [--lang c,python] [--precision double|single]``."""
     from ..design.search import design_tube
     from ..spec.loader import load_spec
-    from .generate import generate_files
-    from .output import write_generation
-    options = parse_options(args.lang, args.precision)
+    from .api import generate
+    parse_options(args.languages, args.precision)   # bad options fail before the design
     spec = load_spec(args.spec)
     design = design_tube(spec).tube
-    files = generate_files(spec, design, options)
-    write_generation(Path(args.out), files)
-    print(f"wrote {len(files)} files for {spec.name} ({', '.join(options.langs)}, "
-          f"{options.precision}) into {args.out}")
+    files = generate(spec, design, Path(args.out_dir), args.languages, args.precision)
+    print(f"wrote {len(files)} files for {spec.name} ({args.languages}, "
+          f"{args.precision}) into {args.out_dir}")
     return 0
 
 
@@ -45,19 +44,20 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 0
 
 
-def register_cli(subparsers) -> None:
-    """Add ``generate`` and ``check`` to the ``stt-codegen`` parser."""
-    p = subparsers.add_parser("generate", help="write the C and Python controllers of a spec")
+def configure_generate(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen generate``."""
     p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
-    p.add_argument("-o", "--out", required=True, metavar="DIR",
+    p.add_argument("-o", "--out", dest="out_dir", required=True, metavar="DIR",
                    help="output folder (created; only files of a previous generation are replaced)")
-    p.add_argument("--lang", default=",".join(LANGUAGES), metavar="LANGS",
+    p.add_argument("--lang", dest="languages", default=",".join(LANGUAGES), metavar="LANGS",
                    help="comma-separated subset of: %(default)s")
     p.add_argument("--precision", default="double", choices=PRECISIONS,
                    help="floating-point type of the C code (default: %(default)s)")
     p.set_defaults(handler=cmd_generate)
 
-    p = subparsers.add_parser("check", help="regenerate generated/ and compare (exit 1 on drift)")
+
+def configure_check(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen check``."""
     p.add_argument("--root", default="generated", metavar="DIR",
                    help="folder of the committed output (default: %(default)s)")
     p.add_argument("--update", action="store_true", help="rewrite the folder instead of comparing")

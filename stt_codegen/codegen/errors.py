@@ -1,9 +1,9 @@
-"""Errors of the code generator (all :class:`~stt_codegen.errors.SttError`: exit code 2)."""
+"""Errors of the code generator (all :class:`~stt_codegen.errors.ToolchainError`: exit code 3)."""
 
 from __future__ import annotations
 
-from ..errors import SttError
+from ..errors import ToolchainError
 
 
-class CodegenError(SttError):
+class CodegenError(ToolchainError):
     """Generation cannot proceed: unexpected CasADi output, a failed build, an unsafe output folder."""

@@ -32,21 +32,21 @@ class Options:
 
 
 def parse_options(langs: str | list | tuple = "c,python", precision: str = "double") -> Options:
-    """Validate ``--lang`` (comma-separated or a list) and ``--precision``.
+    """Validate the languages (comma-separated or a list) and the precision.
 
     Raises
     ------
     SpecError
-        Unknown or empty language list (field ``--lang``), unknown precision
-        (``--precision``).
+        Unknown or empty language list (field ``languages``; ``--lang`` on the command
+        line), unknown precision (field ``precision``).
     """
     items = [s.strip() for s in langs.split(",")] if isinstance(langs, str) else list(langs)
     if not items or any(not s for s in items):
-        raise SpecError("--lang", f"expected a comma-separated list of {', '.join(LANGUAGES)}")
+        raise SpecError("languages", f"expected a comma-separated list of {', '.join(LANGUAGES)}")
     unknown = [s for s in items if s not in LANGUAGES]
     if unknown:
-        raise SpecError("--lang", f"unknown language {unknown[0]!r} (known: {', '.join(LANGUAGES)})")
+        raise SpecError("languages", f"unknown language {unknown[0]!r} (known: {', '.join(LANGUAGES)})")
     if precision not in PRECISIONS:
-        raise SpecError("--precision", f"unknown precision {precision!r} "
+        raise SpecError("precision", f"unknown precision {precision!r} "
                                        f"(known: {', '.join(PRECISIONS)})")
     return Options(tuple(s for s in LANGUAGES if s in items), precision)

@@ -55,7 +55,7 @@ def previous_files(out_dir: Path, check_hashes: bool = True) -> list[str]:
     Raises
     ------
     SpecError
-        ``out_dir`` holds entries that are not ours (field ``-o``).
+        ``out_dir`` holds entries that are not ours (field ``out_dir``).
     """
     entries = sorted(p.name for p in out_dir.iterdir())
     if not entries:
@@ -71,22 +71,22 @@ def previous_files(out_dir: Path, check_hashes: bool = True) -> list[str]:
     except (OSError, ValueError, KeyError, TypeError, AttributeError, RecursionError):
         files = None
     if files is None:
-        raise SpecError("-o", f"{str(out_dir)!r} is not empty and has no stt-codegen manifest: "
+        raise SpecError("out_dir", f"{str(out_dir)!r} is not empty and has no stt-codegen manifest: "
                               "refusing to overwrite files it did not generate")
     unsafe = [name for name in files if not _flat_name(name) or name == MANIFEST]
     if unsafe:
-        raise SpecError("-o", f"the manifest in {str(out_dir)!r} lists {str(unsafe[0])[:80]!r}, "
+        raise SpecError("out_dir", f"the manifest in {str(out_dir)!r} lists {str(unsafe[0])[:80]!r}, "
                               "not a file name stt-codegen writes: refusing to touch it")
     foreign = [name for name in entries if name not in files and name != MANIFEST
                or not (out_dir / name).is_file() or (out_dir / name).is_symlink()]
     if foreign:
-        raise SpecError("-o", f"{str(out_dir)!r} holds {foreign[0]!r}, not a file listed in its "
+        raise SpecError("out_dir", f"{str(out_dir)!r} holds {foreign[0]!r}, not a file listed in its "
                               "stt-codegen manifest: refusing to overwrite or mix")
     if check_hashes:
         edited = [name for name in entries if name != MANIFEST
                   and _file_sha256(out_dir / name) != files[name]]
         if edited:
-            raise SpecError("-o", f"{str(out_dir)!r} holds {edited[0]!r}, changed since "
+            raise SpecError("out_dir", f"{str(out_dir)!r} holds {edited[0]!r}, changed since "
                                   "stt-codegen generated it: refusing to overwrite it "
                                   "(move it away to regenerate)")
     return [name for name in entries if name != MANIFEST]
@@ -102,23 +102,23 @@ def write_generation(out_dir: str | Path, files: dict[str, bytes],
     Raises
     ------
     SpecError
-        Unsafe or unusable output folder (field ``-o``).
+        Unsafe or unusable output folder (field ``out_dir``).
     """
     out_dir = Path(out_dir)
     for name in files:
         if not _flat_name(name):
-            raise SpecError("-o", f"refusing to write file name {name!r}")
+            raise SpecError("out_dir", f"refusing to write file name {name!r}")
     if out_dir.exists() and not out_dir.is_dir():
-        raise SpecError("-o", f"{str(out_dir)!r} exists and is not a folder")
+        raise SpecError("out_dir", f"{str(out_dir)!r} exists and is not a folder")
     parent = out_dir.parent if str(out_dir.parent) else Path(".")
     if not parent.is_dir():
-        raise SpecError("-o", f"parent folder of {str(out_dir)!r} does not exist")
+        raise SpecError("out_dir", f"parent folder of {str(out_dir)!r} does not exist")
     created = not out_dir.exists()
     if created:
         try:
             out_dir.mkdir()
         except OSError as exc:
-            raise SpecError("-o", f"cannot create {str(out_dir)!r}: {exc.strerror}") from None
+            raise SpecError("out_dir", f"cannot create {str(out_dir)!r}: {exc.strerror}") from None
         old: list[str] = []
     else:
         old = previous_files(out_dir, check_hashes=not replace_edited)
@@ -136,7 +136,7 @@ def write_generation(out_dir: str | Path, files: dict[str, bytes],
     except OSError as exc:
         if created:
             shutil.rmtree(out_dir, ignore_errors=True)
-        raise SpecError("-o", f"cannot write into {str(out_dir)!r}: {exc.strerror or exc}") from None
+        raise SpecError("out_dir", f"cannot write into {str(out_dir)!r}: {exc.strerror or exc}") from None
     except BaseException:
         if created:
             shutil.rmtree(out_dir, ignore_errors=True)

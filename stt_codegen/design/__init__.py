@@ -5,7 +5,3 @@ Contract: :func:`.search.design_tube` turns a :class:`~stt_codegen.spec.Spec` in
 :mod:`.certificate` (safety of the tube for every ``t >= 0``) and the sampling check, or
 raises :class:`~stt_codegen.errors.DesignError` with the reason. See ``docs/design.md``.
 """
-
-from .cli import register_cli
-
-__all__ = ["register_cli"]

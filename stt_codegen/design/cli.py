@@ -1,4 +1,4 @@
-"""Subcommand ``design`` (registered by :func:`register_cli`): design and certify only."""
+"""Subcommand ``design`` (arguments from :func:`configure_design`): design and certify only."""
 
 from __future__ import annotations
 
@@ -24,7 +24,7 @@ def cmd_design(args: argparse.Namespace) -> int:
                              indent=2, sort_keys=True))
         raise
     if args.plot:
-        from .plot import plot_design
+        from ..runtime.plots import plot_design
         atomic_write_bytes(Path(args.plot), lambda tmp: plot_design(spec, design, tmp))
     if args.json:
         print(json.dumps(design.to_json(spec.name), indent=2, sort_keys=True))
@@ -46,9 +46,8 @@ def cmd_design(args: argparse.Namespace) -> int:
     return 0
 
 
-def register_cli(subparsers) -> None:
-    """Add the ``design`` subcommand."""
-    p = subparsers.add_parser("design", help="design and certify the tube (no simulation)")
+def configure_design(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen design``."""
     p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--plot", metavar="PNG", help="write a figure of the designed tube")

@@ -3,7 +3,8 @@
 Public API: :func:`build_elf`, :func:`run_qemu`, :func:`measure`, the result
 types :class:`BuildResult`, :class:`RunResult`, :class:`Footprint`, and
 :class:`MissingTool` (a tool is not installed; names its Debian package);
-:func:`run_embedded` (the ``embedded`` subcommand's pipeline) and :func:`register_cli`.
+:func:`run_embedded` (the ``embedded`` subcommand's pipeline; its arguments are in
+:mod:`.cli`).
 """
 
 from stt_codegen.embedded.footprint import Footprint, measure
@@ -12,9 +13,8 @@ from stt_codegen.embedded.target import (BuildError, BuildResult, RunError, RunR
 from stt_codegen.embedded.toolchain import (MissingTool, find_toolchain, missing_message,
                                             missing_tools)
 
-from stt_codegen.embedded.cli import register_cli
 from stt_codegen.embedded.deploy import run_embedded
 
 __all__ = ["BuildError", "BuildResult", "Footprint", "MissingTool", "RunError", "RunResult",
-           "build_elf", "find_toolchain", "measure", "missing_message", "missing_tools", "register_cli",
+           "build_elf", "find_toolchain", "measure", "missing_message", "missing_tools",
            "run_embedded", "run_qemu"]

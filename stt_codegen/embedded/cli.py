@@ -1,4 +1,4 @@
-"""Subcommand ``stt-codegen embedded SPEC [--json]`` (registered by :func:`register_cli`)."""
+"""Subcommand ``stt-codegen embedded SPEC [--json]`` (configured by :func:`configure_embedded`)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ def cmd_embedded(args: argparse.Namespace) -> int:
     from ..spec.loader import load_spec
     from .deploy import run_embedded
     if args.build_dir is not None and not Path(args.build_dir).parent.is_dir():
-        raise SpecError("--build-dir", f"folder {str(Path(args.build_dir).parent)!r} does not exist")
+        raise SpecError("build_dir", f"folder {str(Path(args.build_dir).parent)!r} does not exist")
     spec = load_spec(args.spec)
     design = design_tube(spec).tube
     report = run_embedded(spec, design, args.build_dir, seed=args.seed,
@@ -42,10 +42,8 @@ def cmd_embedded(args: argparse.Namespace) -> int:
     return 0 if report["ok"] else 1
 
 
-def register_cli(subparsers) -> None:
-    """Add ``embedded`` to the ``stt-codegen`` parser."""
-    p = subparsers.add_parser(
-        "embedded", help="run the single-precision controller on an emulated Cortex-M4F")
+def configure_embedded(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen embedded``."""
     p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--seed", type=int, default=0, help="disturbance seed (default: 0)")

@@ -40,7 +40,7 @@ from ..tube import reference as R
 from ..codegen import tolerance as T
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
-from ..errors import SttError
+from ..errors import ToolchainError
 from ..spec.loader import Spec
 from ..tube.parameters import TubeDesign
 from . import board
@@ -54,14 +54,14 @@ from .toolchain import missing_message
 COUNT_FRACTIONS = (0.0, 0.2, 0.4, 0.6, 0.8, 0.999)
 
 
-class ToolsMissing(SttError):
+class ToolsMissing(ToolchainError):
     """The cross toolchain or QEMU is missing; the message names the Debian packages."""
 
 
 def _selftest_counts(stdout: str) -> tuple[int, int]:
     m = re.search(r"^(\d+) passed, (\d+) failed$", stdout, re.MULTILINE)
     if m is None:
-        raise SttError(f"self-test printed no 'N passed, N failed' line:\n{stdout[-2000:]}")
+        raise ToolchainError(f"self-test printed no 'N passed, N failed' line:\n{stdout[-2000:]}")
     return int(m.group(1)), int(m.group(2))
 
 
@@ -124,7 +124,7 @@ def run_embedded(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
     ------
     ToolsMissing
         A tool is not installed (the message names the Debian packages).
-    SttError
+    ToolchainError
         A build or run failed.
     """
     message = missing_message()
@@ -143,9 +143,9 @@ def run_embedded(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
     def run(elf, **kw):
         res = run_qemu(elf, timeout=timeout, **kw)
         if res.timed_out:
-            raise SttError(f"{elf.name}: QEMU timed out after {timeout:g} s")
+            raise ToolchainError(f"{elf.name}: QEMU timed out after {timeout:g} s")
         if res.exit_code == board.FAULT_EXIT_STATUS:
-            raise SttError(f"{elf.name}: fault on the target:\n{res.stderr}")
+            raise ToolchainError(f"{elf.name}: fault on the target:\n{res.stderr}")
         return res
 
     # 1. the generated self-test

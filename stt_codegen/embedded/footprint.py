@@ -25,13 +25,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from stt_codegen.embedded.toolchain import find_toolchain, run_tool
-from stt_codegen.errors import SttError
+from stt_codegen.errors import ToolchainError
 
 _CALL_RELOCS = ("R_ARM_THM_CALL", "R_ARM_THM_JUMP24", "R_ARM_THM_JUMP19", "R_ARM_CALL",
                 "R_ARM_JUMP24")
 
 
-class FootprintError(SttError):
+class FootprintError(ToolchainError):
     """The stack bound cannot be computed (unknown entry, recursion)."""
 
 

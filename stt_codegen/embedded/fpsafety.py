@@ -30,7 +30,7 @@ from ..tube import reference as R
 from ..codegen import tolerance as T
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
-from ..errors import SttError
+from ..errors import ToolchainError
 from ..spec.loader import Spec
 from ..tube.parameters import TubeDesign
 from .programs import parse_replay, replay_source
@@ -137,13 +137,13 @@ def check_host(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
         proc = subprocess.run(base[:1] + list(extra) + base[1:] + ["-o", str(exe)],
                               capture_output=True, text=True, check=False)
         if proc.returncode:
-            raise SttError(f"host build failed:\n{proc.stderr}")
+            raise ToolchainError(f"host build failed:\n{proc.stderr}")
         return subprocess.run([str(exe)], capture_output=True, text=True, check=False,
                               timeout=600)
 
     run = build_run((), out / "fpsafety")
     if run.returncode:
-        raise SttError(f"fpsafety exited with {run.returncode}:\n{run.stderr[-2000:]}")
+        raise ToolchainError(f"fpsafety exited with {run.returncode}:\n{run.stderr[-2000:]}")
     res = parse_replay(run.stdout, spec.dimension)
     raised, summary = [], {}
     for k, (fs, ft) in enumerate(res.flags):

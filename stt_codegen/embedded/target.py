@@ -27,7 +27,7 @@ from pathlib import Path
 
 from stt_codegen.embedded import board
 from stt_codegen.embedded.toolchain import ToolError, Toolchain, find_toolchain, run_tool
-from stt_codegen.errors import SttError
+from stt_codegen.errors import ToolchainError
 
 #: Code generation flags for the Cortex-M4F (single-precision FPU, hard-float ABI).
 CPU_FLAGS: tuple[str, ...] = (
@@ -53,7 +53,7 @@ class BuildError(ToolError):
     """The cross compiler or linker failed (``command``, ``output``)."""
 
 
-class RunError(SttError):
+class RunError(ToolchainError):
     """QEMU could not run the program, or the trace could not be interpreted."""
 
 

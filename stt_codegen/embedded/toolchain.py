@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from stt_codegen.errors import SttError
+from stt_codegen.errors import ToolchainError
 
 #: Tool name -> Debian package that provides it.
 DEBIAN_PACKAGES: dict[str, str] = {
@@ -35,7 +35,7 @@ BUILD_TOOLS: tuple[str, ...] = (
 RUN_TOOLS: tuple[str, ...] = ("qemu-system-arm", "arm-none-eabi-nm")
 
 
-class MissingTool(SttError):
+class MissingTool(ToolchainError):
     """A tool the embedded harness needs is not installed.
 
     Parameters
@@ -54,7 +54,7 @@ class MissingTool(SttError):
             f"(apt-get install -y {package})")
 
 
-class ToolError(SttError):
+class ToolError(ToolchainError):
     """A tool (compiler, linker, binutils) failed.
 
     Parameters

@@ -92,9 +92,9 @@ def make_controller(name: str, design: TubeDesign) -> Controller:
     Raises
     ------
     SpecError
-        Unknown backend (field ``--backend``).
+        Unknown backend (field ``backend``).
     """
     if name not in _FACTORIES:
-        raise SpecError("--backend", f"unknown backend {name!r} "
+        raise SpecError("backend", f"unknown backend {name!r} "
                                      f"(known: {', '.join(_FACTORIES)})")
     return _FACTORIES[name](design)

@@ -1,30 +1,52 @@
-"""Figures of a closed-loop run, in the manner of the paper's Fig. 3."""
+"""Figures of a closed-loop run, in the manner of the paper's Fig. 3.
+
+The figure is a :class:`matplotlib.figure.Figure` drawn on an explicit Agg canvas: this
+module neither selects matplotlib's global backend nor uses ``pyplot``, so importing it
+(also into a notebook) changes no global state.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.patches import Circle, Polygon, Rectangle  # noqa: E402
-from scipy.spatial import ConvexHull  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+import numpy as np
+from matplotlib.patches import Circle, Polygon, Rectangle
+from scipy.spatial import ConvexHull
 
 from ..tube import reference
 from .simulate import SimulationResult
 from ..spec.loader import Box, Spec
 from ..tube.parameters import TubeDesign
 
+if TYPE_CHECKING:
+    from ..design.result import Design
 
-def _rect(ax, box: Box, dims: tuple[int, int], **style) -> None:
+
+def agg_figure(**kwargs) -> Figure:
+    """A :class:`~matplotlib.figure.Figure` on its own Agg canvas (``kwargs`` go to
+    ``Figure``): it can be saved as PNG without pyplot and without touching matplotlib's
+    global backend."""
+    fig = Figure(**kwargs)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def draw_box(ax, box: Box, dims: tuple[int, int], **style) -> None:
+    """Draw the projection of ``box`` on the state dimensions ``dims`` as a rectangle.
+
+    ``style`` goes to :class:`matplotlib.patches.Rectangle` (``fc``, ``ec``, ``label``...).
+    """
     i, j = dims
     ax.add_patch(Rectangle((box.lower[i], box.lower[j]), box.upper[i] - box.lower[i],
                            box.upper[j] - box.lower[j], **style))
 
 
-def _draw_unsafe_sets(ax, spec: Spec, dims: tuple[int, int]) -> None:
-    """Obstacles as given (filled) and, for balls and polytopes, their covering boxes."""
+def draw_unsafe_sets(ax, spec: Spec, dims: tuple[int, int]) -> None:
+    """Draw the spec's obstacles on the state dimensions ``dims``: as given (filled, labelled
+    ``U1``, ``U2``...) and, for balls and polytopes, their covering boxes (dashed)."""
     for j, unsafe in enumerate(spec.unsafe_sets):
         label = "obstacles" if j == 0 else None
         if not set(dims) <= set(unsafe.dims):
@@ -47,7 +69,7 @@ def _draw_unsafe_sets(ax, spec: Spec, dims: tuple[int, int]) -> None:
         ax.annotate(f"U{j + 1}", center, ha="center", va="center", color="white")
     covered = [o for o in spec.obstacles if spec.unsafe_sets[o.source].kind != "box"]
     for m, obstacle in enumerate(covered):
-        _rect(ax, obstacle.box(spec.state_space), dims, fill=False, ec="tab:red", lw=0.5,
+        draw_box(ax, obstacle.box(spec.state_space), dims, fill=False, ec="tab:red", lw=0.5,
               ls="--", label="covering boxes" if m == 0 else None)
 
 
@@ -69,15 +91,15 @@ def plot_run(spec: Spec, design: TubeDesign, result: SimulationResult, path: str
     traj = result.trajectory
     n = spec.dimension
     g_l, g_u, _, _ = reference.adaptive_tube(design, traj.t, traj.alpha)
-    fig = plt.figure(figsize=(11, 2.6 * max(n, 2)), layout="constrained")
+    fig = agg_figure(figsize=(11, 2.6 * max(n, 2)), layout="constrained")
     grid = fig.add_gridspec(n, 2, width_ratios=[1.1, 1.4])
     if n >= 2:
         ax = fig.add_subplot(grid[:, 0])
         dims = (0, 1)
-        _rect(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
-        _draw_unsafe_sets(ax, spec, dims)
-        _rect(ax, spec.initial_set, dims, fc="tab:blue", alpha=0.3, label="initial set")
-        _rect(ax, spec.target_set, dims, fc="tab:green", alpha=0.35, label="target")
+        draw_box(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
+        draw_unsafe_sets(ax, spec, dims)
+        draw_box(ax, spec.initial_set, dims, fc="tab:blue", alpha=0.3, label="initial set")
+        draw_box(ax, spec.target_set, dims, fc="tab:green", alpha=0.35, label="target")
         ax.plot(traj.x[:, 0], traj.x[:, 1], "k--", lw=1.2, label="trajectory")
         ax.plot(*traj.x[0, :2], "o", color="tab:blue")
         ax.set_xlabel("$x_1$")
@@ -100,6 +122,78 @@ def plot_run(spec: Spec, design: TubeDesign, result: SimulationResult, path: str
         if i == 0:
             ax.legend(loc="best", fontsize=7)
     out = Path(path)
+    fig.savefig(out, dpi=110, format="png")
+    return out
+
+
+#: Reach boxes drawn over the arena.
+BOXES_DRAWN = 24
+
+
+def plot_design(spec: Spec, design: Design, path: str | Path) -> Path:
+    """Write a PNG of ``design``: tube boxes (the certificate's enclosure) and via boxes in
+    the first two dimensions, and the certified enclosure of ``gamma_L``, ``gamma_U`` per
+    dimension against time.
+
+    Parameters
+    ----------
+    spec : Spec
+    design : Design
+        From :func:`stt_codegen.design_tube`.
+    path : str or path
+        Output file; its folder must exist.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    tube, enc = design.tube, design.certificate.enclosure
+    n = spec.dimension
+    t_c = tube.prescribed_time
+    fig = agg_figure(figsize=(11, 2.6 * max(n, 2)), layout="constrained")
+    grid = fig.add_gridspec(n, 2, width_ratios=[1.1, 1.4])
+    if n >= 2:
+        ax = fig.add_subplot(grid[:, 0])
+        dims = (0, 1)
+        draw_box(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
+        draw_unsafe_sets(ax, spec, dims)
+        draw_box(ax, spec.target_set, dims, fc="tab:green", alpha=0.35, label="target")
+        times = np.linspace(0.0, t_c, BOXES_DRAWN)
+        which = np.searchsorted(enc.t_start, times, side="right") - 1
+        for k in which:
+            draw_box(ax, Box(tuple(enc.lower_min[k]), tuple(enc.upper_max[k])), dims, fill=False,
+                  ec="tab:orange", lw=0.6,
+                  label="tube box (certified enclosure)" if k == which[0] else None)
+        for k, seg in enumerate(tube.segments if design.method != "paper" else ()):
+            draw_box(ax, Box(seg.lower_to, seg.upper_to), dims, fill=False, ec="tab:purple",
+                  lw=1.2, label="via boxes" if k == 0 else None)
+        ax.set_xlim(spec.state_space.lower[0], spec.state_space.upper[0])
+        ax.set_ylim(spec.state_space.lower[1], spec.state_space.upper[1])
+        ax.set_xlabel("$x_1$")
+        ax.set_ylabel("$x_2$")
+        ax.set_aspect("equal")
+        ax.legend(loc="lower right", fontsize=7)
+        ax.set_title(f"{spec.name}: {design.method} method, "
+                     f"{design.design_time_s * 1e3:.1f} ms")
+    end = 1.2 * t_c
+    keep = enc.t_start < end
+    t0 = enc.t_start[keep]
+    t1 = np.minimum(enc.t_end[keep], end)
+    for i in range(n):
+        ax = fig.add_subplot(grid[i, 1])
+        for lo, hi, colour, name in ((enc.lower_min, enc.lower_max, "tab:blue", r"$\gamma_L$"),
+                                     (enc.upper_min, enc.upper_max, "tab:orange",
+                                      r"$\gamma_U$")):
+            for k in range(t0.size):
+                ax.fill_between([t0[k], t1[k]], [lo[keep][k, i]] * 2, [hi[keep][k, i]] * 2,
+                                color=colour, alpha=0.35, lw=0.8, edgecolor=colour,
+                                label=f"{name} enclosure" if k == 0 else None)
+        ax.axvline(t_c, color="tab:red", lw=0.8, ls=":", label="$t_c$")
+        ax.set_ylabel(f"$x_{i + 1}$")
+        if i == n - 1:
+            ax.set_xlabel("t [s] (certified for every t >= 0; drawn up to 1.2 t_c)")
+        if i == 0:
+            ax.legend(loc="best", fontsize=7)
+    out = Path(path)
     fig.savefig(out, dpi=110)
-    plt.close(fig)
     return out

@@ -99,20 +99,30 @@ def _rk4(rhs, t: float, x: np.ndarray, u: np.ndarray, h: float) -> np.ndarray:
 def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
              horizon: float | None = None, seed: int = 0,
              plant: "ct.NonlinearIOSystem | None" = None) -> SimulationResult:
-    """Run the sampled controller of ``backend`` against the spec's plant.
+    """Run the sampled controller of ``backend`` against the spec's plant; judge Definition 2.1.
+
+    At each sampling instant ``t_k = k / rate_hz`` the controller reads ``x(t_k)`` and
+    computes ``u_k`` by law (13) and the next ``alpha`` by the implicit step of the
+    adaptive law (11); ``u_k`` is held until ``t_{k+1}`` while the plant (eq. (14) or
+    ``x_dot = u + w``, with the spec's seeded, bounded disturbance ``w``) is integrated by
+    Runge-Kutta. The run starts at ``x(0)`` (``initial.state``) with ``alpha = 0``.
 
     Parameters
     ----------
     spec : Spec
+        The task: sets, ``t_c``, plant and disturbance bound.
     design : TubeDesign
-        From :func:`stt_codegen.design.search.design_tube`.
-    backend : str
-        A name from :func:`stt_codegen.runtime.backends.backend_names`.
+        From :func:`stt_codegen.design_tube`.
+    backend : str, optional
+        Implementation of the controller step: ``"reference"`` (the numpy oracle, default),
+        ``"casadi"`` (the CasADi model), ``"c"`` (the generated C, compiled with the
+        system's C compiler) or ``"python"`` (the generated Python); see
+        :func:`stt_codegen.runtime.backends.backend_names`.
     horizon : float, optional
         Simulated time, seconds; default ``t_c``. Definition 2.1 is judged on
         ``[0, min(horizon, t_c)]``; a horizon shorter than ``t_c`` cannot satisfy it.
-    seed : int
-        Seed of the disturbance.
+    seed : int, optional
+        Seed of the disturbance ``w``.
     plant : control.NonlinearIOSystem, optional
         The plant to control instead of the spec's ``[plant]`` (``n`` states, inputs and
         outputs, the state as output); it must include its own disturbance.
@@ -120,17 +130,23 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
     Returns
     -------
     SimulationResult
+        ``satisfied`` (reach the target by ``t_c``, avoid every obstacle, stay in the
+        state space), the reach time (s), the clearance (state units), ``max |u|`` per
+        input, and ``trajectory``: ``t`` (N,), ``x`` (N, n), ``u`` (N, n), ``alpha``
+        (N, 2n), ``status`` (N,), with ``N = ceil(horizon * rate_hz) + 1``.
 
     Raises
     ------
     SpecError
-        Unknown backend, a non-positive horizon, or a run of more than
-        :data:`~stt_codegen.design.samples.STEP_BUDGET` steps.
+        Unknown backend (field ``backend``), a non-positive horizon (``horizon``), or a run
+        of more than :data:`~stt_codegen.design.samples.STEP_BUDGET` steps.
+    ToolchainError
+        Backend ``"c"``: no C compiler, or it failed.
     """
     t_c = spec.prescribed_time
     horizon = t_c if horizon is None else float(horizon)
     if not math.isfinite(horizon) or horizon <= 0:
-        raise SpecError("--horizon", f"must be a positive number of seconds, got {horizon!r}")
+        raise SpecError("horizon", f"must be a positive number of seconds, got {horizon!r}")
     check_step_budget(int(math.ceil(horizon * design.rate_hz - 1e-9)), horizon, design.rate_hz)
     controller = make_controller(backend, design)
     if plant is None:

@@ -9,18 +9,21 @@ the field and the reason.
 from __future__ import annotations
 
 import hashlib
+import json
 import math
 import re
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
+from ..cases import bundled_cases, bundled_spec_bytes
 from ..errors import SpecError
+from .schema import (NAME_REGEX, PLANT_MODELS, TUBE_METHODS, AssumptionsTable, ControllerTable,
+                     PlantTable, TubeTable, check_document, key_name)
 
-NAME_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9_-]{0,63}")
-PLANT_MODELS = ("omnidirectional", "single-integrator", "linear")
+NAME_PATTERN = re.compile(NAME_REGEX)
 #: Fraction of the available room used by the default half-widths ``d_0`` and ``d_T``.
 DEFAULT_HALF_WIDTH_FRACTION = 0.8
 #: Largest state dimension accepted (the generated code unrolls per dimension).
@@ -30,21 +33,16 @@ MAX_OBSTACLES = 4096
 _TOP_KEYS = {"name", "prescribed_time", "state_space", "initial", "target", "obstacles",
              "tube", "controller", "plant", "assumptions"}
 _REQUIRED_TOP = ("name", "prescribed_time", "state_space", "initial", "target")
-_TUBE_DEFAULTS = {
-    "delta_b": 0.2,
-    "theta0": 0.01,
-    "kappa": 5.0,
-    "mu": 1.0,
-    "smoothness": 50.0,
-}
-#: ``tube.method``: the paper's single reach tube, via-point reach tubes, or paper first.
-TUBE_METHODS = ("paper", "via", "auto")
-_CONTROLLER_DEFAULTS: dict[str, float | None] = {"gain": None, "rate_hz": 1000.0}
-_PLANT_DEFAULTS: dict[str, Any] = {"model": "single-integrator", "disturbance_amplitude": 0.1}
+# the defaults are the schema's (spec/schema.py), so that editors show the same ones
+# circumvent_sharpness (automatic when omitted) and method are not plain numbers
+_TUBE_DEFAULTS = {k: f.default for k, f in TubeTable.model_fields.items()
+                  if k not in ("circumvent_sharpness", "method")}
+_CONTROLLER_DEFAULTS: dict[str, float | None] = {
+    k: f.default for k, f in ControllerTable.model_fields.items()}
+_PLANT_DEFAULTS: dict[str, Any] = {k: f.default for k, f in PlantTable.model_fields.items()}
 #: Keys of ``[plant]`` that only the ``linear`` model takes.
 _LINEAR_KEYS = ("a", "g", "c")
-_ASSUMPTION_KEYS = ("input_gain", "input_gain_skew", "input_gain_coupling", "drift_bound",
-                    "disturbance_bound")
+_ASSUMPTION_KEYS = tuple(AssumptionsTable.model_fields)
 
 
 @dataclass(frozen=True)
@@ -317,18 +315,50 @@ class Spec:
         """Every obstacle as a full-dimensional box."""
         return [o.box(self.state_space) for o in self.obstacles]
 
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> "Spec":
+        """Validate a spec given as a dictionary, the same document as a TOML file.
+
+        Parameters
+        ----------
+        data : mapping
+            The spec's tables as nested dicts and lists, exactly as :mod:`tomllib` would
+            read the file: ``{"name": ..., "prescribed_time": ..., "state_space":
+            {"lower": [...], "upper": [...]}, ...}`` (see the README's *Spec format*).
+
+        Returns
+        -------
+        Spec
+            ``source_hash`` is the SHA-256 of the validated document as canonical JSON
+            (sorted keys), since there are no file bytes.
+
+        Raises
+        ------
+        SpecError
+            As :func:`load_spec`: the field and the reason.
+        """
+        if not isinstance(data, Mapping):
+            raise SpecError("", f"a spec is a table (dict), got {_kind(data)}")
+        try:
+            doc = _as_document(data)
+        except RecursionError:
+            raise SpecError("", "nested too deeply") from None
+        spec = _validate(doc)
+        canonical = json.dumps(doc, sort_keys=True, default=repr).encode()
+        return _replace_hash(spec, hashlib.sha256(canonical).hexdigest())
+
 
 # --------------------------------------------------------------------------- loading
 
 
-def bundled_cases() -> list[str]:
-    """Names of the bundled specs, sorted."""
-    folder = resources.files("stt_codegen.cases")
-    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
-
-
 def load_spec(spec: str | Path) -> Spec:
     """Load and validate a spec, by bundled name or by file path.
+
+    A spec is one prescribed-time reach-avoid-stay task (Definition 2.1): the state space
+    ``X``, the initial set ``X_0`` and state ``x(0)``, the target ``T``, the unsafe sets
+    and the prescribed time ``t_c`` (seconds), with the tube's parameters (eqs. (2)-(11)),
+    the controller's gain and rate (law (13)) and the plant used in simulation. The format
+    is the README's *Spec format*; :meth:`Spec.from_dict` takes the same as a dict.
 
     Parameters
     ----------
@@ -338,6 +368,7 @@ def load_spec(spec: str | Path) -> Spec:
     Returns
     -------
     Spec
+        Frozen; vectors are tuples of length ``n``, the state dimension.
 
     Raises
     ------
@@ -347,7 +378,7 @@ def load_spec(spec: str | Path) -> Spec:
     """
     text = str(spec)
     if text in bundled_cases() and not Path(text).exists():
-        data = resources.files("stt_codegen.cases").joinpath(text + ".toml").read_bytes()
+        data = bundled_spec_bytes(text)
     else:
         path = Path(text)
         try:
@@ -380,6 +411,15 @@ def parse_spec(data: bytes | str) -> Spec:
     return _replace_hash(spec, hashlib.sha256(raw).hexdigest())
 
 
+def _as_document(value: Any) -> Any:
+    """A Python value as TOML would read it: mappings as dicts, tuples as lists."""
+    if isinstance(value, Mapping):
+        return {k: _as_document(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_as_document(v) for v in value]
+    return value
+
+
 def _replace_hash(spec: Spec, digest: str) -> Spec:
     from dataclasses import replace
     return replace(spec, source_hash=digest)
@@ -405,11 +445,7 @@ def _no_unknown(table: dict, allowed: set[str], where: str) -> None:
     unknown = sorted(set(table) - allowed)
     if unknown:
         prefix = f"{where}." if where else ""
-        key = unknown[0]
-        if not re.fullmatch(r"[A-Za-z0-9_-]{1,64}", key):
-            # an empty, long or odd key (newlines...) is quoted: the message names it on one line
-            key = repr(key) if len(key) <= 64 else repr(key[:64]) + "..."
-        raise SpecError(f"{prefix}{key}",
+        raise SpecError(f"{prefix}{key_name(unknown[0])}",
                         f"unknown key (allowed: {', '.join(sorted(allowed))})")
 
 
@@ -489,6 +525,7 @@ def _half_width(table: dict, name: str, center: tuple[float, ...], box: Box,
 
 
 def _validate(doc: dict) -> Spec:
+    check_document(doc)     # types, known keys, finite numbers (spec/schema.py)
     _no_unknown(doc, _TOP_KEYS, "")
     for key in _REQUIRED_TOP:
         if key not in doc:

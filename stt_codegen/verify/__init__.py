@@ -1,5 +1,10 @@
 """Symbolic and numeric verification of the paper's formulas (``stt-codegen verify``).
 
+The package is callable: ``stt_codegen.verify(spec, design=None, plant=None)`` is
+:func:`stt_codegen.verify.command.verify` and returns a :class:`VerificationReport`.
+(The front door's ``verify`` and this package share one name, so the package itself is
+the function; see ``docs/library.md``.)
+
 Every check returns a :class:`Check`. The modules:
 
 * :mod:`.lemma` -- Lemma 3.3 pieces: smoothness of the tubes (4), (7)-(8),
@@ -7,14 +12,19 @@ Every check returns a :class:`Check`. The modules:
 * :mod:`.transform` -- error transform and the Lyapunov derivative of the proof
   of Theorem 4.1;
 * :mod:`.assumption` -- Assumption 2 for a plant's input matrix;
-* :mod:`.adaptive` -- non-negativity and an explicit bound of the adaptive law (11).
+* :mod:`.adaptive` -- non-negativity and an explicit bound of the adaptive law (11);
+* :mod:`.command` -- every check of one design, :func:`~.command.verify`.
 """
+
+import sys
+import types
+from typing import TYPE_CHECKING
 
 from .adaptive import (adaptive_law_checks, adversarial_psi_signals, alpha_rate_bound,
                        alpha_upper_bound, check_adaptive_law_numeric, simulate_alpha)
 from .assumption import (assumption2_omnidirectional, assumption2_single_integrator,
                          check_assumption2, symmetric_part)
-from .check import Check, all_passed, format_report
+from .check import Check, VerificationReport, all_passed, format_report
 from .lemma import (bump_rate_bound, check_bump_flat_all_orders, check_bump_flatness,
                     check_reach_continuity, check_reach_flat_all_orders, check_smooth_max,
                     lemma_checks, reach_rate_bound, reach_rate_constant)
@@ -24,6 +34,7 @@ from .transform import (check_epsilon_jacobian, check_lyapunov_derivative,
 
 __all__ = [
     "Check",
+    "VerificationReport",
     "all_passed",
     "format_report",
     # Lemma 3.3
@@ -57,8 +68,21 @@ __all__ = [
     "simulate_alpha",
 ]
 
+if TYPE_CHECKING:
+    from ..spec.loader import Spec
+    from ..tube.parameters import TubeDesign
 
-def register_cli(subparsers) -> None:
-    """Add ``stt-codegen verify`` (see :mod:`.command`)."""
-    from .command import register_cli as _register
-    _register(subparsers)
+
+class _CallablePackage(types.ModuleType):
+    """This package's type: a module that can be called as :func:`.command.verify`."""
+
+    def __call__(self, spec: "Spec", design: "TubeDesign | None" = None,
+                 plant: "str | None" = None) -> VerificationReport:
+        """Every check of a spec's designed tube: see :func:`stt_codegen.verify.command.verify`."""
+        from .command import verify
+        return verify(spec, design, plant)
+
+
+# the package object itself becomes callable (PEP 549-style, supported since Python 3.5);
+# only this module's own type is set, nothing global
+sys.modules[__name__].__class__ = _CallablePackage

@@ -1,4 +1,4 @@
-"""The result object shared by every verification check."""
+"""The result objects of verification: one :class:`Check`, and a :class:`VerificationReport`."""
 
 from __future__ import annotations
 
@@ -42,3 +42,47 @@ def all_passed(checks: Iterable[Check]) -> bool:
 def format_report(checks: Iterable[Check]) -> str:
     """One line per check, ``[PASS]``/``[FAIL]`` first."""
     return "\n".join(str(c) for c in checks)
+
+
+@dataclass(frozen=True)
+class VerificationReport:
+    """Every check of one spec's designed tube (what ``stt-codegen verify`` prints).
+
+    Parameters
+    ----------
+    spec : str
+        The spec's name.
+    checks : tuple of Check
+        In the order of :func:`stt_codegen.verify.command.verify_design`; a spec for
+        which no tube can be designed has the single failed check ``tube.design``.
+    """
+
+    spec: str
+    checks: tuple[Check, ...]
+
+    @property
+    def passed(self) -> bool:
+        """``True`` when every check passed."""
+        return all_passed(self.checks)
+
+    @property
+    def failed(self) -> tuple[Check, ...]:
+        """The checks that failed, in order."""
+        return tuple(c for c in self.checks if not c.passed)
+
+    def __getitem__(self, name: str) -> Check:
+        """The check named ``name`` (e.g. ``"tube.avoids_obstacle_1"``); ``KeyError`` if none."""
+        for c in self.checks:
+            if c.name == name:
+                return c
+        raise KeyError(name)
+
+    def to_json(self) -> list[dict[str, Any]]:
+        """``[{"name", "passed", "detail"}, ...]``, the output of ``verify --json``."""
+        return [{"name": c.name, "passed": c.passed, "detail": c.detail} for c in self.checks]
+
+    def __str__(self) -> str:
+        """One line per check, ``PASS``/``FAIL`` first, then ``N passed, M failed``."""
+        lines = [f"{'PASS' if c.passed else 'FAIL'}  {c.name}: {c.detail}" for c in self.checks]
+        failed = len(self.failed)
+        return "\n".join(lines + [f"{len(self.checks) - failed} passed, {failed} failed"])

@@ -22,7 +22,7 @@ from ..spec.loader import PLANT_MODELS, Spec, load_spec
 from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
 from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_omnidirectional, assumption2_single_integrator
-from .check import Check, all_passed
+from .check import Check, VerificationReport
 from .lemma import bump_rate_bound, lemma_checks, reach_rate_bound
 from .sampled import linear_plant_checks, sampled_checks
 from .transform import error_transform_checks
@@ -152,27 +152,56 @@ def verify_spec(spec: Spec, plant: str | None = None) -> list[Check]:
     return verify_design(spec, design, plant)
 
 
+def verify(spec: Spec, design: TubeDesign | None = None,
+           plant: str | None = None) -> VerificationReport:
+    """Check the paper's lemmas, the assumptions and the tube certificate for a spec.
+
+    The checks: Lemma 3.3 (smoothness of eqs. (4), (7)-(10) and explicit rate bounds),
+    the error transform and the Lyapunov derivative of Theorem 4.1 (eq. (12), law (13)),
+    Assumption 2 for the plant, the adaptive law (11) per component of ``alpha``, the
+    sampling-rate limit, the room at the start and the continuous-time certificate of the
+    tube (non-empty, contains ``x(0)``, in the state space, misses every obstacle, in the
+    target from ``t_c`` on).
+
+    Parameters
+    ----------
+    spec : Spec
+        From :func:`stt_codegen.load_spec` or :meth:`stt_codegen.Spec.from_dict`.
+    design : TubeDesign, optional
+        The design to check; by default the tube is designed first, and a spec with no
+        design gives a report whose one check, ``tube.design``, failed.
+    plant : str, optional
+        Plant model for Assumption 2 (``"omnidirectional"`` or ``"single-integrator"``);
+        default the spec's ``plant.model``.
+
+    Returns
+    -------
+    VerificationReport
+        ``report.passed`` is ``True`` when every check passed; ``report.failed`` lists
+        the others with their evidence.
+
+    Raises
+    ------
+    SpecError
+        Unknown plant model (field ``plant``), or one that does not fit the spec's
+        dimension.
+    """
+    if plant is not None and plant not in PLANT_MODELS:
+        raise SpecError("plant", f"must be one of {', '.join(PLANT_MODELS)}")
+    if plant == "omnidirectional" and spec.dimension != 3:
+        raise SpecError("plant", "the omnidirectional robot has 3 states")
+    checks = verify_spec(spec, plant) if design is None else verify_design(spec, design, plant)
+    return VerificationReport(spec.name, tuple(checks))
+
+
 def _cmd_verify(args: argparse.Namespace) -> int:
-    if args.plant is not None and args.plant not in PLANT_MODELS:
-        raise SpecError("--plant", f"must be one of {', '.join(PLANT_MODELS)}")
-    spec = load_spec(args.spec)
-    if args.plant == "omnidirectional" and spec.dimension != 3:
-        raise SpecError("--plant", "the omnidirectional robot has 3 states")
-    checks = verify_spec(spec, args.plant)
-    if args.json:
-        print(json.dumps([{"name": c.name, "passed": c.passed, "detail": c.detail}
-                          for c in checks], indent=2))
-    else:
-        for c in checks:
-            print(f"{'PASS' if c.passed else 'FAIL'}  {c.name}: {c.detail}")
-        failed = sum(not c.passed for c in checks)
-        print(f"{len(checks) - failed} passed, {failed} failed")
-    return 0 if all_passed(checks) else 1
+    report = verify(load_spec(args.spec), plant=args.plant)
+    print(json.dumps(report.to_json(), indent=2) if args.json else str(report))
+    return 0 if report.passed else 1
 
 
-def register_cli(subparsers) -> None:
-    """Add the ``verify`` subcommand."""
-    p = subparsers.add_parser("verify", help="check the paper's lemmas and certify the tube")
+def configure_verify(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen verify``."""
     p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
     p.add_argument("--json", action="store_true", help="print a JSON list of checks")
     p.add_argument("--plant", default=None, metavar="MODEL",

@@ -1,15 +1,15 @@
 """Exceptions raised by the code emitter.
 
-Both derive from :class:`stt_codegen.errors.SttError`, so the command line reports
-them as one line (``error: ...``) without a traceback.
+Both derive from :class:`stt_codegen.errors.ToolchainError`, so the command line reports
+them as one line (``error: ...``) without a traceback, exit code 3.
 """
 
 from __future__ import annotations
 
-from stt_codegen.errors import SttError
+from stt_codegen.errors import ToolchainError
 
 
-class EmitError(SttError):
+class EmitError(ToolchainError):
     """A CasADi Function cannot be turned into code (not SX, free symbols, bad names...)."""
 
 

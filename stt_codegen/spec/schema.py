@@ -1,0 +1,351 @@
+"""The spec file's schema, with pydantic v2: types, known keys, finite numbers.
+
+:class:`SpecDocument` describes the TOML document (the README's *Spec format*) as it is
+written: every table and key, its type, its sign, its default. Validation is strict (no
+coercion: ``"9"`` is not a number, ``true`` is not a number), extra keys are forbidden, and
+numbers must be finite and at most 1e12 in magnitude. :func:`check_document` turns the
+first violation into a :class:`~stt_codegen.errors.SpecError` naming the field, in the
+loader's words (``prescribed_time: must be positive, got -1``). The rules that relate
+fields to each other (lengths equal to the state dimension, sets inside the state space,
+``x(0)`` in the interior of ``X_0``, obstacles missing the start and the target) are the
+loader's (:mod:`stt_codegen.spec.loader`).
+
+:func:`json_schema` is the JSON Schema of the document (``stt-codegen schema``): editors
+with a TOML language server validate and complete spec files with it.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Annotated, Any, Literal
+
+from pydantic import (AllowInfNan, BaseModel, ConfigDict, Discriminator, Field, Strict, Tag,
+                      ValidationError)
+
+from ..errors import SpecError
+
+#: Largest magnitude of any number in a spec.
+MAX_MAGNITUDE = 1e12
+#: A spec name: a C identifier once ``-`` becomes ``_``, at most 64 characters.
+NAME_REGEX = r"^[A-Za-z][A-Za-z0-9_-]{0,63}$"
+#: Plant models of ``[plant] model``.
+PLANT_MODELS = ("omnidirectional", "single-integrator", "linear")
+#: ``tube.method``: the paper's single reach tube, via-point reach tubes, or paper first.
+TUBE_METHODS = ("paper", "via", "auto")
+#: At most this many vertices per polytope.
+MAX_VERTICES = 1024
+
+# strict: an integer is a number, a boolean or a string is not; no NaN, no infinity
+Number = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE)]
+Positive = Annotated[float, Strict(), AllowInfNan(False), Field(gt=0, le=MAX_MAGNITUDE)]
+NonNegative = Annotated[float, Strict(), AllowInfNan(False), Field(ge=0, le=MAX_MAGNITUDE)]
+Vector = Annotated[list[Number], Field(min_length=1)]
+Index = Annotated[int, Strict(), Field(ge=0)]
+Matrix = Annotated[list[Vector], Field(min_length=1)]
+
+
+def _omitted(description: str) -> Any:
+    """A key that may be left out (the loader then derives its value), but not null: TOML
+    has no null, and the JSON Schema shows no default."""
+    return Field(None, description=description,
+                 json_schema_extra=lambda schema: schema.pop("default", None))
+
+
+class _Table(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
+
+
+class BoxTable(_Table):
+    """A box ``prod_i [lower_i, upper_i]``, one entry per state dimension."""
+
+    lower: Vector = Field(description="lower corner, state units")
+    upper: Vector = Field(description="upper corner, state units; upper >= lower")
+
+
+class InitialTable(BoxTable):
+    """The initial set ``X_0`` (a box inside ``X``) and the initial state ``x(0)``."""
+
+    state: Vector = _omitted("x(0), in the interior of X_0; default its centre")
+    half_width: Vector = _omitted("d_0 of eq. (2), positive; default 0.8 x the room around "
+                                  "x(0) in X_0")
+
+
+class TargetTable(BoxTable):
+    """The target set ``T`` (a box inside ``X``)."""
+
+    center: Vector = _omitted("eta of eq. (3), in the interior of T; default its centre")
+    half_width: Vector = _omitted("d_T of eq. (3), positive; default 0.8 x the room around "
+                                  "eta in T")
+
+
+class BoxObstacle(_Table):
+    """A box obstacle; given on the dimensions ``dims`` (default the first ones)."""
+
+    lower: Vector
+    upper: Vector
+    dims: list[Index] = _omitted("state dimensions of lower/upper (default the first ones); "
+                                 "the box spans the others")
+
+
+class BallObstacle(_Table):
+    """A ball obstacle, covered by boxes (Remark 3.1)."""
+
+    center: Vector
+    radius: Positive
+    dims: list[Index] = _omitted("state dimensions of the coordinates (default the first "
+                                 "ones)")
+    tolerance: Positive = Field(0.05, description="largest distance from the covering "
+                                                  "boxes to the ball, state units")
+
+
+class PolytopeObstacle(_Table):
+    """A convex polytope obstacle given by its vertices, covered by boxes (Remark 3.1)."""
+
+    vertices: Annotated[list[Vector], Field(min_length=1, max_length=MAX_VERTICES)]
+    dims: list[Index] = _omitted("state dimensions of the coordinates (default the first "
+                                 "ones)")
+    tolerance: Positive = Field(0.05, description="largest distance from the covering "
+                                                  "boxes to the polytope, state units")
+
+
+def _obstacle_kind(value: Any) -> str | None:
+    """The loader's rule: ``vertices`` makes a polytope, ``center`` or ``radius`` a ball."""
+    if not isinstance(value, dict):
+        return None
+    if "vertices" in value:
+        return "polytope"
+    return "ball" if "center" in value or "radius" in value else "box"
+
+
+Obstacle = Annotated[Annotated[BoxObstacle, Tag("box")] | Annotated[BallObstacle, Tag("ball")]
+                     | Annotated[PolytopeObstacle, Tag("polytope")],
+                     Discriminator(_obstacle_kind)]
+
+
+class TubeTable(_Table):
+    """Tube shaping, section III of the paper."""
+
+    delta_b: Positive = Field(0.2, description="delta_B of eqs. (7)-(8): clearance kept "
+                                               "from each obstacle, state units")
+    circumvent_sharpness: Positive = _omitted("k^j of eqs. (7)-(8), the same for every "
+                                              "obstacle; default chosen per circumvent by "
+                                              "the design")
+    theta0: Positive = Field(0.01, description="theta_0 of eq. (11)")
+    kappa: Positive = Field(5.0, description="kappa of eq. (11)")
+    mu: Positive = Field(1.0, description="mu of eq. (11), state units")
+    smoothness: Positive = Field(50.0, description="nu of the smooth max/min of eqs. "
+                                                   "(9)-(10), 1/state units")
+    method: Literal[TUBE_METHODS] = Field("auto",  # type: ignore[valid-type]
+                                          description="paper: one reach tube, eq. (4); via: "
+                                                      "through via boxes; auto: paper first")
+
+
+class ControllerTable(_Table):
+    """The deployed controller, law (13)."""
+
+    gain: Positive = _omitted("k of law (13); default derived from the designed tube")
+    rate_hz: Positive = Field(1000.0, description="sampling rate, Hz")
+
+
+class PlantTable(_Table):
+    """The plant used in simulation only; the controller never sees it."""
+
+    model: Literal[PLANT_MODELS] = Field("single-integrator",  # type: ignore[valid-type]
+                                         description="omnidirectional: eq. (14), 3 states; "
+                                                     "single-integrator: x_dot = u + w; "
+                                                     "linear: x_dot = a x + c + g u + w")
+    disturbance_amplitude: NonNegative = Field(0.1, description="bound on |w_i|, state "
+                                                                "units per second")
+    a: Matrix = _omitted("linear model only: the n x n matrix a, as rows; default zero")
+    g: Matrix = _omitted("linear model only: the n x n input matrix g, as rows; default "
+                         "the identity")
+    c: Vector = _omitted("linear model only: the constant drift c; default zero")
+
+
+class AssumptionsTable(_Table):
+    """What the controller's designer knows about the unknown plant x_dot = f + g u + w."""
+
+    input_gain: Annotated[list[Number], Field(min_length=2, max_length=2)] = _omitted(
+        "[g_min, g_max]: bounds on the eigenvalues of the symmetric part of g(x); "
+        "g_min > 0 (Assumption 2); default [1, 1]")
+    input_gain_skew: NonNegative = Field(0.0, description="bound on the norm of the skew "
+                                                          "part of g(x)")
+    input_gain_coupling: NonNegative = _omitted("bound on the off-diagonal part of each row "
+                                                "of g(x); default implied by the two above")
+    drift_bound: NonNegative = Field(0.0, description="bound on |f(x)|, state units per "
+                                                      "second")
+    disturbance_bound: NonNegative = _omitted("bound on |w(t)|, state units per second; "
+                                              "default sqrt(n) x plant.disturbance_amplitude")
+
+
+class SpecDocument(_Table):
+    """One prescribed-time reach-avoid-stay task (Definition 2.1) and its design parameters.
+
+    The document of a spec file, key for key; see the README's *Spec format*.
+    """
+
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True,
+                              title="stt-codegen spec")
+
+    name: Annotated[str, Strict(), Field(pattern=NAME_REGEX)] = Field(
+        description="identifier [A-Za-z][A-Za-z0-9_-]*, at most 64 characters")
+    prescribed_time: Positive = Field(description="t_c of Definition 2.1, seconds")
+    state_space: BoxTable = Field(description="the state space X")
+    initial: InitialTable
+    target: TargetTable
+    obstacles: list[Obstacle] = Field([], description="unsafe sets inside X: boxes, balls, "
+                                                      "convex polytopes")
+    tube: TubeTable = TubeTable()
+    controller: ControllerTable = ControllerTable()
+    plant: PlantTable = PlantTable()
+    assumptions: AssumptionsTable = AssumptionsTable()
+
+
+#: The JSON Schema dialect of :func:`json_schema`: draft 7, which TOML language servers
+#: (Taplo, Even Better TOML, Tombi) read; references are JSON pointers into ``$defs``.
+JSON_SCHEMA_DIALECT = "http://json-schema.org/draft-07/schema#"
+
+
+def json_schema() -> dict[str, Any]:
+    """The JSON Schema (draft 7) of a spec document, from :class:`SpecDocument`."""
+    return {"$schema": JSON_SCHEMA_DIALECT, **SpecDocument.model_json_schema()}
+
+
+_TABLES: dict[str, type[_Table]] = {
+    "state_space": BoxTable, "initial": InitialTable, "target": TargetTable,
+    "tube": TubeTable, "controller": ControllerTable, "plant": PlantTable,
+    "assumptions": AssumptionsTable,
+    "box": BoxObstacle, "ball": BallObstacle, "polytope": PolytopeObstacle}
+
+
+def key_name(key: str) -> str:
+    """A key as it appears in a field name: quoted when empty, long or odd (newlines...),
+    so that the message names it on one line."""
+    if re.fullmatch(r"[A-Za-z0-9_-]{1,64}", key):
+        return key
+    return repr(key) if len(key) <= 64 else repr(key[:64]) + "..."
+
+
+def _field(loc: tuple) -> str:
+    """``("obstacles", 2, "ball", "radius")`` -> ``"obstacles[2].radius"`` (union tags dropped)."""
+    text = ""
+    for k, part in enumerate(loc):
+        if isinstance(part, int):
+            text += f"[{part}]"
+        elif not (part in ("box", "ball", "polytope") and k and isinstance(loc[k - 1], int)):
+            name = key_name(part) if k == len(loc) - 1 else part
+            text += f".{name}" if text else name
+    return text
+
+
+def _allowed(loc: tuple) -> list[str]:
+    """The keys of the table in which ``loc`` names a key."""
+    tables = [_TABLES[p] for p in loc[:-1] if isinstance(p, str) and p in _TABLES]
+    return sorted((tables[-1] if tables else SpecDocument).model_fields)
+
+
+def _kind(value: Any) -> str:
+    return {bool: "a boolean", str: "a string", list: "an array", dict: "a table",
+            int: "an integer", float: "a float"}.get(type(value), type(value).__name__)
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else f"{text[:20]}...({len(text)} characters)"
+
+
+def _reason(error: dict) -> str:
+    """One violation in the loader's words."""
+    kind, value, ctx = error["type"], error.get("input"), error.get("ctx") or {}
+    if kind in ("list_type", "too_short", "too_long") and error["loc"][-1] == "input_gain":
+        return f"must be an array [g_min, g_max] of two numbers, got {_short(value)}"
+    if kind == "missing":
+        return "missing"
+    if kind == "extra_forbidden":
+        return f"unknown key (allowed: {', '.join(_allowed(error['loc']))})"
+    if kind == "finite_number":
+        return f"must be finite, got {value!r}"
+    if kind in ("float_type", "float_parsing"):
+        if isinstance(value, int) and not isinstance(value, bool):
+            return f"magnitude {_short(value)} is beyond 1e12"
+        return f"must be a number, got {_kind(value)}"
+    if kind in ("int_type", "int_parsing", "int_from_float"):
+        return f"must be an integer, got {_kind(value)}"
+    if kind == "string_type":
+        return f"must be a string, got {_kind(value)}"
+    if kind == "string_pattern_mismatch":
+        return (f"{_short(value)} is not an identifier: it must match [A-Za-z][A-Za-z0-9_-]* "
+                "and be at most 64 characters")
+    if kind == "literal_error":
+        return f"must be one of {ctx.get('expected', '')}, got {_short(value)}".replace("'", "")
+    if kind == "greater_than":
+        return f"must be positive, got {value!r}"
+    if kind == "greater_than_equal":
+        return f"must be non-negative, got {value!r}"
+    if kind == "less_than_equal":
+        return f"magnitude {value!r} is beyond 1e12"
+    if kind == "too_short":
+        return "must not be empty"
+    if kind == "too_long":
+        return f"{len(value)} entries; at most {ctx.get('max_length')}"
+    if kind == "list_type":
+        what = {"obstacles": "tables", "vertices": "points (arrays)",
+                "dims": "dimension indices", "a": "rows (arrays of numbers)",
+                "g": "rows (arrays of numbers)"}.get(error["loc"][-1], "numbers")
+        return f"must be an array of {what}, got {_kind(value)}"
+    if kind in ("model_type", "model_attributes_type", "dict_type", "union_tag_not_found",
+                "union_tag_invalid"):
+        return f"must be a table, got {_kind(value)}"
+    return error["msg"]
+
+
+#: Arrays of arrays: a row that is not an array is reported as the whole array's fault.
+_NESTED = ("vertices", "a", "g")
+
+
+def _row_as_array(error: dict) -> dict:
+    loc = error["loc"]
+    if (error["type"] == "list_type" and len(loc) >= 2 and isinstance(loc[-1], int)
+            and loc[-2] in _NESTED):
+        return {**error, "loc": loc[:-1], "input": [error["input"]]}
+    return error
+
+
+def _order(fields: tuple[str, ...]):
+    """Sort key: unknown top-level keys first, then missing ones, then in field order."""
+    def key(error: dict) -> tuple[int, int, int]:
+        loc, kind = error["loc"], error["type"]
+        if len(loc) == 1 and kind in ("extra_forbidden", "missing"):
+            return (0 if kind == "extra_forbidden" else 1, 0, 0)
+        top = fields.index(loc[0]) if loc and loc[0] in fields else len(fields)
+        return (2, top, {"extra_forbidden": 0, "missing": 1}.get(kind, 2))
+    return key
+
+
+def check_document(doc: Any) -> SpecDocument:
+    """Validate a spec document against :class:`SpecDocument`.
+
+    Parameters
+    ----------
+    doc : dict
+        The document as :mod:`tomllib` reads it.
+
+    Returns
+    -------
+    SpecDocument
+        With the defaults of the keys not given.
+
+    Raises
+    ------
+    SpecError
+        The first violation: the field (``"tube.kappa"``, ``"obstacles[2].radius"``) and
+        the reason (``"must be positive, got 0.0"``).
+    """
+    try:
+        return SpecDocument.model_validate(doc)
+    except ValidationError as exc:
+        first = _row_as_array(sorted(exc.errors(include_url=False),
+                                     key=_order(tuple(SpecDocument.model_fields)))[0])
+        raise SpecError(_field(first["loc"]), _reason(first)) from None
+    except RecursionError:
+        raise SpecError("", "nested too deeply") from None

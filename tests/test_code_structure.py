@@ -1,0 +1,160 @@
+"""The package's structure: no import cycle, no private name across modules, citations that
+resolve, and the test suite's own rules (derandomized property tests)."""
+
+from __future__ import annotations
+
+import ast
+import os
+import re
+from pathlib import Path
+
+import pytest
+from hypothesis import settings
+
+import stt_codegen
+
+PACKAGE = Path(stt_codegen.__file__).parent
+REPO = PACKAGE.parent
+
+
+def _module_name(path: Path) -> str:
+    parts = path.relative_to(REPO).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+MODULES = {_module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+
+
+def _target(module: str, node: ast.ImportFrom, is_package: bool) -> str:
+    if not node.level:
+        return node.module or ""
+    base = module.split(".") if is_package else module.split(".")[:-1]
+    base = base[:len(base) - (node.level - 1)]
+    return ".".join(base + ([node.module] if node.module else []))
+
+
+def _module_level_imports(path: Path) -> list[ast.stmt]:
+    """Import statements executed when the module is imported: the module's body and the
+    bodies of its top-level ``try`` blocks, not function bodies, not ``if TYPE_CHECKING``."""
+    found = []
+    for node in ast.parse(path.read_text()).body:
+        if isinstance(node, (ast.Import, ast.ImportFrom)):
+            found.append(node)
+        elif isinstance(node, ast.Try):
+            found += [n for n in node.body if isinstance(n, (ast.Import, ast.ImportFrom))]
+    return found
+
+
+def import_graph() -> dict[str, set[str]]:
+    """Module -> the package's modules it imports at import time, parent packages included
+    (importing ``a.b.c`` first imports ``a.b``)."""
+    graph: dict[str, set[str]] = {}
+    for module, path in MODULES.items():
+        edges: set[str] = set()
+        for node in _module_level_imports(path):
+            if isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            else:
+                target = _target(module, node, path.name == "__init__.py")
+                names = [f"{target}.{a.name}" if f"{target}.{a.name}" in MODULES else target
+                         for a in node.names]
+            edges |= {n for n in names if n in MODULES}
+        for name in list(edges):
+            parts = name.split(".")
+            edges |= {".".join(parts[:k]) for k in range(2, len(parts))
+                      if not module.startswith(".".join(parts[:k]) + ".")}
+        edges.discard(module)
+        graph[module] = edges
+    return graph
+
+
+def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
+    """One cycle of the graph as a list of modules (first == last), or None."""
+    state: dict[str, int] = {}
+
+    def visit(node: str, path: list[str]) -> list[str] | None:
+        state[node] = 1
+        path.append(node)
+        for nxt in sorted(graph.get(node, ())):
+            if state.get(nxt) == 1:
+                return path[path.index(nxt):] + [nxt]
+            if not state.get(nxt):
+                cycle = visit(nxt, path)
+                if cycle:
+                    return cycle
+        path.pop()
+        state[node] = 2
+        return None
+
+    for start in sorted(graph):
+        if not state.get(start):
+            cycle = visit(start, [])
+            if cycle:
+                return cycle
+    return None
+
+
+def test_the_graph_sees_the_imports():
+    graph = import_graph()
+    assert len(graph) > 50
+    assert "stt_codegen.spec.loader" in graph["stt_codegen.design.search"]
+    assert "stt_codegen.codegen" in graph["stt_codegen.runtime.compiled"]   # parent package
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert find_cycle({"a": {"b"}, "b": set()}) is None
+
+
+def test_no_import_cycle_between_the_packages_modules():
+    assert find_cycle(import_graph()) is None
+
+
+def test_the_architecture_document_states_the_dependencies():
+    """docs/architecture.md's table "package | imports" is the import graph, by package."""
+    doc = (REPO / "docs" / "architecture.md").read_text()
+    table = doc[doc.index("| package | imports |"):].split("\n\n", 1)[0]
+    stated = {}
+    for row in table.splitlines()[2:]:
+        package, imports = row.strip("|").split("|")
+        name = re.findall(r"`([\w.]+)`", package)[0]
+        stated[name] = set(re.findall(r"`([\w.]+)`", imports.split(";")[0]))
+
+    def package_of(module: str) -> str:
+        parts = module.split(".")
+        return parts[1] if len(parts) > 1 else parts[0]
+
+    actual = {package_of(m): set() for m in MODULES}
+    for module, edges in import_graph().items():
+        actual[package_of(module)] |= {package_of(e) for e in edges} - {package_of(module)}
+    assert stated == actual
+
+
+def test_no_module_imports_a_private_name_from_another_module():
+    """``from x import _y`` anywhere in the package (functions included) is refused."""
+    offenders = []
+    for module, path in MODULES.items():
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ImportFrom):
+                for alias in node.names:
+                    if alias.name.startswith("_") and not alias.name.startswith("__"):
+                        offenders.append(f"{module}:{node.lineno} imports {alias.name}")
+    assert offenders == []
+
+
+def test_citations_of_the_design_notes_resolve():
+    """The code, tests and README cite docs/design-notes.md by item; every item exists."""
+    notes = (REPO / "docs" / "design-notes.md").read_text()
+    items = {int(m) for m in re.findall(r"^\s*(\d+)\. \*\*", notes, flags=re.M)}
+    assert items == set(range(1, 14))
+    cited = []
+    files = [*PACKAGE.rglob("*.py"), *(REPO / "tests").glob("*.py"), REPO / "README.md"]
+    for path in files:
+        text = path.read_text()
+        assert "paper-notes" not in text or path.name == Path(__file__).name, path
+        cited += [int(n) for n in re.findall(r"design[- ]notes(?:\.md)?,? items? (\d+)", text)]
+    assert cited and set(cited) <= items
+
+
+def test_property_tests_are_derandomized_by_default():
+    """conftest loads the 'ci' profile under CI, and by default."""
+    if not os.environ.get("CI") and os.environ.get("HYPOTHESIS_PROFILE", "ci") != "ci":
+        pytest.skip("another Hypothesis profile was asked for outside CI")
+    assert settings.default.derandomize is True and settings.default.database is None

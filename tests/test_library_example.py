@@ -1,0 +1,74 @@
+"""The library example of docs/library.md (and the README's "Use from Python"), run verbatim."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+import stt_codegen
+
+DOC = Path(__file__).parent.parent / "docs" / "library.md"
+
+
+def python_blocks_of(markdown: str) -> list[str]:
+    """The ```python fenced blocks of a markdown text, in order."""
+    return re.findall(r"^```python\n(.*?)^```$", markdown, flags=re.S | re.M)
+
+
+def python_blocks(path: Path) -> list[str]:
+    """The ```python fenced blocks of a markdown file, in order."""
+    return python_blocks_of(path.read_text())
+
+
+def test_the_document_has_the_examples():
+    blocks = python_blocks(DOC)
+    assert len(blocks) == 2
+    assert "stt.load_spec" in blocks[0] and "stt.Spec.from_dict" in blocks[1]
+
+
+def test_the_readme_example_is_the_documents():
+    """The README's "Use from Python" shows the first example of docs/library.md, verbatim
+    (so the test below runs the README's code too)."""
+    readme = (DOC.parent.parent / "README.md").read_text()
+    if "## Use from Python" not in readme:
+        pytest.skip("the README has no section 'Use from Python' yet")
+    section = readme.split("## Use from Python", 1)[1].split("\n## ", 1)[0]
+    assert python_blocks_of(section)[0] == python_blocks(DOC)[0]
+
+
+@pytest.mark.parametrize("k", [0, 1])
+def test_library_example_runs_verbatim(k, tmp_path, monkeypatch, capsys):
+    if k == 0 and shutil.which("cc") is None and shutil.which("gcc") is None:
+        pytest.skip("the example compiles C: install the Debian package gcc")
+    monkeypatch.chdir(tmp_path)
+    exec(compile(python_blocks(DOC)[k], f"{DOC.name}[{k}]", "exec"), {})
+    out = capsys.readouterr().out
+    if k == 0:
+        assert "omnirobot-s1: " in out and "checks passed" in out
+        assert sorted(p.name for p in (tmp_path / "omnirobot-s1-float").iterdir()) == [
+            "Makefile", "manifest.json", "omnirobot_s1.c", "omnirobot_s1.h",
+            "omnirobot_s1_selftest.c", "omnirobot_s1_vectors.json"]
+    else:
+        lines = out.splitlines()
+        assert lines[0] == "True"
+        assert lines[1].startswith("prescribed_time - must be positive")
+        assert lines[2].startswith("no design: ")
+
+
+def test_every_public_name_has_a_docstring():
+    names = [n for n in stt_codegen.__all__ if n != "__version__"]
+    assert {"load_spec", "Spec", "design_tube", "generate", "simulate", "verify",
+            "SpecError", "DesignError", "ToolchainError"} <= set(names)
+    for name in names:
+        obj = getattr(stt_codegen, name)
+        doc = (type(obj).__call__.__doc__ if name == "verify" else obj.__doc__) or ""
+        assert len(doc.strip()) > 20, name
+    for name in ("generate", "simulate", "load_spec", "design_tube"):
+        doc = getattr(stt_codegen, name).__doc__
+        assert "Parameters\n" in doc and "Returns\n" in doc and "Raises\n" in doc, name
+    assert "Parameters\n" in stt_codegen.verify.command.verify.__doc__
+    assert callable(stt_codegen.verify) and stt_codegen.verify.lemma is not None
+    assert stt_codegen.Spec.from_dict.__doc__
