@@ -49,7 +49,7 @@ def test_library_example_runs_verbatim(k, tmp_path, monkeypatch, capsys):
     if k == 0:
         assert "omnirobot-s1: " in out and "checks passed" in out
         assert sorted(p.name for p in (tmp_path / "omnirobot-s1-float").iterdir()) == [
-            "Makefile", "manifest.json", "omnirobot_s1.c", "omnirobot_s1.h",
+            "CMakeLists.txt", "Makefile", "manifest.json", "omnirobot_s1.c", "omnirobot_s1.h",
             "omnirobot_s1_selftest.c", "omnirobot_s1_vectors.json"]
     else:
         lines = out.splitlines()
