@@ -22,7 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..codegen.emit import c_source
 from ..codegen.render import c_identifier, render
+from ..runtime.dynamics import NAMED_MODELS, plant_rhs
 from ..runtime.plants import Disturbance
 from ..runtime.simulate import SUBSTEPS
 from ..spec.loader import Spec
@@ -93,7 +95,14 @@ def closed_loop_source(spec: Spec, design: TubeDesign, *, seed: int = 0, decimat
         w_omega=[[_d(v) for v in r] for r in dist.frequencies],
         w_phi=[[_d(v) for v in r] for r in dist.phases],
         replay=[int(k) for k in replay], obstacles=_obstacles(spec),
-        has_obstacles=bool(spec.unsafe_sets))
+        has_obstacles=bool(spec.unsafe_sets),
+        plant_rhs=c_source(plant_rhs(_named_model(spec.plant_model), n)).strip())
+
+
+def _named_model(model: str) -> str:
+    """The named plant the closed loop simulates: a ``linear`` spec plant is simulated as
+    the single integrator here (its matrices are not compiled in)."""
+    return model if model in NAMED_MODELS else "single-integrator"
 
 
 def float_bits(values) -> list[str]:

@@ -1,7 +1,9 @@
 """Plant models for closed-loop simulation, as python-control ``NonlinearIOSystem``s.
 
 The controller never sees these: they only stand in for the unknown system (1),
-``x_dot = f(x) + g(x) u + w``, in simulation.
+``x_dot = f(x) + g(x) u + w``, in simulation. The named plants' ``g(x) u`` is the one
+definition in :mod:`.dynamics`, printed to Python by the emitter (the same Function is
+printed to C for the embedded closed loop and to SymPy for Assumption 2).
 """
 
 from __future__ import annotations
@@ -9,8 +11,10 @@ from __future__ import annotations
 import control as ct
 import numpy as np
 
+from ..codegen.emit import python_function
 from ..errors import SpecError
 from ..spec.loader import LinearPlant
+from .dynamics import plant_rhs
 
 #: Number of sinusoids summed in each disturbance component.
 DISTURBANCE_TERMS = 3
@@ -50,23 +54,28 @@ def omnidirectional_robot(disturbance: Disturbance) -> ct.NonlinearIOSystem:
     """The omnidirectional robot of eq. (14): ``x_dot = R(x3) u + w(t)``.
 
     States ``[x1, x2, x3]`` (position in m, heading in rad); inputs ``[v1, v2, omega]``
-    in the robot frame (m/s, rad/s); outputs the state.
+    in the robot frame (m/s, rad/s); outputs the state. ``R(x3) u`` is
+    :func:`.dynamics.plant_rhs` (``"omnidirectional"``).
     """
-    def rhs(t, x, u, params):
-        c, s = np.cos(x[2]), np.sin(x[2])
-        return np.array([c * u[0] - s * u[1], s * u[0] + c * u[1], u[2]]) + disturbance(t)
-
-    return ct.nlsys(rhs, None, inputs=["v1", "v2", "omega"], states=["x1", "x2", "x3"],
-                    outputs=["x1", "x2", "x3"], name="omnidirectional_robot")
+    return _named_plant("omnidirectional", 3, disturbance, inputs=["v1", "v2", "omega"],
+                        states=["x1", "x2", "x3"], outputs=["x1", "x2", "x3"],
+                        name="omnidirectional_robot")
 
 
 def single_integrator(dimension: int, disturbance: Disturbance) -> ct.NonlinearIOSystem:
-    """``x_dot = u + w(t)`` in ``dimension`` states; outputs the state."""
-    def rhs(t, x, u, params):
-        return np.asarray(u, dtype=float) + disturbance(t)
+    """``x_dot = u + w(t)`` in ``dimension`` states; outputs the state
+    (:func:`.dynamics.plant_rhs`, ``"single-integrator"``)."""
+    return _named_plant("single-integrator", dimension, disturbance, inputs=dimension,
+                        states=dimension, outputs=dimension, name="single_integrator")
 
-    return ct.nlsys(rhs, None, inputs=dimension, states=dimension, outputs=dimension,
-                    name="single_integrator")
+
+def _named_plant(model: str, n: int, disturbance: Disturbance, **io) -> ct.NonlinearIOSystem:
+    g_u = python_function(plant_rhs(model, n))
+
+    def rhs(t, x, u, params):
+        return np.array(g_u(x, u)[0]) + disturbance(t)
+
+    return ct.nlsys(rhs, None, **io)
 
 
 def linear_plant(a, g, c, disturbance: Disturbance) -> ct.NonlinearIOSystem:

@@ -40,6 +40,8 @@ piece                  inputs                                       outputs
 ``newton_root_start``  alpha, psi, c, A                             a0
 ``newton_iteration``   a, alpha, psi, c, A                          a (one division)
 ``law``                x (n), gamma_L (n), gamma_U (n), gain        u (n), inside (law (13))
+``error_transform``    x (n), gamma_L (n), gamma_U (n)              e, epsilon, xi (section IV;
+                                                                    for verify, not emitted)
 =====================  ===========================================  ==========================
 
 Vectors of length 2n stack the lower bounds then the upper ones (``[L; U]``).
@@ -331,21 +333,56 @@ def newton_pieces() -> tuple:
     )
 
 
-def law_expression(x, gamma_l, gamma_u, gain, n: int) -> tuple:
-    """Deployed law (13) with clamps: ``(u, inside)``; ``e`` clamped to ``[-E_MAX, E_MAX]``
-    and ``gamma_d`` floored at ``GAMMA_D_MIN`` so that ``u`` is finite everywhere."""
+def _scaled_error(x, gamma_l, gamma_u) -> tuple:
+    """``(gamma_d, width, e)``: ``width = max(gamma_d, GAMMA_D_MIN)``, ``e = (2 x - gamma_s)
+    / width`` (``gamma_s = gamma_U + gamma_L``, ``gamma_d = gamma_U - gamma_L``)."""
     gamma_d = gamma_u - gamma_l
     width = ca.fmax(gamma_d, GAMMA_D_MIN)
-    e = (2.0 * x - (gamma_u + gamma_l)) / width
+    return gamma_d, width, (2.0 * x - (gamma_u + gamma_l)) / width
+
+
+def _transform(e, width) -> tuple:
+    """``(e_c, epsilon, xi)`` from the scaled error: ``e`` clamped to ``[-E_MAX, E_MAX]``."""
+    e_c = ca.fmin(ca.fmax(e, -E_MAX), E_MAX)
+    epsilon = ca.log((1.0 + e_c) / (1.0 - e_c))
+    xi = 4.0 / (width * (1.0 - e_c ** 2))
+    return e_c, epsilon, xi
+
+
+def error_transform_expression(x, gamma_l, gamma_u) -> tuple:
+    """Error transform of section IV with clamps: ``(e, epsilon, xi)`` (n-vectors, SX).
+
+    ``e = (2 x - gamma_s) / gamma_d`` (``gamma_s = gamma_U + gamma_L``, ``gamma_d =
+    gamma_U - gamma_L`` floored at ``GAMMA_D_MIN``) clamped to ``[-E_MAX, E_MAX]``,
+    ``epsilon = ln((1 + e)/(1 - e))``, ``xi = 4 / (gamma_d (1 - e^2))`` (the diagonal of
+    ``xi`` in law (13)), finite everywhere; the same construction as :func:`law_expression`.
+    """
+    _, width, e = _scaled_error(x, gamma_l, gamma_u)
+    return _transform(e, width)
+
+
+def law_expression(x, gamma_l, gamma_u, gain, n: int) -> tuple:
+    """Deployed law (13) with clamps: ``(u, inside)``, ``u = -gain xi epsilon`` with the
+    ``epsilon``, ``xi`` of :func:`error_transform_expression` (finite everywhere)."""
+    gamma_d, width, e = _scaled_error(x, gamma_l, gamma_u)
     inside = 1.0
     for i in range(n):
         # judged with the true width: below the GAMMA_D_MIN floor a state outside the tube
         # must not be reported inside
         inside = ca.logic_and(inside, ca.fabs(2.0 * x[i] - (gamma_u[i] + gamma_l[i])) < gamma_d[i])
-    e_c = ca.fmin(ca.fmax(e, -E_MAX), E_MAX)
-    epsilon = ca.log((1.0 + e_c) / (1.0 - e_c))
-    xi = 4.0 / (width * (1.0 - e_c ** 2))
+    _, epsilon, xi = _transform(e, width)
     return -gain * xi * epsilon, inside
+
+
+@lru_cache(maxsize=None)
+def error_transform(n: int) -> ca.Function:
+    """``error_transform(x, gamma_L, gamma_U) -> (e, epsilon, xi)``: the expressions
+    :func:`law` is built from, as their own Function (for ``stt-codegen verify``; not
+    emitted)."""
+    x, gamma_l, gamma_u = (ca.SX.sym(name, n) for name in ("x", "gamma_L", "gamma_U"))
+    return ca.Function("error_transform", [x, gamma_l, gamma_u],
+                       list(error_transform_expression(x, gamma_l, gamma_u)),
+                       ["x", "gamma_L", "gamma_U"], ["e", "epsilon", "xi"])
 
 
 @lru_cache(maxsize=None)

@@ -5,13 +5,20 @@ The package is callable: ``stt_codegen.verify(spec, design=None, plant=None)`` i
 (The front door's ``verify`` and this package share one name, so the package itself is
 the function; see ``docs/library.md``.)
 
-Every check returns a :class:`Check`. The modules:
+Every check returns a :class:`Check`. The checks are proved on the deployed expressions:
+the pieces of :mod:`stt_codegen.tube.pieces` printed by the emitter's SymPy printer. The
+modules:
 
+* :mod:`.deployed` -- the deployed expressions as SymPy, reduced to a domain, and their
+  equality with the paper's formulas (``deployed.*``);
+* :mod:`.statements` -- the paper's formulas as stated, the right-hand sides of those
+  equalities only;
 * :mod:`.lemma` -- Lemma 3.3 pieces: smoothness of the tubes (4), (7)-(8),
   (9)-(10) and explicit rate bounds;
 * :mod:`.transform` -- error transform and the Lyapunov derivative of the proof
   of Theorem 4.1;
-* :mod:`.assumption` -- Assumption 2 for a plant's input matrix;
+* :mod:`.assumption` -- Assumption 2 for a plant's input matrix (the named plants' from
+  :mod:`stt_codegen.runtime.dynamics`);
 * :mod:`.adaptive` -- non-negativity and an explicit bound of the adaptive law (11);
 * :mod:`.command` -- every check of one design, :func:`~.command.verify`.
 """

@@ -34,6 +34,7 @@ import sympy as sp
 from scipy.integrate import solve_ivp
 
 from .check import Check
+from .deployed import trigger, trigger_clamped
 
 __all__ = [
     "theta",
@@ -198,24 +199,29 @@ def adaptive_law_checks(
                      "would make alpha unbounded, growing like t^(1/3))",
                      {"theta0": theta0, "kappa": kappa, "mu": mu}))
 
-    p, a, y = sp.symbols("psi alpha y", real=True)
-    th0, kap, mu_s = sp.symbols("theta0 kappa mu", positive=True)
-    th = th0 * (1 - sp.tanh(p - mu_s))
-    # -- non-negativity
-    ident = sp.simplify((1 - sp.tanh(y) - 2 / (1 + sp.exp(2 * y))).rewrite(sp.exp))
+    # the deployed trigger (pieces.conflict printed by the SymPy printer), in the symbols
+    # psi (real), theta0 and mu (positive); deployed.trigger proves it equal to
+    # theta0 (1 - tanh(psi - mu)) where its clamps are inactive
+    clamped, (p, th0, mu_s) = trigger_clamped()
+    th = trigger()
+    kap = sp.Symbol("kappa", positive=True)
+    # -- non-negativity, on the deployed expression with its clamps
+    positive = bool(clamped.is_positive)
     zthr = theta_zero_threshold()
     out.append(Check(
         "adaptive.nonnegative",
-        ident == 0,
-        "theta = theta0 (1 - tanh(psi - mu)) = 2 theta0/(1 + e^{2(psi-mu)}) > 0 "
-        f"(identity {'verified' if ident == 0 else 'FAILED'}), so alpha_dot >= -kappa "
+        positive,
+        f"the deployed theta = {clamped} is "
+        f"{'proved > 0' if positive else 'NOT proved > 0'} for every psi (theta0 > 0), "
+        "so alpha_dot >= -kappa "
         "alpha and alpha(0) = 0 give alpha(t) >= 0 (alpha_dot = theta/psi^2 >= 0 at "
-        f"alpha = 0). In double precision theta == 0 once psi - mu > {zthr:.6g}: then "
-        "alpha_dot = -kappa alpha, still >= 0",
+        "alpha = 0). (The numpy oracle's 1 - tanh(psi - mu) rounds to 0 once psi - mu > "
+        f"{zthr:.6g}; then alpha_dot = -kappa alpha, still >= 0.)",
         {"theta_zero_threshold": zthr},
     ))
     # -- upper bound
     pm, aa, ts = sp.symbols("psi_min a theta_sup", real=True)
+    # d theta/d psi of the deployed trigger (0 where a clamp acts: still <= 0)
     dth = sp.simplify((sp.diff(th, p) + th0 * sp.sech(p - mu_s) ** 2).rewrite(sp.exp))
     fa = kap * aa * (pm + aa) ** 2
     dfa = sp.factor(sp.diff(fa, aa))

@@ -16,10 +16,12 @@ from typing import Mapping, Sequence
 
 import sympy as sp
 
+from ..codegen.emit import sympy_expressions
+from ..runtime.dynamics import input_matrix
 from .check import Check
-from .formulas import omnidirectional_g, single_integrator_g
 
 __all__ = [
+    "plant_input_matrix",
     "symmetric_part",
     "check_assumption2",
     "assumption2_omnidirectional",
@@ -31,6 +33,27 @@ __all__ = [
 TOUCH_TOL = 1e-12
 #: Range ends are snapped outward to multiples of 1/SNAP.
 SNAP = 10**15
+
+
+def plant_input_matrix(model: str, n: int, x: Sequence[sp.Symbol]) -> sp.Matrix:
+    """The deployed ``g(x)`` of a named plant as a SymPy matrix.
+
+    :func:`stt_codegen.runtime.dynamics.input_matrix` (the one definition of the plant,
+    also simulated and compiled into the embedded closed loop) printed by the SymPy
+    printer, with the state entries ``x``.
+
+    Parameters
+    ----------
+    model : str
+        ``"omnidirectional"`` (eq. (14)) or ``"single-integrator"``.
+    n : int
+        State dimension.
+    x : sequence of sympy.Symbol, length n
+    """
+    (g,) = sympy_expressions(input_matrix(model, n), {"x": list(x)})
+    # dense column-major -> (n, n); exact zeros and ones as SymPy integers
+    entries = [sp.nsimplify(v) if v.is_Number else v for v in g]
+    return sp.Matrix(n, n, lambda i, j: entries[j * n + i])
 
 
 def symmetric_part(g: sp.Matrix) -> sp.Matrix:
@@ -153,12 +176,13 @@ def assumption2_omnidirectional(heading_range: Sequence[float]) -> Check:
     heading_range : (lo, hi)
         Range of ``x3`` the tube (or the state space) allows, in radians.
     """
-    x3 = sp.Symbol("x3", real=True)
-    return check_assumption2(omnidirectional_g(x3), {x3: tuple(heading_range)},
-                             name="assumption2.omnidirectional")
+    x = sp.symbols("x1:4", real=True)
+    return check_assumption2(plant_input_matrix("omnidirectional", 3, x),
+                             {x[2]: tuple(heading_range)}, name="assumption2.omnidirectional")
 
 
 def assumption2_single_integrator(n: int) -> Check:
     """Assumption 2 for ``x_dot = u + w``: ``g_s = I``, ``g_lower = 1``."""
-    return check_assumption2(single_integrator_g(n), {},
+    x = sp.symbols(f"x1:{n + 1}", real=True)
+    return check_assumption2(plant_input_matrix("single-integrator", n, x), {},
                              name="assumption2.single_integrator")

@@ -23,6 +23,7 @@ from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
 from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_omnidirectional, assumption2_single_integrator
 from .check import Check, VerificationReport
+from .deployed import deployed_checks
 from .lemma import bump_rate_bound, lemma_checks, reach_rate_bound
 from .sampled import linear_plant_checks, sampled_checks
 from .transform import error_transform_checks
@@ -33,11 +34,13 @@ _SIDES = ("L", "U")
 
 @functools.lru_cache(maxsize=None)
 def symbolic_checks(max_n: int) -> tuple[Check, ...]:
-    """The design-independent proofs (Lemma 3.3 limits, smooth max, error transform).
+    """The design-independent proofs: the deployed pieces equal the paper's formulas
+    (``deployed.*``), Lemma 3.3 limits, smooth max, error transform.
 
     They take SymPy some seconds and depend on no parameter, so a process proves them once.
     """
-    return tuple(lemma_checks(orders=3)) + tuple(error_transform_checks(max_n=max_n))
+    return (tuple(deployed_checks()) + tuple(lemma_checks(orders=3))
+            + tuple(error_transform_checks(max_n=max_n)))
 
 
 def _psi_ranges(design: TubeDesign, certificate: Certificate) -> tuple[np.ndarray, np.ndarray]:
@@ -61,7 +64,8 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> l
     Returns
     -------
     list of Check
-        In order: Lemma 3.3, the error transform, Assumption 2 (and, for the linear
+        In order: Lemma 3.3, the error transform, the equality of each deployed piece with
+        the paper's formula (``deployed.*``), Assumption 2 (and, for the linear
         plant, whether it meets ``[assumptions]``), the adaptive law (per component of
         ``alpha``), the tube certificate, and the sampled closed loop
         (:func:`~stt_codegen.verify.sampled.sampled_checks`).
@@ -78,7 +82,8 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> l
     reach_checks = [reach_rate_bound(*p) for p in reach]
     bump_checks = [bump_rate_bound(*p) for p in bumps]
     checks = [c for c in symbolic if c.name.startswith("lemma")] + reach_checks + bump_checks
-    checks += [c for c in symbolic if not c.name.startswith("lemma")]
+    checks += [c for c in symbolic if not c.name.startswith(("lemma", "deployed"))]
+    checks += [c for c in symbolic if c.name.startswith("deployed")]
     # smooth-step segments: sup |d/dt tau^3 (10 - 15 tau + 6 tau^2)| = 30/16 per duration
     # (at tau = 1/2, where 30 tau^2 (1 - tau)^2 is largest)
     smooth_rates = [abs(b - a) * 1.875 / seg.duration for seg in design.segments
@@ -156,7 +161,10 @@ def verify(spec: Spec, design: TubeDesign | None = None,
            plant: str | None = None) -> VerificationReport:
     """Check the paper's lemmas, the assumptions and the tube certificate for a spec.
 
-    The checks: Lemma 3.3 (smoothness of eqs. (4), (7)-(10) and explicit rate bounds),
+    The checks run on the deployed expressions (the pieces of :mod:`stt_codegen.tube.pieces`
+    printed by the SymPy printer; ``deployed.*`` proves each equal to the paper's formula
+    where the code writes it differently): Lemma 3.3 (smoothness of eqs. (4), (7)-(10)
+    and explicit rate bounds),
     the error transform and the Lyapunov derivative of Theorem 4.1 (eq. (12), law (13)),
     Assumption 2 for the plant, the adaptive law (11) per component of ``alpha``, the
     sampling-rate limit, the room at the start and the continuous-time certificate of the

@@ -18,6 +18,12 @@ with SymPy for symbolic parameters:
 
 Together with the bound on ``alpha`` and ``alpha_dot`` of
 :mod:`stt_codegen.verify.adaptive`, these give Lemma 3.3 by the chain rule.
+
+The expressions are the deployed ones (:mod:`.deployed`: the pieces of
+:mod:`stt_codegen.tube.pieces` printed by the SymPy printer, reduced to the branch the
+lemma is about): the reach tube and its rate output, the bump and its rate output, ``F_nu``.
+The smooth max is proved on the paper's statement, which ``deployed.smooth_max`` proves
+equal to the deployed ``max~`` and ``min~``.
 """
 
 from __future__ import annotations
@@ -28,8 +34,10 @@ import mpmath
 import numpy as np
 import sympy as sp
 
+from . import deployed
 from .check import Check
-from .formulas import bump, reach_branch, smax
+from .deployed import K, M, NU as _NU, R, T, T_C, TARGET, X0
+from .statements import smax
 
 __all__ = [
     "check_reach_continuity",
@@ -51,17 +59,10 @@ __all__ = [
     "K",
 ]
 
-# Symbols shared with callers that pass an altered expression.
-T = sp.Symbol("t", real=True)
-T_C = sp.Symbol("t_c", positive=True)
-X0 = sp.Symbol("X", real=True)
-TARGET = sp.Symbol("T", real=True)
-M = sp.Symbol("m", real=True)
-R = sp.Symbol("r", positive=True)
-K = sp.Symbol("k", positive=True)
+# Symbols shared with callers that pass an altered expression: T, T_C, X0, TARGET, M, R,
+# K (those of the deployed expressions, :mod:`.deployed`).
 _W = sp.Symbol("w", positive=True)
 _H = sp.Symbol("h", positive=True)
-_NU = sp.Symbol("nu", positive=True)
 
 
 def _is_zero(expr: sp.Expr) -> bool:
@@ -127,9 +128,10 @@ def check_reach_continuity(
     ----------
     branch : sympy expression, optional
         The ``t < t_c`` branch in the symbols :data:`T`, :data:`T_C`,
-        :data:`X0`, :data:`TARGET`; default eq. (4).
+        :data:`X0`, :data:`TARGET`; default the deployed one
+        (:func:`.deployed.reach_branch`, proved equal to eq. (4)).
     constant : sympy expression, optional
-        The ``t >= t_c`` branch; default :data:`TARGET`.
+        The ``t >= t_c`` branch; default the deployed one (:func:`.deployed.reach_after`).
     orders : int
         Highest derivative order checked.
 
@@ -139,9 +141,9 @@ def check_reach_continuity(
         ``data["limits"]`` lists the left limit of each order (as strings).
     """
     if branch is None:
-        branch = reach_branch(T, T_C, X0, TARGET)
+        branch = deployed.reach_branch()
     if constant is None:
-        constant = TARGET
+        constant = deployed.reach_after()
     limits: list[str] = []
     for j, lim in enumerate(_left_limits_at_tc(branch, orders)):
         limits.append(str(lim))
@@ -160,7 +162,8 @@ def check_reach_continuity(
         "lemma3.3.reach.continuity",
         True,
         f"lim t->t_c^- rho = {constant} and lim d^j rho/dt^j = 0 for j = 1..{orders} "
-        f"(symbolic X, T, t_c > 0; substitution w = t/(t_c - t) -> oo)",
+        f"(deployed progress_tanh + interpolate; symbolic X, T, t_c > 0; substitution "
+        "w = t/(t_c - t) -> oo)",
         {"limits": limits, "orders": orders},
     )
 
@@ -227,20 +230,21 @@ def check_bump_flatness(expr: sp.Expr | None = None, orders: int = 4) -> Check:
     Parameters
     ----------
     expr : sympy expression, optional
-        The in-window branch in :data:`T`, :data:`M`, :data:`R`, :data:`K`;
-        default eqs. (7)-(8).
+        The in-window branch in :data:`T`, :data:`M`, :data:`R`, :data:`K`, used at both
+        edges; default the deployed bump (:func:`.deployed.bump_window`, height 1) on
+        each half of its window (where its exponent clamp at -80 is inactive).
     orders : int
         Highest derivative order checked.
     """
-    if expr is None:
-        expr = bump(T, M, R, K)
+    f_left = deployed.bump_window(-1) if expr is None else expr
+    f_right = deployed.bump_window(1) if expr is None else expr
+    expr = f_right
     limits: list[tuple[str, str]] = []
-    f = expr
     for j in range(orders + 1):
         if j > 0:
-            f = sp.diff(f, T)
-        left = sp.simplify(sp.limit(f.subs(T, M - R + _H), _H, 0, "+"))
-        right = sp.simplify(sp.limit(f.subs(T, M + R - _H), _H, 0, "+"))
+            f_left, f_right = sp.diff(f_left, T), sp.diff(f_right, T)
+        left = sp.simplify(sp.limit(f_left.subs(T, M - R + _H), _H, 0, "+"))
+        right = sp.simplify(sp.limit(f_right.subs(T, M + R - _H), _H, 0, "+"))
         limits.append((str(left), str(right)))
         for edge, lim in (("m - r (from inside)", left), ("m + r (from inside)", right)):
             if not _is_zero(lim):
@@ -350,7 +354,7 @@ def reach_rate_bound(x0: float, target: float, t_c: float) -> Check:
     """Explicit ``sup_t |rho_dot(t)|`` for one bound of the tube (4).
 
     ``rho_dot = (T - X) sech^2(w) (1+w)^2 / t_c`` with ``w = t/(t_c - t)``
-    (verified symbolically), 0 for ``t >= t_c``; so
+    (verified symbolically on the deployed ``rho_dot`` output), 0 for ``t >= t_c``; so
     ``sup |rho_dot| = |T - X| C / t_c`` with ``C`` from
     :func:`reach_rate_constant`, attained at ``t* = t_c w*/(1+w*)``.
 
@@ -363,7 +367,7 @@ def reach_rate_bound(x0: float, target: float, t_c: float) -> Check:
     """
     if not t_c > 0:
         return Check("lemma3.3.reach.rate_bound", False, f"t_c = {t_c} is not > 0", {})
-    deriv = sp.diff(reach_branch(T, T_C, X0, TARGET), T)
+    deriv = deployed.reach_rate()   # the deployed rho_dot output, t < t_c
     claimed = (TARGET - X0) * sp.sech(_W) ** 2 * (1 + _W) ** 2 / T_C
     ident = sp.simplify((deriv.subs(T, T_C * _W / (1 + _W)) - claimed).rewrite(sp.exp))
     stat = sp.simplify(
@@ -416,8 +420,9 @@ def bump_rate_bound(k: float, r: float, height: float = 1.0) -> Check:
                      f"need k > 0 and r > 0, got k = {k}, r = {r}", {})
     z = sp.Symbol("z", positive=True)
     q = sp.Symbol("q", positive=True)
-    b_z = bump(T, M, R, K).subs(T, M + R * z)
-    bdot = sp.diff(bump(T, M, R, K), T).subs(T, M + R * z)
+    # the deployed bump and its deployed y_dot output on the half t > m of the window
+    b_z = deployed.bump_window(1).subs(T, M + R * z)
+    bdot = deployed.bump_window(1, rate=True).subs(T, M + R * z)
     form_ok = sp.simplify(bdot - (-2 * K / R) * z / (1 - z**2) ** 2 * b_z) == 0
     h = z / (1 - z**2) ** 2 * sp.exp(-K * z**2 / (1 - z**2))
     # z (1 - z^2)^2 d ln h/dz, a polynomial in z^2
@@ -507,11 +512,13 @@ def check_smooth_max(expr: sp.Expr | None = None, arity: int = 2) -> Check:
         lim = sp.limit(bias, d, sp.oo)
         if lim != 0:
             failures.append(f"bias tends to {lim}, not 0, as |a-b| -> oo")
+        # the deployed max~ (max + log1p(exp(-nu|a-b|))/nu) on a_1 = a_2 + d
         stable = sp.simplify(sp.logcombine(
-            expr.subs(a1, a2 + d) - (a2 + d) - sp.log(1 + sp.exp(-_NU * d)) / _NU,
+            expr.subs(a1, a2 + d) - deployed.smooth_max_half(1).subs(a1, a2 + d),
             force=True))
         if stable != 0:
-            failures.append("overflow-free form max + log1p(exp(-nu|a-b|))/nu differs")
+            failures.append("the deployed overflow-free form max + log1p(exp(-nu|a-b|))/nu "
+                            "differs")
     if failures:
         return Check("lemma3.3.smooth_max", False, "; ".join(failures),
                      {"expr": str(expr), "bias": str(bias)})
@@ -521,7 +528,7 @@ def check_smooth_max(expr: sp.Expr | None = None, arity: int = 2) -> Check:
         f"partials = softmax weights in (0,1), sum 1 (m = {arity}); C-infinity; "
         + (f"bias smax - max = {bias} (a - b = d >= 0) decreasing from ln(2)/nu to 0: "
            "0 <= smax - max <= ln(2)/nu, -ln(2)/nu <= smin - min <= 0; equals "
-           "max + log1p(exp(-nu|a-b|))/nu" if arity == 2 else
+           "the deployed max + log1p(exp(-nu|a-b|))/nu" if arity == 2 else
            f"smax - max = ln(sum_j e^(nu(a_j - max)))/nu in [0, ln({arity})/nu] "
            f"(the sum is in [1, {arity}]), ln({arity})/nu attained at equal arguments"),
         {"expr": str(expr), "bias": str(bias), "bias_max": "log(2)/nu"},
@@ -559,10 +566,11 @@ def check_open_bump_sum(arity: int = 3) -> Check:
         if sp.simplify(sp.diff(full, y) - sp.exp(_NU * (y - full))) != 0:
             failures.append(f"dF/d{y} is not exp(nu ({y} - F))")
             break
-    shifted = big_m + sp.log(sp.exp(-_NU * big_m) + sum(
-        sp.exp(_NU * (y - big_m)) - sp.exp(-_NU * big_m) for y in ys)) / _NU
+    shifted, _, deployed_ys, _, top = deployed.open_bump_sum(arity)
+    shifted = shifted.xreplace({top: big_m, **dict(zip(deployed_ys, ys))})
     if sp.simplify(sp.expand_log(sp.exp(_NU * shifted) - sp.exp(_NU * full), force=True)) != 0:
-        failures.append("the overflow-free form differs")
+        failures.append("the deployed overflow-free form (fnu_init, fnu_add, fnu_finish) "
+                        "differs")
     grid = np.linspace(0.0, 3.0, 7)
     worst = 0.0
     for nu in (0.5, 5.0, 50.0):
@@ -577,8 +585,8 @@ def check_open_bump_sum(arity: int = 3) -> Check:
         return Check(name, False, "; ".join(failures), {})
     return Check(name, True, f"F_nu of eq. (9) ({arity} arguments): F(0) = 0, a closed window "
                  "(y_j = 0) drops out exactly, F = y for one argument, dF/dy_j = "
-                 "exp(nu (y_j - F)) > 0 (non-decreasing, C-infinity), the overflow-free "
-                 "form is equal; max(0, y) <= F <= max(0, y) + ln(m)/nu (and on a grid)",
+                 "exp(nu (y_j - F)) > 0 (non-decreasing, C-infinity), the deployed "
+                 "overflow-free form (fnu_init, fnu_add, fnu_finish) is equal; max(0, y) <= F <= max(0, y) + ln(m)/nu (and on a grid)",
                  {"arity": arity})
 
 

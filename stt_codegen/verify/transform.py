@@ -4,6 +4,11 @@
 ``xi = diag(4/(gamma_d_i (1 - e_i^2)))``. The paper writes
 ``xi = 4 gamma_d^{-1} (I - e e^T)^{-1}``; read as an outer product this is not
 the Jacobian of ``epsilon`` for ``n >= 2`` (docs/design-notes.md, item 2).
+
+``e``, ``epsilon`` and ``xi`` are the deployed ones: :func:`.deployed.error_transform`
+prints :func:`stt_codegen.tube.pieces.error_transform` (the expressions law (13) is built
+from) with the SymPy printer, where its clamps are inactive; ``deployed.law`` proves them
+equal to the formulas above and the deployed ``u`` equal to ``-k xi epsilon``.
 """
 
 from __future__ import annotations
@@ -13,6 +18,7 @@ from typing import Callable
 import sympy as sp
 
 from .check import Check
+from .deployed import error_transform
 
 __all__ = [
     "xi_diagonal",
@@ -37,17 +43,15 @@ def xi_outer_product(e: sp.Matrix, gamma_d: sp.Matrix) -> sp.Matrix:
     return 4 * sp.diag(*[1 / g for g in gamma_d]) * (sp.eye(n) - e * e.T).inv()
 
 
-def _symbols(n: int) -> tuple[sp.Matrix, sp.Matrix, sp.Matrix]:
-    x = sp.Matrix(sp.symbols(f"x1:{n + 1}", real=True))
-    gs = sp.Matrix(sp.symbols(f"gamma_s1:{n + 1}", real=True))
-    gd = sp.Matrix(sp.symbols(f"gamma_d1:{n + 1}", positive=True))
-    return x, gs, gd
-
-
-def _transform(x: sp.Matrix, gs: sp.Matrix, gd: sp.Matrix) -> tuple[sp.Matrix, sp.Matrix]:
-    e = sp.Matrix([(2 * x[i] - gs[i]) / gd[i] for i in range(len(x))])
-    eps = sp.Matrix([sp.log((1 + ei) / (1 - ei)) for ei in e])
-    return e, eps
+def _time_dependent(n: int, t: sp.Symbol) -> tuple:
+    """The deployed ``(e, epsilon, xi)`` with ``x_i``, ``gamma_s_i``, ``gamma_d_i`` functions
+    of ``t``, and those functions ``(x, gamma_s, gamma_d)``."""
+    e, eps, xi_d, x_s, gs_s, gd_s = error_transform(n)
+    x = sp.Matrix([sp.Function(f"x{i + 1}", real=True)(t) for i in range(n)])
+    gs = sp.Matrix([sp.Function(f"gamma_s{i + 1}", real=True)(t) for i in range(n)])
+    gd = sp.Matrix([sp.Function(f"gamma_d{i + 1}", positive=True)(t) for i in range(n)])
+    to_time = {**dict(zip(x_s, x)), **dict(zip(gs_s, gs)), **dict(zip(gd_s, gd))}
+    return e.xreplace(to_time), eps.xreplace(to_time), xi_d.xreplace(to_time), x, gs, gd
 
 
 def check_epsilon_jacobian(n: int, xi: XiBuilder | None = None) -> Check:
@@ -64,22 +68,22 @@ def check_epsilon_jacobian(n: int, xi: XiBuilder | None = None) -> Check:
     n : int
         State dimension (1, 2, 3 are cheap).
     xi : callable, optional
-        ``xi(e, gamma_d) -> Matrix``; default :func:`xi_diagonal`. Pass
-        :func:`xi_outer_product` to see the paper's literal reading fail.
+        ``xi(e, gamma_d) -> Matrix``; default the deployed ``xi`` (the diagonal reading,
+        :func:`xi_diagonal`). Pass :func:`xi_outer_product` to see the paper's literal
+        reading fail.
     """
-    xi = xi or xi_diagonal
-    x, gs, gd = _symbols(n)
-    e, eps = _transform(x, gs, gd)
+    _, eps, xi_d, x, gs, gd = error_transform(n)
     es = sp.Matrix(sp.symbols(f"e1:{n + 1}", real=True))
     # evaluate in e-coordinates: x_i = (gamma_d_i e_i + gamma_s_i)/2 (a bijection)
     back = {x[i]: (gd[i] * es[i] + gs[i]) / 2 for i in range(n)}
     jac = eps.jacobian(x).subs(back)
-    diff = (jac - xi(es, gd)).applyfunc(lambda v: sp.factor(sp.cancel(sp.together(v))))
+    xi_m = sp.diag(*xi_d).subs(back) if xi is None else xi(es, gd)
+    diff = (jac - xi_m).applyfunc(lambda v: sp.factor(sp.cancel(sp.together(v))))
     name = f"theorem4.1.epsilon_jacobian.n{n}"
     if diff.is_zero_matrix:
         return Check(name, True,
-                     f"d epsilon/dx = xi exactly for n = {n} (entrywise, symbolic x, "
-                     "gamma_s, gamma_d > 0); off-diagonal entries 0",
+                     f"d epsilon/dx = xi exactly for n = {n} (the deployed epsilon and xi; "
+                     "entrywise, symbolic x, gamma_s, gamma_d > 0); off-diagonal entries 0",
                      {"n": n})
     bad = [(i, j) for i in range(n) for j in range(n) if diff[i, j] != 0]
     i, j = bad[0]
@@ -130,15 +134,12 @@ def check_lyapunov_derivative(n: int, xi: XiBuilder | None = None) -> Check:
     xi : callable, optional
         As in :func:`check_epsilon_jacobian`.
     """
-    xi = xi or xi_diagonal
     t = sp.Symbol("t", real=True)
-    x = sp.Matrix([sp.Function(f"x{i + 1}", real=True)(t) for i in range(n)])
-    gs = sp.Matrix([sp.Function(f"gamma_s{i + 1}", real=True)(t) for i in range(n)])
-    gd = sp.Matrix([sp.Function(f"gamma_d{i + 1}", positive=True)(t) for i in range(n)])
-    e, eps = _transform(x, gs, gd)
+    e, eps, xi_d, x, gs, gd = _time_dependent(n, t)
+    xi_m = sp.diag(*xi_d) if xi is None else xi(e, gd)
     v = (eps.T * eps)[0] / 2
     vdot = sp.diff(v, t)
-    rhs = (eps.T * xi(e, gd) * (x.diff(t) - (gs.diff(t) + sp.matrix_multiply_elementwise(
+    rhs = (eps.T * xi_m * (x.diff(t) - (gs.diff(t) + sp.matrix_multiply_elementwise(
         gd.diff(t), e)) / 2))[0]
     # Freeze time: derivatives and functions -> symbols, logs -> symbols L_i, then
     # x_i -> (gamma_d_i e_i + gamma_s_i)/2. The difference is linear in the L_i.
@@ -166,7 +167,8 @@ def check_lyapunov_derivative(n: int, xi: XiBuilder | None = None) -> Check:
     if diff == 0:
         return Check(name, True,
                      f"d/dt (eps^T eps/2) = eps^T xi (x_dot - (gamma_s_dot + gamma_d_dot e)/2) "
-                     f"identically for n = {n} (time-dependent x, gamma_s, gamma_d)",
+                     f"identically for n = {n} (the deployed e, epsilon, xi; time-dependent "
+                     "x, gamma_s, gamma_d)",
                      {"n": n})
     return Check(name, False,
                  f"V_dot - eps^T xi (x_dot - (gamma_s_dot + gamma_d_dot e)/2) = {diff} "
