@@ -260,7 +260,8 @@ def check_bump_flatness(expr: sp.Expr | None = None, orders: int = 4) -> Check:
         "lemma3.3.bump.flatness",
         True,
         f"b and d^j b/dt^j (j = 1..{orders}) -> 0 at both window edges m -+ r from "
-        "inside (symbolic m, r > 0, k > 0): the piecewise bump is C^"
+        "inside (the deployed bump on each half of its window; symbolic m, r > 0, k > 0): "
+        "the piecewise bump is C^"
         f"{orders} (C-infinity by the induction of check_bump_flat_all_orders)",
         {"limits": limits, "orders": orders},
     )
