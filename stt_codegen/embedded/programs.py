@@ -24,7 +24,7 @@ import numpy as np
 
 from ..codegen.emit import c_source
 from ..codegen.render import c_identifier, render
-from ..runtime.dynamics import NAMED_MODELS, plant_rhs
+from ..runtime.dynamics import plant_function
 from ..runtime.plants import Disturbance
 from ..runtime.simulate import SUBSTEPS
 from ..spec.loader import Spec
@@ -80,8 +80,10 @@ def closed_loop_source(spec: Spec, design: TubeDesign, *, seed: int = 0, decimat
     prefix = c_identifier(spec.c_name)
     n = spec.dimension
     dist = Disturbance(n, spec.disturbance_amplitude, seed)
-    plant_doc = ("x_dot = R(x3) u + w, R the rotation by the heading x3 (eq. (14))"
-                 if spec.plant_model == "omnidirectional" else "x_dot = u + w")
+    plant_doc = {"omnidirectional": "x_dot = R(x3) u + w, R the rotation by the heading x3 "
+                                    "(eq. (14))",
+                 "linear": "x_dot = a x + c + g u + w, the spec's matrices"}.get(
+                     spec.plant_model, "x_dot = u + w")
     return render(
         "embedded_closed_loop.c.j2", P=prefix, U=prefix.upper(), spec_name=spec.name,
         real="float", plant=spec.plant_model, plant_doc=plant_doc, n=n,
@@ -96,13 +98,7 @@ def closed_loop_source(spec: Spec, design: TubeDesign, *, seed: int = 0, decimat
         w_phi=[[_d(v) for v in r] for r in dist.phases],
         replay=[int(k) for k in replay], obstacles=_obstacles(spec),
         has_obstacles=bool(spec.unsafe_sets),
-        plant_rhs=c_source(plant_rhs(_named_model(spec.plant_model), n)).strip())
-
-
-def _named_model(model: str) -> str:
-    """The named plant the closed loop simulates: a ``linear`` spec plant is simulated as
-    the single integrator here (its matrices are not compiled in)."""
-    return model if model in NAMED_MODELS else "single-integrator"
+        plant_rhs=c_source(plant_function(spec.plant_model, n, spec.linear_plant)).strip())
 
 
 def float_bits(values) -> list[str]:

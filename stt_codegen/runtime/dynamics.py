@@ -11,17 +11,22 @@ omnidirectional robot of eq. (14) (``g(x) = R(x3)``, ``f = 0``) and the single i
 * the embedded closed loop (``templates/embedded_closed_loop.c.j2``) contains
   :func:`plant_rhs` printed by the C printer.
 
-The spec's ``linear`` plant (``x_dot = A x + c + G u + w``) has its matrices in the spec;
-it is :func:`stt_codegen.runtime.plants.linear_plant`.
+The spec's ``linear`` plant (``x_dot = a x + c + g u + w``, matrices from the spec) is
+:func:`linear_rhs`, used the same way by the simulation and the embedded closed loop
+(its Assumption 2 check is :func:`stt_codegen.verify.sampled.linear_plant_checks`, on the
+spec's ``g``). :func:`plant_function` picks the one of a spec's ``[plant]``.
 """
 
 from __future__ import annotations
 
 from functools import lru_cache
 
-import casadi as ca
+from typing import Sequence
 
-__all__ = ["NAMED_MODELS", "input_matrix", "plant_rhs"]
+import casadi as ca
+import numpy as np
+
+__all__ = ["NAMED_MODELS", "input_matrix", "linear_rhs", "plant_function", "plant_rhs"]
 
 #: Plants with a fixed model (``plant.model`` values other than ``"linear"``).
 NAMED_MODELS = ("omnidirectional", "single-integrator")
@@ -81,3 +86,51 @@ def plant_rhs(model: str, n: int) -> ca.Function:
     x, u = ca.SX.sym("x", n), ca.SX.sym("u", n)
     return ca.Function("plant_rhs", [x, u], [ca.mtimes(_g(model, x), u)], ["x", "u"],
                        ["x_dot"])
+
+
+def linear_rhs(a: Sequence[Sequence[float]], g: Sequence[Sequence[float]],
+               c: Sequence[float]) -> ca.Function:
+    """``plant_rhs(x, u) -> x_dot = a x + c + g u`` (the spec's ``linear`` plant without
+    ``w``), the matrices as constants.
+
+    Parameters
+    ----------
+    a, g : array_like, shape (n, n)
+        Drift and input matrices (1/s and state units per input unit per second).
+    c : array_like, shape (n,)
+        Constant drift, state units per second.
+    """
+    a, g, c = (np.array(m, dtype=float) for m in (a, g, c))
+    n = c.size
+    x, u = ca.SX.sym("x", n), ca.SX.sym("u", n)
+    rows = []
+    for i in range(n):
+        # a_i x + c_i + g_i u, summed left to right as numpy's a @ x + c + g @ u for small n
+        ax = sum((a[i, j] * x[j] for j in range(1, n)), a[i, 0] * x[0])
+        gu = sum((g[i, j] * u[j] for j in range(1, n)), g[i, 0] * u[0])
+        rows.append(ax + c[i] + gu)
+    return ca.Function("plant_rhs", [x, u], [ca.vertcat(*rows)], ["x", "u"], ["x_dot"])
+
+
+def plant_function(model: str, n: int, linear=None) -> ca.Function:
+    """``plant_rhs(x, u) -> g(x) u`` (``+ a x + c`` for ``linear``) of a spec's ``[plant]``.
+
+    Parameters
+    ----------
+    model : str
+        ``plant.model``: a :data:`NAMED_MODELS` entry or ``"linear"``.
+    n : int
+        State dimension.
+    linear : LinearPlant, optional
+        The ``linear`` model's matrices (default ``a = 0``, ``g = I``, ``c = 0``).
+
+    Raises
+    ------
+    ValueError
+        As :func:`input_matrix`.
+    """
+    if model != "linear":
+        return plant_rhs(model, n)
+    if linear is None:
+        return linear_rhs(np.zeros((n, n)), np.eye(n), np.zeros(n))
+    return linear_rhs(linear.a, linear.g, linear.c)

@@ -2,8 +2,9 @@
 
 The controller never sees these: they only stand in for the unknown system (1),
 ``x_dot = f(x) + g(x) u + w``, in simulation. The named plants' ``g(x) u`` is the one
-definition in :mod:`.dynamics`, printed to Python by the emitter (the same Function is
-printed to C for the embedded closed loop and to SymPy for Assumption 2).
+definition in :mod:`.dynamics` (and so is the spec's ``linear`` plant), printed to Python
+by the emitter (the same Functions are printed to C for the embedded closed loop, and
+``g(x)`` to SymPy for Assumption 2).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import numpy as np
 from ..codegen.emit import python_function
 from ..errors import SpecError
 from ..spec.loader import LinearPlant
-from .dynamics import plant_rhs
+from .dynamics import linear_rhs, plant_rhs
 
 #: Number of sinusoids summed in each disturbance component.
 DISTURBANCE_TERMS = 3
@@ -57,7 +58,7 @@ def omnidirectional_robot(disturbance: Disturbance) -> ct.NonlinearIOSystem:
     in the robot frame (m/s, rad/s); outputs the state. ``R(x3) u`` is
     :func:`.dynamics.plant_rhs` (``"omnidirectional"``).
     """
-    return _named_plant("omnidirectional", 3, disturbance, inputs=["v1", "v2", "omega"],
+    return _plant(plant_rhs("omnidirectional", 3), disturbance, inputs=["v1", "v2", "omega"],
                         states=["x1", "x2", "x3"], outputs=["x1", "x2", "x3"],
                         name="omnidirectional_robot")
 
@@ -65,12 +66,14 @@ def omnidirectional_robot(disturbance: Disturbance) -> ct.NonlinearIOSystem:
 def single_integrator(dimension: int, disturbance: Disturbance) -> ct.NonlinearIOSystem:
     """``x_dot = u + w(t)`` in ``dimension`` states; outputs the state
     (:func:`.dynamics.plant_rhs`, ``"single-integrator"``)."""
-    return _named_plant("single-integrator", dimension, disturbance, inputs=dimension,
+    return _plant(plant_rhs("single-integrator", dimension), disturbance, inputs=dimension,
                         states=dimension, outputs=dimension, name="single_integrator")
 
 
-def _named_plant(model: str, n: int, disturbance: Disturbance, **io) -> ct.NonlinearIOSystem:
-    g_u = python_function(plant_rhs(model, n))
+def _plant(function, disturbance: Disturbance, **io) -> ct.NonlinearIOSystem:
+    """A python-control plant ``x_dot = function(x, u) + w(t)``, ``function`` a
+    :mod:`.dynamics` Function printed to Python."""
+    g_u = python_function(function)
 
     def rhs(t, x, u, params):
         return np.array(g_u(x, u)[0]) + disturbance(t)
@@ -81,6 +84,8 @@ def _named_plant(model: str, n: int, disturbance: Disturbance, **io) -> ct.Nonli
 def linear_plant(a, g, c, disturbance: Disturbance) -> ct.NonlinearIOSystem:
     """``x_dot = a x + c + g u + w(t)``: the spec's ``model = "linear"``; outputs the state.
 
+    ``a x + c + g u`` is :func:`.dynamics.linear_rhs`, printed to Python.
+
     Parameters
     ----------
     a, g : array_like, shape (n, n)
@@ -89,13 +94,9 @@ def linear_plant(a, g, c, disturbance: Disturbance) -> ct.NonlinearIOSystem:
         Constant drift, state units per second.
     disturbance : Disturbance
     """
-    a, g, c = (np.array(m, dtype=float) for m in (a, g, c))
-    n = c.size
-
-    def rhs(t, x, u, params):
-        return a @ x + c + g @ np.asarray(u, dtype=float) + disturbance(t)
-
-    return ct.nlsys(rhs, None, inputs=n, states=n, outputs=n, name="linear_plant")
+    n = np.asarray(c).size
+    return _plant(linear_rhs(a, g, c), disturbance, inputs=n, states=n, outputs=n,
+                  name="linear_plant")
 
 
 def make_plant(model: str, dimension: int, amplitude: float, seed: int = 0,
