@@ -172,9 +172,10 @@ def on_domain(expr: sp.Expr, params: Mapping[sp.Symbol, sp.Expr] | None = None,
         nodes = [n for n in sp.postorder_traversal(expr) if isinstance(n, kinds)]
         if not nodes:
             break
-        # innermost first: its arguments hold no other undecided node
-        node = next(n for n in nodes if not any(isinstance(a, kinds) for a in n.args
-                                                for a in sp.preorder_traversal(a)))
+        # innermost first: no undecided node below it
+        node = next(n for n in nodes
+                    if not any(isinstance(sub, kinds) for arg in n.args
+                               for sub in sp.preorder_traversal(arg)))
         expr = expr.xreplace({node: _decide(node, params, inactive)})
     if expr.has(sp.Piecewise, sp.Min, sp.Max, sp.Abs, sp.sign) or any(
             isinstance(a, sp.Rel) for a in sp.preorder_traversal(expr)):
