@@ -298,7 +298,7 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
 
     ``theta / (psi + a)^2 - kappa a`` decreases on ``a > max(0, -psi)``; the root lies in
     ``[max(0, -psi), max(0, -psi) + (theta/kappa)^(1/3)]``. Bisection until the bracket
-    is ``1e-13`` relative (or ``1e-18`` absolute) wide; both ends stay rigorous.
+    is ``1e-11`` relative (or ``1e-16`` absolute) wide; both ends stay rigorous.
     """
     lo = np.maximum(0.0, -psi)
     hi = lo + np.cbrt(theta / kappa)
@@ -307,7 +307,7 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
     with np.errstate(divide="ignore", invalid="ignore"):
         for _ in range(1100):
             mid = 0.5 * (lo + hi)
-            if np.all((mid <= lo) | (mid >= hi) | (hi - lo <= 1e-13 * hi + 1e-18)):
+            if np.all((mid <= lo) | (mid >= hi) | (hi - lo <= 1e-11 * hi + 1e-16)):
                 break
             z = psi + mid
             above = (z > 0) & (theta / (z * z) > kappa * mid)   # still left of the root
