@@ -59,10 +59,10 @@ from .parameters import E_MAX, GAMMA_D_MIN, NEWTON_TINY, SMOOTHSTEP, TANH
 #: and the trigger of (11)): ``exp(+-80)`` is a normal number in float32 and float64, so no
 #: step raises an overflow or underflow flag or sets ``errno``.
 EXP_ARGUMENT_BOUND = 80.0
-#: ``nu |a - b|`` from which :func:`smooth_max_needed` may skip the correction, and
-#: ``e^-40`` rounded up (for its exactness test).
-SMOOTH_SKIP_ARGUMENT = 40.0
-_EXP_MINUS_SKIP = 4.25e-18
+#: The base of the skip test of :func:`smooth_max_needed` and ``2^54 e^-34`` (30.875...)
+#: rounded up by more than 0.1 % (for its exactness proof).
+SMOOTH_SKIP_BASE = 34.0
+_SKIP_SCALE = 30.91
 
 #: Profile codes of the segment table, in the order of ``PROFILE_NAMES``.
 PROFILE_NAMES = (TANH, SMOOTHSTEP)
@@ -204,13 +204,19 @@ def smooth_max_expression(a, b, nu):
 def smooth_max_needed(a, b, nu):
     """``(max(a, b), needed)``: ``needed`` is 0 where ``max~(a, b) == max(a, b)`` exactly.
 
-    ``needed`` is 0 when ``nu |a - b| >= 40`` and ``|max| >= 2^54 e^-40 / nu``: the
-    correction ``log1p(e^-nu|a-b|) / nu < e^-40 / nu <= |max| 2^-54`` is then below half an
-    ulp of the max in float64 and float32, so ``max~(a, b) == max(a, b)`` exactly.
+    With ``D = min(nu |a - b|, 80)`` (the correction's ``exp`` receives ``-D``,
+    :func:`smooth_max_expression`) and ``y = nu |max|``, ``needed`` is 0 when
+    ``y (D - 33) >= 30.91``. As ``e^x >= 1 + x`` for every ``x``, ``e^-D <= e^-34 / (D -
+    33)`` for ``D > 33``, so the correction
+    ``log1p(e^-D) / nu < e^-34 / (nu (D - 33)) <= |max| e^-34 / 30.91 < |max| 2^-54``
+    (``30.91 > 2^54 e^-34 (1 + 10^-3)``; for ``D <= 33`` the test fails). The correction
+    is then below half an ulp of the max (``|max| 2^-54`` in float64, far below it in
+    float32; the 0.1 % margin covers the rounding of the test's and the correction's few
+    operations), so ``max~(a, b) == max(a, b)`` exactly.
     """
     top = ca.fmax(a, b)
-    sharp = ca.logic_and(nu * ca.fabs(a - b) >= SMOOTH_SKIP_ARGUMENT,
-                         ca.fabs(top) >= 2.0 ** 54 * _EXP_MINUS_SKIP / nu)
+    exponent = ca.fmin(nu * ca.fabs(a - b), EXP_ARGUMENT_BOUND)
+    sharp = (nu * ca.fabs(top)) * (exponent - (SMOOTH_SKIP_BASE - 1.0)) >= _SKIP_SCALE
     return top, ca.logic_not(sharp)
 
 

@@ -467,7 +467,7 @@ static void body_candidate_rates(const omnirobot_s1_real* rho_dot, const omnirob
   c_dot[5] = w0;
 }
 
-/* CasADi Function 'smooth_max_test': 17 instructions. */
+/* CasADi Function 'smooth_max_test': 19 instructions. */
 static void body_smooth_max_test(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* nu, omnirobot_s1_real* max, omnirobot_s1_real* needed) {
   omnirobot_s1_real w0;
   omnirobot_s1_real w1;
@@ -478,17 +478,19 @@ static void body_smooth_max_test(const omnirobot_s1_real* a, const omnirobot_s1_
   w1 = b[0];
   w2 = (w1 > w0) ? w1 : w0;
   max[0] = w2;
-  w3 = 40.0;
+  w3 = 30.91;
   w4 = nu[0];
+  w2 = fabs(w2);
+  w2 = w4 * w2;
   w0 = w0 - w1;
   w0 = fabs(w0);
-  w0 = w4 * w0;
-  w3 = (w3 <= w0) ? 1.0 : 0.0;
-  w0 = 0.07656119366529843;
-  w0 = w0 / w4;
-  w2 = fabs(w2);
-  w0 = (w0 <= w2) ? 1.0 : 0.0;
-  w3 = ((w3 != 0.0) && (w0 != 0.0)) ? 1.0 : 0.0;
+  w4 = w4 * w0;
+  w0 = 80.0;
+  w4 = (w0 < w4) ? w0 : w4;
+  w0 = 33.0;
+  w4 = w4 - w0;
+  w2 = w2 * w4;
+  w3 = (w3 <= w2) ? 1.0 : 0.0;
   w3 = (w3 == 0.0) ? 1.0 : 0.0;
   needed[0] = w3;
 }
@@ -516,7 +518,7 @@ static void body_smooth_max(const omnirobot_s1_real* a, const omnirobot_s1_real*
   max[0] = w2;
 }
 
-/* CasADi Function 'smooth_min_test': 20 instructions. */
+/* CasADi Function 'smooth_min_test': 22 instructions. */
 static void body_smooth_min_test(const omnirobot_s1_real* a, const omnirobot_s1_real* b, const omnirobot_s1_real* nu, omnirobot_s1_real* min, omnirobot_s1_real* needed) {
   omnirobot_s1_real w0;
   omnirobot_s1_real w1;
@@ -530,17 +532,19 @@ static void body_smooth_min_test(const omnirobot_s1_real* a, const omnirobot_s1_
   w1 = (w3 > w1) ? w3 : w1;
   w3 = -w1;
   min[0] = w3;
-  w3 = 40.0;
+  w3 = 30.91;
   w4 = nu[0];
+  w1 = fabs(w1);
+  w1 = w4 * w1;
   w2 = w2 - w0;
   w2 = fabs(w2);
-  w2 = w4 * w2;
-  w3 = (w3 <= w2) ? 1.0 : 0.0;
-  w2 = 0.07656119366529843;
-  w2 = w2 / w4;
-  w1 = fabs(w1);
-  w2 = (w2 <= w1) ? 1.0 : 0.0;
-  w3 = ((w3 != 0.0) && (w2 != 0.0)) ? 1.0 : 0.0;
+  w4 = w4 * w2;
+  w2 = 80.0;
+  w4 = (w2 < w4) ? w2 : w4;
+  w2 = 33.0;
+  w4 = w4 - w2;
+  w1 = w1 * w4;
+  w3 = (w3 <= w1) ? 1.0 : 0.0;
   w3 = (w3 == 0.0) ? 1.0 : 0.0;
   needed[0] = w3;
 }

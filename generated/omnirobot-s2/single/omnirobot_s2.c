@@ -468,7 +468,7 @@ static void body_candidate_rates(const omnirobot_s2_real* rho_dot, const omnirob
   c_dot[5] = w0;
 }
 
-/* CasADi Function 'smooth_max_test': 17 instructions. */
+/* CasADi Function 'smooth_max_test': 19 instructions. */
 static void body_smooth_max_test(const omnirobot_s2_real* a, const omnirobot_s2_real* b, const omnirobot_s2_real* nu, omnirobot_s2_real* max, omnirobot_s2_real* needed) {
   omnirobot_s2_real w0;
   omnirobot_s2_real w1;
@@ -479,17 +479,19 @@ static void body_smooth_max_test(const omnirobot_s2_real* a, const omnirobot_s2_
   w1 = b[0];
   w2 = (w1 > w0) ? w1 : w0;
   max[0] = w2;
-  w3 = 40.0f;
+  w3 = 30.91f;
   w4 = nu[0];
+  w2 = fabsf(w2);
+  w2 = w4 * w2;
   w0 = w0 - w1;
   w0 = fabsf(w0);
-  w0 = w4 * w0;
-  w3 = (w3 <= w0) ? 1.0f : 0.0f;
-  w0 = 0.07656119366529843f;
-  w0 = w0 / w4;
-  w2 = fabsf(w2);
-  w0 = (w0 <= w2) ? 1.0f : 0.0f;
-  w3 = ((w3 != 0.0f) && (w0 != 0.0f)) ? 1.0f : 0.0f;
+  w4 = w4 * w0;
+  w0 = 80.0f;
+  w4 = (w0 < w4) ? w0 : w4;
+  w0 = 33.0f;
+  w4 = w4 - w0;
+  w2 = w2 * w4;
+  w3 = (w3 <= w2) ? 1.0f : 0.0f;
   w3 = (w3 == 0.0f) ? 1.0f : 0.0f;
   needed[0] = w3;
 }
@@ -517,7 +519,7 @@ static void body_smooth_max(const omnirobot_s2_real* a, const omnirobot_s2_real*
   max[0] = w2;
 }
 
-/* CasADi Function 'smooth_min_test': 20 instructions. */
+/* CasADi Function 'smooth_min_test': 22 instructions. */
 static void body_smooth_min_test(const omnirobot_s2_real* a, const omnirobot_s2_real* b, const omnirobot_s2_real* nu, omnirobot_s2_real* min, omnirobot_s2_real* needed) {
   omnirobot_s2_real w0;
   omnirobot_s2_real w1;
@@ -531,17 +533,19 @@ static void body_smooth_min_test(const omnirobot_s2_real* a, const omnirobot_s2_
   w1 = (w3 > w1) ? w3 : w1;
   w3 = -w1;
   min[0] = w3;
-  w3 = 40.0f;
+  w3 = 30.91f;
   w4 = nu[0];
+  w1 = fabsf(w1);
+  w1 = w4 * w1;
   w2 = w2 - w0;
   w2 = fabsf(w2);
-  w2 = w4 * w2;
-  w3 = (w3 <= w2) ? 1.0f : 0.0f;
-  w2 = 0.07656119366529843f;
-  w2 = w2 / w4;
-  w1 = fabsf(w1);
-  w2 = (w2 <= w1) ? 1.0f : 0.0f;
-  w3 = ((w3 != 0.0f) && (w2 != 0.0f)) ? 1.0f : 0.0f;
+  w4 = w4 * w2;
+  w2 = 80.0f;
+  w4 = (w2 < w4) ? w2 : w4;
+  w2 = 33.0f;
+  w4 = w4 - w2;
+  w1 = w1 * w4;
+  w3 = (w3 <= w1) ? 1.0f : 0.0f;
   w3 = (w3 == 0.0f) ? 1.0f : 0.0f;
   needed[0] = w3;
 }

@@ -905,7 +905,7 @@ def body_candidate_rates(rho_dot, alpha_dot):
 
 
 def body_smooth_max_test(a, b, nu):
-    """CasADi Function 'body_smooth_max_test' (17 instructions).
+    """CasADi Function 'body_smooth_max_test' (19 instructions).
 
     Parameters
     ----------
@@ -930,17 +930,19 @@ def body_smooth_max_test(a, b, nu):
     w1 = float(b[0])
     w2 = _fmax(w0, w1)
     max[0] = w2
-    w3 = 40.0
+    w3 = 30.91
     w4 = float(nu[0])
+    w2 = math.fabs(w2)
+    w2 = w4 * w2
     w0 = w0 - w1
     w0 = math.fabs(w0)
-    w0 = w4 * w0
-    w3 = 1.0 if w3 <= w0 else 0.0
-    w0 = 0.07656119366529843
-    w0 = _div(w0, w4)
-    w2 = math.fabs(w2)
-    w0 = 1.0 if w0 <= w2 else 0.0
-    w3 = 1.0 if w3 != 0.0 and w0 != 0.0 else 0.0
+    w4 = w4 * w0
+    w0 = 80.0
+    w4 = _fmin(w4, w0)
+    w0 = 33.0
+    w4 = w4 - w0
+    w2 = w2 * w4
+    w3 = 1.0 if w3 <= w2 else 0.0
     w3 = 1.0 if w3 == 0.0 else 0.0
     needed[0] = w3
     return (max, needed)
@@ -985,7 +987,7 @@ def body_smooth_max(a, b, nu):
 
 
 def body_smooth_min_test(a, b, nu):
-    """CasADi Function 'body_smooth_min_test' (20 instructions).
+    """CasADi Function 'body_smooth_min_test' (22 instructions).
 
     Parameters
     ----------
@@ -1013,17 +1015,19 @@ def body_smooth_min_test(a, b, nu):
     w1 = _fmax(w1, w3)
     w3 = -w1
     min[0] = w3
-    w3 = 40.0
+    w3 = 30.91
     w4 = float(nu[0])
+    w1 = math.fabs(w1)
+    w1 = w4 * w1
     w2 = w2 - w0
     w2 = math.fabs(w2)
-    w2 = w4 * w2
-    w3 = 1.0 if w3 <= w2 else 0.0
-    w2 = 0.07656119366529843
-    w2 = _div(w2, w4)
-    w1 = math.fabs(w1)
-    w2 = 1.0 if w2 <= w1 else 0.0
-    w3 = 1.0 if w3 != 0.0 and w2 != 0.0 else 0.0
+    w4 = w4 * w2
+    w2 = 80.0
+    w4 = _fmin(w4, w2)
+    w2 = 33.0
+    w4 = w4 - w2
+    w1 = w1 * w4
+    w3 = 1.0 if w3 <= w1 else 0.0
     w3 = 1.0 if w3 == 0.0 else 0.0
     needed[0] = w3
     return (min, needed)
