@@ -22,7 +22,7 @@ from .parameters import E_MAX, GAMMA_D_MIN, LOWER, SMOOTHSTEP, TANH, ReachSegmen
 Array = np.ndarray
 
 
-def _libm(function):
+def _libm(function, name: str):
     """Element-wise ``function`` from Python's ``math`` module (the C library's libm).
 
     numpy's own ``exp``/``log``/``tanh`` use SIMD kernels that differ from libm by an ulp
@@ -36,7 +36,9 @@ def _libm(function):
         x = np.asarray(x, dtype=float)
         return vectorized(x) if x.size else x.copy()
 
-    apply.__name__ = function.__name__
+    apply.__name__ = name
+    apply.__doc__ = (f"``{name}`` element-wise through libm (Python's ``math``), on an array of any "
+                     "shape; NaN outside the function's domain.")
     return apply
 
 
@@ -46,10 +48,10 @@ def _safe(function, domain):
     return wrapped
 
 
-exp = _libm(lambda v: math.exp(v) if v < 709.0 else math.inf)
-log = _libm(_safe(math.log, lambda v: v > 0))
-log1p = _libm(_safe(math.log1p, lambda v: v > -1))
-tanh = _libm(math.tanh)
+exp = _libm(lambda v: math.exp(v) if v < 709.0 else math.inf, "exp")
+log = _libm(_safe(math.log, lambda v: v > 0), "log")
+log1p = _libm(_safe(math.log1p, lambda v: v > -1), "log1p")
+tanh = _libm(math.tanh, "tanh")
 
 
 @contextlib.contextmanager
