@@ -73,6 +73,34 @@ def draw_unsafe_sets(ax, spec: Spec, dims: tuple[int, int]) -> None:
               ls="--", label="covering boxes" if m == 0 else None)
 
 
+def arena_figure(spec: Spec):
+    """The two-column figure of :func:`plot_run` and :func:`plot_design`.
+
+    Returns
+    -------
+    fig : matplotlib.figure.Figure
+    grid : matplotlib.gridspec.GridSpec
+        ``n`` rows, 2 columns: the right column has one axes per dimension.
+    ax : matplotlib.axes.Axes or None
+        The arena (left column, dimensions 0 and 1) with the state space, the obstacles and
+        the target drawn; ``None`` when ``n < 2``.
+    """
+    n = spec.dimension
+    fig = agg_figure(figsize=(11, 2.6 * max(n, 2)), layout="constrained")
+    grid = fig.add_gridspec(n, 2, width_ratios=[1.1, 1.4])
+    if n < 2:
+        return fig, grid, None
+    ax = fig.add_subplot(grid[:, 0])
+    dims = (0, 1)
+    draw_box(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
+    draw_unsafe_sets(ax, spec, dims)
+    draw_box(ax, spec.target_set, dims, fc="tab:green", alpha=0.35, label="target")
+    ax.set_xlabel("$x_1$")
+    ax.set_ylabel("$x_2$")
+    ax.set_aspect("equal")
+    return fig, grid, ax
+
+
 def plot_run(spec: Spec, design: TubeDesign, result: SimulationResult, path: str | Path) -> Path:
     """Write a PNG: the arena with the trajectory, and each dimension's tube against time.
 
@@ -91,20 +119,11 @@ def plot_run(spec: Spec, design: TubeDesign, result: SimulationResult, path: str
     traj = result.trajectory
     n = spec.dimension
     g_l, g_u, _, _ = reference.adaptive_tube(design, traj.t, traj.alpha)
-    fig = agg_figure(figsize=(11, 2.6 * max(n, 2)), layout="constrained")
-    grid = fig.add_gridspec(n, 2, width_ratios=[1.1, 1.4])
-    if n >= 2:
-        ax = fig.add_subplot(grid[:, 0])
-        dims = (0, 1)
-        draw_box(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
-        draw_unsafe_sets(ax, spec, dims)
-        draw_box(ax, spec.initial_set, dims, fc="tab:blue", alpha=0.3, label="initial set")
-        draw_box(ax, spec.target_set, dims, fc="tab:green", alpha=0.35, label="target")
+    fig, grid, ax = arena_figure(spec)
+    if ax is not None:
+        draw_box(ax, spec.initial_set, (0, 1), fc="tab:blue", alpha=0.3, label="initial set")
         ax.plot(traj.x[:, 0], traj.x[:, 1], "k--", lw=1.2, label="trajectory")
         ax.plot(*traj.x[0, :2], "o", color="tab:blue")
-        ax.set_xlabel("$x_1$")
-        ax.set_ylabel("$x_2$")
-        ax.set_aspect("equal")
         ax.legend(loc="lower right", fontsize=7)
         verdict = "satisfied" if result.satisfied else "NOT satisfied"
         ax.set_title(f"{spec.name}: {verdict}, reach {result.reach_time} s")
@@ -150,14 +169,9 @@ def plot_design(spec: Spec, design: Design, path: str | Path) -> Path:
     tube, enc = design.tube, design.certificate.enclosure
     n = spec.dimension
     t_c = tube.prescribed_time
-    fig = agg_figure(figsize=(11, 2.6 * max(n, 2)), layout="constrained")
-    grid = fig.add_gridspec(n, 2, width_ratios=[1.1, 1.4])
-    if n >= 2:
-        ax = fig.add_subplot(grid[:, 0])
+    fig, grid, ax = arena_figure(spec)
+    if ax is not None:
         dims = (0, 1)
-        draw_box(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
-        draw_unsafe_sets(ax, spec, dims)
-        draw_box(ax, spec.target_set, dims, fc="tab:green", alpha=0.35, label="target")
         times = np.linspace(0.0, t_c, BOXES_DRAWN)
         which = np.searchsorted(enc.t_start, times, side="right") - 1
         for k in which:
@@ -169,9 +183,6 @@ def plot_design(spec: Spec, design: Design, path: str | Path) -> Path:
                   lw=1.2, label="via boxes" if k == 0 else None)
         ax.set_xlim(spec.state_space.lower[0], spec.state_space.upper[0])
         ax.set_ylim(spec.state_space.lower[1], spec.state_space.upper[1])
-        ax.set_xlabel("$x_1$")
-        ax.set_ylabel("$x_2$")
-        ax.set_aspect("equal")
         ax.legend(loc="lower right", fontsize=7)
         ax.set_title(f"{spec.name}: {design.method} method, "
                      f"{design.design_time_s * 1e3:.1f} ms")
