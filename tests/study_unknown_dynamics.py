@@ -186,7 +186,7 @@ def _declared_setup(case):
         a = Assumptions(DECLARED["input_gain"], DECLARED["input_gain_skew"],
                         DECLARED["input_gain_coupling"], DECLARED["drift_bound"],
                         DECLARED["disturbance_bound"])
-        rate, gain = lowest_rate(design, a)
+        rate, gain = lowest_rate(design, spec, a)
         if rate is None:
             raise SystemExit(f"{case}: no rate passes the sampled check for {DECLARED}")
         spec = dataclasses.replace(spec, rate_hz=rate, assumptions=a)

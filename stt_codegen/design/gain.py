@@ -20,11 +20,10 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-import numpy as np
 
-from ..spec.loader import Assumptions
+from ..spec.loader import Assumptions, Spec
 from ..tube.parameters import TubeDesign
-from .samples import TubeSamples, sample_tube
+from .samples import sample_tube
 
 #: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
 RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
@@ -102,18 +101,23 @@ def gain_derivation(design: TubeDesign, min_width: float, min_width_time: float,
             "stable_gain_limit": stable_below, "explanation": words}
 
 
-def lowest_rate(design: TubeDesign, assumptions: Assumptions,
+def lowest_rate(design: TubeDesign, spec: Spec, assumptions: Assumptions,
                 explicit_gain: float | None = None) -> tuple[float | None, float | None]:
-    """The lowest of ``rate_hz`` times :data:`RATE_FACTORS` at which the sampled check passes.
+    """The lowest of ``rate_hz`` times :data:`RATE_FACTORS` at which the design holds.
 
-    The largest factor is tried first; if it fails, no factor is reported.
-
-    The tube keeps its circumvents and is re-sampled at each rate; the gain is
-    ``explicit_gain`` if given, else re-derived at that rate (:func:`derived_gain`).
+    At each rate the tube keeps its circumvents and segments, is certified again
+    (:func:`~stt_codegen.design.certificate.certify_tube`: the deployed ``alpha`` and the
+    sampling-rate check depend on the rate), and the sampled check
+    (:func:`~stt_codegen.verify.sampled.check_sampled`) must pass with the gain the design
+    would use there: ``explicit_gain`` if given, else :func:`derived_gain` at that rate's
+    certified narrowest width. The largest factor is tried first; if it fails, no factor
+    is reported.
 
     Parameters
     ----------
     design : TubeDesign
+    spec : Spec
+        For the certificate (state space, obstacles, target).
     assumptions : Assumptions
     explicit_gain : float, optional
 
@@ -123,16 +127,16 @@ def lowest_rate(design: TubeDesign, assumptions: Assumptions,
         ``(None, None)`` when no factor tried works.
     """
     from ..verify.sampled import check_sampled
+    from .certificate import certify_tube
 
     def passes(factor: float) -> tuple[bool, float]:
         trial = replace(design, rate_hz=design.rate_hz * factor)
-        samples = sample_tube(trial)
-        # the width at the samples of this rate (no certificate is run at trial rates: the
-        # caller is told to verify the rate it picks)
-        width = float((samples.gamma_upper - samples.gamma_lower).min())
+        certificate = certify_tube(trial, spec)
         gain = (explicit_gain if explicit_gain is not None
-                else derived_gain(width, trial.rate_hz, assumptions))
-        return check_sampled(trial, samples, assumptions, gain).passed, gain
+                else derived_gain(certificate.min_width, trial.rate_hz, assumptions))
+        if not certificate.passed:
+            return False, gain
+        return check_sampled(trial, sample_tube(trial), assumptions, gain).passed, gain
 
     # the fastest rate first: when even it fails (coupling beyond what any rate can
     # handle), one check answers instead of all of them

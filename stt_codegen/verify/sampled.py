@@ -258,7 +258,7 @@ def sampled_checks(spec: Spec, design: TubeDesign, samples: TubeSamples,
                   f"of the half-width (least at t = {result.time:.4f} s, dimension "
                   f"{result.dimension})")
     else:
-        rate, gain = lowest_rate(design, a, spec.gain)
+        rate, gain = lowest_rate(design, spec, a, spec.gain)
         g_max = a.input_gain[1]
         if rate is not None:
             need = f"the condition needs {rate / 1000:.3g} kHz (k = {gain:.4g}) at g_max = {g_max:g}"
