@@ -20,7 +20,6 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-
 from ..spec.loader import Assumptions, Spec
 from ..tube.parameters import TubeDesign
 from .samples import sample_tube
