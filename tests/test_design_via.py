@@ -18,7 +18,7 @@ from stt_codegen.design.search import base_design, design_tube
 from stt_codegen.design.via import via_design
 from stt_codegen.errors import DesignError
 from stt_codegen.runtime.simulate import simulate
-from stt_codegen.spec.loader import Box, parse_spec
+from stt_codegen.spec.loader import Box, load_spec, parse_spec
 from stt_codegen.tube import reference as R
 
 SERPENTINE = (Path(__file__).parent / "specs" / "serpentine.toml").read_text()
@@ -176,3 +176,18 @@ def test_random_arena_with_a_corridor_is_satisfied(index):
     design = design_tube(spec)
     result = simulate(spec, design.tube, backend="c", seed=index)
     assert result.satisfied, (design.method, result)
+
+
+def test_a_convex_wall_across_the_straight_path_is_passed_with_via_points():
+    """The README's example (tests/specs/diagonal-wall.toml): the paper's method has no
+    design (one bump per covering box cannot detour around the wall's end); via points do,
+    and the generated-C closed loop is satisfied without touching the wall."""
+    spec = load_spec(Path(__file__).parent / "specs" / "diagonal-wall.toml")
+    paper = dataclasses.replace(spec, tube=dataclasses.replace(spec.tube, method="paper"))
+    with pytest.raises(DesignError):
+        design_tube(paper)
+    design = design_tube(spec)
+    assert design.method == "via" and design.certificate.passed
+    result = simulate(spec, design.tube, backend="c")
+    assert result.satisfied and result.stayed_in_tube and not result.collision
+    assert result.min_obstacle_clearance > 0.0
