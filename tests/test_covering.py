@@ -18,7 +18,6 @@ from stt_codegen.errors import SpecError
 from stt_codegen.spec.shapes import Ball, make_polytope
 from stt_codegen.runtime.simulate import simulate
 from stt_codegen.spec.loader import load_spec, parse_spec
-from stt_codegen.design.samples import sample_tube
 
 SPECS = Path(__file__).parent / "specs"
 BESIDE = arena_toml("beside", extra="[tube]\ncircumvent_sharpness = 0.1\n",

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-import pytest
 from conftest import designed, model_of
 from sampling import E_LIMIT, random_points
 

@@ -11,7 +11,7 @@ import pytest
 from conftest import designed
 
 from stt_codegen.errors import SpecError
-from stt_codegen.spec.loader import load_spec, parse_spec
+from stt_codegen.spec.loader import parse_spec
 from stt_codegen.tube.parameters import Circumvent
 from stt_codegen.verify.command import verify_design, verify_spec
 

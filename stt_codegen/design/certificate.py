@@ -316,10 +316,6 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
     return lo, hi
 
 
-def _theta(design: TubeDesign, psi: np.ndarray) -> np.ndarray:
-    return design.theta0 * (1.0 - np.tanh(psi - design.mu))
-
-
 # --------------------------------------------------------------------------- intervals
 
 
@@ -377,8 +373,8 @@ def _alpha_ranges(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
     """
     kappa, dt = design.kappa, 1.0 / design.rate_hz
     c = 1.0 + kappa * dt
-    theta_hi = _theta(design, psi_lo)
-    theta_lo = _theta(design, psi_hi)
+    theta_hi = reference.trigger(design, psi_lo)
+    theta_lo = reference.trigger(design, psi_hi)
     star_hi = alpha_fixed_point(psi_lo, theta_hi, kappa)[1]
     star_lo = alpha_fixed_point(psi_hi, theta_lo, kappa)[0]
     with np.errstate(divide="ignore", over="ignore", under="ignore", invalid="ignore"):
@@ -500,8 +496,8 @@ def _enclose(design: TubeDesign, pieces: _Pieces, alpha_min, alpha_max, t0, t1) 
     # alpha_dot = theta(psi) / (psi + alpha)^2 - kappa alpha decreases in alpha and psi
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         z_lo = pieces.psi_lo + alpha_min
-        fast = np.where(z_lo > 0, _theta(design, pieces.psi_lo) / (z_lo * z_lo), np.inf)
-        slow = _theta(design, pieces.psi_hi) / (pieces.psi_hi + alpha_max) ** 2
+        fast = np.where(z_lo > 0, reference.trigger(design, pieces.psi_lo) / (z_lo * z_lo), np.inf)
+        slow = reference.trigger(design, pieces.psi_hi) / (pieces.psi_hi + alpha_max) ** 2
     adot_max = fast - design.kappa * alpha_min
     adot_min = slow - design.kappa * alpha_max
     # gamma_dot is a convex combination of (rho_dot -+ alpha_dot) and beta_dot (eq. (10))

@@ -316,6 +316,24 @@ def conflict_distance(design: TubeDesign, t) -> Array:
     return np.concatenate([beta_u - rho_l, rho_u - beta_l], axis=1)
 
 
+def trigger(design: TubeDesign, psi) -> Array:
+    """The trigger of the adaptive law (11), ``theta = theta0 (1 - tanh(psi - mu))``.
+
+    ``sign`` is approximated by ``tanh`` with unit slope, as the paper says.
+
+    Parameters
+    ----------
+    psi : array_like, any shape
+        ``psi`` of eq. (11), state units.
+
+    Returns
+    -------
+    ndarray, the shape of ``psi``
+        In ``[0, 2 theta0]``.
+    """
+    return design.theta0 * (1.0 - tanh(np.asarray(psi, dtype=float) - design.mu))
+
+
 def adaptive_law(design: TubeDesign, t, alpha) -> tuple[Array, Array]:
     """Adaptive law (11): ``alpha_dot = theta / (psi + alpha)^2 - kappa alpha``.
 
@@ -336,7 +354,7 @@ def adaptive_law(design: TubeDesign, t, alpha) -> tuple[Array, Array]:
     t = _time(t)
     psi = conflict_distance(design, t)
     alpha = _rows(alpha, t.size, psi.shape[1])
-    theta = design.theta0 * (1.0 - tanh(psi - design.mu))
+    theta = trigger(design, psi)
     z = psi + alpha
     return theta / z**2 - design.kappa * alpha, -2.0 * theta / z**3 - design.kappa
 
@@ -462,7 +480,7 @@ def alpha_step(design: TubeDesign, t, dt, alpha) -> Array:
     dt = np.broadcast_to(np.asarray(dt, dtype=float), t.shape)
     psi = conflict_distance(design, t + dt)
     alpha = _rows(alpha, t.size, psi.shape[1])
-    theta = design.theta0 * (1.0 - tanh(psi - design.mu))
+    theta = trigger(design, psi)
     return implicit_alpha_root(alpha, psi, theta, dt[:, None], design.kappa)
 
 

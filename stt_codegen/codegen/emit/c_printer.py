@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
-from typing import Dict, List, Sequence, Set, Union
+from typing import Dict, List, Sequence, Set, Tuple, Union
 
 from .errors import EmitError
 from .instructions import Input, IOSpec, Output, Program, lower
