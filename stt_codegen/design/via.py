@@ -13,8 +13,8 @@ boxes ``B_0 = X-hat_0, B_1, ..., B_m = T-hat`` (issue 10, design notes item 12):
   lies inside the bounding box of ``B_k`` and ``B_{k+1}``. A move is allowed when that
   bounding box, widened by :data:`VIA_MARGIN`, misses every obstacle: the segment then
   needs no circumvent.
-* **Path.** Dijkstra over the moves between neighbouring cells (``networkx``, weights
-  the centre distance, ties broken by node order: deterministic), then shortened
+* **Path.** Dijkstra over the moves between neighbouring cells (``scipy.sparse.csgraph``,
+  weights the centre distance; the same input gives the same path), then shortened
   greedily: from each via box, the farthest later box on the path it can move to
   directly.
 * **Timing.** Durations in proportion to the centre distance (max norm), the last
@@ -30,8 +30,8 @@ import math
 from dataclasses import dataclass, replace
 from itertools import product
 
-import networkx as nx
 import numpy as np
+from scipy.sparse import csgraph, csr_matrix
 
 from ..errors import DesignError
 from ..spec.loader import Spec
@@ -150,23 +150,36 @@ def plan_via(spec: Spec, base: TubeDesign) -> ViaPlan:
     a, b = pairs[:, 0], pairs[:, 1]
     ok = _free(np.minimum(lows[a], lows[b]), np.maximum(highs[a], highs[b]), obstacles, space)
     mids = 0.5 * (lows + highs)
-    length = np.max(np.abs(mids[a] - mids[b]), axis=1)
-    graph = nx.Graph()
-    graph.add_nodes_from(np.flatnonzero(free).tolist())
-    graph.add_weighted_edges_from(zip(a[ok].tolist(), b[ok].tolist(), length[ok].tolist()))
-    nodes = {k: (lows[k], highs[k]) for k in graph.nodes}
-    try:
-        path = nx.dijkstra_path(graph, 0, 1, weight="weight")
-    except nx.NetworkXNoPath:
-        reach = sorted(nx.node_connected_component(graph, 0))
-        near = min(reach, key=lambda k: float(np.max(np.abs(mids[k] - goal_centre))))
+    path, dist = _shortest_path(len(lows), a[ok], b[ok],
+                                np.max(np.abs(mids[a[ok]] - mids[b[ok]]), axis=1))
+    if path is None:
+        reach = np.flatnonzero(np.isfinite(dist))
+        near = int(reach[np.argmin(np.max(np.abs(mids[reach] - goal_centre), axis=1))])
         where = ", ".join(f"{v:.2f}" for v in mids[near])
         raise DesignError(
             f"no via-point path: the free passage reachable from x(0) (via boxes of "
             f"half-width {half:g} with {VIA_MARGIN:g} clearance) comes closest to the target "
-            f"at ({where}); the passage is too narrow there") from None
+            f"at ({where}); the passage is too narrow there")
+    nodes = {k: (lows[k], highs[k]) for k in path}
     path = _shortcut(path, nodes, obstacles, space)
     return _timed(path, nodes, base.prescribed_time)
+
+
+def _shortest_path(count: int, a: np.ndarray, b: np.ndarray,
+                   length: np.ndarray) -> tuple[list[int] | None, np.ndarray]:
+    """Dijkstra over the undirected moves ``a[q] -- b[q]`` from node 0 (start box) to node 1
+    (target box): the path (``None`` without one) and the distances from node 0 (``inf``
+    where unreachable)."""
+    # csgraph reads an explicit zero of a sparse matrix as an edge (a zero-length move);
+    # the pairs are distinct, so nothing is summed
+    graph = csr_matrix((length, (a, b)), shape=(count, count))
+    dist, before = csgraph.dijkstra(graph, directed=False, indices=0, return_predecessors=True)
+    if not np.isfinite(dist[1]):
+        return None, dist
+    path = [1]
+    while path[-1] != 0:
+        path.append(int(before[path[-1]]))
+    return path[::-1], dist
 
 
 def _shortcut(path: list, nodes: dict, obstacles: np.ndarray, space) -> list:
