@@ -81,3 +81,55 @@ upper = [{box.upper[0]!r}, {box.upper[1]!r}]
     failure = cert.first_failure()                              # the certificate catches it
     assert failure is not None and failure.name == "avoids obstacle 0"
     assert "may meet obstacle 0" in failure.detail
+
+
+def _fixed_point_cases():
+    rng = np.random.default_rng(7)
+    n = 400
+    psi = np.concatenate([rng.uniform(-3, 5, n), rng.uniform(-1e-3, 1e-3, n),
+                          10 ** rng.uniform(-14, 1, n), -10 ** rng.uniform(-14, 1, n)])
+    theta = np.concatenate([0.02 / (1 + np.exp(2 * (psi[:2 * n] - 1))),
+                            10 ** rng.uniform(-30, -1, 2 * n)])
+    return psi, theta
+
+
+def test_alpha_fixed_point_bracket_is_rigorous_and_tight():
+    """The Newton bracket of a* (kappa a = theta / (psi + a)^2) holds in 50-digit
+    arithmetic: f >= 0 at lo (or lo on the pole), f <= 0 right of the pole at hi."""
+    mpmath = pytest.importorskip("mpmath")
+    from stt_codegen.design.certificate import alpha_fixed_point
+    mpmath.mp.dps = 50
+    psi, theta = _fixed_point_cases()
+    kappa = 5.0
+    lo, hi = alpha_fixed_point(psi, theta, kappa)
+    assert np.all(lo <= hi) and np.all(lo >= 0.0)
+    assert np.all(hi - lo <= 1e-10 * hi + 1e-15)
+
+    def f(a, p, t):
+        return t / (p + a) ** 2 - kappa * a
+    for p, t, a, b in zip(psi, theta, lo, hi):
+        p, t, a, b = (mpmath.mpf(float(v)) for v in (p, t, a, b))
+        assert p + a <= 0 or f(a, p, t) >= 0
+        assert p + b > 0 and f(b, p, t) <= 0
+
+
+def test_step_root_bracket_is_rigorous():
+    """step_root's bracket of the implicit step's root, checked in 50-digit arithmetic."""
+    mpmath = pytest.importorskip("mpmath")
+    from stt_codegen.design.certificate import step_root
+    mpmath.mp.dps = 50
+    rng = np.random.default_rng(3)
+    for _ in range(2000):
+        a = float(10 ** rng.uniform(-12, 0)) * float(rng.integers(0, 2))
+        psi = float(rng.uniform(-2, 5))
+        theta = float(0.02 / (1 + np.exp(2 * (psi - 1))))
+        dt = float(10 ** rng.uniform(-5, 0))
+        c = 1.0 + 5.0 * dt
+        lo, hi = step_root(a, psi, theta, dt, c)
+        assert lo <= hi
+
+        def g(x):
+            x = mpmath.mpf(x)
+            return c * x - a - dt * theta / (psi + x) ** 2
+        assert psi + lo <= 0 or g(lo) <= 0
+        assert psi + hi > 0 and g(hi) >= 0

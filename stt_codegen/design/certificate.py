@@ -53,12 +53,14 @@ MAX_MOVE_PER_SAMPLE = 0.25
 #: then fails with that reason); the work is linear in it.
 MAX_INTERVALS = 200_000
 #: A thin interval is cut into this many pieces (fewer rounds than bisection).
-SPLIT = 8
+SPLIT = 4
 #: Shortest interval the bisection creates, seconds (or one sampling period if longer):
 #: at very high rates the enclosures need no finer time resolution than this.
 MIN_INTERVAL = 1e-4
 #: Intervals of at most this many steps follow the extreme implicit steps one by one.
 EXACT_STEPS = 4
+#: Relative width at which :func:`step_root` stops refining its (rigorous) bracket.
+STEP_ROOT_TOLERANCE = 1e-13
 
 #: Certified property names, in report order (``avoids obstacle j`` repeats per obstacle).
 PROPERTIES = ("non-empty", "initial state inside", "inside state space", "avoids obstacle",
@@ -171,6 +173,10 @@ class Certificate:
     state: tuple = field(default=((), [], [], []), compare=False, repr=False)
     #: A property the tube fails for certain at some instant (refinement stopped there).
     decisive: str = ""
+    #: Intervals whose ``alpha`` bounds this certificate computed, over all refinement
+    #: rounds, those resumed from another certificate excluded (a deterministic measure
+    #: of its cost).
+    work: int = 0
 
     def first_failure(self) -> Margin | None:
         """The decisive failure if there is one, else the first property not proven."""
@@ -296,24 +302,50 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
                                                                                   np.ndarray]:
     """Bracket ``[lo, hi]`` of ``a*``, the root of ``kappa a = theta / (psi + a)^2`` with ``psi + a > 0``.
 
-    ``theta / (psi + a)^2 - kappa a`` decreases on ``a > max(0, -psi)``; the root lies in
-    ``[max(0, -psi), max(0, -psi) + (theta/kappa)^(1/3)]``. Bisection until the bracket
-    is ``1e-11`` relative (or ``1e-16`` absolute) wide; both ends stay rigorous.
+    ``f(a) = theta / (psi + a)^2 - kappa a`` is decreasing and convex on ``a > -psi``, with
+    slope ``<= -kappa``. Newton from a start with ``f >= 0`` (``0``, or just right of the
+    pole) rises monotonically to the root; from any iterate ``x`` the root lies in
+    ``[x, x + f(x) / kappa]`` when ``f(x) >= 0`` and in ``[x - f(x) / f'(x), x]`` otherwise
+    (convexity); where a Newton step would leave the bracket (or ``x`` rounds onto the
+    pole) the next point is the bracket's middle. Iterates until the bracket is ``1e-11`` relative (or ``1e-16`` absolute)
+    wide; both ends are widened by ``1e-13`` relative for rounding.
+
+    Parameters
+    ----------
+    psi, theta : ndarray, same shape
+        State units and ``1/s`` state units^3 (eq. (11)); ``theta >= 0``.
+    kappa : float
+        ``1/s``.
+
+    Returns
+    -------
+    lo, hi : ndarray, the shape of ``psi``
+        ``0`` where ``theta = 0``.
     """
-    lo = np.maximum(0.0, -psi)
-    hi = lo + np.cbrt(theta / kappa)
-    lo = np.where(theta > 0, lo, 0.0)
-    hi = np.where(theta > 0, hi, 0.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        for _ in range(1100):
-            mid = 0.5 * (lo + hi)
-            if np.all((mid <= lo) | (mid >= hi) | (hi - lo <= 1e-11 * hi + 1e-16)):
+    pole = np.maximum(0.0, -psi)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        # right of the pole, f >= 0 at pole + eps: theta/eps^2 >= kappa (eps + max(-psi, 0))
+        eps = np.minimum(np.cbrt(theta / (2.0 * kappa)),
+                         np.sqrt(theta / (2.0 * kappa * np.maximum(-psi, 1e-300))))
+        x = np.where(psi > 0.0, 0.0, pole + eps)
+        lo, hi = pole, pole + np.cbrt(theta / kappa)
+        for _ in range(100):
+            z = psi + x
+            f = theta / (z * z) - kappa * x
+            slope = -2.0 * theta / (z * z * z) - kappa
+            usable = (z > 0.0) & np.isfinite(f) & np.isfinite(slope)   # else: at the pole
+            right = f >= 0.0
+            lo = np.where(usable, np.maximum(lo, np.where(right, x, x - f / slope)), lo)
+            hi = np.where(usable, np.minimum(hi, np.where(right, x + f / kappa, x)), hi)
+            if np.all(hi - lo <= 1e-11 * hi + 1e-16):
                 break
-            z = psi + mid
-            above = (z > 0) & (theta / (z * z) > kappa * mid)   # still left of the root
-            lo = np.where(above, mid, lo)
-            hi = np.where(above, hi, mid)
-    return lo, hi
+            # Newton, or bisection where Newton is not usable or leaves the bracket
+            step = np.where(usable, x - f / slope, np.nan)
+            inside = (step > lo) & (step < hi)
+            x = np.where(inside, step, 0.5 * (lo + hi))
+    done = theta > 0.0
+    return (np.where(done, np.maximum(pole, lo * (1.0 - 1e-13)), 0.0),
+            np.where(done, hi * (1.0 + 1e-13) + 1e-300, 0.0))
 
 
 # --------------------------------------------------------------------------- intervals
@@ -385,11 +417,11 @@ def _alpha_ranges(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
     k_count, m = star_hi.shape
     a_lo, a_hi = list(start[0]), list(start[1])
     s_lo, s_hi = star_lo.tolist(), star_hi.tolist()
-    d_lo, th, ps, n_steps = decay_lo.tolist(), (2.0 * dt * theta_hi).tolist(), \
-        psi_lo.tolist(), steps.tolist()
-    out_lo, out_hi = np.empty((k_count, m)).tolist(), np.empty((k_count, m)).tolist()
+    d_lo, n_steps = decay_lo.tolist(), steps.tolist()
+    out_lo, out_hi = [[0.0] * m for _ in range(k_count)], [[0.0] * m for _ in range(k_count)]
     p_lo, p_hi = psi_lo.tolist(), psi_hi.tolist()
     t_lo, t_hi = theta_lo.tolist(), theta_hi.tolist()
+    ps, two_dt = p_lo, 2.0 * dt
     entries = []
     for k in range(k_count):
         entries.append((list(a_lo), list(a_hi)))
@@ -428,7 +460,7 @@ def _alpha_ranges(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
             a_lo[i] = end if end > 0.0 else 0.0
             # upper sequence (psi_lo, theta_hi)
             if hi_i >= sh[i]:        # falling: one implicit step of N dt lags behind
-                q = 1.0 / (c + th[k][i] / (ps[k][i] + hi_i) ** 3)
+                q = 1.0 / (c + two_dt * t_hi[k][i] / (ps[k][i] + hi_i) ** 3)
                 end = min(step_root(hi_i, ps[k][i], t_hi[k][i], span, c_span)[1],
                           sh[i] + (hi_i - sh[i]) * q ** steps_k)
                 row_hi[i] = hi_i
@@ -447,7 +479,8 @@ def step_root(a: float, psi: float, theta: float, dt: float, c: float) -> tuple[
     ``g`` has slope ``>= c`` on ``x > -psi``, so for any ``x`` there
     ``|a+ - x| <= |g(x)| / c``: the bracket is rigorous after any number of Newton
     iterations. They start at ``a`` (``alpha`` moves little per step) or, where
-    ``psi + a <= 0``, at the left start of :func:`stt_codegen.tube.model.implicit_alpha_update`.
+    ``psi + a <= 0``, at the left start of :func:`stt_codegen.tube.model.implicit_alpha_update`,
+    and stop once the bracket is :data:`STEP_ROOT_TOLERANCE` relative wide.
     """
     big_a = dt * theta
     if not big_a > 0.0:
@@ -457,7 +490,11 @@ def step_root(a: float, psi: float, theta: float, dt: float, c: float) -> tuple[
         z = psi + x
         if not z > 0.0:
             break
-        x_next = x - (c * x - a - big_a / (z * z)) / (c + 2.0 * big_a / (z * z * z))
+        zz = z * z
+        g = c * x - a - big_a / zz
+        if abs(g) <= STEP_ROOT_TOLERANCE * c * x:
+            return _root_bracket(x, g, c, a + big_a / zz)
+        x_next = x - g / (c + 2.0 * big_a / (zz * z))
         if x_next == x:
             break
         x = x_next
@@ -474,7 +511,15 @@ def step_root(a: float, psi: float, theta: float, dt: float, c: float) -> tuple[
             x = x_next
     z = psi + x
     g = c * x - a - big_a / (z * z)
-    return (x - g / c, x) if g > 0.0 else (x, x - g / c)
+    return _root_bracket(x, g, c, a + big_a / (z * z))
+
+
+def _root_bracket(x: float, g: float, c: float, terms: float) -> tuple[float, float]:
+    """``[x, x - g/c]`` or ``[x - g/c, x]`` (slope ``>= c``), widened by the rounding of
+    ``g = c x - terms`` (a few ulps of its largest term)."""
+    slack = 1e-15 * (c * abs(x) + terms) / c
+    lo, hi = (x - g / c, x) if g > 0.0 else (x, x - g / c)
+    return lo - slack, hi + slack
 
 
 def _enclose(design: TubeDesign, pieces: _Pieces, alpha_min, alpha_max, t0, t1) -> Enclosure:
@@ -643,6 +688,7 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
     min_steps = max(1, int(MIN_INTERVAL * design.rate_hz))
     budget_hit = False
     decisive = ""
+    work = 0
     m = 2 * design.dimension
     previous: tuple = ([], [], [], [])      # points, rows_lo, rows_hi, entries
     reuse_limit = 0                         # intervals of `previous` that may be reused
@@ -671,6 +717,7 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
         start = old_entries[keep] if keep else ([0.0] * m, [0.0] * m)
         rows_lo, rows_hi, entries = _alpha_ranges(design, pieces.psi_lo[keep:],
                                                   pieces.psi_hi[keep:], steps[keep:], start)
+        work += len(points) - keep
         rows_lo, rows_hi = old_lo[:keep] + rows_lo, old_hi[:keep] + rows_hi
         entries = old_entries[:keep] + entries
         previous = (list(points), rows_lo, rows_hi, entries)
@@ -704,7 +751,7 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
         points = sorted(set(points) | cuts)
     certificate = _report(design, spec, enc, selected, final, budget_hit, end * dt,
                           max_intervals)
-    return replace(certificate, state=previous, decisive=decisive)
+    return replace(certificate, state=previous, decisive=decisive, work=work)
 
 
 def _surely_failing(design: TubeDesign, spec: Spec, t: np.ndarray, a_min: np.ndarray,

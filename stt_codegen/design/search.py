@@ -56,6 +56,11 @@ AUTO_WIDTH_FRACTION = 0.25
 MAX_CANDIDATE_CHECKS = 40
 #: The same for the first try of ``tube.method = "auto"`` (via points come next).
 AUTO_CANDIDATE_CHECKS = 6
+#: Work budget of that first try: intervals whose ``alpha`` bounds its certificates
+#: compute, summed over its candidate tubes (``Certificate.work``, a deterministic
+#: measure of the cost; a paper design that needs more is rare, and via points are
+#: cheaper to certify). The full search comes after via points.
+AUTO_CANDIDATE_INTERVALS = 1500
 #: Refinement budget of a candidate's certificate in the search (intervals): a candidate
 #: that needs more is too thin to keep (the bundled cases need about 500).
 CANDIDATE_INTERVALS = 3000
@@ -366,16 +371,17 @@ def design_tube(spec: Spec) -> Design:
     method = spec.tube.method
     # "auto": the paper's search on a short budget, then via points, then the paper's
     # search on its full budget (a hard arena rarely needs it)
-    stages = {"paper": [(METHOD_PAPER, MAX_CANDIDATE_CHECKS)], "via": [(METHOD_VIA, 0)],
-              "auto": [(METHOD_PAPER, AUTO_CANDIDATE_CHECKS), (METHOD_VIA, 0),
-                       (METHOD_PAPER, MAX_CANDIDATE_CHECKS)]}[method]
+    full = (METHOD_PAPER, MAX_CANDIDATE_CHECKS, None)
+    stages = {"paper": [full], "via": [(METHOD_VIA, 0, None)],
+              "auto": [(METHOD_PAPER, AUTO_CANDIDATE_CHECKS, AUTO_CANDIDATE_INTERVALS),
+                       (METHOD_VIA, 0, None), full]}[method]
     errors: dict[str, str] = {}
-    for used, budget in stages:
+    for used, budget, work in stages:
         if used in errors and "candidate tubes" not in errors[used]:
             continue          # the paper's search ended for another reason than its budget
         try:
             tube, check = (_via(spec, base) if used == METHOD_VIA
-                           else paper_design(spec, base, budget))
+                           else paper_design(spec, base, budget, work))
             break
         except DesignError as exc:
             errors[used] = str(exc)
@@ -396,8 +402,8 @@ def _via(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck]:
     return tube, check
 
 
-def paper_design(spec: Spec, base: TubeDesign,
-                 max_checks: int = MAX_CANDIDATE_CHECKS) -> tuple[TubeDesign, TubeCheck]:
+def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_CHECKS,
+                 max_work: int | None = None) -> tuple[TubeDesign, TubeCheck]:
     """The paper's design: circumvents (7)-(9) on the single reach tube ``base``.
 
     Parameters
@@ -407,6 +413,10 @@ def paper_design(spec: Spec, base: TubeDesign,
         The paper's reach tube (:func:`base_design`).
     max_checks : int
         Candidate tubes to certify at most.
+    max_work : int, optional
+        Certificate work (``Certificate.work``, intervals computed), summed over the
+        candidates, at most (default: no limit beyond :data:`CANDIDATE_INTERVALS` per
+        candidate).
 
     Returns
     -------
@@ -417,8 +427,8 @@ def paper_design(spec: Spec, base: TubeDesign,
     Raises
     ------
     DesignError
-        No choice of circumvents passes :func:`check_tube` (or :data:`MAX_CANDIDATE_CHECKS`
-        candidates were tried).
+        No choice of circumvents passes :func:`check_tube` (or ``max_checks`` candidates
+        or ``max_work`` intervals were used up).
     """
     boxes = spec.obstacle_boxes()
     delta_b = spec.tube.delta_b
@@ -450,16 +460,20 @@ def paper_design(spec: Spec, base: TubeDesign,
         options[j] = [tuple(per_box[b][key] for b in members) for key in keys]
     order = sorted(options, key=lambda j: (starts[j], j))
     failures: dict[int, str] = {}
-    budget = [max_checks]
+    budget = [max_checks, CANDIDATE_INTERVALS * max_checks if max_work is None else max_work]
 
     def check(design: TubeDesign, **kwargs) -> TubeCheck:
-        if budget[0] <= 0:
-            raise DesignError(f"no certified circumvents within {max_checks} "
-                              "candidate tubes (" + "; ".join(
+        if budget[0] <= 0 or budget[1] <= 0:
+            raise DesignError(f"no certified circumvents within {max_checks} candidate tubes"
+                              + ("" if max_work is None else f" and {max_work} intervals of "
+                                 "certificate work") + " (" + "; ".join(
                                   f"obstacle {j}: {r}" for j, r in sorted(failures.items()))
                               + ")")
         budget[0] -= 1
-        return check_tube(design, spec, max_intervals=CANDIDATE_INTERVALS, **kwargs)
+        found = check_tube(design, spec, max_intervals=min(CANDIDATE_INTERVALS, budget[1]),
+                           **kwargs)
+        budget[1] -= found.certificate.work
+        return found
 
     def search(level: int, chosen: tuple[Circumvent, ...],
                parent: TubeCheck | None) -> tuple[TubeDesign, TubeCheck] | None:
