@@ -133,3 +133,23 @@ def test_step_root_bracket_is_rigorous():
             return c * x - a - dt * theta / (psi + x) ** 2
         assert psi + lo <= 0 or g(lo) <= 0
         assert psi + hi > 0 and g(hi) >= 0
+
+
+def test_sharpened_narrowest_width_is_sound_and_sharper(case):
+    """The narrowest width the gain comes from: a lower bound of the deployed tube's width
+    (alpha interpolated between samples, at 40 000 random times and at every sample),
+    and no looser than the partition's own enclosure."""
+    spec, design, check = designed(case)
+    cert = check.certificate
+    enc = cert.enclosure
+    samples = sample_tube(design, 1.2 * design.prescribed_time)
+    rng = np.random.default_rng(1)
+    t = np.concatenate([samples.t, rng.uniform(0.0, samples.t[-1], 40_000)])
+    k = np.minimum(np.searchsorted(samples.t, t, side="right") - 1, samples.t.size - 2)
+    frac = (t - samples.t[k]) / (samples.t[k + 1] - samples.t[k])
+    alpha = (1 - frac)[:, None] * samples.alpha[k] + frac[:, None] * samples.alpha[k + 1]
+    g_l, g_u, _, _ = R.adaptive_tube(design, t, alpha)
+    true_min = float((g_u - g_l).min())
+    assert cert.min_width <= true_min + 1e-12
+    assert cert.min_width >= float((enc.upper_min - enc.lower_max).min())
+    assert cert.margin("non-empty").margin == cert.min_width

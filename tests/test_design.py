@@ -144,3 +144,20 @@ def test_a_start_at_the_tube_edge_is_rejected():
     found = design_tube(spec)
     accepted = found.check
     assert accepted.passed and accepted.initial_error <= MAX_INITIAL_ERROR
+
+
+def test_the_gain_comes_from_the_tubes_width_not_from_a_loose_enclosure():
+    """Random arena 178 of seed 0: on one sampling period where both bounds move fast the
+    partition's enclosure of the width is 5 mm, the tube itself is 38 mm wide. A gain
+    derived from 5 mm (0.0017) left the state lagging at |e| = 0.95 until the tube moved
+    past it (the only arena A* satisfied and the toolkit did not); from the sharpened
+    bound the loop is satisfied."""
+    from stt_codegen.bench.arenas import generate_arena
+    from stt_codegen.runtime.simulate import simulate
+    spec = generate_arena(0, 178).to_spec()
+    found = design_tube(spec)
+    enc = found.check.certificate.enclosure
+    assert float((enc.upper_min - enc.lower_max).min()) < 0.01
+    assert found.check.min_width > 0.03
+    result = simulate(spec, found.tube, backend="c")
+    assert result.satisfied and result.stayed_in_tube
