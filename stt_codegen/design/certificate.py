@@ -316,11 +316,14 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
     """Bracket ``[lo, hi]`` of ``a*``, the root of ``kappa a = theta / (psi + a)^2`` with ``psi + a > 0``.
 
     ``f(a) = theta / (psi + a)^2 - kappa a`` is decreasing and convex on ``a > -psi``, with
-    slope ``<= -kappa``. Newton from a start with ``f >= 0`` (``0``, or just right of the
-    pole) rises monotonically to the root; from any iterate ``x`` the root lies in
-    ``[x, x + f(x) / kappa]`` when ``f(x) >= 0`` and in ``[x - f(x) / f'(x), x]`` otherwise
-    (convexity); where a Newton step would leave the bracket (or ``x`` rounds onto the
-    pole) the next point is the bracket's middle. Iterates until the bracket is ``1e-11`` relative (or ``1e-16`` absolute)
+    slope ``<= -kappa``. Newton starts at ``theta / (kappa psi^2)`` (``psi > 0``; right of
+    the root, so the first step lands left of it) or just right of the pole (``f >= 0``),
+    and from the left rises monotonically to the root. Every iterate ``x`` bounds the root:
+    from below where ``f(x) >= 0``, from above otherwise, and then its Newton point bounds
+    it from below (convexity); a probe right of a left iterate (twice its Newton step and
+    a few ulps) bounds it from above where ``f <= 0`` there. Where a Newton step would
+    leave the bracket (or ``x`` rounds onto the pole) the next point is the bracket's
+    middle. Iterates until the bracket is ``1e-11`` relative (or ``1e-16`` absolute)
     wide; both ends are widened by ``1e-13`` relative for rounding.
 
     Parameters
@@ -340,22 +343,28 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
         # right of the pole, f >= 0 at pole + eps: theta/eps^2 >= kappa (eps + max(-psi, 0))
         eps = np.minimum(np.cbrt(theta / (2.0 * kappa)),
                          np.sqrt(theta / (2.0 * kappa * np.maximum(-psi, 1e-300))))
-        x = np.where(psi > 0.0, 0.0, pole + eps)
         lo, hi = pole, pole + np.cbrt(theta / kappa)
+        # psi > 0: theta / (kappa psi^2), right of the root and close to it when a* << psi
+        x = np.where(psi > 0.0, np.minimum(theta / (kappa * psi * psi), hi), pole + eps)
         for _ in range(100):
             z = psi + x
             f = theta / (z * z) - kappa * x
-            slope = -2.0 * theta / (z * z * z) - kappa
-            usable = (z > 0.0) & np.isfinite(f) & np.isfinite(slope)   # else: at the pole
-            right = f >= 0.0
-            lo = np.where(usable, np.maximum(lo, np.where(right, x, x - f / slope)), lo)
-            hi = np.where(usable, np.minimum(hi, np.where(right, x + f / kappa, x)), hi)
+            newton = x - f / (-2.0 * theta / (z * z * z) - kappa)
+            usable = (z > 0.0) & np.isfinite(newton)        # else: x rounds onto the pole
+            left = f >= 0.0                                  # x left of the root
+            # right of a left iterate by twice its Newton step and a few ulps: an upper
+            # bound wherever f <= 0 there
+            probe = x + 2.0 * (newton - x) + 4.0 * np.spacing(x)
+            z_probe = psi + probe
+            above = (z_probe > 0.0) & (theta / (z_probe * z_probe) - kappa * probe <= 0.0)
+            lo = np.where(usable, np.maximum(lo, np.where(left, x, newton)), lo)
+            hi = np.where(usable, np.minimum(hi, np.where(left, np.where(above, probe, hi), x)),
+                          hi)
             if np.all(hi - lo <= 1e-11 * hi + 1e-16):
                 break
             # Newton, or bisection where Newton is not usable or leaves the bracket
-            step = np.where(usable, x - f / slope, np.nan)
-            inside = (step > lo) & (step < hi)
-            x = np.where(inside, step, 0.5 * (lo + hi))
+            inside = usable & (newton >= lo) & (newton <= hi)
+            x = np.where(inside, newton, 0.5 * (lo + hi))
     done = theta > 0.0
     return (np.where(done, np.maximum(pole, lo * (1.0 - 1e-13)), 0.0),
             np.where(done, hi * (1.0 + 1e-13) + 1e-300, 0.0))
@@ -817,8 +826,10 @@ def _surely_failing(design: TubeDesign, spec: Spec, t: np.ndarray, a_min: np.nda
     """
     if not t.size:
         return ""
-    g_l, g_u, _, _ = reference.adaptive_tube(design, t, a_min)
-    w_l, w_u, _, _ = reference.adaptive_tube(design, t, a_max)
+    both_l, both_u, _, _ = reference.adaptive_tube(design, np.concatenate([t, t]),
+                                                   np.concatenate([a_min, a_max]))
+    g_l, w_l = both_l[:t.size], both_l[t.size:]
+    g_u, w_u = both_u[:t.size], both_u[t.size:]
     boxes = spec.obstacle_boxes()
     for b in selected:
         lo, hi = np.array(boxes[b].lower), np.array(boxes[b].upper)
