@@ -55,12 +55,12 @@ AUTO_WIDTH_FRACTION = 0.25
 #: Candidate certificates the paper's search may run before it gives up.
 MAX_CANDIDATE_CHECKS = 40
 #: The same for the first try of ``tube.method = "auto"`` (via points come next).
-AUTO_CANDIDATE_CHECKS = 6
+AUTO_CANDIDATE_CHECKS = 5
 #: Work budget of that first try: intervals whose ``alpha`` bounds its certificates
 #: compute, summed over its candidate tubes (``Certificate.work``, a deterministic
 #: measure of the cost; a paper design that needs more is rare, and via points are
 #: cheaper to certify). The full search comes after via points.
-AUTO_CANDIDATE_INTERVALS = 1500
+AUTO_CANDIDATE_INTERVALS = 1000
 #: Refinement budget of a candidate's certificate in the search (intervals): a candidate
 #: that needs more is too thin to keep (the bundled cases need about 500).
 CANDIDATE_INTERVALS = 3000
