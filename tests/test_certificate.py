@@ -153,3 +153,27 @@ def test_sharpened_narrowest_width_is_sound_and_sharper(case):
     assert cert.min_width <= true_min + 1e-12
     assert cert.min_width >= float((enc.upper_min - enc.lower_max).min())
     assert cert.margin("non-empty").margin == cert.min_width
+
+
+def test_numpy_math_is_per_thread():
+    """The certificate's switch to numpy's ufuncs (reference.numpy_math) holds in its own
+    thread only: another thread evaluating the oracle meanwhile keeps libm."""
+    import math
+    import threading
+    x = np.random.default_rng(5).uniform(-30.0, 30.0, 20_000)
+    libm = np.array([math.exp(v) for v in x])
+    assert not np.array_equal(np.exp(x), libm)       # the two differ somewhere on x
+    inside, seen = threading.Event(), {}
+
+    def other():
+        inside.wait()
+        seen["other"] = R.exp(x)
+    thread = threading.Thread(target=other)
+    thread.start()
+    with R.numpy_math():
+        inside.set()
+        thread.join()
+        seen["here"] = R.exp(x)
+    assert np.array_equal(seen["other"], libm)
+    assert np.array_equal(seen["here"], np.exp(x))
+    assert np.array_equal(R.exp(x), libm)

@@ -13,6 +13,7 @@ Shapes: ``t`` is ``(N,)``; ``x`` is ``(N, n)``; ``alpha`` is ``(N, 2n)`` and hol
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import math
 
 import numpy as np
@@ -48,10 +49,32 @@ def _safe(function, domain):
     return wrapped
 
 
-exp = _libm(lambda v: math.exp(v) if v < 709.0 else math.inf, "exp")
-log = _libm(_safe(math.log, lambda v: v > 0), "log")
-log1p = _libm(_safe(math.log1p, lambda v: v > -1), "log1p")
-tanh = _libm(math.tanh, "tanh")
+_LIBM = {
+    "exp": _libm(lambda v: math.exp(v) if v < 709.0 else math.inf, "exp"),
+    "log": _libm(_safe(math.log, lambda v: v > 0), "log"),
+    "log1p": _libm(_safe(math.log1p, lambda v: v > -1), "log1p"),
+    "tanh": _libm(math.tanh, "tanh"),
+}
+_NUMPY = {"exp": np.exp, "log": np.log, "log1p": np.log1p, "tanh": np.tanh}
+#: True inside :func:`numpy_math` (per thread and per asyncio task: a context variable).
+_USE_NUMPY: contextvars.ContextVar[bool] = contextvars.ContextVar("stt_numpy_math",
+                                                                    default=False)
+
+
+def _dispatch(name: str):
+    libm, fast = _LIBM[name], _NUMPY[name]
+
+    def apply(x):
+        return fast(x) if _USE_NUMPY.get() else libm(x)
+    apply.__name__ = name
+    apply.__doc__ = libm.__doc__ + " Inside :func:`numpy_math`, numpy's ufunc instead."
+    return apply
+
+
+exp = _dispatch("exp")
+log = _dispatch("log")
+log1p = _dispatch("log1p")
+tanh = _dispatch("tanh")
 
 
 @contextlib.contextmanager
@@ -60,15 +83,15 @@ def numpy_math():
 
     numpy's kernels differ from libm by an ulp or so and are tens of times faster on
     arrays; the certificate (:mod:`stt_codegen.design.certificate`), whose margins are
-    far above rounding, evaluates the oracle's formulas this way. Not thread-safe.
+    far above rounding, evaluates the oracle's formulas this way. The switch is a context
+    variable, so other threads (and asyncio tasks) keep libm.
     """
-    saved = {name: globals()[name] for name in ("exp", "log", "log1p", "tanh")}
-    globals().update(exp=np.exp, log=np.log, log1p=np.log1p, tanh=np.tanh)
+    token = _USE_NUMPY.set(True)
     try:
         with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
             yield
     finally:
-        globals().update(saved)
+        _USE_NUMPY.reset(token)
 
 
 def _time(t) -> Array:
