@@ -1,7 +1,10 @@
 """One arena, every method: the unit of work of ``stt-codegen bench arenas``.
 
-:func:`run_arena` is a plain top-level function of picklable arguments returning plain
-data, so that it runs unchanged in a local process pool or on a Dask worker.
+:func:`plan_arena` (designs and plans, timed) and :func:`loop_arena` (closed loops) are
+plain top-level functions of picklable arguments returning picklable data, so that they
+run unchanged in a local process pool or on a Dask worker; the bench runs the first over
+every arena, then the second, so that no compiler or simulation runs beside a timed
+design; :func:`run_arena` is both for one arena.
 
 Methods (:data:`METHODS`):
 
@@ -82,35 +85,26 @@ def _outcome(seconds: float, reason: str, result: SimulationResult | None) -> di
             "clearance": None if result is None else result.min_obstacle_clearance}
 
 
-def _run_stt(spec, index: int, method: str, runs: dict) -> dict[str, Any]:
-    """Design with ``tube.method = method`` and run the C controller; ``runs`` caches the
-    closed loop of a tube already simulated (same tube, same seed: same run)."""
+def _plan_stt(spec, method: str) -> dict[str, Any]:
+    """Design with ``tube.method = method``: ``{"seconds", "tube"}`` or ``{"seconds",
+    "reason"}``."""
     from dataclasses import replace
 
     from ..design.search import design_tube
-    from ..runtime.simulate import simulate
     spec = replace(spec, tube=replace(spec.tube, method=method))
     begin = time.perf_counter()
     try:
         design = design_tube(spec)
     except DesignError as exc:
-        return _outcome(time.perf_counter() - begin, design_failure(str(exc)), None)
-    if design.tube not in runs:
-        runs[design.tube] = simulate(spec, design.tube, backend="c", seed=index)
-    result = runs[design.tube]
-    return _outcome(design.design_time_s, closed_loop_failure(result), result)
+        return {"seconds": time.perf_counter() - begin, "reason": design_failure(str(exc))}
+    return {"seconds": design.design_time_s, "tube": design.tube}
 
 
-def _run_baseline(spec, plan, index: int) -> dict[str, Any]:
-    from .tracker import track
-    if plan.path is None:
-        return _outcome(plan.seconds, plan.reason, None)
-    result = track(spec, plan.path, seed=index)
-    return _outcome(plan.seconds, closed_loop_failure(result), result)
+def plan_arena(seed: int, index: int, methods: tuple[str, ...] = METHODS) -> dict[str, Any]:
+    """Phase 1 of :func:`run_arena`: every method's design or plan, timed.
 
-
-def run_arena(seed: int, index: int, methods: tuple[str, ...] = METHODS) -> dict[str, Any]:
-    """Run every method on arena ``index`` of ``seed``.
+    Nothing else runs in the worker meanwhile (no compiler, no closed loop), so the times
+    of the methods are comparable and not inflated by the bench's own simulations.
 
     Parameters
     ----------
@@ -122,24 +116,85 @@ def run_arena(seed: int, index: int, methods: tuple[str, ...] = METHODS) -> dict
     Returns
     -------
     dict
+        ``{"index", "plans": {method: {"seconds", and "tube" (STT), "plan" (baselines)
+        or "reason" (failure category)}}}``; picklable.
+    """
+    spec = generate_arena(seed, index).to_spec()
+    plans: dict[str, Any] = {}
+    for method in methods:
+        if method in ("stt-paper", "stt"):
+            plans[method] = _plan_stt(spec, "paper" if method == "stt-paper" else "auto")
+        elif method == "astar":
+            from .astar import plan_astar
+            plan = plan_astar(spec)
+            plans[method] = {"seconds": plan.seconds, "plan": plan}
+        elif method == "rrtstar":
+            from .rrtstar import plan_rrtstar
+            plan = plan_rrtstar(spec, seed=1 + 100_003 * seed + index)
+            plans[method] = {"seconds": plan.seconds, "plan": plan}
+        else:
+            raise ValueError(f"unknown method {method!r}")
+    return {"index": index, "plans": plans}
+
+
+def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
+    """Phase 2 of :func:`run_arena`: the closed loop of every method's design or plan.
+
+    STT tubes run the generated C controller (backend ``c``); a tube that two methods share
+    (``auto`` returning the paper's tube) runs once. Baseline paths run the tracker.
+
+    Parameters
+    ----------
+    seed, index : int
+    plans : dict
+        ``plans`` of :func:`plan_arena` for this arena.
+
+    Returns
+    -------
+    dict
         ``{"index", "name", "methods": {method: {"success" (bool), "seconds"
         (design or planning time, s), "reason" (failure category, "" on success),
         "reach_time" (s or None), "clearance" (m or None)}}}``.
     """
+    from ..runtime.simulate import simulate
+    from .tracker import track
     arena = generate_arena(seed, index)
     spec = arena.to_spec()
     out: dict[str, Any] = {}
     runs: dict = {}
-    for method in methods:
-        if method in ("stt-paper", "stt"):
-            out[method] = _run_stt(spec, index, "paper" if method == "stt-paper" else "auto",
-                                   runs)
-        elif method == "astar":
-            from .astar import plan_astar
-            out[method] = _run_baseline(spec, plan_astar(spec), index)
-        elif method == "rrtstar":
-            from .rrtstar import plan_rrtstar
-            out[method] = _run_baseline(spec, plan_rrtstar(spec, seed=1 + 100_003 * seed + index), index)
+    for method, planned in plans.items():
+        if "reason" in planned:
+            out[method] = _outcome(planned["seconds"], planned["reason"], None)
+        elif "tube" in planned:
+            tube = planned["tube"]
+            if tube not in runs:
+                runs[tube] = simulate(spec, tube, backend="c", seed=index)
+            out[method] = _outcome(planned["seconds"], closed_loop_failure(runs[tube]),
+                                   runs[tube])
         else:
-            raise ValueError(f"unknown method {method!r}")
+            plan = planned["plan"]
+            if plan.path is None:
+                out[method] = _outcome(plan.seconds, plan.reason, None)
+            else:
+                result = track(spec, plan.path, seed=index)
+                out[method] = _outcome(plan.seconds, closed_loop_failure(result), result)
     return {"index": index, "name": arena.name, "methods": out}
+
+
+def run_arena(seed: int, index: int, methods: tuple[str, ...] = METHODS) -> dict[str, Any]:
+    """Run every method on arena ``index`` of ``seed``: :func:`plan_arena`, then
+    :func:`loop_arena` (the bench runs the two phases over all arenas in turn).
+
+    Parameters
+    ----------
+    seed, index : int
+        Which arena (see :func:`~.arenas.generate_arena`).
+    methods : tuple of str
+        Subset of :data:`METHODS`.
+
+    Returns
+    -------
+    dict
+        As :func:`loop_arena`.
+    """
+    return loop_arena(seed, index, plan_arena(seed, index, methods)["plans"])

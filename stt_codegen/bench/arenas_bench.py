@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SpecError
-from .arena_job import LABELS, METHODS, run_arena
+from .arena_job import LABELS, METHODS, loop_arena, plan_arena
 from .arenas import generate_arenas
 from .parallel import run_parallel
 from .report import machine, machine_line, seconds_text, summarize, table
@@ -71,7 +71,7 @@ def run_arenas_bench(count: int, seed: int, workers: int | None = None,
     dict
         ``{"count", "seed", "machine", "workers", "scheduler", "skipped" (method ->
         reason), "methods" (method -> :func:`~.report.summarize`), "arenas" (per-arena
-        results of :func:`~.arena_job.run_arena`)}``.
+        results of :func:`~.arena_job.loop_arena`)}``.
 
     Raises
     ------
@@ -89,9 +89,14 @@ def run_arenas_bench(count: int, seed: int, workers: int | None = None,
             raise SpecError("methods", f"unknown method {m!r} (known: {', '.join(METHODS)})")
         if m in skipped:
             raise SpecError("methods", f"{m} cannot run: {skipped[m]}")
+    # two phases: the timed designs and plans, then the closed loops (which compile C):
+    # a design is never timed while a compiler or a simulation runs beside it
     calls = [(seed, k, tuple(methods)) for k in range(count)]
-    arenas = run_parallel(run_arena, calls, workers=workers, scheduler=scheduler,
-                          progress=progress, description="arenas")
+    planned = run_parallel(plan_arena, calls, workers=workers, scheduler=scheduler,
+                           progress=progress, description="designs")
+    arenas = run_parallel(loop_arena, [(seed, p["index"], p["plans"]) for p in planned],
+                          workers=workers, scheduler=scheduler, progress=progress,
+                          description="closed loops")
     summary = {m: summarize([a["methods"][m] for a in arenas]) for m in methods}
     return {"count": count, "seed": seed, "machine": machine(),
             "workers": None if scheduler else workers, "scheduler": scheduler,
