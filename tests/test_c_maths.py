@@ -7,6 +7,8 @@ through ctypes on float32 arrays:
   million floats, plus the point of the largest error of the exhaustive sweep and the
   points where ``round(x / ln 2)`` changes) the error against ``exp`` in double is
   below the documented 0.8904 ulp;
+* it does not decrease across the points where ``round(x / ln 2)`` changes (64 floats
+  each side);
 * outside the fast path (``|x| > 80``, ``|x| < 2^-28``, infinities, NaN) it returns the C library's
   ``expf`` bit for bit;
 * no float of the sample (subnormals included) raises a floating-point exception flag but
@@ -14,7 +16,8 @@ through ctypes on float32 arrays:
 * the pieces' exponent clamp lies inside the fast path, so every exp of a deployed step
   takes it.
 The exhaustive sweep over all 2.2e9 floats of ``[-80, 80]`` (``exhaustive_sweep_source``,
-about a minute) is run by hand; its result is the documented bound.
+about a minute) is run by hand; its result is the documented bound (and monotonicity on
+the whole domain).
 """
 
 from __future__ import annotations
@@ -112,6 +115,22 @@ def test_error_below_the_documented_bound(stt_expf):
     assert err.max() > 0.5  # not correctly rounded: the bound is not vacuous
     # the largest error of the exhaustive sweep is in the sample
     assert err[np.nonzero(x == np.float32(WORST_X))[0][0]] > 0.89
+
+
+def test_monotone_where_the_reduction_switches(stt_expf):
+    # 64 consecutive floats on each side of every point where k = round(x / ln 2) changes
+    for edge in np.float32((np.arange(-115, 116) + 0.5) * np.log(2.0)):
+        if abs(edge) > 80.0:
+            continue
+        below = [edge]
+        for _ in range(64):
+            below.append(np.nextafter(below[-1], np.float32(-np.inf)))
+        above = [edge]
+        for _ in range(64):
+            above.append(np.nextafter(above[-1], np.float32(np.inf)))
+        x = np.float32(below[::-1] + above[1:])
+        y, _, _, _ = stt_expf(x)
+        assert np.all(np.diff(y.astype(np.float64)) >= 0.0), edge
 
 
 def test_no_flag_and_no_errno_on_the_clamped_domain(stt_expf):
