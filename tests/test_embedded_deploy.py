@@ -71,7 +71,9 @@ def test_embedded_case(case, reports, tmp_path_factory, capsys) -> None:
     total = sum(v["instructions"] for v in by_function.values())
     assert abs(total - sum(counts) / len(counts)) <= 0.05 * len(by_function) + 1e-9
     assert by_function[case.replace("-", "_") + "_step"]["entries"] == 1
-    assert by_function["stt_expf"]["entries"] >= 6          # the trigger's six
+    # (gcc may split off the fast path as stt_expf.part.0, the guard inlined in the callers)
+    own = [v["entries"] for name, v in by_function.items() if name.startswith("stt_expf")]
+    assert max(own) >= 6                                 # the trigger's six
     assert "expf" not in by_function and "__ieee754_expf" not in by_function
 
 
