@@ -65,6 +65,16 @@ def test_embedded_case(case, reports, tmp_path_factory, capsys) -> None:
     assert all(1000 < c < 50000 for c in counts)
     assert max(counts) < 1.3 * min(counts)             # branch-free body, libm varies a little
     assert r["instructions_per_step"] == round(sum(counts) / len(counts))
+    # where they go: the per-function means add up to the mean count; every exp of a
+    # normal step takes stt_expf's fast path (newlib's expf is never entered)
+    by_function = r["instructions_detail"]["by_function"]
+    total = sum(v["instructions"] for v in by_function.values())
+    assert abs(total - sum(counts) / len(counts)) <= 0.05 * len(by_function) + 1e-9
+    assert by_function[case.replace("-", "_") + "_step"]["entries"] == 1
+    # (gcc may split off the fast path as stt_expf.part.0, the guard inlined in the callers)
+    own = [v["entries"] for name, v in by_function.items() if name.startswith("stt_expf")]
+    assert max(own) >= 6                                 # the trigger's six
+    assert "expf" not in by_function and "__ieee754_expf" not in by_function
 
 
 def test_embedded_text_output(capsys, tmp_path) -> None:

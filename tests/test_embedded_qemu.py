@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from stt_codegen.embedded import board, build_elf, missing_message, run_qemu
-from stt_codegen.embedded.target import BuildError, count_region_instructions
+from stt_codegen.embedded.target import (BuildError, count_region_instructions,
+                                         profile_regions)
 
 
 @pytest.fixture(scope="module", autouse=True)
@@ -158,6 +159,14 @@ def test_instruction_counts(tmp_path: Path) -> None:
     # loop(10u): movs r0, #10; bl; 10 x (subs, bne); bx lr
     assert loop == 1 + 1 + 2 * 10 + 1
     assert len(set(exps)) == 1 and 20 < exps[0] < 500  # same input, same path
+    # the same regions split by function: they add up, six and loop run where they are
+    assert run.functions is not None and len(run.functions) == 6
+    assert [sum(v[0] for v in r.values()) for r in run.functions] == run.instructions
+    assert run.functions[0] == {}
+    assert run.functions[1]["six"] == [6, 1] and run.functions[1]["main"] == [1, 0]
+    # loop branches back to its first instruction: 10 entries for 1 call
+    assert run.functions[2]["loop"] == [2 * 10 + 1, 10]
+    assert all(r["expf"][1] == 1 for r in run.functions[3:])
     stack = int(re.search(r"stack=(\d+)", run.stdout).group(1))
     assert 0 < stack < 512
 
@@ -178,3 +187,9 @@ def test_count_parser() -> None:
         "Trace 0: 0x7f00 [00800408/000000d2/00000110/ff000201] stt_measure_end",
     ]
     assert count_region_instructions(lines, (0xC0, 0xC4), 0xD0) == [2]
+    # the two counted instructions: main's at 0x100 and f's first at 0x200
+    functions = {"main": (0x100, 0x180), "f": (0x200, 0x210)}
+    assert profile_regions(lines, (0xC0, 0xC4), 0xD0, functions) == [
+        {"main": [1, 1], "f": [1, 1]}]
+    assert profile_regions(lines, (0xC0, 0xC4), 0xD0, {"f": (0x200, 0x210)}) == [
+        {"?": [1, 0], "f": [1, 1]}]

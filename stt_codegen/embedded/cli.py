@@ -32,6 +32,10 @@ def cmd_embedded(args: argparse.Namespace) -> int:
               f"({r['stack_bytes_measured']} B measured)")
         print(f"  {r['instructions_per_step']} instructions per step "
               f"(counts {r['instructions_detail']['counts']})")
+        top = list(r["instructions_detail"]["by_function"].items())[:6]
+        if top:
+            print("  most instructions in: " + ", ".join(
+                f"{name} {v['instructions']:g} ({v['entries']:g} calls)" for name, v in top))
         clear = "-" if r["min_clearance"] is None else f"{r['min_clearance']:.3f}"
         reach = "-" if r["reach_time"] is None else f"{r['reach_time']:.3f}"
         print(f"  closed loop: {'satisfied' if r['closed_loop_satisfied'] else 'NOT satisfied'}"

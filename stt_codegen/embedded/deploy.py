@@ -18,7 +18,9 @@ Pipeline (:func:`run_embedded`): design the tube, generate the single-precision 
    each step a measured region: ``instructions_per_step`` (exact count of emulated
    instructions, QEMU ``-singlestep -d exec,nochain`` trace, from the return of
    ``stt_measure_begin`` to the call of ``stt_measure_end``: the call of ``P_step`` with
-   its argument set-up, the typed API's checks, the body and every libm call);
+   its argument set-up, the typed API's checks, the body and every libm call), and where
+   they go (``instructions_detail["by_function"]``: mean exclusive instructions and
+   entries per function, from the same trace and the ELF's symbol table);
    the painted stack of these steps is ``stack_bytes_measured``.
 
 Footprint of the controller object ``P.o`` alone (:func:`~stt_codegen.embedded.measure`,
@@ -198,6 +200,7 @@ def run_embedded(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
                     defines={"STT_MEASURE": None})
     cnt_run = run(cnt.elf, count_instructions=True)
     counts = list(cnt_run.instructions or [])
+    by_function = function_profile(cnt_run.functions or [])
     cnt_out = parse_replay(cnt_run.stdout, n)
 
     fp = measure(cl.objects[:1], cl.su_files[:1], entry=f"{prefix}_step")
@@ -231,7 +234,8 @@ def run_embedded(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
             "steps": ks, "t": [float(v) for v in t_r], "counts": counts,
             "how": "exact count of emulated Thumb-2 instructions of one P_step call (argument "
                    "set-up, API checks, body, libm) at the closed loop's inputs, QEMU "
-                   "-singlestep -d exec,nochain trace; not cycles"},
+                   "-singlestep -d exec,nochain trace; not cycles",
+            "by_function": by_function},
     }
     if compare_host:
         from ..runtime.simulate import simulate
@@ -244,6 +248,32 @@ def run_embedded(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
     report["ok"] = failed == 0 and report["closed_loop_satisfied"]
     report["build_dir"] = str(out)
     return report
+
+
+def function_profile(regions: list[dict[str, list[int]]]) -> dict[str, dict[str, float]]:
+    """Mean over the counted steps of each function's exclusive instructions and entries.
+
+    Parameters
+    ----------
+    regions : list of dict
+        :attr:`~stt_codegen.embedded.target.RunResult.functions` of the counting run.
+
+    Returns
+    -------
+    dict
+        ``{function: {"instructions": mean, "entries": mean}}`` (rounded to 0.1), most
+        instructions first (ties by name); the instructions add up to the mean count per
+        step. ``entries`` counts executions of the function's first instruction (its
+        calls). Inlined bodies count in the function they were inlined into.
+    """
+    if not regions:
+        return {}
+    names = sorted({name for region in regions for name in region})
+    mean = {name: [sum(r.get(name, [0, 0])[k] for r in regions) / len(regions)
+                   for k in (0, 1)] for name in names}
+    order = sorted(names, key=lambda name: (-mean[name][0], name))
+    return {name: {"instructions": round(mean[name][0], 1), "entries": round(mean[name][1], 1)}
+            for name in order}
 
 
 def _vectors(path: Path):

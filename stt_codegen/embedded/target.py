@@ -10,7 +10,8 @@ Instruction counts come from QEMU's execution trace: with ``-singlestep`` every
 translation block is one guest instruction and ``-d exec,nochain`` logs every
 executed block, so the log has one line per executed instruction. The host
 counts the lines between the return from ``stt_measure_begin()`` and the entry
-of ``stt_measure_end()``, minus the ``bl stt_measure_end`` itself. The count is
+of ``stt_measure_end()``, minus the ``bl stt_measure_end`` itself, and splits them by
+function with the ELF's symbol table (:func:`profile_regions`). The count is
 exact for the emulated instruction stream (conditional instructions that are
 skipped still count); it is not a cycle count (QEMU models no pipeline, caches,
 wait states, and no DWT cycle counter: ``DWT->CYCCNT`` reads 0 on mps2-an386).
@@ -18,6 +19,7 @@ wait states, and no DWT cycle counter: ``DWT->CYCCNT`` reads 0 on mps2-an386).
 
 from __future__ import annotations
 
+import bisect
 import re
 import subprocess
 import tempfile
@@ -110,6 +112,9 @@ class RunResult:
         the fault message of the startup code).
     command : tuple of str
         The QEMU command line.
+    functions : list of dict or None
+        When counted, per region ``{function: [instructions, entries]}``
+        (:func:`profile_regions`): where the region's instructions were executed.
     """
 
     stdout: str
@@ -118,6 +123,7 @@ class RunResult:
     timed_out: bool = False
     stderr: str = ""
     command: tuple[str, ...] = ()
+    functions: list[dict[str, list[int]]] | None = None
 
 
 def _build(cmd: Sequence[str]) -> None:
@@ -264,18 +270,49 @@ def build_elf(sources: Sequence[Path], include_dirs: Iterable[Path] = (),
                        link_command=tuple(link), elf_sizes=elf_sizes(elf, tc))
 
 
-def _function_ranges(elf: Path, nm: Path, names: Sequence[str]) -> dict[str, tuple[int, int]]:
+def _function_ranges(elf: Path, nm: Path, names: Sequence[str] | None = None
+                     ) -> dict[str, tuple[int, int]]:
+    """``{name: (start, stop)}`` of the ELF's functions (all of them when ``names`` is None)."""
     out = run_tool([str(nm), "-S", "--defined-only", str(elf)])
     ranges: dict[str, tuple[int, int]] = {}
     for line in out.splitlines():
         parts = line.split()
-        if len(parts) == 4 and parts[3] in names and parts[2] in "Tt":
+        if (len(parts) == 4 and parts[2] in "Tt"
+                and (names is None or parts[3] in names)):
             start = int(parts[0], 16) & ~1
             ranges[parts[3]] = (start, start + int(parts[1], 16))
     return ranges
 
 
 _TRACE_PC = re.compile(r"^Trace \d+: \S+ \[[0-9a-fA-F]+/([0-9a-fA-F]+)/")
+
+
+def _regions(trace: Iterable[str], begin: tuple[int, int], end_entry: int):
+    """The program counters of each measured region: yields one list per region, the
+    instructions after ``stt_measure_begin`` returned and before ``stt_measure_end`` was
+    entered, the ``bl stt_measure_end`` excluded."""
+    current: list[int] | None = None
+    started = False
+    b0, b1 = begin
+    for line in trace:
+        m = _TRACE_PC.match(line)
+        if m is None:
+            continue
+        pc = int(m.group(1), 16)
+        if pc == end_entry:
+            if current is not None:
+                yield current[:-1]
+            current = None
+            continue
+        if pc == b0:
+            current, started = [], False
+            continue
+        if current is None:
+            continue
+        if not started and b0 <= pc < b1:
+            continue
+        started = True
+        current.append(pc)
 
 
 def count_region_instructions(trace: Iterable[str], begin: tuple[int, int],
@@ -299,30 +336,44 @@ def count_region_instructions(trace: Iterable[str], begin: tuple[int, int],
         returned and before ``stt_measure_end`` was entered, excluding the
         ``bl stt_measure_end`` instruction.
     """
-    counts: list[int] = []
-    current: int | None = None
-    started = False
-    b0, b1 = begin
-    for line in trace:
-        m = _TRACE_PC.match(line)
-        if m is None:
-            continue
-        pc = int(m.group(1), 16)
-        if pc == end_entry:
-            if current is not None:
-                counts.append(current - 1)
-            current = None
-            continue
-        if pc == b0:
-            current, started = 0, False
-            continue
-        if current is None:
-            continue
-        if not started and b0 <= pc < b1:
-            continue
-        started = True
-        current += 1
-    return counts
+    return [len(pcs) for pcs in _regions(trace, begin, end_entry)]
+
+
+def profile_regions(trace: Iterable[str], begin: tuple[int, int], end_entry: int,
+                    functions: Mapping[str, tuple[int, int]]) -> list[dict[str, list[int]]]:
+    """Per measured region, the instructions of each function (exclusive) and its entries.
+
+    Parameters
+    ----------
+    trace, begin, end_entry
+        As :func:`count_region_instructions`.
+    functions : mapping
+        ``{name: (start, stop)}`` address ranges (``nm -S``); an instruction outside every
+        range counts under ``"?"``.
+
+    Returns
+    -------
+    list of dict
+        For each region, ``{name: [instructions, entries]}``: the instructions executed
+        inside the function's range (callees excluded; the region's instructions split
+        by function, so they add up to :func:`count_region_instructions`'s count) and
+        how many times its first instruction was executed (its calls, unless it loops
+        back to its first instruction).
+    """
+    ranges = sorted((start, stop, name) for name, (start, stop) in functions.items())
+    starts = [start for start, _, _ in ranges]
+    out: list[dict[str, list[int]]] = []
+    for pcs in _regions(trace, begin, end_entry):
+        region: dict[str, list[int]] = {}
+        for pc in pcs:
+            i = bisect.bisect_right(starts, pc) - 1
+            inside = i >= 0 and pc < ranges[i][1]
+            entry = region.setdefault(ranges[i][2] if inside else "?", [0, 0])
+            entry[0] += 1
+            if inside and pc == ranges[i][0]:
+                entry[1] += 1
+        out.append(region)
+    return out
 
 
 def qemu_command(elf: Path, *, trace_file: Path | None = None,
@@ -396,12 +447,14 @@ def run_qemu(elf: Path, timeout: float = 60.0, *,
         if any(line.startswith("qemu-system-arm:") and "warning" not in line
                for line in stderr.splitlines()):
             raise RunError(f"{' '.join(cmd)}: {stderr}")
-        counts = None
+        profile = None
         if trace is not None:
-            ranges = _function_ranges(elf, tc.nm, ("stt_measure_begin", "stt_measure_end"))
-            if len(ranges) != 2:
+            ranges = _function_ranges(elf, tc.nm)
+            if "stt_measure_begin" not in ranges or "stt_measure_end" not in ranges:
                 raise RunError(f"{elf}: no stt_measure_begin/stt_measure_end to count between")
             with open(trace, encoding="utf-8", errors="replace") as fh:
-                counts = count_region_instructions(fh, ranges["stt_measure_begin"],
-                                                   ranges["stt_measure_end"][0])
-    return RunResult(stdout, proc.returncode, counts, stderr=stderr, command=tuple(cmd))
+                profile = profile_regions(fh, ranges["stt_measure_begin"],
+                                          ranges["stt_measure_end"][0], ranges)
+    counts = None if profile is None else [sum(v[0] for v in r.values()) for r in profile]
+    return RunResult(stdout, proc.returncode, counts, stderr=stderr, command=tuple(cmd),
+                     functions=profile)

@@ -80,6 +80,67 @@ static const omnirobot_s3_window OMNIROBOT_S3_WINDOWS[OMNIROBOT_S3_N_WINDOWS] = 
 
 /* ------------------------------------------------------------- emitted bodies */
 
+/* stt_expf(x): expf(x), within 0.89 ulp of the exact e^x for |x| <= 80 (every
+   float there checked), with no library call for 2^-28 <= |x| <= 80: k = round(x / ln 2), r = x - k ln 2 in two
+   parts (Cody-Waite), e^r = 1 + r + r^2 q(r) (q minimax, degree 4), then one exact
+   multiplication by a tabled power of two. Other x (and NaN) go to expf. The fast path
+   raises no exception flag but FE_INEXACT and does not touch errno. See
+   stt_codegen/codegen/emit/c_maths.py. */
+static float stt_expf(float x) {
+  /* 2^k for k = -116 .. 116 */
+  static const float POWERS_OF_TWO[233] = {
+    0x1p-116f, 0x1p-115f, 0x1p-114f, 0x1p-113f, 0x1p-112f, 0x1p-111f, 0x1p-110f, 0x1p-109f,
+    0x1p-108f, 0x1p-107f, 0x1p-106f, 0x1p-105f, 0x1p-104f, 0x1p-103f, 0x1p-102f, 0x1p-101f,
+    0x1p-100f, 0x1p-99f, 0x1p-98f, 0x1p-97f, 0x1p-96f, 0x1p-95f, 0x1p-94f, 0x1p-93f,
+    0x1p-92f, 0x1p-91f, 0x1p-90f, 0x1p-89f, 0x1p-88f, 0x1p-87f, 0x1p-86f, 0x1p-85f,
+    0x1p-84f, 0x1p-83f, 0x1p-82f, 0x1p-81f, 0x1p-80f, 0x1p-79f, 0x1p-78f, 0x1p-77f,
+    0x1p-76f, 0x1p-75f, 0x1p-74f, 0x1p-73f, 0x1p-72f, 0x1p-71f, 0x1p-70f, 0x1p-69f,
+    0x1p-68f, 0x1p-67f, 0x1p-66f, 0x1p-65f, 0x1p-64f, 0x1p-63f, 0x1p-62f, 0x1p-61f,
+    0x1p-60f, 0x1p-59f, 0x1p-58f, 0x1p-57f, 0x1p-56f, 0x1p-55f, 0x1p-54f, 0x1p-53f,
+    0x1p-52f, 0x1p-51f, 0x1p-50f, 0x1p-49f, 0x1p-48f, 0x1p-47f, 0x1p-46f, 0x1p-45f,
+    0x1p-44f, 0x1p-43f, 0x1p-42f, 0x1p-41f, 0x1p-40f, 0x1p-39f, 0x1p-38f, 0x1p-37f,
+    0x1p-36f, 0x1p-35f, 0x1p-34f, 0x1p-33f, 0x1p-32f, 0x1p-31f, 0x1p-30f, 0x1p-29f,
+    0x1p-28f, 0x1p-27f, 0x1p-26f, 0x1p-25f, 0x1p-24f, 0x1p-23f, 0x1p-22f, 0x1p-21f,
+    0x1p-20f, 0x1p-19f, 0x1p-18f, 0x1p-17f, 0x1p-16f, 0x1p-15f, 0x1p-14f, 0x1p-13f,
+    0x1p-12f, 0x1p-11f, 0x1p-10f, 0x1p-9f, 0x1p-8f, 0x1p-7f, 0x1p-6f, 0x1p-5f,
+    0x1p-4f, 0x1p-3f, 0x1p-2f, 0x1p-1f, 0x1p0f, 0x1p1f, 0x1p2f, 0x1p3f,
+    0x1p4f, 0x1p5f, 0x1p6f, 0x1p7f, 0x1p8f, 0x1p9f, 0x1p10f, 0x1p11f,
+    0x1p12f, 0x1p13f, 0x1p14f, 0x1p15f, 0x1p16f, 0x1p17f, 0x1p18f, 0x1p19f,
+    0x1p20f, 0x1p21f, 0x1p22f, 0x1p23f, 0x1p24f, 0x1p25f, 0x1p26f, 0x1p27f,
+    0x1p28f, 0x1p29f, 0x1p30f, 0x1p31f, 0x1p32f, 0x1p33f, 0x1p34f, 0x1p35f,
+    0x1p36f, 0x1p37f, 0x1p38f, 0x1p39f, 0x1p40f, 0x1p41f, 0x1p42f, 0x1p43f,
+    0x1p44f, 0x1p45f, 0x1p46f, 0x1p47f, 0x1p48f, 0x1p49f, 0x1p50f, 0x1p51f,
+    0x1p52f, 0x1p53f, 0x1p54f, 0x1p55f, 0x1p56f, 0x1p57f, 0x1p58f, 0x1p59f,
+    0x1p60f, 0x1p61f, 0x1p62f, 0x1p63f, 0x1p64f, 0x1p65f, 0x1p66f, 0x1p67f,
+    0x1p68f, 0x1p69f, 0x1p70f, 0x1p71f, 0x1p72f, 0x1p73f, 0x1p74f, 0x1p75f,
+    0x1p76f, 0x1p77f, 0x1p78f, 0x1p79f, 0x1p80f, 0x1p81f, 0x1p82f, 0x1p83f,
+    0x1p84f, 0x1p85f, 0x1p86f, 0x1p87f, 0x1p88f, 0x1p89f, 0x1p90f, 0x1p91f,
+    0x1p92f, 0x1p93f, 0x1p94f, 0x1p95f, 0x1p96f, 0x1p97f, 0x1p98f, 0x1p99f,
+    0x1p100f, 0x1p101f, 0x1p102f, 0x1p103f, 0x1p104f, 0x1p105f, 0x1p106f, 0x1p107f,
+    0x1p108f, 0x1p109f, 0x1p110f, 0x1p111f, 0x1p112f, 0x1p113f, 0x1p114f, 0x1p115f,
+    0x1p116f
+  };
+  const float magnitude = fabsf(x);
+  float y;
+  if ((magnitude <= 80.0f) && (magnitude >= 3.725290298461914e-09f)) {
+    const float k = ((x * 1.4426950216293335f) + 12582912.0f) - 12582912.0f;
+    const float r_hi = x - (k * 0.693145751953125f);
+    const float r_lo = k * 1.428606765330187e-06f;
+    const float r = r_hi - r_lo;
+    const float r_err = (r_hi - r) - r_lo;
+    const int k_int = (int)k;
+    float q = 0.0013813088880851865f;
+    q = (q * r) + 0.008369408547878265f;
+    q = (q * r) + 0.04166845604777336f;
+    q = (q * r) + 0.16666515171527863f;
+    q = (q * r) + 0.4999999403953552f;
+    y = (1.0f + (r + (r_err + ((r * r) * q)))) * POWERS_OF_TWO[(unsigned int)k_int + 116u];
+  } else {
+    y = expf(x);
+  }
+  return y;
+}
+
 /* CasADi Function 'progress_tanh_value': 22 instructions. */
 static void body_progress_tanh_value(const omnirobot_s3_real* t, const omnirobot_s3_real* start, const omnirobot_s3_real* end, omnirobot_s3_real* p) {
   omnirobot_s3_real w0;
@@ -312,7 +373,7 @@ static void body_bump_value(const omnirobot_s3_real* t, const omnirobot_s3_real*
   w4 = -w4;
   w5 = -80.0f;
   w4 = (w5 > w4) ? w5 : w4;
-  w4 = expf(w4);
+  w4 = stt_expf(w4);
   w2 = w2 * w4;
   w0 = (w0 != 0.0f) ? w2 : 0.0f;
   y[0] = w0;
@@ -362,7 +423,7 @@ static void body_bump(const omnirobot_s3_real* t, const omnirobot_s3_real* start
   w8 = -w5;
   w9 = -80.0f;
   w10 = (w9 > w8) ? w9 : w8;
-  w10 = expf(w10);
+  w10 = stt_expf(w10);
   w11 = w2 * w10;
   w11 = (w0 != 0.0f) ? w11 : 0.0f;
   y[0] = w11;
@@ -511,7 +572,7 @@ static void body_smooth_max(const omnirobot_s3_real* a, const omnirobot_s3_real*
   w0 = -w0;
   w1 = -80.0f;
   w0 = (w1 > w0) ? w1 : w0;
-  w0 = expf(w0);
+  w0 = stt_expf(w0);
   w0 = log1pf(w0);
   w0 = w0 / w3;
   w2 = w2 + w0;
@@ -567,7 +628,7 @@ static void body_smooth_min(const omnirobot_s3_real* a, const omnirobot_s3_real*
   w2 = -w2;
   w0 = -80.0f;
   w2 = (w0 > w2) ? w0 : w2;
-  w2 = expf(w2);
+  w2 = stt_expf(w2);
   w2 = log1pf(w2);
   w2 = w2 / w3;
   w1 = w1 + w2;
@@ -599,7 +660,7 @@ static void body_smooth_max_rate(const omnirobot_s3_real* a, const omnirobot_s3_
   w0 = -w0;
   w6 = -80.0f;
   w7 = (w6 > w0) ? w6 : w0;
-  w7 = expf(w7);
+  w7 = stt_expf(w7);
   w8 = (w6 <= w0) ? 1.0f : 0.0f;
   w0 = (w0 <= w6) ? 1.0f : 0.0f;
   w0 = w8 + w0;
@@ -654,7 +715,7 @@ static void body_smooth_min_rate(const omnirobot_s3_real* a, const omnirobot_s3_
   w0 = -w0;
   w6 = -80.0f;
   w7 = (w6 > w0) ? w6 : w0;
-  w7 = expf(w7);
+  w7 = stt_expf(w7);
   w8 = (w6 <= w0) ? 1.0f : 0.0f;
   w0 = (w0 <= w6) ? 1.0f : 0.0f;
   w0 = w8 + w0;
@@ -730,7 +791,7 @@ static void body_conflict(const omnirobot_s3_real* rho, const omnirobot_s3_real*
   w0 = (w9 > w0) ? w9 : w0;
   w10 = 80.0f;
   w0 = (w10 < w0) ? w10 : w0;
-  w0 = expf(w0);
+  w0 = stt_expf(w0);
   w0 = w7 + w0;
   w0 = w6 / w0;
   theta[0] = w0;
@@ -738,7 +799,7 @@ static void body_conflict(const omnirobot_s3_real* rho, const omnirobot_s3_real*
   w1 = w1 + w1;
   w1 = (w9 > w1) ? w9 : w1;
   w1 = (w10 < w1) ? w10 : w1;
-  w1 = expf(w1);
+  w1 = stt_expf(w1);
   w1 = w7 + w1;
   w1 = w6 / w1;
   theta[1] = w1;
@@ -746,7 +807,7 @@ static void body_conflict(const omnirobot_s3_real* rho, const omnirobot_s3_real*
   w2 = w2 + w2;
   w2 = (w9 > w2) ? w9 : w2;
   w2 = (w10 < w2) ? w10 : w2;
-  w2 = expf(w2);
+  w2 = stt_expf(w2);
   w2 = w7 + w2;
   w2 = w6 / w2;
   theta[2] = w2;
@@ -754,7 +815,7 @@ static void body_conflict(const omnirobot_s3_real* rho, const omnirobot_s3_real*
   w3 = w3 + w3;
   w3 = (w9 > w3) ? w9 : w3;
   w3 = (w10 < w3) ? w10 : w3;
-  w3 = expf(w3);
+  w3 = stt_expf(w3);
   w3 = w7 + w3;
   w3 = w6 / w3;
   theta[3] = w3;
@@ -762,7 +823,7 @@ static void body_conflict(const omnirobot_s3_real* rho, const omnirobot_s3_real*
   w4 = w4 + w4;
   w4 = (w9 > w4) ? w9 : w4;
   w4 = (w10 < w4) ? w10 : w4;
-  w4 = expf(w4);
+  w4 = stt_expf(w4);
   w4 = w7 + w4;
   w4 = w6 / w4;
   theta[4] = w4;
@@ -770,7 +831,7 @@ static void body_conflict(const omnirobot_s3_real* rho, const omnirobot_s3_real*
   w5 = w5 + w5;
   w5 = (w9 > w5) ? w9 : w5;
   w5 = (w10 < w5) ? w10 : w5;
-  w5 = expf(w5);
+  w5 = stt_expf(w5);
   w7 = w7 + w5;
   w6 = w6 / w7;
   theta[5] = w6;
