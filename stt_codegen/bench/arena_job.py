@@ -182,19 +182,7 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
 
 
 def run_arena(seed: int, index: int, methods: tuple[str, ...] = METHODS) -> dict[str, Any]:
-    """Run every method on arena ``index`` of ``seed``: :func:`plan_arena`, then
-    :func:`loop_arena` (the bench runs the two phases over all arenas in turn).
-
-    Parameters
-    ----------
-    seed, index : int
-        Which arena (see :func:`~.arenas.generate_arena`).
-    methods : tuple of str
-        Subset of :data:`METHODS`.
-
-    Returns
-    -------
-    dict
-        As :func:`loop_arena`.
-    """
+    """Run every method on arena ``index`` of ``seed``: :func:`plan_arena` (same
+    parameters), then :func:`loop_arena` (same result). The bench runs the two phases over
+    all arenas in turn."""
     return loop_arena(seed, index, plan_arena(seed, index, methods)["plans"])
