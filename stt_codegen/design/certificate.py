@@ -799,6 +799,8 @@ def _narrowest(design: TubeDesign, enc: Enclosure) -> tuple[float, float]:
         if not best > 0.0:
             break
         band = width <= best * (1.0 + WIDTH_BAND)
+        if not band.any():
+            break
         done_w += list(width[~band])
         done_t += list(t0[~band])
         q = np.arange(WIDTH_PIECES)
