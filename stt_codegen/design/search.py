@@ -460,7 +460,7 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
         options[j] = [tuple(per_box[b][key] for b in members) for key in keys]
     order = sorted(options, key=lambda j: (starts[j], j))
     failures: dict[int, str] = {}
-    budget = [max_checks, CANDIDATE_INTERVALS * max_checks if max_work is None else max_work]
+    budget: list[float] = [max_checks, math.inf if max_work is None else max_work]
 
     def check(design: TubeDesign, **kwargs) -> TubeCheck:
         if budget[0] <= 0 or budget[1] <= 0:
@@ -470,8 +470,8 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
                                   f"obstacle {j}: {r}" for j, r in sorted(failures.items()))
                               + ")")
         budget[0] -= 1
-        found = check_tube(design, spec, max_intervals=min(CANDIDATE_INTERVALS, budget[1]),
-                           **kwargs)
+        found = check_tube(design, spec,
+                           max_intervals=int(min(CANDIDATE_INTERVALS, budget[1])), **kwargs)
         budget[1] -= found.certificate.work
         return found
 
