@@ -132,9 +132,6 @@ class Enclosure:
         enclosure's width is not positive: ``non-empty`` fails there).
     psi_min, psi_max : ndarray, shape (K, 2n)
         Range of ``psi`` (eq. (11)) on the interval.
-    lower_rate_min, lower_rate_max, upper_rate_min, upper_rate_max : ndarray, shape (K, n)
-        ``gamma_L_dot`` and ``gamma_U_dot`` (``alpha`` moving by (11)) lie in these
-        ranges on the interval, state units per second.
     """
 
     t_start: np.ndarray
@@ -148,10 +145,6 @@ class Enclosure:
     move_ratio: np.ndarray
     psi_min: np.ndarray
     psi_max: np.ndarray
-    lower_rate_min: np.ndarray
-    lower_rate_max: np.ndarray
-    upper_rate_min: np.ndarray
-    upper_rate_max: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -443,7 +436,7 @@ def _alpha_ranges(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
     out_lo, out_hi = [[0.0] * m for _ in range(k_count)], [[0.0] * m for _ in range(k_count)]
     p_lo, p_hi = psi_lo.tolist(), psi_hi.tolist()
     t_lo, t_hi = theta_lo.tolist(), theta_hi.tolist()
-    ps, two_dt = p_lo, 2.0 * dt
+    two_dt = 2.0 * dt
     entries = []
     for k in range(k_count):
         entries.append((list(a_lo), list(a_hi)))
@@ -482,12 +475,12 @@ def _alpha_ranges(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
             a_lo[i] = end if end > 0.0 else 0.0
             # upper sequence (psi_lo, theta_hi)
             if hi_i >= sh[i]:        # falling: one implicit step of N dt lags behind
-                q = 1.0 / (c + two_dt * t_hi[k][i] / (ps[k][i] + hi_i) ** 3)
-                end = min(step_root(hi_i, ps[k][i], t_hi[k][i], span, c_span)[1],
+                q = 1.0 / (c + two_dt * t_hi[k][i] / (p_lo[k][i] + hi_i) ** 3)
+                end = min(step_root(hi_i, p_lo[k][i], t_hi[k][i], span, c_span)[1],
                           sh[i] + (hi_i - sh[i]) * q ** steps_k)
                 row_hi[i] = hi_i
             else:                    # rising: no faster than its initial rate
-                z = ps[k][i] + hi_i
+                z = p_lo[k][i] + hi_i
                 end = sh[i] if not z > 0.0 else min(
                     sh[i], hi_i + span * (t_hi[k][i] / (z * z) - kappa * hi_i))
                 row_hi[i] = end
@@ -586,8 +579,7 @@ def _enclose(design: TubeDesign, pieces: _Pieces, alpha_min, alpha_max, t0, t1) 
         ratio = np.where(width > 0, move / width, 0.0)
     ratio = np.where(np.isnan(ratio), np.inf, ratio)
     return Enclosure(t0, t1, lower_min, lower_max, upper_min, upper_max, alpha_min, alpha_max,
-                     ratio.max(axis=1), pieces.psi_lo, pieces.psi_hi, gl_min, gl_max, gu_min,
-                     gu_max)
+                     ratio.max(axis=1), pieces.psi_lo, pieces.psi_hi)
 
 
 def enclose_tube(design: TubeDesign, samples) -> Enclosure:
