@@ -91,3 +91,17 @@ def test_deployed_alpha_converges_to_a_stiff_solver():
     assert 1.9 <= err1 / err2 <= 2.1              # first order: halving dt halves the error
     richardson = np.abs(2 * a2[::2] - a1 - ref1).max()
     assert richardson <= 0.1 * err1               # the error is the method's, not a bug's
+
+
+def test_generated_c_runs_two_iterations_before_its_fixed_point_test():
+    """The C template runs the first two Newton iterations without the fixed-point test
+    (docs/codegen.md): that is the model's result only when the model runs at least two."""
+    from pathlib import Path
+
+    assert NEWTON_ITERATIONS >= 2
+    source = (Path(__file__).resolve().parents[1] / "generated" / "omnirobot-s1" / "double"
+              / "omnirobot_s1.c").read_text(encoding="ascii")
+    body = source[source.index("static void omnirobot_s1_implicit_step"):]
+    body = body[:body.index("\n}\n")]
+    assert body.count("body_newton_iteration(") == 3
+    assert body.index("body_newton_iteration(") < body.index("while (k < ")

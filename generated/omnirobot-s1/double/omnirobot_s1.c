@@ -1388,14 +1388,22 @@ static void omnirobot_s1_implicit_step(omnirobot_s1_real t, omnirobot_s1_real dt
     omnirobot_s1_real c;
     omnirobot_s1_real big_a;
     omnirobot_s1_real root;
-    int k = 0;
+    int k = 2;
     body_newton_start(&a[i], &psi[i], &theta[i], &dt, &OMNIROBOT_S1_PARAMETERS.kappa, &s, &c, &big_a,
                       &root);
     if (root != 0.0) {
       body_newton_root_start(&a[i], &psi[i], &c, &big_a, &s);
     }
     /* 5 iterations; an iteration that returns its input would return it again,
-       so the loop stops there with the same result */
+       so the loop stops there with the same result. The first two run without that test
+       (if the first returned its input, the second returns it again): fewer branches. */
+    body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
+    s = s_next;
+    body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
+    if (s_next == s) {
+      k = 5;
+    }
+    s = s_next;
     while (k < 5) {
       body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
       if (s_next == s) {
