@@ -849,10 +849,10 @@ def _report(design: TubeDesign, spec: Spec, enc: Enclosure, selected, final: boo
             f"{max_intervals} intervals was exhausted)") if budget_hit else ""
 
     width = enc.upper_min - enc.lower_max
-    m, t, _ = _worst(width, t0) if narrowest is None else (*narrowest, 0)
-    margins.append(Margin("non-empty", m > ROUNDING_MARGIN, m, t,
-                          f"min width gamma_U - gamma_L >= {m:.6g} (interval at t = {t:.4f} s)"
-                          + note))
+    min_width, t = _worst(width, t0)[:2] if narrowest is None else narrowest
+    margins.append(Margin("non-empty", min_width > ROUNDING_MARGIN, min_width, t,
+                          f"min width gamma_U - gamma_L >= {min_width:.6g} (interval at "
+                          f"t = {t:.4f} s)" + note))
 
     x0 = np.array(design.initial_state)
     g_l0, g_u0, _, _ = reference.adaptive_tube(design, [0.0], np.zeros(2 * design.dimension))
@@ -899,6 +899,5 @@ def _report(design: TubeDesign, spec: Spec, enc: Enclosure, selected, final: boo
                           f"a tube bound moves at most {ratio:.3g} tube widths in one sampling "
                           f"period at {design.rate_hz:g} Hz (limit {MAX_MOVE_PER_SAMPLE}; "
                           f"worst on the interval at t = {float(t0[k]):.3f} s)" + note))
-    narrowest_width = float(width.min()) if narrowest is None else narrowest[0]
-    return Certificate(math.inf, int(t0.size), tuple(margins), ratio, narrowest_width,
+    return Certificate(math.inf, int(t0.size), tuple(margins), ratio, min_width,
                        initial_error, enc)

@@ -20,7 +20,6 @@ spec's ``g``). :func:`plant_function` picks the one of a spec's ``[plant]``.
 from __future__ import annotations
 
 from functools import lru_cache
-
 from typing import Sequence
 
 import casadi as ca
