@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..tube.parameters import TubeDesign
 from .certificate import Certificate
+
+if TYPE_CHECKING:
+    from ..spec.loader import Spec
 
 #: The reach-tube methods a design can use (``tube.method`` of the spec picks among them).
 METHOD_PAPER = "paper"
@@ -32,12 +35,17 @@ class Design:
     design_time_s : float
         In-process wall time of the design and its certificate, seconds (not compared:
         two designs of one spec are equal).
+    spec : Spec
+        The spec the tube was designed for. ``generate``, ``simulate``, ``verify`` and the
+        plots take a :class:`Design` and read its spec from here, so a tube cannot be
+        paired with another spec's name, obstacles or plant.
     """
 
     tube: TubeDesign
     method: str
     check: Any
     design_time_s: float = field(compare=False)
+    spec: Spec = field(compare=False, repr=False, kw_only=True)
 
     @property
     def certificate(self) -> Certificate:

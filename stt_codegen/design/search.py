@@ -391,7 +391,8 @@ def design_tube(spec: Spec) -> Design:
         raise DesignError(f"{errors[METHOD_PAPER]}; with via points: {errors[METHOD_VIA]}")
     gain = (spec.gain if spec.gain is not None
             else derived_gain(check.min_width, tube.rate_hz, spec.assumptions))
-    return Design(replace(tube, gain=gain), used, check, time.perf_counter() - started)
+    return Design(replace(tube, gain=gain), used, check, time.perf_counter() - started,
+                  spec=spec)
 
 
 def _via(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck]:
