@@ -22,6 +22,8 @@ command-line flags: the command line translates a parameter name into its flag.
 
 from __future__ import annotations
 
+from typing import Any
+
 
 class SttError(Exception):
     """Base class of every error the toolkit raises on purpose.
@@ -58,7 +60,23 @@ class DesignError(SttError):
     A negative outcome, not bad input: the spec is well formed, but the design search
     (with its continuous-time certificate) finds no acceptable tube. Command line: exit
     code 1.
+
+    Parameters
+    ----------
+    message : str
+        The reason, in the user's terms.
+    kind : enum member, optional
+        What failed, as a value of the design package's failure enum (callers branch on
+        this, never on the message text); ``None`` where no design was attempted.
+    tried : object, optional
+        The best rejected tube (a ``TubeDesign``), for a plot of what was tried; ``None``
+        where no tube was built.
     """
+
+    def __init__(self, message: str, *, kind: Any = None, tried: Any = None) -> None:
+        self.kind = kind
+        self.tried = tried
+        super().__init__(message)
 
 
 class ToolchainError(SttError):
