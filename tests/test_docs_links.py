@@ -84,3 +84,16 @@ def test_the_readme_is_a_front_page():
     assert test_command.startswith('python3 -m pip install -e ".[test]"')
     ci = (REPO / ".ci" / "run").read_text().splitlines()
     assert test_command in ci
+
+
+def test_the_documented_spec_file_loads():
+    """docs/spec-format.md's commented file is a valid spec, every optional key included."""
+    import tomllib
+
+    import stt_codegen
+
+    text = (REPO / "docs" / "spec-format.md").read_text()
+    blocks = re.findall(r"^```toml\n(.*?)^```$", text, flags=re.S | re.M)
+    assert len(blocks) == 1
+    spec = stt_codegen.Spec.from_dict(tomllib.loads(blocks[0]))
+    assert spec.name == "omnirobot-s1" and spec.prescribed_time == 9.0
