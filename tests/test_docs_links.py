@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import re
+import tomllib
 from pathlib import Path
 
 import pytest
+
+import stt_codegen
 
 REPO = Path(__file__).resolve().parent.parent
 DOCUMENTS = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
@@ -88,10 +91,6 @@ def test_the_readme_is_a_front_page():
 
 def test_the_documented_spec_file_loads():
     """docs/spec-format.md's commented file is a valid spec, every optional key included."""
-    import tomllib
-
-    import stt_codegen
-
     text = (REPO / "docs" / "spec-format.md").read_text()
     blocks = re.findall(r"^```toml\n(.*?)^```$", text, flags=re.S | re.M)
     assert len(blocks) == 1
