@@ -146,7 +146,7 @@ def test_citations_of_the_decisions_resolve():
     decisions = (REPO / "docs" / "decisions.md").read_text()
     numbers = [int(m) for m in re.findall(r"^(\d+)\. \*\*", decisions, flags=re.M)]
     assert numbers == list(range(1, len(numbers) + 1)) and len(numbers) >= 17
-    cited = []
+    cited = [int(n) for n in re.findall(r"\bdecisions?\s+(\d+)", decisions)]   # its own
     files = [*PACKAGE.rglob("*.py"), *(REPO / "tests").glob("*.py"),
              *(REPO / "tests" / "specs").glob("*.toml"), *(REPO / "docs").glob("*.md"),
              REPO / "README.md"]
@@ -157,8 +157,8 @@ def test_citations_of_the_decisions_resolve():
             stale = re.findall(r"design[- ]notes(?:\.md)?,? items? \d+|README,? \*?\"?Decisions"
                                r"|README's \*?\"?Decisions|README decision", text)
             assert stale == [], (path, stale)
-        cited += [int(n) for n in re.findall(r"decisions(?:\.md)?\]?(?:\([^)]*\))?,? "
-                                             r"decisions? (\d+)", text)]
+        cited += [int(n) for n in re.findall(r"decisions(?:\.md)?\]?(?:\([^)]*\))?,?\s+"
+                                             r"decisions?\s+(\d+)", text)]
     assert cited and set(cited) <= set(numbers)
 
 
