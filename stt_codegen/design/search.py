@@ -1,7 +1,7 @@
 """Design of the spatiotemporal tube for a spec: windows (5), circumvent choices (6), gain.
 
-The paper leaves several points open or, read literally, fails (see the README's
-"Decisions" section). This module decides them deterministically:
+The paper leaves several points open or, read literally, fails (see
+docs/decisions.md). This module decides them deterministically:
 
 * **Windows, eq. (5)**, computed robustly: with ``s = tanh(t / (t_c - t))`` the reach
   tube is linear in ``s``, so the times at which its box overlaps an obstacle box form
