@@ -257,7 +257,7 @@ def _switch(new: Path, target: Path, exists: bool) -> None:
 
 
 def write_generation(out_dir: str | Path, files: dict[str, bytes],
-                     replace_edited: bool = False, lock_timeout: float = LOCK_TIMEOUT) -> None:
+                     replace_edited: bool = False, lock_timeout: float | None = None) -> None:
     """Write ``files`` (name -> bytes, flat names) as the generation in ``out_dir``.
 
     See the module docstring: ``out_dir`` afterwards holds exactly ``files`` (and the
@@ -272,8 +272,9 @@ def write_generation(out_dir: str | Path, files: dict[str, bytes],
     replace_edited : bool
         Also replace listed files whose content changed since they were generated
         (``check --update`` on the version-controlled ``generated/``).
-    lock_timeout : float
-        Seconds to wait for another writer of the same folder.
+    lock_timeout : float, optional
+        Seconds to wait for another writer of the same folder; default
+        :data:`LOCK_TIMEOUT`.
 
     Raises
     ------
@@ -296,7 +297,8 @@ def write_generation(out_dir: str | Path, files: dict[str, bytes],
     target = Path(os.path.realpath(out_dir))
     if target.parent == target:
         raise SpecError("out_dir", f"refusing to generate into the root folder {shown!r}")
-    with _locked(target.parent, target.name, shown, lock_timeout):
+    timeout = LOCK_TIMEOUT if lock_timeout is None else lock_timeout
+    with _locked(target.parent, target.name, shown, timeout):
         new = None
         try:
             _recover(target.parent, target)
