@@ -51,6 +51,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ..errors import SpecError
+from ..system import fsync_path, write_durably
 from .generate import GENERATOR, MANIFEST
 
 #: Seconds a writer waits for another writer of the same folder before giving up.
@@ -237,14 +238,6 @@ def _exchange(a: Path, b: Path) -> bool:
     raise OSError(err, os.strerror(err), str(b))
 
 
-def _fsync(path: Path) -> None:
-    fd = os.open(path, os.O_RDONLY | os.O_CLOEXEC)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
-
-
 def _switch(new: Path, target: Path, exists: bool) -> None:
     """Put ``new`` at ``target``; afterwards ``new`` holds the old generation (if any)."""
     if not exists:
@@ -309,19 +302,16 @@ def write_generation(out_dir: str | Path, files: dict[str, bytes],
             new = target.parent / f".{target.name}{_TMP}{secrets.token_hex(4)}"
             os.mkdir(new, 0o777)
             for name, data in files.items():
-                with open(new / name, "xb") as fh:
-                    fh.write(data)
-                    fh.flush()
-                    os.fsync(fh.fileno())
+                write_durably(new / name, data)
             carried = build_products(files)
             for name in products:
                 if name in carried and name not in files:
                     os.rename(target / name, new / name)
             if exists:
                 os.chmod(new, target.stat().st_mode & 0o7777)
-            _fsync(new)
+            fsync_path(new)
             _switch(new, target, exists)
-            _fsync(target.parent)
+            fsync_path(target.parent)
         except OSError as exc:
             raise SpecError("out_dir", f"cannot write {shown!r}: {exc.strerror or exc}") from None
         finally:
