@@ -265,3 +265,29 @@ def test_generate_after_make_and_cmake(tmp_path, capsys):
     assert sorted(content(out)) == ["manifest.json", "omnirobot_s1.py",
                                     "omnirobot_s1_vectors.json"]
     assert leftovers(out) == []
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="renameat2 is Linux's")
+def test_the_switch_is_one_exchange_on_linux(tmp_path):
+    """On Linux the two folders are swapped in one system call (no moment without DIR)."""
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    (tmp_path / "a" / "x").write_text("a")
+    assert output._exchange(tmp_path / "a", tmp_path / "b") is True
+    assert (tmp_path / "b" / "x").read_text() == "a" and not (tmp_path / "a" / "x").exists()
+
+
+def test_an_error_between_the_fallbacks_renames_puts_the_old_folder_back(tmp_path, monkeypatch):
+    out = tmp_path / "out"
+    write_generation(out, A)
+    monkeypatch.setattr(output, "_exchange", lambda a, b: False)
+    real_rename = os.rename
+
+    def failing_second_rename(src, dst):
+        if Path(dst) == out.resolve() and ".stt-codegen-tmp-" in str(src):
+            raise KeyboardInterrupt
+        real_rename(src, dst)
+    monkeypatch.setattr(output.os, "rename", failing_second_rename)
+    with pytest.raises(KeyboardInterrupt):
+        write_generation(out, B)
+    assert content(out) == A and leftovers(out) == []

@@ -245,7 +245,12 @@ def _switch(new: Path, target: Path, exists: bool) -> None:
     elif not _exchange(new, target):
         old = target.parent / f".{target.name}{_OLD}{secrets.token_hex(4)}"
         os.rename(target, old)
-        os.rename(new, target)
+        try:
+            os.rename(new, target)
+        except BaseException:           # an error or Ctrl-C between the renames: undo
+            if not os.path.lexists(target):
+                os.rename(old, target)
+            raise
         os.rename(old, new)
 
 
