@@ -291,3 +291,25 @@ def test_an_error_between_the_fallbacks_renames_puts_the_old_folder_back(tmp_pat
     with pytest.raises(KeyboardInterrupt):
         write_generation(out, B)
     assert content(out) == A and leftovers(out) == []
+
+
+def test_the_next_writer_restores_a_folder_left_between_the_fallbacks_renames(tmp_path,
+                                                                           monkeypatch):
+    """What a writer killed between ``DIR -> old`` and ``new -> DIR`` leaves: no DIR, the
+    old generation in ``.DIR.stt-codegen-old-*``, the new one (maybe partial) in
+    ``.DIR.stt-codegen-tmp-*``, the lock file. The next writer puts the old one back
+    before anything else (here it then fails: the old generation stays)."""
+    out = tmp_path / "out"
+    write_generation(out, A)
+    os.rename(out, tmp_path / ".out.stt-codegen-old-0123abcd")
+    (tmp_path / ".out.stt-codegen-tmp-89abcdef").mkdir()
+    (tmp_path / ".out.stt-codegen-tmp-89abcdef" / "b0.c").write_bytes(B["b0.c"][:100])
+    (tmp_path / ".out.stt-codegen-lock").write_text("12345\n")
+    (tmp_path / ".out.stt-codegen-tmp-keep").mkdir()      # not a name a writer makes
+
+    def disk_full(path, data):
+        raise OSError(28, "No space left on device")
+    monkeypatch.setattr(output, "write_durably", disk_full)
+    with pytest.raises(SpecError, match="No space left on device"):
+        write_generation(out, B)
+    assert content(out) == A and leftovers(out) == [".out.stt-codegen-tmp-keep"]
