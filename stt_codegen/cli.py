@@ -23,12 +23,12 @@ import functools
 import importlib
 import json
 import os
-import secrets
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
 from .errors import DesignError, SpecError, SttError, ToolchainError
+from .system import atomic_write
 
 #: Every subcommand: name -> (one-line help, ``"module:function"``). The function takes the
 #: subcommand's :class:`argparse.ArgumentParser`, adds its arguments and sets
@@ -62,23 +62,6 @@ EXIT_CODES: tuple[tuple[type[BaseException], int], ...] = (
     (ToolchainError, 3),
     (SttError, 3),
 )
-
-
-def atomic_write_bytes(path: Path, writer) -> None:
-    """Call ``writer(tmp_path)`` then move the file into place: never half-written."""
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise SpecError("output", f"folder {str(folder)!r} does not exist")
-    # not mkstemp: its 0600 would stay on the file; O_EXCL with 0666 lets the umask decide
-    tmp = folder / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}{path.suffix}"
-    os.close(os.open(tmp, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666))
-    try:
-        writer(Path(tmp))
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def _design(spec_arg: str):
@@ -122,7 +105,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     result = simulate(spec, design, backend=args.backend, horizon=args.horizon, seed=args.seed)
     if args.plot:
         from .runtime.plots import plot_run
-        atomic_write_bytes(Path(args.plot), lambda tmp: plot_run(spec, design, result, tmp))
+        atomic_write(Path(args.plot), lambda tmp: plot_run(spec, design, result, tmp))
     if args.json:
         data = result.to_json()
         data["design"] = designed.to_json(spec.name)
@@ -156,7 +139,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         design = designed.tube
         write_generation(out / name, generate_files(spec, design, Options()))
         result = simulate(spec, design, backend=args.backend)
-        atomic_write_bytes(out / f"{name}.png", lambda tmp: plot_run(spec, design, result, tmp))
+        atomic_write(out / f"{name}.png", lambda tmp: plot_run(spec, design, result, tmp))
         print(_summary_line(result), flush=True)
         all_ok &= result.satisfied
     print(f"generated code in {out}/<case>/, plots in {out}/<case>.png")

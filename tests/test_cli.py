@@ -117,16 +117,16 @@ def test_atomic_write_leaves_a_normal_file_or_nothing(tmp_path):
     writer that fails leaves nothing behind."""
     import os
 
-    from stt_codegen.cli import atomic_write_bytes
+    from stt_codegen.system import atomic_write
     mask = os.umask(0o022)
     try:
-        atomic_write_bytes(tmp_path / "a.png", lambda tmp: tmp.write_bytes(b"png"))
+        atomic_write(tmp_path / "a.png", lambda tmp: tmp.write_bytes(b"png"))
 
         def failing(tmp):
             tmp.write_bytes(b"half")
             raise RuntimeError("disk full")
         with pytest.raises(RuntimeError):
-            atomic_write_bytes(tmp_path / "b.png", failing)
+            atomic_write(tmp_path / "b.png", failing)
     finally:
         os.umask(mask)
     assert (tmp_path / "a.png").read_bytes() == b"png"

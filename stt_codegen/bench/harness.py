@@ -38,6 +38,7 @@ from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..errors import ToolchainError
 from ..spec.loader import NAME_PATTERN
+from ..system import find_tool
 from ..tube.parameters import TubeDesign
 
 #: Compiler flags of the harness and the generated source (those of backend ``c``
@@ -198,11 +199,12 @@ class Harness:
 
         Raises
         ------
+        MissingTool
+            valgrind is not installed.
         BenchError
-            valgrind is not installed or failed.
+            valgrind failed.
         """
-        if not shutil.which("valgrind"):
-            raise BenchError("valgrind is not installed (Debian package valgrind)")
+        find_tool("valgrind", package="valgrind")
         return self._callgrind_total(steps) / steps
 
     def _callgrind_total(self, steps: int) -> int:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 def cmd_design(args: argparse.Namespace) -> int:
     """``stt-codegen design SPEC [--json] [--plot PNG]``: 0 designed, 1 no design, 2 bad input."""
-    from ..cli import atomic_write_bytes
+    from ..system import atomic_write
     from ..errors import DesignError, SpecError
     from ..spec.loader import load_spec
     from .search import design_tube
@@ -25,7 +25,7 @@ def cmd_design(args: argparse.Namespace) -> int:
         raise
     if args.plot:
         from ..runtime.plots import plot_design
-        atomic_write_bytes(Path(args.plot), lambda tmp: plot_design(spec, design, tmp))
+        atomic_write(Path(args.plot), lambda tmp: plot_design(spec, design, tmp))
     if args.json:
         print(json.dumps(design.to_json(spec.name), indent=2, sort_keys=True))
         return 0

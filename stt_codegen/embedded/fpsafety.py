@@ -19,7 +19,6 @@ where :mod:`stt_codegen.codegen.tolerance` claims a bound.
 from __future__ import annotations
 
 import itertools
-import shutil
 import subprocess
 import tempfile
 from pathlib import Path
@@ -32,6 +31,7 @@ from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..errors import ToolchainError
 from ..spec.loader import Spec
+from ..system import find_tool
 from ..tube.parameters import TubeDesign
 from .programs import parse_replay, replay_source
 
@@ -98,11 +98,7 @@ def adversarial_inputs(design: TubeDesign) -> dict:
 
 
 def _host_cc() -> str:
-    cc = shutil.which("gcc") or shutil.which("cc")
-    if cc is None:
-        from .toolchain import MissingTool
-        raise MissingTool("gcc", "gcc")
-    return cc
+    return find_tool("gcc", "cc", package="gcc")
 
 
 def check_host(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,

@@ -1,19 +1,21 @@
 """Locate the cross toolchain and the emulator used by the embedded harness.
 
-Every tool is looked up on ``PATH`` (``shutil.which``); a missing tool raises
-:class:`MissingTool`, which names the Debian package that provides it, so a
-caller (or a test) can tell the user exactly what to install.
+Every tool is looked up on ``PATH`` with :func:`stt_codegen.system.find_tool`; a
+missing tool raises :class:`~stt_codegen.system.MissingTool`, which names the Debian
+package that provides it, so a caller (or a test) can tell the user exactly what to
+install.
 """
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from stt_codegen import system
 from stt_codegen.errors import ToolchainError
+from stt_codegen.system import MissingTool
 
 #: Tool name -> Debian package that provides it.
 DEBIAN_PACKAGES: dict[str, str] = {
@@ -33,25 +35,6 @@ BUILD_TOOLS: tuple[str, ...] = (
 )
 #: Tools needed to run a program.
 RUN_TOOLS: tuple[str, ...] = ("qemu-system-arm", "arm-none-eabi-nm")
-
-
-class MissingTool(ToolchainError):
-    """A tool the embedded harness needs is not installed.
-
-    Parameters
-    ----------
-    tool : str
-        Name of the missing executable (or ``"rdimon.specs"`` for newlib).
-    package : str
-        Debian package that provides it.
-    """
-
-    def __init__(self, tool: str, package: str) -> None:
-        self.tool = tool
-        self.package = package
-        super().__init__(
-            f"{tool} not found; install the Debian package {package} "
-            f"(apt-get install -y {package})")
 
 
 class ToolError(ToolchainError):
@@ -145,15 +128,15 @@ def find_tool(tool: str) -> Path:
     """
     package = DEBIAN_PACKAGES[tool]
     if tool == "rdimon.specs":
-        gcc = shutil.which("arm-none-eabi-gcc")
-        if gcc is None or not _has_newlib(gcc):
+        try:
+            gcc = system.find_tool("arm-none-eabi-gcc", package=package)
+        except MissingTool:
+            raise MissingTool(tool, package) from None
+        if not _has_newlib(gcc):
             raise MissingTool(tool, package)
         return Path(subprocess.run([gcc, "-print-file-name=rdimon.specs"],
                                    capture_output=True, text=True, check=True).stdout.strip())
-    found = shutil.which(tool)
-    if found is None:
-        raise MissingTool(tool, package)
-    return Path(found)
+    return Path(system.find_tool(tool, package=package))
 
 
 def missing_tools(tools: tuple[str, ...] = BUILD_TOOLS + RUN_TOOLS) -> list[MissingTool]:

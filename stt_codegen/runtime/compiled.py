@@ -12,7 +12,6 @@ from __future__ import annotations
 import ctypes
 import hashlib
 import os
-import shutil
 import subprocess
 import tempfile
 import types
@@ -25,6 +24,7 @@ from ..tube.parameters import TubeDesign
 from ..codegen.errors import CodegenError
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
+from ..system import atomic_write, find_tool
 
 #: Flags of the shared-library build (``-ffp-contract=off``: same rounding as CasADi's VM).
 CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fPIC", "-shared", "-Wall", "-Wextra",
@@ -47,11 +47,15 @@ def cache_dir() -> Path:
 
 
 def compiler() -> str:
-    """The C compiler: ``$CC``, else the first of ``cc``, ``gcc``, ``clang`` on ``PATH``."""
-    for name in [os.environ.get("CC")] + ["cc", "gcc", "clang"]:
-        if name and shutil.which(name):
-            return name
-    raise CodegenError("no C compiler found (set CC)")
+    """The C compiler: ``$CC``, else the first of ``cc``, ``gcc``, ``clang`` on ``PATH``.
+
+    Raises
+    ------
+    MissingTool
+        None is installed.
+    """
+    names = [name for name in (os.environ.get("CC"), "cc", "gcc", "clang") if name]
+    return find_tool(*names, package="gcc")
 
 
 def build_shared(sources: dict[str, bytes], c_file: str, cc: str | None = None,
@@ -67,6 +71,8 @@ def build_shared(sources: dict[str, bytes], c_file: str, cc: str | None = None,
     ------
     CodegenError
         The compiler failed (its output is in the message).
+    MissingTool
+        ``cc`` not given and no C compiler installed.
     """
     cc = cc or compiler()
     cmd = [cc, *CFLAGS, *extra_flags]
@@ -86,10 +92,7 @@ def build_shared(sources: dict[str, bytes], c_file: str, cc: str | None = None,
                               capture_output=True, text=True)
         if proc.returncode != 0:
             raise CodegenError(f"{cc} failed:\n{proc.stderr}")
-        fd, staged = tempfile.mkstemp(dir=lib.parent, prefix=f".{key}.", suffix=".so")
-        os.close(fd)
-        shutil.copyfile(out, staged)
-        os.replace(staged, lib)
+        atomic_write(lib, out.read_bytes())
     return lib
 
 
