@@ -294,8 +294,11 @@ def design_tube(spec: Spec) -> Design:
         else:
             paper, via = errors[METHOD_PAPER], errors[METHOD_VIA]
             message, kind = f"{paper}; with via points: {via}", paper.kind
+            if via.kind is FailureKind.WALLED_OFF:   # the reason neither method can pass
+                message, kind = f"{via} (the paper's search: {paper})", via.kind
             tried = paper.tried if paper.tried is not None else via.tried
-        if kind is FailureKind.SAMPLING_RATE and tried is not None:
+        if (kind is FailureKind.SAMPLING_RATE and tried is not None
+                and check_tube(tried, spec).kind is FailureKind.SAMPLING_RATE):
             rate = lowest_passing_rate(tried, spec)
             message += ("; the tube tried passes its check from controller.rate_hz = "
                         f"{rate:g} (the lowest to two significant digits)" if rate is not None
