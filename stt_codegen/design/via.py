@@ -223,8 +223,9 @@ def _walled_off(spec: Spec, space, grid_dims: list[int], counts: list[int],
     met = _meets(around_lo, around_hi, obstacles, 0.0).any(axis=0)
     names = sorted({spec.obstacles[k].source for k in np.flatnonzero(met)})
     border = bool(np.any((grid == 0) | (grid == np.array(counts) - 1)))
-    what = "the target" if target_side else "the start x(0)"
-    return (f"{what} is walled off by obstacle{'s' if len(names) > 1 else ''} "
+    what = "the target is walled off from x(0)" if target_side else \
+        "x(0) is walled off from the target"
+    return (f"{what} by obstacle{'s' if len(names) > 1 else ''} "
             f"{', '.join(map(str, names))}" + (" and the state-space boundary" if border
                                               else "")
             + ": no path joins x(0) and the target centre through gaps at least one via-grid "
