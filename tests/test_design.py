@@ -244,3 +244,19 @@ def test_the_linear_plant_check_on_the_command_line(tmp_path):
     ok = parse_spec(arena_toml("skewed", 9.0,
                                '[plant]\nmodel = "linear"\ng = [[1.0, 0.5], [-0.5, 1.0]]\n'))
     assert design_tube(ok).certificate.passed
+
+
+@pytest.mark.parametrize("index, kind", [(2, FailureKind.SEARCH_BUDGET),
+                                         (6, FailureKind.INITIAL_STATE),
+                                         (26, FailureKind.NON_EMPTY)])
+def test_paper_search_refusals_are_typed(index, kind):
+    """Random arenas the paper's method alone cannot design (seed 1): the kind says why
+    (the search's budget, or the first obstacle's failure in the message), and the tube
+    tried is the one that chose circumvents for the most obstacles."""
+    from random_arenas import arena_toml as random_arena
+    spec = parse_spec(random_arena(1, index) + '[tube]\nmethod = "paper"\n')
+    with pytest.raises(DesignError) as info:
+        design_tube(spec)
+    assert info.value.kind is kind
+    tried = info.value.tried
+    assert tried is not None and tried.circumvents and not check_tube(tried, spec).passed
