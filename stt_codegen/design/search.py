@@ -170,7 +170,7 @@ def lowest_passing_rate(tube: TubeDesign, spec: Spec) -> float | None:
     while high is None:
         if low >= cap:
             return None
-        factor = min(max(ratio / MAX_MOVE_PER_SAMPLE, 1.25), RATE_SEARCH_FACTOR)  # inf, nan
+        factor = min(max(ratio / MAX_MOVE_PER_SAMPLE, 1.25), RATE_SEARCH_FACTOR)  # inf: capped
         guess = min(max(_grid_index(_grid_value(low) * factor), low + 1), cap)
         ok, ratio = passes(guess)
         if ok:
