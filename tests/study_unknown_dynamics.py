@@ -1,4 +1,4 @@
-"""Issues 7 and 13, unknown dynamics: the batch study behind the README figures (a script).
+"""Issues 7 and 13, unknown dynamics: the study behind docs/guarantees.md's figures (a script).
 
     python tests/study_unknown_dynamics.py [RUNS_PER_CASE] [--out results.json]
     python tests/study_unknown_dynamics.py --declared [RUNS_PER_CASE] [--out results.json]

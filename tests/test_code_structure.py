@@ -139,18 +139,27 @@ def test_no_module_imports_a_private_name_from_another_module():
     assert offenders == []
 
 
-def test_citations_of_the_design_notes_resolve():
-    """The code, tests and README cite docs/design-notes.md by item; every item exists."""
-    notes = (REPO / "docs" / "design-notes.md").read_text()
-    items = {int(m) for m in re.findall(r"^\s*(\d+)\. \*\*", notes, flags=re.M)}
-    assert items == set(range(1, 14))
-    cited = []
-    files = [*PACKAGE.rglob("*.py"), *(REPO / "tests").glob("*.py"), REPO / "README.md"]
+def test_citations_of_the_decisions_resolve():
+    """Code, tests, specs and documents cite docs/decisions.md by number ("docs/decisions.md,
+    decision N"); every cited decision exists, and no citation of the lists that
+    docs/decisions.md replaced (the README's *Decisions*, design notes items) is left."""
+    decisions = (REPO / "docs" / "decisions.md").read_text()
+    numbers = [int(m) for m in re.findall(r"^(\d+)\. \*\*", decisions, flags=re.M)]
+    assert numbers == list(range(1, len(numbers) + 1)) and len(numbers) >= 17
+    cited = [int(n) for n in re.findall(r"\bdecisions?\s+(\d+)", decisions)]   # its own
+    files = [*PACKAGE.rglob("*.py"), *(REPO / "tests").glob("*.py"),
+             *(REPO / "tests" / "specs").glob("*.toml"), *(REPO / "docs").glob("*.md"),
+             REPO / "README.md"]
     for path in files:
         text = path.read_text()
         assert "paper-notes" not in text or path.name == Path(__file__).name, path
-        cited += [int(n) for n in re.findall(r"design[- ]notes(?:\.md)?,? items? (\d+)", text)]
-    assert cited and set(cited) <= items
+        if path.name != Path(__file__).name:
+            stale = re.findall(r"design[- ]notes(?:\.md)?,? items? \d+|README,? \*?\"?Decisions"
+                               r"|README's \*?\"?Decisions|README decision", text)
+            assert stale == [], (path, stale)
+        cited += [int(n) for n in re.findall(r"decisions(?:\.md)?\]?(?:\([^)]*\))?,?\s+"
+                                             r"decisions?\s+(\d+)", text)]
+    assert cited and set(cited) <= set(numbers)
 
 
 def test_property_tests_are_derandomized_by_default():

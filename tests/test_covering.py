@@ -46,7 +46,7 @@ def test_ball_whose_bounding_box_meets_the_start_is_split_and_used():
     as_box = BESIDE + "[[obstacles]]\nlower = [0.38, 0.38]\nupper = [1.62, 1.62]\n"
     with pytest.raises(SpecError, match="meets the initial set"):
         parse_spec(as_box)                   # its bounding box violates Assumption 3
-    spec = load_spec(SPECS / "ball-beside-start.toml")   # the README's example
+    spec = load_spec(SPECS / "ball-beside-start.toml")   # docs/spec-format.md's example
     assert spec.unsafe_sets[0].kind == "ball" and len(spec.obstacles) > 1
     rng = np.random.default_rng(0)
     ball = spec.unsafe_sets[0].shape

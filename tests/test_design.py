@@ -79,7 +79,7 @@ def test_bundled_designs_pass_their_check(case):
     assert check.max_move_ratio <= MAX_MOVE_PER_SAMPLE
     assert design.gain > 0 and design.circumvents
     # the wall O1 is passed underneath from S1 (x2, upper side): the literal eq. (6)
-    # would pick x1 and let the robot cross O1 (docs/design-notes.md, item 6)
+    # would pick x1 and let the robot cross O1 (docs/decisions.md, decision 6)
     if case == "omnirobot-s1":
         c = [c for c in design.circumvents if c.obstacle == 0][0]
         assert (c.dimension, c.side) == (1, "upper")

@@ -228,7 +228,7 @@ def test_random_arena_with_a_corridor_is_satisfied(index):
 
 
 def test_a_convex_wall_across_the_straight_path_is_passed_with_via_points():
-    """The README's example (tests/specs/diagonal-wall.toml): the paper's method has no
+    """docs/spec-format.md's example (tests/specs/diagonal-wall.toml): the paper's method has no
     design (one bump per covering box cannot detour around the wall's end); via points do,
     and the generated-C closed loop is satisfied without touching the wall."""
     spec = load_spec(Path(__file__).parent / "specs" / "diagonal-wall.toml")

@@ -3,10 +3,11 @@
 Property (hypothesis, derandomized, 15 examples): for ``x_dot = f(x) + g(x) u + w`` with
 ``f`` a bounded smooth term plus a linear term, ``g = D + S + K(x)`` whose symmetric part
 has eigenvalues in ``[g_min, g_max]`` with ``g_max <= 1`` (the default gain's assumption,
-README decision 10) and a state-dependent skew part ``K`` of norm at most ``g_min / 2``,
+docs/decisions.md, decision 15) and a state-dependent skew part ``K`` of norm at most
+``g_min / 2``,
 and ``|w_i| <= 0.2``, the sampled closed loop of every bundled case stays in the tube
 and satisfies the task. ``tests/study_unknown_dynamics.py`` is the larger study (wider
-ranges, failures classified); its figures are in the README.
+ranges, failures classified); its figures are in docs/guarantees.md.
 """
 
 from __future__ import annotations
@@ -61,7 +62,7 @@ def test_unknown_plants_within_the_gain_assumption_stay_in_the_tube(knobs):
 
 def test_a_plant_beyond_the_gain_assumption_needs_a_faster_rate():
     """Documented limit: ``g = 9.2 I`` breaks the 1 kHz loop of S2; doubling the rate (the
-    gain kept) restores it (see the README's figures). The default gain is now set from
+    gain kept) restores it (see docs/guarantees.md). The default gain is now set from
     the certified (smaller) tube width, about a third of the former one, so the plant gain
     that breaks the loop is three times the former ``g = 3 I``: the same ``k g``."""
     knobs = {"case": "omnirobot-s2", "seed": 3, "f_amp": 0.0, "f_lin": 0.0, "g_min": 9.2,
@@ -82,7 +83,7 @@ ARENAS = settings(derandomize=True, deadline=None, database=None, max_examples=6
 def test_unknown_plants_on_random_arenas(index, seed, f_amp, g_min, w_amp):
     """The benchmark's random arenas (2-D), with unknown plants inside the gain assumption.
 
-    Arenas without a certifiable design are the benchmark's subject (README, Performance),
+    Arenas without a certifiable design are the benchmark's subject (docs/performance.md),
     not this property's: they are skipped by ``assume``.
     """
     spec = generate_arena(seed=0, index=index).to_spec()

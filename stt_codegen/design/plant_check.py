@@ -18,7 +18,7 @@ import numpy as np
 from ..spec.loader import Spec
 
 #: Heading range of the omnidirectional robot (eq. (14)) where ``g_s`` is positive
-#: definite: ``g_s = diag(cos x3, cos x3, 1)`` (design notes, item 10).
+#: definite: ``g_s = diag(cos x3, cos x3, 1)`` (docs/decisions.md, decision 10).
 HALF_PI = math.pi / 2
 
 

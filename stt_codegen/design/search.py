@@ -1,7 +1,7 @@
 """Design of the spatiotemporal tube for a spec: the search over circumvents (6), the gain.
 
-The paper leaves several points open or, read literally, fails (see the README's
-"Decisions" section). This module decides them deterministically:
+The paper leaves several points open or, read literally, fails (see
+docs/decisions.md). This module decides them deterministically:
 
 * **Windows and candidates, eqs. (5)-(6)**: :mod:`stt_codegen.design.windows`.
 * **Search**: a design is accepted only if its tube passes :func:`check_tube`: the

@@ -1,6 +1,6 @@
 """Problem specification: one prescribed-time reach-avoid-stay task (Definition 2.1).
 
-A spec is a TOML file with a fixed schema (see the README). :func:`load_spec`
+A spec is a TOML file with a fixed schema (docs/spec-format.md). :func:`load_spec`
 reads a bundled case by name or a file by path, validates every field and
 returns a frozen :class:`Spec`. Every rejection is a :class:`SpecError` naming
 the field and the reason.
@@ -324,7 +324,7 @@ class Spec:
         data : mapping
             The spec's tables as nested dicts and lists, exactly as :mod:`tomllib` would
             read the file: ``{"name": ..., "prescribed_time": ..., "state_space":
-            {"lower": [...], "upper": [...]}, ...}`` (see the README's *Spec format*).
+            {"lower": [...], "upper": [...]}, ...}`` (see docs/spec-format.md).
 
         Returns
         -------
@@ -358,7 +358,7 @@ def load_spec(spec: str | Path) -> Spec:
     ``X``, the initial set ``X_0`` and state ``x(0)``, the target ``T``, the unsafe sets
     and the prescribed time ``t_c`` (seconds), with the tube's parameters (eqs. (2)-(11)),
     the controller's gain and rate (law (13)) and the plant used in simulation. The format
-    is the README's *Spec format*; :meth:`Spec.from_dict` takes the same as a dict.
+    is docs/spec-format.md's; :meth:`Spec.from_dict` takes the same as a dict.
 
     Parameters
     ----------

@@ -1,6 +1,6 @@
 """The spec file's schema, with pydantic v2: types, known keys, finite numbers.
 
-:class:`SpecDocument` describes the TOML document (the README's *Spec format*) as it is
+:class:`SpecDocument` describes the TOML document (docs/spec-format.md) as it is
 written: every table and key, its type, its sign, its default. Validation is strict (no
 coercion: ``"9"`` is not a number, ``true`` is not a number), extra keys are forbidden, and
 numbers must be finite and at most 1e12 in magnitude. :func:`check_document` turns the
@@ -181,7 +181,7 @@ class AssumptionsTable(_Table):
 class SpecDocument(_Table):
     """One prescribed-time reach-avoid-stay task (Definition 2.1) and its design parameters.
 
-    The document of a spec file, key for key; see the README's *Spec format*.
+    The document of a spec file, key for key; see docs/spec-format.md.
     """
 
     model_config = ConfigDict(extra="forbid", strict=True, frozen=True,

@@ -269,7 +269,7 @@ class TubeModel:
 
 
 def build_model(design: TubeDesign) -> TubeModel:
-    """Build the CasADi SX functions of a design (see ``interfaces`` in the README).
+    """Build the CasADi SX functions of a design (the table in docs/codegen.md).
 
     Parameters
     ----------

@@ -410,7 +410,7 @@ def error_transform(design: TubeDesign, x, t, alpha) -> tuple[Array, Array, Arra
 
     ``e = gamma_d^{-1} (2 x - gamma_s)``, ``epsilon_i = ln((1 + e_i) / (1 - e_i))``,
     ``xi = diag(4 / (gamma_d_i (1 - e_i^2)))`` (the element-wise reading of
-    ``4 gamma_d^{-1} (I - e e^T)^{-1}``, see docs/design-notes.md, item 2).
+    ``4 gamma_d^{-1} (I - e e^T)^{-1}``, see docs/decisions.md, decision 2).
 
     Parameters
     ----------

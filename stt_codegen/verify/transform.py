@@ -3,7 +3,7 @@
 ``e_i = (2 x_i - gamma_s_i)/gamma_d_i``, ``epsilon_i = ln((1+e_i)/(1-e_i))``,
 ``xi = diag(4/(gamma_d_i (1 - e_i^2)))``. The paper writes
 ``xi = 4 gamma_d^{-1} (I - e e^T)^{-1}``; read as an outer product this is not
-the Jacobian of ``epsilon`` for ``n >= 2`` (docs/design-notes.md, item 2).
+the Jacobian of ``epsilon`` for ``n >= 2`` (docs/decisions.md, decision 2).
 
 ``e``, ``epsilon`` and ``xi`` are the deployed ones: :func:`.deployed.error_transform`
 prints :func:`stt_codegen.tube.pieces.error_transform` (the expressions law (13) is built

@@ -3,10 +3,10 @@
 The controller keeps ``x(t)`` strictly inside the box ``[gamma_L(t), gamma_U(t)]``
 (Theorem 4.1), so if that box is non-empty, misses every obstacle, stays in the state
 space and, from ``t_c`` on, lies in the target, then Definition 2.1 holds whatever the
-dynamics (design notes, item 11). This package proves those properties for the tube the
-deployed controller enforces: ``alpha`` follows the controller's own backward-Euler step
-of (11) at its sampling rate (linearly interpolated between the instants), from
-``alpha(0) = 0``. It also bounds how far a tube bound moves in one sampling period
+dynamics (docs/decisions.md, decision 11). This package proves those properties for the
+tube the deployed controller enforces: ``alpha`` follows the controller's own
+backward-Euler step of (11) at its sampling rate (linearly interpolated between the
+instants), from ``alpha(0) = 0``. It also bounds how far a tube bound moves in one sampling period
 (a sampled controller cannot follow a faster tube). Proofs in ``docs/design.md``.
 
 Modules, one layer each:
