@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
+import math
+
 import numpy as np
 import pytest
 from conftest import arena_toml, designed
@@ -179,3 +182,26 @@ def test_numpy_math_is_per_thread():
     assert np.array_equal(seen["other"], libm)
     assert np.array_equal(seen["here"], np.exp(x))
     assert np.array_equal(R.exp(x), libm)
+
+
+def test_resume_state_is_typed_and_resuming_from_it_changes_nothing(case):
+    """The refinement's end state (what the design search resumes from) is a frozen
+    CertificateState: one entry per interval, and a certificate resumed from its own
+    state at ``t = inf`` reuses it (only the tail ``[T, inf)`` is enclosed again, from
+    the last interval's entry: its margins agree to rounding)."""
+    from stt_codegen.design.certificate import CertificateState
+    spec, design, _ = designed(case)
+    certificate = certify_tube(design, spec)
+    state = certificate.state
+    assert isinstance(state, CertificateState)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        state.points = ()
+    assert len(state.points) == certificate.intervals
+    assert len(state.alpha_lo) == len(state.alpha_hi) == len(state.entries) == len(state.points)
+    assert list(state.points) == sorted(set(state.points))
+    again = certify_tube(design, spec, resume=(certificate, math.inf))
+    assert again.intervals == certificate.intervals and again.work <= 2 < certificate.work
+    assert again.state.points == state.points
+    for m, n in zip(again.margins, certificate.margins):
+        assert (m.name, m.passed) == (n.name, n.passed)
+        assert m.margin == pytest.approx(n.margin, rel=1e-12, abs=1e-15)

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -11,9 +14,10 @@ from conftest import arena_toml, designed
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from stt_codegen.design.search import (MAX_MOVE_PER_SAMPLE, base_design, check_tube, design_tube,
-                                overlap_interval, progress_time)
+from stt_codegen.design.failures import FailureKind
 from stt_codegen.design.samples import sample_tube
+from stt_codegen.design.search import MAX_MOVE_PER_SAMPLE, base_design, check_tube, design_tube
+from stt_codegen.design.windows import overlap_interval, progress_time
 from stt_codegen.errors import DesignError
 from stt_codegen.spec.loader import Box, load_spec, parse_spec
 
@@ -133,7 +137,8 @@ def test_a_start_at_the_tube_edge_is_rejected():
     the edge of the narrowed tube; deployed, the first input was 1e8 and the state left the
     arena in one period. The check refuses it, and the search finds another design."""
     from stt_codegen.bench.arenas import generate_arena
-    from stt_codegen.design.search import MAX_INITIAL_ERROR, candidates
+    from stt_codegen.design.search import MAX_INITIAL_ERROR
+    from stt_codegen.design.windows import candidates
     spec = generate_arena(0, 233).to_spec()
     base = base_design(spec)
     first = candidates(base, spec, 1, spec.tube.delta_b)[0]
@@ -164,3 +169,94 @@ def test_the_gain_comes_from_the_tubes_width_not_from_a_loose_enclosure():
     assert found.check.min_width > 0.03
     result = simulate(spec, found.tube, backend="c")
     assert result.satisfied and result.stayed_in_tube
+
+
+# --------------------------------------------------------------------------- failures
+
+
+def test_every_refusal_carries_a_kind_and_the_tube_tried():
+    """Callers branch on DesignError.kind, never on the message (issue 19)."""
+    spec = load_spec("omnirobot-s1")
+    paper = dataclasses.replace(spec, tube=dataclasses.replace(
+        spec.tube, circumvent_sharpness=0.01, method="paper"))
+    with pytest.raises(DesignError) as info:
+        design_tube(paper)
+    assert info.value.kind is FailureKind.SAMPLING_RATE
+    assert info.value.tried is not None and info.value.tried.circumvents
+    # the tube has circumvents, so a smoother bump is offered too
+    assert "tube.circumvent_sharpness" in str(info.value)
+
+
+def _rate_spec(rate_hz: float, method: str = "paper"):
+    return parse_spec(arena_toml("open", 2.0, f"[tube]\nmethod = \"{method}\"\n"
+                                 f"[controller]\nrate_hz = {float(rate_hz)!r}\n"))
+
+
+def test_a_rate_refusal_without_obstacles_names_the_lowest_rate_that_passes():
+    """No obstacle, so no circumvent: the refusal used to suggest tube.circumvent_sharpness
+    and no rate. It names the lowest two-digit rate that passes: designing with it
+    passes, and with the two-digit rate below it fails for the sampling rate again."""
+    with pytest.raises(DesignError) as info:
+        design_tube(_rate_spec(10.0))
+    message = str(info.value)
+    assert info.value.kind is FailureKind.SAMPLING_RATE
+    assert "circumvent_sharpness" not in message
+    found = re.search(r"passes its check from controller\.rate_hz = ([0-9.e+]+) \(the lowest",
+                      message)
+    assert found, message
+    rate = float(found.group(1))
+    assert rate > 10.0
+    design = design_tube(_rate_spec(rate))
+    assert design.certificate.passed and design.tube.rate_hz == rate
+    below = rate - 10.0 ** (math.floor(math.log10(rate)) - 1)
+    with pytest.raises(DesignError) as lower:
+        design_tube(_rate_spec(below))
+    assert lower.value.kind is FailureKind.SAMPLING_RATE
+    # the default method (via points next) passes at that rate too
+    assert design_tube(_rate_spec(rate, "auto")).certificate.passed
+
+
+@pytest.mark.parametrize("g, eigenvalue", [("[[-1.0, 0.0], [0.0, -1.0]]", "-1"),
+                                           ("[[1.0, 0.0], [0.0, -0.5]]", "-0.5"),
+                                           ("[[0.0, 1.0], [-1.0, 0.0]]", "0")])
+def test_a_linear_plant_breaking_assumption_2_is_refused(g, eigenvalue):
+    """g = -I used to design (exit 0) and fail in simulation without a reason."""
+    spec = parse_spec(arena_toml("reversed", 9.0,
+                                 f"[plant]\nmodel = \"linear\"\ng = {g}\n"))
+    with pytest.raises(DesignError) as info:
+        design_tube(spec)
+    assert info.value.kind is FailureKind.PLANT and info.value.tried is None
+    message = str(info.value)
+    assert message.startswith("plant.g: ") and "Assumption 2" in message
+    assert re.search(rf"eigenvalue {re.escape(eigenvalue)}\b", message), message
+
+
+def test_the_linear_plant_check_on_the_command_line(tmp_path):
+    path = tmp_path / "reversed.toml"
+    path.write_text(arena_toml("reversed", 9.0,
+                               '[plant]\nmodel = "linear"\ng = [[-1.0, 0.0], [0.0, -1.0]]\n'))
+    out = subprocess.run([sys.executable, "-m", "stt_codegen.cli", "design", str(path)],
+                         capture_output=True, text=True)
+    assert out.returncode == 1 and out.stdout == ""
+    assert out.stderr.startswith("error: plant.g: ") and out.stderr.count("\n") == 1
+    assert "Traceback" not in out.stderr
+    # a positive definite g with a skew part designs
+    ok = parse_spec(arena_toml("skewed", 9.0,
+                               '[plant]\nmodel = "linear"\ng = [[1.0, 0.5], [-0.5, 1.0]]\n'))
+    assert design_tube(ok).certificate.passed
+
+
+@pytest.mark.parametrize("index, kind", [(2, FailureKind.SEARCH_BUDGET),
+                                         (6, FailureKind.INITIAL_STATE),
+                                         (26, FailureKind.NON_EMPTY)])
+def test_paper_search_refusals_are_typed(index, kind):
+    """Random arenas the paper's method alone cannot design (seed 1): the kind says why
+    (the search's budget, or the first obstacle's failure in the message), and the tube
+    tried is the one that chose circumvents for the most obstacles."""
+    from random_arenas import arena_toml as random_arena
+    spec = parse_spec(random_arena(1, index) + '[tube]\nmethod = "paper"\n')
+    with pytest.raises(DesignError) as info:
+        design_tube(spec)
+    assert info.value.kind is kind
+    tried = info.value.tried
+    assert tried is not None and tried.circumvents and not check_tube(tried, spec).passed

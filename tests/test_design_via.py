@@ -13,6 +13,7 @@ import pytest
 from random_arenas import arena_spec, disc_can_pass
 
 from stt_codegen.design.certificate import MAX_MOVE_PER_SAMPLE, certify_tube
+from stt_codegen.design.failures import FailureKind
 from stt_codegen.design.samples import sample_tube
 from stt_codegen.design.search import base_design, design_tube
 from stt_codegen.design.via import via_design
@@ -90,10 +91,58 @@ upper = [{box.upper[0]!r}, {box.upper[1]!r}]
 
 
 def test_no_free_passage_says_where():
-    spec = parse_spec(SERPENTINE.split("[[obstacles]]")[0] + WALL)
+    """A gap of 0.2 in a wall: a point passes, a via box (half-width 0.1 and 0.05
+    clearance) does not."""
+    gap = """
+[[obstacles]]
+lower = [2.0, 0.0]
+upper = [2.5, 2.4]
+[[obstacles]]
+lower = [2.0, 2.6]
+upper = [2.5, 5.0]
+"""
+    spec = parse_spec(SERPENTINE.split("[[obstacles]]")[0] + gap)
     with pytest.raises(DesignError, match=r"no via-point path: .* comes closest to the target "
-                                          r"at \(.*\); the passage is too narrow there"):
+                                          r"at \(.*\); the passage is too narrow there") as info:
         via_design(spec, base_design(spec))
+    assert info.value.kind is FailureKind.NO_PASSAGE
+
+
+def test_a_wall_across_the_arena_is_not_called_a_narrow_passage():
+    spec = parse_spec(SERPENTINE.split("[[obstacles]]")[0] + WALL)
+    with pytest.raises(DesignError, match=r"no via-point path: (the target|x\(0\)) is walled "
+                                          r"off from (x\(0\)|the target) by obstacle 0 and "
+                                          r"the state-space boundary") as info:
+        via_design(spec, base_design(spec))
+    assert info.value.kind is FailureKind.WALLED_OFF
+    assert "too narrow" not in str(info.value)
+
+
+WALLED_TARGET = SERPENTINE.split("[[obstacles]]")[0] + """
+[[obstacles]]
+lower = [2.0, 0.0]
+upper = [2.5, 1.0]
+[[obstacles]]
+lower = [3.8, 3.8]
+upper = [4.0, 5.0]
+[[obstacles]]
+lower = [3.8, 3.8]
+upper = [5.0, 4.0]
+"""
+
+
+@pytest.mark.parametrize("method", ["via", "auto"])
+def test_a_walled_off_target_is_named_with_its_walls(method):
+    """Obstacles 1 and 2 close the corner around the target: the refusal says so (it used
+    to say that the passage is too narrow), naming them and not obstacle 0."""
+    spec = parse_spec(WALLED_TARGET + f'[tube]\nmethod = "{method}"\n')
+    with pytest.raises(DesignError) as info:
+        design_tube(spec)
+    message = str(info.value)
+    assert message.startswith("no via-point path: the target is walled off from x(0) by "
+                              "obstacles 1, 2 and the state-space boundary"), message
+    assert "too narrow" not in message
+    assert info.value.kind is FailureKind.WALLED_OFF
 
 
 @pytest.mark.parametrize("index", range(8))
@@ -139,7 +188,7 @@ def test_design_json_fields_and_exit_codes(tmp_path):
     blocked.write_text(SERPENTINE.split("[[obstacles]]")[0] + WALL)
     no = run_cli("design", str(blocked))
     assert no.returncode == 1 and "Traceback" not in no.stderr
-    assert len(no.stderr.strip().splitlines()) == 1 and "too narrow" in no.stderr
+    assert len(no.stderr.strip().splitlines()) == 1 and "walled off" in no.stderr
 
     bad = tmp_path / "bad.toml"
     bad.write_text(SERPENTINE.replace("[[obstacles]]", "[tube]\nmethod = \"straight\"\n"

@@ -1,4 +1,4 @@
-"""The result of a tube design: the tube, how it was found, its certificate and its cost."""
+"""The result of a tube design: the tube, how it was found, its check and certificate, its cost."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..tube.parameters import TubeDesign
 from .certificate import Certificate
+from .failures import FailureKind
 
 if TYPE_CHECKING:
     from ..spec.loader import Spec
@@ -15,6 +16,40 @@ if TYPE_CHECKING:
 #: The reach-tube methods a design can use (``tube.method`` of the spec picks among them).
 METHOD_PAPER = "paper"
 METHOD_VIA = "via"
+
+
+@dataclass(frozen=True)
+class TubeCheck:
+    """Outcome of :func:`~stt_codegen.design.search.check_tube` on a designed tube.
+
+    Attributes
+    ----------
+    passed : bool
+    reason : str
+        Empty when passed, else the first failed condition in words.
+    min_width : float
+        Certified lower bound of ``min_t min_i gamma_d_i(t)``, state units.
+    min_clearance : float
+        Certified smallest separation of the tube box from an obstacle it must avoid
+        (positive: clear), state units; ``inf`` without obstacles.
+    max_move_ratio : float
+        Certified bound of ``|gamma_dot| dt / gamma_d`` over all ``t``.
+    initial_error : float
+        ``max_i |e_i|`` of ``x(0)`` in the tube at ``t = 0``.
+    certificate : Certificate
+        The continuous-time certificate behind the verdict.
+    kind : FailureKind or None
+        What failed (``None`` when passed).
+    """
+
+    passed: bool
+    reason: str
+    min_width: float
+    min_clearance: float
+    max_move_ratio: float
+    initial_error: float
+    certificate: Certificate
+    kind: FailureKind | None = None
 
 
 @dataclass(frozen=True)
@@ -43,7 +78,7 @@ class Design:
 
     tube: TubeDesign
     method: str
-    check: Any
+    check: TubeCheck
     design_time_s: float = field(compare=False)
     spec: Spec = field(compare=False, repr=False, kw_only=True)
 

@@ -1,22 +1,17 @@
-"""Design of the spatiotemporal tube for a spec: windows (5), circumvent choices (6), gain.
+"""Design of the spatiotemporal tube for a spec: the search over circumvents (6), the gain.
 
 The paper leaves several points open or, read literally, fails (see
 docs/decisions.md). This module decides them deterministically:
 
-* **Windows, eq. (5)**, computed robustly: with ``s = tanh(t / (t_c - t))`` the reach
-  tube is linear in ``s``, so the times at which its box overlaps an obstacle box form
-  one interval of ``s`` per dimension; intersected over dimensions and mapped back with
-  ``t = t_c a / (1 + a)``, ``a = atanh(s)``. No 0/0 on degenerate dimensions.
-* **Dimension and side, eq. (6)**: every valid (dimension, side) of every obstacle is a
-  candidate; candidates are tried in a fixed order (longest overlap first) and a design
-  is accepted only if its tube passes :func:`check_tube`: the continuous-time
-  certificate (:mod:`stt_codegen.design.certificate`) and the sampling-rate limit. The search
-  is a depth-first search with backtracking over obstacles in the order of their
-  windows (one choice per spec obstacle, shared by the boxes of a covering); it fails
-  with a :class:`DesignError` naming the obstacle when no candidate passes.
-* **Bump window**: the active window is widened around the overlap interval so that
-  the bump, whose sharpness ``k^j`` the spec fixes, is within ``delta_B / 2`` of its peak
-  where the reach tube first and last overlaps the obstacle.
+* **Windows and candidates, eqs. (5)-(6)**: :mod:`stt_codegen.design.windows`.
+* **Search**: a design is accepted only if its tube passes :func:`check_tube`: the
+  continuous-time certificate (:mod:`stt_codegen.design.certificate`) and the
+  sampling-rate limit. The search is a depth-first search with backtracking over
+  obstacles in the order of their windows (one choice per spec obstacle, shared by the
+  boxes of a covering); it fails with a :class:`DesignError` naming the obstacle when no
+  candidate passes. Every :class:`DesignError` raised here carries a
+  :class:`~stt_codegen.design.failures.FailureKind` and, where a tube was built, the
+  best rejected one (``tried``).
 * **Default gain** of law (13): half the sampled-loop stability limit at the tube's
   narrowest point, for the plants the spec's ``[assumptions]`` declare
   (:func:`~stt_codegen.design.gain.derived_gain`).
@@ -26,32 +21,25 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
-from ..tube import reference
-from .gain import derived_gain
-from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, Certificate, certify_tube
-from .result import METHOD_PAPER, METHOD_VIA, Design
-from .via import via_design
 from ..errors import DesignError
-from ..spec.loader import Box, Spec
-from ..tube.parameters import LOWER, UPPER, Circumvent, TubeDesign, paper_segments
+from ..spec.loader import Spec
+from ..tube.parameters import Circumvent, TubeDesign, paper_segments
+from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, certify_tube
+from .failures import FailureKind, property_kind
+from .gain import derived_gain
+from .plant_check import plant_failure
+from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
+from .via import via_design
+from .windows import WINDOW_INFLATION, candidates, overlap_interval, progress_time
 
 #: Largest ``|e_i|`` of ``x(0)`` in the tube at ``t = 0``: near the tube's edge law (13)
 #: is so steep that the first sampled step overshoots (measured: at ``|e| ~ 1`` the
 #: first input was 1e8 and the state left the arena in one period).
 MAX_INITIAL_ERROR = 0.5
-#: Obstacles are inflated by this fraction of ``delta_B`` to compute overlap windows.
-WINDOW_INFLATION = 0.5
-#: Circumvent sharpness values ``k^j`` the automatic choice picks from, sharpest first.
-SHARPNESS_LADDER = (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0)
-#: Ladder values tried per circumvent, from the sharpest that passes the quick estimate.
-AUTO_SHARPNESS_TRIES = 3
-#: The quick estimate's tube width, as a fraction of the reach tube's (the adaptive
-#: tube is narrower where it circumvents).
-AUTO_WIDTH_FRACTION = 0.25
 #: Candidate certificates the paper's search may run before it gives up.
 MAX_CANDIDATE_CHECKS = 40
 #: The same for the first try of ``tube.method = "auto"`` (via points come next).
@@ -68,37 +56,9 @@ CANDIDATE_INTERVALS = 3000
 #: while an obstacle lies within the window inflation of the target box.
 TARGET_SHRINK = 0.5
 TARGET_SHRINK_STEPS = 4
-
-
-@dataclass(frozen=True)
-class TubeCheck:
-    """Outcome of :func:`check_tube` on a time grid.
-
-    Attributes
-    ----------
-    passed : bool
-    reason : str
-        Empty when passed, else the first failed condition in words.
-    min_width : float
-        Certified lower bound of ``min_t min_i gamma_d_i(t)``, state units.
-    min_clearance : float
-        Certified smallest separation of the tube box from an obstacle it must avoid
-        (positive: clear), state units; ``inf`` without obstacles.
-    max_move_ratio : float
-        Largest ``|gamma_dot| dt / gamma_d`` on the grid.
-    initial_error : float
-        ``max_i |e_i|`` of ``x(0)`` in the tube at ``t = 0``.
-    certificate : Certificate
-        The continuous-time certificate behind the verdict.
-    """
-
-    passed: bool
-    reason: str
-    min_width: float
-    min_clearance: float
-    max_move_ratio: float
-    initial_error: float
-    certificate: Certificate
+#: A tube refused for its sampling rate is checked at rates up to this factor above it
+#: (:func:`lowest_passing_rate`), to name the lowest that passes.
+RATE_SEARCH_FACTOR = 1000.0
 
 
 def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = None,
@@ -134,161 +94,96 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
     initial_error = certificate.initial_error
     max_ratio = certificate.max_move_ratio
 
-    def result(reason: str) -> TubeCheck:
+    def result(reason: str, kind: FailureKind | None) -> TubeCheck:
         return TubeCheck(not reason, reason, certificate.min_width,
                          min(clearances, default=math.inf), max_ratio, initial_error,
-                         certificate)
+                         certificate, kind)
 
     if certificate.decisive:               # fails for certain at some instant
         failure = certificate.first_failure()
-        return result(f"{failure.name} fails: {failure.detail}")
+        return result(f"{failure.name} fails: {failure.detail}", property_kind(failure.name))
     if not margins["sampling rate"].passed:  # first: a tube this fast also fails the rest
         also = ("" if margins["non-empty"].passed else
                 f"; non-empty fails too: {margins['non-empty'].detail}")
-        return result(f"{margins['sampling rate'].detail}; a larger "
-                      f"tube.circumvent_sharpness or controller.rate_hz helps{also}")
+        sharper = " or tube.circumvent_sharpness" if design.circumvents else ""
+        return result(f"{margins['sampling rate'].detail}; a larger controller.rate_hz"
+                      f"{sharper} helps{also}", FailureKind.SAMPLING_RATE)
     if not margins["non-empty"].passed:
-        return result(f"non-empty fails: {margins['non-empty'].detail}")
+        return result(f"non-empty fails: {margins['non-empty'].detail}", FailureKind.NON_EMPTY)
     if initial_error > MAX_INITIAL_ERROR and margins["initial state inside"].passed:
         return result(f"x(0) starts at |e| = {initial_error:.3g} of the tube's half-width "
                       f"at t = 0 (limit {MAX_INITIAL_ERROR}): the first sampled steps would "
-                      "overshoot")
+                      "overshoot", FailureKind.INITIAL_ERROR)
     failure = certificate.first_failure()
     if failure is not None:
-        return result(f"{failure.name} fails: {failure.detail}")
-    return result("")
+        return result(f"{failure.name} fails: {failure.detail}", property_kind(failure.name))
+    return result("", None)
 
 
-# --------------------------------------------------------------------------- windows
+def _grid_index(rate_hz: float) -> int:
+    """Index of the smallest two-significant-digit value ``>= rate_hz`` (``m 10^e``,
+    ``10 <= m <= 99``: index ``90 e + m - 10``)."""
+    e = math.floor(math.log10(rate_hz)) - 1
+    m = math.ceil(rate_hz / 10.0 ** e * (1.0 - 1e-12))
+    if m >= 100:
+        e, m = e + 1, 10
+    return 90 * e + max(m, 10) - 10
 
 
-def dimension_interval(design: TubeDesign, box: Box, i: int,
-                       margin: float) -> tuple[float, float] | None:
-    """Interval of ``s`` in ``[0, 1]`` where the reach tube's projection on ``i`` meets ``box``'s.
+def _grid_value(index: int) -> float:
+    e, m = divmod(index, 90)
+    return float(f"{m + 10}e{e}")
 
-    ``rho_L_i(s) <= upper_i + margin`` and ``rho_U_i(s) >= lower_i - margin`` are linear
-    in ``s`` (eq. (4)); ``None`` when they never hold together.
+
+def lowest_passing_rate(tube: TubeDesign, spec: Spec) -> float | None:
+    """The lowest ``controller.rate_hz`` (two significant digits) at which ``tube`` passes
+    :func:`check_tube`, or ``None`` up to :data:`RATE_SEARCH_FACTOR` times its rate.
+
+    A bound moves at most ``|gamma_dot| / rate`` in one period, so the certified
+    ``max_move_ratio`` scales about as ``1 / rate``: the first try is
+    ``rate_hz * max_move_ratio / MAX_MOVE_PER_SAMPLE``; ``alpha`` (hence the width)
+    changes with the rate too, so tries grow until one passes, then a bisection on the
+    two-digit values between the last failing and the passing rate finds the lowest
+    (the tube's check at each rate decides; the answer is a rate where it passed).
+
+    Parameters
+    ----------
+    tube : TubeDesign
+        A tube that fails the sampling-rate limit at ``tube.rate_hz``.
+    spec : Spec
+
+    Returns
+    -------
+    float or None
+        Hz.
     """
-    lo, hi = 0.0, 1.0
-    x_l, x_u = design.initial_lower[i], design.initial_upper[i]
-    for a, slope, bound, sign in ((x_l, design.target_lower[i] - x_l, box.upper[i] + margin, 1),
-                                  (x_u, design.target_upper[i] - x_u, box.lower[i] - margin, -1)):
-        a, slope, bound = sign * a, sign * slope, sign * bound  # a + slope s <= bound
-        if slope == 0:
-            if a > bound:
-                return None
-            continue
-        limit = (bound - a) / slope
-        if slope > 0:
-            hi = min(hi, limit)
-        else:
-            lo = max(lo, limit)
-    return (lo, hi) if lo <= hi else None
+    def passes(index: int) -> tuple[bool, float]:
+        found = check_tube(replace(tube, rate_hz=_grid_value(index)), spec)
+        return found.passed, found.max_move_ratio
 
-
-def overlap_interval(design: TubeDesign, box: Box, margin: float) -> tuple[float, float] | None:
-    """Interval of ``s = tanh(t/(t_c - t))`` in ``[0, 1]`` where the reach tube box meets ``box``.
-
-    The robust reading of eq. (5): the intersection over dimensions of
-    :func:`dimension_interval`, with ``box`` inflated by ``margin``. ``None`` when the
-    tube never meets the inflated box.
-    """
-    lo, hi = 0.0, 1.0
-    for i in range(design.dimension):
-        interval = dimension_interval(design, box, i, margin)
-        if interval is None:
+    cap = _grid_index(tube.rate_hz * RATE_SEARCH_FACTOR)
+    low = _grid_index(tube.rate_hz)
+    if _grid_value(low) > tube.rate_hz:
+        low -= 1                     # the two-digit value below the (failing) rate
+    ratio = check_tube(tube, spec).max_move_ratio
+    high = None
+    while high is None:
+        if low >= cap:
             return None
-        lo, hi = max(lo, interval[0]), min(hi, interval[1])
-    return (lo, hi) if lo <= hi else None
-
-
-def progress_time(design: TubeDesign, s: float) -> float:
-    """Inverse of ``s = tanh(t/(t_c - t))``: ``t = t_c a / (1 + a)``, ``a = atanh(s)``."""
-    if s >= 1.0:
-        return design.prescribed_time
-    a = math.atanh(max(s, 0.0))
-    return design.prescribed_time * a / (1.0 + a)
-
-
-def candidates(design: TubeDesign, spec: Spec, j: int, delta_b: float) -> list[Circumvent]:
-    """The circumvents that could avoid obstacle box ``j``, best first (deterministic order).
-
-    Order: dimensions where the reach tube overlaps the obstacle's projection for the
-    longest part of ``[0, 1]`` in ``s`` first, then the side that needs the bound to
-    move least at the middle of the window, then dimension index.
-    """
-    box = spec.obstacle_boxes()[j]
-    margin = WINDOW_INFLATION * delta_b
-    interval = overlap_interval(design, box, margin)
-    if interval is None:
-        return []
-    t1, t2 = (progress_time(design, s) for s in interval)
-    mid = np.array([0.5 * (t1 + t2)])
-    rho_l, rho_u, _, _ = reference.reach_tube(design, mid)
-    result = []
-    for i in range(design.dimension):
-        lo_x, hi_x = spec.state_space.lower[i], spec.state_space.upper[i]
-        if box.lower[i] <= lo_x and box.upper[i] >= hi_x:
-            continue  # the obstacle spans this dimension
-        interval_i = dimension_interval(design, box, i, margin)
-        span = 0.0 if interval_i is None else interval_i[1] - interval_i[0]
-        for side in (LOWER, UPPER):
-            if side == LOWER:
-                peak = box.upper[i] + delta_b
-                if peak >= hi_x:
-                    continue
-                base, height = lo_x, peak - lo_x
-                move = max(0.0, peak - float(rho_l[0, i]))
-            else:
-                peak = box.lower[i] - delta_b
-                if peak <= lo_x:
-                    continue
-                base, height = hi_x, hi_x - peak
-                move = max(0.0, float(rho_u[0, i]) - peak)
-            width = float(np.min(rho_u[0] - rho_l[0]))
-            for rank_k, k in enumerate(_sharpness_options(spec, height, delta_b, t1, t2,
-                                                          width, design.rate_hz)):
-                radius, center = _window(height, delta_b, k, t1, t2)
-                result.append((-span, move, i, 0 if side == LOWER else 1, rank_k,
-                               Circumvent(j, i, side, center - radius, center + radius,
-                                          height, base, k)))
-    result.sort(key=lambda r: r[:5])
-    return [r[-1] for r in result]
-
-
-def _window(height: float, delta_b: float, k: float, t1: float, t2: float):
-    """Half-width and centre of the bump window: within ``delta_b / 2`` of the peak on [t1, t2]."""
-    level = (height - 0.5 * delta_b) / height
-    z = math.sqrt(-math.log(level) / (k - math.log(level)))
-    return max(0.5 * (t2 - t1), 1e-9) / z, 0.5 * (t1 + t2)
-
-
-def bump_rate_peak(k: float, radius: float) -> float:
-    """``sup_t |b_dot|`` of the bump (7)-(8), 1/s (``verify.lemma.bump_rate_bound``)."""
-    q = ((1.0 - k) + math.sqrt((1.0 - k) ** 2 + 3.0)) / 3.0
-    return 2.0 * k / radius * math.sqrt(q) / (1.0 - q) ** 2 * math.exp(-k * q / (1.0 - q))
-
-
-def _sharpness_options(spec: Spec, height: float, delta_b: float, t1: float, t2: float,
-                       width: float, rate_hz: float) -> list[float]:
-    """``k^j`` values to try, best first: the spec's, or the automatic ladder.
-
-    Automatic: the sharpest value of :data:`SHARPNESS_LADDER` whose bump moves the bound
-    by at most ``MAX_MOVE_PER_SAMPLE`` of :data:`AUTO_WIDTH_FRACTION` of the reach tube's
-    width per sampling period (a quick necessary estimate), then the next
-    :data:`AUTO_SHARPNESS_TRIES` - 1 smoother ones: the certificate's sampling-rate check
-    decides among them.
-    """
-    if spec.tube.circumvent_sharpness is not None:
-        return [spec.tube.circumvent_sharpness]
-    limit = MAX_MOVE_PER_SAMPLE * AUTO_WIDTH_FRACTION * width * rate_hz
-    first = len(SHARPNESS_LADDER) - 1
-    for q, k in enumerate(SHARPNESS_LADDER):
-        radius, _ = _window(height, delta_b, k, t1, t2)
-        if height * bump_rate_peak(k, radius) <= limit:
-            first = q
-            break
-    return list(SHARPNESS_LADDER[first:first + AUTO_SHARPNESS_TRIES])
+        factor = min(max(ratio / MAX_MOVE_PER_SAMPLE, 1.25), RATE_SEARCH_FACTOR)  # inf: capped
+        guess = min(max(_grid_index(_grid_value(low) * factor), low + 1), cap)
+        ok, ratio = passes(guess)
+        if ok:
+            high = guess
+        else:
+            low = guess
+    while high - low > 1:
+        mid = (low + high) // 2
+        if passes(mid)[0]:
+            high = mid
+        else:
+            low = mid
+    return _grid_value(high)
 
 
 # --------------------------------------------------------------------------- the search
@@ -363,10 +258,17 @@ def design_tube(spec: Spec) -> Design:
     Raises
     ------
     DesignError
-        No tube of the allowed methods passes :func:`check_tube`; the message gives the
-        reason (for via points: where the free passage is too narrow).
+        The spec's plant violates Assumption 2 (:mod:`~stt_codegen.design.plant_check`),
+        or no tube of the allowed methods passes :func:`check_tube`; the message gives
+        the reason (for via points: where the free passage is too narrow, or what walls
+        off the start or the target), ``kind`` what failed
+        (:class:`~stt_codegen.design.failures.FailureKind`) and ``tried`` the best
+        rejected tube (``None`` where none was built).
     """
     started = time.perf_counter()
+    reason = plant_failure(spec)
+    if reason:
+        raise DesignError(reason, kind=FailureKind.PLANT)
     base = base_design(spec)
     method = spec.tube.method
     # "auto": the paper's search on a short budget, then via points, then the paper's
@@ -375,20 +277,34 @@ def design_tube(spec: Spec) -> Design:
     stages = {"paper": [full], "via": [(METHOD_VIA, 0, None)],
               "auto": [(METHOD_PAPER, AUTO_CANDIDATE_CHECKS, AUTO_CANDIDATE_INTERVALS),
                        (METHOD_VIA, 0, None), full]}[method]
-    errors: dict[str, str] = {}
+    errors: dict[str, DesignError] = {}
     for used, budget, work in stages:
-        if used in errors and "candidate tubes" not in errors[used]:
+        if used in errors and errors[used].kind is not FailureKind.SEARCH_BUDGET:
             continue          # the paper's search ended for another reason than its budget
         try:
             tube, check = (_via(spec, base) if used == METHOD_VIA
                            else paper_design(spec, base, budget, work))
             break
         except DesignError as exc:
-            errors[used] = str(exc)
+            errors[used] = exc
     else:
         if len(errors) == 1:
-            raise DesignError(next(iter(errors.values())))
-        raise DesignError(f"{errors[METHOD_PAPER]}; with via points: {errors[METHOD_VIA]}")
+            (only,) = errors.values()
+            message, kind, tried = str(only), only.kind, only.tried
+        else:
+            paper, via = errors[METHOD_PAPER], errors[METHOD_VIA]
+            message, kind = f"{paper}; with via points: {via}", paper.kind
+            if via.kind is FailureKind.WALLED_OFF:   # the reason neither method can pass
+                message, kind = f"{via} (the paper's search: {paper})", via.kind
+            tried = paper.tried if paper.tried is not None else via.tried
+        if (kind is FailureKind.SAMPLING_RATE and tried is not None
+                and check_tube(tried, spec).kind is FailureKind.SAMPLING_RATE):
+            rate = lowest_passing_rate(tried, spec)
+            message += ("; the tube tried passes its check from controller.rate_hz = "
+                        f"{rate:g} (the lowest to two significant digits)" if rate is not None
+                        else "; no controller.rate_hz up to "
+                        f"{RATE_SEARCH_FACTOR:g} times this one makes the tube tried pass")
+        raise DesignError(message, kind=kind, tried=tried)
     gain = (spec.gain if spec.gain is not None
             else derived_gain(check.min_width, tube.rate_hz, spec.assumptions))
     return Design(replace(tube, gain=gain), used, check, time.perf_counter() - started,
@@ -399,7 +315,8 @@ def _via(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck]:
     tube = via_design(spec, base)
     check = check_tube(tube, spec)
     if not check.passed:
-        raise DesignError(f"the via-point tube fails its check: {check.reason}")
+        raise DesignError(f"the via-point tube fails its check: {check.reason}",
+                          kind=check.kind, tried=tube)
     return tube, check
 
 
@@ -446,7 +363,8 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
             continue
         if interval[1] >= 1.0:
             raise DesignError(f"obstacle {j} comes within {WINDOW_INFLATION * delta_b:g} of "
-                              "the target box eta +- d_T: shrink target.half_width")
+                              "the target box eta +- d_T: shrink target.half_width",
+                              kind=FailureKind.OBSTACLE_AT_TARGET, tried=base)
         found_here = candidates(base, spec, b, delta_b)
         per_box[b] = {(c.dimension, c.side, q): c for q, c in enumerate(found_here)}
         groups.setdefault(j, []).append(b)
@@ -457,19 +375,25 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
         keys = [key for key in rank[j] if all(key in per_box[b] for b in members)]
         if not keys:
             raise DesignError(f"obstacle {j} cannot be circumvented: no dimension leaves "
-                              f"room of delta_b = {delta_b:g} beside it")
+                              f"room of delta_b = {delta_b:g} beside it",
+                              kind=FailureKind.NO_ROOM, tried=base)
         options[j] = [tuple(per_box[b][key] for b in members) for key in keys]
     order = sorted(options, key=lambda j: (starts[j], j))
-    failures: dict[int, str] = {}
+    failures: dict[int, TubeCheck] = {}     # per obstacle: its first rejected candidate
     budget: list[float] = [max_checks, math.inf if max_work is None else max_work]
+    # the rejected tube that got furthest (most obstacles chosen), for DesignError.tried
+    best: list = [-1, base]
+    final_failure: list[TubeCheck] = []     # the complete tubes' checks
+
+    def reasons() -> str:
+        return "; ".join(f"obstacle {j}: {f.reason}" for j, f in sorted(failures.items()))
 
     def check(design: TubeDesign, **kwargs) -> TubeCheck:
         if budget[0] <= 0 or budget[1] <= 0:
             raise DesignError(f"no certified circumvents within {max_checks} candidate tubes"
                               + ("" if max_work is None else f" and {max_work} intervals of "
-                                 "certificate work") + " (" + "; ".join(
-                                  f"obstacle {j}: {r}" for j, r in sorted(failures.items()))
-                              + ")")
+                                 "certificate work") + f" ({reasons()})",
+                              kind=FailureKind.SEARCH_BUDGET, tried=best[1])
         budget[0] -= 1
         found = check_tube(design, spec,
                            max_intervals=int(min(CANDIDATE_INTERVALS, budget[1])), **kwargs)
@@ -483,7 +407,12 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
             # the same tube as the last partial check: resume all of it
             accepted = check(design, resume=None if parent is None
                              else (parent.certificate, math.inf))
-            return (design, accepted) if accepted.passed else None
+            if accepted.passed:
+                return design, accepted
+            final_failure.append(accepted)
+            if level > best[0]:
+                best[:] = [level, design]
+            return None
         j = order[level]
         done = [b for k in order[:level + 1] for b in groups[k]]
         hopeless: set[tuple[int, str]] = set()
@@ -497,8 +426,10 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
             partial = check(design, obstacles=done, final=False,
                             resume=None if parent is None else (parent.certificate, opens))
             if not partial.passed:
-                failures.setdefault(j, partial.reason)
-                if not partial.reason.startswith("a tube bound moves"):
+                failures.setdefault(j, partial)
+                if level > best[0]:
+                    best[:] = [level, design]
+                if partial.kind is not FailureKind.SAMPLING_RATE:
                     hopeless.add(side)   # a smoother bump only helps the sampling rate
                 continue
             found = search(level + 1, chosen + option, partial)
@@ -509,8 +440,11 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
     found = search(0, (), None)
     if found is None:
         if not order:
-            raise DesignError(f"the reach tube fails its check: {check_tube(base, spec).reason}")
-        detail = "; ".join(f"obstacle {j}: {r}" for j, r in sorted(failures.items()))
+            base_check = check_tube(base, spec)
+            raise DesignError(f"the reach tube fails its check: {base_check.reason}",
+                              kind=base_check.kind, tried=base)
+        first = (failures[min(failures)] if failures else final_failure[0])
         raise DesignError("no choice of circumvent dimension and side passes the tube "
-                          f"check ({detail or 'the final check failed'})")
+                          f"check ({reasons() or 'the final check failed'})",
+                          kind=first.kind, tried=best[1])
     return found

@@ -35,6 +35,7 @@ from scipy.sparse import csgraph, csr_matrix
 
 from ..errors import DesignError
 from ..spec.loader import Spec
+from .failures import FailureKind
 from ..tube.parameters import SMOOTHSTEP, ReachSegment, TubeDesign
 
 #: Largest half-width of a via box, state units.
@@ -68,15 +69,20 @@ class ViaPlan:
                                   SMOOTHSTEP) for k in range(len(self.times) - 1))
 
 
+def _meets(lower: np.ndarray, upper: np.ndarray, obstacles: np.ndarray,
+           margin: float) -> np.ndarray:
+    """(K, B): box k, widened by ``margin``, meets obstacle box b (touching does not count)."""
+    lo, hi = lower[:, None, :] - margin, upper[:, None, :] + margin
+    return np.all((lo < obstacles[None, :, 1, :]) & (hi > obstacles[None, :, 0, :]), axis=2)
+
+
 def _free(lower: np.ndarray, upper: np.ndarray, obstacles: np.ndarray,
-          space: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
-    """Boxes (K, n) that lie in the state space and keep VIA_MARGIN from every obstacle."""
+          space: tuple[np.ndarray, np.ndarray], margin: float = VIA_MARGIN) -> np.ndarray:
+    """Boxes (K, n) that lie in the state space and keep ``margin`` from every obstacle."""
     inside = np.all((lower >= space[0]) & (upper <= space[1]), axis=1)
     if not len(obstacles):
         return inside
-    lo, hi = lower[:, None, :] - VIA_MARGIN, upper[:, None, :] + VIA_MARGIN
-    meets = np.all((lo < obstacles[None, :, 1, :]) & (hi > obstacles[None, :, 0, :]), axis=2)
-    return inside & ~meets.any(axis=1)
+    return inside & ~_meets(lower, upper, obstacles, margin).any(axis=1)
 
 
 def plan_via(spec: Spec, base: TubeDesign) -> ViaPlan:
@@ -96,8 +102,10 @@ def plan_via(spec: Spec, base: TubeDesign) -> ViaPlan:
     Raises
     ------
     DesignError
-        No chain of free moves joins the two boxes; the message says where the free
-        passage reachable from ``x(0)`` comes closest to the target.
+        No chain of free moves joins the two boxes (kind ``NO_PASSAGE``); the message
+        says where the free passage reachable from ``x(0)`` comes closest to the target.
+        Where not even a point can pass (kind ``WALLED_OFF``), it names the obstacles
+        that wall off the target (or the start) instead.
     """
     n = base.dimension
     space = (np.array(spec.state_space.lower), np.array(spec.state_space.upper))
@@ -114,6 +122,36 @@ def plan_via(spec: Spec, base: TubeDesign) -> ViaPlan:
     while math.prod(int(extent[i] / step) for i in grid_dims) > MAX_CELLS:
         step *= 1.25
     counts = [max(int(extent[i] / step), 1) for i in grid_dims]
+    lows, highs = _grid_nodes(space, grid_dims, counts, (start_lo, start_hi),
+                              (goal_lo, goal_hi), half)
+    pairs, ok = _moves(lows, highs, counts, obstacles, space, VIA_MARGIN)
+    a, b = pairs[:, 0], pairs[:, 1]
+    mids = 0.5 * (lows + highs)
+    path, dist = _shortest_path(len(lows), a[ok], b[ok],
+                                np.max(np.abs(mids[a[ok]] - mids[b[ok]]), axis=1))
+    if path is None:
+        walled = _walled_off(spec, space, grid_dims, counts, obstacles)
+        if walled:
+            raise DesignError(f"no via-point path: {walled}", kind=FailureKind.WALLED_OFF)
+        goal_centre = 0.5 * (goal_lo + goal_hi)
+        reach = np.flatnonzero(np.isfinite(dist))
+        near = int(reach[np.argmin(np.max(np.abs(mids[reach] - goal_centre), axis=1))])
+        where = ", ".join(f"{v:.2f}" for v in mids[near])
+        raise DesignError(
+            f"no via-point path: the free passage reachable from x(0) (via boxes of "
+            f"half-width {half:g} with {VIA_MARGIN:g} clearance) comes closest to the target "
+            f"at ({where}); the passage is too narrow there", kind=FailureKind.NO_PASSAGE)
+    nodes = {k: (lows[k], highs[k]) for k in path}
+    path = _shortcut(path, nodes, obstacles, space)
+    return _timed(path, nodes, base.prescribed_time)
+
+
+def _grid_nodes(space, grid_dims: list[int], counts: list[int], start, goal,
+                half: float) -> tuple[np.ndarray, np.ndarray]:
+    """Boxes of the graph's nodes, lower and upper corners (2 + K, n): node 0 is the start
+    box, node 1 the target box, node 2 + q the via box of grid cell q (C order)."""
+    (start_lo, start_hi), (goal_lo, goal_hi) = start, goal
+    extent = space[1] - space[0]
     cells = np.indices(counts).reshape(len(grid_dims), -1).T        # (K, g), C order
     start_centre = 0.5 * (start_lo + start_hi)
     goal_centre = 0.5 * (goal_lo + goal_hi)
@@ -128,14 +166,19 @@ def plan_via(spec: Spec, base: TubeDesign) -> ViaPlan:
     highs = start_hi + (goal_hi - start_hi) * fraction[:, None]
     lows[:, grid_dims] = centre[:, grid_dims] - half
     highs[:, grid_dims] = centre[:, grid_dims] + half
-    # node 0 is the start box, node 1 the target box, node 2 + q grid cell q
-    lows = np.vstack([start_lo, goal_lo, lows])
-    highs = np.vstack([start_hi, goal_hi, highs])
-    free = _free(lows, highs, obstacles, space)
+    return np.vstack([start_lo, goal_lo, lows]), np.vstack([start_hi, goal_hi, highs])
+
+
+def _moves(lows: np.ndarray, highs: np.ndarray, counts: list[int], obstacles: np.ndarray,
+           space, margin: float) -> tuple[np.ndarray, np.ndarray]:
+    """Candidate moves between free nodes (neighbouring cells, and the start and target
+    boxes to every cell and to each other), shape (M, 2), and which are free: the
+    bounding box of the two boxes, widened by ``margin``, misses every obstacle."""
+    free = _free(lows, highs, obstacles, space, margin)
     free[:2] = True   # the spec's own boxes (checked by the loader and the certificate)
-    flat = np.arange(len(cells)).reshape(counts) + 2
+    flat = np.arange(len(lows) - 2).reshape(counts) + 2
     pairs = []
-    for o in product((-1, 0, 1), repeat=len(grid_dims)):
+    for o in product((-1, 0, 1), repeat=len(counts)):
         if not any(o) or o < (0,) * len(o):
             continue       # each neighbour pair once
         src = tuple(slice(max(0, -d), c - max(0, d)) for d, c in zip(o, counts))
@@ -148,21 +191,45 @@ def plan_via(spec: Spec, base: TubeDesign) -> ViaPlan:
     pairs = np.vstack(pairs)
     pairs = pairs[free[pairs[:, 0]] & free[pairs[:, 1]]]
     a, b = pairs[:, 0], pairs[:, 1]
-    ok = _free(np.minimum(lows[a], lows[b]), np.maximum(highs[a], highs[b]), obstacles, space)
-    mids = 0.5 * (lows + highs)
-    path, dist = _shortest_path(len(lows), a[ok], b[ok],
-                                np.max(np.abs(mids[a[ok]] - mids[b[ok]]), axis=1))
-    if path is None:
-        reach = np.flatnonzero(np.isfinite(dist))
-        near = int(reach[np.argmin(np.max(np.abs(mids[reach] - goal_centre), axis=1))])
-        where = ", ".join(f"{v:.2f}" for v in mids[near])
-        raise DesignError(
-            f"no via-point path: the free passage reachable from x(0) (via boxes of "
-            f"half-width {half:g} with {VIA_MARGIN:g} clearance) comes closest to the target "
-            f"at ({where}); the passage is too narrow there")
-    nodes = {k: (lows[k], highs[k]) for k in path}
-    path = _shortcut(path, nodes, obstacles, space)
-    return _timed(path, nodes, base.prescribed_time)
+    return pairs, _free(np.minimum(lows[a], lows[b]), np.maximum(highs[a], highs[b]),
+                        obstacles, space, margin)
+
+
+def _walled_off(spec: Spec, space, grid_dims: list[int], counts: list[int],
+                obstacles: np.ndarray) -> str:
+    """Why no path of any width joins ``x(0)`` and the target centre ("" if one does).
+
+    The same grid as the via boxes, with points instead of boxes and no clearance: when
+    even a point cannot move from ``x(0)`` to the target centre, the smaller of their two
+    connected regions is walled off; the obstacles met by the moves out of it wall it.
+    """
+    x0, eta = np.array(spec.initial_state), np.array(spec.target_center)
+    lows, highs = _grid_nodes(space, grid_dims, counts, (x0, x0), (eta, eta), 0.0)
+    pairs, ok = _moves(lows, highs, counts, obstacles, space, 0.0)
+    graph = csr_matrix((np.ones(int(ok.sum())), (pairs[ok, 0], pairs[ok, 1])),
+                       shape=(len(lows), len(lows)))
+    _, labels = csgraph.connected_components(graph, directed=False)
+    if labels[0] == labels[1]:
+        return ""
+    target_side = np.sum(labels == labels[1]) <= np.sum(labels == labels[0])
+    inner = labels == labels[1 if target_side else 0]
+    # every neighbour move out of the walled-off region meets an obstacle (or leaves X)
+    step = np.array([(space[1][i] - space[0][i]) / c for i, c in zip(grid_dims, counts)])
+    nodes = np.flatnonzero(inner)
+    grid = np.array(np.unravel_index(nodes[nodes >= 2] - 2, counts)).reshape(len(counts), -1).T
+    around_lo, around_hi = lows[nodes].copy(), highs[nodes].copy()
+    around_lo[:, grid_dims] -= 1.5 * step
+    around_hi[:, grid_dims] += 1.5 * step
+    met = _meets(around_lo, around_hi, obstacles, 0.0).any(axis=0)
+    names = sorted({spec.obstacles[k].source for k in np.flatnonzero(met)})
+    border = bool(np.any((grid == 0) | (grid == np.array(counts) - 1)))
+    what = "the target is walled off from x(0)" if target_side else \
+        "x(0) is walled off from the target"
+    return (f"{what} by obstacle{'s' if len(names) > 1 else ''} "
+            f"{', '.join(map(str, names))}" + (" and the state-space boundary" if border
+                                              else "")
+            + ": no path joins x(0) and the target centre through gaps at least one via-grid "
+            f"cell ({float(step.max()):.3g}) wide")
 
 
 def _shortest_path(count: int, a: np.ndarray, b: np.ndarray,

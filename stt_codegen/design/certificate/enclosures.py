@@ -1,0 +1,249 @@
+"""Interval enclosures of the tube's pieces: ranges of ``rho``, the bumps, ``beta``, ``psi``.
+
+Vectorized over the ``K`` intervals ``[t0, t1]`` of a partition (proofs in
+``docs/design.md``): ``rho`` is monotone on every reach segment; each bump of eqs.
+(7)-(8) rises up to its centre and falls after it, ``|b_dot|`` unimodal on each
+half-window; eq. (9) is monotone in every bump and the smooth max/min of eq. (10) in every
+argument. :func:`enclose` composes them with a range of ``alpha`` into an
+:class:`~.report.Enclosure`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...tube import reference
+from ...tube.parameters import LOWER, TANH, TubeDesign
+from .report import Enclosure
+
+
+def _tanh_rate_peak() -> float:
+    lo, hi = 0.5, 1.0
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        if (1.0 + mid) * math.tanh(mid) < 1.0:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+#: ``w*``, the root of ``(1 + w) tanh w = 1``: the tanh profile's rate peaks at
+#: ``tau = w* / (1 + w*)`` (see ``verify.lemma.reach_rate_bound``).
+_W_STAR = _tanh_rate_peak()
+
+
+def _bump_peaks(sharpness: float) -> float:
+    """``z*`` where ``|b_dot|`` peaks, as a fraction of the half-window (``verify.lemma``)."""
+    return math.sqrt(((1.0 - sharpness) + math.sqrt((1.0 - sharpness) ** 2 + 3.0)) / 3.0)
+
+
+def bump_ranges(c, t0: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Range of one bump and of its rate ``b_dot`` on each interval, shape (K,) each.
+
+    The bump rises up to its centre and falls after it; ``b_dot`` is 0 at the window's
+    edges and centre and monotone between them and its peaks ``m -+ r z*``, so its
+    extremes on an interval are at the ends or at those points inside.
+
+    Returns
+    -------
+    low, high, rate_min, rate_max : ndarray, shape (K,)
+    """
+    z = _bump_peaks(c.sharpness)
+    points = [t0, t1, np.clip(c.center, t0, t1)] + [
+        np.clip(c.center + sign * c.radius * z, t0, t1) for sign in (-1, 1)]
+    values, rates = reference.bump(np.concatenate(points), c.center, c.radius, c.sharpness)
+    values = values.reshape(len(points), -1)
+    rates = rates.reshape(len(points), -1)
+    low = np.minimum(values[0], values[1])
+    high = np.where((t0 <= c.center) & (c.center <= t1), 1.0, np.maximum(values[0], values[1]))
+    return low, high, rates.min(axis=0), rates.max(axis=0)
+
+
+def circumvent_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
+    """Ranges of ``beta_L`` and ``beta_U`` (eq. (9)) over each interval, shape (K, n) each.
+
+    ``beta_L`` is non-decreasing and ``beta_U`` non-increasing in every bump value, so
+    eq. (9) at the ends of the bumps' ranges gives the ends of theirs.
+    """
+    t0, t1 = np.atleast_1d(t0), np.atleast_1d(t1)
+    ranges = [bump_ranges(c, t0, t1) for c in design.circumvents]
+    lower_min, upper_max, _ = reference.circumvent_from_bumps(design, [r[0] for r in ranges],
+                                                              t0.size)
+    lower_max, upper_min, _ = reference.circumvent_from_bumps(design, [r[1] for r in ranges],
+                                                              t0.size)
+    return (lower_min, lower_max), (upper_min, upper_max)
+
+
+def _circumvent_rate(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
+    """Ranges of ``beta_L_dot`` and ``beta_U_dot`` per interval, shape (K, n) each.
+
+    ``beta_L_dot = sum_j w_j B^j b_dot_j`` with weights ``w_j`` in ``[0, 1]``
+    (:func:`~stt_codegen.tube.reference.open_bump_sum`), ``beta_U_dot`` its negative.
+
+    Returns
+    -------
+    (lower_min, lower_max), (upper_min, upper_max)
+    """
+    n = design.dimension
+    lo_l, hi_l = np.zeros((t0.size, n)), np.zeros((t0.size, n))
+    lo_u, hi_u = np.zeros((t0.size, n)), np.zeros((t0.size, n))
+    for c in design.circumvents:
+        _, _, r_min, r_max = bump_ranges(c, t0, t1)
+        i = c.dimension
+        if c.side == LOWER:
+            lo_l[:, i] += c.height * np.minimum(r_min, 0.0)
+            hi_l[:, i] += c.height * np.maximum(r_max, 0.0)
+        else:
+            lo_u[:, i] -= c.height * np.maximum(r_max, 0.0)
+            hi_u[:, i] -= c.height * np.minimum(r_min, 0.0)
+    return (lo_l, hi_l), (lo_u, hi_u)
+
+
+def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
+    """Ranges of ``rho_L``, ``rho_U`` and of their rates per interval, shape (K, n) each.
+
+    ``rho`` is monotone on each segment; its rate has one sign there and is unimodal
+    (peak at ``tau = w*/(1+w*)`` for ``"tanh"``, ``1/2`` for ``"smoothstep"``) and 0 at a
+    segment's end; evaluated at a boundary it is the right limit, so 0 joins the range
+    of an interval with a segment end inside.
+
+    Returns
+    -------
+    (lower_min, lower_max), (upper_min, upper_max), ((rate_lower_min, rate_lower_max),
+    (rate_upper_min, rate_upper_max))
+    """
+    edges = sorted({s.start for s in design.segments} | {s.end for s in design.segments})
+    peaks = [s.start + s.duration * (_W_STAR / (1.0 + _W_STAR) if s.profile == TANH else 0.5)
+             for s in design.segments]
+    points = [t0, t1] + [np.clip(e, t0, t1) for e in edges]
+    value_points = len(points)
+    points += [np.clip(p, t0, t1) for p in peaks]
+    rho_l, rho_u, rate_l, rate_u = reference.reach_tube(design, np.concatenate(points))
+    shape = (len(points), t0.size, design.dimension)
+    rho_l, rho_u = rho_l.reshape(shape)[:value_points], rho_u.reshape(shape)[:value_points]
+    rate_l, rate_u = rate_l.reshape(shape), rate_u.reshape(shape)
+    ends = np.zeros(t0.shape, dtype=bool)
+    for seg in design.segments:
+        ends |= (t0 < seg.end) & (seg.end <= t1)
+    zero = np.where(ends[:, None], 0.0, np.nan)
+
+    def span(rate):
+        return np.fmin(rate.min(0), zero), np.fmax(rate.max(0), zero)
+
+    return ((rho_l.min(0), rho_l.max(0)), (rho_u.min(0), rho_u.max(0)),
+            (span(rate_l), span(rate_u)))
+
+
+# --------------------------------------------------------------------------- intervals
+
+
+@dataclass(frozen=True)
+class Pieces:
+    """What an interval contributes, vectorized over the K intervals of a partition."""
+
+    rho_l: tuple
+    rho_u: tuple
+    beta_l: tuple
+    beta_u: tuple
+    rho_rate: tuple
+    beta_rate: tuple
+    psi_lo: np.ndarray
+    psi_hi: np.ndarray
+
+
+def piece_ranges(design: TubeDesign, t0: np.ndarray, t1: np.ndarray) -> Pieces:
+    """Ranges of ``rho``, ``beta``, their rates and ``psi`` (eq. (11)) on each ``[t0, t1]``."""
+    rho_l, rho_u, rho_rate = reach_range(design, t0, t1)
+    beta_l, beta_u = circumvent_range(design, t0, t1)
+    beta_rate = _circumvent_rate(design, t0, t1)
+    psi_lo = np.concatenate([beta_u[0] - rho_l[1], rho_u[0] - beta_l[1]], axis=1)
+    psi_hi = np.concatenate([beta_u[1] - rho_l[0], rho_u[1] - beta_l[0]], axis=1)
+    return Pieces(rho_l, rho_u, beta_l, beta_u, rho_rate, beta_rate, psi_lo, psi_hi)
+
+
+def enclose(design: TubeDesign, pieces: Pieces, alpha_min: np.ndarray, alpha_max: np.ndarray,
+            t0: np.ndarray, t1: np.ndarray) -> Enclosure:
+    """Bounds of ``gamma_L``, ``gamma_U`` and their rates (eq. (10)) on each interval.
+
+    Parameters
+    ----------
+    pieces : Pieces
+        From :func:`piece_ranges` on the same intervals.
+    alpha_min, alpha_max : ndarray, shape (K, 2n)
+        Range of ``alpha`` on each interval.
+    t0, t1 : ndarray, shape (K,)
+        Seconds.
+    """
+    n = design.dimension
+    nu = design.smoothness
+
+    def smax(a, b):
+        return reference.smooth_max(np.stack([a, b], -1), nu)[0]
+
+    def smin(a, b):
+        return -smax(-a, -b)
+
+    al_lo, al_hi = alpha_min[:, :n], alpha_max[:, :n]
+    au_lo, au_hi = alpha_min[:, n:], alpha_max[:, n:]
+    lower_min = smax(pieces.rho_l[0] - al_hi, pieces.beta_l[0])
+    lower_max = smax(pieces.rho_l[1] - al_lo, pieces.beta_l[1])
+    upper_min = smin(pieces.rho_u[0] + au_lo, pieces.beta_u[0])
+    upper_max = smin(pieces.rho_u[1] + au_hi, pieces.beta_u[1])
+    # alpha_dot = theta(psi) / (psi + alpha)^2 - kappa alpha decreases in alpha and psi
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        z_lo = pieces.psi_lo + alpha_min
+        fast = np.where(z_lo > 0, reference.trigger(design, pieces.psi_lo) / (z_lo * z_lo), np.inf)
+        slow = reference.trigger(design, pieces.psi_hi) / (pieces.psi_hi + alpha_max) ** 2
+    adot_max = fast - design.kappa * alpha_min
+    adot_min = slow - design.kappa * alpha_max
+    # gamma_dot is a convex combination of (rho_dot -+ alpha_dot) and beta_dot (eq. (10))
+    (rl_min, rl_max), (ru_min, ru_max) = pieces.rho_rate
+    (bl_min, bl_max), (bu_min, bu_max) = pieces.beta_rate
+    gl_min = np.minimum(rl_min - adot_max[:, :n], bl_min)
+    gl_max = np.maximum(rl_max - adot_min[:, :n], bl_max)
+    gu_min = np.minimum(ru_min + adot_min[:, n:], bu_min)
+    gu_max = np.maximum(ru_max + adot_max[:, n:], bu_max)
+    rate_l = np.maximum(np.abs(gl_min), np.abs(gl_max))
+    rate_u = np.maximum(np.abs(gu_min), np.abs(gu_max))
+    width = upper_min - lower_max
+    # a bound moves in one period at most |gamma_dot| dt, and at most its whole range on
+    # the interval (which is at least one period long)
+    move = np.minimum(np.maximum(rate_l, rate_u) / design.rate_hz,
+                      np.maximum(lower_max - lower_min, upper_max - upper_min))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # where the enclosure is empty the ratio means nothing: non-empty fails there
+        ratio = np.where(width > 0, move / width, 0.0)
+    ratio = np.where(np.isnan(ratio), np.inf, ratio)
+    return Enclosure(t0, t1, lower_min, lower_max, upper_min, upper_max, alpha_min, alpha_max,
+                     ratio.max(axis=1), pieces.psi_lo, pieces.psi_hi)
+
+
+def enclose_tube(design: TubeDesign, samples) -> Enclosure:
+    """Enclosures of ``gamma_L``, ``gamma_U`` on every sampling interval of ``samples``.
+
+    ``alpha`` is the deployed sequence of ``samples`` (:func:`~.samples.sample_tube`),
+    linearly interpolated, so on ``[t_k, t_{k+1}]`` it lies between ``alpha_k`` and
+    ``alpha_{k+1}``; the other pieces are enclosed as in :func:`certify_tube`. Per sample:
+    for checks that follow the sampled loop step by step (``verify``'s sampled check).
+
+    Parameters
+    ----------
+    design : TubeDesign
+    samples : TubeSamples
+        ``t`` (N,) and ``alpha`` (N, 2n).
+
+    Returns
+    -------
+    Enclosure
+        ``N - 1`` intervals.
+    """
+    t0, t1 = samples.t[:-1], samples.t[1:]
+    a0, a1 = samples.alpha[:-1], samples.alpha[1:]
+    return enclose(design, piece_ranges(design, t0, t1), np.minimum(a0, a1), np.maximum(a0, a1),
+                    t0, t1)
+
+

@@ -1,0 +1,247 @@
+"""The certificate's refinement loop: adaptive bisection of ``[0, inf)`` until proven.
+
+The proof works on long intervals ``[t_a, t_b]`` of sampling instants and splits an
+interval only where a margin is too thin; nothing is allocated per sample, and the last
+interval ``[T, inf)`` is closed analytically (after ``T``, ``psi`` is constant, so
+``alpha`` stays between its value at ``T`` and ``a*`` for ever). A certificate can resume
+the partition and ``alpha`` bounds of a related one (:class:`~.report.CertificateState`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from ...spec.loader import Spec
+from ...tube import reference
+from ...tube.parameters import TubeDesign
+from .enclosures import enclose, piece_ranges
+from .implicit_step import alpha_ranges
+from .report import (MAX_MOVE_PER_SAMPLE, ROUNDING_MARGIN, Certificate, CertificateState, Enclosure,
+                     certificate_report, obstacle_separation)
+
+#: Most intervals the adaptive bisection may create before it gives up (the certificate
+#: then fails with that reason); the work is linear in it.
+MAX_INTERVALS = 200_000
+#: A thin interval is cut into this many pieces (fewer rounds than bisection).
+SPLIT = 4
+#: Shortest interval the bisection creates, seconds (or one sampling period if longer):
+#: at very high rates the enclosures need no finer time resolution than this.
+MIN_INTERVAL = 1e-4
+#: The narrowest width (the gain of law (13) comes from it) is sharpened on the intervals
+#: whose width bound is within this fraction of the narrowest ...
+WIDTH_BAND = 0.02
+#: ... cut into this many pieces, this many times.
+WIDTH_PIECES = 16
+WIDTH_ROUNDS = 2
+
+
+def _breakpoints(design: TubeDesign) -> tuple[list[int], int]:
+    """Initial partition (sample indices) and ``T``'s index, after which ``psi`` is constant."""
+    rate = design.rate_hz
+    times = [0.0, design.prescribed_time]
+    for s in design.segments:
+        times += [s.start, s.end]
+    for c in design.circumvents:
+        times += [c.start, c.center, c.end]
+    last = max(times)
+    end = int(math.ceil(last * rate)) + 1
+    points = {0, end}
+    for t in times:
+        if 0.0 < t < last:
+            k = int(math.floor(t * rate))
+            points.update((k, k + 1))
+    return sorted(p for p in points if 0 <= p <= end), end
+
+
+def _failing(design: TubeDesign, spec: Spec, enc: Enclosure, selected, final: bool):
+    """Boolean (K,) mask of intervals on which some property is not yet proven."""
+    bad = (enc.upper_min - enc.lower_max).min(axis=1) <= ROUNDING_MARGIN
+    lo, hi = np.array(design.state_lower), np.array(design.state_upper)
+    bad |= np.minimum(enc.lower_min - lo, hi - enc.upper_max).min(axis=1) < 0.0
+    for _, sep, _, _, _ in obstacle_separation(spec, enc, selected):
+        bad |= sep <= ROUNDING_MARGIN
+    if final:
+        late = enc.t_end > design.prescribed_time
+        t_lo, t_hi = np.array(spec.target_set.lower), np.array(spec.target_set.upper)
+        inside = np.minimum(enc.lower_min - t_lo, t_hi - enc.upper_max).min(axis=1)
+        bad |= late & (inside <= ROUNDING_MARGIN)
+    bad |= enc.move_ratio > MAX_MOVE_PER_SAMPLE
+    return bad
+
+
+def certify_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = None,
+                 final: bool = True, max_intervals: int = MAX_INTERVALS,
+                 resume: tuple[Certificate, float] | None = None) -> Certificate:
+    """Prove the tube's safety properties for every ``t >= 0``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+    spec : Spec
+        For the state space, obstacles and target set.
+    obstacles : list of int, optional
+        Indices of ``spec.obstacle_boxes()`` to certify against; default all.
+    final : bool
+        Also prove ``inside target after t_c`` (a partial design of the search skips it).
+    max_intervals : int
+        Refinement budget; when it runs out, the properties not yet proven fail.
+    resume : (Certificate, float), optional
+        The certificate of a design whose tube equals this one before the given time
+        (seconds), e.g. the same circumvents but one whose window opens then: its
+        partition and ``alpha`` bounds before that time are reused (work shared across
+        the candidates of the design search).
+
+    Returns
+    -------
+    Certificate
+        Properties ``non-empty``, ``initial state inside``, ``inside state space``,
+        ``avoids obstacle j`` (one per spec obstacle), ``inside target after t_c`` and
+        ``sampling rate`` (no bound moves more than :data:`MAX_MOVE_PER_SAMPLE` tube
+        widths in one period), each with its smallest margin.
+    """
+    with reference.numpy_math():
+        return _certify(design, spec, obstacles, final, max_intervals, resume)
+
+
+def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
+             max_intervals: int, resume) -> Certificate:
+    selected = list(range(len(spec.obstacle_boxes()))) if obstacles is None else obstacles
+    points, end = _breakpoints(design)
+    dt = 1.0 / design.rate_hz
+    min_steps = max(1, int(MIN_INTERVAL * design.rate_hz))
+    budget_hit = False
+    decisive = ""
+    work = 0
+    m = 2 * design.dimension
+    previous = CertificateState()
+    reuse_limit = 0                         # intervals of `previous` that may be reused
+    if resume is not None:
+        parent, until = resume
+        old = list(parent.state.points)
+        # the parent's points up to `until`: its intervals that end by then carry over
+        cut = int(np.searchsorted(np.array(old, dtype=float) * dt, until, side="right"))
+        cut = min(cut, len(old) - 1)
+        if cut >= 2 and old[-1] == end:
+            points = sorted(set(old[:cut]) | {p for p in points if p > old[cut - 1]})
+            previous = parent.state
+            reuse_limit = cut - 1
+    while True:
+        i0 = np.array(points)
+        i1 = np.append(i0[1:], -1)            # -1: the tail [T, inf)
+        t0 = i0 * dt
+        t1 = np.where(i1 < 0, np.inf, i1 * dt)
+        pieces = piece_ranges(design, t0, np.where(i1 < 0, t0, t1))
+        steps = np.where(i1 < 0, np.inf, (i1 - i0).astype(float))
+        # the intervals before the first new cut are unchanged: resume alpha after them
+        same = next((q for q, (a, b) in enumerate(zip(points, previous.points)) if a != b),
+                    min(len(points), len(previous.points)))
+        keep = max(0, min(same - 1, len(previous.entries) - 1, reuse_limit))
+        start = previous.entries[keep] if keep else ([0.0] * m, [0.0] * m)
+        rows_lo, rows_hi, entries = alpha_ranges(design, pieces.psi_lo[keep:],
+                                                  pieces.psi_hi[keep:], steps[keep:], start)
+        work += len(points) - keep
+        previous = CertificateState(tuple(points), previous.alpha_lo[:keep] + tuple(rows_lo),
+                                    previous.alpha_hi[:keep] + tuple(rows_hi),
+                                    previous.entries[:keep] + tuple(entries))
+        rows_lo, rows_hi = previous.alpha_lo, previous.alpha_hi
+        reuse_limit = len(previous.entries)   # from now on `previous` is this tube's own
+        a_min, a_max = np.maximum(np.array(rows_lo), 0.0), np.array(rows_hi)
+        enc = enclose(design, pieces, a_min, a_max, t0, t1)
+        bad = _failing(design, spec, enc, selected, final)
+        length = np.where(i1 < 0, 0, i1 - i0)
+        splittable = length >= max(2, 2 * min_steps)
+        split = bad & splittable
+        # a thin single-sample interval: its alpha may come in loose from a long predecessor
+        single = bad & ~split
+        pred = np.zeros_like(bad)
+        pred[:-1] = single[1:]
+        split |= pred & splittable
+        # stop once a single-sample interval (with a single-sample predecessor or none)
+        # fails: refining elsewhere cannot change the verdict
+        failed = np.flatnonzero(single)
+        if failed.size and np.any((failed == 0) | (length[np.maximum(failed - 1, 0)] <= 1)):
+            break
+        decisive = _surely_failing(design, spec, t0[bad], a_min[bad], a_max[bad], selected)
+        if decisive:
+            break             # the tube itself fails at an instant: no refinement helps
+        if not split.any():
+            break
+        if len(points) + (SPLIT - 1) * int(split.sum()) > max_intervals:
+            budget_hit = True
+            break
+        cuts = {int(a + (b * q) // SPLIT) for a, b in zip(i0[split], length[split])
+                for q in range(1, SPLIT)}
+        points = sorted(set(points) | cuts)
+    narrowest = _narrowest(design, enc) if final and not bad.any() else None
+    certificate = certificate_report(design, spec, enc, selected, final, budget_hit,
+                                     end * dt, max_intervals, narrowest)
+    return replace(certificate, state=previous, decisive=decisive, work=work)
+
+
+def _narrowest(design: TubeDesign, enc: Enclosure) -> tuple[float, float]:
+    """A sharper lower bound of the tube's narrowest width, and where it is (s).
+
+    On an interval the deployed ``alpha`` lies in ``[alpha_min, alpha_max]`` at every
+    ``t``, so the width on any piece of it is bounded below with that range and the
+    piece's own (tighter) ranges of ``rho`` and ``beta``. The intervals within
+    :data:`WIDTH_BAND` of the narrowest are cut into :data:`WIDTH_PIECES` pieces,
+    :data:`WIDTH_ROUNDS` times (the pieces within the band again); ``alpha`` is not
+    propagated again, so this costs a few vectorized evaluations.
+    """
+    width = (enc.upper_min - enc.lower_max).min(axis=1)
+    t0, t1 = enc.t_start, enc.t_end
+    a_min, a_max = enc.alpha_min, enc.alpha_max
+    keep = ~np.isfinite(t1)                       # the tail [T, inf) stays as it is
+    done_w, done_t = list(width[keep]), list(t0[keep])
+    t0, t1, a_min, a_max, width = t0[~keep], t1[~keep], a_min[~keep], a_max[~keep], width[~keep]
+    for _ in range(WIDTH_ROUNDS):
+        best = min(width.min(initial=math.inf), min(done_w, default=math.inf))
+        if not best > 0.0:
+            break
+        band = width <= best * (1.0 + WIDTH_BAND)
+        if not band.any():
+            break
+        done_w += list(width[~band])
+        done_t += list(t0[~band])
+        q = np.arange(WIDTH_PIECES)
+        span = (t1[band] - t0[band])[:, None]
+        s0 = (t0[band][:, None] + span * q / WIDTH_PIECES).ravel()
+        s1 = (t0[band][:, None] + span * (q + 1) / WIDTH_PIECES).ravel()
+        s1 = np.maximum(s1, s0)
+        a_min = np.repeat(a_min[band], WIDTH_PIECES, axis=0)
+        a_max = np.repeat(a_max[band], WIDTH_PIECES, axis=0)
+        piece = enclose(design, piece_ranges(design, s0, s1), a_min, a_max, s0, s1)
+        t0, t1, width = s0, s1, (piece.upper_min - piece.lower_max).min(axis=1)
+    done_w += list(width)
+    done_t += list(t0)
+    k = int(np.argmin(done_w))
+    return float(done_w[k]), float(done_t[k])
+
+
+def _surely_failing(design: TubeDesign, spec: Spec, t: np.ndarray, a_min: np.ndarray,
+                    a_max: np.ndarray, selected) -> str:
+    """The property the tube certainly fails at one of the instants ``t`` ("" if none).
+
+    With ``alpha`` in ``[a_min, a_max]``, the tube box at ``t`` contains the box for
+    ``a_min`` (``gamma_L`` falls and ``gamma_U`` rises with ``alpha``) and is at most as
+    wide as the box for ``a_max``.
+    """
+    if not t.size:
+        return ""
+    both_l, both_u, _, _ = reference.adaptive_tube(design, np.concatenate([t, t]),
+                                                   np.concatenate([a_min, a_max]))
+    g_l, w_l = both_l[:t.size], both_l[t.size:]
+    g_u, w_u = both_u[:t.size], both_u[t.size:]
+    boxes = spec.obstacle_boxes()
+    for b in selected:
+        lo, hi = np.array(boxes[b].lower), np.array(boxes[b].upper)
+        if np.any(np.all((g_l < hi) & (g_u > lo), axis=1)):
+            return f"avoids obstacle {spec.obstacles[b].source}"
+    if np.any(np.max(w_l - w_u, axis=1) > 0.0):
+        return "non-empty"
+    return ""
+
+

@@ -1,0 +1,46 @@
+"""Why a tube design failed, as a value: callers branch on it, never on message text.
+
+A :class:`~stt_codegen.errors.DesignError` raised by the design package carries one of
+these in ``kind``; a :class:`~stt_codegen.design.result.TubeCheck` that did not pass
+carries one too.
+"""
+
+from __future__ import annotations
+
+from enum import Enum
+
+
+class FailureKind(Enum):
+    """What made a tube (or the design search) fail.
+
+    Tube check (a certificate property or a sampled-loop limit, in the order
+    :func:`~stt_codegen.design.search.check_tube` reports them): ``SAMPLING_RATE``,
+    ``NON_EMPTY``, ``INITIAL_ERROR``, ``INITIAL_STATE``, ``STATE_SPACE``, ``OBSTACLE``,
+    ``TARGET``. Design search: ``OBSTACLE_AT_TARGET`` (an obstacle within the window
+    inflation of the target box), ``NO_ROOM`` (no dimension leaves room beside an
+    obstacle), ``SEARCH_BUDGET`` (candidate tubes or certificate work used up),
+    ``NO_PASSAGE`` (no via-point path: the free passage is too narrow),
+    ``WALLED_OFF`` (the start or the target is enclosed by obstacles), ``PLANT``
+    (the spec's plant violates Assumption 2).
+    """
+
+    SAMPLING_RATE = "sampling rate"
+    NON_EMPTY = "non-empty"
+    INITIAL_ERROR = "initial error"
+    INITIAL_STATE = "initial state inside"
+    STATE_SPACE = "inside state space"
+    OBSTACLE = "avoids obstacle"
+    TARGET = "inside target after t_c"
+    OBSTACLE_AT_TARGET = "obstacle at target"
+    NO_ROOM = "no room beside obstacle"
+    SEARCH_BUDGET = "search budget"
+    NO_PASSAGE = "no via-point passage"
+    WALLED_OFF = "walled off"
+    PLANT = "plant assumption"
+
+
+def property_kind(name: str) -> FailureKind:
+    """The kind of a failed certificate property (``Margin.name``, e.g. ``avoids obstacle 2``)."""
+    if name.startswith(FailureKind.OBSTACLE.value):
+        return FailureKind.OBSTACLE
+    return FailureKind(name)

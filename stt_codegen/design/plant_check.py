@@ -1,0 +1,80 @@
+"""Assumption 2 for a plant the spec names: the symmetric part of ``g`` positive definite.
+
+Law (13) with its positive gain ``k`` keeps ``x`` in the tube only if the symmetric part
+``g_s = (g + g^T) / 2`` of the input matrix is uniformly positive definite (Assumption 2;
+for a negative definite ``g_s`` Remark 4.2 asks a negative gain, which the controller
+does not take). The design refuses a spec whose named plant violates it, before any tube
+is built: a tube for such a plant is certified, but no controller of law (13) follows it.
+Plain numpy, so that ``verify`` (which also proves the bound symbolically) can reuse it.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Sequence
+
+import numpy as np
+
+from ..spec.loader import Spec
+
+#: Heading range of the omnidirectional robot (eq. (14)) where ``g_s`` is positive
+#: definite: ``g_s = diag(cos x3, cos x3, 1)`` (docs/decisions.md, decision 10).
+HALF_PI = math.pi / 2
+
+
+def symmetric_eigenvalues(g: Sequence[Sequence[float]]) -> np.ndarray:
+    """Eigenvalues of ``(g + g^T) / 2``, ascending.
+
+    Parameters
+    ----------
+    g : array_like, shape (n, n)
+
+    Returns
+    -------
+    ndarray, shape (n,)
+    """
+    g = np.asarray(g, dtype=float)
+    return np.linalg.eigvalsh((g + g.T) / 2)
+
+
+def linear_plant_failure(g: Sequence[Sequence[float]]) -> str:
+    """Why a linear plant's constant ``g`` violates Assumption 2 ("" when it holds).
+
+    The reason names ``plant.g`` and the eigenvalue of ``(g + g^T) / 2`` closest to
+    (or beyond) zero.
+    """
+    eig = symmetric_eigenvalues(g)
+    if eig[0] > 0.0:
+        return ""
+    if eig[-1] < 0.0:
+        return (f"plant.g: (g + g^T)/2 is negative definite (largest eigenvalue "
+                f"{eig[-1]:.6g}): Assumption 2 asks it positive definite, and law (13) "
+                "with its positive gain k would push x out of the tube (Remark 4.2's "
+                "negative gain is not supported)")
+    return (f"plant.g: (g + g^T)/2 has the eigenvalue {eig[0]:.6g} <= 0: Assumption 2 asks "
+            "it positive definite, else no gain k of law (13) keeps x in the tube")
+
+
+def heading_range_failure(lower: float, upper: float) -> str:
+    """Why a heading range ``[lower, upper]`` (rad) of eq. (14) loses Assumption 2 ("" if not).
+
+    ``g_s = diag(cos x3, cos x3, 1)`` is positive definite only while ``|x3| < pi/2``.
+    """
+    if -HALF_PI < lower and upper < HALF_PI:
+        return ""
+    return (f"state_space: the heading x3 ranges over [{lower:g}, {upper:g}] rad, which "
+            "reaches |x3| = pi/2 where cos x3 = 0: the omnidirectional robot's (g + g^T)/2 "
+            "= diag(cos x3, cos x3, 1) is then not positive definite (Assumption 2)")
+
+
+def plant_failure(spec: Spec) -> str:
+    """Why the spec's ``linear`` plant violates Assumption 2 ("" when it holds or when
+    the spec names no matrix).
+
+    Only the ``linear`` model's ``plant.g`` is checked here: the omnidirectional robot's
+    heading range is :func:`heading_range_failure`'s (``verify`` reports it, and
+    ``verify --plant`` may check another plant for the same tube).
+    """
+    if spec.plant_model == "linear" and spec.linear_plant is not None:
+        return linear_plant_failure(spec.linear_plant.g)
+    return ""
