@@ -140,3 +140,88 @@ def test_bad_shapes_name_field_and_reason(table, field, reason):
     with pytest.raises(SpecError) as info:
         parse_spec(BESIDE + "[[obstacles]]\n" + table)
     assert info.value.field == field and reason in info.value.reason, str(info.value)
+
+
+def test_too_close_to_the_start_names_the_start_set(monkeypatch):
+    """A covering refused because the shape comes close to X0 blames X0 (and not T): with
+    a budget of 20 boxes, the ball 1 micrometre from the start's corner needs 27 at
+    tolerance 0.2, 8 without the start set."""
+    import stt_codegen.spec.covering as covering
+    ball = Ball((0.9, 0.9), 0.565684)
+    assert len(cover(ball, 0.2, [])) <= 20 < len(cover(ball, 0.2, [START]))
+    monkeypatch.setattr(covering, "MAX_BOXES", 20)
+    with pytest.raises(SpecError) as info:
+        parse_spec(BESIDE + "[[obstacles]]\ncenter = [0.9, 0.9]\nradius = 0.565684\n"
+                            "tolerance = 0.2\n")
+    assert info.value.field == "obstacles[0]"
+    assert "misses the initial set" in info.value.reason, str(info.value)
+    assert "target" not in info.value.reason
+
+
+def test_a_tolerance_too_fine_for_the_shape_is_blamed_on_the_tolerance():
+    """Issue 23 item 7: a quadrilateral in mid-arena, far from the start and the target, at
+    tolerance 0.01 needs more than MAX_BOXES boxes; the message says so (it blamed the
+    initial and target sets) and comes at once (it took seconds)."""
+    quad = "[[obstacles]]\nvertices = [[1.5, 2.0], [2.5, 1.2], [3.5, 2.8], [2.2, 3.6]]\n"
+    text = arena_toml("quad", extra=BALL.replace("1.0, 1.0", "4.0, 1.0") + quad
+                      + "tolerance = 0.01\n")
+    with pytest.raises(SpecError) as info:
+        parse_spec(text)
+    assert info.value.field == "obstacles[1]", str(info.value)
+    reason = info.value.reason
+    assert "tolerance 0.01" in reason and "too fine" in reason, reason
+    assert "initial" not in reason and "target" not in reason, reason
+    spec = parse_spec(text.replace("tolerance = 0.01", "tolerance = 0.05"))
+    assert len([o for o in spec.obstacles if o.source == 1]) <= MAX_BOXES
+
+
+def _random_polygon(rng, center, radius):
+    angles = np.sort(rng.uniform(0.0, 2 * np.pi, int(rng.integers(3, 9))))
+    return center + radius * np.c_[np.cos(angles), np.sin(angles)]
+
+
+def test_polygon_box_hull_is_the_linear_programs_one():
+    """The exact planar hull of ``polygon ∩ box`` contains the LP's (up to the LP's own
+    tolerance) and is no larger than it (up to the rounding margin)."""
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        shape = make_polytope(_random_polygon(rng, rng.uniform(1, 4, 2), rng.uniform(0.1, 1.0)),
+                              "obstacles[0]")
+        lo = rng.uniform(0.0, 4.0, 2)
+        hi = lo + rng.uniform(0.0, 2.0, 2)
+        exact, lp = shape.box_hull(lo, hi), shape._box_hull_lp(lo, hi)
+        if lp is None or exact is None:
+            # both empty, or the box only grazes the polygon within the LP's tolerance
+            other = exact if lp is None else lp
+            assert other is None or np.min(other[1] - other[0]) < 1e-6
+            continue
+        assert np.all(exact[0] <= lp[0] + 1e-7) and np.all(lp[1] <= exact[1] + 1e-7)
+        assert np.all(lp[0] <= exact[0] + 1e-9) and np.all(exact[1] <= lp[1] + 1e-9)
+
+
+def test_eighty_polygons_are_covered_soundly_and_fast():
+    """Issue 23 item 7: 80 random convex polygons at tolerance 0.02 (the covering took
+    about 11 s, 0.14 s per polygon; now well under a second in all). Every box is within
+    the tolerance, random points of every polygon are covered, the result is the same
+    twice."""
+    import time
+    rng = np.random.default_rng(7)
+    shapes = [make_polytope(_random_polygon(rng, rng.uniform(0.9, 4.1, 2),
+                                            rng.uniform(0.05, 0.4)), "obstacles[0]")
+              for _ in range(80)]
+    forbidden = [START, (np.array([4.5, 4.5]), np.array([5.0, 5.0]))]
+    start = time.perf_counter()
+    coverings = [cover(shape, 0.02, forbidden) for shape in shapes]
+    elapsed = time.perf_counter() - start
+    assert elapsed < 5.0, elapsed
+    for shape, boxes in zip(shapes, coverings):
+        assert 0 < len(boxes) <= MAX_BOXES
+        pts = np.array(shape.vertices)
+
+        def in_polygon(r, pts=pts):
+            return r.dirichlet(np.ones(len(pts)), 500) @ pts
+
+        assert_valid_covering(shape, boxes, 0.02, forbidden, rng, in_polygon)
+    again = cover(shapes[0], 0.02, forbidden)
+    assert [(tuple(a), tuple(b)) for a, b in again] == [(tuple(a), tuple(b))
+                                                        for a, b in coverings[0]]
