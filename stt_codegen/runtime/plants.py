@@ -15,6 +15,7 @@ import numpy as np
 from ..codegen.emit import python_function
 from ..errors import SpecError
 from ..spec.loader import LinearPlant
+from ..spec.plants import PLANT_MODELS, dimension_mismatch
 from .dynamics import linear_rhs, plant_rhs
 
 #: Number of sinusoids summed in each disturbance component.
@@ -106,7 +107,7 @@ def make_plant(model: str, dimension: int, amplitude: float, seed: int = 0,
     Parameters
     ----------
     model : str
-        One of :data:`stt_codegen.spec.loader.PLANT_MODELS`.
+        One of :data:`stt_codegen.spec.plants.PLANT_MODELS`.
     dimension : int
     amplitude : float
         Bound on every ``|w_i|`` (:class:`Disturbance`).
@@ -127,9 +128,9 @@ def make_plant(model: str, dimension: int, amplitude: float, seed: int = 0,
         if len(linear.c) != dimension:
             raise SpecError("plant.c", f"has {len(linear.c)} entries for {dimension} states")
         return linear_plant(linear.a, linear.g, linear.c, disturbance)
+    if model in PLANT_MODELS and dimension_mismatch(model, dimension):
+        raise SpecError("plant.model", dimension_mismatch(model, dimension))
     if model == "omnidirectional":
-        if dimension != 3:
-            raise SpecError("plant.model", "the omnidirectional robot has 3 states")
         return omnidirectional_robot(disturbance)
     if model == "single-integrator":
         return single_integrator(dimension, disturbance)
