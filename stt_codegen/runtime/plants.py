@@ -15,7 +15,7 @@ import numpy as np
 from ..codegen.emit import python_function
 from ..errors import SpecError
 from ..spec.loader import LinearPlant
-from ..spec.plants import PLANT_MODELS, dimension_mismatch
+from ..spec.plants import PLANT_MODELS, PLANTS, dimension_mismatch
 from .dynamics import linear_rhs, plant_rhs
 
 #: Number of sinusoids summed in each disturbance component.
@@ -59,9 +59,10 @@ def omnidirectional_robot(disturbance: Disturbance) -> ct.NonlinearIOSystem:
     in the robot frame (m/s, rad/s); outputs the state. ``R(x3) u`` is
     :func:`.dynamics.plant_rhs` (``"omnidirectional"``).
     """
-    return _plant(plant_rhs("omnidirectional", 3), disturbance, inputs=["v1", "v2", "omega"],
-                        states=["x1", "x2", "x3"], outputs=["x1", "x2", "x3"],
-                        name="omnidirectional_robot")
+    robot = PLANTS["omnidirectional"]
+    states = [f"x{i + 1}" for i in range(robot.states)]
+    return _plant(plant_rhs(robot.name, robot.states), disturbance, inputs=list(robot.inputs),
+                  states=states, outputs=states, name="omnidirectional_robot")
 
 
 def single_integrator(dimension: int, disturbance: Disturbance) -> ct.NonlinearIOSystem:
