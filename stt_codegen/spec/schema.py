@@ -27,6 +27,8 @@ from .plants import PLANT_MODELS, PLANTS
 
 #: Largest magnitude of any number in a spec.
 MAX_MAGNITUDE = 1e12
+#: Default covering tolerance of balls and polytopes (Remark 3.1), state units.
+DEFAULT_TOLERANCE = 0.05
 #: A spec name: a C identifier once ``-`` becomes ``_``, at most 64 characters.
 NAME_REGEX = r"^[A-Za-z][A-Za-z0-9_-]{0,63}$"
 #: Largest state dimension (the generated code unrolls per dimension).
@@ -97,8 +99,9 @@ class BallObstacle(_Table):
     radius: Positive
     dims: list[Index] = _omitted("state dimensions of the coordinates (default the first "
                                  "ones)")
-    tolerance: Positive = Field(0.05, description="largest distance from the covering "
-                                                  "boxes to the ball, state units")
+    tolerance: Positive = Field(DEFAULT_TOLERANCE, description="largest distance from the "
+                                                               "covering boxes to the ball, "
+                                                               "state units")
 
 
 class PolytopeObstacle(_Table):
@@ -107,8 +110,9 @@ class PolytopeObstacle(_Table):
     vertices: Annotated[list[Vector], Field(min_length=1, max_length=MAX_VERTICES)]
     dims: list[Index] = _omitted("state dimensions of the coordinates (default the first "
                                  "ones)")
-    tolerance: Positive = Field(0.05, description="largest distance from the covering "
-                                                  "boxes to the polytope, state units")
+    tolerance: Positive = Field(DEFAULT_TOLERANCE, description="largest distance from the "
+                                                               "covering boxes to the "
+                                                               "polytope, state units")
 
 
 def _obstacle_kind(value: Any) -> str | None:
@@ -259,6 +263,10 @@ def short_repr(value: Any) -> str:
     return text if len(text) <= 40 else f"{text[:20]}...({len(text)} characters)"
 
 
+def _beyond(value: Any) -> str:
+    return f"magnitude {short_repr(value)} is beyond {MAX_MAGNITUDE:.0e}".replace("e+", "e")
+
+
 def _reason(error: dict) -> str:
     """One violation in the loader's words."""
     kind, value, ctx = error["type"], error.get("input"), error.get("ctx") or {}
@@ -272,7 +280,7 @@ def _reason(error: dict) -> str:
         return f"must be finite, got {value!r}"
     if kind in ("float_type", "float_parsing"):
         if isinstance(value, int) and not isinstance(value, bool):
-            return f"magnitude {short_repr(value)} is beyond 1e12"
+            return _beyond(value)
         return f"must be a number, got {value_kind(value)}"
     if kind in ("int_type", "int_parsing", "int_from_float"):
         return f"must be an integer, got {value_kind(value)}"
@@ -288,7 +296,7 @@ def _reason(error: dict) -> str:
     if kind == "greater_than_equal":
         return f"must be non-negative, got {value!r}"
     if kind == "less_than_equal":
-        return f"magnitude {value!r} is beyond 1e12"
+        return _beyond(value)
     if kind == "too_short":
         return "must not be empty"
     if kind == "too_long":
