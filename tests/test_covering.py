@@ -31,8 +31,7 @@ def assert_valid_covering(shape, boxes, tolerance, forbidden, rng, inside_points
         for f_lo, f_hi in forbidden:        # Assumption 3, per box: misses X0 and T
             assert not (np.all(lo <= f_hi) and np.all(f_lo <= hi))
         corners = np.array(list(itertools.product(*zip(lo, hi))))
-        worst = (float(np.max(shape.distance(corners))) if isinstance(shape, Ball)
-                 else max(shape.distance(c) for c in corners))
+        worst = float(np.max(shape.distance(corners)))
         assert worst <= tolerance + 1e-12   # within the tolerance of the shape
     lows = np.array([b[0] for b in boxes])
     highs = np.array([b[1] for b in boxes])
@@ -225,3 +224,45 @@ def test_eighty_polygons_are_covered_soundly_and_fast():
     again = cover(shapes[0], 0.02, forbidden)
     assert [(tuple(a), tuple(b)) for a, b in again] == [(tuple(a), tuple(b))
                                                         for a, b in coverings[0]]
+
+
+def test_polygon_distance_is_the_quadratic_programs_one():
+    """The planar closed form (all points and edges at once) agrees with the general QP."""
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        shape = make_polytope(_random_polygon(rng, rng.uniform(1, 4, 2), rng.uniform(0.1, 1.0)),
+                              "obstacles[0]")
+        points = rng.uniform(0.0, 5.0, (30, 2))
+        closed = shape.distance(points)
+        qp = np.array([0.0 if np.all(shape.halfspaces[0] @ p <= shape.halfspaces[1] + 1e-12)
+                       else shape._qp_distance(p) for p in points])
+        assert closed.shape == (30,) and np.allclose(closed, qp, atol=1e-6)
+
+
+def eighty_polygons_toml(seed: int = 0, count: int = 80, tolerance: float = 0.02) -> str:
+    """Issue 23 item 7's spec: ``count`` random convex polygons (3-7 vertices, radius
+    0.05-0.2 m) in the 5 m x 5 m arena, start ``[0, 0.5]^2``, target ``[4.5, 5]^2``."""
+    rng = np.random.default_rng(seed)
+    extra = ""
+    for _ in range(count):
+        centre, radius = rng.uniform(0.9, 4.1, 2), rng.uniform(0.05, 0.2)
+        angles = np.sort(rng.uniform(0.0, 2 * np.pi, int(rng.integers(3, 8))))
+        points = centre + radius * np.c_[np.cos(angles), np.sin(angles)]
+        extra += ("[[obstacles]]\nvertices = [" + ", ".join(
+            f"[{float(x)!r}, {float(y)!r}]" for x, y in points) + f"]\ntolerance = {tolerance!r}\n")
+    return arena_toml("eighty-polygons", extra=extra)
+
+
+@pytest.mark.slow
+def test_eighty_polygons_design_in_seconds():
+    """Issue 23 item 7: the whole design of 80 polygons at tolerance 0.02 (about 1300
+    boxes) took 91 s, nearly all of it the covering; now a few seconds (bound generous
+    for a loaded machine)."""
+    import time
+    start = time.perf_counter()
+    spec = parse_spec(eighty_polygons_toml())
+    found = design_tube(spec)
+    elapsed = time.perf_counter() - start
+    assert len(spec.unsafe_sets) == 80 and len(spec.obstacles) > 80
+    assert found.check.passed
+    assert elapsed < 30.0, elapsed
