@@ -166,3 +166,18 @@ def test_plant_state_counts_come_from_the_one_registry():
         with pytest.raises(SpecError) as info:
             make_plant(plant.name, n, 0.1)
         assert (info.value.field, info.value.reason) == ("plant.model", reason)
+
+
+@pytest.mark.parametrize("text, field, reason", [
+    (replace("lower = [0.0, 0.0]\nupper = [5.0, 5.0]",
+             "lower = [" + ", ".join(["0.0"] * 65) + "]\nupper = [" + ", ".join(["5.0"] * 65)
+             + "]"), "state_space.lower", "65 dimensions; at most 64"),
+    (VALID + "[[obstacles]]\nlower = [2.0, 2.0]\nupper = [3.0, 3.0]\n" * 4096, "obstacles",
+     "4097 obstacles; at most 4096"),
+    (VALID + "[[obstacles]]\nvertices = [" + ", ".join(["[1.0, 2.0]"] * 1025) + "]\n",
+     "obstacles[1].vertices", "1025 vertices; at most 1024"),
+], ids=["dimensions", "obstacles", "vertices"])
+def test_size_limits_name_what_is_counted(text, field, reason):
+    with pytest.raises(SpecError) as info:
+        parse_spec(text)
+    assert (info.value.field, info.value.reason) == (field, reason)

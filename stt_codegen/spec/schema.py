@@ -300,7 +300,10 @@ def _reason(error: dict) -> str:
     if kind == "too_short":
         return "must not be empty"
     if kind == "too_long":
-        return f"{len(value)} entries; at most {ctx.get('max_length')}"
+        what = {"obstacles": "obstacles", "vertices": "vertices"}.get(
+            error["loc"][-1], "dimensions" if ctx.get("max_length") == MAX_DIMENSION
+            else "entries")
+        return f"{len(value)} {what}; at most {ctx.get('max_length')}"
     if kind == "list_type":
         what = {"obstacles": "tables", "vertices": "points (arrays)",
                 "dims": "dimension indices", "a": "rows (arrays of numbers)",
