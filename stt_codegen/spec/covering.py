@@ -14,9 +14,15 @@ closed form for a ball; exact for a polygon, from its edges' crossings of the bo
 sides, widened by a rounding margin; linear programs for polytopes in three or four
 dimensions).
 
+Then the accepted boxes are merged (:func:`_merge`): each absorbs one of the last
+:data:`MERGE_WINDOW` kept boxes it touches when the hull of the shape's part in their
+bounding box is again acceptable (within ``tolerance`` at its corners, missing the
+forbidden boxes); about a third fewer boxes for polygons, hence fewer obstacles for the
+design.
+
 Cost: one box hull and one corner-distance evaluation per visited box, at most
-``2 MAX_BOXES + 1`` visits per shape; for a polygon both are a few numpy operations on its
-edges (80 polygons at tolerance 0.02 cover in well under a second). A refusal costs one
+``2 MAX_BOXES + 1`` visits per shape, and at most ``MERGE_WINDOW`` per box and merge when
+merging; for a polygon both are a few numpy operations on its edges. A refusal costs one
 more covering, without the forbidden boxes, to tell its reason: a tolerance too fine for
 the shape's size, or a shape too close to the initial or target set.
 """
@@ -30,8 +36,10 @@ import numpy as np
 
 from ..errors import SpecError
 
-#: At most this many boxes per shape.
+#: At most this many boxes per shape (counted before merging).
 MAX_BOXES = 256
+#: A box may merge with one of this many boxes accepted just before it.
+MERGE_WINDOW = 8
 
 
 def _corner_distance(shape, lo: np.ndarray, hi: np.ndarray) -> float:
@@ -86,6 +94,39 @@ def _bisect(shape, tolerance: float,
     return accepted
 
 
+def _acceptable(shape, lo: np.ndarray, hi: np.ndarray, tolerance: float,
+                forbidden: Sequence[tuple[np.ndarray, np.ndarray]]) -> bool:
+    return (not any(np.all(lo <= f_hi) and np.all(f_lo <= hi) for f_lo, f_hi in forbidden)
+            and _corner_distance(shape, lo, hi) <= tolerance)
+
+
+def _merge(shape, boxes: list[tuple[np.ndarray, np.ndarray]], tolerance: float,
+           forbidden: Sequence[tuple[np.ndarray, np.ndarray]]) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Fewer boxes: each box, in order, absorbs one of the last :data:`MERGE_WINDOW` kept
+    boxes it touches while the hull of the shape's part in their bounding box is
+    acceptable.
+
+    Sound: that hull contains the shape's part in both boxes, and the accepted boxes'
+    union contains the shape.
+    """
+    kept: list[tuple[np.ndarray, np.ndarray]] = []
+    for box in boxes:
+        merged = True
+        while merged and kept:
+            merged = False
+            for k in range(1, min(MERGE_WINDOW, len(kept)) + 1):
+                if not (np.all(kept[-k][0] <= box[1]) and np.all(box[0] <= kept[-k][1])):
+                    continue                    # apart: their bounding box spans a gap
+                hull = shape.box_hull(np.minimum(kept[-k][0], box[0]),
+                                      np.maximum(kept[-k][1], box[1]))
+                if _acceptable(shape, *hull, tolerance, forbidden):
+                    del kept[-k]
+                    box, merged = hull, True
+                    break
+        kept.append(box)
+    return kept
+
+
 def _fits(shape, tolerance: float, forbidden) -> bool:
     try:
         _bisect(shape, tolerance, forbidden)
@@ -127,7 +168,7 @@ def cover(shape, tolerance: float, forbidden: Sequence[tuple[np.ndarray, np.ndar
         it).
     """
     try:
-        return _bisect(shape, tolerance, forbidden)
+        return _merge(shape, _bisect(shape, tolerance, forbidden), tolerance, forbidden)
     except _OverBudget as over:
         met = over.met
     what = "ball" if hasattr(shape, "radius") else "polytope"
