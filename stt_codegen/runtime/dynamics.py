@@ -40,7 +40,7 @@ def _g(model: str, x):
 
 
 def _dimension(model: str, n: int) -> None:
-    if model in NAMED_MODELS and dimension_mismatch(model, n):
+    if dimension_mismatch(model, n):
         raise ValueError(dimension_mismatch(model, n))
 
 

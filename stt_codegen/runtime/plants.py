@@ -15,7 +15,7 @@ import numpy as np
 from ..codegen.emit import python_function
 from ..errors import SpecError
 from ..spec.loader import LinearPlant
-from ..spec.plants import PLANT_MODELS, PLANTS, dimension_mismatch
+from ..spec.plants import PLANTS, dimension_mismatch
 from .dynamics import linear_rhs, plant_rhs
 
 #: Number of sinusoids summed in each disturbance component.
@@ -129,7 +129,7 @@ def make_plant(model: str, dimension: int, amplitude: float, seed: int = 0,
         if len(linear.c) != dimension:
             raise SpecError("plant.c", f"has {len(linear.c)} entries for {dimension} states")
         return linear_plant(linear.a, linear.g, linear.c, disturbance)
-    if model in PLANT_MODELS and dimension_mismatch(model, dimension):
+    if dimension_mismatch(model, dimension):
         raise SpecError("plant.model", dimension_mismatch(model, dimension))
     if model == "omnidirectional":
         return omnidirectional_robot(disturbance)

@@ -119,7 +119,7 @@ def _merge(shape, boxes: list[tuple[np.ndarray, np.ndarray]], tolerance: float,
                     continue                    # apart: their bounding box spans a gap
                 hull = shape.box_hull(np.minimum(kept[-k][0], box[0]),
                                       np.maximum(kept[-k][1], box[1]))
-                if _acceptable(shape, *hull, tolerance, forbidden):
+                if hull is not None and _acceptable(shape, *hull, tolerance, forbidden):
                     del kept[-k]
                     box, merged = hull, True
                     break

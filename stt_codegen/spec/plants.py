@@ -62,7 +62,8 @@ MODEL_KEYS: dict[str, str] = {key: name for name, p in PLANTS.items() for key in
 
 
 def dimension_mismatch(model: str, n: int) -> str | None:
-    """Why ``model`` cannot have ``n`` states, or ``None`` if it can.
+    """Why ``model`` cannot have ``n`` states, or ``None`` if it can (or is not a known
+    model: the caller reports that).
 
     Parameters
     ----------
@@ -70,13 +71,8 @@ def dimension_mismatch(model: str, n: int) -> str | None:
         A :data:`PLANT_MODELS` entry.
     n : int
         State dimension.
-
-    Raises
-    ------
-    KeyError
-        ``model`` is not a known model.
     """
-    required = PLANTS[model].states
+    required = PLANTS[model].states if model in PLANTS else None
     if required is None or required == n:
         return None
     return f"the {model} robot has {required} states, the state space has {n}"
