@@ -31,8 +31,7 @@ def assert_valid_covering(shape, boxes, tolerance, forbidden, rng, inside_points
         for f_lo, f_hi in forbidden:        # Assumption 3, per box: misses X0 and T
             assert not (np.all(lo <= f_hi) and np.all(f_lo <= hi))
         corners = np.array(list(itertools.product(*zip(lo, hi))))
-        worst = (float(np.max(shape.distance(corners))) if isinstance(shape, Ball)
-                 else max(shape.distance(c) for c in corners))
+        worst = float(np.max(shape.distance(corners)))
         assert worst <= tolerance + 1e-12   # within the tolerance of the shape
     lows = np.array([b[0] for b in boxes])
     highs = np.array([b[1] for b in boxes])
@@ -140,3 +139,130 @@ def test_bad_shapes_name_field_and_reason(table, field, reason):
     with pytest.raises(SpecError) as info:
         parse_spec(BESIDE + "[[obstacles]]\n" + table)
     assert info.value.field == field and reason in info.value.reason, str(info.value)
+
+
+def test_too_close_to_the_start_names_the_start_set(monkeypatch):
+    """A covering refused because the shape comes close to X0 blames X0 (and not T): with
+    a budget of 20 boxes, the ball 1 micrometre from the start's corner needs 27 at
+    tolerance 0.2 (before merging), 8 without the start set."""
+    import stt_codegen.spec.covering as covering
+    ball = Ball((0.9, 0.9), 0.565684)
+    monkeypatch.setattr(covering, "MAX_BOXES", 20)
+    assert cover(ball, 0.2, [])                         # fits without the start set
+    with pytest.raises(SpecError) as info:
+        parse_spec(BESIDE + "[[obstacles]]\ncenter = [0.9, 0.9]\nradius = 0.565684\n"
+                            "tolerance = 0.2\n")
+    assert info.value.field == "obstacles[0]"
+    assert "misses the initial set" in info.value.reason, str(info.value)
+    assert "target" not in info.value.reason
+
+
+def test_a_tolerance_too_fine_for_the_shape_is_blamed_on_the_tolerance():
+    """Issue 23 item 7: a quadrilateral in mid-arena, far from the start and the target, at
+    tolerance 0.01 needs more than MAX_BOXES boxes; the message says so (it blamed the
+    initial and target sets) and comes at once (it took seconds)."""
+    quad = "[[obstacles]]\nvertices = [[1.5, 2.0], [2.5, 1.2], [3.5, 2.8], [2.2, 3.6]]\n"
+    text = arena_toml("quad", extra=BALL.replace("1.0, 1.0", "4.0, 1.0") + quad
+                      + "tolerance = 0.01\n")
+    with pytest.raises(SpecError) as info:
+        parse_spec(text)
+    assert info.value.field == "obstacles[1]", str(info.value)
+    reason = info.value.reason
+    assert "tolerance 0.01" in reason and "too fine" in reason, reason
+    assert "initial" not in reason and "target" not in reason, reason
+    spec = parse_spec(text.replace("tolerance = 0.01", "tolerance = 0.05"))
+    assert len([o for o in spec.obstacles if o.source == 1]) <= MAX_BOXES
+
+
+def _random_polygon(rng, center, radius):
+    angles = np.sort(rng.uniform(0.0, 2 * np.pi, int(rng.integers(3, 9))))
+    return center + radius * np.c_[np.cos(angles), np.sin(angles)]
+
+
+def test_polygon_box_hull_is_the_linear_programs_one():
+    """The exact planar hull of ``polygon ∩ box`` contains the LP's (up to the LP's own
+    tolerance) and is no larger than it (up to the rounding margin)."""
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        shape = make_polytope(_random_polygon(rng, rng.uniform(1, 4, 2), rng.uniform(0.1, 1.0)),
+                              "obstacles[0]")
+        lo = rng.uniform(0.0, 4.0, 2)
+        hi = lo + rng.uniform(0.0, 2.0, 2)
+        exact, lp = shape.box_hull(lo, hi), shape._box_hull_lp(lo, hi)
+        if lp is None or exact is None:
+            # both empty, or the box only grazes the polygon within the LP's tolerance
+            other = exact if lp is None else lp
+            assert other is None or np.min(other[1] - other[0]) < 1e-6
+            continue
+        assert np.all(exact[0] <= lp[0] + 1e-7) and np.all(lp[1] <= exact[1] + 1e-7)
+        assert np.all(lp[0] <= exact[0] + 1e-9) and np.all(exact[1] <= lp[1] + 1e-9)
+
+
+def test_eighty_polygons_are_covered_soundly_and_fast():
+    """Issue 23 item 7: 80 random convex polygons at tolerance 0.02 (the covering took
+    about 30 s with linear programs per box; now about 2 s on a loaded machine). Every box
+    is within the tolerance, random points of every polygon are covered, the result is the
+    same twice."""
+    import time
+    rng = np.random.default_rng(7)
+    shapes = [make_polytope(_random_polygon(rng, rng.uniform(0.9, 4.1, 2),
+                                            rng.uniform(0.05, 0.4)), "obstacles[0]")
+              for _ in range(80)]
+    forbidden = [START, (np.array([4.5, 4.5]), np.array([5.0, 5.0]))]
+    start = time.perf_counter()
+    coverings = [cover(shape, 0.02, forbidden) for shape in shapes]
+    elapsed = time.perf_counter() - start
+    assert elapsed < 10.0, elapsed           # about 2 s on a loaded 2-core machine
+    for shape, boxes in zip(shapes, coverings):
+        assert 0 < len(boxes) <= MAX_BOXES
+        pts = np.array(shape.vertices)
+
+        def in_polygon(r, pts=pts):
+            return r.dirichlet(np.ones(len(pts)), 500) @ pts
+
+        assert_valid_covering(shape, boxes, 0.02, forbidden, rng, in_polygon)
+    again = cover(shapes[0], 0.02, forbidden)
+    assert [(tuple(a), tuple(b)) for a, b in again] == [(tuple(a), tuple(b))
+                                                        for a, b in coverings[0]]
+
+
+def test_polygon_distance_is_the_quadratic_programs_one():
+    """The planar closed form (all points and edges at once) agrees with the general QP."""
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        shape = make_polytope(_random_polygon(rng, rng.uniform(1, 4, 2), rng.uniform(0.1, 1.0)),
+                              "obstacles[0]")
+        points = rng.uniform(0.0, 5.0, (30, 2))
+        closed = shape.distance(points)
+        qp = np.array([0.0 if np.all(shape.halfspaces[0] @ p <= shape.halfspaces[1] + 1e-12)
+                       else shape._qp_distance(p) for p in points])
+        assert closed.shape == (30,) and np.allclose(closed, qp, atol=1e-6)
+
+
+def eighty_polygons_toml(seed: int = 0, count: int = 80, tolerance: float = 0.02) -> str:
+    """Issue 23 item 7's spec: ``count`` random convex polygons (3-7 vertices, radius
+    0.05-0.2 m) in the 5 m x 5 m arena, start ``[0, 0.5]^2``, target ``[4.5, 5]^2``."""
+    rng = np.random.default_rng(seed)
+    extra = ""
+    for _ in range(count):
+        centre, radius = rng.uniform(0.9, 4.1, 2), rng.uniform(0.05, 0.2)
+        angles = np.sort(rng.uniform(0.0, 2 * np.pi, int(rng.integers(3, 8))))
+        points = centre + radius * np.c_[np.cos(angles), np.sin(angles)]
+        extra += ("[[obstacles]]\nvertices = [" + ", ".join(
+            f"[{float(x)!r}, {float(y)!r}]" for x, y in points) + f"]\ntolerance = {tolerance!r}\n")
+    return arena_toml("eighty-polygons", extra=extra)
+
+
+@pytest.mark.slow
+def test_eighty_polygons_design_in_seconds():
+    """Issue 23 item 7: the whole design of 80 polygons at tolerance 0.02 (about 1300
+    boxes) took 91 s, nearly all of it the covering; now a few seconds (bound generous
+    for a loaded machine)."""
+    import time
+    start = time.perf_counter()
+    spec = parse_spec(eighty_polygons_toml())
+    found = design_tube(spec)
+    elapsed = time.perf_counter() - start
+    assert len(spec.unsafe_sets) == 80 and len(spec.obstacles) > 80
+    assert found.check.passed
+    assert elapsed < 30.0, elapsed

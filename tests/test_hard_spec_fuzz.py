@@ -183,7 +183,9 @@ def test_high_dimensional_shapes_are_bounded(shape, n, monkeypatch):
     to the accepted-or-pending count, which stays within ``MAX_BOXES``) and measures the
     distance from the shape at one point per box for a ball (its farthest corner) and at
     the ``2^k`` corners for a polytope, whose dimension ``k`` is at most
-    ``MAX_POLYTOPE_DIMENSION`` (larger ones are refused before any covering).
+    ``MAX_POLYTOPE_DIMENSION`` (larger ones are refused before any covering). A refusal
+    is explained by one more covering (without the forbidden boxes): at most three
+    coverings for the two loads.
     """
     evaluated: list[int] = []
     for cls in (Ball, Polytope):
@@ -197,7 +199,7 @@ def test_high_dimensional_shapes_are_bounded(shape, n, monkeypatch):
         assert evaluated == []
         return
     per_box = 1 if shape == "ball" else 2 ** n
-    assert 0 < sum(evaluated) <= 2 * (2 * MAX_BOXES + 1) * per_box
+    assert 0 < sum(evaluated) <= 3 * (2 * MAX_BOXES + 1) * per_box
 
 
 FUZZED_FILES = [

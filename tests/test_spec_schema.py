@@ -3,6 +3,7 @@ it accepts the bundled specs and rejects what the loader rejects structurally.""
 
 from __future__ import annotations
 
+import copy
 import json
 import math
 import tomllib
@@ -126,3 +127,40 @@ def test_a_spec_from_a_dict_is_the_spec_from_its_file():
     with pytest.raises(SpecError) as info:
         Spec.from_dict([("name", "x")])
     assert info.value.field == "" and "table" in info.value.reason
+
+
+def test_numpy_arrays_and_scalars_are_accepted_where_lists_and_numbers_are():
+    """``Spec.from_dict`` takes numpy arrays for lists (also nested: vertices, matrices)
+    and numpy scalars for numbers: the same Spec, and hash, as the plain document."""
+    import numpy as np
+
+    from stt_codegen import Spec
+    plain = tomllib.loads(arena_toml("numpy", extra=(
+        "[[obstacles]]\nvertices = [[2.0, 2.0], [3.0, 2.0], [2.5, 3.0]]\n"
+        "[[obstacles]]\ncenter = [1.0, 3.5]\nradius = 0.3\ndims = [0, 1]\n"
+        "[plant]\nmodel = \"linear\"\na = [[0.0, 1.0], [0.0, 0.0]]\nc = [0.1, 0.0]\n"
+        "[assumptions]\ninput_gain = [0.5, 2.0]\n")))
+    arrays = copy.deepcopy(plain)
+    arrays["prescribed_time"] = np.float64(9.0)
+    arrays["state_space"] = {k: np.array(v) for k, v in plain["state_space"].items()}
+    arrays["initial"]["upper"] = np.array([0.5, 0.5], dtype=np.float32)
+    arrays["target"] = {k: np.array(v) for k, v in plain["target"].items()}
+    arrays["obstacles"][0]["vertices"] = np.array(plain["obstacles"][0]["vertices"])
+    arrays["obstacles"][1]["radius"] = np.float64(0.3)
+    arrays["obstacles"][1]["dims"] = np.arange(2)                     # int64 indices
+    arrays["plant"]["a"] = np.array(plain["plant"]["a"])
+    arrays["plant"]["c"] = np.array(plain["plant"]["c"])
+    arrays["assumptions"]["input_gain"] = np.array([0.5, 2.0])
+    expected = Spec.from_dict(plain)
+    spec = Spec.from_dict(arrays)
+    assert spec == expected and spec.source_hash == expected.source_hash
+    assert spec.linear_plant.a == ((0.0, 1.0), (0.0, 0.0))
+    assert all(type(v) is float for v in spec.state_space.lower + spec.initial_set.upper)
+    # an integer scalar is a number too; a numpy boolean is not, as a Python one is not
+    assert Spec.from_dict({**plain, "prescribed_time": np.int64(9)}) == expected
+    with pytest.raises(SpecError) as info:
+        Spec.from_dict({**plain, "prescribed_time": np.bool_(True)})
+    assert info.value.field == "prescribed_time" and "must be a number" in info.value.reason
+    with pytest.raises(SpecError) as info:      # the array's shape is still checked
+        Spec.from_dict({**plain, "state_space": {"lower": np.zeros(3), "upper": np.ones(3)}})
+    assert info.value.field == "initial.lower" and "must have 3 entries" in info.value.reason

@@ -141,3 +141,43 @@ def test_infinite_number_in_array():
     with pytest.raises(SpecError) as info:
         parse_spec(replace("[initial]\nlower = [0.0, 0.0]", "[initial]\nlower = [-inf, 0.0]"))
     assert info.value.field == "initial.lower[0]" and "finite" in info.value.reason
+
+
+def test_plant_state_counts_come_from_the_one_registry():
+    """A model that requires a state count is refused on another one, with the registry's
+    reason, by the loader, by the simulation's plant factory and by ``verify --plant``."""
+    from stt_codegen.runtime.plants import make_plant
+    from stt_codegen.spec.plants import PLANTS, dimension_mismatch
+    from stt_codegen.verify.command import verify
+    fixed = [p for p in PLANTS.values() if p.states is not None]
+    assert fixed and all(dimension_mismatch(p.name, p.states) is None for p in fixed)
+    two_states = parse_spec(VALID)
+    for plant in fixed:
+        n = 2 if plant.states != 2 else 3
+        reason = dimension_mismatch(plant.name, n)
+        assert f"has {plant.states} states" in reason and str(n) in reason
+        if n == 2:
+            with pytest.raises(SpecError) as info:
+                parse_spec(VALID + f'\n[plant]\nmodel = "{plant.name}"\n')
+            assert (info.value.field, info.value.reason) == ("plant.model", reason)
+            with pytest.raises(SpecError) as info:
+                verify(two_states, plant=plant.name)
+            assert (info.value.field, info.value.reason) == ("plant", reason)
+        with pytest.raises(SpecError) as info:
+            make_plant(plant.name, n, 0.1)
+        assert (info.value.field, info.value.reason) == ("plant.model", reason)
+
+
+@pytest.mark.parametrize("text, field, reason", [
+    (replace("lower = [0.0, 0.0]\nupper = [5.0, 5.0]",
+             "lower = [" + ", ".join(["0.0"] * 65) + "]\nupper = [" + ", ".join(["5.0"] * 65)
+             + "]"), "state_space.lower", "65 dimensions; at most 64"),
+    (VALID + "[[obstacles]]\nlower = [2.0, 2.0]\nupper = [3.0, 3.0]\n" * 4096, "obstacles",
+     "4097 obstacles; at most 4096"),
+    (VALID + "[[obstacles]]\nvertices = [" + ", ".join(["[1.0, 2.0]"] * 1025) + "]\n",
+     "obstacles[1].vertices", "1025 vertices; at most 1024"),
+], ids=["dimensions", "obstacles", "vertices"])
+def test_size_limits_name_what_is_counted(text, field, reason):
+    with pytest.raises(SpecError) as info:
+        parse_spec(text)
+    assert (info.value.field, info.value.reason) == (field, reason)

@@ -25,10 +25,9 @@ from typing import Sequence
 import casadi as ca
 import numpy as np
 
-__all__ = ["NAMED_MODELS", "input_matrix", "linear_rhs", "plant_function", "plant_rhs"]
+from ..spec.plants import NAMED_MODELS, dimension_mismatch
 
-#: Plants with a fixed model (``plant.model`` values other than ``"linear"``).
-NAMED_MODELS = ("omnidirectional", "single-integrator")
+__all__ = ["NAMED_MODELS", "input_matrix", "linear_rhs", "plant_function", "plant_rhs"]
 
 
 def _g(model: str, x):
@@ -41,8 +40,8 @@ def _g(model: str, x):
 
 
 def _dimension(model: str, n: int) -> None:
-    if model == "omnidirectional" and n != 3:
-        raise ValueError("the omnidirectional robot has 3 states")
+    if dimension_mismatch(model, n):
+        raise ValueError(dimension_mismatch(model, n))
 
 
 @lru_cache(maxsize=None)

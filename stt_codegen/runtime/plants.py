@@ -15,6 +15,7 @@ import numpy as np
 from ..codegen.emit import python_function
 from ..errors import SpecError
 from ..spec.loader import LinearPlant
+from ..spec.plants import PLANTS, dimension_mismatch
 from .dynamics import linear_rhs, plant_rhs
 
 #: Number of sinusoids summed in each disturbance component.
@@ -58,9 +59,10 @@ def omnidirectional_robot(disturbance: Disturbance) -> ct.NonlinearIOSystem:
     in the robot frame (m/s, rad/s); outputs the state. ``R(x3) u`` is
     :func:`.dynamics.plant_rhs` (``"omnidirectional"``).
     """
-    return _plant(plant_rhs("omnidirectional", 3), disturbance, inputs=["v1", "v2", "omega"],
-                        states=["x1", "x2", "x3"], outputs=["x1", "x2", "x3"],
-                        name="omnidirectional_robot")
+    robot = PLANTS["omnidirectional"]
+    states = [f"x{i + 1}" for i in range(robot.states)]
+    return _plant(plant_rhs(robot.name, robot.states), disturbance, inputs=list(robot.inputs),
+                  states=states, outputs=states, name="omnidirectional_robot")
 
 
 def single_integrator(dimension: int, disturbance: Disturbance) -> ct.NonlinearIOSystem:
@@ -106,7 +108,7 @@ def make_plant(model: str, dimension: int, amplitude: float, seed: int = 0,
     Parameters
     ----------
     model : str
-        One of :data:`stt_codegen.spec.loader.PLANT_MODELS`.
+        One of :data:`stt_codegen.spec.plants.PLANT_MODELS`.
     dimension : int
     amplitude : float
         Bound on every ``|w_i|`` (:class:`Disturbance`).
@@ -127,9 +129,9 @@ def make_plant(model: str, dimension: int, amplitude: float, seed: int = 0,
         if len(linear.c) != dimension:
             raise SpecError("plant.c", f"has {len(linear.c)} entries for {dimension} states")
         return linear_plant(linear.a, linear.g, linear.c, disturbance)
+    if dimension_mismatch(model, dimension):
+        raise SpecError("plant.model", dimension_mismatch(model, dimension))
     if model == "omnidirectional":
-        if dimension != 3:
-            raise SpecError("plant.model", "the omnidirectional robot has 3 states")
         return omnidirectional_robot(disturbance)
     if model == "single-integrator":
         return single_integrator(dimension, disturbance)

@@ -1,9 +1,22 @@
 """Problem specification: one prescribed-time reach-avoid-stay task (Definition 2.1).
 
+<<<<<<< HEAD
 A spec is a TOML file with a fixed schema (docs/spec-format.md). :func:`load_spec`
 reads a bundled case by name or a file by path, validates every field and
 returns a frozen :class:`Spec`. Every rejection is a :class:`SpecError` naming
 the field and the reason.
+=======
+A spec is a TOML file with a fixed schema (see the README). :func:`load_spec`
+reads a bundled case by name or a file by path, validates it and returns a frozen
+:class:`Spec`. Every rejection is a :class:`SpecError` naming the field and the reason.
+
+One validation path: the schema (:mod:`.schema`, pydantic) checks every key, type, sign
+and enum and fills in the defaults; this module builds the :class:`Spec` from the
+validated :class:`~.schema.SpecDocument` and checks only the rules that relate fields to
+each other (lengths equal to the state dimension, boxes inside boxes, points in
+interiors, obstacles against the start and the target, a plant model's state count from
+:mod:`.plants`).
+>>>>>>> spec
 """
 
 from __future__ import annotations
@@ -20,29 +33,13 @@ from typing import Any
 
 from ..cases import bundled_cases, bundled_spec_bytes
 from ..errors import SpecError
-from .schema import (NAME_REGEX, PLANT_MODELS, TUBE_METHODS, AssumptionsTable, ControllerTable,
-                     PlantTable, TubeTable, check_document, key_name)
+from .plants import MODEL_KEYS, dimension_mismatch
+from .schema import (NAME_REGEX, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
+                     PlantTable, PolytopeObstacle, check_document, value_kind)
 
 NAME_PATTERN = re.compile(NAME_REGEX)
 #: Fraction of the available room used by the default half-widths ``d_0`` and ``d_T``.
 DEFAULT_HALF_WIDTH_FRACTION = 0.8
-#: Largest state dimension accepted (the generated code unrolls per dimension).
-MAX_DIMENSION = 64
-MAX_OBSTACLES = 4096
-
-_TOP_KEYS = {"name", "prescribed_time", "state_space", "initial", "target", "obstacles",
-             "tube", "controller", "plant", "assumptions"}
-_REQUIRED_TOP = ("name", "prescribed_time", "state_space", "initial", "target")
-# the defaults are the schema's (spec/schema.py), so that editors show the same ones
-# circumvent_sharpness (automatic when omitted) and method are not plain numbers
-_TUBE_DEFAULTS = {k: f.default for k, f in TubeTable.model_fields.items()
-                  if k not in ("circumvent_sharpness", "method")}
-_CONTROLLER_DEFAULTS: dict[str, float | None] = {
-    k: f.default for k, f in ControllerTable.model_fields.items()}
-_PLANT_DEFAULTS: dict[str, Any] = {k: f.default for k, f in PlantTable.model_fields.items()}
-#: Keys of ``[plant]`` that only the ``linear`` model takes.
-_LINEAR_KEYS = ("a", "g", "c")
-_ASSUMPTION_KEYS = tuple(AssumptionsTable.model_fields)
 
 
 @dataclass(frozen=True)
@@ -324,7 +321,13 @@ class Spec:
         data : mapping
             The spec's tables as nested dicts and lists, exactly as :mod:`tomllib` would
             read the file: ``{"name": ..., "prescribed_time": ..., "state_space":
+<<<<<<< HEAD
             {"lower": [...], "upper": [...]}, ...}`` (see docs/spec-format.md).
+=======
+            {"lower": [...], "upper": [...]}, ...}`` (see the README's *Spec format*).
+            Tuples and numpy arrays are accepted wherever a list is, numpy scalars
+            wherever a number is.
+>>>>>>> spec
 
         Returns
         -------
@@ -338,7 +341,7 @@ class Spec:
             As :func:`load_spec`: the field and the reason.
         """
         if not isinstance(data, Mapping):
-            raise SpecError("", f"a spec is a table (dict), got {_kind(data)}")
+            raise SpecError("", f"a spec is a table (dict), got {value_kind(data)}")
         try:
             doc = _as_document(data)
         except RecursionError:
@@ -412,9 +415,12 @@ def parse_spec(data: bytes | str) -> Spec:
 
 
 def _as_document(value: Any) -> Any:
-    """A Python value as TOML would read it: mappings as dicts, tuples as lists."""
+    """A Python value as TOML would read it: mappings as dicts, tuples and numpy arrays as
+    lists, numpy scalars as Python numbers."""
     if isinstance(value, Mapping):
         return {k: _as_document(v) for k, v in value.items()}
+    if type(value).__module__ == "numpy" and hasattr(value, "tolist"):
+        value = value.tolist()      # an array to nested lists, a scalar to int/float/bool
     if isinstance(value, (list, tuple)):
         return [_as_document(v) for v in value]
     return value
@@ -425,78 +431,64 @@ def _replace_hash(spec: Spec, digest: str) -> Spec:
     return replace(spec, source_hash=digest)
 
 
-# --------------------------------------------------------------------------- field readers
+# --------------------------------------------------------------------------- validation
+# Only rules that relate fields to each other: the schema has checked every key, type,
+# sign and enum (spec/schema.py), and given the defaults.
 
 
-def _table(doc: dict, key: str, required: bool, allowed: set[str], where: str = "") -> dict:
-    name = f"{where}{key}"
-    if key not in doc:
-        if required:
-            raise SpecError(name, "missing")
-        return {}
-    value = doc[key]
-    if not isinstance(value, dict):
-        raise SpecError(name, f"must be a table, got {_kind(value)}")
-    _no_unknown(value, allowed, name)
-    return value
+def _validate(raw: dict) -> Spec:
+    doc = check_document(raw)
+    state_space = _box(doc.state_space, "state_space", None)
+    n = len(state_space.lower)
+
+    initial_set = _box(doc.initial, "initial", n)
+    if not state_space.contains_box(initial_set):
+        raise SpecError("initial", "the initial set is not inside the state space")
+    x0 = (_vector(doc.initial.state, "initial.state", n) if doc.initial.state is not None
+          else initial_set.center)
+    _interior(x0, initial_set, "initial.state", "initial set")
+    d0 = _half_width(doc.initial.half_width, "initial", x0, initial_set, "initial set")
+
+    target_set = _box(doc.target, "target", n)
+    if not state_space.contains_box(target_set):
+        raise SpecError("target", "the target set is not inside the state space")
+    eta = (_vector(doc.target.center, "target.center", n) if doc.target.center is not None
+           else target_set.center)
+    _interior(eta, target_set, "target.center", "target set")
+    d_t = _half_width(doc.target.half_width, "target", eta, target_set, "target set")
+
+    unsafe_sets = tuple(_unsafe_set(table, f"obstacles[{j}]", state_space)
+                        for j, table in enumerate(doc.obstacles))
+    obstacles = _cover_all(unsafe_sets, state_space, initial_set, target_set)
+
+    model = doc.plant.model
+    mismatch = dimension_mismatch(model, n)
+    if mismatch:
+        raise SpecError("plant.model", mismatch)
+    amplitude = doc.plant.disturbance_amplitude
+    tube = TubeParameters(**doc.tube.model_dump())
+    return Spec(name=doc.name, prescribed_time=doc.prescribed_time, state_space=state_space,
+                initial_set=initial_set, initial_state=x0, initial_half_width=d0,
+                target_set=target_set, target_center=eta, target_half_width=d_t,
+                obstacles=obstacles, unsafe_sets=unsafe_sets, tube=tube,
+                gain=doc.controller.gain, rate_hz=doc.controller.rate_hz,
+                plant_model=model, disturbance_amplitude=amplitude,
+                linear_plant=_linear_plant(doc.plant, n),
+                assumptions=_assumptions(doc.assumptions, n, amplitude),
+                target_half_width_given=doc.target.half_width is not None)
 
 
-def _no_unknown(table: dict, allowed: set[str], where: str) -> None:
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        prefix = f"{where}." if where else ""
-        raise SpecError(f"{prefix}{key_name(unknown[0])}",
-                        f"unknown key (allowed: {', '.join(sorted(allowed))})")
-
-
-def _kind(value: Any) -> str:
-    return {bool: "a boolean", str: "a string", list: "an array", dict: "a table",
-            int: "an integer", float: "a float"}.get(type(value), type(value).__name__)
-
-
-def _number(value: Any, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise SpecError(name, f"must be a number, got {_kind(value)}")
-    if isinstance(value, int) and abs(value) > 10**12:
-        # before float(): tomllib reads integers of any length, float() overflows
-        raise SpecError(name, f"magnitude {_short(value)} is beyond 1e12")
-    number = float(value)
-    if not math.isfinite(number):
-        raise SpecError(name, f"must be finite, got {value!r}")
-    if abs(number) > 1e12:
-        raise SpecError(name, f"magnitude {value!r} is beyond 1e12")
-    return number
-
-
-def _short(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 40 else f"{text[:20]}...({len(text)} characters)"
-
-
-def _positive(value: Any, name: str) -> float:
-    number = _number(value, name)
-    if number <= 0:
-        raise SpecError(name, f"must be positive, got {value!r}")
-    return number
-
-
-def _vector(value: Any, name: str, length: int | None) -> tuple[float, ...]:
-    if not isinstance(value, list):
-        raise SpecError(name, f"must be an array of numbers, got {_kind(value)}")
+def _vector(value: list[float], name: str, length: int | None) -> tuple[float, ...]:
+    """A validated list of numbers, of ``length`` entries (one per state dimension)."""
     if length is not None and len(value) != length:
         raise SpecError(name, f"must have {length} entries (one per state dimension), "
                               f"got {len(value)}")
-    if not value:
-        raise SpecError(name, "must not be empty")
-    return tuple(_number(v, f"{name}[{k}]") for k, v in enumerate(value))
+    return tuple(value)
 
 
-def _box(table: dict, name: str, length: int | None) -> Box:
-    for key in ("lower", "upper"):
-        if key not in table:
-            raise SpecError(f"{name}.{key}", "missing")
-    lower = _vector(table["lower"], f"{name}.lower", length)
-    upper = _vector(table["upper"], f"{name}.upper", len(lower))
+def _box(table: BoxTable | BoxObstacle, name: str, length: int | None) -> Box:
+    lower = _vector(table.lower, f"{name}.lower", length)
+    upper = _vector(table.upper, f"{name}.upper", len(lower))
     for k, (a, b) in enumerate(zip(lower, upper)):
         if a > b:
             raise SpecError(f"{name}.lower", f"lower[{k}] = {a!r} exceeds upper[{k}] = {b!r}")
@@ -505,12 +497,19 @@ def _box(table: dict, name: str, length: int | None) -> Box:
     return Box(lower, upper)
 
 
-def _half_width(table: dict, name: str, center: tuple[float, ...], box: Box,
+def _interior(point: tuple[float, ...], box: Box, name: str, label: str) -> None:
+    for k, (v, a, b) in enumerate(zip(point, box.lower, box.upper)):
+        if not a < v < b:
+            raise SpecError(name, f"entry {k} = {v!r} is not in the interior ({a!r}, {b!r}) "
+                                  f"of the {label}")
+
+
+def _half_width(value: list[float] | None, name: str, center: tuple[float, ...], box: Box,
                 label: str) -> tuple[float, ...]:
     room = tuple(min(c - a, b - c) for c, a, b in zip(center, box.lower, box.upper))
-    if "half_width" not in table:
+    if value is None:
         return tuple(DEFAULT_HALF_WIDTH_FRACTION * r for r in room)
-    width = _vector(table["half_width"], f"{name}.half_width", len(center))
+    width = _vector(value, f"{name}.half_width", len(center))
     for k, (d, r) in enumerate(zip(width, room)):
         if d <= 0:
             raise SpecError(f"{name}.half_width", f"entry {k} must be positive, got {d!r}")
@@ -521,186 +520,63 @@ def _half_width(table: dict, name: str, center: tuple[float, ...], box: Box,
     return width
 
 
-# --------------------------------------------------------------------------- validation
-
-
-def _validate(doc: dict) -> Spec:
-    check_document(doc)     # types, known keys, finite numbers (spec/schema.py)
-    _no_unknown(doc, _TOP_KEYS, "")
-    for key in _REQUIRED_TOP:
-        if key not in doc:
-            raise SpecError(key, "missing")
-
-    name = doc["name"]
-    if not isinstance(name, str):
-        raise SpecError("name", f"must be a string, got {_kind(name)}")
-    if not NAME_PATTERN.fullmatch(name):
-        raise SpecError("name", f"{name!r} is not an identifier: it must match "
-                                "[A-Za-z][A-Za-z0-9_-]* and be at most 64 characters")
-    t_c = _positive(doc["prescribed_time"], "prescribed_time")
-
-    space_t = _table(doc, "state_space", True, {"lower", "upper"})
-    state_space = _box(space_t, "state_space", None)
-    n = len(state_space.lower)
-    if n > MAX_DIMENSION:
-        raise SpecError("state_space.lower", f"{n} dimensions; at most {MAX_DIMENSION}")
-
-    init_t = _table(doc, "initial", True, {"lower", "upper", "state", "half_width"})
-    initial_set = _box(init_t, "initial", n)
-    if not state_space.contains_box(initial_set):
-        raise SpecError("initial", "the initial set is not inside the state space")
-    if "state" in init_t:
-        x0 = _vector(init_t["state"], "initial.state", n)
-    else:
-        x0 = initial_set.center
-    for k, (v, a, b) in enumerate(zip(x0, initial_set.lower, initial_set.upper)):
-        if not a < v < b:
-            raise SpecError("initial.state", f"entry {k} = {v!r} is not in the interior "
-                                             f"({a!r}, {b!r}) of the initial set")
-    d0 = _half_width(init_t, "initial", x0, initial_set, "initial set")
-
-    target_t = _table(doc, "target", True, {"lower", "upper", "center", "half_width"})
-    target_set = _box(target_t, "target", n)
-    if not state_space.contains_box(target_set):
-        raise SpecError("target", "the target set is not inside the state space")
-    eta = (_vector(target_t["center"], "target.center", n) if "center" in target_t
-           else target_set.center)
-    for k, (v, a, b) in enumerate(zip(eta, target_set.lower, target_set.upper)):
-        if not a < v < b:
-            raise SpecError("target.center", f"entry {k} = {v!r} is not in the interior "
-                                             f"({a!r}, {b!r}) of the target set")
-    d_t = _half_width(target_t, "target", eta, target_set, "target set")
-
-    unsafe_sets = _unsafe_sets(doc.get("obstacles", []), state_space)
-    obstacles = _cover_all(unsafe_sets, state_space, initial_set, target_set)
-
-    tube_t = _table(doc, "tube", False, set(_TUBE_DEFAULTS) | {"circumvent_sharpness",
-                                                               "method"})
-    method = tube_t.get("method", "auto")
-    if not isinstance(method, str) or method not in TUBE_METHODS:
-        raise SpecError("tube.method", f"must be one of {', '.join(TUBE_METHODS)}, "
-                                       f"got {method!r}")
-    sharpness = (_positive(tube_t["circumvent_sharpness"], "tube.circumvent_sharpness")
-                 if "circumvent_sharpness" in tube_t else None)
-    tube = TubeParameters(**{key: _positive(tube_t.get(key, default), f"tube.{key}")
-                             for key, default in _TUBE_DEFAULTS.items()},
-                          circumvent_sharpness=sharpness, method=method)
-
-    ctrl_t = _table(doc, "controller", False, set(_CONTROLLER_DEFAULTS))
-    gain = _positive(ctrl_t["gain"], "controller.gain") if "gain" in ctrl_t else None
-    rate_hz = _positive(ctrl_t.get("rate_hz", _CONTROLLER_DEFAULTS["rate_hz"]),
-                        "controller.rate_hz")
-
-    plant_t = _table(doc, "plant", False, set(_PLANT_DEFAULTS) | set(_LINEAR_KEYS))
-    model = plant_t.get("model", _PLANT_DEFAULTS["model"])
-    if not isinstance(model, str) or model not in PLANT_MODELS:
-        raise SpecError("plant.model", f"must be one of {', '.join(PLANT_MODELS)}, "
-                                       f"got {model!r}")
-    if model == "omnidirectional" and n != 3:
-        raise SpecError("plant.model", f"the omnidirectional robot (eq. 14) has 3 states, "
-                                       f"the state space has {n}")
-    amplitude = _number(plant_t.get("disturbance_amplitude",
-                                    _PLANT_DEFAULTS["disturbance_amplitude"]),
-                        "plant.disturbance_amplitude")
-    if amplitude < 0:
-        raise SpecError("plant.disturbance_amplitude", f"must be non-negative, got {amplitude!r}")
-    linear = _linear_plant(plant_t, model, n)
-    assumptions = _assumptions(_table(doc, "assumptions", False, set(_ASSUMPTION_KEYS)),
-                               n, amplitude)
-
-    return Spec(name=name, prescribed_time=t_c, state_space=state_space,
-                initial_set=initial_set, initial_state=x0, initial_half_width=d0,
-                target_set=target_set, target_center=eta, target_half_width=d_t,
-                obstacles=obstacles, unsafe_sets=unsafe_sets, tube=tube, gain=gain,
-                rate_hz=rate_hz,
-                plant_model=model, disturbance_amplitude=amplitude, linear_plant=linear,
-                assumptions=assumptions,
-                target_half_width_given="half_width" in target_t)
-
-
-def _matrix(value: Any, name: str, n: int) -> tuple[tuple[float, ...], ...]:
+def _matrix(rows: list[list[float]], name: str, n: int) -> tuple[tuple[float, ...], ...]:
     """An n x n matrix given as a list of n rows of n numbers."""
-    if not isinstance(value, list) or not all(isinstance(row, list) for row in value):
-        raise SpecError(name, f"must be an array of {n} rows (arrays of {n} numbers), "
-                              f"got {_kind(value)}")
-    if len(value) != n:
-        raise SpecError(name, f"must have {n} rows (one per state dimension), got {len(value)}")
-    return tuple(_vector(row, f"{name}[{k}]", n) for k, row in enumerate(value))
+    if len(rows) != n:
+        raise SpecError(name, f"must have {n} rows (one per state dimension), got {len(rows)}")
+    return tuple(_vector(row, f"{name}[{k}]", n) for k, row in enumerate(rows))
 
 
-def _linear_plant(table: dict, model: str, n: int) -> LinearPlant | None:
+def _linear_plant(table: PlantTable, n: int) -> LinearPlant | None:
     """The matrices ``a``, ``g``, ``c`` of ``[plant]``; only the ``linear`` model takes them."""
-    given = [key for key in _LINEAR_KEYS if key in table]
-    if model != "linear":
-        if given:
-            raise SpecError(f"plant.{given[0]}", f"only the linear model takes a matrix "
-                                                 f"(plant.model is {model!r})")
+    for key, owner in MODEL_KEYS.items():
+        if getattr(table, key) is not None and owner != table.model:
+            raise SpecError(f"plant.{key}", f"only the {owner} model takes {key} "
+                                            f"(plant.model is {table.model!r})")
+    if table.model != "linear":
         return None
     identity = tuple(tuple(1.0 if i == j else 0.0 for j in range(n)) for i in range(n))
     zero = tuple(tuple(0.0 for _ in range(n)) for _ in range(n))
-    a = _matrix(table["a"], "plant.a", n) if "a" in table else zero
-    g = _matrix(table["g"], "plant.g", n) if "g" in table else identity
-    c = _vector(table["c"], "plant.c", n) if "c" in table else tuple(0.0 for _ in range(n))
+    a = _matrix(table.a, "plant.a", n) if table.a is not None else zero
+    g = _matrix(table.g, "plant.g", n) if table.g is not None else identity
+    c = _vector(table.c, "plant.c", n) if table.c is not None else tuple(0.0 for _ in range(n))
     return LinearPlant(a, g, c)
 
 
-def _non_negative(value: Any, name: str) -> float:
-    number = _number(value, name)
-    if number < 0:
-        raise SpecError(name, f"must be non-negative, got {value!r}")
-    return number
-
-
-def _assumptions(table: dict, n: int, amplitude: float) -> Assumptions:
+def _assumptions(table: AssumptionsTable, n: int, amplitude: float) -> Assumptions:
     """``[assumptions]`` with its defaults (see :class:`Assumptions`)."""
-    g_min, g_max = 1.0, 1.0
-    if "input_gain" in table:
-        value = table["input_gain"]
-        if not isinstance(value, list) or len(value) != 2:
-            raise SpecError("assumptions.input_gain", "must be an array [g_min, g_max] of two "
-                                                      f"numbers, got {_short(value)}")
-        g_min, g_max = (_number(v, f"assumptions.input_gain[{k}]") for k, v in enumerate(value))
-        if g_min <= 0:
-            raise SpecError("assumptions.input_gain", f"g_min = {g_min!r} must be positive "
-                                                      "(Assumption 2)")
-        if g_min > g_max:
-            raise SpecError("assumptions.input_gain", f"g_min = {g_min!r} exceeds "
-                                                      f"g_max = {g_max!r}")
-    skew = _non_negative(table.get("input_gain_skew", 0.0), "assumptions.input_gain_skew")
+    g_min, g_max = table.input_gain if table.input_gain is not None else (1.0, 1.0)
+    if g_min <= 0:
+        raise SpecError("assumptions.input_gain", f"g_min = {g_min!r} must be positive "
+                                                  "(Assumption 2)")
+    if g_min > g_max:
+        raise SpecError("assumptions.input_gain", f"g_min = {g_min!r} exceeds g_max = {g_max!r}")
+    skew = table.input_gain_skew
     implied = 0.5 * (g_max - g_min) + skew
-    coupling = _non_negative(table.get("input_gain_coupling", implied),
-                             "assumptions.input_gain_coupling")
-    if coupling > implied:
-        coupling = implied          # the other bounds already imply a smaller one
-    drift = _non_negative(table.get("drift_bound", 0.0), "assumptions.drift_bound")
-    disturbance = _non_negative(table.get("disturbance_bound", math.sqrt(n) * amplitude),
-                                "assumptions.disturbance_bound")
-    return Assumptions((g_min, g_max), skew, coupling, drift, disturbance,
-                       tuple(key for key in _ASSUMPTION_KEYS if key in table))
+    coupling = implied if table.input_gain_coupling is None else table.input_gain_coupling
+    coupling = min(coupling, implied)       # the other bounds already imply a smaller one
+    disturbance = (math.sqrt(n) * amplitude if table.disturbance_bound is None
+                   else table.disturbance_bound)
+    return Assumptions((g_min, g_max), skew, coupling, table.drift_bound, disturbance,
+                       tuple(key for key in AssumptionsTable.model_fields
+                             if key in table.model_fields_set))
 
 
-#: Default covering tolerance of balls and polytopes, state units.
-DEFAULT_COVERING_TOLERANCE = 0.05
-_BOX_KEYS = {"lower", "upper", "dims"}
-_BALL_KEYS = {"center", "radius", "dims", "tolerance"}
-_POLYTOPE_KEYS = {"vertices", "dims", "tolerance"}
-
-
-def _dims(table: dict, name: str, m: int, n: int, coordinates: str) -> tuple[int, ...]:
+def _dims(given: list[int] | None, name: str, m: int, n: int,
+          coordinates: str) -> tuple[int, ...]:
     if m > n:
         raise SpecError(f"{name}.{coordinates}", f"{m} entries for a {n}-dimensional "
                                                  "state space")
-    if "dims" not in table:
+    if given is None:
         return tuple(range(m))
-    dims_v = table["dims"]
-    if not isinstance(dims_v, list) or len(dims_v) != m:
+    if len(given) != m:
         raise SpecError(f"{name}.dims", f"must be an array of {m} dimension indices")
-    for d in dims_v:
-        if isinstance(d, bool) or not isinstance(d, int) or not 0 <= d < n:
+    for d in given:
+        if not d < n:
             raise SpecError(f"{name}.dims", f"{d!r} is not a dimension index in 0..{n - 1}")
-    if len(set(dims_v)) != m:
+    if len(set(given)) != m:
         raise SpecError(f"{name}.dims", "repeats a dimension")
-    return tuple(dims_v)
+    return tuple(given)
 
 
 def _inside(lower, upper, dims, state_space: Box, name: str) -> None:
@@ -710,51 +586,26 @@ def _inside(lower, upper, dims, state_space: Box, name: str) -> None:
                                   "is not inside the state space")
 
 
-def _unsafe_sets(value: Any, state_space: Box) -> tuple[UnsafeSet, ...]:
+def _unsafe_set(table: BoxObstacle | BallObstacle | PolytopeObstacle, name: str,
+                state_space: Box) -> UnsafeSet:
     from .shapes import Ball, make_polytope
     n = len(state_space.lower)
-    if not isinstance(value, list):
-        raise SpecError("obstacles", f"must be an array of tables, got {_kind(value)}")
-    if len(value) > MAX_OBSTACLES:
-        raise SpecError("obstacles", f"{len(value)} obstacles; at most {MAX_OBSTACLES}")
-    result = []
-    for j, table in enumerate(value):
-        name = f"obstacles[{j}]"
-        if not isinstance(table, dict):
-            raise SpecError(name, f"must be a table, got {_kind(table)}")
-        if "vertices" in table:
-            _no_unknown(table, _POLYTOPE_KEYS, name)
-            verts = table["vertices"]
-            if not isinstance(verts, list) or not verts or not all(isinstance(v, list)
-                                                                   for v in verts):
-                raise SpecError(f"{name}.vertices", "must be an array of points (arrays)")
-            if len(verts) > 1024:
-                raise SpecError(f"{name}.vertices", f"{len(verts)} vertices; at most 1024")
-            m = len(verts[0]) if isinstance(verts[0], list) else 0
-            points = [_vector(v, f"{name}.vertices[{k}]", m) for k, v in enumerate(verts)]
-            dims = _dims(table, name, m, n, "vertices")
-            shape = make_polytope([list(p) for p in points], name)
-        elif "center" in table or "radius" in table:
-            _no_unknown(table, _BALL_KEYS, name)
-            for key in ("center", "radius"):
-                if key not in table:
-                    raise SpecError(f"{name}.{key}", "missing")
-            center = _vector(table["center"], f"{name}.center", None)
-            dims = _dims(table, name, len(center), n, "center")
-            shape = Ball(center, _positive(table["radius"], f"{name}.radius"))
-        else:
-            _no_unknown(table, _BOX_KEYS, name)
-            box = _box(table, name, None)
-            dims = _dims(table, name, len(box.lower), n, "lower")
-            _inside(box.lower, box.upper, dims, state_space, name)
-            result.append(UnsafeSet("box", dims, box))
-            continue
-        _inside(shape.lower, shape.upper, dims, state_space, name)
-        tolerance = _positive(table.get("tolerance", DEFAULT_COVERING_TOLERANCE),
-                              f"{name}.tolerance")
-        result.append(UnsafeSet("ball" if isinstance(shape, Ball) else "polytope", dims,
-                                shape, tolerance))
-    return tuple(result)
+    if isinstance(table, BoxObstacle):
+        box = _box(table, name, None)
+        dims = _dims(table.dims, name, len(box.lower), n, "lower")
+        _inside(box.lower, box.upper, dims, state_space, name)
+        return UnsafeSet("box", dims, box)
+    if isinstance(table, PolytopeObstacle):
+        m = len(table.vertices[0])
+        points = [_vector(v, f"{name}.vertices[{k}]", m) for k, v in enumerate(table.vertices)]
+        dims = _dims(table.dims, name, m, n, "vertices")
+        shape: Any = make_polytope([list(p) for p in points], name)
+        kind = "polytope"
+    else:
+        dims = _dims(table.dims, name, len(table.center), n, "center")
+        shape, kind = Ball(tuple(table.center), table.radius), "ball"
+    _inside(shape.lower, shape.upper, dims, state_space, name)
+    return UnsafeSet(kind, dims, shape, table.tolerance)
 
 
 def _cover_all(unsafe_sets: tuple[UnsafeSet, ...], state_space: Box, initial_set: Box,
@@ -764,16 +615,16 @@ def _cover_all(unsafe_sets: tuple[UnsafeSet, ...], state_space: Box, initial_set
 
     from .covering import cover
     obstacles = []
+    labels = ("initial", "target")
     for j, unsafe in enumerate(unsafe_sets):
         name = f"obstacles[{j}]"
         dims = list(unsafe.dims)
         forbidden = [(np.array(b.lower)[dims], np.array(b.upper)[dims])
                      for b in (initial_set, target_set)]
-        for (lo, hi), label in zip(forbidden, ("initial", "target")):
+        for (lo, hi), label, box in zip(forbidden, labels, (initial_set, target_set)):
             if unsafe.kind == "box":
                 meets = _embed(unsafe.shape.lower, unsafe.shape.upper, unsafe.dims,
-                               state_space).meets(initial_set if label == "initial"
-                                                  else target_set)
+                               state_space).meets(box)
             else:
                 meets = unsafe.shape.meets_box(lo, hi)
             if meets:
@@ -781,7 +632,8 @@ def _cover_all(unsafe_sets: tuple[UnsafeSet, ...], state_space: Box, initial_set
         if unsafe.kind == "box":
             obstacles.append(Obstacle(unsafe.shape.lower, unsafe.shape.upper, unsafe.dims, j))
             continue
-        for lo, hi in cover(unsafe.shape, unsafe.tolerance, forbidden, name):
+        for lo, hi in cover(unsafe.shape, unsafe.tolerance, forbidden, name,
+                            [f"the {label} set" for label in labels]):
             obstacles.append(Obstacle(tuple(float(v) for v in lo), tuple(float(v) for v in hi),
                                       unsafe.dims, j))
     return tuple(obstacles)

@@ -23,13 +23,18 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Discriminator, Field, 
                       ValidationError)
 
 from ..errors import SpecError
+from .plants import PLANT_MODELS, PLANTS
 
 #: Largest magnitude of any number in a spec.
 MAX_MAGNITUDE = 1e12
+#: Default covering tolerance of balls and polytopes (Remark 3.1), state units.
+DEFAULT_TOLERANCE = 0.05
 #: A spec name: a C identifier once ``-`` becomes ``_``, at most 64 characters.
 NAME_REGEX = r"^[A-Za-z][A-Za-z0-9_-]{0,63}$"
-#: Plant models of ``[plant] model``.
-PLANT_MODELS = ("omnidirectional", "single-integrator", "linear")
+#: Largest state dimension (the generated code unrolls per dimension).
+MAX_DIMENSION = 64
+#: At most this many ``[[obstacles]]`` entries.
+MAX_OBSTACLES = 4096
 #: ``tube.method``: the paper's single reach tube, via-point reach tubes, or paper first.
 TUBE_METHODS = ("paper", "via", "auto")
 #: At most this many vertices per polytope.
@@ -39,7 +44,7 @@ MAX_VERTICES = 1024
 Number = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE)]
 Positive = Annotated[float, Strict(), AllowInfNan(False), Field(gt=0, le=MAX_MAGNITUDE)]
 NonNegative = Annotated[float, Strict(), AllowInfNan(False), Field(ge=0, le=MAX_MAGNITUDE)]
-Vector = Annotated[list[Number], Field(min_length=1)]
+Vector = Annotated[list[Number], Field(min_length=1, max_length=MAX_DIMENSION)]
 Index = Annotated[int, Strict(), Field(ge=0)]
 Matrix = Annotated[list[Vector], Field(min_length=1)]
 
@@ -94,8 +99,9 @@ class BallObstacle(_Table):
     radius: Positive
     dims: list[Index] = _omitted("state dimensions of the coordinates (default the first "
                                  "ones)")
-    tolerance: Positive = Field(0.05, description="largest distance from the covering "
-                                                  "boxes to the ball, state units")
+    tolerance: Positive = Field(DEFAULT_TOLERANCE, description="largest distance from the "
+                                                               "covering boxes to the ball, "
+                                                               "state units")
 
 
 class PolytopeObstacle(_Table):
@@ -104,8 +110,9 @@ class PolytopeObstacle(_Table):
     vertices: Annotated[list[Vector], Field(min_length=1, max_length=MAX_VERTICES)]
     dims: list[Index] = _omitted("state dimensions of the coordinates (default the first "
                                  "ones)")
-    tolerance: Positive = Field(0.05, description="largest distance from the covering "
-                                                  "boxes to the polytope, state units")
+    tolerance: Positive = Field(DEFAULT_TOLERANCE, description="largest distance from the "
+                                                               "covering boxes to the "
+                                                               "polytope, state units")
 
 
 def _obstacle_kind(value: Any) -> str | None:
@@ -150,10 +157,9 @@ class ControllerTable(_Table):
 class PlantTable(_Table):
     """The plant used in simulation only; the controller never sees it."""
 
-    model: Literal[PLANT_MODELS] = Field("single-integrator",  # type: ignore[valid-type]
-                                         description="omnidirectional: eq. (14), 3 states; "
-                                                     "single-integrator: x_dot = u + w; "
-                                                     "linear: x_dot = a x + c + g u + w")
+    model: Literal[PLANT_MODELS] = Field(  # type: ignore[valid-type]
+        "single-integrator", description="; ".join(f"{p.name}: {p.summary}"
+                                                   for p in PLANTS.values()))
     disturbance_amplitude: NonNegative = Field(0.1, description="bound on |w_i|, state "
                                                                 "units per second")
     a: Matrix = _omitted("linear model only: the n x n matrix a, as rows; default zero")
@@ -193,8 +199,9 @@ class SpecDocument(_Table):
     state_space: BoxTable = Field(description="the state space X")
     initial: InitialTable
     target: TargetTable
-    obstacles: list[Obstacle] = Field([], description="unsafe sets inside X: boxes, balls, "
-                                                      "convex polytopes")
+    obstacles: list[Obstacle] = Field([], max_length=MAX_OBSTACLES,
+                                      description="unsafe sets inside X: boxes, balls, "
+                                                  "convex polytopes")
     tube: TubeTable = TubeTable()
     controller: ControllerTable = ControllerTable()
     plant: PlantTable = PlantTable()
@@ -244,21 +251,27 @@ def _allowed(loc: tuple) -> list[str]:
     return sorted((tables[-1] if tables else SpecDocument).model_fields)
 
 
-def _kind(value: Any) -> str:
+def value_kind(value: Any) -> str:
+    """What a value is, in TOML's words (``"an array"``, ``"a table"``...)."""
     return {bool: "a boolean", str: "a string", list: "an array", dict: "a table",
             int: "an integer", float: "a float"}.get(type(value), type(value).__name__)
 
 
-def _short(value: Any) -> str:
+def short_repr(value: Any) -> str:
+    """``repr(value)``, cut to one short line."""
     text = repr(value)
     return text if len(text) <= 40 else f"{text[:20]}...({len(text)} characters)"
+
+
+def _beyond(value: Any) -> str:
+    return f"magnitude {short_repr(value)} is beyond {MAX_MAGNITUDE:.0e}".replace("e+", "e")
 
 
 def _reason(error: dict) -> str:
     """One violation in the loader's words."""
     kind, value, ctx = error["type"], error.get("input"), error.get("ctx") or {}
     if kind in ("list_type", "too_short", "too_long") and error["loc"][-1] == "input_gain":
-        return f"must be an array [g_min, g_max] of two numbers, got {_short(value)}"
+        return f"must be an array [g_min, g_max] of two numbers, got {short_repr(value)}"
     if kind == "missing":
         return "missing"
     if kind == "extra_forbidden":
@@ -267,35 +280,38 @@ def _reason(error: dict) -> str:
         return f"must be finite, got {value!r}"
     if kind in ("float_type", "float_parsing"):
         if isinstance(value, int) and not isinstance(value, bool):
-            return f"magnitude {_short(value)} is beyond 1e12"
-        return f"must be a number, got {_kind(value)}"
+            return _beyond(value)
+        return f"must be a number, got {value_kind(value)}"
     if kind in ("int_type", "int_parsing", "int_from_float"):
-        return f"must be an integer, got {_kind(value)}"
+        return f"must be an integer, got {value_kind(value)}"
     if kind == "string_type":
-        return f"must be a string, got {_kind(value)}"
+        return f"must be a string, got {value_kind(value)}"
     if kind == "string_pattern_mismatch":
-        return (f"{_short(value)} is not an identifier: it must match [A-Za-z][A-Za-z0-9_-]* "
+        return (f"{short_repr(value)} is not an identifier: it must match [A-Za-z][A-Za-z0-9_-]* "
                 "and be at most 64 characters")
     if kind == "literal_error":
-        return f"must be one of {ctx.get('expected', '')}, got {_short(value)}".replace("'", "")
+        return f"must be one of {ctx.get('expected', '')}, got {short_repr(value)}".replace("'", "")
     if kind == "greater_than":
         return f"must be positive, got {value!r}"
     if kind == "greater_than_equal":
         return f"must be non-negative, got {value!r}"
     if kind == "less_than_equal":
-        return f"magnitude {value!r} is beyond 1e12"
+        return _beyond(value)
     if kind == "too_short":
         return "must not be empty"
     if kind == "too_long":
-        return f"{len(value)} entries; at most {ctx.get('max_length')}"
+        what = {"obstacles": "obstacles", "vertices": "vertices"}.get(
+            error["loc"][-1], "dimensions" if ctx.get("max_length") == MAX_DIMENSION
+            else "entries")
+        return f"{len(value)} {what}; at most {ctx.get('max_length')}"
     if kind == "list_type":
         what = {"obstacles": "tables", "vertices": "points (arrays)",
                 "dims": "dimension indices", "a": "rows (arrays of numbers)",
                 "g": "rows (arrays of numbers)"}.get(error["loc"][-1], "numbers")
-        return f"must be an array of {what}, got {_kind(value)}"
+        return f"must be an array of {what}, got {value_kind(value)}"
     if kind in ("model_type", "model_attributes_type", "dict_type", "union_tag_not_found",
                 "union_tag_invalid"):
-        return f"must be a table, got {_kind(value)}"
+        return f"must be a table, got {value_kind(value)}"
     return error["msg"]
 
 

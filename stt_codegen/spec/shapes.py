@@ -6,6 +6,7 @@ spans the state space in the others. All geometry here is in those ``k`` coordin
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 
@@ -17,6 +18,8 @@ from ..errors import SpecError
 
 #: Largest number of coordinates (``dims``) a polytope obstacle may be given on.
 MAX_POLYTOPE_DIMENSION = 4
+#: Relative widening of an exact box hull (one and two dimensions), against rounding.
+ROUNDING = 1e-12
 
 
 @dataclass(frozen=True)
@@ -81,6 +84,7 @@ class Polytope:
     vertices: tuple[tuple[float, ...], ...]
     _a: np.ndarray = field(init=False, repr=False, compare=False)
     _b: np.ndarray = field(init=False, repr=False, compare=False)
+    _ring: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         points = np.array(self.vertices, dtype=float)
@@ -88,13 +92,17 @@ class Polytope:
         if k == 1:
             a = np.array([[1.0], [-1.0]])
             b = np.array([points.max(), -points.min()])
+            ring = points[[points.argmin(), points.argmax()]]
         else:
             hull = ConvexHull(points)
             a, b = hull.equations[:, :-1], -hull.equations[:, -1]
             norms = np.linalg.norm(a, axis=1)
             a, b = a / norms[:, None], b / norms
+            # in the plane, the hull's vertices in counter-clockwise order (its edges)
+            ring = points[hull.vertices] if k == 2 else points
         object.__setattr__(self, "_a", a)
         object.__setattr__(self, "_b", b)
+        object.__setattr__(self, "_ring", ring)
 
     @property
     def halfspaces(self) -> tuple[np.ndarray, np.ndarray]:
@@ -117,24 +125,30 @@ class Polytope:
         """
         return np.max(np.atleast_2d(points) @ self._a.T - self._b, axis=1)
 
-    def distance(self, point: np.ndarray) -> float:
-        """Euclidean distance from one point (k,) to the polytope.
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """Euclidean distance from each point (N, k) (or one point (k,)) to the polytope, (N,).
 
-        Closed form in one and two dimensions (distance to the nearest edge); a small
-        convex QP (SLSQP) in more.
+        Closed form in one and two dimensions (the distance to the nearest edge, all points
+        at once); a small convex QP (SLSQP) per point outside in more.
         """
-        p = np.asarray(point, dtype=float)
-        if np.all(self._a @ p <= self._b + 1e-12):
-            return 0.0
-        points = np.array(self.vertices, dtype=float)
-        if p.size == 1:
-            return float(max(points.min() - p[0], p[0] - points.max(), 0.0))
-        if p.size == 2:
-            hull = points[ConvexHull(points).vertices]
-            a, b = hull, np.roll(hull, -1, axis=0)
-            ab = b - a
-            s = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.einsum("ij,ij->i", ab, ab), 0, 1)
-            return float(np.min(np.linalg.norm(a + s[:, None] * ab - p, axis=1)))
+        p = np.atleast_2d(np.asarray(points, dtype=float))
+        inside = np.all(p @ self._a.T <= self._b + 1e-12, axis=1)
+        k = p.shape[1]
+        if k == 1:
+            lo, hi = self._ring[0, 0], self._ring[1, 0]
+            return np.maximum(np.maximum(lo - p[:, 0], p[:, 0] - hi), 0.0)
+        if k == 2:
+            a = self._ring
+            ab = np.roll(a, -1, axis=0) - a                         # edges (m, 2)
+            ap = p[:, None, :] - a[None, :, :]                      # (N, m, 2)
+            s = np.clip(np.einsum("nmj,mj->nm", ap, ab) / np.einsum("mj,mj->m", ab, ab),
+                        0.0, 1.0)
+            gap = ap - s[:, :, None] * ab
+            far = np.sqrt(np.min(np.einsum("nmj,nmj->nm", gap, gap), axis=1))
+            return np.where(inside, 0.0, far)
+        return np.array([0.0 if ok else self._qp_distance(q) for q, ok in zip(p, inside)])
+
+    def _qp_distance(self, p: np.ndarray) -> float:
         start = np.array(self.vertices, dtype=float).mean(axis=0)
         res = minimize(lambda y: 0.5 * np.sum((y - p) ** 2), start, jac=lambda y: y - p,
                        constraints=[{"type": "ineq", "fun": lambda y: self._b - self._a @ y,
@@ -146,7 +160,44 @@ class Polytope:
         return float(max(np.linalg.norm(y - p), self.signed_clearance(p)[0]))
 
     def box_hull(self, lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-        """The smallest box containing ``polytope ∩ [lower, upper]`` (2k LPs), or ``None``."""
+        """The smallest box containing ``polytope ∩ [lower, upper]``, or ``None`` if empty.
+
+        Exact in one and two dimensions (from the vertices inside the box, the edges'
+        crossings of the box's sides and the box's corners inside the polygon, widened by
+        :data:`ROUNDING` and clipped to the box, so that rounding never loses a point);
+        ``2k`` linear programs in more.
+        """
+        lower, upper = np.asarray(lower, float), np.asarray(upper, float)
+        k = lower.size
+        if k > 2:
+            return self._box_hull_lp(lower, upper)
+        scale = ROUNDING * (1.0 + float(np.max(np.abs(np.concatenate([lower, upper])))))
+        points = [self._ring]
+        if k == 2:
+            a = self._ring
+            b = np.roll(a, -1, axis=0)
+            for axis in (0, 1):
+                other = 1 - axis
+                for side in (lower[axis], upper[axis]):
+                    da = a[:, axis] - side
+                    db = b[:, axis] - side
+                    cross = (da * db <= 0) & (da != db)
+                    t = da[cross] / (da[cross] - db[cross])
+                    hit = np.empty((t.size, 2))
+                    hit[:, axis] = side
+                    hit[:, other] = a[cross, other] + t * (b[cross, other] - a[cross, other])
+                    points.append(hit)
+        corners = np.array(list(itertools.product(*zip(lower, upper))))
+        points.append(corners[np.all(corners @ self._a.T <= self._b + scale, axis=1)])
+        points = np.concatenate(points)
+        points = points[np.all((points >= lower - scale) & (points <= upper + scale), axis=1)]
+        if points.shape[0] == 0:
+            return None
+        lo = np.maximum(points.min(axis=0) - scale, lower)
+        hi = np.minimum(points.max(axis=0) + scale, upper)
+        return lo, hi
+
+    def _box_hull_lp(self, lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         k = len(lower)
         bounds = list(zip(lower, upper))
         lo, hi = np.empty(k), np.empty(k)

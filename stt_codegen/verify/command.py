@@ -18,7 +18,8 @@ from ..design.certificate import Certificate
 from ..design.samples import sample_tube
 from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
-from ..spec.loader import PLANT_MODELS, Spec, load_spec
+from ..spec.loader import Spec, load_spec
+from ..spec.plants import PLANT_MODELS, dimension_mismatch
 from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
 from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_omnidirectional, assumption2_single_integrator
@@ -58,7 +59,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> l
     spec : Spec
     design : TubeDesign
     plant : str, optional
-        Plant model for Assumption 2 (one of :data:`stt_codegen.spec.loader.PLANT_MODELS`);
+        Plant model for Assumption 2 (one of :data:`stt_codegen.spec.plants.PLANT_MODELS`);
         default the spec's.
 
     Returns
@@ -196,8 +197,8 @@ def verify(spec: Spec, design: TubeDesign | None = None,
     """
     if plant is not None and plant not in PLANT_MODELS:
         raise SpecError("plant", f"must be one of {', '.join(PLANT_MODELS)}")
-    if plant == "omnidirectional" and spec.dimension != 3:
-        raise SpecError("plant", "the omnidirectional robot has 3 states")
+    if plant is not None and dimension_mismatch(plant, spec.dimension):
+        raise SpecError("plant", dimension_mismatch(plant, spec.dimension))
     checks = verify_spec(spec, plant) if design is None else verify_design(spec, design, plant)
     return VerificationReport(spec.name, tuple(checks))
 

@@ -1,0 +1,78 @@
+"""The plant models a spec may name (``[plant] model``): the one registry of their facts.
+
+Everything that needs a fact about a model reads it here: the schema (the allowed names
+and their descriptions), the loader (the state count a model requires, the ``[plant]``
+keys only some models take), the simulation's and the embedded loop's dynamics
+(:mod:`stt_codegen.runtime.dynamics`, :mod:`stt_codegen.runtime.plants`) and
+``stt-codegen verify --plant``. A new model is an entry of :data:`PLANTS` and its
+dynamics in :mod:`stt_codegen.runtime.dynamics`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+__all__ = ["PLANTS", "PLANT_MODELS", "MODEL_KEYS", "NAMED_MODELS", "PlantModel",
+           "dimension_mismatch"]
+
+
+@dataclass(frozen=True)
+class PlantModel:
+    """Facts about one plant model of system (1), ``x_dot = f(x) + g(x) u + w``.
+
+    Attributes
+    ----------
+    name : str
+        The ``plant.model`` value.
+    summary : str
+        One line for the schema and help texts.
+    states : int or None
+        The state dimension ``n`` the model requires, ``None`` for any.
+    inputs : tuple of str or None
+        Names of the inputs ``u``, ``None`` for one per state (``u1``, ``u2``, ...).
+    keys : tuple of str
+        Keys of ``[plant]`` only this model takes (its matrices).
+    """
+
+    name: str
+    summary: str
+    states: int | None = None
+    inputs: tuple[str, ...] | None = None
+    keys: tuple[str, ...] = ()
+
+    def input_count(self, n: int) -> int:
+        """Number of inputs for ``n`` states."""
+        return n if self.inputs is None else len(self.inputs)
+
+
+#: Every model, by ``plant.model`` name, in the schema's order.
+PLANTS: dict[str, PlantModel] = {p.name: p for p in (
+    PlantModel("omnidirectional", "eq. (14), x_dot = R(x3) u + w, 3 states (x, y, heading)",
+               states=3, inputs=("v1", "v2", "omega")),
+    PlantModel("single-integrator", "x_dot = u + w"),
+    PlantModel("linear", "x_dot = a x + c + g u + w, the matrices from [plant]",
+               keys=("a", "g", "c")),
+)}
+#: The ``plant.model`` values.
+PLANT_MODELS: tuple[str, ...] = tuple(PLANTS)
+#: Models with fixed dynamics (no matrices from the spec).
+NAMED_MODELS: tuple[str, ...] = tuple(name for name, p in PLANTS.items() if not p.keys)
+#: ``[plant]`` keys that belong to one model, with the model.
+MODEL_KEYS: dict[str, str] = {key: name for name, p in PLANTS.items() for key in p.keys}
+
+
+def dimension_mismatch(model: str, n: int) -> str | None:
+    """Why ``model`` cannot have ``n`` states, or ``None`` if it can (or is not a known
+    model: the caller reports that).
+
+    Parameters
+    ----------
+    model : str
+        A :data:`PLANT_MODELS` entry.
+    n : int
+        State dimension.
+    """
+    required = PLANTS[model].states if model in PLANTS else None
+    if required is None or required == n:
+        return None
+    return f"the {model} robot has {required} states, the state space has {n}"
