@@ -1,12 +1,6 @@
 """Problem specification: one prescribed-time reach-avoid-stay task (Definition 2.1).
 
-<<<<<<< HEAD
 A spec is a TOML file with a fixed schema (docs/spec-format.md). :func:`load_spec`
-reads a bundled case by name or a file by path, validates every field and
-returns a frozen :class:`Spec`. Every rejection is a :class:`SpecError` naming
-the field and the reason.
-=======
-A spec is a TOML file with a fixed schema (see the README). :func:`load_spec`
 reads a bundled case by name or a file by path, validates it and returns a frozen
 :class:`Spec`. Every rejection is a :class:`SpecError` naming the field and the reason.
 
@@ -16,7 +10,6 @@ validated :class:`~.schema.SpecDocument` and checks only the rules that relate f
 each other (lengths equal to the state dimension, boxes inside boxes, points in
 interiors, obstacles against the start and the target, a plant model's state count from
 :mod:`.plants`).
->>>>>>> spec
 """
 
 from __future__ import annotations
@@ -321,13 +314,9 @@ class Spec:
         data : mapping
             The spec's tables as nested dicts and lists, exactly as :mod:`tomllib` would
             read the file: ``{"name": ..., "prescribed_time": ..., "state_space":
-<<<<<<< HEAD
             {"lower": [...], "upper": [...]}, ...}`` (see docs/spec-format.md).
-=======
-            {"lower": [...], "upper": [...]}, ...}`` (see the README's *Spec format*).
             Tuples and numpy arrays are accepted wherever a list is, numpy scalars
             wherever a number is.
->>>>>>> spec
 
         Returns
         -------
