@@ -1288,6 +1288,10 @@ int omnirobot_s2_tube(omnirobot_s2_real t, const omnirobot_s2_real alpha[OMNIROB
     omnirobot_s2_real g_l_dot[OMNIROBOT_S2_N];
     omnirobot_s2_real g_u_dot[OMNIROBOT_S2_N];
     int rates = 0;
+    /* zeroed: written only on the paths that compute them (gcc's -Wmaybe-uninitialized
+       cannot tell for n = 1) */
+    omnirobot_s2_zero(g_l_dot, OMNIROBOT_S2_N);
+    omnirobot_s2_zero(g_u_dot, OMNIROBOT_S2_N);
     if ((gamma_L_dot != NULL) || (gamma_U_dot != NULL)) {
       rates = 1;
     }

@@ -1348,6 +1348,10 @@ int omnirobot_s3_tube(omnirobot_s3_real t, const omnirobot_s3_real alpha[OMNIROB
     omnirobot_s3_real g_l_dot[OMNIROBOT_S3_N];
     omnirobot_s3_real g_u_dot[OMNIROBOT_S3_N];
     int rates = 0;
+    /* zeroed: written only on the paths that compute them (gcc's -Wmaybe-uninitialized
+       cannot tell for n = 1) */
+    omnirobot_s3_zero(g_l_dot, OMNIROBOT_S3_N);
+    omnirobot_s3_zero(g_u_dot, OMNIROBOT_S3_N);
     if ((gamma_L_dot != NULL) || (gamma_U_dot != NULL)) {
       rates = 1;
     }
