@@ -10,8 +10,9 @@
  *
  * C99, depends on <math.h> only (link with -lm). No allocation, no global or static
  * mutable state: every function is reentrant and thread-safe. Arithmetic: float.
- * Do not compile with -ffast-math / -Ofast (the source stops with #error): it would
- * remove the input checks.
+ * Do not compile with -ffast-math, -Ofast, -ffinite-math-only or clang's -fno-honor-nans /
+ * -fno-honor-infinities (the source stops with #error under each of the first three and
+ * under the last two together): they would remove the input checks.
  *
  * Units: time t, dt in seconds; x, gamma_L, gamma_U, alpha in state units (the spec's);
  * gamma_*_dot in state units per second; u in state units per second (the input of the

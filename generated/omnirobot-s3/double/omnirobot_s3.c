@@ -13,8 +13,10 @@
 
 #include "omnirobot_s3.h"
 
-#ifdef __FAST_MATH__
-#error "omnirobot_s3.c must not be compiled with -ffast-math (or -Ofast): it removes the isfinite() input checks and changes the rounding the tolerances assume"
+/* -ffast-math and -Ofast define __FAST_MATH__; -ffinite-math-only (gcc, clang) and clang's
+   -fno-honor-nans -fno-honor-infinities together define __FINITE_MATH_ONLY__ 1. */
+#if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && (__FINITE_MATH_ONLY__ != 0))
+#error "omnirobot_s3.c must not be compiled with -ffast-math (or -Ofast, -ffinite-math-only, -fno-honor-nans, -fno-honor-infinities): they remove the isfinite() input checks and change the rounding the tolerances assume"
 #endif
 
 /* ------------------------------------------------------------- spec tables */
