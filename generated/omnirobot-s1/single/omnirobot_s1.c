@@ -1388,6 +1388,12 @@ int omnirobot_s1_tube(omnirobot_s1_real t, const omnirobot_s1_real alpha[OMNIROB
       omnirobot_s1_zero(gamma_L_dot, OMNIROBOT_S1_N);
       omnirobot_s1_zero(gamma_U_dot, OMNIROBOT_S1_N);
     }
+  } else {
+    /* gamma_L or gamma_U NULL: INVALID_INPUT, every other output zeroed */
+    omnirobot_s1_zero(gamma_L, OMNIROBOT_S1_N);
+    omnirobot_s1_zero(gamma_U, OMNIROBOT_S1_N);
+    omnirobot_s1_zero(gamma_L_dot, OMNIROBOT_S1_N);
+    omnirobot_s1_zero(gamma_U_dot, OMNIROBOT_S1_N);
   }
   return status;
 }
@@ -1546,6 +1552,16 @@ int omnirobot_s1_step(const omnirobot_s1_real x[OMNIROBOT_S1_N], omnirobot_s1_re
     } else {
       omnirobot_s1_copy(uc, u, OMNIROBOT_S1_N);
     }
+  } else {
+    /* u or alpha_next NULL: INVALID_INPUT, the other output written as documented */
+    if (alpha_next != NULL) {
+      if (alpha == NULL) {
+        omnirobot_s1_zero(alpha_next, OMNIROBOT_S1_N_ALPHA);
+      } else {
+        omnirobot_s1_keep_alpha(alpha, alpha_next);
+      }
+    }
+    omnirobot_s1_zero(u, OMNIROBOT_S1_N);
   }
   return status;
 }

@@ -1389,6 +1389,12 @@ int omnirobot_s2_tube(omnirobot_s2_real t, const omnirobot_s2_real alpha[OMNIROB
       omnirobot_s2_zero(gamma_L_dot, OMNIROBOT_S2_N);
       omnirobot_s2_zero(gamma_U_dot, OMNIROBOT_S2_N);
     }
+  } else {
+    /* gamma_L or gamma_U NULL: INVALID_INPUT, every other output zeroed */
+    omnirobot_s2_zero(gamma_L, OMNIROBOT_S2_N);
+    omnirobot_s2_zero(gamma_U, OMNIROBOT_S2_N);
+    omnirobot_s2_zero(gamma_L_dot, OMNIROBOT_S2_N);
+    omnirobot_s2_zero(gamma_U_dot, OMNIROBOT_S2_N);
   }
   return status;
 }
@@ -1547,6 +1553,16 @@ int omnirobot_s2_step(const omnirobot_s2_real x[OMNIROBOT_S2_N], omnirobot_s2_re
     } else {
       omnirobot_s2_copy(uc, u, OMNIROBOT_S2_N);
     }
+  } else {
+    /* u or alpha_next NULL: INVALID_INPUT, the other output written as documented */
+    if (alpha_next != NULL) {
+      if (alpha == NULL) {
+        omnirobot_s2_zero(alpha_next, OMNIROBOT_S2_N_ALPHA);
+      } else {
+        omnirobot_s2_keep_alpha(alpha, alpha_next);
+      }
+    }
+    omnirobot_s2_zero(u, OMNIROBOT_S2_N);
   }
   return status;
 }

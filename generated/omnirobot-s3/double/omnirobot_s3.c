@@ -1327,6 +1327,12 @@ int omnirobot_s3_tube(omnirobot_s3_real t, const omnirobot_s3_real alpha[OMNIROB
       omnirobot_s3_zero(gamma_L_dot, OMNIROBOT_S3_N);
       omnirobot_s3_zero(gamma_U_dot, OMNIROBOT_S3_N);
     }
+  } else {
+    /* gamma_L or gamma_U NULL: INVALID_INPUT, every other output zeroed */
+    omnirobot_s3_zero(gamma_L, OMNIROBOT_S3_N);
+    omnirobot_s3_zero(gamma_U, OMNIROBOT_S3_N);
+    omnirobot_s3_zero(gamma_L_dot, OMNIROBOT_S3_N);
+    omnirobot_s3_zero(gamma_U_dot, OMNIROBOT_S3_N);
   }
   return status;
 }
@@ -1485,6 +1491,16 @@ int omnirobot_s3_step(const omnirobot_s3_real x[OMNIROBOT_S3_N], omnirobot_s3_re
     } else {
       omnirobot_s3_copy(uc, u, OMNIROBOT_S3_N);
     }
+  } else {
+    /* u or alpha_next NULL: INVALID_INPUT, the other output written as documented */
+    if (alpha_next != NULL) {
+      if (alpha == NULL) {
+        omnirobot_s3_zero(alpha_next, OMNIROBOT_S3_N_ALPHA);
+      } else {
+        omnirobot_s3_keep_alpha(alpha, alpha_next);
+      }
+    }
+    omnirobot_s3_zero(u, OMNIROBOT_S3_N);
   }
   return status;
 }
