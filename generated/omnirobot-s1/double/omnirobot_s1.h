@@ -35,7 +35,9 @@
  *          from alpha = 0, and far below ALPHA_MAX.
  *
  * Status codes (return value of every function):
- *   OMNIROBOT_S1_STATUS_OK            0  outputs valid, x strictly inside the tube.
+ *   OMNIROBOT_S1_STATUS_OK            0  outputs valid, x strictly inside the tube:
+ *                                  gamma_L_i < x_i < gamma_U_i for every i, compared
+ *                                  exactly (no rounding) with the bounds P_tube returns.
  *   OMNIROBOT_S1_STATUS_OUTSIDE_TUBE  1  x is on or outside the tube (|e_i| >= 1) or the tube
  *                                  is empty in some dimension: u is still finite (the
  *                                  error e is clamped to +-(1 - 2^-20) and the width

@@ -1583,7 +1583,7 @@ def body_newton_iteration(a, alpha, psi, c, A):
 
 
 def body_law(x, gamma_L, gamma_U, gain):
-    """CasADi Function 'body_law' (94 instructions).
+    """CasADi Function 'body_law' (88 instructions).
 
     Parameters
     ----------
@@ -1613,92 +1613,86 @@ def body_law(x, gamma_L, gamma_U, gain):
     w3 = float(gamma_L[0])
     w4 = w2 - w3
     w5 = 1e-06
-    w6 = _fmax(w4, w5)
-    w7 = 1.0
-    w8 = float(x[0])
-    w9 = w8 + w8
-    w10 = w2 + w3
-    w9 = w9 - w10
-    w9 = _div(w9, w6)
-    w10 = -0.9999990463256836
-    w9 = _fmax(w9, w10)
-    w11 = 0.9999990463256836
-    w9 = _fmin(w9, w11)
-    w12 = w9 * w9
-    w12 = w7 - w12
-    w6 = w6 * w12
-    w6 = _div(w1, w6)
-    w6 = w0 * w6
-    w12 = w7 + w9
-    w9 = w7 - w9
-    w12 = _div(w12, w9)
-    w12 = _log(w12)
-    w6 = w6 * w12
-    w6 = -w6
-    u[0] = w6
-    w6 = float(gamma_U[1])
-    w12 = float(gamma_L[1])
-    w9 = w6 - w12
-    w13 = _fmax(w9, w5)
-    w14 = float(x[1])
-    w15 = w14 + w14
-    w16 = w6 + w12
+    w4 = _fmax(w4, w5)
+    w6 = 1.0
+    w7 = float(x[0])
+    w8 = w7 + w7
+    w9 = w2 + w3
+    w8 = w8 - w9
+    w8 = _div(w8, w4)
+    w9 = -0.9999990463256836
+    w8 = _fmax(w8, w9)
+    w10 = 0.9999990463256836
+    w8 = _fmin(w8, w10)
+    w11 = w8 * w8
+    w11 = w6 - w11
+    w4 = w4 * w11
+    w4 = _div(w1, w4)
+    w4 = w0 * w4
+    w11 = w6 + w8
+    w8 = w6 - w8
+    w11 = _div(w11, w8)
+    w11 = _log(w11)
+    w4 = w4 * w11
+    w4 = -w4
+    u[0] = w4
+    w4 = float(gamma_U[1])
+    w11 = float(gamma_L[1])
+    w8 = w4 - w11
+    w8 = _fmax(w8, w5)
+    w12 = float(x[1])
+    w13 = w12 + w12
+    w14 = w4 + w11
+    w13 = w13 - w14
+    w13 = _div(w13, w8)
+    w13 = _fmax(w13, w9)
+    w13 = _fmin(w13, w10)
+    w14 = w13 * w13
+    w14 = w6 - w14
+    w8 = w8 * w14
+    w8 = _div(w1, w8)
+    w8 = w0 * w8
+    w14 = w6 + w13
+    w13 = w6 - w13
+    w14 = _div(w14, w13)
+    w14 = _log(w14)
+    w8 = w8 * w14
+    w8 = -w8
+    u[1] = w8
+    w8 = float(gamma_U[2])
+    w14 = float(gamma_L[2])
+    w13 = w8 - w14
+    w13 = _fmax(w13, w5)
+    w5 = float(x[2])
+    w15 = w5 + w5
+    w16 = w8 + w14
     w15 = w15 - w16
     w15 = _div(w15, w13)
-    w15 = _fmax(w15, w10)
-    w15 = _fmin(w15, w11)
-    w16 = w15 * w15
-    w16 = w7 - w16
-    w13 = w13 * w16
-    w13 = _div(w1, w13)
-    w13 = w0 * w13
-    w16 = w7 + w15
-    w15 = w7 - w15
-    w16 = _div(w16, w15)
-    w16 = _log(w16)
-    w13 = w13 * w16
-    w13 = -w13
-    u[1] = w13
-    w13 = float(gamma_U[2])
-    w16 = float(gamma_L[2])
-    w15 = w13 - w16
-    w5 = _fmax(w15, w5)
-    w17 = float(x[2])
-    w18 = w17 + w17
-    w19 = w13 + w16
-    w18 = w18 - w19
-    w18 = _div(w18, w5)
-    w18 = _fmax(w18, w10)
-    w18 = _fmin(w18, w11)
-    w11 = w18 * w18
-    w11 = w7 - w11
-    w5 = w5 * w11
-    w1 = _div(w1, w5)
+    w15 = _fmax(w15, w9)
+    w15 = _fmin(w15, w10)
+    w10 = w15 * w15
+    w10 = w6 - w10
+    w13 = w13 * w10
+    w1 = _div(w1, w13)
     w0 = w0 * w1
-    w1 = w7 + w18
-    w18 = w7 - w18
-    w1 = _div(w1, w18)
+    w1 = w6 + w15
+    w15 = w6 - w15
+    w1 = _div(w1, w15)
     w1 = _log(w1)
     w0 = w0 * w1
     w0 = -w0
     u[2] = w0
-    w8 = w8 + w8
-    w2 = w2 + w3
-    w8 = w8 - w2
-    w8 = math.fabs(w8)
-    w8 = 1.0 if w8 < w4 else 0.0
-    w7 = 1.0 if w7 != 0.0 and w8 != 0.0 else 0.0
-    w14 = w14 + w14
-    w6 = w6 + w12
-    w14 = w14 - w6
-    w14 = math.fabs(w14)
-    w14 = 1.0 if w14 < w9 else 0.0
-    w7 = 1.0 if w7 != 0.0 and w14 != 0.0 else 0.0
-    w17 = w17 + w17
-    w13 = w13 + w16
-    w17 = w17 - w13
-    w17 = math.fabs(w17)
-    w17 = 1.0 if w17 < w15 else 0.0
-    w7 = 1.0 if w7 != 0.0 and w17 != 0.0 else 0.0
-    inside[0] = w7
+    w3 = 1.0 if w3 < w7 else 0.0
+    w7 = 1.0 if w7 < w2 else 0.0
+    w3 = 1.0 if w3 != 0.0 and w7 != 0.0 else 0.0
+    w6 = 1.0 if w6 != 0.0 and w3 != 0.0 else 0.0
+    w11 = 1.0 if w11 < w12 else 0.0
+    w12 = 1.0 if w12 < w4 else 0.0
+    w11 = 1.0 if w11 != 0.0 and w12 != 0.0 else 0.0
+    w6 = 1.0 if w6 != 0.0 and w11 != 0.0 else 0.0
+    w14 = 1.0 if w14 < w5 else 0.0
+    w5 = 1.0 if w5 < w8 else 0.0
+    w14 = 1.0 if w14 != 0.0 and w5 != 0.0 else 0.0
+    w6 = 1.0 if w6 != 0.0 and w14 != 0.0 else 0.0
+    inside[0] = w6
     return (u, inside)
