@@ -99,7 +99,7 @@ def test_c_reports_ok_only_strictly_inside(precision, root):
         sel = np.array([KINDS[k % 3][0] == kind for k in range(len(rows))])
         assert np.all(expected[sel] == want)
         wrong = int(np.sum(status[sel] != want))
-        assert wrong == 0, f"{wrong} of {int(sel.sum())} points {kind} a bound report another status"
+        assert wrong == 0, f"{wrong} of {int(sel.sum())} points {kind} a bound: other status"
     assert np.array_equal(control_status, status)
     if precision == "double":
         step = model_of(CASE)["controller_step"]
