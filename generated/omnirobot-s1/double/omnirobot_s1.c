@@ -946,7 +946,7 @@ static void body_newton_iteration(const omnirobot_s1_real* a, const omnirobot_s1
   a_next[0] = w0;
 }
 
-/* CasADi Function 'law': 88 instructions. */
+/* CasADi Function 'law': 87 instructions. */
 static void body_law(const omnirobot_s1_real* x, const omnirobot_s1_real* gamma_L, const omnirobot_s1_real* gamma_U, const omnirobot_s1_real* gain, omnirobot_s1_real* u, omnirobot_s1_real* inside) {
   omnirobot_s1_real w0;
   omnirobot_s1_real w1;
@@ -1034,25 +1034,24 @@ static void body_law(const omnirobot_s1_real* x, const omnirobot_s1_real* gamma_
   w1 = w1 / w13;
   w0 = w0 * w1;
   w1 = w6 + w15;
-  w15 = w6 - w15;
-  w1 = w1 / w15;
+  w6 = w6 - w15;
+  w1 = w1 / w6;
   w1 = log(w1);
   w0 = w0 * w1;
   w0 = -w0;
   u[2] = w0;
   w3 = (w3 < w7) ? 1.0 : 0.0;
   w7 = (w7 < w2) ? 1.0 : 0.0;
-  w3 = ((w3 != 0.0) && (w7 != 0.0)) ? 1.0 : 0.0;
-  w6 = ((w6 != 0.0) && (w3 != 0.0)) ? 1.0 : 0.0;
+  w3 = w3 * w7;
   w11 = (w11 < w12) ? 1.0 : 0.0;
+  w3 = w3 * w11;
   w12 = (w12 < w4) ? 1.0 : 0.0;
-  w11 = ((w11 != 0.0) && (w12 != 0.0)) ? 1.0 : 0.0;
-  w6 = ((w6 != 0.0) && (w11 != 0.0)) ? 1.0 : 0.0;
+  w3 = w3 * w12;
   w14 = (w14 < w5) ? 1.0 : 0.0;
+  w3 = w3 * w14;
   w5 = (w5 < w8) ? 1.0 : 0.0;
-  w14 = ((w14 != 0.0) && (w5 != 0.0)) ? 1.0 : 0.0;
-  w6 = ((w6 != 0.0) && (w14 != 0.0)) ? 1.0 : 0.0;
-  inside[0] = w6;
+  w3 = w3 * w5;
+  inside[0] = w3;
 }
 
 /* ----------------------------------------------------------------- typed API */

@@ -1582,7 +1582,7 @@ def body_newton_iteration(a, alpha, psi, c, A):
 
 
 def body_law(x, gamma_L, gamma_U, gain):
-    """CasADi Function 'body_law' (88 instructions).
+    """CasADi Function 'body_law' (87 instructions).
 
     Parameters
     ----------
@@ -1675,23 +1675,22 @@ def body_law(x, gamma_L, gamma_U, gain):
     w1 = _div(w1, w13)
     w0 = w0 * w1
     w1 = w6 + w15
-    w15 = w6 - w15
-    w1 = _div(w1, w15)
+    w6 = w6 - w15
+    w1 = _div(w1, w6)
     w1 = _log(w1)
     w0 = w0 * w1
     w0 = -w0
     u[2] = w0
     w3 = 1.0 if w3 < w7 else 0.0
     w7 = 1.0 if w7 < w2 else 0.0
-    w3 = 1.0 if w3 != 0.0 and w7 != 0.0 else 0.0
-    w6 = 1.0 if w6 != 0.0 and w3 != 0.0 else 0.0
+    w3 = w3 * w7
     w11 = 1.0 if w11 < w12 else 0.0
+    w3 = w3 * w11
     w12 = 1.0 if w12 < w4 else 0.0
-    w11 = 1.0 if w11 != 0.0 and w12 != 0.0 else 0.0
-    w6 = 1.0 if w6 != 0.0 and w11 != 0.0 else 0.0
+    w3 = w3 * w12
     w14 = 1.0 if w14 < w5 else 0.0
+    w3 = w3 * w14
     w5 = 1.0 if w5 < w8 else 0.0
-    w14 = 1.0 if w14 != 0.0 and w5 != 0.0 else 0.0
-    w6 = 1.0 if w6 != 0.0 and w14 != 0.0 else 0.0
-    inside[0] = w6
+    w3 = w3 * w5
+    inside[0] = w3
     return (u, inside)
