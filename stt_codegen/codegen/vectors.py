@@ -1,44 +1,81 @@
 """Test vectors: inputs and expected outputs from the numpy reference, with tolerances.
 
 The inputs are float32 numbers (exact in both precisions), drawn with a fixed seed:
-:data:`INSIDE` points with ``|e_i| <= 0.99`` in tubes at least 1e-2 wide (so that the
-status is the same in single precision, see
-:func:`~stt_codegen.codegen.tolerance.status_certain`), and :data:`OUTSIDE` points with
-``1.1 <= |e_i| <= 2`` in one dimension (status OUTSIDE_TUBE, ``u`` clamped); times
-cover ``[0, 1.2 t_c]``, so after ``t_c`` too. Expected values are the reference's
-(:mod:`stt_codegen.tube.reference`) at those inputs; tolerances are
-:mod:`~stt_codegen.codegen.tolerance`'s bounds for the chosen precision (double: with the
-floor ``1e-12 max(1, |ref|)``).
+:data:`INSIDE` points with ``|e_i| <= 0.99`` in tubes at least 1e-2 wide, and
+:data:`OUTSIDE` points with ``1.1 <= |e_i| <= 2`` in one dimension (status OUTSIDE_TUBE,
+``u`` clamped); every point's status is certain in the generated precision (see
+:func:`~stt_codegen.codegen.tolerance.status_certain`). Times cover ``[0, 1.2 t_c]``, so
+after ``t_c`` too. Expected values are the reference's (:mod:`stt_codegen.tube.reference`)
+at those inputs; tolerances are :mod:`~stt_codegen.codegen.tolerance`'s bounds for the
+chosen precision (double: with the floor ``1e-12 max(1, |ref|)``).
+
+The search is bounded (:data:`ROUNDS` rounds of :data:`BATCH` candidates). A precision
+whose error bound on the tube's bounds is not small against the tube's width at the
+spec's coordinates (about ``4 * 64 * unit`` times the largest coordinate; single
+precision on an arena at 1e6 m, or a narrow tube in a 20 km arena) has no point whose
+status is certain: that is a :class:`~stt_codegen.errors.SpecError` naming ``precision``
+(see docs/codegen.md, "Large coordinates").
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from ..errors import SpecError
 from ..tube import reference as R
 from ..tube.parameters import STATUS_OK, STATUS_OUTSIDE_TUBE
 from ..tube.parameters import TubeDesign
 from . import tolerance as T
+from .errors import CodegenError
 
 INSIDE = 48
 OUTSIDE = 8
 SEED = 20240531
+#: Candidates per round of the search.
+BATCH = 64
+#: Rounds before the search gives up (the bundled cases need 2; about 1 s of work).
+ROUNDS = 200
+#: Width, in error bounds of the tube's bounds, below which no OUTSIDE point
+#: (``1.1 <= |e| <= 2``) has a certain status: ``status_certain`` needs
+#: ``|e| - 1 > 4 (1 + |e|) dg / w``, so ``w > 12 dg`` at ``|e| = 2``; 16 leaves a third
+#: of the OUTSIDE draws.
+RESOLUTION = 16.0
 
 
 def _f32(a) -> np.ndarray:
     return np.asarray(a, dtype=np.float32).astype(np.float64)
 
 
-def sample_inputs(design: TubeDesign) -> dict[str, np.ndarray]:
-    """The vectors' inputs: ``x`` (N, n), ``t`` (N,), ``dt`` (N,), ``alpha`` (N, 2n)."""
+def sample_inputs(design: TubeDesign, precision: str = "single") -> dict[str, np.ndarray]:
+    """The vectors' inputs: ``x`` (N, n), ``t`` (N,), ``dt`` (N,), ``alpha`` (N, 2n).
+
+    Parameters
+    ----------
+    design : TubeDesign
+    precision : {"single", "double"}
+        Every point's status is certain in this precision.
+
+    Raises
+    ------
+    SpecError
+        ``precision``: after :data:`ROUNDS` rounds too few points have a certain status
+        because the precision cannot resolve the tube at the spec's coordinates.
+    CodegenError
+        Too few points for another reason (an internal limit).
+    """
     rng = np.random.default_rng(SEED)
     n = design.dimension
     t_c = design.prescribed_time
+    unit = T.unit_roundoff(precision)
     chosen = {k: [] for k in ("x", "t", "dt", "alpha")}
     want = {False: INSIDE, True: OUTSIDE}
     have = {False: 0, True: 0}
-    while have[False] < INSIDE or have[True] < OUTSIDE:
-        m = 64
+    widest = 0.0  # widest narrowest-dimension width of a usable candidate
+    resolvable = 0  # usable candidates whose tube the precision resolves
+    for _ in range(ROUNDS):
+        if have[False] >= INSIDE and have[True] >= OUTSIDE:
+            break
+        m = BATCH
         t = _f32(rng.uniform(0.0, 1.2 * t_c, m))
         psi = R.conflict_distance(design, t)
         alpha = _f32(np.maximum(0.0, -psi + 1e-2)
@@ -51,8 +88,13 @@ def sample_inputs(design: TubeDesign) -> dict[str, np.ndarray]:
         e[outside, k[outside]] = far[outside]
         g_l, g_u, _, _ = R.adaptive_tube(design, t, alpha)
         x = _f32(((g_u - g_l) * e + (g_u + g_l)) / 2)
-        ok = (np.all(g_u - g_l >= 1e-2, axis=1) & np.all(psi + alpha > 0, axis=1)
-              & T.status_certain(design, x, alpha, g_l, g_u, T.UNIT_SINGLE))
+        usable = np.all(g_u - g_l >= 1e-2, axis=1) & np.all(psi + alpha > 0, axis=1)
+        narrowest = np.min(g_u - g_l, axis=1)
+        if usable.any():
+            widest = max(widest, float(np.max(narrowest[usable])))
+        dg = T.gamma_bound(design, alpha, unit)[:, 0]
+        resolvable += int(np.sum(usable & (narrowest > RESOLUTION * dg)))
+        ok = usable & T.status_certain(design, x, alpha, g_l, g_u, unit)
         _, _, inside = R.controller_step(design, x, t, dt, alpha)
         for i in np.flatnonzero(ok):
             kind = bool(inside[i] == 0.0)
@@ -61,6 +103,22 @@ def sample_inputs(design: TubeDesign) -> dict[str, np.ndarray]:
             have[kind] += 1
             for key, value in (("x", x), ("t", t), ("dt", dt), ("alpha", alpha)):
                 chosen[key].append(value[i])
+    if have[False] < INSIDE or have[True] < OUTSIDE:
+        magnitude = max(max(abs(v) for v in design.state_lower),
+                        max(abs(v) for v in design.state_upper))
+        if resolvable == 0:
+            hint = "; use precision double" if precision == "single" else (
+                "; shift the spec's coordinates nearer 0")
+            bound = T.GAMMA_FACTOR * unit * (1.0 + magnitude)
+            raise SpecError("precision", (
+                f"{precision} precision cannot resolve a tube of width {widest:.3g} at "
+                f"coordinates of magnitude {magnitude:.3g}: the error bound of its bounds "
+                f"there is {bound:.3g} and the test points need a width above "
+                f"{RESOLUTION * bound:.3g}{hint}"))
+        raise CodegenError(
+            f"test vectors: {have[False]} of {INSIDE} inside and {have[True]} of {OUTSIDE} "
+            f"outside points with a certain {precision}-precision status after "
+            f"{ROUNDS * BATCH} candidates")
     return {k: np.array(v) for k, v in chosen.items()}
 
 
@@ -74,7 +132,7 @@ def test_vectors(design: TubeDesign, precision: str) -> dict:
         ``gamma_L``, ``gamma_U`` (reference); ``tol_u``, ``tol_alpha_next``,
         ``tol_gamma`` (absolute tolerances, same shapes); ``unit_roundoff``.
     """
-    p = sample_inputs(design)
+    p = sample_inputs(design, precision)
     x, t, dt, alpha = p["x"], p["t"], p["dt"], p["alpha"]
     u, alpha_next, inside = R.controller_step(design, x, t, dt, alpha)
     g_l, g_u, _, _ = R.adaptive_tube(design, t, alpha)

@@ -370,12 +370,13 @@ def error_transform_expression(x, gamma_l, gamma_u) -> tuple:
 def law_expression(x, gamma_l, gamma_u, gain, n: int) -> tuple:
     """Deployed law (13) with clamps: ``(u, inside)``, ``u = -gain xi epsilon`` with the
     ``epsilon``, ``xi`` of :func:`error_transform_expression` (finite everywhere)."""
-    gamma_d, width, e = _scaled_error(x, gamma_l, gamma_u)
+    _, width, e = _scaled_error(x, gamma_l, gamma_u)
     inside = 1.0
     for i in range(n):
-        # judged with the true width: below the GAMMA_D_MIN floor a state outside the tube
-        # must not be reported inside
-        inside = ca.logic_and(inside, ca.fabs(2.0 * x[i] - (gamma_u[i] + gamma_l[i])) < gamma_d[i])
+        # gamma_L < x < gamma_U, two comparisons, exact (no rounding): on or outside the
+        # bounds, or an empty tube, is not inside (docs/codegen.md, "Status OK"); a
+        # product of 0/1 values (exact) costs fewer instructions than logic_and
+        inside = inside * (x[i] > gamma_l[i]) * (x[i] < gamma_u[i])
     _, epsilon, xi = _transform(e, width)
     return -gain * xi * epsilon, inside
 

@@ -512,16 +512,16 @@ def controller_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, 
 
     ``u`` follows law (13) with ``e`` clamped to ``[-E_MAX, E_MAX]`` and ``gamma_d``
     floored at ``GAMMA_D_MIN``, so it is finite outside the tube too. ``inside`` is
-    judged with the true width, ``|2 x_i - gamma_s_i| < gamma_d_i`` (that is,
-    ``|e_i| < 1`` and ``gamma_d_i > 0``): below the floor the floored ``e`` is smaller than
-    the true one and would report a state outside the tube as inside.
+    ``gamma_L_i < x_i < gamma_U_i`` for every ``i``, two comparisons without rounding (the
+    rounded ``|2 x_i - gamma_s_i| < gamma_d_i`` reported points on the bounds and one ulp
+    outside as inside); an empty tube has no inside point.
 
     Returns
     -------
     u : ndarray, shape (N, n)
     alpha_next : ndarray, shape (N, 2n)
     inside : ndarray, shape (N,)
-        1.0 where ``|2 x_i - (gamma_U_i + gamma_L_i)| < gamma_d_i`` for every ``i``, else 0.0.
+        1.0 where ``gamma_L_i < x_i < gamma_U_i`` for every ``i``, else 0.0.
     """
     t = _time(t)
     gamma_l, gamma_u, _, _ = adaptive_tube(design, t, alpha)
@@ -529,7 +529,7 @@ def controller_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, 
     gamma_d = gamma_u - gamma_l
     width = np.maximum(gamma_d, GAMMA_D_MIN)
     e = (2.0 * x - (gamma_u + gamma_l)) / width
-    inside = np.all(np.abs(2.0 * x - (gamma_u + gamma_l)) < gamma_d, axis=1).astype(float)
+    inside = np.all((x > gamma_l) & (x < gamma_u), axis=1).astype(float)
     e_c = np.clip(e, -E_MAX, E_MAX)
     epsilon = log((1.0 + e_c) / (1.0 - e_c))
     xi = 4.0 / (width * (1.0 - e_c**2))

@@ -13,8 +13,10 @@
 
 #include "omnirobot_s2.h"
 
-#ifdef __FAST_MATH__
-#error "omnirobot_s2.c must not be compiled with -ffast-math (or -Ofast): it removes the isfinite() input checks and changes the rounding the tolerances assume"
+/* -ffast-math and -Ofast define __FAST_MATH__; -ffinite-math-only (gcc, clang) and clang's
+   -fno-honor-nans -fno-honor-infinities together define __FINITE_MATH_ONLY__ 1. */
+#if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && (__FINITE_MATH_ONLY__ != 0))
+#error "omnirobot_s2.c must not be compiled with -ffast-math (or -Ofast, -ffinite-math-only, -fno-honor-nans, -fno-honor-infinities): they remove the isfinite() input checks and change the rounding the tolerances assume"
 #endif
 
 /* ------------------------------------------------------------- spec tables */
@@ -945,7 +947,7 @@ static void body_newton_iteration(const omnirobot_s2_real* a, const omnirobot_s2
   a_next[0] = w0;
 }
 
-/* CasADi Function 'law': 94 instructions. */
+/* CasADi Function 'law': 87 instructions. */
 static void body_law(const omnirobot_s2_real* x, const omnirobot_s2_real* gamma_L, const omnirobot_s2_real* gamma_U, const omnirobot_s2_real* gain, omnirobot_s2_real* u, omnirobot_s2_real* inside) {
   omnirobot_s2_real w0;
   omnirobot_s2_real w1;
@@ -964,103 +966,93 @@ static void body_law(const omnirobot_s2_real* x, const omnirobot_s2_real* gamma_
   omnirobot_s2_real w14;
   omnirobot_s2_real w15;
   omnirobot_s2_real w16;
-  omnirobot_s2_real w17;
-  omnirobot_s2_real w18;
-  omnirobot_s2_real w19;
   w0 = gain[0];
   w1 = 4.0;
   w2 = gamma_U[0];
   w3 = gamma_L[0];
   w4 = w2 - w3;
   w5 = 1e-06;
-  w6 = (w5 > w4) ? w5 : w4;
-  w7 = 1.0;
-  w8 = x[0];
-  w9 = w8 + w8;
-  w10 = w2 + w3;
-  w9 = w9 - w10;
-  w9 = w9 / w6;
-  w10 = -0.9999990463256836;
-  w9 = (w10 > w9) ? w10 : w9;
-  w11 = 0.9999990463256836;
-  w9 = (w11 < w9) ? w11 : w9;
-  w12 = w9 * w9;
-  w12 = w7 - w12;
-  w6 = w6 * w12;
-  w6 = w1 / w6;
-  w6 = w0 * w6;
-  w12 = w7 + w9;
-  w9 = w7 - w9;
-  w12 = w12 / w9;
-  w12 = log(w12);
-  w6 = w6 * w12;
-  w6 = -w6;
-  u[0] = w6;
-  w6 = gamma_U[1];
-  w12 = gamma_L[1];
-  w9 = w6 - w12;
-  w13 = (w5 > w9) ? w5 : w9;
-  w14 = x[1];
-  w15 = w14 + w14;
-  w16 = w6 + w12;
+  w4 = (w5 > w4) ? w5 : w4;
+  w6 = 1.0;
+  w7 = x[0];
+  w8 = w7 + w7;
+  w9 = w2 + w3;
+  w8 = w8 - w9;
+  w8 = w8 / w4;
+  w9 = -0.9999990463256836;
+  w8 = (w9 > w8) ? w9 : w8;
+  w10 = 0.9999990463256836;
+  w8 = (w10 < w8) ? w10 : w8;
+  w11 = w8 * w8;
+  w11 = w6 - w11;
+  w4 = w4 * w11;
+  w4 = w1 / w4;
+  w4 = w0 * w4;
+  w11 = w6 + w8;
+  w8 = w6 - w8;
+  w11 = w11 / w8;
+  w11 = log(w11);
+  w4 = w4 * w11;
+  w4 = -w4;
+  u[0] = w4;
+  w4 = gamma_U[1];
+  w11 = gamma_L[1];
+  w8 = w4 - w11;
+  w8 = (w5 > w8) ? w5 : w8;
+  w12 = x[1];
+  w13 = w12 + w12;
+  w14 = w4 + w11;
+  w13 = w13 - w14;
+  w13 = w13 / w8;
+  w13 = (w9 > w13) ? w9 : w13;
+  w13 = (w10 < w13) ? w10 : w13;
+  w14 = w13 * w13;
+  w14 = w6 - w14;
+  w8 = w8 * w14;
+  w8 = w1 / w8;
+  w8 = w0 * w8;
+  w14 = w6 + w13;
+  w13 = w6 - w13;
+  w14 = w14 / w13;
+  w14 = log(w14);
+  w8 = w8 * w14;
+  w8 = -w8;
+  u[1] = w8;
+  w8 = gamma_U[2];
+  w14 = gamma_L[2];
+  w13 = w8 - w14;
+  w13 = (w5 > w13) ? w5 : w13;
+  w5 = x[2];
+  w15 = w5 + w5;
+  w16 = w8 + w14;
   w15 = w15 - w16;
   w15 = w15 / w13;
-  w15 = (w10 > w15) ? w10 : w15;
-  w15 = (w11 < w15) ? w11 : w15;
-  w16 = w15 * w15;
-  w16 = w7 - w16;
-  w13 = w13 * w16;
-  w13 = w1 / w13;
-  w13 = w0 * w13;
-  w16 = w7 + w15;
-  w15 = w7 - w15;
-  w16 = w16 / w15;
-  w16 = log(w16);
-  w13 = w13 * w16;
-  w13 = -w13;
-  u[1] = w13;
-  w13 = gamma_U[2];
-  w16 = gamma_L[2];
-  w15 = w13 - w16;
-  w5 = (w5 > w15) ? w5 : w15;
-  w17 = x[2];
-  w18 = w17 + w17;
-  w19 = w13 + w16;
-  w18 = w18 - w19;
-  w18 = w18 / w5;
-  w18 = (w10 > w18) ? w10 : w18;
-  w18 = (w11 < w18) ? w11 : w18;
-  w11 = w18 * w18;
-  w11 = w7 - w11;
-  w5 = w5 * w11;
-  w1 = w1 / w5;
+  w15 = (w9 > w15) ? w9 : w15;
+  w15 = (w10 < w15) ? w10 : w15;
+  w10 = w15 * w15;
+  w10 = w6 - w10;
+  w13 = w13 * w10;
+  w1 = w1 / w13;
   w0 = w0 * w1;
-  w1 = w7 + w18;
-  w18 = w7 - w18;
-  w1 = w1 / w18;
+  w1 = w6 + w15;
+  w6 = w6 - w15;
+  w1 = w1 / w6;
   w1 = log(w1);
   w0 = w0 * w1;
   w0 = -w0;
   u[2] = w0;
-  w8 = w8 + w8;
-  w2 = w2 + w3;
-  w8 = w8 - w2;
-  w8 = fabs(w8);
-  w8 = (w8 < w4) ? 1.0 : 0.0;
-  w7 = ((w7 != 0.0) && (w8 != 0.0)) ? 1.0 : 0.0;
-  w14 = w14 + w14;
-  w6 = w6 + w12;
-  w14 = w14 - w6;
-  w14 = fabs(w14);
-  w14 = (w14 < w9) ? 1.0 : 0.0;
-  w7 = ((w7 != 0.0) && (w14 != 0.0)) ? 1.0 : 0.0;
-  w17 = w17 + w17;
-  w13 = w13 + w16;
-  w17 = w17 - w13;
-  w17 = fabs(w17);
-  w17 = (w17 < w15) ? 1.0 : 0.0;
-  w7 = ((w7 != 0.0) && (w17 != 0.0)) ? 1.0 : 0.0;
-  inside[0] = w7;
+  w3 = (w3 < w7) ? 1.0 : 0.0;
+  w7 = (w7 < w2) ? 1.0 : 0.0;
+  w3 = w3 * w7;
+  w11 = (w11 < w12) ? 1.0 : 0.0;
+  w3 = w3 * w11;
+  w12 = (w12 < w4) ? 1.0 : 0.0;
+  w3 = w3 * w12;
+  w14 = (w14 < w5) ? 1.0 : 0.0;
+  w3 = w3 * w14;
+  w5 = (w5 < w8) ? 1.0 : 0.0;
+  w3 = w3 * w5;
+  inside[0] = w3;
 }
 
 /* ----------------------------------------------------------------- typed API */
@@ -1288,6 +1280,10 @@ int omnirobot_s2_tube(omnirobot_s2_real t, const omnirobot_s2_real alpha[OMNIROB
     omnirobot_s2_real g_l_dot[OMNIROBOT_S2_N];
     omnirobot_s2_real g_u_dot[OMNIROBOT_S2_N];
     int rates = 0;
+    /* zeroed: written only on the paths that compute them (gcc's -Wmaybe-uninitialized
+       cannot tell for n = 1) */
+    omnirobot_s2_zero(g_l_dot, OMNIROBOT_S2_N);
+    omnirobot_s2_zero(g_u_dot, OMNIROBOT_S2_N);
     if ((gamma_L_dot != NULL) || (gamma_U_dot != NULL)) {
       rates = 1;
     }
@@ -1322,6 +1318,12 @@ int omnirobot_s2_tube(omnirobot_s2_real t, const omnirobot_s2_real alpha[OMNIROB
       omnirobot_s2_zero(gamma_L_dot, OMNIROBOT_S2_N);
       omnirobot_s2_zero(gamma_U_dot, OMNIROBOT_S2_N);
     }
+  } else {
+    /* gamma_L or gamma_U NULL: INVALID_INPUT, every other output zeroed */
+    omnirobot_s2_zero(gamma_L, OMNIROBOT_S2_N);
+    omnirobot_s2_zero(gamma_U, OMNIROBOT_S2_N);
+    omnirobot_s2_zero(gamma_L_dot, OMNIROBOT_S2_N);
+    omnirobot_s2_zero(gamma_U_dot, OMNIROBOT_S2_N);
   }
   return status;
 }
@@ -1480,6 +1482,16 @@ int omnirobot_s2_step(const omnirobot_s2_real x[OMNIROBOT_S2_N], omnirobot_s2_re
     } else {
       omnirobot_s2_copy(uc, u, OMNIROBOT_S2_N);
     }
+  } else {
+    /* u or alpha_next NULL: INVALID_INPUT, the other output written as documented */
+    if (alpha_next != NULL) {
+      if (alpha == NULL) {
+        omnirobot_s2_zero(alpha_next, OMNIROBOT_S2_N_ALPHA);
+      } else {
+        omnirobot_s2_keep_alpha(alpha, alpha_next);
+      }
+    }
+    omnirobot_s2_zero(u, OMNIROBOT_S2_N);
   }
   return status;
 }

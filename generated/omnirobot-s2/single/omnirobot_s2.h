@@ -10,8 +10,9 @@
  *
  * C99, depends on <math.h> only (link with -lm). No allocation, no global or static
  * mutable state: every function is reentrant and thread-safe. Arithmetic: float.
- * Do not compile with -ffast-math / -Ofast (the source stops with #error): it would
- * remove the input checks.
+ * Do not compile with -ffast-math, -Ofast, -ffinite-math-only or clang's -fno-honor-nans /
+ * -fno-honor-infinities (the source stops with #error under each of the first three and
+ * under the last two together): they would remove the input checks.
  *
  * Units: time t, dt in seconds; x, gamma_L, gamma_U, alpha in state units (the spec's);
  * gamma_*_dot in state units per second; u in state units per second (the input of the
@@ -34,7 +35,9 @@
  *          from alpha = 0, and far below ALPHA_MAX.
  *
  * Status codes (return value of every function):
- *   OMNIROBOT_S2_STATUS_OK            0  outputs valid, x strictly inside the tube.
+ *   OMNIROBOT_S2_STATUS_OK            0  outputs valid, x strictly inside the tube:
+ *                                  gamma_L_i < x_i < gamma_U_i for every i, compared
+ *                                  exactly (no rounding) with the bounds P_tube returns.
  *   OMNIROBOT_S2_STATUS_OUTSIDE_TUBE  1  x is on or outside the tube (|e_i| >= 1) or the tube
  *                                  is empty in some dimension: u is still finite (the
  *                                  error e is clamped to +-(1 - 2^-20) and the width
