@@ -25,7 +25,6 @@ Results (proved in :func:`adaptive_law_checks`, tested in
 
 from __future__ import annotations
 
-import functools
 from fractions import Fraction
 from typing import Callable, Mapping
 
@@ -153,7 +152,6 @@ def alpha_rate_bound(
     return y_min, float(np.nextafter(max(ts / y_min**2, kappa * a_max), np.inf))
 
 
-@functools.lru_cache(maxsize=None)
 def adaptive_law_form() -> dict:
     """The symbolic part of :func:`adaptive_law_checks`, for every ``theta0``, ``kappa``,
     ``mu`` > 0 and every ``psi``.

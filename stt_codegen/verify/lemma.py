@@ -28,7 +28,6 @@ equal to the deployed ``max~`` and ``min~``.
 
 from __future__ import annotations
 
-import functools
 from typing import Sequence
 
 import mpmath
@@ -352,7 +351,6 @@ def reach_rate_constant(digits: int = 30) -> tuple[float, float, float]:
     return float(w_star), float(c_lo.a), float(np.nextafter(float(c_hi.b), np.inf))
 
 
-@functools.lru_cache(maxsize=None)
 def reach_rate_form() -> bool:
     """The symbolic part of :func:`reach_rate_bound`, for every ``X``, ``T``, ``t_c``.
 
@@ -412,7 +410,6 @@ def reach_rate_bound(x0: float, target: float, t_c: float, form: bool | None = N
     )
 
 
-@functools.lru_cache(maxsize=None)
 def bump_rate_form() -> bool:
     """The symbolic part of :func:`bump_rate_bound`, for every ``m``, ``r > 0``, ``k > 0``.
 
