@@ -18,8 +18,7 @@ from ..tube import reference
 from ..design.certificate import Certificate
 from ..design.result import Design
 from ..design.samples import sample_tube
-from ..design.search import (MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, TubeCheck, check_tube,
-                             design_tube)
+from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
 from ..spec.loader import PLANT_MODELS, Spec, load_spec
 from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
@@ -62,7 +61,7 @@ def _psi_ranges(design: TubeDesign, certificate: Certificate) -> tuple[np.ndarra
 
 
 def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
-                  tube_check: TubeCheck | None = None, cache: bool = True,
+                  cache: bool = True,
                   progress: Callable[[str], None] | None = None) -> list[Check]:
     """Run every check on a designed tube.
 
@@ -73,9 +72,6 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     plant : str, optional
         Plant model for Assumption 2 (one of :data:`stt_codegen.spec.loader.PLANT_MODELS`);
         default the spec's.
-    tube_check : TubeCheck, optional
-        ``check_tube(design, spec)`` when this process has just computed it (the design
-        of :func:`verify_spec`); computed here when omitted.
     cache : bool
         Take the design-independent proofs from the proof cache
         (:func:`~stt_codegen.verify.proofs.design_independent_proofs`).
@@ -125,8 +121,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         checks.append(assumption2_single_integrator(n))
 
     stage("tube certificate")
-    if tube_check is None:
-        tube_check = check_tube(design, spec)
+    tube_check = check_tube(design, spec)   # not the designer's: verify certifies again
     enclosure = tube_check.certificate.enclosure
     stage("adaptive law")
     psi_min, psi0 = _psi_ranges(design, tube_check.certificate)
@@ -180,20 +175,14 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
 
 def verify_spec(spec: Spec, plant: str | None = None, *, cache: bool = True,
                 progress: Callable[[str], None] | None = None) -> list[Check]:
-    """Design the tube of a spec and run :func:`verify_design`; a design failure is a FAIL.
-
-    The design's own check (:attr:`Design.check <stt_codegen.design.result.Design.check>`,
-    computed by :func:`~stt_codegen.design.search.design_tube` in this call) is the tube
-    check, not computed a second time.
-    """
+    """Design the tube of a spec and run :func:`verify_design`; a design failure is a FAIL."""
     stage = _Stages(progress, design=True)
     stage("design")
     try:
         design = design_tube(spec)
     except DesignError as exc:
         return [Check("tube.design", False, str(exc))]
-    return verify_design(spec, design.tube, plant, tube_check=design.check, cache=cache,
-                         progress=stage)
+    return verify_design(spec, design.tube, plant, cache=cache, progress=stage)
 
 
 def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
@@ -220,8 +209,8 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
     ----------
     design_or_spec : Design or Spec
         A :class:`~stt_codegen.design.result.Design` (from
-        :func:`stt_codegen.design_tube`), checked against its own ``design.spec`` and
-        certified again here; or a :class:`~stt_codegen.spec.loader.Spec`, designed
+        :func:`stt_codegen.design_tube`), checked against its own ``design.spec`` (its
+        tube is certified again here, not taken from ``design.certificate``); or a :class:`~stt_codegen.spec.loader.Spec`, designed
         first: a spec with no design gives a report whose one check, ``tube.design``,
         failed.
     plant : str, optional

@@ -226,7 +226,10 @@ def store(key: str, proofs: Proofs) -> bool:
         tmp.write_text(text, encoding="utf-8")
         os.replace(tmp, path)
     except OSError:
-        tmp.unlink(missing_ok=True)
+        try:
+            tmp.unlink(missing_ok=True)
+        except OSError:     # the folder itself could not be made
+            pass
         return False
     return True
 
