@@ -97,6 +97,15 @@ def test_an_unwritable_cache_costs_time_only(tmp_path, monkeypatch):
     assert list(tmp_path.iterdir()) == [blocker]
 
 
+def test_an_unreadable_proof_source_means_no_cache(cache_home, tmp_path, monkeypatch):
+    calls: list = []
+    monkeypatch.setattr(proofs, "prove", _stub(calls))
+    monkeypatch.setattr(proofs.lemma, "__file__", str(tmp_path / "missing.py"))
+    proofs.design_independent_proofs(2)
+    proofs.design_independent_proofs(2)
+    assert calls == [2, 2] and not cache_home.exists()
+
+
 def _bump_linear_exponent(rates: bool = True) -> ca.Function:
     """The bump with ``-k |d| / den`` for ``-k d^2 / den`` in the exponent."""
     names = ["t", "start", "end", "center", "radius", "sharpness", "height"]
