@@ -28,6 +28,14 @@ from typing import TYPE_CHECKING, Any
 
 from .errors import DesignError, SpecError, SttError, ToolchainError
 
+# ``stt_codegen.verify`` is the function (``_LAZY`` below), and ``stt_codegen/verify/`` is
+# also the package of the checks. The import system binds a subpackage to its parent's
+# attribute when it first loads it, and only then: so the (cheap) package is loaded here,
+# once, and that binding dropped. After this, ``import stt_codegen.verify.lemma`` and the
+# like never rebind the name, and ``stt_codegen.verify`` is always the function.
+from . import verify as _verify_package  # noqa: E402,F401
+globals().pop("verify", None)
+
 __version__ = "0.1.0"
 
 #: Public name -> module that defines it; imported on first attribute access.

@@ -214,3 +214,23 @@ def test_the_command_line_json_has_no_progress(cache_home):
     assert run.returncode == 0, run.stderr
     assert json.loads(run.stdout)[0]["name"] == "lemma3.3.reach.continuity"
     assert run.stderr == ""
+
+
+@pytest.mark.parametrize("first", ["import stt_codegen.verify.lemma", "import stt_codegen",
+                                   "from stt_codegen.verify import Check"])
+def test_stt_codegen_verify_is_the_function_whatever_is_imported_first(first):
+    """The package ``stt_codegen/verify/`` never shadows the front door's function."""
+    code = (f"{first}\nimport stt_codegen, stt_codegen.verify.proofs\n"
+            "from stt_codegen.verify.command import verify\n"
+            "assert stt_codegen.verify is verify, stt_codegen.verify\n"
+            "from stt_codegen import verify as again\nassert again is verify")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=False)
+    assert run.returncode == 0, run.stderr
+
+
+def test_importing_stt_codegen_stays_cheap():
+    code = "import sys, stt_codegen\nassert 'sympy' not in sys.modules and 'numpy' not in sys.modules"
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=False)
+    assert run.returncode == 0, run.stderr

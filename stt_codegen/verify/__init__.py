@@ -24,17 +24,41 @@ modules:
 * :mod:`.command` -- every check of one design, :func:`~.command.verify`.
 """
 
-from .adaptive import (adaptive_law_checks, adversarial_psi_signals, alpha_rate_bound,
-                       alpha_upper_bound, check_adaptive_law_numeric, simulate_alpha)
-from .assumption import (assumption2_omnidirectional, assumption2_single_integrator,
-                         check_assumption2, symmetric_part)
-from .check import Check, VerificationReport, all_passed, format_report
-from .lemma import (bump_rate_bound, check_bump_flat_all_orders, check_bump_flatness,
-                    check_reach_continuity, check_reach_flat_all_orders, check_smooth_max,
-                    lemma_checks, reach_rate_bound, reach_rate_constant)
-from .transform import (check_epsilon_jacobian, check_lyapunov_derivative,
-                        error_transform_checks, outer_product_difference, xi_diagonal,
-                        xi_outer_product)
+import importlib
+from typing import Any
+
+#: Public name -> submodule that defines it; imported on first use (PEP 562), so importing
+#: this package costs nothing (``import stt_codegen`` imports it, see there).
+_LAZY: dict[str, str] = {
+    **dict.fromkeys(("adaptive_law_checks", "adversarial_psi_signals", "alpha_rate_bound",
+                     "alpha_upper_bound", "check_adaptive_law_numeric", "simulate_alpha"),
+                    "adaptive"),
+    **dict.fromkeys(("assumption2_omnidirectional", "assumption2_single_integrator",
+                     "check_assumption2", "symmetric_part"), "assumption"),
+    **dict.fromkeys(("Check", "VerificationReport", "all_passed", "format_report"), "check"),
+    **dict.fromkeys(("bump_rate_bound", "check_bump_flat_all_orders", "check_bump_flatness",
+                     "check_reach_continuity", "check_reach_flat_all_orders",
+                     "check_smooth_max", "lemma_checks", "reach_rate_bound",
+                     "reach_rate_constant"), "lemma"),
+    **dict.fromkeys(("check_epsilon_jacobian", "check_lyapunov_derivative",
+                     "error_transform_checks", "outer_product_difference", "xi_diagonal",
+                     "xi_outer_product"), "transform"),
+}
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name on first use (PEP 562)."""
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.{module}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
 
 __all__ = [
     "Check",
