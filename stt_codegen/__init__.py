@@ -10,10 +10,9 @@ Spatiotemporal Tubes Approach". The front door, in the order of the flow (see
   and certify the tube (10) for every ``t``;
 * :func:`generate` - write the standalone C and Python controllers into a folder;
 * :func:`simulate` - run a sampled controller in closed loop and judge Definition 2.1;
-* :func:`verify` - the paper's lemmas, the assumptions and the tube certificate, as a
-  :class:`VerificationReport` (``stt_codegen.verify`` is also the package of the checks:
-  the package is callable, ``verify(spec, design)`` is
-  :func:`stt_codegen.verify.command.verify`);
+* :func:`verify` - the paper's lemmas, the assumptions and the tube certificate of a
+  design (or of a spec, designed first), as a :class:`VerificationReport`
+  (:func:`stt_codegen.verify.command.verify`);
 * the errors, in three kinds: :class:`SpecError` (bad input), :class:`DesignError` (no
   design, a negative outcome), :class:`ToolchainError` (a tool or an internal step
   failed); all are :class:`SttError`.
@@ -29,6 +28,14 @@ from typing import TYPE_CHECKING, Any
 
 from .errors import DesignError, SpecError, SttError, ToolchainError
 
+# ``stt_codegen.verify`` is the function (``_LAZY`` below), and ``stt_codegen/verify/`` is
+# also the package of the checks. The import system binds a subpackage to its parent's
+# attribute when it first loads it, and only then: so the (cheap) package is loaded here,
+# once, and that binding dropped. After this, ``import stt_codegen.verify.lemma`` and the
+# like never rebind the name, and ``stt_codegen.verify`` is always the function.
+from . import verify as _verify_package  # noqa: E402,F401
+globals().pop("verify", None)
+
 __version__ = "0.1.0"
 
 #: Public name -> module that defines it; imported on first attribute access.
@@ -43,9 +50,10 @@ _LAZY: dict[str, str] = {
     "simulate": "stt_codegen.runtime.simulate",
     "SimulationResult": "stt_codegen.runtime.simulate",
     "VerificationReport": "stt_codegen.verify.check",
+    "verify": "stt_codegen.verify.command",
 }
 
-__all__ = ["DesignError", "SpecError", "SttError", "ToolchainError", "__version__", "verify",
+__all__ = ["DesignError", "SpecError", "SttError", "ToolchainError", "__version__",
            *sorted(_LAZY)]
 
 if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
@@ -62,8 +70,6 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
 
 def __getattr__(name: str) -> Any:
     """Import a public name on first use (PEP 562)."""
-    if name == "verify":  # the subpackage, which is callable: see its docstring
-        return importlib.import_module("stt_codegen.verify")
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'stt_codegen' has no attribute {name!r}")
@@ -73,4 +79,4 @@ def __getattr__(name: str) -> Any:
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY) | {"verify"})
+    return sorted(set(globals()) | set(_LAZY))

@@ -15,7 +15,7 @@ the check accepts must not fail.
 
 ``--declared`` (issue 13): one set of declared bounds, :data:`DECLARED`; for each case the
 gain is derived from them and the rate is the lowest that passes the check
-(:func:`stt_codegen.design.gain.lowest_rate`); plants are drawn within the bounds
+(:func:`stt_codegen.verify.sampled.lowest_rate`); plants are drawn within the bounds
 (:func:`test_plants_support.plant_within`). Every run must hold.
 
 Seeded: the same runs every time. Prints a summary; ``--out`` writes every run as JSON.
@@ -180,7 +180,7 @@ def _declared_setup(case):
     """``(spec, design at the lowest rate, samples)`` for :data:`DECLARED`, cached."""
     key = ("declared", case)
     if key not in _CACHE:
-        from stt_codegen.design.gain import lowest_rate
+        from stt_codegen.verify.sampled import lowest_rate
         from stt_codegen.spec.loader import Assumptions
         spec, design = _designed(case)
         a = Assumptions(DECLARED["input_gain"], DECLARED["input_gain_skew"],

@@ -12,20 +12,15 @@ with factors in ``[-q, q]``, ``q = (g_max - g_min) / (g_max + g_min)``. For the 
 ``g_min = g_max = 1`` this is ``gamma_d,min^2 / (16 dt)``, the gain the toolkit has always
 used. Whether the gain and rate really keep every plant of the assumptions in the tube
 (drift, disturbance, coupling, the law's nonlinearity, the tube's motion) is decided by
-:func:`stt_codegen.verify.sampled.check_sampled`; :func:`lowest_rate` searches the rate
-at which it passes.
+:func:`stt_codegen.verify.sampled.check_sampled`, and
+:func:`stt_codegen.verify.sampled.lowest_rate` searches the rate at which it passes (the
+design layer never imports verify: verify builds on design).
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
-
-from ..spec.loader import Assumptions, Spec
+from ..spec.loader import Assumptions
 from ..tube.parameters import TubeDesign
-from .samples import sample_tube
-
-#: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
-RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
 
 
 def derived_gain(min_width: float, rate_hz: float, assumptions: Assumptions) -> float:
@@ -98,52 +93,3 @@ def gain_derivation(design: TubeDesign, min_width: float, min_width_time: float,
             "source": "derived" if explicit_gain is None else "controller.gain",
             "factor_at_g_min": factors[0], "factor_at_g_max": factors[1],
             "stable_gain_limit": stable_below, "explanation": words}
-
-
-def lowest_rate(design: TubeDesign, spec: Spec, assumptions: Assumptions,
-                explicit_gain: float | None = None) -> tuple[float | None, float | None]:
-    """The lowest of ``rate_hz`` times :data:`RATE_FACTORS` at which the design holds.
-
-    At each rate the tube keeps its circumvents and segments, is certified again
-    (:func:`~stt_codegen.design.certificate.certify_tube`: the deployed ``alpha`` and the
-    sampling-rate check depend on the rate), and the sampled check
-    (:func:`~stt_codegen.verify.sampled.check_sampled`) must pass with the gain the design
-    would use there: ``explicit_gain`` if given, else :func:`derived_gain` at that rate's
-    certified narrowest width. The largest factor is tried first; if it fails, no factor
-    is reported.
-
-    Parameters
-    ----------
-    design : TubeDesign
-    spec : Spec
-        For the certificate (state space, obstacles, target).
-    assumptions : Assumptions
-    explicit_gain : float, optional
-
-    Returns
-    -------
-    rate_hz, gain : float or None
-        ``(None, None)`` when no factor tried works.
-    """
-    from ..verify.sampled import check_sampled
-    from .certificate import certify_tube
-
-    def passes(factor: float) -> tuple[bool, float]:
-        trial = replace(design, rate_hz=design.rate_hz * factor)
-        certificate = certify_tube(trial, spec)
-        gain = (explicit_gain if explicit_gain is not None
-                else derived_gain(certificate.min_width, trial.rate_hz, assumptions))
-        if not certificate.passed:
-            return False, gain
-        return check_sampled(trial, sample_tube(trial), assumptions, gain).passed, gain
-
-    # the fastest rate first: when even it fails (coupling beyond what any rate can
-    # handle), one check answers instead of all of them
-    ok, fastest_gain = passes(RATE_FACTORS[-1])
-    if not ok:
-        return None, None
-    for factor in RATE_FACTORS[:-1]:
-        ok, gain = passes(factor)
-        if ok:
-            return design.rate_hz * factor, gain
-    return design.rate_hz * RATE_FACTORS[-1], fastest_gain

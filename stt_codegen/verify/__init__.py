@@ -1,9 +1,8 @@
 """Symbolic and numeric verification of the paper's formulas (``stt-codegen verify``).
 
-The package is callable: ``stt_codegen.verify(spec, design=None, plant=None)`` is
-:func:`stt_codegen.verify.command.verify` and returns a :class:`VerificationReport`.
-(The front door's ``verify`` and this package share one name, so the package itself is
-the function; see ``docs/library.md``.)
+The entry point is the function :func:`stt_codegen.verify.command.verify` (the front
+door's ``stt_codegen.verify``): ``verify(design)`` or ``verify(spec)`` returns a
+:class:`VerificationReport`.
 
 Every check returns a :class:`Check`. The checks are proved on the deployed expressions:
 the pieces of :mod:`stt_codegen.tube.pieces` printed by the emitter's SymPy printer. The
@@ -20,24 +19,46 @@ modules:
 * :mod:`.assumption` -- Assumption 2 for a plant's input matrix (the named plants' from
   :mod:`stt_codegen.runtime.dynamics`);
 * :mod:`.adaptive` -- non-negativity and an explicit bound of the adaptive law (11);
+* :mod:`.sampled` -- the sampled closed loop for every plant of ``[assumptions]``;
+* :mod:`.proofs` -- the design-independent proofs, cached on disk;
 * :mod:`.command` -- every check of one design, :func:`~.command.verify`.
 """
 
-import sys
-import types
-from typing import TYPE_CHECKING
+import importlib
+from typing import Any
 
-from .adaptive import (adaptive_law_checks, adversarial_psi_signals, alpha_rate_bound,
-                       alpha_upper_bound, check_adaptive_law_numeric, simulate_alpha)
-from .assumption import (assumption2_omnidirectional, assumption2_single_integrator,
-                         check_assumption2, symmetric_part)
-from .check import Check, VerificationReport, all_passed, format_report
-from .lemma import (bump_rate_bound, check_bump_flat_all_orders, check_bump_flatness,
-                    check_reach_continuity, check_reach_flat_all_orders, check_smooth_max,
-                    lemma_checks, reach_rate_bound, reach_rate_constant)
-from .transform import (check_epsilon_jacobian, check_lyapunov_derivative,
-                        error_transform_checks, outer_product_difference, xi_diagonal,
-                        xi_outer_product)
+#: Public name -> submodule that defines it; imported on first use (PEP 562), so importing
+#: this package costs nothing (``import stt_codegen`` imports it, see there).
+_LAZY: dict[str, str] = {
+    **dict.fromkeys(("adaptive_law_checks", "adversarial_psi_signals", "alpha_rate_bound",
+                     "alpha_upper_bound", "check_adaptive_law_numeric", "simulate_alpha"),
+                    "adaptive"),
+    **dict.fromkeys(("assumption2_omnidirectional", "assumption2_single_integrator",
+                     "check_assumption2", "symmetric_part"), "assumption"),
+    **dict.fromkeys(("Check", "VerificationReport", "all_passed", "format_report"), "check"),
+    **dict.fromkeys(("bump_rate_bound", "check_bump_flat_all_orders", "check_bump_flatness",
+                     "check_reach_continuity", "check_reach_flat_all_orders",
+                     "check_smooth_max", "lemma_checks", "reach_rate_bound",
+                     "reach_rate_constant"), "lemma"),
+    **dict.fromkeys(("check_epsilon_jacobian", "check_lyapunov_derivative",
+                     "error_transform_checks", "outer_product_difference", "xi_diagonal",
+                     "xi_outer_product"), "transform"),
+}
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name on first use (PEP 562)."""
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.{module}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))
+
 
 __all__ = [
     "Check",
@@ -74,22 +95,3 @@ __all__ = [
     "check_adaptive_law_numeric",
     "simulate_alpha",
 ]
-
-if TYPE_CHECKING:
-    from ..spec.loader import Spec
-    from ..tube.parameters import TubeDesign
-
-
-class _CallablePackage(types.ModuleType):
-    """This package's type: a module that can be called as :func:`.command.verify`."""
-
-    def __call__(self, spec: "Spec", design: "TubeDesign | None" = None,
-                 plant: "str | None" = None) -> VerificationReport:
-        """Every check of a spec's designed tube: see :func:`stt_codegen.verify.command.verify`."""
-        from .command import verify
-        return verify(spec, design, plant)
-
-
-# the package object itself becomes callable (PEP 549-style, supported since Python 3.5);
-# only this module's own type is set, nothing global
-sys.modules[__name__].__class__ = _CallablePackage

@@ -31,7 +31,6 @@ from typing import Callable, Mapping
 import mpmath
 import numpy as np
 import sympy as sp
-from scipy.integrate import solve_ivp
 
 from .check import Check
 from .deployed import trigger, trigger_clamped
@@ -153,6 +152,41 @@ def alpha_rate_bound(
     return y_min, float(np.nextafter(max(ts / y_min**2, kappa * a_max), np.inf))
 
 
+def adaptive_law_form() -> dict:
+    """The symbolic part of :func:`adaptive_law_checks`, for every ``theta0``, ``kappa``,
+    ``mu`` > 0 and every ``psi``.
+
+    On the deployed trigger (``pieces.conflict`` printed by the SymPy printer, in the
+    symbols ``psi`` real, ``theta0`` and ``mu`` positive; ``deployed.trigger`` proves it
+    equal to ``theta0 (1 - tanh(psi - mu))`` where its clamps are inactive): it is
+    positive with its clamps, ``d theta/d psi = -theta0 sech^2(psi - mu)``, and the
+    algebra of the upper bound's proof. Independent of the design: :mod:`.proofs` caches
+    it.
+
+    Returns
+    -------
+    dict
+        ``trigger`` (the clamped deployed trigger, str), ``trigger_positive`` (bool),
+        ``upper_bound_proved`` (bool) and ``df_da`` (``d/da kappa a (psi_min + a)^2``,
+        str).
+    """
+    clamped, (p, th0, mu_s) = trigger_clamped()
+    th = trigger()
+    kap = sp.Symbol("kappa", positive=True)
+    pm, aa, ts = sp.symbols("psi_min a theta_sup", real=True)
+    # d theta/d psi of the deployed trigger (0 where a clamp acts: still <= 0)
+    dth = sp.simplify((sp.diff(th, p) + th0 * sp.sech(p - mu_s) ** 2).rewrite(sp.exp))
+    fa = kap * aa * (pm + aa) ** 2
+    dfa = sp.factor(sp.diff(fa, aa))
+    dfa_ok = sp.expand(dfa - kap * (pm + aa) * (pm + 3 * aa)) == 0
+    split_ok = sp.simplify(ts / (pm + aa) ** 2 - kap * aa - (ts - fa) / (pm + aa) ** 2) == 0
+    dinv = sp.diff(1 / (p + aa) ** 2, p)  # = -2/(p + a)^3 < 0 for p + a > 0
+    dinv_ok = sp.simplify(dinv + 2 / (p + aa) ** 3) == 0
+    return {"trigger": str(clamped), "trigger_positive": bool(clamped.is_positive),
+            "upper_bound_proved": bool(dth == 0 and dfa_ok and split_ok and dinv_ok),
+            "df_da": str(dfa)}
+
+
 def adaptive_law_checks(
     psi_min: float,
     theta0: float,
@@ -160,6 +194,7 @@ def adaptive_law_checks(
     mu: float,
     psi0: float | None = None,
     psi_dot_max: float | None = None,
+    form: dict | None = None,
 ) -> list[Check]:
     """Symbolic checks of the adaptive law (11) for given parameters.
 
@@ -175,6 +210,9 @@ def adaptive_law_checks(
         ``sup_t |psi_dot(t)|`` (e.g. from :func:`.lemma.reach_rate_bound` and
         :func:`.lemma.bump_rate_bound`); with ``psi0`` gives an explicit bound
         of ``|alpha_dot|``, which Lemma 3.3 needs.
+    form : dict, optional
+        The result of :func:`adaptive_law_form` when already known (the proof cache,
+        :mod:`.proofs`); proved here when omitted.
 
     Returns
     -------
@@ -199,19 +237,14 @@ def adaptive_law_checks(
                      "would make alpha unbounded, growing like t^(1/3))",
                      {"theta0": theta0, "kappa": kappa, "mu": mu}))
 
-    # the deployed trigger (pieces.conflict printed by the SymPy printer), in the symbols
-    # psi (real), theta0 and mu (positive); deployed.trigger proves it equal to
-    # theta0 (1 - tanh(psi - mu)) where its clamps are inactive
-    clamped, (p, th0, mu_s) = trigger_clamped()
-    th = trigger()
-    kap = sp.Symbol("kappa", positive=True)
+    proved = adaptive_law_form() if form is None else form
     # -- non-negativity, on the deployed expression with its clamps
-    positive = bool(clamped.is_positive)
+    positive = proved["trigger_positive"]
     zthr = theta_zero_threshold()
     out.append(Check(
         "adaptive.nonnegative",
         positive,
-        f"the deployed theta = {clamped} is "
+        f"the deployed theta = {proved['trigger']} is "
         f"{'proved > 0' if positive else 'NOT proved > 0'} for every psi (theta0 > 0), "
         "so alpha_dot >= -kappa "
         "alpha and alpha(0) = 0 give alpha(t) >= 0 (alpha_dot = theta/psi^2 >= 0 at "
@@ -220,21 +253,11 @@ def adaptive_law_checks(
         {"theta_zero_threshold": zthr},
     ))
     # -- upper bound
-    pm, aa, ts = sp.symbols("psi_min a theta_sup", real=True)
-    # d theta/d psi of the deployed trigger (0 where a clamp acts: still <= 0)
-    dth = sp.simplify((sp.diff(th, p) + th0 * sp.sech(p - mu_s) ** 2).rewrite(sp.exp))
-    fa = kap * aa * (pm + aa) ** 2
-    dfa = sp.factor(sp.diff(fa, aa))
-    dfa_ok = sp.expand(dfa - kap * (pm + aa) * (pm + 3 * aa)) == 0
-    split_ok = sp.simplify(ts / (pm + aa) ** 2 - kap * aa - (ts - fa) / (pm + aa) ** 2) == 0
-    dinv = sp.diff(1 / (p + aa) ** 2, p)  # = -2/(p + a)^3 < 0 for p + a > 0
-    dinv_ok = sp.simplify(dinv + 2 / (p + aa) ** 3) == 0
     a_max = alpha_upper_bound(psi_min, theta0, kappa, mu)
     ts_num = float(theta(psi_min, theta0, mu))
-    proof_ok = dth == 0 and dfa_ok and split_ok and dinv_ok
     out.append(Check(
         "adaptive.upper_bound",
-        proof_ok,
+        proved["upper_bound_proved"],
         f"alpha(t) <= alpha_max = {a_max:.12g}, the root a > max(0, -psi_min) of "
         f"kappa a (psi_min + a)^2 = theta_sup = theta0 (1 - tanh(psi_min - mu)) = "
         f"{ts_num:.6g} (psi_min = {psi_min}). Proof: d theta/d psi = -theta0 "
@@ -244,7 +267,7 @@ def adaptive_law_checks(
         "Tight: the equilibrium of (11) for psi == psi_min. Assumes psi + alpha > 0 "
         "(adaptive.singularity)",
         {"alpha_max": a_max, "theta_sup": ts_num, "psi_min": psi_min,
-         "df_da": str(dfa)},
+         "df_da": proved["df_da"]},
     ))
     # -- singularity psi + alpha = 0
     if psi0 is not None:
@@ -308,6 +331,9 @@ def simulate_alpha(
     def jac(t: float, a: np.ndarray) -> np.ndarray:
         ps = psi(t)
         return np.array([[-2 * theta(ps, theta0, mu) / (ps + a[0]) ** 3 - kappa]])
+
+    # scipy.integrate takes ~0.4 s to import and only this numeric cross-check needs it
+    from scipy.integrate import solve_ivp
 
     sol = solve_ivp(rhs, (0.0, t_end), [0.0], method="Radau", jac=jac, rtol=rtol,
                     atol=atol, max_step=max_step)

@@ -8,13 +8,15 @@ its ``psi``, and the continuous-time tube certificate (:mod:`stt_codegen.design.
 from __future__ import annotations
 
 import argparse
-import functools
 import json
+import sys
+from typing import Callable
 
 import numpy as np
 
 from ..tube import reference
 from ..design.certificate import Certificate
+from ..design.result import Design
 from ..design.samples import sample_tube
 from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
@@ -24,24 +26,32 @@ from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
 from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_omnidirectional, assumption2_single_integrator
 from .check import Check, VerificationReport
-from .deployed import deployed_checks
-from .lemma import bump_rate_bound, lemma_checks, reach_rate_bound
+from .lemma import bump_rate_bound, reach_rate_bound
+from .proofs import design_independent_proofs
 from .sampled import linear_plant_checks, sampled_checks
-from .transform import error_transform_checks
 
 #: Dimension names used in check names.
 _SIDES = ("L", "U")
 
+#: The stages ``verify`` reports to its ``progress`` callback, in order; the proofs from
+#: the cache are reported as the last proof stage.
+STAGES = ("design", "deployed pieces", "lemma 3.3", "error transform", "rate bound forms",
+          "rate bounds", "assumption 2", "tube certificate", "adaptive law", "sampled loop")
+_CACHED = "cached proofs"
 
-@functools.lru_cache(maxsize=None)
-def symbolic_checks(max_n: int) -> tuple[Check, ...]:
-    """The design-independent proofs: the deployed pieces equal the paper's formulas
-    (``deployed.*``), Lemma 3.3 limits, smooth max, error transform.
 
-    They take SymPy some seconds and depend on no parameter, so a process proves them once.
-    """
-    return (tuple(deployed_checks()) + tuple(lemma_checks(orders=3))
-            + tuple(error_transform_checks(max_n=max_n)))
+class _Stages:
+    """``progress`` wrapped to say ``"<stage> (i/N)"`` for the stages of one run."""
+
+    def __init__(self, progress: Callable[[str], None] | None, design: bool) -> None:
+        self.progress = progress
+        self.names = STAGES if design else STAGES[1:]
+
+    def __call__(self, label: str) -> None:
+        if self.progress is None:
+            return
+        index = self.names.index("rate bound forms" if label == _CACHED else label) + 1
+        self.progress(f"{label} ({index}/{len(self.names)})")
 
 
 def _psi_ranges(design: TubeDesign, certificate: Certificate) -> tuple[np.ndarray, np.ndarray]:
@@ -51,7 +61,9 @@ def _psi_ranges(design: TubeDesign, certificate: Certificate) -> tuple[np.ndarra
     return psi_min, psi0
 
 
-def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> list[Check]:
+def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
+                  cache: bool = True,
+                  progress: Callable[[str], None] | None = None) -> list[Check]:
     """Run every check on a designed tube.
 
     Parameters
@@ -61,6 +73,11 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> l
     plant : str, optional
         Plant model for Assumption 2 (one of :data:`stt_codegen.spec.plants.PLANT_MODELS`);
         default the spec's.
+    cache : bool
+        Take the design-independent proofs from the proof cache
+        (:func:`~stt_codegen.verify.proofs.design_independent_proofs`).
+    progress : callable, optional
+        Called with ``"<stage> (i/N)"`` before each stage.
 
     Returns
     -------
@@ -71,17 +88,18 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> l
         ``alpha``), the tube certificate, and the sampled closed loop
         (:func:`~stt_codegen.verify.sampled.sampled_checks`).
     """
+    stage = progress if isinstance(progress, _Stages) else _Stages(progress, design=False)
     model = plant or spec.plant_model
-    tube_check = check_tube(design, spec)
-    enclosure = tube_check.certificate.enclosure
     n = design.dimension
+    proofs = design_independent_proofs(min(n, 3), cache=cache, progress=stage)
     reach = sorted({(a, b, seg.duration) for seg in design.segments if seg.profile == TANH
                     for a, b in zip(seg.lower_from + seg.upper_from,
                                     seg.lower_to + seg.upper_to) if a != b})
     bumps = [(c.sharpness, c.radius, c.height) for c in design.circumvents]
-    symbolic = symbolic_checks(min(n, 3))
-    reach_checks = [reach_rate_bound(*p) for p in reach]
-    bump_checks = [bump_rate_bound(*p) for p in bumps]
+    symbolic = proofs.checks
+    stage("rate bounds")
+    reach_checks = [reach_rate_bound(*p, form=proofs.forms["reach_rate"]) for p in reach]
+    bump_checks = [bump_rate_bound(*p, form=proofs.forms["bump_rate"]) for p in bumps]
     checks = [c for c in symbolic if c.name.startswith("lemma")] + reach_checks + bump_checks
     checks += [c for c in symbolic if not c.name.startswith(("lemma", "deployed"))]
     checks += [c for c in symbolic if c.name.startswith("deployed")]
@@ -94,6 +112,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> l
                    default=0.0)
     bump_rate = {p: chk.data.get("bound", np.inf) for p, chk in zip(bumps, bump_checks)}
 
+    stage("assumption 2")
     if model == "omnidirectional":
         checks.append(assumption2_omnidirectional((spec.state_space.lower[2],
                                                    spec.state_space.upper[2])))
@@ -102,6 +121,10 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> l
     else:
         checks.append(assumption2_single_integrator(n))
 
+    stage("tube certificate")
+    tube_check = check_tube(design, spec)   # not the designer's: verify certifies again
+    enclosure = tube_check.certificate.enclosure
+    stage("adaptive law")
     psi_min, psi0 = _psi_ranges(design, tube_check.certificate)
     for c in range(2 * n):
         i, side = c % n, _SIDES[c // n]
@@ -110,7 +133,8 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> l
                         for b in design.circumvents_on(i, other))
         label = f"x{i + 1},{side}"
         for check in adaptive_law_checks(float(psi_min[c]), design.theta0, design.kappa,
-                                         design.mu, float(psi0[c]), rho_rate + beta_rate):
+                                         design.mu, float(psi0[c]), rho_rate + beta_rate,
+                                         form=proofs.forms["adaptive_law"]):
             if check.name in ("adaptive.parameters", "adaptive.nonnegative"):
                 if c == 0:      # independent of psi: report once
                     checks.append(check)
@@ -145,43 +169,61 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None) -> l
                             margin.detail, {"margin": margin.margin, "time": margin.time}))
     # the sampled loop is followed sample by sample (sample_tube refuses a horizon over its
     # step budget with a SpecError)
+    stage("sampled loop")
     checks += sampled_checks(spec, design, sample_tube(design), tube_check.certificate)
     return checks
 
 
-def verify_spec(spec: Spec, plant: str | None = None) -> list[Check]:
+def verify_spec(spec: Spec, plant: str | None = None, *, cache: bool = True,
+                progress: Callable[[str], None] | None = None) -> list[Check]:
     """Design the tube of a spec and run :func:`verify_design`; a design failure is a FAIL."""
+    stage = _Stages(progress, design=True)
+    stage("design")
     try:
-        design = design_tube(spec).tube
+        design = design_tube(spec)
     except DesignError as exc:
         return [Check("tube.design", False, str(exc))]
-    return verify_design(spec, design, plant)
+    return verify_design(spec, design.tube, plant, cache=cache, progress=stage)
 
 
-def verify(spec: Spec, design: TubeDesign | None = None,
-           plant: str | None = None) -> VerificationReport:
-    """Check the paper's lemmas, the assumptions and the tube certificate for a spec.
+def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
+           progress: Callable[[str], None] | None = None,
+           cache: bool = True) -> VerificationReport:
+    """Check the paper's lemmas, the assumptions and the tube certificate of a design.
 
     The checks run on the deployed expressions (the pieces of :mod:`stt_codegen.tube.pieces`
     printed by the SymPy printer; ``deployed.*`` proves each equal to the paper's formula
     where the code writes it differently): Lemma 3.3 (smoothness of eqs. (4), (7)-(10)
-    and explicit rate bounds),
-    the error transform and the Lyapunov derivative of Theorem 4.1 (eq. (12), law (13)),
-    Assumption 2 for the plant, the adaptive law (11) per component of ``alpha``, the
-    sampling-rate limit, the room at the start and the continuous-time certificate of the
-    tube (non-empty, contains ``x(0)``, in the state space, misses every obstacle, in the
-    target from ``t_c`` on).
+    and explicit rate bounds), the error transform and the Lyapunov derivative of
+    Theorem 4.1 (eq. (12), law (13)), Assumption 2 for the plant, the adaptive law (11)
+    per component of ``alpha``, the sampling-rate limit, the room at the start, the
+    continuous-time certificate of the tube (non-empty, contains ``x(0)``, in the state
+    space, misses every obstacle, in the target from ``t_c`` on) and the sampled closed
+    loop for every plant of the spec's ``[assumptions]``. ``docs/verification.md`` says
+    what each check proves.
+
+    The proofs that depend on no spec parameter are taken from an on-disk cache keyed by a
+    hash of everything they depend on (:mod:`stt_codegen.verify.proofs`), so only the
+    first run on a machine pays for them.
 
     Parameters
     ----------
-    spec : Spec
-        From :func:`stt_codegen.load_spec` or :meth:`stt_codegen.Spec.from_dict`.
-    design : TubeDesign, optional
-        The design to check; by default the tube is designed first, and a spec with no
-        design gives a report whose one check, ``tube.design``, failed.
+    design_or_spec : Design or Spec
+        A :class:`~stt_codegen.design.result.Design` (from
+        :func:`stt_codegen.design_tube`), checked against its own ``design.spec`` (its
+        tube is certified again here, not taken from ``design.certificate``); or a :class:`~stt_codegen.spec.loader.Spec`, designed
+        first: a spec with no design gives a report whose one check, ``tube.design``,
+        failed.
     plant : str, optional
-        Plant model for Assumption 2 (``"omnidirectional"`` or ``"single-integrator"``);
-        default the spec's ``plant.model``.
+        Plant model for Assumption 2 (one of
+        :data:`~stt_codegen.spec.loader.PLANT_MODELS`); default the spec's
+        ``plant.model``.
+    progress : callable, optional
+        Called with one string, ``"<stage> (i/N)"`` (e.g. ``"lemma 3.3 (3/10)"``),
+        before each stage; the command line prints it on a terminal.
+    cache : bool
+        Read and write the proof cache (default); ``False`` proves everything again
+        and touches no file. The report is the same either way.
 
     Returns
     -------
@@ -194,17 +236,68 @@ def verify(spec: Spec, design: TubeDesign | None = None,
     SpecError
         Unknown plant model (field ``plant``), or one that does not fit the spec's
         dimension.
+    TypeError
+        ``design_or_spec`` is neither a ``Design`` nor a ``Spec`` (for example a
+        ``(spec, tube)`` pair: pass the ``Design``, which carries its spec).
+
+    See Also
+    --------
+    stt_codegen.design_tube : the design to verify.
+    stt_codegen.verify.proofs.design_independent_proofs : the cached proofs.
+    stt_codegen.verify.check.VerificationReport : the result.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> from stt_codegen.verify.command import verify
+    >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    >>> report = verify(design)
+    >>> report.passed
+    True
+    >>> report["lemma3.3.reach.continuity"].passed
+    True
+    >>> verify(stt.load_spec("omnirobot-s1")).passed       # designs it first
+    True
     """
+    if isinstance(design_or_spec, Design):
+        spec = design_or_spec.spec
+    elif isinstance(design_or_spec, Spec):
+        spec = design_or_spec
+    else:
+        raise TypeError(f"verify takes a Design or a Spec, not {type(design_or_spec).__name__}"
+                        " (a Design carries its spec: verify(design))")
     if plant is not None and plant not in PLANT_MODELS:
         raise SpecError("plant", f"must be one of {', '.join(PLANT_MODELS)}")
     if plant is not None and dimension_mismatch(plant, spec.dimension):
         raise SpecError("plant", dimension_mismatch(plant, spec.dimension))
-    checks = verify_spec(spec, plant) if design is None else verify_design(spec, design, plant)
+    if isinstance(design_or_spec, Design):
+        checks = verify_design(spec, design_or_spec.tube, plant, cache=cache,
+                               progress=progress)
+    else:
+        checks = verify_spec(spec, plant, cache=cache, progress=progress)
     return VerificationReport(spec.name, tuple(checks))
 
 
+def _terminal_progress() -> Callable[[str], None] | None:
+    """Progress on stderr when it is a terminal (one line, rewritten), else ``None``."""
+    if not sys.stderr.isatty():
+        return None
+
+    def show(message: str) -> None:
+        sys.stderr.write(f"\rverify: {message} ...\x1b[K")
+        sys.stderr.flush()
+    return show
+
+
 def _cmd_verify(args: argparse.Namespace) -> int:
-    report = verify(load_spec(args.spec), plant=args.plant)
+    progress = None if args.json else _terminal_progress()
+    try:
+        report = verify(load_spec(args.spec), plant=args.plant, progress=progress,
+                        cache=not args.no_cache)
+    finally:
+        if progress is not None:
+            sys.stderr.write("\r\x1b[K")
+            sys.stderr.flush()
     print(json.dumps(report.to_json(), indent=2) if args.json else str(report))
     return 0 if report.passed else 1
 
@@ -215,4 +308,7 @@ def configure_verify(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print a JSON list of checks")
     p.add_argument("--plant", default=None, metavar="MODEL",
                    help=f"plant for Assumption 2 ({', '.join(PLANT_MODELS)}; default: the spec's)")
+    p.add_argument("--no-cache", action="store_true",
+                   help="prove the spec-independent lemmas again instead of reading the "
+                        "proof cache (~/.cache/stt-codegen; see docs/verification.md)")
     p.set_defaults(handler=_cmd_verify)

@@ -47,6 +47,7 @@ __all__ = [
     "error_transform",
     "law",
     "deployed_checks",
+    "proved_pieces",
     "T", "T_C", "X0", "TARGET", "M", "R", "K", "NU",
 ]
 
@@ -200,6 +201,7 @@ def _equal(a: sp.Expr, b: sp.Expr) -> bool:
 # ---------------------------------------------------------------------------
 
 
+@functools.lru_cache(maxsize=None)
 def _reach_printed() -> tuple[sp.Expr, sp.Expr]:
     """``rho`` and ``rho_dot`` of a tanh segment from ``X`` at 0 to ``T`` at ``t_c``."""
     (p,), (p_dot,) = sympy_expressions(pieces.progress("tanh"),
@@ -230,6 +232,7 @@ def reach_rate() -> sp.Expr:
     return on_domain(rho_dot, {T: T_C * _W / (1 + _W)})
 
 
+@functools.lru_cache(maxsize=None)
 def _bump_printed() -> tuple[sp.Expr, sp.Expr]:
     (y,), (y_dot,) = sympy_expressions(pieces.bump(), {
         "t": [T], "start": [M - R], "end": [M + R], "center": [M], "radius": [R],
@@ -257,27 +260,29 @@ _A, _B = sp.symbols("a_1 a_2", real=True)
 
 
 @functools.lru_cache(maxsize=None)
+def _smooth_printed(index: int) -> sp.Expr:
+    """Printed value of ``pieces.smooth_pieces()[index]`` (1: ``max~``, 3: ``min~``)."""
+    (value,) = sympy_expressions(pieces.smooth_pieces()[index], {"a": [_A], "b": [_B],
+                                                                "nu": [NU]})
+    return value[0]
+
+
+@functools.lru_cache(maxsize=None)
 def smooth_max_half(side: int = 1) -> sp.Expr:
     """Deployed ``max~(a_1, a_2)`` on ``a_1 = a_2 + side d``, ``d >= 0``, clamp inactive."""
-    (value,) = sympy_expressions(pieces.smooth_pieces()[1], {"a": [_A], "b": [_B], "nu": [NU]})
-    return on_domain(value[0], {_A: _B + side * _D}, {-EXP_CLAMP: 1})
+    return on_domain(_smooth_printed(1), {_A: _B + side * _D}, {-EXP_CLAMP: 1})
 
 
 @functools.lru_cache(maxsize=None)
 def smooth_min_half(side: int = 1) -> sp.Expr:
     """Deployed ``min~(a_1, a_2)`` on ``a_1 = a_2 + side d``, ``d >= 0``, clamp inactive."""
-    (value,) = sympy_expressions(pieces.smooth_pieces()[3], {"a": [_A], "b": [_B], "nu": [NU]})
-    return on_domain(value[0], {_A: _B + side * _D}, {-EXP_CLAMP: 1})
+    return on_domain(_smooth_printed(3), {_A: _B + side * _D}, {-EXP_CLAMP: 1})
 
 
 @functools.lru_cache(maxsize=None)
-def open_bump_sum(arity: int = 3) -> tuple:
-    """Deployed ``F_nu`` of eq. (9) over ``arity`` bumps: ``(F, F_dot, ys, y_dots, top)``.
-
-    ``fnu_init``, ``fnu_add`` (once per bump) and ``fnu_finish`` (``bound = 0``,
-    ``sign = 1``) composed as the generated code composes them, ``top >= 0`` symbolic,
-    exponent clamps inactive.
-    """
+def _open_bump_printed(arity: int) -> tuple:
+    """Printed ``F_nu`` over ``arity`` bumps, before reduction: ``(F, F_dot, ys, y_dots,
+    top)``."""
     init, add, finish, _ = pieces.fnu_pieces()
     ys = sp.symbols(f"y_1:{arity + 1}", nonnegative=True)
     y_dots = sp.symbols(f"ydot_1:{arity + 1}", real=True)
@@ -290,6 +295,18 @@ def open_bump_sum(arity: int = 3) -> tuple:
     (f,), (f_dot,) = sympy_expressions(finish, {
         "bound": [0], "sign": [1], "top": [top], "total": [total], "rate": [rate],
         "nu": [NU]})
+    return f, f_dot, ys, y_dots, top
+
+
+@functools.lru_cache(maxsize=None)
+def open_bump_sum(arity: int = 3) -> tuple:
+    """Deployed ``F_nu`` of eq. (9) over ``arity`` bumps: ``(F, F_dot, ys, y_dots, top)``.
+
+    ``fnu_init``, ``fnu_add`` (once per bump) and ``fnu_finish`` (``bound = 0``,
+    ``sign = 1``) composed as the generated code composes them, ``top >= 0`` symbolic,
+    exponent clamps inactive.
+    """
+    f, f_dot, ys, y_dots, top = _open_bump_printed(arity)
     clamp = {-EXP_CLAMP: 1}
     return on_domain(f, {}, clamp), on_domain(f_dot, {}, clamp), ys, y_dots, top
 
@@ -336,6 +353,14 @@ def _transform_symbols(n: int):
 
 
 @functools.lru_cache(maxsize=None)
+def _transform_printed(n: int) -> tuple:
+    """Printed ``(e, epsilon, xi)`` of :func:`stt_codegen.tube.pieces.error_transform`."""
+    x, gs, gd = _transform_symbols(n)
+    return sympy_expressions(pieces.error_transform(n), {
+        "x": list(x), "gamma_L": list((gs - gd) / 2), "gamma_U": list((gs + gd) / 2)})
+
+
+@functools.lru_cache(maxsize=None)
 def error_transform(n: int) -> tuple:
     """Deployed ``(e, epsilon, xi)`` of section IV, each an ``n``-vector, and the symbols.
 
@@ -345,8 +370,7 @@ def error_transform(n: int) -> tuple:
     clamps are inactive. Returns ``(e, epsilon, xi, x, gamma_s, gamma_d)`` as Matrices.
     """
     x, gs, gd = _transform_symbols(n)
-    printed = sympy_expressions(pieces.error_transform(n), {
-        "x": list(x), "gamma_L": list((gs - gd) / 2), "gamma_U": list((gs + gd) / 2)})
+    printed = _transform_printed(n)
     clamps = _TRANSFORM_CLAMPS
     e, eps, xi = (sp.Matrix([on_domain(v, {}, clamps)
                              for v in out]) for out in printed)
@@ -354,16 +378,55 @@ def error_transform(n: int) -> tuple:
 
 
 @functools.lru_cache(maxsize=None)
-def law(n: int) -> tuple:
-    """Deployed ``u`` of law (13) on the same domain as :func:`error_transform`, and the
-    gain symbol: ``(u, gain)``."""
+def _law_printed(n: int) -> tuple:
+    """Printed ``u`` of :func:`stt_codegen.tube.pieces.law` and the gain symbol."""
     x, gs, gd = _transform_symbols(n)
     gain = sp.Symbol("g", positive=True)
     (u, _) = sympy_expressions(pieces.law(n), {
         "x": list(x), "gamma_L": list((gs - gd) / 2), "gamma_U": list((gs + gd) / 2),
         "gain": [gain]})
+    return u, gain
+
+
+@functools.lru_cache(maxsize=None)
+def law(n: int) -> tuple:
+    """Deployed ``u`` of law (13) on the same domain as :func:`error_transform`, and the
+    gain symbol: ``(u, gain)``."""
+    u, gain = _law_printed(n)
     clamps = _TRANSFORM_CLAMPS
     return sp.Matrix([on_domain(v, {}, clamps) for v in u]), gain
+
+
+def proved_pieces(max_n: int = 3) -> dict[str, object]:
+    """Every piece the design-independent proofs print, as CasADi Functions.
+
+    The proofs of :func:`deployed_checks`, :func:`stt_codegen.verify.lemma.lemma_checks`,
+    :func:`stt_codegen.verify.transform.error_transform_checks` (``n = 1..max_n``) and the
+    symbolic parts of the rate bounds and the adaptive law see the deployed code only
+    through these pieces, printed by :func:`stt_codegen.codegen.emit.sympy_expressions`.
+    Their serialization is part of the key of the proof cache
+    (:mod:`stt_codegen.verify.proofs`): a changed piece misses the cache
+    (``tests/test_verify_proofs.py`` checks that every piece printed while proving is
+    listed here).
+
+    Parameters
+    ----------
+    max_n : int
+        Largest dimension of the error transform proved.
+
+    Returns
+    -------
+    dict of str to casadi.Function
+    """
+    init, add, finish, _ = pieces.fnu_pieces()
+    smooth = pieces.smooth_pieces()
+    return {"progress_tanh": pieces.progress("tanh"), "interpolate": pieces.interpolate(1),
+            "bump": pieces.bump(), "smooth_max": smooth[1], "smooth_min": smooth[3],
+            "fnu_init": init, "fnu_add": add, "fnu_finish": finish,
+            "conflict": pieces.conflict(1), "alpha_rate": pieces.alpha_rate(1),
+            "law.n2": pieces.law(2),
+            **{f"error_transform.n{n}": pieces.error_transform(n)
+               for n in range(1, max_n + 1)}}
 
 
 # ---------------------------------------------------------------------------

@@ -245,7 +245,7 @@ def check_bump_flatness(expr: sp.Expr | None = None, orders: int = 4) -> Check:
             f_left, f_right = sp.diff(f_left, T), sp.diff(f_right, T)
         left = sp.simplify(sp.limit(f_left.subs(T, M - R + _H), _H, 0, "+"))
         right = sp.simplify(sp.limit(f_right.subs(T, M + R - _H), _H, 0, "+"))
-        limits.append((str(left), str(right)))
+        limits.append([str(left), str(right)])
         for edge, lim in (("m - r (from inside)", left), ("m + r (from inside)", right)):
             if not _is_zero(lim):
                 return Check(
@@ -351,7 +351,25 @@ def reach_rate_constant(digits: int = 30) -> tuple[float, float, float]:
     return float(w_star), float(c_lo.a), float(np.nextafter(float(c_hi.b), np.inf))
 
 
-def reach_rate_bound(x0: float, target: float, t_c: float) -> Check:
+def reach_rate_form() -> bool:
+    """The symbolic part of :func:`reach_rate_bound`, for every ``X``, ``T``, ``t_c``.
+
+    Proves that the deployed ``rho_dot`` output (:func:`.deployed.reach_rate`) is
+    ``(T - X) sech^2(w) (1+w)^2 / t_c`` with ``w = t/(t_c - t)`` on ``0 <= t < t_c``, and
+    the derivative of ``sech^2(w) (1+w)^2`` used by :func:`reach_rate_constant`.
+    Independent of the design: :mod:`.proofs` caches it.
+    """
+    deriv = deployed.reach_rate()   # the deployed rho_dot output, t < t_c
+    claimed = (TARGET - X0) * sp.sech(_W) ** 2 * (1 + _W) ** 2 / T_C
+    ident = sp.simplify((deriv.subs(T, T_C * _W / (1 + _W)) - claimed).rewrite(sp.exp))
+    stat = sp.simplify(
+        (sp.diff(sp.sech(_W) ** 2 * (1 + _W) ** 2, _W)
+         - 2 * sp.sech(_W) ** 2 * (1 + _W) * (1 - (1 + _W) * sp.tanh(_W))).rewrite(sp.exp)
+    )
+    return bool(ident == 0 and stat == 0)
+
+
+def reach_rate_bound(x0: float, target: float, t_c: float, form: bool | None = None) -> Check:
     """Explicit ``sup_t |rho_dot(t)|`` for one bound of the tube (4).
 
     ``rho_dot = (T - X) sech^2(w) (1+w)^2 / t_c`` with ``w = t/(t_c - t)``
@@ -365,16 +383,13 @@ def reach_rate_bound(x0: float, target: float, t_c: float) -> Check:
         Initial-box bound and target-box bound of one dimension and side.
     t_c : float
         Prescribed time, > 0.
+    form : bool, optional
+        The result of :func:`reach_rate_form` when already known (the proof cache,
+        :mod:`.proofs`); proved here when omitted.
     """
     if not t_c > 0:
         return Check("lemma3.3.reach.rate_bound", False, f"t_c = {t_c} is not > 0", {})
-    deriv = deployed.reach_rate()   # the deployed rho_dot output, t < t_c
-    claimed = (TARGET - X0) * sp.sech(_W) ** 2 * (1 + _W) ** 2 / T_C
-    ident = sp.simplify((deriv.subs(T, T_C * _W / (1 + _W)) - claimed).rewrite(sp.exp))
-    stat = sp.simplify(
-        (sp.diff(sp.sech(_W) ** 2 * (1 + _W) ** 2, _W)
-         - 2 * sp.sech(_W) ** 2 * (1 + _W) * (1 - (1 + _W) * sp.tanh(_W))).rewrite(sp.exp)
-    )
+    proved = reach_rate_form() if form is None else form
     w_star, c_lo, c_hi = reach_rate_constant()
     bound = abs(target - x0) * c_hi / t_c
     t_star = t_c * w_star / (1 + w_star)
@@ -383,7 +398,7 @@ def reach_rate_bound(x0: float, target: float, t_c: float) -> Check:
     ww = tt / (t_c - tt)
     with np.errstate(over="ignore"):
         sampled = float(np.max(np.abs(target - x0) / np.cosh(ww) ** 2 * (1 + ww) ** 2 / t_c))
-    ok = ident == 0 and stat == 0 and sampled <= bound * (1 + 1e-12)
+    ok = proved and sampled <= bound * (1 + 1e-12)
     return Check(
         "lemma3.3.reach.rate_bound",
         ok,
@@ -395,7 +410,31 @@ def reach_rate_bound(x0: float, target: float, t_c: float) -> Check:
     )
 
 
-def bump_rate_bound(k: float, r: float, height: float = 1.0) -> Check:
+def bump_rate_form() -> bool:
+    """The symbolic part of :func:`bump_rate_bound`, for every ``m``, ``r > 0``, ``k > 0``.
+
+    Proves that the deployed ``y_dot`` output on ``t > m`` (:func:`.deployed.bump_window`)
+    is ``-(2k/r) z (1 - z^2)^-2 b`` with ``z = (t - m)/r``, that the stationarity
+    condition of ``h`` is ``3 q^2 - 2(1 - k) q - 1 = 0`` in ``q = z^2``, and that ``q*``
+    is its root. Independent of the design: :mod:`.proofs` caches it.
+    """
+    z = sp.Symbol("z", positive=True)
+    q = sp.Symbol("q", positive=True)
+    # the deployed bump and its deployed y_dot output on the half t > m of the window
+    b_z = deployed.bump_window(1).subs(T, M + R * z)
+    bdot = deployed.bump_window(1, rate=True).subs(T, M + R * z)
+    form_ok = sp.simplify(bdot - (-2 * K / R) * z / (1 - z**2) ** 2 * b_z) == 0
+    h = z / (1 - z**2) ** 2 * sp.exp(-K * z**2 / (1 - z**2))
+    # z (1 - z^2)^2 d ln h/dz, a polynomial in z^2
+    stat = sp.expand(sp.cancel(sp.diff(sp.log(h), z) * z * (1 - z**2) ** 2))
+    poly_ok = sp.expand(stat + (3 * q**2 - 2 * (1 - K) * q - 1).subs(q, z**2)) == 0
+    q_star = ((1 - K) + sp.sqrt((1 - K) ** 2 + 3)) / 3
+    root_ok = sp.simplify((3 * q**2 - 2 * (1 - K) * q - 1).subs(q, q_star)) == 0
+    return bool(form_ok and poly_ok and root_ok)
+
+
+def bump_rate_bound(k: float, r: float, height: float = 1.0,
+                    form: bool | None = None) -> Check:
     """Explicit ``sup_t |d/dt (B b(t))|`` for the circumvent bump (7)-(8).
 
     With ``z = (t - m)/r``: ``b_dot = -(2k/r) h(z) sign(z)``,
@@ -415,22 +454,14 @@ def bump_rate_bound(k: float, r: float, height: float = 1.0) -> Check:
         Half-width of the window > 0.
     height : float
         Bump height ``B^j`` (1 gives ``sup |b_dot|``).
+    form : bool, optional
+        The result of :func:`bump_rate_form` when already known (the proof cache,
+        :mod:`.proofs`); proved here when omitted.
     """
     if not (k > 0 and r > 0):
         return Check("lemma3.3.bump.rate_bound", False,
                      f"need k > 0 and r > 0, got k = {k}, r = {r}", {})
-    z = sp.Symbol("z", positive=True)
-    q = sp.Symbol("q", positive=True)
-    # the deployed bump and its deployed y_dot output on the half t > m of the window
-    b_z = deployed.bump_window(1).subs(T, M + R * z)
-    bdot = deployed.bump_window(1, rate=True).subs(T, M + R * z)
-    form_ok = sp.simplify(bdot - (-2 * K / R) * z / (1 - z**2) ** 2 * b_z) == 0
-    h = z / (1 - z**2) ** 2 * sp.exp(-K * z**2 / (1 - z**2))
-    # z (1 - z^2)^2 d ln h/dz, a polynomial in z^2
-    stat = sp.expand(sp.cancel(sp.diff(sp.log(h), z) * z * (1 - z**2) ** 2))
-    poly_ok = sp.expand(stat + (3 * q**2 - 2 * (1 - K) * q - 1).subs(q, z**2)) == 0
-    q_star = ((1 - K) + sp.sqrt((1 - K) ** 2 + 3)) / 3
-    root_ok = sp.simplify((3 * q**2 - 2 * (1 - K) * q - 1).subs(q, q_star)) == 0
+    proved = bump_rate_form() if form is None else form
     with mpmath.workdps(30):
         kk = mpmath.mpf(k)
         qs = ((1 - kk) + mpmath.sqrt((1 - kk) ** 2 + 3)) / 3
@@ -442,7 +473,7 @@ def bump_rate_bound(k: float, r: float, height: float = 1.0) -> Check:
     with np.errstate(over="ignore", under="ignore"):
         sampled = float(np.max(height * 2 * k / r * np.abs(zz) / (1 - zz**2) ** 2
                                * np.exp(-k * zz**2 / (1 - zz**2))))
-    ok = form_ok and poly_ok and root_ok and 0 < qs < 1 and sampled <= sup_up * (1 + 1e-9)
+    ok = proved and 0 < qs < 1 and sampled <= sup_up * (1 + 1e-9)
     return Check(
         "lemma3.3.bump.rate_bound",
         ok,

@@ -29,17 +29,19 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ..design.certificate import Certificate, enclose_tube
-from ..design.samples import TubeSamples
-from ..design.gain import RATE_FACTORS, gain_derivation, lowest_rate
+from ..design.certificate import Certificate, certify_tube, enclose_tube
+from ..design.gain import derived_gain, gain_derivation
+from ..design.samples import TubeSamples, sample_tube
 from ..spec.loader import Assumptions, LinearPlant, Spec
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .check import Check
 
+#: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
+RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
 
 
 @dataclass(frozen=True)
@@ -208,6 +210,52 @@ def check_sampled(design: TubeDesign, samples: TubeSamples, assumptions: Assumpt
     return SampledCheck(True, top, worst, worst_t, worst_i, "", data)
 
 
+def lowest_rate(design: TubeDesign, spec: Spec, assumptions: Assumptions,
+                explicit_gain: float | None = None) -> tuple[float | None, float | None]:
+    """The lowest of ``rate_hz`` times :data:`RATE_FACTORS` at which the design holds.
+
+    At each rate the tube keeps its circumvents and segments, is certified again
+    (:func:`~stt_codegen.design.certificate.certify_tube`: the deployed ``alpha`` and the
+    sampling-rate check depend on the rate), and the sampled check
+    (:func:`check_sampled`) must pass with the gain the design would use there:
+    ``explicit_gain`` if given, else :func:`~stt_codegen.design.gain.derived_gain` at that
+    rate's certified narrowest width. The largest factor is tried first; if it fails, no factor
+    is reported.
+
+    Parameters
+    ----------
+    design : TubeDesign
+    spec : Spec
+        For the certificate (state space, obstacles, target).
+    assumptions : Assumptions
+    explicit_gain : float, optional
+
+    Returns
+    -------
+    rate_hz, gain : float or None
+        ``(None, None)`` when no factor tried works.
+    """
+    def passes(factor: float) -> tuple[bool, float]:
+        trial = replace(design, rate_hz=design.rate_hz * factor)
+        certificate = certify_tube(trial, spec)
+        gain = (explicit_gain if explicit_gain is not None
+                else derived_gain(certificate.min_width, trial.rate_hz, assumptions))
+        if not certificate.passed:
+            return False, gain
+        return check_sampled(trial, sample_tube(trial), assumptions, gain).passed, gain
+
+    # the fastest rate first: when even it fails (coupling beyond what any rate can
+    # handle), one check answers instead of all of them
+    ok, fastest_gain = passes(RATE_FACTORS[-1])
+    if not ok:
+        return None, None
+    for factor in RATE_FACTORS[:-1]:
+        ok, gain = passes(factor)
+        if ok:
+            return design.rate_hz * factor, gain
+    return design.rate_hz * RATE_FACTORS[-1], fastest_gain
+
+
 # --------------------------------------------------------------------------- verify
 
 
@@ -226,7 +274,7 @@ def sampled_checks(spec: Spec, design: TubeDesign, samples: TubeSamples,
     ``sampled.gain``: ``k`` is below the linearized stability limit at the narrowest tube
     for ``g_max``, with the derivation (:func:`~stt_codegen.design.gain.gain_derivation`)
     in words. ``sampled.tube_kept``: :func:`check_sampled` for the spec's assumptions;
-    when it fails, the lowest rate that passes (:func:`~stt_codegen.design.gain.lowest_rate`).
+    when it fails, the lowest rate that passes (:func:`lowest_rate`).
 
     Parameters
     ----------
