@@ -10,7 +10,9 @@ import sys
 import pytest
 from conftest import designed
 
-from stt_codegen.errors import SpecError
+from stt_codegen.design.failures import FailureKind
+from stt_codegen.design.search import design_tube
+from stt_codegen.errors import DesignError, SpecError
 from stt_codegen.spec.loader import parse_spec
 from stt_codegen.tube.parameters import Circumvent
 from stt_codegen.verify.command import verify_design, verify_spec
@@ -95,12 +97,22 @@ def test_heading_range_reaching_pi_over_2_fails_assumption_2(tmp_path):
                         "lower = [0.0, 0.0, -1.6]\nupper = [5.0, 5.0, 1.6]")
     path = tmp_path / "wide.toml"
     path.write_text(wide)
+    # the plant is known (eq. (14)): design refuses it, and verify reports why
+    with pytest.raises(DesignError, match="pi/2") as refused:
+        design_tube(parse_spec(wide))
+    assert refused.value.kind is FailureKind.PLANT
     bad = failed(verify_spec(parse_spec(wide)))
-    assert list(bad) == ["assumption2.omnidirectional"]
+    assert list(bad) == ["tube.design"] and "Assumption 2" in bad["tube.design"]
+    out = run("verify", str(path))
+    assert out.returncode == 1 and "FAIL  tube.design" in out.stdout and "pi/2" in out.stdout
+    # the symbolic check names the point where positivity is lost, for the tube designed
+    # as if for another plant
+    spec = parse_spec(wide)
+    tube = design_tube(dataclasses.replace(spec, plant_model="single-integrator")).tube
+    bad = failed(verify_design(spec, tube))
+    assert "assumption2.omnidirectional" in bad
     assert "1.5707963" in bad["assumption2.omnidirectional"] or "pi/2" in \
         bad["assumption2.omnidirectional"]
-    out = run("verify", str(path))
-    assert out.returncode == 1 and "FAIL  assumption2.omnidirectional" in out.stdout
     ok = run("verify", str(path), "--plant", "single-integrator")
     assert ok.returncode == 0, ok.stdout[-2000:]
 

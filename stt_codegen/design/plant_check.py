@@ -68,13 +68,14 @@ def heading_range_failure(lower: float, upper: float) -> str:
 
 
 def plant_failure(spec: Spec) -> str:
-    """Why the spec's ``linear`` plant violates Assumption 2 ("" when it holds or when
-    the spec names no matrix).
+    """Why the spec's plant violates Assumption 2 ("" when it holds or is not known).
 
-    Only the ``linear`` model's ``plant.g`` is checked here: the omnidirectional robot's
-    heading range is :func:`heading_range_failure`'s (``verify`` reports it, and
-    ``verify --plant`` may check another plant for the same tube).
+    The ``linear`` model's ``plant.g`` (:func:`linear_plant_failure`) and the
+    omnidirectional robot's heading range, the third dimension of the state space
+    (:func:`heading_range_failure`). The single integrator (``g = I``) always holds.
     """
     if spec.plant_model == "linear" and spec.linear_plant is not None:
         return linear_plant_failure(spec.linear_plant.g)
+    if spec.plant_model == "omnidirectional":
+        return heading_range_failure(spec.state_space.lower[2], spec.state_space.upper[2])
     return ""

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from dataclasses import replace
 from typing import Callable
 
 import numpy as np
@@ -176,11 +177,15 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
 
 def verify_spec(spec: Spec, plant: str | None = None, *, cache: bool = True,
                 progress: Callable[[str], None] | None = None) -> list[Check]:
-    """Design the tube of a spec and run :func:`verify_design`; a design failure is a FAIL."""
+    """Design the tube of a spec and run :func:`verify_design`; a design failure is a FAIL.
+
+    With ``plant``, the tube is designed for that plant model instead of the spec's (the
+    design refuses a plant that violates Assumption 2).
+    """
     stage = _Stages(progress, design=True)
     stage("design")
     try:
-        design = design_tube(spec)
+        design = design_tube(spec if plant is None else replace(spec, plant_model=plant))
     except DesignError as exc:
         return [Check("tube.design", False, str(exc))]
     return verify_design(spec, design.tube, plant, cache=cache, progress=stage)
