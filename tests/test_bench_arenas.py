@@ -127,6 +127,7 @@ def test_summary_statistics():
     assert list(s["failures"].items()) == [("collision", 2), ("no path found", 1)]
 
 
+@pytest.mark.bench
 def test_one_arena_job(tmp_path, monkeypatch):
     monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path / "cache"))
     result = run_arena(0, 1, ("stt", "astar"))

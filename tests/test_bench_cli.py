@@ -23,6 +23,7 @@ def test_local_pool_keeps_the_order():
         run_parallel(operator.mul, calls, workers=0, progress=False)
 
 
+@pytest.mark.bench
 def test_arenas_json_on_local_processes(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path / "cache"))
     specs = tmp_path / "specs"
@@ -44,6 +45,7 @@ def test_arenas_json_on_local_processes(tmp_path, monkeypatch, capsys):
     assert "leaked" not in captured.err  # OMPL stays in the worker processes
 
 
+@pytest.mark.bench
 def test_arenas_table(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path / "cache"))
     assert main(["bench", "arenas", "--count", "1", "--methods", "astar", "--workers", "1",
@@ -52,6 +54,7 @@ def test_arenas_table(tmp_path, monkeypatch, capsys):
     assert "A* + tracker" in out and "time median" in out and "machine:" in out
 
 
+@pytest.mark.bench
 def test_arenas_on_a_dask_cluster(tmp_path, monkeypatch):
     distributed = pytest.importorskip("distributed")
     monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path / "cache"))

@@ -97,6 +97,7 @@ def test_plot_is_written(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["run.png"]   # no temporary left
 
 
+@pytest.mark.slow
 def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
     out = run("demo", "--out", str(tmp_path / "demo"))
     assert out.returncode == 0, out.stderr

@@ -15,6 +15,7 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
@@ -51,6 +52,7 @@ def _run(knobs, rate_factor=1.0):
     return simulate(spec, design, backend="c", plant=unknown_plant(p, bounds["centre"])), bounds
 
 
+@pytest.mark.slow
 @PLANTS
 @given(knobs=nominal_plants())
 def test_unknown_plants_within_the_gain_assumption_stay_in_the_tube(knobs):
@@ -60,6 +62,7 @@ def test_unknown_plants_within_the_gain_assumption_stay_in_the_tube(knobs):
     assert result.satisfied and not result.collision and not result.left_state_space, knobs
 
 
+@pytest.mark.slow
 def test_a_plant_beyond_the_gain_assumption_needs_a_faster_rate():
     """Documented limit: ``g = 9.2 I`` breaks the 1 kHz loop of S2; doubling the rate (the
     gain kept) restores it (see docs/guarantees.md). The default gain is now set from
@@ -77,6 +80,7 @@ ARENAS = settings(derandomize=True, deadline=None, database=None, max_examples=6
                   suppress_health_check=list(HealthCheck))
 
 
+@pytest.mark.slow
 @ARENAS
 @given(index=st.integers(0, 200), seed=st.integers(0, 2**32 - 1),
        f_amp=st.floats(0.0, 2.0), g_min=st.floats(0.2, 1.0), w_amp=st.floats(0.0, 0.2))

@@ -112,6 +112,7 @@ def _in_empty_folder(tmp_path, monkeypatch):
     assert os.listdir(tmp_path) == [], "loading a spec wrote a file"
 
 
+@pytest.mark.slow
 @fuzz(250)
 @given(doc=st.sampled_from(range(len(DOCS))), pick=st.integers(0, 10**6),
        action=st.sampled_from(["replace", "replace", "delete", "scale", "grow", "add"]),
@@ -175,7 +176,8 @@ def _ball_or_polytope(n: int, shape: str, tolerance: float) -> str:
 
 
 @pytest.mark.parametrize("shape,n", [("ball", 12), ("ball", 40), ("ball", 64),
-                                     ("polytope", 4), ("polytope", 12), ("polytope", 40)])
+                                     pytest.param("polytope", 4, marks=pytest.mark.slow),
+                                     ("polytope", 12), ("polytope", 40)])
 def test_high_dimensional_shapes_are_bounded(shape, n, monkeypatch):
     """A covering must not enumerate 2^n box corners: its work is counted, not timed.
 
