@@ -12,7 +12,7 @@ from pathlib import Path
 
 import casadi
 import pytest
-from test_codegen_support import files_of
+from codegen_helpers import files_of
 
 from stt_codegen import __version__
 from stt_codegen.cli import main

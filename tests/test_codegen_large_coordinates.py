@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 import pytest
-from test_codegen_support import COMPILERS
+from codegen_helpers import COMPILERS
 
 SPECS = Path(__file__).parent / "specs"
 ARENAS = ["shifted-arena-1e6", "wide-arena-20km"]

@@ -24,7 +24,7 @@ from stt_codegen.bench.arenas import generate_arena
 from stt_codegen.design.search import design_tube
 from stt_codegen.errors import DesignError
 from stt_codegen.runtime.simulate import simulate
-from test_hard_support import plant_bounds, random_plant_parameters, unknown_plant
+from hard_helpers import plant_bounds, random_plant_parameters, unknown_plant
 
 PLANTS = settings(derandomize=True, deadline=None, database=None, max_examples=15,
                   suppress_health_check=list(HealthCheck))

@@ -25,7 +25,7 @@ from stt_codegen.errors import SpecError
 from stt_codegen.spec.covering import MAX_BOXES
 from stt_codegen.spec.shapes import MAX_POLYTOPE_DIMENSION, Ball, Polytope
 from stt_codegen.spec.loader import Spec, parse_spec
-from test_hard_support import dumps, shape_docs
+from hard_helpers import dumps, shape_docs
 
 DOCS = shape_docs()
 TEXTS = [dumps(d).encode() for d in DOCS]

@@ -11,7 +11,7 @@ import pytest
 from conftest import CASES, designed
 from hypothesis import HealthCheck, given, note, settings
 from hypothesis import strategies as st
-from test_plants_support import plant_system, plant_within
+from plants_helpers import plant_system, plant_within
 
 from stt_codegen.design.gain import derived_gain, gain_derivation
 from stt_codegen.design.samples import sample_tube
