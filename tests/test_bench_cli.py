@@ -82,6 +82,9 @@ def test_arenas_on_a_dask_cluster(tmp_path, monkeypatch):
     (["bench", "step", "omnirobot-s1", "--steps", "0"], "--steps"),
     (["bench", "scaling", "--obstacles", "1,x"], "--obstacles"),
     (["bench", "scaling", "--dimensions", "0"], "--dimensions"),
+    (["bench", "covering", "--count", "-1"], "--count"),
+    (["bench", "covering", "--tolerance", "0"], "--tolerance"),
+    (["bench", "alpha", "no-such-case"], ""),
 ])
 def test_bad_input_exits_2_without_traceback(argv, field, capsys, monkeypatch):
     monkeypatch.setattr(parallel, "CONNECT_TIMEOUT", "1s")

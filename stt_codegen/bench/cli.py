@@ -1,4 +1,5 @@
-"""The ``bench`` subcommand and its sub-subcommands ``arenas``, ``step`` and ``scaling``."""
+"""The ``bench`` subcommand and its sub-subcommands ``arenas``, ``step``, ``scaling``,
+``covering`` and ``alpha``."""
 
 from __future__ import annotations
 
@@ -27,8 +28,18 @@ def _cmd_scaling(args: argparse.Namespace) -> int:
     return main_scaling(args)
 
 
+def _cmd_covering(args: argparse.Namespace) -> int:
+    from .covering import main_covering
+    return main_covering(args)
+
+
+def _cmd_alpha(args: argparse.Namespace) -> int:
+    from .alpha import main_alpha
+    return main_alpha(args)
+
+
 def configure_bench(bench: argparse.ArgumentParser) -> None:
-    """Sub-subcommands ``bench arenas``, ``bench step`` and ``bench scaling``."""
+    """Sub-subcommands ``bench arenas``, ``step``, ``scaling``, ``covering`` and ``alpha``."""
     bench.description = ("Benchmarks. Every comparison is measured side by side in one run on "
                          "this machine; ratios, not absolute times, are the result.")
     sub = bench.add_subparsers(dest="bench_command", required=True, metavar="BENCH")
@@ -66,3 +77,20 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="give up compiling one design after S seconds (default: %(default)s)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(handler=_cmd_scaling)
+
+    p = sub.add_parser("covering", help="covering random polygons by boxes, and the design "
+                                        "around them: boxes and seconds")
+    p.add_argument("--count", type=int, default=80, help="polygons (default: %(default)s)")
+    p.add_argument("--seed", type=_non_negative_int, default=0,
+                   help="polygon seed (default: %(default)s)")
+    p.add_argument("--tolerance", type=float, default=0.02, metavar="M",
+                   help="covering tolerance of every polygon (default: %(default)s)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(handler=_cmd_covering)
+
+    p = sub.add_parser("alpha", help="the implicit alpha step: Newton iterations against "
+                                     "bisection, and convergence to a stiff solver")
+    p.add_argument("spec", metavar="SPEC", nargs="?", default="omnirobot-s1",
+                   help="bundled case name or spec file (default: %(default)s)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(handler=_cmd_alpha)
