@@ -183,7 +183,7 @@ def test_design_json_fields_and_exit_codes(tmp_path):
     props = {p["name"]: p for p in data["certificate"]["properties"]}
     assert props["avoids obstacle 0"]["passed"] and props["avoids obstacle 0"]["margin"] > 0
     assert data["certificate"]["horizon"] == "inf"
-    assert 0 < data["design_time_s"] < 60 and data["gain"] > 0
+    assert data["design_time_s"] > 0 and data["gain"] > 0     # a duration: no bound on it
 
     blocked = tmp_path / "wall.toml"
     blocked.write_text(SERPENTINE.split("[[obstacles]]")[0] + WALL)
