@@ -7,7 +7,8 @@ docs/decisions.md, decision 15) and a state-dependent skew part ``K`` of norm at
 ``g_min / 2``,
 and ``|w_i| <= 0.2``, the sampled closed loop of every bundled case stays in the tube
 and satisfies the task. ``tests/study_unknown_dynamics.py`` is the larger study (wider
-ranges, failures classified); its figures are in docs/guarantees.md.
+ranges, failures classified); its figures are in docs/guarantees.md. The properties run
+closed loops (slow tier); one plant at the edges of the assumption is in the fast tier.
 """
 
 from __future__ import annotations
@@ -60,6 +61,18 @@ def test_unknown_plants_within_the_gain_assumption_stay_in_the_tube(knobs):
     assert bounds["g_sym_min"] >= knobs["g_min"] - 1e-12 and bounds["g_sym_max"] <= 1 + 1e-12
     assert result.stayed_in_tube, (knobs, bounds)
     assert result.satisfied and not result.collision and not result.left_state_space, knobs
+
+
+def test_a_plant_at_the_edges_of_the_gain_assumption_stays_in_the_tube():
+    """The property above on one plant, in the fast tier: every knob at the end of its
+    range (symmetric part of ``g`` from 0.2 to 1, skew part 0.1, ``f`` amplitude 2 and
+    slope 0.5, ``|w_i| = 0.2``)."""
+    knobs = {"case": "omnirobot-s2", "seed": 1, "f_amp": 2.0, "f_lin": 0.5, "g_min": 0.2,
+             "g_max": 1.0, "skew": 0.1, "w_amp": 0.2}
+    result, bounds = _run(knobs)
+    assert bounds["g_sym_min"] >= 0.2 - 1e-12 and bounds["g_sym_max"] <= 1 + 1e-12
+    assert result.stayed_in_tube, bounds
+    assert result.satisfied and not result.collision and not result.left_state_space
 
 
 @pytest.mark.slow

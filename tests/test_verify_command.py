@@ -43,7 +43,9 @@ def test_all_checks_pass_on_the_paper_cases(case):
 def test_cli_json_and_exit_code():
     out = run("verify", "omnirobot-s2", "--json")
     assert out.returncode == 0, out.stderr
+    assert out.stderr == ""                        # no progress, no warning: JSON only
     data = json.loads(out.stdout)
+    assert data[0]["name"] == "lemma3.3.reach.continuity"
     assert all(set(d) == {"name", "passed", "detail"} and d["passed"] for d in data)
     assert len(data) > 30
 
