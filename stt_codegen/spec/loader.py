@@ -563,7 +563,7 @@ def _input_bound(table: ActuatorTable | None, model: str, n: int) -> tuple[float
         return None
     plant = PLANTS[model]
     count = plant.input_count(n)
-    names = plant.inputs or tuple(f"u{i + 1}" for i in range(n))
+    names = plant.input_names(n)
     if len(table.input_bound) != count:
         raise SpecError("actuator.input_bound",
                         f"must have {count} entries (one per input of the {model} plant: "

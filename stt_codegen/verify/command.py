@@ -29,6 +29,7 @@ from .assumption import assumption2_omnidirectional, assumption2_single_integrat
 from .check import Check, VerificationReport
 from .lemma import bump_rate_bound, reach_rate_bound
 from .proofs import design_independent_proofs
+from .actuator import input_bound_check, prove_input_bound
 from .sampled import linear_plant_checks, sampled_checks
 
 #: Dimension names used in check names.
@@ -86,8 +87,10 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         In order: Lemma 3.3, the error transform, the equality of each deployed piece with
         the paper's formula (``deployed.*``), Assumption 2 (and, for the linear
         plant, whether it meets ``[assumptions]``), the adaptive law (per component of
-        ``alpha``), the tube certificate, and the sampled closed loop
-        (:func:`~stt_codegen.verify.sampled.sampled_checks`).
+        ``alpha``), the tube certificate, the sampled closed loop
+        (:func:`~stt_codegen.verify.sampled.sampled_checks`) and, for a spec with
+        ``[actuator]``, ``sampled.input_bound``
+        (:func:`~stt_codegen.verify.actuator.input_bound_check`).
     """
     stage = progress if isinstance(progress, _Stages) else _Stages(progress, design=False)
     model = plant or spec.plant_model
@@ -172,6 +175,8 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     # step budget with a SpecError)
     stage("sampled loop")
     checks += sampled_checks(spec, design, sample_tube(design), tube_check.certificate)
+    if spec.input_bound is not None:
+        checks.append(input_bound_check(spec, prove_input_bound(design, spec)))
     return checks
 
 
