@@ -6,6 +6,8 @@ model; without ``[actuator]`` no piece, table or status is added."""
 from __future__ import annotations
 
 import dataclasses
+import re
+import shutil
 import subprocess
 from functools import lru_cache
 
@@ -134,3 +136,29 @@ def test_selftest_covers_the_clamp_status(precision, tmp_path):
     header = files[f"{spec.c_name}.h"].decode()
     assert "#define CLAMPED_STATUS_INPUT_CLAMPED 3" in header
     assert "#define CLAMPED_INPUT_BOUND_0 0.6" in header
+
+
+@pytest.mark.skipif(shutil.which("cppcheck") is None,
+                    reason="cppcheck missing: install the Debian package cppcheck")
+def test_the_clamp_adds_no_misra_deviation(tmp_path):
+    """omnirobot-s1 with a clamp: cppcheck's MISRA C:2012 findings are still only the
+    listed deviations (the bound table is one more const table, rule 8.9)."""
+    from test_codegen_misra import DEVIATIONS
+    spec, tube, _ = designed("omnirobot-s1")
+    tube = dataclasses.replace(tube, input_bound=(2.0, 2.0, 1.0))
+    prefix = spec.c_name
+    files = generate_files(spec, tube, Options(("c",), "single"))
+    folder = write(tmp_path, {k: v for k, v in files.items() if k in (f"{prefix}.c",
+                                                                       f"{prefix}.h")})
+    proc = subprocess.run(["cppcheck", "--enable=all", "--addon=misra", "--std=c99",
+                           "--suppress=missingIncludeSystem", "--quiet",
+                           "--template={file}:{line}:{id}", f"{prefix}.c"],
+                          cwd=folder, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    findings = [line.split(":") for line in proc.stderr.splitlines() if line.count(":") >= 2]
+    bound_table = False
+    for name, line, check in findings:
+        text = (folder / name).read_text().splitlines()[int(line) - 1]
+        assert any(d[0] == check and re.search(d[1], text) for d in DEVIATIONS), (check, text)
+        bound_table |= "_INPUT_BOUND[" in text
+    assert bound_table           # the table was analysed, and is the listed 8.9 deviation
