@@ -5,6 +5,8 @@ thing and legends off the data, u(t) in a run's figure, a plot when there is no 
 from __future__ import annotations
 
 import re
+import subprocess
+import sys
 from functools import lru_cache
 
 import numpy as np
@@ -12,6 +14,7 @@ import pytest
 from conftest import arena_toml
 from matplotlib.patches import Circle, Polygon, Rectangle
 
+from stt_codegen.cli import main
 from stt_codegen.design.search import design_tube
 from stt_codegen.errors import DesignError, SpecError
 from stt_codegen.runtime import plots
@@ -68,6 +71,11 @@ def mixed_3d():
     return parse_spec(MIXED_3D)
 
 
+def run_cli(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "stt_codegen.cli", *args],
+                          capture_output=True, text=True, timeout=600)
+
+
 def arena_of(fig):
     """The arena axes of a figure (added first)."""
     return fig.axes[0]
@@ -115,6 +123,29 @@ def test_good_dims_and_the_default():
         plots.parse_dims("0,1", 1)
     with pytest.raises(SpecError):          # the library checks too
         plots.arena_figure(load_spec("omnirobot-s1"), 1, (1, 1))
+
+
+@pytest.mark.parametrize("command", [["design", "omnirobot-s1"],
+                                     ["simulate", "omnirobot-s1", "--backend", "reference"]])
+def test_bad_dims_on_the_command_line_exit_2_before_any_work(tmp_path, command):
+    png = tmp_path / "x.png"
+    out = run_cli(*command, "--plot", str(png), "--dims", "0,3")
+    assert out.returncode == 2
+    assert out.stderr.startswith("error: --dims: ") and out.stderr.count("\n") == 1
+    assert "Traceback" not in out.stderr and out.stdout == ""
+    assert not png.exists()
+
+
+def test_dims_reach_the_figure(tmp_path, monkeypatch, capsys):
+    drawn = []
+    monkeypatch.setattr(plots, "save", lambda fig, path: drawn.append(fig))
+    assert main(["design", "omnirobot-s1", "--plot", str(tmp_path / "d.png"),
+                 "--dims", "0,2"]) == 0
+    (fig,) = drawn
+    ax = arena_of(fig)
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("$x_{1}$", "$x_{3}$")
+    assert "projection" in ax.get_title()
+    assert ax.get_ylim() == pytest.approx((-1.2 - 0.048, 1.2 + 0.048))
 
 
 # --------------------------------------------------------------------------- obstacles
@@ -220,6 +251,20 @@ def test_run_figure_has_u_of_t_with_one_line_per_input(short_run):
 # --------------------------------------------------------------------------- no design
 
 
+def test_design_plot_without_a_design_shows_the_rejected_tube(tmp_path):
+    spec_file = tmp_path / "near.toml"
+    spec_file.write_text(NEAR_TARGET)
+    png = tmp_path / "near.png"
+    out = run_cli("design", str(spec_file), "--plot", str(png))
+    assert out.returncode == 1 and "Traceback" not in out.stderr
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    lines = out.stderr.splitlines()
+    assert lines == [f"plot written to {png}: it shows the best rejected tube",
+                     "error: obstacle 1 comes within 0.1 of the target box eta +- d_T: "
+                     "shrink target.half_width"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["near.png", "near.toml"]
+
+
 def test_rejected_figure_has_the_reason_in_its_title():
     spec = parse_spec(NEAR_TARGET)
     with pytest.raises(DesignError) as info:
@@ -230,3 +275,15 @@ def test_rejected_figure_has_the_reason_in_its_title():
     # a 2-D arena is no projection, and says none
     assert arena_of(fig).get_title() == "near: NO DESIGN (obstacle at target), the best " \
                                         "rejected tube"
+
+
+def test_design_plot_when_nothing_was_tried_writes_nothing_and_says_so(tmp_path):
+    spec_file = tmp_path / "reversed.toml"
+    spec_file.write_text(arena_toml("reversed", 9.0, '[plant]\nmodel = "linear"\n'
+                                    'g = [[-1.0, 0.0], [0.0, -1.0]]\n'))
+    png = tmp_path / "reversed.png"
+    out = run_cli("design", str(spec_file), "--plot", str(png))
+    assert out.returncode == 1 and not png.exists()
+    first, error = out.stderr.splitlines()
+    assert first == f"no plot written to {png}: no tube was tried"
+    assert error.startswith("error: plant.g: ")
