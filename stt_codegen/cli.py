@@ -140,6 +140,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from .runtime.plots import plot_run
     from .runtime.simulate import simulate
     from .cases import bundled_cases
+    from .spec.loader import load_spec
+    dims = {name: _plot_dims(args.dims, load_spec(name)) for name in bundled_cases()}
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print(f"For every bundled case: design the tube, generate the C and Python controllers "
@@ -148,12 +150,11 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     all_ok = True
     for name in bundled_cases():
         spec, designed = _design(name)
-        dims = _plot_dims(args.dims, spec)
         design = designed.tube
         write_generation(out / name, generate_files(spec, design, Options()))
         result = simulate(spec, design, backend=args.backend)
         atomic_write(out / f"{name}.png",
-                     lambda tmp: plot_run(spec, design, result, tmp, dims=dims))
+                     lambda tmp: plot_run(spec, design, result, tmp, dims=dims[name]))
         print(_summary_line(result), flush=True)
         all_ok &= result.satisfied
     print(f"generated code in {out}/<case>/, plots in {out}/<case>.png")

@@ -125,15 +125,17 @@ def test_good_dims_and_the_default():
         plots.arena_figure(load_spec("omnirobot-s1"), 1, (1, 1))
 
 
-@pytest.mark.parametrize("command", [["design", "omnirobot-s1"],
-                                     ["simulate", "omnirobot-s1", "--backend", "reference"]])
+@pytest.mark.parametrize("command", [["design", "omnirobot-s1", "--plot", "x.png"],
+                                     ["simulate", "omnirobot-s1", "--backend", "reference",
+                                      "--plot", "x.png"],
+                                     ["demo", "--out", "demo"]])
 def test_bad_dims_on_the_command_line_exit_2_before_any_work(tmp_path, command):
-    png = tmp_path / "x.png"
-    out = run_cli(*command, "--plot", str(png), "--dims", "0,3")
+    out = subprocess.run([sys.executable, "-m", "stt_codegen.cli", *command, "--dims", "0,3"],
+                         capture_output=True, text=True, timeout=600, cwd=tmp_path)
     assert out.returncode == 2
     assert out.stderr.startswith("error: --dims: ") and out.stderr.count("\n") == 1
     assert "Traceback" not in out.stderr and out.stdout == ""
-    assert not png.exists()
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_dims_reach_the_figure(tmp_path, monkeypatch, capsys):
