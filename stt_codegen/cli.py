@@ -71,6 +71,12 @@ def _design(spec_arg: str):
     return spec, design_tube(spec)
 
 
+def _plot_dims(text: str | None, spec) -> tuple[int, int]:
+    """The arena's dimensions of ``--dims I,J`` for ``spec`` (SpecError ``dims`` if bad)."""
+    from .runtime.plots import parse_dims
+    return parse_dims(text, spec.dimension)
+
+
 def _cmd_cases(args: argparse.Namespace) -> int:
     from .cases import bundled_cases
     for name in bundled_cases():
@@ -98,14 +104,20 @@ def _check_output_folder(path: str | None) -> None:
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
+    from .design.search import design_tube
     from .runtime.simulate import simulate
+    from .spec.loader import load_spec
     _check_output_folder(args.plot)
-    spec, designed = _design(args.spec)
+    spec = load_spec(args.spec)
+    if args.plot or args.dims is not None:
+        dims = _plot_dims(args.dims, spec)
+    designed = design_tube(spec)
     design = designed.tube
     result = simulate(spec, design, backend=args.backend, horizon=args.horizon, seed=args.seed)
     if args.plot:
         from .runtime.plots import plot_run
-        atomic_write(Path(args.plot), lambda tmp: plot_run(spec, design, result, tmp))
+        atomic_write(Path(args.plot), lambda tmp: plot_run(spec, design, result, tmp,
+                                                           dims=dims))
     if args.json:
         data = result.to_json()
         data["design"] = designed.to_json(spec.name)
@@ -128,6 +140,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     from .runtime.plots import plot_run
     from .runtime.simulate import simulate
     from .cases import bundled_cases
+    from .spec.loader import load_spec
+    dims = {name: _plot_dims(args.dims, load_spec(name)) for name in bundled_cases()}
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print(f"For every bundled case: design the tube, generate the C and Python controllers "
@@ -139,7 +153,8 @@ def _cmd_demo(args: argparse.Namespace) -> int:
         design = designed.tube
         write_generation(out / name, generate_files(spec, design, Options()))
         result = simulate(spec, design, backend=args.backend)
-        atomic_write(out / f"{name}.png", lambda tmp: plot_run(spec, design, result, tmp))
+        atomic_write(out / f"{name}.png",
+                     lambda tmp: plot_run(spec, design, result, tmp, dims=dims[name]))
         print(_summary_line(result), flush=True)
         all_ok &= result.satisfied
     print(f"generated code in {out}/<case>/, plots in {out}/<case>.png")
@@ -168,6 +183,11 @@ def _backend_argument(p: argparse.ArgumentParser) -> None:
                    help="controller implementation (default: %(default)s)")
 
 
+def _dims_argument(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--dims", metavar="I,J", help="state dimensions of the plot's arena, "
+                   "zero-based (default: 0,1)")
+
+
 def configure_simulate(p: argparse.ArgumentParser) -> None:
     """Arguments of ``stt-codegen simulate``."""
     p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
@@ -176,6 +196,7 @@ def configure_simulate(p: argparse.ArgumentParser) -> None:
                    help="simulated time in seconds (default: t_c)")
     p.add_argument("--seed", type=int, default=0, help="disturbance seed (default: 0)")
     p.add_argument("--plot", metavar="PNG", help="write a figure of the run")
+    _dims_argument(p)
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(handler=_cmd_simulate)
 
@@ -185,6 +206,7 @@ def configure_demo(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", default="stt-demo", metavar="DIR",
                    help="folder for the generated code and the plots (default: %(default)s)")
     _backend_argument(p)
+    _dims_argument(p)
     p.set_defaults(handler=_cmd_demo)
 
 
