@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import SpecError
+from ..system import atomic_write
 from .arena_job import LABELS, METHODS, loop_arena, plan_arena
 from .arenas import generate_arenas
 from .parallel import run_parallel
@@ -33,7 +34,6 @@ def write_specs(folder: Path, count: int, seed: int) -> list[Path]:
     SpecError
         The folder does not exist (field ``specs``).
     """
-    from ..cli import atomic_write_bytes
     folder = Path(folder)
     if not folder.is_dir():
         raise SpecError("specs", f"folder {str(folder)!r} does not exist")
@@ -41,7 +41,7 @@ def write_specs(folder: Path, count: int, seed: int) -> list[Path]:
     for arena in generate_arenas(count, seed):
         path = folder / f"{arena.name}.toml"
         text = arena.to_toml().encode("utf-8")
-        atomic_write_bytes(path, lambda tmp, data=text: tmp.write_bytes(data))
+        atomic_write(path, text, field="specs")
         paths.append(path)
     return paths
 
