@@ -27,6 +27,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 from .errors import DesignError, SpecError, SttError, ToolchainError
+from .version import __version__
 
 # ``stt_codegen.verify`` is the function (``_LAZY`` below), and ``stt_codegen/verify/`` is
 # also the package of the checks. The import system binds a subpackage to its parent's
@@ -35,8 +36,6 @@ from .errors import DesignError, SpecError, SttError, ToolchainError
 # like never rebind the name, and ``stt_codegen.verify`` is always the function.
 from . import verify as _verify_package  # noqa: E402,F401
 globals().pop("verify", None)
-
-__version__ = "0.1.0"
 
 #: Public name -> module that defines it; imported on first attribute access.
 _LAZY: dict[str, str] = {

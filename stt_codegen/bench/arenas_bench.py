@@ -3,8 +3,6 @@ on the same random arenas, side by side in one run (the paper's Table I, redone)
 
 from __future__ import annotations
 
-import argparse
-import json
 from pathlib import Path
 from typing import Any
 
@@ -121,18 +119,3 @@ def format_arenas_report(report: dict[str, Any]) -> str:
         lines.append(f"skipped {LABELS[method]}: {why}")
     lines.append(machine_line(report["machine"]))
     return "\n".join(lines)
-
-
-def main_arenas(args: argparse.Namespace) -> int:
-    """Handler of ``bench arenas``; exit 0."""
-    if args.specs:
-        write_specs(Path(args.specs), args.count, args.seed)
-    report = run_arenas_bench(args.count, args.seed, workers=args.workers,
-                              scheduler=args.scheduler,
-                              methods=tuple(args.methods.split(",")) if args.methods else None,
-                              progress=not args.no_progress)
-    if args.json:
-        print(json.dumps(report, indent=1, sort_keys=True, allow_nan=False))
-    else:
-        print(format_arenas_report(report))
-    return 0

@@ -1,4 +1,4 @@
-"""``stt-codegen verify``: every check of a spec's designed tube, with its evidence.
+"""Every check of a spec's designed tube, with its evidence (``stt-codegen verify``).
 
 Connects the symbolic checks of this package to a concrete design: the rate bounds of
 Lemma 3.3 for its tube and bumps, Assumption 2 for its plant, the adaptive-law bounds for
@@ -7,9 +7,6 @@ its ``psi``, and the continuous-time tube certificate (:mod:`stt_codegen.design.
 
 from __future__ import annotations
 
-import argparse
-import json
-import sys
 from dataclasses import replace
 from typing import Callable
 
@@ -21,7 +18,7 @@ from ..design.result import Design
 from ..design.samples import sample_tube
 from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
-from ..spec.loader import Spec, load_spec
+from ..spec.loader import Spec
 from ..spec.plants import PLANT_MODELS, dimension_mismatch
 from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
 from .adaptive import adaptive_law_checks, alpha_upper_bound
@@ -282,38 +279,3 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
         checks = verify_spec(spec, plant, cache=cache, progress=progress)
     return VerificationReport(spec.name, tuple(checks))
 
-
-def _terminal_progress() -> Callable[[str], None] | None:
-    """Progress on stderr when it is a terminal (one line, rewritten), else ``None``."""
-    if not sys.stderr.isatty():
-        return None
-
-    def show(message: str) -> None:
-        sys.stderr.write(f"\rverify: {message} ...\x1b[K")
-        sys.stderr.flush()
-    return show
-
-
-def _cmd_verify(args: argparse.Namespace) -> int:
-    progress = None if args.json else _terminal_progress()
-    try:
-        report = verify(load_spec(args.spec), plant=args.plant, progress=progress,
-                        cache=not args.no_cache)
-    finally:
-        if progress is not None:
-            sys.stderr.write("\r\x1b[K")
-            sys.stderr.flush()
-    print(json.dumps(report.to_json(), indent=2) if args.json else str(report))
-    return 0 if report.passed else 1
-
-
-def configure_verify(p: argparse.ArgumentParser) -> None:
-    """Arguments of ``stt-codegen verify``."""
-    p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
-    p.add_argument("--json", action="store_true", help="print a JSON list of checks")
-    p.add_argument("--plant", default=None, metavar="MODEL",
-                   help=f"plant for Assumption 2 ({', '.join(PLANT_MODELS)}; default: the spec's)")
-    p.add_argument("--no-cache", action="store_true",
-                   help="prove the spec-independent lemmas again instead of reading the "
-                        "proof cache (~/.cache/stt-codegen; see docs/verification.md)")
-    p.set_defaults(handler=_cmd_verify)
