@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import designed
+from conftest import design_of
 import stt_codegen
 from stt_codegen import cli
 from stt_codegen.cli import cases as cases_command
@@ -54,9 +54,8 @@ def test_main_maps_each_kind_to_its_exit_code(monkeypatch, capsys, error, code):
 def test_a_library_parameter_is_reported_as_the_flag_the_user_knows(capsys):
     """``simulate(horizon=...)`` raises ``SpecError("horizon", ...)``; the CLI says ``--horizon``."""
     from stt_codegen.runtime.simulate import simulate
-    spec, design, _ = designed("omnirobot-s1")
     with pytest.raises(SpecError) as info:
-        simulate(spec, design, horizon=-1.0)
+        simulate(design_of("omnirobot-s1"), horizon=-1.0)
     assert info.value.field == "horizon"
     assert cli.main(["simulate", "omnirobot-s1", "--horizon", "-1"]) == 2
     assert capsys.readouterr().err.startswith("error: --horizon: must be a positive")

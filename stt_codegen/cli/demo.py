@@ -13,7 +13,7 @@ from .simulate import SUMMARY_HEADER, summary_line
 def cmd_demo(args: argparse.Namespace) -> int:
     """0 every case satisfied, 1 otherwise, 3 toolchain."""
     from ..cases import bundled_cases
-    from ..codegen import Options, generate_files, write_generation
+    from ..codegen.api import generate
     from ..runtime.plots import plot_run
     from ..runtime.simulate import simulate
     out = Path(args.out)
@@ -23,11 +23,10 @@ def cmd_demo(args: argparse.Namespace) -> int:
     print(SUMMARY_HEADER)
     all_ok = True
     for name in bundled_cases():
-        designed = load_and_design(name)
-        spec, design = designed.spec, designed.tube
-        write_generation(out / name, generate_files(spec, design, Options()))
-        result = simulate(spec, design, backend=args.backend)
-        atomic_write(out / f"{name}.png", lambda tmp: plot_run(spec, design, result, tmp))
+        design = load_and_design(name)
+        generate(design, out / name)
+        result = simulate(design, backend=args.backend)
+        atomic_write(out / f"{name}.png", lambda tmp: plot_run(design, result, tmp))
         print(summary_line(result), flush=True)
         all_ok &= result.satisfied
     print(f"generated code in {out}/<case>/, plots in {out}/<case>.png")

@@ -26,10 +26,10 @@ def cmd_design(args: argparse.Namespace) -> int:
 
     def draw(path):
         from ..runtime.plots import plot_design
-        return plot_design(spec, design, path)
+        return plot_design(design, path)
     write_plot(args, draw)
     if args.json:
-        print_json(design.to_json(spec.name))
+        print_json(design.to_json())
         return 0
     tube = design.tube
     print(f"{spec.name}: designed with the {design.method} method in "

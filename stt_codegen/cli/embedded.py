@@ -37,8 +37,7 @@ def cmd_embedded(args: argparse.Namespace) -> int:
     from ..embedded.deploy import run_embedded
     if args.build_dir is not None and not Path(args.build_dir).parent.is_dir():
         raise SpecError("build_dir", f"folder {str(Path(args.build_dir).parent)!r} does not exist")
-    designed = load_and_design(args.spec)
-    report = run_embedded(designed.spec, designed.tube, args.build_dir, seed=args.seed,
+    report = run_embedded(load_and_design(args.spec), args.build_dir, seed=args.seed,
                           compare_host=not args.no_host)
     if args.json:
         print_json(report)

@@ -13,10 +13,10 @@ def cmd_generate(args: argparse.Namespace) -> int:
     """0 written, 1 no design, 2 bad input, 3 code generator failure."""
     from ..codegen.api import generate
     parse_options(args.languages, args.precision)   # bad options fail before the design
-    designed = load_and_design(args.spec)
-    spec = designed.spec
-    files = generate(spec, designed.tube, Path(args.out_dir), args.languages, args.precision)
-    print(f"wrote {len(files)} files for {spec.name} ({args.languages}, "
+    design = load_and_design(args.spec)
+    files = generate(design, Path(args.out_dir), languages=args.languages,
+                     precision=args.precision)
+    print(f"wrote {len(files)} files for {design.spec.name} ({args.languages}, "
           f"{args.precision}) into {args.out_dir}")
     return 0
 

@@ -26,22 +26,21 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     """0 satisfied, 1 not satisfied or no design, 2 bad input, 3 toolchain."""
     from ..runtime.simulate import simulate
     check_plot_folder(args)
-    designed = load_and_design(args.spec)
-    spec, design = designed.spec, designed.tube
-    result = simulate(spec, design, backend=args.backend, horizon=args.horizon, seed=args.seed)
+    design = load_and_design(args.spec)
+    result = simulate(design, backend=args.backend, horizon=args.horizon, seed=args.seed)
 
     def draw(path):
         from ..runtime.plots import plot_run
-        return plot_run(spec, design, result, path)
+        return plot_run(design, result, path)
     write_plot(args, draw)
     if args.json:
         data = result.to_json()
-        data["design"] = designed.to_json(spec.name)
+        data["design"] = design.to_json()
         print_json(data)
     else:
         print(SUMMARY_HEADER)
         print(summary_line(result))
-        print(f"backend {result.backend}, {result.steps} steps at {design.rate_hz:g} Hz, "
+        print(f"backend {result.backend}, {result.steps} steps at {design.tube.rate_hz:g} Hz, "
               f"t_c = {result.prescribed_time:g} s, gain k = {design.gain:.4g}, "
               f"stayed in tube: {'yes' if result.stayed_in_tube else 'NO'}, "
               f"collision: {'YES' if result.collision else 'no'}, "

@@ -8,7 +8,6 @@ module neither selects matplotlib's global backend nor uses ``pyplot``, so impor
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
@@ -16,13 +15,10 @@ import numpy as np
 from matplotlib.patches import Circle, Polygon, Rectangle
 from scipy.spatial import ConvexHull
 
+from ..design.result import Design, require_design
 from ..tube import reference
 from .simulate import SimulationResult
 from ..spec.loader import Box, Spec
-from ..tube.parameters import TubeDesign
-
-if TYPE_CHECKING:
-    from ..design.result import Design
 
 
 def agg_figure(**kwargs) -> Figure:
@@ -101,24 +97,51 @@ def arena_figure(spec: Spec):
     return fig, grid, ax
 
 
-def plot_run(spec: Spec, design: TubeDesign, result: SimulationResult, path: str | Path) -> Path:
-    """Write a PNG: the arena with the trajectory, and each dimension's tube against time.
+def plot_run(design: Design, result: SimulationResult, path: str | Path) -> Path:
+    """Write a PNG of a closed-loop run, in the manner of the paper's Fig. 3.
+
+    On the left, the arena (dimensions ``x1``, ``x2``): the state space, the obstacles,
+    the initial and target sets and the trajectory; on the right, for each dimension, the
+    tube ``[gamma_L, gamma_U]`` of eq. (10) (with the run's ``alpha``) against time, the
+    state inside it, and ``t_c``.
 
     Parameters
     ----------
-    spec, design : Spec, TubeDesign
+    design : Design
+        From :func:`stt_codegen.design_tube`: the run's tube and (``design.spec``) its task.
     result : SimulationResult
-        With its trajectory.
+        From :func:`stt_codegen.simulate` on ``design``, with its trajectory.
     path : str or path
-        Output file; its folder must exist.
+        Output file (PNG); its folder must exist.
 
     Returns
     -------
     pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    TypeError
+        ``design`` is not a :class:`~stt_codegen.design.result.Design`.
+
+    See Also
+    --------
+    stt_codegen.simulate : the run.
+    stt_codegen.plot_design : the certified tube, before any run.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    >>> result = stt.simulate(design, backend="casadi")
+    >>> stt.plot_run(design, result, "s1-run.png").name
+    's1-run.png'
     """
+    design = require_design(design, "plot_run")
+    spec, tube = design.spec, design.tube
     traj = result.trajectory
     n = spec.dimension
-    g_l, g_u, _, _ = reference.adaptive_tube(design, traj.t, traj.alpha)
+    g_l, g_u, _, _ = reference.adaptive_tube(tube, traj.t, traj.alpha)
     fig, grid, ax = arena_figure(spec)
     if ax is not None:
         draw_box(ax, spec.initial_set, (0, 1), fc="tab:blue", alpha=0.3, label="initial set")
@@ -149,23 +172,42 @@ def plot_run(spec: Spec, design: TubeDesign, result: SimulationResult, path: str
 BOXES_DRAWN = 24
 
 
-def plot_design(spec: Spec, design: Design, path: str | Path) -> Path:
+def plot_design(design: Design, path: str | Path) -> Path:
     """Write a PNG of ``design``: tube boxes (the certificate's enclosure) and via boxes in
-    the first two dimensions, and the certified enclosure of ``gamma_L``, ``gamma_U`` per
-    dimension against time.
+    the first two dimensions, and the certified enclosure of ``gamma_L``, ``gamma_U`` (eq.
+    (10)) per dimension against time.
 
     Parameters
     ----------
-    spec : Spec
     design : Design
-        From :func:`stt_codegen.design_tube`.
+        From :func:`stt_codegen.design_tube` (its spec gives the arena).
     path : str or path
-        Output file; its folder must exist.
+        Output file (PNG); its folder must exist.
 
     Returns
     -------
     pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    TypeError
+        ``design`` is not a :class:`~stt_codegen.design.result.Design`.
+
+    See Also
+    --------
+    stt_codegen.design_tube : the design.
+    stt_codegen.plot_run : a closed-loop run in its tube.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    >>> stt.plot_design(design, "s1-tube.png").name
+    's1-tube.png'
     """
+    design = require_design(design, "plot_design")
+    spec = design.spec
     tube, enc = design.tube, design.certificate.enclosure
     n = spec.dimension
     t_c = tube.prescribed_time

@@ -213,9 +213,9 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
     design_or_spec : Design or Spec
         A :class:`~stt_codegen.design.result.Design` (from
         :func:`stt_codegen.design_tube`), checked against its own ``design.spec`` (its
-        tube is certified again here, not taken from ``design.certificate``); or a :class:`~stt_codegen.spec.loader.Spec`, designed
-        first: a spec with no design gives a report whose one check, ``tube.design``,
-        failed.
+        tube is certified again here, not taken from ``design.certificate``); or a
+        :class:`~stt_codegen.spec.loader.Spec`, designed first: a spec with no design
+        gives a report whose one check, ``tube.design``, failed.
     plant : str, optional
         Plant model for Assumption 2 (one of
         :data:`~stt_codegen.spec.loader.PLANT_MODELS`); default the spec's
@@ -251,14 +251,13 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
     Examples
     --------
     >>> import stt_codegen as stt
-    >>> from stt_codegen.verify.command import verify
     >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
-    >>> report = verify(design)
+    >>> report = stt.verify(design)
     >>> report.passed
     True
     >>> report["lemma3.3.reach.continuity"].passed
     True
-    >>> verify(stt.load_spec("omnirobot-s1")).passed       # designs it first
+    >>> stt.verify(stt.load_spec("omnirobot-s1")).passed       # designs it first
     True
     """
     if isinstance(design_or_spec, Design):
@@ -266,8 +265,10 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
     elif isinstance(design_or_spec, Spec):
         spec = design_or_spec
     else:
-        raise TypeError(f"verify takes a Design or a Spec, not {type(design_or_spec).__name__}"
-                        " (a Design carries its spec: verify(design))")
+        raise TypeError(f"verify(): parameter 'design_or_spec' must be a Design or a Spec, not "
+                        f"{type(design_or_spec).__name__}; pass the Design that "
+                        "stt_codegen.design_tube(spec) returned (it carries its spec), or the "
+                        "Spec")
     if plant is not None and plant not in PLANT_MODELS:
         raise SpecError("plant", f"must be one of {', '.join(PLANT_MODELS)}")
     if plant is not None and dimension_mismatch(plant, spec.dimension):
