@@ -8,7 +8,8 @@ from conftest import design_of
 from scipy.integrate import solve_ivp
 
 from stt_codegen.runtime import backends
-from stt_codegen.runtime.plants import Disturbance, make_plant
+from stt_codegen.errors import SpecError
+from stt_codegen.runtime.plants import Disturbance, check_seed, make_plant
 from stt_codegen.runtime.simulate import SUBSTEPS, _rk4, simulate
 
 
@@ -92,3 +93,18 @@ def test_judging_reports_failures(monkeypatch):
 def test_short_horizon_cannot_satisfy():
     result = simulate(design_of("omnirobot-s3"), backend="casadi", horizon=2.0)
     assert result.steps == 2000 and not result.satisfied
+
+
+@pytest.mark.parametrize("seed", [-1, 2**32, 1.5, True, "3"])
+def test_the_seed_is_an_integer_in_32_bits(seed):
+    design = design_of("omnirobot-s1")
+    with pytest.raises(SpecError) as info:
+        simulate(design, backend="casadi", horizon=0.1, seed=seed)
+    assert info.value.field == "seed"
+    assert info.value.reason == f"must be an integer in [0, 2**32), got {seed!r}"
+
+
+def test_the_largest_seed_and_numpy_integers_are_seeds():
+    design = design_of("omnirobot-s1")
+    assert simulate(design, backend="casadi", horizon=0.1, seed=np.uint32(2**32 - 1)).steps == 100
+    assert check_seed(np.int64(7)) == 7 and type(check_seed(np.int64(7))) is int

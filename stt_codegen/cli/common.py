@@ -10,8 +10,11 @@ import argparse
 import json
 from typing import TYPE_CHECKING, Any
 
+from ..errors import DesignError
+
 if TYPE_CHECKING:
     from ..design.result import Design
+    from ..spec.loader import Spec
 
 
 def add_spec_argument(p: argparse.ArgumentParser) -> None:
@@ -41,16 +44,67 @@ def print_json(data: Any) -> None:
     print(json.dumps(data, indent=2, sort_keys=True))
 
 
-def load_and_design(spec_arg: str) -> Design:
-    """Load the spec ``SPEC`` names and design its tube.
+def add_seed_argument(p: argparse.ArgumentParser) -> None:
+    """``--seed N``: the disturbance seed, checked by :func:`checked_seed`."""
+    p.add_argument("--seed", type=int, default=0,
+                   help="disturbance seed, an integer in [0, 2**32) (default: 0)")
+
+
+def checked_seed(args: argparse.Namespace) -> int:
+    """``--seed``, checked before any work (the library's rule,
+    :func:`stt_codegen.runtime.plants.check_seed`).
+
+    Raises
+    ------
+    SpecError
+        Field ``seed`` (shown as ``--seed``): not in ``[0, 2**32)``.
+    """
+    from ..runtime.plants import check_seed
+    return check_seed(args.seed)
+
+
+def no_design_document(spec: Spec, error: DesignError) -> dict[str, Any]:
+    """What every command that designs prints with ``--json`` when there is no design.
+
+    Returns
+    -------
+    dict
+        ``spec`` (the name), ``designed`` (``False``), ``reason`` (the message of the
+        error) and ``kind`` (the :class:`~stt_codegen.design.failures.FailureKind` value,
+        e.g. ``"walled off"``, or ``None``). A design is ``Design.to_json()``, with
+        ``designed`` ``True``.
+    """
+    kind = getattr(error.kind, "value", None)
+    return {"spec": spec.name, "designed": False, "reason": str(error), "kind": kind}
+
+
+def design_spec(spec: Spec, args: argparse.Namespace) -> Design:
+    """Design the tube of ``spec`` for a command; with ``--json``, when there is no design,
+    print :func:`no_design_document` on standard output first.
+
+    Raises
+    ------
+    DesignError
+        No certified tube exists for the spec: exit code 1, the reason on standard error.
+    """
+    from ..design.search import design_tube
+    try:
+        return design_tube(spec)
+    except DesignError as exc:
+        if getattr(args, "json", False):
+            print_json(no_design_document(spec, exc))
+        raise
+
+
+def load_and_design(args: argparse.Namespace) -> Design:
+    """:func:`design_spec` of the spec ``SPEC`` names (a bundled case or a file).
 
     Raises
     ------
     SpecError
         The spec is invalid or cannot be found.
     DesignError
-        No certified tube exists for it (exit code 1, the reason on standard error).
+        As :func:`design_spec`.
     """
-    from ..design.search import design_tube
     from ..spec.loader import load_spec
-    return design_tube(load_spec(spec_arg))
+    return design_spec(load_spec(args.spec), args)

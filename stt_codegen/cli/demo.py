@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from ..system import atomic_write
-from .common import add_backend_argument, load_and_design
+from .common import add_backend_argument, design_spec
 from .simulate import SUMMARY_HEADER, summary_line
 
 
@@ -16,6 +16,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     from ..codegen.api import generate
     from ..runtime.plots import plot_run
     from ..runtime.simulate import simulate
+    from ..spec.loader import load_spec
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print(f"For every bundled case: design the tube, generate the C and Python controllers "
@@ -23,7 +24,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     print(SUMMARY_HEADER)
     all_ok = True
     for name in bundled_cases():
-        design = load_and_design(name)
+        design = design_spec(load_spec(name), args)
         generate(design, out / name)
         result = simulate(design, backend=args.backend)
         atomic_write(out / f"{name}.png", lambda tmp: plot_run(design, result, tmp))

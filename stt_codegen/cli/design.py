@@ -3,26 +3,16 @@
 from __future__ import annotations
 
 import argparse
-import json
 
-from .common import add_json_argument, add_spec_argument, print_json
+from .common import add_json_argument, add_spec_argument, load_and_design, print_json
 from .plotting import add_plot_argument, check_plot_folder, write_plot
 
 
 def cmd_design(args: argparse.Namespace) -> int:
     """0 designed, 1 no design, 2 bad input."""
-    from ..errors import DesignError
-    from ..spec.loader import load_spec
-    from ..design.search import design_tube
     check_plot_folder(args)
-    spec = load_spec(args.spec)
-    try:
-        design = design_tube(spec)
-    except DesignError as exc:
-        if args.json:
-            print(json.dumps({"spec": spec.name, "designed": False, "reason": str(exc)},
-                             indent=2, sort_keys=True))
-        raise
+    design = load_and_design(args)
+    spec = design.spec
 
     def draw(path):
         from ..runtime.plots import plot_design

@@ -6,7 +6,8 @@ import argparse
 from pathlib import Path
 
 from ..errors import SpecError
-from .common import add_json_argument, add_spec_argument, load_and_design, print_json
+from .common import (add_json_argument, add_seed_argument, add_spec_argument, checked_seed,
+                     load_and_design, print_json)
 
 
 def _print_report(r: dict) -> None:
@@ -35,9 +36,10 @@ def _print_report(r: dict) -> None:
 def cmd_embedded(args: argparse.Namespace) -> int:
     """Design, generate single precision, run on QEMU mps2-an386; 0 iff all passed."""
     from ..embedded.deploy import run_embedded
+    seed = checked_seed(args)
     if args.build_dir is not None and not Path(args.build_dir).parent.is_dir():
         raise SpecError("build_dir", f"folder {str(Path(args.build_dir).parent)!r} does not exist")
-    report = run_embedded(load_and_design(args.spec), args.build_dir, seed=args.seed,
+    report = run_embedded(load_and_design(args), args.build_dir, seed=seed,
                           compare_host=not args.no_host)
     if args.json:
         print_json(report)
@@ -50,7 +52,7 @@ def configure_embedded(p: argparse.ArgumentParser) -> None:
     """Arguments of ``stt-codegen embedded``."""
     add_spec_argument(p)
     add_json_argument(p)
-    p.add_argument("--seed", type=int, default=0, help="disturbance seed (default: 0)")
+    add_seed_argument(p)
     p.add_argument("--build-dir", default=None, metavar="DIR",
                    help="keep the generated code, programs and ELFs there (default: temporary)")
     p.add_argument("--no-host", action="store_true",

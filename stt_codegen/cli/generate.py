@@ -13,7 +13,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     """0 written, 1 no design, 2 bad input, 3 code generator failure."""
     from ..codegen.api import generate
     parse_options(args.languages, args.precision)   # bad options fail before the design
-    design = load_and_design(args.spec)
+    design = load_and_design(args)
     files = generate(design, Path(args.out_dir), languages=args.languages,
                      precision=args.precision)
     print(f"wrote {len(files)} files for {design.spec.name} ({args.languages}, "

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from .common import (add_backend_argument, add_json_argument, add_spec_argument,
-                     load_and_design, print_json)
+from .common import (add_backend_argument, add_json_argument, add_seed_argument,
+                     add_spec_argument, checked_seed, load_and_design, print_json)
 from .plotting import add_plot_argument, check_plot_folder, write_plot
 
 #: Header of the table of :func:`summary_line` rows (``simulate`` and ``demo``).
@@ -25,9 +25,10 @@ def summary_line(result) -> str:
 def cmd_simulate(args: argparse.Namespace) -> int:
     """0 satisfied, 1 not satisfied or no design, 2 bad input, 3 toolchain."""
     from ..runtime.simulate import simulate
+    seed = checked_seed(args)
     check_plot_folder(args)
-    design = load_and_design(args.spec)
-    result = simulate(design, backend=args.backend, horizon=args.horizon, seed=args.seed)
+    design = load_and_design(args)
+    result = simulate(design, backend=args.backend, horizon=args.horizon, seed=seed)
 
     def draw(path):
         from ..runtime.plots import plot_run
@@ -56,7 +57,7 @@ def configure_simulate(p: argparse.ArgumentParser) -> None:
     add_backend_argument(p)
     p.add_argument("--horizon", type=float, default=None, metavar="S",
                    help="simulated time in seconds (default: t_c)")
-    p.add_argument("--seed", type=int, default=0, help="disturbance seed (default: 0)")
+    add_seed_argument(p)
     add_plot_argument(p, "the run")
     add_json_argument(p)
     p.set_defaults(handler=cmd_simulate)

@@ -7,7 +7,7 @@ import json
 import sys
 from collections.abc import Callable
 
-from .common import add_json_argument, add_spec_argument
+from .common import add_json_argument, add_spec_argument, design_spec
 
 
 def _terminal_progress() -> Callable[[str], None] | None:
@@ -22,13 +22,13 @@ def _terminal_progress() -> Callable[[str], None] | None:
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
-    """0 every check passed, 1 a check failed, 2 bad input."""
+    """0 every check passed, 1 a check failed or no design, 2 bad input."""
     from ..spec.loader import load_spec
-    from ..verify.command import verify
+    from ..verify.command import spec_for_plant, verify
+    design = design_spec(spec_for_plant(load_spec(args.spec), args.plant), args)
     progress = None if args.json else _terminal_progress()
     try:
-        report = verify(load_spec(args.spec), plant=args.plant, progress=progress,
-                        cache=not args.no_cache)
+        report = verify(design, plant=args.plant, progress=progress, cache=not args.no_cache)
     finally:
         if progress is not None:
             sys.stderr.write("\r\x1b[K")

@@ -98,10 +98,12 @@ class Design:
         Returns
         -------
         dict
-            ``spec`` (the name of :attr:`spec`), ``method``, ``circumvents`` (spec obstacle index, dimension, side,
-            window start and end in s, height, sharpness), ``via`` (boxes and times;
-            empty for the paper's method), ``gain``, ``certificate`` (each property with
-            its margin and where it is smallest) and ``design_time_s``.
+            ``spec`` (the name of :attr:`spec`), ``designed`` (``True``; the command
+            line's document for a spec with no design has ``False``), ``method``,
+            ``circumvents`` (spec obstacle index, dimension, side, window start and end in
+            s, height, sharpness), ``via`` (boxes and times; empty for the paper's
+            method), ``segments``, ``gain``, ``certificate`` (each property with its
+            margin and where it is smallest) and ``design_time_s``.
         """
         tube = self.tube
         via = []
@@ -113,6 +115,7 @@ class Design:
                     for s in segs]
         return {
             "spec": self.spec.name,
+            "designed": True,
             "method": self.method,
             "circumvents": [{"obstacle": c.obstacle, "dimension": c.dimension,
                              "side": c.side, "start": c.start, "end": c.end,

@@ -44,6 +44,7 @@ from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..design.result import Design, require_design
 from ..errors import ToolchainError
+from ..runtime.plants import check_seed
 from ..tube.parameters import TubeDesign
 from . import board
 from .footprint import elf_stack_bound, linked_sizes, measure
@@ -110,7 +111,8 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
     out_dir : Path, optional
         Build folder (generated C, programs, objects, ELFs); a temporary one by default.
     seed : int
-        Disturbance seed of the closed loop (and of the host simulation compared with it).
+        Disturbance seed of the closed loop (and of the host simulation compared with it),
+        in ``[0, 2**32)``.
     count_fractions : sequence of float
         Times (fractions of ``t_c``) of the steps whose instructions are counted.
     compare_host : bool
@@ -128,6 +130,8 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
     ------
     TypeError
         ``design`` is not a :class:`~stt_codegen.design.result.Design`.
+    SpecError
+        ``seed`` is not an integer in ``[0, 2**32)`` (field ``seed``).
     ToolsMissing
         A tool is not installed (the message names the Debian packages).
     ToolchainError
@@ -135,6 +139,7 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
     """
     design = require_design(design, "run_embedded")
     spec, tube = design.spec, design.tube
+    seed = check_seed(seed)
     message = missing_message()
     if message:
         raise ToolsMissing(message)

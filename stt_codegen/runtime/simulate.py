@@ -20,7 +20,7 @@ from .backends import STATUS_OK, make_controller
 from ..design.result import Design, require_design
 from ..design.samples import check_step_budget
 from ..errors import SpecError
-from .plants import make_plant
+from .plants import check_seed, make_plant
 from ..spec.loader import Spec
 from ..tube.parameters import TubeDesign
 
@@ -135,7 +135,7 @@ def simulate(design: Design, backend: str = "reference", horizon: float | None =
         Definition 2.1 is judged on ``[0, min(horizon, t_c)]``; a horizon shorter than
         ``t_c`` cannot satisfy it.
     seed : int, optional
-        Seed of the disturbance ``w``.
+        Seed of the disturbance ``w``: an integer (Python or numpy) in ``[0, 2**32)``.
     plant : control.NonlinearIOSystem, optional
         The plant to control instead of the spec's ``[plant]`` (``n`` states, inputs and
         outputs, the state as output); it must include its own disturbance.
@@ -155,7 +155,8 @@ def simulate(design: Design, backend: str = "reference", horizon: float | None =
         or a ``Spec``, say): call :func:`stt_codegen.design_tube` first.
     SpecError
         Unknown backend (field ``backend``), a horizon that is not a positive number of
-        seconds (``horizon``), or a run of more than
+        seconds (``horizon``), a seed that is not an integer in ``[0, 2**32)``
+        (``seed``), or a run of more than
         :data:`~stt_codegen.design.samples.STEP_BUDGET` steps.
     ToolchainError
         Backend ``"c"``: no C compiler, or it failed.
@@ -195,6 +196,7 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     Parameters, result and errors are those of :func:`simulate`, with the spec and the
     tube (:class:`~stt_codegen.tube.parameters.TubeDesign`) in place of the design.
     """
+    seed = check_seed(seed)
     t_c = spec.prescribed_time
     horizon = t_c if horizon is None else _seconds(horizon)
     check_step_budget(int(math.ceil(horizon * tube.rate_hz - 1e-9)), horizon, tube.rate_hz)

@@ -172,17 +172,38 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     return checks
 
 
+def spec_for_plant(spec: Spec, plant: str | None) -> Spec:
+    """The spec to design for when Assumption 2 is checked for ``plant``: ``spec`` with
+    ``plant`` as its plant model (``spec`` itself when ``plant`` is ``None``), so that the
+    design refuses a plant that violates the assumption.
+
+    Raises
+    ------
+    SpecError
+        Field ``plant``: not one of :data:`~stt_codegen.spec.plants.PLANT_MODELS`, or a
+        model that does not fit the spec's dimension.
+    """
+    if plant is None:
+        return spec
+    if plant not in PLANT_MODELS:
+        raise SpecError("plant", f"must be one of {', '.join(PLANT_MODELS)}")
+    mismatch = dimension_mismatch(plant, spec.dimension)
+    if mismatch:
+        raise SpecError("plant", mismatch)
+    return replace(spec, plant_model=plant)
+
+
 def verify_spec(spec: Spec, plant: str | None = None, *, cache: bool = True,
                 progress: Callable[[str], None] | None = None) -> list[Check]:
     """Design the tube of a spec and run :func:`verify_design`; a design failure is a FAIL.
 
-    With ``plant``, the tube is designed for that plant model instead of the spec's (the
-    design refuses a plant that violates Assumption 2).
+    With ``plant``, the tube is designed for that plant model instead of the spec's
+    (:func:`spec_for_plant`).
     """
     stage = _Stages(progress, design=True)
     stage("design")
     try:
-        design = design_tube(spec if plant is None else replace(spec, plant_model=plant))
+        design = design_tube(spec_for_plant(spec, plant))
     except DesignError as exc:
         return [Check("tube.design", False, str(exc))]
     return verify_design(spec, design.tube, plant, cache=cache, progress=stage)
@@ -269,10 +290,7 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
                         f"{type(design_or_spec).__name__}; pass the Design that "
                         "stt_codegen.design_tube(spec) returned (it carries its spec), or the "
                         "Spec")
-    if plant is not None and plant not in PLANT_MODELS:
-        raise SpecError("plant", f"must be one of {', '.join(PLANT_MODELS)}")
-    if plant is not None and dimension_mismatch(plant, spec.dimension):
-        raise SpecError("plant", dimension_mismatch(plant, spec.dimension))
+    spec_for_plant(spec, plant)     # a bad plant is refused before any work
     if isinstance(design_or_spec, Design):
         checks = verify_design(spec, design_or_spec.tube, plant, cache=cache,
                                progress=progress)
