@@ -213,3 +213,13 @@ def test_property_tests_are_derandomized_by_default():
     if not os.environ.get("CI") and os.environ.get("HYPOTHESIS_PROFILE", "ci") != "ci":
         pytest.skip("another Hypothesis profile was asked for outside CI")
     assert settings.default.derandomize is True and settings.default.database is None
+
+
+def test_every_package_is_installed():
+    """pyproject.toml lists the packages explicitly: a new subpackage (``cli``,
+    ``design.certificate``) missing from the list would be absent from a wheel."""
+    import tomllib
+    listed = set(tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"]
+                 ["packages"])
+    folders = {_module_name(p) for p in PACKAGE.rglob("__init__.py")}
+    assert folders <= listed

@@ -1,7 +1,8 @@
-"""What several commands share: their common arguments and the design step.
+"""What several commands share: their common arguments, the design step and the document
+printed with ``--json`` when there is no design.
 
-Heavy packages are imported inside the functions, so that configuring a command (``--help``)
-imports nothing but the standard library.
+The library is imported inside the functions that need it, so that importing this module
+(for ``stt-codegen --help`` or ``cases``) costs nothing.
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ def print_json(data: Any) -> None:
 
 def add_seed_argument(p: argparse.ArgumentParser) -> None:
     """``--seed N``: the disturbance seed, checked by :func:`checked_seed`."""
-    p.add_argument("--seed", type=int, default=0,
+    p.add_argument("--seed", type=int, default=0, metavar="N",
                    help="disturbance seed, an integer in [0, 2**32) (default: 0)")
 
 
