@@ -189,7 +189,7 @@ def test_obstacles_are_numbered_as_the_messages_number_them():
     design = design_tube(spec)
     named = {int(m.name.split()[-1]) for m in design.certificate.margins
              if m.name.startswith("avoids obstacle")}
-    labels = obstacle_labels(arena_of(plots.design_figure(spec, design)))
+    labels = obstacle_labels(arena_of(plots.design_figure(design)))
     assert set(labels) == named == {0, 1, 2, 3}
     for j in named:
         box = spec.unsafe_sets[j].shape
@@ -220,7 +220,7 @@ def assert_legends_are_clean(fig) -> int:
 @pytest.mark.parametrize("dims", [(0, 1), (0, 2)])
 def test_design_legends_have_one_entry_per_thing_outside_the_axes(dims):
     for spec in (load_spec("omnirobot-s1"), mixed_3d()):
-        fig = plots.design_figure(spec, design_tube(spec), dims)
+        fig = plots.design_figure(design_tube(spec), dims)
         assert assert_legends_are_clean(fig) == 2
         arena = [t.get_text() for t in arena_of(fig).get_legend().get_texts()]
         assert arena.count(plots.OBSTACLE_LABEL) == 1
@@ -229,14 +229,13 @@ def test_design_legends_have_one_entry_per_thing_outside_the_axes(dims):
 
 @pytest.fixture(scope="module")
 def short_run():
-    spec = load_spec("omnirobot-s2")
-    tube = design_tube(spec).tube
-    return spec, tube, simulate(spec, tube, backend="reference", horizon=1.0)
+    design = design_tube(load_spec("omnirobot-s2"))
+    return design, simulate(design, backend="reference", horizon=1.0)
 
 
 def test_run_figure_has_u_of_t_with_one_line_per_input(short_run):
-    spec, tube, result = short_run
-    fig = plots.run_figure(spec, tube, result, (1, 2))
+    design, result = short_run
+    fig = plots.run_figure(design, result, (1, 2))
     assert assert_legends_are_clean(fig) == 3     # arena, the tube plots, u(t)
     (u_ax,) = [ax for ax in fig.axes if ax.get_ylabel().startswith("u")]
     lines = [line for line in u_ax.get_lines() if line.get_label() != "$t_c$"]

@@ -33,12 +33,12 @@ from ..errors import SpecError
 from ..spec.loader import Box, Spec, UnsafeSet
 from ..spec.plants import PLANTS
 from ..tube import reference
+from ..design.result import Design, require_design
 from ..tube.parameters import TANH, TubeDesign
 from .simulate import SimulationResult
 
 if TYPE_CHECKING:
     from ..design.certificate import Certificate
-    from ..design.result import Design
     from ..errors import DesignError
 
 #: The state dimensions the arena is drawn on unless told otherwise.
@@ -311,14 +311,15 @@ def draw_inputs(ax: Axes, spec: Spec, result: SimulationResult) -> None:
     legend_right(ax)
 
 
-def run_figure(spec: Spec, design: TubeDesign, result: SimulationResult,
+def run_figure(design: Design, result: SimulationResult,
                dims: tuple[int, int] = DEFAULT_DIMS) -> Figure:
     """The figure of a closed-loop run: arena with the trajectory, the tube and the state
     per dimension against time, and the inputs against time.
 
     Parameters
     ----------
-    spec, design : Spec, TubeDesign
+    design : Design
+        From :func:`stt_codegen.design_tube`: the run's tube and (``design.spec``) its task.
     result : SimulationResult
         With its trajectory: ``x`` (N, n), ``u`` (N, m), ``alpha`` (N, 2n) at ``t`` (N,) s.
     dims : tuple of int, length 2
@@ -329,9 +330,11 @@ def run_figure(spec: Spec, design: TubeDesign, result: SimulationResult,
     matplotlib.figure.Figure
         ``n + 1`` time plots: ``x_1``...``x_n`` in their tube, then ``u(t)``.
     """
+    design = require_design(design, "run_figure")
+    spec = design.spec
     traj = result.trajectory
     n = spec.dimension
-    g_l, g_u, _, _ = reference.adaptive_tube(design, traj.t, traj.alpha)
+    g_l, g_u, _, _ = reference.adaptive_tube(design.tube, traj.t, traj.alpha)
     fig, grid, ax = arena_figure(spec, n + 1, dims)
     if ax is not None:
         i, j = dims
@@ -357,25 +360,53 @@ def run_figure(spec: Spec, design: TubeDesign, result: SimulationResult,
     return fig
 
 
-def plot_run(spec: Spec, design: TubeDesign, result: SimulationResult, path: str | Path, *,
+def plot_run(design: Design, result: SimulationResult, path: str | Path, *,
              dims: tuple[int, int] = DEFAULT_DIMS) -> Path:
-    """Write a PNG of a closed-loop run (:func:`run_figure`).
+    """Write a PNG of a closed-loop run, in the manner of the paper's Fig. 3
+    (:func:`run_figure`).
+
+    On the left, the arena on the dimensions ``dims``: the state space, every obstacle
+    (projected), the initial and target sets and the trajectory; on the right, for each
+    dimension, the tube ``[gamma_L, gamma_U]`` of eq. (10) (with the run's ``alpha``)
+    against time with the state inside it and ``t_c``, then the inputs ``u(t)``.
 
     Parameters
     ----------
-    spec, design : Spec, TubeDesign
+    design : Design
+        From :func:`stt_codegen.design_tube`: the run's tube and (``design.spec``) its task.
     result : SimulationResult
-        With its trajectory.
+        From :func:`stt_codegen.simulate` on ``design``, with its trajectory.
     path : str or path
-        Output file; its folder must exist.
+        Output file (PNG); its folder must exist.
     dims : tuple of int, length 2
-        State dimensions of the arena.
+        State dimensions of the arena, zero-based (:func:`check_dims`).
 
     Returns
     -------
     pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    TypeError
+        ``design`` is not a :class:`~stt_codegen.design.result.Design`.
+    SpecError
+        ``dims`` is not two distinct dimensions of the state space (field ``dims``).
+
+    See Also
+    --------
+    stt_codegen.simulate : the run.
+    stt_codegen.plot_design : the certified tube, before any run.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    >>> result = stt.simulate(design, backend="casadi")
+    >>> stt.plot_run(design, result, "s1-run.png").name
+    's1-run.png'
     """
-    return save(run_figure(spec, design, result, dims), path)
+    return save(run_figure(require_design(design, "plot_run"), result, dims), path)
 
 
 # --------------------------------------------------------------------------- a design
@@ -467,35 +498,56 @@ def tube_figure(spec: Spec, tube: TubeDesign, certificate: Certificate, headline
     return fig
 
 
-def design_figure(spec: Spec, design: Design, dims: tuple[int, int] = DEFAULT_DIMS) -> Figure:
+def design_figure(design: Design, dims: tuple[int, int] = DEFAULT_DIMS) -> Figure:
     """The figure of a certified design (:func:`tube_figure`), its method and time in the
     title."""
+    design = require_design(design, "design_figure")
+    spec = design.spec
     return tube_figure(spec, design.tube, design.certificate,
                        f"{spec.name}: {design.method} method, "
                        f"{design.design_time_s * 1e3:.1f} ms", dims)
 
 
-def plot_design(spec: Spec, design: Design, path: str | Path, *,
+def plot_design(design: Design, path: str | Path, *,
                 dims: tuple[int, int] = DEFAULT_DIMS) -> Path:
     """Write a PNG of ``design``: tube boxes (the certificate's enclosure) and via boxes
-    over the arena, and the certified enclosure of ``gamma_L``, ``gamma_U`` per dimension
-    against time (:func:`design_figure`).
+    over the arena, and the certified enclosure of ``gamma_L``, ``gamma_U`` (eq. (10)) per
+    dimension against time (:func:`design_figure`).
 
     Parameters
     ----------
-    spec : Spec
     design : Design
-        From :func:`stt_codegen.design_tube`.
+        From :func:`stt_codegen.design_tube` (its spec gives the arena).
     path : str or path
-        Output file; its folder must exist.
+        Output file (PNG); its folder must exist.
     dims : tuple of int, length 2
-        State dimensions of the arena.
+        State dimensions of the arena, zero-based (:func:`check_dims`).
 
     Returns
     -------
     pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    TypeError
+        ``design`` is not a :class:`~stt_codegen.design.result.Design`.
+    SpecError
+        ``dims`` is not two distinct dimensions of the state space (field ``dims``).
+
+    See Also
+    --------
+    stt_codegen.design_tube : the design.
+    stt_codegen.plot_run : a closed-loop run in its tube.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    >>> stt.plot_design(design, "s1-tube.png").name
+    's1-tube.png'
     """
-    return save(design_figure(spec, design, dims), path)
+    return save(design_figure(require_design(design, "plot_design"), dims), path)
 
 
 def rejected_figure(spec: Spec, error: DesignError,

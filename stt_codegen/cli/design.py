@@ -1,0 +1,55 @@
+"""``stt-codegen design SPEC``: design and certify the tube only (no simulation)."""
+
+from __future__ import annotations
+
+import argparse
+
+from ..errors import DesignError
+from .common import add_json_argument, add_spec_argument, design_spec, print_json
+from .plotting import (add_plot_argument, check_plot_folder, plot_dims, write_plot,
+                       write_rejected_plot)
+
+
+def cmd_design(args: argparse.Namespace) -> int:
+    """0 designed, 1 no design (``--plot``: the best rejected tube is drawn), 2 bad input."""
+    from ..spec.loader import load_spec
+    check_plot_folder(args)
+    spec = load_spec(args.spec)
+    dims = plot_dims(args, spec)
+    try:
+        design = design_spec(spec, args)
+    except DesignError as exc:
+        write_rejected_plot(args, spec, exc, dims)
+        raise
+
+    def draw(path):
+        from ..runtime.plots import plot_design
+        return plot_design(design, path, dims=dims)
+    write_plot(args, draw)
+    if args.json:
+        print_json(design.to_json())
+        return 0
+    tube = design.tube
+    print(f"{spec.name}: designed with the {design.method} method in "
+          f"{design.design_time_s * 1e3:.1f} ms, gain k = {tube.gain:.4g}, "
+          f"{len(tube.segments)} reach segment(s), {len(tube.circumvents)} circumvent(s)")
+    for c in tube.circumvents:
+        print(f"  circumvent obstacle {c.obstacle}: x{c.dimension + 1} {c.side}, window "
+              f"[{c.start:.3f}, {c.end:.3f}] s, height {c.height:.3g}, sharpness {c.sharpness:g}")
+    for s in tube.segments:
+        box = ", ".join(f"[{a:.3g}, {b:.3g}]" for a, b in zip(s.lower_to, s.upper_to))
+        print(f"  reach segment {s.profile} [{s.start:.3f}, {s.end:.3f}] s to {box}")
+    for m in design.certificate.margins:
+        print(f"  {'PASS' if m.passed else 'FAIL'}  {m.name}: margin {m.margin:.4g}")
+    if args.plot:
+        print(f"plot written to {args.plot}")
+    return 0
+
+
+def configure_design(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen design``."""
+    add_spec_argument(p)
+    add_json_argument(p)
+    add_plot_argument(p, "the designed tube (of the best rejected tube when there "
+                      "is no design)")
+    p.set_defaults(handler=cmd_design)
