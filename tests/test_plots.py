@@ -252,11 +252,12 @@ def test_run_figure_has_u_of_t_with_one_line_per_input(short_run):
 # --------------------------------------------------------------------------- no design
 
 
-def test_design_plot_without_a_design_shows_the_rejected_tube(tmp_path):
+@pytest.mark.parametrize("command", ["design", "simulate"])
+def test_plot_without_a_design_shows_the_rejected_tube(command, tmp_path):
     spec_file = tmp_path / "near.toml"
     spec_file.write_text(NEAR_TARGET)
     png = tmp_path / "near.png"
-    out = run_cli("design", str(spec_file), "--plot", str(png))
+    out = run_cli(command, str(spec_file), "--plot", str(png))
     assert out.returncode == 1 and "Traceback" not in out.stderr
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     lines = out.stderr.splitlines()

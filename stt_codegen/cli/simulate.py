@@ -6,7 +6,9 @@ import argparse
 
 from .common import (add_backend_argument, add_json_argument, add_seed_argument,
                      add_spec_argument, checked_seed, design_spec, print_json)
-from .plotting import add_plot_argument, check_plot_folder, plot_dims, write_plot
+from ..errors import DesignError
+from .plotting import (add_plot_argument, check_plot_folder, plot_dims, write_plot,
+                       write_rejected_plot)
 
 #: Header of the table of :func:`summary_line` rows (``simulate`` and ``demo``).
 SUMMARY_HEADER = f"{'case':<22} {'satisfied':<9} {'reach [s]':>9} {'clearance':>9}   max |u|"
@@ -30,7 +32,11 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     check_plot_folder(args)
     spec = load_spec(args.spec)
     dims = plot_dims(args, spec)
-    design = design_spec(spec, args)
+    try:
+        design = design_spec(spec, args)
+    except DesignError as exc:
+        write_rejected_plot(args, spec, exc, dims)
+        raise
     result = simulate(design, backend=args.backend, horizon=args.horizon, seed=seed)
 
     def draw(path):
