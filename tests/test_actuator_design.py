@@ -21,11 +21,11 @@ from stt_codegen.design.input_bound import input_peak, input_prover, phi
 from stt_codegen.design.search import design_tube
 from stt_codegen.design.samples import sample_tube
 from stt_codegen.errors import DesignError
-from stt_codegen.runtime.simulate import simulate
+from stt_codegen.runtime.simulate import run_closed_loop, simulate
 from stt_codegen.spec.loader import load_spec, parse_spec
 from stt_codegen.tube import reference as R
 from stt_codegen.tube.parameters import STATUS_INPUT_CLAMPED, STATUS_OK, STATUS_OUTSIDE_TUBE
-from stt_codegen.verify.actuator import prove_input_bound, sampled_error_bound
+from stt_codegen.verify.actuator import sampled_error_bound
 from stt_codegen.verify.command import verify
 from stt_codegen.verify.sampled import check_sampled
 
@@ -51,7 +51,7 @@ def robot():
 def test_without_actuator_nothing_changes():
     design = design_tube(load_spec("omnirobot-s1"))
     assert design.input_proof is None and design.tube.input_bound is None
-    assert "input_bound" not in design.to_json("omnirobot-s1")
+    assert "input_bound" not in design.to_json()
 
 
 def test_the_peak_is_law_13s_input():
@@ -102,7 +102,7 @@ def test_a_bound_the_default_design_exceeds_gets_a_slower_tube():
     assert design.tube.input_bound == bound and design.input_proof.meets(bound)
     assert design.method == "via" and design.tube != default.tube
     assert max(p / b for p, b in zip(design.input_proof.peak, bound)) < 0.7
-    document = design.to_json(spec.name)
+    document = design.to_json()
     assert document["input_bound"] == list(bound)
     assert document["input_peak"]["peak"] == list(design.input_proof.peak)
     assert document["input_peak"]["margin"] > 0.3
@@ -145,7 +145,7 @@ def test_verify_fails_a_tube_beyond_the_bound():
 
 def test_the_closed_loop_with_the_generated_c_stays_within_the_bound():
     spec, design = robot()
-    result = simulate(spec, design.tube, backend="c")
+    result = simulate(design, backend="c")
     assert result.satisfied and result.stayed_in_tube and result.clamped_steps == 0
     assert all(u <= b for u, b in zip(result.max_abs_u, spec.input_bound))
     assert set(result.trajectory.status) == {STATUS_OK}
@@ -157,7 +157,7 @@ def test_on_a_plant_of_the_assumptions_the_loop_stays_below_the_proved_peak():
     spec = small((3.5, 3.5))
     design = design_tube(spec)
     for seed in (0, 1, 2):
-        result = simulate(spec, design.tube, backend="c", seed=seed)
+        result = simulate(design, backend="c", seed=seed)
         assert result.satisfied and result.clamped_steps == 0
         assert all(u <= p for u, p in zip(result.max_abs_u, design.input_proof.peak))
 
@@ -170,10 +170,12 @@ def test_the_clamp_acts_and_reports_on_a_tube_beyond_the_bound():
     defence, the guarantee is the design's."""
     spec = small(None)
     tube = design_tube(spec).tube
-    near = simulate(spec, dataclasses.replace(tube, input_bound=(2.8, 2.8)), backend="c")
+    near = run_closed_loop(spec, dataclasses.replace(tube, input_bound=(2.8, 2.8)),
+                           backend="c")
     assert near.clamped_steps > 0 and STATUS_INPUT_CLAMPED in near.trajectory.status
     assert max(near.max_abs_u) == 2.8 and near.stayed_in_tube
-    far = simulate(spec, dataclasses.replace(tube, input_bound=(1.5, 1.5)), backend="c")
+    far = run_closed_loop(spec, dataclasses.replace(tube, input_bound=(1.5, 1.5)),
+                          backend="c")
     assert far.clamped_steps > 0 and max(far.max_abs_u) == 1.5
     assert not far.stayed_in_tube and STATUS_OUTSIDE_TUBE in far.trajectory.status
 

@@ -7,8 +7,9 @@
   processes or a Dask cluster;
 * :mod:`.harness` - a generated C timing harness, compiled, timed and run under callgrind;
 * :mod:`.step`, :mod:`.scaling` - the per-step cost and its growth;
-* :mod:`.report` - statistics, tables and the machine description;
-* :mod:`.cli` - the ``bench`` subcommand's arguments.
+* :mod:`.report` - statistics, tables and the machine description.
+
+The ``bench`` subcommand's arguments are in :mod:`stt_codegen.cli.bench`.
 
 Every benchmark measures what it compares side by side in one run and reports ratios;
 the tests check structure and invariants, never speed.

@@ -20,7 +20,7 @@ Methods (:data:`METHODS`):
   OMPL is installed).
 
 Every method runs on the same arena with the same disturbance (seed = arena index), the
-same sampling rate and the same judge, :func:`stt_codegen.runtime.simulate.simulate`.
+same sampling rate and the same judge, :func:`stt_codegen.runtime.simulate.run_closed_loop`.
 """
 
 from __future__ import annotations
@@ -162,7 +162,7 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
         |u|^2 dt``, m^2/s, or None)}}}``; the last four are ``None`` without a closed
         loop.
     """
-    from ..runtime.simulate import simulate
+    from ..runtime.simulate import run_closed_loop
     from .tracker import track
     arena = generate_arena(seed, index)
     spec = arena.to_spec()
@@ -174,7 +174,7 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
         elif "tube" in planned:
             tube = planned["tube"]
             if tube not in runs:
-                runs[tube] = simulate(spec, tube, backend="c", seed=index)
+                runs[tube] = run_closed_loop(spec, tube, backend="c", seed=index)
             out[method] = _outcome(planned["seconds"], closed_loop_failure(runs[tube]),
                                    runs[tube])
         else:

@@ -3,12 +3,11 @@ on the same random arenas, side by side in one run (the paper's Table I, redone)
 
 from __future__ import annotations
 
-import argparse
-import json
 from pathlib import Path
 from typing import Any
 
 from ..errors import SpecError
+from ..system import atomic_write
 from .arena_job import LABELS, METHODS, loop_arena, plan_arena
 from .arenas import generate_arenas
 from .parallel import run_parallel
@@ -33,7 +32,6 @@ def write_specs(folder: Path, count: int, seed: int) -> list[Path]:
     SpecError
         The folder does not exist (field ``specs``).
     """
-    from ..cli import atomic_write_bytes
     folder = Path(folder)
     if not folder.is_dir():
         raise SpecError("specs", f"folder {str(folder)!r} does not exist")
@@ -41,7 +39,7 @@ def write_specs(folder: Path, count: int, seed: int) -> list[Path]:
     for arena in generate_arenas(count, seed):
         path = folder / f"{arena.name}.toml"
         text = arena.to_toml().encode("utf-8")
-        atomic_write_bytes(path, lambda tmp, data=text: tmp.write_bytes(data))
+        atomic_write(path, text, field="specs")
         paths.append(path)
     return paths
 
@@ -133,18 +131,3 @@ def format_arenas_report(report: dict[str, Any]) -> str:
 
 def _figure(value: float | None) -> str:
     return "-" if value is None else f"{value:.3g}"
-
-
-def main_arenas(args: argparse.Namespace) -> int:
-    """Handler of ``bench arenas``; exit 0."""
-    if args.specs:
-        write_specs(Path(args.specs), args.count, args.seed)
-    report = run_arenas_bench(args.count, args.seed, workers=args.workers,
-                              scheduler=args.scheduler,
-                              methods=tuple(args.methods.split(",")) if args.methods else None,
-                              progress=not args.no_progress)
-    if args.json:
-        print(json.dumps(report, indent=1, sort_keys=True, allow_nan=False))
-    else:
-        print(format_arenas_report(report))
-    return 0

@@ -22,7 +22,7 @@ import math
 import casadi
 import numpy as np
 
-from .. import __version__
+from ..version import __version__
 from .emit import CPrinter, lower, python_source
 from ..tube.model import build_model
 from ..spec.loader import Spec

@@ -99,16 +99,18 @@ class Design:
         """``k`` of law (13)."""
         return self.tube.gain
 
-    def to_json(self, spec_name: str) -> dict[str, Any]:
+    def to_json(self) -> dict[str, Any]:
         """The design as plain JSON types (the ``design`` command's and ``simulate --json``'s).
 
         Returns
         -------
         dict
-            ``spec``, ``method``, ``circumvents`` (spec obstacle index, dimension, side,
-            window start and end in s, height, sharpness), ``via`` (boxes and times;
-            empty for the paper's method), ``gain``, ``certificate`` (each property with
-            its margin and where it is smallest) and ``design_time_s``; for a spec with
+            ``spec`` (the name of :attr:`spec`), ``designed`` (``True``; the command
+            line's document for a spec with no design has ``False``), ``method``,
+            ``circumvents`` (spec obstacle index, dimension, side, window start and end in
+            s, height, sharpness), ``via`` (boxes and times; empty for the paper's
+            method), ``segments``, ``gain``, ``certificate`` (each property with its
+            margin and where it is smallest) and ``design_time_s``; for a spec with
             ``[actuator]`` also ``input_bound`` and ``input_peak`` (the proved peak of
             each input, when it occurs, the horizon covered, the relative margin).
         """
@@ -121,7 +123,8 @@ class Design:
             via += [{"time": s.end, "lower": list(s.lower_to), "upper": list(s.upper_to)}
                     for s in segs]
         return {
-            "spec": spec_name,
+            "spec": self.spec.name,
+            "designed": True,
             "method": self.method,
             "circumvents": [{"obstacle": c.obstacle, "dimension": c.dimension,
                              "side": c.side, "start": c.start, "end": c.end,
@@ -154,3 +157,39 @@ class Design:
                 "input_peak": {"peak": list(proof.peak), "time": list(proof.time),
                                "horizon": proof.horizon, "margin": proof.margin(bound)}}
 
+
+def require_design(value: object, function: str, parameter: str = "design") -> Design:
+    """``value``, checked to be a :class:`Design`: the front door's functions take the
+    design object itself, which carries its spec, so that a tube cannot be paired with
+    another spec's name, obstacles or plant.
+
+    Parameters
+    ----------
+    value : object
+        What the caller passed as ``parameter``.
+    function : str
+        The public function's name, for the message (``"simulate"``).
+    parameter : str
+        The parameter's name, for the message.
+
+    Returns
+    -------
+    Design
+        ``value``.
+
+    Raises
+    ------
+    TypeError
+        ``value`` is not a ``Design`` (a ``TubeDesign``, a ``Spec``, ...); the message
+        names the parameter and says to call ``design_tube``.
+    """
+    if isinstance(value, Design):
+        return value
+    kind = type(value).__name__
+    if isinstance(value, TubeDesign):
+        hint = ("this is design.tube; pass the Design that stt_codegen.design_tube(spec) "
+                "returned, which carries its spec")
+    else:
+        hint = "call stt_codegen.design_tube(spec) and pass the Design it returns"
+    raise TypeError(f"{function}(): parameter {parameter!r} must be a Design, not {kind}; "
+                    f"{hint}")

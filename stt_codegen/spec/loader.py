@@ -17,6 +17,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import os
 import re
 import tomllib
 from collections.abc import Mapping
@@ -333,6 +334,29 @@ class Spec:
         ------
         SpecError
             As :func:`load_spec`: the field and the reason.
+
+        See Also
+        --------
+        load_spec : the same from a bundled case name or a TOML file.
+        stt_codegen.design_tube : the next step, the tube of the spec.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import stt_codegen as stt
+        >>> task = {
+        ...     "name": "corridor", "prescribed_time": 8.0,
+        ...     "state_space": {"lower": [0.0, 0.0], "upper": [5.0, 5.0]},
+        ...     "initial": {"lower": [0.0, 0.0], "upper": [0.5, 0.5]},
+        ...     "target": {"lower": np.array([4.5, 4.5]), "upper": np.array([5.0, 5.0])},
+        ...     "obstacles": [{"lower": [2.0, 2.0], "upper": [3.0, 3.0]}]}
+        >>> spec = stt.Spec.from_dict(task)
+        >>> spec.dimension, spec.target_set.lower
+        (2, (4.5, 4.5))
+        >>> stt.Spec.from_dict({**task, "prescribed_time": -8.0})
+        Traceback (most recent call last):
+        ...
+        stt_codegen.errors.SpecError: prescribed_time: must be positive, got -8.0
         """
         if not isinstance(data, Mapping):
             raise SpecError("", f"a spec is a table (dict), got {value_kind(data)}")
@@ -369,10 +393,33 @@ def load_spec(spec: str | Path) -> Spec:
 
     Raises
     ------
+    TypeError
+        ``spec`` is neither a string nor a path (a dict: use :meth:`Spec.from_dict`).
     SpecError
         The file does not exist or cannot be read, is not valid TOML, or a field
         is missing, unknown, of the wrong type or fails a rule of the schema.
+
+    See Also
+    --------
+    Spec.from_dict : the same from a dictionary.
+    stt_codegen.bundled_cases : the bundled case names.
+    stt_codegen.design_tube : the next step, the tube of the spec.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> spec = stt.load_spec("omnirobot-s1")         # or a path: stt.load_spec("task.toml")
+    >>> spec.name, spec.dimension, spec.prescribed_time
+    ('omnirobot-s1', 3, 9.0)
+    >>> stt.load_spec("no-such-case")                          # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    stt_codegen.errors.SpecError: no bundled case and no file named 'no-such-case' (bundled: ...)
     """
+    if not isinstance(spec, (str, os.PathLike)):
+        hint = "; for a dict use Spec.from_dict" if isinstance(spec, Mapping) else ""
+        raise TypeError(f"load_spec(): parameter 'spec' must be a bundled case name or a "
+                        f"path, not {type(spec).__name__}{hint}")
     text = str(spec)
     if text in bundled_cases() and not Path(text).exists():
         data = bundled_spec_bytes(text)
