@@ -7,7 +7,7 @@ certified widths, :mod:`.input_bound`) shows that law (13) never asks any input 
 than its bound. Deterministic, in this order, the first tube that meets the bound wins:
 
 1. the design of the spec without ``[actuator]`` (the default design: a spec whose
-   default tube keeps the bound gets exactly that tube);
+   default tube keeps the bound gets exactly that tube), then :func:`slower_variants`:
 2. **softer circumvents**: when the default is the paper's method with circumvents and
    the spec leaves ``tube.circumvent_sharpness`` free, the paper's search with every
    circumvent's sharpness ``k^j`` fixed to each value of the ladder above the default's
@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 from ..errors import DesignError, SpecError
@@ -49,38 +49,59 @@ MIN_IMPROVEMENT = 0.95
 
 @dataclass(frozen=True)
 class Candidate:
-    """One tube tried against the bound: how it was made, the design, its proof."""
+    """One tube tried against the bound.
+
+    Attributes
+    ----------
+    label : str
+        How it was made (``"default design"``, ``"softer circumvents (k = 0.2)"``,
+        ``"via points"``).
+    design : Design
+        The certified design (without the bound).
+    proof : InputProof
+        The proved peak of each input along it.
+    """
 
     label: str
     design: Design
     proof: InputProof
 
 
-def _variants(spec: Spec, design_free: Callable[[Spec], Design]) -> Iterator[tuple[str, Callable[[], Design]]]:
-    """The designs to try, in order, as ``(label, make)``; ``spec`` has no ``[actuator]``."""
-    made: dict[str, Design] = {}
+def slower_variants(spec: Spec, default: Design) -> list[tuple[str, Spec]]:
+    """The specs to design after the default one, in order, as ``(label, spec)``.
 
-    def default() -> Design:
-        made["default"] = design_free(spec)
-        return made["default"]
+    Parameters
+    ----------
+    spec : Spec
+        Without ``[actuator]``.
+    default : Design
+        Its default design.
 
-    yield "default design", default
-    first = made.get("default")
-    if (first is not None and first.method == METHOD_PAPER and first.tube.circumvents
+    Returns
+    -------
+    list of (str, Spec)
+        Softer circumvents (the paper's tube with every ``k^j`` fixed to each ladder value
+        above the default's largest), when the default is the paper's tube with
+        circumvents and ``tube.circumvent_sharpness`` is free; then via points, when
+        ``tube.method`` allows them and the default is not already a via tube.
+    """
+    out: list[tuple[str, Spec]] = []
+    if (default.method == METHOD_PAPER and default.tube.circumvents
             and spec.tube.circumvent_sharpness is None and spec.tube.method != METHOD_VIA):
-        sharpest = max(c.sharpness for c in first.tube.circumvents)
-        for k in (v for v in SHARPNESS_LADDER if v > sharpest):
-            softer = replace(spec, tube=replace(spec.tube, circumvent_sharpness=k,
-                                                method=METHOD_PAPER))
-            yield f"softer circumvents (k = {k:g})", lambda s=softer: design_free(s)
-    if spec.tube.method in ("auto", METHOD_VIA) and (first is None or first.method != METHOD_VIA):
-        via = replace(spec, tube=replace(spec.tube, method=METHOD_VIA))
-        yield "via points", lambda: design_free(via)
+        sharpest = max(c.sharpness for c in default.tube.circumvents)
+        out += [(f"softer circumvents (k = {k:g})",
+                 replace(spec, tube=replace(spec.tube, circumvent_sharpness=k,
+                                            method=METHOD_PAPER)))
+                for k in SHARPNESS_LADDER if k > sharpest]
+    if spec.tube.method in ("auto", METHOD_VIA) and default.method != METHOD_VIA:
+        out.append(("via points", replace(spec, tube=replace(spec.tube, method=METHOD_VIA))))
+    return out
 
 
 def candidates(spec: Spec, design_free: Callable[[Spec], Design],
                prover: InputProver) -> tuple[Candidate | None, list[Candidate]]:
-    """Try the variants of :func:`_variants` on ``spec`` (which has ``[actuator]``).
+    """Try the default design, then :func:`slower_variants`, on ``spec`` (which has
+    ``[actuator]``), until one is proved within the bound.
 
     Returns
     -------
@@ -96,24 +117,24 @@ def candidates(spec: Spec, design_free: Callable[[Spec], Design],
     """
     bound = spec.input_bound
     free = replace(spec, input_bound=None)
-    tried: list[Candidate] = []
+    default = design_free(free)
+    tried = [Candidate("default design", default, prover(default.tube, spec))]
+    if tried[0].proof.meets(bound):
+        return tried[0], tried
     softer_failed = False
-    for label, make in _variants(free, design_free):
-        softer = label.startswith("softer")
+    for label, variant in slower_variants(free, default):
+        softer = variant.tube.method == METHOD_PAPER
         if softer and softer_failed:
             continue
         try:
-            design = make()
+            design = design_free(variant)
         except DesignError:
-            if label == "default design":
-                raise
             # a smoother bump has a longer window: once the paper's search fails with one,
             # the smoother ones are not tried (on to via points)
             softer_failed = softer_failed or softer
             continue
-        proof = prover(design.tube, spec)
-        tried.append(Candidate(label, design, proof))
-        if proof.meets(bound):
+        tried.append(Candidate(label, design, prover(design.tube, spec)))
+        if tried[-1].proof.meets(bound):
             return tried[-1], tried
     return None, tried
 

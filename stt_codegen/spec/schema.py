@@ -185,7 +185,7 @@ class AssumptionsTable(_Table):
 
 
 class ActuatorTable(_Table):
-    """The actuators' limits: law (13) must never ask for more (issue 20)."""
+    """The actuators' limits: law (13) must never ask an input for more than its bound."""
 
     input_bound: Annotated[list[Positive], Field(min_length=1, max_length=MAX_DIMENSION)] = \
         Field(description="largest |u_i| each input may be asked for, in input units (for "
