@@ -21,12 +21,12 @@ from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
 from ..spec.plants import PLANT_MODELS, dimension_mismatch
 from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
+from .actuator import input_bound_check, prove_input_bound
 from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_omnidirectional, assumption2_single_integrator
 from .check import Check, VerificationReport
 from .lemma import bump_rate_bound, reach_rate_bound
 from .proofs import design_independent_proofs
-from .actuator import input_bound_check, prove_input_bound
 from .sampled import linear_plant_checks, sampled_checks
 
 #: Dimension names used in check names.
