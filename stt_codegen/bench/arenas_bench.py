@@ -103,19 +103,31 @@ def run_arenas_bench(count: int, seed: int, workers: int | None = None,
 
 def format_arenas_report(report: dict[str, Any]) -> str:
     """The human-readable table of :func:`run_arenas_bench`'s result."""
-    rows = []
+    rows, effort = [], []
     for method, s in report["methods"].items():
         failures = ", ".join(f"{r} ({n})" for r, n in s["failures"].items()) or "-"
         rows.append([LABELS[method], f"{s['successes']}/{s['runs']}",
                      f"{100 * s['success_rate']:.1f} %", seconds_text(s["time_median_s"]),
                      seconds_text(s["time_p95_s"]), failures])
+        effort.append([LABELS[method], str(s.get("effort_runs", 0)),
+                       *(_figure(s.get(key)) for key in ("peak_u_median", "peak_u_p95",
+                                                         "effort_median", "effort_p95"))])
     lines = [f"{report['count']} arenas (seed {report['seed']}): 5 m x 5 m, four 1 m x 1 m "
              "obstacles, t_c = 9 s, single integrator, |w_i| <= 0.1 m/s, 1 kHz",
              table(["method", "satisfied", "rate", "time median", "time p95",
                     "failures by reason"], rows),
              "time: STT = design_tube (search + continuous-time certificate); "
-             "baselines = planning (grid/planner construction + search)."]
+             "baselines = planning (grid/planner construction + search).",
+             "",
+             table(["method", "satisfied runs", "peak |u| median", "peak |u| p95",
+                    "effort median", "effort p95"], effort),
+             "control effort over the satisfied runs: peak |u| = the largest |u_i| of a run "
+             "(m/s); effort = integral of |u|^2 dt over [0, t_c] (m^2/s)."]
     for method, why in report["skipped"].items():
         lines.append(f"skipped {LABELS[method]}: {why}")
     lines.append(machine_line(report["machine"]))
     return "\n".join(lines)
+
+
+def _figure(value: float | None) -> str:
+    return "-" if value is None else f"{value:.3g}"

@@ -41,6 +41,10 @@ def cmd_design(args: argparse.Namespace) -> int:
         print(f"  reach segment {s.profile} [{s.start:.3f}, {s.end:.3f}] s to {box}")
     for m in design.certificate.margins:
         print(f"  {'PASS' if m.passed else 'FAIL'}  {m.name}: margin {m.margin:.4g}")
+    if design.input_proof is not None:          # [actuator]
+        peaks = ", ".join(f"{p:.4g} <= {b:g}" for p, b in zip(design.input_proof.peak,
+                                                              tube.input_bound))
+        print(f"  PASS  input bound: law (13) asks at most [{peaks}] (proved)")
     if args.plot:
         print(f"plot written to {args.plot}")
     return 0

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 from ..tube.parameters import TubeDesign
 from .certificate import Certificate
 from .failures import FailureKind
+from .input_bound import InputProof
 
 if TYPE_CHECKING:
     from ..spec.loader import Spec
@@ -74,6 +75,10 @@ class Design:
         The spec the tube was designed for. ``generate``, ``simulate``, ``verify`` and the
         plots take a :class:`Design` and read its spec from here, so a tube cannot be
         paired with another spec's name, obstacles or plant.
+    input_proof : InputProof or None
+        For a spec with ``[actuator]``: the proved peak of each input of law (13) along
+        the tube (:mod:`~stt_codegen.design.input_bound`), within ``input_bound``;
+        ``None`` otherwise.
     """
 
     tube: TubeDesign
@@ -81,6 +86,8 @@ class Design:
     check: TubeCheck
     design_time_s: float = field(compare=False)
     spec: Spec = field(compare=False, repr=False, kw_only=True)
+    input_proof: InputProof | None = field(default=None, compare=False, repr=False,
+                                           kw_only=True)
 
     @property
     def certificate(self) -> Certificate:
@@ -103,7 +110,9 @@ class Design:
             ``circumvents`` (spec obstacle index, dimension, side, window start and end in
             s, height, sharpness), ``via`` (boxes and times; empty for the paper's
             method), ``segments``, ``gain``, ``certificate`` (each property with its
-            margin and where it is smallest) and ``design_time_s``.
+            margin and where it is smallest) and ``design_time_s``; for a spec with
+            ``[actuator]`` also ``input_bound`` and ``input_peak`` (the proved peak of
+            each input, when it occurs, the horizon covered, the relative margin).
         """
         tube = self.tube
         via = []
@@ -135,8 +144,18 @@ class Design:
                                for m in self.certificate.margins],
             },
             "design_time_s": self.design_time_s,
+            **self._actuator_json(),
         }
 
+    def _actuator_json(self) -> dict[str, Any]:
+        """``input_bound`` and the proved ``input_peak`` (with where each peak is), for a
+        spec with ``[actuator]`` only: without it the document is as before."""
+        if self.tube.input_bound is None or self.input_proof is None:
+            return {}
+        proof, bound = self.input_proof, self.tube.input_bound
+        return {"input_bound": list(bound),
+                "input_peak": {"peak": list(proof.peak), "time": list(proof.time),
+                               "horizon": proof.horizon, "margin": proof.margin(bound)}}
 
 
 def require_design(value: object, function: str, parameter: str = "design") -> Design:

@@ -29,6 +29,7 @@ from ..errors import DesignError
 from ..spec.loader import Spec
 from ..tube.parameters import Circumvent, TubeDesign, paper_segments
 from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, certify_tube
+from .actuator import design_within_bound
 from .failures import FailureKind, property_kind
 from .gain import derived_gain
 from .plant_check import plant_failure
@@ -258,6 +259,10 @@ def design_tube(spec: Spec) -> Design:
         :func:`stt_codegen.simulate`, :func:`stt_codegen.verify` and the plots take it
         whole.
 
+    With ``[actuator]`` (``spec.input_bound``), the tube is accepted only when law (13) is
+    proved to stay within the bound along it, slowed where it must be, or refused
+    (:func:`~stt_codegen.design.actuator.design_within_bound`).
+
     Raises
     ------
     TypeError
@@ -269,7 +274,9 @@ def design_tube(spec: Spec) -> Design:
         the reason (for via points: where the free passage is too narrow, or what walls
         off the start or the target), ``kind`` what failed
         (:class:`~stt_codegen.design.failures.FailureKind`) and ``tried`` the best
-        rejected tube (``None`` where none was built).
+        rejected tube (``None`` where none was built). With ``[actuator]``: no design
+        within ``t_c`` keeps the bound (kind ``INPUT_BOUND``; the message names the
+        ``prescribed_time`` that works).
 
     See Also
     --------
@@ -293,6 +300,8 @@ def design_tube(spec: Spec) -> Design:
                 else "; load it with load_spec" if isinstance(spec, str) else "")
         raise TypeError(f"design_tube(): parameter 'spec' must be a Spec, not "
                         f"{type(spec).__name__}{hint}")
+    if spec.input_bound is not None:      # [actuator]: design/actuator.py
+        return design_within_bound(spec, design_tube)
     started = time.perf_counter()
     reason = plant_failure(spec)
     if reason:

@@ -16,7 +16,7 @@ import numpy as np
 
 import control as ct
 
-from .backends import STATUS_OK, make_controller
+from .backends import STATUS_INPUT_CLAMPED, STATUS_OK, make_controller
 from ..design.result import Design, require_design
 from ..design.samples import check_step_budget
 from ..errors import SpecError
@@ -61,11 +61,19 @@ class SimulationResult:
         (distance to the nearest facet's plane). ``None`` without obstacles.
     left_state_space : bool
     stayed_in_tube : bool
-        Every controller step on ``[0, horizon]`` reported the state inside the tube.
+        Every controller step on ``[0, horizon]`` reported the state inside the tube
+        (``STATUS_OK``, or ``STATUS_INPUT_CLAMPED``: inside, ``u`` clamped).
     max_abs_u : list of float
-        Per input, over the run.
+        Peak ``|u_i|`` per input over the run, input units.
     steps : int
         Controller steps taken.
+    control_effort : float
+        ``integral of |u(t)|^2 dt`` over ``[0, horizon]`` (Euclidean norm; ``u`` held
+        between samples, so exactly ``sum_k |u_k|^2 dt`` over the ``steps`` hold
+        intervals), input units squared times seconds.
+    clamped_steps : int
+        Steps whose status was ``STATUS_INPUT_CLAMPED`` (the actuator clamp acted; only a
+        design with ``[actuator]`` has it).
     """
 
     spec: str
@@ -80,6 +88,8 @@ class SimulationResult:
     stayed_in_tube: bool
     max_abs_u: list[float]
     steps: int
+    control_effort: float = 0.0
+    clamped_steps: int = 0
     trajectory: Trajectory | None = field(default=None, repr=False)
 
     def to_json(self) -> dict:
@@ -145,7 +155,8 @@ def simulate(design: Design, backend: str = "reference", horizon: float | None =
     SimulationResult
         ``satisfied`` (reach the target by ``t_c``, avoid every obstacle, stay in the
         state space), the reach time (s), the clearance (state units), ``max |u|`` per
-        input, and ``trajectory``: ``t`` (N,), ``x`` (N, n), ``u`` (N, n), ``alpha``
+        input, the control effort ``integral |u|^2 dt``, the steps the actuator clamp
+        acted, and ``trajectory``: ``t`` (N,), ``x`` (N, n), ``u`` (N, n), ``alpha``
         (N, 2n), ``status`` (N,), with ``N = ceil(horizon * rate_hz) + 1``.
 
     Raises
@@ -258,6 +269,8 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
         spec=spec.name, backend=backend, satisfied=satisfied, reached=reached,
         reach_time=reach_time, prescribed_time=t_c, collision=collision,
         min_obstacle_clearance=min_clear, left_state_space=left,
-        stayed_in_tube=bool(np.all(status == STATUS_OK)),
+        stayed_in_tube=bool(np.all((status == STATUS_OK) | (status == STATUS_INPUT_CLAMPED))),
         max_abs_u=[float(v) for v in np.abs(us).max(axis=0)], steps=steps,
+        control_effort=float(np.sum(us[:steps] ** 2) * dt),
+        clamped_steps=int(np.sum(status == STATUS_INPUT_CLAMPED)),
         trajectory=Trajectory(ts, xs, us, alphas, status))

@@ -27,8 +27,8 @@ from typing import Any
 
 from ..cases import bundled_cases, bundled_spec_bytes
 from ..errors import SpecError
-from .plants import MODEL_KEYS, dimension_mismatch
-from .schema import (NAME_REGEX, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
+from .plants import MODEL_KEYS, PLANTS, dimension_mismatch
+from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
                      PlantTable, PolytopeObstacle, check_document, value_kind)
 
 NAME_PATTERN = re.compile(NAME_REGEX)
@@ -264,6 +264,10 @@ class Spec:
         The matrices of the ``linear`` model (``None`` for the other models).
     assumptions : Assumptions
         The ``[assumptions]`` section, defaults filled in.
+    input_bound : tuple of float or None
+        ``[actuator] input_bound``: the largest ``|u_i|`` law (13) may ask of each input,
+        in input units, one per input of the plant model (``None``: no ``[actuator]``,
+        no limit).
     source_hash : str
         SHA-256 of the spec file's bytes.
     target_half_width_given : bool
@@ -289,6 +293,7 @@ class Spec:
     disturbance_amplitude: float
     linear_plant: LinearPlant | None = None
     assumptions: Assumptions = Assumptions()
+    input_bound: tuple[float, ...] | None = None
     source_hash: str = field(default="", compare=False)
     target_half_width_given: bool = True
 
@@ -511,6 +516,7 @@ def _validate(raw: dict) -> Spec:
                 plant_model=model, disturbance_amplitude=amplitude,
                 linear_plant=_linear_plant(doc.plant, n),
                 assumptions=_assumptions(doc.assumptions, n, amplitude),
+                input_bound=_input_bound(doc.actuator, model, n),
                 target_half_width_given=doc.target.half_width is not None)
 
 
@@ -596,6 +602,20 @@ def _assumptions(table: AssumptionsTable, n: int, amplitude: float) -> Assumptio
     return Assumptions((g_min, g_max), skew, coupling, table.drift_bound, disturbance,
                        tuple(key for key in AssumptionsTable.model_fields
                              if key in table.model_fields_set))
+
+
+def _input_bound(table: ActuatorTable | None, model: str, n: int) -> tuple[float, ...] | None:
+    """``[actuator] input_bound``: one positive number per input of the plant model."""
+    if table is None:
+        return None
+    plant = PLANTS[model]
+    count = plant.input_count(n)
+    names = plant.input_names(n)
+    if len(table.input_bound) != count:
+        raise SpecError("actuator.input_bound",
+                        f"must have {count} entries (one per input of the {model} plant: "
+                        f"{', '.join(names)}), got {len(table.input_bound)}")
+    return tuple(float(v) for v in table.input_bound)
 
 
 def _dims(given: list[int] | None, name: str, m: int, n: int,

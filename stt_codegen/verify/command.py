@@ -21,6 +21,7 @@ from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
 from ..spec.plants import PLANT_MODELS, dimension_mismatch
 from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
+from .actuator import input_bound_check, prove_input_bound
 from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_omnidirectional, assumption2_single_integrator
 from .check import Check, VerificationReport
@@ -83,8 +84,10 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         In order: Lemma 3.3, the error transform, the equality of each deployed piece with
         the paper's formula (``deployed.*``), Assumption 2 (and, for the linear
         plant, whether it meets ``[assumptions]``), the adaptive law (per component of
-        ``alpha``), the tube certificate, and the sampled closed loop
-        (:func:`~stt_codegen.verify.sampled.sampled_checks`).
+        ``alpha``), the tube certificate, the sampled closed loop
+        (:func:`~stt_codegen.verify.sampled.sampled_checks`) and, for a spec with
+        ``[actuator]``, ``sampled.input_bound``
+        (:func:`~stt_codegen.verify.actuator.input_bound_check`).
     """
     stage = progress if isinstance(progress, _Stages) else _Stages(progress, design=False)
     model = plant or spec.plant_model
@@ -169,6 +172,8 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     # step budget with a SpecError)
     stage("sampled loop")
     checks += sampled_checks(spec, design, sample_tube(design), tube_check.certificate)
+    if spec.input_bound is not None:
+        checks.append(input_bound_check(spec, prove_input_bound(design, spec)))
     return checks
 
 
