@@ -7,15 +7,30 @@ Spatiotemporal Tubes Approach". The front door, in the order of the flow (see
 * :func:`load_spec` - read and validate a spec (a bundled case name or a TOML file);
   :meth:`Spec.from_dict` - the same from a dictionary;
 * :func:`design_tube` - choose windows (5), circumvents (6)-(9) and the gain of law (13),
-  and certify the tube (10) for every ``t``;
-* :func:`generate` - write the standalone C and Python controllers into a folder;
-* :func:`simulate` - run a sampled controller in closed loop and judge Definition 2.1;
+  and certify the tube (10) for every ``t``; returns a :class:`Design`, which carries
+  its spec (``design.spec``) and its tube (``design.tube``, a :class:`TubeDesign`);
+* :func:`generate` - write the standalone C and Python controllers of a design into a
+  folder;
+* :func:`simulate` - run a design's sampled controller in closed loop and judge
+  Definition 2.1;
 * :func:`verify` - the paper's lemmas, the assumptions and the tube certificate of a
   design (or of a spec, designed first), as a :class:`VerificationReport`
   (:func:`stt_codegen.verify.command.verify`);
+* :func:`plot_design`, :func:`plot_run` - figures of a design, and of a run;
 * the errors, in three kinds: :class:`SpecError` (bad input), :class:`DesignError` (no
   design, a negative outcome), :class:`ToolchainError` (a tool or an internal step
   failed); all are :class:`SttError`.
+
+``generate``, ``simulate``, ``verify`` and the plots take the :class:`Design` itself, so a
+tube is never paired with another spec; given anything else (a ``TubeDesign``, a ``Spec``
+where a design is needed) they raise ``TypeError`` saying to call :func:`design_tube`::
+
+    import stt_codegen as stt
+    design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    stt.generate(design, "out", languages=["c"], precision="single")
+    result = stt.simulate(design, backend="c")
+    stt.plot_run(design, result, "run.png")
+    assert stt.verify(design).passed
 
 ``import stt_codegen`` is cheap: each name is imported on first use (PEP 562), so the
 command line and a notebook pay only for what they call.
@@ -27,6 +42,7 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 from .errors import DesignError, SpecError, SttError, ToolchainError
+from .version import __version__
 
 # ``stt_codegen.verify`` is the function (``_LAZY`` below), and ``stt_codegen/verify/`` is
 # also the package of the checks. The import system binds a subpackage to its parent's
@@ -35,8 +51,6 @@ from .errors import DesignError, SpecError, SttError, ToolchainError
 # like never rebind the name, and ``stt_codegen.verify`` is always the function.
 from . import verify as _verify_package  # noqa: E402,F401
 globals().pop("verify", None)
-
-__version__ = "0.1.0"
 
 #: Public name -> module that defines it; imported on first attribute access.
 _LAZY: dict[str, str] = {
@@ -49,6 +63,8 @@ _LAZY: dict[str, str] = {
     "generate": "stt_codegen.codegen.api",
     "simulate": "stt_codegen.runtime.simulate",
     "SimulationResult": "stt_codegen.runtime.simulate",
+    "plot_design": "stt_codegen.runtime.plots",
+    "plot_run": "stt_codegen.runtime.plots",
     "VerificationReport": "stt_codegen.verify.check",
     "verify": "stt_codegen.verify.command",
 }
@@ -60,6 +76,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .codegen.api import generate
     from .design.result import Design
     from .design.search import design_tube
+    from .runtime.plots import plot_design, plot_run
     from .runtime.simulate import SimulationResult, simulate
     from .cases import bundled_cases
     from .spec.loader import Spec, load_spec

@@ -28,12 +28,17 @@ settings.load_profile("ci" if os.environ.get("CI") else os.environ.get("HYPOTHES
 
 
 @lru_cache(maxsize=None)
+def design_of(name: str):
+    """The :class:`~stt_codegen.design.result.Design` of a bundled case, cached (what the
+    front door's ``generate``, ``simulate``, ``verify`` and plots take)."""
+    return design_tube(load_spec(name))
+
+
 def designed(name: str):
-    """``(spec, design, check)`` of a bundled case, cached."""
-    spec = load_spec(name)
-    found = design_tube(spec)
-    design, check = found.tube, found.check
-    return spec, design, check
+    """``(spec, tube, check)`` of a bundled case, cached: the parts of :func:`design_of`,
+    for the internal functions that take them apart."""
+    found = design_of(name)
+    return found.spec, found.tube, found.check
 
 
 @lru_cache(maxsize=None)

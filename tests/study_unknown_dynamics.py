@@ -63,7 +63,7 @@ def draw(case: str, index: int) -> dict:
 
 
 def run_one(case: str, knobs: dict, rate_factor: float = 1.0, gain_factor: float = 1.0):
-    from stt_codegen.runtime.simulate import simulate
+    from stt_codegen.runtime.simulate import run_closed_loop
     from test_hard_support import plant_bounds, random_plant_parameters, unknown_plant
     spec, design = _designed(case)
     rng = np.random.default_rng(knobs["seed"])
@@ -74,7 +74,7 @@ def run_one(case: str, knobs: dict, rate_factor: float = 1.0, gain_factor: float
         spec = dataclasses.replace(spec, rate_hz=spec.rate_hz * rate_factor)
         design = dataclasses.replace(design, rate_hz=design.rate_hz * rate_factor,
                                      gain=design.gain * gain_factor)
-    result = simulate(spec, design, backend="c", plant=unknown_plant(p, bounds["centre"]))
+    result = run_closed_loop(spec, design, backend="c", plant=unknown_plant(p, bounds["centre"]))
     verdict = None
     if rate_factor == 1.0 and gain_factor == 1.0:
         verdict = _check_own_bounds(case, p, spec)
@@ -144,7 +144,7 @@ def study(args) -> dict:
 
 def sweep_one(args):
     """One point of the 1-D sweeps: ``g = lam I`` (f = 0) or ``f`` constant (g = I)."""
-    from stt_codegen.runtime.simulate import simulate
+    from stt_codegen.runtime.simulate import run_closed_loop
     from test_hard_support import unknown_plant
     case, kind, value, rate_factor = args
     spec, design = _designed(case)
@@ -158,7 +158,7 @@ def sweep_one(args):
         spec = dataclasses.replace(spec, rate_hz=spec.rate_hz * rate_factor)
         design = dataclasses.replace(design, rate_hz=design.rate_hz * rate_factor)
     centre = (np.array(spec.state_space.lower) + np.array(spec.state_space.upper)) / 2
-    r = simulate(spec, design, backend="c", plant=unknown_plant(p, centre))
+    r = run_closed_loop(spec, design, backend="c", plant=unknown_plant(p, centre))
     return case, kind, value, rate_factor, bool(r.satisfied and r.stayed_in_tube)
 
 
@@ -196,13 +196,13 @@ def _declared_setup(case):
 
 def declared_one(args) -> dict:
     """One plant within :data:`DECLARED` on one case, at the derived gain and rate."""
-    from stt_codegen.runtime.simulate import simulate
+    from stt_codegen.runtime.simulate import run_closed_loop
     from test_plants_support import plant_system, plant_within
     case, index = args
     spec, design = _declared_setup(case)
     rng = np.random.default_rng([CASES.index(case), index, 13])
     plant = plant_system(plant_within(rng, spec.assumptions, spec.state_space))
-    r = simulate(spec, design, backend="c", plant=plant)
+    r = run_closed_loop(spec, design, backend="c", plant=plant)
     return {"case": case, "index": index, "rate_hz": design.rate_hz, "gain": design.gain,
             "satisfied": bool(r.satisfied), "in_tube": bool(r.stayed_in_tube),
             "collision": bool(r.collision), "left": bool(r.left_state_space)}

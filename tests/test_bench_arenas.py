@@ -125,6 +125,22 @@ def test_summary_statistics():
     assert s["time_median_s"] == pytest.approx(np.median([o["seconds"] for o in outcomes]))
     assert s["time_median_s"] <= s["time_p95_s"] <= 100.0
     assert list(s["failures"].items()) == [("collision", 2), ("no path found", 1)]
+    assert s["effort_runs"] == 0 and s["peak_u_median"] is None   # none carries peak_u
+
+
+def test_effort_statistics_are_over_the_satisfied_runs():
+    outcomes = [{"success": True, "seconds": 1.0, "reason": "", "peak_u": float(k),
+                 "effort": 10.0 * k} for k in range(1, 21)]
+    outcomes += [{"success": False, "seconds": 1.0, "reason": "collision", "peak_u": 1e6,
+                  "effort": 1e9}]
+    outcomes += [{"success": False, "seconds": 1.0, "reason": "no path found",
+                  "peak_u": None, "effort": None}]
+    s = summarize(outcomes)
+    assert s["effort_runs"] == 20
+    assert s["peak_u_median"] == pytest.approx(10.5)
+    assert s["peak_u_p95"] == pytest.approx(np.percentile(np.arange(1, 21), 95))
+    assert s["effort_median"] == pytest.approx(105.0)
+    assert s["effort_p95"] == pytest.approx(10 * np.percentile(np.arange(1, 21), 95))
 
 
 @pytest.mark.bench
@@ -133,7 +149,12 @@ def test_one_arena_job(tmp_path, monkeypatch):
     result = run_arena(0, 1, ("stt", "astar"))
     assert result["name"] == "arena-0-1" and set(result["methods"]) == {"stt", "astar"}
     for outcome in result["methods"].values():
-        assert set(outcome) == {"success", "seconds", "reason", "reach_time", "clearance"}
+        assert set(outcome) == {"success", "seconds", "reason", "reach_time", "clearance",
+                                "peak_u", "effort"}
         assert outcome["seconds"] > 0 and outcome["success"] == (outcome["reason"] == "")
         if outcome["success"]:
             assert 0 < outcome["reach_time"] <= 9.0 and outcome["clearance"] > 0
+            # from x(0) = (0.40, 1.76) into [4.5, 5]^2 by t_c = 9 s with |w| <= 0.1 sqrt(2):
+            # |integral u dt| >= 4.93 - 1.27 m, so integral |u|^2 dt >= 3.66^2 / 9 s
+            # (Cauchy-Schwarz) and max_i |u_i| >= 3.66 / (9 sqrt(2)) m/s
+            assert outcome["peak_u"] >= 0.28 and outcome["effort"] >= 1.48

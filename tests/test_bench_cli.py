@@ -13,7 +13,8 @@ from stt_codegen.bench.parallel import run_parallel
 from stt_codegen.cli import main
 from stt_codegen.errors import SpecError
 
-SUMMARY_KEYS = {"runs", "successes", "success_rate", "time_median_s", "time_p95_s", "failures"}
+SUMMARY_KEYS = {"runs", "successes", "success_rate", "time_median_s", "time_p95_s", "failures",
+                "effort_runs", "peak_u_median", "peak_u_p95", "effort_median", "effort_p95"}
 
 
 def test_local_pool_keeps_the_order():
@@ -39,6 +40,10 @@ def test_arenas_json_on_local_processes(tmp_path, monkeypatch, capsys):
         assert set(summary) == SUMMARY_KEYS and summary["runs"] == 2
         assert summary["successes"] + sum(summary["failures"].values()) == 2
         assert summary["time_median_s"] <= summary["time_p95_s"]
+        assert summary["effort_runs"] == summary["successes"]
+        if summary["effort_runs"]:
+            assert 0 < summary["peak_u_median"] <= summary["peak_u_p95"]
+            assert 0 < summary["effort_median"] <= summary["effort_p95"]
     assert [a["name"] for a in report["arenas"]] == ["arena-5-0", "arena-5-1"]
     assert sorted(p.name for p in specs.iterdir()) == ["arena-5-0.toml", "arena-5-1.toml"]
     assert report["machine"]["cpus"] >= 1
@@ -52,6 +57,7 @@ def test_arenas_table(tmp_path, monkeypatch, capsys):
                  "--no-progress"]) == 0
     out = capsys.readouterr().out
     assert "A* + tracker" in out and "time median" in out and "machine:" in out
+    assert "peak |u| median" in out and "effort p95" in out
 
 
 @pytest.mark.bench

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import CASES
+from conftest import CASES, arena_toml
 
 from stt_codegen.spec.loader import bundled_cases
 
@@ -133,3 +133,60 @@ def test_atomic_write_leaves_a_normal_file_or_nothing(tmp_path):
     assert (tmp_path / "a.png").read_bytes() == b"png"
     assert (tmp_path / "a.png").stat().st_mode & 0o777 == 0o644
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.png"]
+
+
+@pytest.mark.parametrize("command", ["simulate", "embedded"])
+@pytest.mark.parametrize("seed", ["-5", str(2**32)])
+def test_a_seed_outside_32_bits_is_bad_input_named_by_its_flag(command, seed, capsys):
+    """Issue 19: ``--seed -5`` ended in a traceback; now one line, exit 2, before any work."""
+    from stt_codegen.cli import main
+    assert main([command, "omnirobot-s1", "--seed", seed]) == 2
+    captured = capsys.readouterr()
+    assert captured.err == f"error: --seed: must be an integer in [0, 2**32), got {seed}\n"
+    assert captured.out == ""
+
+
+#: A valid spec the design refuses at once: its linear plant has g = -I (Assumption 2).
+REVERSED_PLANT = arena_toml("reversed", 9.0,
+                            '[plant]\nmodel = "linear"\ng = [[-1.0, 0.0], [0.0, -1.0]]\n')
+
+
+@pytest.mark.parametrize("command, json_option", [
+    (["design"], True), (["simulate", "--backend", "casadi"], True), (["verify"], True),
+    (["embedded"], True), (["generate", "-o", "OUT"], False), (["demo", "--out", "OUT"], False),
+])
+def test_every_command_that_designs_says_why_there_is_no_design(command, json_option, tmp_path,
+                                                               monkeypatch, capsys):
+    """Exit 1, the design's reason as one line on stderr, nothing written; with ``--json``,
+    one document of one shape on stdout (``simulate --json`` printed nothing)."""
+    from stt_codegen import cases
+    from stt_codegen.cli import main
+    from stt_codegen.design.search import design_tube
+    from stt_codegen.errors import DesignError
+    from stt_codegen.spec.loader import parse_spec
+    path = tmp_path / "reversed.toml"
+    path.write_text(REVERSED_PLANT)
+    with pytest.raises(DesignError) as refused:
+        design_tube(parse_spec(REVERSED_PLANT))
+    name, *options = [str(tmp_path / "out") if a == "OUT" else a for a in command]
+    if name == "demo":      # the demo designs the bundled cases: make the spec one of them
+        monkeypatch.setattr(cases, "bundled_cases", lambda: [str(path)])
+        argv = [name, *options]
+    else:
+        argv = [name, str(path), *options]
+    for as_json in ([False, True] if json_option else [False]):
+        assert main(argv + ["--json"] * as_json) == 1
+        captured = capsys.readouterr()
+        assert captured.err == f"error: {refused.value}\n"
+        if as_json:
+            assert json.loads(captured.out) == {
+                "spec": "reversed", "designed": False, "reason": str(refused.value),
+                "kind": refused.value.kind.value}
+    assert not (tmp_path / "out").exists() or name == "demo"
+
+
+def test_a_design_document_says_it_is_one(capsys):
+    from stt_codegen.cli import main
+    assert main(["design", "omnirobot-s1", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["designed"] is True and data["spec"] == "omnirobot-s1"

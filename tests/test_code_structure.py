@@ -1,5 +1,6 @@
-"""The package's structure: no import cycle, no private name across modules, citations that
-resolve, and the test suite's own rules (derandomized property tests)."""
+"""The package's structure: layers without cycles or upward imports (imports inside functions
+counted), no private name across modules, citations that resolve, and the test suite's own
+rules (derandomized property tests)."""
 
 from __future__ import annotations
 
@@ -33,25 +34,37 @@ def _target(module: str, node: ast.ImportFrom, is_package: bool) -> str:
     return ".".join(base + ([node.module] if node.module else []))
 
 
-def _module_level_imports(path: Path) -> list[ast.stmt]:
-    """Import statements executed when the module is imported: the module's body and the
-    bodies of its top-level ``try`` blocks, not function bodies, not ``if TYPE_CHECKING``."""
-    found = []
-    for node in ast.parse(path.read_text()).body:
+def _is_type_checking(test: ast.expr) -> bool:
+    return (isinstance(test, ast.Name) and test.id == "TYPE_CHECKING") or \
+        (isinstance(test, ast.Attribute) and test.attr == "TYPE_CHECKING")
+
+
+def imports_of(path: Path) -> list[ast.Import | ast.ImportFrom]:
+    """Every import statement of a module, wherever it is: the module's body, function and
+    method bodies, ``try`` blocks; not the body of an ``if TYPE_CHECKING:`` (never run)."""
+    found: list[ast.Import | ast.ImportFrom] = []
+
+    def visit(node: ast.AST) -> None:
         if isinstance(node, (ast.Import, ast.ImportFrom)):
             found.append(node)
-        elif isinstance(node, ast.Try):
-            found += [n for n in node.body if isinstance(n, (ast.Import, ast.ImportFrom))]
+        elif isinstance(node, ast.If) and _is_type_checking(node.test):
+            for child in node.orelse:
+                visit(child)
+            return
+        for child in ast.iter_child_nodes(node):
+            visit(child)
+
+    visit(ast.parse(path.read_text()))
     return found
 
 
 def import_graph() -> dict[str, set[str]]:
-    """Module -> the package's modules it imports at import time, parent packages included
-    (importing ``a.b.c`` first imports ``a.b``)."""
+    """Module -> the package's modules it imports, at import time or in a function, parent
+    packages included (importing ``a.b.c`` first imports ``a.b``)."""
     graph: dict[str, set[str]] = {}
     for module, path in MODULES.items():
         edges: set[str] = set()
-        for node in _module_level_imports(path):
+        for node in imports_of(path):
             if isinstance(node, ast.Import):
                 names = [a.name for a in node.names]
             else:
@@ -66,6 +79,32 @@ def import_graph() -> dict[str, set[str]]:
         edges.discard(module)
         graph[module] = edges
     return graph
+
+
+def package_of(module: str) -> str:
+    """``stt_codegen.design.search`` -> ``design``; the front door ``stt_codegen`` itself."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else parts[0]
+
+
+def package_graph() -> dict[str, set[str]]:
+    """Package -> the other packages its modules import (:func:`import_graph`, by package)."""
+    actual: dict[str, set[str]] = {package_of(m): set() for m in MODULES}
+    for module, edges in import_graph().items():
+        actual[package_of(module)] |= {package_of(e) for e in edges} - {package_of(module)}
+    return actual
+
+
+def stated_layers() -> list[tuple[str, set[str]]]:
+    """docs/architecture.md's table "package | imports", in its order: (package, imports)."""
+    doc = (REPO / "docs" / "architecture.md").read_text()
+    table = doc[doc.index("| package | imports |"):].split("\n\n", 1)[0]
+    rows = []
+    for row in table.splitlines()[2:]:
+        package, imports = row.strip("|").split("|")
+        name = re.findall(r"`([\w.]+)`", package)[0]
+        rows.append((name, set(re.findall(r"`([\w.]+)`", imports.split(";")[0]))))
+    return rows
 
 
 def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
@@ -99,32 +138,39 @@ def test_the_graph_sees_the_imports():
     assert len(graph) > 50
     assert "stt_codegen.spec.loader" in graph["stt_codegen.design.search"]
     assert "stt_codegen.codegen" in graph["stt_codegen.runtime.compiled"]   # parent package
+    assert "stt_codegen.runtime.simulate" in graph["stt_codegen.cli.simulate"]  # in a function
     assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
     assert find_cycle({"a": {"b"}, "b": set()}) is None
 
 
+def test_imports_of_counts_functions_and_skips_type_checking(tmp_path):
+    path = tmp_path / "m.py"
+    path.write_text("import a\nfrom typing import TYPE_CHECKING\nif TYPE_CHECKING:\n"
+                    "    import hidden\nelse:\n    import shown\n"
+                    "def f():\n    import inner\n    class C:\n        def g(self):\n"
+                    "            from deep import x\n")
+    names = [a.name for n in imports_of(path) for a in n.names]
+    assert names == ["a", "TYPE_CHECKING", "shown", "inner", "x"]
+
+
 def test_no_import_cycle_between_the_packages_modules():
+    """Counting the imports inside functions too."""
     assert find_cycle(import_graph()) is None
 
 
 def test_the_architecture_document_states_the_dependencies():
     """docs/architecture.md's table "package | imports" is the import graph, by package."""
-    doc = (REPO / "docs" / "architecture.md").read_text()
-    table = doc[doc.index("| package | imports |"):].split("\n\n", 1)[0]
-    stated = {}
-    for row in table.splitlines()[2:]:
-        package, imports = row.strip("|").split("|")
-        name = re.findall(r"`([\w.]+)`", package)[0]
-        stated[name] = set(re.findall(r"`([\w.]+)`", imports.split(";")[0]))
+    assert dict(stated_layers()) == package_graph()
 
-    def package_of(module: str) -> str:
-        parts = module.split(".")
-        return parts[1] if len(parts) > 1 else parts[0]
 
-    actual = {package_of(m): set() for m in MODULES}
-    for module, edges in import_graph().items():
-        actual[package_of(module)] |= {package_of(e) for e in edges} - {package_of(module)}
-    assert stated == actual
+def test_no_package_imports_a_package_below_it():
+    """Layers: a package imports only the packages listed above it in the table (so the
+    packages have no cycle either), counting the imports inside functions."""
+    order = [name for name, _ in stated_layers()]
+    assert sorted(order) == sorted(package_graph())
+    upward = sorted(f"{package} imports {other}" for package, imports in package_graph().items()
+                    for other in imports if order.index(other) > order.index(package))
+    assert upward == []
 
 
 def test_no_module_imports_a_private_name_from_another_module():
@@ -167,3 +213,13 @@ def test_property_tests_are_derandomized_by_default():
     if not os.environ.get("CI") and os.environ.get("HYPOTHESIS_PROFILE", "ci") != "ci":
         pytest.skip("another Hypothesis profile was asked for outside CI")
     assert settings.default.derandomize is True and settings.default.database is None
+
+
+def test_every_package_is_installed():
+    """pyproject.toml lists the packages explicitly: a new subpackage (``cli``,
+    ``design.certificate``) missing from the list would be absent from a wheel."""
+    import tomllib
+    listed = set(tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"]
+                 ["packages"])
+    folders = {_module_name(p) for p in PACKAGE.rglob("__init__.py")}
+    assert folders <= listed

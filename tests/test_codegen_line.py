@@ -51,6 +51,5 @@ def test_builds_warning_free_and_passes_its_selftest(precision, cc, level, tmp_p
 
 def test_simulate_with_the_c_backend():
     from stt_codegen.runtime.simulate import simulate
-    spec, design = _line()
-    result = simulate(spec, design, backend="c")
+    result = simulate(design_tube(load_spec(str(SPEC))), backend="c")
     assert result.satisfied and result.stayed_in_tube

@@ -60,9 +60,8 @@ def test_ball_whose_bounding_box_meets_the_start_is_split_and_used():
     assert_valid_covering(ball, boxes, 0.05, [START, (np.array([4.5, 0.0]), np.array([5.0, 0.5]))],
                           rng, in_ball)
     found = design_tube(spec)
-    design, check = found.tube, found.check
-    assert check.passed
-    result = simulate(spec, design, "casadi")
+    assert found.check.passed
+    result = simulate(found, backend="casadi")
     assert result.satisfied and result.min_obstacle_clearance > 0.1   # against the real ball
 
 

@@ -167,7 +167,7 @@ def test_the_gain_comes_from_the_tubes_width_not_from_a_loose_enclosure():
     enc = found.check.certificate.enclosure
     assert float((enc.upper_min - enc.lower_max).min()) < 0.01
     assert found.check.min_width > 0.03
-    result = simulate(spec, found.tube, backend="c")
+    result = simulate(found, backend="c")
     assert result.satisfied and result.stayed_in_tube
 
 

@@ -44,7 +44,7 @@ def test_auto_uses_via_points_where_the_papers_tube_has_no_design():
     assert len(design.tube.segments) >= 3
     assert {s.profile for s in design.tube.segments} == {"smoothstep"}
     assert design.tube.segments[-1].end <= spec.prescribed_time
-    assert design.to_json(spec.name)["via"][0]["time"] == 0.0
+    assert design.to_json()["via"][0]["time"] == 0.0
 
 
 def test_reach_tube_and_its_rate_are_continuous_at_every_via_point():
@@ -225,7 +225,7 @@ def test_random_arena_with_a_corridor_is_satisfied(index):
     if not disc_can_pass(spec):
         pytest.skip("no corridor for a 0.15 m disc")
     design = design_tube(spec)
-    result = simulate(spec, design.tube, backend="c", seed=index)
+    result = simulate(design, backend="c", seed=index)
     assert result.satisfied, (design.method, result)
 
 
@@ -239,6 +239,6 @@ def test_a_convex_wall_across_the_straight_path_is_passed_with_via_points():
         design_tube(paper)
     design = design_tube(spec)
     assert design.method == "via" and design.certificate.passed
-    result = simulate(spec, design.tube, backend="c")
+    result = simulate(design, backend="c")
     assert result.satisfied and result.stayed_in_tube and not result.collision
     assert result.min_obstacle_clearance > 0.0

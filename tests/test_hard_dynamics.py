@@ -24,7 +24,7 @@ from conftest import CASES, designed
 from stt_codegen.bench.arenas import generate_arena
 from stt_codegen.design.search import design_tube
 from stt_codegen.errors import DesignError
-from stt_codegen.runtime.simulate import simulate
+from stt_codegen.runtime.simulate import run_closed_loop, simulate
 from hard_helpers import plant_bounds, random_plant_parameters, unknown_plant
 
 PLANTS = settings(derandomize=True, deadline=None, database=None, max_examples=15,
@@ -50,7 +50,8 @@ def _run(knobs, rate_factor=1.0):
     if rate_factor != 1.0:
         spec = dataclasses.replace(spec, rate_hz=spec.rate_hz * rate_factor)
         design = dataclasses.replace(design, rate_hz=design.rate_hz * rate_factor)
-    return simulate(spec, design, backend="c", plant=unknown_plant(p, bounds["centre"])), bounds
+    return (run_closed_loop(spec, design, backend="c", plant=unknown_plant(p, bounds["centre"])),
+            bounds)
 
 
 @pytest.mark.slow
@@ -105,12 +106,12 @@ def test_unknown_plants_on_random_arenas(index, seed, f_amp, g_min, w_amp):
     """
     spec = generate_arena(seed=0, index=index).to_spec()
     try:
-        design = design_tube(spec).tube
+        design = design_tube(spec)
     except DesignError:
         assume(False)
     p = random_plant_parameters(np.random.default_rng(seed), f_amp, 0.3, g_min, 1.0,
                                 0.5 * g_min, w_amp, n=2)
     bounds = plant_bounds(p, spec)
-    result = simulate(spec, design, backend="c", plant=unknown_plant(p, bounds["centre"]))
+    result = simulate(design, backend="c", plant=unknown_plant(p, bounds["centre"]))
     assert result.stayed_in_tube, (index, seed, bounds)
     assert result.satisfied and not result.collision, (index, seed, bounds)

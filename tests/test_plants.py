@@ -39,20 +39,18 @@ def test_linear_plant_defaults_are_the_single_integrator():
 def test_matrix_plant_on_the_arena_is_satisfied():
     spec = load_spec(SPECS / "linear-arena-s1.toml")
     assert spec.plant_model == "linear" and spec.linear_plant.g[1] == (-0.1, 1.0, 0.05)
-    design = design_tube(spec).tube
-    result = simulate(spec, design, backend="c")
+    result = simulate(design_tube(spec), backend="c")
     assert result.satisfied and result.stayed_in_tube and not result.collision
 
 
 def test_gain_range_spec_with_g_3_is_satisfied_with_the_derived_gain_only():
-    spec = load_spec(SPECS / "gain-range-s2.toml")
-    design = design_tube(spec).tube
-    result = simulate(spec, design, backend="c")
+    design = design_tube(load_spec(SPECS / "gain-range-s2.toml"))
+    result = simulate(design, backend="c")
     assert result.satisfied and result.stayed_in_tube
     fixed = load_spec(SPECS / "gain-range-s2-fixed-gain.toml")
-    design_fixed = design_tube(fixed).tube
+    design_fixed = design_tube(fixed)
     assert design_fixed.gain == fixed.gain > design.gain
-    assert not simulate(fixed, design_fixed, backend="c").stayed_in_tube
+    assert not simulate(design_fixed, backend="c").stayed_in_tube
 
 
 SUPPORT = settings(derandomize=True, deadline=None, database=None, max_examples=40,

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import designed
+from conftest import design_of
 from scipy.integrate import solve_ivp
 
 from stt_codegen.runtime import backends
-from stt_codegen.runtime.plants import Disturbance, make_plant
+from stt_codegen.errors import SpecError
+from stt_codegen.runtime.plants import Disturbance, check_seed, make_plant
 from stt_codegen.runtime.simulate import SUBSTEPS, _rk4, simulate
 
 
@@ -16,8 +17,9 @@ from stt_codegen.runtime.simulate import SUBSTEPS, _rk4, simulate
 # test_reference_and_casadi_loops_agree keeps it in the fast tier over 3 s
 @pytest.mark.parametrize("backend", [pytest.param("reference", marks=pytest.mark.slow), "casadi"])
 def test_paper_cases_are_satisfied(case, backend):
-    spec, design, _ = designed(case)
-    result = simulate(spec, design, backend=backend)
+    design = design_of(case)
+    spec = design.spec
+    result = simulate(design, backend=backend)
     assert result.satisfied, result.to_json()
     assert result.reached and result.reach_time < spec.prescribed_time
     assert not result.collision and not result.left_state_space and result.stayed_in_tube
@@ -26,9 +28,9 @@ def test_paper_cases_are_satisfied(case, backend):
 
 
 def test_reference_and_casadi_loops_agree():
-    spec, design, _ = designed("omnirobot-s2")
-    a = simulate(spec, design, "reference", horizon=3.0)
-    b = simulate(spec, design, "casadi", horizon=3.0)
+    design = design_of("omnirobot-s2")
+    a = simulate(design, backend="reference", horizon=3.0)
+    b = simulate(design, backend="casadi", horizon=3.0)
     np.testing.assert_allclose(a.trajectory.x, b.trajectory.x, rtol=0, atol=1e-10)
 
 
@@ -76,21 +78,35 @@ class _Stubborn:
 
 
 def test_judging_reports_failures(monkeypatch):
-    spec, design, _ = designed("omnirobot-s1")
+    design = design_of("omnirobot-s1")
     monkeypatch.setitem(backends._FACTORIES, "idle", lambda d: _Stubborn([0.0, 0.0, 0.0]))
-    idle = simulate(spec, design, "idle", horizon=1.0)
+    idle = simulate(design, backend="idle", horizon=1.0)
     assert not idle.satisfied and not idle.reached and idle.reach_time is None
     # straight east from S1 runs into O1 = [1, 2] x [4, 5]
     monkeypatch.setitem(backends._FACTORIES, "east", lambda d: _Stubborn([1.0, 0.0, 0.0]))
-    east = simulate(spec, design, "east")
+    east = simulate(design, backend="east")
     assert east.collision and not east.satisfied and east.min_obstacle_clearance < 0
     # straight north leaves the state space
     monkeypatch.setitem(backends._FACTORIES, "north", lambda d: _Stubborn([0.0, 1.0, 0.0]))
-    north = simulate(spec, design, "north", horizon=2.0)
+    north = simulate(design, backend="north", horizon=2.0)
     assert north.left_state_space and not north.satisfied
 
 
 def test_short_horizon_cannot_satisfy():
-    spec, design, _ = designed("omnirobot-s3")
-    result = simulate(spec, design, "casadi", horizon=2.0)
+    result = simulate(design_of("omnirobot-s3"), backend="casadi", horizon=2.0)
     assert result.steps == 2000 and not result.satisfied
+
+
+@pytest.mark.parametrize("seed", [-1, 2**32, 1.5, True, "3"])
+def test_the_seed_is_an_integer_in_32_bits(seed):
+    design = design_of("omnirobot-s1")
+    with pytest.raises(SpecError) as info:
+        simulate(design, backend="casadi", horizon=0.1, seed=seed)
+    assert info.value.field == "seed"
+    assert info.value.reason == f"must be an integer in [0, 2**32), got {seed!r}"
+
+
+def test_the_largest_seed_and_numpy_integers_are_seeds():
+    design = design_of("omnirobot-s1")
+    assert simulate(design, backend="casadi", horizon=0.1, seed=np.uint32(2**32 - 1)).steps == 100
+    assert check_seed(np.int64(7)) == 7 and type(check_seed(np.int64(7))) is int

@@ -81,6 +81,10 @@ def test_an_unknown_key_is_rejected_by_both(validator, where):
     (("obstacles", 0, "lower"), [], "obstacles[0].lower", "must not be empty"),
     (("obstacles", 0, "lower"), "x", "obstacles[0].lower", "must be an array of numbers"),
     (("state_space",), 3, "state_space", "must be a table"),
+    (("actuator",), {"input_bound": [1.0, 0.0, 1.0]}, "actuator.input_bound[1]",
+     "must be positive"),
+    (("actuator",), {"input_bound": "x"}, "actuator.input_bound", "must be an array"),
+    (("actuator",), {}, "actuator.input_bound", "missing"),
 ])
 def test_schema_and_validator_agree_on_bad_values(validator, path, value, field, reason):
     doc = _valid_doc()

@@ -104,6 +104,20 @@ BAD = [
     (VALID + "\n[plant]\ndisturbance_amplitude = -0.1\n", "plant.disturbance_amplitude",
      "non-negative"),
     (replace("[initial]", "initial = 3\n[initial_x]"), "initial_x", "unknown key"),
+    (VALID + "\n[actuator]\ninput_bound = [2.0]\n", "actuator.input_bound",
+     "must have 2 entries (one per input of the single-integrator plant: u1, u2), got 1"),
+    (VALID + "\n[actuator]\ninput_bound = [2.0, 0.0]\n", "actuator.input_bound[1]",
+     "must be positive"),
+    (VALID + "\n[actuator]\ninput_bound = [2.0, -1]\n", "actuator.input_bound[1]",
+     "must be positive"),
+    (VALID + "\n[actuator]\ninput_bound = [2.0, inf]\n", "actuator.input_bound[1]",
+     "must be finite"),
+    (VALID + "\n[actuator]\ninput_bound = []\n", "actuator.input_bound", "must not be empty"),
+    (VALID + "\n[actuator]\ninput_bound = 2.0\n", "actuator.input_bound",
+     "must be an array of numbers"),
+    (VALID + "\n[actuator]\n", "actuator.input_bound", "missing"),
+    (VALID + "\n[actuator]\ninput_bound = [1.0, 1.0]\nmax_rate = 3\n", "actuator.max_rate",
+     "unknown key (allowed: input_bound)"),
     ("obstacles = 5\n" + VALID.replace("[[obstacles]]\nlower = [2.0, 2.0]\nupper = [3.0, 3.0]\n", ""),
      "obstacles", "must be an array"),
 ]
@@ -117,6 +131,23 @@ def test_bad_input_names_field_and_reason(text, field, reason):
     assert info.value.field == field, str(info.value)
     assert reason in info.value.reason, str(info.value)
     assert str(info.value).startswith(f"{field}: " if field else reason[:5])
+
+
+def test_actuator_input_bound_one_per_input():
+    """``[actuator] input_bound``: absent is ``None`` (no limit); given, one positive number
+    per input of the plant model, whose input names the count's message uses."""
+    assert parse_spec(VALID).input_bound is None
+    assert load_spec("omnirobot-s1").input_bound is None
+    assert parse_spec(VALID + "\n[actuator]\ninput_bound = [2, 0.5]\n").input_bound == (2.0, 0.5)
+    from importlib import resources
+    robot = resources.files("stt_codegen.cases").joinpath("omnirobot-s1.toml").read_text()
+    assert parse_spec(robot + "\n[actuator]\ninput_bound = [2.0, 2.0, 1.0]\n"
+                      ).input_bound == (2.0, 2.0, 1.0)
+    with pytest.raises(SpecError) as info:
+        parse_spec(robot + "\n[actuator]\ninput_bound = [2.0, 2.0]\n")
+    assert info.value.field == "actuator.input_bound"
+    assert info.value.reason == ("must have 3 entries (one per input of the omnidirectional "
+                                 "plant: v1, v2, omega), got 2")
 
 
 def test_missing_file_and_non_utf8(tmp_path):

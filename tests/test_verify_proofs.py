@@ -15,10 +15,11 @@ import casadi as ca
 import pytest
 import sympy as sp
 
+import stt_codegen.cli.verify as verify_command_line
 from stt_codegen.design.search import design_tube
 from stt_codegen.spec.loader import load_spec
 from stt_codegen.tube import pieces
-from stt_codegen.verify import command, deployed, proofs
+from stt_codegen.verify import deployed, proofs
 from stt_codegen.verify.check import Check
 from stt_codegen.verify.command import verify
 
@@ -159,10 +160,10 @@ def test_progress_goes_to_a_terminal_only(monkeypatch):
             pass
 
     monkeypatch.setattr(sys, "stderr", Terminal(False))
-    assert command._terminal_progress() is None
+    assert verify_command_line._terminal_progress() is None
     terminal = Terminal(True)
     monkeypatch.setattr(sys, "stderr", terminal)
-    command._terminal_progress()("lemma 3.3 (3/10)")
+    verify_command_line._terminal_progress()("lemma 3.3 (3/10)")
     assert terminal.text == "\rverify: lemma 3.3 (3/10) ...\x1b[K"
 
 

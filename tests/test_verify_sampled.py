@@ -15,7 +15,7 @@ from plants_helpers import plant_system, plant_within
 
 from stt_codegen.design.gain import derived_gain, gain_derivation
 from stt_codegen.design.samples import sample_tube
-from stt_codegen.runtime.simulate import simulate
+from stt_codegen.runtime.simulate import run_closed_loop
 from stt_codegen.spec.loader import Assumptions, load_spec
 from stt_codegen.verify.command import verify_spec
 from stt_codegen.verify.sampled import check_sampled
@@ -118,7 +118,8 @@ def test_no_plant_that_the_check_accepts_leaves_the_tube(case, seed, g_min, spre
     if not verdict.passed:
         return
     plant = plant_system(plant_within(np.random.default_rng(seed), a, spec.state_space))
-    result = simulate(spec, dataclasses.replace(design, gain=gain), backend="c", plant=plant)
+    result = run_closed_loop(spec, dataclasses.replace(design, gain=gain), backend="c",
+                             plant=plant)
     assert result.stayed_in_tube and result.satisfied, (case, a, gain)
 
 
@@ -133,8 +134,8 @@ def test_accepted_bounds_hold_for_several_plants():
         assert check_sampled(design, s, a, gain).passed, case
         for seed in range(2):
             plant = plant_system(plant_within(np.random.default_rng(seed), a, spec.state_space))
-            result = simulate(spec, dataclasses.replace(design, gain=gain), backend="c",
-                              plant=plant)
+            result = run_closed_loop(spec, dataclasses.replace(design, gain=gain), backend="c",
+                                     plant=plant)
             assert result.stayed_in_tube and result.satisfied, (case, seed)
 
 

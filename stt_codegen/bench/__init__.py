@@ -9,8 +9,9 @@
 * :mod:`.step`, :mod:`.scaling` - the per-step cost and its growth;
 * :mod:`.covering` - covering many polygons by boxes, and the design around them;
 * :mod:`.alpha` - the implicit alpha step: Newton iterations, convergence in ``dt``;
-* :mod:`.report` - statistics, tables and the machine description;
-* :mod:`.cli` - the ``bench`` subcommand's arguments.
+* :mod:`.report` - statistics, tables and the machine description.
+
+The ``bench`` subcommand's arguments are in :mod:`stt_codegen.cli.bench`.
 
 Every benchmark measures what it compares side by side in one run and reports ratios;
 the tests check structure and invariants, never speed; they count work where a

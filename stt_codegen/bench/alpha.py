@@ -23,9 +23,7 @@ prints the figures.
 
 from __future__ import annotations
 
-import argparse
 import dataclasses
-import json
 from typing import Any
 
 import casadi as ca
@@ -136,10 +134,3 @@ def format_alpha_report(report: dict[str, Any]) -> str:
         f"Richardson 2 a(2r) - a(r): largest error {conv['richardson_max_abs_error']:.3g}",
         machine_line(report["machine"])])
 
-
-def main_alpha(args: argparse.Namespace) -> int:
-    """Handler of ``bench alpha``; exit 0."""
-    report = run_alpha_bench(args.spec)
-    print(json.dumps(report, indent=1, sort_keys=True) if args.json
-          else format_alpha_report(report))
-    return 0

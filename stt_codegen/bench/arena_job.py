@@ -20,7 +20,7 @@ Methods (:data:`METHODS`):
   OMPL is installed).
 
 Every method runs on the same arena with the same disturbance (seed = arena index), the
-same sampling rate and the same judge, :func:`stt_codegen.runtime.simulate.simulate`.
+same sampling rate and the same judge, :func:`stt_codegen.runtime.simulate.run_closed_loop`.
 """
 
 from __future__ import annotations
@@ -82,7 +82,10 @@ def closed_loop_failure(result: SimulationResult) -> str:
 def _outcome(seconds: float, reason: str, result: SimulationResult | None) -> dict[str, Any]:
     return {"success": not reason, "seconds": seconds, "reason": reason,
             "reach_time": None if result is None else result.reach_time,
-            "clearance": None if result is None else result.min_obstacle_clearance}
+            "clearance": None if result is None else result.min_obstacle_clearance,
+            # the largest |u_i| over the run and the inputs, and integral |u|^2 dt
+            "peak_u": None if result is None else max(result.max_abs_u),
+            "effort": None if result is None else result.control_effort}
 
 
 def _plan_stt(spec, method: str) -> dict[str, Any]:
@@ -154,9 +157,12 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
     dict
         ``{"index", "name", "methods": {method: {"success" (bool), "seconds"
         (design or planning time, s), "reason" (failure category, "" on success),
-        "reach_time" (s or None), "clearance" (m or None)}}}``.
+        "reach_time" (s or None), "clearance" (m or None), "peak_u" (the largest
+        ``|u_i|`` over the run and the inputs, m/s, or None), "effort" (``integral
+        |u|^2 dt``, m^2/s, or None)}}}``; the last four are ``None`` without a closed
+        loop.
     """
-    from ..runtime.simulate import simulate
+    from ..runtime.simulate import run_closed_loop
     from .tracker import track
     arena = generate_arena(seed, index)
     spec = arena.to_spec()
@@ -168,7 +174,7 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
         elif "tube" in planned:
             tube = planned["tube"]
             if tube not in runs:
-                runs[tube] = simulate(spec, tube, backend="c", seed=index)
+                runs[tube] = run_closed_loop(spec, tube, backend="c", seed=index)
             out[method] = _outcome(planned["seconds"], closed_loop_failure(runs[tube]),
                                    runs[tube])
         else:

@@ -3,12 +3,11 @@ on the same random arenas, side by side in one run (the paper's Table I, redone)
 
 from __future__ import annotations
 
-import argparse
-import json
 from pathlib import Path
 from typing import Any
 
 from ..errors import SpecError
+from ..system import atomic_write
 from .arena_job import LABELS, METHODS, loop_arena, plan_arena
 from .arenas import generate_arenas
 from .parallel import run_parallel
@@ -33,7 +32,6 @@ def write_specs(folder: Path, count: int, seed: int) -> list[Path]:
     SpecError
         The folder does not exist (field ``specs``).
     """
-    from ..cli import atomic_write_bytes
     folder = Path(folder)
     if not folder.is_dir():
         raise SpecError("specs", f"folder {str(folder)!r} does not exist")
@@ -41,7 +39,7 @@ def write_specs(folder: Path, count: int, seed: int) -> list[Path]:
     for arena in generate_arenas(count, seed):
         path = folder / f"{arena.name}.toml"
         text = arena.to_toml().encode("utf-8")
-        atomic_write_bytes(path, lambda tmp, data=text: tmp.write_bytes(data))
+        atomic_write(path, text, field="specs")
         paths.append(path)
     return paths
 
@@ -105,34 +103,31 @@ def run_arenas_bench(count: int, seed: int, workers: int | None = None,
 
 def format_arenas_report(report: dict[str, Any]) -> str:
     """The human-readable table of :func:`run_arenas_bench`'s result."""
-    rows = []
+    rows, effort = [], []
     for method, s in report["methods"].items():
         failures = ", ".join(f"{r} ({n})" for r, n in s["failures"].items()) or "-"
         rows.append([LABELS[method], f"{s['successes']}/{s['runs']}",
                      f"{100 * s['success_rate']:.1f} %", seconds_text(s["time_median_s"]),
                      seconds_text(s["time_p95_s"]), failures])
+        effort.append([LABELS[method], str(s.get("effort_runs", 0)),
+                       *(_figure(s.get(key)) for key in ("peak_u_median", "peak_u_p95",
+                                                         "effort_median", "effort_p95"))])
     lines = [f"{report['count']} arenas (seed {report['seed']}): 5 m x 5 m, four 1 m x 1 m "
              "obstacles, t_c = 9 s, single integrator, |w_i| <= 0.1 m/s, 1 kHz",
              table(["method", "satisfied", "rate", "time median", "time p95",
                     "failures by reason"], rows),
              "time: STT = design_tube (search + continuous-time certificate); "
-             "baselines = planning (grid/planner construction + search)."]
+             "baselines = planning (grid/planner construction + search).",
+             "",
+             table(["method", "satisfied runs", "peak |u| median", "peak |u| p95",
+                    "effort median", "effort p95"], effort),
+             "control effort over the satisfied runs: peak |u| = the largest |u_i| of a run "
+             "(m/s); effort = integral of |u|^2 dt over [0, t_c] (m^2/s)."]
     for method, why in report["skipped"].items():
         lines.append(f"skipped {LABELS[method]}: {why}")
     lines.append(machine_line(report["machine"]))
     return "\n".join(lines)
 
 
-def main_arenas(args: argparse.Namespace) -> int:
-    """Handler of ``bench arenas``; exit 0."""
-    if args.specs:
-        write_specs(Path(args.specs), args.count, args.seed)
-    report = run_arenas_bench(args.count, args.seed, workers=args.workers,
-                              scheduler=args.scheduler,
-                              methods=tuple(args.methods.split(",")) if args.methods else None,
-                              progress=not args.no_progress)
-    if args.json:
-        print(json.dumps(report, indent=1, sort_keys=True, allow_nan=False))
-    else:
-        print(format_arenas_report(report))
-    return 0
+def _figure(value: float | None) -> str:
+    return "-" if value is None else f"{value:.3g}"

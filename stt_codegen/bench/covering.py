@@ -10,8 +10,6 @@ the covering's work instead (``tests/test_covering.py``); this command gives the
 
 from __future__ import annotations
 
-import argparse
-import json
 import time
 from typing import Any
 
@@ -123,10 +121,3 @@ def format_covering_report(report: dict[str, Any]) -> str:
         f"{report['boxes']} boxes",
         table(["step", "CPU", "wall"], rows), outcome, machine_line(report["machine"])])
 
-
-def main_covering(args: argparse.Namespace) -> int:
-    """Handler of ``bench covering``; exit 0."""
-    report = run_covering_bench(args.seed, args.count, args.tolerance)
-    print(json.dumps(report, indent=1, sort_keys=True) if args.json
-          else format_covering_report(report))
-    return 0

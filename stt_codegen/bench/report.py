@@ -47,14 +47,18 @@ def summarize(outcomes: list[dict[str, Any]]) -> dict[str, Any]:
     Parameters
     ----------
     outcomes : list of dict
-        Per arena, ``{"success": bool, "seconds": float, "reason": str}``.
+        Per arena, ``{"success": bool, "seconds": float, "reason": str}``, and for the
+        arenas with a closed loop ``"peak_u"`` and ``"effort"`` (floats).
 
     Returns
     -------
     dict
         ``runs``, ``successes``, ``success_rate`` (0..1), ``time_median_s`` and
         ``time_p95_s`` (design or planning time over all runs, failed ones included,
-        seconds) and ``failures`` (reason -> count, most frequent first).
+        seconds), ``failures`` (reason -> count, most frequent first) and the control
+        effort over the ``effort_runs`` satisfied runs: ``peak_u_median``,
+        ``peak_u_p95`` (the largest ``|u_i|`` of a run) and ``effort_median``,
+        ``effort_p95`` (its ``integral |u|^2 dt``), ``None`` without such runs.
     """
     seconds = np.array([o["seconds"] for o in outcomes], dtype=float)
     successes = sum(bool(o["success"]) for o in outcomes)
@@ -66,7 +70,24 @@ def summarize(outcomes: list[dict[str, Any]]) -> dict[str, Any]:
         "time_median_s": float(np.median(seconds)) if len(seconds) else None,
         "time_p95_s": float(np.percentile(seconds, 95)) if len(seconds) else None,
         "failures": dict(sorted(failures.items(), key=lambda kv: (-kv[1], kv[0]))),
+        **_effort(outcomes),
     }
+
+
+def _effort(outcomes: list[dict[str, Any]]) -> dict[str, Any]:
+    """Median and p95 of the peak ``|u|`` and of ``integral |u|^2 dt`` over the satisfied
+    runs (``peak_u``, ``effort`` of each outcome; older outcomes without them count
+    none)."""
+    done = [o for o in outcomes if o["success"] and o.get("peak_u") is not None]
+    peak = np.array([o["peak_u"] for o in done], dtype=float)
+    effort = np.array([o["effort"] for o in done], dtype=float)
+
+    def stat(values: np.ndarray, q: float) -> float | None:
+        return float(np.percentile(values, q)) if values.size else None
+
+    return {"effort_runs": len(done),
+            "peak_u_median": stat(peak, 50), "peak_u_p95": stat(peak, 95),
+            "effort_median": stat(effort, 50), "effort_p95": stat(effort, 95)}
 
 
 def table(header: list[str], rows: list[list[str]]) -> str:

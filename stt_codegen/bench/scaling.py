@@ -23,8 +23,6 @@ large / small) and the size of the object's code (``.text``; only the tables gro
 
 from __future__ import annotations
 
-import argparse
-import json
 from typing import Any
 
 import numpy as np
@@ -187,15 +185,6 @@ def sparse_window_experiment(compile_timeout: float = 900.0, callgrind: bool = T
     return {"rows": rows, "instruction_ratio": ratio}
 
 
-def _int_list(text: str, field: str) -> list[int]:
-    try:
-        values = [int(v) for v in text.split(",") if v.strip()]
-    except ValueError:
-        raise SpecError(field, f"expected a comma-separated list of integers, got {text!r}") from None
-    if not values:
-        raise SpecError(field, "empty list")
-    return values
-
 
 def run_scaling_bench(obstacles: list[int], dimensions: list[int],
                       compile_timeout: float = 900.0, active_obstacles: int | None = None,
@@ -314,13 +303,3 @@ def format_scaling_report(report: dict[str, Any]) -> str:
                "outside: recorded closed-loop inputs (of 9000) outside the synthetic tube")
     out.append(machine_line(report["machine"]))
     return "\n".join(out)
-
-
-def main_scaling(args: argparse.Namespace) -> int:
-    """Handler of ``bench scaling``; exit 0."""
-    report = run_scaling_bench(_int_list(args.obstacles, "obstacles"),
-                               _int_list(args.dimensions, "dimensions"),
-                               compile_timeout=args.compile_timeout)
-    print(json.dumps(report, indent=1, sort_keys=True) if args.json
-          else format_scaling_report(report))
-    return 0

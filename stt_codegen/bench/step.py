@@ -18,8 +18,6 @@ the largest ``|u - u_C|`` of each implementation on 64 of the inputs is reported
 
 from __future__ import annotations
 
-import argparse
-import json
 from typing import Any
 
 import numpy as np
@@ -156,11 +154,3 @@ def format_step_report(report: dict[str, Any]) -> str:
               + (f"{ir:.0f}" if ir is not None else f"skipped: {report.get('callgrind_skipped')}")),
              machine_line(report["machine"])]
     return "\n".join(lines)
-
-
-def main_step(args: argparse.Namespace) -> int:
-    """Handler of ``bench step``; exit 0."""
-    report = run_step_bench(args.spec, steps=args.steps)
-    print(json.dumps(report, indent=1, sort_keys=True) if args.json
-          else format_step_report(report))
-    return 0

@@ -8,11 +8,11 @@ along the path and commands ``u = SPEED (carrot - x) / |carrot - x|``. Near the 
 ``t_c = 9`` s; the lookahead is small enough that cutting a right-angle corner stays
 inside the planners' 0.2 m margin.
 
-The closed loop is run by :func:`stt_codegen.runtime.simulate.simulate` itself, so that the
-baselines are judged by the very same code as the tube controller: same plant and
-disturbance seed, same sampling rate (the spec's, 1 kHz) and integration, same
-Definition 2.1 on ``[0, t_c]`` (target reached by ``t_c``, no collision at any
-integration point, state space never left).
+The closed loop is run by :func:`stt_codegen.runtime.simulate.run_closed_loop`, the loop of
+``simulate`` itself, so that the baselines are judged by the very same code as the tube
+controller: same plant and disturbance seed, same sampling rate (the spec's, 1 kHz) and
+integration, same Definition 2.1 on ``[0, t_c]`` (target reached by ``t_c``, no collision
+at any integration point, state space never left).
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ import numpy as np
 
 from ..runtime.backends import STATUS_OK, backend_names, register_backend
 from ..design.search import base_design
-from ..runtime.simulate import SimulationResult, simulate
+from ..runtime.simulate import SimulationResult, run_closed_loop
 from ..spec.loader import Spec
 from ..tube.parameters import TubeDesign
 
@@ -123,13 +123,14 @@ def track(spec: Spec, path: np.ndarray, seed: int) -> SimulationResult:
     Returns
     -------
     SimulationResult
-        From :func:`stt_codegen.runtime.simulate.simulate`; ``backend`` is ``bench-path-tracker``.
+        From :func:`stt_codegen.runtime.simulate.run_closed_loop`; ``backend`` is
+        ``bench-path-tracker``.
     """
     if BACKEND not in backend_names():
         register_backend(BACKEND, _factory)
     design = base_design(spec)
     _PATHS[design.name] = np.asarray(path, float)
     try:
-        return simulate(spec, design, backend=BACKEND, seed=seed)
+        return run_closed_loop(spec, design, backend=BACKEND, seed=seed)
     finally:
         _PATHS.pop(design.name, None)

@@ -2,10 +2,12 @@
 
 * :func:`~.generate.generate_files` - every file of one generation, in memory;
 * :func:`~.output.write_generation` - write them safely into ``-o DIR``;
-* :mod:`.bundled` - the committed ``generated/`` folder and its drift check;
-* :class:`~.controllers.CController`, :class:`~.controllers.GeneratedPythonController` -
-  the generated code as backends ``c`` and ``python``;
-* :mod:`.cli` - the ``generate`` and ``check`` subcommands' arguments.
+* :func:`~.api.generate` - both, for a :class:`~stt_codegen.design.result.Design` (the
+  front door's ``stt_codegen.generate``);
+* :mod:`.bundled` - the committed ``generated/`` folder and its drift check.
+
+The generated code runs as the backends ``c`` and ``python`` in
+:mod:`stt_codegen.runtime.compiled`.
 """
 
 from .generate import generate_files

@@ -1,39 +1,39 @@
-"""The library's code generation call: design -> standalone controller files in a folder."""
+"""The library's code generation call: a design -> standalone controller files in a folder."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
 
-from ..spec.loader import Spec
-from ..tube.parameters import TubeDesign
+from ..design.result import Design, require_design
 from .generate import generate_files
 from .options import LANGUAGES, parse_options
 from .output import write_generation
 
 
-def generate(spec: Spec, design: TubeDesign, out_dir: str | Path,
+def generate(design: Design, out_dir: str | Path,
              languages: str | Sequence[str] = LANGUAGES,
              precision: str = "double") -> list[Path]:
     """Write the standalone controller of a designed tube into a folder.
 
     What ``stt-codegen generate SPEC -o DIR`` writes: for C, ``P.h`` and ``P.c`` (C99,
-    ``<math.h>`` only, no allocation), ``P_selftest.c``, a Makefile; for Python, ``P.py``
-    (imports only :mod:`math`); the test vectors ``P_vectors.json`` and ``manifest.json``
-    (``P`` is the spec name with ``-`` replaced by ``_``). The code computes law (13) with
-    the tube of eqs. (2)-(10) and the implicit step of the adaptive law (11).
+    ``<math.h>`` only, no allocation), ``P_selftest.c``, a Makefile and a CMakeLists.txt;
+    for Python, ``P.py`` (imports only :mod:`math`); the test vectors ``P_vectors.json``
+    and ``manifest.json`` (``P`` is the spec name with ``-`` replaced by ``_``). The code
+    computes law (13), ``u = -k xi(x, t) epsilon(x, t)``, with the tube of eqs. (2)-(10)
+    and the implicit step of the adaptive law (11).
 
     Parameters
     ----------
-    spec : Spec
-        Its name and ``source_hash`` go into the files.
-    design : TubeDesign
-        From :func:`stt_codegen.design_tube`.
+    design : Design
+        From :func:`stt_codegen.design_tube`; its spec's name and ``source_hash`` go into
+        the files, its tube's numbers into the code.
     out_dir : str or path
         Folder; created if missing (its parent must exist). Files of a previous
         generation are replaced; anything else in it is refused. Nothing is half-written.
     languages : str or sequence of str, optional
-        Subset of ``("c", "python")``, or the same comma-separated; default both.
+        Subset of ``("c", "python")`` (a list, a tuple, a numpy array of strings), or
+        the same comma-separated; default both.
     precision : {"double", "single"}, optional
         Floating-point type of the C code (``double`` or ``float``); the Python module
         always computes in Python floats.
@@ -45,13 +45,33 @@ def generate(spec: Spec, design: TubeDesign, out_dir: str | Path,
 
     Raises
     ------
+    TypeError
+        ``design`` is not a :class:`~stt_codegen.design.result.Design` (a ``TubeDesign``
+        or a ``Spec``, say): call :func:`stt_codegen.design_tube` first.
     SpecError
         Unknown language (field ``languages``) or precision (``precision``); an unusable
         or foreign output folder (``out_dir``).
     ToolchainError
         ``CodegenError`` or ``EmitError``: the model could not be turned into code.
+
+    See Also
+    --------
+    stt_codegen.design_tube : the design to generate code for.
+    stt_codegen.simulate : run the generated C or Python in closed loop (``backend="c"``,
+        ``"python"``).
+    stt_codegen.codegen.generate.generate_files : the same files in memory.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    >>> files = stt.generate(design, "s1-float", languages=["c"], precision="single")
+    >>> [f.name for f in files]                                  # doctest: +NORMALIZE_WHITESPACE
+    ['CMakeLists.txt', 'Makefile', 'manifest.json', 'omnirobot_s1.c', 'omnirobot_s1.h',
+     'omnirobot_s1_selftest.c', 'omnirobot_s1_vectors.json']
     """
+    design = require_design(design, "generate")
     options = parse_options(languages, precision)
-    files = generate_files(spec, design, options)
+    files = generate_files(design.spec, design.tube, options)
     write_generation(out_dir, files)
     return [Path(out_dir) / name for name in sorted(files)]

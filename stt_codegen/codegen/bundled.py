@@ -37,10 +37,9 @@ def expected_tree() -> dict[str, bytes]:
     """Every committed file, keyed by its path relative to ``generated/`` (POSIX)."""
     tree: dict[str, bytes] = {}
     for case in bundled_cases():
-        spec = load_spec(case)
-        design = design_tube(spec).tube
+        design = design_tube(load_spec(case))
         for sub, options in LAYOUT.items():
-            for name, data in generate_files(spec, design, options).items():
+            for name, data in generate_files(design.spec, design.tube, options).items():
                 tree[f"{case}/{sub}/{name}"] = data
     return tree
 

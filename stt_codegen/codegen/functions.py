@@ -39,16 +39,18 @@ def deployed_functions(model: TubeModel) -> list[ca.Function]:
     members = [len(design.circumvents_on(i, side)) for i in range(design.dimension)
                for side in (LOWER, UPPER)]
     return P.deployed_pieces(design.dimension, profiles, single_bounds=1 in members,
-                             multi_bounds=any(m > 1 for m in members))
+                             multi_bounds=any(m > 1 for m in members),
+                             saturated=design.input_bound is not None)
 
 
 def clamped_control(model: TubeModel) -> ca.Function:
-    """``control(x, t, alpha) -> (u, inside)``: the ``u`` and ``inside`` of the model's step."""
+    """``control(x, t, alpha) -> (u, inside[, within_bound])``: the ``u``, ``inside`` (and,
+    for a design with an actuator bound, ``within_bound``) of the model's step."""
     step = model["controller_step"]
     n = model.design.dimension
     x = ca.SX.sym("x", n)
     t = ca.SX.sym("t")
     alpha = ca.SX.sym("alpha", 2 * n)
-    u, _, inside = step(x, t, 1e-3, alpha)
-    return ca.Function("control", [x, t, alpha], [u, inside], ["x", "t", "alpha"],
-                       ["u", "inside"])
+    u, _, inside, *within = step(x, t, 1e-3, alpha)
+    return ca.Function("control", [x, t, alpha], [u, inside, *within], ["x", "t", "alpha"],
+                       ["u", "inside", *(["within_bound"] if within else [])])

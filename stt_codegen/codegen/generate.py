@@ -22,7 +22,7 @@ import math
 import casadi
 import numpy as np
 
-from .. import __version__
+from ..version import __version__
 from .emit import CPrinter, lower, python_source
 from ..tube.model import build_model
 from ..spec.loader import Spec
@@ -107,7 +107,9 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
                      rate_hz=c_real(design.rate_hz, single),
                      dt_min=c_real(limits["dt_min"], single),
                      dt_max=c_real(limits["dt_max"], single),
-                     alpha_max=c_real(limits["alpha_max"], single))
+                     alpha_max=c_real(limits["alpha_max"], single),
+                     input_bound=(None if design.input_bound is None else
+                                  [c_real(b, single) for b in design.input_bound]))
         for name, template in ((f"{prefix}.h", "c_header.h.j2"), (f"{prefix}.c", "c_source.c.j2"),
                                ("Makefile", "Makefile.j2"),
                                ("CMakeLists.txt", "CMakeLists.txt.j2")):
@@ -136,7 +138,9 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
                              rate_hz=repr(float(design.rate_hz)),
                              dt_min=repr(limits["dt_min"]),
                              dt_max=repr(limits["dt_max"]),
-                             alpha_max=repr(limits["alpha_max"]))
+                             alpha_max=repr(limits["alpha_max"]),
+                             input_bound=(None if design.input_bound is None else
+                                          [repr(float(b)) for b in design.input_bound]))
     vec_name = f"{prefix}_vectors.json"
     files_bytes = {k: v.encode("ascii") for k, v in files.items()}
     files_bytes[vec_name] = _json_bytes({

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ..errors import SpecError
@@ -31,8 +32,9 @@ class Options:
         return {"langs": list(self.langs), "precision": self.precision}
 
 
-def parse_options(langs: str | list | tuple = "c,python", precision: str = "double") -> Options:
-    """Validate the languages (comma-separated or a list) and the precision.
+def parse_options(langs: str | Sequence[str] = "c,python", precision: str = "double") -> Options:
+    """Validate the languages (comma-separated, or a sequence such as a list, a tuple or a
+    numpy array of strings) and the precision.
 
     Raises
     ------

@@ -4,7 +4,10 @@ The inputs are float32 numbers (exact in both precisions), drawn with a fixed se
 :data:`INSIDE` points with ``|e_i| <= 0.99`` in tubes at least 1e-2 wide, and
 :data:`OUTSIDE` points with ``1.1 <= |e_i| <= 2`` in one dimension (status OUTSIDE_TUBE,
 ``u`` clamped); every point's status is certain in the generated precision (see
-:func:`~stt_codegen.codegen.tolerance.status_certain`). Times cover ``[0, 1.2 t_c]``, so
+:func:`~stt_codegen.codegen.tolerance.status_certain`). For a design with an actuator
+bound the inside points' status is ``OK`` or ``INPUT_CLAMPED`` as the reference clamps
+``u``, and only points whose clamp decision is certain in the precision are kept
+(every ``|u_i|`` of law (13) farther from ``input_bound_i`` than its error bound). Times cover ``[0, 1.2 t_c]``, so
 after ``t_c`` too. Expected values are the reference's (:mod:`stt_codegen.tube.reference`)
 at those inputs; tolerances are :mod:`~stt_codegen.codegen.tolerance`'s bounds for the
 chosen precision (double: with the floor ``1e-12 max(1, |ref|)``).
@@ -23,7 +26,6 @@ import numpy as np
 
 from ..errors import SpecError
 from ..tube import reference as R
-from ..tube.parameters import STATUS_OK, STATUS_OUTSIDE_TUBE
 from ..tube.parameters import TubeDesign
 from . import tolerance as T
 from .errors import CodegenError
@@ -96,6 +98,8 @@ def sample_inputs(design: TubeDesign, precision: str = "single") -> dict[str, np
         resolvable += int(np.sum(usable & (narrowest > RESOLUTION * dg)))
         ok = usable & T.status_certain(design, x, alpha, g_l, g_u, unit)
         _, _, inside = R.controller_step(design, x, t, dt, alpha)
+        if design.input_bound is not None:
+            ok &= _clamp_certain(design, x, t, alpha, g_l, g_u, unit)
         for i in np.flatnonzero(ok):
             kind = bool(inside[i] == 0.0)
             if kind != bool(outside[i]) or have[kind] >= want[kind]:
@@ -122,6 +126,16 @@ def sample_inputs(design: TubeDesign, precision: str = "single") -> dict[str, np
     return {k: np.array(v) for k, v in chosen.items()}
 
 
+def _clamp_certain(design: TubeDesign, x, t, alpha, g_l, g_u, unit: float) -> np.ndarray:
+    """Whether the actuator clamp's decision cannot depend on rounding, shape (N,): every
+    ``|u_i|`` of law (13) is farther from ``input_bound_i`` than its error bound plus the
+    rounding of the bound itself."""
+    u, _, _ = R.law_step(design, x, t, np.full(t.shape, 1e-3), alpha)
+    bound = np.array(design.input_bound)
+    tol = T.u_bound(design, x, alpha, g_l, g_u, u, unit) + unit * bound
+    return np.all(np.abs(np.abs(u) - bound) > tol, axis=1)
+
+
 def test_vectors(design: TubeDesign, precision: str) -> dict:
     """Inputs, expected outputs and tolerances of every vector, as JSON-ready lists.
 
@@ -134,17 +148,20 @@ def test_vectors(design: TubeDesign, precision: str) -> dict:
     """
     p = sample_inputs(design, precision)
     x, t, dt, alpha = p["x"], p["t"], p["dt"], p["alpha"]
-    u, alpha_next, inside = R.controller_step(design, x, t, dt, alpha)
+    u, alpha_next, status = R.controller_status(design, x, t, dt, alpha)
     g_l, g_u, _, _ = R.adaptive_tube(design, t, alpha)
     unit = T.unit_roundoff(precision)
-    tol_u = T.u_bound(design, x, alpha, g_l, g_u, u, unit)
+    # the bound of law (13)'s u bounds the clamped u too (the clamp is 1-Lipschitz, and an
+    # entry clamped at a certain decision is off by the rounding of the bound only, far
+    # below the term |u| 2 dg / w of the bound)
+    u_law = R.law_step(design, x, t, dt, alpha)[0]
+    tol_u = T.u_bound(design, x, alpha, g_l, g_u, u_law, unit)
     tol_a = T.alpha_bound(design, alpha, alpha_next, unit)
     tol_g = np.broadcast_to(T.gamma_bound(design, alpha, unit), g_l.shape)
     if precision == "double":
         tol_u = T.with_double_floor(tol_u, u)
         tol_a = T.with_double_floor(tol_a, alpha_next)
         tol_g = T.with_double_floor(tol_g, np.maximum(np.abs(g_l), np.abs(g_u)))
-    status = np.where(inside == 1.0, STATUS_OK, STATUS_OUTSIDE_TUBE)
 
     def rows(a):
         return [[float(v) for v in row] for row in np.asarray(a)]

@@ -21,7 +21,8 @@ class FailureKind(Enum):
     obstacle), ``SEARCH_BUDGET`` (candidate tubes or certificate work used up),
     ``NO_PASSAGE`` (no via-point path: the free passage is too narrow),
     ``WALLED_OFF`` (the start or the target is enclosed by obstacles), ``PLANT``
-    (the spec's plant violates Assumption 2).
+    (the spec's plant violates Assumption 2), ``INPUT_BOUND`` (no design within ``t_c``
+    is proved to keep law (13) within ``[actuator] input_bound``).
     """
 
     SAMPLING_RATE = "sampling rate"
@@ -37,6 +38,7 @@ class FailureKind(Enum):
     NO_PASSAGE = "no via-point passage"
     WALLED_OFF = "walled off"
     PLANT = "plant assumption"
+    INPUT_BOUND = "input bound"
 
 
 def property_kind(name: str) -> FailureKind:

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 from ..tube.parameters import TubeDesign
 from .certificate import Certificate
 from .failures import FailureKind
+from .input_bound import InputProof
 
 if TYPE_CHECKING:
     from ..spec.loader import Spec
@@ -74,6 +75,10 @@ class Design:
         The spec the tube was designed for. ``generate``, ``simulate``, ``verify`` and the
         plots take a :class:`Design` and read its spec from here, so a tube cannot be
         paired with another spec's name, obstacles or plant.
+    input_proof : InputProof or None
+        For a spec with ``[actuator]``: the proved peak of each input of law (13) along
+        the tube (:mod:`~stt_codegen.design.input_bound`), within ``input_bound``;
+        ``None`` otherwise.
     """
 
     tube: TubeDesign
@@ -81,6 +86,8 @@ class Design:
     check: TubeCheck
     design_time_s: float = field(compare=False)
     spec: Spec = field(compare=False, repr=False, kw_only=True)
+    input_proof: InputProof | None = field(default=None, compare=False, repr=False,
+                                           kw_only=True)
 
     @property
     def certificate(self) -> Certificate:
@@ -92,16 +99,20 @@ class Design:
         """``k`` of law (13)."""
         return self.tube.gain
 
-    def to_json(self, spec_name: str) -> dict[str, Any]:
+    def to_json(self) -> dict[str, Any]:
         """The design as plain JSON types (the ``design`` command's and ``simulate --json``'s).
 
         Returns
         -------
         dict
-            ``spec``, ``method``, ``circumvents`` (spec obstacle index, dimension, side,
-            window start and end in s, height, sharpness), ``via`` (boxes and times;
-            empty for the paper's method), ``gain``, ``certificate`` (each property with
-            its margin and where it is smallest) and ``design_time_s``.
+            ``spec`` (the name of :attr:`spec`), ``designed`` (``True``; the command
+            line's document for a spec with no design has ``False``), ``method``,
+            ``circumvents`` (spec obstacle index, dimension, side, window start and end in
+            s, height, sharpness), ``via`` (boxes and times; empty for the paper's
+            method), ``segments``, ``gain``, ``certificate`` (each property with its
+            margin and where it is smallest) and ``design_time_s``; for a spec with
+            ``[actuator]`` also ``input_bound`` and ``input_peak`` (the proved peak of
+            each input, when it occurs, the horizon covered, the relative margin).
         """
         tube = self.tube
         via = []
@@ -112,7 +123,8 @@ class Design:
             via += [{"time": s.end, "lower": list(s.lower_to), "upper": list(s.upper_to)}
                     for s in segs]
         return {
-            "spec": spec_name,
+            "spec": self.spec.name,
+            "designed": True,
             "method": self.method,
             "circumvents": [{"obstacle": c.obstacle, "dimension": c.dimension,
                              "side": c.side, "start": c.start, "end": c.end,
@@ -132,5 +144,52 @@ class Design:
                                for m in self.certificate.margins],
             },
             "design_time_s": self.design_time_s,
+            **self._actuator_json(),
         }
 
+    def _actuator_json(self) -> dict[str, Any]:
+        """``input_bound`` and the proved ``input_peak`` (with where each peak is), for a
+        spec with ``[actuator]`` only: without it the document is as before."""
+        if self.tube.input_bound is None or self.input_proof is None:
+            return {}
+        proof, bound = self.input_proof, self.tube.input_bound
+        return {"input_bound": list(bound),
+                "input_peak": {"peak": list(proof.peak), "time": list(proof.time),
+                               "horizon": proof.horizon, "margin": proof.margin(bound)}}
+
+
+def require_design(value: object, function: str, parameter: str = "design") -> Design:
+    """``value``, checked to be a :class:`Design`: the front door's functions take the
+    design object itself, which carries its spec, so that a tube cannot be paired with
+    another spec's name, obstacles or plant.
+
+    Parameters
+    ----------
+    value : object
+        What the caller passed as ``parameter``.
+    function : str
+        The public function's name, for the message (``"simulate"``).
+    parameter : str
+        The parameter's name, for the message.
+
+    Returns
+    -------
+    Design
+        ``value``.
+
+    Raises
+    ------
+    TypeError
+        ``value`` is not a ``Design`` (a ``TubeDesign``, a ``Spec``, ...); the message
+        names the parameter and says to call ``design_tube``.
+    """
+    if isinstance(value, Design):
+        return value
+    kind = type(value).__name__
+    if isinstance(value, TubeDesign):
+        hint = ("this is design.tube; pass the Design that stt_codegen.design_tube(spec) "
+                "returned, which carries its spec")
+    else:
+        hint = "call stt_codegen.design_tube(spec) and pass the Design it returns"
+    raise TypeError(f"{function}(): parameter {parameter!r} must be a Design, not {kind}; "
+                    f"{hint}")

@@ -29,6 +29,7 @@ from ..errors import DesignError
 from ..spec.loader import Spec
 from ..tube.parameters import Circumvent, TubeDesign, paper_segments
 from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, certify_tube
+from .actuator import design_within_bound
 from .failures import FailureKind, property_kind
 from .gain import derived_gain
 from .plant_check import plant_failure
@@ -246,25 +247,61 @@ def design_tube(spec: Spec) -> Design:
     Parameters
     ----------
     spec : Spec
+        From :func:`stt_codegen.load_spec` or :meth:`stt_codegen.Spec.from_dict`.
 
     Returns
     -------
     Design
         The tube with its gain (the spec's ``controller.gain``, or
         :func:`~stt_codegen.design.gain.derived_gain` at the certified narrowest width),
-        the method used, its check and certificate (every ``t >= 0``) and the design's
-        wall time in seconds.
+        the method used, its check and certificate (every ``t >= 0``), the design's
+        wall time in seconds, and ``spec``. :func:`stt_codegen.generate`,
+        :func:`stt_codegen.simulate`, :func:`stt_codegen.verify` and the plots take it
+        whole.
+
+    With ``[actuator]`` (``spec.input_bound``), the tube is accepted only when law (13) is
+    proved to stay within the bound along it, slowed where it must be, or refused
+    (:func:`~stt_codegen.design.actuator.design_within_bound`).
 
     Raises
     ------
+    TypeError
+        ``spec`` is not a :class:`~stt_codegen.spec.loader.Spec` (a dict or a file name:
+        load it first).
     DesignError
         The spec's plant violates Assumption 2 (:mod:`~stt_codegen.design.plant_check`),
         or no tube of the allowed methods passes :func:`check_tube`; the message gives
         the reason (for via points: where the free passage is too narrow, or what walls
         off the start or the target), ``kind`` what failed
         (:class:`~stt_codegen.design.failures.FailureKind`) and ``tried`` the best
-        rejected tube (``None`` where none was built).
+        rejected tube (``None`` where none was built). With ``[actuator]``: no design
+        within ``t_c`` keeps the bound (kind ``INPUT_BOUND``; the message names the
+        ``prescribed_time`` that works).
+
+    See Also
+    --------
+    stt_codegen.load_spec, stt_codegen.Spec.from_dict : the spec.
+    stt_codegen.generate : the standalone controller of the design.
+    stt_codegen.simulate : the design in closed loop.
+    stt_codegen.verify : the paper's lemmas and the certificate, checked again.
+    stt_codegen.plot_design : a figure of the certified tube.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    >>> design.method, design.certificate.passed, design.spec.name
+    ('paper', True, 'omnirobot-s1')
+    >>> [(c.obstacle, c.side) for c in design.tube.circumvents]   # obstacle 0: its upper side
+    [(0, 'upper')]
     """
+    if not isinstance(spec, Spec):
+        hint = ("; for a dict use Spec.from_dict" if isinstance(spec, dict)
+                else "; load it with load_spec" if isinstance(spec, str) else "")
+        raise TypeError(f"design_tube(): parameter 'spec' must be a Spec, not "
+                        f"{type(spec).__name__}{hint}")
+    if spec.input_bound is not None:      # [actuator]: design/actuator.py
+        return design_within_bound(spec, design_tube)
     started = time.perf_counter()
     reason = plant_failure(spec)
     if reason:

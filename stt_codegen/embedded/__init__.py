@@ -4,7 +4,7 @@ Public API: :func:`build_elf`, :func:`run_qemu`, :func:`measure`, the result
 types :class:`BuildResult`, :class:`RunResult`, :class:`Footprint`, and
 :class:`MissingTool` (a tool is not installed; names its Debian package);
 :func:`run_embedded` (the ``embedded`` subcommand's pipeline; its arguments are in
-:mod:`.cli`).
+:mod:`stt_codegen.cli.embedded`).
 """
 
 from stt_codegen.embedded.footprint import Footprint, measure

@@ -1,6 +1,6 @@
 """``stt-codegen embedded SPEC``: the single-precision controller on an emulated Cortex-M4F.
 
-Pipeline (:func:`run_embedded`): design the tube, generate the single-precision C
+Pipeline (:func:`run_embedded`, for a design): generate the single-precision C
 (``generate_files(..., Options(("c",), "single"))``), then build for the Cortex-M4F
 (``-mcpu=cortex-m4 -mfpu=fpv4-sp-d16 -mfloat-abi=hard``, newlib, ``-O2``) and run under
 ``qemu-system-arm -machine mps2-an386`` with semihosting:
@@ -12,7 +12,7 @@ Pipeline (:func:`run_embedded`): design the tube, generate the single-precision 
    vectors (normwise), and ``error_to_bound`` the largest ``|error| / bound`` of
    :mod:`stt_codegen.codegen.tolerance` (single) for ``u``, ``alpha_next``, the tube;
 3. the closed-loop program (:func:`~stt_codegen.embedded.programs.closed_loop_source`),
-   compared with the host simulation ``simulate(spec, design, backend="c")`` (double
+   compared with the host simulation ``simulate(design, backend="c")`` (double
    controller, same plant and disturbance): ``max_state_deviation``;
 4. the replay program at the controller inputs the closed loop met at a few steps,
    each step a measured region: ``instructions_per_step`` (exact count of emulated
@@ -42,8 +42,9 @@ from ..tube import reference as R
 from ..codegen import tolerance as T
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
+from ..design.result import Design, require_design
 from ..errors import ToolchainError
-from ..spec.loader import Spec
+from ..runtime.plants import check_seed
 from ..tube.parameters import TubeDesign
 from . import board
 from .footprint import elf_stack_bound, linked_sizes, measure
@@ -75,7 +76,7 @@ def compare_outputs(design: TubeDesign, x, t, dt, alpha, out) -> dict:
     single-precision bound, per output), ``status_mismatches``.
     """
     x, alpha = np.atleast_2d(x), np.atleast_2d(alpha)
-    u, a_next, inside = R.controller_step(design, x, t, dt, alpha)
+    u, a_next, status = R.controller_status(design, x, t, dt, alpha)
     g_l, g_u, _, _ = R.adaptive_tube(design, t, alpha)
     unit = T.UNIT_SINGLE
     tol_u = T.u_bound(design, x, alpha, g_l, g_u, u, unit)
@@ -83,7 +84,6 @@ def compare_outputs(design: TubeDesign, x, t, dt, alpha, out) -> dict:
     tol_g = np.broadcast_to(T.gamma_bound(design, alpha, unit), g_l.shape)
     du = np.abs(out.u - u)
     norm = np.maximum(np.max(np.abs(u), axis=1), np.finfo(float).tiny)
-    status = np.where(inside == 1.0, 0, 1)
     return {
         "max_rel_error_u": float(np.max(np.max(du, axis=1) / norm)),
         "max_abs_error_u": float(du.max()),
@@ -97,22 +97,25 @@ def compare_outputs(design: TubeDesign, x, t, dt, alpha, out) -> dict:
     }
 
 
-def run_embedded(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
+def run_embedded(design: Design, out_dir: Path | None = None, *,
                  seed: int = 0, count_fractions=COUNT_FRACTIONS, compare_host: bool = True,
                  timeout: float = 600.0) -> dict:
-    """Build, run and measure the single-precision controller of ``spec`` on QEMU.
+    """Build, run and measure the single-precision controller of a design on QEMU.
 
     Parameters
     ----------
-    spec, design
+    design : Design
+        From :func:`stt_codegen.design_tube` (its spec gives the name, the plant and the
+        closed loop's task).
     out_dir : Path, optional
         Build folder (generated C, programs, objects, ELFs); a temporary one by default.
     seed : int
-        Disturbance seed of the closed loop (and of the host simulation compared with it).
+        Disturbance seed of the closed loop (and of the host simulation compared with it),
+        in ``[0, 2**32)``.
     count_fractions : sequence of float
         Times (fractions of ``t_c``) of the steps whose instructions are counted.
     compare_host : bool
-        Also run ``simulate(spec, design, backend="c")`` and report the deviation.
+        Also run ``simulate(design, backend="c", seed=seed)`` and report the deviation.
     timeout : float
         Seconds per QEMU run.
 
@@ -124,18 +127,25 @@ def run_embedded(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
 
     Raises
     ------
+    TypeError
+        ``design`` is not a :class:`~stt_codegen.design.result.Design`.
+    SpecError
+        ``seed`` is not an integer in ``[0, 2**32)`` (field ``seed``).
     ToolsMissing
         A tool is not installed (the message names the Debian packages).
     ToolchainError
         A build or run failed.
     """
+    design = require_design(design, "run_embedded")
+    spec, tube = design.spec, design.tube
+    seed = check_seed(seed)
     message = missing_message()
     if message:
         raise ToolsMissing(message)
     out = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="stt-embedded-"))
     gen = out / "generated"
     gen.mkdir(parents=True, exist_ok=True)
-    files = generate_files(spec, design, Options(("c",), "single"))
+    files = generate_files(spec, tube, Options(("c",), "single"))
     for name, data in files.items():
         (gen / name).write_bytes(data)
     prefix = spec.c_name
@@ -159,18 +169,18 @@ def run_embedded(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
     vec = _vectors(gen / f"{prefix}_vectors.json")
     rp_dir = out / "replay"
     rp_dir.mkdir(exist_ok=True)
-    (rp_dir / "vectors.c").write_text(replay_source(spec, design, *vec, what="test vectors"))
+    (rp_dir / "vectors.c").write_text(replay_source(spec, tube, *vec, what="test vectors"))
     rp = build_elf([lib, rp_dir / "vectors.c"], [gen], rp_dir / "build", name="vectors")
     rp_out = parse_replay(run(rp.elf).stdout, n)
-    errors = compare_outputs(design, *vec, rp_out)
+    errors = compare_outputs(tube, *vec, rp_out)
 
     # 3. the closed loop
-    steps = steps_of(spec, design)
+    steps = steps_of(spec, tube)
     replay_steps = sorted({min(steps - 1, int(round(f * steps))) for f in count_fractions})
     cl_dir = out / "closed_loop"
     cl_dir.mkdir(exist_ok=True)
     (cl_dir / f"{prefix}_closed_loop.c").write_text(
-        closed_loop_source(spec, design, seed=seed, replay=replay_steps))
+        closed_loop_source(spec, tube, seed=seed, replay=replay_steps))
     cl = build_elf([lib, cl_dir / f"{prefix}_closed_loop.c"], [gen], cl_dir / "build",
                    name="closed_loop")
     cl_run = run(cl.elf)
@@ -193,8 +203,8 @@ def run_embedded(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
     t_r = np.array([loop.replay_inputs[k][0] for k in ks])
     a_r = np.array([loop.replay_inputs[k][1] for k in ks])
     x_r = np.array([loop.replay_inputs[k][2] for k in ks])
-    dt_r = np.full(len(ks), np.float32(1.0 / design.rate_hz))
-    (cl_dir / "steps.c").write_text(replay_source(spec, design, x_r, t_r, dt_r, a_r,
+    dt_r = np.full(len(ks), np.float32(1.0 / tube.rate_hz))
+    (cl_dir / "steps.c").write_text(replay_source(spec, tube, x_r, t_r, dt_r, a_r,
                                                   what="closed-loop inputs"))
     cnt = build_elf([lib, cl_dir / "steps.c"], [gen], cl_dir / "count", name="steps",
                     defines={"STT_MEASURE": None})
@@ -239,7 +249,7 @@ def run_embedded(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
     }
     if compare_host:
         from ..runtime.simulate import simulate
-        host = simulate(spec, design, backend="c", seed=seed)
+        host = simulate(design, backend="c", seed=seed)
         tr = host.trajectory
         dev = max(float(np.max(np.abs(x - tr.x[k]))) for k, x in loop.states.items())
         report["host_satisfied"] = host.satisfied

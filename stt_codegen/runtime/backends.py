@@ -14,9 +14,11 @@ import numpy as np
 
 from ..tube import reference
 from ..errors import SpecError
-from ..tube.parameters import STATUS_INVALID_INPUT, STATUS_OK, STATUS_OUTSIDE_TUBE, TubeDesign
+from ..tube.parameters import (STATUS_INPUT_CLAMPED, STATUS_INVALID_INPUT, STATUS_OK,
+                               STATUS_OUTSIDE_TUBE, TubeDesign)
 
-__all__ = ["STATUS_INVALID_INPUT", "STATUS_OK", "STATUS_OUTSIDE_TUBE", "Controller",
+__all__ = ["STATUS_INPUT_CLAMPED", "STATUS_INVALID_INPUT", "STATUS_OK", "STATUS_OUTSIDE_TUBE",
+           "Controller",
            "backend_names", "make_controller", "register_backend"]
 
 
@@ -31,7 +33,7 @@ class Controller(Protocol):
 
 
 class ReferenceController:
-    """The numpy reference (:func:`stt_codegen.tube.reference.controller_step`)."""
+    """The numpy reference (:func:`stt_codegen.tube.reference.controller_status`)."""
 
     name = "reference"
 
@@ -39,8 +41,8 @@ class ReferenceController:
         self.design = design
 
     def step(self, x, t, dt, alpha):
-        u, alpha_next, inside = reference.controller_step(self.design, x, t, dt, alpha)
-        return u[0], alpha_next[0], STATUS_OK if inside[0] else STATUS_OUTSIDE_TUBE
+        u, alpha_next, status = reference.controller_status(self.design, x, t, dt, alpha)
+        return u[0], alpha_next[0], int(status[0])
 
 
 class CasadiController:
@@ -53,9 +55,11 @@ class CasadiController:
         self.function = build_model(design)["controller_step"]
 
     def step(self, x, t, dt, alpha):
-        u, alpha_next, inside = self.function(x, t, dt, alpha)
-        return (np.array(u).ravel(), np.array(alpha_next).ravel(),
-                STATUS_OK if float(inside) else STATUS_OUTSIDE_TUBE)
+        # a design with an actuator bound has a fourth output, within_bound
+        u, alpha_next, inside, *within = self.function(x, t, dt, alpha)
+        status = (STATUS_OUTSIDE_TUBE if not float(inside) else
+                  STATUS_INPUT_CLAMPED if within and not float(within[0]) else STATUS_OK)
+        return np.array(u).ravel(), np.array(alpha_next).ravel(), status
 
 
 def _generated_c(design: TubeDesign) -> Controller:

@@ -9,6 +9,8 @@ by the emitter (the same Functions are printed to C for the embedded closed loop
 
 from __future__ import annotations
 
+import operator
+
 import control as ct
 import numpy as np
 
@@ -20,6 +22,29 @@ from .dynamics import linear_rhs, plant_rhs
 
 #: Number of sinusoids summed in each disturbance component.
 DISTURBANCE_TERMS = 3
+
+#: Disturbance seeds are integers in ``[0, SEED_LIMIT)``: 32 bits, the range numpy's legacy
+#: ``RandomState`` accepts too, so a seed can be passed to any generator.
+SEED_LIMIT = 2**32
+
+
+def check_seed(seed: object) -> int:
+    """``seed`` as an ``int``, if it is a disturbance seed: an integer (Python or numpy) in
+    ``[0, 2**32)``.
+
+    Raises
+    ------
+    SpecError
+        Field ``seed``: not an integer (a float, a bool, a string...), negative, or too
+        large.
+    """
+    try:
+        value = None if isinstance(seed, bool) else operator.index(seed)
+    except TypeError:
+        value = None
+    if value is None or not 0 <= value < SEED_LIMIT:
+        raise SpecError("seed", f"must be an integer in [0, 2**32), got {seed!r}")
+    return value
 
 
 class Disturbance:
@@ -35,11 +60,16 @@ class Disturbance:
     amplitude : float
         ``A >= 0``, the bound on every ``|w_i|``, state units per second.
     seed : int
-        Seed of ``numpy.random.default_rng``.
+        Seed of ``numpy.random.default_rng``, in ``[0, 2**32)`` (:func:`check_seed`).
+
+    Raises
+    ------
+    SpecError
+        Field ``seed``: not an integer in ``[0, 2**32)``.
     """
 
     def __init__(self, dimension: int, amplitude: float, seed: int = 0) -> None:
-        rng = np.random.default_rng(seed)
+        rng = np.random.default_rng(check_seed(seed))
         weights = rng.uniform(0.2, 1.0, (dimension, DISTURBANCE_TERMS))
         self.amplitude = float(amplitude)
         self.weights = weights / weights.sum(axis=1, keepdims=True)

@@ -16,10 +16,11 @@ import numpy as np
 
 import control as ct
 
-from .backends import STATUS_OK, make_controller
+from .backends import STATUS_INPUT_CLAMPED, STATUS_OK, make_controller
+from ..design.result import Design, require_design
 from ..design.samples import check_step_budget
 from ..errors import SpecError
-from .plants import make_plant
+from .plants import check_seed, make_plant
 from ..spec.loader import Spec
 from ..tube.parameters import TubeDesign
 
@@ -60,11 +61,19 @@ class SimulationResult:
         (distance to the nearest facet's plane). ``None`` without obstacles.
     left_state_space : bool
     stayed_in_tube : bool
-        Every controller step on ``[0, horizon]`` reported the state inside the tube.
+        Every controller step on ``[0, horizon]`` reported the state inside the tube
+        (``STATUS_OK``, or ``STATUS_INPUT_CLAMPED``: inside, ``u`` clamped).
     max_abs_u : list of float
-        Per input, over the run.
+        Peak ``|u_i|`` per input over the run, input units.
     steps : int
         Controller steps taken.
+    control_effort : float
+        ``integral of |u(t)|^2 dt`` over ``[0, horizon]`` (Euclidean norm; ``u`` held
+        between samples, so exactly ``sum_k |u_k|^2 dt`` over the ``steps`` hold
+        intervals), input units squared times seconds.
+    clamped_steps : int
+        Steps whose status was ``STATUS_INPUT_CLAMPED`` (the actuator clamp acted; only a
+        design with ``[actuator]`` has it).
     """
 
     spec: str
@@ -79,6 +88,8 @@ class SimulationResult:
     stayed_in_tube: bool
     max_abs_u: list[float]
     steps: int
+    control_effort: float = 0.0
+    clamped_steps: int = 0
     trajectory: Trajectory | None = field(default=None, repr=False)
 
     def to_json(self) -> dict:
@@ -86,6 +97,18 @@ class SimulationResult:
         data = asdict(self)
         data.pop("trajectory")
         return data
+
+
+def _seconds(horizon: object) -> float:
+    """``horizon`` as a positive, finite float (a Python or numpy number)."""
+    try:
+        value = float(horizon)
+    except (TypeError, ValueError):
+        raise SpecError("horizon", f"must be a positive number of seconds, got {horizon!r}") \
+            from None
+    if not math.isfinite(value) or value <= 0:
+        raise SpecError("horizon", f"must be a positive number of seconds, got {value!r}")
+    return value
 
 
 def _rk4(rhs, t: float, x: np.ndarray, u: np.ndarray, h: float) -> np.ndarray:
@@ -96,33 +119,33 @@ def _rk4(rhs, t: float, x: np.ndarray, u: np.ndarray, h: float) -> np.ndarray:
     return x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
-def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
-             horizon: float | None = None, seed: int = 0,
-             plant: "ct.NonlinearIOSystem | None" = None) -> SimulationResult:
-    """Run the sampled controller of ``backend`` against the spec's plant; judge Definition 2.1.
+def simulate(design: Design, backend: str = "reference", horizon: float | None = None,
+             seed: int = 0, plant: ct.NonlinearIOSystem | None = None) -> SimulationResult:
+    """Run the sampled controller of a design against its spec's plant; judge Definition 2.1.
 
     At each sampling instant ``t_k = k / rate_hz`` the controller reads ``x(t_k)`` and
-    computes ``u_k`` by law (13) and the next ``alpha`` by the implicit step of the
-    adaptive law (11); ``u_k`` is held until ``t_{k+1}`` while the plant (eq. (14) or
-    ``x_dot = u + w``, with the spec's seeded, bounded disturbance ``w``) is integrated by
-    Runge-Kutta. The run starts at ``x(0)`` (``initial.state``) with ``alpha = 0``.
+    computes ``u_k`` by law (13), ``u = -k xi(x, t) epsilon(x, t)``, and the next
+    ``alpha`` by the implicit step of the adaptive law (11); ``u_k`` is held until
+    ``t_{k+1}`` while the plant (eq. (14), ``x_dot = u + w`` or the spec's linear plant,
+    with the spec's seeded, bounded disturbance ``w``) is integrated by Runge-Kutta. The
+    run starts at ``x(0)`` (``initial.state``) with ``alpha = 0``.
 
     Parameters
     ----------
-    spec : Spec
-        The task: sets, ``t_c``, plant and disturbance bound.
-    design : TubeDesign
-        From :func:`stt_codegen.design_tube`.
+    design : Design
+        From :func:`stt_codegen.design_tube`: the tube and gain, and (``design.spec``) the
+        task: sets, ``t_c``, plant and disturbance bound.
     backend : str, optional
         Implementation of the controller step: ``"reference"`` (the numpy oracle, default),
         ``"casadi"`` (the CasADi model), ``"c"`` (the generated C, compiled with the
         system's C compiler) or ``"python"`` (the generated Python); see
         :func:`stt_codegen.runtime.backends.backend_names`.
     horizon : float, optional
-        Simulated time, seconds; default ``t_c``. Definition 2.1 is judged on
-        ``[0, min(horizon, t_c)]``; a horizon shorter than ``t_c`` cannot satisfy it.
+        Simulated time, seconds (a Python or numpy number); default ``t_c``.
+        Definition 2.1 is judged on ``[0, min(horizon, t_c)]``; a horizon shorter than
+        ``t_c`` cannot satisfy it.
     seed : int, optional
-        Seed of the disturbance ``w``.
+        Seed of the disturbance ``w``: an integer (Python or numpy) in ``[0, 2**32)``.
     plant : control.NonlinearIOSystem, optional
         The plant to control instead of the spec's ``[plant]`` (``n`` states, inputs and
         outputs, the state as output); it must include its own disturbance.
@@ -132,23 +155,63 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
     SimulationResult
         ``satisfied`` (reach the target by ``t_c``, avoid every obstacle, stay in the
         state space), the reach time (s), the clearance (state units), ``max |u|`` per
-        input, and ``trajectory``: ``t`` (N,), ``x`` (N, n), ``u`` (N, n), ``alpha``
+        input, the control effort ``integral |u|^2 dt``, the steps the actuator clamp
+        acted, and ``trajectory``: ``t`` (N,), ``x`` (N, n), ``u`` (N, n), ``alpha``
         (N, 2n), ``status`` (N,), with ``N = ceil(horizon * rate_hz) + 1``.
 
     Raises
     ------
+    TypeError
+        ``design`` is not a :class:`~stt_codegen.design.result.Design` (a ``TubeDesign``
+        or a ``Spec``, say): call :func:`stt_codegen.design_tube` first.
     SpecError
-        Unknown backend (field ``backend``), a non-positive horizon (``horizon``), or a run
-        of more than :data:`~stt_codegen.design.samples.STEP_BUDGET` steps.
+        Unknown backend (field ``backend``), a horizon that is not a positive number of
+        seconds (``horizon``), a seed that is not an integer in ``[0, 2**32)``
+        (``seed``), or a run of more than
+        :data:`~stt_codegen.design.samples.STEP_BUDGET` steps.
     ToolchainError
         Backend ``"c"``: no C compiler, or it failed.
+
+    See Also
+    --------
+    stt_codegen.design_tube : the design to run.
+    stt_codegen.plot_run : a figure of the run.
+    stt_codegen.verify : the proof that the sampled loop stays in the tube.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    >>> result = stt.simulate(design, backend="casadi")
+    >>> result.satisfied, result.reach_time < design.spec.prescribed_time
+    (True, True)
+    >>> result.trajectory.x.shape                # 9 s at 1 kHz, states x1, x2, x3
+    (9001, 3)
+    >>> stt.simulate(design, backend="casadi", horizon=2.0).satisfied   # before t_c
+    False
     """
+    design = require_design(design, "simulate")
+    return run_closed_loop(design.spec, design.tube, backend=backend, horizon=horizon,
+                           seed=seed, plant=plant)
+
+
+def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
+                    horizon: float | None = None, seed: int = 0,
+                    plant: ct.NonlinearIOSystem | None = None) -> SimulationResult:
+    """The closed loop of :func:`simulate` for a spec and a tube given apart.
+
+    For tubes that are not a design of their spec: the benchmarks' tracker runs on the
+    spec's base parameters, the benchmark passes tubes between processes, and tests run
+    altered tubes (another gain). Not on the front door: there, :func:`simulate` takes a
+    :class:`~stt_codegen.design.result.Design`, which pairs the tube with its spec.
+    Parameters, result and errors are those of :func:`simulate`, with the spec and the
+    tube (:class:`~stt_codegen.tube.parameters.TubeDesign`) in place of the design.
+    """
+    seed = check_seed(seed)
     t_c = spec.prescribed_time
-    horizon = t_c if horizon is None else float(horizon)
-    if not math.isfinite(horizon) or horizon <= 0:
-        raise SpecError("horizon", f"must be a positive number of seconds, got {horizon!r}")
-    check_step_budget(int(math.ceil(horizon * design.rate_hz - 1e-9)), horizon, design.rate_hz)
-    controller = make_controller(backend, design)
+    horizon = t_c if horizon is None else _seconds(horizon)
+    check_step_budget(int(math.ceil(horizon * tube.rate_hz - 1e-9)), horizon, tube.rate_hz)
+    controller = make_controller(backend, tube)
     if plant is None:
         plant = make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed,
                            spec.linear_plant)
@@ -157,8 +220,8 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
         return plant.dynamics(t, x, u)
 
     n = spec.dimension
-    dt = 1.0 / design.rate_hz
-    steps = int(math.ceil(horizon * design.rate_hz - 1e-9))
+    dt = 1.0 / tube.rate_hz
+    steps = int(math.ceil(horizon * tube.rate_hz - 1e-9))
     lo, hi = np.array(spec.state_space.lower), np.array(spec.state_space.upper)
     t_lo, t_hi = np.array(spec.target_set.lower), np.array(spec.target_set.upper)
 
@@ -206,6 +269,8 @@ def simulate(spec: Spec, design: TubeDesign, backend: str = "reference",
         spec=spec.name, backend=backend, satisfied=satisfied, reached=reached,
         reach_time=reach_time, prescribed_time=t_c, collision=collision,
         min_obstacle_clearance=min_clear, left_state_space=left,
-        stayed_in_tube=bool(np.all(status == STATUS_OK)),
+        stayed_in_tube=bool(np.all((status == STATUS_OK) | (status == STATUS_INPUT_CLAMPED))),
         max_abs_u=[float(v) for v in np.abs(us).max(axis=0)], steps=steps,
+        control_effort=float(np.sum(us[:steps] ** 2) * dt),
+        clamped_steps=int(np.sum(status == STATUS_INPUT_CLAMPED)),
         trajectory=Trajectory(ts, xs, us, alphas, status))

@@ -17,6 +17,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import os
 import re
 import tomllib
 from collections.abc import Mapping
@@ -26,8 +27,8 @@ from typing import Any
 
 from ..cases import bundled_cases, bundled_spec_bytes
 from ..errors import SpecError
-from .plants import MODEL_KEYS, dimension_mismatch
-from .schema import (NAME_REGEX, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
+from .plants import MODEL_KEYS, PLANTS, dimension_mismatch
+from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
                      PlantTable, PolytopeObstacle, check_document, value_kind)
 
 NAME_PATTERN = re.compile(NAME_REGEX)
@@ -263,6 +264,10 @@ class Spec:
         The matrices of the ``linear`` model (``None`` for the other models).
     assumptions : Assumptions
         The ``[assumptions]`` section, defaults filled in.
+    input_bound : tuple of float or None
+        ``[actuator] input_bound``: the largest ``|u_i|`` law (13) may ask of each input,
+        in input units, one per input of the plant model (``None``: no ``[actuator]``,
+        no limit).
     source_hash : str
         SHA-256 of the spec file's bytes.
     target_half_width_given : bool
@@ -288,6 +293,7 @@ class Spec:
     disturbance_amplitude: float
     linear_plant: LinearPlant | None = None
     assumptions: Assumptions = Assumptions()
+    input_bound: tuple[float, ...] | None = None
     source_hash: str = field(default="", compare=False)
     target_half_width_given: bool = True
 
@@ -328,6 +334,29 @@ class Spec:
         ------
         SpecError
             As :func:`load_spec`: the field and the reason.
+
+        See Also
+        --------
+        load_spec : the same from a bundled case name or a TOML file.
+        stt_codegen.design_tube : the next step, the tube of the spec.
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> import stt_codegen as stt
+        >>> task = {
+        ...     "name": "corridor", "prescribed_time": 8.0,
+        ...     "state_space": {"lower": [0.0, 0.0], "upper": [5.0, 5.0]},
+        ...     "initial": {"lower": [0.0, 0.0], "upper": [0.5, 0.5]},
+        ...     "target": {"lower": np.array([4.5, 4.5]), "upper": np.array([5.0, 5.0])},
+        ...     "obstacles": [{"lower": [2.0, 2.0], "upper": [3.0, 3.0]}]}
+        >>> spec = stt.Spec.from_dict(task)
+        >>> spec.dimension, spec.target_set.lower
+        (2, (4.5, 4.5))
+        >>> stt.Spec.from_dict({**task, "prescribed_time": -8.0})
+        Traceback (most recent call last):
+        ...
+        stt_codegen.errors.SpecError: prescribed_time: must be positive, got -8.0
         """
         if not isinstance(data, Mapping):
             raise SpecError("", f"a spec is a table (dict), got {value_kind(data)}")
@@ -364,10 +393,33 @@ def load_spec(spec: str | Path) -> Spec:
 
     Raises
     ------
+    TypeError
+        ``spec`` is neither a string nor a path (a dict: use :meth:`Spec.from_dict`).
     SpecError
         The file does not exist or cannot be read, is not valid TOML, or a field
         is missing, unknown, of the wrong type or fails a rule of the schema.
+
+    See Also
+    --------
+    Spec.from_dict : the same from a dictionary.
+    stt_codegen.bundled_cases : the bundled case names.
+    stt_codegen.design_tube : the next step, the tube of the spec.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> spec = stt.load_spec("omnirobot-s1")         # or a path: stt.load_spec("task.toml")
+    >>> spec.name, spec.dimension, spec.prescribed_time
+    ('omnirobot-s1', 3, 9.0)
+    >>> stt.load_spec("no-such-case")                          # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    stt_codegen.errors.SpecError: no bundled case and no file named 'no-such-case' (bundled: ...)
     """
+    if not isinstance(spec, (str, os.PathLike)):
+        hint = "; for a dict use Spec.from_dict" if isinstance(spec, Mapping) else ""
+        raise TypeError(f"load_spec(): parameter 'spec' must be a bundled case name or a "
+                        f"path, not {type(spec).__name__}{hint}")
     text = str(spec)
     if text in bundled_cases() and not Path(text).exists():
         data = bundled_spec_bytes(text)
@@ -464,6 +516,7 @@ def _validate(raw: dict) -> Spec:
                 plant_model=model, disturbance_amplitude=amplitude,
                 linear_plant=_linear_plant(doc.plant, n),
                 assumptions=_assumptions(doc.assumptions, n, amplitude),
+                input_bound=_input_bound(doc.actuator, model, n),
                 target_half_width_given=doc.target.half_width is not None)
 
 
@@ -549,6 +602,20 @@ def _assumptions(table: AssumptionsTable, n: int, amplitude: float) -> Assumptio
     return Assumptions((g_min, g_max), skew, coupling, table.drift_bound, disturbance,
                        tuple(key for key in AssumptionsTable.model_fields
                              if key in table.model_fields_set))
+
+
+def _input_bound(table: ActuatorTable | None, model: str, n: int) -> tuple[float, ...] | None:
+    """``[actuator] input_bound``: one positive number per input of the plant model."""
+    if table is None:
+        return None
+    plant = PLANTS[model]
+    count = plant.input_count(n)
+    names = plant.input_names(n)
+    if len(table.input_bound) != count:
+        raise SpecError("actuator.input_bound",
+                        f"must have {count} entries (one per input of the {model} plant: "
+                        f"{', '.join(names)}), got {len(table.input_bound)}")
+    return tuple(float(v) for v in table.input_bound)
 
 
 def _dims(given: list[int] | None, name: str, m: int, n: int,

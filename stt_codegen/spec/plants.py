@@ -44,6 +44,10 @@ class PlantModel:
         """Number of inputs for ``n`` states."""
         return n if self.inputs is None else len(self.inputs)
 
+    def input_names(self, n: int) -> tuple[str, ...]:
+        """Names of the inputs for ``n`` states (``u1``, ``u2``, ... when the model has none)."""
+        return tuple(f"u{i + 1}" for i in range(n)) if self.inputs is None else self.inputs
+
 
 #: Every model, by ``plant.model`` name, in the schema's order.
 PLANTS: dict[str, PlantModel] = {p.name: p for p in (

@@ -184,6 +184,16 @@ class AssumptionsTable(_Table):
                                               "default sqrt(n) x plant.disturbance_amplitude")
 
 
+class ActuatorTable(_Table):
+    """The actuators' limits: law (13) must never ask an input for more than its bound."""
+
+    input_bound: Annotated[list[Positive], Field(min_length=1, max_length=MAX_DIMENSION)] = \
+        Field(description="largest |u_i| each input may be asked for, in input units (for "
+                          "the omnidirectional robot v1, v2 in m/s, omega in rad/s; for the "
+                          "other plants one per state, state units per second); positive; "
+                          "one entry per input")
+
+
 class SpecDocument(_Table):
     """One prescribed-time reach-avoid-stay task (Definition 2.1) and its design parameters.
 
@@ -206,6 +216,8 @@ class SpecDocument(_Table):
     controller: ControllerTable = ControllerTable()
     plant: PlantTable = PlantTable()
     assumptions: AssumptionsTable = AssumptionsTable()
+    actuator: ActuatorTable = _omitted("actuator limits; omitted: no limit (the design, the "
+                                       "generated code and verify ignore actuators)")
 
 
 #: The JSON Schema dialect of :func:`json_schema`: draft 7, which TOML language servers
@@ -221,7 +233,7 @@ def json_schema() -> dict[str, Any]:
 _TABLES: dict[str, type[_Table]] = {
     "state_space": BoxTable, "initial": InitialTable, "target": TargetTable,
     "tube": TubeTable, "controller": ControllerTable, "plant": PlantTable,
-    "assumptions": AssumptionsTable,
+    "assumptions": AssumptionsTable, "actuator": ActuatorTable,
     "box": BoxObstacle, "ball": BallObstacle, "polytope": PolytopeObstacle}
 
 

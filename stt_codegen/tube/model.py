@@ -325,9 +325,17 @@ def build_model(design: TubeDesign) -> TubeModel:
                                     ["t", "dt", "alpha"], ["alpha_next"])
 
     u, inside = controller_law(design, x, gamma_l, gamma_u)
-    fns["controller_step"] = ca.Function(
-        "controller_step", [x, t, dt, alpha], [u, alpha_next, inside],
-        ["x", "t", "dt", "alpha"], ["u", "alpha_next", "inside"])
+    if design.input_bound is None:
+        fns["controller_step"] = ca.Function(
+            "controller_step", [x, t, dt, alpha], [u, alpha_next, inside],
+            ["x", "t", "dt", "alpha"], ["u", "alpha_next", "inside"])
+    else:
+        # the actuator clamp after law (13): a fourth output, within_bound (1.0 when no
+        # entry of u was clamped)
+        u, within = P.saturate_expression(u, ca.DM(design.input_bound), n)
+        fns["controller_step"] = ca.Function(
+            "controller_step", [x, t, dt, alpha], [u, alpha_next, inside, within],
+            ["x", "t", "dt", "alpha"], ["u", "alpha_next", "inside", "within_bound"])
     return TubeModel(design, {name: fns[name] for name in FUNCTION_NAMES})
 
 

@@ -28,6 +28,10 @@ STATUS_OK = 0
 STATUS_OUTSIDE_TUBE = 1
 #: An input is outside the step's domain: ``u = 0``, ``alpha`` kept.
 STATUS_INVALID_INPUT = 2
+#: ``x`` is strictly inside the tube, but law (13) asked for more than the actuator bound
+#: (``[actuator] input_bound``) in some input: ``u`` was clamped to ``+-input_bound``.
+#: Only designs with an input bound return it; ``OUTSIDE_TUBE`` takes precedence.
+STATUS_INPUT_CLAMPED = 3
 
 LOWER = "lower"
 UPPER = "upper"
@@ -182,6 +186,11 @@ class TubeDesign:
         ``k`` of the control law (13).
     rate_hz : float
         Sampling rate of the deployed controller, Hz.
+    input_bound : tuple of float or None
+        ``[actuator] input_bound``, one per entry of ``u`` (input units): the deployed step
+        clamps ``u_i`` to ``[-input_bound_i, input_bound_i]`` and reports
+        ``STATUS_INPUT_CLAMPED`` when it did; ``None`` (default): no clamp, and the
+        generated code is that of a design without actuator limits.
     """
 
     name: str
@@ -197,10 +206,15 @@ class TubeDesign:
     mu: float
     gain: float
     rate_hz: float
+    input_bound: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         if not self.segments:
             raise ValueError("a tube design needs at least one reach segment")
+        if self.input_bound is not None and (
+                len(self.input_bound) != len(self.state_lower)
+                or not all(b > 0 for b in self.input_bound)):
+            raise ValueError("input_bound needs one positive entry per state dimension")
         for a, b in zip(self.segments, self.segments[1:]):
             if (b.start != a.end or b.lower_from != a.lower_to
                     or b.upper_from != a.upper_to):

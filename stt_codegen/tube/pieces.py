@@ -40,6 +40,9 @@ piece                  inputs                                       outputs
 ``newton_root_start``  alpha, psi, c, A                             a0
 ``newton_iteration``   a, alpha, psi, c, A                          a (one division)
 ``law``                x (n), gamma_L (n), gamma_U (n), gain        u (n), inside (law (13))
+``saturate``           u (n), bound (n)                             u clamped to +-bound,
+                                                                    within (designs with
+                                                                    ``[actuator]`` only)
 ``error_transform``    x (n), gamma_L (n), gamma_U (n)              e, epsilon, xi (section IV;
                                                                     for verify, not emitted)
 =====================  ===========================================  ==========================
@@ -381,6 +384,30 @@ def law_expression(x, gamma_l, gamma_u, gain, n: int) -> tuple:
     return -gain * xi * epsilon, inside
 
 
+def saturate_expression(u, bound, n: int) -> tuple:
+    """The actuator clamp: ``(u_c, within)`` (SX), ``u_c = min(max(u, -bound), bound)``
+    entry by entry and ``within = 1`` when no entry was moved (``-bound_i <= u_i <= bound_i``
+    for every ``i``, exact comparisons; a product of 0/1 values, exact), else 0.
+
+    For finite ``u`` the clamp is the projection on the box ``[-bound, bound]``: it moves
+    no entry inside the box, so where law (13) stays within the bound it is the identity.
+    The generated code checks ``u`` for finiteness before it is clamped.
+    """
+    within = 1.0
+    for i in range(n):
+        within = within * (u[i] >= -bound[i]) * (u[i] <= bound[i])
+    return ca.fmin(ca.fmax(u, -bound), bound), within
+
+
+@lru_cache(maxsize=None)
+def saturate(n: int) -> ca.Function:
+    """``saturate(u, bound) -> (u_c, within)``: :func:`saturate_expression`."""
+    u, bound = ca.SX.sym("u", n), ca.SX.sym("bound", n)
+    u_c, within = saturate_expression(u, bound, n)
+    return ca.Function("saturate", [u, bound], [u_c, within], ["u", "bound"],
+                       ["u_c", "within"])
+
+
 @lru_cache(maxsize=None)
 def error_transform(n: int) -> ca.Function:
     """``error_transform(x, gamma_L, gamma_U) -> (e, epsilon, xi)``: the expressions
@@ -403,12 +430,13 @@ def law(n: int) -> ca.Function:
 
 
 def deployed_pieces(n: int, profiles: tuple, single_bounds: bool = True,
-                    multi_bounds: bool = True) -> list:
+                    multi_bounds: bool = True, saturated: bool = False) -> list:
     """Every piece the generated code of a design of dimension ``n`` calls, in a fixed order.
 
     ``profiles``: the segment profiles it uses; ``single_bounds`` / ``multi_bounds``: whether
     some bound has exactly one / several circumvents (``bump`` is emitted with either, the
-    ``F_nu`` pieces only with several, ``fnu_single`` only with one).
+    ``F_nu`` pieces only with several, ``fnu_single`` only with one); ``saturated``: the
+    design has an actuator bound (``saturate`` is emitted last, only then).
     """
     init, add, finish, single = fnu_pieces()
     cand, cand_rates = candidates(n)
@@ -418,4 +446,4 @@ def deployed_pieces(n: int, profiles: tuple, single_bounds: bool = True,
     return [*(progress(p, False) for p in used), *(progress(p) for p in used),
             interpolate(n, False), interpolate(n),
             *circumvents, cand, cand_rates, *smooth_pieces(), conflict(n), alpha_rate(n),
-            later(), *newton_pieces(), law(n)]
+            later(), *newton_pieces(), law(n), *([saturate(n)] if saturated else [])]

@@ -18,7 +18,8 @@ import math
 
 import numpy as np
 
-from .parameters import E_MAX, GAMMA_D_MIN, LOWER, SMOOTHSTEP, TANH, ReachSegment, TubeDesign
+from .parameters import (E_MAX, GAMMA_D_MIN, LOWER, SMOOTHSTEP, STATUS_INPUT_CLAMPED, STATUS_OK,
+                         STATUS_OUTSIDE_TUBE, TANH, ReachSegment, TubeDesign)
 
 Array = np.ndarray
 
@@ -507,22 +508,9 @@ def alpha_step(design: TubeDesign, t, dt, alpha) -> Array:
     return implicit_alpha_root(alpha, psi, theta, dt[:, None], design.kappa)
 
 
-def controller_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, Array]:
-    """One step of the deployed controller: ``u`` at ``(x, t, alpha)`` and the next ``alpha``.
-
-    ``u`` follows law (13) with ``e`` clamped to ``[-E_MAX, E_MAX]`` and ``gamma_d``
-    floored at ``GAMMA_D_MIN``, so it is finite outside the tube too. ``inside`` is
-    ``gamma_L_i < x_i < gamma_U_i`` for every ``i``, two comparisons without rounding (the
-    rounded ``|2 x_i - gamma_s_i| < gamma_d_i`` reported points on the bounds and one ulp
-    outside as inside); an empty tube has no inside point.
-
-    Returns
-    -------
-    u : ndarray, shape (N, n)
-    alpha_next : ndarray, shape (N, 2n)
-    inside : ndarray, shape (N,)
-        1.0 where ``gamma_L_i < x_i < gamma_U_i`` for every ``i``, else 0.0.
-    """
+def law_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, Array]:
+    """:func:`controller_step` before the actuator clamp: law (13)'s ``u`` (with the clamps
+    of ``e`` and ``gamma_d``), shape (N, n), the next ``alpha`` (N, 2n) and ``inside`` (N,)."""
     t = _time(t)
     gamma_l, gamma_u, _, _ = adaptive_tube(design, t, alpha)
     x = _rows(x, t.size, design.dimension)
@@ -534,3 +522,68 @@ def controller_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, 
     epsilon = log((1.0 + e_c) / (1.0 - e_c))
     xi = 4.0 / (width * (1.0 - e_c**2))
     return -design.gain * xi * epsilon, alpha_step(design, t, dt, alpha), inside
+
+
+def saturate(design: TubeDesign, u) -> tuple[Array, Array]:
+    """The actuator clamp of ``[actuator] input_bound``: ``u`` limited to ``+-input_bound``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        Without an input bound the clamp is the identity.
+    u : array_like, shape (N, n)
+        Law (13)'s ``u``, input units.
+
+    Returns
+    -------
+    u_clamped : ndarray, shape (N, n)
+        Each entry moved to the nearest of ``[-input_bound_i, input_bound_i]``.
+    within : ndarray, shape (N,)
+        1.0 where no entry was moved (``|u_i| <= input_bound_i`` for every ``i``), else 0.0.
+    """
+    u = np.atleast_2d(np.asarray(u, dtype=float))
+    if design.input_bound is None:
+        return u, np.ones(u.shape[0])
+    bound = np.array(design.input_bound)
+    within = np.all(np.abs(u) <= bound, axis=1).astype(float)
+    return np.clip(u, -bound, bound), within
+
+
+def controller_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, Array]:
+    """One step of the deployed controller: ``u`` at ``(x, t, alpha)`` and the next ``alpha``.
+
+    ``u`` follows law (13) with ``e`` clamped to ``[-E_MAX, E_MAX]`` and ``gamma_d``
+    floored at ``GAMMA_D_MIN``, so it is finite outside the tube too, and, for a design
+    with an actuator bound, clamped to ``+-input_bound`` (:func:`saturate`). ``inside`` is
+    ``gamma_L_i < x_i < gamma_U_i`` for every ``i``, two comparisons without rounding (the
+    rounded ``|2 x_i - gamma_s_i| < gamma_d_i`` reported points on the bounds and one ulp
+    outside as inside); an empty tube has no inside point.
+
+    Returns
+    -------
+    u : ndarray, shape (N, n)
+    alpha_next : ndarray, shape (N, 2n)
+    inside : ndarray, shape (N,)
+        1.0 where ``gamma_L_i < x_i < gamma_U_i`` for every ``i``, else 0.0.
+    """
+    u, alpha_next, inside = law_step(design, x, t, dt, alpha)
+    return saturate(design, u)[0], alpha_next, inside
+
+
+def controller_status(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, Array]:
+    """:func:`controller_step` with the status code of the generated API instead of ``inside``.
+
+    Returns
+    -------
+    u : ndarray, shape (N, n)
+    alpha_next : ndarray, shape (N, 2n)
+    status : ndarray of int, shape (N,)
+        ``STATUS_OUTSIDE_TUBE`` where ``x`` is not strictly inside the tube, else
+        ``STATUS_INPUT_CLAMPED`` where the actuator clamp moved an entry of ``u``, else
+        ``STATUS_OK``.
+    """
+    u, alpha_next, inside = law_step(design, x, t, dt, alpha)
+    u_c, within = saturate(design, u)
+    status = np.where(inside == 0.0, STATUS_OUTSIDE_TUBE,
+                      np.where(within == 0.0, STATUS_INPUT_CLAMPED, STATUS_OK))
+    return u_c, alpha_next, status

@@ -20,12 +20,16 @@ modules:
   :mod:`stt_codegen.runtime.dynamics`);
 * :mod:`.adaptive` -- non-negativity and an explicit bound of the adaptive law (11);
 * :mod:`.sampled` -- the sampled closed loop for every plant of ``[assumptions]``;
+* :mod:`.actuator` -- the input bound of ``[actuator]`` from the sampled check's bound on
+  ``e`` (``sampled.input_bound``; registered as the design's input prover);
 * :mod:`.proofs` -- the design-independent proofs, cached on disk;
 * :mod:`.command` -- every check of one design, :func:`~.command.verify`.
 """
 
 import importlib
 from typing import Any
+
+from ..design.input_bound import register_input_prover
 
 #: Public name -> submodule that defines it; imported on first use (PEP 562), so importing
 #: this package costs nothing (``import stt_codegen`` imports it, see there).
@@ -44,6 +48,18 @@ _LAZY: dict[str, str] = {
                      "error_transform_checks", "outer_product_difference", "xi_diagonal",
                      "xi_outer_product"), "transform"),
 }
+
+
+def _prove_input_bound(tube: Any, spec: Any) -> Any:
+    """:func:`.actuator.prove_input_bound`, imported on first use."""
+    from .actuator import prove_input_bound
+    return prove_input_bound(tube, spec)
+
+
+# The design accepts a tube under [actuator] only with this proof (the sampled-data
+# check's bound on e, verify's), and cannot import verify, which builds on it: the
+# prover is registered here, when the package is loaded (``import stt_codegen`` loads it).
+register_input_prover(_prove_input_bound)
 
 
 def __getattr__(name: str) -> Any:

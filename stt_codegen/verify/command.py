@@ -1,4 +1,4 @@
-"""``stt-codegen verify``: every check of a spec's designed tube, with its evidence.
+"""Every check of a spec's designed tube, with its evidence (``stt-codegen verify``).
 
 Connects the symbolic checks of this package to a concrete design: the rate bounds of
 Lemma 3.3 for its tube and bumps, Assumption 2 for its plant, the adaptive-law bounds for
@@ -7,9 +7,6 @@ its ``psi``, and the continuous-time tube certificate (:mod:`stt_codegen.design.
 
 from __future__ import annotations
 
-import argparse
-import json
-import sys
 from dataclasses import replace
 from typing import Callable
 
@@ -21,9 +18,10 @@ from ..design.result import Design
 from ..design.samples import sample_tube
 from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
-from ..spec.loader import Spec, load_spec
+from ..spec.loader import Spec
 from ..spec.plants import PLANT_MODELS, dimension_mismatch
 from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
+from .actuator import input_bound_check, prove_input_bound
 from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_omnidirectional, assumption2_single_integrator
 from .check import Check, VerificationReport
@@ -86,8 +84,10 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         In order: Lemma 3.3, the error transform, the equality of each deployed piece with
         the paper's formula (``deployed.*``), Assumption 2 (and, for the linear
         plant, whether it meets ``[assumptions]``), the adaptive law (per component of
-        ``alpha``), the tube certificate, and the sampled closed loop
-        (:func:`~stt_codegen.verify.sampled.sampled_checks`).
+        ``alpha``), the tube certificate, the sampled closed loop
+        (:func:`~stt_codegen.verify.sampled.sampled_checks`) and, for a spec with
+        ``[actuator]``, ``sampled.input_bound``
+        (:func:`~stt_codegen.verify.actuator.input_bound_check`).
     """
     stage = progress if isinstance(progress, _Stages) else _Stages(progress, design=False)
     model = plant or spec.plant_model
@@ -172,20 +172,43 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     # step budget with a SpecError)
     stage("sampled loop")
     checks += sampled_checks(spec, design, sample_tube(design), tube_check.certificate)
+    if spec.input_bound is not None:
+        checks.append(input_bound_check(spec, prove_input_bound(design, spec)))
     return checks
+
+
+def spec_for_plant(spec: Spec, plant: str | None) -> Spec:
+    """The spec to design for when Assumption 2 is checked for ``plant``: ``spec`` with
+    ``plant`` as its plant model (``spec`` itself when ``plant`` is ``None``), so that the
+    design refuses a plant that violates the assumption.
+
+    Raises
+    ------
+    SpecError
+        Field ``plant``: not one of :data:`~stt_codegen.spec.plants.PLANT_MODELS`, or a
+        model that does not fit the spec's dimension.
+    """
+    if plant is None:
+        return spec
+    if plant not in PLANT_MODELS:
+        raise SpecError("plant", f"must be one of {', '.join(PLANT_MODELS)}")
+    mismatch = dimension_mismatch(plant, spec.dimension)
+    if mismatch:
+        raise SpecError("plant", mismatch)
+    return replace(spec, plant_model=plant)
 
 
 def verify_spec(spec: Spec, plant: str | None = None, *, cache: bool = True,
                 progress: Callable[[str], None] | None = None) -> list[Check]:
     """Design the tube of a spec and run :func:`verify_design`; a design failure is a FAIL.
 
-    With ``plant``, the tube is designed for that plant model instead of the spec's (the
-    design refuses a plant that violates Assumption 2).
+    With ``plant``, the tube is designed for that plant model instead of the spec's
+    (:func:`spec_for_plant`).
     """
     stage = _Stages(progress, design=True)
     stage("design")
     try:
-        design = design_tube(spec if plant is None else replace(spec, plant_model=plant))
+        design = design_tube(spec_for_plant(spec, plant))
     except DesignError as exc:
         return [Check("tube.design", False, str(exc))]
     return verify_design(spec, design.tube, plant, cache=cache, progress=stage)
@@ -216,9 +239,9 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
     design_or_spec : Design or Spec
         A :class:`~stt_codegen.design.result.Design` (from
         :func:`stt_codegen.design_tube`), checked against its own ``design.spec`` (its
-        tube is certified again here, not taken from ``design.certificate``); or a :class:`~stt_codegen.spec.loader.Spec`, designed
-        first: a spec with no design gives a report whose one check, ``tube.design``,
-        failed.
+        tube is certified again here, not taken from ``design.certificate``); or a
+        :class:`~stt_codegen.spec.loader.Spec`, designed first: a spec with no design
+        gives a report whose one check, ``tube.design``, failed.
     plant : str, optional
         Plant model for Assumption 2 (one of
         :data:`~stt_codegen.spec.loader.PLANT_MODELS`); default the spec's
@@ -254,14 +277,13 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
     Examples
     --------
     >>> import stt_codegen as stt
-    >>> from stt_codegen.verify.command import verify
     >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
-    >>> report = verify(design)
+    >>> report = stt.verify(design)
     >>> report.passed
     True
     >>> report["lemma3.3.reach.continuity"].passed
     True
-    >>> verify(stt.load_spec("omnirobot-s1")).passed       # designs it first
+    >>> stt.verify(stt.load_spec("omnirobot-s1")).passed       # designs it first
     True
     """
     if isinstance(design_or_spec, Design):
@@ -269,12 +291,11 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
     elif isinstance(design_or_spec, Spec):
         spec = design_or_spec
     else:
-        raise TypeError(f"verify takes a Design or a Spec, not {type(design_or_spec).__name__}"
-                        " (a Design carries its spec: verify(design))")
-    if plant is not None and plant not in PLANT_MODELS:
-        raise SpecError("plant", f"must be one of {', '.join(PLANT_MODELS)}")
-    if plant is not None and dimension_mismatch(plant, spec.dimension):
-        raise SpecError("plant", dimension_mismatch(plant, spec.dimension))
+        raise TypeError(f"verify(): parameter 'design_or_spec' must be a Design or a Spec, not "
+                        f"{type(design_or_spec).__name__}; pass the Design that "
+                        "stt_codegen.design_tube(spec) returned (it carries its spec), or the "
+                        "Spec")
+    spec_for_plant(spec, plant)     # a bad plant is refused before any work
     if isinstance(design_or_spec, Design):
         checks = verify_design(spec, design_or_spec.tube, plant, cache=cache,
                                progress=progress)
@@ -282,38 +303,3 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
         checks = verify_spec(spec, plant, cache=cache, progress=progress)
     return VerificationReport(spec.name, tuple(checks))
 
-
-def _terminal_progress() -> Callable[[str], None] | None:
-    """Progress on stderr when it is a terminal (one line, rewritten), else ``None``."""
-    if not sys.stderr.isatty():
-        return None
-
-    def show(message: str) -> None:
-        sys.stderr.write(f"\rverify: {message} ...\x1b[K")
-        sys.stderr.flush()
-    return show
-
-
-def _cmd_verify(args: argparse.Namespace) -> int:
-    progress = None if args.json else _terminal_progress()
-    try:
-        report = verify(load_spec(args.spec), plant=args.plant, progress=progress,
-                        cache=not args.no_cache)
-    finally:
-        if progress is not None:
-            sys.stderr.write("\r\x1b[K")
-            sys.stderr.flush()
-    print(json.dumps(report.to_json(), indent=2) if args.json else str(report))
-    return 0 if report.passed else 1
-
-
-def configure_verify(p: argparse.ArgumentParser) -> None:
-    """Arguments of ``stt-codegen verify``."""
-    p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
-    p.add_argument("--json", action="store_true", help="print a JSON list of checks")
-    p.add_argument("--plant", default=None, metavar="MODEL",
-                   help=f"plant for Assumption 2 ({', '.join(PLANT_MODELS)}; default: the spec's)")
-    p.add_argument("--no-cache", action="store_true",
-                   help="prove the spec-independent lemmas again instead of reading the "
-                        "proof cache (~/.cache/stt-codegen; see docs/verification.md)")
-    p.set_defaults(handler=_cmd_verify)

@@ -67,6 +67,10 @@ class SampledCheck:
         Empty when passed, else what fails, in numbers.
     data : dict
         Numbers for reports.
+    abs_e : ndarray or None, shape (K + 1, n)
+        When passed: the proved bound of ``|e_i(t_k)|`` at every sample of ``samples``
+        (read by :func:`stt_codegen.verify.actuator.sampled_error_bound` for the input
+        bound); ``None`` otherwise.
     """
 
     passed: bool
@@ -76,6 +80,7 @@ class SampledCheck:
     dimension: int
     reason: str
     data: dict = field(default_factory=dict)
+    abs_e: np.ndarray | None = field(default=None, compare=False, repr=False)
 
 
 def _phi(s: np.ndarray) -> np.ndarray:
@@ -164,9 +169,11 @@ def check_sampled(design: TubeDesign, samples: TubeSamples, assumptions: Assumpt
     e = ((x0 - centre[0]) / half[0]).tolist()
     box = [[v, v] for v in e]                             # enclosure of e(t_k), per dim
     worst, worst_t, worst_i, top = math.inf, 0.0, 0, max(abs(v) for v in e)
+    abs_e = []                                            # the bound of |e(t_k)|, per sample
     for k in range(len(enclosure.t_start)):
         t = float(samples.t[k])
         reach = [max(-a, b) for a, b in box]
+        abs_e.append(reach)
         if max(reach) > E_MAX:
             i = int(np.argmax(reach))
             return fail(f"|e_{i}| may reach {max(reach):.6g} at t = {t:.4f} s, beyond the "
@@ -207,7 +214,8 @@ def check_sampled(design: TubeDesign, samples: TubeSamples, assumptions: Assumpt
         box = new_box
         top = max(top, max(max(-a, b) for a, b in box))
     data.update({"max_abs_e": top, "margin": worst})
-    return SampledCheck(True, top, worst, worst_t, worst_i, "", data)
+    abs_e.append([max(-a, b) for a, b in box])
+    return SampledCheck(True, top, worst, worst_t, worst_i, "", data, np.array(abs_e))
 
 
 def lowest_rate(design: TubeDesign, spec: Spec, assumptions: Assumptions,

@@ -1,9 +1,14 @@
-"""The ``bench`` subcommand and its sub-subcommands ``arenas``, ``step``, ``scaling``,
-``covering`` and ``alpha``."""
+"""``stt-codegen bench arenas | step | scaling | covering | alpha``: the benchmarks and
+studies of :mod:`stt_codegen.bench`."""
 
 from __future__ import annotations
 
 import argparse
+import json
+from pathlib import Path
+
+from ..errors import SpecError
+from .common import add_json_argument, add_spec_argument
 
 
 def _non_negative_int(text: str) -> int:
@@ -13,29 +18,62 @@ def _non_negative_int(text: str) -> int:
     return value
 
 
+def _int_list(text: str, field: str) -> list[int]:
+    """``"1,10,100"`` as ``[1, 10, 100]``; :class:`SpecError` naming ``field`` otherwise."""
+    try:
+        values = [int(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise SpecError(field, f"expected a comma-separated list of integers, got {text!r}") from None
+    if not values:
+        raise SpecError(field, "empty list")
+    return values
+
+
 def _cmd_arenas(args: argparse.Namespace) -> int:
-    from .arenas_bench import main_arenas
-    return main_arenas(args)
+    from ..bench.arenas_bench import format_arenas_report, run_arenas_bench, write_specs
+    if args.specs:
+        write_specs(Path(args.specs), args.count, args.seed)
+    report = run_arenas_bench(args.count, args.seed, workers=args.workers,
+                              scheduler=args.scheduler,
+                              methods=tuple(args.methods.split(",")) if args.methods else None,
+                              progress=not args.no_progress)
+    print(json.dumps(report, indent=1, sort_keys=True, allow_nan=False) if args.json
+          else format_arenas_report(report))
+    return 0
 
 
 def _cmd_step(args: argparse.Namespace) -> int:
-    from .step import main_step
-    return main_step(args)
+    from ..bench.step import format_step_report, run_step_bench
+    report = run_step_bench(args.spec, steps=args.steps)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_step_report(report))
+    return 0
 
 
 def _cmd_scaling(args: argparse.Namespace) -> int:
-    from .scaling import main_scaling
-    return main_scaling(args)
+    from ..bench.scaling import format_scaling_report, run_scaling_bench
+    report = run_scaling_bench(_int_list(args.obstacles, "obstacles"),
+                               _int_list(args.dimensions, "dimensions"),
+                               compile_timeout=args.compile_timeout)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_scaling_report(report))
+    return 0
 
 
 def _cmd_covering(args: argparse.Namespace) -> int:
-    from .covering import main_covering
-    return main_covering(args)
+    from ..bench.covering import format_covering_report, run_covering_bench
+    report = run_covering_bench(args.seed, args.count, args.tolerance)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_covering_report(report))
+    return 0
 
 
 def _cmd_alpha(args: argparse.Namespace) -> int:
-    from .alpha import main_alpha
-    return main_alpha(args)
+    from ..bench.alpha import format_alpha_report, run_alpha_bench
+    report = run_alpha_bench(args.spec)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_alpha_report(report))
+    return 0
 
 
 def configure_bench(bench: argparse.ArgumentParser) -> None:
@@ -56,15 +94,15 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
     p.add_argument("--specs", default=None, metavar="DIR",
                    help="also write the arenas as spec files into DIR")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_json_argument(p)
     p.set_defaults(handler=_cmd_arenas)
 
     p = sub.add_parser("step", help="cost of one controller step: reference, CasADi, "
                                     "generated Python, generated C")
-    p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
+    add_spec_argument(p)
     p.add_argument("--steps", type=int, default=None, metavar="N",
                    help="C steps per timed run (default: 100000)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_json_argument(p)
     p.set_defaults(handler=_cmd_step)
 
     p = sub.add_parser("scaling", help="code size, generation time and step cost vs "
@@ -75,7 +113,7 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="state dimensions (default: %(default)s)")
     p.add_argument("--compile-timeout", type=float, default=900.0, metavar="S",
                    help="give up compiling one design after S seconds (default: %(default)s)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_json_argument(p)
     p.set_defaults(handler=_cmd_scaling)
 
     p = sub.add_parser("covering", help="covering random polygons by boxes, and the design "
@@ -85,12 +123,12 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="polygon seed (default: %(default)s)")
     p.add_argument("--tolerance", type=float, default=0.02, metavar="M",
                    help="covering tolerance of every polygon (default: %(default)s)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_json_argument(p)
     p.set_defaults(handler=_cmd_covering)
 
     p = sub.add_parser("alpha", help="the implicit alpha step: Newton iterations against "
                                      "bisection, and convergence to a stiff solver")
     p.add_argument("spec", metavar="SPEC", nargs="?", default="omnirobot-s1",
                    help="bundled case name or spec file (default: %(default)s)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    add_json_argument(p)
     p.set_defaults(handler=_cmd_alpha)

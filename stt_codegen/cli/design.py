@@ -1,33 +1,33 @@
-"""Subcommand ``design`` (arguments from :func:`configure_design`): design and certify only."""
+"""``stt-codegen design SPEC``: design and certify the tube only (no simulation)."""
 
 from __future__ import annotations
 
 import argparse
-import json
-from pathlib import Path
+
+from ..errors import DesignError
+from .common import add_json_argument, add_spec_argument, design_spec, print_json
+from .plotting import (add_plot_argument, check_plot_folder, plot_dims, write_plot,
+                       write_rejected_plot)
 
 
 def cmd_design(args: argparse.Namespace) -> int:
-    """``stt-codegen design SPEC [--json] [--plot PNG]``: 0 designed, 1 no design, 2 bad input."""
-    from ..system import atomic_write
-    from ..errors import DesignError, SpecError
+    """0 designed, 1 no design (``--plot``: the best rejected tube is drawn), 2 bad input."""
     from ..spec.loader import load_spec
-    from .search import design_tube
-    if args.plot and not Path(args.plot).parent.is_dir():
-        raise SpecError("--plot", f"folder {str(Path(args.plot).parent)!r} does not exist")
+    check_plot_folder(args)
     spec = load_spec(args.spec)
+    dims = plot_dims(args, spec)
     try:
-        design = design_tube(spec)
+        design = design_spec(spec, args)
     except DesignError as exc:
-        if args.json:
-            print(json.dumps({"spec": spec.name, "designed": False, "reason": str(exc)},
-                             indent=2, sort_keys=True))
+        write_rejected_plot(args, spec, exc, dims)
         raise
-    if args.plot:
+
+    def draw(path):
         from ..runtime.plots import plot_design
-        atomic_write(Path(args.plot), lambda tmp: plot_design(spec, design, tmp))
+        return plot_design(design, path, dims=dims)
+    write_plot(args, draw)
     if args.json:
-        print(json.dumps(design.to_json(spec.name), indent=2, sort_keys=True))
+        print_json(design.to_json())
         return 0
     tube = design.tube
     print(f"{spec.name}: designed with the {design.method} method in "
@@ -41,6 +41,10 @@ def cmd_design(args: argparse.Namespace) -> int:
         print(f"  reach segment {s.profile} [{s.start:.3f}, {s.end:.3f}] s to {box}")
     for m in design.certificate.margins:
         print(f"  {'PASS' if m.passed else 'FAIL'}  {m.name}: margin {m.margin:.4g}")
+    if design.input_proof is not None:          # [actuator]
+        peaks = ", ".join(f"{p:.4g} <= {b:g}" for p, b in zip(design.input_proof.peak,
+                                                              tube.input_bound))
+        print(f"  PASS  input bound: law (13) asks at most [{peaks}] (proved)")
     if args.plot:
         print(f"plot written to {args.plot}")
     return 0
@@ -48,7 +52,8 @@ def cmd_design(args: argparse.Namespace) -> int:
 
 def configure_design(p: argparse.ArgumentParser) -> None:
     """Arguments of ``stt-codegen design``."""
-    p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--plot", metavar="PNG", help="write a figure of the designed tube")
+    add_spec_argument(p)
+    add_json_argument(p)
+    add_plot_argument(p, "the designed tube (of the best rejected tube when there "
+                      "is no design)")
     p.set_defaults(handler=cmd_design)

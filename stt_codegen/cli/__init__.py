@@ -1,0 +1,132 @@
+"""The ``stt-codegen`` command line: a thin layer over the library, at the bottom of the
+package's layers (no library module imports it).
+
+Exit codes (:data:`EXIT_CODES`, the one place that maps error kinds to codes):
+
+* 0 success (``simulate``: the task is satisfied);
+* 1 a negative outcome: ``simulate``: not satisfied; ``check``: drift; ``verify``: a check
+  failed; any command that designs: no tube can be designed for the spec
+  (:class:`DesignError`);
+* 2 bad input (:class:`SpecError`, or an argument argparse rejects);
+* 3 a tool is missing or failed, or an internal failure (:class:`ToolchainError`);
+* 130 interrupted.
+
+Errors are one line ``error: ...`` on standard error, no traceback.
+
+Subcommands are listed in :data:`COMMANDS` with their one-line help and the function that
+configures their arguments, one small module a command (:mod:`.design`, :mod:`.simulate`,
+:mod:`.demo`, :mod:`.generate`, :mod:`.check`, :mod:`.verify`, :mod:`.embedded`,
+:mod:`.bench`, :mod:`.cases`, :mod:`.schema`); what several share is in :mod:`.common`
+(arguments, the design step and its no-design document) and :mod:`.plotting` (``--plot``).
+Only the chosen command's module is imported, so ``--help`` and ``cases`` import nothing
+heavy.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import sys
+from collections.abc import Sequence
+
+from ..errors import DesignError, SpecError, SttError, ToolchainError
+from ..version import __version__
+from .parser import CommandParser
+
+#: Every subcommand: name -> (one-line help, ``"module:function"``). The function takes the
+#: subcommand's :class:`argparse.ArgumentParser`, adds its arguments and sets
+#: ``handler=fn(args) -> int`` (the exit code). It is imported only when the command runs.
+COMMANDS: dict[str, tuple[str, str]] = {
+    "cases": ("list the bundled specs", "stt_codegen.cli.cases:configure_cases"),
+    "simulate": ("design the tube and simulate the closed loop",
+                 "stt_codegen.cli.simulate:configure_simulate"),
+    "demo": ("generate, compile and run the controller of every bundled case in closed "
+             "loop; print a table, write code and plots",
+             "stt_codegen.cli.demo:configure_demo"),
+    "generate": ("write the C and Python controllers of a spec",
+                 "stt_codegen.cli.generate:configure_generate"),
+    "check": ("regenerate generated/ and compare (exit 1 on drift)",
+              "stt_codegen.cli.check:configure_check"),
+    "verify": ("check the paper's lemmas and certify the tube",
+               "stt_codegen.cli.verify:configure_verify"),
+    "embedded": ("run the single-precision controller on an emulated Cortex-M4F",
+                 "stt_codegen.cli.embedded:configure_embedded"),
+    "bench": ("benchmarks: random arenas vs planners, step cost, scaling",
+              "stt_codegen.cli.bench:configure_bench"),
+    "design": ("design and certify the tube (no simulation)",
+               "stt_codegen.cli.design:configure_design"),
+    "schema": ("print the JSON Schema of spec files (for editors and tools)",
+               "stt_codegen.cli.schema:configure_schema"),
+}
+
+#: Error kind -> exit code; the first matching row wins.
+EXIT_CODES: tuple[tuple[type[BaseException], int], ...] = (
+    (SpecError, 2),
+    (DesignError, 1),
+    (ToolchainError, 3),
+    (SttError, 3),
+)
+
+
+def _chosen_command(argv: Sequence[str]) -> str | None:
+    """The subcommand named in ``argv``: the first argument that is not an option."""
+    return next((a for a in argv if not a.startswith("-")), None)
+
+
+def _configure(parser: argparse.ArgumentParser, command: str) -> None:
+    module_name, function_name = COMMANDS[command][1].split(":")
+    getattr(importlib.import_module(module_name), function_name)(parser)
+
+
+def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
+    """The argument parser: every subcommand's name and help, and the arguments of the
+    subcommand named in ``argv`` (only its module is imported)."""
+    parser = argparse.ArgumentParser(
+        prog="stt-codegen",
+        description="Spatiotemporal-tube controllers for prescribed-time reach-avoid-stay "
+                    "tasks. Exit codes: 0 success, 1 negative outcome (not satisfied, no "
+                    "design, a check failed, drift), 2 bad input, 3 tool or internal "
+                    "failure.")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
+                                parser_class=CommandParser)
+    chosen = _chosen_command(argv)
+    for name, (help_text, _) in COMMANDS.items():
+        p = sub.add_parser(name, help=help_text)
+        if name == chosen:
+            _configure(p, name)
+            parser.set_defaults(command_parser=p)
+    return parser
+
+
+def exit_code(exc: BaseException) -> int:
+    """The exit code of an error kind (:data:`EXIT_CODES`)."""
+    return next(code for kind, code in EXIT_CODES if isinstance(exc, kind))
+
+
+def _message(exc: SttError, flags: dict[str, str]) -> str:
+    """``exc``'s one-line message; a library parameter is named by its command-line flag."""
+    if isinstance(exc, SpecError) and exc.field in flags:
+        return f"{flags[exc.field]}: {exc.reason}"
+    return str(exc)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``stt-codegen`` console script; returns the exit code."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser(argv)
+    args = parser.parse_args(argv)
+    try:
+        return int(args.handler(args))
+    except SttError as exc:
+        print(f"error: {_message(exc, args.command_parser.flags)}", file=sys.stderr)
+        return exit_code(exc)
+    except KeyboardInterrupt:
+        print("error: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        # the reader went away (``stt-codegen design ... | head``): stop quietly, as a Unix
+        # filter does; point stdout at devnull so the interpreter's final flush is silent
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141

@@ -1,0 +1,18 @@
+"""``stt-codegen cases``: list the bundled specs, one name a line."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def cmd_cases(args: argparse.Namespace) -> int:
+    """Print the bundled specs' names; exit 0."""
+    from ..cases import bundled_cases
+    for name in bundled_cases():
+        print(name)
+    return 0
+
+
+def configure_cases(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen cases`` (none)."""
+    p.set_defaults(handler=cmd_cases)

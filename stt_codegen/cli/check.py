@@ -1,0 +1,35 @@
+"""``stt-codegen check``: regenerate ``generated/`` and compare it with the committed one."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """``stt-codegen check [--root generated] [--update]``: 0 identical, 1 drift."""
+    from ..codegen.bundled import drift, update_generated, version_note
+    root = Path(args.root)
+    if args.update:
+        update_generated(root)
+        print(f"regenerated {root}/")
+        return 0
+    diffs = drift(root)
+    print(version_note())
+    if diffs:
+        for text in diffs:
+            sys.stdout.write(text)
+        print(f"drift: {len(diffs)} file(s) under {root}/ differ from a fresh generation "
+              f"(run `stt-codegen check --update` and commit)", file=sys.stderr)
+        return 1
+    print(f"{root}/ is up to date")
+    return 0
+
+
+def configure_check(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen check``."""
+    p.add_argument("--root", default="generated", metavar="DIR",
+                   help="folder of the committed output (default: %(default)s)")
+    p.add_argument("--update", action="store_true", help="rewrite the folder instead of comparing")
+    p.set_defaults(handler=cmd_check)

@@ -1,0 +1,111 @@
+"""What several commands share: their common arguments, the design step and the document
+printed with ``--json`` when there is no design.
+
+The library is imported inside the functions that need it, so that importing this module
+(for ``stt-codegen --help`` or ``cases``) costs nothing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import TYPE_CHECKING, Any
+
+from ..errors import DesignError
+
+if TYPE_CHECKING:
+    from ..design.result import Design
+    from ..spec.loader import Spec
+
+
+def add_spec_argument(p: argparse.ArgumentParser) -> None:
+    """The positional ``SPEC``: a bundled case name or a spec file."""
+    p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
+
+
+def add_json_argument(p: argparse.ArgumentParser, text: str = "print one JSON object") -> None:
+    """``--json``: print one JSON document on standard output instead of text."""
+    p.add_argument("--json", action="store_true", help=text)
+
+
+def default_backend() -> str:
+    """The backend ``simulate`` and ``demo`` use unless told otherwise."""
+    return "c"
+
+
+def add_backend_argument(p: argparse.ArgumentParser) -> None:
+    """``--backend``: the controller implementation (``stt_codegen.runtime.backends``)."""
+    from ..runtime.backends import backend_names
+    p.add_argument("--backend", default=default_backend(), choices=backend_names(),
+                   help="controller implementation (default: %(default)s)")
+
+
+def print_json(data: Any) -> None:
+    """Print ``data`` as one indented JSON document with sorted keys."""
+    print(json.dumps(data, indent=2, sort_keys=True))
+
+
+def add_seed_argument(p: argparse.ArgumentParser) -> None:
+    """``--seed N``: the disturbance seed, checked by :func:`checked_seed`."""
+    p.add_argument("--seed", type=int, default=0, metavar="N",
+                   help="disturbance seed, an integer in [0, 2**32) (default: 0)")
+
+
+def checked_seed(args: argparse.Namespace) -> int:
+    """``--seed``, checked before any work (the library's rule,
+    :func:`stt_codegen.runtime.plants.check_seed`).
+
+    Raises
+    ------
+    SpecError
+        Field ``seed`` (shown as ``--seed``): not in ``[0, 2**32)``.
+    """
+    from ..runtime.plants import check_seed
+    return check_seed(args.seed)
+
+
+def no_design_document(spec: Spec, error: DesignError) -> dict[str, Any]:
+    """What every command that designs prints with ``--json`` when there is no design.
+
+    Returns
+    -------
+    dict
+        ``spec`` (the name), ``designed`` (``False``), ``reason`` (the message of the
+        error) and ``kind`` (the :class:`~stt_codegen.design.failures.FailureKind` value,
+        e.g. ``"walled off"``, or ``None``). A design is ``Design.to_json()``, with
+        ``designed`` ``True``.
+    """
+    kind = getattr(error.kind, "value", None)
+    return {"spec": spec.name, "designed": False, "reason": str(error), "kind": kind}
+
+
+def design_spec(spec: Spec, args: argparse.Namespace) -> Design:
+    """Design the tube of ``spec`` for a command; with ``--json``, when there is no design,
+    print :func:`no_design_document` on standard output first.
+
+    Raises
+    ------
+    DesignError
+        No certified tube exists for the spec: exit code 1, the reason on standard error.
+    """
+    from ..design.search import design_tube
+    try:
+        return design_tube(spec)
+    except DesignError as exc:
+        if getattr(args, "json", False):
+            print_json(no_design_document(spec, exc))
+        raise
+
+
+def load_and_design(args: argparse.Namespace) -> Design:
+    """:func:`design_spec` of the spec ``SPEC`` names (a bundled case or a file).
+
+    Raises
+    ------
+    SpecError
+        The spec is invalid or cannot be found.
+    DesignError
+        As :func:`design_spec`.
+    """
+    from ..spec.loader import load_spec
+    return design_spec(load_spec(args.spec), args)

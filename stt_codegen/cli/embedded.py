@@ -1,0 +1,60 @@
+"""``stt-codegen embedded SPEC``: the single-precision controller on an emulated Cortex-M4F."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..errors import SpecError
+from .common import (add_json_argument, add_seed_argument, add_spec_argument, checked_seed,
+                     load_and_design, print_json)
+
+
+def _print_report(r: dict) -> None:
+    print(f"{r['spec']} on {r['target']}")
+    print(f"  self-test: {r['vectors_passed']} passed, {r['vectors_failed']} failed; "
+          f"max rel. error of u {r['max_rel_error_u']:.3g}; error/bound: "
+          + ", ".join(f"{k} {v:.3g}" for k, v in r["error_to_bound"].items()))
+    print(f"  flash {r['flash_bytes']} B (linked {r['flash_bytes_linked']} B), "
+          f"RAM {r['ram_bytes']} B, stack {r['stack_bytes']} B static "
+          f"({r['stack_bytes_measured']} B measured)")
+    print(f"  {r['instructions_per_step']} instructions per step "
+          f"(counts {r['instructions_detail']['counts']})")
+    top = list(r["instructions_detail"]["by_function"].items())[:6]
+    if top:
+        print("  most instructions in: " + ", ".join(
+            f"{name} {v['instructions']:g} ({v['entries']:g} calls)" for name, v in top))
+    clear = "-" if r["min_clearance"] is None else f"{r['min_clearance']:.3f}"
+    reach = "-" if r["reach_time"] is None else f"{r['reach_time']:.3f}"
+    print(f"  closed loop: {'satisfied' if r['closed_loop_satisfied'] else 'NOT satisfied'}"
+          f", reach {reach} s, clearance {clear}, {r['steps']} steps, "
+          f"outside-tube steps {r['outside_tube_steps']}")
+    if "max_state_deviation" in r:
+        print(f"  max |x_target - x_host| = {r['max_state_deviation']:.3g}")
+
+
+def cmd_embedded(args: argparse.Namespace) -> int:
+    """Design, generate single precision, run on QEMU mps2-an386; 0 iff all passed."""
+    from ..embedded.deploy import run_embedded
+    seed = checked_seed(args)
+    if args.build_dir is not None and not Path(args.build_dir).parent.is_dir():
+        raise SpecError("build_dir", f"folder {str(Path(args.build_dir).parent)!r} does not exist")
+    report = run_embedded(load_and_design(args), args.build_dir, seed=seed,
+                          compare_host=not args.no_host)
+    if args.json:
+        print_json(report)
+    else:
+        _print_report(report)
+    return 0 if report["ok"] else 1
+
+
+def configure_embedded(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen embedded``."""
+    add_spec_argument(p)
+    add_json_argument(p)
+    add_seed_argument(p)
+    p.add_argument("--build-dir", default=None, metavar="DIR",
+                   help="keep the generated code, programs and ELFs there (default: temporary)")
+    p.add_argument("--no-host", action="store_true",
+                   help="skip the comparison with the host simulation")
+    p.set_defaults(handler=cmd_embedded)

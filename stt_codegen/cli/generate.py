@@ -1,0 +1,33 @@
+"""``stt-codegen generate SPEC -o DIR``: write the standalone controllers of a spec."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..codegen.options import LANGUAGES, PRECISIONS, parse_options
+from .common import add_spec_argument, load_and_design
+
+
+def cmd_generate(args: argparse.Namespace) -> int:
+    """0 written, 1 no design, 2 bad input, 3 code generator failure."""
+    from ..codegen.api import generate
+    parse_options(args.languages, args.precision)   # bad options fail before the design
+    design = load_and_design(args)
+    files = generate(design, Path(args.out_dir), languages=args.languages,
+                     precision=args.precision)
+    print(f"wrote {len(files)} files for {design.spec.name} ({args.languages}, "
+          f"{args.precision}) into {args.out_dir}")
+    return 0
+
+
+def configure_generate(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen generate``."""
+    add_spec_argument(p)
+    p.add_argument("-o", "--out", dest="out_dir", required=True, metavar="DIR",
+                   help="output folder (created; only files of a previous generation are replaced)")
+    p.add_argument("--lang", dest="languages", default=",".join(LANGUAGES), metavar="LANGS",
+                   help="comma-separated subset of: %(default)s")
+    p.add_argument("--precision", default="double", choices=PRECISIONS,
+                   help="floating-point type of the C code (default: %(default)s)")
+    p.set_defaults(handler=cmd_generate)

@@ -1,0 +1,82 @@
+"""``--plot PNG`` and ``--dims I,J`` of the commands that draw a figure (``design``,
+``simulate``; ``demo`` takes ``--dims`` for its plots).
+
+One place for the options, their early checks (before any long computation) and the atomic
+write of the figure.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from ..errors import SpecError
+from ..system import atomic_write
+
+if TYPE_CHECKING:
+    from ..errors import DesignError
+    from ..spec.loader import Spec
+
+
+def add_dims_argument(p: argparse.ArgumentParser) -> None:
+    """``--dims I,J``: the state dimensions of the plot's arena."""
+    p.add_argument("--dims", metavar="I,J", help="state dimensions of the plot's arena, "
+                   "zero-based (default: 0,1)")
+
+
+def add_plot_argument(p: argparse.ArgumentParser, what: str) -> None:
+    """``--plot PNG``: write a figure of ``what`` (words for the help text); and
+    ``--dims``."""
+    p.add_argument("--plot", metavar="PNG", help=f"write a figure of {what}")
+    add_dims_argument(p)
+
+
+def check_plot_folder(args: argparse.Namespace) -> None:
+    """Refuse a ``--plot`` path whose folder does not exist, before any work.
+
+    Raises
+    ------
+    SpecError
+        Field ``plot`` (shown as ``--plot``).
+    """
+    if getattr(args, "plot", None):
+        folder = Path(args.plot).parent
+        if not folder.is_dir():
+            raise SpecError("plot", f"folder {str(folder)!r} does not exist")
+
+
+def plot_dims(args: argparse.Namespace, spec: Spec) -> tuple[int, int]:
+    """``--dims`` for ``spec``, checked before any work (default ``(0, 1)``).
+
+    Raises
+    ------
+    SpecError
+        Field ``dims`` (shown as ``--dims``): not two distinct dimensions of the state
+        space.
+    """
+    from ..runtime.plots import parse_dims
+    return parse_dims(args.dims, spec.dimension)
+
+
+def write_plot(args: argparse.Namespace, draw: Callable[[Path], object]) -> None:
+    """Write the figure ``draw(path)`` saves to ``--plot``, atomically; nothing without
+    ``--plot``."""
+    if args.plot:
+        atomic_write(Path(args.plot), draw, field="plot")
+
+
+def write_rejected_plot(args: argparse.Namespace, spec: Spec, error: DesignError,
+                        dims: tuple[int, int]) -> None:
+    """With ``--plot``, when there is no design: write the figure of the best rejected
+    tube (``error.tried``) and say so on standard error, or say why there is no figure."""
+    if not args.plot:
+        return
+    if error.tried is None:
+        print(f"no plot written to {args.plot}: no tube was tried", file=sys.stderr)
+        return
+    from ..runtime.plots import plot_rejected
+    write_plot(args, lambda path: plot_rejected(spec, error, path, dims=dims))
+    print(f"plot written to {args.plot}: it shows the best rejected tube", file=sys.stderr)

@@ -1,0 +1,72 @@
+"""``stt-codegen simulate SPEC``: design the tube, run the closed loop, judge Definition 2.1."""
+
+from __future__ import annotations
+
+import argparse
+
+from .common import (add_backend_argument, add_json_argument, add_seed_argument,
+                     add_spec_argument, checked_seed, design_spec, print_json)
+from ..errors import DesignError
+from .plotting import (add_plot_argument, check_plot_folder, plot_dims, write_plot,
+                       write_rejected_plot)
+
+#: Header of the table of :func:`summary_line` rows (``simulate`` and ``demo``).
+SUMMARY_HEADER = f"{'case':<22} {'satisfied':<9} {'reach [s]':>9} {'clearance':>9}   max |u|"
+
+
+def summary_line(result) -> str:
+    """One row of the summary table: case, satisfied, reach time, clearance, max ``|u|``."""
+    clearance = ("-" if result.min_obstacle_clearance is None
+                 else f"{result.min_obstacle_clearance:.3f}")
+    reach = "-" if result.reach_time is None else f"{result.reach_time:.3f}"
+    u_max = ", ".join(f"{v:.3g}" for v in result.max_abs_u)
+    return (f"{result.spec:<22} {'yes' if result.satisfied else 'NO':<9} {reach:>9} "
+            f"{clearance:>9}   [{u_max}]")
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    """0 satisfied, 1 not satisfied or no design, 2 bad input, 3 toolchain."""
+    from ..runtime.simulate import simulate
+    from ..spec.loader import load_spec
+    seed = checked_seed(args)
+    check_plot_folder(args)
+    spec = load_spec(args.spec)
+    dims = plot_dims(args, spec)
+    try:
+        design = design_spec(spec, args)
+    except DesignError as exc:
+        write_rejected_plot(args, spec, exc, dims)
+        raise
+    result = simulate(design, backend=args.backend, horizon=args.horizon, seed=seed)
+
+    def draw(path):
+        from ..runtime.plots import plot_run
+        return plot_run(design, result, path, dims=dims)
+    write_plot(args, draw)
+    if args.json:
+        data = result.to_json()
+        data["design"] = design.to_json()
+        print_json(data)
+    else:
+        print(SUMMARY_HEADER)
+        print(summary_line(result))
+        print(f"backend {result.backend}, {result.steps} steps at {design.tube.rate_hz:g} Hz, "
+              f"t_c = {result.prescribed_time:g} s, gain k = {design.gain:.4g}, "
+              f"stayed in tube: {'yes' if result.stayed_in_tube else 'NO'}, "
+              f"collision: {'YES' if result.collision else 'no'}, "
+              f"left state space: {'YES' if result.left_state_space else 'no'}")
+        if args.plot:
+            print(f"plot written to {args.plot}")
+    return 0 if result.satisfied else 1
+
+
+def configure_simulate(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen simulate``."""
+    add_spec_argument(p)
+    add_backend_argument(p)
+    p.add_argument("--horizon", type=float, default=None, metavar="S",
+                   help="simulated time in seconds (default: t_c)")
+    add_seed_argument(p)
+    add_plot_argument(p, "the run")
+    add_json_argument(p)
+    p.set_defaults(handler=cmd_simulate)

@@ -1,0 +1,50 @@
+"""``stt-codegen verify SPEC``: every check of a spec's designed tube, with its evidence."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable
+
+from .common import add_json_argument, add_spec_argument, design_spec
+
+
+def _terminal_progress() -> Callable[[str], None] | None:
+    """Progress on stderr when it is a terminal (one line, rewritten), else ``None``."""
+    if not sys.stderr.isatty():
+        return None
+
+    def show(message: str) -> None:
+        sys.stderr.write(f"\rverify: {message} ...\x1b[K")
+        sys.stderr.flush()
+    return show
+
+
+def cmd_verify(args: argparse.Namespace) -> int:
+    """0 every check passed, 1 a check failed or no design, 2 bad input."""
+    from ..spec.loader import load_spec
+    from ..verify.command import spec_for_plant, verify
+    design = design_spec(spec_for_plant(load_spec(args.spec), args.plant), args)
+    progress = None if args.json else _terminal_progress()
+    try:
+        report = verify(design, plant=args.plant, progress=progress, cache=not args.no_cache)
+    finally:
+        if progress is not None:
+            sys.stderr.write("\r\x1b[K")
+            sys.stderr.flush()
+    print(json.dumps(report.to_json(), indent=2) if args.json else str(report))
+    return 0 if report.passed else 1
+
+
+def configure_verify(p: argparse.ArgumentParser) -> None:
+    """Arguments of ``stt-codegen verify``."""
+    from ..spec.plants import PLANT_MODELS
+    add_spec_argument(p)
+    add_json_argument(p, "print a JSON list of checks")
+    p.add_argument("--plant", default=None, metavar="MODEL",
+                   help=f"plant for Assumption 2 ({', '.join(PLANT_MODELS)}; default: the spec's)")
+    p.add_argument("--no-cache", action="store_true",
+                   help="prove the spec-independent lemmas again instead of reading the "
+                        "proof cache (~/.cache/stt-codegen; see docs/verification.md)")
+    p.set_defaults(handler=cmd_verify)

@@ -1,0 +1,293 @@
+"""Design within the actuators' limits (``[actuator] input_bound``, issue 20).
+
+:func:`design_within_bound` is what :func:`~stt_codegen.design.search.design_tube` does
+for a spec with ``[actuator]``. It accepts a tube only when the prover
+(:func:`~.input_bound.input_prover`: ``verify``'s sampled-data bound on ``e`` and the
+certified widths, :mod:`.input_bound`) shows that law (13) never asks any input for more
+than its bound. Deterministic, in this order, the first tube that meets the bound wins:
+
+1. the design of the spec without ``[actuator]`` (the default design: a spec whose
+   default tube keeps the bound gets exactly that tube), then :func:`slower_variants`:
+2. **softer circumvents**: when the default is the paper's method with circumvents and
+   the spec leaves ``tube.circumvent_sharpness`` free, the paper's search with every
+   circumvent's sharpness ``k^j`` fixed to each value of the ladder above the default's
+   largest, smoother each time (a longer window: the bound rises more slowly), until the
+   paper's search fails;
+3. **via points** (``tube.method`` ``"auto"`` or ``"via"``): smooth-step segments through
+   via boxes, timed in proportion to their length over all of ``t_c`` (no circumvent
+   flanks).
+
+When none does, the design is refused (``DesignError``, kind ``INPUT_BOUND``) naming the
+smallest ``prescribed_time`` at which the same procedure meets the bound (a search on
+two-significant-digit values: growing, then a bisection) and the bound the best design
+within ``t_c`` needs. The accepted :class:`~.result.Design` carries the bound in its tube
+(the generated code clamps ``u`` to it) and the proof (``Design.input_proof``).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+from ..errors import DesignError, SpecError
+from ..spec.loader import Spec
+from .failures import FailureKind
+from .input_bound import InputProof, InputProver, input_prover
+from .result import METHOD_PAPER, METHOD_VIA, Design
+from .samples import HORIZON_FACTOR, STEP_BUDGET
+from .windows import SHARPNESS_LADDER
+
+#: The ``prescribed_time`` search tries up to this many times the spec's ``t_c``.
+MAX_TIME_FACTOR = 16.0
+#: A longer ``t_c`` must lower the best peak-to-bound ratio by at least this factor, or the
+#: search stops: the peak no longer falls with the tube's speed (the disturbance and drift
+#: bounds alone ask for it).
+MIN_IMPROVEMENT = 0.95
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One tube tried against the bound.
+
+    Attributes
+    ----------
+    label : str
+        How it was made (``"default design"``, ``"softer circumvents (k = 0.2)"``,
+        ``"via points"``).
+    design : Design
+        The certified design (without the bound).
+    proof : InputProof
+        The proved peak of each input along it.
+    """
+
+    label: str
+    design: Design
+    proof: InputProof
+
+
+def slower_variants(spec: Spec, default: Design) -> list[tuple[str, Spec]]:
+    """The specs to design after the default one, in order, as ``(label, spec)``.
+
+    Parameters
+    ----------
+    spec : Spec
+        Without ``[actuator]``.
+    default : Design
+        Its default design.
+
+    Returns
+    -------
+    list of (str, Spec)
+        Softer circumvents (the paper's tube with every ``k^j`` fixed to each ladder value
+        above the default's largest), when the default is the paper's tube with
+        circumvents and ``tube.circumvent_sharpness`` is free; then via points, when
+        ``tube.method`` allows them and the default is not already a via tube.
+    """
+    out: list[tuple[str, Spec]] = []
+    if (default.method == METHOD_PAPER and default.tube.circumvents
+            and spec.tube.circumvent_sharpness is None and spec.tube.method != METHOD_VIA):
+        sharpest = max(c.sharpness for c in default.tube.circumvents)
+        out += [(f"softer circumvents (k = {k:g})",
+                 replace(spec, tube=replace(spec.tube, circumvent_sharpness=k,
+                                            method=METHOD_PAPER)))
+                for k in SHARPNESS_LADDER if k > sharpest]
+    if spec.tube.method in ("auto", METHOD_VIA) and default.method != METHOD_VIA:
+        out.append(("via points", replace(spec, tube=replace(spec.tube, method=METHOD_VIA))))
+    return out
+
+
+def candidates(spec: Spec, design_free: Callable[[Spec], Design],
+               prover: InputProver) -> tuple[Candidate | None, list[Candidate]]:
+    """Try the default design, then :func:`slower_variants`, on ``spec`` (which has
+    ``[actuator]``), until one is proved within the bound.
+
+    Returns
+    -------
+    accepted : Candidate or None
+        The first whose proof meets ``spec.input_bound``.
+    tried : list of Candidate
+        Every candidate built, in order (the accepted one last).
+
+    Raises
+    ------
+    DesignError
+        The default design itself fails (no tube at all, whatever the bound).
+    """
+    bound = spec.input_bound
+    free = replace(spec, input_bound=None)
+    default = design_free(free)
+    tried = [Candidate("default design", default, prover(default.tube, spec))]
+    if tried[0].proof.meets(bound):
+        return tried[0], tried
+    softer_failed = False
+    for label, variant in slower_variants(free, default):
+        softer = variant.tube.method == METHOD_PAPER
+        if softer and softer_failed:
+            continue
+        try:
+            design = design_free(variant)
+        except DesignError:
+            # a smoother bump has a longer window: once the paper's search fails with one,
+            # the smoother ones are not tried (on to via points)
+            softer_failed = softer_failed or softer
+            continue
+        tried.append(Candidate(label, design, prover(design.tube, spec)))
+        if tried[-1].proof.meets(bound):
+            return tried[-1], tried
+    return None, tried
+
+
+def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> Design:
+    """The certified design of ``spec`` whose law (13) is proved to stay within ``[actuator]``.
+
+    Parameters
+    ----------
+    spec : Spec
+        With ``input_bound`` set.
+    design_free : callable
+        ``Spec -> Design``, the design without an input bound
+        (:func:`~stt_codegen.design.search.design_tube` on a spec without ``[actuator]``).
+
+    Returns
+    -------
+    Design
+        Its tube carries ``input_bound`` (the generated code clamps ``u`` to it),
+        ``input_proof`` the proved peaks, ``spec`` the given spec.
+
+    Raises
+    ------
+    DesignError
+        No tube at all (as without ``[actuator]``); or no design within ``t_c`` keeps the
+        bound (kind ``INPUT_BOUND``; ``tried``: the tube with the lowest peak-to-bound
+        ratio): the message names the smallest ``prescribed_time`` that works, or why none
+        up to :data:`MAX_TIME_FACTOR` times ``t_c`` does, and the bound the best design
+        within ``t_c`` needs.
+    """
+    started = time.perf_counter()
+    prover = input_prover()
+    bound = spec.input_bound
+    accepted, tried = candidates(spec, design_free, prover)
+    if accepted is not None:
+        design = accepted.design
+        return replace(design, tube=replace(design.tube, input_bound=bound), spec=spec,
+                       input_proof=accepted.proof,
+                       design_time_s=time.perf_counter() - started)
+    proved = [c for c in tried if c.proof.proved]
+    names = _input_names(spec)
+    if not proved:
+        reasons = "; ".join(f"{c.label}: {c.proof.reason}" for c in tried)
+        raise DesignError(
+            "no bound on law (13)'s input can be proved for actuator.input_bound: the "
+            f"sampled-data check fails for every design tried ({reasons})",
+            kind=FailureKind.INPUT_BOUND, tried=tried[0].design.tube if tried else None)
+    best = min(proved, key=lambda c: c.proof.ratio(bound))
+    worst = max(range(len(bound)), key=lambda i: best.proof.peak[i] / bound[i])
+    needs = ", ".join(f"{_round_up(v):g}" for v in best.proof.peak)
+    message = (f"no design within prescribed_time = {spec.prescribed_time:g} s keeps law (13) "
+               f"within actuator.input_bound = [{', '.join(f'{b:g}' for b in bound)}]: the "
+               f"best ({best.label}) asks up to {best.proof.peak[worst]:.3g} of input "
+               f"{names[worst]} (bound {bound[worst]:g}) at t = {best.proof.time[worst]:.3f} s")
+    works, why = smallest_prescribed_time(spec, design_free, prover,
+                                          best.proof.ratio(bound))
+    if works is not None:
+        message += (f"; prescribed_time = {works:g} s works (the smallest to two significant "
+                    f"digits), or input_bound = [{needs}] with this prescribed_time")
+    else:
+        message += f"; {why}; input_bound = [{needs}] works with this prescribed_time"
+    raise DesignError(message, kind=FailureKind.INPUT_BOUND, tried=best.design.tube)
+
+
+def _input_names(spec: Spec) -> tuple[str, ...]:
+    from ..spec.plants import PLANTS
+    return PLANTS[spec.plant_model].input_names(spec.dimension)
+
+
+def _round_up(value: float, digits: int = 3) -> float:
+    """The smallest number of ``digits`` significant digits ``>= value`` (> 0)."""
+    e = math.floor(math.log10(value)) - digits + 1
+    up = math.ceil(value / 10.0 ** e * (1.0 - 1e-12)) * 10.0 ** e
+    return float(f"{up:.{digits}g}") if float(f"{up:.{digits}g}") >= value else up
+
+
+def _grid_index(value: float) -> int:
+    """Index of the smallest two-significant-digit number ``>= value`` (``m 10^e``,
+    ``10 <= m <= 99``: index ``90 e + m - 10``)."""
+    e = math.floor(math.log10(value)) - 1
+    m = math.ceil(value / 10.0 ** e * (1.0 - 1e-12))
+    if m >= 100:
+        e, m = e + 1, 10
+    return 90 * e + max(m, 10) - 10
+
+
+def _grid_value(index: int) -> float:
+    e, m = divmod(index, 90)
+    return float(f"{m + 10}e{e}")
+
+
+def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
+                             prover: InputProver, ratio: float) -> tuple[float | None, str]:
+    """The smallest ``prescribed_time`` (two significant digits) at which the procedure of
+    :func:`candidates` meets the bound, above the spec's ``t_c`` (which fails).
+
+    Law (13)'s peak input falls about as ``1 / t_c`` while the tube's speed dominates it,
+    so each try grows ``t_c`` by the best peak-to-bound ratio found so far (between 1.25
+    and 4); once a try passes, a bisection on the two-digit values between the last
+    failing and the passing one finds the smallest (the check at each value decides; the
+    answer is a value where it passed).
+
+    Parameters
+    ----------
+    spec : Spec
+        With ``input_bound``.
+    design_free, prover
+        As in :func:`candidates`.
+    ratio : float
+        The best ``max_i peak_i / bound_i`` at the spec's ``t_c`` (> 1).
+
+    Returns
+    -------
+    prescribed_time : float or None
+        Seconds.
+    why : str
+        When ``None``: why the search stopped.
+    """
+    cap = min(MAX_TIME_FACTOR * spec.prescribed_time,
+              STEP_BUDGET / (HORIZON_FACTOR * spec.rate_hz))
+
+    def passes(index: int) -> tuple[bool, float]:
+        trial = replace(spec, prescribed_time=_grid_value(index))
+        try:
+            accepted, tried = candidates(trial, design_free, prover)
+        except (DesignError, SpecError):
+            return False, math.inf
+        best = min((c.proof.ratio(spec.input_bound) for c in tried), default=math.inf)
+        return accepted is not None, best
+
+    low = _grid_index(spec.prescribed_time)
+    if _grid_value(low) > spec.prescribed_time:
+        low -= 1
+    high = None
+    while high is None:
+        guess = max(_grid_index(_grid_value(low) * min(max(ratio, 1.25), 4.0)), low + 1)
+        if _grid_value(guess) > cap:
+            return None, (f"no prescribed_time up to {cap:.3g} s meets it "
+                          f"({MAX_TIME_FACTOR:g} t_c or the step budget of the sampled check)")
+        ok, found = passes(guess)
+        if ok:
+            high = guess
+        elif not found < MIN_IMPROVEMENT * ratio:
+            return None, (f"a longer prescribed_time does not lower the peak enough (at "
+                          f"{_grid_value(guess):g} s the best design still asks {found:.3g} "
+                          "times the bound): the disturbance and drift bounds of "
+                          "[assumptions] alone ask for about that much")
+        else:
+            low, ratio = guess, found
+    while high - low > 1:
+        mid = (low + high) // 2
+        if passes(mid)[0]:
+            high = mid
+        else:
+            low = mid
+    return _grid_value(high), ""

@@ -1,0 +1,141 @@
+"""The peak input of law (13) along a tube, and the prover the design asks for it.
+
+Law (13) gives, per input, ``|u_i| = 4 k phi(|e_i|) / gamma_d_i`` with
+``phi(s) = 2 atanh(s) / (1 - s^2)`` (``epsilon_i = 2 atanh(e_i)``,
+``xi_i = 4 / (gamma_d_i (1 - e_i^2))``). ``phi`` is increasing on ``[0, 1)``, so a bound
+``E_k,i`` of ``|e_i(t_k)|`` at each sample and a lower bound ``W_k,i`` of the width there
+bound the input the deployed controller asks for at that sample:
+
+    |u_k,i| <= 4 k phi(E_k,i) / max(W_k,i, GAMMA_D_MIN)          (input_peak)
+
+(the deployed law divides by the width floored at ``GAMMA_D_MIN``, and ``e`` is clamped
+to ``E_MAX``). ``docs/sampled-data.md`` ("The input bound") has the argument.
+
+The bound on ``e`` is the sampled-data check's (:mod:`stt_codegen.verify.sampled`), which
+builds on the design and so cannot be imported here; :mod:`stt_codegen.verify` registers
+its prover with :func:`register_input_prover` when the package is loaded (``import
+stt_codegen`` loads it), and the design (:mod:`.actuator`) asks :func:`input_prover`.
+This module imports nothing heavy at import time (numpy inside its functions): the
+verify package imports it whenever ``stt_codegen`` is imported.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from ..errors import DesignError
+from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
+from .failures import FailureKind
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from ..spec.loader import Spec
+
+
+@dataclass(frozen=True)
+class InputProof:
+    """The proved peak of every input of law (13) along a tube, for the spec's plants.
+
+    Attributes
+    ----------
+    proved : bool
+        The sampled-data check passed, so ``peak`` bounds ``|u_i|`` at every sample of
+        its horizon for every plant of ``[assumptions]``.
+    peak : tuple of float
+        Per input, input units (``inf`` when not proved).
+    time : tuple of float
+        Per input, the sample instant of the peak, seconds.
+    horizon : float
+        End of the samples covered, seconds (the sampled check's, ``1.1 t_c``).
+    reason : str
+        When not proved: why (the sampled check's failure).
+    """
+
+    proved: bool
+    peak: tuple[float, ...]
+    time: tuple[float, ...]
+    horizon: float
+    reason: str = ""
+
+    def ratio(self, bound: tuple[float, ...]) -> float:
+        """``max_i peak_i / bound_i`` (``inf`` when not proved): at most 1 meets the bound."""
+        if not self.proved:
+            return math.inf
+        return max(p / b for p, b in zip(self.peak, bound))
+
+    def meets(self, bound: tuple[float, ...]) -> bool:
+        """Proved, and ``peak_i <= bound_i`` for every input."""
+        return self.proved and all(p <= b for p, b in zip(self.peak, bound))
+
+    def margin(self, bound: tuple[float, ...]) -> float:
+        """``min_i (bound_i - peak_i) / bound_i``: the relative room left (negative:
+        exceeded; ``-inf`` when not proved)."""
+        if not self.proved:
+            return -math.inf
+        return min((b - p) / b for p, b in zip(self.peak, bound))
+
+
+def phi(s: "np.ndarray") -> "np.ndarray":
+    """``|u_i| gamma_d_i / (4 k)`` of law (13) at ``|e_i| = s``: ``2 atanh(s) / (1 - s^2)``."""
+    import numpy as np
+    s = np.minimum(np.asarray(s, dtype=float), E_MAX)
+    return 2.0 * np.arctanh(s) / (1.0 - s * s)
+
+
+def input_peak(gain: float, abs_e: "np.ndarray", width: "np.ndarray", t: "np.ndarray",
+               horizon: float) -> InputProof:
+    """The peak of each input of law (13), from bounds of ``|e|`` and of the width.
+
+    Parameters
+    ----------
+    gain : float
+        ``k`` of law (13).
+    abs_e : ndarray, shape (K, n)
+        A bound of ``|e_i(t_k)|`` at each sample, below 1.
+    width : ndarray, shape (K, n)
+        A lower bound of ``gamma_d_i(t_k)`` at each sample, state units.
+    t : ndarray, shape (K,)
+        The sample instants, seconds.
+    horizon : float
+        Seconds, for the report.
+
+    Returns
+    -------
+    InputProof
+        ``peak_i = max_k 4 k phi(abs_e_k,i) / max(width_k,i, GAMMA_D_MIN)``, proved.
+    """
+    import numpy as np
+    u = 4.0 * gain * phi(abs_e) / np.maximum(width, GAMMA_D_MIN)
+    where = np.argmax(u, axis=0)
+    return InputProof(True, tuple(float(v) for v in u.max(axis=0)),
+                      tuple(float(t[k]) for k in where), float(horizon))
+
+
+#: ``(tube, spec) -> InputProof``: proves the peak inputs of a designed tube (with its gain)
+#: for the plants of ``spec.assumptions``.
+InputProver = Callable[[TubeDesign, "Spec"], InputProof]
+_PROVERS: list[InputProver] = []
+
+
+def register_input_prover(prover: InputProver) -> None:
+    """Make ``prover`` the one the design asks (:mod:`stt_codegen.verify` registers its own)."""
+    _PROVERS[:] = [prover]
+
+
+def input_prover() -> InputProver:
+    """The registered prover.
+
+    Raises
+    ------
+    DesignError
+        None is registered (``stt_codegen.verify`` was not loaded; ``import stt_codegen``
+        loads it), kind ``INPUT_BOUND``.
+    """
+    if not _PROVERS:
+        raise DesignError("no input-bound prover is registered (import stt_codegen loads "
+                          "stt_codegen.verify, which registers it)", kind=FailureKind.INPUT_BOUND)
+    return _PROVERS[0]

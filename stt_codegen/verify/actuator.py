@@ -1,0 +1,123 @@
+"""``sampled.input_bound``: the deployed law (13) never asks an input for more than
+``[actuator] input_bound`` (issue 20).
+
+From the sampled-data check (:mod:`.sampled`), which proves a bound ``E_k,i`` of
+``|e_i(t_k)|`` at every sample for every plant of ``[assumptions]``, and the certified
+enclosure of the tube on each sampling interval (a lower bound ``W_k,i`` of its width
+there), :func:`~stt_codegen.design.input_bound.input_peak` bounds every input the
+controller computes: ``|u_k,i| <= 4 k phi(E_k,i) / max(W_k,i, GAMMA_D_MIN)``. The argument
+is in ``docs/sampled-data.md`` ("The input bound"). The design asks the same prover
+(:func:`prove_input_bound`, registered by this package) before it accepts a tube.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..design.certificate import enclose_tube
+from ..design.input_bound import InputProof, input_peak
+from ..design.samples import TubeSamples, sample_tube
+from ..spec.loader import Spec
+from ..spec.plants import PLANTS
+from ..tube import reference
+from ..tube.parameters import TubeDesign
+from .check import Check
+from .sampled import SampledCheck, check_sampled
+
+
+def sampled_error_bound(result: SampledCheck, samples: TubeSamples) -> np.ndarray | None:
+    """The sampled check's bound of ``|e_i(t_k)|``, shape (K, n), or ``None`` if it failed.
+
+    The one place that reads the sampled check's result for the input bound: its
+    per-sample bound (``abs_e``) when it gives one, else its overall bound (``max_abs_e``,
+    the largest ``|e|`` at any sample) at every sample.
+    """
+    if not result.passed:
+        return None
+    n = samples.gamma_lower.shape[1]
+    per_sample = getattr(result, "abs_e", None)
+    if per_sample is not None and np.shape(per_sample) == (samples.t.size, n):
+        return np.asarray(per_sample, dtype=float)
+    level = float(result.data.get("max_abs_e", result.level))
+    return np.full((samples.t.size, n), level)
+
+
+def certified_widths(tube: TubeDesign, samples: TubeSamples) -> np.ndarray:
+    """A lower bound of the tube's width at every sample, shape (K, n): the certified
+    enclosure of the interval that starts there (the last sample ends the last one)."""
+    enclosure = enclose_tube(tube, samples)
+    width = enclosure.upper_min - enclosure.lower_max
+    return np.vstack([width, width[-1:]])
+
+
+def prove_input_bound(tube: TubeDesign, spec: Spec) -> InputProof:
+    """The proved peak of each input of law (13) along ``tube`` for the spec's plants.
+
+    Parameters
+    ----------
+    tube : TubeDesign
+        With its gain (the input bound's clamp, if any, plays no part: the proof shows
+        it never acts).
+    spec : Spec
+        Its ``[assumptions]``.
+
+    Returns
+    -------
+    InputProof
+        Not proved when the sampled-data check fails (its reason); the horizon is the
+        sampled check's, ``1.1 t_c``.
+
+    Raises
+    ------
+    SpecError
+        More samples than the step budget (as :func:`~stt_codegen.design.samples.sample_tube`).
+    """
+    # the oracle's exp/log/tanh as numpy's ufuncs (within an ulp of libm, tens of times
+    # faster), as the certificate does: every margin here is far above rounding
+    with reference.numpy_math():
+        samples = sample_tube(tube)
+        horizon = float(samples.t[-1])
+        result = check_sampled(tube, samples, spec.assumptions)
+        abs_e = sampled_error_bound(result, samples)
+        if abs_e is None:
+            n = tube.dimension
+            return InputProof(False, (np.inf,) * n, (0.0,) * n, horizon,
+                              f"the sampled-data check fails: {result.reason}")
+        widths = certified_widths(tube, samples)
+    return input_peak(tube.gain, abs_e, widths, samples.t, horizon)
+
+
+def input_bound_check(spec: Spec, proof: InputProof) -> Check:
+    """``sampled.input_bound``: every input's proved peak within ``spec.input_bound``.
+
+    Parameters
+    ----------
+    spec : Spec
+        With ``input_bound``.
+    proof : InputProof
+        :func:`prove_input_bound` of the design.
+
+    Returns
+    -------
+    Check
+        Data: ``input_bound``, ``peak``, ``time`` (per input), ``margin`` (the smallest
+        ``(bound - peak) / bound``), ``horizon``.
+    """
+    bound = spec.input_bound
+    names = PLANTS[spec.plant_model].input_names(spec.dimension)
+    data = {"input_bound": list(bound), "peak": list(proof.peak), "time": list(proof.time),
+            "margin": proof.margin(bound), "horizon": proof.horizon, "inputs": list(names)}
+    if not proof.proved:
+        return Check("sampled.input_bound", False,
+                     f"no bound on law (13)'s input is proved: {proof.reason}", data)
+    each = ", ".join(f"|{name}| <= {p:.4g} (bound {b:g}, at t = {t:.3f} s)"
+                     for name, p, b, t in zip(names, proof.peak, bound, proof.time))
+    ok = proof.meets(bound)
+    detail = (f"law (13) asks at most {each} at every sample on [0, {proof.horizon:.4g}] s, "
+              f"for every plant of [assumptions] (from the sampled check's bound on |e| at "
+              f"each sample and the certified width there): margin {proof.margin(bound):.3g} "
+              "of the bound")
+    if not ok:
+        over = [name for name, p, b in zip(names, proof.peak, bound) if p > b]
+        detail += f"; beyond the bound in {', '.join(over)}"
+    return Check("sampled.input_bound", ok, detail, data)
