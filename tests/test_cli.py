@@ -62,10 +62,13 @@ upper = [1.0]
 """
 
 
+# --horizon -1 repeats test_errors_and_imports.py's in-process check: it and nan are slow-tier
 @pytest.mark.parametrize("args, message", [
     (["simulate", "no-such-case"], "no bundled case and no file named 'no-such-case'"),
-    (["simulate", "omnirobot-s1", "--horizon", "-1"], "--horizon: must be a positive"),
-    (["simulate", "omnirobot-s1", "--horizon", "nan"], "--horizon: must be a positive"),
+    pytest.param(["simulate", "omnirobot-s1", "--horizon", "-1"],
+                 "--horizon: must be a positive", marks=pytest.mark.slow),
+    pytest.param(["simulate", "omnirobot-s1", "--horizon", "nan"],
+                 "--horizon: must be a positive", marks=pytest.mark.slow),
     (["simulate", "BADFILE"], "prescribed_time: must be positive"),
 ])
 def test_bad_input_exit_2_without_traceback(tmp_path, args, message):

@@ -30,7 +30,7 @@ sys.exit(main(["generate", "omnirobot-s3", "-o", sys.argv[1], "--precision", sys
 """
 
 
-@pytest.mark.parametrize("precision", ["double", "single"])
+@pytest.mark.parametrize("precision", ["double", pytest.param("single", marks=pytest.mark.slow)])
 def test_byte_identical_across_processes_and_hash_seeds(precision, tmp_path):
     outs = []
     for seed in ("0", "12345"):

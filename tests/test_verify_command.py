@@ -86,13 +86,6 @@ def test_an_obstacle_the_tube_cannot_get_around():
     assert "no choice of circumvent dimension and side passes" in bad["tube.design"]
     assert "obstacle 0" in bad["tube.design"]
 
-def test_design_failure_is_exit_1_without_traceback(tmp_path):
-    path = tmp_path / "wall.toml"
-    path.write_text(SPEC + "[[obstacles]]\nlower = [2.0, 0.0]\nupper = [2.5, 5.0]\n")
-    out = run("simulate", str(path))
-    assert out.returncode == 1 and out.stderr.startswith("error: ")
-    assert "obstacle 0" in out.stderr and "Traceback" not in out.stderr
-
 
 def test_heading_range_reaching_pi_over_2_fails_assumption_2(tmp_path):
     wide = SPEC.replace("lower = [0.0, 0.0, -1.2]\nupper = [5.0, 5.0, 1.2]",
