@@ -92,6 +92,7 @@ def test_plot_into_missing_folder_fails_before_simulating(tmp_path):
     assert not (tmp_path / "no").exists()
 
 
+@pytest.mark.slow
 def test_plot_is_written(tmp_path):
     png = tmp_path / "run.png"
     out = run("simulate", "omnirobot-s2", "--backend", "casadi", "--plot", str(png))

@@ -30,7 +30,10 @@ sys.exit(main(["generate", "omnirobot-s3", "-o", sys.argv[1], "--precision", sys
 """
 
 
-@pytest.mark.parametrize("precision", ["double", pytest.param("single", marks=pytest.mark.slow)])
+# generate in two processes (slow tier); the emitter's own cross-process identity is
+# tests/test_emit_instructions.py's, in the fast tier
+@pytest.mark.slow
+@pytest.mark.parametrize("precision", ["double", "single"])
 def test_byte_identical_across_processes_and_hash_seeds(precision, tmp_path):
     outs = []
     for seed in ("0", "12345"):
