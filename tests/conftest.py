@@ -68,3 +68,13 @@ def arena_toml(name: str, prescribed_time: float = 9.0, extra: str = "",
 @pytest.fixture(params=CASES)
 def case(request):
     return request.param
+
+
+def pytest_runtest_setup(item):
+    """A test marked ``embedded`` needs the Cortex-M toolchain and QEMU: without them it is
+    skipped, and the message names the Debian packages to install."""
+    if item.get_closest_marker("embedded") is not None:
+        from stt_codegen.embedded import missing_message
+        message = missing_message()
+        if message:
+            pytest.skip("embedded toolchain: " + message)

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from conftest import arena_toml, designed
 from sampling import random_points
-from test_codegen_support import COMPILERS, CLib, compile_shared, flags, write
+from codegen_helpers import COMPILERS, CLib, compile_shared, flags, write
 from test_model_equivalence import casadi_outputs
 
 from stt_codegen.codegen.functions import clamped_control, deployed_functions

@@ -1,4 +1,8 @@
-"""The implicit alpha step: Newton (model) against bisection (reference) and a stiff solver."""
+"""The implicit alpha step: Newton (model) against bisection (reference) and a stiff solver.
+
+``stt-codegen bench alpha`` prints the figures these tests bound: the error after each
+number of Newton iterations, and the deployed alpha's error at 1, 2 and 4 kHz.
+"""
 
 from __future__ import annotations
 
@@ -63,8 +67,14 @@ def test_newton_root_solves_the_implicit_equation(psi, alpha, theta0, dt, kappa)
     assert abs(a - root) <= 1e-12 * max(1.0, abs(root))
 
 
-def test_deployed_alpha_converges_to_a_stiff_solver():
-    """Backward Euler at the deployed rate against Radau at rtol 1e-10 (first order in dt)."""
+def test_deployed_alpha_is_backward_euler_of_the_adaptive_law():
+    """The deployed alpha at its rate and at twice it, against Radau: within the first-order
+    error of backward Euler (1.15e-3 at 1 kHz), halved with dt, and Richardson's
+    ``2 a_2r - a_r`` far closer still, so the error is the method's, not a bug's.
+
+    Radau at rtol 1e-8 is accurate to about 1e-10 here, far below the errors compared.
+    The figures (rates 1, 2 and 4 kHz, Radau at rtol 1e-10) are ``stt-codegen bench alpha``'s.
+    """
     _, design, _ = designed("omnirobot-s1")
     horizon = 1.1 * design.prescribed_time
 
@@ -75,7 +85,7 @@ def test_deployed_alpha_converges_to_a_stiff_solver():
         return np.diag(R.adaptive_law(design, t, a)[1][0])
 
     exact = solve_ivp(rhs, (0.0, horizon), np.zeros(2 * design.dimension), method="Radau",
-                      rtol=1e-10, atol=1e-12, jac=jac, dense_output=True, max_step=0.01)
+                      rtol=1e-8, atol=1e-10, jac=jac, dense_output=True, max_step=0.1)
     assert exact.status == 0
     runs = {}
     for rate in (design.rate_hz, 2 * design.rate_hz):

@@ -143,6 +143,7 @@ def test_effort_statistics_are_over_the_satisfied_runs():
     assert s["effort_p95"] == pytest.approx(10 * np.percentile(np.arange(1, 21), 95))
 
 
+@pytest.mark.bench
 def test_one_arena_job(tmp_path, monkeypatch):
     monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path / "cache"))
     result = run_arena(0, 1, ("stt", "astar"))

@@ -24,6 +24,7 @@ def test_local_pool_keeps_the_order():
         run_parallel(operator.mul, calls, workers=0, progress=False)
 
 
+@pytest.mark.bench
 def test_arenas_json_on_local_processes(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path / "cache"))
     specs = tmp_path / "specs"
@@ -49,6 +50,7 @@ def test_arenas_json_on_local_processes(tmp_path, monkeypatch, capsys):
     assert "leaked" not in captured.err  # OMPL stays in the worker processes
 
 
+@pytest.mark.bench
 def test_arenas_table(tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path / "cache"))
     assert main(["bench", "arenas", "--count", "1", "--methods", "astar", "--workers", "1",
@@ -58,6 +60,7 @@ def test_arenas_table(tmp_path, monkeypatch, capsys):
     assert "peak |u| median" in out and "effort p95" in out
 
 
+@pytest.mark.bench
 def test_arenas_on_a_dask_cluster(tmp_path, monkeypatch):
     distributed = pytest.importorskip("distributed")
     monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path / "cache"))
@@ -85,6 +88,9 @@ def test_arenas_on_a_dask_cluster(tmp_path, monkeypatch):
     (["bench", "step", "omnirobot-s1", "--steps", "0"], "--steps"),
     (["bench", "scaling", "--obstacles", "1,x"], "--obstacles"),
     (["bench", "scaling", "--dimensions", "0"], "--dimensions"),
+    (["bench", "covering", "--count", "-1"], "--count"),
+    (["bench", "covering", "--tolerance", "0"], "--tolerance"),
+    (["bench", "alpha", "no-such-case"], ""),
 ])
 def test_bad_input_exits_2_without_traceback(argv, field, capsys, monkeypatch):
     monkeypatch.setattr(parallel, "CONNECT_TIMEOUT", "1s")

@@ -25,6 +25,7 @@ def _cache(tmp_path, monkeypatch):
     monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path / "cache"))
 
 
+@pytest.mark.bench
 @needs_valgrind
 def test_step_report(capsys):
     assert main(["bench", "step", "omnirobot-s1", "--steps", "2000", "--json"]) == 0
@@ -53,6 +54,7 @@ _LIBRARY_OPS = ("OP_EXP", "OP_LOG", "OP_LOG1P", "OP_EXPM1", "OP_POW", "OP_CONSTP
                 "OP_HYPOT")
 
 
+@pytest.mark.bench
 def test_step_operation_counts_match_casadis_instruction_list():
     """The benchmark's operation counts against CasADi's own instruction list of the step."""
     import casadi
@@ -75,6 +77,7 @@ def test_step_operation_counts_match_casadis_instruction_list():
     assert report["instructions_per_step"] is None
 
 
+@pytest.mark.bench
 @needs_valgrind
 def test_callgrind_count_is_deterministic_and_per_step():
     harness = build_harness(synthetic_design(3, 2))
@@ -113,6 +116,7 @@ def test_synthetic_designs():
         synthetic_design(1, 0)
 
 
+@pytest.mark.bench
 @needs_valgrind
 def test_scaling_report():
     report = run_scaling_bench([1, 6], [3], active_obstacles=4, sparse=(3, 60))

@@ -62,10 +62,13 @@ upper = [1.0]
 """
 
 
+# --horizon -1 repeats test_errors_and_imports.py's in-process check: it and nan are slow-tier
 @pytest.mark.parametrize("args, message", [
     (["simulate", "no-such-case"], "no bundled case and no file named 'no-such-case'"),
-    (["simulate", "omnirobot-s1", "--horizon", "-1"], "--horizon: must be a positive"),
-    (["simulate", "omnirobot-s1", "--horizon", "nan"], "--horizon: must be a positive"),
+    pytest.param(["simulate", "omnirobot-s1", "--horizon", "-1"],
+                 "--horizon: must be a positive", marks=pytest.mark.slow),
+    pytest.param(["simulate", "omnirobot-s1", "--horizon", "nan"],
+                 "--horizon: must be a positive", marks=pytest.mark.slow),
     (["simulate", "BADFILE"], "prescribed_time: must be positive"),
 ])
 def test_bad_input_exit_2_without_traceback(tmp_path, args, message):
@@ -89,6 +92,7 @@ def test_plot_into_missing_folder_fails_before_simulating(tmp_path):
     assert not (tmp_path / "no").exists()
 
 
+@pytest.mark.slow
 def test_plot_is_written(tmp_path):
     png = tmp_path / "run.png"
     out = run("simulate", "omnirobot-s2", "--backend", "casadi", "--plot", str(png))
@@ -97,6 +101,7 @@ def test_plot_is_written(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["run.png"]   # no temporary left
 
 
+@pytest.mark.slow
 def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
     out = run("demo", "--out", str(tmp_path / "demo"))
     assert out.returncode == 0, out.stderr

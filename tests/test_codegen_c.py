@@ -7,7 +7,7 @@ import subprocess
 
 import numpy as np
 import pytest
-from test_codegen_support import COMPILERS, built, files_of, flags, write
+from codegen_helpers import COMPILERS, built, files_of, flags, write
 from conftest import CASES, designed, model_of
 from sampling import random_points
 from test_model_equivalence import casadi_outputs

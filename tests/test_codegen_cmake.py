@@ -7,7 +7,7 @@ import subprocess
 
 import pytest
 from conftest import designed
-from test_codegen_support import files_of, write
+from codegen_helpers import files_of, write
 
 CMAKE = shutil.which("cmake")
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import casadi
 import pytest
-from test_codegen_support import files_of
+from codegen_helpers import files_of
 
 from stt_codegen import __version__
 from stt_codegen.cli import main
@@ -30,6 +30,9 @@ sys.exit(main(["generate", "omnirobot-s3", "-o", sys.argv[1], "--precision", sys
 """
 
 
+# generate in two processes (slow tier); the emitter's own cross-process identity is
+# tests/test_emit_instructions.py's, in the fast tier
+@pytest.mark.slow
 @pytest.mark.parametrize("precision", ["double", "single"])
 def test_byte_identical_across_processes_and_hash_seeds(precision, tmp_path):
     outs = []

@@ -13,7 +13,7 @@ import subprocess
 
 import pytest
 from conftest import designed
-from test_codegen_support import COMPILERS, files_of, write
+from codegen_helpers import COMPILERS, files_of, write
 
 GUARD = "must not be compiled with -ffast-math"
 FAMILIES = [("gcc", ["-Ofast"]), ("gcc", ["-O2", "-ffast-math"]),

@@ -11,7 +11,7 @@ from functools import lru_cache
 from pathlib import Path
 
 import pytest
-from test_codegen_support import COMPILERS, STRICT, write
+from codegen_helpers import COMPILERS, STRICT, write
 
 from stt_codegen.codegen.generate import generate_files
 from stt_codegen.codegen.options import Options

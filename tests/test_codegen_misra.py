@@ -16,7 +16,7 @@ import subprocess
 
 import pytest
 from conftest import designed
-from test_codegen_support import files_of, write
+from codegen_helpers import files_of, write
 
 CPPCHECK = shutil.which("cppcheck")
 

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 from conftest import designed
-from test_codegen_support import COMPILERS, built
+from codegen_helpers import COMPILERS, built
 
 from stt_codegen.tube import reference as R
 

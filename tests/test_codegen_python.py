@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from test_codegen_support import files_of
+from codegen_helpers import files_of
 from conftest import CASES, designed, model_of
 from sampling import random_points
 from test_model_equivalence import casadi_outputs

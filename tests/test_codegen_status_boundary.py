@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from conftest import designed, model_of
 from sampling import random_points
-from test_codegen_support import COMPILERS, built, files_of
+from codegen_helpers import COMPILERS, built, files_of
 from test_model_equivalence import casadi_outputs
 
 from stt_codegen.runtime.compiled import load_python_module

@@ -62,6 +62,7 @@ def test_reach_tube_and_its_rate_are_continuous_at_every_via_point():
     assert np.max(np.abs(R.reach_tube(tube, mid)[2])) > 0.1
 
 
+@pytest.mark.slow
 def test_a_via_tube_meeting_an_obstacle_between_two_samples_is_rejected():
     """A 0.1 mm obstacle that the via tube's corner clips for less than one 20 ms period."""
     spec, design = serpentine()
@@ -182,7 +183,7 @@ def test_design_json_fields_and_exit_codes(tmp_path):
     props = {p["name"]: p for p in data["certificate"]["properties"]}
     assert props["avoids obstacle 0"]["passed"] and props["avoids obstacle 0"]["margin"] > 0
     assert data["certificate"]["horizon"] == "inf"
-    assert 0 < data["design_time_s"] < 60 and data["gain"] > 0
+    assert data["design_time_s"] > 0 and data["gain"] > 0     # a duration: no bound on it
 
     blocked = tmp_path / "wall.toml"
     blocked.write_text(SERPENTINE.split("[[obstacles]]")[0] + WALL)
@@ -211,7 +212,8 @@ def test_huge_prescribed_time_designs_and_simulate_refuses_with_exit_2(tmp_path)
     assert "budget" in out.stderr and "Traceback" not in out.stderr
 
 
-ARENAS = range(12)
+#: Arenas 0 and 1 in the fast tier, the others in the slow one (a closed loop each).
+ARENAS = [0, 1] + [pytest.param(k, marks=pytest.mark.slow) for k in range(2, 12)]
 
 
 @pytest.mark.parametrize("index", ARENAS)

@@ -13,14 +13,6 @@ import pytest
 
 from conftest import CASES
 from stt_codegen.cli import main
-from stt_codegen.embedded import missing_message
-
-
-@pytest.fixture(scope="module", autouse=True)
-def _tools() -> None:
-    message = missing_message()
-    if message:
-        pytest.skip("embedded toolchain: " + message)
 
 
 @pytest.fixture(scope="module")
@@ -37,6 +29,7 @@ def _report(case, reports, tmp_path_factory, capsys) -> dict:
     return reports[case]
 
 
+@pytest.mark.embedded
 @pytest.mark.parametrize("case", CASES)
 def test_embedded_case(case, reports, tmp_path_factory, capsys) -> None:
     code, r = _report(case, reports, tmp_path_factory, capsys)
@@ -77,6 +70,7 @@ def test_embedded_case(case, reports, tmp_path_factory, capsys) -> None:
     assert "expf" not in by_function and "__ieee754_expf" not in by_function
 
 
+@pytest.mark.embedded
 def test_embedded_text_output(capsys, tmp_path) -> None:
     code = main(["embedded", "omnirobot-s2", "--no-host", "--build-dir", str(tmp_path / "b")])
     out = capsys.readouterr().out

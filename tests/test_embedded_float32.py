@@ -24,7 +24,9 @@ def _gcc() -> None:
         pytest.skip("host C compiler missing: install the Debian package gcc")
 
 
-@pytest.mark.parametrize("case", CASES)
+# S1 (with the sanitizers) in the fast tier; S2 and S3 in the slow one
+@pytest.mark.parametrize("case", [CASES[0]] + [pytest.param(c, marks=pytest.mark.slow)
+                                                for c in CASES[1:]])
 def test_no_overflow_or_invalid_on_adversarial_inputs(case, tmp_path) -> None:
     spec, design, _ = designed(case)
     r = check_host(spec, design, tmp_path, sanitize=(case == CASES[0]))

@@ -7,15 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from stt_codegen.embedded import build_elf, measure, missing_message, run_qemu
+from stt_codegen.embedded import build_elf, measure, run_qemu
 from stt_codegen.embedded.footprint import FootprintError, worst_stack
-
-
-@pytest.fixture(scope="module", autouse=True)
-def _tools() -> None:
-    message = missing_message()
-    if message:
-        pytest.skip("embedded toolchain: " + message)
 
 
 # A "controller": a wrapper calling a body, like the generated code.
@@ -68,6 +61,7 @@ def built(tmp_path_factory: pytest.TempPathFactory):
     return build_elf([d / "ctrl.c", d / "main.c"], out_dir=d / "build")
 
 
+@pytest.mark.embedded
 def test_sizes_of_controller_object(built) -> None:
     fp = measure(built.objects[:1], built.su_files[:1], entry="ctrl_step")
     assert fp.data == 4
@@ -81,6 +75,7 @@ def test_sizes_of_controller_object(built) -> None:
     assert both.text > fp.text and both.stack_bytes is None
 
 
+@pytest.mark.embedded
 def test_static_stack_along_call_chain(built) -> None:
     fp = measure(built.objects[:1], built.su_files[:1], entry="ctrl_step")
     assert fp.stack_is_static
@@ -93,6 +88,7 @@ def test_static_stack_along_call_chain(built) -> None:
     assert measure(built.objects[:1], entry="ctrl_step").stack_bytes == fp.stack_bytes
 
 
+@pytest.mark.embedded
 def test_painted_stack_consistent_with_static_bound(built) -> None:
     fp = measure(built.objects[:1], entry="ctrl_step")
     run = run_qemu(built.elf, timeout=60, count_instructions=True)
@@ -116,6 +112,7 @@ def test_worst_stack_picks_deepest_path_and_rejects_recursion() -> None:
         worst_stack("zz", frames, graph)
 
 
+@pytest.mark.embedded
 def test_su_files_written(built) -> None:
     for su in built.su_files:
         assert Path(su).exists()

@@ -9,16 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from stt_codegen.embedded import board, build_elf, missing_message, run_qemu
+from stt_codegen.embedded import board, build_elf, run_qemu
 from stt_codegen.embedded.target import (BuildError, count_region_instructions,
                                          profile_regions)
-
-
-@pytest.fixture(scope="module", autouse=True)
-def _tools() -> None:
-    message = missing_message()
-    if message:
-        pytest.skip("embedded toolchain: " + message)
 
 
 MATH_PROGRAM = r"""
@@ -66,6 +59,7 @@ def _build(tmp_path: Path, source: str, defines: dict | None = None, **kw):
     return build_elf([src], out_dir=tmp_path / "build", defines=defines, **kw)
 
 
+@pytest.mark.embedded
 def test_float_maths_pass(tmp_path: Path) -> None:
     res = _build(tmp_path, MATH_PROGRAM, _wants())
     run = run_qemu(res.elf, timeout=60)
@@ -82,6 +76,7 @@ def test_float_maths_pass(tmp_path: Path) -> None:
     assert res.elf_sizes["text"] > 0
 
 
+@pytest.mark.embedded
 def test_failing_program_exits_nonzero(tmp_path: Path) -> None:
     wants = _wants() | {"LOGF_WANT": "1.0f"}
     run = run_qemu(_build(tmp_path, MATH_PROGRAM, wants).elf, timeout=60)
@@ -90,11 +85,13 @@ def test_failing_program_exits_nonzero(tmp_path: Path) -> None:
     assert "logf" in run.stdout and "FAIL" in run.stdout
 
 
+@pytest.mark.embedded
 def test_exit_status_passed_through(tmp_path: Path) -> None:
     src = "#include <stdlib.h>\nint main(void) { exit(42); }\n"
     assert run_qemu(_build(tmp_path, src).elf, timeout=30).exit_code == 42
 
 
+@pytest.mark.embedded
 def test_fault_gives_fault_status(tmp_path: Path) -> None:
     src = "int main(void) { __builtin_trap(); }\n"  # udf: UsageFault -> HardFault
     run = run_qemu(_build(tmp_path, src).elf, timeout=30)
@@ -102,12 +99,14 @@ def test_fault_gives_fault_status(tmp_path: Path) -> None:
     assert "fault" in run.stderr
 
 
+@pytest.mark.embedded
 def test_timeout(tmp_path: Path) -> None:
     src = "int main(void) { for (;;) { __asm__ volatile(\"\"); } }\n"
     run = run_qemu(_build(tmp_path, src).elf, timeout=2)
     assert run.timed_out and run.exit_code is None
 
 
+@pytest.mark.embedded
 def test_build_error(tmp_path: Path) -> None:
     with pytest.raises(BuildError, match="error"):
         _build(tmp_path, "int main(void) { return undefined_thing; }\n")
@@ -149,6 +148,7 @@ int main(void)
 """
 
 
+@pytest.mark.embedded
 def test_instruction_counts(tmp_path: Path) -> None:
     run = run_qemu(_build(tmp_path, COUNT_PROGRAM).elf, timeout=60, count_instructions=True)
     assert run.exit_code == 0, run.stdout
@@ -171,6 +171,7 @@ def test_instruction_counts(tmp_path: Path) -> None:
     assert 0 < stack < 512
 
 
+@pytest.mark.embedded
 def test_without_counting_no_counts(tmp_path: Path) -> None:
     run = run_qemu(_build(tmp_path, COUNT_PROGRAM).elf, timeout=60)
     assert run.exit_code == 0 and run.instructions is None

@@ -169,6 +169,7 @@ print(json.dumps({"modules": len(names), "changed": changed}))
 """
 
 
+@pytest.mark.slow
 def test_no_module_changes_global_state_when_imported():
     """Import every module of the package: warnings, numpy, matplotlib, sys.path... unchanged."""
     proc = subprocess.run([sys.executable, "-c", GLOBAL_STATE], capture_output=True, text=True,

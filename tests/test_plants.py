@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from test_plants_support import input_matrix, plant_within
+from plants_helpers import input_matrix, plant_within
 
 from stt_codegen.design.search import design_tube
 from stt_codegen.runtime.plants import Disturbance, make_plant

@@ -126,9 +126,11 @@ def test_good_dims_and_the_default():
 
 
 @pytest.mark.parametrize("command", [["design", "omnirobot-s1", "--plot", "x.png"],
-                                     ["simulate", "omnirobot-s1", "--backend", "reference",
-                                      "--plot", "x.png"],
-                                     ["demo", "--out", "demo"]])
+                                     pytest.param(["simulate", "omnirobot-s1", "--backend",
+                                                   "reference", "--plot", "x.png"],
+                                                  marks=pytest.mark.slow),
+                                     pytest.param(["demo", "--out", "demo"],
+                                                  marks=pytest.mark.slow)])
 def test_bad_dims_on_the_command_line_exit_2_before_any_work(tmp_path, command):
     out = subprocess.run([sys.executable, "-m", "stt_codegen.cli", *command, "--dims", "0,3"],
                          capture_output=True, text=True, timeout=600, cwd=tmp_path)
@@ -217,7 +219,7 @@ def assert_legends_are_clean(fig) -> int:
     return len(legends)
 
 
-@pytest.mark.parametrize("dims", [(0, 1), (0, 2)])
+@pytest.mark.parametrize("dims", [(0, 1), pytest.param((0, 2), marks=pytest.mark.slow)])
 def test_design_legends_have_one_entry_per_thing_outside_the_axes(dims):
     for spec in (load_spec("omnirobot-s1"), mixed_3d()):
         fig = plots.design_figure(design_tube(spec), dims)

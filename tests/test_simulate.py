@@ -13,7 +13,9 @@ from stt_codegen.runtime.plants import Disturbance, check_seed, make_plant
 from stt_codegen.runtime.simulate import SUBSTEPS, _rk4, simulate
 
 
-@pytest.mark.parametrize("backend", ["reference", "casadi"])
+# the numpy reference runs the 9000 steps in about 10 s: its loop is slow-tier, and
+# test_reference_and_casadi_loops_agree keeps it in the fast tier over 3 s
+@pytest.mark.parametrize("backend", [pytest.param("reference", marks=pytest.mark.slow), "casadi"])
 def test_paper_cases_are_satisfied(case, backend):
     design = design_of(case)
     spec = design.spec

@@ -66,7 +66,8 @@ def test_bound_is_certified_and_tight(psi_min: float, theta0: float, kappa: floa
         assert rhs <= 1e-12 * kappa * a
 
 
-@pytest.mark.parametrize("psi_min", [-0.5, 0.3, -2.0])
+@pytest.mark.parametrize("psi_min", [pytest.param(-0.5, marks=pytest.mark.slow),
+                                     pytest.param(0.3, marks=pytest.mark.slow), -2.0])
 def test_numeric_adversarial(psi_min: float) -> None:
     c = check_adaptive_law_numeric(adversarial_psi_signals(1.0, psi_min), 6.0, **CASE)
     assert c.passed, c.detail

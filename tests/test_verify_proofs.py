@@ -208,15 +208,6 @@ def test_every_printed_piece_is_in_the_key(monkeypatch):
         getattr(getattr(deployed, name), "cache_clear", lambda: None)()
 
 
-@pytest.mark.slow
-def test_the_command_line_json_has_no_progress(cache_home):
-    run = subprocess.run([sys.executable, "-m", "stt_codegen.cli", "verify", "omnirobot-s1",
-                          "--json"], capture_output=True, text=True, check=False)
-    assert run.returncode == 0, run.stderr
-    assert json.loads(run.stdout)[0]["name"] == "lemma3.3.reach.continuity"
-    assert run.stderr == ""
-
-
 @pytest.mark.parametrize("first", ["import stt_codegen.verify.lemma", "import stt_codegen",
                                    "from stt_codegen.verify import Check"])
 def test_stt_codegen_verify_is_the_function_whatever_is_imported_first(first):

@@ -7,10 +7,11 @@ import dataclasses
 from pathlib import Path
 
 import numpy as np
+import pytest
 from conftest import CASES, designed
 from hypothesis import HealthCheck, given, note, settings
 from hypothesis import strategies as st
-from test_plants_support import plant_system, plant_within
+from plants_helpers import plant_system, plant_within
 
 from stt_codegen.design.gain import derived_gain, gain_derivation
 from stt_codegen.design.samples import sample_tube
@@ -38,6 +39,7 @@ def by_name(checks) -> dict:
     return {c.name: c for c in checks}
 
 
+@pytest.mark.slow
 def test_derived_gain_passes_and_the_old_default_fails_with_the_rate_it_needs():
     good = by_name(verify_spec(load_spec(SPECS / "gain-range-s2.toml")))
     assert all(c.passed for c in good.values()), [c for c in good.values() if not c.passed]
@@ -98,6 +100,7 @@ SOUND = settings(derandomize=True, deadline=None, database=None, max_examples=12
                  suppress_health_check=list(HealthCheck))
 
 
+@pytest.mark.slow
 @SOUND
 @given(case=st.sampled_from(CASES), seed=st.integers(0, 2**32 - 1),
        g_min=st.floats(0.3, 1.5), spread=st.floats(0.0, 2.0), skew=st.floats(0.0, 0.1),
@@ -120,6 +123,7 @@ def test_no_plant_that_the_check_accepts_leaves_the_tube(case, seed, g_min, spre
     assert result.stayed_in_tube and result.satisfied, (case, a, gain)
 
 
+@pytest.mark.slow
 def test_accepted_bounds_hold_for_several_plants():
     """A non-vacuous instance of the property: bounds the check accepts on every case."""
     a = Assumptions((0.5, 1.5), 0.1, 0.1, 0.5, 0.3)
@@ -135,6 +139,7 @@ def test_accepted_bounds_hold_for_several_plants():
             assert result.stayed_in_tube and result.satisfied, (case, seed)
 
 
+@pytest.mark.slow
 def test_worst_case_coupling_is_a_documented_limit_of_the_check():
     """input_gain = [0.5, 3] without input_gain_coupling implies a row coupling of 1.25:
     the check fails at every rate it tries and says which bound to refine."""

@@ -1,4 +1,5 @@
-"""``stt-codegen bench arenas | step | scaling``: the benchmarks of :mod:`stt_codegen.bench`."""
+"""``stt-codegen bench arenas | step | scaling | covering | alpha``: the benchmarks and
+studies of :mod:`stt_codegen.bench`."""
 
 from __future__ import annotations
 
@@ -59,8 +60,24 @@ def _cmd_scaling(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_covering(args: argparse.Namespace) -> int:
+    from ..bench.covering import format_covering_report, run_covering_bench
+    report = run_covering_bench(args.seed, args.count, args.tolerance)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_covering_report(report))
+    return 0
+
+
+def _cmd_alpha(args: argparse.Namespace) -> int:
+    from ..bench.alpha import format_alpha_report, run_alpha_bench
+    report = run_alpha_bench(args.spec)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_alpha_report(report))
+    return 0
+
+
 def configure_bench(bench: argparse.ArgumentParser) -> None:
-    """Sub-subcommands ``bench arenas``, ``bench step`` and ``bench scaling``."""
+    """Sub-subcommands ``bench arenas``, ``step``, ``scaling``, ``covering`` and ``alpha``."""
     bench.description = ("Benchmarks. Every comparison is measured side by side in one run on "
                          "this machine; ratios, not absolute times, are the result.")
     sub = bench.add_subparsers(dest="bench_command", required=True, metavar="BENCH")
@@ -98,3 +115,20 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="give up compiling one design after S seconds (default: %(default)s)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_scaling)
+
+    p = sub.add_parser("covering", help="covering random polygons by boxes, and the design "
+                                        "around them: boxes and seconds")
+    p.add_argument("--count", type=int, default=80, help="polygons (default: %(default)s)")
+    p.add_argument("--seed", type=_non_negative_int, default=0,
+                   help="polygon seed (default: %(default)s)")
+    p.add_argument("--tolerance", type=float, default=0.02, metavar="M",
+                   help="covering tolerance of every polygon (default: %(default)s)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_covering)
+
+    p = sub.add_parser("alpha", help="the implicit alpha step: Newton iterations against "
+                                     "bisection, and convergence to a stiff solver")
+    p.add_argument("spec", metavar="SPEC", nargs="?", default="omnirobot-s1",
+                   help="bundled case name or spec file (default: %(default)s)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_alpha)
