@@ -395,8 +395,13 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
                                  "certificate work") + f" ({reasons()})",
                               kind=FailureKind.SEARCH_BUDGET, tried=best[1])
         budget[0] -= 1
-        found = check_tube(design, spec,
-                           max_intervals=int(min(CANDIDATE_INTERVALS, budget[1])), **kwargs)
+        # the budget counts new work: the intervals resumed from the parent come free
+        resume = kwargs.get("resume")
+        reused = 0 if resume is None else int(np.searchsorted(
+            np.array(resume[0].state.points, dtype=float) / design.rate_hz, resume[1],
+            side="right"))
+        found = check_tube(design, spec, max_intervals=int(
+            min(CANDIDATE_INTERVALS, reused + budget[1])), **kwargs)
         budget[1] -= found.certificate.work
         return found
 
