@@ -125,6 +125,15 @@ def test_summary_statistics():
     assert s["time_median_s"] == pytest.approx(np.median([o["seconds"] for o in outcomes]))
     assert s["time_median_s"] <= s["time_p95_s"] <= 100.0
     assert list(s["failures"].items()) == [("collision", 2), ("no path found", 1)]
+    assert s["max_abs_e_median"] is None and s["max_abs_e_max"] is None  # no tube reported
+
+
+def test_summary_of_the_normalized_error_counts_satisfied_runs_only():
+    outcomes = [{"success": True, "seconds": 1.0, "reason": "", "max_abs_e": e}
+                for e in (0.1, 0.3, 0.2)]
+    outcomes += [{"success": False, "seconds": 1.0, "reason": "collision", "max_abs_e": 0.99}]
+    s = summarize(outcomes)
+    assert s["max_abs_e_median"] == pytest.approx(0.2) and s["max_abs_e_max"] == 0.3
 
 
 def test_one_arena_job(tmp_path, monkeypatch):
@@ -132,7 +141,11 @@ def test_one_arena_job(tmp_path, monkeypatch):
     result = run_arena(0, 1, ("stt", "astar"))
     assert result["name"] == "arena-0-1" and set(result["methods"]) == {"stt", "astar"}
     for outcome in result["methods"].values():
-        assert set(outcome) == {"success", "seconds", "reason", "reach_time", "clearance"}
+        assert set(outcome) == {"success", "seconds", "reason", "reach_time", "clearance",
+                                "max_abs_e"}
         assert outcome["seconds"] > 0 and outcome["success"] == (outcome["reason"] == "")
         if outcome["success"]:
             assert 0 < outcome["reach_time"] <= 9.0 and outcome["clearance"] > 0
+    # the tube controller's state keeps off its tube's wall; a tracker has no tube
+    assert 0.0 <= result["methods"]["stt"]["max_abs_e"] <= 0.7
+    assert result["methods"]["astar"]["max_abs_e"] is None

@@ -79,10 +79,13 @@ def closed_loop_failure(result: SimulationResult) -> str:
     return "other"  # pragma: no cover - satisfied is exactly the three above
 
 
-def _outcome(seconds: float, reason: str, result: SimulationResult | None) -> dict[str, Any]:
+def _outcome(seconds: float, reason: str, result: SimulationResult | None,
+             tube: bool = False) -> dict[str, Any]:
     return {"success": not reason, "seconds": seconds, "reason": reason,
             "reach_time": None if result is None else result.reach_time,
-            "clearance": None if result is None else result.min_obstacle_clearance}
+            "clearance": None if result is None else result.min_obstacle_clearance,
+            # the state's normalized error in its tube (a baseline has no tube)
+            "max_abs_e": result.max_abs_e if tube and result is not None else None}
 
 
 def _plan_stt(spec, method: str) -> dict[str, Any]:
@@ -154,7 +157,9 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
     dict
         ``{"index", "name", "methods": {method: {"success" (bool), "seconds"
         (design or planning time, s), "reason" (failure category, "" on success),
-        "reach_time" (s or None), "clearance" (m or None)}}}``.
+        "reach_time" (s or None), "clearance" (m or None), "max_abs_e" (the largest
+        ``|e_i|`` of the state in its tube, STT methods; ``None`` for the baselines or
+        without a closed loop)}}}``.
     """
     from ..runtime.simulate import simulate
     from .tracker import track
@@ -170,7 +175,7 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
             if tube not in runs:
                 runs[tube] = simulate(spec, tube, backend="c", seed=index)
             out[method] = _outcome(planned["seconds"], closed_loop_failure(runs[tube]),
-                                   runs[tube])
+                                   runs[tube], tube=True)
         else:
             plan = planned["plan"]
             if plan.path is None:

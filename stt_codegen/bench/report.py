@@ -47,19 +47,26 @@ def summarize(outcomes: list[dict[str, Any]]) -> dict[str, Any]:
     Parameters
     ----------
     outcomes : list of dict
-        Per arena, ``{"success": bool, "seconds": float, "reason": str}``.
+        Per arena, ``{"success": bool, "seconds": float, "reason": str}`` and, for a tube
+        controller, ``"max_abs_e"`` (the state's largest normalized error in its tube).
 
     Returns
     -------
     dict
         ``runs``, ``successes``, ``success_rate`` (0..1), ``time_median_s`` and
         ``time_p95_s`` (design or planning time over all runs, failed ones included,
-        seconds) and ``failures`` (reason -> count, most frequent first).
+        seconds), ``failures`` (reason -> count, most frequent first) and, over the
+        satisfied runs that report it, ``max_abs_e_median`` and ``max_abs_e_max`` (``None``
+        without any).
     """
     seconds = np.array([o["seconds"] for o in outcomes], dtype=float)
     successes = sum(bool(o["success"]) for o in outcomes)
     failures = Counter(o["reason"] for o in outcomes if not o["success"])
+    errors = np.array([o["max_abs_e"] for o in outcomes
+                       if o["success"] and o.get("max_abs_e") is not None], dtype=float)
     return {
+        "max_abs_e_median": float(np.median(errors)) if errors.size else None,
+        "max_abs_e_max": float(errors.max()) if errors.size else None,
         "runs": len(outcomes),
         "successes": successes,
         "success_rate": successes / len(outcomes) if outcomes else 0.0,
