@@ -103,7 +103,7 @@ def _circumvent_rate(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
     return (lo_l, hi_l), (lo_u, hi_u)
 
 
-def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
+def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool = True):
     """Ranges of ``rho_L``, ``rho_U``, of their rates and the least ``rho_U - rho_L`` per interval.
 
     ``rho`` is monotone on each segment; its rate has one sign there and is unimodal
@@ -114,6 +114,11 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
     monotone on each segment too, so its least value on an interval is at its ends or at a
     segment boundary inside: a box that moves keeps its width, however far it moves.
 
+    Parameters
+    ----------
+    rates : bool
+        Also the rates' ranges (else ``None`` in their place).
+
     Returns
     -------
     (lower_min, lower_max), (upper_min, upper_max), ((rate_lower_min, rate_lower_max),
@@ -122,13 +127,16 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
     """
     edges = sorted({s.start for s in design.segments} | {s.end for s in design.segments})
     peaks = [s.start + s.duration * (_W_STAR / (1.0 + _W_STAR) if s.profile == TANH else 0.5)
-             for s in design.segments]
+             for s in design.segments] if rates else []
     points = [t0, t1] + [np.clip(e, t0, t1) for e in edges]
     value_points = len(points)
     points += [np.clip(p, t0, t1) for p in peaks]
     rho_l, rho_u, rate_l, rate_u = reference.reach_tube(design, np.concatenate(points))
     shape = (len(points), t0.size, design.dimension)
     rho_l, rho_u = rho_l.reshape(shape)[:value_points], rho_u.reshape(shape)[:value_points]
+    if not rates:
+        return ((rho_l.min(0), rho_l.max(0)), (rho_u.min(0), rho_u.max(0)), None,
+                (rho_u - rho_l).min(0))
     rate_l, rate_u = rate_l.reshape(shape), rate_u.reshape(shape)
     ends = np.zeros(t0.shape, dtype=bool)
     for seg in design.segments:
@@ -169,6 +177,35 @@ def piece_ranges(design: TubeDesign, t0: np.ndarray, t1: np.ndarray) -> Pieces:
     psi_lo = np.concatenate([beta_u[0] - rho_l[1], rho_u[0] - beta_l[1]], axis=1)
     psi_hi = np.concatenate([beta_u[1] - rho_l[0], rho_u[1] - beta_l[0]], axis=1)
     return Pieces(rho_l, rho_u, beta_l, beta_u, rho_rate, beta_rate, psi_lo, psi_hi, rho_width)
+
+
+def piece_widths(design: TubeDesign, t0: np.ndarray, t1: np.ndarray,
+                 alpha_min: np.ndarray) -> np.ndarray:
+    """Lower bound of ``gamma_U - gamma_L`` on each ``[t0, t1]`` for ``alpha >= alpha_min``.
+
+    The bound of :func:`enclose` (``width_min``) without the rest: the larger of
+    ``min gamma_U - max gamma_L`` and :func:`width_lower_bound`, each monotone in ``alpha``.
+
+    Parameters
+    ----------
+    t0, t1 : ndarray, shape (K,)
+        Seconds.
+    alpha_min : ndarray, shape (K, 2n)
+
+    Returns
+    -------
+    ndarray, shape (K, n)
+    """
+    n = design.dimension
+    nu = design.smoothness
+    rho_l, rho_u, _, rho_width = reach_range(design, t0, t1, rates=False)
+    beta_l, beta_u = circumvent_range(design, t0, t1)
+    pieces = Pieces(rho_l, rho_u, beta_l, beta_u, None, None, None, None, rho_width)
+    lower_max = reference.smooth_max(np.stack([rho_l[1] - alpha_min[:, :n], beta_l[1]], -1),
+                                     nu)[0]
+    upper_min = -reference.smooth_max(np.stack([-(rho_u[0] + alpha_min[:, n:]), -beta_u[0]],
+                                               -1), nu)[0]
+    return np.maximum(upper_min - lower_max, width_lower_bound(design, pieces, alpha_min))
 
 
 def _softplus(d: np.ndarray, nu: float) -> np.ndarray:

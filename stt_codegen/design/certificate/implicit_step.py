@@ -85,6 +85,17 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
             np.where(done, hi * (1.0 + 1e-13) + 1e-300, 0.0))
 
 
+def _fixed_points(psi_lo: np.ndarray, psi_hi: np.ndarray, theta_lo: np.ndarray,
+                  theta_hi: np.ndarray, kappa: float) -> tuple[np.ndarray, np.ndarray]:
+    """The lower end of ``a*``'s bracket for (``psi_hi``, ``theta_lo``) and the upper end for
+    (``psi_lo``, ``theta_hi``), in one vectorized :func:`alpha_fixed_point` (its cost is
+    mostly per iteration, not per element)."""
+    lo, hi = alpha_fixed_point(np.concatenate([psi_hi, psi_lo]),
+                               np.concatenate([theta_lo, theta_hi]), kappa)
+    half = psi_lo.shape[0]
+    return lo[:half], hi[half:]
+
+
 class Propagation:
     """The per-interval coefficients of :func:`alpha_ranges`, to carry bounds one interval on.
 
@@ -113,8 +124,8 @@ class Propagation:
         star_hi, star_lo = np.zeros_like(psi_lo), np.zeros_like(psi_hi)
         long = steps > EXACT_STEPS
         if long.any():
-            star_hi[long] = alpha_fixed_point(psi_lo[long], theta_hi[long], kappa)[1]
-            star_lo[long] = alpha_fixed_point(psi_hi[long], theta_lo[long], kappa)[0]
+            star_lo[long], star_hi[long] = _fixed_points(psi_lo[long], psi_hi[long],
+                                                         theta_lo[long], theta_hi[long], kappa)
         with np.errstate(divide="ignore", over="ignore", under="ignore", invalid="ignore"):
             q_lo = 1.0 / (c + 2.0 * dt * theta_lo / (psi_hi + star_lo) ** 3)
             decay_lo = np.where(np.isinf(steps)[:, None], 0.0,
@@ -314,8 +325,7 @@ def sequence_bounds(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
     c = 1.0 + kappa * dt
     theta_hi = reference.trigger(design, psi_lo)
     theta_lo = reference.trigger(design, psi_hi)
-    star_hi = alpha_fixed_point(psi_lo, theta_hi, kappa)[1]
-    star_lo = alpha_fixed_point(psi_hi, theta_lo, kappa)[0]
+    star_lo, star_hi = _fixed_points(psi_lo, psi_hi, theta_lo, theta_hi, kappa)
     with np.errstate(divide="ignore", over="ignore", under="ignore", invalid="ignore"):
         q_lo = 1.0 / (c + 2.0 * dt * theta_lo / (psi_hi + star_lo) ** 3)
         q_lo = np.where(np.isnan(q_lo), 1.0, q_lo)        # no rate known: monotone only

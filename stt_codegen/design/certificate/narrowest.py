@@ -7,11 +7,11 @@ width on an interval by :func:`~.enclosures.width_lower_bound`; where ``rho``, `
 and bound in continuous time (proofs in ``docs/design.md``, "The narrowest width"):
 
 * **Pieces.** An interval is cut into pieces; ``rho`` and ``beta`` get the piece's own
-  ranges (:func:`~.enclosures.piece_ranges`), and the deployed ``alpha`` a range of its own
+  ranges, and the deployed ``alpha`` a range of its own
   too: on an interval of one sampling period (where ``alpha`` is the linear interpolation
   of its two end values) between the linear interpolations of the bounds at the two ends;
   on a longer one between the two extreme constant-coefficient sequences over the piece's
-  steps (:meth:`~.implicit_step.SequenceBounds.within`). :func:`~.enclosures.enclose`
+  steps (:meth:`~.implicit_step.SequenceBounds.within`). :func:`~.enclosures.piece_widths`
   then bounds the width on the piece from below, for every ``t`` in it.
 * **Upper bound.** The width grows with ``alpha`` (``gamma_L`` falls with ``alpha_L``,
   ``gamma_U`` rises with ``alpha_U``), so the width at an instant with ``alpha`` at its upper
@@ -38,7 +38,7 @@ import numpy as np
 
 from ...tube import reference
 from ...tube.parameters import TubeDesign
-from .enclosures import enclose, piece_ranges
+from .enclosures import piece_widths
 from .implicit_step import SequenceBounds, sequence_bounds
 from .report import Enclosure
 
@@ -224,9 +224,7 @@ def sharpen_narrowest(design: TubeDesign, enc: Enclosure, steps: np.ndarray,
         f0, f1 = n0, n1
         s0, s1 = at(par, f0), at(par, f1)
         s1 = np.maximum(s1, s0)
-        a_lo, a_hi = alpha_of(par, f0, f1)
-        piece = enclose(design, piece_ranges(design, s0, s1), a_lo, a_hi, s0, s1)
-        low = piece.width_min.min(axis=1)
+        low = piece_widths(design, s0, s1, alpha_of(par, f0, f1)[0]).min(axis=1)
         pieces += par.size
     else:
         # rounds used up (never in practice: 8^12 pieces an interval): the last pieces
