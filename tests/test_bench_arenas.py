@@ -126,6 +126,15 @@ def test_summary_statistics():
     assert s["time_median_s"] <= s["time_p95_s"] <= 100.0
     assert list(s["failures"].items()) == [("collision", 2), ("no path found", 1)]
     assert s["effort_runs"] == 0 and s["peak_u_median"] is None   # none carries peak_u
+    assert s["max_abs_e_median"] is None and s["max_abs_e_max"] is None  # no tube reported
+
+
+def test_summary_of_the_normalized_error_counts_satisfied_runs_only():
+    outcomes = [{"success": True, "seconds": 1.0, "reason": "", "max_abs_e": e}
+                for e in (0.1, 0.3, 0.2)]
+    outcomes += [{"success": False, "seconds": 1.0, "reason": "collision", "max_abs_e": 0.99}]
+    s = summarize(outcomes)
+    assert s["max_abs_e_median"] == pytest.approx(0.2) and s["max_abs_e_max"] == 0.3
 
 
 def test_effort_statistics_are_over_the_satisfied_runs():
@@ -150,7 +159,7 @@ def test_one_arena_job(tmp_path, monkeypatch):
     assert result["name"] == "arena-0-1" and set(result["methods"]) == {"stt", "astar"}
     for outcome in result["methods"].values():
         assert set(outcome) == {"success", "seconds", "reason", "reach_time", "clearance",
-                                "peak_u", "effort"}
+                                "peak_u", "effort", "max_abs_e"}
         assert outcome["seconds"] > 0 and outcome["success"] == (outcome["reason"] == "")
         if outcome["success"]:
             assert 0 < outcome["reach_time"] <= 9.0 and outcome["clearance"] > 0
@@ -158,3 +167,6 @@ def test_one_arena_job(tmp_path, monkeypatch):
             # |integral u dt| >= 4.93 - 1.27 m, so integral |u|^2 dt >= 3.66^2 / 9 s
             # (Cauchy-Schwarz) and max_i |u_i| >= 3.66 / (9 sqrt(2)) m/s
             assert outcome["peak_u"] >= 0.28 and outcome["effort"] >= 1.48
+    # the tube controller's state keeps off its tube's wall; a tracker has no tube
+    assert 0.0 <= result["methods"]["stt"]["max_abs_e"] <= 0.7
+    assert result["methods"]["astar"]["max_abs_e"] is None

@@ -49,6 +49,8 @@ def test_enclosures_contain_the_deployed_tube(case, resumed):
     assert np.all(enc.alpha_min[j] - slack <= alpha) and np.all(alpha <= enc.alpha_max[j] + slack)
     assert np.all(enc.lower_min[j] - slack <= g_l) and np.all(g_l <= enc.lower_max[j] + slack)
     assert np.all(enc.upper_min[j] - slack <= g_u) and np.all(g_u <= enc.upper_max[j] + slack)
+    assert np.all(enc.width_min[j] - slack <= g_u - g_l)
+    assert np.all(enc.width_min >= enc.upper_min - enc.lower_max)
     # and the enclosures are not vacuous: their median width is a small part of the tube
     assert np.median(enc.lower_max - enc.lower_min) < 0.1
 

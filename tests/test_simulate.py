@@ -11,6 +11,7 @@ from stt_codegen.runtime import backends
 from stt_codegen.errors import SpecError
 from stt_codegen.runtime.plants import Disturbance, check_seed, make_plant
 from stt_codegen.runtime.simulate import SUBSTEPS, _rk4, simulate
+from stt_codegen.tube import reference as R
 
 
 # the numpy reference runs the 9000 steps in about 10 s: its loop is slow-tier, and
@@ -25,6 +26,9 @@ def test_paper_cases_are_satisfied(case, backend):
     assert not result.collision and not result.left_state_space and result.stayed_in_tube
     assert result.min_obstacle_clearance > 0
     assert result.steps == 9000 and len(result.max_abs_u) == 3
+    # the state keeps off the tube's wall (issue 20: it rode it at |e| = 0.81 on S2 when
+    # the gain came from a loose bound of the tube's width)
+    assert 0.0 < result.max_abs_e <= 0.7, result.max_abs_e
 
 
 def test_reference_and_casadi_loops_agree():
@@ -77,6 +81,19 @@ class _Stubborn:
         return self.u, alpha, backends.STATUS_OK
 
 
+class _Lazy:
+    """The reference controller's ``alpha`` and status, but no input."""
+
+    name = "lazy"
+
+    def __init__(self, design):
+        self.inner = backends.make_controller("reference", design)
+
+    def step(self, x, t, dt, alpha):
+        u, alpha_next, status = self.inner.step(x, t, dt, alpha)
+        return np.zeros_like(u), alpha_next, status
+
+
 def test_judging_reports_failures(monkeypatch):
     design = design_of("omnirobot-s1")
     monkeypatch.setitem(backends._FACTORIES, "idle", lambda d: _Stubborn([0.0, 0.0, 0.0]))
@@ -86,6 +103,14 @@ def test_judging_reports_failures(monkeypatch):
     monkeypatch.setitem(backends._FACTORIES, "east", lambda d: _Stubborn([1.0, 0.0, 0.0]))
     east = simulate(design, backend="east")
     assert east.collision and not east.satisfied and east.min_obstacle_clearance < 0
+    # the normalized error is the state's, in the tube (here alpha follows the deployed
+    # step and the state stays put): left behind by the tube, beyond 1
+    monkeypatch.setitem(backends._FACTORIES, "lazy", lambda d: _Lazy(d))
+    lazy = simulate(spec, design, "lazy", horizon=2.0)
+    g_l, g_u, _, _ = R.adaptive_tube(design, lazy.trajectory.t, lazy.trajectory.alpha)
+    e = (2 * lazy.trajectory.x - (g_u + g_l)) / (g_u - g_l)
+    assert lazy.max_abs_e == pytest.approx(float(np.abs(e).max()), rel=1e-12)
+    assert lazy.max_abs_e > 1.0 and not lazy.stayed_in_tube
     # straight north leaves the state space
     monkeypatch.setitem(backends._FACTORIES, "north", lambda d: _Stubborn([0.0, 1.0, 0.0]))
     north = simulate(design, backend="north", horizon=2.0)

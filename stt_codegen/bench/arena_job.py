@@ -79,13 +79,16 @@ def closed_loop_failure(result: SimulationResult) -> str:
     return "other"  # pragma: no cover - satisfied is exactly the three above
 
 
-def _outcome(seconds: float, reason: str, result: SimulationResult | None) -> dict[str, Any]:
+def _outcome(seconds: float, reason: str, result: SimulationResult | None,
+             tube: bool = False) -> dict[str, Any]:
     return {"success": not reason, "seconds": seconds, "reason": reason,
             "reach_time": None if result is None else result.reach_time,
             "clearance": None if result is None else result.min_obstacle_clearance,
             # the largest |u_i| over the run and the inputs, and integral |u|^2 dt
             "peak_u": None if result is None else max(result.max_abs_u),
-            "effort": None if result is None else result.control_effort}
+            "effort": None if result is None else result.control_effort,
+            # the state's normalized error in its tube (a baseline has no tube)
+            "max_abs_e": result.max_abs_e if tube and result is not None else None}
 
 
 def _plan_stt(spec, method: str) -> dict[str, Any]:
@@ -159,8 +162,9 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
         (design or planning time, s), "reason" (failure category, "" on success),
         "reach_time" (s or None), "clearance" (m or None), "peak_u" (the largest
         ``|u_i|`` over the run and the inputs, m/s, or None), "effort" (``integral
-        |u|^2 dt``, m^2/s, or None)}}}``; the last four are ``None`` without a closed
-        loop.
+        |u|^2 dt``, m^2/s, or None), "max_abs_e" (the largest ``|e_i|`` of the state in its
+        tube, STT methods; ``None`` for the baselines)}}}``; the last five are ``None``
+        without a closed loop.
     """
     from ..runtime.simulate import run_closed_loop
     from .tracker import track
@@ -176,7 +180,7 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
             if tube not in runs:
                 runs[tube] = run_closed_loop(spec, tube, backend="c", seed=index)
             out[method] = _outcome(planned["seconds"], closed_loop_failure(runs[tube]),
-                                   runs[tube])
+                                   runs[tube], tube=True)
         else:
             plan = planned["plan"]
             if plan.path is None:

@@ -47,8 +47,9 @@ def summarize(outcomes: list[dict[str, Any]]) -> dict[str, Any]:
     Parameters
     ----------
     outcomes : list of dict
-        Per arena, ``{"success": bool, "seconds": float, "reason": str}``, and for the
-        arenas with a closed loop ``"peak_u"`` and ``"effort"`` (floats).
+        Per arena, ``{"success": bool, "seconds": float, "reason": str}``, for the
+        arenas with a closed loop ``"peak_u"`` and ``"effort"`` (floats) and, for a tube
+        controller, ``"max_abs_e"`` (the state's largest normalized error in its tube).
 
     Returns
     -------
@@ -58,12 +59,18 @@ def summarize(outcomes: list[dict[str, Any]]) -> dict[str, Any]:
         seconds), ``failures`` (reason -> count, most frequent first) and the control
         effort over the ``effort_runs`` satisfied runs: ``peak_u_median``,
         ``peak_u_p95`` (the largest ``|u_i|`` of a run) and ``effort_median``,
-        ``effort_p95`` (its ``integral |u|^2 dt``), ``None`` without such runs.
+        ``effort_p95`` (its ``integral |u|^2 dt``), ``None`` without such runs;
+        and, over the satisfied runs that report it, ``max_abs_e_median`` and
+        ``max_abs_e_max`` (``None`` without any).
     """
     seconds = np.array([o["seconds"] for o in outcomes], dtype=float)
     successes = sum(bool(o["success"]) for o in outcomes)
     failures = Counter(o["reason"] for o in outcomes if not o["success"])
+    errors = np.array([o["max_abs_e"] for o in outcomes
+                       if o["success"] and o.get("max_abs_e") is not None], dtype=float)
     return {
+        "max_abs_e_median": float(np.median(errors)) if errors.size else None,
+        "max_abs_e_max": float(errors.max()) if errors.size else None,
         "runs": len(outcomes),
         "successes": successes,
         "success_rate": successes / len(outcomes) if outcomes else 0.0,

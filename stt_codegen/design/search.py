@@ -34,6 +34,7 @@ from .failures import FailureKind, property_kind
 from .gain import derived_gain
 from .plant_check import plant_failure
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
+from .tracking import tracking_demand
 from .via import via_design
 from .windows import WINDOW_INFLATION, candidates, overlap_interval, progress_time
 
@@ -342,10 +343,36 @@ def design_tube(spec: Spec) -> Design:
                         else "; no controller.rate_hz up to "
                         f"{RATE_SEARCH_FACTOR:g} times this one makes the tube tried pass")
         raise DesignError(message, kind=kind, tried=tried)
+    tube = _with_gain(tube, check, spec)
+    if method == "auto" and used == METHOD_PAPER and METHOD_VIA not in errors:
+        tube, used, check = _trackable(spec, base, tube, check)
+    return Design(tube, used, check, time.perf_counter() - started, spec=spec)
+
+
+def _with_gain(tube: TubeDesign, check: TubeCheck, spec: Spec) -> TubeDesign:
+    """``tube`` with the spec's ``controller.gain``, or the gain derived from its certified
+    narrowest width (:func:`~stt_codegen.design.gain.derived_gain`)."""
     gain = (spec.gain if spec.gain is not None
             else derived_gain(check.min_width, tube.rate_hz, spec.assumptions))
-    return Design(replace(tube, gain=gain), used, check, time.perf_counter() - started,
-                  spec=spec)
+    return replace(tube, gain=gain)
+
+
+def _trackable(spec: Spec, base: TubeDesign, tube: TubeDesign,
+               check: TubeCheck) -> tuple[TubeDesign, str, TubeCheck]:
+    """``auto``'s choice between the paper's tube and via points when the paper's asks for
+    more gain than it has (:func:`~stt_codegen.design.tracking.tracking_demand` above 1):
+    the via tube if it has a design that asks for less, else the paper's."""
+    demand = tracking_demand(tube, check.certificate, spec)
+    if demand.ratio <= 1.0:
+        return tube, METHOD_PAPER, check
+    try:
+        via, via_check = _via(spec, base)
+    except DesignError:
+        return tube, METHOD_PAPER, check
+    via = _with_gain(via, via_check, spec)
+    if tracking_demand(via, via_check.certificate, spec).ratio < demand.ratio:
+        return via, METHOD_VIA, via_check
+    return tube, METHOD_PAPER, check
 
 
 def _via(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck]:
@@ -432,8 +459,13 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
                                  "certificate work") + f" ({reasons()})",
                               kind=FailureKind.SEARCH_BUDGET, tried=best[1])
         budget[0] -= 1
-        found = check_tube(design, spec,
-                           max_intervals=int(min(CANDIDATE_INTERVALS, budget[1])), **kwargs)
+        # the budget counts new work: the intervals resumed from the parent come free
+        resume = kwargs.get("resume")
+        reused = 0 if resume is None else int(np.searchsorted(
+            np.array(resume[0].state.points, dtype=float) / design.rate_hz, resume[1],
+            side="right"))
+        found = check_tube(design, spec, max_intervals=int(
+            min(CANDIDATE_INTERVALS, reused + budget[1])), **kwargs)
         budget[1] -= found.certificate.work
         return found
 

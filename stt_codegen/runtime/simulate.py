@@ -22,6 +22,7 @@ from ..design.samples import check_step_budget
 from ..errors import SpecError
 from .plants import check_seed, make_plant
 from ..spec.loader import Spec
+from ..tube import reference
 from ..tube.parameters import TubeDesign
 
 #: Runge-Kutta steps per sampling period.
@@ -63,6 +64,11 @@ class SimulationResult:
     stayed_in_tube : bool
         Every controller step on ``[0, horizon]`` reported the state inside the tube
         (``STATUS_OK``, or ``STATUS_INPUT_CLAMPED``: inside, ``u`` clamped).
+    max_abs_e : float or None
+        ``max_k max_i |e_i(t_k)|`` over the controller steps on ``[0, horizon]``, the
+        normalized error ``e = (2 x - (gamma_U + gamma_L)) / (gamma_U - gamma_L)`` of the
+        state in the design's tube (eq. (10) at the step's ``alpha``): 1 is the tube's wall.
+        ``None`` where the tube is empty at a step (then ``e`` is not defined).
     max_abs_u : list of float
         Peak ``|u_i|`` per input over the run, input units.
     steps : int
@@ -86,6 +92,7 @@ class SimulationResult:
     min_obstacle_clearance: float | None
     left_state_space: bool
     stayed_in_tube: bool
+    max_abs_e: float | None
     max_abs_u: list[float]
     steps: int
     control_effort: float = 0.0
@@ -265,11 +272,17 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
         min_clear, collision = None, False
     left = bool(np.any((within < lo) | (within > hi)))
     satisfied = reached and not collision and not left and horizon >= t_c
+    with reference.numpy_math():
+        g_l, g_u, _, _ = reference.adaptive_tube(design, ts, alphas)
+    width = g_u - g_l
+    max_abs_e = (float(np.max(np.abs(2.0 * xs - (g_u + g_l)) / width))
+                 if np.all(width > 0.0) else None)
     return SimulationResult(
         spec=spec.name, backend=backend, satisfied=satisfied, reached=reached,
         reach_time=reach_time, prescribed_time=t_c, collision=collision,
         min_obstacle_clearance=min_clear, left_state_space=left,
         stayed_in_tube=bool(np.all((status == STATUS_OK) | (status == STATUS_INPUT_CLAMPED))),
+        max_abs_e=max_abs_e,
         max_abs_u=[float(v) for v in np.abs(us).max(axis=0)], steps=steps,
         control_effort=float(np.sum(us[:steps] ** 2) * dt),
         clamped_steps=int(np.sum(status == STATUS_INPUT_CLAMPED)),

@@ -22,18 +22,23 @@ The public names are importable from here.
 """
 
 from .enclosures import (Pieces, bump_ranges, circumvent_range, enclose, enclose_tube,
-                         piece_ranges, reach_range)
-from .implicit_step import (EXACT_STEPS, STEP_ROOT_TOLERANCE, alpha_fixed_point, alpha_ranges,
-                            step_root)
-from .refine import (MAX_INTERVALS, MIN_INTERVAL, SPLIT, WIDTH_BAND, WIDTH_PIECES, WIDTH_ROUNDS,
-                     certify_tube)
+                         piece_ranges, reach_range, width_lower_bound)
+from .implicit_step import (EXACT_STEPS, STEP_ROOT_TOLERANCE, Propagation, SequenceBounds,
+                            alpha_fixed_point, alpha_ranges, sequence_bounds, step_root)
+from .narrowest import (WIDTH_PIECE_BUDGET, WIDTH_SPLIT, WIDTH_TOLERANCE, Narrowest,
+                        sharpen_narrowest)
+from .refine import MAX_INTERVALS, MIN_INTERVAL, SPLIT, WIDTH_REFINE_ROUNDS, certify_tube
+from .repropagate import repropagate, step_psi
 from .report import (MAX_MOVE_PER_SAMPLE, PROPERTIES, ROUNDING_MARGIN, Certificate,
                      CertificateState, Enclosure, Margin, certificate_report,
                      obstacle_separation)
 
 __all__ = ["EXACT_STEPS", "MAX_INTERVALS", "MAX_MOVE_PER_SAMPLE", "MIN_INTERVAL", "PROPERTIES",
-           "ROUNDING_MARGIN", "SPLIT", "STEP_ROOT_TOLERANCE", "WIDTH_BAND", "WIDTH_PIECES",
-           "WIDTH_ROUNDS", "Certificate", "CertificateState", "Enclosure", "Margin", "Pieces",
-           "alpha_fixed_point", "alpha_ranges", "bump_ranges", "certificate_report",
-           "certify_tube", "circumvent_range", "enclose", "enclose_tube",
-           "obstacle_separation", "piece_ranges", "reach_range", "step_root"]
+           "ROUNDING_MARGIN", "SPLIT", "STEP_ROOT_TOLERANCE", "WIDTH_PIECE_BUDGET",
+           "WIDTH_REFINE_ROUNDS", "WIDTH_SPLIT", "WIDTH_TOLERANCE", "Certificate",
+           "CertificateState", "Enclosure", "Margin", "Narrowest", "Pieces", "Propagation",
+           "SequenceBounds", "alpha_fixed_point", "alpha_ranges", "bump_ranges",
+           "certificate_report", "certify_tube", "circumvent_range", "enclose",
+           "enclose_tube", "obstacle_separation", "piece_ranges", "reach_range",
+           "repropagate", "sequence_bounds", "sharpen_narrowest", "step_psi", "step_root",
+           "width_lower_bound"]

@@ -103,28 +103,40 @@ def _circumvent_rate(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
     return (lo_l, hi_l), (lo_u, hi_u)
 
 
-def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
-    """Ranges of ``rho_L``, ``rho_U`` and of their rates per interval, shape (K, n) each.
+def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool = True):
+    """Ranges of ``rho_L``, ``rho_U``, of their rates and the least ``rho_U - rho_L`` per interval.
 
     ``rho`` is monotone on each segment; its rate has one sign there and is unimodal
     (peak at ``tau = w*/(1+w*)`` for ``"tanh"``, ``1/2`` for ``"smoothstep"``) and 0 at a
     segment's end; evaluated at a boundary it is the right limit, so 0 joins the range
-    of an interval with a segment end inside.
+    of an interval with a segment end inside. The reach box's width
+    ``rho_U - rho_L = (U_from - L_from) + ((U_to - L_to) - (U_from - L_from)) p(tau)`` is
+    monotone on each segment too, so its least value on an interval is at its ends or at a
+    segment boundary inside: a box that moves keeps its width, however far it moves.
+
+    Parameters
+    ----------
+    rates : bool
+        Also the rates' ranges (else ``None`` in their place).
 
     Returns
     -------
     (lower_min, lower_max), (upper_min, upper_max), ((rate_lower_min, rate_lower_max),
-    (rate_upper_min, rate_upper_max))
+    (rate_upper_min, rate_upper_max)), width_min
+        Each (K, n).
     """
     edges = sorted({s.start for s in design.segments} | {s.end for s in design.segments})
     peaks = [s.start + s.duration * (_W_STAR / (1.0 + _W_STAR) if s.profile == TANH else 0.5)
-             for s in design.segments]
+             for s in design.segments] if rates else []
     points = [t0, t1] + [np.clip(e, t0, t1) for e in edges]
     value_points = len(points)
     points += [np.clip(p, t0, t1) for p in peaks]
     rho_l, rho_u, rate_l, rate_u = reference.reach_tube(design, np.concatenate(points))
     shape = (len(points), t0.size, design.dimension)
     rho_l, rho_u = rho_l.reshape(shape)[:value_points], rho_u.reshape(shape)[:value_points]
+    if not rates:
+        return ((rho_l.min(0), rho_l.max(0)), (rho_u.min(0), rho_u.max(0)), None,
+                (rho_u - rho_l).min(0))
     rate_l, rate_u = rate_l.reshape(shape), rate_u.reshape(shape)
     ends = np.zeros(t0.shape, dtype=bool)
     for seg in design.segments:
@@ -135,7 +147,7 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
         return np.fmin(rate.min(0), zero), np.fmax(rate.max(0), zero)
 
     return ((rho_l.min(0), rho_l.max(0)), (rho_u.min(0), rho_u.max(0)),
-            (span(rate_l), span(rate_u)))
+            (span(rate_l), span(rate_u)), (rho_u - rho_l).min(0))
 
 
 # --------------------------------------------------------------------------- intervals
@@ -153,16 +165,85 @@ class Pieces:
     beta_rate: tuple
     psi_lo: np.ndarray
     psi_hi: np.ndarray
+    #: least ``rho_U - rho_L`` on the interval, (K, n)
+    rho_width: np.ndarray
 
 
 def piece_ranges(design: TubeDesign, t0: np.ndarray, t1: np.ndarray) -> Pieces:
     """Ranges of ``rho``, ``beta``, their rates and ``psi`` (eq. (11)) on each ``[t0, t1]``."""
-    rho_l, rho_u, rho_rate = reach_range(design, t0, t1)
+    rho_l, rho_u, rho_rate, rho_width = reach_range(design, t0, t1)
     beta_l, beta_u = circumvent_range(design, t0, t1)
     beta_rate = _circumvent_rate(design, t0, t1)
     psi_lo = np.concatenate([beta_u[0] - rho_l[1], rho_u[0] - beta_l[1]], axis=1)
     psi_hi = np.concatenate([beta_u[1] - rho_l[0], rho_u[1] - beta_l[0]], axis=1)
-    return Pieces(rho_l, rho_u, beta_l, beta_u, rho_rate, beta_rate, psi_lo, psi_hi)
+    return Pieces(rho_l, rho_u, beta_l, beta_u, rho_rate, beta_rate, psi_lo, psi_hi, rho_width)
+
+
+def piece_widths(design: TubeDesign, t0: np.ndarray, t1: np.ndarray,
+                 alpha_min: np.ndarray) -> np.ndarray:
+    """Lower bound of ``gamma_U - gamma_L`` on each ``[t0, t1]`` for ``alpha >= alpha_min``.
+
+    The bound of :func:`enclose` (``width_min``) without the rest: the larger of
+    ``min gamma_U - max gamma_L`` and :func:`width_lower_bound`, each monotone in ``alpha``.
+
+    Parameters
+    ----------
+    t0, t1 : ndarray, shape (K,)
+        Seconds.
+    alpha_min : ndarray, shape (K, 2n)
+
+    Returns
+    -------
+    ndarray, shape (K, n)
+    """
+    n = design.dimension
+    nu = design.smoothness
+    rho_l, rho_u, _, rho_width = reach_range(design, t0, t1, rates=False)
+    beta_l, beta_u = circumvent_range(design, t0, t1)
+    pieces = Pieces(rho_l, rho_u, beta_l, beta_u, None, None, None, None, rho_width)
+    lower_max = reference.smooth_max(np.stack([rho_l[1] - alpha_min[:, :n], beta_l[1]], -1),
+                                     nu)[0]
+    upper_min = -reference.smooth_max(np.stack([-(rho_u[0] + alpha_min[:, n:]), -beta_u[0]],
+                                               -1), nu)[0]
+    return np.maximum(upper_min - lower_max, width_lower_bound(design, pieces, alpha_min))
+
+
+def _softplus(d: np.ndarray, nu: float) -> np.ndarray:
+    """``(1/nu) ln(1 + exp(nu d))``, increasing: ``max~(a, b) = a + softplus(b - a)``."""
+    return np.logaddexp(0.0, nu * d) / nu
+
+
+def width_lower_bound(design: TubeDesign, pieces: Pieces, alpha_min: np.ndarray) -> np.ndarray:
+    """A lower bound of ``gamma_U - gamma_L`` on each interval that does not lose the box's move.
+
+    With ``s(d) = (1/nu) ln(1 + exp(nu d))``, eq. (10) reads ``gamma_L = (rho_L - alpha_L) +
+    s(beta_L - rho_L + alpha_L)`` and ``gamma_U = (rho_U + alpha_U) - s(rho_U + alpha_U -
+    beta_U)``, so exactly
+
+        gamma_U - gamma_L = (rho_U - rho_L) + [alpha_U - s(rho_U + alpha_U - beta_U)]
+                                            + [alpha_L - s(beta_L - rho_L + alpha_L)].
+
+    Each bracket increases with its ``alpha`` (slope ``1 - s' >= 0``) and its ``beta``'s
+    distance, and falls with its ``rho`` bound; the first term is bounded by
+    ``rho_U - rho_L`` itself (:func:`reach_range`). On a segment without circumvents the
+    brackets are tiny, so the bound is the reach box's width, whatever the box's move.
+
+    Parameters
+    ----------
+    pieces : Pieces
+    alpha_min : ndarray, shape (K, 2n)
+        Lower bounds of ``alpha`` on the intervals.
+
+    Returns
+    -------
+    ndarray, shape (K, n)
+    """
+    n = design.dimension
+    nu = design.smoothness
+    al_lo, au_lo = alpha_min[:, :n], alpha_min[:, n:]
+    upper = au_lo - _softplus(pieces.rho_u[1] + au_lo - pieces.beta_u[0], nu)
+    lower = al_lo - _softplus(pieces.beta_l[1] - pieces.rho_l[0] + al_lo, nu)
+    return pieces.rho_width + upper + lower
 
 
 def enclose(design: TubeDesign, pieces: Pieces, alpha_min: np.ndarray, alpha_max: np.ndarray,
@@ -209,7 +290,7 @@ def enclose(design: TubeDesign, pieces: Pieces, alpha_min: np.ndarray, alpha_max
     gu_max = np.maximum(ru_max + adot_max[:, n:], bu_max)
     rate_l = np.maximum(np.abs(gl_min), np.abs(gl_max))
     rate_u = np.maximum(np.abs(gu_min), np.abs(gu_max))
-    width = upper_min - lower_max
+    width = np.maximum(upper_min - lower_max, width_lower_bound(design, pieces, alpha_min))
     # a bound moves in one period at most |gamma_dot| dt, and at most its whole range on
     # the interval (which is at least one period long)
     move = np.minimum(np.maximum(rate_l, rate_u) / design.rate_hz,
@@ -219,7 +300,7 @@ def enclose(design: TubeDesign, pieces: Pieces, alpha_min: np.ndarray, alpha_max
         ratio = np.where(width > 0, move / width, 0.0)
     ratio = np.where(np.isnan(ratio), np.inf, ratio)
     return Enclosure(t0, t1, lower_min, lower_max, upper_min, upper_max, alpha_min, alpha_max,
-                     ratio.max(axis=1), pieces.psi_lo, pieces.psi_hi)
+                     ratio.max(axis=1), pieces.psi_lo, pieces.psi_hi, width)
 
 
 def enclose_tube(design: TubeDesign, samples) -> Enclosure:

@@ -13,6 +13,7 @@ bound on ``alpha`` (what could widen the tube into an obstacle) holds for it exa
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -84,8 +85,137 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
             np.where(done, hi * (1.0 + 1e-13) + 1e-300, 0.0))
 
 
+def _fixed_points(psi_lo: np.ndarray, psi_hi: np.ndarray, theta_lo: np.ndarray,
+                  theta_hi: np.ndarray, kappa: float) -> tuple[np.ndarray, np.ndarray]:
+    """The lower end of ``a*``'s bracket for (``psi_hi``, ``theta_lo``) and the upper end for
+    (``psi_lo``, ``theta_hi``), in one vectorized :func:`alpha_fixed_point` (its cost is
+    mostly per iteration, not per element)."""
+    lo, hi = alpha_fixed_point(np.concatenate([psi_hi, psi_lo]),
+                               np.concatenate([theta_lo, theta_hi]), kappa)
+    half = psi_lo.shape[0]
+    return lo[:half], hi[half:]
+
+
+class Propagation:
+    """The per-interval coefficients of :func:`alpha_ranges`, to carry bounds one interval on.
+
+    Built once for a partition (vectorized: ``theta``, the fixed points ``a*`` of the longer
+    intervals, their decay factors); :meth:`advance` then carries the bounds of ``alpha``
+    across interval ``k`` (a plain-Python loop over the ``2n`` components).
+
+    Parameters
+    ----------
+    design : TubeDesign
+    psi_lo, psi_hi : ndarray, shape (K, 2n)
+    steps : ndarray, shape (K,)
+        Steps per interval (``inf`` for the tail).
+    step_psi : list, optional
+        As in :func:`alpha_ranges`.
+    """
+
+    def __init__(self, design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
+                 steps: np.ndarray, step_psi: list | None = None):
+        kappa, dt = design.kappa, 1.0 / design.rate_hz
+        c = 1.0 + kappa * dt
+        theta_hi = reference.trigger(design, psi_lo)
+        theta_lo = reference.trigger(design, psi_hi)
+        # the fixed points matter on the longer intervals only (the short ones follow
+        # their steps)
+        star_hi, star_lo = np.zeros_like(psi_lo), np.zeros_like(psi_hi)
+        long = steps > EXACT_STEPS
+        if long.any():
+            star_lo[long], star_hi[long] = _fixed_points(psi_lo[long], psi_hi[long],
+                                                         theta_lo[long], theta_hi[long], kappa)
+        with np.errstate(divide="ignore", over="ignore", under="ignore", invalid="ignore"):
+            q_lo = 1.0 / (c + 2.0 * dt * theta_lo / (psi_hi + star_lo) ** 3)
+            decay_lo = np.where(np.isinf(steps)[:, None], 0.0,
+                                np.power(q_lo, np.minimum(steps, 1e300)[:, None]))
+        decay_lo = np.where(np.isnan(decay_lo), 1.0, decay_lo)  # no rate known: monotone only
+        self.kappa, self.dt, self.c = kappa, dt, c
+        self.m = psi_lo.shape[1]
+        self.s_lo, self.s_hi = star_lo.tolist(), star_hi.tolist()
+        self.d_lo, self.steps = decay_lo.tolist(), steps.tolist()
+        self.p_lo, self.p_hi = psi_lo.tolist(), psi_hi.tolist()
+        self.t_lo, self.t_hi = theta_lo.tolist(), theta_hi.tolist()
+        self.step_psi = step_psi
+
+    def advance(self, k: int, a_lo: list, a_hi: list) -> tuple[list, list]:
+        """Carry the bounds ``a_lo``, ``a_hi`` of ``alpha`` at interval ``k``'s start to its end.
+
+        Parameters
+        ----------
+        k : int
+        a_lo, a_hi : list of float, (2n,)
+            Bounds at the start; overwritten with the bounds at the end (unchanged for the
+            tail, which has none).
+
+        Returns
+        -------
+        row_lo, row_hi : list of float, (2n,)
+            Range of ``alpha`` on the interval.
+        """
+        kappa, dt, c, m = self.kappa, self.dt, self.c, self.m
+        sl, sh, steps_k = self.s_lo[k], self.s_hi[k], self.steps[k]
+        p_lo, p_hi, t_lo, t_hi = self.p_lo[k], self.p_hi[k], self.t_lo[k], self.t_hi[k]
+        row_lo, row_hi = [0.0] * m, [0.0] * m
+        if steps_k <= EXACT_STEPS:
+            # few steps: follow the extreme backward-Euler sequences exactly, each step
+            # with its own psi where it is known
+            own = None if self.step_psi is None else self.step_psi[k]
+            for i in range(m):
+                lo_i, hi_i = a_lo[i], a_hi[i]
+                low, high = lo_i, hi_i
+                for j in range(int(steps_k)):
+                    if own is None:      # the interval's range of psi
+                        psi_l, psi_h, th_l, th_h = p_lo[i], p_hi[i], t_lo[i], t_hi[i]
+                    else:                # the step's own psi
+                        psi_l, psi_h = own[0][j][i], own[1][j][i]
+                        th_l, th_h = own[2][j][i], own[3][j][i]
+                    lo_i = max(step_root(lo_i, psi_h, th_l, dt, c)[0], 0.0)
+                    hi_i = step_root(hi_i, psi_l, th_h, dt, c)[1]
+                    low, high = min(low, lo_i), max(high, hi_i)
+                row_lo[i], row_hi[i], a_lo[i], a_hi[i] = low, high, lo_i, hi_i
+            return row_lo, row_hi
+        if math.isinf(steps_k):
+            # psi is constant from here on: alpha moves monotonically to a* for ever
+            for i in range(m):
+                row_lo[i] = min(a_lo[i], sl[i])
+                row_hi[i] = max(a_hi[i], sh[i])
+            return row_lo, row_hi
+        span = steps_k * dt
+        c_span = 1.0 + kappa * span
+        d_lo = self.d_lo[k]
+        for i in range(m):
+            lo_i, hi_i = a_lo[i], a_hi[i]
+            # lower sequence (psi_hi, theta_lo)
+            if lo_i <= sl[i]:        # rising: one implicit step of N dt lags behind
+                end = max(step_root(lo_i, p_hi[i], t_lo[i], span, c_span)[0],
+                          sl[i] - (sl[i] - lo_i) * d_lo[i])
+                row_lo[i] = lo_i
+            else:                    # falling: no faster than its initial rate
+                z = p_hi[i] + lo_i
+                end = sl[i] if not z > 0.0 else max(
+                    sl[i], lo_i + span * (t_lo[i] / (z * z) - kappa * lo_i))
+                row_lo[i] = end
+            a_lo[i] = end if end > 0.0 else 0.0
+            # upper sequence (psi_lo, theta_hi)
+            if hi_i >= sh[i]:        # falling: one implicit step of N dt lags behind
+                q = 1.0 / (c + 2.0 * dt * t_hi[i] / (p_lo[i] + hi_i) ** 3)
+                end = min(step_root(hi_i, p_lo[i], t_hi[i], span, c_span)[1],
+                          sh[i] + (hi_i - sh[i]) * q ** steps_k)
+                row_hi[i] = hi_i
+            else:                    # rising: no faster than its initial rate
+                z = p_lo[i] + hi_i
+                end = sh[i] if not z > 0.0 else min(
+                    sh[i], hi_i + span * (t_hi[i] / (z * z) - kappa * hi_i))
+                row_hi[i] = end
+            a_hi[i] = end
+        return row_lo, row_hi
+
+
 def alpha_ranges(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
-                  steps: np.ndarray, start: tuple[list, list]):
+                  steps: np.ndarray, start: tuple[list, list],
+                  step_psi: list | None = None):
     """Ranges of the deployed ``alpha`` on each interval, carried from bounds at the first.
 
     On an interval of ``N`` steps with ``psi`` in ``[psi_lo, psi_hi]``, the deployed
@@ -96,7 +226,8 @@ def alpha_ranges(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
     length ``N dt`` from ``A``, nor behind ``a* -+ |A - a*| q^N`` with
     ``q = 1 / (c + 2 dt theta / z^3)`` (convexity of ``1/z^2``); one moving away from
     ``A`` is never ahead of ``A + N dt f(A)``, nor past ``a*``. ``alpha >= 0`` always.
-    At most :data:`EXACT_STEPS` steps follow the extreme implicit steps one by one.
+    At most :data:`EXACT_STEPS` steps follow the extreme implicit steps one by one
+    (:class:`Propagation`).
 
     Parameters
     ----------
@@ -105,6 +236,12 @@ def alpha_ranges(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
         Steps per interval (``inf`` for the tail).
     start : (list, list)
         Lower and upper bounds of ``alpha`` at the first interval's start.
+    step_psi : list, optional
+        Per interval: for one of at most :data:`EXACT_STEPS` steps, the ranges
+        ``(psi_lo, psi_hi, theta_lo, theta_hi)`` of ``psi`` and ``theta`` at the instants
+        its steps use, nested lists (steps, 2n) (the deployed step ``k -> k + 1`` takes
+        ``psi(t_{k+1})``), so each step is followed with its own ``psi`` instead of the
+        interval's range; ``None`` (or no list): the interval's range.
 
     Returns
     -------
@@ -113,74 +250,91 @@ def alpha_ranges(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
     entries : list of (list, list)
         Bounds of ``alpha`` at each interval's start (to resume from).
     """
+    run = Propagation(design, psi_lo, psi_hi, steps, step_psi)
+    a_lo, a_hi = list(start[0]), list(start[1])
+    out_lo, out_hi, entries = [], [], []
+    for k in range(len(run.steps)):
+        entries.append((list(a_lo), list(a_hi)))
+        row_lo, row_hi = run.advance(k, a_lo, a_hi)
+        out_lo.append(row_lo)
+        out_hi.append(row_hi)
+    return out_lo, out_hi, entries
+
+
+@dataclass(frozen=True)
+class SequenceBounds:
+    """The extreme constant-coefficient sequences of intervals, to bound ``alpha`` inside them.
+
+    On an interval with ``psi`` in ``[psi_lo, psi_hi]`` and ``alpha`` in ``[A_lo, A_hi]`` at
+    its start, the deployed ``alpha`` after ``j`` steps lies between the sequences of
+    (``psi_hi``, ``theta_lo``) from ``A_lo`` and of (``psi_lo``, ``theta_hi``) from ``A_hi``
+    (:func:`alpha_ranges`), for every ``j``, not only at the interval's end: :meth:`within`
+    bounds it over a part of the interval, with the bounds :func:`alpha_ranges` uses for the
+    whole. Arrays (K, 2n); build with :func:`sequence_bounds`.
+    """
+
+    start_lo: np.ndarray
+    start_hi: np.ndarray
+    star_lo: np.ndarray
+    star_hi: np.ndarray
+    q_lo: np.ndarray
+    q_hi: np.ndarray
+    rate_lo: np.ndarray
+    rate_hi: np.ndarray
+    dt: float
+
+    def within(self, rows: np.ndarray, j0: np.ndarray, j1: np.ndarray) -> tuple[np.ndarray,
+                                                                               np.ndarray]:
+        """Range of the deployed ``alpha`` over steps ``j0 .. j1`` of intervals ``rows``.
+
+        The lower sequence rising to ``a*`` is at least ``a* - (a* - A) q^j`` (least at
+        ``j0``); falling, at least ``max(a*, A + j dt f(A))`` (least at ``j1``). The upper
+        sequence alike, mirrored. ``alpha >= 0``.
+
+        Parameters
+        ----------
+        rows : ndarray of int, shape (P,)
+            Interval of each part.
+        j0, j1 : ndarray, shape (P,)
+            Steps from the interval's start, ``0 <= j0 <= j1``.
+
+        Returns
+        -------
+        lo, hi : ndarray, shape (P, 2n)
+        """
+        a_lo, a_hi = self.start_lo[rows], self.start_hi[rows]
+        s_lo, s_hi = self.star_lo[rows], self.star_hi[rows]
+        j0, j1 = j0[:, None], j1[:, None]
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            rise = s_lo - (s_lo - a_lo) * np.power(self.q_lo[rows], j0)
+            fall = np.maximum(s_lo, a_lo + j1 * self.dt * self.rate_lo[rows])
+            lo = np.where(a_lo <= s_lo, np.maximum(a_lo, np.nan_to_num(rise, nan=-np.inf)),
+                          np.nan_to_num(fall, nan=-np.inf))
+            drop = s_hi + (a_hi - s_hi) * np.power(self.q_hi[rows], j0)
+            climb = np.minimum(s_hi, a_hi + j1 * self.dt * self.rate_hi[rows])
+            hi = np.where(a_hi >= s_hi, np.nan_to_num(drop, nan=np.inf),
+                          np.nan_to_num(climb, nan=np.inf))
+        return np.maximum(lo, 0.0), hi
+
+
+def sequence_bounds(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
+                    start_lo: np.ndarray, start_hi: np.ndarray) -> SequenceBounds:
+    """:class:`SequenceBounds` of intervals with ``psi`` in ``[psi_lo, psi_hi]`` (K, 2n) and
+    ``alpha`` in ``[start_lo, start_hi]`` at their start (K, 2n)."""
     kappa, dt = design.kappa, 1.0 / design.rate_hz
     c = 1.0 + kappa * dt
     theta_hi = reference.trigger(design, psi_lo)
     theta_lo = reference.trigger(design, psi_hi)
-    star_hi = alpha_fixed_point(psi_lo, theta_hi, kappa)[1]
-    star_lo = alpha_fixed_point(psi_hi, theta_lo, kappa)[0]
+    star_lo, star_hi = _fixed_points(psi_lo, psi_hi, theta_lo, theta_hi, kappa)
     with np.errstate(divide="ignore", over="ignore", under="ignore", invalid="ignore"):
         q_lo = 1.0 / (c + 2.0 * dt * theta_lo / (psi_hi + star_lo) ** 3)
-        decay_lo = np.where(np.isinf(steps)[:, None], 0.0,
-                            np.power(q_lo, np.minimum(steps, 1e300)[:, None]))
-    decay_lo = np.where(np.isnan(decay_lo), 1.0, decay_lo)   # no rate known: monotone only
-    k_count, m = star_hi.shape
-    a_lo, a_hi = list(start[0]), list(start[1])
-    s_lo, s_hi = star_lo.tolist(), star_hi.tolist()
-    d_lo, n_steps = decay_lo.tolist(), steps.tolist()
-    out_lo, out_hi = [[0.0] * m for _ in range(k_count)], [[0.0] * m for _ in range(k_count)]
-    p_lo, p_hi = psi_lo.tolist(), psi_hi.tolist()
-    t_lo, t_hi = theta_lo.tolist(), theta_hi.tolist()
-    two_dt = 2.0 * dt
-    entries = []
-    for k in range(k_count):
-        entries.append((list(a_lo), list(a_hi)))
-        sl, sh, row_lo, row_hi, steps_k = s_lo[k], s_hi[k], out_lo[k], out_hi[k], n_steps[k]
-        if steps_k <= EXACT_STEPS:
-            # few steps: follow the extreme backward-Euler sequences exactly
-            for i in range(m):
-                lo_i, hi_i = a_lo[i], a_hi[i]
-                low, high = lo_i, hi_i
-                for _ in range(int(steps_k)):
-                    lo_i = max(step_root(lo_i, p_hi[k][i], t_lo[k][i], dt, c)[0], 0.0)
-                    hi_i = step_root(hi_i, p_lo[k][i], t_hi[k][i], dt, c)[1]
-                    low, high = min(low, lo_i), max(high, hi_i)
-                row_lo[i], row_hi[i], a_lo[i], a_hi[i] = low, high, lo_i, hi_i
-            continue
-        if math.isinf(steps_k):
-            # psi is constant from here on: alpha moves monotonically to a* for ever
-            for i in range(m):
-                row_lo[i] = min(a_lo[i], sl[i])
-                row_hi[i] = max(a_hi[i], sh[i])
-            continue
-        span = steps_k * dt
-        c_span = 1.0 + kappa * span
-        for i in range(m):
-            lo_i, hi_i = a_lo[i], a_hi[i]
-            # lower sequence (psi_hi, theta_lo)
-            if lo_i <= sl[i]:        # rising: one implicit step of N dt lags behind
-                end = max(step_root(lo_i, p_hi[k][i], t_lo[k][i], span, c_span)[0],
-                          sl[i] - (sl[i] - lo_i) * d_lo[k][i])
-                row_lo[i] = lo_i
-            else:                    # falling: no faster than its initial rate
-                z = p_hi[k][i] + lo_i
-                end = sl[i] if not z > 0.0 else max(
-                    sl[i], lo_i + span * (t_lo[k][i] / (z * z) - kappa * lo_i))
-                row_lo[i] = end
-            a_lo[i] = end if end > 0.0 else 0.0
-            # upper sequence (psi_lo, theta_hi)
-            if hi_i >= sh[i]:        # falling: one implicit step of N dt lags behind
-                q = 1.0 / (c + two_dt * t_hi[k][i] / (p_lo[k][i] + hi_i) ** 3)
-                end = min(step_root(hi_i, p_lo[k][i], t_hi[k][i], span, c_span)[1],
-                          sh[i] + (hi_i - sh[i]) * q ** steps_k)
-                row_hi[i] = hi_i
-            else:                    # rising: no faster than its initial rate
-                z = p_lo[k][i] + hi_i
-                end = sh[i] if not z > 0.0 else min(
-                    sh[i], hi_i + span * (t_hi[k][i] / (z * z) - kappa * hi_i))
-                row_hi[i] = end
-            a_hi[i] = end
-    return out_lo, out_hi, entries
+        q_lo = np.where(np.isnan(q_lo), 1.0, q_lo)        # no rate known: monotone only
+        q_hi = 1.0 / (c + 2.0 * dt * theta_hi / (psi_lo + start_hi) ** 3)
+        z_lo, z_hi = psi_hi + start_lo, psi_lo + start_hi
+        # f(A) = theta / (psi + A)^2 - kappa A; where psi + A <= 0 only a* bounds the move
+        rate_lo = np.where(z_lo > 0.0, theta_lo / (z_lo * z_lo) - kappa * start_lo, -np.inf)
+        rate_hi = np.where(z_hi > 0.0, theta_hi / (z_hi * z_hi) - kappa * start_hi, np.inf)
+    return SequenceBounds(start_lo, start_hi, star_lo, star_hi, q_lo, q_hi, rate_lo, rate_hi, dt)
 
 
 def step_root(a: float, psi: float, theta: float, dt: float, c: float) -> tuple[float, float]:

@@ -19,6 +19,8 @@ from ...tube import reference
 from ...tube.parameters import TubeDesign
 from .enclosures import enclose, piece_ranges
 from .implicit_step import alpha_ranges
+from .narrowest import sharpen_narrowest
+from .repropagate import repropagate, step_psi
 from .report import (MAX_MOVE_PER_SAMPLE, ROUNDING_MARGIN, Certificate, CertificateState, Enclosure,
                      certificate_report, obstacle_separation)
 
@@ -30,12 +32,16 @@ SPLIT = 4
 #: Shortest interval the bisection creates, seconds (or one sampling period if longer):
 #: at very high rates the enclosures need no finer time resolution than this.
 MIN_INTERVAL = 1e-4
-#: The narrowest width (the gain of law (13) comes from it) is sharpened on the intervals
-#: whose width bound is within this fraction of the narrowest ...
-WIDTH_BAND = 0.02
-#: ... cut into this many pieces, this many times.
-WIDTH_PIECES = 16
-WIDTH_ROUNDS = 2
+#: Rounds of finer ``alpha`` propagation for the narrowest width, at most
+#: (:func:`_alpha_refinement`; the certificate's proof is complete before them).
+WIDTH_REFINE_ROUNDS = 6
+#: ... while the bound is below ``1 - WIDTH_REFINE_TOLERANCE`` of the upper bound of the
+#: narrowest width, and each round raises it by at least ``WIDTH_REFINE_GAIN`` of that ...
+WIDTH_REFINE_TOLERANCE = 0.15
+WIDTH_REFINE_GAIN = 0.01
+#: ... and at most this many intervals in the partition after them (a budget of its own:
+#: the proof's ``max_intervals`` is the design search's, spent by then).
+WIDTH_REFINE_INTERVALS = 2000
 
 
 def _breakpoints(design: TubeDesign) -> tuple[list[int], int]:
@@ -58,7 +64,7 @@ def _breakpoints(design: TubeDesign) -> tuple[list[int], int]:
 
 def _failing(design: TubeDesign, spec: Spec, enc: Enclosure, selected, final: bool):
     """Boolean (K,) mask of intervals on which some property is not yet proven."""
-    bad = (enc.upper_min - enc.lower_max).min(axis=1) <= ROUNDING_MARGIN
+    bad = enc.width_min.min(axis=1) <= ROUNDING_MARGIN
     lo, hi = np.array(design.state_lower), np.array(design.state_upper)
     bad |= np.minimum(enc.lower_min - lo, hi - enc.upper_max).min(axis=1) < 0.0
     for _, sep, _, _, _ in obstacle_separation(spec, enc, selected):
@@ -117,6 +123,8 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
     work = 0
     m = 2 * design.dimension
     previous = CertificateState()
+    proven = None                           # (enclosure, state, Narrowest) once all holds
+    width_rounds = 0
     reuse_limit = 0                         # intervals of `previous` that may be reused
     if resume is not None:
         parent, until = resume
@@ -135,17 +143,24 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
         t1 = np.where(i1 < 0, np.inf, i1 * dt)
         pieces = piece_ranges(design, t0, np.where(i1 < 0, t0, t1))
         steps = np.where(i1 < 0, np.inf, (i1 - i0).astype(float))
-        # the intervals before the first new cut are unchanged: resume alpha after them
-        same = next((q for q, (a, b) in enumerate(zip(points, previous.points)) if a != b),
-                    min(len(points), len(previous.points)))
-        keep = max(0, min(same - 1, len(previous.entries) - 1, reuse_limit))
-        start = previous.entries[keep] if keep else ([0.0] * m, [0.0] * m)
-        rows_lo, rows_hi, entries = alpha_ranges(design, pieces.psi_lo[keep:],
-                                                  pieces.psi_hi[keep:], steps[keep:], start)
-        work += len(points) - keep
-        previous = CertificateState(tuple(points), previous.alpha_lo[:keep] + tuple(rows_lo),
-                                    previous.alpha_hi[:keep] + tuple(rows_hi),
-                                    previous.entries[:keep] + tuple(entries))
+        if proven is not None:
+            # a cut of a proven partition: its bounds stay valid, follow the cuts only
+            previous, done = repropagate(design, pieces, points, steps, proven[1])
+            work += done
+        else:
+            # the intervals before the first new cut are unchanged: resume alpha after them
+            same = next((q for q, (a, b) in enumerate(zip(points, previous.points)) if a != b),
+                        min(len(points), len(previous.points)))
+            keep = max(0, min(same - 1, len(previous.entries) - 1, reuse_limit))
+            start = previous.entries[keep] if keep else ([0.0] * m, [0.0] * m)
+            rows_lo, rows_hi, entries = alpha_ranges(design, pieces.psi_lo[keep:],
+                                                      pieces.psi_hi[keep:], steps[keep:], start,
+                                                      step_psi(design, i0[keep:], steps[keep:]))
+            work += len(points) - keep
+            previous = CertificateState(tuple(points),
+                                        previous.alpha_lo[:keep] + tuple(rows_lo),
+                                        previous.alpha_hi[:keep] + tuple(rows_hi),
+                                        previous.entries[:keep] + tuple(entries))
         rows_lo, rows_hi = previous.alpha_lo, previous.alpha_hi
         reuse_limit = len(previous.entries)   # from now on `previous` is this tube's own
         a_min, a_max = np.maximum(np.array(rows_lo), 0.0), np.array(rows_hi)
@@ -153,6 +168,25 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
         bad = _failing(design, spec, enc, selected, final)
         length = np.where(i1 < 0, 0, i1 - i0)
         splittable = length >= max(2, 2 * min_steps)
+        if final and not bad.any():
+            # every property proven: sharpen the narrowest width (the gain comes from it)
+            entry_lo = np.array([e[0] for e in previous.entries])
+            entry_hi = np.array([e[1] for e in previous.entries])
+            narrow = sharpen_narrowest(design, enc, steps, entry_lo, entry_hi)
+            gained = (narrow.lower - proven[2].lower if proven is not None else math.inf)
+            proven = (enc, previous, narrow)
+            thin = narrow.interval_lower < (1.0 - WIDTH_REFINE_TOLERANCE) * narrow.upper
+            split = _alpha_refinement(narrow.alpha_limited & thin, splittable)
+            if (width_rounds >= WIDTH_REFINE_ROUNDS or not split.any()
+                    or narrow.lower >= (1.0 - WIDTH_REFINE_TOLERANCE) * narrow.upper
+                    or gained < WIDTH_REFINE_GAIN * narrow.upper
+                    or len(points) + (SPLIT - 1) * int(split.sum()) > WIDTH_REFINE_INTERVALS):
+                break
+            width_rounds += 1
+            points = _cut(points, i0, length, split)
+            continue
+        if proven is not None:
+            break      # a finer alpha left a property unproven: keep the proven partition
         split = bad & splittable
         # a thin single-sample interval: its alpha may come in loose from a long predecessor
         single = bad & ~split
@@ -172,53 +206,37 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
         if len(points) + (SPLIT - 1) * int(split.sum()) > max_intervals:
             budget_hit = True
             break
-        cuts = {int(a + (b * q) // SPLIT) for a, b in zip(i0[split], length[split])
-                for q in range(1, SPLIT)}
-        points = sorted(set(points) | cuts)
-    narrowest = _narrowest(design, enc) if final and not bad.any() else None
+        points = _cut(points, i0, length, split)
+    narrowest = None
+    if proven is not None:
+        enc, previous, narrow = proven
+        narrowest = (narrow.lower, narrow.time)
     certificate = certificate_report(design, spec, enc, selected, final, budget_hit,
                                      end * dt, max_intervals, narrowest)
     return replace(certificate, state=previous, decisive=decisive, work=work)
 
 
-def _narrowest(design: TubeDesign, enc: Enclosure) -> tuple[float, float]:
-    """A sharper lower bound of the tube's narrowest width, and where it is (s).
+def _cut(points: list[int], i0: np.ndarray, length: np.ndarray, split: np.ndarray) -> list[int]:
+    """``points`` with every interval of ``split`` cut into :data:`SPLIT` (sample indices)."""
+    cuts = {int(a + (b * q) // SPLIT) for a, b in zip(i0[split], length[split])
+            for q in range(1, SPLIT)}
+    return sorted(set(points) | cuts)
 
-    On an interval the deployed ``alpha`` lies in ``[alpha_min, alpha_max]`` at every
-    ``t``, so the width on any piece of it is bounded below with that range and the
-    piece's own (tighter) ranges of ``rho`` and ``beta``. The intervals within
-    :data:`WIDTH_BAND` of the narrowest are cut into :data:`WIDTH_PIECES` pieces,
-    :data:`WIDTH_ROUNDS` times (the pieces within the band again); ``alpha`` is not
-    propagated again, so this costs a few vectorized evaluations.
+
+def _alpha_refinement(limited: np.ndarray, splittable: np.ndarray) -> np.ndarray:
+    """Intervals to cut so that ``alpha``'s bounds tighten where the width bound needs it.
+
+    An *alpha-limited* interval (:class:`~.narrowest.Narrowest`) is cut if it is long
+    enough (a narrower range of ``psi`` on each part narrows ``alpha``'s); one too short
+    to cut has the nearest long interval before it cut instead, through which ``alpha``
+    arrives with loose bounds.
     """
-    width = (enc.upper_min - enc.lower_max).min(axis=1)
-    t0, t1 = enc.t_start, enc.t_end
-    a_min, a_max = enc.alpha_min, enc.alpha_max
-    keep = ~np.isfinite(t1)                       # the tail [T, inf) stays as it is
-    done_w, done_t = list(width[keep]), list(t0[keep])
-    t0, t1, a_min, a_max, width = t0[~keep], t1[~keep], a_min[~keep], a_max[~keep], width[~keep]
-    for _ in range(WIDTH_ROUNDS):
-        best = min(width.min(initial=math.inf), min(done_w, default=math.inf))
-        if not best > 0.0:
-            break
-        band = width <= best * (1.0 + WIDTH_BAND)
-        if not band.any():
-            break
-        done_w += list(width[~band])
-        done_t += list(t0[~band])
-        q = np.arange(WIDTH_PIECES)
-        span = (t1[band] - t0[band])[:, None]
-        s0 = (t0[band][:, None] + span * q / WIDTH_PIECES).ravel()
-        s1 = (t0[band][:, None] + span * (q + 1) / WIDTH_PIECES).ravel()
-        s1 = np.maximum(s1, s0)
-        a_min = np.repeat(a_min[band], WIDTH_PIECES, axis=0)
-        a_max = np.repeat(a_max[band], WIDTH_PIECES, axis=0)
-        piece = enclose(design, piece_ranges(design, s0, s1), a_min, a_max, s0, s1)
-        t0, t1, width = s0, s1, (piece.upper_min - piece.lower_max).min(axis=1)
-    done_w += list(width)
-    done_t += list(t0)
-    k = int(np.argmin(done_w))
-    return float(done_w[k]), float(done_t[k])
+    split = limited & splittable
+    long_before = np.where(splittable, np.arange(splittable.size), -1)
+    nearest = np.maximum.accumulate(np.concatenate([[-1], long_before[:-1]]))
+    before = nearest[np.flatnonzero(limited & ~splittable)]
+    split[before[before >= 0]] = True
+    return split
 
 
 def _surely_failing(design: TubeDesign, spec: Spec, t: np.ndarray, a_min: np.ndarray,

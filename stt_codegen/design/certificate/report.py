@@ -71,6 +71,10 @@ class Enclosure:
         enclosure's width is not positive: ``non-empty`` fails there).
     psi_min, psi_max : ndarray, shape (K, 2n)
         Range of ``psi`` (eq. (11)) on the interval.
+    width_min : ndarray, shape (K, n)
+        Lower bound of ``gamma_U - gamma_L`` on the interval: at least
+        ``upper_min - lower_max``, and tighter where the box moves
+        (:func:`~.enclosures.width_lower_bound`).
     """
 
     t_start: np.ndarray
@@ -84,6 +88,7 @@ class Enclosure:
     move_ratio: np.ndarray
     psi_min: np.ndarray
     psi_max: np.ndarray
+    width_min: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -202,8 +207,7 @@ def certificate_report(design: TubeDesign, spec: Spec, enc: Enclosure, selected,
     note = (" (the certificate's refinement budget of "
             f"{max_intervals} intervals was exhausted)") if budget_hit else ""
 
-    width = enc.upper_min - enc.lower_max
-    min_width, t = _worst(width, t0)[:2] if narrowest is None else narrowest
+    min_width, t = _worst(enc.width_min, t0)[:2] if narrowest is None else narrowest
     margins.append(Margin("non-empty", min_width > ROUNDING_MARGIN, min_width, t,
                           f"min width gamma_U - gamma_L >= {min_width:.6g} (interval at "
                           f"t = {t:.4f} s)" + note))
