@@ -273,7 +273,7 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     left = bool(np.any((within < lo) | (within > hi)))
     satisfied = reached and not collision and not left and horizon >= t_c
     with reference.numpy_math():
-        g_l, g_u, _, _ = reference.adaptive_tube(design, ts, alphas)
+        g_l, g_u, _, _ = reference.adaptive_tube(tube, ts, alphas)
     width = g_u - g_l
     max_abs_e = (float(np.max(np.abs(2.0 * xs - (g_u + g_l)) / width))
                  if np.all(width > 0.0) else None)

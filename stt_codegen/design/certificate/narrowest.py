@@ -115,7 +115,6 @@ def _piece_alpha(rows: np.ndarray, f0: np.ndarray, f1: np.ndarray, steps: np.nda
     """
     a_min, a_max = enc.alpha_min[rows], enc.alpha_max[rows]
     n_steps = steps[rows]
-    single = (n_steps == 1)[:, None]
     g0, g1 = f0[:, None], f1[:, None]
     start_lo, start_hi, end_lo, end_hi = (e[rows] for e in entry)
     lo = np.minimum((1 - g0) * start_lo + g0 * end_lo, (1 - g1) * start_lo + g1 * end_lo)
