@@ -10,7 +10,6 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from dataclasses import replace
 from typing import Callable
 
 import numpy as np
@@ -29,7 +28,7 @@ from .assumption import assumption2_omnidirectional, assumption2_single_integrat
 from .check import Check, VerificationReport
 from .lemma import bump_rate_bound, reach_rate_bound
 from .proofs import design_independent_proofs
-from .sampled import linear_plant_checks, sampled_checks
+from .sampled import plant_bounds_checks, sampled_checks
 
 #: Dimension names used in check names.
 _SIDES = ("L", "U")
@@ -72,7 +71,8 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     spec : Spec
     design : TubeDesign
     plant : str, optional
-        Plant model for Assumption 2 (one of :data:`stt_codegen.spec.plants.PLANT_MODELS`);
+        Plant model (one of :data:`stt_codegen.spec.plants.PLANT_MODELS`) for Assumption 2
+        and the sampled check's bounds (:meth:`~stt_codegen.spec.loader.Spec.with_plant_model`);
         default the spec's.
     cache : bool
         Take the design-independent proofs from the proof cache
@@ -90,7 +90,9 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         (:func:`~stt_codegen.verify.sampled.sampled_checks`).
     """
     stage = progress if isinstance(progress, _Stages) else _Stages(progress, design=False)
-    model = plant or spec.plant_model
+    if plant is not None:
+        spec = spec.with_plant_model(plant)      # the plant's own bounds (SpecError if the
+    model = spec.plant_model                     # declared [assumptions] contradict them)
     n = design.dimension
     proofs = design_independent_proofs(min(n, 3), cache=cache, progress=stage)
     reach = sorted({(a, b, seg.duration) for seg in design.segments if seg.profile == TANH
@@ -117,10 +119,9 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     if model == "omnidirectional":
         checks.append(assumption2_omnidirectional((spec.state_space.lower[2],
                                                    spec.state_space.upper[2])))
-    elif model == "linear":
-        checks += linear_plant_checks(spec)
-    else:
+    elif model != "linear":
         checks.append(assumption2_single_integrator(n))
+    checks += plant_bounds_checks(spec, model)   # assumption2.linear for the linear model
 
     stage("tube certificate")
     tube_check = check_tube(design, spec)   # not the designer's: verify certifies again
@@ -185,7 +186,7 @@ def verify_spec(spec: Spec, plant: str | None = None, *, cache: bool = True,
     stage = _Stages(progress, design=True)
     stage("design")
     try:
-        design = design_tube(spec if plant is None else replace(spec, plant_model=plant))
+        design = design_tube(spec if plant is None else spec.with_plant_model(plant))
     except DesignError as exc:
         return [Check("tube.design", False, str(exc))]
     return verify_design(spec, design.tube, plant, cache=cache, progress=stage)
