@@ -116,6 +116,22 @@ def test_next_level_contains_the_ball_in_the_next_coordinates():
         assert np.linalg.norm(image, axis=1).max() <= bound * (1 + 1e-12) + 1e-15
 
 
+def test_next_level_with_box_limits_contains_the_image_of_the_ball_and_box():
+    rng = np.random.default_rng(8)
+    for _ in range(300):
+        m = int(rng.integers(1, 4))
+        alpha = rng.uniform(0.8, 1.25, m)
+        beta = rng.uniform(-0.05, 0.05, m)
+        level = float(rng.uniform(0, 2.0))
+        limits = rng.uniform(0, 1.5, m) * level
+        a = _ball_points(rng, level, limits, 400)
+        with np.errstate(divide="ignore"):
+            image = np.arctanh(np.clip(alpha * np.tanh(a) + beta, -1, 1))
+        bound = next_level(level, alpha.tolist(), beta.tolist(), limits.tolist())
+        assert bound <= next_level(level, alpha.tolist(), beta.tolist()) * (1 + 1e-12)
+        assert np.linalg.norm(image, axis=1).max() <= bound * (1 + 1e-12) + 1e-15
+
+
 def test_next_level_is_exact_for_a_tube_that_does_not_move():
     assert next_level(0.7, [1.0, 1.0], [0.0, 0.0]) == pytest.approx(0.7)
 

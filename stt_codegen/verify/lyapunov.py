@@ -202,28 +202,41 @@ def _concave_max(rates: Sequence[float], caps: Sequence[float], budget: float) -
     return min(best, dual(hi)[0])
 
 
-def next_level(level: float, alpha: Sequence[float], beta: Sequence[float]) -> float:
-    """A radius of ``W`` in the next sample's coordinates that contains the ball of radius
-    ``level`` in this sample's.
+def next_level(level: float, alpha: Sequence[float], beta: Sequence[float],
+               limits: Sequence[float] | None = None) -> float:
+    """A radius of ``W`` in the next sample's coordinates that contains the set
+    ``{sum a_i^2 <= level^2, |a_i| <= limit_i}`` of this sample's (``a_i = atanh e_i``).
 
     With ``e'_i = alpha_i e_i + beta_i`` (``alpha_i = h_i / h'_i``,
-    ``beta_i = (c_i - c'_i) / h'_i``), ``m_i(a) = atanh(alpha_i tanh(a) + beta_i)`` and
-    ``|m(a)| <= |m(0)| + max_i sup_{|a| <= level} |m_i'| |a|`` (triangle inequality and the
-    mean value theorem per axis). ``m_i' = alpha_i (1 - t^2) / (1 - (alpha_i t + beta_i)^2)``
-    at ``t = tanh a``; its extremes on ``[-tanh r, tanh r]`` are at the ends or at a root of
+    ``beta_i = (c_i - c'_i) / h'_i``), ``m_i(a) = atanh(alpha_i tanh(a) + beta_i)``, and per
+    axis ``|m_i(a_i)| <= |m_i(0)| + L_i |a_i|`` (mean value theorem) with
+    ``L_i = sup |m_i'|`` on ``|a| <= min(level, limit_i)``; by Minkowski's inequality
+    ``|m(a)| <= |m(0)| + |(L_i a_i)_i|``, and the largest ``sum L_i^2 a_i^2`` over the set is
+    a linear program in ``a_i^2`` (filled greedily). ``m_i' = alpha_i (1 - t^2) / (1 -
+    (alpha_i t + beta_i)^2)`` at ``t = tanh a``; its extremes are at the ends or at a root of
     ``alpha beta t^2 + (alpha^2 + beta^2 - 1) t + alpha beta``.
+
+    Parameters
+    ----------
+    level : float
+    alpha, beta : sequence of float
+    limits : sequence of float, optional
+        Bounds of ``|a_i|`` (default: ``level`` for every axis).
 
     Returns
     -------
     float
-        ``inf`` when the ball reaches ``|e'_i| >= 1``.
+        ``inf`` when the set reaches ``|e'_i| >= 1``.
     """
-    top = math.tanh(level)
-    slope, shift = 0.0, 0.0
-    for al, be in zip(alpha, beta):
+    if limits is None:
+        limits = [level] * len(alpha)
+    shift, weighted = 0.0, []
+    for al, be, lim in zip(alpha, beta, limits):
         if abs(be) >= 1.0:
             return math.inf
         shift += math.atanh(be) ** 2
+        cap = min(level, lim)
+        top = math.tanh(cap)
         points = [-top, top]
         qa, qb = al * be, al * al + be * be - 1.0
         if qa != 0.0:
@@ -232,9 +245,18 @@ def next_level(level: float, alpha: Sequence[float], beta: Sequence[float]) -> f
                 root = math.sqrt(disc)
                 points += [t for t in ((-qb + root) / (2 * qa), (-qb - root) / (2 * qa))
                            if -top < t < top]
+        slope = 0.0
         for t in points:
             inner = al * t + be
             if abs(inner) >= 1.0:
                 return math.inf
             slope = max(slope, al * (1.0 - t * t) / (1.0 - inner * inner))
-    return math.sqrt(shift) + slope * level
+        weighted.append((slope * slope, cap * cap))
+    budget, spread = level * level, 0.0
+    for square, cap in sorted(weighted, reverse=True):
+        take = min(cap, budget)
+        spread += square * take
+        budget -= take
+        if budget <= 0.0:
+            break
+    return math.sqrt(shift) + math.sqrt(spread)

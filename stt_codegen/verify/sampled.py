@@ -78,6 +78,12 @@ class SampledCheck:
     data: dict = field(default_factory=dict)
 
 
+def _atanh_reach(lo: float, hi: float) -> float:
+    """``max |atanh e|`` over ``e`` in ``[lo, hi]`` (``inf`` if it reaches ``|e| >= 1``)."""
+    top = max(-lo, hi)
+    return math.atanh(top) if top < 1.0 else math.inf
+
+
 def _as_class(plants: Assumptions | PlantClass) -> PlantClass:
     return plants if isinstance(plants, PlantClass) else PlantClass(plants)
 
@@ -111,7 +117,8 @@ def _ball(level: float, limits: list[float], halves: list[float], reach: list[fl
 
 
 def check_sampled(design: TubeDesign, samples: TubeSamples,
-                  plants: Assumptions | PlantClass, gain: float | None = None) -> SampledCheck:
+                  plants: Assumptions | PlantClass, gain: float | None = None, *,
+                  lyapunov: bool = True) -> SampledCheck:
     """Prove that the sampled closed loop keeps ``|e_i| < 1`` at and between samples.
 
     A sufficient condition, checked by propagating an enclosure of ``e(t_k)`` (a box and
@@ -133,6 +140,9 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
         which evaluates its plant model on the tube); ``input_gain[0] > 0`` is needed.
     gain : float, optional
         ``k`` to check instead of ``design.gain``.
+    lyapunov : bool
+        Use the Lyapunov balls (default); ``False`` keeps the per-axis argument alone,
+        the check before issue 20 (for comparisons).
 
     Returns
     -------
@@ -145,7 +155,7 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     dt = 1.0 / design.rate_hz
     blocks = a.coupled_blocks(n)
     block_of = {i: b for b in blocks for i in b}
-    balls = [b for b in blocks if len(b) > 1]
+    balls = [b for b in blocks if len(b) > 1] if lyapunov else []
     lo, hi = samples.gamma_lower, samples.gamma_upper
     width = hi - lo
     data = {"gain": k_gain, "rate_hz": design.rate_hz, "input_gain": list(a.input_gain),
@@ -201,10 +211,10 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
             others = [j for j in block_of[i] if j != i]
             z_sq = (others_max([limits[j] for j in others], level.get(block_of[i], math.inf),
                                [h_k[j] for j in others]) if others else 0.0)
-            push = dt * (push_l[k] + coupling_l[k] * 2.0 * k_gain * math.sqrt(z_sq))
             p_lo, p_hi, x_lo, x_hi = axis_interval(
                 box[i][0], box[i][1], centre_l[k][i], h_k[i], pull_l[k][i], g_min_l[k],
-                g_max_l[k], peak_out[k][i], push)
+                g_max_l[k], peak_out[k][i], dt * push_l[k], dt * 2.0 * k_gain * math.sqrt(z_sq),
+                coupling_l[k], skew_l[k])
             path.append([(p_lo - centre_l[k][i]) / h_k[i], (p_hi - centre_l[k][i]) / h_k[i]])
             ends.append((x_lo, x_hi))
         end_level = {}
@@ -228,10 +238,15 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
                             f"[{t:.4f}, {t + dt:.4f}] s (the enclosure of x reaches "
                             f"{-room:.3g} half-widths beyond its edge)", room, t, i, top)
         h_n, c_n = half_l[k + 1], centre_l[k + 1]
+        # |atanh e_i(t_{k+1})| in this sample's coordinates, from the per-axis end ranges
+        end_limits = [_atanh_reach((x_lo - centre_l[k][i]) / h_k[i],
+                                   (x_hi - centre_l[k][i]) / h_k[i])
+                      for i, (x_lo, x_hi) in enumerate(ends)]
         box = [[(x_lo - c_n[i]) / h_n[i], (x_hi - c_n[i]) / h_n[i]]
                for i, (x_lo, x_hi) in enumerate(ends)]
         for b in balls:
-            r = (next_level(end_level[b], [alpha[k][i] for i in b], [beta[k][i] for i in b])
+            r = (next_level(end_level[b], [alpha[k][i] for i in b], [beta[k][i] for i in b],
+                            [end_limits[i] for i in b])
                  if math.isfinite(end_level[b]) else math.inf)
             level[b] = r
             if math.isfinite(r):

@@ -16,7 +16,8 @@ import math
 
 import numpy as np
 
-__all__ = ["phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "axis_interval"]
+__all__ = ["phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "coupling_push",
+           "axis_interval"]
 
 
 def phi(s: np.ndarray) -> np.ndarray:
@@ -58,17 +59,48 @@ def peak(ratio: np.ndarray) -> np.ndarray:
     return np.where(ratio <= 2.0, 0.0, lo)
 
 
+def coupling_push(others: float, coupling: float, spread: float, skew: float,
+                  own: float) -> float:
+    """A bound of the displacement the other inputs cause on axis ``i`` over one interval,
+    whatever ``g_ii`` is, beyond what ``g_min`` (outward) or ``g_max`` (inward) of the own
+    input leaves.
+
+    ``others`` bounds ``dt |u_j|`` over the other axes of the block (Euclidean), ``own`` is
+    ``dt |u_i|``. The off-diagonal part of row ``i`` of ``g`` is at most ``coupling``; it is
+    also its symmetric part (at most ``sqrt(min(g_ii - g_min, g_max - g_ii) spread)`` by the
+    Schur complement of ``g_s - g_min I >= 0`` and of ``g_max I - g_s >= 0``) plus its skew
+    part (at most ``skew``). Maximizing ``-(g_ii - g_min) own + sqrt((g_ii - g_min) spread)
+    others`` over ``g_ii`` gives ``spread others^2 / (4 own)`` when ``others <= 2 own``, else
+    ``spread (others - own)`` (docs/sampled-data.md, eq. (A3)).
+
+    Parameters
+    ----------
+    others, coupling, spread, skew, own : float
+        As above; ``spread = g_max - g_min``.
+    """
+    if others <= 0.0:
+        return 0.0
+    if others <= 2.0 * own:
+        symmetric = spread * others * others / (4.0 * own)
+    else:
+        symmetric = spread * (others - own)
+    return min(coupling * others, symmetric + skew * others)
+
+
 def axis_interval(a: float, b: float, c0: float, h0: float, pull: float, g_min: float,
-                  g_max: float, s_peak: float, push: float) -> tuple[float, float, float, float]:
+                  g_max: float, s_peak: float, push: float, others: float = 0.0,
+                  coupling: float = 0.0, skew: float = 0.0) -> tuple[float, float, float, float]:
     """Enclosures of ``x_i`` on ``[t_k, t_{k+1}]`` and at ``t_{k+1}``, for every
     ``e_i(t_k)`` in ``[a, b]``.
 
     ``sigma x_i(t_{k+1})`` lies in ``[I(s), O(s)]`` for ``s = |e_i(t_k)|`` of sign
-    ``sigma``, with ``I(s) = sigma c0 + s h0 - g_max pull phi(s) - push`` and
-    ``O(s) = sigma c0 + s h0 - g_min pull phi(s) + push``; both are concave in ``s``, so
-    ``min I`` is at an end of the range of ``s`` and ``max O`` at ``s*`` clipped to it.
-    ``x_i`` moves along a line between ``t_k`` and ``t_{k+1}``'s extremes, so the path
-    lies between the start and the end.
+    ``sigma``, with ``I(s) = sigma c0 + s h0 - g_max pull phi(s) - push - C(s)`` and
+    ``O(s) = sigma c0 + s h0 - g_min pull phi(s) + push + C(s)``, where ``C(s)`` is
+    :func:`coupling_push` with ``own = pull phi(s)``. Without ``C`` both are concave in
+    ``s``, so ``min I`` is at an end of the range of ``s`` and ``max O`` at ``s*`` clipped
+    to it; ``C`` decreases in ``s``, so it is taken at the range's lower end ``s_a``.
+    ``x_i`` moves along a line between ``t_k`` and ``t_{k+1}``'s extremes, so the path lies
+    between the start and the end.
 
     Parameters
     ----------
@@ -83,23 +115,29 @@ def axis_interval(a: float, b: float, c0: float, h0: float, pull: float, g_min: 
     s_peak : float
         :func:`peak` of ``h0 / (g_min pull)``.
     push : float
-        ``dt D_i``: the largest displacement the other terms cause, state units.
+        ``dt |f + w|`` bound, state units.
+    others : float
+        ``dt |u_j|`` over the other axes of the block, bound (0: none).
+    coupling, skew : float
+        Row coupling and skew bound of ``g`` (see :func:`coupling_push`).
 
     Returns
     -------
     path_lo, path_hi, end_lo, end_hi : float
         ``x_i`` on the whole interval, and at ``t_{k+1}``, state units.
     """
+    spread = g_max - g_min
     path_lo = end_lo = math.inf
     path_hi = end_hi = -math.inf
     for sign, s_a, s_b in ((1.0, max(a, 0.0), b), (-1.0, max(-b, 0.0), -a)):
         if s_b < s_a or (s_b == 0.0 and sign < 0):
             continue
+        extra = push + coupling_push(others, coupling, spread, skew, pull * phi_scalar(s_a))
         start_a, start_b = sign * c0 + s_a * h0, sign * c0 + s_b * h0
         s_star = min(max(s_peak, s_a), s_b)
-        out_max = sign * c0 + s_star * h0 - pull * g_min * phi_scalar(s_star) + push
+        out_max = sign * c0 + s_star * h0 - pull * g_min * phi_scalar(s_star) + extra
         in_min = min(start_a - pull * g_max * phi_scalar(s_a),
-                     start_b - pull * g_max * phi_scalar(s_b)) - push
+                     start_b - pull * g_max * phi_scalar(s_b)) - extra
         low, high = min(start_a, in_min), max(start_b, out_max)
         if sign > 0:
             path_lo, path_hi = min(path_lo, low), max(path_hi, high)
