@@ -221,8 +221,9 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
         first: a spec with no design gives a report whose one check, ``tube.design``,
         failed.
     plant : str, optional
-        Plant model for Assumption 2 (one of
-        :data:`~stt_codegen.spec.loader.PLANT_MODELS`); default the spec's
+        Plant model for Assumption 2 and the sampled check's bounds (one of
+        :data:`~stt_codegen.spec.plants.PLANT_MODELS`;
+        :meth:`~stt_codegen.spec.loader.Spec.with_plant_model`); default the spec's
         ``plant.model``.
     progress : callable, optional
         Called with one string, ``"<stage> (i/N)"`` (e.g. ``"lemma 3.3 (3/10)"``),
@@ -240,8 +241,9 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
     Raises
     ------
     SpecError
-        Unknown plant model (field ``plant``), or one that does not fit the spec's
-        dimension.
+        Unknown plant model (field ``plant``), one that does not fit the spec's
+        dimension, or one that violates a declared ``[assumptions]`` bound (the field
+        names the key).
     TypeError
         ``design_or_spec`` is neither a ``Design`` nor a ``Spec`` (for example a
         ``(spec, tube)`` pair: pass the ``Design``, which carries its spec).
@@ -313,7 +315,8 @@ def configure_verify(p: argparse.ArgumentParser) -> None:
     p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
     p.add_argument("--json", action="store_true", help="print a JSON list of checks")
     p.add_argument("--plant", default=None, metavar="MODEL",
-                   help=f"plant for Assumption 2 ({', '.join(PLANT_MODELS)}; default: the spec's)")
+                   help=f"plant for Assumption 2 and the sampled check's bounds "
+                        f"({', '.join(PLANT_MODELS)}; default: the spec's)")
     p.add_argument("--no-cache", action="store_true",
                    help="prove the spec-independent lemmas again instead of reading the "
                         "proof cache (~/.cache/stt-codegen; see docs/verification.md)")
