@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..design.certificate.report import Enclosure
+from ..design.certificate import Enclosure
 from ..spec.assumptions import Assumptions
 from ..spec.loader import LinearPlant, Spec
 from ..spec.model_bounds import EXACT_DRIFT_DIMENSIONS, model_bounds
