@@ -43,7 +43,8 @@ def configure_verify(p: argparse.ArgumentParser) -> None:
     add_spec_argument(p)
     add_json_argument(p, "print a JSON list of checks")
     p.add_argument("--plant", default=None, metavar="MODEL",
-                   help=f"plant for Assumption 2 ({', '.join(PLANT_MODELS)}; default: the spec's)")
+                   help=f"plant for Assumption 2 and the sampled check's bounds "
+                        f"({', '.join(PLANT_MODELS)}; default: the spec's)")
     p.add_argument("--no-cache", action="store_true",
                    help="prove the spec-independent lemmas again instead of reading the "
                         "proof cache (~/.cache/stt-codegen; see docs/verification.md)")

@@ -16,17 +16,18 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 import os
 import re
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 from ..cases import bundled_cases, bundled_spec_bytes
 from ..errors import SpecError
+from .assumptions import Assumptions, combine_assumptions
+from .model_bounds import model_bounds
 from .plants import MODEL_KEYS, PLANTS, dimension_mismatch
 from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
                      PlantTable, PolytopeObstacle, check_document, value_kind)
@@ -166,45 +167,6 @@ class TubeParameters:
 
 
 @dataclass(frozen=True)
-class Assumptions:
-    """What the controller's designer knows about the unknown plant (1), ``[assumptions]``.
-
-    The plant is ``x_dot = f(x) + g(x) u + w``; every bound holds uniformly over the state
-    space ``X`` (and ``w`` over time). Used to derive the default gain ``k`` of law (13)
-    (:mod:`stt_codegen.design.gain`) and by the sampled-data check
-    (:mod:`stt_codegen.verify.sampled`); the controller itself never sees them.
-
-    Attributes
-    ----------
-    input_gain : tuple of float, (g_min, g_max)
-        Bounds on the eigenvalues of the symmetric part ``(g + g^T) / 2`` of ``g(x)``;
-        Assumption 2 asks ``g_min > 0``. Default ``(1, 1)``: ``g = I`` plus a skew part,
-        the plant the default gain has always assumed.
-    input_gain_skew : float
-        Bound on the spectral norm of the skew part ``(g - g^T) / 2``; default 0.
-    input_gain_coupling : float
-        Bound on the Euclidean norm of the off-diagonal part of every row of ``g(x)``:
-        how strongly one input drives the other states. Default
-        ``(g_max - g_min) / 2 + input_gain_skew``, the bound the two above imply; declare
-        a smaller one when the structure of ``g`` is known (0 for a diagonal ``g``).
-    drift_bound : float
-        Bound on the Euclidean norm ``|f(x)|``, state units per second; default 0.
-    disturbance_bound : float
-        Bound on the Euclidean norm ``|w(t)|``, state units per second; default
-        ``sqrt(n)`` times ``plant.disturbance_amplitude`` (the simulated disturbance).
-    declared : tuple of str
-        The keys the spec set explicitly (the others are defaults).
-    """
-
-    input_gain: tuple[float, float] = (1.0, 1.0)
-    input_gain_skew: float = 0.0
-    input_gain_coupling: float = 0.0
-    drift_bound: float = 0.0
-    disturbance_bound: float = 0.0
-    declared: tuple[str, ...] = ()
-
-
-@dataclass(frozen=True)
 class LinearPlant:
     """The ``linear`` plant of ``[plant]``: ``x_dot = a x + c + g u + w``.
 
@@ -256,14 +218,15 @@ class Spec:
     rate_hz : float
         Sampling rate of the deployed controller, Hz.
     plant_model : str
-        ``"omnidirectional"`` (eq. (14)), ``"single-integrator"`` or ``"linear"``;
-        simulation only.
+        ``"omnidirectional"`` (eq. (14)), ``"single-integrator"`` or ``"linear"``: the
+        plant ``simulate`` runs, and the source of the bounds in :attr:`assumptions`.
     disturbance_amplitude : float
-        Bound on ``|w_i|``; simulation only.
+        Bound on ``|w_i|`` of the simulated disturbance.
     linear_plant : LinearPlant or None
         The matrices of the ``linear`` model (``None`` for the other models).
     assumptions : Assumptions
-        The ``[assumptions]`` section, defaults filled in.
+        The plant bounds: the model's over the state space, with the ``[assumptions]``
+        section (:func:`~.assumptions.combine_assumptions`).
     input_bound : tuple of float or None
         ``[actuator] input_bound``: the largest ``|u_i|`` law (13) may ask of each input,
         in input units, one per input of the plant model (``None``: no ``[actuator]``,
@@ -310,6 +273,31 @@ class Spec:
     def obstacle_boxes(self) -> list[Box]:
         """Every obstacle as a full-dimensional box."""
         return [o.box(self.state_space) for o in self.obstacles]
+
+    def with_plant_model(self, model: str) -> "Spec":
+        """This spec with another ``plant.model``, its :attr:`assumptions` derived again.
+
+        The declared ``[assumptions]`` keys keep their values; the others come from
+        ``model`` (a ``linear`` model without this spec's matrices is ``a = 0``,
+        ``g = I``, ``c = 0``).
+
+        Raises
+        ------
+        SpecError
+            A declared bound that ``model`` violates (the field names the key), or a
+            model whose state count differs (field ``plant``).
+        """
+        if model == self.plant_model:
+            return self
+        mismatch = dimension_mismatch(model, self.dimension)
+        if mismatch:
+            raise SpecError("plant", mismatch)
+        a = self.assumptions
+        declared = {key: getattr(a, key) for key in a.declared}
+        linear = self.linear_plant if model == "linear" else None
+        bounds = model_bounds(model, self.state_space.lower, self.state_space.upper, linear)
+        return replace(self, plant_model=model, assumptions=combine_assumptions(
+            bounds, declared, self.dimension, self.disturbance_amplitude))
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> "Spec":
@@ -507,6 +495,7 @@ def _validate(raw: dict) -> Spec:
     if mismatch:
         raise SpecError("plant.model", mismatch)
     amplitude = doc.plant.disturbance_amplitude
+    linear = _linear_plant(doc.plant, n)
     tube = TubeParameters(**doc.tube.model_dump())
     return Spec(name=doc.name, prescribed_time=doc.prescribed_time, state_space=state_space,
                 initial_set=initial_set, initial_state=x0, initial_half_width=d0,
@@ -514,8 +503,9 @@ def _validate(raw: dict) -> Spec:
                 obstacles=obstacles, unsafe_sets=unsafe_sets, tube=tube,
                 gain=doc.controller.gain, rate_hz=doc.controller.rate_hz,
                 plant_model=model, disturbance_amplitude=amplitude,
-                linear_plant=_linear_plant(doc.plant, n),
-                assumptions=_assumptions(doc.assumptions, n, amplitude),
+                linear_plant=linear,
+                assumptions=_assumptions(doc.assumptions, n, amplitude, model, state_space,
+                                         linear),
                 input_bound=_input_bound(doc.actuator, model, n),
                 target_half_width_given=doc.target.half_width is not None)
 
@@ -585,23 +575,14 @@ def _linear_plant(table: PlantTable, n: int) -> LinearPlant | None:
     return LinearPlant(a, g, c)
 
 
-def _assumptions(table: AssumptionsTable, n: int, amplitude: float) -> Assumptions:
-    """``[assumptions]`` with its defaults (see :class:`Assumptions`)."""
-    g_min, g_max = table.input_gain if table.input_gain is not None else (1.0, 1.0)
-    if g_min <= 0:
-        raise SpecError("assumptions.input_gain", f"g_min = {g_min!r} must be positive "
-                                                  "(Assumption 2)")
-    if g_min > g_max:
-        raise SpecError("assumptions.input_gain", f"g_min = {g_min!r} exceeds g_max = {g_max!r}")
-    skew = table.input_gain_skew
-    implied = 0.5 * (g_max - g_min) + skew
-    coupling = implied if table.input_gain_coupling is None else table.input_gain_coupling
-    coupling = min(coupling, implied)       # the other bounds already imply a smaller one
-    disturbance = (math.sqrt(n) * amplitude if table.disturbance_bound is None
-                   else table.disturbance_bound)
-    return Assumptions((g_min, g_max), skew, coupling, table.drift_bound, disturbance,
-                       tuple(key for key in AssumptionsTable.model_fields
-                             if key in table.model_fields_set))
+def _assumptions(table: AssumptionsTable, n: int, amplitude: float, model: str,
+                 state_space: Box, linear: LinearPlant | None) -> Assumptions:
+    """``[assumptions]`` combined with what the plant model implies over the state space
+    (:func:`~.assumptions.combine_assumptions`)."""
+    declared = {key: getattr(table, key) for key in AssumptionsTable.model_fields
+                if key in table.model_fields_set}
+    bounds = model_bounds(model, state_space.lower, state_space.upper, linear)
+    return combine_assumptions(bounds, declared, n, amplitude)
 
 
 def _input_bound(table: ActuatorTable | None, model: str, n: int) -> tuple[float, ...] | None:

@@ -7,7 +7,6 @@ its ``psi``, and the continuous-time tube certificate (:mod:`stt_codegen.design.
 
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import Callable
 
 import numpy as np
@@ -19,7 +18,7 @@ from ..design.samples import sample_tube
 from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
-from ..spec.plants import PLANT_MODELS, dimension_mismatch
+from ..spec.plants import PLANT_MODELS
 from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
 from .actuator import input_bound_check, prove_input_bound
 from .adaptive import adaptive_law_checks, alpha_upper_bound
@@ -27,7 +26,7 @@ from .assumption import assumption2_omnidirectional, assumption2_single_integrat
 from .check import Check, VerificationReport
 from .lemma import bump_rate_bound, reach_rate_bound
 from .proofs import design_independent_proofs
-from .sampled import linear_plant_checks, sampled_checks
+from .sampled import plant_bounds_checks, sampled_checks
 
 #: Dimension names used in check names.
 _SIDES = ("L", "U")
@@ -70,7 +69,8 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     spec : Spec
     design : TubeDesign
     plant : str, optional
-        Plant model for Assumption 2 (one of :data:`stt_codegen.spec.plants.PLANT_MODELS`);
+        Plant model (one of :data:`stt_codegen.spec.plants.PLANT_MODELS`) for Assumption 2
+        and the sampled check's bounds (:meth:`~stt_codegen.spec.loader.Spec.with_plant_model`);
         default the spec's.
     cache : bool
         Take the design-independent proofs from the proof cache
@@ -90,7 +90,9 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         (:func:`~stt_codegen.verify.actuator.input_bound_check`).
     """
     stage = progress if isinstance(progress, _Stages) else _Stages(progress, design=False)
-    model = plant or spec.plant_model
+    if plant is not None:
+        spec = spec.with_plant_model(plant)      # the plant's own bounds (SpecError if the
+    model = spec.plant_model                     # declared [assumptions] contradict them)
     n = design.dimension
     proofs = design_independent_proofs(min(n, 3), cache=cache, progress=stage)
     reach = sorted({(a, b, seg.duration) for seg in design.segments if seg.profile == TANH
@@ -117,10 +119,9 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     if model == "omnidirectional":
         checks.append(assumption2_omnidirectional((spec.state_space.lower[2],
                                                    spec.state_space.upper[2])))
-    elif model == "linear":
-        checks += linear_plant_checks(spec)
-    else:
+    elif model != "linear":
         checks.append(assumption2_single_integrator(n))
+    checks += plant_bounds_checks(spec, model)   # assumption2.linear for the linear model
 
     stage("tube certificate")
     tube_check = check_tube(design, spec)   # not the designer's: verify certifies again
@@ -178,24 +179,24 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
 
 
 def spec_for_plant(spec: Spec, plant: str | None) -> Spec:
-    """The spec to design for when Assumption 2 is checked for ``plant``: ``spec`` with
-    ``plant`` as its plant model (``spec`` itself when ``plant`` is ``None``), so that the
-    design refuses a plant that violates the assumption.
+    """The spec to design for when Assumption 2 and the sampled check are judged for
+    ``plant``: ``spec`` with ``plant`` as its plant model and that model's own bounds
+    (:meth:`~stt_codegen.spec.loader.Spec.with_plant_model`; ``spec`` itself when
+    ``plant`` is ``None``), so that the design refuses a plant that violates the
+    assumption.
 
     Raises
     ------
     SpecError
         Field ``plant``: not one of :data:`~stt_codegen.spec.plants.PLANT_MODELS`, or a
-        model that does not fit the spec's dimension.
+        model that does not fit the spec's dimension; a declared ``[assumptions]`` bound
+        that the model violates (the field names the key).
     """
     if plant is None:
         return spec
     if plant not in PLANT_MODELS:
         raise SpecError("plant", f"must be one of {', '.join(PLANT_MODELS)}")
-    mismatch = dimension_mismatch(plant, spec.dimension)
-    if mismatch:
-        raise SpecError("plant", mismatch)
-    return replace(spec, plant_model=plant)
+    return spec.with_plant_model(plant)
 
 
 def verify_spec(spec: Spec, plant: str | None = None, *, cache: bool = True,
@@ -243,8 +244,9 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
         :class:`~stt_codegen.spec.loader.Spec`, designed first: a spec with no design
         gives a report whose one check, ``tube.design``, failed.
     plant : str, optional
-        Plant model for Assumption 2 (one of
-        :data:`~stt_codegen.spec.loader.PLANT_MODELS`); default the spec's
+        Plant model for Assumption 2 and the sampled check's bounds (one of
+        :data:`~stt_codegen.spec.plants.PLANT_MODELS`;
+        :meth:`~stt_codegen.spec.loader.Spec.with_plant_model`); default the spec's
         ``plant.model``.
     progress : callable, optional
         Called with one string, ``"<stage> (i/N)"`` (e.g. ``"lemma 3.3 (3/10)"``),
@@ -262,8 +264,9 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
     Raises
     ------
     SpecError
-        Unknown plant model (field ``plant``), or one that does not fit the spec's
-        dimension.
+        Unknown plant model (field ``plant``), one that does not fit the spec's
+        dimension, or one that violates a declared ``[assumptions]`` bound (the field
+        names the key).
     TypeError
         ``design_or_spec`` is neither a ``Design`` nor a ``Spec`` (for example a
         ``(spec, tube)`` pair: pass the ``Design``, which carries its spec).

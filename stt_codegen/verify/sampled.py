@@ -2,32 +2,25 @@
 
 Theorem 4.1 is a continuous-time result. The deployed controller reads ``x(t_k)`` at
 ``t_k = k dt``, computes ``u_k`` by law (13) with its clamps and holds it until
-``t_{k+1}`` (zero-order hold). This module proves, for every plant of the spec's
-``[assumptions]`` (:class:`~stt_codegen.spec.loader.Assumptions`), that ``|e_i| < 1`` at
-and between samples on the whole horizon of the tube's certificate. The condition and
-its proof are in ``docs/sampled-data.md``; in short, per dimension ``i`` and sampling
-interval ``[t_k, t_k + dt]``:
+``t_{k+1}`` (zero-order hold). This module proves, for every plant of a plant class
+(:class:`~stt_codegen.verify.plant_class.PlantClass`: the spec's plant model and
+``[assumptions]``), that ``|e_i| < 1`` at and between samples on the whole horizon of the
+tube's certificate. The condition and its proof are in ``docs/sampled-data.md``. It
+propagates, from ``e(0)``, an enclosure of ``e(t_k)`` that is the intersection of
 
-* ``x_dot_i = g_ii u_i + d_i`` with ``g_ii`` in ``[g_min, g_max]`` (a diagonal entry of
-  ``g`` is one of its symmetric part) and
-  ``|d_i| <= D_i = drift_bound + disturbance_bound + (h + s) |u_{-i}|``, where
-  ``h = (g_max - g_min) / 2`` bounds the off-diagonal part of a row of the symmetric part,
-  ``s`` (``input_gain_skew``) that of the skew part, and ``u_{-i}`` the other inputs;
-* ``u`` is held, so ``x_i(t)`` lies between two lines through ``x_i(t_k)``;
-* if every ``|e_j(t_k)| <= level_j``, the inputs are bounded, and the lines must stay
-  strictly inside the certified enclosure of the tube on the interval
-  (:func:`~stt_codegen.design.certificate.enclose_tube`) and end with
-  ``|e_i(t_{k+1})| <= level_i``.
+* a box, one interval per axis (:mod:`.sampled_axis`: each axis on its own, the other
+  inputs of its block of ``g`` taken at their worst through the coupling), and
+* one Lyapunov ball per block of ``g`` (:mod:`.lyapunov`: ``sum atanh(e_i)^2 <= r^2``,
+  the level of law (13)'s own function, in which the symmetric part of ``g`` enters as a
+  matrix bound and its skew part cancels to first order).
 
-The box ``|e_i| <= level_i`` is then invariant at the samples (induction on ``k``), and
-``x`` stays strictly inside the tube between them. ``e(t_k)`` ranges over a partition
-of ``[0, level_i]`` (and its mirror), and every cell is bounded by monotonicity, so no
-point is skipped.
+Each part bounds the other: the box gives the ball its curvature, the ball caps the
+other inputs in the box. On every interval ``x`` must stay strictly inside the
+certified enclosure of the tube (:func:`~stt_codegen.design.certificate.enclose_tube`).
 """
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import dataclass, field, replace
 
@@ -36,12 +29,19 @@ import numpy as np
 from ..design.certificate import Certificate, certify_tube, enclose_tube
 from ..design.gain import derived_gain, gain_derivation
 from ..design.samples import TubeSamples, sample_tube
-from ..spec.loader import Assumptions, LinearPlant, Spec
+from ..spec.assumptions import Assumptions
+from ..spec.loader import Spec
+from ..spec.model_bounds import model_bounds
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .check import Check
+from .lyapunov import level_after, next_level, others_max
+from .plant_class import PlantClass, plant_class
+from .sampled_axis import axis_interval, peak, phi_slope_scalar
 
 #: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
 RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
+#: Iterations of the bootstrap of a ball's between-samples level (see :func:`_ball`).
+BALL_ITERATIONS = 12
 
 
 @dataclass(frozen=True)
@@ -51,14 +51,14 @@ class SampledCheck:
     Attributes
     ----------
     passed : bool
-        The sufficient condition holds: no plant of the assumptions leaves the tube.
+        The sufficient condition holds: no plant of the class leaves the tube.
     level : float
-        The proved bound of ``max_i |e_i(t_k)|`` at the samples (the smallest level that
-        works); when failed, the level with the smallest violation.
+        The proved bound of ``max_i |e_i(t_k)|`` at the samples; when failed, the bound
+        reached before the failure.
     margin : float
         Smallest relative room left, ``min`` over intervals and dimensions of the room to
-        the tube's edge between samples divided by the tube's half-width, and of
-        ``level - |e_i(t_{k+1})|``; negative when failed.
+        the tube's edge between samples divided by the tube's half-width; negative when
+        failed.
     time : float
         Start of the sampling interval where the margin is smallest, seconds.
     dimension : int
@@ -83,40 +83,54 @@ class SampledCheck:
     abs_e: np.ndarray | None = field(default=None, compare=False, repr=False)
 
 
-def _phi(s: np.ndarray) -> np.ndarray:
-    """``|u_i| gamma_d_i / (4 k) = epsilon_i / (1 - e_i^2)`` of law (13) at ``|e_i| = s``."""
-    return 2.0 * np.arctanh(s) / (1.0 - s * s)
+def _atanh_reach(lo: float, hi: float) -> float:
+    """``max |atanh e|`` over ``e`` in ``[lo, hi]`` (``inf`` if it reaches ``|e| >= 1``)."""
+    top = max(-lo, hi)
+    return math.atanh(top) if top < 1.0 else math.inf
 
 
-def _phi_slope(s: np.ndarray) -> np.ndarray:
-    """``d phi / d s = (2 + 4 s atanh(s)) / (1 - s^2)^2`` (positive, increasing)."""
-    return (2.0 + 4.0 * s * np.arctanh(s)) / (1.0 - s * s) ** 2
+def _as_class(plants: Assumptions | PlantClass) -> PlantClass:
+    return plants if isinstance(plants, PlantClass) else PlantClass(plants)
 
 
-def _peak(ratio: np.ndarray) -> np.ndarray:
-    """``s* = argmax_s (s - phi(s) / ratio)`` on ``[0, 1)``: ``phi'(s*) = ratio``, 0 if
-    ``ratio <= phi'(0) = 2``. Bisection (``phi'`` is increasing)."""
-    lo, hi = np.zeros_like(ratio), np.full_like(ratio, 1.0 - 1e-15)
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        up = _phi_slope(mid) < ratio
-        lo, hi = np.where(up, mid, lo), np.where(up, hi, mid)
-    return np.where(ratio <= 2.0, 0.0, lo)
+def _ball(level: float, limits: list[float], halves: list[float], reach: list[float],
+          gain: float, dt: float, g_min: float, g_max: float, skew: float,
+          push: float) -> tuple[float, float]:
+    """``(R_mid, R_end)`` of one block's ball on one interval, or ``(inf, inf)``.
+
+    ``W <= R_mid^2`` on the whole interval and ``W <= R_end^2`` at its end, in this
+    sample's coordinates. The curvature along the step needs a bound of ``|e_i|`` along
+    it: the per-axis path range ``reach`` and a guessed level ``R``; the guess holds when
+    the level it gives is strictly below it (a first-exit argument, docs/sampled-data.md).
+    """
+    guess = level * (1.0 + 1e-3) + 1e-6
+    for _ in range(BALL_ITERATIONS):
+        top = math.tanh(guess)
+        if top > E_MAX:
+            break
+        rho = [min(r, top) for r in reach]
+        curvature = [phi_slope_scalar(x) / h ** 2 for x, h in zip(rho, halves)]
+        end_sq = level_after(level, limits, halves, curvature, gain, dt, g_min, g_max,
+                             skew, push)
+        if not math.isfinite(end_sq):
+            break
+        mid = math.sqrt(max(level * level, end_sq))
+        if mid < guess:
+            return mid, math.sqrt(max(end_sq, 0.0))
+        guess = mid + 0.5 * (mid - level) + 1e-9
+    return math.inf, math.inf
 
 
-def _phi1(s: float) -> float:
-    return 2.0 * math.atanh(s) / (1.0 - s * s)
-
-
-def check_sampled(design: TubeDesign, samples: TubeSamples, assumptions: Assumptions,
-                  gain: float | None = None) -> SampledCheck:
+def check_sampled(design: TubeDesign, samples: TubeSamples,
+                  plants: Assumptions | PlantClass, gain: float | None = None, *,
+                  lyapunov: bool = True) -> SampledCheck:
     """Prove that the sampled closed loop keeps ``|e_i| < 1`` at and between samples.
 
-    A sufficient condition, checked by propagating an enclosure of ``e(t_k)`` from
-    ``e(0)`` (``docs/sampled-data.md``): on every sampling interval, for every plant
-    ``x_dot = f(x) + g(x) u + w`` of ``assumptions`` and every ``e(t_k)`` in the
-    enclosure, ``x`` stays strictly inside the tube's certified enclosure until
-    ``t_{k+1}``, and ``e(t_{k+1})`` lies in the next enclosure, inside
+    A sufficient condition, checked by propagating an enclosure of ``e(t_k)`` (a box and
+    one Lyapunov ball per block of ``g``) from ``e(0)`` (``docs/sampled-data.md``): on
+    every sampling interval, for every plant ``x_dot = f(x) + g(x) u + w`` of the class and
+    every ``e(t_k)`` in the enclosure, ``x`` stays strictly inside the tube's certified
+    enclosure until ``t_{k+1}``, and ``e(t_{k+1})`` lies in the next enclosure, inside
     ``[-E_MAX, E_MAX]``.
 
     Parameters
@@ -126,100 +140,136 @@ def check_sampled(design: TubeDesign, samples: TubeSamples, assumptions: Assumpt
     samples : TubeSamples
         The deployed tube at the rate of ``design``
         (:func:`~stt_codegen.design.samples.sample_tube`).
-    assumptions : Assumptions
-        The declared plant bounds; ``input_gain[0] > 0`` is needed.
+    plants : Assumptions or PlantClass
+        The plant bounds (:func:`~stt_codegen.verify.plant_class.plant_class` for a spec,
+        which evaluates its plant model on the tube); ``input_gain[0] > 0`` is needed.
     gain : float, optional
         ``k`` to check instead of ``design.gain``.
+    lyapunov : bool
+        Use the Lyapunov balls (default); ``False`` keeps the per-axis argument alone,
+        the check before issue 20 (for comparisons).
 
     Returns
     -------
     SampledCheck
     """
+    cls = _as_class(plants)
+    a = cls.assumptions
     k_gain = design.gain if gain is None else float(gain)
     n = design.dimension
     dt = 1.0 / design.rate_hz
-    g_min, g_max = assumptions.input_gain
-    coupling = assumptions.input_gain_coupling
-    push = assumptions.drift_bound + assumptions.disturbance_bound
+    blocks = a.coupled_blocks(n)
+    block_of = {i: b for b in blocks for i in b}
+    balls = [b for b in blocks if len(b) > 1] if lyapunov else []
     lo, hi = samples.gamma_lower, samples.gamma_upper
     width = hi - lo
-    data = {"gain": k_gain, "rate_hz": design.rate_hz, "input_gain": [g_min, g_max],
-            "input_gain_skew": assumptions.input_gain_skew,
-            "input_gain_coupling": assumptions.input_gain_coupling,
-            "drift_bound": assumptions.drift_bound,
-            "disturbance_bound": assumptions.disturbance_bound}
+    data = {"gain": k_gain, "rate_hz": design.rate_hz, "input_gain": list(a.input_gain),
+            "input_gain_skew": a.input_gain_skew,
+            "input_gain_coupling": a.input_gain_coupling, "drift_bound": a.drift_bound,
+            "disturbance_bound": a.disturbance_bound, "blocks": [list(b) for b in blocks]}
 
     def fail(reason: str, margin: float, t: float, i: int, level: float) -> SampledCheck:
         return SampledCheck(False, level, margin, t, i, reason, data)
 
-    if g_min <= 0:
+    if a.input_gain[0] <= 0:
         return fail("input_gain[0] must be positive (Assumption 2): law (13) cannot pull "
                     "the state back otherwise", -math.inf, 0.0, 0, math.nan)
     if width.min() < GAMMA_D_MIN:
         return fail(f"the tube is narrower than GAMMA_D_MIN = {GAMMA_D_MIN:g} at a sample",
                     -math.inf, 0.0, 0, math.nan)
     enclosure = enclose_tube(design, samples)
+    count = len(enclosure.t_start)
+    bounds = cls.on_intervals(enclosure, count)
+    data["refined_on_the_tube"] = list(bounds.refined)
     half = 0.5 * width
     centre = 0.5 * (hi + lo)
     pull = 4.0 * dt * k_gain / width                      # (K+1, n): dt |u| / phi per unit g
-    peak_out = _peak(half / (pull * g_min)).tolist()      # maximizer of the outward end
+    peak_out = peak(half[:count] / (pull[:count] * bounds.g_min[:, None])).tolist()
+    up_e = ((enclosure.upper_min - centre[:count]) / half[:count]).tolist()
+    low_e = ((enclosure.lower_max - centre[:count]) / half[:count]).tolist()
+    alpha = (half[:count] / half[1:count + 1]).tolist()
+    beta = ((centre[:count] - centre[1:count + 1]) / half[1:count + 1]).tolist()
     half_l, centre_l, pull_l = half.tolist(), centre.tolist(), pull.tolist()
-    up_l, low_l = enclosure.upper_min.tolist(), enclosure.lower_max.tolist()
-    x0 = np.array(design.initial_state)
-    e = ((x0 - centre[0]) / half[0]).tolist()
-    box = [[v, v] for v in e]                             # enclosure of e(t_k), per dim
-    worst, worst_t, worst_i, top = math.inf, 0.0, 0, max(abs(v) for v in e)
+    g_min_l, g_max_l = bounds.g_min.tolist(), bounds.g_max.tolist()
+    skew_l, coupling_l, push_l = (bounds.skew.tolist(), bounds.coupling.tolist(),
+                                  bounds.push.tolist())
+    e0 = ((np.array(design.initial_state) - centre[0]) / half[0]).tolist()
+    box = [[v, v] for v in e0]                            # enclosure of e(t_k), per dim
+    level = {b: math.sqrt(sum(math.atanh(e0[i]) ** 2 for i in b)) for b in balls}
+    worst, worst_t, worst_i = math.inf, 0.0, 0
+    top = max(abs(v) for v in e0)
+    ball_lost = ball_max = 0.0
     abs_e = []                                            # the bound of |e(t_k)|, per sample
-    for k in range(len(enclosure.t_start)):
+    for k in range(count):
         t = float(samples.t[k])
-        reach = [max(-a, b) for a, b in box]
-        abs_e.append(reach)
-        if max(reach) > E_MAX:
-            i = int(np.argmax(reach))
-            return fail(f"|e_{i}| may reach {max(reach):.6g} at t = {t:.4f} s, beyond the "
-                        f"clamp E_MAX", -math.inf, t, i, max(reach))
-        u_max = [k_gain * 4.0 * _phi1(r) / (2.0 * half_l[k][j]) for j, r in enumerate(reach)]
-        total = sum(v * v for v in u_max)
-        new_box = []
+        reach_e = [max(-x, y) for x, y in box]
+        abs_e.append(reach_e)
+        if max(reach_e) > E_MAX:
+            i = int(np.argmax(reach_e))
+            return fail(f"|e_{i}| may reach {max(reach_e):.6g} at t = {t:.4f} s, beyond the "
+                        f"clamp E_MAX", -math.inf, t, i, top)
+        limits = [math.atanh(v) for v in reach_e]         # max |atanh e_i| over the box
+        for b in balls:                                   # the box's corner bounds W too
+            level[b] = min(level[b], math.sqrt(sum(limits[i] ** 2 for i in b)))
+            ball_max = max(ball_max, level[b])
+        h_k = half_l[k]
+        path, ends = [], []
         for i in range(n):
-            a, b = box[i]
-            h0, c0, p = half_l[k][i], centre_l[k][i], pull_l[k][i]
-            h1, c1 = half_l[k + 1][i], centre_l[k + 1][i]
-            d = dt * (push + coupling * math.sqrt(max(total - u_max[i] ** 2, 0.0)))
-            path_lo = end_lo = math.inf
-            path_hi = end_hi = -math.inf
-            for sign, s_a, s_b in ((1.0, max(a, 0.0), b), (-1.0, max(-b, 0.0), -a)):
-                if s_b < s_a or (s_b == 0.0 and sign < 0):
-                    continue
-                start_a, start_b = sign * c0 + s_a * h0, sign * c0 + s_b * h0
-                s_star = min(max(peak_out[k][i], s_a), s_b)
-                out_max = sign * c0 + s_star * h0 - p * g_min * _phi1(s_star) + d
-                in_min = min(start_a - p * g_max * _phi1(s_a),
-                             start_b - p * g_max * _phi1(s_b)) - d
-                low, high = min(start_a, in_min), max(start_b, out_max)
-                if sign > 0:
-                    path_lo, path_hi = min(path_lo, low), max(path_hi, high)
-                    end_lo, end_hi = min(end_lo, in_min), max(end_hi, out_max)
-                else:
-                    path_lo, path_hi = min(path_lo, -high), max(path_hi, -low)
-                    end_lo, end_hi = min(end_lo, -out_max), max(end_hi, -in_min)
-            room = min(up_l[k][i] - path_hi, path_lo - low_l[k][i]) / h0
+            others = [j for j in block_of[i] if j != i]
+            z_sq = (others_max([limits[j] for j in others], level.get(block_of[i], math.inf),
+                               [h_k[j] for j in others]) if others else 0.0)
+            p_lo, p_hi, x_lo, x_hi = axis_interval(
+                box[i][0], box[i][1], centre_l[k][i], h_k[i], pull_l[k][i], g_min_l[k],
+                g_max_l[k], peak_out[k][i], dt * push_l[k], dt * 2.0 * k_gain * math.sqrt(z_sq),
+                coupling_l[k], skew_l[k])
+            path.append([(p_lo - centre_l[k][i]) / h_k[i], (p_hi - centre_l[k][i]) / h_k[i]])
+            ends.append((x_lo, x_hi))
+        end_level = {}
+        for b in balls:
+            mid, end = _ball(level[b], [limits[i] for i in b], [h_k[i] for i in b],
+                             [min(max(-path[i][0], path[i][1]), 1.0) for i in b], k_gain, dt,
+                             g_min_l[k], g_max_l[k], skew_l[k], push_l[k])
+            if math.isfinite(mid):
+                edge = math.tanh(mid)
+                for i in b:
+                    path[i] = [max(path[i][0], -edge), min(path[i][1], edge)]
+            else:
+                ball_lost += 1
+            end_level[b] = end
+        for i in range(n):
+            room = min(up_e[k][i] - path[i][1], path[i][0] - low_e[k][i])
             if room < worst:
                 worst, worst_t, worst_i = room, t, i
             if room <= 0.0:
-                return fail(f"a plant of the assumptions may leave the tube in dimension {i} "
-                            f"on [{t:.4f}, {t + dt:.4f}] s (the enclosure of x reaches "
+                return fail(f"a plant of the class may leave the tube in dimension {i} on "
+                            f"[{t:.4f}, {t + dt:.4f}] s (the enclosure of x reaches "
                             f"{-room:.3g} half-widths beyond its edge)", room, t, i, top)
-            new_box.append([(end_lo - c1) / h1, (end_hi - c1) / h1])
-        box = new_box
-        top = max(top, max(max(-a, b) for a, b in box))
-    data.update({"max_abs_e": top, "margin": worst})
-    abs_e.append([max(-a, b) for a, b in box])
+        h_n, c_n = half_l[k + 1], centre_l[k + 1]
+        # |atanh e_i(t_{k+1})| in this sample's coordinates, from the per-axis end ranges
+        end_limits = [_atanh_reach((x_lo - centre_l[k][i]) / h_k[i],
+                                   (x_hi - centre_l[k][i]) / h_k[i])
+                      for i, (x_lo, x_hi) in enumerate(ends)]
+        box = [[(x_lo - c_n[i]) / h_n[i], (x_hi - c_n[i]) / h_n[i]]
+               for i, (x_lo, x_hi) in enumerate(ends)]
+        for b in balls:
+            r = (next_level(end_level[b], [alpha[k][i] for i in b], [beta[k][i] for i in b],
+                            [end_limits[i] for i in b])
+                 if math.isfinite(end_level[b]) else math.inf)
+            level[b] = r
+            if math.isfinite(r):
+                edge = math.tanh(r)
+                for i in b:
+                    box[i] = [max(box[i][0], -edge), min(box[i][1], edge)]
+        top = max(top, max(max(-x, y) for x, y in box))
+    data.update({"max_abs_e": top, "margin": worst, "max_level": ball_max,
+                 "intervals_without_ball": int(ball_lost)})
+    abs_e.append([max(-x, y) for x, y in box])
     return SampledCheck(True, top, worst, worst_t, worst_i, "", data, np.array(abs_e))
 
 
-def lowest_rate(design: TubeDesign, spec: Spec, assumptions: Assumptions,
-                explicit_gain: float | None = None) -> tuple[float | None, float | None]:
+def lowest_rate(design: TubeDesign, spec: Spec, plants: Assumptions | PlantClass,
+                explicit_gain: float | None = None,
+                passes_at_rate: bool | None = None) -> tuple[float | None, float | None]:
     """The lowest of ``rate_hz`` times :data:`RATE_FACTORS` at which the design holds.
 
     At each rate the tube keeps its circumvents and segments, is certified again
@@ -227,22 +277,28 @@ def lowest_rate(design: TubeDesign, spec: Spec, assumptions: Assumptions,
     sampling-rate check depend on the rate), and the sampled check
     (:func:`check_sampled`) must pass with the gain the design would use there:
     ``explicit_gain`` if given, else :func:`~stt_codegen.design.gain.derived_gain` at that
-    rate's certified narrowest width. The largest factor is tried first; if it fails, no factor
-    is reported.
+    rate's certified narrowest width. When the design holds at ``rate_hz`` the factors
+    below 1 are tried in increasing order; else the largest factor first (if it fails, no
+    factor is reported), then the others above 1 in increasing order.
 
     Parameters
     ----------
     design : TubeDesign
     spec : Spec
         For the certificate (state space, obstacles, target).
-    assumptions : Assumptions
+    plants : Assumptions or PlantClass
     explicit_gain : float, optional
+    passes_at_rate : bool, optional
+        Whether the check already passed at ``design.rate_hz`` with its gain (saves a run);
+        default: find out.
 
     Returns
     -------
     rate_hz, gain : float or None
         ``(None, None)`` when no factor tried works.
     """
+    assumptions = _as_class(plants).assumptions
+
     def passes(factor: float) -> tuple[bool, float]:
         trial = replace(design, rate_hz=design.rate_hz * factor)
         certificate = certify_tube(trial, spec)
@@ -250,29 +306,53 @@ def lowest_rate(design: TubeDesign, spec: Spec, assumptions: Assumptions,
                 else derived_gain(certificate.min_width, trial.rate_hz, assumptions))
         if not certificate.passed:
             return False, gain
-        return check_sampled(trial, sample_tube(trial), assumptions, gain).passed, gain
+        return check_sampled(trial, sample_tube(trial), plants, gain).passed, gain
 
-    # the fastest rate first: when even it fails (coupling beyond what any rate can
-    # handle), one check answers instead of all of them
-    ok, fastest_gain = passes(RATE_FACTORS[-1])
+    below = [f for f in RATE_FACTORS if f < 1.0]
+    above = [f for f in RATE_FACTORS if f > 1.0]
+    if passes_at_rate is None:
+        passes_at_rate, gain_at_rate = passes(1.0)
+    else:
+        gain_at_rate = (explicit_gain if explicit_gain is not None
+                        else derived_gain(certify_tube(design, spec).min_width,
+                                          design.rate_hz, assumptions))
+    if passes_at_rate:
+        for factor in below:
+            ok, gain = passes(factor)
+            if ok:
+                return design.rate_hz * factor, gain
+        return design.rate_hz, gain_at_rate
+    # the fastest rate first: when even it fails, one check answers instead of all of them
+    ok, fastest_gain = passes(above[-1])
     if not ok:
         return None, None
-    for factor in RATE_FACTORS[:-1]:
+    for factor in above[:-1]:
         ok, gain = passes(factor)
         if ok:
             return design.rate_hz * factor, gain
-    return design.rate_hz * RATE_FACTORS[-1], fastest_gain
+    return design.rate_hz * above[-1], fastest_gain
 
 
 # --------------------------------------------------------------------------- verify
 
 
-def _bounds_words(a: Assumptions) -> str:
+def _bounds_words(a: Assumptions, refined: tuple[str, ...] = ()) -> str:
     g_min, g_max = a.input_gain
-    source = "declared" if a.declared else "defaults: declare [assumptions] for your plant"
-    return (f"eig((g + g^T)/2) in [{g_min:g}, {g_max:g}], |skew part| <= "
-            f"{a.input_gain_skew:g}, row coupling <= {a.input_gain_coupling:g}, |f| <= "
-            f"{a.drift_bound:g}, |w| <= {a.disturbance_bound:.3g} ({source})")
+    if a.model and not a.declared:
+        source = f"the {a.model} model's own bounds over the state space"
+    elif a.model:
+        source = (f"declared: {', '.join(a.declared)}; the rest from the {a.model} model "
+                  "over the state space")
+    else:
+        source = "given"
+    if refined:
+        source += f"; {', '.join(refined)} evaluated on the tube per sampling interval"
+    words = (f"eig((g + g^T)/2) in [{g_min:.6g}, {g_max:.6g}], |skew part| <= "
+             f"{a.input_gain_skew:.6g}, row coupling <= {a.input_gain_coupling:.6g}, |f| <= "
+             f"{a.drift_bound:.6g}, |w| <= {a.disturbance_bound:.3g}")
+    if len(a.blocks) > 1:
+        words += f", g block diagonal on {[list(b) for b in a.blocks]}"
+    return f"{words} ({source})"
 
 
 def sampled_checks(spec: Spec, design: TubeDesign, samples: TubeSamples,
@@ -281,8 +361,9 @@ def sampled_checks(spec: Spec, design: TubeDesign, samples: TubeSamples,
 
     ``sampled.gain``: ``k`` is below the linearized stability limit at the narrowest tube
     for ``g_max``, with the derivation (:func:`~stt_codegen.design.gain.gain_derivation`)
-    in words. ``sampled.tube_kept``: :func:`check_sampled` for the spec's assumptions;
-    when it fails, the lowest rate that passes (:func:`lowest_rate`).
+    in words. ``sampled.tube_kept``: :func:`check_sampled` for the spec's plant class
+    (:func:`~stt_codegen.verify.plant_class.plant_class`), with the lowest rate that
+    passes (:func:`lowest_rate`), whether or not the spec's rate does.
 
     Parameters
     ----------
@@ -300,94 +381,95 @@ def sampled_checks(spec: Spec, design: TubeDesign, samples: TubeSamples,
     list of Check
     """
     a = spec.assumptions
+    plants = plant_class(spec)
     narrowest = certificate.margin("non-empty")
     derivation = gain_derivation(design, narrowest.margin, narrowest.time, a, spec.gain)
     gain_ok = derivation["gain"] < derivation["stable_gain_limit"]
     checks = [Check("sampled.gain", gain_ok, derivation["explanation"]
                     + ("" if gain_ok else f"; k = {derivation['gain']:.6g} is beyond the "
                        f"limit at g_max = {a.input_gain[1]:g}"), derivation)]
-    result = check_sampled(design, samples, a)
-    if result.passed:
-        detail = (f"every plant with {_bounds_words(a)} stays strictly inside the tube at "
-                  f"and between samples at {design.rate_hz:g} Hz with k = {design.gain:.6g}:"
-                  f" |e| <= {result.level:.4g} at the samples, room >= {result.margin:.3g} "
-                  f"of the half-width (least at t = {result.time:.4f} s, dimension "
-                  f"{result.dimension})")
+    result = check_sampled(design, samples, plants)
+    words = _bounds_words(a, tuple(result.data.get("refined_on_the_tube", ())))
+    rate, gain = lowest_rate(design, spec, plants, spec.gain, passes_at_rate=result.passed)
+    g_max = a.input_gain[1]
+    if rate is not None:
+        lowest = f"lowest passing rate {rate / 1000:.3g} kHz (k = {gain:.4g})"
     else:
-        rate, gain = lowest_rate(design, spec, a, spec.gain)
-        g_max = a.input_gain[1]
-        if rate is not None:
-            need = f"the condition needs {rate / 1000:.3g} kHz (k = {gain:.4g}) at g_max = {g_max:g}"
-        else:
-            need = (f"no rate up to {design.rate_hz * RATE_FACTORS[-1] / 1000:g} kHz passes "
-                    f"the condition at g_max = {g_max:g}")
-            if a.input_gain_coupling > 0:
-                need += (f" (row coupling {a.input_gain_coupling:g} next to g_min = "
-                         f"{a.input_gain[0]:g}: declare a smaller input_gain_coupling if the "
-                         "structure of g allows)")
+        lowest = (f"no rate up to {design.rate_hz * RATE_FACTORS[-1] / 1000:g} kHz passes "
+                  f"the condition at g_max = {g_max:g}")
+        if a.input_gain_coupling > 0 and "input_gain_coupling" not in a.declared:
+            lowest += (f" (row coupling {a.input_gain_coupling:g} next to g_min = "
+                       f"{a.input_gain[0]:g}: declare a smaller input_gain_coupling if the "
+                       "structure of g allows)")
+    if result.passed:
+        detail = (f"every plant with {words} stays strictly inside the tube at and between "
+                  f"samples at {design.rate_hz:g} Hz with k = {design.gain:.6g}: |e| <= "
+                  f"{result.level:.4g} at the samples, room >= {result.margin:.3g} of the "
+                  f"half-width (least at t = {result.time:.4f} s, dimension "
+                  f"{result.dimension}); {lowest}")
+    else:
+        need = (f"the condition needs {rate / 1000:.3g} kHz (k = {gain:.4g}) at g_max = "
+                f"{g_max:g}" if rate is not None else lowest)
         label = "controller.gain" if spec.gain is not None else "the derived gain"
-        detail = (f"{result.reason}, for plants with {_bounds_words(a)} at "
-                  f"{design.rate_hz:g} Hz and k = {design.gain:.6g} ({label}); {need}")
+        detail = (f"{result.reason}, for plants with {words} at {design.rate_hz:g} Hz and "
+                  f"k = {design.gain:.6g} ({label}); {need}")
+    if a.notes:
+        detail += "; " + "; ".join(a.notes) + " (the declared bounds are used; they cover the model)"
     checks.append(Check("sampled.tube_kept", result.passed, detail,
                         {**result.data, "level": result.level, "margin": result.margin,
-                         "time": result.time}))
+                         "time": result.time, "lowest_rate_hz": rate,
+                         "lowest_rate_gain": gain}))
     return checks
 
 
-def _drift_bound(plant: LinearPlant, space) -> float:
-    """``max_{x in X} |a x + c|``: at a vertex of the box (the norm is convex); for more
-    than 12 dimensions the bound ``|a m + c| + sum_j |a_j| r_j`` (centre m, half-widths r)."""
-    a, c = np.array(plant.a), np.array(plant.c)
-    lo, hi = np.array(space.lower), np.array(space.upper)
-    if lo.size <= 12:
-        corners = np.array(list(itertools.product(*zip(lo, hi))))
-        return float(np.linalg.norm(corners @ a.T + c, axis=1).max())
-    m, r = (lo + hi) / 2, (hi - lo) / 2
-    return float(np.linalg.norm(a @ m + c) + np.linalg.norm(a, axis=0) @ r)
+def plant_bounds_checks(spec: Spec, model: str | None = None) -> list[Check]:
+    """Whether the plant model meets the assumptions ``verify`` judges it against.
 
+    ``sampled.plant_within_assumptions``: the model's bounds over the state space
+    (:func:`~stt_codegen.spec.model_bounds.model_bounds`: eigenvalues of the symmetric part
+    of ``g``, norm of its skew part, row coupling, ``max |f|``) lie within
+    ``spec.assumptions``. The loader makes this hold for every spec it builds (a bound the
+    model violates is a ``SpecError``); a spec changed in Python
+    (``dataclasses.replace``) can break it, and then the sampled verdict is not about the
+    model, which this check says. For the ``linear`` model also ``assumption2.linear``:
+    ``lambda_min((g + g^T)/2) > 0``.
 
-def linear_plant_checks(spec: Spec) -> list[Check]:
-    """Assumption 2 for the spec's ``linear`` plant, and whether it meets ``[assumptions]``.
+    Parameters
+    ----------
+    spec : Spec
+    model : str, optional
+        Plant model, default the spec's.
 
     Returns
     -------
     list of Check
-        ``assumption2.linear`` (``lambda_min((g + g^T)/2) > 0``) and
-        ``sampled.plant_within_assumptions`` (the plant's ``g``, skew part, row coupling
-        and ``max |a x + c|`` over the state space against the declared bounds).
     """
-    plant = spec.linear_plant
-    n = spec.dimension
-    if plant is None:
-        eye = tuple(tuple(float(i == j) for j in range(n)) for i in range(n))
-        plant = LinearPlant(tuple(tuple(0.0 for _ in range(n)) for _ in range(n)), eye,
-                            tuple(0.0 for _ in range(n)))
-    g = np.array(plant.g)
-    sym, skew = (g + g.T) / 2, (g - g.T) / 2
-    eig = np.linalg.eigvalsh(sym)
-    checks = [Check("assumption2.linear", bool(eig[0] > 0),
-                    f"lambda_min((g + g^T)/2) = {eig[0]:.6g} for the linear plant's g"
-                    + ("" if eig[0] > 0 else ": Assumption 2 fails, law (13) cannot hold "
-                       "this plant"), {"lambda_min": float(eig[0])})]
-    off = g - np.diag(np.diag(g))
-    found = {"input_gain": (float(eig[0]), float(eig[-1])),
-             "input_gain_skew": float(np.linalg.norm(skew, 2)),
-             "input_gain_coupling": float(np.linalg.norm(off, axis=1).max()),
-             "drift_bound": _drift_bound(plant, spec.state_space)}
+    model = model or spec.plant_model
+    linear = spec.linear_plant if model == "linear" else None
+    b = model_bounds(model, spec.state_space.lower, spec.state_space.upper, linear)
+    checks = []
+    if model == "linear":
+        lam = b.input_gain[0]
+        checks.append(Check("assumption2.linear", bool(lam > 0),
+                            f"lambda_min((g + g^T)/2) >= {lam:.6g} for the linear plant's g"
+                            + ("" if lam > 0 else ": Assumption 2 fails, law (13) cannot "
+                               "hold this plant"), {"lambda_min": lam}))
     a = spec.assumptions
-    tol = 1e-12
+    tol = 1e-9
     bad = []
-    if found["input_gain"][0] < a.input_gain[0] - tol or found["input_gain"][1] > a.input_gain[1] + tol:
-        bad.append(f"eig((g + g^T)/2) spans [{found['input_gain'][0]:.6g}, "
-                   f"{found['input_gain'][1]:.6g}], outside input_gain {list(a.input_gain)}")
+    if b.input_gain[0] < a.input_gain[0] - tol or b.input_gain[1] > a.input_gain[1] + tol:
+        bad.append(f"eig((g + g^T)/2) spans [{b.input_gain[0]:.6g}, {b.input_gain[1]:.6g}], "
+                   f"outside input_gain {list(a.input_gain)}")
     for key in ("input_gain_skew", "input_gain_coupling", "drift_bound"):
-        if found[key] > getattr(a, key) + tol:
-            bad.append(f"{key} is {found[key]:.6g} > {getattr(a, key):g}")
-    checks.append(Check("sampled.plant_within_assumptions", not bad,
-                        "the linear plant meets [assumptions] (eig in "
-                        f"[{found['input_gain'][0]:.6g}, {found['input_gain'][1]:.6g}], skew "
-                        f"{found['input_gain_skew']:.3g}, coupling "
-                        f"{found['input_gain_coupling']:.3g}, max |a x + c| "
-                        f"{found['drift_bound']:.3g})" if not bad else "; ".join(bad),
-                        {k: v for k, v in found.items()}))
+        if getattr(b, key) > getattr(a, key) + tol:
+            bad.append(f"{key} is {getattr(b, key):.6g} > {getattr(a, key):g}")
+    found = {"input_gain": list(b.input_gain), "input_gain_skew": b.input_gain_skew,
+             "input_gain_coupling": b.input_gain_coupling, "drift_bound": b.drift_bound}
+    checks.append(Check(
+        "sampled.plant_within_assumptions", not bad,
+        f"the {model} model meets the bounds the sampled check uses (eig in "
+        f"[{b.input_gain[0]:.6g}, {b.input_gain[1]:.6g}], skew {b.input_gain_skew:.3g}, "
+        f"coupling {b.input_gain_coupling:.3g}, max |f| {b.drift_bound:.3g} over the state "
+        "space)" if not bad else f"the {model} model is outside the bounds the sampled check "
+        "uses, so its verdict does not cover this plant: " + "; ".join(bad), found))
     return checks

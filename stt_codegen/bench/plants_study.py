@@ -1,0 +1,193 @@
+"""The wide study of unknown plants (issues 7, 13, 20): simulation against the sampled check.
+
+Draws plants ``x_dot = f(x) + g(x) u + w`` over wide ranges (``|f|`` up to about 6,
+eigenvalues of the symmetric part of ``g`` in ``[0.05, 5]``, a skew part up to 1,
+``|w_i| <= 0.5``), runs the generated C controller of each bundled case (its design's gain
+and rate) against each, and asks the sampled check
+(:func:`~stt_codegen.verify.sampled.check_sampled`) whether it proves that plant's own
+bounds. A plant the check accepts must hold in simulation; the study reports how many of
+the plants that hold the check accepts.
+
+The plants and seeds are those of the former ``tests/study_unknown_dynamics.py`` (issue
+7), which this module replaces, so that the numbers compare. Run::
+
+    python -m stt_codegen.bench.plants_study [RUNS_PER_CASE] [--workers W] [--out rows.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import math
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from ..design.samples import sample_tube
+from ..design.search import design_tube
+from ..runtime.simulate import simulate
+from ..spec.assumptions import Assumptions
+from ..spec.loader import load_spec
+from ..verify.sampled import check_sampled
+
+__all__ = ["CASES", "RANGES", "draw", "plant_parameters", "own_bounds", "study_one",
+           "study_plants"]
+
+CASES = ("omnirobot-s1", "omnirobot-s2", "omnirobot-s3")
+#: Ranges of the drawn knobs (uniform): sinusoidal drift amplitude, linear drift's spectral
+#: norm, ``g_min``, ``g_max / g_min``, skew amplitude, disturbance amplitude per state.
+RANGES = {"f_amp": (0.0, 3.0), "f_lin": (0.0, 1.0), "g_min": (0.05, 1.0),
+          "g_max_over_min": (1.0, 6.0), "skew": (0.0, 1.0), "w_amp": (0.0, 0.5)}
+
+
+@lru_cache(maxsize=None)
+def _designed(case: str):
+    spec = load_spec(case)
+    design = design_tube(spec).tube
+    return spec, design, sample_tube(design)
+
+
+def draw(case: str, index: int) -> dict:
+    """The knobs of plant ``index`` of ``case`` (seeded by both)."""
+    rng = np.random.default_rng([CASES.index(case), index, 7])
+    r = {k: float(rng.uniform(*v)) for k, v in RANGES.items()}
+    return {"f_amp": r["f_amp"], "f_lin": r["f_lin"], "g_min": r["g_min"],
+            "g_max": r["g_min"] * r["g_max_over_min"], "skew": r["skew"], "w_amp": r["w_amp"],
+            "seed": [CASES.index(case), index]}
+
+
+def _unit_skew(v: np.ndarray) -> np.ndarray:
+    if len(v) == 2:
+        return np.array([[0.0, -1.0], [1.0, 0.0]])
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
+def plant_parameters(knobs: dict, n: int = 3) -> dict:
+    """``f(x) = f_amp sin(W x + phi) + L (x - c)``, ``g(x) = S + skew tanh(v . x) K``,
+    ``w_i = w_amp sin(omega_i t + p_i)``; ``S`` symmetric with eigenvalues in
+    ``[g_min, g_max]`` (both reached), ``K`` a unit skew matrix."""
+    rng = np.random.default_rng(knobs["seed"])
+    q, _ = np.linalg.qr(rng.normal(size=(n, n)))
+    eig = rng.uniform(knobs["g_min"], knobs["g_max"], n)
+    eig[0], eig[-1] = knobs["g_min"], knobs["g_max"]
+    lin = rng.normal(size=(n, n))
+    lin = lin / np.linalg.norm(lin, 2)
+    axis = rng.normal(size=n)
+    return {"W": rng.normal(size=(n, n)), "phi": rng.uniform(0, 2 * np.pi, n),
+            "f_amp": knobs["f_amp"], "L": knobs["f_lin"] * lin,
+            "sym": q @ np.diag(eig) @ q.T, "skew_axis": axis / np.linalg.norm(axis),
+            "skew": knobs["skew"], "v": rng.normal(size=n), "w_amp": knobs["w_amp"],
+            "omega": rng.uniform(0.2, 5.0, n), "w_phase": rng.uniform(0, 2 * np.pi, n)}
+
+
+def _system(p: dict, centre: np.ndarray):
+    import control as ct
+    k_mat = _unit_skew(p["skew_axis"])
+
+    def rhs(t, x, u, params):
+        f = p["f_amp"] * np.sin(p["W"] @ x + p["phi"]) + p["L"] @ (x - centre)
+        g = p["sym"] + p["skew"] * np.tanh(p["v"] @ x) * k_mat
+        w = p["w_amp"] * np.sin(p["omega"] * t + p["w_phase"])
+        return f + g @ np.asarray(u, float) + w
+
+    n = len(centre)
+    return ct.nlsys(rhs, None, inputs=n, states=n, outputs=n)
+
+
+def own_bounds(p: dict, spec) -> Assumptions:
+    """The bounds a user who knew the drawn plant would declare (over the state space)."""
+    n = spec.dimension
+    eig = np.linalg.eigvalsh(p["sym"])
+    k_mat = _unit_skew(p["skew_axis"])
+    off = p["sym"] - np.diag(np.diag(p["sym"]))
+    coupling = float(np.max(np.linalg.norm(off, axis=1)
+                            + p["skew"] * np.linalg.norm(k_mat, axis=1)))
+    half = (np.array(spec.state_space.upper) - np.array(spec.state_space.lower)) / 2
+    drift = p["f_amp"] * math.sqrt(n) + np.linalg.norm(p["L"], 2) * np.linalg.norm(half)
+    return Assumptions((float(eig[0]), float(eig[-1])), float(p["skew"]), coupling,
+                       float(drift), float(p["w_amp"] * math.sqrt(n)))
+
+
+def _holds(case: str, p: dict, rate_factor: float = 1.0) -> bool:
+    spec, design, _ = _designed(case)
+    if rate_factor != 1.0:
+        spec = dataclasses.replace(spec, rate_hz=spec.rate_hz * rate_factor)
+        design = dataclasses.replace(design, rate_hz=design.rate_hz * rate_factor)
+    centre = (np.array(spec.state_space.lower) + np.array(spec.state_space.upper)) / 2
+    result = simulate(spec, design, backend="c", plant=_system(p, centre))
+    return bool(result.satisfied and result.stayed_in_tube)
+
+
+def study_one(job: tuple[str, int]) -> dict:
+    """One plant: whether it holds in simulation, the check's verdict on its own bounds,
+    and, when it fails, whether it holds at 2, 4 or 8 times the rate."""
+    case, index = job
+    spec, design, samples = _designed(case)
+    knobs = draw(case, index)
+    p = plant_parameters(knobs)
+    bounds = own_bounds(p, spec)
+    started = time.perf_counter()
+    verdict = check_sampled(design, samples, bounds)
+    check_s = time.perf_counter() - started
+    held = _holds(case, p)
+    row = {"case": case, "index": index, **knobs, "held": held,
+           "check_accepts": verdict.passed, "check_s": check_s,
+           "g_min_own": bounds.input_gain[0], "g_max_own": bounds.input_gain[1],
+           "coupling": bounds.input_gain_coupling,
+           "push": bounds.drift_bound + bounds.disturbance_bound,
+           "check_fails_at": None if verdict.passed else verdict.time}
+    if not held:
+        row["holds_at_rate_factor"] = next((f for f in (2.0, 4.0, 8.0) if _holds(case, p, f)),
+                                           None)
+    return row
+
+
+def study_plants(runs: int, workers: int = 2) -> list[dict]:
+    """``runs`` plants per bundled case (:func:`study_one`), in parallel."""
+    jobs = [(case, i) for case in CASES for i in range(runs)]
+    if workers <= 1:
+        return [study_one(j) for j in jobs]
+    with ProcessPoolExecutor(workers) as pool:
+        return list(pool.map(study_one, jobs, chunksize=2))
+
+
+def summary(rows: list[dict]) -> str:
+    """The study's figures in words."""
+    held = [r for r in rows if r["held"]]
+    accepted = [r for r in rows if r["check_accepts"]]
+    bad = [r for r in accepted if not r["held"]]
+    lines = [f"{len(rows)} plants: {len(held)} hold in simulation; the sampled check accepts "
+             f"{len(accepted)} ({len([r for r in accepted if r['held']])} of the "
+             f"{len(held)} that hold, {100 * len(accepted) / max(len(held), 1):.1f} %), "
+             f"of which {len(bad)} fail"]
+    for case in CASES:
+        sub = [r for r in rows if r["case"] == case]
+        lines.append(f"  {case}: {sum(r['held'] for r in sub)}/{len(sub)} hold, check "
+                     f"accepts {sum(r['check_accepts'] for r in sub)}")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m stt_codegen.bench.plants_study",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("runs", nargs="?", type=int, default=100,
+                        help="plants per bundled case (default 100)")
+    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--out", default=None, help="write every row as JSON")
+    args = parser.parse_args(argv)
+    started = time.perf_counter()
+    rows = study_plants(args.runs, args.workers)
+    print(summary(rows))
+    print(f"({time.perf_counter() - started:.0f} s)")
+    if args.out:
+        Path(args.out).write_text(json.dumps(rows, indent=1))
+    return 1 if any(r["check_accepts"] and not r["held"] for r in rows) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

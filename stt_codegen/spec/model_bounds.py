@@ -1,0 +1,276 @@
+"""What a named plant model implies about system (1) on a box of states.
+
+A spec's ``[plant] model`` is the plant ``stt-codegen simulate`` runs and the plant
+``verify`` judges. Its input matrix ``g(x)`` and drift ``f(x)`` are known, so the bounds of
+``[assumptions]`` (:class:`~stt_codegen.spec.loader.Assumptions`) follow from it, over the
+state space ``X`` for the spec and over a smaller box (the tube on one sampling interval)
+for ``verify``'s sampled check:
+
+* ``input_gain``: the range of the eigenvalues of the symmetric part
+  ``g_s = (g + g^T) / 2`` (Assumption 2 asks its lower end positive);
+* ``input_gain_skew``: the largest spectral norm of the skew part ``(g - g^T) / 2``;
+* ``input_gain_coupling``: the largest Euclidean norm of the off-diagonal part of a row
+  of ``g``;
+* ``drift_bound``: the largest ``|f(x)|``;
+* ``blocks``: a partition of the state indices in which ``g(x)`` is block diagonal for
+  every ``x`` (an input of one block never moves a state of another).
+
+Every number is an outer bound: computed exactly where the model allows (the heading
+range of eq. (14), the vertices of the box for a linear drift), then widened by a few
+units in the last place (:data:`REL_PAD`) so that rounding cannot make it tighter than
+the model. Plain Python (no numpy): the spec loader uses it.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+__all__ = ["ModelBounds", "model_bounds", "symmetric_eigen_range", "REL_PAD"]
+
+#: Relative outward widening of every computed bound (rounding of ``cos``, ``sin`` and of
+#: the Jacobi eigenvalue iteration is far below it).
+REL_PAD = 1e-12
+#: Up to this many states, ``max |a x + c|`` over a box is evaluated at all its vertices
+#: (exact: the norm is convex); beyond, an upper bound.
+EXACT_DRIFT_DIMENSIONS = 10
+
+
+@dataclass(frozen=True)
+class ModelBounds:
+    """Bounds a plant model implies on a box of states (see the module docstring).
+
+    Attributes
+    ----------
+    model : str
+        The ``plant.model`` name.
+    input_gain : tuple of float, (g_min, g_max)
+        Range of the eigenvalues of ``(g(x) + g(x)^T) / 2`` over the box (``g_min`` may
+        be ``<= 0``: the model then violates Assumption 2 there).
+    input_gain_skew : float
+        Largest ``|(g(x) - g(x)^T) / 2|_2``.
+    input_gain_coupling : float
+        Largest Euclidean norm of the off-diagonal part of a row of ``g(x)``.
+    drift_bound : float
+        Largest ``|f(x)|``, state units per second.
+    blocks : tuple of tuple of int
+        Partition of ``0..n-1``: ``g(x)`` is block diagonal with these blocks for every
+        ``x``, in increasing order.
+    where : tuple of (str, str)
+        For each key above, where the model attains it, in words (for messages).
+    remedy : str
+        What a spec whose ``[assumptions]`` contradict the model can change, in words.
+    """
+
+    model: str
+    input_gain: tuple[float, float]
+    input_gain_skew: float
+    input_gain_coupling: float
+    drift_bound: float
+    blocks: tuple[tuple[int, ...], ...]
+    where: tuple[tuple[str, str], ...] = ()
+    remedy: str = ""
+
+    def words(self, key: str) -> str:
+        """Where the model attains ``key`` ("" if not recorded)."""
+        return dict(self.where).get(key, "")
+
+
+def _down(v: float) -> float:
+    return v - REL_PAD * max(1.0, abs(v))
+
+
+def _up(v: float) -> float:
+    return v + REL_PAD * abs(v)
+
+
+def _contains_point(lo: float, hi: float, phase: float, period: float) -> bool:
+    """Whether ``[lo, hi]`` contains ``phase + m period`` for an integer ``m``."""
+    m = math.ceil((lo - phase) / period)
+    return phase + m * period <= hi
+
+
+def cos_range(lo: float, hi: float) -> tuple[float, float]:
+    """``(min, max)`` of ``cos`` on ``[lo, hi]`` (radians), exact up to rounding."""
+    values = [math.cos(lo), math.cos(hi)]
+    if _contains_point(lo, hi, 0.0, 2 * math.pi):
+        values.append(1.0)
+    if _contains_point(lo, hi, math.pi, 2 * math.pi):
+        values.append(-1.0)
+    return min(values), max(values)
+
+
+def abs_sin_max(lo: float, hi: float) -> float:
+    """``max |sin|`` on ``[lo, hi]`` (radians), exact up to rounding."""
+    if _contains_point(lo, hi, math.pi / 2, math.pi):
+        return 1.0
+    return max(abs(math.sin(lo)), abs(math.sin(hi)))
+
+
+def _omnidirectional(lower: Sequence[float], upper: Sequence[float]) -> ModelBounds:
+    # eq. (14): g = R(x3), g_s = diag(cos x3, cos x3, 1), skew part sin x3 [[0, -1], [1, 0]]
+    lo, hi = float(lower[2]), float(upper[2])
+    c_min, c_max = cos_range(lo, hi)
+    s_max = abs_sin_max(lo, hi)
+    heading = f"x3 in [{lo:g}, {hi:g}]"
+    return ModelBounds(
+        # the eigenvalue 1 (of g_33) is exact and cos x3 <= 1: g_max = 1
+        "omnidirectional", (_down(min(c_min, 1.0)), 1.0), _up(s_max),
+        _up(s_max), 0.0, ((0, 1), (2,)),
+        (("input_gain", f"eigenvalues cos x3 and 1 of (g + g^T)/2 for {heading}"),
+         ("input_gain_skew", f"|sin x3| for {heading}"),
+         ("input_gain_coupling", f"|sin x3| in rows 1 and 2 for {heading}"),
+         ("drift_bound", "f = 0")),
+        "narrow state_space's heading range (x3)")
+
+
+def _jacobi_eigenvalues(m: list[list[float]]) -> list[float]:
+    """Eigenvalues of a symmetric matrix (cyclic Jacobi rotations), ascending."""
+    a = [row[:] for row in m]
+    n = len(a)
+    scale = math.sqrt(sum(v * v for row in a for v in row)) or 1.0
+    for _ in range(100):
+        off = sum(a[i][j] ** 2 for i in range(n) for j in range(n) if i != j)
+        if off <= (1e-17 * scale) ** 2:
+            break
+        for p in range(n - 1):
+            for q in range(p + 1, n):
+                if a[p][q] == 0.0:
+                    continue
+                theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q])
+                t = math.copysign(1.0, theta) / (abs(theta) + math.hypot(theta, 1.0))
+                c = 1.0 / math.hypot(t, 1.0)
+                s = t * c
+                for k in range(n):          # columns p, q
+                    akp, akq = a[k][p], a[k][q]
+                    a[k][p], a[k][q] = c * akp - s * akq, s * akp + c * akq
+                for k in range(n):          # rows p, q
+                    apk, aqk = a[p][k], a[q][k]
+                    a[p][k], a[q][k] = c * apk - s * aqk, s * apk + c * aqk
+    return sorted(a[i][i] for i in range(n))
+
+
+def symmetric_eigen_range(g: Sequence[Sequence[float]]) -> tuple[float, float, float]:
+    """``(lambda_min, lambda_max)`` of ``(g + g^T)/2`` and ``|(g - g^T)/2|_2``, widened
+    outward by :data:`REL_PAD` times ``|g|_F`` (the Jacobi iteration's accuracy is far
+    better); exact, not widened, for a diagonal ``(g + g^T)/2`` and a zero skew part.
+
+    Parameters
+    ----------
+    g : sequence of sequence of float, shape (n, n)
+    """
+    n = len(g)
+    sym = [[(g[i][j] + g[j][i]) / 2 for j in range(n)] for i in range(n)]
+    skew = [[(g[i][j] - g[j][i]) / 2 for j in range(n)] for i in range(n)]
+    # |K|_2^2 = lambda_max(K^T K)
+    ktk = [[sum(skew[k][i] * skew[k][j] for k in range(n)) for j in range(n)]
+           for i in range(n)]
+    eig = _jacobi_eigenvalues(sym)
+    size = math.sqrt(sum(v * v for row in g for v in row))
+    diagonal = all(sym[i][j] == 0.0 for i in range(n) for j in range(n) if i != j)
+    pad = 0.0 if diagonal else REL_PAD * size
+    skew_norm = math.sqrt(max(_jacobi_eigenvalues(ktk)[-1], 0.0))
+    skew_pad = REL_PAD * size if skew_norm > 0 else 0.0
+    return eig[0] - pad, eig[-1] + pad, skew_norm + skew_pad
+
+
+def _blocks(g: Sequence[Sequence[float]]) -> tuple[tuple[int, ...], ...]:
+    """Connected components of the graph with an edge where ``g_ij != 0`` or ``g_ji != 0``."""
+    n = len(g)
+    parent = list(range(n))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for i in range(n):
+        for j in range(n):
+            if i != j and g[i][j] != 0.0:
+                parent[root(i)] = root(j)
+    groups: dict[int, list[int]] = {}
+    for i in range(n):
+        groups.setdefault(root(i), []).append(i)
+    return tuple(sorted(tuple(v) for v in groups.values()))
+
+
+def linear_drift_bound(a: Sequence[Sequence[float]], c: Sequence[float],
+                       lower: Sequence[float], upper: Sequence[float]) -> float:
+    """``max |a x + c|`` over the box ``[lower, upper]``: exact at the vertices up to
+    :data:`EXACT_DRIFT_DIMENSIONS` states (the norm is convex), else
+    ``|a m + c| + sum_j |a_j| r_j`` (centre ``m``, half-widths ``r``, columns ``a_j``)."""
+    n = len(c)
+
+    def norm_at(x: Sequence[float]) -> float:
+        return math.sqrt(sum((sum(a[i][j] * x[j] for j in range(n)) + c[i]) ** 2
+                             for i in range(n)))
+
+    if n <= EXACT_DRIFT_DIMENSIONS:
+        return _up(max(norm_at(v) for v in itertools.product(*zip(lower, upper))))
+    mid = [(lo + hi) / 2 for lo, hi in zip(lower, upper)]
+    half = [(hi - lo) / 2 for lo, hi in zip(lower, upper)]
+    columns = [math.sqrt(sum(a[i][j] ** 2 for i in range(n))) for j in range(n)]
+    return _up(norm_at(mid) + sum(cj * rj for cj, rj in zip(columns, half)))
+
+
+def _linear(lower: Sequence[float], upper: Sequence[float], linear) -> ModelBounds:
+    n = len(lower)
+    if linear is None:
+        a = [[0.0] * n for _ in range(n)]
+        g = [[float(i == j) for j in range(n)] for i in range(n)]
+        c = [0.0] * n
+    else:
+        a, g, c = linear.a, linear.g, linear.c
+    g_min, g_max, skew = symmetric_eigen_range(g)
+    coupling = max((math.sqrt(sum(g[i][j] ** 2 for j in range(n) if j != i))
+                    for i in range(n)), default=0.0)
+    return ModelBounds(
+        "linear", (g_min, g_max), skew, _up(coupling), linear_drift_bound(a, c, lower, upper),
+        _blocks(g),
+        (("input_gain", "eigenvalues of (g + g^T)/2 for the constant plant.g"),
+         ("input_gain_skew", "|(g - g^T)/2| for plant.g"),
+         ("input_gain_coupling", "the largest off-diagonal row of plant.g"),
+         ("drift_bound", "max |a x + c| over the box")),
+        "correct plant.a, plant.g or plant.c")
+
+
+def model_bounds(model: str, lower: Sequence[float], upper: Sequence[float],
+                 linear=None) -> ModelBounds:
+    """The bounds ``model`` implies for every state in the box ``[lower, upper]``.
+
+    Parameters
+    ----------
+    model : str
+        A ``plant.model`` name (:data:`~stt_codegen.spec.plants.PLANT_MODELS`):
+        ``"omnidirectional"`` (eq. (14), ``g = R(x3)``, ``f = 0``; depends on the heading
+        range ``[lower[2], upper[2]]``), ``"single-integrator"`` (``g = I``, ``f = 0``) or
+        ``"linear"`` (``x_dot = a x + c + g u``).
+    lower, upper : sequence of float, length n
+        The box (the state space, or the tube on an interval), state units.
+    linear : LinearPlant, optional
+        The ``linear`` model's matrices; default ``a = 0``, ``g = I``, ``c = 0``.
+
+    Returns
+    -------
+    ModelBounds
+
+    Raises
+    ------
+    ValueError
+        Unknown model.
+    """
+    n = len(lower)
+    if model == "omnidirectional":
+        return _omnidirectional(lower, upper)
+    if model == "single-integrator":
+        return ModelBounds("single-integrator", (1.0, 1.0), 0.0, 0.0, 0.0,
+                           tuple((i,) for i in range(n)),
+                           (("input_gain", "g = I"), ("input_gain_skew", "g = I"),
+                            ("input_gain_coupling", "g = I"), ("drift_bound", "f = 0")),
+                           'describe your plant with [plant] model = "linear" and its g')
+    if model == "linear":
+        return _linear(lower, upper, linear)
+    raise ValueError(f"unknown plant model {model!r}")

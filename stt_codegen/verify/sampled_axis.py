@@ -1,0 +1,148 @@
+"""One axis of the sampled loop over one sampling interval: the per-axis interval argument.
+
+Law (13) on axis ``i`` at ``|e_i| = s`` asks ``u_i = -(4 k / gamma_d,i) phi(s)`` (signed
+with ``e_i``), with ``phi(s) = 2 atanh(s) / (1 - s^2)``. Held over ``[t_k, t_k + dt]``,
+``x_i`` moves as ``x_dot_i = g_ii u_i + d_i`` with ``g_ii`` in ``[g_min, g_max]`` (a
+diagonal entry of ``g`` is one of its symmetric part) and ``|d_i| <= D_i`` (drift,
+disturbance and the other inputs through the coupling). :func:`axis_interval` encloses
+``x_i`` over the interval and at its end for every ``e_i(t_k)`` in an interval
+(docs/sampled-data.md, "The per-axis argument"). Plain floats: it runs once per axis and
+sampling interval.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+__all__ = ["phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "coupling_push",
+           "axis_interval"]
+
+
+def phi(s: np.ndarray) -> np.ndarray:
+    """``phi(s) = 2 atanh(s) / (1 - s^2)``: ``|u_i| gamma_d,i / (4 k)`` of law (13) at
+    ``|e_i| = s``; odd, increasing, convex on ``[0, 1)``."""
+    return 2.0 * np.arctanh(s) / (1.0 - s * s)
+
+
+def phi_slope(s: np.ndarray) -> np.ndarray:
+    """``phi'(s) = (2 + 4 s atanh(s)) / (1 - s^2)^2``: even, increasing in ``|s|``,
+    ``phi'(0) = 2``."""
+    return (2.0 + 4.0 * s * np.arctanh(s)) / (1.0 - s * s) ** 2
+
+
+def phi_scalar(s: float) -> float:
+    """:func:`phi` for one float."""
+    return 2.0 * math.atanh(s) / (1.0 - s * s)
+
+
+def phi_slope_scalar(s: float) -> float:
+    """:func:`phi_slope` for one float."""
+    return (2.0 + 4.0 * s * math.atanh(s)) / (1.0 - s * s) ** 2
+
+
+def peak(ratio: np.ndarray) -> np.ndarray:
+    """``s* = argmax_s (s - phi(s) / ratio)`` on ``[0, 1)``: ``phi'(s*) = ratio``, or 0
+    where ``ratio <= phi'(0) = 2``. Bisection (``phi'`` is increasing), to 60 halvings.
+
+    Parameters
+    ----------
+    ratio : ndarray
+        ``h / (g_min p)``: half-width over the pull of the weakest gain, any shape.
+    """
+    lo, hi = np.zeros_like(ratio), np.full_like(ratio, 1.0 - 1e-15)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        up = phi_slope(mid) < ratio
+        lo, hi = np.where(up, mid, lo), np.where(up, hi, mid)
+    return np.where(ratio <= 2.0, 0.0, lo)
+
+
+def coupling_push(others: float, coupling: float, spread: float, skew: float,
+                  own: float) -> float:
+    """A bound of the displacement the other inputs cause on axis ``i`` over one interval,
+    whatever ``g_ii`` is, beyond what ``g_min`` (outward) or ``g_max`` (inward) of the own
+    input leaves.
+
+    ``others`` bounds ``dt |u_j|`` over the other axes of the block (Euclidean), ``own`` is
+    ``dt |u_i|``. The off-diagonal part of row ``i`` of ``g`` is at most ``coupling``; it is
+    also its symmetric part (at most ``sqrt(min(g_ii - g_min, g_max - g_ii) spread)`` by the
+    Schur complement of ``g_s - g_min I >= 0`` and of ``g_max I - g_s >= 0``) plus its skew
+    part (at most ``skew``). Maximizing ``-(g_ii - g_min) own + sqrt((g_ii - g_min) spread)
+    others`` over ``g_ii`` gives ``spread others^2 / (4 own)`` when ``others <= 2 own``, else
+    ``spread (others - own)`` (docs/sampled-data.md, eq. (A3)).
+
+    Parameters
+    ----------
+    others, coupling, spread, skew, own : float
+        As above; ``spread = g_max - g_min``.
+    """
+    if others <= 0.0:
+        return 0.0
+    if others <= 2.0 * own:
+        symmetric = spread * others * others / (4.0 * own)
+    else:
+        symmetric = spread * (others - own)
+    return min(coupling * others, symmetric + skew * others)
+
+
+def axis_interval(a: float, b: float, c0: float, h0: float, pull: float, g_min: float,
+                  g_max: float, s_peak: float, push: float, others: float = 0.0,
+                  coupling: float = 0.0, skew: float = 0.0) -> tuple[float, float, float, float]:
+    """Enclosures of ``x_i`` on ``[t_k, t_{k+1}]`` and at ``t_{k+1}``, for every
+    ``e_i(t_k)`` in ``[a, b]``.
+
+    ``sigma x_i(t_{k+1})`` lies in ``[I(s), O(s)]`` for ``s = |e_i(t_k)|`` of sign
+    ``sigma``, with ``I(s) = sigma c0 + s h0 - g_max pull phi(s) - push - C(s)`` and
+    ``O(s) = sigma c0 + s h0 - g_min pull phi(s) + push + C(s)``, where ``C(s)`` is
+    :func:`coupling_push` with ``own = pull phi(s)``. Without ``C`` both are concave in
+    ``s``, so ``min I`` is at an end of the range of ``s`` and ``max O`` at ``s*`` clipped
+    to it; ``C`` decreases in ``s``, so it is taken at the range's lower end ``s_a``.
+    ``x_i`` moves along a line between ``t_k`` and ``t_{k+1}``'s extremes, so the path lies
+    between the start and the end.
+
+    Parameters
+    ----------
+    a, b : float
+        ``e_i(t_k)`` lies in ``[a, b]``, inside ``(-1, 1)``.
+    c0, h0 : float
+        The tube's centre and half-width on axis ``i`` at ``t_k``, state units.
+    pull : float
+        ``4 k dt / gamma_d,i``: ``dt |u_i| / phi(s)`` per unit of ``g_ii``.
+    g_min, g_max : float
+        Range of ``g_ii`` (of the eigenvalues of the symmetric part of ``g``).
+    s_peak : float
+        :func:`peak` of ``h0 / (g_min pull)``.
+    push : float
+        ``dt |f + w|`` bound, state units.
+    others : float
+        ``dt |u_j|`` over the other axes of the block, bound (0: none).
+    coupling, skew : float
+        Row coupling and skew bound of ``g`` (see :func:`coupling_push`).
+
+    Returns
+    -------
+    path_lo, path_hi, end_lo, end_hi : float
+        ``x_i`` on the whole interval, and at ``t_{k+1}``, state units.
+    """
+    spread = g_max - g_min
+    path_lo = end_lo = math.inf
+    path_hi = end_hi = -math.inf
+    for sign, s_a, s_b in ((1.0, max(a, 0.0), b), (-1.0, max(-b, 0.0), -a)):
+        if s_b < s_a or (s_b == 0.0 and sign < 0):
+            continue
+        extra = push + coupling_push(others, coupling, spread, skew, pull * phi_scalar(s_a))
+        start_a, start_b = sign * c0 + s_a * h0, sign * c0 + s_b * h0
+        s_star = min(max(s_peak, s_a), s_b)
+        out_max = sign * c0 + s_star * h0 - pull * g_min * phi_scalar(s_star) + extra
+        in_min = min(start_a - pull * g_max * phi_scalar(s_a),
+                     start_b - pull * g_max * phi_scalar(s_b)) - extra
+        low, high = min(start_a, in_min), max(start_b, out_max)
+        if sign > 0:
+            path_lo, path_hi = min(path_lo, low), max(path_hi, high)
+            end_lo, end_hi = min(end_lo, in_min), max(end_hi, out_max)
+        else:
+            path_lo, path_hi = min(path_lo, -high), max(path_hi, -low)
+            end_lo, end_hi = min(end_lo, -out_max), max(end_hi, -in_min)
+    return path_lo, path_hi, end_lo, end_hi
