@@ -33,6 +33,7 @@ from dataclasses import dataclass, replace
 
 from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
+from .grid import grid_index, grid_value
 from .failures import FailureKind
 from .input_bound import InputProof, InputProver, input_prover
 from .result import METHOD_PAPER, METHOD_VIA, Design
@@ -211,20 +212,6 @@ def _round_up(value: float, digits: int = 3) -> float:
     return float(f"{up:.{digits}g}") if float(f"{up:.{digits}g}") >= value else up
 
 
-def _grid_index(value: float) -> int:
-    """Index of the smallest two-significant-digit number ``>= value`` (``m 10^e``,
-    ``10 <= m <= 99``: index ``90 e + m - 10``)."""
-    e = math.floor(math.log10(value)) - 1
-    m = math.ceil(value / 10.0 ** e * (1.0 - 1e-12))
-    if m >= 100:
-        e, m = e + 1, 10
-    return 90 * e + max(m, 10) - 10
-
-
-def _grid_value(index: int) -> float:
-    e, m = divmod(index, 90)
-    return float(f"{m + 10}e{e}")
-
 
 def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
                              prover: InputProver, ratio: float) -> tuple[float | None, str]:
@@ -257,7 +244,7 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
               STEP_BUDGET / (HORIZON_FACTOR * spec.rate_hz))
 
     def passes(index: int) -> tuple[bool, float]:
-        trial = replace(spec, prescribed_time=_grid_value(index))
+        trial = replace(spec, prescribed_time=grid_value(index))
         try:
             accepted, tried = candidates(trial, design_free, prover)
         except (DesignError, SpecError):
@@ -265,13 +252,13 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
         best = min((c.proof.ratio(spec.input_bound) for c in tried), default=math.inf)
         return accepted is not None, best
 
-    low = _grid_index(spec.prescribed_time)
-    if _grid_value(low) > spec.prescribed_time:
+    low = grid_index(spec.prescribed_time)
+    if grid_value(low) > spec.prescribed_time:
         low -= 1
     high = None
     while high is None:
-        guess = max(_grid_index(_grid_value(low) * min(max(ratio, 1.25), 4.0)), low + 1)
-        if _grid_value(guess) > cap:
+        guess = max(grid_index(grid_value(low) * min(max(ratio, 1.25), 4.0)), low + 1)
+        if grid_value(guess) > cap:
             return None, (f"no prescribed_time up to {cap:.3g} s meets it "
                           f"({MAX_TIME_FACTOR:g} t_c or the step budget of the sampled check)")
         ok, found = passes(guess)
@@ -279,7 +266,7 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
             high = guess
         elif not found < MIN_IMPROVEMENT * ratio:
             return None, (f"a longer prescribed_time does not lower the peak enough (at "
-                          f"{_grid_value(guess):g} s the best design still asks {found:.3g} "
+                          f"{grid_value(guess):g} s the best design still asks {found:.3g} "
                           "times the bound): the disturbance and drift bounds of "
                           "[assumptions] alone ask for about that much")
         else:
@@ -290,4 +277,4 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
             high = mid
         else:
             low = mid
-    return _grid_value(high), ""
+    return grid_value(high), ""

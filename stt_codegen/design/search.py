@@ -31,6 +31,7 @@ from ..tube.parameters import Circumvent, TubeDesign, paper_segments
 from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, certify_tube
 from .actuator import design_within_bound
 from .failures import FailureKind, property_kind
+from .grid import grid_index, grid_value
 from .gain import derived_gain
 from .plant_check import plant_failure
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
@@ -122,20 +123,6 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
     return result("", None)
 
 
-def _grid_index(rate_hz: float) -> int:
-    """Index of the smallest two-significant-digit value ``>= rate_hz`` (``m 10^e``,
-    ``10 <= m <= 99``: index ``90 e + m - 10``)."""
-    e = math.floor(math.log10(rate_hz)) - 1
-    m = math.ceil(rate_hz / 10.0 ** e * (1.0 - 1e-12))
-    if m >= 100:
-        e, m = e + 1, 10
-    return 90 * e + max(m, 10) - 10
-
-
-def _grid_value(index: int) -> float:
-    e, m = divmod(index, 90)
-    return float(f"{m + 10}e{e}")
-
 
 def lowest_passing_rate(tube: TubeDesign, spec: Spec) -> float | None:
     """The lowest ``controller.rate_hz`` (two significant digits) at which ``tube`` passes
@@ -160,12 +147,12 @@ def lowest_passing_rate(tube: TubeDesign, spec: Spec) -> float | None:
         Hz.
     """
     def passes(index: int) -> tuple[bool, float]:
-        found = check_tube(replace(tube, rate_hz=_grid_value(index)), spec)
+        found = check_tube(replace(tube, rate_hz=grid_value(index)), spec)
         return found.passed, found.max_move_ratio
 
-    cap = _grid_index(tube.rate_hz * RATE_SEARCH_FACTOR)
-    low = _grid_index(tube.rate_hz)
-    if _grid_value(low) > tube.rate_hz:
+    cap = grid_index(tube.rate_hz * RATE_SEARCH_FACTOR)
+    low = grid_index(tube.rate_hz)
+    if grid_value(low) > tube.rate_hz:
         low -= 1                     # the two-digit value below the (failing) rate
     ratio = check_tube(tube, spec).max_move_ratio
     high = None
@@ -173,7 +160,7 @@ def lowest_passing_rate(tube: TubeDesign, spec: Spec) -> float | None:
         if low >= cap:
             return None
         factor = min(max(ratio / MAX_MOVE_PER_SAMPLE, 1.25), RATE_SEARCH_FACTOR)  # inf: capped
-        guess = min(max(_grid_index(_grid_value(low) * factor), low + 1), cap)
+        guess = min(max(grid_index(grid_value(low) * factor), low + 1), cap)
         ok, ratio = passes(guess)
         if ok:
             high = guess
@@ -185,7 +172,7 @@ def lowest_passing_rate(tube: TubeDesign, spec: Spec) -> float | None:
             high = mid
         else:
             low = mid
-    return _grid_value(high)
+    return grid_value(high)
 
 
 # --------------------------------------------------------------------------- the search

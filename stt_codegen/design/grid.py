@@ -1,0 +1,26 @@
+"""The grid of two-significant-digit numbers on which searches report a value.
+
+A searched rate (Hz) or prescribed time (s) is reported as the smallest number
+``m 10^e`` (``10 <= m <= 99``) that passes, so that a refusal names a value a user can
+type and two runs name the same one. The grid is indexed by integers (``90 e + m - 10``)
+so that a search can bisect on it.
+"""
+
+from __future__ import annotations
+
+import math
+
+
+def grid_index(value: float) -> int:
+    """Index of the smallest two-significant-digit number ``>= value`` (``value > 0``)."""
+    e = math.floor(math.log10(value)) - 1
+    m = math.ceil(value / 10.0 ** e * (1.0 - 1e-12))
+    if m >= 100:
+        e, m = e + 1, 10
+    return 90 * e + max(m, 10) - 10
+
+
+def grid_value(index: int) -> float:
+    """The number of index ``index`` (:func:`grid_index`'s inverse on the grid)."""
+    e, m = divmod(index, 90)
+    return float(f"{m + 10}e{e}")
