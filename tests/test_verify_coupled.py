@@ -11,7 +11,7 @@ import control as ct
 import numpy as np
 import pytest
 from conftest import CASES, designed
-from test_plants_support import plant_system, plant_within
+from plants_helpers import plant_system, plant_within
 
 from stt_codegen.bench.plants_study import study_one
 from stt_codegen.design.samples import sample_tube
