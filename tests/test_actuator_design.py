@@ -90,7 +90,10 @@ def test_a_bound_the_default_design_meets_keeps_its_tube():
     bounded = design_tube(small((3.5, 3.5)))
     assert bounded.tube == dataclasses.replace(default.tube, input_bound=(3.5, 3.5))
     assert bounded.input_proof.meets((3.5, 3.5))
-    assert bounded.input_proof.peak == pytest.approx((2.9965, 2.9965), abs=1e-3)
+    # the proof bounds what the law really asks along a run, and is not vacuous
+    run = simulate(bounded, backend="reference")
+    assert np.all(np.array(run.max_abs_u) <= np.array(bounded.input_proof.peak))
+    assert max(bounded.input_proof.peak) > 0.5 * 3.5
 
 
 def test_a_bound_the_default_design_exceeds_gets_a_slower_tube():

@@ -17,7 +17,7 @@ import pytest
 from stt_codegen.bench.arenas import generate_arena
 from stt_codegen.design.search import design_tube
 from stt_codegen.design.tracking import TRACKING_ERROR, tracking_demand
-from stt_codegen.runtime.simulate import simulate
+from stt_codegen.runtime.simulate import run_closed_loop
 from stt_codegen.spec.loader import load_spec
 
 SPECS = Path(__file__).parent / "specs"
@@ -44,20 +44,20 @@ def test_a_tube_the_gain_cannot_follow_gives_way_to_via_points(spec):
     paper = design_tube(_method(spec, "paper"))
     demand = tracking_demand(paper.tube, paper.certificate, spec)
     assert demand.ratio > 1.0
-    assert simulate(spec, paper.tube, backend="reference").max_abs_e > TRACKING_ERROR
+    assert run_closed_loop(spec, paper.tube, backend="reference").max_abs_e > TRACKING_ERROR
     chosen = design_tube(spec)
     assert chosen.method == "via"
     assert tracking_demand(chosen.tube, chosen.certificate, spec).ratio < 1.0
-    result = simulate(spec, chosen.tube, backend="reference")
+    result = run_closed_loop(spec, chosen.tube, backend="reference")
     assert result.satisfied and result.max_abs_e < 0.1
 
 
 def test_the_demand_does_not_depend_on_the_declared_gain_range():
     """k lambda* is the same for every [g_min, g_max] (k = w^2 / (8 dt (g_min + g_max)),
     lambda* their middle): the demand measures the tube, not the plant's uncertainty."""
-    spec = load_spec("omnirobot-s2")
-    wide = dataclasses.replace(spec, assumptions=dataclasses.replace(
-        spec.assumptions, input_gain=(0.36, 1.0)))
+    robot = load_spec("omnirobot-s2")
+    spec, wide = (dataclasses.replace(robot, assumptions=dataclasses.replace(
+        robot.assumptions, input_gain=gains)) for gains in ((1.0, 1.0), (0.36, 1.0)))
     a, b = design_tube(spec), design_tube(wide)
     assert b.gain == pytest.approx(a.gain * 2.0 / 1.36)
     assert (tracking_demand(b.tube, b.certificate, wide).ratio

@@ -15,7 +15,7 @@ from plants_helpers import plant_system, plant_within
 
 from stt_codegen.bench.plants_study import study_one
 from stt_codegen.design.samples import sample_tube
-from stt_codegen.runtime.simulate import simulate
+from stt_codegen.runtime.simulate import run_closed_loop
 from stt_codegen.spec.assumptions import Assumptions
 from stt_codegen.tube import reference
 from stt_codegen.verify.command import verify_design
@@ -74,7 +74,7 @@ def test_plants_of_the_robot_class_stay_within_the_proved_error(case, kind):
     spec, design, _ = designed(case)
     result = check_sampled(design, samples_of(case), plant_class(spec))
     w = spec.assumptions.disturbance_bound * np.array([1.0, -1.0, 1.0]) / math.sqrt(3)
-    run = simulate(spec, design, backend="c", plant=_rotation_plant(kind, w))
+    run = run_closed_loop(spec, design, backend="c", plant=_rotation_plant(kind, w))
     assert run.stayed_in_tube and run.satisfied
     assert _max_sampled_error(design, run) <= result.level
 
@@ -102,7 +102,7 @@ def test_a_coupled_class_the_check_accepts_stays_within_the_proved_error():
     assert result.passed and per_axis.passed and result.level <= per_axis.level
     for seed in range(2):
         plant = plant_system(plant_within(np.random.default_rng(seed), a, spec.state_space))
-        run = simulate(dataclasses.replace(spec, assumptions=a), design, backend="c",
+        run = run_closed_loop(dataclasses.replace(spec, assumptions=a), design, backend="c",
                        plant=plant)
         assert run.stayed_in_tube and run.satisfied
         assert _max_sampled_error(design, run) <= result.level

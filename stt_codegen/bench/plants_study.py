@@ -30,7 +30,7 @@ import numpy as np
 
 from ..design.samples import sample_tube
 from ..design.search import design_tube
-from ..runtime.simulate import simulate
+from ..runtime.simulate import run_closed_loop
 from ..spec.assumptions import Assumptions
 from ..spec.loader import load_spec
 from ..verify.sampled import check_sampled
@@ -119,7 +119,7 @@ def _holds(case: str, p: dict, rate_factor: float = 1.0) -> bool:
         spec = dataclasses.replace(spec, rate_hz=spec.rate_hz * rate_factor)
         design = dataclasses.replace(design, rate_hz=design.rate_hz * rate_factor)
     centre = (np.array(spec.state_space.lower) + np.array(spec.state_space.upper)) / 2
-    result = simulate(spec, design, backend="c", plant=_system(p, centre))
+    result = run_closed_loop(spec, design, backend="c", plant=_system(p, centre))
     return bool(result.satisfied and result.stayed_in_tube)
 
 

@@ -22,6 +22,7 @@ from ..spec.plants import PLANTS
 from ..tube import reference
 from ..tube.parameters import TubeDesign
 from .check import Check
+from .plant_class import plant_class
 from .sampled import SampledCheck, check_sampled
 
 
@@ -59,7 +60,9 @@ def prove_input_bound(tube: TubeDesign, spec: Spec) -> InputProof:
         With its gain (the input bound's clamp, if any, plays no part: the proof shows
         it never acts).
     spec : Spec
-        Its ``[assumptions]``.
+        Its plant class (:func:`~stt_codegen.verify.plant_class.plant_class`: the model's
+        bounds evaluated on the tube per interval, and ``[assumptions]``), the one
+        ``sampled.tube_kept`` judges.
 
     Returns
     -------
@@ -77,7 +80,7 @@ def prove_input_bound(tube: TubeDesign, spec: Spec) -> InputProof:
     with reference.numpy_math():
         samples = sample_tube(tube)
         horizon = float(samples.t[-1])
-        result = check_sampled(tube, samples, spec.assumptions)
+        result = check_sampled(tube, samples, plant_class(spec))
         abs_e = sampled_error_bound(result, samples)
         if abs_e is None:
             n = tube.dimension
