@@ -30,18 +30,26 @@ from stt_codegen.tube.parameters import (STATUS_INPUT_CLAMPED, STATUS_OK,
                                          STATUS_OUTSIDE_TUBE)
 
 POINTS = 2000
-#: Low enough that about half of the points inside the tube ask for more.
-BOUND = (0.6, 0.9)
 
 
 @lru_cache(maxsize=None)
 def bounded():
     """A 2-D arena design with the clamp (the tube of the spec without ``[actuator]``, so
-    that these tests do not depend on the bound-aware search)."""
+    that these tests do not depend on the bound-aware search).
+
+    The bound is derived from the design, not pinned (law (13)'s ``|u|`` scales with the
+    default gain): per input, the median of law (13)'s ``|u_i|`` over the test points
+    inside the tube, to two significant digits, so that about half of those points ask
+    for more in each input and both statuses OK and INPUT_CLAMPED occur."""
     spec = parse_spec(arena_toml("clamped", extra="[[obstacles]]\nlower = [2.0, 2.0]\n"
                                  "upper = [3.0, 3.0]\n"))
-    tube = dataclasses.replace(design_tube(spec).tube, input_bound=BOUND)
-    return spec, tube
+    free = design_tube(spec).tube
+    p = _points(free)
+    u_law = R.law_step(free, p["x"], p["t"], p["dt"], p["alpha"])[0]
+    inside = R.controller_step(free, p["x"], p["t"], p["dt"], p["alpha"])[2] != 0.0
+    median = np.median(np.abs(u_law[inside]), axis=0)
+    bound = tuple(float(f"{m:.2g}") for m in median)
+    return spec, dataclasses.replace(free, input_bound=bound)
 
 
 def _statuses(model_outputs) -> np.ndarray:
@@ -75,7 +83,7 @@ def test_model_and_reference_clamp_and_report_it():
     step = casadi_outputs(build_model(tube)["controller_step"], p)
     u_ref, next_ref, status_ref = R.controller_status(tube, p["x"], p["t"], p["dt"], p["alpha"])
     u_law = R.law_step(tube, p["x"], p["t"], p["dt"], p["alpha"])[0]
-    bound = np.array(BOUND)
+    bound = np.array(tube.input_bound)
     assert np.all(np.abs(step[0]) <= bound) and np.all(np.abs(u_ref) <= bound)
     # the clamp moves exactly the entries beyond the bound, to the bound
     beyond = np.abs(u_law) > bound
@@ -107,14 +115,15 @@ def test_double_c_and_python_equal_the_model_bit_for_bit(tmp_path):
     assert np.array_equal(got["control_u"], control[0])
     assert np.array_equal(got["status"], _statuses(step))
     assert np.array_equal(got["control_status"], got["status"])
-    assert np.all(np.abs(got["u"]) <= np.array(BOUND))
+    assert np.all(np.abs(got["u"]) <= np.array(tube.input_bound))
     mod = load_python_module(files[f"{spec.c_name}.py"], spec.c_name)
     rows = [mod.step(p["x"][i], p["t"][i], p["dt"][i], p["alpha"][i]) for i in range(POINTS)]
     assert np.array_equal(np.array([r[0] for r in rows]), step[0])
     assert np.array_equal(np.array([r[2] for r in rows]), got["status"])
     controls = [mod.control(p["x"][i], p["t"][i], p["alpha"][i]) for i in range(POINTS)]
     assert np.array_equal(np.array([c[0] for c in controls]), control[0])
-    assert mod.STATUS_INPUT_CLAMPED == STATUS_INPUT_CLAMPED and mod.INPUT_BOUND == list(BOUND)
+    assert mod.STATUS_INPUT_CLAMPED == STATUS_INPUT_CLAMPED
+    assert mod.INPUT_BOUND == list(tube.input_bound)
 
 
 @pytest.mark.skipif(not COMPILERS, reason="no C compiler")
@@ -135,7 +144,7 @@ def test_selftest_covers_the_clamp_status(precision, tmp_path):
     assert run.returncode == 0 and " 0 failed" in run.stdout, run.stdout[-2000:]
     header = files[f"{spec.c_name}.h"].decode()
     assert "#define CLAMPED_STATUS_INPUT_CLAMPED 3" in header
-    assert "#define CLAMPED_INPUT_BOUND_0 0.6" in header
+    assert f"#define CLAMPED_INPUT_BOUND_0 {tube.input_bound[0]!r}" in header
 
 
 @pytest.mark.skipif(shutil.which("cppcheck") is None,

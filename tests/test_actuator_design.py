@@ -104,11 +104,14 @@ def test_a_bound_the_default_design_exceeds_gets_a_slower_tube():
     assert before.proved and before.peak[1] > 4 * bound[1]          # v2 on O1's flank
     assert design.tube.input_bound == bound and design.input_proof.meets(bound)
     assert design.method == "via" and design.tube != default.tube
-    assert max(p / b for p, b in zip(design.input_proof.peak, bound)) < 0.7
+    # the accepted tube is the first slower one proved within the bound: its proof is the
+    # prover's on that tube, and its margin is the room left by the worst input
+    assert design.input_proof == input_prover()(design.tube, spec)
     document = design.to_json()
     assert document["input_bound"] == list(bound)
     assert document["input_peak"]["peak"] == list(design.input_proof.peak)
-    assert document["input_peak"]["margin"] > 0.3
+    margin = 1 - max(p / b for p, b in zip(design.input_proof.peak, bound))
+    assert document["input_peak"]["margin"] == pytest.approx(margin, rel=1e-12) and margin >= 0
 
 
 def test_softer_circumvents_keep_the_papers_tube():
@@ -130,8 +133,12 @@ def test_verify_proves_the_bound():
     report = verify(design)
     check = report["sampled.input_bound"]
     assert check.passed and report.passed, [str(c) for c in report.failed]
-    assert check.data["margin"] > 0.3 and check.data["inputs"] == ["v1", "v2", "omega"]
+    assert check.data["inputs"] == ["v1", "v2", "omega"]
+    # verify proves again, independently of the design, the peak the design proved
+    assert check.data["peak"] == list(design.input_proof.peak)
     assert all(p <= b for p, b in zip(check.data["peak"], spec.input_bound))
+    margin = 1 - max(p / b for p, b in zip(check.data["peak"], spec.input_bound))
+    assert check.data["margin"] == pytest.approx(margin, rel=1e-12) and margin >= 0
     assert "|v2| <=" in check.detail
 
 
@@ -143,7 +150,11 @@ def test_verify_fails_a_tube_beyond_the_bound():
     report = verify(dataclasses.replace(default, spec=spec))
     check = report["sampled.input_bound"]
     assert not check.passed and "beyond the bound in u1, u2" in check.detail
-    assert check.data["margin"] == pytest.approx(1 - 2.9965 / 1.5, abs=1e-3)
+    # the peak verify proves is the one the design proves for that tube (a bound it
+    # keeps, test_a_bound_the_default_design_meets_keeps_its_tube)
+    peak = design_tube(small((3.5, 3.5))).input_proof.peak
+    assert check.data["peak"] == list(peak) and min(peak) > 1.5
+    assert check.data["margin"] == pytest.approx(1 - max(peak) / 1.5, rel=1e-12)
 
 
 def test_the_closed_loop_with_the_generated_c_stays_within_the_bound():
@@ -229,4 +240,5 @@ def test_the_command_line(tmp_path, capsys):
     assert _works(err) > 3.0
     path.write_text(path.read_text().replace("[1.5, 1.5]", "[3.5, 3.5]"))
     assert main(["design", str(path)]) == 0
-    assert "input bound: law (13) asks at most [2.996 <= 3.5" in capsys.readouterr().out
+    peaks = ", ".join(f"{p:.4g} <= 3.5" for p in design_tube(small((3.5, 3.5))).input_proof.peak)
+    assert f"PASS  input bound: law (13) asks at most [{peaks}] (proved)" in capsys.readouterr().out
