@@ -14,7 +14,8 @@ from stt_codegen.cli import main
 from stt_codegen.errors import SpecError
 
 SUMMARY_KEYS = {"runs", "successes", "success_rate", "time_median_s", "time_p95_s", "failures",
-                "effort_runs", "peak_u_median", "peak_u_p95", "effort_median", "effort_p95"}
+                "effort_runs", "peak_u_median", "peak_u_p95", "effort_median", "effort_p95",
+                "max_abs_e_median", "max_abs_e_max"}
 
 
 def test_local_pool_keeps_the_order():

@@ -78,14 +78,14 @@ def test_a_plant_at_the_edges_of_the_gain_assumption_stays_in_the_tube():
 
 @pytest.mark.slow
 def test_a_plant_beyond_the_gain_assumption_needs_a_faster_rate():
-    """Documented limit: ``g = 3.8 I`` breaks the 1 kHz loop of S2; doubling the rate (the
+    """Documented limit: ``g = 2.6 I`` breaks the 1 kHz loop of S2; doubling the rate (the
     gain kept) restores it (see docs/guarantees.md). The default gain comes from the
-    certified narrowest width; since issue 20 that bound is within 10 % of S2's deployed
-    width and the gain is 0.220 (was 0.0907 from a looser bound, when the plant that broke
-    the loop was ``g = 9.2 I``): the same ``k g``. (Measured: 2.6 I to 4.5 I all break at
-    1 kHz and hold at 2 kHz.)"""
-    knobs = {"case": "omnirobot-s2", "seed": 3, "f_amp": 0.0, "f_lin": 0.0, "g_min": 3.8,
-             "g_max": 3.8, "skew": 0.0, "w_amp": 0.1}
+    certified narrowest width and the robot's own ``input_gain = [cos 1.2, 1]``; since issue
+    20 it is 0.323 (was 0.0907 from a looser bound and ``g = I``, when the plant that broke
+    the loop was ``g = 9.2 I``, and 0.220 with the tight width alone, ``g = 3.8 I``): the
+    same ``k g`` of about 0.84."""
+    knobs = {"case": "omnirobot-s2", "seed": 3, "f_amp": 0.0, "f_lin": 0.0, "g_min": 2.6,
+             "g_max": 2.6, "skew": 0.0, "w_amp": 0.1}
     slow, _ = _run(knobs)
     fast, _ = _run(knobs, rate_factor=2.0)
     assert not slow.stayed_in_tube
