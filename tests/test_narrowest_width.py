@@ -98,6 +98,7 @@ def via_designs() -> tuple:
     return tuple(out)
 
 
+@pytest.mark.slow
 def test_fifty_seeded_via_designs_width_is_sound_and_tight():
     ratios = [check_sound_and_tight(d.tube, d.certificate) for d in via_designs()]
     assert len(ratios) == VIA_DESIGNS and min(ratios) >= TIGHT

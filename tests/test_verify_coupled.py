@@ -93,9 +93,14 @@ def test_a_plant_outside_its_declared_bounds_is_not_accepted():
 def test_a_coupled_class_the_check_accepts_stays_within_the_proved_error():
     """A class with coupling and drift, one block of three coupled states: the check
     passes, and plants drawn within it stay below the |e| it proves. The Lyapunov balls
-    never weaken the per-axis argument (they only cut its boxes)."""
+    never weaken the per-axis argument (they only cut its boxes).
+
+    With the gains of the tight width (s3: k = 0.484) the check no longer proves the
+    class with the largest coupling its eigenvalue range and skew allow
+    ((1.2 - 0.8) / 2 + 0.3 = 0.5; margin -1.75 at t = 1.324 s); with coupling 0.4 it
+    does, and there the ball cuts the per-axis |e| (0.573 < 0.576)."""
     spec, design, _ = designed("omnirobot-s3")
-    a = Assumptions((0.8, 1.2), 0.3, 0.5, 0.2, 0.17)
+    a = Assumptions((0.8, 1.2), 0.3, 0.4, 0.2, 0.17)
     s = samples_of("omnirobot-s3")
     result = check_sampled(design, s, a)
     per_axis = check_sampled(design, s, a, lyapunov=False)
