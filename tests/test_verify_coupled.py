@@ -113,11 +113,15 @@ def test_a_coupled_class_the_check_accepts_stays_within_the_proved_error():
         assert _max_sampled_error(design, run) <= result.level
 
 
-# the wide study (bench/plants_study.py): plants 0-2 of each case, and one the check accepts
-WIDE = [(c, i) for c in CASES for i in range(2)] + [("omnirobot-s3", 1)]
+# the wide study (bench/plants_study.py): plants 0-1 of each case, and the plants the check
+# accepts among the first 100 of each case at the spec's rate with the gains of the tight
+# width (s1: k = 0.200, s2: 0.323, s3: 0.484): s1 47, s3 41 and 44; none of s2
+ACCEPTED = [("omnirobot-s1", 47), ("omnirobot-s3", 41), ("omnirobot-s3", 44)]
+WIDE = [(c, i) for c in CASES for i in range(2)] + ACCEPTED
 
 
 def test_a_sample_of_the_wide_study_no_accepted_plant_fails():
     rows = [study_one(job) for job in WIDE]
-    assert any(r["check_accepts"] for r in rows)
+    accepted = {(r["case"], r["index"]) for r in rows if r["check_accepts"]}
+    assert accepted >= set(ACCEPTED), rows     # else the soundness below proves nothing
     assert all(r["held"] for r in rows if r["check_accepts"]), rows
