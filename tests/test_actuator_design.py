@@ -114,6 +114,7 @@ def test_a_bound_the_default_design_exceeds_gets_a_slower_tube():
     assert document["input_peak"]["margin"] == pytest.approx(margin, rel=1e-12) and margin >= 0
 
 
+@pytest.mark.slow
 def test_softer_circumvents_keep_the_papers_tube():
     """Where a softer circumvent suffices the design keeps the paper's method and slows
     the circumvent only (the sharpness is left to the design in this spec)."""

@@ -170,6 +170,7 @@ def run_cli(*args: str) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, timeout=600)
 
 
+@pytest.mark.slow
 def test_design_json_fields_and_exit_codes(tmp_path):
     ok = run_cli("design", "omnirobot-s1", "--json")
     assert ok.returncode == 0, ok.stderr

@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from plants_helpers import input_matrix, plant_within
@@ -43,6 +44,7 @@ def test_matrix_plant_on_the_arena_is_satisfied():
     assert result.satisfied and result.stayed_in_tube and not result.collision
 
 
+@pytest.mark.slow
 def test_gain_range_spec_with_g_3_is_satisfied_with_the_derived_gain_only():
     design = design_tube(load_spec(SPECS / "gain-range-s2.toml"))
     result = simulate(design, backend="c")

@@ -31,6 +31,7 @@ def test_paper_cases_are_satisfied(case, backend):
     assert 0.0 < result.max_abs_e <= 0.7, result.max_abs_e
 
 
+@pytest.mark.slow
 def test_reference_and_casadi_loops_agree():
     design = design_of("omnirobot-s2")
     a = simulate(design, backend="reference", horizon=3.0)

@@ -87,6 +87,7 @@ def test_an_obstacle_the_tube_cannot_get_around():
     assert "obstacle 0" in bad["tube.design"]
 
 
+@pytest.mark.slow
 def test_heading_range_reaching_pi_over_2_fails_assumption_2(tmp_path):
     wide = SPEC.replace("lower = [0.0, 0.0, -1.2]\nupper = [5.0, 5.0, 1.2]",
                         "lower = [0.0, 0.0, -1.6]\nupper = [5.0, 5.0, 1.6]")

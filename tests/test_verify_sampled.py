@@ -52,6 +52,7 @@ def test_derived_gain_passes_and_the_old_default_fails_with_the_rate_it_needs():
     assert "beyond the limit at g_max = 3" in bad["sampled.gain"].detail
 
 
+@pytest.mark.slow
 def test_matrix_plant_spec_passes_every_check():
     checks = by_name(verify_spec(load_spec(SPECS / "linear-arena-s1.toml")))
     assert all(c.passed for c in checks.values())
