@@ -4,23 +4,14 @@ from __future__ import annotations
 
 import argparse
 
-from ..errors import DesignError
-from .common import add_json_argument, add_spec_argument, design_spec, print_json
-from .plotting import (add_plot_argument, check_plot_folder, plot_dims, write_plot,
-                       write_rejected_plot)
+from .common import add_json_argument, add_spec_argument, print_json
+from .plotting import add_plot_argument, design_to_plot, write_plot
 
 
 def cmd_design(args: argparse.Namespace) -> int:
     """0 designed, 1 no design (``--plot``: the best rejected tube is drawn), 2 bad input."""
-    from ..spec.loader import load_spec
-    check_plot_folder(args)
-    spec = load_spec(args.spec)
-    dims = plot_dims(args, spec)
-    try:
-        design = design_spec(spec, args)
-    except DesignError as exc:
-        write_rejected_plot(args, spec, exc, dims)
-        raise
+    design, dims = design_to_plot(args)
+    spec = design.spec
 
     def draw(path):
         from ..runtime.plots import plot_design

@@ -17,6 +17,7 @@ from ..errors import SpecError
 from ..system import atomic_write
 
 if TYPE_CHECKING:
+    from ..design.result import Design
     from ..errors import DesignError
     from ..spec.loader import Spec
 
@@ -80,3 +81,33 @@ def write_rejected_plot(args: argparse.Namespace, spec: Spec, error: DesignError
     from ..runtime.plots import plot_rejected
     write_plot(args, lambda path: plot_rejected(spec, error, path, dims=dims))
     print(f"plot written to {args.plot}: it shows the best rejected tube", file=sys.stderr)
+
+
+def design_to_plot(args: argparse.Namespace) -> tuple[Design, tuple[int, int]]:
+    """Load ``SPEC``, check ``--plot`` and ``--dims`` before any work, and design the tube
+    (:func:`~.common.design_spec`); with no design, :func:`write_rejected_plot` first.
+
+    Returns
+    -------
+    design : Design
+    dims : tuple of int, length 2
+        The arena's dimensions of the figure.
+
+    Raises
+    ------
+    SpecError
+        A bad spec, ``--plot`` folder or ``--dims``.
+    DesignError
+        No design (exit 1).
+    """
+    from ..errors import DesignError
+    from ..spec.loader import load_spec
+    from .common import design_spec
+    check_plot_folder(args)
+    spec = load_spec(args.spec)
+    dims = plot_dims(args, spec)
+    try:
+        return design_spec(spec, args), dims
+    except DesignError as exc:
+        write_rejected_plot(args, spec, exc, dims)
+        raise

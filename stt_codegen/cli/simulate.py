@@ -5,10 +5,8 @@ from __future__ import annotations
 import argparse
 
 from .common import (add_backend_argument, add_json_argument, add_seed_argument,
-                     add_spec_argument, checked_seed, design_spec, print_json)
-from ..errors import DesignError
-from .plotting import (add_plot_argument, check_plot_folder, plot_dims, write_plot,
-                       write_rejected_plot)
+                     add_spec_argument, checked_seed, print_json)
+from .plotting import add_plot_argument, design_to_plot, write_plot
 
 #: Header of the table of :func:`summary_line` rows (``simulate`` and ``demo``).
 SUMMARY_HEADER = f"{'case':<22} {'satisfied':<9} {'reach [s]':>9} {'clearance':>9}   max |u|"
@@ -27,16 +25,8 @@ def summary_line(result) -> str:
 def cmd_simulate(args: argparse.Namespace) -> int:
     """0 satisfied, 1 not satisfied or no design, 2 bad input, 3 toolchain."""
     from ..runtime.simulate import simulate
-    from ..spec.loader import load_spec
     seed = checked_seed(args)
-    check_plot_folder(args)
-    spec = load_spec(args.spec)
-    dims = plot_dims(args, spec)
-    try:
-        design = design_spec(spec, args)
-    except DesignError as exc:
-        write_rejected_plot(args, spec, exc, dims)
-        raise
+    design, dims = design_to_plot(args)
     result = simulate(design, backend=args.backend, horizon=args.horizon, seed=seed)
 
     def draw(path):
