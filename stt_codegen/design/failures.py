@@ -22,7 +22,8 @@ class FailureKind(Enum):
     ``NO_PASSAGE`` (no via-point path: the free passage is too narrow),
     ``WALLED_OFF`` (the start or the target is enclosed by obstacles), ``PLANT``
     (the spec's plant violates Assumption 2), ``INPUT_BOUND`` (no design within ``t_c``
-    is proved to keep law (13) within ``[actuator] input_bound``).
+    is proved to keep law (13) within ``[actuator] input_bound``), ``TASK`` (a timed
+    task of ``[[tasks]]`` is not certified, or its plan has no time; docs/tasks.md).
     """
 
     SAMPLING_RATE = "sampling rate"
@@ -39,10 +40,13 @@ class FailureKind(Enum):
     WALLED_OFF = "walled off"
     PLANT = "plant assumption"
     INPUT_BOUND = "input bound"
+    TASK = "task"
 
 
 def property_kind(name: str) -> FailureKind:
     """The kind of a failed certificate property (``Margin.name``, e.g. ``avoids obstacle 2``)."""
     if name.startswith(FailureKind.OBSTACLE.value):
         return FailureKind.OBSTACLE
+    if name.startswith(FailureKind.TASK.value + " "):
+        return FailureKind.TASK
     return FailureKind(name)

@@ -79,6 +79,10 @@ class Design:
         For a spec with ``[actuator]``: the proved peak of each input of law (13) along
         the tube (:mod:`~stt_codegen.design.input_bound`), within ``input_bound``;
         ``None`` otherwise.
+    task_choices : tuple of int
+        For a spec with ``[[tasks]]``: per task, the index of the box the tube was
+        planned through (the ``any_of`` alternative; 0 for a single box); empty
+        otherwise (docs/tasks.md).
     """
 
     tube: TubeDesign
@@ -88,6 +92,7 @@ class Design:
     spec: Spec = field(compare=False, repr=False, kw_only=True)
     input_proof: InputProof | None = field(default=None, compare=False, repr=False,
                                            kw_only=True)
+    task_choices: tuple[int, ...] = field(default=(), kw_only=True)
 
     @property
     def certificate(self) -> Certificate:
@@ -145,7 +150,25 @@ class Design:
             },
             "design_time_s": self.design_time_s,
             **self._actuator_json(),
+            **self._tasks_json(),
         }
+
+    def _tasks_json(self) -> dict[str, Any]:
+        """``tasks``: per ``[[tasks]]`` entry its label, kind, window, the box planned
+        through (``alternative``, its corners) and the certified margin; for a spec with
+        tasks only: without them the document is as before."""
+        if not self.spec.tasks:
+            return {}
+        margins = {m.name: m for m in self.certificate.margins}
+        out = []
+        for task, q in zip(self.spec.tasks, self.task_choices):
+            m = margins.get(task.name)
+            out.append({"task": task.label, "kind": task.kind, "window": list(task.window),
+                        "alternative": q, "lower": list(task.boxes[q].lower),
+                        "upper": list(task.boxes[q].upper),
+                        "certified": bool(m is not None and m.passed),
+                        "margin": None if m is None else m.margin})
+        return {"tasks": out}
 
     def _actuator_json(self) -> dict[str, Any]:
         """``input_bound`` and the proved ``input_peak`` (with where each peak is), for a

@@ -36,6 +36,7 @@ from .gain import derived_gain
 from .plant_check import plant_failure
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
 from .tracking import tracking_demand
+from .tasks import alternatives, plan_tasks
 from .via import via_design
 from .windows import WINDOW_INFLATION, candidates, overlap_interval, progress_time
 
@@ -295,6 +296,10 @@ def design_tube(spec: Spec) -> Design:
     if reason:
         raise DesignError(reason, kind=FailureKind.PLANT)
     base = base_design(spec)
+    if spec.tasks:              # [[tasks]]: via points through the tasks' boxes
+        tube, check, choice = _tasks(spec, base)
+        return Design(_with_gain(tube, check, spec), METHOD_VIA, check,
+                      time.perf_counter() - started, spec=spec, task_choices=choice)
     method = spec.tube.method
     # "auto": the paper's search on a short budget, then via points, then the paper's
     # search on its full budget (a hard arena rarely needs it)
@@ -360,6 +365,28 @@ def _trackable(spec: Spec, base: TubeDesign, tube: TubeDesign,
     if tracking_demand(via, via_check.certificate, spec).ratio < demand.ratio:
         return via, METHOD_VIA, via_check
     return tube, METHOD_PAPER, check
+
+
+def _tasks(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck, tuple[int, ...]]:
+    """The first plan through the tasks' boxes (:mod:`~stt_codegen.design.tasks`, the
+    ``any_of`` alternatives in :func:`~stt_codegen.design.tasks.alternatives` order) whose
+    tube passes :func:`check_tube`, and the alternatives it took."""
+    failures: list[DesignError] = []
+    for choice in alternatives(spec):
+        try:
+            tube = plan_tasks(spec, base, choice)
+        except DesignError as exc:
+            failures.append(exc)
+            continue
+        check = check_tube(tube, spec)
+        if check.passed:
+            return tube, check, choice
+        failures.append(DesignError(f"the tube through the tasks' boxes fails its check: "
+                                    f"{check.reason}", kind=check.kind, tried=tube))
+    first = failures[0]
+    more = f" (and {len(failures) - 1} other choices of any_of boxes)" if len(failures) > 1 \
+        else ""
+    raise DesignError(f"{first}{more}", kind=first.kind, tried=first.tried)
 
 
 def _via(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck]:

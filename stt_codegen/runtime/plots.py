@@ -36,6 +36,7 @@ from ..tube import reference
 from ..design.result import Design, require_design
 from ..tube.parameters import TANH, TubeDesign
 from .simulate import SimulationResult
+from .task_plots import draw_task_windows, draw_tasks
 
 if TYPE_CHECKING:
     from ..design.certificate import Certificate
@@ -228,6 +229,7 @@ def draw_arena(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
     draw_box(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
     draw_unsafe_sets(ax, spec, dims)
     draw_box(ax, spec.target_set, dims, fc="tab:green", alpha=0.35, label="target")
+    draw_tasks(ax, spec, dims)          # [[tasks]], if any
     i, j = dims
     ax.set_xlabel(_state_label(i))
     ax.set_ylabel(_state_label(j))
@@ -352,6 +354,7 @@ def run_figure(design: Design, result: SimulationResult,
         ax.plot(traj.t, g_l[:, i], color="tab:orange", lw=0.8)
         ax.plot(traj.t, g_u[:, i], color="tab:orange", lw=0.8)
         ax.plot(traj.t, traj.x[:, i], "k", lw=1.0, label="state")
+        draw_task_windows(ax, spec, i)
         ax.axvline(spec.prescribed_time, color="tab:red", lw=0.8, ls=":", label="$t_c$")
         ax.set_ylabel(_state_label(i))
         if i == 0:
@@ -485,6 +488,7 @@ def tube_figure(spec: Spec, tube: TubeDesign, certificate: Certificate, headline
     for i in range(n):
         ax = fig.add_subplot(grid[i, 1])
         draw_enclosure(ax, certificate, i, end)
+        draw_task_windows(ax, spec, i)
         ax.axvline(t_c, color="tab:red", lw=0.8, ls=":", label="$t_c$")
         if failure_time is not None:
             ax.axvline(failure_time, color="black", lw=1.0, ls="-.",

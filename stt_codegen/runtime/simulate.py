@@ -24,6 +24,7 @@ from .plants import check_seed, make_plant
 from ..spec.loader import Spec
 from ..tube import reference
 from ..tube.parameters import TubeDesign
+from .tasks import TaskOutcome, judge_tasks
 
 #: Runge-Kutta steps per sampling period.
 SUBSTEPS = 2
@@ -48,7 +49,8 @@ class SimulationResult:
     ----------
     spec, backend : str
     satisfied : bool
-        ``reached`` and not ``collision`` and not ``left_state_space``.
+        ``reached`` and not ``collision`` and not ``left_state_space`` (and every task of
+        ``tasks`` met).
     reached : bool
         The state entered the target set no later than ``t_c``.
     reach_time : float or None
@@ -80,6 +82,9 @@ class SimulationResult:
     clamped_steps : int
         Steps whose status was ``STATUS_INPUT_CLAMPED`` (the actuator clamp acted; only a
         design with ``[actuator]`` has it).
+    tasks : list of TaskOutcome
+        Each ``[[tasks]]`` entry judged on the run (:mod:`~.tasks`: met, when, margin);
+        ``satisfied`` also needs every one met. Empty without tasks.
     """
 
     spec: str
@@ -98,11 +103,15 @@ class SimulationResult:
     control_effort: float = 0.0
     clamped_steps: int = 0
     trajectory: Trajectory | None = field(default=None, repr=False)
+    tasks: list[TaskOutcome] = field(default_factory=list)
 
     def to_json(self) -> dict:
-        """The result as a JSON-ready dict (without the trajectory)."""
+        """The result as a JSON-ready dict (without the trajectory; ``tasks`` only for a
+        spec with ``[[tasks]]``)."""
         data = asdict(self)
         data.pop("trajectory")
+        if not data["tasks"]:
+            data.pop("tasks")
         return data
 
 
@@ -271,7 +280,9 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     else:
         min_clear, collision = None, False
     left = bool(np.any((within < lo) | (within > hi)))
-    satisfied = reached and not collision and not left and horizon >= t_c
+    tasks = judge_tasks(spec, path_t, path)
+    satisfied = (reached and not collision and not left and horizon >= t_c
+                 and all(task.met for task in tasks))
     with reference.numpy_math():
         g_l, g_u, _, _ = reference.adaptive_tube(tube, ts, alphas)
     width = g_u - g_l
@@ -286,4 +297,4 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
         max_abs_u=[float(v) for v in np.abs(us).max(axis=0)], steps=steps,
         control_effort=float(np.sum(us[:steps] ** 2) * dt),
         clamped_steps=int(np.sum(status == STATUS_INPUT_CLAMPED)),
-        trajectory=Trajectory(ts, xs, us, alphas, status))
+        trajectory=Trajectory(ts, xs, us, alphas, status), tasks=tasks)

@@ -29,6 +29,7 @@ from ..errors import SpecError
 from .assumptions import Assumptions, combine_assumptions
 from .model_bounds import model_bounds
 from .plants import MODEL_KEYS, PLANTS, dimension_mismatch
+from .tasks import Task, build_tasks
 from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
                      PlantTable, PolytopeObstacle, check_document, value_kind)
 
@@ -236,6 +237,8 @@ class Spec:
     target_half_width_given : bool
         ``target.half_width`` was set in the spec (else the design may shrink the
         default ``d_T`` to keep an obstacle beside the target out of the target box).
+    tasks : tuple of Task
+        The ``[[tasks]]`` entries (:mod:`~.tasks`, docs/tasks.md); empty without them.
     """
 
     name: str
@@ -259,6 +262,7 @@ class Spec:
     input_bound: tuple[float, ...] | None = None
     source_hash: str = field(default="", compare=False)
     target_half_width_given: bool = True
+    tasks: tuple[Task, ...] = ()
 
     @property
     def dimension(self) -> int:
@@ -507,7 +511,12 @@ def _validate(raw: dict) -> Spec:
                 assumptions=_assumptions(doc.assumptions, n, amplitude, model, state_space,
                                          linear),
                 input_bound=_input_bound(doc.actuator, model, n),
-                target_half_width_given=doc.target.half_width is not None)
+                target_half_width_given=doc.target.half_width is not None,
+                tasks=build_tasks(doc.tasks or (), n, doc.prescribed_time,
+                                  (state_space.lower, state_space.upper),
+                                  [(b.lower, b.upper, o.source) for o, b in
+                                   zip(obstacles, (o.box(state_space) for o in obstacles))],
+                                  doc.tube.method, doc.actuator is not None))
 
 
 def _vector(value: list[float], name: str, length: int | None) -> tuple[float, ...]:

@@ -39,6 +39,11 @@ MAX_OBSTACLES = 4096
 TUBE_METHODS = ("paper", "via", "auto")
 #: At most this many vertices per polytope.
 MAX_VERTICES = 1024
+#: ``[[tasks]]`` kinds (docs/tasks.md).
+TASK_KINDS = ("reach", "stay")
+#: At most this many ``[[tasks]]`` entries, and boxes in one ``any_of``.
+MAX_TASKS = 32
+MAX_ALTERNATIVES = 8
 
 # strict: an integer is a number, a boolean or a string is not; no NaN, no infinity
 Number = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE)]
@@ -194,6 +199,29 @@ class ActuatorTable(_Table):
                           "one entry per input")
 
 
+class TaskBoxTable(_Table):
+    """One box of a reach task's ``any_of``."""
+
+    lower: Vector = Field(description="lower corner, state units")
+    upper: Vector = Field(description="upper corner, state units; upper > lower")
+
+
+class TaskTable(_Table):
+    """A timed task (docs/tasks.md): reach a box at some t of the window, or stay in a box
+    for every t of it."""
+
+    kind: Literal[TASK_KINDS] = Field(  # type: ignore[valid-type]
+        description="reach: inside the box at some t in window (eventually); stay: inside "
+                    "the box for every t in window (always)")
+    window: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = Field(
+        description="[t0, t1], seconds, 0 <= t0 < t1 <= prescribed_time")
+    lower: Vector = _omitted("lower corner of the task's box, state units (or any_of)")
+    upper: Vector = _omitted("upper corner of the task's box, state units")
+    any_of: Annotated[list[TaskBoxTable], Field(min_length=1, max_length=MAX_ALTERNATIVES)] = \
+        _omitted("reach only: the boxes of which one is to be reached (instead of "
+                 "lower/upper); the design picks the first that certifies, in this order")
+
+
 class SpecDocument(_Table):
     """One prescribed-time reach-avoid-stay task (Definition 2.1) and its design parameters.
 
@@ -218,6 +246,9 @@ class SpecDocument(_Table):
     assumptions: AssumptionsTable = AssumptionsTable()
     actuator: ActuatorTable = _omitted("actuator limits; omitted: no limit (the design, the "
                                        "generated code and verify ignore actuators)")
+    tasks: Annotated[list[TaskTable], Field(max_length=MAX_TASKS)] = _omitted(
+        "timed reach and stay tasks besides the target (docs/tasks.md), in window order; "
+        "omitted: none")
 
 
 #: The JSON Schema dialect of :func:`json_schema`: draft 7, which TOML language servers
@@ -234,7 +265,8 @@ _TABLES: dict[str, type[_Table]] = {
     "state_space": BoxTable, "initial": InitialTable, "target": TargetTable,
     "tube": TubeTable, "controller": ControllerTable, "plant": PlantTable,
     "assumptions": AssumptionsTable, "actuator": ActuatorTable,
-    "box": BoxObstacle, "ball": BallObstacle, "polytope": PolytopeObstacle}
+    "box": BoxObstacle, "ball": BallObstacle, "polytope": PolytopeObstacle,
+    "tasks": TaskTable, "any_of": TaskBoxTable}
 
 
 def key_name(key: str) -> str:
@@ -284,6 +316,8 @@ def _reason(error: dict) -> str:
     kind, value, ctx = error["type"], error.get("input"), error.get("ctx") or {}
     if kind in ("list_type", "too_short", "too_long") and error["loc"][-1] == "input_gain":
         return f"must be an array [g_min, g_max] of two numbers, got {short_repr(value)}"
+    if kind in ("list_type", "too_short", "too_long") and error["loc"][-1] == "window":
+        return f"must be an array [t0, t1] of two numbers, got {short_repr(value)}"
     if kind == "missing":
         return "missing"
     if kind == "extra_forbidden":

@@ -21,6 +21,7 @@ from .enclosures import enclose, piece_ranges
 from .implicit_step import alpha_ranges
 from .narrowest import sharpen_narrowest
 from .repropagate import repropagate, step_psi
+from .tasks import task_margins
 from .report import (MAX_MOVE_PER_SAMPLE, ROUNDING_MARGIN, Certificate, CertificateState, Enclosure,
                      certificate_report, obstacle_separation)
 
@@ -106,7 +107,9 @@ def certify_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = N
         Properties ``non-empty``, ``initial state inside``, ``inside state space``,
         ``avoids obstacle j`` (one per spec obstacle), ``inside target after t_c`` and
         ``sampling rate`` (no bound moves more than :data:`MAX_MOVE_PER_SAMPLE` tube
-        widths in one period), each with its smallest margin.
+        widths in one period), each with its smallest margin; with ``final``, one
+        ``task Tk reach`` or ``task Tk stay`` per ``[[tasks]]`` entry after them
+        (:mod:`.tasks`).
     """
     with reference.numpy_math():
         return _certify(design, spec, obstacles, final, max_intervals, resume)
@@ -213,6 +216,9 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
         narrowest = (narrow.lower, narrow.time)
     certificate = certificate_report(design, spec, enc, selected, final, budget_hit,
                                      end * dt, max_intervals, narrowest)
+    if final and spec.tasks:     # [[tasks]]: one property each, after the others
+        certificate = replace(certificate, margins=certificate.margins
+                              + task_margins(design, spec, enc))
     return replace(certificate, state=previous, decisive=decisive, work=work)
 
 

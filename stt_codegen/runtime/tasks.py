@@ -1,0 +1,99 @@
+"""Timed tasks judged on a closed-loop trajectory (the figures: :mod:`.task_plots`).
+
+:func:`judge_tasks` reads each ``[[tasks]]`` entry (docs/tasks.md) on the simulated states
+at the sampling instants and the Runge-Kutta points between them (the same points as the
+collision check of :func:`~stt_codegen.runtime.simulate.simulate`) that fall inside the
+task's window:
+
+* **reach**: met when some point is in one of the task's boxes (closed box); ``time`` is
+  the first such point, ``box`` the alternative it was in, ``margin`` the largest over
+  the window's points of how deep the state is in its box (negative: how far out);
+* **stay**: met when every point of the window is in the box; ``time`` is the first point
+  outside it (``None`` when met), ``margin`` the smallest depth.
+
+The depth of ``x`` in a box is ``min_i min(x_i - lower_i, upper_i - x_i)``, state units.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..spec.loader import Spec
+from ..spec.tasks import STAY, Task
+
+
+@dataclass(frozen=True)
+class TaskOutcome:
+    """One task judged on a trajectory (module notes).
+
+    Attributes
+    ----------
+    task : str
+        Its label, ``"T1"``...
+    kind : {"reach", "stay"}
+    window : list of float
+        ``[t0, t1]``, seconds.
+    met : bool
+    time : float or None
+        Reach: the first instant in a box; stay: the first instant out of it; seconds.
+    margin : float or None
+        State units (module notes); ``None`` when no point of the run lies in the window
+        (a run shorter than the window's start).
+    box : int or None
+        Reach: the ``any_of`` alternative reached first (0 for a single box).
+    """
+
+    task: str
+    kind: str
+    window: list[float]
+    met: bool
+    time: float | None
+    margin: float | None
+    box: int | None = None
+
+
+def _depth(x: np.ndarray, lower, upper) -> np.ndarray:
+    return np.minimum(x - np.array(lower), np.array(upper) - x).min(axis=1)
+
+
+def judge_task(task: Task, t: np.ndarray, x: np.ndarray) -> TaskOutcome:
+    """Judge one task on states ``x`` (N, n) at times ``t`` (N,) seconds (module notes)."""
+    t0, t1 = task.window
+    inside = (t >= t0 - 1e-12) & (t <= t1 + 1e-12)
+    tw, xw = t[inside], x[inside]
+    window = [t0, t1]
+    if not tw.size:
+        return TaskOutcome(task.label, task.kind, window, False, None, None)
+    depths = np.array([_depth(xw, b.lower, b.upper) for b in task.boxes])     # (B, K)
+    if task.kind == STAY:
+        out = np.flatnonzero(depths[0] < 0.0)
+        return TaskOutcome(task.label, task.kind, window, not out.size,
+                           float(tw[out[0]]) if out.size else None, float(depths[0].min()))
+    hit = np.flatnonzero((depths >= 0.0).any(axis=0))
+    first = int(hit[0]) if hit.size else None
+    box = int(np.argmax(depths[:, first] >= 0.0)) if first is not None else None
+    return TaskOutcome(task.label, task.kind, window, first is not None,
+                       float(tw[first]) if first is not None else None,
+                       float(depths.max()), box)
+
+
+def judge_tasks(spec: Spec, t: np.ndarray, x: np.ndarray) -> list[TaskOutcome]:
+    """:func:`judge_task` for every task of ``spec`` (empty without tasks).
+
+    Parameters
+    ----------
+    spec : Spec
+    t : ndarray, shape (N,)
+        Seconds, increasing.
+    x : ndarray, shape (N, n)
+        The state at ``t``.
+
+    Returns
+    -------
+    list of TaskOutcome
+        In the spec's order.
+    """
+    return [judge_task(task, t, x) for task in spec.tasks]
+
