@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import CASES, arena_toml
+from conftest import CASES, TASK_CASES, arena_toml
 
 from stt_codegen.spec.loader import bundled_cases
 
@@ -25,12 +25,14 @@ def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
 def test_cases_lists_bundled_specs():
     out = run("cases")
     assert out.returncode == 0
-    assert out.stdout.split() == ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3"]
+    assert out.stdout.split() == ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3",
+                                  "tasks-stay", "tasks-visit"]
 
 
-def test_bundled_cases_are_the_paper_cases():
-    """The conftest's CASES (the parameters of the ``case`` fixture) are the bundled specs."""
-    assert bundled_cases() == CASES
+def test_bundled_cases_are_the_paper_cases_and_the_task_examples():
+    """The conftest's CASES (the parameters of the ``case`` fixture) are the paper's bundled
+    specs; the others are the timed-task examples (TASK_CASES)."""
+    assert bundled_cases() == CASES + TASK_CASES
 
 
 def test_simulate_json_reports_definition_2_1():
@@ -106,13 +108,13 @@ def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
     out = run("demo", "--out", str(tmp_path / "demo"))
     assert out.returncode == 0, out.stderr
     assert "run the c controller" in out.stdout
-    for name in ("omnirobot-s1", "omnirobot-s2", "omnirobot-s3"):
+    for name in CASES + TASK_CASES:
         assert name in out.stdout
         assert (tmp_path / "demo" / f"{name}.png").stat().st_size > 10_000
         c_name = name.replace("-", "_")
         for suffix in (".c", ".h", ".py", "_selftest.c"):
             assert (tmp_path / "demo" / name / f"{c_name}{suffix}").is_file()
-    assert out.stdout.count(" yes ") == 3
+    assert out.stdout.count(" yes ") == len(CASES + TASK_CASES)
     again = run("demo", "--out", str(tmp_path / "demo"))     # its own files: overwritten
     assert again.returncode == 0, again.stderr
 

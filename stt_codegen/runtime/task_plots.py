@@ -1,6 +1,6 @@
 """Timed tasks on the figures: each task's boxes on the arena, its window on the time plots.
 
-Reach boxes are dashed purple outlines, stay boxes dotted teal ones, captioned with the
+Reach boxes are dashed pink outlines, stay boxes dotted teal ones, captioned with the
 task's label and window (``"T1 [7, 8] s"``; docs/tasks.md).
 """
 
@@ -22,12 +22,12 @@ def task_caption(task: Task) -> str:
 def draw_tasks(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
     """Draw every task's boxes projected on ``dims``, captioned (:func:`task_caption`).
 
-    Reach boxes are dashed purple outlines, stay boxes dotted teal ones; every ``any_of``
+    Reach boxes are dashed pink outlines, stay boxes dotted teal ones; every ``any_of``
     box carries the caption.
     """
     i, j = dims
     for task in spec.tasks:
-        color = "tab:cyan" if task.kind == STAY else "tab:purple"
+        color = "tab:cyan" if task.kind == STAY else "tab:pink"
         for q, box in enumerate(task.boxes):
             b = Box(box.lower, box.upper)
             ax.add_patch(Rectangle((b.lower[i], b.lower[j]), b.upper[i] - b.lower[i],
@@ -43,7 +43,7 @@ def draw_task_windows(ax: Axes, spec: Spec, i: int) -> None:
     """On a time plot of state ``x_i``: each task's box over its window (``[t0, t1]`` by
     the box's range in dimension ``i``), captioned."""
     for task in spec.tasks:
-        color = "tab:cyan" if task.kind == STAY else "tab:purple"
+        color = "tab:cyan" if task.kind == STAY else "tab:pink"
         t0, t1 = task.window
         for box in task.boxes:
             ax.add_patch(Rectangle((t0, box.lower[i]), t1 - t0, box.upper[i] - box.lower[i],

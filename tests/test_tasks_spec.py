@@ -1,0 +1,121 @@
+"""``[[tasks]]`` in the spec (issue 21, docs/tasks.md): the schema, the cross-field rules,
+clear SpecErrors, the CLI's exit code, and specs without tasks unchanged."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from stt_codegen.cases import bundled_spec_bytes
+from stt_codegen.errors import SpecError
+from stt_codegen.spec.loader import Spec, load_spec, parse_spec
+from stt_codegen.spec.schema import json_schema
+
+
+def doc(tasks: list, **extra) -> dict:
+    return {"name": "timed", "prescribed_time": 10.0,
+            "state_space": {"lower": [0.0, 0.0], "upper": [5.0, 5.0]},
+            "initial": {"lower": [0.0, 0.0], "upper": [0.6, 0.6]},
+            "target": {"lower": [4.4, 4.4], "upper": [5.0, 5.0]},
+            "obstacles": [{"lower": [2.0, 2.0], "upper": [3.0, 3.0]}],
+            "tasks": tasks, **extra}
+
+
+REACH = {"kind": "reach", "window": [2.0, 3.0], "lower": [3.5, 0.5], "upper": [4.0, 1.0]}
+STAY = {"kind": "stay", "window": [5.0, 6.0], "lower": [0.0, 3.5], "upper": [2.0, 5.0]}
+
+
+def test_tasks_are_read_in_order_with_labels():
+    any_of = {"kind": "reach", "window": [7.0, 8.0],
+              "any_of": [{"lower": [3.5, 3.5], "upper": [4.0, 4.0]},
+                         {"lower": [0.5, 3.5], "upper": [1.0, 4.0]}]}
+    spec = Spec.from_dict(doc([REACH, STAY, any_of]))
+    assert [(t.label, t.kind, t.window, len(t.boxes)) for t in spec.tasks] == [
+        ("T1", "reach", (2.0, 3.0), 1), ("T2", "stay", (5.0, 6.0), 1),
+        ("T3", "reach", (7.0, 8.0), 2)]
+    assert spec.tasks[2].boxes[1].lower == (0.5, 3.5)
+
+
+BAD = [
+    ({**REACH, "kind": "always"}, "tasks[0].kind", "must be one of"),
+    ({**REACH, "window": [2.0]}, "tasks[0].window", "[t0, t1]"),
+    ({**REACH, "window": [3.0, 2.0]}, "tasks[0].window", "below"),
+    ({**REACH, "window": [-1.0, 2.0]}, "tasks[0].window[0]", "non-negative"),
+    ({**REACH, "window": [2.0, 11.0]}, "tasks[0].window", "after prescribed_time"),
+    ({**REACH, "lower": [3.5, 0.5, 0.0]}, "tasks[0].lower", "2 entries"),
+    ({**REACH, "upper": [3.5, 1.0]}, "tasks[0].lower", "not below"),
+    ({**REACH, "upper": [6.0, 1.0]}, "tasks[0]", "not inside the state space"),
+    ({**REACH, "lower": [2.5, 0.5], "upper": [4.0, 2.5]}, "tasks[0]", "meets obstacle 0"),
+    ({"kind": "reach", "window": [2.0, 3.0]}, "tasks[0].lower", "missing"),
+    ({**STAY, "any_of": [{"lower": [0.0, 3.5], "upper": [1.0, 4.0]}]}, "tasks[0].any_of",
+     "only a reach task"),
+    ({**REACH, "any_of": [{"lower": [0.0, 3.5], "upper": [1.0, 4.0]}]}, "tasks[0].any_of",
+     "not both"),
+    ({"kind": "reach", "window": [2.0, 3.0], "any_of": []}, "tasks[0].any_of",
+     "must not be empty"),
+    ({"kind": "reach", "window": [2.0, 3.0], "any_of": [{"lower": [2.5, 2.5],
+                                                          "upper": [3.5, 3.5]}]},
+     "tasks[0].any_of[0]", "meets obstacle 0"),
+    ({**REACH, "colour": "red"}, "tasks[0].colour", "unknown key (allowed: any_of, kind,"),
+    ({"kind": "reach", "window": [2.0, 3.0], "any_of": [{"lower": [0.0, 3.5],
+                                                          "upper": [1.0, 4.0], "x": 1}]},
+     "tasks[0].any_of[0].x", "unknown key (allowed: lower, upper)"),
+]
+
+
+@pytest.mark.parametrize("task, field, reason", BAD)
+def test_a_bad_task_is_a_spec_error_naming_the_field(task, field, reason):
+    with pytest.raises(SpecError) as info:
+        Spec.from_dict(doc([task]))
+    assert info.value.field == field and reason in info.value.reason, str(info.value)
+
+
+def test_windows_come_in_order_without_overlap():
+    with pytest.raises(SpecError) as info:
+        Spec.from_dict(doc([STAY, REACH]))
+    assert info.value.field == "tasks[1].window" and "before the previous" in str(info.value)
+    touching = {**REACH, "window": [6.0, 7.0]}
+    assert len(Spec.from_dict(doc([STAY, touching])).tasks) == 2
+
+
+def test_tasks_need_via_points_and_no_actuator():
+    with pytest.raises(SpecError) as info:
+        Spec.from_dict(doc([REACH], tube={"method": "paper"}))
+    assert info.value.field == "tube.method"
+    with pytest.raises(SpecError) as info:
+        Spec.from_dict(doc([REACH], actuator={"input_bound": [1.0, 1.0]}))
+    assert info.value.field == "tasks" and "not supported" in info.value.reason
+
+
+def test_cli_exits_2_without_traceback(tmp_path):
+    text = bundled_spec_bytes("tasks-stay").decode().replace("window = [5.0, 7.0]",
+                                                             "window = [5.0, 70.0]")
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    out = subprocess.run([sys.executable, "-m", "stt_codegen.cli", "design", str(path)],
+                         capture_output=True, text=True, timeout=300)
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert "tasks[0].window" in out.stderr
+
+
+def test_a_spec_without_tasks_is_unchanged():
+    """No tasks key, or an empty list: no tasks, and the same spec (hash of the file's
+    bytes unchanged; the dict's hash is of the document as given)."""
+    spec = load_spec("omnirobot-s1")
+    assert spec.tasks == ()
+    again = parse_spec(bundled_spec_bytes("omnirobot-s1"))
+    assert again == spec and again.source_hash == spec.source_hash
+    assert Spec.from_dict(doc([])).tasks == ()
+
+
+def test_json_schema_describes_tasks():
+    schema = json_schema()
+    tasks = schema["properties"]["tasks"]
+    assert tasks["type"] == "array"
+    table = schema["$defs"]["TaskTable"]
+    assert set(table["properties"]) == {"kind", "window", "lower", "upper", "any_of"}
+    assert table["properties"]["kind"]["enum"] == ["reach", "stay"]
+    json.dumps(schema)
