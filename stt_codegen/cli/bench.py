@@ -1,4 +1,4 @@
-"""``stt-codegen bench arenas | step | scaling | covering | alpha``: the benchmarks and
+"""``stt-codegen bench arenas | tasks | step | scaling | covering | alpha``: the benchmarks and
 studies of :mod:`stt_codegen.bench`."""
 
 from __future__ import annotations
@@ -76,8 +76,17 @@ def _cmd_alpha(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_tasks(args: argparse.Namespace) -> int:
+    from ..bench.tasks_bench import format_tasks_report, run_tasks_bench
+    report = run_tasks_bench(args.count, args.seed, progress=not args.no_progress)
+    print(json.dumps(report, indent=1, sort_keys=True, allow_nan=False) if args.json
+          else format_tasks_report(report))
+    return 0
+
+
 def configure_bench(bench: argparse.ArgumentParser) -> None:
-    """Sub-subcommands ``bench arenas``, ``step``, ``scaling``, ``covering`` and ``alpha``."""
+    """Sub-subcommands ``bench arenas``, ``tasks``, ``step``, ``scaling``, ``covering`` and
+    ``alpha``."""
     bench.description = ("Benchmarks. Every comparison is measured side by side in one run on "
                          "this machine; ratios, not absolute times, are the result.")
     sub = bench.add_subparsers(dest="bench_command", required=True, metavar="BENCH")
@@ -96,6 +105,15 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_arenas)
+
+    p = sub.add_parser("tasks", help="timed reach tasks: STT vs sequential A* with waiting "
+                                     "(plus the tracker) on random problems")
+    p.add_argument("--count", type=int, default=20, help="number of problems (default: 20)")
+    p.add_argument("--seed", type=_non_negative_int, default=0,
+                   help="problem seed (default: 0)")
+    p.add_argument("--no-progress", action="store_true", help="no line per problem")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_tasks)
 
     p = sub.add_parser("step", help="cost of one controller step: reference, CasADi, "
                                     "generated Python, generated C")

@@ -1,0 +1,169 @@
+"""The timed-task baseline: sequential A* with waiting, followed by the bench's tracker.
+
+What a user without tubes would do for "visit A (or A') during [t0, t1], then B during
+[t2, t3], ..., then the target": plan a path leg by leg on the A* grid of :mod:`.astar`
+(the free space of :mod:`.planning`, obstacles and walls inflated by 0.2 m), from ``x(0)``
+to the centre of the first task box, from there to the next, and from the last to the
+target's centre; for an ``any_of`` task take the box whose leg is shortest. The tracker of
+:mod:`.tracker` (carrot following at 1.5 m/s, then a proportional hold at the leg's end)
+follows leg ``j`` until the middle of task ``j``'s window, where it switches to the next
+leg: it waits at the box when it arrives early. The closed loop is
+:func:`~stt_codegen.runtime.simulate.run_closed_loop`, which judges the tasks and
+Definition 2.1 exactly as for the tube controller.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import networkx as nx
+import numpy as np
+
+from ..design.search import base_design
+from ..runtime.backends import STATUS_OK, backend_names, register_backend
+from ..runtime.simulate import SimulationResult, run_closed_loop
+from ..spec.loader import Spec
+from .astar import RESOLUTION, grid_graph
+from .planning import FreeSpace
+from .tracker import PathTracker
+
+BACKEND = "bench-timed-tracker"
+
+
+@dataclass(frozen=True)
+class TimedPlan:
+    """The legs of the baseline and when the tracker switches from one to the next.
+
+    Attributes
+    ----------
+    legs : tuple of numpy.ndarray
+        Leg ``j``: waypoints (K, 2), metres; ``None`` for the whole plan when some leg has
+        no path (see ``reason``).
+    switch : tuple of float
+        Seconds: leg ``j + 1`` starts at ``switch[j]`` (the middle of task ``j``'s window).
+    choices : tuple of int
+        The box taken per task (``any_of`` alternative).
+    seconds : float
+        Planning time (grid and every A* search), seconds.
+    reason : str
+        Empty when every leg has a path.
+    """
+
+    legs: tuple | None
+    switch: tuple[float, ...]
+    choices: tuple[int, ...]
+    seconds: float
+    reason: str = ""
+
+
+def _node(graph: nx.Graph, origin: np.ndarray, point: np.ndarray):
+    nodes = np.array(list(graph.nodes), dtype=float).reshape(-1, 2)
+    if not len(nodes):
+        return None
+    k = int(np.argmin(np.sum((origin + RESOLUTION * nodes - point) ** 2, axis=1)))
+    return int(nodes[k, 0]), int(nodes[k, 1])
+
+
+def _leg(graph, origin, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray | None, float]:
+    """The A* path from ``a`` to ``b`` (K, 2) and its length, or ``(None, inf)``."""
+    source, target = _node(graph, origin, a), _node(graph, origin, b)
+
+    def heuristic(p, q):
+        return RESOLUTION * math.hypot(p[0] - q[0], p[1] - q[1])
+
+    try:
+        if source is None or target is None:
+            raise nx.NetworkXNoPath
+        nodes = nx.astar_path(graph, source, target, heuristic=heuristic, weight="weight")
+    except nx.NetworkXNoPath:
+        return None, math.inf
+    path = np.vstack([a, origin + RESOLUTION * np.array(nodes, dtype=float), b])
+    return path, float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1)))
+
+
+def plan_timed(spec: Spec) -> TimedPlan:
+    """Plan the baseline's legs (module notes) for a 2-D spec with reach tasks.
+
+    Parameters
+    ----------
+    spec : Spec
+        2-D, its tasks all ``reach``.
+
+    Returns
+    -------
+    TimedPlan
+        ``reason`` is ``"no path found (leg j)"`` when a leg has no path on the grid.
+    """
+    begin = time.perf_counter()
+    space = FreeSpace.of(spec)
+    graph, origin = grid_graph(space)
+    here = space.start
+    legs, choices = [], []
+    for j, task in enumerate(spec.tasks):
+        options = [_leg(graph, origin, here, np.array(box.center)) for box in task.boxes]
+        q = int(np.argmin([length for _, length in options]))
+        if options[q][0] is None:
+            return TimedPlan(None, (), (), time.perf_counter() - begin, f"no path found "
+                             f"(leg {j})")
+        legs.append(options[q][0])
+        choices.append(q)
+        here = np.array(task.boxes[q].center)
+    last, _ = _leg(graph, origin, here, space.goal)
+    if last is None:
+        return TimedPlan(None, (), (), time.perf_counter() - begin,
+                         f"no path found (leg {len(legs)})")
+    legs.append(last)
+    switch = tuple(0.5 * (t.window[0] + t.window[1]) for t in spec.tasks)
+    return TimedPlan(tuple(legs), switch, tuple(choices), time.perf_counter() - begin)
+
+
+class TimedTracker:
+    """The bench's :class:`~.tracker.PathTracker` on each leg in turn, switching at fixed
+    times (a :class:`~stt_codegen.runtime.backends.Controller`)."""
+
+    name = BACKEND
+
+    def __init__(self, plan: TimedPlan) -> None:
+        self.trackers = [PathTracker(leg) for leg in plan.legs]
+        self.switch = list(plan.switch)
+
+    def step(self, x, t, dt, alpha):
+        """The controller step: the active leg's tracker command; ``alpha`` passed through."""
+        j = sum(1 for s in self.switch if t >= s)
+        return (self.trackers[j].command(np.asarray(x, float)), np.asarray(alpha, float),
+                STATUS_OK)
+
+
+_PLANS: dict[str, TimedPlan] = {}
+
+
+def _factory(design) -> TimedTracker:
+    return TimedTracker(_PLANS.pop(design.name))
+
+
+def track_timed(spec: Spec, plan: TimedPlan, seed: int) -> SimulationResult:
+    """Run :class:`TimedTracker` on ``plan`` in closed loop (tasks and Definition 2.1
+    judged by :func:`~stt_codegen.runtime.simulate.run_closed_loop`).
+
+    Parameters
+    ----------
+    spec : Spec
+    plan : TimedPlan
+        With legs.
+    seed : int
+        Disturbance seed (the tube controller's on the same problem).
+
+    Returns
+    -------
+    SimulationResult
+    """
+    if BACKEND not in backend_names():
+        register_backend(BACKEND, _factory)
+    design = base_design(spec)
+    _PLANS[design.name] = plan
+    try:
+        return run_closed_loop(spec, design, backend=BACKEND, seed=seed)
+    finally:
+        _PLANS.pop(design.name, None)
