@@ -45,6 +45,12 @@ def cmd_simulate(args: argparse.Namespace) -> int:
               f"stayed in tube: {'yes' if result.stayed_in_tube else 'NO'}, "
               f"collision: {'YES' if result.collision else 'no'}, "
               f"left state space: {'YES' if result.left_state_space else 'no'}")
+        for task in result.tasks:                 # [[tasks]]
+            when = "" if task.time is None else f" at {task.time:g} s"
+            print(f"task {task.task} {task.kind} [{task.window[0]:g}, {task.window[1]:g}] s: "
+                  f"{'met' if task.met else 'NOT met'}"
+                  f"{when if task.kind == 'reach' or not task.met else ''}, margin "
+                  f"{'-' if task.margin is None else f'{task.margin:.3g}'}")
         if args.plot:
             print(f"plot written to {args.plot}")
     return 0 if result.satisfied else 1
