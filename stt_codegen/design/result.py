@@ -92,7 +92,7 @@ class Design:
     spec: Spec = field(compare=False, repr=False, kw_only=True)
     input_proof: InputProof | None = field(default=None, compare=False, repr=False,
                                            kw_only=True)
-    task_choices: tuple[int, ...] = field(default=(), kw_only=True)
+    task_choices: tuple[int, ...] = field(default=(), repr=False, kw_only=True)
 
     @property
     def certificate(self) -> Certificate:
