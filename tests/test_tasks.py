@@ -133,6 +133,24 @@ def test_stay_task_holds_the_tube_in_its_box_over_the_window():
     assert np.all(g_l >= [0.0, 3.5]) and np.all(g_u <= [2.0, 5.0])
 
 
+def test_stay_window_from_zero_holds_the_start_box():
+    """A stay window from t = 0 leaves no time to move: the tube holds X-hat_0 (inside the
+    stay box) over it, and the certificate proves the stay from t = 0."""
+    tasks = [{"kind": "stay", "window": [0.0, 2.0], "lower": [0.0, 0.0], "upper": [1.5, 1.5]},
+             {"kind": "reach", "window": [5.0, 6.0], "lower": [3.0, 0.5], "upper": [3.6, 1.1]}]
+    spec = spec_of(arena(2, tasks, obstacles=[], t_c=10.0))
+    design = design_tube(spec)
+    first = design.tube.segments[0]
+    assert (first.start, first.end) == (0.0, 2.0) and first.lower_from == first.lower_to
+    m = margins(design.certificate)["task T1 stay"]
+    assert m.passed and m.time == 0.0
+    # a start box that is not inside the stay box: no time to get there, refused
+    tasks[0] = {**tasks[0], "lower": [0.3, 0.0]}
+    with pytest.raises(DesignError) as info:
+        design_tube(spec_of(arena(2, tasks, obstacles=[], t_c=10.0)))
+    assert info.value.kind is FailureKind.TASK
+
+
 @pytest.mark.slow
 def test_stay_task_is_met_in_closed_loop():
     tasks = [{"kind": "stay", "window": [3.0, 6.0], "lower": [0.0, 3.5], "upper": [2.0, 5.0]}]

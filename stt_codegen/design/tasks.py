@@ -11,7 +11,9 @@ of the via-point design (:mod:`stt_codegen.design.via`), in window order, then t
 * **Hold.** The reach tube ``rho`` stays equal to the waypoint box over a hold interval:
   for a reach task the middle of its window, ``[t0 + HOLD_LEAD w, t1 - HOLD_LEAD w]``
   (``w = t1 - t0``); for a stay task the whole window, entered up to ``STAY_LEAD`` seconds
-  early (at most a quarter of the time since the previous hold ended).
+  early (at most a quarter of the time since the previous hold ended). A stay window that
+  leaves no time to move (one from ``t = 0``) holds the box the tube is already in
+  (``X-hat_0``, or the previous waypoint) when that box lies inside the stay box.
 * **Legs.** Between two holds (and from ``X-hat_0`` at 0 to the first, and from the last
   to the target box ``T-hat`` at ``t_c``), :func:`~stt_codegen.design.via.plan_via` plans
   via boxes through the free space over the leg's duration: the same grid, moves,
@@ -83,6 +85,13 @@ def waypoint_box(task: Task, choice: int, previous: np.ndarray,
     return centre - half, centre + half
 
 
+def _within(box: tuple, task_box) -> bool:
+    """Whether ``box`` (lower, upper) lies inside ``task_box`` (the certificate then says
+    whether the tube, wider by ``alpha``, does)."""
+    return bool(np.all(np.array(box[0]) >= task_box.lower)
+                and np.all(np.array(box[1]) <= task_box.upper))
+
+
 def _leg(spec: Spec, base: TubeDesign, start: tuple, goal: tuple, t0: float,
          t1: float) -> list[ReachSegment]:
     """Via segments from box ``start`` at ``t0`` to box ``goal`` at ``t1`` (seconds)."""
@@ -136,6 +145,11 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...]) -> TubeDes
             arrive, until = t0 - min(STAY_LEAD, 0.25 * (t0 - leave)), t1
         else:
             arrive, until = t0 + HOLD_LEAD * (t1 - t0), t1 - HOLD_LEAD * (t1 - t0)
+        if task.kind == STAY and not arrive > leave and _within(start, task.boxes[0]):
+            # a stay window from where the tube already is (e.g. from t = 0): hold it there
+            segments.append(ReachSegment(leave, until, *start, *start, SMOOTHSTEP))
+            leave = until
+            continue
         if not arrive > leave:
             raise DesignError(f"task {task.label}: no time to reach its box before "
                               f"{arrive:g} s", kind=FailureKind.TASK, tried=base)
