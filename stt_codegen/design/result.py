@@ -216,3 +216,48 @@ def require_design(value: object, function: str, parameter: str = "design") -> D
         hint = "call stt_codegen.design_tube(spec) and pass the Design it returns"
     raise TypeError(f"{function}(): parameter {parameter!r} must be a Design, not {kind}; "
                     f"{hint}")
+
+
+def paired_design(spec: object, design: object, function: str) -> Design:
+    """The design of a ``(spec, design)`` pair, checked to be that spec's design.
+
+    ``simulate(spec, design)`` (the spec first, as the API before :class:`Design` took
+    them) is accepted when the design was made from that very spec (the same
+    ``source_hash``, the SHA-256 of the validated document): then the spec adds nothing
+    and the design's own is used. A design of another spec is refused, so a tube is never
+    run against another spec's obstacles, target or plant.
+
+    Parameters
+    ----------
+    spec : object
+        What the caller passed first; must be a :class:`~stt_codegen.spec.loader.Spec`.
+    design : Design
+        What the caller passed second.
+    function : str
+        The public function's name, for the messages.
+
+    Returns
+    -------
+    Design
+        ``design``.
+
+    Raises
+    ------
+    TypeError
+        ``spec`` is not a ``Spec`` (see :func:`require_design`).
+    SpecError
+        Field ``design``: the design was made from another spec.
+    """
+    from ..errors import SpecError
+    from ..spec.loader import Spec
+
+    if not isinstance(spec, Spec):
+        require_design(spec, function)
+    assert isinstance(design, Design)
+    if design.spec.source_hash != spec.source_hash or design.spec != spec:
+        raise SpecError("design", f"{function}(spec, design): the design was made from "
+                                  f"spec {design.spec.name!r} ({design.spec.source_hash[:12]}), "
+                                  f"not from the spec {spec.name!r} ({spec.source_hash[:12]}) "
+                                  f"passed with it; pass the design alone, "
+                                  f"{function}(design, ...)")
+    return design

@@ -31,7 +31,6 @@ from dataclasses import dataclass, replace
 from itertools import product
 
 import numpy as np
-from scipy.sparse import csgraph, csr_matrix
 
 from ..errors import DesignError
 from ..spec.loader import Spec
@@ -203,6 +202,7 @@ def _walled_off(spec: Spec, space, grid_dims: list[int], counts: list[int],
     even a point cannot move from ``x(0)`` to the target centre, the smaller of their two
     connected regions is walled off; the obstacles met by the moves out of it wall it.
     """
+    from scipy.sparse import csgraph, csr_matrix   # on first use: paper designs never load it
     x0, eta = np.array(spec.initial_state), np.array(spec.target_center)
     lows, highs = _grid_nodes(space, grid_dims, counts, (x0, x0), (eta, eta), 0.0)
     pairs, ok = _moves(lows, highs, counts, obstacles, space, 0.0)
@@ -237,6 +237,7 @@ def _shortest_path(count: int, a: np.ndarray, b: np.ndarray,
     """Dijkstra over the undirected moves ``a[q] -- b[q]`` from node 0 (start box) to node 1
     (target box): the path (``None`` without one) and the distances from node 0 (``inf``
     where unreachable)."""
+    from scipy.sparse import csgraph, csr_matrix
     # csgraph reads an explicit zero of a sparse matrix as an edge (a zero-length move);
     # the pairs are distinct, so nothing is summed
     graph = csr_matrix((length, (a, b)), shape=(count, count))

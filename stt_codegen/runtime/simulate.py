@@ -17,7 +17,7 @@ import numpy as np
 import control as ct
 
 from .backends import STATUS_INPUT_CLAMPED, STATUS_OK, make_controller
-from ..design.result import Design, require_design
+from ..design.result import Design, paired_design, require_design
 from ..design.samples import check_step_budget
 from ..errors import SpecError
 from .plants import check_seed, make_plant
@@ -150,7 +150,10 @@ def simulate(design: Design, backend: str = "reference", horizon: float | None =
     ----------
     design : Design
         From :func:`stt_codegen.design_tube`: the tube and gain, and (``design.spec``) the
-        task: sets, ``t_c``, plant and disturbance bound.
+        task: sets, ``t_c``, plant and disturbance bound. The pair ``simulate(spec,
+        design)`` (the spec first, as before ``Design`` existed) is accepted when
+        ``design`` was made from that spec, and runs the ``"reference"`` backend; pass
+        the design alone to choose another.
     backend : str, optional
         Implementation of the controller step: ``"reference"`` (the numpy oracle, default),
         ``"casadi"`` (the CasADi model), ``"c"`` (the generated C, compiled with the
@@ -181,7 +184,8 @@ def simulate(design: Design, backend: str = "reference", horizon: float | None =
         ``design`` is not a :class:`~stt_codegen.design.result.Design` (a ``TubeDesign``
         or a ``Spec``, say): call :func:`stt_codegen.design_tube` first.
     SpecError
-        Unknown backend (field ``backend``), a horizon that is not a positive number of
+        ``simulate(spec, design)`` with a design of another spec (field ``design``);
+        unknown backend (field ``backend``), a horizon that is not a positive number of
         seconds (``horizon``), a seed that is not an integer in ``[0, 2**32)``
         (``seed``), or a run of more than
         :data:`~stt_codegen.design.samples.STEP_BUDGET` steps.
@@ -206,6 +210,8 @@ def simulate(design: Design, backend: str = "reference", horizon: float | None =
     >>> stt.simulate(design, backend="casadi", horizon=2.0).satisfied   # before t_c
     False
     """
+    if isinstance(backend, Design):          # simulate(spec, design): the spec first
+        design, backend = paired_design(design, backend, "simulate"), "reference"
     design = require_design(design, "simulate")
     return run_closed_loop(design.spec, design.tube, backend=backend, horizon=horizon,
                            seed=seed, plant=plant)

@@ -11,8 +11,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import linprog, minimize
-from scipy.spatial import ConvexHull, QhullError
 
 from ..errors import SpecError
 
@@ -94,6 +92,7 @@ class Polytope:
             b = np.array([points.max(), -points.min()])
             ring = points[[points.argmin(), points.argmax()]]
         else:
+            from scipy.spatial import ConvexHull   # scipy on first use: box specs never load it
             hull = ConvexHull(points)
             a, b = hull.equations[:, :-1], -hull.equations[:, -1]
             norms = np.linalg.norm(a, axis=1)
@@ -149,6 +148,7 @@ class Polytope:
         return np.array([0.0 if ok else self._qp_distance(q) for q, ok in zip(p, inside)])
 
     def _qp_distance(self, p: np.ndarray) -> float:
+        from scipy.optimize import minimize
         start = np.array(self.vertices, dtype=float).mean(axis=0)
         res = minimize(lambda y: 0.5 * np.sum((y - p) ** 2), start, jac=lambda y: y - p,
                        constraints=[{"type": "ineq", "fun": lambda y: self._b - self._a @ y,
@@ -198,6 +198,7 @@ class Polytope:
         return lo, hi
 
     def _box_hull_lp(self, lower: np.ndarray, upper: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        from scipy.optimize import linprog
         k = len(lower)
         bounds = list(zip(lower, upper))
         lo, hi = np.empty(k), np.empty(k)
@@ -237,6 +238,7 @@ def make_polytope(vertices: list, name: str) -> Polytope:
     if np.linalg.matrix_rank(points[1:] - points[0], tol=1e-9) < k:
         raise SpecError(f"{name}.vertices", "the vertices are degenerate (their hull has no "
                                             "interior)")
+    from scipy.spatial import QhullError
     try:
         return Polytope(tuple(tuple(float(v) for v in p) for p in vertices))
     except QhullError as exc:  # pragma: no cover - rank check above catches these

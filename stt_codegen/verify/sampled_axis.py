@@ -132,12 +132,13 @@ def axis_interval(a: float, b: float, c0: float, h0: float, pull: float, g_min: 
     for sign, s_a, s_b in ((1.0, max(a, 0.0), b), (-1.0, max(-b, 0.0), -a)):
         if s_b < s_a or (s_b == 0.0 and sign < 0):
             continue
-        extra = push + coupling_push(others, coupling, spread, skew, pull * phi_scalar(s_a))
+        phi_a, phi_b = phi_scalar(s_a), phi_scalar(s_b)
+        extra = push + coupling_push(others, coupling, spread, skew, pull * phi_a)
         start_a, start_b = sign * c0 + s_a * h0, sign * c0 + s_b * h0
         s_star = min(max(s_peak, s_a), s_b)
-        out_max = sign * c0 + s_star * h0 - pull * g_min * phi_scalar(s_star) + extra
-        in_min = min(start_a - pull * g_max * phi_scalar(s_a),
-                     start_b - pull * g_max * phi_scalar(s_b)) - extra
+        phi_star = phi_a if s_star == s_a else phi_b if s_star == s_b else phi_scalar(s_star)
+        out_max = sign * c0 + s_star * h0 - pull * g_min * phi_star + extra
+        in_min = min(start_a - pull * g_max * phi_a, start_b - pull * g_max * phi_b) - extra
         low, high = min(start_a, in_min), max(start_b, out_max)
         if sign > 0:
             path_lo, path_hi = min(path_lo, low), max(path_hi, high)
