@@ -1,6 +1,6 @@
 """Timed tasks on the figures: each task's boxes on the arena, its window on the time plots.
 
-Reach boxes are dashed pink outlines, stay boxes dotted teal ones, captioned with the
+Reach boxes are dashed pink outlines, stay boxes dotted cyan ones, captioned with the
 task's label and window (``"T1 [7, 8] s"``; docs/tasks.md).
 """
 
@@ -22,7 +22,7 @@ def task_caption(task: Task) -> str:
 def draw_tasks(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
     """Draw every task's boxes projected on ``dims``, captioned (:func:`task_caption`).
 
-    Reach boxes are dashed pink outlines, stay boxes dotted teal ones; every ``any_of``
+    Reach boxes are dashed pink outlines, stay boxes dotted cyan ones; every ``any_of``
     box carries the caption.
     """
     i, j = dims
