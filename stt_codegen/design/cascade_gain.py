@@ -94,8 +94,8 @@ def derived_second_stage(design: TubeDesign, min_width: float, input_gain: tuple
     omega2_min = INNER_STEP_FRACTION * g_min / (g_max * dt)
     omega1 = omega2_min / TIME_SCALE_SEPARATION
     k1 = omega1 * min_width**2 / 16.0
-    speed = tube_speed(design)
-    floor = FLOOR_MARGIN * (drift_bound + omega1 * speed) / omega2_min
+    speed = float(tube_speed(design))
+    floor = float(FLOOR_MARGIN * (drift_bound + omega1 * speed) / omega2_min)
     k2 = INNER_STEP_FRACTION * floor**2 / (4.0 * dt * g_max)
     first = dataclasses.replace(design, gain=k1, input_bound=None)
     x1 = np.array(design.initial_state, dtype=float)

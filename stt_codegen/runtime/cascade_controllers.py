@@ -94,16 +94,19 @@ def _compiled(design: TubeDesign, stage: SecondStage):
     from ..codegen.errors import CodegenError
 
     files = cascade_c_files(design, stage, "stt_cascade", "double")
-    folder = Path(tempfile.mkdtemp(prefix="stt-cascade-"))
-    for name, text in files.items():
-        (folder / name).write_text(text)
-    lib = folder / "libstt_cascade.so"
-    proc = subprocess.run([compiler(), *CFLAGS, "-o", str(lib),
-                           str(folder / "stt_cascade.c"), "-lm"],
-                          capture_output=True, text=True)
-    if proc.returncode != 0:
-        raise CodegenError(f"the C compiler failed on the cascade step: {proc.stderr[:2000]}")
-    handle = ctypes.CDLL(str(lib))
+    # the folder is removed once the library is loaded (it stays mapped)
+    with tempfile.TemporaryDirectory(prefix="stt-cascade-") as name:
+        folder = Path(name)
+        for file, text in files.items():
+            (folder / file).write_text(text)
+        lib = folder / "libstt_cascade.so"
+        proc = subprocess.run([compiler(), *CFLAGS, "-o", str(lib),
+                               str(folder / "stt_cascade.c"), "-lm"],
+                              capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise CodegenError("the C compiler failed on the cascade step: "
+                               f"{proc.stderr[:2000]}")
+        handle = ctypes.CDLL(str(lib))
     entry = handle.stt_cascade_step
     real_p = ctypes.POINTER(ctypes.c_double)
     entry.argtypes = [ctypes.c_double, ctypes.c_double, real_p, real_p, real_p, real_p,
