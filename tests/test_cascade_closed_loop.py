@@ -84,7 +84,7 @@ def test_backends_agree_on_the_closed_loop() -> None:
 @needs_cc
 @pytest.mark.parametrize("mass", [0.8, 1.6])
 def test_quadrotor_among_pillars_is_satisfied(mass) -> None:
-    spec = stt.load_spec("tests/specs/quadrotor-pillars.toml")
+    spec = stt.load_spec("second-order-quadrotor")
     design = stt.design_tube(spec)
     drift = 9.81 + 0.4 * 3.0 / 0.8 + 0.2       # gravity, drag at 3 m/s for 0.8 kg, |w|
     stage, _ = derived_second_stage(design.tube, design.check.min_width, (1 / 1.6, 1 / 0.8),

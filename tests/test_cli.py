@@ -25,12 +25,14 @@ def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
 def test_cases_lists_bundled_specs():
     out = run("cases")
     assert out.returncode == 0
-    assert out.stdout.split() == ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3"]
+    assert out.stdout.split() == ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3",
+                                  "second-order-quadrotor", "second-order-s1"]
 
 
 def test_bundled_cases_are_the_paper_cases():
-    """The conftest's CASES (the parameters of the ``case`` fixture) are the bundled specs."""
-    assert bundled_cases() == CASES
+    """The conftest's CASES (the parameters of the ``case`` fixture) are the bundled specs of
+    first-order plants (the second-order ones, issue 22, have tests of their own)."""
+    assert [c for c in bundled_cases() if not c.startswith("second-order-")] == CASES
 
 
 def test_simulate_json_reports_definition_2_1():
@@ -112,7 +114,13 @@ def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
         c_name = name.replace("-", "_")
         for suffix in (".c", ".h", ".py", "_selftest.c"):
             assert (tmp_path / "demo" / name / f"{c_name}{suffix}").is_file()
-    assert out.stdout.count(" yes ") == 3
+    for name in ("second-order-s1", "second-order-quadrotor"):      # issue 22: the cascade
+        assert name in out.stdout
+        assert (tmp_path / "demo" / f"{name}.png").stat().st_size > 10_000
+        c_name = name.replace("-", "_") + "_cascade"
+        for suffix in (".c", ".h", ".py", "_vectors.json"):
+            assert (tmp_path / "demo" / name / f"{c_name}{suffix}").is_file()
+    assert out.stdout.count(" yes ") == 5
     again = run("demo", "--out", str(tmp_path / "demo"))     # its own files: overwritten
     assert again.returncode == 0, again.stderr
 

@@ -182,3 +182,92 @@ def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str) -> 
             "              OK if inside_v[0] == 1.0 else OUTSIDE_VELOCITY_TUBE)\n"
             "    return list(u), list(alpha_next), list(r), status\n")
     return {f"{prefix}.py": text}
+
+
+#: Test vectors per generation: sample points of the cascade step.
+VECTOR_COUNT = 64
+
+
+def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_COUNT) -> dict:
+    """Test vectors of the cascade step from the numpy oracle (JSON-ready, deterministic).
+
+    Points: ``t`` spread over ``[0, 1.1 t_c]`` where the tube at ``alpha = 0`` is at least
+    1e-3 wide, ``alpha = 0``, ``dt`` the design's period,
+    ``x1`` inside the position tube (``|e1| <= 0.9``), ``x2 = r + rho2 s`` with ``|s| <=
+    0.9``, from a fixed seed; expected ``u``, ``r``, ``alpha_next`` and status from
+    :func:`stt_codegen.tube.cascade_reference.cascade_step`.
+    """
+    import numpy as np
+
+    from ..tube import cascade_reference, reference
+
+    rng = np.random.default_rng(22)
+    n = design.dimension
+    t = np.linspace(0.0, 1.1 * design.prescribed_time, 4 * count)
+    dt = 1.0 / design.rate_hz
+    alpha = np.zeros((t.size, 2 * n))
+    g_l, g_u, _, _ = reference.adaptive_tube(design, t, alpha)
+    # where the tube at alpha = 0 is at least 1e-3 wide (where bumps conflict it is empty
+    # until alpha grows), every 4th such time
+    keep = np.flatnonzero(np.all(g_u - g_l > 1e-3, axis=1))[::4][:count]
+    t, alpha, g_l, g_u = t[keep], alpha[keep], g_l[keep], g_u[keep]
+    count = t.size
+    x1 = (g_u + g_l) / 2 + (g_u - g_l) / 2 * rng.uniform(-0.9, 0.9, (count, n))
+    _, _, r, _, _ = cascade_reference.cascade_step(design, stage, x1, np.zeros((count, n)),
+                                                   t, dt, alpha)
+    rho2 = cascade_reference.velocity_tube(stage, t)
+    x2 = r + rho2 * rng.uniform(-0.9, 0.9, (count, n))
+    u, alpha_next, r, inside_p, inside_v = cascade_reference.cascade_step(
+        design, stage, x1, x2, t, dt, alpha)
+    status = np.where(inside_p == 0, CASCADE_OUTSIDE_POSITION_TUBE,
+                      np.where(inside_v == 0, CASCADE_OUTSIDE_VELOCITY_TUBE, CASCADE_OK))
+    return {"_generated": "GENERATED FILE, DO NOT EDIT: cascade test vectors from the numpy "
+                          "reference (stt_codegen.tube.cascade_reference).",
+            "dt": dt,
+            "vectors": [{"t": float(t[k]), "x1": x1[k].tolist(), "x2": x2[k].tolist(),
+                         "alpha": alpha[k].tolist(), "u": u[k].tolist(), "r": r[k].tolist(),
+                         "alpha_next": alpha_next[k].tolist(), "status": int(status[k])}
+                        for k in range(count)]}
+
+
+def cascade_generation(design, options) -> dict[str, bytes]:
+    """Every file of the cascade controller of a second-order design, in memory.
+
+    ``P_cascade.h``, ``P_cascade.c`` (with ``"c"`` in ``options.langs``, in
+    ``options.precision``), ``P_cascade.py`` (with ``"python"``), ``P_cascade_vectors.json``
+    and ``manifest.json``; ``P`` is the spec's C name. The second stage is the default one
+    of :func:`stt_codegen.design.cascade_gain.second_stage_of`.
+
+    Parameters
+    ----------
+    design : Design
+        Of a spec with ``[second_order]``.
+    options : Options
+
+    Returns
+    -------
+    dict of str to bytes
+
+    Raises
+    ------
+    SpecError
+        A first-order spec (field ``second_order``).
+    """
+    import json
+
+    from ..design.cascade_gain import second_stage_of
+    from .generate import MANIFEST, manifest
+
+    stage, _ = second_stage_of(design)
+    prefix = f"{design.spec.c_name}_cascade"
+    texts: dict[str, str] = {}
+    if "c" in options.langs:
+        texts.update(cascade_c_files(design.tube, stage, prefix, options.precision))
+    if "python" in options.langs:
+        texts.update(cascade_python_file(design.tube, stage, prefix))
+    texts[f"{prefix}_vectors.json"] = json.dumps(cascade_vectors(design.tube, stage),
+                                                 indent=1) + "\n"
+    files = {name: text.encode() for name, text in texts.items()}
+    files[MANIFEST] = (json.dumps(manifest(design.spec, options, files), indent=2,
+                                  sort_keys=True) + "\n").encode()
+    return files

@@ -108,3 +108,36 @@ def derived_second_stage(design: TubeDesign, min_width: float, input_gain: tuple
                    "velocity_gain": k2, "width_floor": floor,
                    "width_start": list(stage.width_start), "decay": omega1,
                    "initial_velocity_error": z0.tolist()}
+
+
+def second_stage_of(design) -> tuple[SecondStage, dict]:
+    """The default second stage of a design whose spec has ``[second_order]``.
+
+    ``F`` is ``second_order.drift_bound`` plus ``plant.disturbance_amplitude`` (the bound
+    on every ``|w_i|``); ``g`` in ``second_order.input_gain``; ``x2(0)`` is
+    ``second_order.initial_velocity``; ``gamma_d,min`` the certified narrowest width.
+
+    Parameters
+    ----------
+    design : Design
+        From :func:`stt_codegen.design_tube`.
+
+    Returns
+    -------
+    stage : SecondStage
+    derivation : dict
+        As :func:`derived_second_stage`.
+
+    Raises
+    ------
+    SpecError
+        The spec has no ``[second_order]`` table (field ``second_order``).
+    """
+    from ..errors import SpecError
+    order = design.spec.second_order
+    if order is None:
+        raise SpecError("second_order", "the spec describes a first-order plant (no "
+                                        "[second_order] table)")
+    return derived_second_stage(design.tube, design.check.min_width, order.input_gain,
+                                order.drift_bound + design.spec.disturbance_amplitude,
+                                order.initial_velocity)

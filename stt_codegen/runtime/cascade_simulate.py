@@ -70,6 +70,9 @@ class CascadeResult:
     max_abs_x2 : list of float
         Peak ``|x2_i|``, velocity units.
     steps : int
+    exceeded_velocity_bound : bool
+        Some sampled ``|x2_i|`` reached the spec's ``second_order.velocity_bound`` (then
+        not ``satisfied``); ``False`` without a bound.
     """
 
     spec: str
@@ -88,6 +91,7 @@ class CascadeResult:
     max_abs_u: list[float]
     max_abs_x2: list[float]
     steps: int
+    exceeded_velocity_bound: bool = False
     trajectory: CascadeTrajectory | None = field(default=None, repr=False)
 
     def to_json(self) -> dict:
@@ -101,7 +105,8 @@ def simulate_second_order(spec: Spec, tube: TubeDesign, stage: SecondStage, *,
                           model: str = "double-integrator", params=None,
                           initial_velocity=None, disturbance_amplitude: float | None = None,
                           backend: str = "reference", seed: int = 0,
-                          horizon: float | None = None) -> CascadeResult:
+                          horizon: float | None = None,
+                          velocity_bound=None) -> CascadeResult:
     """Run the sampled cascade on a second-order plant; judge Definition 2.1 on ``x1``.
 
     Parameters
@@ -127,6 +132,8 @@ def simulate_second_order(spec: Spec, tube: TubeDesign, stage: SecondStage, *,
         Seed of the disturbance.
     horizon : float, optional
         Seconds, default ``t_c``.
+    velocity_bound : sequence of float, optional
+        ``|x2_i|`` must stay below it (else not satisfied).
 
     Returns
     -------
@@ -211,13 +218,47 @@ def simulate_second_order(spec: Spec, tube: TubeDesign, stage: SecondStage, *,
     with reference.numpy_math():
         g_l, g_u, _, _ = reference.adaptive_tube(tube, ts, alphas)
     max_e = float(np.max(np.abs(2.0 * x1s - (g_u + g_l)) / (g_u - g_l)))
+    fast = (velocity_bound is not None
+            and bool(np.any(np.abs(x2s[ts <= t_c + 1e-12]) >= np.array(velocity_bound))))
     return CascadeResult(
         spec=spec.name, backend=backend, model=model,
-        satisfied=reached and not collision and not left and horizon >= t_c,
+        satisfied=reached and not collision and not left and not fast and horizon >= t_c,
         reached=reached, reach_time=float(ts[int(np.argmax(in_target))]) if reached else None,
         prescribed_time=t_c, collision=collision, min_obstacle_clearance=min_clear,
         left_state_space=left, stayed_in_tube=bool(np.all(status != 1) and np.all(status != 2)),
         stayed_in_velocity_tube=bool(np.all(status == CASCADE_OK)), max_abs_e=max_e,
         max_abs_u=[float(v) for v in np.abs(us).max(axis=0)],
         max_abs_x2=[float(v) for v in np.abs(x2s).max(axis=0)], steps=steps,
+        exceeded_velocity_bound=fast,
         trajectory=CascadeTrajectory(ts, x1s, x2s, us, rs, alphas, status))
+
+
+def simulate_cascade(design, backend: str = "reference", horizon: float | None = None,
+                     seed: int = 0) -> CascadeResult:
+    """The closed loop of a design whose spec has ``[second_order]``: the default second
+    stage (:func:`stt_codegen.design.cascade_gain.second_stage_of`) on the spec's model,
+    parameters, initial velocity and velocity bound.
+
+    Parameters
+    ----------
+    design : Design
+    backend, horizon, seed
+        As :func:`simulate_second_order`.
+
+    Returns
+    -------
+    CascadeResult
+
+    Raises
+    ------
+    SpecError
+        As :func:`simulate_second_order`; a first-order spec (field ``second_order``).
+    """
+    from ..design.cascade_gain import second_stage_of
+    stage, _ = second_stage_of(design)
+    order = design.spec.second_order
+    return simulate_second_order(design.spec, design.tube, stage, model=order.model,
+                                 params=order.parameters,
+                                 initial_velocity=order.initial_velocity, backend=backend,
+                                 seed=seed, horizon=horizon,
+                                 velocity_bound=order.velocity_bound)

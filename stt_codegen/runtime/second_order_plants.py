@@ -2,7 +2,8 @@
 
 ``x1_dot = x2``, ``x2_dot = f(x1, x2) + g(x1, x2) u + w`` (docs/second-order.md). Each
 model is one Function ``second_order_rhs(x1, x2, u, w, params) -> (x1_dot, x2_dot)`` whose
-physical numbers are the input ``params`` (so one Function serves a whole family of
+physical numbers are the input ``params`` (names and nominal values:
+:data:`stt_codegen.spec.second_order.MODELS`) (so one Function serves a whole family of
 plants, e.g. the random plants of a study), printed to Python by the emitter for the
 simulation. The controller never sees them.
 
@@ -23,35 +24,14 @@ is Assumption 2 for the second stage.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import lru_cache
 
 import casadi as ca
 
-#: The named second-order models, in order.
-SECOND_ORDER_MODELS = ("double-integrator", "quadrotor", "two-link-arm")
+from ..spec.second_order import MODELS, SECOND_ORDER_MODELS, SecondOrderModel
 
-
-@dataclass(frozen=True)
-class SecondOrderModel:
-    """A named second-order model: its dimension (``None``: any), parameter names and
-    nominal parameter values (SI units)."""
-
-    name: str
-    dimension: int | None
-    parameters: tuple[str, ...]
-    nominal: tuple[float, ...]
-
-
-MODELS = {
-    "double-integrator": SecondOrderModel("double-integrator", None, ("mass",), (1.0,)),
-    "quadrotor": SecondOrderModel("quadrotor", 3, ("mass", "drag", "gravity"),
-                                  (1.0, 0.3, 9.81)),
-    "two-link-arm": SecondOrderModel(
-        "two-link-arm", 2, ("mass1", "mass2", "length1", "length2", "inertia1", "inertia2",
-                            "gravity"),
-        (1.0, 1.0, 1.0, 1.0, 1.0 / 12.0, 1.0 / 12.0, 0.0)),
-}
+__all__ = ["MODELS", "SECOND_ORDER_MODELS", "input_matrix", "model_info",
+           "second_order_rhs"]
 
 
 def model_info(model: str, n: int) -> SecondOrderModel:
