@@ -76,6 +76,14 @@ def _cmd_alpha(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_second_order(args: argparse.Namespace) -> int:
+    from ..bench.second_order_study import format_second_order_report, run_second_order_study
+    report = run_second_order_study(args.spec, args.count, args.seed)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_second_order_report(report))
+    return 0
+
+
 def configure_bench(bench: argparse.ArgumentParser) -> None:
     """Sub-subcommands ``bench arenas``, ``step``, ``scaling``, ``covering`` and ``alpha``."""
     bench.description = ("Benchmarks. Every comparison is measured side by side in one run on "
@@ -132,3 +140,12 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="bundled case name or spec file (default: %(default)s)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_alpha)
+
+    p = sub.add_parser("second-order", help="the cascade law on random second-order plants "
+                                            "within a case's declared bounds (issue 22)")
+    p.add_argument("spec", metavar="SPEC", nargs="?", default="second-order-s1",
+                   help="bundled case or spec file with [second_order] (default: %(default)s)")
+    p.add_argument("--count", type=int, default=300, help="plants (default: %(default)s)")
+    p.add_argument("--seed", type=_non_negative_int, default=0, help="seed (default: 0)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_second_order)
