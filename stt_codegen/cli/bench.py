@@ -102,6 +102,10 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
     p.add_argument("--specs", default=None, metavar="DIR",
                    help="also write the arenas as spec files into DIR")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--plant", choices=("single-integrator", "double-integrator"),
+                   default="single-integrator",
+                   help="double-integrator: the cascade law (docs/second-order.md) beside "
+                        "A* + a velocity-loop tracker, sequentially (default: %(default)s)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_arenas)
 

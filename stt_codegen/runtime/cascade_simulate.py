@@ -106,7 +106,7 @@ def simulate_second_order(spec: Spec, tube: TubeDesign, stage: SecondStage, *,
                           initial_velocity=None, disturbance_amplitude: float | None = None,
                           backend: str = "reference", seed: int = 0,
                           horizon: float | None = None,
-                          velocity_bound=None) -> CascadeResult:
+                          velocity_bound=None, controller=None) -> CascadeResult:
     """Run the sampled cascade on a second-order plant; judge Definition 2.1 on ``x1``.
 
     Parameters
@@ -134,6 +134,10 @@ def simulate_second_order(spec: Spec, tube: TubeDesign, stage: SecondStage, *,
         Seconds, default ``t_c``.
     velocity_bound : sequence of float, optional
         ``|x2_i|`` must stay below it (else not satisfied).
+    controller : object, optional
+        Another controller with the step of
+        :class:`~stt_codegen.runtime.cascade_controllers.CascadeController` (a baseline
+        judged by the same loop); ``backend`` is then only its label.
 
     Returns
     -------
@@ -166,7 +170,8 @@ def simulate_second_order(spec: Spec, tube: TubeDesign, stage: SecondStage, *,
     amplitude = (spec.disturbance_amplitude if disturbance_amplitude is None
                  else float(disturbance_amplitude))
     w = Disturbance(n, amplitude, seed)
-    controller = CascadeController(backend, tube, stage)
+    if controller is None:
+        controller = CascadeController(backend, tube, stage)
     rhs_fn = python_function(second_order_rhs(model, n))
     p_list = params.tolist()
 
