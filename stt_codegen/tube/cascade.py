@@ -93,11 +93,6 @@ def velocity_transform(n: int) -> ca.Function:
                        ["x2", "r", "rho2"], ["e2", "epsilon2", "xi2"])
 
 
-def cascade_pieces(n: int) -> list:
-    """The second stage's pieces that deployed code calls, in a fixed order."""
-    return [velocity_tube(n), velocity_law(n)]
-
-
 def cascade_step(design: TubeDesign, stage: SecondStage) -> ca.Function:
     """``cascade_step(x1, x2, t, dt, alpha) -> (u, alpha_next, r, inside_position,
     inside_velocity)``: one sampled step of the cascade (docs/second-order.md).
