@@ -47,3 +47,11 @@ def test_double_integrator_arena_runs_both_methods() -> None:
     assert out["stt"]["satisfied"] and out["stt"]["in_tube"]
     assert out["astar"]["satisfied"]
     assert "in_tube" not in out["astar"]          # a tracker has no tube to stay in
+
+
+@pytest.mark.slow
+def test_bench_arenas_dispatches_on_the_plant(capsys) -> None:
+    from stt_codegen.cli import main
+    assert main(["bench", "arenas", "--plant", "double-integrator", "--count", "1"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("double integrator, 1 arenas, seed 0: satisfied STT cascade")

@@ -30,6 +30,13 @@ def _int_list(text: str, field: str) -> list[int]:
 
 
 def _cmd_arenas(args: argparse.Namespace) -> int:
+    if args.plant == "double-integrator":       # issue 22: the cascade beside A* + tracker
+        from ..bench.second_order_arenas import (format_double_integrator_report,
+                                                 run_double_integrator_bench)
+        report = run_double_integrator_bench(args.count, args.seed)
+        print(json.dumps(report, indent=1, sort_keys=True) if args.json
+              else format_double_integrator_report(report))
+        return 0
     from ..bench.arenas_bench import format_arenas_report, run_arenas_bench, write_specs
     if args.specs:
         write_specs(Path(args.specs), args.count, args.seed)
