@@ -90,3 +90,33 @@ def test_committed_python_meets_its_vectors(case) -> None:
         np.testing.assert_allclose(u, v["u"], rtol=DOUBLE_TOLERANCE, atol=DOUBLE_TOLERANCE)
         np.testing.assert_allclose(alpha_next, v["alpha_next"], rtol=DOUBLE_TOLERANCE,
                                    atol=DOUBLE_TOLERANCE)
+
+
+CPPCHECK = shutil.which("cppcheck")
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(CPPCHECK is None,
+                    reason="cppcheck missing: install the Debian package cppcheck")
+@pytest.mark.parametrize("precision", ["double", "single"])
+@pytest.mark.parametrize("case", CASES)
+def test_cppcheck_misra_findings_are_the_listed_deviations(tmp_path, case, precision) -> None:
+    """The first-order code's deviation list (tests/test_codegen_misra.py), unchanged, covers
+    the cascade: only the entry point is reported (unusedFunction: the application calls it)."""
+    import re
+
+    from test_codegen_misra import DEVIATIONS
+    prefix = case.replace("-", "_") + "_cascade"
+    for suffix in (".c", ".h"):
+        (tmp_path / f"{prefix}{suffix}").write_bytes(
+            (_folder(case, precision) / f"{prefix}{suffix}").read_bytes())
+    proc = subprocess.run([CPPCHECK, "--enable=all", "--addon=misra", "--std=c99",
+                           "--suppress=missingIncludeSystem", "--quiet",
+                           "--template={file}:{line}:{id}", f"{prefix}.c"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    findings = [line.split(":") for line in proc.stderr.splitlines() if line.count(":") >= 2]
+    assert findings, "cppcheck reported nothing: the unused entry point must show up"
+    for name, line, check in findings:
+        text = (tmp_path / name).read_text().splitlines()[int(line) - 1]
+        assert [d for d in DEVIATIONS if d[0] == check and re.search(d[1], text)], (check, text)

@@ -1239,36 +1239,39 @@ static int second_order_quadrotor_cascade_finite(const float* v, int count, int 
 
 int second_order_quadrotor_cascade_step(float t, float dt, const float* x1, const float* x2,
     const float* alpha, float* u, float* alpha_next, float* r) {
-  float tv[1];
-  float dtv[1];
-  float inside_position[1];
-  float inside_velocity[1];
-  int status;
-  int i;
-  int valid = (isfinite(t) != 0) && (t >= 0.0f) && (isfinite(dt) != 0)
-      && (dt > 0.0f) && (dt <= 1.0f);
-  valid = valid && (second_order_quadrotor_cascade_finite(x1, SECOND_ORDER_QUADROTOR_CASCADE_N, 0) != 0)
+  int status = SECOND_ORDER_QUADROTOR_CASCADE_INVALID_INPUT;
+  int valid = 0;
+  if ((isfinite(t) != 0) && (t >= 0.0f) && (isfinite(dt) != 0)
+      && (dt > 0.0f) && (dt <= 1.0f)
+      && (second_order_quadrotor_cascade_finite(x1, SECOND_ORDER_QUADROTOR_CASCADE_N, 0) != 0)
       && (second_order_quadrotor_cascade_finite(x2, SECOND_ORDER_QUADROTOR_CASCADE_N, 0) != 0)
-      && (second_order_quadrotor_cascade_finite(alpha, 2 * SECOND_ORDER_QUADROTOR_CASCADE_N, 1) != 0);
+      && (second_order_quadrotor_cascade_finite(alpha, (2 * SECOND_ORDER_QUADROTOR_CASCADE_N), 1) != 0)) {
+    valid = 1;
+  }
   if (valid == 0) {
+    int i;
     for (i = 0; i < SECOND_ORDER_QUADROTOR_CASCADE_N; ++i) {
       u[i] = 0.0f;
       r[i] = 0.0f;
     }
-    for (i = 0; i < 2 * SECOND_ORDER_QUADROTOR_CASCADE_N; ++i) {
+    for (i = 0; i < (2 * SECOND_ORDER_QUADROTOR_CASCADE_N); ++i) {
       alpha_next[i] = (isfinite(alpha[i]) != 0) ? alpha[i] : 0.0f;
     }
-    return SECOND_ORDER_QUADROTOR_CASCADE_INVALID_INPUT;
-  }
-  tv[0] = t;
-  dtv[0] = dt;
-  second_order_quadrotor_cascade_cascade_step(x1, x2, tv, dtv, alpha, u, alpha_next, r, inside_position, inside_velocity);
-  if (inside_position[0] != 1.0f) {
-    status = SECOND_ORDER_QUADROTOR_CASCADE_OUTSIDE_POSITION_TUBE;
-  } else if (inside_velocity[0] != 1.0f) {
-    status = SECOND_ORDER_QUADROTOR_CASCADE_OUTSIDE_VELOCITY_TUBE;
   } else {
-    status = SECOND_ORDER_QUADROTOR_CASCADE_OK;
+    float tv[1];
+    float dtv[1];
+    float inside_position[1];
+    float inside_velocity[1];
+    tv[0] = t;
+    dtv[0] = dt;
+    second_order_quadrotor_cascade_cascade_step(x1, x2, tv, dtv, alpha, u, alpha_next, r, inside_position, inside_velocity);
+    if (inside_position[0] != 1.0f) {
+      status = SECOND_ORDER_QUADROTOR_CASCADE_OUTSIDE_POSITION_TUBE;
+    } else if (inside_velocity[0] != 1.0f) {
+      status = SECOND_ORDER_QUADROTOR_CASCADE_OUTSIDE_VELOCITY_TUBE;
+    } else {
+      status = SECOND_ORDER_QUADROTOR_CASCADE_OK;
+    }
   }
   return status;
 }

@@ -860,36 +860,39 @@ static int second_order_s1_cascade_finite(const double* v, int count, int nonneg
 
 int second_order_s1_cascade_step(double t, double dt, const double* x1, const double* x2,
     const double* alpha, double* u, double* alpha_next, double* r) {
-  double tv[1];
-  double dtv[1];
-  double inside_position[1];
-  double inside_velocity[1];
-  int status;
-  int i;
-  int valid = (isfinite(t) != 0) && (t >= 0.0) && (isfinite(dt) != 0)
-      && (dt > 0.0) && (dt <= 1.0);
-  valid = valid && (second_order_s1_cascade_finite(x1, SECOND_ORDER_S1_CASCADE_N, 0) != 0)
+  int status = SECOND_ORDER_S1_CASCADE_INVALID_INPUT;
+  int valid = 0;
+  if ((isfinite(t) != 0) && (t >= 0.0) && (isfinite(dt) != 0)
+      && (dt > 0.0) && (dt <= 1.0)
+      && (second_order_s1_cascade_finite(x1, SECOND_ORDER_S1_CASCADE_N, 0) != 0)
       && (second_order_s1_cascade_finite(x2, SECOND_ORDER_S1_CASCADE_N, 0) != 0)
-      && (second_order_s1_cascade_finite(alpha, 2 * SECOND_ORDER_S1_CASCADE_N, 1) != 0);
+      && (second_order_s1_cascade_finite(alpha, (2 * SECOND_ORDER_S1_CASCADE_N), 1) != 0)) {
+    valid = 1;
+  }
   if (valid == 0) {
+    int i;
     for (i = 0; i < SECOND_ORDER_S1_CASCADE_N; ++i) {
       u[i] = 0.0;
       r[i] = 0.0;
     }
-    for (i = 0; i < 2 * SECOND_ORDER_S1_CASCADE_N; ++i) {
+    for (i = 0; i < (2 * SECOND_ORDER_S1_CASCADE_N); ++i) {
       alpha_next[i] = (isfinite(alpha[i]) != 0) ? alpha[i] : 0.0;
     }
-    return SECOND_ORDER_S1_CASCADE_INVALID_INPUT;
-  }
-  tv[0] = t;
-  dtv[0] = dt;
-  second_order_s1_cascade_cascade_step(x1, x2, tv, dtv, alpha, u, alpha_next, r, inside_position, inside_velocity);
-  if (inside_position[0] != 1.0) {
-    status = SECOND_ORDER_S1_CASCADE_OUTSIDE_POSITION_TUBE;
-  } else if (inside_velocity[0] != 1.0) {
-    status = SECOND_ORDER_S1_CASCADE_OUTSIDE_VELOCITY_TUBE;
   } else {
-    status = SECOND_ORDER_S1_CASCADE_OK;
+    double tv[1];
+    double dtv[1];
+    double inside_position[1];
+    double inside_velocity[1];
+    tv[0] = t;
+    dtv[0] = dt;
+    second_order_s1_cascade_cascade_step(x1, x2, tv, dtv, alpha, u, alpha_next, r, inside_position, inside_velocity);
+    if (inside_position[0] != 1.0) {
+      status = SECOND_ORDER_S1_CASCADE_OUTSIDE_POSITION_TUBE;
+    } else if (inside_velocity[0] != 1.0) {
+      status = SECOND_ORDER_S1_CASCADE_OUTSIDE_VELOCITY_TUBE;
+    } else {
+      status = SECOND_ORDER_S1_CASCADE_OK;
+    }
   }
   return status;
 }
