@@ -19,6 +19,9 @@ def test_random_plants_stay_within_the_declared_bounds() -> None:
         assert 0.8 <= mass <= 1.25
     with pytest.raises(SpecError):
         random_parameters("two-link-arm", (1.0, 1.0), rng)
+    wide = [random_parameters("double-integrator", (0.8, 1.25), rng, spread=4.0)[0]
+            for _ in range(500)]
+    assert 1 / 5.0 <= min(wide) and max(wide) <= 1 / 0.2 and max(wide) > 1.25
 
 
 def test_study_refuses_a_first_order_spec_and_a_bad_count() -> None:
@@ -27,6 +30,9 @@ def test_study_refuses_a_first_order_spec_and_a_bad_count() -> None:
     assert info.value.field == "second_order"
     with pytest.raises(SpecError):
         run_second_order_study("second-order-s1", 0)
+    with pytest.raises(SpecError) as info:
+        run_second_order_study("second-order-s1", 1, spread=0.5)
+    assert info.value.field == "spread"
 
 
 @pytest.mark.slow

@@ -34,8 +34,11 @@ DRAG_MAX = 0.4
 GRAVITY = 9.81
 
 
-def random_parameters(model: str, input_gain: tuple, rng: np.random.Generator) -> list[float]:
-    """One plant's parameters within the declared bounds (the module docstring).
+def random_parameters(model: str, input_gain: tuple, rng: np.random.Generator,
+                      spread: float = 1.0) -> list[float]:
+    """One plant's parameters within the declared bounds (the module docstring), or, with
+    ``spread > 1``, beyond them: ``1/m`` in ``[g_min / spread, g_max spread]``, drag up to
+    ``spread DRAG_MAX``.
 
     Raises
     ------
@@ -43,17 +46,17 @@ def random_parameters(model: str, input_gain: tuple, rng: np.random.Generator) -
         A model the study does not draw (field ``second_order.model``).
     """
     g_min, g_max = input_gain
-    mass = 1.0 / rng.uniform(g_min, g_max)
+    mass = 1.0 / rng.uniform(g_min / spread, g_max * spread)
     if model == "double-integrator":
         return [mass]
     if model == "quadrotor":
-        return [mass, float(rng.uniform(0.0, DRAG_MAX)), GRAVITY]
+        return [mass, float(rng.uniform(0.0, DRAG_MAX * spread)), GRAVITY]
     raise SpecError("second_order.model", f"the study draws double-integrator and quadrotor "
                                           f"plants, not {model!r}")
 
 
 def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed: int = 0,
-                           backend: str = "c") -> dict:
+                           backend: str = "c", spread: float = 1.0) -> dict:
     """Run the study (module docstring).
 
     Parameters
@@ -66,6 +69,10 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
         Seed of the draws.
     backend : str
         Controller backend (``c`` by default: the emitted C of the cascade).
+    spread : float
+        1 (default): plants within the declared bounds; > 1: beyond them
+        (:func:`random_parameters`, and disturbance amplitudes up to ``spread`` times the
+        declared one), to find where the cascade fails.
 
     Returns
     -------
@@ -81,6 +88,8 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
     """
     if count < 1:
         raise SpecError("count", f"must be at least 1, got {count}")
+    if not spread >= 1.0:
+        raise SpecError("spread", f"must be at least 1, got {spread}")
     started = time.perf_counter()
     design = design_tube(load_spec(case))
     stage, derivation = second_stage_of(design)
@@ -90,8 +99,8 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
     satisfied = in_tubes = 0
     failures = []
     for k in range(count):
-        params = random_parameters(order.model, order.input_gain, rng)
-        amplitude = float(rng.uniform(0.0, spec.disturbance_amplitude))
+        params = random_parameters(order.model, order.input_gain, rng, spread)
+        amplitude = float(rng.uniform(0.0, spread * spec.disturbance_amplitude))
         plant_seed = int(rng.integers(0, 2**32))
         result = simulate_second_order(spec, design.tube, stage, model=order.model,
                                        params=params, initial_velocity=order.initial_velocity,
@@ -109,6 +118,7 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
                                  "stayed_in_tube", "stayed_in_velocity_tube", "max_abs_e",
                                  "max_abs_u", "max_abs_x2", "exceeded_velocity_bound")}})
     return {"case": spec.name, "model": order.model, "count": count, "seed": seed,
+            "spread": spread,
             "backend": backend, "satisfied": satisfied, "satisfied_share": satisfied / count,
             "in_both_tubes": in_tubes, "in_both_tubes_share": in_tubes / count,
             "stage": {"position_gain": stage.position_gain,
@@ -121,7 +131,8 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
 
 def format_second_order_report(report: dict) -> str:
     """The study as a few lines of text."""
-    lines = [f"{report['case']} ({report['model']}), {report['count']} random plants, seed "
+    lines = [f"{report['case']} ({report['model']}), {report['count']} random plants "
+             f"(spread {report['spread']:g}), seed "
              f"{report['seed']}, backend {report['backend']}: satisfied "
              f"{report['satisfied']}/{report['count']} ({100 * report['satisfied_share']:.1f} %),"
              f" in both tubes {report['in_both_tubes']}/{report['count']} "

@@ -85,7 +85,7 @@ def _cmd_alpha(args: argparse.Namespace) -> int:
 
 def _cmd_second_order(args: argparse.Namespace) -> int:
     from ..bench.second_order_study import format_second_order_report, run_second_order_study
-    report = run_second_order_study(args.spec, args.count, args.seed)
+    report = run_second_order_study(args.spec, args.count, args.seed, spread=args.spread)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_second_order_report(report))
     return 0
@@ -158,5 +158,7 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="bundled case or spec file with [second_order] (default: %(default)s)")
     p.add_argument("--count", type=int, default=300, help="plants (default: %(default)s)")
     p.add_argument("--seed", type=_non_negative_int, default=0, help="seed (default: 0)")
+    p.add_argument("--spread", type=float, default=1.0, metavar="F",
+                   help="draw plants F times beyond the declared bounds (default: 1, within)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_second_order)
