@@ -186,3 +186,17 @@ def test_generated_python_runs_and_matches_the_oracle(tube) -> None:
         np.testing.assert_allclose(u, expected[0][k], rtol=1e-10, atol=1e-12)
         np.testing.assert_allclose(r, expected[2][k], rtol=1e-10, atol=1e-12)
     assert namespace["step"](-1.0, 1e-3, p["x"][0], p["x2"][0], p["alpha"][0])[3] == 2
+
+
+def test_the_oracles_unclamped_transform_is_the_deployed_one_inside() -> None:
+    rng = np.random.default_rng(9)
+    r, rho2 = rng.uniform(-2, 2, (200, 3)), rng.uniform(0.1, 2, (200, 3))
+    x2 = r + rho2 * rng.uniform(-0.99, 0.99, (200, 3))
+    expected = cascade_reference.velocity_transform(x2, r, rho2)
+    f = cascade.velocity_transform(3)
+    for k in range(200):
+        got = [np.array(v).ravel() for v in f(x2[k], r[k], rho2[k])]
+        for a, b in zip(got, expected):
+            np.testing.assert_allclose(a, b[k], rtol=1e-12, atol=1e-15)
+    outside = cascade_reference.velocity_transform([[2.0]], [[0.0]], [[1.0]])
+    assert np.isnan(outside[1][0, 0])                  # the oracle does not clamp

@@ -22,7 +22,9 @@ from ..tube.parameters import TubeDesign
 from ..tube.second_stage import (CASCADE_OK, CASCADE_OUTSIDE_POSITION_TUBE,
                                  CASCADE_OUTSIDE_VELOCITY_TUBE, SecondStage)
 from ..version import __version__
+from ..design.result import Design
 from .emit import CPrinter, lower, python_source
+from .options import Options
 
 #: Status of an input outside the step's domain (as the first-order API's INVALID_INPUT).
 CASCADE_INVALID_INPUT = 2
@@ -233,7 +235,7 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
                         for k in range(count)]}
 
 
-def cascade_generation(design, options) -> dict[str, bytes]:
+def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
     """Every file of the cascade controller of a second-order design, in memory.
 
     ``P_cascade.h``, ``P_cascade.c`` (with ``"c"`` in ``options.langs``, in

@@ -24,12 +24,16 @@ These are engineering defaults, not a proof: the sampled cascade is not certifie
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..tube import reference
 from ..tube.parameters import TubeDesign
 from ..tube.second_stage import SecondStage
+
+if TYPE_CHECKING:
+    from .result import Design
 
 #: ``omega2 dt`` at ``lambda = g_max``.
 INNER_STEP_FRACTION = 0.1
@@ -110,7 +114,7 @@ def derived_second_stage(design: TubeDesign, min_width: float, input_gain: tuple
                    "initial_velocity_error": z0.tolist()}
 
 
-def second_stage_of(design) -> tuple[SecondStage, dict]:
+def second_stage_of(design: "Design") -> tuple[SecondStage, dict]:
     """The default second stage of a design whose spec has ``[second_order]``.
 
     ``F`` is ``second_order.drift_bound`` plus ``plant.disturbance_amplitude`` (the bound

@@ -28,6 +28,7 @@ import numpy as np
 from ..codegen.cascade_source import cascade_c_files
 from ..codegen.emit import c_source
 from ..design.cascade_gain import second_stage_of
+from ..design.result import Design
 from ..errors import SpecError, ToolchainError
 from ..runtime.cascade_simulate import SUBSTEPS
 from ..runtime.plants import Disturbance
@@ -50,7 +51,7 @@ def _array(name: str, values, kind: str = "double") -> str:
     return f"static const {kind} {name}[{max(1, len(flat))}] = {{{', '.join(flat) or '0.0'}}};"
 
 
-def closed_loop_program(design, prefix: str, seed: int = 0) -> str:
+def closed_loop_program(design: Design, prefix: str, seed: int = 0) -> str:
     """The C text of the closed-loop program (see the module docstring).
 
     Raises
@@ -206,7 +207,7 @@ def _summary(stdout: str) -> dict:
     return out
 
 
-def run_cascade_embedded(design, seed: int = 0, timeout: float = 600.0) -> dict:
+def run_cascade_embedded(design: Design, seed: int = 0, timeout: float = 600.0) -> dict:
     """Build and run the cascade's closed loop on the emulated Cortex-M4F.
 
     Parameters

@@ -7,12 +7,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..design.result import Design
 from ..tube import reference
 from .cascade_simulate import CascadeResult
 from .plots import agg_figure, draw_arena, save
 
 
-def plot_cascade_run(design, result: CascadeResult, path: str | Path,
+def plot_cascade_run(design: Design, result: CascadeResult, path: str | Path,
                      dims: tuple[int, int] = (0, 1)) -> Path:
     """Write a PNG of a cascade run.
 

@@ -15,6 +15,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ..codegen.emit import python_function
+from ..design.result import Design
 from ..design.samples import check_step_budget
 from ..errors import SpecError
 from ..spec.loader import Spec
@@ -238,7 +239,7 @@ def simulate_second_order(spec: Spec, tube: TubeDesign, stage: SecondStage, *,
         trajectory=CascadeTrajectory(ts, x1s, x2s, us, rs, alphas, status))
 
 
-def simulate_cascade(design, backend: str = "reference", horizon: float | None = None,
+def simulate_cascade(design: Design, backend: str = "reference", horizon: float | None = None,
                      seed: int = 0) -> CascadeResult:
     """The closed loop of a design whose spec has ``[second_order]``: the default second
     stage (:func:`stt_codegen.design.cascade_gain.second_stage_of`) on the spec's model,

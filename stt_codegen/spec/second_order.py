@@ -12,8 +12,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ..errors import SpecError
+
+if TYPE_CHECKING:
+    from .schema import SecondOrderTable
 
 __all__ = ["MODELS", "SECOND_ORDER_MODELS", "SecondOrder", "SecondOrderModel",
            "parse_second_order"]
@@ -86,7 +90,7 @@ def _numbers(values, field: str, count: int | None = None) -> tuple[float, ...]:
     return out
 
 
-def parse_second_order(table, n: int) -> SecondOrder | None:
+def parse_second_order(table: "SecondOrderTable | None", n: int) -> SecondOrder | None:
     """The ``[second_order]`` table of a spec with ``n`` positions, checked.
 
     Parameters
