@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import shutil
+
 import numpy as np
 import pytest
 
 from stt_codegen.bench.second_order_study import (DRAG_MAX, format_second_order_report,
                                                   random_parameters, run_second_order_study)
 from stt_codegen.errors import SpecError
+
+needs_cc = pytest.mark.skipif(shutil.which("gcc") is None and shutil.which("clang") is None,
+                              reason="no C compiler (install gcc or clang)")
 
 
 def test_random_plants_stay_within_the_declared_bounds() -> None:
@@ -36,6 +41,7 @@ def test_study_refuses_a_first_order_spec_and_a_bad_count() -> None:
 
 
 @pytest.mark.slow
+@needs_cc
 def test_small_study_counts_what_it_ran() -> None:
     report = run_second_order_study("second-order-s1", 3, seed=1)
     assert report["count"] == 3 and 0 <= report["satisfied"] <= 3
@@ -47,6 +53,7 @@ def test_small_study_counts_what_it_ran() -> None:
 
 
 @pytest.mark.slow
+@needs_cc
 def test_double_integrator_arena_runs_both_methods() -> None:
     from stt_codegen.bench.second_order_arenas import run_arena_double_integrator
     out = run_arena_double_integrator(0, 0)
@@ -56,6 +63,7 @@ def test_double_integrator_arena_runs_both_methods() -> None:
 
 
 @pytest.mark.slow
+@needs_cc
 def test_bench_arenas_dispatches_on_the_plant(capsys) -> None:
     from stt_codegen.cli import main
     assert main(["bench", "arenas", "--plant", "double-integrator", "--count", "1"]) == 0

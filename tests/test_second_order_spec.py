@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 import subprocess
 import sys
 import tomllib
@@ -91,6 +92,8 @@ def test_a_bad_table_exits_2_without_traceback(tmp_path) -> None:
 
 
 @pytest.mark.slow
+@pytest.mark.skipif(shutil.which("gcc") is None and shutil.which("clang") is None,
+                    reason="no C compiler (install gcc or clang)")
 def test_simulate_runs_the_cascade(tmp_path) -> None:
     out = _cli("simulate", "second-order-s1", "--backend", "c", "--json")
     assert out.returncode == 0, out.stderr
