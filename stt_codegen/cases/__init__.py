@@ -1,4 +1,5 @@
-"""The bundled specs: the paper's case study (section V), one TOML file per start set."""
+"""The bundled specs: the paper's case study (section V), one TOML file per start set, and
+two second-order cases (issue 22, docs/second-order.md)."""
 
 from __future__ import annotations
 

@@ -30,6 +30,13 @@ def _int_list(text: str, field: str) -> list[int]:
 
 
 def _cmd_arenas(args: argparse.Namespace) -> int:
+    if args.plant == "double-integrator":       # issue 22: the cascade beside A* + tracker
+        from ..bench.second_order_arenas import (format_double_integrator_report,
+                                                 run_double_integrator_bench)
+        report = run_double_integrator_bench(args.count, args.seed)
+        print(json.dumps(report, indent=1, sort_keys=True) if args.json
+              else format_double_integrator_report(report))
+        return 0
     from ..bench.arenas_bench import format_arenas_report, run_arenas_bench, write_specs
     if args.specs:
         write_specs(Path(args.specs), args.count, args.seed)
@@ -84,6 +91,14 @@ def _cmd_tasks(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_second_order(args: argparse.Namespace) -> int:
+    from ..bench.second_order_study import format_second_order_report, run_second_order_study
+    report = run_second_order_study(args.spec, args.count, args.seed, spread=args.spread)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_second_order_report(report))
+    return 0
+
+
 def configure_bench(bench: argparse.ArgumentParser) -> None:
     """Sub-subcommands ``bench arenas``, ``tasks``, ``step``, ``scaling``, ``covering`` and
     ``alpha``."""
@@ -103,6 +118,10 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
     p.add_argument("--specs", default=None, metavar="DIR",
                    help="also write the arenas as spec files into DIR")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--plant", choices=("single-integrator", "double-integrator"),
+                   default="single-integrator",
+                   help="double-integrator: the cascade law (docs/second-order.md) beside "
+                        "A* + a velocity-loop tracker, sequentially (default: %(default)s)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_arenas)
 
@@ -150,3 +169,14 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="bundled case name or spec file (default: %(default)s)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_alpha)
+
+    p = sub.add_parser("second-order", help="the cascade law on random second-order plants "
+                                            "within a case's declared bounds (issue 22)")
+    p.add_argument("spec", metavar="SPEC", nargs="?", default="second-order-s1",
+                   help="bundled case or spec file with [second_order] (default: %(default)s)")
+    p.add_argument("--count", type=int, default=300, help="plants (default: %(default)s)")
+    p.add_argument("--seed", type=_non_negative_int, default=0, help="seed (default: 0)")
+    p.add_argument("--spread", type=float, default=1.0, metavar="F",
+                   help="draw plants F times beyond the declared bounds (default: 1, within)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_second_order)

@@ -29,8 +29,15 @@ def cmd_demo(args: argparse.Namespace) -> int:
     for name, spec in specs.items():
         design = design_spec(spec, args)
         generate(design, out / name)
-        result = simulate(design, backend=args.backend)
-        atomic_write(out / f"{name}.png", lambda tmp: plot_run(design, result, tmp, dims=dims[name]))
+        if spec.second_order is not None:   # the cascade law (issue 22)
+            from ..runtime.cascade_plots import plot_cascade_run
+            from ..runtime.cascade_simulate import simulate_cascade
+            result = simulate_cascade(design, backend=args.backend)
+            draw = plot_cascade_run
+        else:
+            result = simulate(design, backend=args.backend)
+            draw = plot_run
+        atomic_write(out / f"{name}.png", lambda tmp: draw(design, result, tmp, dims=dims[name]))
         print(summary_line(result), flush=True)
         all_ok &= result.satisfied
     print(f"generated code in {out}/<case>/, plots in {out}/<case>.png")

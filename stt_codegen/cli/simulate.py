@@ -27,9 +27,17 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from ..runtime.simulate import simulate
     seed = checked_seed(args)
     design, dims = design_to_plot(args)
-    result = simulate(design, backend=args.backend, horizon=args.horizon, seed=seed)
+    if design.spec.second_order is not None:     # the cascade law (issue 22)
+        from ..runtime.cascade_simulate import simulate_cascade
+        result = simulate_cascade(design, backend=args.backend, horizon=args.horizon,
+                                  seed=seed)
+    else:
+        result = simulate(design, backend=args.backend, horizon=args.horizon, seed=seed)
 
     def draw(path):
+        if design.spec.second_order is not None:
+            from ..runtime.cascade_plots import plot_cascade_run
+            return plot_cascade_run(design, result, path, dims=dims)
         from ..runtime.plots import plot_run
         return plot_run(design, result, path, dims=dims)
     write_plot(args, draw)
@@ -41,7 +49,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         print(SUMMARY_HEADER)
         print(summary_line(result))
         print(f"backend {result.backend}, {result.steps} steps at {design.tube.rate_hz:g} Hz, "
-              f"t_c = {result.prescribed_time:g} s, gain k = {design.gain:.4g}, "
+              f"t_c = {result.prescribed_time:g} s, "
+              + (f"gain k = {design.gain:.4g}, " if design.spec.second_order is None else
+                 "cascade law, stayed in velocity tube: "
+                 f"{'yes' if result.stayed_in_velocity_tube else 'NO'}, ") +
               f"stayed in tube: {'yes' if result.stayed_in_tube else 'NO'}, "
               f"collision: {'YES' if result.collision else 'no'}, "
               f"left state space: {'YES' if result.left_state_space else 'no'}")

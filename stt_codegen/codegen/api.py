@@ -21,7 +21,9 @@ def generate(design: Design, out_dir: str | Path,
     for Python, ``P.py`` (imports only :mod:`math`); the test vectors ``P_vectors.json``
     and ``manifest.json`` (``P`` is the spec name with ``-`` replaced by ``_``). The code
     computes law (13), ``u = -k xi(x, t) epsilon(x, t)``, with the tube of eqs. (2)-(10)
-    and the implicit step of the adaptive law (11).
+    and the implicit step of the adaptive law (11). For a spec with ``[second_order]``:
+    the cascade controller instead (:func:`~.cascade_source.cascade_generation`,
+    docs/second-order.md).
 
     Parameters
     ----------
@@ -72,6 +74,10 @@ def generate(design: Design, out_dir: str | Path,
     """
     design = require_design(design, "generate")
     options = parse_options(languages, precision)
-    files = generate_files(design.spec, design.tube, options)
+    if design.spec.second_order is not None:     # the cascade controller (issue 22)
+        from .cascade_source import cascade_generation
+        files = cascade_generation(design, options)
+    else:
+        files = generate_files(design.spec, design.tube, options)
     write_generation(out_dir, files)
     return [Path(out_dir) / name for name in sorted(files)]

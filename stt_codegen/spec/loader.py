@@ -30,6 +30,7 @@ from .assumptions import Assumptions, combine_assumptions
 from .model_bounds import model_bounds
 from .plants import MODEL_KEYS, PLANTS, dimension_mismatch
 from .tasks import Task, build_tasks
+from .second_order import SecondOrder, parse_second_order
 from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
                      PlantTable, PolytopeObstacle, check_document, value_kind)
 
@@ -232,6 +233,9 @@ class Spec:
         ``[actuator] input_bound``: the largest ``|u_i|`` law (13) may ask of each input,
         in input units, one per input of the plant model (``None``: no ``[actuator]``,
         no limit).
+    second_order : SecondOrder or None
+        ``[second_order]``: a second-order plant (docs/second-order.md); ``None`` for a
+        first-order spec.
     source_hash : str
         SHA-256 of the spec file's bytes.
     target_half_width_given : bool
@@ -260,6 +264,7 @@ class Spec:
     linear_plant: LinearPlant | None = None
     assumptions: Assumptions = Assumptions()
     input_bound: tuple[float, ...] | None = None
+    second_order: SecondOrder | None = None
     source_hash: str = field(default="", compare=False)
     target_half_width_given: bool = True
     tasks: tuple[Task, ...] = ()
@@ -511,6 +516,7 @@ def _validate(raw: dict) -> Spec:
                 assumptions=_assumptions(doc.assumptions, n, amplitude, model, state_space,
                                          linear),
                 input_bound=_input_bound(doc.actuator, model, n),
+                second_order=parse_second_order(doc.second_order, n),
                 target_half_width_given=doc.target.half_width is not None,
                 tasks=build_tasks(doc.tasks or (), n, doc.prescribed_time,
                                   (state_space.lower, state_space.upper),

@@ -24,6 +24,7 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Discriminator, Field, 
 
 from ..errors import SpecError
 from .plants import PLANT_MODELS, PLANTS
+from .second_order import MODELS as SECOND_ORDER_MODELS
 
 #: Largest magnitude of any number in a spec.
 MAX_MAGNITUDE = 1e12
@@ -222,6 +223,23 @@ class TaskTable(_Table):
                  "lower/upper); the design picks the first that certifies, in this order")
 
 
+class SecondOrderTable(_Table):
+    """A second-order plant x1_dot = x2, x2_dot = f + g u + w (docs/second-order.md)."""
+
+    model: Literal[tuple(SECOND_ORDER_MODELS)] = Field(  # type: ignore[valid-type]
+        description="; ".join(f"{m.name}: {m.summary}" for m in SECOND_ORDER_MODELS.values()))
+    parameters: Vector = _omitted("the simulated plant's parameters, in the model's order; "
+                                  "default nominal")
+    initial_velocity: Vector = _omitted("x2(0), one per position; default 0")
+    velocity_bound: Annotated[list[Positive], Field(min_length=1, max_length=MAX_DIMENSION)] \
+        = _omitted("bound on |x2_i| the run must keep; default none")
+    input_gain: Annotated[list[Number], Field(min_length=2, max_length=2)] = Field(
+        [1.0, 1.0], description="[g_min, g_max]: declared bounds on the eigenvalues of the "
+                                "symmetric part of g")
+    drift_bound: NonNegative = Field(0.0, description="declared bound on every |f_i|, "
+                                                      "velocity units per second")
+
+
 class SpecDocument(_Table):
     """One prescribed-time reach-avoid-stay task (Definition 2.1) and its design parameters.
 
@@ -249,6 +267,8 @@ class SpecDocument(_Table):
     tasks: Annotated[list[TaskTable], Field(max_length=MAX_TASKS)] = _omitted(
         "timed reach and stay tasks besides the target (docs/tasks.md), in window order; "
         "omitted: none")
+    second_order: SecondOrderTable = _omitted("a second-order plant and its cascade law "
+                                              "(docs/second-order.md); omitted: first order")
 
 
 #: The JSON Schema dialect of :func:`json_schema`: draft 7, which TOML language servers
@@ -265,6 +285,7 @@ _TABLES: dict[str, type[_Table]] = {
     "state_space": BoxTable, "initial": InitialTable, "target": TargetTable,
     "tube": TubeTable, "controller": ControllerTable, "plant": PlantTable,
     "assumptions": AssumptionsTable, "actuator": ActuatorTable,
+    "second_order": SecondOrderTable,
     "box": BoxObstacle, "ball": BallObstacle, "polytope": PolytopeObstacle,
     "tasks": TaskTable, "any_of": TaskBoxTable}
 

@@ -1,0 +1,121 @@
+"""``stt-codegen bench arenas --plant double-integrator``: the cascade on random arenas,
+beside a planner and a tracker for the same plant (issue 22, docs/second-order.md).
+
+The arenas are :func:`~.arenas.generate_arena`'s (seeded, four 1 m obstacles, 5 m x 5 m,
+``t_c = 9`` s). The plant is a double integrator ``x2_dot = u / m + w`` with ``m = 1`` kg
+and the arena's disturbance bound (0.1 per axis, here m/s^2), starting at rest; both
+methods run in the same loop (:func:`~stt_codegen.runtime.cascade_simulate.simulate_second_order`)
+with the same disturbance seed (the arena index), judged by Definition 2.1:
+
+* ``stt``: the tube of the arena's spec with ``circumvent_sharpness = 1`` (a second-order
+  plant cannot follow the 0.1 bumps, docs/second-order.md), the default second stage for
+  ``1/m`` in ``[0.8, 1.25]``, the emitted C of the cascade;
+* ``astar``: the A* path of :func:`~.astar.plan_astar`, followed by the carrot of
+  :class:`~.tracker.PathTracker` as a velocity reference, and a velocity loop
+  ``u = m_nominal VELOCITY_GAIN (v_ref - x2)`` (nominal mass 1 kg).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from ..design.cascade_gain import derived_second_stage
+from ..design.search import design_tube
+from ..errors import DesignError
+from ..runtime.cascade_simulate import simulate_second_order
+from .arenas import generate_arena
+
+#: Velocity-loop gain of the baseline tracker, 1/s.
+VELOCITY_GAIN = 10.0
+#: Declared range of ``1/m`` for the cascade's default gains.
+INPUT_GAIN = (0.8, 1.25)
+#: The circumvent sharpness of the second-order designs.
+SHARPNESS = 1.0
+
+
+class VelocityTracker:
+    """Carrot following as a velocity reference plus a proportional velocity loop (the
+    step of :class:`~stt_codegen.runtime.cascade_controllers.CascadeController`)."""
+
+    name = "astar-tracker"
+
+    def __init__(self, path: np.ndarray) -> None:
+        from .tracker import PathTracker
+        self.carrot = PathTracker(path)
+
+    def step(self, x1, x2, t, dt, alpha):
+        """``u``, ``alpha`` (passed through), the velocity reference and status 0."""
+        v_ref = self.carrot.command(np.asarray(x1, float))
+        return VELOCITY_GAIN * (v_ref - np.asarray(x2, float)), np.asarray(alpha, float), v_ref, 0
+
+
+def _summary(result) -> dict:
+    return {"satisfied": bool(result.satisfied), "reach_time": result.reach_time,
+            "clearance": result.min_obstacle_clearance,
+            "peak_u": max(result.max_abs_u), "collision": bool(result.collision),
+            "in_tube": bool(result.stayed_in_tube and result.stayed_in_velocity_tube)}
+
+
+def run_arena_double_integrator(seed: int, index: int) -> dict:
+    """Both methods on one arena: ``{"index", "stt": {...}, "astar": {...}}`` with
+    ``satisfied``, ``reach_time``, ``clearance``, ``peak_u`` or ``reason``."""
+    from .astar import plan_astar
+    spec = generate_arena(seed, index).to_spec()
+    spec = replace(spec, tube=replace(spec.tube, circumvent_sharpness=SHARPNESS))
+    out: dict = {"index": index}
+    begin = time.perf_counter()
+    try:
+        design = design_tube(spec)
+    except DesignError as exc:
+        design = None
+        out["stt"] = {"satisfied": False, "reason": f"no design: {str(exc)[:120]}",
+                      "seconds": time.perf_counter() - begin}
+    else:
+        stage, _ = derived_second_stage(design.tube, design.check.min_width, INPUT_GAIN,
+                                        spec.disturbance_amplitude, np.zeros(2))
+        result = simulate_second_order(spec, design.tube, stage, params=[1.0], backend="c",
+                                       seed=index)
+        out["stt"] = {**_summary(result), "seconds": design.design_time_s}
+    plan = plan_astar(spec)
+    if plan.path is None:
+        out["astar"] = {"satisfied": False, "reason": f"no path: {plan.reason}",
+                        "seconds": plan.seconds}
+    else:
+        # the loop reports max |e1| in a tube: the arena's design, else the base tube
+        # (unchecked); the tracker never reads it
+        from ..design.search import base_design
+        tube = design.tube if design is not None else base_design(spec)
+        result = simulate_second_order(spec, tube, None, params=[1.0],
+                                       backend="astar-tracker", seed=index,
+                                       controller=VelocityTracker(plan.path))
+        summary = _summary(result)
+        summary.pop("in_tube")
+        out["astar"] = {**summary, "seconds": plan.seconds}
+    return out
+
+
+def run_double_integrator_bench(count: int, seed: int) -> dict:
+    """Every arena in turn (sequential: no timing is compared), the satisfied rates."""
+    arenas = [run_arena_double_integrator(seed, k) for k in range(count)]
+    rates = {m: sum(a[m]["satisfied"] for a in arenas) / count for m in ("stt", "astar")}
+    return {"plant": "double-integrator", "count": count, "seed": seed,
+            "satisfied_rate": rates, "arenas": arenas}
+
+
+def format_double_integrator_report(report: dict) -> str:
+    """The rates and the failures, a few lines."""
+    lines = [f"double integrator, {report['count']} arenas, seed {report['seed']}: satisfied "
+             f"STT cascade {100 * report['satisfied_rate']['stt']:.1f} %, A* + tracker "
+             f"{100 * report['satisfied_rate']['astar']:.1f} %"]
+    for arena in report["arenas"]:
+        for method in ("stt", "astar"):
+            r = arena[method]
+            if not r["satisfied"]:
+                why = r.get("reason") or ("collision" if r["collision"] else
+                                          "target not reached" if r["reach_time"] is None
+                                          else "other")
+                lines.append(f"  arena {arena['index']} {method}: {why}")
+    return "\n".join(lines)

@@ -1,0 +1,145 @@
+"""``stt-codegen bench second-order``: the cascade on random second-order plants within the
+declared bounds of a bundled second-order case (issue 22, docs/second-order.md).
+
+For a design whose spec has ``[second_order]``, the default second stage is derived once
+from the spec's declared bounds (as ``simulate`` does); then ``count`` plants are drawn
+within those bounds and each runs the closed loop with the emitted C of the cascade
+(:func:`stt_codegen.runtime.cascade_simulate.simulate_second_order`, backend ``c``):
+
+* double integrator: mass ``m`` uniform with ``1/m`` in ``second_order.input_gain``;
+* quadrotor: the same mass range, drag uniform in ``[0, DRAG_MAX]`` (the value the bundled
+  case's ``drift_bound`` assumes), gravity 9.81;
+* every plant: disturbance amplitude uniform in ``[0, plant.disturbance_amplitude]``, its
+  own disturbance seed.
+
+The report gives the share satisfied (Definition 2.1 and the velocity bound), the share
+that stayed in both tubes, and every failure with its plant and what went wrong.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ..design.cascade_gain import second_stage_of
+from ..design.search import design_tube
+from ..errors import SpecError
+from ..runtime.cascade_simulate import simulate_second_order
+from ..spec.loader import load_spec
+
+#: Largest drag of the random quadrotors, N s / m.
+DRAG_MAX = 0.4
+#: Gravity of the random quadrotors, m/s^2.
+GRAVITY = 9.81
+
+
+def random_parameters(model: str, input_gain: tuple, rng: np.random.Generator,
+                      spread: float = 1.0) -> list[float]:
+    """One plant's parameters within the declared bounds (the module docstring), or, with
+    ``spread > 1``, beyond them: ``1/m`` in ``[g_min / spread, g_max spread]``, drag up to
+    ``spread DRAG_MAX``.
+
+    Raises
+    ------
+    SpecError
+        A model the study does not draw (field ``second_order.model``).
+    """
+    g_min, g_max = input_gain
+    mass = 1.0 / rng.uniform(g_min / spread, g_max * spread)
+    if model == "double-integrator":
+        return [mass]
+    if model == "quadrotor":
+        return [mass, float(rng.uniform(0.0, DRAG_MAX * spread)), GRAVITY]
+    raise SpecError("second_order.model", f"the study draws double-integrator and quadrotor "
+                                          f"plants, not {model!r}")
+
+
+def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed: int = 0,
+                           backend: str = "c", spread: float = 1.0) -> dict:
+    """Run the study (module docstring).
+
+    Parameters
+    ----------
+    case : str
+        A bundled case or spec file with ``[second_order]``.
+    count : int
+        Plants, >= 1.
+    seed : int
+        Seed of the draws.
+    backend : str
+        Controller backend (``c`` by default: the emitted C of the cascade).
+    spread : float
+        1 (default): plants within the declared bounds; > 1: beyond them
+        (:func:`random_parameters`, and disturbance amplitudes up to ``spread`` times the
+        declared one), to find where the cascade fails.
+
+    Returns
+    -------
+    dict
+        ``case``, ``model``, ``count``, ``satisfied`` and ``in_both_tubes`` (counts and
+        shares), ``stage`` (the second stage used), ``failures`` (plant, seed, amplitude,
+        result summary), ``seconds``.
+
+    Raises
+    ------
+    SpecError
+        A spec without ``[second_order]``, a bad count.
+    """
+    if count < 1:
+        raise SpecError("count", f"must be at least 1, got {count}")
+    if not spread >= 1.0:
+        raise SpecError("spread", f"must be at least 1, got {spread}")
+    started = time.perf_counter()
+    design = design_tube(load_spec(case))
+    stage, derivation = second_stage_of(design)
+    spec = design.spec
+    order = spec.second_order
+    rng = np.random.default_rng(seed)
+    satisfied = in_tubes = 0
+    failures = []
+    for k in range(count):
+        params = random_parameters(order.model, order.input_gain, rng, spread)
+        amplitude = float(rng.uniform(0.0, spread * spec.disturbance_amplitude))
+        plant_seed = int(rng.integers(0, 2**32))
+        result = simulate_second_order(spec, design.tube, stage, model=order.model,
+                                       params=params, initial_velocity=order.initial_velocity,
+                                       disturbance_amplitude=amplitude, backend=backend,
+                                       seed=plant_seed, velocity_bound=order.velocity_bound)
+        satisfied += result.satisfied
+        both = result.stayed_in_tube and result.stayed_in_velocity_tube
+        in_tubes += both
+        if not (result.satisfied and both):
+            summary = result.to_json()
+            failures.append({"index": k, "params": params, "amplitude": amplitude,
+                             "seed": plant_seed,
+                             **{key: summary[key] for key in (
+                                 "satisfied", "reach_time", "min_obstacle_clearance",
+                                 "stayed_in_tube", "stayed_in_velocity_tube", "max_abs_e",
+                                 "max_abs_u", "max_abs_x2", "exceeded_velocity_bound")}})
+    return {"case": spec.name, "model": order.model, "count": count, "seed": seed,
+            "spread": spread,
+            "backend": backend, "satisfied": satisfied, "satisfied_share": satisfied / count,
+            "in_both_tubes": in_tubes, "in_both_tubes_share": in_tubes / count,
+            "stage": {"position_gain": stage.position_gain,
+                      "velocity_gain": stage.velocity_gain,
+                      "width_floor": stage.width_floor[0], "decay": stage.decay,
+                      "input_gain": list(order.input_gain),
+                      "drift_bound": derivation["drift_bound"]},
+            "failures": failures, "seconds": time.perf_counter() - started}
+
+
+def format_second_order_report(report: dict) -> str:
+    """The study as a few lines of text."""
+    lines = [f"{report['case']} ({report['model']}), {report['count']} random plants "
+             f"(spread {report['spread']:g}), seed "
+             f"{report['seed']}, backend {report['backend']}: satisfied "
+             f"{report['satisfied']}/{report['count']} ({100 * report['satisfied_share']:.1f} %),"
+             f" in both tubes {report['in_both_tubes']}/{report['count']} "
+             f"({100 * report['in_both_tubes_share']:.1f} %), {report['seconds']:.0f} s"]
+    for f in report["failures"][:20]:
+        lines.append(f"  plant {f['index']}: params {[round(v, 4) for v in f['params']]}, "
+                     f"|w| <= {f['amplitude']:.3g}: satisfied {f['satisfied']}, position tube "
+                     f"{f['stayed_in_tube']}, velocity tube {f['stayed_in_velocity_tube']}, "
+                     f"max |e1| {f['max_abs_e']:.3g}")
+    return "\n".join(lines)

@@ -1,0 +1,127 @@
+"""Backends of the cascade step for second-order plants (docs/second-order.md).
+
+Every backend computes ``(x1, x2, t, dt, alpha) -> (u, alpha_next, r, status)`` of
+:func:`stt_codegen.tube.cascade.cascade_step`: ``reference`` (the numpy oracle,
+:mod:`stt_codegen.tube.cascade_reference`), ``casadi`` (CasADi's evaluation of the
+Function), ``python`` (the Function printed to Python by the emitter) and ``c`` (printed to
+C by the emitter, :mod:`stt_codegen.codegen.cascade_source`, compiled with the system's C
+compiler and loaded with ``ctypes``).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import subprocess
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ..codegen.emit import python_function
+from ..errors import SpecError
+from ..tube import cascade_reference
+from ..tube.parameters import TubeDesign
+from ..tube.second_stage import (CASCADE_OK, CASCADE_OUTSIDE_POSITION_TUBE,
+                                 CASCADE_OUTSIDE_VELOCITY_TUBE, SecondStage)
+
+#: The backends of the cascade step, in order.
+CASCADE_BACKENDS = ("reference", "casadi", "python", "c")
+
+
+def _status(inside_position: float, inside_velocity: float) -> int:
+    if not inside_position:
+        return CASCADE_OUTSIDE_POSITION_TUBE
+    return CASCADE_OK if inside_velocity else CASCADE_OUTSIDE_VELOCITY_TUBE
+
+
+class CascadeController:
+    """One backend of the cascade step.
+
+    Parameters
+    ----------
+    backend : str
+        One of :data:`CASCADE_BACKENDS`.
+    design : TubeDesign
+    stage : SecondStage
+
+    Raises
+    ------
+    SpecError
+        Unknown backend (field ``backend``).
+    ToolchainError, MissingTool
+        Backend ``c``: no C compiler, or it failed.
+    """
+
+    def __init__(self, backend: str, design: TubeDesign, stage: SecondStage) -> None:
+        if backend not in CASCADE_BACKENDS:
+            raise SpecError("backend", f"unknown backend {backend!r} for a second-order "
+                                       f"plant (known: {', '.join(CASCADE_BACKENDS)})")
+        self.name, self.design, self.stage = backend, design, stage
+        self._n = design.dimension
+        if backend == "reference":
+            self._call = self._reference
+        else:
+            from ..tube.cascade import cascade_step
+            function = cascade_step(design, stage)
+            if backend == "casadi":
+                self._call = lambda *a: [np.array(v, dtype=float).ravel() for v in function(*a)]
+            elif backend == "python":
+                printed = python_function(function)
+                self._call = lambda *a: [np.array(v, dtype=float).ravel()
+                                         for v in printed(*[np.ravel(v).tolist() for v in a])]
+            else:
+                self._call = _compiled(design, stage)
+
+    def _reference(self, x1, x2, t, dt, alpha):
+        out = cascade_reference.cascade_step(self.design, self.stage, x1[None], x2[None],
+                                             t, dt, alpha[None])
+        return [np.ravel(v) for v in out]
+
+    def step(self, x1: np.ndarray, x2: np.ndarray, t: float, dt: float,
+             alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+        """``u`` (n,), ``alpha_next`` (2n,), ``r`` (n,) and the status (``CASCADE_*``)."""
+        u, alpha_next, r, inside_p, inside_v = self._call(
+            np.asarray(x1, dtype=float), np.asarray(x2, dtype=float), float(t), float(dt),
+            np.asarray(alpha, dtype=float))
+        return u, alpha_next, r, _status(float(np.ravel(inside_p)[0]),
+                                         float(np.ravel(inside_v)[0]))
+
+
+def _compiled(design: TubeDesign, stage: SecondStage):
+    """The emitted C of the cascade step (double), compiled and loaded."""
+    from ..codegen.cascade_source import cascade_c_files
+    from .compiled import CFLAGS, compiler
+    from ..codegen.errors import CodegenError
+
+    files = cascade_c_files(design, stage, "stt_cascade", "double")
+    # the folder is removed once the library is loaded (it stays mapped)
+    with tempfile.TemporaryDirectory(prefix="stt-cascade-") as name:
+        folder = Path(name)
+        for file, text in files.items():
+            (folder / file).write_text(text)
+        lib = folder / "libstt_cascade.so"
+        proc = subprocess.run([compiler(), *CFLAGS, "-o", str(lib),
+                               str(folder / "stt_cascade.c"), "-lm"],
+                              capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise CodegenError("the C compiler failed on the cascade step: "
+                               f"{proc.stderr[:2000]}")
+        handle = ctypes.CDLL(str(lib))
+    entry = handle.stt_cascade_step
+    real_p = ctypes.POINTER(ctypes.c_double)
+    entry.argtypes = [ctypes.c_double, ctypes.c_double, real_p, real_p, real_p, real_p,
+                      real_p, real_p]
+    entry.restype = ctypes.c_int
+    n = design.dimension
+
+    def call(x1, x2, t, dt, alpha):
+        bufs = [np.ascontiguousarray(v, dtype=np.float64) for v in (x1, x2, alpha)]
+        u, alpha_next, r = np.zeros(n), np.zeros(2 * n), np.zeros(n)
+        code = entry(t, dt, *(b.ctypes.data_as(real_p) for b in bufs),
+                     *(b.ctypes.data_as(real_p) for b in (u, alpha_next, r)))
+        inside_p = 0.0 if code == CASCADE_OUTSIDE_POSITION_TUBE else 1.0
+        inside_v = 1.0 if code == CASCADE_OK else 0.0
+        return [u, alpha_next, r, np.array([inside_p]), np.array([inside_v])]
+
+    call.library = handle  # keep the library loaded with the closure
+    return call

@@ -1,0 +1,122 @@
+"""The committed cascade controllers under generated/ (issue 22): compiled, run on their
+vectors from the numpy reference, with the project's warning flags; the Python module too."""
+
+from __future__ import annotations
+
+import ctypes
+import json
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+CASES = ["second-order-s1", "second-order-quadrotor"]
+CC = shutil.which("gcc") or shutil.which("clang")
+STRICT = ["-std=c99", "-O2", "-ffp-contract=off", "-Wall", "-Wextra", "-Wpedantic", "-Wshadow",
+          "-Wconversion", "-Wdouble-promotion", "-Wcast-qual", "-Wstrict-prototypes",
+          "-Wmissing-prototypes", "-Werror"]
+#: double C against the reference: the CasADi model meets it at 1e-12 (tests/test_cascade.py)
+DOUBLE_TOLERANCE = 1e-9
+
+
+def _folder(case: str, precision: str) -> Path:
+    return REPO / "generated" / case / precision
+
+
+def _vectors(case: str) -> dict:
+    prefix = case.replace("-", "_") + "_cascade"
+    return json.loads((_folder(case, "double") / f"{prefix}_vectors.json").read_text())
+
+
+def _build(tmp_path: Path, case: str, precision: str):
+    prefix = case.replace("-", "_") + "_cascade"
+    lib = tmp_path / f"lib{prefix}_{precision}.so"
+    proc = subprocess.run([CC, *STRICT, "-fPIC", "-shared",
+                           str(_folder(case, precision) / f"{prefix}.c"), "-o", str(lib), "-lm"],
+                          capture_output=True, text=True)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    step = getattr(ctypes.CDLL(str(lib)), f"{prefix}_step")
+    real = ctypes.c_double if precision == "double" else ctypes.c_float
+    step.argtypes = [real, real] + [ctypes.POINTER(real)] * 6
+    step.restype = ctypes.c_int
+    return step, real, np.float64 if precision == "double" else np.float32
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (install gcc or clang)")
+@pytest.mark.parametrize("precision", ["double", "single"])
+@pytest.mark.parametrize("case", CASES)
+def test_committed_c_meets_its_vectors(tmp_path, case, precision) -> None:
+    step, real, dtype = _build(tmp_path, case, precision)
+    data = _vectors(case)
+    pointer = ctypes.POINTER(real)
+    worst = 0.0
+    assert len(data["vectors"]) >= 32
+    for v in data["vectors"]:
+        x1, x2, alpha = (np.ascontiguousarray(v[k], dtype=dtype) for k in ("x1", "x2", "alpha"))
+        n = x1.size
+        u, alpha_next, r = np.zeros(n, dtype), np.zeros(2 * n, dtype), np.zeros(n, dtype)
+        code = step(v["t"], data["dt"], *(a.ctypes.data_as(pointer)
+                                           for a in (x1, x2, alpha, u, alpha_next, r)))
+        assert code == v["status"] == 0
+        assert np.all(np.isfinite(u)) and np.all(np.isfinite(alpha_next))
+        if precision == "single":
+            # no derived float bound for the cascade yet (docs/second-order.md): the float
+            # step pushes the same way; its error is measured, not asserted
+            assert np.all(np.sign(u) == np.sign(v["u"]))
+            continue
+        for got, name in ((u, "u"), (r, "r"), (alpha_next, "alpha_next")):
+            expected = np.array(v[name])
+            error = np.abs(got - expected) / np.maximum(1.0, np.abs(expected))
+            worst = max(worst, float(error.max()))
+    assert worst <= DOUBLE_TOLERANCE, worst
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_committed_python_meets_its_vectors(case) -> None:
+    prefix = case.replace("-", "_") + "_cascade"
+    namespace: dict = {}
+    source = (_folder(case, "double") / f"{prefix}.py").read_text()
+    exec(compile(source, f"{prefix}.py", "exec"), namespace)
+    assert [line for line in source.splitlines() if line.startswith(("import", "from"))] \
+        == ["import math"]
+    data = _vectors(case)
+    for v in data["vectors"][::4]:
+        u, alpha_next, r, status = namespace["step"](v["t"], data["dt"], v["x1"], v["x2"],
+                                                     v["alpha"])
+        assert status == v["status"]
+        np.testing.assert_allclose(u, v["u"], rtol=DOUBLE_TOLERANCE, atol=DOUBLE_TOLERANCE)
+        np.testing.assert_allclose(alpha_next, v["alpha_next"], rtol=DOUBLE_TOLERANCE,
+                                   atol=DOUBLE_TOLERANCE)
+
+
+CPPCHECK = shutil.which("cppcheck")
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(CPPCHECK is None,
+                    reason="cppcheck missing: install the Debian package cppcheck")
+@pytest.mark.parametrize("precision", ["double", "single"])
+@pytest.mark.parametrize("case", CASES)
+def test_cppcheck_misra_findings_are_the_listed_deviations(tmp_path, case, precision) -> None:
+    """The first-order code's deviation list (tests/test_codegen_misra.py), unchanged, covers
+    the cascade: only the entry point is reported (unusedFunction: the application calls it)."""
+    import re
+
+    from test_codegen_misra import DEVIATIONS
+    prefix = case.replace("-", "_") + "_cascade"
+    for suffix in (".c", ".h"):
+        (tmp_path / f"{prefix}{suffix}").write_bytes(
+            (_folder(case, precision) / f"{prefix}{suffix}").read_bytes())
+    proc = subprocess.run([CPPCHECK, "--enable=all", "--addon=misra", "--std=c99",
+                           "--suppress=missingIncludeSystem", "--quiet",
+                           "--template={file}:{line}:{id}", f"{prefix}.c"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    findings = [line.split(":") for line in proc.stderr.splitlines() if line.count(":") >= 2]
+    assert findings, "cppcheck reported nothing: the unused entry point must show up"
+    for name, line, check in findings:
+        text = (tmp_path / name).read_text().splitlines()[int(line) - 1]
+        assert [d for d in DEVIATIONS if d[0] == check and re.search(d[1], text)], (check, text)
