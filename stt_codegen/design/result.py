@@ -79,6 +79,9 @@ class Design:
         For a spec with ``[actuator]``: the proved peak of each input of law (13) along
         the tube (:mod:`~stt_codegen.design.input_bound`), within ``input_bound``;
         ``None`` otherwise.
+    motion : str
+        For a spec with moving obstacles: how the tube avoids them (``"space-time"``,
+        ``"timed via"`` or ``"swept"``, :mod:`~stt_codegen.design.moving`); else ``""``.
     """
 
     tube: TubeDesign
@@ -88,6 +91,7 @@ class Design:
     spec: Spec = field(compare=False, repr=False, kw_only=True)
     input_proof: InputProof | None = field(default=None, compare=False, repr=False,
                                            kw_only=True)
+    motion: str = field(default="", compare=False, kw_only=True)
 
     @property
     def certificate(self) -> Certificate:
@@ -145,7 +149,20 @@ class Design:
             },
             "design_time_s": self.design_time_s,
             **self._actuator_json(),
+            **self._motion_json(),
         }
+
+    def _motion_json(self) -> dict[str, Any]:
+        """``motion`` and ``moving_obstacles`` (each with its certified margin), for a spec
+        with moving obstacles only: without them the document is as before."""
+        if not self.spec.moving_obstacles:
+            return {}
+        margins = {m.name: m for m in self.certificate.margins}
+        return {"motion": self.motion, "moving_obstacles": [
+            {"obstacle": ob.source, "motion": ob.motion, "active": [
+                ob.active[0], "inf" if math.isinf(ob.active[1]) else ob.active[1]],
+             "margin": margins[f"avoids moving obstacle {ob.source}"].margin}
+            for ob in self.spec.moving_obstacles]}
 
     def _actuator_json(self) -> dict[str, Any]:
         """``input_bound`` and the proved ``input_peak`` (with where each peak is), for a
