@@ -16,6 +16,8 @@ from stt_codegen.design.search import design_tube  # noqa: E402
 from stt_codegen.spec.loader import load_spec  # noqa: E402
 
 CASES = ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3"]
+#: Bundled cases beyond the paper's (tested in their own files, not by the ``case`` fixture).
+EXTRA_CASES = ["crossing-moving"]
 
 # Property tests draw the same examples on every run: a fixed seed (derandomize) and no
 # example database. "ci" is the default and the only profile under CI (CI=true);

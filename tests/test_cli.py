@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import CASES, arena_toml
+from conftest import CASES, EXTRA_CASES, arena_toml
 
 from stt_codegen.spec.loader import bundled_cases
 
@@ -25,12 +25,14 @@ def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
 def test_cases_lists_bundled_specs():
     out = run("cases")
     assert out.returncode == 0
-    assert out.stdout.split() == ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3"]
+    assert out.stdout.split() == ["crossing-moving", "omnirobot-s1", "omnirobot-s2",
+                                  "omnirobot-s3"]
 
 
 def test_bundled_cases_are_the_paper_cases():
-    """The conftest's CASES (the parameters of the ``case`` fixture) are the bundled specs."""
-    assert bundled_cases() == CASES
+    """The conftest's CASES (the parameters of the ``case`` fixture) and EXTRA_CASES are the
+    bundled specs."""
+    assert bundled_cases() == sorted(CASES + EXTRA_CASES)
 
 
 def test_simulate_json_reports_definition_2_1():
