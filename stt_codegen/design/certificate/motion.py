@@ -12,7 +12,8 @@ separated along some dimension of the obstacle, the property holds on the whole 
 The margin is that separation. Where it is not positive, the interval is cut (as
 :mod:`.refine` does, in sample indices) and ``alpha``'s bounds are followed again on the
 cuts only (:func:`~.repropagate.repropagate`); the loop stops when every moving obstacle is
-proven, at single-sample intervals, or at :data:`MOTION_INTERVALS`.
+proven, at single-sample intervals, at :data:`MOTION_INTERVALS`, or as soon as the tube
+certainly meets an obstacle at an instant (:func:`_surely_meets`).
 
 Argument and limits: docs/moving-obstacles.md.
 """
@@ -76,6 +77,28 @@ def _enclosure(design: TubeDesign, points: list[int], state: CertificateState
     return enc, state
 
 
+def _surely_meets(design: TubeDesign, spec: Spec, enc: Enclosure, state: CertificateState,
+                  bad: np.ndarray) -> bool:
+    """Whether the tube certainly meets a moving obstacle at the start of a ``bad`` interval.
+
+    With ``alpha >= alpha_lo`` there, the tube box contains the box for ``alpha_lo``
+    (``gamma_L`` falls and ``gamma_U`` rises with ``alpha``); if that box meets the
+    obstacle's box at that instant, no refinement can prove the property.
+    """
+    k = np.flatnonzero(bad & np.isfinite(enc.t_start))
+    t = enc.t_start[k]
+    a_min = np.maximum(np.array(state.alpha_lo)[k], 0.0)
+    g_l, g_u, _, _ = reference.adaptive_tube(design, t, a_min)
+    for ob in spec.moving_obstacles:
+        d = list(ob.dims)
+        centre, half = ob.centre(t), np.array(ob.half_size)
+        meets = ob.is_active(t) & np.all((g_l[:, d] < centre + half)
+                                         & (g_u[:, d] > centre - half), axis=1)
+        if meets.any():
+            return True
+    return False
+
+
 def certify_motion(design: TubeDesign, spec: Spec, certificate: Certificate,
                    max_intervals: int = MOTION_INTERVALS) -> Certificate:
     """``certificate`` with one property per moving obstacle of ``spec``, proven for every ``t``.
@@ -110,7 +133,7 @@ def certify_motion(design: TubeDesign, spec: Spec, certificate: Certificate,
             bad = np.zeros(enc.t_start.size, dtype=bool)
             for _, sep, _ in seps:
                 bad |= sep <= ROUNDING_MARGIN
-            if not bad.any():
+            if not bad.any() or _surely_meets(design, spec, enc, state, bad):
                 break
             i0 = np.array(points)
             length = np.append(i0[1:] - i0[:-1], 0)
