@@ -52,3 +52,16 @@ def test_bad_count_is_a_spec_error():
     with pytest.raises(stt.SpecError) as err:
         random_moving_obstacles(np.random.default_rng(0), spec, count=5)
     assert err.value.field == "count"
+
+
+@pytest.mark.slow
+def test_the_study_reports_both_designs():
+    from stt_codegen.bench.moving_study import study_moving
+    result = study_moving(3, 0)
+    assert result["arenas"] == 3 and result["moving_obstacles"] >= 1
+    for name in ("stt", "swept_only"):
+        r = result[name]
+        assert sum(r["how"].values()) == 3
+        assert r["satisfied"] <= r["designed"] <= 3
+    # STT avoids in space-time what the swept baseline must go around (or cannot)
+    assert result["stt"]["designed"] >= result["swept_only"]["designed"]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 import math
+import shutil
 import subprocess
 
 import numpy as np
@@ -307,3 +308,20 @@ def test_moving_obstacles_in_three_dimensions():
     assert design.motion == MOTION_TIMED_VIA and design.certificate.passed
     result = stt.simulate(design, backend="python")
     assert result.satisfied and result.min_obstacle_clearance > 0, result.to_json()
+
+
+@pytest.mark.embedded
+@pytest.mark.skipif(shutil.which("arm-none-eabi-gcc") is None
+                    or shutil.which("qemu-system-arm") is None,
+                    reason="needs the Debian packages gcc-arm-none-eabi, libnewlib-arm-none-eabi "
+                           "and qemu-system-arm")
+def test_the_crossing_on_the_cortex_m4f(tmp_path):
+    """The single-precision controller of the crossing on QEMU mps2-an386: every vector
+    passes, the closed loop on the target follows the host run, which meets no moving
+    obstacle."""
+    from stt_codegen.embedded.deploy import run_embedded
+    design = stt.design_tube(stt.load_spec("crossing-moving"))
+    report = run_embedded(design, tmp_path / "build")
+    assert report["ok"] and report["vectors_failed"] == 0 and report["vectors_passed"] > 500
+    assert report["closed_loop_satisfied"] and report["host_satisfied"]
+    assert report["max_state_deviation"] < 1e-3
