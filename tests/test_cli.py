@@ -108,13 +108,13 @@ def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
     out = run("demo", "--out", str(tmp_path / "demo"))
     assert out.returncode == 0, out.stderr
     assert "run the c controller" in out.stdout
-    for name in ("omnirobot-s1", "omnirobot-s2", "omnirobot-s3"):
+    for name in CASES + EXTRA_CASES:
         assert name in out.stdout
         assert (tmp_path / "demo" / f"{name}.png").stat().st_size > 10_000
         c_name = name.replace("-", "_")
         for suffix in (".c", ".h", ".py", "_selftest.c"):
             assert (tmp_path / "demo" / name / f"{c_name}{suffix}").is_file()
-    assert out.stdout.count(" yes ") == 3
+    assert out.stdout.count(" yes ") == len(CASES + EXTRA_CASES)
     again = run("demo", "--out", str(tmp_path / "demo"))     # its own files: overwritten
     assert again.returncode == 0, again.stderr
 

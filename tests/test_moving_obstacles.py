@@ -194,6 +194,7 @@ def test_the_crossing_is_designed_by_re_timing_and_certified():
     # neither the static design nor the swept regions give a tube here
     static = stt.design_tube(static_part(spec))
     assert not check_tube(static.tube, spec).passed
+    assert not check_tube(stt.design_tube(static_part(spec)).tube, spec).passed
     swept, _ = swept_spec(spec)
     with pytest.raises(stt.DesignError):
         stt.design_tube(swept)
@@ -325,3 +326,33 @@ def test_the_crossing_on_the_cortex_m4f(tmp_path):
     assert report["ok"] and report["vectors_failed"] == 0 and report["vectors_passed"] > 500
     assert report["closed_loop_satisfied"] and report["host_satisfied"]
     assert report["max_state_deviation"] < 1e-3
+
+
+def test_routes_go_around_fewer_obstacles_first():
+    from stt_codegen.design.moving import routes
+    assert routes(0) == []
+    assert routes(3) == [(), (0,), (1,), (2,), (0, 1), (0, 2), (1, 2)]
+    assert len(routes(6)) == 16
+
+
+@pytest.mark.slow
+def test_going_around_one_moving_obstacle_and_timing_the_others():
+    """Random arena 43 of seed 0 with its random moving obstacles (the moving-obstacle
+    study): neither the static tube nor the swept regions give a tube; going around the
+    swept region of some and timing the others does."""
+    import tomllib
+
+    from stt_codegen.bench.arenas import generate_arena
+    from stt_codegen.bench.moving import random_moving_obstacles
+    arena = generate_arena(0, 43)
+    doc = tomllib.loads(arena.to_toml())
+    doc["obstacles"] += random_moving_obstacles(np.random.default_rng([0, 43]), arena.to_spec())
+    spec = stt.Spec.from_dict(doc)
+    assert not check_tube(stt.design_tube(static_part(spec)).tube, spec).passed
+    swept, _ = swept_spec(spec)
+    with pytest.raises(stt.DesignError):
+        stt.design_tube(swept)
+    design = stt.design_tube(spec)
+    assert design.motion == MOTION_TIMED_VIA and design.certificate.passed
+    result = stt.simulate(design, backend="python")
+    assert result.satisfied and result.min_obstacle_clearance > 0

@@ -7,8 +7,9 @@ space-time disjointness from every moving obstacle, :mod:`.certificate.motion`) 
 
 1. **space-time** (``"space-time"``): the design for the static obstacles alone (the spec's
    own ``tube.method``), checked against the moving obstacles as they really are;
-2. **re-timed via plan** (``"timed via"``): the via boxes of the static via-point design,
-   re-timed on a grid of :data:`TIME_STEPS` steps over ``[0, t_c]``: a breadth-first search
+2. **re-timed via plan** (``"timed via"``): the via boxes of the static via-point design
+   (first for the static obstacles alone, then going around the swept regions of one, two,
+   ... of the moving obstacles, :func:`routes`), re-timed against the others on a grid of :data:`TIME_STEPS` steps over ``[0, t_c]``: a breadth-first search
    over (via box, time step) that may wait at a via box or take a segment at one of
    :data:`DURATION_FACTORS` times its planned duration, each move kept clear (by
    :data:`~.via.VIA_MARGIN`) of the hull of every moving obstacle over the move's time,
@@ -25,7 +26,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
+from itertools import combinations
 from dataclasses import replace
 
 import numpy as np
@@ -49,6 +51,8 @@ TIME_STEPS = 60
 DURATION_FACTORS = (1.0, 0.75, 1.5, 0.5, 2.0)
 #: Sub-intervals on which a move is checked against the obstacles' hulls.
 MOVE_CHECKS = 8
+#: Most sets of moving obstacles to go around that the re-timing step tries (:func:`routes`).
+MAX_ROUTES = 16
 
 
 def static_part(spec: Spec) -> Spec:
@@ -56,19 +60,27 @@ def static_part(spec: Spec) -> Spec:
     return replace(spec, moving_obstacles=())
 
 
-def swept_spec(spec: Spec) -> tuple[Spec | None, str]:
-    """``spec`` with each moving obstacle as the static box it sweeps while active.
+def swept_spec(spec: Spec, which: Sequence[int] | None = None) -> tuple[Spec | None, str]:
+    """``spec`` with moving obstacles as the static boxes they sweep while active.
+
+    Parameters
+    ----------
+    spec : Spec
+    which : sequence of int, optional
+        Positions in ``spec.moving_obstacles`` to sweep; default all. The others stay
+        moving.
 
     Returns
     -------
     (Spec or None, str)
-        The spec (moving obstacles removed, their swept boxes, clipped to the state space,
-        added as obstacles with the same index), or ``None`` and why not (a swept box meets
-        the initial set or the target set, or lies outside the state space).
+        The spec (those moving obstacles removed, their swept boxes, clipped to the state
+        space, added as obstacles with the same index), or ``None`` and why not (a swept
+        box meets the initial set or the target set).
     """
     extra = []
     space = spec.state_space
-    for ob in spec.moving_obstacles:
+    chosen = range(len(spec.moving_obstacles)) if which is None else which
+    for ob in (spec.moving_obstacles[i] for i in chosen):
         lo, hi, _ = ob.hull([ob.active[0]], [ob.active[1]])
         lower = tuple(max(float(a), space.lower[d]) for a, d in zip(lo[0], ob.dims))
         upper = tuple(min(float(b), space.upper[d]) for b, d in zip(hi[0], ob.dims))
@@ -81,7 +93,16 @@ def swept_spec(spec: Spec) -> tuple[Spec | None, str]:
                 return None, (f"the region moving obstacle {ob.source} sweeps while active "
                               f"meets the {label} set")
         extra.append(swept)
-    return replace(spec, obstacles=spec.obstacles + tuple(extra), moving_obstacles=()), ""
+    keep = tuple(ob for i, ob in enumerate(spec.moving_obstacles) if i not in chosen)
+    return replace(spec, obstacles=spec.obstacles + tuple(extra), moving_obstacles=keep), ""
+
+
+def routes(count: int) -> list[tuple[int, ...]]:
+    """The sets of moving obstacles to go around (swept) while timing the others, in the
+    order tried: none first, then by size, then by index; the set of all is not among
+    them (that is the swept step); at most :data:`MAX_ROUTES`."""
+    out = [c for size in range(count) for c in combinations(range(count), size)]
+    return out[:MAX_ROUTES]
 
 
 def _clear(lower: np.ndarray, upper: np.ndarray, spec: Spec, t_a: float, t_b: float) -> bool:
@@ -220,23 +241,31 @@ def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
                f"{found.reason}"]
     kind = found.kind
     if spec.input_bound is None:
-        via = (first if first.method == METHOD_VIA else
-               _try(lambda: design_static(replace(static, tube=replace(static.tube,
-                                                                       method="via")))))
-        if via is None:
-            reasons.append("no via-point design to re-time")
-        else:
-            segments = retime(via.tube.segments, spec)
+        tried: list[str] = []
+        for which in routes(len(spec.moving_obstacles)):
+            partial, _ = swept_spec(spec, which)
+            if partial is None:
+                continue
+            around = static_part(partial)
+            via = (first if not which and first.method == METHOD_VIA else
+                   _try(lambda: design_static(replace(around, tube=replace(around.tube,
+                                                                           method="via")))))
+            if via is None:
+                continue
+            segments = retime(via.tube.segments, partial)
             if segments is None:
-                reasons.append(f"no re-timing of the via boxes on {TIME_STEPS} time steps "
-                               "keeps clear of the moving obstacles")
-            else:
-                tube = replace(via.tube, segments=segments)
-                timed = check(tube, spec)
-                if timed.passed:
-                    return _design(_accept(tube, timed, spec), METHOD_VIA, timed, spec,
-                                   started, MOTION_TIMED_VIA, via)
-                reasons.append(f"the re-timed via tube fails: {timed.reason}")
+                continue
+            tube = replace(via.tube, segments=segments)
+            timed = check(tube, spec)
+            if timed.passed:
+                return _design(_accept(tube, timed, spec), METHOD_VIA, timed, spec,
+                               started, MOTION_TIMED_VIA, via)
+            tried.append(f"the re-timed via tube around {list(which) or 'none'} fails: "
+                         f"{timed.reason}")
+        reasons.append("; ".join(tried) if tried else
+                       f"no re-timing of the via boxes on {TIME_STEPS} time steps keeps "
+                       "clear of the moving obstacles (going around none, one or more of "
+                       "them)")
     swept, why = swept_spec(spec)
     if swept is None:
         reasons.append(f"no swept design: {why}")
@@ -270,5 +299,5 @@ def _design(tube: TubeDesign, method: str, check: TubeCheck, spec: Spec, started
 
 
 __all__ = ["DURATION_FACTORS", "MOTION_SPACE_TIME", "MOTION_SWEPT", "MOTION_TIMED_VIA",
-           "MOVE_CHECKS", "TIME_STEPS", "design_moving", "retime", "static_part",
+           "MAX_ROUTES", "MOVE_CHECKS", "TIME_STEPS", "design_moving", "routes", "retime", "static_part",
            "swept_spec"]
