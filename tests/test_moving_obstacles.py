@@ -7,12 +7,14 @@ import copy
 import math
 import shutil
 import subprocess
+import tomllib
 
 import numpy as np
 import pytest
 from codegen_helpers import COMPILERS, flags, write
 
 import stt_codegen as stt
+from stt_codegen.cases import bundled_spec_bytes
 from stt_codegen.codegen.generate import generate_files
 from stt_codegen.codegen.options import Options
 from stt_codegen.design.failures import FailureKind
@@ -340,8 +342,6 @@ def test_going_around_one_moving_obstacle_and_timing_the_others():
     """Random arena 43 of seed 0 with its random moving obstacles (the moving-obstacle
     study): neither the static tube nor the swept regions give a tube; going around the
     swept region of some and timing the others does."""
-    import tomllib
-
     from stt_codegen.bench.arenas import generate_arena
     from stt_codegen.bench.moving import random_moving_obstacles
     arena = generate_arena(0, 43)
@@ -356,3 +356,13 @@ def test_going_around_one_moving_obstacle_and_timing_the_others():
     assert design.motion == MOTION_TIMED_VIA and design.certificate.passed
     result = stt.simulate(design, backend="python")
     assert result.satisfied and result.min_obstacle_clearance > 0
+
+
+def test_the_paper_method_is_kept_with_moving_obstacles():
+    """``tube.method = "paper"``: no re-timed via tube; the crossing then has no design (its
+    swept regions wall the target off), and the message says so."""
+    doc = tomllib.loads(bundled_spec_bytes("crossing-moving").decode())
+    doc["tube"] = {"method": "paper"}
+    with pytest.raises(stt.DesignError, match="no swept design|swept regions") as err:
+        stt.design_tube(stt.Spec.from_dict(doc))
+    assert "re-timed" not in str(err.value) and "re-timing" not in str(err.value)

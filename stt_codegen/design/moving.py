@@ -18,7 +18,8 @@ space-time disjointness from every moving obstacle, :mod:`.certificate.motion`) 
    holding every position it takes while active (clipped to the state space), and the
    static design run on that; refused when such a box meets the start or the target.
 
-Specs with ``[actuator]`` skip step 2 (its input proof is the static design's). The
+Specs with ``[actuator]`` skip step 2 (its input proof is the static design's), and so do
+specs with ``tube.method = "paper"`` (step 2's tube is a via-point tube). The
 argument and the limits: docs/moving-obstacles.md.
 """
 
@@ -38,7 +39,7 @@ from ..tube import reference
 from ..tube.parameters import ReachSegment, TubeDesign
 from .failures import FailureKind
 from .gain import derived_gain
-from .result import METHOD_VIA, Design, TubeCheck
+from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
 from .via import VIA_MARGIN
 
 #: How the tube of a spec with moving obstacles was found (``Design.motion``).
@@ -240,7 +241,7 @@ def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
     reasons = [f"the {first.method} design for the static obstacles fails in space-time: "
                f"{found.reason}"]
     kind = found.kind
-    if spec.input_bound is None:
+    if spec.input_bound is None and spec.tube.method != METHOD_PAPER:
         tried: list[str] = []
         for which in routes(len(spec.moving_obstacles)):
             partial, _ = swept_spec(spec, which)
