@@ -116,7 +116,9 @@ class Design:
             method), ``segments``, ``gain``, ``certificate`` (each property with its
             margin and where it is smallest) and ``design_time_s``; for a spec with
             ``[actuator]`` also ``input_bound`` and ``input_peak`` (the proved peak of
-            each input, when it occurs, the horizon covered, the relative margin).
+            each input, when it occurs, the horizon covered, the relative margin); for a
+            spec with moving obstacles also ``motion`` and ``moving_obstacles`` (index,
+            motion, active interval, certified margin; docs/moving-obstacles.md).
         """
         tube = self.tube
         via = []
