@@ -106,18 +106,17 @@ def routes(count: int) -> list[tuple[int, ...]]:
     return out[:MAX_ROUTES]
 
 
-def _clear(lower: np.ndarray, upper: np.ndarray, spec: Spec, t_a: float, t_b: float) -> bool:
-    """The box ``[lower, upper]`` keeps :data:`VIA_MARGIN` from every moving obstacle's hull
-    over ``[t_a, t_b]``."""
+def _clear(lower: np.ndarray, upper: np.ndarray, spec: Spec, t_a: np.ndarray,
+           t_b: np.ndarray) -> np.ndarray:
+    """Boolean (K,): box ``[lower[k], upper[k]]`` (shape (K, n)) keeps :data:`VIA_MARGIN`
+    from every moving obstacle's hull over ``[t_a[k], t_b[k]]``."""
+    ok = np.ones(len(t_a), dtype=bool)
     for ob in spec.moving_obstacles:
-        lo, hi, present = ob.hull([t_a], [t_b])
-        if not present[0]:
-            continue
+        lo, hi, present = ob.hull(t_a, t_b)
         d = list(ob.dims)
-        gap = np.maximum(lo[0] - upper[d], lower[d] - hi[0]).max()
-        if gap <= VIA_MARGIN:
-            return False
-    return True
+        gap = np.maximum(lo - upper[:, d], lower[:, d] - hi).max(axis=1)
+        ok &= ~present | (gap > VIA_MARGIN)
+    return ok
 
 
 def _move_clear(seg: ReachSegment, spec: Spec) -> bool:
@@ -128,13 +127,10 @@ def _move_clear(seg: ReachSegment, spec: Spec) -> bool:
         p, _ = reference.segment_progress(seg, cuts)
     a_lo, a_hi = np.array(seg.lower_from), np.array(seg.upper_from)
     b_lo, b_hi = np.array(seg.lower_to), np.array(seg.upper_to)
-    for k in range(MOVE_CHECKS):
-        p0, p1 = float(p[k]), float(p[k + 1])
-        lo = np.minimum(a_lo + (b_lo - a_lo) * p0, a_lo + (b_lo - a_lo) * p1)
-        hi = np.maximum(a_hi + (b_hi - a_hi) * p0, a_hi + (b_hi - a_hi) * p1)
-        if not _clear(lo, hi, spec, float(cuts[k]), float(cuts[k + 1])):
-            return False
-    return True
+    p0, p1 = p[:-1, None], p[1:, None]
+    lo = np.minimum(a_lo + (b_lo - a_lo) * p0, a_lo + (b_lo - a_lo) * p1)
+    hi = np.maximum(a_hi + (b_hi - a_hi) * p0, a_hi + (b_hi - a_hi) * p1)
+    return bool(_clear(lo, hi, spec, cuts[:-1], cuts[1:]).all())
 
 
 def retime(segments: tuple[ReachSegment, ...], spec: Spec) -> tuple[ReachSegment, ...] | None:
@@ -152,6 +148,10 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec) -> tuple[ReachSegment
     m = len(segments)
     boxes = [(np.array(s.lower_from), np.array(s.upper_from)) for s in segments]
     boxes.append((np.array(segments[-1].lower_to), np.array(segments[-1].upper_to)))
+    steps = np.arange(TIME_STEPS + 1)
+    # waits: box k over [i tau, (i + 1) tau], for every i at once
+    waits = [_clear(np.tile(lo, (TIME_STEPS + 1, 1)), np.tile(hi, (TIME_STEPS + 1, 1)), spec,
+                    steps * tau, (steps + 1) * tau) for lo, hi in boxes]
     # parent[(k, i)] = (previous state, segment taken or None for a wait)
     parent: dict[tuple[int, int], tuple[tuple[int, int] | None, ReachSegment | None]] = {
         (0, 0): (None, None)}
@@ -163,10 +163,8 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec) -> tuple[ReachSegment
             if k == m:
                 goal = (k, i)
                 break
-            lo, hi = boxes[k]
             nxt = (k, i + 1)
-            if (i < TIME_STEPS and nxt not in parent
-                    and _clear(lo, hi, spec, i * tau, (i + 1) * tau)):
+            if i < TIME_STEPS and nxt not in parent and waits[k][i]:
                 parent[nxt] = ((k, i), None)
                 frontier.append(nxt)
             planned = segments[k].end - segments[k].start
@@ -187,7 +185,7 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec) -> tuple[ReachSegment
         return None
     # the tube waits in the target box from the arrival to t_c: that wait must be clear too
     lo, hi = boxes[m]
-    if not _clear(lo, hi, spec, goal[1] * tau, t_c):
+    if not _clear(lo[None, :], hi[None, :], spec, np.array([goal[1] * tau]), np.array([t_c]))[0]:
         return None
     out = []
     state: tuple[int, int] | None = goal
