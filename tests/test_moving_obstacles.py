@@ -158,7 +158,7 @@ def test_a_tube_meeting_a_moving_box_between_two_samples_is_rejected(straight, k
         ob = {"lower": list(c - 0.01), "upper": list(c + 0.01),
               "active": [(k + 0.2) * dt, (k + 0.8) * dt]}
     else:   # 10 km/s along y: from 5 m below the centre at k dt to 5 m above at (k + 1) dt
-        ob = {"lower": [c[0] - 0.01, c[1] - 5.0 - 0.01], "upper": [c[0] + 0.01, c[1] - 5.0 + 0.01],
+        ob = {"lower": [c[0] - 0.01, c[1] - 5.01], "upper": [c[0] + 0.01, c[1] - 4.99],
               "velocity": [0.0, 10.0 / dt], "active": [k * dt, (k + 1) * dt]}
     spec = stt.Spec.from_dict(with_obstacles(ob))
     # at no sampling instant is the box present within 1 m of the tube's centre
@@ -196,7 +196,6 @@ def test_the_crossing_is_designed_by_re_timing_and_certified():
     # neither the static design nor the swept regions give a tube here
     static = stt.design_tube(static_part(spec))
     assert not check_tube(static.tube, spec).passed
-    assert not check_tube(stt.design_tube(static_part(spec)).tube, spec).passed
     swept, _ = swept_spec(spec)
     with pytest.raises(stt.DesignError):
         stt.design_tube(swept)

@@ -9,8 +9,9 @@ space-time disjointness from every moving obstacle, :mod:`.certificate.motion`) 
    own ``tube.method``), checked against the moving obstacles as they really are;
 2. **re-timed via plan** (``"timed via"``): the via boxes of the static via-point design
    (first for the static obstacles alone, then going around the swept regions of one, two,
-   ... of the moving obstacles, :func:`routes`), re-timed against the others on a grid of :data:`TIME_STEPS` steps over ``[0, t_c]``: a breadth-first search
-   over (via box, time step) that may wait at a via box or take a segment at one of
+   ... of the moving obstacles, :func:`routes`), re-timed against the others on a grid
+   of :data:`TIME_STEPS` steps over ``[0, t_c]``: a breadth-first search over (via box,
+   time step) that may wait at a via box or take a segment at one of
    :data:`DURATION_FACTORS` times its planned duration, each move kept clear (by
    :data:`~.via.VIA_MARGIN`) of the hull of every moving obstacle over the move's time,
    earliest arrival first (deterministic: fixed orders, no randomness);
@@ -297,6 +298,6 @@ def _design(tube: TubeDesign, method: str, check: TubeCheck, spec: Spec, started
                   input_proof=source.input_proof, motion=motion)
 
 
-__all__ = ["DURATION_FACTORS", "MOTION_SPACE_TIME", "MOTION_SWEPT", "MOTION_TIMED_VIA",
-           "MAX_ROUTES", "MOVE_CHECKS", "TIME_STEPS", "design_moving", "routes", "retime", "static_part",
-           "swept_spec"]
+__all__ = ["DURATION_FACTORS", "MAX_ROUTES", "MOTION_SPACE_TIME", "MOTION_SWEPT",
+           "MOTION_TIMED_VIA", "MOVE_CHECKS", "TIME_STEPS", "design_moving", "retime", "routes",
+           "static_part", "swept_spec"]
