@@ -18,6 +18,8 @@ from stt_codegen.spec.loader import load_spec  # noqa: E402
 CASES = ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3"]
 #: The bundled examples of timed tasks (issue 21, docs/tasks.md), besides the paper's.
 TASK_CASES = ["tasks-stay", "tasks-visit"]
+#: The bundled example of moving obstacles (issue 21, docs/moving-obstacles.md).
+EXTRA_CASES = ["crossing-moving"]
 
 # Property tests draw the same examples on every run: a fixed seed (derandomize) and no
 # example database. "ci" is the default and the only profile under CI (CI=true);

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import CASES, TASK_CASES, arena_toml
+from conftest import CASES, EXTRA_CASES, TASK_CASES, arena_toml
 
 from stt_codegen.spec.loader import bundled_cases
 
@@ -25,16 +25,17 @@ def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
 def test_cases_lists_bundled_specs():
     out = run("cases")
     assert out.returncode == 0
-    assert out.stdout.split() == ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3",
-                                  "second-order-quadrotor", "second-order-s1",
+    assert out.stdout.split() == ["crossing-moving", "omnirobot-s1", "omnirobot-s2",
+                                  "omnirobot-s3", "second-order-quadrotor", "second-order-s1",
                                   "tasks-stay", "tasks-visit"]
 
 
 def test_bundled_cases_are_the_paper_cases_and_the_examples():
     """The conftest's CASES (the parameters of the ``case`` fixture) are the paper's bundled
-    specs; the others are the timed-task examples (TASK_CASES) and the second-order cases
-    (issue 22, with tests of their own)."""
-    assert [c for c in bundled_cases() if not c.startswith("second-order-")] == CASES + TASK_CASES
+    specs; the others are the timed-task examples (TASK_CASES), the moving-obstacle example
+    (EXTRA_CASES) and the second-order cases (issue 22, with tests of their own)."""
+    first_order = [c for c in bundled_cases() if not c.startswith("second-order-")]
+    assert first_order == sorted(CASES + TASK_CASES + EXTRA_CASES)
 
 
 def test_simulate_json_reports_definition_2_1():
@@ -110,7 +111,7 @@ def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
     out = run("demo", "--out", str(tmp_path / "demo"))
     assert out.returncode == 0, out.stderr
     assert "run the c controller" in out.stdout
-    for name in CASES + TASK_CASES:
+    for name in CASES + TASK_CASES + EXTRA_CASES:
         assert name in out.stdout
         assert (tmp_path / "demo" / f"{name}.png").stat().st_size > 10_000
         c_name = name.replace("-", "_")
@@ -122,7 +123,7 @@ def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
         c_name = name.replace("-", "_") + "_cascade"
         for suffix in (".c", ".h", ".py", "_vectors.json"):
             assert (tmp_path / "demo" / name / f"{c_name}{suffix}").is_file()
-    assert out.stdout.count(" yes ") == len(CASES + TASK_CASES) + 2
+    assert out.stdout.count(" yes ") == len(CASES + TASK_CASES + EXTRA_CASES) + 2
     again = run("demo", "--out", str(tmp_path / "demo"))     # its own files: overwritten
     assert again.returncode == 0, again.stderr
 

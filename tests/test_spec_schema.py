@@ -85,6 +85,10 @@ def test_an_unknown_key_is_rejected_by_both(validator, where):
      "must be positive"),
     (("actuator",), {"input_bound": "x"}, "actuator.input_bound", "must be an array"),
     (("actuator",), {}, "actuator.input_bound", "missing"),
+    (("obstacles", 0, "active"), [1.0, 2.0, 3.0], "obstacles[0].active", "[t_on, t_off]"),
+    (("obstacles", 0, "active"), [-1.0, 2.0], "obstacles[0].active[0]", "non-negative"),
+    (("obstacles", 0, "velocity"), "x", "obstacles[0].velocity", "must be an array"),
+    (("obstacles", 0, "path"), [1.0], "obstacles[0].path", "must be an array of rows"),
 ])
 def test_schema_and_validator_agree_on_bad_values(validator, path, value, field, reason):
     doc = _valid_doc()

@@ -24,6 +24,8 @@ def cmd_design(args: argparse.Namespace) -> int:
     print(f"{spec.name}: designed with the {design.method} method in "
           f"{design.design_time_s * 1e3:.1f} ms, gain k = {tube.gain:.4g}, "
           f"{len(tube.segments)} reach segment(s), {len(tube.circumvents)} circumvent(s)")
+    if design.motion:                            # moving obstacles: how they are avoided
+        print(f"  moving obstacles avoided: {design.motion} (docs/moving-obstacles.md)")
     for c in tube.circumvents:
         print(f"  circumvent obstacle {c.obstacle}: x{c.dimension + 1} {c.side}, window "
               f"[{c.start:.3f}, {c.end:.3f}] s, height {c.height:.3g}, sharpness {c.sharpness:g}")

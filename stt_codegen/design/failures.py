@@ -24,6 +24,9 @@ class FailureKind(Enum):
     (the spec's plant violates Assumption 2), ``INPUT_BOUND`` (no design within ``t_c``
     is proved to keep law (13) within ``[actuator] input_bound``), ``TASK`` (a timed
     task of ``[[tasks]]`` is not certified, or its plan has no time; docs/tasks.md).
+    Moving obstacles (docs/moving-obstacles.md): ``MOVING_OBSTACLE`` (the tube may meet one in space-time),
+    ``SWEPT_AT_START`` (no design avoids them in space-time, and the region a moving
+    obstacle sweeps meets the start or the target, so it cannot be avoided as a static box).
     """
 
     SAMPLING_RATE = "sampling rate"
@@ -41,10 +44,14 @@ class FailureKind(Enum):
     PLANT = "plant assumption"
     INPUT_BOUND = "input bound"
     TASK = "task"
+    MOVING_OBSTACLE = "avoids moving obstacle"
+    SWEPT_AT_START = "swept region at start or target"
 
 
 def property_kind(name: str) -> FailureKind:
     """The kind of a failed certificate property (``Margin.name``, e.g. ``avoids obstacle 2``)."""
+    if name.startswith(FailureKind.MOVING_OBSTACLE.value):
+        return FailureKind.MOVING_OBSTACLE
     if name.startswith(FailureKind.OBSTACLE.value):
         return FailureKind.OBSTACLE
     if name.startswith(FailureKind.TASK.value + " "):

@@ -83,6 +83,9 @@ class Design:
         For a spec with ``[[tasks]]``: per task, the index of the box the tube was
         planned through (the ``any_of`` alternative; 0 for a single box); empty
         otherwise (docs/tasks.md).
+    motion : str
+        For a spec with moving obstacles: how the tube avoids them (``"space-time"``,
+        ``"timed via"`` or ``"swept"``, :mod:`~stt_codegen.design.moving`); else ``""``.
     """
 
     tube: TubeDesign
@@ -93,6 +96,7 @@ class Design:
     input_proof: InputProof | None = field(default=None, compare=False, repr=False,
                                            kw_only=True)
     task_choices: tuple[int, ...] = field(default=(), repr=False, kw_only=True)
+    motion: str = field(default="", compare=False, kw_only=True)
 
     @property
     def certificate(self) -> Certificate:
@@ -117,7 +121,9 @@ class Design:
             method), ``segments``, ``gain``, ``certificate`` (each property with its
             margin and where it is smallest) and ``design_time_s``; for a spec with
             ``[actuator]`` also ``input_bound`` and ``input_peak`` (the proved peak of
-            each input, when it occurs, the horizon covered, the relative margin).
+            each input, when it occurs, the horizon covered, the relative margin); for a
+            spec with moving obstacles also ``motion`` and ``moving_obstacles`` (index,
+            motion, active interval, certified margin; docs/moving-obstacles.md).
         """
         tube = self.tube
         via = []
@@ -151,6 +157,7 @@ class Design:
             "design_time_s": self.design_time_s,
             **self._actuator_json(),
             **self._tasks_json(),
+            **self._motion_json(),
         }
 
     def _tasks_json(self) -> dict[str, Any]:
@@ -169,6 +176,18 @@ class Design:
                         "certified": bool(m is not None and m.passed),
                         "margin": None if m is None else m.margin})
         return {"tasks": out}
+
+    def _motion_json(self) -> dict[str, Any]:
+        """``motion`` and ``moving_obstacles`` (each with its certified margin), for a spec
+        with moving obstacles only: without them the document is as before."""
+        if not self.spec.moving_obstacles:
+            return {}
+        margins = {m.name: m for m in self.certificate.margins}
+        return {"motion": self.motion, "moving_obstacles": [
+            {"obstacle": ob.source, "motion": ob.motion, "active": [
+                ob.active[0], "inf" if math.isinf(ob.active[1]) else ob.active[1]],
+             "margin": margins[f"avoids moving obstacle {ob.source}"].margin}
+            for ob in self.spec.moving_obstacles]}
 
     def _actuator_json(self) -> dict[str, Any]:
         """``input_bound`` and the proved ``input_peak`` (with where each peak is), for a

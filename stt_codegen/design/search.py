@@ -29,9 +29,11 @@ from ..errors import DesignError
 from ..spec.loader import Spec
 from ..tube.parameters import Circumvent, TubeDesign, paper_segments
 from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, certify_tube
+from .certificate.motion import certify_motion
 from .actuator import design_within_bound
 from .failures import FailureKind, property_kind
 from .grid import grid_index, grid_value
+from .moving import design_moving
 from .gain import derived_gain
 from .plant_check import plant_failure
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
@@ -93,6 +95,8 @@ def check_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = Non
     """
     certificate = certify_tube(design, spec, obstacles=obstacles, final=final,
                                max_intervals=max_intervals, resume=resume)
+    if spec.moving_obstacles:           # space-time disjointness (certificate/motion.py)
+        certificate = certify_motion(design, spec, certificate)
     margins = {m.name: m for m in certificate.margins}
     clearances = [m.margin for m in certificate.margins if m.name.startswith("avoids")]
     initial_error = certificate.initial_error
@@ -289,6 +293,8 @@ def design_tube(spec: Spec) -> Design:
                 else "; load it with load_spec" if isinstance(spec, str) else "")
         raise TypeError(f"design_tube(): parameter 'spec' must be a Spec, not "
                         f"{type(spec).__name__}{hint}")
+    if spec.moving_obstacles:             # obstacles that move: design/moving.py
+        return design_moving(spec, design_tube, check_tube)
     if spec.input_bound is not None:      # [actuator]: design/actuator.py
         return design_within_bound(spec, design_tube)
     started = time.perf_counter()

@@ -35,6 +35,7 @@ from ..spec.plants import PLANTS
 from ..tube import reference
 from ..design.result import Design, require_design
 from ..tube.parameters import TANH, TubeDesign
+from .motion_plots import draw_moving_obstacles, mark_states
 from .simulate import SimulationResult
 from .task_plots import draw_task_windows, draw_tasks
 
@@ -199,9 +200,10 @@ def draw_unsafe_sets(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
     avoids.
     """
     anchors: dict[tuple[float, float], list[int]] = {}
-    for j, unsafe in enumerate(spec.unsafe_sets):
+    for k, unsafe in enumerate(spec.unsafe_sets):
+        j = k if unsafe.source is None else unsafe.source
         patch, anchor = obstacle_projection(unsafe, spec.state_space, dims, **OBSTACLE_STYLE,
-                                            label=OBSTACLE_LABEL if j == 0 else None,
+                                            label=OBSTACLE_LABEL if k == 0 else None,
                                             gid=f"obstacle {j}")
         ax.add_patch(patch)
         anchors.setdefault((round(anchor[0], 9), round(anchor[1], 9)), []).append(j)
@@ -209,7 +211,9 @@ def draw_unsafe_sets(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
         ax.annotate(", ".join(map(str, numbers)), anchor, ha="center", va="center",
                     color="white", fontweight="bold", gid="obstacle label", zorder=5,
                     bbox={"boxstyle": "round,pad=0.15", "fc": "0.3", "ec": "none"})
-    covered = [o for o in spec.obstacles if spec.unsafe_sets[o.source].kind != "box"]
+    kinds = {(k if u.source is None else u.source): u.kind
+             for k, u in enumerate(spec.unsafe_sets)}
+    covered = [o for o in spec.obstacles if kinds[o.source] != "box"]
     for m, obstacle in enumerate(covered):
         draw_box(ax, obstacle.box(spec.state_space), dims, fill=False, ec="tab:red", lw=0.5,
                  ls="--", label="covering boxes" if m == 0 else None)
@@ -228,6 +232,7 @@ def draw_arena(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
     """The state space, the obstacles and the target on ``ax``, projected on ``dims``."""
     draw_box(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
     draw_unsafe_sets(ax, spec, dims)
+    draw_moving_obstacles(ax, spec, dims)      # time slices (motion_plots.py); none: nothing
     draw_box(ax, spec.target_set, dims, fc="tab:green", alpha=0.35, label="target")
     draw_tasks(ax, spec, dims)          # [[tasks]], if any
     i, j = dims
@@ -343,6 +348,7 @@ def run_figure(design: Design, result: SimulationResult,
         draw_box(ax, spec.initial_set, dims, fc="tab:blue", alpha=0.3, label="initial set")
         ax.plot(traj.x[:, i], traj.x[:, j], "k--", lw=1.2, label="trajectory")
         ax.plot(traj.x[0, i], traj.x[0, j], "o", color="tab:blue", label="x(0)")
+        mark_states(ax, spec, traj.t, traj.x, dims)    # at the moving obstacles' slice times
         verdict = "satisfied" if result.satisfied else "NOT satisfied"
         ax.set_title(arena_title(spec, dims, f"{spec.name}: {verdict}, reach "
                                              f"{result.reach_time} s"), fontsize=10)

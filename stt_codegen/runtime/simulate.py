@@ -279,10 +279,14 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     in_target = np.all((xs >= t_lo) & (xs <= t_hi), axis=1) & (ts <= t_c + 1e-12)
     reached = bool(in_target.any())
     reach_time = float(ts[int(np.argmax(in_target))]) if reached else None
-    if spec.unsafe_sets:
-        clearance = np.min([u.signed_clearance(within) for u in spec.unsafe_sets], axis=0)
+    if spec.unsafe_sets or spec.moving_obstacles:
+        # a moving obstacle where it is at each instant (inf while not active)
+        clearance = np.min([u.signed_clearance(within) for u in spec.unsafe_sets]
+                           + [ob.signed_clearance(within, path_t[judged])
+                              for ob in spec.moving_obstacles], axis=0)
         min_clear = float(clearance.min())
         collision = bool(min_clear <= 0.0)
+        min_clear = min_clear if math.isfinite(min_clear) else None
     else:
         min_clear, collision = None, False
     left = bool(np.any((within < lo) | (within > hi)))

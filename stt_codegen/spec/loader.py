@@ -28,6 +28,7 @@ from ..cases import bundled_cases, bundled_spec_bytes
 from ..errors import SpecError
 from .assumptions import Assumptions, combine_assumptions
 from .model_bounds import model_bounds
+from .motion import MovingObstacle, check_moving, is_moving, moving_obstacle
 from .plants import MODEL_KEYS, PLANTS, dimension_mismatch
 from .tasks import Task, build_tasks
 from .second_order import SecondOrder, parse_second_order
@@ -113,12 +114,16 @@ class UnsafeSet:
         In the coordinates ``dims`` (a ``Box`` of length ``len(dims)`` for boxes).
     tolerance : float or None
         Covering tolerance (balls and polytopes), state units.
+    source : int or None
+        Index of the spec's ``[[obstacles]]`` entry (``None``: its place in
+        ``Spec.unsafe_sets``, which holds the obstacles that do not move).
     """
 
     kind: str
     dims: tuple[int, ...]
     shape: Any
     tolerance: float | None = None
+    source: int | None = None
 
     def signed_clearance(self, points) -> "Any":
         """Distance of each state (N, n) outside the set, minus its depth inside.
@@ -243,6 +248,9 @@ class Spec:
         default ``d_T`` to keep an obstacle beside the target out of the target box).
     tasks : tuple of Task
         The ``[[tasks]]`` entries (:mod:`~.tasks`, docs/tasks.md); empty without them.
+    moving_obstacles : tuple of MovingObstacle
+        The ``[[obstacles]]`` boxes with ``active``, ``velocity`` or ``path``
+        (:mod:`~.motion`); they are in neither :attr:`obstacles` nor :attr:`unsafe_sets`.
     """
 
     name: str
@@ -268,6 +276,7 @@ class Spec:
     source_hash: str = field(default="", compare=False)
     target_half_width_given: bool = True
     tasks: tuple[Task, ...] = ()
+    moving_obstacles: tuple[MovingObstacle, ...] = ()
 
     @property
     def dimension(self) -> int:
@@ -495,9 +504,12 @@ def _validate(raw: dict) -> Spec:
     _interior(eta, target_set, "target.center", "target set")
     d_t = _half_width(doc.target.half_width, "target", eta, target_set, "target set")
 
-    unsafe_sets = tuple(_unsafe_set(table, f"obstacles[{j}]", state_space)
-                        for j, table in enumerate(doc.obstacles))
+    unsafe_sets = tuple(_unsafe_set(table, f"obstacles[{j}]", state_space, j)
+                        for j, table in enumerate(doc.obstacles) if not is_moving(table))
     obstacles = _cover_all(unsafe_sets, state_space, initial_set, target_set)
+    moving = tuple(_moving(table, f"obstacles[{j}]", j, state_space, initial_set, target_set,
+                           doc.prescribed_time)
+                   for j, table in enumerate(doc.obstacles) if is_moving(table))
 
     model = doc.plant.model
     mismatch = dimension_mismatch(model, n)
@@ -522,7 +534,8 @@ def _validate(raw: dict) -> Spec:
                                   (state_space.lower, state_space.upper),
                                   [(b.lower, b.upper, o.source) for o, b in
                                    zip(obstacles, (o.box(state_space) for o in obstacles))],
-                                  doc.tube.method, doc.actuator is not None))
+                                  doc.tube.method, doc.actuator is not None),
+                moving_obstacles=moving)
 
 
 def _vector(value: list[float], name: str, length: int | None) -> tuple[float, ...]:
@@ -638,15 +651,25 @@ def _inside(lower, upper, dims, state_space: Box, name: str) -> None:
                                   "is not inside the state space")
 
 
+def _moving(table: BoxObstacle, name: str, j: int, state_space: Box, initial_set: Box,
+            target_set: Box, prescribed_time: float) -> MovingObstacle:
+    """A box with ``active``/``velocity``/``path`` (:mod:`.motion`); it may leave ``X``."""
+    box = _box(table, name, None)
+    dims = _dims(table.dims, name, len(box.lower), len(state_space.lower), "lower")
+    obstacle = moving_obstacle(table, name, j, dims, box.lower, box.upper)
+    check_moving(obstacle, name, initial_set, target_set, prescribed_time)
+    return obstacle
+
+
 def _unsafe_set(table: BoxObstacle | BallObstacle | PolytopeObstacle, name: str,
-                state_space: Box) -> UnsafeSet:
+                state_space: Box, source: int | None = None) -> UnsafeSet:
     from .shapes import Ball, make_polytope
     n = len(state_space.lower)
     if isinstance(table, BoxObstacle):
         box = _box(table, name, None)
         dims = _dims(table.dims, name, len(box.lower), n, "lower")
         _inside(box.lower, box.upper, dims, state_space, name)
-        return UnsafeSet("box", dims, box)
+        return UnsafeSet("box", dims, box, source=source)
     if isinstance(table, PolytopeObstacle):
         m = len(table.vertices[0])
         points = [_vector(v, f"{name}.vertices[{k}]", m) for k, v in enumerate(table.vertices)]
@@ -657,7 +680,7 @@ def _unsafe_set(table: BoxObstacle | BallObstacle | PolytopeObstacle, name: str,
         dims = _dims(table.dims, name, len(table.center), n, "center")
         shape, kind = Ball(tuple(table.center), table.radius), "ball"
     _inside(shape.lower, shape.upper, dims, state_space, name)
-    return UnsafeSet(kind, dims, shape, table.tolerance)
+    return UnsafeSet(kind, dims, shape, table.tolerance, source)
 
 
 def _cover_all(unsafe_sets: tuple[UnsafeSet, ...], state_space: Box, initial_set: Box,
@@ -668,7 +691,8 @@ def _cover_all(unsafe_sets: tuple[UnsafeSet, ...], state_space: Box, initial_set
     from .covering import cover
     obstacles = []
     labels = ("initial", "target")
-    for j, unsafe in enumerate(unsafe_sets):
+    for k, unsafe in enumerate(unsafe_sets):
+        j = k if unsafe.source is None else unsafe.source
         name = f"obstacles[{j}]"
         dims = list(unsafe.dims)
         forbidden = [(np.array(b.lower)[dims], np.array(b.upper)[dims])

@@ -45,6 +45,10 @@ TASK_KINDS = ("reach", "stay")
 #: At most this many ``[[tasks]]`` entries, and boxes in one ``any_of``.
 MAX_TASKS = 32
 MAX_ALTERNATIVES = 8
+#: At most this many rows in a moving obstacle's ``path``.
+MAX_PATH_ROWS = 1024
+#: The keys that make an obstacle move (box obstacles only: spec/motion.py).
+MOTION_KEYS = ("active", "velocity", "path")
 
 # strict: an integer is a number, a boolean or a string is not; no NaN, no infinity
 Number = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE)]
@@ -96,6 +100,14 @@ class BoxObstacle(_Table):
     upper: Vector
     dims: list[Index] = _omitted("state dimensions of lower/upper (default the first ones); "
                                  "the box spans the others")
+    # moving obstacles (issue 21, docs/moving-obstacles.md; cross-field rules: spec/motion.py)
+    active: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = _omitted(
+        "[t_on, t_off], seconds, t_on < t_off: when the obstacle exists; default always")
+    velocity: Vector = _omitted("state units/s on dims: the box translates from lower/upper "
+                                "at t_on (needs active)")
+    path: Annotated[list[Vector], Field(min_length=1, max_length=MAX_PATH_ROWS)] = _omitted(
+        "rows [t, centre...] (t in s, increasing), piecewise linear, held before the first "
+        "and after the last row; lower/upper give the size and the box at the first row")
 
 
 class BallObstacle(_Table):
@@ -341,6 +353,12 @@ def _reason(error: dict) -> str:
         return f"must be an array [t0, t1] of two numbers, got {short_repr(value)}"
     if kind == "missing":
         return "missing"
+    if kind == "extra_forbidden" and error["loc"][-1] in MOTION_KEYS and any(
+            part in ("ball", "polytope") for part in error["loc"]):
+        return ("motion (active, velocity, path) is for box obstacles only: give a box "
+                "that covers the shape (docs/moving-obstacles.md)")
+    if kind in ("list_type", "too_short", "too_long") and error["loc"][-1] == "active":
+        return f"must be an array [t_on, t_off] of two numbers, got {short_repr(value)}"
     if kind == "extra_forbidden":
         return f"unknown key (allowed: {', '.join(_allowed(error['loc']))})"
     if kind == "finite_number":
@@ -373,6 +391,7 @@ def _reason(error: dict) -> str:
         return f"{len(value)} {what}; at most {ctx.get('max_length')}"
     if kind == "list_type":
         what = {"obstacles": "tables", "vertices": "points (arrays)",
+                "path": "rows [t, centre...] (arrays of numbers)",
                 "dims": "dimension indices", "a": "rows (arrays of numbers)",
                 "g": "rows (arrays of numbers)"}.get(error["loc"][-1], "numbers")
         return f"must be an array of {what}, got {value_kind(value)}"
@@ -383,7 +402,7 @@ def _reason(error: dict) -> str:
 
 
 #: Arrays of arrays: a row that is not an array is reported as the whole array's fault.
-_NESTED = ("vertices", "a", "g")
+_NESTED = ("vertices", "a", "g", "path")
 
 
 def _row_as_array(error: dict) -> dict:

@@ -1,0 +1,303 @@
+"""Designing a tube that avoids moving obstacles where and when they are (issue 21, part B).
+
+A spec's moving obstacles (``Spec.moving_obstacles``, :mod:`stt_codegen.spec.motion`) are
+not seen by the static design search. :func:`design_moving` tries, in order, and returns the
+first tube whose check (:func:`~stt_codegen.design.search.check_tube`, which certifies
+space-time disjointness from every moving obstacle, :mod:`.certificate.motion`) passes:
+
+1. **space-time** (``"space-time"``): the design for the static obstacles alone (the spec's
+   own ``tube.method``), checked against the moving obstacles as they really are;
+2. **re-timed via plan** (``"timed via"``): the via boxes of the static via-point design
+   (first for the static obstacles alone, then going around the swept regions of one, two,
+   ... of the moving obstacles, :func:`routes`), re-timed against the others on a grid
+   of :data:`TIME_STEPS` steps over ``[0, t_c]``: a breadth-first search over (via box,
+   time step) that may wait at a via box or take a segment at one of
+   :data:`DURATION_FACTORS` times its planned duration, each move kept clear (by
+   :data:`~.via.VIA_MARGIN`) of the hull of every moving obstacle over the move's time,
+   earliest arrival first (deterministic: fixed orders, no randomness);
+3. **swept** (``"swept"``, conservative): each moving obstacle replaced by the static box
+   holding every position it takes while active (clipped to the state space), and the
+   static design run on that; refused when such a box meets the start or the target.
+
+Specs with ``[actuator]`` skip step 2 (its input proof is the static design's), and so do
+specs with ``tube.method = "paper"`` (step 2's tube is a via-point tube). The
+argument and the limits: docs/moving-obstacles.md.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Sequence
+from itertools import combinations
+from dataclasses import replace
+
+import numpy as np
+
+from ..errors import DesignError
+from ..spec.loader import Obstacle, Spec
+from ..tube import reference
+from ..tube.parameters import ReachSegment, TubeDesign
+from .failures import FailureKind
+from .gain import derived_gain
+from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
+from .via import VIA_MARGIN
+
+#: How the tube of a spec with moving obstacles was found (``Design.motion``).
+MOTION_SPACE_TIME = "space-time"
+MOTION_TIMED_VIA = "timed via"
+MOTION_SWEPT = "swept"
+#: Time steps of the re-timing grid over ``[0, t_c]``.
+TIME_STEPS = 60
+#: Durations a re-timed segment may take, as multiples of its planned duration.
+DURATION_FACTORS = (1.0, 0.75, 1.5, 0.5, 2.0)
+#: Sub-intervals on which a move is checked against the obstacles' hulls.
+MOVE_CHECKS = 8
+#: Most sets of moving obstacles to go around that the re-timing step tries (:func:`routes`).
+MAX_ROUTES = 16
+
+
+def static_part(spec: Spec) -> Spec:
+    """``spec`` without its moving obstacles (what the static design search sees)."""
+    return replace(spec, moving_obstacles=())
+
+
+def swept_spec(spec: Spec, which: Sequence[int] | None = None) -> tuple[Spec | None, str]:
+    """``spec`` with moving obstacles as the static boxes they sweep while active.
+
+    Parameters
+    ----------
+    spec : Spec
+    which : sequence of int, optional
+        Positions in ``spec.moving_obstacles`` to sweep; default all. The others stay
+        moving.
+
+    Returns
+    -------
+    (Spec or None, str)
+        The spec (those moving obstacles removed, their swept boxes, clipped to the state
+        space, added as obstacles with the same index), or ``None`` and why not (a swept
+        box meets the initial set or the target set).
+    """
+    extra = []
+    space = spec.state_space
+    chosen = range(len(spec.moving_obstacles)) if which is None else which
+    for ob in (spec.moving_obstacles[i] for i in chosen):
+        lo, hi, _ = ob.hull([ob.active[0]], [ob.active[1]])
+        lower = tuple(max(float(a), space.lower[d]) for a, d in zip(lo[0], ob.dims))
+        upper = tuple(min(float(b), space.upper[d]) for b, d in zip(hi[0], ob.dims))
+        if any(a >= b for a, b in zip(lower, upper)):
+            continue                       # never inside the state space
+        swept = Obstacle(lower, upper, ob.dims, ob.source)
+        box = swept.box(space)
+        for label, other in (("initial", spec.initial_set), ("target", spec.target_set)):
+            if box.meets(other):
+                return None, (f"the region moving obstacle {ob.source} sweeps while active "
+                              f"meets the {label} set")
+        extra.append(swept)
+    keep = tuple(ob for i, ob in enumerate(spec.moving_obstacles) if i not in chosen)
+    return replace(spec, obstacles=spec.obstacles + tuple(extra), moving_obstacles=keep), ""
+
+
+def routes(count: int) -> list[tuple[int, ...]]:
+    """The sets of moving obstacles to go around (swept) while timing the others, in the
+    order tried: none first, then by size, then by index; the set of all is not among
+    them (that is the swept step); at most :data:`MAX_ROUTES`."""
+    out = [c for size in range(count) for c in combinations(range(count), size)]
+    return out[:MAX_ROUTES]
+
+
+def _clear(lower: np.ndarray, upper: np.ndarray, spec: Spec, t_a: np.ndarray,
+           t_b: np.ndarray) -> np.ndarray:
+    """Boolean (K,): box ``[lower[k], upper[k]]`` (shape (K, n)) keeps :data:`VIA_MARGIN`
+    from every moving obstacle's hull over ``[t_a[k], t_b[k]]``."""
+    ok = np.ones(len(t_a), dtype=bool)
+    for ob in spec.moving_obstacles:
+        lo, hi, present = ob.hull(t_a, t_b)
+        d = list(ob.dims)
+        gap = np.maximum(lo - upper[:, d], lower[:, d] - hi).max(axis=1)
+        ok &= ~present | (gap > VIA_MARGIN)
+    return ok
+
+
+def _move_clear(seg: ReachSegment, spec: Spec) -> bool:
+    """The reach box of ``seg`` (monotone profile) misses every moving obstacle on
+    ``[start, end]``, checked on :data:`MOVE_CHECKS` sub-intervals."""
+    cuts = np.linspace(seg.start, seg.end, MOVE_CHECKS + 1)
+    with reference.numpy_math():
+        p, _ = reference.segment_progress(seg, cuts)
+    a_lo, a_hi = np.array(seg.lower_from), np.array(seg.upper_from)
+    b_lo, b_hi = np.array(seg.lower_to), np.array(seg.upper_to)
+    p0, p1 = p[:-1, None], p[1:, None]
+    lo = np.minimum(a_lo + (b_lo - a_lo) * p0, a_lo + (b_lo - a_lo) * p1)
+    hi = np.maximum(a_hi + (b_hi - a_hi) * p0, a_hi + (b_hi - a_hi) * p1)
+    return bool(_clear(lo, hi, spec, cuts[:-1], cuts[1:]).all())
+
+
+def retime(segments: tuple[ReachSegment, ...], spec: Spec) -> tuple[ReachSegment, ...] | None:
+    """The via boxes of ``segments`` re-timed to miss the moving obstacles (module notes).
+
+    Returns
+    -------
+    tuple of ReachSegment or None
+        Segments through the same boxes, with waits between them (the reach tube holds a
+        box between two segments), the last ending by ``t_c``; ``None`` if the search
+        finds no timing.
+    """
+    t_c = spec.prescribed_time
+    tau = t_c / TIME_STEPS
+    m = len(segments)
+    boxes = [(np.array(s.lower_from), np.array(s.upper_from)) for s in segments]
+    boxes.append((np.array(segments[-1].lower_to), np.array(segments[-1].upper_to)))
+    steps = np.arange(TIME_STEPS + 1)
+    # waits: box k over [i tau, (i + 1) tau], for every i at once
+    waits = [_clear(np.tile(lo, (TIME_STEPS + 1, 1)), np.tile(hi, (TIME_STEPS + 1, 1)), spec,
+                    steps * tau, (steps + 1) * tau) for lo, hi in boxes]
+    # parent[(k, i)] = (previous state, segment taken or None for a wait)
+    parent: dict[tuple[int, int], tuple[tuple[int, int] | None, ReachSegment | None]] = {
+        (0, 0): (None, None)}
+    frontier = [(0, 0)]
+    goal = None
+    for i in range(TIME_STEPS + 1):
+        at_i = sorted(s for s in frontier if s[1] == i)
+        for k, _ in at_i:
+            if k == m:
+                goal = (k, i)
+                break
+            nxt = (k, i + 1)
+            if i < TIME_STEPS and nxt not in parent and waits[k][i]:
+                parent[nxt] = ((k, i), None)
+                frontier.append(nxt)
+            planned = segments[k].end - segments[k].start
+            for f in DURATION_FACTORS:
+                d = max(1, int(math.ceil(f * planned / tau - 1e-9)))
+                to = (k + 1, i + d)
+                if to[1] > TIME_STEPS or to in parent:
+                    continue
+                seg = replace(segments[k], start=i * tau, end=(i + d) * tau)
+                if to[0] == m:
+                    seg = replace(seg, end=min(seg.end, t_c))
+                if _move_clear(seg, spec):
+                    parent[to] = ((k, i), seg)
+                    frontier.append(to)
+        if goal is not None:
+            break
+    if goal is None:
+        return None
+    # the tube waits in the target box from the arrival to t_c: that wait must be clear too
+    lo, hi = boxes[m]
+    if not _clear(lo[None, :], hi[None, :], spec, np.array([goal[1] * tau]), np.array([t_c]))[0]:
+        return None
+    out = []
+    state: tuple[int, int] | None = goal
+    while state is not None:
+        state, seg = parent[state]
+        if seg is not None:
+            out.append(seg)
+    return tuple(reversed(out))
+
+
+def _accept(tube: TubeDesign, check: TubeCheck, spec: Spec) -> TubeDesign:
+    gain = (spec.gain if spec.gain is not None
+            else derived_gain(check.min_width, tube.rate_hz, spec.assumptions))
+    return replace(tube, gain=gain)
+
+
+def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
+                  check: Callable[[TubeDesign, Spec], TubeCheck]) -> Design:
+    """Design a certified tube for a spec with moving obstacles (see the module notes).
+
+    Parameters
+    ----------
+    spec : Spec
+        With ``moving_obstacles``.
+    design_static : callable
+        :func:`~stt_codegen.design.search.design_tube` (passed in: this module is below it).
+    check : callable
+        :func:`~stt_codegen.design.search.check_tube`.
+
+    Returns
+    -------
+    Design
+        For ``spec`` (its check includes ``avoids moving obstacle j`` for each), with
+        ``motion`` saying which of the three ways found it.
+
+    Raises
+    ------
+    DesignError
+        No design avoids the static obstacles (the static search's error), or none of the
+        three ways gives a tube that passes; the message says what each found, ``kind``
+        is the space-time check's (``MOVING_OBSTACLE`` usually) or ``SWEPT_AT_START``,
+        ``tried`` the static design's tube.
+    """
+    started = time.perf_counter()
+    static = static_part(spec)
+    first = design_static(static)        # a static failure is final: raise it as it is
+    found = check(first.tube, spec)
+    if found.passed:
+        return _design(first.tube, first.method, found, spec, started, MOTION_SPACE_TIME,
+                       first)
+    reasons = [f"the {first.method} design for the static obstacles fails in space-time: "
+               f"{found.reason}"]
+    kind = found.kind
+    if spec.input_bound is None and spec.tube.method != METHOD_PAPER:
+        tried: list[str] = []
+        for which in routes(len(spec.moving_obstacles)):
+            partial, _ = swept_spec(spec, which)
+            if partial is None:
+                continue
+            around = static_part(partial)
+            via = (first if not which and first.method == METHOD_VIA else
+                   _try(lambda: design_static(replace(around, tube=replace(around.tube,
+                                                                           method="via")))))
+            if via is None:
+                continue
+            segments = retime(via.tube.segments, partial)
+            if segments is None:
+                continue
+            tube = replace(via.tube, segments=segments)
+            timed = check(tube, spec)
+            if timed.passed:
+                return _design(_accept(tube, timed, spec), METHOD_VIA, timed, spec,
+                               started, MOTION_TIMED_VIA, via)
+            tried.append(f"the re-timed via tube around {list(which) or 'none'} fails: "
+                         f"{timed.reason}")
+        reasons.append("; ".join(tried) if tried else
+                       f"no re-timing of the via boxes on {TIME_STEPS} time steps keeps "
+                       "clear of the moving obstacles (going around none, one or more of "
+                       "them)")
+    swept, why = swept_spec(spec)
+    if swept is None:
+        reasons.append(f"no swept design: {why}")
+        kind = FailureKind.SWEPT_AT_START
+    else:
+        try:
+            design = design_static(swept)
+        except DesignError as exc:
+            reasons.append(f"no design avoids the swept regions: {exc}")
+        else:
+            final = check(design.tube, spec)
+            if final.passed:
+                return _design(design.tube, design.method, final, spec, started,
+                               MOTION_SWEPT, design)
+            reasons.append(f"the swept design fails: {final.reason}")
+    raise DesignError("no tube avoids the moving obstacles: " + "; ".join(reasons),
+                      kind=kind, tried=first.tube)
+
+
+def _try(make: Callable[[], Design]) -> Design | None:
+    try:
+        return make()
+    except DesignError:
+        return None
+
+
+def _design(tube: TubeDesign, method: str, check: TubeCheck, spec: Spec, started: float,
+            motion: str, source: Design) -> Design:
+    return Design(tube, method, check, time.perf_counter() - started, spec=spec,
+                  input_proof=source.input_proof, motion=motion)
+
+
+__all__ = ["DURATION_FACTORS", "MAX_ROUTES", "MOTION_SPACE_TIME", "MOTION_SWEPT",
+           "MOTION_TIMED_VIA", "MOVE_CHECKS", "TIME_STEPS", "design_moving", "retime", "routes",
+           "static_part", "swept_spec"]
