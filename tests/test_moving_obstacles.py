@@ -402,3 +402,32 @@ def test_a_certified_moving_obstacle_is_missed_on_a_dense_grid(straight):
             overlap = np.all((g_l < centre + half) & (g_u > centre - half), axis=1)
             assert not np.any(overlap & moving.is_active(t)), ob
     assert any(verdicts) and not all(verdicts)
+
+
+@pytest.mark.slow
+def test_tasks_and_moving_obstacles_together():
+    """A spec with ``[[tasks]]`` and a moving obstacle: the tasks' plan is checked in
+    space-time, so the design reports both (each task's box and margin, the obstacle's
+    margin) and the run meets both; the same obstacle active longer, across the tasks'
+    plan, is refused (the re-timing does not keep the waypoints in their windows:
+    docs/moving-obstacles.md, "With [[tasks]]")."""
+    doc = tomllib.loads(bundled_spec_bytes("crossing-moving").decode())
+    doc.update(name="crossing_tasks", tube={"method": "auto"})
+    doc["obstacles"] = [{"lower": [1.7, 3.4], "upper": [2.3, 4.0], "velocity": [0.0, -0.6],
+                         "active": [0.0, 1.5]}]
+    doc["tasks"] = [{"kind": "reach", "window": [0.6, 1.2], "lower": [1.0, 1.7],
+                     "upper": [1.6, 2.3]},
+                    {"kind": "reach", "window": [5.0, 6.0], "lower": [3.0, 1.7],
+                     "upper": [3.6, 2.3]}]
+    design = stt.design_tube(stt.Spec.from_dict(doc))
+    assert design.motion == MOTION_SPACE_TIME
+    data = design.to_json()
+    assert [t["task"] for t in data["tasks"]] == ["T1", "T2"]
+    assert all(t["certified"] and t["margin"] > 0 for t in data["tasks"])
+    assert data["moving_obstacles"][0]["margin"] > 0
+    run = stt.simulate(design, backend="reference")
+    assert run.satisfied and all(t.met for t in run.tasks)
+    doc["obstacles"][0]["active"] = [0.0, 8.0]      # now it crosses the tasks' plan
+    with pytest.raises(stt.DesignError) as info:
+        stt.design_tube(stt.Spec.from_dict(doc))
+    assert info.value.kind is FailureKind.MOVING_OBSTACLE

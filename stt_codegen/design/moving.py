@@ -295,7 +295,8 @@ def _try(make: Callable[[], Design]) -> Design | None:
 def _design(tube: TubeDesign, method: str, check: TubeCheck, spec: Spec, started: float,
             motion: str, source: Design) -> Design:
     return Design(tube, method, check, time.perf_counter() - started, spec=spec,
-                  input_proof=source.input_proof, motion=motion)
+                  input_proof=source.input_proof, motion=motion,
+                  task_choices=source.task_choices)
 
 
 __all__ = ["DURATION_FACTORS", "MAX_ROUTES", "MOTION_SPACE_TIME", "MOTION_SWEPT",
