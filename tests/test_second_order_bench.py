@@ -32,7 +32,7 @@ def test_random_plants_stay_within_the_declared_bounds() -> None:
 def test_study_refuses_a_first_order_spec_and_a_bad_count() -> None:
     with pytest.raises(SpecError) as info:
         run_second_order_study("omnirobot-s1", 1)
-    assert info.value.field == "second_order"
+    assert info.value.field == "plant.model"
     with pytest.raises(SpecError):
         run_second_order_study("second-order-s1", 0)
     with pytest.raises(SpecError) as info:

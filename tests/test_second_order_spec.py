@@ -1,4 +1,6 @@
-"""The spec's [second_order] table (stt_codegen/spec/second_order.py, docs/spec-format.md)."""
+"""Second-order plants in the spec: a second-order ``[plant] model`` with
+``initial.velocity``, ``state_space.velocity_bound`` and the second stage's
+``[assumptions]`` (stt_codegen/spec/second_order.py, docs/spec-format.md)."""
 
 from __future__ import annotations
 
@@ -15,13 +17,26 @@ import pytest
 import stt_codegen as stt
 from stt_codegen.cases import bundled_spec_bytes
 from stt_codegen.errors import SpecError
+from stt_codegen.spec.plants import SECOND_ORDER_MODELS
+from stt_codegen.spec.schema import json_schema
 
 REPO = Path(__file__).resolve().parents[1]
 
 
-def _doc(**second_order) -> dict:
-    data = tomllib.loads(bundled_spec_bytes("second-order-quadrotor").decode())
-    data["second_order"].update(second_order)
+def _doc(name: str = "second-order-quadrotor") -> dict:
+    return tomllib.loads(bundled_spec_bytes(name).decode())
+
+
+def _changed(changes: dict, name: str = "second-order-quadrotor") -> dict:
+    """The bundled spec with ``{"table.key": value}`` set (``None``: the key removed)."""
+    data = _doc(name)
+    for path, value in changes.items():
+        table, key = path.split(".")
+        data.setdefault(table, {})
+        if value is None:
+            data[table].pop(key, None)
+        else:
+            data[table][key] = value
     return data
 
 
@@ -30,16 +45,33 @@ def test_bundled_second_order_cases_parse() -> None:
     order = spec.second_order
     assert order.model == "quadrotor" and order.parameters == (1.2, 0.3, 9.81)
     assert order.velocity_bound == (3.0, 3.0, 3.0) and order.input_gain == (0.625, 1.25)
+    assert order.drift_bound == 11.31
+    # the position stage is a single integrator; [assumptions] bound the second stage only
+    assert spec.plant_model == "single-integrator" and spec.assumptions.declared == ()
     s1 = stt.load_spec("second-order-s1").second_order
     assert s1.model == "double-integrator" and s1.initial_velocity == (0.0, 0.0)
     assert stt.load_spec("omnirobot-s1").second_order is None
 
 
-def test_defaults() -> None:
+def test_no_second_order_table_and_the_models_are_plant_models() -> None:
+    for name in ("second-order-s1", "second-order-quadrotor"):
+        assert "second_order" not in _doc(name)
+        assert _doc(name)["plant"]["model"] in SECOND_ORDER_MODELS
     data = _doc()
-    for key in ("parameters", "initial_velocity", "velocity_bound", "input_gain",
-                "drift_bound"):
-        data["second_order"].pop(key)
+    data["second_order"] = {"model": "quadrotor"}
+    with pytest.raises(SpecError) as info:
+        stt.Spec.from_dict(data)
+    assert info.value.field == "second_order"
+    schema = json_schema()
+    assert "second_order" not in schema["properties"]
+    assert set(SECOND_ORDER_MODELS) <= set(schema["$defs"]["PlantTable"]["properties"]["model"]
+                                           ["enum"])
+
+
+def test_defaults() -> None:
+    data = _changed({"plant.parameters": None, "initial.velocity": None,
+                     "state_space.velocity_bound": None})
+    data.pop("assumptions")
     order = stt.Spec.from_dict(data).second_order
     assert order.parameters == (1.0, 0.3, 9.81)         # the model's nominal ones
     assert order.initial_velocity == (0.0, 0.0, 0.0) and order.velocity_bound is None
@@ -47,33 +79,70 @@ def test_defaults() -> None:
 
 
 @pytest.mark.parametrize("change,field", [
-    ({"model": "two-link-arm"}, "second_order.model"),
-    ({"parameters": [1.0, 0.3]}, "second_order.parameters"),
-    ({"parameters": [-1.0, 0.3, 9.81]}, "second_order.parameters"),
-    ({"initial_velocity": [0.0, 0.0]}, "second_order.initial_velocity"),
-    ({"initial_velocity": [0.0, 3.5, 0.0]}, "second_order.initial_velocity"),
-    ({"velocity_bound": [3.0, 3.0]}, "second_order.velocity_bound"),
-    ({"input_gain": [2.0, 1.0]}, "second_order.input_gain"),
+    ({"plant.model": "two-link-arm"}, "plant.model"),
+    ({"plant.parameters": [1.0, 0.3]}, "plant.parameters"),
+    ({"plant.parameters": [-1.0, 0.3, 9.81]}, "plant.parameters"),
+    ({"initial.velocity": [0.0, 0.0]}, "initial.velocity"),
+    ({"initial.velocity": [0.0, 3.5, 0.0]}, "initial.velocity"),
+    ({"state_space.velocity_bound": [3.0, 3.0]}, "state_space.velocity_bound"),
+    ({"state_space.velocity_bound": [3.0, 0.0, 3.0]}, "state_space.velocity_bound"),
+    ({"assumptions.input_gain": [2.0, 1.0]}, "assumptions.input_gain"),
+    ({"assumptions.input_gain": [1.0]}, "assumptions.input_gain"),
+    ({"assumptions.drift_bound": -1.0}, "assumptions.drift_bound"),
+    # the first-order bounds have no meaning for the second stage
+    ({"assumptions.input_gain_skew": 0.1}, "assumptions.input_gain_skew"),
+    ({"assumptions.disturbance_bound": 0.3}, "assumptions.disturbance_bound"),
+    ({"plant.a": [[0.0] * 3] * 3}, "plant.a"),
 ])
-def test_bad_tables_name_the_field(change, field) -> None:
+def test_bad_keys_name_the_field(change, field) -> None:
     with pytest.raises(SpecError) as info:
-        stt.Spec.from_dict(_doc(**change))
-    assert info.value.field == field
+        stt.Spec.from_dict(_changed(change))
+    assert info.value.field == field or info.value.field.startswith(field + "[")
+
+
+@pytest.mark.parametrize("key,value", [("initial.velocity", [0.0, 0.0, 0.0]),
+                                       ("state_space.velocity_bound", [1.0, 1.0, 1.0]),
+                                       ("plant.parameters", [1.0])])
+@pytest.mark.parametrize("model", ["single-integrator", "omnidirectional", "linear"])
+def test_velocity_keys_on_a_first_order_model_are_refused(key, value, model) -> None:
+    data = _changed({key: value, "plant.model": model, "plant.parameters": None,
+                     "initial.velocity": None, "state_space.velocity_bound": None})
+    data[key.split(".")[0]][key.split(".")[1]] = value
+    data.pop("assumptions")
+    with pytest.raises(SpecError) as info:
+        stt.Spec.from_dict(data)
+    assert info.value.field == key
+    assert "only a second-order plant.model" in info.value.reason and model in info.value.reason
+
+
+def test_a_first_order_spec_is_unchanged_by_the_second_order_keys() -> None:
+    data = _changed({"plant.model": "single-integrator", "plant.parameters": None,
+                     "initial.velocity": None, "state_space.velocity_bound": None})
+    spec = stt.Spec.from_dict(data)        # [assumptions] are then the first-order ones
+    assert spec.second_order is None and spec.plant_model == "single-integrator"
+    assert spec.assumptions.input_gain == (0.625, 1.25)
+    assert spec.assumptions.declared == ("input_gain", "drift_bound")
 
 
 def test_schema_refuses_unknown_models_and_keys() -> None:
-    for change in ({"model": "blimp"}, {"thrust": 1.0}):
+    for change, field in (({"plant.model": "blimp"}, "plant.model"),
+                          ({"plant.thrust": 1.0}, "plant.thrust"),
+                          ({"initial.initial_velocity": [0.0] * 3},
+                           "initial.initial_velocity")):
         with pytest.raises(SpecError) as info:
-            stt.Spec.from_dict(_doc(**change))
-        assert info.value.field.startswith("second_order")
+            stt.Spec.from_dict(_changed(change))
+        assert info.value.field == field
 
 
-def test_the_documented_table_loads() -> None:
+def test_the_documented_tables_load() -> None:
     text = (REPO / "docs" / "spec-format.md").read_text()
-    block = re.search(r"^```text\n(\[second_order\].*?)^```$", text, flags=re.S | re.M)
-    data = tomllib.loads(bundled_spec_bytes("second-order-quadrotor").decode())
-    data["second_order"] = tomllib.loads(block.group(1))["second_order"]
-    assert stt.Spec.from_dict(data).second_order.model == "quadrotor"
+    block = re.search(r"^```text\n(\[state_space\].*?)^```$", text, flags=re.S | re.M)
+    documented = tomllib.loads(block.group(1))
+    data = _doc()
+    for table, keys in documented.items():
+        data[table] = {**data.get(table, {}), **keys}
+    order = stt.Spec.from_dict(data).second_order
+    assert order.model == "quadrotor" and order.velocity_bound == (3.0, 3.0, 3.0)
 
 
 def _cli(*args, cwd=None):
@@ -85,10 +154,10 @@ def _cli(*args, cwd=None):
 def test_a_bad_table_exits_2_without_traceback(tmp_path) -> None:
     path = tmp_path / "bad.toml"
     path.write_text(bundled_spec_bytes("second-order-s1").decode().replace(
-        "initial_velocity = [0.0, 0.0]", "initial_velocity = [0.0]"))
+        "velocity = [0.0, 0.0]", "velocity = [0.0]"))
     out = _cli("design", str(path))
     assert out.returncode == 2 and "Traceback" not in out.stderr
-    assert "second_order.initial_velocity" in out.stderr
+    assert "initial.velocity" in out.stderr
 
 
 @pytest.mark.slow

@@ -1,12 +1,12 @@
 """``stt-codegen bench second-order``: the cascade on random second-order plants within the
 declared bounds of a bundled second-order case (issue 22, docs/second-order.md).
 
-For a design whose spec has ``[second_order]``, the default second stage is derived once
+For a design whose spec has a second-order ``plant.model``, the default second stage is derived once
 from the spec's declared bounds (as ``simulate`` does); then ``count`` plants are drawn
 within those bounds and each runs the closed loop with the emitted C of the cascade
 (:func:`stt_codegen.runtime.cascade_simulate.simulate_second_order`, backend ``c``):
 
-* double integrator: mass ``m`` uniform with ``1/m`` in ``second_order.input_gain``;
+* double integrator: mass ``m`` uniform with ``1/m`` in ``assumptions.input_gain``;
 * quadrotor: the same mass range, drag uniform in ``[0, DRAG_MAX]`` (the value the bundled
   case's ``drift_bound`` assumes), gravity 9.81;
 * every plant: disturbance amplitude uniform in ``[0, plant.disturbance_amplitude]``, its
@@ -43,7 +43,7 @@ def random_parameters(model: str, input_gain: tuple, rng: np.random.Generator,
     Raises
     ------
     SpecError
-        A model the study does not draw (field ``second_order.model``).
+        A model the study does not draw (field ``plant.model``).
     """
     g_min, g_max = input_gain
     mass = 1.0 / rng.uniform(g_min / spread, g_max * spread)
@@ -51,8 +51,8 @@ def random_parameters(model: str, input_gain: tuple, rng: np.random.Generator,
         return [mass]
     if model == "quadrotor":
         return [mass, float(rng.uniform(0.0, DRAG_MAX * spread)), GRAVITY]
-    raise SpecError("second_order.model", f"the study draws double-integrator and quadrotor "
-                                          f"plants, not {model!r}")
+    raise SpecError("plant.model", f"the study draws double-integrator and quadrotor "
+                                   f"plants, not {model!r}")
 
 
 def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed: int = 0,
@@ -62,7 +62,7 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
     Parameters
     ----------
     case : str
-        A bundled case or spec file with ``[second_order]``.
+        A bundled case or spec file with a second-order ``plant.model``.
     count : int
         Plants, >= 1.
     seed : int
@@ -84,7 +84,7 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
     Raises
     ------
     SpecError
-        A spec without ``[second_order]``, a bad count.
+        A first-order spec, a bad count.
     """
     if count < 1:
         raise SpecError("count", f"must be at least 1, got {count}")

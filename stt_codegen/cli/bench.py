@@ -173,7 +173,8 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
     p = sub.add_parser("second-order", help="the cascade law on random second-order plants "
                                             "within a case's declared bounds (issue 22)")
     p.add_argument("spec", metavar="SPEC", nargs="?", default="second-order-s1",
-                   help="bundled case or spec file with [second_order] (default: %(default)s)")
+                   help="bundled case or spec file with a second-order plant.model "
+                        "(default: %(default)s)")
     p.add_argument("--count", type=int, default=300, help="plants (default: %(default)s)")
     p.add_argument("--seed", type=_non_negative_int, default=0, help="seed (default: 0)")
     p.add_argument("--spread", type=float, default=1.0, metavar="F",

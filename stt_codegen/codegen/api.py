@@ -21,7 +21,7 @@ def generate(design: Design, out_dir: str | Path,
     for Python, ``P.py`` (imports only :mod:`math`); the test vectors ``P_vectors.json``
     and ``manifest.json`` (``P`` is the spec name with ``-`` replaced by ``_``). The code
     computes law (13), ``u = -k xi(x, t) epsilon(x, t)``, with the tube of eqs. (2)-(10)
-    and the implicit step of the adaptive law (11). For a spec with ``[second_order]``:
+    and the implicit step of the adaptive law (11). For a second-order ``plant.model``:
     the cascade controller instead (:func:`~.cascade_source.cascade_generation`,
     docs/second-order.md).
 

@@ -176,7 +176,7 @@ def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
     Parameters
     ----------
     design : Design
-        Of a spec with ``[second_order]``.
+        Of a spec with a second-order ``plant.model``.
     options : Options
 
     Returns
@@ -186,7 +186,7 @@ def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
     Raises
     ------
     SpecError
-        A first-order spec (field ``second_order``).
+        A first-order spec (field ``plant.model``).
     """
     import json
 

@@ -115,11 +115,11 @@ def derived_second_stage(design: TubeDesign, min_width: float, input_gain: tuple
 
 
 def second_stage_of(design: "Design") -> tuple[SecondStage, dict]:
-    """The default second stage of a design whose spec has ``[second_order]``.
+    """The default second stage of a design whose spec has a second-order ``plant.model``.
 
-    ``F`` is ``second_order.drift_bound`` plus ``plant.disturbance_amplitude`` (the bound
-    on every ``|w_i|``); ``g`` in ``second_order.input_gain``; ``x2(0)`` is
-    ``second_order.initial_velocity``; ``gamma_d,min`` the certified narrowest width.
+    ``F`` is ``assumptions.drift_bound`` plus ``plant.disturbance_amplitude`` (the bound
+    on every ``|w_i|``); ``g`` in ``assumptions.input_gain``; ``x2(0)`` is
+    ``initial.velocity``; ``gamma_d,min`` the certified narrowest width.
 
     Parameters
     ----------
@@ -135,13 +135,13 @@ def second_stage_of(design: "Design") -> tuple[SecondStage, dict]:
     Raises
     ------
     SpecError
-        The spec has no ``[second_order]`` table (field ``second_order``).
+        The spec's ``plant.model`` is first order (field ``plant.model``).
     """
     from ..errors import SpecError
     order = design.spec.second_order
     if order is None:
-        raise SpecError("second_order", "the spec describes a first-order plant (no "
-                                        "[second_order] table)")
+        raise SpecError("plant.model", "the spec describes a first-order plant (not a "
+                                       "second-order plant.model)")
     return derived_second_stage(design.tube, design.check.min_width, order.input_gain,
                                 order.drift_bound + design.spec.disturbance_amplitude,
                                 order.initial_velocity)

@@ -1,6 +1,7 @@
 """The cascade controller for a second-order plant on an emulated Cortex-M4F (issue 22).
 
-:func:`run_cascade_embedded` builds, for a design whose spec has ``[second_order]``:
+:func:`run_cascade_embedded` builds, for a design whose spec has a second-order
+``plant.model``:
 
 * the single-precision cascade C (:func:`stt_codegen.codegen.cascade_source.cascade_c_files`);
 * a closed-loop program: the plant (:func:`stt_codegen.runtime.second_order_plants.second_order_rhs`
@@ -57,13 +58,13 @@ def closed_loop_program(design: Design, prefix: str, seed: int = 0) -> str:
     Raises
     ------
     SpecError
-        A first-order spec (field ``second_order``), or an obstacle that is not a box
+        A first-order spec (field ``plant.model``), or an obstacle that is not a box
         (field ``obstacles``: the program judges boxes only).
     """
     spec = design.spec
     order = spec.second_order
     if order is None:
-        raise SpecError("second_order", "the spec describes a first-order plant")
+        raise SpecError("plant.model", "the spec describes a first-order plant")
     n = spec.dimension
     boxes = []
     for j, unsafe in enumerate(spec.unsafe_sets):
@@ -213,7 +214,7 @@ def run_cascade_embedded(design: Design, seed: int = 0, timeout: float = 600.0) 
     Parameters
     ----------
     design : Design
-        Of a spec with ``[second_order]``.
+        Of a spec with a second-order ``plant.model``.
     seed : int
         Disturbance seed.
     timeout : float

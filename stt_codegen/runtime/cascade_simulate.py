@@ -72,7 +72,7 @@ class CascadeResult:
         Peak ``|x2_i|``, velocity units.
     steps : int
     exceeded_velocity_bound : bool
-        Some sampled ``|x2_i|`` reached the spec's ``second_order.velocity_bound`` (then
+        Some sampled ``|x2_i|`` reached the spec's ``state_space.velocity_bound`` (then
         not ``satisfied``); ``False`` without a bound.
     """
 
@@ -241,7 +241,7 @@ def simulate_second_order(spec: Spec, tube: TubeDesign, stage: SecondStage, *,
 
 def simulate_cascade(design: Design, backend: str = "reference", horizon: float | None = None,
                      seed: int = 0) -> CascadeResult:
-    """The closed loop of a design whose spec has ``[second_order]``: the default second
+    """The closed loop of a design whose spec has a second-order ``plant.model``: the default second
     stage (:func:`stt_codegen.design.cascade_gain.second_stage_of`) on the spec's model,
     parameters, initial velocity and velocity bound.
 
@@ -258,7 +258,7 @@ def simulate_cascade(design: Design, backend: str = "reference", horizon: float 
     Raises
     ------
     SpecError
-        As :func:`simulate_second_order`; a first-order spec (field ``second_order``).
+        As :func:`simulate_second_order`; a first-order spec (field ``plant.model``).
     """
     from ..design.cascade_gain import second_stage_of
     stage, _ = second_stage_of(design)

@@ -3,9 +3,9 @@
 ``x1_dot = x2``, ``x2_dot = f(x1, x2) + g(x1, x2) u + w`` (docs/second-order.md). Each
 model is one Function ``second_order_rhs(x1, x2, u, w, params) -> (x1_dot, x2_dot)`` whose
 physical numbers are the input ``params`` (names and nominal values:
-:data:`stt_codegen.spec.second_order.MODELS`) (so one Function serves a whole family of
-plants, e.g. the random plants of a study), printed to Python by the emitter for the
-simulation. The controller never sees them.
+:data:`stt_codegen.spec.plants.SECOND_ORDER_PLANTS`) (so one Function serves a whole
+family of plants, e.g. the random plants of a study), printed to Python by the emitter for
+the simulation. The controller never sees them.
 
 =====================  =====  ================================================  =============
 model                  n      x2_dot                                            params

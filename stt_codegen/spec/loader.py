@@ -29,7 +29,7 @@ from ..errors import SpecError
 from .assumptions import Assumptions, combine_assumptions
 from .model_bounds import model_bounds
 from .motion import MovingObstacle, check_moving, is_moving, moving_obstacle
-from .plants import MODEL_KEYS, PLANTS, dimension_mismatch
+from .plants import MODEL_KEYS, PLANTS, SECOND_ORDER_MODELS, dimension_mismatch, is_second_order
 from .tasks import Task, build_tasks
 from .second_order import SecondOrder, parse_second_order
 from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
@@ -226,7 +226,10 @@ class Spec:
         Sampling rate of the deployed controller, Hz.
     plant_model : str
         ``"omnidirectional"`` (eq. (14)), ``"single-integrator"`` or ``"linear"``: the
-        plant ``simulate`` runs, and the source of the bounds in :attr:`assumptions`.
+        plant ``simulate`` runs, and the source of the bounds in :attr:`assumptions`. For a
+        spec whose ``plant.model`` is second order, ``"single-integrator"``: the position
+        stage ``x1_dot = x2`` that the tube and law (13) see (the plant itself is
+        :attr:`second_order`).
     disturbance_amplitude : float
         Bound on ``|w_i|`` of the simulated disturbance.
     linear_plant : LinearPlant or None
@@ -239,7 +242,9 @@ class Spec:
         in input units, one per input of the plant model (``None``: no ``[actuator]``,
         no limit).
     second_order : SecondOrder or None
-        ``[second_order]``: a second-order plant (docs/second-order.md); ``None`` for a
+        The second-order plant (``plant.model`` a second-order model, with
+        ``plant.parameters``, ``initial.velocity``, ``state_space.velocity_bound`` and the
+        ``[assumptions]`` of its second stage; docs/second-order.md); ``None`` for a
         first-order spec.
     source_hash : str
         SHA-256 of the spec file's bytes.
@@ -517,6 +522,9 @@ def _validate(raw: dict) -> Spec:
         raise SpecError("plant.model", mismatch)
     amplitude = doc.plant.disturbance_amplitude
     linear = _linear_plant(doc.plant, n)
+    second_order = _second_order(doc, n)
+    if second_order is not None:
+        model = "single-integrator"     # the position stage x1_dot = x2 (Spec.plant_model)
     tube = TubeParameters(**doc.tube.model_dump())
     return Spec(name=doc.name, prescribed_time=doc.prescribed_time, state_space=state_space,
                 initial_set=initial_set, initial_state=x0, initial_half_width=d0,
@@ -525,10 +533,11 @@ def _validate(raw: dict) -> Spec:
                 gain=doc.controller.gain, rate_hz=doc.controller.rate_hz,
                 plant_model=model, disturbance_amplitude=amplitude,
                 linear_plant=linear,
-                assumptions=_assumptions(doc.assumptions, n, amplitude, model, state_space,
-                                         linear),
+                assumptions=_assumptions(doc.assumptions if second_order is None
+                                         else AssumptionsTable(), n, amplitude, model,
+                                         state_space, linear),
                 input_bound=_input_bound(doc.actuator, model, n),
-                second_order=parse_second_order(doc.second_order, n),
+                second_order=second_order,
                 target_half_width_given=doc.target.half_width is not None,
                 tasks=build_tasks(doc.tasks or (), n, doc.prescribed_time,
                                   (state_space.lower, state_space.upper),
@@ -601,6 +610,36 @@ def _linear_plant(table: PlantTable, n: int) -> LinearPlant | None:
     g = _matrix(table.g, "plant.g", n) if table.g is not None else identity
     c = _vector(table.c, "plant.c", n) if table.c is not None else tuple(0.0 for _ in range(n))
     return LinearPlant(a, g, c)
+
+
+#: The ``[assumptions]`` keys a second-order model takes (those of its second stage).
+SECOND_ORDER_ASSUMPTIONS = ("input_gain", "drift_bound")
+
+
+def _second_order(doc: Any, n: int) -> SecondOrder | None:
+    """The second-order plant of a spec (``plant.model`` second order), or ``None``; the
+    second-order keys (:data:`~.second_order.SECOND_ORDER_ONLY`) refused on a first-order
+    model, the first-order ``[assumptions]`` keys refused on a second-order one."""
+    model = doc.plant.model
+    given = {"plant.parameters": doc.plant.parameters, "initial.velocity": doc.initial.velocity,
+             "state_space.velocity_bound": doc.state_space.velocity_bound}
+    if not is_second_order(model):
+        for field_name, value in given.items():
+            if value is not None:
+                raise SpecError(field_name, f"only a second-order plant.model "
+                                            f"({', '.join(SECOND_ORDER_MODELS)}) takes it "
+                                            f"(plant.model is {model!r})")
+        return None
+    table = doc.assumptions
+    for key in AssumptionsTable.model_fields:
+        if key in table.model_fields_set and key not in SECOND_ORDER_ASSUMPTIONS:
+            raise SpecError(f"assumptions.{key}",
+                            f"a second-order plant.model ({model!r}) takes only "
+                            f"{' and '.join(SECOND_ORDER_ASSUMPTIONS)} in [assumptions] "
+                            "(the bounds of its second stage)")
+    return parse_second_order(model, n, doc.plant.parameters, doc.initial.velocity,
+                              doc.state_space.velocity_bound, table.input_gain,
+                              table.drift_bound)
 
 
 def _assumptions(table: AssumptionsTable, n: int, amplitude: float, model: str,

@@ -1,5 +1,10 @@
 """The plant models a spec may name (``[plant] model``): the one registry of their facts.
 
+Two families: the first-order models of system (1) (:data:`PLANTS`), driven by law (13),
+and the second-order models ``x1_dot = x2``, ``x2_dot = f + g u + w``
+(:data:`SECOND_ORDER_PLANTS`), driven by the cascade law of docs/second-order.md. A
+second-order model implies order 2; there is no ``order`` key.
+
 Everything that needs a fact about a model reads it here: the schema (the allowed names
 and their descriptions), the loader (the state count a model requires, the ``[plant]``
 keys only some models take), the simulation's and the embedded loop's dynamics
@@ -12,8 +17,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["PLANTS", "PLANT_MODELS", "MODEL_KEYS", "NAMED_MODELS", "PlantModel",
-           "dimension_mismatch"]
+__all__ = ["ALL_PLANT_MODELS", "PLANTS", "PLANT_MODELS", "MODEL_KEYS", "NAMED_MODELS",
+           "PlantModel", "SECOND_ORDER_MODELS", "SECOND_ORDER_PLANTS", "SecondOrderModel",
+           "dimension_mismatch", "is_second_order"]
 
 
 @dataclass(frozen=True)
@@ -65,6 +71,43 @@ NAMED_MODELS: tuple[str, ...] = tuple(name for name, p in PLANTS.items() if not 
 MODEL_KEYS: dict[str, str] = {key: name for name, p in PLANTS.items() for key in p.keys}
 
 
+@dataclass(frozen=True)
+class SecondOrderModel:
+    """A named second-order model: its dimension (``None``: any), a summary, parameter
+    names and nominal parameter values (SI units)."""
+
+    name: str
+    summary: str
+    dimension: int | None
+    parameters: tuple[str, ...]
+    nominal: tuple[float, ...]
+
+
+#: Every second-order model, by ``plant.model`` name (dynamics:
+#: :mod:`stt_codegen.runtime.second_order_plants`).
+SECOND_ORDER_PLANTS: dict[str, SecondOrderModel] = {m.name: m for m in (
+    SecondOrderModel("double-integrator", "second order, x2_dot = u / mass + w, any n", None,
+                     ("mass",), (1.0,)),
+    SecondOrderModel("quadrotor", "second order, x2_dot = u / mass - (drag / mass) x2 - "
+                     "gravity e3 + w, thrust vector u, n = 3", 3, ("mass", "drag", "gravity"),
+                     (1.0, 0.3, 9.81)),
+    SecondOrderModel("two-link-arm", "second order, joint space, M(q) q_ddot + C(q, q_dot) "
+                     "q_dot + G(q) = u + w, n = 2", 2,
+                     ("mass1", "mass2", "length1", "length2", "inertia1", "inertia2",
+                      "gravity"),
+                     (1.0, 1.0, 1.0, 1.0, 1.0 / 12.0, 1.0 / 12.0, 0.0)),
+)}
+#: The second-order ``plant.model`` values, in order.
+SECOND_ORDER_MODELS: tuple[str, ...] = tuple(SECOND_ORDER_PLANTS)
+#: Every ``plant.model`` value a spec may give: first order, then second order.
+ALL_PLANT_MODELS: tuple[str, ...] = PLANT_MODELS + SECOND_ORDER_MODELS
+
+
+def is_second_order(model: str) -> bool:
+    """Whether ``plant.model`` names a second-order model (order 2: the cascade law)."""
+    return model in SECOND_ORDER_PLANTS
+
+
 def dimension_mismatch(model: str, n: int) -> str | None:
     """Why ``model`` cannot have ``n`` states, or ``None`` if it can (or is not a known
     model: the caller reports that).
@@ -72,10 +115,15 @@ def dimension_mismatch(model: str, n: int) -> str | None:
     Parameters
     ----------
     model : str
-        A :data:`PLANT_MODELS` entry.
+        A :data:`ALL_PLANT_MODELS` entry.
     n : int
-        State dimension.
+        State dimension (positions, for a second-order model).
     """
+    if model in SECOND_ORDER_PLANTS:
+        positions = SECOND_ORDER_PLANTS[model].dimension
+        if positions is None or positions == n:
+            return None
+        return f"the {model} model has {positions} positions, the state space has {n}"
     required = PLANTS[model].states if model in PLANTS else None
     if required is None or required == n:
         return None

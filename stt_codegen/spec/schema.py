@@ -23,8 +23,7 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Discriminator, Field, 
                       ValidationError)
 
 from ..errors import SpecError
-from .plants import PLANT_MODELS, PLANTS
-from .second_order import MODELS as SECOND_ORDER_MODELS
+from .plants import ALL_PLANT_MODELS, PLANTS, SECOND_ORDER_PLANTS
 
 #: Largest magnitude of any number in a spec.
 MAX_MAGNITUDE = 1e12
@@ -77,12 +76,22 @@ class BoxTable(_Table):
     upper: Vector = Field(description="upper corner, state units; upper >= lower")
 
 
+class StateSpaceTable(BoxTable):
+    """The state space ``X`` (positions, for a second-order plant)."""
+
+    velocity_bound: Annotated[list[Positive], Field(min_length=1, max_length=MAX_DIMENSION)] \
+        = _omitted("second-order models only: bound on |x2_i| the run must keep, one per "
+                   "position; default none")
+
+
 class InitialTable(BoxTable):
     """The initial set ``X_0`` (a box inside ``X``) and the initial state ``x(0)``."""
 
     state: Vector = _omitted("x(0), in the interior of X_0; default its centre")
     half_width: Vector = _omitted("d_0 of eq. (2), positive; default 0.8 x the room around "
                                   "x(0) in X_0")
+    velocity: Vector = _omitted("second-order models only: the initial velocity x2(0), one "
+                                "per position; default 0")
 
 
 class TargetTable(BoxTable):
@@ -175,15 +184,17 @@ class ControllerTable(_Table):
 class PlantTable(_Table):
     """The plant used in simulation only; the controller never sees it."""
 
-    model: Literal[PLANT_MODELS] = Field(  # type: ignore[valid-type]
-        "single-integrator", description="; ".join(f"{p.name}: {p.summary}"
-                                                   for p in PLANTS.values()))
+    model: Literal[ALL_PLANT_MODELS] = Field(  # type: ignore[valid-type]
+        "single-integrator", description="; ".join(
+            f"{p.name}: {p.summary}" for p in (*PLANTS.values(), *SECOND_ORDER_PLANTS.values())))
     disturbance_amplitude: NonNegative = Field(0.1, description="bound on |w_i|, state "
                                                                 "units per second")
     a: Matrix = _omitted("linear model only: the n x n matrix a, as rows; default zero")
     g: Matrix = _omitted("linear model only: the n x n input matrix g, as rows; default "
                          "the identity")
     c: Vector = _omitted("linear model only: the constant drift c; default zero")
+    parameters: Vector = _omitted("second-order models only: the simulated plant's "
+                                  "parameters, in the model's order; default nominal")
 
 
 class AssumptionsTable(_Table):
@@ -191,13 +202,16 @@ class AssumptionsTable(_Table):
 
     input_gain: Annotated[list[Number], Field(min_length=2, max_length=2)] = _omitted(
         "[g_min, g_max]: bounds on the eigenvalues of the symmetric part of g(x); "
-        "g_min > 0 (Assumption 2); default [1, 1]")
+        "g_min > 0 (Assumption 2); default [1, 1]. For a second-order model: of the second "
+        "stage's g")
     input_gain_skew: NonNegative = Field(0.0, description="bound on the norm of the skew "
                                                           "part of g(x)")
     input_gain_coupling: NonNegative = _omitted("bound on the off-diagonal part of each row "
                                                 "of g(x); default implied by the two above")
     drift_bound: NonNegative = Field(0.0, description="bound on |f(x)|, state units per "
-                                                      "second")
+                                                      "second. For a second-order model: "
+                                                      "on every |f_i| of the second stage, "
+                                                      "velocity units per second")
     disturbance_bound: NonNegative = _omitted("bound on |w(t)|, state units per second; "
                                               "default sqrt(n) x plant.disturbance_amplitude")
 
@@ -235,23 +249,6 @@ class TaskTable(_Table):
                  "lower/upper); the design picks the first that certifies, in this order")
 
 
-class SecondOrderTable(_Table):
-    """A second-order plant x1_dot = x2, x2_dot = f + g u + w (docs/second-order.md)."""
-
-    model: Literal[tuple(SECOND_ORDER_MODELS)] = Field(  # type: ignore[valid-type]
-        description="; ".join(f"{m.name}: {m.summary}" for m in SECOND_ORDER_MODELS.values()))
-    parameters: Vector = _omitted("the simulated plant's parameters, in the model's order; "
-                                  "default nominal")
-    initial_velocity: Vector = _omitted("x2(0), one per position; default 0")
-    velocity_bound: Annotated[list[Positive], Field(min_length=1, max_length=MAX_DIMENSION)] \
-        = _omitted("bound on |x2_i| the run must keep; default none")
-    input_gain: Annotated[list[Number], Field(min_length=2, max_length=2)] = Field(
-        [1.0, 1.0], description="[g_min, g_max]: declared bounds on the eigenvalues of the "
-                                "symmetric part of g")
-    drift_bound: NonNegative = Field(0.0, description="declared bound on every |f_i|, "
-                                                      "velocity units per second")
-
-
 class SpecDocument(_Table):
     """One prescribed-time reach-avoid-stay task (Definition 2.1) and its design parameters.
 
@@ -264,7 +261,7 @@ class SpecDocument(_Table):
     name: Annotated[str, Strict(), Field(pattern=NAME_REGEX)] = Field(
         description="identifier [A-Za-z][A-Za-z0-9_-]*, at most 64 characters")
     prescribed_time: Positive = Field(description="t_c of Definition 2.1, seconds")
-    state_space: BoxTable = Field(description="the state space X")
+    state_space: StateSpaceTable = Field(description="the state space X")
     initial: InitialTable
     target: TargetTable
     obstacles: list[Obstacle] = Field([], max_length=MAX_OBSTACLES,
@@ -279,8 +276,6 @@ class SpecDocument(_Table):
     tasks: Annotated[list[TaskTable], Field(max_length=MAX_TASKS)] = _omitted(
         "timed reach and stay tasks besides the target (docs/tasks.md), in window order; "
         "omitted: none")
-    second_order: SecondOrderTable = _omitted("a second-order plant and its cascade law "
-                                              "(docs/second-order.md); omitted: first order")
 
 
 #: The JSON Schema dialect of :func:`json_schema`: draft 7, which TOML language servers
@@ -294,10 +289,9 @@ def json_schema() -> dict[str, Any]:
 
 
 _TABLES: dict[str, type[_Table]] = {
-    "state_space": BoxTable, "initial": InitialTable, "target": TargetTable,
+    "state_space": StateSpaceTable, "initial": InitialTable, "target": TargetTable,
     "tube": TubeTable, "controller": ControllerTable, "plant": PlantTable,
     "assumptions": AssumptionsTable, "actuator": ActuatorTable,
-    "second_order": SecondOrderTable,
     "box": BoxObstacle, "ball": BallObstacle, "polytope": PolytopeObstacle,
     "tasks": TaskTable, "any_of": TaskBoxTable}
 

@@ -88,7 +88,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         (:func:`~stt_codegen.verify.sampled.sampled_checks`) and, for a spec with
         ``[actuator]``, ``sampled.input_bound``
         (:func:`~stt_codegen.verify.actuator.input_bound_check`). For a spec with
-        ``[second_order]``, the cascade's lemmas (:func:`~stt_codegen.verify.cascade.cascade_checks`)
+        a second-order ``plant.model``, the cascade's lemmas (:func:`~stt_codegen.verify.cascade.cascade_checks`)
         and the failed ``cascade.sampled`` instead of the last two.
     """
     stage = progress if isinstance(progress, _Stages) else _Stages(progress, design=False)
