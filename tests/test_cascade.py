@@ -161,6 +161,30 @@ def test_emitted_c_single_compiles_without_warnings(tmp_path, tube) -> None:
     assert "double" not in files["cascade_test.c"].split("*/", 1)[1]
 
 
+@pytest.mark.skipif(CC is None, reason="no C compiler (install gcc or clang)")
+def test_emitted_c_single_is_within_the_derived_bound(tmp_path, tube) -> None:
+    """The single C against the numpy oracle on 1000 points (times packed near window
+    edges and ``t_c``, ``alpha > 0``, ``|e2| <= 0.99``, inputs rounded to float32): every
+    ``u``, ``r`` and ``alpha_next`` within :func:`tolerance.cascade_bounds`."""
+    from stt_codegen.codegen import tolerance
+    lib, _ = _load(tmp_path, tube, "single")
+    step = lib.cascade_test_step
+    real_p = ctypes.POINTER(ctypes.c_float)
+    step.argtypes = [ctypes.c_float, ctypes.c_float] + [real_p] * 6
+    p = {k: np.asarray(v, dtype=np.float32).astype(float)
+         for k, v in _points(tube, 1000, seed=8).items()}
+    x1, x2, t, dt, alpha = (p[k] for k in ("x", "x2", "t", "dt", "alpha"))
+    u_ref, a_ref, r_ref, _, _ = cascade_reference.cascade_step(tube, STAGE, x1, x2, t, dt, alpha)
+    bounds = tolerance.cascade_bounds(tube, STAGE, x1, x2, t, alpha, r_ref, a_ref,
+                                      tolerance.UNIT_SINGLE)
+    for k in range(t.size):
+        inputs = [np.ascontiguousarray(a[k], dtype=np.float32) for a in (x1, x2, alpha)]
+        u, alpha_next, r = np.zeros(3, np.float32), np.zeros(6, np.float32), np.zeros(3, np.float32)
+        step(t[k], dt[k], *(a.ctypes.data_as(real_p) for a in (*inputs, u, alpha_next, r)))
+        for got, ref, bound in zip((u, r, alpha_next), (u_ref, r_ref, a_ref), bounds):
+            assert np.all(np.abs(got - ref[k]) <= bound[k]), (k, got, ref[k], bound[k])
+
+
 def test_generated_files_are_deterministic_and_say_what_they_are(tube) -> None:
     first = {**cascade_c_files(tube, STAGE, "cascade_test"),
              **cascade_python_file(tube, STAGE, "cascade_test")}

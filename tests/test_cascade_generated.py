@@ -1,5 +1,7 @@
 """The committed cascade controllers under generated/ (issue 22): compiled, run on their
-vectors from the numpy reference, with the project's warning flags; the Python module too."""
+vectors from the numpy reference, with the project's warning flags, every output within the
+vectors' derived tolerances (stt_codegen.codegen.tolerance.cascade_bounds) in both
+precisions; the Python module too."""
 
 from __future__ import annotations
 
@@ -18,17 +20,22 @@ CC = shutil.which("gcc") or shutil.which("clang")
 STRICT = ["-std=c99", "-O2", "-ffp-contract=off", "-Wall", "-Wextra", "-Wpedantic", "-Wshadow",
           "-Wconversion", "-Wdouble-promotion", "-Wcast-qual", "-Wstrict-prototypes",
           "-Wmissing-prototypes", "-Werror"]
-#: double C against the reference: the CasADi model meets it at 1e-12 (tests/test_cascade.py)
+#: double Python against the reference: the CasADi model meets it at 1e-12 (tests/test_cascade.py)
 DOUBLE_TOLERANCE = 1e-9
+#: Non-vacuity of the single-precision bound of ``u``: the share of entries whose tolerance
+#: is below 10 % of ``|u|`` (measured: 0.945 on second-order-s1, 1.0 on the quadrotor; the
+#: others have ``u`` near 0 (``|e2| < 0.04``) or ``r``'s bound at 2.7-4.2 % of ``rho2``
+#: with ``|e2| >= 0.43``, where ``g``'s slope multiplies it; docs/second-order.md)
+SINGLE_U_SHARE = 0.9
 
 
 def _folder(case: str, precision: str) -> Path:
     return REPO / "generated" / case / precision
 
 
-def _vectors(case: str) -> dict:
+def _vectors(case: str, precision: str = "double") -> dict:
     prefix = case.replace("-", "_") + "_cascade"
-    return json.loads((_folder(case, "double") / f"{prefix}_vectors.json").read_text())
+    return json.loads((_folder(case, precision) / f"{prefix}_vectors.json").read_text())
 
 
 def _build(tmp_path: Path, case: str, precision: str):
@@ -49,29 +56,37 @@ def _build(tmp_path: Path, case: str, precision: str):
 @pytest.mark.parametrize("precision", ["double", "single"])
 @pytest.mark.parametrize("case", CASES)
 def test_committed_c_meets_its_vectors(tmp_path, case, precision) -> None:
+    """Every output (``u``, ``r``, ``alpha_next``) within its vector's tolerance, the error
+    bound of :func:`stt_codegen.codegen.tolerance.cascade_bounds` for the folder's
+    precision; in single precision the bound of ``u`` is below 10 % of ``|u|`` on most
+    entries (not vacuous)."""
     step, real, dtype = _build(tmp_path, case, precision)
-    data = _vectors(case)
+    data = _vectors(case, precision)
+    assert data["precision"] == precision
     pointer = ctypes.POINTER(real)
-    worst = 0.0
     assert len(data["vectors"]) >= 32
+    ratios = {"u": 0.0, "r": 0.0, "alpha_next": 0.0}
+    tight = []
     for v in data["vectors"]:
         x1, x2, alpha = (np.ascontiguousarray(v[k], dtype=dtype) for k in ("x1", "x2", "alpha"))
+        # the inputs are exact in the precision, as the bound assumes
+        assert all(np.array_equal(a.astype(np.float64), v[k])
+                   for a, k in ((x1, "x1"), (x2, "x2"), (alpha, "alpha")))
         n = x1.size
         u, alpha_next, r = np.zeros(n, dtype), np.zeros(2 * n, dtype), np.zeros(n, dtype)
         code = step(v["t"], data["dt"], *(a.ctypes.data_as(pointer)
                                            for a in (x1, x2, alpha, u, alpha_next, r)))
         assert code == v["status"] == 0
         assert np.all(np.isfinite(u)) and np.all(np.isfinite(alpha_next))
-        if precision == "single":
-            # no derived float bound for the cascade yet (docs/second-order.md): the float
-            # step pushes the same way; its error is measured, not asserted
-            assert np.all(np.sign(u) == np.sign(v["u"]))
-            continue
         for got, name in ((u, "u"), (r, "r"), (alpha_next, "alpha_next")):
-            expected = np.array(v[name])
-            error = np.abs(got - expected) / np.maximum(1.0, np.abs(expected))
-            worst = max(worst, float(error.max()))
-    assert worst <= DOUBLE_TOLERANCE, worst
+            error = np.abs(got.astype(np.float64) - np.array(v[name]))
+            tolerance = np.array(v["tol_" + name])
+            assert np.all(error <= tolerance), (name, v["t"], error, tolerance)
+            ratios[name] = max(ratios[name], float(np.max(error / tolerance)))
+        tight.extend(np.array(v["tol_u"]) < 0.1 * np.abs(v["u"]))
+    assert all(ratio <= 1.0 for ratio in ratios.values()), ratios
+    if precision == "single":
+        assert np.mean(tight) >= SINGLE_U_SHARE, np.mean(tight)
 
 
 @pytest.mark.parametrize("case", CASES)

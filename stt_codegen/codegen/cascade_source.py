@@ -123,23 +123,32 @@ def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str) -> 
 VECTOR_COUNT = 64
 
 
-def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_COUNT) -> dict:
+def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_COUNT,
+                    precision: str = "double") -> dict:
     """Test vectors of the cascade step from the numpy oracle (JSON-ready, deterministic).
 
     Points: ``t`` spread over ``[0, 1.1 t_c]`` where the tube at ``alpha = 0`` is at least
     1e-3 wide, ``alpha = 0``, ``dt`` the design's period,
     ``x1`` inside the position tube (``|e1| <= 0.9``), ``x2 = r + rho2 s`` with ``|s| <=
-    0.9``, from a fixed seed; expected ``u``, ``r``, ``alpha_next`` and status from
-    :func:`stt_codegen.tube.cascade_reference.cascade_step`.
+    0.9``, from a fixed seed; ``t``, ``dt``, ``x1`` and ``x2`` are float32 numbers (exact in
+    both precisions, as the first-order vectors). Expected ``u``, ``r``, ``alpha_next`` and
+    status from :func:`stt_codegen.tube.cascade_reference.cascade_step`; absolute
+    tolerances ``tol_u``, ``tol_r``, ``tol_alpha_next`` from
+    :func:`stt_codegen.codegen.tolerance.cascade_bounds` for ``precision`` (double: with the
+    floor ``1e-12 max(1, |ref|)``).
     """
     import numpy as np
 
     from ..tube import cascade_reference, reference
+    from . import tolerance as T
+
+    def f32(a):
+        return np.asarray(a, dtype=np.float32).astype(np.float64)
 
     rng = np.random.default_rng(22)
     n = design.dimension
-    t = np.linspace(0.0, 1.1 * design.prescribed_time, 4 * count)
-    dt = 1.0 / design.rate_hz
+    t = f32(np.linspace(0.0, 1.1 * design.prescribed_time, 4 * count))
+    dt = float(np.float32(1.0 / design.rate_hz))
     alpha = np.zeros((t.size, 2 * n))
     g_l, g_u, _, _ = reference.adaptive_tube(design, t, alpha)
     # where the tube at alpha = 0 is at least 1e-3 wide (where bumps conflict it is empty
@@ -147,21 +156,28 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     keep = np.flatnonzero(np.all(g_u - g_l > 1e-3, axis=1))[::4][:count]
     t, alpha, g_l, g_u = t[keep], alpha[keep], g_l[keep], g_u[keep]
     count = t.size
-    x1 = (g_u + g_l) / 2 + (g_u - g_l) / 2 * rng.uniform(-0.9, 0.9, (count, n))
+    x1 = f32((g_u + g_l) / 2 + (g_u - g_l) / 2 * rng.uniform(-0.9, 0.9, (count, n)))
     _, _, r, _, _ = cascade_reference.cascade_step(design, stage, x1, np.zeros((count, n)),
                                                    t, dt, alpha)
     rho2 = cascade_reference.velocity_tube(stage, t)
-    x2 = r + rho2 * rng.uniform(-0.9, 0.9, (count, n))
+    x2 = f32(r + rho2 * rng.uniform(-0.9, 0.9, (count, n)))
     u, alpha_next, r, inside_p, inside_v = cascade_reference.cascade_step(
         design, stage, x1, x2, t, dt, alpha)
     status = np.where(inside_p == 0, CASCADE_OUTSIDE_POSITION_TUBE,
                       np.where(inside_v == 0, CASCADE_OUTSIDE_VELOCITY_TUBE, CASCADE_OK))
+    unit = T.unit_roundoff(precision)
+    tol_u, tol_r, tol_a = T.cascade_bounds(design, stage, x1, x2, t, alpha, r, alpha_next, unit)
+    if precision == "double":
+        tol_u, tol_r, tol_a = (T.with_double_floor(tol, ref) for tol, ref in
+                               ((tol_u, u), (tol_r, r), (tol_a, alpha_next)))
     return {"_generated": "GENERATED FILE, DO NOT EDIT: cascade test vectors from the numpy "
                           "reference (stt_codegen.tube.cascade_reference).",
-            "dt": dt,
+            "dt": dt, "precision": precision, "unit_roundoff": unit,
             "vectors": [{"t": float(t[k]), "x1": x1[k].tolist(), "x2": x2[k].tolist(),
                          "alpha": alpha[k].tolist(), "u": u[k].tolist(), "r": r[k].tolist(),
-                         "alpha_next": alpha_next[k].tolist(), "status": int(status[k])}
+                         "alpha_next": alpha_next[k].tolist(), "status": int(status[k]),
+                         "tol_u": tol_u[k].tolist(), "tol_r": tol_r[k].tolist(),
+                         "tol_alpha_next": tol_a[k].tolist()}
                         for k in range(count)]}
 
 
@@ -200,7 +216,8 @@ def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
         texts.update(cascade_c_files(design.tube, stage, prefix, options.precision))
     if "python" in options.langs:
         texts.update(cascade_python_file(design.tube, stage, prefix))
-    texts[f"{prefix}_vectors.json"] = json.dumps(cascade_vectors(design.tube, stage),
+    texts[f"{prefix}_vectors.json"] = json.dumps(cascade_vectors(design.tube, stage,
+                                                                 precision=options.precision),
                                                  indent=1) + "\n"
     files = {name: text.encode() for name, text in texts.items()}
     files[MANIFEST] = (json.dumps(manifest(design.spec, options, files), indent=2,

@@ -26,6 +26,12 @@ libm whose functions are within a few ulp of correctly rounded.
 * **alpha_next.** The Newton iteration converges to a few ulp of the root; the root's
   sensitivity to ``psi`` is at most 1 and to ``theta``'s relative error at most
   ``|alpha_next| + |alpha|``. Bound: ``GAMMA_FACTOR * unit * (S + |alpha| + |alpha_next|)``.
+* **The cascade** (second-order plants, :func:`cascade_bounds`): ``r`` is law (13) with
+  gain ``k1``, bounded as ``u`` above (``dr``); the velocity error ``e2 = (x2 - r) / rho2``
+  takes ``dr``, the difference's rounding and ``rho2(t)``'s error
+  (:func:`velocity_tube_bound`); ``u = -(2 k2 / rho2) g(e2)`` is again the spread of
+  ``g`` over ``[e2 - de2, e2 + de2]``, scaled, plus local rounding, the latter evaluated
+  at the interval's far end (:func:`_law_error`); ``alpha_next`` as above.
 """
 
 from __future__ import annotations
@@ -102,3 +108,105 @@ def alpha_bound(design: TubeDesign, alpha, alpha_next, unit: float) -> np.ndarra
 def with_double_floor(bound: np.ndarray, reference: np.ndarray) -> np.ndarray:
     """``max(bound, 1e-12 max(1, |reference|))``: the double tolerance of the vectors."""
     return np.maximum(bound, DOUBLE_FLOOR * np.maximum(1.0, np.abs(reference)))
+
+
+#: Roundings of the velocity tube ``rho2(t)``: the literals ``rho2(0)``, ``rho2(inf)``,
+#: ``l`` (3), ``rho2(0) - rho2(inf)``, ``-l t``, ``exp`` (2), the product and the sum (5):
+#: 8, with the 4x margin of :data:`GAMMA_FACTOR`.
+VELOCITY_TUBE_FACTOR = 32.0
+
+
+def velocity_tube_bound(stage, t, rho2, unit: float) -> np.ndarray:
+    """Bound on the error of ``rho2(t)``, shape (N, n): ``(32 + 8 l min(t, 80/l)) unit
+    rho2``. The exponent's relative error (``l``'s literal and the product, ``2 unit``) is
+    multiplied by ``l t`` in ``exp``; the other roundings are relative to terms of ``rho2``
+    (each at most ``rho2``); ``4x`` margin on both."""
+    t = np.maximum(np.atleast_1d(np.asarray(t, dtype=float)), 0.0)
+    exponent = np.minimum(stage.decay * t, 80.0)
+    return (VELOCITY_TUBE_FACTOR + 4.0 * 2.0 * exponent)[:, None] * unit * np.asarray(rho2)
+
+
+def _divided(numerator_error, value, width, width_error, unit: float) -> np.ndarray:
+    """Error bound of a computed ``e = z / w`` (``value = e`` exact): ``z`` off by
+    ``numerator_error``, ``w`` by ``width_error`` (2 wherever ``w <= width_error``: ``e`` is
+    then undetermined and the clamp bounds it), plus the quotient's rounding."""
+    safe = width > width_error
+    de = (numerator_error + np.abs(value) * width_error) / np.where(safe, width - width_error, 1.0)
+    de = de + 2.0 * unit * (np.abs(value) + de)
+    return np.where(safe, de, 2.0)
+
+
+def _law_error(e, de, factor, relative, unit: float) -> np.ndarray:
+    """Error bound of a computed ``factor g(e)`` (law (13)'s form) whose ``e`` is off by at
+    most ``de`` and whose ``factor`` by ``relative`` (relative): the exact spread of ``g``
+    over ``[e - de, e + de]`` (clamped to ``+-E_MAX`` as the code does), plus, at the far
+    end of the interval (``|g| <= g_far``, ``|e| <= e_far``), the factor's error
+    ``relative g_far`` and the local rounding of ``g`` there, ``16 unit (g_far + 1) /
+    (1 - e_far^2)``: ``log`` of the rounded quotient ``(1+e)/(1-e)`` is off by ``3 unit``
+    plus its ulp, and the computed ``1 - e*e`` by ``unit (e^2 + 1 - e^2)`` absolute, a
+    relative ``unit / (1 - e^2)`` (this is what grows near the boundary), with the
+    quotients and products: at most ``unit (5 |g| + 3) / (1 - e^2)``, 3x margin."""
+    g0 = _g(e)
+    low, high = _g(e - de), _g(e + de)
+    spread = np.maximum(high - g0, g0 - low)
+    g_far = np.maximum(np.abs(low), np.abs(high))
+    e_far = np.minimum(np.abs(e) + de, E_MAX)
+    local = LAW_FACTOR * unit * (g_far + 1.0) / (1.0 - e_far * e_far)
+    return factor * (spread + local + relative * g_far)
+
+
+def cascade_bounds(design: TubeDesign, stage, x1, x2, t, alpha, r_ref, alpha_next,
+                   unit: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Bounds on the errors of the cascade step's ``u``, ``r`` (shape (N, n)) and
+    ``alpha_next`` (N, 2n) against the double reference (docs/second-order.md, "Generated
+    code"). Inputs exact in the precision, as in the module docstring; ``r_ref``,
+    ``alpha_next`` the reference's outputs; ``stage`` a
+    :class:`~stt_codegen.tube.second_stage.SecondStage`.
+
+    * **r** ``= -(4 k1 / w) g(e1)``, law (13) with gain ``k1`` on the adaptive tube: the
+      argument of "Control u" above, with the tube bounds' ``dg = GAMMA_FACTOR unit S``,
+      ``e1``'s error ``de1 = (2 |x1| unit + 2 (1 + |e1|) dg) / (w - 2 dg) + 4 unit (|e1| +
+      de1)`` (:func:`u_bound`'s ``de`` with the computed width ``w - 2 dg`` as divisor),
+      and :func:`_law_error` (the spread of ``g`` over ``[e1 - de1, e1 + de1]``, ``w``'s
+      relative error ``2 dg / (w - 2 dg)``, the local rounding at the interval's far
+      end): ``dr``.
+    * **rho2(t)**: :func:`velocity_tube_bound`, ``drho``.
+    * **e2** ``= (x2 - r) / rho2`` (``rho2`` floored at ``GAMMA_D_MIN``): the computed
+      difference is off by ``dr (1 + unit) + unit |x2 - r|``; divided by the computed
+      ``rho2`` (off by ``drho``) and rounded, ``de2`` (:func:`_divided`).
+    * **u** ``= -(2 k2 / rho2) g(e2)``, the same ``g`` (``xi2 eps2`` on the tube of width
+      ``2 rho2``): :func:`_law_error` with ``factor = 2 k2 / rho2`` and ``rho2``'s relative
+      error ``drho / (rho2 - drho)``.
+    * **alpha_next**: the first stage's implicit step, unchanged: :func:`alpha_bound`.
+
+    Where ``e +- de`` reaches ``+-E_MAX`` the bound covers the clamped value and is as wide
+    as ``g``'s range there (the computed state may be outside the tube).
+    """
+    import dataclasses
+
+    from ..tube import reference
+    from ..tube.cascade_reference import velocity_tube
+
+    x1, x2 = np.atleast_2d(x1), np.atleast_2d(x2)
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    alpha = np.atleast_2d(alpha)
+    first = dataclasses.replace(design, gain=stage.position_gain, input_bound=None)
+    gamma_l, gamma_u, _, _ = reference.adaptive_tube(first, t, alpha)
+    dg = gamma_bound(first, alpha, unit)
+    width = np.maximum(gamma_u - gamma_l, GAMMA_D_MIN)
+    e1 = (2.0 * x1 - (gamma_u + gamma_l)) / width
+    # numerator 2 x1 - (gamma_U + gamma_L): the bounds' 2 dg and the roundings of the sum
+    # and the difference, unit (2 |x1| + 2 |e1| w); the width's 2 dg in _divided
+    de1 = _divided(2.0 * dg + unit * (2.0 * np.abs(x1) + 2.0 * np.abs(e1) * width), e1,
+                   width, 2.0 * dg, unit)
+    relative1 = np.where(width > 2.0 * dg, 2.0 * dg / np.maximum(width - 2.0 * dg, 1e-300),
+                         np.inf)
+    tol_r = _law_error(e1, de1, 4.0 * stage.position_gain / width, relative1, unit)
+    rho2 = np.maximum(velocity_tube(stage, t), GAMMA_D_MIN)
+    drho = velocity_tube_bound(stage, t, rho2, unit)
+    z = x2 - r_ref
+    e2 = z / rho2
+    de2 = _divided((1.0 + unit) * tol_r + unit * np.abs(z), e2, rho2, drho, unit)
+    relative2 = drho / (rho2 - drho)
+    tol_u = _law_error(e2, de2, 2.0 * stage.velocity_gain / rho2, relative2, unit)
+    return tol_u, tol_r, alpha_bound(first, alpha, alpha_next, unit)
