@@ -22,7 +22,9 @@ class FailureKind(Enum):
     ``NO_PASSAGE`` (no via-point path: the free passage is too narrow),
     ``WALLED_OFF`` (the start or the target is enclosed by obstacles), ``PLANT``
     (the spec's plant violates Assumption 2), ``INPUT_BOUND`` (no design within ``t_c``
-    is proved to keep law (13) within ``[actuator] input_bound``).
+    is proved to keep law (13) within ``[actuator] input_bound``), ``TRACKING``
+    (``tube.method = "paper"``: every certified tube is one the gain cannot follow, its
+    sampled-data proof bounds ``|e|`` above 0.7, :func:`~.tracking.unfollowable`).
     """
 
     SAMPLING_RATE = "sampling rate"
@@ -39,6 +41,7 @@ class FailureKind(Enum):
     WALLED_OFF = "walled off"
     PLANT = "plant assumption"
     INPUT_BOUND = "input bound"
+    TRACKING = "tracking"
 
 
 def property_kind(name: str) -> FailureKind:
