@@ -77,6 +77,7 @@ def test_the_peak_is_law_13s_input():
     proof = input_peak(tube.gain, np.abs(e), g_u - g_l, t, 2.0)
     assert np.allclose(proof.peak, np.abs(u).max(axis=0), rtol=1e-12)
     assert proof.time == (1.9, 0.7)
+    assert proof.max_abs_e == 0.8             # the |e| bound the peak is proved from
     assert phi(0.0) == 0.0 and phi(0.5) == pytest.approx(2 * math.atanh(0.5) / 0.75)
 
 
