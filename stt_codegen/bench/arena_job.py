@@ -48,7 +48,9 @@ def design_failure(message: str) -> str:
 
     Categories: ``design: no free passage for via points``,
     ``design: obstacle next to target``, ``design: no room beside obstacle``,
-    ``design: bound too fast for the sampling rate``, ``design: <certificate property>``
+    ``design: gain cannot follow the tube`` (the paper's method, :func:`stt_codegen.design.
+    tracking.unfollowable`), ``design: bound too fast for the sampling rate``,
+    ``design: <certificate property>``
     (e.g. ``avoids obstacle``, ``non-empty``, ``inside target after t_c``),
     ``design: other``.
     """
@@ -58,6 +60,8 @@ def design_failure(message: str) -> str:
         return "design: obstacle next to target"
     if "cannot be circumvented" in message:
         return "design: no room beside obstacle"
+    if "is proved only to |e|" in message:
+        return "design: gain cannot follow the tube"
     first = message.split("; ")[0]
     if "moves" in first and "tube widths" in first:
         return "design: bound too fast for the sampling rate"

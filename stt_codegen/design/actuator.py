@@ -7,7 +7,9 @@ certified widths, :mod:`.input_bound`) shows that law (13) never asks any input 
 than its bound. Deterministic, in this order, the first tube that meets the bound wins:
 
 1. the design of the spec without ``[actuator]`` (the default design: a spec whose
-   default tube keeps the bound gets exactly that tube), then :func:`slower_variants`:
+   default tube keeps the bound gets exactly that tube), except that ``auto`` does not
+   prefer the smoother via tube by its speed estimate here (``design_tube``: the proved
+   peak orders the tubes instead), then :func:`slower_variants`:
 2. **softer circumvents**: when the default is the paper's method with circumvents and
    the spec leaves ``tube.circumvent_sharpness`` free, the paper's search with every
    circumvent's sharpness ``k^j`` fixed to each value of the ladder above the default's

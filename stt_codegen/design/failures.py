@@ -22,11 +22,14 @@ class FailureKind(Enum):
     ``NO_PASSAGE`` (no via-point path: the free passage is too narrow),
     ``WALLED_OFF`` (the start or the target is enclosed by obstacles), ``PLANT``
     (the spec's plant violates Assumption 2), ``INPUT_BOUND`` (no design within ``t_c``
-    is proved to keep law (13) within ``[actuator] input_bound``), ``TASK`` (a timed
-    task of ``[[tasks]]`` is not certified, or its plan has no time; docs/tasks.md).
-    Moving obstacles (docs/moving-obstacles.md): ``MOVING_OBSTACLE`` (the tube may meet one in space-time),
-    ``SWEPT_AT_START`` (no design avoids them in space-time, and the region a moving
-    obstacle sweeps meets the start or the target, so it cannot be avoided as a static box).
+    is proved to keep law (13) within ``[actuator] input_bound``), ``TRACKING``
+    (``tube.method = "paper"``: every certified tube is one the gain cannot follow, its
+    sampled-data proof bounds ``|e|`` above 0.7, :func:`~.tracking.unfollowable`),
+    ``TASK`` (a timed task of ``[[tasks]]`` is not certified, or its plan has no time;
+    docs/tasks.md). Moving obstacles (docs/moving-obstacles.md): ``MOVING_OBSTACLE``
+    (the tube may meet one in space-time), ``SWEPT_AT_START`` (no design avoids them in
+    space-time, and the region a moving obstacle sweeps meets the start or the target,
+    so it cannot be avoided as a static box).
     """
 
     SAMPLING_RATE = "sampling rate"
@@ -46,6 +49,7 @@ class FailureKind(Enum):
     TASK = "task"
     MOVING_OBSTACLE = "avoids moving obstacle"
     SWEPT_AT_START = "swept region at start or target"
+    TRACKING = "tracking"
 
 
 def property_kind(name: str) -> FailureKind:

@@ -53,6 +53,10 @@ class InputProof:
         End of the samples covered, seconds (the sampled check's, ``1.1 t_c``).
     reason : str
         When not proved: why (the sampled check's failure).
+    max_abs_e : float
+        The bound of ``|e_i(t_k)|`` the peak is proved from, largest over the samples and
+        dimensions (``inf`` when not proved); ``design_tube`` reads it to refuse a paper
+        tube one gain cannot follow (:mod:`.tracking`).
     """
 
     proved: bool
@@ -60,6 +64,7 @@ class InputProof:
     time: tuple[float, ...]
     horizon: float
     reason: str = ""
+    max_abs_e: float = math.inf
 
     def ratio(self, bound: tuple[float, ...]) -> float:
         """``max_i peak_i / bound_i`` (``inf`` when not proved): at most 1 meets the bound."""
@@ -106,13 +111,15 @@ def input_peak(gain: float, abs_e: "np.ndarray", width: "np.ndarray", t: "np.nda
     Returns
     -------
     InputProof
-        ``peak_i = max_k 4 k phi(abs_e_k,i) / max(width_k,i, GAMMA_D_MIN)``, proved.
+        ``peak_i = max_k 4 k phi(abs_e_k,i) / max(width_k,i, GAMMA_D_MIN)``, proved;
+        ``max_abs_e = max abs_e``.
     """
     import numpy as np
     u = 4.0 * gain * phi(abs_e) / np.maximum(width, GAMMA_D_MIN)
     where = np.argmax(u, axis=0)
     return InputProof(True, tuple(float(v) for v in u.max(axis=0)),
-                      tuple(float(t[k]) for k in where), float(horizon))
+                      tuple(float(t[k]) for k in where), float(horizon),
+                      max_abs_e=float(np.max(abs_e)))
 
 
 #: ``(tube, spec) -> InputProof``: proves the peak inputs of a designed tube (with its gain)

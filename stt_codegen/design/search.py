@@ -37,7 +37,7 @@ from .moving import design_moving
 from .gain import derived_gain
 from .plant_check import plant_failure
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
-from .tracking import tracking_demand
+from .tracking import SMOOTHER_RATIO, centre_speed, tracking_demand, unfollowable
 from .tasks import alternatives, plan_tasks
 from .via import via_design
 from .windows import WINDOW_INFLATION, candidates, overlap_interval, progress_time
@@ -296,7 +296,15 @@ def design_tube(spec: Spec) -> Design:
     if spec.moving_obstacles:             # obstacles that move: design/moving.py
         return design_moving(spec, design_tube, check_tube)
     if spec.input_bound is not None:      # [actuator]: design/actuator.py
-        return design_within_bound(spec, design_tube)
+        # the bound's proof orders the tubes there (default, softer circumvents, via
+        # points): auto's estimate of the smoother tube plays no part
+        return design_within_bound(spec, lambda free: _design(free, smoother=False))
+    return _design(spec, smoother=True)
+
+
+def _design(spec: Spec, smoother: bool) -> Design:
+    """:func:`design_tube` without ``[actuator]``; ``smoother``: ``auto`` may prefer the
+    smoother via tube to the paper's circumvents (:func:`_trackable`)."""
     started = time.perf_counter()
     reason = plant_failure(spec)
     if reason:
@@ -319,7 +327,8 @@ def design_tube(spec: Spec) -> Design:
             continue          # the paper's search ended for another reason than its budget
         try:
             tube, check = (_via(spec, base) if used == METHOD_VIA
-                           else paper_design(spec, base, budget, work))
+                           else paper_design(spec, base, budget, work,
+                                             followable=method == METHOD_PAPER))
             break
         except DesignError as exc:
             errors[used] = exc
@@ -343,7 +352,7 @@ def design_tube(spec: Spec) -> Design:
         raise DesignError(message, kind=kind, tried=tried)
     tube = _with_gain(tube, check, spec)
     if method == "auto" and used == METHOD_PAPER and METHOD_VIA not in errors:
-        tube, used, check = _trackable(spec, base, tube, check)
+        tube, used, check = _trackable(spec, base, tube, check, smoother)
     return Design(tube, used, check, time.perf_counter() - started, spec=spec)
 
 
@@ -355,20 +364,29 @@ def _with_gain(tube: TubeDesign, check: TubeCheck, spec: Spec) -> TubeDesign:
     return replace(tube, gain=gain)
 
 
-def _trackable(spec: Spec, base: TubeDesign, tube: TubeDesign,
-               check: TubeCheck) -> tuple[TubeDesign, str, TubeCheck]:
-    """``auto``'s choice between the paper's tube and via points when the paper's asks for
-    more gain than it has (:func:`~stt_codegen.design.tracking.tracking_demand` above 1):
-    the via tube if it has a design that asks for less, else the paper's."""
+def _trackable(spec: Spec, base: TubeDesign, tube: TubeDesign, check: TubeCheck,
+               prefer_smoother: bool = True) -> tuple[TubeDesign, str, TubeCheck]:
+    """``auto``'s choice between the paper's tube and via points: the via tube when the
+    paper's asks for more gain than it has
+    (:func:`~stt_codegen.design.tracking.tracking_demand` above 1) and the via tube asks
+    for less, or (with ``prefer_smoother``: not under ``[actuator]``, whose proof orders
+    the tubes) when the paper's has circumvents and the via tube's centre moves at most
+    ``SMOOTHER_RATIO`` of the paper's peak speed
+    (:func:`~stt_codegen.design.tracking.centre_speed`; docs/design.md, "Smoother tubes");
+    else the paper's."""
     demand = tracking_demand(tube, check.certificate, spec)
-    if demand.ratio <= 1.0:
+    smoother = prefer_smoother and bool(tube.circumvents)
+    if demand.ratio <= 1.0 and not smoother:
         return tube, METHOD_PAPER, check
     try:
         via, via_check = _via(spec, base)
     except DesignError:
         return tube, METHOD_PAPER, check
     via = _with_gain(via, via_check, spec)
-    if tracking_demand(via, via_check.certificate, spec).ratio < demand.ratio:
+    if demand.ratio > 1.0 and tracking_demand(via, via_check.certificate, spec).ratio < demand.ratio:
+        return via, METHOD_VIA, via_check
+    if smoother and (centre_speed(via, via_check.certificate)
+                     <= SMOOTHER_RATIO * centre_speed(tube, check.certificate)):
         return via, METHOD_VIA, via_check
     return tube, METHOD_PAPER, check
 
@@ -405,7 +423,8 @@ def _via(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck]:
 
 
 def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_CHECKS,
-                 max_work: int | None = None) -> tuple[TubeDesign, TubeCheck]:
+                 max_work: int | None = None,
+                 followable: bool = False) -> tuple[TubeDesign, TubeCheck]:
     """The paper's design: circumvents (7)-(9) on the single reach tube ``base``.
 
     Parameters
@@ -419,6 +438,10 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
         Certificate work (``Certificate.work``, intervals computed), summed over the
         candidates, at most (default: no limit beyond :data:`CANDIDATE_INTERVALS` per
         candidate).
+    followable : bool
+        Also refuse a certified tube with circumvents that law (13), with the gain derived
+        for it, cannot follow (:func:`~stt_codegen.design.tracking.unfollowable`) and
+        search on (``tube.method = "paper"``, which has no other tube to fall back on).
 
     Returns
     -------
@@ -430,7 +453,8 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
     ------
     DesignError
         No choice of circumvents passes :func:`check_tube` (or ``max_checks`` candidates
-        or ``max_work`` intervals were used up).
+        or ``max_work`` intervals were used up); with ``followable``, kind ``TRACKING``
+        when every certified choice was one the gain cannot follow.
     """
     boxes = spec.obstacle_boxes()
     delta_b = spec.tube.delta_b
@@ -470,7 +494,9 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
     final_failure: list[TubeCheck] = []     # the complete tubes' checks
 
     def reasons() -> str:
-        return "; ".join(f"obstacle {j}: {f.reason}" for j, f in sorted(failures.items()))
+        unfollowed = [f.reason for f in final_failure if f.kind is FailureKind.TRACKING][:1]
+        return "; ".join([f"obstacle {j}: {f.reason}" for j, f in sorted(failures.items())]
+                         + [f"the first certified tube: {r}" for r in unfollowed])
 
     def check(design: TubeDesign, **kwargs) -> TubeCheck:
         if budget[0] <= 0 or budget[1] <= 0:
@@ -497,7 +523,14 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
             accepted = check(design, resume=None if parent is None
                              else (parent.certificate, math.inf))
             if accepted.passed:
-                return design, accepted
+                # the circumvents are what one gain may not follow: a straight tube is the
+                # method's only one, and its proved |e| is far below (docs/design.md)
+                why = (unfollowable(_with_gain(design, accepted, spec), accepted.certificate,
+                                    spec) if followable and design.circumvents else "")
+                if not why:
+                    return design, accepted
+                accepted = replace(accepted, passed=False, reason=why,
+                                   kind=FailureKind.TRACKING)
             final_failure.append(accepted)
             if level > best[0]:
                 best[:] = [level, design]
@@ -533,6 +566,8 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
             raise DesignError(f"the reach tube fails its check: {base_check.reason}",
                               kind=base_check.kind, tried=base)
         first = (failures[min(failures)] if failures else final_failure[0])
+        # a certified tube the gain cannot follow: that is what failed
+        first = next((f for f in final_failure if f.kind is FailureKind.TRACKING), first)
         raise DesignError("no choice of circumvent dimension and side passes the tube "
                           f"check ({reasons() or 'the final check failed'})",
                           kind=first.kind, tried=best[1])

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -34,12 +35,17 @@ from ..spec.loader import Spec
 from ..tube import reference
 from ..tube.parameters import TubeDesign
 from .certificate import Certificate
+from .input_bound import input_prover
 
 #: The normalized error the demand is computed for (issue 20's acceptance: ``max |e| <=
 #: 0.7`` in closed loop).
 TRACKING_ERROR = 0.7
 #: Values of ``e`` in ``[-E, E]`` tried for the least speed the state needs.
 _ERRORS = np.linspace(-TRACKING_ERROR, TRACKING_ERROR, 29)
+#: ``auto`` prefers the via-point tube to the paper's tube with circumvents when the via
+#: tube's centre moves at most this fraction of the paper tube's peak centre speed
+#: (:func:`centre_speed`; docs/design.md, "Smoother tubes").
+SMOOTHER_RATIO = 0.8
 
 
 @dataclass(frozen=True)
@@ -77,11 +83,7 @@ def tracking_demand(design: TubeDesign, certificate: Certificate, spec: Spec) ->
     -------
     TrackingDemand
     """
-    state = certificate.state
-    t = np.array(state.points, dtype=float) / design.rate_hz
-    alpha = 0.5 * (np.array([e[0] for e in state.entries]) + np.array([e[1] for e in state.entries]))
-    with reference.numpy_math():
-        g_l, g_u, rate_l, rate_u = reference.adaptive_tube(design, t, alpha)
+    t, g_l, g_u, rate_l, rate_u = _partition(design, certificate)
     speed = np.full(g_l.shape, np.inf)
     for e in _ERRORS:
         speed = np.minimum(speed, np.abs((1.0 + e) * rate_u + (1.0 - e) * rate_l) / 2.0)
@@ -95,3 +97,92 @@ def tracking_demand(design: TubeDesign, certificate: Certificate, spec: Spec) ->
     ratio = need * (g_u - g_l) / (4.0 * phi * design_point * design.gain)
     k, i = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
     return TrackingDemand(float(ratio[k, i]), float(t[k]), int(i))
+
+
+def _partition(design: TubeDesign, certificate: Certificate) -> tuple[np.ndarray, ...]:
+    """The tube and its rates at the certificate's partition (``alpha`` midway in its
+    proven bounds): ``t`` (K,), ``gamma_L``, ``gamma_U``, their rates (K, n)."""
+    state = certificate.state
+    t = np.array(state.points, dtype=float) / design.rate_hz
+    alpha = 0.5 * (np.array([e[0] for e in state.entries]) + np.array([e[1] for e in state.entries]))
+    with reference.numpy_math():
+        return (t, *reference.adaptive_tube(design, t, alpha))
+
+
+def centre_speed(design: TubeDesign, certificate: Certificate) -> float:
+    """The peak speed of the tube's centre, ``max |gamma_L_dot + gamma_U_dot| / 2`` over
+    the dimensions and the instants of the certificate's partition (an estimate).
+
+    With the gains of the bench's arenas the state rides near the centre (median ``max
+    |e|`` below 0.01), so law (13) asks about this speed of the plant: the estimate
+    :func:`~stt_codegen.design.search.design_tube`'s ``auto`` compares between the paper's
+    tube and via points (docs/design.md, "Smoother tubes").
+
+    Parameters
+    ----------
+    design : TubeDesign
+    certificate : Certificate
+        Of ``design``: its partition's instants and ``alpha`` bounds.
+
+    Returns
+    -------
+    float
+        State units per second.
+    """
+    _, _, _, rate_l, rate_u = _partition(design, certificate)
+    return float(np.max(np.abs(rate_l + rate_u)) / 2.0)
+
+
+@lru_cache(maxsize=32)
+def proved_error(design: TubeDesign, spec: Spec) -> float:
+    """The sampled-data proof's bound of ``max |e_i(t_k)|`` over the samples of ``design``
+    for the plants of ``spec`` (``InputProof.max_abs_e`` of the registered prover), ``-inf``
+    when the proof fails (it cannot tell). Cached per ``(design, spec)``: the same bundled
+    design is asked for again and again in one process, and the proof takes 0.2-1 s.
+
+    Raises
+    ------
+    DesignError
+        No prover is registered (``stt_codegen.verify`` not loaded), kind ``INPUT_BOUND``.
+    """
+    proof = input_prover()(design, spec)
+    return proof.max_abs_e if proof.proved else -math.inf
+
+
+def unfollowable(design: TubeDesign, certificate: Certificate, spec: Spec) -> str:
+    """Why law (13) with ``design``'s gain cannot follow the tube at ``|e| <= E``, or ``""``.
+
+    The tube is refused when the sampled-data proof (the registered prover of
+    :func:`~stt_codegen.design.input_bound.input_prover`: ``verify``'s bound of
+    ``|e_i(t_k)|`` at every sample, for every plant of the spec's class) bounds ``|e|``
+    above :data:`TRACKING_ERROR` somewhere. A tube whose proof fails is not refused here
+    (the proof cannot tell; ``verify`` reports it).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        With its gain set.
+    certificate : Certificate
+        Of ``design``.
+    spec : Spec
+        Without ``[actuator]`` or with it (the bound plays no part).
+
+    Returns
+    -------
+    str
+        The reason, in numbers; empty when the tube is kept.
+
+    Raises
+    ------
+    DesignError
+        No prover is registered (``stt_codegen.verify`` not loaded), kind ``INPUT_BOUND``.
+    """
+    # every candidate is proved: the demand, an estimate, is no screen (arena 18 of seed 0:
+    # demand 0.24, proved and simulated |e| 0.75)
+    proved = proved_error(design, spec)
+    if proved <= TRACKING_ERROR:
+        return ""
+    demand = tracking_demand(design, certificate, spec)
+    return (f"law (13) with gain {design.gain:.3g} is proved only to |e| <= "
+            f"{proved:.3f} on this tube (above {TRACKING_ERROR}; tracking demand "
+            f"{demand.ratio:.3g} at t = {demand.time:.3f} s, dimension {demand.dimension})")
