@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..errors import DesignError
-from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
+from ..tube.parameters import E_MAX, GAMMA_D_MIN
 from .failures import FailureKind
 
 if TYPE_CHECKING:
@@ -122,9 +122,10 @@ def input_peak(gain: float, abs_e: "np.ndarray", width: "np.ndarray", t: "np.nda
                       max_abs_e=float(np.max(abs_e)))
 
 
-#: ``(tube, spec) -> InputProof``: proves the peak inputs of a designed tube (with its gain)
-#: for the plants of ``spec.assumptions``.
-InputProver = Callable[[TubeDesign, "Spec"], InputProof]
+#: ``(tube, spec, *, per_axis_first=False) -> InputProof``: proves the peak inputs of a
+#: designed tube (with its gain) for the plants of ``spec.assumptions``; ``per_axis_first``
+#: bounds ``e`` by the cheaper per-axis argument where it passes (no tighter).
+InputProver = Callable[..., InputProof]
 _PROVERS: list[InputProver] = []
 
 

@@ -50,10 +50,10 @@ _LAZY: dict[str, str] = {
 }
 
 
-def _prove_input_bound(tube: Any, spec: Any) -> Any:
+def _prove_input_bound(tube: Any, spec: Any, *, per_axis_first: bool = False) -> Any:
     """:func:`.actuator.prove_input_bound`, imported on first use."""
     from .actuator import prove_input_bound
-    return prove_input_bound(tube, spec)
+    return prove_input_bound(tube, spec, per_axis_first=per_axis_first)
 
 
 # The design accepts a tube under [actuator] only with this proof (the sampled-data

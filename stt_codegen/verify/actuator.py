@@ -16,14 +16,13 @@ import numpy as np
 
 from ..design.certificate import enclose_tube
 from ..design.input_bound import InputProof, input_peak
-from ..design.samples import TubeSamples, sample_tube
+from ..design.samples import TubeSamples
 from ..spec.loader import Spec
 from ..spec.plants import PLANTS
 from ..tube import reference
 from ..tube.parameters import TubeDesign
 from .check import Check
-from .plant_class import plant_class
-from .sampled import SampledCheck, check_sampled
+from .sampled import SampledCheck, sampled_check_of
 
 
 def sampled_error_bound(result: SampledCheck, samples: TubeSamples) -> np.ndarray | None:
@@ -51,7 +50,8 @@ def certified_widths(tube: TubeDesign, samples: TubeSamples) -> np.ndarray:
     return np.vstack([width, width[-1:]])
 
 
-def prove_input_bound(tube: TubeDesign, spec: Spec) -> InputProof:
+def prove_input_bound(tube: TubeDesign, spec: Spec, *,
+                      per_axis_first: bool = False) -> InputProof:
     """The proved peak of each input of law (13) along ``tube`` for the spec's plants.
 
     Parameters
@@ -63,6 +63,10 @@ def prove_input_bound(tube: TubeDesign, spec: Spec) -> InputProof:
         Its plant class (:func:`~stt_codegen.verify.plant_class.plant_class`: the model's
         bounds evaluated on the tube per interval, and ``[assumptions]``), the one
         ``sampled.tube_kept`` judges.
+    per_axis_first : bool
+        Bound ``e`` by the per-axis argument where it passes (``verify``'s check, cheaper;
+        bounds no tighter than the Lyapunov balls') instead of the whole check with the
+        balls everywhere (the default; the peaks of ``[actuator]`` are proved from it).
 
     Returns
     -------
@@ -75,17 +79,16 @@ def prove_input_bound(tube: TubeDesign, spec: Spec) -> InputProof:
     SpecError
         More samples than the step budget (as :func:`~stt_codegen.design.samples.sample_tube`).
     """
-    # the oracle's exp/log/tanh as numpy's ufuncs (within an ulp of libm, tens of times
-    # faster), as the certificate does: every margin here is far above rounding
+    # the check is computed once per (tube, spec, per_axis_first) in a process:
+    # sampled_check_of samples with the oracle's exp/log/tanh as numpy's ufuncs
+    samples, result = sampled_check_of(tube, spec, per_axis_first)
+    horizon = float(samples.t[-1])
+    abs_e = sampled_error_bound(result, samples)
+    if abs_e is None:
+        n = tube.dimension
+        return InputProof(False, (np.inf,) * n, (0.0,) * n, horizon,
+                          f"the sampled-data check fails: {result.reason}")
     with reference.numpy_math():
-        samples = sample_tube(tube)
-        horizon = float(samples.t[-1])
-        result = check_sampled(tube, samples, plant_class(spec))
-        abs_e = sampled_error_bound(result, samples)
-        if abs_e is None:
-            n = tube.dimension
-            return InputProof(False, (np.inf,) * n, (0.0,) * n, horizon,
-                              f"the sampled-data check fails: {result.reason}")
         widths = certified_widths(tube, samples)
     return input_peak(tube.gain, abs_e, widths, samples.t, horizon)
 

@@ -14,7 +14,6 @@ import numpy as np
 from ..tube import reference
 from ..design.certificate import Certificate
 from ..design.result import Design
-from ..design.samples import sample_tube
 from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
@@ -183,7 +182,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         return checks + cascade_checks(min(n, 2)) + [sampled_cascade_check()]
     stage("sampled loop")
     with reference.numpy_math():
-        checks += sampled_checks(spec, design, sample_tube(design), tube_check.certificate)
+        checks += sampled_checks(spec, design, tube_check.certificate)
     if spec.input_bound is not None:
         checks.append(input_bound_check(spec, prove_input_bound(design, spec)))
     return checks

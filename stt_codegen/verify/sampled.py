@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from functools import lru_cache
 
 import numpy as np
 
@@ -32,6 +33,7 @@ from ..design.samples import TubeSamples, sample_tube
 from ..spec.assumptions import Assumptions
 from ..spec.loader import Spec
 from ..spec.model_bounds import model_bounds
+from ..tube import reference
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .check import Check
 from .lyapunov import level_after, next_level, others_max
@@ -285,6 +287,47 @@ def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,
     return per_axis if per_axis.passed else check_sampled(design, samples, plants, gain)
 
 
+def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
+                     ) -> tuple[TubeSamples, SampledCheck]:
+    """The sampled-data check of a designed tube for its spec's plant class, once per
+    process: the design's tracking proof, the ``[actuator]`` proof and ``verify`` ask for
+    the same check of the same tube (a bundled design is asked for again and again).
+
+    The tube is sampled with numpy's ufuncs for the oracle's exp/log/tanh (within an ulp
+    of libm, as the certificate does: every margin here is far above rounding), over the
+    default horizon of :func:`~stt_codegen.design.samples.sample_tube`.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        With its gain.
+    spec : Spec
+        Its plant class (:func:`~stt_codegen.verify.plant_class.plant_class`).
+    per_axis_first : bool
+        :func:`check_sampled_first_per_axis` (the same verdict; where the per-axis argument
+        passes, its bounds, which the Lyapunov balls could only tighten) instead of
+        :func:`check_sampled` with the balls everywhere.
+
+    Returns
+    -------
+    samples : TubeSamples
+    check : SampledCheck
+    """
+    return _sampled_check(design, spec, bool(per_axis_first))
+
+
+@lru_cache(maxsize=16)
+def _sampled_check(design: TubeDesign, spec: Spec, per_axis_first: bool
+                   ) -> tuple[TubeSamples, SampledCheck]:
+    """:func:`sampled_check_of`, cached on its arguments as given positionally."""
+    with reference.numpy_math():
+        samples = sample_tube(design)
+        plants = plant_class(spec)
+        check = (check_sampled_first_per_axis(design, samples, plants) if per_axis_first
+                 else check_sampled(design, samples, plants))
+    return samples, check
+
+
 def lowest_rate(design: TubeDesign, spec: Spec, plants: Assumptions | PlantClass,
                 explicit_gain: float | None = None,
                 passes_at_rate: bool | None = None) -> tuple[float | None, float | None]:
@@ -373,8 +416,7 @@ def _bounds_words(a: Assumptions, refined: tuple[str, ...] = ()) -> str:
     return f"{words} ({source})"
 
 
-def sampled_checks(spec: Spec, design: TubeDesign, samples: TubeSamples,
-                   certificate: Certificate) -> list[Check]:
+def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> list[Check]:
     """The checks of ``stt-codegen verify`` for the sampled closed loop.
 
     ``sampled.gain``: ``k`` is below the linearized stability limit at the narrowest tube
@@ -387,9 +429,8 @@ def sampled_checks(spec: Spec, design: TubeDesign, samples: TubeSamples,
     ----------
     spec : Spec
     design : TubeDesign
-        With its gain set (the spec's ``controller.gain`` or the derived one).
-    samples : TubeSamples
-        ``design``'s tube at its sampling instants.
+        With its gain set (the spec's ``controller.gain`` or the derived one); its tube is
+        sampled by :func:`sampled_check_of` (once per process).
     certificate : Certificate
         ``design``'s tube certificate (its ``non-empty`` margin is the width the gain is
         derived from).
@@ -406,7 +447,7 @@ def sampled_checks(spec: Spec, design: TubeDesign, samples: TubeSamples,
     checks = [Check("sampled.gain", gain_ok, derivation["explanation"]
                     + ("" if gain_ok else f"; k = {derivation['gain']:.6g} is beyond the "
                        f"limit at g_max = {a.input_gain[1]:g}"), derivation)]
-    result = check_sampled_first_per_axis(design, samples, plants)
+    result = sampled_check_of(design, spec)[1]
     words = _bounds_words(a, tuple(result.data.get("refined_on_the_tube", ())))
     rate, gain = lowest_rate(design, spec, plants, spec.gain, passes_at_rate=result.passed)
     g_max = a.input_gain[1]
