@@ -36,11 +36,13 @@ import numpy as np
 
 from ..errors import DesignError
 from ..spec.loader import Obstacle, Spec
+from ..spec.tasks import STAY, Task
 from ..tube import reference
 from ..tube.parameters import ReachSegment, TubeDesign
 from .failures import FailureKind
 from .gain import derived_gain
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
+from .tasks import STAY_LEAD
 from .via import VIA_MARGIN
 
 #: How the tube of a spec with moving obstacles was found (``Design.motion``).
@@ -55,6 +57,9 @@ DURATION_FACTORS = (1.0, 0.75, 1.5, 0.5, 2.0)
 MOVE_CHECKS = 8
 #: Most sets of moving obstacles to go around that the re-timing step tries (:func:`routes`).
 MAX_ROUTES = 16
+#: With ``[[tasks]]``: a reach task's waypoint box is held (``rho`` equal to it) over at
+#: least this share of the task's window, inside the window.
+TASK_HOLD_SHARE = 0.25
 
 
 def static_part(spec: Spec) -> Spec:
@@ -134,19 +139,70 @@ def _move_clear(seg: ReachSegment, spec: Spec) -> bool:
     return bool(_clear(lo, hi, spec, cuts[:-1], cuts[1:]).all())
 
 
+def task_holds(segments: Sequence[ReachSegment], spec: Spec) -> dict[int, Task] | None:
+    """The hold segments of a tasks' plan (:func:`~.tasks.plan_tasks`), by segment index.
+
+    Parameters
+    ----------
+    segments : sequence of ReachSegment
+        A via plan of ``spec``.
+    spec : Spec
+        Its ``tasks`` (in window order).
+
+    Returns
+    -------
+    dict of int to Task, or None
+        For each task, the index of the first segment after the previous task's that holds
+        one box (``rho`` constant) over a sub-interval of ``[t0 - STAY_LEAD, t1]``; empty
+        without tasks; ``None`` when some task has no such segment (not a tasks' plan).
+    """
+    out: dict[int, Task] = {}
+    k = 0
+    for task in spec.tasks:
+        t0, t1 = task.window
+        while k < len(segments) and not (
+                segments[k].lower_from == segments[k].lower_to
+                and segments[k].upper_from == segments[k].upper_to
+                and segments[k].start >= t0 - STAY_LEAD - 1e-9
+                and segments[k].end <= t1 + 1e-9):
+            k += 1
+        if k == len(segments):
+            return None
+        out[k] = task
+        k += 1
+    return out
+
+
+def _hold_ok(task: Task, start: float, end: float) -> bool:
+    """Whether holding the waypoint box over ``[start, end]`` (s) serves ``task``: a stay
+    task's whole window, or :data:`TASK_HOLD_SHARE` of a reach task's window inside it."""
+    t0, t1 = task.window
+    if task.kind == STAY:
+        return start <= t0 + 1e-9 and end >= t1 - 1e-9
+    return min(end, t1) - max(start, t0) >= TASK_HOLD_SHARE * (t1 - t0) - 1e-9
+
+
 def retime(segments: tuple[ReachSegment, ...], spec: Spec) -> tuple[ReachSegment, ...] | None:
     """The via boxes of ``segments`` re-timed to miss the moving obstacles (module notes).
+
+    With ``spec.tasks``, each task's hold segment (:func:`task_holds`) is not re-timed by
+    :data:`DURATION_FACTORS`: it may start at any step and last any number of steps such
+    that the held interval serves its task (:func:`_hold_ok`) and the box keeps clear over
+    it; the waits before and after it are free.
 
     Returns
     -------
     tuple of ReachSegment or None
         Segments through the same boxes, with waits between them (the reach tube holds a
         box between two segments), the last ending by ``t_c``; ``None`` if the search
-        finds no timing.
+        finds no timing (or ``segments`` is not a plan of ``spec``'s tasks).
     """
     t_c = spec.prescribed_time
     tau = t_c / TIME_STEPS
     m = len(segments)
+    holds = task_holds(segments, spec)
+    if holds is None:
+        return None
     boxes = [(np.array(s.lower_from), np.array(s.upper_from)) for s in segments]
     boxes.append((np.array(segments[-1].lower_to), np.array(segments[-1].upper_to)))
     steps = np.arange(TIME_STEPS + 1)
@@ -168,6 +224,17 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec) -> tuple[ReachSegment
             if i < TIME_STEPS and nxt not in parent and waits[k][i]:
                 parent[nxt] = ((k, i), None)
                 frontier.append(nxt)
+            if k in holds:
+                # hold the waypoint box from step i to step j (clear: the waits' boxes)
+                for j in range(i + 1, TIME_STEPS + 1):
+                    if not waits[k][j - 1]:
+                        break
+                    to = (k + 1, j)
+                    if to not in parent and _hold_ok(holds[k], i * tau, j * tau):
+                        parent[to] = ((k, i), replace(segments[k], start=i * tau,
+                                                      end=j * tau))
+                        frontier.append(to)
+                continue
             planned = segments[k].end - segments[k].start
             for f in DURATION_FACTORS:
                 d = max(1, int(math.ceil(f * planned / tau - 1e-9)))
@@ -300,5 +367,5 @@ def _design(tube: TubeDesign, method: str, check: TubeCheck, spec: Spec, started
 
 
 __all__ = ["DURATION_FACTORS", "MAX_ROUTES", "MOTION_SPACE_TIME", "MOTION_SWEPT",
-           "MOTION_TIMED_VIA", "MOVE_CHECKS", "TIME_STEPS", "design_moving", "retime", "routes",
-           "static_part", "swept_spec"]
+           "MOTION_TIMED_VIA", "MOVE_CHECKS", "TASK_HOLD_SHARE", "TIME_STEPS", "design_moving",
+           "retime", "routes", "static_part", "swept_spec", "task_holds"]
