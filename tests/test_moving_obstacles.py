@@ -20,7 +20,7 @@ from stt_codegen.codegen.options import Options
 from stt_codegen.design.failures import FailureKind
 from stt_codegen.design.moving import (MOTION_SPACE_TIME, MOTION_SWEPT, MOTION_TIMED_VIA,
                                        TASK_HOLD_SHARE, static_part, swept_spec,
-                                       task_holds)
+                                       retime, task_holds)
 from stt_codegen.design.search import check_tube
 from stt_codegen.runtime.simulate import run_closed_loop
 from stt_codegen.spec.schema import json_schema
@@ -454,3 +454,25 @@ def test_tasks_and_moving_obstacles_together():
     with pytest.raises(stt.DesignError) as info:
         stt.design_tube(stt.Spec.from_dict(doc))
     assert info.value.kind is FailureKind.MOVING_OBSTACLE
+
+
+@pytest.mark.slow
+def test_a_detour_around_where_a_moving_obstacle_crosses_the_tasks_plan():
+    """Problem 53 of ``bench tasks --seed 0``: the only moving obstacle drifts across the
+    first leg's lane while that leg must be under way, so neither the tasks' plan (step 1) nor any timing of
+    its via boxes misses it, and the region it sweeps meets the start set (no swept
+    design). Planning around the box it sweeps over 1 s either side of where the plan
+    meets it, and timing that plan against it as it moves, gives a certified tube."""
+    from stt_codegen.bench.task_arenas import task_problem
+    spec = task_problem(0, 53)
+    assert len(spec.moving_obstacles) == 1 and swept_spec(spec)[0] is None
+    planned = stt.design_tube(static_part(spec))
+    assert not check_tube(planned.tube, spec).passed
+    assert retime(planned.tube.segments, spec) is None
+    design = stt.design_tube(spec)
+    assert design.motion == MOTION_TIMED_VIA and design.certificate.passed
+    data = design.to_json()
+    assert all(t["certified"] and t["margin"] > 0 for t in data["tasks"])
+    assert data["moving_obstacles"][0]["margin"] > 0
+    run = stt.simulate(design, backend="reference")
+    assert run.satisfied and all(t.met for t in run.tasks)

@@ -14,7 +14,10 @@ space-time disjointness from every moving obstacle, :mod:`.certificate.motion`) 
    time step) that may wait at a via box or take a segment at one of
    :data:`DURATION_FACTORS` times its planned duration, each move kept clear (by
    :data:`~.via.VIA_MARGIN`) of the hull of every moving obstacle over the move's time,
-   earliest arrival first (deterministic: fixed orders, no randomness);
+   earliest arrival first (deterministic: fixed orders, no randomness); with ``[[tasks]]``
+   each task's hold segment (:func:`task_holds`) may instead start at any step and last
+   any number of steps that keep it in its task's window (:data:`TASK_HOLD_SHARE`), with
+   free waits before and after it;
 3. **swept** (``"swept"``, conservative): each moving obstacle replaced by the static box
    holding every position it takes while active (clipped to the state space), and the
    static design run on that; refused when such a box meets the start or the target.
@@ -41,6 +44,7 @@ from ..tube import reference
 from ..tube.parameters import ReachSegment, TubeDesign
 from .failures import FailureKind
 from .gain import derived_gain
+from .certificate.motion import MOVING_PROPERTY
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
 from .tasks import STAY_LEAD
 from .via import VIA_MARGIN
@@ -57,6 +61,9 @@ DURATION_FACTORS = (1.0, 0.75, 1.5, 0.5, 2.0)
 MOVE_CHECKS = 8
 #: Most sets of moving obstacles to go around that the re-timing step tries (:func:`routes`).
 MAX_ROUTES = 16
+#: Half-lengths (s) of the time spans around where the static tube meets a moving obstacle
+#: over which the detour step (:func:`partial_spec`) sweeps it, in the order tried.
+DETOUR_SPANS = (1.0, 2.0)
 #: With ``[[tasks]]``: a reach task's waypoint box is held (``rho`` equal to it) over at
 #: least this share of the task's window, inside the window.
 TASK_HOLD_SHARE = 0.25
@@ -102,6 +109,29 @@ def swept_spec(spec: Spec, which: Sequence[int] | None = None) -> tuple[Spec | N
         extra.append(swept)
     keep = tuple(ob for i, ob in enumerate(spec.moving_obstacles) if i not in chosen)
     return replace(spec, obstacles=spec.obstacles + tuple(extra), moving_obstacles=keep), ""
+
+
+def partial_spec(spec: Spec, position: int, t_a: float, t_b: float) -> Spec | None:
+    """``spec``'s static part plus the box moving obstacle ``position`` sweeps over
+    ``[t_a, t_b]`` (met with its active interval, clipped to the state space) as a static
+    obstacle: a spec to *plan* a detour on (the re-timing and the check still see the
+    obstacle moving). ``None`` when that box meets the initial or the target set, or the
+    interval misses the active one."""
+    ob = spec.moving_obstacles[position]
+    a, b = max(t_a, ob.active[0]), min(t_b, ob.active[1])
+    if not a < b:
+        return None
+    lo, hi, _ = ob.hull([a], [b])
+    space = spec.state_space
+    lower = tuple(max(float(v), space.lower[d]) for v, d in zip(lo[0], ob.dims))
+    upper = tuple(min(float(v), space.upper[d]) for v, d in zip(hi[0], ob.dims))
+    if any(x >= y for x, y in zip(lower, upper)):
+        return None
+    swept = Obstacle(lower, upper, ob.dims, ob.source)
+    box = swept.box(space)
+    if box.meets(spec.initial_set) or box.meets(spec.target_set):
+        return None
+    return replace(spec, obstacles=spec.obstacles + (swept,), moving_obstacles=())
 
 
 def routes(count: int) -> list[tuple[int, ...]]:
@@ -329,6 +359,24 @@ def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
                                started, MOTION_TIMED_VIA, via)
             tried.append(f"the re-timed via tube around {list(which) or 'none'} fails: "
                          f"{timed.reason}")
+        for position, when in _meetings(found, spec):
+            for span in DETOUR_SPANS:
+                planning = partial_spec(spec, position, when - span, when + span)
+                via = None if planning is None else _try(lambda: design_static(
+                    replace(planning, tube=replace(planning.tube, method="via"))))
+                if via is None:
+                    continue
+                segments = retime(via.tube.segments, spec)
+                if segments is None:
+                    continue
+                tube = replace(via.tube, segments=segments)
+                timed = check(tube, spec)
+                if timed.passed:
+                    return _design(_accept(tube, timed, spec), METHOD_VIA, timed, spec,
+                                   started, MOTION_TIMED_VIA, via)
+                tried.append(f"the re-timed via tube around moving obstacle "
+                             f"{spec.moving_obstacles[position].source} over "
+                             f"[{when - span:g}, {when + span:g}] s fails: {timed.reason}")
         reasons.append("; ".join(tried) if tried else
                        f"no re-timing of the via boxes on {TIME_STEPS} time steps keeps "
                        "clear of the moving obstacles (going around none, one or more of "
@@ -352,6 +400,18 @@ def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
                       kind=kind, tried=first.tube)
 
 
+def _meetings(found: TubeCheck, spec: Spec) -> list[tuple[int, float]]:
+    """(position in ``spec.moving_obstacles``, time of the smallest margin, s) of each
+    moving obstacle the checked tube is not certified to miss, in the spec's order."""
+    margins = {m.name: m for m in found.certificate.margins}
+    out = []
+    for position, ob in enumerate(spec.moving_obstacles):
+        m = margins.get(f"{MOVING_PROPERTY} {ob.source}")
+        if m is not None and not m.passed:
+            out.append((position, float(m.time)))
+    return out
+
+
 def _try(make: Callable[[], Design]) -> Design | None:
     try:
         return make()
@@ -366,6 +426,6 @@ def _design(tube: TubeDesign, method: str, check: TubeCheck, spec: Spec, started
                   task_choices=source.task_choices)
 
 
-__all__ = ["DURATION_FACTORS", "MAX_ROUTES", "MOTION_SPACE_TIME", "MOTION_SWEPT",
+__all__ = ["DETOUR_SPANS", "DURATION_FACTORS", "MAX_ROUTES", "MOTION_SPACE_TIME", "MOTION_SWEPT",
            "MOTION_TIMED_VIA", "MOVE_CHECKS", "TASK_HOLD_SHARE", "TIME_STEPS", "design_moving",
-           "retime", "routes", "static_part", "swept_spec", "task_holds"]
+           "retime", "routes", "partial_spec", "static_part", "swept_spec", "task_holds"]
