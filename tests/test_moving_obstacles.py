@@ -459,8 +459,8 @@ def test_tasks_and_moving_obstacles_together():
 @pytest.mark.slow
 def test_a_detour_around_where_a_moving_obstacle_crosses_the_tasks_plan():
     """Problem 53 of ``bench tasks --seed 0``: the only moving obstacle drifts across the
-    first leg's lane while that leg must be under way, so neither the tasks' plan (step 1) nor any timing of
-    its via boxes misses it, and the region it sweeps meets the start set (no swept
+    first leg's lane while that leg must be under way, so neither the tasks' plan (step 1)
+    nor any timing of its via boxes misses it, and the region it sweeps meets the start set (no swept
     design). Planning around the box it sweeps over 1 s either side of where the plan
     meets it, and timing that plan against it as it moves, gives a certified tube."""
     from stt_codegen.bench.task_arenas import task_problem

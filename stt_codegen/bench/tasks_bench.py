@@ -38,9 +38,9 @@ def run_task_problem(seed: int, index: int) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``{"index", "tasks" (count), "moving" (moving obstacles), "methods": {method: {"satisfied", "seconds",
-        "reason" ("" when satisfied), "effort" (m^2/s or None), "choices" (alternative
-        per task or None), and for STT with moving obstacles "motion" (how the tube was
+        ``{"index", "tasks" (count), "moving" (moving obstacles), "methods": {method:
+        {"satisfied", "seconds", "reason" ("" when satisfied), "effort" (m^2/s or None),
+        "choices" (alternative per task or None), and for STT with moving obstacles "motion" (how the tube was
         found, ``Design.motion``)}}}``.
     """
     from ..design.search import design_tube

@@ -20,10 +20,14 @@ space-time disjointness from every moving obstacle, :mod:`.certificate.motion`) 
    free waits before and after it;
 3. **swept** (``"swept"``, conservative): each moving obstacle replaced by the static box
    holding every position it takes while active (clipped to the state space), and the
-   static design run on that; refused when such a box meets the start or the target.
+   static design run on that; refused when such a box meets the start or the target;
+4. **detour** (``"timed via"`` too): for each moving obstacle the step-1 tube is not
+   certified to miss, the via plan (tasks' plan included) around the box it sweeps over
+   :data:`DETOUR_SPANS` seconds either side of where that tube comes closest to it
+   (:func:`partial_spec`), re-timed as in step 2 against every moving obstacle as it moves.
 
-Specs with ``[actuator]`` skip step 2 (its input proof is the static design's), and so do
-specs with ``tube.method = "paper"`` (step 2's tube is a via-point tube). The
+Specs with ``[actuator]`` skip steps 2 and 4 (its input proof is the static design's),
+and so do specs with ``tube.method = "paper"`` (their tubes are via-point tubes). The
 argument and the limits: docs/moving-obstacles.md.
 """
 
@@ -359,24 +363,6 @@ def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
                                started, MOTION_TIMED_VIA, via)
             tried.append(f"the re-timed via tube around {list(which) or 'none'} fails: "
                          f"{timed.reason}")
-        for position, when in _meetings(found, spec):
-            for span in DETOUR_SPANS:
-                planning = partial_spec(spec, position, when - span, when + span)
-                via = None if planning is None else _try(lambda: design_static(
-                    replace(planning, tube=replace(planning.tube, method="via"))))
-                if via is None:
-                    continue
-                segments = retime(via.tube.segments, spec)
-                if segments is None:
-                    continue
-                tube = replace(via.tube, segments=segments)
-                timed = check(tube, spec)
-                if timed.passed:
-                    return _design(_accept(tube, timed, spec), METHOD_VIA, timed, spec,
-                                   started, MOTION_TIMED_VIA, via)
-                tried.append(f"the re-timed via tube around moving obstacle "
-                             f"{spec.moving_obstacles[position].source} over "
-                             f"[{when - span:g}, {when + span:g}] s fails: {timed.reason}")
         reasons.append("; ".join(tried) if tried else
                        f"no re-timing of the via boxes on {TIME_STEPS} time steps keeps "
                        "clear of the moving obstacles (going around none, one or more of "
@@ -396,8 +382,42 @@ def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
                 return _design(design.tube, design.method, final, spec, started,
                                MOTION_SWEPT, design)
             reasons.append(f"the swept design fails: {final.reason}")
+    if spec.input_bound is None and spec.tube.method != METHOD_PAPER:
+        detoured, why = _detour(spec, found, design_static, check, started)
+        if detoured is not None:
+            return detoured
+        reasons.append(why)
     raise DesignError("no tube avoids the moving obstacles: " + "; ".join(reasons),
                       kind=kind, tried=first.tube)
+
+
+def _detour(spec: Spec, found: TubeCheck, design_static: Callable[[Spec], Design],
+            check: Callable[[TubeDesign, Spec], TubeCheck],
+            started: float) -> tuple[Design | None, str]:
+    """Step 4 (module notes): a via plan around the box a moving obstacle sweeps near where
+    the static tube ``found`` meets it, re-timed against every moving obstacle; the design,
+    or ``None`` and what was found."""
+    tried: list[str] = []
+    for position, when in _meetings(found, spec):
+        for span in DETOUR_SPANS:
+            planning = partial_spec(spec, position, when - span, when + span)
+            via = None if planning is None else _try(lambda: design_static(
+                replace(planning, tube=replace(planning.tube, method="via"))))
+            if via is None:
+                continue
+            segments = retime(via.tube.segments, spec)
+            if segments is None:
+                continue
+            tube = replace(via.tube, segments=segments)
+            timed = check(tube, spec)
+            if timed.passed:
+                return (_design(_accept(tube, timed, spec), METHOD_VIA, timed, spec,
+                                started, MOTION_TIMED_VIA, via), "")
+            tried.append(f"the re-timed via tube around moving obstacle "
+                         f"{spec.moving_obstacles[position].source} over "
+                         f"[{when - span:g}, {when + span:g}] s fails: {timed.reason}")
+    return None, ("; ".join(tried) if tried else "no detour around where the static tube "
+                  "meets a moving obstacle is planned and re-timed")
 
 
 def _meetings(found: TubeCheck, spec: Spec) -> list[tuple[int, float]]:
