@@ -10,9 +10,11 @@ reach tasks drawn from ``numpy.random.default_rng([S, k, 1])``:
 * each task box is :data:`TASK_SIZE` m square, its lower corner uniform in
   ``[0, 5 - TASK_SIZE]^2``; the first task is an ``any_of`` of two such boxes;
 * a box that meets an obstacle (touching allowed, as the spec's rule), the target or the
-  start set is drawn again.
-
-No moving obstacles (part B of issue 21 is another branch).
+  start set is drawn again;
+* then 0-4 moving obstacles (:func:`~.moving.random_moving_obstacles`, the count drawn
+  uniformly), from the same generator after the task boxes, each never meeting the start
+  set, the target or a task box (every ``any_of`` alternative) while active; they are
+  appended to ``[[obstacles]]`` after the four static boxes.
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import numpy as np
 
 from ..spec.loader import Box, Spec, parse_spec
 from .arenas import generate_arena
+from .moving import random_moving_obstacles
 
 #: Side of a task box, metres.
 TASK_SIZE = 0.6
@@ -88,7 +91,21 @@ def task_problem_toml(seed: int, index: int) -> str:
                 " } ]\n"
         else:
             text += _box_toml(_draw_box(rng, avoid))
+    with_tasks = parse_spec(text)
+    boxes = [box for task in with_tasks.tasks for box in task.boxes]
+    for entry in random_moving_obstacles(rng, with_tasks, keep_clear=boxes):
+        text += _moving_toml(entry)
     return text
+
+
+def _moving_toml(entry: dict) -> str:
+    """A moving obstacle's spec-dict entry (:func:`~.moving.random_moving_obstacles`) as an
+    ``[[obstacles]]`` table, numbers written exactly (``repr``)."""
+    def value(v) -> str:
+        return "[" + ", ".join(value(x) for x in v) + "]" if isinstance(v, list) else repr(v)
+    return "\n[[obstacles]]\n" + "".join(f"{key} = {value(entry[key])}\n"
+                                         for key in ("lower", "upper", "velocity", "active",
+                                                     "path") if key in entry)
 
 
 def task_problem(seed: int, index: int) -> Spec:

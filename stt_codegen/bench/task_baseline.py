@@ -7,7 +7,11 @@ to the centre of the first task box, from there to the next, and from the last t
 target's centre; for an ``any_of`` task take the box whose leg is shortest. The tracker of
 :mod:`.tracker` (carrot following at 1.5 m/s, then a proportional hold at the leg's end)
 follows leg ``j`` until the middle of task ``j``'s window, where it switches to the next
-leg: it waits at the box when it arrives early. The closed loop is
+leg: it waits at the box when it arrives early. With moving obstacles (which A* on the
+static grid does not see), each leg may also wait at its start until its path is clear in
+space-time (:mod:`.task_timing`: the earliest departure that still arrives by the middle
+of the task's window, or by ``t_c``, and keeps the planners' margin from every moving
+obstacle on the nominal schedule); without them nothing changes. The closed loop is
 :func:`~stt_codegen.runtime.simulate.run_closed_loop`, which judges the tasks and
 Definition 2.1 exactly as for the tube controller.
 """
@@ -27,7 +31,8 @@ from ..runtime.simulate import SimulationResult, run_closed_loop
 from ..spec.loader import Spec
 from .astar import RESOLUTION, grid_graph
 from .planning import FreeSpace
-from .tracker import PathTracker
+from .task_timing import departure
+from .tracker import GOAL_GAIN, SPEED, PathTracker
 
 BACKEND = "bench-timed-tracker"
 
@@ -42,13 +47,20 @@ class TimedPlan:
         Leg ``j``: waypoints (K, 2), metres; ``None`` for the whole plan when some leg has
         no path (see ``reason``).
     switch : tuple of float
-        Seconds: leg ``j + 1`` starts at ``switch[j]`` (the middle of task ``j``'s window).
+        Seconds: leg ``j + 1`` starts at ``switch[j]`` (the middle of task ``j``'s window,
+        later when it waits for moving obstacles).
     choices : tuple of int
         The box taken per task (``any_of`` alternative).
     seconds : float
         Planning time (grid and every A* search), seconds.
     reason : str
         Empty when every leg has a path.
+    start : float
+        Seconds: leg 0 starts then (0 unless it waits for a moving obstacle); the robot
+        holds ``x(0)`` before.
+    clear : tuple of bool
+        Per leg: whether its departure keeps clear of the moving obstacles on the nominal
+        schedule (:func:`~.task_timing.departure`; ``True`` without moving obstacles).
     """
 
     legs: tuple | None
@@ -56,6 +68,8 @@ class TimedPlan:
     choices: tuple[int, ...]
     seconds: float
     reason: str = ""
+    start: float = 0.0
+    clear: tuple[bool, ...] = ()
 
 
 def _node(graph: nx.Graph, origin: np.ndarray, point: np.ndarray):
@@ -115,8 +129,16 @@ def plan_timed(spec: Spec) -> TimedPlan:
         return TimedPlan(None, (), (), time.perf_counter() - begin,
                          f"no path found (leg {len(legs)})")
     legs.append(last)
-    switch = tuple(0.5 * (t.window[0] + t.window[1]) for t in spec.tasks)
-    return TimedPlan(tuple(legs), switch, tuple(choices), time.perf_counter() - begin)
+    deadlines = [0.5 * (t.window[0] + t.window[1]) for t in spec.tasks]
+    deadlines.append(spec.prescribed_time)
+    leave, ok, may_start = [], [], 0.0
+    for leg, deadline in zip(legs, deadlines):
+        depart, fine = departure(leg, may_start, deadline, spec.moving_obstacles)
+        leave.append(depart)
+        ok.append(fine)
+        may_start = deadline
+    return TimedPlan(tuple(legs), tuple(leave[1:]), tuple(choices),
+                     time.perf_counter() - begin, start=leave[0], clear=tuple(ok))
 
 
 class TimedTracker:
@@ -128,12 +150,20 @@ class TimedTracker:
     def __init__(self, plan: TimedPlan) -> None:
         self.trackers = [PathTracker(leg) for leg in plan.legs]
         self.switch = list(plan.switch)
+        self.start = plan.start
+        self.home = np.asarray(plan.legs[0][0], float)
 
     def step(self, x, t, dt, alpha):
-        """The controller step: the active leg's tracker command; ``alpha`` passed through."""
+        """The controller step: the active leg's tracker command (before ``plan.start``, a
+        proportional hold at ``x(0)``); ``alpha`` passed through."""
+        x = np.asarray(x, float)
+        if t < self.start:
+            u = GOAL_GAIN * (self.home - x[:2])
+            norm = float(np.linalg.norm(u))
+            return (u if norm <= SPEED else u * (SPEED / norm),
+                    np.asarray(alpha, float), STATUS_OK)
         j = sum(1 for s in self.switch if t >= s)
-        return (self.trackers[j].command(np.asarray(x, float)), np.asarray(alpha, float),
-                STATUS_OK)
+        return self.trackers[j].command(x), np.asarray(alpha, float), STATUS_OK
 
 
 _PLANS: dict[str, TimedPlan] = {}

@@ -1,17 +1,19 @@
 """``stt-codegen bench tasks``: timed reach tasks, STT against sequential A* with waiting.
 
 On each random problem of :mod:`.task_arenas` (2-3 timed reach goals, the first with two
-alternatives, four static obstacles):
+alternatives, four static obstacles, 0-4 moving obstacles):
 
 * **STT**: :func:`~stt_codegen.design.search.design_tube` (via legs through the tasks'
   boxes, every task certified for every ``t``), then the generated C controller (backend
   ``c``) in closed loop; time: the design's ``design_time_s``.
-* **A* + tracker**: :func:`~.task_baseline.plan_timed` then
-  :func:`~.task_baseline.track_timed`; time: the planning (grid and searches).
+* **A* + tracker**: :func:`~.task_baseline.plan_timed` (legs on the static grid, each
+  waiting at its start until it is clear of the moving obstacles in space-time) then
+  :func:`~.task_baseline.track_timed`; time: the planning (grid, searches and timing).
 
 Both closed loops are :func:`~stt_codegen.runtime.simulate.run_closed_loop` with the
 same disturbance seed (the problem's index) and judge: *satisfied* means every task met in
-its window, the target reached by ``t_c``, no collision, the state space kept. Effort is
+its window, the target reached by ``t_c``, no collision (with a moving obstacle: where it
+is at that time), the state space kept. Effort is
 ``integral |u|^2 dt`` over the run (m^2/s). All in one process, problem after problem, the
 timed design or plan never beside a compiler or a simulation.
 """
@@ -36,9 +38,10 @@ def run_task_problem(seed: int, index: int) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``{"index", "tasks" (count), "methods": {method: {"satisfied", "seconds",
-        "reason" ("" when satisfied), "effort" (m^2/s or None), "choices" (alternative
-        per task or None)}}}``.
+        ``{"index", "tasks" (count), "moving" (moving obstacles), "methods": {method:
+        {"satisfied", "seconds", "reason" ("" when satisfied), "effort" (m^2/s or None),
+        "choices" (alternative per task or None), and for STT with moving obstacles "motion" (how the tube was
+        found, ``Design.motion``)}}}``.
     """
     from ..design.search import design_tube
     from ..runtime.simulate import run_closed_loop
@@ -54,6 +57,7 @@ def run_task_problem(seed: int, index: int) -> dict[str, Any]:
         seconds = design.design_time_s
         result = run_closed_loop(spec, design.tube, backend="c", seed=index)
         out["stt"] = _outcome(seconds, result, list(design.task_choices))
+        out["stt"]["motion"] = design.motion
     plan = plan_timed(spec)
     if plan.legs is None:
         out["astar"] = {"satisfied": False, "seconds": plan.seconds, "reason": plan.reason,
@@ -61,7 +65,8 @@ def run_task_problem(seed: int, index: int) -> dict[str, Any]:
     else:
         out["astar"] = _outcome(plan.seconds, track_timed(spec, plan, seed=index),
                                 list(plan.choices))
-    return {"index": index, "tasks": len(spec.tasks), "methods": out}
+    return {"index": index, "tasks": len(spec.tasks), "moving": len(spec.moving_obstacles),
+            "methods": out}
 
 
 def _outcome(seconds: float, result, choices: list[int]) -> dict[str, Any]:
@@ -89,7 +94,8 @@ def run_tasks_bench(count: int, seed: int, progress: bool = False) -> dict[str, 
     Returns
     -------
     dict
-        ``{"count", "seed", "problems" (per problem), "summary": {method: {"satisfied"
+        ``{"count", "seed", "problems" (per problem), "with_moving" (problems with at
+        least one moving obstacle), "summary": {method: {"satisfied"
         (count), "rate", "seconds_median", "seconds_p95" (design or planning, s),
         "effort_median" (over its satisfied runs, m^2/s)}}, "stt_misses_baseline"
         (indices where the baseline is satisfied and STT is not)}``.
@@ -124,14 +130,16 @@ def run_tasks_bench(count: int, seed: int, progress: bool = False) -> dict[str, 
             "effort_median": float(np.median(efforts)) if efforts else None}
     misses = [p["index"] for p in problems
               if p["methods"]["astar"]["satisfied"] and not p["methods"]["stt"]["satisfied"]]
-    return {"count": count, "seed": seed, "problems": problems, "summary": summary,
+    return {"count": count, "seed": seed, "problems": problems,
+            "with_moving": sum(p["moving"] > 0 for p in problems), "summary": summary,
             "stt_misses_baseline": misses}
 
 
 def format_tasks_report(report: dict[str, Any]) -> str:
     """The report of :func:`run_tasks_bench` as a table."""
     lines = [f"bench tasks: {report['count']} problems of seed {report['seed']} "
-             "(2-3 timed reach goals, the first with two alternatives, 4 static obstacles)",
+             "(2-3 timed reach goals, the first with two alternatives, 4 static obstacles, "
+             f"0-4 moving obstacles: {report['with_moving']} problems have some)",
              f"{'method':<36}{'satisfied':>10}{'time median':>13}{'p95':>10}"
              f"{'effort median':>15}"]
     for name in METHODS:

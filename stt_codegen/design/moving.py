@@ -14,13 +14,20 @@ space-time disjointness from every moving obstacle, :mod:`.certificate.motion`) 
    time step) that may wait at a via box or take a segment at one of
    :data:`DURATION_FACTORS` times its planned duration, each move kept clear (by
    :data:`~.via.VIA_MARGIN`) of the hull of every moving obstacle over the move's time,
-   earliest arrival first (deterministic: fixed orders, no randomness);
+   earliest arrival first (deterministic: fixed orders, no randomness); with ``[[tasks]]``
+   each task's hold segment (:func:`task_holds`) may instead start at any step and last
+   any number of steps that keep it in its task's window (:data:`TASK_HOLD_SHARE`), with
+   free waits before and after it;
 3. **swept** (``"swept"``, conservative): each moving obstacle replaced by the static box
    holding every position it takes while active (clipped to the state space), and the
-   static design run on that; refused when such a box meets the start or the target.
+   static design run on that; refused when such a box meets the start or the target;
+4. **detour** (``"timed via"`` too): for each moving obstacle the step-1 tube is not
+   certified to miss, the via plan (tasks' plan included) around the box it sweeps over
+   :data:`DETOUR_SPANS` seconds either side of where that tube comes closest to it
+   (:func:`partial_spec`), re-timed as in step 2 against every moving obstacle as it moves.
 
-Specs with ``[actuator]`` skip step 2 (its input proof is the static design's), and so do
-specs with ``tube.method = "paper"`` (step 2's tube is a via-point tube). The
+Specs with ``[actuator]`` skip steps 2 and 4 (its input proof is the static design's),
+and so do specs with ``tube.method = "paper"`` (their tubes are via-point tubes). The
 argument and the limits: docs/moving-obstacles.md.
 """
 
@@ -36,11 +43,14 @@ import numpy as np
 
 from ..errors import DesignError
 from ..spec.loader import Obstacle, Spec
+from ..spec.tasks import STAY, Task
 from ..tube import reference
 from ..tube.parameters import ReachSegment, TubeDesign
 from .failures import FailureKind
 from .gain import derived_gain
+from .certificate.motion import MOVING_PROPERTY
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
+from .tasks import STAY_LEAD
 from .via import VIA_MARGIN
 
 #: How the tube of a spec with moving obstacles was found (``Design.motion``).
@@ -55,6 +65,12 @@ DURATION_FACTORS = (1.0, 0.75, 1.5, 0.5, 2.0)
 MOVE_CHECKS = 8
 #: Most sets of moving obstacles to go around that the re-timing step tries (:func:`routes`).
 MAX_ROUTES = 16
+#: Half-lengths (s) of the time spans around where the static tube meets a moving obstacle
+#: over which the detour step (:func:`partial_spec`) sweeps it, in the order tried.
+DETOUR_SPANS = (1.0, 2.0)
+#: With ``[[tasks]]``: a reach task's waypoint box is held (``rho`` equal to it) over at
+#: least this share of the task's window, inside the window.
+TASK_HOLD_SHARE = 0.25
 
 
 def static_part(spec: Spec) -> Spec:
@@ -99,6 +115,29 @@ def swept_spec(spec: Spec, which: Sequence[int] | None = None) -> tuple[Spec | N
     return replace(spec, obstacles=spec.obstacles + tuple(extra), moving_obstacles=keep), ""
 
 
+def partial_spec(spec: Spec, position: int, t_a: float, t_b: float) -> Spec | None:
+    """``spec``'s static part plus the box moving obstacle ``position`` sweeps over
+    ``[t_a, t_b]`` (met with its active interval, clipped to the state space) as a static
+    obstacle: a spec to *plan* a detour on (the re-timing and the check still see the
+    obstacle moving). ``None`` when that box meets the initial or the target set, or the
+    interval misses the active one."""
+    ob = spec.moving_obstacles[position]
+    a, b = max(t_a, ob.active[0]), min(t_b, ob.active[1])
+    if not a < b:
+        return None
+    lo, hi, _ = ob.hull([a], [b])
+    space = spec.state_space
+    lower = tuple(max(float(v), space.lower[d]) for v, d in zip(lo[0], ob.dims))
+    upper = tuple(min(float(v), space.upper[d]) for v, d in zip(hi[0], ob.dims))
+    if any(x >= y for x, y in zip(lower, upper)):
+        return None
+    swept = Obstacle(lower, upper, ob.dims, ob.source)
+    box = swept.box(space)
+    if box.meets(spec.initial_set) or box.meets(spec.target_set):
+        return None
+    return replace(spec, obstacles=spec.obstacles + (swept,), moving_obstacles=())
+
+
 def routes(count: int) -> list[tuple[int, ...]]:
     """The sets of moving obstacles to go around (swept) while timing the others, in the
     order tried: none first, then by size, then by index; the set of all is not among
@@ -134,19 +173,70 @@ def _move_clear(seg: ReachSegment, spec: Spec) -> bool:
     return bool(_clear(lo, hi, spec, cuts[:-1], cuts[1:]).all())
 
 
+def task_holds(segments: Sequence[ReachSegment], spec: Spec) -> dict[int, Task] | None:
+    """The hold segments of a tasks' plan (:func:`~.tasks.plan_tasks`), by segment index.
+
+    Parameters
+    ----------
+    segments : sequence of ReachSegment
+        A via plan of ``spec``.
+    spec : Spec
+        Its ``tasks`` (in window order).
+
+    Returns
+    -------
+    dict of int to Task, or None
+        For each task, the index of the first segment after the previous task's that holds
+        one box (``rho`` constant) over a sub-interval of ``[t0 - STAY_LEAD, t1]``; empty
+        without tasks; ``None`` when some task has no such segment (not a tasks' plan).
+    """
+    out: dict[int, Task] = {}
+    k = 0
+    for task in spec.tasks:
+        t0, t1 = task.window
+        while k < len(segments) and not (
+                segments[k].lower_from == segments[k].lower_to
+                and segments[k].upper_from == segments[k].upper_to
+                and segments[k].start >= t0 - STAY_LEAD - 1e-9
+                and segments[k].end <= t1 + 1e-9):
+            k += 1
+        if k == len(segments):
+            return None
+        out[k] = task
+        k += 1
+    return out
+
+
+def _hold_ok(task: Task, start: float, end: float) -> bool:
+    """Whether holding the waypoint box over ``[start, end]`` (s) serves ``task``: a stay
+    task's whole window, or :data:`TASK_HOLD_SHARE` of a reach task's window inside it."""
+    t0, t1 = task.window
+    if task.kind == STAY:
+        return start <= t0 + 1e-9 and end >= t1 - 1e-9
+    return min(end, t1) - max(start, t0) >= TASK_HOLD_SHARE * (t1 - t0) - 1e-9
+
+
 def retime(segments: tuple[ReachSegment, ...], spec: Spec) -> tuple[ReachSegment, ...] | None:
     """The via boxes of ``segments`` re-timed to miss the moving obstacles (module notes).
+
+    With ``spec.tasks``, each task's hold segment (:func:`task_holds`) is not re-timed by
+    :data:`DURATION_FACTORS`: it may start at any step and last any number of steps such
+    that the held interval serves its task (:func:`_hold_ok`) and the box keeps clear over
+    it; the waits before and after it are free.
 
     Returns
     -------
     tuple of ReachSegment or None
         Segments through the same boxes, with waits between them (the reach tube holds a
         box between two segments), the last ending by ``t_c``; ``None`` if the search
-        finds no timing.
+        finds no timing (or ``segments`` is not a plan of ``spec``'s tasks).
     """
     t_c = spec.prescribed_time
     tau = t_c / TIME_STEPS
     m = len(segments)
+    holds = task_holds(segments, spec)
+    if holds is None:
+        return None
     boxes = [(np.array(s.lower_from), np.array(s.upper_from)) for s in segments]
     boxes.append((np.array(segments[-1].lower_to), np.array(segments[-1].upper_to)))
     steps = np.arange(TIME_STEPS + 1)
@@ -168,6 +258,17 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec) -> tuple[ReachSegment
             if i < TIME_STEPS and nxt not in parent and waits[k][i]:
                 parent[nxt] = ((k, i), None)
                 frontier.append(nxt)
+            if k in holds:
+                # hold the waypoint box from step i to step j (clear: the waits' boxes)
+                for j in range(i + 1, TIME_STEPS + 1):
+                    if not waits[k][j - 1]:
+                        break
+                    to = (k + 1, j)
+                    if to not in parent and _hold_ok(holds[k], i * tau, j * tau):
+                        parent[to] = ((k, i), replace(segments[k], start=i * tau,
+                                                      end=j * tau))
+                        frontier.append(to)
+                continue
             planned = segments[k].end - segments[k].start
             for f in DURATION_FACTORS:
                 d = max(1, int(math.ceil(f * planned / tau - 1e-9)))
@@ -281,8 +382,54 @@ def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
                 return _design(design.tube, design.method, final, spec, started,
                                MOTION_SWEPT, design)
             reasons.append(f"the swept design fails: {final.reason}")
+    if spec.input_bound is None and spec.tube.method != METHOD_PAPER:
+        detoured, why = _detour(spec, found, design_static, check, started)
+        if detoured is not None:
+            return detoured
+        reasons.append(why)
     raise DesignError("no tube avoids the moving obstacles: " + "; ".join(reasons),
                       kind=kind, tried=first.tube)
+
+
+def _detour(spec: Spec, found: TubeCheck, design_static: Callable[[Spec], Design],
+            check: Callable[[TubeDesign, Spec], TubeCheck],
+            started: float) -> tuple[Design | None, str]:
+    """Step 4 (module notes): a via plan around the box a moving obstacle sweeps near where
+    the static tube ``found`` meets it, re-timed against every moving obstacle; the design,
+    or ``None`` and what was found."""
+    tried: list[str] = []
+    for position, when in _meetings(found, spec):
+        for span in DETOUR_SPANS:
+            planning = partial_spec(spec, position, when - span, when + span)
+            via = None if planning is None else _try(lambda: design_static(
+                replace(planning, tube=replace(planning.tube, method="via"))))
+            if via is None:
+                continue
+            segments = retime(via.tube.segments, spec)
+            if segments is None:
+                continue
+            tube = replace(via.tube, segments=segments)
+            timed = check(tube, spec)
+            if timed.passed:
+                return (_design(_accept(tube, timed, spec), METHOD_VIA, timed, spec,
+                                started, MOTION_TIMED_VIA, via), "")
+            tried.append(f"the re-timed via tube around moving obstacle "
+                         f"{spec.moving_obstacles[position].source} over "
+                         f"[{when - span:g}, {when + span:g}] s fails: {timed.reason}")
+    return None, ("; ".join(tried) if tried else "no detour around where the static tube "
+                  "meets a moving obstacle is planned and re-timed")
+
+
+def _meetings(found: TubeCheck, spec: Spec) -> list[tuple[int, float]]:
+    """(position in ``spec.moving_obstacles``, time of the smallest margin, s) of each
+    moving obstacle the checked tube is not certified to miss, in the spec's order."""
+    margins = {m.name: m for m in found.certificate.margins}
+    out = []
+    for position, ob in enumerate(spec.moving_obstacles):
+        m = margins.get(f"{MOVING_PROPERTY} {ob.source}")
+        if m is not None and not m.passed:
+            out.append((position, float(m.time)))
+    return out
 
 
 def _try(make: Callable[[], Design]) -> Design | None:
@@ -299,6 +446,6 @@ def _design(tube: TubeDesign, method: str, check: TubeCheck, spec: Spec, started
                   task_choices=source.task_choices)
 
 
-__all__ = ["DURATION_FACTORS", "MAX_ROUTES", "MOTION_SPACE_TIME", "MOTION_SWEPT",
-           "MOTION_TIMED_VIA", "MOVE_CHECKS", "TIME_STEPS", "design_moving", "retime", "routes",
-           "static_part", "swept_spec"]
+__all__ = ["DETOUR_SPANS", "DURATION_FACTORS", "MAX_ROUTES", "MOTION_SPACE_TIME", "MOTION_SWEPT",
+           "MOTION_TIMED_VIA", "MOVE_CHECKS", "TASK_HOLD_SHARE", "TIME_STEPS", "design_moving",
+           "retime", "routes", "partial_spec", "static_part", "swept_spec", "task_holds"]
