@@ -112,7 +112,10 @@ class Design:
             method), ``segments``, ``gain``, ``certificate`` (each property with its
             margin and where it is smallest) and ``design_time_s``; for a spec with
             ``[actuator]`` also ``input_bound`` and ``input_peak`` (the proved peak of
-            each input, when it occurs, the horizon covered, the relative margin).
+            each input, when it occurs, the horizon covered, the relative margin); for a
+            spec with a second-order ``plant.model`` also ``cascade`` (``gains``: the
+            default second stage's derivation; ``rate``: linearized sampled factors and the
+            lowest rate, :func:`~stt_codegen.design.cascade_gain.cascade_rate`).
         """
         tube = self.tube
         via = []
@@ -145,7 +148,22 @@ class Design:
             },
             "design_time_s": self.design_time_s,
             **self._actuator_json(),
+            **self._cascade_json(),
         }
+
+    def _cascade_json(self) -> dict[str, Any]:
+        """``cascade``: the default second stage's derivation (``gains``) and the linearized
+        sampled loops' factors and lowest rate (``rate``, an estimate, not a certificate),
+        for a spec with a second-order ``plant.model`` only: without it the document is as
+        before."""
+        order = self.spec.second_order
+        if order is None:
+            return {}
+        from .cascade_gain import cascade_rate, second_stage_of
+        stage, derivation = second_stage_of(self)
+        return {"cascade": {"gains": derivation,
+                            "rate": cascade_rate(stage, order.input_gain, self.check.min_width,
+                                                 self.tube.rate_hz)}}
 
     def _actuator_json(self) -> dict[str, Any]:
         """``input_bound`` and the proved ``input_peak`` (with where each peak is), for a
