@@ -123,7 +123,10 @@ class Design:
             ``[actuator]`` also ``input_bound`` and ``input_peak`` (the proved peak of
             each input, when it occurs, the horizon covered, the relative margin); for a
             spec with moving obstacles also ``motion`` and ``moving_obstacles`` (index,
-            motion, active interval, certified margin; docs/moving-obstacles.md).
+            motion, active interval, certified margin; docs/moving-obstacles.md); for a
+            spec with a second-order ``plant.model`` also ``cascade`` (``gains``: the
+            default second stage's derivation; ``rate``: linearized sampled factors and the
+            lowest rate, :func:`~stt_codegen.design.cascade_gain.cascade_rate`).
         """
         tube = self.tube
         via = []
@@ -158,6 +161,7 @@ class Design:
             **self._actuator_json(),
             **self._tasks_json(),
             **self._motion_json(),
+            **self._cascade_json(),
         }
 
     def _tasks_json(self) -> dict[str, Any]:
@@ -188,6 +192,20 @@ class Design:
                 ob.active[0], "inf" if math.isinf(ob.active[1]) else ob.active[1]],
              "margin": margins[f"avoids moving obstacle {ob.source}"].margin}
             for ob in self.spec.moving_obstacles]}
+
+    def _cascade_json(self) -> dict[str, Any]:
+        """``cascade``: the default second stage's derivation (``gains``) and the linearized
+        sampled loops' factors and lowest rate (``rate``, an estimate, not a certificate),
+        for a spec with a second-order ``plant.model`` only: without it the document is as
+        before."""
+        order = self.spec.second_order
+        if order is None:
+            return {}
+        from .cascade_gain import cascade_rate, second_stage_of
+        stage, derivation = second_stage_of(self)
+        return {"cascade": {"gains": derivation,
+                            "rate": cascade_rate(stage, order.input_gain, self.check.min_width,
+                                                 self.tube.rate_hz)}}
 
     def _actuator_json(self) -> dict[str, Any]:
         """``input_bound`` and the proved ``input_peak`` (with where each peak is), for a

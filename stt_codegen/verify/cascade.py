@@ -17,6 +17,9 @@ holds where the clamps are inactive (``rho2 >= GAMMA_D_MIN``, ``|e2| <= E_MAX``)
 * ``cascade.velocity_tube``: ``rho2(0) = width_start``, ``rho2 >= rho2_inf`` for ``t >= 0``,
   ``|rho2_dot| <= l (rho2(0) - rho2_inf)``.
 
+``cascade.rate`` (:func:`cascade_rate_check`) reports linearized estimates of the sampled
+loops and the lowest rate they allow: numbers, not a proof.
+
 :data:`NOT_PROVED` says what is not proved about the sampled cascade.
 """
 
@@ -185,6 +188,35 @@ def sampled_cascade_check() -> Check:
     continuous-time lemmas of the cascade, not that the sampled cascade keeps a plant of the
     declared class in both tubes (docs/second-order.md, "What is not proved")."""
     return Check("cascade.sampled", False, NOT_PROVED, {})
+
+
+def cascade_rate_check(spec, design, min_width: float, rate_hz: float | None = None) -> Check:
+    """``cascade.rate``: the linearized sampled cascade's factors and the lowest rate at
+    which they stay in ``(-1, 1)`` for the deployed (default) gains
+    (:func:`stt_codegen.design.cascade_gain.cascade_rate`); PASS when the spec's rate is at
+    or above it. A linearized estimate, not a certificate (``cascade.sampled`` stays FAIL).
+
+    Parameters
+    ----------
+    spec : Spec
+        With a second-order ``plant.model`` (its ``input_gain``, drift bound,
+        ``initial.velocity``).
+    design : TubeDesign
+        The position tube; its ``rate_hz`` is the rate judged.
+    min_width : float
+        ``gamma_d,min``, the certified narrowest width.
+    rate_hz : float, optional
+        The rate judged with the gains derived at ``design.rate_hz`` (default that rate):
+        the gains stay those deployed at the spec's rate.
+    """
+    from ..design.cascade_gain import cascade_rate, cascade_rate_words, derived_second_stage
+    order = spec.second_order
+    stage, _ = derived_second_stage(design, min_width, order.input_gain,
+                                    order.drift_bound + spec.disturbance_amplitude,
+                                    order.initial_velocity)
+    rate = cascade_rate(stage, order.input_gain, min_width,
+                        design.rate_hz if rate_hz is None else rate_hz)
+    return Check("cascade.rate", rate["passed"], cascade_rate_words(rate), rate)
 
 
 def cascade_checks(max_n: int = 2) -> list[Check]:
