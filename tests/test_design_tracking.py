@@ -47,6 +47,7 @@ def test_bundled_cases_keep_the_papers_tube(case):
     assert tracking_demand(found.tube, found.certificate, spec).ratio < 1.0
 
 
+@pytest.mark.slow          # about 20 s a case: closed loops of the reference
 @pytest.mark.parametrize("spec", [generate_arena(0, 7).to_spec(),
                                   load_spec(SPECS / "shifted-arena-1e6.toml")],
                          ids=["arena-0-7", "shifted-arena-1e6"])

@@ -120,6 +120,7 @@ ACCEPTED = [("omnirobot-s1", 47), ("omnirobot-s3", 41), ("omnirobot-s3", 44)]
 WIDE = [(c, i) for c in CASES for i in range(2)] + ACCEPTED
 
 
+@pytest.mark.slow          # about 20 s: a closed loop per plant of the sample
 def test_a_sample_of_the_wide_study_no_accepted_plant_fails():
     rows = [study_one(job) for job in WIDE]
     accepted = {(r["case"], r["index"]) for r in rows if r["check_accepts"]}
