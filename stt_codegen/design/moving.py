@@ -351,16 +351,11 @@ def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
             via = (first if not which and first.method == METHOD_VIA else
                    _try(lambda: design_static(replace(around, tube=replace(around.tube,
                                                                            method="via")))))
-            if via is None:
+            timed = _retimed(via, partial, spec, check, started)
+            if timed is None:
                 continue
-            segments = retime(via.tube.segments, partial)
-            if segments is None:
-                continue
-            tube = replace(via.tube, segments=segments)
-            timed = check(tube, spec)
-            if timed.passed:
-                return _design(_accept(tube, timed, spec), METHOD_VIA, timed, spec,
-                               started, MOTION_TIMED_VIA, via)
+            if isinstance(timed, Design):
+                return timed
             tried.append(f"the re-timed via tube around {list(which) or 'none'} fails: "
                          f"{timed.reason}")
         reasons.append("; ".join(tried) if tried else
@@ -403,21 +398,35 @@ def _detour(spec: Spec, found: TubeCheck, design_static: Callable[[Spec], Design
             planning = partial_spec(spec, position, when - span, when + span)
             via = None if planning is None else _try(lambda: design_static(
                 replace(planning, tube=replace(planning.tube, method="via"))))
-            if via is None:
+            timed = _retimed(via, spec, spec, check, started)
+            if timed is None:
                 continue
-            segments = retime(via.tube.segments, spec)
-            if segments is None:
-                continue
-            tube = replace(via.tube, segments=segments)
-            timed = check(tube, spec)
-            if timed.passed:
-                return (_design(_accept(tube, timed, spec), METHOD_VIA, timed, spec,
-                                started, MOTION_TIMED_VIA, via), "")
+            if isinstance(timed, Design):
+                return timed, ""
             tried.append(f"the re-timed via tube around moving obstacle "
                          f"{spec.moving_obstacles[position].source} over "
                          f"[{when - span:g}, {when + span:g}] s fails: {timed.reason}")
     return None, ("; ".join(tried) if tried else "no detour around where the static tube "
                   "meets a moving obstacle is planned and re-timed")
+
+
+def _retimed(via: Design | None, timing: Spec, spec: Spec,
+             check: Callable[[TubeDesign, Spec], TubeCheck],
+             started: float) -> Design | TubeCheck | None:
+    """``via``'s boxes re-timed against the moving obstacles of ``timing``
+    (:func:`retime`) and checked for ``spec``: the design when the check passes, the failed
+    check otherwise, ``None`` when there is no via design or no re-timing."""
+    if via is None:
+        return None
+    segments = retime(via.tube.segments, timing)
+    if segments is None:
+        return None
+    tube = replace(via.tube, segments=segments)
+    timed = check(tube, spec)
+    if timed.passed:
+        return _design(_accept(tube, timed, spec), METHOD_VIA, timed, spec, started,
+                       MOTION_TIMED_VIA, via)
+    return timed
 
 
 def _meetings(found: TubeCheck, spec: Spec) -> list[tuple[int, float]]:

@@ -169,6 +169,32 @@ class Pieces:
     rho_width: np.ndarray
 
 
+@dataclass(frozen=True)
+class Partition:
+    """A cut partition of the samples: interval ``q`` is ``[i0[q] dt, i1[q] dt]`` (``i1 =
+    -1``: the tail ``[T, inf)``, ``t1 = inf``), ``steps`` sampling periods long (``inf`` for
+    the tail), with the ranges of the tube's pieces on it."""
+
+    i0: np.ndarray
+    i1: np.ndarray
+    t0: np.ndarray
+    t1: np.ndarray
+    steps: np.ndarray
+    pieces: Pieces
+
+
+def partition(design: TubeDesign, points: list[int]) -> Partition:
+    """The intervals between consecutive sample indices ``points`` (the last one opens the
+    tail) and the pieces' ranges on them (:func:`piece_ranges`; the tail's at its start)."""
+    dt = 1.0 / design.rate_hz
+    i0 = np.array(points)
+    i1 = np.append(i0[1:], -1)
+    t0 = i0 * dt
+    t1 = np.where(i1 < 0, np.inf, i1 * dt)
+    return Partition(i0, i1, t0, t1, np.where(i1 < 0, np.inf, (i1 - i0).astype(float)),
+                     piece_ranges(design, t0, np.where(i1 < 0, t0, t1)))
+
+
 def piece_ranges(design: TubeDesign, t0: np.ndarray, t1: np.ndarray) -> Pieces:
     """Ranges of ``rho``, ``beta``, their rates and ``psi`` (eq. (11)) on each ``[t0, t1]``."""
     rho_l, rho_u, rho_rate, rho_width = reach_range(design, t0, t1)

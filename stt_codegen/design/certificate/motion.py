@@ -27,7 +27,7 @@ import numpy as np
 from ...spec.loader import Spec
 from ...tube import reference
 from ...tube.parameters import TubeDesign
-from .enclosures import enclose, piece_ranges
+from .enclosures import enclose, partition
 from .report import ROUNDING_MARGIN, Certificate, CertificateState, Enclosure, Margin
 from .repropagate import repropagate
 
@@ -64,16 +64,10 @@ def moving_separation(spec: Spec, enc: Enclosure) -> list[tuple[int, np.ndarray,
 def _enclosure(design: TubeDesign, points: list[int], state: CertificateState
                ) -> tuple[Enclosure, CertificateState]:
     """The enclosure on a cut partition, ``alpha`` followed from ``state`` on the cuts only."""
-    dt = 1.0 / design.rate_hz
-    i0 = np.array(points)
-    i1 = np.append(i0[1:], -1)                 # -1: the tail [T, inf)
-    t0 = i0 * dt
-    t1 = np.where(i1 < 0, np.inf, i1 * dt)
-    pieces = piece_ranges(design, t0, np.where(i1 < 0, t0, t1))
-    steps = np.where(i1 < 0, np.inf, (i1 - i0).astype(float))
-    state, _ = repropagate(design, pieces, points, steps, state)
+    part = partition(design, points)
+    state, _ = repropagate(design, part.pieces, points, part.steps, state)
     a_min = np.maximum(np.array(state.alpha_lo), 0.0)
-    enc = enclose(design, pieces, a_min, np.array(state.alpha_hi), t0, t1)
+    enc = enclose(design, part.pieces, a_min, np.array(state.alpha_hi), part.t0, part.t1)
     return enc, state
 
 

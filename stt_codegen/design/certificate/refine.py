@@ -17,7 +17,7 @@ import numpy as np
 from ...spec.loader import Spec
 from ...tube import reference
 from ...tube.parameters import TubeDesign
-from .enclosures import enclose, piece_ranges
+from .enclosures import enclose, partition
 from .implicit_step import alpha_ranges
 from .narrowest import sharpen_narrowest
 from .repropagate import repropagate, step_psi
@@ -140,12 +140,9 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
             previous = parent.state
             reuse_limit = cut - 1
     while True:
-        i0 = np.array(points)
-        i1 = np.append(i0[1:], -1)            # -1: the tail [T, inf)
-        t0 = i0 * dt
-        t1 = np.where(i1 < 0, np.inf, i1 * dt)
-        pieces = piece_ranges(design, t0, np.where(i1 < 0, t0, t1))
-        steps = np.where(i1 < 0, np.inf, (i1 - i0).astype(float))
+        part = partition(design, points)      # i1 = -1: the tail [T, inf)
+        i0, i1, t0, t1, steps, pieces = (part.i0, part.i1, part.t0, part.t1, part.steps,
+                                         part.pieces)
         if proven is not None:
             # a cut of a proven partition: its bounds stay valid, follow the cuts only
             previous, done = repropagate(design, pieces, points, steps, proven[1])
