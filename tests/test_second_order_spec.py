@@ -180,3 +180,37 @@ def test_generate_writes_the_cascade(tmp_path) -> None:
                      "second_order_s1_cascade.py", "second_order_s1_cascade_vectors.json"]
     committed = REPO / "generated" / "second-order-s1" / "double" / "second_order_s1_cascade.c"
     assert (tmp_path / "out" / "second_order_s1_cascade.c").read_bytes() == committed.read_bytes()
+
+
+def test_tasks_and_moving_obstacles_are_refused_with_a_second_order_plant():
+    """The cascade's run judges static obstacles only: a second-order spec with [[tasks]]
+    or a moving obstacle is refused, naming the field, before any design."""
+    data = _doc("second-order-s1")
+    data["tasks"] = [{"kind": "reach", "window": [4.0, 5.0], "lower": [3.2, 3.7],
+                      "upper": [3.8, 4.3]}]
+    with pytest.raises(SpecError) as info:
+        stt.Spec.from_dict(data)
+    assert info.value.field == "tasks" and "second-order" in str(info.value)
+    data = _doc("second-order-s1")
+    data["obstacles"].append({"lower": [2.0, 0.0], "upper": [2.4, 0.4],
+                              "velocity": [0.0, 0.1], "active": [0.0, 2.0]})
+    with pytest.raises(SpecError) as info:
+        stt.Spec.from_dict(data)
+    assert info.value.field == f"obstacles[{len(data['obstacles']) - 1}]"
+
+
+def test_the_front_door_simulates_a_second_order_design_with_the_cascade():
+    """``stt.simulate`` runs the cascade law on the spec's second-order model (it ran law
+    (13) on the position stage alone before), and the command line's text output works."""
+    design = stt.design_tube(stt.load_spec("second-order-s1"))
+    result = stt.simulate(design, horizon=0.5)
+    assert type(result).__name__ == "CascadeResult" and result.tasks == []
+    assert result.trajectory.x2.shape[1] == 2                 # velocities were simulated
+    with pytest.raises(SpecError) as info:
+        stt.simulate(design, horizon=0.5, plant=object())
+    assert info.value.field == "plant"
+    out = subprocess.run([sys.executable, "-m", "stt_codegen.cli", "simulate",
+                          "second-order-s1", "--backend", "reference", "--horizon", "0.5"],
+                         capture_output=True, text=True, cwd=REPO, timeout=300)
+    assert out.returncode == 1 and "Traceback" not in out.stderr   # not reached by 0.5 s
+    assert "cascade law" in out.stdout

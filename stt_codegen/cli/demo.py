@@ -29,13 +29,11 @@ def cmd_demo(args: argparse.Namespace) -> int:
     for name, spec in specs.items():
         design = design_spec(spec, args)
         generate(design, out / name)
+        result = simulate(design, backend=args.backend)   # the cascade's for second order
         if spec.second_order is not None:   # the cascade law (issue 22)
             from ..runtime.cascade_plots import plot_cascade_run
-            from ..runtime.cascade_simulate import simulate_cascade
-            result = simulate_cascade(design, backend=args.backend)
             draw = plot_cascade_run
         else:
-            result = simulate(design, backend=args.backend)
             draw = plot_run
         atomic_write(out / f"{name}.png", lambda tmp: draw(design, result, tmp, dims=dims[name]))
         print(summary_line(result), flush=True)

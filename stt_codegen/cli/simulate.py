@@ -27,12 +27,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from ..runtime.simulate import simulate
     seed = checked_seed(args)
     design, dims = design_to_plot(args)
-    if design.spec.second_order is not None:     # the cascade law (issue 22)
-        from ..runtime.cascade_simulate import simulate_cascade
-        result = simulate_cascade(design, backend=args.backend, horizon=args.horizon,
-                                  seed=seed)
-    else:
-        result = simulate(design, backend=args.backend, horizon=args.horizon, seed=seed)
+    result = simulate(design, backend=args.backend, horizon=args.horizon, seed=seed)
 
     def draw(path):
         if design.spec.second_order is not None:

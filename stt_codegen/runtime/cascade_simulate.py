@@ -94,11 +94,15 @@ class CascadeResult:
     steps: int
     exceeded_velocity_bound: bool = False
     trajectory: CascadeTrajectory | None = field(default=None, repr=False)
+    #: As :attr:`SimulationResult.tasks`; always empty: a second-order spec takes no
+    #: ``[[tasks]]`` (the loader refuses them).
+    tasks: list = field(default_factory=list)
 
     def to_json(self) -> dict:
-        """The result as a JSON-ready dict (without the trajectory)."""
+        """The result as a JSON-ready dict (without the trajectory and the empty tasks)."""
         data = asdict(self)
         data.pop("trajectory")
+        data.pop("tasks")
         return data
 
 

@@ -172,6 +172,10 @@ def simulate(design: Design, backend: str = "reference", horizon: float | None =
     Returns
     -------
     SimulationResult
+        For a spec with a second-order ``plant.model``, the cascade law's run instead
+        (:func:`stt_codegen.runtime.cascade_simulate.simulate_cascade`, a
+        :class:`~stt_codegen.runtime.cascade_simulate.CascadeResult` with the same fields
+        and the velocity stage's; ``plant`` must then be ``None``).
         ``satisfied`` (reach the target by ``t_c``, avoid every obstacle, stay in the
         state space), the reach time (s), the clearance (state units), ``max |u|`` per
         input, the control effort ``integral |u|^2 dt``, the steps the actuator clamp
@@ -213,6 +217,12 @@ def simulate(design: Design, backend: str = "reference", horizon: float | None =
     if isinstance(backend, Design):          # simulate(spec, design): the spec first
         design, backend = paired_design(design, backend, "simulate"), "reference"
     design = require_design(design, "simulate")
+    if design.spec.second_order is not None:     # the cascade law (issue 22)
+        if plant is not None:
+            raise SpecError("plant", "a second-order spec runs its own plant.model through "
+                                     "the cascade law; another plant cannot be given")
+        from .cascade_simulate import simulate_cascade
+        return simulate_cascade(design, backend=backend, horizon=horizon, seed=seed)
     return run_closed_loop(design.spec, design.tube, backend=backend, horizon=horizon,
                            seed=seed, plant=plant)
 
