@@ -214,3 +214,6 @@ def test_the_front_door_simulates_a_second_order_design_with_the_cascade():
                          capture_output=True, text=True, cwd=REPO, timeout=300)
     assert out.returncode == 1 and "Traceback" not in out.stderr   # not reached by 0.5 s
     assert "cascade law" in out.stdout
+    with pytest.raises(TypeError, match="plot_cascade_run"):      # not drawn as law (13)'s
+        stt.plot_run(design, result, REPO / "never-written.png")
+    assert not (REPO / "never-written.png").exists()

@@ -398,7 +398,9 @@ def plot_run(design: Design, result: SimulationResult, path: str | Path, *,
     Raises
     ------
     TypeError
-        ``design`` is not a :class:`~stt_codegen.design.result.Design`.
+        ``design`` is not a :class:`~stt_codegen.design.result.Design`, or ``result`` is
+        a second-order run (a ``CascadeResult``: draw it with
+        :func:`stt_codegen.runtime.cascade_plots.plot_cascade_run`).
     SpecError
         ``dims`` is not two distinct dimensions of the state space (field ``dims``).
 
@@ -415,7 +417,14 @@ def plot_run(design: Design, result: SimulationResult, path: str | Path, *,
     >>> stt.plot_run(design, result, "s1-run.png").name
     's1-run.png'
     """
-    return save(run_figure(require_design(design, "plot_run"), result, dims), path)
+    design = require_design(design, "plot_run")
+    if not isinstance(result, SimulationResult):
+        hint = (": a second-order run, drawn by stt_codegen.runtime.cascade_plots."
+                "plot_cascade_run(design, result, path)" if design.spec.second_order
+                is not None else "")
+        raise TypeError(f"plot_run(): parameter 'result' must be a SimulationResult, not "
+                        f"{type(result).__name__}{hint}")
+    return save(run_figure(design, result, dims), path)
 
 
 # --------------------------------------------------------------------------- a design
