@@ -63,6 +63,40 @@ def _nearest(graph: nx.Graph, origin: np.ndarray, point: np.ndarray,
     return int(nodes[k, 0]), int(nodes[k, 1])
 
 
+def grid_path(graph: nx.Graph, origin: np.ndarray, start: np.ndarray, goal: np.ndarray,
+              resolution: float = RESOLUTION) -> np.ndarray | None:
+    """A* on the occupancy grid between the free nodes nearest ``start`` and ``goal``.
+
+    Parameters
+    ----------
+    graph, origin
+        From :func:`grid_graph`.
+    start, goal : ndarray, shape (2,)
+        Metres.
+    resolution : float
+        The grid's spacing, metres.
+
+    Returns
+    -------
+    ndarray, shape (K, 2), or None
+        The grid nodes of the path, metres (``start`` and ``goal`` not included); ``None``
+        when no free node is reachable from the other.
+    """
+    source = _nearest(graph, origin, start, resolution)
+    target = _nearest(graph, origin, goal, resolution)
+
+    def heuristic(a, b):
+        return resolution * math.hypot(a[0] - b[0], a[1] - b[1])
+
+    try:
+        if source is None or target is None:
+            raise nx.NetworkXNoPath
+        nodes = nx.astar_path(graph, source, target, heuristic=heuristic, weight="weight")
+    except nx.NetworkXNoPath:
+        return None
+    return origin + resolution * np.array(nodes, dtype=float)
+
+
 def plan_astar(spec: Spec, resolution: float = RESOLUTION) -> Plan:
     """Plan from ``x(0)`` to the target's centre with A* on the occupancy grid.
 
@@ -81,18 +115,8 @@ def plan_astar(spec: Spec, resolution: float = RESOLUTION) -> Plan:
     begin = time.perf_counter()
     space = FreeSpace.of(spec)
     graph, origin = grid_graph(space, resolution)
-    source = _nearest(graph, origin, space.start, resolution)
-    target = _nearest(graph, origin, space.goal, resolution)
-
-    def heuristic(a, b):
-        return resolution * math.hypot(a[0] - b[0], a[1] - b[1])
-
-    try:
-        if source is None or target is None:
-            raise nx.NetworkXNoPath
-        nodes = nx.astar_path(graph, source, target, heuristic=heuristic, weight="weight")
-    except nx.NetworkXNoPath:
+    path = grid_path(graph, origin, space.start, space.goal, resolution)
+    if path is None:
         return Plan(None, time.perf_counter() - begin, "no path found")
-    path = origin + resolution * np.array(nodes, dtype=float)
     path = np.vstack([space.start, path, space.goal])
     return Plan(path, time.perf_counter() - begin)

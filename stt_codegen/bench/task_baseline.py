@@ -22,14 +22,13 @@ import math
 import time
 from dataclasses import dataclass
 
-import networkx as nx
 import numpy as np
 
 from ..design.search import base_design
 from ..runtime.backends import STATUS_OK, backend_names, register_backend
 from ..runtime.simulate import SimulationResult, run_closed_loop
 from ..spec.loader import Spec
-from .astar import RESOLUTION, grid_graph
+from .astar import RESOLUTION, grid_graph, grid_path
 from .planning import FreeSpace
 from .task_timing import departure
 from .tracker import GOAL_GAIN, SPEED, PathTracker
@@ -72,28 +71,12 @@ class TimedPlan:
     clear: tuple[bool, ...] = ()
 
 
-def _node(graph: nx.Graph, origin: np.ndarray, point: np.ndarray):
-    nodes = np.array(list(graph.nodes), dtype=float).reshape(-1, 2)
-    if not len(nodes):
-        return None
-    k = int(np.argmin(np.sum((origin + RESOLUTION * nodes - point) ** 2, axis=1)))
-    return int(nodes[k, 0]), int(nodes[k, 1])
-
-
 def _leg(graph, origin, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray | None, float]:
     """The A* path from ``a`` to ``b`` (K, 2) and its length, or ``(None, inf)``."""
-    source, target = _node(graph, origin, a), _node(graph, origin, b)
-
-    def heuristic(p, q):
-        return RESOLUTION * math.hypot(p[0] - q[0], p[1] - q[1])
-
-    try:
-        if source is None or target is None:
-            raise nx.NetworkXNoPath
-        nodes = nx.astar_path(graph, source, target, heuristic=heuristic, weight="weight")
-    except nx.NetworkXNoPath:
+    nodes = grid_path(graph, origin, a, b, RESOLUTION)
+    if nodes is None:
         return None, math.inf
-    path = np.vstack([a, origin + RESOLUTION * np.array(nodes, dtype=float), b])
+    path = np.vstack([a, nodes, b])
     return path, float(np.sum(np.linalg.norm(np.diff(path, axis=0), axis=1)))
 
 

@@ -35,7 +35,7 @@ from dataclasses import dataclass, replace
 
 from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
-from .grid import grid_index, grid_value
+from .grid import grid_index, grid_value, smallest_passing
 from .failures import FailureKind
 from .input_bound import InputProof, InputProver, input_prover
 from .result import METHOD_PAPER, METHOD_VIA, Design
@@ -273,10 +273,4 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
                           "[assumptions] alone ask for about that much")
         else:
             low, ratio = guess, found
-    while high - low > 1:
-        mid = (low + high) // 2
-        if passes(mid)[0]:
-            high = mid
-        else:
-            low = mid
-    return grid_value(high), ""
+    return grid_value(smallest_passing(lambda i: passes(i)[0], low, high)), ""

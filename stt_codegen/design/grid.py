@@ -9,6 +9,7 @@ so that a search can bisect on it.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 
 def grid_index(value: float) -> int:
@@ -24,3 +25,15 @@ def grid_value(index: int) -> float:
     """The number of index ``index`` (:func:`grid_index`'s inverse on the grid)."""
     e, m = divmod(index, 90)
     return float(f"{m + 10}e{e}")
+
+
+def smallest_passing(passes: Callable[[int], bool], low: int, high: int) -> int:
+    """The smallest index in ``(low, high]`` at which ``passes`` holds, by bisection, given
+    that it fails at ``low`` and holds at ``high`` (and is monotone between them)."""
+    while high - low > 1:
+        mid = (low + high) // 2
+        if passes(mid):
+            high = mid
+        else:
+            low = mid
+    return high

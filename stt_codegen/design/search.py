@@ -32,7 +32,7 @@ from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, certify_tube
 from .certificate.motion import certify_motion
 from .actuator import design_within_bound
 from .failures import FailureKind, property_kind
-from .grid import grid_index, grid_value
+from .grid import grid_index, grid_value, smallest_passing
 from .moving import design_moving
 from .gain import derived_gain
 from .plant_check import plant_failure
@@ -171,13 +171,7 @@ def lowest_passing_rate(tube: TubeDesign, spec: Spec) -> float | None:
             high = guess
         else:
             low = guess
-    while high - low > 1:
-        mid = (low + high) // 2
-        if passes(mid)[0]:
-            high = mid
-        else:
-            low = mid
-    return grid_value(high)
+    return grid_value(smallest_passing(lambda i: passes(i)[0], low, high))
 
 
 # --------------------------------------------------------------------------- the search
