@@ -12,6 +12,14 @@ The plants and seeds are those of the former ``tests/study_unknown_dynamics.py``
 7), which this module replaces, so that the numbers compare. Run::
 
     python -m stt_codegen.bench.plants_study [RUNS_PER_CASE] [--workers W] [--out rows.json]
+                                             [--classes] [--own-gain]
+
+``--classes`` also searches each plant's class (its own bounds) for a member that leaves
+the tube (:func:`~stt_codegen.verify.class_search.search_class`): no sound check may accept
+a class with such a member, so the study then says how many of the plants that hold any
+sound check could accept at most, and how many of those the check accepts. ``--own-gain``
+runs everything at the gain the design derives from each plant's own bounds, as a user who
+declared them in ``[assumptions]`` would get, instead of the bundled design's gain.
 """
 
 from __future__ import annotations
@@ -28,12 +36,14 @@ from pathlib import Path
 
 import numpy as np
 
+from ..design.gain import derived_gain
 from ..design.samples import sample_tube
 from ..design.search import design_tube
 from ..runtime.simulate import run_closed_loop
 from ..spec.assumptions import Assumptions
 from ..spec.loader import load_spec
 from ..verify.sampled import check_sampled
+from ..verify.class_search import replay, search_class
 
 __all__ = ["CASES", "RANGES", "draw", "plant_parameters", "own_bounds", "study_one",
            "study_plants"]
@@ -50,6 +60,12 @@ def _designed(case: str):
     spec = load_spec(case)
     design = design_tube(spec).tube
     return spec, design, sample_tube(design)
+
+
+@lru_cache(maxsize=None)
+def _min_width(case: str) -> float:
+    """The certified narrowest width of the case's design, from which its gain is derived."""
+    return design_tube(load_spec(case)).check.min_width
 
 
 def draw(case: str, index: int) -> dict:
@@ -113,8 +129,10 @@ def own_bounds(p: dict, spec) -> Assumptions:
                        float(drift), float(p["w_amp"] * math.sqrt(n)))
 
 
-def _holds(case: str, p: dict, rate_factor: float = 1.0) -> bool:
+def _holds(case: str, p: dict, rate_factor: float = 1.0, gain: float | None = None) -> bool:
     spec, design, _ = _designed(case)
+    if gain is not None:
+        design = dataclasses.replace(design, gain=gain)
     if rate_factor != 1.0:
         spec = dataclasses.replace(spec, rate_hz=spec.rate_hz * rate_factor)
         design = dataclasses.replace(design, rate_hz=design.rate_hz * rate_factor)
@@ -123,33 +141,55 @@ def _holds(case: str, p: dict, rate_factor: float = 1.0) -> bool:
     return bool(result.satisfied and result.stayed_in_tube)
 
 
-def study_one(job: tuple[str, int]) -> dict:
+def study_one(job: tuple) -> dict:
     """One plant: whether it holds in simulation, the check's verdict on its own bounds,
-    and, when it fails, whether it holds at 2, 4 or 8 times the rate."""
-    case, index = job
+    and, when it fails, whether it holds at 2, 4 or 8 times the rate.
+
+    ``job`` is ``(case, index)``, ``(case, index, classes)`` or ``(case, index, classes,
+    own_gain)``. With ``classes`` true, the row's ``class_counterexample`` is a member of
+    the plant's class that leaves the tube
+    (:meth:`~stt_codegen.verify.class_search.Counterexample.to_json`), or ``None`` when the
+    search finds none. With ``own_gain`` true, the gain of law (13) is the one the design
+    derives from the plant's own bounds (:func:`~stt_codegen.design.gain.derived_gain` at
+    the design's certified narrowest width), as if the user had declared them in
+    ``[assumptions]``, for the check, the search and the simulation alike; otherwise it is
+    the bundled design's (derived from the robot's bounds)."""
+    case, index = job[:2]
+    classes, own_gain = (tuple(job[2:]) + (False, False))[:2]
     spec, design, samples = _designed(case)
     knobs = draw(case, index)
     p = plant_parameters(knobs)
     bounds = own_bounds(p, spec)
+    gain = derived_gain(_min_width(case), design.rate_hz, bounds) if own_gain else None
+    if gain is not None:
+        design = dataclasses.replace(design, gain=gain)
     started = time.perf_counter()
     verdict = check_sampled(design, samples, bounds)
     check_s = time.perf_counter() - started
-    held = _holds(case, p)
+    held = _holds(case, p, gain=gain)
     row = {"case": case, "index": index, **knobs, "held": held,
            "check_accepts": verdict.passed, "check_s": check_s,
            "g_min_own": bounds.input_gain[0], "g_max_own": bounds.input_gain[1],
            "coupling": bounds.input_gain_coupling,
            "push": bounds.drift_bound + bounds.disturbance_bound,
-           "check_fails_at": None if verdict.passed else verdict.time}
+           "check_fails_at": None if verdict.passed else verdict.time,
+           "gain": design.gain}
+    if classes:
+        found = search_class(design, samples, bounds)
+        row["class_counterexample"] = (None if found is None else
+                                       {**found.to_json(), "replayed_on_c": replay(design, found)})
     if not held:
-        row["holds_at_rate_factor"] = next((f for f in (2.0, 4.0, 8.0) if _holds(case, p, f)),
-                                           None)
+        row["holds_at_rate_factor"] = next(
+            (f for f in (2.0, 4.0, 8.0) if _holds(case, p, f, gain)), None)
     return row
 
 
-def study_plants(runs: int, workers: int = 2) -> list[dict]:
-    """``runs`` plants per bundled case (:func:`study_one`), in parallel."""
-    jobs = [(case, i) for case in CASES for i in range(runs)]
+def study_plants(runs: int, workers: int = 2, classes: bool = False,
+                 own_gain: bool = False) -> list[dict]:
+    """``runs`` plants per bundled case (:func:`study_one`, with the class search when
+    ``classes``, at the gain derived from each plant's bounds when ``own_gain``), in
+    parallel."""
+    jobs = [(case, i, classes, own_gain) for case in CASES for i in range(runs)]
     if workers <= 1:
         return [study_one(j) for j in jobs]
     with ProcessPoolExecutor(workers) as pool:
@@ -169,6 +209,22 @@ def summary(rows: list[dict]) -> str:
         sub = [r for r in rows if r["case"] == case]
         lines.append(f"  {case}: {sum(r['held'] for r in sub)}/{len(sub)} hold, check "
                      f"accepts {sum(r['check_accepts'] for r in sub)}")
+    if rows and all("class_counterexample" in r for r in rows):
+        open_ = [r for r in held if r["class_counterexample"] is None]
+        replayed = sum(bool(r["class_counterexample"] and r["class_counterexample"].get(
+            "replayed_on_c")) for r in held)
+        unsound = [r for r in accepted if r["class_counterexample"] is not None]
+        lines.append(
+            f"classes: {len(held) - len(open_)} of the {len(held)} plants that hold have a "
+            f"member of their own class that leaves the tube (no sound check may accept "
+            f"them); the search finds none for {len(open_)}, of which the check accepts "
+            f"{sum(r['check_accepts'] for r in open_)}; accepted classes with a "
+            f"counterexample: {len(unsound)}; counterexamples confirmed by the generated C "
+            f"controller: {replayed} of {len(held) - len(open_)}")
+        for case in CASES:
+            sub = [r for r in held if r["case"] == case]
+            lines.append(f"  {case}: {sum(r['class_counterexample'] is None for r in sub)} "
+                         f"of {len(sub)} that hold without a counterexample found")
     return "\n".join(lines)
 
 
@@ -179,14 +235,21 @@ def main(argv: list[str] | None = None) -> int:
                         help="plants per bundled case (default 100)")
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", default=None, help="write every row as JSON")
+    parser.add_argument("--classes", action="store_true",
+                        help="also search each plant's class for a member that leaves the tube")
+    parser.add_argument("--own-gain", action="store_true",
+                        help="use the gain derived from each plant's own bounds instead of "
+                             "the bundled design's")
     args = parser.parse_args(argv)
     started = time.perf_counter()
-    rows = study_plants(args.runs, args.workers)
+    rows = study_plants(args.runs, args.workers, args.classes, args.own_gain)
     print(summary(rows))
     print(f"({time.perf_counter() - started:.0f} s)")
     if args.out:
         Path(args.out).write_text(json.dumps(rows, indent=1))
-    return 1 if any(r["check_accepts"] and not r["held"] for r in rows) else 0
+    unsound = any(r["check_accepts"] and (not r["held"] or r.get("class_counterexample"))
+                  for r in rows)
+    return 1 if unsound else 0
 
 
 if __name__ == "__main__":

@@ -1,0 +1,314 @@
+"""Members of a plant class that leave the tube: plants no sound sampled check may accept.
+
+The sampled-data check (:func:`~stt_codegen.verify.sampled.check_sampled`) proves a whole
+class of plants, the bounds of :class:`~stt_codegen.spec.assumptions.Assumptions`: every
+``x_dot = f(x) + g(x) u + w`` whose ``g`` has the symmetric part's eigenvalues in
+``[g_min, g_max]``, a skew part of norm at most ``input_gain_skew``, off-diagonal rows of
+norm at most ``input_gain_coupling``, and ``|f| <= drift_bound``, ``|w| <=
+disturbance_bound``. A check that accepts a class has to be right for *every* member,
+not only for the plant the bounds were read from. This module searches a class for a
+member that leaves the tube under the sampled law (13): when it finds one, no sound check
+can accept that class, whatever its argument.
+
+The search is an adversary on the sampled loop, exact in its arithmetic:
+
+* ``g`` is piecewise constant along the path: on each sampling interval, one matrix
+  ``G_m`` of a finite set of members of the class (:func:`class_matrices`: the extreme
+  eigenvalues in every arrangement, rotated and not, with the largest skew part, each
+  kept only if its rows obey the coupling bound);
+* ``f + w`` is constant on each interval, of norm ``drift_bound + disturbance_bound``, in
+  one of a finite set of directions (the axes, the normalized error, the gradient of law
+  (13)'s Lyapunov function, both signs);
+* with ``u_k`` held, the step is exact: ``x_{k+1} = x_k + dt (G_m u_k + d_k)``.
+
+Three strategies choose ``(G_m, d_k)`` at each sample: greedily the largest next
+``max_i |e_i|``, greedily the largest next ``sum_i atanh(e_i)^2``, and, for each of the
+first :data:`HELD_RUNS` members held for the whole run, the direction of the largest next
+``max_i |e_i|``. A run is a
+counterexample when ``|e_i(t_k)| >= 1`` at a sample (the state is outside the deployed
+tube there). Such a plant is a member of the class: ``g(x)`` and ``f(x)`` defined along
+the path (which does not cross itself), ``w`` along time; a smooth member of the class
+follows it as closely as wanted (the exits found go beyond the tube by a margin,
+:attr:`Counterexample.depth`). The search is not exhaustive: finding none proves nothing.
+
+``verify`` runs the greedy strategies when its sampled check fails on bounds that hold on
+every interval alike, and reports a member it finds, confirmed on the numpy reference of
+the deployed controller (:func:`replay`): the failure is then not the check's caution.
+The wide study runs the search on each plant's class
+(``python -m stt_codegen.bench.plants_study --classes``; docs/sampled-data.md, "The wide
+study, and how much a sound check can accept").
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..design.samples import TubeSamples
+from ..spec.assumptions import Assumptions
+from ..tube.parameters import TubeDesign
+
+__all__ = ["Counterexample", "class_matrices", "replay", "search_class", "within_class"]
+
+#: Random rotations of the extreme eigenvalues tried per class (besides the axis-aligned
+#: arrangements).
+ROTATIONS = 16
+#: Members held for a whole run (the first of :func:`class_matrices`), after the greedy runs.
+HELD_RUNS = 24
+
+
+@dataclass(frozen=True)
+class Counterexample:
+    """A member of the class whose sampled loop leaves the tube.
+
+    Attributes
+    ----------
+    strategy : str
+        How the adversary chose ``(G, d)`` on each interval.
+    time : float
+        The sample at which ``|e_i| >= 1``, seconds.
+    dimension : int
+        The dimension ``i`` (0-based).
+    depth : float
+        ``|e_i|`` there (``>= 1``; how far outside the tube, in half-widths from its centre).
+    max_abs_e : float
+        The largest ``|e|`` at the samples before the exit.
+    gains : ndarray, shape (K, n, n)
+        ``g`` on each sampling interval up to the exit (a member of the class).
+    pushes : ndarray, shape (K, n)
+        ``f + w`` on each interval, state units per second.
+    """
+
+    strategy: str
+    time: float
+    dimension: int
+    depth: float
+    max_abs_e: float
+    gains: np.ndarray = field(compare=False, repr=False, default=None)
+    pushes: np.ndarray = field(compare=False, repr=False, default=None)
+
+    def to_json(self) -> dict:
+        """The figures, without the path (JSON-ready)."""
+        return {"strategy": self.strategy, "time": self.time, "dimension": self.dimension,
+                "depth": self.depth, "max_abs_e": self.max_abs_e}
+
+
+def _unit_skew(axis: np.ndarray) -> np.ndarray:
+    """The skew matrix of the cross product with ``axis`` (3-D), or the rotation generator
+    (2-D); spectral norm ``|axis|``."""
+    if len(axis) == 2:
+        return np.array([[0.0, -1.0], [1.0, 0.0]])
+    return np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]],
+                     [-axis[1], axis[0], 0.0]])
+
+
+def within_class(g: np.ndarray, bounds: Assumptions, tol: float = 1e-9) -> bool:
+    """``g`` obeys the class's bounds on ``g``: eigenvalues of its symmetric part, norm of
+    its skew part, norm of each row's off-diagonal part (up to ``tol`` relative), and zero
+    entries between the class's blocks (:meth:`Assumptions.coupled_blocks`)."""
+    n = len(g)
+    g_min, g_max = bounds.input_gain
+    block_of = {i: b for b in bounds.coupled_blocks(n) for i in b}
+    if any(g[i, j] != 0.0 for i in range(n) for j in range(n) if j not in block_of[i]):
+        return False
+    eig = np.linalg.eigvalsh(0.5 * (g + g.T))
+    skew = np.linalg.norm(0.5 * (g - g.T), 2)
+    rows = np.linalg.norm(g - np.diag(np.diag(g)), axis=1).max(initial=0.0)
+    slack = 1.0 + tol
+    return bool(eig[0] >= g_min / slack and eig[-1] <= g_max * slack
+                and skew <= bounds.input_gain_skew * slack + tol
+                and rows <= bounds.input_gain_coupling * slack + tol)
+
+
+def _block_matrices(bounds: Assumptions, m: int, rng: np.random.Generator
+                    ) -> list[np.ndarray]:
+    """Candidate ``m x m`` blocks: extreme eigenvalues (on the axes, and rotated) plus the
+    largest skew part the coupling bound allows (about each axis and random axes, both
+    signs)."""
+    g_min, g_max = bounds.input_gain
+    skew = bounds.input_gain_skew
+    syms = [np.diag(e) for e in itertools.product((g_min, g_max), repeat=m)]
+    if m > 1:
+        for _ in range(ROTATIONS):
+            q, _ = np.linalg.qr(rng.normal(size=(m, m)))
+            syms.append(q @ np.diag(rng.choice((g_min, g_max), m)) @ q.T)
+    if m == 1 or skew == 0.0:
+        skews = [np.zeros((m, m))]
+    elif m == 2:
+        skews = [sign * skew * _unit_skew(np.zeros(2)) for sign in (1.0, -1.0)]
+    else:
+        axes = list(np.eye(m)) + [v / np.linalg.norm(v) for v in rng.normal(size=(4, m))]
+        skews = [sign * skew * _unit_skew(a) for a in axes for sign in (1.0, -1.0)]
+    return [s + k for s, k in itertools.product(syms, skews)]
+
+
+def class_matrices(bounds: Assumptions, n: int, seed: int = 0) -> list[np.ndarray]:
+    """Constant input gains ``g`` of the class, at its extremes.
+
+    Block by block (:meth:`Assumptions.coupled_blocks`; ``g`` is zero between blocks), the
+    symmetric part has eigenvalues ``g_min`` and ``g_max`` (every arrangement on the axes,
+    and :data:`ROTATIONS` random rotations), the skew part the largest norm the coupling
+    bound allows (scaled by 1, 0.75, 0.5 or 0), about each axis and random axes, both
+    signs. Only matrices :func:`within_class` are returned, without repeats, in a fixed
+    order.
+
+    Parameters
+    ----------
+    bounds : Assumptions
+        The class.
+    n : int
+        States (``g`` is ``n x n``); blocks of at most 3 states.
+    seed : int
+        Seeds the random rotations and axes.
+
+    Returns
+    -------
+    list of ndarray, each (n, n)
+    """
+    rng = np.random.default_rng([seed, n, 11])
+    blocks = bounds.coupled_blocks(n)
+    choices = [_block_matrices(bounds, len(b), rng) for b in blocks]
+    unique: dict[bytes, np.ndarray] = {}
+    for parts in itertools.product(*choices):
+        full = np.zeros((n, n))
+        for b, part in zip(blocks, parts):
+            full[np.ix_(b, b)] = part
+        sym = 0.5 * (full + full.T)
+        for scale in (1.0, 0.75, 0.5, 0.0):      # the largest skew the coupling allows
+            g = sym + scale * (full - sym)
+            if within_class(g, bounds):
+                unique.setdefault(np.round(g, 12).tobytes(), g)
+                break
+    return list(unique.values())
+
+
+def _directions(e: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """Unit directions of ``f + w`` tried at a sample: the axes, the normalized error and
+    the gradient of ``W`` (law (13)'s Lyapunov function), both signs; (m, n)."""
+    n = len(e)
+    rows = [np.eye(n), -np.eye(n)]
+    for v in (e, z):
+        norm = np.linalg.norm(v)
+        if norm > 0.0:
+            rows.append(np.stack([v / norm, -v / norm]))
+    return np.concatenate(rows)
+
+
+def _run(design: TubeDesign, samples: TubeSamples, members: list[np.ndarray],
+         push: float, score: str, strategy: str) -> Counterexample | None:
+    lower, upper = samples.gamma_lower, samples.gamma_upper
+    centre, half = 0.5 * (upper + lower), 0.5 * (upper - lower)
+    dt = 1.0 / design.rate_hz
+    gain = design.gain
+    x = np.array(design.initial_state, dtype=float)
+    g_all = np.stack(members)                                   # (M, n, n)
+    top = 0.0
+    gains, pushes = [], []
+
+    def found(k: int, e: np.ndarray) -> Counterexample:
+        i = int(np.argmax(np.abs(e)))
+        return Counterexample(strategy, float(samples.t[k]), i, float(abs(e[i])), top,
+                              np.array(gains).reshape(k, *g_all.shape[1:]),
+                              np.array(pushes).reshape(k, len(x)))
+
+    for k in range(len(samples.t) - 1):
+        e = (x - centre[k]) / half[k]
+        worst = float(np.max(np.abs(e)))
+        if worst >= 1.0:
+            return found(k, e)
+        top = max(top, worst)
+        z = 2.0 * np.arctanh(e) / (1.0 - e * e) / half[k]
+        u = -2.0 * gain * z                                     # law (13): -k xi epsilon
+        moves = g_all @ u                                        # (M, n)
+        dirs = push * _directions(e, z)                          # (D, n)
+        nxt = x + dt * (moves[:, None, :] + dirs[None, :, :])    # (M, D, n)
+        e_next = (nxt - centre[k + 1]) / half[k + 1]
+        if score == "max":
+            value = np.max(np.abs(e_next), axis=-1)
+        else:
+            value = np.sum(np.arctanh(np.clip(np.abs(e_next), 0.0, 1.0 - 1e-15)) ** 2,
+                           axis=-1)
+        m, d = np.unravel_index(int(np.argmax(value)), value.shape)
+        x = nxt[m, d]
+        gains.append(g_all[m])
+        pushes.append(dirs[d])
+    e = (x - centre[-1]) / half[-1]
+    return found(len(samples.t) - 1, e) if float(np.max(np.abs(e))) >= 1.0 else None
+
+
+def search_class(design: TubeDesign, samples: TubeSamples, bounds: Assumptions,
+                 seed: int = 0, held_runs: int = HELD_RUNS) -> Counterexample | None:
+    """Search the class ``bounds`` for a member whose sampled loop leaves the tube.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The designed tube: its gain ``k`` of law (13), rate and ``x(0)``.
+    samples : TubeSamples
+        The deployed tube at every sample (:func:`~stt_codegen.design.samples.sample_tube`).
+    bounds : Assumptions
+        The class (its ``g`` bounds, ``drift_bound + disturbance_bound``).
+    seed : int
+        Seeds :func:`class_matrices`.
+    held_runs : int
+        How many members to also hold for a whole run, after the greedy runs (default
+        :data:`HELD_RUNS`; ``verify`` asks for 0).
+
+    Returns
+    -------
+    Counterexample or None
+        The first counterexample found (see the module's text for the strategies), or
+        ``None`` when none is found (which proves nothing).
+    """
+    members = class_matrices(bounds, design.dimension, seed)
+    push = bounds.drift_bound + bounds.disturbance_bound
+    if not members:
+        return None
+    for score in ("max", "lyapunov"):
+        found = _run(design, samples, members, push, score, f"greedy {score}")
+        if found is not None:
+            return found
+    for j, g in enumerate(members[:held_runs]):
+        found = _run(design, samples, [g], push, "max", f"member {j} held")
+        if found is not None:
+            return found
+    return None
+
+
+def replay(design: TubeDesign, found: Counterexample, backend: str = "c") -> bool:
+    """Replay a counterexample on a deployed controller: ``True`` when the controller of
+    ``backend`` (the generated C by default, see
+    :func:`~stt_codegen.runtime.backends.make_controller`) reports ``STATUS_OK`` at every
+    sample before the exit and ``STATUS_OUTSIDE_TUBE`` at it.
+
+    The plant steps exactly as in the search, ``x_{k+1} = x_k + dt (G_k u_k + d_k)``, with
+    ``u_k`` and the tube now computed by the deployed controller itself (its own ``alpha``
+    iteration, law (13) with its clamps), so a counterexample does not rest on the search's
+    numpy copy of the law.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The design the counterexample was found for.
+    found : Counterexample
+        From :func:`search_class`.
+    backend : str
+        ``"c"`` (needs a C compiler), ``"python"``, ``"casadi"`` or ``"reference"``.
+
+    Returns
+    -------
+    bool
+    """
+    from ..runtime.backends import STATUS_OK, STATUS_OUTSIDE_TUBE, make_controller
+    controller = make_controller(backend, design)
+    dt = 1.0 / design.rate_hz
+    x = np.array(design.initial_state, dtype=float)
+    alpha = np.zeros(2 * design.dimension)
+    for k, (g, d) in enumerate(zip(found.gains, found.pushes)):
+        u, alpha, status = controller.step(x, k * dt, dt, alpha)
+        if status != STATUS_OK:
+            return False
+        x = x + dt * (g @ u + d)
+    return controller.step(x, len(found.gains) * dt, dt, alpha)[2] == STATUS_OUTSIDE_TUBE

@@ -1,0 +1,137 @@
+"""The class search (verify/class_search.py): members of a plant class that leave the tube.
+
+A counterexample is a plant of the class under the sampled law (13): its gains are members
+of the class, its push within the bound, and the deployed controller (the generated
+Python), replayed on it, reports the state outside the tube. The sampled check, being
+sound, must reject every class the search breaks; and the classes the check accepts must
+resist the search (docs/sampled-data.md, "How much a sound check can accept")."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from conftest import designed
+
+from stt_codegen.bench import plants_study
+from stt_codegen.verify.class_search import class_matrices, replay, search_class, within_class
+from stt_codegen.design.samples import sample_tube
+from stt_codegen.spec.assumptions import Assumptions
+from stt_codegen.verify.plant_class import PlantClass
+from stt_codegen.verify.sampled import check_sampled
+
+_SAMPLES: dict = {}
+
+
+def _tube(case: str):
+    spec, design, _ = designed(case)
+    if case not in _SAMPLES:
+        _SAMPLES[case] = sample_tube(design)
+    return spec, design, _SAMPLES[case]
+
+
+def _study_bounds(case: str, index: int, decoupled: bool = False) -> Assumptions:
+    """The wide study's plant ``index``'s own bounds; ``decoupled``: with its skew and
+    coupling set to 0 (a narrower class, of diagonal ``g``)."""
+    spec = designed(case)[0]
+    bounds = plants_study.own_bounds(plants_study.plant_parameters(
+        plants_study.draw(case, index)), spec)
+    return (dataclasses.replace(bounds, input_gain_skew=0.0, input_gain_coupling=0.0)
+            if decoupled else bounds)
+
+
+@pytest.mark.parametrize("bounds", [
+    Assumptions((0.3, 2.0), 0.6, 1.0, 1.0, 0.1),
+    Assumptions((0.5, 0.5), 0.0, 0.0, 1.0, 0.1),
+    Assumptions((0.36, 1.0), 0.93, 0.93, 0.0, 0.17, blocks=((0, 1), (2,))),
+    Assumptions((0.2, 3.0), 0.9, 0.5, 1.0, 0.1),
+], ids=["coupled", "diagonal", "robot-blocks", "coupling-caps-skew"])
+def test_the_members_are_in_the_class_and_reach_its_extremes(bounds):
+    members = class_matrices(bounds, 3)
+    assert members and all(within_class(g, bounds) for g in members)
+    eig = np.array([np.linalg.eigvalsh(0.5 * (g + g.T))[[0, -1]] for g in members])
+    assert eig[:, 0].min() == pytest.approx(bounds.input_gain[0])
+    assert eig[:, 1].max() == pytest.approx(bounds.input_gain[1])
+    skew = max(np.linalg.norm(0.5 * (g - g.T), 2) for g in members)
+    rows = max(np.linalg.norm(g - np.diag(np.diag(g)), axis=1).max() for g in members)
+    assert skew <= bounds.input_gain_skew * (1 + 1e-9)
+    assert rows <= bounds.input_gain_coupling * (1 + 1e-9) + 1e-12
+    if bounds.input_gain_coupling >= 2 * bounds.input_gain_skew > 0:
+        assert skew == pytest.approx(bounds.input_gain_skew)   # the largest skew is tried
+    for g in members:                                          # nothing between blocks
+        for block in bounds.coupled_blocks(3):
+            others = [j for j in range(3) if j not in block]
+            assert not g[np.ix_(block, others)].any()
+
+
+def test_within_class_refuses_what_is_outside():
+    bounds = Assumptions((0.5, 2.0), 0.3, 0.6, 0.0, 0.0)
+    assert within_class(np.diag([0.5, 1.0, 2.0]), bounds)
+    assert not within_class(np.diag([0.49, 1.0, 2.0]), bounds)       # g_min
+    assert not within_class(np.diag([0.5, 1.0, 2.01]), bounds)       # g_max
+    skewed = np.diag([1.0, 1.0, 1.0]) + 0.31 * np.array([[0, -1, 0], [1, 0, 0], [0, 0, 0]])
+    assert not within_class(skewed, bounds)                          # skew
+    sym = np.array([[1.2, 0.5, 0.4], [0.5, 1.2, 0.0], [0.4, 0.0, 1.2]])
+    assert np.linalg.eigvalsh(sym).min() >= 0.5           # in the eigenvalue range, but
+    assert not within_class(sym, bounds)                  # its first row's coupling is 0.64
+    crossing = np.eye(3)
+    crossing[0, 2] = 0.1
+    assert within_class(crossing, bounds)
+    blocked = Assumptions((0.5, 2.0), 0.3, 0.6, 0.0, 0.0, blocks=((0, 1), (2,)))
+    assert not within_class(crossing, blocked)            # x3's input moves x1
+
+
+def test_a_counterexample_is_a_member_that_the_deployed_controller_reports_outside():
+    """Replayed on the generated Python controller: every interval's ``g`` is in the class,
+    the push is within the bound, the status is OK up to the exit and OUTSIDE there."""
+    case = "omnirobot-s1"
+    spec, design, samples = _tube(case)
+    bounds = _study_bounds(case, 0)
+    found = search_class(design, samples, bounds)
+    assert found is not None and found.depth >= 1.0 and found.max_abs_e < 1.0
+    steps = len(found.gains)
+    assert len(found.pushes) == steps and np.isclose(samples.t[steps], found.time)
+    push = bounds.drift_bound + bounds.disturbance_bound
+    assert all(within_class(g, bounds) for g in found.gains)
+    assert np.linalg.norm(found.pushes, axis=1).max() <= push * (1 + 1e-12)
+    assert replay(design, found, "python")
+    # the same path one interval short ends inside the tube: the exit is where it says
+    early = dataclasses.replace(found, gains=found.gains[:-1], pushes=found.pushes[:-1])
+    assert not replay(design, early, "python")
+
+
+def test_the_robot_class_over_the_whole_heading_range_has_a_member_that_leaves():
+    """Why the check refuses the robot's bounds taken over the whole state space
+    (tests/test_verify_coupled.py): a member of that class leaves the tube; only the
+    bounds on the tube (the heading's range there) are proved."""
+    spec, design, samples = _tube("omnirobot-s1")
+    bounds = spec.assumptions
+    assert bounds.blocks == ((0, 1), (2,))
+    found = search_class(design, samples, bounds)
+    assert found is not None
+    assert not check_sampled(design, samples, PlantClass(bounds)).passed
+
+
+@pytest.mark.parametrize("case,index,decoupled", [
+    ("omnirobot-s1", 0, False), ("omnirobot-s1", 9, False), ("omnirobot-s2", 1, False),
+    ("omnirobot-s3", 0, False), ("omnirobot-s1", 2, True)])
+def test_the_check_rejects_the_classes_the_search_breaks(case, index, decoupled):
+    spec, design, samples = _tube(case)
+    bounds = _study_bounds(case, index, decoupled)
+    assert search_class(design, samples, bounds) is not None
+    assert not check_sampled(design, samples, bounds).passed
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case,index,decoupled", [
+    ("omnirobot-s1", 47, False), ("omnirobot-s3", 41, False), ("omnirobot-s3", 44, False),
+    ("omnirobot-s1", 9, True)])
+def test_the_classes_the_check_accepts_resist_the_search(case, index, decoupled):
+    """The wide study's plants the check accepts (and one decoupled class it accepts): a
+    counterexample here would be a hole in the check (the search is independent of its
+    argument)."""
+    spec, design, samples = _tube(case)
+    bounds = _study_bounds(case, index, decoupled)
+    assert check_sampled(design, samples, bounds).passed
+    assert search_class(design, samples, bounds) is None
