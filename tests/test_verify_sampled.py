@@ -50,6 +50,10 @@ def test_derived_gain_passes_and_the_old_default_fails_with_the_rate_it_needs():
     detail = bad["sampled.tube_kept"].detail
     assert "needs 2 kHz" in detail and "g_max = 3" in detail and "controller.gain" in detail
     assert "beyond the limit at g_max = 3" in bad["sampled.gain"].detail
+    # a member of the class leaves the tube (verify/class_search.py): the check is right
+    member = bad["sampled.tube_kept"].data["class_counterexample"]
+    assert member is not None and member["depth"] >= 1.0
+    assert "not the check's caution" in detail and f"t = {member['time']:.4f} s" in detail
 
 
 @pytest.mark.slow
@@ -149,3 +153,6 @@ def test_worst_case_coupling_is_a_documented_limit_of_the_check():
     assert not kept.passed and checks["sampled.gain"].passed
     assert "no rate up to 16 kHz passes" in kept.detail
     assert "row coupling 1.25" in kept.detail and "input_gain_coupling" in kept.detail
+    # no member of the class that leaves is found: here the check may be too cautious
+    assert kept.data["class_counterexample"] is None
+    assert "not the check's caution" not in kept.detail

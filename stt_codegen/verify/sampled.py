@@ -472,13 +472,36 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
         label = "controller.gain" if spec.gain is not None else "the derived gain"
         detail = (f"{result.reason}, for plants with {words} at {design.rate_hz:g} Hz and "
                   f"k = {design.gain:.6g} ({label}); {need}")
+        found = _member_that_leaves(design, spec, result)
+        if found is not None:
+            detail += (f"; and the failure is not the check's caution: a plant of the class "
+                       f"leaves the tube (g on each interval an extreme member of the class, "
+                       f"|f + w| at its bound): |e_{found.dimension}| = {found.depth:.3g} "
+                       f"at t = {found.time:.4f} s ({found.strategy}; verify/class_search.py)")
     if a.notes:
         detail += "; " + "; ".join(a.notes) + " (the declared bounds are used; they cover the model)"
-    checks.append(Check("sampled.tube_kept", result.passed, detail,
-                        {**result.data, "level": result.level, "margin": result.margin,
-                         "time": result.time, "lowest_rate_hz": rate,
-                         "lowest_rate_gain": gain}))
+    data = {**result.data, "level": result.level, "margin": result.margin,
+            "time": result.time, "lowest_rate_hz": rate, "lowest_rate_gain": gain}
+    if not result.passed:
+        data["class_counterexample"] = None if found is None else found.to_json()
+    checks.append(Check("sampled.tube_kept", result.passed, detail, data))
     return checks
+
+
+def _member_that_leaves(design: TubeDesign, spec: Spec, result: SampledCheck):
+    """A member of the spec's plant class that leaves the tube under the sampled law
+    (:func:`~stt_codegen.verify.class_search.search_class`, greedy strategies only),
+    confirmed on the numpy reference of the deployed controller; ``None`` when the check
+    passed, when the class's bounds are evaluated on the tube per interval (the search's
+    members obey the bounds over the whole state space, which may be wider), or when none
+    is found."""
+    if result.passed or result.data.get("refined_on_the_tube") or \
+            spec.assumptions.input_gain[0] <= 0:
+        return None
+    from .class_search import replay, search_class
+    samples = sampled_check_of(design, spec)[0]
+    found = search_class(design, samples, spec.assumptions, held_runs=0)
+    return found if found is not None and replay(design, found, "reference") else None
 
 
 def plant_bounds_checks(spec: Spec, model: str | None = None) -> list[Check]:
