@@ -43,7 +43,7 @@ from ..runtime.simulate import run_closed_loop
 from ..spec.assumptions import Assumptions
 from ..spec.loader import load_spec
 from ..verify.sampled import check_sampled
-from ..verify.class_search import replay, search_class
+from ..verify.class_search import replay, search_class, unit_skew
 
 __all__ = ["CASES", "RANGES", "draw", "plant_parameters", "own_bounds", "study_one",
            "study_plants"]
@@ -77,12 +77,6 @@ def draw(case: str, index: int) -> dict:
             "seed": [CASES.index(case), index]}
 
 
-def _unit_skew(v: np.ndarray) -> np.ndarray:
-    if len(v) == 2:
-        return np.array([[0.0, -1.0], [1.0, 0.0]])
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-
-
 def plant_parameters(knobs: dict, n: int = 3) -> dict:
     """``f(x) = f_amp sin(W x + phi) + L (x - c)``, ``g(x) = S + skew tanh(v . x) K``,
     ``w_i = w_amp sin(omega_i t + p_i)``; ``S`` symmetric with eigenvalues in
@@ -103,7 +97,7 @@ def plant_parameters(knobs: dict, n: int = 3) -> dict:
 
 def _system(p: dict, centre: np.ndarray):
     import control as ct
-    k_mat = _unit_skew(p["skew_axis"])
+    k_mat = unit_skew(p["skew_axis"])
 
     def rhs(t, x, u, params):
         f = p["f_amp"] * np.sin(p["W"] @ x + p["phi"]) + p["L"] @ (x - centre)
@@ -119,7 +113,7 @@ def own_bounds(p: dict, spec) -> Assumptions:
     """The bounds a user who knew the drawn plant would declare (over the state space)."""
     n = spec.dimension
     eig = np.linalg.eigvalsh(p["sym"])
-    k_mat = _unit_skew(p["skew_axis"])
+    k_mat = unit_skew(p["skew_axis"])
     off = p["sym"] - np.diag(np.diag(p["sym"]))
     coupling = float(np.max(np.linalg.norm(off, axis=1)
                             + p["skew"] * np.linalg.norm(k_mat, axis=1)))

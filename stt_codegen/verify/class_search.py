@@ -24,12 +24,14 @@ The search is an adversary on the sampled loop, exact in its arithmetic:
 Three strategies choose ``(G_m, d_k)`` at each sample: greedily the largest next
 ``max_i |e_i|``, greedily the largest next ``sum_i atanh(e_i)^2``, and, for each of the
 first :data:`HELD_RUNS` members held for the whole run, the direction of the largest next
-``max_i |e_i|``. A run is a
-counterexample when ``|e_i(t_k)| >= 1`` at a sample (the state is outside the deployed
-tube there). Such a plant is a member of the class: ``g(x)`` and ``f(x)`` defined along
-the path (which does not cross itself), ``w`` along time; a smooth member of the class
-follows it as closely as wanted (the exits found go beyond the tube by a margin,
-:attr:`Counterexample.depth`). The search is not exhaustive: finding none proves nothing.
+``max_i |e_i|``. A run is a counterexample when ``|e_i(t_k)| >= 1`` at a sample (the
+state is outside the deployed tube there). The path is the trajectory of a member of the
+class as long as it does not pass one point twice with two different choices: then
+``g(x)`` and ``f(x)`` are defined on the path and extended off it within the bounds (which
+are convex sets), and ``w`` is defined along time. A polyline in 3-D generically never
+meets itself, and the exits go beyond the edge by a margin (:attr:`Counterexample.depth`),
+so smoothing the switches between samples keeps them. The search is not exhaustive:
+finding none proves nothing.
 
 ``verify`` runs the greedy strategies when its sampled check fails on bounds that hold on
 every interval alike, and reports a member it finds, confirmed on the numpy reference of
@@ -50,7 +52,8 @@ from ..design.samples import TubeSamples
 from ..spec.assumptions import Assumptions
 from ..tube.parameters import TubeDesign
 
-__all__ = ["Counterexample", "class_matrices", "replay", "search_class", "within_class"]
+__all__ = ["Counterexample", "class_matrices", "replay", "search_class", "unit_skew",
+           "within_class"]
 
 #: Random rotations of the extreme eigenvalues tried per class (besides the axis-aligned
 #: arrangements).
@@ -95,7 +98,7 @@ class Counterexample:
                 "depth": self.depth, "max_abs_e": self.max_abs_e}
 
 
-def _unit_skew(axis: np.ndarray) -> np.ndarray:
+def unit_skew(axis: np.ndarray) -> np.ndarray:
     """The skew matrix of the cross product with ``axis`` (3-D), or the rotation generator
     (2-D); spectral norm ``|axis|``."""
     if len(axis) == 2:
@@ -137,10 +140,10 @@ def _block_matrices(bounds: Assumptions, m: int, rng: np.random.Generator
     if m == 1 or skew == 0.0:
         skews = [np.zeros((m, m))]
     elif m == 2:
-        skews = [sign * skew * _unit_skew(np.zeros(2)) for sign in (1.0, -1.0)]
+        skews = [sign * skew * unit_skew(np.zeros(2)) for sign in (1.0, -1.0)]
     else:
         axes = list(np.eye(m)) + [v / np.linalg.norm(v) for v in rng.normal(size=(4, m))]
-        skews = [sign * skew * _unit_skew(a) for a in axes for sign in (1.0, -1.0)]
+        skews = [sign * skew * unit_skew(a) for a in axes for sign in (1.0, -1.0)]
     return [s + k for s, k in itertools.product(syms, skews)]
 
 
