@@ -84,7 +84,8 @@ def test_within_class_refuses_what_is_outside():
 
 def test_a_counterexample_is_a_member_that_the_deployed_controller_reports_outside():
     """Replayed on the generated Python controller: every interval's ``g`` is in the class,
-    the push is within the bound, the status is OK up to the exit and OUTSIDE there."""
+    the push is within the bound, and the controller reports the state outside the tube
+    (here exactly at the search's exit: one interval short, it is still inside)."""
     case = "omnirobot-s1"
     spec, design, samples = _tube(case)
     bounds = _study_bounds(case, 0)
