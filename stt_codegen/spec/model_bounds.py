@@ -28,7 +28,7 @@ import math
 from dataclasses import dataclass
 from typing import Sequence
 
-__all__ = ["ModelBounds", "model_bounds", "symmetric_eigen_range", "REL_PAD"]
+__all__ = ["ModelBounds", "model_bounds", "row_coupling", "symmetric_eigen_range", "REL_PAD"]
 
 #: Relative outward widening of every computed bound (rounding of ``cos``, ``sin`` and of
 #: the Jacobi eigenvalue iteration is far below it).
@@ -176,6 +176,19 @@ def symmetric_eigen_range(g: Sequence[Sequence[float]]) -> tuple[float, float, f
     return eig[0] - pad, eig[-1] + pad, skew_norm + skew_pad
 
 
+def row_coupling(g: Sequence[Sequence[float]]) -> float:
+    """The largest Euclidean norm of a row of ``g`` without its diagonal entry (how strongly
+    the other inputs drive one state), rounded up.
+
+    Parameters
+    ----------
+    g : sequence of sequence of float, shape (n, n)
+    """
+    n = len(g)
+    return _up(max((math.sqrt(sum(g[i][j] ** 2 for j in range(n) if j != i))
+                    for i in range(n)), default=0.0))
+
+
 def _blocks(g: Sequence[Sequence[float]]) -> tuple[tuple[int, ...], ...]:
     """Connected components of the graph with an edge where ``g_ij != 0`` or ``g_ji != 0``."""
     n = len(g)
@@ -225,10 +238,8 @@ def _linear(lower: Sequence[float], upper: Sequence[float], linear) -> ModelBoun
     else:
         a, g, c = linear.a, linear.g, linear.c
     g_min, g_max, skew = symmetric_eigen_range(g)
-    coupling = max((math.sqrt(sum(g[i][j] ** 2 for j in range(n) if j != i))
-                    for i in range(n)), default=0.0)
     return ModelBounds(
-        "linear", (g_min, g_max), skew, _up(coupling), linear_drift_bound(a, c, lower, upper),
+        "linear", (g_min, g_max), skew, row_coupling(g), linear_drift_bound(a, c, lower, upper),
         _blocks(g),
         (("input_gain", "eigenvalues of (g + g^T)/2 for the constant plant.g"),
          ("input_gain_skew", "|(g - g^T)/2| for plant.g"),

@@ -514,6 +514,22 @@ def law_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, Array]:
     t = _time(t)
     gamma_l, gamma_u, _, _ = adaptive_tube(design, t, alpha)
     x = _rows(x, t.size, design.dimension)
+    u, inside = law(design.gain, x, gamma_l, gamma_u)
+    return u, alpha_step(design, t, dt, alpha), inside
+
+
+def law(gain: float, x, gamma_l, gamma_u) -> tuple[Array, Array]:
+    """Law (13) in a known tube, with the deployed clamps of ``e`` (``E_MAX``) and of the
+    width (``GAMMA_D_MIN``): ``u = -k xi epsilon``, shape (N, n), and ``inside`` (N,), 1.0
+    where ``x`` is strictly inside ``(gamma_l, gamma_u)``.
+
+    Parameters
+    ----------
+    gain : float
+        ``k`` of (13).
+    x, gamma_l, gamma_u : array_like, shape (N, n)
+        State and tube bounds, state units.
+    """
     gamma_d = gamma_u - gamma_l
     width = np.maximum(gamma_d, GAMMA_D_MIN)
     e = (2.0 * x - (gamma_u + gamma_l)) / width
@@ -521,7 +537,7 @@ def law_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, Array]:
     e_c = np.clip(e, -E_MAX, E_MAX)
     epsilon = log((1.0 + e_c) / (1.0 - e_c))
     xi = 4.0 / (width * (1.0 - e_c**2))
-    return -design.gain * xi * epsilon, alpha_step(design, t, dt, alpha), inside
+    return -gain * xi * epsilon, inside
 
 
 def saturate(design: TubeDesign, u) -> tuple[Array, Array]:

@@ -50,6 +50,8 @@ import numpy as np
 
 from ..design.samples import TubeSamples
 from ..spec.assumptions import Assumptions
+from ..spec.model_bounds import row_coupling, symmetric_eigen_range
+from ..tube import reference
 from ..tube.parameters import TubeDesign
 
 __all__ = ["Counterexample", "class_matrices", "replay", "search_class", "unit_skew",
@@ -116,13 +118,12 @@ def within_class(g: np.ndarray, bounds: Assumptions, tol: float = 1e-9) -> bool:
     block_of = {i: b for b in bounds.coupled_blocks(n) for i in b}
     if any(g[i, j] != 0.0 for i in range(n) for j in range(n) if j not in block_of[i]):
         return False
-    eig = np.linalg.eigvalsh(0.5 * (g + g.T))
-    skew = np.linalg.norm(0.5 * (g - g.T), 2)
-    rows = np.linalg.norm(g - np.diag(np.diag(g)), axis=1).max(initial=0.0)
-    slack = 1.0 + tol
-    return bool(eig[0] >= g_min / slack and eig[-1] <= g_max * slack
+    rows = g.tolist()
+    low, high, skew = symmetric_eigen_range(rows)     # what the constant g implies (the
+    slack = 1.0 + tol                                  # linear model's bounds)
+    return bool(low >= g_min / slack and high <= g_max * slack
                 and skew <= bounds.input_gain_skew * slack + tol
-                and rows <= bounds.input_gain_coupling * slack + tol)
+                and row_coupling(rows) <= bounds.input_gain_coupling * slack + tol)
 
 
 def _block_matrices(bounds: Assumptions, m: int, rng: np.random.Generator
@@ -189,7 +190,8 @@ def class_matrices(bounds: Assumptions, n: int, seed: int = 0) -> list[np.ndarra
 
 def _directions(e: np.ndarray, z: np.ndarray) -> np.ndarray:
     """Unit directions of ``f + w`` tried at a sample: the axes, the normalized error and
-    the gradient of ``W`` (law (13)'s Lyapunov function), both signs; (m, n)."""
+    ``z``, the gradient of ``W`` (law (13)'s Lyapunov function, along ``-u``), both signs;
+    (m, n)."""
     n = len(e)
     rows = [np.eye(n), -np.eye(n)]
     for v in (e, z):
@@ -222,10 +224,9 @@ def _run(design: TubeDesign, samples: TubeSamples, members: list[np.ndarray],
         if worst >= 1.0:
             return found(k, e)
         top = max(top, worst)
-        z = 2.0 * np.arctanh(e) / (1.0 - e * e) / half[k]
-        u = -2.0 * gain * z                                     # law (13): -k xi epsilon
+        u = reference.law(gain, x[None, :], lower[k][None, :], upper[k][None, :])[0][0]
         moves = g_all @ u                                        # (M, n)
-        dirs = push * _directions(e, z)                          # (D, n)
+        dirs = push * _directions(e, -u)                         # (D, n)
         nxt = x + dt * (moves[:, None, :] + dirs[None, :, :])    # (M, D, n)
         e_next = (nxt - centre[k + 1]) / half[k + 1]
         if score == "max":
@@ -289,7 +290,7 @@ def replay(design: TubeDesign, found: Counterexample, backend: str = "c") -> boo
     The plant is the counterexample's: ``g = G_k`` and ``f + w = d_k`` on interval ``k``,
     stepped exactly, ``x_{k+1} = x_k + dt (G_k u_k + d_k)``, with ``u_k`` and the tube now
     computed by the deployed controller itself (its own ``alpha`` iteration, law (13) with
-    its clamps), so a counterexample does not rest on the search's numpy copy of the law.
+    its clamps), so a counterexample does not rest on the numpy reference alone.
     The replayed path may leave before the search's: the adversary drives the loop into
     the law's over-correction, where the rounding of two implementations grows from step
     to step; an earlier exit of the same plant confirms it all the same.
