@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from conftest import arena_toml, designed
 
+from stt_codegen.rounding import round_down
 from stt_codegen.tube import reference as R
 from stt_codegen.design.certificate import certify_tube
 from stt_codegen.design.search import base_design
@@ -157,7 +158,8 @@ def test_sharpened_narrowest_width_is_sound_and_sharper(case):
     true_min = float((g_u - g_l).min())
     assert cert.min_width <= true_min + 1e-12
     assert cert.min_width >= float((enc.upper_min - enc.lower_max).min())
-    assert cert.margin("non-empty").margin == cert.min_width
+    # the gains' width is the non-empty margin rounded down, the same on every CPU
+    assert cert.min_width == round_down(cert.margin("non-empty").margin)
 
 
 def test_numpy_math_is_per_thread():

@@ -14,6 +14,7 @@ import subprocess
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
+CHECK_FAILED = "FAILED at step: stt-codegen check (generated/ is current)"
 
 
 def _script(path: Path, body: str) -> None:
@@ -40,15 +41,15 @@ def _run_copy(tmp_path: Path, check_status: int) -> tuple[subprocess.CompletedPr
 def test_a_failing_check_stops_ci_and_is_named(tmp_path):
     done, calls = _run_copy(tmp_path, check_status=1)
     assert done.returncode != 0
-    assert "FAILED at step: stt-codegen check" in done.stderr
+    assert CHECK_FAILED in done.stderr
     assert "stt-codegen check" in calls
     assert "-m pytest" not in calls, "the fast tier ran after stt-codegen check failed"
 
 
 def test_with_every_step_passing_ci_reaches_the_tiers(tmp_path):
     """The same stand-ins with a passing check: the run goes on to both pytest runs (it
-    stops later, at the oldest-CasADi step, whose venv the stand-in does not make)."""
+    stops later, at the first step needing a venv, which the stand-in does not make)."""
     done, calls = _run_copy(tmp_path, check_status=0)
     assert "python3 -m pytest -q\n" in calls
     assert 'python3 -m pytest -q -m slow or embedded or bench' in calls
-    assert "FAILED at step: stt-codegen check" not in done.stderr
+    assert CHECK_FAILED not in done.stderr

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from conftest import CASES, designed
 
+from stt_codegen.rounding import round_down
 from stt_codegen.bench.arenas import generate_arena
 from stt_codegen.design.certificate import (certify_tube, enclose, piece_ranges,
                                             sequence_bounds)
@@ -61,7 +62,8 @@ def check_sound_and_tight(design, certificate) -> float:
     assert np.all(enc.width_min[j] <= width + 1e-12)
     sampled = float(width.min())
     assert certificate.min_width <= sampled + 1e-12
-    assert certificate.margin("non-empty").margin == certificate.min_width
+    # the gains' width is the non-empty margin rounded down, the same on every CPU
+    assert certificate.min_width == round_down(certificate.margin("non-empty").margin)
     ratio = certificate.min_width / sampled
     assert ratio >= TIGHT, (design.name, certificate.min_width, sampled)
     return ratio

@@ -78,7 +78,8 @@ def test_default_gain_is_unchanged_for_g_equal_to_identity(case):
     width = check.min_width
     assert derived_gain(width, design.rate_hz, Assumptions()) == width**2 / (16.0 / design.rate_hz)
     narrowest = check.certificate.margin("non-empty")
-    info = gain_derivation(design, narrowest.margin, narrowest.time, spec.assumptions)
+    info = gain_derivation(design, check.certificate.min_width, narrowest.time,
+                           spec.assumptions)
     assert info["gain"] == design.gain and info["source"] == "derived"
 
 

@@ -22,7 +22,6 @@ import time
 
 import numpy as np
 
-from ..design.cascade_gain import second_stage_of
 from ..design.search import design_tube
 from ..errors import SpecError
 from ..runtime.cascade_simulate import simulate_second_order
@@ -92,7 +91,7 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
         raise SpecError("spread", f"must be at least 1, got {spread}")
     started = time.perf_counter()
     design = design_tube(load_spec(case))
-    stage, derivation = second_stage_of(design)
+    stage, derivation = design.second_stage
     spec = design.spec
     order = spec.second_order
     rng = np.random.default_rng(seed)

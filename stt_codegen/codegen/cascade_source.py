@@ -139,6 +139,7 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     """
     import numpy as np
 
+    from ..rounding import round_up_array
     from ..tube import cascade_reference, reference
     from . import tolerance as T
 
@@ -170,6 +171,8 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     if precision == "double":
         tol_u, tol_r, tol_a = (T.with_double_floor(tol, ref) for tol, ref in
                                ((tol_u, u), (tol_r, r), (tol_a, alpha_next)))
+    # rounded up to a few digits: still bounds, and the same on every CPU (docs/codegen.md)
+    tol_u, tol_r, tol_a = (round_up_array(tol) for tol in (tol_u, tol_r, tol_a))
     return {"_generated": "GENERATED FILE, DO NOT EDIT: cascade test vectors from the numpy "
                           "reference (stt_codegen.tube.cascade_reference).",
             "dt": dt, "precision": precision, "unit_roundoff": unit,
@@ -187,7 +190,7 @@ def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
     ``P_cascade.h``, ``P_cascade.c`` (with ``"c"`` in ``options.langs``, in
     ``options.precision``), ``P_cascade.py`` (with ``"python"``), ``P_cascade_vectors.json``
     and ``manifest.json``; ``P`` is the spec's C name. The second stage is the default one
-    of :func:`stt_codegen.design.cascade_gain.second_stage_of`.
+    of :attr:`stt_codegen.design.result.Design.second_stage`.
 
     Parameters
     ----------
@@ -206,10 +209,9 @@ def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
     """
     import json
 
-    from ..design.cascade_gain import second_stage_of
     from .generate import MANIFEST, manifest
 
-    stage, _ = second_stage_of(design)
+    stage, _ = design.second_stage
     prefix = f"{design.spec.c_name}_cascade"
     texts: dict[str, str] = {}
     if "c" in options.langs:

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..tube import reference
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 
 UNIT_DOUBLE = 2.0 ** -53
@@ -63,7 +64,7 @@ def scale(design: TubeDesign, alpha: np.ndarray) -> np.ndarray:
 
 def _g(e: np.ndarray) -> np.ndarray:
     e = np.clip(e, -E_MAX, E_MAX)
-    return np.log((1.0 + e) / (1.0 - e)) / (1.0 - e * e)
+    return reference.log((1.0 + e) / (1.0 - e)) / (1.0 - e * e)   # libm: the same on every CPU
 
 
 def gamma_bound(design: TubeDesign, alpha, unit: float) -> np.ndarray:

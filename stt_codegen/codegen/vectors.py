@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import SpecError
+from ..rounding import round_up_array
 from ..tube import reference as R
 from ..tube.parameters import TubeDesign
 from . import tolerance as T
@@ -162,6 +163,8 @@ def test_vectors(design: TubeDesign, precision: str) -> dict:
         tol_u = T.with_double_floor(tol_u, u)
         tol_a = T.with_double_floor(tol_a, alpha_next)
         tol_g = T.with_double_floor(tol_g, np.maximum(np.abs(g_l), np.abs(g_u)))
+    # rounded up to a few digits: still bounds, and the same on every CPU (docs/codegen.md)
+    tol_u, tol_a, tol_g = (round_up_array(tol) for tol in (tol_u, tol_a, tol_g))
 
     def rows(a):
         return [[float(v) for v in row] for row in np.asarray(a)]

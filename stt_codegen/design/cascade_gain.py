@@ -27,16 +27,14 @@ sampled loops' factors for deployed gains and the lowest rate at which they stay
 from __future__ import annotations
 
 import dataclasses
-from typing import TYPE_CHECKING
+import math
 
 import numpy as np
 
+from ..rounding import round_up
 from ..tube import reference
 from ..tube.parameters import TubeDesign
 from ..tube.second_stage import SecondStage
-
-if TYPE_CHECKING:
-    from .result import Design
 
 #: ``omega2 dt`` at ``lambda = g_max``.
 INNER_STEP_FRACTION = 0.1
@@ -50,14 +48,16 @@ SPEED_SAMPLES = 4001
 
 def tube_speed(design: TubeDesign, samples: int = SPEED_SAMPLES) -> float:
     """``V``: the largest ``|rho_dot|`` and ``|beta_dot|`` of the designed tube on a grid of
-    ``[0, t_c]``, state units per second (sampled: an estimate, not a bound)."""
+    ``[0, t_c]``, state units per second (sampled: an estimate, not a bound), rounded up to
+    :data:`~stt_codegen.rounding.DIGITS` significant digits so that the gains derived from
+    it are the same on every CPU."""
     t = np.linspace(0.0, design.prescribed_time, samples)
     with reference.numpy_math():
         _, _, rho_l_dot, rho_u_dot = reference.reach_tube(design, t)
         _, _, beta_l_dot, beta_u_dot = reference.circumvent(design, t)
     rates = np.concatenate([np.abs(v).ravel() for v in (rho_l_dot, rho_u_dot, beta_l_dot,
                                                          beta_u_dot)])
-    return float(np.max(rates[np.isfinite(rates)]))
+    return round_up(float(np.max(rates[np.isfinite(rates)])))
 
 
 def derived_second_stage(design: TubeDesign, min_width: float, input_gain: tuple,
@@ -117,39 +117,6 @@ def derived_second_stage(design: TubeDesign, min_width: float, input_gain: tuple
                    "initial_velocity_error": z0.tolist()}
 
 
-def second_stage_of(design: "Design") -> tuple[SecondStage, dict]:
-    """The default second stage of a design whose spec has a second-order ``plant.model``.
-
-    ``F`` is ``assumptions.drift_bound`` plus ``plant.disturbance_amplitude`` (the bound
-    on every ``|w_i|``); ``g`` in ``assumptions.input_gain``; ``x2(0)`` is
-    ``initial.velocity``; ``gamma_d,min`` the certified narrowest width.
-
-    Parameters
-    ----------
-    design : Design
-        From :func:`stt_codegen.design_tube`.
-
-    Returns
-    -------
-    stage : SecondStage
-    derivation : dict
-        As :func:`derived_second_stage`.
-
-    Raises
-    ------
-    SpecError
-        The spec's ``plant.model`` is first order (field ``plant.model``).
-    """
-    from ..errors import SpecError
-    order = design.spec.second_order
-    if order is None:
-        raise SpecError("plant.model", "the spec describes a first-order plant (not a "
-                                       "second-order plant.model)")
-    return derived_second_stage(design.tube, design.check.min_width, order.input_gain,
-                                order.drift_bound + design.spec.disturbance_amplitude,
-                                order.initial_velocity)
-
-
 #: ``|e2|`` at which the transform's slope is taken for :func:`cascade_rate`.
 CONSIDERED_E2 = 0.96
 
@@ -163,7 +130,7 @@ def transform_slope_growth(e2: float) -> float:
 def law_slope_growth(e2: float) -> float:
     """``d u/d z`` at ``e2`` over its value at 0, for ``u = -k2 xi2 epsilon2`` with ``xi2 =
     2 / (rho2 (1 - e2^2))`` also depending on ``z``: ``(1 + e2 epsilon2) / (1 - e2^2)^2``."""
-    eps = float(np.log((1.0 + e2) / (1.0 - e2)))
+    eps = math.log((1.0 + e2) / (1.0 - e2))
     return (1.0 + e2 * eps) / (1.0 - e2 * e2) ** 2
 
 

@@ -4,9 +4,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
+from ..errors import SpecError
 from ..tube.parameters import TubeDesign
+from ..tube.second_stage import SecondStage
+from .cascade_gain import cascade_rate, derived_second_stage
 from .certificate import Certificate
 from .failures import FailureKind
 from .input_bound import InputProof
@@ -108,6 +112,36 @@ class Design:
         """``k`` of law (13)."""
         return self.tube.gain
 
+    @cached_property
+    def second_stage(self) -> tuple[SecondStage, dict]:
+        """The cascade's second stage of a second-order design, and its derivation.
+
+        Derived once, on first use, by
+        :func:`~stt_codegen.design.cascade_gain.derived_second_stage`: ``F`` is
+        ``assumptions.drift_bound`` plus ``plant.disturbance_amplitude`` (the bound on every
+        ``|w_i|``); ``g`` in ``assumptions.input_gain``; ``x2(0)`` is ``initial.velocity``;
+        ``gamma_d,min`` the certified narrowest width (docs/second-order.md, "Gains").
+
+        Returns
+        -------
+        stage : SecondStage
+            ``k1``, ``k2`` and the velocity tube ``rho2``.
+        derivation : dict
+            As :func:`~stt_codegen.design.cascade_gain.derived_second_stage`.
+
+        Raises
+        ------
+        SpecError
+            The spec's ``plant.model`` is first order (field ``plant.model``).
+        """
+        order = self.spec.second_order
+        if order is None:
+            raise SpecError("plant.model", "the spec describes a first-order plant (not a "
+                                           "second-order plant.model)")
+        return derived_second_stage(self.tube, self.check.min_width, order.input_gain,
+                                    order.drift_bound + self.spec.disturbance_amplitude,
+                                    order.initial_velocity)
+
     def to_json(self) -> dict[str, Any]:
         """The design as plain JSON types (the ``design`` command's and ``simulate --json``'s).
 
@@ -201,8 +235,7 @@ class Design:
         order = self.spec.second_order
         if order is None:
             return {}
-        from .cascade_gain import cascade_rate, second_stage_of
-        stage, derivation = second_stage_of(self)
+        stage, derivation = self.second_stage
         return {"cascade": {"gains": derivation,
                             "rate": cascade_rate(stage, order.input_gain, self.check.min_width,
                                                  self.tube.rate_hz)}}
@@ -253,48 +286,3 @@ def require_design(value: object, function: str, parameter: str = "design") -> D
         hint = "call stt_codegen.design_tube(spec) and pass the Design it returns"
     raise TypeError(f"{function}(): parameter {parameter!r} must be a Design, not {kind}; "
                     f"{hint}")
-
-
-def paired_design(spec: object, design: object, function: str) -> Design:
-    """The design of a ``(spec, design)`` pair, checked to be that spec's design.
-
-    ``simulate(spec, design)`` (the spec first, as the API before :class:`Design` took
-    them) is accepted when the design was made from that very spec (the same
-    ``source_hash``, the SHA-256 of the validated document): then the spec adds nothing
-    and the design's own is used. A design of another spec is refused, so a tube is never
-    run against another spec's obstacles, target or plant.
-
-    Parameters
-    ----------
-    spec : object
-        What the caller passed first; must be a :class:`~stt_codegen.spec.loader.Spec`.
-    design : Design
-        What the caller passed second.
-    function : str
-        The public function's name, for the messages.
-
-    Returns
-    -------
-    Design
-        ``design``.
-
-    Raises
-    ------
-    TypeError
-        ``spec`` is not a ``Spec`` (see :func:`require_design`).
-    SpecError
-        Field ``design``: the design was made from another spec.
-    """
-    from ..errors import SpecError
-    from ..spec.loader import Spec
-
-    if not isinstance(spec, Spec):
-        require_design(spec, function)
-    assert isinstance(design, Design)
-    if design.spec.source_hash != spec.source_hash or design.spec != spec:
-        raise SpecError("design", f"{function}(spec, design): the design was made from "
-                                  f"spec {design.spec.name!r} ({design.spec.source_hash[:12]}), "
-                                  f"not from the spec {spec.name!r} ({spec.source_hash[:12]}) "
-                                  f"passed with it; pass the design alone, "
-                                  f"{function}(design, ...)")
-    return design

@@ -28,7 +28,6 @@ import numpy as np
 
 from ..codegen.cascade_source import cascade_c_files
 from ..codegen.emit import c_source
-from ..design.cascade_gain import second_stage_of
 from ..design.result import Design
 from ..errors import SpecError, ToolchainError
 from ..runtime.cascade_simulate import SUBSTEPS
@@ -237,7 +236,7 @@ def run_cascade_embedded(design: Design, seed: int = 0, timeout: float = 600.0) 
     ToolchainError
         A build or a run failed.
     """
-    stage, _ = second_stage_of(design)
+    stage, _ = design.second_stage
     prefix = f"{design.spec.c_name}_cascade"
     files = cascade_c_files(design.tube, stage, prefix, "single")
     with tempfile.TemporaryDirectory(prefix="stt-cascade-m4-") as name:

@@ -246,7 +246,7 @@ def simulate_second_order(spec: Spec, tube: TubeDesign, stage: SecondStage, *,
 def simulate_cascade(design: Design, backend: str = "reference", horizon: float | None = None,
                      seed: int = 0) -> CascadeResult:
     """The closed loop of a design whose spec has a second-order ``plant.model``: the default second
-    stage (:func:`stt_codegen.design.cascade_gain.second_stage_of`) on the spec's model,
+    stage (:attr:`stt_codegen.design.result.Design.second_stage`) on the spec's model,
     parameters, initial velocity and velocity bound.
 
     Parameters
@@ -264,8 +264,7 @@ def simulate_cascade(design: Design, backend: str = "reference", horizon: float 
     SpecError
         As :func:`simulate_second_order`; a first-order spec (field ``plant.model``).
     """
-    from ..design.cascade_gain import second_stage_of
-    stage, _ = second_stage_of(design)
+    stage, _ = design.second_stage
     order = design.spec.second_order
     return simulate_second_order(design.spec, design.tube, stage, model=order.model,
                                  params=order.parameters,

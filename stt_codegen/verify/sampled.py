@@ -35,7 +35,7 @@ from ..spec.loader import Spec
 from ..spec.model_bounds import model_bounds
 from ..tube import reference
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
-from .check import Check
+from .check import Check, distinct
 from .lyapunov import level_after, next_level, others_max
 from .plant_class import PlantClass, plant_class
 from .sampled_axis import axis_interval, peak, phi_slope_scalar
@@ -441,12 +441,14 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
     """
     a = spec.assumptions
     plants = plant_class(spec)
-    narrowest = certificate.margin("non-empty")
-    derivation = gain_derivation(design, narrowest.margin, narrowest.time, a, spec.gain)
+    # the width the design derived its gain from: the certified one, rounded down
+    derivation = gain_derivation(design, certificate.min_width,
+                                 certificate.margin("non-empty").time, a, spec.gain)
     gain_ok = derivation["gain"] < derivation["stable_gain_limit"]
     checks = [Check("sampled.gain", gain_ok, derivation["explanation"]
-                    + ("" if gain_ok else f"; k = {derivation['gain']:.6g} is beyond the "
-                       f"limit at g_max = {a.input_gain[1]:g}"), derivation)]
+                    + ("" if gain_ok else f"; k = "
+                       f"{distinct(derivation['gain'], derivation['stable_gain_limit'], 6)} is "
+                       f"at or beyond the limit at g_max = {a.input_gain[1]:g}"), derivation)]
     result = sampled_check_of(design, spec)[1]
     words = _bounds_words(a, tuple(result.data.get("refined_on_the_tube", ())))
     rate, gain = lowest_rate(design, spec, plants, spec.gain, passes_at_rate=result.passed)

@@ -35,7 +35,7 @@ static const crossing_moving_parameters CROSSING_MOVING_PARAMETERS = {
   0.01f, /* theta0 */
   1.0f, /* mu */
   5.0f, /* kappa */
-  14.283627090326688f /* gain */
+  14.280249999999999f /* gain */
 };
 
 /* State-space bounds [X; X-bar], the sign of eq. (9) on each (+1 lower, -1 upper) and the

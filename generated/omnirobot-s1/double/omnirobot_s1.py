@@ -100,7 +100,7 @@ SMOOTHNESS = 50.0  # nu of the smooth max/min and of F_nu (eqs. (9)-(10)), 1/sta
 THETA0 = 0.01  # theta_0 of the trigger (11)
 MU = 1.0  # mu of the trigger (11), state units
 KAPPA = 5.0  # kappa of the adaptive law (11), 1/s
-GAIN = 0.1999043077398775  # k of the control law (13)
+GAIN = 0.19984553367539223  # k of the control law (13)
 # State-space bounds [X; X-bar], the sign of eq. (9) on each, circumvents on each.
 BOUND = (0.0, 0.0, -1.2, 5.0, 5.0, 1.2)
 SIGN = (1.0, 1.0, 1.0, -1.0, -1.0, -1.0)

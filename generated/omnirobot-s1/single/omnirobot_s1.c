@@ -35,7 +35,7 @@ static const omnirobot_s1_parameters OMNIROBOT_S1_PARAMETERS = {
   0.01f, /* theta0 */
   1.0f, /* mu */
   5.0f, /* kappa */
-  0.1999043077398775f /* gain */
+  0.19984553367539223f /* gain */
 };
 
 /* State-space bounds [X; X-bar], the sign of eq. (9) on each (+1 lower, -1 upper) and the

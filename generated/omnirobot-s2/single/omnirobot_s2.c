@@ -35,7 +35,7 @@ static const omnirobot_s2_parameters OMNIROBOT_S2_PARAMETERS = {
   0.01f, /* theta0 */
   1.0f, /* mu */
   5.0f, /* kappa */
-  0.3230367133277287f /* gain */
+  0.32297398466333366f /* gain */
 };
 
 /* State-space bounds [X; X-bar], the sign of eq. (9) on each (+1 lower, -1 upper) and the

@@ -35,7 +35,7 @@ static const omnirobot_s3_parameters OMNIROBOT_S3_PARAMETERS = {
   0.01, /* theta0 */
   1.0, /* mu */
   5.0, /* kappa */
-  0.48401687917315833 /* gain */
+  0.4840062093335954 /* gain */
 };
 
 /* State-space bounds [X; X-bar], the sign of eq. (9) on each (+1 lower, -1 upper) and the

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...rounding import round_down
 from ...spec.loader import Spec
 from ...tube import reference
 from ...tube.parameters import TubeDesign
@@ -127,7 +128,8 @@ class Certificate:
     max_move_ratio : float
         Certified bound of ``|gamma_dot| dt / gamma_d`` over all ``t``.
     min_width : float
-        Certified lower bound of ``min_t min_i gamma_d_i(t)``, state units.
+        Certified lower bound of ``min_t min_i gamma_d_i(t)``, state units, rounded down to
+        :data:`~stt_codegen.rounding.DIGITS` significant digits (the same on every CPU).
     initial_error : float
         ``max_i |e_i|`` of ``x(0)`` in the tube at ``t = 0``.
     enclosure : Enclosure
@@ -257,5 +259,7 @@ def certificate_report(design: TubeDesign, spec: Spec, enc: Enclosure, selected,
                           f"a tube bound moves at most {ratio:.3g} tube widths in one sampling "
                           f"period at {design.rate_hz:g} Hz (limit {MAX_MOVE_PER_SAMPLE}; "
                           f"worst on the interval at t = {float(t0[k]):.3f} s)" + note))
-    return Certificate(math.inf, int(t0.size), tuple(margins), ratio, min_width,
+    # The width the gains derive from, rounded down (still a certified lower bound) so that
+    # it is the same whatever SIMD kernels computed the enclosures (docs/codegen.md).
+    return Certificate(math.inf, int(t0.size), tuple(margins), ratio, round_down(min_width),
                        initial_error, enc)
