@@ -21,7 +21,7 @@ from ..spec.loader import Spec
 from ..spec.plants import PLANTS
 from ..tube import reference
 from ..tube.parameters import TubeDesign
-from .check import Check
+from .check import Check, distinct
 from .sampled import SampledCheck, sampled_check_of
 
 
@@ -116,7 +116,7 @@ def input_bound_check(spec: Spec, proof: InputProof) -> Check:
     if not proof.proved:
         return Check("sampled.input_bound", False,
                      f"no bound on law (13)'s input is proved: {proof.reason}", data)
-    each = ", ".join(f"|{name}| <= {p:.4g} (bound {b:g}, at t = {t:.3f} s)"
+    each = ", ".join(f"|{name}| <= {distinct(p, b, 4)} (bound {b:g}, at t = {t:.3f} s)"
                      for name, p, b, t in zip(names, proof.peak, bound, proof.time))
     ok = proof.meets(bound)
     detail = (f"law (13) asks at most {each} at every sample on [0, {proof.horizon:.4g}] s, "

@@ -1,0 +1,43 @@
+"""A check's printed figures agree with its verdict.
+
+On the U-maze of gymnasium-robotics' PointMaze (tests/specs/umaze-cascade.toml) verify
+once printed ``FAIL adaptive.deployed[x1,L]: the deployed alpha stays in [0, 0.00578368]
+... within the bound 0.00578368``: the enclosure's peak was 1.03e-10 relative above the
+certified ``alpha_max`` (its brackets' rounding) and both printed the same.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import stt_codegen as stt
+from stt_codegen.verify.check import distinct
+from stt_codegen.verify.command import _deployed_alpha_check as deployed_alpha_check
+
+SPECS = Path(__file__).parent / "specs"
+
+
+def test_distinct_prints_enough_digits_to_tell_two_numbers_apart():
+    assert distinct(0.00578368332243275, 0.005783683321835951) == "0.0057836833224"
+    assert distinct(0.25, 0.25) == "0.25"
+    assert distinct(0.2501, 0.25) == "0.2501"
+    assert distinct(1.23456, 2.0) == "1.23"
+    assert float(distinct(0.1 + 0.2, 0.3)) == 0.1 + 0.2
+
+
+def test_deployed_alpha_by_enclosure_or_by_induction():
+    proved = deployed_alpha_check("x1,L", 0.5, 0.4, 0.0)
+    assert proved.passed and proved.data["proved_by"] == "enclosure"
+    hair_above = deployed_alpha_check("x1,L", 0.005783683321835951, 0.00578368332243275, 0.0)
+    assert hair_above.passed and hair_above.data["proved_by"] == "induction"
+    assert "1e-10 relative above" in hair_above.detail
+    below_zero = deployed_alpha_check("x1,L", 0.5, 0.4, -1e-3)
+    assert not below_zero.passed and "-0.001" in below_zero.detail
+
+
+def test_umaze_adaptive_checks_pass_with_their_figures():
+    spec = stt.load_spec(SPECS / "umaze-cascade.toml")
+    report = stt.verify(stt.design_tube(spec))
+    deployed = [c for c in report.checks if c.name.startswith("adaptive.deployed")]
+    assert len(deployed) == 4
+    assert all(c.passed for c in deployed), [str(c) for c in deployed]
