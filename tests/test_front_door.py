@@ -39,26 +39,26 @@ def test_a_design_is_needed_and_the_error_says_how_to_get_one(function, wrong, t
     assert list(tmp_path.iterdir()) == []          # refused before any work
 
 
-def test_the_old_two_argument_calls_are_refused_or_checked():
+def test_the_old_two_argument_calls_are_refused():
     """``generate(spec, tube, ...)`` wrote one spec's tube under another spec's name and
-    hash: it now stops at the first argument. ``simulate(spec, design)`` failed deep
-    inside with an AttributeError: it now runs when the design is that spec's, and is
-    refused, naming ``design``, when it is another spec's."""
+    hash: it now stops at the first argument. ``simulate`` has one form, the design alone
+    and the rest by keyword: ``simulate(spec, design, backend="python")`` once ended in
+    Python's ``got multiple values for argument 'backend'``."""
     design = design_of("omnirobot-s1")
     with pytest.raises(TypeError, match="parameter 'design' must be a Design, not Spec"):
         stt.generate(design.spec, design.tube, "out")
     with pytest.raises(TypeError, match="parameter 'design' must be a Design, not Spec"):
-        stt.simulate(design.spec, design.tube)
-    paired = stt.simulate(design.spec, design, horizon=0.2, seed=1)
-    alone = stt.simulate(design, backend="reference", horizon=0.2, seed=1)
-    assert np.array_equal(paired.trajectory.x, alone.trajectory.x)
-    other = design_of("omnirobot-s2")
-    with pytest.raises(stt.SpecError) as info:
-        stt.simulate(other.spec, design, horizon=0.2)
-    assert info.value.field == "design"
-    assert "'omnirobot-s1'" in str(info.value) and "'omnirobot-s2'" in str(info.value)
-    with pytest.raises(TypeError, match="parameter 'design' must be a Design, not dict"):
-        stt.simulate({"name": "x"}, design)
+        stt.simulate(design.spec)
+    for call in (lambda: stt.simulate(design.spec, design),
+                 lambda: stt.simulate(design.spec, design, backend="python"),
+                 lambda: stt.simulate(design, "python")):
+        with pytest.raises(TypeError) as info:
+            call()
+        assert str(info.value).startswith("simulate() takes the design alone")
+        assert "simulate(design, backend=..., horizon=..., seed=..., plant=...)" in \
+            str(info.value)
+    run = stt.simulate(design, backend="python", horizon=0.2, seed=1)
+    assert run.trajectory.x.shape == (201, 3)
 
 
 def test_the_spec_steps_refuse_the_wrong_kind_of_input():

@@ -107,7 +107,7 @@ def test_judging_reports_failures(monkeypatch):
     # the normalized error is the state's, in the tube (here alpha follows the deployed
     # step and the state stays put): left behind by the tube, beyond 1
     monkeypatch.setitem(backends._FACTORIES, "lazy", lambda d: _Lazy(d))
-    lazy = simulate(design, "lazy", horizon=2.0)
+    lazy = simulate(design, backend="lazy", horizon=2.0)
     g_l, g_u, _, _ = R.adaptive_tube(design.tube, lazy.trajectory.t, lazy.trajectory.alpha)
     e = (2 * lazy.trajectory.x - (g_u + g_l)) / (g_u - g_l)
     assert lazy.max_abs_e == pytest.approx(float(np.abs(e).max()), rel=1e-12)

@@ -17,7 +17,7 @@ import numpy as np
 import control as ct
 
 from .backends import STATUS_INPUT_CLAMPED, STATUS_OK, make_controller
-from ..design.result import Design, paired_design, require_design
+from ..design.result import Design, require_design
 from ..design.samples import check_step_budget
 from ..errors import SpecError
 from .plants import check_seed, make_plant
@@ -135,8 +135,9 @@ def _rk4(rhs, t: float, x: np.ndarray, u: np.ndarray, h: float) -> np.ndarray:
     return x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
 
 
-def simulate(design: Design, backend: str = "reference", horizon: float | None = None,
-             seed: int = 0, plant: ct.NonlinearIOSystem | None = None) -> SimulationResult:
+def simulate(design: Design, *positional: object, backend: str = "reference",
+             horizon: float | None = None, seed: int = 0,
+             plant: ct.NonlinearIOSystem | None = None) -> SimulationResult:
     """Run the sampled controller of a design against its spec's plant; judge Definition 2.1.
 
     At each sampling instant ``t_k = k / rate_hz`` the controller reads ``x(t_k)`` and
@@ -150,10 +151,11 @@ def simulate(design: Design, backend: str = "reference", horizon: float | None =
     ----------
     design : Design
         From :func:`stt_codegen.design_tube`: the tube and gain, and (``design.spec``) the
-        task: sets, ``t_c``, plant and disturbance bound. The pair ``simulate(spec,
-        design)`` (the spec first, as before ``Design`` existed) is accepted when
-        ``design`` was made from that spec, and runs the ``"reference"`` backend; pass
-        the design alone to choose another.
+        task: sets, ``t_c``, plant and disturbance bound. The design is the one positional
+        argument; the others are keywords.
+    *positional
+        Nothing: a second positional argument (``simulate(spec, design)``, or a backend
+        name by position) is refused with a ``TypeError`` saying how to call.
     backend : str, optional
         Implementation of the controller step: ``"reference"`` (the numpy oracle, default),
         ``"casadi"`` (the CasADi model), ``"c"`` (the generated C, compiled with the
@@ -186,10 +188,10 @@ def simulate(design: Design, backend: str = "reference", horizon: float | None =
     ------
     TypeError
         ``design`` is not a :class:`~stt_codegen.design.result.Design` (a ``TubeDesign``
-        or a ``Spec``, say): call :func:`stt_codegen.design_tube` first.
+        or a ``Spec``, say): call :func:`stt_codegen.design_tube` first; or more than one
+        positional argument.
     SpecError
-        ``simulate(spec, design)`` with a design of another spec (field ``design``);
-        unknown backend (field ``backend``), a horizon that is not a positive number of
+        Unknown backend (field ``backend``), a horizon that is not a positive number of
         seconds (``horizon``), a seed that is not an integer in ``[0, 2**32)``
         (``seed``), or a run of more than
         :data:`~stt_codegen.design.samples.STEP_BUDGET` steps.
@@ -214,8 +216,10 @@ def simulate(design: Design, backend: str = "reference", horizon: float | None =
     >>> stt.simulate(design, backend="casadi", horizon=2.0).satisfied   # before t_c
     False
     """
-    if isinstance(backend, Design):          # simulate(spec, design): the spec first
-        design, backend = paired_design(design, backend, "simulate"), "reference"
+    if positional:
+        raise TypeError("simulate() takes the design alone, which carries its spec "
+                        "(design.spec), and every other argument by keyword: "
+                        "simulate(design, backend=..., horizon=..., seed=..., plant=...)")
     design = require_design(design, "simulate")
     if design.spec.second_order is not None:     # the cascade law (issue 22)
         if plant is not None:
