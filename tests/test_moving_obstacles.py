@@ -55,7 +55,7 @@ def test_moving_obstacles_keep_their_spec_index():
 
 
 @pytest.mark.parametrize("extra, field, reason", [
-    ({"velocity": [0.0, 1.0]}, "obstacles[0].velocity", "needs active"),
+    ({"velocity": [0.0, 0.0]}, "obstacles[0].velocity", "never leaves the state space"),
     ({"active": [3.0, 1.0]}, "obstacles[0].active", "must be less than"),
     ({"active": [1.0]}, "obstacles[0].active", "array [t_on, t_off]"),
     ({"active": [-1.0, 1.0]}, "obstacles[0].active[0]", "non-negative"),
@@ -72,6 +72,33 @@ def test_bad_motion_is_a_spec_error(extra, field, reason):
     with pytest.raises(stt.SpecError) as err:
         stt.Spec.from_dict(doc)
     assert err.value.field == field and reason in err.value.reason, str(err.value)
+
+
+@pytest.mark.parametrize("velocity, t_off, end", [
+    ([0.0, 1.0], 1.0, (2.25, 5.25)),       # up: its lower face 4.0 reaches the top 5.0
+    ([0.0, -1.0], 4.5, (2.25, -0.25)),     # down: its upper face 4.5 reaches the floor 0.0
+    ([1.0, -1.0], 3.0, (5.25, 1.25)),      # right first: 2.0 reaches 5.0 before 4.5 meets 0
+])
+def test_a_moving_box_without_active_moves_until_it_has_left_the_state_space(velocity, t_off,
+                                                                             end):
+    """A person crossing a corridor: no ``active``, the box is there from 0 until it is out."""
+    spec = stt.Spec.from_dict(with_obstacles({"lower": [2.0, 4.0], "upper": [2.5, 4.5],
+                                              "velocity": velocity}))
+    (moving,) = spec.moving_obstacles
+    assert moving.active == (0.0, t_off)
+    assert moving.centres[-1] == pytest.approx(end)
+    assert moving.times == (0.0, t_off)
+
+
+def test_a_box_crossing_without_active_is_designed_certified_and_avoided():
+    spec = stt.Spec.from_dict(with_obstacles({"lower": [2.0, 4.0], "upper": [3.0, 5.0],
+                                              "velocity": [0.0, -1.0]}))
+    assert spec.moving_obstacles[0].active == (0.0, 5.0)
+    design = stt.design_tube(spec)
+    margin = design.certificate.margin("avoids moving obstacle 0")
+    assert margin.passed and margin.margin > 0
+    result = stt.simulate(design, backend="reference")
+    assert result.satisfied and not result.collision
 
 
 def test_balls_and_polytopes_cannot_move():

@@ -704,7 +704,9 @@ def _moving(table: BoxObstacle, name: str, j: int, state_space: Box, initial_set
     """A box with ``active``/``velocity``/``path`` (:mod:`.motion`); it may leave ``X``."""
     box = _box(table, name, None)
     dims = _dims(table.dims, name, len(box.lower), len(state_space.lower), "lower")
-    obstacle = moving_obstacle(table, name, j, dims, box.lower, box.upper)
+    obstacle = moving_obstacle(table, name, j, dims, box.lower, box.upper,
+                               space=(tuple(state_space.lower[i] for i in dims),
+                                      tuple(state_space.upper[i] for i in dims)))
     check_moving(obstacle, name, initial_set, target_set, prescribed_time)
     return obstacle
 

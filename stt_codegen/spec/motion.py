@@ -9,9 +9,11 @@ when it is.
 * ``active = [t_on, t_off]`` (seconds): the obstacle exists for ``t_on <= t <= t_off``;
   omitted, always (``[0, inf)``).
 * ``velocity`` (state units/s, on ``dims``): the box translates linearly from its
-  ``lower``/``upper`` at ``t_on``; it needs ``active`` (a box moving for ever sweeps an
-  unbounded region, and the certificate encloses every ``t`` after the tube's last
-  breakpoint at once).
+  ``lower``/``upper`` at ``t_on``. Without ``active`` it moves until it has left the state
+  space for good: ``t_off`` is the time its trailing face crosses the state space's far
+  boundary in the first dimension that separates them (:func:`leaving_time`; a moving
+  box moving for ever would sweep an unbounded region, which the certificate, enclosing
+  every ``t`` after the tube's last breakpoint at once, cannot take).
 * ``path`` (rows ``[t, centre...]``, times increasing): the centre moves piecewise linearly
   between the rows and is held before the first and after the last; ``lower``/``upper``
   give the size and must be the box at the first row (their centre is the first row's).
@@ -184,8 +186,43 @@ def is_moving(table: Any) -> bool:
     return any(getattr(table, key, None) is not None for key in ("active", "velocity", "path"))
 
 
+def leaving_time(lower: Sequence[float], upper: Sequence[float], velocity: Sequence[float],
+                 space_lower: Sequence[float], space_upper: Sequence[float]) -> float:
+    """How long a box translating at ``velocity`` takes to leave a box ``space`` for good.
+
+    In a dimension with ``v > 0`` the box is past ``space`` once its lower face passes the
+    space's upper face, after ``(space_upper - lower) / v``; with ``v < 0`` once its upper
+    face passes the lower face, after ``(space_lower - upper) / v``. Disjoint in one
+    dimension is disjoint, and in each moving dimension the separation only grows, so the
+    box is gone from the first of these times on.
+
+    Parameters
+    ----------
+    lower, upper : sequence of float, length m
+        The box at the start, state units.
+    velocity : sequence of float, length m
+        State units per second.
+    space_lower, space_upper : sequence of float, length m
+        The state space on the box's dimensions, state units.
+
+    Returns
+    -------
+    float
+        Seconds from the start, ``>= 0``; ``inf`` if no entry of ``velocity`` is non-zero.
+    """
+    times = []
+    for a, b, v, lo, hi in zip(lower, upper, velocity, space_lower, space_upper):
+        if v > 0:
+            times.append(max(0.0, (hi - a) / v))
+        elif v < 0:
+            times.append(max(0.0, (lo - b) / v))
+    return min(times, default=math.inf)
+
+
 def moving_obstacle(table: Any, name: str, source: int, dims: tuple[int, ...],
-                    lower: tuple[float, ...], upper: tuple[float, ...]) -> MovingObstacle:
+                    lower: tuple[float, ...], upper: tuple[float, ...],
+                    space: tuple[tuple[float, ...], tuple[float, ...]] | None = None
+                    ) -> MovingObstacle:
     """Build a :class:`MovingObstacle` from a box entry with motion keys, checking its rules.
 
     Parameters
@@ -200,6 +237,9 @@ def moving_obstacle(table: Any, name: str, source: int, dims: tuple[int, ...],
         Its dimensions (checked by the loader).
     lower, upper : tuple of float
         Its box at ``t_on`` (checked non-empty by the loader).
+    space : (tuple of float, tuple of float), optional
+        The state space's bounds on ``dims``: a box with ``velocity`` and no ``active`` is
+        active from 0 until it has left them (:func:`leaving_time`).
 
     Returns
     -------
@@ -209,7 +249,7 @@ def moving_obstacle(table: Any, name: str, source: int, dims: tuple[int, ...],
     ------
     SpecError
         ``active`` not increasing; both ``velocity`` and ``path``; ``velocity`` without
-        ``active``; a wrong length; path times not increasing; a path not starting at the
+        ``active`` that never leaves the state space (zero, or no ``space``); a wrong length; path times not increasing; a path not starting at the
         centre of ``lower``/``upper``.
     """
     m = len(dims)
@@ -221,13 +261,16 @@ def moving_obstacle(table: Any, name: str, source: int, dims: tuple[int, ...],
     centre = tuple(0.5 * (a + b) for a, b in zip(lower, upper))
     half = tuple(0.5 * (b - a) for a, b in zip(lower, upper))
     if table.velocity is not None:
-        if table.active is None:
-            raise SpecError(f"{name}.velocity", "needs active = [t_on, t_off]: a box moving for "
-                                                "ever sweeps an unbounded region")
         v = tuple(table.velocity)
         if len(v) != m:
             raise SpecError(f"{name}.velocity", f"must have {m} entries (one per entry of "
                                                 f"lower), got {len(v)}")
+        if table.active is None:
+            t_off = math.inf if space is None else leaving_time(lower, upper, v, *space)
+            if math.isinf(t_off):
+                raise SpecError(f"{name}.velocity", "a box that never leaves the state space "
+                                "needs active = [t_on, t_off] (a zero velocity: omit "
+                                "velocity for a box that stays)")
         end = tuple(c + vk * (t_off - t_on) for c, vk in zip(centre, v))
         return MovingObstacle(source, dims, half, (t_on, t_off), (centre, end), (t_on, t_off),
                               "velocity")

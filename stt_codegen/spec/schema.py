@@ -113,7 +113,8 @@ class BoxObstacle(_Table):
     active: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = _omitted(
         "[t_on, t_off], seconds, t_on < t_off: when the obstacle exists; default always")
     velocity: Vector = _omitted("state units/s on dims: the box translates from lower/upper "
-                                "at t_on (needs active)")
+                                "at t_on; without active, from 0 until it has left the "
+                                "state space")
     path: Annotated[list[Vector], Field(min_length=1, max_length=MAX_PATH_ROWS)] = _omitted(
         "rows [t, centre...] (t in s, increasing), piecewise linear, held before the first "
         "and after the last row; lower/upper give the size and the box at the first row")
