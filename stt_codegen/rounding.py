@@ -10,7 +10,9 @@ valid* (a lower bound down, an upper bound up), and every later step (the certif
 use of the number, the tolerance argument, the printed file) works with the rounded value.
 Two machines then agree unless their values straddle a rounding boundary, which needs a
 relative difference of about ``10**-DIGITS`` where the kernels differ by about ``10**-16``.
-The rule is in docs/codegen.md, "Numbers independent of the CPU".
+The rule is in docs/codegen.md, "Numbers independent of the CPU". The other way round,
+:func:`distinct` prints a number compared with a limit with the digits it takes to tell
+them apart.
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ from decimal import ROUND_CEILING, ROUND_FLOOR, Decimal
 
 import numpy as np
 
-__all__ = ["DIGITS", "round_down", "round_up", "round_up_array"]
+__all__ = ["DIGITS", "distinct", "round_down", "round_up", "round_up_array"]
 
 #: Significant digits kept by :func:`round_down` and :func:`round_up`.
 DIGITS = 4
@@ -92,3 +94,29 @@ def round_up_array(a, digits: int = DIGITS) -> np.ndarray:
     """
     a = np.asarray(a, dtype=float)
     return np.array([round_up(v, digits) for v in a.ravel()], dtype=float).reshape(a.shape)
+
+
+def distinct(value: float, other: float, digits: int = 3) -> str:
+    """``value`` printed with at least ``digits`` significant digits, and with as many more
+    (up to 17) as it takes to differ from ``other`` printed the same way.
+
+    A check that compares ``value`` with a limit ``other`` prints both: where they differ
+    only in late digits, a FAIL whose printed figures look equal (or a PASS whose figures
+    look reversed) would contradict itself.
+
+    Parameters
+    ----------
+    value, other : float
+        The number to print and the one it was compared with.
+    digits : int, optional
+        The fewest significant digits (default 3).
+
+    Returns
+    -------
+    str
+        ``value`` in ``g`` format.
+    """
+    for d in range(digits, 18):
+        if f"{value:.{d}g}" != f"{other:.{d}g}" or value == other:
+            return f"{value:.{d}g}"
+    return repr(value)

@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import stt_codegen as stt
-from stt_codegen.verify.check import distinct
+from stt_codegen.rounding import distinct
 from stt_codegen.verify.command import _deployed_alpha_check as deployed_alpha_check
 
 SPECS = Path(__file__).parent / "specs"
@@ -41,3 +41,12 @@ def test_umaze_adaptive_checks_pass_with_their_figures():
     deployed = [c for c in report.checks if c.name.startswith("adaptive.deployed")]
     assert len(deployed) == 4
     assert all(c.passed for c in deployed), [str(c) for c in deployed]
+
+
+def test_a_margin_failing_under_the_rounding_margin_says_why():
+    """A certificate margin of 5e-10 passes nothing (it must exceed the enclosures'
+    rounding, 1e-9) and printed alone it reads as positive: the text names the limit."""
+    from stt_codegen.design.certificate.report import ROUNDING_MARGIN, _below_rounding
+    assert ROUNDING_MARGIN == 1e-9
+    assert "must exceed 1e-09" in _below_rounding(5e-10)
+    assert _below_rounding(2e-9) == ""

@@ -21,7 +21,8 @@ from ..spec.loader import Spec
 from ..spec.plants import PLANTS
 from ..tube import reference
 from ..tube.parameters import TubeDesign
-from .check import Check, distinct
+from ..rounding import distinct
+from .check import Check
 from .sampled import SampledCheck, sampled_check_of
 
 

@@ -34,32 +34,6 @@ class Check:
         return f"[{'PASS' if self.passed else 'FAIL'}] {self.name}: {self.detail}"
 
 
-def distinct(value: float, other: float, digits: int = 3) -> str:
-    """``value`` printed with at least ``digits`` significant digits, and with as many more
-    (up to 17) as it takes to differ from ``other`` printed the same way.
-
-    A check that compares ``value`` with a limit ``other`` prints both: where they differ
-    only in late digits, a FAIL whose printed figures look equal (or a PASS whose figures
-    look reversed) would contradict itself.
-
-    Parameters
-    ----------
-    value, other : float
-        The number to print and the one it was compared with.
-    digits : int, optional
-        The fewest significant digits (default 3).
-
-    Returns
-    -------
-    str
-        ``value`` in ``g`` format.
-    """
-    for d in range(digits, 18):
-        if f"{value:.{d}g}" != f"{other:.{d}g}" or value == other:
-            return f"{value:.{d}g}"
-    return repr(value)
-
-
 def all_passed(checks: Iterable[Check]) -> bool:
     """Return ``True`` when every check in ``checks`` passed."""
     return all(c.passed for c in checks)

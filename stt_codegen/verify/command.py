@@ -22,7 +22,8 @@ from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
 from .actuator import input_bound_check, prove_input_bound
 from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_omnidirectional, assumption2_single_integrator
-from .check import Check, VerificationReport, distinct
+from ..rounding import distinct
+from .check import Check, VerificationReport
 from .lemma import bump_rate_bound, reach_rate_bound
 from .proofs import design_independent_proofs
 from .sampled import plant_bounds_checks, sampled_checks

@@ -35,7 +35,8 @@ from ..spec.loader import Spec
 from ..spec.model_bounds import model_bounds
 from ..tube import reference
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
-from .check import Check, distinct
+from ..rounding import distinct
+from .check import Check
 from .lyapunov import level_after, next_level, others_max
 from .plant_class import PlantClass, plant_class
 from .sampled_axis import axis_interval, peak, phi_slope_scalar
@@ -542,11 +543,13 @@ def plant_bounds_checks(spec: Spec, model: str | None = None) -> list[Check]:
     tol = 1e-9
     bad = []
     if b.input_gain[0] < a.input_gain[0] - tol or b.input_gain[1] > a.input_gain[1] + tol:
-        bad.append(f"eig((g + g^T)/2) spans [{b.input_gain[0]:.6g}, {b.input_gain[1]:.6g}], "
-                   f"outside input_gain {list(a.input_gain)}")
+        bad.append(f"eig((g + g^T)/2) spans [{distinct(b.input_gain[0], a.input_gain[0], 6)}, "
+                   f"{distinct(b.input_gain[1], a.input_gain[1], 6)}], outside input_gain "
+                   f"{list(a.input_gain)} (tolerance {tol:g})")
     for key in ("input_gain_skew", "input_gain_coupling", "drift_bound"):
         if getattr(b, key) > getattr(a, key) + tol:
-            bad.append(f"{key} is {getattr(b, key):.6g} > {getattr(a, key):g}")
+            bad.append(f"{key} is {distinct(getattr(b, key), getattr(a, key), 6)} > "
+                       f"{getattr(a, key)!r} (tolerance {tol:g})")
     found = {"input_gain": list(b.input_gain), "input_gain_skew": b.input_gain_skew,
              "input_gain_coupling": b.input_gain_coupling, "drift_bound": b.drift_bound}
     checks.append(Check(

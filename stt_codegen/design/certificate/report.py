@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...rounding import round_down
+from ...rounding import distinct, round_down
 from ...spec.loader import Spec
 from ...tube import reference
 from ...tube.parameters import TubeDesign
@@ -201,6 +201,13 @@ def _worst(values: np.ndarray, t: np.ndarray) -> tuple[float, float, int]:
     return float(flat[k]), float(t[k]), k
 
 
+def _below_rounding(margin: float) -> str:
+    """What a failing margin adds to its text: one in ``(0, ROUNDING_MARGIN]`` prints as
+    positive and fails because it is not above the enclosures' rounding."""
+    return "" if margin > ROUNDING_MARGIN else (
+        f" (a margin must exceed {ROUNDING_MARGIN:g}, the enclosures' rounding)")
+
+
 def certificate_report(design: TubeDesign, spec: Spec, enc: Enclosure, selected, final: bool,
             budget_hit: bool, tail_start: float, max_intervals: int,
             narrowest: tuple[float, float] | None = None) -> Certificate:
@@ -212,14 +219,14 @@ def certificate_report(design: TubeDesign, spec: Spec, enc: Enclosure, selected,
     min_width, t = _worst(enc.width_min, t0)[:2] if narrowest is None else narrowest
     margins.append(Margin("non-empty", min_width > ROUNDING_MARGIN, min_width, t,
                           f"min width gamma_U - gamma_L >= {min_width:.6g} (interval at "
-                          f"t = {t:.4f} s)" + note))
+                          f"t = {t:.4f} s)" + _below_rounding(min_width) + note))
 
     x0 = np.array(design.initial_state)
     g_l0, g_u0, _, _ = reference.adaptive_tube(design, [0.0], np.zeros(2 * design.dimension))
     g_l0, g_u0 = g_l0[0], g_u0[0]
     m0 = float(np.min(np.minimum(x0 - g_l0, g_u0 - x0)))
     margins.append(Margin("initial state inside", m0 > ROUNDING_MARGIN, m0, 0.0,
-                          f"x(0) is {m0:.6g} inside the tube at t = 0"))
+                          f"x(0) is {m0:.6g} inside the tube at t = 0" + _below_rounding(m0)))
     width0 = g_u0 - g_l0
     initial_error = (float(np.max(np.abs((2 * x0 - (g_u0 + g_l0)) / width0)))
                      if np.all(width0 > 0) else math.inf)
@@ -250,13 +257,15 @@ def certificate_report(design: TubeDesign, spec: Spec, enc: Enclosure, selected,
         m, t, _ = _worst(inside, t0[late])
         margins.append(Margin("inside target after t_c", m > ROUNDING_MARGIN, m, t,
                               f"min distance inside the target {m:.6g} for t >= {t:.4f} s "
-                              f"(every t >= {tail_start:.4f} s enclosed at once)" + note))
+                              f"(every t >= {tail_start:.4f} s enclosed at once)"
+                              + _below_rounding(m) + note))
 
     k = int(np.argmax(enc.move_ratio))
     ratio = float(enc.move_ratio[k])
     margins.append(Margin("sampling rate", ratio <= MAX_MOVE_PER_SAMPLE,
                           MAX_MOVE_PER_SAMPLE - ratio, float(t0[k]),
-                          f"a tube bound moves at most {ratio:.3g} tube widths in one sampling "
+                          f"a tube bound moves at most {distinct(ratio, MAX_MOVE_PER_SAMPLE)}"
+                          " tube widths in one sampling "
                           f"period at {design.rate_hz:g} Hz (limit {MAX_MOVE_PER_SAMPLE}; "
                           f"worst on the interval at t = {float(t0[k]):.3f} s)" + note))
     # The width the gains derive from, rounded down (still a certified lower bound) so that
