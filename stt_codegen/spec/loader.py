@@ -35,6 +35,9 @@ from .second_order import SecondOrder, parse_second_order
 from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
                      PlantTable, PolytopeObstacle, check_document, value_kind)
 
+__all__ = ["Assumptions", "Box", "LinearPlant", "NAME_PATTERN", "Obstacle", "Spec", "UnsafeSet",
+           "bundled_cases", "load_spec", "parse_spec"]
+
 NAME_PATTERN = re.compile(NAME_REGEX)
 #: Fraction of the available room used by the default half-widths ``d_0`` and ``d_T``.
 DEFAULT_HALF_WIDTH_FRACTION = 0.8

@@ -28,7 +28,8 @@ import math
 from dataclasses import dataclass
 from typing import Sequence
 
-__all__ = ["ModelBounds", "model_bounds", "row_coupling", "symmetric_eigen_range", "REL_PAD"]
+__all__ = ["ModelBounds", "model_bounds", "row_coupling", "symmetric_eigen_range", "REL_PAD",
+           "EXACT_DRIFT_DIMENSIONS"]
 
 #: Relative outward widening of every computed bound (rounding of ``cos``, ``sin`` and of
 #: the Jacobi eigenvalue iteration is far below it).

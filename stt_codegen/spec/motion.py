@@ -37,6 +37,8 @@ import numpy as np
 
 from ..errors import SpecError
 
+__all__ = ["MovingObstacle", "check_moving", "is_moving", "moving_obstacle"]
+
 #: Relative tolerance on a path's first centre against the centre of ``lower``/``upper``.
 CENTRE_TOLERANCE = 1e-9
 

@@ -25,6 +25,10 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Discriminator, Field, 
 from ..errors import SpecError
 from .plants import ALL_PLANT_MODELS, PLANTS, SECOND_ORDER_PLANTS
 
+__all__ = ["ActuatorTable", "AssumptionsTable", "BallObstacle", "BoxObstacle", "BoxTable",
+           "NAME_REGEX", "PlantTable", "PolytopeObstacle", "check_document", "json_schema",
+           "value_kind"]
+
 #: Largest magnitude of any number in a spec.
 MAX_MAGNITUDE = 1e12
 #: Default covering tolerance of balls and polytopes (Remark 3.1), state units.

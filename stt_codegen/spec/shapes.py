@@ -14,6 +14,8 @@ import numpy as np
 
 from ..errors import SpecError
 
+__all__ = ["Ball", "MAX_POLYTOPE_DIMENSION", "Polytope", "make_polytope"]
+
 #: Largest number of coordinates (``dims``) a polytope obstacle may be given on.
 MAX_POLYTOPE_DIMENSION = 4
 #: Relative widening of an exact box hull (one and two dimensions), against rounding.
