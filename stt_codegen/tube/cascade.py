@@ -29,6 +29,9 @@ from .model import adaptive_tube, conflict_and_trigger, implicit_alpha_update
 from .parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .second_stage import SecondStage
 
+__all__ = ["CASCADE_OUTPUTS", "cascade_step", "velocity_law", "velocity_transform",
+           "velocity_tube"]
+
 #: The outputs of :func:`cascade_step`, in order.
 CASCADE_OUTPUTS = ("u", "alpha_next", "r", "inside_position", "inside_velocity")
 

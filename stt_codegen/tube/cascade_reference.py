@@ -18,6 +18,8 @@ from . import reference
 from .parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .second_stage import SecondStage
 
+__all__ = ["cascade_step", "reference", "velocity_transform", "velocity_tube"]
+
 Array = np.ndarray
 
 

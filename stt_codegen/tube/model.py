@@ -33,6 +33,10 @@ import casadi as ca
 from . import pieces as P
 from .parameters import LOWER, NEWTON_ITERATIONS, TubeDesign
 
+__all__ = ["FUNCTION_NAMES", "TubeModel", "adaptive_tube", "alpha_trajectory_function",
+           "build_model", "conflict_and_trigger", "controller_law", "design_tables",
+           "implicit_alpha_update", "segment_rows"]
+
 #: The functions of a model, in order.
 FUNCTION_NAMES = ("reach_tube", "circumvent", "tube", "adaptive_law", "error_transform",
                   "control", "alpha_step", "controller_step")

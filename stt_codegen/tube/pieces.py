@@ -58,6 +58,12 @@ import casadi as ca
 
 from .parameters import E_MAX, GAMMA_D_MIN, NEWTON_TINY, SMOOTHSTEP, TANH
 
+__all__ = ["EXP_ARGUMENT_BOUND", "PROFILE_NAMES", "alpha_rate", "bump", "candidates", "conflict",
+           "deployed_pieces", "error_transform", "error_transform_expression", "fnu_pieces",
+           "interpolate", "later", "law", "law_expression", "newton_iteration_expression",
+           "newton_root_start_expression", "newton_start_expression", "progress",
+           "saturate_expression", "smooth_pieces", "trigger_expression"]
+
 #: Bound on the argument of ``exp`` where it could be large (the smooth max's correction
 #: and the trigger of (11)): ``exp(+-80)`` is a normal number in float32 and float64, so no
 #: step raises an overflow or underflow flag or sets ``errno``.

@@ -21,6 +21,12 @@ import numpy as np
 from .parameters import (E_MAX, GAMMA_D_MIN, LOWER, SMOOTHSTEP, STATUS_INPUT_CLAMPED, STATUS_OK,
                          STATUS_OUTSIDE_TUBE, TANH, ReachSegment, TubeDesign)
 
+__all__ = ["adaptive_law", "adaptive_tube", "alpha_step", "bump", "circumvent",
+           "circumvent_from_bumps", "conflict_distance", "control", "controller_status",
+           "controller_step", "error_transform", "exp", "implicit_alpha_root", "law", "law_step",
+           "log", "numpy_math", "open_bump_sum", "reach_tube", "segment_progress", "smooth_max",
+           "trigger"]
+
 Array = np.ndarray
 
 
