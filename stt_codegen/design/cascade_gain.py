@@ -38,6 +38,9 @@ from ..tube.second_stage import SecondStage
 if TYPE_CHECKING:
     from .result import Design
 
+__all__ = ["INNER_STEP_FRACTION", "cascade_rate", "cascade_rate_words", "derived_second_stage",
+           "law_slope_growth", "second_stage_of", "transform_slope_growth"]
+
 #: ``omega2 dt`` at ``lambda = g_max``.
 INNER_STEP_FRACTION = 0.1
 #: ``omega2,min / omega1``.

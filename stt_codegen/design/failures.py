@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from enum import Enum
 
+__all__ = ["FailureKind", "property_kind"]
+
 
 class FailureKind(Enum):
     """What made a tube (or the design search) fail.

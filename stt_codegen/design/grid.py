@@ -11,6 +11,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+__all__ = ["grid_index", "grid_value", "smallest_passing"]
+
 
 def grid_index(value: float) -> int:
     """Index of the smallest two-significant-digit number ``>= value`` (``value > 0``)."""

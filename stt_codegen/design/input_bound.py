@@ -35,6 +35,9 @@ if TYPE_CHECKING:
 
     from ..spec.loader import Spec
 
+__all__ = ["InputProof", "InputProver", "input_peak", "input_prover", "phi",
+           "register_input_prover"]
+
 
 @dataclass(frozen=True)
 class InputProof:

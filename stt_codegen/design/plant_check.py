@@ -17,6 +17,8 @@ import numpy as np
 
 from ..spec.loader import Spec
 
+__all__ = ["plant_failure"]
+
 #: Heading range of the omnidirectional robot (eq. (14)) where ``g_s`` is positive
 #: definite: ``g_s = diag(cos x3, cos x3, 1)`` (docs/decisions.md, decision 10).
 HALF_PI = math.pi / 2

@@ -16,6 +16,8 @@ from ..tube import reference
 from ..tube.model import alpha_trajectory_function
 from ..tube.parameters import TubeDesign
 
+__all__ = ["HORIZON_FACTOR", "STEP_BUDGET", "TubeSamples", "check_step_budget", "sample_tube"]
+
 #: Default horizon of a sampled tube, as a multiple of ``t_c``.
 HORIZON_FACTOR = 1.1
 #: Most controller steps a per-sample computation (:func:`sample_tube`, ``simulate``)

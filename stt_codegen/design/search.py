@@ -42,6 +42,9 @@ from .tasks import alternatives, plan_tasks
 from .via import via_design
 from .windows import WINDOW_INFLATION, candidates, overlap_interval, progress_time
 
+__all__ = ["MAX_INITIAL_ERROR", "MAX_MOVE_PER_SAMPLE", "base_design", "check_tube", "design_tube",
+           "paper_design"]
+
 #: Largest ``|e_i|`` of ``x(0)`` in the tube at ``t = 0``: near the tube's edge law (13)
 #: is so steep that the first sampled step overshoots (measured: at ``|e| ~ 1`` the
 #: first input was 1e8 and the state left the arena in one period).

@@ -37,6 +37,9 @@ from ..tube.parameters import TubeDesign
 from .certificate import Certificate
 from .input_bound import input_prover
 
+__all__ = ["SMOOTHER_RATIO", "TRACKING_ERROR", "centre_speed", "proved_error", "tracking_demand",
+           "unfollowable"]
+
 #: The normalized error the demand is computed for (issue 20's acceptance: ``max |e| <=
 #: 0.7`` in closed loop).
 TRACKING_ERROR = 0.7

@@ -37,6 +37,8 @@ from ..spec.loader import Spec
 from .failures import FailureKind
 from ..tube.parameters import SMOOTHSTEP, ReachSegment, TubeDesign
 
+__all__ = ["VIA_MARGIN", "plan_via", "via_design"]
+
 #: Largest half-width of a via box, state units.
 VIA_HALF_WIDTH = 0.1
 #: Clearance kept between a move's bounding box and every obstacle, state units.

@@ -23,6 +23,9 @@ from ..tube import reference
 from ..tube.parameters import LOWER, UPPER, Circumvent, TubeDesign
 from .certificate import MAX_MOVE_PER_SAMPLE
 
+__all__ = ["SHARPNESS_LADDER", "WINDOW_INFLATION", "candidates", "overlap_interval",
+           "progress_time"]
+
 #: Obstacles are inflated by this fraction of ``delta_b`` to compute overlap windows.
 WINDOW_INFLATION = 0.5
 #: Circumvent sharpness values ``k^j`` the automatic choice picks from, sharpest first.

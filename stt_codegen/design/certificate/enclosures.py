@@ -19,6 +19,9 @@ from ...tube import reference
 from ...tube.parameters import LOWER, TANH, TubeDesign
 from .report import Enclosure
 
+__all__ = ["Pieces", "bump_ranges", "circumvent_range", "enclose", "enclose_tube", "partition",
+           "piece_ranges", "piece_widths", "reach_range", "width_lower_bound"]
+
 
 def _tanh_rate_peak() -> float:
     lo, hi = 0.5, 1.0

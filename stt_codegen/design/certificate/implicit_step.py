@@ -20,6 +20,9 @@ import numpy as np
 from ...tube import reference
 from ...tube.parameters import TubeDesign
 
+__all__ = ["EXACT_STEPS", "Propagation", "STEP_ROOT_TOLERANCE", "SequenceBounds",
+           "alpha_fixed_point", "alpha_ranges", "sequence_bounds", "step_root"]
+
 #: Intervals of at most this many steps follow the extreme implicit steps one by one.
 EXACT_STEPS = 4
 #: Relative width at which :func:`step_root` stops refining its (rigorous) bracket.

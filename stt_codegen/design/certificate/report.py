@@ -17,6 +17,9 @@ from ...spec.loader import Spec
 from ...tube import reference
 from ...tube.parameters import TubeDesign
 
+__all__ = ["Certificate", "CertificateState", "Enclosure", "MAX_MOVE_PER_SAMPLE", "Margin",
+           "PROPERTIES", "ROUNDING_MARGIN", "certificate_report", "obstacle_separation"]
+
 #: Margins below this (state units) count as failures: rounding in the enclosures.
 ROUNDING_MARGIN = 1e-9
 #: Largest distance a tube bound may move in one sampling period, as a fraction of the

@@ -20,6 +20,8 @@ from .enclosures import Pieces
 from .implicit_step import EXACT_STEPS, Propagation
 from .report import CertificateState
 
+__all__ = ["repropagate", "step_psi"]
+
 #: Bounds brought into a kept interval replace its own where they are tighter by more than
 #: this fraction of its own bounds' spread (plus ``1e-12``) in some component.
 TIGHTER = 0.01

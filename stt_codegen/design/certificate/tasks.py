@@ -31,6 +31,8 @@ from ...tube.parameters import TubeDesign
 from .enclosures import enclose, piece_ranges
 from .report import ROUNDING_MARGIN, Enclosure, Margin
 
+__all__ = ["task_margins"]
+
 #: Pieces a window is cut into at most (besides the partition's points inside it).
 TASK_PIECES = 200
 
