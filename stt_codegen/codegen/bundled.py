@@ -27,6 +27,8 @@ from .generate import generate_files
 from .options import Options
 from .output import write_generation
 
+__all__ = ["LAYOUT", "drift", "update_generated", "version_note"]
+
 #: The CasADi version whose output ``generated/`` holds (the byte-identical reference).
 REFERENCE_CASADI_VERSION = "3.8.2"
 

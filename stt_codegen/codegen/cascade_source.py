@@ -33,6 +33,8 @@ from .emit import CPrinter, lower, python_source
 from .options import Options
 from .render import render
 
+__all__ = ["cascade_c_files", "cascade_generation", "cascade_python_file"]
+
 #: Status of an input outside the step's domain (as the first-order API's INVALID_INPUT).
 CASCADE_INVALID_INPUT = 2
 #: Largest accepted ``dt``, seconds.

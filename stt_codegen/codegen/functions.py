@@ -31,6 +31,8 @@ from ..tube import pieces as P
 from ..tube.model import TubeModel
 from ..tube.parameters import LOWER, UPPER
 
+__all__ = ["clamped_control", "deployed_functions"]
+
 
 def deployed_functions(model: TubeModel) -> list[ca.Function]:
     """The deployed SX Functions of a design, in generation order."""

@@ -35,6 +35,8 @@ from .tables import design_table_rows
 from ..tube.pieces import PROFILE_NAMES
 from .vectors import test_vectors
 
+__all__ = ["GENERATOR", "MANIFEST", "Options", "generate_files", "input_limits", "manifest"]
+
 MANIFEST = "manifest.json"
 GENERATOR = "stt-codegen"
 

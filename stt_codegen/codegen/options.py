@@ -7,6 +7,8 @@ from dataclasses import dataclass
 
 from ..errors import SpecError
 
+__all__ = ["LANGUAGES", "Options", "PRECISIONS", "parse_options"]
+
 #: Supported languages, in the canonical order used in file lists and manifests.
 LANGUAGES = ("c", "python")
 #: Supported precisions of the C code (the Python module always uses Python floats).

@@ -54,6 +54,8 @@ from ..errors import SpecError
 from ..system import fsync_path, write_durably
 from .generate import GENERATOR, MANIFEST
 
+__all__ = ["LOCK_TIMEOUT", "build_products", "write_generation"]
+
 #: Seconds a writer waits for another writer of the same folder before giving up.
 LOCK_TIMEOUT = 60.0
 _LOCK = ".stt-codegen-lock"

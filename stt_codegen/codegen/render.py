@@ -18,6 +18,8 @@ import jinja2
 
 from ..errors import SpecError
 
+__all__ = ["c_identifier", "c_real", "render"]
+
 _C_KEYWORDS = frozenset(
     "auto break case char const continue default do double else enum extern float for goto "
     "if inline int long register restrict return short signed sizeof static struct switch "

@@ -18,6 +18,8 @@ from ..tube.model import design_tables, segment_rows
 from ..tube.parameters import TubeDesign
 from ..tube.pieces import PROFILE_NAMES
 
+__all__ = ["design_table_rows"]
+
 #: Tube parameters in table order: (field, attribute of TubeDesign, comment).
 PARAMETERS = (
     ("smoothness", "smoothness", "nu of the smooth max/min and of F_nu (eqs. (9)-(10)), 1/state units"),

@@ -40,6 +40,9 @@ import numpy as np
 
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 
+__all__ = ["GAMMA_FACTOR", "UNIT_SINGLE", "alpha_bound", "cascade_bounds", "gamma_bound",
+           "status_certain", "u_bound", "unit_roundoff", "with_double_floor"]
+
 UNIT_DOUBLE = 2.0 ** -53
 UNIT_SINGLE = 2.0 ** -24
 #: Rounding count of a tube bound, with a 4x margin.

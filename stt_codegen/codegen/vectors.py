@@ -30,6 +30,8 @@ from ..tube.parameters import TubeDesign
 from . import tolerance as T
 from .errors import CodegenError
 
+__all__ = ["BATCH", "INSIDE", "OUTSIDE", "ROUNDS", "sample_inputs", "test_vectors"]
+
 INSIDE = 48
 OUTSIDE = 8
 SEED = 20240531

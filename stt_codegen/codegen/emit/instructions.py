@@ -25,6 +25,9 @@ import casadi
 from .errors import EmitError, UnsupportedOperation
 from .ops import OPS, casadi_op_name
 
+__all__ = ["Binary", "Const", "IOSpec", "IfElseZero", "Input", "Instruction", "OPS", "Output",
+           "Program", "Unary", "lower", "op_name"]
+
 
 @dataclass(frozen=True)
 class Input:
