@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from importlib import resources
 
+__all__ = ["bundled_cases", "bundled_spec_bytes"]
+
 
 def bundled_cases() -> list[str]:
     """Names of the bundled specs (``omnirobot-s1``, ...), sorted; load one with
