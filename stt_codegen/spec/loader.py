@@ -452,9 +452,22 @@ def load_spec(spec: str | Path) -> Spec:
 def parse_spec(data: bytes | str) -> Spec:
     """Validate the text of a spec file; see :func:`load_spec`.
 
+    Parameters
+    ----------
+    data : bytes or str
+        The TOML text of a spec file (``bytes`` must be UTF-8).
+
+    Returns
+    -------
+    Spec
+        The validated spec; its hash is the SHA-256 of the UTF-8 text.
+
     Raises
     ------
     SpecError
+    SpecError
+        Text that is not UTF-8 or not TOML (field ``""``), or a field that fails validation
+        (the error names the field and the reason).
     """
     raw = data.encode("utf-8") if isinstance(data, str) else bytes(data)
     try:

@@ -223,6 +223,18 @@ class Polytope:
 def make_polytope(vertices: list, name: str) -> Polytope:
     """Validate a vertex list and build the polytope.
 
+    Parameters
+    ----------
+    vertices : list of list of float, shape (v, k)
+        The vertices, state units, ``k <= MAX_POLYTOPE_DIMENSION``.
+    name : str
+        The obstacle's field name in errors (``obstacles[i]``).
+
+    Returns
+    -------
+    Polytope
+        The convex hull of the vertices.
+
     Raises
     ------
     SpecError
