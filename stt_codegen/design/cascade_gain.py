@@ -159,13 +159,35 @@ CONSIDERED_E2 = 0.96
 
 def transform_slope_growth(e2: float) -> float:
     """``d epsilon2/d e2`` at ``e2`` over its value at 0: ``1 / (1 - e2^2)`` (the slope of
-    ``epsilon2 = ln((1+e2)/(1-e2))`` is ``2 / (1 - e2^2)``)."""
+    ``epsilon2 = ln((1+e2)/(1-e2))`` is ``2 / (1 - e2^2)``).
+
+    Parameters
+    ----------
+    e2 : float
+        The second stage's normalized error, ``|e2| < 1``.
+
+    Returns
+    -------
+    float
+        ``1 / (1 - e2^2)``, at least 1.
+    """
     return 1.0 / (1.0 - e2 * e2)
 
 
 def law_slope_growth(e2: float) -> float:
     """``d u/d z`` at ``e2`` over its value at 0, for ``u = -k2 xi2 epsilon2`` with ``xi2 =
-    2 / (rho2 (1 - e2^2))`` also depending on ``z``: ``(1 + e2 epsilon2) / (1 - e2^2)^2``."""
+    2 / (rho2 (1 - e2^2))`` also depending on ``z``: ``(1 + e2 epsilon2) / (1 - e2^2)^2``.
+
+    Parameters
+    ----------
+    e2 : float
+        The second stage's normalized error, ``|e2| < 1``.
+
+    Returns
+    -------
+    float
+        ``(1 + e2 epsilon2) / (1 - e2^2)^2``, at least 1.
+    """
     eps = float(np.log((1.0 + e2) / (1.0 - e2)))
     return (1.0 + e2 * eps) / (1.0 - e2 * e2) ** 2
 
@@ -252,7 +274,18 @@ def cascade_rate(stage: SecondStage, input_gain: tuple, min_width: float, rate_h
 
 
 def cascade_rate_words(rate: dict) -> str:
-    """:func:`cascade_rate`'s figures in one sentence (``cascade.rate``'s detail)."""
+    """:func:`cascade_rate`'s figures in one sentence (``cascade.rate``'s detail).
+
+    Parameters
+    ----------
+    rate : dict
+        What :func:`cascade_rate` returns.
+
+    Returns
+    -------
+    str
+        One sentence: the inner and outer loops' factors, the lowest rate and the verdict.
+    """
     lo, hi = rate["inner_factors"]
     glo, ghi = rate["inner_factors_grown"]
     llo, lhi = rate["inner_factors_law_slope"]

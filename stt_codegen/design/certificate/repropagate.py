@@ -44,6 +44,8 @@ def step_psi(design: TubeDesign, i0: np.ndarray, steps: np.ndarray) -> list:
         Sample index of each interval's start.
     steps : ndarray, shape (K,)
         Sampling periods per interval (``inf`` for the tail).
+    design : TubeDesign
+        The tube.
 
     Returns
     -------
@@ -88,6 +90,8 @@ def repropagate(design: TubeDesign, pieces: Pieces, points: list[int], steps: np
         Sampling periods per new interval (``inf`` for the tail).
     old : CertificateState
         The proven partition's bounds.
+    design : TubeDesign
+        The tube.
 
     Returns
     -------
