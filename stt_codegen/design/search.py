@@ -181,7 +181,20 @@ def lowest_passing_rate(tube: TubeDesign, spec: Spec) -> float | None:
 
 
 def base_design(spec: Spec, gain: float = 1.0) -> TubeDesign:
-    """The design without circumvents, from the spec's boxes and parameters."""
+    """The design without circumvents, from the spec's boxes and parameters.
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec (its sets, tube parameters and rate).
+    gain : float
+        The gain ``k`` of law (13).
+
+    Returns
+    -------
+    TubeDesign
+        The paper's reach tube (4) from ``X_0``-hat (2) to ``T``-hat (3), no circumvents.
+    """
     x0, d0 = spec.initial_state, spec.initial_half_width
     eta, d_t = spec.target_center, target_half_width(spec)
     return TubeDesign(

@@ -287,5 +287,23 @@ def _timed(path: list, nodes: dict, prescribed_time: float) -> ViaPlan:
 
 
 def via_design(spec: Spec, base: TubeDesign) -> TubeDesign:
-    """``base`` with its reach tube replaced by the via-point segments of :func:`plan_via`."""
+    """``base`` with its reach tube replaced by the via-point segments of :func:`plan_via`.
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec.
+    base : TubeDesign
+        The design without circumvents (:func:`~.search.base_design`).
+
+    Returns
+    -------
+    TubeDesign
+        ``base`` through the via points, without circumvents.
+
+    Raises
+    ------
+    DesignError
+        :func:`plan_via` finds no path.
+    """
     return replace(base, segments=plan_via(spec, base).segments(), circumvents=())
