@@ -107,6 +107,20 @@ def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str) -> 
     only). The emitter's Python printer prints the composed Function; the template
     ``cascade_module.py.j2`` holds the rest of the text.
 
+    Parameters
+    ----------
+    design : TubeDesign
+        The first stage's tube (positions).
+    stage : SecondStage
+        The second stage (velocity tube and gains), of the design's dimension.
+    prefix : str
+        Module name, an ASCII identifier.
+
+    Returns
+    -------
+    dict of str to str
+        One entry, ``<prefix>.py`` and its text.
+
     Raises
     ------
     ValueError

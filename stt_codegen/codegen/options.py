@@ -38,6 +38,18 @@ def parse_options(langs: str | Sequence[str] = "c,python", precision: str = "dou
     """Validate the languages (comma-separated, or a sequence such as a list, a tuple or a
     numpy array of strings) and the precision.
 
+    Parameters
+    ----------
+    langs : str or sequence of str
+        Languages among :data:`LANGUAGES` (``"c"``, ``"python"``).
+    precision : str
+        One of :data:`PRECISIONS` (``"double"``, ``"single"``).
+
+    Returns
+    -------
+    Options
+        The languages in :data:`LANGUAGES` order, without repeats, and the precision.
+
     Raises
     ------
     SpecError

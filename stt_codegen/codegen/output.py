@@ -83,6 +83,16 @@ def build_products(names) -> dict[str, str]:
     ``Makefile``: ``P.o`` and ``P_selftest``; ``CMakeLists.txt``: the build folder
     ``build`` (``cmake -S . -B build``). ``P`` is the prefix of the listed ``P.c`` and
     ``P_selftest.c``.
+
+    Parameters
+    ----------
+    names : iterable of str
+        File names of one generation.
+
+    Returns
+    -------
+    dict of str to str
+        Product name (relative to the output folder) to ``"file"`` or ``"dir"``.
     """
     names = set(names)
     prefixes = [n[:-len("_selftest.c")] for n in names

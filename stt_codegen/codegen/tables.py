@@ -96,6 +96,11 @@ def design_table_rows(design: TubeDesign, literal: Callable[[float], str],
         Float -> source text (exact in the target precision).
     single : bool
         Whether the code computes in float32 (the open-window bound uses the rounded times).
+
+    Returns
+    -------
+    Tables
+        The rows of every table of the generated code.
     """
     tables = design_tables(design)
     parameters = [(field, literal(getattr(design, attr)), comment)

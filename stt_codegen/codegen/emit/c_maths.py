@@ -197,6 +197,16 @@ int main(void) {{
 def source(op: str) -> str:
     """C text of the function of this module that computes ``op`` (see :data:`FUNCTIONS`).
 
+    Parameters
+    ----------
+    op : str
+        An op name (:mod:`.ops`); only ``"exp"`` has a function here.
+
+    Returns
+    -------
+    str
+        The C text of the function (``stt_expf``).
+
     Raises
     ------
     KeyError
