@@ -302,7 +302,8 @@ def implicit_alpha_update(alpha, psi, theta, dt, kappa: float,
 
 
 def controller_law(design: TubeDesign, x, gamma_l, gamma_u) -> tuple:
-    """Deployed law (13) with clamps: returns ``(u, inside)`` (see :mod:`stt_codegen.tube.parameters`).
+    """Deployed law (13) with clamps: returns ``(u, inside)`` (see
+    :mod:`stt_codegen.tube.parameters`).
 
     Parameters
     ----------
