@@ -465,7 +465,6 @@ def parse_spec(data: bytes | str) -> Spec:
     Raises
     ------
     SpecError
-    SpecError
         Text that is not UTF-8 or not TOML (field ``""``), or a field that fails validation
         (the error names the field and the reason).
     """
