@@ -399,10 +399,10 @@ def trigger(design: TubeDesign, psi) -> Array:
 
     Parameters
     ----------
-    psi : array_like, any shape
-        ``psi`` of eq. (11), state units.
     design : TubeDesign
         The tube (``theta0``, ``mu``).
+    psi : array_like, any shape
+        ``psi`` of eq. (11), state units.
 
     Returns
     -------
@@ -419,11 +419,11 @@ def adaptive_law(design: TubeDesign, t, alpha) -> tuple[Array, Array]:
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube (``theta0``, ``mu``, ``kappa``).
     t : array_like, shape (N,)
     alpha : array_like, shape (N, 2n)
         ``[alpha_L, alpha_U]``, valid where ``psi + alpha > 0``.
-    design : TubeDesign
-        The tube (``theta0``, ``mu``, ``kappa``).
 
     Returns
     -------
@@ -480,11 +480,11 @@ def error_transform(design: TubeDesign, x, t, alpha) -> tuple[Array, Array, Arra
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube.
     x : array_like, shape (N, n)
     t : array_like, shape (N,)
     alpha : array_like, shape (N, 2n)
-    design : TubeDesign
-        The tube.
 
     Returns
     -------
@@ -575,11 +575,11 @@ def alpha_step(design: TubeDesign, t, dt, alpha) -> Array:
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube (``theta0``, ``mu``, ``kappa``).
     t, dt : array_like, shape (N,)
         Seconds; ``dt > 0``.
     alpha : array_like, shape (N, 2n)
-    design : TubeDesign
-        The tube (``theta0``, ``mu``, ``kappa``).
 
     Returns
     -------

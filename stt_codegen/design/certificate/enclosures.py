@@ -138,12 +138,12 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool 
 
     Parameters
     ----------
-    rates : bool
-        Also the rates' ranges (else ``None`` in their place).
     design : TubeDesign
         The tube (its reach segments).
     t0, t1 : ndarray, shape (K,)
         Ends of the intervals, s.
+    rates : bool
+        Also the rates' ranges (else ``None`` in their place).
 
     Returns
     -------
@@ -284,11 +284,11 @@ def piece_widths(design: TubeDesign, t0: np.ndarray, t1: np.ndarray,
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube.
     t0, t1 : ndarray, shape (K,)
         Seconds.
     alpha_min : ndarray, shape (K, 2n)
-    design : TubeDesign
-        The tube.
 
     Returns
     -------
@@ -328,11 +328,11 @@ def width_lower_bound(design: TubeDesign, pieces: Pieces, alpha_min: np.ndarray)
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube (its smoothness ``nu``).
     pieces : Pieces
     alpha_min : ndarray, shape (K, 2n)
         Lower bounds of ``alpha`` on the intervals.
-    design : TubeDesign
-        The tube (its smoothness ``nu``).
 
     Returns
     -------
@@ -352,14 +352,14 @@ def enclose(design: TubeDesign, pieces: Pieces, alpha_min: np.ndarray, alpha_max
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube.
     pieces : Pieces
         From :func:`piece_ranges` on the same intervals.
     alpha_min, alpha_max : ndarray, shape (K, 2n)
         Range of ``alpha`` on each interval.
     t0, t1 : ndarray, shape (K,)
         Seconds.
-    design : TubeDesign
-        The tube.
 
     Returns
     -------

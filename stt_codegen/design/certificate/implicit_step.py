@@ -234,6 +234,8 @@ def alpha_ranges(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube (``theta0``, ``mu``, ``kappa``, ``rate_hz``).
     psi_lo, psi_hi : ndarray, shape (K, 2n)
     steps : ndarray, shape (K,)
         Steps per interval (``inf`` for the tail).
@@ -245,8 +247,6 @@ def alpha_ranges(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
         its steps use, nested lists (steps, 2n) (the deployed step ``k -> k + 1`` takes
         ``psi(t_{k+1})``), so each step is followed with its own ``psi`` instead of the
         interval's range; ``None`` (or no list): the interval's range.
-    design : TubeDesign
-        The tube (``theta0``, ``mu``, ``kappa``, ``rate_hz``).
 
     Returns
     -------

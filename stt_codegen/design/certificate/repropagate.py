@@ -40,12 +40,12 @@ def step_psi(design: TubeDesign, i0: np.ndarray, steps: np.ndarray) -> list:
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube.
     i0 : ndarray of int, shape (K,)
         Sample index of each interval's start.
     steps : ndarray, shape (K,)
         Sampling periods per interval (``inf`` for the tail).
-    design : TubeDesign
-        The tube.
 
     Returns
     -------
@@ -82,6 +82,8 @@ def repropagate(design: TubeDesign, pieces: Pieces, points: list[int], steps: np
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube.
     pieces : Pieces
         Of the new partition (``psi`` ranges).
     points : list of int
@@ -90,8 +92,6 @@ def repropagate(design: TubeDesign, pieces: Pieces, points: list[int], steps: np
         Sampling periods per new interval (``inf`` for the tail).
     old : CertificateState
         The proven partition's bounds.
-    design : TubeDesign
-        The tube.
 
     Returns
     -------
