@@ -288,11 +288,14 @@ def implicit_alpha_update(alpha, psi, theta, dt, kappa: float,
     dt : casadi.SX scalar
         Step, seconds, positive.
     kappa : float
+        ``kappa`` of eq. (11), 1/s.
     iterations : int
+        Newton iterations after the start.
 
     Returns
     -------
     casadi.SX, shape (m, 1)
+        ``alpha`` after the step, state units.
     """
     a0, c, a_coef, root = P.newton_start_expression(alpha, psi, theta, dt, kappa)
     a = ca.if_else(root, P.newton_root_start_expression(alpha, psi, c, a_coef), a0)

@@ -543,6 +543,7 @@ def implicit_alpha_root(alpha: Array, psi: Array, theta: Array, dt: Array,
     ----------
     alpha, psi, theta, dt : array_like, broadcastable
     kappa : float
+        ``kappa`` of eq. (11), 1/s.
 
     Returns
     -------
