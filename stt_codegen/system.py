@@ -69,7 +69,18 @@ def find_tool(*names: str, package: str) -> str:
 
 
 def fsync_path(path: str | Path) -> None:
-    """Flush a file's or a folder's content (a folder: its entries) to the disk."""
+    """Flush a file's or a folder's content (a folder: its entries) to the disk.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        An existing file or folder.
+
+    Raises
+    ------
+    OSError
+        ``path`` cannot be opened or flushed.
+    """
     fd = os.open(path, os.O_RDONLY | os.O_CLOEXEC)
     try:
         os.fsync(fd)
@@ -79,6 +90,13 @@ def fsync_path(path: str | Path) -> None:
 
 def write_durably(path: str | Path, data: bytes) -> None:
     """Create the file ``path`` (it must not exist) holding ``data``, flushed to the disk.
+
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file to create; its folder must exist.
+    data : bytes
+        The whole content of the file.
 
     Raises
     ------

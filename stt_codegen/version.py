@@ -5,4 +5,6 @@ into every manifest and ``stt-codegen --version`` prints it. Keep it equal to
 ``[project] version`` of ``pyproject.toml``.
 """
 
+__all__ = ["__version__"]
+
 __version__ = "0.1.0"

@@ -5,14 +5,38 @@ from __future__ import annotations
 
 from importlib import resources
 
+__all__ = ["bundled_cases", "bundled_spec_bytes"]
+
 
 def bundled_cases() -> list[str]:
     """Names of the bundled specs (``omnirobot-s1``, ...), sorted; load one with
-    :func:`stt_codegen.load_spec`."""
+    :func:`stt_codegen.load_spec`.
+
+    Returns
+    -------
+    list of str
+        The case names, sorted, without the ``.toml`` suffix.
+    """
     folder = resources.files(__name__)
     return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
 
 
 def bundled_spec_bytes(name: str) -> bytes:
-    """The bytes of the bundled spec ``name`` (one of :func:`bundled_cases`)."""
+    """The bytes of the bundled spec ``name`` (one of :func:`bundled_cases`).
+
+    Parameters
+    ----------
+    name : str
+        A bundled case's name, without ``.toml`` (one of :func:`bundled_cases`).
+
+    Returns
+    -------
+    bytes
+        The TOML text of the spec, as stored in the package.
+
+    Raises
+    ------
+    FileNotFoundError
+        ``name`` is no bundled case.
+    """
     return resources.files(__name__).joinpath(name + ".toml").read_bytes()

@@ -10,6 +10,8 @@ from .generate import generate_files
 from .options import LANGUAGES, parse_options
 from .output import write_generation
 
+__all__ = ["generate"]
+
 
 def generate(design: Design, out_dir: str | Path,
              languages: str | Sequence[str] = LANGUAGES,

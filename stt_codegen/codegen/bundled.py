@@ -27,6 +27,8 @@ from .generate import generate_files
 from .options import Options
 from .output import write_generation
 
+__all__ = ["LAYOUT", "drift", "update_generated", "version_note"]
+
 #: The CasADi version whose output ``generated/`` holds (the byte-identical reference).
 REFERENCE_CASADI_VERSION = "3.8.2"
 
@@ -57,7 +59,13 @@ def actual_tree(root: Path) -> dict[str, bytes]:
 
 
 def version_note() -> str:
-    """One line naming the CasADi version compared against, and whether it is the reference."""
+    """One line naming the CasADi version compared against, and whether it is the reference.
+
+    Returns
+    -------
+    str
+        The note ``stt-codegen check`` prints with its verdict.
+    """
     import casadi
     installed = casadi.__version__
     if installed == REFERENCE_CASADI_VERSION:
@@ -68,7 +76,22 @@ def version_note() -> str:
 
 
 def drift(root: Path, expected: dict[str, bytes] | None = None) -> list[str]:
-    """Unified diffs (one string per differing file; empty: identical) of ``root``."""
+    """Unified diffs (one string per differing file; empty: identical) of ``root``.
+
+    Parameters
+    ----------
+    root : pathlib.Path
+        The ``generated/`` folder to compare.
+    expected : dict of str to bytes, optional
+        The files expected, keyed by path relative to ``root`` (POSIX); default a fresh
+        generation of every bundled case (:func:`expected_tree`).
+
+    Returns
+    -------
+    list of str
+        One unified diff per file that differs, or a line naming a missing or stray file,
+        in path order.
+    """
     expected = expected_tree() if expected is None else expected
     actual = actual_tree(root)
     out = []
@@ -95,7 +118,13 @@ def drift(root: Path, expected: dict[str, bytes] | None = None) -> list[str]:
 
 
 def update_generated(root: Path) -> None:
-    """Regenerate every committed folder under ``root`` (each written atomically)."""
+    """Regenerate every committed folder under ``root`` (each written atomically).
+
+    Parameters
+    ----------
+    root : pathlib.Path
+        The ``generated/`` folder; created if missing.
+    """
     tree = expected_tree()
     folders: dict[str, dict[str, bytes]] = {}
     for path, data in tree.items():

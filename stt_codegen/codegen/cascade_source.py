@@ -33,6 +33,8 @@ from .emit import CPrinter, lower, python_source
 from .options import Options
 from .render import render
 
+__all__ = ["cascade_c_files", "cascade_generation", "cascade_python_file"]
+
 #: Status of an input outside the step's domain (as the first-order API's INVALID_INPUT).
 CASCADE_INVALID_INPUT = 2
 #: Largest accepted ``dt``, seconds.
@@ -104,6 +106,20 @@ def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str) -> 
     status)``, the same function, statuses and input checks as the C (imports ``math``
     only). The emitter's Python printer prints the composed Function; the template
     ``cascade_module.py.j2`` holds the rest of the text.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The first stage's tube (positions).
+    stage : SecondStage
+        The second stage (velocity tube and gains), of the design's dimension.
+    prefix : str
+        Module name, an ASCII identifier.
+
+    Returns
+    -------
+    dict of str to str
+        One entry, ``<prefix>.py`` and its text.
 
     Raises
     ------

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from ..errors import ToolchainError
 
+__all__ = ["CodegenError"]
+
 
 class CodegenError(ToolchainError):
     """Generation cannot proceed: unexpected CasADi output, a failed build, an unsafe output folder."""

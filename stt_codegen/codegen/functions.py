@@ -31,9 +31,23 @@ from ..tube import pieces as P
 from ..tube.model import TubeModel
 from ..tube.parameters import LOWER, UPPER
 
+__all__ = ["clamped_control", "deployed_functions"]
+
 
 def deployed_functions(model: TubeModel) -> list[ca.Function]:
-    """The deployed SX Functions of a design, in generation order."""
+    """The deployed SX Functions of a design, in generation order.
+
+    Parameters
+    ----------
+    model : TubeModel
+        The design's CasADi model.
+
+    Returns
+    -------
+    list of casadi.Function
+        The pieces the generated code calls (:func:`~stt_codegen.tube.pieces.deployed_pieces`
+        for the design's dimension, profiles, circumvent counts and actuator bound).
+    """
     design = model.design
     profiles = tuple(sorted({segment.profile for segment in design.segments}))
     members = [len(design.circumvents_on(i, side)) for i in range(design.dimension)
@@ -45,7 +59,19 @@ def deployed_functions(model: TubeModel) -> list[ca.Function]:
 
 def clamped_control(model: TubeModel) -> ca.Function:
     """``control(x, t, alpha) -> (u, inside[, within_bound])``: the ``u``, ``inside`` (and,
-    for a design with an actuator bound, ``within_bound``) of the model's step."""
+    for a design with an actuator bound, ``within_bound``) of the model's step.
+
+    Parameters
+    ----------
+    model : TubeModel
+        The design's CasADi model (its ``controller_step``).
+
+    Returns
+    -------
+    casadi.Function
+        Inputs ``x`` (n), ``t`` (s), ``alpha`` (2n); outputs ``u`` (n) of law (13) with the
+        deployed clamps, ``inside`` and, with an actuator bound, ``within_bound``.
+    """
     step = model["controller_step"]
     n = model.design.dimension
     x = ca.SX.sym("x", n)

@@ -35,6 +35,8 @@ from .tables import design_table_rows
 from ..tube.pieces import PROFILE_NAMES
 from .vectors import test_vectors
 
+__all__ = ["GENERATOR", "MANIFEST", "Options", "generate_files", "input_limits", "manifest"]
+
 MANIFEST = "manifest.json"
 GENERATOR = "stt-codegen"
 
@@ -163,6 +165,16 @@ def input_limits(design: TubeDesign) -> dict[str, float]:
     adaptive law keeps ``alpha`` below about the state space's extent, and below this
     bound every intermediate of the step stays finite in single precision for specs
     within the loader's 1e12 limit (kappa alpha and (psi + alpha)^2 stay below 1e37).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (prescribed time and state-space bounds).
+
+    Returns
+    -------
+    dict of str to float
+        ``dt_min`` and ``dt_max`` (s) and ``alpha_max`` (state units).
     """
     scale = 1.0 + max(abs(v) for v in (*design.state_lower, *design.state_upper))
     return {"dt_min": 2.0 ** -20, "dt_max": 2.0 ** math.ceil(math.log2(design.prescribed_time)),
@@ -170,7 +182,22 @@ def input_limits(design: TubeDesign) -> dict[str, float]:
 
 
 def manifest(spec: Spec, options: Options, files: dict[str, bytes]) -> dict:
-    """The manifest: versions, spec hash, options and the SHA-256 of every other file."""
+    """The manifest: versions, spec hash, options and the SHA-256 of every other file.
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec generated from (its name and source hash).
+    options : Options
+        The generation's languages and precision.
+    files : dict of str to bytes
+        The generated files by name; the manifest's own entry is skipped.
+
+    Returns
+    -------
+    dict
+        JSON-ready; file hashes as hex SHA-256, in name order.
+    """
     return {
         "_generated": "GENERATED FILE, DO NOT EDIT: manifest of an stt-codegen generation.",
         "generator": GENERATOR,

@@ -7,6 +7,8 @@ from dataclasses import dataclass
 
 from ..errors import SpecError
 
+__all__ = ["LANGUAGES", "Options", "PRECISIONS", "parse_options"]
+
 #: Supported languages, in the canonical order used in file lists and manifests.
 LANGUAGES = ("c", "python")
 #: Supported precisions of the C code (the Python module always uses Python floats).
@@ -35,6 +37,18 @@ class Options:
 def parse_options(langs: str | Sequence[str] = "c,python", precision: str = "double") -> Options:
     """Validate the languages (comma-separated, or a sequence such as a list, a tuple or a
     numpy array of strings) and the precision.
+
+    Parameters
+    ----------
+    langs : str or sequence of str
+        Languages among :data:`LANGUAGES` (``"c"``, ``"python"``).
+    precision : str
+        One of :data:`PRECISIONS` (``"double"``, ``"single"``).
+
+    Returns
+    -------
+    Options
+        The languages in :data:`LANGUAGES` order, without repeats, and the precision.
 
     Raises
     ------

@@ -54,6 +54,8 @@ from ..errors import SpecError
 from ..system import fsync_path, write_durably
 from .generate import GENERATOR, MANIFEST
 
+__all__ = ["LOCK_TIMEOUT", "build_products", "write_generation"]
+
 #: Seconds a writer waits for another writer of the same folder before giving up.
 LOCK_TIMEOUT = 60.0
 _LOCK = ".stt-codegen-lock"
@@ -81,6 +83,16 @@ def build_products(names) -> dict[str, str]:
     ``Makefile``: ``P.o`` and ``P_selftest``; ``CMakeLists.txt``: the build folder
     ``build`` (``cmake -S . -B build``). ``P`` is the prefix of the listed ``P.c`` and
     ``P_selftest.c``.
+
+    Parameters
+    ----------
+    names : iterable of str
+        File names of one generation.
+
+    Returns
+    -------
+    dict of str to str
+        Product name (relative to the output folder) to ``"file"`` or ``"dir"``.
     """
     names = set(names)
     prefixes = [n[:-len("_selftest.c")] for n in names

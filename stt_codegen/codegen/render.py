@@ -18,6 +18,8 @@ import jinja2
 
 from ..errors import SpecError
 
+__all__ = ["c_identifier", "c_real", "render"]
+
 _C_KEYWORDS = frozenset(
     "auto break case char const continue default do double else enum extern float for goto "
     "if inline int long register restrict return short signed sizeof static struct switch "
@@ -26,7 +28,25 @@ _C_KEYWORDS = frozenset(
 
 def c_identifier(name: str, field: str = "name") -> str:
     """``name`` if it is a C and Python identifier that is not a keyword and has no
-    leading underscore, else :class:`SpecError` (``field``)."""
+    leading underscore, else :class:`SpecError` (``field``).
+
+    Parameters
+    ----------
+    name : str
+        The candidate identifier (a spec's name or a prefix).
+    field : str
+        The field an error names.
+
+    Returns
+    -------
+    str
+        ``name`` itself.
+
+    Raises
+    ------
+    SpecError
+        ``name`` is not ``[A-Za-z][A-Za-z0-9_]{0,63}`` or is a C or Python keyword.
+    """
     if not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]{0,63}", name):
         raise SpecError(field, f"{name!r} is not usable as a C identifier")
     if name in _C_KEYWORDS or keyword.iskeyword(name):
@@ -50,7 +70,26 @@ def py_comment(text: str) -> str:
 
 
 def c_real(value: float, single: bool) -> str:
-    """A C literal reading back exactly to ``value`` (double) or to its nearest float."""
+    """A C literal reading back exactly to ``value`` (double) or to its nearest float.
+
+    Parameters
+    ----------
+    value : float
+        A finite number.
+    single : bool
+        Print a ``float`` literal (``f`` suffix), else a ``double`` one.
+
+    Returns
+    -------
+    str
+        The shortest decimal that reads back to ``value`` (``repr``), with ``.0`` added to
+        an integer.
+
+    Raises
+    ------
+    ValueError
+        ``value`` is infinite or NaN.
+    """
     text = repr(float(value))
     if "e" not in text and "." not in text and "inf" not in text and "nan" not in text:
         text += ".0"
@@ -80,5 +119,18 @@ def _load(name: str) -> str:
 
 
 def render(template: str, **context) -> str:
-    """Render template ``template`` (a file name in ``templates/``) with ``context``."""
+    """Render template ``template`` (a file name in ``templates/``) with ``context``.
+
+    Parameters
+    ----------
+    template : str
+        The template's file name, e.g. ``"c_source.c.j2"``.
+    **context
+        The template's variables.
+
+    Returns
+    -------
+    str
+        The rendered text.
+    """
     return environment().get_template(template).render(**context)

@@ -18,6 +18,8 @@ from ..tube.model import design_tables, segment_rows
 from ..tube.parameters import TubeDesign
 from ..tube.pieces import PROFILE_NAMES
 
+__all__ = ["design_table_rows"]
+
 #: Tube parameters in table order: (field, attribute of TubeDesign, comment).
 PARAMETERS = (
     ("smoothness", "smoothness", "nu of the smooth max/min and of F_nu (eqs. (9)-(10)), 1/state units"),
@@ -94,6 +96,11 @@ def design_table_rows(design: TubeDesign, literal: Callable[[float], str],
         Float -> source text (exact in the target precision).
     single : bool
         Whether the code computes in float32 (the open-window bound uses the rounded times).
+
+    Returns
+    -------
+    Tables
+        The rows of every table of the generated code.
     """
     tables = design_tables(design)
     parameters = [(field, literal(getattr(design, attr)), comment)

@@ -41,6 +41,9 @@ import numpy as np
 from ..tube import reference
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 
+__all__ = ["GAMMA_FACTOR", "UNIT_SINGLE", "alpha_bound", "cascade_bounds", "gamma_bound",
+           "status_certain", "u_bound", "unit_roundoff", "with_double_floor"]
+
 UNIT_DOUBLE = 2.0 ** -53
 UNIT_SINGLE = 2.0 ** -24
 #: Rounding count of a tube bound, with a 4x margin.
@@ -52,7 +55,18 @@ DOUBLE_FLOOR = 1e-12
 
 
 def unit_roundoff(precision: str) -> float:
-    """``2**-53`` for ``"double"``, ``2**-24`` for ``"single"``."""
+    """``2**-53`` for ``"double"``, ``2**-24`` for ``"single"``.
+
+    Parameters
+    ----------
+    precision : str
+        ``"double"`` or ``"single"``.
+
+    Returns
+    -------
+    float
+        The unit roundoff ``u`` of the precision.
+    """
     return UNIT_DOUBLE if precision == "double" else UNIT_SINGLE
 
 
@@ -68,12 +82,48 @@ def _g(e: np.ndarray) -> np.ndarray:
 
 
 def gamma_bound(design: TubeDesign, alpha, unit: float) -> np.ndarray:
-    """Bound on the error of ``gamma_L``/``gamma_U``, shape (N, 1) (broadcasts over n)."""
+    """Bound on the error of ``gamma_L``/``gamma_U``, shape (N, 1) (broadcasts over n).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    alpha : array_like, shape (N, 2n)
+        ``alpha`` at the points, state units.
+    unit : float
+        Unit roundoff of the generated code's precision.
+
+    Returns
+    -------
+    ndarray, shape (N, 1)
+        State units.
+    """
     return (GAMMA_FACTOR * unit * scale(design, alpha))[:, None]
 
 
 def u_bound(design: TubeDesign, x, alpha, gamma_l, gamma_u, u_ref, unit: float) -> np.ndarray:
-    """Bound on the error of ``u``, shape (N, n); see the module docstring."""
+    """Bound on the error of ``u``, shape (N, n); see the module docstring.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (its gain).
+    x : array_like, shape (N, n)
+        States, state units.
+    alpha : array_like, shape (N, 2n)
+        ``alpha`` at the points.
+    gamma_l, gamma_u : ndarray, shape (N, n)
+        The reference's adaptive tube, state units.
+    u_ref : ndarray, shape (N, n)
+        The reference's ``u``.
+    unit : float
+        Unit roundoff of the generated code's precision.
+
+    Returns
+    -------
+    ndarray, shape (N, n)
+        Input units.
+    """
     x = np.atleast_2d(x)
     dg = gamma_bound(design, alpha, unit)
     width = np.maximum(gamma_u - gamma_l, GAMMA_D_MIN)
@@ -88,7 +138,27 @@ def u_bound(design: TubeDesign, x, alpha, gamma_l, gamma_u, u_ref, unit: float) 
 
 
 def status_certain(design: TubeDesign, x, alpha, gamma_l, gamma_u, unit: float) -> np.ndarray:
-    """Whether the inside/outside status cannot depend on rounding, shape (N,)."""
+    """Whether the inside/outside status cannot depend on rounding, shape (N,).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    x : array_like, shape (N, n)
+        States, state units.
+    alpha : array_like, shape (N, 2n)
+        ``alpha`` at the points.
+    gamma_l, gamma_u : ndarray, shape (N, n)
+        The reference's adaptive tube, state units.
+    unit : float
+        Unit roundoff of the generated code's precision.
+
+    Returns
+    -------
+    ndarray of bool, shape (N,)
+        True where every ``|e_i|`` is clear of 1 by more than its rounding error and the
+        tube is wider than its own.
+    """
     x = np.atleast_2d(x)
     dg = gamma_bound(design, alpha, unit)
     width = gamma_u - gamma_l
@@ -100,14 +170,44 @@ def status_certain(design: TubeDesign, x, alpha, gamma_l, gamma_u, unit: float) 
 
 
 def alpha_bound(design: TubeDesign, alpha, alpha_next, unit: float) -> np.ndarray:
-    """Bound on the error of ``alpha_next``, shape (N, 2n)."""
+    """Bound on the error of ``alpha_next``, shape (N, 2n).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    alpha : array_like, shape (N, 2n)
+        ``alpha`` at the points.
+    alpha_next : ndarray, shape (N, 2n)
+        The reference's next ``alpha``.
+    unit : float
+        Unit roundoff of the generated code's precision.
+
+    Returns
+    -------
+    ndarray, shape (N, 2n)
+        State units.
+    """
     alpha = np.atleast_2d(alpha)
     return GAMMA_FACTOR * unit * (scale(design, alpha)[:, None] + np.abs(alpha)
                                   + np.abs(alpha_next))
 
 
 def with_double_floor(bound: np.ndarray, reference: np.ndarray) -> np.ndarray:
-    """``max(bound, 1e-12 max(1, |reference|))``: the double tolerance of the vectors."""
+    """``max(bound, 1e-12 max(1, |reference|))``: the double tolerance of the vectors.
+
+    Parameters
+    ----------
+    bound : ndarray
+        A rounding-error bound.
+    reference : ndarray
+        The reference value it is for, the shape of ``bound``.
+
+    Returns
+    -------
+    ndarray
+        The floored bound.
+    """
     return np.maximum(bound, DOUBLE_FLOOR * np.maximum(1.0, np.abs(reference)))
 
 
@@ -182,6 +282,32 @@ def cascade_bounds(design: TubeDesign, stage, x1, x2, t, alpha, r_ref, alpha_nex
 
     Where ``e +- de`` reaches ``+-E_MAX`` the bound covers the clamped value and is as wide
     as ``g``'s range there (the computed state may be outside the tube).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The first stage's tube.
+    stage : SecondStage
+        The second stage (gains ``k1``, ``k2``, velocity tube).
+    x1, x2 : array_like, shape (N, n)
+        Positions and velocities.
+    t : array_like, shape (N,)
+        Times, s.
+    alpha : array_like, shape (N, 2n)
+        ``alpha`` at the points.
+    r_ref : ndarray, shape (N, n)
+        The reference's virtual velocity ``r``.
+    alpha_next : ndarray, shape (N, 2n)
+        The reference's next ``alpha``.
+    unit : float
+        Unit roundoff of the generated code's precision.
+
+    Returns
+    -------
+    tol_u, tol_r : ndarray, shape (N, n)
+        Bounds on the errors of ``u`` and ``r``.
+    tol_alpha : ndarray, shape (N, 2n)
+        Bound on the error of ``alpha_next``.
     """
     import dataclasses
 

@@ -31,6 +31,8 @@ from ..tube.parameters import TubeDesign
 from . import tolerance as T
 from .errors import CodegenError
 
+__all__ = ["BATCH", "INSIDE", "OUTSIDE", "ROUNDS", "sample_inputs", "test_vectors"]
+
 INSIDE = 48
 OUTSIDE = 8
 SEED = 20240531
@@ -57,6 +59,12 @@ def sample_inputs(design: TubeDesign, precision: str = "single") -> dict[str, np
     design : TubeDesign
     precision : {"single", "double"}
         Every point's status is certain in this precision.
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``x`` (N, n), ``t`` (N,) s, ``dt`` (N,) s, ``alpha`` (N, 2n), float32-exact values,
+        :data:`INSIDE` points inside the tube and :data:`OUTSIDE` outside, in the order drawn.
 
     Raises
     ------
@@ -139,6 +147,13 @@ def _clamp_certain(design: TubeDesign, x, t, alpha, g_l, g_u, unit: float) -> np
 
 def test_vectors(design: TubeDesign, precision: str) -> dict:
     """Inputs, expected outputs and tolerances of every vector, as JSON-ready lists.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    precision : str
+        ``"double"`` or ``"single"``: the tolerances are for that precision.
 
     Returns
     -------

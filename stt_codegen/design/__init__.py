@@ -6,3 +6,5 @@ Contract: :func:`.search.design_tube` turns a :class:`~stt_codegen.spec.Spec` in
 raises :class:`~stt_codegen.errors.DesignError` with the reason, its
 :class:`.failures.FailureKind` and the best rejected tube. See ``docs/design.md``.
 """
+
+__all__: list[str] = []

@@ -42,6 +42,8 @@ from .result import METHOD_PAPER, METHOD_VIA, Design
 from .samples import HORIZON_FACTOR, STEP_BUDGET
 from .windows import SHARPNESS_LADDER
 
+__all__ = ["design_within_bound"]
+
 #: The ``prescribed_time`` search tries up to this many times the spec's ``t_c``.
 MAX_TIME_FACTOR = 16.0
 #: A longer ``t_c`` must lower the best peak-to-bound ratio by at least this factor, or the

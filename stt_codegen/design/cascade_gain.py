@@ -36,6 +36,9 @@ from ..tube import reference
 from ..tube.parameters import TubeDesign
 from ..tube.second_stage import SecondStage
 
+__all__ = ["INNER_STEP_FRACTION", "cascade_rate", "cascade_rate_words", "derived_second_stage",
+           "law_slope_growth", "transform_slope_growth"]
+
 #: ``omega2 dt`` at ``lambda = g_max``.
 INNER_STEP_FRACTION = 0.1
 #: ``omega2,min / omega1``.
@@ -123,13 +126,35 @@ CONSIDERED_E2 = 0.96
 
 def transform_slope_growth(e2: float) -> float:
     """``d epsilon2/d e2`` at ``e2`` over its value at 0: ``1 / (1 - e2^2)`` (the slope of
-    ``epsilon2 = ln((1+e2)/(1-e2))`` is ``2 / (1 - e2^2)``)."""
+    ``epsilon2 = ln((1+e2)/(1-e2))`` is ``2 / (1 - e2^2)``).
+
+    Parameters
+    ----------
+    e2 : float
+        The second stage's normalized error, ``|e2| < 1``.
+
+    Returns
+    -------
+    float
+        ``1 / (1 - e2^2)``, at least 1.
+    """
     return 1.0 / (1.0 - e2 * e2)
 
 
 def law_slope_growth(e2: float) -> float:
     """``d u/d z`` at ``e2`` over its value at 0, for ``u = -k2 xi2 epsilon2`` with ``xi2 =
-    2 / (rho2 (1 - e2^2))`` also depending on ``z``: ``(1 + e2 epsilon2) / (1 - e2^2)^2``."""
+    2 / (rho2 (1 - e2^2))`` also depending on ``z``: ``(1 + e2 epsilon2) / (1 - e2^2)^2``.
+
+    Parameters
+    ----------
+    e2 : float
+        The second stage's normalized error, ``|e2| < 1``.
+
+    Returns
+    -------
+    float
+        ``(1 + e2 epsilon2) / (1 - e2^2)^2``, at least 1.
+    """
     eps = math.log((1.0 + e2) / (1.0 - e2))
     return (1.0 + e2 * eps) / (1.0 - e2 * e2) ** 2
 
@@ -216,7 +241,18 @@ def cascade_rate(stage: SecondStage, input_gain: tuple, min_width: float, rate_h
 
 
 def cascade_rate_words(rate: dict) -> str:
-    """:func:`cascade_rate`'s figures in one sentence (``cascade.rate``'s detail)."""
+    """:func:`cascade_rate`'s figures in one sentence (``cascade.rate``'s detail).
+
+    Parameters
+    ----------
+    rate : dict
+        What :func:`cascade_rate` returns.
+
+    Returns
+    -------
+    str
+        One sentence: the inner and outer loops' factors, the lowest rate and the verdict.
+    """
     lo, hi = rate["inner_factors"]
     glo, ghi = rate["inner_factors_grown"]
     llo, lhi = rate["inner_factors_law_slope"]

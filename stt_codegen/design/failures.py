@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from enum import Enum
 
+__all__ = ["FailureKind", "property_kind"]
+
 
 class FailureKind(Enum):
     """What made a tube (or the design search) fail.
@@ -53,7 +55,24 @@ class FailureKind(Enum):
 
 
 def property_kind(name: str) -> FailureKind:
-    """The kind of a failed certificate property (``Margin.name``, e.g. ``avoids obstacle 2``)."""
+    """The kind of a failed certificate property (``Margin.name``, e.g. ``avoids obstacle 2``).
+
+    Parameters
+    ----------
+    name : str
+        A certificate property's name (a :data:`~.certificate.report.PROPERTIES` entry, or
+        one with an obstacle's or task's number appended).
+
+    Returns
+    -------
+    FailureKind
+        The kind a failure of that property is reported with.
+
+    Raises
+    ------
+    ValueError
+        ``name`` is no certificate property.
+    """
     if name.startswith(FailureKind.MOVING_OBSTACLE.value):
         return FailureKind.MOVING_OBSTACLE
     if name.startswith(FailureKind.OBSTACLE.value):

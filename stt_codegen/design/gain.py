@@ -22,6 +22,8 @@ from __future__ import annotations
 from ..spec.loader import Assumptions
 from ..tube.parameters import TubeDesign
 
+__all__ = ["derived_gain", "gain_derivation"]
+
 
 def derived_gain(min_width: float, rate_hz: float, assumptions: Assumptions) -> float:
     """Default ``k`` of law (13): ``gamma_d,min^2 / (8 dt (g_min + g_max))``.

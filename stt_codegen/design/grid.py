@@ -11,9 +11,22 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+__all__ = ["grid_index", "grid_value", "smallest_passing"]
+
 
 def grid_index(value: float) -> int:
-    """Index of the smallest two-significant-digit number ``>= value`` (``value > 0``)."""
+    """Index of the smallest two-significant-digit number ``>= value`` (``value > 0``).
+
+    Parameters
+    ----------
+    value : float
+        A positive number (a rate in Hz, a time in s).
+
+    Returns
+    -------
+    int
+        ``90 e + m - 10`` for the smallest ``m 10^e >= value``, ``10 <= m <= 99``.
+    """
     e = math.floor(math.log10(value)) - 1
     m = math.ceil(value / 10.0 ** e * (1.0 - 1e-12))
     if m >= 100:
@@ -22,14 +35,40 @@ def grid_index(value: float) -> int:
 
 
 def grid_value(index: int) -> float:
-    """The number of index ``index`` (:func:`grid_index`'s inverse on the grid)."""
+    """The number of index ``index`` (:func:`grid_index`'s inverse on the grid).
+
+    Parameters
+    ----------
+    index : int
+        A grid index.
+
+    Returns
+    -------
+    float
+        ``m 10^e`` with ``e, m - 10 = divmod(index, 90)``.
+    """
     e, m = divmod(index, 90)
     return float(f"{m + 10}e{e}")
 
 
 def smallest_passing(passes: Callable[[int], bool], low: int, high: int) -> int:
     """The smallest index in ``(low, high]`` at which ``passes`` holds, by bisection, given
-    that it fails at ``low`` and holds at ``high`` (and is monotone between them)."""
+    that it fails at ``low`` and holds at ``high`` (and is monotone between them).
+
+    Parameters
+    ----------
+    passes : callable
+        ``passes(index) -> bool``, monotone in the index.
+    low : int
+        An index at which ``passes`` fails.
+    high : int
+        An index at which ``passes`` holds, ``high > low``.
+
+    Returns
+    -------
+    int
+        The smallest passing index in ``(low, high]``.
+    """
     while high - low > 1:
         mid = (low + high) // 2
         if passes(mid):

@@ -35,6 +35,9 @@ if TYPE_CHECKING:
 
     from ..spec.loader import Spec
 
+__all__ = ["InputProof", "InputProver", "input_peak", "input_prover", "phi",
+           "register_input_prover"]
+
 
 @dataclass(frozen=True)
 class InputProof:
@@ -85,7 +88,18 @@ class InputProof:
 
 
 def phi(s: "np.ndarray") -> "np.ndarray":
-    """``|u_i| gamma_d_i / (4 k)`` of law (13) at ``|e_i| = s``: ``2 atanh(s) / (1 - s^2)``."""
+    """``|u_i| gamma_d_i / (4 k)`` of law (13) at ``|e_i| = s``: ``2 atanh(s) / (1 - s^2)``.
+
+    Parameters
+    ----------
+    s : ndarray
+        ``|e_i|`` in ``[0, 1)``, any shape; clamped at ``E_MAX`` as the deployed law is.
+
+    Returns
+    -------
+    ndarray, the shape of ``s``
+        ``2 atanh(s) / (1 - s^2)``, non-negative.
+    """
     import numpy as np
     s = np.minimum(np.asarray(s, dtype=float), E_MAX)
     return 2.0 * np.arctanh(s) / (1.0 - s * s)
@@ -130,12 +144,24 @@ _PROVERS: list[InputProver] = []
 
 
 def register_input_prover(prover: InputProver) -> None:
-    """Make ``prover`` the one the design asks (:mod:`stt_codegen.verify` registers its own)."""
+    """Make ``prover`` the one the design asks (:mod:`stt_codegen.verify` registers its own).
+
+    Parameters
+    ----------
+    prover : InputProver
+        A callable returning an :class:`InputProof` for a designed tube and a spec; it
+        replaces any registered before.
+    """
     _PROVERS[:] = [prover]
 
 
 def input_prover() -> InputProver:
     """The registered prover.
+
+    Returns
+    -------
+    InputProver
+        The prover last registered by :func:`register_input_prover`.
 
     Raises
     ------

@@ -74,7 +74,18 @@ TASK_HOLD_SHARE = 0.25
 
 
 def static_part(spec: Spec) -> Spec:
-    """``spec`` without its moving obstacles (what the static design search sees)."""
+    """``spec`` without its moving obstacles (what the static design search sees).
+
+    Parameters
+    ----------
+    spec : Spec
+        A spec, with or without moving obstacles.
+
+    Returns
+    -------
+    Spec
+        The same spec with ``moving_obstacles`` empty.
+    """
     return replace(spec, moving_obstacles=())
 
 
@@ -120,7 +131,22 @@ def partial_spec(spec: Spec, position: int, t_a: float, t_b: float) -> Spec | No
     ``[t_a, t_b]`` (met with its active interval, clipped to the state space) as a static
     obstacle: a spec to *plan* a detour on (the re-timing and the check still see the
     obstacle moving). ``None`` when that box meets the initial or the target set, or the
-    interval misses the active one."""
+    interval misses the active one.
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec.
+    position : int
+        Index of the moving obstacle in ``spec.moving_obstacles``.
+    t_a, t_b : float
+        The time interval swept, s, ``t_a < t_b`` for a non-empty sweep.
+
+    Returns
+    -------
+    Spec or None
+        The static spec with the swept box added, or None.
+    """
     ob = spec.moving_obstacles[position]
     a, b = max(t_a, ob.active[0]), min(t_b, ob.active[1])
     if not a < b:
@@ -141,7 +167,18 @@ def partial_spec(spec: Spec, position: int, t_a: float, t_b: float) -> Spec | No
 def routes(count: int) -> list[tuple[int, ...]]:
     """The sets of moving obstacles to go around (swept) while timing the others, in the
     order tried: none first, then by size, then by index; the set of all is not among
-    them (that is the swept step); at most :data:`MAX_ROUTES`."""
+    them (that is the swept step); at most :data:`MAX_ROUTES`.
+
+    Parameters
+    ----------
+    count : int
+        Number of moving obstacles.
+
+    Returns
+    -------
+    list of tuple of int
+        Each a set of indices into ``spec.moving_obstacles``, increasing.
+    """
     out = [c for size in range(count) for c in combinations(range(count), size)]
     return out[:MAX_ROUTES]
 
@@ -223,6 +260,13 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec) -> tuple[ReachSegment
     :data:`DURATION_FACTORS`: it may start at any step and last any number of steps such
     that the held interval serves its task (:func:`_hold_ok`) and the box keeps clear over
     it; the waits before and after it are free.
+
+    Parameters
+    ----------
+    segments : tuple of ReachSegment
+        The static plan's segments (via boxes), in order.
+    spec : Spec
+        The spec with its moving obstacles (and tasks).
 
     Returns
     -------

@@ -17,6 +17,8 @@ import numpy as np
 
 from ..spec.loader import Spec
 
+__all__ = ["plant_failure"]
+
 #: Heading range of the omnidirectional robot (eq. (14)) where ``g_s`` is positive
 #: definite: ``g_s = diag(cos x3, cos x3, 1)`` (docs/decisions.md, decision 10).
 HALF_PI = math.pi / 2
@@ -73,6 +75,16 @@ def plant_failure(spec: Spec) -> str:
     The ``linear`` model's ``plant.g`` (:func:`linear_plant_failure`) and the
     omnidirectional robot's heading range, the third dimension of the state space
     (:func:`heading_range_failure`). The single integrator (``g = I``) always holds.
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec (its plant model, ``plant.g`` and state space).
+
+    Returns
+    -------
+    str
+        The reason, naming the violated condition of Assumption 2, or ``""``.
     """
     if spec.plant_model == "linear" and spec.linear_plant is not None:
         return linear_plant_failure(spec.linear_plant.g)

@@ -18,6 +18,8 @@ from .input_bound import InputProof
 if TYPE_CHECKING:
     from ..spec.loader import Spec
 
+__all__ = ["Design", "METHOD_PAPER", "METHOD_VIA", "TubeCheck", "require_design"]
+
 #: The reach-tube methods a design can use (``tube.method`` of the spec picks among them).
 METHOD_PAPER = "paper"
 METHOD_VIA = "via"

@@ -16,6 +16,8 @@ from ..tube import reference
 from ..tube.model import alpha_trajectory_function
 from ..tube.parameters import TubeDesign
 
+__all__ = ["HORIZON_FACTOR", "STEP_BUDGET", "TubeSamples", "check_step_budget", "sample_tube"]
+
 #: Default horizon of a sampled tube, as a multiple of ``t_c``.
 HORIZON_FACTOR = 1.1
 #: Most controller steps a per-sample computation (:func:`sample_tube`, ``simulate``)
@@ -25,6 +27,15 @@ STEP_BUDGET = 1_000_000
 
 def check_step_budget(steps: int, horizon: float, rate_hz: float) -> None:
     """Refuse a per-sample run of more than :data:`STEP_BUDGET` steps.
+
+    Parameters
+    ----------
+    steps : int
+        The number of sampling periods of the run.
+    horizon : float
+        The run's length, s.
+    rate_hz : float
+        The sampling rate, Hz.
 
     Raises
     ------
@@ -40,7 +51,19 @@ def check_step_budget(steps: int, horizon: float, rate_hz: float) -> None:
 
 @dataclass(frozen=True)
 class TubeSamples:
-    """The tube sampled on a grid: ``t`` (N,), ``alpha`` (N, 2n), ``gamma_*`` (N, n)."""
+    """The tube sampled on a grid: ``t`` (N,), ``alpha`` (N, 2n), ``gamma_*`` (N, n).
+
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        The sampling instants ``k / rate_hz``, s, from 0.
+    alpha : ndarray, shape (N, 2n)
+        ``[alpha_L, alpha_U]`` of eq. (11) at each instant, state units.
+    gamma_lower, gamma_upper : ndarray, shape (N, n)
+        The adaptive tube ``gamma_L``, ``gamma_U`` of eq. (10), state units.
+    gamma_lower_dot, gamma_upper_dot : ndarray, shape (N, n)
+        Their time derivatives along the adaptive law, state units/s.
+    """
 
     t: np.ndarray
     alpha: np.ndarray
@@ -61,6 +84,11 @@ def sample_tube(design: TubeDesign, horizon: float | None = None) -> TubeSamples
     design : TubeDesign
     horizon : float, optional
         End time, seconds; default ``HORIZON_FACTOR * t_c``.
+
+    Returns
+    -------
+    TubeSamples
+        The tube at ``N = ceil(horizon rate_hz) + 1`` instants.
 
     Raises
     ------

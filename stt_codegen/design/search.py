@@ -42,6 +42,9 @@ from .tasks import alternatives, plan_tasks
 from .via import via_design
 from .windows import WINDOW_INFLATION, candidates, overlap_interval, progress_time
 
+__all__ = ["MAX_INITIAL_ERROR", "MAX_MOVE_PER_SAMPLE", "base_design", "check_tube", "design_tube",
+           "paper_design"]
+
 #: Largest ``|e_i|`` of ``x(0)`` in the tube at ``t = 0``: near the tube's edge law (13)
 #: is so steep that the first sampled step overshoots (measured: at ``|e| ~ 1`` the
 #: first input was 1e8 and the state left the arena in one period).
@@ -178,7 +181,20 @@ def lowest_passing_rate(tube: TubeDesign, spec: Spec) -> float | None:
 
 
 def base_design(spec: Spec, gain: float = 1.0) -> TubeDesign:
-    """The design without circumvents, from the spec's boxes and parameters."""
+    """The design without circumvents, from the spec's boxes and parameters.
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec (its sets, tube parameters and rate).
+    gain : float
+        The gain ``k`` of law (13).
+
+    Returns
+    -------
+    TubeDesign
+        The paper's reach tube (4) from ``X_0``-hat (2) to ``T``-hat (3), no circumvents.
+    """
     x0, d0 = spec.initial_state, spec.initial_half_width
     eta, d_t = spec.target_center, target_half_width(spec)
     return TubeDesign(

@@ -40,6 +40,8 @@ from ..tube.parameters import SMOOTHSTEP, ReachSegment, TubeDesign, paper_segmen
 from .failures import FailureKind
 from .via import plan_via
 
+__all__ = ["STAY_LEAD", "alternatives", "plan_tasks"]
+
 #: A waypoint box's half-width, at most this share of the task box's.
 TASK_BOX_SHARE = 0.6
 #: Room kept between a waypoint box and its task box's walls, share of the task box's

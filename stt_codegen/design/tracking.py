@@ -37,6 +37,9 @@ from ..tube.parameters import TubeDesign
 from .certificate import Certificate
 from .input_bound import input_prover
 
+__all__ = ["SMOOTHER_RATIO", "TRACKING_ERROR", "centre_speed", "proved_error", "tracking_demand",
+           "unfollowable"]
+
 #: The normalized error the demand is computed for (issue 20's acceptance: ``max |e| <=
 #: 0.7`` in closed loop).
 TRACKING_ERROR = 0.7
@@ -139,6 +142,18 @@ def proved_error(design: TubeDesign, spec: Spec) -> float:
     for the plants of ``spec`` (``InputProof.max_abs_e`` of the registered prover), ``-inf``
     when the proof fails (it cannot tell). Cached per ``(design, spec)``: the same bundled
     design is asked for again and again in one process, and the proof takes 0.2-1 s.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube with its gain.
+    spec : Spec
+        The spec (its ``[assumptions]``, the plants the proof covers).
+
+    Returns
+    -------
+    float
+        The bound, in ``[0, 1)`` when proved, else ``-inf``.
 
     Raises
     ------

@@ -37,6 +37,8 @@ from ..spec.loader import Spec
 from .failures import FailureKind
 from ..tube.parameters import SMOOTHSTEP, ReachSegment, TubeDesign
 
+__all__ = ["VIA_MARGIN", "plan_via", "via_design"]
+
 #: Largest half-width of a via box, state units.
 VIA_HALF_WIDTH = 0.1
 #: Clearance kept between a move's bounding box and every obstacle, state units.
@@ -285,5 +287,23 @@ def _timed(path: list, nodes: dict, prescribed_time: float) -> ViaPlan:
 
 
 def via_design(spec: Spec, base: TubeDesign) -> TubeDesign:
-    """``base`` with its reach tube replaced by the via-point segments of :func:`plan_via`."""
+    """``base`` with its reach tube replaced by the via-point segments of :func:`plan_via`.
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec.
+    base : TubeDesign
+        The design without circumvents (:func:`~.search.base_design`).
+
+    Returns
+    -------
+    TubeDesign
+        ``base`` through the via points, without circumvents.
+
+    Raises
+    ------
+    DesignError
+        :func:`plan_via` finds no path.
+    """
     return replace(base, segments=plan_via(spec, base).segments(), circumvents=())

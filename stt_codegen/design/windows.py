@@ -23,6 +23,9 @@ from ..tube import reference
 from ..tube.parameters import LOWER, UPPER, Circumvent, TubeDesign
 from .certificate import MAX_MOVE_PER_SAMPLE
 
+__all__ = ["SHARPNESS_LADDER", "WINDOW_INFLATION", "candidates", "overlap_interval",
+           "progress_time"]
+
 #: Obstacles are inflated by this fraction of ``delta_b`` to compute overlap windows.
 WINDOW_INFLATION = 0.5
 #: Circumvent sharpness values ``k^j`` the automatic choice picks from, sharpest first.
@@ -64,6 +67,20 @@ def overlap_interval(design: TubeDesign, box: Box, margin: float) -> tuple[float
     The robust reading of eq. (5): the intersection over dimensions of
     :func:`dimension_interval`, with ``box`` inflated by ``margin``. ``None`` when the
     tube never meets the inflated box.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (its reach segments).
+    box : Box
+        An obstacle box.
+    margin : float
+        Inflation of ``box`` on every side, state units.
+
+    Returns
+    -------
+    (float, float) or None
+        ``(s_1, s_2)``, ``0 <= s_1 <= s_2 <= 1``, or None.
     """
     lo, hi = 0.0, 1.0
     for i in range(design.dimension):
@@ -75,7 +92,20 @@ def overlap_interval(design: TubeDesign, box: Box, margin: float) -> tuple[float
 
 
 def progress_time(design: TubeDesign, s: float) -> float:
-    """Inverse of ``s = tanh(t/(t_c - t))``: ``t = t_c a / (1 + a)``, ``a = atanh(s)``."""
+    """Inverse of ``s = tanh(t/(t_c - t))``: ``t = t_c a / (1 + a)``, ``a = atanh(s)``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (its prescribed time ``t_c``).
+    s : float
+        Progress in ``[0, 1]`` (1 and above give ``t_c``).
+
+    Returns
+    -------
+    float
+        The time ``t``, s, in ``[0, t_c]``.
+    """
     if s >= 1.0:
         return design.prescribed_time
     a = math.atanh(max(s, 0.0))
@@ -88,6 +118,22 @@ def candidates(design: TubeDesign, spec: Spec, j: int, delta_b: float) -> list[C
     Order: dimensions where the reach tube overlaps the obstacle's projection for the
     longest part of ``[0, 1]`` in ``s`` first, then the side that needs the bound to
     move least at the middle of the window, then dimension index.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The design the circumvents are added to (its reach tube).
+    spec : Spec
+        The spec (state space and obstacle boxes).
+    j : int
+        Index of the obstacle box in ``spec.obstacle_boxes()``.
+    delta_b : float
+        ``delta_B`` of eqs. (7)-(8), the clearance kept from the obstacle, state units.
+
+    Returns
+    -------
+    list of Circumvent
+        Empty when the reach tube never comes near the box.
     """
     box = spec.obstacle_boxes()[j]
     margin = WINDOW_INFLATION * delta_b

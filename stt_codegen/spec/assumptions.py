@@ -141,6 +141,13 @@ def combine_assumptions(bounds: ModelBounds, declared: Mapping[str, object], n: 
     prefix : str
         Field prefix for errors.
 
+    Returns
+    -------
+    Assumptions
+        The bounds the design uses: a declared bound where given (never tighter than the
+        model's: that is refused), the model's otherwise; its notes name each declared value
+        wider than the model's.
+
     Raises
     ------
     SpecError

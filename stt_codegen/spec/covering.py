@@ -36,6 +36,8 @@ import numpy as np
 
 from ..errors import SpecError
 
+__all__ = ["MAX_BOXES", "MERGE_WINDOW", "cover"]
+
 #: At most this many boxes per shape (counted before merging).
 MAX_BOXES = 256
 #: A box may merge with one of this many boxes accepted just before it.

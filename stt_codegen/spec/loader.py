@@ -35,6 +35,9 @@ from .second_order import SecondOrder, parse_second_order
 from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
                      PlantTable, PolytopeObstacle, check_document, value_kind)
 
+__all__ = ["Assumptions", "Box", "LinearPlant", "NAME_PATTERN", "Obstacle", "Spec", "UnsafeSet",
+           "bundled_cases", "load_spec", "parse_spec"]
+
 NAME_PATTERN = re.compile(NAME_REGEX)
 #: Fraction of the available room used by the default half-widths ``d_0`` and ``d_T``.
 DEFAULT_HALF_WIDTH_FRACTION = 0.8
@@ -449,9 +452,21 @@ def load_spec(spec: str | Path) -> Spec:
 def parse_spec(data: bytes | str) -> Spec:
     """Validate the text of a spec file; see :func:`load_spec`.
 
+    Parameters
+    ----------
+    data : bytes or str
+        The TOML text of a spec file (``bytes`` must be UTF-8).
+
+    Returns
+    -------
+    Spec
+        The validated spec; its hash is the SHA-256 of the UTF-8 text.
+
     Raises
     ------
     SpecError
+        Text that is not UTF-8 or not TOML (field ``""``), or a field that fails validation
+        (the error names the field and the reason).
     """
     raw = data.encode("utf-8") if isinstance(data, str) else bytes(data)
     try:

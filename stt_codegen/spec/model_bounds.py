@@ -28,7 +28,8 @@ import math
 from dataclasses import dataclass
 from typing import Sequence
 
-__all__ = ["ModelBounds", "model_bounds", "row_coupling", "symmetric_eigen_range", "REL_PAD"]
+__all__ = ["ModelBounds", "model_bounds", "row_coupling", "symmetric_eigen_range", "REL_PAD",
+           "EXACT_DRIFT_DIMENSIONS"]
 
 #: Relative outward widening of every computed bound (rounding of ``cos``, ``sin`` and of
 #: the Jacobi eigenvalue iteration is far below it).
@@ -160,6 +161,14 @@ def symmetric_eigen_range(g: Sequence[Sequence[float]]) -> tuple[float, float, f
     Parameters
     ----------
     g : sequence of sequence of float, shape (n, n)
+
+    Returns
+    -------
+    lambda_min, lambda_max : float
+        Smallest and largest eigenvalue of the symmetric part ``(g + g^T)/2``, widened
+        outward.
+    skew_norm : float
+        Spectral norm of the skew part ``(g - g^T)/2``, rounded up (0 for a symmetric ``g``).
     """
     n = len(g)
     sym = [[(g[i][j] + g[j][i]) / 2 for j in range(n)] for i in range(n)]
@@ -183,6 +192,11 @@ def row_coupling(g: Sequence[Sequence[float]]) -> float:
     Parameters
     ----------
     g : sequence of sequence of float, shape (n, n)
+
+    Returns
+    -------
+    float
+        ``max_i sqrt(sum_{j != i} g_ij^2)``, rounded up; 0 for ``n = 1``.
     """
     n = len(g)
     return _up(max((math.sqrt(sum(g[i][j] ** 2 for j in range(n) if j != i))

@@ -39,6 +39,8 @@ import numpy as np
 
 from ..errors import SpecError
 
+__all__ = ["MovingObstacle", "check_moving", "is_moving", "moving_obstacle"]
+
 #: Relative tolerance on a path's first centre against the centre of ``lower``/``upper``.
 CENTRE_TOLERANCE = 1e-9
 
@@ -182,7 +184,19 @@ class MovingObstacle:
 
 
 def is_moving(table: Any) -> bool:
-    """Whether an ``[[obstacles]]`` entry (validated by the schema) moves or has ``active``."""
+    """Whether an ``[[obstacles]]`` entry (validated by the schema) moves or has ``active``.
+
+    Parameters
+    ----------
+    table : BoxObstacle
+        One validated ``[[obstacles]]`` table (any table kind: only ``active``, ``velocity``
+        and ``path`` are read).
+
+    Returns
+    -------
+    bool
+        True if any of ``active``, ``velocity``, ``path`` is given.
+    """
     return any(getattr(table, key, None) is not None for key in ("active", "velocity", "path"))
 
 
@@ -298,6 +312,19 @@ def moving_obstacle(table: Any, name: str, source: int, dims: tuple[int, ...],
 def check_moving(obstacle: MovingObstacle, name: str, initial_set: Any, target_set: Any,
                  prescribed_time: float) -> None:
     """The moving box misses ``X_0`` at ``t = 0`` and ``T`` at every ``t >= t_c``.
+
+    Parameters
+    ----------
+    obstacle : MovingObstacle
+        The moving box.
+    name : str
+        Its field name in errors (``obstacles[i]``).
+    initial_set : Box
+        The initial set ``X_0`` (``lower``/``upper`` of shape (n,), state units).
+    target_set : Box
+        The target ``T`` (``lower``/``upper`` of shape (n,), state units).
+    prescribed_time : float
+        The prescribed time ``t_c``, s.
 
     Raises
     ------

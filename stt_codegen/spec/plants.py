@@ -74,7 +74,21 @@ MODEL_KEYS: dict[str, str] = {key: name for name, p in PLANTS.items() for key in
 @dataclass(frozen=True)
 class SecondOrderModel:
     """A named second-order model: its dimension (``None``: any), a summary, parameter
-    names and nominal parameter values (SI units)."""
+    names and nominal parameter values (SI units).
+
+    Attributes
+    ----------
+    name : str
+        The ``plant.model`` name.
+    summary : str
+        One line describing the model.
+    dimension : int or None
+        Number of positions ``n`` (the state has ``2 n``); None: any ``n``.
+    parameters : tuple of str
+        Names of the model's ``plant.parameters``, in order.
+    nominal : tuple of float
+        Their nominal values, SI units.
+    """
 
     name: str
     summary: str
@@ -104,7 +118,19 @@ ALL_PLANT_MODELS: tuple[str, ...] = PLANT_MODELS + SECOND_ORDER_MODELS
 
 
 def is_second_order(model: str) -> bool:
-    """Whether ``plant.model`` names a second-order model (order 2: the cascade law)."""
+    """Whether ``plant.model`` names a second-order model (order 2: the cascade law).
+
+    Parameters
+    ----------
+    model : str
+        A ``plant.model`` name.
+
+    Returns
+    -------
+    bool
+        True for a second-order model (:data:`SECOND_ORDER_PLANTS`), False otherwise (also
+        for an unknown name).
+    """
     return model in SECOND_ORDER_PLANTS
 
 
@@ -118,6 +144,11 @@ def dimension_mismatch(model: str, n: int) -> str | None:
         A :data:`ALL_PLANT_MODELS` entry.
     n : int
         State dimension (positions, for a second-order model).
+
+    Returns
+    -------
+    str or None
+        The reason, naming the model's and the state space's dimension, or None.
     """
     if model in SECOND_ORDER_PLANTS:
         positions = SECOND_ORDER_PLANTS[model].dimension

@@ -25,6 +25,10 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Discriminator, Field, 
 from ..errors import SpecError
 from .plants import ALL_PLANT_MODELS, PLANTS, SECOND_ORDER_PLANTS
 
+__all__ = ["ActuatorTable", "AssumptionsTable", "BallObstacle", "BoxObstacle", "BoxTable",
+           "NAME_REGEX", "PlantTable", "PolytopeObstacle", "check_document", "json_schema",
+           "value_kind"]
+
 #: Largest magnitude of any number in a spec.
 MAX_MAGNITUDE = 1e12
 #: Default covering tolerance of balls and polytopes (Remark 3.1), state units.
@@ -105,8 +109,8 @@ class TargetTable(BoxTable):
 class BoxObstacle(_Table):
     """A box obstacle; given on the dimensions ``dims`` (default the first ones)."""
 
-    lower: Vector
-    upper: Vector
+    lower: Vector = Field(description="lower corner on dims, state units")
+    upper: Vector = Field(description="upper corner on dims, state units; upper >= lower")
     dims: list[Index] = _omitted("state dimensions of lower/upper (default the first ones); "
                                  "the box spans the others")
     # moving obstacles (issue 21, docs/moving-obstacles.md; cross-field rules: spec/motion.py)
@@ -123,8 +127,8 @@ class BoxObstacle(_Table):
 class BallObstacle(_Table):
     """A ball obstacle, covered by boxes (Remark 3.1)."""
 
-    center: Vector
-    radius: Positive
+    center: Vector = Field(description="centre on dims, state units")
+    radius: Positive = Field(description="radius, state units")
     dims: list[Index] = _omitted("state dimensions of the coordinates (default the first "
                                  "ones)")
     tolerance: Positive = Field(DEFAULT_TOLERANCE, description="largest distance from the "
@@ -135,7 +139,8 @@ class BallObstacle(_Table):
 class PolytopeObstacle(_Table):
     """A convex polytope obstacle given by its vertices, covered by boxes (Remark 3.1)."""
 
-    vertices: Annotated[list[Vector], Field(min_length=1, max_length=MAX_VERTICES)]
+    vertices: Annotated[list[Vector], Field(min_length=1, max_length=MAX_VERTICES)] = Field(
+        description="the vertices on dims, state units; the obstacle is their convex hull")
     dims: list[Index] = _omitted("state dimensions of the coordinates (default the first "
                                  "ones)")
     tolerance: Positive = Field(DEFAULT_TOLERANCE, description="largest distance from the "
@@ -285,7 +290,13 @@ JSON_SCHEMA_DIALECT = "http://json-schema.org/draft-07/schema#"
 
 
 def json_schema() -> dict[str, Any]:
-    """The JSON Schema (draft 7) of a spec document, from :class:`SpecDocument`."""
+    """The JSON Schema (draft 7) of a spec document, from :class:`SpecDocument`.
+
+    Returns
+    -------
+    dict
+        The schema, with ``$schema`` naming draft 7; JSON-serialisable.
+    """
     return {"$schema": JSON_SCHEMA_DIALECT, **SpecDocument.model_json_schema()}
 
 
@@ -324,7 +335,19 @@ def _allowed(loc: tuple) -> list[str]:
 
 
 def value_kind(value: Any) -> str:
-    """What a value is, in TOML's words (``"an array"``, ``"a table"``...)."""
+    """What a value is, in TOML's words (``"an array"``, ``"a table"``...).
+
+    Parameters
+    ----------
+    value : object
+        A value parsed from TOML.
+
+    Returns
+    -------
+    str
+        ``"a boolean"``, ``"a string"``, ``"an array"``, ``"a table"``, ``"an integer"``,
+        ``"a float"``, or the type's name for anything else (dates).
+    """
     return {bool: "a boolean", str: "a string", list: "an array", dict: "a table",
             int: "an integer", float: "a float"}.get(type(value), type(value).__name__)
 

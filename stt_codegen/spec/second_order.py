@@ -86,6 +86,7 @@ def parse_second_order(model: str, n: int, parameters: Sequence[float] | None = 
     model : str
         ``plant.model``, a :data:`SECOND_ORDER_MODELS` entry.
     n : int
+        Number of positions (the state space's dimension).
     parameters : sequence of float, optional
         ``plant.parameters`` (default the model's nominal ones).
     velocity : sequence of float, optional

@@ -14,6 +14,8 @@ import numpy as np
 
 from ..errors import SpecError
 
+__all__ = ["Ball", "MAX_POLYTOPE_DIMENSION", "Polytope", "make_polytope"]
+
 #: Largest number of coordinates (``dims``) a polytope obstacle may be given on.
 MAX_POLYTOPE_DIMENSION = 4
 #: Relative widening of an exact box hull (one and two dimensions), against rounding.
@@ -220,6 +222,18 @@ class Polytope:
 
 def make_polytope(vertices: list, name: str) -> Polytope:
     """Validate a vertex list and build the polytope.
+
+    Parameters
+    ----------
+    vertices : list of list of float, shape (v, k)
+        The vertices, state units, ``k <= MAX_POLYTOPE_DIMENSION``.
+    name : str
+        The obstacle's field name in errors (``obstacles[i]``).
+
+    Returns
+    -------
+    Polytope
+        The convex hull of the vertices.
 
     Raises
     ------

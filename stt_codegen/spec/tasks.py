@@ -25,6 +25,8 @@ from typing import Sequence
 
 from ..errors import SpecError
 
+__all__ = ["STAY", "Task", "build_tasks"]
+
 REACH = "reach"
 STAY = "stay"
 

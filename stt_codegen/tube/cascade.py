@@ -29,6 +29,9 @@ from .model import adaptive_tube, conflict_and_trigger, implicit_alpha_update
 from .parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .second_stage import SecondStage
 
+__all__ = ["CASCADE_OUTPUTS", "cascade_step", "velocity_law", "velocity_transform",
+           "velocity_tube"]
+
 #: The outputs of :func:`cascade_step`, in order.
 CASCADE_OUTPUTS = ("u", "alpha_next", "r", "inside_position", "inside_velocity")
 
@@ -66,7 +69,19 @@ def velocity_law_expression(x2, r, rho2, gain, n: int) -> tuple:
 
 @lru_cache(maxsize=None)
 def velocity_tube(n: int) -> ca.Function:
-    """``velocity_tube(t, width_start, width_floor, decay) -> rho2``."""
+    """``velocity_tube(t, width_start, width_floor, decay) -> rho2``.
+
+    Parameters
+    ----------
+    n : int
+        Number of positions; ``width_start``, ``width_floor``, ``rho2`` have ``n`` entries.
+
+    Returns
+    -------
+    casadi.Function
+        The velocity tube ``rho2(t) = (rho2(0) - rho2(inf)) exp(-l max(t, 0)) + rho2(inf)``
+        (velocity units), ``t`` in s, ``decay`` ``l`` in 1/s.
+    """
     t, decay = ca.SX.sym("t"), ca.SX.sym("decay")
     start, floor = ca.SX.sym("width_start", n), ca.SX.sym("width_floor", n)
     return ca.Function("velocity_tube", [t, start, floor, decay],
@@ -76,7 +91,20 @@ def velocity_tube(n: int) -> ca.Function:
 
 @lru_cache(maxsize=None)
 def velocity_law(n: int) -> ca.Function:
-    """``velocity_law(x2, r, rho2, gain) -> (u, inside)``."""
+    """``velocity_law(x2, r, rho2, gain) -> (u, inside)``.
+
+    Parameters
+    ----------
+    n : int
+        Number of positions; ``x2``, ``r``, ``rho2`` and ``u`` have ``n`` entries.
+
+    Returns
+    -------
+    casadi.Function
+        The second stage's law ``u = -gain xi2 epsilon2`` (the form of law (13) on the
+        velocity tube ``(r - rho2, r + rho2)``) and ``inside``, 1 when ``|x2 - r| < rho2``
+        entry by entry.
+    """
     x2, r, rho2 = (ca.SX.sym(name, n) for name in ("x2", "r", "rho2"))
     gain = ca.SX.sym("gain")
     u, inside = velocity_law_expression(x2, r, rho2, gain, n)
@@ -86,7 +114,19 @@ def velocity_law(n: int) -> ca.Function:
 
 @lru_cache(maxsize=None)
 def velocity_transform(n: int) -> ca.Function:
-    """``velocity_transform(x2, r, rho2) -> (e2, epsilon2, xi2)`` (for ``verify``)."""
+    """``velocity_transform(x2, r, rho2) -> (e2, epsilon2, xi2)`` (for ``verify``).
+
+    Parameters
+    ----------
+    n : int
+        Number of positions; every input and output has ``n`` entries.
+
+    Returns
+    -------
+    casadi.Function
+        The second stage's normalized error ``e2``, transformed error ``epsilon2`` and
+        ``xi2`` (1 / velocity units), with the clamps of the deployed law.
+    """
     x2, r, rho2 = (ca.SX.sym(name, n) for name in ("x2", "r", "rho2"))
     return ca.Function("velocity_transform", [x2, r, rho2],
                        list(velocity_transform_expression(x2, r, rho2)),

@@ -18,12 +18,28 @@ from . import reference
 from .parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .second_stage import SecondStage
 
+__all__ = ["cascade_step", "velocity_transform", "velocity_tube"]
+
 Array = np.ndarray
 
 
 def velocity_tube(stage: SecondStage, t) -> Array:
     """``rho2(t) = (rho2(0) - rho2(inf)) e^{-l t} + rho2(inf)`` for ``t >= 0`` (``rho2(0)``
-    before), shape (N, n), velocity units."""
+    before), shape (N, n), velocity units.
+
+    Parameters
+    ----------
+    stage : SecondStage
+        The second stage: ``width_start`` ``rho2(0)``, ``width_floor`` ``rho2(inf)`` (shape
+        (n,), velocity units) and ``decay`` ``l`` (1/s).
+    t : float or array_like, shape (N,)
+        Times, s.
+
+    Returns
+    -------
+    ndarray, shape (N, n)
+        ``rho2`` at each time.
+    """
     t = np.atleast_1d(np.asarray(t, dtype=float))
     start, floor = np.array(stage.width_start), np.array(stage.width_floor)
     decay = reference.exp(-stage.decay * np.maximum(t, 0.0))
@@ -33,6 +49,15 @@ def velocity_tube(stage: SecondStage, t) -> Array:
 def velocity_transform(x2, r, rho2) -> tuple[Array, Array, Array]:
     """``e2 = (x2 - r) / rho2``, ``epsilon2 = ln((1 + e2)/(1 - e2))``, ``xi2 = 2 / (rho2 (1 -
     e2^2))`` (no clamps: the paper's transform on the tube ``(r - rho2, r + rho2)``).
+
+    Parameters
+    ----------
+    x2 : array_like, shape (N, n)
+        Velocity, velocity units.
+    r : array_like, shape (N, n)
+        Virtual velocity ``r`` (law (13) of the first stage), velocity units.
+    rho2 : array_like, shape (N, n)
+        Velocity tube half-width, velocity units.
 
     Returns
     -------

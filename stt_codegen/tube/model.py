@@ -33,6 +33,10 @@ import casadi as ca
 from . import pieces as P
 from .parameters import LOWER, NEWTON_ITERATIONS, TubeDesign
 
+__all__ = ["FUNCTION_NAMES", "TubeModel", "adaptive_tube", "alpha_trajectory_function",
+           "build_model", "conflict_and_trigger", "controller_law", "design_tables",
+           "implicit_alpha_update", "segment_rows"]
+
 #: The functions of a model, in order.
 FUNCTION_NAMES = ("reach_tube", "circumvent", "tube", "adaptive_law", "error_transform",
                   "control", "alpha_step", "controller_step")
@@ -66,7 +70,18 @@ class DesignTables:
 
 
 def design_tables(design: TubeDesign) -> DesignTables:
-    """The table order of a design's numbers (shared by the model and the generated code)."""
+    """The table order of a design's numbers (shared by the model and the generated code).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+
+    Returns
+    -------
+    DesignTables
+        Its segments, circumvent windows, state-space bounds and signs, in table order.
+    """
     n = design.dimension
     rows = []
     for index, c in enumerate(design.circumvents):
@@ -79,7 +94,20 @@ def design_tables(design: TubeDesign) -> DesignTables:
 
 
 def segment_rows(design: TubeDesign, segment) -> tuple:
-    """``(from, to)`` of a reach segment as 2n lists ``[lower; upper]``."""
+    """``(from, to)`` of a reach segment as 2n lists ``[lower; upper]``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube the segment belongs to.
+    segment : ReachSegment
+        One reach segment.
+
+    Returns
+    -------
+    from_row, to_row : list of float
+        ``2n`` entries each, state units: the segment's start box and end box.
+    """
     return (list(segment.lower_from) + list(segment.upper_from),
             list(segment.lower_to) + list(segment.upper_to))
 
@@ -158,7 +186,20 @@ def circumvent(design: TubeDesign, t) -> tuple:
 
 
 def conflict_and_trigger(design: TubeDesign, t) -> tuple:
-    """``psi`` (eq. (11), ``[beta_U - rho_L; rho_U - beta_L]``) and ``theta`` at ``t``."""
+    """``psi`` (eq. (11), ``[beta_U - rho_L; rho_U - beta_L]``) and ``theta`` at ``t``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    t : casadi.SX
+        Time, s.
+
+    Returns
+    -------
+    psi, theta : casadi.SX, shape (2n,)
+        Conflict (state units) and trigger of eq. (11).
+    """
     rho, _ = reach_tube_rates(design, t)
     beta, _ = circumvent_rates(design, t)
     return P.conflict(design.dimension)(rho, beta, design.theta0, design.mu)
@@ -181,7 +222,22 @@ def adaptive_law(design: TubeDesign, t, alpha):
 
 
 def adaptive_tube(design: TubeDesign, t, alpha) -> tuple:
-    """``gamma_L``, ``gamma_U`` of eq. (10), SX vectors of length n."""
+    """``gamma_L``, ``gamma_U`` of eq. (10), SX vectors of length n.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (its numbers become constants of the graph).
+    t : casadi.SX
+        Time, s.
+    alpha : casadi.SX, shape (2n,)
+        ``[alpha_L; alpha_U]`` of eq. (11), state units.
+
+    Returns
+    -------
+    gamma_l, gamma_u : casadi.SX, shape (n,)
+        The adaptive tube, state units.
+    """
     n = design.dimension
     rho, _ = reach_tube_rates(design, t)
     beta, _ = circumvent_rates(design, t)
@@ -232,11 +288,14 @@ def implicit_alpha_update(alpha, psi, theta, dt, kappa: float,
     dt : casadi.SX scalar
         Step, seconds, positive.
     kappa : float
+        ``kappa`` of eq. (11), 1/s.
     iterations : int
+        Newton iterations after the start.
 
     Returns
     -------
     casadi.SX, shape (m, 1)
+        ``alpha`` after the step, state units.
     """
     a0, c, a_coef, root = P.newton_start_expression(alpha, psi, theta, dt, kappa)
     a = ca.if_else(root, P.newton_root_start_expression(alpha, psi, c, a_coef), a0)
@@ -246,7 +305,25 @@ def implicit_alpha_update(alpha, psi, theta, dt, kappa: float,
 
 
 def controller_law(design: TubeDesign, x, gamma_l, gamma_u) -> tuple:
-    """Deployed law (13) with clamps: returns ``(u, inside)`` (see :mod:`stt_codegen.tube.parameters`)."""
+    """Deployed law (13) with clamps: returns ``(u, inside)`` (see
+    :mod:`stt_codegen.tube.parameters`).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (its gain ``k``).
+    x : casadi.SX, shape (n,)
+        State, state units.
+    gamma_l, gamma_u : casadi.SX, shape (n,)
+        The adaptive tube of eq. (10), state units.
+
+    Returns
+    -------
+    u : casadi.SX, shape (n,)
+        The input of law (13).
+    inside : casadi.SX
+        1 when ``gamma_L < x < gamma_U`` entry by entry, else 0.
+    """
     return P.law_expression(x, gamma_l, gamma_u, design.gain, design.dimension)
 
 
@@ -343,6 +420,13 @@ def alpha_trajectory_function(design: TubeDesign, steps: int) -> ca.Function:
     """``alpha`` along a grid of ``steps`` implicit steps, given ``psi`` on the grid.
 
     Used by the design search to integrate (11) exactly as the deployed controller does.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (``theta0``, ``mu``, ``kappa``).
+    steps : int
+        Number of steps of the grid.
 
     Returns
     -------

@@ -9,6 +9,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+__all__ = ["Circumvent", "E_MAX", "GAMMA_D_MIN", "LOWER", "NEWTON_ITERATIONS", "NEWTON_TINY",
+           "ReachSegment", "SMOOTHSTEP", "STATUS_INPUT_CLAMPED", "STATUS_INVALID_INPUT",
+           "STATUS_OK", "STATUS_OUTSIDE_TUBE", "TANH", "TubeDesign", "UPPER", "paper_segments"]
+
 #: Largest ``|e_i|`` used to compute ``u`` in the deployed controller step: ``e`` is
 #: clamped to ``[-E_MAX, E_MAX]`` so that ``u`` is finite everywhere (1 - 2**-20, exact in
 #: float32 and float64).

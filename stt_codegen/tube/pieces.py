@@ -58,6 +58,12 @@ import casadi as ca
 
 from .parameters import E_MAX, GAMMA_D_MIN, NEWTON_TINY, SMOOTHSTEP, TANH
 
+__all__ = ["EXP_ARGUMENT_BOUND", "PROFILE_NAMES", "alpha_rate", "bump", "candidates", "conflict",
+           "deployed_pieces", "error_transform", "error_transform_expression", "fnu_pieces",
+           "interpolate", "later", "law", "law_expression", "newton_iteration_expression",
+           "newton_root_start_expression", "newton_start_expression", "progress",
+           "saturate_expression", "smooth_pieces", "trigger_expression"]
+
 #: Bound on the argument of ``exp`` where it could be large (the smooth max's correction
 #: and the trigger of (11)): ``exp(+-80)`` is a normal number in float32 and float64, so no
 #: step raises an overflow or underflow flag or sets ``errno``.
@@ -101,7 +107,26 @@ def progress_expression(profile: str, t, start, end):
 @lru_cache(maxsize=None)
 def progress(profile: str, rates: bool = True) -> ca.Function:
     """``progress_<profile>(t, start, end) -> (p, p_dot)``; without rates
-    ``progress_<profile>_value(t, start, end) -> p``."""
+    ``progress_<profile>_value(t, start, end) -> p``.
+
+    Parameters
+    ----------
+    profile : str
+        One of :data:`PROFILE_NAMES`: ``"tanh"`` (``tanh((t - start) / (end - t))``, eq. (4))
+        or ``"smoothstep"`` (quintic); see :func:`progress_expression`.
+    rates : bool
+        Also return ``p_dot``, the derivative in ``t`` (1/s).
+
+    Returns
+    -------
+    casadi.Function
+        Scalar inputs ``t``, ``start``, ``end`` (s); ``p`` in ``[0, 1]``.
+
+    Raises
+    ------
+    ValueError
+        Unknown profile.
+    """
     t, start, end = _sym("t", "start", "end")
     p = progress_expression(profile, t, start, end)
     if not rates:
@@ -114,7 +139,20 @@ def progress(profile: str, rates: bool = True) -> ca.Function:
 @lru_cache(maxsize=None)
 def interpolate(n: int, rates: bool = True) -> ca.Function:
     """``interpolate(p, p_dot, from, to) -> (rho, rho_dot)``: ``(to - from) p + from``;
-    without rates ``interpolate_value(p, from, to) -> rho``."""
+    without rates ``interpolate_value(p, from, to) -> rho``.
+
+    Parameters
+    ----------
+    n : int
+        State dimension; ``from``, ``to``, ``rho`` have ``2n`` entries ``[L; U]``.
+    rates : bool
+        Also take ``p_dot`` and return ``rho_dot`` (state units/s).
+
+    Returns
+    -------
+    casadi.Function
+        The reach tube ``rho`` of one segment (state units) from its progress ``p``.
+    """
     p, p_dot = _sym("p", "p_dot")
     lo, hi = ca.SX.sym("from", 2 * n), ca.SX.sym("to", 2 * n)
     if not rates:
@@ -132,6 +170,17 @@ def bump(rates: bool = True) -> ca.Function:
     (``start < t < end`` and ``|d| < r``), exactly 0 outside (eqs. (7)-(8)); the exponent
     is clamped at -80 (no underflow near the edges, where ``y < 2e-35 B``). Without rates
     ``bump_value(...) -> y``.
+
+    Parameters
+    ----------
+    rates : bool
+        Also return ``y_dot`` (state units/s), the derivative in ``t``.
+
+    Returns
+    -------
+    casadi.Function
+        Scalar inputs: ``t``, ``start``, ``end``, ``center`` (``m``), ``radius`` (``r``) in
+        s, ``sharpness`` (``k``), ``height`` (``B``, state units); output ``y``, state units.
     """
     t, start, end, center, radius, sharpness, height = _sym(
         "t", "start", "end", "center", "radius", "sharpness", "height")
@@ -163,6 +212,14 @@ def fnu_pieces() -> tuple:
     (``y_j = 0``) adds exactly 0. ``rate = sum_j exp(nu (y_j - top)) y_j_dot`` gives
     ``F_dot = rate / total``. ``beta = bound + sign F``: ``sign`` is +1 on a lower bound
     (``beta_L = X + F``), -1 on an upper one (``beta_U = X-bar - F``).
+
+    Returns
+    -------
+    init, add, finish, single : casadi.Function
+        Scalar pieces: ``init(top, nu) -> (total, rate)``, ``add(total, rate, y, y_dot, top,
+        nu) -> (total_next, rate_next)`` once per open circumvent, ``finish(bound, sign, top,
+        total, rate, nu) -> (beta, beta_dot)``, and ``single(bound, sign, y, y_dot) -> (beta,
+        beta_dot)`` for a bound with one circumvent (``beta = bound + sign y``).
     """
     top, nu, total, rate, y, y_dot, bound, sign = _sym(
         "top", "nu", "total", "rate", "y", "y_dot", "bound", "sign")
@@ -185,7 +242,19 @@ def fnu_pieces() -> tuple:
 
 @lru_cache(maxsize=None)
 def candidates(n: int) -> tuple:
-    """``candidates(rho, alpha)`` and ``candidate_rates(rho_dot, alpha_dot)`` (2n each)."""
+    """``candidates(rho, alpha)`` and ``candidate_rates(rho_dot, alpha_dot)`` (2n each).
+
+    Parameters
+    ----------
+    n : int
+        State dimension; every input and output has ``2n`` entries ``[L; U]``.
+
+    Returns
+    -------
+    candidates, candidate_rates : casadi.Function
+        ``c = [rho_L - alpha_L; rho_U + alpha_U]``, the first arguments of eq. (10)'s smooth
+        max and min, and its rate ``c_dot`` (state units, state units/s).
+    """
     rho, alpha = ca.SX.sym("rho", 2 * n), ca.SX.sym("alpha", 2 * n)
     value = ca.vertcat(rho[:n] - alpha[:n], rho[n:] + alpha[n:])
     rho_dot, alpha_dot = ca.SX.sym("rho_dot", 2 * n), ca.SX.sym("alpha_dot", 2 * n)
@@ -226,7 +295,17 @@ def smooth_max_needed(a, b, nu):
 @lru_cache(maxsize=None)
 def smooth_pieces() -> tuple:
     """``smooth_max_test``, ``smooth_max``, ``smooth_min_test``, ``smooth_min``,
-    ``smooth_max_rate``, ``smooth_min_rate`` (scalars; ``min~(a, b) = -max~(-a, -b)``)."""
+    ``smooth_max_rate``, ``smooth_min_rate`` (scalars; ``min~(a, b) = -max~(-a, -b)``).
+
+    Returns
+    -------
+    tuple of casadi.Function
+        Six scalar Functions, in the order above: ``smooth_max_test(a, b, nu) -> (max,
+        needed)`` (``needed = 0`` when ``max(a, b)`` is exact to the last bit),
+        ``smooth_max(a, b, nu) -> max~`` (eq. (10)), the same two for ``min~``, and
+        ``smooth_max_rate``/``smooth_min_rate(a, b, a_dot, b_dot, nu)``, the rate by the
+        chain rule.
+    """
     a, b, nu, a_dot, b_dot = _sym("a", "b", "nu", "a_dot", "b_dot")
     top, needed = smooth_max_needed(a, b, nu)
     neg_top, neg_needed = smooth_max_needed(-a, -b, nu)
@@ -256,7 +335,22 @@ def trigger_expression(psi, theta0, mu):
     """``theta = theta0 (1 - tanh(psi - mu))`` of eq. (11) as ``2 theta0 / (1 + exp(y))``,
     ``y = 2 (psi - mu)`` clamped to ``[-80, 80]`` (the same function: ``1 - tanh(y/2) =
     2 / (1 + e^y)``; one ``exp`` instead of ``tanh``; exact to the last bit, or below
-    ``4e-35 theta0``, where clamped)."""
+    ``4e-35 theta0``, where clamped).
+
+    Parameters
+    ----------
+    psi : casadi.SX
+        The conflict ``psi`` of eq. (11), state units (any shape).
+    theta0 : casadi.SX or float
+        Height ``theta0`` of the trigger.
+    mu : casadi.SX or float
+        Offset ``mu`` of the trigger, state units.
+
+    Returns
+    -------
+    casadi.SX
+        ``theta``, the shape of ``psi``, in ``(0, 2 theta0)``.
+    """
     y = ca.fmin(ca.fmax(2.0 * (psi - mu), -EXP_ARGUMENT_BOUND), EXP_ARGUMENT_BOUND)
     return (2.0 * theta0) / (1.0 + ca.exp(y))
 
@@ -264,7 +358,19 @@ def trigger_expression(psi, theta0, mu):
 @lru_cache(maxsize=None)
 def conflict(n: int) -> ca.Function:
     """``conflict(rho, beta, theta0, mu) -> (psi, theta)``: ``psi = [beta_U - rho_L;
-    rho_U - beta_L]`` and the trigger of eq. (11)."""
+    rho_U - beta_L]`` and the trigger of eq. (11).
+
+    Parameters
+    ----------
+    n : int
+        State dimension; ``rho``, ``beta``, ``psi``, ``theta`` have ``2n`` entries ``[L; U]``.
+
+    Returns
+    -------
+    casadi.Function
+        Inputs ``rho`` (reach tube (4)), ``beta`` (circumvent (9)), state units, and the
+        trigger's scalars ``theta0``, ``mu``.
+    """
     rho, beta = ca.SX.sym("rho", 2 * n), ca.SX.sym("beta", 2 * n)
     theta0, mu = _sym("theta0", "mu")
     psi = ca.vertcat(beta[n:] - rho[:n], rho[n:] - beta[:n])
@@ -275,7 +381,18 @@ def conflict(n: int) -> ca.Function:
 
 @lru_cache(maxsize=None)
 def alpha_rate(n: int) -> ca.Function:
-    """``alpha_rate(alpha, psi, theta, kappa) -> theta / (psi + alpha)^2 - kappa alpha``."""
+    """``alpha_rate(alpha, psi, theta, kappa) -> theta / (psi + alpha)^2 - kappa alpha``.
+
+    Parameters
+    ----------
+    n : int
+        State dimension; ``alpha``, ``psi``, ``theta`` and ``alpha_dot`` have ``2n`` entries.
+
+    Returns
+    -------
+    casadi.Function
+        The right-hand side of eq. (11), ``alpha_dot`` in state units/s.
+    """
     alpha, psi, theta = (ca.SX.sym(name, 2 * n) for name in ("alpha", "psi", "theta"))
     kappa = ca.SX.sym("kappa")
     return ca.Function("alpha_rate", [alpha, psi, theta, kappa],
@@ -285,13 +402,40 @@ def alpha_rate(n: int) -> ca.Function:
 
 @lru_cache(maxsize=None)
 def later() -> ca.Function:
-    """``later(t, dt) -> t + dt``."""
+    """``later(t, dt) -> t + dt``.
+
+    Returns
+    -------
+    casadi.Function
+        ``t_next = t + dt`` (s), a Function so that the generated code rounds it the same way.
+    """
     t, dt = _sym("t", "dt")
     return ca.Function("later", [t, dt], [t + dt], ["t", "dt"], ["t_next"])
 
 
 def newton_start_expression(alpha, psi, theta, dt, kappa) -> tuple:
-    """``(a0, c, A, root)`` of the implicit step; see :func:`newton_pieces`."""
+    """``(a0, c, A, root)`` of the implicit step; see :func:`newton_pieces`.
+
+    Parameters
+    ----------
+    alpha : casadi.SX
+        ``alpha`` before the step, ``2n`` entries.
+    psi : casadi.SX
+        The conflict ``psi`` at the end of the step, ``2n`` entries.
+    theta : casadi.SX
+        The trigger ``theta`` at the end of the step, ``2n`` entries.
+    dt : casadi.SX
+        Step, s.
+    kappa : casadi.SX
+        Decay ``kappa`` of eq. (11), 1/s.
+
+    Returns
+    -------
+    a0, c, A, root : casadi.SX
+        The start ``alpha / c``, ``c = 1 + kappa dt``, ``A = dt theta``, and ``root``: 1
+        where ``a0`` is not a safe Newton start (``psi + a0 <= 0`` or ``2 c z0^3 < A``), so
+        :func:`newton_root_start_expression` gives the start instead.
+    """
     c = 1.0 + kappa * dt
     a_coef = dt * theta
     a0 = alpha / c
@@ -302,7 +446,25 @@ def newton_start_expression(alpha, psi, theta, dt, kappa) -> tuple:
 
 def newton_root_start_expression(alpha, psi, c, a_coef):
     """``max(alpha / c, -psi + delta)``, ``delta = min((A / 2c)^(1/3), sqrt(A / 2Q))``,
-    ``Q = max(-c psi - alpha, 0)``."""
+    ``Q = max(-c psi - alpha, 0)``.
+
+    Parameters
+    ----------
+    alpha : casadi.SX
+        ``alpha`` before the step.
+    psi : casadi.SX
+        The conflict ``psi`` at the end of the step.
+    c : casadi.SX
+        ``1 + kappa dt``.
+    a_coef : casadi.SX
+        ``A = dt theta``.
+
+    Returns
+    -------
+    casadi.SX
+        A start at or right of the root of ``c a - alpha - A / (psi + a)^2``, with
+        ``psi + a > 0``.
+    """
     q = ca.fmax(-c * psi - alpha, 0.0)
     delta = ca.fmin((a_coef / (2.0 * c)) ** (1.0 / 3.0),
                     ca.sqrt(a_coef / (2.0 * ca.fmax(q, NEWTON_TINY))))
@@ -311,7 +473,26 @@ def newton_root_start_expression(alpha, psi, c, a_coef):
 
 def newton_iteration_expression(a, alpha, psi, c, a_coef):
     """``a - z (z^2 (c a - alpha) - A) / (c z^3 + 2 A)``, ``z = psi + a``: one Newton
-    iteration on ``g(a) = c a - alpha - A / z^2`` with one division."""
+    iteration on ``g(a) = c a - alpha - A / z^2`` with one division.
+
+    Parameters
+    ----------
+    a : casadi.SX
+        The current iterate.
+    alpha : casadi.SX
+        ``alpha`` before the step.
+    psi : casadi.SX
+        The conflict ``psi`` at the end of the step.
+    c : casadi.SX
+        ``1 + kappa dt``.
+    a_coef : casadi.SX
+        ``A = dt theta``.
+
+    Returns
+    -------
+    casadi.SX
+        The next iterate.
+    """
     z = psi + a
     z2 = z * z
     return a - z * (z2 * (c * a - alpha) - a_coef) / (c * (z2 * z) + 2.0 * a_coef)
@@ -365,6 +546,18 @@ def error_transform_expression(x, gamma_l, gamma_u) -> tuple:
     gamma_U - gamma_L`` floored at ``GAMMA_D_MIN``) clamped to ``[-E_MAX, E_MAX]``,
     ``epsilon = ln((1 + e)/(1 - e))``, ``xi = 4 / (gamma_d (1 - e^2))`` (the diagonal of
     ``xi`` in law (13)), finite everywhere; the same construction as :func:`law_expression`.
+
+    Parameters
+    ----------
+    x : casadi.SX, shape (n,)
+        State, state units.
+    gamma_l, gamma_u : casadi.SX, shape (n,)
+        The adaptive tube ``gamma_L``, ``gamma_U`` of eq. (10), state units.
+
+    Returns
+    -------
+    e, epsilon, xi : casadi.SX, shape (n,)
+        Normalized error, transformed error, and ``xi`` (1 / state units).
     """
     _, width, e = _scaled_error(x, gamma_l, gamma_u)
     return _transform(e, width)
@@ -372,7 +565,26 @@ def error_transform_expression(x, gamma_l, gamma_u) -> tuple:
 
 def law_expression(x, gamma_l, gamma_u, gain, n: int) -> tuple:
     """Deployed law (13) with clamps: ``(u, inside)``, ``u = -gain xi epsilon`` with the
-    ``epsilon``, ``xi`` of :func:`error_transform_expression` (finite everywhere)."""
+    ``epsilon``, ``xi`` of :func:`error_transform_expression` (finite everywhere).
+
+    Parameters
+    ----------
+    x : casadi.SX, shape (n,)
+        State, state units.
+    gamma_l, gamma_u : casadi.SX, shape (n,)
+        The adaptive tube of eq. (10), state units.
+    gain : casadi.SX or float
+        The gain ``k`` of law (13).
+    n : int
+        State dimension.
+
+    Returns
+    -------
+    u : casadi.SX, shape (n,)
+        The input of law (13).
+    inside : casadi.SX
+        1 when ``gamma_L < x < gamma_U`` entry by entry, else 0.
+    """
     _, width, e = _scaled_error(x, gamma_l, gamma_u)
     inside = 1.0
     for i in range(n):
@@ -392,6 +604,22 @@ def saturate_expression(u, bound, n: int) -> tuple:
     For finite ``u`` the clamp is the projection on the box ``[-bound, bound]``: it moves
     no entry inside the box, so where law (13) stays within the bound it is the identity.
     The generated code checks ``u`` for finiteness before it is clamped.
+
+    Parameters
+    ----------
+    u : casadi.SX, shape (n,)
+        Input of law (13).
+    bound : casadi.SX, shape (n,)
+        The actuator bound ``[actuator] u_max``, positive, input units.
+    n : int
+        Input dimension.
+
+    Returns
+    -------
+    u_c : casadi.SX, shape (n,)
+        The clamped input.
+    within : casadi.SX
+        1 when no entry was clamped, else 0.
     """
     within = 1.0
     for i in range(n):
@@ -412,7 +640,18 @@ def saturate(n: int) -> ca.Function:
 def error_transform(n: int) -> ca.Function:
     """``error_transform(x, gamma_L, gamma_U) -> (e, epsilon, xi)``: the expressions
     :func:`law` is built from, as their own Function (for ``stt-codegen verify``; not
-    emitted)."""
+    emitted).
+
+    Parameters
+    ----------
+    n : int
+        State dimension (every input and output has ``n`` entries).
+
+    Returns
+    -------
+    casadi.Function
+        :func:`error_transform_expression` as a Function.
+    """
     x, gamma_l, gamma_u = (ca.SX.sym(name, n) for name in ("x", "gamma_L", "gamma_U"))
     return ca.Function("error_transform", [x, gamma_l, gamma_u],
                        list(error_transform_expression(x, gamma_l, gamma_u)),
@@ -421,7 +660,18 @@ def error_transform(n: int) -> ca.Function:
 
 @lru_cache(maxsize=None)
 def law(n: int) -> ca.Function:
-    """``law(x, gamma_L, gamma_U, gain) -> (u, inside)``."""
+    """``law(x, gamma_L, gamma_U, gain) -> (u, inside)``.
+
+    Parameters
+    ----------
+    n : int
+        State dimension (``x``, ``gamma_L``, ``gamma_U``, ``u`` have ``n`` entries).
+
+    Returns
+    -------
+    casadi.Function
+        :func:`law_expression` as a Function.
+    """
     x, gamma_l, gamma_u = (ca.SX.sym(name, n) for name in ("x", "gamma_L", "gamma_U"))
     gain = ca.SX.sym("gain")
     u, inside = law_expression(x, gamma_l, gamma_u, gain, n)
@@ -437,6 +687,24 @@ def deployed_pieces(n: int, profiles: tuple, single_bounds: bool = True,
     some bound has exactly one / several circumvents (``bump`` is emitted with either, the
     ``F_nu`` pieces only with several, ``fnu_single`` only with one); ``saturated``: the
     design has an actuator bound (``saturate`` is emitted last, only then).
+
+    Parameters
+    ----------
+    n : int
+        State dimension.
+    profiles : tuple of str
+        The segment profiles the design uses (a subset of :data:`PROFILE_NAMES`).
+    single_bounds : bool
+        Some bound has exactly one circumvent.
+    multi_bounds : bool
+        Some bound has several circumvents.
+    saturated : bool
+        The design has an actuator bound.
+
+    Returns
+    -------
+    list of casadi.Function
+        The pieces, in emission order (the order of the generated files).
     """
     init, add, finish, single = fnu_pieces()
     cand, cand_rates = candidates(n)

@@ -21,6 +21,12 @@ import numpy as np
 from .parameters import (E_MAX, GAMMA_D_MIN, LOWER, SMOOTHSTEP, STATUS_INPUT_CLAMPED, STATUS_OK,
                          STATUS_OUTSIDE_TUBE, TANH, ReachSegment, TubeDesign)
 
+__all__ = ["adaptive_law", "adaptive_tube", "alpha_step", "bump", "circumvent",
+           "circumvent_from_bumps", "conflict_distance", "control", "controller_status",
+           "controller_step", "error_transform", "exp", "implicit_alpha_root", "law", "law_step",
+           "log", "numpy_math", "open_bump_sum", "reach_tube", "segment_progress", "smooth_max",
+           "trigger"]
+
 Array = np.ndarray
 
 
@@ -68,7 +74,18 @@ def _dispatch(name: str):
     def apply(x):
         return fast(x) if _USE_NUMPY.get() else libm(x)
     apply.__name__ = name
-    apply.__doc__ = libm.__doc__ + " Inside :func:`numpy_math`, numpy's ufunc instead."
+    apply.__doc__ = libm.__doc__ + f""" Inside :func:`numpy_math`, numpy's ufunc instead.
+
+    Parameters
+    ----------
+    x : array_like, any shape
+        The argument.
+
+    Returns
+    -------
+    ndarray, the shape of ``x``
+        ``{name}(x)``, NaN outside the domain.
+    """
     return apply
 
 
@@ -86,6 +103,12 @@ def numpy_math():
     arrays; the certificate (:mod:`stt_codegen.design.certificate`), whose margins are
     far above rounding, evaluates the oracle's formulas this way. The switch is a context
     variable, so other threads (and asyncio tasks) keep libm.
+
+    Yields
+    ------
+    None
+        The body of the ``with`` statement runs with numpy's kernels and numpy's floating
+        point warnings silenced.
     """
     token = _USE_NUMPY.set(True)
     try:
@@ -208,6 +231,15 @@ def smooth_max(values: Array, nu: float, axis: int = -1) -> tuple[Array, Array]:
     Evaluated without overflow: ``max(a, b) + log1p(exp(-nu |a - b|)) / nu`` for two
     values, ``M + ln(sum_j exp(nu (a_j - M))) / nu`` with ``M = max_j a_j`` for more.
 
+    Parameters
+    ----------
+    values : array_like
+        The ``a_j`` along ``axis``, state units.
+    nu : float
+        Smoothness ``nu > 0`` of eq. (10); larger is closer to ``max``.
+    axis : int
+        The axis reduced.
+
     Returns
     -------
     value : ndarray
@@ -316,6 +348,13 @@ def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
     Bumps on the same bound are combined by :func:`open_bump_sum`; a bound with no bump
     is the state-space bound.
 
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (its circumvents and state-space bounds).
+    t : float or array_like, shape (N,)
+        Times, s.
+
     Returns
     -------
     beta_L, beta_U, beta_L_dot, beta_U_dot : ndarray, shape (N, n)
@@ -334,7 +373,20 @@ def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
 
 
 def conflict_distance(design: TubeDesign, t) -> Array:
-    """``psi = [beta_U - rho_L, rho_U - beta_L]`` of eq. (11), shape (N, 2n)."""
+    """``psi = [beta_U - rho_L, rho_U - beta_L]`` of eq. (11), shape (N, 2n).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    t : float or array_like, shape (N,)
+        Times, s.
+
+    Returns
+    -------
+    ndarray, shape (N, 2n)
+        ``psi``, state units; positive where the reach tube and the circumvent do not conflict.
+    """
     rho_l, rho_u, _, _ = reach_tube(design, t)
     beta_l, beta_u, _, _ = circumvent(design, t)
     return np.concatenate([beta_u - rho_l, rho_u - beta_l], axis=1)
@@ -347,6 +399,8 @@ def trigger(design: TubeDesign, psi) -> Array:
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube (``theta0``, ``mu``).
     psi : array_like, any shape
         ``psi`` of eq. (11), state units.
 
@@ -365,6 +419,8 @@ def adaptive_law(design: TubeDesign, t, alpha) -> tuple[Array, Array]:
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube (``theta0``, ``mu``, ``kappa``).
     t : array_like, shape (N,)
     alpha : array_like, shape (N, 2n)
         ``[alpha_L, alpha_U]``, valid where ``psi + alpha > 0``.
@@ -387,6 +443,15 @@ def adaptive_tube(design: TubeDesign, t, alpha) -> tuple[Array, Array, Array, Ar
     """Adaptive tube (10): ``gamma_L = max~(rho_L - alpha_L, beta_L)``, ``gamma_U = min~(rho_U + alpha_U, beta_U)``.
 
     The derivatives are total time derivatives along the adaptive law (11).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    t : float or array_like, shape (N,)
+        Times, s.
+    alpha : array_like, shape (N, 2n)
+        ``[alpha_L, alpha_U]`` of eq. (11), state units.
 
     Returns
     -------
@@ -415,6 +480,8 @@ def error_transform(design: TubeDesign, x, t, alpha) -> tuple[Array, Array, Arra
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube.
     x : array_like, shape (N, n)
     t : array_like, shape (N,)
     alpha : array_like, shape (N, 2n)
@@ -440,7 +507,24 @@ def error_transform(design: TubeDesign, x, t, alpha) -> tuple[Array, Array, Arra
 
 
 def control(design: TubeDesign, x, t, alpha) -> Array:
-    """Control law (13): ``u = -k xi epsilon``, shape (N, n)."""
+    """Control law (13): ``u = -k xi epsilon``, shape (N, n).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (its gain ``k``).
+    x : array_like, shape (N, n)
+        State, state units.
+    t : float or array_like, shape (N,)
+        Times, s.
+    alpha : array_like, shape (N, 2n)
+        ``[alpha_L, alpha_U]``, state units.
+
+    Returns
+    -------
+    ndarray, shape (N, n)
+        ``u``, without clamps (NaN or infinite outside the tube).
+    """
     _, epsilon, xi, _ = error_transform(design, x, t, alpha)
     return -design.gain * xi * epsilon
 
@@ -459,6 +543,7 @@ def implicit_alpha_root(alpha: Array, psi: Array, theta: Array, dt: Array,
     ----------
     alpha, psi, theta, dt : array_like, broadcastable
     kappa : float
+        ``kappa`` of eq. (11), 1/s.
 
     Returns
     -------
@@ -491,6 +576,8 @@ def alpha_step(design: TubeDesign, t, dt, alpha) -> Array:
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube (``theta0``, ``mu``, ``kappa``).
     t, dt : array_like, shape (N,)
         Seconds; ``dt > 0``.
     alpha : array_like, shape (N, 2n)
@@ -510,7 +597,30 @@ def alpha_step(design: TubeDesign, t, dt, alpha) -> Array:
 
 def law_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, Array]:
     """:func:`controller_step` before the actuator clamp: law (13)'s ``u`` (with the clamps
-    of ``e`` and ``gamma_d``), shape (N, n), the next ``alpha`` (N, 2n) and ``inside`` (N,)."""
+    of ``e`` and ``gamma_d``), shape (N, n), the next ``alpha`` (N, 2n) and ``inside`` (N,).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    x : array_like, shape (N, n)
+        State, state units.
+    t : float or array_like, shape (N,)
+        Times, s.
+    dt : float or array_like, shape (N,)
+        Steps, s, positive.
+    alpha : array_like, shape (N, 2n)
+        ``alpha`` at ``t``, state units.
+
+    Returns
+    -------
+    u : ndarray, shape (N, n)
+        Law (13) with the deployed clamps, before the actuator clamp.
+    alpha_next : ndarray, shape (N, 2n)
+        ``alpha`` at ``t + dt`` (:func:`alpha_step`).
+    inside : ndarray, shape (N,)
+        1.0 where ``x`` is strictly inside the tube, else 0.0.
+    """
     t = _time(t)
     gamma_l, gamma_u, _, _ = adaptive_tube(design, t, alpha)
     x = _rows(x, t.size, design.dimension)
@@ -529,6 +639,13 @@ def law(gain: float, x, gamma_l, gamma_u) -> tuple[Array, Array]:
         ``k`` of (13).
     x, gamma_l, gamma_u : array_like, shape (N, n)
         State and tube bounds, state units.
+
+    Returns
+    -------
+    u : ndarray, shape (N, n)
+        The input.
+    inside : ndarray, shape (N,)
+        1.0 inside, else 0.0.
     """
     gamma_d = gamma_u - gamma_l
     width = np.maximum(gamma_d, GAMMA_D_MIN)
@@ -575,6 +692,19 @@ def controller_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, 
     rounded ``|2 x_i - gamma_s_i| < gamma_d_i`` reported points on the bounds and one ulp
     outside as inside); an empty tube has no inside point.
 
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    x : array_like, shape (N, n)
+        State, state units.
+    t : float or array_like, shape (N,)
+        Times, s.
+    dt : float or array_like, shape (N,)
+        Steps, s, positive.
+    alpha : array_like, shape (N, 2n)
+        ``alpha`` at ``t``, state units.
+
     Returns
     -------
     u : ndarray, shape (N, n)
@@ -588,6 +718,19 @@ def controller_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, 
 
 def controller_status(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, Array]:
     """:func:`controller_step` with the status code of the generated API instead of ``inside``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    x : array_like, shape (N, n)
+        State, state units.
+    t : float or array_like, shape (N,)
+        Times, s.
+    dt : float or array_like, shape (N,)
+        Steps, s, positive.
+    alpha : array_like, shape (N, 2n)
+        ``alpha`` at ``t``, state units.
 
     Returns
     -------

@@ -50,6 +50,9 @@ from typing import Tuple
 
 import numpy as np
 
+__all__ = ["EXP_COEFFICIENTS", "FAST_BOUND", "FUNCTIONS", "K_MAX", "LN2_HI", "LN2_LO", "LOG2E",
+           "expf_source", "source"]
+
 #: Name of the single-precision exp defined in the generated C.
 EXPF_NAME = "stt_expf"
 #: The fast path serves ``|x| <= FAST_BOUND`` (the pieces clamp every exponent to
@@ -193,6 +196,16 @@ int main(void) {{
 
 def source(op: str) -> str:
     """C text of the function of this module that computes ``op`` (see :data:`FUNCTIONS`).
+
+    Parameters
+    ----------
+    op : str
+        An op name (:mod:`.ops`); only ``"exp"`` has a function here.
+
+    Returns
+    -------
+    str
+        The C text of the function (``stt_expf``).
 
     Raises
     ------

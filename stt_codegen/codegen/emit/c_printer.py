@@ -49,6 +49,8 @@ from .errors import EmitError
 from .instructions import Input, IOSpec, Output, Program, Unary, lower
 from .printer import FunctionLike, InstructionPrinter
 
+__all__ = ["CPrinter", "Precision", "c_source"]
+
 #: C99 ``<math.h>`` functions the printer may call (op name = double function name).
 MATH_FUNCTIONS: Tuple[str, ...] = (
     "fabs", "copysign", "floor", "ceil", "fmod", "remainder", "sqrt", "pow", "exp", "expm1",

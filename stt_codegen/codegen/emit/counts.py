@@ -10,6 +10,8 @@ import casadi
 from .instructions import Program, lower, op_name
 from .ops import CATEGORIES, OPS_BY_NAME
 
+__all__ = ["OperationCounts", "count_operations"]
+
 
 @dataclass(frozen=True)
 class OperationCounts:

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from stt_codegen.errors import ToolchainError
 
+__all__ = ["EmitError", "UnsupportedOperation"]
+
 
 class EmitError(ToolchainError):
     """A CasADi Function cannot be turned into code (not SX, free symbols, bad names...)."""

@@ -25,10 +25,25 @@ import casadi
 from .errors import EmitError, UnsupportedOperation
 from .ops import OPS, casadi_op_name
 
+__all__ = ["Binary", "Const", "IOSpec", "IfElseZero", "Input", "Instruction", "OPS", "Output",
+           "Program", "Unary", "lower", "op_name"]
+
 
 @dataclass(frozen=True)
 class Input:
-    """``w[dest] = input[input_index][position]`` (nonzero ``nz`` of that input)."""
+    """``w[dest] = input[input_index][position]`` (nonzero ``nz`` of that input).
+
+    Attributes
+    ----------
+    dest : int
+        Work register written.
+    input_index : int
+        Which input of the Function.
+    nz : int
+        Index among that input's nonzeros.
+    position : int
+        Dense column-major index of that nonzero.
+    """
 
     dest: int
     input_index: int
@@ -38,7 +53,19 @@ class Input:
 
 @dataclass(frozen=True)
 class Output:
-    """``output[output_index][position] = w[src]`` (nonzero ``nz`` of that output)."""
+    """``output[output_index][position] = w[src]`` (nonzero ``nz`` of that output).
+
+    Attributes
+    ----------
+    output_index : int
+        Which output of the Function.
+    nz : int
+        Index among that output's nonzeros.
+    position : int
+        Dense column-major index of that nonzero.
+    src : int
+        Work register read.
+    """
 
     output_index: int
     nz: int
@@ -48,7 +75,15 @@ class Output:
 
 @dataclass(frozen=True)
 class Const:
-    """``w[dest] = value`` (a double, possibly ``inf``, ``-inf``, ``nan`` or ``-0.0``)."""
+    """``w[dest] = value`` (a double, possibly ``inf``, ``-inf``, ``nan`` or ``-0.0``).
+
+    Attributes
+    ----------
+    dest : int
+        Work register written.
+    value : float
+        The constant.
+    """
 
     dest: int
     value: float
@@ -56,7 +91,17 @@ class Const:
 
 @dataclass(frozen=True)
 class Unary:
-    """``w[dest] = op(w[arg])``; ``op`` is an op name of :mod:`stt_codegen.codegen.emit.ops`."""
+    """``w[dest] = op(w[arg])``; ``op`` is an op name of :mod:`stt_codegen.codegen.emit.ops`.
+
+    Attributes
+    ----------
+    op : str
+        The operation's name.
+    dest : int
+        Work register written.
+    arg : int
+        Work register read.
+    """
 
     op: str
     dest: int
@@ -65,7 +110,17 @@ class Unary:
 
 @dataclass(frozen=True)
 class Binary:
-    """``w[dest] = op(w[a], w[b])``; for ``constpow`` ``w[b]`` holds the exponent."""
+    """``w[dest] = op(w[a], w[b])``; for ``constpow`` ``w[b]`` holds the exponent.
+
+    Attributes
+    ----------
+    op : str
+        The operation's name.
+    dest : int
+        Work register written.
+    a, b : int
+        Work registers read, in operand order.
+    """
 
     op: str
     dest: int
@@ -75,7 +130,17 @@ class Binary:
 
 @dataclass(frozen=True)
 class IfElseZero:
-    """``w[dest] = 0.0 if w[cond] == 0 else w[value]`` (0.0 even if the value is NaN)."""
+    """``w[dest] = 0.0 if w[cond] == 0 else w[value]`` (0.0 even if the value is NaN).
+
+    Attributes
+    ----------
+    dest : int
+        Work register written.
+    cond : int
+        Work register of the condition.
+    value : int
+        Work register of the value.
+    """
 
     dest: int
     cond: int

@@ -26,6 +26,8 @@ from typing import Dict, Tuple
 
 import casadi
 
+__all__ = ["CATEGORIES", "OPS", "OPS_BY_NAME", "casadi_op_name"]
+
 DATA = "data"
 ARITHMETIC = "arithmetic"
 LOGIC = "logic"

@@ -37,6 +37,8 @@ from .errors import EmitError, UnsupportedOperation
 from .instructions import (Binary, Const, IfElseZero, Input, Instruction, IOSpec, Output,
                            Program, Unary, lower)
 
+__all__ = ["FunctionLike", "InstructionPrinter"]
+
 FunctionLike = Union[casadi.Function, Program]
 
 

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from typing import Dict, Tuple
 
+__all__ = ["HELPERS", "HELPER_DEPENDENCIES"]
+
 # (name, source, names of helpers it calls); the order is the order of emission.
 HELPERS: Tuple[Tuple[str, str, Tuple[str, ...]], ...] = (
     ("_div", '''\

@@ -57,6 +57,8 @@ from .instructions import IOSpec, Program, lower
 from .printer import FunctionLike, InstructionPrinter
 from .python_helpers import HELPER_DEPENDENCIES, HELPERS
 
+__all__ = ["PythonPrinter", "python_function", "python_source"]
+
 _RESERVED = frozenset({"math", "float", "len", "ValueError"})
 _REGISTER = re.compile(r"^w[0-9]+$")
 

@@ -25,6 +25,8 @@ from .errors import UnsupportedOperation
 from .instructions import IOSpec, Program, lower
 from .printer import FunctionLike, InstructionPrinter
 
+__all__ = ["SymPyPrinter", "sympy_expressions"]
+
 
 def _piece(condition) -> sympy.Expr:
     return sympy.Piecewise((sympy.Integer(1), condition), (sympy.Integer(0), True))

@@ -19,6 +19,9 @@ from ...tube import reference
 from ...tube.parameters import LOWER, TANH, TubeDesign
 from .report import Enclosure
 
+__all__ = ["Pieces", "bump_ranges", "circumvent_range", "enclose", "enclose_tube", "partition",
+           "piece_ranges", "piece_widths", "reach_range", "width_lower_bound"]
+
 
 def _tanh_rate_peak() -> float:
     lo, hi = 0.5, 1.0
@@ -48,6 +51,13 @@ def bump_ranges(c, t0: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
     edges and centre and monotone between them and its peaks ``m -+ r z*``, so its
     extremes on an interval are at the ends or at those points inside.
 
+    Parameters
+    ----------
+    c : Circumvent
+        One circumvent (its ``center``, ``radius`` in s and ``sharpness``).
+    t0, t1 : ndarray, shape (K,)
+        Ends of the intervals, s, ``t0 <= t1``.
+
     Returns
     -------
     low, high, rate_min, rate_max : ndarray, shape (K,)
@@ -68,6 +78,18 @@ def circumvent_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
 
     ``beta_L`` is non-decreasing and ``beta_U`` non-increasing in every bump value, so
     eq. (9) at the ends of the bumps' ranges gives the ends of theirs.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (its circumvents and state-space bounds).
+    t0, t1 : ndarray, shape (K,)
+        Ends of the intervals, s.
+
+    Returns
+    -------
+    (lower_min, lower_max), (upper_min, upper_max) : ndarray, shape (K, n)
+        Ranges of ``beta_L`` and ``beta_U``, state units.
     """
     t0, t1 = np.atleast_1d(t0), np.atleast_1d(t1)
     ranges = [bump_ranges(c, t0, t1) for c in design.circumvents]
@@ -116,6 +138,10 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool 
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube (its reach segments).
+    t0, t1 : ndarray, shape (K,)
+        Ends of the intervals, s.
     rates : bool
         Also the rates' ranges (else ``None`` in their place).
 
@@ -155,7 +181,25 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool 
 
 @dataclass(frozen=True)
 class Pieces:
-    """What an interval contributes, vectorized over the K intervals of a partition."""
+    """What an interval contributes, vectorized over the K intervals of a partition.
+
+    Attributes
+    ----------
+    rho_l, rho_u : tuple of ndarray
+        ``(min, max)`` of ``rho_L`` and ``rho_U`` (eq. (4)) on each interval, (K, n) each,
+        state units.
+    beta_l, beta_u : tuple of ndarray
+        ``(min, max)`` of ``beta_L`` and ``beta_U`` (eq. (9)), (K, n) each, state units.
+    rho_rate : tuple or None
+        ``((min, max) of rho_L_dot, (min, max) of rho_U_dot)``, (K, n) each, state units/s;
+        None where not needed (:func:`piece_widths`).
+    beta_rate : tuple or None
+        The same for ``beta_L_dot``, ``beta_U_dot``.
+    psi_lo, psi_hi : ndarray or None
+        Range of ``psi`` (eq. (11)), shape (K, 2n), state units.
+    rho_width : ndarray
+        Least ``rho_U - rho_L`` on each interval, shape (K, n), state units.
+    """
 
     rho_l: tuple
     rho_u: tuple
@@ -185,7 +229,20 @@ class Partition:
 
 def partition(design: TubeDesign, points: list[int]) -> Partition:
     """The intervals between consecutive sample indices ``points`` (the last one opens the
-    tail) and the pieces' ranges on them (:func:`piece_ranges`; the tail's at its start)."""
+    tail) and the pieces' ranges on them (:func:`piece_ranges`; the tail's at its start).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (its rate sets the sample times ``i / rate_hz``).
+    points : list of int
+        Increasing sample indices, the cuts.
+
+    Returns
+    -------
+    Partition
+        ``len(points)`` intervals, the last one the tail ``[t_last, inf)``.
+    """
     dt = 1.0 / design.rate_hz
     i0 = np.array(points)
     i1 = np.append(i0[1:], -1)
@@ -196,7 +253,20 @@ def partition(design: TubeDesign, points: list[int]) -> Partition:
 
 
 def piece_ranges(design: TubeDesign, t0: np.ndarray, t1: np.ndarray) -> Pieces:
-    """Ranges of ``rho``, ``beta``, their rates and ``psi`` (eq. (11)) on each ``[t0, t1]``."""
+    """Ranges of ``rho``, ``beta``, their rates and ``psi`` (eq. (11)) on each ``[t0, t1]``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    t0, t1 : ndarray, shape (K,)
+        Ends of the intervals, s, ``t0 <= t1``.
+
+    Returns
+    -------
+    Pieces
+        The ranges on the ``K`` intervals.
+    """
     rho_l, rho_u, rho_rate, rho_width = reach_range(design, t0, t1)
     beta_l, beta_u = circumvent_range(design, t0, t1)
     beta_rate = _circumvent_rate(design, t0, t1)
@@ -214,6 +284,8 @@ def piece_widths(design: TubeDesign, t0: np.ndarray, t1: np.ndarray,
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube.
     t0, t1 : ndarray, shape (K,)
         Seconds.
     alpha_min : ndarray, shape (K, 2n)
@@ -256,6 +328,8 @@ def width_lower_bound(design: TubeDesign, pieces: Pieces, alpha_min: np.ndarray)
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube (its smoothness ``nu``).
     pieces : Pieces
     alpha_min : ndarray, shape (K, 2n)
         Lower bounds of ``alpha`` on the intervals.
@@ -278,12 +352,20 @@ def enclose(design: TubeDesign, pieces: Pieces, alpha_min: np.ndarray, alpha_max
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube.
     pieces : Pieces
         From :func:`piece_ranges` on the same intervals.
     alpha_min, alpha_max : ndarray, shape (K, 2n)
         Range of ``alpha`` on each interval.
     t0, t1 : ndarray, shape (K,)
         Seconds.
+
+    Returns
+    -------
+    Enclosure
+        Bounds of ``gamma_L``, ``gamma_U`` (state units), of ``|gamma_dot|`` (state units/s)
+        and the least width ``gamma_U - gamma_L`` on each interval.
     """
     n = design.dimension
     nu = design.smoothness

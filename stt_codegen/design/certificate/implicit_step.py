@@ -20,6 +20,9 @@ import numpy as np
 from ...tube import reference
 from ...tube.parameters import TubeDesign
 
+__all__ = ["EXACT_STEPS", "Propagation", "STEP_ROOT_TOLERANCE", "SequenceBounds",
+           "alpha_fixed_point", "alpha_ranges", "sequence_bounds", "step_root"]
+
 #: Intervals of at most this many steps follow the extreme implicit steps one by one.
 EXACT_STEPS = 4
 #: Relative width at which :func:`step_root` stops refining its (rigorous) bracket.
@@ -231,6 +234,8 @@ def alpha_ranges(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube (``theta0``, ``mu``, ``kappa``, ``rate_hz``).
     psi_lo, psi_hi : ndarray, shape (K, 2n)
     steps : ndarray, shape (K,)
         Steps per interval (``inf`` for the tail).
@@ -271,6 +276,20 @@ class SequenceBounds:
     (:func:`alpha_ranges`), for every ``j``, not only at the interval's end: :meth:`within`
     bounds it over a part of the interval, with the bounds :func:`alpha_ranges` uses for the
     whole. Arrays (K, 2n); build with :func:`sequence_bounds`.
+
+    Attributes
+    ----------
+    start_lo, start_hi : ndarray, shape (K, 2n)
+        Bounds ``A_lo``, ``A_hi`` of ``alpha`` at each interval's start, state units.
+    star_lo, star_hi : ndarray, shape (K, 2n)
+        Fixed points ``a*`` of the lower and the upper sequence.
+    q_lo, q_hi : ndarray, shape (K, 2n)
+        Contraction factors ``q`` of the two sequences towards ``a*`` (1: none known).
+    rate_lo, rate_hi : ndarray, shape (K, 2n)
+        ``f(A) = theta / (psi + A)^2 - kappa A`` at the two starts, state units/s (``-+inf``
+        where ``psi + A <= 0``).
+    dt : float
+        Sampling period, s.
     """
 
     start_lo: np.ndarray
@@ -320,7 +339,22 @@ class SequenceBounds:
 def sequence_bounds(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
                     start_lo: np.ndarray, start_hi: np.ndarray) -> SequenceBounds:
     """:class:`SequenceBounds` of intervals with ``psi`` in ``[psi_lo, psi_hi]`` (K, 2n) and
-    ``alpha`` in ``[start_lo, start_hi]`` at their start (K, 2n)."""
+    ``alpha`` in ``[start_lo, start_hi]`` at their start (K, 2n).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (``theta0``, ``mu``, ``kappa``, ``rate_hz``).
+    psi_lo, psi_hi : ndarray, shape (K, 2n)
+        Range of ``psi`` (eq. (11)) on each interval, state units.
+    start_lo, start_hi : ndarray, shape (K, 2n)
+        Range of ``alpha`` at each interval's start, state units.
+
+    Returns
+    -------
+    SequenceBounds
+        The two extreme sequences of every interval.
+    """
     kappa, dt = design.kappa, 1.0 / design.rate_hz
     c = 1.0 + kappa * dt
     theta_hi = reference.trigger(design, psi_lo)
@@ -345,6 +379,24 @@ def step_root(a: float, psi: float, theta: float, dt: float, c: float) -> tuple[
     iterations. They start at ``a`` (``alpha`` moves little per step) or, where
     ``psi + a <= 0``, at the left start of :func:`stt_codegen.tube.model.implicit_alpha_update`,
     and stop once the bracket is :data:`STEP_ROOT_TOLERANCE` relative wide.
+
+    Parameters
+    ----------
+    a : float
+        ``alpha`` before the step, state units.
+    psi : float
+        ``psi`` at the end of the step, state units.
+    theta : float
+        ``theta`` at the end of the step.
+    dt : float
+        Step, s.
+    c : float
+        ``1 + kappa dt``.
+
+    Returns
+    -------
+    lo, hi : float
+        ``lo <= a+ <= hi``.
     """
     big_a = dt * theta
     if not big_a > 0.0:

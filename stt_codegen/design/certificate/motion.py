@@ -31,6 +31,8 @@ from .enclosures import enclose, partition
 from .report import ROUNDING_MARGIN, Certificate, CertificateState, Enclosure, Margin
 from .repropagate import repropagate
 
+__all__ = ["MOVING_PROPERTY", "certify_motion"]
+
 #: Most intervals the refinement for moving obstacles may create (its own budget, on top
 #: of the partition the rest of the certificate proved).
 MOTION_INTERVALS = 50_000

@@ -42,6 +42,9 @@ from .enclosures import piece_widths
 from .implicit_step import SequenceBounds, sequence_bounds
 from .report import Enclosure
 
+__all__ = ["Narrowest", "WIDTH_PIECE_BUDGET", "WIDTH_SPLIT", "WIDTH_TOLERANCE",
+           "sharpen_narrowest"]
+
 #: The narrowest width is sharpened until its lower bound is within this fraction of the
 #: upper bound ``U`` (or cutting can no longer help, or the budget is spent).
 WIDTH_TOLERANCE = 0.1

@@ -25,6 +25,8 @@ from .tasks import task_margins
 from .report import (MAX_MOVE_PER_SAMPLE, ROUNDING_MARGIN, Certificate, CertificateState, Enclosure,
                      certificate_report, obstacle_separation)
 
+__all__ = ["MAX_INTERVALS", "MIN_INTERVAL", "SPLIT", "WIDTH_REFINE_ROUNDS", "certify_tube"]
+
 #: Most intervals the adaptive bisection may create before it gives up (the certificate
 #: then fails with that reason); the work is linear in it.
 MAX_INTERVALS = 200_000

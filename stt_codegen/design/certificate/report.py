@@ -18,6 +18,9 @@ from ...spec.loader import Spec
 from ...tube import reference
 from ...tube.parameters import TubeDesign
 
+__all__ = ["Certificate", "CertificateState", "Enclosure", "MAX_MOVE_PER_SAMPLE", "Margin",
+           "PROPERTIES", "ROUNDING_MARGIN", "certificate_report", "obstacle_separation"]
+
 #: Margins below this (state units) count as failures: rounding in the enclosures.
 ROUNDING_MARGIN = 1e-9
 #: Largest distance a tube bound may move in one sampling period, as a fraction of the
@@ -133,6 +136,15 @@ class Certificate:
     initial_error : float
         ``max_i |e_i|`` of ``x(0)`` in the tube at ``t = 0``.
     enclosure : Enclosure
+    state : CertificateState
+        The final partition and ``alpha`` bounds (to resume a related certificate from).
+    decisive : str
+        A property the tube fails for certain at some instant (refinement stopped there);
+        ``""`` if none.
+    work : int
+        Intervals whose ``alpha`` bounds this certificate computed over all refinement
+        rounds, those resumed from another certificate excluded (a deterministic measure of
+        its cost).
     """
 
     horizon: float
@@ -173,6 +185,15 @@ class Certificate:
 def obstacle_separation(spec: Spec, enc: Enclosure, selected):
     """Separation of the enclosure from each spec obstacle of the boxes ``selected``.
 
+    Parameters
+    ----------
+    spec : Spec
+        The spec (its obstacles and their covering boxes).
+    enc : Enclosure
+        Bounds of ``gamma`` on ``K`` intervals.
+    selected : list of int
+        Indices of ``spec.obstacle_boxes()`` to measure against.
+
     Returns
     -------
     list of (int, ndarray (K,), list of int, ndarray (B, K), list of ndarray (K, n))
@@ -211,6 +232,37 @@ def _below_rounding(margin: float) -> str:
 def certificate_report(design: TubeDesign, spec: Spec, enc: Enclosure, selected, final: bool,
             budget_hit: bool, tail_start: float, max_intervals: int,
             narrowest: tuple[float, float] | None = None) -> Certificate:
+    """The margins of the tube's properties from its enclosure over a partition.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    spec : Spec
+        For the state space, obstacles and target set.
+    enc : Enclosure
+        Bounds of ``gamma`` on the final partition's ``K`` intervals.
+    selected : list of int
+        Indices of ``spec.obstacle_boxes()`` certified against.
+    final : bool
+        Also report ``inside target after t_c``.
+    budget_hit : bool
+        The refinement budget ran out: the messages of failed margins say so.
+    tail_start : float
+        Start of the tail interval ``[tail_start, inf)``, s.
+    max_intervals : int
+        The refinement budget (for the message).
+    narrowest : (float, float), optional
+        ``(width, time)`` of a sharper lower bound of the least width ``gamma_U -
+        gamma_L`` (state units, s) than the enclosure's, if one was computed.
+
+    Returns
+    -------
+    Certificate
+        Margins in the order of :data:`PROPERTIES`, one ``avoids obstacle j`` per spec
+        obstacle; ``state``, ``decisive`` and ``work`` at their defaults (the caller sets
+        them).
+    """
     t0 = enc.t_start
     margins = []
     note = (" (the certificate's refinement budget of "

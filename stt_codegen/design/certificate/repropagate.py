@@ -20,6 +20,8 @@ from .enclosures import Pieces
 from .implicit_step import EXACT_STEPS, Propagation
 from .report import CertificateState
 
+__all__ = ["repropagate", "step_psi"]
+
 #: Bounds brought into a kept interval replace its own where they are tighter by more than
 #: this fraction of its own bounds' spread (plus ``1e-12``) in some component.
 TIGHTER = 0.01
@@ -38,6 +40,8 @@ def step_psi(design: TubeDesign, i0: np.ndarray, steps: np.ndarray) -> list:
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube.
     i0 : ndarray of int, shape (K,)
         Sample index of each interval's start.
     steps : ndarray, shape (K,)
@@ -78,6 +82,8 @@ def repropagate(design: TubeDesign, pieces: Pieces, points: list[int], steps: np
 
     Parameters
     ----------
+    design : TubeDesign
+        The tube.
     pieces : Pieces
         Of the new partition (``psi`` ranges).
     points : list of int

@@ -31,6 +31,8 @@ from ...tube.parameters import TubeDesign
 from .enclosures import enclose, piece_ranges
 from .report import ROUNDING_MARGIN, Enclosure, Margin
 
+__all__ = ["task_margins"]
+
 #: Pieces a window is cut into at most (besides the partition's points inside it).
 TASK_PIECES = 200
 
@@ -124,6 +126,21 @@ def task_margin(design: TubeDesign, task: Task, enc: Enclosure) -> Margin:
 
 def task_margins(design: TubeDesign, spec: Spec, enc: Enclosure) -> tuple[Margin, ...]:
     """:func:`task_margin` of every task of ``spec``, in the spec's order (empty without
-    tasks)."""
+    tasks).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    spec : Spec
+        The spec; its ``tasks`` are judged.
+    enc : Enclosure
+        Bounds of ``gamma`` on the final partition.
+
+    Returns
+    -------
+    tuple of Margin
+        One ``task Tk reach`` or ``task Tk stay`` margin per task.
+    """
     return tuple(task_margin(design, task, enc) for task in spec.tasks)
 
