@@ -37,8 +37,8 @@ from ..tube.parameters import TubeDesign
 from .certificate import Certificate
 from .input_bound import input_prover
 
-#: The normalized error the demand is computed for (issue 20's acceptance: ``max |e| <=
-#: 0.7`` in closed loop).
+#: The normalized error the demand is computed for: the closed loop is to keep ``max |e| <=
+#: 0.7``.
 TRACKING_ERROR = 0.7
 #: Values of ``e`` in ``[-E, E]`` tried for the least speed the state needs.
 _ERRORS = np.linspace(-TRACKING_ERROR, TRACKING_ERROR, 29)
