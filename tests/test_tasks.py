@@ -1,4 +1,4 @@
-"""Timed tasks (issue 21, docs/tasks.md): the design through the tasks' boxes, each task a
+"""Timed tasks (docs/tasks.md): the design through the tasks' boxes, each task a
 certified property for every t (rejected when violated between two samples), the
 simulation's verdict, the generated C, and 3-D as 2-D."""
 
