@@ -16,9 +16,9 @@ from stt_codegen.design.search import design_tube  # noqa: E402
 from stt_codegen.spec.loader import load_spec  # noqa: E402
 
 CASES = ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3"]
-#: The bundled examples of timed tasks (issue 21, docs/tasks.md), besides the paper's.
+#: The bundled examples of timed tasks (docs/tasks.md), besides the paper's.
 TASK_CASES = ["tasks-stay", "tasks-visit"]
-#: The bundled example of moving obstacles (issue 21, docs/moving-obstacles.md).
+#: The bundled example of moving obstacles (docs/moving-obstacles.md).
 EXTRA_CASES = ["crossing-moving"]
 
 # Property tests draw the same examples on every run: a fixed seed (derandomize) and no

@@ -1,4 +1,4 @@
-"""Random plants within declared ``[assumptions]`` (issue 13), for the tests and the study.
+"""Random plants within declared ``[assumptions]``, for the tests and the study.
 
 A plant ``x_dot = f(x) + g(x) u + w(t)`` is drawn so that every bound of
 :class:`~stt_codegen.spec.loader.Assumptions` holds uniformly over the state space:

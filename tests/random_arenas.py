@@ -1,4 +1,4 @@
-"""Seeded random arenas for the design acceptance test (issue 10), and a corridor check.
+"""Seeded random arenas for the design acceptance test, and a corridor check.
 
 Arena ``k`` of seed ``s``: the 5 m x 5 m state space, 5-8 box obstacles with sides drawn in
 [0.4, 1.4] m, a 0.5 m x 0.5 m start set and target set anywhere (not meeting an obstacle or

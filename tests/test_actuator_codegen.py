@@ -1,5 +1,5 @@
 """The actuator clamp of ``[actuator] input_bound`` in the model, the reference and the
-generated code (issue 20, item 4): ``u`` never beyond the bound, ``STATUS_INPUT_CLAMPED``
+generated code: ``u`` never beyond the bound, ``STATUS_INPUT_CLAMPED``
 when law (13) asked for more, the double C and the Python bit-identical to the CasADi
 model; without ``[actuator]`` no piece, table or status is added."""
 

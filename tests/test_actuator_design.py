@@ -1,4 +1,4 @@
-"""Design and verify under ``[actuator] input_bound`` (issue 20, item 4): the design meets
+"""Design and verify under ``[actuator] input_bound``: the design meets
 a bound the default tube exceeds, or refuses naming the ``prescribed_time`` that works;
 ``verify`` proves the bound (``sampled.input_bound``); the closed loop, with the generated
 C, never exceeds it."""

@@ -1,4 +1,4 @@
-"""``[assumptions]`` and the ``linear`` plant in the spec loader (issue 13): defaults,
+"""``[assumptions]`` and the ``linear`` plant in the spec loader: defaults,
 values, and one ``SpecError`` naming the field for every rule."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""``stt-codegen bench tasks`` (issue 21): the seeded problems, the baseline's plan, the
+"""``stt-codegen bench tasks``: the seeded problems, the baseline's plan, the
 report's arithmetic, the command's refusals."""
 
 from __future__ import annotations

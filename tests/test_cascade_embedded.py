@@ -1,4 +1,4 @@
-"""The cascade controller in closed loop on the emulated Cortex-M4F (issue 22)."""
+"""The cascade controller in closed loop on the emulated Cortex-M4F."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The committed cascade controllers under generated/ (issue 22): compiled, run on their
+"""The committed cascade controllers under generated/: compiled, run on their
 vectors from the numpy reference, with the project's warning flags, every output within the
 vectors' derived tolerances (stt_codegen.codegen.tolerance.cascade_bounds) in both
 precisions; the Python module too."""

@@ -33,7 +33,7 @@ def test_cases_lists_bundled_specs():
 def test_bundled_cases_are_the_paper_cases_and_the_examples():
     """The conftest's CASES (the parameters of the ``case`` fixture) are the paper's bundled
     specs; the others are the timed-task examples (TASK_CASES), the moving-obstacle example
-    (EXTRA_CASES) and the second-order cases (issue 22, with tests of their own)."""
+    (EXTRA_CASES) and the second-order cases (with tests of their own)."""
     first_order = [c for c in bundled_cases() if not c.startswith("second-order-")]
     assert first_order == sorted(CASES + TASK_CASES + EXTRA_CASES)
 
@@ -117,7 +117,7 @@ def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
         c_name = name.replace("-", "_")
         for suffix in (".c", ".h", ".py", "_selftest.c"):
             assert (tmp_path / "demo" / name / f"{c_name}{suffix}").is_file()
-    for name in ("second-order-s1", "second-order-quadrotor"):      # issue 22: the cascade
+    for name in ("second-order-s1", "second-order-quadrotor"):      # the cascade
         assert name in out.stdout
         assert (tmp_path / "demo" / f"{name}.png").stat().st_size > 10_000
         c_name = name.replace("-", "_") + "_cascade"
@@ -153,7 +153,7 @@ def test_atomic_write_leaves_a_normal_file_or_nothing(tmp_path):
 @pytest.mark.parametrize("command", ["simulate", "embedded"])
 @pytest.mark.parametrize("seed", ["-5", str(2**32)])
 def test_a_seed_outside_32_bits_is_bad_input_named_by_its_flag(command, seed, capsys):
-    """Issue 19: ``--seed -5`` ended in a traceback; now one line, exit 2, before any work."""
+    """``--seed -5`` ended in a traceback; now one line, exit 2, before any work."""
     from stt_codegen.cli import main
     assert main([command, "omnirobot-s1", "--seed", seed]) == 2
     captured = capsys.readouterr()

@@ -1,4 +1,4 @@
-"""The generated C refuses every compiler mode that assumes no NaN or infinity (issue 23.2).
+"""The generated C refuses every compiler mode that assumes no NaN or infinity.
 
 Such a mode folds ``isfinite`` to 1, so NaN and infinite inputs pass the input checks:
 with clang ``-ffinite-math-only``, ``x[0] = NaN`` returned OK with ``u[0] = NaN``. The old

@@ -1,4 +1,4 @@
-"""Large coordinates (issue 23.1): ``generate`` finishes, double works, single says why not.
+"""Large coordinates: ``generate`` finishes, double works, single says why not.
 
 ``sample_inputs`` looked, without bound, for test points whose single-precision status is
 certain; with the tube narrower than about ``4 * 64 * 2^-24`` times the largest coordinate
@@ -37,7 +37,7 @@ def _cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
                               env=env, capture_output=True, text=True, timeout=HANG)
     except subprocess.TimeoutExpired:
         pytest.fail(f"stt-codegen {' '.join(args)} did not finish in {HANG} s: a hang "
-                    "(the unbounded search for test points of issue 23.1?)")
+                    "(an unbounded search for test points?)")
 
 
 @pytest.mark.parametrize("arena", ARENAS)

@@ -1,4 +1,4 @@
-"""A one-dimensional spec (n = 1, issue 19): its C builds under the project's warning flags.
+"""A one-dimensional spec (n = 1): its C builds under the project's warning flags.
 
 gcc 12 rejected ``P_tube`` of a 1-state spec (``-Werror=maybe-uninitialized`` on
 ``g_u_dot[0]``), so ``simulate`` (C backend) and ``embedded`` exited 3.

@@ -1,4 +1,4 @@
-"""NULL output pointers (issue 23.6): every output whose pointer is not NULL is written.
+"""NULL output pointers: every output whose pointer is not NULL is written.
 
 The header promises, on INVALID_INPUT, ``u = 0``, ``alpha_next = alpha`` (non-finite
 entries 0, ``alpha`` NULL: 0) and ``gamma_* = 0`` "when the pointers allow". With one

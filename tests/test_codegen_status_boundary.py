@@ -1,4 +1,4 @@
-"""Status OK means strictly inside the tube (issue 23.5), C (double, single) and Python.
+"""Status OK means strictly inside the tube, C (double, single) and Python.
 
 The old test ``|2 x - (gamma_U + gamma_L)| < gamma_U - gamma_L`` is rounded: on
 omnirobot-s1 it reported OK for points exactly on a bound and for points one ulp outside.

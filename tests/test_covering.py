@@ -158,7 +158,7 @@ def test_too_close_to_the_start_names_the_start_set(monkeypatch):
 
 
 def test_a_tolerance_too_fine_for_the_shape_is_blamed_on_the_tolerance():
-    """Issue 23 item 7: a quadrilateral in mid-arena, far from the start and the target, at
+    """A quadrilateral in mid-arena, far from the start and the target, at
     tolerance 0.01 needs more than MAX_BOXES boxes; the message says so (it blamed the
     initial and target sets) and comes at once (it took seconds)."""
     quad = "[[obstacles]]\nvertices = [[1.5, 2.0], [2.5, 1.2], [3.5, 2.8], [2.2, 3.6]]\n"
@@ -253,7 +253,7 @@ def assert_bounded_work(work: dict[str, list[int]]) -> None:
 
 
 def test_eighty_polygons_are_covered_soundly_with_bounded_work(monkeypatch):
-    """Issue 23 item 7: 80 random convex polygons at tolerance 0.02 (the covering took
+    """80 random convex polygons at tolerance 0.02 (the covering took
     about 30 s with a linear program per box hull). Every box is within the tolerance,
     random points of every polygon are covered, the result is the same twice, and the
     work is bounded: no linear or quadratic program, the covering's count of hulls and
@@ -295,7 +295,7 @@ def test_polygon_distance_is_the_quadratic_programs_one():
 
 @pytest.mark.slow
 def test_eighty_polygons_design_with_bounded_work(monkeypatch):
-    """Issue 23 item 7: the whole design of 80 polygons at tolerance 0.02 (774 boxes; it
+    """The whole design of 80 polygons at tolerance 0.02 (774 boxes; it
     took 91 s, nearly all of it the covering) is certified; the covering of the spec's 80
     polygons does no linear or quadratic program and its bounded count of hulls and
     distances, and the certificate stays within its interval budget.

@@ -175,7 +175,7 @@ def test_the_gain_comes_from_the_tubes_width_not_from_a_loose_enclosure():
 
 
 def test_every_refusal_carries_a_kind_and_the_tube_tried():
-    """Callers branch on DesignError.kind, never on the message (issue 19)."""
+    """Callers branch on DesignError.kind, never on the message."""
     spec = load_spec("omnirobot-s1")
     paper = dataclasses.replace(spec, tube=dataclasses.replace(
         spec.tube, circumvent_sharpness=0.01, method="paper"))

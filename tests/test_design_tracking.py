@@ -1,6 +1,6 @@
 """``auto`` prefers via points when the paper's tube asks for more gain than it has, or moves
 much faster than the via tube; ``tube.method = "paper"`` refuses a tube the gain cannot
-follow (issue 20).
+follow.
 
 Law (13) has one gain, bounded by the sampled loop at the tube's narrowest point
 (docs/decisions.md, decision 15). A tube that squeezes one dimension to millimetres while

@@ -1,4 +1,4 @@
-"""Issue 10 acceptance: via-point tubes, automatic sharpness, the design command, random arenas."""
+"""Via-point tubes, automatic sharpness, the design command, random arenas."""
 
 from __future__ import annotations
 

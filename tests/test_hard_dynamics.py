@@ -1,4 +1,4 @@
-"""Issue 7, unknown dynamics: the generated C controller on plants it was not designed for.
+"""Unknown dynamics: the generated C controller on plants it was not designed for.
 
 Property (hypothesis, derandomized, 15 examples): for ``x_dot = f(x) + g(x) u + w`` with
 ``f`` a bounded smooth term plus a linear term, ``g = D + S + K(x)`` whose symmetric part

@@ -1,4 +1,4 @@
-"""Issue 7, hostile inputs to the generated C and Python APIs.
+"""Hostile inputs to the generated C and Python APIs.
 
 Every public function (``P_tube``, ``P_control``, ``P_alpha_step``, ``P_step``) of a
 bundled spec, double and single, is called with NaN, infinities, huge and tiny values,

@@ -1,4 +1,4 @@
-"""Issue 7, ``generate -o DIR``: never writes outside DIR, never overwrites files it did not generate.
+"""``generate -o DIR``: never writes outside DIR, never overwrites files it did not generate.
 
 Each hostile layout is checked through the command line (exit 2, one ``error:`` line)
 and by comparing every file under the test folder before and after: nothing outside

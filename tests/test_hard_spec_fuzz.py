@@ -1,4 +1,4 @@
-"""Issue 7, hostile spec files: every input loads or raises SpecError naming a field.
+"""Hostile spec files: every input loads or raises SpecError naming a field.
 
 Hypothesis, derandomized (the same examples on every run). Inputs: random mutations of
 the bundled specs and of variants with a ball and polytopes (a value replaced by a hostile

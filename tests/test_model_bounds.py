@@ -1,4 +1,4 @@
-"""Named plants declare their own bounds (issue 20): what a model implies over a box, and
+"""Named plants declare their own bounds: what a model implies over a box, and
 how ``[assumptions]`` combines with it (contradictions are a ``SpecError`` naming the key)."""
 
 from __future__ import annotations

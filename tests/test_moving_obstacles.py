@@ -1,4 +1,4 @@
-"""Moving obstacles (issue 21, part B): the spec keys, the space-time certificate, the design,
+"""Moving obstacles: the spec keys, the space-time certificate, the design,
 the simulation, the generated C, in 2-D and 3-D (docs/moving-obstacles.md)."""
 
 from __future__ import annotations

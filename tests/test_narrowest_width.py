@@ -1,4 +1,4 @@
-"""The certified narrowest width, the gain of law (13) comes from: sound, and tight (issue 20).
+"""The certified narrowest width, the gain of law (13) comes from: sound, and tight.
 
 Sound: a lower bound of the deployed tube's width at every ``t`` (the controller's own
 ``alpha`` steps, interpolated between samples). Tight: within 20 % of the width densely
@@ -76,7 +76,7 @@ def test_bundled_cases_width_is_sound_and_tight(case):
 
 @pytest.mark.parametrize("name", ISSUE_SPECS)
 def test_issue_tasks_width_is_sound_and_tight(name):
-    """The tasks of issue 20's table: via points, the bound was 6 to 16 times below the
+    """Via-point tasks where a loose bound of the width was 6 to 16 times below the
     deployed width (0.033 for 0.2, 0.015 for 0.1, 0.013 for 0.2)."""
     found = design_tube(load_spec(SPECS / name))
     assert found.method == "via"

@@ -1,4 +1,4 @@
-"""Issue 23, the output folder under concurrency, kills and builds.
+"""The output folder under concurrency, kills and builds.
 
 * Two writers of one folder at once: both succeed, one after the other (a ``flock``
   beside the folder), and the folder is then exactly one complete generation; a writer

@@ -1,4 +1,4 @@
-"""Plants from the spec (issue 13): the ``linear`` model, and the random plants the
+"""Plants from the spec: the ``linear`` model, and the random plants the
 sampled-data tests draw within declared ``[assumptions]``."""
 
 from __future__ import annotations

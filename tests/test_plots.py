@@ -1,4 +1,4 @@
-"""The figures (issue 19): the arena's dimensions chosen and validated, every obstacle in
+"""The figures: the arena's dimensions chosen and validated, every obstacle in
 every projection, obstacles numbered as the messages number them, one legend entry per
 thing and legends off the data, u(t) in a run's figure, a plot when there is no design."""
 

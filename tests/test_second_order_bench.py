@@ -1,4 +1,4 @@
-"""The second-order study and the double-integrator arenas bench (issue 22)."""
+"""The second-order study and the double-integrator arenas bench."""
 
 from __future__ import annotations
 

@@ -26,8 +26,8 @@ def test_paper_cases_are_satisfied(case, backend):
     assert not result.collision and not result.left_state_space and result.stayed_in_tube
     assert result.min_obstacle_clearance > 0
     assert result.steps == 9000 and len(result.max_abs_u) == 3
-    # the state keeps off the tube's wall (issue 20: it rode it at |e| = 0.81 on S2 when
-    # the gain came from a loose bound of the tube's width)
+    # the state keeps off the tube's wall (with a gain from a loose bound of the tube's
+    # width it rode it at |e| = 0.81 on S2)
     assert 0.0 < result.max_abs_e <= 0.7, result.max_abs_e
 
 

@@ -1,4 +1,4 @@
-"""Timed tasks (issue 21, docs/tasks.md): the design through the tasks' boxes, each task a
+"""Timed tasks (docs/tasks.md): the design through the tasks' boxes, each task a
 certified property for every t (rejected when violated between two samples), the
 simulation's verdict, the generated C, and 3-D as 2-D."""
 
@@ -149,6 +149,17 @@ def test_stay_window_from_zero_holds_the_start_box():
     with pytest.raises(DesignError) as info:
         design_tube(spec_of(arena(2, tasks, obstacles=[], t_c=10.0)))
     assert info.value.kind is FailureKind.TASK
+
+
+def test_reach_window_from_zero_is_designed_and_certified():
+    """A reach window may start at t = 0 (docs/tasks.md): its hold is the window's middle
+    half, so the first leg has time; the certificate proves the task inside the window."""
+    tasks = [{"kind": "reach", "window": [0.0, 0.5], "lower": [0.0, 0.0], "upper": [0.8, 0.8]}]
+    design = design_tube(spec_of(arena(2, tasks, t_c=10.0)))
+    hold = [s for s in design.tube.segments if s.lower_from == s.lower_to]
+    assert (hold[0].start, hold[0].end) == (0.125, 0.375)
+    m = margins(design.certificate)["task T1 reach"]
+    assert m.passed and 0.0 <= m.time <= 0.5
 
 
 @pytest.mark.slow

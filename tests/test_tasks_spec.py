@@ -1,4 +1,4 @@
-"""``[[tasks]]`` in the spec (issue 21, docs/tasks.md): the schema, the cross-field rules,
+"""``[[tasks]]`` in the spec (docs/tasks.md): the schema, the cross-field rules,
 clear SpecErrors, the CLI's exit code, and specs without tasks unchanged."""
 
 from __future__ import annotations

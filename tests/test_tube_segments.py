@@ -1,4 +1,4 @@
-"""Piecewise reach tube and the eq. (9) combination over open circumvents (issue 10, step 0)."""
+"""Piecewise reach tube and the eq. (9) combination over open circumvents."""
 
 from __future__ import annotations
 

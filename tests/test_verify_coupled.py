@@ -1,4 +1,4 @@
-"""The sampled check with coupled plants (issue 20): the robot judged with its own bounds,
+"""The sampled check with coupled plants: the robot judged with its own bounds,
 plants of that class simulated against the bound the check proves, a plant outside its
 bounds refused, and a derandomized sample of the wide study (no accepted plant fails)."""
 

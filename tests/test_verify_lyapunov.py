@@ -1,4 +1,4 @@
-"""The Lyapunov level of the coupled sampled check (issue 20), one sampling interval at a
+"""The Lyapunov level of the coupled sampled check, one sampling interval at a
 time: every bound of ``verify/lyapunov.py`` is compared with the exact step of plants of
 the class, at many points of the ball (seeded: the same cases every run)."""
 

@@ -1,4 +1,4 @@
-"""The sampled-data check of ``verify`` (issue 13): its verdicts on the example specs, and
+"""The sampled-data check of ``verify``: its verdicts on the example specs, and
 its soundness: no plant within the declared bounds of a passing check leaves the tube."""
 
 from __future__ import annotations
@@ -94,7 +94,7 @@ def test_the_check_fails_where_the_linearization_is_unstable(case):
 
 
 def test_g_3_with_the_old_gain_fails_in_simulation_and_in_the_check():
-    """docs/guarantees.md's limit case (issue 7): flagged before deployment now."""
+    """docs/guarantees.md's limit case: flagged before deployment now."""
     spec, design, _ = designed("omnirobot-s2")
     tight = Assumptions((3.0, 3.0), 0.0, 0.0, 0.0, spec.assumptions.disturbance_bound)
     s = samples_of("omnirobot-s2")

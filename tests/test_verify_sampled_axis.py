@@ -1,4 +1,4 @@
-"""The per-axis bound of the coupling (issue 20): the other inputs' push on one axis,
+"""The per-axis bound of the coupling: the other inputs' push on one axis,
 correlated with that axis's own gain, against random matrices of the class."""
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 The deployed law floors ``gamma_d`` at ``GAMMA_D_MIN`` (1e-6) to keep ``u`` finite. The
 floored ``e`` is smaller than the true one, so judging ``|e| < 1`` with it would report a
-state outside a tube narrower than the floor as inside (issue 13).
+state outside a tube narrower than the floor as inside.
 """
 
 from __future__ import annotations

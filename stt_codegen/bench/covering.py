@@ -20,7 +20,7 @@ from ..errors import DesignError, SpecError
 from ..spec.loader import parse_spec
 from .report import machine, machine_line, table
 
-#: The default spec: 80 polygons at tolerance 0.02 (issue 23 item 7).
+#: The default spec: 80 polygons at tolerance 0.02 (docs/performance.md).
 DEFAULT_COUNT = 80
 DEFAULT_TOLERANCE = 0.02
 

@@ -1,4 +1,4 @@
-"""Seeded random moving obstacles for benchmarks (issue 21: ``bench tasks`` draws 0-4).
+"""Seeded random moving obstacles for benchmarks (``bench tasks`` draws 0-4).
 
 :func:`random_moving_obstacles` returns spec-dict ``[[obstacles]]`` entries
 (docs/moving-obstacles.md) for an arena given as a :class:`~stt_codegen.spec.loader.Spec`.

@@ -1,4 +1,4 @@
-"""The wide study of unknown plants (issues 7, 13, 20): simulation against the sampled check.
+"""The wide study of unknown plants: simulation against the sampled check.
 
 Draws plants ``x_dot = f(x) + g(x) u + w`` over wide ranges (``|f|`` up to about 6,
 eigenvalues of the symmetric part of ``g`` in ``[0.05, 5]``, a skew part up to 1,

@@ -1,5 +1,5 @@
 """``stt-codegen bench arenas --plant double-integrator``: the cascade on random arenas,
-beside a planner and a tracker for the same plant (issue 22, docs/second-order.md).
+beside a planner and a tracker for the same plant (docs/second-order.md).
 
 The arenas are :func:`~.arenas.generate_arena`'s (seeded, four 1 m obstacles, 5 m x 5 m,
 ``t_c = 9`` s). The plant is a double integrator ``x2_dot = u / m + w`` with ``m = 1`` kg

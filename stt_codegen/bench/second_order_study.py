@@ -1,5 +1,5 @@
 """``stt-codegen bench second-order``: the cascade on random second-order plants within the
-declared bounds of a bundled second-order case (issue 22, docs/second-order.md).
+declared bounds of a bundled second-order case (docs/second-order.md).
 
 For a design whose spec has a second-order ``plant.model``, the default second stage is derived once
 from the spec's declared bounds (as ``simulate`` does); then ``count`` plants are drawn

@@ -1,4 +1,4 @@
-"""Seeded random timed-task problems for ``stt-codegen bench tasks`` (issue 21).
+"""Seeded random timed-task problems for ``stt-codegen bench tasks`` (docs/tasks.md).
 
 Problem ``k`` of seed ``S`` is random arena ``k`` of seed ``S`` of :mod:`.arenas` (the
 case study's 5 m x 5 m arena, four random 1 m x 1 m obstacles, a random start set, the

@@ -1,5 +1,5 @@
 """The bundled specs: the paper's case study (section V), one TOML file per start set, and
-two second-order cases (issue 22, docs/second-order.md)."""
+two second-order cases (docs/second-order.md)."""
 
 from __future__ import annotations
 

@@ -30,7 +30,7 @@ def _int_list(text: str, field: str) -> list[int]:
 
 
 def _cmd_arenas(args: argparse.Namespace) -> int:
-    if args.plant == "double-integrator":       # issue 22: the cascade beside A* + tracker
+    if args.plant == "double-integrator":       # the cascade beside A* + tracker
         from ..bench.second_order_arenas import (format_double_integrator_report,
                                                  run_double_integrator_bench)
         report = run_double_integrator_bench(args.count, args.seed)
@@ -171,7 +171,7 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
     p.set_defaults(handler=_cmd_alpha)
 
     p = sub.add_parser("second-order", help="the cascade law on random second-order plants "
-                                            "within a case's declared bounds (issue 22)")
+                                            "within a case's declared bounds")
     p.add_argument("spec", metavar="SPEC", nargs="?", default="second-order-s1",
                    help="bundled case or spec file with a second-order plant.model "
                         "(default: %(default)s)")

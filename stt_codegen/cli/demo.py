@@ -30,7 +30,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
         design = design_spec(spec, args)
         generate(design, out / name)
         result = simulate(design, backend=args.backend)   # the cascade's for second order
-        if spec.second_order is not None:   # the cascade law (issue 22)
+        if spec.second_order is not None:   # the cascade law
             from ..runtime.cascade_plots import plot_cascade_run
             draw = plot_cascade_run
         else:

@@ -76,7 +76,7 @@ def generate(design: Design, out_dir: str | Path,
     """
     design = require_design(design, "generate")
     options = parse_options(languages, precision)
-    if design.spec.second_order is not None:     # the cascade controller (issue 22)
+    if design.spec.second_order is not None:     # the cascade controller
         from .cascade_source import cascade_generation
         files = cascade_generation(design, options)
     else:

@@ -42,7 +42,7 @@ def expected_tree() -> dict[str, bytes]:
     for case in bundled_cases():
         design = design_tube(load_spec(case))
         for sub, options in LAYOUT.items():
-            # a second-order case (issue 22): the cascade controller, docs/second-order.md
+            # a second-order case: the cascade controller, docs/second-order.md
             files = (cascade_generation(design, options) if design.spec.second_order
                      else generate_files(design.spec, design.tube, options))
             for name, data in files.items():

@@ -1,4 +1,4 @@
-"""Design within the actuators' limits (``[actuator] input_bound``, issue 20).
+"""Design within the actuators' limits (``[actuator] input_bound``).
 
 :func:`design_within_bound` is what :func:`~stt_codegen.design.search.design_tube` does
 for a spec with ``[actuator]``. It accepts a tube only when the prover

@@ -1,4 +1,4 @@
-"""Designing a tube that avoids moving obstacles where and when they are (issue 21, part B).
+"""Designing a tube that avoids moving obstacles where and when they are.
 
 A spec's moving obstacles (``Spec.moving_obstacles``, :mod:`stt_codegen.spec.motion`) are
 not seen by the static design search. :func:`design_moving` tries, in order, and returns the

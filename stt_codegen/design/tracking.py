@@ -40,8 +40,8 @@ from .input_bound import input_prover
 __all__ = ["SMOOTHER_RATIO", "TRACKING_ERROR", "centre_speed", "proved_error", "tracking_demand",
            "unfollowable"]
 
-#: The normalized error the demand is computed for (issue 20's acceptance: ``max |e| <=
-#: 0.7`` in closed loop).
+#: The normalized error the demand is computed for: the closed loop is to keep ``max |e| <=
+#: 0.7``.
 TRACKING_ERROR = 0.7
 #: Values of ``e`` in ``[-E, E]`` tried for the least speed the state needs.
 _ERRORS = np.linspace(-TRACKING_ERROR, TRACKING_ERROR, 29)

@@ -2,7 +2,7 @@
 
 When the paper's single straight reach tube (eq. (4)) with one circumvent per obstacle
 has no certified design, the reach box can instead move through a short sequence of via
-boxes ``B_0 = X-hat_0, B_1, ..., B_m = T-hat`` (issue 10, docs/decisions.md, decision 12):
+boxes ``B_0 = X-hat_0, B_1, ..., B_m = T-hat`` (docs/decisions.md, decision 12):
 
 * **Free boxes.** The state space is cut into a grid of cells of side ``h`` in the
   dimensions some obstacle restricts (the others interpolate from ``X-hat_0`` to

@@ -1,4 +1,4 @@
-"""The cascade controller for a second-order plant on an emulated Cortex-M4F (issue 22).
+"""The cascade controller for a second-order plant on an emulated Cortex-M4F.
 
 :func:`run_cascade_embedded` builds, for a design whose spec has a second-order
 ``plant.model``:

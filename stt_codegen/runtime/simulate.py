@@ -221,7 +221,7 @@ def simulate(design: Design, *positional: object, backend: str = "reference",
                         "(design.spec), and every other argument by keyword: "
                         "simulate(design, backend=..., horizon=..., seed=..., plant=...)")
     design = require_design(design, "simulate")
-    if design.spec.second_order is not None:     # the cascade law (issue 22)
+    if design.spec.second_order is not None:     # the cascade law
         if plant is not None:
             raise SpecError("plant", "a second-order spec runs its own plant.model through "
                                      "the cascade law; another plant cannot be given")

@@ -5,7 +5,8 @@ Contract: :func:`load_spec` / :func:`parse_spec` return a frozen :class:`Spec` o
 polytopes are covered by boxes here (:mod:`.covering`, Remark 3.1), so every later stage
 sees boxes only (``Spec.obstacle_boxes()``) and the shapes as given (``Spec.unsafe_sets``).
 One validation path: :mod:`.schema` checks every value, :mod:`.loader` only the rules that
-relate fields to each other; plant-model facts are :mod:`.plants` (docs/spec.md).
+relate fields to each other; plant-model facts are :mod:`.plants` (docs/architecture.md,
+"One validation path").
 """
 
 from .loader import Box, Obstacle, Spec, UnsafeSet, bundled_cases, load_spec, parse_spec

@@ -1,7 +1,7 @@
 """Obstacles that move or exist only for a while: the spec's ``active``, ``velocity``, ``path``.
 
 A box obstacle with any of the keys ``active``, ``velocity`` or ``path`` is a *moving
-obstacle* (issue 21, part B; the argument is docs/moving-obstacles.md): it is not in
+obstacle* (the argument is docs/moving-obstacles.md): it is not in
 ``Spec.obstacles`` (the static boxes the design search avoids at every ``t``) but in
 ``Spec.moving_obstacles``, a :class:`MovingObstacle` each, which the design avoids where and
 when it is.

@@ -113,7 +113,7 @@ class BoxObstacle(_Table):
     upper: Vector = Field(description="upper corner on dims, state units; upper >= lower")
     dims: list[Index] = _omitted("state dimensions of lower/upper (default the first ones); "
                                  "the box spans the others")
-    # moving obstacles (issue 21, docs/moving-obstacles.md; cross-field rules: spec/motion.py)
+    # moving obstacles (docs/moving-obstacles.md; cross-field rules: spec/motion.py)
     active: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = _omitted(
         "[t_on, t_off], seconds, t_on < t_off: when the obstacle exists; default always")
     velocity: Vector = _omitted("state units/s on dims: the box translates from lower/upper "

@@ -1,5 +1,5 @@
 """``sampled.input_bound``: the deployed law (13) never asks an input for more than
-``[actuator] input_bound`` (issue 20).
+``[actuator] input_bound``.
 
 From the sampled-data check (:mod:`.sampled`), which proves a bound ``E_k,i`` of
 ``|e_i(t_k)|`` at every sample for every plant of ``[assumptions]``, and the certified

@@ -202,7 +202,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     # ulp of libm, tens of times faster), as the certificate and the input-bound prover
     # do: every margin here is far above rounding
     if spec.second_order is not None:
-        # issue 22: the deployed controller is the cascade, not law (13) on this plant: its
+        # the deployed controller is the cascade, not law (13) on this plant: its
         # lemmas, and a plain FAIL for what is not proved (docs/second-order.md)
         from .cascade import cascade_checks, cascade_rate_check, sampled_cascade_check
         stage("sampled loop")          # the cascade takes the sampled loop's slot

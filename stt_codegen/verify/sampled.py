@@ -150,7 +150,7 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
         ``k`` to check instead of ``design.gain``.
     lyapunov : bool
         Use the Lyapunov balls (default); ``False`` keeps the per-axis argument alone,
-        the check before issue 20 (for comparisons).
+        without the Lyapunov level (for comparisons).
 
     Returns
     -------
