@@ -38,6 +38,8 @@ from ..tube.model import implicit_alpha_update
 from ..tube.parameters import NEWTON_ITERATIONS, TubeDesign
 from .report import machine, machine_line, table
 
+__all__ = ["RATE_FACTORS", "format_alpha_report", "run_alpha_bench"]
+
 #: The adversarial batch: size, seed, and the adaptive law's kappa.
 BATCH = 100_000
 SEED = 0

@@ -33,6 +33,9 @@ from ..errors import DesignError
 from ..runtime.simulate import SimulationResult
 from .arenas import generate_arena
 
+__all__ = ["LABELS", "METHODS", "closed_loop_failure", "design_failure", "loop_arena",
+           "plan_arena", "run_arena"]
+
 METHODS = ("stt-paper", "stt", "astar", "rrtstar")
 #: Names of the certificate's properties (:mod:`stt_codegen.design.certificate`), as they appear
 #: in design errors.

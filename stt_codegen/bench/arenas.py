@@ -31,6 +31,8 @@ import numpy as np
 from ..errors import SpecError
 from ..spec.loader import Box, Spec, parse_spec
 
+__all__ = ["ARENA", "OBSTACLE_SIZE", "START_SIZE", "TARGET", "generate_arena", "generate_arenas"]
+
 #: The case study's arena, target, obstacle size and start-set size, metres.
 ARENA = Box((0.0, 0.0), (5.0, 5.0))
 TARGET = Box((4.5, 4.5), (5.0, 5.0))

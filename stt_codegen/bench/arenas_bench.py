@@ -14,6 +14,8 @@ from .parallel import run_parallel
 from .report import machine, machine_line, seconds_text, summarize, table
 from .rrtstar import ompl_available
 
+__all__ = ["available_methods", "format_arenas_report", "run_arenas_bench", "write_specs"]
+
 
 def available_methods() -> tuple[tuple[str, ...], dict[str, str]]:
     """The methods that can run here, and why the others cannot (method -> reason)."""

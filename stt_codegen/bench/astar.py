@@ -19,6 +19,8 @@ import numpy as np
 from ..spec.loader import Spec
 from .planning import FreeSpace, Plan
 
+__all__ = ["RESOLUTION", "grid_graph", "grid_path", "plan_astar"]
+
 #: Grid spacing, metres.
 RESOLUTION = 0.05
 

@@ -20,6 +20,8 @@ from ..errors import DesignError, SpecError
 from ..spec.loader import parse_spec
 from .report import machine, machine_line, table
 
+__all__ = ["format_covering_report", "polygons_toml", "run_covering_bench"]
+
 #: The default spec: 80 polygons at tolerance 0.02 (issue 23 item 7).
 DEFAULT_COUNT = 80
 DEFAULT_TOLERANCE = 0.02

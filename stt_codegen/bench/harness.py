@@ -41,6 +41,8 @@ from ..spec.loader import NAME_PATTERN
 from ..system import find_tool
 from ..tube.parameters import TubeDesign
 
+__all__ = ["BenchError", "build_harness", "harness_source"]
+
 #: Compiler flags of the harness and the generated source (those of backend ``c``
 #: without ``-shared -fPIC``).
 CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off")

@@ -29,6 +29,8 @@ from ..spec.loader import Spec
 from .arenas import generate_arena
 from .moving import random_moving_obstacles
 
+__all__ = ["study_moving"]
+
 
 def _run(spec: Spec) -> tuple[str, float, bool]:
     """(how it was designed or ``"no design"``, design seconds, satisfied in closed loop)."""

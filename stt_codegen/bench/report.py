@@ -10,6 +10,8 @@ from typing import Any
 
 import numpy as np
 
+__all__ = ["machine", "machine_line", "seconds_text", "summarize", "table"]
+
 
 def machine() -> dict[str, Any]:
     """The machine a benchmark ran on: CPU model, CPUs usable, OS, Python, C compiler."""

@@ -21,6 +21,8 @@ import numpy as np
 from ..spec.loader import Spec
 from .planning import FreeSpace, Plan
 
+__all__ = ["ompl_available", "plan_rrtstar"]
+
 #: RRT* iterations per arena (the first solution typically appears within 100).
 ITERATIONS = 2000
 #: Wall-clock cap per arena, seconds.

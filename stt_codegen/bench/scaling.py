@@ -33,6 +33,8 @@ from .harness import BenchError, build_harness
 from .report import machine, machine_line, seconds_text, table
 from .timing import MIN_BATCH_SECONDS
 
+__all__ = ["format_scaling_report", "run_scaling_bench", "synthetic_design"]
+
 #: Obstacles in the dimension sweep (the case study's count).
 DIMENSION_SWEEP_OBSTACLES = 4
 #: Obstacles of the active-window experiment.

@@ -28,6 +28,9 @@ from ..errors import DesignError
 from ..runtime.cascade_simulate import simulate_second_order
 from .arenas import generate_arena
 
+__all__ = ["format_double_integrator_report", "run_arena_double_integrator",
+           "run_double_integrator_bench"]
+
 #: Velocity-loop gain of the baseline tracker, 1/s.
 VELOCITY_GAIN = 10.0
 #: Declared range of ``1/m`` for the cascade's default gains.

@@ -27,6 +27,8 @@ from ..errors import SpecError
 from ..runtime.cascade_simulate import simulate_second_order
 from ..spec.loader import load_spec
 
+__all__ = ["DRAG_MAX", "format_second_order_report", "random_parameters", "run_second_order_study"]
+
 #: Largest drag of the random quadrotors, N s / m.
 DRAG_MAX = 0.4
 #: Gravity of the random quadrotors, m/s^2.

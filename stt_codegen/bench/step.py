@@ -26,6 +26,8 @@ from .harness import BenchError, build_harness
 from .report import machine, machine_line, seconds_text, table
 from .timing import python_batch, round_robin
 
+__all__ = ["format_step_report", "run_step_bench"]
+
 #: Compiled-loop steps per timed run, and rounds of the round-robin.
 DEFAULT_STEPS = 100_000
 ROUNDS = 7

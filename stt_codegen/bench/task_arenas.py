@@ -25,6 +25,8 @@ from ..spec.loader import Box, Spec, parse_spec
 from .arenas import generate_arena
 from .moving import random_moving_obstacles
 
+__all__ = ["task_problem", "task_problem_toml"]
+
 #: Side of a task box, metres.
 TASK_SIZE = 0.6
 #: Seconds between consecutive window centres (and before the first).

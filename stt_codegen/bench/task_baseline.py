@@ -33,6 +33,8 @@ from .planning import FreeSpace
 from .task_timing import departure
 from .tracker import GOAL_GAIN, SPEED, PathTracker
 
+__all__ = ["plan_timed", "track_timed"]
+
 BACKEND = "bench-timed-tracker"
 
 

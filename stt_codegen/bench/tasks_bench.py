@@ -28,6 +28,8 @@ from ..errors import DesignError, SpecError
 from .task_arenas import task_problem
 from .task_baseline import plan_timed, track_timed
 
+__all__ = ["METHODS", "format_tasks_report", "run_tasks_bench"]
+
 METHODS = ("stt", "astar")
 LABELS = {"stt": "STT (C controller)", "astar": "sequential A* + waiting + tracker"}
 

@@ -7,6 +7,8 @@ import statistics
 import time
 from collections.abc import Callable, Sequence
 
+__all__ = ["MIN_BATCH_SECONDS", "python_batch", "round_robin"]
+
 #: Smallest duration of one timed batch, seconds.
 MIN_BATCH_SECONDS = 0.2
 

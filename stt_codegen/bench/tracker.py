@@ -28,6 +28,8 @@ from ..runtime.simulate import SimulationResult, run_closed_loop
 from ..spec.loader import Spec
 from ..tube.parameters import TubeDesign
 
+__all__ = ["GOAL_GAIN", "PathTracker", "SPEED", "track"]
+
 #: Cruise speed, m/s.
 SPEED = 1.5
 #: Carrot distance ahead of the projection on the path, metres.

@@ -34,6 +34,8 @@ from ..errors import DesignError, SpecError, SttError, ToolchainError
 from ..version import __version__
 from .parser import CommandParser
 
+__all__ = ["COMMANDS", "EXIT_CODES", "build_parser", "exit_code", "main"]
+
 #: Every subcommand: name -> (one-line help, ``"module:function"``). The function takes the
 #: subcommand's :class:`argparse.ArgumentParser`, adds its arguments and sets
 #: ``handler=fn(args) -> int`` (the exit code). It is imported only when the command runs.

@@ -10,6 +10,8 @@ from pathlib import Path
 from ..errors import SpecError
 from .common import add_json_argument, add_spec_argument
 
+__all__ = ["configure_bench"]
+
 
 def _non_negative_int(text: str) -> int:
     value = int(text)

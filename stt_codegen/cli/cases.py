@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+__all__ = ["cmd_cases", "configure_cases"]
+
 
 def cmd_cases(args: argparse.Namespace) -> int:
     """Print the bundled specs' names; exit 0."""

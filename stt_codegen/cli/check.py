@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+__all__ = ["cmd_check", "configure_check"]
+
 
 def cmd_check(args: argparse.Namespace) -> int:
     """``stt-codegen check [--root generated] [--update]``: 0 identical, 1 drift."""

@@ -17,6 +17,9 @@ if TYPE_CHECKING:
     from ..design.result import Design
     from ..spec.loader import Spec
 
+__all__ = ["add_backend_argument", "add_json_argument", "add_seed_argument", "add_spec_argument",
+           "checked_seed", "design_spec", "load_and_design", "print_json"]
+
 
 def add_spec_argument(p: argparse.ArgumentParser) -> None:
     """The positional ``SPEC``: a bundled case name or a spec file."""

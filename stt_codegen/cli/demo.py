@@ -10,6 +10,8 @@ from .common import add_backend_argument, design_spec
 from .plotting import add_dims_argument, plot_dims
 from .simulate import SUMMARY_HEADER, summary_line
 
+__all__ = ["cmd_demo", "configure_demo"]
+
 
 def cmd_demo(args: argparse.Namespace) -> int:
     """0 every case satisfied, 1 otherwise, 3 toolchain."""

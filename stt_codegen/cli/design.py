@@ -7,6 +7,8 @@ import argparse
 from .common import add_json_argument, add_spec_argument, print_json
 from .plotting import add_plot_argument, design_to_plot, write_plot
 
+__all__ = ["cmd_design", "configure_design"]
+
 
 def cmd_design(args: argparse.Namespace) -> int:
     """0 designed, 1 no design (``--plot``: the best rejected tube is drawn), 2 bad input."""

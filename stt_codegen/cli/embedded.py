@@ -9,6 +9,8 @@ from ..errors import SpecError
 from .common import (add_json_argument, add_seed_argument, add_spec_argument, checked_seed,
                      load_and_design, print_json)
 
+__all__ = ["cmd_embedded", "configure_embedded"]
+
 
 def _print_report(r: dict) -> None:
     print(f"{r['spec']} on {r['target']}")

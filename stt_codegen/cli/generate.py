@@ -8,6 +8,8 @@ from pathlib import Path
 from ..codegen.options import LANGUAGES, PRECISIONS, parse_options
 from .common import add_spec_argument, load_and_design
 
+__all__ = ["cmd_generate", "configure_generate"]
+
 
 def cmd_generate(args: argparse.Namespace) -> int:
     """0 written, 1 no design, 2 bad input, 3 code generator failure."""

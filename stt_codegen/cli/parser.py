@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import functools
 
+__all__ = ["CommandParser"]
+
 
 class CommandParser(argparse.ArgumentParser):
     """An argument parser that remembers the option of each destination, ``flags[dest]``.

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import json
 
+__all__ = ["cmd_schema", "configure_schema"]
+
 
 def cmd_schema(args: argparse.Namespace) -> int:
     """Print the schema of :mod:`stt_codegen.spec.schema`; exit 0."""

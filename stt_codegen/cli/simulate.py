@@ -8,6 +8,8 @@ from .common import (add_backend_argument, add_json_argument, add_seed_argument,
                      add_spec_argument, checked_seed, print_json)
 from .plotting import add_plot_argument, design_to_plot, write_plot
 
+__all__ = ["SUMMARY_HEADER", "cmd_simulate", "configure_simulate", "summary_line"]
+
 #: Header of the table of :func:`summary_line` rows (``simulate`` and ``demo``).
 SUMMARY_HEADER = f"{'case':<22} {'satisfied':<9} {'reach [s]':>9} {'clearance':>9}   max |u|"
 

@@ -9,6 +9,8 @@ from collections.abc import Callable
 
 from .common import add_json_argument, add_spec_argument, design_spec
 
+__all__ = ["cmd_verify", "configure_verify"]
+
 
 def _terminal_progress() -> Callable[[str], None] | None:
     """Progress on stderr when it is a terminal (one line, rewritten), else ``None``."""

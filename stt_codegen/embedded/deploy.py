@@ -54,6 +54,8 @@ from .programs import (closed_loop_source, parse_closed_loop, parse_replay, repl
 from .target import CPU_FLAGS, build_elf, run_qemu
 from .toolchain import missing_message
 
+__all__ = ["compare_outputs", "run_embedded"]
+
 #: Steps whose instructions are counted: evenly spread over [0, t_c) (fractions of t_c).
 COUNT_FRACTIONS = (0.0, 0.2, 0.4, 0.6, 0.8, 0.999)
 

@@ -27,6 +27,9 @@ from pathlib import Path
 from stt_codegen.embedded.toolchain import find_toolchain, run_tool
 from stt_codegen.errors import ToolchainError
 
+__all__ = ["Footprint", "FootprintError", "elf_stack_bound", "linked_sizes", "measure",
+           "worst_stack"]
+
 _CALL_RELOCS = ("R_ARM_THM_CALL", "R_ARM_THM_JUMP24", "R_ARM_THM_JUMP19", "R_ARM_CALL",
                 "R_ARM_JUMP24")
 

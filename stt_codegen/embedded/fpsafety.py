@@ -35,6 +35,8 @@ from ..system import find_tool
 from ..tube.parameters import TubeDesign
 from .programs import parse_replay, replay_source
 
+__all__ = ["adversarial_inputs", "check_host"]
+
 FLAG_NAMES = {1: "FE_OVERFLOW", 2: "FE_INVALID", 4: "FE_DIVBYZERO"}
 SANITIZE = ("-fsanitize=float-divide-by-zero,float-cast-overflow,undefined",
             "-fno-sanitize-recover=all")

@@ -30,6 +30,8 @@ from ..runtime.simulate import SUBSTEPS
 from ..spec.loader import Spec
 from ..tube.parameters import TubeDesign
 
+__all__ = ["closed_loop_source", "parse_closed_loop", "parse_replay", "replay_source", "steps_of"]
+
 
 def _d(value: float) -> str:
     """A C double literal that reads back exactly."""

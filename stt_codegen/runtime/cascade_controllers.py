@@ -24,6 +24,8 @@ from ..tube.parameters import TubeDesign
 from ..tube.second_stage import (CASCADE_OK, CASCADE_OUTSIDE_POSITION_TUBE,
                                  CASCADE_OUTSIDE_VELOCITY_TUBE, SecondStage)
 
+__all__ = ["CascadeController"]
+
 #: The backends of the cascade step, in order.
 CASCADE_BACKENDS = ("reference", "casadi", "python", "c")
 

@@ -12,6 +12,8 @@ from ..tube import reference
 from .cascade_simulate import CascadeResult
 from .plots import agg_figure, draw_arena, save
 
+__all__ = ["plot_cascade_run"]
+
 
 def plot_cascade_run(design: Design, result: CascadeResult, path: str | Path,
                      dims: tuple[int, int] = (0, 1)) -> Path:

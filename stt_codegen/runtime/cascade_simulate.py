@@ -26,6 +26,9 @@ from .cascade_controllers import CascadeController
 from .plants import Disturbance
 from .second_order_plants import model_info, second_order_rhs
 
+__all__ = ["CascadeResult", "CascadeTrajectory", "SUBSTEPS", "simulate_cascade",
+           "simulate_second_order"]
+
 #: Runge-Kutta steps per sampling period.
 SUBSTEPS = 2
 

@@ -26,6 +26,8 @@ from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..system import atomic_write, find_tool
 
+__all__ = ["CController", "CFLAGS", "GeneratedPythonController", "compiler", "load_python_module"]
+
 #: Flags of the shared-library build (``-ffp-contract=off``: same rounding as CasADi's VM).
 CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fPIC", "-shared", "-Wall", "-Wextra",
           "-Wpedantic", "-Wshadow", "-Werror")

@@ -18,6 +18,8 @@ from matplotlib.patches import Rectangle
 from ..spec.loader import Spec
 from ..spec.motion import MovingObstacle
 
+__all__ = ["draw_moving_obstacles", "mark_states"]
+
 #: Instants at which each moving obstacle is drawn.
 SLICES = 4
 #: Colour map of the slice times, over ``[0, t_c]``.

@@ -20,6 +20,8 @@ from ..spec.loader import LinearPlant
 from ..spec.plants import PLANTS, dimension_mismatch
 from .dynamics import linear_rhs, plant_rhs
 
+__all__ = ["Disturbance", "check_seed", "make_plant"]
+
 #: Number of sinusoids summed in each disturbance component.
 DISTURBANCE_TERMS = 3
 

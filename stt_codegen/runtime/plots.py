@@ -43,6 +43,10 @@ if TYPE_CHECKING:
     from ..design.certificate import Certificate
     from ..errors import DesignError
 
+__all__ = ["OBSTACLE_LABEL", "agg_figure", "arena_figure", "design_figure", "draw_arena",
+           "parse_dims", "plot_design", "plot_rejected", "plot_run", "rejected_figure",
+           "run_figure", "save"]
+
 #: The state dimensions the arena is drawn on unless told otherwise.
 DEFAULT_DIMS = (0, 1)
 #: Tube boxes (at most) drawn over the arena of a design.

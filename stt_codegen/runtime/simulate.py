@@ -26,6 +26,8 @@ from ..tube import reference
 from ..tube.parameters import TubeDesign
 from .tasks import TaskOutcome, judge_tasks
 
+__all__ = ["SUBSTEPS", "SimulationResult", "Trajectory", "run_closed_loop", "simulate"]
+
 #: Runge-Kutta steps per sampling period.
 SUBSTEPS = 2
 

@@ -12,6 +12,8 @@ from matplotlib.patches import Rectangle
 from ..spec.loader import Box, Spec
 from ..spec.tasks import STAY, Task
 
+__all__ = ["draw_task_windows", "draw_tasks"]
+
 
 def task_caption(task: Task) -> str:
     """The label drawn beside a task's box: ``"T1 [7, 8] s"`` (``"T2 stay [2, 4] s"``)."""

@@ -23,6 +23,8 @@ import numpy as np
 from ..spec.loader import Spec
 from ..spec.tasks import STAY, Task
 
+__all__ = ["TaskOutcome", "judge_tasks"]
+
 
 @dataclass(frozen=True)
 class TaskOutcome:

@@ -25,6 +25,8 @@ from ..rounding import distinct
 from .check import Check
 from .sampled import SampledCheck, sampled_check_of
 
+__all__ = ["input_bound_check", "prove_input_bound", "sampled_error_bound"]
+
 
 def sampled_error_bound(result: SampledCheck, samples: TubeSamples) -> np.ndarray | None:
     """The sampled check's bound of ``|e_i(t_k)|``, shape (K, n), or ``None`` if it failed.

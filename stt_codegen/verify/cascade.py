@@ -35,6 +35,10 @@ from ..tube.parameters import E_MAX, GAMMA_D_MIN
 from .check import Check
 from .deployed import on_domain
 
+__all__ = ["NOT_PROVED", "cascade_checks", "cascade_rate_check", "check_jacobian",
+           "check_lyapunov_derivative", "check_pushes_back", "check_transform",
+           "check_velocity_tube", "sampled_cascade_check"]
+
 #: What ``verify`` does not prove about the cascade, in words.
 NOT_PROVED = (
     "not proved: the bounds E1, E2 < 1 of the continuous-time argument are shown to exist, "

@@ -5,6 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Iterable
 
+__all__ = ["Check", "VerificationReport", "all_passed", "format_report"]
+
 
 @dataclass(frozen=True)
 class Check:

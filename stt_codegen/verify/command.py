@@ -28,6 +28,8 @@ from .lemma import bump_rate_bound, reach_rate_bound
 from .proofs import design_independent_proofs
 from .sampled import plant_bounds_checks, sampled_checks
 
+__all__ = ["spec_for_plant", "verify", "verify_design", "verify_spec"]
+
 #: Dimension names used in check names.
 _SIDES = ("L", "U")
 

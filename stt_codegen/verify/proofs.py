@@ -51,6 +51,9 @@ from . import check as _check
 from . import adaptive, deployed, lemma, statements, transform
 from .check import Check
 
+__all__ = ["CACHE_FORMAT", "Proofs", "design_independent_proofs", "load_cached", "proof_key",
+           "prove", "store"]
+
 #: Version of the cache file's layout; files of another version are never read.
 CACHE_FORMAT = 1
 

@@ -41,6 +41,9 @@ from .lyapunov import level_after, next_level, others_max
 from .plant_class import PlantClass, plant_class
 from .sampled_axis import axis_interval, peak, phi_slope_scalar
 
+__all__ = ["SampledCheck", "check_sampled", "plant_bounds_checks", "sampled_check_of",
+           "sampled_checks"]
+
 #: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
 RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
 #: Iterations of the bootstrap of a ball's between-samples level (see :func:`_ball`).
