@@ -35,7 +35,26 @@ SUBSTEPS = 2
 
 @dataclass
 class CascadeTrajectory:
-    """Sampled signals: ``t`` (N,), ``x1``, ``x2``, ``u``, ``r`` (N, n), ``status`` (N,)."""
+    """Sampled signals of the cascade's closed loop, ``N`` instants.
+
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        Sampling instants, s.
+    x1 : ndarray, shape (N, n)
+        Positions, state units.
+    x2 : ndarray, shape (N, n)
+        Velocities, state units per second.
+    u : ndarray, shape (N, n)
+        Inputs of the cascade law, held over each sampling interval, input units.
+    r : ndarray, shape (N, n)
+        The velocity reference of the first stage (the centre of the velocity tube), state
+        units per second.
+    alpha : ndarray, shape (N, 2n)
+        The adaptive law's ``alpha`` (eq. (11)) at each instant.
+    status : ndarray of int, shape (N,)
+        The step's status code (``CASCADE_OK``: inside both tubes).
+    """
 
     t: np.ndarray
     x1: np.ndarray
@@ -77,6 +96,12 @@ class CascadeResult:
     exceeded_velocity_bound : bool
         Some sampled ``|x2_i|`` reached the spec's ``state_space.velocity_bound`` (then
         not ``satisfied``); ``False`` without a bound.
+    prescribed_time : float
+        ``t_c``, s.
+    trajectory : CascadeTrajectory or None
+        The sampled signals.
+    tasks : list
+        Always empty (a second-order spec takes no ``[[tasks]]``).
     """
 
     spec: str

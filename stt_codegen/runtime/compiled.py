@@ -51,6 +51,11 @@ def cache_dir() -> Path:
 def compiler() -> str:
     """The C compiler: ``$CC``, else the first of ``cc``, ``gcc``, ``clang`` on ``PATH``.
 
+    Returns
+    -------
+    str
+        The compiler's path.
+
     Raises
     ------
     MissingTool
@@ -99,7 +104,24 @@ def build_shared(sources: dict[str, bytes], c_file: str, cc: str | None = None,
 
 
 class CController:
-    """Backend ``c``: the generated C (double), compiled and loaded with ``ctypes``."""
+    """Backend ``c``: the generated C (double), compiled and loaded with ``ctypes``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube and gain compiled into the generated C.
+    precision : {"double", "float"}, optional
+        The floating-point type of the generated C (its ``step`` then takes that type).
+    cc : str, optional
+        The C compiler; default :func:`compiler`.
+
+    Raises
+    ------
+    MissingTool
+        No C compiler is installed.
+    ToolchainError
+        The compiler failed.
+    """
 
     name = "c"
 
@@ -146,14 +168,33 @@ class CController:
 
 
 def load_python_module(source: bytes, name: str) -> types.ModuleType:
-    """Execute generated Python source as a module (not added to ``sys.modules``)."""
+    """Execute generated Python source as a module (not added to ``sys.modules``).
+
+    Parameters
+    ----------
+    source : bytes
+        The generated module's source, ASCII.
+    name : str
+        The module's name.
+
+    Returns
+    -------
+    types.ModuleType
+        The executed module.
+    """
     module = types.ModuleType(name)
     exec(compile(source.decode("ascii"), f"<generated {name}.py>", "exec"), module.__dict__)
     return module
 
 
 class GeneratedPythonController:
-    """Backend ``python``: the generated Python module, executed from memory."""
+    """Backend ``python``: the generated Python module, executed from memory.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube and gain the generated Python module is generated for.
+    """
 
     name = "python"
 

@@ -70,7 +70,18 @@ OBSTACLE_LABEL = "obstacle j (obstacles[j] of the spec)"
 def agg_figure(**kwargs) -> Figure:
     """A :class:`~matplotlib.figure.Figure` on its own Agg canvas (``kwargs`` go to
     ``Figure``): it can be saved as PNG without pyplot and without touching matplotlib's
-    global backend."""
+    global backend.
+
+    Parameters
+    ----------
+    **kwargs
+        Passed to :class:`matplotlib.figure.Figure` (``figsize``, ``layout``...).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, with its canvas.
+    """
     fig = Figure(**kwargs)
     FigureCanvasAgg(fig)
     return fig
@@ -121,6 +132,11 @@ def parse_dims(text: str | None, n: int) -> tuple[int, int]:
         ``"I,J"``, zero-based state indices.
     n : int
         State dimension of the spec.
+
+    Returns
+    -------
+    tuple of int, length 2
+        The two distinct state dimensions ``(I, J)``.
 
     Raises
     ------
@@ -233,7 +249,17 @@ def _equal_aspect(spec: Spec, dims: tuple[int, int]) -> bool:
 
 
 def draw_arena(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
-    """The state space, the obstacles and the target on ``ax``, projected on ``dims``."""
+    """The state space, the obstacles and the target on ``ax``, projected on ``dims``.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The axes to draw on.
+    spec : Spec
+        The spec whose sets are drawn.
+    dims : tuple of int, length 2
+        The state dimensions of the axes, zero-based.
+    """
     draw_box(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
     draw_unsafe_sets(ax, spec, dims)
     draw_moving_obstacles(ax, spec, dims)      # time slices (motion_plots.py); none: nothing
@@ -523,7 +549,25 @@ def tube_figure(spec: Spec, tube: TubeDesign, certificate: Certificate, headline
 
 def design_figure(design: Design, dims: tuple[int, int] = DEFAULT_DIMS) -> Figure:
     """The figure of a certified design (:func:`tube_figure`), its method and time in the
-    title."""
+    title.
+
+    Parameters
+    ----------
+    design : Design
+        From :func:`stt_codegen.design_tube`.
+    dims : tuple of int, length 2, optional
+        State dimensions of the arena, zero-based (:func:`check_dims`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, on its Agg canvas (:func:`agg_figure`).
+
+    Raises
+    ------
+    TypeError
+        ``design`` is not a :class:`~stt_codegen.design.result.Design`.
+    """
     design = require_design(design, "design_figure")
     spec = design.spec
     return tube_figure(spec, design.tube, design.certificate,
@@ -585,6 +629,13 @@ def rejected_figure(spec: Spec, error: DesignError,
     spec : Spec
     error : DesignError
         From :func:`stt_codegen.design_tube` on ``spec``, with ``tried`` not ``None``.
+    dims : tuple of int, length 2, optional
+        State dimensions of the arena, zero-based (:func:`check_dims`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, on its Agg canvas (:func:`agg_figure`).
 
     Raises
     ------
@@ -624,7 +675,20 @@ def plot_rejected(spec: Spec, error: DesignError, path: str | Path, *,
 
 
 def save(fig: Figure, path: str | Path) -> Path:
-    """Write ``fig`` as PNG to ``path`` (its folder must exist)."""
+    """Write ``fig`` as PNG to ``path`` (its folder must exist).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : str or pathlib.Path
+        The PNG file to write (110 dpi).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     out = Path(path)
     fig.savefig(out, dpi=110, format="png")
     return out

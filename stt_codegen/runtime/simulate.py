@@ -34,7 +34,21 @@ SUBSTEPS = 2
 
 @dataclass
 class Trajectory:
-    """Sampled closed-loop signals: ``t`` (N,), ``x`` (N, n), ``u`` (N, n), ``alpha`` (N, 2n), ``status`` (N,)."""
+    """Sampled closed-loop signals, ``N`` instants.
+
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        Sampling instants ``t_k = k / rate_hz``, s.
+    x : ndarray, shape (N, n)
+        The state at ``t_k``, state units.
+    u : ndarray, shape (N, n)
+        The input of law (13) computed at ``t_k`` and held until ``t_{k+1}``, input units.
+    alpha : ndarray, shape (N, 2n)
+        The adaptive law's ``alpha`` (eq. (11)) used at ``t_k``.
+    status : ndarray of int, shape (N,)
+        The step's status code (:data:`~stt_codegen.runtime.backends.STATUS_OK`...).
+    """
 
     t: np.ndarray
     x: np.ndarray
@@ -87,6 +101,8 @@ class SimulationResult:
     tasks : list of TaskOutcome
         Each ``[[tasks]]`` entry judged on the run (:mod:`~.tasks`: met, when, margin);
         ``satisfied`` also needs every one met. Empty without tasks.
+    trajectory : Trajectory or None
+        The sampled signals.
     """
 
     spec: str
@@ -244,6 +260,20 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     :class:`~stt_codegen.design.result.Design`, which pairs the tube with its spec.
     Parameters, result and errors are those of :func:`simulate`, with the spec and the
     tube (:class:`~stt_codegen.tube.parameters.TubeDesign`) in place of the design.
+
+    Parameters
+    ----------
+    spec : Spec
+        The task: sets, ``t_c``, plant, disturbance bound.
+    tube : TubeDesign
+        The tube and gain to run.
+    backend, horizon, seed, plant
+        As :func:`simulate`.
+
+    Returns
+    -------
+    SimulationResult
+        As :func:`simulate`.
     """
     seed = check_seed(seed)
     t_c = spec.prescribed_time
