@@ -375,6 +375,13 @@ def elf_functions(elf: Path) -> tuple[dict[str, int], dict[str, set[str]]]:
 def elf_stack_bound(elf: Path, entry: str) -> dict:
     """Static worst-case stack of ``entry`` in a linked ELF, library code included.
 
+    Parameters
+    ----------
+    elf : pathlib.Path
+        The linked program.
+    entry : str
+        The function whose worst-case stack is bounded (e.g. the controller's ``step``).
+
     Returns
     -------
     dict
@@ -395,6 +402,18 @@ def linked_sizes(map_file: Path, obj: Path) -> dict[str, int]:
 
     Parsed from the GNU ld map file's memory map (the part after "Linker script and
     memory map"; discarded sections are listed before it).
+
+    Parameters
+    ----------
+    map_file : pathlib.Path
+        The GNU ld map file (``-Map``).
+    obj : pathlib.Path
+        The object file, as the map file names it.
+
+    Returns
+    -------
+    dict of str to int
+        Bytes of ``text`` (``.text*``, ``.ARM.ex*``), ``rodata``, ``data`` and ``bss``.
     """
     text = Path(map_file).read_text(errors="replace")
     start = text.find("Linker script and memory map")

@@ -55,7 +55,15 @@ _STARTUP_FLAGS: tuple[str, ...] = ("-std=gnu99", "-Wall", "-ffunction-sections",
 
 
 class BuildError(ToolError):
-    """The cross compiler or linker failed (``command``, ``output``)."""
+    """The cross compiler or linker failed (``command``, ``output``).
+
+    Parameters
+    ----------
+    command : sequence of str
+        The command that failed.
+    output : str
+        Its standard error and output.
+    """
 
 
 class RunError(ToolchainError):
