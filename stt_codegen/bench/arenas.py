@@ -163,6 +163,18 @@ def generate_arena(seed: int, index: int) -> Arena:
 def generate_arenas(count: int, seed: int) -> list[Arena]:
     """Arenas ``0 .. count - 1`` of ``seed``.
 
+    Parameters
+    ----------
+    count : int
+        Number of arenas, >= 1.
+    seed : int
+        Arena seed, >= 0.
+
+    Returns
+    -------
+    list of Arena
+        Arena ``k`` is :func:`generate_arena` ``(seed, k)``.
+
     Raises
     ------
     SpecError

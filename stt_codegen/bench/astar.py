@@ -28,6 +28,13 @@ RESOLUTION = 0.05
 def grid_graph(space: FreeSpace, resolution: float = RESOLUTION) -> tuple[nx.Graph, np.ndarray]:
     """The free nodes of the grid and their 8-connected edges.
 
+    Parameters
+    ----------
+    space : FreeSpace
+        The arena: its bounds and its obstacles grown by the planners' margin.
+    resolution : float, optional
+        Grid spacing, metres.
+
     Returns
     -------
     graph : networkx.Graph

@@ -70,6 +70,15 @@ def run_covering_bench(seed: int = 0, count: int = DEFAULT_COUNT,
                        tolerance: float = DEFAULT_TOLERANCE) -> dict[str, Any]:
     """Cover and design the spec of :func:`polygons_toml`, timed.
 
+    Parameters
+    ----------
+    seed : int, optional
+        Seed of the polygons (:func:`polygons_toml`).
+    count : int, optional
+        Number of polygons, >= 0.
+    tolerance : float, optional
+        Every polygon's covering tolerance, metres, > 0.
+
     Returns
     -------
     dict
@@ -111,7 +120,18 @@ def run_covering_bench(seed: int = 0, count: int = DEFAULT_COUNT,
 
 
 def format_covering_report(report: dict[str, Any]) -> str:
-    """The human-readable table of :func:`run_covering_bench`'s result."""
+    """The human-readable table of :func:`run_covering_bench`'s result.
+
+    Parameters
+    ----------
+    report : dict
+        The result of :func:`run_covering_bench`.
+
+    Returns
+    -------
+    str
+        The spec line, the CPU and wall time table, the outcome and the machine line.
+    """
     cover, design = report["covering"], report["design"]
     outcome = (f"designed ({report['method']}), certified: "
                f"{'yes' if report['certified'] else 'no'}" if report["designed"]

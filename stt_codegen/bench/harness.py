@@ -138,7 +138,21 @@ int main(int argc, char **argv) {
 
 def harness_source(design: TubeDesign, prefix: str) -> str:
     """The C source of the timing harness for ``design``, whose generated files are
-    ``prefix.h`` / ``prefix.c``."""
+    ``prefix.h`` / ``prefix.c``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        Gives the initial state, the sampling period ``1 / rate_hz`` (s) and the number of
+        recorded steps ``ceil(t_c * rate_hz)``.
+    prefix : str
+        The generated code's C prefix.
+
+    Returns
+    -------
+    str
+        The harness's C source.
+    """
     record = max(1, int(np.ceil(design.prescribed_time * design.rate_hz - 1e-9)))
     return (_HARNESS.replace("@PU@", prefix.upper()).replace("@P@", prefix)
             .replace("@X0@", ", ".join(repr(float(v)) for v in design.initial_state))

@@ -46,6 +46,13 @@ def _run(spec: Spec) -> tuple[str, float, bool]:
 def study_moving(count: int, seed: int) -> dict[str, Any]:
     """Run the study on arenas ``0 .. count - 1`` of ``seed`` (see the module notes).
 
+    Parameters
+    ----------
+    count : int
+        Number of arenas.
+    seed : int
+        Arena seed, >= 0 (also seeds the moving obstacles of each arena).
+
     Returns
     -------
     dict

@@ -34,7 +34,13 @@ CHECK_RESOLUTION = 0.005
 
 
 def ompl_available() -> str:
-    """Empty when OMPL's Python bindings import, else why not (one line)."""
+    """Empty when OMPL's Python bindings import, else why not (one line).
+
+    Returns
+    -------
+    str
+        ``""`` when OMPL imports, else the reason and how to install it.
+    """
     try:
         from ompl import base, geometric, util  # noqa: F401
     except ImportError as exc:

@@ -268,7 +268,18 @@ def _row_cells(r: dict[str, Any], first: str) -> list[str]:
 
 
 def format_scaling_report(report: dict[str, Any]) -> str:
-    """The human-readable tables of :func:`run_scaling_bench`'s result."""
+    """The human-readable tables of :func:`run_scaling_bench`'s result.
+
+    Parameters
+    ----------
+    report : dict
+        The result of :func:`run_scaling_bench`.
+
+    Returns
+    -------
+    str
+        One table per sweep and the machine line.
+    """
     header = ["{}", "generate", "compile -O2", "C source", "object", "time/step",
               "instr/step", "model arith / transc.", "outside"]
     out = []

@@ -41,6 +41,23 @@ def random_parameters(model: str, input_gain: tuple, rng: np.random.Generator,
     ``spread > 1``, beyond them: ``1/m`` in ``[g_min / spread, g_max spread]``, drag up to
     ``spread DRAG_MAX``.
 
+    Parameters
+    ----------
+    model : {"double-integrator", "quadrotor"}
+        The plant model.
+    input_gain : tuple of float, (g_min, g_max)
+        The declared bounds on ``1/m``, 1/kg.
+    rng : numpy.random.Generator
+        The source of the draw.
+    spread : float, optional
+        Factor by which the draw goes beyond the bounds (1: within them).
+
+    Returns
+    -------
+    list of float
+        ``[m]`` (kg) for the double integrator; ``[m, drag, gravity]`` (kg, N s/m, m/s^2)
+        for the quadrotor.
+
     Raises
     ------
     SpecError
@@ -131,7 +148,18 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
 
 
 def format_second_order_report(report: dict) -> str:
-    """The study as a few lines of text."""
+    """The study as a few lines of text.
+
+    Parameters
+    ----------
+    report : dict
+        The result of :func:`run_second_order_study`.
+
+    Returns
+    -------
+    str
+        The shares satisfied and in both tubes, then the first 20 failures, one a line.
+    """
     lines = [f"{report['case']} ({report['model']}), {report['count']} random plants "
              f"(spread {report['spread']:g}), seed "
              f"{report['seed']}, backend {report['backend']}: satisfied "

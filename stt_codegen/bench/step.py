@@ -140,7 +140,18 @@ def run_step_bench(spec_arg: str, steps: int | None = None, rounds: int = ROUNDS
 
 
 def format_step_report(report: dict[str, Any]) -> str:
-    """The human-readable tables of :func:`run_step_bench`'s result."""
+    """The human-readable tables of :func:`run_step_bench`'s result.
+
+    Parameters
+    ----------
+    report : dict
+        The result of :func:`run_step_bench`.
+
+    Returns
+    -------
+    str
+        The time-per-step table, the operation counts and the machine line.
+    """
     rows = [[r["name"], seconds_text(r["seconds_per_step"]), f"{r['ratio_to_c']:.3g}x",
              f"{r['max_abs_u_difference']:.1e}"] for r in report["implementations"]]
     ops = report["operations"]

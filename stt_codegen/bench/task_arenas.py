@@ -111,5 +111,23 @@ def _moving_toml(entry: dict) -> str:
 
 
 def task_problem(seed: int, index: int) -> Spec:
-    """Problem ``index`` of ``seed`` (:func:`task_problem_toml`), validated."""
+    """Problem ``index`` of ``seed`` (:func:`task_problem_toml`), validated.
+
+    Parameters
+    ----------
+    seed : int
+        Problem seed, >= 0.
+    index : int
+        Problem index, >= 0.
+
+    Returns
+    -------
+    Spec
+        The validated spec ``tasks-<seed>-<index>``.
+
+    Raises
+    ------
+    SpecError
+        A negative seed or index.
+    """
     return parse_spec(task_problem_toml(seed, index))
