@@ -225,6 +225,18 @@ def spec_for_plant(spec: Spec, plant: str | None) -> Spec:
     ``plant`` is ``None``), so that the design refuses a plant that violates the
     assumption.
 
+    Parameters
+    ----------
+    spec : Spec
+        The spec.
+    plant : str or None
+        A plant model, or ``None`` for the spec's own.
+
+    Returns
+    -------
+    Spec
+        The spec for ``plant``.
+
     Raises
     ------
     SpecError
@@ -245,6 +257,24 @@ def verify_spec(spec: Spec, plant: str | None = None, *, cache: bool = True,
 
     With ``plant``, the tube is designed for that plant model instead of the spec's
     (:func:`spec_for_plant`).
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec.
+    plant, cache, progress
+        As :func:`verify_design`.
+
+    Returns
+    -------
+    list of Check
+        :func:`verify_design`'s checks, or the single failed check ``tube.design`` when no
+        tube can be designed.
+
+    Raises
+    ------
+    SpecError
+        As :func:`spec_for_plant`.
     """
     stage = _Stages(progress, design=True)
     stage("design")

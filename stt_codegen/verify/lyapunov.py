@@ -31,7 +31,18 @@ MAX_EXACT_BLOCK = 8
 
 def psi(a: float) -> float:
     """``phi(tanh a) = 2 a cosh(a)^2``: law (13)'s ``|u_i| gamma_d,i / (4 k)`` at
-    ``atanh |e_i| = a``; odd, increasing, and ``psi(sqrt(b))^2`` is convex in ``b``."""
+    ``atanh |e_i| = a``; odd, increasing, and ``psi(sqrt(b))^2`` is convex in ``b``.
+
+    Parameters
+    ----------
+    a : float
+        ``atanh |e_i|``.
+
+    Returns
+    -------
+    float
+        ``2 a cosh(a)^2``.
+    """
     return 2.0 * a * math.cosh(a) ** 2
 
 
@@ -52,6 +63,12 @@ def others_max(limits: Sequence[float], level: float, halves: Sequence[float]) -
         ``r``, the ball's radius in ``atanh`` units (``inf``: no ball).
     halves : sequence of float
         Half-widths ``h_j``, state units.
+
+    Returns
+    -------
+    float
+        The maximum (or, beyond :data:`MAX_EXACT_BLOCK` axes or without a ball, the box's
+        bound), 1/state units squared.
     """
     caps = [min(a, level) ** 2 for a in limits]
     values = [(psi(math.sqrt(c)) / h) ** 2 for c, h in zip(caps, halves)]

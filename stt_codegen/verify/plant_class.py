@@ -122,6 +122,11 @@ def plant_class(spec: Spec, assumptions: Assumptions | None = None) -> PlantClas
     assumptions : Assumptions, optional
         Instead of ``spec.assumptions`` (then no model evaluation unless its ``model`` is
         the spec's).
+
+    Returns
+    -------
+    PlantClass
+        The class the sampled check takes its bounds from, per interval.
     """
     a = spec.assumptions if assumptions is None else assumptions
     if not a.model or a.model != spec.plant_model:

@@ -205,7 +205,18 @@ def _cache_file(key: str) -> Path:
 
 
 def load_cached(key: str) -> Proofs | None:
-    """The cached proofs of ``key``, or ``None`` (no entry, unreadable, corrupt, stale)."""
+    """The cached proofs of ``key``, or ``None`` (no entry, unreadable, corrupt, stale).
+
+    Parameters
+    ----------
+    key : str
+        The proofs' key (:func:`proof_key`).
+
+    Returns
+    -------
+    Proofs or None
+        The cached proofs.
+    """
     try:
         payload = json.loads(_cache_file(key).read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, ValueError):
@@ -215,6 +226,13 @@ def load_cached(key: str) -> Proofs | None:
 
 def store(key: str, proofs: Proofs) -> bool:
     """Write ``proofs`` under ``key`` atomically (a temporary file, then ``os.replace``).
+
+    Parameters
+    ----------
+    key : str
+        The proofs' key (:func:`proof_key`).
+    proofs : Proofs
+        The proofs to cache.
 
     Returns
     -------
