@@ -180,6 +180,7 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
     Parameters
     ----------
     seed, index : int
+        Which arena (see :func:`~.arenas.generate_arena`), as given to :func:`plan_arena`.
     plans : dict
         ``plans`` of :func:`plan_arena` for this arena.
 

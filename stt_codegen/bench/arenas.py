@@ -137,6 +137,8 @@ def generate_arena(seed: int, index: int) -> Arena:
     Returns
     -------
     Arena
+        The arena: its start box and obstacles (``to_spec()`` and ``to_toml()`` add the
+        fixed target).
 
     Raises
     ------

@@ -40,6 +40,7 @@ def grid_graph(space: FreeSpace, resolution: float = RESOLUTION) -> tuple[nx.Gra
     graph : networkx.Graph
         Nodes ``(i, j)`` at ``origin + resolution * (i, j)``; attribute ``weight`` in metres.
     origin : numpy.ndarray, shape (2,)
+        The position of node ``(0, 0)``, metres (a multiple of ``resolution``).
     """
     origin = space.lower - (space.lower % resolution)
     counts = np.floor((space.upper - origin) / resolution).astype(int) + 1

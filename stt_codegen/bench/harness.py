@@ -256,12 +256,14 @@ def build_harness(design: TubeDesign, compile_timeout: float = 900.0) -> Harness
     Parameters
     ----------
     design : TubeDesign
+        The design whose generated C is timed.
     compile_timeout : float
         Seconds allowed to compile the generated source.
 
     Returns
     -------
     Harness
+        The built harness (its executable and what it measures).
 
     Raises
     ------

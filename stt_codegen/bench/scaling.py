@@ -64,10 +64,12 @@ def synthetic_design(obstacles: int, dimension: int, windows: str = "random",
         ``min(1, 0.95 * 8 MAX_SIMULTANEOUS / m)`` s (at most :data:`MAX_SIMULTANEOUS` open). With ``"open"`` and ``"closed"`` the heights are scaled by 0.05 so that
         the closed loop stays inside the tube (the computation graph is the same).
     seed : int
+        Seeds the random circumvents (dimension, side, window, height).
 
     Returns
     -------
     TubeDesign
+        The design (not certified: only its size matters).
 
     Raises
     ------
@@ -197,6 +199,8 @@ def run_scaling_bench(obstacles: list[int], dimensions: list[int],
     Parameters
     ----------
     obstacles, dimensions : list of int
+        Obstacle counts (each >= 0) of the obstacle sweep and dimensions (each >= 1) of the
+        dimension sweep.
     compile_timeout : float
         Seconds allowed per compilation; a design that takes longer is reported with an
         ``error``.
@@ -204,6 +208,7 @@ def run_scaling_bench(obstacles: list[int], dimensions: list[int],
         Circumvents of the active-window experiment (default
         :data:`ACTIVE_EXPERIMENT_OBSTACLES`; 0 skips it).
     callgrind : bool
+        Also count instructions per step under callgrind.
     sparse : (int, int), optional
         Circumvent counts of :func:`sparse_window_experiment` (default
         ``(SPARSE_SMALL, SPARSE_LARGE)``; ``(0, 0)`` skips it).

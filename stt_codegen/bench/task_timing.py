@@ -104,6 +104,7 @@ def departure(path: np.ndarray, begin: float, deadline: float,
     deadline : float
         When it must have arrived (s), ``> begin``.
     obstacles : sequence of MovingObstacle
+        The spec's moving obstacles.
 
     Returns
     -------

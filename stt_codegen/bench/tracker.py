@@ -119,6 +119,7 @@ def track(spec: Spec, path: np.ndarray, seed: int) -> SimulationResult:
     spec : Spec
         A 2-D spec (its plant, disturbance bound, rate and ``t_c`` are used).
     path : numpy.ndarray, shape (K, 2)
+        The planned way points, metres.
     seed : int
         Disturbance seed (the same as the tube controller's on this arena).
 

@@ -132,6 +132,7 @@ def design_to_plot(args: argparse.Namespace) -> tuple[Design, tuple[int, int]]:
     Returns
     -------
     design : Design
+        The certified design.
     dims : tuple of int, length 2
         The arena's dimensions of the figure.
 

@@ -85,6 +85,7 @@ def closed_loop_source(spec: Spec, design: TubeDesign, *, seed: int = 0, decimat
     Parameters
     ----------
     spec, design
+        The spec (sets, ``t_c``, plant, disturbance) and its design (rate).
     seed : int
         Disturbance seed (as ``simulate(..., seed=seed)``).
     decimate : int

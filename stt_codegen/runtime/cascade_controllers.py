@@ -44,7 +44,9 @@ class CascadeController:
     backend : str
         One of :data:`CASCADE_BACKENDS`.
     design : TubeDesign
+        The position tube and its gain.
     stage : SecondStage
+        The velocity stage: tube ``rho2`` and gain.
 
     Raises
     ------

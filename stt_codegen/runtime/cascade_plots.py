@@ -33,6 +33,7 @@ def plot_cascade_run(design: Design, result: CascadeResult, path: str | Path,
     Returns
     -------
     pathlib.Path
+        ``path``.
     """
     spec, tube, traj = design.spec, design.tube, result.trajectory
     n = spec.dimension

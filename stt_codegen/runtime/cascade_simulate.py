@@ -72,16 +72,20 @@ class CascadeResult:
     Attributes
     ----------
     spec, backend, model : str
+        The spec's name, the backend and the second-order plant model.
     satisfied : bool
         ``reached`` and not ``collision`` and not ``left_state_space``.
     reached : bool
+        ``x1`` entered the target no later than ``t_c``.
     reach_time : float or None
         First sampled instant with ``x1`` in the target, seconds.
     collision : bool
+        ``x1`` met an obstacle on ``[0, t_c]``.
     min_obstacle_clearance : float or None
         Smallest signed distance of ``x1`` to an obstacle over ``[0, t_c]`` (every
         integration point), state units.
     left_state_space : bool
+        ``x1`` left the state space on ``[0, t_c]``.
     stayed_in_tube : bool
         Every step had ``x1`` strictly inside the position tube.
     stayed_in_velocity_tube : bool
@@ -93,6 +97,7 @@ class CascadeResult:
     max_abs_x2 : list of float
         Peak ``|x2_i|``, velocity units.
     steps : int
+        Controller steps taken.
     exceeded_velocity_bound : bool
         Some sampled ``|x2_i|`` reached the spec's ``state_space.velocity_bound`` (then
         not ``satisfied``); ``False`` without a bound.
@@ -175,6 +180,8 @@ def simulate_second_order(spec: Spec, tube: TubeDesign, stage: SecondStage, *,
     Returns
     -------
     CascadeResult
+        Definition 2.1 judged on ``x1``, both tubes' status, peaks of ``|u|`` and ``|x2|``, and
+        the trajectory.
 
     Raises
     ------
@@ -280,12 +287,14 @@ def simulate_cascade(design: Design, backend: str = "reference", horizon: float 
     Parameters
     ----------
     design : Design
+        From :func:`stt_codegen.design_tube`, its spec with a second-order ``plant.model``.
     backend, horizon, seed
         As :func:`simulate_second_order`.
 
     Returns
     -------
     CascadeResult
+        As :func:`simulate_second_order`.
 
     Raises
     ------

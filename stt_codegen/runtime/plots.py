@@ -303,6 +303,7 @@ def arena_figure(spec: Spec, rows: int, dims: tuple[int, int]) -> tuple[Figure, 
     Parameters
     ----------
     spec : Spec
+        The spec whose arena is drawn.
     rows : int
         Time plots in the right column.
     dims : tuple of int, length 2
@@ -311,6 +312,7 @@ def arena_figure(spec: Spec, rows: int, dims: tuple[int, int]) -> tuple[Figure, 
     Returns
     -------
     fig : matplotlib.figure.Figure
+        The figure, on its Agg canvas.
     grid : matplotlib.gridspec.GridSpec
         ``rows`` rows, 2 columns.
     ax : matplotlib.axes.Axes or None
@@ -627,6 +629,7 @@ def rejected_figure(spec: Spec, error: DesignError,
     Parameters
     ----------
     spec : Spec
+        The spec that has no design.
     error : DesignError
         From :func:`stt_codegen.design_tube` on ``spec``, with ``tried`` not ``None``.
     dims : tuple of int, length 2, optional
@@ -660,6 +663,7 @@ def plot_rejected(spec: Spec, error: DesignError, path: str | Path, *,
     Parameters
     ----------
     spec : Spec
+        The spec that has no design.
     error : DesignError
         With ``tried`` not ``None``.
     path : str or path
@@ -670,6 +674,7 @@ def plot_rejected(spec: Spec, error: DesignError, path: str | Path, *,
     Returns
     -------
     pathlib.Path
+        ``path``.
     """
     return save(rejected_figure(spec, error, dims), path)
 

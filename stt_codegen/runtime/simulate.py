@@ -64,6 +64,7 @@ class SimulationResult:
     Attributes
     ----------
     spec, backend : str
+        The spec's name and the backend that ran the controller.
     satisfied : bool
         ``reached`` and not ``collision`` and not ``left_state_space`` (and every task of
         ``tasks`` met).
@@ -72,6 +73,7 @@ class SimulationResult:
     reach_time : float or None
         First sampled instant in the target, seconds.
     prescribed_time : float
+        ``t_c``, s.
     collision : bool
         The state met an obstacle on ``[0, t_c]`` (checked at every integration point).
     min_obstacle_clearance : float or None
@@ -79,6 +81,7 @@ class SimulationResult:
         inside it), state units; exact for boxes and balls, a lower bound for polytopes
         (distance to the nearest facet's plane). ``None`` without obstacles.
     left_state_space : bool
+        The state left the state space on ``[0, t_c]``.
     stayed_in_tube : bool
         Every controller step on ``[0, horizon]`` reported the state inside the tube
         (``STATUS_OK``, or ``STATUS_INPUT_CLAMPED``: inside, ``u`` clamped).

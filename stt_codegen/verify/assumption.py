@@ -49,6 +49,7 @@ def plant_input_matrix(model: str, n: int, x: Sequence[sp.Symbol]) -> sp.Matrix:
     n : int
         State dimension.
     x : sequence of sympy.Symbol, length n
+        The state's symbols.
 
     Returns
     -------

@@ -133,6 +133,7 @@ def check_lyapunov_derivative(n: int, tube_rate: bool = True) -> Check:
     Parameters
     ----------
     n : int
+        Number of positions (= velocities).
     tube_rate : bool, optional
         ``False`` drops the term ``rho2_dot e2`` from the claim (a wrong identity, which
         the check must refuse: the tests use it).

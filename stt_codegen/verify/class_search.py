@@ -196,6 +196,7 @@ def class_matrices(bounds: Assumptions, n: int, seed: int = 0) -> list[np.ndarra
     Returns
     -------
     list of ndarray, each (n, n)
+        The members of the class tried, in a fixed order.
     """
     rng = np.random.default_rng([seed, n, 11])
     blocks = bounds.coupled_blocks(n)
@@ -333,6 +334,7 @@ def replay(design: TubeDesign, found: Counterexample, backend: str = "c") -> boo
     Returns
     -------
     bool
+        Whether the deployed controller confirms the exit.
     """
     from ..runtime.backends import STATUS_OK, STATUS_OUTSIDE_TUBE, make_controller
     controller = make_controller(backend, design)

@@ -97,7 +97,9 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     Parameters
     ----------
     spec : Spec
+        The spec the tube was designed for.
     design : TubeDesign
+        Its designed tube and gain.
     plant : str, optional
         Plant model (one of :data:`stt_codegen.spec.plants.PLANT_MODELS`) for Assumption 2
         and the sampled check's bounds (:meth:`~stt_codegen.spec.loader.Spec.with_plant_model`);

@@ -607,6 +607,7 @@ def proved_pieces(max_n: int = 3) -> dict[str, object]:
     Returns
     -------
     dict of str to casadi.Function
+        Name -> piece (``error_transform.n1`` .. ``error_transform.n<max_n>`` among them).
     """
     init, add, finish, _ = pieces.fnu_pieces()
     smooth = pieces.smooth_pieces()

@@ -236,7 +236,10 @@ def next_level(level: float, alpha: Sequence[float], beta: Sequence[float],
     Parameters
     ----------
     level : float
+        ``r``: this sample's set has ``sum a_i^2 <= r^2``.
     alpha, beta : sequence of float
+        ``alpha_i = h_i / h'_i`` and ``beta_i = (c_i - c'_i) / h'_i`` per axis: the change of
+        coordinates to the next sample's centre ``c'`` and half-widths ``h'``.
     limits : sequence of float, optional
         Bounds of ``|a_i|`` (default: ``level`` for every axis).
 

@@ -161,6 +161,7 @@ def prove(max_n: int = 3, progress: Progress | None = None) -> Proofs:
     Returns
     -------
     Proofs
+        The proofs, freshly computed.
     """
     say = progress or (lambda label: None)
     say("deployed pieces")

@@ -158,6 +158,8 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     Returns
     -------
     SampledCheck
+        The verdict, its level and margin, the time and dimension of a failure, and the
+        bounds of ``|e|``.
     """
     cls = _as_class(plants)
     a = cls.assumptions
@@ -315,7 +317,9 @@ def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
     Returns
     -------
     samples : TubeSamples
+        The design's tube at its sampling instants.
     check : SampledCheck
+        The verdict (cached per process).
     """
     return _sampled_check(design, spec, bool(per_axis_first))
 
@@ -432,6 +436,7 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
     Parameters
     ----------
     spec : Spec
+        The spec the design is for.
     design : TubeDesign
         With its gain set (the spec's ``controller.gain`` or the derived one); its tube is
         sampled by :func:`sampled_check_of` (once per process).
@@ -442,6 +447,7 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
     Returns
     -------
     list of Check
+        ``sampled.gain`` (the gain below its stability limit) and ``sampled.tube_kept``.
     """
     a = spec.assumptions
     plants = plant_class(spec)
@@ -525,12 +531,15 @@ def plant_bounds_checks(spec: Spec, model: str | None = None) -> list[Check]:
     Parameters
     ----------
     spec : Spec
+        The spec: its state space, linear matrices and ``[assumptions]``.
     model : str, optional
         Plant model, default the spec's.
 
     Returns
     -------
     list of Check
+        ``sampled.plant_within_assumptions`` and, for the ``linear`` model, first
+        ``assumption2.linear``.
     """
     model = model or spec.plant_model
     linear = spec.linear_plant if model == "linear" else None
