@@ -152,6 +152,11 @@ def plan_arena(seed: int, index: int, methods: tuple[str, ...] = METHODS) -> dic
     dict
         ``{"index", "plans": {method: {"seconds", and "tube" (STT), "plan" (baselines)
         or "reason" (failure category)}}}``; picklable.
+
+    Raises
+    ------
+    ValueError
+        A method not in :data:`METHODS`.
     """
     spec = generate_arena(seed, index).to_spec()
     plans: dict[str, Any] = {}

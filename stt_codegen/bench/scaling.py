@@ -219,6 +219,12 @@ def run_scaling_bench(obstacles: list[int], dimensions: list[int],
         ``machine``, ``obstacle_sweep``, ``dimension_sweep``, ``active_windows`` (rows of
         :func:`measure` with a ``windows`` key), ``sparse_windows`` (or None) and
         ``conclusion`` (a sentence).
+
+    Raises
+    ------
+    SpecError
+        A negative obstacle count (field ``obstacles``) or a dimension below 1
+        (``dimensions``).
     """
     for m in obstacles:
         if m < 0:
