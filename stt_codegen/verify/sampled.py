@@ -41,8 +41,8 @@ from .lyapunov import level_after, next_level, others_max
 from .plant_class import PlantClass, plant_class
 from .sampled_axis import axis_interval, peak, phi_slope_scalar
 
-__all__ = ["SampledCheck", "check_sampled", "plant_bounds_checks", "sampled_check_of",
-           "sampled_checks"]
+__all__ = ["SampledCheck", "check_sampled", "lowest_rate", "plant_bounds_checks",
+           "sampled_check_of", "sampled_checks"]
 
 #: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
 RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
@@ -353,10 +353,14 @@ def lowest_rate(design: TubeDesign, spec: Spec, plants: Assumptions | PlantClass
     Parameters
     ----------
     design : TubeDesign
+        The design: its tube, ``rate_hz`` and gain.
     spec : Spec
         For the certificate (state space, obstacles, target).
     plants : Assumptions or PlantClass
+        The plant bounds the sampled check uses.
     explicit_gain : float, optional
+        The gain ``k`` of law (13) at every rate (the spec's ``controller.gain``); default the
+        gain derived at each rate.
     passes_at_rate : bool, optional
         Whether the check already passed at ``design.rate_hz`` with its gain (saves a run);
         default: find out.
@@ -364,7 +368,8 @@ def lowest_rate(design: TubeDesign, spec: Spec, plants: Assumptions | PlantClass
     Returns
     -------
     rate_hz, gain : float or None
-        ``(None, None)`` when no factor tried works.
+        The lowest rate found, Hz, and the gain used there; ``(None, None)`` when no factor
+        tried works.
     """
     assumptions = _as_class(plants).assumptions
 
