@@ -110,8 +110,9 @@ class CController:
     ----------
     design : TubeDesign
         The tube and gain compiled into the generated C.
-    precision : {"double", "float"}, optional
-        The floating-point type of the generated C (its ``step`` then takes that type).
+    precision : {"double", "single"}, optional
+        The floating-point type of the generated C (``double`` or ``float``; its ``step``
+        then takes that type).
     cc : str, optional
         The C compiler; default :func:`compiler`.
 
@@ -119,8 +120,8 @@ class CController:
     ------
     MissingTool
         No C compiler is installed.
-    ToolchainError
-        The compiler failed.
+    CodegenError
+        The compiler failed (a :class:`~stt_codegen.errors.ToolchainError`).
     """
 
     name = "c"

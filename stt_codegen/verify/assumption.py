@@ -114,7 +114,7 @@ def check_assumption2(
     -------
     Check
         Named ``name``; ``data`` holds ``g_s``, its eigenvalues and, on PASS, ``g_lower``
-        and where it is attained.
+        and where it is attained; on FAIL by a vanishing eigenvalue, where (``lost_at``).
     """
     gs = symmetric_part(g)
     eig = gs.eigenvals()
