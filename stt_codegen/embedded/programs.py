@@ -42,7 +42,8 @@ def _d(value: float) -> str:
 
 
 def steps_of(spec: Spec, design: TubeDesign) -> int:
-    """Controller periods over ``[0, t_c]``, as :func:`stt_codegen.runtime.simulate.simulate` counts.
+    """Controller periods over ``[0, t_c]``, as :func:`stt_codegen.runtime.simulate.simulate`
+    counts.
 
     Parameters
     ----------
