@@ -17,3 +17,5 @@ Every benchmark measures what it compares side by side in one run and reports ra
 the tests check structure and invariants, never speed; they count work where a
 benchmark times it.
 """
+
+__all__: list[str] = []

@@ -38,6 +38,8 @@ from ..tube.model import implicit_alpha_update
 from ..tube.parameters import NEWTON_ITERATIONS, TubeDesign
 from .report import machine, machine_line, table
 
+__all__ = ["RATE_FACTORS", "format_alpha_report", "run_alpha_bench"]
+
 #: The adversarial batch: size, seed, and the adaptive law's kappa.
 BATCH = 100_000
 SEED = 0
@@ -109,7 +111,28 @@ def convergence(design: TubeDesign) -> dict[str, Any]:
 
 
 def run_alpha_bench(spec_arg: str = "omnirobot-s1") -> dict[str, Any]:
-    """Both studies; the convergence one on ``spec_arg``'s design."""
+    """Both studies; the convergence one on ``spec_arg``'s design.
+
+    Parameters
+    ----------
+    spec_arg : str, optional
+        A bundled case name or a spec file; its design's ``alpha`` is integrated for the
+        convergence study.
+
+    Returns
+    -------
+    dict
+        ``spec`` (name), ``batch`` and ``kappa`` (of the Newton study), ``newton`` (rows of
+        iterations and largest relative error against the bisection root), ``convergence``
+        (error of the deployed ``alpha`` against Radau per rate, Hz) and ``machine``.
+
+    Raises
+    ------
+    SpecError
+        An invalid or unknown spec.
+    DesignError
+        The spec has no design.
+    """
     spec = load_spec(spec_arg)
     design = design_tube(spec).tube
     return {"spec": spec.name, "batch": BATCH, "kappa": KAPPA, "newton": newton_errors(),
@@ -117,7 +140,18 @@ def run_alpha_bench(spec_arg: str = "omnirobot-s1") -> dict[str, Any]:
 
 
 def format_alpha_report(report: dict[str, Any]) -> str:
-    """The human-readable tables of :func:`run_alpha_bench`'s result."""
+    """The human-readable tables of :func:`run_alpha_bench`'s result.
+
+    Parameters
+    ----------
+    report : dict
+        The result of :func:`run_alpha_bench`.
+
+    Returns
+    -------
+    str
+        The tables and the machine line, lines separated by newlines.
+    """
     newton = [[str(r["iterations"]) + (" (deployed)" if r["deployed"] else ""),
                f"{r['max_relative_error']:.2g}"] for r in report["newton"]]
     conv = report["convergence"]

@@ -33,6 +33,9 @@ from ..errors import DesignError
 from ..runtime.simulate import SimulationResult
 from .arenas import generate_arena
 
+__all__ = ["LABELS", "METHODS", "closed_loop_failure", "design_failure", "loop_arena",
+           "plan_arena", "run_arena"]
+
 METHODS = ("stt-paper", "stt", "astar", "rrtstar")
 #: Names of the certificate's properties (:mod:`stt_codegen.design.certificate`), as they appear
 #: in design errors.
@@ -53,6 +56,16 @@ def design_failure(message: str) -> str:
     ``design: <certificate property>``
     (e.g. ``avoids obstacle``, ``non-empty``, ``inside target after t_c``),
     ``design: other``.
+
+    Parameters
+    ----------
+    message : str
+        The error's message.
+
+    Returns
+    -------
+    str
+        The category.
     """
     if "no via-point path" in message:
         return "design: no free passage for via points"
@@ -71,7 +84,18 @@ def design_failure(message: str) -> str:
 
 
 def closed_loop_failure(result: SimulationResult) -> str:
-    """Why a closed-loop run fails Definition 2.1 (empty when it satisfies it)."""
+    """Why a closed-loop run fails Definition 2.1 (empty when it satisfies it).
+
+    Parameters
+    ----------
+    result : SimulationResult
+        The judged run.
+
+    Returns
+    -------
+    str
+        ``""``, ``"collision"``, ``"left the arena"`` or ``"target not reached by t_c"``.
+    """
     if result.satisfied:
         return ""
     if result.collision:
@@ -128,6 +152,11 @@ def plan_arena(seed: int, index: int, methods: tuple[str, ...] = METHODS) -> dic
     dict
         ``{"index", "plans": {method: {"seconds", and "tube" (STT), "plan" (baselines)
         or "reason" (failure category)}}}``; picklable.
+
+    Raises
+    ------
+    ValueError
+        A method not in :data:`METHODS`.
     """
     spec = generate_arena(seed, index).to_spec()
     plans: dict[str, Any] = {}
@@ -156,6 +185,7 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
     Parameters
     ----------
     seed, index : int
+        Which arena (see :func:`~.arenas.generate_arena`), as given to :func:`plan_arena`.
     plans : dict
         ``plans`` of :func:`plan_arena` for this arena.
 
@@ -198,5 +228,20 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
 def run_arena(seed: int, index: int, methods: tuple[str, ...] = METHODS) -> dict[str, Any]:
     """Run every method on arena ``index`` of ``seed``: :func:`plan_arena` (same
     parameters), then :func:`loop_arena` (same result). The bench runs the two phases over
-    all arenas in turn."""
+    all arenas in turn.
+
+    Parameters
+    ----------
+    seed : int
+        Arena seed, >= 0.
+    index : int
+        Arena index, >= 0.
+    methods : tuple of str, optional
+        Subset of :data:`METHODS`.
+
+    Returns
+    -------
+    dict
+        As :func:`loop_arena`.
+    """
     return loop_arena(seed, index, plan_arena(seed, index, methods)["plans"])

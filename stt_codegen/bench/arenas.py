@@ -31,6 +31,8 @@ import numpy as np
 from ..errors import SpecError
 from ..spec.loader import Box, Spec, parse_spec
 
+__all__ = ["ARENA", "OBSTACLE_SIZE", "START_SIZE", "TARGET", "generate_arena", "generate_arenas"]
+
 #: The case study's arena, target, obstacle size and start-set size, metres.
 ARENA = Box((0.0, 0.0), (5.0, 5.0))
 TARGET = Box((4.5, 4.5), (5.0, 5.0))
@@ -135,6 +137,8 @@ def generate_arena(seed: int, index: int) -> Arena:
     Returns
     -------
     Arena
+        The arena: its start box and obstacles (``to_spec()`` and ``to_toml()`` add the
+        fixed target).
 
     Raises
     ------
@@ -160,6 +164,18 @@ def generate_arena(seed: int, index: int) -> Arena:
 
 def generate_arenas(count: int, seed: int) -> list[Arena]:
     """Arenas ``0 .. count - 1`` of ``seed``.
+
+    Parameters
+    ----------
+    count : int
+        Number of arenas, >= 1.
+    seed : int
+        Arena seed, >= 0.
+
+    Returns
+    -------
+    list of Arena
+        Arena ``k`` is :func:`generate_arena` ``(seed, k)``.
 
     Raises
     ------

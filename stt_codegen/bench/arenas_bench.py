@@ -14,9 +14,19 @@ from .parallel import run_parallel
 from .report import machine, machine_line, seconds_text, summarize, table
 from .rrtstar import ompl_available
 
+__all__ = ["available_methods", "format_arenas_report", "run_arenas_bench", "write_specs"]
+
 
 def available_methods() -> tuple[tuple[str, ...], dict[str, str]]:
-    """The methods that can run here, and why the others cannot (method -> reason)."""
+    """The methods that can run here, and why the others cannot (method -> reason).
+
+    Returns
+    -------
+    methods : tuple of str
+        The runnable methods of :data:`~.arena_job.METHODS`, in its order.
+    skipped : dict of str to str
+        Method -> the reason it cannot run (``rrtstar`` without OMPL).
+    """
     skipped = {}
     why = ompl_available()
     if why:
@@ -26,6 +36,20 @@ def available_methods() -> tuple[tuple[str, ...], dict[str, str]]:
 
 def write_specs(folder: Path, count: int, seed: int) -> list[Path]:
     """Write arenas ``0 .. count - 1`` of ``seed`` as spec files ``arena-S-K.toml``.
+
+    Parameters
+    ----------
+    folder : pathlib.Path
+        An existing folder.
+    count : int
+        Number of arenas, >= 1.
+    seed : int
+        Arena seed, >= 0.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files written, in arena order.
 
     Raises
     ------
@@ -102,7 +126,18 @@ def run_arenas_bench(count: int, seed: int, workers: int | None = None,
 
 
 def format_arenas_report(report: dict[str, Any]) -> str:
-    """The human-readable table of :func:`run_arenas_bench`'s result."""
+    """The human-readable table of :func:`run_arenas_bench`'s result.
+
+    Parameters
+    ----------
+    report : dict
+        The result of :func:`run_arenas_bench`.
+
+    Returns
+    -------
+    str
+        The success and time table, the control-effort table and the machine line.
+    """
     rows, effort = [], []
     for method, s in report["methods"].items():
         failures = ", ".join(f"{r} ({n})" for r, n in s["failures"].items()) or "-"

@@ -19,6 +19,8 @@ import numpy as np
 from ..spec.loader import Spec
 from .planning import FreeSpace, Plan
 
+__all__ = ["RESOLUTION", "grid_graph", "grid_path", "plan_astar"]
+
 #: Grid spacing, metres.
 RESOLUTION = 0.05
 
@@ -26,11 +28,19 @@ RESOLUTION = 0.05
 def grid_graph(space: FreeSpace, resolution: float = RESOLUTION) -> tuple[nx.Graph, np.ndarray]:
     """The free nodes of the grid and their 8-connected edges.
 
+    Parameters
+    ----------
+    space : FreeSpace
+        The arena: its bounds and its obstacles grown by the planners' margin.
+    resolution : float, optional
+        Grid spacing, metres.
+
     Returns
     -------
     graph : networkx.Graph
         Nodes ``(i, j)`` at ``origin + resolution * (i, j)``; attribute ``weight`` in metres.
     origin : numpy.ndarray, shape (2,)
+        The position of node ``(0, 0)``, metres (a multiple of ``resolution``).
     """
     origin = space.lower - (space.lower % resolution)
     counts = np.floor((space.upper - origin) / resolution).astype(int) + 1

@@ -20,6 +20,8 @@ from ..errors import DesignError, SpecError
 from ..spec.loader import parse_spec
 from .report import machine, machine_line, table
 
+__all__ = ["format_covering_report", "polygons_toml", "run_covering_bench"]
+
 #: The default spec: 80 polygons at tolerance 0.02 (docs/performance.md).
 DEFAULT_COUNT = 80
 DEFAULT_TOLERANCE = 0.02
@@ -68,6 +70,15 @@ def run_covering_bench(seed: int = 0, count: int = DEFAULT_COUNT,
                        tolerance: float = DEFAULT_TOLERANCE) -> dict[str, Any]:
     """Cover and design the spec of :func:`polygons_toml`, timed.
 
+    Parameters
+    ----------
+    seed : int, optional
+        Seed of the polygons (:func:`polygons_toml`).
+    count : int, optional
+        Number of polygons, >= 0.
+    tolerance : float, optional
+        Every polygon's covering tolerance, metres, > 0.
+
     Returns
     -------
     dict
@@ -109,7 +120,18 @@ def run_covering_bench(seed: int = 0, count: int = DEFAULT_COUNT,
 
 
 def format_covering_report(report: dict[str, Any]) -> str:
-    """The human-readable table of :func:`run_covering_bench`'s result."""
+    """The human-readable table of :func:`run_covering_bench`'s result.
+
+    Parameters
+    ----------
+    report : dict
+        The result of :func:`run_covering_bench`.
+
+    Returns
+    -------
+    str
+        The spec line, the CPU and wall time table, the outcome and the machine line.
+    """
     cover, design = report["covering"], report["design"]
     outcome = (f"designed ({report['method']}), certified: "
                f"{'yes' if report['certified'] else 'no'}" if report["designed"]

@@ -41,6 +41,8 @@ from ..spec.loader import NAME_PATTERN
 from ..system import find_tool
 from ..tube.parameters import TubeDesign
 
+__all__ = ["BenchError", "build_harness", "harness_source"]
+
 #: Compiler flags of the harness and the generated source (those of backend ``c``
 #: without ``-shared -fPIC``).
 CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off")
@@ -136,7 +138,21 @@ int main(int argc, char **argv) {
 
 def harness_source(design: TubeDesign, prefix: str) -> str:
     """The C source of the timing harness for ``design``, whose generated files are
-    ``prefix.h`` / ``prefix.c``."""
+    ``prefix.h`` / ``prefix.c``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        Gives the initial state, the sampling period ``1 / rate_hz`` (s) and the number of
+        recorded steps ``ceil(t_c * rate_hz)``.
+    prefix : str
+        The generated code's C prefix.
+
+    Returns
+    -------
+    str
+        The harness's C source.
+    """
     record = max(1, int(np.ceil(design.prescribed_time * design.rate_hz - 1e-9)))
     return (_HARNESS.replace("@PU@", prefix.upper()).replace("@P@", prefix)
             .replace("@X0@", ", ".join(repr(float(v)) for v in design.initial_state))
@@ -240,12 +256,14 @@ def build_harness(design: TubeDesign, compile_timeout: float = 900.0) -> Harness
     Parameters
     ----------
     design : TubeDesign
+        The design whose generated C is timed.
     compile_timeout : float
         Seconds allowed to compile the generated source.
 
     Returns
     -------
     Harness
+        The built harness (its executable and what it measures).
 
     Raises
     ------

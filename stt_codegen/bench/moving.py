@@ -31,6 +31,8 @@ from ..spec.loader import Box, Spec
 from ..spec.motion import moving_obstacle
 from ..spec.schema import BoxObstacle
 
+__all__ = ["random_moving_obstacles"]
+
 #: Side of a moving box, metres (state units).
 SIZE_MIN, SIZE_MAX = 0.3, 0.6
 #: Speed of a crossing box, state units per second.

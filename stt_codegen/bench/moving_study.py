@@ -29,6 +29,8 @@ from ..spec.loader import Spec
 from .arenas import generate_arena
 from .moving import random_moving_obstacles
 
+__all__ = ["study_moving"]
+
 
 def _run(spec: Spec) -> tuple[str, float, bool]:
     """(how it was designed or ``"no design"``, design seconds, satisfied in closed loop)."""
@@ -43,6 +45,13 @@ def _run(spec: Spec) -> tuple[str, float, bool]:
 
 def study_moving(count: int, seed: int) -> dict[str, Any]:
     """Run the study on arenas ``0 .. count - 1`` of ``seed`` (see the module notes).
+
+    Parameters
+    ----------
+    count : int
+        Number of arenas.
+    seed : int
+        Arena seed, >= 0 (also seeds the moving obstacles of each arena).
 
     Returns
     -------

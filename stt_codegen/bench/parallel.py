@@ -22,6 +22,8 @@ from tqdm import tqdm
 
 from ..errors import SpecError
 
+__all__ = ["run_parallel"]
+
 #: How long to wait for a Dask scheduler to answer.
 CONNECT_TIMEOUT = "10s"
 

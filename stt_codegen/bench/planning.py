@@ -15,6 +15,8 @@ import numpy as np
 
 from ..spec.loader import Spec
 
+__all__ = ["FreeSpace", "MARGIN", "Plan"]
+
 #: Clearance kept from obstacles and walls by the planners, metres.
 MARGIN = 0.2
 

@@ -69,7 +69,21 @@ def _min_width(case: str) -> float:
 
 
 def draw(case: str, index: int) -> dict:
-    """The knobs of plant ``index`` of ``case`` (seeded by both)."""
+    """The knobs of plant ``index`` of ``case`` (seeded by both).
+
+    Parameters
+    ----------
+    case : str
+        One of :data:`CASES`.
+    index : int
+        The plant's number within the case.
+
+    Returns
+    -------
+    dict
+        A value in each range of :data:`RANGES` (``g_max`` as ``g_min`` times the drawn
+        ratio) and ``seed``, the pair that seeds :func:`plant_parameters`.
+    """
     rng = np.random.default_rng([CASES.index(case), index, 7])
     r = {k: float(rng.uniform(*v)) for k, v in RANGES.items()}
     return {"f_amp": r["f_amp"], "f_lin": r["f_lin"], "g_min": r["g_min"],
@@ -80,7 +94,22 @@ def draw(case: str, index: int) -> dict:
 def plant_parameters(knobs: dict, n: int = 3) -> dict:
     """``f(x) = f_amp sin(W x + phi) + L (x - c)``, ``g(x) = S + skew tanh(v . x) K``,
     ``w_i = w_amp sin(omega_i t + p_i)``; ``S`` symmetric with eigenvalues in
-    ``[g_min, g_max]`` (both reached), ``K`` a unit skew matrix."""
+    ``[g_min, g_max]`` (both reached), ``K`` a unit skew matrix.
+
+    Parameters
+    ----------
+    knobs : dict
+        From :func:`draw`.
+    n : int, optional
+        State dimension.
+
+    Returns
+    -------
+    dict
+        ``W`` (n, n), ``phi`` (n,), ``f_amp``, ``L`` (n, n) of the drift; ``sym`` (n, n),
+        ``skew_axis`` (n,), ``skew``, ``v`` (n,) of the input matrix; ``w_amp``, ``omega``
+        (n,) rad/s and ``w_phase`` (n,) of the disturbance.
+    """
     rng = np.random.default_rng(knobs["seed"])
     q, _ = np.linalg.qr(rng.normal(size=(n, n)))
     eig = rng.uniform(knobs["g_min"], knobs["g_max"], n)
@@ -110,7 +139,22 @@ def _system(p: dict, centre: np.ndarray):
 
 
 def own_bounds(p: dict, spec) -> Assumptions:
-    """The bounds a user who knew the drawn plant would declare (over the state space)."""
+    """The bounds a user who knew the drawn plant would declare (over the state space).
+
+    Parameters
+    ----------
+    p : dict
+        The plant, from :func:`plant_parameters`.
+    spec : Spec
+        Gives the state space the drift is bounded over.
+
+    Returns
+    -------
+    Assumptions
+        ``input_gain`` (the extreme eigenvalues of ``S``), ``input_gain_skew``,
+        ``input_gain_coupling``, ``drift_bound`` and ``disturbance_bound`` (Euclidean, over
+        the state space).
+    """
     n = spec.dimension
     eig = np.linalg.eigvalsh(p["sym"])
     k_mat = unit_skew(p["skew_axis"])
@@ -147,7 +191,22 @@ def study_one(job: tuple) -> dict:
     derives from the plant's own bounds (:func:`~stt_codegen.design.gain.derived_gain` at
     the design's certified narrowest width), as if the user had declared them in
     ``[assumptions]``, for the check, the search and the simulation alike; otherwise it is
-    the bundled design's (derived from the robot's bounds)."""
+    the bundled design's (derived from the robot's bounds).
+
+    Parameters
+    ----------
+    job : tuple
+        ``(case, index[, classes[, own_gain]])``: a case of :data:`CASES`, the plant's index
+        and two bools (default ``False``).
+
+    Returns
+    -------
+    dict
+        The knobs and ``held``, ``check_accepts``, ``check_s`` (s), the plant's own bounds
+        (``g_min_own``, ``g_max_own``, ``coupling``, ``push``), ``check_fails_at`` (s or
+        ``None``), ``gain``; with ``classes`` ``class_counterexample``; when it did not hold
+        ``holds_at_rate_factor`` (2, 4, 8 or ``None``).
+    """
     case, index = job[:2]
     classes, own_gain = (tuple(job[2:]) + (False, False))[:2]
     spec, design, samples = _designed(case)
@@ -182,7 +241,24 @@ def study_plants(runs: int, workers: int = 2, classes: bool = False,
                  own_gain: bool = False) -> list[dict]:
     """``runs`` plants per bundled case (:func:`study_one`, with the class search when
     ``classes``, at the gain derived from each plant's bounds when ``own_gain``), in
-    parallel."""
+    parallel.
+
+    Parameters
+    ----------
+    runs : int
+        Plants per case.
+    workers : int, optional
+        Processes; 1 or fewer runs them in this process.
+    classes : bool, optional
+        Search each plant's class for a counterexample.
+    own_gain : bool, optional
+        Use the gain derived from each plant's own bounds.
+
+    Returns
+    -------
+    list of dict
+        :func:`study_one`'s rows, case by case, in index order.
+    """
     jobs = [(case, i, classes, own_gain) for case in CASES for i in range(runs)]
     if workers <= 1:
         return [study_one(j) for j in jobs]

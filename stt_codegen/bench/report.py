@@ -10,9 +10,18 @@ from typing import Any
 
 import numpy as np
 
+__all__ = ["machine", "machine_line", "seconds_text", "summarize", "table"]
+
 
 def machine() -> dict[str, Any]:
-    """The machine a benchmark ran on: CPU model, CPUs usable, OS, Python, C compiler."""
+    """The machine a benchmark ran on: CPU model, CPUs usable, OS, Python, C compiler.
+
+    Returns
+    -------
+    dict
+        ``cpu`` (model name), ``cpus`` (usable by this process), ``system``, ``python`` and
+        ``cc`` (the first line of ``cc --version``, or ``"unknown"``).
+    """
     cpu = platform.processor() or platform.machine()
     try:
         with open("/proc/cpuinfo", encoding="utf-8") as f:
@@ -36,7 +45,18 @@ def machine() -> dict[str, Any]:
 
 
 def machine_line(info: dict[str, Any]) -> str:
-    """One line describing :func:`machine`'s output."""
+    """One line describing :func:`machine`'s output.
+
+    Parameters
+    ----------
+    info : dict
+        From :func:`machine`.
+
+    Returns
+    -------
+    str
+        ``machine: <cpu>, <cpus> CPUs, <system>, Python <version>, <cc>``.
+    """
     return (f"machine: {info['cpu']}, {info['cpus']} CPUs, {info['system']}, "
             f"Python {info['python']}, {info['cc']}")
 
@@ -98,7 +118,20 @@ def _effort(outcomes: list[dict[str, Any]]) -> dict[str, Any]:
 
 
 def table(header: list[str], rows: list[list[str]]) -> str:
-    """A plain-text table with columns padded to their widest cell (Markdown-compatible)."""
+    """A plain-text table with columns padded to their widest cell (Markdown-compatible).
+
+    Parameters
+    ----------
+    header : list of str
+        Column titles.
+    rows : list of list of str
+        Cells, one list per row, as many as the header.
+
+    Returns
+    -------
+    str
+        The table, lines separated by newlines.
+    """
     widths = [max(len(str(c)) for c in column) for column in zip(header, *rows)]
 
     def line(cells):
@@ -109,7 +142,18 @@ def table(header: list[str], rows: list[list[str]]) -> str:
 
 
 def seconds_text(value: float | None) -> str:
-    """A duration with a sensible unit (ns, us, ms, s)."""
+    """A duration with a sensible unit (ns, us, ms, s).
+
+    Parameters
+    ----------
+    value : float or None
+        Seconds.
+
+    Returns
+    -------
+    str
+        Three significant digits and the unit (``"1.23 ms"``), or ``"-"`` for ``None``.
+    """
     if value is None:
         return "-"
     for unit, scale in (("s", 1.0), ("ms", 1e-3), ("us", 1e-6)):

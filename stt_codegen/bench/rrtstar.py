@@ -21,6 +21,8 @@ import numpy as np
 from ..spec.loader import Spec
 from .planning import FreeSpace, Plan
 
+__all__ = ["ompl_available", "plan_rrtstar"]
+
 #: RRT* iterations per arena (the first solution typically appears within 100).
 ITERATIONS = 2000
 #: Wall-clock cap per arena, seconds.
@@ -32,7 +34,13 @@ CHECK_RESOLUTION = 0.005
 
 
 def ompl_available() -> str:
-    """Empty when OMPL's Python bindings import, else why not (one line)."""
+    """Empty when OMPL's Python bindings import, else why not (one line).
+
+    Returns
+    -------
+    str
+        ``""`` when OMPL imports, else the reason and how to install it.
+    """
     try:
         from ompl import base, geometric, util  # noqa: F401
     except ImportError as exc:

@@ -33,6 +33,8 @@ from .harness import BenchError, build_harness
 from .report import machine, machine_line, seconds_text, table
 from .timing import MIN_BATCH_SECONDS
 
+__all__ = ["format_scaling_report", "run_scaling_bench", "synthetic_design"]
+
 #: Obstacles in the dimension sweep (the case study's count).
 DIMENSION_SWEEP_OBSTACLES = 4
 #: Obstacles of the active-window experiment.
@@ -62,10 +64,12 @@ def synthetic_design(obstacles: int, dimension: int, windows: str = "random",
         ``min(1, 0.95 * 8 MAX_SIMULTANEOUS / m)`` s (at most :data:`MAX_SIMULTANEOUS` open). With ``"open"`` and ``"closed"`` the heights are scaled by 0.05 so that
         the closed loop stays inside the tube (the computation graph is the same).
     seed : int
+        Seeds the random circumvents (dimension, side, window, height).
 
     Returns
     -------
     TubeDesign
+        The design (not certified: only its size matters).
 
     Raises
     ------
@@ -195,6 +199,8 @@ def run_scaling_bench(obstacles: list[int], dimensions: list[int],
     Parameters
     ----------
     obstacles, dimensions : list of int
+        Obstacle counts (each >= 0) of the obstacle sweep and dimensions (each >= 1) of the
+        dimension sweep.
     compile_timeout : float
         Seconds allowed per compilation; a design that takes longer is reported with an
         ``error``.
@@ -202,6 +208,7 @@ def run_scaling_bench(obstacles: list[int], dimensions: list[int],
         Circumvents of the active-window experiment (default
         :data:`ACTIVE_EXPERIMENT_OBSTACLES`; 0 skips it).
     callgrind : bool
+        Also count instructions per step under callgrind.
     sparse : (int, int), optional
         Circumvent counts of :func:`sparse_window_experiment` (default
         ``(SPARSE_SMALL, SPARSE_LARGE)``; ``(0, 0)`` skips it).
@@ -212,6 +219,12 @@ def run_scaling_bench(obstacles: list[int], dimensions: list[int],
         ``machine``, ``obstacle_sweep``, ``dimension_sweep``, ``active_windows`` (rows of
         :func:`measure` with a ``windows`` key), ``sparse_windows`` (or None) and
         ``conclusion`` (a sentence).
+
+    Raises
+    ------
+    SpecError
+        A negative obstacle count (field ``obstacles``) or a dimension below 1
+        (``dimensions``).
     """
     for m in obstacles:
         if m < 0:
@@ -266,7 +279,18 @@ def _row_cells(r: dict[str, Any], first: str) -> list[str]:
 
 
 def format_scaling_report(report: dict[str, Any]) -> str:
-    """The human-readable tables of :func:`run_scaling_bench`'s result."""
+    """The human-readable tables of :func:`run_scaling_bench`'s result.
+
+    Parameters
+    ----------
+    report : dict
+        The result of :func:`run_scaling_bench`.
+
+    Returns
+    -------
+    str
+        One table per sweep and the machine line.
+    """
     header = ["{}", "generate", "compile -O2", "C source", "object", "time/step",
               "instr/step", "model arith / transc.", "outside"]
     out = []

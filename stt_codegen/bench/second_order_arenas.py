@@ -28,6 +28,9 @@ from ..errors import DesignError
 from ..runtime.cascade_simulate import simulate_second_order
 from .arenas import generate_arena
 
+__all__ = ["format_double_integrator_report", "run_arena_double_integrator",
+           "run_double_integrator_bench"]
+
 #: Velocity-loop gain of the baseline tracker, 1/s.
 VELOCITY_GAIN = 10.0
 #: Declared range of ``1/m`` for the cascade's default gains.
@@ -61,7 +64,23 @@ def _summary(result) -> dict:
 
 def run_arena_double_integrator(seed: int, index: int) -> dict:
     """Both methods on one arena: ``{"index", "stt": {...}, "astar": {...}}`` with
-    ``satisfied``, ``reach_time``, ``clearance``, ``peak_u`` or ``reason``."""
+    ``satisfied``, ``reach_time``, ``clearance``, ``peak_u`` or ``reason``.
+
+    Parameters
+    ----------
+    seed : int
+        Arena seed, >= 0.
+    index : int
+        Arena index, >= 0; also the disturbance seed of both runs.
+
+    Returns
+    -------
+    dict
+        ``index``, and per method (``stt``: the cascade on the designed tube; ``astar``: A*
+        plus the tracker) ``satisfied``, ``seconds`` (design or planning time, s) and either
+        ``reason`` (no design or no path) or ``reach_time`` (s), ``clearance`` (m),
+        ``peak_u``, ``collision`` and ``in_tube``.
+    """
     from .astar import plan_astar
     spec = generate_arena(seed, index).to_spec()
     spec = replace(spec, tube=replace(spec.tube, circumvent_sharpness=SHARPNESS))
@@ -98,7 +117,21 @@ def run_arena_double_integrator(seed: int, index: int) -> dict:
 
 
 def run_double_integrator_bench(count: int, seed: int) -> dict:
-    """Every arena in turn (sequential: no timing is compared), the satisfied rates."""
+    """Every arena in turn (sequential: no timing is compared), the satisfied rates.
+
+    Parameters
+    ----------
+    count : int
+        Number of arenas, >= 1.
+    seed : int
+        Arena seed, >= 0.
+
+    Returns
+    -------
+    dict
+        ``plant``, ``count``, ``seed``, ``satisfied_rate`` (method -> share in 0..1) and
+        ``arenas`` (:func:`run_arena_double_integrator`'s results).
+    """
     arenas = [run_arena_double_integrator(seed, k) for k in range(count)]
     rates = {m: sum(a[m]["satisfied"] for a in arenas) / count for m in ("stt", "astar")}
     return {"plant": "double-integrator", "count": count, "seed": seed,
@@ -106,7 +139,18 @@ def run_double_integrator_bench(count: int, seed: int) -> dict:
 
 
 def format_double_integrator_report(report: dict) -> str:
-    """The rates and the failures, a few lines."""
+    """The rates and the failures, a few lines.
+
+    Parameters
+    ----------
+    report : dict
+        The result of :func:`run_double_integrator_bench`.
+
+    Returns
+    -------
+    str
+        The satisfied rates, then one line per failed run with its reason.
+    """
     lines = [f"double integrator, {report['count']} arenas, seed {report['seed']}: satisfied "
              f"STT cascade {100 * report['satisfied_rate']['stt']:.1f} %, A* + tracker "
              f"{100 * report['satisfied_rate']['astar']:.1f} %"]

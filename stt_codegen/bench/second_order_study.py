@@ -27,6 +27,8 @@ from ..errors import SpecError
 from ..runtime.cascade_simulate import simulate_second_order
 from ..spec.loader import load_spec
 
+__all__ = ["DRAG_MAX", "format_second_order_report", "random_parameters", "run_second_order_study"]
+
 #: Largest drag of the random quadrotors, N s / m.
 DRAG_MAX = 0.4
 #: Gravity of the random quadrotors, m/s^2.
@@ -38,6 +40,23 @@ def random_parameters(model: str, input_gain: tuple, rng: np.random.Generator,
     """One plant's parameters within the declared bounds (the module docstring), or, with
     ``spread > 1``, beyond them: ``1/m`` in ``[g_min / spread, g_max spread]``, drag up to
     ``spread DRAG_MAX``.
+
+    Parameters
+    ----------
+    model : {"double-integrator", "quadrotor"}
+        The plant model.
+    input_gain : tuple of float, (g_min, g_max)
+        The declared bounds on ``1/m``, 1/kg.
+    rng : numpy.random.Generator
+        The source of the draw.
+    spread : float, optional
+        Factor by which the draw goes beyond the bounds (1: within them).
+
+    Returns
+    -------
+    list of float
+        ``[m]`` (kg) for the double integrator; ``[m, drag, gravity]`` (kg, N s/m, m/s^2)
+        for the quadrotor.
 
     Raises
     ------
@@ -129,7 +148,18 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
 
 
 def format_second_order_report(report: dict) -> str:
-    """The study as a few lines of text."""
+    """The study as a few lines of text.
+
+    Parameters
+    ----------
+    report : dict
+        The result of :func:`run_second_order_study`.
+
+    Returns
+    -------
+    str
+        The shares satisfied and in both tubes, then the first 20 failures, one a line.
+    """
     lines = [f"{report['case']} ({report['model']}), {report['count']} random plants "
              f"(spread {report['spread']:g}), seed "
              f"{report['seed']}, backend {report['backend']}: satisfied "

@@ -26,6 +26,8 @@ from .harness import BenchError, build_harness
 from .report import machine, machine_line, seconds_text, table
 from .timing import python_batch, round_robin
 
+__all__ = ["format_step_report", "run_step_bench"]
+
 #: Compiled-loop steps per timed run, and rounds of the round-robin.
 DEFAULT_STEPS = 100_000
 ROUNDS = 7
@@ -138,7 +140,18 @@ def run_step_bench(spec_arg: str, steps: int | None = None, rounds: int = ROUNDS
 
 
 def format_step_report(report: dict[str, Any]) -> str:
-    """The human-readable tables of :func:`run_step_bench`'s result."""
+    """The human-readable tables of :func:`run_step_bench`'s result.
+
+    Parameters
+    ----------
+    report : dict
+        The result of :func:`run_step_bench`.
+
+    Returns
+    -------
+    str
+        The time-per-step table, the operation counts and the machine line.
+    """
     rows = [[r["name"], seconds_text(r["seconds_per_step"]), f"{r['ratio_to_c']:.3g}x",
              f"{r['max_abs_u_difference']:.1e}"] for r in report["implementations"]]
     ops = report["operations"]

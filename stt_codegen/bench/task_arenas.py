@@ -25,6 +25,8 @@ from ..spec.loader import Box, Spec, parse_spec
 from .arenas import generate_arena
 from .moving import random_moving_obstacles
 
+__all__ = ["task_problem", "task_problem_toml"]
+
 #: Side of a task box, metres.
 TASK_SIZE = 0.6
 #: Seconds between consecutive window centres (and before the first).
@@ -109,5 +111,23 @@ def _moving_toml(entry: dict) -> str:
 
 
 def task_problem(seed: int, index: int) -> Spec:
-    """Problem ``index`` of ``seed`` (:func:`task_problem_toml`), validated."""
+    """Problem ``index`` of ``seed`` (:func:`task_problem_toml`), validated.
+
+    Parameters
+    ----------
+    seed : int
+        Problem seed, >= 0.
+    index : int
+        Problem index, >= 0.
+
+    Returns
+    -------
+    Spec
+        The validated spec ``tasks-<seed>-<index>``.
+
+    Raises
+    ------
+    SpecError
+        A negative seed or index.
+    """
     return parse_spec(task_problem_toml(seed, index))

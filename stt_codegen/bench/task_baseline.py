@@ -33,6 +33,8 @@ from .planning import FreeSpace
 from .task_timing import departure
 from .tracker import GOAL_GAIN, SPEED, PathTracker
 
+__all__ = ["plan_timed", "track_timed"]
+
 BACKEND = "bench-timed-tracker"
 
 
@@ -163,6 +165,7 @@ def track_timed(spec: Spec, plan: TimedPlan, seed: int) -> SimulationResult:
     Parameters
     ----------
     spec : Spec
+        The problem (a spec with ``[[tasks]]``).
     plan : TimedPlan
         With legs.
     seed : int
@@ -171,6 +174,7 @@ def track_timed(spec: Spec, plan: TimedPlan, seed: int) -> SimulationResult:
     Returns
     -------
     SimulationResult
+        The run, tasks judged; ``backend`` is the tracker's name.
     """
     if BACKEND not in backend_names():
         register_backend(BACKEND, _factory)

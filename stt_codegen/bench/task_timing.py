@@ -40,7 +40,22 @@ SLACK = 0.15
 
 def positions(path: np.ndarray, depart: float, t: np.ndarray) -> np.ndarray:
     """Nominal positions (len(t), 2) on ``path`` (K, 2): at ``path[0]`` until ``depart``
-    (s), then along it at :data:`~.tracker.SPEED` m/s, then at ``path[-1]``."""
+    (s), then along it at :data:`~.tracker.SPEED` m/s, then at ``path[-1]``.
+
+    Parameters
+    ----------
+    path : numpy.ndarray, shape (K, 2)
+        The leg's way points, metres.
+    depart : float
+        Departure time, s.
+    t : numpy.ndarray, shape (N,)
+        Times, s.
+
+    Returns
+    -------
+    numpy.ndarray, shape (N, 2)
+        Positions, metres.
+    """
     path = np.asarray(path, float)
     arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
     s = np.clip((np.asarray(t, float) - depart) * SPEED, 0.0, arc[-1])
@@ -50,7 +65,22 @@ def positions(path: np.ndarray, depart: float, t: np.ndarray) -> np.ndarray:
 def gap(points: np.ndarray, t: np.ndarray, obstacles: Sequence[MovingObstacle]) -> float:
     """The smallest distance (metres, by the largest separation along a dimension; ``inf``
     when none is present) of a point ``points[k]`` ((K, 2)) from an obstacle's hull over
-    ``[t[k] - SLACK, t[k] + SLACK]`` (seconds); negative inside."""
+    ``[t[k] - SLACK, t[k] + SLACK]`` (seconds); negative inside.
+
+    Parameters
+    ----------
+    points : numpy.ndarray, shape (K, 2)
+        Positions, metres.
+    t : numpy.ndarray, shape (K,)
+        Their times, s.
+    obstacles : sequence of MovingObstacle
+        The spec's moving obstacles.
+
+    Returns
+    -------
+    float
+        The smallest gap, metres (``inf`` when no obstacle is present near any ``t[k]``).
+    """
     out = np.inf
     for ob in obstacles:
         lo, hi, present = ob.hull(t - SLACK, t + SLACK)
@@ -74,6 +104,7 @@ def departure(path: np.ndarray, begin: float, deadline: float,
     deadline : float
         When it must have arrived (s), ``> begin``.
     obstacles : sequence of MovingObstacle
+        The spec's moving obstacles.
 
     Returns
     -------

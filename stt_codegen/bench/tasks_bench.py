@@ -28,6 +28,8 @@ from ..errors import DesignError, SpecError
 from .task_arenas import task_problem
 from .task_baseline import plan_timed, track_timed
 
+__all__ = ["METHODS", "format_tasks_report", "run_tasks_bench"]
+
 METHODS = ("stt", "astar")
 LABELS = {"stt": "STT (C controller)", "astar": "sequential A* + waiting + tracker"}
 
@@ -136,7 +138,19 @@ def run_tasks_bench(count: int, seed: int, progress: bool = False) -> dict[str, 
 
 
 def format_tasks_report(report: dict[str, Any]) -> str:
-    """The report of :func:`run_tasks_bench` as a table."""
+    """The report of :func:`run_tasks_bench` as a table.
+
+    Parameters
+    ----------
+    report : dict
+        The result of :func:`run_tasks_bench`.
+
+    Returns
+    -------
+    str
+        The table of methods (satisfied, design or planning time, control effort), the
+        problems the baseline satisfies and STT does not, and the failures by reason.
+    """
     lines = [f"bench tasks: {report['count']} problems of seed {report['seed']} "
              "(2-3 timed reach goals, the first with two alternatives, 4 static obstacles, "
              f"0-4 moving obstacles: {report['with_moving']} problems have some)",

@@ -7,6 +7,8 @@ import statistics
 import time
 from collections.abc import Callable, Sequence
 
+__all__ = ["MIN_BATCH_SECONDS", "python_batch", "round_robin"]
+
 #: Smallest duration of one timed batch, seconds.
 MIN_BATCH_SECONDS = 0.2
 
@@ -48,7 +50,20 @@ def round_robin(batches: dict[str, Callable[[], float]], repeats: int) -> dict[s
 
 def python_batch(step: Callable, inputs: Sequence[tuple]) -> Callable[[], float]:
     """A batch runner for :func:`round_robin`: calls ``step(*inputs[k])`` cycling over the
-    inputs, as many times as :func:`calibrate` says; returns seconds per call."""
+    inputs, as many times as :func:`calibrate` says; returns seconds per call.
+
+    Parameters
+    ----------
+    step : callable
+        The function timed.
+    inputs : sequence of tuple
+        Argument tuples, cycled over.
+
+    Returns
+    -------
+    callable
+        ``run() -> float``: one batch, seconds per call.
+    """
     count = len(inputs)
 
     def run_calls(calls: int) -> None:

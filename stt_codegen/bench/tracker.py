@@ -28,6 +28,8 @@ from ..runtime.simulate import SimulationResult, run_closed_loop
 from ..spec.loader import Spec
 from ..tube.parameters import TubeDesign
 
+__all__ = ["GOAL_GAIN", "PathTracker", "SPEED", "track"]
+
 #: Cruise speed, m/s.
 SPEED = 1.5
 #: Carrot distance ahead of the projection on the path, metres.
@@ -117,6 +119,7 @@ def track(spec: Spec, path: np.ndarray, seed: int) -> SimulationResult:
     spec : Spec
         A 2-D spec (its plant, disturbance bound, rate and ``t_c`` are used).
     path : numpy.ndarray, shape (K, 2)
+        The planned way points, metres.
     seed : int
         Disturbance seed (the same as the tube controller's on this arena).
 

@@ -34,6 +34,8 @@ from ..errors import DesignError, SpecError, SttError, ToolchainError
 from ..version import __version__
 from .parser import CommandParser
 
+__all__ = ["COMMANDS", "EXIT_CODES", "build_parser", "exit_code", "main"]
+
 #: Every subcommand: name -> (one-line help, ``"module:function"``). The function takes the
 #: subcommand's :class:`argparse.ArgumentParser`, adds its arguments and sets
 #: ``handler=fn(args) -> int`` (the exit code). It is imported only when the command runs.
@@ -81,7 +83,20 @@ def _configure(parser: argparse.ArgumentParser, command: str) -> None:
 
 def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
     """The argument parser: every subcommand's name and help, and the arguments of the
-    subcommand named in ``argv`` (only its module is imported)."""
+    subcommand named in ``argv`` (only its module is imported).
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The command line (without the program name); only the subcommand it names gets its
+        arguments configured. Empty: every subcommand listed, none configured.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The ``stt-codegen`` parser; for the chosen subcommand its defaults hold ``handler``
+        (``fn(args) -> int``) and ``command_parser`` (its :class:`CommandParser`).
+    """
     parser = argparse.ArgumentParser(
         prog="stt-codegen",
         description="Spatiotemporal-tube controllers for prescribed-time reach-avoid-stay "
@@ -101,7 +116,23 @@ def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
 
 
 def exit_code(exc: BaseException) -> int:
-    """The exit code of an error kind (:data:`EXIT_CODES`)."""
+    """The exit code of an error kind (:data:`EXIT_CODES`).
+
+    Parameters
+    ----------
+    exc : BaseException
+        The error a command raised.
+
+    Returns
+    -------
+    int
+        The code of the first row of :data:`EXIT_CODES` whose kind ``exc`` is an instance of.
+
+    Raises
+    ------
+    StopIteration
+        ``exc`` is none of the kinds of :data:`EXIT_CODES` (not an :class:`SttError`).
+    """
     return next(code for kind, code in EXIT_CODES if isinstance(exc, kind))
 
 
@@ -113,7 +144,21 @@ def _message(exc: SttError, flags: dict[str, str]) -> str:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``stt-codegen`` console script; returns the exit code."""
+    """Entry point of the ``stt-codegen`` console script; returns the exit code.
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments without the program name; ``None`` reads ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The exit code: the handler's (0 success, 1 a negative outcome), or the code of the
+        :class:`SttError` it raised (:func:`exit_code`; the message on standard error), 130 on
+        an interrupt, 141 when standard output was closed by its reader. argparse exits with 2
+        on arguments it rejects.
+    """
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser(argv)
     args = parser.parse_args(argv)

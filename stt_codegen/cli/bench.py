@@ -10,6 +10,8 @@ from pathlib import Path
 from ..errors import SpecError
 from .common import add_json_argument, add_spec_argument
 
+__all__ = ["configure_bench"]
+
 
 def _non_negative_int(text: str) -> int:
     value = int(text)
@@ -101,7 +103,14 @@ def _cmd_second_order(args: argparse.Namespace) -> int:
 
 def configure_bench(bench: argparse.ArgumentParser) -> None:
     """Sub-subcommands ``bench arenas``, ``tasks``, ``step``, ``scaling``, ``covering`` and
-    ``alpha``."""
+    ``alpha``.
+
+    Parameters
+    ----------
+    bench : argparse.ArgumentParser
+        The parser of ``stt-codegen bench``; its sub-subcommands are added to it, each with its
+        ``handler``.
+    """
     bench.description = ("Benchmarks. Every comparison is measured side by side in one run on "
                          "this machine; ratios, not absolute times, are the result.")
     sub = bench.add_subparsers(dest="bench_command", required=True, metavar="BENCH")

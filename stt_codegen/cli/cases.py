@@ -4,9 +4,22 @@ from __future__ import annotations
 
 import argparse
 
+__all__ = ["cmd_cases", "configure_cases"]
+
 
 def cmd_cases(args: argparse.Namespace) -> int:
-    """Print the bundled specs' names; exit 0."""
+    """Print the bundled specs' names; exit 0.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed arguments (none are read).
+
+    Returns
+    -------
+    int
+        0.
+    """
     from ..cases import bundled_cases
     for name in bundled_cases():
         print(name)
@@ -14,5 +27,11 @@ def cmd_cases(args: argparse.Namespace) -> int:
 
 
 def configure_cases(p: argparse.ArgumentParser) -> None:
-    """Arguments of ``stt-codegen cases`` (none)."""
+    """Arguments of ``stt-codegen cases`` (none).
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; its ``handler`` is set to :func:`cmd_cases`.
+    """
     p.set_defaults(handler=cmd_cases)

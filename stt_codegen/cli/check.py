@@ -6,9 +6,23 @@ import argparse
 import sys
 from pathlib import Path
 
+__all__ = ["cmd_check", "configure_check"]
+
 
 def cmd_check(args: argparse.Namespace) -> int:
-    """``stt-codegen check [--root generated] [--update]``: 0 identical, 1 drift."""
+    """``stt-codegen check [--root generated] [--update]``: 0 identical, 1 drift.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``root`` (the folder of the committed output) and ``update`` (rewrite it instead of
+        comparing).
+
+    Returns
+    -------
+    int
+        0 identical (or rewritten), 1 drift (the differences on standard output).
+    """
     from ..codegen.bundled import drift, update_generated, version_note
     root = Path(args.root)
     if args.update:
@@ -28,7 +42,14 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def configure_check(p: argparse.ArgumentParser) -> None:
-    """Arguments of ``stt-codegen check``."""
+    """Arguments of ``stt-codegen check``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; gets ``--root`` and ``--update`` and the ``handler``
+        :func:`cmd_check`.
+    """
     p.add_argument("--root", default="generated", metavar="DIR",
                    help="folder of the committed output (default: %(default)s)")
     p.add_argument("--update", action="store_true", help="rewrite the folder instead of comparing")

@@ -17,14 +17,31 @@ if TYPE_CHECKING:
     from ..design.result import Design
     from ..spec.loader import Spec
 
+__all__ = ["add_backend_argument", "add_json_argument", "add_seed_argument", "add_spec_argument",
+           "checked_seed", "design_spec", "load_and_design", "print_json"]
+
 
 def add_spec_argument(p: argparse.ArgumentParser) -> None:
-    """The positional ``SPEC``: a bundled case name or a spec file."""
+    """The positional ``SPEC``: a bundled case name or a spec file.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; gets the positional ``spec``.
+    """
     p.add_argument("spec", metavar="SPEC", help="bundled case name or spec file")
 
 
 def add_json_argument(p: argparse.ArgumentParser, text: str = "print one JSON object") -> None:
-    """``--json``: print one JSON document on standard output instead of text."""
+    """``--json``: print one JSON document on standard output instead of text.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; gets ``--json`` (``args.json``, a bool).
+    text : str, optional
+        The option's help text.
+    """
     p.add_argument("--json", action="store_true", help=text)
 
 
@@ -34,19 +51,38 @@ def default_backend() -> str:
 
 
 def add_backend_argument(p: argparse.ArgumentParser) -> None:
-    """``--backend``: the controller implementation (``stt_codegen.runtime.backends``)."""
+    """``--backend``: the controller implementation (``stt_codegen.runtime.backends``).
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; gets ``--backend`` (the registered backends' names, default
+        ``"c"``).
+    """
     from ..runtime.backends import backend_names
     p.add_argument("--backend", default=default_backend(), choices=backend_names(),
                    help="controller implementation (default: %(default)s)")
 
 
 def print_json(data: Any) -> None:
-    """Print ``data`` as one indented JSON document with sorted keys."""
+    """Print ``data`` as one indented JSON document with sorted keys.
+
+    Parameters
+    ----------
+    data : Any
+        A JSON-serialisable object (dicts, lists, str, numbers, bool, None).
+    """
     print(json.dumps(data, indent=2, sort_keys=True))
 
 
 def add_seed_argument(p: argparse.ArgumentParser) -> None:
-    """``--seed N``: the disturbance seed, checked by :func:`checked_seed`."""
+    """``--seed N``: the disturbance seed, checked by :func:`checked_seed`.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; gets ``--seed`` (an int, default 0).
+    """
     p.add_argument("--seed", type=int, default=0, metavar="N",
                    help="disturbance seed, an integer in [0, 2**32) (default: 0)")
 
@@ -54,6 +90,16 @@ def add_seed_argument(p: argparse.ArgumentParser) -> None:
 def checked_seed(args: argparse.Namespace) -> int:
     """``--seed``, checked before any work (the library's rule,
     :func:`stt_codegen.runtime.plants.check_seed`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments with ``seed``.
+
+    Returns
+    -------
+    int
+        The seed, in ``[0, 2**32)``.
 
     Raises
     ------
@@ -83,6 +129,18 @@ def design_spec(spec: Spec, args: argparse.Namespace) -> Design:
     """Design the tube of ``spec`` for a command; with ``--json``, when there is no design,
     print :func:`no_design_document` on standard output first.
 
+    Parameters
+    ----------
+    spec : Spec
+        The loaded spec.
+    args : argparse.Namespace
+        Parsed arguments; ``json`` (if present) asks for the document on no design.
+
+    Returns
+    -------
+    Design
+        The certified design (:func:`stt_codegen.design.search.design_tube`).
+
     Raises
     ------
     DesignError
@@ -99,6 +157,17 @@ def design_spec(spec: Spec, args: argparse.Namespace) -> Design:
 
 def load_and_design(args: argparse.Namespace) -> Design:
     """:func:`design_spec` of the spec ``SPEC`` names (a bundled case or a file).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments with ``spec`` (a bundled case name or a spec file) and, optionally,
+        ``json``.
+
+    Returns
+    -------
+    Design
+        The certified design of the spec.
 
     Raises
     ------

@@ -10,9 +10,29 @@ from .common import add_backend_argument, design_spec
 from .plotting import add_dims_argument, plot_dims
 from .simulate import SUMMARY_HEADER, summary_line
 
+__all__ = ["cmd_demo", "configure_demo"]
+
 
 def cmd_demo(args: argparse.Namespace) -> int:
-    """0 every case satisfied, 1 otherwise, 3 toolchain."""
+    """0 every case satisfied, 1 otherwise, 3 toolchain.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``out`` (the folder for code and plots, created), ``backend`` and ``dims``.
+
+    Returns
+    -------
+    int
+        0 every bundled case satisfied, 1 otherwise.
+
+    Raises
+    ------
+    ToolchainError
+        A compiler is missing or fails (exit code 3).
+    SpecError
+        ``--dims`` is not two distinct dimensions of a case (exit code 2).
+    """
     from ..cases import bundled_cases
     from ..codegen.api import generate
     from ..runtime.plots import plot_run
@@ -43,7 +63,14 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
 
 def configure_demo(p: argparse.ArgumentParser) -> None:
-    """Arguments of ``stt-codegen demo``."""
+    """Arguments of ``stt-codegen demo``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; gets ``--out``, ``--backend``, ``--dims`` and the ``handler``
+        :func:`cmd_demo`.
+    """
     p.add_argument("--out", default="stt-demo", metavar="DIR",
                    help="folder for the generated code and the plots (default: %(default)s)")
     add_backend_argument(p)

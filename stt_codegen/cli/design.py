@@ -7,9 +7,29 @@ import argparse
 from .common import add_json_argument, add_spec_argument, print_json
 from .plotting import add_plot_argument, design_to_plot, write_plot
 
+__all__ = ["cmd_design", "configure_design"]
+
 
 def cmd_design(args: argparse.Namespace) -> int:
-    """0 designed, 1 no design (``--plot``: the best rejected tube is drawn), 2 bad input."""
+    """0 designed, 1 no design (``--plot``: the best rejected tube is drawn), 2 bad input.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``spec``, ``json``, ``plot`` and ``dims``.
+
+    Returns
+    -------
+    int
+        0 designed (the design as text, or ``Design.to_json()`` with ``--json``).
+
+    Raises
+    ------
+    SpecError
+        A bad spec, ``--plot`` folder or ``--dims`` (exit code 2).
+    DesignError
+        No design (exit code 1).
+    """
     design, dims = design_to_plot(args)
     spec = design.spec
 
@@ -48,7 +68,14 @@ def cmd_design(args: argparse.Namespace) -> int:
 
 
 def configure_design(p: argparse.ArgumentParser) -> None:
-    """Arguments of ``stt-codegen design``."""
+    """Arguments of ``stt-codegen design``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; gets ``SPEC``, ``--json``, ``--plot``, ``--dims`` and the
+        ``handler`` :func:`cmd_design`.
+    """
     add_spec_argument(p)
     add_json_argument(p)
     add_plot_argument(p, "the designed tube (of the best rejected tube when there "

@@ -9,6 +9,8 @@ from ..errors import SpecError
 from .common import (add_json_argument, add_seed_argument, add_spec_argument, checked_seed,
                      load_and_design, print_json)
 
+__all__ = ["cmd_embedded", "configure_embedded"]
+
 
 def _print_report(r: dict) -> None:
     print(f"{r['spec']} on {r['target']}")
@@ -34,7 +36,27 @@ def _print_report(r: dict) -> None:
 
 
 def cmd_embedded(args: argparse.Namespace) -> int:
-    """Design, generate single precision, run on QEMU mps2-an386; 0 iff all passed."""
+    """Design, generate single precision, run on QEMU mps2-an386; 0 iff all passed.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``spec``, ``json``, ``seed``, ``build_dir`` (kept build folder or ``None``) and
+        ``no_host`` (skip the comparison with the host simulation).
+
+    Returns
+    -------
+    int
+        0 every check of the run passed (the cascade: the task satisfied), 1 otherwise or no
+        design.
+
+    Raises
+    ------
+    SpecError
+        A bad spec, ``--seed`` or ``--build-dir`` whose folder does not exist (exit code 2).
+    ToolchainError
+        The Arm toolchain or QEMU is missing or fails (exit code 3).
+    """
     from ..embedded.deploy import run_embedded
     seed = checked_seed(args)
     if args.build_dir is not None and not Path(args.build_dir).parent.is_dir():
@@ -61,7 +83,14 @@ def cmd_embedded(args: argparse.Namespace) -> int:
 
 
 def configure_embedded(p: argparse.ArgumentParser) -> None:
-    """Arguments of ``stt-codegen embedded``."""
+    """Arguments of ``stt-codegen embedded``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; gets ``SPEC``, ``--json``, ``--seed``, ``--build-dir``,
+        ``--no-host`` and the ``handler`` :func:`cmd_embedded`.
+    """
     add_spec_argument(p)
     add_json_argument(p)
     add_seed_argument(p)

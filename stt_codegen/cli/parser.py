@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import functools
 
+__all__ = ["CommandParser"]
+
 
 class CommandParser(argparse.ArgumentParser):
     """An argument parser that remembers the option of each destination, ``flags[dest]``.
@@ -12,6 +14,16 @@ class CommandParser(argparse.ArgumentParser):
     The dictionary is shared with the parsers of nested subcommands (``bench arenas``), so
     an error about a library parameter (``SpecError("horizon", ...)``) can be reported
     with the flag the user typed (``--horizon``).
+
+    Parameters
+    ----------
+    *args
+        Passed to :class:`argparse.ArgumentParser`.
+    flags : dict of str to str, optional
+        The shared ``dest -> flag`` dictionary (a nested subcommand's parser gets its
+        parent's); ``None`` starts an empty one.
+    **kwargs
+        Passed to :class:`argparse.ArgumentParser`.
     """
 
     def __init__(self, *args, flags: dict[str, str] | None = None, **kwargs) -> None:

@@ -21,16 +21,32 @@ if TYPE_CHECKING:
     from ..errors import DesignError
     from ..spec.loader import Spec
 
+__all__ = ["add_dims_argument", "add_plot_argument", "design_to_plot", "plot_dims", "write_plot"]
+
 
 def add_dims_argument(p: argparse.ArgumentParser) -> None:
-    """``--dims I,J``: the state dimensions of the plot's arena."""
+    """``--dims I,J``: the state dimensions of the plot's arena.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; gets ``--dims`` (a string, parsed by :func:`plot_dims`).
+    """
     p.add_argument("--dims", metavar="I,J", help="state dimensions of the plot's arena, "
                    "zero-based (default: 0,1)")
 
 
 def add_plot_argument(p: argparse.ArgumentParser, what: str) -> None:
     """``--plot PNG``: write a figure of ``what`` (words for the help text); and
-    ``--dims``."""
+    ``--dims``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; gets ``--plot`` and ``--dims``.
+    what : str
+        What the figure shows, for the help text.
+    """
     p.add_argument("--plot", metavar="PNG", help=f"write a figure of {what}")
     add_dims_argument(p)
 
@@ -52,6 +68,18 @@ def check_plot_folder(args: argparse.Namespace) -> None:
 def plot_dims(args: argparse.Namespace, spec: Spec) -> tuple[int, int]:
     """``--dims`` for ``spec``, checked before any work (default ``(0, 1)``).
 
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments with ``dims`` (``"I,J"`` or ``None``).
+    spec : Spec
+        The spec whose state dimension bounds ``I`` and ``J``.
+
+    Returns
+    -------
+    tuple of int, length 2
+        The two zero-based state dimensions of the figure.
+
     Raises
     ------
     SpecError
@@ -64,7 +92,16 @@ def plot_dims(args: argparse.Namespace, spec: Spec) -> tuple[int, int]:
 
 def write_plot(args: argparse.Namespace, draw: Callable[[Path], object]) -> None:
     """Write the figure ``draw(path)`` saves to ``--plot``, atomically; nothing without
-    ``--plot``."""
+    ``--plot``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments with ``plot`` (a PNG path or ``None``).
+    draw : callable
+        ``draw(path)`` saves the figure to ``path`` (a temporary file, renamed to ``--plot``
+        when complete).
+    """
     if args.plot:
         atomic_write(Path(args.plot), draw, field="plot")
 
@@ -87,9 +124,15 @@ def design_to_plot(args: argparse.Namespace) -> tuple[Design, tuple[int, int]]:
     """Load ``SPEC``, check ``--plot`` and ``--dims`` before any work, and design the tube
     (:func:`~.common.design_spec`); with no design, :func:`write_rejected_plot` first.
 
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments with ``spec``, ``plot``, ``dims`` and, optionally, ``json``.
+
     Returns
     -------
     design : Design
+        The certified design.
     dims : tuple of int, length 2
         The arena's dimensions of the figure.
 

@@ -8,12 +8,25 @@ from .common import (add_backend_argument, add_json_argument, add_seed_argument,
                      add_spec_argument, checked_seed, print_json)
 from .plotting import add_plot_argument, design_to_plot, write_plot
 
+__all__ = ["SUMMARY_HEADER", "cmd_simulate", "configure_simulate", "summary_line"]
+
 #: Header of the table of :func:`summary_line` rows (``simulate`` and ``demo``).
 SUMMARY_HEADER = f"{'case':<22} {'satisfied':<9} {'reach [s]':>9} {'clearance':>9}   max |u|"
 
 
 def summary_line(result) -> str:
-    """One row of the summary table: case, satisfied, reach time, clearance, max ``|u|``."""
+    """One row of the summary table: case, satisfied, reach time, clearance, max ``|u|``.
+
+    Parameters
+    ----------
+    result : SimulationResult or CascadeResult
+        One closed-loop run.
+
+    Returns
+    -------
+    str
+        The row, aligned under :data:`SUMMARY_HEADER`.
+    """
     clearance = ("-" if result.min_obstacle_clearance is None
                  else f"{result.min_obstacle_clearance:.3f}")
     reach = "-" if result.reach_time is None else f"{result.reach_time:.3f}"
@@ -23,7 +36,28 @@ def summary_line(result) -> str:
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
-    """0 satisfied, 1 not satisfied or no design, 2 bad input, 3 toolchain."""
+    """0 satisfied, 1 not satisfied or no design, 2 bad input, 3 toolchain.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``spec``, ``backend``, ``horizon`` (s, or ``None`` for ``t_c``), ``seed``, ``plot``,
+        ``dims`` and ``json``.
+
+    Returns
+    -------
+    int
+        0 the task is satisfied, 1 it is not.
+
+    Raises
+    ------
+    SpecError
+        A bad spec, ``--seed``, ``--horizon``, ``--plot`` folder or ``--dims`` (exit code 2).
+    DesignError
+        No design (exit code 1).
+    ToolchainError
+        The backend's compiler is missing or fails (exit code 3).
+    """
     from ..runtime.simulate import simulate
     seed = checked_seed(args)
     design, dims = design_to_plot(args)
@@ -63,7 +97,14 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def configure_simulate(p: argparse.ArgumentParser) -> None:
-    """Arguments of ``stt-codegen simulate``."""
+    """Arguments of ``stt-codegen simulate``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; gets ``SPEC``, ``--backend``, ``--horizon``, ``--seed``,
+        ``--plot``, ``--dims``, ``--json`` and the ``handler`` :func:`cmd_simulate`.
+    """
     add_spec_argument(p)
     add_backend_argument(p)
     p.add_argument("--horizon", type=float, default=None, metavar="S",

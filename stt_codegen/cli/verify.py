@@ -9,6 +9,8 @@ from collections.abc import Callable
 
 from .common import add_json_argument, add_spec_argument, design_spec
 
+__all__ = ["cmd_verify", "configure_verify"]
+
 
 def _terminal_progress() -> Callable[[str], None] | None:
     """Progress on stderr when it is a terminal (one line, rewritten), else ``None``."""
@@ -22,7 +24,26 @@ def _terminal_progress() -> Callable[[str], None] | None:
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
-    """0 every check passed, 1 a check failed or no design, 2 bad input."""
+    """0 every check passed, 1 a check failed or no design, 2 bad input.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``spec``, ``plant`` (a plant model or ``None`` for the spec's), ``json`` and
+        ``no_cache`` (prove the design-independent lemmas again).
+
+    Returns
+    -------
+    int
+        0 every check passed, 1 a check failed.
+
+    Raises
+    ------
+    SpecError
+        A bad spec or plant model (exit code 2).
+    DesignError
+        No design (exit code 1).
+    """
     from ..spec.loader import load_spec
     from ..verify.command import spec_for_plant, verify
     design = design_spec(spec_for_plant(load_spec(args.spec), args.plant), args)
@@ -38,7 +59,14 @@ def cmd_verify(args: argparse.Namespace) -> int:
 
 
 def configure_verify(p: argparse.ArgumentParser) -> None:
-    """Arguments of ``stt-codegen verify``."""
+    """Arguments of ``stt-codegen verify``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; gets ``SPEC``, ``--json``, ``--plant``, ``--no-cache`` and
+        the ``handler`` :func:`cmd_verify`.
+    """
     from ..spec.plants import PLANT_MODELS
     add_spec_argument(p)
     add_json_argument(p, "print a JSON list of checks")

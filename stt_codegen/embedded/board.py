@@ -12,6 +12,9 @@ top). QEMU loads the ELF and the core resets from the vector table at address 0.
 
 from __future__ import annotations
 
+__all__ = ["FAULT_EXIT_STATUS", "HEADER", "HEADER_NAME", "LINKER_SCRIPT", "LINKER_SCRIPT_NAME",
+           "MACHINE", "STARTUP", "STARTUP_NAME"]
+
 MACHINE = "mps2-an386"
 FLASH_ORIGIN = 0x00000000
 FLASH_LENGTH = 4 * 1024 * 1024

@@ -35,6 +35,8 @@ from ..runtime.plants import Disturbance
 from ..runtime.second_order_plants import second_order_rhs
 from .target import build_elf, elf_sizes, run_qemu
 
+__all__ = ["MEASURED_STEPS", "run_cascade_embedded"]
+
 #: Steps ``0..MEASURED_STEPS`` are counted (the first ones: the cost hardly depends on t).
 MEASURED_STEPS = 4
 

@@ -54,6 +54,8 @@ from .programs import (closed_loop_source, parse_closed_loop, parse_replay, repl
 from .target import CPU_FLAGS, build_elf, run_qemu
 from .toolchain import missing_message
 
+__all__ = ["compare_outputs", "run_embedded"]
+
 #: Steps whose instructions are counted: evenly spread over [0, t_c) (fractions of t_c).
 COUNT_FRACTIONS = (0.0, 0.2, 0.4, 0.6, 0.8, 0.999)
 
@@ -75,6 +77,30 @@ def compare_outputs(design: TubeDesign, x, t, dt, alpha, out) -> dict:
     Returns ``max_rel_error_u`` (normwise per vector, see the module docstring),
     ``max_abs_error_u`` and ``error_to_bound`` (largest ratio of the error to the
     single-precision bound, per output), ``status_mismatches``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The design whose double-precision reference (:mod:`stt_codegen.tube.reference`) is
+        the yardstick.
+    x : array_like, shape (N, n)
+        The states given to the program, state units.
+    t : array_like, shape (N,)
+        Times, s.
+    dt : array_like, shape (N,)
+        Sampling periods, s.
+    alpha : array_like, shape (N, 2n)
+        The adaptive law's ``alpha``.
+    out : ReplayOutput
+        What the single-precision program computed at those inputs
+        (:func:`stt_codegen.embedded.programs.parse_replay`).
+
+    Returns
+    -------
+    dict
+        ``max_rel_error_u`` (float), ``max_abs_error_u`` (float, input units),
+        ``error_to_bound`` (dict ``u``, ``alpha_next``, ``gamma`` -> float; at most 1 where
+        the single-precision bounds hold) and ``status_mismatches`` (int).
     """
     x, alpha = np.atleast_2d(x), np.atleast_2d(alpha)
     u, a_next, status = R.controller_status(design, x, t, dt, alpha)

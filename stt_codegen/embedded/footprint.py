@@ -27,6 +27,9 @@ from pathlib import Path
 from stt_codegen.embedded.toolchain import find_toolchain, run_tool
 from stt_codegen.errors import ToolchainError
 
+__all__ = ["Footprint", "FootprintError", "elf_stack_bound", "linked_sizes", "measure",
+           "worst_stack"]
+
 _CALL_RELOCS = ("R_ARM_THM_CALL", "R_ARM_THM_JUMP24", "R_ARM_THM_JUMP19", "R_ARM_CALL",
                 "R_ARM_JUMP24")
 
@@ -372,6 +375,13 @@ def elf_functions(elf: Path) -> tuple[dict[str, int], dict[str, set[str]]]:
 def elf_stack_bound(elf: Path, entry: str) -> dict:
     """Static worst-case stack of ``entry`` in a linked ELF, library code included.
 
+    Parameters
+    ----------
+    elf : pathlib.Path
+        The linked program.
+    entry : str
+        The function whose worst-case stack is bounded (e.g. the controller's ``step``).
+
     Returns
     -------
     dict
@@ -392,6 +402,18 @@ def linked_sizes(map_file: Path, obj: Path) -> dict[str, int]:
 
     Parsed from the GNU ld map file's memory map (the part after "Linker script and
     memory map"; discarded sections are listed before it).
+
+    Parameters
+    ----------
+    map_file : pathlib.Path
+        The GNU ld map file (``-Map``).
+    obj : pathlib.Path
+        The object file, as the map file names it.
+
+    Returns
+    -------
+    dict of str to int
+        Bytes of ``text`` (``.text*``, ``.ARM.ex*``), ``rodata``, ``data`` and ``bss``.
     """
     text = Path(map_file).read_text(errors="replace")
     start = text.find("Linker script and memory map")

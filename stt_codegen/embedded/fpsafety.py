@@ -35,6 +35,8 @@ from ..system import find_tool
 from ..tube.parameters import TubeDesign
 from .programs import parse_replay, replay_source
 
+__all__ = ["adversarial_inputs", "check_host"]
+
 FLAG_NAMES = {1: "FE_OVERFLOW", 2: "FE_INVALID", 4: "FE_DIVBYZERO"}
 SANITIZE = ("-fsanitize=float-divide-by-zero,float-cast-overflow,undefined",
             "-fno-sanitize-recover=all")
@@ -70,7 +72,21 @@ STATE_E = (0.0, 0.5, -0.999, 0.999999, 1.0, -1.0, 3.0)
 
 def adversarial_inputs(design: TubeDesign) -> dict:
     """Inputs ``x`` (N, n), ``t``, ``dt`` (N,), ``alpha`` (N, 2n) (float32 values) and
-    labels ``what`` (N,)."""
+    labels ``what`` (N,).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The design whose adversarial times, ``alpha`` values and states near the tube's
+        walls (``e`` in :data:`STATE_E`) are combined with the periods :data:`DTS`.
+
+    Returns
+    -------
+    dict
+        ``x`` (N, n) state units, ``t`` (N,) s, ``dt`` (N,) s, ``alpha`` (N, 2n), each
+        ndarray of float32-representable values, and ``what`` (list of N str), the label of
+        each input.
+    """
     n = design.dimension
     rows = {"x": [], "t": [], "dt": [], "alpha": [], "what": []}
     for (tname, t), dt in itertools.product(adversarial_times(design), DTS):
@@ -105,6 +121,20 @@ def check_host(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
                sanitize: bool = True, inputs: dict | None = None) -> dict:
     """Run the adversarial inputs through the single-precision C on the host.
 
+    Parameters
+    ----------
+    spec : Spec
+        The spec (name, dimension) of the generated code.
+    design : TubeDesign
+        The design compiled in single precision.
+    out_dir : pathlib.Path, optional
+        Folder for the generated code and the programs (created); default a new temporary
+        folder.
+    sanitize : bool, optional
+        Also build with :data:`SANITIZE` (undefined-behaviour sanitizer) and run that.
+    inputs : dict, optional
+        Inputs as :func:`adversarial_inputs` returns them; default those of ``design``.
+
     Returns
     -------
     dict
@@ -114,6 +144,11 @@ def check_host(spec: Spec, design: TubeDesign, out_dir: Path | None = None, *,
         or the first runtime error; ``bounded``: the error/bound ratios
         (:func:`stt_codegen.embedded.deploy.compare_outputs`) on the inputs inside the
         tube where the bound applies, and their count.
+
+    Raises
+    ------
+    ToolchainError
+        The host C compiler fails, or the program exits with an error.
     """
     from .deploy import compare_outputs
     out = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="stt-fp32-"))

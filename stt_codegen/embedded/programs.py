@@ -30,6 +30,8 @@ from ..runtime.simulate import SUBSTEPS
 from ..spec.loader import Spec
 from ..tube.parameters import TubeDesign
 
+__all__ = ["closed_loop_source", "parse_closed_loop", "parse_replay", "replay_source", "steps_of"]
+
 
 def _d(value: float) -> str:
     """A C double literal that reads back exactly."""
@@ -40,7 +42,21 @@ def _d(value: float) -> str:
 
 
 def steps_of(spec: Spec, design: TubeDesign) -> int:
-    """Controller periods over ``[0, t_c]``, as :func:`stt_codegen.runtime.simulate.simulate` counts."""
+    """Controller periods over ``[0, t_c]``, as :func:`stt_codegen.runtime.simulate.simulate`
+    counts.
+
+    Parameters
+    ----------
+    spec : Spec
+        Gives ``t_c`` (s).
+    design : TubeDesign
+        Gives ``rate_hz`` (Hz).
+
+    Returns
+    -------
+    int
+        ``ceil(t_c * rate_hz)``.
+    """
     return int(math.ceil(spec.prescribed_time * design.rate_hz - 1e-9))
 
 
@@ -70,12 +86,19 @@ def closed_loop_source(spec: Spec, design: TubeDesign, *, seed: int = 0, decimat
     Parameters
     ----------
     spec, design
+        The spec (sets, ``t_c``, plant, disturbance) and its design (rate).
     seed : int
         Disturbance seed (as ``simulate(..., seed=seed)``).
     decimate : int
         Print the state every ``decimate`` steps (and at the last one).
     replay : list of int
         Steps whose controller inputs are printed (``S`` lines), increasing.
+
+    Returns
+    -------
+    str
+        The C source of the program (single precision), which prints the sampled states
+        (``X`` lines), the replay steps' inputs (``S`` lines) and a ``closed loop:`` summary.
     """
     prefix = c_identifier(spec.c_name)
     n = spec.dimension
@@ -108,7 +131,31 @@ def float_bits(values) -> list[str]:
 
 
 def replay_source(spec: Spec, design: TubeDesign, x, t, dt, alpha, what: str) -> str:
-    """The replay program at float inputs ``x`` (N, n), ``t`` (N,), ``dt`` (N,), ``alpha`` (N, 2n)."""
+    """The replay program at float inputs ``x`` (N, n), ``t`` (N,), ``dt`` (N,), ``alpha`` (N, 2n).
+
+    Parameters
+    ----------
+    spec : Spec
+        Gives the generated code's prefix and the dimension ``n``.
+    design : TubeDesign
+        The design (the inputs are the program's data; the controller is the generated
+        code it is linked with).
+    x : array_like, shape (N, n)
+        States, state units, rounded to float32.
+    t : array_like, shape (N,)
+        Times, s.
+    dt : array_like, shape (N,)
+        Sampling periods, s.
+    alpha : array_like, shape (N, 2n)
+        The adaptive law's ``alpha``.
+    what : str
+        What the inputs are, for the program's header comment.
+
+    Returns
+    -------
+    str
+        The C source of the program, which prints one ``R`` line per input.
+    """
     prefix = c_identifier(spec.c_name)
     x = np.atleast_2d(np.asarray(x, dtype=np.float32))
     rows = [float_bits(np.concatenate([x[k], [t[k], dt[k]], alpha[k]])) for k in range(len(t))]
@@ -141,7 +188,20 @@ class ReplayOutput:
 
 
 def parse_replay(stdout: str, n: int) -> ReplayOutput:
-    """Parse the ``R`` (and ``F``) lines of the replay program."""
+    """Parse the ``R`` (and ``F``) lines of the replay program.
+
+    Parameters
+    ----------
+    stdout : str
+        The program's standard output.
+    n : int
+        State dimension.
+
+    Returns
+    -------
+    ReplayOutput
+        One row per ``R`` line, in order.
+    """
     rows, stacks, flags, nonfinite = [], [], [], []
     for line in stdout.splitlines():
         parts = line.split()
@@ -176,7 +236,25 @@ class ClosedLoopOutput:
 
 
 def parse_closed_loop(stdout: str, n: int) -> ClosedLoopOutput:
-    """Parse the closed-loop program's output (raises ``ValueError`` without a summary)."""
+    """Parse the closed-loop program's output (raises ``ValueError`` without a summary).
+
+    Parameters
+    ----------
+    stdout : str
+        The program's standard output.
+    n : int
+        State dimension.
+
+    Returns
+    -------
+    ClosedLoopOutput
+        The summary, the states (state units) and the replay inputs.
+
+    Raises
+    ------
+    ValueError
+        No ``closed loop:`` summary line.
+    """
     m = _SUMMARY.search(stdout)
     if m is None:
         raise ValueError("no 'closed loop:' summary line in the program's output")

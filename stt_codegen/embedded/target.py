@@ -31,6 +31,9 @@ from stt_codegen.embedded import board
 from stt_codegen.embedded.toolchain import ToolError, Toolchain, find_toolchain, run_tool
 from stt_codegen.errors import ToolchainError
 
+__all__ = ["BuildError", "BuildResult", "CPU_FLAGS", "RunError", "RunResult", "build_elf",
+           "count_region_instructions", "elf_sizes", "profile_regions", "run_qemu"]
+
 #: Code generation flags for the Cortex-M4F (single-precision FPU, hard-float ABI).
 CPU_FLAGS: tuple[str, ...] = (
     "-mcpu=cortex-m4", "-mfpu=fpv4-sp-d16", "-mfloat-abi=hard", "-mthumb",
@@ -52,7 +55,15 @@ _STARTUP_FLAGS: tuple[str, ...] = ("-std=gnu99", "-Wall", "-ffunction-sections",
 
 
 class BuildError(ToolError):
-    """The cross compiler or linker failed (``command``, ``output``)."""
+    """The cross compiler or linker failed (``command``, ``output``).
+
+    Parameters
+    ----------
+    command : sequence of str
+        The command that failed.
+    output : str
+        Its standard error and output.
+    """
 
 
 class RunError(ToolchainError):

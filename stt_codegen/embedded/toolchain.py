@@ -17,6 +17,9 @@ from stt_codegen import system
 from stt_codegen.errors import ToolchainError
 from stt_codegen.system import MissingTool
 
+__all__ = ["BUILD_TOOLS", "DEBIAN_PACKAGES", "MissingTool", "RUN_TOOLS", "ToolError", "Toolchain",
+           "find_tool", "find_toolchain", "missing_message", "missing_tools", "run_tool"]
+
 #: Tool name -> Debian package that provides it.
 DEBIAN_PACKAGES: dict[str, str] = {
     "arm-none-eabi-gcc": "gcc-arm-none-eabi",

@@ -4,3 +4,5 @@ Contract: every backend (:mod:`.backends`) steps ``(x, t, dt, alpha) -> (u, alph
 status)``; :func:`.simulate.simulate` runs one against a python-control plant
 (:mod:`.plants`) and judges Definition 2.1.
 """
+
+__all__: list[str] = []

@@ -81,17 +81,46 @@ _FACTORIES: dict[str, Callable[[TubeDesign], Controller]] = {
 
 
 def register_backend(name: str, factory: Callable[[TubeDesign], Controller]) -> None:
-    """Make ``factory(design)`` available as backend ``name``."""
+    """Make ``factory(design)`` available as backend ``name``.
+
+    Parameters
+    ----------
+    name : str
+        The backend's name (``--backend``); an existing name is replaced.
+    factory : callable
+        ``factory(design)`` builds the :class:`Controller` for a
+        :class:`~stt_codegen.tube.parameters.TubeDesign`.
+    """
     _FACTORIES[name] = factory
 
 
 def backend_names() -> list[str]:
-    """The registered backend names, in registration order."""
+    """The registered backend names, in registration order.
+
+    Returns
+    -------
+    list of str
+        ``"reference"``, ``"casadi"``, ``"c"``, ``"python"``, then any registered later.
+    """
     return list(_FACTORIES)
 
 
 def make_controller(name: str, design: TubeDesign) -> Controller:
     """The controller of backend ``name`` for a design.
+
+    Parameters
+    ----------
+    name : str
+        A name of :func:`backend_names`.
+    design : TubeDesign
+        The tube and gain the controller runs.
+
+    Returns
+    -------
+    Controller
+        ``step(x, t, dt, alpha) -> (u, alpha_next, status)``: ``x`` (n,) state units, ``t``
+        and ``dt`` in s, ``alpha`` (2n,); ``u`` (n,) input units by law (13), ``alpha_next``
+        (2n,) by the implicit step of the adaptive law (11), ``status`` a ``STATUS_*`` code.
 
     Raises
     ------

@@ -24,6 +24,8 @@ from ..tube.parameters import TubeDesign
 from ..tube.second_stage import (CASCADE_OK, CASCADE_OUTSIDE_POSITION_TUBE,
                                  CASCADE_OUTSIDE_VELOCITY_TUBE, SecondStage)
 
+__all__ = ["CascadeController"]
+
 #: The backends of the cascade step, in order.
 CASCADE_BACKENDS = ("reference", "casadi", "python", "c")
 
@@ -42,7 +44,9 @@ class CascadeController:
     backend : str
         One of :data:`CASCADE_BACKENDS`.
     design : TubeDesign
+        The position tube and its gain.
     stage : SecondStage
+        The velocity stage: tube ``rho2`` and gain.
 
     Raises
     ------

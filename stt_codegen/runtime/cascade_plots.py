@@ -12,6 +12,8 @@ from ..tube import reference
 from .cascade_simulate import CascadeResult
 from .plots import agg_figure, draw_arena, save
 
+__all__ = ["plot_cascade_run"]
+
 
 def plot_cascade_run(design: Design, result: CascadeResult, path: str | Path,
                      dims: tuple[int, int] = (0, 1)) -> Path:
@@ -31,6 +33,7 @@ def plot_cascade_run(design: Design, result: CascadeResult, path: str | Path,
     Returns
     -------
     pathlib.Path
+        ``path``.
     """
     spec, tube, traj = design.spec, design.tube, result.trajectory
     n = spec.dimension

@@ -26,13 +26,35 @@ from .cascade_controllers import CascadeController
 from .plants import Disturbance
 from .second_order_plants import model_info, second_order_rhs
 
+__all__ = ["CascadeResult", "CascadeTrajectory", "SUBSTEPS", "simulate_cascade",
+           "simulate_second_order"]
+
 #: Runge-Kutta steps per sampling period.
 SUBSTEPS = 2
 
 
 @dataclass
 class CascadeTrajectory:
-    """Sampled signals: ``t`` (N,), ``x1``, ``x2``, ``u``, ``r`` (N, n), ``status`` (N,)."""
+    """Sampled signals of the cascade's closed loop, ``N`` instants.
+
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        Sampling instants, s.
+    x1 : ndarray, shape (N, n)
+        Positions, state units.
+    x2 : ndarray, shape (N, n)
+        Velocities, state units per second.
+    u : ndarray, shape (N, n)
+        Inputs of the cascade law, held over each sampling interval, input units.
+    r : ndarray, shape (N, n)
+        The velocity reference of the first stage (the centre of the velocity tube), state
+        units per second.
+    alpha : ndarray, shape (N, 2n)
+        The adaptive law's ``alpha`` (eq. (11)) at each instant.
+    status : ndarray of int, shape (N,)
+        The step's status code (``CASCADE_OK``: inside both tubes).
+    """
 
     t: np.ndarray
     x1: np.ndarray
@@ -50,16 +72,20 @@ class CascadeResult:
     Attributes
     ----------
     spec, backend, model : str
+        The spec's name, the backend and the second-order plant model.
     satisfied : bool
         ``reached`` and not ``collision`` and not ``left_state_space``.
     reached : bool
+        ``x1`` entered the target no later than ``t_c``.
     reach_time : float or None
         First sampled instant with ``x1`` in the target, seconds.
     collision : bool
+        ``x1`` met an obstacle on ``[0, t_c]``.
     min_obstacle_clearance : float or None
         Smallest signed distance of ``x1`` to an obstacle over ``[0, t_c]`` (every
         integration point), state units.
     left_state_space : bool
+        ``x1`` left the state space on ``[0, t_c]``.
     stayed_in_tube : bool
         Every step had ``x1`` strictly inside the position tube.
     stayed_in_velocity_tube : bool
@@ -71,9 +97,16 @@ class CascadeResult:
     max_abs_x2 : list of float
         Peak ``|x2_i|``, velocity units.
     steps : int
+        Controller steps taken.
     exceeded_velocity_bound : bool
         Some sampled ``|x2_i|`` reached the spec's ``state_space.velocity_bound`` (then
         not ``satisfied``); ``False`` without a bound.
+    prescribed_time : float
+        ``t_c``, s.
+    trajectory : CascadeTrajectory or None
+        The sampled signals.
+    tasks : list
+        Always empty (a second-order spec takes no ``[[tasks]]``).
     """
 
     spec: str
@@ -147,6 +180,8 @@ def simulate_second_order(spec: Spec, tube: TubeDesign, stage: SecondStage, *,
     Returns
     -------
     CascadeResult
+        Definition 2.1 judged on ``x1``, both tubes' status, peaks of ``|u|`` and ``|x2|``, and
+        the trajectory.
 
     Raises
     ------
@@ -252,12 +287,14 @@ def simulate_cascade(design: Design, backend: str = "reference", horizon: float 
     Parameters
     ----------
     design : Design
+        From :func:`stt_codegen.design_tube`, its spec with a second-order ``plant.model``.
     backend, horizon, seed
         As :func:`simulate_second_order`.
 
     Returns
     -------
     CascadeResult
+        As :func:`simulate_second_order`.
 
     Raises
     ------

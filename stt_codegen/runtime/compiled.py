@@ -26,6 +26,8 @@ from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..system import atomic_write, find_tool
 
+__all__ = ["CController", "CFLAGS", "GeneratedPythonController", "compiler", "load_python_module"]
+
 #: Flags of the shared-library build (``-ffp-contract=off``: same rounding as CasADi's VM).
 CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fPIC", "-shared", "-Wall", "-Wextra",
           "-Wpedantic", "-Wshadow", "-Werror")
@@ -48,6 +50,11 @@ def cache_dir() -> Path:
 
 def compiler() -> str:
     """The C compiler: ``$CC``, else the first of ``cc``, ``gcc``, ``clang`` on ``PATH``.
+
+    Returns
+    -------
+    str
+        The compiler's path.
 
     Raises
     ------
@@ -97,7 +104,25 @@ def build_shared(sources: dict[str, bytes], c_file: str, cc: str | None = None,
 
 
 class CController:
-    """Backend ``c``: the generated C (double), compiled and loaded with ``ctypes``."""
+    """Backend ``c``: the generated C (double), compiled and loaded with ``ctypes``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube and gain compiled into the generated C.
+    precision : {"double", "single"}, optional
+        The floating-point type of the generated C (``double`` or ``float``; its ``step``
+        then takes that type).
+    cc : str, optional
+        The C compiler; default :func:`compiler`.
+
+    Raises
+    ------
+    MissingTool
+        No C compiler is installed.
+    CodegenError
+        The compiler failed (a :class:`~stt_codegen.errors.ToolchainError`).
+    """
 
     name = "c"
 
@@ -144,14 +169,33 @@ class CController:
 
 
 def load_python_module(source: bytes, name: str) -> types.ModuleType:
-    """Execute generated Python source as a module (not added to ``sys.modules``)."""
+    """Execute generated Python source as a module (not added to ``sys.modules``).
+
+    Parameters
+    ----------
+    source : bytes
+        The generated module's source, ASCII.
+    name : str
+        The module's name.
+
+    Returns
+    -------
+    types.ModuleType
+        The executed module.
+    """
     module = types.ModuleType(name)
     exec(compile(source.decode("ascii"), f"<generated {name}.py>", "exec"), module.__dict__)
     return module
 
 
 class GeneratedPythonController:
-    """Backend ``python``: the generated Python module, executed from memory."""
+    """Backend ``python``: the generated Python module, executed from memory.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube and gain the generated Python module is generated for.
+    """
 
     name = "python"
 

@@ -56,6 +56,11 @@ def input_matrix(model: str, n: int) -> ca.Function:
     n : int
         State dimension.
 
+    Returns
+    -------
+    casadi.Function
+        ``plant_input_matrix(x) -> g``, ``x`` (n,), ``g`` (n, n).
+
     Raises
     ------
     ValueError
@@ -74,6 +79,11 @@ def plant_rhs(model: str, n: int) -> ca.Function:
     ----------
     model, n
         As :func:`input_matrix`.
+
+    Returns
+    -------
+    casadi.Function
+        ``plant_rhs(x, u) -> x_dot``, each (n,); ``x_dot`` in state units per second.
 
     Raises
     ------
@@ -97,6 +107,11 @@ def linear_rhs(a: Sequence[Sequence[float]], g: Sequence[Sequence[float]],
         Drift and input matrices (1/s and state units per input unit per second).
     c : array_like, shape (n,)
         Constant drift, state units per second.
+
+    Returns
+    -------
+    casadi.Function
+        ``plant_rhs(x, u) -> x_dot``, each (n,); ``x_dot`` in state units per second.
     """
     a, g, c = (np.array(m, dtype=float) for m in (a, g, c))
     n = c.size
@@ -121,6 +136,11 @@ def plant_function(model: str, n: int, linear=None) -> ca.Function:
         State dimension.
     linear : LinearPlant, optional
         The ``linear`` model's matrices (default ``a = 0``, ``g = I``, ``c = 0``).
+
+    Returns
+    -------
+    casadi.Function
+        ``plant_rhs(x, u) -> x_dot``, each (n,); ``x_dot`` in state units per second.
 
     Raises
     ------

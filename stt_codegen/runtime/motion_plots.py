@@ -18,6 +18,8 @@ from matplotlib.patches import Rectangle
 from ..spec.loader import Spec
 from ..spec.motion import MovingObstacle
 
+__all__ = ["draw_moving_obstacles", "mark_states"]
+
 #: Instants at which each moving obstacle is drawn.
 SLICES = 4
 #: Colour map of the slice times, over ``[0, t_c]``.
@@ -44,6 +46,16 @@ def draw_moving_obstacles(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
     """Draw each moving obstacle of ``spec`` at its :func:`slice_times`, projected on ``dims``.
 
     Patches have the gid ``"moving obstacle j"``; labels ``"j @ t s"``.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The arena's axes.
+    spec : Spec
+        The spec whose ``moving_obstacles`` are drawn.
+    dims : tuple of int, length 2
+        The state dimensions of the axes, zero-based; a dimension the obstacle does not move
+        in spans the state space.
     """
     t_c = spec.prescribed_time
     for m, ob in enumerate(spec.moving_obstacles):
@@ -75,7 +87,21 @@ def draw_moving_obstacles(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
 def mark_states(ax: Axes, spec: Spec, t: np.ndarray, x: np.ndarray,
                 dims: tuple[int, int]) -> None:
     """Mark the state of a run (times ``t`` (N,), states ``x`` (N, n)) at every slice time of
-    the moving obstacles, in the slice's colour."""
+    the moving obstacles, in the slice's colour.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The arena's axes.
+    spec : Spec
+        The spec whose moving obstacles give the slice times.
+    t : ndarray, shape (N,)
+        Times of the run, s.
+    x : ndarray, shape (N, n)
+        States of the run, state units.
+    dims : tuple of int, length 2
+        The state dimensions of the axes, zero-based.
+    """
     times = sorted({s for ob in spec.moving_obstacles
                     for s in slice_times(ob, spec.prescribed_time)})
     for q, s in enumerate(times):

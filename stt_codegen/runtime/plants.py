@@ -20,6 +20,8 @@ from ..spec.loader import LinearPlant
 from ..spec.plants import PLANTS, dimension_mismatch
 from .dynamics import linear_rhs, plant_rhs
 
+__all__ = ["Disturbance", "check_seed", "make_plant"]
+
 #: Number of sinusoids summed in each disturbance component.
 DISTURBANCE_TERMS = 3
 
@@ -31,6 +33,16 @@ SEED_LIMIT = 2**32
 def check_seed(seed: object) -> int:
     """``seed`` as an ``int``, if it is a disturbance seed: an integer (Python or numpy) in
     ``[0, 2**32)``.
+
+    Parameters
+    ----------
+    seed : object
+        The seed to check.
+
+    Returns
+    -------
+    int
+        ``seed`` as a Python ``int``.
 
     Raises
     ------
@@ -140,11 +152,19 @@ def make_plant(model: str, dimension: int, amplitude: float, seed: int = 0,
     model : str
         One of :data:`stt_codegen.spec.plants.PLANT_MODELS`.
     dimension : int
+        State dimension ``n``.
     amplitude : float
-        Bound on every ``|w_i|`` (:class:`Disturbance`).
+        Bound on every ``|w_i|`` (:class:`Disturbance`), state units per second.
     seed : int
+        Seed of the disturbance, in ``[0, 2**32)``.
     linear : LinearPlant, optional
         The matrices of the ``linear`` model (default ``a = 0``, ``g = I``, ``c = 0``).
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        ``x_dot = f(x, u) + w(t)`` with ``n`` states, inputs and outputs (the state as
+        output), ``w`` the seeded :class:`Disturbance`.
 
     Raises
     ------

@@ -43,6 +43,10 @@ if TYPE_CHECKING:
     from ..design.certificate import Certificate
     from ..errors import DesignError
 
+__all__ = ["OBSTACLE_LABEL", "agg_figure", "arena_figure", "design_figure", "draw_arena",
+           "parse_dims", "plot_design", "plot_rejected", "plot_run", "rejected_figure",
+           "run_figure", "save"]
+
 #: The state dimensions the arena is drawn on unless told otherwise.
 DEFAULT_DIMS = (0, 1)
 #: Tube boxes (at most) drawn over the arena of a design.
@@ -66,7 +70,18 @@ OBSTACLE_LABEL = "obstacle j (obstacles[j] of the spec)"
 def agg_figure(**kwargs) -> Figure:
     """A :class:`~matplotlib.figure.Figure` on its own Agg canvas (``kwargs`` go to
     ``Figure``): it can be saved as PNG without pyplot and without touching matplotlib's
-    global backend."""
+    global backend.
+
+    Parameters
+    ----------
+    **kwargs
+        Passed to :class:`matplotlib.figure.Figure` (``figsize``, ``layout``...).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, with its canvas.
+    """
     fig = Figure(**kwargs)
     FigureCanvasAgg(fig)
     return fig
@@ -117,6 +132,11 @@ def parse_dims(text: str | None, n: int) -> tuple[int, int]:
         ``"I,J"``, zero-based state indices.
     n : int
         State dimension of the spec.
+
+    Returns
+    -------
+    tuple of int, length 2
+        The two distinct state dimensions ``(I, J)``.
 
     Raises
     ------
@@ -229,7 +249,17 @@ def _equal_aspect(spec: Spec, dims: tuple[int, int]) -> bool:
 
 
 def draw_arena(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
-    """The state space, the obstacles and the target on ``ax``, projected on ``dims``."""
+    """The state space, the obstacles and the target on ``ax``, projected on ``dims``.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The axes to draw on.
+    spec : Spec
+        The spec whose sets are drawn.
+    dims : tuple of int, length 2
+        The state dimensions of the axes, zero-based.
+    """
     draw_box(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
     draw_unsafe_sets(ax, spec, dims)
     draw_moving_obstacles(ax, spec, dims)      # time slices (motion_plots.py); none: nothing
@@ -273,6 +303,7 @@ def arena_figure(spec: Spec, rows: int, dims: tuple[int, int]) -> tuple[Figure, 
     Parameters
     ----------
     spec : Spec
+        The spec whose arena is drawn.
     rows : int
         Time plots in the right column.
     dims : tuple of int, length 2
@@ -281,6 +312,7 @@ def arena_figure(spec: Spec, rows: int, dims: tuple[int, int]) -> tuple[Figure, 
     Returns
     -------
     fig : matplotlib.figure.Figure
+        The figure, on its Agg canvas.
     grid : matplotlib.gridspec.GridSpec
         ``rows`` rows, 2 columns.
     ax : matplotlib.axes.Axes or None
@@ -519,7 +551,25 @@ def tube_figure(spec: Spec, tube: TubeDesign, certificate: Certificate, headline
 
 def design_figure(design: Design, dims: tuple[int, int] = DEFAULT_DIMS) -> Figure:
     """The figure of a certified design (:func:`tube_figure`), its method and time in the
-    title."""
+    title.
+
+    Parameters
+    ----------
+    design : Design
+        From :func:`stt_codegen.design_tube`.
+    dims : tuple of int, length 2, optional
+        State dimensions of the arena, zero-based (:func:`check_dims`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, on its Agg canvas (:func:`agg_figure`).
+
+    Raises
+    ------
+    TypeError
+        ``design`` is not a :class:`~stt_codegen.design.result.Design`.
+    """
     design = require_design(design, "design_figure")
     spec = design.spec
     return tube_figure(spec, design.tube, design.certificate,
@@ -579,8 +629,16 @@ def rejected_figure(spec: Spec, error: DesignError,
     Parameters
     ----------
     spec : Spec
+        The spec that has no design.
     error : DesignError
         From :func:`stt_codegen.design_tube` on ``spec``, with ``tried`` not ``None``.
+    dims : tuple of int, length 2, optional
+        State dimensions of the arena, zero-based (:func:`check_dims`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, on its Agg canvas (:func:`agg_figure`).
 
     Raises
     ------
@@ -605,6 +663,7 @@ def plot_rejected(spec: Spec, error: DesignError, path: str | Path, *,
     Parameters
     ----------
     spec : Spec
+        The spec that has no design.
     error : DesignError
         With ``tried`` not ``None``.
     path : str or path
@@ -615,12 +674,26 @@ def plot_rejected(spec: Spec, error: DesignError, path: str | Path, *,
     Returns
     -------
     pathlib.Path
+        ``path``.
     """
     return save(rejected_figure(spec, error, dims), path)
 
 
 def save(fig: Figure, path: str | Path) -> Path:
-    """Write ``fig`` as PNG to ``path`` (its folder must exist)."""
+    """Write ``fig`` as PNG to ``path`` (its folder must exist).
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : str or pathlib.Path
+        The PNG file to write (110 dpi).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     out = Path(path)
     fig.savefig(out, dpi=110, format="png")
     return out

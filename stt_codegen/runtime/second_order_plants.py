@@ -37,6 +37,18 @@ __all__ = ["MODELS", "SECOND_ORDER_MODELS", "input_matrix", "model_info",
 def model_info(model: str, n: int) -> SecondOrderModel:
     """The :class:`SecondOrderModel` of a name, checked against the dimension.
 
+    Parameters
+    ----------
+    model : str
+        A name of :data:`SECOND_ORDER_MODELS`.
+    n : int
+        Number of positions (= velocities = inputs).
+
+    Returns
+    -------
+    SecondOrderModel
+        The model's description (dimension, parameters and their nominal values).
+
     Raises
     ------
     ValueError
@@ -106,7 +118,26 @@ def second_order_rhs(model: str, n: int) -> ca.Function:
 @lru_cache(maxsize=None)
 def input_matrix(model: str, n: int) -> ca.Function:
     """``second_order_input_matrix(x1, x2, params) -> g``: ``d x2_dot / d u``, (n, n),
-    exact (algorithmic differentiation of :func:`second_order_rhs`), for Assumption 2."""
+    exact (algorithmic differentiation of :func:`second_order_rhs`), for Assumption 2.
+
+    Parameters
+    ----------
+    model : str
+        A name of :data:`SECOND_ORDER_MODELS`.
+    n : int
+        Number of positions (= velocities = inputs).
+
+    Returns
+    -------
+    casadi.Function
+        ``second_order_input_matrix(x1, x2, params) -> g``: ``x1``, ``x2`` (n,), ``params``
+        the model's parameters, ``g`` (n, n).
+
+    Raises
+    ------
+    ValueError
+        Unknown model, or a dimension it does not have (:func:`model_info`).
+    """
     rhs = second_order_rhs(model, n)
     x1, x2, u, w = (ca.SX.sym(name, n) for name in ("x1", "x2", "u", "w"))
     p = ca.SX.sym("params", rhs.numel_in(4))

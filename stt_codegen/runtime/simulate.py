@@ -26,13 +26,29 @@ from ..tube import reference
 from ..tube.parameters import TubeDesign
 from .tasks import TaskOutcome, judge_tasks
 
+__all__ = ["SUBSTEPS", "SimulationResult", "Trajectory", "run_closed_loop", "simulate"]
+
 #: Runge-Kutta steps per sampling period.
 SUBSTEPS = 2
 
 
 @dataclass
 class Trajectory:
-    """Sampled closed-loop signals: ``t`` (N,), ``x`` (N, n), ``u`` (N, n), ``alpha`` (N, 2n), ``status`` (N,)."""
+    """Sampled closed-loop signals, ``N`` instants.
+
+    Attributes
+    ----------
+    t : ndarray, shape (N,)
+        Sampling instants ``t_k = k / rate_hz``, s.
+    x : ndarray, shape (N, n)
+        The state at ``t_k``, state units.
+    u : ndarray, shape (N, n)
+        The input of law (13) computed at ``t_k`` and held until ``t_{k+1}``, input units.
+    alpha : ndarray, shape (N, 2n)
+        The adaptive law's ``alpha`` (eq. (11)) used at ``t_k``.
+    status : ndarray of int, shape (N,)
+        The step's status code (:data:`~stt_codegen.runtime.backends.STATUS_OK`...).
+    """
 
     t: np.ndarray
     x: np.ndarray
@@ -48,6 +64,7 @@ class SimulationResult:
     Attributes
     ----------
     spec, backend : str
+        The spec's name and the backend that ran the controller.
     satisfied : bool
         ``reached`` and not ``collision`` and not ``left_state_space`` (and every task of
         ``tasks`` met).
@@ -56,6 +73,7 @@ class SimulationResult:
     reach_time : float or None
         First sampled instant in the target, seconds.
     prescribed_time : float
+        ``t_c``, s.
     collision : bool
         The state met an obstacle on ``[0, t_c]`` (checked at every integration point).
     min_obstacle_clearance : float or None
@@ -63,6 +81,7 @@ class SimulationResult:
         inside it), state units; exact for boxes and balls, a lower bound for polytopes
         (distance to the nearest facet's plane). ``None`` without obstacles.
     left_state_space : bool
+        The state left the state space on ``[0, t_c]``.
     stayed_in_tube : bool
         Every controller step on ``[0, horizon]`` reported the state inside the tube
         (``STATUS_OK``, or ``STATUS_INPUT_CLAMPED``: inside, ``u`` clamped).
@@ -85,6 +104,8 @@ class SimulationResult:
     tasks : list of TaskOutcome
         Each ``[[tasks]]`` entry judged on the run (:mod:`~.tasks`: met, when, margin);
         ``satisfied`` also needs every one met. Empty without tasks.
+    trajectory : Trajectory or None
+        The sampled signals.
     """
 
     spec: str
@@ -242,6 +263,20 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     :class:`~stt_codegen.design.result.Design`, which pairs the tube with its spec.
     Parameters, result and errors are those of :func:`simulate`, with the spec and the
     tube (:class:`~stt_codegen.tube.parameters.TubeDesign`) in place of the design.
+
+    Parameters
+    ----------
+    spec : Spec
+        The task: sets, ``t_c``, plant, disturbance bound.
+    tube : TubeDesign
+        The tube and gain to run.
+    backend, horizon, seed, plant
+        As :func:`simulate`.
+
+    Returns
+    -------
+    SimulationResult
+        As :func:`simulate`.
     """
     seed = check_seed(seed)
     t_c = spec.prescribed_time

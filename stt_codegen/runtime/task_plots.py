@@ -12,6 +12,8 @@ from matplotlib.patches import Rectangle
 from ..spec.loader import Box, Spec
 from ..spec.tasks import STAY, Task
 
+__all__ = ["draw_task_windows", "draw_tasks"]
+
 
 def task_caption(task: Task) -> str:
     """The label drawn beside a task's box: ``"T1 [7, 8] s"`` (``"T2 stay [2, 4] s"``)."""
@@ -24,6 +26,15 @@ def draw_tasks(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
 
     Reach boxes are dashed pink outlines, stay boxes dotted cyan ones; every ``any_of``
     box carries the caption.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The arena's axes.
+    spec : Spec
+        The spec whose ``tasks`` are drawn.
+    dims : tuple of int, length 2
+        The state dimensions of the axes, zero-based.
     """
     i, j = dims
     for task in spec.tasks:
@@ -41,7 +52,17 @@ def draw_tasks(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
 
 def draw_task_windows(ax: Axes, spec: Spec, i: int) -> None:
     """On a time plot of state ``x_i``: each task's box over its window (``[t0, t1]`` by
-    the box's range in dimension ``i``), captioned."""
+    the box's range in dimension ``i``), captioned.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The time plot of ``x_i`` (time in s on the horizontal axis).
+    spec : Spec
+        The spec whose ``tasks`` are drawn.
+    i : int
+        The state dimension of the plot, zero-based.
+    """
     for task in spec.tasks:
         color = "tab:cyan" if task.kind == STAY else "tab:pink"
         t0, t1 = task.window

@@ -23,6 +23,8 @@ import numpy as np
 from ..spec.loader import Spec
 from ..spec.tasks import STAY, Task
 
+__all__ = ["TaskOutcome", "judge_tasks"]
+
 
 @dataclass(frozen=True)
 class TaskOutcome:
@@ -33,9 +35,11 @@ class TaskOutcome:
     task : str
         Its label, ``"T1"``...
     kind : {"reach", "stay"}
+        The task's kind.
     window : list of float
         ``[t0, t1]``, seconds.
     met : bool
+        Whether the run meets the task.
     time : float or None
         Reach: the first instant in a box; stay: the first instant out of it; seconds.
     margin : float or None
@@ -85,6 +89,7 @@ def judge_tasks(spec: Spec, t: np.ndarray, x: np.ndarray) -> list[TaskOutcome]:
     Parameters
     ----------
     spec : Spec
+        The spec whose ``tasks`` are judged.
     t : ndarray, shape (N,)
         Seconds, increasing.
     x : ndarray, shape (N, n)

@@ -25,6 +25,8 @@ from ..rounding import distinct
 from .check import Check
 from .sampled import SampledCheck, sampled_check_of
 
+__all__ = ["input_bound_check", "prove_input_bound", "sampled_error_bound"]
+
 
 def sampled_error_bound(result: SampledCheck, samples: TubeSamples) -> np.ndarray | None:
     """The sampled check's bound of ``|e_i(t_k)|``, shape (K, n), or ``None`` if it failed.
@@ -32,6 +34,19 @@ def sampled_error_bound(result: SampledCheck, samples: TubeSamples) -> np.ndarra
     The one place that reads the sampled check's result for the input bound: its
     per-sample bound (``abs_e``) when it gives one, else its overall bound (``max_abs_e``,
     the largest ``|e|`` at any sample) at every sample.
+
+    Parameters
+    ----------
+    result : SampledCheck
+        The sampled closed-loop check of the design (:func:`~.sampled.check_sampled`).
+    samples : TubeSamples
+        The tube at the sampling instants ``t_k`` (K of them).
+
+    Returns
+    -------
+    ndarray, shape (K, n), or None
+        The bound of ``|e_i(t_k)|`` per sample and axis (each in ``[0, 1)``); ``None`` when
+        the check failed.
     """
     if not result.passed:
         return None

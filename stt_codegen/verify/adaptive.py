@@ -40,6 +40,7 @@ __all__ = [
     "theta_zero_threshold",
     "alpha_upper_bound",
     "alpha_rate_bound",
+    "adaptive_law_form",
     "adaptive_law_checks",
     "simulate_alpha",
     "adversarial_psi_signals",
@@ -50,7 +51,22 @@ PsiFn = Callable[[float], float]
 
 
 def theta(psi: float | np.ndarray, theta0: float, mu: float) -> float | np.ndarray:
-    """Trigger of (11): ``theta0 (1 - tanh(psi - mu))``, in ``[0, 2 theta0)``."""
+    """Trigger of (11): ``theta0 (1 - tanh(psi - mu))``, in ``[0, 2 theta0)``.
+
+    Parameters
+    ----------
+    psi : float or ndarray
+        The conflict distance ``psi_i^lambda`` of (11), state units, any shape.
+    theta0 : float
+        The trigger's gain ``theta_o > 0``.
+    mu : float
+        The conflict tolerance ``mu > 0``, state units.
+
+    Returns
+    -------
+    float or ndarray
+        ``theta_i^lambda``, the shape of ``psi``.
+    """
     return theta0 * (1.0 - np.tanh(psi - mu))
 
 
@@ -59,6 +75,11 @@ def theta_zero_threshold() -> float:
 
     For ``psi - mu`` beyond it ``theta`` is exactly 0 in floating point, so
     (11) reduces to ``alpha_dot = -kappa alpha``: still ``alpha >= 0``.
+
+    Returns
+    -------
+    float
+        The threshold (state units, as ``psi - mu``).
     """
     lo, hi = 1.0, 40.0
     while np.nextafter(lo, hi) < hi:
@@ -103,6 +124,16 @@ def alpha_upper_bound(psi_min: float, theta0: float, kappa: float, mu: float) ->
         Lower bound of ``psi(t)`` over all time (may be negative).
     theta0, kappa, mu : float
         Parameters of (11), all > 0.
+
+    Returns
+    -------
+    float
+        ``alpha_max``, state units, rounded up.
+
+    Raises
+    ------
+    ValueError
+        ``theta0``, ``kappa`` or ``mu`` is not positive.
     """
     if not (theta0 > 0 and kappa > 0 and mu > 0):
         raise ValueError("theta0, kappa and mu must be > 0")
@@ -142,6 +173,29 @@ def alpha_rate_bound(
     ``y_dot >= -psi_dot_max + theta0/y^2 - kappa alpha_max > 0``. Then
     ``-kappa alpha_max <= alpha_dot <= theta_sup/y_min^2``.
     Requires ``psi0 > 0``.
+
+    Parameters
+    ----------
+    psi0 : float
+        ``psi(0)``, > 0, state units.
+    psi_min : float
+        Lower bound of ``psi(t)`` over all time, state units.
+    psi_dot_max : float
+        Bound of ``|psi_dot|``, state units per second.
+    theta0, kappa, mu : float
+        Parameters of (11), all > 0 (``kappa`` in 1/s, ``mu`` in state units).
+
+    Returns
+    -------
+    y_min : float
+        Lower bound of ``psi + alpha``, state units, rounded down.
+    alpha_dot_max : float
+        Bound of ``|alpha_dot|``, state units per second, rounded up.
+
+    Raises
+    ------
+    ValueError
+        ``psi0 <= 0``, or a parameter of (11) not positive.
     """
     if not psi0 > 0:
         raise ValueError("psi(0) must be > 0")
@@ -318,10 +372,28 @@ def simulate_alpha(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Integrate (11) with ``solve_ivp`` (Radau, exact Jacobian).
 
+    Parameters
+    ----------
+    psi : callable
+        ``psi(t) -> float``, the conflict distance, state units.
+    t_end : float
+        End of the integration, s.
+    theta0, kappa, mu : float
+        Parameters of (11) (``kappa`` in 1/s, ``mu`` in state units).
+    rtol, atol : float, optional
+        Tolerances of ``solve_ivp``.
+    max_step : float, optional
+        Largest step of the integrator, s.
+
     Returns
     -------
     (t, alpha, psi_values) : arrays
         Accepted steps of the integrator.
+
+    Raises
+    ------
+    RuntimeError
+        The integrator failed.
     """
 
     def rhs(t: float, a: np.ndarray) -> np.ndarray:
@@ -353,6 +425,18 @@ def adversarial_psi_signals(psi0: float, psi_min: float) -> dict[str, PsiFn]:
     Step-like drops (slopes 50 and 2000), a circumvent-like bump (eqs. (7)-(8)
     with ``k = 0.01``), an oscillation between the two levels, and a drop held
     for long (where ``alpha`` approaches ``alpha_max``).
+
+    Parameters
+    ----------
+    psi0 : float
+        The signals' value at ``t = 0``, state units.
+    psi_min : float
+        Their minimum, state units.
+
+    Returns
+    -------
+    dict of str to callable
+        ``name -> psi(t)``: ``step``, ``steep_step``, ``bump_like``, ``oscillating``, ``hold``.
     """
     drop = psi0 - psi_min
 
@@ -387,6 +471,22 @@ def check_adaptive_law_numeric(
     slack 1e-9 for the integrator) and ``psi + alpha > 0`` at every step.
     ``data`` holds per signal the peak ``alpha``, ``alpha_max``, their ratio
     and the least ``psi + alpha``.
+
+    Parameters
+    ----------
+    signals : mapping of str to callable
+        ``name -> psi(t)`` (e.g. :func:`adversarial_psi_signals`).
+    t_end : float
+        End of each integration, s.
+    theta0, kappa, mu : float
+        Parameters of (11) (``kappa`` in 1/s, ``mu`` in state units).
+    psi_min : float, optional
+        Lower bound of every ``psi``; default each signal's observed minimum.
+
+    Returns
+    -------
+    Check
+        ``adaptive.numeric``.
     """
     per: dict[str, dict[str, float]] = {}
     fails: list[str] = []

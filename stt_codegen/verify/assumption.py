@@ -49,6 +49,12 @@ def plant_input_matrix(model: str, n: int, x: Sequence[sp.Symbol]) -> sp.Matrix:
     n : int
         State dimension.
     x : sequence of sympy.Symbol, length n
+        The state's symbols.
+
+    Returns
+    -------
+    sympy.Matrix, shape (n, n)
+        ``g(x)`` of system (1).
     """
     (g,) = sympy_expressions(input_matrix(model, n), {"x": list(x)})
     # dense column-major -> (n, n); exact zeros and ones as SymPy integers
@@ -57,7 +63,18 @@ def plant_input_matrix(model: str, n: int, x: Sequence[sp.Symbol]) -> sp.Matrix:
 
 
 def symmetric_part(g: sp.Matrix) -> sp.Matrix:
-    """``g_s = (g + g^T)/2``, simplified entrywise."""
+    """``g_s = (g + g^T)/2``, simplified entrywise.
+
+    Parameters
+    ----------
+    g : sympy.Matrix, shape (n, n)
+        An input matrix ``g(x)``.
+
+    Returns
+    -------
+    sympy.Matrix, shape (n, n)
+        ``g_s``, whose least eigenvalue Assumption 2 bounds below.
+    """
     return ((g + g.T) / 2).applyfunc(sp.simplify)
 
 
@@ -92,6 +109,12 @@ def check_assumption2(
         ``{state_symbol: (lo, hi)}`` for every variable the eigenvalues use.
     name : str
         Name of the returned check.
+
+    Returns
+    -------
+    Check
+        Named ``name``; ``data`` holds ``g_s``, its eigenvalues and, on PASS, ``g_lower``
+        and where it is attained; on FAIL by a vanishing eigenvalue, where (``lost_at``).
     """
     gs = symmetric_part(g)
     eig = gs.eigenvals()
@@ -175,6 +198,11 @@ def assumption2_omnidirectional(heading_range: Sequence[float]) -> Check:
     ----------
     heading_range : (lo, hi)
         Range of ``x3`` the tube (or the state space) allows, in radians.
+
+    Returns
+    -------
+    Check
+        ``assumption2.omnidirectional`` (:func:`check_assumption2`).
     """
     x = sp.symbols("x1:4", real=True)
     return check_assumption2(plant_input_matrix("omnidirectional", 3, x),
@@ -182,7 +210,18 @@ def assumption2_omnidirectional(heading_range: Sequence[float]) -> Check:
 
 
 def assumption2_single_integrator(n: int) -> Check:
-    """Assumption 2 for ``x_dot = u + w``: ``g_s = I``, ``g_lower = 1``."""
+    """Assumption 2 for ``x_dot = u + w``: ``g_s = I``, ``g_lower = 1``.
+
+    Parameters
+    ----------
+    n : int
+        State dimension.
+
+    Returns
+    -------
+    Check
+        ``assumption2.single_integrator`` (:func:`check_assumption2`).
+    """
     x = sp.symbols(f"x1:{n + 1}", real=True)
     return check_assumption2(plant_input_matrix("single-integrator", n, x), {},
                              name="assumption2.single_integrator")

@@ -35,6 +35,10 @@ from ..tube.parameters import E_MAX, GAMMA_D_MIN
 from .check import Check
 from .deployed import on_domain
 
+__all__ = ["NOT_PROVED", "cascade_checks", "cascade_rate_check", "check_jacobian",
+           "check_lyapunov_derivative", "check_pushes_back", "check_transform",
+           "check_velocity_tube", "sampled_cascade_check"]
+
 #: What ``verify`` does not prove about the cascade, in words.
 NOT_PROVED = (
     "not proved: the bounds E1, E2 < 1 of the continuous-time argument are shown to exist, "
@@ -73,7 +77,18 @@ def _zero(expr) -> bool:
 
 def check_transform(n: int) -> Check:
     """The deployed ``e2``, ``epsilon2``, ``xi2``, ``u`` equal the formulas of
-    docs/second-order.md."""
+    docs/second-order.md.
+
+    Parameters
+    ----------
+    n : int
+        Number of positions (= velocities).
+
+    Returns
+    -------
+    Check
+        ``cascade.transform.n<n>``.
+    """
     e, eps, xi, u, k2, x2, r, rho2 = deployed_transform(n)
     ok = True
     for i in range(n):
@@ -90,7 +105,18 @@ def check_transform(n: int) -> Check:
 
 
 def check_jacobian(n: int) -> Check:
-    """``d epsilon2 / d x2 = diag(xi2)`` and ``d epsilon2 / d r = -diag(xi2)``."""
+    """``d epsilon2 / d x2 = diag(xi2)`` and ``d epsilon2 / d r = -diag(xi2)``.
+
+    Parameters
+    ----------
+    n : int
+        Number of positions (= velocities).
+
+    Returns
+    -------
+    Check
+        ``cascade.jacobian.n<n>``.
+    """
     _, eps, xi, _, _, x2, r, rho2 = deployed_transform(n)
     jx = (eps.jacobian(x2) - sp.diag(*xi)).applyfunc(lambda v: sp.simplify(sp.together(v)))
     jr = (eps.jacobian(r) + sp.diag(*xi)).applyfunc(lambda v: sp.simplify(sp.together(v)))
@@ -107,9 +133,15 @@ def check_lyapunov_derivative(n: int, tube_rate: bool = True) -> Check:
     Parameters
     ----------
     n : int
+        Number of positions (= velocities).
     tube_rate : bool, optional
         ``False`` drops the term ``rho2_dot e2`` from the claim (a wrong identity, which
         the check must refuse: the tests use it).
+
+    Returns
+    -------
+    Check
+        ``cascade.lyapunov_derivative.n<n>``: passed when the difference simplifies to 0.
     """
     e, eps, xi, _, _, x2, r, rho2 = deployed_transform(n)
     t = sp.Symbol("t", real=True)
@@ -137,6 +169,11 @@ def check_pushes_back() -> Check:
     ``epsilon2 = ln(w)`` and ``1 - e2^2 = 4 w / (w + 1)^2``, so ``xi2 > 0``; ``epsilon2``
     has the sign of ``w - 1``, which is the sign of ``e2``, so ``u z = -k2 xi2 epsilon2
     rho2 e2 <= 0``.
+
+    Returns
+    -------
+    Check
+        ``cascade.pushes_back``; ``data`` holds ``xi2`` and ``epsilon2`` in ``w``.
     """
     e, eps, xi, u, k2, x2, r, rho2 = deployed_transform(1)
     w = sp.Symbol("w", positive=True)
@@ -160,7 +197,13 @@ def check_velocity_tube() -> Check:
     """``rho2(0) = width_start``, ``rho2(t) >= width_floor`` and ``|rho2_dot| <= l
     (width_start - width_floor)`` for ``t >= 0``, on the deployed expression (the exponent
     clamp at -80 inactive: ``l t <= 80``; beyond, ``rho2`` is the floor plus
-    ``(width_start - width_floor) e^-80``, also above the floor)."""
+    ``(width_start - width_floor) e^-80``, also above the floor).
+
+    Returns
+    -------
+    Check
+        ``cascade.velocity_tube``; ``data`` holds the reduced ``rho2``.
+    """
     t = sp.Symbol("t", nonnegative=True)
     floor, gap, decay = (sp.Symbol(s, positive=True) for s in ("rho2_inf", "g", "l"))
     (rho2,) = sympy_expressions(cascade.velocity_tube(1), {
@@ -186,7 +229,13 @@ def check_velocity_tube() -> Check:
 def sampled_cascade_check() -> Check:
     """``cascade.sampled``: always FAILS, with :data:`NOT_PROVED`: ``verify`` proves the
     continuous-time lemmas of the cascade, not that the sampled cascade keeps a plant of the
-    declared class in both tubes (docs/second-order.md, "What is not proved")."""
+    declared class in both tubes (docs/second-order.md, "What is not proved").
+
+    Returns
+    -------
+    Check
+        ``cascade.sampled``, failed, its message :data:`NOT_PROVED`.
+    """
     return Check("cascade.sampled", False, NOT_PROVED, {})
 
 
@@ -208,6 +257,12 @@ def cascade_rate_check(spec, design, min_width: float, rate_hz: float | None = N
     rate_hz : float, optional
         The rate judged with the gains derived at ``design.rate_hz`` (default that rate):
         the gains stay those deployed at the spec's rate.
+
+    Returns
+    -------
+    Check
+        ``cascade.rate``; ``data`` is :func:`~stt_codegen.design.cascade_gain.cascade_rate`'s
+        result.
     """
     from ..design.cascade_gain import cascade_rate, cascade_rate_words, derived_second_stage
     order = spec.second_order
@@ -220,7 +275,20 @@ def cascade_rate_check(spec, design, min_width: float, rate_hz: float | None = N
 
 
 def cascade_checks(max_n: int = 2) -> list[Check]:
-    """Every check of this module (``n = 1..max_n`` where the dimension matters)."""
+    """Every check of this module (``n = 1..max_n`` where the dimension matters).
+
+    Parameters
+    ----------
+    max_n : int, optional
+        Largest number of positions proved.
+
+    Returns
+    -------
+    list of Check
+        The transform, Jacobian and Lyapunov derivative for each ``n``, then
+        ``cascade.pushes_back`` and ``cascade.velocity_tube`` (not ``cascade.sampled`` nor
+        ``cascade.rate``, which need a design).
+    """
     out = []
     for n in range(1, max_n + 1):
         out += [check_transform(n), check_jacobian(n), check_lyapunov_derivative(n)]

@@ -5,6 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Iterable
 
+__all__ = ["Check", "VerificationReport", "all_passed", "format_report"]
+
 
 @dataclass(frozen=True)
 class Check:
@@ -35,12 +37,34 @@ class Check:
 
 
 def all_passed(checks: Iterable[Check]) -> bool:
-    """Return ``True`` when every check in ``checks`` passed."""
+    """Return ``True`` when every check in ``checks`` passed.
+
+    Parameters
+    ----------
+    checks : iterable of Check
+        The checks.
+
+    Returns
+    -------
+    bool
+        Whether all passed (``True`` for none).
+    """
     return all(c.passed for c in checks)
 
 
 def format_report(checks: Iterable[Check]) -> str:
-    """One line per check, ``[PASS]``/``[FAIL]`` first."""
+    """One line per check, ``[PASS]``/``[FAIL]`` first.
+
+    Parameters
+    ----------
+    checks : iterable of Check
+        The checks, in the order printed.
+
+    Returns
+    -------
+    str
+        The lines, separated by newlines.
+    """
     return "\n".join(str(c) for c in checks)
 
 

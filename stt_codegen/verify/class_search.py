@@ -102,7 +102,18 @@ class Counterexample:
 
 def unit_skew(axis: np.ndarray) -> np.ndarray:
     """The skew matrix of the cross product with ``axis`` (3-D), or the rotation generator
-    (2-D); spectral norm ``|axis|``."""
+    (2-D); spectral norm ``|axis|``.
+
+    Parameters
+    ----------
+    axis : ndarray, shape (2,) or (3,)
+        A unit vector (its direction is ignored in 2-D).
+
+    Returns
+    -------
+    ndarray, shape (2, 2) or (3, 3)
+        The skew-symmetric matrix ``K``.
+    """
     if len(axis) == 2:
         return np.array([[0.0, -1.0], [1.0, 0.0]])
     return np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]],
@@ -112,7 +123,22 @@ def unit_skew(axis: np.ndarray) -> np.ndarray:
 def within_class(g: np.ndarray, bounds: Assumptions, tol: float = 1e-9) -> bool:
     """``g`` obeys the class's bounds on ``g``: eigenvalues of its symmetric part, norm of
     its skew part, norm of each row's off-diagonal part (up to ``tol`` relative), and zero
-    entries between the class's blocks (:meth:`Assumptions.coupled_blocks`)."""
+    entries between the class's blocks (:meth:`Assumptions.coupled_blocks`).
+
+    Parameters
+    ----------
+    g : ndarray, shape (n, n)
+        A constant input matrix.
+    bounds : Assumptions
+        The declared class (``[assumptions]``).
+    tol : float, optional
+        Relative (and, for the norms, absolute) tolerance.
+
+    Returns
+    -------
+    bool
+        Whether ``g`` is a member of the class.
+    """
     n = len(g)
     g_min, g_max = bounds.input_gain
     block_of = {i: b for b in bounds.coupled_blocks(n) for i in b}
@@ -170,6 +196,7 @@ def class_matrices(bounds: Assumptions, n: int, seed: int = 0) -> list[np.ndarra
     Returns
     -------
     list of ndarray, each (n, n)
+        The members of the class tried, in a fixed order.
     """
     rng = np.random.default_rng([seed, n, 11])
     blocks = bounds.coupled_blocks(n)
@@ -307,6 +334,7 @@ def replay(design: TubeDesign, found: Counterexample, backend: str = "c") -> boo
     Returns
     -------
     bool
+        Whether the deployed controller confirms the exit.
     """
     from ..runtime.backends import STATUS_OK, STATUS_OUTSIDE_TUBE, make_controller
     controller = make_controller(backend, design)

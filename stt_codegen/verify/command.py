@@ -28,6 +28,8 @@ from .lemma import bump_rate_bound, reach_rate_bound
 from .proofs import design_independent_proofs
 from .sampled import plant_bounds_checks, sampled_checks
 
+__all__ = ["spec_for_plant", "verify", "verify_design", "verify_spec"]
+
 #: Dimension names used in check names.
 _SIDES = ("L", "U")
 
@@ -95,7 +97,9 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     Parameters
     ----------
     spec : Spec
+        The spec the tube was designed for.
     design : TubeDesign
+        Its designed tube and gain.
     plant : str, optional
         Plant model (one of :data:`stt_codegen.spec.plants.PLANT_MODELS`) for Assumption 2
         and the sampled check's bounds (:meth:`~stt_codegen.spec.loader.Spec.with_plant_model`);
@@ -223,6 +227,18 @@ def spec_for_plant(spec: Spec, plant: str | None) -> Spec:
     ``plant`` is ``None``), so that the design refuses a plant that violates the
     assumption.
 
+    Parameters
+    ----------
+    spec : Spec
+        The spec.
+    plant : str or None
+        A plant model, or ``None`` for the spec's own.
+
+    Returns
+    -------
+    Spec
+        The spec for ``plant``.
+
     Raises
     ------
     SpecError
@@ -243,6 +259,24 @@ def verify_spec(spec: Spec, plant: str | None = None, *, cache: bool = True,
 
     With ``plant``, the tube is designed for that plant model instead of the spec's
     (:func:`spec_for_plant`).
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec.
+    plant, cache, progress
+        As :func:`verify_design`.
+
+    Returns
+    -------
+    list of Check
+        :func:`verify_design`'s checks, or the single failed check ``tube.design`` when no
+        tube can be designed.
+
+    Raises
+    ------
+    SpecError
+        As :func:`spec_for_plant`.
     """
     stage = _Stages(progress, design=True)
     stage("design")

@@ -73,7 +73,18 @@ class DomainUndecided(ValueError):
 
 
 def exact(expr: sp.Expr) -> sp.Expr:
-    """``expr`` with every ``Float`` replaced by the exact rational of its double."""
+    """``expr`` with every ``Float`` replaced by the exact rational of its double.
+
+    Parameters
+    ----------
+    expr : sympy.Expr
+        A printed expression.
+
+    Returns
+    -------
+    sympy.Expr
+        The same expression without floating-point numbers.
+    """
     return expr.xreplace({f: sp.Rational(float(f)) for f in expr.atoms(sp.Float)})
 
 
@@ -213,21 +224,56 @@ def _reach_printed() -> tuple[sp.Expr, sp.Expr]:
 
 @functools.lru_cache(maxsize=None)
 def reach_branch() -> sp.Expr:
-    """Deployed reach tube (4) on ``0 <= t < t_c`` (``t = t_c w/(1+w)``, ``w >= 0``)."""
+    """Deployed reach tube (4) on ``0 <= t < t_c`` (``t = t_c w/(1+w)``, ``w >= 0``).
+
+    Returns
+    -------
+    sympy.Expr
+        ``rho`` in :data:`T`, :data:`T_C`, :data:`X0` (the start bound) and :data:`TARGET`,
+        state units.
+
+    Raises
+    ------
+    DomainUndecided
+        A branch of the printed piece is not decided on the domain.
+    """
     rho, _ = _reach_printed()
     return on_domain(rho, {T: T_C * _W / (1 + _W)})
 
 
 @functools.lru_cache(maxsize=None)
 def reach_after() -> sp.Expr:
-    """Deployed reach tube on ``t >= t_c`` (``t = t_c + w``)."""
+    """Deployed reach tube on ``t >= t_c`` (``t = t_c + w``).
+
+    Returns
+    -------
+    sympy.Expr
+        ``rho`` in :data:`T`, :data:`T_C`, :data:`X0` and :data:`TARGET` (the target bound).
+
+    Raises
+    ------
+    DomainUndecided
+        As :func:`reach_branch`.
+    """
     rho, _ = _reach_printed()
     return on_domain(rho, {T: T_C + _W})
 
 
 @functools.lru_cache(maxsize=None)
 def reach_rate() -> sp.Expr:
-    """Deployed ``rho_dot`` output on ``0 <= t < t_c``."""
+    """Deployed ``rho_dot`` output on ``0 <= t < t_c``.
+
+    Returns
+    -------
+    sympy.Expr
+        ``rho_dot`` in :data:`T`, :data:`T_C`, :data:`X0` and :data:`TARGET`, state units
+        per second.
+
+    Raises
+    ------
+    DomainUndecided
+        As :func:`reach_branch`.
+    """
     _, rho_dot = _reach_printed()
     return on_domain(rho_dot, {T: T_C * _W / (1 + _W)})
 
@@ -244,14 +290,48 @@ def _bump_printed() -> tuple[sp.Expr, sp.Expr]:
 def bump_window(side: int = 1, rate: bool = False) -> sp.Expr:
     """Deployed bump (7)-(8) (height 1, window ``(m - r, m + r)``) on the half
     ``t = m + side r v/(1+v)``, ``v > 0``, of its window (``0 < side (t - m) < r``), where
-    the exponent clamp at -80 is inactive; with ``rate`` its ``y_dot`` output."""
+    the exponent clamp at -80 is inactive; with ``rate`` its ``y_dot`` output.
+
+    Parameters
+    ----------
+    side : {1, -1}, optional
+        The half after (1) or before (-1) the centre ``m``.
+    rate : bool, optional
+        The time derivative ``y_dot`` instead of ``y``.
+
+    Returns
+    -------
+    sympy.Expr
+        In :data:`T`, :data:`M`, :data:`R` and :data:`K`.
+
+    Raises
+    ------
+    DomainUndecided
+        A branch of the printed piece is not decided on the domain.
+    """
     y, y_dot = _bump_printed()
     return on_domain(y_dot if rate else y, {T: M + side * R * _V / (1 + _V)}, {-EXP_CLAMP: 1})
 
 
 @functools.lru_cache(maxsize=None)
 def bump_outside(side: int = 1) -> sp.Expr:
-    """Deployed bump on ``t = m + side (r + w)``, outside its window."""
+    """Deployed bump on ``t = m + side (r + w)``, outside its window.
+
+    Parameters
+    ----------
+    side : {1, -1}, optional
+        After (1) or before (-1) the window.
+
+    Returns
+    -------
+    sympy.Expr
+        The bump there (0 once reduced), in :data:`T`, :data:`M`, :data:`R`, :data:`K`.
+
+    Raises
+    ------
+    DomainUndecided
+        As :func:`bump_window`.
+    """
     y, _ = _bump_printed()
     return on_domain(y, {T: M + side * (R + _W)})
 
@@ -269,13 +349,45 @@ def _smooth_printed(index: int) -> sp.Expr:
 
 @functools.lru_cache(maxsize=None)
 def smooth_max_half(side: int = 1) -> sp.Expr:
-    """Deployed ``max~(a_1, a_2)`` on ``a_1 = a_2 + side d``, ``d >= 0``, clamp inactive."""
+    """Deployed ``max~(a_1, a_2)`` on ``a_1 = a_2 + side d``, ``d >= 0``, clamp inactive.
+
+    Parameters
+    ----------
+    side : {1, -1}, optional
+        ``a_1 >= a_2`` (1) or ``a_1 <= a_2`` (-1).
+
+    Returns
+    -------
+    sympy.Expr
+        In ``a_1``, ``a_2`` and :data:`NU`.
+
+    Raises
+    ------
+    DomainUndecided
+        A branch of the printed piece is not decided on the domain.
+    """
     return on_domain(_smooth_printed(1), {_A: _B + side * _D}, {-EXP_CLAMP: 1})
 
 
 @functools.lru_cache(maxsize=None)
 def smooth_min_half(side: int = 1) -> sp.Expr:
-    """Deployed ``min~(a_1, a_2)`` on ``a_1 = a_2 + side d``, ``d >= 0``, clamp inactive."""
+    """Deployed ``min~(a_1, a_2)`` on ``a_1 = a_2 + side d``, ``d >= 0``, clamp inactive.
+
+    Parameters
+    ----------
+    side : {1, -1}, optional
+        ``a_1 >= a_2`` (1) or ``a_1 <= a_2`` (-1).
+
+    Returns
+    -------
+    sympy.Expr
+        In ``a_1``, ``a_2`` and :data:`NU`.
+
+    Raises
+    ------
+    DomainUndecided
+        As :func:`smooth_max_half`.
+    """
     return on_domain(_smooth_printed(3), {_A: _B + side * _D}, {-EXP_CLAMP: 1})
 
 
@@ -305,6 +417,22 @@ def open_bump_sum(arity: int = 3) -> tuple:
     ``fnu_init``, ``fnu_add`` (once per bump) and ``fnu_finish`` (``bound = 0``,
     ``sign = 1``) composed as the generated code composes them, ``top >= 0`` symbolic,
     exponent clamps inactive.
+
+    Parameters
+    ----------
+    arity : int, optional
+        Number of bumps.
+
+    Returns
+    -------
+    tuple
+        ``F`` and ``F_dot`` (sympy.Expr), the bump symbols ``ys`` and their rates ``y_dots``
+        (tuples of ``arity`` symbols) and the symbol ``top``.
+
+    Raises
+    ------
+    DomainUndecided
+        A branch of the printed pieces is not decided on the domain.
     """
     f, f_dot, ys, y_dots, top = _open_bump_printed(arity)
     clamp = {-EXP_CLAMP: 1}
@@ -316,7 +444,15 @@ _PSI, _MU, _THETA0 = (sp.Symbol("psi", real=True), sp.Symbol("mu", positive=True
 
 
 def trigger_clamped() -> tuple[sp.Expr, tuple[sp.Symbol, sp.Symbol, sp.Symbol]]:
-    """Deployed trigger ``theta`` of eq. (11) with its clamps, in ``(psi, theta0, mu)``."""
+    """Deployed trigger ``theta`` of eq. (11) with its clamps, in ``(psi, theta0, mu)``.
+
+    Returns
+    -------
+    theta : sympy.Expr
+        The printed trigger, floats made exact (:func:`exact`).
+    symbols : tuple of sympy.Symbol
+        ``(psi, theta0, mu)``.
+    """
     (_, theta) = sympy_expressions(pieces.conflict(1), {
         "rho": [0, 0], "beta": [0, _PSI], "theta0": [_THETA0], "mu": [_MU]})
     return exact(theta[0]), (_PSI, _THETA0, _MU)
@@ -324,14 +460,33 @@ def trigger_clamped() -> tuple[sp.Expr, tuple[sp.Symbol, sp.Symbol, sp.Symbol]]:
 
 @functools.lru_cache(maxsize=None)
 def trigger() -> sp.Expr:
-    """Deployed trigger of eq. (11) where its exponent clamps ``[-80, 80]`` are inactive."""
+    """Deployed trigger of eq. (11) where its exponent clamps ``[-80, 80]`` are inactive.
+
+    Returns
+    -------
+    sympy.Expr
+        ``theta`` in ``(psi, theta0, mu)`` (the symbols of :func:`trigger_clamped`).
+
+    Raises
+    ------
+    DomainUndecided
+        A branch of the printed piece is not decided on the domain.
+    """
     theta, _ = trigger_clamped()
     return on_domain(theta, {}, {-EXP_CLAMP: 1, EXP_CLAMP: -1})
 
 
 @functools.lru_cache(maxsize=None)
 def alpha_rate() -> tuple[sp.Expr, tuple[sp.Symbol, ...]]:
-    """Deployed ``alpha_dot`` of eq. (11) in ``(alpha, psi, theta, kappa)``."""
+    """Deployed ``alpha_dot`` of eq. (11) in ``(alpha, psi, theta, kappa)``.
+
+    Returns
+    -------
+    rate : sympy.Expr
+        ``alpha_dot``, floats made exact.
+    symbols : tuple of sympy.Symbol
+        ``(alpha, psi, theta, kappa)``.
+    """
     a, p, th = sp.symbols("alpha psi theta", real=True)
     kappa = sp.Symbol("kappa", positive=True)
     (rate,) = sympy_expressions(pieces.alpha_rate(1), {
@@ -368,6 +523,23 @@ def error_transform(n: int) -> tuple:
     is built from) with ``gamma_L = (gamma_s - gamma_d)/2``, ``gamma_U = (gamma_s +
     gamma_d)/2``, on the domain ``gamma_d >= GAMMA_D_MIN``, ``|e| <= E_MAX`` where the
     clamps are inactive. Returns ``(e, epsilon, xi, x, gamma_s, gamma_d)`` as Matrices.
+
+    Parameters
+    ----------
+    n : int
+        State dimension.
+
+    Returns
+    -------
+    e, epsilon, xi : sympy.Matrix, shape (n, 1)
+        Normalized error, transformed error and the diagonal of ``xi``.
+    x, gamma_s, gamma_d : sympy.Matrix, shape (n, 1)
+        Their symbols: the state, ``gamma_U + gamma_L`` and ``gamma_U - gamma_L``.
+
+    Raises
+    ------
+    DomainUndecided
+        A branch of the printed piece is not decided on the domain.
     """
     x, gs, gd = _transform_symbols(n)
     printed = _transform_printed(n)
@@ -391,7 +563,25 @@ def _law_printed(n: int) -> tuple:
 @functools.lru_cache(maxsize=None)
 def law(n: int) -> tuple:
     """Deployed ``u`` of law (13) on the same domain as :func:`error_transform`, and the
-    gain symbol: ``(u, gain)``."""
+    gain symbol: ``(u, gain)``.
+
+    Parameters
+    ----------
+    n : int
+        State dimension.
+
+    Returns
+    -------
+    u : sympy.Matrix, shape (n, 1)
+        ``-k xi epsilon``, input units, in the symbols of :func:`error_transform`.
+    gain : sympy.Symbol
+        The gain ``k`` of law (13) (printed as ``g``, positive).
+
+    Raises
+    ------
+    DomainUndecided
+        A branch of the printed piece is not decided on the domain.
+    """
     u, gain = _law_printed(n)
     clamps = _TRANSFORM_CLAMPS
     return sp.Matrix([on_domain(v, {}, clamps) for v in u]), gain
@@ -417,6 +607,7 @@ def proved_pieces(max_n: int = 3) -> dict[str, object]:
     Returns
     -------
     dict of str to casadi.Function
+        Name -> piece (``error_transform.n1`` .. ``error_transform.n<max_n>`` among them).
     """
     init, add, finish, _ = pieces.fnu_pieces()
     smooth = pieces.smooth_pieces()
@@ -526,6 +717,13 @@ def deployed_checks() -> list[Check]:
 
     A piece whose branches the domain does not decide (a changed piece) gives a failed
     check naming the undecided branch, not an exception.
+
+    Returns
+    -------
+    list of Check
+        ``deployed.reach``, ``deployed.bump``, ``deployed.smooth_max``,
+        ``deployed.open_bump_sum``, ``deployed.trigger``, ``deployed.alpha_rate`` and
+        ``deployed.law.n2``.
     """
     out = []
     for name, check in (("deployed.reach", check_reach), ("deployed.bump", check_bump),

@@ -45,7 +45,9 @@ __all__ = [
     "check_bump_flatness",
     "check_bump_flat_all_orders",
     "reach_rate_constant",
+    "reach_rate_form",
     "reach_rate_bound",
+    "bump_rate_form",
     "bump_rate_bound",
     "check_smooth_max",
     "check_open_bump_sum",
@@ -181,6 +183,16 @@ def check_reach_flat_all_orders(orders: int = 4) -> Check:
     arbitrary function ``P``. Then ``|d^j tanh/dt^j| <= 4 e^{-2w} |P_j(w, S)|``
     with ``|S| <= 1``, which tends to 0 because ``lim w^N e^{-2w} = 0`` for every
     ``N`` (also checked). ``P_1..P_orders`` are computed explicitly.
+
+    Parameters
+    ----------
+    orders : int, optional
+        Number of polynomials ``P_1..P_orders`` computed explicitly.
+
+    Returns
+    -------
+    Check
+        ``lemma3.3.reach.flat_all_orders``; ``data`` lists the ``P_j``.
     """
     w, s = sp.symbols("w S", real=True)
     n_sym = sp.Symbol("N", integer=True, positive=True)
@@ -235,6 +247,12 @@ def check_bump_flatness(expr: sp.Expr | None = None, orders: int = 4) -> Check:
         each half of its window (where its exponent clamp at -80 is inactive).
     orders : int
         Highest derivative order checked.
+
+    Returns
+    -------
+    Check
+        ``lemma3.3.bump.flatness``; ``data["limits"]`` lists the two one-sided limits of
+        each order; on FAIL, the order and edge where a limit is not 0.
     """
     f_left = deployed.bump_window(-1) if expr is None else expr
     f_right = deployed.bump_window(1) if expr is None else expr
@@ -279,6 +297,16 @@ def check_bump_flat_all_orders(orders: int = 4) -> Check:
     verified for an arbitrary ``Q``. Since ``|s| <= r``,
     ``|Q_j(s, u)| <= C u^N`` for large ``u``, and ``u^N e^{-k r^2 u} -> 0``
     because ``k r^2 > 0`` (checked).
+
+    Parameters
+    ----------
+    orders : int, optional
+        Number of polynomials ``Q_1..Q_orders`` computed explicitly.
+
+    Returns
+    -------
+    Check
+        ``lemma3.3.bump.flat_all_orders``; ``data`` lists the ``Q_j``.
     """
     s, u = sp.symbols("s u", real=True)
     c = sp.Symbol("c", positive=True)  # c = k r^2
@@ -324,10 +352,20 @@ def reach_rate_constant(digits: int = 30) -> tuple[float, float, float]:
     where ``tanh w* = 1/(1+w*)`` and so ``C = (1+w*)^2 - 1 = w*(2 + w*)``.
     ``w*`` is bracketed by interval arithmetic (mpmath ``iv``).
 
+    Parameters
+    ----------
+    digits : int, optional
+        Working precision of mpmath, decimal digits.
+
     Returns
     -------
     (w_star, C_lower, C_upper) : tuple of float
         ``C_upper`` is a rigorous upper bound (rounded up).
+
+    Raises
+    ------
+    ArithmeticError
+        The interval bracketing of ``w*`` failed.
     """
     iv = mpmath.iv
 
@@ -358,6 +396,11 @@ def reach_rate_form() -> bool:
     ``(T - X) sech^2(w) (1+w)^2 / t_c`` with ``w = t/(t_c - t)`` on ``0 <= t < t_c``, and
     the derivative of ``sech^2(w) (1+w)^2`` used by :func:`reach_rate_constant`.
     Independent of the design: :mod:`.proofs` caches it.
+
+    Returns
+    -------
+    bool
+        Whether both identities were proved.
     """
     deriv = deployed.reach_rate()   # the deployed rho_dot output, t < t_c
     claimed = (TARGET - X0) * sp.sech(_W) ** 2 * (1 + _W) ** 2 / T_C
@@ -386,6 +429,12 @@ def reach_rate_bound(x0: float, target: float, t_c: float, form: bool | None = N
     form : bool, optional
         The result of :func:`reach_rate_form` when already known (the proof cache,
         :mod:`.proofs`); proved here when omitted.
+
+    Returns
+    -------
+    Check
+        ``lemma3.3.reach.rate_bound``; ``data["bound"]`` is the bound, state units per
+        second; FAIL when ``t_c <= 0`` or the symbolic form is not proved.
     """
     if not t_c > 0:
         return Check("lemma3.3.reach.rate_bound", False, f"t_c = {t_c} is not > 0", {})
@@ -417,6 +466,11 @@ def bump_rate_form() -> bool:
     is ``-(2k/r) z (1 - z^2)^-2 b`` with ``z = (t - m)/r``, that the stationarity
     condition of ``h`` is ``3 q^2 - 2(1 - k) q - 1 = 0`` in ``q = z^2``, and that ``q*``
     is its root. Independent of the design: :mod:`.proofs` caches it.
+
+    Returns
+    -------
+    bool
+        Whether the three identities were proved.
     """
     z = sp.Symbol("z", positive=True)
     q = sp.Symbol("q", positive=True)
@@ -457,6 +511,13 @@ def bump_rate_bound(k: float, r: float, height: float = 1.0,
     form : bool, optional
         The result of :func:`bump_rate_form` when already known (the proof cache,
         :mod:`.proofs`); proved here when omitted.
+
+    Returns
+    -------
+    Check
+        ``lemma3.3.bump.rate_bound``; ``data`` holds the bound (``height`` units per
+        second, ``r`` in s), ``z_star``, ``q_star`` and the dense-grid maximum; FAIL when
+        ``k`` or ``r`` is not positive or the symbolic form is not proved.
     """
     if not (k > 0 and r > 0):
         return Check("lemma3.3.bump.rate_bound", False,
@@ -509,6 +570,11 @@ def check_smooth_max(expr: sp.Expr | None = None, arity: int = 2) -> Check:
         (positive); default the form above.
     arity : int
         Number of arguments (>= 2) for the gradient checks.
+
+    Returns
+    -------
+    Check
+        ``lemma3.3.smooth_max``; ``data`` holds the expression and its bias.
     """
     args = sp.symbols(f"a_1:{arity + 1}", real=True)
     if expr is None:
@@ -579,6 +645,16 @@ def check_open_bump_sum(arity: int = 3) -> Check:
     bounds ``max(0, y) <= F <= max(0, y) + ln(m)/nu`` for ``y >= 0``: with
     ``S = sum_j e^{nu y_j} - (m - 1)`` one has ``e^{nu max} <= S <= m e^{nu max}``
     (each ``e^{nu y_j} >= 1``); checked numerically on a grid as well.
+
+    Parameters
+    ----------
+    arity : int, optional
+        Number of bumps ``y_j``.
+
+    Returns
+    -------
+    Check
+        ``design.open_bump_sum``.
     """
     ys = sp.symbols(f"y_1:{arity + 1}", nonnegative=True)
     big_m = sp.Symbol("M", nonnegative=True)
@@ -642,6 +718,12 @@ def lemma_checks(
         Tube bounds for which to report ``sup |rho_dot|``.
     bumps : sequence of (k, r, B)
         Circumvent bumps for which to report ``sup |B b_dot|``.
+
+    Returns
+    -------
+    list of Check
+        Continuity and flatness of the reach tube and the bump, the smooth max (2 and 3
+        arguments), ``F_nu``, then one rate bound per entry of ``reach`` and ``bumps``.
     """
     out = [
         check_reach_continuity(orders=orders),

@@ -31,7 +31,18 @@ MAX_EXACT_BLOCK = 8
 
 def psi(a: float) -> float:
     """``phi(tanh a) = 2 a cosh(a)^2``: law (13)'s ``|u_i| gamma_d,i / (4 k)`` at
-    ``atanh |e_i| = a``; odd, increasing, and ``psi(sqrt(b))^2`` is convex in ``b``."""
+    ``atanh |e_i| = a``; odd, increasing, and ``psi(sqrt(b))^2`` is convex in ``b``.
+
+    Parameters
+    ----------
+    a : float
+        ``atanh |e_i|``.
+
+    Returns
+    -------
+    float
+        ``2 a cosh(a)^2``.
+    """
     return 2.0 * a * math.cosh(a) ** 2
 
 
@@ -52,6 +63,12 @@ def others_max(limits: Sequence[float], level: float, halves: Sequence[float]) -
         ``r``, the ball's radius in ``atanh`` units (``inf``: no ball).
     halves : sequence of float
         Half-widths ``h_j``, state units.
+
+    Returns
+    -------
+    float
+        The maximum (or, beyond :data:`MAX_EXACT_BLOCK` axes or without a ball, the box's
+        bound), 1/state units squared.
     """
     caps = [min(a, level) ** 2 for a in limits]
     values = [(psi(math.sqrt(c)) / h) ** 2 for c, h in zip(caps, halves)]
@@ -219,7 +236,10 @@ def next_level(level: float, alpha: Sequence[float], beta: Sequence[float],
     Parameters
     ----------
     level : float
+        ``r``: this sample's set has ``sum a_i^2 <= r^2``.
     alpha, beta : sequence of float
+        ``alpha_i = h_i / h'_i`` and ``beta_i = (c_i - c'_i) / h'_i`` per axis: the change of
+        coordinates to the next sample's centre ``c'`` and half-widths ``h'``.
     limits : sequence of float, optional
         Bounds of ``|a_i|`` (default: ``level`` for every axis).
 

@@ -58,6 +58,7 @@ class PlantClass:
     Attributes
     ----------
     assumptions : Assumptions
+        The bounds on ``g``, ``f`` and ``w``.
     lower, upper : tuple of float or None
         The state space ``X`` (``None``: no model evaluation).
     linear : LinearPlant or None
@@ -119,9 +120,15 @@ def plant_class(spec: Spec, assumptions: Assumptions | None = None) -> PlantClas
     Parameters
     ----------
     spec : Spec
+        The spec: its assumptions, plant model and state space.
     assumptions : Assumptions, optional
         Instead of ``spec.assumptions`` (then no model evaluation unless its ``model`` is
         the spec's).
+
+    Returns
+    -------
+    PlantClass
+        The class the sampled check takes its bounds from, per interval.
     """
     a = spec.assumptions if assumptions is None else assumptions
     if not a.model or a.model != spec.plant_model:

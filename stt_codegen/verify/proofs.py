@@ -51,6 +51,9 @@ from . import check as _check
 from . import adaptive, deployed, lemma, statements, transform
 from .check import Check
 
+__all__ = ["CACHE_FORMAT", "Proofs", "design_independent_proofs", "load_cached", "proof_key",
+           "prove", "store"]
+
 #: Version of the cache file's layout; files of another version are never read.
 CACHE_FORMAT = 1
 
@@ -158,6 +161,7 @@ def prove(max_n: int = 3, progress: Progress | None = None) -> Proofs:
     Returns
     -------
     Proofs
+        The proofs, freshly computed.
     """
     say = progress or (lambda label: None)
     say("deployed pieces")
@@ -202,7 +206,18 @@ def _cache_file(key: str) -> Path:
 
 
 def load_cached(key: str) -> Proofs | None:
-    """The cached proofs of ``key``, or ``None`` (no entry, unreadable, corrupt, stale)."""
+    """The cached proofs of ``key``, or ``None`` (no entry, unreadable, corrupt, stale).
+
+    Parameters
+    ----------
+    key : str
+        The proofs' key (:func:`proof_key`).
+
+    Returns
+    -------
+    Proofs or None
+        The cached proofs.
+    """
     try:
         payload = json.loads(_cache_file(key).read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, ValueError):
@@ -212,6 +227,13 @@ def load_cached(key: str) -> Proofs | None:
 
 def store(key: str, proofs: Proofs) -> bool:
     """Write ``proofs`` under ``key`` atomically (a temporary file, then ``os.replace``).
+
+    Parameters
+    ----------
+    key : str
+        The proofs' key (:func:`proof_key`).
+    proofs : Proofs
+        The proofs to cache.
 
     Returns
     -------

@@ -41,6 +41,9 @@ from .lyapunov import level_after, next_level, others_max
 from .plant_class import PlantClass, plant_class
 from .sampled_axis import axis_interval, peak, phi_slope_scalar
 
+__all__ = ["SampledCheck", "check_sampled", "lowest_rate", "plant_bounds_checks",
+           "sampled_check_of", "sampled_checks"]
+
 #: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
 RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
 #: Iterations of the bootstrap of a ball's between-samples level (see :func:`_ball`).
@@ -155,6 +158,8 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     Returns
     -------
     SampledCheck
+        The verdict, its level and margin, the time and dimension of a failure, and the
+        bounds of ``|e|``.
     """
     cls = _as_class(plants)
     a = cls.assumptions
@@ -312,7 +317,9 @@ def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
     Returns
     -------
     samples : TubeSamples
+        The design's tube at its sampling instants.
     check : SampledCheck
+        The verdict (cached per process).
     """
     return _sampled_check(design, spec, bool(per_axis_first))
 
@@ -346,10 +353,14 @@ def lowest_rate(design: TubeDesign, spec: Spec, plants: Assumptions | PlantClass
     Parameters
     ----------
     design : TubeDesign
+        The design: its tube, ``rate_hz`` and gain.
     spec : Spec
         For the certificate (state space, obstacles, target).
     plants : Assumptions or PlantClass
+        The plant bounds the sampled check uses.
     explicit_gain : float, optional
+        The gain ``k`` of law (13) at every rate (the spec's ``controller.gain``); default the
+        gain derived at each rate.
     passes_at_rate : bool, optional
         Whether the check already passed at ``design.rate_hz`` with its gain (saves a run);
         default: find out.
@@ -357,7 +368,8 @@ def lowest_rate(design: TubeDesign, spec: Spec, plants: Assumptions | PlantClass
     Returns
     -------
     rate_hz, gain : float or None
-        ``(None, None)`` when no factor tried works.
+        The lowest rate found, Hz, and the gain used there; ``(None, None)`` when no factor
+        tried works.
     """
     assumptions = _as_class(plants).assumptions
 
@@ -429,6 +441,7 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
     Parameters
     ----------
     spec : Spec
+        The spec the design is for.
     design : TubeDesign
         With its gain set (the spec's ``controller.gain`` or the derived one); its tube is
         sampled by :func:`sampled_check_of` (once per process).
@@ -439,6 +452,7 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
     Returns
     -------
     list of Check
+        ``sampled.gain`` (the gain below its stability limit) and ``sampled.tube_kept``.
     """
     a = spec.assumptions
     plants = plant_class(spec)
@@ -522,12 +536,15 @@ def plant_bounds_checks(spec: Spec, model: str | None = None) -> list[Check]:
     Parameters
     ----------
     spec : Spec
+        The spec: its state space, linear matrices and ``[assumptions]``.
     model : str, optional
         Plant model, default the spec's.
 
     Returns
     -------
     list of Check
+        ``sampled.plant_within_assumptions`` and, for the ``linear`` model, first
+        ``assumption2.linear``.
     """
     model = model or spec.plant_model
     linear = spec.linear_plant if model == "linear" else None

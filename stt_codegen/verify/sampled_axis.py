@@ -22,23 +22,67 @@ __all__ = ["phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "coupli
 
 def phi(s: np.ndarray) -> np.ndarray:
     """``phi(s) = 2 atanh(s) / (1 - s^2)``: ``|u_i| gamma_d,i / (4 k)`` of law (13) at
-    ``|e_i| = s``; odd, increasing, convex on ``[0, 1)``."""
+    ``|e_i| = s``; odd, increasing, convex on ``[0, 1)``.
+
+    Parameters
+    ----------
+    s : ndarray
+        ``|e_i|`` in ``[0, 1)``, any shape.
+
+    Returns
+    -------
+    ndarray
+        ``phi(s)``, the shape of ``s``.
+    """
     return 2.0 * np.arctanh(s) / (1.0 - s * s)
 
 
 def phi_slope(s: np.ndarray) -> np.ndarray:
     """``phi'(s) = (2 + 4 s atanh(s)) / (1 - s^2)^2``: even, increasing in ``|s|``,
-    ``phi'(0) = 2``."""
+    ``phi'(0) = 2``.
+
+    Parameters
+    ----------
+    s : ndarray
+        ``e_i`` in ``(-1, 1)``, any shape.
+
+    Returns
+    -------
+    ndarray
+        ``phi'(s)``, the shape of ``s``.
+    """
     return (2.0 + 4.0 * s * np.arctanh(s)) / (1.0 - s * s) ** 2
 
 
 def phi_scalar(s: float) -> float:
-    """:func:`phi` for one float."""
+    """:func:`phi` for one float.
+
+    Parameters
+    ----------
+    s : float
+        ``|e_i|`` in ``[0, 1)``.
+
+    Returns
+    -------
+    float
+        ``phi(s)``.
+    """
     return 2.0 * math.atanh(s) / (1.0 - s * s)
 
 
 def phi_slope_scalar(s: float) -> float:
-    """:func:`phi_slope` for one float."""
+    """:func:`phi_slope` for one float.
+
+    Parameters
+    ----------
+    s : float
+        ``e_i`` in ``(-1, 1)``.
+
+    Returns
+    -------
+    float
+        ``phi'(s)``.
+    """
     return (2.0 + 4.0 * s * math.atanh(s)) / (1.0 - s * s) ** 2
 
 
@@ -50,6 +94,11 @@ def peak(ratio: np.ndarray) -> np.ndarray:
     ----------
     ratio : ndarray
         ``h / (g_min p)``: half-width over the pull of the weakest gain, any shape.
+
+    Returns
+    -------
+    ndarray
+        ``s*`` in ``[0, 1)``, the shape of ``ratio``.
     """
     lo, hi = np.zeros_like(ratio), np.full_like(ratio, 1.0 - 1e-15)
     for _ in range(60):
@@ -77,6 +126,12 @@ def coupling_push(others: float, coupling: float, spread: float, skew: float,
     ----------
     others, coupling, spread, skew, own : float
         As above; ``spread = g_max - g_min``.
+
+    Returns
+    -------
+    float
+        The bound, state units: the least of ``coupling others`` and the symmetric bound plus
+        ``skew others``; 0 when ``others <= 0``.
     """
     if others <= 0.0:
         return 0.0

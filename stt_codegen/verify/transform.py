@@ -33,12 +33,38 @@ XiBuilder = Callable[[sp.Matrix, sp.Matrix], sp.Matrix]
 
 
 def xi_diagonal(e: sp.Matrix, gamma_d: sp.Matrix) -> sp.Matrix:
-    """``xi = diag(4/(gamma_d_i (1 - e_i^2)))`` (the toolkit's reading of (13))."""
+    """``xi = diag(4/(gamma_d_i (1 - e_i^2)))`` (the toolkit's reading of (13)).
+
+    Parameters
+    ----------
+    e : sympy.Matrix, shape (n, 1)
+        The normalized error.
+    gamma_d : sympy.Matrix, shape (n, 1)
+        The tube widths ``gamma_{i,U} - gamma_{i,L}``, state units.
+
+    Returns
+    -------
+    sympy.Matrix, shape (n, n)
+        The diagonal ``xi``, which equals ``d epsilon / d x``.
+    """
     return sp.diag(*[4 / (gamma_d[i] * (1 - e[i] ** 2)) for i in range(len(e))])
 
 
 def xi_outer_product(e: sp.Matrix, gamma_d: sp.Matrix) -> sp.Matrix:
-    """``xi = 4 gamma_d^{-1} (I - e e^T)^{-1}`` with ``e e^T`` the outer product."""
+    """``xi = 4 gamma_d^{-1} (I - e e^T)^{-1}`` with ``e e^T`` the outer product.
+
+    Parameters
+    ----------
+    e : sympy.Matrix, shape (n, 1)
+        The normalized error.
+    gamma_d : sympy.Matrix, shape (n, 1)
+        The tube widths ``gamma_{i,U} - gamma_{i,L}``, state units.
+
+    Returns
+    -------
+    sympy.Matrix, shape (n, n)
+        The paper's literal ``xi`` of section IV (not ``d epsilon / d x`` for ``n >= 2``).
+    """
     n = len(e)
     return 4 * sp.diag(*[1 / g for g in gamma_d]) * (sp.eye(n) - e * e.T).inv()
 
@@ -71,6 +97,12 @@ def check_epsilon_jacobian(n: int, xi: XiBuilder | None = None) -> Check:
         ``xi(e, gamma_d) -> Matrix``; default the deployed ``xi`` (the diagonal reading,
         :func:`xi_diagonal`). Pass :func:`xi_outer_product` to see the paper's literal
         reading fail.
+
+    Returns
+    -------
+    Check
+        ``theorem4.1.epsilon_jacobian.n<n>``: passed when every entry of the difference
+        simplifies to 0.
     """
     _, eps, xi_d, x, gs, gd = error_transform(n)
     es = sp.Matrix(sp.symbols(f"e1:{n + 1}", real=True))
@@ -101,6 +133,17 @@ def outer_product_difference(n: int = 2) -> Check:
     outer-product reading equals ``4 gamma_d^{-1} (I + e e^T/(1 - |e|^2))``;
     the check reports the symbolic difference to the Jacobian with ``e_i`` as
     independent symbols in ``(-1, 1)``. For ``n = 1`` they agree.
+
+    Parameters
+    ----------
+    n : int, optional
+        State dimension.
+
+    Returns
+    -------
+    Check
+        ``theorem4.1.outer_product_reading.n<n>``: passed when the readings differ exactly
+        for ``n >= 2`` and the Sherman-Morrison form holds.
     """
     es = sp.Matrix(sp.symbols(f"e1:{n + 1}", real=True))
     gd = sp.Matrix(sp.symbols(f"gamma_d1:{n + 1}", positive=True))
@@ -133,6 +176,11 @@ def check_lyapunov_derivative(n: int, xi: XiBuilder | None = None) -> Check:
         State dimension.
     xi : callable, optional
         As in :func:`check_epsilon_jacobian`.
+
+    Returns
+    -------
+    Check
+        ``theorem4.1.lyapunov_derivative.n<n>``: passed when the difference simplifies to 0.
     """
     t = sp.Symbol("t", real=True)
     e, eps, xi_d, x, gs, gd = _time_dependent(n, t)
@@ -177,7 +225,18 @@ def check_lyapunov_derivative(n: int, xi: XiBuilder | None = None) -> Check:
 
 
 def error_transform_checks(max_n: int = 3) -> list[Check]:
-    """Jacobian (n = 1..max_n), outer-product difference (n = 2), V_dot (n = 1..max_n)."""
+    """Jacobian (n = 1..max_n), outer-product difference (n = 2), V_dot (n = 1..max_n).
+
+    Parameters
+    ----------
+    max_n : int, optional
+        Largest state dimension proved.
+
+    Returns
+    -------
+    list of Check
+        In that order.
+    """
     out = [check_epsilon_jacobian(n) for n in range(1, max_n + 1)]
     out.append(outer_product_difference(2))
     out += [check_lyapunov_derivative(n) for n in range(1, max_n + 1)]
