@@ -337,7 +337,8 @@ def sequence_bounds(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
     return SequenceBounds(start_lo, start_hi, star_lo, star_hi, q_lo, q_hi, rate_lo, rate_hi, dt)
 
 
-def step_root(a: float, psi: float, theta: float, dt: float, c: float) -> tuple[float, float]:
+def step_root(a: float, psi: float, theta: float, dt: float, c: float,
+              _tolerance: float = STEP_ROOT_TOLERANCE) -> tuple[float, float]:
     """Bracket of the backward-Euler root ``a+`` of ``g(x) = c x - a - dt theta / (psi + x)^2``.
 
     ``g`` has slope ``>= c`` on ``x > -psi``, so for any ``x`` there
@@ -345,19 +346,40 @@ def step_root(a: float, psi: float, theta: float, dt: float, c: float) -> tuple[
     iterations. They start at ``a`` (``alpha`` moves little per step) or, where
     ``psi + a <= 0``, at the left start of :func:`stt_codegen.tube.model.implicit_alpha_update`,
     and stop once the bracket is :data:`STEP_ROOT_TOLERANCE` relative wide.
+
+    Parameters
+    ----------
+    a : float
+        ``alpha`` before the step, state units.
+    psi, theta : float
+        ``psi`` (state units) and ``theta`` (eq. (11)) of the step.
+    dt : float
+        Step length, seconds.
+    c : float
+        ``1 + kappa dt``.
+
+    Returns
+    -------
+    lo, hi : float
+        The bracket, ``lo <= a+ <= hi``.
     """
     big_a = dt * theta
     if not big_a > 0.0:
         return a / c, a / c
     x = a
+    # the bracket's arithmetic is _root_bracket's, written out in this hot loop
     for _ in range(6):
         z = psi + x
         if not z > 0.0:
             break
         zz = z * z
-        g = c * x - a - big_a / zz
-        if abs(g) <= STEP_ROOT_TOLERANCE * c * x:
-            return _root_bracket(x, g, c, a + big_a / zz)
+        pull = big_a / zz
+        g = c * x - a - pull
+        if abs(g) <= _tolerance * c * x:
+            slack = 1e-15 * (c * abs(x) + (a + pull)) / c
+            if g > 0.0:
+                return x - g / c - slack, x + slack
+            return x - slack, x - g / c + slack
         x_next = x - g / (c + 2.0 * big_a / (zz * z))
         if x_next == x:
             break
