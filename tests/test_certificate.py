@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 
@@ -139,6 +140,76 @@ def test_step_root_bracket_is_rigorous():
             return c * x - a - dt * theta / (psi + x) ** 2
         assert psi + lo <= 0 or g(lo) <= 0
         assert psi + hi > 0 and g(hi) >= 0
+
+
+def _step_root_transcribed(a, psi, theta, dt, c):
+    """step_root's Newton loop and bracket written plainly (the bracket in its own
+    function), as a second reading of the hot loop's arithmetic."""
+    from stt_codegen.design.certificate.implicit_step import STEP_ROOT_TOLERANCE
+
+    def bracket(x, g, terms):
+        slack = 1e-15 * (c * abs(x) + terms) / c
+        lo, hi = (x - g / c, x) if g > 0.0 else (x, x - g / c)
+        return lo - slack, hi + slack
+    big_a = dt * theta
+    if not big_a > 0.0:
+        return a / c, a / c
+    x = a
+    for _ in range(6):
+        z = psi + x
+        if not z > 0.0:
+            break
+        g = c * x - a - big_a / (z * z)
+        if abs(g) <= STEP_ROOT_TOLERANCE * c * x:
+            return bracket(x, g, a + big_a / (z * z))
+        x_next = x - g / (c + 2.0 * big_a / (z * z * z))
+        if x_next == x:
+            break
+        x = x_next
+    if not psi + x > 0.0:
+        q = max(-c * psi - a, 1e-300)
+        x = max(a / c, -psi + min((big_a / (2.0 * c)) ** (1.0 / 3.0),
+                                  math.sqrt(big_a / (2.0 * q))))
+        for _ in range(60):
+            z = psi + x
+            x_next = x - (c * x - a - big_a / (z * z)) / (c + 2.0 * big_a / (z * z * z))
+            if not x_next > x:
+                break
+            x = x_next
+    z = psi + x
+    return bracket(x, c * x - a - big_a / (z * z), a + big_a / (z * z))
+
+
+def test_step_root_is_its_transcription_to_the_last_bit():
+    """The hot loop of step_root (bracket written out) gives the transcription's numbers
+    exactly, on the Newton path and on the left start (psi + a <= 0)."""
+    from stt_codegen.design.certificate import step_root
+    rng = np.random.default_rng(5)
+    left = 0
+    for _ in range(5000):
+        a = float(10 ** rng.uniform(-12, 0)) * float(rng.integers(0, 2))
+        psi = float(rng.uniform(-2, 5))
+        theta = float(0.02 / (1 + np.exp(2 * (psi - 1))))
+        dt = float(10 ** rng.uniform(-5, 1))
+        c = 1.0 + 5.0 * dt
+        left += psi + a <= 0.0
+        assert step_root(a, psi, theta, dt, c) == _step_root_transcribed(a, psi, theta, dt, c)
+    assert left > 100        # the left start is exercised too
+
+
+def test_point_tube_is_the_reference_tube(case):
+    """The certificate's tube at points without rates (point_tube: the early failure test
+    and the initial-state margin) is reference.adaptive_tube's gamma_L, gamma_U exactly."""
+    from stt_codegen.design.certificate.report import point_tube
+    spec, design, _ = designed(case)
+    rng = np.random.default_rng(1)
+    t = np.concatenate([[0.0], rng.uniform(0.0, 1.2 * design.prescribed_time, 500)])
+    alpha = rng.uniform(0.0, 0.05, (t.size, 2 * design.dimension))
+    for numpy_math in (False, True):
+        with R.numpy_math() if numpy_math else contextlib.nullcontext():
+            g_l, g_u = point_tube(design, t, alpha)
+            ref_l, ref_u, _, _ = R.adaptive_tube(design, t, alpha)
+        assert np.array_equal(g_l, ref_l) and np.array_equal(g_u, ref_u)
 
 
 def test_sharpened_narrowest_width_is_sound_and_sharper(case):

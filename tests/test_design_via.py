@@ -243,3 +243,27 @@ def test_a_convex_wall_across_the_straight_path_is_passed_with_via_points():
     result = simulate(design, backend="c")
     assert result.satisfied and result.stayed_in_tube and not result.collision
     assert result.min_obstacle_clearance > 0.0
+
+
+def test_box_obstacle_meeting_is_the_definition():
+    """The via planner's overlap test (one obstacle column at a time) says box k widened by
+    the margin meets obstacle b exactly when it does so strictly in every dimension, on
+    boxes placed to touch, overlap and miss."""
+    from stt_codegen.design import via
+    rng = np.random.default_rng(2)
+    for n, count, boxes in ((2, 400, 4), (3, 200, 3), (2, 5, 0), (2, 0, 2)):
+        # corners on a 0.05 grid, so that many boxes touch an obstacle exactly
+        lower = np.round(rng.uniform(0.0, 5.0, (count, n)) * 20) / 20
+        upper = lower + np.round(rng.uniform(0.05, 1.0, (count, n)) * 20) / 20
+        ob_lo = np.round(rng.uniform(0.0, 4.0, (boxes, n)) * 20) / 20
+        obstacles = np.stack([ob_lo, ob_lo + 1.0], axis=1)
+        for margin in (0.0, 0.05):
+            meets = via._meets(lower, upper, obstacles, margin)
+            assert meets.shape == (count, boxes)
+            for k in range(count):
+                for b in range(boxes):
+                    strict = all(lower[k, i] - margin < obstacles[b, 1, i]
+                                 and upper[k, i] + margin > obstacles[b, 0, i] for i in range(n))
+                    assert meets[k, b] == strict
+            if count and boxes:
+                assert meets.any() and not meets.all()

@@ -102,9 +102,23 @@ def tracking_demand(design: TubeDesign, certificate: Certificate, spec: Spec) ->
     return TrackingDemand(float(ratio[k, i]), float(t[k]), int(i))
 
 
+#: The last few results of :func:`_partition`, with the (design, certificate) objects they
+#: are of: ``auto`` asks for the demand and the centre speed of the same tube in turn.
+_RECENT: list[tuple[TubeDesign, Certificate, tuple[np.ndarray, ...]]] = []
+
+
 def _partition(design: TubeDesign, certificate: Certificate) -> tuple[np.ndarray, ...]:
     """The tube and its rates at the certificate's partition (``alpha`` midway in its
     proven bounds): ``t`` (K,), ``gamma_L``, ``gamma_U``, their rates (K, n)."""
+    for known, of, result in list(_RECENT):
+        if known is design and of is certificate:
+            return result
+    result = _evaluate_partition(design, certificate)
+    _RECENT[:] = [(design, certificate, result)] + _RECENT[:1]
+    return result
+
+
+def _evaluate_partition(design: TubeDesign, certificate: Certificate) -> tuple[np.ndarray, ...]:
     state = certificate.state
     t = np.array(state.points, dtype=float) / design.rate_hz
     alpha = 0.5 * (np.array([e[0] for e in state.entries]) + np.array([e[1] for e in state.entries]))

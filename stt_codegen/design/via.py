@@ -73,8 +73,13 @@ class ViaPlan:
 def _meets(lower: np.ndarray, upper: np.ndarray, obstacles: np.ndarray,
            margin: float) -> np.ndarray:
     """(K, B): box k, widened by ``margin``, meets obstacle box b (touching does not count)."""
-    lo, hi = lower[:, None, :] - margin, upper[:, None, :] + margin
-    return np.all((lo < obstacles[None, :, 1, :]) & (hi > obstacles[None, :, 0, :]), axis=2)
+    lo, hi = lower - margin, upper + margin
+    out = np.ones((lower.shape[0], obstacles.shape[0]), dtype=bool)
+    # one column of one obstacle at a time: (K,) temporaries instead of (K, B, n) ones
+    for b in range(obstacles.shape[0]):
+        for i in range(lower.shape[1]):
+            out[:, b] &= (lo[:, i] < obstacles[b, 1, i]) & (hi[:, i] > obstacles[b, 0, i])
+    return out
 
 
 def _free(lower: np.ndarray, upper: np.ndarray, obstacles: np.ndarray,

@@ -371,7 +371,8 @@ def sequence_bounds(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
     return SequenceBounds(start_lo, start_hi, star_lo, star_hi, q_lo, q_hi, rate_lo, rate_hi, dt)
 
 
-def step_root(a: float, psi: float, theta: float, dt: float, c: float) -> tuple[float, float]:
+def step_root(a: float, psi: float, theta: float, dt: float, c: float,
+              _tolerance: float = STEP_ROOT_TOLERANCE) -> tuple[float, float]:
     """Bracket of the backward-Euler root ``a+`` of ``g(x) = c x - a - dt theta / (psi + x)^2``.
 
     ``g`` has slope ``>= c`` on ``x > -psi``, so for any ``x`` there
@@ -392,6 +393,8 @@ def step_root(a: float, psi: float, theta: float, dt: float, c: float) -> tuple[
         Step, s.
     c : float
         ``1 + kappa dt``.
+    _tolerance : float, optional
+        Relative width at which Newton stops (default :data:`STEP_ROOT_TOLERANCE`).
 
     Returns
     -------
@@ -402,14 +405,19 @@ def step_root(a: float, psi: float, theta: float, dt: float, c: float) -> tuple[
     if not big_a > 0.0:
         return a / c, a / c
     x = a
+    # the bracket's arithmetic is _root_bracket's, written out in this hot loop
     for _ in range(6):
         z = psi + x
         if not z > 0.0:
             break
         zz = z * z
-        g = c * x - a - big_a / zz
-        if abs(g) <= STEP_ROOT_TOLERANCE * c * x:
-            return _root_bracket(x, g, c, a + big_a / zz)
+        pull = big_a / zz
+        g = c * x - a - pull
+        if abs(g) <= _tolerance * c * x:
+            slack = 1e-15 * (c * abs(x) + (a + pull)) / c
+            if g > 0.0:
+                return x - g / c - slack, x + slack
+            return x - slack, x - g / c + slack
         x_next = x - g / (c + 2.0 * big_a / (zz * z))
         if x_next == x:
             break

@@ -40,7 +40,7 @@ from ...tube import reference
 from ...tube.parameters import TubeDesign
 from .enclosures import piece_widths
 from .implicit_step import SequenceBounds, sequence_bounds
-from .report import Enclosure
+from .report import Enclosure, point_tube
 
 __all__ = ["Narrowest", "WIDTH_PIECE_BUDGET", "WIDTH_SPLIT", "WIDTH_TOLERANCE",
            "sharpen_narrowest"]
@@ -90,13 +90,8 @@ class Narrowest:
 
 def point_widths(design: TubeDesign, t: np.ndarray, alpha: np.ndarray) -> np.ndarray:
     """``min_i gamma_d_i``, the width of eq. (10)'s tube, at ``t`` (K,) for ``alpha`` (K, 2n)."""
-    n = design.dimension
-    rho_l, rho_u, _, _ = reference.reach_tube(design, t)
-    beta_l, beta_u, _, _ = reference.circumvent(design, t)
-    nu = design.smoothness
-    gamma_l, _ = reference.smooth_max(np.stack([rho_l - alpha[:, :n], beta_l], -1), nu)
-    neg_u, _ = reference.smooth_max(np.stack([-(rho_u + alpha[:, n:]), -beta_u], -1), nu)
-    return (-neg_u - gamma_l).min(axis=1)
+    gamma_l, gamma_u = point_tube(design, t, alpha)
+    return (gamma_u - gamma_l).min(axis=1)
 
 
 def _piece_alpha(rows: np.ndarray, f0: np.ndarray, f1: np.ndarray, steps: np.ndarray,

@@ -23,7 +23,7 @@ from .narrowest import sharpen_narrowest
 from .repropagate import repropagate, step_psi
 from .tasks import task_margins
 from .report import (MAX_MOVE_PER_SAMPLE, ROUNDING_MARGIN, Certificate, CertificateState, Enclosure,
-                     certificate_report, obstacle_separation)
+                     certificate_report, obstacle_separation, point_tube)
 
 __all__ = ["MAX_INTERVALS", "MIN_INTERVAL", "SPLIT", "WIDTH_REFINE_ROUNDS", "certify_tube"]
 
@@ -254,8 +254,7 @@ def _surely_failing(design: TubeDesign, spec: Spec, t: np.ndarray, a_min: np.nda
     """
     if not t.size:
         return ""
-    both_l, both_u, _, _ = reference.adaptive_tube(design, np.concatenate([t, t]),
-                                                   np.concatenate([a_min, a_max]))
+    both_l, both_u = point_tube(design, np.concatenate([t, t]), np.concatenate([a_min, a_max]))
     g_l, w_l = both_l[:t.size], both_l[t.size:]
     g_u, w_u = both_u[:t.size], both_u[t.size:]
     boxes = spec.obstacle_boxes()

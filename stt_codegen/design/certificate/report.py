@@ -19,7 +19,8 @@ from ...tube import reference
 from ...tube.parameters import TubeDesign
 
 __all__ = ["Certificate", "CertificateState", "Enclosure", "MAX_MOVE_PER_SAMPLE", "Margin",
-           "PROPERTIES", "ROUNDING_MARGIN", "certificate_report", "obstacle_separation"]
+           "PROPERTIES", "ROUNDING_MARGIN", "certificate_report", "obstacle_separation",
+           "point_tube"]
 
 #: Margins below this (state units) count as failures: rounding in the enclosures.
 ROUNDING_MARGIN = 1e-9
@@ -229,6 +230,35 @@ def _below_rounding(margin: float) -> str:
         f" (a margin must exceed {ROUNDING_MARGIN:g}, the enclosures' rounding)")
 
 
+def point_tube(design: TubeDesign, t: np.ndarray, alpha: np.ndarray) -> tuple[np.ndarray,
+                                                                            np.ndarray]:
+    """``gamma_L``, ``gamma_U`` of eq. (10) at ``t`` for ``alpha``, without their rates.
+
+    The numbers of :func:`stt_codegen.tube.reference.adaptive_tube` (the same operations),
+    at half its cost: the rates need ``psi`` and the adaptive law on top.
+
+    Parameters
+    ----------
+    design : TubeDesign
+    t : ndarray, shape (K,)
+        Seconds.
+    alpha : ndarray, shape (K, 2n)
+        ``[alpha_L, alpha_U]``, state units.
+
+    Returns
+    -------
+    gamma_L, gamma_U : ndarray, shape (K, n)
+        State units.
+    """
+    n = design.dimension
+    rho_l, rho_u, _, _ = reference.reach_tube(design, t)
+    beta_l, beta_u, _, _ = reference.circumvent(design, t)
+    nu = design.smoothness
+    gamma_l, _ = reference.smooth_max(np.stack([rho_l - alpha[:, :n], beta_l], -1), nu)
+    neg_u, _ = reference.smooth_max(np.stack([-(rho_u + alpha[:, n:]), -beta_u], -1), nu)
+    return gamma_l, -neg_u
+
+
 def certificate_report(design: TubeDesign, spec: Spec, enc: Enclosure, selected, final: bool,
             budget_hit: bool, tail_start: float, max_intervals: int,
             narrowest: tuple[float, float] | None = None) -> Certificate:
@@ -274,7 +304,7 @@ def certificate_report(design: TubeDesign, spec: Spec, enc: Enclosure, selected,
                           f"t = {t:.4f} s)" + _below_rounding(min_width) + note))
 
     x0 = np.array(design.initial_state)
-    g_l0, g_u0, _, _ = reference.adaptive_tube(design, [0.0], np.zeros(2 * design.dimension))
+    g_l0, g_u0 = point_tube(design, np.zeros(1), np.zeros((1, 2 * design.dimension)))
     g_l0, g_u0 = g_l0[0], g_u0[0]
     m0 = float(np.min(np.minimum(x0 - g_l0, g_u0 - x0)))
     margins.append(Margin("initial state inside", m0 > ROUNDING_MARGIN, m0, 0.0,
