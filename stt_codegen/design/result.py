@@ -125,8 +125,8 @@ class Design:
             spec with moving obstacles also ``motion`` and ``moving_obstacles`` (index,
             motion, active interval, certified margin; docs/moving-obstacles.md); for a
             spec with a second-order ``plant.model`` also ``cascade`` (``gains``: the
-            default second stage's derivation; ``rate``: linearized sampled factors and the
-            lowest rate, :func:`~stt_codegen.design.cascade_gain.cascade_rate`).
+            certified second stage's derivation and its sampled-data certificate,
+            :func:`~stt_codegen.design.cascade_gain.second_stage_of`).
         """
         tube = self.tube
         via = []
@@ -194,18 +194,13 @@ class Design:
             for ob in self.spec.moving_obstacles]}
 
     def _cascade_json(self) -> dict[str, Any]:
-        """``cascade``: the default second stage's derivation (``gains``) and the linearized
-        sampled loops' factors and lowest rate (``rate``, an estimate, not a certificate),
-        for a spec with a second-order ``plant.model`` only: without it the document is as
-        before."""
-        order = self.spec.second_order
-        if order is None:
+        """``cascade``: the certified second stage's derivation with its sampled-data
+        certificate (``gains``), for a spec with a second-order ``plant.model`` only:
+        without it the document is as before."""
+        if self.spec.second_order is None:
             return {}
-        from .cascade_gain import cascade_rate, second_stage_of
-        stage, derivation = second_stage_of(self)
-        return {"cascade": {"gains": derivation,
-                            "rate": cascade_rate(stage, order.input_gain, self.check.min_width,
-                                                 self.tube.rate_hz)}}
+        from .cascade_gain import second_stage_of
+        return {"cascade": {"gains": second_stage_of(self)[1]}}
 
     def _actuator_json(self) -> dict[str, Any]:
         """``input_bound`` and the proved ``input_peak`` (with where each peak is), for a

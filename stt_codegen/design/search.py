@@ -31,6 +31,7 @@ from ..tube.parameters import Circumvent, TubeDesign, paper_segments
 from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, certify_tube
 from .certificate.motion import certify_motion
 from .actuator import design_within_bound
+from .cascade_gain import require_certified_stage
 from .failures import FailureKind, property_kind
 from .grid import grid_index, grid_value, smallest_passing
 from .moving import design_moving
@@ -293,7 +294,8 @@ def design_tube(spec: Spec) -> Design:
         # the bound's proof orders the tubes there (default, softer circumvents, via
         # points): auto's estimate of the smoother tube plays no part
         return design_within_bound(spec, lambda free: _design(free, smoother=False))
-    return _design(spec, smoother=True)
+    # a second-order spec: the sampled cascade must be certified (design/cascade_gain.py)
+    return require_certified_stage(_design(spec, smoother=True))
 
 
 def _design(spec: Spec, smoother: bool) -> Design:
