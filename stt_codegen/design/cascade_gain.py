@@ -47,8 +47,9 @@ if TYPE_CHECKING:
 #: error back harder per period (the certificate's contraction); a larger separation
 #: slows the virtual velocity ``r`` (less change of ``r`` per period); a larger floor
 #: widens the velocity tube.
-SHAPES = ((0.3, 10.0, 4.0), (0.5, 10.0, 4.0), (0.3, 10.0, 16.0), (0.5, 5.0, 4.0),
-          (0.2, 20.0, 4.0), (0.1, 10.0, 4.0))
+SHAPES = ((0.3, 10.0, 4.0), (1.0, 5.0, 4.0), (0.5, 10.0, 4.0), (1.4, 10.0, 4.0),
+          (0.3, 10.0, 16.0))
+
 #: Samples of the tube's speed over ``[0, t_c]``.
 SPEED_SAMPLES = 4001
 
