@@ -41,7 +41,7 @@ def test_verify_of_a_second_order_spec_proves_the_lemmas_and_the_sampled_cascade
     import stt_codegen as stt
     report = stt.verify(stt.design_tube(stt.load_spec("second-order-s1")))
     names = [c.name for c in report.checks]
-    assert report.failed == []
+    assert list(report.failed) == []
     assert "cascade.lyapunov_derivative.n2" in names and "cascade.velocity_tube" in names
     # law (13)'s sampled check is about a first-order plant: not run for the cascade (the
     # stand-in [plant]'s bounds check remains); the linearized estimate is gone
