@@ -158,3 +158,46 @@ def test_a_mutated_gain_or_rate_is_refused() -> None:
     # a velocity tube too narrow for the declared drift
     narrow = dataclasses.replace(stage, width_floor=tuple(v / 50 for v in stage.width_floor))
     assert not cascade_check_of(design.tube, design.spec, narrow).passed
+
+
+def test_the_bounds_of_the_change_of_r_hold_on_random_steps() -> None:
+    """:func:`step_velocity_change` and :func:`virtual_velocity_change` against the exact
+    change of ``r = -(2 k1 / half) phi(e1)`` on seeded random steps consistent with their
+    premises (the tube's centre and half-width at both ends, ``x1`` moved by ``h (r_k +
+    z) + delta``)."""
+    from stt_codegen.verify.cascade_sampled import step_velocity_change, virtual_velocity_change
+    from stt_codegen.verify.sampled_axis import phi_scalar
+    rng = np.random.default_rng(7)
+    worst_step = worst_path = 0.0
+    for _ in range(3000):
+        k1, h = rng.uniform(0.001, 0.1), rng.choice([1e-3, 1e-2])
+        half_k = rng.uniform(0.1, 1.0)
+        half_n = half_k * (1 + rng.uniform(-0.02, 0.02))
+        c_k = rng.uniform(-1, 1)
+        c_n = c_k + rng.uniform(-0.02, 0.02)
+        a = rng.uniform(-0.9, 0.8)
+        b = min(a + rng.uniform(0, 0.2), 0.9)
+        e = rng.uniform(a, b)
+        z_max, acc = rng.uniform(0, 1), rng.uniform(0, 10)
+        z, delta = rng.uniform(-z_max, z_max), rng.uniform(-1, 1) * 0.5 * h * h * acc
+        r_k = -(2 * k1 / half_k) * phi_scalar(e)
+        x1_n = c_k + e * half_k + h * (r_k + z) + delta
+        e_n = (x1_n - c_n) / half_n
+        if abs(e_n) >= 0.95:
+            continue
+        r_n = -(2 * k1 / half_n) * phi_scalar(e_n)
+        bound = step_velocity_change(k1, h, a, b, (c_k - c_n) / half_n, half_k / half_n,
+                                     max(abs(a), abs(b), abs(e_n)), half_k, half_n,
+                                     h * z_max + 0.5 * h * h * acc)
+        assert abs(r_n - r_k) <= bound * (1 + 1e-12) + 1e-15
+        worst_step = max(worst_step, abs(r_n - r_k) / bound if bound else 0.0)
+        # the between-samples bound: the tube anywhere within spans covering both ends
+        speed = abs(r_k) + z_max + h * acc
+        move = 2 * (abs(c_n - c_k) + abs(half_n - half_k))
+        w_lo, w_hi = 2 * min(half_k, half_n), 2 * max(half_k, half_n)
+        path = virtual_velocity_change(k1, h, abs(e), max(abs(e), abs(e_n)), speed, move,
+                                       w_lo, w_hi)
+        assert abs(r_n - r_k) <= path * (1 + 1e-12) + 1e-15
+        worst_path = max(worst_path, abs(r_n - r_k) / path if path else 0.0)
+    # the bounds are not vacuous: some steps come within a factor 3 of them
+    assert worst_step > 1 / 3 and worst_path > 1 / 20
