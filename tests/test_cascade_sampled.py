@@ -201,3 +201,19 @@ def test_the_bounds_of_the_change_of_r_hold_on_random_steps() -> None:
         worst_path = max(worst_path, abs(r_n - r_k) / path if path else 0.0)
     # the bounds are not vacuous: some steps come within a factor 3 of them
     assert worst_step > 1 / 3 and worst_path > 1 / 20
+
+
+def test_the_spec_s_own_plant_is_checked_against_the_class() -> None:
+    from stt_codegen.verify.cascade import plant_within_class_check
+    for name in ("second-order-s1", "second-order-quadrotor", str(UMAZE)):
+        check = plant_within_class_check(stt.load_spec(name))
+        assert check.passed, check.detail
+    spec = stt.load_spec("second-order-quadrotor")
+    # gravity alone exceeds a drift bound of 5: the certificate would not cover the plant
+    low = dataclasses.replace(spec, second_order=dataclasses.replace(spec.second_order,
+                                                                     drift_bound=5.0))
+    check = plant_within_class_check(low)
+    assert not check.passed and "drift_bound" in check.detail
+    heavy = dataclasses.replace(spec, second_order=dataclasses.replace(
+        spec.second_order, parameters=(2.0, 0.3, 9.81)))
+    assert not plant_within_class_check(heavy).passed       # 1/m = 0.5 < g_min = 0.625

@@ -231,6 +231,15 @@ def sampled_cascade_check(spec, tube, min_width: float) -> Check:
     return Check("cascade.sampled", result.passed, detail, data)
 
 
+def plant_within_class_check(spec) -> Check:
+    """``cascade.plant_within_assumptions``: the spec's simulated second-order plant lies in
+    the class ``cascade.sampled`` certifies
+    (:func:`~stt_codegen.verify.cascade_sampled.model_within_class`)."""
+    from .cascade_sampled import model_within_class
+    ok, words, data = model_within_class(spec)
+    return Check("cascade.plant_within_assumptions", ok, words, data)
+
+
 def cascade_checks(max_n: int = 2) -> list[Check]:
     """Every check of this module (``n = 1..max_n`` where the dimension matters)."""
     out = []

@@ -429,3 +429,50 @@ def cascade_check_of(tube: TubeDesign, spec: Spec, stage: SecondStage) -> Cascad
         samples = sample_tube(tube)
     return check_cascade_sampled(tube, samples, stage, cascade_class(spec),
                                  spec.second_order.initial_velocity)
+
+
+def model_within_class(spec: Spec) -> tuple[bool, str, dict]:
+    """Whether the spec's own simulated plant (``plant.model`` with ``plant.parameters``)
+    belongs to its :func:`cascade_class`, so that the certificate covers it.
+
+    ``double-integrator``: ``g = I / m``, ``f = 0``. ``quadrotor``: ``g = I / m``, ``f =
+    -(c / m) x2 - g0 e3``, so ``|f_i| <= (c / m) |x2_i| + g0 [i = 3]``: within the drift
+    bound where ``|x2_i| < velocity_bound_i`` (which the certificate proves); without a
+    velocity bound only when ``c = 0``. ``two-link-arm``: not checked (its ``M(q)^-1`` and
+    Coriolis terms are not bounded here), so not covered.
+
+    Returns
+    -------
+    ok : bool
+    words : str
+    data : dict
+    """
+    order = spec.second_order
+    cls = cascade_class(spec)
+    p = dict(zip(SECOND_ORDER_PLANTS[order.model].parameters, order.parameters))
+    if order.model == "two-link-arm":
+        return False, ("the two-link-arm model's bounds are not derived: the certificate "
+                       "covers the declared class only, not this plant"), {}
+    g = 1.0 / p["mass"]
+    n = spec.dimension
+    slope = p.get("drag", 0.0) / p["mass"]
+    offset = [0.0] * n
+    if order.model == "quadrotor":
+        offset[2] = p["gravity"]
+    if slope > 0 and cls.velocity_bound is None:
+        drift = math.inf
+    else:
+        drift = max(offset[i] + slope * (cls.velocity_bound[i] if slope > 0 else 0.0)
+                    for i in range(n))
+    bad = []
+    if not cls.g_min <= g <= cls.g_max:
+        bad.append(f"g = 1/mass = {g:.6g} outside input_gain [{cls.g_min:g}, {cls.g_max:g}]")
+    if drift > cls.drift_bound * (1 + 1e-12):
+        bad.append(f"max |f_i| = {drift:.6g} (within velocity_bound) exceeds drift_bound "
+                   f"{cls.drift_bound:g}")
+    data = {"input_gain": g, "drift": drift}
+    if bad:
+        return False, (f"the spec's {order.model} plant is outside the class the certificate "
+                       "covers: " + "; ".join(bad)), data
+    return True, (f"the spec's {order.model} plant (g = {g:.6g} I, max |f_i| = {drift:.6g} "
+                  "within velocity_bound) is in the declared class"), data

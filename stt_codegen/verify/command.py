@@ -179,9 +179,10 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     if spec.second_order is not None:
         # the deployed controller is the cascade, not law (13) on this plant: its lemmas
         # and its sampled-data certificate (docs/second-order.md)
-        from .cascade import cascade_checks, sampled_cascade_check
+        from .cascade import cascade_checks, plant_within_class_check, sampled_cascade_check
         stage("sampled loop")          # the cascade takes the sampled loop's slot
         return checks + cascade_checks(min(n, 2)) + [
+            plant_within_class_check(spec),
             sampled_cascade_check(spec, design, tube_check.min_width)]
     stage("sampled loop")
     with reference.numpy_math():
