@@ -11,7 +11,7 @@ from conftest import designed
 from second_order_helpers import MASS_RANGE, planar_s1
 
 import stt_codegen as stt
-from stt_codegen.design.cascade_gain import INNER_STEP_FRACTION, derived_second_stage
+from stt_codegen.design.cascade_gain import SHAPES, derived_second_stage
 from stt_codegen.errors import SpecError
 from stt_codegen.runtime.cascade_simulate import simulate_second_order
 from stt_codegen.tube import cascade_reference
@@ -27,7 +27,7 @@ def test_default_gains_follow_the_declared_bounds() -> None:
     dt = 1.0 / tube.rate_hz
     floor = stage.width_floor[0]
     # the inner loop's linearized step at g_max, and the time-scale separation
-    assert 4 * stage.velocity_gain * 2.0 / floor**2 * dt == pytest.approx(INNER_STEP_FRACTION)
+    assert 4 * stage.velocity_gain * 2.0 / floor**2 * dt == pytest.approx(SHAPES[0][0])
     assert 16 * stage.position_gain / check.min_width**2 == pytest.approx(info["omega2_min"] / 10)
     # rho2(0) contains the initial velocity error with the floor to spare
     r0 = cascade_reference.cascade_step(tube, stage, [tube.initial_state], [x2], 0.0, dt,

@@ -23,10 +23,12 @@ STRICT = ["-std=c99", "-O2", "-ffp-contract=off", "-Wall", "-Wextra", "-Wpedanti
 #: double Python against the reference: the CasADi model meets it at 1e-12 (tests/test_cascade.py)
 DOUBLE_TOLERANCE = 1e-9
 #: Non-vacuity of the single-precision bound of ``u``: the share of entries whose tolerance
-#: is below 10 % of ``|u|`` (measured: 0.945 on second-order-s1, 1.0 on the quadrotor; the
-#: others have ``u`` near 0 (``|e2| < 0.04``) or ``r``'s bound at 2.7-4.2 % of ``rho2``
-#: with ``|e2| >= 0.43``, where ``g``'s slope multiplies it; docs/second-order.md)
-SINGLE_U_SHARE = 0.9
+#: is below 10 % of ``|u|`` (measured with the certified second stages: 0.836 on
+#: second-order-s1, whose certified k1 is three times the linearized default's, so ``r``
+#: and its rounding are larger next to the same ``rho2``; the others have ``u`` near 0
+#: or ``r``'s bound a few % of ``rho2``, where ``g``'s slope multiplies it;
+#: docs/second-order.md)
+SINGLE_U_SHARE = 0.8
 
 
 def _folder(case: str, precision: str) -> Path:

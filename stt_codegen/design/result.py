@@ -7,10 +7,9 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
-from ..errors import SpecError
 from ..tube.parameters import TubeDesign
 from ..tube.second_stage import SecondStage
-from .cascade_gain import cascade_rate, derived_second_stage
+from .cascade_gain import second_stage_for
 from .certificate import Certificate
 from .failures import FailureKind
 from .input_bound import InputProof
@@ -116,33 +115,29 @@ class Design:
 
     @cached_property
     def second_stage(self) -> tuple[SecondStage, dict]:
-        """The cascade's second stage of a second-order design, and its derivation.
+        """The cascade's certified second stage of a second-order design, and its derivation.
 
-        Derived once, on first use, by
-        :func:`~stt_codegen.design.cascade_gain.derived_second_stage`: ``F`` is
-        ``assumptions.drift_bound`` plus ``plant.disturbance_amplitude`` (the bound on every
-        ``|w_i|``); ``g`` in ``assumptions.input_gain``; ``x2(0)`` is ``initial.velocity``;
-        ``gamma_d,min`` the certified narrowest width (docs/second-order.md, "Gains").
+        The first shape of :data:`~stt_codegen.design.cascade_gain.SHAPES` whose sampled
+        cascade is certified at the spec's rate
+        (:func:`~stt_codegen.design.cascade_gain.second_stage_for`, computed once per tube;
+        docs/second-order.md, "The sampled cascade").
 
         Returns
         -------
         stage : SecondStage
             ``k1``, ``k2`` and the velocity tube ``rho2``.
         derivation : dict
-            As :func:`~stt_codegen.design.cascade_gain.derived_second_stage`.
+            As :func:`~stt_codegen.design.cascade_gain.derived_second_stage`, with the
+            ``certificate``.
 
         Raises
         ------
         SpecError
             The spec's ``plant.model`` is first order (field ``plant.model``).
+        DesignError
+            No shape is certified at the design's rate (kind ``SAMPLING_RATE``).
         """
-        order = self.spec.second_order
-        if order is None:
-            raise SpecError("plant.model", "the spec describes a first-order plant (not a "
-                                           "second-order plant.model)")
-        return derived_second_stage(self.tube, self.check.min_width, order.input_gain,
-                                    order.drift_bound + self.spec.disturbance_amplitude,
-                                    order.initial_velocity)
+        return second_stage_for(self.tube, self.spec, self.check.min_width)
 
     def to_json(self) -> dict[str, Any]:
         """The design as plain JSON types (the ``design`` command's and ``simulate --json``'s).
@@ -161,8 +156,8 @@ class Design:
             spec with moving obstacles also ``motion`` and ``moving_obstacles`` (index,
             motion, active interval, certified margin; docs/moving-obstacles.md); for a
             spec with a second-order ``plant.model`` also ``cascade`` (``gains``: the
-            default second stage's derivation; ``rate``: linearized sampled factors and the
-            lowest rate, :func:`~stt_codegen.design.cascade_gain.cascade_rate`).
+            certified second stage's derivation and its sampled-data certificate,
+            :func:`~stt_codegen.design.cascade_gain.second_stage_of`).
         """
         tube = self.tube
         via = []
@@ -230,17 +225,12 @@ class Design:
             for ob in self.spec.moving_obstacles]}
 
     def _cascade_json(self) -> dict[str, Any]:
-        """``cascade``: the default second stage's derivation (``gains``) and the linearized
-        sampled loops' factors and lowest rate (``rate``, an estimate, not a certificate),
-        for a spec with a second-order ``plant.model`` only: without it the document is as
-        before."""
-        order = self.spec.second_order
-        if order is None:
+        """``cascade``: the certified second stage's derivation with its sampled-data
+        certificate (``gains``), for a spec with a second-order ``plant.model`` only:
+        without it the document is as before."""
+        if self.spec.second_order is None:
             return {}
-        stage, derivation = self.second_stage
-        return {"cascade": {"gains": derivation,
-                            "rate": cascade_rate(stage, order.input_gain, self.check.min_width,
-                                                 self.tube.rate_hz)}}
+        return {"cascade": {"gains": self.second_stage[1]}}
 
     def _actuator_json(self) -> dict[str, Any]:
         """``input_bound`` and the proved ``input_peak`` (with where each peak is), for a

@@ -309,7 +309,11 @@ def design_tube(spec: Spec) -> Design:
         # the bound's proof orders the tubes there (default, softer circumvents, via
         # points): auto's estimate of the smoother tube plays no part
         return design_within_bound(spec, lambda free: _design(free, smoother=False))
-    return _design(spec, smoother=True)
+    # a second-order spec: the sampled cascade must be certified (design/cascade_gain.py)
+    design = _design(spec, smoother=True)
+    if spec.second_order is not None:
+        design.second_stage      # DesignError unless the sampled cascade is certified
+    return design
 
 
 def _design(spec: Spec, smoother: bool) -> Design:

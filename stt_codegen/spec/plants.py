@@ -74,7 +74,8 @@ MODEL_KEYS: dict[str, str] = {key: name for name, p in PLANTS.items() for key in
 @dataclass(frozen=True)
 class SecondOrderModel:
     """A named second-order model: its dimension (``None``: any), a summary, parameter
-    names and nominal parameter values (SI units).
+    names and nominal parameter values (SI units), and whether its input matrix ``g`` is
+    diagonal for every parameter value and state.
 
     Attributes
     ----------
@@ -88,6 +89,9 @@ class SecondOrderModel:
         Names of the model's ``plant.parameters``, in order.
     nominal : tuple of float
         Their nominal values, SI units.
+    diagonal_input : bool
+        ``g`` is diagonal (``I / m``: an input moves its own velocity only), so the sampled
+        cascade's certificate takes no coupling between axes.
     """
 
     name: str
@@ -95,16 +99,17 @@ class SecondOrderModel:
     dimension: int | None
     parameters: tuple[str, ...]
     nominal: tuple[float, ...]
+    diagonal_input: bool = False
 
 
 #: Every second-order model, by ``plant.model`` name (dynamics:
 #: :mod:`stt_codegen.runtime.second_order_plants`).
 SECOND_ORDER_PLANTS: dict[str, SecondOrderModel] = {m.name: m for m in (
     SecondOrderModel("double-integrator", "second order, x2_dot = u / mass + w, any n", None,
-                     ("mass",), (1.0,)),
+                     ("mass",), (1.0,), diagonal_input=True),
     SecondOrderModel("quadrotor", "second order, x2_dot = u / mass - (drag / mass) x2 - "
                      "gravity e3 + w, thrust vector u, n = 3", 3, ("mass", "drag", "gravity"),
-                     (1.0, 0.3, 9.81)),
+                     (1.0, 0.3, 9.81), diagonal_input=True),
     SecondOrderModel("two-link-arm", "second order, joint space, M(q) q_ddot + C(q, q_dot) "
                      "q_dot + G(q) = u + w, n = 2", 2,
                      ("mass1", "mass2", "length1", "length2", "inertia1", "inertia2",

@@ -29,6 +29,7 @@ modules:
 import importlib
 from typing import Any
 
+from ..design.cascade_prover import register_cascade_certifier
 from ..design.input_bound import register_input_prover
 
 #: Public name -> submodule that defines it; imported on first use (PEP 562), so importing
@@ -60,6 +61,17 @@ def _prove_input_bound(tube: Any, spec: Any, *, per_axis_first: bool = False) ->
 # check's bound on e, verify's), and cannot import verify, which builds on it: the
 # prover is registered here, when the package is loaded (``import stt_codegen`` loads it).
 register_input_prover(_prove_input_bound)
+
+
+def _certify_cascade(tube: Any, spec: Any, stage: Any) -> tuple[bool, dict]:
+    """:func:`.cascade_sampled.certify_stage`, imported on first use."""
+    from .cascade_sampled import certify_stage
+    return certify_stage(tube, spec, stage)
+
+
+# The design keeps a second stage only when the sampled cascade is certified (verify's
+# certificate, registered here for the same reason as the input prover).
+register_cascade_certifier(_certify_cascade)
 
 
 def __getattr__(name: str) -> Any:

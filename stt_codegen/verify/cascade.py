@@ -17,10 +17,8 @@ holds where the clamps are inactive (``rho2 >= GAMMA_D_MIN``, ``|e2| <= E_MAX``)
 * ``cascade.velocity_tube``: ``rho2(0) = width_start``, ``rho2 >= rho2_inf`` for ``t >= 0``,
   ``|rho2_dot| <= l (rho2(0) - rho2_inf)``.
 
-``cascade.rate`` (:func:`cascade_rate_check`) reports linearized estimates of the sampled
-loops and the lowest rate they allow: numbers, not a proof.
-
-:data:`NOT_PROVED` says what is not proved about the sampled cascade.
+``cascade.sampled`` (:func:`sampled_cascade_check`) reports the sampled cascade's
+certificate (:mod:`.cascade_sampled`).
 """
 
 from __future__ import annotations
@@ -35,17 +33,9 @@ from ..tube.parameters import E_MAX, GAMMA_D_MIN
 from .check import Check
 from .deployed import on_domain
 
-__all__ = ["NOT_PROVED", "cascade_checks", "cascade_rate_check", "check_jacobian",
-           "check_lyapunov_derivative", "check_pushes_back", "check_transform",
-           "check_velocity_tube", "sampled_cascade_check"]
-
-#: What ``verify`` does not prove about the cascade, in words.
-NOT_PROVED = (
-    "not proved: the bounds E1, E2 < 1 of the continuous-time argument are shown to exist, "
-    "not computed (they depend on sup |r_dot|, which grows without bound near the position "
-    "tube's wall); no bound on |u| or |x2| follows and no actuator limit is applied; the "
-    "sampled cascade (u held for dt) is not certified: staying in both tubes is measured "
-    "in simulation only (docs/second-order.md, 'What is not proved')")
+__all__ = ["cascade_checks", "check_jacobian", "check_lyapunov_derivative",
+           "check_pushes_back", "check_transform", "check_velocity_tube",
+           "plant_within_class_check", "sampled_cascade_check"]
 
 _CLAMPS = {sp.Rational(GAMMA_D_MIN): 1, sp.Rational(E_MAX): -1, -sp.Rational(E_MAX): 1}
 
@@ -226,52 +216,82 @@ def check_velocity_tube() -> Check:
                  else f"not shown for rho2 = {expr}", {"rho2": str(expr)})
 
 
-def sampled_cascade_check() -> Check:
-    """``cascade.sampled``: always FAILS, with :data:`NOT_PROVED`: ``verify`` proves the
-    continuous-time lemmas of the cascade, not that the sampled cascade keeps a plant of the
-    declared class in both tubes (docs/second-order.md, "What is not proved").
-
-    Returns
-    -------
-    Check
-        ``cascade.sampled``, failed, its message :data:`NOT_PROVED`.
-    """
-    return Check("cascade.sampled", False, NOT_PROVED, {})
-
-
-def cascade_rate_check(spec, design, min_width: float, rate_hz: float | None = None) -> Check:
-    """``cascade.rate``: the linearized sampled cascade's factors and the lowest rate at
-    which they stay in ``(-1, 1)`` for the deployed (default) gains
-    (:func:`stt_codegen.design.cascade_gain.cascade_rate`); PASS when the spec's rate is at
-    or above it. A linearized estimate, not a certificate (``cascade.sampled`` stays FAIL).
+def sampled_cascade_check(spec, tube, min_width: float) -> Check:
+    """``cascade.sampled``: the sampled cascade's certificate
+    (:func:`~stt_codegen.verify.cascade_sampled.check_cascade_sampled`) for the deployed
+    second stage and the spec's declared plants, with its margins and the lowest certified
+    rate (:func:`~stt_codegen.design.cascade_gain.lowest_certified_rate`).
 
     Parameters
     ----------
     spec : Spec
-        With a second-order ``plant.model`` (its ``input_gain``, drift bound,
-        ``initial.velocity``).
-    design : TubeDesign
-        The position tube; its ``rate_hz`` is the rate judged.
+        With a second-order ``plant.model``.
+    tube : TubeDesign
+        The position tube; the second stage is the one the design deploys
+        (:func:`~stt_codegen.design.cascade_gain.certified_stage`), or, when none is
+        certified, the first shape's (to report its figures).
     min_width : float
-        ``gamma_d,min``, the certified narrowest width.
-    rate_hz : float, optional
-        The rate judged with the gains derived at ``design.rate_hz`` (default that rate):
-        the gains stay those deployed at the spec's rate.
+        ``gamma_d,min`` of the tube's certificate.
 
     Returns
     -------
     Check
-        ``cascade.rate``; ``data`` is :func:`~stt_codegen.design.cascade_gain.cascade_rate`'s
-        result.
+        PASS when the certificate holds at the spec's rate; FAIL with its figures otherwise.
     """
-    from ..design.cascade_gain import cascade_rate, cascade_rate_words, derived_second_stage
-    order = spec.second_order
-    stage, _ = derived_second_stage(design, min_width, order.input_gain,
-                                    order.drift_bound + spec.disturbance_amplitude,
-                                    order.initial_velocity)
-    rate = cascade_rate(stage, order.input_gain, min_width,
-                        design.rate_hz if rate_hz is None else rate_hz)
-    return Check("cascade.rate", rate["passed"], cascade_rate_words(rate), rate)
+    from ..design.cascade_gain import certified_stage, lowest_certified_rate
+    from .cascade_sampled import cascade_check_of
+    stage, derivation = certified_stage(tube, spec, min_width)
+    if stage is None:
+        from ..design.cascade_gain import derived_second_stage
+        order = spec.second_order
+        stage, derivation = derived_second_stage(
+            tube, min_width, order.input_gain,
+            order.drift_bound + spec.disturbance_amplitude, order.initial_velocity)
+    result = cascade_check_of(tube, spec, stage)
+    rate = lowest_certified_rate(tube, spec, passes_at_rate=result.passed)
+    lowest = (f"lowest certified rate {rate:g} Hz (on the two-digit grid, a second stage "
+              "derived there)" if rate is not None else
+              f"no rate up to {tube.rate_hz * 16:g} Hz is certified")
+    words = result.data["class"]
+    if result.passed:
+        detail = (f"proved: every plant with {words} keeps |e1| < 1 and |e2| < 1 at and "
+                  f"between samples at {tube.rate_hz:g} Hz over [0, "
+                  f"{result.data['horizon']:.4g}] s, with k1 = {stage.position_gain:.4g}, "
+                  f"k2 = {stage.velocity_gain:.4g}, rho2 from {max(stage.width_start):.4g} "
+                  f"to {min(stage.width_floor):.4g} (l = {stage.decay:.4g}): |e1| <= "
+                  f"{result.max_abs_e1:.3g}, |e2| <= {result.max_abs_e2:.3g} at the "
+                  f"samples; room >= {result.position_margin:.3g} of the position tube's "
+                  f"half-width and {result.velocity_margin:.3g} of rho2 between samples "
+                  f"(least at t = {result.time:.4f} s, dimension {result.dimension}); "
+                  f"|u_i| <= {[round(v, 4) for v in result.peak_input]}, |x2_i| <= "
+                  f"{[round(v, 4) for v in result.peak_velocity]}; {lowest}")
+    else:
+        detail = (f"not proved at {tube.rate_hz:g} Hz for plants with {words}: "
+                  f"{result.reason}; {lowest}")
+    data = {**result.data, "passed": result.passed, "reason": result.reason,
+            "time": result.time, "dimension": result.dimension, "lowest_rate_hz": rate,
+            "gains": derivation}
+    return Check("cascade.sampled", result.passed, detail, data)
+
+
+def plant_within_class_check(spec) -> Check:
+    """``cascade.plant_within_assumptions``: the spec's simulated second-order plant lies in
+    the class ``cascade.sampled`` certifies
+    (:func:`~stt_codegen.verify.cascade_sampled.model_within_class`).
+
+    Parameters
+    ----------
+    spec : Spec
+        With a second-order ``plant.model``.
+
+    Returns
+    -------
+    Check
+        PASS when the model with its parameters is in the class, with the figures.
+    """
+    from .cascade_sampled import model_within_class
+    ok, words, data = model_within_class(spec)
+    return Check("cascade.plant_within_assumptions", ok, words, data)
 
 
 def cascade_checks(max_n: int = 2) -> list[Check]:

@@ -121,9 +121,9 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         ``[actuator]``, ``sampled.input_bound``
         (:func:`~stt_codegen.verify.actuator.input_bound_check`). For a spec with
         a second-order ``plant.model``, the cascade's lemmas (:func:`~stt_codegen.verify.cascade.cascade_checks`),
-        the linearized ``cascade.rate``
-        (:func:`~stt_codegen.verify.cascade.cascade_rate_check`) and the failed
-        ``cascade.sampled`` instead of the last two.
+        and the sampled cascade's certificate ``cascade.sampled``
+        (:func:`~stt_codegen.verify.cascade.sampled_cascade_check`) instead of the last
+        two.
     """
     stage = progress if isinstance(progress, _Stages) else _Stages(progress, design=False)
     if plant is not None:
@@ -206,12 +206,13 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     # ulp of libm, tens of times faster), as the certificate and the input-bound prover
     # do: every margin here is far above rounding
     if spec.second_order is not None:
-        # the deployed controller is the cascade, not law (13) on this plant: its
-        # lemmas, and a plain FAIL for what is not proved (docs/second-order.md)
-        from .cascade import cascade_checks, cascade_rate_check, sampled_cascade_check
+        # the deployed controller is the cascade, not law (13) on this plant: its lemmas
+        # and its sampled-data certificate (docs/second-order.md)
+        from .cascade import cascade_checks, plant_within_class_check, sampled_cascade_check
         stage("sampled loop")          # the cascade takes the sampled loop's slot
         return checks + cascade_checks(min(n, 2)) + [
-            cascade_rate_check(spec, design, tube_check.min_width), sampled_cascade_check()]
+            plant_within_class_check(spec),
+            sampled_cascade_check(spec, design, tube_check.min_width)]
     stage("sampled loop")
     with reference.numpy_math():
         checks += sampled_checks(spec, design, tube_check.certificate)
