@@ -25,8 +25,8 @@ import casadi
 
 from ..tube.cascade import cascade_step
 from ..tube.parameters import TubeDesign
-from ..tube.second_stage import (CASCADE_OK, CASCADE_OUTSIDE_POSITION_TUBE,
-                                 CASCADE_OUTSIDE_VELOCITY_TUBE, SecondStage)
+from ..tube.parameters import Status
+from ..tube.second_stage import SecondStage
 from ..version import __version__
 from ..design.result import Design
 from .emit import CPrinter, lower, python_source
@@ -47,9 +47,9 @@ def design_hash(design: TubeDesign, stage: SecondStage) -> str:
 
 
 #: Status names and codes, in the order the C header and the Python module define them.
-_STATUSES = (("OK", CASCADE_OK), ("OUTSIDE_POSITION_TUBE", CASCADE_OUTSIDE_POSITION_TUBE),
+_STATUSES = (("OK", Status.OK), ("OUTSIDE_POSITION_TUBE", Status.OUTSIDE_TUBE),
              ("INVALID_INPUT", CASCADE_INVALID_INPUT),
-             ("OUTSIDE_VELOCITY_TUBE", CASCADE_OUTSIDE_VELOCITY_TUBE))
+             ("OUTSIDE_VELOCITY_TUBE", Status.OUTSIDE_VELOCITY_TUBE))
 
 
 def _context(design: TubeDesign, stage: SecondStage, prefix: str, precision: str) -> dict:
@@ -180,8 +180,8 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     x2 = f32(r + rho2 * rng.uniform(-0.9, 0.9, (count, n)))
     u, alpha_next, r, inside_p, inside_v = cascade_reference.cascade_step(
         design, stage, x1, x2, t, dt, alpha)
-    status = np.where(inside_p == 0, CASCADE_OUTSIDE_POSITION_TUBE,
-                      np.where(inside_v == 0, CASCADE_OUTSIDE_VELOCITY_TUBE, CASCADE_OK))
+    status = np.where(inside_p == 0, Status.OUTSIDE_TUBE,
+                      np.where(inside_v == 0, Status.OUTSIDE_VELOCITY_TUBE, Status.OK))
     unit = T.unit_roundoff(precision)
     tol_u, tol_r, tol_a = T.cascade_bounds(design, stage, x1, x2, t, alpha, r, alpha_next, unit)
     if precision == "double":

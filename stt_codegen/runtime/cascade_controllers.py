@@ -21,8 +21,8 @@ from ..codegen.emit import python_function
 from ..errors import SpecError
 from ..tube import cascade_reference
 from ..tube.parameters import TubeDesign
-from ..tube.second_stage import (CASCADE_OK, CASCADE_OUTSIDE_POSITION_TUBE,
-                                 CASCADE_OUTSIDE_VELOCITY_TUBE, SecondStage)
+from ..tube.parameters import Status
+from ..tube.second_stage import SecondStage
 
 __all__ = ["CascadeController"]
 
@@ -32,8 +32,8 @@ CASCADE_BACKENDS = ("reference", "casadi", "python", "c")
 
 def _status(inside_position: float, inside_velocity: float) -> int:
     if not inside_position:
-        return CASCADE_OUTSIDE_POSITION_TUBE
-    return CASCADE_OK if inside_velocity else CASCADE_OUTSIDE_VELOCITY_TUBE
+        return Status.OUTSIDE_TUBE
+    return Status.OK if inside_velocity else Status.OUTSIDE_VELOCITY_TUBE
 
 
 class CascadeController:
@@ -83,7 +83,7 @@ class CascadeController:
 
     def step(self, x1: np.ndarray, x2: np.ndarray, t: float, dt: float,
              alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
-        """``u`` (n,), ``alpha_next`` (2n,), ``r`` (n,) and the status (``CASCADE_*``)."""
+        """``u`` (n,), ``alpha_next`` (2n,), ``r`` (n,) and the :class:`~stt_codegen.tube.parameters.Status`."""
         u, alpha_next, r, inside_p, inside_v = self._call(
             np.asarray(x1, dtype=float), np.asarray(x2, dtype=float), float(t), float(dt),
             np.asarray(alpha, dtype=float))
@@ -123,8 +123,8 @@ def _compiled(design: TubeDesign, stage: SecondStage):
         u, alpha_next, r = np.zeros(n), np.zeros(2 * n), np.zeros(n)
         code = entry(t, dt, *(b.ctypes.data_as(real_p) for b in bufs),
                      *(b.ctypes.data_as(real_p) for b in (u, alpha_next, r)))
-        inside_p = 0.0 if code == CASCADE_OUTSIDE_POSITION_TUBE else 1.0
-        inside_v = 1.0 if code == CASCADE_OK else 0.0
+        inside_p = 0.0 if code == Status.OUTSIDE_TUBE else 1.0
+        inside_v = 1.0 if code == Status.OK else 0.0
         return [u, alpha_next, r, np.array([inside_p]), np.array([inside_v])]
 
     call.library = handle  # keep the library loaded with the closure

@@ -21,7 +21,8 @@ from ..errors import SpecError
 from ..spec.loader import Spec
 from ..tube import reference
 from ..tube.parameters import TubeDesign
-from ..tube.second_stage import CASCADE_OK, SecondStage
+from ..tube.parameters import Status
+from ..tube.second_stage import SecondStage
 from .cascade_controllers import CascadeController
 from .plants import Disturbance
 from .second_order_plants import model_info, second_order_rhs
@@ -53,7 +54,7 @@ class CascadeTrajectory:
     alpha : ndarray, shape (N, 2n)
         The adaptive law's ``alpha`` (eq. (11)) at each instant.
     status : ndarray of int, shape (N,)
-        The step's status code (``CASCADE_OK``: inside both tubes).
+        The step's status code (``Status.OK``: inside both tubes).
     """
 
     t: np.ndarray
@@ -89,7 +90,7 @@ class CascadeResult:
     stayed_in_tube : bool
         Every step had ``x1`` strictly inside the position tube.
     stayed_in_velocity_tube : bool
-        Every step had ``|x2 - r| < rho2`` too (status ``CASCADE_OK`` throughout).
+        Every step had ``|x2 - r| < rho2`` too (status ``Status.OK`` throughout).
     max_abs_e : float
         ``max |e1|``, the normalized position error in the tube (1: the wall).
     max_abs_u : list of float
@@ -271,7 +272,7 @@ def simulate_second_order(spec: Spec, tube: TubeDesign, stage: SecondStage, *,
         reached=reached, reach_time=float(ts[int(np.argmax(in_target))]) if reached else None,
         prescribed_time=t_c, collision=collision, min_obstacle_clearance=min_clear,
         left_state_space=left, stayed_in_tube=bool(np.all(status != 1) and np.all(status != 2)),
-        stayed_in_velocity_tube=bool(np.all(status == CASCADE_OK)), max_abs_e=max_e,
+        stayed_in_velocity_tube=bool(np.all(status == Status.OK)), max_abs_e=max_e,
         max_abs_u=[float(v) for v in np.abs(us).max(axis=0)],
         max_abs_x2=[float(v) for v in np.abs(x2s).max(axis=0)], steps=steps,
         exceeded_velocity_bound=fast,

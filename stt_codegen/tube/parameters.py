@@ -7,11 +7,13 @@ the CasADi model (:mod:`stt_codegen.tube.model`) and through it the generated co
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass
 
 __all__ = ["Circumvent", "E_MAX", "GAMMA_D_MIN", "LOWER", "NEWTON_ITERATIONS", "NEWTON_TINY",
            "ReachSegment", "SMOOTHSTEP", "STATUS_INPUT_CLAMPED", "STATUS_INVALID_INPUT",
-           "STATUS_OK", "STATUS_OUTSIDE_TUBE", "TANH", "TubeDesign", "UPPER", "paper_segments"]
+           "STATUS_OK", "STATUS_OUTSIDE_TUBE", "STATUS_OUTSIDE_VELOCITY_TUBE", "Status", "TANH",
+           "TubeDesign", "UPPER", "paper_segments"]
 
 #: Largest ``|e_i|`` used to compute ``u`` in the deployed controller step: ``e`` is
 #: clamped to ``[-E_MAX, E_MAX]`` so that ``u`` is finite everywhere (1 - 2**-20, exact in
@@ -26,16 +28,42 @@ NEWTON_ITERATIONS = 5
 #: Floor used in the Newton start point to avoid 0/0 (representable in float32).
 NEWTON_TINY = 1e-30
 
-#: Status codes of one controller step, in every backend and in the generated code.
-STATUS_OK = 0
-#: ``x`` is not strictly inside the tube (or the tube is empty): ``u`` is still finite.
-STATUS_OUTSIDE_TUBE = 1
-#: An input is outside the step's domain: ``u = 0``, ``alpha`` kept.
-STATUS_INVALID_INPUT = 2
-#: ``x`` is strictly inside the tube, but law (13) asked for more than the actuator bound
-#: (``[actuator] input_bound``) in some input: ``u`` was clamped to ``+-input_bound``.
-#: Only designs with an input bound return it; ``OUTSIDE_TUBE`` takes precedence.
-STATUS_INPUT_CLAMPED = 3
+class Status(enum.IntEnum):
+    """Status code of one controller step, for both orders, in every backend and in the
+    generated code (``<PREFIX>_STATUS_<NAME>`` in C, ``STATUS_<NAME>`` in Python).
+
+    Attributes
+    ----------
+    OK : 0
+        The state is strictly inside its tube(s); ``u`` is the law's output.
+    OUTSIDE_TUBE : 1
+        ``x`` (the position ``x1`` for a second-order plant) is not strictly inside the
+        designed tube, or the tube is empty: ``u`` is still finite.
+    INVALID_INPUT : 2
+        An input of the step is outside its domain: ``u = 0``, ``alpha`` kept.
+    INPUT_CLAMPED : 3
+        Inside the tube(s), but the law asked for more than the actuator bound
+        (``[actuator] input_bound``) in some input: ``u`` was clamped to
+        ``+-input_bound``. Only designs with an input bound return it; ``OUTSIDE_TUBE``
+        and ``OUTSIDE_VELOCITY_TUBE`` take precedence.
+    OUTSIDE_VELOCITY_TUBE : 4
+        Second order only: the position is inside its tube, the velocity error
+        ``x2 - r`` is not inside ``(-rho2, rho2)``.
+    """
+
+    OK = 0
+    OUTSIDE_TUBE = 1
+    INVALID_INPUT = 2
+    INPUT_CLAMPED = 3
+    OUTSIDE_VELOCITY_TUBE = 4
+
+
+#: Aliases of :class:`Status` members (the names the generated code uses).
+STATUS_OK = Status.OK
+STATUS_OUTSIDE_TUBE = Status.OUTSIDE_TUBE
+STATUS_INVALID_INPUT = Status.INVALID_INPUT
+STATUS_INPUT_CLAMPED = Status.INPUT_CLAMPED
+STATUS_OUTSIDE_VELOCITY_TUBE = Status.OUTSIDE_VELOCITY_TUBE
 
 LOWER = "lower"
 UPPER = "upper"

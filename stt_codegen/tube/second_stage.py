@@ -15,15 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["CASCADE_OK", "CASCADE_OUTSIDE_POSITION_TUBE", "CASCADE_OUTSIDE_VELOCITY_TUBE",
-           "SecondStage"]
-
-#: Status of a cascade step: both errors inside their tubes.
-CASCADE_OK = 0
-#: The position ``x1`` is not strictly inside the designed tube.
-CASCADE_OUTSIDE_POSITION_TUBE = 1
-#: The position is inside, the velocity error ``x2 - r`` is not inside ``(-rho2, rho2)``.
-CASCADE_OUTSIDE_VELOCITY_TUBE = 4
+__all__ = ["SecondStage"]
 
 
 @dataclass(frozen=True)
