@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import functools
 import tomllib
+from dataclasses import replace
 
 import numpy as np
 
 import stt_codegen as stt
 from stt_codegen.cases import bundled_spec_bytes
 from stt_codegen.design.cascade_gain import derived_second_stage
+from stt_codegen.spec.second_order import SecondOrder
 
 #: Mass range of the double-integrator tests (kg): ``g = 1 / m`` in [0.8, 1.25].
 MASS_RANGE = (0.8, 1.25)
@@ -34,3 +36,12 @@ def planar_s1():
                                     (1.0 / MASS_RANGE[1], 1.0 / MASS_RANGE[0]), 0.1,
                                     np.zeros(2))
     return spec, design, stage
+
+
+def as_double_integrator(spec, mass: float = 1.0):
+    """``spec`` with a double integrator of mass ``mass`` (kg) as its plant, at rest, with
+    the declared ``1/m`` range of :data:`MASS_RANGE`."""
+    plant = SecondOrder(model="double-integrator", parameters=(mass,),
+                        initial_velocity=(0.0,) * spec.dimension, velocity_bound=None,
+                        input_gain=(1.0 / MASS_RANGE[1], 1.0 / MASS_RANGE[0]), drift_bound=0.0)
+    return replace(spec, second_order=plant)

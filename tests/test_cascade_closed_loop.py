@@ -8,12 +8,13 @@ import shutil
 import numpy as np
 import pytest
 from conftest import designed
-from second_order_helpers import MASS_RANGE, planar_s1
+from second_order_helpers import MASS_RANGE, as_double_integrator, planar_s1
 
 import stt_codegen as stt
 from stt_codegen.design.cascade_gain import SHAPES, derived_second_stage
 from stt_codegen.errors import SpecError
-from stt_codegen.runtime.cascade_simulate import simulate_second_order
+from stt_codegen.runtime.plants import make_plant, second_order_plant
+from stt_codegen.runtime.simulate import run_closed_loop
 from stt_codegen.tube import cascade_reference
 
 CC = shutil.which("gcc") or shutil.which("clang")
@@ -43,13 +44,21 @@ def test_default_gains_follow_the_declared_bounds() -> None:
 def test_bad_simulation_input_names_the_field() -> None:
     spec, tube, _ = designed("omnirobot-s1")
     stage, _ = derived_second_stage(tube, 0.05, (1.0, 1.0), 0.1, np.zeros(3))
-    for kwargs, field in (({"backend": "fortran"}, "backend"), ({"model": "blimp"}, "plant.model"),
-                          ({"model": "two-link-arm"}, "plant.model"),
-                          ({"params": [1.0, 2.0]}, "params"),
-                          ({"initial_velocity": [0.0]}, "initial.velocity"),
-                          ({"horizon": -1.0}, "horizon")):
+    second = as_double_integrator(spec)
+    for call, field in (
+            (lambda: run_closed_loop(second, tube, stage=stage, backend="fortran"), "backend"),
+            (lambda: run_closed_loop(second, tube, stage=stage, horizon=-1.0), "horizon"),
+            (lambda: run_closed_loop(second, tube), "stage"),            # no second stage
+            (lambda: run_closed_loop(spec, tube, stage=stage), "stage"),  # first order
+            (lambda: run_closed_loop(second, tube, stage=stage,          # n states, not 2n
+                                     plant=make_plant(
+                                         "single-integrator", 3, 0.1)), "plant"),
+            (lambda: second_order_plant("blimp", 3, [1.0], 0.1), "plant.model"),
+            (lambda: second_order_plant("two-link-arm", 3, [1.0] * 7, 0.1), "plant.model"),
+            (lambda: second_order_plant("double-integrator", 3, [1.0, 2.0], 0.1),
+             "plant.parameters")):
         with pytest.raises(SpecError) as info:
-            simulate_second_order(spec, tube, stage, **kwargs)
+            call()
         assert info.value.field == field
 
 
@@ -58,8 +67,8 @@ def test_bad_simulation_input_names_the_field() -> None:
 @pytest.mark.parametrize("mass", MASS_RANGE)
 def test_double_integrator_in_the_s1_arena_is_satisfied_with_the_c_backend(mass) -> None:
     spec, design, stage = planar_s1()
-    result = simulate_second_order(spec, design.tube, stage, model="double-integrator",
-                                   params=[mass], backend="c", seed=3)
+    result = run_closed_loop(as_double_integrator(spec, mass), design.tube, stage=stage,
+                             backend="c", seed=3)
     assert result.satisfied, result.to_json()
     assert result.stayed_in_tube and result.stayed_in_velocity_tube
     assert result.reach_time <= spec.prescribed_time
@@ -70,14 +79,16 @@ def test_double_integrator_in_the_s1_arena_is_satisfied_with_the_c_backend(mass)
 @needs_cc
 def test_backends_agree_on_the_closed_loop() -> None:
     spec, design, stage = planar_s1()
-    runs = {b: simulate_second_order(spec, design.tube, stage, params=[1.0], backend=b,
-                                     horizon=0.3)
+    runs = {b: run_closed_loop(as_double_integrator(spec), design.tube, stage=stage,
+                               backend=b, horizon=0.3)
             for b in ("reference", "casadi", "python", "c")}
     base = runs["casadi"].trajectory
     for name in ("python", "c"):     # printed from the same Function: the same bits
         assert np.array_equal(runs[name].trajectory.u, base.u), name
     np.testing.assert_allclose(runs["reference"].trajectory.u, base.u, rtol=1e-9, atol=1e-9)
-    np.testing.assert_allclose(runs["reference"].trajectory.x1, base.x1, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(runs["reference"].trajectory.x, base.x, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(runs["reference"].trajectory.velocity, base.velocity, rtol=0,
+                               atol=1e-9)
 
 
 @pytest.mark.slow
@@ -89,9 +100,8 @@ def test_quadrotor_among_pillars_is_satisfied(mass) -> None:
     drift = 9.81 + 0.4 * 3.0 / 0.8 + 0.2       # gravity, drag at 3 m/s for 0.8 kg, |w|
     stage, _ = derived_second_stage(design.tube, design.check.min_width, (1 / 1.6, 1 / 0.8),
                                     drift, np.zeros(3))
-    result = simulate_second_order(spec, design.tube, stage, model="quadrotor",
-                                   params=[mass, 0.4, 9.81], disturbance_amplitude=0.2,
-                                   backend="c")
+    plant = second_order_plant("quadrotor", 3, [mass, 0.4, 9.81], 0.2)
+    result = run_closed_loop(spec, design.tube, stage=stage, plant=plant, backend="c")
     assert result.satisfied and result.stayed_in_velocity_tube, result.to_json()
     # hovering needs m g0 in the vertical thrust
     assert result.max_abs_u[2] >= mass * 9.81

@@ -7,7 +7,6 @@ import pytest
 
 import stt_codegen as stt
 from stt_codegen.embedded.cascade_loop import MEASURED_STEPS, run_cascade_embedded
-from stt_codegen.runtime.cascade_simulate import simulate_cascade
 
 
 @pytest.mark.embedded
@@ -19,7 +18,7 @@ def test_cascade_on_the_cortex_m4f_is_satisfied_like_the_host(case) -> None:
     assert report["outside_position"] == report["outside_velocity"] == report["invalid"] == 0
     assert len(report["instructions_per_step"]) == MEASURED_STEPS + 1
     assert all(1000 < c < 20000 for c in report["instructions_per_step"])
-    host = simulate_cascade(design, backend="c")       # double controller, same plant
+    host = stt.simulate(design, backend="c")       # double controller, same plant
     assert abs(report["reach_time"] - host.reach_time) <= 0.01
     assert abs(report["min_clearance"] - host.min_obstacle_clearance) <= 1e-3
-    np.testing.assert_allclose(report["final_state"], host.trajectory.x1[-1], atol=1e-3)
+    np.testing.assert_allclose(report["final_state"], host.trajectory.x[-1], atol=1e-3)

@@ -4,7 +4,7 @@ beside a planner and a tracker for the same plant (docs/second-order.md).
 The arenas are :func:`~.arenas.generate_arena`'s (seeded, four 1 m obstacles, 5 m x 5 m,
 ``t_c = 9`` s). The plant is a double integrator ``x2_dot = u / m + w`` with ``m = 1`` kg
 and the arena's disturbance bound (0.1 per axis, here m/s^2), starting at rest; both
-methods run in the same loop (:func:`~stt_codegen.runtime.cascade_simulate.simulate_second_order`)
+methods run in the same loop (:func:`~stt_codegen.runtime.simulate.run_closed_loop`)
 with the same disturbance seed (the arena index), judged by Definition 2.1:
 
 * ``stt``: the tube of the arena's spec with ``circumvent_sharpness = 1`` (a second-order
@@ -25,11 +25,13 @@ import numpy as np
 from ..design.cascade_gain import derived_second_stage
 from ..design.search import design_tube
 from ..errors import DesignError
-from ..runtime.cascade_simulate import simulate_second_order
+from ..runtime.simulate import run_closed_loop
+from ..spec.loader import Spec
+from ..spec.second_order import SecondOrder
 from .arenas import generate_arena
 
-__all__ = ["format_double_integrator_report", "run_arena_double_integrator",
-           "run_double_integrator_bench"]
+__all__ = ["double_integrator_spec", "format_double_integrator_report",
+           "run_arena_double_integrator", "run_double_integrator_bench"]
 
 #: Velocity-loop gain of the baseline tracker, 1/s.
 VELOCITY_GAIN = 10.0
@@ -41,7 +43,8 @@ SHARPNESS = 1.0
 
 class VelocityTracker:
     """Carrot following as a velocity reference plus a proportional velocity loop (the
-    step of :class:`~stt_codegen.runtime.cascade_controllers.CascadeController`)."""
+    controller step of :func:`~stt_codegen.runtime.backends.make_controller`, on
+    ``x = [x1; x2]``)."""
 
     name = "astar-tracker"
 
@@ -49,10 +52,32 @@ class VelocityTracker:
         from .tracker import PathTracker
         self.carrot = PathTracker(path)
 
-    def step(self, x1, x2, t, dt, alpha):
-        """``u``, ``alpha`` (passed through), the velocity reference and status 0."""
-        v_ref = self.carrot.command(np.asarray(x1, float))
-        return VELOCITY_GAIN * (v_ref - np.asarray(x2, float)), np.asarray(alpha, float), v_ref, 0
+    def step(self, x, t, dt, alpha):
+        """``u``, ``alpha`` (passed through) and status 0 (``Status.OK``)."""
+        x = np.asarray(x, float)
+        n = x.size // 2
+        v_ref = self.carrot.command(x[:n])
+        return VELOCITY_GAIN * (v_ref - x[n:]), np.asarray(alpha, float), 0
+
+
+def double_integrator_spec(spec: Spec) -> Spec:
+    """The arena's spec with a unit-mass double integrator as its plant.
+
+    Parameters
+    ----------
+    spec : Spec
+        A first-order arena spec (:func:`~.arenas.generate_arena`).
+
+    Returns
+    -------
+    Spec
+        ``spec`` whose plant is ``x2_dot = u / m + w`` with ``m = 1`` kg, at rest at
+        ``x(0)``, with the declared ``1/m`` range :data:`INPUT_GAIN`.
+    """
+    plant = SecondOrder(model="double-integrator", parameters=(1.0,),
+                        initial_velocity=(0.0,) * spec.dimension, velocity_bound=None,
+                        input_gain=INPUT_GAIN, drift_bound=0.0)
+    return replace(spec, second_order=plant)
 
 
 def _summary(result) -> dict:
@@ -95,8 +120,8 @@ def run_arena_double_integrator(seed: int, index: int) -> dict:
     else:
         stage, _ = derived_second_stage(design.tube, design.check.min_width, INPUT_GAIN,
                                         spec.disturbance_amplitude, np.zeros(2))
-        result = simulate_second_order(spec, design.tube, stage, params=[1.0], backend="c",
-                                       seed=index)
+        result = run_closed_loop(double_integrator_spec(spec), design.tube, stage=stage,
+                                 backend="c", seed=index)
         out["stt"] = {**_summary(result), "seconds": design.design_time_s}
     plan = plan_astar(spec)
     if plan.path is None:
@@ -107,9 +132,9 @@ def run_arena_double_integrator(seed: int, index: int) -> dict:
         # (unchecked); the tracker never reads it
         from ..design.search import base_design
         tube = design.tube if design is not None else base_design(spec)
-        result = simulate_second_order(spec, tube, None, params=[1.0],
-                                       backend="astar-tracker", seed=index,
-                                       controller=VelocityTracker(plan.path))
+        result = run_closed_loop(double_integrator_spec(spec), tube,
+                                 backend="astar-tracker", seed=index,
+                                 controller=VelocityTracker(plan.path))
         summary = _summary(result)
         summary.pop("in_tube")
         out["astar"] = {**summary, "seconds": plan.seconds}

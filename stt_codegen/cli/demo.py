@@ -50,12 +50,8 @@ def cmd_demo(args: argparse.Namespace) -> int:
         design = design_spec(spec, args)
         generate(design, out / name)
         result = simulate(design, backend=args.backend)   # the cascade's for second order
-        if spec.second_order is not None:   # the cascade law
-            from ..runtime.cascade_plots import plot_cascade_run
-            draw = plot_cascade_run
-        else:
-            draw = plot_run
-        atomic_write(out / f"{name}.png", lambda tmp: draw(design, result, tmp, dims=dims[name]))
+        atomic_write(out / f"{name}.png",
+                     lambda tmp: plot_run(design, result, tmp, dims=dims[name]))
         print(summary_line(result), flush=True)
         all_ok &= result.satisfied
     print(f"generated code in {out}/<case>/, plots in {out}/<case>.png")

@@ -19,7 +19,7 @@ def summary_line(result) -> str:
 
     Parameters
     ----------
-    result : SimulationResult or CascadeResult
+    result : SimulationResult
         One closed-loop run.
 
     Returns
@@ -64,9 +64,6 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     result = simulate(design, backend=args.backend, horizon=args.horizon, seed=seed)
 
     def draw(path):
-        if design.spec.second_order is not None:
-            from ..runtime.cascade_plots import plot_cascade_run
-            return plot_cascade_run(design, result, path, dims=dims)
         from ..runtime.plots import plot_run
         return plot_run(design, result, path, dims=dims)
     write_plot(args, draw)
@@ -79,8 +76,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         print(summary_line(result))
         print(f"backend {result.backend}, {result.steps} steps at {design.tube.rate_hz:g} Hz, "
               f"t_c = {result.prescribed_time:g} s, "
-              + (f"gain k = {design.gain:.4g}, " if design.spec.second_order is None else
-                 "cascade law, stayed in velocity tube: "
+              + (f"gain k = {design.gain:.4g}, " if result.stayed_in_velocity_tube is None
+                 else "cascade law, stayed in velocity tube: "
                  f"{'yes' if result.stayed_in_velocity_tube else 'NO'}, ") +
               f"stayed in tube: {'yes' if result.stayed_in_tube else 'NO'}, "
               f"collision: {'YES' if result.collision else 'no'}, "

@@ -7,7 +7,7 @@
 * a closed-loop program: the plant (:func:`stt_codegen.runtime.second_order_plants.second_order_rhs`
   printed by the emitter's C printer, in double), the disturbance of
   :class:`stt_codegen.runtime.plants.Disturbance` (same seed, same sinusoids), RK4 with
-  :data:`stt_codegen.runtime.cascade_simulate.SUBSTEPS` substeps per period, judged on box
+  :data:`stt_codegen.runtime.simulate.SUBSTEPS` substeps per period, judged on box
   obstacles, the state space, the target and the velocity bound;
 
 and runs it under ``qemu-system-arm -machine mps2-an386`` twice: the whole run
@@ -30,7 +30,7 @@ from ..codegen.cascade_source import cascade_c_files
 from ..codegen.emit import c_source
 from ..design.result import Design
 from ..errors import SpecError, ToolchainError
-from ..runtime.cascade_simulate import SUBSTEPS
+from ..runtime.simulate import SUBSTEPS
 from ..runtime.plants import Disturbance
 from ..runtime.second_order_plants import second_order_rhs
 from .target import build_elf, elf_sizes, run_qemu

@@ -2,7 +2,10 @@
 
 Every backend computes the same step, ``(x, t, dt, alpha) -> (u, alpha_next, status)``,
 from a different implementation: the numpy reference, CasADi's own evaluation, or the
-generated code. New backends register a factory with :func:`register_backend`.
+generated code. The step is the same for both orders of plant: for a first-order plant
+``x`` is its state (n) and the step is law (13); for a second-order plant ``x`` is
+``[x1; x2]`` (2n) and the step is the cascade law (docs/second-order.md), whose factories
+also take the second stage. New backends register a factory with :func:`register_backend`.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ from ..tube import reference
 from ..errors import SpecError
 from ..tube.parameters import (STATUS_INPUT_CLAMPED, STATUS_INVALID_INPUT, STATUS_OK,
                                STATUS_OUTSIDE_TUBE, TubeDesign)
+from ..tube.second_stage import SecondStage
 
 __all__ = ["STATUS_INPUT_CLAMPED", "STATUS_INVALID_INPUT", "STATUS_OK", "STATUS_OUTSIDE_TUBE",
            "Controller",
@@ -29,7 +33,9 @@ class Controller(Protocol):
 
     def step(self, x: np.ndarray, t: float, dt: float,
              alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
-        """Return ``u`` (n,), ``alpha_next`` (2n,) and a status code."""
+        """Return ``u`` (n,), ``alpha_next`` (2n,) and a status code
+        (:class:`~stt_codegen.tube.parameters.Status`); ``x`` is the plant's state (n, or
+        2n for a second-order plant)."""
 
 
 class ReferenceController:
@@ -72,62 +78,106 @@ def _generated_python(design: TubeDesign) -> Controller:
     return GeneratedPythonController(design)
 
 
-_FACTORIES: dict[str, Callable[[TubeDesign], Controller]] = {
-    "reference": ReferenceController,
-    "casadi": CasadiController,
-    "c": _generated_c,
-    "python": _generated_python,
+def _cascade(backend: str) -> Callable[[TubeDesign, SecondStage], Controller]:
+    def factory(design: TubeDesign, stage: SecondStage) -> Controller:
+        from .cascade_controllers import CascadeController
+        return CascadeController(backend, design, stage)
+    return factory
+
+
+#: Factories by plant order, then by backend name: order 1 ``factory(design)``, order 2
+#: ``factory(design, stage)``.
+_FACTORIES: dict[int, dict[str, Callable[..., Controller]]] = {
+    1: {"reference": ReferenceController,
+        "casadi": CasadiController,
+        "c": _generated_c,
+        "python": _generated_python},
+    2: {name: _cascade(name) for name in ("reference", "casadi", "c", "python")},
 }
 
 
-def register_backend(name: str, factory: Callable[[TubeDesign], Controller]) -> None:
-    """Make ``factory(design)`` available as backend ``name``.
+def _order(order: int) -> dict[str, Callable[..., Controller]]:
+    if order not in _FACTORIES:
+        raise SpecError("order", f"a plant's order is 1 or 2, got {order!r}")
+    return _FACTORIES[order]
+
+
+def register_backend(name: str, factory: Callable[..., Controller], *, order: int = 1) -> None:
+    """Make ``factory`` available as backend ``name`` for plants of one order.
 
     Parameters
     ----------
     name : str
-        The backend's name (``--backend``); an existing name is replaced.
+        The backend's name (``--backend``); an existing name of that order is replaced.
     factory : callable
-        ``factory(design)`` builds the :class:`Controller` for a
-        :class:`~stt_codegen.tube.parameters.TubeDesign`.
+        Order 1: ``factory(design)`` builds the :class:`Controller` for a
+        :class:`~stt_codegen.tube.parameters.TubeDesign`. Order 2: ``factory(design,
+        stage)``, with the cascade's :class:`~stt_codegen.tube.second_stage.SecondStage`.
+    order : {1, 2}, optional
+        The plant order the backend serves (default 1).
+
+    Raises
+    ------
+    SpecError
+        ``order`` is not 1 or 2 (field ``order``).
     """
-    _FACTORIES[name] = factory
+    _order(order)[name] = factory
 
 
-def backend_names() -> list[str]:
-    """The registered backend names, in registration order.
+def backend_names(order: int = 1) -> list[str]:
+    """The registered backend names of one plant order, in registration order.
+
+    Parameters
+    ----------
+    order : {1, 2}, optional
+        The plant order (default 1).
 
     Returns
     -------
     list of str
         ``"reference"``, ``"casadi"``, ``"c"``, ``"python"``, then any registered later.
+
+    Raises
+    ------
+    SpecError
+        ``order`` is not 1 or 2 (field ``order``).
     """
-    return list(_FACTORIES)
+    return list(_order(order))
 
 
-def make_controller(name: str, design: TubeDesign) -> Controller:
+def make_controller(name: str, design: TubeDesign,
+                    stage: SecondStage | None = None) -> Controller:
     """The controller of backend ``name`` for a design.
 
     Parameters
     ----------
     name : str
-        A name of :func:`backend_names`.
+        A name of :func:`backend_names` of the plant's order.
     design : TubeDesign
         The tube and gain the controller runs.
+    stage : SecondStage, optional
+        The cascade's second stage: given for a second-order plant (the cascade law),
+        ``None`` for a first-order one (law (13)).
 
     Returns
     -------
     Controller
-        ``step(x, t, dt, alpha) -> (u, alpha_next, status)``: ``x`` (n,) state units, ``t``
-        and ``dt`` in s, ``alpha`` (2n,); ``u`` (n,) input units by law (13), ``alpha_next``
-        (2n,) by the implicit step of the adaptive law (11), ``status`` a ``STATUS_*`` code.
+        ``step(x, t, dt, alpha) -> (u, alpha_next, status)``: ``x`` (n,) state units, or
+        ``[x1; x2]`` (2n,) for a second-order plant; ``t`` and ``dt`` in s, ``alpha``
+        (2n,); ``u`` (n,) input units, ``alpha_next`` (2n,) by the implicit step of the
+        adaptive law (11), ``status`` a :class:`~stt_codegen.tube.parameters.Status`.
 
     Raises
     ------
     SpecError
-        Unknown backend (field ``backend``).
+        Unknown backend for the plant's order (field ``backend``).
+    ToolchainError
+        Backend ``"c"``: no C compiler, or it failed.
     """
-    if name not in _FACTORIES:
-        raise SpecError("backend", f"unknown backend {name!r} "
-                                     f"(known: {', '.join(_FACTORIES)})")
-    return _FACTORIES[name](design)
+    order = 1 if stage is None else 2
+    factories = _order(order)
+    if name not in factories:
+        kind = "a first-order" if order == 1 else "a second-order"
+        raise SpecError("backend", f"unknown backend {name!r} for {kind} plant "
+                                   f"(known: {', '.join(factories)})")
+    return factories[name](design) if stage is None else factories[name](design, stage)

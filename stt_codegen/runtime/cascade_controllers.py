@@ -1,7 +1,8 @@
 """Backends of the cascade step for second-order plants (docs/second-order.md).
 
-Every backend computes ``(x1, x2, t, dt, alpha) -> (u, alpha_next, r, status)`` of
-:func:`stt_codegen.tube.cascade.cascade_step`: ``reference`` (the numpy oracle,
+Every backend computes the controller step of both orders, ``(x, t, dt, alpha) -> (u,
+alpha_next, status)``, here with the plant's state ``x = [x1; x2]`` (2n: positions, then
+velocities), from :func:`stt_codegen.tube.cascade.cascade_step`: ``reference`` (the numpy oracle,
 :mod:`stt_codegen.tube.cascade_reference`), ``casadi`` (CasADi's evaluation of the
 Function), ``python`` (the Function printed to Python by the emitter) and ``c`` (printed to
 C by the emitter, :mod:`stt_codegen.codegen.cascade_source`, compiled with the system's C
@@ -20,8 +21,7 @@ import numpy as np
 from ..codegen.emit import python_function
 from ..errors import SpecError
 from ..tube import cascade_reference
-from ..tube.parameters import TubeDesign
-from ..tube.parameters import Status
+from ..tube.parameters import Status, TubeDesign
 from ..tube.second_stage import SecondStage
 
 __all__ = ["CascadeController"]
@@ -81,14 +81,35 @@ class CascadeController:
                                              t, dt, alpha[None])
         return [np.ravel(v) for v in out]
 
-    def step(self, x1: np.ndarray, x2: np.ndarray, t: float, dt: float,
-             alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
-        """``u`` (n,), ``alpha_next`` (2n,), ``r`` (n,) and the :class:`~stt_codegen.tube.parameters.Status`."""
-        u, alpha_next, r, inside_p, inside_v = self._call(
-            np.asarray(x1, dtype=float), np.asarray(x2, dtype=float), float(t), float(dt),
-            np.asarray(alpha, dtype=float))
-        return u, alpha_next, r, _status(float(np.ravel(inside_p)[0]),
-                                         float(np.ravel(inside_v)[0]))
+    def step(self, x: np.ndarray, t: float, dt: float,
+             alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+        """One cascade step.
+
+        Parameters
+        ----------
+        x : array_like, shape (2n,)
+            The plant's state ``[x1; x2]``: positions (state units), then velocities
+            (state units per second).
+        t, dt : float
+            The sampling instant and period, s.
+        alpha : array_like, shape (2n,)
+            The adaptive law's ``alpha`` (eq. (11)).
+
+        Returns
+        -------
+        u : ndarray, shape (n,)
+            The input, input units.
+        alpha_next : ndarray, shape (2n,)
+            ``alpha`` at ``t + dt``.
+        status : Status
+            :class:`~stt_codegen.tube.parameters.Status` of the step.
+        """
+        x = np.asarray(x, dtype=float)
+        n = self._n
+        u, alpha_next, _r, inside_p, inside_v = self._call(
+            x[:n], x[n:], float(t), float(dt), np.asarray(alpha, dtype=float))
+        return u, alpha_next, _status(float(np.ravel(inside_p)[0]),
+                                      float(np.ravel(inside_v)[0]))
 
 
 def _compiled(design: TubeDesign, stage: SecondStage):

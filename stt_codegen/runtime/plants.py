@@ -19,8 +19,9 @@ from ..errors import SpecError
 from ..spec.loader import LinearPlant
 from ..spec.plants import PLANTS, dimension_mismatch
 from .dynamics import linear_rhs, plant_rhs
+from .second_order_plants import model_info, second_order_rhs
 
-__all__ = ["Disturbance", "check_seed", "make_plant"]
+__all__ = ["Disturbance", "check_seed", "make_plant", "second_order_plant", "spec_plant"]
 
 #: Number of sinusoids summed in each disturbance component.
 DISTURBANCE_TERMS = 3
@@ -186,3 +187,86 @@ def make_plant(model: str, dimension: int, amplitude: float, seed: int = 0,
     if model == "single-integrator":
         return single_integrator(dimension, disturbance)
     raise SpecError("plant.model", f"unknown model {model!r}")
+
+
+def second_order_plant(model: str, dimension: int, parameters, amplitude: float,
+                       seed: int = 0) -> ct.NonlinearIOSystem:
+    """A second-order plant ``x1_dot = x2``, ``x2_dot = f + g u + w(t)``, as one system.
+
+    Its state is ``[x1; x2]`` (``2 n`` states: positions, then velocities); ``f + g u`` is
+    :func:`.second_order_plants.second_order_rhs`, printed to Python, and the seeded
+    disturbance ``w`` acts on ``x2_dot``.
+
+    Parameters
+    ----------
+    model : str
+        One of :data:`stt_codegen.spec.plants.SECOND_ORDER_MODELS`.
+    dimension : int
+        Positions ``n`` (= velocities = inputs).
+    parameters : sequence of float
+        The model's physical parameters (:data:`stt_codegen.spec.plants.SECOND_ORDER_PLANTS`).
+    amplitude : float
+        Bound on every ``|w_i|``, velocity units per second.
+    seed : int
+        Seed of the disturbance, in ``[0, 2**32)``.
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        ``2 n`` states, ``n`` inputs, the state as output.
+
+    Raises
+    ------
+    SpecError
+        Unknown model or a dimension it does not have (field ``plant.model``), or a
+        parameter count it does not take (``plant.parameters``).
+    """
+    try:
+        info = model_info(model, dimension)
+    except ValueError as exc:
+        raise SpecError("plant.model", str(exc)) from None
+    params = [float(v) for v in parameters]
+    if len(params) != len(info.parameters):
+        raise SpecError("plant.parameters", f"model {model!r} takes {len(info.parameters)} "
+                                            f"parameters ({', '.join(info.parameters)})")
+    rhs_fn = python_function(second_order_rhs(model, dimension))
+    disturbance = Disturbance(dimension, amplitude, seed)
+    n = dimension
+
+    def rhs(t, s, u, _params):
+        d1, d2 = rhs_fn(s[:n].tolist(), s[n:].tolist(), np.asarray(u).tolist(),
+                        disturbance(t).tolist(), params)
+        return np.concatenate([d1, d2])
+
+    states = [f"x1_{i + 1}" for i in range(n)] + [f"x2_{i + 1}" for i in range(n)]
+    return ct.nlsys(rhs, None, inputs=n, states=states, outputs=states,
+                    name=f"second_order_{model.replace('-', '_')}")
+
+
+def spec_plant(spec, seed: int = 0) -> ct.NonlinearIOSystem:
+    """The plant a spec names (``[plant]``), of the spec's order.
+
+    Parameters
+    ----------
+    spec : Spec
+        Its ``plant.model`` (and, for a second-order model, ``plant.parameters``) and
+        ``disturbance_amplitude``.
+    seed : int
+        Seed of the disturbance, in ``[0, 2**32)``.
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        :func:`make_plant` (``n`` states) or :func:`second_order_plant` (``2 n`` states).
+
+    Raises
+    ------
+    SpecError
+        As :func:`make_plant` and :func:`second_order_plant`.
+    """
+    order = spec.second_order
+    if order is None:
+        return make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed,
+                          spec.linear_plant)
+    return second_order_plant(order.model, spec.dimension, order.parameters,
+                              spec.disturbance_amplitude, seed)

@@ -431,8 +431,7 @@ def plot_run(design: Design, result: SimulationResult, path: str | Path, *,
     ------
     TypeError
         ``design`` is not a :class:`~stt_codegen.design.result.Design`, or ``result`` is
-        a second-order run (a ``CascadeResult``: draw it with
-        :func:`stt_codegen.runtime.cascade_plots.plot_cascade_run`).
+        not a :class:`~stt_codegen.runtime.simulate.SimulationResult`.
     SpecError
         ``dims`` is not two distinct dimensions of the state space (field ``dims``).
 
@@ -451,11 +450,8 @@ def plot_run(design: Design, result: SimulationResult, path: str | Path, *,
     """
     design = require_design(design, "plot_run")
     if not isinstance(result, SimulationResult):
-        hint = (": a second-order run, drawn by stt_codegen.runtime.cascade_plots."
-                "plot_cascade_run(design, result, path)" if design.spec.second_order
-                is not None else "")
         raise TypeError(f"plot_run(): parameter 'result' must be a SimulationResult, not "
-                        f"{type(result).__name__}{hint}")
+                        f"{type(result).__name__}")
     return save(run_figure(design, result, dims), path)
 
 

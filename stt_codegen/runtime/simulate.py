@@ -1,10 +1,15 @@
 """Closed-loop simulation: a sampled controller on a continuous plant, and Definition 2.1.
 
-The controller runs at ``rate_hz``: at each sampling instant ``t_k`` it reads ``x(t_k)``,
-computes ``u_k`` and its next ``alpha``; ``u_k`` is held until ``t_{k+1}``. The plant, a
-python-control ``NonlinearIOSystem``, is integrated over each hold interval by the
-classical Runge-Kutta method with :data:`SUBSTEPS` steps (its accuracy against an
-adaptive solver at tight tolerance is tested).
+One loop for both orders of plant. The controller runs at ``rate_hz``: at each sampling
+instant ``t_k`` it reads the plant's state ``x(t_k)`` (a first-order plant's ``n``
+states, or a second-order plant's positions and velocities ``[x1; x2]``), computes ``u_k``
+and its next ``alpha`` (law (13), or the cascade law of docs/second-order.md); ``u_k`` is
+held until ``t_{k+1}``. The plant, a python-control ``NonlinearIOSystem``
+(:func:`~stt_codegen.runtime.plants.spec_plant`), is integrated over each hold interval by
+the classical Runge-Kutta method with :data:`SUBSTEPS` steps (its accuracy against an
+adaptive solver at tight tolerance is tested). Definition 2.1 is judged on the positions
+(the spec's state space), the same way for both orders: target, obstacles (moving ones
+where they are), state space, ``[[tasks]]``; a second-order run also on its velocities.
 """
 
 from __future__ import annotations
@@ -16,14 +21,15 @@ import numpy as np
 
 import control as ct
 
-from .backends import STATUS_INPUT_CLAMPED, STATUS_OK, make_controller
+from .backends import Controller, make_controller
 from ..design.result import Design, require_design
 from ..design.samples import check_step_budget
 from ..errors import SpecError
-from .plants import check_seed, make_plant
+from .plants import check_seed, spec_plant
 from ..spec.loader import Spec
-from ..tube import reference
-from ..tube.parameters import TubeDesign
+from ..tube import cascade_reference, reference
+from ..tube.parameters import Status, TubeDesign
+from ..tube.second_stage import SecondStage
 from .tasks import TaskOutcome, judge_tasks
 
 __all__ = ["SUBSTEPS", "SimulationResult", "Trajectory", "run_closed_loop", "simulate"]
@@ -41,13 +47,21 @@ class Trajectory:
     t : ndarray, shape (N,)
         Sampling instants ``t_k = k / rate_hz``, s.
     x : ndarray, shape (N, n)
-        The state at ``t_k``, state units.
+        The positions at ``t_k`` (the spec's state space: a first-order plant's state, a
+        second-order plant's ``x1``), state units.
     u : ndarray, shape (N, n)
-        The input of law (13) computed at ``t_k`` and held until ``t_{k+1}``, input units.
+        The input computed at ``t_k`` and held until ``t_{k+1}``, input units.
     alpha : ndarray, shape (N, 2n)
         The adaptive law's ``alpha`` (eq. (11)) used at ``t_k``.
     status : ndarray of int, shape (N,)
-        The step's status code (:data:`~stt_codegen.runtime.backends.STATUS_OK`...).
+        The step's :class:`~stt_codegen.tube.parameters.Status` code.
+    velocity : ndarray, shape (N, n), or None
+        Second-order plant: the velocities ``x2(t_k)``, state units per second; ``None``
+        for a first-order plant.
+    r : ndarray, shape (N, n), or None
+        Second-order plant: the cascade's virtual velocity ``r`` at ``t_k`` (the centre of
+        the velocity tube, from the numpy oracle at the run's states), state units per
+        second; ``None`` for a first-order plant or a controller without a second stage.
     """
 
     t: np.ndarray
@@ -55,6 +69,8 @@ class Trajectory:
     u: np.ndarray
     alpha: np.ndarray
     status: np.ndarray
+    velocity: np.ndarray | None = None
+    r: np.ndarray | None = None
 
 
 @dataclass
@@ -66,8 +82,8 @@ class SimulationResult:
     spec, backend : str
         The spec's name and the backend that ran the controller.
     satisfied : bool
-        ``reached`` and not ``collision`` and not ``left_state_space`` (and every task of
-        ``tasks`` met).
+        ``reached`` and not ``collision`` and not ``left_state_space`` and not
+        ``exceeded_velocity_bound`` (and every task of ``tasks`` met).
     reached : bool
         The state entered the target set no later than ``t_c``.
     reach_time : float or None
@@ -83,8 +99,8 @@ class SimulationResult:
     left_state_space : bool
         The state left the state space on ``[0, t_c]``.
     stayed_in_tube : bool
-        Every controller step on ``[0, horizon]`` reported the state inside the tube
-        (``STATUS_OK``, or ``STATUS_INPUT_CLAMPED``: inside, ``u`` clamped).
+        Every controller step on ``[0, horizon]`` reported the positions inside the tube
+        (no ``OUTSIDE_TUBE`` or ``INVALID_INPUT`` status).
     max_abs_e : float or None
         ``max_k max_i |e_i(t_k)|`` over the controller steps on ``[0, horizon]``, the
         normalized error ``e = (2 x - (gamma_U + gamma_L)) / (gamma_U - gamma_L)`` of the
@@ -106,6 +122,16 @@ class SimulationResult:
         ``satisfied`` also needs every one met. Empty without tasks.
     trajectory : Trajectory or None
         The sampled signals.
+    stayed_in_velocity_tube : bool or None
+        Second-order plant: every step also had the velocity error inside its tube,
+        ``|x2 - r| < rho2`` (status ``OK`` or ``INPUT_CLAMPED`` throughout); ``None`` for a
+        first-order plant.
+    max_abs_velocity : list of float or None
+        Second-order plant: peak sampled ``|x2_i|``, state units per second; ``None`` for a
+        first-order plant.
+    exceeded_velocity_bound : bool
+        Some sampled ``|x2_i|`` on ``[0, t_c]`` reached the spec's
+        ``state_space.velocity_bound`` (then not ``satisfied``); ``False`` without a bound.
     """
 
     spec: str
@@ -125,14 +151,21 @@ class SimulationResult:
     clamped_steps: int = 0
     trajectory: Trajectory | None = field(default=None, repr=False)
     tasks: list[TaskOutcome] = field(default_factory=list)
+    stayed_in_velocity_tube: bool | None = None
+    max_abs_velocity: list[float] | None = None
+    exceeded_velocity_bound: bool = False
 
     def to_json(self) -> dict:
         """The result as a JSON-ready dict (without the trajectory; ``tasks`` only for a
-        spec with ``[[tasks]]``)."""
+        spec with ``[[tasks]]``; the velocity fields only for a second-order plant)."""
         data = asdict(self)
         data.pop("trajectory")
         if not data["tasks"]:
             data.pop("tasks")
+        if data["max_abs_velocity"] is None:
+            for key in ("stayed_in_velocity_tube", "max_abs_velocity",
+                        "exceeded_velocity_bound"):
+                data.pop(key)
         return data
 
 
@@ -166,7 +199,10 @@ def simulate(design: Design, *positional: object, backend: str = "reference",
     ``alpha`` by the implicit step of the adaptive law (11); ``u_k`` is held until
     ``t_{k+1}`` while the plant (eq. (14), ``x_dot = u + w`` or the spec's linear plant,
     with the spec's seeded, bounded disturbance ``w``) is integrated by Runge-Kutta. The
-    run starts at ``x(0)`` (``initial.state``) with ``alpha = 0``.
+    run starts at ``x(0)`` (``initial.state``) with ``alpha = 0``. For a spec with a
+    second-order ``plant.model`` the same loop runs the cascade law (docs/second-order.md)
+    with the design's second stage (:attr:`~stt_codegen.design.result.Design.second_stage`)
+    on ``[x1; x2]``, from ``x2(0) = initial.velocity``.
 
     Parameters
     ----------
@@ -189,21 +225,20 @@ def simulate(design: Design, *positional: object, backend: str = "reference",
     seed : int, optional
         Seed of the disturbance ``w``: an integer (Python or numpy) in ``[0, 2**32)``.
     plant : control.NonlinearIOSystem, optional
-        The plant to control instead of the spec's ``[plant]`` (``n`` states, inputs and
-        outputs, the state as output); it must include its own disturbance.
+        The plant to control instead of the spec's ``[plant]``, of the spec's order
+        (``n`` states, or ``2 n`` for a second-order spec: positions then velocities;
+        ``n`` inputs; the state as output); it must include its own disturbance.
 
     Returns
     -------
     SimulationResult
-        For a spec with a second-order ``plant.model``, the cascade law's run instead
-        (:func:`stt_codegen.runtime.cascade_simulate.simulate_cascade`, a
-        :class:`~stt_codegen.runtime.cascade_simulate.CascadeResult` with the same fields
-        and the velocity stage's; ``plant`` must then be ``None``).
         ``satisfied`` (reach the target by ``t_c``, avoid every obstacle, stay in the
         state space), the reach time (s), the clearance (state units), ``max |u|`` per
         input, the control effort ``integral |u|^2 dt``, the steps the actuator clamp
         acted, and ``trajectory``: ``t`` (N,), ``x`` (N, n), ``u`` (N, n), ``alpha``
-        (N, 2n), ``status`` (N,), with ``N = ceil(horizon * rate_hz) + 1``.
+        (N, 2n), ``status`` (N,), with ``N = ceil(horizon * rate_hz) + 1`` (and, for a
+        second-order plant, ``velocity`` (N, n) and ``r`` (N, n), with the velocity
+        tube's verdict and the peak ``|x2|``).
 
     Raises
     ------
@@ -212,7 +247,8 @@ def simulate(design: Design, *positional: object, backend: str = "reference",
         or a ``Spec``, say): call :func:`stt_codegen.design_tube` first; or more than one
         positional argument.
     SpecError
-        Unknown backend (field ``backend``), a horizon that is not a positive number of
+        Unknown backend (field ``backend``), a ``plant`` without the spec's states and
+        inputs (field ``plant``), a horizon that is not a positive number of
         seconds (``horizon``), a seed that is not an integer in ``[0, 2**32)``
         (``seed``), or a run of more than
         :data:`~stt_codegen.design.samples.STEP_BUDGET` steps.
@@ -242,84 +278,107 @@ def simulate(design: Design, *positional: object, backend: str = "reference",
                         "(design.spec), and every other argument by keyword: "
                         "simulate(design, backend=..., horizon=..., seed=..., plant=...)")
     design = require_design(design, "simulate")
-    if design.spec.second_order is not None:     # the cascade law
-        if plant is not None:
-            raise SpecError("plant", "a second-order spec runs its own plant.model through "
-                                     "the cascade law; another plant cannot be given")
-        from .cascade_simulate import simulate_cascade
-        return simulate_cascade(design, backend=backend, horizon=horizon, seed=seed)
+    stage = design.second_stage[0] if design.spec.second_order is not None else None
     return run_closed_loop(design.spec, design.tube, backend=backend, horizon=horizon,
-                           seed=seed, plant=plant)
+                           seed=seed, plant=plant, stage=stage)
 
 
 def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
                     horizon: float | None = None, seed: int = 0,
-                    plant: ct.NonlinearIOSystem | None = None) -> SimulationResult:
+                    plant: ct.NonlinearIOSystem | None = None,
+                    stage: SecondStage | None = None,
+                    controller: Controller | None = None) -> SimulationResult:
     """The closed loop of :func:`simulate` for a spec and a tube given apart.
 
     For tubes that are not a design of their spec: the benchmarks' tracker runs on the
     spec's base parameters, the benchmark passes tubes between processes, and tests run
-    altered tubes (another gain). Not on the front door: there, :func:`simulate` takes a
-    :class:`~stt_codegen.design.result.Design`, which pairs the tube with its spec.
-    Parameters, result and errors are those of :func:`simulate`, with the spec and the
-    tube (:class:`~stt_codegen.tube.parameters.TubeDesign`) in place of the design.
+    altered tubes (another gain, another second stage). Not on the front door: there,
+    :func:`simulate` takes a :class:`~stt_codegen.design.result.Design`, which pairs the
+    tube with its spec. Parameters, result and errors are those of :func:`simulate`, with
+    the spec and the tube (:class:`~stt_codegen.tube.parameters.TubeDesign`) in place of
+    the design.
 
     Parameters
     ----------
     spec : Spec
-        The task: sets, ``t_c``, plant, disturbance bound.
+        The task: sets, ``t_c``, plant (its order: one or two), disturbance bound.
     tube : TubeDesign
         The tube and gain to run.
     backend, horizon, seed, plant
         As :func:`simulate`.
+    stage : SecondStage, optional
+        The cascade's second stage, for a second-order spec (required unless
+        ``controller`` is given); ``None`` for a first-order spec.
+    controller : Controller, optional
+        Another controller with the step of
+        :func:`~stt_codegen.runtime.backends.make_controller` (a baseline judged by the
+        same loop); ``backend`` is then only its label.
 
     Returns
     -------
     SimulationResult
         As :func:`simulate`.
+
+    Raises
+    ------
+    SpecError
+        As :func:`simulate`; a second stage given for a first-order spec, or missing for a
+        second-order one (field ``stage``).
     """
     seed = check_seed(seed)
     t_c = spec.prescribed_time
     horizon = t_c if horizon is None else _seconds(horizon)
-    check_step_budget(int(math.ceil(horizon * tube.rate_hz - 1e-9)), horizon, tube.rate_hz)
-    controller = make_controller(backend, tube)
+    steps = int(math.ceil(horizon * tube.rate_hz - 1e-9))
+    check_step_budget(steps, horizon, tube.rate_hz)
+    n = spec.dimension
+    order = spec.second_order
+    if (order is None) != (stage is None) and controller is None:
+        raise SpecError("stage", "a second-order spec runs the cascade law, which needs its "
+                                 "second stage (Design.second_stage)" if order is not None
+                        else "a first-order spec runs law (13), which has no second stage")
+    if controller is None:
+        controller = make_controller(backend, tube, stage)
+    x = np.array(spec.initial_state if order is None
+                 else [*spec.initial_state, *order.initial_velocity], dtype=float)
     if plant is None:
-        plant = make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed,
-                           spec.linear_plant)
+        plant = spec_plant(spec, seed)
+    elif (getattr(plant, "nstates", None), getattr(plant, "ninputs", None)) != (x.size, n):
+        raise SpecError("plant", f"must be a control.NonlinearIOSystem with {x.size} states "
+                                 f"and {n} inputs for this spec"
+                                 + (" (positions, then velocities)" if order is not None
+                                    else ""))
 
     def rhs(t, x, u):
         return plant.dynamics(t, x, u)
 
-    n = spec.dimension
     dt = 1.0 / tube.rate_hz
-    steps = int(math.ceil(horizon * tube.rate_hz - 1e-9))
     lo, hi = np.array(spec.state_space.lower), np.array(spec.state_space.upper)
     t_lo, t_hi = np.array(spec.target_set.lower), np.array(spec.target_set.upper)
 
     ts = np.arange(steps + 1) * dt
-    xs = np.zeros((steps + 1, n))
+    states = np.zeros((steps + 1, x.size))
     us = np.zeros((steps + 1, n))
     alphas = np.zeros((steps + 1, 2 * n))
     status = np.zeros(steps + 1, dtype=int)
-    x = np.array(spec.initial_state, dtype=float)
     alpha = np.zeros(2 * n)
-    dense = [x[None, :]]
+    dense = [x[None, :n]]
     dense_t = [np.zeros(1)]
+    h = dt / SUBSTEPS
     for k in range(steps + 1):
         t = ts[k]
-        xs[k], alphas[k] = x, alpha
+        states[k], alphas[k] = x, alpha
         u, alpha_next, code = controller.step(x, t, dt, alpha)
         us[k], status[k] = u, code
         if k == steps:
             break
-        h = dt / SUBSTEPS
         points = []
         for m in range(SUBSTEPS):
             x = _rk4(rhs, t + m * h, x, u, h)
-            points.append(x)
+            points.append(x[:n])
         dense.append(np.array(points))
         dense_t.append(t + h * np.arange(1, SUBSTEPS + 1))
         alpha = alpha_next
+    xs = states[:, :n]
     path = np.vstack(dense)
     path_t = np.concatenate(dense_t)
     judged = path_t <= t_c + 1e-12
@@ -340,20 +399,50 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
         min_clear, collision = None, False
     left = bool(np.any((within < lo) | (within > hi)))
     tasks = judge_tasks(spec, path_t, path)
+    velocity = _velocity_verdict(spec, tube, stage, ts, states, alphas, status, dt)
     satisfied = (reached and not collision and not left and horizon >= t_c
+                 and not velocity["exceeded_velocity_bound"]
                  and all(task.met for task in tasks))
     with reference.numpy_math():
         g_l, g_u, _, _ = reference.adaptive_tube(tube, ts, alphas)
     width = g_u - g_l
     max_abs_e = (float(np.max(np.abs(2.0 * xs - (g_u + g_l)) / width))
                  if np.all(width > 0.0) else None)
+    outside = (status == Status.OUTSIDE_TUBE) | (status == Status.INVALID_INPUT)
     return SimulationResult(
         spec=spec.name, backend=backend, satisfied=satisfied, reached=reached,
         reach_time=reach_time, prescribed_time=t_c, collision=collision,
         min_obstacle_clearance=min_clear, left_state_space=left,
-        stayed_in_tube=bool(np.all((status == STATUS_OK) | (status == STATUS_INPUT_CLAMPED))),
+        stayed_in_tube=not bool(np.any(outside)),
         max_abs_e=max_abs_e,
         max_abs_u=[float(v) for v in np.abs(us).max(axis=0)], steps=steps,
         control_effort=float(np.sum(us[:steps] ** 2) * dt),
-        clamped_steps=int(np.sum(status == STATUS_INPUT_CLAMPED)),
-        trajectory=Trajectory(ts, xs, us, alphas, status), tasks=tasks)
+        clamped_steps=int(np.sum(status == Status.INPUT_CLAMPED)),
+        trajectory=Trajectory(ts, xs, us, alphas, status, velocity.pop("velocity"),
+                              velocity.pop("r")),
+        tasks=tasks, **velocity)
+
+
+def _velocity_verdict(spec: Spec, tube: TubeDesign, stage: SecondStage | None,
+                      ts: np.ndarray, states: np.ndarray, alphas: np.ndarray,
+                      status: np.ndarray, dt: float) -> dict:
+    """The second-order fields of a run (velocities, ``r``, the velocity tube's verdict,
+    the velocity bound); empty ones for a first-order plant."""
+    n = spec.dimension
+    order = spec.second_order
+    if order is None:
+        return {"velocity": None, "r": None, "stayed_in_velocity_tube": None,
+                "max_abs_velocity": None, "exceeded_velocity_bound": False}
+    x1, x2 = states[:, :n], states[:, n:]
+    r = None
+    if stage is not None:
+        with reference.numpy_math():
+            r = cascade_reference.cascade_step(tube, stage, x1, x2, ts, dt, alphas)[2]
+    bound = order.velocity_bound
+    exceeded = (bound is not None
+                and bool(np.any(np.abs(x2[ts <= spec.prescribed_time + 1e-12])
+                                >= np.array(bound))))
+    inside = (status == Status.OK) | (status == Status.INPUT_CLAMPED)
+    return {"velocity": x2, "r": r, "stayed_in_velocity_tube": bool(np.all(inside)),
+            "max_abs_velocity": [float(v) for v in np.abs(x2).max(axis=0)],
+            "exceeded_velocity_bound": exceeded}
