@@ -233,3 +233,45 @@ def test_every_package_is_installed():
                  ["packages"])
     folders = {_module_name(p) for p in PACKAGE.rglob("__init__.py")}
     assert folders <= listed
+
+
+def _order_tests(tree: ast.AST) -> list[int]:
+    """Lines where code decides on ``<x>.second_order`` itself: compared with ``None`` or
+    used as a truth value (an ``if``, ``while``, conditional expression or boolean)."""
+    def is_order(node: ast.expr) -> bool:
+        return isinstance(node, ast.Attribute) and node.attr == "second_order"
+    lines = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Compare) and any(
+                is_order(side) for side in (node.left, *node.comparators)) and any(
+                isinstance(side, ast.Constant) and side.value is None
+                for side in (node.left, *node.comparators)):
+            lines.append(node.lineno)
+        tests = ([node.test] if isinstance(node, (ast.If, ast.While, ast.IfExp)) else
+                 node.values if isinstance(node, ast.BoolOp) else
+                 [node.operand] if isinstance(node, ast.UnaryOp)
+                 and isinstance(node.op, ast.Not) else [])
+        lines += [t.lineno for t in tests if is_order(t)]
+    return sorted(lines)
+
+
+def test_order_tests_are_found():
+    tree = ast.parse("if spec.second_order is not None: pass\n"
+                     "a = 1 if d.spec.second_order else 2\n"
+                     "b = not s.second_order\n"
+                     "c = s.second_order.model\n")
+    assert _order_tests(tree) == [1, 2, 3]
+
+
+def test_the_plant_order_is_decided_in_one_place():
+    """The controller variant (law (13) or the cascade) follows ``Spec.order``, defined in
+    ``spec/``: no module elsewhere tests ``second_order`` against ``None`` or for truth
+    (it reads the second-order plant's fields only)."""
+    found = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        if path.relative_to(PACKAGE).parts[0] == "spec":
+            continue
+        lines = _order_tests(ast.parse(path.read_text()))
+        if lines:
+            found[str(path.relative_to(PACKAGE))] = lines
+    assert not found, f"test Spec.order instead of second_order: {found}"

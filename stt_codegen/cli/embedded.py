@@ -62,7 +62,7 @@ def cmd_embedded(args: argparse.Namespace) -> int:
     if args.build_dir is not None and not Path(args.build_dir).parent.is_dir():
         raise SpecError("build_dir", f"folder {str(Path(args.build_dir).parent)!r} does not exist")
     design = load_and_design(args)
-    if design.spec.second_order is not None:     # the cascade law
+    if design.spec.order == 2:     # the cascade law
         from ..embedded.cascade_loop import run_cascade_embedded
         report = run_cascade_embedded(design, seed=seed)
         if args.json:

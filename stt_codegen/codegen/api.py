@@ -7,10 +7,34 @@ from pathlib import Path
 
 from ..design.result import Design, require_design
 from .generate import generate_files
-from .options import LANGUAGES, parse_options
+from .options import LANGUAGES, Options, parse_options
 from .output import write_generation
 
-__all__ = ["generate"]
+__all__ = ["design_files", "generate"]
+
+
+def design_files(design: Design, options: Options) -> dict[str, bytes]:
+    """The generated files of a design, in memory: the controller of the spec's order.
+
+    Parameters
+    ----------
+    design : Design
+        From :func:`stt_codegen.design_tube`.
+    options : Options
+        Languages and precision (:func:`~.options.parse_options`).
+
+    Returns
+    -------
+    dict of str to bytes
+        File name to content: law (13)'s controller
+        (:func:`~.generate.generate_files`) for a first-order plant, the cascade
+        controller (:func:`~.cascade_source.cascade_generation`, docs/second-order.md)
+        for a second-order one.
+    """
+    if design.spec.order == 2:
+        from .cascade_source import cascade_generation
+        return cascade_generation(design, options)
+    return generate_files(design.spec, design.tube, options)
 
 
 def generate(design: Design, out_dir: str | Path,
@@ -76,10 +100,6 @@ def generate(design: Design, out_dir: str | Path,
     """
     design = require_design(design, "generate")
     options = parse_options(languages, precision)
-    if design.spec.second_order is not None:     # the cascade controller
-        from .cascade_source import cascade_generation
-        files = cascade_generation(design, options)
-    else:
-        files = generate_files(design.spec, design.tube, options)
+    files = design_files(design, options)
     write_generation(out_dir, files)
     return [Path(out_dir) / name for name in sorted(files)]

@@ -22,8 +22,7 @@ from pathlib import Path
 
 from ..design.search import design_tube
 from ..spec.loader import bundled_cases, load_spec
-from .cascade_source import cascade_generation
-from .generate import generate_files
+from .api import design_files
 from .options import Options
 from .output import write_generation
 
@@ -42,9 +41,7 @@ def expected_tree() -> dict[str, bytes]:
     for case in bundled_cases():
         design = design_tube(load_spec(case))
         for sub, options in LAYOUT.items():
-            # a second-order case: the cascade controller, docs/second-order.md
-            files = (cascade_generation(design, options) if design.spec.second_order
-                     else generate_files(design.spec, design.tube, options))
+            files = design_files(design, options)
             for name, data in files.items():
                 tree[f"{case}/{sub}/{name}"] = data
     return tree

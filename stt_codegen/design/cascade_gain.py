@@ -260,7 +260,7 @@ def second_stage_for(tube: TubeDesign, spec, min_width: float) -> tuple[SecondSt
         rate that is).
     """
     from ..errors import SpecError
-    if spec.second_order is None:
+    if spec.order != 2:
         raise SpecError("plant.model", "the spec describes a first-order plant (not a "
                                        "second-order plant.model)")
     return _second_stage(tube, spec, min_width)

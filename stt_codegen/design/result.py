@@ -228,7 +228,7 @@ class Design:
         """``cascade``: the certified second stage's derivation with its sampled-data
         certificate (``gains``), for a spec with a second-order ``plant.model`` only:
         without it the document is as before."""
-        if self.spec.second_order is None:
+        if self.spec.order != 2:
             return {}
         return {"cascade": {"gains": self.second_stage[1]}}
 

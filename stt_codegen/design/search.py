@@ -311,7 +311,7 @@ def design_tube(spec: Spec) -> Design:
         return design_within_bound(spec, lambda free: _design(free, smoother=False))
     # a second-order spec: the sampled cascade must be certified (design/cascade_gain.py)
     design = _design(spec, smoother=True)
-    if spec.second_order is not None:
+    if spec.order == 2:
         design.second_stage      # DesignError unless the sampled cascade is certified
     return design
 

@@ -264,9 +264,8 @@ def spec_plant(spec, seed: int = 0) -> ct.NonlinearIOSystem:
     SpecError
         As :func:`make_plant` and :func:`second_order_plant`.
     """
-    order = spec.second_order
-    if order is None:
+    if spec.order == 1:
         return make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed,
                           spec.linear_plant)
-    return second_order_plant(order.model, spec.dimension, order.parameters,
-                              spec.disturbance_amplitude, seed)
+    return second_order_plant(spec.second_order.model, spec.dimension,
+                              spec.second_order.parameters, spec.disturbance_amplitude, seed)

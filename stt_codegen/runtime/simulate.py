@@ -278,7 +278,7 @@ def simulate(design: Design, *positional: object, backend: str = "reference",
                         "(design.spec), and every other argument by keyword: "
                         "simulate(design, backend=..., horizon=..., seed=..., plant=...)")
     design = require_design(design, "simulate")
-    stage = design.second_stage[0] if design.spec.second_order is not None else None
+    stage = design.second_stage[0] if design.spec.order == 2 else None
     return run_closed_loop(design.spec, design.tube, backend=backend, horizon=horizon,
                            seed=seed, plant=plant, stage=stage)
 
@@ -331,21 +331,20 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     steps = int(math.ceil(horizon * tube.rate_hz - 1e-9))
     check_step_budget(steps, horizon, tube.rate_hz)
     n = spec.dimension
-    order = spec.second_order
-    if (order is None) != (stage is None) and controller is None:
+    if (spec.order == 2) != (stage is not None) and controller is None:
         raise SpecError("stage", "a second-order spec runs the cascade law, which needs its "
-                                 "second stage (Design.second_stage)" if order is not None
+                                 "second stage (Design.second_stage)" if spec.order == 2
                         else "a first-order spec runs law (13), which has no second stage")
     if controller is None:
         controller = make_controller(backend, tube, stage)
-    x = np.array(spec.initial_state if order is None
-                 else [*spec.initial_state, *order.initial_velocity], dtype=float)
+    x = np.array(spec.initial_state if spec.order == 1
+                 else [*spec.initial_state, *spec.second_order.initial_velocity], dtype=float)
     if plant is None:
         plant = spec_plant(spec, seed)
     elif (getattr(plant, "nstates", None), getattr(plant, "ninputs", None)) != (x.size, n):
         raise SpecError("plant", f"must be a control.NonlinearIOSystem with {x.size} states "
                                  f"and {n} inputs for this spec"
-                                 + (" (positions, then velocities)" if order is not None
+                                 + (" (positions, then velocities)" if spec.order == 2
                                     else ""))
 
     def rhs(t, x, u):
@@ -429,8 +428,7 @@ def _velocity_verdict(spec: Spec, tube: TubeDesign, stage: SecondStage | None,
     """The second-order fields of a run (velocities, ``r``, the velocity tube's verdict,
     the velocity bound); empty ones for a first-order plant."""
     n = spec.dimension
-    order = spec.second_order
-    if order is None:
+    if spec.order == 1:
         return {"velocity": None, "r": None, "stayed_in_velocity_tube": None,
                 "max_abs_velocity": None, "exceeded_velocity_bound": False}
     x1, x2 = states[:, :n], states[:, n:]
@@ -438,7 +436,7 @@ def _velocity_verdict(spec: Spec, tube: TubeDesign, stage: SecondStage | None,
     if stage is not None:
         with reference.numpy_math():
             r = cascade_reference.cascade_step(tube, stage, x1, x2, ts, dt, alphas)[2]
-    bound = order.velocity_bound
+    bound = spec.second_order.velocity_bound
     exceeded = (bound is not None
                 and bool(np.any(np.abs(x2[ts <= spec.prescribed_time + 1e-12])
                                 >= np.array(bound))))

@@ -292,6 +292,20 @@ class Spec:
         return len(self.state_space.lower)
 
     @property
+    def order(self) -> int:
+        """The plant's order: the one place that decides which controller variant runs.
+
+        Returns
+        -------
+        int
+            1: system (1), ``x_dot = f(x) + g(x) u + w``, driven by law (13); 2: a
+            second-order ``plant.model`` (:attr:`second_order`), ``x1_dot = x2``, ``x2_dot
+            = f + g u + w``, driven by the cascade law (docs/second-order.md) on the same
+            tube of the positions ``x1``.
+        """
+        return 1 if self.second_order is None else 2
+
+    @property
     def c_name(self) -> str:
         """The name as a C identifier (``-`` replaced by ``_``)."""
         return self.name.replace("-", "_")

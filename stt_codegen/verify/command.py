@@ -205,7 +205,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     # step budget with a SpecError); the oracle's exp/log/tanh as numpy's ufuncs (within an
     # ulp of libm, tens of times faster), as the certificate and the input-bound prover
     # do: every margin here is far above rounding
-    if spec.second_order is not None:
+    if spec.order == 2:
         # the deployed controller is the cascade, not law (13) on this plant: its lemmas
         # and its sampled-data certificate (docs/second-order.md)
         from .cascade import cascade_checks, plant_within_class_check, sampled_cascade_check
