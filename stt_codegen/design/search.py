@@ -303,17 +303,24 @@ def design_tube(spec: Spec) -> Design:
                 else "; load it with load_spec" if isinstance(spec, str) else "")
         raise TypeError(f"design_tube(): parameter 'spec' must be a Spec, not "
                         f"{type(spec).__name__}{hint}")
+    design = _position_stage(spec)
+    # a second-order spec: the sampled cascade must be certified on the final tube, whatever
+    # path designed it (design/cascade_gain.py)
+    if spec.order == 2:
+        design.second_stage      # DesignError unless the sampled cascade is certified
+    return design
+
+
+def _position_stage(spec: Spec) -> Design:
+    """:func:`design_tube` without the second stage of a second-order spec: the tube of the
+    positions, for moving obstacles, ``[actuator]`` or neither."""
     if spec.moving_obstacles:             # obstacles that move: design/moving.py
-        return design_moving(spec, design_tube, check_tube)
+        return design_moving(spec, _position_stage, check_tube)
     if spec.input_bound is not None:      # [actuator]: design/actuator.py
         # the bound's proof orders the tubes there (default, softer circumvents, via
         # points): auto's estimate of the smoother tube plays no part
         return design_within_bound(spec, lambda free: _design(free, smoother=False))
-    # a second-order spec: the sampled cascade must be certified (design/cascade_gain.py)
-    design = _design(spec, smoother=True)
-    if spec.order == 2:
-        design.second_stage      # DesignError unless the sampled cascade is certified
-    return design
+    return _design(spec, smoother=True)
 
 
 def _design(spec: Spec, smoother: bool) -> Design:

@@ -554,15 +554,6 @@ def _validate(raw: dict) -> Spec:
     second_order = _second_order(doc, n)
     if second_order is not None:
         model = "single-integrator"     # the position stage x1_dot = x2 (Spec.plant_model)
-        # the cascade's simulation judges static obstacles only (docs/second-order.md)
-        if doc.tasks:
-            raise SpecError("tasks", f"a second-order plant.model ({second_order.model}) "
-                                     "takes no [[tasks]] yet: the cascade's run does not "
-                                     "judge them")
-        if moving:
-            raise SpecError(f"obstacles[{moving[0].source}]",
-                            f"a second-order plant.model ({second_order.model}) takes only "
-                            "static obstacles yet: the cascade's run does not judge moving ones")
     tube = TubeParameters(**doc.tube.model_dump())
     return Spec(name=doc.name, prescribed_time=doc.prescribed_time, state_space=state_space,
                 initial_set=initial_set, initial_state=x0, initial_half_width=d0,
