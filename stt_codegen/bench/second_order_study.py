@@ -27,6 +27,8 @@ from ..errors import SpecError
 from ..runtime.plants import second_order_plant
 from ..runtime.simulate import run_closed_loop
 from ..spec.loader import load_spec
+from ..verify.cascade_adversary import search_cascade
+from ..verify.cascade_sampled import cascade_class
 
 __all__ = ["DRAG_MAX", "format_second_order_report", "random_parameters", "run_second_order_study"]
 
@@ -37,10 +39,11 @@ GRAVITY = 9.81
 
 
 def random_parameters(model: str, input_gain: tuple, rng: np.random.Generator,
-                      spread: float = 1.0) -> list[float]:
+                      spread: float = 1.0, corners: bool = False) -> list[float]:
     """One plant's parameters within the declared bounds (the module docstring), or, with
     ``spread > 1``, beyond them: ``1/m`` in ``[g_min / spread, g_max spread]``, drag up to
-    ``spread DRAG_MAX``.
+    ``spread DRAG_MAX``; with ``corners``, at a corner of that range (each parameter at one
+    of its ends, drawn).
 
     Parameters
     ----------
@@ -52,6 +55,8 @@ def random_parameters(model: str, input_gain: tuple, rng: np.random.Generator,
         The source of the draw.
     spread : float, optional
         Factor by which the draw goes beyond the bounds (1: within them).
+    corners : bool, optional
+        Draw each parameter at an end of its range (default: uniform in it).
 
     Returns
     -------
@@ -65,17 +70,21 @@ def random_parameters(model: str, input_gain: tuple, rng: np.random.Generator,
         A model the study does not draw (field ``plant.model``).
     """
     g_min, g_max = input_gain
-    mass = 1.0 / rng.uniform(g_min / spread, g_max * spread)
+
+    def draw(low: float, high: float) -> float:
+        return float(rng.choice([low, high]) if corners else rng.uniform(low, high))
+    mass = 1.0 / draw(g_min / spread, g_max * spread)
     if model == "double-integrator":
         return [mass]
     if model == "quadrotor":
-        return [mass, float(rng.uniform(0.0, DRAG_MAX * spread)), GRAVITY]
+        return [mass, draw(0.0, DRAG_MAX * spread), GRAVITY]
     raise SpecError("plant.model", f"the study draws double-integrator and quadrotor "
                                    f"plants, not {model!r}")
 
 
 def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed: int = 0,
-                           backend: str = "c", spread: float = 1.0) -> dict:
+                           backend: str = "c", spread: float = 1.0,
+                           corners: bool = False, adversary: bool = False) -> dict:
     """Run the study (module docstring).
 
     Parameters
@@ -92,6 +101,13 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
         1 (default): plants within the declared bounds; > 1: beyond them
         (:func:`random_parameters`, and disturbance amplitudes up to ``spread`` times the
         declared one), to find where the cascade fails.
+    corners : bool
+        Plants at the corners of the range (:func:`random_parameters`) with the largest
+        disturbance amplitude of the range (default: uniform draws).
+    adversary : bool
+        Also run the adversary of :func:`~stt_codegen.verify.cascade_adversary.search_cascade`
+        on the class the design's certificate proves (``adversary``: the exits it found,
+        which must be none for a certified design, and its seconds).
 
     Returns
     -------
@@ -118,8 +134,9 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
     satisfied = in_tubes = 0
     failures = []
     for k in range(count):
-        params = random_parameters(order.model, order.input_gain, rng, spread)
-        amplitude = float(rng.uniform(0.0, spread * spec.disturbance_amplitude))
+        params = random_parameters(order.model, order.input_gain, rng, spread, corners)
+        amplitude = (spread * spec.disturbance_amplitude if corners
+                     else float(rng.uniform(0.0, spread * spec.disturbance_amplitude)))
         plant_seed = int(rng.integers(0, 2**32))
         plant = second_order_plant(order.model, spec.dimension, params, amplitude, plant_seed)
         result = run_closed_loop(spec, design.tube, stage=stage, backend=backend,
@@ -135,8 +152,14 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
                                  "satisfied", "reach_time", "min_obstacle_clearance",
                                  "stayed_in_tube", "stayed_in_velocity_tube", "max_abs_e",
                                  "max_abs_u", "max_abs_velocity", "exceeded_velocity_bound")}})
+    found = None
+    if adversary:
+        begun = time.perf_counter()
+        exits = search_cascade(design.tube, stage, cascade_class(spec), order.initial_velocity)
+        found = {"exits": [e.to_json() for e in exits],
+                 "seconds": time.perf_counter() - begun}
     return {"case": spec.name, "model": order.model, "count": count, "seed": seed,
-            "spread": spread,
+            "spread": spread, "corners": corners, "adversary": found,
             "backend": backend, "satisfied": satisfied, "satisfied_share": satisfied / count,
             "in_both_tubes": in_tubes, "in_both_tubes_share": in_tubes / count,
             "stage": {"position_gain": stage.position_gain,
@@ -161,11 +184,20 @@ def format_second_order_report(report: dict) -> str:
         The shares satisfied and in both tubes, then the first 20 failures, one a line.
     """
     lines = [f"{report['case']} ({report['model']}), {report['count']} random plants "
-             f"(spread {report['spread']:g}), seed "
+             f"(spread {report['spread']:g}{', at the corners' if report['corners'] else ''}),"
+             f" seed "
              f"{report['seed']}, backend {report['backend']}: satisfied "
              f"{report['satisfied']}/{report['count']} ({100 * report['satisfied_share']:.1f} %),"
              f" in both tubes {report['in_both_tubes']}/{report['count']} "
              f"({100 * report['in_both_tubes_share']:.1f} %), {report['seconds']:.0f} s"]
+    if report["adversary"] is not None:
+        exits = report["adversary"]["exits"]
+        lines.append(f"adversary (extreme members switched per interval, "
+                     f"{report['adversary']['seconds']:.0f} s): "
+                     + ("no member left a tube" if not exits else
+                        "; ".join(f"{e['strategy']} left the {e['tube']} tube at "
+                                  f"{e['time']:g} s (depth {e['depth']:.3g})"
+                                  for e in exits)))
     for f in report["failures"][:20]:
         lines.append(f"  plant {f['index']}: params {[round(v, 4) for v in f['params']]}, "
                      f"|w| <= {f['amplitude']:.3g}: satisfied {f['satisfied']}, position tube "

@@ -95,7 +95,8 @@ def _cmd_tasks(args: argparse.Namespace) -> int:
 
 def _cmd_second_order(args: argparse.Namespace) -> int:
     from ..bench.second_order_study import format_second_order_report, run_second_order_study
-    report = run_second_order_study(args.spec, args.count, args.seed, spread=args.spread)
+    report = run_second_order_study(args.spec, args.count, args.seed, spread=args.spread,
+                                    corners=args.corners, adversary=args.adversary)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_second_order_report(report))
     return 0
@@ -188,5 +189,11 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=_non_negative_int, default=0, help="seed (default: 0)")
     p.add_argument("--spread", type=float, default=1.0, metavar="F",
                    help="draw plants F times beyond the declared bounds (default: 1, within)")
+    p.add_argument("--corners", action="store_true",
+                   help="plants at the corners of the declared bounds, with the largest "
+                        "disturbance")
+    p.add_argument("--adversary", action="store_true",
+                   help="also search the certified class for a member that leaves a tube "
+                        "(extreme members switched per sampling interval)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_second_order)
