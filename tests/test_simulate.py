@@ -10,7 +10,7 @@ from scipy.integrate import solve_ivp
 from stt_codegen.runtime import backends
 from stt_codegen.errors import SpecError
 from stt_codegen.runtime.plants import Disturbance, check_seed, make_plant
-from stt_codegen.runtime.simulate import SUBSTEPS, _rk4, simulate
+from stt_codegen.runtime.simulate import _RungeKutta, simulate
 from stt_codegen.tube import reference as R
 
 
@@ -59,10 +59,9 @@ def test_runge_kutta_hold_matches_an_adaptive_solver():
     for k in range(200):
         u = rng.normal(0, 5, 3)
         t = k * dt
-        got = x
-        for m in range(SUBSTEPS):
-            got = _rk4(lambda s, y, v: plant.dynamics(s, y, v), t + m * dt / SUBSTEPS, got, u,
-                       dt / SUBSTEPS)
+        stepper = _RungeKutta(plant)
+        stepper.reset(x)
+        got = stepper.advance(t, u, dt)[0][-1]
         exact = solve_ivp(lambda s, y: plant.dynamics(s, y, u), (t, t + dt), x,
                           method="DOP853", rtol=1e-13, atol=1e-14).y[:, -1]
         worst = max(worst, np.abs(got - exact).max())

@@ -132,6 +132,12 @@ class SimulationResult:
     exceeded_velocity_bound : bool
         Some sampled ``|x2_i|`` on ``[0, t_c]`` reached the spec's
         ``state_space.velocity_bound`` (then not ``satisfied``); ``False`` without a bound.
+    contacts : int or None
+        A MuJoCo plant (:class:`~stt_codegen.runtime.mujoco_plant.MujocoPlant`): the MuJoCo
+        steps with a contact other than with a ground plane (then not ``satisfied``);
+        ``None`` for the other plants.
+    first_contact : list or None
+        ``[t, geom1, geom2]`` of the first such contact (s, geom names), else ``None``.
     """
 
     spec: str
@@ -154,14 +160,20 @@ class SimulationResult:
     stayed_in_velocity_tube: bool | None = None
     max_abs_velocity: list[float] | None = None
     exceeded_velocity_bound: bool = False
+    contacts: int | None = None
+    first_contact: list | None = None
 
     def to_json(self) -> dict:
         """The result as a JSON-ready dict (without the trajectory; ``tasks`` only for a
-        spec with ``[[tasks]]``; the velocity fields only for a second-order plant)."""
+        spec with ``[[tasks]]``; the velocity fields only for a second-order plant, the
+        contact fields only for a MuJoCo plant)."""
         data = asdict(self)
         data.pop("trajectory")
         if not data["tasks"]:
             data.pop("tasks")
+        if data["contacts"] is None:
+            data.pop("contacts")
+            data.pop("first_contact")
         if data["max_abs_velocity"] is None:
             for key in ("stayed_in_velocity_tube", "max_abs_velocity",
                         "exceeded_velocity_bound"):
@@ -181,12 +193,35 @@ def _seconds(horizon: object) -> float:
     return value
 
 
-def _rk4(rhs, t: float, x: np.ndarray, u: np.ndarray, h: float) -> np.ndarray:
-    k1 = rhs(t, x, u)
-    k2 = rhs(t + h / 2, x + h / 2 * k1, u)
-    k3 = rhs(t + h / 2, x + h / 2 * k2, u)
-    k4 = rhs(t + h, x + h * k3, u)
-    return x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+class _RungeKutta:
+    """A python-control plant integrated over each hold interval by the classical
+    Runge-Kutta method, :data:`SUBSTEPS` steps (the stepping interface of
+    :class:`~stt_codegen.runtime.mujoco_plant.MujocoPlant`)."""
+
+    contact_count = None
+
+    def __init__(self, plant: ct.NonlinearIOSystem) -> None:
+        self.plant = plant
+        self.x = None
+
+    def reset(self, x0: np.ndarray) -> np.ndarray:
+        self.x = np.array(x0, dtype=float)
+        return self.x
+
+    def advance(self, t: float, u: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        h = dt / SUBSTEPS
+        x, f = self.x, self.plant.dynamics
+        points = np.empty((SUBSTEPS, x.size))
+        for m in range(SUBSTEPS):
+            tm = t + m * h
+            k1 = f(tm, x, u)
+            k2 = f(tm + h / 2, x + h / 2 * k1, u)
+            k3 = f(tm + h / 2, x + h / 2 * k2, u)
+            k4 = f(tm + h, x + h * k3, u)
+            x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            points[m] = x
+        self.x = x
+        return points, t + h * np.arange(1, SUBSTEPS + 1)
 
 
 def simulate(design: Design, *positional: object, backend: str = "reference",
@@ -342,14 +377,13 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     if plant is None:
         plant = spec_plant(spec, seed)
     elif (getattr(plant, "nstates", None), getattr(plant, "ninputs", None)) != (x.size, n):
-        raise SpecError("plant", f"must be a control.NonlinearIOSystem with {x.size} states "
+        raise SpecError("plant", f"must be a control.NonlinearIOSystem (or a plant with "
+                                 f"advance(), as MujocoPlant) with {x.size} states "
                                  f"and {n} inputs for this spec"
                                  + (" (positions, then velocities)" if spec.order == 2
                                     else ""))
-
-    def rhs(t, x, u):
-        return plant.dynamics(t, x, u)
-
+    stepper = plant if hasattr(plant, "advance") else _RungeKutta(plant)
+    x = stepper.reset(x)
     dt = 1.0 / tube.rate_hz
     lo, hi = np.array(spec.state_space.lower), np.array(spec.state_space.upper)
     t_lo, t_hi = np.array(spec.target_set.lower), np.array(spec.target_set.upper)
@@ -362,7 +396,6 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     alpha = np.zeros(2 * n)
     dense = [x[None, :n]]
     dense_t = [np.zeros(1)]
-    h = dt / SUBSTEPS
     for k in range(steps + 1):
         t = ts[k]
         states[k], alphas[k] = x, alpha
@@ -370,12 +403,10 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
         us[k], status[k] = u, code
         if k == steps:
             break
-        points = []
-        for m in range(SUBSTEPS):
-            x = _rk4(rhs, t + m * h, x, u, h)
-            points.append(x[:n])
-        dense.append(np.array(points))
-        dense_t.append(t + h * np.arange(1, SUBSTEPS + 1))
+        points, times = stepper.advance(t, u, dt)
+        x = points[-1]
+        dense.append(points[:, :n])
+        dense_t.append(times)
         alpha = alpha_next
     xs = states[:, :n]
     path = np.vstack(dense)
@@ -399,8 +430,9 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     left = bool(np.any((within < lo) | (within > hi)))
     tasks = judge_tasks(spec, path_t, path)
     velocity = _velocity_verdict(spec, tube, stage, ts, states, alphas, status, dt)
+    contacts = stepper.contact_count
     satisfied = (reached and not collision and not left and horizon >= t_c
-                 and not velocity["exceeded_velocity_bound"]
+                 and not velocity["exceeded_velocity_bound"] and not contacts
                  and all(task.met for task in tasks))
     with reference.numpy_math():
         g_l, g_u, _, _ = reference.adaptive_tube(tube, ts, alphas)
@@ -419,7 +451,9 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
         clamped_steps=int(np.sum(status == Status.INPUT_CLAMPED)),
         trajectory=Trajectory(ts, xs, us, alphas, status, velocity.pop("velocity"),
                               velocity.pop("r")),
-        tasks=tasks, **velocity)
+        tasks=tasks, contacts=contacts,
+        first_contact=(None if getattr(stepper, "first_contact", None) is None
+                       else list(stepper.first_contact)), **velocity)
 
 
 def _velocity_verdict(spec: Spec, tube: TubeDesign, stage: SecondStage | None,
