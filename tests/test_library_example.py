@@ -25,8 +25,9 @@ def python_blocks(path: Path) -> list[str]:
 
 def test_the_document_has_the_examples():
     blocks = python_blocks(DOC)
-    assert len(blocks) == 2
+    assert len(blocks) == 3
     assert "stt.load_spec" in blocks[0] and "stt.Spec.from_dict" in blocks[1]
+    assert "MujocoPlant" in blocks[2]
 
 
 def test_the_readme_example_is_the_documents():
@@ -72,3 +73,15 @@ def test_every_public_name_has_a_docstring():
     from stt_codegen.verify.command import verify
     assert "Parameters\n" in verify.__doc__ and "Examples\n" in verify.__doc__
     assert stt_codegen.Spec.from_dict.__doc__
+
+
+@pytest.mark.slow
+def test_the_mujoco_example_runs_verbatim(monkeypatch, capsys):
+    """The MuJoCo example, from the repository's root (its files are the tests' own)."""
+    pytest.importorskip("mujoco", reason="MuJoCo is not installed: pip install mujoco")
+    if shutil.which("cc") is None and shutil.which("gcc") is None:
+        pytest.skip("the example compiles C: install the Debian package gcc")
+    monkeypatch.chdir(DOC.parent.parent)
+    exec(compile(python_blocks(DOC)[2], f"{DOC.name}[2]", "exec"), {})
+    satisfied, contacts, peak = capsys.readouterr().out.split()
+    assert satisfied == "True" and contacts == "0" and float(peak) < 1.0
