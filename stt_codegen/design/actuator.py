@@ -35,6 +35,7 @@ from dataclasses import dataclass, replace
 
 from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
+from .cascade_gain import cascade_input_proof
 from .grid import grid_index, grid_value, smallest_passing
 from .failures import FailureKind
 from .input_bound import InputProof, InputProver, input_prover
@@ -123,7 +124,7 @@ def candidates(spec: Spec, design_free: Callable[[Spec], Design],
     bound = spec.input_bound
     free = replace(spec, input_bound=None)
     default = design_free(free)
-    tried = [Candidate("default design", default, prover(default.tube, spec))]
+    tried = [Candidate("default design", default, _proof(default, spec, prover))]
     if tried[0].proof.meets(bound):
         return tried[0], tried
     softer_failed = False
@@ -138,10 +139,19 @@ def candidates(spec: Spec, design_free: Callable[[Spec], Design],
             # the smoother ones are not tried (on to via points)
             softer_failed = softer_failed or softer
             continue
-        tried.append(Candidate(label, design, prover(design.tube, spec)))
+        tried.append(Candidate(label, design, _proof(design, spec, prover)))
         if tried[-1].proof.meets(bound):
             return tried[-1], tried
     return None, tried
+
+
+def _proof(design: Design, spec: Spec, prover: InputProver) -> InputProof:
+    """The proved peak input of a design: law (13)'s by ``prover`` (first order), or the
+    cascade's physical input ``u`` by its sampled-data certificate (second order; the
+    stage kept is the first certified within the bound)."""
+    if spec.order == 2:
+        return cascade_input_proof(design.tube, spec, design.check.min_width)
+    return prover(design.tube, spec)
 
 
 def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> Design:
@@ -184,13 +194,15 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> De
     if not proved:
         reasons = "; ".join(f"{c.label}: {c.proof.reason}" for c in tried)
         raise DesignError(
-            "no bound on law (13)'s input can be proved for actuator.input_bound: the "
-            f"sampled-data check fails for every design tried ({reasons})",
+            f"no bound on {'law (13)' if spec.order == 1 else 'the cascade'}'s input can be "
+            f"proved for actuator.input_bound: the sampled-data check fails for every design "
+            f"tried ({reasons})",
             kind=FailureKind.INPUT_BOUND, tried=tried[0].design.tube if tried else None)
     best = min(proved, key=lambda c: c.proof.ratio(bound))
     worst = max(range(len(bound)), key=lambda i: best.proof.peak[i] / bound[i])
     needs = ", ".join(f"{_round_up(v):g}" for v in best.proof.peak)
-    message = (f"no design within prescribed_time = {spec.prescribed_time:g} s keeps law (13) "
+    law = "law (13)" if spec.order == 1 else "the cascade's input u"
+    message = (f"no design within prescribed_time = {spec.prescribed_time:g} s keeps {law} "
                f"within actuator.input_bound = [{', '.join(f'{b:g}' for b in bound)}]: the "
                f"best ({best.label}) asks up to {best.proof.peak[worst]:.3g} of input "
                f"{names[worst]} (bound {bound[worst]:g}) at t = {best.proof.time[worst]:.3f} s")

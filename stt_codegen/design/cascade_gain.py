@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 
 import numpy as np
 
@@ -37,9 +38,10 @@ from ..tube import reference
 from ..tube.parameters import TubeDesign
 from ..tube.second_stage import SecondStage
 from .cascade_prover import cascade_certifier
+from .input_bound import InputProof
 
-__all__ = ["RATE_SEARCH_FACTOR", "SHAPES", "certified_stage", "derived_second_stage",
-           "lowest_certified_rate", "second_stage_for", "tube_speed"]
+__all__ = ["RATE_SEARCH_FACTOR", "SHAPES", "cascade_input_proof", "certified_stage",
+           "derived_second_stage", "lowest_certified_rate", "second_stage_for", "tube_speed"]
 
 
 #: The shapes of the second stage the design tries, in order, until the sampled cascade's
@@ -147,37 +149,86 @@ def derived_second_stage(design: TubeDesign, min_width: float, input_gain: tuple
 
 def certified_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage | None, dict]:
     """The first shape of :data:`SHAPES` whose second stage the sampled cascade's
-    certificate accepts for ``spec``'s declared plants at ``tube.rate_hz``.
+    certificate accepts for ``spec``'s declared plants at ``tube.rate_hz``, and, with
+    ``[actuator] input_bound``, whose certified peak ``|u_i|`` is within the bound.
 
     Parameters
     ----------
     tube : TubeDesign
-        The position tube at the rate judged.
+        The position tube at the rate judged (its own ``input_bound`` is not used: the
+        certificate proves the law before the actuator clamp, which then never acts).
     spec : Spec
-        With a second-order ``plant.model``.
+        With a second-order ``plant.model``; ``spec.input_bound``, when set, bounds the
+        physical input ``u``, input units.
     min_width : float
         ``gamma_d,min`` of ``tube``'s certificate.
 
     Returns
     -------
     stage : SecondStage or None
-        ``None`` when no shape is certified.
+        ``None`` when no shape is certified (within the bound).
     derivation : dict
         The accepted stage's derivation with its ``certificate``; when none: the last
-        shape's, with the reports of every shape tried (``tried``).
+        shape's, with the reports of every shape tried (``tried``) and, for the shapes
+        certified but above the bound, ``over_bound``: ``[{"shape", "peak_input",
+        "ratio"}]``.
     """
     order = spec.second_order
+    bound = spec.input_bound
+    free = dataclasses.replace(tube, input_bound=None)
     certify = cascade_certifier()
-    tried = []
+    tried, over = [], []
     for shape in SHAPES:
         stage, derivation = derived_second_stage(
-            tube, min_width, order.input_gain, order.drift_bound + spec.disturbance_amplitude,
+            free, min_width, order.input_gain, order.drift_bound + spec.disturbance_amplitude,
             order.initial_velocity, shape)
-        passed, report = certify(tube, spec, stage)
+        passed, report = certify(free, spec, stage)
+        peak = report.get("peak_input")
+        if passed and bound is not None and any(p > b for p, b in zip(peak, bound)):
+            ratio = max(p / b for p, b in zip(peak, bound))
+            over.append({"shape": list(shape), "peak_input": list(peak), "ratio": ratio})
+            tried.append({"shape": list(shape), "reason": (
+                f"certified, but |u| up to [{', '.join(f'{p:.4g}' for p in peak)}] exceeds "
+                f"actuator.input_bound = [{', '.join(f'{b:g}' for b in bound)}]")})
+            continue
         if passed:
             return stage, {**derivation, "certificate": report}
         tried.append({"shape": list(shape), "reason": report.get("reason", "")})
-    return None, {**derivation, "tried": tried}
+    return None, {**derivation, "tried": tried, "over_bound": over}
+
+
+def cascade_input_proof(tube: TubeDesign, spec, min_width: float) -> InputProof:
+    """The certified peak of the cascade's physical input ``|u_i|`` on a tube: the proof
+    the actuator design (:mod:`.actuator`) asks of a second-order design.
+
+    Parameters
+    ----------
+    tube : TubeDesign
+        The certified position tube.
+    spec : Spec
+        With a second-order ``plant.model`` and ``[actuator] input_bound``.
+    min_width : float
+        ``gamma_d,min`` of ``tube``'s certificate.
+
+    Returns
+    -------
+    InputProof
+        For the stage :func:`certified_stage` keeps: its certified peaks (within the
+        bound); when every certified shape exceeds it, the peaks of the one nearest to it
+        (``meets`` is then false); not ``proved`` when no shape is certified at all.
+    """
+    stage, derivation = certified_stage(tube, spec, min_width)
+    if stage is not None:
+        report = derivation["certificate"]
+        return InputProof(True, tuple(report["peak_input"]), tuple(report["peak_input_time"]),
+                          report["horizon"], max_abs_e=report["max_abs_e1"])
+    if derivation["over_bound"]:
+        best = min(derivation["over_bound"], key=lambda o: o["ratio"])
+        return InputProof(True, tuple(best["peak_input"]),
+                          tuple(0.0 for _ in best["peak_input"]), 0.0)
+    n = tube.dimension
+    return InputProof(False, (math.inf,) * n, (0.0,) * n, 0.0,
+                      reason=derivation["tried"][0]["reason"])
 
 
 def _rate_certified(tube: TubeDesign, spec, rate_hz: float) -> bool:

@@ -290,7 +290,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     data = {"rate_hz": design.rate_hz, "position_gain": k1, "velocity_gain": k2,
             "width_start": list(stage.width_start), "width_floor": list(stage.width_floor),
             "decay": stage.decay, "class": plants.words()}
-    peak_u, peak_x2 = [0.0] * n, [0.0] * n
+    peak_u, peak_x2, peak_u_time = [0.0] * n, [0.0] * n, [0.0] * n
     worst = {"position": math.inf, "velocity": math.inf, "least": math.inf, "t": 0.0,
              "i": 0}
     top = [0.0, 0.0]
@@ -299,6 +299,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
         pm, vm = worst["position"], worst["velocity"]
         data.update({"position_margin": pm, "velocity_margin": vm, "max_abs_e1": top[0],
                      "max_abs_e2": top[1], "peak_input": list(peak_u),
+                     "peak_input_time": list(peak_u_time),
                      "peak_velocity": list(peak_x2)})
         return CascadeCheck(passed, reason, pm, vm, top[0], top[1], tuple(peak_u),
                             tuple(peak_x2), worst["t"] if passed else t,
@@ -349,7 +350,8 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
         u_sq = sum(v * v for v in u_abs)
         next1, next2 = [], []
         for i in range(n):
-            peak_u[i] = max(peak_u[i], u_abs[i])
+            if u_abs[i] > peak_u[i]:
+                peak_u[i], peak_u_time[i] = u_abs[i], t
             others = math.sqrt(max(u_sq - u_abs[i] ** 2, 0.0))
             z_abs = reach2[i] * rho_k[i]
             r_abs = 4.0 * k1 / (2.0 * half_l[k][i]) * phi_scalar(reach1[i])

@@ -210,9 +210,14 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         # and its sampled-data certificate (docs/second-order.md)
         from .cascade import cascade_checks, plant_within_class_check, sampled_cascade_check
         stage("sampled loop")          # the cascade takes the sampled loop's slot
-        return checks + cascade_checks(min(n, 2)) + [
+        checks += cascade_checks(min(n, 2)) + [
             plant_within_class_check(spec),
             sampled_cascade_check(spec, design, tube_check.min_width)]
+        if spec.input_bound is not None:     # on the physical input u
+            from ..design.cascade_gain import cascade_input_proof
+            checks.append(input_bound_check(
+                spec, cascade_input_proof(design, spec, tube_check.min_width)))
+        return checks
     stage("sampled loop")
     with reference.numpy_math():
         checks += sampled_checks(spec, design, tube_check.certificate)
