@@ -49,7 +49,8 @@ def _build(tmp_path: Path, case: str, precision: str):
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
     step = getattr(ctypes.CDLL(str(lib)), f"{prefix}_step")
     real = ctypes.c_double if precision == "double" else ctypes.c_float
-    step.argtypes = [real, real] + [ctypes.POINTER(real)] * 6
+    pointer = ctypes.POINTER(real)
+    step.argtypes = [pointer, real, real, pointer, pointer, pointer, pointer]
     step.restype = ctypes.c_int
     return step, real, np.float64 if precision == "double" else np.float32
 
@@ -70,14 +71,14 @@ def test_committed_c_meets_its_vectors(tmp_path, case, precision) -> None:
     ratios = {"u": 0.0, "r": 0.0, "alpha_next": 0.0}
     tight = []
     for v in data["vectors"]:
-        x1, x2, alpha = (np.ascontiguousarray(v[k], dtype=dtype) for k in ("x1", "x2", "alpha"))
+        x, alpha = (np.ascontiguousarray(v[k], dtype=dtype) for k in ("x", "alpha"))
         # the inputs are exact in the precision, as the bound assumes
         assert all(np.array_equal(a.astype(np.float64), v[k])
-                   for a, k in ((x1, "x1"), (x2, "x2"), (alpha, "alpha")))
-        n = x1.size
+                   for a, k in ((x, "x"), (alpha, "alpha")))
+        n = x.size // 2
         u, alpha_next, r = np.zeros(n, dtype), np.zeros(2 * n, dtype), np.zeros(n, dtype)
-        code = step(v["t"], data["dt"], *(a.ctypes.data_as(pointer)
-                                           for a in (x1, x2, alpha, u, alpha_next, r)))
+        code = step(x.ctypes.data_as(pointer), v["t"], data["dt"], alpha.ctypes.data_as(pointer),
+                    *(a.ctypes.data_as(pointer) for a in (u, alpha_next, r)))
         assert code == v["status"] == 0
         assert np.all(np.isfinite(u)) and np.all(np.isfinite(alpha_next))
         for got, name in ((u, "u"), (r, "r"), (alpha_next, "alpha_next")):
@@ -101,8 +102,7 @@ def test_committed_python_meets_its_vectors(case) -> None:
         == ["import math"]
     data = _vectors(case)
     for v in data["vectors"][::4]:
-        u, alpha_next, r, status = namespace["step"](v["t"], data["dt"], v["x1"], v["x2"],
-                                                     v["alpha"])
+        u, alpha_next, r, status = namespace["step"](v["x"], v["t"], data["dt"], v["alpha"])
         assert status == v["status"]
         np.testing.assert_allclose(u, v["u"], rtol=DOUBLE_TOLERANCE, atol=DOUBLE_TOLERANCE)
         np.testing.assert_allclose(alpha_next, v["alpha_next"], rtol=DOUBLE_TOLERANCE,

@@ -24,40 +24,55 @@ import hashlib
 import casadi
 
 from ..tube.cascade import cascade_step
-from ..tube.parameters import TubeDesign
-from ..tube.parameters import Status
+from ..tube.parameters import Status, TubeDesign
 from ..tube.second_stage import SecondStage
 from ..version import __version__
 from ..design.result import Design
 from .emit import CPrinter, lower, python_source
+from .generate import input_limits
 from .options import Options
-from .render import render
+from .render import c_real, render
 
-__all__ = ["cascade_c_files", "cascade_generation", "cascade_python_file"]
-
-#: Status of an input outside the step's domain (as the first-order API's INVALID_INPUT).
-CASCADE_INVALID_INPUT = 2
-#: Largest accepted ``dt``, seconds.
-DT_MAX = 1.0
-
+__all__ = ["cascade_c_files", "cascade_generation", "cascade_python_file", "statuses"]
 
 def design_hash(design: TubeDesign, stage: SecondStage) -> str:
     """SHA-256 of the design's and the stage's numbers (their ``repr``), hex."""
     return hashlib.sha256((repr(design) + repr(stage)).encode()).hexdigest()
 
 
-#: Status names and codes, in the order the C header and the Python module define them.
-_STATUSES = (("OK", Status.OK), ("OUTSIDE_POSITION_TUBE", Status.OUTSIDE_TUBE),
-             ("INVALID_INPUT", CASCADE_INVALID_INPUT),
-             ("OUTSIDE_VELOCITY_TUBE", Status.OUTSIDE_VELOCITY_TUBE))
+def statuses(design: TubeDesign) -> list[tuple[str, int]]:
+    """The status names and codes the cascade's generated code defines, in code order: the
+    first order's (:class:`~stt_codegen.tube.parameters.Status`; ``INPUT_CLAMPED`` only
+    with an actuator bound) and ``OUTSIDE_VELOCITY_TUBE``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The position tube; its ``input_bound`` decides whether ``INPUT_CLAMPED`` is one.
+
+    Returns
+    -------
+    list of (str, int)
+        ``(name, code)`` pairs, by code.
+    """
+    return [(s.name, int(s)) for s in Status
+            if s != Status.INPUT_CLAMPED or design.input_bound is not None]
 
 
-def _context(design: TubeDesign, stage: SecondStage, prefix: str, precision: str) -> dict:
-    """What every cascade template takes: the banner's fields, the names, the statuses."""
+def _context(design: TubeDesign, stage: SecondStage, prefix: str, precision: str,
+             literal) -> dict:
+    """What every cascade template takes: the banner's fields, the names, the statuses,
+    the input domain's limits (those of the first order, :func:`.generate.input_limits`)
+    and the actuator bound, printed by ``literal``."""
+    limits = input_limits(design)
     return {"spec_name": design.name, "design_hash": design_hash(design, stage),
             "toolkit_version": __version__, "casadi_version": casadi.__version__,
             "precision": precision, "P": prefix, "U": prefix.upper(),
-            "n": design.dimension, "statuses": _STATUSES}
+            "n": design.dimension, "statuses": statuses(design),
+            "t_c": literal(design.prescribed_time), "rate_hz": literal(design.rate_hz),
+            **{name: literal(value) for name, value in limits.items()},
+            "input_bound": (None if design.input_bound is None else
+                            [literal(b) for b in design.input_bound])}
 
 
 def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
@@ -89,21 +104,20 @@ def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
     """
     if not prefix.isidentifier() or not prefix.isascii():
         raise ValueError(f"prefix {prefix!r} is not a C identifier")
-    printer = CPrinter(precision, "", f"{prefix}_")
+    single = precision == "single"
+    printer = CPrinter(precision, f"{prefix}_real", f"{prefix}_")
     program = lower(cascade_step(design, stage))
-    context = dict(_context(design, stage, prefix, precision),
-                   real=printer.real, body=printer.doprint(program),
-                   function=printer.function_name(program),
-                   zero=printer.constant(0.0), one=printer.constant(1.0),
-                   dt_max=printer.constant(DT_MAX), dt_max_doc=f"{DT_MAX:g}")
+    context = dict(_context(design, stage, prefix, precision, lambda v: c_real(v, single)),
+                   real="float" if single else "double", body=printer.doprint(program),
+                   function=printer.function_name(program), zero=c_real(0.0, single))
     return {name: render(template, filename=name, **context)
             for name, template in ((f"{prefix}.h", "cascade_header.h.j2"),
                                    (f"{prefix}.c", "cascade_source.c.j2"))}
 
 
 def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str) -> dict[str, str]:
-    """``{<prefix>.py: text}``: ``step(t, dt, x1, x2, alpha) -> (u, alpha_next, r,
-    status)``, the same function, statuses and input checks as the C (imports ``math``
+    """``{<prefix>.py: text}``: ``step(x, t, dt, alpha) -> (u, alpha_next, r, status)``
+    (``x = [x1; x2]``), the same function, statuses and input checks as the C (imports ``math``
     only). The emitter's Python printer prints the composed Function; the template
     ``cascade_module.py.j2`` holds the rest of the text.
 
@@ -130,9 +144,9 @@ def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str) -> 
         raise ValueError(f"prefix {prefix!r} is not an identifier")
     name = f"{prefix}.py"
     return {name: render("cascade_module.py.j2", filename=name,
-                         **_context(design, stage, prefix, "double"),
-                         body=python_source(cascade_step(design, stage)),
-                         dt_max=repr(DT_MAX))}
+                         **_context(design, stage, prefix, "double",
+                                    lambda v: repr(float(v))),
+                         body=python_source(cascade_step(design, stage)))}
 
 
 #: Test vectors per generation: sample points of the cascade step.
@@ -174,14 +188,16 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     t, alpha, g_l, g_u = t[keep], alpha[keep], g_l[keep], g_u[keep]
     count = t.size
     x1 = f32((g_u + g_l) / 2 + (g_u - g_l) / 2 * rng.uniform(-0.9, 0.9, (count, n)))
-    _, _, r, _, _ = cascade_reference.cascade_step(design, stage, x1, np.zeros((count, n)),
-                                                   t, dt, alpha)
+    _, _, r, *_ = cascade_reference.cascade_step(design, stage,
+                                                 np.hstack([x1, np.zeros((count, n))]),
+                                                 t, dt, alpha)
     rho2 = cascade_reference.velocity_tube(stage, t)
     x2 = f32(r + rho2 * rng.uniform(-0.9, 0.9, (count, n)))
-    u, alpha_next, r, inside_p, inside_v = cascade_reference.cascade_step(
-        design, stage, x1, x2, t, dt, alpha)
+    u, alpha_next, r, inside_p, inside_v, within = cascade_reference.cascade_step(
+        design, stage, np.hstack([x1, x2]), t, dt, alpha)
     status = np.where(inside_p == 0, Status.OUTSIDE_TUBE,
-                      np.where(inside_v == 0, Status.OUTSIDE_VELOCITY_TUBE, Status.OK))
+                      np.where(inside_v == 0, Status.OUTSIDE_VELOCITY_TUBE,
+                               np.where(within == 0, Status.INPUT_CLAMPED, Status.OK)))
     unit = T.unit_roundoff(precision)
     tol_u, tol_r, tol_a = T.cascade_bounds(design, stage, x1, x2, t, alpha, r, alpha_next, unit)
     if precision == "double":
@@ -192,7 +208,7 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     return {"_generated": "GENERATED FILE, DO NOT EDIT: cascade test vectors from the numpy "
                           "reference (stt_codegen.tube.cascade_reference).",
             "dt": dt, "precision": precision, "unit_roundoff": unit,
-            "vectors": [{"t": float(t[k]), "x1": x1[k].tolist(), "x2": x2[k].tolist(),
+            "vectors": [{"t": float(t[k]), "x": [*x1[k].tolist(), *x2[k].tolist()],
                          "alpha": alpha[k].tolist(), "u": u[k].tolist(), "r": r[k].tolist(),
                          "alpha_next": alpha_next[k].tolist(), "status": int(status[k]),
                          "tol_u": tol_u[k].tolist(), "tol_r": tol_r[k].tolist(),

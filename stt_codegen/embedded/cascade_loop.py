@@ -136,7 +136,7 @@ def closed_loop_program(design: Design, prefix: str, seed: int = 0) -> str:
         "",
         "int main(void) {",
         "  double s[2 * N], k1[2 * N], k2[2 * N], k3[2 * N], k4[2 * N], tmp[2 * N];",
-        "  float x1[N], x2[N], alpha[2 * N], alpha_next[2 * N], u[N], r[N];",
+        "  float xf[2 * N], alpha[2 * N], alpha_next[2 * N], u[N], r[N];",
         "  double max_u[N], min_clear = 1e300, h = 1.0 / (RATE_HZ * SUBSTEPS);",
         "  long reach = -1, outside_p = 0, outside_v = 0, invalid = 0;",
         "  int left = 0, fast = 0, i, m;",
@@ -147,7 +147,7 @@ def closed_loop_program(design: Design, prefix: str, seed: int = 0) -> str:
         "    double t = (double)k / RATE_HZ;",
         "    int in_target = 1, code;",
         "    for (i = 0; i < N; ++i) {",
-        "      x1[i] = (float)s[i]; x2[i] = (float)s[N + i];",
+        "      xf[i] = (float)s[i]; xf[N + i] = (float)s[N + i];",
         "      if (s[i] < TG_LO[i] || s[i] > TG_HI[i]) { in_target = 0; }",
         "      if (fabs(s[N + i]) >= V_MAX[i] && t <= T_C + 1e-12) { fast = 1; }",
         "    }",
@@ -155,7 +155,7 @@ def closed_loop_program(design: Design, prefix: str, seed: int = 0) -> str:
         "#ifdef MEASURE",
         "    stt_measure_begin();",
         "#endif",
-        f"    code = {prefix}_step((float)t, (float)(1.0 / RATE_HZ), x1, x2, alpha, u, "
+        f"    code = {prefix}_step(xf, (float)t, (float)(1.0 / RATE_HZ), alpha, u, "
         "alpha_next, r);",
         "#ifdef MEASURE",
         "    stt_measure_end();",

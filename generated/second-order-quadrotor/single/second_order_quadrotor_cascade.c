@@ -3,12 +3,21 @@
  * "second-order-quadrotor" and its second stage (SHA-256 97718e85f61c9d30ba9a5e2532f2e26e853d69c9feaa3f75e59ca8dca1235799),
  * precision single. Cascade law of docs/second-order.md.
  */
+/*
+ * Implementation of second_order_quadrotor_cascade.h. The function second_order_quadrotor_cascade_cascade_step is printed by the project's C
+ * printer (stt_codegen.codegen.emit.CPrinter, float) from the CasADi Function
+ * stt_codegen.tube.cascade.cascade_step of the design and its second stage; second_order_quadrotor_cascade_step
+ * checks the inputs, calls it and sets the status.
+ */
 #include <math.h>
+#include <stddef.h>
 
 #include "second_order_quadrotor_cascade.h"
 
+/* -ffast-math and -Ofast define __FAST_MATH__; -ffinite-math-only (gcc, clang) and clang's
+   -fno-honor-nans -fno-honor-infinities together define __FINITE_MATH_ONLY__ 1. */
 #if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && (__FINITE_MATH_ONLY__ != 0))
-#error "second_order_quadrotor_cascade.c must not be compiled with -ffast-math: it removes the isfinite() input checks"
+#error "second_order_quadrotor_cascade.c must not be compiled with -ffast-math (or -Ofast, -ffinite-math-only, -fno-honor-nans, -fno-honor-infinities): they remove the isfinite() input checks"
 #endif
 
 /* stt_expf(x): expf(x), within 0.89 ulp of the exact e^x for |x| <= 80 (every
@@ -73,65 +82,65 @@ static float stt_expf(float x) {
 }
 
 /* CasADi Function 'cascade_step': 1092 instructions. */
-static void second_order_quadrotor_cascade_cascade_step(const float* x1, const float* x2, const float* t, const float* dt, const float* alpha, float* u, float* alpha_next, float* r, float* inside_position, float* inside_velocity) {
-  float w0;
-  float w1;
-  float w2;
-  float w3;
-  float w4;
-  float w5;
-  float w6;
-  float w7;
-  float w8;
-  float w9;
-  float w10;
-  float w11;
-  float w12;
-  float w13;
-  float w14;
-  float w15;
-  float w16;
-  float w17;
-  float w18;
-  float w19;
-  float w20;
-  float w21;
-  float w22;
-  float w23;
-  float w24;
-  float w25;
-  float w26;
-  float w27;
-  float w28;
-  float w29;
-  float w30;
-  float w31;
-  float w32;
-  float w33;
-  float w34;
-  float w35;
-  float w36;
-  float w37;
-  float w38;
-  float w39;
-  float w40;
-  float w41;
-  float w42;
-  float w43;
-  float w44;
-  float w45;
-  float w46;
-  float w47;
-  float w48;
-  float w49;
-  float w50;
-  float w51;
-  float w52;
-  float w53;
-  float w54;
-  float w55;
-  float w56;
-  float w57;
+static void second_order_quadrotor_cascade_cascade_step(const second_order_quadrotor_cascade_real* x, const second_order_quadrotor_cascade_real* t, const second_order_quadrotor_cascade_real* dt, const second_order_quadrotor_cascade_real* alpha, second_order_quadrotor_cascade_real* u, second_order_quadrotor_cascade_real* alpha_next, second_order_quadrotor_cascade_real* r, second_order_quadrotor_cascade_real* inside_position, second_order_quadrotor_cascade_real* inside_velocity) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  second_order_quadrotor_cascade_real w6;
+  second_order_quadrotor_cascade_real w7;
+  second_order_quadrotor_cascade_real w8;
+  second_order_quadrotor_cascade_real w9;
+  second_order_quadrotor_cascade_real w10;
+  second_order_quadrotor_cascade_real w11;
+  second_order_quadrotor_cascade_real w12;
+  second_order_quadrotor_cascade_real w13;
+  second_order_quadrotor_cascade_real w14;
+  second_order_quadrotor_cascade_real w15;
+  second_order_quadrotor_cascade_real w16;
+  second_order_quadrotor_cascade_real w17;
+  second_order_quadrotor_cascade_real w18;
+  second_order_quadrotor_cascade_real w19;
+  second_order_quadrotor_cascade_real w20;
+  second_order_quadrotor_cascade_real w21;
+  second_order_quadrotor_cascade_real w22;
+  second_order_quadrotor_cascade_real w23;
+  second_order_quadrotor_cascade_real w24;
+  second_order_quadrotor_cascade_real w25;
+  second_order_quadrotor_cascade_real w26;
+  second_order_quadrotor_cascade_real w27;
+  second_order_quadrotor_cascade_real w28;
+  second_order_quadrotor_cascade_real w29;
+  second_order_quadrotor_cascade_real w30;
+  second_order_quadrotor_cascade_real w31;
+  second_order_quadrotor_cascade_real w32;
+  second_order_quadrotor_cascade_real w33;
+  second_order_quadrotor_cascade_real w34;
+  second_order_quadrotor_cascade_real w35;
+  second_order_quadrotor_cascade_real w36;
+  second_order_quadrotor_cascade_real w37;
+  second_order_quadrotor_cascade_real w38;
+  second_order_quadrotor_cascade_real w39;
+  second_order_quadrotor_cascade_real w40;
+  second_order_quadrotor_cascade_real w41;
+  second_order_quadrotor_cascade_real w42;
+  second_order_quadrotor_cascade_real w43;
+  second_order_quadrotor_cascade_real w44;
+  second_order_quadrotor_cascade_real w45;
+  second_order_quadrotor_cascade_real w46;
+  second_order_quadrotor_cascade_real w47;
+  second_order_quadrotor_cascade_real w48;
+  second_order_quadrotor_cascade_real w49;
+  second_order_quadrotor_cascade_real w50;
+  second_order_quadrotor_cascade_real w51;
+  second_order_quadrotor_cascade_real w52;
+  second_order_quadrotor_cascade_real w53;
+  second_order_quadrotor_cascade_real w54;
+  second_order_quadrotor_cascade_real w55;
+  second_order_quadrotor_cascade_real w56;
+  second_order_quadrotor_cascade_real w57;
   w0 = 9046.954292479999f;
   w1 = 2.0f;
   w2 = 8.290377273567628e-09f;
@@ -150,7 +159,7 @@ static void second_order_quadrotor_cascade_cascade_step(const float* x1, const f
   w9 = 1e-06f;
   w10 = (w9 > w7) ? w9 : w7;
   w11 = 1.0f;
-  w12 = x2[0];
+  w12 = x[3];
   w13 = 0.027101390625000003f;
   w14 = 4.0f;
   w15 = 5.1f;
@@ -293,7 +302,7 @@ static void second_order_quadrotor_cascade_cascade_step(const float* x1, const f
   w17 = w21 + w24;
   w17 = -w17;
   w17 = (w9 > w17) ? w9 : w17;
-  w34 = x1[0];
+  w34 = x[0];
   w39 = w34 + w34;
   w40 = w24 - w21;
   w39 = w39 - w40;
@@ -331,7 +340,7 @@ static void second_order_quadrotor_cascade_cascade_step(const float* x1, const f
   w2 = w2 * w3;
   w2 = w2 + w8;
   w3 = (w9 > w2) ? w9 : w2;
-  w10 = x2[1];
+  w10 = x[4];
   w39 = w15 * w18;
   w39 = w39 + w19;
   w42 = alpha[4];
@@ -364,7 +373,7 @@ static void second_order_quadrotor_cascade_cascade_step(const float* x1, const f
   w39 = w43 + w45;
   w39 = -w39;
   w39 = (w9 > w39) ? w9 : w39;
-  w46 = x1[1];
+  w46 = x[1];
   w47 = w46 + w46;
   w48 = w45 - w43;
   w47 = w47 - w48;
@@ -397,7 +406,7 @@ static void second_order_quadrotor_cascade_cascade_step(const float* x1, const f
   w3 = w3 * w47;
   w3 = -w3;
   u[1] = w3;
-  w3 = x2[2];
+  w3 = x[5];
   w47 = 0.6000000000000001f;
   w48 = w47 * w18;
   w49 = 1.2f;
@@ -435,7 +444,7 @@ static void second_order_quadrotor_cascade_cascade_step(const float* x1, const f
   w18 = w51 + w55;
   w18 = -w18;
   w18 = (w9 > w18) ? w9 : w18;
-  w9 = x1[2];
+  w9 = x[2];
   w56 = w9 + w9;
   w57 = w55 - w51;
   w56 = w56 - w57;
@@ -1226,52 +1235,130 @@ static void second_order_quadrotor_cascade_cascade_step(const float* x1, const f
   inside_velocity[0] = w24;
 }
 
-static int second_order_quadrotor_cascade_finite(const float* v, int count, int nonnegative) {
-  int ok = 1;
+static int second_order_quadrotor_cascade_finite(const second_order_quadrotor_cascade_real* v, int count) {
   int i;
+  int ok = 1;
   for (i = 0; i < count; ++i) {
-    if ((isfinite(v[i]) == 0) || ((nonnegative != 0) && (v[i] < 0.0f))) {
+    if (isfinite(v[i]) == 0) {
       ok = 0;
     }
   }
   return ok;
 }
 
-int second_order_quadrotor_cascade_step(float t, float dt, const float* x1, const float* x2,
-    const float* alpha, float* u, float* alpha_next, float* r) {
-  int status = SECOND_ORDER_QUADROTOR_CASCADE_INVALID_INPUT;
-  int valid = 0;
-  if ((isfinite(t) != 0) && (t >= 0.0f) && (isfinite(dt) != 0)
-      && (dt > 0.0f) && (dt <= 1.0f)
-      && (second_order_quadrotor_cascade_finite(x1, SECOND_ORDER_QUADROTOR_CASCADE_N, 0) != 0)
-      && (second_order_quadrotor_cascade_finite(x2, SECOND_ORDER_QUADROTOR_CASCADE_N, 0) != 0)
-      && (second_order_quadrotor_cascade_finite(alpha, (2 * SECOND_ORDER_QUADROTOR_CASCADE_N), 1) != 0)) {
-    valid = 1;
-  }
-  if (valid == 0) {
-    int i;
-    for (i = 0; i < SECOND_ORDER_QUADROTOR_CASCADE_N; ++i) {
-      u[i] = 0.0f;
-      r[i] = 0.0f;
+/* alpha in the domain of the adaptive law: every entry finite, in [0, ALPHA_MAX]. */
+static int second_order_quadrotor_cascade_alpha_valid(const second_order_quadrotor_cascade_real* a) {
+  int i;
+  int ok = 1;
+  for (i = 0; i < SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA; ++i) {
+    if (!((a[i] >= 0.0f) && (a[i] <= SECOND_ORDER_QUADROTOR_CASCADE_ALPHA_MAX))) {
+      ok = 0;
     }
-    for (i = 0; i < (2 * SECOND_ORDER_QUADROTOR_CASCADE_N); ++i) {
-      alpha_next[i] = (isfinite(alpha[i]) != 0) ? alpha[i] : 0.0f;
+  }
+  return ok;
+}
+
+/* t in its domain: finite, t >= 0. */
+static int second_order_quadrotor_cascade_time_valid(second_order_quadrotor_cascade_real t) {
+  int ok = 0;
+  if ((isfinite(t) != 0) && (t >= 0.0f)) {
+    ok = 1;
+  }
+  return ok;
+}
+
+/* dt in its domain: DT_MIN <= dt <= DT_MAX. */
+static int second_order_quadrotor_cascade_dt_valid(second_order_quadrotor_cascade_real dt) {
+  int ok = 0;
+  if ((dt >= SECOND_ORDER_QUADROTOR_CASCADE_DT_MIN) && (dt <= SECOND_ORDER_QUADROTOR_CASCADE_DT_MAX)) {
+    ok = 1;
+  }
+  return ok;
+}
+
+static void second_order_quadrotor_cascade_copy(const second_order_quadrotor_cascade_real* from, second_order_quadrotor_cascade_real* to, int count) {
+  int i;
+  for (i = 0; i < count; ++i) {
+    to[i] = from[i];
+  }
+}
+
+/* alpha_next on INVALID_INPUT: alpha, with every non-finite entry replaced by 0. */
+static void second_order_quadrotor_cascade_keep_alpha(const second_order_quadrotor_cascade_real* from, second_order_quadrotor_cascade_real* to) {
+  int i;
+  for (i = 0; i < SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA; ++i) {
+    to[i] = (isfinite(from[i]) != 0) ? from[i] : 0.0f;
+  }
+}
+
+static void second_order_quadrotor_cascade_zero(second_order_quadrotor_cascade_real* v, int count) {
+  if (v != NULL) {
+    int i;
+    for (i = 0; i < count; ++i) {
+      v[i] = 0.0f;
+    }
+  }
+}
+
+int second_order_quadrotor_cascade_step(const second_order_quadrotor_cascade_real x[SECOND_ORDER_QUADROTOR_CASCADE_N_STATE], second_order_quadrotor_cascade_real t, second_order_quadrotor_cascade_real dt,
+    const second_order_quadrotor_cascade_real alpha[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA], second_order_quadrotor_cascade_real u[SECOND_ORDER_QUADROTOR_CASCADE_N],
+    second_order_quadrotor_cascade_real alpha_next[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA], second_order_quadrotor_cascade_real r[SECOND_ORDER_QUADROTOR_CASCADE_N]) {
+  int status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_INVALID_INPUT;
+  if ((u != NULL) && (alpha_next != NULL) && (r != NULL)) {
+    second_order_quadrotor_cascade_real uc[SECOND_ORDER_QUADROTOR_CASCADE_N];
+    second_order_quadrotor_cascade_real rc[SECOND_ORDER_QUADROTOR_CASCADE_N];
+    if (alpha == NULL) {
+      second_order_quadrotor_cascade_zero(alpha_next, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA);
+    } else {
+      second_order_quadrotor_cascade_real a[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+      second_order_quadrotor_cascade_real next[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+      second_order_quadrotor_cascade_copy(alpha, a, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA);
+      if ((x != NULL) && (second_order_quadrotor_cascade_time_valid(t) != 0) && (second_order_quadrotor_cascade_dt_valid(dt) != 0)
+          && (second_order_quadrotor_cascade_finite(x, SECOND_ORDER_QUADROTOR_CASCADE_N_STATE) != 0) && (second_order_quadrotor_cascade_alpha_valid(a) != 0)) {
+        second_order_quadrotor_cascade_real xc[SECOND_ORDER_QUADROTOR_CASCADE_N_STATE];
+        second_order_quadrotor_cascade_real tv[1];
+        second_order_quadrotor_cascade_real dtv[1];
+        second_order_quadrotor_cascade_real inside_position[1];
+        second_order_quadrotor_cascade_real inside_velocity[1];
+        second_order_quadrotor_cascade_copy(x, xc, SECOND_ORDER_QUADROTOR_CASCADE_N_STATE);
+        tv[0] = t;
+        dtv[0] = dt;
+        second_order_quadrotor_cascade_cascade_step(xc, tv, dtv, a, uc, next, rc, inside_position, inside_velocity);
+        if ((second_order_quadrotor_cascade_finite(uc, SECOND_ORDER_QUADROTOR_CASCADE_N) == 0) || (second_order_quadrotor_cascade_finite(rc, SECOND_ORDER_QUADROTOR_CASCADE_N) == 0)
+            || (second_order_quadrotor_cascade_finite(next, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA) == 0)) {
+          status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_INVALID_INPUT;
+        } else if (inside_position[0] == 0.0f) {
+          status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_OUTSIDE_TUBE;
+        } else if (inside_velocity[0] == 0.0f) {
+          status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_OUTSIDE_VELOCITY_TUBE;
+        } else {
+          status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_OK;
+        }
+      }
+      if (status == SECOND_ORDER_QUADROTOR_CASCADE_STATUS_INVALID_INPUT) {
+        second_order_quadrotor_cascade_keep_alpha(a, alpha_next);
+      } else {
+        second_order_quadrotor_cascade_copy(next, alpha_next, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA);
+      }
+    }
+    if (status == SECOND_ORDER_QUADROTOR_CASCADE_STATUS_INVALID_INPUT) {
+      second_order_quadrotor_cascade_zero(u, SECOND_ORDER_QUADROTOR_CASCADE_N);
+      second_order_quadrotor_cascade_zero(r, SECOND_ORDER_QUADROTOR_CASCADE_N);
+    } else {
+      second_order_quadrotor_cascade_copy(uc, u, SECOND_ORDER_QUADROTOR_CASCADE_N);
+      second_order_quadrotor_cascade_copy(rc, r, SECOND_ORDER_QUADROTOR_CASCADE_N);
     }
   } else {
-    float tv[1];
-    float dtv[1];
-    float inside_position[1];
-    float inside_velocity[1];
-    tv[0] = t;
-    dtv[0] = dt;
-    second_order_quadrotor_cascade_cascade_step(x1, x2, tv, dtv, alpha, u, alpha_next, r, inside_position, inside_velocity);
-    if (inside_position[0] != 1.0f) {
-      status = SECOND_ORDER_QUADROTOR_CASCADE_OUTSIDE_POSITION_TUBE;
-    } else if (inside_velocity[0] != 1.0f) {
-      status = SECOND_ORDER_QUADROTOR_CASCADE_OUTSIDE_VELOCITY_TUBE;
-    } else {
-      status = SECOND_ORDER_QUADROTOR_CASCADE_OK;
+    /* u, alpha_next or r NULL: INVALID_INPUT, the other outputs written as documented */
+    if (alpha_next != NULL) {
+      if (alpha == NULL) {
+        second_order_quadrotor_cascade_zero(alpha_next, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA);
+      } else {
+        second_order_quadrotor_cascade_keep_alpha(alpha, alpha_next);
+      }
     }
+    second_order_quadrotor_cascade_zero(u, SECOND_ORDER_QUADROTOR_CASCADE_N);
+    second_order_quadrotor_cascade_zero(r, SECOND_ORDER_QUADROTOR_CASCADE_N);
   }
   return status;
 }

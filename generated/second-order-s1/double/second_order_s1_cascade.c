@@ -3,72 +3,81 @@
  * "second-order-s1" and its second stage (SHA-256 8a27933f0e92c44de5551b2bbd1c76079bd77f4b74544fc0325804d9f53758b3),
  * precision double. Cascade law of docs/second-order.md.
  */
+/*
+ * Implementation of second_order_s1_cascade.h. The function second_order_s1_cascade_cascade_step is printed by the project's C
+ * printer (stt_codegen.codegen.emit.CPrinter, double) from the CasADi Function
+ * stt_codegen.tube.cascade.cascade_step of the design and its second stage; second_order_s1_cascade_step
+ * checks the inputs, calls it and sets the status.
+ */
 #include <math.h>
+#include <stddef.h>
 
 #include "second_order_s1_cascade.h"
 
+/* -ffast-math and -Ofast define __FAST_MATH__; -ffinite-math-only (gcc, clang) and clang's
+   -fno-honor-nans -fno-honor-infinities together define __FINITE_MATH_ONLY__ 1. */
 #if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && (__FINITE_MATH_ONLY__ != 0))
-#error "second_order_s1_cascade.c must not be compiled with -ffast-math: it removes the isfinite() input checks"
+#error "second_order_s1_cascade.c must not be compiled with -ffast-math (or -Ofast, -ffinite-math-only, -fno-honor-nans, -fno-honor-infinities): they remove the isfinite() input checks"
 #endif
 
 /* CasADi Function 'cascade_step': 776 instructions. */
-static void second_order_s1_cascade_cascade_step(const double* x1, const double* x2, const double* t, const double* dt, const double* alpha, double* u, double* alpha_next, double* r, double* inside_position, double* inside_velocity) {
-  double w0;
-  double w1;
-  double w2;
-  double w3;
-  double w4;
-  double w5;
-  double w6;
-  double w7;
-  double w8;
-  double w9;
-  double w10;
-  double w11;
-  double w12;
-  double w13;
-  double w14;
-  double w15;
-  double w16;
-  double w17;
-  double w18;
-  double w19;
-  double w20;
-  double w21;
-  double w22;
-  double w23;
-  double w24;
-  double w25;
-  double w26;
-  double w27;
-  double w28;
-  double w29;
-  double w30;
-  double w31;
-  double w32;
-  double w33;
-  double w34;
-  double w35;
-  double w36;
-  double w37;
-  double w38;
-  double w39;
-  double w40;
-  double w41;
-  double w42;
-  double w43;
-  double w44;
-  double w45;
-  double w46;
-  double w47;
-  double w48;
-  double w49;
-  double w50;
-  double w51;
-  double w52;
-  double w53;
-  double w54;
-  double w55;
+static void second_order_s1_cascade_cascade_step(const second_order_s1_cascade_real* x, const second_order_s1_cascade_real* t, const second_order_s1_cascade_real* dt, const second_order_s1_cascade_real* alpha, second_order_s1_cascade_real* u, second_order_s1_cascade_real* alpha_next, second_order_s1_cascade_real* r, second_order_s1_cascade_real* inside_position, second_order_s1_cascade_real* inside_velocity) {
+  second_order_s1_cascade_real w0;
+  second_order_s1_cascade_real w1;
+  second_order_s1_cascade_real w2;
+  second_order_s1_cascade_real w3;
+  second_order_s1_cascade_real w4;
+  second_order_s1_cascade_real w5;
+  second_order_s1_cascade_real w6;
+  second_order_s1_cascade_real w7;
+  second_order_s1_cascade_real w8;
+  second_order_s1_cascade_real w9;
+  second_order_s1_cascade_real w10;
+  second_order_s1_cascade_real w11;
+  second_order_s1_cascade_real w12;
+  second_order_s1_cascade_real w13;
+  second_order_s1_cascade_real w14;
+  second_order_s1_cascade_real w15;
+  second_order_s1_cascade_real w16;
+  second_order_s1_cascade_real w17;
+  second_order_s1_cascade_real w18;
+  second_order_s1_cascade_real w19;
+  second_order_s1_cascade_real w20;
+  second_order_s1_cascade_real w21;
+  second_order_s1_cascade_real w22;
+  second_order_s1_cascade_real w23;
+  second_order_s1_cascade_real w24;
+  second_order_s1_cascade_real w25;
+  second_order_s1_cascade_real w26;
+  second_order_s1_cascade_real w27;
+  second_order_s1_cascade_real w28;
+  second_order_s1_cascade_real w29;
+  second_order_s1_cascade_real w30;
+  second_order_s1_cascade_real w31;
+  second_order_s1_cascade_real w32;
+  second_order_s1_cascade_real w33;
+  second_order_s1_cascade_real w34;
+  second_order_s1_cascade_real w35;
+  second_order_s1_cascade_real w36;
+  second_order_s1_cascade_real w37;
+  second_order_s1_cascade_real w38;
+  second_order_s1_cascade_real w39;
+  second_order_s1_cascade_real w40;
+  second_order_s1_cascade_real w41;
+  second_order_s1_cascade_real w42;
+  second_order_s1_cascade_real w43;
+  second_order_s1_cascade_real w44;
+  second_order_s1_cascade_real w45;
+  second_order_s1_cascade_real w46;
+  second_order_s1_cascade_real w47;
+  second_order_s1_cascade_real w48;
+  second_order_s1_cascade_real w49;
+  second_order_s1_cascade_real w50;
+  second_order_s1_cascade_real w51;
+  second_order_s1_cascade_real w52;
+  second_order_s1_cascade_real w53;
+  second_order_s1_cascade_real w54;
+  second_order_s1_cascade_real w55;
   w0 = 11.982282816666666;
   w1 = 2.0;
   w2 = 0.0037560128445799923;
@@ -87,7 +96,7 @@ static void second_order_s1_cascade_cascade_step(const double* x1, const double*
   w8 = 1e-06;
   w9 = (w8 > w2) ? w8 : w2;
   w10 = 1.0;
-  w11 = x2[0];
+  w11 = x[2];
   w12 = 0.047235071999999996;
   w13 = 4.0;
   w14 = 1.6875;
@@ -202,7 +211,7 @@ static void second_order_s1_cascade_cascade_step(const double* x1, const double*
   w40 = w36 + w45;
   w40 = -w40;
   w40 = (w8 > w40) ? w8 : w40;
-  w47 = x1[0];
+  w47 = x[0];
   w48 = w47 + w47;
   w49 = w45 - w36;
   w48 = w48 - w49;
@@ -241,7 +250,7 @@ static void second_order_s1_cascade_cascade_step(const double* x1, const double*
   w9 = w9 * w3;
   w9 = w9 + w7;
   w7 = (w8 > w9) ? w8 : w9;
-  w3 = x2[1];
+  w3 = x[3];
   w48 = 4.95;
   w51 = w48 - w18;
   w51 = (w15 != 0.0) ? w51 : 0.0;
@@ -293,7 +302,7 @@ static void second_order_s1_cascade_cascade_step(const double* x1, const double*
   w15 = w54 + w25;
   w15 = -w15;
   w15 = (w8 > w15) ? w8 : w15;
-  w8 = x1[1];
+  w8 = x[1];
   w38 = w8 + w8;
   w27 = w25 - w54;
   w38 = w38 - w27;
@@ -847,52 +856,130 @@ static void second_order_s1_cascade_cascade_step(const double* x1, const double*
   inside_velocity[0] = w45;
 }
 
-static int second_order_s1_cascade_finite(const double* v, int count, int nonnegative) {
-  int ok = 1;
+static int second_order_s1_cascade_finite(const second_order_s1_cascade_real* v, int count) {
   int i;
+  int ok = 1;
   for (i = 0; i < count; ++i) {
-    if ((isfinite(v[i]) == 0) || ((nonnegative != 0) && (v[i] < 0.0))) {
+    if (isfinite(v[i]) == 0) {
       ok = 0;
     }
   }
   return ok;
 }
 
-int second_order_s1_cascade_step(double t, double dt, const double* x1, const double* x2,
-    const double* alpha, double* u, double* alpha_next, double* r) {
-  int status = SECOND_ORDER_S1_CASCADE_INVALID_INPUT;
-  int valid = 0;
-  if ((isfinite(t) != 0) && (t >= 0.0) && (isfinite(dt) != 0)
-      && (dt > 0.0) && (dt <= 1.0)
-      && (second_order_s1_cascade_finite(x1, SECOND_ORDER_S1_CASCADE_N, 0) != 0)
-      && (second_order_s1_cascade_finite(x2, SECOND_ORDER_S1_CASCADE_N, 0) != 0)
-      && (second_order_s1_cascade_finite(alpha, (2 * SECOND_ORDER_S1_CASCADE_N), 1) != 0)) {
-    valid = 1;
-  }
-  if (valid == 0) {
-    int i;
-    for (i = 0; i < SECOND_ORDER_S1_CASCADE_N; ++i) {
-      u[i] = 0.0;
-      r[i] = 0.0;
+/* alpha in the domain of the adaptive law: every entry finite, in [0, ALPHA_MAX]. */
+static int second_order_s1_cascade_alpha_valid(const second_order_s1_cascade_real* a) {
+  int i;
+  int ok = 1;
+  for (i = 0; i < SECOND_ORDER_S1_CASCADE_N_ALPHA; ++i) {
+    if (!((a[i] >= 0.0) && (a[i] <= SECOND_ORDER_S1_CASCADE_ALPHA_MAX))) {
+      ok = 0;
     }
-    for (i = 0; i < (2 * SECOND_ORDER_S1_CASCADE_N); ++i) {
-      alpha_next[i] = (isfinite(alpha[i]) != 0) ? alpha[i] : 0.0;
+  }
+  return ok;
+}
+
+/* t in its domain: finite, t >= 0. */
+static int second_order_s1_cascade_time_valid(second_order_s1_cascade_real t) {
+  int ok = 0;
+  if ((isfinite(t) != 0) && (t >= 0.0)) {
+    ok = 1;
+  }
+  return ok;
+}
+
+/* dt in its domain: DT_MIN <= dt <= DT_MAX. */
+static int second_order_s1_cascade_dt_valid(second_order_s1_cascade_real dt) {
+  int ok = 0;
+  if ((dt >= SECOND_ORDER_S1_CASCADE_DT_MIN) && (dt <= SECOND_ORDER_S1_CASCADE_DT_MAX)) {
+    ok = 1;
+  }
+  return ok;
+}
+
+static void second_order_s1_cascade_copy(const second_order_s1_cascade_real* from, second_order_s1_cascade_real* to, int count) {
+  int i;
+  for (i = 0; i < count; ++i) {
+    to[i] = from[i];
+  }
+}
+
+/* alpha_next on INVALID_INPUT: alpha, with every non-finite entry replaced by 0. */
+static void second_order_s1_cascade_keep_alpha(const second_order_s1_cascade_real* from, second_order_s1_cascade_real* to) {
+  int i;
+  for (i = 0; i < SECOND_ORDER_S1_CASCADE_N_ALPHA; ++i) {
+    to[i] = (isfinite(from[i]) != 0) ? from[i] : 0.0;
+  }
+}
+
+static void second_order_s1_cascade_zero(second_order_s1_cascade_real* v, int count) {
+  if (v != NULL) {
+    int i;
+    for (i = 0; i < count; ++i) {
+      v[i] = 0.0;
+    }
+  }
+}
+
+int second_order_s1_cascade_step(const second_order_s1_cascade_real x[SECOND_ORDER_S1_CASCADE_N_STATE], second_order_s1_cascade_real t, second_order_s1_cascade_real dt,
+    const second_order_s1_cascade_real alpha[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real u[SECOND_ORDER_S1_CASCADE_N],
+    second_order_s1_cascade_real alpha_next[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real r[SECOND_ORDER_S1_CASCADE_N]) {
+  int status = SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT;
+  if ((u != NULL) && (alpha_next != NULL) && (r != NULL)) {
+    second_order_s1_cascade_real uc[SECOND_ORDER_S1_CASCADE_N];
+    second_order_s1_cascade_real rc[SECOND_ORDER_S1_CASCADE_N];
+    if (alpha == NULL) {
+      second_order_s1_cascade_zero(alpha_next, SECOND_ORDER_S1_CASCADE_N_ALPHA);
+    } else {
+      second_order_s1_cascade_real a[SECOND_ORDER_S1_CASCADE_N_ALPHA];
+      second_order_s1_cascade_real next[SECOND_ORDER_S1_CASCADE_N_ALPHA];
+      second_order_s1_cascade_copy(alpha, a, SECOND_ORDER_S1_CASCADE_N_ALPHA);
+      if ((x != NULL) && (second_order_s1_cascade_time_valid(t) != 0) && (second_order_s1_cascade_dt_valid(dt) != 0)
+          && (second_order_s1_cascade_finite(x, SECOND_ORDER_S1_CASCADE_N_STATE) != 0) && (second_order_s1_cascade_alpha_valid(a) != 0)) {
+        second_order_s1_cascade_real xc[SECOND_ORDER_S1_CASCADE_N_STATE];
+        second_order_s1_cascade_real tv[1];
+        second_order_s1_cascade_real dtv[1];
+        second_order_s1_cascade_real inside_position[1];
+        second_order_s1_cascade_real inside_velocity[1];
+        second_order_s1_cascade_copy(x, xc, SECOND_ORDER_S1_CASCADE_N_STATE);
+        tv[0] = t;
+        dtv[0] = dt;
+        second_order_s1_cascade_cascade_step(xc, tv, dtv, a, uc, next, rc, inside_position, inside_velocity);
+        if ((second_order_s1_cascade_finite(uc, SECOND_ORDER_S1_CASCADE_N) == 0) || (second_order_s1_cascade_finite(rc, SECOND_ORDER_S1_CASCADE_N) == 0)
+            || (second_order_s1_cascade_finite(next, SECOND_ORDER_S1_CASCADE_N_ALPHA) == 0)) {
+          status = SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT;
+        } else if (inside_position[0] == 0.0) {
+          status = SECOND_ORDER_S1_CASCADE_STATUS_OUTSIDE_TUBE;
+        } else if (inside_velocity[0] == 0.0) {
+          status = SECOND_ORDER_S1_CASCADE_STATUS_OUTSIDE_VELOCITY_TUBE;
+        } else {
+          status = SECOND_ORDER_S1_CASCADE_STATUS_OK;
+        }
+      }
+      if (status == SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT) {
+        second_order_s1_cascade_keep_alpha(a, alpha_next);
+      } else {
+        second_order_s1_cascade_copy(next, alpha_next, SECOND_ORDER_S1_CASCADE_N_ALPHA);
+      }
+    }
+    if (status == SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT) {
+      second_order_s1_cascade_zero(u, SECOND_ORDER_S1_CASCADE_N);
+      second_order_s1_cascade_zero(r, SECOND_ORDER_S1_CASCADE_N);
+    } else {
+      second_order_s1_cascade_copy(uc, u, SECOND_ORDER_S1_CASCADE_N);
+      second_order_s1_cascade_copy(rc, r, SECOND_ORDER_S1_CASCADE_N);
     }
   } else {
-    double tv[1];
-    double dtv[1];
-    double inside_position[1];
-    double inside_velocity[1];
-    tv[0] = t;
-    dtv[0] = dt;
-    second_order_s1_cascade_cascade_step(x1, x2, tv, dtv, alpha, u, alpha_next, r, inside_position, inside_velocity);
-    if (inside_position[0] != 1.0) {
-      status = SECOND_ORDER_S1_CASCADE_OUTSIDE_POSITION_TUBE;
-    } else if (inside_velocity[0] != 1.0) {
-      status = SECOND_ORDER_S1_CASCADE_OUTSIDE_VELOCITY_TUBE;
-    } else {
-      status = SECOND_ORDER_S1_CASCADE_OK;
+    /* u, alpha_next or r NULL: INVALID_INPUT, the other outputs written as documented */
+    if (alpha_next != NULL) {
+      if (alpha == NULL) {
+        second_order_s1_cascade_zero(alpha_next, SECOND_ORDER_S1_CASCADE_N_ALPHA);
+      } else {
+        second_order_s1_cascade_keep_alpha(alpha, alpha_next);
+      }
     }
+    second_order_s1_cascade_zero(u, SECOND_ORDER_S1_CASCADE_N);
+    second_order_s1_cascade_zero(r, SECOND_ORDER_S1_CASCADE_N);
   }
   return status;
 }
