@@ -30,7 +30,8 @@ from ..runtime.simulate import SUBSTEPS
 from ..spec.loader import Spec
 from ..tube.parameters import TubeDesign
 
-__all__ = ["closed_loop_source", "parse_closed_loop", "parse_replay", "replay_source", "steps_of"]
+__all__ = ["closed_loop_source", "loop_context", "parse_closed_loop", "parse_replay", "replay_source",
+           "steps_of"]
 
 
 def _d(value: float) -> str:
@@ -79,6 +80,45 @@ def _obstacles(spec: Spec) -> list[dict]:
     return out
 
 
+def loop_context(spec: Spec, design: TubeDesign, *, seed: int = 0, decimate: int = 10,
+                 replay: list[int] = ()) -> dict:
+    """What the closed-loop templates of both orders share (``templates/_embedded_plant.j2``,
+    ``_embedded_rk4.j2``, ``_embedded_judge.j2``): the names, the periods, the sets, the
+    disturbance and the obstacles, as C literals.
+
+    Parameters
+    ----------
+    spec, design
+        The spec (sets, ``t_c``, disturbance) and its design (rate).
+    seed : int
+        Disturbance seed (as ``simulate(..., seed=seed)``).
+    decimate : int
+        Print the state every ``decimate`` steps (and at the last one).
+    replay : list of int
+        Steps whose controller inputs are printed, increasing.
+
+    Returns
+    -------
+    dict
+        Template variables.
+    """
+    prefix = c_identifier(spec.c_name)
+    n = spec.dimension
+    dist = Disturbance(n, spec.disturbance_amplitude, seed)
+    return dict(
+        P=prefix, U=prefix.upper(), spec_name=spec.name, real="float", n=n,
+        steps=steps_of(spec, design), substeps=SUBSTEPS, decimate=int(decimate),
+        terms=dist.weights.shape[1], seed=int(seed), rate_hz=f"{design.rate_hz:g}",
+        rate_hz_d=_d(design.rate_hz), t_c=_d(spec.prescribed_time),
+        ss_lo=[_d(v) for v in spec.state_space.lower], ss_hi=[_d(v) for v in spec.state_space.upper],
+        tg_lo=[_d(v) for v in spec.target_set.lower], tg_hi=[_d(v) for v in spec.target_set.upper],
+        w_amp=_d(dist.amplitude), w_c=[[_d(v) for v in r] for r in dist.weights],
+        w_omega=[[_d(v) for v in r] for r in dist.frequencies],
+        w_phi=[[_d(v) for v in r] for r in dist.phases],
+        replay=[int(k) for k in replay], obstacles=_obstacles(spec),
+        has_obstacles=bool(spec.unsafe_sets))
+
+
 def closed_loop_source(spec: Spec, design: TubeDesign, *, seed: int = 0, decimate: int = 10,
                        replay: list[int] = ()) -> str:
     """The closed-loop C program (see the template's header comment).
@@ -100,27 +140,16 @@ def closed_loop_source(spec: Spec, design: TubeDesign, *, seed: int = 0, decimat
         The C source of the program (single precision), which prints the sampled states
         (``X`` lines), the replay steps' inputs (``S`` lines) and a ``closed loop:`` summary.
     """
-    prefix = c_identifier(spec.c_name)
     n = spec.dimension
-    dist = Disturbance(n, spec.disturbance_amplitude, seed)
     plant_doc = {"omnidirectional": "x_dot = R(x3) u + w, R the rotation by the heading x3 "
                                     "(eq. (14))",
                  "linear": "x_dot = a x + c + g u + w, the spec's matrices"}.get(
                      spec.plant_model, "x_dot = u + w")
     return render(
-        "embedded_closed_loop.c.j2", P=prefix, U=prefix.upper(), spec_name=spec.name,
-        real="float", plant=spec.plant_model, plant_doc=plant_doc, n=n,
-        steps=steps_of(spec, design), substeps=SUBSTEPS, decimate=int(decimate),
-        terms=dist.weights.shape[1], seed=int(seed), rate_hz=f"{design.rate_hz:g}",
-        rate_hz_d=_d(design.rate_hz), t_c=_d(spec.prescribed_time),
+        "embedded_closed_loop.c.j2",
+        **loop_context(spec, design, seed=seed, decimate=decimate, replay=replay),
+        plant=spec.plant_model, plant_doc=plant_doc,
         x0=[_d(v) for v in spec.initial_state],
-        ss_lo=[_d(v) for v in spec.state_space.lower], ss_hi=[_d(v) for v in spec.state_space.upper],
-        tg_lo=[_d(v) for v in spec.target_set.lower], tg_hi=[_d(v) for v in spec.target_set.upper],
-        w_amp=_d(dist.amplitude), w_c=[[_d(v) for v in r] for r in dist.weights],
-        w_omega=[[_d(v) for v in r] for r in dist.frequencies],
-        w_phi=[[_d(v) for v in r] for r in dist.phases],
-        replay=[int(k) for k in replay], obstacles=_obstacles(spec),
-        has_obstacles=bool(spec.unsafe_sets),
         plant_rhs=c_source(plant_function(spec.plant_model, n, spec.linear_plant)).strip())
 
 
