@@ -19,17 +19,20 @@ in the Jinja2 templates ``cascade_header.h.j2``, ``cascade_source.c.j2`` and
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 
 import casadi
 
-from ..tube.cascade import cascade_step
+from ..tube.cascade import cascade_step, velocity_law, velocity_tube
+from ..tube.model import build_model
 from ..tube.parameters import Status, TubeDesign
 from ..tube.second_stage import SecondStage
 from ..version import __version__
 from ..design.result import Design
-from .emit import CPrinter, lower, python_source
-from .generate import input_limits
+from .emit import python_source
+from .functions import deployed_functions
+from .generate import c_source_context, input_limits
 from .options import Options
 from .render import c_real, render
 
@@ -104,12 +107,21 @@ def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
     """
     if not prefix.isidentifier() or not prefix.isascii():
         raise ValueError(f"prefix {prefix!r} is not a C identifier")
+    if stage.dimension != design.dimension:
+        raise ValueError(f"second stage of dimension {stage.dimension} for a tube of "
+                         f"dimension {design.dimension}")
     single = precision == "single"
-    printer = CPrinter(precision, f"{prefix}_real", f"{prefix}_")
-    program = lower(cascade_step(design, stage))
-    context = dict(_context(design, stage, prefix, precision, lambda v: c_real(v, single)),
-                   real="float" if single else "double", body=printer.doprint(program),
-                   function=printer.function_name(program), zero=c_real(0.0, single))
+    literal = lambda v: c_real(v, single)  # noqa: E731
+    # the tube's tables carry k1 as law (13)'s gain: r is law (13) with gain k1
+    first = dataclasses.replace(design, gain=stage.position_gain)
+    functions = [*deployed_functions(build_model(first)), velocity_tube(design.dimension),
+                 velocity_law(design.dimension)]
+    context = dict(c_source_context(first, prefix, precision, functions),
+                   **_context(design, stage, prefix, precision, literal), cascade=True,
+                   stage={"velocity_gain": literal(stage.velocity_gain),
+                          "decay": literal(stage.decay),
+                          "width_start": [literal(v) for v in stage.width_start],
+                          "width_floor": [literal(v) for v in stage.width_floor]})
     return {name: render(template, filename=name, **context)
             for name, template in ((f"{prefix}.h", "cascade_header.h.j2"),
                                    (f"{prefix}.c", "cascade_source.c.j2"))}

@@ -36,7 +36,8 @@
  *   alpha  every entry in [0, SECOND_ORDER_S1_CASCADE_ALPHA_MAX]: the adaptive law (11) keeps alpha >= 0
  *          from alpha = 0, and far below ALPHA_MAX.
  *
- * Status codes (return value of second_order_s1_cascade_step):
+ * Status codes (return value of every function; second_order_s1_cascade_tube and second_order_s1_cascade_alpha_step return
+ * OK or INVALID_INPUT, as in the first-order API):
  *   SECOND_ORDER_S1_CASCADE_STATUS_OK                    0  outputs valid, x1 strictly inside the
  *                                          position tube and x2 - r strictly inside
  *                                          (-rho2, rho2), compared exactly.
@@ -88,6 +89,26 @@ typedef float second_order_s1_cascade_real;
 #define SECOND_ORDER_S1_CASCADE_STATUS_OUTSIDE_TUBE 1
 #define SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT 2
 #define SECOND_ORDER_S1_CASCADE_STATUS_OUTSIDE_VELOCITY_TUBE 4
+
+/**
+ * Tube bounds at time t: gamma_L, gamma_U of eq. (10) and their total time derivatives.
+ *
+ * t: seconds, t >= 0. alpha: [SECOND_ORDER_S1_CASCADE_N_ALPHA]. Outputs: [SECOND_ORDER_S1_CASCADE_N] each; gamma_L_dot and
+ * gamma_U_dot may be NULL (not written). Returns OK or INVALID_INPUT (outputs zeroed).
+ */
+int second_order_s1_cascade_tube(second_order_s1_cascade_real t, const second_order_s1_cascade_real alpha[SECOND_ORDER_S1_CASCADE_N_ALPHA],
+    second_order_s1_cascade_real gamma_L[SECOND_ORDER_S1_CASCADE_N], second_order_s1_cascade_real gamma_U[SECOND_ORDER_S1_CASCADE_N],
+    second_order_s1_cascade_real gamma_L_dot[SECOND_ORDER_S1_CASCADE_N], second_order_s1_cascade_real gamma_U_dot[SECOND_ORDER_S1_CASCADE_N]);
+
+/**
+ * Implicit (backward Euler, at most 5 Newton iterations) step of the adaptive law (11)
+ * from t to t + dt.
+ *
+ * t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha, alpha_next: [SECOND_ORDER_S1_CASCADE_N_ALPHA].
+ * Returns OK or INVALID_INPUT (alpha_next = alpha, non-finite entries 0).
+ */
+int second_order_s1_cascade_alpha_step(second_order_s1_cascade_real t, second_order_s1_cascade_real dt,
+    const second_order_s1_cascade_real alpha[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real alpha_next[SECOND_ORDER_S1_CASCADE_N_ALPHA]);
 
 /**
  * One controller step: u and r at (x, t, alpha) and alpha at t + dt. Call at every
