@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 import stt_codegen as stt
-from stt_codegen.embedded.cascade_loop import MEASURED_STEPS, run_cascade_embedded
+from stt_codegen.embedded.cascade_loop import run_cascade_embedded
+from stt_codegen.embedded.deploy import COUNT_FRACTIONS
 
 
 @pytest.mark.embedded
@@ -16,8 +17,11 @@ def test_cascade_on_the_cortex_m4f_is_satisfied_like_the_host(case) -> None:
     report = run_cascade_embedded(design)
     assert report["satisfied"], report
     assert report["outside_position"] == report["outside_velocity"] == report["invalid"] == 0
-    assert len(report["instructions_per_step"]) == MEASURED_STEPS + 1
+    assert len(report["instructions_per_step"]) == len(COUNT_FRACTIONS)
     assert all(1000 < c < 20000 for c in report["instructions_per_step"])
+    assert report["measured_times"][0] == 0.0
+    assert report["measured_times"][-1] == pytest.approx(0.999 * design.spec.prescribed_time,
+                                                         abs=2e-3)
     host = stt.simulate(design, backend="c")       # double controller, same plant
     assert abs(report["reach_time"] - host.reach_time) <= 0.01
     assert abs(report["min_clearance"] - host.min_obstacle_clearance) <= 1e-3

@@ -13,10 +13,13 @@
   :data:`stt_codegen.runtime.simulate.SUBSTEPS` substeps per period and the judgement on the
   spec's obstacles, state space and target; the velocity bound is judged too;
 
-and runs it under ``qemu-system-arm -machine mps2-an386`` twice: the whole run
-(``satisfied``, reach time, clearance, peak ``|u|``, final state), then its steps
-``0..MEASURED_STEPS``, each a measured region (``instructions_per_step``: exact
-count of emulated instructions, the call of ``P_step`` with every libm call).
+and runs it under ``qemu-system-arm -machine mps2-an386``: the whole run (``satisfied``,
+reach time, clearance, peak ``|u|``, final state), which prints the controller's inputs
+at the steps at :data:`~stt_codegen.embedded.deploy.COUNT_FRACTIONS` of ``t_c``; then
+the first order's replay program (:func:`stt_codegen.embedded.programs.replay_source`)
+calls ``P_step`` at these inputs, each call a measured region
+(``instructions_per_step``: exact count of emulated instructions, the call of ``P_step``
+with every libm call), as ``stt-codegen embedded`` measures the first-order step.
 """
 
 from __future__ import annotations
@@ -31,13 +34,11 @@ from ..codegen.render import render
 from ..design.result import Design
 from ..errors import SpecError, ToolchainError
 from ..runtime.second_order_plants import second_order_rhs
-from .programs import loop_context, parse_closed_loop
+from .deploy import COUNT_FRACTIONS, function_profile
+from .programs import loop_context, parse_closed_loop, replay_source, steps_of
 from .target import build_elf, elf_sizes, run_qemu
 
-__all__ = ["MEASURED_STEPS", "closed_loop_program", "run_cascade_embedded"]
-
-#: Steps ``0..MEASURED_STEPS`` are counted.
-MEASURED_STEPS = 4
+__all__ = ["closed_loop_program", "run_cascade_embedded"]
 
 
 def _d(value: float) -> str:
@@ -51,7 +52,7 @@ def _d(value: float) -> str:
 
 
 def closed_loop_program(design: Design, prefix: str, seed: int = 0,
-                        decimate: int = 100) -> str:
+                        decimate: int = 100, replay: list[int] = ()) -> str:
     """The C text of the closed-loop program (``templates/cascade_closed_loop.c.j2``).
 
     Parameters
@@ -64,12 +65,14 @@ def closed_loop_program(design: Design, prefix: str, seed: int = 0,
         Disturbance seed (as ``simulate(..., seed=seed)``).
     decimate : int
         Print the state every ``decimate`` steps (and at the last one).
+    replay : list of int
+        Steps whose controller inputs are printed (``S`` lines), increasing.
 
     Returns
     -------
     str
-        The C source; it prints ``X`` lines (the state ``[x1; x2]``) and a ``closed loop:``
-        summary (:func:`stt_codegen.embedded.programs.parse_closed_loop`).
+        The C source; it prints ``X`` lines (the state ``[x1; x2]``), ``S`` lines and a
+        ``closed loop:`` summary (:func:`stt_codegen.embedded.programs.parse_closed_loop`).
 
     Raises
     ------
@@ -82,7 +85,8 @@ def closed_loop_program(design: Design, prefix: str, seed: int = 0,
         raise SpecError("plant.model", "the spec describes a first-order plant")
     n = spec.dimension
     bound = order.velocity_bound or (math.inf,) * n
-    context = dict(loop_context(spec, design.tube, seed=seed, decimate=decimate),
+    context = dict(loop_context(spec, design.tube, seed=seed, decimate=decimate,
+                                replay=replay),
                    P=prefix, U=prefix.upper(), plant=order.model,
                    x0=[_d(v) for v in (*spec.initial_state, *order.initial_velocity)],
                    parameters=[_d(v) for v in order.parameters],
@@ -112,7 +116,8 @@ def run_cascade_embedded(design: Design, seed: int = 0, timeout: float = 600.0) 
         numbers of steps with each status other than OK (``outside_position``,
         ``outside_velocity``, ``invalid``, ``input_clamped``),
         ``exceeded_velocity_bound``, ``instructions_per_step`` (list over the measured
-        steps), ``flash_bytes_controller`` (text + data of the controller object).
+        steps), ``measured_times`` (their ``t``, s), ``instructions_by_function`` (as
+        ``stt-codegen embedded``'s ``instructions_detail.by_function``), ``flash_bytes_controller`` (text + data of the controller object).
 
     Raises
     ------
@@ -131,18 +136,25 @@ def run_cascade_embedded(design: Design, seed: int = 0, timeout: float = 600.0) 
         folder = Path(name)
         for file, text in files.items():
             (folder / file).write_text(text)
+        steps = steps_of(design.spec, design.tube)
+        replay = sorted({min(steps - 1, int(round(f * steps))) for f in COUNT_FRACTIONS})
         loop = folder / "closed_loop.c"
-        loop.write_text(closed_loop_program(design, prefix, seed))
-        sources = [folder / f"{prefix}.c", loop]
-        full = build_elf(sources, [folder], folder / "full", name="loop")
+        loop.write_text(closed_loop_program(design, prefix, seed, replay=replay))
+        full = build_elf([folder / f"{prefix}.c", loop], [folder], folder / "full", name="loop")
         run = run_qemu(full.elf, timeout=timeout)
         try:
-            output = parse_closed_loop(run.stdout, 2 * n)
+            output = parse_closed_loop(run.stdout, n, 2 * n)
         except ValueError:
             raise ToolchainError(f"the closed loop exited with {run.exit_code} without a "
                                  f"summary:\n{run.stdout[-2000:]}{run.stderr[-2000:]}") from None
-        measured = build_elf(sources, [folder], folder / "measured",
-                             {"MEASURE": None, "STEPS": MEASURED_STEPS}, name="measured")
+        inputs = [output.replay_inputs[k] for k in sorted(output.replay_inputs)]
+        steps_c = folder / "steps.c"
+        steps_c.write_text(replay_source(
+            design.spec, design.tube, [v[2] for v in inputs], [v[0] for v in inputs],
+            [1.0 / design.tube.rate_hz] * len(inputs), [v[1] for v in inputs],
+            what="closed-loop inputs", prefix=prefix))
+        measured = build_elf([folder / f"{prefix}.c", steps_c], [folder], folder / "measured",
+                             {"STT_MEASURE": None}, name="measured")
         counted = run_qemu(measured.elf, timeout=timeout, count_instructions=True)
         sizes = elf_sizes(full.objects[0])
     summary = output.summary
@@ -157,4 +169,6 @@ def run_cascade_embedded(design: Design, seed: int = 0, timeout: float = 600.0) 
             "input_clamped": summary["input_clamped_steps"],
             "exceeded_velocity_bound": bool(summary["exceeded_velocity_bound"]),
             "instructions_per_step": list(counted.instructions or []),
+            "measured_times": [float(v[0]) for v in inputs],
+            "instructions_by_function": function_profile(counted.functions or []),
             "flash_bytes_controller": sizes}

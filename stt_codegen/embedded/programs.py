@@ -159,8 +159,11 @@ def float_bits(values) -> list[str]:
     return [f"0x{int(b):08x}u" for b in a.view(np.uint32)]
 
 
-def replay_source(spec: Spec, design: TubeDesign, x, t, dt, alpha, what: str) -> str:
+def replay_source(spec: Spec, design: TubeDesign, x, t, dt, alpha, what: str,
+                  prefix: str | None = None) -> str:
     """The replay program at float inputs ``x`` (N, n), ``t`` (N,), ``dt`` (N,), ``alpha`` (N, 2n).
+
+    For a second-order spec it calls the cascade's step (``x`` (N, 2n): ``[x1; x2]``).
 
     Parameters
     ----------
@@ -179,17 +182,20 @@ def replay_source(spec: Spec, design: TubeDesign, x, t, dt, alpha, what: str) ->
         The adaptive law's ``alpha``.
     what : str
         What the inputs are, for the program's header comment.
+    prefix : str, optional
+        The controller's C prefix (default: the spec's C name).
 
     Returns
     -------
     str
         The C source of the program, which prints one ``R`` line per input.
     """
-    prefix = c_identifier(spec.c_name)
+    prefix = c_identifier(spec.c_name) if prefix is None else prefix
     x = np.atleast_2d(np.asarray(x, dtype=np.float32))
     rows = [float_bits(np.concatenate([x[k], [t[k], dt[k]], alpha[k]])) for k in range(len(t))]
+    cascade = {"cascade": True} if spec.order == 2 else {}
     return render("embedded_replay.c.j2", P=prefix, spec_name=spec.name, real="float",
-                  n=spec.dimension, count=len(rows), rows=rows, what=what)
+                  n=spec.dimension, count=len(rows), rows=rows, what=what, **cascade)
 
 
 def _f32(word: str) -> float:
@@ -264,7 +270,7 @@ class ClosedLoopOutput:
     replay_inputs: dict
 
 
-def parse_closed_loop(stdout: str, n: int) -> ClosedLoopOutput:
+def parse_closed_loop(stdout: str, n: int, state_size: int | None = None) -> ClosedLoopOutput:
     """Parse the closed-loop program's output (raises ``ValueError`` without a summary).
 
     Parameters
@@ -272,7 +278,10 @@ def parse_closed_loop(stdout: str, n: int) -> ClosedLoopOutput:
     stdout : str
         The program's standard output.
     n : int
-        State dimension.
+        State dimension (positions; ``alpha`` has ``2 n`` entries).
+    state_size : int, optional
+        Entries of the plant's state in the ``X`` and ``S`` lines (default ``n``; ``2 n``
+        for a second-order plant's ``[x1; x2]``).
 
     Returns
     -------
@@ -296,13 +305,14 @@ def parse_closed_loop(stdout: str, n: int) -> ClosedLoopOutput:
             summary[key] = int(value)
         else:
             summary[key] = float(value)
+    size = n if state_size is None else state_size
     states, replay = {}, {}
     for line in stdout.splitlines():
         parts = line.split()
         if parts and parts[0] == "X":
-            states[int(parts[1])] = np.array([_f64(w) for w in parts[2:2 + n]])
+            states[int(parts[1])] = np.array([_f64(w) for w in parts[2:2 + size]])
         elif parts and parts[0] == "S":
             vals = [_f32(w) for w in parts[2:]]
             replay[int(parts[1])] = (vals[0], np.array(vals[1:1 + 2 * n]),
-                                     np.array(vals[1 + 2 * n:1 + 3 * n]))
+                                     np.array(vals[1 + 2 * n:1 + 2 * n + size]))
     return ClosedLoopOutput(summary, states, replay)

@@ -116,10 +116,6 @@ def cascade_step(design: TubeDesign, stage: SecondStage, x, t, dt,
     e = np.clip(z / width, -E_MAX, E_MAX)
     epsilon = reference.log((1.0 + e) / (1.0 - e))
     xi = 2.0 / (width * (1.0 - e * e))
-    u = -stage.velocity_gain * xi * epsilon
-    within = np.ones(u.shape[0])
-    if design.input_bound is not None:
-        limit = np.asarray(design.input_bound, dtype=float)[None, :]
-        within = np.all(np.abs(u) <= limit, axis=1).astype(float)
-        u = np.where(u > limit, limit, np.where(u < -limit, -limit, u))
+    # the reference's own clamp (numpy.clip), not the model's saturate piece
+    u, within = reference.saturate(design, -stage.velocity_gain * xi * epsilon)
     return u, alpha_next, r, inside_position, inside_velocity, within
