@@ -230,6 +230,13 @@ def test_generated_python_runs_and_matches_the_oracle(tube) -> None:
     assert invalid[3] == namespace["STATUS_INVALID_INPUT"] == Status.INVALID_INPUT
     assert invalid[0] == [0.0] * 3 and invalid[2] == [0.0] * 3
     assert invalid[1] == list(p["alpha"][0])
+    nan_x = [*p["state"][0][:5], float("nan")]
+    nan_alpha = [*p["alpha"][0][:5], float("inf")]
+    for args in ((nan_x, 1.0, 1e-3, p["alpha"][0]), (p["state"][0], 1.0, 1e-3, nan_alpha),
+                 (p["state"][0][:5], 1.0, 1e-3, p["alpha"][0])):
+        u, alpha_next, r, status = namespace["step"](*args)
+        assert status == Status.INVALID_INPUT and u == r == [0.0] * 3
+        assert alpha_next == [v if np.isfinite(v) else 0.0 for v in args[3]]
 
 
 def test_the_oracles_unclamped_transform_is_the_deployed_one_inside() -> None:

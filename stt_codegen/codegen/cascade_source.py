@@ -1,20 +1,27 @@
 """Standalone C and Python of the cascade controller for second-order plants.
 
-One entry point, ``<prefix>_step(t, dt, x1, x2, alpha, u, alpha_next, r) -> status``: the
-function :func:`stt_codegen.tube.cascade.cascade_step` of a design and its second stage,
-printed by the emitter's C printer (double or single) and Python printer, behind input
-checks. Unlike the first-order generated code (:mod:`.generate`, table-driven, evaluating
-only the active segment and the open circumvents), the composed Function is printed
-whole, with the design's numbers as constants: every segment and every circumvent is
-evaluated at every step (the same values: a closed circumvent contributes exactly 0).
-C99, ``<math.h>`` only, no allocation, no static mutable state; deterministic text
-(docs/second-order.md, "Generated code").
+The entry point has the first order's argument order, ``<prefix>_step(x, t, dt, alpha,
+u, alpha_next, r) -> status`` with ``x = [x1; x2]``, and its statuses (plus
+``OUTSIDE_VELOCITY_TUBE``); it computes :func:`stt_codegen.tube.cascade.cascade_step` of a
+design and its second stage, bit for bit in double precision.
 
-This module only prepares the data: the bodies the emitter prints, the names, the
-constants (as the printer's literals) and the banner's fields. The text of the files is
-in the Jinja2 templates ``cascade_header.h.j2``, ``cascade_source.c.j2`` and
-``cascade_module.py.j2`` (with the banner ``_banner_cascade.j2``) of the top-level
-``templates/``, rendered through :func:`.render.render` as the first-order files are.
+* C: a variant of the first-order source (:func:`.generate.c_source_context`,
+  ``c_source.c.j2``): the same tables and table-driven tube (only the active segment and
+  the open circumvents), ``P_tube``, ``P_alpha_step`` and input checks, with the cascade's
+  law (``cascade_source.c.j2``: the first order's ``law`` piece with gain ``k1`` for
+  ``r``, the pieces ``velocity_tube`` and ``velocity_law``, the first order's
+  ``saturate`` with an actuator bound) and the second stage's numbers in a ``const``
+  table. C99, ``<math.h>`` and ``<stddef.h>`` only, no allocation, no static mutable
+  state.
+* Python: the composed Function printed whole by the emitter's Python printer, behind the
+  first order's input checks.
+
+Deterministic text (docs/second-order.md, "Generated code"). This module only prepares
+the data: the bodies the emitter prints, the names, the constants (as the printer's
+literals) and the banner's fields. The text of the files is in the Jinja2 templates
+``cascade_header.h.j2``, ``cascade_source.c.j2`` and ``cascade_module.py.j2`` (with the
+banner ``_banner_cascade.j2``) of the top-level ``templates/``, rendered through
+:func:`.render.render` as the first-order files are.
 """
 
 from __future__ import annotations
@@ -82,8 +89,9 @@ def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
                     precision: str = "double") -> dict[str, str]:
     """``{<prefix>.h: text, <prefix>.c: text}`` of the cascade controller.
 
-    The emitter's C printer prints the composed Function; the templates
-    ``cascade_header.h.j2`` and ``cascade_source.c.j2`` hold the rest of the text.
+    The emitter's C printer prints the pieces (the first order's and the cascade's); the
+    templates ``cascade_header.h.j2`` and ``cascade_source.c.j2`` (which extends the
+    first-order ``c_source.c.j2``) hold the rest of the text.
 
     Parameters
     ----------
