@@ -353,3 +353,24 @@ def test_generated_python_with_a_bound_reports_input_clamped(tube, bounded) -> N
         np.testing.assert_allclose(u, expected[0][k], rtol=1e-10, atol=1e-12)
         statuses.append(status)
     assert len(set(statuses)) == 2
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (install gcc or clang)")
+@pytest.mark.parametrize("precision", ["double", "single"])
+def test_vectors_with_a_bound_cover_clamped_steps_and_the_c_meets_them(tmp_path, bounded,
+                                                                       precision) -> None:
+    """The oracle's vectors of a design with an actuator bound have clamped and unclamped
+    steps; the C of either precision returns their statuses, and ``u``, ``r``,
+    ``alpha_next`` within their tolerances."""
+    from stt_codegen.codegen.cascade_source import cascade_vectors
+    data = cascade_vectors(bounded, STAGE, precision=precision)
+    statuses = [v["status"] for v in data["vectors"]]
+    assert Status.INPUT_CLAMPED in statuses and Status.OK in statuses
+    lib, _ = _load(tmp_path, bounded, precision)
+    step = _c_step(lib, precision)
+    for v in data["vectors"]:
+        code, u, alpha_next, r = step(v["x"], v["t"], data["dt"], v["alpha"])
+        assert code == v["status"]
+        assert np.all(np.abs(u) <= np.array(bounded.input_bound, dtype=u.dtype))
+        for got, name in ((u, "u"), (r, "r"), (alpha_next, "alpha_next")):
+            assert np.all(np.abs(got - np.array(v[name])) <= np.array(v["tol_" + name])), name

@@ -185,7 +185,10 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     status from :func:`stt_codegen.tube.cascade_reference.cascade_step`; absolute
     tolerances ``tol_u``, ``tol_r``, ``tol_alpha_next`` from
     :func:`stt_codegen.codegen.tolerance.cascade_bounds` for ``precision`` (double: with the
-    floor ``1e-12 max(1, |ref|)``).
+    floor ``1e-12 max(1, |ref|)``). With an actuator bound, the expected status is ``OK``
+    or ``INPUT_CLAMPED`` as the oracle clamps, and only points whose clamp decision is
+    certain in the precision are kept (every ``|u_i|`` of the law farther from the bound
+    than its tolerance plus the bound's rounding), as for the first order.
     """
     import numpy as np
 
@@ -225,6 +228,18 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
                                ((tol_u, u), (tol_r, r), (tol_a, alpha_next)))
     # rounded up to a few digits: still bounds, and the same on every CPU (docs/codegen.md)
     tol_u, tol_r, tol_a = (round_up_array(tol) for tol in (tol_u, tol_r, tol_a))
+    if design.input_bound is not None:
+        # only points whose clamp decision is certain in the precision: every |u_i| of the
+        # law farther from the bound than its error bound plus the bound's rounding (the
+        # first order's rule, docs/codegen.md "Actuator limits: the clamp")
+        free = cascade_reference.cascade_step(dataclasses.replace(design, input_bound=None),
+                                              stage, np.hstack([x1, x2]), t, dt, alpha)[0]
+        bound = np.asarray(design.input_bound)
+        keep = np.all(np.abs(np.abs(free) - bound) > tol_u + 2 * unit * bound, axis=1)
+        t, x1, x2, alpha, u, r, alpha_next, status, tol_u, tol_r, tol_a = (
+            a[keep] for a in (t, x1, x2, alpha, u, r, alpha_next, status, tol_u, tol_r,
+                              tol_a))
+        count = t.size
     return {"_generated": "GENERATED FILE, DO NOT EDIT: cascade test vectors from the numpy "
                           "reference (stt_codegen.tube.cascade_reference).",
             "dt": dt, "precision": precision, "unit_roundoff": unit,
