@@ -17,7 +17,7 @@ from test_emit_python import casadi_dense, same_double
 from stt_codegen.codegen.cascade_source import cascade_c_files, cascade_python_file
 from stt_codegen.codegen.emit import python_function
 from stt_codegen.tube import cascade, cascade_reference
-from stt_codegen.tube.parameters import E_MAX
+from stt_codegen.tube.parameters import E_MAX, Status
 from stt_codegen.tube.second_stage import SecondStage
 
 CC = shutil.which("gcc") or shutil.which("clang")
@@ -42,10 +42,11 @@ def _points(tube, count: int, seed: int, velocity_limit: float = 0.99):
     r, _, _ = cascade_reference.reference.law_step(first, p["x"], p["t"], p["dt"], p["alpha"])
     rho2 = cascade_reference.velocity_tube(STAGE, p["t"])
     p["x2"] = r + rho2 * rng.uniform(-velocity_limit, velocity_limit, r.shape)
+    p["state"] = np.hstack([p["x"], p["x2"]])
     return p
 
 
-def _casadi(function, p, names=("x", "x2", "t", "dt", "alpha")):
+def _casadi(function, p, names=("state", "t", "dt", "alpha")):
     count = len(p["t"])
     args = [np.atleast_2d(p[k]) if p[k].ndim == 1 else p[k].T for k in names]
     out = function.map(count)(*args)
@@ -74,7 +75,7 @@ def test_velocity_tube_piece_matches_the_oracle() -> None:
 def test_cascade_step_matches_the_oracle(tube) -> None:
     p = _points(tube, 3000, seed=4)
     got = _casadi(cascade.cascade_step(tube, STAGE), p)
-    expected = cascade_reference.cascade_step(tube, STAGE, p["x"], p["x2"], p["t"], p["dt"],
+    expected = cascade_reference.cascade_step(tube, STAGE, p["state"], p["t"], p["dt"],
                                               p["alpha"])
     assert got[3].min() == 1.0 and expected[3].min() == 1.0      # all inside the tube
     assert got[4].min() == 1.0 and expected[4].min() == 1.0
@@ -90,6 +91,7 @@ def test_outside_the_velocity_tube_is_reported_and_u_stays_finite(tube) -> None:
     first = dataclasses.replace(tube, gain=STAGE.position_gain)
     r, _, _ = cascade_reference.reference.law_step(first, p["x"], p["t"], p["dt"], p["alpha"])
     p["x2"] = r + rho2 * np.where(np.arange(len(p["t"]))[:, None] % 2 == 0, 1.0, -3.0)
+    p["state"] = np.hstack([p["x"], p["x2"]])
     u, _, _, inside_p, inside_v = _casadi(cascade.cascade_step(tube, STAGE), p)
     assert inside_p.min() == 1.0 and inside_v.max() == 0.0
     assert np.all(np.isfinite(u))
@@ -106,7 +108,7 @@ def test_emitted_python_is_bit_identical_to_casadi(tube) -> None:
     printed = python_function(function)
     p = _points(tube, 40, seed=6)
     for k in range(40):
-        inputs = [list(np.atleast_1d(p[name][k])) for name in ("x", "x2", "t", "dt", "alpha")]
+        inputs = [list(np.atleast_1d(p[name][k])) for name in ("state", "t", "dt", "alpha")]
         expected = casadi_dense(function, inputs)
         got = printed(*inputs)
         for e, g in zip(expected, got):
@@ -124,35 +126,54 @@ def _load(tmp_path, tube, precision: str):
     return ctypes.CDLL(str(lib)), files
 
 
+def _c_step(lib, precision: str = "double"):
+    """``step(x, t, dt, alpha) -> (code, u, alpha_next, r)`` of the loaded C."""
+    real = ctypes.c_double if precision == "double" else ctypes.c_float
+    dtype = np.float64 if precision == "double" else np.float32
+    pointer = ctypes.POINTER(real)
+    entry = lib.cascade_test_step
+    entry.argtypes = [pointer, real, real, pointer, pointer, pointer, pointer]
+    entry.restype = ctypes.c_int
+
+    def step(x, t, dt, alpha):
+        x, alpha = (np.ascontiguousarray(v, dtype=dtype) for v in (x, alpha))
+        n = x.size // 2
+        u, alpha_next, r = np.full(n, 7.0, dtype), np.zeros(2 * n, dtype), np.full(n, 7.0, dtype)
+        code = entry(x.ctypes.data_as(pointer), t, dt, alpha.ctypes.data_as(pointer),
+                     *(a.ctypes.data_as(pointer) for a in (u, alpha_next, r)))
+        return code, u, alpha_next, r
+    return step
+
+
 @pytest.mark.skipif(CC is None, reason="no C compiler (install gcc or clang)")
 def test_emitted_c_double_is_bit_identical_and_checks_inputs(tmp_path, tube) -> None:
     lib, files = _load(tmp_path, tube, "double")
     assert "malloc" not in files["cascade_test.c"]
     includes = [line for line in files["cascade_test.c"].splitlines()
                 if line.startswith("#include")]
-    assert includes == ["#include <math.h>", '#include "cascade_test.h"']
+    assert includes == ["#include <math.h>", "#include <stddef.h>", '#include "cascade_test.h"']
     function = cascade.cascade_step(tube, STAGE)
-    real_p = ctypes.POINTER(ctypes.c_double)
-    step = lib.cascade_test_step
-    step.argtypes = [ctypes.c_double, ctypes.c_double] + [real_p] * 6
+    step = _c_step(lib)
     p = _points(tube, 200, seed=7)
     for k in range(200):
-        x1, x2, alpha = (np.ascontiguousarray(p[name][k], dtype=float)
-                         for name in ("x", "x2", "alpha"))
-        u, alpha_next, r = np.zeros(3), np.zeros(6), np.zeros(3)
-        code = step(float(p["t"][k]), float(p["dt"][k]),
-                    *(a.ctypes.data_as(real_p) for a in (x1, x2, alpha, u, alpha_next, r)))
-        expected = casadi_dense(function, [x1, x2, [p["t"][k]], [p["dt"][k]], alpha])
-        assert code == 0
-        for got, exp in zip((u, alpha_next, r), expected):
-            assert all(same_double(float(a), b) for a, b in zip(got, exp))
-    # outside the domain: INVALID_INPUT, u = 0, alpha kept
-    x1, x2, alpha = np.full(3, 1.0), np.zeros(3), np.full(6, 0.1)
-    u = np.full(3, 7.0)
-    alpha_next, r = np.zeros(6), np.zeros(3)
-    for t, dt in ((-1.0, 1e-3), (float("nan"), 1e-3), (1.0, 0.0), (1.0, 2.0)):
-        code = step(t, dt, *(a.ctypes.data_as(real_p) for a in (x1, x2, alpha, u, alpha_next, r)))
-        assert code == 2 and np.all(u == 0.0) and np.all(alpha_next == alpha)
+        x, alpha = p["state"][k], p["alpha"][k]
+        code, *got = step(x, float(p["t"][k]), float(p["dt"][k]), alpha)
+        expected = casadi_dense(function, [x, [p["t"][k]], [p["dt"][k]], alpha])
+        assert code == Status.OK
+        for out, exp in zip(got, expected):
+            assert all(same_double(float(a), b) for a, b in zip(out, exp))
+    # outside the domain: INVALID_INPUT, u = 0, r = 0, alpha kept (non-finite entries 0)
+    x, alpha = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0]), np.full(6, 0.1)
+    nan = float("nan")
+    for t, dt, xs, a in ((-1.0, 1e-3, x, alpha), (nan, 1e-3, x, alpha), (1.0, 0.0, x, alpha),
+                         (1.0, 100.0, x, alpha), (1.0, 1e-3, np.r_[x[:5], nan], alpha),
+                         (1.0, 1e-3, np.r_[x[:3], np.inf, x[4:]], alpha),
+                         (1.0, 1e-3, x, np.r_[alpha[:5], -1.0]),
+                         (1.0, 1e-3, x, np.r_[alpha[:5], nan])):
+        code, u, alpha_next, r = step(xs, t, dt, a)
+        assert code == Status.INVALID_INPUT
+        assert np.all(u == 0.0) and np.all(r == 0.0)
+        assert np.array_equal(alpha_next, np.where(np.isfinite(a), a, 0.0))
 
 
 @pytest.mark.skipif(CC is None, reason="no C compiler (install gcc or clang)")
@@ -168,19 +189,15 @@ def test_emitted_c_single_is_within_the_derived_bound(tmp_path, tube) -> None:
     ``u``, ``r`` and ``alpha_next`` within :func:`tolerance.cascade_bounds`."""
     from stt_codegen.codegen import tolerance
     lib, _ = _load(tmp_path, tube, "single")
-    step = lib.cascade_test_step
-    real_p = ctypes.POINTER(ctypes.c_float)
-    step.argtypes = [ctypes.c_float, ctypes.c_float] + [real_p] * 6
+    step = _c_step(lib, "single")
     p = {k: np.asarray(v, dtype=np.float32).astype(float)
          for k, v in _points(tube, 1000, seed=8).items()}
-    x1, x2, t, dt, alpha = (p[k] for k in ("x", "x2", "t", "dt", "alpha"))
-    u_ref, a_ref, r_ref, _, _ = cascade_reference.cascade_step(tube, STAGE, x1, x2, t, dt, alpha)
+    x1, x2, x, t, dt, alpha = (p[k] for k in ("x", "x2", "state", "t", "dt", "alpha"))
+    u_ref, a_ref, r_ref, *_ = cascade_reference.cascade_step(tube, STAGE, x, t, dt, alpha)
     bounds = tolerance.cascade_bounds(tube, STAGE, x1, x2, t, alpha, r_ref, a_ref,
                                       tolerance.UNIT_SINGLE)
     for k in range(t.size):
-        inputs = [np.ascontiguousarray(a[k], dtype=np.float32) for a in (x1, x2, alpha)]
-        u, alpha_next, r = np.zeros(3, np.float32), np.zeros(6, np.float32), np.zeros(3, np.float32)
-        step(t[k], dt[k], *(a.ctypes.data_as(real_p) for a in (*inputs, u, alpha_next, r)))
+        _, u, alpha_next, r = step(x[k], t[k], dt[k], alpha[k])
         for got, ref, bound in zip((u, r, alpha_next), (u_ref, r_ref, a_ref), bounds):
             assert np.all(np.abs(got - ref[k]) <= bound[k]), (k, got, ref[k], bound[k])
 
@@ -201,15 +218,25 @@ def test_generated_python_runs_and_matches_the_oracle(tube) -> None:
     exec(compile(cascade_python_file(tube, STAGE, "cascade_test")["cascade_test.py"],
                  "cascade_test.py", "exec"), namespace)
     p = _points(tube, 30, seed=8)
-    expected = cascade_reference.cascade_step(tube, STAGE, p["x"], p["x2"], p["t"], p["dt"],
+    expected = cascade_reference.cascade_step(tube, STAGE, p["state"], p["t"], p["dt"],
                                               p["alpha"])
     for k in range(30):
-        u, alpha_next, r, status = namespace["step"](p["t"][k], p["dt"][k], p["x"][k],
-                                                     p["x2"][k], p["alpha"][k])
-        assert status == namespace["OK"]
+        u, alpha_next, r, status = namespace["step"](p["state"][k], p["t"][k], p["dt"][k],
+                                                     p["alpha"][k])
+        assert status == namespace["STATUS_OK"] == Status.OK
         np.testing.assert_allclose(u, expected[0][k], rtol=1e-10, atol=1e-12)
         np.testing.assert_allclose(r, expected[2][k], rtol=1e-10, atol=1e-12)
-    assert namespace["step"](-1.0, 1e-3, p["x"][0], p["x2"][0], p["alpha"][0])[3] == 2
+    invalid = namespace["step"](p["state"][0], -1.0, 1e-3, p["alpha"][0])
+    assert invalid[3] == namespace["STATUS_INVALID_INPUT"] == Status.INVALID_INPUT
+    assert invalid[0] == [0.0] * 3 and invalid[2] == [0.0] * 3
+    assert invalid[1] == list(p["alpha"][0])
+    nan_x = [*p["state"][0][:5], float("nan")]
+    nan_alpha = [*p["alpha"][0][:5], float("inf")]
+    for args in ((nan_x, 1.0, 1e-3, p["alpha"][0]), (p["state"][0], 1.0, 1e-3, nan_alpha),
+                 (p["state"][0][:5], 1.0, 1e-3, p["alpha"][0])):
+        u, alpha_next, r, status = namespace["step"](*args)
+        assert status == Status.INVALID_INPUT and u == r == [0.0] * 3
+        assert alpha_next == [v if np.isfinite(v) else 0.0 for v in args[3]]
 
 
 def test_the_oracles_unclamped_transform_is_the_deployed_one_inside() -> None:
@@ -224,3 +251,126 @@ def test_the_oracles_unclamped_transform_is_the_deployed_one_inside() -> None:
             np.testing.assert_allclose(a, b[k], rtol=1e-12, atol=1e-15)
     outside = cascade_reference.velocity_transform([[2.0]], [[0.0]], [[1.0]])
     assert np.isnan(outside[1][0, 0])                  # the oracle does not clamp
+
+
+@pytest.fixture(scope="module")
+def bounded(tube):
+    """The tube with an actuator bound near the median ``|u|`` of :func:`_points`: about
+    half of the steps clamp some input."""
+    p = _points(tube, 400, seed=10)
+    u = cascade_reference.cascade_step(tube, STAGE, p["state"], p["t"], p["dt"], p["alpha"])[0]
+    return dataclasses.replace(tube, input_bound=tuple(float(b) for b in
+                                                       np.median(np.abs(u), axis=0)))
+
+
+def test_the_actuator_bound_clamps_u_like_the_oracle(tube, bounded) -> None:
+    p = _points(tube, 2000, seed=11)
+    function = cascade.cascade_step(bounded, STAGE)
+    assert function.name_out()[-1] == "within_bound"
+    got = _casadi(function, p)
+    expected = cascade_reference.cascade_step(bounded, STAGE, p["state"], p["t"], p["dt"],
+                                              p["alpha"])
+    free = cascade_reference.cascade_step(tube, STAGE, p["state"], p["t"], p["dt"], p["alpha"])
+    bound = np.array(bounded.input_bound)
+    moved = np.any(np.abs(free[0]) > bound, axis=1)
+    assert 0.2 < moved.mean() < 0.95                    # clamped and unclamped steps
+    assert np.array_equal(got[5].ravel(), (~moved).astype(float))
+    assert np.array_equal(expected[5], (~moved).astype(float))
+    assert np.all(np.abs(got[0]) <= bound)
+    for a, b in zip(got, expected):
+        b = np.asarray(b, dtype=float).reshape(a.shape)
+        assert np.max(np.abs(a - b) / np.maximum(1.0, np.abs(b))) <= TOLERANCE
+    # where nothing is clamped, u is the unbounded law's
+    np.testing.assert_array_equal(expected[0][~moved], free[0][~moved])
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (install gcc or clang)")
+def test_emitted_c_with_a_bound_is_bit_identical_and_reports_input_clamped(tmp_path, tube,
+                                                                           bounded) -> None:
+    lib, files = _load(tmp_path, bounded, "double")
+    assert "CASCADE_TEST_STATUS_INPUT_CLAMPED 3" in files["cascade_test.h"]
+    step = _c_step(lib)
+    function = cascade.cascade_step(bounded, STAGE)
+    p = _points(tube, 300, seed=12)
+    # every third point outside the velocity tube: OUTSIDE_VELOCITY_TUBE takes precedence
+    rho2 = cascade_reference.velocity_tube(STAGE, p["t"])
+    p["state"][::3, 3:] += 3.0 * rho2[::3]
+    codes = []
+    for k in range(300):
+        x, alpha = p["state"][k], p["alpha"][k]
+        code, *got = step(x, float(p["t"][k]), float(p["dt"][k]), alpha)
+        expected = casadi_dense(function, [x, [p["t"][k]], [p["dt"][k]], alpha])
+        for out, exp in zip(got, expected):
+            assert all(same_double(float(a), b) for a, b in zip(out, exp))
+        inside_p, inside_v, within = (e[0] for e in expected[3:])
+        assert inside_p == 1.0
+        assert code == (Status.OUTSIDE_VELOCITY_TUBE if inside_v == 0.0 else
+                        Status.INPUT_CLAMPED if within == 0.0 else Status.OK)
+        assert np.all(np.abs(got[0]) <= np.array(bounded.input_bound))
+        codes.append(code)
+    assert {Status.OK, Status.INPUT_CLAMPED, Status.OUTSIDE_VELOCITY_TUBE} <= set(codes)
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (install gcc or clang)")
+@pytest.mark.parametrize("precision", ["double", "single"])
+def test_every_output_is_finite_whatever_the_inputs(tmp_path, tube, bounded,
+                                                    precision) -> None:
+    """Extreme finite inputs (states and times up to 1e30, ``alpha`` up to ``ALPHA_MAX``)
+    and non-finite ones: every output finite, ``|u| <= input_bound``."""
+    from stt_codegen.codegen.generate import input_limits
+    lib, _ = _load(tmp_path, bounded, precision)
+    step = _c_step(lib, precision)
+    limits = input_limits(bounded)
+    rng = np.random.default_rng(13)
+    big = 1e30
+    specials = [0.0, -0.0, 1e-30, -1e-30, big, -big, float("nan"), float("inf")]
+    seen = set()
+    for k in range(400):
+        x = rng.choice(specials, 6) if k % 2 else rng.uniform(-1, 1, 6) * 10.0 ** rng.integers(-3, 30, 6)
+        t = float(rng.choice([0.0, 1e-6, 5.0, 1e6, big, float("nan")]))
+        dt = float(rng.choice([limits["dt_min"], 1e-3, limits["dt_max"], 0.0]))
+        alpha = rng.choice([0.0, 1e-3, 10.0, limits["alpha_max"]], 6)
+        code, u, alpha_next, r = step(x, t, dt, alpha)
+        seen.add(code)
+        assert all(np.all(np.isfinite(v)) for v in (u, alpha_next, r)), (x, t, dt, alpha)
+        assert np.all(np.abs(u) <= np.array(bounded.input_bound, dtype=u.dtype))
+    assert Status.INVALID_INPUT in seen and Status.OUTSIDE_TUBE in seen
+
+
+def test_generated_python_with_a_bound_reports_input_clamped(tube, bounded) -> None:
+    namespace: dict = {}
+    exec(compile(cascade_python_file(bounded, STAGE, "cascade_test")["cascade_test.py"],
+                 "cascade_test.py", "exec"), namespace)
+    assert namespace["STATUS_INPUT_CLAMPED"] == Status.INPUT_CLAMPED
+    p = _points(tube, 60, seed=14)
+    expected = cascade_reference.cascade_step(bounded, STAGE, p["state"], p["t"], p["dt"],
+                                              p["alpha"])
+    statuses = []
+    for k in range(60):
+        u, _, _, status = namespace["step"](p["state"][k], p["t"][k], p["dt"][k],
+                                            p["alpha"][k])
+        assert status == (Status.OK if expected[5][k] else Status.INPUT_CLAMPED)
+        np.testing.assert_allclose(u, expected[0][k], rtol=1e-10, atol=1e-12)
+        statuses.append(status)
+    assert len(set(statuses)) == 2
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (install gcc or clang)")
+@pytest.mark.parametrize("precision", ["double", "single"])
+def test_vectors_with_a_bound_cover_clamped_steps_and_the_c_meets_them(tmp_path, bounded,
+                                                                       precision) -> None:
+    """The oracle's vectors of a design with an actuator bound have clamped and unclamped
+    steps; the C of either precision returns their statuses, and ``u``, ``r``,
+    ``alpha_next`` within their tolerances."""
+    from stt_codegen.codegen.cascade_source import cascade_vectors
+    data = cascade_vectors(bounded, STAGE, precision=precision)
+    statuses = [v["status"] for v in data["vectors"]]
+    assert Status.INPUT_CLAMPED in statuses and Status.OK in statuses
+    lib, _ = _load(tmp_path, bounded, precision)
+    step = _c_step(lib, precision)
+    for v in data["vectors"]:
+        code, u, alpha_next, r = step(v["x"], v["t"], data["dt"], v["alpha"])
+        assert code == v["status"]
+        assert np.all(np.abs(u) <= np.array(bounded.input_bound, dtype=u.dtype))
+        for got, name in ((u, "u"), (r, "r"), (alpha_next, "alpha_next")):
+            assert np.all(np.abs(got - np.array(v[name])) <= np.array(v["tol_" + name])), name

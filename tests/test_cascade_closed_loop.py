@@ -31,7 +31,7 @@ def test_default_gains_follow_the_declared_bounds() -> None:
     assert 4 * stage.velocity_gain * 2.0 / floor**2 * dt == pytest.approx(SHAPES[0][0])
     assert 16 * stage.position_gain / check.min_width**2 == pytest.approx(info["omega2_min"] / 10)
     # rho2(0) contains the initial velocity error with the floor to spare
-    r0 = cascade_reference.cascade_step(tube, stage, [tube.initial_state], [x2], 0.0, dt,
+    r0 = cascade_reference.cascade_step(tube, stage, [[*tube.initial_state, *x2]], 0.0, dt,
                                         np.zeros((1, 6)))[2][0]
     assert np.all(np.array(stage.width_start) - np.abs(x2 - r0) == pytest.approx(floor))
     assert all(type(v) is float for v in (info["width_floor"], info["tube_speed"]))

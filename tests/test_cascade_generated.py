@@ -49,7 +49,8 @@ def _build(tmp_path: Path, case: str, precision: str):
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
     step = getattr(ctypes.CDLL(str(lib)), f"{prefix}_step")
     real = ctypes.c_double if precision == "double" else ctypes.c_float
-    step.argtypes = [real, real] + [ctypes.POINTER(real)] * 6
+    pointer = ctypes.POINTER(real)
+    step.argtypes = [pointer, real, real, pointer, pointer, pointer, pointer]
     step.restype = ctypes.c_int
     return step, real, np.float64 if precision == "double" else np.float32
 
@@ -70,14 +71,14 @@ def test_committed_c_meets_its_vectors(tmp_path, case, precision) -> None:
     ratios = {"u": 0.0, "r": 0.0, "alpha_next": 0.0}
     tight = []
     for v in data["vectors"]:
-        x1, x2, alpha = (np.ascontiguousarray(v[k], dtype=dtype) for k in ("x1", "x2", "alpha"))
+        x, alpha = (np.ascontiguousarray(v[k], dtype=dtype) for k in ("x", "alpha"))
         # the inputs are exact in the precision, as the bound assumes
         assert all(np.array_equal(a.astype(np.float64), v[k])
-                   for a, k in ((x1, "x1"), (x2, "x2"), (alpha, "alpha")))
-        n = x1.size
+                   for a, k in ((x, "x"), (alpha, "alpha")))
+        n = x.size // 2
         u, alpha_next, r = np.zeros(n, dtype), np.zeros(2 * n, dtype), np.zeros(n, dtype)
-        code = step(v["t"], data["dt"], *(a.ctypes.data_as(pointer)
-                                           for a in (x1, x2, alpha, u, alpha_next, r)))
+        code = step(x.ctypes.data_as(pointer), v["t"], data["dt"], alpha.ctypes.data_as(pointer),
+                    *(a.ctypes.data_as(pointer) for a in (u, alpha_next, r)))
         assert code == v["status"] == 0
         assert np.all(np.isfinite(u)) and np.all(np.isfinite(alpha_next))
         for got, name in ((u, "u"), (r, "r"), (alpha_next, "alpha_next")):
@@ -101,8 +102,7 @@ def test_committed_python_meets_its_vectors(case) -> None:
         == ["import math"]
     data = _vectors(case)
     for v in data["vectors"][::4]:
-        u, alpha_next, r, status = namespace["step"](v["t"], data["dt"], v["x1"], v["x2"],
-                                                     v["alpha"])
+        u, alpha_next, r, status = namespace["step"](v["x"], v["t"], data["dt"], v["alpha"])
         assert status == v["status"]
         np.testing.assert_allclose(u, v["u"], rtol=DOUBLE_TOLERANCE, atol=DOUBLE_TOLERANCE)
         np.testing.assert_allclose(alpha_next, v["alpha_next"], rtol=DOUBLE_TOLERANCE,
@@ -112,6 +112,30 @@ def test_committed_python_meets_its_vectors(case) -> None:
 CPPCHECK = shutil.which("cppcheck")
 
 
+#: Findings of the first-order template on a design without circumvents (the window
+#: table's type is declared but unused: its members, the type, its tag, N_WINDOWS and
+#: MAX_OPEN), as in the committed first-order ``tasks-visit``; the cascade's C is that
+#: template (second-order-s1's tube has no circumvent).
+NO_WINDOW_DEVIATIONS = (
+    ("unusedStructMember", r"^  (\w+_real (start|end|center|radius|sharpness|height|max_end)"
+                           r"|int bound);$"),
+    ("misra-c2012-2.3", r"^\} \w+_window;$"),
+    ("misra-c2012-2.4", r"^typedef struct \{$"),
+    ("misra-c2012-2.5", r"^#define \w+_(N_WINDOWS|MAX_OPEN) "),
+)
+
+
+def _cppcheck(folder: Path, source: str) -> list:
+    proc = subprocess.run([CPPCHECK, "--enable=all", "--addon=misra", "--std=c99",
+                           "--suppress=missingIncludeSystem", "--quiet",
+                           "--template={file}:{line}:{id}", source],
+                          cwd=folder, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    return [(name, check, (folder / name).read_text().splitlines()[int(line) - 1])
+            for name, line, check in (line.split(":") for line in proc.stderr.splitlines()
+                                      if line.count(":") >= 2)]
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(CPPCHECK is None,
                     reason="cppcheck missing: install the Debian package cppcheck")
@@ -119,7 +143,10 @@ CPPCHECK = shutil.which("cppcheck")
 @pytest.mark.parametrize("case", CASES)
 def test_cppcheck_misra_findings_are_the_listed_deviations(tmp_path, case, precision) -> None:
     """The first-order code's deviation list (tests/test_codegen_misra.py), unchanged, covers
-    the cascade: only the entry point is reported (unusedFunction: the application calls it)."""
+    the cascade (the API functions are not called in the file: unusedFunction), with, for a
+    tube without circumvents, the first-order template's findings on such a design
+    (:data:`NO_WINDOW_DEVIATIONS`, checked to be the committed first-order ``tasks-visit``'s
+    too)."""
     import re
 
     from test_codegen_misra import DEVIATIONS
@@ -127,13 +154,89 @@ def test_cppcheck_misra_findings_are_the_listed_deviations(tmp_path, case, preci
     for suffix in (".c", ".h"):
         (tmp_path / f"{prefix}{suffix}").write_bytes(
             (_folder(case, precision) / f"{prefix}{suffix}").read_bytes())
-    proc = subprocess.run([CPPCHECK, "--enable=all", "--addon=misra", "--std=c99",
-                           "--suppress=missingIncludeSystem", "--quiet",
-                           "--template={file}:{line}:{id}", f"{prefix}.c"],
-                          cwd=tmp_path, capture_output=True, text=True, timeout=600)
-    assert proc.returncode == 0, proc.stderr
-    findings = [line.split(":") for line in proc.stderr.splitlines() if line.count(":") >= 2]
-    assert findings, "cppcheck reported nothing: the unused entry point must show up"
-    for name, line, check in findings:
-        text = (tmp_path / name).read_text().splitlines()[int(line) - 1]
-        assert [d for d in DEVIATIONS if d[0] == check and re.search(d[1], text)], (check, text)
+    text = (tmp_path / f"{prefix}.c").read_text()
+    allowed = DEVIATIONS + (NO_WINDOW_DEVIATIONS if "_N_WINDOWS 0\n" in text else ())
+    findings = _cppcheck(tmp_path, f"{prefix}.c")
+    assert findings, "cppcheck reported nothing: the unused entry points must show up"
+    for name, check, line in findings:
+        assert [d for d in allowed if d[0] == check and re.search(d[1], line)], (check, line)
+    if allowed != DEVIATIONS:
+        first = tmp_path / "first"
+        first.mkdir()
+        for suffix in (".c", ".h"):
+            (first / f"tasks_visit{suffix}").write_bytes(
+                (REPO / "generated" / "tasks-visit" / precision /
+                 f"tasks_visit{suffix}").read_bytes())
+        inherited = {check for _, check, line in _cppcheck(first, "tasks_visit.c")
+                     if any(d[0] == check and re.search(d[1], line)
+                            for d in NO_WINDOW_DEVIATIONS)}
+        assert inherited == {d[0] for d in NO_WINDOW_DEVIATIONS}
+
+
+@pytest.mark.skipif(CC is None, reason="no C compiler (install gcc or clang)")
+@pytest.mark.parametrize("bounded", [False, True])
+@pytest.mark.parametrize("case", CASES)
+def test_table_driven_c_is_bit_identical_to_casadi(tmp_path, case, bounded) -> None:
+    """The table-driven double C of a bundled design (the quadrotor's has two circumvents on
+    one bound: the F_nu pieces; with ``bounded``, an actuator bound near the median ``|u|``)
+    equals CasADi's ``cascade_step`` bit for bit at 150 random points inside both tubes, and
+    at the same points with the velocity pushed out of its tube; the committed C is the
+    generation without a bound."""
+    import dataclasses
+
+    from conftest import design_of
+    from sampling import random_points
+    from test_emit_python import casadi_dense, same_double
+
+    from stt_codegen.codegen.cascade_source import cascade_c_files
+    from stt_codegen.tube import cascade, cascade_reference
+    from stt_codegen.tube.parameters import Status
+
+    design = design_of(case)
+    stage, _ = design.second_stage
+    tube, n = design.tube, design.tube.dimension
+    p = random_points(tube, 150, seed=3)
+    rng = np.random.default_rng(4)
+    state = np.hstack([p["x"], np.zeros_like(p["x"])])
+    _, _, r, *_ = cascade_reference.cascade_step(tube, stage, state, p["t"], p["dt"], p["alpha"])
+    rho2 = cascade_reference.velocity_tube(stage, p["t"])
+    state[:, n:] = r + rho2 * rng.uniform(-0.95, 0.95, r.shape)
+    if bounded:
+        u = cascade_reference.cascade_step(tube, stage, state, p["t"], p["dt"], p["alpha"])[0]
+        tube = dataclasses.replace(tube, input_bound=tuple(
+            float(b) for b in np.maximum(np.median(np.abs(u), axis=0), 1e-3)))
+    prefix = case.replace("-", "_") + "_cascade"
+    files = cascade_c_files(tube, stage, prefix, "double")
+    if not bounded:
+        assert files[f"{prefix}.c"] == (_folder(case, "double") / f"{prefix}.c").read_text()
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    lib = tmp_path / "lib.so"
+    proc = subprocess.run([CC, *STRICT, "-fPIC", "-shared", str(tmp_path / f"{prefix}.c"),
+                           "-o", str(lib), "-lm"], capture_output=True, text=True)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    entry = getattr(ctypes.CDLL(str(lib)), f"{prefix}_step")
+    pointer = ctypes.POINTER(ctypes.c_double)
+    entry.argtypes = [pointer, ctypes.c_double, ctypes.c_double, pointer, pointer, pointer,
+                      pointer]
+    function = cascade.cascade_step(tube, stage)
+    codes = set()
+    for push in (0.0, 3.0):
+        for k in range(150):
+            x = np.ascontiguousarray(state[k], dtype=np.float64)
+            x[n:] += push * rho2[k]
+            alpha = np.ascontiguousarray(p["alpha"][k], dtype=np.float64)
+            u, alpha_next, r_c = np.zeros(n), np.zeros(2 * n), np.zeros(n)
+            code = entry(x.ctypes.data_as(pointer), float(p["t"][k]), float(p["dt"][k]),
+                         alpha.ctypes.data_as(pointer),
+                         *(a.ctypes.data_as(pointer) for a in (u, alpha_next, r_c)))
+            expected = casadi_dense(function, [x, [p["t"][k]], [p["dt"][k]], alpha])
+            for got, exp in zip((u, alpha_next, r_c), expected):
+                assert all(same_double(float(a), b) for a, b in zip(got, exp)), (k, push)
+            flags = [e[0] for e in expected[3:]] + ([] if bounded else [1.0])
+            assert code == (Status.OUTSIDE_TUBE if flags[0] == 0.0 else
+                            Status.OUTSIDE_VELOCITY_TUBE if flags[1] == 0.0 else
+                            Status.INPUT_CLAMPED if flags[2] == 0.0 else Status.OK)
+            codes.add(code)
+    assert Status.OK in codes and Status.OUTSIDE_VELOCITY_TUBE in codes
+    assert (Status.INPUT_CLAMPED in codes) == bounded

@@ -50,8 +50,8 @@ def adversary_run(design, stage, plants, strategy: str, seed: int = 0):
     with reference.numpy_math():
         for k in range(steps):
             t = k * h
-            u, alpha_next, r, inside1, inside2 = cascade_reference.cascade_step(
-                tube, stage, x1, x2, np.array([t]), np.array([h]), alpha)
+            u, alpha_next, r, inside1, inside2, _ = cascade_reference.cascade_step(
+                tube, stage, np.hstack([x1, x2]), np.array([t]), np.array([h]), alpha)
             if inside1[0] < 1 or inside2[0] < 1:
                 return np.inf, np.inf, np.inf
             g_l, g_u, _, _ = reference.adaptive_tube(tube, np.array([t]), alpha)

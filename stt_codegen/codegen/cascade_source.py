@@ -1,71 +1,97 @@
 """Standalone C and Python of the cascade controller for second-order plants.
 
-One entry point, ``<prefix>_step(t, dt, x1, x2, alpha, u, alpha_next, r) -> status``: the
-function :func:`stt_codegen.tube.cascade.cascade_step` of a design and its second stage,
-printed by the emitter's C printer (double or single) and Python printer, behind input
-checks. Unlike the first-order generated code (:mod:`.generate`, table-driven, evaluating
-only the active segment and the open circumvents), the composed Function is printed
-whole, with the design's numbers as constants: every segment and every circumvent is
-evaluated at every step (the same values: a closed circumvent contributes exactly 0).
-C99, ``<math.h>`` only, no allocation, no static mutable state; deterministic text
-(docs/second-order.md, "Generated code").
+The entry point has the first order's argument order, ``<prefix>_step(x, t, dt, alpha,
+u, alpha_next, r) -> status`` with ``x = [x1; x2]``, and its statuses (plus
+``OUTSIDE_VELOCITY_TUBE``); it computes :func:`stt_codegen.tube.cascade.cascade_step` of a
+design and its second stage, bit for bit in double precision.
 
-This module only prepares the data: the bodies the emitter prints, the names, the
-constants (as the printer's literals) and the banner's fields. The text of the files is
-in the Jinja2 templates ``cascade_header.h.j2``, ``cascade_source.c.j2`` and
-``cascade_module.py.j2`` (with the banner ``_banner_cascade.j2``) of the top-level
-``templates/``, rendered through :func:`.render.render` as the first-order files are.
+* C: a variant of the first-order source (:func:`.generate.c_source_context`,
+  ``c_source.c.j2``): the same tables and table-driven tube (only the active segment and
+  the open circumvents), ``P_tube``, ``P_alpha_step`` and input checks, with the cascade's
+  law (``cascade_source.c.j2``: the first order's ``law`` piece with gain ``k1`` for
+  ``r``, the pieces ``velocity_tube`` and ``velocity_law``, the first order's
+  ``saturate`` with an actuator bound) and the second stage's numbers in a ``const``
+  table. C99, ``<math.h>`` and ``<stddef.h>`` only, no allocation, no static mutable
+  state.
+* Python: the composed Function printed whole by the emitter's Python printer, behind the
+  first order's input checks.
+
+Deterministic text (docs/second-order.md, "Generated code"). This module only prepares
+the data: the bodies the emitter prints, the names, the constants (as the printer's
+literals) and the banner's fields. The text of the files is in the Jinja2 templates
+``cascade_header.h.j2``, ``cascade_source.c.j2`` and ``cascade_module.py.j2`` (with the
+banner ``_banner_cascade.j2``) of the top-level ``templates/``, rendered through
+:func:`.render.render` as the first-order files are.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 
 import casadi
 
-from ..tube.cascade import cascade_step
-from ..tube.parameters import TubeDesign
-from ..tube.parameters import Status
+from ..tube.cascade import cascade_step, velocity_law, velocity_tube
+from ..tube.model import build_model
+from ..tube.parameters import Status, TubeDesign
 from ..tube.second_stage import SecondStage
 from ..version import __version__
 from ..design.result import Design
-from .emit import CPrinter, lower, python_source
+from .emit import python_source
+from .functions import deployed_functions
+from .generate import c_source_context, input_limits
 from .options import Options
-from .render import render
+from .render import c_real, render
 
-__all__ = ["cascade_c_files", "cascade_generation", "cascade_python_file"]
-
-#: Status of an input outside the step's domain (as the first-order API's INVALID_INPUT).
-CASCADE_INVALID_INPUT = 2
-#: Largest accepted ``dt``, seconds.
-DT_MAX = 1.0
-
+__all__ = ["cascade_c_files", "cascade_generation", "cascade_python_file", "statuses"]
 
 def design_hash(design: TubeDesign, stage: SecondStage) -> str:
     """SHA-256 of the design's and the stage's numbers (their ``repr``), hex."""
     return hashlib.sha256((repr(design) + repr(stage)).encode()).hexdigest()
 
 
-#: Status names and codes, in the order the C header and the Python module define them.
-_STATUSES = (("OK", Status.OK), ("OUTSIDE_POSITION_TUBE", Status.OUTSIDE_TUBE),
-             ("INVALID_INPUT", CASCADE_INVALID_INPUT),
-             ("OUTSIDE_VELOCITY_TUBE", Status.OUTSIDE_VELOCITY_TUBE))
+def statuses(design: TubeDesign) -> list[tuple[str, int]]:
+    """The status names and codes the cascade's generated code defines, in code order: the
+    first order's (:class:`~stt_codegen.tube.parameters.Status`; ``INPUT_CLAMPED`` only
+    with an actuator bound) and ``OUTSIDE_VELOCITY_TUBE``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The position tube; its ``input_bound`` decides whether ``INPUT_CLAMPED`` is one.
+
+    Returns
+    -------
+    list of (str, int)
+        ``(name, code)`` pairs, by code.
+    """
+    return [(s.name, int(s)) for s in Status
+            if s != Status.INPUT_CLAMPED or design.input_bound is not None]
 
 
-def _context(design: TubeDesign, stage: SecondStage, prefix: str, precision: str) -> dict:
-    """What every cascade template takes: the banner's fields, the names, the statuses."""
+def _context(design: TubeDesign, stage: SecondStage, prefix: str, precision: str,
+             literal) -> dict:
+    """What every cascade template takes: the banner's fields, the names, the statuses,
+    the input domain's limits (those of the first order, :func:`.generate.input_limits`)
+    and the actuator bound, printed by ``literal``."""
+    limits = input_limits(design)
     return {"spec_name": design.name, "design_hash": design_hash(design, stage),
             "toolkit_version": __version__, "casadi_version": casadi.__version__,
             "precision": precision, "P": prefix, "U": prefix.upper(),
-            "n": design.dimension, "statuses": _STATUSES}
+            "n": design.dimension, "statuses": statuses(design),
+            "t_c": literal(design.prescribed_time), "rate_hz": literal(design.rate_hz),
+            **{name: literal(value) for name, value in limits.items()},
+            "input_bound": (None if design.input_bound is None else
+                            [literal(b) for b in design.input_bound])}
 
 
 def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
                     precision: str = "double") -> dict[str, str]:
     """``{<prefix>.h: text, <prefix>.c: text}`` of the cascade controller.
 
-    The emitter's C printer prints the composed Function; the templates
-    ``cascade_header.h.j2`` and ``cascade_source.c.j2`` hold the rest of the text.
+    The emitter's C printer prints the pieces (the first order's and the cascade's); the
+    templates ``cascade_header.h.j2`` and ``cascade_source.c.j2`` (which extends the
+    first-order ``c_source.c.j2``) hold the rest of the text.
 
     Parameters
     ----------
@@ -89,21 +115,29 @@ def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
     """
     if not prefix.isidentifier() or not prefix.isascii():
         raise ValueError(f"prefix {prefix!r} is not a C identifier")
-    printer = CPrinter(precision, "", f"{prefix}_")
-    program = lower(cascade_step(design, stage))
-    context = dict(_context(design, stage, prefix, precision),
-                   real=printer.real, body=printer.doprint(program),
-                   function=printer.function_name(program),
-                   zero=printer.constant(0.0), one=printer.constant(1.0),
-                   dt_max=printer.constant(DT_MAX), dt_max_doc=f"{DT_MAX:g}")
+    if stage.dimension != design.dimension:
+        raise ValueError(f"second stage of dimension {stage.dimension} for a tube of "
+                         f"dimension {design.dimension}")
+    single = precision == "single"
+    literal = lambda v: c_real(v, single)  # noqa: E731
+    # the tube's tables carry k1 as law (13)'s gain: r is law (13) with gain k1
+    first = dataclasses.replace(design, gain=stage.position_gain)
+    functions = [*deployed_functions(build_model(first)), velocity_tube(design.dimension),
+                 velocity_law(design.dimension)]
+    context = dict(c_source_context(first, prefix, precision, functions),
+                   **_context(design, stage, prefix, precision, literal), cascade=True,
+                   stage={"velocity_gain": literal(stage.velocity_gain),
+                          "decay": literal(stage.decay),
+                          "width_start": [literal(v) for v in stage.width_start],
+                          "width_floor": [literal(v) for v in stage.width_floor]})
     return {name: render(template, filename=name, **context)
             for name, template in ((f"{prefix}.h", "cascade_header.h.j2"),
                                    (f"{prefix}.c", "cascade_source.c.j2"))}
 
 
 def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str) -> dict[str, str]:
-    """``{<prefix>.py: text}``: ``step(t, dt, x1, x2, alpha) -> (u, alpha_next, r,
-    status)``, the same function, statuses and input checks as the C (imports ``math``
+    """``{<prefix>.py: text}``: ``step(x, t, dt, alpha) -> (u, alpha_next, r, status)``
+    (``x = [x1; x2]``), the same function, statuses and input checks as the C (imports ``math``
     only). The emitter's Python printer prints the composed Function; the template
     ``cascade_module.py.j2`` holds the rest of the text.
 
@@ -130,9 +164,9 @@ def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str) -> 
         raise ValueError(f"prefix {prefix!r} is not an identifier")
     name = f"{prefix}.py"
     return {name: render("cascade_module.py.j2", filename=name,
-                         **_context(design, stage, prefix, "double"),
-                         body=python_source(cascade_step(design, stage)),
-                         dt_max=repr(DT_MAX))}
+                         **_context(design, stage, prefix, "double",
+                                    lambda v: repr(float(v))),
+                         body=python_source(cascade_step(design, stage)))}
 
 
 #: Test vectors per generation: sample points of the cascade step.
@@ -151,7 +185,10 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     status from :func:`stt_codegen.tube.cascade_reference.cascade_step`; absolute
     tolerances ``tol_u``, ``tol_r``, ``tol_alpha_next`` from
     :func:`stt_codegen.codegen.tolerance.cascade_bounds` for ``precision`` (double: with the
-    floor ``1e-12 max(1, |ref|)``).
+    floor ``1e-12 max(1, |ref|)``). With an actuator bound, the expected status is ``OK``
+    or ``INPUT_CLAMPED`` as the oracle clamps, and only points whose clamp decision is
+    certain in the precision are kept (every ``|u_i|`` of the law farther from the bound
+    than its tolerance plus the bound's rounding), as for the first order.
     """
     import numpy as np
 
@@ -174,14 +211,16 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     t, alpha, g_l, g_u = t[keep], alpha[keep], g_l[keep], g_u[keep]
     count = t.size
     x1 = f32((g_u + g_l) / 2 + (g_u - g_l) / 2 * rng.uniform(-0.9, 0.9, (count, n)))
-    _, _, r, _, _ = cascade_reference.cascade_step(design, stage, x1, np.zeros((count, n)),
-                                                   t, dt, alpha)
+    _, _, r, *_ = cascade_reference.cascade_step(design, stage,
+                                                 np.hstack([x1, np.zeros((count, n))]),
+                                                 t, dt, alpha)
     rho2 = cascade_reference.velocity_tube(stage, t)
     x2 = f32(r + rho2 * rng.uniform(-0.9, 0.9, (count, n)))
-    u, alpha_next, r, inside_p, inside_v = cascade_reference.cascade_step(
-        design, stage, x1, x2, t, dt, alpha)
+    u, alpha_next, r, inside_p, inside_v, within = cascade_reference.cascade_step(
+        design, stage, np.hstack([x1, x2]), t, dt, alpha)
     status = np.where(inside_p == 0, Status.OUTSIDE_TUBE,
-                      np.where(inside_v == 0, Status.OUTSIDE_VELOCITY_TUBE, Status.OK))
+                      np.where(inside_v == 0, Status.OUTSIDE_VELOCITY_TUBE,
+                               np.where(within == 0, Status.INPUT_CLAMPED, Status.OK)))
     unit = T.unit_roundoff(precision)
     tol_u, tol_r, tol_a = T.cascade_bounds(design, stage, x1, x2, t, alpha, r, alpha_next, unit)
     if precision == "double":
@@ -189,10 +228,22 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
                                ((tol_u, u), (tol_r, r), (tol_a, alpha_next)))
     # rounded up to a few digits: still bounds, and the same on every CPU (docs/codegen.md)
     tol_u, tol_r, tol_a = (round_up_array(tol) for tol in (tol_u, tol_r, tol_a))
+    if design.input_bound is not None:
+        # only points whose clamp decision is certain in the precision: every |u_i| of the
+        # law farther from the bound than its error bound plus the bound's rounding (the
+        # first order's rule, docs/codegen.md "Actuator limits: the clamp")
+        free = cascade_reference.cascade_step(dataclasses.replace(design, input_bound=None),
+                                              stage, np.hstack([x1, x2]), t, dt, alpha)[0]
+        bound = np.asarray(design.input_bound)
+        keep = np.all(np.abs(np.abs(free) - bound) > tol_u + 2 * unit * bound, axis=1)
+        t, x1, x2, alpha, u, r, alpha_next, status, tol_u, tol_r, tol_a = (
+            a[keep] for a in (t, x1, x2, alpha, u, r, alpha_next, status, tol_u, tol_r,
+                              tol_a))
+        count = t.size
     return {"_generated": "GENERATED FILE, DO NOT EDIT: cascade test vectors from the numpy "
                           "reference (stt_codegen.tube.cascade_reference).",
             "dt": dt, "precision": precision, "unit_roundoff": unit,
-            "vectors": [{"t": float(t[k]), "x1": x1[k].tolist(), "x2": x2[k].tolist(),
+            "vectors": [{"t": float(t[k]), "x": [*x1[k].tolist(), *x2[k].tolist()],
                          "alpha": alpha[k].tolist(), "u": u[k].tolist(), "r": r[k].tolist(),
                          "alpha_next": alpha_next[k].tolist(), "status": int(status[k]),
                          "tol_u": tol_u[k].tolist(), "tol_r": tol_r[k].tolist(),

@@ -35,7 +35,8 @@ from .tables import design_table_rows
 from ..tube.pieces import PROFILE_NAMES
 from .vectors import test_vectors
 
-__all__ = ["GENERATOR", "MANIFEST", "Options", "generate_files", "input_limits", "manifest"]
+__all__ = ["GENERATOR", "MANIFEST", "Options", "c_source_context", "generate_files", "input_limits",
+           "manifest"]
 
 MANIFEST = "manifest.json"
 GENERATOR = "stt-codegen"
@@ -100,18 +101,7 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
     }
     files: dict[str, str] = {}
     if "c" in options.langs:
-        bodies = CPrinter(options.precision, real=f"{prefix}_real", prefix="body_")
-        c_ctx = dict(common, bodies=bodies.doprint(functions).rstrip("\n"),
-                     spec_tables=design_table_rows(design, lambda v: c_real(v, single), single),
-                     profile_codes={name: k for k, name in enumerate(PROFILE_NAMES)},
-                     guard=f"{prefix.upper()}_H", zero=c_real(0.0, single),
-                     t_c=c_real(design.prescribed_time, single),
-                     rate_hz=c_real(design.rate_hz, single),
-                     dt_min=c_real(limits["dt_min"], single),
-                     dt_max=c_real(limits["dt_max"], single),
-                     alpha_max=c_real(limits["alpha_max"], single),
-                     input_bound=(None if design.input_bound is None else
-                                  [c_real(b, single) for b in design.input_bound]))
+        c_ctx = dict(common, **c_source_context(design, prefix, options.precision, functions))
         for name, template in ((f"{prefix}.h", "c_header.h.j2"), (f"{prefix}.c", "c_source.c.j2"),
                                ("Makefile", "Makefile.j2"),
                                ("CMakeLists.txt", "CMakeLists.txt.j2")):
@@ -152,6 +142,44 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
         "tolerance": _TOLERANCE_DOC[options.precision], **vectors})
     files_bytes[MANIFEST] = _json_bytes(manifest(spec, options, files_bytes))
     return dict(sorted(files_bytes.items()))
+
+
+def c_source_context(design: TubeDesign, prefix: str, precision: str,
+                     functions: list) -> dict:
+    """The variables of ``templates/c_source.c.j2`` and ``c_header.h.j2`` that depend on the
+    design: the printed bodies, the tables, the input domain, the actuator bound.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (tables, limits, ``input_bound``).
+    prefix : str
+        The C prefix (a validated identifier).
+    precision : {"double", "single"}
+    functions : list of casadi.Function
+        The pieces whose bodies are printed (``body_<name>``), in order.
+
+    Returns
+    -------
+    dict
+        Template variables.
+    """
+    single = precision == "single"
+    limits = input_limits(design)
+    bodies = CPrinter(precision, real=f"{prefix}_real", prefix="body_")
+    return dict(P=prefix, U=prefix.upper(), n=design.dimension, newton=NEWTON_ITERATIONS,
+                real="float" if single else "double", precision=precision,
+                bodies=bodies.doprint(functions).rstrip("\n"),
+                spec_tables=design_table_rows(design, lambda v: c_real(v, single), single),
+                profile_codes={name: k for k, name in enumerate(PROFILE_NAMES)},
+                guard=f"{prefix.upper()}_H", zero=c_real(0.0, single),
+                t_c=c_real(design.prescribed_time, single),
+                rate_hz=c_real(design.rate_hz, single),
+                dt_min=c_real(limits["dt_min"], single),
+                dt_max=c_real(limits["dt_max"], single),
+                alpha_max=c_real(limits["alpha_max"], single),
+                input_bound=(None if design.input_bound is None else
+                             [c_real(b, single) for b in design.input_bound]))
 
 
 def input_limits(design: TubeDesign) -> dict[str, float]:

@@ -54,7 +54,7 @@ from .programs import (closed_loop_source, parse_closed_loop, parse_replay, repl
 from .target import CPU_FLAGS, build_elf, run_qemu
 from .toolchain import missing_message
 
-__all__ = ["compare_outputs", "run_embedded"]
+__all__ = ["COUNT_FRACTIONS", "compare_outputs", "function_profile", "run_embedded"]
 
 #: Steps whose instructions are counted: evenly spread over [0, t_c) (fractions of t_c).
 COUNT_FRACTIONS = (0.0, 0.2, 0.4, 0.6, 0.8, 0.999)

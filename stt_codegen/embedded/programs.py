@@ -30,7 +30,8 @@ from ..runtime.simulate import SUBSTEPS
 from ..spec.loader import Spec
 from ..tube.parameters import TubeDesign
 
-__all__ = ["closed_loop_source", "parse_closed_loop", "parse_replay", "replay_source", "steps_of"]
+__all__ = ["closed_loop_source", "loop_context", "parse_closed_loop", "parse_replay", "replay_source",
+           "steps_of"]
 
 
 def _d(value: float) -> str:
@@ -79,6 +80,45 @@ def _obstacles(spec: Spec) -> list[dict]:
     return out
 
 
+def loop_context(spec: Spec, design: TubeDesign, *, seed: int = 0, decimate: int = 10,
+                 replay: list[int] = ()) -> dict:
+    """What the closed-loop templates of both orders share (``templates/_embedded_plant.j2``,
+    ``_embedded_rk4.j2``, ``_embedded_judge.j2``): the names, the periods, the sets, the
+    disturbance and the obstacles, as C literals.
+
+    Parameters
+    ----------
+    spec, design
+        The spec (sets, ``t_c``, disturbance) and its design (rate).
+    seed : int
+        Disturbance seed (as ``simulate(..., seed=seed)``).
+    decimate : int
+        Print the state every ``decimate`` steps (and at the last one).
+    replay : list of int
+        Steps whose controller inputs are printed, increasing.
+
+    Returns
+    -------
+    dict
+        Template variables.
+    """
+    prefix = c_identifier(spec.c_name)
+    n = spec.dimension
+    dist = Disturbance(n, spec.disturbance_amplitude, seed)
+    return dict(
+        P=prefix, U=prefix.upper(), spec_name=spec.name, real="float", n=n,
+        steps=steps_of(spec, design), substeps=SUBSTEPS, decimate=int(decimate),
+        terms=dist.weights.shape[1], seed=int(seed), rate_hz=f"{design.rate_hz:g}",
+        rate_hz_d=_d(design.rate_hz), t_c=_d(spec.prescribed_time),
+        ss_lo=[_d(v) for v in spec.state_space.lower], ss_hi=[_d(v) for v in spec.state_space.upper],
+        tg_lo=[_d(v) for v in spec.target_set.lower], tg_hi=[_d(v) for v in spec.target_set.upper],
+        w_amp=_d(dist.amplitude), w_c=[[_d(v) for v in r] for r in dist.weights],
+        w_omega=[[_d(v) for v in r] for r in dist.frequencies],
+        w_phi=[[_d(v) for v in r] for r in dist.phases],
+        replay=[int(k) for k in replay], obstacles=_obstacles(spec),
+        has_obstacles=bool(spec.unsafe_sets))
+
+
 def closed_loop_source(spec: Spec, design: TubeDesign, *, seed: int = 0, decimate: int = 10,
                        replay: list[int] = ()) -> str:
     """The closed-loop C program (see the template's header comment).
@@ -100,27 +140,16 @@ def closed_loop_source(spec: Spec, design: TubeDesign, *, seed: int = 0, decimat
         The C source of the program (single precision), which prints the sampled states
         (``X`` lines), the replay steps' inputs (``S`` lines) and a ``closed loop:`` summary.
     """
-    prefix = c_identifier(spec.c_name)
     n = spec.dimension
-    dist = Disturbance(n, spec.disturbance_amplitude, seed)
     plant_doc = {"omnidirectional": "x_dot = R(x3) u + w, R the rotation by the heading x3 "
                                     "(eq. (14))",
                  "linear": "x_dot = a x + c + g u + w, the spec's matrices"}.get(
                      spec.plant_model, "x_dot = u + w")
     return render(
-        "embedded_closed_loop.c.j2", P=prefix, U=prefix.upper(), spec_name=spec.name,
-        real="float", plant=spec.plant_model, plant_doc=plant_doc, n=n,
-        steps=steps_of(spec, design), substeps=SUBSTEPS, decimate=int(decimate),
-        terms=dist.weights.shape[1], seed=int(seed), rate_hz=f"{design.rate_hz:g}",
-        rate_hz_d=_d(design.rate_hz), t_c=_d(spec.prescribed_time),
+        "embedded_closed_loop.c.j2",
+        **loop_context(spec, design, seed=seed, decimate=decimate, replay=replay),
+        plant=spec.plant_model, plant_doc=plant_doc,
         x0=[_d(v) for v in spec.initial_state],
-        ss_lo=[_d(v) for v in spec.state_space.lower], ss_hi=[_d(v) for v in spec.state_space.upper],
-        tg_lo=[_d(v) for v in spec.target_set.lower], tg_hi=[_d(v) for v in spec.target_set.upper],
-        w_amp=_d(dist.amplitude), w_c=[[_d(v) for v in r] for r in dist.weights],
-        w_omega=[[_d(v) for v in r] for r in dist.frequencies],
-        w_phi=[[_d(v) for v in r] for r in dist.phases],
-        replay=[int(k) for k in replay], obstacles=_obstacles(spec),
-        has_obstacles=bool(spec.unsafe_sets),
         plant_rhs=c_source(plant_function(spec.plant_model, n, spec.linear_plant)).strip())
 
 
@@ -130,8 +159,11 @@ def float_bits(values) -> list[str]:
     return [f"0x{int(b):08x}u" for b in a.view(np.uint32)]
 
 
-def replay_source(spec: Spec, design: TubeDesign, x, t, dt, alpha, what: str) -> str:
+def replay_source(spec: Spec, design: TubeDesign, x, t, dt, alpha, what: str,
+                  prefix: str | None = None) -> str:
     """The replay program at float inputs ``x`` (N, n), ``t`` (N,), ``dt`` (N,), ``alpha`` (N, 2n).
+
+    For a second-order spec it calls the cascade's step (``x`` (N, 2n): ``[x1; x2]``).
 
     Parameters
     ----------
@@ -150,17 +182,20 @@ def replay_source(spec: Spec, design: TubeDesign, x, t, dt, alpha, what: str) ->
         The adaptive law's ``alpha``.
     what : str
         What the inputs are, for the program's header comment.
+    prefix : str, optional
+        The controller's C prefix (default: the spec's C name).
 
     Returns
     -------
     str
         The C source of the program, which prints one ``R`` line per input.
     """
-    prefix = c_identifier(spec.c_name)
+    prefix = c_identifier(spec.c_name) if prefix is None else prefix
     x = np.atleast_2d(np.asarray(x, dtype=np.float32))
     rows = [float_bits(np.concatenate([x[k], [t[k], dt[k]], alpha[k]])) for k in range(len(t))]
+    cascade = {"cascade": True} if spec.order == 2 else {}
     return render("embedded_replay.c.j2", P=prefix, spec_name=spec.name, real="float",
-                  n=spec.dimension, count=len(rows), rows=rows, what=what)
+                  n=spec.dimension, count=len(rows), rows=rows, what=what, **cascade)
 
 
 def _f32(word: str) -> float:
@@ -235,7 +270,7 @@ class ClosedLoopOutput:
     replay_inputs: dict
 
 
-def parse_closed_loop(stdout: str, n: int) -> ClosedLoopOutput:
+def parse_closed_loop(stdout: str, n: int, state_size: int | None = None) -> ClosedLoopOutput:
     """Parse the closed-loop program's output (raises ``ValueError`` without a summary).
 
     Parameters
@@ -243,7 +278,10 @@ def parse_closed_loop(stdout: str, n: int) -> ClosedLoopOutput:
     stdout : str
         The program's standard output.
     n : int
-        State dimension.
+        State dimension (positions; ``alpha`` has ``2 n`` entries).
+    state_size : int, optional
+        Entries of the plant's state in the ``X`` and ``S`` lines (default ``n``; ``2 n``
+        for a second-order plant's ``[x1; x2]``).
 
     Returns
     -------
@@ -267,13 +305,14 @@ def parse_closed_loop(stdout: str, n: int) -> ClosedLoopOutput:
             summary[key] = int(value)
         else:
             summary[key] = float(value)
+    size = n if state_size is None else state_size
     states, replay = {}, {}
     for line in stdout.splitlines():
         parts = line.split()
         if parts and parts[0] == "X":
-            states[int(parts[1])] = np.array([_f64(w) for w in parts[2:2 + n]])
+            states[int(parts[1])] = np.array([_f64(w) for w in parts[2:2 + size]])
         elif parts and parts[0] == "S":
             vals = [_f32(w) for w in parts[2:]]
             replay[int(parts[1])] = (vals[0], np.array(vals[1:1 + 2 * n]),
-                                     np.array(vals[1 + 2 * n:1 + 3 * n]))
+                                     np.array(vals[1 + 2 * n:1 + 2 * n + size]))
     return ClosedLoopOutput(summary, states, replay)

@@ -30,10 +30,12 @@ __all__ = ["CascadeController"]
 CASCADE_BACKENDS = ("reference", "casadi", "python", "c")
 
 
-def _status(inside_position: float, inside_velocity: float) -> int:
+def _status(inside_position: float, inside_velocity: float, within_bound: float) -> int:
     if not inside_position:
         return Status.OUTSIDE_TUBE
-    return Status.OK if inside_velocity else Status.OUTSIDE_VELOCITY_TUBE
+    if not inside_velocity:
+        return Status.OUTSIDE_VELOCITY_TUBE
+    return Status.OK if within_bound else Status.INPUT_CLAMPED
 
 
 class CascadeController:
@@ -76,9 +78,9 @@ class CascadeController:
             else:
                 self._call = _compiled(design, stage)
 
-    def _reference(self, x1, x2, t, dt, alpha):
-        out = cascade_reference.cascade_step(self.design, self.stage, x1[None], x2[None],
-                                             t, dt, alpha[None])
+    def _reference(self, x, t, dt, alpha):
+        out = cascade_reference.cascade_step(self.design, self.stage, x[None], t, dt,
+                                             alpha[None])
         return [np.ravel(v) for v in out]
 
     def step(self, x: np.ndarray, t: float, dt: float,
@@ -105,11 +107,12 @@ class CascadeController:
             :class:`~stt_codegen.tube.parameters.Status` of the step.
         """
         x = np.asarray(x, dtype=float)
-        n = self._n
-        u, alpha_next, _r, inside_p, inside_v = self._call(
-            x[:n], x[n:], float(t), float(dt), np.asarray(alpha, dtype=float))
-        return u, alpha_next, _status(float(np.ravel(inside_p)[0]),
-                                      float(np.ravel(inside_v)[0]))
+        out = self._call(x, float(t), float(dt), np.asarray(alpha, dtype=float))
+        if len(out) == 3:          # the compiled step returns its status
+            return out
+        u, alpha_next, _r, inside_p, inside_v, *within = out
+        flags = [float(np.ravel(v)[0]) for v in (inside_p, inside_v, *within)]
+        return u, alpha_next, _status(*flags, *([1.0] if not within else []))
 
 
 def _compiled(design: TubeDesign, stage: SecondStage):
@@ -134,19 +137,16 @@ def _compiled(design: TubeDesign, stage: SecondStage):
         handle = ctypes.CDLL(str(lib))
     entry = handle.stt_cascade_step
     real_p = ctypes.POINTER(ctypes.c_double)
-    entry.argtypes = [ctypes.c_double, ctypes.c_double, real_p, real_p, real_p, real_p,
-                      real_p, real_p]
+    entry.argtypes = [real_p, ctypes.c_double, ctypes.c_double, real_p, real_p, real_p, real_p]
     entry.restype = ctypes.c_int
     n = design.dimension
 
-    def call(x1, x2, t, dt, alpha):
-        bufs = [np.ascontiguousarray(v, dtype=np.float64) for v in (x1, x2, alpha)]
+    def call(x, t, dt, alpha):
+        x, alpha = (np.ascontiguousarray(v, dtype=np.float64) for v in (x, alpha))
         u, alpha_next, r = np.zeros(n), np.zeros(2 * n), np.zeros(n)
-        code = entry(t, dt, *(b.ctypes.data_as(real_p) for b in bufs),
+        code = entry(x.ctypes.data_as(real_p), t, dt, alpha.ctypes.data_as(real_p),
                      *(b.ctypes.data_as(real_p) for b in (u, alpha_next, r)))
-        inside_p = 0.0 if code == Status.OUTSIDE_TUBE else 1.0
-        inside_v = 1.0 if code == Status.OK else 0.0
-        return [u, alpha_next, r, np.array([inside_p]), np.array([inside_v])]
+        return u, alpha_next, Status(code)
 
     call.library = handle  # keep the library loaded with the closure
     return call

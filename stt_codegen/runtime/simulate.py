@@ -469,7 +469,7 @@ def _velocity_verdict(spec: Spec, tube: TubeDesign, stage: SecondStage | None,
     r = None
     if stage is not None:
         with reference.numpy_math():
-            r = cascade_reference.cascade_step(tube, stage, x1, x2, ts, dt, alphas)[2]
+            r = cascade_reference.cascade_step(tube, stage, states, ts, dt, alphas)[2]
     bound = spec.second_order.velocity_bound
     exceeded = (bound is not None
                 and bool(np.any(np.abs(x2[ts <= spec.prescribed_time + 1e-12])

@@ -32,7 +32,8 @@ from .second_stage import SecondStage
 __all__ = ["CASCADE_OUTPUTS", "cascade_step", "velocity_law", "velocity_transform",
            "velocity_tube"]
 
-#: The outputs of :func:`cascade_step`, in order.
+#: The outputs of :func:`cascade_step`, in order (``within_bound`` follows them with an
+#: actuator bound).
 CASCADE_OUTPUTS = ("u", "alpha_next", "r", "inside_position", "inside_velocity")
 
 
@@ -134,28 +135,35 @@ def velocity_transform(n: int) -> ca.Function:
 
 
 def cascade_step(design: TubeDesign, stage: SecondStage) -> ca.Function:
-    """``cascade_step(x1, x2, t, dt, alpha) -> (u, alpha_next, r, inside_position,
-    inside_velocity)``: one sampled step of the cascade (docs/second-order.md).
+    """``cascade_step(x, t, dt, alpha) -> (u, alpha_next, r, inside_position,
+    inside_velocity[, within_bound])``: one sampled step of the cascade
+    (docs/second-order.md), with the first-order step's argument order.
 
-    ``r`` is law (13) of :func:`stt_codegen.tube.pieces.law` with gain ``k1`` on the
-    adaptive tube of eq. (10) at ``(t, alpha)``; ``u`` is :func:`velocity_law` with gain
-    ``k2`` on ``rho2(t)``; ``alpha_next`` is the deployed implicit step of (11), exactly as
-    in :func:`stt_codegen.tube.model.build_model`. A design's actuator bound is not applied
-    (the cascade has no saturation proof).
+    ``x = [x1; x2]`` is the plant's state: positions, then velocities. ``r`` is law (13) of
+    :func:`stt_codegen.tube.pieces.law` with gain ``k1`` on the adaptive tube of eq. (10)
+    at ``(t, alpha)``; ``u`` is :func:`velocity_law` with gain ``k2`` on ``rho2(t)``;
+    ``alpha_next`` is the deployed implicit step of (11), exactly as in
+    :func:`stt_codegen.tube.model.build_model`. With an actuator bound
+    (``design.input_bound``: the bound on the physical input ``u``, one per input), ``u``
+    is clamped to ``[-input_bound, input_bound]`` by
+    :func:`stt_codegen.tube.pieces.saturate` (the first order's clamp) and a sixth output,
+    ``within_bound``, is 1.0 when no entry was moved.
 
     Parameters
     ----------
     design : TubeDesign
-        The position tube (its ``gain`` is not used: ``stage.position_gain`` is ``k1``).
+        The position tube (its ``gain`` is not used: ``stage.position_gain`` is ``k1``)
+        and the actuator bound ``input_bound`` (or ``None``).
     stage : SecondStage
         Of the same dimension.
 
     Returns
     -------
     casadi.Function
-        Inputs ``x1`` (n, m), ``x2`` (n, m/s), ``t`` (s), ``dt`` (s), ``alpha`` (2n);
-        outputs :data:`CASCADE_OUTPUTS`: ``u`` (n, input units), ``alpha_next`` (2n),
-        ``r`` (n, m/s), ``inside_position`` and ``inside_velocity`` (1.0 or 0.0).
+        Inputs ``x`` (2n: m, then m/s), ``t`` (s), ``dt`` (s), ``alpha`` (2n); outputs
+        :data:`CASCADE_OUTPUTS`: ``u`` (n, input units), ``alpha_next`` (2n), ``r`` (n,
+        m/s), ``inside_position`` and ``inside_velocity`` (1.0 or 0.0), and with an
+        actuator bound ``within_bound`` (1.0 or 0.0).
 
     Raises
     ------
@@ -166,7 +174,8 @@ def cascade_step(design: TubeDesign, stage: SecondStage) -> ca.Function:
     if stage.dimension != n:
         raise ValueError(f"second stage of dimension {stage.dimension} for a tube of "
                          f"dimension {n}")
-    x1, x2 = ca.SX.sym("x1", n), ca.SX.sym("x2", n)
+    x = ca.SX.sym("x", 2 * n)
+    x1, x2 = x[:n], x[n:]
     t, dt = ca.SX.sym("t"), ca.SX.sym("dt")
     alpha = ca.SX.sym("alpha", 2 * n)
     gamma_l, gamma_u = adaptive_tube(design, t, alpha)
@@ -174,8 +183,14 @@ def cascade_step(design: TubeDesign, stage: SecondStage) -> ca.Function:
     rho2 = velocity_tube(n)(t, ca.DM(stage.width_start), ca.DM(stage.width_floor),
                             stage.decay)
     u, inside_velocity = velocity_law(n)(x2, r, rho2, stage.velocity_gain)
+    outputs, names = [u], list(CASCADE_OUTPUTS)
+    if design.input_bound is not None:
+        u, within = P.saturate(n)(u, ca.DM(design.input_bound))
+        outputs, names = [u], [*names, "within_bound"]
     psi_next, theta_next = conflict_and_trigger(design, P.later()(t, dt))
     alpha_next = implicit_alpha_update(alpha, psi_next, theta_next, dt, design.kappa)
-    return ca.Function("cascade_step", [x1, x2, t, dt, alpha],
-                       [u, alpha_next, r, inside_position, inside_velocity],
-                       ["x1", "x2", "t", "dt", "alpha"], list(CASCADE_OUTPUTS))
+    outputs += [alpha_next, r, inside_position, inside_velocity]
+    if design.input_bound is not None:
+        outputs.append(within)
+    return ca.Function("cascade_step", [x, t, dt, alpha], outputs,
+                       ["x", "t", "dt", "alpha"], names)

@@ -71,17 +71,19 @@ def velocity_transform(x2, r, rho2) -> tuple[Array, Array, Array]:
     return e, epsilon, 2.0 / (rho2 * (1.0 - e * e))
 
 
-def cascade_step(design: TubeDesign, stage: SecondStage, x1, x2, t, dt,
-                 alpha) -> tuple[Array, Array, Array, Array, Array]:
-    """One step of the deployed cascade, with the clamps of law (13).
+def cascade_step(design: TubeDesign, stage: SecondStage, x, t, dt,
+                 alpha) -> tuple[Array, Array, Array, Array, Array, Array]:
+    """One step of the deployed cascade, with the clamps of law (13) and the actuator's.
 
     Parameters
     ----------
     design : TubeDesign
-        The position tube (``design.gain`` is replaced by ``stage.position_gain``).
+        The position tube (``design.gain`` is replaced by ``stage.position_gain``) and the
+        actuator bound ``design.input_bound`` on ``u`` (or ``None``).
     stage : SecondStage
-    x1, x2 : array_like, shape (N, n)
-        Positions (state units) and velocities (state units per second).
+    x : array_like, shape (N, 2n)
+        The plant's state ``[x1; x2]``: positions (state units), then velocities (state
+        units per second).
     t, dt : array_like, shape (N,)
         Seconds.
     alpha : array_like, shape (N, 2n)
@@ -90,22 +92,30 @@ def cascade_step(design: TubeDesign, stage: SecondStage, x1, x2, t, dt,
     -------
     u : ndarray, shape (N, n)
         ``-k2 xi2 epsilon2`` with ``e2`` clamped to ``[-E_MAX, E_MAX]`` and ``rho2`` floored
-        at ``GAMMA_D_MIN`` (finite everywhere).
+        at ``GAMMA_D_MIN`` (finite everywhere), then, with an actuator bound, each entry
+        limited to ``[-input_bound_i, input_bound_i]``.
     alpha_next : ndarray, shape (N, 2n)
     r : ndarray, shape (N, n)
         The virtual velocity, law (13) with gain ``k1``.
     inside_position, inside_velocity : ndarray, shape (N,)
         1.0 where ``gamma_L < x1 < gamma_U``, resp. ``|x2 - r| < rho2``, in every dimension.
+    within_bound : ndarray, shape (N,)
+        1.0 where the actuator bound moved no entry of ``u`` (always, without a bound).
     """
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    n = design.dimension
+    x1, x2 = x[:, :n], x[:, n:]
     first = dataclasses.replace(design, gain=stage.position_gain, input_bound=None)
     r, alpha_next, inside_position = reference.law_step(first, x1, t, dt, alpha)
     t = np.atleast_1d(np.asarray(t, dtype=float))
     rho2 = velocity_tube(stage, t)
-    x2 = np.broadcast_to(np.asarray(x2, dtype=float), r.shape)
+    x2 = np.broadcast_to(x2, r.shape)
     z = x2 - r
     inside_velocity = np.all((z > -rho2) & (z < rho2), axis=1).astype(float)
     width = np.maximum(rho2, GAMMA_D_MIN)
     e = np.clip(z / width, -E_MAX, E_MAX)
     epsilon = reference.log((1.0 + e) / (1.0 - e))
     xi = 2.0 / (width * (1.0 - e * e))
-    return -stage.velocity_gain * xi * epsilon, alpha_next, r, inside_position, inside_velocity
+    # the reference's own clamp (numpy.clip), not the model's saturate piece
+    u, within = reference.saturate(design, -stage.velocity_gain * xi * epsilon)
+    return u, alpha_next, r, inside_position, inside_velocity, within

@@ -114,8 +114,8 @@ def _errors(tube: TubeDesign, stage: SecondStage, x1, x2, t: float, dt: float, a
     position, inside velocity)``."""
     rows = x1.shape[0]
     times = np.full(rows, t)
-    u, alpha_next, r, inside_p, inside_v = cascade_reference.cascade_step(
-        tube, stage, x1, x2, times, dt, alpha)
+    u, alpha_next, r, inside_p, inside_v, _within = cascade_reference.cascade_step(
+        tube, stage, np.hstack([x1, x2]), times, dt, alpha)
     g_l, g_u, _, _ = reference.adaptive_tube(tube, times, alpha)
     with np.errstate(divide="ignore", invalid="ignore"):
         e1 = np.abs(2.0 * x1 - (g_u + g_l)) / (g_u - g_l)

@@ -3,1214 +3,1724 @@
  * "second-order-quadrotor" and its second stage (SHA-256 97718e85f61c9d30ba9a5e2532f2e26e853d69c9feaa3f75e59ca8dca1235799),
  * precision double. Cascade law of docs/second-order.md.
  */
+/*
+ * Implementation of second_order_quadrotor_cascade.h. The functions body_* are printed by the project's C
+ * printer (stt_codegen.codegen.emit.CPrinter, double) from the CasADi SX Functions of
+ * the first-order model's pieces and the cascade's (stt_codegen.tube.cascade), one
+ * statement per instruction of CasADi's virtual machine; the API below checks inputs,
+ * evaluates the tube over the open circumvents only (the first order's tables) and the
+ * cascade's two stages, and checks their results.
+ */
 #include <math.h>
+#include <stddef.h>
 
 #include "second_order_quadrotor_cascade.h"
 
+/* -ffast-math and -Ofast define __FAST_MATH__; -ffinite-math-only (gcc, clang) and clang's
+   -fno-honor-nans -fno-honor-infinities together define __FINITE_MATH_ONLY__ 1. */
 #if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && (__FINITE_MATH_ONLY__ != 0))
-#error "second_order_quadrotor_cascade.c must not be compiled with -ffast-math: it removes the isfinite() input checks"
+#error "second_order_quadrotor_cascade.c must not be compiled with -ffast-math (or -Ofast, -ffinite-math-only, -fno-honor-nans, -fno-honor-infinities): they remove the isfinite() input checks and change the rounding the tolerances assume"
 #endif
 
-/* CasADi Function 'cascade_step': 1092 instructions. */
-static void second_order_quadrotor_cascade_cascade_step(const double* x1, const double* x2, const double* t, const double* dt, const double* alpha, double* u, double* alpha_next, double* r, double* inside_position, double* inside_velocity) {
-  double w0;
-  double w1;
-  double w2;
-  double w3;
-  double w4;
-  double w5;
-  double w6;
-  double w7;
-  double w8;
-  double w9;
-  double w10;
-  double w11;
-  double w12;
-  double w13;
-  double w14;
-  double w15;
-  double w16;
-  double w17;
-  double w18;
-  double w19;
-  double w20;
-  double w21;
-  double w22;
-  double w23;
-  double w24;
-  double w25;
-  double w26;
-  double w27;
-  double w28;
-  double w29;
-  double w30;
-  double w31;
-  double w32;
-  double w33;
-  double w34;
-  double w35;
-  double w36;
-  double w37;
-  double w38;
-  double w39;
-  double w40;
-  double w41;
-  double w42;
-  double w43;
-  double w44;
-  double w45;
-  double w46;
-  double w47;
-  double w48;
-  double w49;
-  double w50;
-  double w51;
-  double w52;
-  double w53;
-  double w54;
-  double w55;
-  double w56;
-  double w57;
-  w0 = 9046.954292479999;
-  w1 = 2.0;
-  w2 = 8.290377273567628e-09;
-  w3 = 100.0;
-  w4 = t[0];
-  w5 = 0.0;
-  w6 = (w5 > w4) ? w5 : w4;
-  w3 = w3 * w6;
-  w3 = -w3;
-  w6 = -80.0;
-  w3 = (w6 > w3) ? w6 : w3;
-  w3 = exp(w3);
-  w7 = w2 * w3;
-  w8 = 6.72568;
-  w7 = w7 + w8;
-  w9 = 1e-06;
-  w10 = (w9 > w7) ? w9 : w7;
-  w11 = 1.0;
-  w12 = x2[0];
-  w13 = 0.027101390625000003;
-  w14 = 4.0;
-  w15 = 5.1;
-  w16 = 10.0;
-  w17 = (w4 < w16) ? 1.0 : 0.0;
-  w18 = (w4 < w5) ? 1.0 : 0.0;
-  w18 = (w18 == 0.0) ? 1.0 : 0.0;
-  w19 = w16 - w4;
-  w19 = (w17 != 0.0) ? w19 : 0.0;
-  w20 = (w17 == 0.0) ? 1.0 : 0.0;
-  w20 = (w20 != 0.0) ? w11 : 0.0;
-  w19 = w19 + w20;
-  w19 = w4 / w19;
-  w19 = tanh(w19);
-  w18 = (w18 != 0.0) ? w19 : 0.0;
-  w18 = (w17 != 0.0) ? w18 : 0.0;
-  w17 = (w17 == 0.0) ? 1.0 : 0.0;
-  w17 = (w17 != 0.0) ? w11 : 0.0;
-  w18 = w18 + w17;
-  w17 = w15 * w18;
-  w19 = 0.7;
-  w17 = w17 + w19;
-  w20 = alpha[3];
-  w17 = w17 + w20;
-  w21 = -w17;
-  w22 = 6.0;
-  w23 = 1.0033291693641804;
-  w24 = (w23 < w4) ? 1.0 : 0.0;
-  w25 = 3.2021538373170984;
-  w26 = (w4 < w25) ? 1.0 : 0.0;
-  w24 = ((w24 != 0.0) && (w26 != 0.0)) ? 1.0 : 0.0;
-  w26 = 2.1027415033406394;
-  w27 = w4 - w26;
-  w28 = fabs(w27);
-  w29 = 1.099412333976459;
-  w28 = (w28 < w29) ? 1.0 : 0.0;
-  w24 = ((w24 != 0.0) && (w28 != 0.0)) ? 1.0 : 0.0;
-  w28 = 4.2;
-  w30 = w27 * w27;
-  w31 = fabs(w27);
-  w31 = w29 - w31;
-  w27 = fabs(w27);
-  w27 = w29 + w27;
-  w31 = w31 * w27;
-  w31 = (w24 != 0.0) ? w31 : 0.0;
-  w27 = (w24 == 0.0) ? 1.0 : 0.0;
-  w27 = (w27 != 0.0) ? w11 : 0.0;
-  w31 = w31 + w27;
-  w30 = w30 / w31;
-  w30 = -w30;
-  w30 = (w6 > w30) ? w6 : w30;
-  w30 = exp(w30);
-  w30 = w28 * w30;
-  w24 = (w24 != 0.0) ? w30 : 0.0;
-  w30 = (w24 > w5) ? w24 : w5;
-  w31 = 1.3012432470576862;
-  w27 = (w31 < w4) ? 1.0 : 0.0;
-  w32 = 7.2490932967185575;
-  w33 = (w4 < w32) ? 1.0 : 0.0;
-  w27 = ((w27 != 0.0) && (w33 != 0.0)) ? 1.0 : 0.0;
-  w33 = 4.275168271888122;
-  w34 = w4 - w33;
-  w35 = fabs(w34);
-  w36 = 2.973925024830436;
-  w35 = (w35 < w36) ? 1.0 : 0.0;
-  w27 = ((w27 != 0.0) && (w35 != 0.0)) ? 1.0 : 0.0;
-  w35 = 2.7;
-  w37 = w34 * w34;
-  w38 = fabs(w34);
-  w38 = w36 - w38;
-  w34 = fabs(w34);
-  w34 = w36 + w34;
-  w38 = w38 * w34;
-  w38 = (w27 != 0.0) ? w38 : 0.0;
-  w34 = (w27 == 0.0) ? 1.0 : 0.0;
-  w34 = (w34 != 0.0) ? w11 : 0.0;
-  w38 = w38 + w34;
-  w37 = w37 / w38;
-  w37 = -w37;
-  w37 = (w6 > w37) ? w6 : w37;
-  w37 = exp(w37);
-  w37 = w35 * w37;
-  w27 = (w27 != 0.0) ? w37 : 0.0;
-  w30 = (w27 > w30) ? w27 : w30;
-  w37 = 50.0;
-  w38 = w37 * w30;
-  w38 = -w38;
-  w38 = (w6 > w38) ? w6 : w38;
-  w38 = exp(w38);
-  w24 = w24 - w30;
-  w24 = w37 * w24;
-  w24 = (w6 > w24) ? w6 : w24;
-  w24 = exp(w24);
-  w34 = w37 * w30;
-  w34 = -w34;
-  w34 = (w6 > w34) ? w6 : w34;
-  w34 = exp(w34);
-  w24 = w24 - w34;
-  w38 = w38 + w24;
-  w27 = w27 - w30;
-  w27 = w37 * w27;
-  w27 = (w6 > w27) ? w6 : w27;
-  w27 = exp(w27);
-  w24 = w37 * w30;
-  w24 = -w24;
-  w24 = (w6 > w24) ? w6 : w24;
-  w24 = exp(w24);
-  w27 = w27 - w24;
-  w38 = w38 + w27;
-  w38 = log(w38);
-  w38 = w38 / w37;
-  w30 = w30 + w38;
-  w30 = w22 - w30;
-  w38 = -w30;
-  w21 = (w38 > w21) ? w38 : w21;
-  w30 = w30 - w17;
-  w30 = fabs(w30);
-  w30 = w37 * w30;
-  w30 = -w30;
-  w30 = (w6 > w30) ? w6 : w30;
-  w30 = exp(w30);
-  w30 = log1p(w30);
-  w30 = w30 / w37;
-  w21 = w21 + w30;
-  w30 = 4.9;
-  w17 = w30 * w18;
-  w38 = 0.3;
-  w17 = w17 + w38;
-  w27 = alpha[0];
-  w17 = w17 - w27;
-  w24 = (w5 > w17) ? w5 : w17;
-  w17 = fabs(w17);
-  w17 = w37 * w17;
-  w17 = -w17;
-  w17 = (w6 > w17) ? w6 : w17;
-  w17 = exp(w17);
-  w17 = log1p(w17);
-  w17 = w17 / w37;
-  w24 = w24 + w17;
-  w17 = w21 + w24;
-  w17 = -w17;
-  w17 = (w9 > w17) ? w9 : w17;
-  w34 = x1[0];
-  w39 = w34 + w34;
-  w40 = w24 - w21;
-  w39 = w39 - w40;
-  w39 = w39 / w17;
-  w40 = -0.9999990463256836;
-  w39 = (w40 > w39) ? w40 : w39;
-  w41 = 0.9999990463256836;
-  w39 = (w41 < w39) ? w41 : w39;
-  w42 = w39 * w39;
-  w42 = w11 - w42;
-  w17 = w17 * w42;
-  w17 = w14 / w17;
-  w17 = w13 * w17;
-  w42 = w11 + w39;
-  w39 = w11 - w39;
-  w42 = w42 / w39;
-  w42 = log(w42);
-  w17 = w17 * w42;
-  w42 = w12 + w17;
-  w42 = w42 / w10;
-  w42 = (w40 > w42) ? w40 : w42;
-  w42 = (w41 < w42) ? w41 : w42;
-  w39 = w42 * w42;
-  w39 = w11 - w39;
-  w10 = w10 * w39;
-  w10 = w1 / w10;
-  w10 = w0 * w10;
-  w39 = w11 + w42;
-  w42 = w11 - w42;
-  w39 = w39 / w42;
-  w39 = log(w39);
-  w10 = w10 * w39;
-  w10 = -w10;
-  u[0] = w10;
+/* ------------------------------------------------------------- spec tables */
+
+/* Tube parameters. */
+typedef struct {
+  second_order_quadrotor_cascade_real smoothness; /* nu of the smooth max/min and of F_nu (eqs. (9)-(10)), 1/state units */
+  second_order_quadrotor_cascade_real theta0; /* theta_0 of the trigger (11) */
+  second_order_quadrotor_cascade_real mu; /* mu of the trigger (11), state units */
+  second_order_quadrotor_cascade_real kappa; /* kappa of the adaptive law (11), 1/s */
+  second_order_quadrotor_cascade_real gain; /* k of the control law (13) */
+} second_order_quadrotor_cascade_parameters;
+
+static const second_order_quadrotor_cascade_parameters SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS = {
+  50.0, /* smoothness */
+  0.01, /* theta0 */
+  1.0, /* mu */
+  5.0, /* kappa */
+  0.027101390625000003 /* gain */
+};
+
+/* State-space bounds [X; X-bar], the sign of eq. (9) on each (+1 lower, -1 upper) and the
+   number of circumvents acting on each. */
+static const second_order_quadrotor_cascade_real SECOND_ORDER_QUADROTOR_CASCADE_BOUND[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA] = { 0.0, 0.0, 0.0, 6.0, 6.0, 3.0 };
+static const second_order_quadrotor_cascade_real SECOND_ORDER_QUADROTOR_CASCADE_SIGN[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA] = { 1.0, 1.0, 1.0, -1.0, -1.0, -1.0 };
+static const int SECOND_ORDER_QUADROTOR_CASCADE_MEMBERS[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA] = { 0, 0, 0, 2, 0, 0 };
+
+/* Reach tube (eq. (4)), one row per segment: rho = from + (to - from) p(t) on
+   [start, end]; profile 0 = tanh (eq. (4)), 1 = smoothstep (quintic). Rows: [L; U]. */
+typedef struct {
+  second_order_quadrotor_cascade_real start;
+  second_order_quadrotor_cascade_real end;
+  int profile;
+  second_order_quadrotor_cascade_real from[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real to[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+} second_order_quadrotor_cascade_segment;
+
+#define SECOND_ORDER_QUADROTOR_CASCADE_N_SEGMENTS 1
+static const second_order_quadrotor_cascade_segment SECOND_ORDER_QUADROTOR_CASCADE_SEGMENTS[SECOND_ORDER_QUADROTOR_CASCADE_N_SEGMENTS] = {
+  { 0.0, 10.0, 0, { 0.3, 0.3, 0.8, 0.7, 0.7, 1.2 }, { 5.2, 5.2, 1.2, 5.8, 5.8, 1.8 } }
+};
+
+/* Circumvents (eqs. (7)-(9)), one row per window, sorted by start: window (start, end),
+   center m, radius r, sharpness k, height B, running maximum of the ends (to find the open
+   windows), bound index (i: lower bound of dimension i, N + i: upper bound). */
+typedef struct {
+  second_order_quadrotor_cascade_real start;
+  second_order_quadrotor_cascade_real end;
+  second_order_quadrotor_cascade_real center;
+  second_order_quadrotor_cascade_real radius;
+  second_order_quadrotor_cascade_real sharpness;
+  second_order_quadrotor_cascade_real height;
+  second_order_quadrotor_cascade_real max_end;
+  int bound;
+} second_order_quadrotor_cascade_window;
+
+#define SECOND_ORDER_QUADROTOR_CASCADE_N_WINDOWS 2
+/* most windows open at one time (size of the work arrays) */
+#define SECOND_ORDER_QUADROTOR_CASCADE_MAX_OPEN 2
+static const second_order_quadrotor_cascade_window SECOND_ORDER_QUADROTOR_CASCADE_WINDOWS[SECOND_ORDER_QUADROTOR_CASCADE_N_WINDOWS] = {
+  { 1.0033291693641804, 3.2021538373170984, 2.1027415033406394, 1.099412333976459, 1.0, 4.2, 3.2021538373170984, 3 }, /* obstacle 0 */
+  { 1.3012432470576862, 7.2490932967185575, 4.275168271888122, 2.973925024830436, 1.0, 2.7, 7.2490932967185575, 3 } /* obstacle 1 */
+};
+
+/* ------------------------------------------------------------- emitted bodies */
+
+/* CasADi Function 'progress_tanh_value': 22 instructions. */
+static void body_progress_tanh_value(const second_order_quadrotor_cascade_real* t, const second_order_quadrotor_cascade_real* start, const second_order_quadrotor_cascade_real* end, second_order_quadrotor_cascade_real* p) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  w0 = t[0];
+  w1 = end[0];
+  w2 = (w0 < w1) ? 1.0 : 0.0;
+  w3 = start[0];
+  w3 = w0 - w3;
+  w4 = 0.0;
+  w4 = (w3 < w4) ? 1.0 : 0.0;
+  w4 = (w4 == 0.0) ? 1.0 : 0.0;
+  w1 = w1 - w0;
+  w1 = (w2 != 0.0) ? w1 : 0.0;
+  w0 = (w2 == 0.0) ? 1.0 : 0.0;
+  w5 = 1.0;
+  w0 = (w0 != 0.0) ? w5 : 0.0;
+  w1 = w1 + w0;
+  w3 = w3 / w1;
+  w3 = tanh(w3);
+  w4 = (w4 != 0.0) ? w3 : 0.0;
+  w4 = (w2 != 0.0) ? w4 : 0.0;
+  w2 = (w2 == 0.0) ? 1.0 : 0.0;
+  w2 = (w2 != 0.0) ? w5 : 0.0;
+  w4 = w4 + w2;
+  p[0] = w4;
+}
+
+/* CasADi Function 'progress_tanh': 32 instructions. */
+static void body_progress_tanh(const second_order_quadrotor_cascade_real* t, const second_order_quadrotor_cascade_real* start, const second_order_quadrotor_cascade_real* end, second_order_quadrotor_cascade_real* p, second_order_quadrotor_cascade_real* p_dot) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  second_order_quadrotor_cascade_real w6;
+  second_order_quadrotor_cascade_real w7;
+  w0 = t[0];
+  w1 = end[0];
+  w2 = (w0 < w1) ? 1.0 : 0.0;
+  w3 = start[0];
+  w3 = w0 - w3;
+  w4 = 0.0;
+  w4 = (w3 < w4) ? 1.0 : 0.0;
+  w4 = (w4 == 0.0) ? 1.0 : 0.0;
+  w1 = w1 - w0;
+  w1 = (w2 != 0.0) ? w1 : 0.0;
+  w0 = (w2 == 0.0) ? 1.0 : 0.0;
+  w5 = 1.0;
+  w0 = (w0 != 0.0) ? w5 : 0.0;
+  w1 = w1 + w0;
+  w3 = w3 / w1;
+  w0 = tanh(w3);
+  w6 = (w4 != 0.0) ? w0 : 0.0;
+  w6 = (w2 != 0.0) ? w6 : 0.0;
+  w7 = (w2 == 0.0) ? 1.0 : 0.0;
+  w7 = (w7 != 0.0) ? w5 : 0.0;
+  w6 = w6 + w7;
+  p[0] = w6;
+  w0 = w0 * w0;
+  w5 = w5 - w0;
+  w0 = 1.0 / w1;
+  w3 = w3 / w1;
+  w3 = (w2 != 0.0) ? w3 : 0.0;
+  w0 = w0 + w3;
+  w5 = w5 * w0;
+  w4 = (w4 != 0.0) ? w5 : 0.0;
+  w2 = (w2 != 0.0) ? w4 : 0.0;
+  p_dot[0] = w2;
+}
+
+/* CasADi Function 'interpolate_value': 37 instructions. */
+static void body_interpolate_value(const second_order_quadrotor_cascade_real* p, const second_order_quadrotor_cascade_real* from, const second_order_quadrotor_cascade_real* to, second_order_quadrotor_cascade_real* rho) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  w0 = to[0];
+  w1 = from[0];
+  w0 = w0 - w1;
+  w2 = p[0];
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[0] = w0;
+  w0 = to[1];
+  w1 = from[1];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[1] = w0;
+  w0 = to[2];
+  w1 = from[2];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[2] = w0;
+  w0 = to[3];
+  w1 = from[3];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[3] = w0;
+  w0 = to[4];
+  w1 = from[4];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[4] = w0;
+  w0 = to[5];
+  w1 = from[5];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho[5] = w0;
+}
+
+/* CasADi Function 'interpolate': 56 instructions. */
+static void body_interpolate(const second_order_quadrotor_cascade_real* p, const second_order_quadrotor_cascade_real* p_dot, const second_order_quadrotor_cascade_real* from, const second_order_quadrotor_cascade_real* to, second_order_quadrotor_cascade_real* rho, second_order_quadrotor_cascade_real* rho_dot) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  second_order_quadrotor_cascade_real w6;
+  second_order_quadrotor_cascade_real w7;
+  second_order_quadrotor_cascade_real w8;
+  second_order_quadrotor_cascade_real w9;
+  second_order_quadrotor_cascade_real w10;
+  second_order_quadrotor_cascade_real w11;
+  second_order_quadrotor_cascade_real w12;
+  second_order_quadrotor_cascade_real w13;
+  w0 = to[0];
+  w1 = from[0];
+  w2 = w0 - w1;
+  w3 = p[0];
   w2 = w2 * w3;
-  w2 = w2 + w8;
-  w3 = (w9 > w2) ? w9 : w2;
-  w10 = x2[1];
-  w39 = w15 * w18;
-  w39 = w39 + w19;
-  w42 = alpha[4];
-  w39 = w39 + w42;
-  w43 = -w39;
-  w44 = -6.0;
-  w43 = (w44 > w43) ? w44 : w43;
-  w39 = w22 - w39;
-  w39 = fabs(w39);
-  w39 = w37 * w39;
-  w39 = -w39;
-  w39 = (w6 > w39) ? w6 : w39;
-  w39 = exp(w39);
-  w39 = log1p(w39);
-  w39 = w39 / w37;
-  w43 = w43 + w39;
-  w39 = w30 * w18;
-  w39 = w39 + w38;
-  w44 = alpha[1];
-  w39 = w39 - w44;
-  w45 = (w5 > w39) ? w5 : w39;
-  w39 = fabs(w39);
-  w39 = w37 * w39;
-  w39 = -w39;
-  w39 = (w6 > w39) ? w6 : w39;
-  w39 = exp(w39);
-  w39 = log1p(w39);
-  w39 = w39 / w37;
-  w45 = w45 + w39;
-  w39 = w43 + w45;
-  w39 = -w39;
-  w39 = (w9 > w39) ? w9 : w39;
-  w46 = x1[1];
-  w47 = w46 + w46;
-  w48 = w45 - w43;
-  w47 = w47 - w48;
-  w47 = w47 / w39;
-  w47 = (w40 > w47) ? w40 : w47;
-  w47 = (w41 < w47) ? w41 : w47;
-  w48 = w47 * w47;
-  w48 = w11 - w48;
-  w39 = w39 * w48;
-  w39 = w14 / w39;
-  w39 = w13 * w39;
-  w48 = w11 + w47;
-  w47 = w11 - w47;
-  w48 = w48 / w47;
-  w48 = log(w48);
-  w39 = w39 * w48;
-  w48 = w10 + w39;
-  w48 = w48 / w3;
-  w48 = (w40 > w48) ? w40 : w48;
-  w48 = (w41 < w48) ? w41 : w48;
-  w47 = w48 * w48;
-  w47 = w11 - w47;
-  w3 = w3 * w47;
-  w3 = w1 / w3;
-  w3 = w0 * w3;
-  w47 = w11 + w48;
-  w48 = w11 - w48;
-  w47 = w47 / w48;
-  w47 = log(w47);
-  w3 = w3 * w47;
-  w3 = -w3;
-  u[1] = w3;
-  w3 = x2[2];
-  w47 = 0.6000000000000001;
-  w48 = w47 * w18;
-  w49 = 1.2;
-  w48 = w48 + w49;
-  w50 = alpha[5];
-  w48 = w48 + w50;
-  w51 = -w48;
-  w52 = -3.0;
-  w51 = (w52 > w51) ? w52 : w51;
-  w52 = 3.0;
-  w48 = w52 - w48;
-  w48 = fabs(w48);
-  w48 = w37 * w48;
-  w48 = -w48;
-  w48 = (w6 > w48) ? w6 : w48;
-  w48 = exp(w48);
-  w48 = log1p(w48);
-  w48 = w48 / w37;
-  w51 = w51 + w48;
-  w48 = 0.3999999999999999;
-  w18 = w48 * w18;
-  w53 = 0.8;
-  w18 = w18 + w53;
-  w54 = alpha[2];
-  w18 = w18 - w54;
-  w55 = (w5 > w18) ? w5 : w18;
-  w18 = fabs(w18);
-  w18 = w37 * w18;
-  w18 = -w18;
-  w18 = (w6 > w18) ? w6 : w18;
-  w18 = exp(w18);
-  w18 = log1p(w18);
-  w18 = w18 / w37;
-  w55 = w55 + w18;
-  w18 = w51 + w55;
-  w18 = -w18;
-  w18 = (w9 > w18) ? w9 : w18;
-  w9 = x1[2];
-  w56 = w9 + w9;
-  w57 = w55 - w51;
-  w56 = w56 - w57;
-  w56 = w56 / w18;
-  w56 = (w40 > w56) ? w40 : w56;
-  w56 = (w41 < w56) ? w41 : w56;
-  w57 = w56 * w56;
-  w57 = w11 - w57;
-  w18 = w18 * w57;
-  w14 = w14 / w18;
-  w13 = w13 * w14;
-  w14 = w11 + w56;
-  w56 = w11 - w56;
-  w14 = w14 / w56;
-  w14 = log(w14);
-  w13 = w13 * w14;
-  w14 = w3 + w13;
-  w14 = w14 / w8;
-  w14 = (w40 > w14) ? w40 : w14;
-  w14 = (w41 < w14) ? w41 : w14;
-  w41 = w14 * w14;
-  w41 = w11 - w41;
-  w41 = w8 * w41;
-  w1 = w1 / w41;
+  w2 = w2 + w1;
+  rho[0] = w2;
+  w2 = to[1];
+  w4 = from[1];
+  w5 = w2 - w4;
+  w5 = w5 * w3;
+  w5 = w5 + w4;
+  rho[1] = w5;
+  w5 = to[2];
+  w6 = from[2];
+  w7 = w5 - w6;
+  w7 = w7 * w3;
+  w7 = w7 + w6;
+  rho[2] = w7;
+  w7 = to[3];
+  w8 = from[3];
+  w9 = w7 - w8;
+  w9 = w9 * w3;
+  w9 = w9 + w8;
+  rho[3] = w9;
+  w9 = to[4];
+  w10 = from[4];
+  w11 = w9 - w10;
+  w11 = w11 * w3;
+  w11 = w11 + w10;
+  rho[4] = w11;
+  w11 = to[5];
+  w12 = from[5];
+  w13 = w11 - w12;
+  w13 = w13 * w3;
+  w13 = w13 + w12;
+  rho[5] = w13;
+  w0 = w0 - w1;
+  w1 = p_dot[0];
   w0 = w0 * w1;
-  w1 = w11 + w14;
-  w14 = w11 - w14;
-  w1 = w1 / w14;
+  rho_dot[0] = w0;
+  w2 = w2 - w4;
+  w2 = w2 * w1;
+  rho_dot[1] = w2;
+  w5 = w5 - w6;
+  w5 = w5 * w1;
+  rho_dot[2] = w5;
+  w7 = w7 - w8;
+  w7 = w7 * w1;
+  rho_dot[3] = w7;
+  w9 = w9 - w10;
+  w9 = w9 * w1;
+  rho_dot[4] = w9;
+  w11 = w11 - w12;
+  w11 = w11 * w1;
+  rho_dot[5] = w11;
+}
+
+/* CasADi Function 'bump_value': 34 instructions. */
+static void body_bump_value(const second_order_quadrotor_cascade_real* t, const second_order_quadrotor_cascade_real* start, const second_order_quadrotor_cascade_real* end, const second_order_quadrotor_cascade_real* center, const second_order_quadrotor_cascade_real* radius, const second_order_quadrotor_cascade_real* sharpness, const second_order_quadrotor_cascade_real* height, second_order_quadrotor_cascade_real* y) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  w0 = start[0];
+  w1 = t[0];
+  w0 = (w0 < w1) ? 1.0 : 0.0;
+  w2 = end[0];
+  w2 = (w1 < w2) ? 1.0 : 0.0;
+  w0 = ((w0 != 0.0) && (w2 != 0.0)) ? 1.0 : 0.0;
+  w2 = center[0];
+  w1 = w1 - w2;
+  w2 = fabs(w1);
+  w3 = radius[0];
+  w2 = (w2 < w3) ? 1.0 : 0.0;
+  w0 = ((w0 != 0.0) && (w2 != 0.0)) ? 1.0 : 0.0;
+  w2 = height[0];
+  w4 = sharpness[0];
+  w5 = w1 * w1;
+  w4 = w4 * w5;
+  w5 = fabs(w1);
+  w5 = w3 - w5;
+  w1 = fabs(w1);
+  w3 = w3 + w1;
+  w5 = w5 * w3;
+  w5 = (w0 != 0.0) ? w5 : 0.0;
+  w3 = (w0 == 0.0) ? 1.0 : 0.0;
+  w1 = 1.0;
+  w3 = (w3 != 0.0) ? w1 : 0.0;
+  w5 = w5 + w3;
+  w4 = w4 / w5;
+  w4 = -w4;
+  w5 = -80.0;
+  w4 = (w5 > w4) ? w5 : w4;
+  w4 = exp(w4);
+  w2 = w2 * w4;
+  w0 = (w0 != 0.0) ? w2 : 0.0;
+  y[0] = w0;
+}
+
+/* CasADi Function 'bump': 57 instructions. */
+static void body_bump(const second_order_quadrotor_cascade_real* t, const second_order_quadrotor_cascade_real* start, const second_order_quadrotor_cascade_real* end, const second_order_quadrotor_cascade_real* center, const second_order_quadrotor_cascade_real* radius, const second_order_quadrotor_cascade_real* sharpness, const second_order_quadrotor_cascade_real* height, second_order_quadrotor_cascade_real* y, second_order_quadrotor_cascade_real* y_dot) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  second_order_quadrotor_cascade_real w6;
+  second_order_quadrotor_cascade_real w7;
+  second_order_quadrotor_cascade_real w8;
+  second_order_quadrotor_cascade_real w9;
+  second_order_quadrotor_cascade_real w10;
+  second_order_quadrotor_cascade_real w11;
+  w0 = start[0];
+  w1 = t[0];
+  w0 = (w0 < w1) ? 1.0 : 0.0;
+  w2 = end[0];
+  w2 = (w1 < w2) ? 1.0 : 0.0;
+  w0 = ((w0 != 0.0) && (w2 != 0.0)) ? 1.0 : 0.0;
+  w2 = center[0];
+  w1 = w1 - w2;
+  w2 = fabs(w1);
+  w3 = radius[0];
+  w2 = (w2 < w3) ? 1.0 : 0.0;
+  w0 = ((w0 != 0.0) && (w2 != 0.0)) ? 1.0 : 0.0;
+  w2 = height[0];
+  w4 = sharpness[0];
+  w5 = w1 * w1;
+  w5 = w4 * w5;
+  w6 = fabs(w1);
+  w6 = w3 - w6;
+  w7 = fabs(w1);
+  w3 = w3 + w7;
+  w7 = w6 * w3;
+  w7 = (w0 != 0.0) ? w7 : 0.0;
+  w8 = (w0 == 0.0) ? 1.0 : 0.0;
+  w9 = 1.0;
+  w8 = (w8 != 0.0) ? w9 : 0.0;
+  w7 = w7 + w8;
+  w5 = w5 / w7;
+  w8 = -w5;
+  w9 = -80.0;
+  w10 = (w9 > w8) ? w9 : w8;
+  w10 = exp(w10);
+  w11 = w2 * w10;
+  w11 = (w0 != 0.0) ? w11 : 0.0;
+  y[0] = w11;
+  w11 = (w9 <= w8) ? 1.0 : 0.0;
+  w8 = (w8 <= w9) ? 1.0 : 0.0;
+  w8 = w11 + w8;
+  w11 = w11 / w8;
+  w8 = w1 + w1;
+  w4 = w4 * w8;
+  w4 = w4 / w7;
+  w5 = w5 / w7;
+  w7 = (w1 < 0.0) ? -1.0 : ((w1 > 0.0) ? 1.0 : w1);
+  w6 = w6 * w7;
+  w1 = (w1 < 0.0) ? -1.0 : ((w1 > 0.0) ? 1.0 : w1);
+  w3 = w3 * w1;
+  w6 = w6 - w3;
+  w5 = w5 * w6;
+  w5 = -w5;
+  w5 = (w0 != 0.0) ? w5 : 0.0;
+  w4 = w4 + w5;
+  w11 = w11 * w4;
+  w10 = w10 * w11;
+  w2 = w2 * w10;
+  w2 = -w2;
+  w0 = (w0 != 0.0) ? w2 : 0.0;
+  y_dot[0] = w0;
+}
+
+/* CasADi Function 'fnu_init': 10 instructions. */
+static void body_fnu_init(const second_order_quadrotor_cascade_real* top, const second_order_quadrotor_cascade_real* nu, second_order_quadrotor_cascade_real* total, second_order_quadrotor_cascade_real* rate) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  w0 = nu[0];
+  w1 = top[0];
+  w0 = w0 * w1;
+  w0 = -w0;
+  w1 = -80.0;
+  w0 = (w1 > w0) ? w1 : w0;
+  w0 = exp(w0);
+  total[0] = w0;
+  w0 = 0.0;
+  rate[0] = w0;
+}
+
+/* CasADi Function 'fnu_add': 21 instructions. */
+static void body_fnu_add(const second_order_quadrotor_cascade_real* total, const second_order_quadrotor_cascade_real* rate, const second_order_quadrotor_cascade_real* y, const second_order_quadrotor_cascade_real* y_dot, const second_order_quadrotor_cascade_real* top, const second_order_quadrotor_cascade_real* nu, second_order_quadrotor_cascade_real* total_next, second_order_quadrotor_cascade_real* rate_next) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  w0 = total[0];
+  w1 = nu[0];
+  w2 = y[0];
+  w3 = top[0];
+  w2 = w2 - w3;
+  w2 = w1 * w2;
+  w4 = -80.0;
+  w2 = (w4 > w2) ? w4 : w2;
+  w2 = exp(w2);
+  w1 = w1 * w3;
+  w1 = -w1;
+  w1 = (w4 > w1) ? w4 : w1;
+  w1 = exp(w1);
+  w1 = w2 - w1;
+  w0 = w0 + w1;
+  total_next[0] = w0;
+  w0 = rate[0];
+  w1 = y_dot[0];
+  w2 = w2 * w1;
+  w0 = w0 + w2;
+  rate_next[0] = w0;
+}
+
+/* CasADi Function 'fnu_finish': 15 instructions. */
+static void body_fnu_finish(const second_order_quadrotor_cascade_real* bound, const second_order_quadrotor_cascade_real* sign, const second_order_quadrotor_cascade_real* top, const second_order_quadrotor_cascade_real* total, const second_order_quadrotor_cascade_real* rate, const second_order_quadrotor_cascade_real* nu, second_order_quadrotor_cascade_real* beta, second_order_quadrotor_cascade_real* beta_dot) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  w0 = bound[0];
+  w1 = sign[0];
+  w2 = top[0];
+  w3 = total[0];
+  w4 = log(w3);
+  w5 = nu[0];
+  w4 = w4 / w5;
+  w2 = w2 + w4;
+  w2 = w1 * w2;
+  w0 = w0 + w2;
+  beta[0] = w0;
+  w0 = rate[0];
+  w0 = w0 / w3;
+  w1 = w1 * w0;
+  beta_dot[0] = w1;
+}
+
+/* CasADi Function 'candidates': 24 instructions. */
+static void body_candidates(const second_order_quadrotor_cascade_real* rho, const second_order_quadrotor_cascade_real* alpha, second_order_quadrotor_cascade_real* c) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  w0 = rho[0];
+  w1 = alpha[0];
+  w0 = w0 - w1;
+  c[0] = w0;
+  w0 = rho[1];
+  w1 = alpha[1];
+  w0 = w0 - w1;
+  c[1] = w0;
+  w0 = rho[2];
+  w1 = alpha[2];
+  w0 = w0 - w1;
+  c[2] = w0;
+  w0 = rho[3];
+  w1 = alpha[3];
+  w0 = w0 + w1;
+  c[3] = w0;
+  w0 = rho[4];
+  w1 = alpha[4];
+  w0 = w0 + w1;
+  c[4] = w0;
+  w0 = rho[5];
+  w1 = alpha[5];
+  w0 = w0 + w1;
+  c[5] = w0;
+}
+
+/* CasADi Function 'candidate_rates': 24 instructions. */
+static void body_candidate_rates(const second_order_quadrotor_cascade_real* rho_dot, const second_order_quadrotor_cascade_real* alpha_dot, second_order_quadrotor_cascade_real* c_dot) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  w0 = rho_dot[0];
+  w1 = alpha_dot[0];
+  w0 = w0 - w1;
+  c_dot[0] = w0;
+  w0 = rho_dot[1];
+  w1 = alpha_dot[1];
+  w0 = w0 - w1;
+  c_dot[1] = w0;
+  w0 = rho_dot[2];
+  w1 = alpha_dot[2];
+  w0 = w0 - w1;
+  c_dot[2] = w0;
+  w0 = rho_dot[3];
+  w1 = alpha_dot[3];
+  w0 = w0 + w1;
+  c_dot[3] = w0;
+  w0 = rho_dot[4];
+  w1 = alpha_dot[4];
+  w0 = w0 + w1;
+  c_dot[4] = w0;
+  w0 = rho_dot[5];
+  w1 = alpha_dot[5];
+  w0 = w0 + w1;
+  c_dot[5] = w0;
+}
+
+/* CasADi Function 'smooth_max_test': 19 instructions. */
+static void body_smooth_max_test(const second_order_quadrotor_cascade_real* a, const second_order_quadrotor_cascade_real* b, const second_order_quadrotor_cascade_real* nu, second_order_quadrotor_cascade_real* max, second_order_quadrotor_cascade_real* needed) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  w0 = a[0];
+  w1 = b[0];
+  w2 = (w1 > w0) ? w1 : w0;
+  max[0] = w2;
+  w3 = 30.91;
+  w4 = nu[0];
+  w2 = fabs(w2);
+  w2 = w4 * w2;
+  w0 = w0 - w1;
+  w0 = fabs(w0);
+  w4 = w4 * w0;
+  w0 = 80.0;
+  w4 = (w0 < w4) ? w0 : w4;
+  w0 = 33.0;
+  w4 = w4 - w0;
+  w2 = w2 * w4;
+  w3 = (w3 <= w2) ? 1.0 : 0.0;
+  w3 = (w3 == 0.0) ? 1.0 : 0.0;
+  needed[0] = w3;
+}
+
+/* CasADi Function 'smooth_max': 15 instructions. */
+static void body_smooth_max(const second_order_quadrotor_cascade_real* a, const second_order_quadrotor_cascade_real* b, const second_order_quadrotor_cascade_real* nu, second_order_quadrotor_cascade_real* max) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  w0 = a[0];
+  w1 = b[0];
+  w2 = (w1 > w0) ? w1 : w0;
+  w3 = nu[0];
+  w0 = w0 - w1;
+  w0 = fabs(w0);
+  w0 = w3 * w0;
+  w0 = -w0;
+  w1 = -80.0;
+  w0 = (w1 > w0) ? w1 : w0;
+  w0 = exp(w0);
+  w0 = log1p(w0);
+  w0 = w0 / w3;
+  w2 = w2 + w0;
+  max[0] = w2;
+}
+
+/* CasADi Function 'smooth_min_test': 22 instructions. */
+static void body_smooth_min_test(const second_order_quadrotor_cascade_real* a, const second_order_quadrotor_cascade_real* b, const second_order_quadrotor_cascade_real* nu, second_order_quadrotor_cascade_real* min, second_order_quadrotor_cascade_real* needed) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  w0 = a[0];
+  w1 = -w0;
+  w2 = b[0];
+  w3 = -w2;
+  w1 = (w3 > w1) ? w3 : w1;
+  w3 = -w1;
+  min[0] = w3;
+  w3 = 30.91;
+  w4 = nu[0];
+  w1 = fabs(w1);
+  w1 = w4 * w1;
+  w2 = w2 - w0;
+  w2 = fabs(w2);
+  w4 = w4 * w2;
+  w2 = 80.0;
+  w4 = (w2 < w4) ? w2 : w4;
+  w2 = 33.0;
+  w4 = w4 - w2;
+  w1 = w1 * w4;
+  w3 = (w3 <= w1) ? 1.0 : 0.0;
+  w3 = (w3 == 0.0) ? 1.0 : 0.0;
+  needed[0] = w3;
+}
+
+/* CasADi Function 'smooth_min': 18 instructions. */
+static void body_smooth_min(const second_order_quadrotor_cascade_real* a, const second_order_quadrotor_cascade_real* b, const second_order_quadrotor_cascade_real* nu, second_order_quadrotor_cascade_real* min) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  w0 = a[0];
+  w1 = -w0;
+  w2 = b[0];
+  w3 = -w2;
+  w1 = (w3 > w1) ? w3 : w1;
+  w3 = nu[0];
+  w2 = w2 - w0;
+  w2 = fabs(w2);
+  w2 = w3 * w2;
+  w2 = -w2;
+  w0 = -80.0;
+  w2 = (w0 > w2) ? w0 : w2;
+  w2 = exp(w2);
+  w2 = log1p(w2);
+  w2 = w2 / w3;
+  w1 = w1 + w2;
+  w1 = -w1;
+  min[0] = w1;
+}
+
+/* CasADi Function 'smooth_max_rate': 40 instructions. */
+static void body_smooth_max_rate(const second_order_quadrotor_cascade_real* a, const second_order_quadrotor_cascade_real* b, const second_order_quadrotor_cascade_real* a_dot, const second_order_quadrotor_cascade_real* b_dot, const second_order_quadrotor_cascade_real* nu, second_order_quadrotor_cascade_real* max_dot) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  second_order_quadrotor_cascade_real w6;
+  second_order_quadrotor_cascade_real w7;
+  second_order_quadrotor_cascade_real w8;
+  w0 = b[0];
+  w1 = a[0];
+  w2 = (w0 <= w1) ? 1.0 : 0.0;
+  w3 = (w1 <= w0) ? 1.0 : 0.0;
+  w4 = w2 + w3;
+  w2 = w2 / w4;
+  w5 = nu[0];
+  w1 = w1 - w0;
+  w0 = fabs(w1);
+  w0 = w5 * w0;
+  w0 = -w0;
+  w6 = -80.0;
+  w7 = (w6 > w0) ? w6 : w0;
+  w7 = exp(w7);
+  w8 = (w6 <= w0) ? 1.0 : 0.0;
+  w0 = (w0 <= w6) ? 1.0 : 0.0;
+  w0 = w8 + w0;
+  w8 = w8 / w0;
+  w1 = (w1 < 0.0) ? -1.0 : ((w1 > 0.0) ? 1.0 : w1);
+  w0 = w5 * w1;
+  w0 = w8 * w0;
+  w0 = w7 * w0;
+  w6 = 1.0;
+  w6 = w6 + w7;
+  w0 = w0 / w6;
+  w0 = w0 / w5;
+  w2 = w2 - w0;
+  w0 = a_dot[0];
+  w2 = w2 * w0;
+  w3 = w3 / w4;
+  w1 = w5 * w1;
+  w8 = w8 * w1;
+  w7 = w7 * w8;
+  w7 = w7 / w6;
+  w7 = w7 / w5;
+  w3 = w3 + w7;
+  w7 = b_dot[0];
+  w3 = w3 * w7;
+  w2 = w2 + w3;
+  max_dot[0] = w2;
+}
+
+/* CasADi Function 'smooth_min_rate': 42 instructions. */
+static void body_smooth_min_rate(const second_order_quadrotor_cascade_real* a, const second_order_quadrotor_cascade_real* b, const second_order_quadrotor_cascade_real* a_dot, const second_order_quadrotor_cascade_real* b_dot, const second_order_quadrotor_cascade_real* nu, second_order_quadrotor_cascade_real* min_dot) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  second_order_quadrotor_cascade_real w6;
+  second_order_quadrotor_cascade_real w7;
+  second_order_quadrotor_cascade_real w8;
+  w0 = a[0];
+  w1 = -w0;
+  w2 = b[0];
+  w3 = -w2;
+  w4 = (w1 <= w3) ? 1.0 : 0.0;
+  w3 = (w3 <= w1) ? 1.0 : 0.0;
+  w1 = w3 + w4;
+  w4 = w4 / w1;
+  w5 = nu[0];
+  w2 = w2 - w0;
+  w0 = fabs(w2);
+  w0 = w5 * w0;
+  w0 = -w0;
+  w6 = -80.0;
+  w7 = (w6 > w0) ? w6 : w0;
+  w7 = exp(w7);
+  w8 = (w6 <= w0) ? 1.0 : 0.0;
+  w0 = (w0 <= w6) ? 1.0 : 0.0;
+  w0 = w8 + w0;
+  w8 = w8 / w0;
+  w2 = (w2 < 0.0) ? -1.0 : ((w2 > 0.0) ? 1.0 : w2);
+  w0 = w5 * w2;
+  w0 = w8 * w0;
+  w0 = w7 * w0;
+  w6 = 1.0;
+  w6 = w6 + w7;
+  w0 = w0 / w6;
+  w0 = w0 / w5;
+  w4 = w4 + w0;
+  w0 = b_dot[0];
+  w4 = w4 * w0;
+  w2 = w5 * w2;
+  w8 = w8 * w2;
+  w7 = w7 * w8;
+  w7 = w7 / w6;
+  w7 = w7 / w5;
+  w3 = w3 / w1;
+  w7 = w7 - w3;
+  w3 = a_dot[0];
+  w7 = w7 * w3;
+  w4 = w4 - w7;
+  min_dot[0] = w4;
+}
+
+/* CasADi Function 'conflict': 78 instructions. */
+static void body_conflict(const second_order_quadrotor_cascade_real* rho, const second_order_quadrotor_cascade_real* beta, const second_order_quadrotor_cascade_real* theta0, const second_order_quadrotor_cascade_real* mu, second_order_quadrotor_cascade_real* psi, second_order_quadrotor_cascade_real* theta) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  second_order_quadrotor_cascade_real w6;
+  second_order_quadrotor_cascade_real w7;
+  second_order_quadrotor_cascade_real w8;
+  second_order_quadrotor_cascade_real w9;
+  second_order_quadrotor_cascade_real w10;
+  w0 = beta[3];
+  w1 = rho[0];
+  w0 = w0 - w1;
+  psi[0] = w0;
+  w1 = beta[4];
+  w2 = rho[1];
+  w1 = w1 - w2;
+  psi[1] = w1;
+  w2 = beta[5];
+  w3 = rho[2];
+  w2 = w2 - w3;
+  psi[2] = w2;
+  w3 = rho[3];
+  w4 = beta[0];
+  w3 = w3 - w4;
+  psi[3] = w3;
+  w4 = rho[4];
+  w5 = beta[1];
+  w4 = w4 - w5;
+  psi[4] = w4;
+  w5 = rho[5];
+  w6 = beta[2];
+  w5 = w5 - w6;
+  psi[5] = w5;
+  w6 = theta0[0];
+  w6 = w6 + w6;
+  w7 = 1.0;
+  w8 = mu[0];
+  w0 = w0 - w8;
+  w0 = w0 + w0;
+  w9 = -80.0;
+  w0 = (w9 > w0) ? w9 : w0;
+  w10 = 80.0;
+  w0 = (w10 < w0) ? w10 : w0;
+  w0 = exp(w0);
+  w0 = w7 + w0;
+  w0 = w6 / w0;
+  theta[0] = w0;
+  w1 = w1 - w8;
+  w1 = w1 + w1;
+  w1 = (w9 > w1) ? w9 : w1;
+  w1 = (w10 < w1) ? w10 : w1;
+  w1 = exp(w1);
+  w1 = w7 + w1;
+  w1 = w6 / w1;
+  theta[1] = w1;
+  w2 = w2 - w8;
+  w2 = w2 + w2;
+  w2 = (w9 > w2) ? w9 : w2;
+  w2 = (w10 < w2) ? w10 : w2;
+  w2 = exp(w2);
+  w2 = w7 + w2;
+  w2 = w6 / w2;
+  theta[2] = w2;
+  w3 = w3 - w8;
+  w3 = w3 + w3;
+  w3 = (w9 > w3) ? w9 : w3;
+  w3 = (w10 < w3) ? w10 : w3;
+  w3 = exp(w3);
+  w3 = w7 + w3;
+  w3 = w6 / w3;
+  theta[3] = w3;
+  w4 = w4 - w8;
+  w4 = w4 + w4;
+  w4 = (w9 > w4) ? w9 : w4;
+  w4 = (w10 < w4) ? w10 : w4;
+  w4 = exp(w4);
+  w4 = w7 + w4;
+  w4 = w6 / w4;
+  theta[4] = w4;
+  w5 = w5 - w8;
+  w5 = w5 + w5;
+  w5 = (w9 > w5) ? w9 : w5;
+  w5 = (w10 < w5) ? w10 : w5;
+  w5 = exp(w5);
+  w7 = w7 + w5;
+  w6 = w6 / w7;
+  theta[5] = w6;
+}
+
+/* CasADi Function 'alpha_rate': 55 instructions. */
+static void body_alpha_rate(const second_order_quadrotor_cascade_real* alpha, const second_order_quadrotor_cascade_real* psi, const second_order_quadrotor_cascade_real* theta, const second_order_quadrotor_cascade_real* kappa, second_order_quadrotor_cascade_real* alpha_dot) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  w0 = theta[0];
+  w1 = psi[0];
+  w2 = alpha[0];
+  w1 = w1 + w2;
+  w1 = w1 * w1;
+  w0 = w0 / w1;
+  w1 = kappa[0];
+  w2 = w1 * w2;
+  w0 = w0 - w2;
+  alpha_dot[0] = w0;
+  w0 = theta[1];
+  w2 = psi[1];
+  w3 = alpha[1];
+  w2 = w2 + w3;
+  w2 = w2 * w2;
+  w0 = w0 / w2;
+  w3 = w1 * w3;
+  w0 = w0 - w3;
+  alpha_dot[1] = w0;
+  w0 = theta[2];
+  w3 = psi[2];
+  w2 = alpha[2];
+  w3 = w3 + w2;
+  w3 = w3 * w3;
+  w0 = w0 / w3;
+  w2 = w1 * w2;
+  w0 = w0 - w2;
+  alpha_dot[2] = w0;
+  w0 = theta[3];
+  w2 = psi[3];
+  w3 = alpha[3];
+  w2 = w2 + w3;
+  w2 = w2 * w2;
+  w0 = w0 / w2;
+  w3 = w1 * w3;
+  w0 = w0 - w3;
+  alpha_dot[3] = w0;
+  w0 = theta[4];
+  w3 = psi[4];
+  w2 = alpha[4];
+  w3 = w3 + w2;
+  w3 = w3 * w3;
+  w0 = w0 / w3;
+  w2 = w1 * w2;
+  w0 = w0 - w2;
+  alpha_dot[4] = w0;
+  w0 = theta[5];
+  w2 = psi[5];
+  w3 = alpha[5];
+  w2 = w2 + w3;
+  w2 = w2 * w2;
+  w0 = w0 / w2;
+  w1 = w1 * w3;
+  w0 = w0 - w1;
+  alpha_dot[5] = w0;
+}
+
+/* CasADi Function 'later': 4 instructions. */
+static void body_later(const second_order_quadrotor_cascade_real* t, const second_order_quadrotor_cascade_real* dt, second_order_quadrotor_cascade_real* t_next) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  w0 = t[0];
+  w1 = dt[0];
+  w0 = w0 + w1;
+  t_next[0] = w0;
+}
+
+/* CasADi Function 'newton_start': 24 instructions. */
+static void body_newton_start(const second_order_quadrotor_cascade_real* alpha, const second_order_quadrotor_cascade_real* psi, const second_order_quadrotor_cascade_real* theta, const second_order_quadrotor_cascade_real* dt, const second_order_quadrotor_cascade_real* kappa, second_order_quadrotor_cascade_real* a0, second_order_quadrotor_cascade_real* c, second_order_quadrotor_cascade_real* A, second_order_quadrotor_cascade_real* root) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  w0 = alpha[0];
+  w1 = 1.0;
+  w2 = kappa[0];
+  w3 = dt[0];
+  w2 = w2 * w3;
+  w1 = w1 + w2;
+  w0 = w0 / w1;
+  a0[0] = w0;
+  c[0] = w1;
+  w2 = theta[0];
+  w3 = w3 * w2;
+  A[0] = w3;
+  w2 = 0.0;
+  w4 = psi[0];
+  w4 = w4 + w0;
+  w2 = (w2 < w4) ? 1.0 : 0.0;
+  w1 = w1 + w1;
+  w0 = w4 * w4;
+  w0 = w0 * w4;
+  w1 = w1 * w0;
+  w3 = (w3 <= w1) ? 1.0 : 0.0;
+  w2 = ((w2 != 0.0) && (w3 != 0.0)) ? 1.0 : 0.0;
+  w2 = (w2 == 0.0) ? 1.0 : 0.0;
+  root[0] = w2;
+}
+
+/* CasADi Function 'newton_root_start': 23 instructions. */
+static void body_newton_root_start(const second_order_quadrotor_cascade_real* alpha, const second_order_quadrotor_cascade_real* psi, const second_order_quadrotor_cascade_real* c, const second_order_quadrotor_cascade_real* A, second_order_quadrotor_cascade_real* a0) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  w0 = alpha[0];
+  w1 = c[0];
+  w2 = w0 / w1;
+  w3 = A[0];
+  w4 = w1 + w1;
+  w4 = w3 / w4;
+  w5 = 0.3333333333333333;
+  w4 = pow(w4, w5);
+  w5 = psi[0];
+  w1 = w1 * w5;
+  w1 = w1 + w0;
+  w1 = -w1;
+  w0 = 0.0;
+  w1 = (w0 > w1) ? w0 : w1;
+  w0 = 1e-30;
+  w1 = (w0 > w1) ? w0 : w1;
+  w1 = w1 + w1;
+  w3 = w3 / w1;
+  w3 = sqrt(w3);
+  w4 = (w3 < w4) ? w3 : w4;
+  w4 = w4 - w5;
+  w2 = (w4 > w2) ? w4 : w2;
+  a0[0] = w2;
+}
+
+/* CasADi Function 'newton_iteration': 19 instructions. */
+static void body_newton_iteration(const second_order_quadrotor_cascade_real* a, const second_order_quadrotor_cascade_real* alpha, const second_order_quadrotor_cascade_real* psi, const second_order_quadrotor_cascade_real* c, const second_order_quadrotor_cascade_real* A, second_order_quadrotor_cascade_real* a_next) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  w0 = a[0];
+  w1 = psi[0];
+  w1 = w1 + w0;
+  w2 = w1 * w1;
+  w3 = c[0];
+  w4 = w3 * w0;
+  w5 = alpha[0];
+  w4 = w4 - w5;
+  w4 = w2 * w4;
+  w5 = A[0];
+  w4 = w4 - w5;
+  w4 = w1 * w4;
+  w2 = w2 * w1;
+  w3 = w3 * w2;
+  w5 = w5 + w5;
+  w3 = w3 + w5;
+  w4 = w4 / w3;
+  w0 = w0 - w4;
+  a_next[0] = w0;
+}
+
+/* CasADi Function 'law': 87 instructions. */
+static void body_law(const second_order_quadrotor_cascade_real* x, const second_order_quadrotor_cascade_real* gamma_L, const second_order_quadrotor_cascade_real* gamma_U, const second_order_quadrotor_cascade_real* gain, second_order_quadrotor_cascade_real* u, second_order_quadrotor_cascade_real* inside) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  second_order_quadrotor_cascade_real w6;
+  second_order_quadrotor_cascade_real w7;
+  second_order_quadrotor_cascade_real w8;
+  second_order_quadrotor_cascade_real w9;
+  second_order_quadrotor_cascade_real w10;
+  second_order_quadrotor_cascade_real w11;
+  second_order_quadrotor_cascade_real w12;
+  second_order_quadrotor_cascade_real w13;
+  second_order_quadrotor_cascade_real w14;
+  second_order_quadrotor_cascade_real w15;
+  second_order_quadrotor_cascade_real w16;
+  w0 = gain[0];
+  w1 = 4.0;
+  w2 = gamma_U[0];
+  w3 = gamma_L[0];
+  w4 = w2 - w3;
+  w5 = 1e-06;
+  w4 = (w5 > w4) ? w5 : w4;
+  w6 = 1.0;
+  w7 = x[0];
+  w8 = w7 + w7;
+  w9 = w2 + w3;
+  w8 = w8 - w9;
+  w8 = w8 / w4;
+  w9 = -0.9999990463256836;
+  w8 = (w9 > w8) ? w9 : w8;
+  w10 = 0.9999990463256836;
+  w8 = (w10 < w8) ? w10 : w8;
+  w11 = w8 * w8;
+  w11 = w6 - w11;
+  w4 = w4 * w11;
+  w4 = w1 / w4;
+  w4 = w0 * w4;
+  w11 = w6 + w8;
+  w8 = w6 - w8;
+  w11 = w11 / w8;
+  w11 = log(w11);
+  w4 = w4 * w11;
+  w4 = -w4;
+  u[0] = w4;
+  w4 = gamma_U[1];
+  w11 = gamma_L[1];
+  w8 = w4 - w11;
+  w8 = (w5 > w8) ? w5 : w8;
+  w12 = x[1];
+  w13 = w12 + w12;
+  w14 = w4 + w11;
+  w13 = w13 - w14;
+  w13 = w13 / w8;
+  w13 = (w9 > w13) ? w9 : w13;
+  w13 = (w10 < w13) ? w10 : w13;
+  w14 = w13 * w13;
+  w14 = w6 - w14;
+  w8 = w8 * w14;
+  w8 = w1 / w8;
+  w8 = w0 * w8;
+  w14 = w6 + w13;
+  w13 = w6 - w13;
+  w14 = w14 / w13;
+  w14 = log(w14);
+  w8 = w8 * w14;
+  w8 = -w8;
+  u[1] = w8;
+  w8 = gamma_U[2];
+  w14 = gamma_L[2];
+  w13 = w8 - w14;
+  w13 = (w5 > w13) ? w5 : w13;
+  w5 = x[2];
+  w15 = w5 + w5;
+  w16 = w8 + w14;
+  w15 = w15 - w16;
+  w15 = w15 / w13;
+  w15 = (w9 > w15) ? w9 : w15;
+  w15 = (w10 < w15) ? w10 : w15;
+  w10 = w15 * w15;
+  w10 = w6 - w10;
+  w13 = w13 * w10;
+  w1 = w1 / w13;
+  w0 = w0 * w1;
+  w1 = w6 + w15;
+  w6 = w6 - w15;
+  w1 = w1 / w6;
   w1 = log(w1);
   w0 = w0 * w1;
   w0 = -w0;
   u[2] = w0;
-  w0 = dt[0];
-  w4 = w4 + w0;
-  w23 = (w23 < w4) ? 1.0 : 0.0;
-  w25 = (w4 < w25) ? 1.0 : 0.0;
-  w23 = ((w23 != 0.0) && (w25 != 0.0)) ? 1.0 : 0.0;
-  w26 = w4 - w26;
-  w25 = fabs(w26);
-  w25 = (w25 < w29) ? 1.0 : 0.0;
-  w23 = ((w23 != 0.0) && (w25 != 0.0)) ? 1.0 : 0.0;
-  w25 = w26 * w26;
-  w1 = fabs(w26);
-  w1 = w29 - w1;
-  w26 = fabs(w26);
-  w29 = w29 + w26;
-  w1 = w1 * w29;
-  w1 = (w23 != 0.0) ? w1 : 0.0;
-  w29 = (w23 == 0.0) ? 1.0 : 0.0;
-  w29 = (w29 != 0.0) ? w11 : 0.0;
-  w1 = w1 + w29;
-  w25 = w25 / w1;
-  w25 = -w25;
-  w25 = (w6 > w25) ? w6 : w25;
-  w25 = exp(w25);
-  w28 = w28 * w25;
-  w23 = (w23 != 0.0) ? w28 : 0.0;
-  w28 = (w23 > w5) ? w23 : w5;
-  w31 = (w31 < w4) ? 1.0 : 0.0;
-  w32 = (w4 < w32) ? 1.0 : 0.0;
-  w31 = ((w31 != 0.0) && (w32 != 0.0)) ? 1.0 : 0.0;
-  w33 = w4 - w33;
-  w32 = fabs(w33);
-  w32 = (w32 < w36) ? 1.0 : 0.0;
-  w31 = ((w31 != 0.0) && (w32 != 0.0)) ? 1.0 : 0.0;
-  w32 = w33 * w33;
-  w25 = fabs(w33);
-  w25 = w36 - w25;
-  w33 = fabs(w33);
-  w36 = w36 + w33;
-  w25 = w25 * w36;
-  w25 = (w31 != 0.0) ? w25 : 0.0;
-  w36 = (w31 == 0.0) ? 1.0 : 0.0;
-  w36 = (w36 != 0.0) ? w11 : 0.0;
-  w25 = w25 + w36;
-  w32 = w32 / w25;
-  w32 = -w32;
-  w32 = (w6 > w32) ? w6 : w32;
-  w32 = exp(w32);
-  w35 = w35 * w32;
-  w31 = (w31 != 0.0) ? w35 : 0.0;
-  w28 = (w31 > w28) ? w31 : w28;
-  w35 = w37 * w28;
-  w35 = -w35;
-  w35 = (w6 > w35) ? w6 : w35;
-  w35 = exp(w35);
-  w23 = w23 - w28;
-  w23 = w37 * w23;
-  w23 = (w6 > w23) ? w6 : w23;
-  w23 = exp(w23);
-  w32 = w37 * w28;
-  w32 = -w32;
-  w32 = (w6 > w32) ? w6 : w32;
-  w32 = exp(w32);
-  w23 = w23 - w32;
-  w35 = w35 + w23;
-  w31 = w31 - w28;
-  w31 = w37 * w31;
-  w31 = (w6 > w31) ? w6 : w31;
-  w31 = exp(w31);
-  w23 = w37 * w28;
-  w23 = -w23;
-  w23 = (w6 > w23) ? w6 : w23;
-  w23 = exp(w23);
-  w31 = w31 - w23;
-  w35 = w35 + w31;
-  w35 = log(w35);
-  w35 = w35 / w37;
-  w28 = w28 + w35;
-  w28 = w22 - w28;
-  w35 = (w4 < w16) ? 1.0 : 0.0;
-  w37 = (w4 < w5) ? 1.0 : 0.0;
-  w37 = (w37 == 0.0) ? 1.0 : 0.0;
-  w16 = w16 - w4;
-  w16 = (w35 != 0.0) ? w16 : 0.0;
-  w31 = (w35 == 0.0) ? 1.0 : 0.0;
-  w31 = (w31 != 0.0) ? w11 : 0.0;
-  w16 = w16 + w31;
-  w4 = w4 / w16;
-  w4 = tanh(w4);
-  w37 = (w37 != 0.0) ? w4 : 0.0;
-  w37 = (w35 != 0.0) ? w37 : 0.0;
-  w35 = (w35 == 0.0) ? 1.0 : 0.0;
-  w35 = (w35 != 0.0) ? w11 : 0.0;
-  w37 = w37 + w35;
-  w35 = w30 * w37;
-  w35 = w35 + w38;
-  w28 = w28 - w35;
-  w35 = 5.0;
-  w35 = w35 * w0;
-  w35 = w11 + w35;
-  w4 = w27 / w35;
-  w16 = w28 + w4;
-  w31 = (w5 < w16) ? 1.0 : 0.0;
-  w23 = 0.02;
-  w32 = w28 - w11;
-  w32 = w32 + w32;
-  w32 = (w6 > w32) ? w6 : w32;
-  w25 = 80.0;
-  w32 = (w25 < w32) ? w25 : w32;
-  w32 = exp(w32);
-  w32 = w11 + w32;
-  w32 = w23 / w32;
-  w32 = w0 * w32;
-  w36 = w35 + w35;
-  w33 = w16 * w16;
-  w33 = w33 * w16;
-  w33 = w36 * w33;
-  w33 = (w32 <= w33) ? 1.0 : 0.0;
-  w31 = ((w31 != 0.0) && (w33 != 0.0)) ? 1.0 : 0.0;
-  w33 = (w31 == 0.0) ? 1.0 : 0.0;
-  w16 = w27 / w35;
-  w1 = w35 + w35;
-  w29 = w32 / w1;
-  w26 = 0.3333333333333333;
-  w29 = pow(w29, w26);
-  w14 = w35 * w28;
-  w14 = w14 + w27;
-  w14 = -w14;
-  w14 = (w5 > w14) ? w5 : w14;
-  w41 = 1e-30;
-  w14 = (w41 > w14) ? w41 : w14;
-  w14 = w14 + w14;
-  w14 = w32 / w14;
-  w14 = sqrt(w14);
-  w29 = (w14 < w29) ? w14 : w29;
-  w29 = w29 - w28;
-  w16 = (w29 > w16) ? w29 : w16;
-  w33 = (w33 != 0.0) ? w16 : 0.0;
-  w31 = (w31 != 0.0) ? w4 : 0.0;
-  w33 = w33 + w31;
-  w31 = w28 + w33;
-  w4 = w31 * w31;
-  w16 = w35 * w33;
-  w16 = w16 - w27;
-  w16 = w4 * w16;
-  w16 = w16 - w32;
-  w16 = w31 * w16;
-  w4 = w4 * w31;
-  w4 = w35 * w4;
-  w31 = w32 + w32;
-  w4 = w4 + w31;
-  w16 = w16 / w4;
-  w33 = w33 - w16;
-  w16 = w28 + w33;
-  w4 = w16 * w16;
-  w31 = w35 * w33;
-  w31 = w31 - w27;
-  w31 = w4 * w31;
-  w31 = w31 - w32;
-  w31 = w16 * w31;
-  w4 = w4 * w16;
-  w4 = w35 * w4;
-  w16 = w32 + w32;
-  w4 = w4 + w16;
-  w31 = w31 / w4;
-  w33 = w33 - w31;
-  w31 = w28 + w33;
-  w4 = w31 * w31;
-  w16 = w35 * w33;
-  w16 = w16 - w27;
-  w16 = w4 * w16;
-  w16 = w16 - w32;
-  w16 = w31 * w16;
-  w4 = w4 * w31;
-  w4 = w35 * w4;
-  w31 = w32 + w32;
-  w4 = w4 + w31;
-  w16 = w16 / w4;
-  w33 = w33 - w16;
-  w16 = w28 + w33;
-  w4 = w16 * w16;
-  w31 = w35 * w33;
-  w31 = w31 - w27;
-  w31 = w4 * w31;
-  w31 = w31 - w32;
-  w31 = w16 * w31;
-  w4 = w4 * w16;
-  w4 = w35 * w4;
-  w16 = w32 + w32;
-  w4 = w4 + w16;
-  w31 = w31 / w4;
-  w33 = w33 - w31;
-  w28 = w28 + w33;
-  w31 = w28 * w28;
-  w4 = w35 * w33;
-  w4 = w4 - w27;
-  w4 = w31 * w4;
-  w4 = w4 - w32;
-  w4 = w28 * w4;
-  w31 = w31 * w28;
-  w31 = w35 * w31;
-  w32 = w32 + w32;
-  w31 = w31 + w32;
-  w4 = w4 / w31;
-  w33 = w33 - w4;
-  alpha_next[0] = w33;
-  w30 = w30 * w37;
-  w30 = w30 + w38;
-  w22 = w22 - w30;
-  w30 = w44 / w35;
-  w38 = w22 + w30;
-  w33 = (w5 < w38) ? 1.0 : 0.0;
-  w4 = w22 - w11;
-  w4 = w4 + w4;
-  w4 = (w6 > w4) ? w6 : w4;
-  w4 = (w25 < w4) ? w25 : w4;
-  w4 = exp(w4);
-  w4 = w11 + w4;
-  w4 = w23 / w4;
-  w4 = w0 * w4;
-  w31 = w38 * w38;
-  w31 = w31 * w38;
-  w31 = w36 * w31;
-  w31 = (w4 <= w31) ? 1.0 : 0.0;
-  w33 = ((w33 != 0.0) && (w31 != 0.0)) ? 1.0 : 0.0;
-  w31 = (w33 == 0.0) ? 1.0 : 0.0;
-  w38 = w44 / w35;
-  w32 = w4 / w1;
-  w32 = pow(w32, w26);
-  w28 = w35 * w22;
-  w28 = w28 + w44;
-  w28 = -w28;
-  w28 = (w5 > w28) ? w5 : w28;
-  w28 = (w41 > w28) ? w41 : w28;
-  w28 = w28 + w28;
-  w28 = w4 / w28;
-  w28 = sqrt(w28);
-  w32 = (w28 < w32) ? w28 : w32;
-  w32 = w32 - w22;
-  w38 = (w32 > w38) ? w32 : w38;
-  w31 = (w31 != 0.0) ? w38 : 0.0;
-  w33 = (w33 != 0.0) ? w30 : 0.0;
-  w31 = w31 + w33;
-  w33 = w22 + w31;
-  w30 = w33 * w33;
-  w38 = w35 * w31;
-  w38 = w38 - w44;
-  w38 = w30 * w38;
-  w38 = w38 - w4;
-  w38 = w33 * w38;
-  w30 = w30 * w33;
-  w30 = w35 * w30;
-  w33 = w4 + w4;
-  w30 = w30 + w33;
-  w38 = w38 / w30;
-  w31 = w31 - w38;
-  w38 = w22 + w31;
-  w30 = w38 * w38;
-  w33 = w35 * w31;
-  w33 = w33 - w44;
-  w33 = w30 * w33;
-  w33 = w33 - w4;
-  w33 = w38 * w33;
-  w30 = w30 * w38;
-  w30 = w35 * w30;
-  w38 = w4 + w4;
-  w30 = w30 + w38;
-  w33 = w33 / w30;
-  w31 = w31 - w33;
-  w33 = w22 + w31;
-  w30 = w33 * w33;
-  w38 = w35 * w31;
-  w38 = w38 - w44;
-  w38 = w30 * w38;
-  w38 = w38 - w4;
-  w38 = w33 * w38;
-  w30 = w30 * w33;
-  w30 = w35 * w30;
-  w33 = w4 + w4;
-  w30 = w30 + w33;
-  w38 = w38 / w30;
-  w31 = w31 - w38;
-  w38 = w22 + w31;
-  w30 = w38 * w38;
-  w33 = w35 * w31;
-  w33 = w33 - w44;
-  w33 = w30 * w33;
-  w33 = w33 - w4;
-  w33 = w38 * w33;
-  w30 = w30 * w38;
-  w30 = w35 * w30;
-  w38 = w4 + w4;
-  w30 = w30 + w38;
-  w33 = w33 / w30;
-  w31 = w31 - w33;
-  w22 = w22 + w31;
-  w33 = w22 * w22;
-  w30 = w35 * w31;
-  w30 = w30 - w44;
-  w30 = w33 * w30;
-  w30 = w30 - w4;
-  w30 = w22 * w30;
-  w33 = w33 * w22;
-  w33 = w35 * w33;
-  w4 = w4 + w4;
-  w33 = w33 + w4;
-  w30 = w30 / w33;
-  w31 = w31 - w30;
-  alpha_next[1] = w31;
-  w48 = w48 * w37;
-  w48 = w48 + w53;
-  w52 = w52 - w48;
-  w48 = w54 / w35;
-  w53 = w52 + w48;
-  w31 = (w5 < w53) ? 1.0 : 0.0;
-  w30 = w52 - w11;
-  w30 = w30 + w30;
-  w30 = (w6 > w30) ? w6 : w30;
-  w30 = (w25 < w30) ? w25 : w30;
-  w30 = exp(w30);
-  w30 = w11 + w30;
-  w30 = w23 / w30;
-  w30 = w0 * w30;
-  w33 = w53 * w53;
-  w33 = w33 * w53;
-  w33 = w36 * w33;
-  w33 = (w30 <= w33) ? 1.0 : 0.0;
-  w31 = ((w31 != 0.0) && (w33 != 0.0)) ? 1.0 : 0.0;
-  w33 = (w31 == 0.0) ? 1.0 : 0.0;
-  w53 = w54 / w35;
-  w4 = w30 / w1;
-  w4 = pow(w4, w26);
-  w22 = w35 * w52;
-  w22 = w22 + w54;
-  w22 = -w22;
-  w22 = (w5 > w22) ? w5 : w22;
-  w22 = (w41 > w22) ? w41 : w22;
-  w22 = w22 + w22;
-  w22 = w30 / w22;
-  w22 = sqrt(w22);
-  w4 = (w22 < w4) ? w22 : w4;
-  w4 = w4 - w52;
-  w53 = (w4 > w53) ? w4 : w53;
-  w33 = (w33 != 0.0) ? w53 : 0.0;
-  w31 = (w31 != 0.0) ? w48 : 0.0;
-  w33 = w33 + w31;
-  w31 = w52 + w33;
-  w48 = w31 * w31;
-  w53 = w35 * w33;
-  w53 = w53 - w54;
-  w53 = w48 * w53;
-  w53 = w53 - w30;
-  w53 = w31 * w53;
-  w48 = w48 * w31;
-  w48 = w35 * w48;
-  w31 = w30 + w30;
-  w48 = w48 + w31;
-  w53 = w53 / w48;
-  w33 = w33 - w53;
-  w53 = w52 + w33;
-  w48 = w53 * w53;
-  w31 = w35 * w33;
-  w31 = w31 - w54;
-  w31 = w48 * w31;
-  w31 = w31 - w30;
-  w31 = w53 * w31;
-  w48 = w48 * w53;
-  w48 = w35 * w48;
-  w53 = w30 + w30;
-  w48 = w48 + w53;
-  w31 = w31 / w48;
-  w33 = w33 - w31;
-  w31 = w52 + w33;
-  w48 = w31 * w31;
-  w53 = w35 * w33;
-  w53 = w53 - w54;
-  w53 = w48 * w53;
-  w53 = w53 - w30;
-  w53 = w31 * w53;
-  w48 = w48 * w31;
-  w48 = w35 * w48;
-  w31 = w30 + w30;
-  w48 = w48 + w31;
-  w53 = w53 / w48;
-  w33 = w33 - w53;
-  w53 = w52 + w33;
-  w48 = w53 * w53;
-  w31 = w35 * w33;
-  w31 = w31 - w54;
-  w31 = w48 * w31;
-  w31 = w31 - w30;
-  w31 = w53 * w31;
-  w48 = w48 * w53;
-  w48 = w35 * w48;
-  w53 = w30 + w30;
-  w48 = w48 + w53;
-  w31 = w31 / w48;
-  w33 = w33 - w31;
-  w52 = w52 + w33;
-  w31 = w52 * w52;
-  w48 = w35 * w33;
-  w48 = w48 - w54;
-  w48 = w31 * w48;
-  w48 = w48 - w30;
-  w48 = w52 * w48;
-  w31 = w31 * w52;
-  w31 = w35 * w31;
-  w30 = w30 + w30;
-  w31 = w31 + w30;
-  w48 = w48 / w31;
-  w33 = w33 - w48;
-  alpha_next[2] = w33;
-  w33 = w15 * w37;
-  w33 = w33 + w19;
-  w48 = w20 / w35;
-  w31 = w33 + w48;
-  w30 = (w5 < w31) ? 1.0 : 0.0;
-  w52 = w33 - w11;
-  w52 = w52 + w52;
-  w52 = (w6 > w52) ? w6 : w52;
-  w52 = (w25 < w52) ? w25 : w52;
-  w52 = exp(w52);
-  w52 = w11 + w52;
-  w52 = w23 / w52;
-  w52 = w0 * w52;
-  w54 = w31 * w31;
-  w54 = w54 * w31;
-  w54 = w36 * w54;
-  w54 = (w52 <= w54) ? 1.0 : 0.0;
-  w30 = ((w30 != 0.0) && (w54 != 0.0)) ? 1.0 : 0.0;
-  w54 = (w30 == 0.0) ? 1.0 : 0.0;
-  w31 = w20 / w35;
-  w53 = w52 / w1;
-  w53 = pow(w53, w26);
-  w4 = w35 * w33;
-  w4 = w4 + w20;
-  w4 = -w4;
-  w4 = (w5 > w4) ? w5 : w4;
-  w4 = (w41 > w4) ? w41 : w4;
-  w4 = w4 + w4;
-  w4 = w52 / w4;
-  w4 = sqrt(w4);
-  w53 = (w4 < w53) ? w4 : w53;
-  w53 = w53 - w33;
-  w31 = (w53 > w31) ? w53 : w31;
-  w54 = (w54 != 0.0) ? w31 : 0.0;
-  w30 = (w30 != 0.0) ? w48 : 0.0;
-  w54 = w54 + w30;
-  w30 = w33 + w54;
-  w48 = w30 * w30;
-  w31 = w35 * w54;
-  w31 = w31 - w20;
-  w31 = w48 * w31;
-  w31 = w31 - w52;
-  w31 = w30 * w31;
-  w48 = w48 * w30;
-  w48 = w35 * w48;
-  w30 = w52 + w52;
-  w48 = w48 + w30;
-  w31 = w31 / w48;
-  w54 = w54 - w31;
-  w31 = w33 + w54;
-  w48 = w31 * w31;
-  w30 = w35 * w54;
-  w30 = w30 - w20;
-  w30 = w48 * w30;
-  w30 = w30 - w52;
-  w30 = w31 * w30;
-  w48 = w48 * w31;
-  w48 = w35 * w48;
-  w31 = w52 + w52;
-  w48 = w48 + w31;
-  w30 = w30 / w48;
-  w54 = w54 - w30;
-  w30 = w33 + w54;
-  w48 = w30 * w30;
-  w31 = w35 * w54;
-  w31 = w31 - w20;
-  w31 = w48 * w31;
-  w31 = w31 - w52;
-  w31 = w30 * w31;
-  w48 = w48 * w30;
-  w48 = w35 * w48;
-  w30 = w52 + w52;
-  w48 = w48 + w30;
-  w31 = w31 / w48;
-  w54 = w54 - w31;
-  w31 = w33 + w54;
-  w48 = w31 * w31;
-  w30 = w35 * w54;
-  w30 = w30 - w20;
-  w30 = w48 * w30;
-  w30 = w30 - w52;
-  w30 = w31 * w30;
-  w48 = w48 * w31;
-  w48 = w35 * w48;
-  w31 = w52 + w52;
-  w48 = w48 + w31;
-  w30 = w30 / w48;
-  w54 = w54 - w30;
-  w33 = w33 + w54;
-  w30 = w33 * w33;
-  w48 = w35 * w54;
-  w48 = w48 - w20;
-  w48 = w30 * w48;
-  w48 = w48 - w52;
-  w48 = w33 * w48;
-  w30 = w30 * w33;
-  w30 = w35 * w30;
-  w52 = w52 + w52;
-  w30 = w30 + w52;
-  w48 = w48 / w30;
-  w54 = w54 - w48;
-  alpha_next[3] = w54;
-  w15 = w15 * w37;
-  w15 = w15 + w19;
-  w19 = w42 / w35;
-  w54 = w15 + w19;
-  w48 = (w5 < w54) ? 1.0 : 0.0;
-  w30 = w15 - w11;
-  w30 = w30 + w30;
-  w30 = (w6 > w30) ? w6 : w30;
-  w30 = (w25 < w30) ? w25 : w30;
-  w30 = exp(w30);
-  w30 = w11 + w30;
-  w30 = w23 / w30;
-  w30 = w0 * w30;
-  w52 = w54 * w54;
-  w52 = w52 * w54;
-  w52 = w36 * w52;
-  w52 = (w30 <= w52) ? 1.0 : 0.0;
-  w48 = ((w48 != 0.0) && (w52 != 0.0)) ? 1.0 : 0.0;
-  w52 = (w48 == 0.0) ? 1.0 : 0.0;
-  w54 = w42 / w35;
-  w33 = w30 / w1;
-  w33 = pow(w33, w26);
-  w20 = w35 * w15;
-  w20 = w20 + w42;
-  w20 = -w20;
-  w20 = (w5 > w20) ? w5 : w20;
-  w20 = (w41 > w20) ? w41 : w20;
-  w20 = w20 + w20;
-  w20 = w30 / w20;
-  w20 = sqrt(w20);
-  w33 = (w20 < w33) ? w20 : w33;
-  w33 = w33 - w15;
-  w54 = (w33 > w54) ? w33 : w54;
-  w52 = (w52 != 0.0) ? w54 : 0.0;
-  w48 = (w48 != 0.0) ? w19 : 0.0;
-  w52 = w52 + w48;
-  w48 = w15 + w52;
-  w19 = w48 * w48;
-  w54 = w35 * w52;
-  w54 = w54 - w42;
-  w54 = w19 * w54;
-  w54 = w54 - w30;
-  w54 = w48 * w54;
-  w19 = w19 * w48;
-  w19 = w35 * w19;
-  w48 = w30 + w30;
-  w19 = w19 + w48;
-  w54 = w54 / w19;
-  w52 = w52 - w54;
-  w54 = w15 + w52;
-  w19 = w54 * w54;
-  w48 = w35 * w52;
-  w48 = w48 - w42;
-  w48 = w19 * w48;
-  w48 = w48 - w30;
-  w48 = w54 * w48;
-  w19 = w19 * w54;
-  w19 = w35 * w19;
-  w54 = w30 + w30;
-  w19 = w19 + w54;
-  w48 = w48 / w19;
-  w52 = w52 - w48;
-  w48 = w15 + w52;
-  w19 = w48 * w48;
-  w54 = w35 * w52;
-  w54 = w54 - w42;
-  w54 = w19 * w54;
-  w54 = w54 - w30;
-  w54 = w48 * w54;
-  w19 = w19 * w48;
-  w19 = w35 * w19;
-  w48 = w30 + w30;
-  w19 = w19 + w48;
-  w54 = w54 / w19;
-  w52 = w52 - w54;
-  w54 = w15 + w52;
-  w19 = w54 * w54;
-  w48 = w35 * w52;
-  w48 = w48 - w42;
-  w48 = w19 * w48;
-  w48 = w48 - w30;
-  w48 = w54 * w48;
-  w19 = w19 * w54;
-  w19 = w35 * w19;
-  w54 = w30 + w30;
-  w19 = w19 + w54;
-  w48 = w48 / w19;
-  w52 = w52 - w48;
-  w15 = w15 + w52;
-  w48 = w15 * w15;
-  w19 = w35 * w52;
-  w19 = w19 - w42;
-  w19 = w48 * w19;
-  w19 = w19 - w30;
-  w19 = w15 * w19;
-  w48 = w48 * w15;
-  w48 = w35 * w48;
-  w30 = w30 + w30;
-  w48 = w48 + w30;
-  w19 = w19 / w48;
-  w52 = w52 - w19;
-  alpha_next[4] = w52;
-  w47 = w47 * w37;
-  w47 = w47 + w49;
-  w49 = w50 / w35;
-  w37 = w47 + w49;
-  w52 = (w5 < w37) ? 1.0 : 0.0;
-  w19 = w47 - w11;
-  w19 = w19 + w19;
-  w19 = (w6 > w19) ? w6 : w19;
-  w19 = (w25 < w19) ? w25 : w19;
-  w19 = exp(w19);
-  w11 = w11 + w19;
-  w23 = w23 / w11;
-  w0 = w0 * w23;
-  w23 = w37 * w37;
-  w23 = w23 * w37;
-  w36 = w36 * w23;
-  w36 = (w0 <= w36) ? 1.0 : 0.0;
-  w52 = ((w52 != 0.0) && (w36 != 0.0)) ? 1.0 : 0.0;
-  w36 = (w52 == 0.0) ? 1.0 : 0.0;
-  w23 = w50 / w35;
-  w1 = w0 / w1;
-  w1 = pow(w1, w26);
-  w26 = w35 * w47;
-  w26 = w26 + w50;
-  w26 = -w26;
-  w26 = (w5 > w26) ? w5 : w26;
-  w26 = (w41 > w26) ? w41 : w26;
-  w26 = w26 + w26;
-  w26 = w0 / w26;
-  w26 = sqrt(w26);
-  w1 = (w26 < w1) ? w26 : w1;
-  w1 = w1 - w47;
-  w23 = (w1 > w23) ? w1 : w23;
-  w36 = (w36 != 0.0) ? w23 : 0.0;
-  w52 = (w52 != 0.0) ? w49 : 0.0;
-  w36 = w36 + w52;
-  w52 = w47 + w36;
-  w49 = w52 * w52;
-  w23 = w35 * w36;
-  w23 = w23 - w50;
-  w23 = w49 * w23;
-  w23 = w23 - w0;
-  w23 = w52 * w23;
-  w49 = w49 * w52;
-  w49 = w35 * w49;
-  w52 = w0 + w0;
-  w49 = w49 + w52;
-  w23 = w23 / w49;
-  w36 = w36 - w23;
-  w23 = w47 + w36;
-  w49 = w23 * w23;
-  w52 = w35 * w36;
-  w52 = w52 - w50;
-  w52 = w49 * w52;
-  w52 = w52 - w0;
-  w52 = w23 * w52;
-  w49 = w49 * w23;
-  w49 = w35 * w49;
-  w23 = w0 + w0;
-  w49 = w49 + w23;
-  w52 = w52 / w49;
-  w36 = w36 - w52;
-  w52 = w47 + w36;
-  w49 = w52 * w52;
-  w23 = w35 * w36;
-  w23 = w23 - w50;
-  w23 = w49 * w23;
-  w23 = w23 - w0;
-  w23 = w52 * w23;
-  w49 = w49 * w52;
-  w49 = w35 * w49;
-  w52 = w0 + w0;
-  w49 = w49 + w52;
-  w23 = w23 / w49;
-  w36 = w36 - w23;
-  w23 = w47 + w36;
-  w49 = w23 * w23;
-  w52 = w35 * w36;
-  w52 = w52 - w50;
-  w52 = w49 * w52;
-  w52 = w52 - w0;
-  w52 = w23 * w52;
-  w49 = w49 * w23;
-  w49 = w35 * w49;
-  w23 = w0 + w0;
-  w49 = w49 + w23;
-  w52 = w52 / w49;
-  w36 = w36 - w52;
-  w47 = w47 + w36;
-  w52 = w47 * w47;
-  w49 = w35 * w36;
-  w49 = w49 - w50;
-  w49 = w52 * w49;
-  w49 = w49 - w0;
-  w49 = w47 * w49;
-  w52 = w52 * w47;
-  w35 = w35 * w52;
-  w0 = w0 + w0;
-  w35 = w35 + w0;
-  w49 = w49 / w35;
-  w36 = w36 - w49;
-  alpha_next[5] = w36;
-  w36 = -w17;
-  r[0] = w36;
-  w36 = -w39;
-  r[1] = w36;
-  w36 = -w13;
-  r[2] = w36;
-  w24 = (w24 < w34) ? 1.0 : 0.0;
-  w21 = -w21;
-  w34 = (w34 < w21) ? 1.0 : 0.0;
-  w24 = w24 * w34;
-  w45 = (w45 < w46) ? 1.0 : 0.0;
-  w24 = w24 * w45;
-  w43 = -w43;
-  w46 = (w46 < w43) ? 1.0 : 0.0;
-  w24 = w24 * w46;
-  w55 = (w55 < w9) ? 1.0 : 0.0;
-  w24 = w24 * w55;
-  w51 = -w51;
-  w9 = (w9 < w51) ? 1.0 : 0.0;
-  w24 = w24 * w9;
-  inside_position[0] = w24;
-  w24 = -w7;
-  w12 = w12 + w17;
-  w24 = (w24 < w12) ? 1.0 : 0.0;
-  w12 = (w12 < w7) ? 1.0 : 0.0;
-  w24 = w24 * w12;
-  w12 = -w2;
-  w10 = w10 + w39;
-  w12 = (w12 < w10) ? 1.0 : 0.0;
-  w24 = w24 * w12;
-  w10 = (w10 < w2) ? 1.0 : 0.0;
-  w24 = w24 * w10;
-  w10 = -6.72568;
-  w3 = w3 + w13;
-  w10 = (w10 < w3) ? 1.0 : 0.0;
-  w24 = w24 * w10;
-  w3 = (w3 < w8) ? 1.0 : 0.0;
-  w24 = w24 * w3;
-  inside_velocity[0] = w24;
+  w3 = (w3 < w7) ? 1.0 : 0.0;
+  w7 = (w7 < w2) ? 1.0 : 0.0;
+  w3 = w3 * w7;
+  w11 = (w11 < w12) ? 1.0 : 0.0;
+  w3 = w3 * w11;
+  w12 = (w12 < w4) ? 1.0 : 0.0;
+  w3 = w3 * w12;
+  w14 = (w14 < w5) ? 1.0 : 0.0;
+  w3 = w3 * w14;
+  w5 = (w5 < w8) ? 1.0 : 0.0;
+  w3 = w3 * w5;
+  inside[0] = w3;
 }
 
-static int second_order_quadrotor_cascade_finite(const double* v, int count, int nonnegative) {
-  int ok = 1;
+/* CasADi Function 'velocity_tube': 27 instructions. */
+static void body_velocity_tube(const second_order_quadrotor_cascade_real* t, const second_order_quadrotor_cascade_real* width_start, const second_order_quadrotor_cascade_real* width_floor, const second_order_quadrotor_cascade_real* decay, second_order_quadrotor_cascade_real* rho2) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  w0 = width_start[0];
+  w1 = width_floor[0];
+  w0 = w0 - w1;
+  w2 = decay[0];
+  w3 = t[0];
+  w4 = 0.0;
+  w3 = (w4 > w3) ? w4 : w3;
+  w2 = w2 * w3;
+  w2 = -w2;
+  w3 = -80.0;
+  w2 = (w3 > w2) ? w3 : w2;
+  w2 = exp(w2);
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho2[0] = w0;
+  w0 = width_start[1];
+  w1 = width_floor[1];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho2[1] = w0;
+  w0 = width_start[2];
+  w1 = width_floor[2];
+  w0 = w0 - w1;
+  w0 = w0 * w2;
+  w0 = w0 + w1;
+  rho2[2] = w0;
+}
+
+/* CasADi Function 'velocity_law': 84 instructions. */
+static void body_velocity_law(const second_order_quadrotor_cascade_real* x2, const second_order_quadrotor_cascade_real* r, const second_order_quadrotor_cascade_real* rho2, const second_order_quadrotor_cascade_real* gain, second_order_quadrotor_cascade_real* u, second_order_quadrotor_cascade_real* inside) {
+  second_order_quadrotor_cascade_real w0;
+  second_order_quadrotor_cascade_real w1;
+  second_order_quadrotor_cascade_real w2;
+  second_order_quadrotor_cascade_real w3;
+  second_order_quadrotor_cascade_real w4;
+  second_order_quadrotor_cascade_real w5;
+  second_order_quadrotor_cascade_real w6;
+  second_order_quadrotor_cascade_real w7;
+  second_order_quadrotor_cascade_real w8;
+  second_order_quadrotor_cascade_real w9;
+  second_order_quadrotor_cascade_real w10;
+  second_order_quadrotor_cascade_real w11;
+  second_order_quadrotor_cascade_real w12;
+  second_order_quadrotor_cascade_real w13;
+  second_order_quadrotor_cascade_real w14;
+  second_order_quadrotor_cascade_real w15;
+  w0 = gain[0];
+  w1 = 2.0;
+  w2 = rho2[0];
+  w3 = 1e-06;
+  w4 = (w3 > w2) ? w3 : w2;
+  w5 = 1.0;
+  w6 = x2[0];
+  w7 = r[0];
+  w8 = w6 - w7;
+  w8 = w8 / w4;
+  w9 = -0.9999990463256836;
+  w8 = (w9 > w8) ? w9 : w8;
+  w10 = 0.9999990463256836;
+  w8 = (w10 < w8) ? w10 : w8;
+  w11 = w8 * w8;
+  w11 = w5 - w11;
+  w4 = w4 * w11;
+  w4 = w1 / w4;
+  w4 = w0 * w4;
+  w11 = w5 + w8;
+  w8 = w5 - w8;
+  w11 = w11 / w8;
+  w11 = log(w11);
+  w4 = w4 * w11;
+  w4 = -w4;
+  u[0] = w4;
+  w4 = rho2[1];
+  w11 = (w3 > w4) ? w3 : w4;
+  w8 = x2[1];
+  w12 = r[1];
+  w13 = w8 - w12;
+  w13 = w13 / w11;
+  w13 = (w9 > w13) ? w9 : w13;
+  w13 = (w10 < w13) ? w10 : w13;
+  w14 = w13 * w13;
+  w14 = w5 - w14;
+  w11 = w11 * w14;
+  w11 = w1 / w11;
+  w11 = w0 * w11;
+  w14 = w5 + w13;
+  w13 = w5 - w13;
+  w14 = w14 / w13;
+  w14 = log(w14);
+  w11 = w11 * w14;
+  w11 = -w11;
+  u[1] = w11;
+  w11 = rho2[2];
+  w3 = (w3 > w11) ? w3 : w11;
+  w14 = x2[2];
+  w13 = r[2];
+  w15 = w14 - w13;
+  w15 = w15 / w3;
+  w15 = (w9 > w15) ? w9 : w15;
+  w15 = (w10 < w15) ? w10 : w15;
+  w10 = w15 * w15;
+  w10 = w5 - w10;
+  w3 = w3 * w10;
+  w1 = w1 / w3;
+  w0 = w0 * w1;
+  w1 = w5 + w15;
+  w5 = w5 - w15;
+  w1 = w1 / w5;
+  w1 = log(w1);
+  w0 = w0 * w1;
+  w0 = -w0;
+  u[2] = w0;
+  w0 = -w2;
+  w6 = w6 - w7;
+  w0 = (w0 < w6) ? 1.0 : 0.0;
+  w6 = (w6 < w2) ? 1.0 : 0.0;
+  w0 = w0 * w6;
+  w6 = -w4;
+  w8 = w8 - w12;
+  w6 = (w6 < w8) ? 1.0 : 0.0;
+  w0 = w0 * w6;
+  w8 = (w8 < w4) ? 1.0 : 0.0;
+  w0 = w0 * w8;
+  w8 = -w11;
+  w14 = w14 - w13;
+  w8 = (w8 < w14) ? 1.0 : 0.0;
+  w0 = w0 * w8;
+  w14 = (w14 < w11) ? 1.0 : 0.0;
+  w0 = w0 * w14;
+  inside[0] = w0;
+}
+
+/* ----------------------------------------------------------------- typed API */
+
+static int second_order_quadrotor_cascade_finite(const second_order_quadrotor_cascade_real* v, int count) {
   int i;
+  int ok = 1;
   for (i = 0; i < count; ++i) {
-    if ((isfinite(v[i]) == 0) || ((nonnegative != 0) && (v[i] < 0.0))) {
+    if (isfinite(v[i]) == 0) {
       ok = 0;
     }
   }
   return ok;
 }
 
-int second_order_quadrotor_cascade_step(double t, double dt, const double* x1, const double* x2,
-    const double* alpha, double* u, double* alpha_next, double* r) {
-  int status = SECOND_ORDER_QUADROTOR_CASCADE_INVALID_INPUT;
-  int valid = 0;
-  if ((isfinite(t) != 0) && (t >= 0.0) && (isfinite(dt) != 0)
-      && (dt > 0.0) && (dt <= 1.0)
-      && (second_order_quadrotor_cascade_finite(x1, SECOND_ORDER_QUADROTOR_CASCADE_N, 0) != 0)
-      && (second_order_quadrotor_cascade_finite(x2, SECOND_ORDER_QUADROTOR_CASCADE_N, 0) != 0)
-      && (second_order_quadrotor_cascade_finite(alpha, (2 * SECOND_ORDER_QUADROTOR_CASCADE_N), 1) != 0)) {
-    valid = 1;
-  }
-  if (valid == 0) {
-    int i;
-    for (i = 0; i < SECOND_ORDER_QUADROTOR_CASCADE_N; ++i) {
-      u[i] = 0.0;
-      r[i] = 0.0;
+/* alpha in the domain of the adaptive law: every entry finite, in [0, ALPHA_MAX]. */
+static int second_order_quadrotor_cascade_alpha_valid(const second_order_quadrotor_cascade_real* a) {
+  int i;
+  int ok = 1;
+  for (i = 0; i < SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA; ++i) {
+    if (!((a[i] >= 0.0) && (a[i] <= SECOND_ORDER_QUADROTOR_CASCADE_ALPHA_MAX))) {
+      ok = 0;
     }
-    for (i = 0; i < (2 * SECOND_ORDER_QUADROTOR_CASCADE_N); ++i) {
-      alpha_next[i] = (isfinite(alpha[i]) != 0) ? alpha[i] : 0.0;
+  }
+  return ok;
+}
+
+/* t in its domain: finite, t >= 0. */
+static int second_order_quadrotor_cascade_time_valid(second_order_quadrotor_cascade_real t) {
+  int ok = 0;
+  if ((isfinite(t) != 0) && (t >= 0.0)) {
+    ok = 1;
+  }
+  return ok;
+}
+
+/* dt in its domain: DT_MIN <= dt <= DT_MAX. */
+static int second_order_quadrotor_cascade_dt_valid(second_order_quadrotor_cascade_real dt) {
+  int ok = 0;
+  if ((dt >= SECOND_ORDER_QUADROTOR_CASCADE_DT_MIN) && (dt <= SECOND_ORDER_QUADROTOR_CASCADE_DT_MAX)) {
+    ok = 1;
+  }
+  return ok;
+}
+
+static void second_order_quadrotor_cascade_copy(const second_order_quadrotor_cascade_real* from, second_order_quadrotor_cascade_real* to, int count) {
+  int i;
+  for (i = 0; i < count; ++i) {
+    to[i] = from[i];
+  }
+}
+
+/* alpha_next on INVALID_INPUT: alpha, with every non-finite entry replaced by 0. */
+static void second_order_quadrotor_cascade_keep_alpha(const second_order_quadrotor_cascade_real* from, second_order_quadrotor_cascade_real* to) {
+  int i;
+  for (i = 0; i < SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA; ++i) {
+    to[i] = (isfinite(from[i]) != 0) ? from[i] : 0.0;
+  }
+}
+
+static void second_order_quadrotor_cascade_zero(second_order_quadrotor_cascade_real* v, int count) {
+  if (v != NULL) {
+    int i;
+    for (i = 0; i < count; ++i) {
+      v[i] = 0.0;
+    }
+  }
+}
+
+/* ------------------------------------------------------- composition (tables) */
+
+/* rho [L; U] of eq. (4) at t (and rho_dot when rates != 0): the first segment whose end is
+   after t (the last one after every end). */
+static void second_order_quadrotor_cascade_reach(second_order_quadrotor_cascade_real t, int rates, second_order_quadrotor_cascade_real* rho, second_order_quadrotor_cascade_real* rho_dot) {
+  second_order_quadrotor_cascade_real p = 0.0;
+  second_order_quadrotor_cascade_real p_dot = 0.0;
+  int k = SECOND_ORDER_QUADROTOR_CASCADE_N_SEGMENTS - 1;
+  int j;
+  for (j = SECOND_ORDER_QUADROTOR_CASCADE_N_SEGMENTS - 2; j >= 0; --j) {
+    if (t < SECOND_ORDER_QUADROTOR_CASCADE_SEGMENTS[j].end) {
+      k = j;
+    }
+  }
+  if (SECOND_ORDER_QUADROTOR_CASCADE_SEGMENTS[k].profile == 0) {
+    if (rates != 0) {
+      body_progress_tanh(&t, &SECOND_ORDER_QUADROTOR_CASCADE_SEGMENTS[k].start, &SECOND_ORDER_QUADROTOR_CASCADE_SEGMENTS[k].end, &p, &p_dot);
+    } else {
+      body_progress_tanh_value(&t, &SECOND_ORDER_QUADROTOR_CASCADE_SEGMENTS[k].start, &SECOND_ORDER_QUADROTOR_CASCADE_SEGMENTS[k].end, &p);
+    }
+  }
+  if (rates != 0) {
+    body_interpolate(&p, &p_dot, SECOND_ORDER_QUADROTOR_CASCADE_SEGMENTS[k].from, SECOND_ORDER_QUADROTOR_CASCADE_SEGMENTS[k].to, rho, rho_dot);
+  } else {
+    body_interpolate_value(&p, SECOND_ORDER_QUADROTOR_CASCADE_SEGMENTS[k].from, SECOND_ORDER_QUADROTOR_CASCADE_SEGMENTS[k].to, rho);
+  }
+}
+
+/* beta [L; U] of eq. (9) at t (and beta_dot when rates != 0), over the open windows only (a
+   closed window adds exactly 0 to F_nu). */
+static void second_order_quadrotor_cascade_circumvent(second_order_quadrotor_cascade_real t, int rates, second_order_quadrotor_cascade_real* beta,
+    second_order_quadrotor_cascade_real* beta_dot) {
+  second_order_quadrotor_cascade_real top[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real total[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real rate[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  int b;
+  second_order_quadrotor_cascade_real y[SECOND_ORDER_QUADROTOR_CASCADE_MAX_OPEN];
+  second_order_quadrotor_cascade_real y_dot[SECOND_ORDER_QUADROTOR_CASCADE_MAX_OPEN];
+  int bound_of[SECOND_ORDER_QUADROTOR_CASCADE_MAX_OPEN];
+  int open = 0;
+  int lo = 0;
+  int hi = SECOND_ORDER_QUADROTOR_CASCADE_N_WINDOWS;
+  int first;
+  int j;
+  for (b = 0; b < SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA; ++b) {
+    top[b] = 0.0;
+    beta[b] = SECOND_ORDER_QUADROTOR_CASCADE_BOUND[b];
+    beta_dot[b] = 0.0;
+  }
+  for (j = 0; j < SECOND_ORDER_QUADROTOR_CASCADE_MAX_OPEN; ++j) {
+    y[j] = 0.0;
+    y_dot[j] = 0.0;
+    bound_of[j] = 0;
+  }
+  /* rows [0, hi) start before t (binary search); rows before `first` all ended by t */
+  while (lo < hi) {
+    int mid = lo + ((hi - lo) / 2);
+    if (SECOND_ORDER_QUADROTOR_CASCADE_WINDOWS[mid].start < t) {
+      lo = mid + 1;
+    } else {
+      hi = mid;
+    }
+  }
+  first = hi;
+  while ((first > 0) && (SECOND_ORDER_QUADROTOR_CASCADE_WINDOWS[first - 1].max_end > t)) {
+    first = first - 1;
+  }
+  for (j = first; j < hi; ++j) {
+    if ((t < SECOND_ORDER_QUADROTOR_CASCADE_WINDOWS[j].end) && (open < SECOND_ORDER_QUADROTOR_CASCADE_MAX_OPEN)) {
+      const second_order_quadrotor_cascade_window* w = &SECOND_ORDER_QUADROTOR_CASCADE_WINDOWS[j];
+      if (rates != 0) {
+        body_bump(&t, &w->start, &w->end, &w->center, &w->radius, &w->sharpness, &w->height,
+                  &y[open], &y_dot[open]);
+      } else {
+        body_bump_value(&t, &w->start, &w->end, &w->center, &w->radius, &w->sharpness,
+                        &w->height, &y[open]);
+      }
+      bound_of[open] = w->bound;
+      if (y[open] > top[w->bound]) {
+        top[w->bound] = y[open];
+      }
+      open = open + 1;
+    }
+  }
+  for (b = 0; b < SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA; ++b) {
+    if (SECOND_ORDER_QUADROTOR_CASCADE_MEMBERS[b] > 1) {
+      body_fnu_init(&top[b], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness, &total[b], &rate[b]);
+    }
+  }
+  for (j = 0; j < open; ++j) {
+    b = bound_of[j];
+    if (SECOND_ORDER_QUADROTOR_CASCADE_MEMBERS[b] > 1) {
+      second_order_quadrotor_cascade_real total_next;
+      second_order_quadrotor_cascade_real rate_next;
+      body_fnu_add(&total[b], &rate[b], &y[j], &y_dot[j], &top[b], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness,
+                   &total_next, &rate_next);
+      total[b] = total_next;
+      rate[b] = rate_next;
+    }
+  }
+  for (b = 0; b < SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA; ++b) {
+    if (SECOND_ORDER_QUADROTOR_CASCADE_MEMBERS[b] > 1) {
+      body_fnu_finish(&SECOND_ORDER_QUADROTOR_CASCADE_BOUND[b], &SECOND_ORDER_QUADROTOR_CASCADE_SIGN[b], &top[b], &total[b], &rate[b],
+                      &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness, &beta[b], &beta_dot[b]);
+    }
+  }
+}
+
+/* gamma_L, gamma_U of eq. (10) from rho and beta: the smooth max/min's correction only where
+   it can change the max/min */
+static void second_order_quadrotor_cascade_gamma_of(const second_order_quadrotor_cascade_real* rho, const second_order_quadrotor_cascade_real* beta,
+    const second_order_quadrotor_cascade_real* a, second_order_quadrotor_cascade_real* g_l, second_order_quadrotor_cascade_real* g_u) {
+  second_order_quadrotor_cascade_real c[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real needed;
+  int i;
+  body_candidates(rho, a, c);
+  for (i = 0; i < SECOND_ORDER_QUADROTOR_CASCADE_N; ++i) {
+    body_smooth_max_test(&c[i], &beta[i], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness, &g_l[i], &needed);
+    if (needed != 0.0) {
+      body_smooth_max(&c[i], &beta[i], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness, &g_l[i]);
+    }
+    body_smooth_min_test(&c[SECOND_ORDER_QUADROTOR_CASCADE_N + i], &beta[SECOND_ORDER_QUADROTOR_CASCADE_N + i], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness,
+                         &g_u[i], &needed);
+    if (needed != 0.0) {
+      body_smooth_min(&c[SECOND_ORDER_QUADROTOR_CASCADE_N + i], &beta[SECOND_ORDER_QUADROTOR_CASCADE_N + i], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness,
+                      &g_u[i]);
+    }
+  }
+}
+
+/* gamma_L, gamma_U of eq. (10) at (t, a) */
+static void second_order_quadrotor_cascade_gamma(second_order_quadrotor_cascade_real t, const second_order_quadrotor_cascade_real* a, second_order_quadrotor_cascade_real* g_l,
+    second_order_quadrotor_cascade_real* g_u) {
+  second_order_quadrotor_cascade_real rho[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real rho_dot[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real beta[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real beta_dot[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_reach(t, 0, rho, rho_dot);
+  second_order_quadrotor_cascade_circumvent(t, 0, beta, beta_dot);
+  second_order_quadrotor_cascade_gamma_of(rho, beta, a, g_l, g_u);
+}
+
+/* gamma and its total time derivative (alpha moving by (11)) at (t, a) */
+static void second_order_quadrotor_cascade_gamma_and_rates(second_order_quadrotor_cascade_real t, const second_order_quadrotor_cascade_real* a, second_order_quadrotor_cascade_real* g_l,
+    second_order_quadrotor_cascade_real* g_u, second_order_quadrotor_cascade_real* g_l_dot, second_order_quadrotor_cascade_real* g_u_dot) {
+  second_order_quadrotor_cascade_real rho[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real rho_dot[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real beta[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real beta_dot[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real psi[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real theta[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real a_dot[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real c[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real c_dot[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  int i;
+  second_order_quadrotor_cascade_reach(t, 1, rho, rho_dot);
+  second_order_quadrotor_cascade_circumvent(t, 1, beta, beta_dot);
+  second_order_quadrotor_cascade_gamma_of(rho, beta, a, g_l, g_u);
+  body_conflict(rho, beta, &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.theta0, &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.mu, psi, theta);
+  body_alpha_rate(a, psi, theta, &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.kappa, a_dot);
+  body_candidates(rho, a, c);
+  body_candidate_rates(rho_dot, a_dot, c_dot);
+  for (i = 0; i < SECOND_ORDER_QUADROTOR_CASCADE_N; ++i) {
+    body_smooth_max_rate(&c[i], &beta[i], &c_dot[i], &beta_dot[i],
+                         &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness, &g_l_dot[i]);
+    body_smooth_min_rate(&c[SECOND_ORDER_QUADROTOR_CASCADE_N + i], &beta[SECOND_ORDER_QUADROTOR_CASCADE_N + i], &c_dot[SECOND_ORDER_QUADROTOR_CASCADE_N + i],
+                         &beta_dot[SECOND_ORDER_QUADROTOR_CASCADE_N + i], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness, &g_u_dot[i]);
+  }
+}
+
+int second_order_quadrotor_cascade_tube(second_order_quadrotor_cascade_real t, const second_order_quadrotor_cascade_real alpha[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA],
+    second_order_quadrotor_cascade_real gamma_L[SECOND_ORDER_QUADROTOR_CASCADE_N], second_order_quadrotor_cascade_real gamma_U[SECOND_ORDER_QUADROTOR_CASCADE_N],
+    second_order_quadrotor_cascade_real gamma_L_dot[SECOND_ORDER_QUADROTOR_CASCADE_N], second_order_quadrotor_cascade_real gamma_U_dot[SECOND_ORDER_QUADROTOR_CASCADE_N]) {
+  int status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_INVALID_INPUT;
+  if ((gamma_L != NULL) && (gamma_U != NULL)) {
+    second_order_quadrotor_cascade_real g_l[SECOND_ORDER_QUADROTOR_CASCADE_N];
+    second_order_quadrotor_cascade_real g_u[SECOND_ORDER_QUADROTOR_CASCADE_N];
+    second_order_quadrotor_cascade_real g_l_dot[SECOND_ORDER_QUADROTOR_CASCADE_N];
+    second_order_quadrotor_cascade_real g_u_dot[SECOND_ORDER_QUADROTOR_CASCADE_N];
+    int rates = 0;
+    /* zeroed: written only on the paths that compute them (gcc's -Wmaybe-uninitialized
+       cannot tell for n = 1) */
+    second_order_quadrotor_cascade_zero(g_l_dot, SECOND_ORDER_QUADROTOR_CASCADE_N);
+    second_order_quadrotor_cascade_zero(g_u_dot, SECOND_ORDER_QUADROTOR_CASCADE_N);
+    if ((gamma_L_dot != NULL) || (gamma_U_dot != NULL)) {
+      rates = 1;
+    }
+    if ((alpha != NULL) && (second_order_quadrotor_cascade_time_valid(t) != 0) && (second_order_quadrotor_cascade_alpha_valid(alpha) != 0)) {
+      second_order_quadrotor_cascade_real a[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+      second_order_quadrotor_cascade_copy(alpha, a, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA);
+      if (rates != 0) {
+        second_order_quadrotor_cascade_gamma_and_rates(t, a, g_l, g_u, g_l_dot, g_u_dot);
+      } else {
+        second_order_quadrotor_cascade_gamma(t, a, g_l, g_u);
+      }
+      /* the rates hold theta / (psi + alpha)^2: infinite where alpha is not one the
+         adaptive law reaches at t (psi + alpha <= 0) */
+      if ((second_order_quadrotor_cascade_finite(g_l, SECOND_ORDER_QUADROTOR_CASCADE_N) != 0) && (second_order_quadrotor_cascade_finite(g_u, SECOND_ORDER_QUADROTOR_CASCADE_N) != 0)
+          && ((rates == 0) || ((second_order_quadrotor_cascade_finite(g_l_dot, SECOND_ORDER_QUADROTOR_CASCADE_N) != 0)
+                               && (second_order_quadrotor_cascade_finite(g_u_dot, SECOND_ORDER_QUADROTOR_CASCADE_N) != 0)))) {
+        status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_OK;
+      }
+    }
+    if (status == SECOND_ORDER_QUADROTOR_CASCADE_STATUS_OK) {
+      second_order_quadrotor_cascade_copy(g_l, gamma_L, SECOND_ORDER_QUADROTOR_CASCADE_N);
+      second_order_quadrotor_cascade_copy(g_u, gamma_U, SECOND_ORDER_QUADROTOR_CASCADE_N);
+      if (gamma_L_dot != NULL) {
+        second_order_quadrotor_cascade_copy(g_l_dot, gamma_L_dot, SECOND_ORDER_QUADROTOR_CASCADE_N);
+      }
+      if (gamma_U_dot != NULL) {
+        second_order_quadrotor_cascade_copy(g_u_dot, gamma_U_dot, SECOND_ORDER_QUADROTOR_CASCADE_N);
+      }
+    } else {
+      second_order_quadrotor_cascade_zero(gamma_L, SECOND_ORDER_QUADROTOR_CASCADE_N);
+      second_order_quadrotor_cascade_zero(gamma_U, SECOND_ORDER_QUADROTOR_CASCADE_N);
+      second_order_quadrotor_cascade_zero(gamma_L_dot, SECOND_ORDER_QUADROTOR_CASCADE_N);
+      second_order_quadrotor_cascade_zero(gamma_U_dot, SECOND_ORDER_QUADROTOR_CASCADE_N);
     }
   } else {
-    double tv[1];
-    double dtv[1];
-    double inside_position[1];
-    double inside_velocity[1];
-    tv[0] = t;
-    dtv[0] = dt;
-    second_order_quadrotor_cascade_cascade_step(x1, x2, tv, dtv, alpha, u, alpha_next, r, inside_position, inside_velocity);
-    if (inside_position[0] != 1.0) {
-      status = SECOND_ORDER_QUADROTOR_CASCADE_OUTSIDE_POSITION_TUBE;
-    } else if (inside_velocity[0] != 1.0) {
-      status = SECOND_ORDER_QUADROTOR_CASCADE_OUTSIDE_VELOCITY_TUBE;
-    } else {
-      status = SECOND_ORDER_QUADROTOR_CASCADE_OK;
+    /* gamma_L or gamma_U NULL: INVALID_INPUT, every other output zeroed */
+    second_order_quadrotor_cascade_zero(gamma_L, SECOND_ORDER_QUADROTOR_CASCADE_N);
+    second_order_quadrotor_cascade_zero(gamma_U, SECOND_ORDER_QUADROTOR_CASCADE_N);
+    second_order_quadrotor_cascade_zero(gamma_L_dot, SECOND_ORDER_QUADROTOR_CASCADE_N);
+    second_order_quadrotor_cascade_zero(gamma_U_dot, SECOND_ORDER_QUADROTOR_CASCADE_N);
+  }
+  return status;
+}
+
+/* The second stage (docs/second-order.md): k2 of u = -k2 xi2 epsilon2, the decay l of the
+   velocity tube rho2(t) = (rho2(0) - rho2(inf)) exp(-l t) + rho2(inf), its start rho2(0)
+   and floor rho2(inf) (velocity units). k1 is the gain of the tube parameters: the
+   virtual velocity r is law (13) with gain k1. */
+typedef struct {
+  second_order_quadrotor_cascade_real velocity_gain;
+  second_order_quadrotor_cascade_real decay;
+  second_order_quadrotor_cascade_real width_start[SECOND_ORDER_QUADROTOR_CASCADE_N];
+  second_order_quadrotor_cascade_real width_floor[SECOND_ORDER_QUADROTOR_CASCADE_N];
+} second_order_quadrotor_cascade_second_stage;
+
+static const second_order_quadrotor_cascade_second_stage SECOND_ORDER_QUADROTOR_CASCADE_SECOND_STAGE = {
+  9046.954292479999, /* velocity_gain */
+  100.0, /* decay */
+  { 6.725680008290377, 6.725680008290377, 6.72568 }, /* width_start */
+  { 6.72568, 6.72568, 6.72568 } /* width_floor */
+};
+
+/* u and r of the cascade at (x = [x1; x2], t, a), x and a
+   already checked; returns OK, OUTSIDE_TUBE, OUTSIDE_VELOCITY_TUBE, or
+   INVALID_INPUT when u or r is not finite. */
+static int second_order_quadrotor_cascade_law(const second_order_quadrotor_cascade_real* x, second_order_quadrotor_cascade_real t, const second_order_quadrotor_cascade_real* a,
+    second_order_quadrotor_cascade_real* u, second_order_quadrotor_cascade_real* r) {
+  second_order_quadrotor_cascade_real g_l[SECOND_ORDER_QUADROTOR_CASCADE_N];
+  second_order_quadrotor_cascade_real g_u[SECOND_ORDER_QUADROTOR_CASCADE_N];
+  second_order_quadrotor_cascade_real rho2[SECOND_ORDER_QUADROTOR_CASCADE_N];
+  second_order_quadrotor_cascade_real inside_position;
+  second_order_quadrotor_cascade_real inside_velocity;
+  int status;
+  second_order_quadrotor_cascade_gamma(t, a, g_l, g_u);
+  body_law(x, g_l, g_u, &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.gain, r, &inside_position);
+  body_velocity_tube(&t, SECOND_ORDER_QUADROTOR_CASCADE_SECOND_STAGE.width_start, SECOND_ORDER_QUADROTOR_CASCADE_SECOND_STAGE.width_floor,
+                     &SECOND_ORDER_QUADROTOR_CASCADE_SECOND_STAGE.decay, rho2);
+  body_velocity_law(&x[SECOND_ORDER_QUADROTOR_CASCADE_N], r, rho2, &SECOND_ORDER_QUADROTOR_CASCADE_SECOND_STAGE.velocity_gain, u,
+                    &inside_velocity);
+  if ((second_order_quadrotor_cascade_finite(u, SECOND_ORDER_QUADROTOR_CASCADE_N) == 0) || (second_order_quadrotor_cascade_finite(r, SECOND_ORDER_QUADROTOR_CASCADE_N) == 0)) {
+    status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_INVALID_INPUT;
+  } else if (inside_position == 0.0) {
+    status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_OUTSIDE_TUBE;
+  } else if (inside_velocity == 0.0) {
+    status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_OUTSIDE_VELOCITY_TUBE;
+  } else {
+    status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_OK;
+  }
+  return status;
+}
+
+/* implicit step of (11) from t to t + dt, inputs already checked (a: [N_ALPHA]) */
+static void second_order_quadrotor_cascade_implicit_step(second_order_quadrotor_cascade_real t, second_order_quadrotor_cascade_real dt, const second_order_quadrotor_cascade_real* a,
+    second_order_quadrotor_cascade_real* next) {
+  second_order_quadrotor_cascade_real psi[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real theta[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real rho[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real rho_dot[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real beta[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real beta_dot[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real t_next;
+  int i;
+  body_later(&t, &dt, &t_next);
+  second_order_quadrotor_cascade_reach(t_next, 0, rho, rho_dot);
+  second_order_quadrotor_cascade_circumvent(t_next, 0, beta, beta_dot);
+  body_conflict(rho, beta, &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.theta0, &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.mu, psi, theta);
+  for (i = 0; i < SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA; ++i) {
+    second_order_quadrotor_cascade_real s;
+    second_order_quadrotor_cascade_real s_next;
+    second_order_quadrotor_cascade_real c;
+    second_order_quadrotor_cascade_real big_a;
+    second_order_quadrotor_cascade_real root;
+    int k = 2;
+    body_newton_start(&a[i], &psi[i], &theta[i], &dt, &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.kappa, &s, &c, &big_a,
+                      &root);
+    if (root != 0.0) {
+      body_newton_root_start(&a[i], &psi[i], &c, &big_a, &s);
     }
+    /* 5 iterations; an iteration that returns its input would return it again,
+       so the loop stops there with the same result. The first two run without that test
+       (if the first returned its input, the second returns it again): fewer branches. */
+    body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
+    s = s_next;
+    body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
+    if (s_next == s) {
+      k = 5;
+    }
+    s = s_next;
+    while (k < 5) {
+      body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
+      if (s_next == s) {
+        k = 5;
+      } else {
+        k = k + 1;
+      }
+      s = s_next;
+    }
+    next[i] = s;
+  }
+}
+
+int second_order_quadrotor_cascade_alpha_step(second_order_quadrotor_cascade_real t, second_order_quadrotor_cascade_real dt,
+    const second_order_quadrotor_cascade_real alpha[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA], second_order_quadrotor_cascade_real alpha_next[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA]) {
+  int status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_INVALID_INPUT;
+  if (alpha_next != NULL) {
+    if (alpha == NULL) {
+      second_order_quadrotor_cascade_zero(alpha_next, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA);
+    } else {
+      second_order_quadrotor_cascade_real a[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+      second_order_quadrotor_cascade_real next[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+      second_order_quadrotor_cascade_copy(alpha, a, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA);
+      if ((second_order_quadrotor_cascade_time_valid(t) != 0) && (second_order_quadrotor_cascade_dt_valid(dt) != 0)
+          && (second_order_quadrotor_cascade_alpha_valid(a) != 0)) {
+        second_order_quadrotor_cascade_implicit_step(t, dt, a, next);
+        if (second_order_quadrotor_cascade_finite(next, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA) != 0) {
+          status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_OK;
+        }
+      }
+      if (status == SECOND_ORDER_QUADROTOR_CASCADE_STATUS_OK) {
+        second_order_quadrotor_cascade_copy(next, alpha_next, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA);
+      } else {
+        second_order_quadrotor_cascade_keep_alpha(a, alpha_next);
+      }
+    }
+  }
+  return status;
+}
+
+int second_order_quadrotor_cascade_step(const second_order_quadrotor_cascade_real x[SECOND_ORDER_QUADROTOR_CASCADE_N_STATE], second_order_quadrotor_cascade_real t, second_order_quadrotor_cascade_real dt,
+    const second_order_quadrotor_cascade_real alpha[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA], second_order_quadrotor_cascade_real u[SECOND_ORDER_QUADROTOR_CASCADE_N],
+    second_order_quadrotor_cascade_real alpha_next[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA], second_order_quadrotor_cascade_real r[SECOND_ORDER_QUADROTOR_CASCADE_N]) {
+  int status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_INVALID_INPUT;
+  if ((u != NULL) && (alpha_next != NULL) && (r != NULL)) {
+    second_order_quadrotor_cascade_real uc[SECOND_ORDER_QUADROTOR_CASCADE_N];
+    second_order_quadrotor_cascade_real rc[SECOND_ORDER_QUADROTOR_CASCADE_N];
+    if (alpha == NULL) {
+      second_order_quadrotor_cascade_zero(alpha_next, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA);
+    } else {
+      second_order_quadrotor_cascade_real a[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+      second_order_quadrotor_cascade_real next[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+      second_order_quadrotor_cascade_copy(alpha, a, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA);
+      if ((x != NULL) && (second_order_quadrotor_cascade_time_valid(t) != 0) && (second_order_quadrotor_cascade_dt_valid(dt) != 0)
+          && (second_order_quadrotor_cascade_finite(x, SECOND_ORDER_QUADROTOR_CASCADE_N_STATE) != 0) && (second_order_quadrotor_cascade_alpha_valid(a) != 0)) {
+        second_order_quadrotor_cascade_real xc[SECOND_ORDER_QUADROTOR_CASCADE_N_STATE];
+        second_order_quadrotor_cascade_copy(x, xc, SECOND_ORDER_QUADROTOR_CASCADE_N_STATE);
+        status = second_order_quadrotor_cascade_law(xc, t, a, uc, rc);
+        if (status != SECOND_ORDER_QUADROTOR_CASCADE_STATUS_INVALID_INPUT) {
+          second_order_quadrotor_cascade_implicit_step(t, dt, a, next);
+          if (second_order_quadrotor_cascade_finite(next, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA) == 0) {
+            status = SECOND_ORDER_QUADROTOR_CASCADE_STATUS_INVALID_INPUT;
+          }
+        }
+      }
+      if (status == SECOND_ORDER_QUADROTOR_CASCADE_STATUS_INVALID_INPUT) {
+        second_order_quadrotor_cascade_keep_alpha(a, alpha_next);
+      } else {
+        second_order_quadrotor_cascade_copy(next, alpha_next, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA);
+      }
+    }
+    if (status == SECOND_ORDER_QUADROTOR_CASCADE_STATUS_INVALID_INPUT) {
+      second_order_quadrotor_cascade_zero(u, SECOND_ORDER_QUADROTOR_CASCADE_N);
+      second_order_quadrotor_cascade_zero(r, SECOND_ORDER_QUADROTOR_CASCADE_N);
+    } else {
+      second_order_quadrotor_cascade_copy(uc, u, SECOND_ORDER_QUADROTOR_CASCADE_N);
+      second_order_quadrotor_cascade_copy(rc, r, SECOND_ORDER_QUADROTOR_CASCADE_N);
+    }
+  } else {
+    /* u, alpha_next or r NULL: INVALID_INPUT, the other outputs written as documented */
+    if (alpha_next != NULL) {
+      if (alpha == NULL) {
+        second_order_quadrotor_cascade_zero(alpha_next, SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA);
+      } else {
+        second_order_quadrotor_cascade_keep_alpha(alpha, alpha_next);
+      }
+    }
+    second_order_quadrotor_cascade_zero(u, SECOND_ORDER_QUADROTOR_CASCADE_N);
+    second_order_quadrotor_cascade_zero(r, SECOND_ORDER_QUADROTOR_CASCADE_N);
   }
   return status;
 }

@@ -3,23 +3,130 @@
  * "second-order-s1" and its second stage (SHA-256 8a27933f0e92c44de5551b2bbd1c76079bd77f4b74544fc0325804d9f53758b3),
  * precision double. Cascade law of docs/second-order.md.
  */
+/*
+ * Cascade controller of spec "second-order-s1" for the second-order plant
+ * x1_dot = x2, x2_dot = f(x1, x2) + g(x1, x2) u + w (docs/second-order.md): the virtual
+ * velocity r = -k1 xi1 epsilon1 (law (13) on the tube [gamma_L(t, alpha), gamma_U(t, alpha)]
+ * of "Prescribed-time Reach-Avoid-Stay Specifications for Unknown Systems: A
+ * Spatiotemporal Tubes Approach"), the input u = -k2 xi2 epsilon2 on the velocity error
+ * x2 - r inside the velocity tube |x2 - r| < rho2(t),
+ * and the implicit step of the adaptive law (11).
+ *
+ * C99, depends on <math.h> only (link with -lm). No allocation, no global or static
+ * mutable state: every function is reentrant and thread-safe. Arithmetic: double.
+ * Do not compile with -ffast-math, -Ofast, -ffinite-math-only or clang's -fno-honor-nans /
+ * -fno-honor-infinities (the source stops with #error under each of the first three and
+ * under the last two together): they would remove the input checks.
+ *
+ * Units: time t, dt in seconds; positions x1 and alpha in state units (the spec's);
+ * velocities x2 and the virtual velocity r in state units per second; u in input units
+ * (the input of the plant: a force, a torque).
+ *
+ * Shapes: x = [x1; x2] has SECOND_ORDER_S1_CASCADE_N_STATE = 2 SECOND_ORDER_S1_CASCADE_N entries (positions, then
+ * velocities); u and r have SECOND_ORDER_S1_CASCADE_N entries; alpha, alpha_next have SECOND_ORDER_S1_CASCADE_N_ALPHA =
+ * 2 SECOND_ORDER_S1_CASCADE_N entries: [alpha_L, alpha_U]. Start with alpha = 0 at t = 0 and feed
+ * alpha_next back at every step.
+ *
+ * Input domain (anything else is INVALID_INPUT):
+ *   t      finite and t >= 0: seconds since the start of the task (alpha = 0 at t = 0).
+ *   dt     SECOND_ORDER_S1_CASCADE_DT_MIN <= dt <= SECOND_ORDER_S1_CASCADE_DT_MAX: from 2^-20 s (about 1 MHz) to the
+ *          smallest power of two >= t_c.
+ *   x      any finite numbers (far from the tubes: OUTSIDE_TUBE or
+ *          OUTSIDE_VELOCITY_TUBE, u finite).
+ *   alpha  every entry in [0, SECOND_ORDER_S1_CASCADE_ALPHA_MAX]: the adaptive law (11) keeps alpha >= 0
+ *          from alpha = 0, and far below ALPHA_MAX.
+ *
+ * Status codes (return value of every function; second_order_s1_cascade_tube and second_order_s1_cascade_alpha_step return
+ * OK or INVALID_INPUT, as in the first-order API):
+ *   SECOND_ORDER_S1_CASCADE_STATUS_OK                    0  outputs valid, x1 strictly inside the
+ *                                          position tube and x2 - r strictly inside
+ *                                          (-rho2, rho2), compared exactly.
+ *   SECOND_ORDER_S1_CASCADE_STATUS_OUTSIDE_TUBE          1  x1 is on or outside the position tube, or the
+ *                                          tube is empty in some dimension: u and r are
+ *                                          still finite (the errors are clamped to
+ *                                          +-(1 - 2^-20), the widths floored at 1e-6),
+ *                                          alpha_next is valid. The prescribed-time
+ *                                          guarantee no longer holds.
+ *   SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT         2  a NULL pointer or an input outside the domain
+ *                                          above: u = 0, r = 0, alpha_next = alpha with
+ *                                          each non-finite entry replaced by 0 (alpha
+ *                                          NULL: 0).
+ *   SECOND_ORDER_S1_CASCADE_STATUS_OUTSIDE_VELOCITY_TUBE 4  x1 inside its tube, x2 - r on or outside
+ *                                          (-rho2, rho2): u finite, alpha_next valid.
+ * Every number written is finite, whatever the inputs.
+ *
+ * Aliasing: inputs are copied before any output is written, so an output may alias an
+ * input (e.g. alpha_next == alpha for an in-place update).
+ */
 #ifndef SECOND_ORDER_S1_CASCADE_H
 #define SECOND_ORDER_S1_CASCADE_H
 
-/* Positions x1, velocities x2, inputs u and the virtual velocity r have SECOND_ORDER_S1_CASCADE_N entries;
-   alpha, alpha_next have 2 SECOND_ORDER_S1_CASCADE_N ([alpha_L, alpha_U]); start with alpha = 0 at t = 0. */
-#define SECOND_ORDER_S1_CASCADE_N 2
-#define SECOND_ORDER_S1_CASCADE_OK 0
-#define SECOND_ORDER_S1_CASCADE_OUTSIDE_POSITION_TUBE 1
-#define SECOND_ORDER_S1_CASCADE_INVALID_INPUT 2
-#define SECOND_ORDER_S1_CASCADE_OUTSIDE_VELOCITY_TUBE 4
+#ifdef __cplusplus
+extern "C" {
+#endif
 
-/* One step of the cascade: u = -k2 xi2 epsilon2 on the velocity error x2 - r,
-   r = -k1 xi1 epsilon1 (law (13) on the position tube), and alpha_next.
-   Domain: t finite, t >= 0; 0 < dt <= 1; x1, x2 finite; alpha finite, >= 0.
-   Outside it: SECOND_ORDER_S1_CASCADE_INVALID_INPUT, u = 0, r = 0, alpha_next = alpha (non-finite entries 0).
-   Returns SECOND_ORDER_S1_CASCADE_OK, SECOND_ORDER_S1_CASCADE_OUTSIDE_POSITION_TUBE or SECOND_ORDER_S1_CASCADE_OUTSIDE_VELOCITY_TUBE (u finite). */
-int second_order_s1_cascade_step(double t, double dt, const double* x1, const double* x2,
-    const double* alpha, double* u, double* alpha_next, double* r);
+/** Floating-point type of every argument (double precision). */
+typedef double second_order_s1_cascade_real;
+
+/** Number of positions n (of velocities, of inputs). */
+#define SECOND_ORDER_S1_CASCADE_N 2
+/** Length of the state x = [x1; x2]: 2 n. */
+#define SECOND_ORDER_S1_CASCADE_N_STATE 4
+/** Length of alpha: 2 n. */
+#define SECOND_ORDER_S1_CASCADE_N_ALPHA 4
+/** Prescribed time t_c, seconds. */
+#define SECOND_ORDER_S1_CASCADE_PRESCRIBED_TIME 9.0
+/** Sampling rate the tube and the second stage were designed for, Hz (dt = 1 / rate). */
+#define SECOND_ORDER_S1_CASCADE_RATE_HZ 1000.0
+/** Smallest valid dt, seconds: 2^-20 (a sampling rate of about 1 MHz). */
+#define SECOND_ORDER_S1_CASCADE_DT_MIN 9.5367431640625e-07
+/** Largest valid dt, seconds: the smallest power of two >= t_c. */
+#define SECOND_ORDER_S1_CASCADE_DT_MAX 16.0
+/** Largest valid entry of alpha, state units: a power of two >= 1e6 (1 + max |state bound|). */
+#define SECOND_ORDER_S1_CASCADE_ALPHA_MAX 8388608.0
+
+#define SECOND_ORDER_S1_CASCADE_STATUS_OK 0
+#define SECOND_ORDER_S1_CASCADE_STATUS_OUTSIDE_TUBE 1
+#define SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT 2
+#define SECOND_ORDER_S1_CASCADE_STATUS_OUTSIDE_VELOCITY_TUBE 4
+
+/**
+ * Tube bounds at time t: gamma_L, gamma_U of eq. (10) and their total time derivatives.
+ *
+ * t: seconds, t >= 0. alpha: [SECOND_ORDER_S1_CASCADE_N_ALPHA]. Outputs: [SECOND_ORDER_S1_CASCADE_N] each; gamma_L_dot and
+ * gamma_U_dot may be NULL (not written). Returns OK or INVALID_INPUT (outputs zeroed).
+ */
+int second_order_s1_cascade_tube(second_order_s1_cascade_real t, const second_order_s1_cascade_real alpha[SECOND_ORDER_S1_CASCADE_N_ALPHA],
+    second_order_s1_cascade_real gamma_L[SECOND_ORDER_S1_CASCADE_N], second_order_s1_cascade_real gamma_U[SECOND_ORDER_S1_CASCADE_N],
+    second_order_s1_cascade_real gamma_L_dot[SECOND_ORDER_S1_CASCADE_N], second_order_s1_cascade_real gamma_U_dot[SECOND_ORDER_S1_CASCADE_N]);
+
+/**
+ * Implicit (backward Euler, at most 5 Newton iterations) step of the adaptive law (11)
+ * from t to t + dt.
+ *
+ * t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha, alpha_next: [SECOND_ORDER_S1_CASCADE_N_ALPHA].
+ * Returns OK or INVALID_INPUT (alpha_next = alpha, non-finite entries 0).
+ */
+int second_order_s1_cascade_alpha_step(second_order_s1_cascade_real t, second_order_s1_cascade_real dt,
+    const second_order_s1_cascade_real alpha[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real alpha_next[SECOND_ORDER_S1_CASCADE_N_ALPHA]);
+
+/**
+ * One controller step: u and r at (x, t, alpha) and alpha at t + dt. Call at every
+ * sampling instant t_k = k dt with the measured x(t_k) = [x1; x2], hold u until t_{k+1},
+ * then pass alpha_next as alpha.
+ *
+ * x: [SECOND_ORDER_S1_CASCADE_N_STATE]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha:
+ * [SECOND_ORDER_S1_CASCADE_N_ALPHA]. u: [SECOND_ORDER_S1_CASCADE_N] (out). alpha_next: [SECOND_ORDER_S1_CASCADE_N_ALPHA] (out, may alias
+ * alpha). r: [SECOND_ORDER_S1_CASCADE_N] (out, the virtual velocity).
+ * Returns OK, OUTSIDE_TUBE, OUTSIDE_VELOCITY_TUBE or INVALID_INPUT (u = 0, r = 0,
+ * alpha_next = alpha).
+ */
+int second_order_s1_cascade_step(const second_order_s1_cascade_real x[SECOND_ORDER_S1_CASCADE_N_STATE], second_order_s1_cascade_real t, second_order_s1_cascade_real dt,
+    const second_order_s1_cascade_real alpha[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real u[SECOND_ORDER_S1_CASCADE_N],
+    second_order_s1_cascade_real alpha_next[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real r[SECOND_ORDER_S1_CASCADE_N]);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif /* SECOND_ORDER_S1_CASCADE_H */
