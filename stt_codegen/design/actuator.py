@@ -226,11 +226,12 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
                f"{best.proof.time[worst]:.3f} s")
     works, why = smallest_prescribed_time(spec, design_free, prove,
                                           best.proof.ratio(bound))
+    needs = f"[{needs}]" + (f" ({spec.input_unit})" if unit else "")
     if works is not None:
         message += (f"; prescribed_time = {works:g} s works (the smallest to two significant "
-                    f"digits), or input_bound = [{needs}] with this prescribed_time")
+                    f"digits), or input_bound = {needs} with this prescribed_time")
     else:
-        message += f"; {why}; input_bound = [{needs}] works with this prescribed_time"
+        message += f"; {why}; input_bound = {needs} works with this prescribed_time"
     raise DesignError(message, kind=FailureKind.INPUT_BOUND, tried=best.design.tube)
 
 
