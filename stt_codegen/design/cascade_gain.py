@@ -339,17 +339,16 @@ def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage
         return stage, derivation
     from ..errors import DesignError
     from .failures import FailureKind
-    certified = [t for t in derivation["tried"] if t["passed"]]
-    if certified:       # the tubes are kept, the actuator bound is not
+    proof = (cascade_input_proof(tube, spec, min_width) if spec.input_bound is not None
+             else None)
+    if proof is not None and proof.proved:      # the tubes are kept, the bound is not
         unit = f" {spec.input_unit}"
-        least = min(certified, key=lambda t: max(p / b for p, b in zip(t["peak_input"],
-                                                                          spec.input_bound)))
         raise DesignError(
             f"no second stage tried ({len(SHAPES)} shapes) keeps the cascade's input within "
             "actuator.input_bound = [" + ", ".join(f"{b:g}{unit}" for b in spec.input_bound)
-            + "] on this tube: the lowest certified peak is " + ", ".join(
-                f"|{name}| <= {p:.4g}{unit}" for name, p in zip(spec.input_names,
-                                                                least["peak_input"]))
+            + "] on this tube: the certified stage with the lowest peak-to-bound ratio asks "
+            + ", ".join(f"|{name}| <= {p:.4g}{unit}"
+                        for name, p in zip(spec.input_names, proof.peak))
             + "; design_tube slows the tube or names the prescribed_time that works "
             "(docs/second-order.md, 'Force limits')", kind=FailureKind.INPUT_BOUND)
     rate = lowest_certified_rate(tube, spec, passes_at_rate=False)
