@@ -18,7 +18,6 @@ from ..design.certificate import enclose_tube
 from ..design.input_bound import InputProof, input_peak
 from ..design.samples import TubeSamples
 from ..spec.loader import Spec
-from ..spec.plants import PLANTS
 from ..tube import reference
 from ..tube.parameters import TubeDesign
 from ..rounding import distinct
@@ -126,7 +125,7 @@ def input_bound_check(spec: Spec, proof: InputProof) -> Check:
         ``(bound - peak) / bound``), ``horizon``.
     """
     bound = spec.input_bound
-    names = PLANTS[spec.plant_model].input_names(spec.dimension)
+    names = spec.input_names
     data = {"input_bound": list(bound), "peak": list(proof.peak), "time": list(proof.time),
             "margin": proof.margin(bound), "horizon": proof.horizon, "inputs": list(names)}
     if not proof.proved:
