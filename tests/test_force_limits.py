@@ -268,3 +268,13 @@ def test_umaze_a_bound_below_the_first_shapes_peak_takes_a_later_shape():
     # the first shape is certified on this tube, and beyond the bound
     _, tried = certified_stage(design.tube, spec, design.check.min_width, (0.0, 0.0))
     assert tried["tried"][0]["passed"] and max(tried["tried"][0]["peak_input"]) > 0.95 * first
+
+
+@pytest.mark.slow
+def test_umaze_at_100_hz_with_a_bound_is_refused_for_the_rate_naming_one():
+    """No second stage keeps the tubes at 100 Hz, bound or not: the refusal is the rate's
+    (kind SAMPLING_RATE, naming a certified rate), not the bound's."""
+    with pytest.raises(DesignError) as info:
+        stt.design_tube(umaze([1.0, 1.0], rate_hz=100.0))
+    assert info.value.kind is FailureKind.SAMPLING_RATE
+    assert re.search(r"controller\.rate_hz = [0-9.]+ is certified", str(info.value))
