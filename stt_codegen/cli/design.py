@@ -59,9 +59,11 @@ def cmd_design(args: argparse.Namespace) -> int:
     for m in design.certificate.margins:
         print(f"  {'PASS' if m.passed else 'FAIL'}  {m.name}: margin {m.margin:.4g}")
     if design.input_proof is not None:          # [actuator]
-        peaks = ", ".join(f"{p:.4g} <= {b:g}" for p, b in zip(design.input_proof.peak,
-                                                              tube.input_bound))
-        print(f"  PASS  input bound: law (13) asks at most [{peaks}] (proved)")
+        unit = f" {spec.input_unit}" if spec.input_unit else ""
+        peaks = ", ".join(f"{p:.4g} <= {b:g}{unit}" for p, b in zip(design.input_proof.peak,
+                                                                    tube.input_bound))
+        law = "law (13)" if spec.order == 1 else "the cascade's input u"
+        print(f"  PASS  input bound: {law} asks at most [{peaks}] (proved)")
     if args.plot:
         print(f"plot written to {args.plot}")
     return 0

@@ -4,7 +4,9 @@
 for a spec with ``[actuator]``. It accepts a tube only when the prover
 (:func:`~.input_bound.input_prover`: ``verify``'s sampled-data bound on ``e`` and the
 certified widths, :mod:`.input_bound`) shows that law (13) never asks any input for more
-than its bound. Deterministic, in this order, the first tube that meets the bound wins:
+than its bound; for a second-order spec the prover is the sampled cascade's certificate
+(:func:`~.cascade_gain.cascade_input_proof`: the peak force or torque of the certified
+second stage). Deterministic, in this order, the first tube that meets the bound wins:
 
 1. the design of the spec without ``[actuator]`` (the default design: a spec whose
    default tube keeps the bound gets exactly that tube), except that ``auto`` does not
@@ -35,10 +37,9 @@ from dataclasses import dataclass, replace
 
 from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
-from .cascade_gain import cascade_input_proof
 from .grid import grid_index, grid_value, smallest_passing
 from .failures import FailureKind
-from .input_bound import InputProof, InputProver, input_prover
+from .input_bound import InputProof, input_prover
 from .result import METHOD_PAPER, METHOD_VIA, Design
 from .samples import HORIZON_FACTOR, STEP_BUDGET
 from .windows import SHARPNESS_LADDER
@@ -51,6 +52,10 @@ MAX_TIME_FACTOR = 16.0
 #: search stops: the peak no longer falls with the tube's speed (the disturbance and drift
 #: bounds alone ask for it).
 MIN_IMPROVEMENT = 0.95
+
+#: ``(design, spec) -> InputProof``: the proved peak of each input along a design, for the
+#: plants of ``spec`` (law (13)'s or the cascade's).
+DesignProver = Callable[[Design, Spec], InputProof]
 
 
 @dataclass(frozen=True)
@@ -105,9 +110,18 @@ def slower_variants(spec: Spec, default: Design) -> list[tuple[str, Spec]]:
 
 
 def candidates(spec: Spec, design_free: Callable[[Spec], Design],
-               prover: InputProver) -> tuple[Candidate | None, list[Candidate]]:
+               prove: DesignProver) -> tuple[Candidate | None, list[Candidate]]:
     """Try the default design, then :func:`slower_variants`, on ``spec`` (which has
     ``[actuator]``), until one is proved within the bound.
+
+    Parameters
+    ----------
+    spec : Spec
+        With ``input_bound``.
+    design_free : callable
+        ``Spec -> Design``, the design without an input bound.
+    prove : callable
+        ``(Design, Spec) -> InputProof``: the proved peak of each input along a design.
 
     Returns
     -------
@@ -124,7 +138,7 @@ def candidates(spec: Spec, design_free: Callable[[Spec], Design],
     bound = spec.input_bound
     free = replace(spec, input_bound=None)
     default = design_free(free)
-    tried = [Candidate("default design", default, _proof(default, spec, prover))]
+    tried = [Candidate("default design", default, prove(default, spec))]
     if tried[0].proof.meets(bound):
         return tried[0], tried
     softer_failed = False
@@ -139,23 +153,16 @@ def candidates(spec: Spec, design_free: Callable[[Spec], Design],
             # the smoother ones are not tried (on to via points)
             softer_failed = softer_failed or softer
             continue
-        tried.append(Candidate(label, design, _proof(design, spec, prover)))
+        tried.append(Candidate(label, design, prove(design, spec)))
         if tried[-1].proof.meets(bound):
             return tried[-1], tried
     return None, tried
 
 
-def _proof(design: Design, spec: Spec, prover: InputProver) -> InputProof:
-    """The proved peak input of a design: law (13)'s by ``prover`` (first order), or the
-    cascade's physical input ``u`` by its sampled-data certificate (second order; the
-    stage kept is the first certified within the bound)."""
-    if spec.order == 2:
-        return cascade_input_proof(design.tube, spec, design.check.min_width)
-    return prover(design.tube, spec)
-
-
-def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> Design:
-    """The certified design of ``spec`` whose law (13) is proved to stay within ``[actuator]``.
+def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
+                        prove: DesignProver | None = None) -> Design:
+    """The certified design of ``spec`` whose controller is proved to stay within
+    ``[actuator]``.
 
     Parameters
     ----------
@@ -164,6 +171,11 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> De
     design_free : callable
         ``Spec -> Design``, the design without an input bound
         (:func:`~stt_codegen.design.search.design_tube` on a spec without ``[actuator]``).
+    prove : callable, optional
+        ``(Design, Spec) -> InputProof``, the proved peak of each input along a design;
+        default law (13)'s (:func:`~.input_bound.input_prover`). A second-order spec
+        passes the cascade's (:func:`~.cascade_gain.cascade_input_proof`: the physical
+        input of the certified second stage).
 
     Returns
     -------
@@ -181,44 +193,46 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> De
         within ``t_c`` needs.
     """
     started = time.perf_counter()
-    prover = input_prover()
+    if prove is None:
+        prover = input_prover()
+
+        def prove(design: Design, judged: Spec) -> InputProof:
+            return prover(design.tube, judged)
     bound = spec.input_bound
-    accepted, tried = candidates(spec, design_free, prover)
+    accepted, tried = candidates(spec, design_free, prove)
     if accepted is not None:
         design = accepted.design
         return replace(design, tube=replace(design.tube, input_bound=bound), spec=spec,
                        input_proof=accepted.proof,
                        design_time_s=time.perf_counter() - started)
     proved = [c for c in tried if c.proof.proved]
-    names = _input_names(spec)
+    names = spec.input_names
+    # the controller in the user's words: law (13)'s input, or the cascade's force/torque
+    law, unit = (("law (13)", "") if spec.order == 1 else
+                 ("the cascade's input u", f" {spec.input_unit}"))
     if not proved:
         reasons = "; ".join(f"{c.label}: {c.proof.reason}" for c in tried)
         raise DesignError(
-            f"no bound on {'law (13)' if spec.order == 1 else 'the cascade'}'s input can be "
-            f"proved for actuator.input_bound: the sampled-data check fails for every design "
-            f"tried ({reasons})",
+            f"no bound on {law} can be proved for actuator.input_bound: the "
+            f"sampled-data check fails for every design tried ({reasons})",
             kind=FailureKind.INPUT_BOUND, tried=tried[0].design.tube if tried else None)
     best = min(proved, key=lambda c: c.proof.ratio(bound))
     worst = max(range(len(bound)), key=lambda i: best.proof.peak[i] / bound[i])
     needs = ", ".join(f"{_round_up(v):g}" for v in best.proof.peak)
-    law = "law (13)" if spec.order == 1 else "the cascade's input u"
     message = (f"no design within prescribed_time = {spec.prescribed_time:g} s keeps {law} "
-               f"within actuator.input_bound = [{', '.join(f'{b:g}' for b in bound)}]: the "
-               f"best ({best.label}) asks up to {best.proof.peak[worst]:.3g} of input "
-               f"{names[worst]} (bound {bound[worst]:g}) at t = {best.proof.time[worst]:.3f} s")
-    works, why = smallest_prescribed_time(spec, design_free, prover,
+               f"within actuator.input_bound = [{', '.join(f'{b:g}{unit}' for b in bound)}]: "
+               f"the best ({best.label}) asks up to {best.proof.peak[worst]:.3g}{unit} of "
+               f"input {names[worst]} (bound {bound[worst]:g}{unit}) at t = "
+               f"{best.proof.time[worst]:.3f} s")
+    works, why = smallest_prescribed_time(spec, design_free, prove,
                                           best.proof.ratio(bound))
+    needs = f"[{needs}]" + (f" ({spec.input_unit})" if unit else "")
     if works is not None:
         message += (f"; prescribed_time = {works:g} s works (the smallest to two significant "
-                    f"digits), or input_bound = [{needs}] with this prescribed_time")
+                    f"digits), or input_bound = {needs} with this prescribed_time")
     else:
-        message += f"; {why}; input_bound = [{needs}] works with this prescribed_time"
+        message += f"; {why}; input_bound = {needs} works with this prescribed_time"
     raise DesignError(message, kind=FailureKind.INPUT_BOUND, tried=best.design.tube)
-
-
-def _input_names(spec: Spec) -> tuple[str, ...]:
-    from ..spec.plants import PLANTS
-    return PLANTS[spec.plant_model].input_names(spec.dimension)
 
 
 def _round_up(value: float, digits: int = 3) -> float:
@@ -230,7 +244,7 @@ def _round_up(value: float, digits: int = 3) -> float:
 
 
 def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
-                             prover: InputProver, ratio: float) -> tuple[float | None, str]:
+                             prove: DesignProver, ratio: float) -> tuple[float | None, str]:
     """The smallest ``prescribed_time`` (two significant digits) at which the procedure of
     :func:`candidates` meets the bound, above the spec's ``t_c`` (which fails).
 
@@ -244,7 +258,7 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
     ----------
     spec : Spec
         With ``input_bound``.
-    design_free, prover
+    design_free, prove
         As in :func:`candidates`.
     ratio : float
         The best ``max_i peak_i / bound_i`` at the spec's ``t_c`` (> 1).
@@ -262,7 +276,7 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
     def passes(index: int) -> tuple[bool, float]:
         trial = replace(spec, prescribed_time=grid_value(index))
         try:
-            accepted, tried = candidates(trial, design_free, prover)
+            accepted, tried = candidates(trial, design_free, prove)
         except (DesignError, SpecError):
             return False, math.inf
         best = min((c.proof.ratio(spec.input_bound) for c in tried), default=math.inf)

@@ -22,7 +22,10 @@ whose stage the sampled cascade's certificate
 (:func:`stt_codegen.verify.cascade_sampled.check_cascade_sampled`, registered through
 :func:`register_cascade_certifier`: ``design`` cannot import ``verify``) accepts at the
 spec's rate, and :func:`second_stage_for` refuses the design when none is, naming the
-lowest certified rate (:func:`lowest_certified_rate`).
+lowest certified rate (:func:`lowest_certified_rate`). With ``[actuator] input_bound`` (the
+physical input: force or torque) a shape is kept only when the certificate's peak input is
+within the bound too; :func:`cascade_input_proof` gives the design that peak, so that it
+slows the tube or refuses as for law (13) (:mod:`.actuator`).
 """
 
 from __future__ import annotations
@@ -147,94 +150,103 @@ def derived_second_stage(design: TubeDesign, min_width: float, input_gain: tuple
                    "initial_velocity_error": z0.tolist()}
 
 
-def certified_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage | None, dict]:
+def certified_stage(tube: TubeDesign, spec, min_width: float,
+                    bound: tuple[float, ...] | None = None) -> tuple[SecondStage | None, dict]:
     """The first shape of :data:`SHAPES` whose second stage the sampled cascade's
-    certificate accepts for ``spec``'s declared plants at ``tube.rate_hz``, and, with
-    ``[actuator] input_bound``, whose certified peak ``|u_i|`` is within the bound.
+    certificate accepts for ``spec``'s declared plants at ``tube.rate_hz`` and, given a
+    ``bound``, whose certified peak input is within it.
 
     Parameters
     ----------
     tube : TubeDesign
-        The position tube at the rate judged (its own ``input_bound`` is not used: the
-        certificate proves the law before the actuator clamp, which then never acts).
+        The position tube at the rate judged.
     spec : Spec
-        With a second-order ``plant.model``; ``spec.input_bound``, when set, bounds the
-        physical input ``u``, input units.
+        With a second-order ``plant.model``.
     min_width : float
         ``gamma_d,min`` of ``tube``'s certificate.
+    bound : tuple of float, optional
+        ``[actuator] input_bound``, one per physical input (force or torque units): the
+        certificate's ``peak_input[i] <= bound[i]`` is required too. ``None``: the tubes
+        only.
 
     Returns
     -------
     stage : SecondStage or None
-        ``None`` when no shape is certified (within the bound).
+        ``None`` when no shape is accepted.
     derivation : dict
         The accepted stage's derivation with its ``certificate``; when none: the last
-        shape's, with the reports of every shape tried (``tried``) and, for the shapes
-        certified but above the bound, ``over_bound``: ``[{"shape", "peak_input",
-        "ratio"}]``.
+        shape's, with the reports of every shape tried (``tried``: ``shape``, ``passed``
+        (the tubes kept), ``reason``, ``peak_input``, ``peak_input_time``, ``horizon``).
     """
     order = spec.second_order
-    bound = spec.input_bound
-    free = dataclasses.replace(tube, input_bound=None)
     certify = cascade_certifier()
-    tried, over = [], []
+    # the certificate reads neither bound: one certificate per tube and stage, bound or not
+    tube, spec = dataclasses.replace(tube, input_bound=None), dataclasses.replace(
+        spec, input_bound=None)
+    tried = []
     for shape in SHAPES:
         stage, derivation = derived_second_stage(
-            free, min_width, order.input_gain, order.drift_bound + spec.disturbance_amplitude,
+            tube, min_width, order.input_gain, order.drift_bound + spec.disturbance_amplitude,
             order.initial_velocity, shape)
-        passed, report = certify(free, spec, stage)
-        peak = report.get("peak_input")
-        if passed and bound is not None and any(p > b for p, b in zip(peak, bound)):
-            ratio = max(p / b for p, b in zip(peak, bound))
-            over.append({"shape": list(shape), "peak_input": list(peak), "ratio": ratio})
-            tried.append({"shape": list(shape), "reason": (
-                f"certified, but |u| up to [{', '.join(f'{p:.4g}' for p in peak)}] exceeds "
-                f"actuator.input_bound = [{', '.join(f'{b:g}' for b in bound)}]")})
-            continue
-        if passed:
+        passed, report = certify(tube, spec, stage)
+        within = bound is None or all(p <= b for p, b in zip(report["peak_input"], bound))
+        if passed and within:
             return stage, {**derivation, "certificate": report}
-        tried.append({"shape": list(shape), "reason": report.get("reason", "")})
-    return None, {**derivation, "tried": tried, "over_bound": over}
+        reason = report.get("reason", "") if not passed else (
+            "the certified peak input " + ", ".join(f"{p:.4g}" for p in report["peak_input"])
+            + " exceeds the bound " + ", ".join(f"{b:g}" for b in bound))
+        tried.append({"shape": list(shape), "passed": passed, "reason": reason,
+                      "peak_input": list(report["peak_input"]),
+                      "peak_input_time": list(report.get("peak_input_time", [])),
+                      "horizon": report.get("horizon", 0.0)})
+    return None, {**derivation, "tried": tried}
 
 
 def cascade_input_proof(tube: TubeDesign, spec, min_width: float) -> InputProof:
-    """The certified peak of the cascade's physical input ``|u_i|`` on a tube: the proof
-    the actuator design (:mod:`.actuator`) asks of a second-order design.
+    """The certified peak of each physical input ``|u_i|`` of the cascade along ``tube``:
+    that of the second stage :func:`certified_stage` deploys under ``spec.input_bound``,
+    or, when no certified shape keeps the bound, of the certified shape with the lowest
+    peak-to-bound ratio (the design slows the tube or refuses from it,
+    :mod:`.actuator`).
 
     Parameters
     ----------
     tube : TubeDesign
-        The certified position tube.
+        The position tube.
     spec : Spec
-        With a second-order ``plant.model`` and ``[actuator] input_bound``.
+        With a second-order ``plant.model`` and ``input_bound``.
     min_width : float
         ``gamma_d,min`` of ``tube``'s certificate.
 
     Returns
     -------
     InputProof
-        For the stage :func:`certified_stage` keeps: its certified peaks (within the
-        bound); when every certified shape exceeds it, the peaks of the one nearest to it
-        (``meets`` is then false); not ``proved`` when no shape is certified at all.
+        ``peak``: the certificate's ``peak_input`` (force or torque units), a bound of
+        ``|u_k,i|`` at every sample of ``[0, 1.1 t_c]``, hence of the held input; not
+        proved when no shape is certified at ``tube.rate_hz`` (the first shape's reason).
     """
-    stage, derivation = certified_stage(tube, spec, min_width)
+    bound = spec.input_bound
+    stage, derivation = certified_stage(tube, spec, min_width, bound)
     if stage is not None:
         report = derivation["certificate"]
         return InputProof(True, tuple(report["peak_input"]), tuple(report["peak_input_time"]),
-                          report["horizon"], max_abs_e=report["max_abs_e1"])
-    if derivation["over_bound"]:
-        best = min(derivation["over_bound"], key=lambda o: o["ratio"])
-        return InputProof(True, tuple(best["peak_input"]),
-                          tuple(0.0 for _ in best["peak_input"]), 0.0)
-    n = tube.dimension
-    return InputProof(False, (math.inf,) * n, (0.0,) * n, 0.0,
-                      reason=derivation["tried"][0]["reason"])
+                          float(report["horizon"]), max_abs_e=float(report["max_abs_e2"]))
+    certified = [t for t in derivation["tried"] if t["passed"]]
+    if not certified:
+        n = tube.dimension
+        return InputProof(False, (math.inf,) * n, (0.0,) * n, 0.0,
+                          "the sampled cascade is not certified at controller.rate_hz = "
+                          f"{tube.rate_hz:g} Hz with any shape (the first: "
+                          f"{derivation['tried'][0]['reason']})")
+    best = min(certified, key=lambda t: max(p / b for p, b in zip(t["peak_input"], bound)))
+    return InputProof(True, tuple(best["peak_input"]), tuple(best["peak_input_time"]),
+                      float(best["horizon"]))
 
 
 def _rate_certified(tube: TubeDesign, spec, rate_hz: float) -> bool:
     """Whether some shape is certified at ``rate_hz`` (the tube certified again there)."""
     from .certificate import certify_tube
-    trial = dataclasses.replace(tube, rate_hz=rate_hz)
+    trial = dataclasses.replace(tube, rate_hz=rate_hz)     # the tubes kept, not the bound
     certificate = certify_tube(trial, spec)
     return bool(certificate.passed) and certified_stage(
         trial, spec, certificate.min_width)[0] is not None
@@ -284,8 +296,9 @@ def lowest_certified_rate(tube: TubeDesign, spec, passes_at_rate: bool) -> float
 
 def second_stage_for(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage, dict]:
     """The certified second stage of a tube whose spec has a second-order ``plant.model``
-    (:func:`certified_stage`, computed once per tube; :attr:`Design.second_stage
-    <stt_codegen.design.result.Design.second_stage>` is the way to ask for it).
+    (:func:`certified_stage`, within ``spec.input_bound`` when given; computed once per
+    tube; :attr:`Design.second_stage <stt_codegen.design.result.Design.second_stage>` is
+    the way to ask for it).
 
     Parameters
     ----------
@@ -308,7 +321,9 @@ def second_stage_for(tube: TubeDesign, spec, min_width: float) -> tuple[SecondSt
         The spec's ``plant.model`` is first order (field ``plant.model``).
     DesignError
         No shape is certified at the design's rate (kind ``SAMPLING_RATE``, naming the
-        rate that is).
+        rate that is); or, with ``[actuator]``, shapes are certified but none within
+        ``input_bound`` (kind ``INPUT_BOUND``; :func:`~stt_codegen.design_tube` slows the
+        tube or names the ``prescribed_time`` that works instead).
     """
     from ..errors import SpecError
     if spec.order != 2:
@@ -319,11 +334,23 @@ def second_stage_for(tube: TubeDesign, spec, min_width: float) -> tuple[SecondSt
 
 @functools.lru_cache(maxsize=16)
 def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage, dict]:
-    stage, derivation = certified_stage(tube, spec, min_width)
+    stage, derivation = certified_stage(tube, spec, min_width, spec.input_bound)
     if stage is not None:
         return stage, derivation
     from ..errors import DesignError
     from .failures import FailureKind
+    proof = (cascade_input_proof(tube, spec, min_width) if spec.input_bound is not None
+             else None)
+    if proof is not None and proof.proved:      # the tubes are kept, the bound is not
+        unit = f" {spec.input_unit}"
+        raise DesignError(
+            f"no second stage tried ({len(SHAPES)} shapes) keeps the cascade's input within "
+            "actuator.input_bound = [" + ", ".join(f"{b:g}{unit}" for b in spec.input_bound)
+            + "] on this tube: the certified stage with the lowest peak-to-bound ratio asks "
+            + ", ".join(f"|{name}| <= {p:.4g}{unit}"
+                        for name, p in zip(spec.input_names, proof.peak))
+            + "; design_tube slows the tube or names the prescribed_time that works "
+            "(docs/second-order.md, 'Force limits')", kind=FailureKind.INPUT_BOUND)
     rate = lowest_certified_rate(tube, spec, passes_at_rate=False)
     need = (f"controller.rate_hz = {rate:g} is certified" if rate is not None else
             f"no rate up to {tube.rate_hz * RATE_SEARCH_FACTOR:g} Hz is certified; a longer "

@@ -82,7 +82,9 @@ class Design:
         paired with another spec's name, obstacles or plant.
     input_proof : InputProof or None
         For a spec with ``[actuator]``: the proved peak of each input of law (13) along
-        the tube (:mod:`~stt_codegen.design.input_bound`), within ``input_bound``;
+        the tube (:mod:`~stt_codegen.design.input_bound`), within ``input_bound``; for a
+        second-order spec the sampled cascade's certified peak of each physical input
+        (force or torque, :func:`~stt_codegen.design.cascade_gain.cascade_input_proof`);
         ``None`` otherwise.
     task_choices : tuple of int
         For a spec with ``[[tasks]]``: per task, the index of the box the tube was

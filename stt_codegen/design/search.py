@@ -31,6 +31,7 @@ from ..tube.parameters import Circumvent, TubeDesign, paper_segments
 from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, certify_tube
 from .certificate.motion import certify_motion
 from .actuator import design_within_bound
+from .cascade_gain import cascade_input_proof
 from .failures import FailureKind, property_kind
 from .grid import grid_index, grid_value, smallest_passing
 from .moving import design_moving
@@ -264,7 +265,10 @@ def design_tube(spec: Spec) -> Design:
 
     With ``[actuator]`` (``spec.input_bound``), the tube is accepted only when law (13) is
     proved to stay within the bound along it, slowed where it must be, or refused
-    (:func:`~stt_codegen.design.actuator.design_within_bound`).
+    (:func:`~stt_codegen.design.actuator.design_within_bound`). For a second-order spec
+    the bound is on the physical input (force or torque) and the proof is the sampled
+    cascade's certificate: the tube is accepted only with a certified second stage whose
+    peak input is within the bound (docs/second-order.md, "Force limits").
 
     Raises
     ------
@@ -319,8 +323,29 @@ def _position_stage(spec: Spec) -> Design:
     if spec.input_bound is not None:      # [actuator]: design/actuator.py
         # the bound's proof orders the tubes there (default, softer circumvents, via
         # points): auto's estimate of the smoother tube plays no part
+        if spec.order == 2:
+            return _cascade_within_bound(spec)
         return design_within_bound(spec, lambda free: _design(free, smoother=False))
     return _design(spec, smoother=True)
+
+
+def _cascade_within_bound(spec: Spec) -> Design:
+    """The tube of a second-order spec with ``[actuator]``: the first-order procedure
+    (:func:`~stt_codegen.design.actuator.design_within_bound`) with the sampled cascade's
+    certified peak of the physical input as its proof
+    (:func:`~stt_codegen.design.cascade_gain.cascade_input_proof`)."""
+    free = replace(spec, input_bound=None)
+    default = _design(free, smoother=False)
+    # no second stage keeps the tubes at this rate, bound or not: the rate is what to
+    # change (DesignError of kind SAMPLING_RATE naming the rate that is certified)
+    default.second_stage
+
+    def design_free(variant: Spec) -> Design:
+        return default if variant == free else _design(variant, smoother=False)
+
+    return design_within_bound(spec, design_free, prove=lambda design, judged:
+                               cascade_input_proof(design.tube, judged,
+                                                   design.check.min_width))
 
 
 def _design(spec: Spec, smoother: bool) -> Design:

@@ -29,7 +29,8 @@ from ..errors import SpecError
 from .assumptions import Assumptions, combine_assumptions
 from .model_bounds import model_bounds
 from .motion import MovingObstacle, check_moving, is_moving, moving_obstacle
-from .plants import MODEL_KEYS, PLANTS, SECOND_ORDER_MODELS, dimension_mismatch, is_second_order
+from .plants import (MODEL_KEYS, PLANTS, SECOND_ORDER_MODELS, SECOND_ORDER_PLANTS,
+                     dimension_mismatch, is_second_order)
 from .tasks import Task, build_tasks
 from .second_order import SecondOrder, parse_second_order
 from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
@@ -241,9 +242,11 @@ class Spec:
         The plant bounds: the model's over the state space, with the ``[assumptions]``
         section (:func:`~.assumptions.combine_assumptions`).
     input_bound : tuple of float or None
-        ``[actuator] input_bound``: the largest ``|u_i|`` law (13) may ask of each input,
-        in input units, one per input of the plant model (``None``: no ``[actuator]``,
-        no limit).
+        ``[actuator] input_bound``: the largest ``|u_i|`` the controller may ask of each
+        input, in input units, one per input of the plant model (:attr:`input_names`):
+        law (13)'s ``u`` for a first-order model; for a second-order model the physical
+        input (force or torque, :attr:`input_unit`) of the cascade's second stage, not the
+        virtual velocity ``r``. ``None``: no ``[actuator]``, no limit.
     second_order : SecondOrder or None
         The second-order plant (``plant.model`` a second-order model, with
         ``plant.parameters``, ``initial.velocity``, ``state_space.velocity_bound`` and the
@@ -304,6 +307,23 @@ class Spec:
             tube of the positions ``x1``.
         """
         return 1 if self.second_order is None else 2
+
+    @property
+    def input_names(self) -> tuple[str, ...]:
+        """Names of the inputs ``u`` that ``[actuator] input_bound`` bounds, in its order:
+        the second-order model's physical inputs (``F1``, ``F2``, ..., the quadrotor's
+        thrust, the arm's torques) for order 2, else the first-order model's."""
+        if self.second_order is not None:
+            return SECOND_ORDER_PLANTS[self.second_order.model].input_names(self.dimension)
+        return PLANTS[self.plant_model].input_names(self.dimension)
+
+    @property
+    def input_unit(self) -> str:
+        """The SI unit of the inputs for a second-order model (``"N"``, ``"N m"``); ``""``
+        for a first-order model (its inputs are velocities, in state units per second)."""
+        if self.second_order is not None:
+            return SECOND_ORDER_PLANTS[self.second_order.model].input_unit
+        return ""
 
     @property
     def c_name(self) -> str:
@@ -565,7 +585,7 @@ def _validate(raw: dict) -> Spec:
                 assumptions=_assumptions(doc.assumptions if second_order is None
                                          else AssumptionsTable(), n, amplitude, model,
                                          state_space, linear),
-                input_bound=_input_bound(doc.actuator, model, n),
+                input_bound=_input_bound(doc.actuator, doc.plant.model, n),
                 second_order=second_order,
                 target_half_width_given=doc.target.half_width is not None,
                 tasks=build_tasks(doc.tasks or (), n, doc.prescribed_time,
@@ -682,16 +702,18 @@ def _assumptions(table: AssumptionsTable, n: int, amplitude: float, model: str,
 
 
 def _input_bound(table: ActuatorTable | None, model: str, n: int) -> tuple[float, ...] | None:
-    """``[actuator] input_bound``: one positive number per input of the plant model."""
+    """``[actuator] input_bound``: one positive number per input of ``plant.model`` (for a
+    second-order model its physical inputs, forces or torques, in the model's unit)."""
     if table is None:
         return None
-    plant = PLANTS[model]
+    plant = SECOND_ORDER_PLANTS[model] if is_second_order(model) else PLANTS[model]
     count = plant.input_count(n)
     names = plant.input_names(n)
+    unit = f" in {plant.input_unit}" if is_second_order(model) else ""
     if len(table.input_bound) != count:
         raise SpecError("actuator.input_bound",
                         f"must have {count} entries (one per input of the {model} plant: "
-                        f"{', '.join(names)}), got {len(table.input_bound)}")
+                        f"{', '.join(names)}{unit}), got {len(table.input_bound)}")
     return tuple(float(v) for v in table.input_bound)
 
 

@@ -92,6 +92,12 @@ class SecondOrderModel:
     diagonal_input : bool
         ``g`` is diagonal (``I / m``: an input moves its own velocity only), so the sampled
         cascade's certificate takes no coupling between axes.
+    inputs : tuple of str or None
+        Names of the physical inputs ``u`` (one per position), ``None`` for ``F1``,
+        ``F2``, ... (a force per axis).
+    input_unit : str
+        SI unit of every input (``"N"`` for a force, ``"N m"`` for a torque): the unit of
+        ``[actuator] input_bound``.
     """
 
     name: str
@@ -100,6 +106,17 @@ class SecondOrderModel:
     parameters: tuple[str, ...]
     nominal: tuple[float, ...]
     diagonal_input: bool = False
+    inputs: tuple[str, ...] | None = None
+    input_unit: str = "N"
+
+    def input_count(self, n: int) -> int:
+        """Number of physical inputs for ``n`` positions (one per position)."""
+        return n if self.inputs is None else len(self.inputs)
+
+    def input_names(self, n: int) -> tuple[str, ...]:
+        """Names of the physical inputs for ``n`` positions (``F1``, ``F2``, ... when the
+        model has none)."""
+        return tuple(f"F{i + 1}" for i in range(n)) if self.inputs is None else self.inputs
 
 
 #: Every second-order model, by ``plant.model`` name (dynamics:
@@ -109,12 +126,14 @@ SECOND_ORDER_PLANTS: dict[str, SecondOrderModel] = {m.name: m for m in (
                      ("mass",), (1.0,), diagonal_input=True),
     SecondOrderModel("quadrotor", "second order, x2_dot = u / mass - (drag / mass) x2 - "
                      "gravity e3 + w, thrust vector u, n = 3", 3, ("mass", "drag", "gravity"),
-                     (1.0, 0.3, 9.81), diagonal_input=True),
+                     (1.0, 0.3, 9.81), diagonal_input=True,
+                     inputs=("thrust_x", "thrust_y", "thrust_z")),
     SecondOrderModel("two-link-arm", "second order, joint space, M(q) q_ddot + C(q, q_dot) "
                      "q_dot + G(q) = u + w, n = 2", 2,
                      ("mass1", "mass2", "length1", "length2", "inertia1", "inertia2",
                       "gravity"),
-                     (1.0, 1.0, 1.0, 1.0, 1.0 / 12.0, 1.0 / 12.0, 0.0)),
+                     (1.0, 1.0, 1.0, 1.0, 1.0 / 12.0, 1.0 / 12.0, 0.0),
+                     inputs=("tau1", "tau2"), input_unit="N m"),
 )}
 #: The second-order ``plant.model`` values, in order.
 SECOND_ORDER_MODELS: tuple[str, ...] = tuple(SECOND_ORDER_PLANTS)

@@ -223,12 +223,14 @@ class AssumptionsTable(_Table):
 
 
 class ActuatorTable(_Table):
-    """The actuators' limits: law (13) must never ask an input for more than its bound."""
+    """The actuators' limits: the controller must never ask an input for more than its bound."""
 
     input_bound: Annotated[list[Positive], Field(min_length=1, max_length=MAX_DIMENSION)] = \
         Field(description="largest |u_i| each input may be asked for, in input units (for "
                           "the omnidirectional robot v1, v2 in m/s, omega in rad/s; for the "
-                          "other plants one per state, state units per second); positive; "
+                          "other first-order plants one per state, state units per second; "
+                          "for a second-order plant the physical input, one per position: "
+                          "a force in N, the two-link arm's torques in N m); positive; "
                           "one entry per input")
 
 

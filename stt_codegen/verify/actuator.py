@@ -18,7 +18,6 @@ from ..design.certificate import enclose_tube
 from ..design.input_bound import InputProof, input_peak
 from ..design.samples import TubeSamples
 from ..spec.loader import Spec
-from ..spec.plants import PLANTS
 from ..tube import reference
 from ..tube.parameters import TubeDesign
 from ..rounding import distinct
@@ -110,17 +109,14 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *,
 
 
 def input_bound_check(spec: Spec, proof: InputProof) -> Check:
-    """``sampled.input_bound`` (``cascade.input_bound`` for a second-order plant): every
-    input's proved peak within ``spec.input_bound``.
+    """``sampled.input_bound``: every input's proved peak within ``spec.input_bound``.
 
     Parameters
     ----------
     spec : Spec
         With ``input_bound``.
     proof : InputProof
-        :func:`prove_input_bound` of the design (first order), or
-        :func:`~stt_codegen.design.cascade_gain.cascade_input_proof` (the cascade's
-        physical input, from its sampled-data certificate).
+        :func:`prove_input_bound` of the design.
 
     Returns
     -------
@@ -129,24 +125,20 @@ def input_bound_check(spec: Spec, proof: InputProof) -> Check:
         ``(bound - peak) / bound``), ``horizon``.
     """
     bound = spec.input_bound
-    names = PLANTS[spec.plant_model].input_names(spec.dimension)
+    names = spec.input_names
     data = {"input_bound": list(bound), "peak": list(proof.peak), "time": list(proof.time),
             "margin": proof.margin(bound), "horizon": proof.horizon, "inputs": list(names)}
-    name, law, source = (
-        ("sampled.input_bound", "law (13)", "from the sampled check's bound on |e| at each "
-         "sample and the certified width there") if spec.order == 1 else
-        ("cascade.input_bound", "the cascade", "from the sampled cascade's certificate: the "
-         "enclosure of |e2| and rho2 on every interval"))
     if not proof.proved:
-        return Check(name, False, f"no bound on {law}'s input is proved: {proof.reason}",
-                     data)
+        return Check("sampled.input_bound", False,
+                     f"no bound on law (13)'s input is proved: {proof.reason}", data)
     each = ", ".join(f"|{name}| <= {distinct(p, b, 4)} (bound {b:g}, at t = {t:.3f} s)"
                      for name, p, b, t in zip(names, proof.peak, bound, proof.time))
     ok = proof.meets(bound)
-    detail = (f"{law} asks at most {each} at every sample on [0, {proof.horizon:.4g}] s, "
-              f"for every plant of [assumptions] ({source}): margin "
-              f"{proof.margin(bound):.3g} of the bound")
+    detail = (f"law (13) asks at most {each} at every sample on [0, {proof.horizon:.4g}] s, "
+              f"for every plant of [assumptions] (from the sampled check's bound on |e| at "
+              f"each sample and the certified width there): margin {proof.margin(bound):.3g} "
+              "of the bound")
     if not ok:
         over = [name for name, p, b in zip(names, proof.peak, bound) if p > b]
         detail += f"; beyond the bound in {', '.join(over)}"
-    return Check(name, ok, detail, data)
+    return Check("sampled.input_bound", ok, detail, data)

@@ -18,12 +18,13 @@ holds where the clamps are inactive (``rho2 >= GAMMA_D_MIN``, ``|e2| <= E_MAX``)
   ``|rho2_dot| <= l (rho2(0) - rho2_inf)``.
 
 ``cascade.sampled`` (:func:`sampled_cascade_check`) reports the sampled cascade's
-certificate (:mod:`.cascade_sampled`).
+certificate (:mod:`.cascade_sampled`), and, with ``[actuator]``, ``cascade.input_bound``
+(:func:`cascade_input_bound_check`) its certified peak of each physical input against the
+bound.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 
 import sympy as sp
@@ -34,9 +35,10 @@ from ..tube.parameters import E_MAX, GAMMA_D_MIN
 from .check import Check
 from .deployed import on_domain
 
-__all__ = ["cascade_checks", "check_jacobian", "check_lyapunov_derivative",
-           "check_pushes_back", "check_transform", "check_velocity_tube",
-           "plant_within_class_check", "sampled_cascade_check"]
+__all__ = ["cascade_checks", "cascade_input_bound_check", "check_jacobian",
+           "check_lyapunov_derivative", "check_pushes_back", "check_transform",
+           "check_velocity_tube", "judged_stage", "plant_within_class_check",
+           "sampled_cascade_check"]
 
 _CLAMPS = {sp.Rational(GAMMA_D_MIN): 1, sp.Rational(E_MAX): -1, -sp.Rational(E_MAX): 1}
 
@@ -228,9 +230,7 @@ def sampled_cascade_check(spec, tube, min_width: float) -> Check:
     spec : Spec
         With a second-order ``plant.model``.
     tube : TubeDesign
-        The position tube; the second stage is the one the design deploys
-        (:func:`~stt_codegen.design.cascade_gain.certified_stage`), or, when none is
-        certified, the first shape's (to report its figures).
+        The position tube; the second stage is :func:`judged_stage`'s.
     min_width : float
         ``gamma_d,min`` of the tube's certificate.
 
@@ -239,17 +239,9 @@ def sampled_cascade_check(spec, tube, min_width: float) -> Check:
     Check
         PASS when the certificate holds at the spec's rate; FAIL with its figures otherwise.
     """
-    from ..design.cascade_gain import certified_stage, lowest_certified_rate
+    from ..design.cascade_gain import lowest_certified_rate
     from .cascade_sampled import cascade_check_of
-    # the certificate is of the law before the actuator clamp (which it proves never acts)
-    tube = dataclasses.replace(tube, input_bound=None)
-    stage, derivation = certified_stage(tube, spec, min_width)
-    if stage is None:
-        from ..design.cascade_gain import derived_second_stage
-        order = spec.second_order
-        stage, derivation = derived_second_stage(
-            tube, min_width, order.input_gain,
-            order.drift_bound + spec.disturbance_amplitude, order.initial_velocity)
+    stage, derivation = judged_stage(spec, tube, min_width)
     result = cascade_check_of(tube, spec, stage)
     rate = lowest_certified_rate(tube, spec, passes_at_rate=result.passed)
     lowest = (f"lowest certified rate {rate:g} Hz (on the two-digit grid, a second stage "
@@ -275,6 +267,92 @@ def sampled_cascade_check(spec, tube, min_width: float) -> Check:
             "time": result.time, "dimension": result.dimension, "lowest_rate_hz": rate,
             "gains": derivation}
     return Check("cascade.sampled", result.passed, detail, data)
+
+
+def judged_stage(spec, tube, min_width: float) -> tuple:
+    """The second stage ``verify`` judges: the one the design deploys
+    (:func:`~stt_codegen.design.cascade_gain.certified_stage` within ``spec.input_bound``);
+    when no certified shape keeps the bound, the first certified one (its peak input is
+    then reported beyond the bound); when none is certified, the first shape's (to report
+    its figures).
+
+    Parameters
+    ----------
+    spec : Spec
+        With a second-order ``plant.model``.
+    tube : TubeDesign
+        The position tube.
+    min_width : float
+        ``gamma_d,min`` of the tube's certificate.
+
+    Returns
+    -------
+    stage : SecondStage
+    derivation : dict
+        As :func:`~stt_codegen.design.cascade_gain.derived_second_stage`.
+    """
+    from ..design.cascade_gain import certified_stage, derived_second_stage
+    for bound in ((spec.input_bound, None) if spec.input_bound is not None else (None,)):
+        stage, derivation = certified_stage(tube, spec, min_width, bound)
+        if stage is not None:
+            return stage, derivation
+    order = spec.second_order
+    return derived_second_stage(tube, min_width, order.input_gain,
+                                order.drift_bound + spec.disturbance_amplitude,
+                                order.initial_velocity)
+
+
+def cascade_input_bound_check(spec, tube, min_width: float) -> Check:
+    """``cascade.input_bound``: the sampled cascade's certified peak of every physical
+    input ``|u_i|`` (force or torque) within ``[actuator] input_bound``.
+
+    The certificate (:mod:`.cascade_sampled`) bounds ``|u_k,i| <= (2 k2 / rho2(t_k))
+    phi(E2_k,i)`` at every sample for every plant of the class; the deployed input is held
+    between samples, so the bound holds at every instant of ``[0, 1.1 t_c]``
+    (docs/second-order.md, "Force limits").
+
+    Parameters
+    ----------
+    spec : Spec
+        With a second-order ``plant.model`` and ``input_bound``.
+    tube : TubeDesign
+        The position tube; the second stage is :func:`judged_stage`'s.
+    min_width : float
+        ``gamma_d,min`` of the tube's certificate.
+
+    Returns
+    -------
+    Check
+        PASS when the certificate holds and every peak is within its bound. Data:
+        ``input_bound``, ``peak``, ``time`` (per input), ``margin`` (the smallest
+        ``(bound - peak) / bound``), ``inputs``, ``unit``, ``horizon``.
+    """
+    from ..rounding import distinct
+    from .cascade_sampled import cascade_check_of
+    bound, names, unit = spec.input_bound, spec.input_names, spec.input_unit
+    stage, _ = judged_stage(spec, tube, min_width)
+    result = cascade_check_of(tube, spec, stage)
+    margin = min((b - p) / b for p, b in zip(result.peak_input, bound))
+    data = {"input_bound": list(bound), "peak": list(result.peak_input),
+            "time": list(result.peak_input_time), "margin": margin if result.passed else
+            -float("inf"), "inputs": list(names), "unit": unit,
+            "horizon": result.data.get("horizon", 0.0)}
+    if not result.passed:
+        return Check("cascade.input_bound", False, "no bound on the cascade's input is "
+                     f"proved: the sampled cascade is not certified ({result.reason})", data)
+    each = ", ".join(f"|{name}| <= {distinct(p, b, 4)} {unit} (bound {b:g} {unit}, at t = "
+                     f"{t:.3f} s)" for name, p, b, t in zip(names, result.peak_input, bound,
+                                                            result.peak_input_time))
+    ok = all(p <= b for p, b in zip(result.peak_input, bound))
+    detail = (f"the cascade asks at most {each} at every sample on [0, "
+              f"{data['horizon']:.4g}] s, held between samples, for every plant of the "
+              f"certified class (k2 = {stage.velocity_gain:.4g}): margin {margin:.3g} of the "
+              "bound")
+    if not ok:
+        over = [name for name, p, b in zip(names, result.peak_input, bound) if p > b]
+        detail += (f"; beyond the bound in {', '.join(over)} (no certified second stage "
+                   "keeps it on this tube: a longer prescribed_time may)")
+    return Check("cascade.input_bound", ok, detail, data)
 
 
 def plant_within_class_check(spec) -> Check:

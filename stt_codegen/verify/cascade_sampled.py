@@ -141,7 +141,10 @@ class CascadeCheck:
     max_abs_e1, max_abs_e2 : float
         The proved bounds of ``|e1|``, ``|e2|`` at the samples.
     peak_input : tuple of float
-        Per axis, the proved bound of ``|u_k,i|`` over the samples (input units).
+        Per axis, the proved bound of ``|u_k,i|`` over the samples (input units), hence of
+        the held input at every instant of the horizon.
+    peak_input_time : tuple of float
+        Per axis, the sample instant where that bound is reached, seconds.
     peak_velocity : tuple of float
         Per axis, the proved bound of ``|x2_i|`` on the intervals.
     time : float
@@ -163,6 +166,7 @@ class CascadeCheck:
     time: float
     dimension: int
     data: dict = field(default_factory=dict)
+    peak_input_time: tuple[float, ...] = ()
 
 
 def virtual_velocity_change(k1: float, h: float, e1_start: float, e1_path: float,
@@ -290,7 +294,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     data = {"rate_hz": design.rate_hz, "position_gain": k1, "velocity_gain": k2,
             "width_start": list(stage.width_start), "width_floor": list(stage.width_floor),
             "decay": stage.decay, "class": plants.words()}
-    peak_u, peak_x2, peak_u_time = [0.0] * n, [0.0] * n, [0.0] * n
+    peak_u, peak_x2, peak_t = [0.0] * n, [0.0] * n, [0.0] * n
     worst = {"position": math.inf, "velocity": math.inf, "least": math.inf, "t": 0.0,
              "i": 0}
     top = [0.0, 0.0]
@@ -299,11 +303,10 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
         pm, vm = worst["position"], worst["velocity"]
         data.update({"position_margin": pm, "velocity_margin": vm, "max_abs_e1": top[0],
                      "max_abs_e2": top[1], "peak_input": list(peak_u),
-                     "peak_input_time": list(peak_u_time),
-                     "peak_velocity": list(peak_x2)})
+                     "peak_input_time": list(peak_t), "peak_velocity": list(peak_x2)})
         return CascadeCheck(passed, reason, pm, vm, top[0], top[1], tuple(peak_u),
                             tuple(peak_x2), worst["t"] if passed else t,
-                            worst["i"] if passed else i, data)
+                            worst["i"] if passed else i, data, tuple(peak_t))
 
     if not 0.0 < g_min <= g_max or h * f1 >= 1.0:
         return result(False, "need 0 < g_min <= g_max and h F1 < 1")
@@ -351,7 +354,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
         next1, next2 = [], []
         for i in range(n):
             if u_abs[i] > peak_u[i]:
-                peak_u[i], peak_u_time[i] = u_abs[i], t
+                peak_u[i], peak_t[i] = u_abs[i], t
             others = math.sqrt(max(u_sq - u_abs[i] ** 2, 0.0))
             z_abs = reach2[i] * rho_k[i]
             r_abs = 4.0 * k1 / (2.0 * half_l[k][i]) * phi_scalar(reach1[i])

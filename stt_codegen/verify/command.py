@@ -123,7 +123,8 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         a second-order ``plant.model``, the cascade's lemmas (:func:`~stt_codegen.verify.cascade.cascade_checks`),
         and the sampled cascade's certificate ``cascade.sampled``
         (:func:`~stt_codegen.verify.cascade.sampled_cascade_check`) instead of the last
-        two.
+        two, with ``[actuator]`` followed by ``cascade.input_bound``
+        (:func:`~stt_codegen.verify.cascade.cascade_input_bound_check`).
     """
     stage = progress if isinstance(progress, _Stages) else _Stages(progress, design=False)
     if plant is not None:
@@ -208,15 +209,14 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     if spec.order == 2:
         # the deployed controller is the cascade, not law (13) on this plant: its lemmas
         # and its sampled-data certificate (docs/second-order.md)
-        from .cascade import cascade_checks, plant_within_class_check, sampled_cascade_check
+        from .cascade import (cascade_checks, cascade_input_bound_check,
+                              plant_within_class_check, sampled_cascade_check)
         stage("sampled loop")          # the cascade takes the sampled loop's slot
         checks += cascade_checks(min(n, 2)) + [
             plant_within_class_check(spec),
             sampled_cascade_check(spec, design, tube_check.min_width)]
-        if spec.input_bound is not None:     # on the physical input u
-            from ..design.cascade_gain import cascade_input_proof
-            checks.append(input_bound_check(
-                spec, cascade_input_proof(design, spec, tube_check.min_width)))
+        if spec.input_bound is not None:     # the physical input u: force or torque
+            checks.append(cascade_input_bound_check(spec, design, tube_check.min_width))
         return checks
     stage("sampled loop")
     with reference.numpy_math():
