@@ -182,3 +182,34 @@ def test_plots_draw_the_real_obstacles_and_their_margins(design):
             pytest.approx(0.4 + RADIUS)
         assert ax.get_xlim()[0] < 0.0 < RADIUS      # the real state space is in view
         assert math.isclose(ax.get_xlim()[1], 5.1)
+
+
+def test_moving_obstacles_are_drawn_as_given_and_inflated():
+    moving = ROBOT_SPEC.replace("lower = [2.0, 2.0]\nupper = [3.0, 3.0]",
+                                "lower = [2.0, 2.0]\nupper = [3.0, 3.0]\nactive = [5.0, 6.0]")
+    spec = parse_spec(moving)
+    assert spec.moving_obstacles[0].half_size == (0.5 + RADIUS, 0.5 + RADIUS)
+    assert spec.robot.moving_obstacles[0].half_size == (0.5, 0.5)
+    from matplotlib.figure import Figure
+    ax = Figure().subplots()
+    plots.draw_arena(ax, spec, (0, 1))
+    given = [p for p in ax.patches if p.get_gid() == "moving obstacle 0 as given"]
+    inflated = [p for p in ax.patches if p.get_gid() == "moving obstacle 0"]
+    assert given and len(given) == len(inflated)
+    assert given[0].get_width() == pytest.approx(1.0)
+    assert inflated[0].get_width() == pytest.approx(1.0 + 2 * RADIUS)
+
+
+def test_a_polytope_is_inflated_by_the_cube():
+    triangle = ROBOT_SPEC.replace("center = [1.0, 3.5]\nradius = 0.4",
+                                  "vertices = [[0.8, 3.2], [1.4, 3.2], [1.0, 3.8]]")
+    spec = parse_spec(triangle)
+    inflated = spec.unsafe_sets[1].shape
+    real = spec.robot.unsafe_sets[1].shape
+    # every point within the radius of the real triangle is in the inflated one
+    angles = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+    for v in np.array(real.vertices):
+        ring = v + 0.999 * RADIUS * np.c_[np.cos(angles), np.sin(angles)]
+        assert np.all(inflated.signed_clearance(ring) <= 0)
+    assert inflated.lower == pytest.approx((0.8 - RADIUS, 3.2 - RADIUS))
+    assert real.lower == (0.8, 3.2)
