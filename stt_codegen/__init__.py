@@ -17,6 +17,8 @@ Spatiotemporal Tubes Approach". The front door, in the order of the flow (see
   design (or of a spec, designed first), as a :class:`VerificationReport`
   (:func:`stt_codegen.verify.command.verify`);
 * :func:`plot_design`, :func:`plot_run` - figures of a design, and of a run;
+* :func:`import_pointmaze` - the spec of a maze of gymnasium-robotics' PointMaze (the
+  ``mujoco`` extra);
 * the errors, in three kinds: :class:`SpecError` (bad input), :class:`DesignError` (no
   design, a negative outcome), :class:`ToolchainError` (a tool or an internal step
   failed); all are :class:`SttError`.
@@ -67,6 +69,7 @@ _LAZY: dict[str, str] = {
     "plot_run": "stt_codegen.runtime.plots",
     "VerificationReport": "stt_codegen.verify.check",
     "verify": "stt_codegen.verify.command",
+    "import_pointmaze": "stt_codegen.pointmaze",
 }
 
 __all__ = ["DesignError", "SpecError", "SttError", "ToolchainError", "__version__",
@@ -79,6 +82,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .runtime.plots import plot_design, plot_run
     from .runtime.simulate import SimulationResult, simulate
     from .cases import bundled_cases
+    from .pointmaze import import_pointmaze
     from .spec.loader import Spec, load_spec
     from .tube.parameters import TubeDesign
     from .verify.check import VerificationReport

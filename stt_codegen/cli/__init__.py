@@ -60,6 +60,8 @@ COMMANDS: dict[str, tuple[str, str]] = {
                "stt_codegen.cli.design:configure_design"),
     "schema": ("print the JSON Schema of spec files (for editors and tools)",
                "stt_codegen.cli.schema:configure_schema"),
+    "import": ("write a spec from another tool's task (gymnasium-robotics' PointMaze)",
+               "stt_codegen.cli.import_spec:configure_import"),
 }
 
 #: Error kind -> exit code; the first matching row wins.

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
+from ..spec.robot import robot_json
 from ..tube.parameters import TubeDesign
 from ..tube.second_stage import SecondStage
 from .cascade_gain import second_stage_for
@@ -159,7 +160,9 @@ class Design:
             motion, active interval, certified margin; docs/moving-obstacles.md); for a
             spec with a second-order ``plant.model`` also ``cascade`` (``gains``: the
             certified second stage's derivation and its sampled-data certificate,
-            :func:`~stt_codegen.design.cascade_gain.second_stage_of`).
+            :func:`~stt_codegen.design.cascade_gain.second_stage_of`); for a spec with
+            ``[robot]`` also ``robot`` (the radius, the state space as given and shrunk,
+            the inflated obstacle boxes: :func:`~stt_codegen.spec.robot.robot_json`).
         """
         tube = self.tube
         via = []
@@ -195,6 +198,7 @@ class Design:
             **self._tasks_json(),
             **self._motion_json(),
             **self._cascade_json(),
+            **robot_json(self.spec),
         }
 
     def _tasks_json(self) -> dict[str, Any]:

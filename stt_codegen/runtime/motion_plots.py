@@ -45,7 +45,9 @@ def _colour(t: float, prescribed_time: float):
 def draw_moving_obstacles(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
     """Draw each moving obstacle of ``spec`` at its :func:`slice_times`, projected on ``dims``.
 
-    Patches have the gid ``"moving obstacle j"``; labels ``"j @ t s"``.
+    Patches have the gid ``"moving obstacle j"``; labels ``"j @ t s"``. With ``[robot]``
+    these are the inflated boxes, and the boxes as given are drawn inside them, filled (gid
+    ``"moving obstacle j as given"``).
 
     Parameters
     ----------
@@ -58,24 +60,34 @@ def draw_moving_obstacles(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
         in spans the state space.
     """
     t_c = spec.prescribed_time
+    real = () if spec.robot is None else spec.robot.moving_obstacles
+
+    def corners(ob: MovingObstacle, t: float) -> tuple[list[float], list[float]]:
+        centre = ob.centre([t])[0]
+        lower, upper = [], []
+        for d in dims:
+            if d in ob.dims:
+                k = ob.dims.index(d)
+                lower.append(centre[k] - ob.half_size[k])
+                upper.append(centre[k] + ob.half_size[k])
+            else:
+                lower.append(spec.state_space.lower[d])
+                upper.append(spec.state_space.upper[d])
+        return lower, upper
     for m, ob in enumerate(spec.moving_obstacles):
         for q, t in enumerate(slice_times(ob, t_c)):
-            centre = ob.centre([t])[0]
-            lower, upper = [], []
-            for d in dims:
-                if d in ob.dims:
-                    k = ob.dims.index(d)
-                    lower.append(centre[k] - ob.half_size[k])
-                    upper.append(centre[k] + ob.half_size[k])
-                else:
-                    lower.append(spec.state_space.lower[d])
-                    upper.append(spec.state_space.upper[d])
+            lower, upper = corners(ob, t)
             colour = _colour(t, t_c)
             ax.add_patch(Rectangle((lower[0], lower[1]), upper[0] - lower[0], upper[1] - lower[1],
                                    fill=False, ec=colour, lw=1.2, hatch="//",
                                    gid=f"moving obstacle {ob.source}",
                                    label=("moving obstacle (at the times shown)"
                                           if m == 0 and q == 0 else None)))
+            if real:        # [robot]: the box above is inflated; the real one inside it
+                lo, hi = corners(real[m], t)
+                ax.add_patch(Rectangle((lo[0], lo[1]), hi[0] - lo[0], hi[1] - lo[1],
+                                       fc=colour, alpha=0.5, ec=colour,
+                                       gid=f"moving obstacle {ob.source} as given"))
             ax.annotate(f"{ob.source} @ {t:.3g} s", ((lower[0] + upper[0]) / 2,
                                                       (lower[1] + upper[1]) / 2),
                         ha="center", va="center", fontsize=6, color="black",

@@ -65,6 +65,10 @@ OBSTACLE_STYLE: dict[str, Any] = {"fc": "0.55", "ec": "0.3", "alpha": 0.8}
 BELOW_AXIS_POINTS = 40.0
 #: Legend entry of the obstacles.
 OBSTACLE_LABEL = "obstacle j (obstacles[j] of the spec)"
+#: An obstacle inflated by the robot's radius (``[robot]``): the set the reference point
+#: avoids, drawn under the real obstacle.
+MARGIN_STYLE: dict[str, Any] = {"fc": "none", "ec": "0.45", "hatch": "////", "lw": 0.6}
+MARGIN_LABEL = "obstacle inflated by the robot's radius"
 
 
 def agg_figure(**kwargs) -> Figure:
@@ -217,12 +221,21 @@ def draw_unsafe_sets(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
     Each ``[[obstacles]]`` entry ``j`` is one patch (:func:`obstacle_projection`) labelled
     ``j``; entries whose projections share a label point get one label (``"0, 2"``).
     Balls and polytopes also get their covering boxes (dashed), the boxes the design
-    avoids.
+    avoids. With ``[robot]`` the entries are drawn as given, over their inflated sets
+    (hatched, the margin the reference point keeps).
     """
     anchors: dict[tuple[float, float], list[int]] = {}
-    for k, unsafe in enumerate(spec.unsafe_sets):
+    real, space = spec.unsafe_sets, spec.state_space
+    if spec.robot is not None:      # the inflated sets hatched, the real ones over them
+        real, space = spec.robot.unsafe_sets, spec.robot.state_space
+        for k, unsafe in enumerate(spec.unsafe_sets):
+            patch, _ = obstacle_projection(unsafe, spec.state_space, dims, **MARGIN_STYLE,
+                                           label=MARGIN_LABEL if k == 0 else None,
+                                           gid="robot margin")
+            ax.add_patch(patch)
+    for k, unsafe in enumerate(real):
         j = k if unsafe.source is None else unsafe.source
-        patch, anchor = obstacle_projection(unsafe, spec.state_space, dims, **OBSTACLE_STYLE,
+        patch, anchor = obstacle_projection(unsafe, space, dims, **OBSTACLE_STYLE,
                                             label=OBSTACLE_LABEL if k == 0 else None,
                                             gid=f"obstacle {j}")
         ax.add_patch(patch)
@@ -260,7 +273,11 @@ def draw_arena(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
     dims : tuple of int, length 2
         The state dimensions of the axes, zero-based.
     """
-    draw_box(ax, spec.state_space, dims, fill=False, lw=1.5, ec="black")
+    space = spec.state_space if spec.robot is None else spec.robot.state_space
+    draw_box(ax, space, dims, fill=False, lw=1.5, ec="black")
+    if spec.robot is not None:
+        draw_box(ax, spec.state_space, dims, fill=False, lw=0.8, ec="0.4", ls=":",
+                 label=f"state space shrunk by the robot's radius {spec.robot.radius:g}")
     draw_unsafe_sets(ax, spec, dims)
     draw_moving_obstacles(ax, spec, dims)      # time slices (motion_plots.py); none: nothing
     draw_box(ax, spec.target_set, dims, fc="tab:green", alpha=0.35, label="target")
@@ -268,9 +285,9 @@ def draw_arena(ax: Axes, spec: Spec, dims: tuple[int, int]) -> None:
     i, j = dims
     ax.set_xlabel(_state_label(i))
     ax.set_ylabel(_state_label(j))
-    pad = [0.02 * (spec.state_space.upper[d] - spec.state_space.lower[d]) for d in dims]
-    ax.set_xlim(spec.state_space.lower[i] - pad[0], spec.state_space.upper[i] + pad[0])
-    ax.set_ylim(spec.state_space.lower[j] - pad[1], spec.state_space.upper[j] + pad[1])
+    pad = [0.02 * (space.upper[d] - space.lower[d]) for d in dims]
+    ax.set_xlim(space.lower[i] - pad[0], space.upper[i] + pad[0])
+    ax.set_ylim(space.lower[j] - pad[1], space.upper[j] + pad[1])
     ax.set_aspect("equal" if _equal_aspect(spec, dims) else "auto")
 
 

@@ -31,6 +31,8 @@ from .model_bounds import model_bounds
 from .motion import MovingObstacle, check_moving, is_moving, moving_obstacle
 from .plants import (MODEL_KEYS, PLANTS, SECOND_ORDER_MODELS, SECOND_ORDER_PLANTS,
                      dimension_mismatch, is_second_order)
+from .robot import (Robot, inflate_ball, inflate_bounds, inflate_moving, inflate_polytope,
+                    robot_dims, shrink_bounds)
 from .tasks import Task, build_tasks
 from .second_order import SecondOrder, parse_second_order
 from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
@@ -262,6 +264,11 @@ class Spec:
     moving_obstacles : tuple of MovingObstacle
         The ``[[obstacles]]`` boxes with ``active``, ``velocity`` or ``path``
         (:mod:`~.motion`); they are in neither :attr:`obstacles` nor :attr:`unsafe_sets`.
+    robot : Robot or None
+        ``[robot]``: the robot's size and the sets as given (:mod:`~.robot`). With it,
+        :attr:`state_space` is the given one shrunk by the radius and :attr:`obstacles`,
+        :attr:`unsafe_sets`, :attr:`moving_obstacles` are the given ones inflated by it:
+        the sets of the reference point the tube steers. ``None``: a point robot.
     """
 
     name: str
@@ -288,6 +295,7 @@ class Spec:
     target_half_width_given: bool = True
     tasks: tuple[Task, ...] = ()
     moving_obstacles: tuple[MovingObstacle, ...] = ()
+    robot: Robot | None = None
 
     @property
     def dimension(self) -> int:
@@ -560,10 +568,16 @@ def _validate(raw: dict) -> Spec:
 
     unsafe_sets = tuple(_unsafe_set(table, f"obstacles[{j}]", state_space, j)
                         for j, table in enumerate(doc.obstacles) if not is_moving(table))
-    obstacles = _cover_all(unsafe_sets, state_space, initial_set, target_set)
     moving = tuple(_moving(table, f"obstacles[{j}]", j, state_space, initial_set, target_set,
                            doc.prescribed_time)
                    for j, table in enumerate(doc.obstacles) if is_moving(table))
+    robot = _robot(doc, state_space, initial_set, target_set, unsafe_sets, moving)
+    if robot is not None:        # the problem of the reference point: sets inflated, X shrunk
+        state_space, unsafe_sets, moving = _robot_problem(robot, state_space, initial_set,
+                                                          target_set, doc.prescribed_time)
+    obstacles = _cover_all(unsafe_sets, state_space, initial_set, target_set)
+    if robot is not None:
+        obstacles = _clipped(obstacles, state_space)
 
     model = doc.plant.model
     mismatch = dimension_mismatch(model, n)
@@ -593,7 +607,7 @@ def _validate(raw: dict) -> Spec:
                                   [(b.lower, b.upper, o.source) for o, b in
                                    zip(obstacles, (o.box(state_space) for o in obstacles))],
                                   doc.tube.method, doc.actuator is not None),
-                moving_obstacles=moving)
+                moving_obstacles=moving, robot=robot)
 
 
 def _vector(value: list[float], name: str, length: int | None) -> tuple[float, ...]:
@@ -805,3 +819,83 @@ def _cover_all(unsafe_sets: tuple[UnsafeSet, ...], state_space: Box, initial_set
             obstacles.append(Obstacle(tuple(float(v) for v in lo), tuple(float(v) for v in hi),
                                       unsafe.dims, j))
     return tuple(obstacles)
+
+
+# --------------------------------------------------------------------------- [robot]
+
+
+def _robot(doc: Any, state_space: Box, initial_set: Box, target_set: Box,
+           unsafe_sets: tuple[UnsafeSet, ...], moving: tuple[MovingObstacle, ...]
+           ) -> Robot | None:
+    """``[robot]`` and the sets as given, or ``None`` without the table."""
+    if doc.robot is None:
+        return None
+    dims = robot_dims(doc.robot.dims, len(state_space.lower))
+    return Robot(float(doc.robot.radius), dims, state_space, unsafe_sets, moving)
+
+
+def _no_fit(robot: Robot, label: str, why: str) -> SpecError:
+    return SpecError("robot.radius", f"the robot (radius {robot.radius!r}) no longer fits in "
+                                     f"the {label}: {why}")
+
+
+def _robot_problem(robot: Robot, state_space: Box, initial_set: Box, target_set: Box,
+                   prescribed_time: float
+                   ) -> tuple[Box, tuple[UnsafeSet, ...], tuple[MovingObstacle, ...]]:
+    """The state space shrunk and the obstacles inflated by the robot's radius
+    (:mod:`.robot`), checked against the initial and target sets of the reference point."""
+    import numpy as np
+
+    r, dims = robot.radius, robot.dims
+    shrunk = Box(*shrink_bounds(state_space.lower, state_space.upper, dims, r))
+    for label, box in (("initial set", initial_set), ("target set", target_set)):
+        if not shrunk.contains_box(box):
+            raise _no_fit(robot, label, f"the {label} comes within the radius of the state "
+                                        "space's boundary (it must lie inside the state space "
+                                        "shrunk by the radius)")
+    inflated = []
+    for k, unsafe in enumerate(robot.unsafe_sets):
+        j = k if unsafe.source is None else unsafe.source
+        if unsafe.kind == "box":
+            lo, hi = inflate_bounds(unsafe.shape.lower, unsafe.shape.upper, unsafe.dims, dims, r)
+            grown = replace(unsafe, shape=Box(lo, hi))
+        elif unsafe.kind == "ball":
+            grown = replace(unsafe, shape=inflate_ball(unsafe.shape, unsafe.dims, dims, r))
+        else:
+            from .shapes import make_polytope
+            grown = replace(unsafe, shape=make_polytope(inflate_polytope(
+                unsafe.shape.vertices, unsafe.dims, dims, r), f"obstacles[{j}]"))
+        for label, box in (("initial set", initial_set), ("target set", target_set)):
+            if unsafe.kind == "box":
+                meets = _embed(grown.shape.lower, grown.shape.upper, grown.dims,
+                               shrunk).meets(box)
+            else:
+                meets = grown.shape.meets_box(np.array(box.lower)[list(grown.dims)],
+                                              np.array(box.upper)[list(grown.dims)])
+            if meets:
+                raise _no_fit(robot, label, f"obstacles[{j}] inflated by the radius meets it")
+        inflated.append(grown)
+    moving = []
+    for obstacle in robot.moving_obstacles:
+        grown = inflate_moving(obstacle, dims, r)
+        try:
+            check_moving(grown, f"obstacles[{obstacle.source}]", initial_set, target_set,
+                         prescribed_time)
+        except SpecError as exc:
+            label = "initial set" if "initial" in exc.reason else "target set"
+            raise _no_fit(robot, label, f"{exc.field} inflated by the radius {exc.reason}"
+                          ) from None
+        moving.append(grown)
+    return shrunk, tuple(inflated), tuple(moving)
+
+
+def _clipped(obstacles: tuple[Obstacle, ...], state_space: Box) -> tuple[Obstacle, ...]:
+    """The obstacle boxes cut to the (shrunk) state space, those outside it dropped: the
+    reference point never leaves it, so the parts beyond cannot meet the tube."""
+    kept = []
+    for o in obstacles:
+        lo = tuple(max(a, state_space.lower[d]) for a, d in zip(o.lower, o.dims))
+        hi = tuple(min(b, state_space.upper[d]) for b, d in zip(o.upper, o.dims))
+        if all(a < b for a, b in zip(lo, hi)):
+            kept.append(replace(o, lower=lo, upper=hi))
+    return tuple(kept)

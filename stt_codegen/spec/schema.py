@@ -26,8 +26,8 @@ from ..errors import SpecError
 from .plants import ALL_PLANT_MODELS, PLANTS, SECOND_ORDER_PLANTS
 
 __all__ = ["ActuatorTable", "AssumptionsTable", "BallObstacle", "BoxObstacle", "BoxTable",
-           "NAME_REGEX", "PlantTable", "PolytopeObstacle", "check_document", "json_schema",
-           "value_kind"]
+           "NAME_REGEX", "PlantTable", "PolytopeObstacle", "RobotTable", "check_document",
+           "json_schema", "value_kind"]
 
 #: Largest magnitude of any number in a spec.
 MAX_MAGNITUDE = 1e12
@@ -234,6 +234,17 @@ class ActuatorTable(_Table):
                           "one entry per input")
 
 
+class RobotTable(_Table):
+    """The robot's size: the body lies within ``radius`` of the reference point the tube
+    steers (docs/spec-format.md, ``[robot]``)."""
+
+    radius: NonNegative = Field(description="the body's radius around the reference point, "
+                                            "state units of dims (metres); obstacles are "
+                                            "inflated and the state space shrunk by it")
+    dims: Annotated[list[Index], Field(min_length=1, max_length=MAX_DIMENSION)] = _omitted(
+        "state dimensions the body extends in; default the first two (the planar position)")
+
+
 class TaskBoxTable(_Table):
     """One box of a reach task's ``any_of``."""
 
@@ -281,6 +292,7 @@ class SpecDocument(_Table):
     assumptions: AssumptionsTable = AssumptionsTable()
     actuator: ActuatorTable = _omitted("actuator limits; omitted: no limit (the design, the "
                                        "generated code and verify ignore actuators)")
+    robot: RobotTable = _omitted("the robot's size; omitted: the robot is a point")
     tasks: Annotated[list[TaskTable], Field(max_length=MAX_TASKS)] = _omitted(
         "timed reach and stay tasks besides the target (docs/tasks.md), in window order; "
         "omitted: none")
@@ -305,7 +317,7 @@ def json_schema() -> dict[str, Any]:
 _TABLES: dict[str, type[_Table]] = {
     "state_space": StateSpaceTable, "initial": InitialTable, "target": TargetTable,
     "tube": TubeTable, "controller": ControllerTable, "plant": PlantTable,
-    "assumptions": AssumptionsTable, "actuator": ActuatorTable,
+    "assumptions": AssumptionsTable, "actuator": ActuatorTable, "robot": RobotTable,
     "box": BoxObstacle, "ball": BallObstacle, "polytope": PolytopeObstacle,
     "tasks": TaskTable, "any_of": TaskBoxTable}
 
