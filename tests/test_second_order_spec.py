@@ -211,8 +211,9 @@ def test_tasks_and_moving_obstacles_take_the_same_tube_for_a_second_order_plant(
 @pytest.mark.skipif(shutil.which("gcc") is None and shutil.which("clang") is None,
                     reason="no C compiler (install gcc or clang)")
 def test_a_second_order_task_with_a_moving_obstacle_is_satisfied_and_verified() -> None:
-    """The generated C of the cascade meets the task, clears the moving box and stays in
-    both tubes; verify proves everything (exit 0), the sampled cascade included."""
+    """The generated C of the cascade meets the task, clears the moving box, stays in both
+    tubes and within the force bound; verify proves everything (exit 0), the sampled
+    cascade and the force bound included."""
     design = stt.design_tube(stt.load_spec(SPECS / "second-order-tasks.toml"))
     result = stt.simulate(design, backend="c")
     assert result.satisfied, result.to_json()
@@ -223,6 +224,20 @@ def test_a_second_order_task_with_a_moving_obstacle_is_satisfied_and_verified() 
     assert "PASS  cascade.sampled: proved" in out.stdout
     assert "PASS  tube.task_T1_reach" in out.stdout
     assert "PASS  tube.avoids_moving_obstacle_2" in out.stdout
+    assert "PASS  cascade.input_bound" in out.stdout          # [actuator]: forces in N
+    assert all(u <= b for u, b in zip(result.max_abs_u, design.spec.input_bound))
+
+
+@pytest.mark.embedded
+def test_the_second_order_task_spec_on_the_cortex_m4f() -> None:
+    """The same design's generated C (single precision) in the firmware's closed loop:
+    satisfied, never outside a tube, never clamped."""
+    from stt_codegen.embedded.cascade_loop import run_cascade_embedded
+    report = run_cascade_embedded(stt.design_tube(stt.load_spec(
+        SPECS / "second-order-tasks.toml")))
+    assert report["satisfied"], report
+    assert report["outside_position"] == report["outside_velocity"] == report["invalid"] == 0
+    assert report["input_clamped"] == 0
 
 
 def test_the_front_door_simulates_a_second_order_design_with_the_cascade(tmp_path):

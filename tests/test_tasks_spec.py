@@ -81,13 +81,29 @@ def test_windows_come_in_order_without_overlap():
     assert len(Spec.from_dict(doc([STAY, touching])).tasks) == 2
 
 
-def test_tasks_need_via_points_and_no_actuator():
+def test_tasks_need_via_points_and_take_an_actuator_bound():
     with pytest.raises(SpecError) as info:
         Spec.from_dict(doc([REACH], tube={"method": "paper"}))
     assert info.value.field == "tube.method"
-    with pytest.raises(SpecError) as info:
-        Spec.from_dict(doc([REACH], actuator={"input_bound": [1.0, 1.0]}))
-    assert info.value.field == "tasks" and "not supported" in info.value.reason
+    spec = Spec.from_dict(doc([REACH], actuator={"input_bound": [1.0, 1.0]}))
+    assert spec.tasks and spec.input_bound == (1.0, 1.0)
+
+
+@pytest.mark.slow
+def test_tasks_with_an_actuator_bound_are_designed_within_it_and_met():
+    """tasks-visit with [actuator]: the bound is proved along the via tube, the certificate
+    proves the tasks as without it, and the generated C meets both within the bound."""
+    import dataclasses
+    import stt_codegen as stt
+    spec = stt.load_spec("tasks-visit")
+    bound = (3.0, 3.0, 1.0)
+    design = stt.design_tube(dataclasses.replace(spec, input_bound=bound))
+    assert design.input_proof.meets(bound) and design.tube.input_bound == bound
+    names = {m.name for m in design.certificate.margins if m.passed}
+    assert {"task T1 reach", "task T2 reach"} <= names
+    result = stt.simulate(design, backend="casadi")
+    assert result.satisfied and all(task.met for task in result.tasks)
+    assert all(u <= b for u, b in zip(result.max_abs_u, bound))
 
 
 def test_cli_exits_2_without_traceback(tmp_path):

@@ -606,7 +606,7 @@ def _validate(raw: dict) -> Spec:
                                   (state_space.lower, state_space.upper),
                                   [(b.lower, b.upper, o.source) for o, b in
                                    zip(obstacles, (o.box(state_space) for o in obstacles))],
-                                  doc.tube.method, doc.actuator is not None),
+                                  doc.tube.method),
                 moving_obstacles=moving, robot=robot)
 
 

@@ -104,7 +104,7 @@ def _box(lower: Sequence[float] | None, upper: Sequence[float] | None, field: st
 def build_tasks(tables: Sequence, n: int, prescribed_time: float,
                 space: tuple[Sequence[float], Sequence[float]],
                 obstacles: Sequence[tuple[Sequence[float], Sequence[float], int]],
-                method: str, has_actuator: bool) -> tuple[Task, ...]:
+                method: str) -> tuple[Task, ...]:
     """Validate the ``[[tasks]]`` entries against the rest of the spec.
 
     Parameters
@@ -122,8 +122,6 @@ def build_tasks(tables: Sequence, n: int, prescribed_time: float,
         included) and the index of the ``[[obstacles]]`` entry each comes from.
     method : str
         ``tube.method``.
-    has_actuator : bool
-        The spec has ``[actuator]``.
 
     Returns
     -------
@@ -140,8 +138,6 @@ def build_tasks(tables: Sequence, n: int, prescribed_time: float,
         return ()
     if method == "paper":
         raise SpecError("tube.method", "tasks need via points: 'via' or 'auto', not 'paper'")
-    if has_actuator:
-        raise SpecError("tasks", "tasks with [actuator] are not supported yet")
     out: list[Task] = []
     previous_end = 0.0
     for k, table in enumerate(tables):
