@@ -105,3 +105,21 @@ def test_quadrotor_among_pillars_is_satisfied(mass) -> None:
     assert result.satisfied and result.stayed_in_velocity_tube, result.to_json()
     # hovering needs m g0 in the vertical thrust
     assert result.max_abs_u[2] >= mass * 9.81
+
+
+@needs_cc
+def test_the_c_backend_of_the_cascade_is_built_once_into_the_cache(tmp_path, monkeypatch) -> None:
+    """The cascade's ``c`` backend compiles through the first order's build cache: a second
+    controller of the same design loads the same library, without compiling again."""
+    from stt_codegen.runtime.backends import make_controller
+    monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path))
+    _, design, stage = planar_s1()
+    first = make_controller("c", design.tube, stage)
+    built = sorted(tmp_path.glob("*.so"))
+    assert len(built) == 1
+    stamp = built[0].stat().st_mtime_ns
+    second = make_controller("c", design.tube, stage)
+    assert sorted(tmp_path.glob("*.so")) == built and built[0].stat().st_mtime_ns == stamp
+    x = np.array([*design.tube.initial_state, 0.0, 0.0])
+    a, b = (c.step(x, 0.0, 1e-3, np.zeros(4)) for c in (first, second))
+    assert np.array_equal(a[0], b[0]) and a[2] == b[2]

@@ -12,9 +12,6 @@ compiler and loaded with ``ctypes``).
 from __future__ import annotations
 
 import ctypes
-import subprocess
-import tempfile
-from pathlib import Path
 
 import numpy as np
 
@@ -116,25 +113,15 @@ class CascadeController:
 
 
 def _compiled(design: TubeDesign, stage: SecondStage):
-    """The emitted C of the cascade step (double), compiled and loaded."""
+    """The emitted C of the cascade step (double), compiled into the build cache
+    (:func:`~stt_codegen.runtime.compiled.build_shared`: keyed by the sources and the
+    compiler command, as the first order's) and loaded."""
     from ..codegen.cascade_source import cascade_c_files
-    from .compiled import CFLAGS, compiler
-    from ..codegen.errors import CodegenError
+    from .compiled import build_shared
 
     files = cascade_c_files(design, stage, "stt_cascade", "double")
-    # the folder is removed once the library is loaded (it stays mapped)
-    with tempfile.TemporaryDirectory(prefix="stt-cascade-") as name:
-        folder = Path(name)
-        for file, text in files.items():
-            (folder / file).write_text(text)
-        lib = folder / "libstt_cascade.so"
-        proc = subprocess.run([compiler(), *CFLAGS, "-o", str(lib),
-                               str(folder / "stt_cascade.c"), "-lm"],
-                              capture_output=True, text=True)
-        if proc.returncode != 0:
-            raise CodegenError("the C compiler failed on the cascade step: "
-                               f"{proc.stderr[:2000]}")
-        handle = ctypes.CDLL(str(lib))
+    sources = {name: text.encode() for name, text in files.items()}
+    handle = ctypes.CDLL(str(build_shared(sources, "stt_cascade.c")))
     entry = handle.stt_cascade_step
     real_p = ctypes.POINTER(ctypes.c_double)
     entry.argtypes = [real_p, ctypes.c_double, ctypes.c_double, real_p, real_p, real_p, real_p]
