@@ -306,10 +306,8 @@ def piece_widths(design: TubeDesign, t0: np.ndarray, t1: np.ndarray,
     rho_l, rho_u, _, rho_width = reach_range(design, t0, t1, rates=False)
     beta_l, beta_u = circumvent_range(design, t0, t1)
     pieces = Pieces(rho_l, rho_u, beta_l, beta_u, None, None, None, None, rho_width)
-    lower_max = reference.smooth_max(np.stack([rho_l[1] - alpha_min[:, :n], beta_l[1]], -1),
-                                     nu)[0]
-    upper_min = -reference.smooth_max(np.stack([-(rho_u[0] + alpha_min[:, n:]), -beta_u[0]],
-                                               -1), nu)[0]
+    lower_max = reference.smooth_max_pair(rho_l[1] - alpha_min[:, :n], beta_l[1], nu)
+    upper_min = -reference.smooth_max_pair(-(rho_u[0] + alpha_min[:, n:]), -beta_u[0], nu)
     return np.maximum(upper_min - lower_max, width_lower_bound(design, pieces, alpha_min))
 
 
@@ -378,7 +376,7 @@ def enclose(design: TubeDesign, pieces: Pieces, alpha_min: np.ndarray, alpha_max
     nu = design.smoothness
 
     def smax(a, b):
-        return reference.smooth_max(np.stack([a, b], -1), nu)[0]
+        return reference.smooth_max_pair(a, b, nu)
 
     def smin(a, b):
         return -smax(-a, -b)
