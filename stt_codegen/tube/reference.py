@@ -342,7 +342,8 @@ def circumvent_from_bumps(design: TubeDesign, bumps: list,
     out = []
     for side, bounds, sign in ((LOWER, design.state_lower, 1.0),
                                ("upper", design.state_upper, -1.0)):
-        value = np.tile(np.array(bounds, dtype=float), (count, 1))
+        value = np.empty((count, len(bounds)))
+        value[:] = bounds                       # the bound, on every row
         for i in range(design.dimension):
             members = [j for j, c in enumerate(design.circumvents)
                        if c.dimension == i and c.side == side]
