@@ -25,7 +25,7 @@ __all__ = ["adaptive_law", "adaptive_tube", "alpha_step", "bump", "circumvent",
            "circumvent_from_bumps", "conflict_distance", "control", "controller_status",
            "controller_step", "error_transform", "exp", "implicit_alpha_root", "law", "law_step",
            "log", "numpy_math", "open_bump_sum", "reach_tube", "segment_progress", "smooth_max",
-           "trigger"]
+           "smooth_max_pair", "trigger"]
 
 Array = np.ndarray
 
@@ -252,8 +252,7 @@ def smooth_max(values: Array, nu: float, axis: int = -1) -> tuple[Array, Array]:
     if count == 1:
         value = values[..., 0]
     elif count == 2:
-        a, b = values[..., 0], values[..., 1]
-        value = np.maximum(a, b) + log1p(exp(-nu * np.abs(a - b))) / nu
+        value = smooth_max_pair(values[..., 0], values[..., 1], nu)
     else:
         top = values.max(axis=-1)
         total = np.zeros_like(top)
@@ -262,6 +261,24 @@ def smooth_max(values: Array, nu: float, axis: int = -1) -> tuple[Array, Array]:
         value = top + log(total) / nu
     weights = exp(nu * (values - value[..., None]))
     return value, np.moveaxis(weights, -1, axis)
+
+
+def smooth_max_pair(a: Array, b: Array, nu: float) -> Array:
+    """:func:`smooth_max` of two values, without its weights: ``max(a, b) + log1p(exp(-nu |a - b|)) / nu``.
+
+    Parameters
+    ----------
+    a, b : ndarray, the same shape
+        State units.
+    nu : float
+        Smoothness ``nu > 0`` of eq. (10).
+
+    Returns
+    -------
+    ndarray, the shape of ``a``
+        ``(1/nu) ln(exp(nu a) + exp(nu b))``, state units.
+    """
+    return np.maximum(a, b) + log1p(exp(-nu * np.abs(a - b))) / nu
 
 
 def open_bump_sum(heights: Array, nu: float) -> tuple[Array, Array]:
@@ -325,7 +342,8 @@ def circumvent_from_bumps(design: TubeDesign, bumps: list,
     out = []
     for side, bounds, sign in ((LOWER, design.state_lower, 1.0),
                                ("upper", design.state_upper, -1.0)):
-        value = np.tile(np.array(bounds, dtype=float), (count, 1))
+        value = np.empty((count, len(bounds)))
+        value[:] = bounds                       # the bound, on every row
         for i in range(design.dimension):
             members = [j for j, c in enumerate(design.circumvents)
                        if c.dimension == i and c.side == side]

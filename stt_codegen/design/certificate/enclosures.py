@@ -73,7 +73,8 @@ def bump_ranges(c, t0: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
     return low, high, rates.min(axis=0), rates.max(axis=0)
 
 
-def circumvent_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
+def circumvent_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray,
+                     ranges: list | None = None):
     """Ranges of ``beta_L`` and ``beta_U`` (eq. (9)) over each interval, shape (K, n) each.
 
     ``beta_L`` is non-decreasing and ``beta_U`` non-increasing in every bump value, so
@@ -85,6 +86,9 @@ def circumvent_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
         The tube (its circumvents and state-space bounds).
     t0, t1 : ndarray, shape (K,)
         Ends of the intervals, s.
+    ranges : list, optional
+        :func:`bump_ranges` of each of ``design.circumvents`` on these intervals, if
+        already computed.
 
     Returns
     -------
@@ -92,7 +96,8 @@ def circumvent_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
         Ranges of ``beta_L`` and ``beta_U``, state units.
     """
     t0, t1 = np.atleast_1d(t0), np.atleast_1d(t1)
-    ranges = [bump_ranges(c, t0, t1) for c in design.circumvents]
+    if ranges is None:
+        ranges = [bump_ranges(c, t0, t1) for c in design.circumvents]
     lower_min, upper_max, _ = reference.circumvent_from_bumps(design, [r[0] for r in ranges],
                                                               t0.size)
     lower_max, upper_min, _ = reference.circumvent_from_bumps(design, [r[1] for r in ranges],
@@ -100,8 +105,9 @@ def circumvent_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
     return (lower_min, lower_max), (upper_min, upper_max)
 
 
-def _circumvent_rate(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
-    """Ranges of ``beta_L_dot`` and ``beta_U_dot`` per interval, shape (K, n) each.
+def _circumvent_rate(design: TubeDesign, t0: np.ndarray, ranges: list):
+    """Ranges of ``beta_L_dot`` and ``beta_U_dot`` per interval, shape (K, n) each, from the
+    :func:`bump_ranges` of each circumvent.
 
     ``beta_L_dot = sum_j w_j B^j b_dot_j`` with weights ``w_j`` in ``[0, 1]``
     (:func:`~stt_codegen.tube.reference.open_bump_sum`), ``beta_U_dot`` its negative.
@@ -113,8 +119,7 @@ def _circumvent_rate(design: TubeDesign, t0: np.ndarray, t1: np.ndarray):
     n = design.dimension
     lo_l, hi_l = np.zeros((t0.size, n)), np.zeros((t0.size, n))
     lo_u, hi_u = np.zeros((t0.size, n)), np.zeros((t0.size, n))
-    for c in design.circumvents:
-        _, _, r_min, r_max = bump_ranges(c, t0, t1)
+    for c, (_, _, r_min, r_max) in zip(design.circumvents, ranges):
         i = c.dimension
         if c.side == LOWER:
             lo_l[:, i] += c.height * np.minimum(r_min, 0.0)
@@ -268,8 +273,10 @@ def piece_ranges(design: TubeDesign, t0: np.ndarray, t1: np.ndarray) -> Pieces:
         The ranges on the ``K`` intervals.
     """
     rho_l, rho_u, rho_rate, rho_width = reach_range(design, t0, t1)
-    beta_l, beta_u = circumvent_range(design, t0, t1)
-    beta_rate = _circumvent_rate(design, t0, t1)
+    # the bumps' ranges serve both beta's range and its rate's
+    bumps = [bump_ranges(c, t0, t1) for c in design.circumvents]
+    beta_l, beta_u = circumvent_range(design, t0, t1, bumps)
+    beta_rate = _circumvent_rate(design, t0, bumps)
     psi_lo = np.concatenate([beta_u[0] - rho_l[1], rho_u[0] - beta_l[1]], axis=1)
     psi_hi = np.concatenate([beta_u[1] - rho_l[0], rho_u[1] - beta_l[0]], axis=1)
     return Pieces(rho_l, rho_u, beta_l, beta_u, rho_rate, beta_rate, psi_lo, psi_hi, rho_width)
@@ -299,10 +306,8 @@ def piece_widths(design: TubeDesign, t0: np.ndarray, t1: np.ndarray,
     rho_l, rho_u, _, rho_width = reach_range(design, t0, t1, rates=False)
     beta_l, beta_u = circumvent_range(design, t0, t1)
     pieces = Pieces(rho_l, rho_u, beta_l, beta_u, None, None, None, None, rho_width)
-    lower_max = reference.smooth_max(np.stack([rho_l[1] - alpha_min[:, :n], beta_l[1]], -1),
-                                     nu)[0]
-    upper_min = -reference.smooth_max(np.stack([-(rho_u[0] + alpha_min[:, n:]), -beta_u[0]],
-                                               -1), nu)[0]
+    lower_max = reference.smooth_max_pair(rho_l[1] - alpha_min[:, :n], beta_l[1], nu)
+    upper_min = -reference.smooth_max_pair(-(rho_u[0] + alpha_min[:, n:]), -beta_u[0], nu)
     return np.maximum(upper_min - lower_max, width_lower_bound(design, pieces, alpha_min))
 
 
@@ -371,7 +376,7 @@ def enclose(design: TubeDesign, pieces: Pieces, alpha_min: np.ndarray, alpha_max
     nu = design.smoothness
 
     def smax(a, b):
-        return reference.smooth_max(np.stack([a, b], -1), nu)[0]
+        return reference.smooth_max_pair(a, b, nu)
 
     def smin(a, b):
         return -smax(-a, -b)

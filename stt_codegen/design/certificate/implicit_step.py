@@ -136,10 +136,11 @@ class Propagation:
         decay_lo = np.where(np.isnan(decay_lo), 1.0, decay_lo)  # no rate known: monotone only
         self.kappa, self.dt, self.c = kappa, dt, c
         self.m = psi_lo.shape[1]
-        self.s_lo, self.s_hi = star_lo.tolist(), star_hi.tolist()
-        self.d_lo, self.steps = decay_lo.tolist(), steps.tolist()
-        self.p_lo, self.p_hi = psi_lo.tolist(), psi_hi.tolist()
-        self.t_lo, self.t_hi = theta_lo.tolist(), theta_hi.tolist()
+        self.steps = steps.tolist()
+        # per interval, per component: (psi_lo, psi_hi, theta_lo, theta_hi, a*_lo, a*_hi,
+        # decay_lo), converted to floats in one call (advance reads them one by one)
+        self.rows = np.stack([psi_lo, psi_hi, theta_lo, theta_hi, star_lo, star_hi, decay_lo],
+                             axis=-1).tolist()
         self.step_psi = step_psi
 
     def advance(self, k: int, a_lo: list, a_hi: list) -> tuple[list, list]:
@@ -157,62 +158,64 @@ class Propagation:
         row_lo, row_hi : list of float, (2n,)
             Range of ``alpha`` on the interval.
         """
-        kappa, dt, c, m = self.kappa, self.dt, self.c, self.m
-        sl, sh, steps_k = self.s_lo[k], self.s_hi[k], self.steps[k]
-        p_lo, p_hi, t_lo, t_hi = self.p_lo[k], self.p_hi[k], self.t_lo[k], self.t_hi[k]
-        row_lo, row_hi = [0.0] * m, [0.0] * m
+        kappa, dt, c = self.kappa, self.dt, self.c
+        steps_k, row = self.steps[k], self.rows[k]
         if steps_k <= EXACT_STEPS:
-            # few steps: follow the extreme backward-Euler sequences exactly, each step
-            # with its own psi where it is known
-            own = None if self.step_psi is None else self.step_psi[k]
-            for i in range(m):
-                lo_i, hi_i = a_lo[i], a_hi[i]
-                low, high = lo_i, hi_i
-                for j in range(int(steps_k)):
-                    if own is None:      # the interval's range of psi
-                        psi_l, psi_h, th_l, th_h = p_lo[i], p_hi[i], t_lo[i], t_hi[i]
-                    else:                # the step's own psi
-                        psi_l, psi_h = own[0][j][i], own[1][j][i]
-                        th_l, th_h = own[2][j][i], own[3][j][i]
-                    lo_i = max(step_root(lo_i, psi_h, th_l, dt, c)[0], 0.0)
-                    hi_i = step_root(hi_i, psi_l, th_h, dt, c)[1]
-                    low, high = min(low, lo_i), max(high, hi_i)
-                row_lo[i], row_hi[i], a_lo[i], a_hi[i] = low, high, lo_i, hi_i
-            return row_lo, row_hi
+            return self._follow(k, int(steps_k), a_lo, a_hi)
+        row_lo, row_hi = [0.0] * self.m, [0.0] * self.m
         if math.isinf(steps_k):
             # psi is constant from here on: alpha moves monotonically to a* for ever
-            for i in range(m):
-                row_lo[i] = min(a_lo[i], sl[i])
-                row_hi[i] = max(a_hi[i], sh[i])
+            for i, (_, _, _, _, sl, sh, _) in enumerate(row):
+                row_lo[i] = min(a_lo[i], sl)
+                row_hi[i] = max(a_hi[i], sh)
             return row_lo, row_hi
         span = steps_k * dt
         c_span = 1.0 + kappa * span
-        d_lo = self.d_lo[k]
-        for i in range(m):
+        for i, (pl, ph, tl, th, sl, sh, d_lo) in enumerate(row):
             lo_i, hi_i = a_lo[i], a_hi[i]
             # lower sequence (psi_hi, theta_lo)
-            if lo_i <= sl[i]:        # rising: one implicit step of N dt lags behind
-                end = max(step_root(lo_i, p_hi[i], t_lo[i], span, c_span)[0],
-                          sl[i] - (sl[i] - lo_i) * d_lo[i])
+            if lo_i <= sl:           # rising: one implicit step of N dt lags behind
+                end = max(step_root(lo_i, ph, tl, span, c_span)[0], sl - (sl - lo_i) * d_lo)
                 row_lo[i] = lo_i
             else:                    # falling: no faster than its initial rate
-                z = p_hi[i] + lo_i
-                end = sl[i] if not z > 0.0 else max(
-                    sl[i], lo_i + span * (t_lo[i] / (z * z) - kappa * lo_i))
+                z = ph + lo_i
+                end = sl if not z > 0.0 else max(sl, lo_i + span * (tl / (z * z) - kappa * lo_i))
                 row_lo[i] = end
             a_lo[i] = end if end > 0.0 else 0.0
             # upper sequence (psi_lo, theta_hi)
-            if hi_i >= sh[i]:        # falling: one implicit step of N dt lags behind
-                q = 1.0 / (c + 2.0 * dt * t_hi[i] / (p_lo[i] + hi_i) ** 3)
-                end = min(step_root(hi_i, p_lo[i], t_hi[i], span, c_span)[1],
-                          sh[i] + (hi_i - sh[i]) * q ** steps_k)
+            if hi_i >= sh:           # falling: one implicit step of N dt lags behind
+                q = 1.0 / (c + 2.0 * dt * th / (pl + hi_i) ** 3)
+                end = min(step_root(hi_i, pl, th, span, c_span)[1],
+                          sh + (hi_i - sh) * q ** steps_k)
                 row_hi[i] = hi_i
             else:                    # rising: no faster than its initial rate
-                z = p_lo[i] + hi_i
-                end = sh[i] if not z > 0.0 else min(
-                    sh[i], hi_i + span * (t_hi[i] / (z * z) - kappa * hi_i))
+                z = pl + hi_i
+                end = sh if not z > 0.0 else min(sh, hi_i + span * (th / (z * z) - kappa * hi_i))
                 row_hi[i] = end
             a_hi[i] = end
+        return row_lo, row_hi
+
+    def _follow(self, k: int, count: int, a_lo: list, a_hi: list) -> tuple[list, list]:
+        """:meth:`advance` on an interval of ``count <= EXACT_STEPS`` steps: the extreme
+        backward-Euler sequences step by step, each step with its own ``psi`` where it is
+        known, else the interval's range."""
+        dt, c = self.dt, self.c
+        own = None if self.step_psi is None else self.step_psi[k]
+        row_lo, row_hi = [0.0] * self.m, [0.0] * self.m
+        for i, (pl, ph, tl, th, _, _, _) in enumerate(self.rows[k]):
+            lo_i, hi_i = a_lo[i], a_hi[i]
+            low, high = lo_i, hi_i
+            if own is None:          # the interval's range of psi
+                for _ in range(count):
+                    lo_i = max(step_root(lo_i, ph, tl, dt, c)[0], 0.0)
+                    hi_i = step_root(hi_i, pl, th, dt, c)[1]
+                    low, high = min(low, lo_i), max(high, hi_i)
+            else:                    # the step's own psi
+                for own_pl, own_ph, own_tl, own_th in zip(own[0], own[1], own[2], own[3]):
+                    lo_i = max(step_root(lo_i, own_ph[i], own_tl[i], dt, c)[0], 0.0)
+                    hi_i = step_root(hi_i, own_pl[i], own_th[i], dt, c)[1]
+                    low, high = min(low, lo_i), max(high, hi_i)
+            row_lo[i], row_hi[i], a_lo[i], a_hi[i] = low, high, lo_i, hi_i
         return row_lo, row_hi
 
 

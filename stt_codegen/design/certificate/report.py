@@ -254,9 +254,8 @@ def point_tube(design: TubeDesign, t: np.ndarray, alpha: np.ndarray) -> tuple[np
     rho_l, rho_u, _, _ = reference.reach_tube(design, t)
     beta_l, beta_u, _, _ = reference.circumvent(design, t)
     nu = design.smoothness
-    gamma_l, _ = reference.smooth_max(np.stack([rho_l - alpha[:, :n], beta_l], -1), nu)
-    neg_u, _ = reference.smooth_max(np.stack([-(rho_u + alpha[:, n:]), -beta_u], -1), nu)
-    return gamma_l, -neg_u
+    gamma_l = reference.smooth_max_pair(rho_l - alpha[:, :n], beta_l, nu)
+    return gamma_l, -reference.smooth_max_pair(-(rho_u + alpha[:, n:]), -beta_u, nu)
 
 
 def certificate_report(design: TubeDesign, spec: Spec, enc: Enclosure, selected, final: bool,

@@ -1,0 +1,177 @@
+"""The certificate's faster paths give the numbers of the plain ones, to the last bit.
+
+``Propagation`` keeps its coefficients as one nested list and iterates them per
+component; here its bounds are compared with a transcription of the plain propagation
+(coefficient lists indexed one by one) on drawn partitions, start bounds and tube
+parameters. ``smooth_max_pair`` is compared with ``smooth_max`` of the stacked values, and
+``piece_ranges`` (each bump's ranges computed once) with ``circumvent_range`` computing its
+own.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import math
+
+import numpy as np
+from conftest import CASES, designed
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from stt_codegen.design.certificate import (EXACT_STEPS, alpha_fixed_point,
+                                            alpha_ranges, circumvent_range, piece_ranges,
+                                            step_psi, step_root)
+from stt_codegen.tube import reference
+
+
+def _plain_coefficients(design, psi_lo, psi_hi, steps):
+    """The coefficients of the propagation, computed as the plain propagation does."""
+    kappa, dt = design.kappa, 1.0 / design.rate_hz
+    c = 1.0 + kappa * dt
+    theta_hi = reference.trigger(design, psi_lo)
+    theta_lo = reference.trigger(design, psi_hi)
+    star_hi, star_lo = np.zeros_like(psi_lo), np.zeros_like(psi_hi)
+    long = steps > EXACT_STEPS
+    if long.any():
+        # lower ends for (psi_hi, theta_lo) and upper ends for (psi_lo, theta_hi), one call
+        lo, hi = alpha_fixed_point(np.concatenate([psi_hi[long], psi_lo[long]]),
+                                   np.concatenate([theta_lo[long], theta_hi[long]]), kappa)
+        half = int(long.sum())
+        star_lo[long], star_hi[long] = lo[:half], hi[half:]
+    with np.errstate(divide="ignore", over="ignore", under="ignore", invalid="ignore"):
+        q_lo = 1.0 / (c + 2.0 * dt * theta_lo / (psi_hi + star_lo) ** 3)
+        decay_lo = np.where(np.isinf(steps)[:, None], 0.0,
+                            np.power(q_lo, np.minimum(steps, 1e300)[:, None]))
+    decay_lo = np.where(np.isnan(decay_lo), 1.0, decay_lo)
+    return (kappa, dt, c, star_lo.tolist(), star_hi.tolist(), decay_lo.tolist(), steps.tolist(),
+            psi_lo.tolist(), psi_hi.tolist(), theta_lo.tolist(), theta_hi.tolist())
+
+
+def _plain_alpha_ranges(design, psi_lo, psi_hi, steps, start, own_psi):
+    """alpha_ranges written plainly: every coefficient indexed ``[k][i]``."""
+    (kappa, dt, c, s_lo, s_hi, d_lo_all, steps_l, p_lo_all, p_hi_all, t_lo_all,
+     t_hi_all) = _plain_coefficients(design, psi_lo, psi_hi, steps)
+    m = psi_lo.shape[1]
+    a_lo, a_hi = list(start[0]), list(start[1])
+    out_lo, out_hi, entries = [], [], []
+    for k, steps_k in enumerate(steps_l):
+        entries.append((list(a_lo), list(a_hi)))
+        sl, sh = s_lo[k], s_hi[k]
+        p_lo, p_hi, t_lo, t_hi = p_lo_all[k], p_hi_all[k], t_lo_all[k], t_hi_all[k]
+        row_lo, row_hi = [0.0] * m, [0.0] * m
+        if steps_k <= EXACT_STEPS:
+            own = None if own_psi is None else own_psi[k]
+            for i in range(m):
+                lo_i, hi_i = a_lo[i], a_hi[i]
+                low, high = lo_i, hi_i
+                for j in range(int(steps_k)):
+                    if own is None:
+                        psi_l, psi_h, th_l, th_h = p_lo[i], p_hi[i], t_lo[i], t_hi[i]
+                    else:
+                        psi_l, psi_h = own[0][j][i], own[1][j][i]
+                        th_l, th_h = own[2][j][i], own[3][j][i]
+                    lo_i = max(step_root(lo_i, psi_h, th_l, dt, c)[0], 0.0)
+                    hi_i = step_root(hi_i, psi_l, th_h, dt, c)[1]
+                    low, high = min(low, lo_i), max(high, hi_i)
+                row_lo[i], row_hi[i], a_lo[i], a_hi[i] = low, high, lo_i, hi_i
+        elif math.isinf(steps_k):
+            for i in range(m):
+                row_lo[i] = min(a_lo[i], sl[i])
+                row_hi[i] = max(a_hi[i], sh[i])
+        else:
+            span = steps_k * dt
+            c_span = 1.0 + kappa * span
+            d_lo = d_lo_all[k]
+            for i in range(m):
+                lo_i, hi_i = a_lo[i], a_hi[i]
+                if lo_i <= sl[i]:
+                    end = max(step_root(lo_i, p_hi[i], t_lo[i], span, c_span)[0],
+                              sl[i] - (sl[i] - lo_i) * d_lo[i])
+                    row_lo[i] = lo_i
+                else:
+                    z = p_hi[i] + lo_i
+                    end = sl[i] if not z > 0.0 else max(
+                        sl[i], lo_i + span * (t_lo[i] / (z * z) - kappa * lo_i))
+                    row_lo[i] = end
+                a_lo[i] = end if end > 0.0 else 0.0
+                if hi_i >= sh[i]:
+                    q = 1.0 / (c + 2.0 * dt * t_hi[i] / (p_lo[i] + hi_i) ** 3)
+                    end = min(step_root(hi_i, p_lo[i], t_hi[i], span, c_span)[1],
+                              sh[i] + (hi_i - sh[i]) * q ** steps_k)
+                    row_hi[i] = hi_i
+                else:
+                    z = p_lo[i] + hi_i
+                    end = sh[i] if not z > 0.0 else min(
+                        sh[i], hi_i + span * (t_hi[i] / (z * z) - kappa * hi_i))
+                    row_hi[i] = end
+                a_hi[i] = end
+        out_lo.append(row_lo)
+        out_hi.append(row_hi)
+    return out_lo, out_hi, entries
+
+
+@st.composite
+def _partitions(draw):
+    """A bundled tube with drawn kappa and theta0, a drawn partition of its samples (short
+    and long intervals, the tail) and drawn bounds of alpha at its start."""
+    tube = designed(draw(st.sampled_from(CASES)))[1]
+    tube = dataclasses.replace(tube, kappa=tube.kappa * draw(st.floats(0.2, 5.0)),
+                               theta0=tube.theta0 * draw(st.floats(0.2, 5.0)))
+    end = int(math.ceil(tube.prescribed_time * tube.rate_hz)) + 1
+    cuts = draw(st.lists(st.integers(1, end - 1), min_size=1, max_size=30))
+    # runs of single steps, where the short intervals follow each step
+    runs = [p + q for p in draw(st.lists(st.integers(1, end - 6), min_size=1, max_size=4)) for q in range(5)]
+    points = sorted({0, end, *cuts, *runs})
+    m = 2 * tube.dimension
+    lo = draw(st.lists(st.floats(0.0, 0.5), min_size=m, max_size=m))
+    widen = draw(st.lists(st.floats(0.0, 0.5), min_size=m, max_size=m))
+    own = draw(st.booleans())
+    return tube, points, (lo, [a + b for a, b in zip(lo, widen)]), own
+
+
+@settings(max_examples=60, deadline=None)
+@given(_partitions())
+def test_propagation_is_the_plain_propagation_to_the_last_bit(drawn):
+    """alpha_ranges (and so every advance) gives the plain transcription's bounds exactly,
+    with each short step's own psi and with the interval's range."""
+    tube, points, start, own = drawn
+    dt = 1.0 / tube.rate_hz
+    i0 = np.array(points)
+    i1 = np.append(i0[1:], -1)
+    steps = np.where(i1 < 0, np.inf, (i1 - i0).astype(float))
+    t0 = i0 * dt
+    with reference.numpy_math():
+        pieces = piece_ranges(tube, t0, np.where(i1 < 0, t0, i1 * dt))
+        own_psi = step_psi(tube, i0, steps) if own else None
+        fast = alpha_ranges(tube, pieces.psi_lo, pieces.psi_hi, steps, start, own_psi)
+        plain = _plain_alpha_ranges(tube, pieces.psi_lo, pieces.psi_hi, steps, start, own_psi)
+    assert (steps <= EXACT_STEPS).any() and (steps > EXACT_STEPS).any()
+    assert fast == plain
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.lists(st.tuples(st.floats(-50, 50), st.floats(-50, 50)), min_size=1, max_size=20),
+       st.floats(0.1, 200.0), st.booleans())
+def test_smooth_max_pair_is_smooth_max_of_two(pairs, nu, fast_math):
+    """The two-value smooth max is smooth_max's value of the stacked pair, bit for bit,
+    with libm and with numpy's kernels."""
+    values = np.array(pairs)
+    a, b = values[:, 0].copy(), values[:, 1].copy()
+    with reference.numpy_math() if fast_math else contextlib.nullcontext():
+        pair = reference.smooth_max_pair(a, b, nu)
+        full = reference.smooth_max(values, nu)[0]
+    assert np.array_equal(pair, full)
+
+
+def test_piece_ranges_beta_is_circumvent_range():
+    """The beta ranges of piece_ranges (bumps shared with the rates) are circumvent_range's."""
+    for name in CASES:
+        tube = designed(name)[1]
+        assert tube.circumvents
+        t = np.linspace(0.0, tube.prescribed_time, 97)
+        with reference.numpy_math():
+            pieces = piece_ranges(tube, t[:-1], t[1:])
+            beta_l, beta_u = circumvent_range(tube, t[:-1], t[1:])
+        for got, want in zip(pieces.beta_l + pieces.beta_u, beta_l + beta_u):
+            assert np.array_equal(got, want)
