@@ -26,7 +26,8 @@ from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..system import atomic_write, find_tool
 
-__all__ = ["CController", "CFLAGS", "GeneratedPythonController", "compiler", "load_python_module"]
+__all__ = ["CController", "CFLAGS", "GeneratedPythonController", "build_shared", "compiler",
+           "load_python_module"]
 
 #: Flags of the shared-library build (``-ffp-contract=off``: same rounding as CasADi's VM).
 CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fPIC", "-shared", "-Wall", "-Wextra",
@@ -68,6 +69,17 @@ def compiler() -> str:
 def build_shared(sources: dict[str, bytes], c_file: str, cc: str | None = None,
                  extra_flags: tuple = ()) -> Path:
     """Compile ``sources[c_file]`` (with its header) into a cached shared library.
+
+    Parameters
+    ----------
+    sources : dict of str to bytes
+        File name to content: the C file and the headers it includes.
+    c_file : str
+        The key of ``sources`` to compile.
+    cc : str, optional
+        The C compiler; default :func:`compiler`.
+    extra_flags : tuple of str, optional
+        Flags after :data:`CFLAGS` (part of the cache key).
 
     Returns
     -------
