@@ -261,6 +261,9 @@ class Spec:
         default ``d_T`` to keep an obstacle beside the target out of the target box).
     tasks : tuple of Task
         The ``[[tasks]]`` entries (:mod:`~.tasks`, docs/tasks.md); empty without them.
+    task_order : {"listed", "any"}
+        ``[task_order] order``: the tasks are visited in the listed order, or in the order
+        the design chooses.
     moving_obstacles : tuple of MovingObstacle
         The ``[[obstacles]]`` boxes with ``active``, ``velocity`` or ``path``
         (:mod:`~.motion`); they are in neither :attr:`obstacles` nor :attr:`unsafe_sets`.
@@ -294,6 +297,7 @@ class Spec:
     source_hash: str = field(default="", compare=False)
     target_half_width_given: bool = True
     tasks: tuple[Task, ...] = ()
+    task_order: str = "listed"
     moving_obstacles: tuple[MovingObstacle, ...] = ()
     robot: Robot | None = None
 
@@ -607,6 +611,7 @@ def _validate(raw: dict) -> Spec:
                                   [(b.lower, b.upper, o.source) for o, b in
                                    zip(obstacles, (o.box(state_space) for o in obstacles))],
                                   doc.tube.method),
+                task_order=doc.task_order.order if doc.task_order is not None else "listed",
                 moving_obstacles=moving, robot=robot)
 
 

@@ -9,8 +9,11 @@ The schema (:mod:`stt_codegen.spec.schema`) has checked every key, type and sign
 * every box has one entry per state dimension (a dimension the task does not constrain is
   given the state space's bounds), is not empty (``lower < upper`` in every dimension), lies
   inside the state space and does not meet an obstacle (touching is allowed);
-* windows ``[t0, t1]`` satisfy ``0 <= t0 < t1 <= t_c`` and come in order without overlap:
-  each window starts no earlier than the previous one ends (they may touch);
+* windows ``[t0, t1]`` satisfy ``0 <= t0 < t1 <= t_c``; they may overlap and come in any
+  order (the design picks the visit times, and with ``[task_order] order = "any"`` the
+  order; docs/tasks.md, "Timing and order");
+* ``duration`` (stay only) satisfies ``0 < duration <= t1 - t0``; a duration equal to the
+  window's length is the whole window;
 * tasks need the via-point design (``tube.method`` ``"via"`` or ``"auto"``) and no
   ``[actuator]`` (not supported yet).
 
@@ -64,12 +67,24 @@ class Task:
         ``[t0, t1]``, seconds.
     boxes : tuple of TaskBox
         One box, or the ``any_of`` alternatives in the spec's order (reach only).
+    duration : float or None
+        Stay only: inside the box over some interval of this length (seconds) inside the
+        window; ``None``: the whole window.
     """
 
     index: int
     kind: str
     window: tuple[float, float]
     boxes: tuple[TaskBox, ...]
+    duration: float | None = None
+
+    @property
+    def held(self) -> float:
+        """How long the task holds its box, seconds: the stay's duration (the window's
+        length when none is given); 0 for a reach task."""
+        if self.kind != STAY:
+            return 0.0
+        return self.duration if self.duration is not None else self.window[1] - self.window[0]
 
     @property
     def label(self) -> str:
@@ -139,7 +154,6 @@ def build_tasks(tables: Sequence, n: int, prescribed_time: float,
     if method == "paper":
         raise SpecError("tube.method", "tasks need via points: 'via' or 'auto', not 'paper'")
     out: list[Task] = []
-    previous_end = 0.0
     for k, table in enumerate(tables):
         field = f"tasks[{k}]"
         t0, t1 = (float(v) for v in table.window)
@@ -148,11 +162,15 @@ def build_tasks(tables: Sequence, n: int, prescribed_time: float,
         if t1 > prescribed_time:
             raise SpecError(f"{field}.window", f"ends at {t1!r} s, after prescribed_time "
                             f"{prescribed_time!r} s")
-        if t0 < previous_end:
-            raise SpecError(f"{field}.window", f"starts at {t0!r} s, before the previous "
-                            f"task's window ends ({previous_end!r} s): windows come in order "
-                            "and do not overlap")
-        previous_end = t1
+        duration = None if table.duration is None else float(table.duration)
+        if duration is not None:
+            if table.kind != STAY:
+                raise SpecError(f"{field}.duration", "only a stay task takes a duration")
+            if duration > t1 - t0:
+                raise SpecError(f"{field}.duration", f"{duration!r} s is longer than the "
+                                f"window [{t0!r}, {t1!r}] s")
+            if duration == t1 - t0:
+                duration = None
         has_box = table.lower is not None or table.upper is not None
         if table.any_of is not None:
             if table.kind != REACH:
@@ -171,5 +189,5 @@ def build_tasks(tables: Sequence, n: int, prescribed_time: float,
                 if all(a < d and c < b for a, b, c, d in
                        zip(box.lower, box.upper, lower, upper)):
                     raise SpecError(name, f"the task's box meets obstacle {source}")
-        out.append(Task(k, table.kind, (t0, t1), boxes))
+        out.append(Task(k, table.kind, (t0, t1), boxes, duration))
     return tuple(out)
