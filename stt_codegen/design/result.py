@@ -17,6 +17,7 @@ from .input_bound import InputProof
 
 if TYPE_CHECKING:
     from ..spec.loader import Spec
+    from .tasks import TaskPlan
 
 __all__ = ["Design", "METHOD_PAPER", "METHOD_VIA", "TubeCheck", "require_design"]
 
@@ -91,6 +92,9 @@ class Design:
         For a spec with ``[[tasks]]``: per task, the index of the box the tube was
         planned through (the ``any_of`` alternative; 0 for a single box); empty
         otherwise (docs/tasks.md).
+    task_plan : TaskPlan or None
+        For a spec with ``[[tasks]]``: the visit order and each task's hold, the interval
+        over which ``rho`` holds its waypoint box (:mod:`~stt_codegen.design.tasks`).
     motion : str
         For a spec with moving obstacles: how the tube avoids them (``"space-time"``,
         ``"timed via"`` or ``"swept"``, :mod:`~stt_codegen.design.moving`); else ``""``.
@@ -104,6 +108,7 @@ class Design:
     input_proof: InputProof | None = field(default=None, compare=False, repr=False,
                                            kw_only=True)
     task_choices: tuple[int, ...] = field(default=(), repr=False, kw_only=True)
+    task_plan: TaskPlan | None = field(default=None, compare=False, repr=False, kw_only=True)
     motion: str = field(default="", compare=False, kw_only=True)
 
     @property
@@ -209,11 +214,15 @@ class Design:
             return {}
         margins = {m.name: m for m in self.certificate.margins}
         out = []
-        for task, q in zip(self.spec.tasks, self.task_choices):
+        plan = self.task_plan
+        for k, (task, q) in enumerate(zip(self.spec.tasks, self.task_choices)):
             m = margins.get(task.name)
             out.append({"task": task.label, "kind": task.kind, "window": list(task.window),
+                        "duration": task.duration,
                         "alternative": q, "lower": list(task.boxes[q].lower),
                         "upper": list(task.boxes[q].upper),
+                        "visit": None if plan is None else plan.order.index(k) + 1,
+                        "hold": None if plan is None else list(plan.holds[k]),
                         "certified": bool(m is not None and m.passed),
                         "margin": None if m is None else m.margin})
         return {"tasks": out}

@@ -9,7 +9,11 @@ task's window:
   the first such point, ``box`` the alternative it was in, ``margin`` the largest over
   the window's points of how deep the state is in its box (negative: how far out);
 * **stay**: met when every point of the window is in the box; ``time`` is the first point
-  outside it (``None`` when met), ``margin`` the smallest depth.
+  outside it (``None`` when met), ``margin`` the smallest depth;
+* **stay with a duration** ``tau``: met when some run of consecutive points of the window,
+  from its first to its last at least ``tau`` apart, is in the box; ``time`` is the start
+  of the first such run, ``margin`` the largest over runs ``tau`` long of their smallest
+  depth.
 
 The depth of ``x`` in a box is ``min_i min(x_i - lower_i, upper_i - x_i)``, state units.
 """
@@ -71,6 +75,8 @@ def judge_task(task: Task, t: np.ndarray, x: np.ndarray) -> TaskOutcome:
     if not tw.size:
         return TaskOutcome(task.label, task.kind, window, False, None, None)
     depths = np.array([_depth(xw, b.lower, b.upper) for b in task.boxes])     # (B, K)
+    if task.kind == STAY and task.duration is not None:
+        return _judge_duration(task, tw, depths[0])
     if task.kind == STAY:
         out = np.flatnonzero(depths[0] < 0.0)
         return TaskOutcome(task.label, task.kind, window, not out.size,
@@ -81,6 +87,22 @@ def judge_task(task: Task, t: np.ndarray, x: np.ndarray) -> TaskOutcome:
     return TaskOutcome(task.label, task.kind, window, first is not None,
                        float(tw[first]) if first is not None else None,
                        float(depths.max()), box)
+
+
+def _judge_duration(task: Task, tw: np.ndarray, depth: np.ndarray) -> TaskOutcome:
+    """A stay task with a duration on the window's points ``tw`` and depths (module
+    notes)."""
+    best, start = -np.inf, None
+    for i in range(tw.size):
+        j = int(np.searchsorted(tw, tw[i] + task.duration - 1e-12, side="left"))
+        if j >= tw.size:
+            break
+        m = float(depth[i:j + 1].min())
+        if m >= 0.0 and start is None:
+            start = float(tw[i])
+        best = max(best, m)
+    return TaskOutcome(task.label, task.kind, list(task.window), start is not None, start,
+                       None if best == -np.inf else best)
 
 
 def judge_tasks(spec: Spec, t: np.ndarray, x: np.ndarray) -> list[TaskOutcome]:

@@ -14,6 +14,9 @@ lies in ``[lower_min, upper_max]`` at every ``t`` of the piece, not only at samp
 * **stay** (``task Tk stay``): the pieces cover ``[t0, t1]`` (the first starts at or before
   ``t0``, the last ends at or after ``t1``) and on every one the enclosure lies inside the
   box; the margin is the smallest.
+* **stay with a duration** ``tau``: some run of consecutive pieces inside ``[t0, t1]``,
+  together at least ``tau`` long, on every one of which the enclosure lies inside the box;
+  the margin is the largest over such runs of the smallest over the run's pieces.
 
 A margin of at most :data:`~.report.ROUNDING_MARGIN` fails (docs/tasks.md, "The
 certificate").
@@ -81,7 +84,7 @@ def task_margin(design: TubeDesign, task: Task, enc: Enclosure) -> Margin:
     rate = design.rate_hz
     t0, t1 = task.window
     stay = task.kind == STAY
-    a, b = _sample_range(t0, t1, rate, cover=stay)
+    a, b = _sample_range(t0, t1, rate, cover=stay and task.duration is None)
     if b <= a:
         return Margin(task.name, False, -math.inf, t0, f"the window [{t0:g}, {t1:g}] s holds "
                       f"no sampling period at {rate:g} Hz")
@@ -94,6 +97,8 @@ def task_margin(design: TubeDesign, task: Task, enc: Enclosure) -> Margin:
     sub = enclose(design, piece_ranges(design, s0, s1), enc.alpha_min[k], enc.alpha_max[k],
                   s0, s1)
     inside = _inside(task, sub.lower_min, sub.upper_max)          # (B, K)
+    if stay and task.duration is not None:
+        return _duration_margin(task, inside[0], s0, s1)
     if stay:
         q = int(np.argmin(inside[0]))
         m = float(inside[0, q])
@@ -122,6 +127,33 @@ def task_margin(design: TubeDesign, task: Task, enc: Enclosure) -> Margin:
               f"inside the box{'es' if len(task.boxes) > 1 else ''} (best margin {m:.3g} "
               f"on [{s0[q]:.4f}, {s1[q]:.4f}] s)")
     return Margin(task.name, ok, m, float(s0[q]), detail)
+
+
+def _duration_margin(task: Task, inside: np.ndarray, s0: np.ndarray,
+                     s1: np.ndarray) -> Margin:
+    """A stay task with a duration: the best run of consecutive pieces at least
+    ``task.duration`` long (module notes); ``inside`` (K,) per piece ``[s0, s1]``."""
+    t0, t1 = task.window
+    tau = task.duration
+    best, run = -math.inf, (0, 0)
+    for i in range(inside.size):
+        j = int(np.searchsorted(s1, s0[i] + tau - 1e-12, side="left"))
+        if j >= inside.size:
+            break
+        m = float(inside[i:j + 1].min())
+        if m > best:
+            best, run = m, (i, j)
+    if best == -math.inf:
+        return Margin(task.name, False, -math.inf, t0, f"the window [{t0:g}, {t1:g}] s holds "
+                      f"no run of sampling periods {tau:g} s long")
+    i, j = run
+    ok = best > ROUNDING_MARGIN
+    detail = (f"the tube stays inside the box over [{s0[i]:.4f}, {s1[j]:.4f}] s (at least "
+              f"{tau:g} s of the window [{t0:g}, {t1:g}] s), margin >= {best:.6g}" if ok else
+              f"no {tau:g} s of the window [{t0:g}, {t1:g}] s over which the tube is "
+              f"certified inside the box (best margin {best:.3g} over [{s0[i]:.4f}, "
+              f"{s1[j]:.4f}] s)")
+    return Margin(task.name, ok, best, float(s0[i]), detail)
 
 
 def task_margins(design: TubeDesign, spec: Spec, enc: Enclosure) -> tuple[Margin, ...]:
