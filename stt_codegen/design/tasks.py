@@ -54,9 +54,10 @@ HOLD_LEAD = 0.25
 STAY_LEAD = 0.25
 #: Most combinations of ``any_of`` alternatives tried.
 MAX_PLANS = 16
-#: Free timing: a reach task's hold lasts this share of its window and starts at least
-#: half as much after the window opens.
+#: Free timing: a reach task's hold lasts this share of its window, at most
+#: :data:`FREE_HOLD` seconds, and is kept half as much from the window's ends.
 FREE_HOLD_SHARE = 0.25
+FREE_HOLD = 0.5
 #: Free timing: the shortest leg between two holds, seconds.
 MIN_LEG = 0.25
 #: Free timing: the estimated speeds tried, multiples of the even speed (the centres'
@@ -194,8 +195,8 @@ def _span(task: Task) -> tuple[float, float, float]:
         if task.duration is None or task.duration + 2 * STAY_LEAD > w:
             return t0 - STAY_LEAD, t1, w + STAY_LEAD
         return t0, t1, task.duration + 2 * STAY_LEAD
-    lead = 0.5 * FREE_HOLD_SHARE * w
-    return t0 + lead, t1 - lead, FREE_HOLD_SHARE * w
+    hold = min(FREE_HOLD_SHARE * w, FREE_HOLD)
+    return t0 + 0.5 * hold, t1 - 0.5 * hold, hold
 
 
 def _free_holds(spec: Spec, order: tuple[int, ...], boxes: list[tuple],
