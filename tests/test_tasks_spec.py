@@ -50,15 +50,13 @@ BAD = [
     ({**REACH, "upper": [6.0, 1.0]}, "tasks[0]", "not inside the state space"),
     ({**REACH, "lower": [2.5, 0.5], "upper": [4.0, 2.5]}, "tasks[0]", "meets obstacle 0"),
     ({"kind": "reach", "window": [2.0, 3.0]}, "tasks[0].lower", "missing"),
-    ({**STAY, "any_of": [{"lower": [0.0, 3.5], "upper": [1.0, 4.0]}]}, "tasks[0].any_of",
-     "only a reach task"),
     ({**REACH, "any_of": [{"lower": [0.0, 3.5], "upper": [1.0, 4.0]}]}, "tasks[0].any_of",
      "not both"),
     ({"kind": "reach", "window": [2.0, 3.0], "any_of": []}, "tasks[0].any_of",
      "must not be empty"),
     ({"kind": "reach", "window": [2.0, 3.0], "any_of": [{"lower": [2.5, 2.5],
                                                           "upper": [3.5, 3.5]}]},
-     "tasks[0].any_of[0]", "meets obstacle 0"),
+     "tasks[0].any_of", "every box meets an obstacle (any_of[0]: obstacle 0)"),
     ({**REACH, "colour": "red"}, "tasks[0].colour", "unknown key (allowed: any_of, duration, kind,"),
     ({"kind": "reach", "window": [2.0, 3.0], "any_of": [{"lower": [0.0, 3.5],
                                                           "upper": [1.0, 4.0], "x": 1}]},
@@ -82,6 +80,22 @@ def test_windows_may_overlap_and_come_in_any_order():
     with pytest.raises(SpecError) as info:
         Spec.from_dict(doc([REACH], task_order={"order": "shortest"}))
     assert info.value.field == "task_order.order"
+
+
+def test_an_any_of_box_that_meets_an_obstacle_is_dropped_while_one_remains():
+    """any_of for reach and stay; a box meeting the obstacle ([2, 3]^2) is dropped and
+    noted, the others keep their any_of index."""
+    boxes = [{"lower": [0.0, 3.5], "upper": [1.0, 4.0]},
+             {"lower": [2.5, 2.5], "upper": [3.5, 3.5]},
+             {"lower": [3.5, 0.5], "upper": [4.0, 1.0]}]
+    spec = Spec.from_dict(doc([{"kind": "stay", "window": [5.0, 6.0], "any_of": boxes},
+                               {"kind": "reach", "window": [7.0, 8.0], "any_of": boxes}]))
+    for task in spec.tasks:
+        assert task.any_of_index == (0, 2) and task.dropped == ((1, 0),)
+        assert [b.lower for b in task.boxes] == [(0.0, 3.5), (3.5, 0.5)]
+    with pytest.raises(SpecError) as info:     # a single box meeting one is still an error
+        Spec.from_dict(doc([{**STAY, **boxes[1]}]))
+    assert info.value.field == "tasks[0]" and "meets obstacle 0" in info.value.reason
 
 
 def test_a_stay_duration_lies_in_its_window():

@@ -164,3 +164,42 @@ def test_the_run_judge_reads_a_stay_duration_as_stated():
         assert outcome.met is met, (start, end, outcome)
         if met:
             assert outcome.time == pytest.approx(start) and outcome.margin == pytest.approx(0.5)
+
+
+# --------------------------------------------------------------------------- or-goals
+
+
+def test_stay_any_of_switching_boxes_mid_window_is_rejected():
+    """Two adjacent stay boxes ([2, 3] x [2, 3] and [3, 4] x [2, 3]): a tube in the first
+    for the window's first half and in the second for its second half is always in one
+    of them, but in no one box over the window: rejected. Held in the second: passes,
+    and the certificate names the box."""
+    tasks = [{"kind": "stay", "window": [4.0, 6.0],
+              "any_of": [{"lower": [2.0, 2.0], "upper": [3.0, 3.0]},
+                         {"lower": [3.0, 2.0], "upper": [4.0, 3.0]}]}]
+    spec = spec_of(arena(2, tasks, obstacles=[]))
+    first, second = _centred((2.5, 2.5)), _centred((3.5, 2.5))
+    switch = _tube_with(spec, [(3.5, *first), (4.99, *first), (5.01, *second),
+                               (6.5, *second), (8.0, *second)])
+    m = margins(certify_tube(switch, spec))["task T1 stay"]
+    assert not m.passed, m
+    held = _tube_with(spec, [(3.5, *second), (6.5, *second), (8.0, *second)])
+    m = margins(certify_tube(held, spec))["task T1 stay"]
+    assert m.passed and "any_of[1]" in m.detail, m
+    t = np.linspace(0.0, 8.0, 8001)
+    x = np.where((t < 5.0)[:, None], [2.5, 2.5], [3.5, 2.5])
+    assert not judge_task(spec.tasks[0], t, x).met          # the run judge agrees
+    outcome = judge_task(spec.tasks[0], t, np.tile([3.5, 2.5], (t.size, 1)))
+    assert outcome.met and outcome.box == 1
+
+
+def test_stay_any_of_box_meeting_an_obstacle_is_dropped_and_the_design_says_so():
+    tasks = [{"kind": "stay", "window": [4.0, 6.0],
+              "any_of": [{"lower": [2.2, 2.2], "upper": [2.8, 2.8]},      # in the obstacle
+                         {"lower": [0.5, 3.3], "upper": [1.5, 4.3]}]}]
+    spec = spec_of(arena(2, tasks, t_c=12.0))
+    design = design_tube(spec)
+    m = margins(design.certificate)["task T1 stay"]
+    assert m.passed and m.margin > 0.01
+    (doc,) = design.to_json()["tasks"]
+    assert doc["alternative"] == 1 and doc["dropped"] == [{"any_of": 0, "obstacle": 0}]

@@ -54,7 +54,9 @@ def cmd_design(args: argparse.Namespace) -> int:
         print(f"  reach segment {s.profile} [{s.start:.3f}, {s.end:.3f}] s to {box}")
     plan = design.task_plan
     for k, (task, q) in enumerate(zip(spec.tasks, design.task_choices)):      # [[tasks]]
-        which = f" (any_of[{q}])" if len(task.boxes) > 1 else ""
+        which = f" (any_of[{task.any_of_index[q]}])" if len(task.boxes) > 1 else ""
+        for i, o in task.dropped:
+            print(f"  note: task {task.label} any_of[{i}] meets obstacle {o}: dropped")
         visit = "" if plan is None else (f", visit {plan.order.index(k) + 1}, held over "
                                          f"[{plan.holds[k][0]:.3f}, {plan.holds[k][1]:.3f}] s")
         print(f"  task {task.label} {task.kind} [{task.window[0]:g}, {task.window[1]:g}] s: "

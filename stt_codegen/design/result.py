@@ -219,7 +219,9 @@ class Design:
             m = margins.get(task.name)
             out.append({"task": task.label, "kind": task.kind, "window": list(task.window),
                         "duration": task.duration,
-                        "alternative": q, "lower": list(task.boxes[q].lower),
+                        "alternative": task.any_of_index[q],
+                        "dropped": [{"any_of": i, "obstacle": o} for i, o in task.dropped],
+                        "lower": list(task.boxes[q].lower),
                         "upper": list(task.boxes[q].upper),
                         "visit": None if plan is None else plan.order.index(k) + 1,
                         "hold": None if plan is None else list(plan.holds[k]),

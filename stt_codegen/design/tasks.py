@@ -159,8 +159,8 @@ def _boxes(spec: Spec, base: TubeDesign, order: tuple[int, ...],
     return out
 
 
-def _listed_holds(spec: Spec, order: tuple[int, ...],
-                  boxes: list[tuple], base: TubeDesign) -> list[tuple[float, float]] | None:
+def _listed_holds(spec: Spec, order: tuple[int, ...], boxes: list[tuple], base: TubeDesign,
+                  choice: tuple[int, ...]) -> list[tuple[float, float]] | None:
     """The fixed holds (module notes: the middle half of a reach window, a stay's whole
     window entered up to :data:`STAY_LEAD` early) when they follow one another in visit
     order and no stay task has a duration; else ``None``."""
@@ -174,7 +174,7 @@ def _listed_holds(spec: Spec, order: tuple[int, ...],
             return None
         if task.kind == STAY:
             arrive, until = t0 - min(STAY_LEAD, 0.25 * (t0 - leave)), t1
-            if not arrive > leave and _within(start, task.boxes[0]):
+            if not arrive > leave and _within(start, task.boxes[choice[k]]):
                 out.append((leave, until))      # held where the tube already is
                 leave = until
                 continue
@@ -267,7 +267,7 @@ def task_schedule(spec: Spec, base: TubeDesign, order: tuple[int, ...],
         window.
     """
     boxes = _boxes(spec, base, order, choice)
-    holds = _listed_holds(spec, order, boxes, base)
+    holds = _listed_holds(spec, order, boxes, base, choice)
     if holds is None:
         holds, reason = _free_holds(spec, order, boxes, base)
         if holds is None:
