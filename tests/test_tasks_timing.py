@@ -203,3 +203,39 @@ def test_stay_any_of_box_meeting_an_obstacle_is_dropped_and_the_design_says_so()
     assert m.passed and m.margin > 0.01
     (doc,) = design.to_json()["tasks"]
     assert doc["alternative"] == 1 and doc["dropped"] == [{"any_of": 0, "obstacle": 0}]
+
+
+def _two_targets(obstacles: list) -> dict:
+    doc = arena(2, [], obstacles=obstacles, t_c=10.0)
+    doc.pop("tasks")
+    doc["target"] = {"any_of": [{"lower": [4.4, 4.4], "upper": [5.0, 5.0]},
+                                {"lower": [4.4, 0.0], "upper": [5.0, 0.6]}]}
+    doc["tube"] = {"method": "auto"}
+    return doc
+
+
+def test_target_any_of_ends_in_the_first_box_that_designs_and_says_which():
+    """The first target box is walled in (an L of obstacles around it): the tube ends in
+    the second, the design's spec has it as its target and the report says so; the tube
+    is not accepted against the first box."""
+    walls = [{"lower": [3.6, 3.6], "upper": [5.0, 3.9]}, {"lower": [3.6, 3.9], "upper": [3.9, 5.0]}]
+    spec = spec_of(_two_targets(walls))
+    assert [q for q, _ in spec.target_any_of] == [0, 1]
+    design = design_tube(spec)
+    assert design.target_choice == 1 and design.certificate.passed
+    assert design.spec.target_set.lower == (4.4, 0.0)
+    doc = design.to_json()["target_choice"]
+    assert doc["alternative"] == 1 and doc["dropped"] == []
+    first = spec.target_any_of[0][1]
+    m = margins(certify_tube(design.tube, first))["inside target after t_c"]
+    assert not m.passed, m
+
+
+def test_target_any_of_box_meeting_an_obstacle_is_dropped_with_a_note():
+    blocks = [{"lower": [4.6, 4.6], "upper": [4.8, 4.8]}]        # inside the first box
+    spec = spec_of(_two_targets(blocks))
+    assert spec.target_dropped == ((0, "obstacles[0]"),)
+    design = design_tube(spec)
+    assert design.target_choice == 1 and design.certificate.passed
+    assert design.to_json()["target_choice"]["dropped"] == [{"any_of": 0,
+                                                              "obstacle": "obstacles[0]"}]

@@ -52,6 +52,10 @@ def cmd_design(args: argparse.Namespace) -> int:
     for s in tube.segments:
         box = ", ".join(f"[{a:.3g}, {b:.3g}]" for a, b in zip(s.lower_to, s.upper_to))
         print(f"  reach segment {s.profile} [{s.start:.3f}, {s.end:.3f}] s to {box}")
+    if design.target_choice is not None:         # [target] any_of
+        print(f"  target: any_of[{design.target_choice}]")
+        for q, name in spec.target_dropped:
+            print(f"  note: target any_of[{q}] meets {name}: dropped")
     plan = design.task_plan
     for k, (task, q) in enumerate(zip(spec.tasks, design.task_choices)):      # [[tasks]]
         which = f" (any_of[{task.any_of_index[q]}])" if len(task.boxes) > 1 else ""

@@ -92,6 +92,9 @@ class Design:
         For a spec with ``[[tasks]]``: per task, the index of the box the tube was
         planned through (the ``any_of`` alternative; 0 for a single box); empty
         otherwise (docs/tasks.md).
+    target_choice : int or None
+        For a spec with ``[target] any_of``: the ``any_of`` index of the target box the
+        tube ends in (``spec``'s target is that box); ``None`` otherwise.
     task_plan : TaskPlan or None
         For a spec with ``[[tasks]]``: the visit order and each task's hold, the interval
         over which ``rho`` holds its waypoint box (:mod:`~stt_codegen.design.tasks`).
@@ -109,6 +112,7 @@ class Design:
                                            kw_only=True)
     task_choices: tuple[int, ...] = field(default=(), repr=False, kw_only=True)
     task_plan: TaskPlan | None = field(default=None, compare=False, repr=False, kw_only=True)
+    target_choice: int | None = field(default=None, kw_only=True)
     motion: str = field(default="", compare=False, kw_only=True)
 
     @property
@@ -201,10 +205,23 @@ class Design:
             "design_time_s": self.design_time_s,
             **self._actuator_json(),
             **self._tasks_json(),
+            **self._target_json(),
             **self._motion_json(),
             **self._cascade_json(),
             **robot_json(self.spec),
         }
+
+    def _target_json(self) -> dict[str, Any]:
+        """``target_choice``: for a spec with ``[target] any_of`` only, the box the tube
+        ends in and the boxes dropped (an obstacle meets them)."""
+        if self.target_choice is None:
+            return {}
+        return {"target_choice": {
+            "alternative": self.target_choice,
+            "lower": list(self.spec.target_set.lower),
+            "upper": list(self.spec.target_set.upper),
+            "dropped": [{"any_of": q, "obstacle": name}
+                        for q, name in self.spec.target_dropped]}}
 
     def _tasks_json(self) -> dict[str, Any]:
         """``tasks``: per ``[[tasks]]`` entry its label, kind, window, the box planned

@@ -309,12 +309,35 @@ def design_tube(spec: Spec) -> Design:
                 else "; load it with load_spec" if isinstance(spec, str) else "")
         raise TypeError(f"design_tube(): parameter 'spec' must be a Spec, not "
                         f"{type(spec).__name__}{hint}")
+    if spec.target_any_of:                # [target] any_of: the first box that designs
+        return _any_target(spec)
     design = _position_stage(spec)
     # a second-order spec: the sampled cascade must be certified on the final tube, whatever
     # path designed it (design/cascade_gain.py)
     if spec.order == 2:
         design.second_stage      # DesignError unless the sampled cascade is certified
     return design
+
+
+def _any_target(spec: Spec) -> Design:
+    """:func:`design_tube` with each target box of ``[target] any_of`` in turn; the first
+    designed and certified is kept, its spec carrying the alternatives (docs/tasks.md,
+    "Or-goals")."""
+    failures: list[tuple[int, DesignError]] = []
+    for q, variant in spec.target_any_of:
+        try:
+            design = design_tube(replace(variant, source_hash=spec.source_hash))
+        except DesignError as exc:
+            failures.append((q, exc))
+            continue
+        chosen = replace(variant, source_hash=spec.source_hash,
+                         target_any_of=spec.target_any_of, target_dropped=spec.target_dropped)
+        return replace(design, spec=chosen, target_choice=q)
+    q, first = failures[0]
+    more = (f" (and target any_of[{', '.join(str(k) for k, _ in failures[1:])}])"
+            if len(failures) > 1 else "")
+    raise DesignError(f"target any_of[{q}]: {first}{more}", kind=first.kind,
+                      tried=first.tried)
 
 
 def _position_stage(spec: Spec) -> Design:

@@ -261,6 +261,13 @@ class Spec:
         default ``d_T`` to keep an obstacle beside the target out of the target box).
     tasks : tuple of Task
         The ``[[tasks]]`` entries (:mod:`~.tasks`, docs/tasks.md); empty without them.
+    target_any_of : tuple of (int, Spec)
+        ``[target] any_of``: per target box kept, its ``any_of`` index and the spec with
+        that box as the target (whose own ``target_any_of`` is empty); this spec is the
+        first of them. Empty for a single target.
+    target_dropped : tuple of (int, str)
+        ``[target] any_of`` boxes dropped because an obstacle meets them: the index and
+        the obstacle's field.
     task_order : {"listed", "any"}
         ``[task_order] order``: the tasks are visited in the listed order, or in the order
         the design chooses.
@@ -298,6 +305,9 @@ class Spec:
     target_half_width_given: bool = True
     tasks: tuple[Task, ...] = ()
     task_order: str = "listed"
+    target_any_of: tuple[tuple[int, "Spec"], ...] = field(default=(), compare=False,
+                                                          repr=False)
+    target_dropped: tuple[tuple[int, str], ...] = ()
     moving_obstacles: tuple[MovingObstacle, ...] = ()
     robot: Robot | None = None
 
@@ -549,8 +559,39 @@ def _replace_hash(spec: Spec, digest: str) -> Spec:
 # sign and enum (spec/schema.py), and given the defaults.
 
 
+def _any_target(raw: dict, doc: Any) -> Spec:
+    """A spec with ``[target] any_of``: one spec per target box (an obstacle meeting a box
+    drops it), the first kept one carrying them all (``Spec.target_any_of``)."""
+    given = [k for k in ("lower", "upper", "center", "half_width")
+             if getattr(doc.target, k) is not None]
+    if given:
+        raise SpecError("target.any_of", f"give either any_of or {'/'.join(given)}, not "
+                        "both (each target box takes its own default centre and half-width)")
+    kept, dropped = [], []
+    for q, box in enumerate(doc.target.any_of):
+        variant = {**raw, "target": {"lower": box.lower, "upper": box.upper}}
+        try:
+            kept.append((q, _validate(variant)))
+        except SpecError as exc:
+            if exc.reason.startswith("meets the target set"):
+                dropped.append((q, exc.field))
+                continue
+            field_name = exc.field.replace("target", f"target.any_of[{q}]", 1) \
+                if exc.field.startswith("target") else exc.field
+            raise SpecError(field_name, exc.reason) from None
+    if not kept:
+        raise SpecError("target.any_of", "every box meets an obstacle (" + ", ".join(
+            f"any_of[{q}]: {name}" for q, name in dropped) + ")")
+    return replace(kept[0][1], target_any_of=tuple(kept), target_dropped=tuple(dropped))
+
+
 def _validate(raw: dict) -> Spec:
     doc = check_document(raw)
+    if doc.target.any_of is not None:
+        return _any_target(raw, doc)
+    for key in ("lower", "upper"):
+        if getattr(doc.target, key) is None:
+            raise SpecError(f"target.{key}", "missing (give lower and upper, or any_of)")
     state_space = _box(doc.state_space, "state_space", None)
     n = len(state_space.lower)
 

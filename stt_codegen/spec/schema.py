@@ -101,8 +101,15 @@ class InitialTable(BoxTable):
 
 
 class TargetTable(BoxTable):
-    """The target set ``T`` (a box inside ``X``)."""
+    """The target set ``T`` (a box inside ``X``), or several (``any_of``)."""
 
+    lower: Vector = _omitted("lower corner, state units (or any_of)")
+    upper: Vector = _omitted("upper corner, state units; upper >= lower")
+    any_of: Annotated[list["TaskBoxTable"], Field(min_length=1,
+                                                  max_length=MAX_ALTERNATIVES)] = _omitted(
+        "target boxes of which the tube ends in one (instead of lower/upper); the design "
+        "picks the first that it certifies, in this order, and drops one that meets an "
+        "obstacle")
     center: Vector = _omitted("eta of eq. (3), in the interior of T; default its centre")
     half_width: Vector = _omitted("d_T of eq. (3), positive; default 0.8 x the room around "
                                   "eta in T")
