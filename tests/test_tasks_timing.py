@@ -239,3 +239,14 @@ def test_target_any_of_box_meeting_an_obstacle_is_dropped_with_a_note():
     assert design.target_choice == 1 and design.certificate.passed
     assert design.to_json()["target_choice"]["dropped"] == [{"any_of": 0,
                                                               "obstacle": "obstacles[0]"}]
+
+
+def test_free_timing_with_an_actuator_bound_keeps_the_tasks():
+    """Overlapping windows under [actuator]: the design is proved within the bound and
+    every task is still certified, with the visits the tasks' plan chose."""
+    tasks = [reach(C, [2.0, 12.0]), reach(A, [2.0, 12.0])]
+    doc = {**arena(2, tasks, obstacles=[], t_c=15.0), "actuator": {"input_bound": [3.0, 3.0]}}
+    design = design_tube(spec_of(doc))
+    assert design.input_proof.meets((3.0, 3.0)) and design.certificate.passed
+    assert design.task_plan is not None and design.task_plan.order == (0, 1)
+    assert all(margins(design.certificate)[t.name].passed for t in design.spec.tasks)

@@ -201,37 +201,55 @@ def _span(task: Task) -> tuple[float, float, float]:
 
 def _free_holds(spec: Spec, order: tuple[int, ...], boxes: list[tuple],
                 base: TubeDesign) -> tuple[list[tuple[float, float]] | None, str]:
-    """The earliest holds in visit order with estimated travel times (module notes), or
-    ``None`` and why not in the user's terms (which task, which window)."""
+    """The holds of free timing in visit order (module notes), or ``None`` and why not in
+    the user's terms (which task, which window).
+
+    With travel times at an estimated speed (the even speed, then faster), the earliest
+    holds (each as soon as its window and the travel from the previous allow) and the
+    latest (as late as the later ones and the target still allow) bound each hold's start;
+    within them each starts when the even speed along the whole path would get there, so
+    the legs' speeds stay near it."""
     centres = [_centre((base.initial_lower, base.initial_upper))]
     centres += [_centre(b) for b in boxes] + [_centre((base.target_lower, base.target_upper))]
-    length = sum(float(np.linalg.norm(b - a)) for a, b in zip(centres, centres[1:]))
+    legs = [float(np.linalg.norm(b - a)) for a, b in zip(centres, centres[1:])]
+    length = sum(legs)
     spans = [_span(spec.tasks[k]) for k in order]
     spare = base.prescribed_time - sum(s[2] for s in spans)
     reason = ""
     for factor in SPEED_FACTORS:
-        speed = factor * length / max(spare, MIN_LEG)
-        leave, out, previous = 0.0, [], "the start"
+        speed = max(factor * length / max(spare, MIN_LEG), 1e-12)
+        travel = [max(d / speed, MIN_LEG) for d in legs]
+        leave, early, previous = 0.0, [], "the start"
         for j, (k, (earliest, latest, hold)) in enumerate(zip(order, spans)):
-            travel = max(float(np.linalg.norm(centres[j + 1] - centres[j])) / max(speed, 1e-12),
-                         MIN_LEG)
-            arrive = max(earliest, leave + travel)
+            arrive = max(earliest, leave + travel[j])
             task = spec.tasks[k]
             if arrive + hold > latest + 1e-12:
                 reason = (f"task {task.label} ({task.kind}, window [{task.window[0]:g}, "
                           f"{task.window[1]:g}] s) cannot be met after {previous} (left at "
-                          f"{leave:.3g} s, about {travel:.3g} s away at the fastest speed "
+                          f"{leave:.3g} s, about {travel[j]:.3g} s away at the fastest speed "
                           f"tried)")
                 break
-            out.append((arrive, arrive + hold))
+            early.append(arrive)
             leave, previous = arrive + hold, f"task {task.label}"
         else:
-            travel = max(float(np.linalg.norm(centres[-1] - centres[-2])) / max(speed, 1e-12),
-                         MIN_LEG)
-            if leave + travel <= base.prescribed_time:
-                return out, ""
-            reason = (f"no time to reach the target by {base.prescribed_time:g} s after "
-                      f"{previous} (left at {leave:.3g} s)")
+            if leave + travel[-1] > base.prescribed_time:
+                reason = (f"no time to reach the target by {base.prescribed_time:g} s after "
+                          f"{previous} (left at {leave:.3g} s)")
+                continue
+            late = [0.0] * len(spans)
+            bound = base.prescribed_time - travel[-1]
+            for j in reversed(range(len(spans))):
+                late[j] = min(spans[j][1], bound) - spans[j][2]
+                bound = late[j] - travel[j]
+            share = spare / length if length > 0 else 0.0
+            out, leave, elapsed = [], 0.0, 0.0
+            for j, (earliest, _, hold) in enumerate(spans):
+                even = elapsed + share * sum(legs[:j + 1])
+                # late[j] >= max(earliest, leave + travel[j]): the earliest holds exist
+                start = min(max(even, earliest, leave + travel[j]), late[j])
+                out.append((start, start + hold))
+                leave, elapsed = start + hold, elapsed + hold
+            return out, ""
     return None, reason
 
 
