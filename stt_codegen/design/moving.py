@@ -275,6 +275,8 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
         The static plan's segments (via boxes), in order.
     spec : Spec
         The spec with its moving obstacles (and tasks).
+    order : sequence of int, optional
+        The tasks' visit order (``TaskPlan.order``); default the spec's order.
 
     Returns
     -------

@@ -40,7 +40,7 @@ from ..tube.parameters import SMOOTHSTEP, ReachSegment, TubeDesign, paper_segmen
 from .failures import FailureKind
 from .via import plan_via
 
-__all__ = ["FREE_HOLD", "STAY_LEAD", "TaskPlan", "alternatives", "plan_tasks", "task_schedule",
+__all__ = ["FREE_HOLD", "MAX_PLANS", "STAY_LEAD", "TaskPlan", "alternatives", "plan_tasks", "task_schedule",
            "visit_orders"]
 
 #: A waypoint box's half-width, at most this share of the task box's.
