@@ -15,9 +15,9 @@ from test_tasks import _centred, _inside_at_samples, _tube_with, arena, margins,
 
 from stt_codegen.design.certificate import certify_tube
 from stt_codegen.design.failures import FailureKind
-from stt_codegen.design.search import base_design, design_tube
+from stt_codegen.design.search import base_design, check_tube, design_tube
 from stt_codegen.design.tasks import EXACT_ORDERS, task_schedule, visit_orders
-from stt_codegen.errors import DesignError
+from stt_codegen.errors import DesignError, SpecError
 from stt_codegen.runtime.simulate import simulate
 from stt_codegen.runtime.tasks import judge_task
 from stt_codegen.spec.loader import Spec, load_spec
@@ -278,3 +278,44 @@ def test_free_example_with_a_moving_box_is_retimed_in_its_visit_order():
     names = [m.name for m in design.certificate.margins if m.passed]
     assert {"task T1 reach", "task T2 reach", "task T3 stay"} <= set(names)
     assert any(name.startswith("avoids moving obstacle") for name in names)
+
+
+# --------------------------------------------------------------------------- until
+
+
+DOOR_TASK = {"kind": "reach", "window": [2.0, 4.0], "lower": [0.5, 3.5], "upper": [1.5, 4.5]}
+DOOR = {"lower": [2.0, 0.0], "upper": [3.0, 5.0], "active_until": "T1"}
+
+
+def test_an_obstacle_until_a_task_is_designed_around_and_certified():
+    """A wall across the arena exists until T1 (a box left of it) is met: the tube visits
+    T1, then crosses where the wall was; the wall is a box active over [0, 4] s (T1's
+    window end)."""
+    spec = spec_of(arena(2, [DOOR_TASK], obstacles=[DOOR], t_c=12.0))
+    (wall,) = spec.moving_obstacles
+    assert wall.active == (0.0, 4.0)
+    design = design_tube(spec)
+    found = margins(design.certificate)
+    assert found["avoids moving obstacle 0"].passed and found["task T1 reach"].passed
+    for bad, reason in (({**DOOR, "active_until": "T2"}, "no task T2"),
+                        ({**DOOR, "active": [0.0, 1.0]}, "either active or active_until")):
+        with pytest.raises(SpecError) as info:
+            spec_of(arena(2, [DOOR_TASK], obstacles=[bad], t_c=12.0))
+        assert info.value.field == "obstacles[0].active_until" and reason in info.value.reason
+
+
+def test_a_tube_through_the_wall_before_its_task_is_met_is_rejected():
+    """The tube crosses the wall's band at about 1 s, before it reaches T1 (at 3 s, inside
+    the window): the task alone is met, the wall is not avoided while it exists:
+    rejected. The same route crossing after 4 s passes."""
+    spec = spec_of(arena(2, [DOOR_TASK], obstacles=[DOOR], t_c=12.0))
+    band, left, task = _centred((2.5, 1.0)), _centred((1.0, 1.0)), _centred((1.0, 4.0))
+    right = _centred((3.8, 4.0))
+    early = _tube_with(spec, [(0.8, *left), (1.2, *band), (1.6, *right), (2.6, *task),
+                              (3.4, *task), (8.0, *right)])
+    check = check_tube(early, spec)
+    assert not check.passed and "moving obstacle 0" in check.reason, check.reason
+    assert margins(certify_tube(early, spec))["task T1 reach"].passed
+    late = _tube_with(spec, [(2.6, *task), (3.4, *task), (4.0, *_centred((1.5, 4.0))),
+                             (6.0, *right)])
+    assert check_tube(late, spec).passed, check_tube(late, spec).reason

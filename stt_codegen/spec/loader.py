@@ -585,6 +585,34 @@ def _any_target(raw: dict, doc: Any) -> Spec:
     return replace(kept[0][1], target_any_of=tuple(kept), target_dropped=tuple(dropped))
 
 
+def _until_tasks(doc: Any) -> Any:
+    """``doc`` with each obstacle's ``active_until = "Tk"`` turned into ``active = [0, t1]``,
+    ``t1`` the end of task ``Tk``'s window: the task is met by then in any run that meets it,
+    so keeping clear of the box over ``[0, t1]`` keeps clear of it while it exists (a
+    stronger property than needed; docs/tasks.md, "Obstacles until a task")."""
+    if not any(getattr(o, "active_until", None) is not None for o in doc.obstacles):
+        return doc
+    tasks = doc.tasks or []
+    obstacles = []
+    for j, table in enumerate(doc.obstacles):
+        label = getattr(table, "active_until", None)
+        if label is None:
+            obstacles.append(table)
+            continue
+        name = f"obstacles[{j}].active_until"
+        if table.active is not None:
+            raise SpecError(name, "give either active or active_until, not both")
+        k = int(label[1:]) - 1
+        if k >= len(tasks):
+            raise SpecError(name, f"no task {label} (the spec has {len(tasks)} task(s))")
+        if tasks[k].kind != "reach":
+            raise SpecError(name, f"task {label} is a {tasks[k].kind} task; an obstacle "
+                            "lasts until a reach task is met")
+        obstacles.append(table.model_copy(update={"active": [0.0, float(tasks[k].window[1])],
+                                                  "active_until": None}))
+    return doc.model_copy(update={"obstacles": obstacles})
+
+
 def _validate(raw: dict) -> Spec:
     doc = check_document(raw)
     if doc.target.any_of is not None:
@@ -611,6 +639,7 @@ def _validate(raw: dict) -> Spec:
     _interior(eta, target_set, "target.center", "target set")
     d_t = _half_width(doc.target.half_width, "target", eta, target_set, "target set")
 
+    doc = _until_tasks(doc)
     unsafe_sets = tuple(_unsafe_set(table, f"obstacles[{j}]", state_space, j)
                         for j, table in enumerate(doc.obstacles) if not is_moving(table))
     moving = tuple(_moving(table, f"obstacles[{j}]", j, state_space, initial_set, target_set,

@@ -125,6 +125,9 @@ class BoxObstacle(_Table):
     # moving obstacles (docs/moving-obstacles.md; cross-field rules: spec/motion.py)
     active: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = _omitted(
         "[t_on, t_off], seconds, t_on < t_off: when the obstacle exists; default always")
+    active_until: Annotated[str, Strict(), Field(pattern=r"^T[1-9][0-9]*$")] = _omitted(
+        "a reach task's label (\"T1\"...): the obstacle exists from 0 until that task is "
+        "met; the design keeps clear of it until the task's window ends (instead of active)")
     velocity: Vector = _omitted("state units/s on dims: the box translates from lower/upper "
                                 "at t_on; without active, from 0 until it has left the "
                                 "state space")
