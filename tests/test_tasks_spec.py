@@ -50,16 +50,14 @@ BAD = [
     ({**REACH, "upper": [6.0, 1.0]}, "tasks[0]", "not inside the state space"),
     ({**REACH, "lower": [2.5, 0.5], "upper": [4.0, 2.5]}, "tasks[0]", "meets obstacle 0"),
     ({"kind": "reach", "window": [2.0, 3.0]}, "tasks[0].lower", "missing"),
-    ({**STAY, "any_of": [{"lower": [0.0, 3.5], "upper": [1.0, 4.0]}]}, "tasks[0].any_of",
-     "only a reach task"),
     ({**REACH, "any_of": [{"lower": [0.0, 3.5], "upper": [1.0, 4.0]}]}, "tasks[0].any_of",
      "not both"),
     ({"kind": "reach", "window": [2.0, 3.0], "any_of": []}, "tasks[0].any_of",
      "must not be empty"),
     ({"kind": "reach", "window": [2.0, 3.0], "any_of": [{"lower": [2.5, 2.5],
                                                           "upper": [3.5, 3.5]}]},
-     "tasks[0].any_of[0]", "meets obstacle 0"),
-    ({**REACH, "colour": "red"}, "tasks[0].colour", "unknown key (allowed: any_of, kind,"),
+     "tasks[0].any_of", "every box meets an obstacle (any_of[0]: obstacle 0)"),
+    ({**REACH, "colour": "red"}, "tasks[0].colour", "unknown key (allowed: any_of, duration, kind,"),
     ({"kind": "reach", "window": [2.0, 3.0], "any_of": [{"lower": [0.0, 3.5],
                                                           "upper": [1.0, 4.0], "x": 1}]},
      "tasks[0].any_of[0].x", "unknown key (allowed: lower, upper)"),
@@ -73,12 +71,45 @@ def test_a_bad_task_is_a_spec_error_naming_the_field(task, field, reason):
     assert info.value.field == field and reason in info.value.reason, str(info.value)
 
 
-def test_windows_come_in_order_without_overlap():
+def test_windows_may_overlap_and_come_in_any_order():
+    overlapping = {**REACH, "window": [5.5, 7.0]}
+    spec = Spec.from_dict(doc([STAY, REACH, overlapping]))
+    assert [t.window for t in spec.tasks] == [(5.0, 6.0), (2.0, 3.0), (5.5, 7.0)]
+    assert spec.task_order == "listed"
+    assert Spec.from_dict(doc([REACH], task_order={"order": "any"})).task_order == "any"
     with pytest.raises(SpecError) as info:
-        Spec.from_dict(doc([STAY, REACH]))
-    assert info.value.field == "tasks[1].window" and "before the previous" in str(info.value)
-    touching = {**REACH, "window": [6.0, 7.0]}
-    assert len(Spec.from_dict(doc([STAY, touching])).tasks) == 2
+        Spec.from_dict(doc([REACH], task_order={"order": "shortest"}))
+    assert info.value.field == "task_order.order"
+
+
+def test_an_any_of_box_that_meets_an_obstacle_is_dropped_while_one_remains():
+    """any_of for reach and stay; a box meeting the obstacle ([2, 3]^2) is dropped and
+    noted, the others keep their any_of index."""
+    boxes = [{"lower": [0.0, 3.5], "upper": [1.0, 4.0]},
+             {"lower": [2.5, 2.5], "upper": [3.5, 3.5]},
+             {"lower": [3.5, 0.5], "upper": [4.0, 1.0]}]
+    spec = Spec.from_dict(doc([{"kind": "stay", "window": [5.0, 6.0], "any_of": boxes},
+                               {"kind": "reach", "window": [7.0, 8.0], "any_of": boxes}]))
+    for task in spec.tasks:
+        assert task.any_of_index == (0, 2) and task.dropped == ((1, 0),)
+        assert [b.lower for b in task.boxes] == [(0.0, 3.5), (3.5, 0.5)]
+    with pytest.raises(SpecError) as info:     # a single box meeting one is still an error
+        Spec.from_dict(doc([{**STAY, **boxes[1]}]))
+    assert info.value.field == "tasks[0]" and "meets obstacle 0" in info.value.reason
+
+
+def test_a_stay_duration_lies_in_its_window():
+    spec = Spec.from_dict(doc([{**STAY, "window": [4.0, 8.0], "duration": 1.5},
+                               {**STAY, "window": [8.0, 9.0], "duration": 1.0}]))
+    assert [t.duration for t in spec.tasks] == [1.5, None]      # the whole window: None
+    assert [t.held for t in spec.tasks] == [1.5, 1.0]
+    for task, reason in (({**STAY, "duration": 2.0}, "longer than the window"),
+                         ({**REACH, "duration": 0.5}, "only a stay task"),
+                         ({**STAY, "duration": 0.0}, "positive")):
+        with pytest.raises(SpecError) as info:
+            Spec.from_dict(doc([task]))
+        assert info.value.field == "tasks[0].duration" and reason in info.value.reason, \
+            str(info.value)
 
 
 def test_tasks_need_via_points_and_take_an_actuator_bound():
@@ -132,6 +163,8 @@ def test_json_schema_describes_tasks():
     tasks = schema["properties"]["tasks"]
     assert tasks["type"] == "array"
     table = schema["$defs"]["TaskTable"]
-    assert set(table["properties"]) == {"kind", "window", "lower", "upper", "any_of"}
+    assert set(table["properties"]) == {"kind", "window", "lower", "upper", "any_of",
+                                         "duration"}
     assert table["properties"]["kind"]["enum"] == ["reach", "stay"]
+    assert schema["$defs"]["TaskOrderTable"]["properties"]["order"]["enum"] == ["listed", "any"]
     json.dumps(schema)

@@ -52,10 +52,19 @@ def cmd_design(args: argparse.Namespace) -> int:
     for s in tube.segments:
         box = ", ".join(f"[{a:.3g}, {b:.3g}]" for a, b in zip(s.lower_to, s.upper_to))
         print(f"  reach segment {s.profile} [{s.start:.3f}, {s.end:.3f}] s to {box}")
-    for task, q in zip(spec.tasks, design.task_choices):      # [[tasks]]
-        which = f" (any_of[{q}])" if len(task.boxes) > 1 else ""
+    if design.target_choice is not None:         # [target] any_of
+        print(f"  target: any_of[{design.target_choice}]")
+        for q, name in spec.target_dropped:
+            print(f"  note: target any_of[{q}] meets {name}: dropped")
+    plan = design.task_plan
+    for k, (task, q) in enumerate(zip(spec.tasks, design.task_choices)):      # [[tasks]]
+        which = f" (any_of[{task.any_of_index[q]}])" if len(task.boxes) > 1 else ""
+        for i, o in task.dropped:
+            print(f"  note: task {task.label} any_of[{i}] meets obstacle {o}: dropped")
+        visit = "" if plan is None else (f", visit {plan.order.index(k) + 1}, held over "
+                                         f"[{plan.holds[k][0]:.3f}, {plan.holds[k][1]:.3f}] s")
         print(f"  task {task.label} {task.kind} [{task.window[0]:g}, {task.window[1]:g}] s: "
-              f"planned through its box{which}")
+              f"planned through its box{which}{visit}")
     for m in design.certificate.margins:
         print(f"  {'PASS' if m.passed else 'FAIL'}  {m.name}: margin {m.margin:.4g}")
     if design.input_proof is not None:          # [actuator]

@@ -50,7 +50,7 @@ from .failures import FailureKind
 from .gain import derived_gain
 from .certificate.motion import MOVING_PROPERTY
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
-from .tasks import STAY_LEAD
+from .tasks import FREE_HOLD, STAY_LEAD
 from .via import VIA_MARGIN
 
 #: How the tube of a spec with moving obstacles was found (``Design.motion``).
@@ -69,7 +69,7 @@ MAX_ROUTES = 16
 #: over which the detour step (:func:`partial_spec`) sweeps it, in the order tried.
 DETOUR_SPANS = (1.0, 2.0)
 #: With ``[[tasks]]``: a reach task's waypoint box is held (``rho`` equal to it) over at
-#: least this share of the task's window, inside the window.
+#: least this share of the task's window (at most ``FREE_HOLD`` seconds), inside the window.
 TASK_HOLD_SHARE = 0.25
 
 
@@ -210,7 +210,8 @@ def _move_clear(seg: ReachSegment, spec: Spec) -> bool:
     return bool(_clear(lo, hi, spec, cuts[:-1], cuts[1:]).all())
 
 
-def task_holds(segments: Sequence[ReachSegment], spec: Spec) -> dict[int, Task] | None:
+def task_holds(segments: Sequence[ReachSegment], spec: Spec,
+               order: Sequence[int] | None = None) -> dict[int, Task] | None:
     """The hold segments of a tasks' plan (:func:`~.tasks.plan_tasks`), by segment index.
 
     Parameters
@@ -218,7 +219,9 @@ def task_holds(segments: Sequence[ReachSegment], spec: Spec) -> dict[int, Task] 
     segments : sequence of ReachSegment
         A via plan of ``spec``.
     spec : Spec
-        Its ``tasks`` (in window order).
+        Its ``tasks``.
+    order : sequence of int, optional
+        The plan's visit order (``TaskPlan.order``); default the spec's order.
 
     Returns
     -------
@@ -229,7 +232,7 @@ def task_holds(segments: Sequence[ReachSegment], spec: Spec) -> dict[int, Task] 
     """
     out: dict[int, Task] = {}
     k = 0
-    for task in spec.tasks:
+    for task in (spec.tasks if order is None else [spec.tasks[j] for j in order]):
         t0, t1 = task.window
         while k < len(segments) and not (
                 segments[k].lower_from == segments[k].lower_to
@@ -246,14 +249,19 @@ def task_holds(segments: Sequence[ReachSegment], spec: Spec) -> dict[int, Task] 
 
 def _hold_ok(task: Task, start: float, end: float) -> bool:
     """Whether holding the waypoint box over ``[start, end]`` (s) serves ``task``: a stay
-    task's whole window, or :data:`TASK_HOLD_SHARE` of a reach task's window inside it."""
+    task's whole window (its duration and ``STAY_LEAD`` inside the window, for a stay with
+    a duration), or :data:`TASK_HOLD_SHARE` of a reach task's window inside it (at most
+    ``FREE_HOLD`` seconds)."""
     t0, t1 = task.window
+    if task.kind == STAY and task.duration is not None:
+        return min(end, t1) - max(start, t0) >= task.duration + STAY_LEAD - 1e-9
     if task.kind == STAY:
         return start <= t0 + 1e-9 and end >= t1 - 1e-9
-    return min(end, t1) - max(start, t0) >= TASK_HOLD_SHARE * (t1 - t0) - 1e-9
+    return min(end, t1) - max(start, t0) >= min(TASK_HOLD_SHARE * (t1 - t0), FREE_HOLD) - 1e-9
 
 
-def retime(segments: tuple[ReachSegment, ...], spec: Spec) -> tuple[ReachSegment, ...] | None:
+def retime(segments: tuple[ReachSegment, ...], spec: Spec,
+           order: Sequence[int] | None = None) -> tuple[ReachSegment, ...] | None:
     """The via boxes of ``segments`` re-timed to miss the moving obstacles (module notes).
 
     With ``spec.tasks``, each task's hold segment (:func:`task_holds`) is not re-timed by
@@ -267,6 +275,8 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec) -> tuple[ReachSegment
         The static plan's segments (via boxes), in order.
     spec : Spec
         The spec with its moving obstacles (and tasks).
+    order : sequence of int, optional
+        The tasks' visit order (``TaskPlan.order``); default the spec's order.
 
     Returns
     -------
@@ -278,7 +288,7 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec) -> tuple[ReachSegment
     t_c = spec.prescribed_time
     tau = t_c / TIME_STEPS
     m = len(segments)
-    holds = task_holds(segments, spec)
+    holds = task_holds(segments, spec, order)
     if holds is None:
         return None
     boxes = [(np.array(s.lower_from), np.array(s.upper_from)) for s in segments]
@@ -462,7 +472,8 @@ def _retimed(via: Design | None, timing: Spec, spec: Spec,
     check otherwise, ``None`` when there is no via design or no re-timing."""
     if via is None:
         return None
-    segments = retime(via.tube.segments, timing)
+    segments = retime(via.tube.segments, timing,
+                      via.task_plan.order if via.task_plan is not None else None)
     if segments is None:
         return None
     tube = replace(via.tube, segments=segments)

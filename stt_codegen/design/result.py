@@ -17,6 +17,7 @@ from .input_bound import InputProof
 
 if TYPE_CHECKING:
     from ..spec.loader import Spec
+    from .tasks import TaskPlan
 
 __all__ = ["Design", "METHOD_PAPER", "METHOD_VIA", "TubeCheck", "require_design"]
 
@@ -91,6 +92,12 @@ class Design:
         For a spec with ``[[tasks]]``: per task, the index of the box the tube was
         planned through (the ``any_of`` alternative; 0 for a single box); empty
         otherwise (docs/tasks.md).
+    target_choice : int or None
+        For a spec with ``[target] any_of``: the ``any_of`` index of the target box the
+        tube ends in (``spec``'s target is that box); ``None`` otherwise.
+    task_plan : TaskPlan or None
+        For a spec with ``[[tasks]]``: the visit order and each task's hold, the interval
+        over which ``rho`` holds its waypoint box (:mod:`~stt_codegen.design.tasks`).
     motion : str
         For a spec with moving obstacles: how the tube avoids them (``"space-time"``,
         ``"timed via"`` or ``"swept"``, :mod:`~stt_codegen.design.moving`); else ``""``.
@@ -104,6 +111,8 @@ class Design:
     input_proof: InputProof | None = field(default=None, compare=False, repr=False,
                                            kw_only=True)
     task_choices: tuple[int, ...] = field(default=(), repr=False, kw_only=True)
+    task_plan: TaskPlan | None = field(default=None, compare=False, repr=False, kw_only=True)
+    target_choice: int | None = field(default=None, kw_only=True)
     motion: str = field(default="", compare=False, kw_only=True)
 
     @property
@@ -196,10 +205,23 @@ class Design:
             "design_time_s": self.design_time_s,
             **self._actuator_json(),
             **self._tasks_json(),
+            **self._target_json(),
             **self._motion_json(),
             **self._cascade_json(),
             **robot_json(self.spec),
         }
+
+    def _target_json(self) -> dict[str, Any]:
+        """``target_choice``: for a spec with ``[target] any_of`` only, the box the tube
+        ends in and the boxes dropped (an obstacle meets them)."""
+        if self.target_choice is None:
+            return {}
+        return {"target_choice": {
+            "alternative": self.target_choice,
+            "lower": list(self.spec.target_set.lower),
+            "upper": list(self.spec.target_set.upper),
+            "dropped": [{"any_of": q, "obstacle": name}
+                        for q, name in self.spec.target_dropped]}}
 
     def _tasks_json(self) -> dict[str, Any]:
         """``tasks``: per ``[[tasks]]`` entry its label, kind, window, the box planned
@@ -209,11 +231,17 @@ class Design:
             return {}
         margins = {m.name: m for m in self.certificate.margins}
         out = []
-        for task, q in zip(self.spec.tasks, self.task_choices):
+        plan = self.task_plan
+        for k, (task, q) in enumerate(zip(self.spec.tasks, self.task_choices)):
             m = margins.get(task.name)
             out.append({"task": task.label, "kind": task.kind, "window": list(task.window),
-                        "alternative": q, "lower": list(task.boxes[q].lower),
+                        "duration": task.duration,
+                        "alternative": task.any_of_index[q],
+                        "dropped": [{"any_of": i, "obstacle": o} for i, o in task.dropped],
+                        "lower": list(task.boxes[q].lower),
                         "upper": list(task.boxes[q].upper),
+                        "visit": None if plan is None else plan.order.index(k) + 1,
+                        "hold": None if plan is None else list(plan.holds[k]),
                         "certified": bool(m is not None and m.passed),
                         "margin": None if m is None else m.margin})
         return {"tasks": out}

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 import time
+from itertools import islice, product
 from dataclasses import replace
 
 import numpy as np
@@ -39,7 +40,8 @@ from .gain import derived_gain
 from .plant_check import plant_failure
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
 from .tracking import SMOOTHER_RATIO, centre_speed, tracking_demand, unfollowable
-from .tasks import alternatives, plan_tasks
+from .tasks import MAX_PLANS as TASK_PLANS
+from .tasks import TaskPlan, alternatives, plan_tasks, visit_orders
 from .via import via_design
 from .windows import WINDOW_INFLATION, candidates, overlap_interval, progress_time
 
@@ -307,12 +309,35 @@ def design_tube(spec: Spec) -> Design:
                 else "; load it with load_spec" if isinstance(spec, str) else "")
         raise TypeError(f"design_tube(): parameter 'spec' must be a Spec, not "
                         f"{type(spec).__name__}{hint}")
+    if spec.target_any_of:                # [target] any_of: the first box that designs
+        return _any_target(spec)
     design = _position_stage(spec)
     # a second-order spec: the sampled cascade must be certified on the final tube, whatever
     # path designed it (design/cascade_gain.py)
     if spec.order == 2:
         design.second_stage      # DesignError unless the sampled cascade is certified
     return design
+
+
+def _any_target(spec: Spec) -> Design:
+    """:func:`design_tube` with each target box of ``[target] any_of`` in turn; the first
+    designed and certified is kept, its spec carrying the alternatives (docs/tasks.md,
+    "Or-goals")."""
+    failures: list[tuple[int, DesignError]] = []
+    for q, variant in spec.target_any_of:
+        try:
+            design = design_tube(replace(variant, source_hash=spec.source_hash))
+        except DesignError as exc:
+            failures.append((q, exc))
+            continue
+        chosen = replace(variant, source_hash=spec.source_hash,
+                         target_any_of=spec.target_any_of, target_dropped=spec.target_dropped)
+        return replace(design, spec=chosen, target_choice=q)
+    q, first = failures[0]
+    more = (f" (and target any_of[{', '.join(str(k) for k, _ in failures[1:])}])"
+            if len(failures) > 1 else "")
+    raise DesignError(f"target any_of[{q}]: {first}{more}", kind=first.kind,
+                      tried=first.tried)
 
 
 def _position_stage(spec: Spec) -> Design:
@@ -357,9 +382,10 @@ def _design(spec: Spec, smoother: bool) -> Design:
         raise DesignError(reason, kind=FailureKind.PLANT)
     base = base_design(spec)
     if spec.tasks:              # [[tasks]]: via points through the tasks' boxes
-        tube, check, choice = _tasks(spec, base)
+        tube, check, choice, plan = _tasks(spec, base)
         return Design(_with_gain(tube, check, spec), METHOD_VIA, check,
-                      time.perf_counter() - started, spec=spec, task_choices=choice)
+                      time.perf_counter() - started, spec=spec, task_choices=choice,
+                      task_plan=plan)
     method = spec.tube.method
     # "auto": the paper's search on a short budget, then via points, then the paper's
     # search on its full budget (a hard arena rarely needs it)
@@ -437,25 +463,29 @@ def _trackable(spec: Spec, base: TubeDesign, tube: TubeDesign, check: TubeCheck,
     return tube, METHOD_PAPER, check
 
 
-def _tasks(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck, tuple[int, ...]]:
-    """The first plan through the tasks' boxes (:mod:`~stt_codegen.design.tasks`, the
-    ``any_of`` alternatives in :func:`~stt_codegen.design.tasks.alternatives` order) whose
-    tube passes :func:`check_tube`, and the alternatives it took."""
+def _tasks(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck, tuple[int, ...],
+                                                 TaskPlan]:
+    """The first plan through the tasks' boxes (:mod:`~stt_codegen.design.tasks`: the visit
+    orders of :func:`~stt_codegen.design.tasks.visit_orders`, each with the ``any_of``
+    alternatives in :func:`~stt_codegen.design.tasks.alternatives` order, at most
+    ``MAX_PLANS`` plans) whose tube passes :func:`check_tube`, the alternatives it took and
+    its visits."""
     failures: list[DesignError] = []
-    for choice in alternatives(spec):
+    plans = islice(product(visit_orders(spec, base), alternatives(spec)), TASK_PLANS)
+    for order, choice in plans:
         try:
-            tube = plan_tasks(spec, base, choice)
+            tube, plan = plan_tasks(spec, base, choice, order)
         except DesignError as exc:
             failures.append(exc)
             continue
         check = check_tube(tube, spec)
         if check.passed:
-            return tube, check, choice
+            return tube, check, choice, plan
         failures.append(DesignError(f"the tube through the tasks' boxes fails its check: "
                                     f"{check.reason}", kind=check.kind, tried=tube))
     first = failures[0]
-    more = f" (and {len(failures) - 1} other choices of any_of boxes)" if len(failures) > 1 \
-        else ""
+    more = (f" (and {len(failures) - 1} other plans: visit orders, any_of boxes)"
+            if len(failures) > 1 else "")
     raise DesignError(f"{first}{more}", kind=first.kind, tried=first.tried)
 
 

@@ -28,8 +28,8 @@ whose tube passes its check.
 
 from __future__ import annotations
 
-from dataclasses import replace
-from itertools import islice, product
+from dataclasses import dataclass, replace
+from itertools import islice, permutations, product
 
 import numpy as np
 
@@ -40,7 +40,8 @@ from ..tube.parameters import SMOOTHSTEP, ReachSegment, TubeDesign, paper_segmen
 from .failures import FailureKind
 from .via import plan_via
 
-__all__ = ["STAY_LEAD", "alternatives", "plan_tasks"]
+__all__ = ["FREE_HOLD", "MAX_PLANS", "STAY_LEAD", "TaskPlan", "alternatives", "plan_tasks", "task_schedule",
+           "visit_orders"]
 
 #: A waypoint box's half-width, at most this share of the task box's.
 TASK_BOX_SHARE = 0.6
@@ -54,6 +55,20 @@ HOLD_LEAD = 0.25
 STAY_LEAD = 0.25
 #: Most combinations of ``any_of`` alternatives tried.
 MAX_PLANS = 16
+#: Free timing: a reach task's hold lasts this share of its window, at most
+#: :data:`FREE_HOLD` seconds, and is kept half as much from the window's ends.
+FREE_HOLD_SHARE = 0.25
+FREE_HOLD = 0.5
+#: Free timing: the shortest leg between two holds, seconds.
+MIN_LEG = 0.25
+#: Free timing: the estimated speeds tried, multiples of the even speed (the centres'
+#: path length over the time the holds leave).
+SPEED_FACTORS = (1.0, 2.0, 4.0)
+#: ``[task_order] order = "any"``: every order is tried up to this many tasks; beyond,
+#: nearest neighbour then 2-opt on the estimated travel.
+EXACT_ORDERS = 6
+#: ``order = "any"``: orders handed to the certificate at most (shortest first).
+MAX_ORDERS = 4
 
 
 def alternatives(spec: Spec) -> list[tuple[int, ...]]:
@@ -111,7 +126,249 @@ def _leg(spec: Spec, base: TubeDesign, start: tuple, goal: tuple, t0: float,
     return list(replace(plan, times=tuple(times)).segments())
 
 
-def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...]) -> TubeDesign:
+@dataclass(frozen=True)
+class TaskPlan:
+    """The visits a tasks' plan chose (docs/tasks.md, "Timing and order").
+
+    Attributes
+    ----------
+    order : tuple of int
+        Task indices (into ``spec.tasks``) in visit order.
+    holds : tuple of (float, float)
+        Per task in the spec's order: the interval over which ``rho`` holds its waypoint
+        box, seconds.
+    """
+
+    order: tuple[int, ...]
+    holds: tuple[tuple[float, float], ...]
+
+
+def _centre(box: tuple) -> np.ndarray:
+    return 0.5 * (np.array(box[0]) + np.array(box[1]))
+
+
+def _boxes(spec: Spec, base: TubeDesign, order: tuple[int, ...],
+           choice: tuple[int, ...]) -> list[tuple]:
+    """The waypoint boxes (lower, upper tuples) in visit order, each centred as near as it
+    may be to the previous one."""
+    start = (tuple(base.initial_lower), tuple(base.initial_upper))
+    out = []
+    for k in order:
+        lo, hi = waypoint_box(spec.tasks[k], choice[k], _centre(start), base)
+        start = (tuple(float(v) for v in lo), tuple(float(v) for v in hi))
+        out.append(start)
+    return out
+
+
+def _listed_holds(spec: Spec, order: tuple[int, ...], boxes: list[tuple], base: TubeDesign,
+                  choice: tuple[int, ...]) -> list[tuple[float, float]] | None:
+    """The fixed holds (module notes: the middle half of a reach window, a stay's whole
+    window entered up to :data:`STAY_LEAD` early) when they follow one another in visit
+    order and no stay task has a duration; else ``None``."""
+    start = (tuple(base.initial_lower), tuple(base.initial_upper))
+    leave = 0.0
+    out = []
+    for k, box in zip(order, boxes):
+        task = spec.tasks[k]
+        t0, t1 = task.window
+        if task.duration is not None:
+            return None
+        if task.kind == STAY:
+            arrive, until = t0 - min(STAY_LEAD, 0.25 * (t0 - leave)), t1
+            if not arrive > leave and _within(start, task.boxes[choice[k]]):
+                out.append((leave, until))      # held where the tube already is
+                leave = until
+                continue
+        else:
+            arrive, until = t0 + HOLD_LEAD * (t1 - t0), t1 - HOLD_LEAD * (t1 - t0)
+        if not arrive > leave:
+            return None
+        out.append((arrive, until))
+        start, leave = box, until
+    return out if base.prescribed_time > leave else None
+
+
+def _span(task: Task) -> tuple[float, float, float]:
+    """Free timing: ``(earliest start, latest end, length)`` of a task's hold, seconds."""
+    t0, t1 = task.window
+    w = t1 - t0
+    if task.kind == STAY:
+        if task.duration is None or task.duration + 2 * STAY_LEAD > w:
+            return t0 - STAY_LEAD, t1, w + STAY_LEAD
+        return t0, t1, task.duration + 2 * STAY_LEAD
+    hold = min(FREE_HOLD_SHARE * w, FREE_HOLD)
+    return t0 + 0.5 * hold, t1 - 0.5 * hold, hold
+
+
+def _free_holds(spec: Spec, order: tuple[int, ...], boxes: list[tuple],
+                base: TubeDesign) -> tuple[list[tuple[float, float]] | None, str]:
+    """The holds of free timing in visit order (module notes), or ``None`` and why not in
+    the user's terms (which task, which window).
+
+    With travel times at an estimated speed (the even speed, then faster), the earliest
+    holds (each as soon as its window and the travel from the previous allow) and the
+    latest (as late as the later ones and the target still allow) bound each hold's start;
+    within them each starts when the even speed along the whole path would get there, so
+    the legs' speeds stay near it."""
+    centres = [_centre((base.initial_lower, base.initial_upper))]
+    centres += [_centre(b) for b in boxes] + [_centre((base.target_lower, base.target_upper))]
+    legs = [float(np.linalg.norm(b - a)) for a, b in zip(centres, centres[1:])]
+    length = sum(legs)
+    spans = [_span(spec.tasks[k]) for k in order]
+    spare = base.prescribed_time - sum(s[2] for s in spans)
+    reason = ""
+    for factor in SPEED_FACTORS:
+        speed = max(factor * length / max(spare, MIN_LEG), 1e-12)
+        travel = [max(d / speed, MIN_LEG) for d in legs]
+        leave, early, previous = 0.0, [], "the start"
+        for j, (k, (earliest, latest, hold)) in enumerate(zip(order, spans)):
+            arrive = max(earliest, leave + travel[j])
+            task = spec.tasks[k]
+            if arrive + hold > latest + 1e-12:
+                reason = (f"task {task.label} ({task.kind}, window [{task.window[0]:g}, "
+                          f"{task.window[1]:g}] s) cannot be met after {previous} (left at "
+                          f"{leave:.3g} s, about {travel[j]:.3g} s away at the fastest speed "
+                          f"tried)")
+                break
+            early.append(arrive)
+            leave, previous = arrive + hold, f"task {task.label}"
+        else:
+            if leave + travel[-1] > base.prescribed_time:
+                reason = (f"no time to reach the target by {base.prescribed_time:g} s after "
+                          f"{previous} (left at {leave:.3g} s)")
+                continue
+            late = [0.0] * len(spans)
+            bound = base.prescribed_time - travel[-1]
+            for j in reversed(range(len(spans))):
+                late[j] = min(spans[j][1], bound) - spans[j][2]
+                bound = late[j] - travel[j]
+            share = spare / length if length > 0 else 0.0
+            out, leave, elapsed = [], 0.0, 0.0
+            for j, (earliest, _, hold) in enumerate(spans):
+                even = elapsed + share * sum(legs[:j + 1])
+                # late[j] >= max(earliest, leave + travel[j]): the earliest holds exist
+                start = min(max(even, earliest, leave + travel[j]), late[j])
+                out.append((start, start + hold))
+                leave, elapsed = start + hold, elapsed + hold
+            return out, ""
+    return None, reason
+
+
+def task_schedule(spec: Spec, base: TubeDesign, order: tuple[int, ...],
+                  choice: tuple[int, ...]) -> tuple[list[tuple], list[tuple[float, float]]]:
+    """The waypoint boxes and holds of a visit order, both in visit order.
+
+    The fixed holds (the middle half of each reach window, each stay's window) when they
+    follow one another; else the free timing: each hold as early as the estimated travel
+    from the previous one allows (module notes).
+
+    Parameters
+    ----------
+    spec : Spec
+    base : TubeDesign
+        The paper's tube of the spec (``X-hat_0``, ``T-hat``).
+    order : tuple of int
+        Task indices in visit order.
+    choice : tuple of int
+        One alternative per task, spec order.
+
+    Returns
+    -------
+    boxes : list of (tuple, tuple)
+        Waypoint boxes' lower and upper corners, state units.
+    holds : list of (float, float)
+        Hold intervals, seconds.
+
+    Raises
+    ------
+    DesignError
+        Kind ``TASK``: no timing meets the windows in this order, naming the task and its
+        window.
+    """
+    boxes = _boxes(spec, base, order, choice)
+    holds = _listed_holds(spec, order, boxes, base, choice)
+    if holds is None:
+        holds, reason = _free_holds(spec, order, boxes, base)
+        if holds is None:
+            raise DesignError(reason, kind=FailureKind.TASK, tried=base)
+    return boxes, holds
+
+
+def _travel(spec: Spec, base: TubeDesign, order: tuple[int, ...]) -> float:
+    """The centres' path length of a visit order (first alternatives), state units."""
+    boxes = _boxes(spec, base, order, tuple(0 for _ in spec.tasks))
+    centres = [_centre((base.initial_lower, base.initial_upper))]
+    centres += [_centre(b) for b in boxes] + [_centre((base.target_lower, base.target_upper))]
+    return sum(float(np.linalg.norm(b - a)) for a, b in zip(centres, centres[1:]))
+
+
+def _feasible(spec: Spec, base: TubeDesign, order: tuple[int, ...]) -> bool:
+    try:
+        task_schedule(spec, base, order, tuple(0 for _ in spec.tasks))
+    except DesignError:
+        return False
+    return True
+
+
+def _two_opt(spec: Spec, base: TubeDesign, order: list[int]) -> list[int]:
+    """2-opt on the estimated travel: reverse a stretch while it shortens the path."""
+    best, cost = order, _travel(spec, base, tuple(order))
+    improved = True
+    while improved:
+        improved = False
+        for i in range(len(best) - 1):
+            for j in range(i + 2, len(best) + 1):
+                trial = best[:i] + best[i:j][::-1] + best[j:]
+                c = _travel(spec, base, tuple(trial))
+                if c < cost - 1e-12:
+                    best, cost, improved = trial, c, True
+    return best
+
+
+def visit_orders(spec: Spec, base: TubeDesign) -> list[tuple[int, ...]]:
+    """The visit orders to try, best first.
+
+    ``[task_order] order = "listed"``: the spec's order alone. ``"any"``: up to
+    :data:`EXACT_ORDERS` tasks every order whose windows admit a timing
+    (:func:`task_schedule`), shortest estimated travel first, at most
+    :data:`MAX_ORDERS`; beyond, the nearest-neighbour order by window start and travel,
+    improved by 2-opt on the travel (a heuristic: another order may be shorter).
+
+    Parameters
+    ----------
+    spec : Spec
+    base : TubeDesign
+
+    Returns
+    -------
+    list of tuple of int
+        Task indices in visit order; the spec's order when no order admits a timing (its
+        plan then says which task and window fail).
+    """
+    listed = tuple(range(len(spec.tasks)))
+    if spec.task_order != "any" or len(spec.tasks) < 2:
+        return [listed]
+    if len(spec.tasks) <= EXACT_ORDERS:
+        orders = sorted(permutations(listed), key=lambda o: (_travel(spec, base, o), o))
+        good = [o for o in orders if _feasible(spec, base, o)][:MAX_ORDERS]
+        return good or [listed]
+    left, order = set(listed), []
+    here = _centre((base.initial_lower, base.initial_upper))
+    while left:
+        k = min(left, key=lambda i: (spec.tasks[i].window[1],
+                                     float(np.linalg.norm(_centre(
+                                         (spec.tasks[i].boxes[0].lower,
+                                          spec.tasks[i].boxes[0].upper)) - here)), i))
+        order.append(k)
+        left.discard(k)
+        here = _centre((spec.tasks[k].boxes[0].lower, spec.tasks[k].boxes[0].upper))
+    improved = tuple(_two_opt(spec, base, order))
+    return [o for o in (improved, tuple(order)) if _feasible(spec, base, o)][:1] \
+        or [tuple(order)]
+
+
+def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...],
+               order: tuple[int, ...] | None = None) -> tuple[TubeDesign, TaskPlan]:
     """``base`` with its reach tube through the tasks' waypoints (module notes).
 
     Parameters
@@ -123,38 +380,32 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...]) -> TubeDes
         its first and last reach boxes are ``X-hat_0`` and ``T-hat``.
     choice : tuple of int
         One alternative per task (:func:`alternatives`).
+    order : tuple of int, optional
+        Task indices in visit order (:func:`visit_orders`); default the spec's order.
 
     Returns
     -------
-    TubeDesign
+    tube : TubeDesign
         ``smoothstep`` segments, no circumvents; the gain is ``base``'s.
+    plan : TaskPlan
+        The visit order and each task's hold.
 
     Raises
     ------
     DesignError
-        A leg has no via-point path (kinds ``NO_PASSAGE``, ``WALLED_OFF``), or two holds
-        leave it no time (kind ``TASK``).
+        A leg has no via-point path (kinds ``NO_PASSAGE``, ``WALLED_OFF``), or the windows
+        leave no timing (kind ``TASK``, naming the task and its window).
     """
+    order = tuple(range(len(spec.tasks))) if order is None else order
+    boxes, holds = task_schedule(spec, base, order, choice)
     start = (tuple(base.initial_lower), tuple(base.initial_upper))
     leave = 0.0
     segments: list[ReachSegment] = []
-    for task, q in zip(spec.tasks, choice):
-        previous = 0.5 * (np.array(start[0]) + np.array(start[1]))
-        lo, hi = waypoint_box(task, q, previous, base)
-        box = (tuple(float(v) for v in lo), tuple(float(v) for v in hi))
-        t0, t1 = task.window
-        if task.kind == STAY:
-            arrive, until = t0 - min(STAY_LEAD, 0.25 * (t0 - leave)), t1
-        else:
-            arrive, until = t0 + HOLD_LEAD * (t1 - t0), t1 - HOLD_LEAD * (t1 - t0)
-        if task.kind == STAY and not arrive > leave and _within(start, task.boxes[0]):
-            # a stay window from where the tube already is (e.g. from t = 0): hold it there
+    for box, (arrive, until) in zip(boxes, holds):
+        if arrive == leave:        # a stay held where the tube already is
             segments.append(ReachSegment(leave, until, *start, *start, SMOOTHSTEP))
             leave = until
             continue
-        if not arrive > leave:
-            raise DesignError(f"task {task.label}: no time to reach its box before "
-                              f"{arrive:g} s", kind=FailureKind.TASK, tried=base)
         segments += _leg(spec, base, start, box, leave, arrive)
         segments.append(ReachSegment(arrive, until, *box, *box, SMOOTHSTEP))
         start, leave = box, until
@@ -163,4 +414,6 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...]) -> TubeDes
         raise DesignError("no time to reach the target after the last task",
                           kind=FailureKind.TASK, tried=base)
     segments += _leg(spec, base, start, goal, leave, base.prescribed_time)
-    return replace(base, segments=tuple(segments), circumvents=())
+    by_task = dict(zip(order, holds))
+    plan = TaskPlan(order, tuple(by_task[k] for k in range(len(spec.tasks))))
+    return replace(base, segments=tuple(segments), circumvents=()), plan

@@ -261,6 +261,16 @@ class Spec:
         default ``d_T`` to keep an obstacle beside the target out of the target box).
     tasks : tuple of Task
         The ``[[tasks]]`` entries (:mod:`~.tasks`, docs/tasks.md); empty without them.
+    target_any_of : tuple of (int, Spec)
+        ``[target] any_of``: per target box kept, its ``any_of`` index and the spec with
+        that box as the target (whose own ``target_any_of`` is empty); this spec is the
+        first of them. Empty for a single target.
+    target_dropped : tuple of (int, str)
+        ``[target] any_of`` boxes dropped because an obstacle meets them: the index and
+        the obstacle's field.
+    task_order : {"listed", "any"}
+        ``[task_order] order``: the tasks are visited in the listed order, or in the order
+        the design chooses.
     moving_obstacles : tuple of MovingObstacle
         The ``[[obstacles]]`` boxes with ``active``, ``velocity`` or ``path``
         (:mod:`~.motion`); they are in neither :attr:`obstacles` nor :attr:`unsafe_sets`.
@@ -294,6 +304,10 @@ class Spec:
     source_hash: str = field(default="", compare=False)
     target_half_width_given: bool = True
     tasks: tuple[Task, ...] = ()
+    task_order: str = "listed"
+    target_any_of: tuple[tuple[int, "Spec"], ...] = field(default=(), compare=False,
+                                                          repr=False)
+    target_dropped: tuple[tuple[int, str], ...] = ()
     moving_obstacles: tuple[MovingObstacle, ...] = ()
     robot: Robot | None = None
 
@@ -545,8 +559,67 @@ def _replace_hash(spec: Spec, digest: str) -> Spec:
 # sign and enum (spec/schema.py), and given the defaults.
 
 
+def _any_target(raw: dict, doc: Any) -> Spec:
+    """A spec with ``[target] any_of``: one spec per target box (an obstacle meeting a box
+    drops it), the first kept one carrying them all (``Spec.target_any_of``)."""
+    given = [k for k in ("lower", "upper", "center", "half_width")
+             if getattr(doc.target, k) is not None]
+    if given:
+        raise SpecError("target.any_of", f"give either any_of or {'/'.join(given)}, not "
+                        "both (each target box takes its own default centre and half-width)")
+    kept, dropped = [], []
+    for q, box in enumerate(doc.target.any_of):
+        variant = {**raw, "target": {"lower": box.lower, "upper": box.upper}}
+        try:
+            kept.append((q, _validate(variant)))
+        except SpecError as exc:
+            if exc.reason.startswith("meets the target set"):
+                dropped.append((q, exc.field))
+                continue
+            field_name = exc.field.replace("target", f"target.any_of[{q}]", 1) \
+                if exc.field.startswith("target") else exc.field
+            raise SpecError(field_name, exc.reason) from None
+    if not kept:
+        raise SpecError("target.any_of", "every box meets an obstacle (" + ", ".join(
+            f"any_of[{q}]: {name}" for q, name in dropped) + ")")
+    return replace(kept[0][1], target_any_of=tuple(kept), target_dropped=tuple(dropped))
+
+
+def _until_tasks(doc: Any) -> Any:
+    """``doc`` with each obstacle's ``active_until = "Tk"`` turned into ``active = [0, t1]``,
+    ``t1`` the end of task ``Tk``'s window: the task is met by then in any run that meets it,
+    so keeping clear of the box over ``[0, t1]`` keeps clear of it while it exists (a
+    stronger property than needed; docs/tasks.md, "Obstacles until a task")."""
+    if not any(getattr(o, "active_until", None) is not None for o in doc.obstacles):
+        return doc
+    tasks = doc.tasks or []
+    obstacles = []
+    for j, table in enumerate(doc.obstacles):
+        label = getattr(table, "active_until", None)
+        if label is None:
+            obstacles.append(table)
+            continue
+        name = f"obstacles[{j}].active_until"
+        if table.active is not None:
+            raise SpecError(name, "give either active or active_until, not both")
+        k = int(label[1:]) - 1
+        if k >= len(tasks):
+            raise SpecError(name, f"no task {label} (the spec has {len(tasks)} task(s))")
+        if tasks[k].kind != "reach":
+            raise SpecError(name, f"task {label} is a {tasks[k].kind} task; an obstacle "
+                            "lasts until a reach task is met")
+        obstacles.append(table.model_copy(update={"active": [0.0, float(tasks[k].window[1])],
+                                                  "active_until": None}))
+    return doc.model_copy(update={"obstacles": obstacles})
+
+
 def _validate(raw: dict) -> Spec:
     doc = check_document(raw)
+    if doc.target.any_of is not None:
+        return _any_target(raw, doc)
+    for key in ("lower", "upper"):
+        if getattr(doc.target, key) is None:
+            raise SpecError(f"target.{key}", "missing (give lower and upper, or any_of)")
     state_space = _box(doc.state_space, "state_space", None)
     n = len(state_space.lower)
 
@@ -566,6 +639,7 @@ def _validate(raw: dict) -> Spec:
     _interior(eta, target_set, "target.center", "target set")
     d_t = _half_width(doc.target.half_width, "target", eta, target_set, "target set")
 
+    doc = _until_tasks(doc)
     unsafe_sets = tuple(_unsafe_set(table, f"obstacles[{j}]", state_space, j)
                         for j, table in enumerate(doc.obstacles) if not is_moving(table))
     moving = tuple(_moving(table, f"obstacles[{j}]", j, state_space, initial_set, target_set,
@@ -607,6 +681,7 @@ def _validate(raw: dict) -> Spec:
                                   [(b.lower, b.upper, o.source) for o, b in
                                    zip(obstacles, (o.box(state_space) for o in obstacles))],
                                   doc.tube.method),
+                task_order=doc.task_order.order if doc.task_order is not None else "listed",
                 moving_obstacles=moving, robot=robot)
 
 

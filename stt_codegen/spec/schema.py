@@ -45,6 +45,8 @@ TUBE_METHODS = ("paper", "via", "auto")
 MAX_VERTICES = 1024
 #: ``[[tasks]]`` kinds (docs/tasks.md).
 TASK_KINDS = ("reach", "stay")
+#: ``[task_order] order`` values (docs/tasks.md).
+TASK_ORDERS = ("listed", "any")
 #: At most this many ``[[tasks]]`` entries, and boxes in one ``any_of``.
 MAX_TASKS = 32
 MAX_ALTERNATIVES = 8
@@ -99,8 +101,15 @@ class InitialTable(BoxTable):
 
 
 class TargetTable(BoxTable):
-    """The target set ``T`` (a box inside ``X``)."""
+    """The target set ``T`` (a box inside ``X``), or several (``any_of``)."""
 
+    lower: Vector = _omitted("lower corner, state units (or any_of)")
+    upper: Vector = _omitted("upper corner, state units; upper >= lower")
+    any_of: Annotated[list["TaskBoxTable"], Field(min_length=1,
+                                                  max_length=MAX_ALTERNATIVES)] = _omitted(
+        "target boxes of which the tube ends in one (instead of lower/upper); the design "
+        "picks the first that it certifies, in this order, and drops one that meets an "
+        "obstacle")
     center: Vector = _omitted("eta of eq. (3), in the interior of T; default its centre")
     half_width: Vector = _omitted("d_T of eq. (3), positive; default 0.8 x the room around "
                                   "eta in T")
@@ -116,6 +125,9 @@ class BoxObstacle(_Table):
     # moving obstacles (docs/moving-obstacles.md; cross-field rules: spec/motion.py)
     active: Annotated[list[NonNegative], Field(min_length=2, max_length=2)] = _omitted(
         "[t_on, t_off], seconds, t_on < t_off: when the obstacle exists; default always")
+    active_until: Annotated[str, Strict(), Field(pattern=r"^T[1-9][0-9]*$")] = _omitted(
+        "a reach task's label (\"T1\"...): the obstacle exists from 0 until that task is "
+        "met; the design keeps clear of it until the task's window ends (instead of active)")
     velocity: Vector = _omitted("state units/s on dims: the box translates from lower/upper "
                                 "at t_on; without active, from 0 until it has left the "
                                 "state space")
@@ -266,6 +278,17 @@ class TaskTable(_Table):
     any_of: Annotated[list[TaskBoxTable], Field(min_length=1, max_length=MAX_ALTERNATIVES)] = \
         _omitted("reach only: the boxes of which one is to be reached (instead of "
                  "lower/upper); the design picks the first that certifies, in this order")
+    duration: Positive = _omitted(
+        "stay only: inside the box over some interval of this length (seconds) inside the "
+        "window, the design choosing when; omitted: the whole window")
+
+
+class TaskOrderTable(_Table):
+    """Who orders the timed tasks' visits (docs/tasks.md, "Timing and order")."""
+
+    order: Literal[TASK_ORDERS] = Field(  # type: ignore[valid-type]
+        "listed", description="listed: the tasks are visited in the order they are listed; "
+                              "any: the design chooses the order")
 
 
 class SpecDocument(_Table):
@@ -294,8 +317,10 @@ class SpecDocument(_Table):
                                        "generated code and verify ignore actuators)")
     robot: RobotTable = _omitted("the robot's size; omitted: the robot is a point")
     tasks: Annotated[list[TaskTable], Field(max_length=MAX_TASKS)] = _omitted(
-        "timed reach and stay tasks besides the target (docs/tasks.md), in window order; "
-        "omitted: none")
+        "timed reach and stay tasks besides the target (docs/tasks.md), visited in the "
+        "order listed unless [task_order] says otherwise; omitted: none")
+    task_order: TaskOrderTable = _omitted("the order of the tasks' visits; omitted: as "
+                                          "listed")
 
 
 #: The JSON Schema dialect of :func:`json_schema`: draft 7, which TOML language servers
@@ -319,7 +344,7 @@ _TABLES: dict[str, type[_Table]] = {
     "tube": TubeTable, "controller": ControllerTable, "plant": PlantTable,
     "assumptions": AssumptionsTable, "actuator": ActuatorTable, "robot": RobotTable,
     "box": BoxObstacle, "ball": BallObstacle, "polytope": PolytopeObstacle,
-    "tasks": TaskTable, "any_of": TaskBoxTable}
+    "tasks": TaskTable, "any_of": TaskBoxTable, "task_order": TaskOrderTable}
 
 
 def key_name(key: str) -> str:

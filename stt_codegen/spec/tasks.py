@@ -4,13 +4,17 @@ The schema (:mod:`stt_codegen.spec.schema`) has checked every key, type and sign
 ``[[tasks]]`` entry. :func:`build_tasks` checks what relates a task to the rest of the spec
 (docs/tasks.md, "The spec") and turns the entries into :class:`Task` values:
 
-* a reach task has either one box (``lower``/``upper``) or ``any_of`` (a list of boxes),
-  a stay task one box;
+* a task has either one box (``lower``/``upper``) or ``any_of`` (a list of boxes: a reach
+  task is met in any of them, a stay task by staying in one of them);
 * every box has one entry per state dimension (a dimension the task does not constrain is
   given the state space's bounds), is not empty (``lower < upper`` in every dimension), lies
-  inside the state space and does not meet an obstacle (touching is allowed);
-* windows ``[t0, t1]`` satisfy ``0 <= t0 < t1 <= t_c`` and come in order without overlap:
-  each window starts no earlier than the previous one ends (they may touch);
+  inside the state space and does not meet an obstacle (touching is allowed); an ``any_of``
+  box that meets one is dropped (:attr:`Task.dropped` says which) as long as one remains;
+* windows ``[t0, t1]`` satisfy ``0 <= t0 < t1 <= t_c``; they may overlap and come in any
+  order (the design picks the visit times, and with ``[task_order] order = "any"`` the
+  order; docs/tasks.md, "Timing and order");
+* ``duration`` (stay only) satisfies ``0 < duration <= t1 - t0``; a duration equal to the
+  window's length is the whole window;
 * tasks need the via-point design (``tube.method`` ``"via"`` or ``"auto"``) and no
   ``[actuator]`` (not supported yet).
 
@@ -63,13 +67,32 @@ class Task:
     window : (float, float)
         ``[t0, t1]``, seconds.
     boxes : tuple of TaskBox
-        One box, or the ``any_of`` alternatives in the spec's order (reach only).
+        One box, or the ``any_of`` alternatives in the spec's order, without those dropped.
+    duration : float or None
+        Stay only: inside the box over some interval of this length (seconds) inside the
+        window; ``None``: the whole window.
+    any_of_index : tuple of int
+        The ``any_of`` index in the spec of each of :attr:`boxes` (``(0,)`` for one box).
+    dropped : tuple of (int, int)
+        The ``any_of`` boxes dropped because they meet an obstacle: their index and the
+        ``[[obstacles]]`` entry each meets.
     """
 
     index: int
     kind: str
     window: tuple[float, float]
     boxes: tuple[TaskBox, ...]
+    duration: float | None = None
+    any_of_index: tuple[int, ...] = (0,)
+    dropped: tuple[tuple[int, int], ...] = ()
+
+    @property
+    def held(self) -> float:
+        """How long the task holds its box, seconds: the stay's duration (the window's
+        length when none is given); 0 for a reach task."""
+        if self.kind != STAY:
+            return 0.0
+        return self.duration if self.duration is not None else self.window[1] - self.window[0]
 
     @property
     def label(self) -> str:
@@ -139,7 +162,6 @@ def build_tasks(tables: Sequence, n: int, prescribed_time: float,
     if method == "paper":
         raise SpecError("tube.method", "tasks need via points: 'via' or 'auto', not 'paper'")
     out: list[Task] = []
-    previous_end = 0.0
     for k, table in enumerate(tables):
         field = f"tasks[{k}]"
         t0, t1 = (float(v) for v in table.window)
@@ -148,15 +170,17 @@ def build_tasks(tables: Sequence, n: int, prescribed_time: float,
         if t1 > prescribed_time:
             raise SpecError(f"{field}.window", f"ends at {t1!r} s, after prescribed_time "
                             f"{prescribed_time!r} s")
-        if t0 < previous_end:
-            raise SpecError(f"{field}.window", f"starts at {t0!r} s, before the previous "
-                            f"task's window ends ({previous_end!r} s): windows come in order "
-                            "and do not overlap")
-        previous_end = t1
+        duration = None if table.duration is None else float(table.duration)
+        if duration is not None:
+            if table.kind != STAY:
+                raise SpecError(f"{field}.duration", "only a stay task takes a duration")
+            if duration > t1 - t0:
+                raise SpecError(f"{field}.duration", f"{duration!r} s is longer than the "
+                                f"window [{t0!r}, {t1!r}] s")
+            if duration == t1 - t0:
+                duration = None
         has_box = table.lower is not None or table.upper is not None
         if table.any_of is not None:
-            if table.kind != REACH:
-                raise SpecError(f"{field}.any_of", "only a reach task takes any_of")
             if has_box:
                 raise SpecError(f"{field}.any_of", "give either lower/upper or any_of, "
                                 "not both")
@@ -166,10 +190,21 @@ def build_tasks(tables: Sequence, n: int, prescribed_time: float,
         else:
             boxes = (_box(table.lower, table.upper, field, n, space),)
             names = [field]
-        for box, name in zip(boxes, names):
-            for lower, upper, source in obstacles:
-                if all(a < d and c < b for a, b, c, d in
-                       zip(box.lower, box.upper, lower, upper)):
-                    raise SpecError(name, f"the task's box meets obstacle {source}")
-        out.append(Task(k, table.kind, (t0, t1), boxes))
+        kept, dropped = [], []
+        for q, (box, name) in enumerate(zip(boxes, names)):
+            met = [source for lower, upper, source in obstacles
+                   if all(a < d and c < b for a, b, c, d in
+                          zip(box.lower, box.upper, lower, upper))]
+            if met and table.any_of is None:
+                raise SpecError(name, f"the task's box meets obstacle {met[0]}")
+            if met:
+                dropped.append((q, met[0]))
+            else:
+                kept.append(q)
+        if not kept:
+            raise SpecError(f"{field}.any_of", "every box meets an obstacle ("
+                            + ", ".join(f"any_of[{q}]: obstacle {o}" for q, o in dropped)
+                            + ")")
+        out.append(Task(k, table.kind, (t0, t1), tuple(boxes[q] for q in kept), duration,
+                        tuple(kept), tuple(dropped)))
     return tuple(out)

@@ -13,7 +13,12 @@ lies in ``[lower_min, upper_max]`` at every ``t`` of the piece, not only at samp
   pieces and boxes of ``min_i min(lower_min_i - box_lo_i, box_hi_i - upper_max_i)``.
 * **stay** (``task Tk stay``): the pieces cover ``[t0, t1]`` (the first starts at or before
   ``t0``, the last ends at or after ``t1``) and on every one the enclosure lies inside the
-  box; the margin is the smallest.
+  box (one and the same of its ``any_of`` boxes); the margin is the smallest (the largest
+  over boxes).
+* **stay with a duration** ``tau``: some run of consecutive pieces inside ``[t0, t1]``,
+  together at least ``tau`` long, on every one of which the enclosure lies inside the box
+  (one and the same ``any_of`` box); the margin is the largest over such runs (and boxes)
+  of the smallest over the run's pieces.
 
 A margin of at most :data:`~.report.ROUNDING_MARGIN` fails (docs/tasks.md, "The
 certificate").
@@ -81,7 +86,7 @@ def task_margin(design: TubeDesign, task: Task, enc: Enclosure) -> Margin:
     rate = design.rate_hz
     t0, t1 = task.window
     stay = task.kind == STAY
-    a, b = _sample_range(t0, t1, rate, cover=stay)
+    a, b = _sample_range(t0, t1, rate, cover=stay and task.duration is None)
     if b <= a:
         return Margin(task.name, False, -math.inf, t0, f"the window [{t0:g}, {t1:g}] s holds "
                       f"no sampling period at {rate:g} Hz")
@@ -94,14 +99,19 @@ def task_margin(design: TubeDesign, task: Task, enc: Enclosure) -> Margin:
     sub = enclose(design, piece_ranges(design, s0, s1), enc.alpha_min[k], enc.alpha_max[k],
                   s0, s1)
     inside = _inside(task, sub.lower_min, sub.upper_max)          # (B, K)
+    if stay and task.duration is not None:
+        return max((_duration_margin(task, inside[b], s0, s1, b) for b in range(len(inside))),
+                   key=lambda margin: margin.margin)
     if stay:
-        q = int(np.argmin(inside[0]))
-        m = float(inside[0, q])
+        box = int(np.argmax(inside.min(axis=1)))
+        q = int(np.argmin(inside[box]))
+        m = float(inside[box, q])
+        which = f" any_of[{task.any_of_index[box]}]" if len(task.boxes) > 1 else ""
         ok = m > ROUNDING_MARGIN
-        detail = (f"the tube stays inside the box over [{s0[0]:.4f}, {s1[-1]:.4f}] s "
+        detail = (f"the tube stays inside the box{which} over [{s0[0]:.4f}, {s1[-1]:.4f}] s "
                   f"(covers the window [{t0:g}, {t1:g}] s), margin >= {m:.6g} (smallest on "
                   f"[{s0[q]:.4f}, {s1[q]:.4f}] s)" if ok else
-                  f"the tube may leave the box on [{s0[q]:.4f}, {s1[q]:.4f}] s "
+                  f"the tube may leave the box{which} on [{s0[q]:.4f}, {s1[q]:.4f}] s "
                   f"(margin {m:.3g})")
         return Margin(task.name, ok, m, float(s0[q]), detail)
     box, q = np.unravel_index(int(np.argmax(inside)), inside.shape)
@@ -114,7 +124,7 @@ def task_margin(design: TubeDesign, task: Task, enc: Enclosure) -> Margin:
         first -= 1
     while ok and last + 1 < good.size and good[last + 1]:
         last += 1
-    which = f" any_of[{box}]" if len(task.boxes) > 1 else ""
+    which = f" any_of[{task.any_of_index[box]}]" if len(task.boxes) > 1 else ""
     detail = (f"the tube lies inside the box{which} over [{s0[first]:.4f}, {s1[last]:.4f}] s "
               f"of the window [{t0:g}, {t1:g}] s, margin {m:.6g} (largest on "
               f"[{s0[q]:.4f}, {s1[q]:.4f}] s)" if ok else
@@ -122,6 +132,35 @@ def task_margin(design: TubeDesign, task: Task, enc: Enclosure) -> Margin:
               f"inside the box{'es' if len(task.boxes) > 1 else ''} (best margin {m:.3g} "
               f"on [{s0[q]:.4f}, {s1[q]:.4f}] s)")
     return Margin(task.name, ok, m, float(s0[q]), detail)
+
+
+def _duration_margin(task: Task, inside: np.ndarray, s0: np.ndarray,
+                     s1: np.ndarray, box: int) -> Margin:
+    """A stay task with a duration: the best run of consecutive pieces at least
+    ``task.duration`` long (module notes) in ``task.boxes[box]``; ``inside`` (K,) per
+    piece ``[s0, s1]``."""
+    t0, t1 = task.window
+    tau = task.duration
+    best, run = -math.inf, (0, 0)
+    for i in range(inside.size):
+        j = int(np.searchsorted(s1, s0[i] + tau - 1e-12, side="left"))
+        if j >= inside.size:
+            break
+        m = float(inside[i:j + 1].min())
+        if m > best:
+            best, run = m, (i, j)
+    if best == -math.inf:
+        return Margin(task.name, False, -math.inf, t0, f"the window [{t0:g}, {t1:g}] s holds "
+                      f"no run of sampling periods {tau:g} s long")
+    i, j = run
+    ok = best > ROUNDING_MARGIN
+    which = f" any_of[{task.any_of_index[box]}]" if len(task.boxes) > 1 else ""
+    detail = (f"the tube stays inside the box{which} over [{s0[i]:.4f}, {s1[j]:.4f}] s (at least "
+              f"{tau:g} s of the window [{t0:g}, {t1:g}] s), margin >= {best:.6g}" if ok else
+              f"no {tau:g} s of the window [{t0:g}, {t1:g}] s over which the tube is "
+              f"certified inside the box{which} (best margin {best:.3g} over [{s0[i]:.4f}, "
+              f"{s1[j]:.4f}] s)")
+    return Margin(task.name, ok, best, float(s0[i]), detail)
 
 
 def task_margins(design: TubeDesign, spec: Spec, enc: Enclosure) -> tuple[Margin, ...]:
