@@ -113,9 +113,9 @@ def cascade_class(spec: Spec) -> CascadeClass:
     ValueError
         The spec is first order.
     """
-    order = spec.second_order
-    if order is None:
+    if spec.order != 2:
         raise ValueError("cascade_class needs a spec with a second-order plant.model")
+    order = spec.second_order
     g_min, g_max = order.input_gain
     diagonal = SECOND_ORDER_PLANTS[order.model].diagonal_input
     return CascadeClass(g_min, g_max, 0.0 if diagonal else 0.5 * (g_max - g_min),
