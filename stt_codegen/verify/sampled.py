@@ -33,6 +33,7 @@ from ..design.samples import TubeSamples, sample_tube
 from ..spec.assumptions import Assumptions
 from ..spec.loader import Spec
 from ..spec.model_bounds import model_bounds
+from ..spec.plants import MODEL_KEYS
 from ..tube import reference
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from ..rounding import distinct
@@ -530,8 +531,8 @@ def plant_bounds_checks(spec: Spec, model: str | None = None) -> list[Check]:
     ``spec.assumptions``. The loader makes this hold for every spec it builds (a bound the
     model violates is a ``SpecError``); a spec changed in Python
     (``dataclasses.replace``) can break it, and then the sampled verdict is not about the
-    model, which this check says. For the ``linear`` model also ``assumption2.linear``:
-    ``lambda_min((g + g^T)/2) > 0``.
+    model, which this check says. Assumption 2 itself is the model's own check
+    (:func:`~stt_codegen.verify.assumption.assumption2_check`).
 
     Parameters
     ----------
@@ -543,19 +544,13 @@ def plant_bounds_checks(spec: Spec, model: str | None = None) -> list[Check]:
     Returns
     -------
     list of Check
-        ``sampled.plant_within_assumptions`` and, for the ``linear`` model, first
-        ``assumption2.linear``.
+        ``sampled.plant_within_assumptions``.
     """
     model = model or spec.plant_model
-    linear = spec.linear_plant if model == "linear" else None
+    # only a model that takes [plant] matrices is evaluated with the spec's
+    linear = spec.linear_plant if model in MODEL_KEYS.values() else None
     b = model_bounds(model, spec.state_space.lower, spec.state_space.upper, linear)
     checks = []
-    if model == "linear":
-        lam = b.input_gain[0]
-        checks.append(Check("assumption2.linear", bool(lam > 0),
-                            f"lambda_min((g + g^T)/2) >= {lam:.6g} for the linear plant's g"
-                            + ("" if lam > 0 else ": Assumption 2 fails, law (13) cannot "
-                               "hold this plant"), {"lambda_min": lam}))
     a = spec.assumptions
     tol = 1e-9
     bad = []
