@@ -422,7 +422,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
 def certify_stage(tube: TubeDesign, spec: Spec, stage: SecondStage) -> tuple[bool, dict]:
     """:func:`check_cascade_sampled` for ``spec``'s declared plants (:func:`cascade_class`)
     on ``tube`` sampled at its rate: the design's certifier
-    (:func:`~stt_codegen.design.cascade_prover.register_cascade_certifier`).
+    (:func:`~stt_codegen.design.provers.register_prover`).
 
     Parameters
     ----------
