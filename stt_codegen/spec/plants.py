@@ -10,7 +10,7 @@ and their descriptions), the loader (the state count a model requires, the ``[pl
 keys only some models take), the simulation's and the embedded loop's dynamics
 (:mod:`stt_codegen.runtime.dynamics`, :mod:`stt_codegen.runtime.plants`) and
 ``stt-codegen verify --plant``. A new model is an entry of :data:`PLANTS` and its
-dynamics in :mod:`stt_codegen.runtime.dynamics`.
+behaviour in the per-model tables (docs/architecture.md, "The plant registry").
 """
 
 from __future__ import annotations
