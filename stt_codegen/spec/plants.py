@@ -21,7 +21,7 @@ from typing import Mapping, TypeVar
 __all__ = ["ALL_PLANT_MODELS", "PLANTS", "PLANT_MODELS", "MODEL_KEYS", "NAMED_MODELS",
            "MissingPlantBehaviour", "PlantModel", "SECOND_ORDER_MODELS",
            "SECOND_ORDER_PLANTS", "SecondOrderModel", "dimension_mismatch",
-           "is_second_order", "model_behaviour", "plant_entry"]
+           "model_behaviour", "plant_entry"]
 
 _Behaviour = TypeVar("_Behaviour")
 
@@ -160,23 +160,6 @@ SECOND_ORDER_PLANTS: dict[str, SecondOrderModel] = {m.name: m for m in (
 SECOND_ORDER_MODELS: tuple[str, ...] = tuple(SECOND_ORDER_PLANTS)
 #: Every ``plant.model`` value a spec may give: first order, then second order.
 ALL_PLANT_MODELS: tuple[str, ...] = PLANT_MODELS + SECOND_ORDER_MODELS
-
-
-def is_second_order(model: str) -> bool:
-    """Whether ``plant.model`` names a second-order model (order 2: the cascade law).
-
-    Parameters
-    ----------
-    model : str
-        A ``plant.model`` name.
-
-    Returns
-    -------
-    bool
-        True for a second-order model (:data:`SECOND_ORDER_PLANTS`), False otherwise (also
-        for an unknown name).
-    """
-    return model in SECOND_ORDER_PLANTS
 
 
 def plant_entry(model: str) -> PlantModel | SecondOrderModel:
