@@ -275,3 +275,41 @@ def test_the_plant_order_is_decided_in_one_place():
         if lines:
             found[str(path.relative_to(PACKAGE))] = lines
     assert not found, f"test Spec.order instead of second_order: {found}"
+
+
+def _model_name_comparisons(tree: ast.AST, names: frozenset[str]) -> list[int]:
+    """Lines where code compares something with a plant-model name written as a string
+    literal (``== "linear"``, ``in ("quadrotor", ...)``): behaviour per model is a lookup
+    in a table keyed by the model, not a comparison."""
+    def is_name(node: ast.expr) -> bool:
+        if isinstance(node, ast.Constant):
+            return node.value in names
+        if isinstance(node, (ast.Tuple, ast.List, ast.Set)):
+            return any(is_name(e) for e in node.elts)
+        return False
+    return sorted(node.lineno for node in ast.walk(tree) if isinstance(node, ast.Compare)
+                  and any(is_name(side) for side in (node.left, *node.comparators)))
+
+
+def test_model_name_comparisons_are_found():
+    names = frozenset({"linear", "quadrotor"})
+    tree = ast.parse("if model == 'linear': pass\n"
+                     "b = spec.plant_model in ('x', 'quadrotor')\n"
+                     "c = TABLE[model]\n"
+                     "d = model != 'other'\n"
+                     "e = 'quadrotor' != order.model\n")
+    assert _model_name_comparisons(tree, names) == [1, 2, 5]
+
+
+def test_no_module_compares_plant_model_names():
+    """What a plant model does is looked up in the registry's tables (spec/plants.py
+    holds the names; each behaviour a table keyed by them), so a new model without a
+    behaviour is refused by name rather than handled as another model."""
+    from stt_codegen.spec.plants import ALL_PLANT_MODELS
+    names = frozenset(ALL_PLANT_MODELS)
+    found = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        lines = _model_name_comparisons(ast.parse(path.read_text()), names)
+        if lines:
+            found[str(path.relative_to(PACKAGE))] = lines
+    assert not found, f"look the model up in a per-model table instead: {found}"

@@ -74,12 +74,18 @@ def random_parameters(model: str, input_gain: tuple, rng: np.random.Generator,
     def draw(low: float, high: float) -> float:
         return float(rng.choice([low, high]) if corners else rng.uniform(low, high))
     mass = 1.0 / draw(g_min / spread, g_max * spread)
-    if model == "double-integrator":
-        return [mass]
-    if model == "quadrotor":
-        return [mass, draw(0.0, DRAG_MAX * spread), GRAVITY]
-    raise SpecError("plant.model", f"the study draws double-integrator and quadrotor "
-                                   f"plants, not {model!r}")
+    if model not in _OTHER_PARAMETERS:
+        raise SpecError("plant.model", f"the study draws double-integrator and quadrotor "
+                                       f"plants, not {model!r}")
+    return [mass] + _OTHER_PARAMETERS[model](draw, spread)
+
+
+#: The parameters after the mass each model the study draws takes, ``(draw, spread) ->
+#: list``, in :data:`~stt_codegen.spec.plants.SECOND_ORDER_PLANTS`'s order.
+_OTHER_PARAMETERS = {
+    "double-integrator": lambda draw, spread: [],
+    "quadrotor": lambda draw, spread: [draw(0.0, DRAG_MAX * spread), GRAVITY],
+}
 
 
 def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed: int = 0,

@@ -8,6 +8,7 @@ import json
 from pathlib import Path
 
 from ..errors import SpecError
+from ..spec.plants import plant_entry
 from .common import add_json_argument, add_spec_argument
 
 __all__ = ["configure_bench"]
@@ -32,7 +33,7 @@ def _int_list(text: str, field: str) -> list[int]:
 
 
 def _cmd_arenas(args: argparse.Namespace) -> int:
-    if args.plant == "double-integrator":       # the cascade beside A* + tracker
+    if plant_entry(args.plant).order == 2:    # the cascade beside A* + tracker
         from ..bench.second_order_arenas import (format_double_integrator_report,
                                                  run_double_integrator_bench)
         report = run_double_integrator_bench(args.count, args.seed)

@@ -20,7 +20,7 @@ puts
 The linearization only proposes numbers. :func:`certified_stage` keeps the first shape
 whose stage the sampled cascade's certificate
 (:func:`stt_codegen.verify.cascade_sampled.check_cascade_sampled`, registered through
-:func:`register_cascade_certifier`: ``design`` cannot import ``verify``) accepts at the
+:func:`.provers.register_prover`: ``design`` cannot import ``verify``) accepts at the
 spec's rate, and :func:`second_stage_for` refuses the design when none is, naming the
 lowest certified rate (:func:`lowest_certified_rate`). With ``[actuator] input_bound`` (the
 physical input: force or torque) a shape is kept only when the certificate's peak input is
@@ -40,7 +40,7 @@ from ..rounding import round_up
 from ..tube import reference
 from ..tube.parameters import TubeDesign
 from ..tube.second_stage import SecondStage
-from .cascade_prover import cascade_certifier
+from .provers import CASCADE_CERTIFICATE, registered_prover
 from .input_bound import InputProof
 
 __all__ = ["RATE_SEARCH_FACTOR", "SHAPES", "cascade_input_proof", "certified_stage",
@@ -179,7 +179,9 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
         (the tubes kept), ``reason``, ``peak_input``, ``peak_input_time``, ``horizon``).
     """
     order = spec.second_order
-    certify = cascade_certifier()
+    certify = registered_prover(CASCADE_CERTIFICATE)
+    if certify is None:
+        raise RuntimeError("no cascade certifier registered: import stt_codegen first")
     # the certificate reads neither bound: one certificate per tube and stage, bound or not
     tube, spec = dataclasses.replace(tube, input_bound=None), dataclasses.replace(
         spec, input_bound=None)

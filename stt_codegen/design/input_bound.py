@@ -13,8 +13,9 @@ to ``E_MAX``). ``docs/sampled-data.md`` ("The input bound") has the argument.
 
 The bound on ``e`` is the sampled-data check's (:mod:`stt_codegen.verify.sampled`), which
 builds on the design and so cannot be imported here; :mod:`stt_codegen.verify` registers
-its prover with :func:`register_input_prover` when the package is loaded (``import
-stt_codegen`` loads it), and the design (:mod:`.actuator`) asks :func:`input_prover`.
+its prover in the design's one registry of provers (:mod:`.provers`, kind
+``INPUT_BOUND``) when the package is loaded (``import stt_codegen`` loads it), and the
+design (:mod:`.actuator`) asks :func:`input_prover`.
 This module imports nothing heavy at import time (numpy inside its functions): the
 verify package imports it whenever ``stt_codegen`` is imported.
 """
@@ -29,14 +30,14 @@ from typing import TYPE_CHECKING
 from ..errors import DesignError
 from ..tube.parameters import E_MAX, GAMMA_D_MIN
 from .failures import FailureKind
+from .provers import INPUT_BOUND, registered_prover
 
 if TYPE_CHECKING:
     import numpy as np
 
     from ..spec.loader import Spec
 
-__all__ = ["InputProof", "InputProver", "input_peak", "input_prover", "phi",
-           "register_input_prover"]
+__all__ = ["InputProof", "InputProver", "input_peak", "input_prover", "phi"]
 
 
 @dataclass(frozen=True)
@@ -140,19 +141,6 @@ def input_peak(gain: float, abs_e: "np.ndarray", width: "np.ndarray", t: "np.nda
 #: designed tube (with its gain) for the plants of ``spec.assumptions``; ``per_axis_first``
 #: bounds ``e`` by the cheaper per-axis argument where it passes (no tighter).
 InputProver = Callable[..., InputProof]
-_PROVERS: list[InputProver] = []
-
-
-def register_input_prover(prover: InputProver) -> None:
-    """Make ``prover`` the one the design asks (:mod:`stt_codegen.verify` registers its own).
-
-    Parameters
-    ----------
-    prover : InputProver
-        A callable returning an :class:`InputProof` for a designed tube and a spec; it
-        replaces any registered before.
-    """
-    _PROVERS[:] = [prover]
 
 
 def input_prover() -> InputProver:
@@ -161,7 +149,7 @@ def input_prover() -> InputProver:
     Returns
     -------
     InputProver
-        The prover last registered by :func:`register_input_prover`.
+        The prover registered for ``INPUT_BOUND`` (:func:`.provers.register_prover`).
 
     Raises
     ------
@@ -169,7 +157,8 @@ def input_prover() -> InputProver:
         None is registered (``stt_codegen.verify`` was not loaded; ``import stt_codegen``
         loads it), kind ``INPUT_BOUND``.
     """
-    if not _PROVERS:
+    prover = registered_prover(INPUT_BOUND)
+    if prover is None:
         raise DesignError("no input-bound prover is registered (import stt_codegen loads "
                           "stt_codegen.verify, which registers it)", kind=FailureKind.INPUT_BOUND)
-    return _PROVERS[0]
+    return prover

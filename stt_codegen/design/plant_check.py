@@ -86,8 +86,15 @@ def plant_failure(spec: Spec) -> str:
     str
         The reason, naming the violated condition of Assumption 2, or ``""``.
     """
-    if spec.plant_model == "linear" and spec.linear_plant is not None:
-        return linear_plant_failure(spec.linear_plant.g)
-    if spec.plant_model == "omnidirectional":
-        return heading_range_failure(spec.state_space.lower[2], spec.state_space.upper[2])
-    return ""
+    failure = PLANT_FAILURES.get(spec.plant_model)
+    return failure(spec) if failure is not None else ""
+
+
+#: The design-time Assumption-2 check of each first-order model whose ``g`` can violate
+#: it, ``spec -> reason`` (the single integrator's ``g = I`` cannot).
+PLANT_FAILURES = {
+    "linear": lambda spec: ("" if spec.linear_plant is None
+                            else linear_plant_failure(spec.linear_plant.g)),
+    "omnidirectional": lambda spec: heading_range_failure(spec.state_space.lower[2],
+                                                          spec.state_space.upper[2]),
+}

@@ -25,18 +25,30 @@ from typing import Sequence
 import casadi as ca
 import numpy as np
 
-from ..spec.plants import NAMED_MODELS, dimension_mismatch
+from ..spec.plants import (NAMED_MODELS, MissingPlantBehaviour, dimension_mismatch,
+                           model_behaviour)
 
-__all__ = ["NAMED_MODELS", "input_matrix", "linear_rhs", "plant_function", "plant_rhs"]
+__all__ = ["INPUT_MATRICES", "NAMED_MODELS", "input_matrix", "linear_rhs", "plant_function", "plant_rhs"]
+
+
+def _rotation(x):
+    c, s = ca.cos(x[2]), ca.sin(x[2])
+    return ca.vertcat(ca.horzcat(c, -s, 0), ca.horzcat(s, c, 0), ca.horzcat(0, 0, 1))
+
+
+#: ``g(x)`` of each named first-order model (the ``linear`` model's comes from the spec).
+INPUT_MATRICES = {
+    "omnidirectional": _rotation,
+    "single-integrator": lambda x: ca.SX.eye(x.numel()),
+}
 
 
 def _g(model: str, x):
-    if model == "omnidirectional":
-        c, s = ca.cos(x[2]), ca.sin(x[2])
-        return ca.vertcat(ca.horzcat(c, -s, 0), ca.horzcat(s, c, 0), ca.horzcat(0, 0, 1))
-    if model == "single-integrator":
-        return ca.SX.eye(x.numel())
-    raise ValueError(f"unknown plant model {model!r}; known: {', '.join(NAMED_MODELS)}")
+    try:
+        return model_behaviour(INPUT_MATRICES, model, "input matrix g(x)")(x)
+    except MissingPlantBehaviour as err:
+        raise ValueError(f"unknown plant model {model!r}; known: "
+                         f"{', '.join(NAMED_MODELS)}") from err
 
 
 def _dimension(model: str, n: int) -> None:
@@ -147,7 +159,7 @@ def plant_function(model: str, n: int, linear=None) -> ca.Function:
     ValueError
         As :func:`input_matrix`.
     """
-    if model != "linear":
+    if model in INPUT_MATRICES:   # a named model: g(x) is fixed, not from the spec
         return plant_rhs(model, n)
     if linear is None:
         return linear_rhs(np.zeros((n, n)), np.eye(n), np.zeros(n))

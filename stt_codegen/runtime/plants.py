@@ -17,7 +17,7 @@ import numpy as np
 from ..codegen.emit import python_function
 from ..errors import SpecError
 from ..spec.loader import LinearPlant
-from ..spec.plants import PLANTS, dimension_mismatch
+from ..spec.plants import PLANTS, MissingPlantBehaviour, dimension_mismatch, model_behaviour
 from .dynamics import linear_rhs, plant_rhs
 from .second_order_plants import model_info, second_order_rhs
 
@@ -173,20 +173,33 @@ def make_plant(model: str, dimension: int, amplitude: float, seed: int = 0,
         Unknown model, or a dimension the model does not have.
     """
     disturbance = Disturbance(dimension, amplitude, seed)
-    if model == "linear":
-        if linear is None:
-            eye = np.eye(dimension)
-            return linear_plant(0 * eye, eye, np.zeros(dimension), disturbance)
-        if len(linear.c) != dimension:
-            raise SpecError("plant.c", f"has {len(linear.c)} entries for {dimension} states")
-        return linear_plant(linear.a, linear.g, linear.c, disturbance)
+    try:
+        build = model_behaviour(SIMULATION_PLANTS, model, "simulation plant")
+    except MissingPlantBehaviour:
+        raise SpecError("plant.model", f"unknown model {model!r}") from None
     if dimension_mismatch(model, dimension):
         raise SpecError("plant.model", dimension_mismatch(model, dimension))
-    if model == "omnidirectional":
-        return omnidirectional_robot(disturbance)
-    if model == "single-integrator":
-        return single_integrator(dimension, disturbance)
-    raise SpecError("plant.model", f"unknown model {model!r}")
+    return build(dimension, disturbance, linear)
+
+
+def _spec_linear_plant(dimension: int, disturbance: Disturbance,
+                       linear: LinearPlant | None) -> ct.NonlinearIOSystem:
+    """The ``linear`` model with the spec's matrices (default ``a = 0``, ``g = I``,
+    ``c = 0``)."""
+    if linear is None:
+        eye = np.eye(dimension)
+        return linear_plant(0 * eye, eye, np.zeros(dimension), disturbance)
+    if len(linear.c) != dimension:
+        raise SpecError("plant.c", f"has {len(linear.c)} entries for {dimension} states")
+    return linear_plant(linear.a, linear.g, linear.c, disturbance)
+
+
+#: The simulated plant of each first-order model: ``(n, disturbance, linear) -> system``.
+SIMULATION_PLANTS = {
+    "omnidirectional": lambda n, disturbance, _linear: omnidirectional_robot(disturbance),
+    "single-integrator": lambda n, disturbance, _linear: single_integrator(n, disturbance),
+    "linear": _spec_linear_plant,
+}
 
 
 def second_order_plant(model: str, dimension: int, parameters, amplitude: float,

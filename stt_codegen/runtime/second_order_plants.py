@@ -28,9 +28,10 @@ from functools import lru_cache
 
 import casadi as ca
 
+from ..spec.plants import model_behaviour
 from ..spec.second_order import MODELS, SECOND_ORDER_MODELS, SecondOrderModel
 
-__all__ = ["MODELS", "SECOND_ORDER_MODELS", "input_matrix", "model_info",
+__all__ = ["ACCELERATIONS", "MODELS", "SECOND_ORDER_MODELS", "input_matrix", "model_info",
            "second_order_rhs"]
 
 
@@ -80,6 +81,16 @@ def _arm(q, dq, tau, p):
     return ca.vertcat((m22 * rhs[0] - m12 * rhs[1]) / det, (m11 * rhs[1] - m12 * rhs[0]) / det)
 
 
+#: ``f + g u`` (the acceleration ``x2_dot`` without ``w``) of each second-order model,
+#: ``(x1, x2, u, params) -> x2_dot``, parameters in :data:`SECOND_ORDER_PLANTS`'s order.
+ACCELERATIONS = {
+    "double-integrator": lambda x1, x2, u, p: u / p[0],
+    "quadrotor": lambda x1, x2, u, p: u / p[0] - (p[1] / p[0]) * x2
+    - ca.vertcat(0.0, 0.0, p[2]),
+    "two-link-arm": _arm,
+}
+
+
 @lru_cache(maxsize=None)
 def second_order_rhs(model: str, n: int) -> ca.Function:
     """``second_order_rhs(x1, x2, u, w, params) -> (x1_dot, x2_dot)`` of a named model.
@@ -105,12 +116,7 @@ def second_order_rhs(model: str, n: int) -> ca.Function:
     info = model_info(model, n)
     x1, x2, u, w = (ca.SX.sym(name, n) for name in ("x1", "x2", "u", "w"))
     p = ca.SX.sym("params", len(info.parameters))
-    if model == "double-integrator":
-        acc = u / p[0]
-    elif model == "quadrotor":
-        acc = u / p[0] - (p[1] / p[0]) * x2 - ca.vertcat(0.0, 0.0, p[2])
-    else:
-        acc = _arm(x1, x2, u, p)
+    acc = model_behaviour(ACCELERATIONS, model, "acceleration f + g u")(x1, x2, u, p)
     return ca.Function("second_order_rhs", [x1, x2, u, w, p], [x2, acc + w],
                        ["x1", "x2", "u", "w", "params"], ["x1_dot", "x2_dot"])
 

@@ -30,7 +30,7 @@ from .assumptions import Assumptions, combine_assumptions
 from .model_bounds import model_bounds
 from .motion import MovingObstacle, check_moving, is_moving, moving_obstacle
 from .plants import (MODEL_KEYS, PLANTS, SECOND_ORDER_MODELS, SECOND_ORDER_PLANTS,
-                     dimension_mismatch, is_second_order)
+                     dimension_mismatch, plant_entry)
 from .robot import (Robot, inflate_ball, inflate_bounds, inflate_moving, inflate_polytope,
                     robot_dims, shrink_bounds)
 from .tasks import Task, build_tasks
@@ -376,7 +376,8 @@ class Spec:
             raise SpecError("plant", mismatch)
         a = self.assumptions
         declared = {key: getattr(a, key) for key in a.declared}
-        linear = self.linear_plant if model == "linear" else None
+        # only a model that takes [plant] matrices keeps this spec's
+        linear = self.linear_plant if model in MODEL_KEYS.values() else None
         bounds = model_bounds(model, self.state_space.lower, self.state_space.upper, linear)
         return replace(self, plant_model=model, assumptions=combine_assumptions(
             bounds, declared, self.dimension, self.disturbance_amplitude))
@@ -740,7 +741,7 @@ def _linear_plant(table: PlantTable, n: int) -> LinearPlant | None:
         if getattr(table, key) is not None and owner != table.model:
             raise SpecError(f"plant.{key}", f"only the {owner} model takes {key} "
                                             f"(plant.model is {table.model!r})")
-    if table.model != "linear":
+    if table.model not in MODEL_KEYS.values():
         return None
     identity = tuple(tuple(1.0 if i == j else 0.0 for j in range(n)) for i in range(n))
     zero = tuple(tuple(0.0 for _ in range(n)) for _ in range(n))
@@ -761,7 +762,7 @@ def _second_order(doc: Any, n: int) -> SecondOrder | None:
     model = doc.plant.model
     given = {"plant.parameters": doc.plant.parameters, "initial.velocity": doc.initial.velocity,
              "state_space.velocity_bound": doc.state_space.velocity_bound}
-    if not is_second_order(model):
+    if plant_entry(model).order == 1:
         for field_name, value in given.items():
             if value is not None:
                 raise SpecError(field_name, f"only a second-order plant.model "
@@ -795,10 +796,10 @@ def _input_bound(table: ActuatorTable | None, model: str, n: int) -> tuple[float
     second-order model its physical inputs, forces or torques, in the model's unit)."""
     if table is None:
         return None
-    plant = SECOND_ORDER_PLANTS[model] if is_second_order(model) else PLANTS[model]
+    plant = plant_entry(model)
     count = plant.input_count(n)
     names = plant.input_names(n)
-    unit = f" in {plant.input_unit}" if is_second_order(model) else ""
+    unit = f" in {plant.input_unit}" if plant.input_unit else ""
     if len(table.input_bound) != count:
         raise SpecError("actuator.input_bound",
                         f"must have {count} entries (one per input of the {model} plant: "

@@ -28,7 +28,7 @@ import math
 from dataclasses import dataclass
 from typing import Sequence
 
-__all__ = ["ModelBounds", "model_bounds", "row_coupling", "symmetric_eigen_range", "REL_PAD",
+__all__ = ["BOX_BOUNDS", "ModelBounds", "model_bounds", "row_coupling", "symmetric_eigen_range", "REL_PAD",
            "EXACT_DRIFT_DIMENSIONS"]
 
 #: Relative outward widening of every computed bound (rounding of ``cos``, ``sin`` and of
@@ -287,15 +287,25 @@ def model_bounds(model: str, lower: Sequence[float], upper: Sequence[float],
     ValueError
         Unknown model.
     """
+    if model not in BOX_BOUNDS:
+        raise ValueError(f"unknown plant model {model!r}")
+    return BOX_BOUNDS[model](lower, upper, linear)
+
+
+def _single_integrator(lower: Sequence[float], upper: Sequence[float],
+                       linear=None) -> ModelBounds:
     n = len(lower)
-    if model == "omnidirectional":
-        return _omnidirectional(lower, upper)
-    if model == "single-integrator":
-        return ModelBounds("single-integrator", (1.0, 1.0), 0.0, 0.0, 0.0,
-                           tuple((i,) for i in range(n)),
-                           (("input_gain", "g = I"), ("input_gain_skew", "g = I"),
-                            ("input_gain_coupling", "g = I"), ("drift_bound", "f = 0")),
-                           'describe your plant with [plant] model = "linear" and its g')
-    if model == "linear":
-        return _linear(lower, upper, linear)
-    raise ValueError(f"unknown plant model {model!r}")
+    return ModelBounds("single-integrator", (1.0, 1.0), 0.0, 0.0, 0.0,
+                       tuple((i,) for i in range(n)),
+                       (("input_gain", "g = I"), ("input_gain_skew", "g = I"),
+                        ("input_gain_coupling", "g = I"), ("drift_bound", "f = 0")),
+                       'describe your plant with [plant] model = "linear" and its g')
+
+
+#: The bounds over a box of each first-order model, ``(lower, upper, linear) -> bounds``:
+#: what ``[assumptions]`` defaults to.
+BOX_BOUNDS = {
+    "omnidirectional": lambda lower, upper, linear=None: _omnidirectional(lower, upper),
+    "single-integrator": _single_integrator,
+    "linear": _linear,
+}

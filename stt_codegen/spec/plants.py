@@ -10,16 +10,20 @@ and their descriptions), the loader (the state count a model requires, the ``[pl
 keys only some models take), the simulation's and the embedded loop's dynamics
 (:mod:`stt_codegen.runtime.dynamics`, :mod:`stt_codegen.runtime.plants`) and
 ``stt-codegen verify --plant``. A new model is an entry of :data:`PLANTS` and its
-dynamics in :mod:`stt_codegen.runtime.dynamics`.
+behaviour in the per-model tables (docs/architecture.md, "The plant registry").
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Mapping, TypeVar
 
 __all__ = ["ALL_PLANT_MODELS", "PLANTS", "PLANT_MODELS", "MODEL_KEYS", "NAMED_MODELS",
-           "PlantModel", "SECOND_ORDER_MODELS", "SECOND_ORDER_PLANTS", "SecondOrderModel",
-           "dimension_mismatch", "is_second_order"]
+           "MissingPlantBehaviour", "PlantModel", "SECOND_ORDER_MODELS",
+           "SECOND_ORDER_PLANTS", "SecondOrderModel", "dimension_mismatch",
+           "model_behaviour", "plant_entry"]
+
+_Behaviour = TypeVar("_Behaviour")
 
 
 @dataclass(frozen=True)
@@ -38,6 +42,14 @@ class PlantModel:
         Names of the inputs ``u``, ``None`` for one per state (``u1``, ``u2``, ...).
     keys : tuple of str
         Keys of ``[plant]`` only this model takes (its matrices).
+    input_unit : str
+        One SI unit of every input, ``""`` when the inputs have the state's units per
+        second (they may differ between inputs).
+    gain_varies : bool
+        ``g(x)`` depends on the state: its bounds over a smaller box (the tube on a
+        sampling interval) are tighter than over the state space.
+    drift_varies : bool
+        ``f(x)`` depends on the state (through matrices of the spec), likewise.
     """
 
     name: str
@@ -45,6 +57,12 @@ class PlantModel:
     states: int | None = None
     inputs: tuple[str, ...] | None = None
     keys: tuple[str, ...] = ()
+    input_unit: str = ""
+    gain_varies: bool = False
+    drift_varies: bool = False
+
+    #: Order of the model: 1, system (1) driven by law (13).
+    order = 1
 
     def input_count(self, n: int) -> int:
         """Number of inputs for ``n`` states."""
@@ -58,10 +76,10 @@ class PlantModel:
 #: Every model, by ``plant.model`` name, in the schema's order.
 PLANTS: dict[str, PlantModel] = {p.name: p for p in (
     PlantModel("omnidirectional", "eq. (14), x_dot = R(x3) u + w, 3 states (x, y, heading)",
-               states=3, inputs=("v1", "v2", "omega")),
+               states=3, inputs=("v1", "v2", "omega"), gain_varies=True),
     PlantModel("single-integrator", "x_dot = u + w"),
     PlantModel("linear", "x_dot = a x + c + g u + w, the matrices from [plant]",
-               keys=("a", "g", "c")),
+               keys=("a", "g", "c"), drift_varies=True),
 )}
 #: The ``plant.model`` values.
 PLANT_MODELS: tuple[str, ...] = tuple(PLANTS)
@@ -109,6 +127,9 @@ class SecondOrderModel:
     inputs: tuple[str, ...] | None = None
     input_unit: str = "N"
 
+    #: Order of the model: 2, the cascade law.
+    order = 2
+
     def input_count(self, n: int) -> int:
         """Number of physical inputs for ``n`` positions (one per position)."""
         return n if self.inputs is None else len(self.inputs)
@@ -141,8 +162,8 @@ SECOND_ORDER_MODELS: tuple[str, ...] = tuple(SECOND_ORDER_PLANTS)
 ALL_PLANT_MODELS: tuple[str, ...] = PLANT_MODELS + SECOND_ORDER_MODELS
 
 
-def is_second_order(model: str) -> bool:
-    """Whether ``plant.model`` names a second-order model (order 2: the cascade law).
+def plant_entry(model: str) -> PlantModel | SecondOrderModel:
+    """The registry's entry of a ``plant.model`` name (first or second order).
 
     Parameters
     ----------
@@ -151,11 +172,58 @@ def is_second_order(model: str) -> bool:
 
     Returns
     -------
-    bool
-        True for a second-order model (:data:`SECOND_ORDER_PLANTS`), False otherwise (also
-        for an unknown name).
+    PlantModel or SecondOrderModel
+        Its facts; ``order`` says which family.
+
+    Raises
+    ------
+    MissingPlantBehaviour
+        ``model`` is not a known model.
     """
-    return model in SECOND_ORDER_PLANTS
+    if model in SECOND_ORDER_PLANTS:
+        return SECOND_ORDER_PLANTS[model]
+    return model_behaviour(PLANTS, model, "entry in the plant registry")
+
+
+class MissingPlantBehaviour(ValueError):
+    """A plant model has no entry in a per-model table of behaviour (unknown model, or a
+    model added without that behaviour)."""
+
+
+def model_behaviour(table: Mapping[str, _Behaviour], model: str,
+                    what: str) -> _Behaviour:
+    """The behaviour ``model`` registered in a per-model ``table``, refused clearly if none.
+
+    Every module that does something per plant model keeps one table keyed by
+    ``plant.model`` (its dynamics, its bounds over a box, its Assumption-2 check, its
+    input-bound prover) and looks the model up here: a model without an entry is refused
+    by name, never handled as another model.
+
+    Parameters
+    ----------
+    table : mapping of str to object
+        The behaviour per ``plant.model`` name.
+    model : str
+        The ``plant.model`` name.
+    what : str
+        What the table holds, for the message (e.g. ``"Assumption-2 check"``).
+
+    Returns
+    -------
+    object
+        ``table[model]``.
+
+    Raises
+    ------
+    MissingPlantBehaviour
+        ``model`` has no entry, naming the models that have one.
+    """
+    try:
+        return table[model]
+    except KeyError:
+        known = ", ".join(table) or "none"
+        raise MissingPlantBehaviour(f"plant model {model!r} has no {what} (models with "
+                                    f"one: {known})") from None
 
 
 def dimension_mismatch(model: str, n: int) -> str | None:

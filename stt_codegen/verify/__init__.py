@@ -29,8 +29,7 @@ modules:
 import importlib
 from typing import Any
 
-from ..design.cascade_prover import register_cascade_certifier
-from ..design.input_bound import register_input_prover
+from ..design.provers import CASCADE_CERTIFICATE, INPUT_BOUND, register_prover
 
 #: Public name -> submodule that defines it; imported on first use (PEP 562), so importing
 #: this package costs nothing (``import stt_codegen`` imports it, see there).
@@ -60,7 +59,7 @@ def _prove_input_bound(tube: Any, spec: Any, *, per_axis_first: bool = False) ->
 # The design accepts a tube under [actuator] only with this proof (the sampled-data
 # check's bound on e, verify's), and cannot import verify, which builds on it: the
 # prover is registered here, when the package is loaded (``import stt_codegen`` loads it).
-register_input_prover(_prove_input_bound)
+register_prover(INPUT_BOUND, _prove_input_bound)
 
 
 def _certify_cascade(tube: Any, spec: Any, stage: Any) -> tuple[bool, dict]:
@@ -71,7 +70,7 @@ def _certify_cascade(tube: Any, spec: Any, stage: Any) -> tuple[bool, dict]:
 
 # The design keeps a second stage only when the sampled cascade is certified (verify's
 # certificate, registered here for the same reason as the input prover).
-register_cascade_certifier(_certify_cascade)
+register_prover(CASCADE_CERTIFICATE, _certify_cascade)
 
 
 def __getattr__(name: str) -> Any:

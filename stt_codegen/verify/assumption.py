@@ -12,12 +12,16 @@ from __future__ import annotations
 import math
 from fractions import Fraction
 
-from typing import Mapping, Sequence
+from typing import Callable, Mapping, Sequence
 
 import sympy as sp
 
 from ..codegen.emit import sympy_expressions
+from ..errors import SpecError
 from ..runtime.dynamics import input_matrix
+from ..spec.loader import Spec
+from ..spec.model_bounds import model_bounds
+from ..spec.plants import MissingPlantBehaviour, model_behaviour
 from .check import Check
 
 __all__ = [
@@ -26,6 +30,9 @@ __all__ = [
     "check_assumption2",
     "assumption2_omnidirectional",
     "assumption2_single_integrator",
+    "assumption2_linear",
+    "assumption2_check",
+    "ASSUMPTION2_CHECKS",
 ]
 
 #: A range endpoint closer than this to a zero of an eigenvalue counts as
@@ -225,3 +232,65 @@ def assumption2_single_integrator(n: int) -> Check:
     x = sp.symbols(f"x1:{n + 1}", real=True)
     return check_assumption2(plant_input_matrix("single-integrator", n, x), {},
                              name="assumption2.single_integrator")
+
+
+def assumption2_linear(spec: Spec) -> Check:
+    """Assumption 2 for the ``linear`` model: ``lambda_min((g + g^T)/2) > 0`` for the
+    constant ``plant.g`` (its bounds over the state space,
+    :func:`~stt_codegen.spec.model_bounds.model_bounds`).
+
+    Parameters
+    ----------
+    spec : Spec
+        A spec of the ``linear`` model (its ``plant.g``; default ``g = I``).
+
+    Returns
+    -------
+    Check
+        ``assumption2.linear``, with ``lambda_min``.
+    """
+    b = model_bounds("linear", spec.state_space.lower, spec.state_space.upper,
+                     spec.linear_plant)
+    lam = b.input_gain[0]
+    return Check("assumption2.linear", bool(lam > 0),
+                 f"lambda_min((g + g^T)/2) >= {lam:.6g} for the linear plant's g"
+                 + ("" if lam > 0 else ": Assumption 2 fails, law (13) cannot "
+                    "hold this plant"), {"lambda_min": lam})
+
+
+#: The Assumption-2 check of each first-order model, ``spec -> Check``: the proof on the
+#: deployed ``g(x)`` over the state space (the omnidirectional robot's heading range).
+ASSUMPTION2_CHECKS: dict[str, Callable[[Spec], Check]] = {
+    "omnidirectional": lambda spec: assumption2_omnidirectional(
+        (spec.state_space.lower[2], spec.state_space.upper[2])),
+    "single-integrator": lambda spec: assumption2_single_integrator(spec.dimension),
+    "linear": assumption2_linear,
+}
+
+
+def assumption2_check(spec: Spec, model: str) -> Check:
+    """Assumption 2 for ``model`` over the spec's state space (:data:`ASSUMPTION2_CHECKS`).
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec (its state space and, for ``linear``, its matrices).
+    model : str
+        The first-order ``plant.model`` to check.
+
+    Returns
+    -------
+    Check
+        The model's ``assumption2.*`` check.
+
+    Raises
+    ------
+    SpecError
+        ``model`` has no Assumption-2 check (field ``plant.model``): a model is never
+        checked as another.
+    """
+    try:
+        check = model_behaviour(ASSUMPTION2_CHECKS, model, "Assumption-2 check")
+    except MissingPlantBehaviour as err:
+        raise SpecError("plant.model", str(err)) from None
+    return check(spec)

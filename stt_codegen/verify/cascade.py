@@ -370,9 +370,8 @@ def plant_within_class_check(spec) -> Check:
     Check
         PASS when the model with its parameters is in the class, with the figures.
     """
-    from .cascade_sampled import model_within_class
-    ok, words, data = model_within_class(spec)
-    return Check("cascade.plant_within_assumptions", ok, words, data)
+    from .plant_within import plant_within_assumptions
+    return plant_within_assumptions(spec)
 
 
 def cascade_checks(max_n: int = 2) -> list[Check]:

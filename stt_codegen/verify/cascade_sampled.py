@@ -422,7 +422,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
 def certify_stage(tube: TubeDesign, spec: Spec, stage: SecondStage) -> tuple[bool, dict]:
     """:func:`check_cascade_sampled` for ``spec``'s declared plants (:func:`cascade_class`)
     on ``tube`` sampled at its rate: the design's certifier
-    (:func:`~stt_codegen.design.cascade_prover.register_cascade_certifier`).
+    (:func:`~stt_codegen.design.provers.register_prover`).
 
     Parameters
     ----------
@@ -468,6 +468,25 @@ def cascade_check_of(tube: TubeDesign, spec: Spec, stage: SecondStage) -> Cascad
                                  spec.second_order.initial_velocity)
 
 
+def _double_integrator_terms(p: dict, n: int) -> tuple[float, float, list[float]]:
+    return 1.0 / p["mass"], 0.0, [0.0] * n
+
+
+def _quadrotor_terms(p: dict, n: int) -> tuple[float, float, list[float]]:
+    offset = [0.0] * n
+    offset[2] = p["gravity"]
+    return 1.0 / p["mass"], p["drag"] / p["mass"], offset
+
+
+#: The second-order models with ``g = I / m`` and ``|f_i| <= slope |x2_i| + offset_i``:
+#: ``(parameters by name, n) -> (g, slope, offset)``. A model not here (the two-link arm)
+#: has no derived bounds, so its certificate covers the declared class only.
+MASS_MODEL_TERMS = {
+    "double-integrator": _double_integrator_terms,
+    "quadrotor": _quadrotor_terms,
+}
+
+
 def model_within_class(spec: Spec) -> tuple[bool, str, dict]:
     """Whether the spec's own simulated plant (``plant.model`` with ``plant.parameters``)
     belongs to its :func:`cascade_class`, so that the certificate covers it.
@@ -492,15 +511,12 @@ def model_within_class(spec: Spec) -> tuple[bool, str, dict]:
     order = spec.second_order
     cls = cascade_class(spec)
     p = dict(zip(SECOND_ORDER_PLANTS[order.model].parameters, order.parameters))
-    if order.model == "two-link-arm":
-        return False, ("the two-link-arm model's bounds are not derived: the certificate "
+    terms = MASS_MODEL_TERMS.get(order.model)
+    if terms is None:
+        return False, (f"the {order.model} model's bounds are not derived: the certificate "
                        "covers the declared class only, not this plant"), {}
-    g = 1.0 / p["mass"]
     n = spec.dimension
-    slope = p.get("drag", 0.0) / p["mass"]
-    offset = [0.0] * n
-    if order.model == "quadrotor":
-        offset[2] = p["gravity"]
+    g, slope, offset = terms(p, n)
     if slope > 0 and cls.velocity_bound is None:
         drift = math.inf
     else:

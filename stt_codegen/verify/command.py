@@ -21,7 +21,7 @@ from ..spec.plants import PLANT_MODELS
 from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
 from .actuator import input_bound_check, prove_input_bound
 from .adaptive import adaptive_law_checks, alpha_upper_bound
-from .assumption import assumption2_omnidirectional, assumption2_single_integrator
+from .assumption import assumption2_check
 from ..rounding import distinct
 from .check import Check, VerificationReport
 from .lemma import bump_rate_bound, reach_rate_bound
@@ -153,12 +153,9 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     bump_rate = {p: chk.data.get("bound", np.inf) for p, chk in zip(bumps, bump_checks)}
 
     stage("assumption 2")
-    if model == "omnidirectional":
-        checks.append(assumption2_omnidirectional((spec.state_space.lower[2],
-                                                   spec.state_space.upper[2])))
-    elif model != "linear":
-        checks.append(assumption2_single_integrator(n))
-    checks += plant_bounds_checks(spec, model)   # assumption2.linear for the linear model
+    checks.append(assumption2_check(spec, model))
+    if spec.order == 1:    # the cascade's membership check is reported with its lemmas
+        checks += plant_bounds_checks(spec, model)
 
     stage("tube certificate")
     tube_check = check_tube(design, spec)   # not the designer's: verify certifies again

@@ -20,6 +20,7 @@ from ..design.certificate import Enclosure
 from ..spec.assumptions import Assumptions
 from ..spec.loader import LinearPlant, Spec
 from ..spec.model_bounds import EXACT_DRIFT_DIMENSIONS, model_bounds
+from ..spec.plants import PLANTS
 
 __all__ = ["PlantClass", "IntervalBounds", "plant_class"]
 
@@ -88,16 +89,16 @@ class PlantClass:
         drift = a.drift_bound * ones
         refined: list[str] = []
         model = a.model
-        if self.lower is not None and self.upper is not None and model:
+        if self.lower is not None and self.upper is not None and model in PLANTS:
             lo = np.maximum(enclosure.lower_min[:count], np.array(self.lower))
             hi = np.minimum(enclosure.upper_max[:count], np.array(self.upper))
-            if a.g_from_model and model == "omnidirectional":
+            if a.g_from_model and PLANTS[model].gain_varies:
                 for k, (l_k, h_k) in enumerate(zip(lo.tolist(), hi.tolist())):
                     b = model_bounds(model, l_k, h_k)
                     g_min[k], g_max[k] = b.input_gain
                     skew[k], coupling[k] = b.input_gain_skew, b.input_gain_coupling
                 refined += ["input_gain", "input_gain_skew", "input_gain_coupling"]
-            if (a.drift_from_model and model == "linear" and self.linear is not None
+            if (a.drift_from_model and PLANTS[model].drift_varies and self.linear is not None
                     and any(v != 0.0 for row in self.linear.a for v in row)
                     and len(self.lower) <= min(6, EXACT_DRIFT_DIMENSIONS)):
                 for k, (l_k, h_k) in enumerate(zip(lo.tolist(), hi.tolist())):

@@ -32,7 +32,6 @@ from ..design.gain import derived_gain, gain_derivation
 from ..design.samples import TubeSamples, sample_tube
 from ..spec.assumptions import Assumptions
 from ..spec.loader import Spec
-from ..spec.model_bounds import model_bounds
 from ..tube import reference
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from ..rounding import distinct
@@ -530,8 +529,9 @@ def plant_bounds_checks(spec: Spec, model: str | None = None) -> list[Check]:
     ``spec.assumptions``. The loader makes this hold for every spec it builds (a bound the
     model violates is a ``SpecError``); a spec changed in Python
     (``dataclasses.replace``) can break it, and then the sampled verdict is not about the
-    model, which this check says. For the ``linear`` model also ``assumption2.linear``:
-    ``lambda_min((g + g^T)/2) > 0``.
+    model, which this check says (:func:`~.plant_within.plant_within_assumptions`, the
+    one membership check of both orders). Assumption 2 itself is the model's own check
+    (:func:`~stt_codegen.verify.assumption.assumption2_check`).
 
     Parameters
     ----------
@@ -543,37 +543,7 @@ def plant_bounds_checks(spec: Spec, model: str | None = None) -> list[Check]:
     Returns
     -------
     list of Check
-        ``sampled.plant_within_assumptions`` and, for the ``linear`` model, first
-        ``assumption2.linear``.
+        ``sampled.plant_within_assumptions``.
     """
-    model = model or spec.plant_model
-    linear = spec.linear_plant if model == "linear" else None
-    b = model_bounds(model, spec.state_space.lower, spec.state_space.upper, linear)
-    checks = []
-    if model == "linear":
-        lam = b.input_gain[0]
-        checks.append(Check("assumption2.linear", bool(lam > 0),
-                            f"lambda_min((g + g^T)/2) >= {lam:.6g} for the linear plant's g"
-                            + ("" if lam > 0 else ": Assumption 2 fails, law (13) cannot "
-                               "hold this plant"), {"lambda_min": lam}))
-    a = spec.assumptions
-    tol = 1e-9
-    bad = []
-    if b.input_gain[0] < a.input_gain[0] - tol or b.input_gain[1] > a.input_gain[1] + tol:
-        bad.append(f"eig((g + g^T)/2) spans [{distinct(b.input_gain[0], a.input_gain[0], 6)}, "
-                   f"{distinct(b.input_gain[1], a.input_gain[1], 6)}], outside input_gain "
-                   f"{list(a.input_gain)} (tolerance {tol:g})")
-    for key in ("input_gain_skew", "input_gain_coupling", "drift_bound"):
-        if getattr(b, key) > getattr(a, key) + tol:
-            bad.append(f"{key} is {distinct(getattr(b, key), getattr(a, key), 6)} > "
-                       f"{getattr(a, key)!r} (tolerance {tol:g})")
-    found = {"input_gain": list(b.input_gain), "input_gain_skew": b.input_gain_skew,
-             "input_gain_coupling": b.input_gain_coupling, "drift_bound": b.drift_bound}
-    checks.append(Check(
-        "sampled.plant_within_assumptions", not bad,
-        f"the {model} model meets the bounds the sampled check uses (eig in "
-        f"[{b.input_gain[0]:.6g}, {b.input_gain[1]:.6g}], skew {b.input_gain_skew:.3g}, "
-        f"coupling {b.input_gain_coupling:.3g}, max |f| {b.drift_bound:.3g} over the state "
-        "space)" if not bad else f"the {model} model is outside the bounds the sampled check "
-        "uses, so its verdict does not cover this plant: " + "; ".join(bad), found))
-    return checks
+    from .plant_within import plant_within_assumptions
+    return [plant_within_assumptions(spec, model)]
