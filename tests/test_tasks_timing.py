@@ -21,6 +21,7 @@ from stt_codegen.errors import DesignError, SpecError
 from stt_codegen.runtime.simulate import simulate
 from stt_codegen.runtime.tasks import judge_task
 from stt_codegen.spec.loader import Spec, load_spec
+from stt_codegen.tube import reference
 
 A = {"lower": [3.4, 0.6], "upper": [4.0, 1.2]}       # bottom right
 B = {"lower": [0.6, 3.4], "upper": [1.2, 4.0]}       # top left
@@ -278,6 +279,22 @@ def test_free_example_with_a_moving_box_is_retimed_in_its_visit_order():
     names = [m.name for m in design.certificate.margins if m.passed]
     assert {"task T1 reach", "task T2 reach", "task T3 stay"} <= set(names)
     assert any(name.startswith("avoids moving obstacle") for name in names)
+    # the re-timed visits are reported: each hold lies in its task's window, holds its box
+    # (rho constant over it) and, for the stay, lasts its duration
+    plan = design.task_plan
+    assert plan is not None and plan.order == (2, 0, 1)
+    rows = {row["task"]: row for row in design.to_json()["tasks"]}
+    for k, task in enumerate(design.spec.tasks):
+        start, end = plan.holds[k]
+        t0, t1 = task.window
+        assert rows[task.label]["hold"] == [start, end]
+        assert rows[task.label]["visit"] == plan.order.index(k) + 1
+        inside = min(end, t1) - max(start, t0)
+        assert inside > 0 and (task.duration is None or inside >= task.duration), task.label
+        times = np.linspace(start, end, 7)
+        lower, upper = reference.reach_tube(design.tube, times)[:2]
+        assert np.all(lower == lower[0]) and np.all(upper == upper[0]), task.label
+    assert [plan.holds[k] for k in plan.order] == sorted(plan.holds)
 
 
 # --------------------------------------------------------------------------- until

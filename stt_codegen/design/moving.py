@@ -50,7 +50,7 @@ from .failures import FailureKind
 from .gain import derived_gain
 from .certificate.motion import MOVING_PROPERTY
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
-from .tasks import FREE_HOLD, STAY_LEAD
+from .tasks import FREE_HOLD, STAY_LEAD, TaskPlan
 from .via import VIA_MARGIN
 
 #: How the tube of a spec with moving obstacles was found (``Design.motion``).
@@ -507,9 +507,44 @@ def _design(tube: TubeDesign, method: str, check: TubeCheck, spec: Spec, started
             motion: str, source: Design) -> Design:
     return Design(tube, method, check, time.perf_counter() - started, spec=spec,
                   input_proof=source.input_proof, motion=motion,
-                  task_choices=source.task_choices)
+                  task_choices=source.task_choices,
+                  task_plan=retimed_plan(tube.segments, spec, source.task_plan))
+
+
+def retimed_plan(segments: Sequence[ReachSegment], spec: Spec,
+                 plan: TaskPlan | None) -> TaskPlan | None:
+    """The visits of a tasks' plan after :func:`retime`: the same order, each task's hold
+    the interval over which ``segments`` keep ``rho`` at its waypoint box (from the end of
+    the segment that reaches the box to the start of the one that leaves it, waits
+    included).
+
+    Parameters
+    ----------
+    segments : sequence of ReachSegment
+        The re-timed plan (or any via plan of ``spec``'s tasks).
+    spec : Spec
+        Its ``tasks``.
+    plan : TaskPlan or None
+        The plan before re-timing (its ``order``).
+
+    Returns
+    -------
+    TaskPlan or None
+        ``None`` when ``plan`` is ``None`` or ``segments`` hold no box for some task.
+    """
+    if plan is None:
+        return None
+    holds = task_holds(segments, spec, plan.order)
+    if holds is None:
+        return None
+    held = {}
+    for task_index, k in zip(plan.order, holds):      # holds: segment indices in visit order
+        start = segments[k - 1].end if k > 0 else 0.0
+        end = segments[k + 1].start if k + 1 < len(segments) else spec.prescribed_time
+        held[task_index] = (float(start), float(end))
+    return TaskPlan(plan.order, tuple(held[j] for j in range(len(spec.tasks))))
 
 
 __all__ = ["DETOUR_SPANS", "DURATION_FACTORS", "MAX_ROUTES", "MOTION_SPACE_TIME", "MOTION_SWEPT",
            "MOTION_TIMED_VIA", "MOVE_CHECKS", "TASK_HOLD_SHARE", "TIME_STEPS", "design_moving",
-           "retime", "routes", "partial_spec", "static_part", "swept_spec", "task_holds"]
+           "retime", "retimed_plan", "routes", "partial_spec", "static_part", "swept_spec", "task_holds"]
