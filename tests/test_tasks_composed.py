@@ -63,7 +63,7 @@ def test_the_generated_c_meets_everything_and_verify_proves_it(design):
                            "and qemu-system-arm")
 def test_the_composed_spec_on_the_cortex_m4f(design, tmp_path):
     """The single-precision C in the firmware's closed loop: every vector passes, every task
-    is met on the target's own states, no obstacle (the cart included) is met."""
+    is met on the target's own states, no static obstacle is met, the tube is kept."""
     from stt_codegen.embedded.deploy import run_embedded
     report = run_embedded(design, tmp_path / "build")
     assert report["ok"] and report["vectors_failed"] == 0, report
