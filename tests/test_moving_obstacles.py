@@ -19,8 +19,8 @@ from stt_codegen.codegen.generate import generate_files
 from stt_codegen.codegen.options import Options
 from stt_codegen.design.failures import FailureKind
 from stt_codegen.design.moving import (MOTION_SPACE_TIME, MOTION_SWEPT, MOTION_TIMED_VIA,
-                                       TASK_HOLD_SHARE, static_part, swept_spec,
-                                       retime, task_holds)
+                                       TASK_HOLD_SHARE, static_part, retime, task_holds)
+from stt_codegen.design.swept import swept_spec
 from stt_codegen.design.search import check_tube
 from stt_codegen.runtime.simulate import run_closed_loop
 from stt_codegen.spec.schema import json_schema

@@ -19,7 +19,7 @@ from stt_codegen.design.search import base_design, check_tube, design_tube
 from stt_codegen.design.tasks import EXACT_ORDERS, task_schedule, visit_orders
 from stt_codegen.errors import DesignError, SpecError
 from stt_codegen.runtime.simulate import simulate
-from stt_codegen.runtime.tasks import judge_task
+from stt_codegen.runtime.tasks import judge_task, until_met
 from stt_codegen.spec.loader import Spec, load_spec
 from stt_codegen.tube import reference
 
@@ -336,3 +336,55 @@ def test_a_tube_through_the_wall_before_its_task_is_met_is_rejected():
     late = _tube_with(spec, [(2.6, *task), (3.4, *task), (4.0, *_centred((1.5, 4.0))),
                              (6.0, *right)])
     assert check_tube(late, spec).passed, check_tube(late, spec).reason
+
+
+def test_the_wall_may_be_crossed_once_the_task_is_certified_met_inside_its_window():
+    """The wall exists until T1 is met, not until T1's window ends: a tube that holds the
+    task's box over [2.6, 3.4] s and crosses the wall's band right after, at about 3.7 s
+    (before the window's end, 4 s), is certified; the same crossing with the task's box
+    reached only after it (at 3.9 s) is rejected."""
+    spec = spec_of(arena(2, [DOOR_TASK], obstacles=[DOOR], t_c=12.0))
+    task, band = _centred((1.0, 4.0)), _centred((2.5, 4.0))
+    right = _centred((3.8, 4.0))
+    met_first = _tube_with(spec, [(2.6, *task), (3.4, *task), (3.7, *band), (4.0, *right),
+                                  (8.0, *right)])
+    check = check_tube(met_first, spec)
+    assert check.passed, check.reason
+    wall = margins(check.certificate)["avoids moving obstacle 0"]
+    assert "until T1 is met, which the tube certifies by t = " in wall.detail
+    met_late = _tube_with(spec, [(2.6, *_centred((1.0, 2.6))), (3.4, *band),
+                                 (3.9, *task), (3.95, *task), (8.0, *right)])
+    late = check_tube(met_late, spec)
+    assert not late.passed and "moving obstacle 0" in late.reason, late.reason
+
+
+def test_a_door_until_its_key_with_the_whole_run_as_window_is_designed():
+    """A wall with a door closed until T1 (a key left of the wall) is met, T1's window
+    almost the whole run: the door exists until 11 s at the latest, too late to reach the
+    target by 12 s through it, so only the key met first opens the way. The design plans
+    the legs to the key around the door and the rest through it; the run meets the key,
+    then passes where the door was, and is satisfied."""
+    walls = [{"lower": [2.0, 0.0], "upper": [3.0, 2.2]}, {"lower": [2.0, 3.2], "upper": [3.0, 5.0]}]
+    door = {"lower": [2.0, 2.2], "upper": [3.0, 3.2], "active_until": "T1"}
+    key = {"kind": "reach", "window": [0.5, 11.0], "lower": [0.4, 3.8], "upper": [1.0, 4.4]}
+    spec = spec_of(arena(2, [key], obstacles=walls + [door], t_c=12.0))
+    (closed,) = spec.moving_obstacles
+    assert closed.until == 0 and closed.active == (0.0, 11.0)
+    design = design_tube(spec)
+    found = margins(design.certificate)
+    assert design.certificate.passed and found["task T1 reach"].passed
+    assert design.to_json()["moving_obstacles"][0]["until"] == "T1"
+    result = simulate(design, backend="python")
+    assert result.satisfied and result.tasks[0].met, result.to_json()
+    # the run goes through the doorway, after it has met the key
+    t = result.trajectory.t
+    x = result.trajectory.x
+    in_door = np.all((x[:, :2] >= [2.0, 2.2]) & (x[:, :2] <= [3.0, 3.2]), axis=1)
+    assert in_door.any() and t[in_door].min() > result.tasks[0].time
+    # the judge keeps the door until the run meets the key: a run that had not met it
+    # would have hit the door
+    from dataclasses import replace as _replace
+    unmet = [_replace(result.tasks[0], met=False, time=None)]
+    (kept,) = until_met(design.spec, unmet)
+    assert kept.active == closed.active
+    assert kept.signed_clearance(x[in_door], t[in_door]).min() <= 0.0

@@ -5,7 +5,7 @@ random moving obstacles (:func:`~.moving.random_moving_obstacles`, generator
 ``default_rng([S, k])``). For each, the design (:func:`stt_codegen.design_tube`: space-time,
 re-timed via, swept) and, as the baseline a user would otherwise take, the *swept-only*
 design (every moving obstacle as the static box it sweeps,
-:func:`~stt_codegen.design.moving.swept_spec`) are run; each design found is simulated (Python backend, collisions with moving obstacles
+:func:`~stt_codegen.design.swept.swept_spec`) are run; each design found is simulated (Python backend, collisions with moving obstacles
 where they are). Reported: how each design was found, designed and satisfied counts, and the
 design time (median, p95), measured side by side in one run (docs/moving-obstacles.md).
 """
@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..design.moving import swept_spec
+from ..design.swept import swept_spec
 from ..design.search import design_tube
 from ..errors import DesignError
 from ..runtime.simulate import simulate

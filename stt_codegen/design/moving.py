@@ -51,6 +51,7 @@ from .gain import derived_gain
 from .certificate.motion import MOVING_PROPERTY
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
 from .tasks import FREE_HOLD, STAY_LEAD, TaskPlan
+from .swept import swept_spec
 from .via import VIA_MARGIN
 
 #: How the tube of a spec with moving obstacles was found (``Design.motion``).
@@ -74,7 +75,13 @@ TASK_HOLD_SHARE = 0.25
 
 
 def static_part(spec: Spec) -> Spec:
-    """``spec`` without its moving obstacles (what the static design search sees).
+    """``spec`` without the moving obstacles that only the space-time steps handle (what the
+    static design search sees).
+
+    An obstacle until a task (``MovingObstacle.until``) is kept: the tasks' plan keeps
+    clear of the box it sweeps until that task's hold (:func:`~.tasks.plan_tasks`), and the
+    certificate checks it until the tube is certified to meet the task
+    (:func:`~.certificate.motion.until_ended`).
 
     Parameters
     ----------
@@ -84,46 +91,26 @@ def static_part(spec: Spec) -> Spec:
     Returns
     -------
     Spec
-        The same spec with ``moving_obstacles`` empty.
+        The same spec with only its obstacles until a task as ``moving_obstacles``.
     """
-    return replace(spec, moving_obstacles=())
+    return replace(spec, moving_obstacles=tuple(ob for ob in spec.moving_obstacles
+                                                if ob.until is not None))
 
 
-def swept_spec(spec: Spec, which: Sequence[int] | None = None) -> tuple[Spec | None, str]:
-    """``spec`` with moving obstacles as the static boxes they sweep while active.
+def moves(spec: Spec) -> bool:
+    """Whether ``spec`` has moving obstacles that need :func:`design_moving` (obstacles
+    until a task alone do not: the static design keeps clear of them, see
+    :func:`static_part`).
 
     Parameters
     ----------
     spec : Spec
-    which : sequence of int, optional
-        Positions in ``spec.moving_obstacles`` to sweep; default all. The others stay
-        moving.
 
     Returns
     -------
-    (Spec or None, str)
-        The spec (those moving obstacles removed, their swept boxes, clipped to the state
-        space, added as obstacles with the same index), or ``None`` and why not (a swept
-        box meets the initial set or the target set).
+    bool
     """
-    extra = []
-    space = spec.state_space
-    chosen = range(len(spec.moving_obstacles)) if which is None else which
-    for ob in (spec.moving_obstacles[i] for i in chosen):
-        lo, hi, _ = ob.hull([ob.active[0]], [ob.active[1]])
-        lower = tuple(max(float(a), space.lower[d]) for a, d in zip(lo[0], ob.dims))
-        upper = tuple(min(float(b), space.upper[d]) for b, d in zip(hi[0], ob.dims))
-        if any(a >= b for a, b in zip(lower, upper)):
-            continue                       # never inside the state space
-        swept = Obstacle(lower, upper, ob.dims, ob.source)
-        box = swept.box(space)
-        for label, other in (("initial", spec.initial_set), ("target", spec.target_set)):
-            if box.meets(other):
-                return None, (f"the region moving obstacle {ob.source} sweeps while active "
-                              f"meets the {label} set")
-        extra.append(swept)
-    keep = tuple(ob for i, ob in enumerate(spec.moving_obstacles) if i not in chosen)
-    return replace(spec, obstacles=spec.obstacles + tuple(extra), moving_obstacles=keep), ""
+    return any(ob.until is None for ob in spec.moving_obstacles)
 
 
 def partial_spec(spec: Spec, position: int, t_a: float, t_b: float) -> Spec | None:
@@ -546,5 +533,5 @@ def retimed_plan(segments: Sequence[ReachSegment], spec: Spec,
 
 
 __all__ = ["DETOUR_SPANS", "DURATION_FACTORS", "MAX_ROUTES", "MOTION_SPACE_TIME", "MOTION_SWEPT",
-           "MOTION_TIMED_VIA", "MOVE_CHECKS", "TASK_HOLD_SHARE", "TIME_STEPS", "design_moving",
-           "retime", "retimed_plan", "routes", "partial_spec", "static_part", "swept_spec", "task_holds"]
+           "MOTION_TIMED_VIA", "MOVE_CHECKS", "TASK_HOLD_SHARE", "TIME_STEPS", "design_moving", "moves",
+           "retime", "retimed_plan", "routes", "partial_spec", "static_part", "task_holds"]

@@ -166,7 +166,8 @@ class Design:
             ``[actuator]`` also ``input_bound`` and ``input_peak`` (the proved peak of
             each input, when it occurs, the horizon covered, the relative margin); for a
             spec with moving obstacles also ``motion`` and ``moving_obstacles`` (index,
-            motion, active interval, certified margin; docs/moving-obstacles.md); for a
+            motion, active interval, the task it lasts until or ``None``, certified
+            margin; docs/moving-obstacles.md); for a
             spec with a second-order ``plant.model`` also ``cascade`` (``gains``: the
             certified second stage's derivation and its sampled-data certificate,
             :func:`~stt_codegen.design.cascade_gain.second_stage_of`); for a spec with
@@ -255,6 +256,7 @@ class Design:
         return {"motion": self.motion, "moving_obstacles": [
             {"obstacle": ob.source, "motion": ob.motion, "active": [
                 ob.active[0], "inf" if math.isinf(ob.active[1]) else ob.active[1]],
+             "until": None if ob.until is None else self.spec.tasks[ob.until].label,
              "margin": margins[f"avoids moving obstacle {ob.source}"].margin}
             for ob in self.spec.moving_obstacles]}
 

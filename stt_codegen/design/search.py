@@ -35,7 +35,7 @@ from .actuator import design_within_bound
 from .cascade_gain import cascade_input_proof
 from .failures import FailureKind, property_kind
 from .grid import grid_index, grid_value, smallest_passing
-from .moving import design_moving
+from .moving import MOTION_SPACE_TIME, design_moving, moves
 from .gain import derived_gain
 from .plant_check import plant_failure
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
@@ -343,7 +343,7 @@ def _any_target(spec: Spec) -> Design:
 def _position_stage(spec: Spec) -> Design:
     """:func:`design_tube` without the second stage of a second-order spec: the tube of the
     positions, for moving obstacles, ``[actuator]`` or neither."""
-    if spec.moving_obstacles:             # obstacles that move: design/moving.py
+    if moves(spec):                       # obstacles that move: design/moving.py
         return design_moving(spec, _position_stage, check_tube)
     if spec.input_bound is not None:      # [actuator]: design/actuator.py
         # the bound's proof orders the tubes there (default, softer circumvents, via
@@ -383,9 +383,11 @@ def _design(spec: Spec, smoother: bool) -> Design:
     base = base_design(spec)
     if spec.tasks:              # [[tasks]]: via points through the tasks' boxes
         tube, check, choice, plan = _tasks(spec, base)
+        # obstacles until a task are certified in space-time (certificate/motion.py)
         return Design(_with_gain(tube, check, spec), METHOD_VIA, check,
                       time.perf_counter() - started, spec=spec, task_choices=choice,
-                      task_plan=plan)
+                      task_plan=plan,
+                      motion=MOTION_SPACE_TIME if spec.moving_obstacles else "")
     method = spec.tube.method
     # "auto": the paper's search on a short budget, then via points, then the paper's
     # search on its full budget (a hard arena rarely needs it)

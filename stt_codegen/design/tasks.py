@@ -38,6 +38,7 @@ from ..spec.loader import Spec
 from ..spec.tasks import STAY, Task
 from ..tube.parameters import SMOOTHSTEP, ReachSegment, TubeDesign, paper_segments
 from .failures import FailureKind
+from .swept import swept_spec
 from .via import plan_via
 
 __all__ = ["FREE_HOLD", "MAX_PLANS", "STAY_LEAD", "TaskPlan", "alternatives", "plan_tasks", "task_schedule",
@@ -107,6 +108,17 @@ def _within(box: tuple, task_box) -> bool:
     whether the tube, wider by ``alpha``, does)."""
     return bool(np.all(np.array(box[0]) >= task_box.lower)
                 and np.all(np.array(box[1]) <= task_box.upper))
+
+
+def _around(spec: Spec, pending: list[int]) -> Spec:
+    """The spec a leg is planned on: the obstacles until a task that is not yet met
+    (positions ``pending`` in ``spec.moving_obstacles``) as the static boxes they sweep
+    (:func:`~.swept.swept_spec`; ``spec`` itself when one meets the start or the target:
+    the certificate then decides)."""
+    if not pending:
+        return spec
+    around, _ = swept_spec(spec, pending)
+    return spec if around is None else around
 
 
 def _leg(spec: Spec, base: TubeDesign, start: tuple, goal: tuple, t0: float,
@@ -401,14 +413,17 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...],
     start = (tuple(base.initial_lower), tuple(base.initial_upper))
     leave = 0.0
     segments: list[ReachSegment] = []
-    for box, (arrive, until) in zip(boxes, holds):
+    # obstacles until a task: the legs up to that task's hold go around the box it sweeps
+    pending = [i for i, ob in enumerate(spec.moving_obstacles) if ob.until is not None]
+    for k, box, (arrive, until) in zip(order, boxes, holds):
         if arrive == leave:        # a stay held where the tube already is
             segments.append(ReachSegment(leave, until, *start, *start, SMOOTHSTEP))
             leave = until
             continue
-        segments += _leg(spec, base, start, box, leave, arrive)
+        segments += _leg(_around(spec, pending), base, start, box, leave, arrive)
         segments.append(ReachSegment(arrive, until, *box, *box, SMOOTHSTEP))
         start, leave = box, until
+        pending = [i for i in pending if spec.moving_obstacles[i].until != k]
     goal = (tuple(base.target_lower), tuple(base.target_upper))
     if not base.prescribed_time > leave:
         raise DesignError("no time to reach the target after the last task",

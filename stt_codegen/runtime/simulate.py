@@ -30,7 +30,7 @@ from ..spec.loader import Spec
 from ..tube import cascade_reference, reference
 from ..tube.parameters import Status, TubeDesign
 from ..tube.second_stage import SecondStage
-from .tasks import TaskOutcome, judge_tasks
+from .tasks import TaskOutcome, judge_tasks, until_met
 
 __all__ = ["SUBSTEPS", "SimulationResult", "Trajectory", "run_closed_loop", "simulate"]
 
@@ -417,18 +417,19 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     in_target = np.all((xs >= t_lo) & (xs <= t_hi), axis=1) & (ts <= t_c + 1e-12)
     reached = bool(in_target.any())
     reach_time = float(ts[int(np.argmax(in_target))]) if reached else None
+    tasks = judge_tasks(spec, path_t, path)
     if spec.unsafe_sets or spec.moving_obstacles:
-        # a moving obstacle where it is at each instant (inf while not active)
+        # a moving obstacle where it is at each instant (inf while not active); one until a
+        # task is gone once the run has met the task
         clearance = np.min([u.signed_clearance(within) for u in spec.unsafe_sets]
                            + [ob.signed_clearance(within, path_t[judged])
-                              for ob in spec.moving_obstacles], axis=0)
+                              for ob in until_met(spec, tasks)], axis=0)
         min_clear = float(clearance.min())
         collision = bool(min_clear <= 0.0)
         min_clear = min_clear if math.isfinite(min_clear) else None
     else:
         min_clear, collision = None, False
     left = bool(np.any((within < lo) | (within > hi)))
-    tasks = judge_tasks(spec, path_t, path)
     velocity = _velocity_verdict(spec, tube, stage, ts, states, alphas, status, dt)
     contacts = stepper.contact_count
     satisfied = (reached and not collision and not left and horizon >= t_c

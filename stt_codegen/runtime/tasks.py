@@ -28,7 +28,7 @@ import numpy as np
 from ..spec.loader import Spec
 from ..spec.tasks import STAY, Task
 
-__all__ = ["TaskOutcome", "judge_tasks"]
+__all__ = ["TaskOutcome", "judge_tasks", "until_met"]
 
 
 @dataclass(frozen=True)
@@ -130,3 +130,24 @@ def judge_tasks(spec: Spec, t: np.ndarray, x: np.ndarray) -> list[TaskOutcome]:
     """
     return [judge_task(task, t, x) for task in spec.tasks]
 
+
+
+def until_met(spec: Spec, outcomes: list[TaskOutcome]) -> tuple:
+    """The spec's moving obstacles as a run meets them: one until a task
+    (``MovingObstacle.until``) ends when the run first meets that task (it lasts to the end
+    of the task's window when the run does not).
+
+    Parameters
+    ----------
+    spec : Spec
+        Its ``moving_obstacles``.
+    outcomes : list of TaskOutcome
+        :func:`judge_tasks` of the run.
+
+    Returns
+    -------
+    tuple of MovingObstacle
+    """
+    return tuple(ob if ob.until is None or not outcomes[ob.until].met
+                 else ob.ended_at(outcomes[ob.until].time)
+                 for ob in spec.moving_obstacles)

@@ -587,10 +587,11 @@ def _any_target(raw: dict, doc: Any) -> Spec:
 
 
 def _until_tasks(doc: Any) -> Any:
-    """``doc`` with each obstacle's ``active_until = "Tk"`` turned into ``active = [0, t1]``,
-    ``t1`` the end of task ``Tk``'s window: the task is met by then in any run that meets it,
-    so keeping clear of the box over ``[0, t1]`` keeps clear of it while it exists (a
-    stronger property than needed; docs/tasks.md, "Obstacles until a task")."""
+    """``doc`` with each obstacle's ``active_until = "Tk"`` given ``active = [0, t1]``, ``t1``
+    the end of task ``Tk``'s window: a run that meets the task has met it by then, so the box
+    exists at most that long; the moving obstacle keeps ``Tk`` (``MovingObstacle.until``),
+    and the certificate and the run judge end it when the task is met (docs/tasks.md,
+    "Obstacles until a task")."""
     if not any(getattr(o, "active_until", None) is not None for o in doc.obstacles):
         return doc
     tasks = doc.tasks or []
@@ -609,8 +610,7 @@ def _until_tasks(doc: Any) -> Any:
         if tasks[k].kind != "reach":
             raise SpecError(name, f"task {label} is a {tasks[k].kind} task; an obstacle "
                             "lasts until a reach task is met")
-        obstacles.append(table.model_copy(update={"active": [0.0, float(tasks[k].window[1])],
-                                                  "active_until": None}))
+        obstacles.append(table.model_copy(update={"active": [0.0, float(tasks[k].window[1])]}))
     return doc.model_copy(update={"obstacles": obstacles})
 
 

@@ -32,7 +32,7 @@ This module is plain Python and numpy; the boxes it is given are any objects wit
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Sequence
 
 import numpy as np
@@ -68,6 +68,11 @@ class MovingObstacle:
         ``(t_on, t_off)``, seconds; ``t_off`` may be ``inf``.
     motion : {"still", "velocity", "path"}
         How the spec gave it.
+    until : int or None
+        ``active_until = "Tk"``: index ``k - 1`` of the reach task whose meeting ends the
+        box. It exists from ``t_on`` until a run first meets that task, and at the latest
+        until the end of the task's window, which is ``t_off`` (docs/tasks.md, "Obstacles
+        until a task").
     """
 
     source: int
@@ -77,6 +82,12 @@ class MovingObstacle:
     centres: tuple[tuple[float, ...], ...]
     active: tuple[float, float]
     motion: str
+    until: int | None = None
+
+    def ended_at(self, t_off: float) -> "MovingObstacle":
+        """The same box, gone after ``min(t_off, active[1])`` (an obstacle until a task, once
+        the task is met at ``t_off``)."""
+        return replace(self, active=(self.active[0], min(self.active[1], float(t_off))))
 
     def centre(self, t: Any) -> np.ndarray:
         """The centre at times ``t`` (shape (N,)), shape (N, len(dims)); held outside the knots."""
@@ -268,6 +279,8 @@ def moving_obstacle(table: Any, name: str, source: int, dims: tuple[int, ...],
     """
     m = len(dims)
     t_on, t_off = (0.0, math.inf) if table.active is None else tuple(table.active)
+    label = getattr(table, "active_until", None)       # "Tk": active is [0, end of Tk's window]
+    until = None if label is None else int(label[1:]) - 1
     if not t_on < t_off:
         raise SpecError(f"{name}.active", f"t_on = {t_on!r} must be less than t_off = {t_off!r}")
     if table.velocity is not None and table.path is not None:
@@ -287,7 +300,7 @@ def moving_obstacle(table: Any, name: str, source: int, dims: tuple[int, ...],
                                 "velocity for a box that stays)")
         end = tuple(c + vk * (t_off - t_on) for c, vk in zip(centre, v))
         return MovingObstacle(source, dims, half, (t_on, t_off), (centre, end), (t_on, t_off),
-                              "velocity")
+                              "velocity", until)
     if table.path is not None:
         rows = table.path
         for k, row in enumerate(rows):
@@ -305,8 +318,9 @@ def moving_obstacle(table: Any, name: str, source: int, dims: tuple[int, ...],
             raise SpecError(f"{name}.path", f"the first row's centre {list(first)} is not the "
                                             f"centre {list(centre)} of lower/upper")
         centres = tuple(tuple(float(v) for v in r[1:]) for r in rows)
-        return MovingObstacle(source, dims, half, times, centres, (t_on, t_off), "path")
-    return MovingObstacle(source, dims, half, (t_on,), (centre,), (t_on, t_off), "still")
+        return MovingObstacle(source, dims, half, times, centres, (t_on, t_off), "path", until)
+    return MovingObstacle(source, dims, half, (t_on,), (centre,), (t_on, t_off), "still",
+                          until)
 
 
 def check_moving(obstacle: MovingObstacle, name: str, initial_set: Any, target_set: Any,

@@ -30,8 +30,9 @@ from ...tube.parameters import TubeDesign
 from .enclosures import enclose, partition
 from .report import ROUNDING_MARGIN, Certificate, CertificateState, Enclosure, Margin
 from .repropagate import repropagate
+from .tasks import reach_certified_by
 
-__all__ = ["MOVING_PROPERTY", "certify_motion"]
+__all__ = ["MOVING_PROPERTY", "certify_motion", "until_ended"]
 
 #: Most intervals the refinement for moving obstacles may create (its own budget, on top
 #: of the partition the rest of the certificate proved).
@@ -61,6 +62,45 @@ def moving_separation(spec: Spec, enc: Enclosure) -> list[tuple[int, np.ndarray,
         sep = np.where(present, gaps.max(axis=1), np.inf)
         out.append((obstacle.source, sep, np.array(dims)[best]))
     return out
+
+
+def until_ended(design: TubeDesign, spec: Spec, enc: Enclosure) -> tuple[Spec, dict[int, str]]:
+    """``spec`` with each obstacle until a task (``MovingObstacle.until``) ended where the
+    tube is certified to have met the task (:func:`~.tasks.reach_certified_by`): every run
+    inside the tube has met it by then, so the box no longer exists for it. An obstacle
+    whose task is not certified met keeps its ``active`` (the end of the task's window).
+
+    Parameters
+    ----------
+    design : TubeDesign
+    spec : Spec
+        Its ``moving_obstacles`` and ``tasks``.
+    enc : Enclosure
+        The certificate's enclosure.
+
+    Returns
+    -------
+    spec : Spec
+        The same spec, each such obstacle's ``active`` ending at its task's time.
+    notes : dict of int to str
+        Per obstacle index, the words its margin's detail ends with.
+    """
+    if all(ob.until is None for ob in spec.moving_obstacles):
+        return spec, {}
+    notes, kept = {}, []
+    for ob in spec.moving_obstacles:
+        if ob.until is not None:
+            task = spec.tasks[ob.until]
+            met = reach_certified_by(design, task, enc)
+            if met is not None:
+                ob = ob.ended_at(met)
+                notes[ob.source] = (f"; it exists until {task.label} is met, which the tube "
+                                    f"certifies by t = {met:.4f} s")
+            else:
+                notes[ob.source] = (f"; it exists until {task.label} is met, at the latest "
+                                    f"at the end of its window, {ob.active[1]:g} s")
+        kept.append(ob)
+    return replace(spec, moving_obstacles=tuple(kept)), notes
 
 
 def _enclosure(design: TubeDesign, points: list[int], state: CertificateState
@@ -120,6 +160,7 @@ def certify_motion(design: TubeDesign, spec: Spec, certificate: Certificate,
     """
     if not spec.moving_obstacles:
         return certificate
+    spec, until = until_ended(design, spec, certificate.enclosure)
     with reference.numpy_math():
         enc, state = certificate.enclosure, certificate.state
         points = list(state.points)
@@ -158,7 +199,8 @@ def certify_motion(design: TubeDesign, spec: Spec, certificate: Certificate,
         else:
             detail = (f"the tube may meet moving obstacle {j} on [{t:.4f}, "
                       f"{float(enc.t_end[k]):.4f}] s (separation {m:.3g})" + note)
-        margins.append(Margin(f"{MOVING_PROPERTY} {j}", m > ROUNDING_MARGIN, m, t, detail))
+        margins.append(Margin(f"{MOVING_PROPERTY} {j}", m > ROUNDING_MARGIN, m, t,
+                              detail + until.get(j, "")))
     old = list(certificate.margins)
     at = max((q + 1 for q, mg in enumerate(old) if mg.name.startswith("avoids")),
              default=next(q + 1 for q, mg in enumerate(old) if mg.name == "inside state space"))

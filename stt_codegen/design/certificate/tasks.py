@@ -36,7 +36,7 @@ from ...tube.parameters import TubeDesign
 from .enclosures import enclose, piece_ranges
 from .report import ROUNDING_MARGIN, Enclosure, Margin
 
-__all__ = ["task_margins"]
+__all__ = ["reach_certified_by", "task_margins"]
 
 #: Pieces a window is cut into at most (besides the partition's points inside it).
 TASK_PIECES = 200
@@ -67,6 +67,54 @@ def _inside(task: Task, lower_min: np.ndarray, upper_max: np.ndarray) -> np.ndar
                      for box in task.boxes])
 
 
+def _pieces(design: TubeDesign, task: Task, enc: Enclosure
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The window's pieces ``[s0, s1]`` and how far each one's enclosure lies inside each of
+    the task's boxes, (B, K); ``None`` when the window holds no sampling period."""
+    rate = design.rate_hz
+    t0, t1 = task.window
+    a, b = _sample_range(t0, t1, rate, cover=task.kind == STAY and task.duration is None)
+    if b <= a:
+        return None
+    points = np.rint(enc.t_start * rate).astype(np.int64)
+    cuts = set(np.linspace(a, b, min(TASK_PIECES, b - a) + 1).round().astype(np.int64).tolist())
+    cuts |= {int(p) for p in points if a < p < b}
+    cuts = np.array(sorted(cuts), dtype=np.int64)
+    s0, s1 = cuts[:-1] / rate, cuts[1:] / rate
+    k = np.searchsorted(points, cuts[:-1], side="right") - 1
+    sub = enclose(design, piece_ranges(design, s0, s1), enc.alpha_min[k], enc.alpha_max[k],
+                  s0, s1)
+    return s0, s1, _inside(task, sub.lower_min, sub.upper_max)
+
+
+def reach_certified_by(design: TubeDesign, task: Task, enc: Enclosure) -> float | None:
+    """The time by which every run inside the tube has met a reach task: the end of the
+    first piece of its window on which the tube's enclosure lies inside one of its boxes
+    (by more than :data:`~.report.ROUNDING_MARGIN`).
+
+    Parameters
+    ----------
+    design : TubeDesign
+    task : Task
+        A ``reach`` task.
+    enc : Enclosure
+        A certificate's enclosure (its intervals and ``alpha`` ranges).
+
+    Returns
+    -------
+    float or None
+        Seconds; ``None`` when no piece is certified inside (or the task is a stay).
+    """
+    if task.kind == STAY:
+        return None
+    pieces = _pieces(design, task, enc)
+    if pieces is None:
+        return None
+    _, s1, inside = pieces
+    good = np.flatnonzero((inside > ROUNDING_MARGIN).any(axis=0))
+    return float(s1[good[0]]) if good.size else None
+
+
 def task_margin(design: TubeDesign, task: Task, enc: Enclosure) -> Margin:
     """The certified margin of one task over the partition of ``enc``.
 
@@ -83,22 +131,13 @@ def task_margin(design: TubeDesign, task: Task, enc: Enclosure) -> Margin:
         Named ``task.name``; state units; ``time`` is the start of the piece where the
         margin is reached (reach: largest; stay: smallest).
     """
-    rate = design.rate_hz
     t0, t1 = task.window
     stay = task.kind == STAY
-    a, b = _sample_range(t0, t1, rate, cover=stay and task.duration is None)
-    if b <= a:
+    pieces = _pieces(design, task, enc)
+    if pieces is None:
         return Margin(task.name, False, -math.inf, t0, f"the window [{t0:g}, {t1:g}] s holds "
-                      f"no sampling period at {rate:g} Hz")
-    points = np.rint(enc.t_start * rate).astype(np.int64)
-    cuts = set(np.linspace(a, b, min(TASK_PIECES, b - a) + 1).round().astype(np.int64).tolist())
-    cuts |= {int(p) for p in points if a < p < b}
-    cuts = np.array(sorted(cuts), dtype=np.int64)
-    s0, s1 = cuts[:-1] / rate, cuts[1:] / rate
-    k = np.searchsorted(points, cuts[:-1], side="right") - 1
-    sub = enclose(design, piece_ranges(design, s0, s1), enc.alpha_min[k], enc.alpha_max[k],
-                  s0, s1)
-    inside = _inside(task, sub.lower_min, sub.upper_max)          # (B, K)
+                      f"no sampling period at {design.rate_hz:g} Hz")
+    s0, s1, inside = pieces
     if stay and task.duration is not None:
         return max((_duration_margin(task, inside[b], s0, s1, b) for b in range(len(inside))),
                    key=lambda margin: margin.margin)
