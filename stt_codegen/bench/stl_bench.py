@@ -28,7 +28,10 @@ for the unicycle, one velocity over the step).
 
 from __future__ import annotations
 
+import contextlib
+import io
 import time
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -37,6 +40,8 @@ from ..errors import DesignError, SpecError
 from .stl_judge import FINE_PERIOD, robustness, stlpy_robustness
 from .stl_scenarios import (ORDER_NOTE, SCENARIOS, SKIPPED, make_scenario, scenario_names,
                             scenario_spec, spec_toml, step_seconds)
+
+_MISSING = 'stlpy and rtamt are not installed: install the optional extra with pip install ".[stl]"'
 
 __all__ = ["format_stl_report", "judge_positions", "run_stl_bench", "run_stl_scenario",
            "solve_with_stlpy"]
@@ -99,7 +104,9 @@ def solve_with_stlpy(name: str, horizon: int | None = None) -> dict[str, Any]:
         ``{"solver", "seconds", "plan": (times, positions) or None, "note"}``.
     """
     try:
-        from stlpy.solvers import ScipyGradientSolver
+        # stlpy.solvers prints a warning on stdout for each solver it cannot load
+        with contextlib.redirect_stdout(io.StringIO()):
+            from stlpy.solvers import ScipyGradientSolver
     except ImportError as exc:   # stlpy's solver package fails with today's Drake installed
         return {"solver": None, "seconds": None, "plan": None,
                 "note": f"stlpy.solvers does not import: {exc}"}
@@ -209,7 +216,7 @@ def run_stl_scenario(name: str, horizon: int | None = None, solver: bool = True,
 
 
 def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
-                  solver: bool = True) -> dict[str, Any]:
+                  solver: bool = True, specs: Path | None = None) -> dict[str, Any]:
     """Every scenario (module notes), one after another in one process.
 
     Parameters
@@ -220,6 +227,8 @@ def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
         ``T`` in steps for every scenario instead of the examples'.
     solver : bool
         Also run stlpy's scipy solver on each.
+    specs : Path, optional
+        Also write each written spec there as ``stlpy-<scenario>.toml``.
 
     Returns
     -------
@@ -229,8 +238,14 @@ def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
     Raises
     ------
     SpecError
-        An unknown scenario name (field ``scenarios``).
+        An unknown scenario name (field ``scenarios``); stlpy or rtamt not installed
+        (field ``stl``).
     """
+    try:
+        import rtamt  # noqa: F401
+        import stlpy  # noqa: F401
+    except ImportError:
+        raise SpecError("stl", _MISSING) from None
     known = scenario_names() + list(SKIPPED)
     names = known if names is None else list(names)
     for name in names:
@@ -240,6 +255,11 @@ def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
     rows: list[dict[str, Any]] = []
     for name in names:
         rows += run_stl_scenario(name, horizon, solver)
+    if specs is not None:
+        specs.mkdir(parents=True, exist_ok=True)
+        for row in rows:
+            if "spec" in row:
+                (specs / f"stlpy-{row['scenario']}.toml").write_text(row["spec"])
     return {"rows": rows, "order_note": ORDER_NOTE}
 
 

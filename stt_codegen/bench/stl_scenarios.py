@@ -49,9 +49,10 @@ INITIAL_HALF_SIDE = 0.1
 
 #: Which law a double-integrator scenario is written with, and why.
 ORDER_NOTE = ("double integrators are written as the first-order position law "
-              "(single-integrator, input = velocity, bounded by the example's |v|); the "
-              "second-order cascade is not used because its certified force bound for "
-              "these horizons is far above stlpy's |u| <= 0.5 (see docs/tasks.md)")
+              "(single-integrator: its input is the velocity, bounded by the example's |v|); "
+              "the second-order cascade with stlpy's bounds (|u| <= 0.5 N, |v| <= 1 m/s) "
+              "is not certified: ReachAvoid written so is refused after 91 s (the velocity "
+              "may reach 1.001 m/s, beyond |v| <= 1, at every rate up to 16 kHz)")
 
 #: Scenarios not written, with the reason.
 SKIPPED = {"SteppingStones": "a union safe set (G[0,T] of an or of stones): the project's "
