@@ -47,6 +47,12 @@ def test_formula_text_reads_the_unrolled_operators():
     text, predicates = formula_text(make_scenario("DoorPuzzle").GetSpecification(), 1.0)
     assert text.count("until[0,25]") == 2 and text.count("always[0,25]") == 1
     assert text.count("eventually[0,25]") == 1 and len(predicates) == 40
+    # evaluated on a signal ending at 25 s, the top-level untils are rtamt's unbounded one
+    whole, _ = formula_text(make_scenario("DoorPuzzle").GetSpecification(), 1.0, 25.0)
+    assert whole.count(" until ") == 2 and "until[" not in whole
+    # under a temporal operator an until keeps its window
+    inner = make_scenario("DoorPuzzle").GetSpecification().subformula_list[-1]
+    assert "always[0,3]" in formula_text(inner.always(0, 3), 1.0, 25.0)[0]
     text, _ = formula_text(make_scenario("EitherOr").GetSpecification(), 1.0)
     assert "eventually[0,15]" in text and "always[0,5]" in text
     text, _ = formula_text(make_scenario("NonlinearReachAvoid").GetSpecification(), 0.1)

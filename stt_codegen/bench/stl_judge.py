@@ -5,7 +5,8 @@ stlpy builds its temporal operators by unrolling them over integer steps:
 at the timesteps ``a..b``, ``eventually`` the same with ``or``, and ``phi.until(psi, a, b)``
 an ``or`` over ``t'`` of ``phi`` at ``a..t'-1`` and ``psi`` at ``t'``. :func:`formula_text`
 reads those shapes back as rtamt's ``always[a dt, b dt]``, ``eventually[...]`` and
-``until[...]`` (seconds), and a tree whose timesteps are all 0 as a plain ``and``/``or``;
+``until[...]`` (seconds; at the top, an ``until`` over the whole signal as rtamt's
+unbounded one, the same at ``t = 0``), and a tree whose timesteps are all 0 as a plain ``and``/``or``;
 any other shape is refused (``ValueError``), never guessed.
 
 Each predicate (stlpy's ``LinearPredicate`` ``a y - b >= 0`` or ``NonlinearPredicate``
@@ -58,7 +59,8 @@ def _is_until(tree: Any) -> tuple[Any, Any, int, int] | None:
     return phi, psi, a, a + len(children) - 1
 
 
-def formula_text(formula: Any, dt: float) -> tuple[str, list[Any]]:
+def formula_text(formula: Any, dt: float, horizon: float | None = None,
+                 ) -> tuple[str, list[Any]]:
     """rtamt's text of an stlpy formula, and its predicates (module notes).
 
     Parameters
@@ -67,6 +69,12 @@ def formula_text(formula: Any, dt: float) -> tuple[str, list[Any]]:
         The scenario's formula (``GetSpecification()``, not simplified).
     dt : float
         One step, seconds.
+    horizon : float, optional
+        The end of the signal the text will be evaluated on, s. An ``until[0, b]`` that is
+        not under a temporal operator (so evaluated at ``t = 0`` only) and whose ``b``
+        reaches the horizon is written as rtamt's unbounded ``until``: on that signal the
+        two are the same at ``t = 0``, and rtamt evaluates the unbounded one in linear
+        time (its bounded one takes minutes on the 100 Hz grid).
 
     Returns
     -------
@@ -84,7 +92,7 @@ def formula_text(formula: Any, dt: float) -> tuple[str, list[Any]]:
     predicates: list[Any] = []
     index: dict[int, int] = {}
 
-    def walk(node: Any) -> str:
+    def walk(node: Any, top: bool = False) -> str:
         if not isinstance(node, STLTree):
             if id(node) not in index:
                 index[id(node)] = len(predicates)
@@ -94,18 +102,20 @@ def formula_text(formula: Any, dt: float) -> tuple[str, list[Any]]:
         until = _is_until(node)
         if until is not None:
             phi, psi, a, b = until
-            return f"({walk(phi)} until{_interval(a, b, dt)} {walk(psi)})"
+            whole = top and a == 0 and horizon is not None and b * dt >= horizon - 1e-9
+            window = "" if whole else _interval(a, b, dt)
+            return f"({walk(phi)} until{window} {walk(psi)})"
         if len(children) > 1 and all(c is children[0] for c in children) \
                 and steps == list(range(steps[0], steps[0] + len(steps))):
             op = "always" if node.combination_type == "and" else "eventually"
             return f"({op}{_interval(steps[0], steps[-1], dt)} {walk(children[0])})"
         if all(t == 0 for t in steps):
             join = f" {node.combination_type} "
-            return "(" + join.join(walk(c) for c in children) + ")"
+            return "(" + join.join(walk(c, top) for c in children) + ")"
         raise ValueError(f"formula shape not recognised: {node.combination_type} at "
                          f"timesteps {steps}")
 
-    return walk(formula), predicates
+    return walk(formula, True), predicates
 
 
 def _predicate_values(predicate: Any, y: np.ndarray) -> np.ndarray:
@@ -152,7 +162,7 @@ def robustness(formula: Any, dt: float, times: np.ndarray, y: np.ndarray,
         A formula shape :func:`formula_text` refuses, or a predicate reading a NaN entry.
     """
     import rtamt
-    text, predicates = formula_text(formula, dt)
+    text, predicates = formula_text(formula, dt, float(times[-1]))
     spec = rtamt.StlDiscreteTimeSpecification()
     data: dict[str, list[float]] = {"time": [float(t) for t in times]}
     for k, predicate in enumerate(predicates):
