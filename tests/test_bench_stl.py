@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import sys
+import tomllib
 
 import numpy as np
 import pytest
@@ -18,7 +19,8 @@ from stt_codegen.bench.stl_bench import judge_positions, run_stl_bench  # noqa: 
 from stt_codegen.bench.stl_judge import (formula_text, robustness,  # noqa: E402
                                          stlpy_robustness)
 from stt_codegen.bench.stl_scenarios import (SKIPPED, make_scenario,  # noqa: E402
-                                             scenario_names, scenario_spec, step_seconds)
+                                             scenario_names, scenario_spec, spec_toml,
+                                             step_seconds)
 from stt_codegen.spec.loader import Spec  # noqa: E402
 
 
@@ -76,6 +78,8 @@ def test_grid_catches_a_cut_between_samples():
 def test_every_spec_loads(name):
     doc = scenario_spec(name)
     spec = Spec.from_dict(doc)
+    # the TOML file written by --specs is the same spec
+    assert Spec.from_dict(tomllib.loads(spec_toml(doc, "h"))).source_hash == spec.source_hash
     sc = make_scenario(name)
     assert spec.prescribed_time == pytest.approx(sc.T * step_seconds(sc))
     lower, upper = doc["state_space"]["lower"], doc["state_space"]["upper"]

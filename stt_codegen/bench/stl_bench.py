@@ -268,7 +268,18 @@ def _num(value: float | None, digits: int = 3) -> str:
 
 
 def format_stl_report(report: dict[str, Any]) -> str:
-    """The report of :func:`run_stl_bench` as a Markdown table and its notes."""
+    """The report of :func:`run_stl_bench` as a Markdown table and its notes.
+
+    Parameters
+    ----------
+    report : dict
+        From :func:`run_stl_bench`.
+
+    Returns
+    -------
+    str
+        The table (one row per scenario and variant) and a note per row with a reason.
+    """
     head = ("| scenario | spec | written | designed | satisfied (C) | rtamt samples | "
             "rtamt 100 Hz grid | design (s) | peak \\|u\\| | stlpy scipy: samples / grid "
             "(solve s) |")

@@ -106,7 +106,12 @@ SCENARIOS: dict[str, ScenarioSetting] = {
 
 
 def scenario_names() -> list[str]:
-    """The scenarios :func:`scenario_spec` writes, in stlpy's order."""
+    """The scenarios :func:`scenario_spec` writes, in stlpy's order.
+
+    Returns
+    -------
+    list of str
+    """
     return list(SCENARIOS)
 
 
@@ -146,12 +151,32 @@ _HORIZON_ARG = {"ReachAvoid": 2, "EitherOr": 4, "NarrowPassage": 0, "RandomMulti
 
 
 def step_seconds(scenario: Any) -> float:
-    """One step of the scenario's system, seconds: its ``dt`` if it has one, else 1."""
+    """One step of the scenario's system: its ``dt`` if it has one, else 1 s.
+
+    Parameters
+    ----------
+    scenario : stlpy.benchmarks.BenchmarkScenario
+
+    Returns
+    -------
+    float
+        Seconds.
+    """
     return float(getattr(scenario.GetSystem(), "dt", 1.0))
 
 
 def workspace(scenario: Any) -> tuple[tuple[float, float], tuple[float, float]]:
-    """The scenario's field of view ``((x_lo, x_hi), (y_lo, y_hi))``, from ``add_to_plot``."""
+    """The scenario's field of view, the limits its ``add_to_plot`` sets.
+
+    Parameters
+    ----------
+    scenario : stlpy.benchmarks.BenchmarkScenario
+
+    Returns
+    -------
+    tuple
+        ``((x_lo, x_hi), (y_lo, y_hi))``, state units.
+    """
     from matplotlib.figure import Figure
     ax = Figure().add_subplot()
     scenario.add_to_plot(ax)
@@ -292,11 +317,24 @@ def _value(v: Any) -> str:
         return "{ " + ", ".join(f"{k} = {_value(x)}" for k, x in v.items()) + " }"
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_value(x) for x in v) + "]"
-    return repr(float(round(v, 12)) + 0.0)
+    return repr(float(v) + 0.0)     # repr round-trips: the file is the same spec
 
 
 def spec_toml(doc: dict[str, Any], header: str) -> str:
-    """A spec document of :func:`scenario_spec` as TOML text, ``header`` as its comment."""
+    """A spec document of :func:`scenario_spec` as TOML text.
+
+    Parameters
+    ----------
+    doc : dict
+        From :func:`scenario_spec`.
+    header : str
+        The file's leading comment (one or more lines).
+
+    Returns
+    -------
+    str
+        The TOML text: top-level keys, tables, then arrays of tables.
+    """
     lines = [f"# {line}" for line in header.splitlines()]
     tables: list[str] = []
     for key, v in doc.items():
