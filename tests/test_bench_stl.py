@@ -116,6 +116,26 @@ def test_stepping_stones_is_skipped_with_its_reason():
     assert "SteppingStones" in SKIPPED
 
 
+def test_stepping_stones_has_no_continuous_path():
+    """The reason given for skipping it: the stones connected to x0 (closed boxes that share
+    a point) do not include the target stone."""
+    from stlpy.benchmarks import SteppingStones
+    stones = SteppingStones(15, 15, seed=1).stones   # examples/stepping_stones.py
+
+    def meets(a, b):
+        return a[0] <= b[1] and b[0] <= a[1] and a[2] <= b[3] and b[2] <= a[3]
+
+    reached = {i for i, s in enumerate(stones) if s[0] <= 2.0 <= s[1] and s[2] <= 1.3 <= s[3]}
+    frontier = list(reached)
+    while frontier:
+        i = frontier.pop()
+        for j, other in enumerate(stones):
+            if j not in reached and meets(stones[i], other):
+                reached.add(j)
+                frontier.append(j)
+    assert len(reached) == 3 and len(stones) - 1 not in reached
+
+
 def test_missing_packages_and_unknown_names(monkeypatch, capsys):
     assert main(["bench", "stl", "--scenarios", "Nope"]) == 2
     assert "scenarios: unknown scenario 'Nope'" in capsys.readouterr().err

@@ -55,10 +55,12 @@ ORDER_NOTE = ("double integrators are written as the first-order position law "
               "may reach 1.001 m/s, beyond |v| <= 1, at every rate up to 16 kHz)")
 
 #: Scenarios not written, with the reason.
-SKIPPED = {"SteppingStones": "a union safe set (G[0,T] of an or of stones): the project's "
-                             "state space is one box and its obstacles are boxes, and for "
-                             "seed 1 the stones leave gaps a continuous path must cross, so "
-                             "G holds only at the samples"}
+SKIPPED = {"SteppingStones": "a union safe set (G[0,T] of an or of stones) cannot be a "
+                             "spec (one state-space box, box obstacles), and for seed 1 it "
+                             "is impossible in continuous time: the stones that touch "
+                             "x0 = (2, 1.3) and their neighbours (3 of 15) never meet the "
+                             "target stone, so every path to it leaves the stones between "
+                             "samples"}
 
 
 @dataclass(frozen=True)
