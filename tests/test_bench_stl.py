@@ -170,7 +170,7 @@ def test_bench_stl_every_designed_run_is_satisfied(tmp_path, monkeypatch):
     """All scenarios without stlpy's solver: each is written, and every row designed (as
     written, or without the bound) is satisfied with C with robustness > 0 on the grid."""
     monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path / "cache"))
-    rows = run_stl_bench(solver=False)["rows"]
+    rows = run_stl_bench(solver=None)["rows"]
     assert {r["scenario"] for r in rows if r["written"]} == set(scenario_names())
     designed = [r for r in rows if r["designed"]]
     assert designed

@@ -16,20 +16,22 @@ choices):
    instants (linear interpolation between two records when the rate is not a multiple
    of 100 Hz).
 
-**stlpy's plan.** stlpy's solvers that run here without a commercial licence: its
-``ScipyGradientSolver`` (SLSQP on the robustness by shooting; it takes no input or state
-bounds, so its plan is unbounded). Its MICP solvers need Gurobi or MOSEK, or Drake's
-branch and bound, which the Drake on PyPI (1.51) no longer ships: with it installed,
-``stlpy.solvers`` fails to import. The plan's positions are judged the same way, at the
-samples and on the grid, with the positions moving linearly between samples (stlpy's
-model: ``p[k+1] = p[k] + v[k]`` for the double integrator, ``p[k+1] = p[k] + dt v(theta)``
-for the unicycle, one velocity over the step).
+**stlpy's plan.** stlpy's solvers that run here without a commercial licence
+(:func:`solve_with_stlpy`): its ``ScipyGradientSolver`` (SLSQP on the robustness by
+shooting; it takes no input or state bounds, so its plan is unbounded) and its
+``DrakeMICPSolver`` with Drake's own branch and bound (``--solver drake-bnb``, with
+``pip install drake``; Clp on each node; the example's bounds). Its other MICP solvers need
+Gurobi or MOSEK. The plan's positions are judged the same way, at the samples and on the
+grid, with the positions moving linearly between samples (stlpy's model:
+``p[k+1] = p[k] + v[k]`` for the double integrator, ``p[k+1] = p[k] + dt v(theta)`` for
+the unicycle, one velocity over the step).
 """
 
 from __future__ import annotations
 
 import contextlib
 import io
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -39,11 +41,11 @@ import numpy as np
 from ..errors import DesignError, SpecError
 from .stl_judge import FINE_PERIOD, robustness, stlpy_robustness
 from .stl_scenarios import (ORDER_NOTE, SCENARIOS, SKIPPED, make_scenario, scenario_names,
-                            scenario_spec, spec_toml, step_seconds)
+                            scenario_spec, spec_toml, step_seconds, workspace)
 
 _MISSING = 'stlpy and rtamt are not installed: install the optional extra with pip install ".[stl]"'
 
-__all__ = ["format_stl_report", "judge_positions", "run_stl_bench", "run_stl_scenario",
+__all__ = ["SOLVERS", "format_stl_report", "judge_positions", "run_stl_bench", "run_stl_scenario",
            "solve_with_stlpy"]
 
 
@@ -86,10 +88,44 @@ def judge_positions(formula: Any, dt: float, horizon_steps: int, output_dim: int
     return out
 
 
-def solve_with_stlpy(name: str, horizon: int | None = None) -> dict[str, Any]:
-    """stlpy's scipy solver on the example: its ``x0``; the cost of ``reach_avoid.py``
-    (double integrator) or ``nonlinear_reach_avoid.py`` (unicycle); no bounds (the solver
-    takes none).
+#: stlpy's solvers the bench can run: ``scipy`` (``ScipyGradientSolver``) and
+#: ``drake-bnb`` (``DrakeMICPSolver`` with Drake's own branch and bound on Clp).
+SOLVERS = ("scipy", "drake-bnb")
+
+
+def _stlpy_solvers() -> Any:
+    """``stlpy.solvers``, importable beside today's Drake.
+
+    stlpy 0.3.0 imports ``pydrake.solvers.branch_and_bound`` and ``pydrake.solvers.all``,
+    which Drake has since folded into ``pydrake.solvers`` (Drake 1.51 still has
+    ``MixedIntegerBranchAndBound``, ``IpoptSolver``... there): without the two names,
+    importing ``stlpy.solvers`` fails with Drake installed, its scipy solver included.
+    They are given as aliases of ``pydrake.solvers`` when Drake is installed.
+    """
+    try:
+        import pydrake.solvers
+    except ImportError:
+        pass
+    else:
+        for old in ("pydrake.solvers.branch_and_bound", "pydrake.solvers.all"):
+            sys.modules.setdefault(old, pydrake.solvers)
+    # stlpy.solvers prints a warning on stdout for each solver it cannot load
+    with contextlib.redirect_stdout(io.StringIO()):
+        import stlpy.solvers
+    return stlpy.solvers
+
+
+def solve_with_stlpy(name: str, horizon: int | None = None,
+                     solver: str = "scipy") -> dict[str, Any]:
+    """stlpy's own plan for the example, from the example's ``x0``.
+
+    ``scipy``: ``ScipyGradientSolver`` with the cost of ``reach_avoid.py`` (double
+    integrator) or ``nonlinear_reach_avoid.py`` (unicycle); no bounds (the solver takes
+    none). ``drake-bnb``: ``DrakeMICPSolver(solver="bnb")`` (Drake's branch and bound, Clp
+    on each node, no licence), maximising the robustness, with the example's control and
+    state bounds when the example passes them (``x_min``, ``x_max``: the positions in
+    ``[0, x_max]`` of the field of view the example gives, the velocities within its
+    bound); double integrators only (the MICP needs a linear system).
 
     Parameters
     ----------
@@ -97,6 +133,8 @@ def solve_with_stlpy(name: str, horizon: int | None = None) -> dict[str, Any]:
         A key of :data:`~.stl_scenarios.SCENARIOS`.
     horizon : int, optional
         ``T`` in steps instead of the example's.
+    solver : str
+        One of :data:`SOLVERS`.
 
     Returns
     -------
@@ -104,29 +142,47 @@ def solve_with_stlpy(name: str, horizon: int | None = None) -> dict[str, Any]:
         ``{"solver", "seconds", "plan": (times, positions) or None, "note"}``.
     """
     try:
-        # stlpy.solvers prints a warning on stdout for each solver it cannot load
-        with contextlib.redirect_stdout(io.StringIO()):
-            from stlpy.solvers import ScipyGradientSolver
-    except ImportError as exc:   # stlpy's solver package fails with today's Drake installed
-        return {"solver": None, "seconds": None, "plan": None,
+        solvers = _stlpy_solvers()
+    except ImportError as exc:
+        return {"solver": solver, "seconds": None, "plan": None,
                 "note": f"stlpy.solvers does not import: {exc}"}
     sc = make_scenario(name, horizon)
-    sys = sc.GetSystem()
-    x0 = np.array(SCENARIOS[name].x0, dtype=float)
-    solver = ScipyGradientSolver(sc.GetSpecification(), sys, x0, sc.T, verbose=False)
-    if sys.n == 4:      # reach_avoid.py's cost: velocities and inputs
-        solver.AddQuadraticCost(1e-1 * np.diag([0.0, 0.0, 1.0, 1.0]), 1e-1 * np.eye(sys.m))
-    else:               # nonlinear_reach_avoid.py's: inputs only
-        solver.AddQuadraticCost(np.zeros((sys.n, sys.n)), 1e-3 * np.eye(sys.m))
+    system = sc.GetSystem()
+    setting = SCENARIOS[name]
+    x0 = np.array(setting.x0, dtype=float)
+    formula = sc.GetSpecification()
+    if solver == "scipy":
+        solve = solvers.ScipyGradientSolver(formula, system, x0, sc.T, verbose=False)
+        if system.n == 4:      # reach_avoid.py's cost: velocities and inputs
+            solve.AddQuadraticCost(1e-1 * np.diag([0.0, 0.0, 1.0, 1.0]), 1e-1 * np.eye(system.m))
+        else:                  # nonlinear_reach_avoid.py's: inputs only
+            solve.AddQuadraticCost(np.zeros((system.n, system.n)), 1e-3 * np.eye(system.m))
+    elif not hasattr(solvers, "DrakeMICPSolver"):
+        return {"solver": solver, "seconds": None, "plan": None,
+                "note": "Drake is not installed (pip install drake)"}
+    elif not hasattr(system, "A"):
+        return {"solver": solver, "seconds": None, "plan": None,
+                "note": "the MICP needs a linear system"}
+    else:
+        solve = solvers.DrakeMICPSolver(formula, system, x0, sc.T, solver="bnb",
+                                        verbose=False)
+        if setting.input_bound is not None:
+            u_max = np.array(setting.input_bound, dtype=float)
+            solve.AddControlBounds(-u_max, u_max)
+        if setting.velocity_bound is not None:
+            (_, x_hi), (_, y_hi) = workspace(sc)
+            v_max = np.array(setting.velocity_bound, dtype=float)
+            solve.AddStateBounds(np.concatenate([[0.0, 0.0], -v_max]),
+                                 np.concatenate([setting.position_max or (x_hi, y_hi), v_max]))
     start = time.perf_counter()
-    x, _, _, _ = solver.Solve()
+    with contextlib.redirect_stdout(io.StringIO()):   # Drake's B&B announces itself
+        x, _, _, _ = solve.Solve()
     seconds = time.perf_counter() - start
     if x is None:
-        return {"solver": "scipy", "seconds": seconds, "plan": None, "note": "no solution"}
-    dt = step_seconds(sc)
+        return {"solver": solver, "seconds": seconds, "plan": None, "note": "no solution"}
     steps = x.shape[1]
-    return {"solver": "scipy", "seconds": seconds, "note": "",
-            "plan": (np.arange(steps) * dt, x[:2, :].T)}
+    return {"solver": solver, "seconds": seconds, "note": "",
+            "plan": (np.arange(steps) * step_seconds(sc), x[:2, :].T)}
 
 
 def _row(name: str, variant: str) -> dict[str, Any]:
@@ -167,7 +223,7 @@ def _design_and_judge(name: str, variant: str, doc: dict[str, Any], sc: Any,
     return row
 
 
-def run_stl_scenario(name: str, horizon: int | None = None, solver: bool = True,
+def run_stl_scenario(name: str, horizon: int | None = None, solver: str | None = "scipy",
                      ) -> list[dict[str, Any]]:
     """One scenario: its spec as written and, if that is refused by the bound, without it.
 
@@ -177,8 +233,9 @@ def run_stl_scenario(name: str, horizon: int | None = None, solver: bool = True,
         A key of :data:`~.stl_scenarios.SCENARIOS` or of :data:`~.stl_scenarios.SKIPPED`.
     horizon : int, optional
         ``T`` in steps instead of the example's.
-    solver : bool
-        Also run stlpy's scipy solver and judge its plan (on the first row).
+    solver : str or None
+        Also run this solver of stlpy (:data:`SOLVERS`) and judge its plan (on the first
+        row); ``None``: none.
 
     Returns
     -------
@@ -203,7 +260,7 @@ def run_stl_scenario(name: str, horizon: int | None = None, solver: bool = True,
         unbounded = {k: v for k, v in doc.items() if k != "actuator"}
         rows.append(_design_and_judge(name, "no bound", unbounded, sc, output_dim))
     if solver:
-        plan = solve_with_stlpy(name, horizon)
+        plan = solve_with_stlpy(name, horizon, solver)
         judged = {"solver": plan["solver"], "seconds": plan["seconds"], "note": plan["note"],
                   "samples": None, "grid": None}
         if plan["plan"] is not None:
@@ -216,7 +273,8 @@ def run_stl_scenario(name: str, horizon: int | None = None, solver: bool = True,
 
 
 def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
-                  solver: bool = True, specs: Path | None = None) -> dict[str, Any]:
+                  solver: str | None = "scipy", specs: Path | None = None,
+                  ) -> dict[str, Any]:
     """Every scenario (module notes), one after another in one process.
 
     Parameters
@@ -225,8 +283,8 @@ def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
         Scenarios to run (default: all six written plus ``SteppingStones``, skipped).
     horizon : int, optional
         ``T`` in steps for every scenario instead of the examples'.
-    solver : bool
-        Also run stlpy's scipy solver on each.
+    solver : str or None
+        Also run this solver of stlpy on each (:data:`SOLVERS`); ``None``: none.
     specs : Path, optional
         Also write each written spec there as ``stlpy-<scenario>.toml``.
 
@@ -248,6 +306,8 @@ def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
         raise SpecError("stl", _MISSING) from None
     known = scenario_names() + list(SKIPPED)
     names = known if names is None else list(names)
+    if solver is not None and solver not in SOLVERS:
+        raise SpecError("solver", f"unknown solver {solver!r} (known: {', '.join(SOLVERS)})")
     for name in names:
         if name not in known:
             raise SpecError("scenarios", f"unknown scenario {name!r} (known: "
@@ -281,7 +341,7 @@ def format_stl_report(report: dict[str, Any]) -> str:
         The table (one row per scenario and variant) and a note per row with a reason.
     """
     head = ("| scenario | spec | written | designed | satisfied (C) | rtamt samples | "
-            "rtamt 100 Hz grid | design (s) | peak \\|u\\| | stlpy scipy: samples / grid "
+            "rtamt 100 Hz grid | design (s) | peak \\|u\\| | stlpy's plan: samples / grid "
             "(solve s) |")
     lines = [head, "|" + "---|" * 10]
     notes = []

@@ -80,6 +80,9 @@ class ScenarioSetting:
         example that does, except the unicycle's forward speed ``[0, 10]``), else ``None``.
     velocity_bound : tuple of float or None
         ``x_max``'s velocity entries when the example passes state bounds to its solver.
+    position_max : tuple of float or None
+        ``x_max``'s position entries when they differ from the field of view's upper
+        limits (``x_min``'s are 0 in every double-integrator example).
     """
 
     args: tuple
@@ -87,6 +90,7 @@ class ScenarioSetting:
     x0: tuple[float, ...] = ()
     input_bound: tuple[float, ...] | None = None
     velocity_bound: tuple[float, ...] | None = None
+    position_max: tuple[float, ...] | None = None
 
 
 #: stlpy 0.3.0's examples: ``reach_avoid.py`` defines ``u_min``/``x_min`` but passes
@@ -97,7 +101,8 @@ SCENARIOS: dict[str, ScenarioSetting] = {
                                  20, 5), x0=(2.0, 2.0, 0.0, 0.0),
                                 input_bound=(0.5, 0.5), velocity_bound=(1.0, 1.0)),
     "NarrowPassage": ScenarioSetting((25,), x0=(3.0, 3.6, 0.0, 0.0),
-                                     input_bound=(0.5, 0.5), velocity_bound=(1.0, 1.0)),
+                                     input_bound=(0.5, 0.5), velocity_bound=(1.0, 1.0),
+                                     position_max=(10.0, 10.0)),
     "RandomMultitarget": ScenarioSetting((1, 5, 2, 25), {"seed": 0}, x0=(5.0, 2.0, 0.0, 0.0),
                                          input_bound=(0.5, 0.5), velocity_bound=(1.0, 1.0)),
     "DoorPuzzle": ScenarioSetting((25, 2), x0=(6.0, 1.0, 0.0, 0.0),

@@ -107,7 +107,8 @@ def _cmd_stl(args: argparse.Namespace) -> int:
     from ..bench.stl_bench import format_stl_report, run_stl_bench
     names = [n.strip() for n in args.scenarios.split(",") if n.strip()] if args.scenarios \
         else None
-    report = run_stl_bench(names, horizon=args.horizon, solver=not args.no_solver,
+    report = run_stl_bench(names, horizon=args.horizon,
+                           solver=None if args.solver == "none" else args.solver,
                            specs=Path(args.specs) if args.specs else None)
     if args.json:
         report = {"rows": [{k: v for k, v in row.items() if k != "spec"}
@@ -223,8 +224,10 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
     p.add_argument("--horizon", type=int, default=None, metavar="T",
                    help="stlpy's horizon T in steps for every scenario (default: each "
                         "example's)")
-    p.add_argument("--no-solver", action="store_true",
-                   help="do not run stlpy's scipy solver beside")
+    p.add_argument("--solver", choices=("scipy", "drake-bnb", "none"), default="scipy",
+                   help="stlpy's solver run beside: scipy (ScipyGradientSolver), drake-bnb "
+                        "(DrakeMICPSolver with Drake's branch and bound; pip install drake) "
+                        "or none (default: %(default)s)")
     p.add_argument("--specs", default=None, metavar="DIR",
                    help="also write the specs into DIR")
     add_json_argument(p)
