@@ -15,7 +15,8 @@ from stt_codegen.errors import SpecError
 pytest.importorskip("stlpy", reason='stlpy is not installed: pip install ".[stl]"')
 pytest.importorskip("rtamt", reason='rtamt is not installed: pip install ".[stl]"')
 
-from stt_codegen.bench.stl_bench import judge_positions, run_stl_bench  # noqa: E402
+from stt_codegen.bench.stl_bench import (judge_positions, run_stl_bench,  # noqa: E402
+                                         solve_with_stlpy)
 from stt_codegen.bench.stl_judge import (formula_text, robustness,  # noqa: E402
                                          stlpy_robustness)
 from stt_codegen.bench.stl_scenarios import (SKIPPED, make_scenario,  # noqa: E402
@@ -139,6 +140,8 @@ def test_stepping_stones_has_no_continuous_path():
 def test_missing_packages_and_unknown_names(monkeypatch, capsys):
     assert main(["bench", "stl", "--scenarios", "Nope"]) == 2
     assert "scenarios: unknown scenario 'Nope'" in capsys.readouterr().err
+    with pytest.raises(SpecError, match="solver: unknown solver 'gurobi'"):
+        run_stl_bench(["ReachAvoid"], solver="gurobi")
     monkeypatch.setitem(sys.modules, "rtamt", None)   # import rtamt now fails
     with pytest.raises(SpecError, match=r"pip install \"\.\[stl\]\""):
         run_stl_bench(["ReachAvoid"])
@@ -163,6 +166,24 @@ def test_bench_stl_designs_and_satisfies(tmp_path, monkeypatch, capsys):
     assert max(rows[1]["peak_u"]) <= 1.0 + 1e-9
     assert sorted(p.name for p in (tmp_path / "specs").iterdir()) == [
         "stlpy-NarrowPassage.toml", "stlpy-ReachAvoid.toml"]
+
+
+@pytest.mark.bench
+def test_drake_branch_and_bound_runs_or_says_why():
+    """stlpy's MICP with Drake's branch and bound (no licence), importable beside Drake 1.51
+    through the two aliases: on ReachAvoid it gives a plan judged like any other, or (as on
+    this machine, the example passing no bounds) a note; the unicycle is refused by name."""
+    pytest.importorskip("pydrake", reason="Drake is not installed: pip install drake")
+    assert "MICP needs a linear system" in solve_with_stlpy(
+        "NonlinearReachAvoid", solver="drake-bnb")["note"]
+    plan = solve_with_stlpy("ReachAvoid", solver="drake-bnb")
+    assert plan["solver"] == "drake-bnb"
+    if plan["plan"] is None:
+        assert plan["note"].startswith(("failed:", "no solution"))
+    else:
+        sc = make_scenario("ReachAvoid")
+        scores = judge_positions(sc.GetSpecification(), 1.0, sc.T, 6, *plan["plan"])
+        assert scores["samples"] == pytest.approx(scores["stlpy_samples"], abs=1e-12)
 
 
 @pytest.mark.bench

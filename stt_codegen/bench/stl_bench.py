@@ -175,8 +175,12 @@ def solve_with_stlpy(name: str, horizon: int | None = None,
             solve.AddStateBounds(np.concatenate([[0.0, 0.0], -v_max]),
                                  np.concatenate([setting.position_max or (x_hi, y_hi), v_max]))
     start = time.perf_counter()
-    with contextlib.redirect_stdout(io.StringIO()):   # Drake's B&B announces itself
-        x, _, _, _ = solve.Solve()
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):   # Drake's B&B announces itself
+            x, _, _, _ = solve.Solve()
+    except RuntimeError as exc:   # Drake's B&B gives up on some problems
+        return {"solver": solver, "seconds": time.perf_counter() - start, "plan": None,
+                "note": f"failed: {exc}"}
     seconds = time.perf_counter() - start
     if x is None:
         return {"solver": solver, "seconds": seconds, "plan": None, "note": "no solution"}
