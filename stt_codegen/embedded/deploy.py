@@ -43,7 +43,7 @@ from ..codegen import tolerance as T
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..design.result import Design, require_design
-from ..errors import ToolchainError
+from ..errors import SpecError, ToolchainError
 from ..runtime.plants import check_seed
 from ..tube.parameters import TubeDesign
 from . import board
@@ -156,7 +156,8 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
     TypeError
         ``design`` is not a :class:`~stt_codegen.design.result.Design`.
     SpecError
-        ``seed`` is not an integer in ``[0, 2**32)`` (field ``seed``).
+        ``seed`` is not an integer in ``[0, 2**32)`` (field ``seed``); a MuJoCo plant
+        (field ``plant.model``: its closed loop runs on the host only).
     ToolsMissing
         A tool is not installed (the message names the Debian packages).
     ToolchainError
@@ -164,6 +165,9 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
     """
     design = require_design(design, "run_embedded")
     spec, tube = design.spec, design.tube
+    if spec.mujoco is not None:
+        raise SpecError("plant.model", "the firmware's closed loop needs the plant's equations; "
+                                       "a MuJoCo plant runs on the host (stt-codegen simulate)")
     seed = check_seed(seed)
     message = missing_message()
     if message:
