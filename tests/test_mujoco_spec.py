@@ -120,7 +120,8 @@ def test_mujoco_keys_on_another_model_are_refused():
     doc["plant"] = {"model": "single-integrator", "mjcf": "x.xml"}
     with pytest.raises(SpecError) as err:
         stt.Spec.from_dict(doc)
-    assert err.value.field == "plant.mjcf" and "only the mujoco model" in err.value.reason
+    assert err.value.field == "plant.mjcf"
+    assert "only the mujoco and mujoco-force models take mjcf" in err.value.reason
 
 
 def test_an_unknown_joint_is_named_when_the_plant_is_built(tmp_path):
@@ -162,3 +163,37 @@ def test_imported_pointmazes_run_on_mujoco(tmp_path, maze):
     assert spec.mujoco.actuators == ("vel_x", "vel_y")
     result = stt.simulate(stt.design_tube(spec), backend="c")
     assert result.satisfied and result.contacts == 0, result.to_json()
+
+
+@pytest.mark.slow
+def test_a_force_driven_mjcf_runs_the_cascade_on_mujoco():
+    """``plant.model = "mujoco-force"`` (tests/specs/umaze-mujoco-force.toml): PointMaze's
+    ball through its force motors is second order; the cascade at 1 kHz keeps both tubes
+    on MuJoCo within the motors' range, without a wall contact; verify proves the
+    cascade's certificate for the declared class and says it did not check the plant."""
+    spec = stt.load_spec(Path(__file__).parent / "specs" / "umaze-mujoco-force.toml")
+    assert spec.order == 2 and spec.input_names == ("motor_x", "motor_y")
+    design = stt.design_tube(spec)
+    plant = spec_plant(spec)
+    assert isinstance(plant, MujocoPlant) and plant.nstates == 4
+    result = stt.simulate(design, backend="c")
+    assert result.satisfied and result.stayed_in_velocity_tube, result.to_json()
+    assert result.contacts == 0 and max(result.max_abs_u) <= 1.0
+    report = stt.verify(design)
+    assert list(report.failed) == []
+    checks = {c.name: c for c in report.checks}
+    assert checks["cascade.sampled"].passed
+    assert checks["cascade.plant_within_assumptions"].detail.startswith("not checked")
+    from stt_codegen.embedded.cascade_loop import closed_loop_program
+    with pytest.raises(SpecError) as err:
+        closed_loop_program(design, "p")
+    assert err.value.field == "plant.model"
+
+
+def test_a_force_driven_mjcf_needs_its_declared_class():
+    doc = tomllib.loads((Path(__file__).parent / "specs" / "umaze-mujoco-force.toml")
+                        .read_text())
+    del doc["assumptions"]["drift_bound"]
+    with pytest.raises(SpecError) as err:
+        stt.Spec.from_dict(doc)
+    assert err.value.field == "assumptions.drift_bound" and "no equations" in err.value.reason

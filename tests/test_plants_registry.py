@@ -35,7 +35,8 @@ def test_every_first_order_model_has_every_behaviour():
 def test_every_second_order_model_has_its_dynamics():
     for model in SECOND_ORDER_MODELS:
         assert plant_entry(model).order == 2
-        assert model in ACCELERATIONS, model
+        # a model without equations (MuJoCo) has none to print
+        assert (model in ACCELERATIONS) != plant_entry(model).declared_bounds, model
 
 
 def test_the_tables_hold_no_unregistered_model():

@@ -77,12 +77,15 @@ def closed_loop_program(design: Design, prefix: str, seed: int = 0,
     Raises
     ------
     SpecError
-        A first-order spec (field ``plant.model``).
+        A first-order spec, or a MuJoCo plant (field ``plant.model``).
     """
     spec = design.spec
     order = spec.second_order
     if spec.order != 2:
         raise SpecError("plant.model", "the spec describes a first-order plant")
+    if spec.mujoco is not None:
+        raise SpecError("plant.model", "the firmware's closed loop needs the plant's equations; "
+                                       "a MuJoCo plant runs on the host (stt-codegen simulate)")
     n = spec.dimension
     bound = order.velocity_bound or (math.inf,) * n
     context = dict(loop_context(spec, design.tube, seed=seed, decimate=decimate,

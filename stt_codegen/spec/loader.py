@@ -339,7 +339,10 @@ class Spec:
     def input_names(self) -> tuple[str, ...]:
         """Names of the inputs ``u`` that ``[actuator] input_bound`` bounds, in its order:
         the second-order model's physical inputs (``F1``, ``F2``, ..., the quadrotor's
-        thrust, the arm's torques) for order 2, else the first-order model's."""
+        thrust, the arm's torques) for order 2, else the first-order model's; a MuJoCo
+        plant's actuators."""
+        if self.mujoco is not None:
+            return self.mujoco.actuators
         if self.second_order is not None:
             return SECOND_ORDER_PLANTS[self.second_order.model].input_names(self.dimension)
         return PLANTS[self.plant_model].input_names(self.dimension)
@@ -690,8 +693,8 @@ def _validate(raw: dict) -> Spec:
                                   doc.tube.method),
                 task_order=doc.task_order.order if doc.task_order is not None else "listed",
                 moving_obstacles=moving, robot=robot,
-                mujoco=(mujoco_model(doc.plant, n, plant_entry(model).input_count(n))
-                        if plant_entry(model).simulator_keys else None))
+                mujoco=(mujoco_model(doc.plant, n, plant_entry(doc.plant.model).input_count(n))
+                        if plant_entry(doc.plant.model).simulator_keys else None))
 
 
 def _vector(value: list[float], name: str, length: int | None) -> tuple[float, ...]:
@@ -746,9 +749,12 @@ def _matrix(rows: list[list[float]], name: str, n: int) -> tuple[tuple[float, ..
 def _linear_plant(table: PlantTable, n: int) -> LinearPlant | None:
     """The matrices ``a``, ``g``, ``c`` of ``[plant]``; only the ``linear`` model takes them
     (and only the ``mujoco`` model its simulator's keys)."""
-    for key, owner in (*MODEL_KEYS.items(), *SIMULATOR_KEYS.items()):
-        if getattr(table, key) is not None and owner != table.model:
-            raise SpecError(f"plant.{key}", f"only the {owner} model takes {key} "
+    owners = {**{key: (owner,) for key, owner in MODEL_KEYS.items()}, **SIMULATOR_KEYS}
+    for key, models in owners.items():
+        if getattr(table, key) is not None and table.model not in models:
+            raise SpecError(f"plant.{key}", f"only the {' and '.join(models)} model"
+                                            f"{'s' if len(models) > 1 else ''} take"
+                                            f"{'' if len(models) > 1 else 's'} {key} "
                                             f"(plant.model is {table.model!r})")
     if table.model not in MODEL_KEYS.values():
         return None
@@ -779,6 +785,12 @@ def _second_order(doc: Any, n: int) -> SecondOrder | None:
                                             f"(plant.model is {model!r})")
         return None
     table = doc.assumptions
+    if plant_entry(model).declared_bounds:     # no equations: the class is what is declared
+        for key in SECOND_ORDER_ASSUMPTIONS:
+            if key not in table.model_fields_set:
+                raise SpecError(f"assumptions.{key}", f"required for plant.model = {model!r}: "
+                                "the toolkit has no equations of this plant, so the design "
+                                "and verify use the declared bounds (and cannot check them)")
     for key in AssumptionsTable.model_fields:
         if key in table.model_fields_set and key not in SECOND_ORDER_ASSUMPTIONS:
             raise SpecError(f"assumptions.{key}",

@@ -104,9 +104,6 @@ NAMED_MODELS: tuple[str, ...] = tuple(name for name, p in PLANTS.items()
                                       if not p.keys and not p.declared_bounds)
 #: ``[plant]`` matrix keys that belong to one model, with the model.
 MODEL_KEYS: dict[str, str] = {key: name for name, p in PLANTS.items() for key in p.keys}
-#: ``[plant]`` keys naming a simulator's model of the plant, with the model that takes them.
-SIMULATOR_KEYS: dict[str, str] = {key: name for name, p in PLANTS.items()
-                                  for key in p.simulator_keys}
 #: Models with equations the toolkit knows (their bounds derived, their dynamics simulated).
 MODELS_WITH_EQUATIONS: tuple[str, ...] = tuple(name for name, p in PLANTS.items()
                                                if not p.declared_bounds)
@@ -139,6 +136,11 @@ class SecondOrderModel:
     input_unit : str
         SI unit of every input (``"N"`` for a force, ``"N m"`` for a torque): the unit of
         ``[actuator] input_bound``.
+    simulator_keys : tuple of str
+        As :attr:`PlantModel.simulator_keys`.
+    declared_bounds : bool
+        As :attr:`PlantModel.declared_bounds`: no equations, the declared
+        ``[assumptions]`` (``input_gain`` and ``drift_bound`` required) are the class.
     """
 
     name: str
@@ -149,6 +151,8 @@ class SecondOrderModel:
     diagonal_input: bool = False
     inputs: tuple[str, ...] | None = None
     input_unit: str = "N"
+    simulator_keys: tuple[str, ...] = ()
+    declared_bounds: bool = False
 
     #: Order of the model: 2, the cascade law.
     order = 2
@@ -178,11 +182,24 @@ SECOND_ORDER_PLANTS: dict[str, SecondOrderModel] = {m.name: m for m in (
                       "gravity"),
                      (1.0, 1.0, 1.0, 1.0, 1.0 / 12.0, 1.0 / 12.0, 0.0),
                      inputs=("tau1", "tau2"), input_unit="N m"),
+    SecondOrderModel("mujoco-force", "second order, an MJCF model stepped by MuJoCo through "
+                     "force or torque actuators (plant.mjcf, plant.joints, plant.actuators): "
+                     "the states the joints' positions and velocities, any n; no equations: "
+                     "[assumptions] input_gain and drift_bound are required and taken as "
+                     "declared", None, (), (), inputs=None, input_unit="",
+                     simulator_keys=("mjcf", "joints", "actuators", "timestep"),
+                     declared_bounds=True),
 )}
 #: The second-order ``plant.model`` values, in order.
 SECOND_ORDER_MODELS: tuple[str, ...] = tuple(SECOND_ORDER_PLANTS)
 #: Every ``plant.model`` value a spec may give: first order, then second order.
 ALL_PLANT_MODELS: tuple[str, ...] = PLANT_MODELS + SECOND_ORDER_MODELS
+#: ``[plant]`` keys naming a simulator's model of the plant, with the models that take them.
+SIMULATOR_KEYS: dict[str, tuple[str, ...]] = {
+    key: tuple(name for name, p in (*PLANTS.items(), *SECOND_ORDER_PLANTS.items())
+               if key in p.simulator_keys)
+    for key in dict.fromkeys(k for p in (*PLANTS.values(), *SECOND_ORDER_PLANTS.values())
+                             for k in p.simulator_keys)}
 
 
 def plant_entry(model: str) -> PlantModel | SecondOrderModel:
