@@ -23,12 +23,15 @@ import io
 from collections import deque
 from pathlib import Path
 from typing import Any
+from xml.etree import ElementTree
 
 from .errors import SpecError
+from .spec.plants import plant_entry
 from .system import atomic_write
 
-__all__ = ["DEFAULT_CONTACT_MARGIN", "DEFAULT_RATE_HZ", "SECONDS_PER_CELL", "import_pointmaze",
-           "pointmaze_names", "wall_boxes"]
+__all__ = ["DEFAULT_CONTACT_MARGIN", "DEFAULT_RATE_HZ", "JOINTS", "SECONDS_PER_CELL", "SERVOS",
+           "SERVO_ASSUMPTIONS", "SERVO_DISTURBANCE", "SERVO_KV", "SERVO_TIMESTEP",
+           "import_pointmaze", "pointmaze_names", "wall_boxes"]
 
 #: gymnasium-robotics' PointMaze map names (its environment ids ``PointMaze_<name>-v3``)
 #: -> the constant of ``gymnasium_robotics.envs.maze.maps``.
@@ -48,6 +51,18 @@ DEFAULT_CONTACT_MARGIN = 0.01
 DEFAULT_RATE_HZ = 100.0
 #: Default prescribed time per cell of the shortest path from start to goal, seconds.
 SECONDS_PER_CELL = 2.0
+#: PointMaze's ball joints (the states x, y).
+JOINTS = ("ball_x", "ball_y")
+#: With ``plant.model = "mujoco"``: the velocity servos that replace PointMaze's motors,
+#: their gain (N s/m) and MuJoCo's timestep (s).
+SERVOS = ("vel_x", "vel_y")
+SERVO_KV = 200.0
+SERVO_TIMESTEP = 0.001
+#: The bounds declared for the ball through its servos: the servo's velocity over its
+#: command is kv / (kv + damping) = 0.995 in steady state (PointMaze's joint damping 1), its
+#: lag and the walls' friction are the drift and the disturbance.
+SERVO_ASSUMPTIONS = {"input_gain": [0.9, 1.05], "drift_bound": 0.1}
+SERVO_DISTURBANCE = 0.05
 #: Half side of the initial and target boxes, in cells (a quarter cell: inside the cell
 #: with the ball's radius to spare).
 CELL_BOX_HALF = 0.25
@@ -231,7 +246,9 @@ def import_pointmaze(name: str, path: str | os.PathLike | None = None, *,
         Added to the ball's radius in ``[robot] radius``, metres (default
         :data:`DEFAULT_CONTACT_MARGIN`).
     model : str
-        ``plant.model`` (default ``"single-integrator"``, the first-order point).
+        ``plant.model`` (default ``"single-integrator"``, the first-order point). With
+        ``"mujoco"`` the spec's plant is the written MJCF (``mjcf`` required): the ball
+        through velocity servos, with the bounds :data:`SERVO_ASSUMPTIONS` declared.
     mjcf : path, optional
         Also write the maze's MuJoCo model there, built by gymnasium-robotics'
         ``Maze.make_maze`` with the PointMaze ball; the spec's header names it relative to
@@ -298,10 +315,20 @@ def import_pointmaze(name: str, path: str | os.PathLike | None = None, *,
         "controller": {"rate_hz": float(rate_hz)},
         "plant": {"model": model},
     }
-    Spec.from_dict(doc)                 # refuse what the loader refuses, before writing
     if path is None and mjcf is not None:
         raise SpecError("mjcf", "needs the spec's path too (the spec names the model "
                                 "relative to itself)")
+    on_mujoco = plant_entry(model).declared_bounds     # model = "mujoco": the MJCF is the plant
+    if on_mujoco:
+        if mjcf is None:
+            raise SpecError("mjcf", f"plant.model = {model!r} simulates the maze's MuJoCo "
+                                    "model: give the file to write it to (--mjcf)")
+        rel = os.path.relpath(Path(mjcf).resolve(), Path(path).resolve().parent)
+        doc["plant"] = {"model": model, "mjcf": Path(rel).as_posix(),
+                        "joints": list(JOINTS), "actuators": list(SERVOS),
+                        "disturbance_amplitude": SERVO_DISTURBANCE}
+        doc["assumptions"] = dict(SERVO_ASSUMPTIONS)
+    Spec.from_dict(doc)                 # refuse what the loader refuses, before writing
     if path is not None:
         header = [f"gymnasium-robotics PointMaze {name!r} (PointMaze_{name}-v3), imported by "
                   "stt-codegen:",
@@ -318,18 +345,31 @@ def import_pointmaze(name: str, path: str | os.PathLike | None = None, *,
             if target is not None and not Path(target).resolve().parent.is_dir():
                 raise SpecError(field, f"folder {str(Path(target).parent)!r} does not exist")
         if mjcf is not None:
-            _write_mjcf(maze_map, package, mjcf)
+            _write_mjcf(maze_map, package, mjcf, servos=on_mujoco)
         atomic_write(path, text.encode(), field="path")
     return doc
 
 
-def _write_mjcf(maze_map: list[list[Any]], package: Path, mjcf: str | os.PathLike) -> None:
+def _write_mjcf(maze_map: list[list[Any]], package: Path, mjcf: str | os.PathLike,
+                servos: bool = False) -> None:
     """The maze's MJCF from gymnasium-robotics' ``Maze.make_maze`` (PointMaze's ball,
-    scaling and height), copied out of its temporary file."""
+    scaling and height), copied out of its temporary file; with ``servos``, PointMaze's
+    force motors replaced by velocity servos (:data:`SERVOS`, gain :data:`SERVO_KV`) at a
+    :data:`SERVO_TIMESTEP` timestep, for the first-order law (``plant.model = "mujoco"``)."""
     from gymnasium_robotics.envs.maze.maze_v4 import Maze
     agent = package / "envs" / "assets" / "point" / "point.xml"
     _, temporary = Maze.make_maze(str(agent), maze_map, SCALING, MAZE_HEIGHT)
     try:
+        if servos:
+            tree = ElementTree.parse(temporary)
+            tree.getroot().find("option").set("timestep", repr(SERVO_TIMESTEP))
+            actuators = tree.getroot().find("actuator")
+            for child in list(actuators):
+                actuators.remove(child)
+            for name, joint in zip(SERVOS, JOINTS):
+                ElementTree.SubElement(actuators, "velocity",
+                                       {"name": name, "joint": joint, "kv": repr(SERVO_KV)})
+            tree.write(temporary, encoding="unicode")
         atomic_write(mjcf, lambda target: shutil.copyfile(temporary, target), field="mjcf")
     finally:
         Path(temporary).unlink(missing_ok=True)

@@ -26,14 +26,14 @@ def test_cases_lists_bundled_specs():
     out = run("cases")
     assert out.returncode == 0
     assert out.stdout.split() == ["crossing-moving", "omnirobot-s1", "omnirobot-s2",
-                                  "omnirobot-s3", "second-order-quadrotor", "second-order-s1",
-                                  "tasks-stay", "tasks-visit"]
+                                  "omnirobot-s3", "pointmaze-umaze", "second-order-quadrotor",
+                                  "second-order-s1", "tasks-stay", "tasks-visit"]
 
 
 def test_bundled_cases_are_the_paper_cases_and_the_examples():
     """The conftest's CASES (the parameters of the ``case`` fixture) are the paper's bundled
-    specs; the others are the timed-task examples (TASK_CASES), the moving-obstacle example
-    (EXTRA_CASES) and the second-order cases (with tests of their own)."""
+    specs; the others are the timed-task examples (TASK_CASES), the moving-obstacle and MuJoCo
+    examples (EXTRA_CASES) and the second-order cases (with tests of their own)."""
     first_order = [c for c in bundled_cases() if not c.startswith("second-order-")]
     assert first_order == sorted(CASES + TASK_CASES + EXTRA_CASES)
 

@@ -13,7 +13,7 @@ from stt_codegen.errors import SpecError
 from stt_codegen.runtime.simulate import run_closed_loop
 
 mujoco = pytest.importorskip(
-    "mujoco", reason="MuJoCo is not installed: pip install \".[mujoco]\" (CI installs it)")
+    "mujoco", reason="MuJoCo is not installed: pip install . (a dependency; CI installs it)")
 
 from stt_codegen.runtime.mujoco_plant import MujocoPlant  # noqa: E402  (after the skip)
 

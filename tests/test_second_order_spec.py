@@ -12,6 +12,7 @@ import sys
 import tomllib
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import stt_codegen as stt
@@ -238,6 +239,36 @@ def test_the_second_order_task_spec_on_the_cortex_m4f() -> None:
     assert report["satisfied"], report
     assert report["outside_position"] == report["outside_velocity"] == report["invalid"] == 0
     assert report["input_clamped"] == 0
+    # the task and the moving box, judged on the firmware's own printed states
+    assert [t["met"] for t in report["tasks"]] == [True] and report["moving_clearance"] > 0
+
+
+def test_printed_states_are_judged_on_the_tasks_and_the_moving_obstacles():
+    """judge_printed (the firmware runs' judge of both orders) on the states of a host run
+    of the second-order task spec, every tenth step: met; the same states judged against
+    the task's box moved away, or against the moving box put on the run's path, are not."""
+    from dataclasses import replace
+    from stt_codegen.embedded.programs import judge_printed
+    design = stt.design_tube(stt.load_spec(SPECS / "second-order-tasks.toml"))
+    result = stt.simulate(design, backend="python")
+    rate = design.tube.rate_hz
+    steps = np.rint(result.trajectory.t * rate).astype(int)
+    states = {int(k): np.concatenate([x, v]) for k, x, v in zip(
+        steps, result.trajectory.x, result.trajectory.velocity) if k % 10 == 0}
+    spec = design.spec
+    judged = judge_printed(spec, states, rate)
+    assert judged["met"] and judged["tasks"][0]["met"] and judged["moving_clearance"] > 0
+    (task,) = spec.tasks
+    away = replace(task, boxes=tuple(replace(b, lower=(4.4, 0.1), upper=(4.9, 0.6))
+                                     for b in task.boxes))
+    missed = judge_printed(replace(spec, tasks=(away,)), states, rate)
+    assert not missed["met"] and not missed["tasks"][0]["met"]
+    (box,) = spec.moving_obstacles
+    k = len(result.trajectory.t) // 3                 # where the run is at a third of it
+    centre = tuple(result.trajectory.x[k][list(box.dims)])
+    on_path = replace(box, times=(0.0,), centres=(centre,), active=(0.0, 12.0))
+    hit = judge_printed(replace(spec, moving_obstacles=(on_path,)), states, rate)
+    assert not hit["met"] and hit["moving_clearance"] < 0
 
 
 def test_the_front_door_simulates_a_second_order_design_with_the_cascade(tmp_path):

@@ -4,8 +4,9 @@ two second-order cases (docs/second-order.md)."""
 from __future__ import annotations
 
 from importlib import resources
+from pathlib import Path
 
-__all__ = ["bundled_cases", "bundled_spec_bytes"]
+__all__ = ["bundled_cases", "bundled_folder", "bundled_spec_bytes"]
 
 
 def bundled_cases() -> list[str]:
@@ -19,6 +20,17 @@ def bundled_cases() -> list[str]:
     """
     folder = resources.files(__name__)
     return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def bundled_folder() -> Path:
+    """The folder of the bundled specs (and of the files they name, such as a MuJoCo
+    model), in the installed package.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    return Path(str(resources.files(__name__)))
 
 
 def bundled_spec_bytes(name: str) -> bytes:

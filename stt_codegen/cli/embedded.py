@@ -12,6 +12,18 @@ from .common import (add_json_argument, add_seed_argument, add_spec_argument, ch
 __all__ = ["cmd_embedded", "configure_embedded"]
 
 
+def _judged(r: dict) -> str:
+    """The tasks and moving obstacles judged on the printed states, in words ("" without)."""
+    words = ""
+    if "tasks" in r:
+        words += f", tasks met {sum(t['met'] for t in r['tasks'])}/{len(r['tasks'])}"
+    if "moving_clearance" in r:
+        clear = r["moving_clearance"]
+        words += ", moving obstacles " + ("never active" if clear is None else
+                                          f"clearance {clear:.3f}")
+    return words
+
+
 def _print_report(r: dict) -> None:
     print(f"{r['spec']} on {r['target']}")
     print(f"  self-test: {r['vectors_passed']} passed, {r['vectors_failed']} failed; "
@@ -29,7 +41,7 @@ def _print_report(r: dict) -> None:
     clear = "-" if r["min_clearance"] is None else f"{r['min_clearance']:.3f}"
     reach = "-" if r["reach_time"] is None else f"{r['reach_time']:.3f}"
     print(f"  closed loop: {'satisfied' if r['closed_loop_satisfied'] else 'NOT satisfied'}"
-          f", reach {reach} s, clearance {clear}, {r['steps']} steps, "
+          f", reach {reach} s, clearance {clear}{_judged(r)}, {r['steps']} steps, "
           f"outside-tube steps {r['outside_tube_steps']}")
     if "max_state_deviation" in r:
         print(f"  max |x_target - x_host| = {r['max_state_deviation']:.3g}")
@@ -70,8 +82,8 @@ def cmd_embedded(args: argparse.Namespace) -> int:
         else:
             print(f"{design.spec.name} (cascade) on the Cortex-M4F (QEMU mps2-an386): "
                   f"{'satisfied' if report['satisfied'] else 'NOT satisfied'}, reach "
-                  f"{report['reach_time']} s, clearance {report['min_clearance']:.3f}, "
-                  f"{report['instructions_per_step']} instructions per step")
+                  f"{report['reach_time']} s, clearance {report['min_clearance']:.3f}"
+                  f"{_judged(report)}, {report['instructions_per_step']} instructions per step")
         return 0 if report["satisfied"] else 1
     report = run_embedded(design, args.build_dir, seed=seed,
                           compare_host=not args.no_host)

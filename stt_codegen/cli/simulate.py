@@ -82,6 +82,12 @@ def cmd_simulate(args: argparse.Namespace) -> int:
               f"stayed in tube: {'yes' if result.stayed_in_tube else 'NO'}, "
               f"collision: {'YES' if result.collision else 'no'}, "
               f"left state space: {'YES' if result.left_state_space else 'no'}")
+        if design.spec.mujoco is not None:        # MuJoCo's own contacts
+            first = ("" if result.first_contact is None else
+                     f", first at {result.first_contact[0]:g} s ({result.first_contact[1]} - "
+                     f"{result.first_contact[2]})")
+            print(f"MuJoCo contacts (other than with the ground): {result.contacts} "
+                  f"timesteps{first}")
         for task in result.tasks:                 # [[tasks]]
             when = "" if task.time is None else f" at {task.time:g} s"
             print(f"task {task.task} {task.kind} [{task.window[0]:g}, {task.window[1]:g}] s: "

@@ -67,12 +67,12 @@ def configure_verify(p: argparse.ArgumentParser) -> None:
         The subcommand's parser; gets ``SPEC``, ``--json``, ``--plant``, ``--no-cache`` and
         the ``handler`` :func:`cmd_verify`.
     """
-    from ..spec.plants import PLANT_MODELS
+    from ..spec.plants import MODELS_WITH_EQUATIONS
     add_spec_argument(p)
     add_json_argument(p, "print a JSON list of checks")
     p.add_argument("--plant", default=None, metavar="MODEL",
                    help=f"plant for Assumption 2 and the sampled check's bounds "
-                        f"({', '.join(PLANT_MODELS)}; default: the spec's)")
+                        f"({', '.join(MODELS_WITH_EQUATIONS)}; default: the spec's)")
     p.add_argument("--no-cache", action="store_true",
                    help="prove the spec-independent lemmas again instead of reading the "
                         "proof cache (~/.cache/stt-codegen; see docs/verification.md)")

@@ -43,14 +43,13 @@ from ..codegen import tolerance as T
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..design.result import Design, require_design
-from ..errors import ToolchainError
+from ..errors import SpecError, ToolchainError
 from ..runtime.plants import check_seed
-from ..runtime.tasks import judge_tasks
 from ..tube.parameters import TubeDesign
 from . import board
 from .footprint import elf_stack_bound, linked_sizes, measure
-from .programs import (closed_loop_source, parse_closed_loop, parse_replay, replay_source,
-                       steps_of)
+from .programs import (closed_loop_source, judge_printed, parse_closed_loop, parse_replay,
+                       replay_source, steps_of)
 from .target import CPU_FLAGS, build_elf, run_qemu
 from .toolchain import missing_message
 
@@ -157,7 +156,8 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
     TypeError
         ``design`` is not a :class:`~stt_codegen.design.result.Design`.
     SpecError
-        ``seed`` is not an integer in ``[0, 2**32)`` (field ``seed``).
+        ``seed`` is not an integer in ``[0, 2**32)`` (field ``seed``); a MuJoCo plant
+        (field ``plant.model``: its closed loop runs on the host only).
     ToolsMissing
         A tool is not installed (the message names the Debian packages).
     ToolchainError
@@ -165,6 +165,9 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
     """
     design = require_design(design, "run_embedded")
     spec, tube = design.spec, design.tube
+    if spec.mujoco is not None:
+        raise SpecError("plant.model", "the firmware's closed loop needs the plant's equations; "
+                                       "a MuJoCo plant runs on the host (stt-codegen simulate)")
     seed = check_seed(seed)
     message = missing_message()
     if message:
@@ -224,9 +227,10 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
         "steps": s["steps"],
         "max_abs_u": s["max_abs_u"],
     }
-    if spec.tasks:      # [[tasks]]: judged on the target's printed states (docs/tasks.md)
-        closed.update(_target_tasks(spec, loop.states, tube.rate_hz))
-        closed["closed_loop_satisfied"] &= all(t["met"] for t in closed["tasks"])
+    # tasks and moving obstacles: judged on the target's printed states (docs/tasks.md)
+    judged = judge_printed(spec, loop.states, tube.rate_hz)
+    closed["closed_loop_satisfied"] &= judged.pop("met")
+    closed.update(judged)
 
     # 4. instructions and stack of single steps at closed-loop inputs
     ks = sorted(loop.replay_inputs)
@@ -321,14 +325,3 @@ def _vectors(path: Path):
     data = json.loads(path.read_text())
     return (np.array(data["x"]), np.array(data["t"]), np.array(data["dt"]),
             np.array(data["alpha"]))
-
-
-def _target_tasks(spec, states: dict, rate_hz: float) -> dict:
-    """``{"tasks": [...]}``: each task judged (:func:`~stt_codegen.runtime.tasks.judge_tasks`)
-    on the states the target printed (every tenth step and the last), not on the
-    integration points between them as ``simulate`` does."""
-    from dataclasses import asdict
-    ks = sorted(states)
-    outcomes = judge_tasks(spec, np.array(ks, dtype=float) / rate_hz,
-                           np.array([states[k] for k in ks]))
-    return {"tasks": [asdict(o) for o in outcomes]}

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
@@ -27,10 +27,11 @@ from ..codegen.render import c_identifier, render
 from ..runtime.dynamics import plant_function
 from ..runtime.plants import Disturbance
 from ..runtime.simulate import SUBSTEPS
+from ..runtime.tasks import judge_tasks, until_met
 from ..spec.loader import Spec
 from ..tube.parameters import TubeDesign
 
-__all__ = ["closed_loop_source", "loop_context", "parse_closed_loop", "parse_replay", "replay_source",
+__all__ = ["closed_loop_source", "judge_printed", "loop_context", "parse_closed_loop", "parse_replay", "replay_source",
            "steps_of"]
 
 
@@ -316,3 +317,49 @@ def parse_closed_loop(stdout: str, n: int, state_size: int | None = None) -> Clo
             replay[int(parts[1])] = (vals[0], np.array(vals[1:1 + 2 * n]),
                                      np.array(vals[1 + 2 * n:1 + 2 * n + size]))
     return ClosedLoopOutput(summary, states, replay)
+
+
+def judge_printed(spec: Spec, states: dict, rate_hz: float) -> dict:
+    """The tasks and the moving obstacles judged on the states a closed-loop program printed
+    (every ``decimate``-th step and the last), for both plant orders: what the program
+    itself does not judge (it judges the static obstacles, the state space and the target
+    at every step).
+
+    The judgement is at the printed steps only, coarser than ``simulate``'s, which judges
+    at every integration point: a task met, or an obstacle met, only between two printed
+    steps is not seen.
+
+    Parameters
+    ----------
+    spec : Spec
+        Its ``tasks`` (:func:`~stt_codegen.runtime.tasks.judge_tasks`) and
+        ``moving_obstacles`` (an obstacle until a task ends when the printed run meets it,
+        :func:`~stt_codegen.runtime.tasks.until_met`).
+    states : dict of int to ndarray
+        Step index to the printed state; its first ``spec.dimension`` entries are the
+        positions (shape (n,) or (2 n,)).
+    rate_hz : float
+        The controller's rate, Hz (a step's time is its index over it).
+
+    Returns
+    -------
+    dict
+        ``tasks`` (one dict per task, :class:`~stt_codegen.runtime.tasks.TaskOutcome`'s
+        fields; with tasks only), ``moving_clearance`` (the least signed clearance from the
+        moving obstacles, state units; with moving obstacles only) and ``met`` (every task
+        met and every moving obstacle missed at the printed steps).
+    """
+    ks = sorted(states)
+    t = np.array(ks, dtype=float) / rate_hz
+    x = np.array([states[k][:spec.dimension] for k in ks])
+    outcomes = judge_tasks(spec, t, x)
+    out: dict = {"met": all(o.met for o in outcomes)}
+    if spec.tasks:
+        out["tasks"] = [asdict(o) for o in outcomes]
+    if spec.moving_obstacles:
+        clearance = min(float(ob.signed_clearance(x, t).min())
+                        for ob in until_met(spec, outcomes))
+        out["moving_clearance"] = clearance if math.isfinite(clearance) else None
+        out["met"] = out["met"] and clearance > 0.0
+    return out
+

@@ -25,7 +25,7 @@ from typing import Sequence
 import casadi as ca
 import numpy as np
 
-from ..spec.plants import (NAMED_MODELS, MissingPlantBehaviour, dimension_mismatch,
+from ..spec.plants import (NAMED_MODELS, MissingPlantBehaviour, dimension_mismatch, plant_entry,
                            model_behaviour)
 
 __all__ = ["INPUT_MATRICES", "NAMED_MODELS", "input_matrix", "linear_rhs", "plant_function", "plant_rhs"]
@@ -157,10 +157,13 @@ def plant_function(model: str, n: int, linear=None) -> ca.Function:
     Raises
     ------
     ValueError
-        As :func:`input_matrix`.
+        As :func:`input_matrix`; a model without equations (``mujoco``).
     """
     if model in INPUT_MATRICES:   # a named model: g(x) is fixed, not from the spec
         return plant_rhs(model, n)
+    if plant_entry(model).declared_bounds:
+        raise ValueError(f"the {model} plant has no equations here (it runs in its own "
+                         "simulator)")
     if linear is None:
         return linear_rhs(np.zeros((n, n)), np.eye(n), np.zeros(n))
     return linear_rhs(linear.a, linear.g, linear.c)

@@ -8,9 +8,8 @@ the hardware would). Between two samples the held input drives ``mj_step`` at th
 timestep (``1 / rate_hz`` must be a whole number of timesteps). A contact of the robot with
 anything but a ground plane is recorded: the run judges it like a collision.
 
-``mujoco`` is an optional dependency (``pip install ".[mujoco]"``): this module imports it
-on first use and raises :class:`~stt_codegen.system.MissingTool`-like
-:class:`~stt_codegen.errors.SpecError` naming the extra when it is absent.
+``mujoco`` is a dependency of the package; this module imports it on first use and raises
+a :class:`~stt_codegen.errors.SpecError` saying how to install it when it is absent.
 """
 
 from __future__ import annotations
@@ -42,7 +41,7 @@ def require_mujoco():
         import mujoco
     except ImportError:
         raise SpecError("plant.model", "a MuJoCo plant needs the mujoco package: "
-                                       "pip install \"stt-codegen[mujoco]\" (or pip install "
+                                       "pip install stt-codegen (or pip install "
                                        "mujoco)") from None
     return mujoco
 

@@ -10,6 +10,7 @@ by the emitter (the same Functions are printed to C for the embedded closed loop
 from __future__ import annotations
 
 import operator
+from typing import Any
 
 import control as ct
 import numpy as np
@@ -19,6 +20,7 @@ from ..errors import SpecError
 from ..spec.loader import LinearPlant
 from ..spec.plants import PLANTS, MissingPlantBehaviour, dimension_mismatch, model_behaviour
 from .dynamics import linear_rhs, plant_rhs
+from .mujoco_plant import MujocoPlant
 from .second_order_plants import model_info, second_order_rhs
 
 __all__ = ["Disturbance", "check_seed", "make_plant", "second_order_plant", "spec_plant"]
@@ -195,10 +197,16 @@ def _spec_linear_plant(dimension: int, disturbance: Disturbance,
 
 
 #: The simulated plant of each first-order model: ``(n, disturbance, linear) -> system``.
+def _simulator_only(n: int, disturbance: Disturbance, linear) -> ct.NonlinearIOSystem:
+    raise SpecError("plant.model", "a MuJoCo plant is built from the spec's [plant] "
+                                   "(mjcf, joints, actuators): use spec_plant(spec)")
+
+
 SIMULATION_PLANTS = {
     "omnidirectional": lambda n, disturbance, _linear: omnidirectional_robot(disturbance),
     "single-integrator": lambda n, disturbance, _linear: single_integrator(n, disturbance),
     "linear": _spec_linear_plant,
+    "mujoco": _simulator_only,
 }
 
 
@@ -256,7 +264,7 @@ def second_order_plant(model: str, dimension: int, parameters, amplitude: float,
                     name=f"second_order_{model.replace('-', '_')}")
 
 
-def spec_plant(spec, seed: int = 0) -> ct.NonlinearIOSystem:
+def spec_plant(spec, seed: int = 0) -> Any:
     """The plant a spec names (``[plant]``), of the spec's order.
 
     Parameters
@@ -269,14 +277,19 @@ def spec_plant(spec, seed: int = 0) -> ct.NonlinearIOSystem:
 
     Returns
     -------
-    control.NonlinearIOSystem
-        :func:`make_plant` (``n`` states) or :func:`second_order_plant` (``2 n`` states).
+    control.NonlinearIOSystem or MujocoPlant
+        :func:`make_plant` (``n`` states) or :func:`second_order_plant` (``2 n`` states);
+        for ``plant.model = "mujoco"`` the :class:`~.mujoco_plant.MujocoPlant` of
+        ``spec.mujoco`` (no disturbance is added: MuJoCo's dynamics are the plant's).
 
     Raises
     ------
     SpecError
         As :func:`make_plant` and :func:`second_order_plant`.
     """
+    if spec.mujoco is not None:      # [plant] model = "mujoco": MuJoCo steps the plant
+        m = spec.mujoco
+        return MujocoPlant(m.path, m.joints, m.actuators, spec.order, m.timestep)
     if spec.order == 1:
         return make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed,
                           spec.linear_plant)

@@ -24,12 +24,13 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from ..cases import bundled_cases, bundled_spec_bytes
+from ..cases import bundled_cases, bundled_folder, bundled_spec_bytes
 from ..errors import SpecError
 from .assumptions import Assumptions, combine_assumptions
-from .model_bounds import model_bounds
+from .model_bounds import declared_bounds, model_bounds
 from .motion import MovingObstacle, check_moving, is_moving, moving_obstacle
-from .plants import (MODEL_KEYS, PLANTS, SECOND_ORDER_MODELS, SECOND_ORDER_PLANTS,
+from .mujoco import MujocoModel, mujoco_model, with_folder
+from .plants import (MODEL_KEYS, PLANTS, SECOND_ORDER_MODELS, SECOND_ORDER_PLANTS, SIMULATOR_KEYS,
                      dimension_mismatch, plant_entry)
 from .robot import (Robot, inflate_ball, inflate_bounds, inflate_moving, inflate_polytope,
                     robot_dims, shrink_bounds)
@@ -274,6 +275,9 @@ class Spec:
     moving_obstacles : tuple of MovingObstacle
         The ``[[obstacles]]`` boxes with ``active``, ``velocity`` or ``path``
         (:mod:`~.motion`); they are in neither :attr:`obstacles` nor :attr:`unsafe_sets`.
+    mujoco : MujocoModel or None
+        ``[plant] model = "mujoco"``: the MJCF file, joints and actuators the plant is
+        simulated on (:mod:`.mujoco`).
     robot : Robot or None
         ``[robot]``: the robot's size and the sets as given (:mod:`~.robot`). With it,
         :attr:`state_space` is the given one shrunk by the radius and :attr:`obstacles`,
@@ -310,6 +314,7 @@ class Spec:
     target_dropped: tuple[tuple[int, str], ...] = ()
     moving_obstacles: tuple[MovingObstacle, ...] = ()
     robot: Robot | None = None
+    mujoco: MujocoModel | None = None
 
     @property
     def dimension(self) -> int:
@@ -334,7 +339,10 @@ class Spec:
     def input_names(self) -> tuple[str, ...]:
         """Names of the inputs ``u`` that ``[actuator] input_bound`` bounds, in its order:
         the second-order model's physical inputs (``F1``, ``F2``, ..., the quadrotor's
-        thrust, the arm's torques) for order 2, else the first-order model's."""
+        thrust, the arm's torques) for order 2, else the first-order model's; a MuJoCo
+        plant's actuators."""
+        if self.mujoco is not None:
+            return self.mujoco.actuators
         if self.second_order is not None:
             return SECOND_ORDER_PLANTS[self.second_order.model].input_names(self.dimension)
         return PLANTS[self.plant_model].input_names(self.dimension)
@@ -493,9 +501,10 @@ def load_spec(spec: str | Path) -> Spec:
                         f"path, not {type(spec).__name__}{hint}")
     text = str(spec)
     if text in bundled_cases() and not Path(text).exists():
-        data = bundled_spec_bytes(text)
+        data, folder = bundled_spec_bytes(text), bundled_folder()
     else:
         path = Path(text)
+        folder = path.resolve().parent
         try:
             data = path.read_bytes()
         except FileNotFoundError:
@@ -503,7 +512,7 @@ def load_spec(spec: str | Path) -> Spec:
                                 f"(bundled: {', '.join(bundled_cases())})") from None
         except OSError as exc:
             raise SpecError("", f"cannot read {text!r}: {exc.strerror or exc}") from None
-    return parse_spec(data)
+    return with_folder(parse_spec(data), folder)
 
 
 def parse_spec(data: bytes | str) -> Spec:
@@ -683,7 +692,9 @@ def _validate(raw: dict) -> Spec:
                                    zip(obstacles, (o.box(state_space) for o in obstacles))],
                                   doc.tube.method),
                 task_order=doc.task_order.order if doc.task_order is not None else "listed",
-                moving_obstacles=moving, robot=robot)
+                moving_obstacles=moving, robot=robot,
+                mujoco=(mujoco_model(doc.plant, n, plant_entry(doc.plant.model).input_count(n))
+                        if plant_entry(doc.plant.model).simulator_keys else None))
 
 
 def _vector(value: list[float], name: str, length: int | None) -> tuple[float, ...]:
@@ -736,10 +747,14 @@ def _matrix(rows: list[list[float]], name: str, n: int) -> tuple[tuple[float, ..
 
 
 def _linear_plant(table: PlantTable, n: int) -> LinearPlant | None:
-    """The matrices ``a``, ``g``, ``c`` of ``[plant]``; only the ``linear`` model takes them."""
-    for key, owner in MODEL_KEYS.items():
-        if getattr(table, key) is not None and owner != table.model:
-            raise SpecError(f"plant.{key}", f"only the {owner} model takes {key} "
+    """The matrices ``a``, ``g``, ``c`` of ``[plant]``; only the ``linear`` model takes them
+    (and only the ``mujoco`` model its simulator's keys)."""
+    owners = {**{key: (owner,) for key, owner in MODEL_KEYS.items()}, **SIMULATOR_KEYS}
+    for key, models in owners.items():
+        if getattr(table, key) is not None and table.model not in models:
+            raise SpecError(f"plant.{key}", f"only the {' and '.join(models)} model"
+                                            f"{'s' if len(models) > 1 else ''} take"
+                                            f"{'' if len(models) > 1 else 's'} {key} "
                                             f"(plant.model is {table.model!r})")
     if table.model not in MODEL_KEYS.values():
         return None
@@ -770,6 +785,12 @@ def _second_order(doc: Any, n: int) -> SecondOrder | None:
                                             f"(plant.model is {model!r})")
         return None
     table = doc.assumptions
+    if plant_entry(model).declared_bounds:     # no equations: the class is what is declared
+        for key in SECOND_ORDER_ASSUMPTIONS:
+            if key not in table.model_fields_set:
+                raise SpecError(f"assumptions.{key}", f"required for plant.model = {model!r}: "
+                                "the toolkit has no equations of this plant, so the design "
+                                "and verify use the declared bounds (and cannot check them)")
     for key in AssumptionsTable.model_fields:
         if key in table.model_fields_set and key not in SECOND_ORDER_ASSUMPTIONS:
             raise SpecError(f"assumptions.{key}",
@@ -787,7 +808,15 @@ def _assumptions(table: AssumptionsTable, n: int, amplitude: float, model: str,
     (:func:`~.assumptions.combine_assumptions`)."""
     declared = {key: getattr(table, key) for key in AssumptionsTable.model_fields
                 if key in table.model_fields_set}
-    bounds = model_bounds(model, state_space.lower, state_space.upper, linear)
+    if plant_entry(model).declared_bounds:     # no equations: the declared bounds as they are
+        for key in ("input_gain", "drift_bound"):
+            if key not in declared:
+                raise SpecError(f"assumptions.{key}", f"required for plant.model = {model!r}: "
+                                "the toolkit has no equations of this plant, so the design "
+                                "and verify use the declared bounds (and cannot check them)")
+        bounds = declared_bounds(model, declared, n)
+    else:
+        bounds = model_bounds(model, state_space.lower, state_space.upper, linear)
     return combine_assumptions(bounds, declared, n, amplitude)
 
 

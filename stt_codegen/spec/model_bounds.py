@@ -28,7 +28,7 @@ import math
 from dataclasses import dataclass
 from typing import Sequence
 
-__all__ = ["BOX_BOUNDS", "ModelBounds", "model_bounds", "row_coupling", "symmetric_eigen_range", "REL_PAD",
+__all__ = ["BOX_BOUNDS", "ModelBounds", "declared_bounds", "model_bounds", "row_coupling", "symmetric_eigen_range", "REL_PAD",
            "EXACT_DRIFT_DIMENSIONS"]
 
 #: Relative outward widening of every computed bound (rounding of ``cos``, ``sin`` and of
@@ -290,6 +290,35 @@ def model_bounds(model: str, lower: Sequence[float], upper: Sequence[float],
     if model not in BOX_BOUNDS:
         raise ValueError(f"unknown plant model {model!r}")
     return BOX_BOUNDS[model](lower, upper, linear)
+
+
+def declared_bounds(model: str, declared: dict, n: int) -> ModelBounds:
+    """The bounds of a model without equations (``declared_bounds`` in the plant
+    registry): the declared ``[assumptions]`` themselves, so that nothing is derived or
+    compared; one block of all states (the structure of ``g`` is unknown).
+
+    Parameters
+    ----------
+    model : str
+        The model's name.
+    declared : dict
+        The declared ``[assumptions]`` keys (``input_gain`` and ``drift_bound`` at least).
+    n : int
+        State dimension.
+
+    Returns
+    -------
+    ModelBounds
+    """
+    g_min, g_max = (float(v) for v in declared["input_gain"])
+    skew = float(declared.get("input_gain_skew", 0.0))
+    coupling = float(declared.get("input_gain_coupling", 0.5 * (g_max - g_min) + skew))
+    return ModelBounds(model, (g_min, g_max), skew, coupling,
+                       float(declared["drift_bound"]), (tuple(range(n)),),
+                       tuple((key, "declared") for key in ("input_gain", "input_gain_skew",
+                                                           "input_gain_coupling",
+                                                           "drift_bound")),
+                       "declare the bounds your plant meets in [assumptions]")
 
 
 def _single_integrator(lower: Sequence[float], upper: Sequence[float],

@@ -19,7 +19,8 @@ from dataclasses import dataclass
 from typing import Mapping, TypeVar
 
 __all__ = ["ALL_PLANT_MODELS", "PLANTS", "PLANT_MODELS", "MODEL_KEYS", "NAMED_MODELS",
-           "MissingPlantBehaviour", "PlantModel", "SECOND_ORDER_MODELS",
+           "MissingPlantBehaviour", "MODELS_WITH_EQUATIONS", "PlantModel", "SECOND_ORDER_MODELS",
+           "SIMULATOR_KEYS",
            "SECOND_ORDER_PLANTS", "SecondOrderModel", "dimension_mismatch",
            "model_behaviour", "plant_entry"]
 
@@ -50,6 +51,13 @@ class PlantModel:
         sampling interval) are tighter than over the state space.
     drift_varies : bool
         ``f(x)`` depends on the state (through matrices of the spec), likewise.
+    simulator_keys : tuple of str
+        Keys of ``[plant]`` only this model takes that name a simulator's model of the
+        plant (a MuJoCo file and its joints), not matrices.
+    declared_bounds : bool
+        The toolkit has no equations of the model: every bound the design and ``verify``
+        use is the declared ``[assumptions]`` (``input_gain`` and ``drift_bound`` are
+        required), and nothing proves the plant meets them.
     """
 
     name: str
@@ -60,6 +68,8 @@ class PlantModel:
     input_unit: str = ""
     gain_varies: bool = False
     drift_varies: bool = False
+    simulator_keys: tuple[str, ...] = ()
+    declared_bounds: bool = False
 
     #: Order of the model: 1, system (1) driven by law (13).
     order = 1
@@ -80,13 +90,23 @@ PLANTS: dict[str, PlantModel] = {p.name: p for p in (
     PlantModel("single-integrator", "x_dot = u + w"),
     PlantModel("linear", "x_dot = a x + c + g u + w, the matrices from [plant]",
                keys=("a", "g", "c"), drift_varies=True),
+    PlantModel("mujoco", "an MJCF model stepped by MuJoCo (plant.mjcf, plant.joints, "
+               "plant.actuators): the states the joints' positions, the inputs the "
+               "actuators' controls (velocity actuators); no equations: [assumptions] "
+               "input_gain and drift_bound are required and taken as declared",
+               simulator_keys=("mjcf", "joints", "actuators", "timestep"),
+               declared_bounds=True),
 )}
 #: The ``plant.model`` values.
 PLANT_MODELS: tuple[str, ...] = tuple(PLANTS)
 #: Models with fixed dynamics (no matrices from the spec).
-NAMED_MODELS: tuple[str, ...] = tuple(name for name, p in PLANTS.items() if not p.keys)
-#: ``[plant]`` keys that belong to one model, with the model.
+NAMED_MODELS: tuple[str, ...] = tuple(name for name, p in PLANTS.items()
+                                      if not p.keys and not p.declared_bounds)
+#: ``[plant]`` matrix keys that belong to one model, with the model.
 MODEL_KEYS: dict[str, str] = {key: name for name, p in PLANTS.items() for key in p.keys}
+#: Models with equations the toolkit knows (their bounds derived, their dynamics simulated).
+MODELS_WITH_EQUATIONS: tuple[str, ...] = tuple(name for name, p in PLANTS.items()
+                                               if not p.declared_bounds)
 
 
 @dataclass(frozen=True)
@@ -116,6 +136,11 @@ class SecondOrderModel:
     input_unit : str
         SI unit of every input (``"N"`` for a force, ``"N m"`` for a torque): the unit of
         ``[actuator] input_bound``.
+    simulator_keys : tuple of str
+        As :attr:`PlantModel.simulator_keys`.
+    declared_bounds : bool
+        As :attr:`PlantModel.declared_bounds`: no equations, the declared
+        ``[assumptions]`` (``input_gain`` and ``drift_bound`` required) are the class.
     """
 
     name: str
@@ -126,6 +151,8 @@ class SecondOrderModel:
     diagonal_input: bool = False
     inputs: tuple[str, ...] | None = None
     input_unit: str = "N"
+    simulator_keys: tuple[str, ...] = ()
+    declared_bounds: bool = False
 
     #: Order of the model: 2, the cascade law.
     order = 2
@@ -155,11 +182,24 @@ SECOND_ORDER_PLANTS: dict[str, SecondOrderModel] = {m.name: m for m in (
                       "gravity"),
                      (1.0, 1.0, 1.0, 1.0, 1.0 / 12.0, 1.0 / 12.0, 0.0),
                      inputs=("tau1", "tau2"), input_unit="N m"),
+    SecondOrderModel("mujoco-force", "second order, an MJCF model stepped by MuJoCo through "
+                     "force or torque actuators (plant.mjcf, plant.joints, plant.actuators): "
+                     "the states the joints' positions and velocities, any n; no equations: "
+                     "[assumptions] input_gain and drift_bound are required and taken as "
+                     "declared", None, (), (), inputs=None, input_unit="",
+                     simulator_keys=("mjcf", "joints", "actuators", "timestep"),
+                     declared_bounds=True),
 )}
 #: The second-order ``plant.model`` values, in order.
 SECOND_ORDER_MODELS: tuple[str, ...] = tuple(SECOND_ORDER_PLANTS)
 #: Every ``plant.model`` value a spec may give: first order, then second order.
 ALL_PLANT_MODELS: tuple[str, ...] = PLANT_MODELS + SECOND_ORDER_MODELS
+#: ``[plant]`` keys naming a simulator's model of the plant, with the models that take them.
+SIMULATOR_KEYS: dict[str, tuple[str, ...]] = {
+    key: tuple(name for name, p in (*PLANTS.items(), *SECOND_ORDER_PLANTS.items())
+               if key in p.simulator_keys)
+    for key in dict.fromkeys(k for p in (*PLANTS.values(), *SECOND_ORDER_PLANTS.values())
+                             for k in p.simulator_keys)}
 
 
 def plant_entry(model: str) -> PlantModel | SecondOrderModel:

@@ -213,6 +213,14 @@ class PlantTable(_Table):
     c: Vector = _omitted("linear model only: the constant drift c; default zero")
     parameters: Vector = _omitted("second-order models only: the simulated plant's "
                                   "parameters, in the model's order; default nominal")
+    mjcf: Annotated[str, Strict(), Field(min_length=1)] = _omitted(
+        "mujoco model only: the MJCF file, relative to the spec file's folder")
+    joints: Annotated[list[Annotated[str, Strict()]], Field(min_length=1)] = _omitted(
+        "mujoco model only: the slide or hinge joint of each state, in the spec's order")
+    actuators: Annotated[list[Annotated[str, Strict()]], Field(min_length=1)] = _omitted(
+        "mujoco model only: the actuator of each input, in the order of u")
+    timestep: Positive = _omitted("mujoco model only: MuJoCo's timestep, s; default the "
+                                  "model's own (1 / rate_hz must be a whole number of them)")
 
 
 class AssumptionsTable(_Table):

@@ -30,6 +30,7 @@ __all__ = [
     "check_assumption2",
     "assumption2_omnidirectional",
     "assumption2_single_integrator",
+    "assumption2_declared",
     "assumption2_linear",
     "assumption2_check",
     "ASSUMPTION2_CHECKS",
@@ -258,6 +259,29 @@ def assumption2_linear(spec: Spec) -> Check:
                     "hold this plant"), {"lambda_min": lam})
 
 
+def assumption2_declared(spec: Spec) -> Check:
+    """Assumption 2 for a plant without equations (``plant.model = "mujoco"``): what can be
+    proved is that the declared ``[assumptions] input_gain`` satisfies it (``g_min > 0``);
+    that the plant meets the declared bounds is assumed, not proved, and the check says so.
+
+    Parameters
+    ----------
+    spec : Spec
+        A spec whose plant model has ``declared_bounds`` in the plant registry.
+
+    Returns
+    -------
+    Check
+        ``assumption2.declared``, with ``g_min``.
+    """
+    g_min = spec.assumptions.input_gain[0]
+    return Check("assumption2.declared", bool(g_min > 0),
+                 f"the declared input_gain has g_min = {g_min:.6g} > 0; not proved: that the "
+                 f"{spec.plant_model} plant meets the declared [assumptions] (the toolkit "
+                 "has no equations of it; every guarantee of verify holds for plants that "
+                 "do)", {"g_min": g_min})
+
+
 #: The Assumption-2 check of each first-order model, ``spec -> Check``: the proof on the
 #: deployed ``g(x)`` over the state space (the omnidirectional robot's heading range).
 ASSUMPTION2_CHECKS: dict[str, Callable[[Spec], Check]] = {
@@ -265,6 +289,7 @@ ASSUMPTION2_CHECKS: dict[str, Callable[[Spec], Check]] = {
         (spec.state_space.lower[2], spec.state_space.upper[2])),
     "single-integrator": lambda spec: assumption2_single_integrator(spec.dimension),
     "linear": assumption2_linear,
+    "mujoco": assumption2_declared,
 }
 
 

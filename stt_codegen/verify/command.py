@@ -17,7 +17,7 @@ from ..design.result import Design
 from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
-from ..spec.plants import PLANT_MODELS
+from ..spec.plants import MODELS_WITH_EQUATIONS
 from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
 from .actuator import input_bound_check, prove_input_bound
 from .adaptive import adaptive_law_checks, alpha_upper_bound
@@ -101,7 +101,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     design : TubeDesign
         Its designed tube and gain.
     plant : str, optional
-        Plant model (one of :data:`stt_codegen.spec.plants.PLANT_MODELS`) for Assumption 2
+        Plant model (one of :data:`stt_codegen.spec.plants.MODELS_WITH_EQUATIONS`) for Assumption 2
         and the sampled check's bounds (:meth:`~stt_codegen.spec.loader.Spec.with_plant_model`);
         default the spec's.
     cache : bool
@@ -245,14 +245,15 @@ def spec_for_plant(spec: Spec, plant: str | None) -> Spec:
     Raises
     ------
     SpecError
-        Field ``plant``: not one of :data:`~stt_codegen.spec.plants.PLANT_MODELS`, or a
+        Field ``plant``: not one of :data:`~stt_codegen.spec.plants.MODELS_WITH_EQUATIONS`, or a
         model that does not fit the spec's dimension; a declared ``[assumptions]`` bound
         that the model violates (the field names the key).
     """
     if plant is None:
         return spec
-    if plant not in PLANT_MODELS:
-        raise SpecError("plant", f"must be one of {', '.join(PLANT_MODELS)}")
+    if plant not in MODELS_WITH_EQUATIONS:
+        raise SpecError("plant", f"must be one of {', '.join(MODELS_WITH_EQUATIONS)} (a model "
+                                 "with equations)")
     return spec.with_plant_model(plant)
 
 
@@ -320,7 +321,7 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
         gives a report whose one check, ``tube.design``, failed.
     plant : str, optional
         Plant model for Assumption 2 and the sampled check's bounds (one of
-        :data:`~stt_codegen.spec.plants.PLANT_MODELS`;
+        :data:`~stt_codegen.spec.plants.MODELS_WITH_EQUATIONS`;
         :meth:`~stt_codegen.spec.loader.Spec.with_plant_model`); default the spec's
         ``plant.model``.
     progress : callable, optional

@@ -32,6 +32,7 @@ from ..design.gain import derived_gain, gain_derivation
 from ..design.samples import TubeSamples, sample_tube
 from ..spec.assumptions import Assumptions
 from ..spec.loader import Spec
+from ..spec.plants import PLANTS
 from ..tube import reference
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from ..rounding import distinct
@@ -411,7 +412,10 @@ def lowest_rate(design: TubeDesign, spec: Spec, plants: Assumptions | PlantClass
 
 def _bounds_words(a: Assumptions, refined: tuple[str, ...] = ()) -> str:
     g_min, g_max = a.input_gain
-    if a.model and not a.declared:
+    if a.model and a.model in PLANTS and PLANTS[a.model].declared_bounds:
+        source = (f"declared: {', '.join(a.declared)}; the rest their defaults (the {a.model} "
+                  "plant has no equations here)")
+    elif a.model and not a.declared:
         source = f"the {a.model} model's own bounds over the state space"
     elif a.model:
         source = (f"declared: {', '.join(a.declared)}; the rest from the {a.model} model "
