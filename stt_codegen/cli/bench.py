@@ -1,5 +1,5 @@
-"""``stt-codegen bench arenas | tasks | step | scaling | covering | alpha``: the benchmarks and
-studies of :mod:`stt_codegen.bench`."""
+"""``stt-codegen bench arenas | tasks | step | scaling | covering | alpha | second-order |
+stl``: the benchmarks and studies of :mod:`stt_codegen.bench`."""
 
 from __future__ import annotations
 
@@ -103,9 +103,24 @@ def _cmd_second_order(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_stl(args: argparse.Namespace) -> int:
+    from ..bench.stl_bench import format_stl_report, run_stl_bench
+    names = [n.strip() for n in args.scenarios.split(",") if n.strip()] if args.scenarios \
+        else None
+    report = run_stl_bench(names, horizon=args.horizon,
+                           solver=None if args.solver == "none" else args.solver,
+                           specs=Path(args.specs) if args.specs else None)
+    if args.json:
+        report = {"rows": [{k: v for k, v in row.items() if k != "spec"}
+                           for row in report["rows"]], "order_note": report["order_note"]}
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_stl_report(report))
+    return 0
+
+
 def configure_bench(bench: argparse.ArgumentParser) -> None:
-    """Sub-subcommands ``bench arenas``, ``tasks``, ``step``, ``scaling``, ``covering`` and
-    ``alpha``.
+    """Sub-subcommands ``bench arenas``, ``tasks``, ``step``, ``scaling``, ``covering``,
+    ``alpha``, ``second-order`` and ``stl``.
 
     Parameters
     ----------
@@ -198,3 +213,22 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                         "(extreme members switched per sampling interval)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_second_order)
+
+    p = sub.add_parser("stl", help="stlpy's benchmark scenarios written as specs, designed, "
+                                   "run with the generated C and judged by rtamt "
+                                   '(pip install ".[stl]")')
+    p.add_argument("--scenarios", default=None, metavar="LIST",
+                   help="comma-separated subset of ReachAvoid, EitherOr, NarrowPassage, "
+                        "RandomMultitarget, DoorPuzzle, NonlinearReachAvoid, SteppingStones "
+                        "(default: all)")
+    p.add_argument("--horizon", type=int, default=None, metavar="T",
+                   help="stlpy's horizon T in steps for every scenario (default: each "
+                        "example's)")
+    p.add_argument("--solver", choices=("scipy", "drake-bnb", "none"), default="scipy",
+                   help="stlpy's solver run beside: scipy (ScipyGradientSolver), drake-bnb "
+                        "(DrakeMICPSolver with Drake's branch and bound; pip install drake) "
+                        "or none (default: %(default)s)")
+    p.add_argument("--specs", default=None, metavar="DIR",
+                   help="also write the specs into DIR")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_stl)
