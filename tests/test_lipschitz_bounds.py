@@ -129,3 +129,26 @@ def test_a_bad_declaration_on_the_command_line_is_exit_2(tmp_path):
                          capture_output=True, text=True, timeout=600)
     assert out.returncode == 2 and "input_gain_lipschitz" in out.stderr
     assert "Traceback" not in out.stderr
+
+
+@pytest.mark.slow
+def test_verify_says_not_the_checks_caution_only_about_a_member_of_the_declared_class():
+    """The robot's geometry with a wall, its true bounds for the heading range declared
+    (``g = R(x3)``): without its Lipschitz bound the class has a jumping member that leaves
+    the tube, and ``verify`` says so; with ``input_gain_lipschitz = [0, 0, 1]`` the same
+    verdict, but no member of that class is found, so the caution is not ruled out."""
+    from stt_codegen.verify.command import verify_spec
+    wall = (Path(__file__).parent / "specs" / "wall-gap-s1.toml").read_text()
+    declared = ("\n[assumptions]\ninput_gain = [0.362, 1]\ninput_gain_skew = 0.933\n"
+                "input_gain_coupling = 0.933\n")
+    kept = {}
+    for label, extra in (("jumping", ""), ("lipschitz", "input_gain_lipschitz = [0, 0, 1]\n")):
+        checks = {c.name: c for c in verify_spec(parse_spec(wall + declared + extra))}
+        kept[label] = checks["sampled.tube_kept"]
+    assert not kept["jumping"].passed and not kept["lipschitz"].passed
+    member = kept["jumping"].data["class_counterexample"]
+    assert member is not None and "g Lipschitz" not in member["strategy"]
+    assert "not the check's caution" in kept["jumping"].detail
+    assert "g on each interval an extreme member" in kept["jumping"].detail
+    assert kept["lipschitz"].data["class_counterexample"] is None
+    assert "not the check's caution" not in kept["lipschitz"].detail

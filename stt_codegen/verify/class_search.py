@@ -101,6 +101,11 @@ class Counterexample:
         ``f + w`` on each interval, state units per second.
     drifts : ndarray, shape (K, n)
         The ``f`` part of ``pushes`` (``pushes - drifts`` is ``w``), state units per second.
+    gain_rates : bool
+        ``g`` moved only within the class's ``input_gain_lipschitz`` (else it jumped).
+    drift_rates : bool
+        ``f`` moved only within the class's ``drift_lipschitz``, ``w`` apart within
+        ``disturbance_bound`` (else ``f + w`` jumped within their sum).
     """
 
     strategy: str
@@ -111,6 +116,8 @@ class Counterexample:
     gains: np.ndarray = field(compare=False, repr=False, default=None)
     pushes: np.ndarray = field(compare=False, repr=False, default=None)
     drifts: np.ndarray = field(compare=False, repr=False, default=None)
+    gain_rates: bool = False
+    drift_rates: bool = False
 
     def to_json(self) -> dict:
         """The figures, without the path (JSON-ready)."""
@@ -119,8 +126,8 @@ class Counterexample:
 
     @property
     def lipschitz(self) -> bool:
-        """Whether the search respected the class's Lipschitz bounds (its strategy says so)."""
-        return "Lipschitz" in self.strategy
+        """Whether the search respected a Lipschitz bound of the class (``g``'s or ``f``'s)."""
+        return self.gain_rates or self.drift_rates
 
 
 def unit_skew(axis: np.ndarray) -> np.ndarray:
@@ -293,7 +300,8 @@ def _run(design: TubeDesign, samples: TubeSamples, members: list[np.ndarray],
         i = int(np.argmax(np.abs(e)))
         return Counterexample(strategy, float(samples.t[k]), i, float(abs(e[i])), top,
                               np.array(gains).reshape(k, n, n),
-                              np.array(pushes).reshape(k, n), np.array(drifts).reshape(k, n))
+                              np.array(pushes).reshape(k, n), np.array(drifts).reshape(k, n),
+                              bounds.input_gain_lipschitz is not None, separate)
 
     for k in range(len(samples.t) - 1):
         e = (x - centre[k]) / half[k]
@@ -356,8 +364,9 @@ def search_class(design: TubeDesign, samples: TubeSamples, bounds: Assumptions,
     members = class_matrices(bounds, design.dimension, seed)
     if not members:
         return None
-    mode = (", Lipschitz" if bounds.input_gain_lipschitz is not None
-            or bounds.drift_lipschitz is not None else "")
+    rated = [name for name, rates in (("g", bounds.input_gain_lipschitz),
+                                      ("f", bounds.drift_lipschitz)) if rates is not None]
+    mode = f", {' and '.join(rated)} Lipschitz" if rated else ""
     for score in ("max", "lyapunov"):
         found = _run(design, samples, members, bounds, score, f"greedy {score}{mode}")
         if found is not None:

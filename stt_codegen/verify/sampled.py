@@ -494,10 +494,11 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
                   f"k = {design.gain:.6g} ({label}); {need}")
         found = _member_that_leaves(design, spec, result)
         if found is not None:
-            how = ("g and f changing between samples by at most the declared Lipschitz "
-                   "bounds times the state's move, towards extreme members of the class"
-                   if found.lipschitz else
-                   "g on each interval an extreme member of the class, |f + w| at its bound")
+            how = ("g moving between samples by at most its Lipschitz bound times the "
+                   "state's move, towards extreme members of the class" if found.gain_rates
+                   else "g on each interval an extreme member of the class")
+            how += ("; f likewise within its Lipschitz bound and |f| at its bound, |w| at "
+                    "its bound" if found.drift_rates else ", |f + w| at its bound")
             detail += (f"; and the failure is not the check's caution: a plant of the class "
                        f"leaves the tube ({how}): |e_{found.dimension}| = {found.depth:.3g} "
                        f"at t = {found.time:.4f} s ({found.strategy}; verify/class_search.py)")
