@@ -104,14 +104,79 @@ def test_a_counterexample_is_a_member_that_the_deployed_controller_reports_outsi
 
 def test_the_robot_class_over_the_whole_heading_range_has_a_member_that_leaves():
     """Why the check refuses the robot's bounds taken over the whole state space
-    (tests/test_verify_coupled.py): a member of that class leaves the tube; only the
-    bounds on the tube (the heading's range there) are proved."""
+    (tests/test_verify_coupled.py): a member of that class whose ``g`` may jump leaves the
+    tube; only the bounds on the tube (the heading's range there) are proved. With the
+    robot's own Lipschitz bound (``g = R(x3)`` moves by at most ``|dx3|``) the search finds
+    no member that leaves."""
     spec, design, samples = _tube("omnirobot-s1")
     bounds = spec.assumptions
-    assert bounds.blocks == ((0, 1), (2,))
-    found = search_class(design, samples, bounds)
-    assert found is not None
+    assert bounds.blocks == ((0, 1), (2,)) and bounds.input_gain_lipschitz == (0.0, 0.0, 1.0)
+    jumping = dataclasses.replace(bounds, input_gain_lipschitz=None, drift_lipschitz=None)
+    found = search_class(design, samples, jumping)
+    assert found is not None and not found.lipschitz
     assert not check_sampled(design, samples, PlantClass(bounds)).passed
+    assert search_class(design, samples, bounds, held_runs=0) is None
+
+
+def _path(design, samples, found):
+    """The states at the samples of a counterexample's path (law (13), numpy reference)."""
+    from stt_codegen.tube import reference
+    dt = 1.0 / design.rate_hz
+    x = np.array(design.initial_state, dtype=float)
+    states = [x]
+    for k, (g, push) in enumerate(zip(found.gains, found.pushes)):
+        u = reference.law(design.gain, x[None, :], samples.gamma_lower[k][None, :],
+                          samples.gamma_upper[k][None, :])[0][0]
+        x = x + dt * (g @ u + push)
+        states.append(x)
+    return np.array(states)
+
+
+@pytest.mark.parametrize("index, rates, drift_rates", [
+    (0, (0.0, 0.0, 300.0), None), (9, (0.0, 0.0, 1.0), None),
+    (9, (0.0, 0.0, 300.0), (5.0, 5.0, 5.0))])
+def test_a_lipschitz_counterexample_respects_the_declared_rates(index, rates, drift_rates):
+    """In the Lipschitz mode every interval's ``g`` is in the class and differs from the
+    previous one by at most ``sum_j L_j |dx_j|`` (spectral norm), ``f`` likewise with its
+    own rates and ``|f| <= drift_bound``, ``|w| <= disturbance_bound``; and the deployed
+    controller confirms the exit."""
+    case = "omnirobot-s1"
+    spec, design, samples = _tube(case)
+    bounds = dataclasses.replace(_study_bounds(case, index), input_gain_lipschitz=rates,
+                                 drift_lipschitz=drift_rates)
+    found = search_class(design, samples, bounds, held_runs=0)
+    assert found is not None and found.gain_rates and found.depth >= 1.0
+    assert found.drift_rates == (drift_rates is not None)
+    assert all(within_class(g, bounds) for g in found.gains)
+    moves = np.abs(np.diff(_path(design, samples, found), axis=0))[:-1]    # (K-1, n)
+    changes = np.linalg.norm(np.diff(found.gains, axis=0), 2, axis=(1, 2))
+    assert np.all(changes <= moves @ np.array(rates) * (1 + 1e-9) + 1e-12)
+    assert changes.max() > 0.0                           # the adversary does use its budget
+    drifts = found.drifts
+    disturbance = np.linalg.norm(found.pushes - drifts, axis=1)
+    if drift_rates is None:                              # f + w together, as without rates
+        assert np.linalg.norm(found.pushes, axis=1).max() <= \
+            (bounds.drift_bound + bounds.disturbance_bound) * (1 + 1e-12)
+    else:
+        assert np.linalg.norm(drifts, axis=1).max() <= bounds.drift_bound * (1 + 1e-12)
+        assert disturbance.max() <= bounds.disturbance_bound * (1 + 1e-12)
+        f_changes = np.linalg.norm(np.diff(drifts, axis=0), axis=1)
+        assert np.all(f_changes <= moves @ np.array(drift_rates) * (1 + 1e-9) + 1e-12)
+    assert replay(design, found, "python")
+
+
+def test_without_rates_the_search_is_unchanged():
+    """A class declared without Lipschitz bounds is searched as before: the jumping
+    adversary, and the same counterexample whatever rates it would have been given."""
+    case = "omnirobot-s1"
+    spec, design, samples = _tube(case)
+    bounds = _study_bounds(case, 0)
+    assert bounds.input_gain_lipschitz is None and bounds.drift_lipschitz is None
+    found = search_class(design, samples, bounds, held_runs=0)
+    assert found is not None and not found.lipschitz and found.strategy == "greedy max"
+    huge = dataclasses.replace(bounds, input_gain_lipschitz=(1e9,) * 3)
+    same = search_class(design, samples, huge, held_runs=0)
+    assert same.time == found.time and same.depth == pytest.approx(found.depth)
 
 
 @pytest.mark.parametrize("case,index,decoupled", [

@@ -15,7 +15,11 @@ plant against assumptions its own model breaks. The rules (docs/sampled-data.md,
 * ``input_gain_coupling`` not declared but ``input_gain`` or ``input_gain_skew``
   declared: the value those imply, ``(g_max - g_min)/2 + skew``, as before the models
   had bounds; a declared coupling above that implied value is lowered to it;
-* the model's block structure of ``g`` is kept only while no bound on ``g`` is declared.
+* the model's block structure of ``g`` is kept only while no bound on ``g`` is declared;
+* ``input_gain_lipschitz`` and ``drift_lipschitz`` (one value per state) not declared: the
+  model's own while no bound on ``g`` (respectively ``drift_bound``) is declared, else
+  none (the class's ``g`` or ``f`` may jump, as for a plant the model does not describe);
+  declared: one per state, never below the model's.
 """
 
 from __future__ import annotations
@@ -27,10 +31,12 @@ from typing import Mapping
 from ..errors import SpecError
 from .model_bounds import ModelBounds
 
-__all__ = ["Assumptions", "G_KEYS", "combine_assumptions"]
+__all__ = ["Assumptions", "G_KEYS", "LIPSCHITZ_KEYS", "combine_assumptions"]
 
 #: The keys that bound ``g`` (the others bound ``f`` and ``w``).
 G_KEYS = ("input_gain", "input_gain_skew", "input_gain_coupling")
+#: The keys that bound how fast ``g`` and ``f`` change with the state.
+LIPSCHITZ_KEYS = ("input_gain_lipschitz", "drift_lipschitz")
 #: Relative slack when comparing a declared bound with the model's (a value printed to
 #: many digits and typed back, or the model's outward rounding, is not a contradiction).
 CONTRADICTION_TOL = 1e-9
@@ -72,6 +78,12 @@ class Assumptions:
         :meth:`coupled_blocks`.
     notes : tuple of str
         Declared bounds wider than the model's, in words (reported by ``verify``).
+    input_gain_lipschitz : tuple of float or None
+        Per state ``j``, ``L_j`` with ``|g(x) - g(y)|_2 <= sum_j L_j |x_j - y_j|`` (units of
+        ``g`` per state unit); ``None``: not bounded, ``g`` may jump between any members.
+    drift_lipschitz : tuple of float or None
+        Per state, ``L_j`` with ``|f(x) - f(y)| <= sum_j L_j |x_j - y_j|`` (per second);
+        ``None``: ``f`` may jump.
     """
 
     input_gain: tuple[float, float] = (1.0, 1.0)
@@ -83,6 +95,8 @@ class Assumptions:
     model: str = ""
     blocks: tuple[tuple[int, ...], ...] = ()
     notes: tuple[str, ...] = ()
+    input_gain_lipschitz: tuple[float, ...] | None = None
+    drift_lipschitz: tuple[float, ...] | None = None
 
     def coupled_blocks(self, n: int) -> tuple[tuple[int, ...], ...]:
         """The blocks of ``g`` for ``n`` states: :attr:`blocks` when known; else one block
@@ -200,8 +214,35 @@ def combine_assumptions(bounds: ModelBounds, declared: Mapping[str, object], n: 
         blocks = bounds.blocks
     disturbance = (float(declared["disturbance_bound"])  # type: ignore[arg-type]
                    if "disturbance_bound" in declared else math.sqrt(n) * amplitude)
+    lipschitz = {
+        "input_gain_lipschitz": (bounds.input_gain_lipschitz, g_declared),
+        "drift_lipschitz": (bounds.drift_lipschitz, "drift_bound" in declared)}
+    rates = {key: _lipschitz(key, model_value, replaced, declared, n, bounds, prefix, notes)
+             for key, (model_value, replaced) in lipschitz.items()}
     order = ("input_gain", "input_gain_skew", "input_gain_coupling", "drift_bound",
-             "disturbance_bound")
+             "disturbance_bound", *LIPSCHITZ_KEYS)
     return Assumptions((g_min, g_max), skew, coupling, values["drift_bound"], disturbance,
                        tuple(k for k in order if k in declared), bounds.model, blocks,
-                       tuple(notes))
+                       tuple(notes), rates["input_gain_lipschitz"], rates["drift_lipschitz"])
+
+
+def _lipschitz(key: str, model_value: tuple[float, ...] | None, replaced: bool,
+               declared: Mapping[str, object], n: int, bounds: ModelBounds, prefix: str,
+               notes: list) -> tuple[float, ...] | None:
+    """A Lipschitz bound of :data:`LIPSCHITZ_KEYS`: declared (one per state, never below
+    the model's), else the model's unless the bound it qualifies was declared."""
+    if key not in declared:
+        return None if replaced else model_value
+    field = f"{prefix}.{key}"
+    value = tuple(float(v) for v in declared[key])  # type: ignore[union-attr]
+    if len(value) != n:
+        raise SpecError(field, f"has {len(value)} entries; one per state ({n}) is needed")
+    if model_value is not None:
+        for j, (v, m) in enumerate(zip(value, model_value)):
+            if _tighter(v, m, upper=True):
+                raise _contradiction(f"{field}[{j}]", v, m, bounds, key, declared_above=False)
+        if value != model_value:
+            notes.append(f"{key} {list(value)} is above the {bounds.model} model's "
+                         f"{list(model_value)}")
+        value = tuple(max(v, m) for v, m in zip(value, model_value))
+    return value

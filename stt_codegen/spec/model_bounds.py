@@ -13,7 +13,11 @@ for ``verify``'s sampled check:
   of ``g``;
 * ``drift_bound``: the largest ``|f(x)|``;
 * ``blocks``: a partition of the state indices in which ``g(x)`` is block diagonal for
-  every ``x`` (an input of one block never moves a state of another).
+  every ``x`` (an input of one block never moves a state of another);
+* ``input_gain_lipschitz``, ``drift_lipschitz``: per state, how fast ``g`` and ``f`` may
+  change with that state: ``|g(x) - g(y)|_2 <= sum_j L_j |x_j - y_j|`` (spectral norm)
+  and ``|f(x) - f(y)| <= sum_j L_j |x_j - y_j|`` (Euclidean norm), units of ``g`` or
+  ``f`` per state unit.
 
 Every number is an outer bound: computed exactly where the model allows (the heading
 range of eq. (14), the vertices of the box for a linear drift), then widened by a few
@@ -63,6 +67,11 @@ class ModelBounds:
         For each key above, where the model attains it, in words (for messages).
     remedy : str
         What a spec whose ``[assumptions]`` contradict the model can change, in words.
+    input_gain_lipschitz : tuple of float or None
+        ``L_j`` per state with ``|g(x) - g(y)|_2 <= sum_j L_j |x_j - y_j|``; ``None``: not
+        known (``g`` may jump).
+    drift_lipschitz : tuple of float or None
+        Likewise for ``|f(x) - f(y)|``.
     """
 
     model: str
@@ -73,6 +82,8 @@ class ModelBounds:
     blocks: tuple[tuple[int, ...], ...]
     where: tuple[tuple[str, str], ...] = ()
     remedy: str = ""
+    input_gain_lipschitz: tuple[float, ...] | None = None
+    drift_lipschitz: tuple[float, ...] | None = None
 
     def words(self, key: str) -> str:
         """Where the model attains ``key`` ("" if not recorded)."""
@@ -123,8 +134,12 @@ def _omnidirectional(lower: Sequence[float], upper: Sequence[float]) -> ModelBou
         (("input_gain", f"eigenvalues cos x3 and 1 of (g + g^T)/2 for {heading}"),
          ("input_gain_skew", f"|sin x3| for {heading}"),
          ("input_gain_coupling", f"|sin x3| in rows 1 and 2 for {heading}"),
-         ("drift_bound", "f = 0")),
-        "narrow state_space's heading range (x3)")
+         ("drift_bound", "f = 0"), ("input_gain_lipschitz",
+                                    "|R(a) - R(b)|_2 = 2 |sin((a - b)/2)| <= |a - b|"),
+         ("drift_lipschitz", "f = 0")),
+        "narrow state_space's heading range (x3)",
+        # g = R(x3) depends on the heading only; f = 0
+        (0.0, 0.0, 1.0), (0.0, 0.0, 0.0))
 
 
 def _jacobi_eigenvalues(m: list[list[float]]) -> list[float]:
@@ -258,8 +273,12 @@ def _linear(lower: Sequence[float], upper: Sequence[float], linear) -> ModelBoun
         (("input_gain", "eigenvalues of (g + g^T)/2 for the constant plant.g"),
          ("input_gain_skew", "|(g - g^T)/2| for plant.g"),
          ("input_gain_coupling", "the largest off-diagonal row of plant.g"),
-         ("drift_bound", "max |a x + c| over the box")),
-        "correct plant.a, plant.g or plant.c")
+         ("drift_bound", "max |a x + c| over the box"),
+         ("input_gain_lipschitz", "plant.g is constant"),
+         ("drift_lipschitz", "the Euclidean norms of plant.a's columns")),
+        "correct plant.a, plant.g or plant.c",
+        (0.0,) * n,
+        tuple(_up(math.sqrt(sum(a[i][j] ** 2 for i in range(n)))) for j in range(n)))
 
 
 def model_bounds(model: str, lower: Sequence[float], upper: Sequence[float],
@@ -317,8 +336,16 @@ def declared_bounds(model: str, declared: dict, n: int) -> ModelBounds:
                        float(declared["drift_bound"]), (tuple(range(n)),),
                        tuple((key, "declared") for key in ("input_gain", "input_gain_skew",
                                                            "input_gain_coupling",
-                                                           "drift_bound")),
-                       "declare the bounds your plant meets in [assumptions]")
+                                                           "drift_bound",
+                                                           "input_gain_lipschitz",
+                                                           "drift_lipschitz")),
+                       "declare the bounds your plant meets in [assumptions]",
+                       _declared_vector(declared, "input_gain_lipschitz"),
+                       _declared_vector(declared, "drift_lipschitz"))
+
+
+def _declared_vector(declared: dict, key: str) -> tuple[float, ...] | None:
+    return tuple(float(v) for v in declared[key]) if key in declared else None
 
 
 def _single_integrator(lower: Sequence[float], upper: Sequence[float],
@@ -327,8 +354,10 @@ def _single_integrator(lower: Sequence[float], upper: Sequence[float],
     return ModelBounds("single-integrator", (1.0, 1.0), 0.0, 0.0, 0.0,
                        tuple((i,) for i in range(n)),
                        (("input_gain", "g = I"), ("input_gain_skew", "g = I"),
-                        ("input_gain_coupling", "g = I"), ("drift_bound", "f = 0")),
-                       'describe your plant with [plant] model = "linear" and its g')
+                        ("input_gain_coupling", "g = I"), ("drift_bound", "f = 0"),
+                        ("input_gain_lipschitz", "g = I"), ("drift_lipschitz", "f = 0")),
+                       'describe your plant with [plant] model = "linear" and its g',
+                       (0.0,) * n, (0.0,) * n)
 
 
 #: The bounds over a box of each first-order model, ``(lower, upper, linear) -> bounds``:

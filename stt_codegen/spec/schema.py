@@ -240,6 +240,15 @@ class AssumptionsTable(_Table):
                                                       "velocity units per second")
     disturbance_bound: NonNegative = _omitted("bound on |w(t)|, state units per second; "
                                               "default sqrt(n) x plant.disturbance_amplitude")
+    input_gain_lipschitz: Annotated[list[NonNegative],
+                                    Field(min_length=1, max_length=MAX_DIMENSION)] = _omitted(
+        "one per state: L_j with |g(x) - g(y)|_2 <= sum_j L_j |x_j - y_j| (how fast g may "
+        "change with each state); default the plant model's own (the omnidirectional robot "
+        "[0, 0, 1]) while no bound on g is declared, else none: g may jump")
+    drift_lipschitz: Annotated[list[NonNegative],
+                               Field(min_length=1, max_length=MAX_DIMENSION)] = _omitted(
+        "one per state: L_j with |f(x) - f(y)| <= sum_j L_j |x_j - y_j|, per second; default "
+        "the plant model's own while drift_bound is not declared, else none: f may jump")
 
 
 class ActuatorTable(_Table):

@@ -21,6 +21,17 @@ The search is an adversary on the sampled loop, exact in its arithmetic:
   (13)'s Lyapunov function, both signs);
 * with ``u_k`` held, the step is exact: ``x_{k+1} = x_k + dt (G_m u_k + d_k)``.
 
+When the class bounds how fast ``g`` and ``f`` change with the state
+(``input_gain_lipschitz``, ``drift_lipschitz``: :class:`Assumptions`), the search is of
+that class (the Lipschitz mode): the adversary no longer jumps between members; on each
+interval ``g`` moves from its value on the previous interval towards the member it
+chooses by at most ``sum_j L_j |x_{k,j} - x_{k-1,j}|`` (in the Frobenius norm, which
+bounds the spectral norm the bound is stated in), and ``f`` towards
+``drift_bound`` times the direction it chooses by at most its own such budget, while ``w``
+(of norm ``disturbance_bound``) stays free in time. A step between two members of the
+class is a convex combination of them, so it stays in the class (its bounds are convex
+sets). Without a Lipschitz bound, ``g`` (or ``f``) moves freely, as before.
+
 Three strategies choose ``(G_m, d_k)`` at each sample: greedily the largest next
 ``max_i |e_i|``, greedily the largest next ``sum_i atanh(e_i)^2``, and, for each of the
 first :data:`HELD_RUNS` members held for the whole run, the direction of the largest next
@@ -30,8 +41,12 @@ class as long as it does not pass one point twice with two different choices: th
 ``g(x)`` and ``f(x)`` are defined on the path and extended off it within the bounds (which
 are convex sets), and ``w`` is defined along time. A polyline in 3-D generically never
 meets itself, and the exits go beyond the edge by a margin (:attr:`Counterexample.depth`),
-so smoothing the switches between samples keeps them. The search is not exhaustive:
-finding none proves nothing.
+so smoothing the switches between samples keeps them. In the Lipschitz mode the path is that of a plant whose ``g`` and ``f``
+are held on each interval and change between consecutive samples by at most the declared
+rate times the state's move: the rates hold between consecutive samples of the path (not
+between any two of its points, and ``g`` is not varied within an interval), the sense in
+which a counterexample is "a member of the class the spec declares". The search is not
+exhaustive: finding none proves nothing.
 
 ``verify`` runs the greedy strategies when its sampled check fails on bounds that hold on
 every interval alike, and reports a member it finds, confirmed on the numpy reference of
@@ -84,6 +99,13 @@ class Counterexample:
         ``g`` on each sampling interval up to the exit (a member of the class).
     pushes : ndarray, shape (K, n)
         ``f + w`` on each interval, state units per second.
+    drifts : ndarray, shape (K, n)
+        The ``f`` part of ``pushes`` (``pushes - drifts`` is ``w``), state units per second.
+    gain_rates : bool
+        ``g`` moved only within the class's ``input_gain_lipschitz`` (else it jumped).
+    drift_rates : bool
+        ``f`` moved only within the class's ``drift_lipschitz``, ``w`` apart within
+        ``disturbance_bound`` (else ``f + w`` jumped within their sum).
     """
 
     strategy: str
@@ -93,11 +115,19 @@ class Counterexample:
     max_abs_e: float
     gains: np.ndarray = field(compare=False, repr=False, default=None)
     pushes: np.ndarray = field(compare=False, repr=False, default=None)
+    drifts: np.ndarray = field(compare=False, repr=False, default=None)
+    gain_rates: bool = False
+    drift_rates: bool = False
 
     def to_json(self) -> dict:
         """The figures, without the path (JSON-ready)."""
         return {"strategy": self.strategy, "time": self.time, "dimension": self.dimension,
                 "depth": self.depth, "max_abs_e": self.max_abs_e}
+
+    @property
+    def lipschitz(self) -> bool:
+        """Whether the search respected a Lipschitz bound of the class (``g``'s or ``f``'s)."""
+        return self.gain_rates or self.drift_rates
 
 
 def unit_skew(axis: np.ndarray) -> np.ndarray:
@@ -228,22 +258,50 @@ def _directions(e: np.ndarray, z: np.ndarray) -> np.ndarray:
     return np.concatenate(rows)
 
 
+def _towards(current: np.ndarray, targets: np.ndarray, budget: float) -> np.ndarray:
+    """``current`` moved towards each of ``targets`` by at most ``budget`` (Euclidean norm;
+    for matrices the Frobenius norm, which bounds the spectral norm the Lipschitz bounds
+    are stated in); all of ``targets`` when ``budget`` is infinite."""
+    if not np.isfinite(budget):
+        return targets
+    step = targets - current
+    size = np.sqrt(np.sum(step.reshape(len(step), -1) ** 2, axis=1))
+    shape = (-1,) + (1,) * (step.ndim - 1)
+    scale = np.minimum(1.0, budget / np.maximum(size, 1e-300))
+    return current + scale.reshape(shape) * step
+
+
+def _budget(rates: tuple[float, ...] | None, move: np.ndarray | None) -> float:
+    """How far ``g`` or ``f`` may change after the state moved by ``move``: ``sum_j L_j
+    |move_j|``; infinite without rates (the class's member may jump) or before the first
+    interval."""
+    if rates is None or move is None:
+        return np.inf
+    return float(np.dot(rates, np.abs(move)))
+
+
 def _run(design: TubeDesign, samples: TubeSamples, members: list[np.ndarray],
-         push: float, score: str, strategy: str) -> Counterexample | None:
+         bounds: Assumptions, score: str, strategy: str) -> Counterexample | None:
     lower, upper = samples.gamma_lower, samples.gamma_upper
     centre, half = 0.5 * (upper + lower), 0.5 * (upper - lower)
     dt = 1.0 / design.rate_hz
     gain = design.gain
     x = np.array(design.initial_state, dtype=float)
     g_all = np.stack(members)                                   # (M, n, n)
+    n = len(x)
+    separate = bounds.drift_lipschitz is not None     # f bounded apart from w
+    drift = bounds.drift_bound if separate else bounds.drift_bound + bounds.disturbance_bound
+    free = bounds.disturbance_bound if separate else 0.0
+    g_now, f_now, move = None, np.zeros(n), None
     top = 0.0
-    gains, pushes = [], []
+    gains, pushes, drifts = [], [], []
 
     def found(k: int, e: np.ndarray) -> Counterexample:
         i = int(np.argmax(np.abs(e)))
         return Counterexample(strategy, float(samples.t[k]), i, float(abs(e[i])), top,
-                              np.array(gains).reshape(k, *g_all.shape[1:]),
-                              np.array(pushes).reshape(k, len(x)))
+                              np.array(gains).reshape(k, n, n),
+                              np.array(pushes).reshape(k, n), np.array(drifts).reshape(k, n),
+                              bounds.input_gain_lipschitz is not None, separate)
 
     for k in range(len(samples.t) - 1):
         e = (x - centre[k]) / half[k]
@@ -252,8 +310,13 @@ def _run(design: TubeDesign, samples: TubeSamples, members: list[np.ndarray],
             return found(k, e)
         top = max(top, worst)
         u = reference.law(gain, x[None, :], lower[k][None, :], upper[k][None, :])[0][0]
-        moves = g_all @ u                                        # (M, n)
-        dirs = push * _directions(e, -u)                         # (D, n)
+        g_next = (g_all if g_now is None else
+                  _towards(g_now, g_all, _budget(bounds.input_gain_lipschitz, move)))
+        units = _directions(e, -u)                               # (D, n)
+        f_next = (drift * units if move is None else
+                  _towards(f_now, drift * units, _budget(bounds.drift_lipschitz, move)))
+        dirs = f_next + free * units                             # f + w, (D, n)
+        moves = g_next @ u                                       # (M, n)
         nxt = x + dt * (moves[:, None, :] + dirs[None, :, :])    # (M, D, n)
         e_next = (nxt - centre[k + 1]) / half[k + 1]
         if score == "max":
@@ -262,9 +325,12 @@ def _run(design: TubeDesign, samples: TubeSamples, members: list[np.ndarray],
             value = np.sum(np.arctanh(np.clip(np.abs(e_next), 0.0, 1.0 - 1e-15)) ** 2,
                            axis=-1)
         m, d = np.unravel_index(int(np.argmax(value)), value.shape)
+        move = nxt[m, d] - x
         x = nxt[m, d]
-        gains.append(g_all[m])
+        g_now, f_now = g_next[m], f_next[d]
+        gains.append(g_now)
         pushes.append(dirs[d])
+        drifts.append(f_now)
     e = (x - centre[-1]) / half[-1]
     return found(len(samples.t) - 1, e) if float(np.max(np.abs(e))) >= 1.0 else None
 
@@ -280,7 +346,9 @@ def search_class(design: TubeDesign, samples: TubeSamples, bounds: Assumptions,
     samples : TubeSamples
         The deployed tube at every sample (:func:`~stt_codegen.design.samples.sample_tube`).
     bounds : Assumptions
-        The class (its ``g`` bounds, ``drift_bound + disturbance_bound``).
+        The class (its ``g`` bounds, ``drift_bound + disturbance_bound``, and its
+        ``input_gain_lipschitz`` and ``drift_lipschitz`` when known: then the search is of
+        the Lipschitz-respecting members, see the module's text).
     seed : int
         Seeds :func:`class_matrices`.
     held_runs : int
@@ -294,15 +362,17 @@ def search_class(design: TubeDesign, samples: TubeSamples, bounds: Assumptions,
         ``None`` when none is found (which proves nothing).
     """
     members = class_matrices(bounds, design.dimension, seed)
-    push = bounds.drift_bound + bounds.disturbance_bound
     if not members:
         return None
+    rated = [name for name, rates in (("g", bounds.input_gain_lipschitz),
+                                      ("f", bounds.drift_lipschitz)) if rates is not None]
+    mode = f", {' and '.join(rated)} Lipschitz" if rated else ""
     for score in ("max", "lyapunov"):
-        found = _run(design, samples, members, push, score, f"greedy {score}")
+        found = _run(design, samples, members, bounds, score, f"greedy {score}{mode}")
         if found is not None:
             return found
     for j, g in enumerate(members[:held_runs]):
-        found = _run(design, samples, [g], push, "max", f"member {j} held")
+        found = _run(design, samples, [g], bounds, "max", f"member {j} held{mode}")
         if found is not None:
             return found
     return None

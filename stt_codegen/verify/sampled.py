@@ -494,9 +494,13 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
                   f"k = {design.gain:.6g} ({label}); {need}")
         found = _member_that_leaves(design, spec, result)
         if found is not None:
+            how = ("g moving between samples by at most its Lipschitz bound times the "
+                   "state's move, towards extreme members of the class" if found.gain_rates
+                   else "g on each interval an extreme member of the class")
+            how += ("; f likewise within its Lipschitz bound and |f| at its bound, |w| at "
+                    "its bound" if found.drift_rates else ", |f + w| at its bound")
             detail += (f"; and the failure is not the check's caution: a plant of the class "
-                       f"leaves the tube (g on each interval an extreme member of the class, "
-                       f"|f + w| at its bound): |e_{found.dimension}| = {found.depth:.3g} "
+                       f"leaves the tube ({how}): |e_{found.dimension}| = {found.depth:.3g} "
                        f"at t = {found.time:.4f} s ({found.strategy}; verify/class_search.py)")
     if a.notes:
         detail += "; " + "; ".join(a.notes) + " (the declared bounds are used; they cover the model)"
@@ -511,7 +515,8 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
 def _member_that_leaves(design: TubeDesign, spec: Spec, result: SampledCheck):
     """A member of the spec's plant class that leaves the tube under the sampled law
     (:func:`~stt_codegen.verify.class_search.search_class`, greedy strategies only),
-    confirmed on the numpy reference of the deployed controller; ``None`` when the check
+    confirmed on the numpy reference of the deployed controller (a member that respects
+    the class's Lipschitz bounds when the spec has them); ``None`` when the check
     passed, when the class's bounds are evaluated on the tube per interval (the search's
     members obey the bounds over the whole state space, which may be wider), or when none
     is found."""
