@@ -11,25 +11,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from test_assumptions import BASE as PLANE  # a 4 x 4 m single-integrator arena
 
 from stt_codegen.errors import SpecError
 from stt_codegen.spec.loader import load_spec, parse_spec
 
 CASES = Path(__file__).resolve().parents[1] / "stt_codegen" / "cases"
 ROBOT = (CASES / "omnirobot-s1.toml").read_text()
-PLANE = """
-name = "lipschitz-test"
-prescribed_time = 5.0
-[state_space]
-lower = [0.0, 0.0]
-upper = [4.0, 4.0]
-[initial]
-lower = [0.0, 0.0]
-upper = [1.0, 1.0]
-[target]
-lower = [3.0, 3.0]
-upper = [4.0, 4.0]
-"""
 
 
 def robot_with(assumptions: str):
