@@ -418,11 +418,11 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...],
     for k, box, (arrive, until) in zip(order, boxes, holds):
         if arrive == leave:        # a stay held where the tube already is
             segments.append(ReachSegment(leave, until, *start, *start, SMOOTHSTEP))
-            leave = until
-            continue
-        segments += _leg(_around(spec, pending), base, start, box, leave, arrive)
-        segments.append(ReachSegment(arrive, until, *box, *box, SMOOTHSTEP))
-        start, leave = box, until
+        else:
+            segments += _leg(_around(spec, pending), base, start, box, leave, arrive)
+            segments.append(ReachSegment(arrive, until, *box, *box, SMOOTHSTEP))
+            start = box
+        leave = until
         pending = [i for i in pending if spec.moving_obstacles[i].until != k]
     goal = (tuple(base.target_lower), tuple(base.target_upper))
     if not base.prescribed_time > leave:
