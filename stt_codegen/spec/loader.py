@@ -785,12 +785,7 @@ def _second_order(doc: Any, n: int) -> SecondOrder | None:
                                             f"(plant.model is {model!r})")
         return None
     table = doc.assumptions
-    if plant_entry(model).declared_bounds:     # no equations: the class is what is declared
-        for key in SECOND_ORDER_ASSUMPTIONS:
-            if key not in table.model_fields_set:
-                raise SpecError(f"assumptions.{key}", f"required for plant.model = {model!r}: "
-                                "the toolkit has no equations of this plant, so the design "
-                                "and verify use the declared bounds (and cannot check them)")
+    _require_declared(model, table.model_fields_set)
     for key in AssumptionsTable.model_fields:
         if key in table.model_fields_set and key not in SECOND_ORDER_ASSUMPTIONS:
             raise SpecError(f"assumptions.{key}",
@@ -808,16 +803,25 @@ def _assumptions(table: AssumptionsTable, n: int, amplitude: float, model: str,
     (:func:`~.assumptions.combine_assumptions`)."""
     declared = {key: getattr(table, key) for key in AssumptionsTable.model_fields
                 if key in table.model_fields_set}
-    if plant_entry(model).declared_bounds:     # no equations: the declared bounds as they are
-        for key in ("input_gain", "drift_bound"):
-            if key not in declared:
-                raise SpecError(f"assumptions.{key}", f"required for plant.model = {model!r}: "
-                                "the toolkit has no equations of this plant, so the design "
-                                "and verify use the declared bounds (and cannot check them)")
+    if _require_declared(model, declared):     # no equations: the declared bounds as they are
         bounds = declared_bounds(model, declared, n)
     else:
         bounds = model_bounds(model, state_space.lower, state_space.upper, linear)
     return combine_assumptions(bounds, declared, n, amplitude)
+
+
+def _require_declared(model: str, declared) -> bool:
+    """Whether ``model`` has no equations (``declared_bounds``); then ``input_gain`` and
+    ``drift_bound`` must be among the ``declared`` ``[assumptions]`` keys (``SpecError``
+    naming the missing one)."""
+    if not plant_entry(model).declared_bounds:
+        return False
+    for key in ("input_gain", "drift_bound"):
+        if key not in declared:
+            raise SpecError(f"assumptions.{key}", f"required for plant.model = {model!r}: "
+                            "the toolkit has no equations of this plant, so the design and "
+                            "verify use the declared bounds (and cannot check them)")
+    return True
 
 
 def _input_bound(table: ActuatorTable | None, model: str, n: int) -> tuple[float, ...] | None:
