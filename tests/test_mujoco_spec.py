@@ -190,6 +190,15 @@ def test_a_force_driven_mjcf_runs_the_cascade_on_mujoco():
     assert err.value.field == "plant.model"
 
 
+def test_an_input_bound_of_a_mujoco_plant_is_per_actuator():
+    doc = _doc()
+    doc["actuator"] = {"input_bound": [1.0]}
+    with pytest.raises(SpecError) as err:
+        stt.Spec.from_dict(doc)
+    assert err.value.field == "actuator.input_bound"
+    assert "vel_x, vel_y" in err.value.reason and "got 1" in err.value.reason
+
+
 def test_a_force_driven_mjcf_needs_its_declared_class():
     doc = tomllib.loads((Path(__file__).parent / "specs" / "umaze-mujoco-force.toml")
                         .read_text())

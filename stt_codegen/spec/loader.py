@@ -683,7 +683,8 @@ def _validate(raw: dict) -> Spec:
                 assumptions=_assumptions(doc.assumptions if second_order is None
                                          else AssumptionsTable(), n, amplitude, model,
                                          state_space, linear),
-                input_bound=_input_bound(doc.actuator, doc.plant.model, n),
+                input_bound=_input_bound(doc.actuator, doc.plant.model, n,
+                                         doc.plant.actuators),
                 second_order=second_order,
                 target_half_width_given=doc.target.half_width is not None,
                 tasks=build_tasks(doc.tasks or (), n, doc.prescribed_time,
@@ -824,14 +825,16 @@ def _require_declared(model: str, declared) -> bool:
     return True
 
 
-def _input_bound(table: ActuatorTable | None, model: str, n: int) -> tuple[float, ...] | None:
+def _input_bound(table: ActuatorTable | None, model: str, n: int,
+                 actuators: list[str] | None = None) -> tuple[float, ...] | None:
     """``[actuator] input_bound``: one positive number per input of ``plant.model`` (for a
-    second-order model its physical inputs, forces or torques, in the model's unit)."""
+    second-order model its physical inputs, forces or torques, in the model's unit; for a
+    MuJoCo plant its ``actuators``, named so in the message)."""
     if table is None:
         return None
     plant = plant_entry(model)
     count = plant.input_count(n)
-    names = plant.input_names(n)
+    names = actuators if actuators is not None else plant.input_names(n)
     unit = f" in {plant.input_unit}" if plant.input_unit else ""
     if len(table.input_bound) != count:
         raise SpecError("actuator.input_bound",
