@@ -330,8 +330,10 @@ def declared_bounds(model: str, declared: dict, n: int) -> ModelBounds:
     ModelBounds
     """
     g_min, g_max = (float(v) for v in declared["input_gain"])
+    # a key not declared is not compared; combine_assumptions derives the coupling that
+    # the declared input_gain and skew imply
     skew = float(declared.get("input_gain_skew", 0.0))
-    coupling = float(declared.get("input_gain_coupling", 0.5 * (g_max - g_min) + skew))
+    coupling = float(declared.get("input_gain_coupling", 0.0))
     return ModelBounds(model, (g_min, g_max), skew, coupling,
                        float(declared["drift_bound"]), (tuple(range(n)),),
                        tuple((key, "declared") for key in ("input_gain", "input_gain_skew",

@@ -21,13 +21,17 @@ from .check import Check
 __all__ = ["plant_within_assumptions"]
 
 
+def _not_checked(prefix: str, model: str, verdict: str) -> Check:
+    """The membership check of a plant without equations: passed, saying it is not checked."""
+    return Check(f"{prefix}.plant_within_assumptions", True,
+                 f"not checked: the {model} plant has no equations here, so {verdict} holds "
+                 "for it only if it meets the declared [assumptions]", {"declared_only": True})
+
+
 def _first_order(spec: Spec, model: str | None) -> Check:
     model = model or spec.plant_model
     if plant_entry(model).declared_bounds:      # no equations: nothing to compare
-        return Check("sampled.plant_within_assumptions", True,
-                     f"not checked: the {model} plant has no equations here, so the sampled "
-                     "verdict holds for it only if it meets the declared [assumptions]",
-                     {"declared_only": True})
+        return _not_checked("sampled", model, "the sampled verdict")
     # only a model that takes [plant] matrices is evaluated with the spec's
     linear = spec.linear_plant if model in MODEL_KEYS.values() else None
     b = model_bounds(model, spec.state_space.lower, spec.state_space.upper, linear)
@@ -55,10 +59,7 @@ def _first_order(spec: Spec, model: str | None) -> Check:
 
 def _second_order(spec: Spec, model: str | None) -> Check:
     if plant_entry(spec.second_order.model).declared_bounds:     # no equations to compare
-        return Check("cascade.plant_within_assumptions", True,
-                     f"not checked: the {spec.second_order.model} plant has no equations "
-                     "here, so the cascade's certificate holds for it only if it meets the "
-                     "declared [assumptions]", {"declared_only": True})
+        return _not_checked("cascade", spec.second_order.model, "the cascade's certificate")
     ok, words, data = model_within_class(spec)
     return Check("cascade.plant_within_assumptions", ok, words, data)
 
