@@ -320,6 +320,11 @@ def import_pointmaze(name: str, path: str | os.PathLike | None = None, *,
                                 "relative to itself)")
     on_mujoco = plant_entry(model).declared_bounds     # model = "mujoco": the MJCF is the plant
     if on_mujoco:
+        if plant_entry(model).order != 1:
+            raise SpecError("model", f"{model!r} is not written by the importer: it drives the "
+                                     "ball through velocity servos (model = \"mujoco\"); for "
+                                     "PointMaze's force motors write the second-order spec "
+                                     "by hand (docs/mujoco.md)")
         if mjcf is None:
             raise SpecError("mjcf", f"plant.model = {model!r} simulates the maze's MuJoCo "
                                     "model: give the file to write it to (--mjcf)")

@@ -148,6 +148,18 @@ def test_no_equations_are_made_up_for_it(design):
     assert err.value.field == "plant.model" and "runs on the host" in err.value.reason
 
 
+def test_the_importer_refuses_a_force_driven_mujoco_plant(tmp_path):
+    """The importer writes the ball on velocity servos only: a second-order MuJoCo model is
+    refused by name, and nothing is written."""
+    pytest.importorskip("gymnasium_robotics", reason="gymnasium-robotics is not installed: "
+                                                     "pip install \".[mujoco]\"")
+    out = _cli("import", "pointmaze", "UMaze", "-o", "maze.toml", "--mjcf", "maze.xml",
+               "--model", "mujoco-force", cwd=tmp_path)
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert "'mujoco-force' is not written by the importer" in out.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("maze", ["UMaze", "Medium"])
 def test_imported_pointmazes_run_on_mujoco(tmp_path, maze):
