@@ -115,3 +115,35 @@ def test_generated_c_runs_two_iterations_before_its_fixed_point_test():
     body = body[:body.index("\n}\n")]
     assert body.count("body_newton_iteration(") == 3
     assert body.index("body_newton_iteration(") < body.index("while (k < ")
+
+
+def test_the_single_precision_stop_bounds_the_remaining_error():
+    """After the first Newton iteration from the start (``a0`` or the root start), the
+    root lies above the iterate by at most ``6 A d^2 / (c z^4)`` (``d`` the step, ``z =
+    psi + a0``): the bound on which single precision's implicit step stops
+    (``tolerance.NEWTON_STOP_SINGLE``). On the adversarial batch of the tests above, in
+    double; where the bound is below one unit roundoff of the iterate (where the float
+    code stops), so is the error."""
+    from stt_codegen.codegen.tolerance import NEWTON_STOP_SINGLE
+    from stt_codegen.tube.pieces import newton_pieces
+
+    rng = np.random.default_rng(1)
+    count = 100_000
+    psi = rng.uniform(-3, 5, count)
+    alpha = rng.choice([0.0, 1.0], count) * rng.exponential(1.0, count)
+    theta = 0.01 * (1 - np.tanh(psi - 1.0))
+    dt = rng.choice([1e-5, 1e-4, 1e-3, 1e-2, 0.1, 1.0], count)
+    kappa = 5.0
+    start, root_start, iteration = (f.map(count) for f in newton_pieces())
+    a0, c, big_a, needs_root = (np.array(v).ravel() for v in start(alpha, psi, theta, dt, kappa))
+    rooted = np.array(root_start(alpha, psi, c, big_a)).ravel()
+    a0 = np.where(needs_root != 0.0, rooted, a0)
+    a1 = np.array(iteration(a0, alpha, psi, c, big_a)).ravel()
+    root = R.implicit_alpha_root(alpha, psi, theta, dt, kappa)
+    bound = 6.0 * big_a * (a1 - a0) ** 2 / (c * (psi + a0) ** 4)
+    slack = 4.0 * np.finfo(float).eps * np.maximum(np.abs(root), np.abs(a1))
+    assert np.all(a1 <= root + slack)                      # left of the root
+    assert np.all(root - a1 <= bound * (1.0 + 1e-9) + slack)
+    stops = bound <= NEWTON_STOP_SINGLE * a1
+    assert 0.2 < np.mean(stops) < 1.0                      # neither vacuous nor always
+    assert np.all((root - a1)[stops] <= NEWTON_STOP_SINGLE * a1[stops] + slack[stops])

@@ -168,6 +168,7 @@ def c_source_context(design: TubeDesign, prefix: str, precision: str,
     limits = input_limits(design)
     bodies = CPrinter(precision, real=f"{prefix}_real", prefix="body_")
     return dict(P=prefix, U=prefix.upper(), n=design.dimension, newton=NEWTON_ITERATIONS,
+                newton_stop=c_real(tolerance.NEWTON_STOP_SINGLE, True) if single else None,
                 real="float" if single else "double", precision=precision,
                 bodies=bodies.doprint(functions).rstrip("\n"),
                 spec_tables=design_table_rows(design, lambda v: c_real(v, single), single),

@@ -42,6 +42,8 @@ class Tables:
         2n entries ``[X; X-bar]`` and ``[+1; -1]``.
     members : list of int
         Number of circumvents on each of the 2n bounds.
+    multi : list of int
+        The bounds with several circumvents (``members > 1``), increasing.
     segments : list of dict
         ``start``, ``end``, ``profile`` (index into :data:`PROFILE_NAMES`), ``from``,
         ``to`` (2n lists of str).
@@ -59,6 +61,7 @@ class Tables:
     bounds: list
     signs: list
     members: list
+    multi: list
     segments: list
     windows: list
     max_open: int
@@ -119,8 +122,8 @@ def design_table_rows(design: TubeDesign, literal: Callable[[float], str],
                         "sharpness": literal(c.sharpness), "height": literal(c.height),
                         "max_end": literal(running), "bound": bound, "obstacle": c.obstacle})
     intervals = [(_rounded(c.start, single), _rounded(c.end, single)) for _, c in tables.windows]
+    members = [len(tables.members(b)) for b in range(len(tables.bounds))]
     return Tables(parameters, [literal(v) for v in tables.bounds],
-                  [literal(v) for v in tables.signs],
-                  [len(tables.members(b)) for b in range(len(tables.bounds))],
-                  segments, windows, max_open(intervals),
+                  [literal(v) for v in tables.signs], members,
+                  [b for b, count in enumerate(members) if count > 1], segments, windows, max_open(intervals),
                   [p for p in PROFILE_NAMES if any(s.profile == p for s in tables.segments)])

@@ -4,7 +4,9 @@ Used for the tolerances of the test vectors (JSON and the C self-test) and by th
 single-precision equivalence tests. ``unit`` is the unit roundoff: ``2**-53`` (double),
 ``2**-24`` (single). Inputs are taken as exact (the vectors' inputs are float32 numbers,
 exact in both precisions); the bound covers the rounding of the generated code and of a
-libm whose functions are within a few ulp of correctly rounded.
+libm whose functions are within a few ulp of correctly rounded (a ``log`` within
+:data:`LOG_ERROR_ULP`; single precision's own ``stt_expf`` and ``stt_logf``,
+:mod:`stt_codegen.codegen.emit.c_maths`, are within 0.89 and 0.84 ulp).
 
 * **Tube bounds.** Every ``gamma`` is a short chain (``tanh`` progress, the linear
   reach tube, the circumvent bump, the overflow-safe smooth max/min, ``alpha``) of about
@@ -23,7 +25,9 @@ libm whose functions are within a few ulp of correctly rounded.
   rounding (``log``, quotients) times ``(4k/w)(|g| + 1/(1-e^2))``.
   Where ``|e| + de >= 1`` the computed state may be outside the tube: the status is not
   determined by the precision and the bound covers the clamped value.
-* **alpha_next.** The Newton iteration converges to a few ulp of the root; the root's
+* **alpha_next.** The Newton iteration converges to a few ulp of the root (single
+  precision may stop after the first iteration, when its proven error bound is below
+  ``unit |alpha_next|``: :data:`NEWTON_STOP_SINGLE`); the root's
   sensitivity to ``psi`` is at most 1 and to ``theta``'s relative error at most
   ``|alpha_next| + |alpha|``. Bound: ``GAMMA_FACTOR * unit * (S + |alpha| + |alpha_next|)``.
 * **The cascade** (second-order plants, :func:`cascade_bounds`): ``r`` is law (13) with
@@ -41,8 +45,9 @@ import numpy as np
 from ..tube import reference
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 
-__all__ = ["GAMMA_FACTOR", "UNIT_SINGLE", "alpha_bound", "cascade_bounds", "gamma_bound",
-           "status_certain", "u_bound", "unit_roundoff", "with_double_floor"]
+__all__ = ["GAMMA_FACTOR", "LOG_ERROR_ULP", "NEWTON_STOP_SINGLE", "UNIT_SINGLE", "alpha_bound",
+           "cascade_bounds", "gamma_bound", "status_certain", "u_bound", "unit_roundoff",
+           "with_double_floor"]
 
 UNIT_DOUBLE = 2.0 ** -53
 UNIT_SINGLE = 2.0 ** -24
@@ -50,6 +55,17 @@ UNIT_SINGLE = 2.0 ** -24
 GAMMA_FACTOR = 64.0
 #: Local roundings of the law (13) after ``e``.
 LAW_FACTOR = 16.0
+#: Error of one ``log`` call that :data:`LAW_FACTOR` assumes, in ulps of its result
+#: (:func:`_law_error`): the C library's (fdlibm's ``logf`` and ``log`` are below one ulp)
+#: and single precision's own ``stt_logf`` (below 0.84 ulp on its fast path, the C
+#: library's ``logf`` elsewhere).
+LOG_ERROR_ULP = 1.0
+#: Single precision's implicit step stops its Newton iteration after the first step ``d``
+#: from ``a`` (``z = psi + a``) when the remaining error's bound ``6 A d^2 / (c z^4)`` (``g``
+#: concave and increasing, the iterates left of the root: docs/codegen.md, "Fewer
+#: operations") is at most ``NEWTON_STOP_SINGLE`` times the new iterate: one unit roundoff
+#: of ``alpha_next``, as at the fixed point the double code iterates to.
+NEWTON_STOP_SINGLE = UNIT_SINGLE
 #: Floor of the double tolerance: the acceptance criterion ``1e-12 max(1, |ref|)``.
 DOUBLE_FLOOR = 1e-12
 
@@ -244,9 +260,9 @@ def _law_error(e, de, factor, relative, unit: float) -> np.ndarray:
     end of the interval (``|g| <= g_far``, ``|e| <= e_far``), the factor's error
     ``relative g_far`` and the local rounding of ``g`` there, ``16 unit (g_far + 1) /
     (1 - e_far^2)``: ``log`` of the rounded quotient ``(1+e)/(1-e)`` is off by ``3 unit``
-    plus its ulp, and the computed ``1 - e*e`` by ``unit (e^2 + 1 - e^2)`` absolute, a
-    relative ``unit / (1 - e^2)`` (this is what grows near the boundary), with the
-    quotients and products: at most ``unit (5 |g| + 3) / (1 - e^2)``, 3x margin."""
+    plus its own error (:data:`LOG_ERROR_ULP`, one ulp), and the computed ``1 - e*e`` by
+    ``unit (e^2 + 1 - e^2)`` absolute, a relative ``unit / (1 - e^2)`` (this is what grows
+    near the boundary), with the quotients and products: at most ``unit (5 |g| + 3) / (1 - e^2)``, 3x margin."""
     g0 = _g(e)
     low, high = _g(e - de), _g(e + de)
     spread = np.maximum(high - g0, g0 - low)

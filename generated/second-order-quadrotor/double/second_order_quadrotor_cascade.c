@@ -46,6 +46,9 @@ static const second_order_quadrotor_cascade_parameters SECOND_ORDER_QUADROTOR_CA
 static const second_order_quadrotor_cascade_real SECOND_ORDER_QUADROTOR_CASCADE_BOUND[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA] = { 0.0, 0.0, 0.0, 6.0, 6.0, 3.0 };
 static const second_order_quadrotor_cascade_real SECOND_ORDER_QUADROTOR_CASCADE_SIGN[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA] = { 1.0, 1.0, 1.0, -1.0, -1.0, -1.0 };
 static const int SECOND_ORDER_QUADROTOR_CASCADE_MEMBERS[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA] = { 0, 0, 0, 2, 0, 0 };
+/* The bounds with several circumvents (combined by F_nu, eq. (9)). */
+#define SECOND_ORDER_QUADROTOR_CASCADE_N_MULTI 1
+static const int SECOND_ORDER_QUADROTOR_CASCADE_MULTI[SECOND_ORDER_QUADROTOR_CASCADE_N_MULTI] = { 3 };
 
 /* Reach tube (eq. (4)), one row per segment: rho = from + (to - from) p(t) on
    [start, end]; profile 0 = tanh (eq. (4)), 1 = smoothstep (quintic). Rows: [L; U]. */
@@ -1349,12 +1352,15 @@ static void second_order_quadrotor_cascade_reach(second_order_quadrotor_cascade_
 }
 
 /* beta [L; U] of eq. (9) at t (and beta_dot when rates != 0), over the open windows only (a
-   closed window adds exactly 0 to F_nu). */
+   closed window adds exactly 0 to F_nu; a bound none of whose windows is open is its
+   state-space bound: F_nu of no open window is ln(exp(0)) = 0). */
 static void second_order_quadrotor_cascade_circumvent(second_order_quadrotor_cascade_real t, int rates, second_order_quadrotor_cascade_real* beta,
     second_order_quadrotor_cascade_real* beta_dot) {
   second_order_quadrotor_cascade_real top[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
-  second_order_quadrotor_cascade_real total[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
-  second_order_quadrotor_cascade_real rate[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real total;
+  second_order_quadrotor_cascade_real rate;
+  int m;
+  int k;
   int b;
   second_order_quadrotor_cascade_real y[SECOND_ORDER_QUADROTOR_CASCADE_MAX_OPEN];
   second_order_quadrotor_cascade_real y_dot[SECOND_ORDER_QUADROTOR_CASCADE_MAX_OPEN];
@@ -1404,25 +1410,26 @@ static void second_order_quadrotor_cascade_circumvent(second_order_quadrotor_cas
       open = open + 1;
     }
   }
-  for (b = 0; b < SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA; ++b) {
-    if (SECOND_ORDER_QUADROTOR_CASCADE_MEMBERS[b] > 1) {
-      body_fnu_init(&top[b], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness, &total[b], &rate[b]);
+  for (m = 0; m < SECOND_ORDER_QUADROTOR_CASCADE_N_MULTI; ++m) {
+    b = SECOND_ORDER_QUADROTOR_CASCADE_MULTI[m];
+    /* k: the first open window of bound b (none: beta[b] stays the bound) */
+    k = 0;
+    while ((k < open) && (bound_of[k] != b)) {
+      k = k + 1;
     }
-  }
-  for (j = 0; j < open; ++j) {
-    b = bound_of[j];
-    if (SECOND_ORDER_QUADROTOR_CASCADE_MEMBERS[b] > 1) {
-      second_order_quadrotor_cascade_real total_next;
-      second_order_quadrotor_cascade_real rate_next;
-      body_fnu_add(&total[b], &rate[b], &y[j], &y_dot[j], &top[b], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness,
-                   &total_next, &rate_next);
-      total[b] = total_next;
-      rate[b] = rate_next;
-    }
-  }
-  for (b = 0; b < SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA; ++b) {
-    if (SECOND_ORDER_QUADROTOR_CASCADE_MEMBERS[b] > 1) {
-      body_fnu_finish(&SECOND_ORDER_QUADROTOR_CASCADE_BOUND[b], &SECOND_ORDER_QUADROTOR_CASCADE_SIGN[b], &top[b], &total[b], &rate[b],
+    if (k < open) {
+      body_fnu_init(&top[b], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness, &total, &rate);
+      for (j = k; j < open; ++j) {
+        if (bound_of[j] == b) {
+          second_order_quadrotor_cascade_real total_next;
+          second_order_quadrotor_cascade_real rate_next;
+          body_fnu_add(&total, &rate, &y[j], &y_dot[j], &top[b], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness,
+                       &total_next, &rate_next);
+          total = total_next;
+          rate = rate_next;
+        }
+      }
+      body_fnu_finish(&SECOND_ORDER_QUADROTOR_CASCADE_BOUND[b], &SECOND_ORDER_QUADROTOR_CASCADE_SIGN[b], &top[b], &total, &rate,
                       &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness, &beta[b], &beta_dot[b]);
     }
   }

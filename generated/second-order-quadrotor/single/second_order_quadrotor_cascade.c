@@ -46,6 +46,9 @@ static const second_order_quadrotor_cascade_parameters SECOND_ORDER_QUADROTOR_CA
 static const second_order_quadrotor_cascade_real SECOND_ORDER_QUADROTOR_CASCADE_BOUND[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA] = { 0.0f, 0.0f, 0.0f, 6.0f, 6.0f, 3.0f };
 static const second_order_quadrotor_cascade_real SECOND_ORDER_QUADROTOR_CASCADE_SIGN[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA] = { 1.0f, 1.0f, 1.0f, -1.0f, -1.0f, -1.0f };
 static const int SECOND_ORDER_QUADROTOR_CASCADE_MEMBERS[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA] = { 0, 0, 0, 2, 0, 0 };
+/* The bounds with several circumvents (combined by F_nu, eq. (9)). */
+#define SECOND_ORDER_QUADROTOR_CASCADE_N_MULTI 1
+static const int SECOND_ORDER_QUADROTOR_CASCADE_MULTI[SECOND_ORDER_QUADROTOR_CASCADE_N_MULTI] = { 3 };
 
 /* Reach tube (eq. (4)), one row per segment: rho = from + (to - from) p(t) on
    [start, end]; profile 0 = tanh (eq. (4)), 1 = smoothstep (quintic). Rows: [L; U]. */
@@ -87,9 +90,10 @@ static const second_order_quadrotor_cascade_window SECOND_ORDER_QUADROTOR_CASCAD
 /* ------------------------------------------------------------- emitted bodies */
 
 /* stt_expf(x): expf(x), within 0.89 ulp of the exact e^x for |x| <= 80 (every
-   float there checked), with no library call for 2^-28 <= |x| <= 80: k = round(x / ln 2), r = x - k ln 2 in two
+   float there checked), with no library call for |x| <= 80: below 2^-28, 1 + x (the
+   correctly rounded e^x); else k = round(x / ln 2), r = x - k ln 2 in two
    parts (Cody-Waite), e^r = 1 + r + r^2 q(r) (q minimax, degree 4), then one exact
-   multiplication by a tabled power of two. Other x (and NaN) go to expf. The fast path
+   multiplication by a tabled power of two. Other x (and NaN) go to expf. There it
    raises no exception flag but FE_INEXACT and does not touch errno. See
    stt_codegen/codegen/emit/c_maths.py. */
 static float stt_expf(float x) {
@@ -128,7 +132,9 @@ static float stt_expf(float x) {
   };
   const float magnitude = fabsf(x);
   float y;
-  if ((magnitude <= 80.0f) && (magnitude >= 3.725290298461914e-09f)) {
+  if (magnitude < 3.725290298461914e-09f) {
+    y = 1.0f + x;
+  } else if (magnitude <= 80.0f) {
     const float k = ((x * 1.4426950216293335f) + 12582912.0f) - 12582912.0f;
     const float r_hi = x - (k * 0.693145751953125f);
     const float r_lo = k * 1.428606765330187e-06f;
@@ -143,6 +149,42 @@ static float stt_expf(float x) {
     y = (1.0f + (r + (r_err + ((r * r) * q)))) * POWERS_OF_TWO[(unsigned int)k_int + 116u];
   } else {
     y = expf(x);
+  }
+  return y;
+}
+
+/* stt_logf(x): logf(x), within 0.84 ulp of the exact ln x for 2^-8 <= x <= 2^8 (every
+   float there checked), with no library call there: x = m 2^k with m in [1/sqrt 2, sqrt 2]
+   by exact halvings or doublings, f = m - 1, s = f / (2 + f),
+   ln m = f - f^2/2 + s (f^2/2 + R(s^2)) (R minimax, degree 3), plus k ln 2 in two parts.
+   Other x (zero, negative, infinite, NaN) go to logf. The fast path raises no exception
+   flag but FE_INEXACT and does not touch errno. See stt_codegen/codegen/emit/c_maths.py. */
+static float stt_logf(float x) {
+  float y;
+  if ((x >= 0.00390625f) && (x <= 256.0f)) {
+    float m = x;
+    float k = 0.0f;
+    while (m > 1.4142135381698608f) {
+      m = m * 0.5f;
+      k = k + 1.0f;
+    }
+    while (m < 0.7071067690849304f) {
+      m = m + m;
+      k = k - 1.0f;
+    }
+    {
+      const float f = m - 1.0f;
+      const float s = f / (2.0f + f);
+      const float z = s * s;
+      const float half_f2 = (0.5f * f) * f;
+      float r = 0.29872018098831177f;
+      r = (r * z) + 0.39977532625198364f;
+      r = (r * z) + 0.6666677594184875f;
+      r = r * z;
+      y = (k * 0.693145751953125f) - ((half_f2 - ((s * (half_f2 + r)) + (k * 1.428606765330187e-06f))) - f);
+    }
+  } else {
+    y = logf(x);
   }
   return y;
 }
@@ -516,7 +558,7 @@ static void body_fnu_finish(const second_order_quadrotor_cascade_real* bound, co
   w1 = sign[0];
   w2 = top[0];
   w3 = total[0];
-  w4 = logf(w3);
+  w4 = stt_logf(w3);
   w5 = nu[0];
   w4 = w4 / w5;
   w2 = w2 + w4;
@@ -1110,7 +1152,7 @@ static void body_law(const second_order_quadrotor_cascade_real* x, const second_
   w11 = w6 + w8;
   w8 = w6 - w8;
   w11 = w11 / w8;
-  w11 = logf(w11);
+  w11 = stt_logf(w11);
   w4 = w4 * w11;
   w4 = -w4;
   u[0] = w4;
@@ -1133,7 +1175,7 @@ static void body_law(const second_order_quadrotor_cascade_real* x, const second_
   w14 = w6 + w13;
   w13 = w6 - w13;
   w14 = w14 / w13;
-  w14 = logf(w14);
+  w14 = stt_logf(w14);
   w8 = w8 * w14;
   w8 = -w8;
   u[1] = w8;
@@ -1156,7 +1198,7 @@ static void body_law(const second_order_quadrotor_cascade_real* x, const second_
   w1 = w6 + w15;
   w6 = w6 - w15;
   w1 = w1 / w6;
-  w1 = logf(w1);
+  w1 = stt_logf(w1);
   w0 = w0 * w1;
   w0 = -w0;
   u[2] = w0;
@@ -1250,7 +1292,7 @@ static void body_velocity_law(const second_order_quadrotor_cascade_real* x2, con
   w11 = w5 + w8;
   w8 = w5 - w8;
   w11 = w11 / w8;
-  w11 = logf(w11);
+  w11 = stt_logf(w11);
   w4 = w4 * w11;
   w4 = -w4;
   u[0] = w4;
@@ -1270,7 +1312,7 @@ static void body_velocity_law(const second_order_quadrotor_cascade_real* x2, con
   w14 = w5 + w13;
   w13 = w5 - w13;
   w14 = w14 / w13;
-  w14 = logf(w14);
+  w14 = stt_logf(w14);
   w11 = w11 * w14;
   w11 = -w11;
   u[1] = w11;
@@ -1290,7 +1332,7 @@ static void body_velocity_law(const second_order_quadrotor_cascade_real* x2, con
   w1 = w5 + w15;
   w5 = w5 - w15;
   w1 = w1 / w5;
-  w1 = logf(w1);
+  w1 = stt_logf(w1);
   w0 = w0 * w1;
   w0 = -w0;
   u[2] = w0;
@@ -1410,12 +1452,15 @@ static void second_order_quadrotor_cascade_reach(second_order_quadrotor_cascade_
 }
 
 /* beta [L; U] of eq. (9) at t (and beta_dot when rates != 0), over the open windows only (a
-   closed window adds exactly 0 to F_nu). */
+   closed window adds exactly 0 to F_nu; a bound none of whose windows is open is its
+   state-space bound: F_nu of no open window is ln(exp(0)) = 0). */
 static void second_order_quadrotor_cascade_circumvent(second_order_quadrotor_cascade_real t, int rates, second_order_quadrotor_cascade_real* beta,
     second_order_quadrotor_cascade_real* beta_dot) {
   second_order_quadrotor_cascade_real top[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
-  second_order_quadrotor_cascade_real total[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
-  second_order_quadrotor_cascade_real rate[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA];
+  second_order_quadrotor_cascade_real total;
+  second_order_quadrotor_cascade_real rate;
+  int m;
+  int k;
   int b;
   second_order_quadrotor_cascade_real y[SECOND_ORDER_QUADROTOR_CASCADE_MAX_OPEN];
   second_order_quadrotor_cascade_real y_dot[SECOND_ORDER_QUADROTOR_CASCADE_MAX_OPEN];
@@ -1465,25 +1510,26 @@ static void second_order_quadrotor_cascade_circumvent(second_order_quadrotor_cas
       open = open + 1;
     }
   }
-  for (b = 0; b < SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA; ++b) {
-    if (SECOND_ORDER_QUADROTOR_CASCADE_MEMBERS[b] > 1) {
-      body_fnu_init(&top[b], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness, &total[b], &rate[b]);
+  for (m = 0; m < SECOND_ORDER_QUADROTOR_CASCADE_N_MULTI; ++m) {
+    b = SECOND_ORDER_QUADROTOR_CASCADE_MULTI[m];
+    /* k: the first open window of bound b (none: beta[b] stays the bound) */
+    k = 0;
+    while ((k < open) && (bound_of[k] != b)) {
+      k = k + 1;
     }
-  }
-  for (j = 0; j < open; ++j) {
-    b = bound_of[j];
-    if (SECOND_ORDER_QUADROTOR_CASCADE_MEMBERS[b] > 1) {
-      second_order_quadrotor_cascade_real total_next;
-      second_order_quadrotor_cascade_real rate_next;
-      body_fnu_add(&total[b], &rate[b], &y[j], &y_dot[j], &top[b], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness,
-                   &total_next, &rate_next);
-      total[b] = total_next;
-      rate[b] = rate_next;
-    }
-  }
-  for (b = 0; b < SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA; ++b) {
-    if (SECOND_ORDER_QUADROTOR_CASCADE_MEMBERS[b] > 1) {
-      body_fnu_finish(&SECOND_ORDER_QUADROTOR_CASCADE_BOUND[b], &SECOND_ORDER_QUADROTOR_CASCADE_SIGN[b], &top[b], &total[b], &rate[b],
+    if (k < open) {
+      body_fnu_init(&top[b], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness, &total, &rate);
+      for (j = k; j < open; ++j) {
+        if (bound_of[j] == b) {
+          second_order_quadrotor_cascade_real total_next;
+          second_order_quadrotor_cascade_real rate_next;
+          body_fnu_add(&total, &rate, &y[j], &y_dot[j], &top[b], &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness,
+                       &total_next, &rate_next);
+          total = total_next;
+          rate = rate_next;
+        }
+      }
+      body_fnu_finish(&SECOND_ORDER_QUADROTOR_CASCADE_BOUND[b], &SECOND_ORDER_QUADROTOR_CASCADE_SIGN[b], &top[b], &total, &rate,
                       &SECOND_ORDER_QUADROTOR_CASCADE_PARAMETERS.smoothness, &beta[b], &beta_dot[b]);
     }
   }
@@ -1683,16 +1729,29 @@ static void second_order_quadrotor_cascade_implicit_step(second_order_quadrotor_
     if (root != 0.0f) {
       body_newton_root_start(&a[i], &psi[i], &c, &big_a, &s);
     }
-    /* 5 iterations; an iteration that returns its input would return it again,
-       so the loop stops there with the same result. The first two run without that test
-       (if the first returned its input, the second returns it again): fewer branches. */
+    /* At most 5 iterations. Single precision stops after the first when the
+       remaining error's bound 6 A d^2 / (c z^4) (d the step, z = psi + s before it; g
+       concave and increasing, the iterates left of the root: docs/codegen.md) is at most
+       2^-24 times the new iterate, one unit roundoff (codegen/tolerance.py). Otherwise an
+       iteration that returns its input would return it again, so the loop stops there
+       with the same result; the second runs without that test. */
     body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
-    s = s_next;
-    body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
-    if (s_next == s) {
-      k = 5;
+    {
+      const second_order_quadrotor_cascade_real d = s_next - s;
+      const second_order_quadrotor_cascade_real z = psi[i] + s;
+      const second_order_quadrotor_cascade_real z2 = z * z;
+      s = s_next;
+      if (((6.0f * big_a) * (d * d)) <= (((5.960464477539063e-08f * s) * c) * (z2 * z2))) {
+        k = 5;
+      }
     }
-    s = s_next;
+    if (k < 5) {
+      body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
+      if (s_next == s) {
+        k = 5;
+      }
+      s = s_next;
+    }
     while (k < 5) {
       body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
       if (s_next == s) {

@@ -85,9 +85,10 @@ typedef struct {
 /* ------------------------------------------------------------- emitted bodies */
 
 /* stt_expf(x): expf(x), within 0.89 ulp of the exact e^x for |x| <= 80 (every
-   float there checked), with no library call for 2^-28 <= |x| <= 80: k = round(x / ln 2), r = x - k ln 2 in two
+   float there checked), with no library call for |x| <= 80: below 2^-28, 1 + x (the
+   correctly rounded e^x); else k = round(x / ln 2), r = x - k ln 2 in two
    parts (Cody-Waite), e^r = 1 + r + r^2 q(r) (q minimax, degree 4), then one exact
-   multiplication by a tabled power of two. Other x (and NaN) go to expf. The fast path
+   multiplication by a tabled power of two. Other x (and NaN) go to expf. There it
    raises no exception flag but FE_INEXACT and does not touch errno. See
    stt_codegen/codegen/emit/c_maths.py. */
 static float stt_expf(float x) {
@@ -126,7 +127,9 @@ static float stt_expf(float x) {
   };
   const float magnitude = fabsf(x);
   float y;
-  if ((magnitude <= 80.0f) && (magnitude >= 3.725290298461914e-09f)) {
+  if (magnitude < 3.725290298461914e-09f) {
+    y = 1.0f + x;
+  } else if (magnitude <= 80.0f) {
     const float k = ((x * 1.4426950216293335f) + 12582912.0f) - 12582912.0f;
     const float r_hi = x - (k * 0.693145751953125f);
     const float r_lo = k * 1.428606765330187e-06f;
@@ -141,6 +144,42 @@ static float stt_expf(float x) {
     y = (1.0f + (r + (r_err + ((r * r) * q)))) * POWERS_OF_TWO[(unsigned int)k_int + 116u];
   } else {
     y = expf(x);
+  }
+  return y;
+}
+
+/* stt_logf(x): logf(x), within 0.84 ulp of the exact ln x for 2^-8 <= x <= 2^8 (every
+   float there checked), with no library call there: x = m 2^k with m in [1/sqrt 2, sqrt 2]
+   by exact halvings or doublings, f = m - 1, s = f / (2 + f),
+   ln m = f - f^2/2 + s (f^2/2 + R(s^2)) (R minimax, degree 3), plus k ln 2 in two parts.
+   Other x (zero, negative, infinite, NaN) go to logf. The fast path raises no exception
+   flag but FE_INEXACT and does not touch errno. See stt_codegen/codegen/emit/c_maths.py. */
+static float stt_logf(float x) {
+  float y;
+  if ((x >= 0.00390625f) && (x <= 256.0f)) {
+    float m = x;
+    float k = 0.0f;
+    while (m > 1.4142135381698608f) {
+      m = m * 0.5f;
+      k = k + 1.0f;
+    }
+    while (m < 0.7071067690849304f) {
+      m = m + m;
+      k = k - 1.0f;
+    }
+    {
+      const float f = m - 1.0f;
+      const float s = f / (2.0f + f);
+      const float z = s * s;
+      const float half_f2 = (0.5f * f) * f;
+      float r = 0.29872018098831177f;
+      r = (r * z) + 0.39977532625198364f;
+      r = (r * z) + 0.6666677594184875f;
+      r = r * z;
+      y = (k * 0.693145751953125f) - ((half_f2 - ((s * (half_f2 + r)) + (k * 1.428606765330187e-06f))) - f);
+    }
+  } else {
+    y = logf(x);
   }
   return y;
 }
@@ -939,7 +978,7 @@ static void body_law(const tasks_visit_real* x, const tasks_visit_real* gamma_L,
   w11 = w6 + w8;
   w8 = w6 - w8;
   w11 = w11 / w8;
-  w11 = logf(w11);
+  w11 = stt_logf(w11);
   w4 = w4 * w11;
   w4 = -w4;
   u[0] = w4;
@@ -962,7 +1001,7 @@ static void body_law(const tasks_visit_real* x, const tasks_visit_real* gamma_L,
   w14 = w6 + w13;
   w13 = w6 - w13;
   w14 = w14 / w13;
-  w14 = logf(w14);
+  w14 = stt_logf(w14);
   w8 = w8 * w14;
   w8 = -w8;
   u[1] = w8;
@@ -985,7 +1024,7 @@ static void body_law(const tasks_visit_real* x, const tasks_visit_real* gamma_L,
   w1 = w6 + w15;
   w6 = w6 - w15;
   w1 = w1 / w6;
-  w1 = logf(w1);
+  w1 = stt_logf(w1);
   w0 = w0 * w1;
   w0 = -w0;
   u[2] = w0;
@@ -1300,16 +1339,29 @@ static void tasks_visit_implicit_step(tasks_visit_real t, tasks_visit_real dt, c
     if (root != 0.0f) {
       body_newton_root_start(&a[i], &psi[i], &c, &big_a, &s);
     }
-    /* 5 iterations; an iteration that returns its input would return it again,
-       so the loop stops there with the same result. The first two run without that test
-       (if the first returned its input, the second returns it again): fewer branches. */
+    /* At most 5 iterations. Single precision stops after the first when the
+       remaining error's bound 6 A d^2 / (c z^4) (d the step, z = psi + s before it; g
+       concave and increasing, the iterates left of the root: docs/codegen.md) is at most
+       2^-24 times the new iterate, one unit roundoff (codegen/tolerance.py). Otherwise an
+       iteration that returns its input would return it again, so the loop stops there
+       with the same result; the second runs without that test. */
     body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
-    s = s_next;
-    body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
-    if (s_next == s) {
-      k = 5;
+    {
+      const tasks_visit_real d = s_next - s;
+      const tasks_visit_real z = psi[i] + s;
+      const tasks_visit_real z2 = z * z;
+      s = s_next;
+      if (((6.0f * big_a) * (d * d)) <= (((5.960464477539063e-08f * s) * c) * (z2 * z2))) {
+        k = 5;
+      }
     }
-    s = s_next;
+    if (k < 5) {
+      body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
+      if (s_next == s) {
+        k = 5;
+      }
+      s = s_next;
+    }
     while (k < 5) {
       body_newton_iteration(&s, &a[i], &psi[i], &c, &big_a, &s_next);
       if (s_next == s) {

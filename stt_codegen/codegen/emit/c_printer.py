@@ -25,11 +25,12 @@ body runs, so the NaN cases below never occur on a valid step):
 * ``sign(x)`` is ``-1``/``1`` and ``x`` itself for zeros and NaN (CasADi's ``casadi_sign``).
 * ``sq(x)`` is ``x * x``, ``twice(x)`` is ``x + x``, ``inv(x)`` is ``1 / x``, ``constpow``
   is ``pow`` (all exact rewrites of CasADi's own C).
-* in single precision ``exp`` is ``stt_expf``, defined in the printed text before the
-  functions that use it (:mod:`~stt_codegen.codegen.emit.c_maths`: within 0.89 ulp of
-  ``e^x``, the C library's ``expf`` outside ``|x| <= 80``); it is cheaper than newlib's
-  ``expf`` on the Cortex-M4F. Double precision calls the C library (bit-identity with
-  CasADi).
+* in single precision ``exp`` is ``stt_expf`` and ``log`` is ``stt_logf``, defined in the
+  printed text before the functions that use them (:mod:`~stt_codegen.codegen.emit.c_maths`:
+  within 0.89 ulp of ``e^x``, the C library's ``expf`` outside ``|x| <= 80``; within 0.84
+  ulp of ``ln x``, the C library's ``logf`` outside ``[2^-8, 2^8]``); they are cheaper than
+  newlib's ``expf`` and ``logf`` on the Cortex-M4F. Double precision calls the C library
+  (bit-identity with CasADi).
 * every floating constant is ``repr(float)`` of the double, with the ``f`` suffix in single
   precision (the decimal is then rounded once, to the nearest float); infinities are
   ``HUGE_VAL``/``HUGE_VALF``, NaN is ``NAN`` (cast to double in double precision).
@@ -100,10 +101,10 @@ class Precision:
 
 
 DOUBLE = Precision("double", "double", "", "HUGE_VAL", "((double)NAN)")
-#: Single precision computes ``exp`` with the project's own ``stt_expf`` (see
-#: :mod:`~stt_codegen.codegen.emit.c_maths`: within 0.89 ulp, about 20 instructions
-#: cheaper per call than newlib's ``expf`` on the Cortex-M4F).
-SINGLE = Precision("single", "float", "f", "HUGE_VALF", "NAN", own=("exp",))
+#: Single precision computes ``exp`` and ``log`` with the project's own ``stt_expf`` and
+#: ``stt_logf`` (see :mod:`~stt_codegen.codegen.emit.c_maths`: within 0.89 and 0.84 ulp,
+#: about 20 instructions cheaper per call than newlib's on the Cortex-M4F).
+SINGLE = Precision("single", "float", "f", "HUGE_VALF", "NAN", own=("exp", "log"))
 PRECISIONS: Dict[str, Precision] = {"double": DOUBLE, "single": SINGLE}
 
 
