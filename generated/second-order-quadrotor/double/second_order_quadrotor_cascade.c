@@ -45,7 +45,6 @@ static const second_order_quadrotor_cascade_parameters SECOND_ORDER_QUADROTOR_CA
    number of circumvents acting on each. */
 static const second_order_quadrotor_cascade_real SECOND_ORDER_QUADROTOR_CASCADE_BOUND[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA] = { 0.0, 0.0, 0.0, 6.0, 6.0, 3.0 };
 static const second_order_quadrotor_cascade_real SECOND_ORDER_QUADROTOR_CASCADE_SIGN[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA] = { 1.0, 1.0, 1.0, -1.0, -1.0, -1.0 };
-static const int SECOND_ORDER_QUADROTOR_CASCADE_MEMBERS[SECOND_ORDER_QUADROTOR_CASCADE_N_ALPHA] = { 0, 0, 0, 2, 0, 0 };
 /* The bounds with several circumvents (combined by F_nu, eq. (9)). */
 #define SECOND_ORDER_QUADROTOR_CASCADE_N_MULTI 1
 static const int SECOND_ORDER_QUADROTOR_CASCADE_MULTI[SECOND_ORDER_QUADROTOR_CASCADE_N_MULTI] = { 3 };
@@ -1360,7 +1359,6 @@ static void second_order_quadrotor_cascade_circumvent(second_order_quadrotor_cas
   second_order_quadrotor_cascade_real total;
   second_order_quadrotor_cascade_real rate;
   int m;
-  int k;
   int b;
   second_order_quadrotor_cascade_real y[SECOND_ORDER_QUADROTOR_CASCADE_MAX_OPEN];
   second_order_quadrotor_cascade_real y_dot[SECOND_ORDER_QUADROTOR_CASCADE_MAX_OPEN];
@@ -1411,9 +1409,9 @@ static void second_order_quadrotor_cascade_circumvent(second_order_quadrotor_cas
     }
   }
   for (m = 0; m < SECOND_ORDER_QUADROTOR_CASCADE_N_MULTI; ++m) {
-    b = SECOND_ORDER_QUADROTOR_CASCADE_MULTI[m];
     /* k: the first open window of bound b (none: beta[b] stays the bound) */
-    k = 0;
+    int k = 0;
+    b = SECOND_ORDER_QUADROTOR_CASCADE_MULTI[m];
     while ((k < open) && (bound_of[k] != b)) {
       k = k + 1;
     }

@@ -150,22 +150,36 @@ static float stt_expf(float x) {
 
 /* stt_logf(x): logf(x), within 0.84 ulp of the exact ln x for 2^-8 <= x <= 2^8 (every
    float there checked), with no library call there: x = m 2^k with m in [1/sqrt 2, sqrt 2]
-   by exact halvings or doublings, f = m - 1, s = f / (2 + f),
+   (k counted against tabled thresholds, m = x 2^-k exact), f = m - 1, s = f / (2 + f),
    ln m = f - f^2/2 + s (f^2/2 + R(s^2)) (R minimax, degree 3), plus k ln 2 in two parts.
    Other x (zero, negative, infinite, NaN) go to logf. The fast path raises no exception
    flag but FE_INEXACT and does not touch errno. See stt_codegen/codegen/emit/c_maths.py. */
 static float stt_logf(float x) {
+  /* sqrt 2 2^j and 2^-j / sqrt 2 (j = 0 .. 7): where k steps up or down */
+  static const float ABOVE[8] = { 1.4142135381698608f, 2.8284270763397217f, 5.656854152679443f, 11.313708305358887f, 22.627416610717773f, 45.25483322143555f, 90.5096664428711f, 181.0193328857422f };
+  static const float BELOW[8] = { 0.7071067690849304f, 0.3535533845424652f, 0.1767766922712326f, 0.0883883461356163f, 0.04419417306780815f, 0.022097086533904076f, 0.011048543266952038f, 0.005524271633476019f };
+  /* 2^j for j = -8 .. 8 */
+  static const float SCALE[17] = { 0x1p-8f, 0x1p-7f, 0x1p-6f, 0x1p-5f, 0x1p-4f, 0x1p-3f, 0x1p-2f, 0x1p-1f, 0x1p0f, 0x1p1f, 0x1p2f, 0x1p3f, 0x1p4f, 0x1p5f, 0x1p6f, 0x1p7f, 0x1p8f };
   float y;
   if ((x >= 0.00390625f) && (x <= 256.0f)) {
     float m = x;
-    float k = 0.0f;
-    while (m > 1.4142135381698608f) {
-      m = m * 0.5f;
-      k = k + 1.0f;
+    int j = 0;
+    if (x > ABOVE[0]) {
+      j = 1;
+      while ((j < 8) && (x > ABOVE[j])) {
+        j = j + 1;
+      }
+    } else if (x < BELOW[0]) {
+      j = 1;
+      while ((j < 8) && (x < BELOW[j])) {
+        j = j + 1;
+      }
+      j = -j;
+    } else {
+      /* x in [1/sqrt 2, sqrt 2]: k = 0, m = x */
     }
-    while (m < 0.7071067690849304f) {
-      m = m + m;
-      k = k - 1.0f;
+    if (j != 0) {
+      m = x * SCALE[8 - j];
     }
     {
       const float f = m - 1.0f;
@@ -176,7 +190,12 @@ static float stt_logf(float x) {
       r = (r * z) + 0.39977532625198364f;
       r = (r * z) + 0.6666677594184875f;
       r = r * z;
-      y = (k * 0.693145751953125f) - ((half_f2 - ((s * (half_f2 + r)) + (k * 1.428606765330187e-06f))) - f);
+      if (j == 0) {
+        y = f - (half_f2 - (s * (half_f2 + r)));
+      } else {
+        const float k = (float)j;
+        y = (k * 0.693145751953125f) - ((half_f2 - ((s * (half_f2 + r)) + (k * 1.428606765330187e-06f))) - f);
+      }
     }
   } else {
     y = logf(x);

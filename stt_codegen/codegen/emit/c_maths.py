@@ -5,8 +5,9 @@ Two, both single precision: ``stt_expf`` (op ``exp``) and ``stt_logf`` (op ``log
 costs about 70 instructions per call (its ``__ieee754_expf`` and the wrapper that checks
 for overflow and sets ``errno``) and ``logf`` about 65; a single-precision step makes
 about 8 ``exp`` and 3 to 8 ``log`` calls. ``stt_expf`` costs 43 (48 with the call) and is
-within 0.89 ulp of the exact ``e^x``; ``stt_logf`` costs about 40 plus 6 per factor of 2
-between ``x`` and ``[1/sqrt 2, sqrt 2]`` and is within 0.84 ulp of the exact ``ln x``.
+within 0.89 ulp of the exact ``e^x``; ``stt_logf`` costs about 36 for ``x`` in
+``[1/sqrt 2, sqrt 2]``, about 10 more plus 5 per factor of 2 outside, and is within 0.84
+ulp of the exact ``ln x``.
 
 ``stt_expf`` (the fast path, for ``TINY <= |x| <= FAST_BOUND``, ``2^-28 <= |x| <= 80``;
 ``|x| < 2^-28``, zero included, returns ``1 + x``, as the C library does; any other ``x``,
@@ -51,17 +52,22 @@ domain, monotonicity where ``k`` changes, and the flags; the exhaustive sweep is
 ``2^-8 <= x <= 2^8``; any other ``x``, zero, negatives, infinities and NaN included,
 goes to the C library's ``logf``): the fdlibm scheme without access to the bits.
 
-1. ``x = m 2^k`` with ``m`` in ``[1/sqrt 2, sqrt 2]``, by halving (or doubling) ``m``
-   while it is above ``sqrt 2`` (below ``1/sqrt 2``): at most 8 exact multiplications by
-   2 on the fast path, 6 instructions each. No ``frexpf`` (a library call of about 20
-   instructions, which would leave little to save) and no type punning.
+1. ``x = m 2^k`` with ``m`` in ``[1/sqrt 2, sqrt 2]``: ``k = 0`` and ``m = x`` when ``x``
+   is there (two comparisons); else ``k`` is the number of tabled thresholds
+   ``sqrt 2 2^j`` below ``x`` (or ``-k`` those ``2^-j / sqrt 2`` above it), counted by
+   an integer loop (MISRA C:2012 rule 14.1: no floating loop counter), about 5
+   instructions per step of ``k``, and ``m = x 2^-k``, one exact multiplication by a
+   tabled power of two. No ``frexpf`` (a library call of about 20 instructions, which
+   would leave little to save) and no type punning.
 2. ``f = m - 1`` (exact: Sterbenz), ``s = f / (2 + f)`` (``|s| <= 0.1716``),
    ``ln m = 2 atanh(s) = f - f^2/2 + s (f^2/2 + R(s^2))`` with ``R(z) = z (c1 + c2 z +
    c3 z^2)`` (coefficients :data:`LOG_COEFFICIENTS`, the minimax of
    ``(2 atanh(s) - 2 s) / s`` on ``z <= 0.02944`` by Lawson's iteration, rounded to
    float32: approximation error ``1.8e-9``, 0.015 ulp of the result).
 3. ``ln x = k ln2_hi - ((f^2/2 - (s (f^2/2 + R) + k ln2_lo)) - f)``: ``ln2_hi`` as in
-   ``stt_expf`` (``k ln2_hi`` exact for ``|k| <= 8``).
+   ``stt_expf`` (``k ln2_hi`` exact for ``|k| <= 8``); for ``k = 0`` (``x`` in
+   ``[1/sqrt 2, sqrt 2]``, no table access) the same value as
+   ``f - (f^2/2 - s (f^2/2 + R))``.
 
 Error: below **0.84 ulp** of the exact ``ln x`` for every float ``x`` in ``[2^-8, 2^8]``
 (all 134 217 729 of them, checked against glibc's double ``log``), monotone
@@ -253,6 +259,16 @@ int main(void) {{
 
 
 
+def _thresholds(base: float, sign: int) -> str:
+    """``base 2^(sign j)``, ``j = 0 .. LOG_K_MAX - 1`` (exact: powers of two times a float)."""
+    return ", ".join(_f(base * 2.0 ** (sign * j)) for j in range(LOG_K_MAX))
+
+
+def _log_scales() -> str:
+    """``2^-LOG_K_MAX .. 2^LOG_K_MAX`` as hexadecimal float constants."""
+    return ", ".join(f"0x1p{j}f" for j in range(-LOG_K_MAX, LOG_K_MAX + 1))
+
+
 def logf_source() -> str:
     """C99 text of ``static float stt_logf(float x)`` (needs ``<math.h>``).
 
@@ -265,22 +281,36 @@ def logf_source() -> str:
     return f"""\
 /* {LOGF_NAME}(x): logf(x), within {LOG_BOUND_ULP:g} ulp of the exact ln x for 2^-{LOG_K_MAX} <= x <= 2^{LOG_K_MAX} (every
    float there checked), with no library call there: x = m 2^k with m in [1/sqrt 2, sqrt 2]
-   by exact halvings or doublings, f = m - 1, s = f / (2 + f),
+   (k counted against tabled thresholds, m = x 2^-k exact), f = m - 1, s = f / (2 + f),
    ln m = f - f^2/2 + s (f^2/2 + R(s^2)) (R minimax, degree 3), plus k ln 2 in two parts.
    Other x (zero, negative, infinite, NaN) go to logf. The fast path raises no exception
    flag but FE_INEXACT and does not touch errno. See stt_codegen/codegen/emit/c_maths.py. */
 static float {LOGF_NAME}(float x) {{
+  /* sqrt 2 2^j and 2^-j / sqrt 2 (j = 0 .. {LOG_K_MAX - 1}): where k steps up or down */
+  static const float ABOVE[{LOG_K_MAX}] = {{ {_thresholds(SQRT2, 1)} }};
+  static const float BELOW[{LOG_K_MAX}] = {{ {_thresholds(SQRT1_2, -1)} }};
+  /* 2^j for j = -{LOG_K_MAX} .. {LOG_K_MAX} */
+  static const float SCALE[{2 * LOG_K_MAX + 1}] = {{ {_log_scales()} }};
   float y;
   if ((x >= {_f(LOG_FAST_LOW)}) && (x <= {_f(LOG_FAST_HIGH)})) {{
     float m = x;
-    float k = 0.0f;
-    while (m > {_f(SQRT2)}) {{
-      m = m * 0.5f;
-      k = k + 1.0f;
+    int j = 0;
+    if (x > ABOVE[0]) {{
+      j = 1;
+      while ((j < {LOG_K_MAX}) && (x > ABOVE[j])) {{
+        j = j + 1;
+      }}
+    }} else if (x < BELOW[0]) {{
+      j = 1;
+      while ((j < {LOG_K_MAX}) && (x < BELOW[j])) {{
+        j = j + 1;
+      }}
+      j = -j;
+    }} else {{
+      /* x in [1/sqrt 2, sqrt 2]: k = 0, m = x */
     }}
-    while (m < {_f(SQRT1_2)}) {{
-      m = m + m;
-      k = k - 1.0f;
+    if (j != 0) {{
+      m = x * SCALE[{LOG_K_MAX} - j];
     }}
     {{
       const float f = m - 1.0f;
@@ -291,7 +321,12 @@ static float {LOGF_NAME}(float x) {{
       r = (r * z) + {_f(c[1])};
       r = (r * z) + {_f(c[0])};
       r = r * z;
-      y = (k * {_f(LN2_HI)}) - ((half_f2 - ((s * (half_f2 + r)) + (k * {_f(LN2_LO)}))) - f);
+      if (j == 0) {{
+        y = f - (half_f2 - (s * (half_f2 + r)));
+      }} else {{
+        const float k = (float)j;
+        y = (k * {_f(LN2_HI)}) - ((half_f2 - ((s * (half_f2 + r)) + (k * {_f(LN2_LO)}))) - f);
+      }}
     }}
   }} else {{
     y = logf(x);
