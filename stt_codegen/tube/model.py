@@ -279,7 +279,9 @@ def implicit_alpha_update(alpha, psi, theta, dt, kappa: float,
     ``iterations`` Newton iterations with one division each
     (:func:`stt_codegen.tube.pieces.newton_pieces`). The generated code runs the same
     pieces (the root start only when needed, the iterations in a loop that stops at a
-    fixed point), so it computes exactly this.
+    fixed point), so it computes exactly this in double precision; single precision may
+    stop after the first iteration when a proven bound puts the root within one unit
+    roundoff of it (:data:`stt_codegen.codegen.tolerance.NEWTON_STOP_SINGLE`).
 
     Parameters
     ----------
