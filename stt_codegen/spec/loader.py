@@ -695,6 +695,7 @@ def _validate(raw: dict) -> Spec:
     moving = tuple(_moving(table, f"obstacles[{j}]", j, state_space, initial_set, target_set,
                            doc.prescribed_time)
                    for j, table in enumerate(doc.obstacles) if is_moving(table))
+    linear = _linear_plant(doc.plant, n)      # also refuses another model's [plant] keys
     drive = _differential_drive(doc)
     robot = _robot(doc, state_space, initial_set, target_set, unsafe_sets, moving,
                    0.0 if drive is None else drive.axle_offset)
@@ -711,7 +712,6 @@ def _validate(raw: dict) -> Spec:
         raise SpecError("plant.model", mismatch)
     # a differential drive's disturbance is its slip (Spec.drive)
     amplitude = doc.plant.disturbance_amplitude if drive is None else 0.0
-    linear = _linear_plant(doc.plant, n)
     second_order = _second_order(doc, n)
     if second_order is not None:
         model = "single-integrator"     # the position stage x1_dot = x2 (Spec.plant_model)
@@ -993,7 +993,7 @@ def _robot(doc: Any, state_space: Box, initial_set: Box, target_set: Box,
         return None
     dims = robot_dims(None if doc.robot is None else doc.robot.dims, len(state_space.lower))
     radius = (0.0 if doc.robot is None else float(doc.robot.radius)) + offset
-    return Robot(radius, dims, state_space, unsafe_sets, moving)
+    return Robot(radius, dims, state_space, unsafe_sets, moving, offset)
 
 
 def _differential_drive(doc: Any) -> DifferentialDrive | None:
@@ -1021,6 +1021,12 @@ def _differential_drive(doc: Any) -> DifferentialDrive | None:
 
 
 def _no_fit(robot: Robot, label: str, why: str) -> SpecError:
+    if robot.offset:     # a differential drive: its body's radius plus the axle offset
+        body = robot.radius - robot.offset
+        return SpecError("plant.axle_offset" if body == 0 else "robot.radius",
+                         f"the robot (radius {body!r} around its axle, whose look-ahead point "
+                         f"is plant.axle_offset = {robot.offset!r} ahead: {robot.radius!r} in "
+                         f"all) no longer fits in the {label}: {why}")
     return SpecError("robot.radius", f"the robot (radius {robot.radius!r}) no longer fits in "
                                      f"the {label}: {why}")
 
