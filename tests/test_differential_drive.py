@@ -249,11 +249,25 @@ def test_the_single_precision_c_compiles_strictly(office):
     build_shared({k: v.encode() for k, v in files.items()}, "drive.c")
 
 
-def test_the_firmware_loop_refuses_by_name(office):
+def test_law_13s_firmware_loop_refuses_the_variant_by_name(office):
     from stt_codegen.embedded.deploy import run_embedded
 
-    with pytest.raises(SpecError, match="differential-drive"):
+    with pytest.raises(SpecError, match="look-ahead variant"):
         run_embedded(office)
+
+
+@pytest.mark.embedded
+def test_the_office_on_the_cortex_m4f_is_satisfied_like_the_host(office):
+    from stt_codegen.embedded.look_ahead_loop import run_look_ahead_embedded
+
+    report = run_look_ahead_embedded(office)
+    assert report["satisfied"] and report["outside_position"] == report["invalid"] == 0
+    assert all(500 < c < 5000 for c in report["instructions_per_step"])
+    host = stt.simulate(office, backend="c")        # double controller, same base and slip
+    assert abs(report["reach_time"] - host.reach_time) <= 0.02
+    assert abs(report["min_clearance"] - host.min_obstacle_clearance) <= 2e-3
+    final_point = look_ahead_reference.point(np.array([report["final_state"]]), 0.1)[0]
+    np.testing.assert_allclose(final_point, host.trajectory.x[-1], atol=2e-3)
 
 
 def test_the_command_line_refuses_a_missing_key_with_exit_2(tmp_path):
