@@ -317,3 +317,16 @@ def test_a_mujoco_base_needs_its_wheel_radius():
     del doc["plant"]["wheel_radius"]
     with pytest.raises(SpecError, match="plant.wheel_radius"):
         stt.Spec.from_dict(doc)
+
+
+def test_a_tube_through_the_desks_is_rejected_by_the_certificate(office):
+    """The tube designed for the empty room, checked against the office: it crosses the
+    desks (inflated by the body's radius plus the axle offset), and the check says which."""
+    from stt_codegen.design.search import check_tube
+
+    doc = _doc()
+    doc["obstacles"] = []
+    straight = stt.design_tube(stt.Spec.from_dict(doc)).tube
+    check = check_tube(straight, office.spec)
+    assert not check.passed and "obstacle" in check.reason
+    assert check_tube(office.tube, office.spec).passed
