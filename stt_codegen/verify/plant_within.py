@@ -14,7 +14,7 @@ from __future__ import annotations
 from ..rounding import distinct
 from ..spec.loader import Spec
 from ..spec.model_bounds import model_bounds
-from ..spec.plants import MODEL_KEYS, plant_entry
+from ..spec.plants import plant_entry
 from .cascade_sampled import model_within_class
 from .check import Check
 
@@ -22,19 +22,22 @@ __all__ = ["plant_within_assumptions"]
 
 
 def _not_checked(prefix: str, model: str, verdict: str) -> Check:
-    """The membership check of a plant without equations: passed, saying it is not checked."""
+    """The membership check of a plant without equations (or simulated on MuJoCo): passed,
+    saying it is not checked."""
     return Check(f"{prefix}.plant_within_assumptions", True,
-                 f"not checked: the {model} plant has no equations here, so {verdict} holds "
-                 "for it only if it meets the declared [assumptions]", {"declared_only": True})
+                 f"not checked: the {model} plant runs on MuJoCo, whose equations are not "
+                 f"here, so {verdict} holds for it only if it meets the [assumptions]",
+                 {"declared_only": True})
 
 
 def _first_order(spec: Spec, model: str | None) -> Check:
     model = model or spec.plant_model
-    if plant_entry(model).declared_bounds:      # no equations: nothing to compare
+    # no equations, or a MuJoCo model of the plant: nothing to compare
+    if plant_entry(model).declared_bounds or spec.mujoco is not None:
         return _not_checked("sampled", model, "the sampled verdict")
-    # only a model that takes [plant] matrices is evaluated with the spec's
-    linear = spec.linear_plant if model in MODEL_KEYS.values() else None
-    b = model_bounds(model, spec.state_space.lower, spec.state_space.upper, linear)
+    # only a model that takes [plant] matrices or parameters is evaluated with the spec's
+    b = model_bounds(model, spec.state_space.lower, spec.state_space.upper,
+                     spec.plant_data(model))
     a = spec.assumptions
     tol = 1e-9
     bad = []
