@@ -68,6 +68,9 @@ def test_embedded_case(case, reports, tmp_path_factory, capsys) -> None:
     own = [v["entries"] for name, v in by_function.items() if name.startswith("stt_expf")]
     assert max(own) >= 6                                 # the trigger's six
     assert "expf" not in by_function and "__ieee754_expf" not in by_function
+    # and every log of law (13) stt_logf's (newlib's logf is never entered)
+    assert any(name.startswith("stt_logf") for name in by_function)
+    assert "logf" not in by_function and "__ieee754_logf" not in by_function
 
 
 @pytest.mark.embedded
