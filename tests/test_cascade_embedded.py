@@ -20,7 +20,7 @@ def test_cascade_on_the_cortex_m4f_is_satisfied_like_the_host(case) -> None:
     assert len(report["instructions_per_step"]) == len(COUNT_FRACTIONS)
     assert all(1000 < c < 20000 for c in report["instructions_per_step"])
     if case == "second-order-quadrotor":
-        # the target of issue 30 (exact emulated counts, not time): at most 3000 on average;
+        # the target (exact emulated counts, not time): at most 3000 on average;
         # no log or exp of these steps reaches newlib
         assert np.mean(report["instructions_per_step"]) <= 3000, report["instructions_per_step"]
         names = report["instructions_by_function"]
