@@ -125,5 +125,6 @@ def design_table_rows(design: TubeDesign, literal: Callable[[float], str],
     members = [len(tables.members(b)) for b in range(len(tables.bounds))]
     return Tables(parameters, [literal(v) for v in tables.bounds],
                   [literal(v) for v in tables.signs], members,
-                  [b for b, count in enumerate(members) if count > 1], segments, windows, max_open(intervals),
+                  [b for b, count in enumerate(members) if count > 1], segments, windows,
+                  max_open(intervals),
                   [p for p in PROFILE_NAMES if any(s.profile == p for s in tables.segments)])
