@@ -9,8 +9,9 @@ import pytest
 
 from stt_codegen.tube import reference as R
 from stt_codegen.tube.model import build_model
-from stt_codegen.tube.parameters import (LOWER, SMOOTHSTEP, TANH, UPPER, Circumvent,
-                                         ReachSegment, TubeDesign)
+from stt_codegen.tube.parameters import (CRUISE, CRUISE_RAMP, LOWER, SMOOTHSTEP, TANH, UPPER,
+                                         Circumvent, ReachSegment, TubeDesign,
+                                         peak_rate_factor)
 
 TOLERANCE = 1e-12
 
@@ -38,7 +39,7 @@ def times() -> np.ndarray:
     return np.sort(np.concatenate([rng.uniform(-1.0, 12.0, 2000), near]))
 
 
-@pytest.mark.parametrize("profile", [SMOOTHSTEP, TANH])
+@pytest.mark.parametrize("profile", [SMOOTHSTEP, TANH, CRUISE])
 def test_model_matches_reference_on_segments_and_open_circumvents(profile):
     design = piecewise_design(profile)
     model = build_model(design)
@@ -51,8 +52,9 @@ def test_model_matches_reference_on_segments_and_open_circumvents(profile):
             assert np.all(np.abs(a - b) <= TOLERANCE * np.maximum(1.0, np.abs(b))), name
 
 
-def test_reach_tube_and_its_rate_are_continuous_at_every_via_point():
-    design = piecewise_design(SMOOTHSTEP)
+@pytest.mark.parametrize("profile", [SMOOTHSTEP, CRUISE])
+def test_reach_tube_and_its_rate_are_continuous_at_every_via_point(profile):
+    design = piecewise_design(profile)
     for seg in design.segments:
         for when in (seg.start, seg.end):
             before = R.reach_tube(design, [when - 1e-9])
@@ -61,6 +63,33 @@ def test_reach_tube_and_its_rate_are_continuous_at_every_via_point():
                 assert np.max(np.abs(a - b)) < 1e-6, when
     # far from the ends the rate is not zero: the test above can fail
     assert np.max(np.abs(R.reach_tube(design, [1.0])[2])) > 0.1
+
+
+@pytest.mark.parametrize("profile", [SMOOTHSTEP, CRUISE])
+def test_smooth_profile_peak_rate_and_its_second_derivative(profile):
+    """The CasADi model's p_dot peaks at peak_rate_factor times the mean (1.875 for the
+    smooth step, 1 / (1 - ramp) = 1.25 for the cruise, held over the whole cruise);
+    p_ddot (from the model's p_dot) is continuous, 0 at both ends, and p is monotone."""
+    from stt_codegen.tube.pieces import progress
+    start, end = 1.0, 5.0
+    t = np.linspace(start - 0.5, end + 0.5, 200001)
+    p, p_dot = (np.array(v).ravel() for v in progress(profile).map(t.size)(t[None, :], start, end))
+    mean = 1.0 / (end - start)
+    assert abs(p_dot.max() / mean - peak_rate_factor(profile)) < 1e-9
+    assert np.all(np.diff(p) >= 0.0) and p[0] == 0.0 and p[-1] == 1.0
+    p_ddot = np.diff(p_dot) / np.diff(t)
+    assert np.max(np.abs(np.diff(p_ddot))) < 1e-3 * np.max(np.abs(p_ddot))   # no jump
+    assert np.max(np.abs(p_ddot[np.abs(t[1:] - start) < 1e-3])) < 1e-2
+    assert np.max(np.abs(p_ddot[np.abs(t[1:] - end) < 1e-3])) < 1e-2
+    if profile == CRUISE:
+        tau = (t - start) / (end - start)
+        cruise = (tau > CRUISE_RAMP + 1e-6) & (tau < 1.0 - CRUISE_RAMP - 1e-6)
+        assert np.all(np.abs(p_dot[cruise] / mean - 1.25) < 1e-12)
+        assert peak_rate_factor(CRUISE) == 1.25 and CRUISE_RAMP == 0.2
+        # a ramp covers half its length at the cruise rate: p(ramp) = 1.25 * 0.2 / 2
+        (at_ramp,) = np.array(progress(CRUISE, False)(start + CRUISE_RAMP * (end - start),
+                                                       start, end)).ravel()
+        assert abs(at_ramp - 0.125) < 1e-15
 
 
 def test_reach_tube_holds_its_boxes_outside_the_segments():
