@@ -17,11 +17,14 @@ of the via-point design (:mod:`stt_codegen.design.via`), in window order, then t
 * **Legs.** Between two holds (and from ``X-hat_0`` at 0 to the first, and from the last
   to the target box ``T-hat`` at ``t_c``), :func:`~stt_codegen.design.via.plan_via` plans
   via boxes through the free space over the leg's duration: the same grid, moves,
-  shortening and timing as a whole via design.
+  shortening and timing as a whole via design, with ``"cruise"`` segments (peak rate
+  1.25 times the mean, :data:`~stt_codegen.tube.parameters.CRUISE`). Under free timing
+  each leg's time follows its via path's length (largest coordinate moves), so every leg
+  moves at about the same speed.
 
 The certificate (:mod:`stt_codegen.design.certificate.tasks`) then proves each task for
-every ``t``; the plan only makes it likely to pass. ``any_of`` tasks are tried in
-:func:`alternatives` order (every combination, first alternatives first, at most
+every ``t``; the plan only makes it likely to pass. The plans (visit order and ``any_of``
+alternatives) are tried shortest path first (:func:`task_plans`, at most
 :data:`MAX_PLANS`); :func:`~stt_codegen.design.search.design_tube` keeps the first plan
 whose tube passes its check.
 """
@@ -42,7 +45,7 @@ from .failures import FailureKind
 from .swept import swept_spec
 from .via import ViaPlan, plan_via
 
-__all__ = ["FREE_HOLD", "MAX_PLANS", "STAY_LEAD", "TaskPlan", "alternatives", "plan_tasks", "task_plans",
+__all__ = ["FREE_HOLD", "MAX_PLANS", "STAY_LEAD", "TaskPlan", "plan_tasks", "task_plans",
            "task_schedule", "visit_orders"]
 
 #: A waypoint box's half-width, at most this share of the task box's.
@@ -55,7 +58,7 @@ TASK_ROOM = 0.2
 HOLD_LEAD = 0.25
 #: A stay task's hold starts up to this many seconds before its window opens.
 STAY_LEAD = 0.25
-#: Most combinations of ``any_of`` alternatives tried.
+#: Most plans (visit order and ``any_of`` alternatives) tried.
 MAX_PLANS = 16
 #: Free timing: a reach task's hold lasts this share of its window, at most
 #: :data:`FREE_HOLD` seconds, and is kept half as much from the window's ends.
@@ -63,8 +66,8 @@ FREE_HOLD_SHARE = 0.25
 FREE_HOLD = 0.5
 #: Free timing: the shortest leg between two holds, seconds.
 MIN_LEG = 0.25
-#: Free timing: the estimated speeds tried, multiples of the even speed (the centres'
-#: path length over the time the holds leave).
+#: Free timing: the estimated speeds tried, multiples of the even speed (the legs' path
+#: length over the time the holds leave).
 SPEED_FACTORS = (1.0, 2.0, 4.0)
 #: ``[task_order] order = "any"``: every order is tried up to this many tasks; beyond,
 #: nearest neighbour then 2-opt on the estimated travel.
@@ -74,23 +77,6 @@ MAX_ORDERS = 4
 #: Most (visit order, ``any_of`` combination) pairs ranked by their travel
 #: (:func:`task_plans`).
 MAX_COMBINATIONS = 2048
-
-
-def alternatives(spec: Spec) -> list[tuple[int, ...]]:
-    """The combinations of ``any_of`` alternatives to try, in order.
-
-    Parameters
-    ----------
-    spec : Spec
-
-    Returns
-    -------
-    list of tuple of int
-        One index into ``task.boxes`` per task of ``spec.tasks``; the product of the
-        alternatives in the spec's order (the first of each first), at most
-        :data:`MAX_PLANS`.
-    """
-    return list(islice(product(*(range(len(t.boxes)) for t in spec.tasks)), MAX_PLANS))
 
 
 def waypoint_box(task: Task, choice: int, previous: np.ndarray,
@@ -418,8 +404,8 @@ def task_plans(spec: Spec, base: TubeDesign) -> list[tuple[tuple[int, ...], tupl
 
     The candidate orders (the listed one; with ``order = "any"`` every order up to
     :data:`EXACT_ORDERS` tasks, else :func:`visit_orders`) with every combination of
-    :func:`alternatives` (at most :data:`MAX_COMBINATIONS` pairs; beyond, the orders of
-    :func:`visit_orders`), ranked by the centres' path length (the shortest asks the
+    ``any_of`` alternatives (at most :data:`MAX_COMBINATIONS` pairs; beyond, the orders
+    of :func:`visit_orders`), ranked by the centres' path length (the shortest asks the
     lowest speed of the tube) and kept when their windows admit a timing
     (:func:`task_schedule`), at most :data:`MAX_PLANS`.
 
@@ -460,7 +446,7 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...],
         The paper's tube of the spec (:func:`~stt_codegen.design.search.base_design`):
         its first and last reach boxes are ``X-hat_0`` and ``T-hat``.
     choice : tuple of int
-        One alternative per task (:func:`alternatives`).
+        One alternative per task, spec order (:func:`task_plans`).
     order : tuple of int, optional
         Task indices in visit order (:func:`visit_orders`); default the spec's order.
 
