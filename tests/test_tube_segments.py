@@ -128,3 +128,59 @@ def test_open_bump_sum_is_proved_in_verify():
     check = check_open_bump_sum()
     assert check.passed, check.detail
     assert "design.open_bump_sum" in [c.name for c in lemma_checks(orders=1)]
+
+
+def test_cruise_profile_is_proved_c2_with_its_peak_rate_and_is_deployed_as_documented():
+    """SymPy: the documented cruise profile (ramp share ``a`` in (0, 1/2), symbolic) has
+    ``p``, ``p_dot``, ``p_ddot`` continuous at both joints, ``p = 0, 1`` and
+    ``p_dot = p_ddot = 0`` at the ends, rate ``1 / (1 - a)`` in the cruise and between 0
+    and that on the ramps; the deployed CasADi piece, printed and reduced on each branch,
+    is that profile at ``a = CRUISE_RAMP`` and its ``p_dot`` output is ``dp/dt`` (both to
+    the doubles' rounding of the constants, 1e-13 on every coefficient)."""
+    import sympy as sp
+
+    from stt_codegen.codegen.emit import sympy_expressions
+    from stt_codegen.tube import pieces
+    from stt_codegen.verify.deployed import exact, on_domain
+
+    a = sp.Symbol("a", positive=True)
+    tau, x = sp.symbols("tau x", real=True)
+    v = 1 / (1 - a)
+
+    def covered(y):
+        return v * a * (y**3 - y**4 / 2)
+
+    branches = (covered(tau / a), v * (tau - a / 2), 1 - covered((1 - tau) / a))
+    for k in range(3):
+        d = [sp.diff(b, tau, k) for b in branches]
+        assert sp.simplify((d[0] - d[1]).subs(tau, a)) == 0
+        assert sp.simplify((d[1] - d[2]).subs(tau, 1 - a)) == 0
+        assert sp.simplify(d[0].subs(tau, 0)) == 0
+        assert sp.simplify(d[2].subs(tau, 1) - (0 if k else 1)) == 0
+    assert sp.simplify(sp.diff(branches[1], tau) - v) == 0
+    ramp_rate = sp.simplify(sp.diff(branches[0], tau).subs(tau, a * x))
+    assert sp.simplify(ramp_rate - v * x**2 * (3 - 2 * x)) == 0
+    # on x in [0, 1]: v x^2 (3 - 2x) >= 0 and v - it = v (1 - x)^2 (1 + 2x) >= 0
+    assert sp.simplify(v - ramp_rate - v * (1 - x) ** 2 * (1 + 2 * x)) == 0
+    assert peak_rate_factor(CRUISE) == float(v.subs(a, sp.Rational(1, 5)))
+
+    t = sp.Symbol("t", real=True)
+    d_ = sp.Symbol("d", positive=True)
+    w = sp.Symbol("w", positive=True)
+    (p,), (p_dot,) = sympy_expressions(pieces.progress(CRUISE), {"t": [t], "start": [0],
+                                                                 "end": [d_]})
+    lo, hi = exact(sp.Float(CRUISE_RAMP)), exact(sp.Float(1.0 - CRUISE_RAMP))
+    domains = ({t: lo * d_ * w / (1 + w)}, {t: (lo + (hi - lo) * w / (1 + w)) * d_},
+               {t: (hi + (1 - hi) * w / (1 + w)) * d_})
+    documented = [sp.expand(b.subs(a, sp.Rational(1, 5))) for b in branches]
+
+    def gap(got, expected) -> float:      # largest coefficient of got - expected in tau
+        diff = sp.Poly(sp.expand(got - expected), tau)
+        return max(abs(float(c)) for c in diff.all_coeffs())
+
+    for domain, expected in zip(domains, documented):
+        value, rate = on_domain(p, domain), on_domain(p_dot, domain)
+        value, rate = value.subs(t, tau * d_), (rate * d_).subs(t, tau * d_)
+        assert gap(value, expected) < 1e-13
+        assert gap(rate, sp.diff(expected, tau)) < 1e-13
+    assert pieces.PROFILE_NAMES.index(CRUISE) == 2
