@@ -29,11 +29,16 @@ def design_files(design: Design, options: Options) -> dict[str, bytes]:
         File name to content: law (13)'s controller
         (:func:`~.generate.generate_files`) for a first-order plant, the cascade
         controller (:func:`~.cascade_source.cascade_generation`, docs/second-order.md)
-        for a second-order one.
+        for a second-order one, the look-ahead controller
+        (:func:`~.look_ahead_source.look_ahead_generation`, docs/differential-drive.md)
+        for a differential-drive base.
     """
-    if design.spec.order == 2:
+    if design.spec.variant == "cascade":
         from .cascade_source import cascade_generation
         return cascade_generation(design, options)
+    if design.spec.variant == "look-ahead":
+        from .look_ahead_source import look_ahead_generation
+        return look_ahead_generation(design, options)
     return generate_files(design.spec, design.tube, options)
 
 

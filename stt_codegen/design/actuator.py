@@ -208,8 +208,9 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     proved = [c for c in tried if c.proof.proved]
     names = spec.input_names
     # the controller in the user's words: law (13)'s input, or the cascade's force/torque
-    law, unit = (("law (13)", "") if spec.order == 1 else
-                 ("the cascade's input u", f" {spec.input_unit}"))
+    law, unit = {"first-order": ("law (13)", ""),
+                 "cascade": ("the cascade's input u", f" {spec.input_unit}"),
+                 "look-ahead": ("the base's command (v, omega)", "")}[spec.variant]
     if not proved:
         reasons = "; ".join(f"{c.label}: {c.proof.reason}" for c in tried)
         raise DesignError(

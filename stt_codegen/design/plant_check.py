@@ -17,7 +17,7 @@ import numpy as np
 
 from ..spec.loader import Spec
 
-__all__ = ["plant_failure"]
+__all__ = ["plant_failure", "wheel_error_failure"]
 
 #: Heading range of the omnidirectional robot (eq. (14)) where ``g_s`` is positive
 #: definite: ``g_s = diag(cos x3, cos x3, 1)`` (docs/decisions.md, decision 10).
@@ -69,6 +69,30 @@ def heading_range_failure(lower: float, upper: float) -> str:
             "= diag(cos x3, cos x3, 1) is then not positive definite (Assumption 2)")
 
 
+def wheel_error_failure(spec: Spec) -> str:
+    """Why a differential drive's wheel errors lose Assumption 2 for its look-ahead point
+    ("" if not): the symmetric part of ``g(theta)`` has the smallest eigenvalue ``1 + m -
+    |d| s`` (:mod:`stt_codegen.spec.differential_drive`).
+
+    Parameters
+    ----------
+    spec : Spec
+        A differential-drive spec.
+
+    Returns
+    -------
+    str
+        The reason, naming ``plant.wheel_radius_error``, or ``""``.
+    """
+    g_min = spec.assumptions.input_gain[0]
+    if g_min > 0.0:
+        return ""
+    return (f"plant.wheel_radius_error: with wheel errors {list(spec.drive.wheel_radius_error)} "
+            f"the look-ahead point's (g + g^T)/2 has the eigenvalue {g_min:.6g} <= 0 at some "
+            "heading: Assumption 2 fails (smaller errors, or an axle_offset closer to half the "
+            "track_width)")
+
+
 def plant_failure(spec: Spec) -> str:
     """Why the spec's plant violates Assumption 2 ("" when it holds or is not known).
 
@@ -97,4 +121,5 @@ PLANT_FAILURES = {
                             else linear_plant_failure(spec.linear_plant.g)),
     "omnidirectional": lambda spec: heading_range_failure(spec.state_space.lower[2],
                                                           spec.state_space.upper[2]),
+    "differential-drive": lambda spec: wheel_error_failure(spec),
 }

@@ -7,7 +7,10 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
+from ..errors import SpecError
+from ..spec.plants import model_behaviour
 from ..spec.robot import robot_json
+from ..tube.look_ahead import LookAhead
 from ..tube.parameters import TubeDesign
 from ..tube.second_stage import SecondStage
 from .cascade_gain import second_stage_for
@@ -150,6 +153,42 @@ class Design:
             No shape is certified at the design's rate (kind ``SAMPLING_RATE``).
         """
         return second_stage_for(self.tube, self.spec, self.check.min_width)
+
+    @property
+    def look_ahead(self) -> LookAhead:
+        """The look-ahead variant's data of a differential-drive design: the axle offset
+        and the base's limits ``(v_max, omega_max)`` of ``[actuator] input_bound``
+        (docs/differential-drive.md).
+
+        Returns
+        -------
+        LookAhead
+
+        Raises
+        ------
+        SpecError
+            The spec's ``plant.model`` is not a differential drive (field ``plant.model``).
+        """
+        if self.spec.drive is None:
+            raise SpecError("plant.model", "only a differential-drive base has a look-ahead "
+                                           f"point (plant.model is {self.spec.plant_model!r})")
+        return LookAhead(self.spec.drive.axle_offset, self.spec.input_bound)
+
+    @property
+    def stage(self) -> SecondStage | LookAhead | None:
+        """What the controller variant needs beyond the tube: ``None`` for law (13) on the
+        plant's state, the cascade's :attr:`second_stage`, the :attr:`look_ahead` point.
+
+        Returns
+        -------
+        SecondStage, LookAhead or None
+
+        Raises
+        ------
+        DesignError
+            A second-order design whose second stage is not certified.
+        """
+        return model_behaviour(_STAGES, self.spec.variant, "controller stage")(self)
 
     def to_json(self) -> dict[str, Any]:
         """The design as plain JSON types (the ``design`` command's and ``simulate --json``'s).
@@ -314,3 +353,11 @@ def require_design(value: object, function: str, parameter: str = "design") -> D
         hint = "call stt_codegen.design_tube(spec) and pass the Design it returns"
     raise TypeError(f"{function}(): parameter {parameter!r} must be a Design, not {kind}; "
                     f"{hint}")
+
+
+#: The controller variant's data beyond the tube, per variant (:attr:`Design.stage`).
+_STAGES = {
+    "first-order": lambda design: None,
+    "cascade": lambda design: design.second_stage[0],
+    "look-ahead": lambda design: design.look_ahead,
+}

@@ -32,6 +32,7 @@ from ..tube.parameters import Circumvent, TubeDesign, paper_segments
 from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, certify_tube
 from .certificate.motion import certify_motion
 from .actuator import design_within_bound
+from .look_ahead import look_ahead_within_bound
 from .cascade_gain import cascade_input_proof
 from .failures import FailureKind, property_kind
 from .grid import grid_index, grid_value, smallest_passing
@@ -349,6 +350,8 @@ def _position_stage(spec: Spec) -> Design:
         # points): auto's estimate of the smoother tube plays no part
         if spec.order == 2:
             return _cascade_within_bound(spec)
+        if spec.drive is not None:        # (v, omega) of a differential drive
+            return look_ahead_within_bound(spec, lambda free: _design(free, smoother=False))
         return design_within_bound(spec, lambda free: _design(free, smoother=False))
     return _design(spec, smoother=True)
 

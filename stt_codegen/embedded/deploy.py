@@ -168,6 +168,10 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
     if spec.mujoco is not None:
         raise SpecError("plant.model", "the firmware's closed loop needs the plant's equations; "
                                        "a MuJoCo plant runs on the host (stt-codegen simulate)")
+    if spec.drive is not None:
+        raise SpecError("plant.model", "the firmware's closed loop of a differential-drive base "
+                                       "(the look-ahead variant) is not built yet; its generated "
+                                       "C runs on the host (stt-codegen simulate --backend c)")
     seed = check_seed(seed)
     message = missing_message()
     if message:

@@ -19,6 +19,7 @@ from ..tube import reference
 from ..errors import SpecError
 from ..tube.parameters import (STATUS_INPUT_CLAMPED, STATUS_INVALID_INPUT, STATUS_OK,
                                STATUS_OUTSIDE_TUBE, TubeDesign)
+from ..tube.look_ahead import LookAhead
 from ..tube.second_stage import SecondStage
 
 __all__ = ["STATUS_INPUT_CLAMPED", "STATUS_INVALID_INPUT", "STATUS_OK", "STATUS_OUTSIDE_TUBE",
@@ -85,24 +86,41 @@ def _cascade(backend: str) -> Callable[[TubeDesign, SecondStage], Controller]:
     return factory
 
 
-#: Factories by plant order, then by backend name: order 1 ``factory(design)``, order 2
-#: ``factory(design, stage)``.
-_FACTORIES: dict[int, dict[str, Callable[..., Controller]]] = {
-    1: {"reference": ReferenceController,
-        "casadi": CasadiController,
-        "c": _generated_c,
-        "python": _generated_python},
-    2: {name: _cascade(name) for name in ("reference", "casadi", "c", "python")},
+def _look_ahead(backend: str) -> Callable[[TubeDesign, LookAhead], Controller]:
+    def factory(design: TubeDesign, look_ahead: LookAhead) -> Controller:
+        from .look_ahead_controllers import LookAheadController
+        return LookAheadController(backend, design, look_ahead)
+    return factory
+
+
+#: Factories by controller variant, then by backend name: ``"first-order"``
+#: ``factory(design)``, the others ``factory(design, stage)`` with the variant's data (the
+#: cascade's :class:`SecondStage`, the look-ahead point's :class:`LookAhead`).
+_FACTORIES: dict[str, dict[str, Callable[..., Controller]]] = {
+    "first-order": {"reference": ReferenceController,
+                    "casadi": CasadiController,
+                    "c": _generated_c,
+                    "python": _generated_python},
+    "cascade": {name: _cascade(name) for name in ("reference", "casadi", "c", "python")},
+    "look-ahead": {name: _look_ahead(name) for name in ("reference", "casadi", "c", "python")},
 }
+#: The variant of each plant order (the ``order`` keyword of the functions below).
+_ORDERS = {1: "first-order", 2: "cascade"}
 
 
-def _order(order: int) -> dict[str, Callable[..., Controller]]:
-    if order not in _FACTORIES:
+def _order(order: int, variant: str | None = None) -> dict[str, Callable[..., Controller]]:
+    if variant is not None:
+        if variant not in _FACTORIES:
+            raise SpecError("variant", f"unknown controller variant {variant!r} (known: "
+                                       f"{', '.join(_FACTORIES)})")
+        return _FACTORIES[variant]
+    if order not in _ORDERS:
         raise SpecError("order", f"a plant's order is 1 or 2, got {order!r}")
-    return _FACTORIES[order]
+    return _FACTORIES[_ORDERS[order]]
 
 
-def register_backend(name: str, factory: Callable[..., Controller], *, order: int = 1) -> None:
+def register_backend(name: str, factory: Callable[..., Controller], *, order: int = 1,
+                     variant: str | None = None) -> None:
     """Make ``factory`` available as backend ``name`` for plants of one order.
 
     Parameters
@@ -115,22 +133,28 @@ def register_backend(name: str, factory: Callable[..., Controller], *, order: in
         stage)``, with the cascade's :class:`~stt_codegen.tube.second_stage.SecondStage`.
     order : {1, 2}, optional
         The plant order the backend serves (default 1).
+    variant : {"first-order", "cascade", "look-ahead"}, optional
+        The controller variant instead of ``order`` (``"look-ahead"``: ``factory(design,
+        look_ahead)`` with the differential drive's
+        :class:`~stt_codegen.tube.look_ahead.LookAhead`).
 
     Raises
     ------
     SpecError
-        ``order`` is not 1 or 2 (field ``order``).
+        ``order`` is not 1 or 2 (field ``order``), or an unknown ``variant``.
     """
-    _order(order)[name] = factory
+    _order(order, variant)[name] = factory
 
 
-def backend_names(order: int = 1) -> list[str]:
+def backend_names(order: int = 1, variant: str | None = None) -> list[str]:
     """The registered backend names of one plant order, in registration order.
 
     Parameters
     ----------
     order : {1, 2}, optional
         The plant order (default 1).
+    variant : str, optional
+        The controller variant instead of ``order`` (:data:`~stt_codegen.spec.plants.VARIANTS`).
 
     Returns
     -------
@@ -140,13 +164,13 @@ def backend_names(order: int = 1) -> list[str]:
     Raises
     ------
     SpecError
-        ``order`` is not 1 or 2 (field ``order``).
+        ``order`` is not 1 or 2 (field ``order``), or an unknown ``variant``.
     """
-    return list(_order(order))
+    return list(_order(order, variant))
 
 
 def make_controller(name: str, design: TubeDesign,
-                    stage: SecondStage | None = None) -> Controller:
+                    stage: SecondStage | LookAhead | None = None) -> Controller:
     """The controller of backend ``name`` for a design.
 
     Parameters
@@ -155,15 +179,17 @@ def make_controller(name: str, design: TubeDesign,
         A name of :func:`backend_names` of the plant's order.
     design : TubeDesign
         The tube and gain the controller runs.
-    stage : SecondStage, optional
-        The cascade's second stage: given for a second-order plant (the cascade law),
-        ``None`` for a first-order one (law (13)).
+    stage : SecondStage or LookAhead, optional
+        The variant's data: the cascade's second stage for a second-order plant, the
+        look-ahead point of a differential-drive base; ``None`` for law (13) on the
+        plant's state.
 
     Returns
     -------
     Controller
         ``step(x, t, dt, alpha) -> (u, alpha_next, status)``: ``x`` (n,) state units, or
-        ``[x1; x2]`` (2n,) for a second-order plant; ``t`` and ``dt`` in s, ``alpha``
+        ``[x1; x2]`` (2n,) for a second-order plant, ``(x, y, theta)`` for a
+        differential-drive base (``u = (v, omega)``); ``t`` and ``dt`` in s, ``alpha``
         (2n,); ``u`` (n,) input units, ``alpha_next`` (2n,) by the implicit step of the
         adaptive law (11), ``status`` a :class:`~stt_codegen.tube.parameters.Status`.
 
@@ -174,10 +200,12 @@ def make_controller(name: str, design: TubeDesign,
     ToolchainError
         Backend ``"c"``: no C compiler, or it failed.
     """
-    order = 1 if stage is None else 2
-    factories = _order(order)
+    variant = ("first-order" if stage is None else
+               "look-ahead" if isinstance(stage, LookAhead) else "cascade")
+    factories = _FACTORIES[variant]
     if name not in factories:
-        kind = "a first-order" if order == 1 else "a second-order"
-        raise SpecError("backend", f"unknown backend {name!r} for {kind} plant "
+        kind = {"first-order": "a first-order plant", "cascade": "a second-order plant",
+                "look-ahead": "a differential-drive base"}[variant]
+        raise SpecError("backend", f"unknown backend {name!r} for {kind} "
                                    f"(known: {', '.join(factories)})")
     return factories[name](design) if stage is None else factories[name](design, stage)

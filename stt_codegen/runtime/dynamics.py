@@ -161,6 +161,9 @@ def plant_function(model: str, n: int, linear=None) -> ca.Function:
     """
     if model in INPUT_MATRICES:   # a named model: g(x) is fixed, not from the spec
         return plant_rhs(model, n)
+    if plant_entry(model).plant_states is not None:
+        raise ValueError(f"the {model} plant's state is not the tube's: its dynamics are "
+                         "the variant's own (runtime/differential_drive.py)")
     if plant_entry(model).declared_bounds:
         raise ValueError(f"the {model} plant has no equations here (it runs in its own "
                          "simulator)")

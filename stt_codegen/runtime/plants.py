@@ -17,13 +17,16 @@ import numpy as np
 
 from ..codegen.emit import python_function
 from ..errors import SpecError
+from ..spec.differential_drive import DifferentialDrive
 from ..spec.loader import LinearPlant
 from ..spec.plants import PLANTS, MissingPlantBehaviour, dimension_mismatch, model_behaviour
+from .differential_drive import base_rhs
 from .dynamics import linear_rhs, plant_rhs
 from .mujoco_plant import MujocoPlant
 from .second_order_plants import model_info, second_order_rhs
 
-__all__ = ["Disturbance", "check_seed", "make_plant", "second_order_plant", "spec_plant"]
+__all__ = ["Disturbance", "check_seed", "differential_drive_plant", "make_plant",
+           "second_order_plant", "spec_plant"]
 
 #: Number of sinusoids summed in each disturbance component.
 DISTURBANCE_TERMS = 3
@@ -202,11 +205,18 @@ def _simulator_only(n: int, disturbance: Disturbance, linear) -> ct.NonlinearIOS
                                    "(mjcf, joints, actuators): use spec_plant(spec)")
 
 
+def _base_only(n: int, disturbance: Disturbance, linear) -> ct.NonlinearIOSystem:
+    raise SpecError("plant.model", "a differential-drive base is built from the spec's "
+                                   "[plant] parameters: use spec_plant(spec) or "
+                                   "differential_drive_plant(spec.drive)")
+
+
 SIMULATION_PLANTS = {
     "omnidirectional": lambda n, disturbance, _linear: omnidirectional_robot(disturbance),
     "single-integrator": lambda n, disturbance, _linear: single_integrator(n, disturbance),
     "linear": _spec_linear_plant,
     "mujoco": _simulator_only,
+    "differential-drive": _base_only,
 }
 
 
@@ -264,6 +274,42 @@ def second_order_plant(model: str, dimension: int, parameters, amplitude: float,
                     name=f"second_order_{model.replace('-', '_')}")
 
 
+def differential_drive_plant(drive: DifferentialDrive, seed: int = 0) -> ct.NonlinearIOSystem:
+    """The simulated base of a spec, as a python-control system.
+
+    Parameters
+    ----------
+    drive : DifferentialDrive
+        The base: its track width, wheel errors and slip amplitudes.
+    seed : int
+        Seed of the slip, in ``[0, 2**32)``.
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        States ``x``, ``y``, ``theta`` (m, m, rad); inputs ``v``, ``omega``; the state as
+        output.
+
+    Raises
+    ------
+    SpecError
+        Field ``seed``: not an integer in ``[0, 2**32)``.
+    """
+    rhs_fn = python_function(base_rhs())
+    slip = Disturbance(3, 1.0, seed)
+    amplitude = np.asarray(drive.slip, dtype=float)
+    error, width = list(drive.wheel_radius_error), drive.track_width
+
+    def rhs(t, x, u, _params):
+        w = (amplitude * slip(t)).tolist()
+        return np.array(rhs_fn(np.asarray(x).tolist(), np.asarray(u).tolist(), error, [width],
+                               w)[0], dtype=float)
+
+    states = ["x", "y", "theta"]
+    return ct.nlsys(rhs, None, inputs=["v", "omega"], states=states, outputs=states,
+                    name="differential_drive")
+
+
 def spec_plant(spec, seed: int = 0) -> Any:
     """The plant a spec names (``[plant]``), of the spec's order.
 
@@ -278,7 +324,8 @@ def spec_plant(spec, seed: int = 0) -> Any:
     Returns
     -------
     control.NonlinearIOSystem or MujocoPlant
-        :func:`make_plant` (``n`` states) or :func:`second_order_plant` (``2 n`` states);
+        :func:`make_plant` (``n`` states), :func:`second_order_plant` (``2 n`` states)
+        or :func:`differential_drive_plant` (3 states);
         for ``plant.model = "mujoco"`` the :class:`~.mujoco_plant.MujocoPlant` of
         ``spec.mujoco`` (no disturbance is added: MuJoCo's dynamics are the plant's).
 
@@ -290,6 +337,8 @@ def spec_plant(spec, seed: int = 0) -> Any:
     if spec.mujoco is not None:      # [plant] model = "mujoco": MuJoCo steps the plant
         m = spec.mujoco
         return MujocoPlant(m.path, m.joints, m.actuators, spec.order, m.timestep)
+    if spec.drive is not None:       # a differential-drive base: its own kinematics
+        return differential_drive_plant(spec.drive, seed)
     if spec.order == 1:
         return make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed,
                           spec.linear_plant)

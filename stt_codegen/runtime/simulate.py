@@ -26,9 +26,11 @@ from ..design.result import Design, require_design
 from ..design.samples import check_step_budget
 from ..errors import SpecError
 from .plants import check_seed, spec_plant
+from .state_split import initial_state, positions
 from ..spec.loader import Spec
 from ..tube import cascade_reference, reference
 from ..tube.parameters import Status, TubeDesign
+from ..tube.look_ahead import LookAhead
 from ..tube.second_stage import SecondStage
 from .tasks import TaskOutcome, judge_tasks, until_met
 
@@ -313,7 +315,7 @@ def simulate(design: Design, *positional: object, backend: str = "reference",
                         "(design.spec), and every other argument by keyword: "
                         "simulate(design, backend=..., horizon=..., seed=..., plant=...)")
     design = require_design(design, "simulate")
-    stage = design.second_stage[0] if design.spec.order == 2 else None
+    stage = design.stage
     return run_closed_loop(design.spec, design.tube, backend=backend, horizon=horizon,
                            seed=seed, plant=plant, stage=stage)
 
@@ -321,7 +323,7 @@ def simulate(design: Design, *positional: object, backend: str = "reference",
 def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
                     horizon: float | None = None, seed: int = 0,
                     plant: ct.NonlinearIOSystem | None = None,
-                    stage: SecondStage | None = None,
+                    stage: SecondStage | LookAhead | None = None,
                     controller: Controller | None = None) -> SimulationResult:
     """The closed loop of :func:`simulate` for a spec and a tube given apart.
 
@@ -366,14 +368,13 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     steps = int(math.ceil(horizon * tube.rate_hz - 1e-9))
     check_step_budget(steps, horizon, tube.rate_hz)
     n = spec.dimension
-    if (spec.order == 2) != (stage is not None) and controller is None:
-        raise SpecError("stage", "a second-order spec runs the cascade law, which needs its "
-                                 "second stage (Design.second_stage)" if spec.order == 2
+    if (spec.variant != "first-order") != (stage is not None) and controller is None:
+        raise SpecError("stage", f"a spec of the {spec.variant} variant runs with its "
+                                 "stage (Design.stage)" if stage is None
                         else "a first-order spec runs law (13), which has no second stage")
     if controller is None:
         controller = make_controller(backend, tube, stage)
-    x = np.array(spec.initial_state if spec.order == 1
-                 else [*spec.initial_state, *spec.second_order.initial_velocity], dtype=float)
+    x = initial_state(spec)
     if plant is None:
         plant = spec_plant(spec, seed)
     elif (getattr(plant, "nstates", None), getattr(plant, "ninputs", None)) != (x.size, n):
@@ -394,7 +395,7 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     alphas = np.zeros((steps + 1, 2 * n))
     status = np.zeros(steps + 1, dtype=int)
     alpha = np.zeros(2 * n)
-    dense = [x[None, :n]]
+    dense = [positions(spec, x[None])]
     dense_t = [np.zeros(1)]
     for k in range(steps + 1):
         t = ts[k]
@@ -405,10 +406,10 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
             break
         points, times = stepper.advance(t, u, dt)
         x = points[-1]
-        dense.append(points[:, :n])
+        dense.append(positions(spec, points))
         dense_t.append(times)
         alpha = alpha_next
-    xs = states[:, :n]
+    xs = positions(spec, states)
     path = np.vstack(dense)
     path_t = np.concatenate(dense_t)
     judged = path_t <= t_c + 1e-12

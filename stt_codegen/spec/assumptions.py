@@ -151,7 +151,8 @@ def combine_assumptions(bounds: ModelBounds, declared: Mapping[str, object], n: 
         State dimension.
     amplitude : float
         ``plant.disturbance_amplitude`` (the default ``disturbance_bound`` is
-        ``sqrt(n)`` times it).
+        ``sqrt(n)`` times it, unless the model implies its own,
+        ``bounds.disturbance_bound``).
     prefix : str
         Field prefix for errors.
 
@@ -212,8 +213,15 @@ def combine_assumptions(bounds: ModelBounds, declared: Mapping[str, object], n: 
         blocks = (tuple(range(n)),) if coupling > 0 else tuple((i,) for i in range(n))
     else:
         blocks = bounds.blocks
-    disturbance = (float(declared["disturbance_bound"])  # type: ignore[arg-type]
-                   if "disturbance_bound" in declared else math.sqrt(n) * amplitude)
+    own = (math.sqrt(n) * amplitude if bounds.disturbance_bound is None
+           else bounds.disturbance_bound)
+    if "disturbance_bound" in declared:
+        disturbance = float(declared["disturbance_bound"])  # type: ignore[arg-type]
+        if bounds.disturbance_bound is not None and _tighter(disturbance, own, upper=True):
+            raise _contradiction(f"{prefix}.disturbance_bound", disturbance, own, bounds,
+                                 "disturbance_bound", declared_above=False)
+    else:
+        disturbance = own
     lipschitz = {
         "input_gain_lipschitz": (bounds.input_gain_lipschitz, g_declared),
         "drift_lipschitz": (bounds.drift_lipschitz, "drift_bound" in declared)}

@@ -30,8 +30,9 @@ from .assumptions import Assumptions, combine_assumptions
 from .model_bounds import declared_bounds, model_bounds
 from .motion import MovingObstacle, check_moving, is_moving, moving_obstacle
 from .mujoco import MujocoModel, mujoco_model, with_folder
-from .plants import (MODEL_KEYS, PLANTS, SECOND_ORDER_MODELS, SECOND_ORDER_PLANTS, SIMULATOR_KEYS,
-                     dimension_mismatch, plant_entry)
+from .differential_drive import DifferentialDrive
+from .plants import (MODEL_KEYS, PARAMETER_KEYS, PLANTS, SECOND_ORDER_MODELS, SECOND_ORDER_PLANTS,
+                     SIMULATOR_KEYS, dimension_mismatch, plant_entry)
 from .robot import (Robot, inflate_ball, inflate_bounds, inflate_moving, inflate_polytope,
                     robot_dims, shrink_bounds)
 from .tasks import Task, build_tasks
@@ -255,6 +256,11 @@ class Spec:
         ``plant.parameters``, ``initial.velocity``, ``state_space.velocity_bound`` and the
         ``[assumptions]`` of its second stage; docs/second-order.md); ``None`` for a
         first-order spec.
+    drive : DifferentialDrive or None
+        The differential-drive base (``plant.model = "differential-drive"``: the
+        ``[plant]`` parameters and ``initial.heading``; docs/differential-drive.md), whose
+        look-ahead point the tube holds (the state space, the sets and ``initial.state``
+        are the point's); ``None`` for any other model.
     source_hash : str
         SHA-256 of the spec file's bytes.
     target_half_width_given : bool
@@ -315,6 +321,7 @@ class Spec:
     moving_obstacles: tuple[MovingObstacle, ...] = ()
     robot: Robot | None = None
     mujoco: MujocoModel | None = None
+    drive: DifferentialDrive | None = None
 
     @property
     def dimension(self) -> int:
@@ -334,6 +341,39 @@ class Spec:
             tube of the positions ``x1``.
         """
         return 1 if self.second_order is None else 2
+
+    @property
+    def variant(self) -> str:
+        """The controller variant (:data:`~.plants.VARIANTS`) that runs the plant.
+
+        Returns
+        -------
+        str
+            ``"first-order"`` (law (13) on the plant's state), ``"cascade"`` (a
+            second-order plant, docs/second-order.md) or ``"look-ahead"`` (law (13) on the
+            look-ahead point of a differential-drive base, docs/differential-drive.md).
+        """
+        return "cascade" if self.second_order is not None else \
+            plant_entry(self.plant_model).variant
+
+    def plant_data(self, model: str | None = None) -> Any:
+        """The ``[plant]`` data a model's equations take: the ``linear`` model's matrices,
+        the differential drive's base; ``None`` for a model without any.
+
+        Parameters
+        ----------
+        model : str, optional
+            A first-order ``plant.model`` (default the spec's): the spec's data only if
+            that model takes them.
+
+        Returns
+        -------
+        LinearPlant, DifferentialDrive or None
+        """
+        entry = plant_entry(model or self.plant_model)
+        if entry.keys:
+            return self.linear_plant
+        return self.drive if entry.parameter_keys else None
 
     @property
     def input_names(self) -> tuple[str, ...]:
@@ -384,9 +424,9 @@ class Spec:
             raise SpecError("plant", mismatch)
         a = self.assumptions
         declared = {key: getattr(a, key) for key in a.declared}
-        # only a model that takes [plant] matrices keeps this spec's
-        linear = self.linear_plant if model in MODEL_KEYS.values() else None
-        bounds = model_bounds(model, self.state_space.lower, self.state_space.upper, linear)
+        # only a model that takes [plant] matrices or parameters keeps this spec's
+        bounds = model_bounds(model, self.state_space.lower, self.state_space.upper,
+                              self.plant_data(model))
         return replace(self, plant_model=model, assumptions=combine_assumptions(
             bounds, declared, self.dimension, self.disturbance_amplitude))
 
@@ -655,7 +695,10 @@ def _validate(raw: dict) -> Spec:
     moving = tuple(_moving(table, f"obstacles[{j}]", j, state_space, initial_set, target_set,
                            doc.prescribed_time)
                    for j, table in enumerate(doc.obstacles) if is_moving(table))
-    robot = _robot(doc, state_space, initial_set, target_set, unsafe_sets, moving)
+    linear = _linear_plant(doc.plant, n)      # also refuses another model's [plant] keys
+    drive = _differential_drive(doc)
+    robot = _robot(doc, state_space, initial_set, target_set, unsafe_sets, moving,
+                   0.0 if drive is None else drive.axle_offset)
     if robot is not None:        # the problem of the reference point: sets inflated, X shrunk
         state_space, unsafe_sets, moving = _robot_problem(robot, state_space, initial_set,
                                                           target_set, doc.prescribed_time)
@@ -667,8 +710,8 @@ def _validate(raw: dict) -> Spec:
     mismatch = dimension_mismatch(model, n)
     if mismatch:
         raise SpecError("plant.model", mismatch)
-    amplitude = doc.plant.disturbance_amplitude
-    linear = _linear_plant(doc.plant, n)
+    # a differential drive's disturbance is its slip (Spec.drive)
+    amplitude = doc.plant.disturbance_amplitude if drive is None else 0.0
     second_order = _second_order(doc, n)
     if second_order is not None:
         model = "single-integrator"     # the position stage x1_dot = x2 (Spec.plant_model)
@@ -682,7 +725,7 @@ def _validate(raw: dict) -> Spec:
                 linear_plant=linear,
                 assumptions=_assumptions(doc.assumptions if second_order is None
                                          else AssumptionsTable(), n, amplitude, model,
-                                         state_space, linear),
+                                         state_space, linear if drive is None else drive),
                 input_bound=_input_bound(doc.actuator, doc.plant.model, n,
                                          doc.plant.actuators),
                 second_order=second_order,
@@ -695,7 +738,8 @@ def _validate(raw: dict) -> Spec:
                 task_order=doc.task_order.order if doc.task_order is not None else "listed",
                 moving_obstacles=moving, robot=robot,
                 mujoco=(mujoco_model(doc.plant, n, plant_entry(doc.plant.model).input_count(n))
-                        if plant_entry(doc.plant.model).simulator_keys else None))
+                        if plant_entry(doc.plant.model).simulator_keys else None),
+                drive=drive)
 
 
 def _vector(value: list[float], name: str, length: int | None) -> tuple[float, ...]:
@@ -750,7 +794,8 @@ def _matrix(rows: list[list[float]], name: str, n: int) -> tuple[tuple[float, ..
 def _linear_plant(table: PlantTable, n: int) -> LinearPlant | None:
     """The matrices ``a``, ``g``, ``c`` of ``[plant]``; only the ``linear`` model takes them
     (and only the ``mujoco`` model its simulator's keys)."""
-    owners = {**{key: (owner,) for key, owner in MODEL_KEYS.items()}, **SIMULATOR_KEYS}
+    owners = {**{key: (owner,) for key, owner in (*MODEL_KEYS.items(), *PARAMETER_KEYS.items())},
+              **SIMULATOR_KEYS}
     for key, models in owners.items():
         if getattr(table, key) is not None and table.model not in models:
             raise SpecError(f"plant.{key}", f"only the {' and '.join(models)} model"
@@ -937,16 +982,51 @@ def _cover_all(unsafe_sets: tuple[UnsafeSet, ...], state_space: Box, initial_set
 
 
 def _robot(doc: Any, state_space: Box, initial_set: Box, target_set: Box,
-           unsafe_sets: tuple[UnsafeSet, ...], moving: tuple[MovingObstacle, ...]
-           ) -> Robot | None:
-    """``[robot]`` and the sets as given, or ``None`` without the table."""
-    if doc.robot is None:
+           unsafe_sets: tuple[UnsafeSet, ...], moving: tuple[MovingObstacle, ...],
+           offset: float = 0.0) -> Robot | None:
+    """``[robot]`` and the sets as given, or ``None`` without the table and ``offset``.
+
+    ``offset``: how far the reference point may lie from the body's centre (a
+    differential drive's axle offset), added to the radius: the body's disc of radius
+    ``r`` around the axle lies in the disc of radius ``r + offset`` around the point."""
+    if doc.robot is None and offset == 0.0:
         return None
-    dims = robot_dims(doc.robot.dims, len(state_space.lower))
-    return Robot(float(doc.robot.radius), dims, state_space, unsafe_sets, moving)
+    dims = robot_dims(None if doc.robot is None else doc.robot.dims, len(state_space.lower))
+    radius = (0.0 if doc.robot is None else float(doc.robot.radius)) + offset
+    return Robot(radius, dims, state_space, unsafe_sets, moving, offset)
+
+
+def _differential_drive(doc: Any) -> DifferentialDrive | None:
+    """The base of ``plant.model = "differential-drive"`` (its ``[plant]`` parameters and
+    ``initial.heading``), or ``None`` for another model (which may not take
+    ``initial.heading``); the required keys and the unused ``disturbance_amplitude``
+    checked."""
+    table = doc.plant
+    if not plant_entry(table.model).parameter_keys:
+        if doc.initial.heading is not None:
+            raise SpecError("initial.heading", f"only plant.model = \"differential-drive\" "
+                                               f"takes it (plant.model is {table.model!r})")
+        return None
+    for key in ("axle_offset", "track_width"):
+        if getattr(table, key) is None:
+            raise SpecError(f"plant.{key}", f"required for plant.model = {table.model!r}")
+    if "disturbance_amplitude" in table.model_fields_set:
+        raise SpecError("plant.disturbance_amplitude", f"plant.model = {table.model!r} "
+                        "takes its disturbance as plant.slip (forward, lateral, turn)")
+    return DifferentialDrive(
+        float(table.axle_offset), float(table.track_width),
+        tuple(float(v) for v in table.wheel_radius_error or (0.0, 0.0)),
+        tuple(float(v) for v in table.slip or (0.0, 0.0, 0.0)),
+        float(doc.initial.heading or 0.0))
 
 
 def _no_fit(robot: Robot, label: str, why: str) -> SpecError:
+    if robot.offset:     # a differential drive: its body's radius plus the axle offset
+        body = robot.radius - robot.offset
+        return SpecError("plant.axle_offset" if body == 0 else "robot.radius",
+                         f"the robot (radius {body!r} around its axle, whose look-ahead point "
+                         f"is plant.axle_offset = {robot.offset!r} ahead: {robot.radius!r} in "
+                         f"all) no longer fits in the {label}: {why}")
     return SpecError("robot.radius", f"the robot (radius {robot.radius!r}) no longer fits in "
                                      f"the {label}: {why}")
 

@@ -32,7 +32,7 @@ import math
 from dataclasses import dataclass
 from typing import Sequence
 
-__all__ = ["BOX_BOUNDS", "ModelBounds", "declared_bounds", "model_bounds", "row_coupling", "symmetric_eigen_range", "REL_PAD",
+__all__ = ["BOX_BOUNDS", "ModelBounds", "declared_bounds", "differential_drive_bounds", "model_bounds", "row_coupling", "symmetric_eigen_range", "REL_PAD",
            "EXACT_DRIFT_DIMENSIONS"]
 
 #: Relative outward widening of every computed bound (rounding of ``cos``, ``sin`` and of
@@ -72,6 +72,10 @@ class ModelBounds:
         known (``g`` may jump).
     drift_lipschitz : tuple of float or None
         Likewise for ``|f(x) - f(y)|``.
+    disturbance_bound : float or None
+        Largest ``|w|`` the model's own parameters imply (the differential drive's slip),
+        state units per second; ``None``: the spec's ``plant.disturbance_amplitude``
+        decides.
     """
 
     model: str
@@ -84,6 +88,7 @@ class ModelBounds:
     remedy: str = ""
     input_gain_lipschitz: tuple[float, ...] | None = None
     drift_lipschitz: tuple[float, ...] | None = None
+    disturbance_bound: float | None = None
 
     def words(self, key: str) -> str:
         """Where the model attains ``key`` ("" if not recorded)."""
@@ -294,8 +299,9 @@ def model_bounds(model: str, lower: Sequence[float], upper: Sequence[float],
         ``"linear"`` (``x_dot = a x + c + g u``).
     lower, upper : sequence of float, length n
         The box (the state space, or the tube on an interval), state units.
-    linear : LinearPlant, optional
-        The ``linear`` model's matrices; default ``a = 0``, ``g = I``, ``c = 0``.
+    linear : LinearPlant or DifferentialDrive, optional
+        The model's own ``[plant]`` data: the ``linear`` model's matrices (default ``a =
+        0``, ``g = I``, ``c = 0``), the ``differential-drive`` model's base (required).
 
     Returns
     -------
@@ -362,10 +368,47 @@ def _single_integrator(lower: Sequence[float], upper: Sequence[float],
                        (0.0,) * n, (0.0,) * n)
 
 
+def differential_drive_bounds(drive) -> ModelBounds:
+    """What the base implies for the look-ahead point's system (1), for every heading.
+
+    Parameters
+    ----------
+    drive : DifferentialDrive
+        The base (:class:`~stt_codegen.spec.differential_drive.DifferentialDrive`): its
+        axle offset, track width, wheel errors and slip.
+
+    Returns
+    -------
+    ModelBounds
+        ``input_gain`` ``(1 + m - |d| s, 1 + m + |d| s)``, ``input_gain_skew`` ``|d| |k|``,
+        ``input_gain_coupling`` ``|d| (s + |k|)``, ``drift_bound`` 0, one block, the slip's
+        ``disturbance_bound``; each widened outward by :data:`REL_PAD` (the formulas:
+        :mod:`stt_codegen.spec.differential_drive`).
+    """
+    m, d = drive.mean_error, abs(drive.differential_error)
+    beta = drive.track_width / (2.0 * drive.axle_offset)
+    s, k = 0.5 * (beta + 1.0 / beta), abs(0.5 * (beta - 1.0 / beta))
+    s_v, s_lat, s_w = drive.slip
+    where = "wheel radius errors " + ", ".join(f"{e:g}" for e in drive.wheel_radius_error)
+    return ModelBounds(
+        "differential-drive", (_down(1.0 + m - d * s), _up(1.0 + m + d * s)), _up(d * k),
+        _up(d * (s + k)), 0.0, ((0, 1),),
+        (("input_gain", f"1 + m -+ |d| s for {where}, every heading"),
+         ("input_gain_skew", f"|d| |k| for {where}"),
+         ("input_gain_coupling", f"|d| (s + |k|) for {where}, heading 0"),
+         ("drift_bound", "f = 0"), ("disturbance_bound", "the slip, plant.slip"),
+         ("input_gain_lipschitz", "g depends on the heading, not on p"),
+         ("drift_lipschitz", "f = 0")),
+        "declare wider bounds in [assumptions], or smaller plant.wheel_radius_error",
+        (0.0, 0.0) if d == 0.0 else None, (0.0, 0.0),
+        disturbance_bound=_up(math.hypot(s_v, s_lat + drive.axle_offset * s_w)))
+
+
 #: The bounds over a box of each first-order model, ``(lower, upper, linear) -> bounds``:
 #: what ``[assumptions]`` defaults to.
 BOX_BOUNDS = {
     "omnidirectional": lambda lower, upper, linear=None: _omnidirectional(lower, upper),
     "single-integrator": _single_integrator,
     "linear": _linear,
+    "differential-drive": lambda lower, upper, drive: differential_drive_bounds(drive),
 }

@@ -19,7 +19,8 @@ from dataclasses import dataclass
 from typing import Mapping, TypeVar
 
 __all__ = ["ALL_PLANT_MODELS", "PLANTS", "PLANT_MODELS", "MODEL_KEYS", "NAMED_MODELS",
-           "MissingPlantBehaviour", "MODELS_WITH_EQUATIONS", "PlantModel", "SECOND_ORDER_MODELS",
+           "MissingPlantBehaviour", "MODELS_WITH_EQUATIONS", "PARAMETER_KEYS", "PlantModel",
+           "SECOND_ORDER_MODELS", "VARIANTS",
            "SIMULATOR_KEYS",
            "SECOND_ORDER_PLANTS", "SecondOrderModel", "dimension_mismatch",
            "model_behaviour", "plant_entry"]
@@ -58,6 +59,17 @@ class PlantModel:
         The toolkit has no equations of the model: every bound the design and ``verify``
         use is the declared ``[assumptions]`` (``input_gain`` and ``drift_bound`` are
         required), and nothing proves the plant meets them.
+    parameter_keys : tuple of str
+        Keys of ``[plant]`` only this model takes that give its physical parameters
+        (the differential drive's axle offset, track width, wheel errors and slip).
+    variant : str
+        The controller that drives it (:data:`VARIANTS`): ``"first-order"``, law (13) on
+        the plant's state; ``"look-ahead"``, law (13) on a point ahead of a
+        non-holonomic base (docs/differential-drive.md).
+    plant_states : int or None
+        The plant's own state count when the tube holds a point computed from the
+        state (the differential drive: ``x, y, theta``); ``None``: the tube's states are
+        the plant's.
     """
 
     name: str
@@ -70,6 +82,9 @@ class PlantModel:
     drift_varies: bool = False
     simulator_keys: tuple[str, ...] = ()
     declared_bounds: bool = False
+    parameter_keys: tuple[str, ...] = ()
+    variant: str = "first-order"
+    plant_states: int | None = None
 
     #: Order of the model: 1, system (1) driven by law (13).
     order = 1
@@ -96,14 +111,28 @@ PLANTS: dict[str, PlantModel] = {p.name: p for p in (
                "input_gain and drift_bound are required and taken as declared",
                simulator_keys=("mjcf", "joints", "actuators", "timestep"),
                declared_bounds=True),
+    PlantModel("differential-drive", "a differential-drive base, x_dot = v cos(theta), "
+               "y_dot = v sin(theta), theta_dot = omega (inputs v, omega); the tube holds its "
+               "look-ahead point (x, y) + axle_offset (cos theta, sin theta), 2 states "
+               "(plant.axle_offset, plant.track_width, plant.wheel_radius_error, plant.slip, "
+               "initial.heading)", states=2, inputs=("v", "omega"),
+               parameter_keys=("axle_offset", "track_width", "wheel_radius_error", "slip"),
+               variant="look-ahead", plant_states=3),
 )}
 #: The ``plant.model`` values.
 PLANT_MODELS: tuple[str, ...] = tuple(PLANTS)
 #: Models with fixed dynamics (no matrices from the spec).
 NAMED_MODELS: tuple[str, ...] = tuple(name for name, p in PLANTS.items()
-                                      if not p.keys and not p.declared_bounds)
+                                      if not p.keys and not p.declared_bounds
+                                      and p.plant_states is None)
 #: ``[plant]`` matrix keys that belong to one model, with the model.
 MODEL_KEYS: dict[str, str] = {key: name for name, p in PLANTS.items() for key in p.keys}
+#: ``[plant]`` parameter keys that belong to one model, with the model.
+PARAMETER_KEYS: dict[str, str] = {key: name for name, p in PLANTS.items()
+                                  for key in p.parameter_keys}
+#: The controller variants a plant model may name: law (13), the cascade law for second
+#: order, law (13) on a look-ahead point of a non-holonomic base.
+VARIANTS = ("first-order", "cascade", "look-ahead")
 #: Models with equations the toolkit knows (their bounds derived, their dynamics simulated).
 MODELS_WITH_EQUATIONS: tuple[str, ...] = tuple(name for name, p in PLANTS.items()
                                                if not p.declared_bounds)
@@ -156,6 +185,12 @@ class SecondOrderModel:
 
     #: Order of the model: 2, the cascade law.
     order = 2
+    #: The controller variant (:data:`VARIANTS`).
+    variant = "cascade"
+    #: The plant's state is ``[x1; x2]``, twice the tube's (see :attr:`PlantModel.plant_states`).
+    plant_states = None
+    #: No ``[plant]`` parameter keys beyond ``parameters`` (see :attr:`PlantModel.parameter_keys`).
+    parameter_keys = ()
 
     def input_count(self, n: int) -> int:
         """Number of physical inputs for ``n`` positions (one per position)."""

@@ -51,6 +51,9 @@ class Robot:
         The static ``[[obstacles]]`` as given; ``Spec.unsafe_sets`` are them inflated.
     moving_obstacles : tuple of MovingObstacle
         The moving obstacles as given; ``Spec.moving_obstacles`` are them inflated.
+    offset : float
+        The part of :attr:`radius` that is the reference point's distance from the body's
+        centre (a differential drive's ``plant.axle_offset``), state units; 0 otherwise.
     """
 
     radius: float
@@ -58,6 +61,7 @@ class Robot:
     state_space: Any
     unsafe_sets: tuple[Any, ...] = ()
     moving_obstacles: tuple[Any, ...] = ()
+    offset: float = 0.0
 
 
 def robot_dims(given: Sequence[int] | None, n: int) -> tuple[int, ...]:

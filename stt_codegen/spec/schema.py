@@ -98,6 +98,8 @@ class InitialTable(BoxTable):
                                   "x(0) in X_0")
     velocity: Vector = _omitted("second-order models only: the initial velocity x2(0), one "
                                 "per position; default 0")
+    heading: Number = _omitted("differential-drive only: the heading theta(0), rad; "
+                               "default 0 (state and the box are the look-ahead point's)")
 
 
 class TargetTable(BoxTable):
@@ -221,6 +223,20 @@ class PlantTable(_Table):
         "mujoco model only: the actuator of each input, in the order of u")
     timestep: Positive = _omitted("mujoco model only: MuJoCo's timestep, s; default the "
                                   "model's own (1 / rate_hz must be a whole number of them)")
+    axle_offset: Positive = _omitted(
+        "differential-drive only (required): l, how far ahead of the axle's midpoint the "
+        "look-ahead point the tube holds lies, m")
+    track_width: Positive = _omitted("differential-drive only (required): b, the distance "
+                                     "between the wheels, m")
+    wheel_radius_error: Annotated[list[Annotated[float, Strict(), AllowInfNan(False),
+                                                 Field(gt=-1, lt=1)]],
+                                  Field(min_length=2, max_length=2)] = _omitted(
+        "differential-drive only: [right, left] relative radius errors of the simulated "
+        "base's wheels (a wheel of radius r (1 + e) where the controller assumes r); "
+        "default [0, 0]")
+    slip: Annotated[list[NonNegative], Field(min_length=3, max_length=3)] = _omitted(
+        "differential-drive only: amplitudes of the simulated slip [forward m/s, lateral "
+        "m/s, turn rad/s]; default [0, 0, 0] (plant.disturbance_amplitude does not apply)")
 
 
 class AssumptionsTable(_Table):

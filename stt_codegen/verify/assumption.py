@@ -21,6 +21,7 @@ from ..errors import SpecError
 from ..runtime.dynamics import input_matrix
 from ..spec.loader import Spec
 from ..spec.model_bounds import model_bounds
+from .look_ahead import assumption2_differential_drive
 from ..spec.plants import MissingPlantBehaviour, model_behaviour
 from .check import Check
 
@@ -290,6 +291,7 @@ ASSUMPTION2_CHECKS: dict[str, Callable[[Spec], Check]] = {
     "single-integrator": lambda spec: assumption2_single_integrator(spec.dimension),
     "linear": assumption2_linear,
     "mujoco": assumption2_declared,
+    "differential-drive": lambda spec: assumption2_differential_drive(spec),
 }
 
 

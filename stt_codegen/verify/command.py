@@ -22,6 +22,8 @@ from ..tube.parameters import TANH, TubeDesign, peak_rate_factor
 from .actuator import input_bound_check, prove_input_bound
 from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_check
+from .look_ahead import look_ahead_inverse
+from ..design.look_ahead import look_ahead_input_proof
 from ..rounding import distinct
 from .check import Check, VerificationReport
 from .lemma import bump_rate_bound, reach_rate_bound
@@ -154,6 +156,8 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
 
     stage("assumption 2")
     checks.append(assumption2_check(spec, model))
+    if spec.drive is not None:     # the deployed command inverts the base's kinematics
+        checks.append(look_ahead_inverse())
     if spec.order == 1:    # the cascade's membership check is reported with its lemmas
         checks += plant_bounds_checks(spec, model)
 
@@ -219,7 +223,10 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     with reference.numpy_math():
         checks += sampled_checks(spec, design, tube_check.certificate)
     if spec.input_bound is not None:
-        checks.append(input_bound_check(spec, prove_input_bound(design, spec)))
+        proof = prove_input_bound(design, spec)
+        if spec.drive is not None:     # (v, omega) of the base from the point's peaks
+            proof = look_ahead_input_proof(proof, spec.drive.axle_offset)
+        checks.append(input_bound_check(spec, proof))
     return checks
 
 

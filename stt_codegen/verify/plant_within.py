@@ -14,7 +14,7 @@ from __future__ import annotations
 from ..rounding import distinct
 from ..spec.loader import Spec
 from ..spec.model_bounds import model_bounds
-from ..spec.plants import MODEL_KEYS, plant_entry
+from ..spec.plants import plant_entry
 from .cascade_sampled import model_within_class
 from .check import Check
 
@@ -32,9 +32,9 @@ def _first_order(spec: Spec, model: str | None) -> Check:
     model = model or spec.plant_model
     if plant_entry(model).declared_bounds:      # no equations: nothing to compare
         return _not_checked("sampled", model, "the sampled verdict")
-    # only a model that takes [plant] matrices is evaluated with the spec's
-    linear = spec.linear_plant if model in MODEL_KEYS.values() else None
-    b = model_bounds(model, spec.state_space.lower, spec.state_space.upper, linear)
+    # only a model that takes [plant] matrices or parameters is evaluated with the spec's
+    b = model_bounds(model, spec.state_space.lower, spec.state_space.upper,
+                     spec.plant_data(model))
     a = spec.assumptions
     tol = 1e-9
     bad = []

@@ -1,0 +1,170 @@
+"""Standalone C and Python of the look-ahead variant for differential-drive bases.
+
+The entry point has the first order's argument order, ``<prefix>_step(x, t, dt, alpha, u,
+alpha_next) -> status`` with ``x = (x, y, theta)`` and ``u = (v, omega)``, and its statuses;
+it computes :func:`stt_codegen.tube.look_ahead.look_ahead_step` of a design, bit for bit in
+double precision.
+
+* C: a variant of the first-order source (:func:`.generate.c_source_context`,
+  ``c_source.c.j2``): the same tables and table-driven tube, ``P_tube``, ``P_alpha_step``
+  and input checks, with the variant's law (``look_ahead_source.c.j2``: the pieces
+  ``look_ahead_point`` and ``base_command`` around the first order's ``law``, its
+  ``saturate`` with the base's limits).
+* Python: the composed Function printed whole by the emitter's Python printer, behind the
+  first order's input checks (``look_ahead_module.py.j2``).
+
+The text is in the Jinja2 templates of the top-level ``templates/``, rendered through
+:func:`.render.render` as the other variants' files are; this module only prepares the data.
+"""
+
+from __future__ import annotations
+
+import hashlib
+
+import casadi
+
+from ..tube.look_ahead import LookAhead, base_command, look_ahead_point, look_ahead_step
+from ..tube.model import build_model
+from ..tube import pieces as P
+from ..tube.parameters import Status, TubeDesign
+from ..version import __version__
+from .emit import python_source
+from .functions import deployed_functions
+from .generate import c_source_context, input_limits
+from .render import c_real, render
+
+__all__ = ["look_ahead_c_files", "look_ahead_generation", "look_ahead_python_file"]
+
+
+def _check(design: TubeDesign, look_ahead: LookAhead, prefix: str) -> None:
+    if not prefix.isidentifier() or not prefix.isascii():
+        raise ValueError(f"prefix {prefix!r} is not an identifier")
+    if design.dimension != 2 or design.input_bound is not None:
+        raise ValueError("the look-ahead variant takes a 2-dimensional tube without an "
+                         "input_bound of its own (the base's limits are LookAhead's)")
+
+
+def _context(design: TubeDesign, look_ahead: LookAhead, prefix: str, precision: str,
+             literal) -> dict:
+    """The banner's fields, the names, the statuses, the input domain's limits, the axle
+    offset and the base's limits, printed by ``literal``."""
+    limits = input_limits(design)
+    digest = hashlib.sha256((repr(design) + repr(look_ahead)).encode()).hexdigest()
+    bound = look_ahead.input_bound
+    return {"spec_name": design.name, "design_hash": digest,
+            "toolkit_version": __version__, "casadi_version": casadi.__version__,
+            "precision": precision, "P": prefix, "U": prefix.upper(),
+            "statuses": [(s.name, int(s)) for s in Status
+                         if s not in (Status.OUTSIDE_VELOCITY_TUBE, Status.INPUT_CLAMPED)
+                         or (s == Status.INPUT_CLAMPED and bound is not None)],
+            "t_c": literal(design.prescribed_time), "rate_hz": literal(design.rate_hz),
+            **{name: literal(value) for name, value in limits.items()},
+            "axle_offset": literal(look_ahead.axle_offset),
+            "input_bound": None if bound is None else [literal(b) for b in bound]}
+
+
+def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,
+                       precision: str = "double") -> dict[str, str]:
+    """``{<prefix>.h: text, <prefix>.c: text}`` of the look-ahead controller.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The look-ahead point's tube (2 dimensions, no ``input_bound`` of its own).
+    look_ahead : LookAhead
+        The axle offset and the base's limits.
+    prefix : str
+        A C identifier: the file names and the prefix of every public name.
+    precision : {"double", "single"}
+
+    Returns
+    -------
+    dict of str to str
+        Deterministic for given arguments, CasADi and toolkit versions.
+
+    Raises
+    ------
+    ValueError
+        ``prefix`` not a C identifier, or a tube the variant does not take.
+    """
+    _check(design, look_ahead, prefix)
+    single = precision == "single"
+    functions = [*deployed_functions(build_model(design)), look_ahead_point(), base_command(),
+                 *([P.saturate(2)] if look_ahead.input_bound is not None else [])]
+    context = dict(c_source_context(design, prefix, precision, functions),
+                   **_context(design, look_ahead, prefix, precision,
+                              lambda v: c_real(v, single)), look_ahead=True)
+    return {name: render(template, filename=name, **context)
+            for name, template in ((f"{prefix}.h", "look_ahead_header.h.j2"),
+                                   (f"{prefix}.c", "look_ahead_source.c.j2"))}
+
+
+def look_ahead_python_file(design: TubeDesign, look_ahead: LookAhead,
+                           prefix: str) -> dict[str, str]:
+    """``{<prefix>.py: text}``: ``step(x, t, dt, alpha) -> (u, alpha_next, status)`` with
+    ``x = (x, y, theta)``, the same function, statuses and input checks as the C (imports
+    ``math`` only).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The look-ahead point's tube.
+    look_ahead : LookAhead
+    prefix : str
+        Module name, an ASCII identifier.
+
+    Returns
+    -------
+    dict of str to str
+        One entry, ``<prefix>.py`` and its text.
+
+    Raises
+    ------
+    ValueError
+        ``prefix`` not an identifier, or a tube the variant does not take.
+    """
+    _check(design, look_ahead, prefix)
+    name = f"{prefix}.py"
+    return {name: render("look_ahead_module.py.j2", filename=name,
+                         **_context(design, look_ahead, prefix, "double",
+                                    lambda v: repr(float(v))),
+                         body=python_source(look_ahead_step(design, look_ahead)))}
+
+
+def look_ahead_generation(design, options) -> dict[str, bytes]:
+    """Every file of the look-ahead controller of a differential-drive design, in memory.
+
+    ``P_look_ahead.h``, ``P_look_ahead.c`` (with ``"c"`` in ``options.langs``, in
+    ``options.precision``), ``P_look_ahead.py`` (with ``"python"``) and ``manifest.json``;
+    ``P`` is the spec's C name.
+
+    Parameters
+    ----------
+    design : Design
+        Of a spec with ``plant.model = "differential-drive"``.
+    options : Options
+
+    Returns
+    -------
+    dict of str to bytes
+
+    Raises
+    ------
+    SpecError
+        Not a differential-drive spec (field ``plant.model``).
+    """
+    import json
+
+    from .generate import MANIFEST, manifest
+
+    look_ahead = design.look_ahead
+    prefix = f"{design.spec.c_name}_look_ahead"
+    texts: dict[str, str] = {}
+    if "c" in options.langs:
+        texts.update(look_ahead_c_files(design.tube, look_ahead, prefix, options.precision))
+    if "python" in options.langs:
+        texts.update(look_ahead_python_file(design.tube, look_ahead, prefix))
+    files = {name: text.encode() for name, text in texts.items()}
+    files[MANIFEST] = (json.dumps(manifest(design.spec, options, files), indent=2,
+                                  sort_keys=True) + "\n").encode()
+    return files

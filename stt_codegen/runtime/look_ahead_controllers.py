@@ -1,0 +1,129 @@
+"""Backends of the look-ahead variant for differential-drive bases (docs/differential-drive.md).
+
+Every backend computes the controller step ``(x, t, dt, alpha) -> (u, alpha_next,
+status)``, here with the base's state ``x = (x, y, theta)`` and ``u = (v, omega)``:
+``reference`` (the numpy oracle, :mod:`stt_codegen.tube.look_ahead_reference`), ``casadi``
+(CasADi's evaluation of :func:`stt_codegen.tube.look_ahead.look_ahead_step`), ``python``
+(the Function printed to Python by the emitter) and ``c`` (the generated C of
+:mod:`stt_codegen.codegen.look_ahead_source`, compiled and loaded with ``ctypes``).
+"""
+
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+
+from ..codegen.emit import python_function
+from ..errors import SpecError
+from ..tube import look_ahead_reference
+from ..tube.look_ahead import LookAhead, look_ahead_step
+from ..tube.parameters import Status, TubeDesign
+
+__all__ = ["LOOK_AHEAD_BACKENDS", "LookAheadController"]
+
+#: The backends of the look-ahead step, in order.
+LOOK_AHEAD_BACKENDS = ("reference", "casadi", "c", "python")
+
+
+class LookAheadController:
+    """One backend of the look-ahead step.
+
+    Parameters
+    ----------
+    backend : str
+        One of :data:`LOOK_AHEAD_BACKENDS`.
+    design : TubeDesign
+        The look-ahead point's tube and its gain (no ``input_bound`` of its own).
+    look_ahead : LookAhead
+        The axle offset and the base's limits.
+
+    Raises
+    ------
+    SpecError
+        Unknown backend (field ``backend``).
+    ToolchainError, MissingTool
+        Backend ``c``: no C compiler, or it failed.
+    """
+
+    def __init__(self, backend: str, design: TubeDesign, look_ahead: LookAhead) -> None:
+        if backend not in LOOK_AHEAD_BACKENDS:
+            raise SpecError("backend", f"unknown backend {backend!r} for a differential-drive "
+                                       f"base (known: {', '.join(LOOK_AHEAD_BACKENDS)})")
+        self.name, self.design, self.look_ahead = backend, design, look_ahead
+        if backend == "reference":
+            self._call = self._reference
+        elif backend == "c":
+            self._call = _compiled(design, look_ahead)
+        else:
+            function = look_ahead_step(design, look_ahead)
+            if backend == "casadi":
+                self._call = lambda *a: _with_status(
+                    [np.array(v, dtype=float).ravel() for v in function(*a)])
+            else:
+                printed = python_function(function)
+                self._call = lambda *a: _with_status(
+                    [np.array(v, dtype=float).ravel()
+                     for v in printed(*[np.ravel(v).tolist() for v in a])])
+
+    def _reference(self, x, t, dt, alpha):
+        u, alpha_next, status = look_ahead_reference.look_ahead_status(
+            self.design, self.look_ahead.axle_offset, self.look_ahead.input_bound, x[None],
+            t, dt, alpha[None])
+        return u[0], alpha_next[0], Status(int(status[0]))
+
+    def step(self, x: np.ndarray, t: float, dt: float,
+             alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:
+        """One step of the variant.
+
+        Parameters
+        ----------
+        x : array_like, shape (3,)
+            The base's state: the axle's midpoint (m) and the heading (rad).
+        t, dt : float
+            The sampling instant and period, s.
+        alpha : array_like, shape (4,)
+            The adaptive law's ``alpha`` (eq. (11)), m.
+
+        Returns
+        -------
+        u : ndarray, shape (2,)
+            ``v`` (m/s) and ``omega`` (rad/s).
+        alpha_next : ndarray, shape (4,)
+            ``alpha`` at ``t + dt``.
+        status : Status
+        """
+        return self._call(np.asarray(x, dtype=float), float(t), float(dt),
+                          np.asarray(alpha, dtype=float))
+
+
+def _with_status(out: list) -> tuple[np.ndarray, np.ndarray, Status]:
+    u, alpha_next, inside, *within = out
+    status = (Status.OUTSIDE_TUBE if not inside[0] else
+              Status.INPUT_CLAMPED if within and not within[0][0] else Status.OK)
+    return u, alpha_next, status
+
+
+def _compiled(design: TubeDesign, look_ahead: LookAhead):
+    """The emitted C of the step (double), compiled into the build cache
+    (:func:`~stt_codegen.runtime.compiled.build_shared`) and loaded."""
+    from ..codegen.look_ahead_source import look_ahead_c_files
+    from .compiled import build_shared
+
+    files = look_ahead_c_files(design, look_ahead, "stt_look_ahead", "double")
+    sources = {name: text.encode() for name, text in files.items()}
+    handle = ctypes.CDLL(str(build_shared(sources, "stt_look_ahead.c")))
+    entry = handle.stt_look_ahead_step
+    real_p = ctypes.POINTER(ctypes.c_double)
+    entry.argtypes = [real_p, ctypes.c_double, ctypes.c_double, real_p, real_p, real_p]
+    entry.restype = ctypes.c_int
+
+    def call(x, t, dt, alpha):
+        x, alpha = (np.ascontiguousarray(v, dtype=np.float64) for v in (x, alpha))
+        u, alpha_next = np.zeros(2), np.zeros(4)
+        code = entry(x.ctypes.data_as(real_p), t, dt, alpha.ctypes.data_as(real_p),
+                     u.ctypes.data_as(real_p), alpha_next.ctypes.data_as(real_p))
+        return u, alpha_next, Status(code)
+
+    call.library = handle  # keep the library loaded with the closure
+    return call

@@ -1,0 +1,160 @@
+"""The look-ahead variant of law (13): a differential-drive base kept in the tube by a point.
+
+A differential-drive base (axle midpoint ``(x, y)``, heading ``theta``; inputs forward
+speed ``v`` and turn rate ``omega``) cannot move sideways, so law (13) cannot drive its
+state. The point ``p = (x, y) + l (cos theta, sin theta)`` at ``l`` ahead of the axle can
+be driven in every direction: ``p_dot = M(theta) (v, omega)`` with ``M(theta) = R(theta)
+diag(1, l)``, invertible for ``l > 0``. The variant computes law (13) for ``p`` on the
+designed tube, ``u_p``, and sends the base
+
+    (v, omega) = M(theta)^-1 u_p = (cos theta u1 + sin theta u2,
+                                    (-sin theta u1 + cos theta u2) / l),
+
+so that ``p`` moves as system (1) with ``g = R W' R^T`` (identity for exact wheels;
+docs/differential-drive.md gives the class for wheel errors and slip). The adaptive law
+(11) and the tube are the first order's, unchanged.
+
+The pieces here are CasADi SX Functions, the one source of the deployed maths (printed
+to C and Python by the emitter); the numpy oracle is :mod:`.look_ahead_reference`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import casadi as ca
+
+from . import pieces as P
+from .model import build_model
+from .parameters import TubeDesign
+
+__all__ = ["LOOK_AHEAD_OUTPUTS", "LookAhead", "base_command", "look_ahead_point",
+           "look_ahead_step"]
+
+#: Number of the base's states ``(x, y, theta)`` and of its inputs ``(v, omega)``.
+BASE_STATES, BASE_INPUTS = 3, 2
+#: Outputs of :func:`look_ahead_step`, in order (``within_bound`` with an input bound).
+LOOK_AHEAD_OUTPUTS = ("u", "alpha_next", "inside", "within_bound")
+
+
+@dataclass(frozen=True)
+class LookAhead:
+    """The numbers of the look-ahead variant beyond the tube.
+
+    Attributes
+    ----------
+    axle_offset : float
+        ``l``: the look-ahead point's distance ahead of the axle's midpoint, m, positive.
+    input_bound : tuple of float or None
+        ``(v_max, omega_max)``: the base's limits (m/s, rad/s); the command is clamped to
+        them. ``None``: no limit.
+
+    Raises
+    ------
+    ValueError
+        ``axle_offset`` not positive and finite, or a bound not positive and finite.
+    """
+
+    axle_offset: float
+    input_bound: tuple[float, float] | None = None
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.axle_offset) and self.axle_offset > 0.0):
+            raise ValueError(f"axle_offset must be positive and finite, got "
+                             f"{self.axle_offset!r}")
+        if self.input_bound is not None and not (
+                len(self.input_bound) == BASE_INPUTS
+                and all(math.isfinite(b) and b > 0.0 for b in self.input_bound)):
+            raise ValueError(f"input_bound must be two positive numbers (v, omega), got "
+                             f"{self.input_bound!r}")
+
+
+@lru_cache(maxsize=None)
+def look_ahead_point() -> ca.Function:
+    """``look_ahead_point(state, axle_offset) -> p``: the point the tube holds.
+
+    Returns
+    -------
+    casadi.Function
+        Inputs ``state`` (3: ``x``, ``y`` in m, ``theta`` in rad) and ``axle_offset``
+        (``l``, m); output ``p`` (2, m), ``(x + l cos theta, y + l sin theta)``.
+    """
+    state, offset = ca.SX.sym("state", BASE_STATES), ca.SX.sym("axle_offset")
+    theta = state[2]
+    p = ca.vertcat(state[0] + offset * ca.cos(theta), state[1] + offset * ca.sin(theta))
+    return ca.Function("look_ahead_point", [state, offset], [p], ["state", "axle_offset"],
+                       ["p"])
+
+
+@lru_cache(maxsize=None)
+def base_command() -> ca.Function:
+    """``base_command(state, u_point, axle_offset) -> u``: the base's inputs that move the
+    look-ahead point with velocity ``u_point`` (exact wheels, no slip).
+
+    Returns
+    -------
+    casadi.Function
+        Inputs ``state`` (3; only ``theta``, rad, is used), ``u_point`` (2, m/s) and
+        ``axle_offset`` (m); output ``u`` (2): ``v`` (m/s) and ``omega`` (rad/s),
+        ``M(theta)^-1 u_point``.
+    """
+    state = ca.SX.sym("state", BASE_STATES)
+    u_point, offset = ca.SX.sym("u_point", BASE_INPUTS), ca.SX.sym("axle_offset")
+    c, s = ca.cos(state[2]), ca.sin(state[2])
+    u = ca.vertcat(c * u_point[0] + s * u_point[1], (c * u_point[1] - s * u_point[0]) / offset)
+    return ca.Function("base_command", [state, u_point, offset], [u],
+                       ["state", "u_point", "axle_offset"], ["u"])
+
+
+def look_ahead_step(design: TubeDesign, look_ahead: LookAhead) -> ca.Function:
+    """``look_ahead_step(x, t, dt, alpha) -> (u, alpha_next, inside[, within_bound])``: one
+    sampled step of the look-ahead variant, with the first order's argument order.
+
+    ``x`` is the base's state ``(x, y, theta)``; the point ``p`` of
+    :func:`look_ahead_point` goes through the first-order ``controller_step`` of
+    :func:`stt_codegen.tube.model.build_model` (law (13) on the adaptive tube of eq. (10)
+    and the deployed implicit step of (11)), whose ``u`` :func:`base_command` turns into
+    ``(v, omega)``. With ``look_ahead.input_bound`` the command is clamped by the first
+    order's :func:`stt_codegen.tube.pieces.saturate_expression` and a fourth output,
+    ``within_bound``, is 1.0 when no entry moved.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube of the look-ahead point (2 dimensions) and its gain; its own
+        ``input_bound`` must be ``None`` (the base's bound is ``look_ahead``'s).
+    look_ahead : LookAhead
+
+    Returns
+    -------
+    casadi.Function
+        Inputs ``x`` (3: m, m, rad), ``t`` (s), ``dt`` (s), ``alpha`` (4); outputs
+        :data:`LOOK_AHEAD_OUTPUTS`: ``u`` (2: m/s, rad/s), ``alpha_next`` (4), ``inside``
+        (1.0 when ``p`` is strictly inside the tube, else 0.0)[, ``within_bound``].
+
+    Raises
+    ------
+    ValueError
+        A tube that is not 2-dimensional, or one with its own ``input_bound``.
+    """
+    if design.dimension != BASE_INPUTS:
+        raise ValueError(f"the look-ahead point's tube has 2 dimensions, got "
+                         f"{design.dimension}")
+    if design.input_bound is not None:
+        raise ValueError("the look-ahead variant clamps (v, omega) with LookAhead.input_bound; "
+                         "the tube's own input_bound must be None")
+    x = ca.SX.sym("x", BASE_STATES)
+    t, dt = ca.SX.sym("t"), ca.SX.sym("dt")
+    alpha = ca.SX.sym("alpha", 2 * BASE_INPUTS)
+    offset = ca.SX(look_ahead.axle_offset)
+    p = look_ahead_point()(x, offset)
+    u_point, alpha_next, inside = build_model(design)["controller_step"](p, t, dt, alpha)
+    u = base_command()(x, u_point, offset)
+    outputs, names = [u, alpha_next, inside], list(LOOK_AHEAD_OUTPUTS[:3])
+    if look_ahead.input_bound is not None:
+        u, within = P.saturate_expression(u, ca.DM(list(look_ahead.input_bound)), BASE_INPUTS)
+        outputs, names = [u, alpha_next, inside, within], list(LOOK_AHEAD_OUTPUTS)
+    return ca.Function("look_ahead_step", [x, t, dt, alpha], outputs,
+                       ["x", "t", "dt", "alpha"], names)
