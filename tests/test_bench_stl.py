@@ -90,11 +90,13 @@ def test_every_spec_loads(name):
             assert all(hi <= h0 for hi, h0 in zip(entry["upper"], upper))
 
 
-@pytest.mark.parametrize("name", ["EitherOr", "RandomMultitarget", "DoorPuzzle"])
+@pytest.mark.parametrize("name", ["EitherOr", "RandomMultitarget", "DoorPuzzle",
+                                  "NonlinearReachAvoid"])
 def test_scenarios_with_a_bound_design_within_it(name):
-    """The examples' velocity bound (|v| <= 1, DoorPuzzle 2) is kept: each design is
-    proved to keep law (13) within it (the legs' times follow their paths, the cruise
-    profile's peak is 1.25 times its mean, the shortest plan first) and certified."""
+    """The examples' bounds (|v| <= 1, DoorPuzzle 2; the unicycle's |v| <= 10,
+    |omega| <= 5) are kept: each design is proved to keep law (13) within them (the legs'
+    times follow their paths, the cruise profile's peak is 1.25 times its mean, the
+    shortest plan first; the unicycle's via tube with cruise segments) and certified."""
     from stt_codegen.design.search import design_tube
     doc = scenario_spec(name)
     bound = tuple(doc["actuator"]["input_bound"])
@@ -214,6 +216,8 @@ def test_bench_stl_every_designed_run_is_satisfied(tmp_path, monkeypatch):
     for row in designed:
         assert row["satisfied"] and row["grid"] > 0, row["scenario"]
     within = {r["scenario"]: r for r in designed if r["input_bound"]}
-    assert {"EitherOr", "NarrowPassage", "RandomMultitarget", "DoorPuzzle"} <= set(within)
+    assert set(within) == {"EitherOr", "NarrowPassage", "RandomMultitarget", "DoorPuzzle",
+                           "NonlinearReachAvoid"}
+    assert not [r for r in rows if r["variant"] == "no bound"]   # none refused by its bound
     for row in within.values():
         assert all(p <= b + 1e-9 for p, b in zip(row["peak_u"], row["input_bound"]))

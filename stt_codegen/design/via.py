@@ -314,11 +314,13 @@ def via_design(spec: Spec, base: TubeDesign) -> TubeDesign:
     Returns
     -------
     TubeDesign
-        ``base`` through the via points, without circumvents.
+        ``base`` through the via points, without circumvents, its segments of the profile
+        ``spec.tube.via_profile``.
 
     Raises
     ------
     DesignError
         :func:`plan_via` finds no path.
     """
-    return replace(base, segments=plan_via(spec, base).segments(), circumvents=())
+    return replace(base, segments=plan_via(spec, base).segments(spec.tube.via_profile),
+                   circumvents=())
