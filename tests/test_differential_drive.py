@@ -251,11 +251,25 @@ def test_the_single_precision_c_compiles_strictly(office):
     build_shared({k: v.encode() for k, v in files.items()}, "drive.c")
 
 
-def test_the_firmware_loop_refuses_by_name(office):
+def test_law_13s_firmware_loop_refuses_the_variant_by_name(office):
     from stt_codegen.embedded.deploy import run_embedded
 
-    with pytest.raises(SpecError, match="differential-drive"):
+    with pytest.raises(SpecError, match="look-ahead variant"):
         run_embedded(office)
+
+
+@pytest.mark.embedded
+def test_the_office_on_the_cortex_m4f_is_satisfied_like_the_host(office):
+    from stt_codegen.embedded.look_ahead_loop import run_look_ahead_embedded
+
+    report = run_look_ahead_embedded(office)
+    assert report["satisfied"] and report["outside_position"] == report["invalid"] == 0
+    assert all(500 < c < 5000 for c in report["instructions_per_step"])
+    host = stt.simulate(office, backend="c")        # double controller, same base and slip
+    assert abs(report["reach_time"] - host.reach_time) <= 0.02
+    assert abs(report["min_clearance"] - host.min_obstacle_clearance) <= 2e-3
+    final_point = look_ahead_reference.point(np.array([report["final_state"]]), 0.1)[0]
+    np.testing.assert_allclose(final_point, host.trajectory.x[-1], atol=2e-3)
 
 
 def test_the_command_line_refuses_a_missing_key_with_exit_2(tmp_path):
@@ -266,3 +280,55 @@ def test_the_command_line_refuses_a_missing_key_with_exit_2(tmp_path):
                          capture_output=True, text=True)
     assert run.returncode == 2 and "plant.axle_offset" in run.stderr
     assert "Traceback" not in run.stderr
+
+
+MUJOCO_SPEC = SPEC.with_name("office-drive-mujoco.toml")
+
+
+def test_the_office_on_mujoco_is_satisfied_without_contact():
+    """The project's MuJoCo base (tests/specs/office-drive.xml: wheels on the floor, a
+    caster, the obstacles at their real size) driven by the generated C."""
+    design = stt.design_tube(stt.load_spec(str(MUJOCO_SPEC)))
+    result = stt.simulate(design, backend="c")
+    assert result.satisfied and result.stayed_in_tube and result.contacts == 0
+    assert result.min_obstacle_clearance > 0
+
+
+def test_the_mujoco_base_turns_commands_into_wheel_speeds():
+    """Driven open loop at v = 0.5 m/s for 2 s, then turning at omega = 1 rad/s, the base
+    moves as the kinematics say (the wheels grip: within 3 % of 1 m and of 1 rad)."""
+    from stt_codegen.runtime.plants import spec_plant
+
+    spec = stt.load_spec(str(MUJOCO_SPEC))
+    plant = spec_plant(spec)
+    start = plant.reset([1.0, 1.0, 0.0])
+    for k in range(100):
+        states, _ = plant.advance(0.02 * k, [0.5, 0.0], 0.02)
+    assert states[-1][0] - start[0] == pytest.approx(1.0, rel=0.03)
+    assert abs(states[-1][1] - start[1]) < 0.01
+    heading = states[-1][2]
+    for k in range(50):
+        states, _ = plant.advance(2.0 + 0.02 * k, [0.0, 1.0], 0.02)
+    assert states[-1][2] - heading == pytest.approx(1.0, rel=0.03)
+
+
+def test_a_mujoco_base_needs_its_wheel_radius():
+    import tomllib
+
+    doc = tomllib.loads(MUJOCO_SPEC.read_text())
+    del doc["plant"]["wheel_radius"]
+    with pytest.raises(SpecError, match="plant.wheel_radius"):
+        stt.Spec.from_dict(doc)
+
+
+def test_a_tube_through_the_desks_is_rejected_by_the_certificate(office):
+    """The tube designed for the empty room, checked against the office: it crosses the
+    desks (inflated by the body's radius plus the axle offset), and the check says which."""
+    from stt_codegen.design.search import check_tube
+
+    doc = _doc()
+    doc["obstacles"] = []
+    straight = stt.design_tube(stt.Spec.from_dict(doc)).tube
+    check = check_tube(straight, office.spec)
+    assert not check.passed and "obstacle" in check.reason
+    assert check_tube(office.tube, office.spec).passed

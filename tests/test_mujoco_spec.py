@@ -121,7 +121,7 @@ def test_mujoco_keys_on_another_model_are_refused():
     with pytest.raises(SpecError) as err:
         stt.Spec.from_dict(doc)
     assert err.value.field == "plant.mjcf"
-    assert "only the mujoco and mujoco-force models take mjcf" in err.value.reason
+    assert "only the mujoco, differential-drive and mujoco-force models take mjcf" in err.value.reason
 
 
 def test_an_unknown_joint_is_named_when_the_plant_is_built(tmp_path):

@@ -1,4 +1,4 @@
-"""``stt-codegen bench arenas | tasks | step | scaling | covering | alpha | second-order |
+"""``stt-codegen bench arenas | tasks | drive | step | scaling | covering | alpha | second-order |
 stl``: the benchmarks and studies of :mod:`stt_codegen.bench`."""
 
 from __future__ import annotations
@@ -49,6 +49,14 @@ def _cmd_arenas(args: argparse.Namespace) -> int:
                               progress=not args.no_progress)
     print(json.dumps(report, indent=1, sort_keys=True, allow_nan=False) if args.json
           else format_arenas_report(report))
+    return 0
+
+
+def _cmd_drive(args: argparse.Namespace) -> int:
+    from ..bench.office_arenas import format_office_report, run_office_bench
+    report = run_office_bench(args.count, args.seed)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_office_report(report))
     return 0
 
 
@@ -119,7 +127,7 @@ def _cmd_stl(args: argparse.Namespace) -> int:
 
 
 def configure_bench(bench: argparse.ArgumentParser) -> None:
-    """Sub-subcommands ``bench arenas``, ``tasks``, ``step``, ``scaling``, ``covering``,
+    """Sub-subcommands ``bench arenas``, ``tasks``, ``drive``, ``step``, ``scaling``, ``covering``,
     ``alpha``, ``second-order`` and ``stl``.
 
     Parameters
@@ -159,6 +167,13 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
     p.add_argument("--no-progress", action="store_true", help="no line per problem")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_tasks)
+
+    p = sub.add_parser("drive", help="a differential-drive base beside a holonomic one on "
+                                     "random offices (docs/differential-drive.md)")
+    p.add_argument("--count", type=int, default=100, help="number of offices (default: 100)")
+    p.add_argument("--seed", type=_non_negative_int, default=0, help="office seed (default: 0)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_drive)
 
     p = sub.add_parser("step", help="cost of one controller step: reference, CasADi, "
                                     "generated Python, generated C")

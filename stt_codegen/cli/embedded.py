@@ -74,13 +74,17 @@ def cmd_embedded(args: argparse.Namespace) -> int:
     if args.build_dir is not None and not Path(args.build_dir).parent.is_dir():
         raise SpecError("build_dir", f"folder {str(Path(args.build_dir).parent)!r} does not exist")
     design = load_and_design(args)
-    if design.spec.order == 2:     # the cascade law
+    if design.spec.variant != "first-order":     # the cascade or the look-ahead law
         from ..embedded.cascade_loop import run_cascade_embedded
-        report = run_cascade_embedded(design, seed=seed)
+        from ..embedded.look_ahead_loop import run_look_ahead_embedded
+        run = {"cascade": run_cascade_embedded,
+               "look-ahead": run_look_ahead_embedded}[design.spec.variant]
+        report = run(design, seed=seed)
         if args.json:
             print_json(report)
         else:
-            print(f"{design.spec.name} (cascade) on the Cortex-M4F (QEMU mps2-an386): "
+            print(f"{design.spec.name} ({design.spec.variant}) on the Cortex-M4F (QEMU "
+                  "mps2-an386): "
                   f"{'satisfied' if report['satisfied'] else 'NOT satisfied'}, reach "
                   f"{report['reach_time']} s, clearance {report['min_clearance']:.3f}"
                   f"{_judged(report)}, {report['instructions_per_step']} instructions per step")

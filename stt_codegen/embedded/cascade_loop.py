@@ -25,30 +25,17 @@ with every libm call), as ``stt-codegen embedded`` measures the first-order step
 from __future__ import annotations
 
 import math
-import tempfile
-from pathlib import Path
 
 from ..codegen.cascade_source import cascade_c_files
 from ..codegen.emit import c_source
 from ..codegen.render import render
 from ..design.result import Design
-from ..errors import SpecError, ToolchainError
+from ..errors import SpecError
 from ..runtime.second_order_plants import second_order_rhs
-from .deploy import COUNT_FRACTIONS, function_profile
-from .programs import judge_printed, loop_context, parse_closed_loop, replay_source, steps_of
-from .target import build_elf, elf_sizes, run_qemu
+from .programs import c_double, loop_context
+from .variant_loop import run_report, run_variant_loop
 
 __all__ = ["closed_loop_program", "run_cascade_embedded"]
-
-
-def _d(value: float) -> str:
-    """A C double literal that reads back exactly (``HUGE_VAL`` for an infinite bound)."""
-    if math.isinf(value) and value > 0:
-        return "HUGE_VAL"
-    text = repr(float(value))
-    if not math.isfinite(float(value)):
-        raise ValueError(f"non-finite constant {value!r}")
-    return text if ("." in text or "e" in text) else text + ".0"
 
 
 def closed_loop_program(design: Design, prefix: str, seed: int = 0,
@@ -91,9 +78,9 @@ def closed_loop_program(design: Design, prefix: str, seed: int = 0,
     context = dict(loop_context(spec, design.tube, seed=seed, decimate=decimate,
                                 replay=replay),
                    P=prefix, U=prefix.upper(), plant=order.model,
-                   x0=[_d(v) for v in (*spec.initial_state, *order.initial_velocity)],
-                   parameters=[_d(v) for v in order.parameters],
-                   velocity_bound=[_d(v) for v in bound],
+                   x0=[c_double(v) for v in (*spec.initial_state, *order.initial_velocity)],
+                   parameters=[c_double(v) for v in order.parameters],
+                   velocity_bound=[c_double(v) for v in bound],
                    plant_rhs=c_source(second_order_rhs(order.model, n)).strip())
     return render("cascade_closed_loop.c.j2", **context)
 
@@ -137,45 +124,14 @@ def run_cascade_embedded(design: Design, seed: int = 0, timeout: float = 600.0) 
     prefix = f"{design.spec.c_name}_cascade"
     n = design.spec.dimension
     files = cascade_c_files(design.tube, stage, prefix, "single")
-    with tempfile.TemporaryDirectory(prefix="stt-cascade-m4-") as name:
-        folder = Path(name)
-        for file, text in files.items():
-            (folder / file).write_text(text)
-        steps = steps_of(design.spec, design.tube)
-        replay = sorted({min(steps - 1, int(round(f * steps))) for f in COUNT_FRACTIONS})
-        loop = folder / "closed_loop.c"
-        loop.write_text(closed_loop_program(design, prefix, seed, replay=replay))
-        full = build_elf([folder / f"{prefix}.c", loop], [folder], folder / "full", name="loop")
-        run = run_qemu(full.elf, timeout=timeout)
-        try:
-            output = parse_closed_loop(run.stdout, n, 2 * n)
-        except ValueError:
-            raise ToolchainError(f"the closed loop exited with {run.exit_code} without a "
-                                 f"summary:\n{run.stdout[-2000:]}{run.stderr[-2000:]}") from None
-        inputs = [output.replay_inputs[k] for k in sorted(output.replay_inputs)]
-        steps_c = folder / "steps.c"
-        steps_c.write_text(replay_source(
-            design.spec, design.tube, [v[2] for v in inputs], [v[0] for v in inputs],
-            [1.0 / design.tube.rate_hz] * len(inputs), [v[1] for v in inputs],
-            what="closed-loop inputs", prefix=prefix))
-        measured = build_elf([folder / f"{prefix}.c", steps_c], [folder], folder / "measured",
-                             {"STT_MEASURE": None}, name="measured")
-        counted = run_qemu(measured.elf, timeout=timeout, count_instructions=True)
-        sizes = elf_sizes(full.objects[0])
+    output, measured = run_variant_loop(
+        design, files, prefix, lambda replay: closed_loop_program(design, prefix, seed,
+                                                                  replay=replay),
+        2 * n, timeout)
     summary = output.summary
     final = output.states[max(output.states)]
-    # tasks and moving obstacles: judged on the printed states, as the first order's
-    judged = judge_printed(design.spec, output.states, design.tube.rate_hz)
-    return {"satisfied": bool(summary["satisfied"]) and judged.pop("met"), **judged,
-            "reach_time": summary["reach_time"] if summary["reached"] else None,
-            "min_clearance": summary["min_clearance"], "max_abs_u": summary["max_abs_u"],
+    return {**run_report(design, output),
             "final_state": final[:n].tolist(), "final_velocity": final[n:].tolist(),
-            "outside_position": summary["outside_tube_steps"],
             "outside_velocity": summary["outside_velocity_tube_steps"],
-            "invalid": summary["invalid_steps"],
-            "input_clamped": summary["input_clamped_steps"],
             "exceeded_velocity_bound": bool(summary["exceeded_velocity_bound"]),
-            "instructions_per_step": list(counted.instructions or []),
-            "measured_times": [float(v[0]) for v in inputs],
-            "instructions_by_function": function_profile(counted.functions or []),
-            "flash_bytes_controller": sizes}
+            **measured}

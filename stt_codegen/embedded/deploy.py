@@ -168,10 +168,10 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
     if spec.mujoco is not None:
         raise SpecError("plant.model", "the firmware's closed loop needs the plant's equations; "
                                        "a MuJoCo plant runs on the host (stt-codegen simulate)")
-    if spec.drive is not None:
-        raise SpecError("plant.model", "the firmware's closed loop of a differential-drive base "
-                                       "(the look-ahead variant) is not built yet; its generated "
-                                       "C runs on the host (stt-codegen simulate --backend c)")
+    if spec.variant != "first-order":    # its own program: stt-codegen embedded picks it
+        raise SpecError("plant.model", f"the {spec.variant} variant's firmware loop is "
+                                       "run_cascade_embedded or run_look_ahead_embedded, not "
+                                       "law (13)'s")
     seed = check_seed(seed)
     message = missing_message()
     if message:

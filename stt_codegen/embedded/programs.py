@@ -25,18 +25,38 @@ import numpy as np
 from ..codegen.emit import c_source
 from ..codegen.render import c_identifier, render
 from ..runtime.dynamics import plant_function
+from ..runtime.state_split import positions
 from ..runtime.plants import Disturbance
 from ..runtime.simulate import SUBSTEPS
 from ..runtime.tasks import judge_tasks, until_met
 from ..spec.loader import Spec
 from ..tube.parameters import TubeDesign
 
-__all__ = ["closed_loop_source", "judge_printed", "loop_context", "parse_closed_loop", "parse_replay", "replay_source",
-           "steps_of"]
+__all__ = ["ClosedLoopOutput", "c_double", "closed_loop_source", "judge_printed", "loop_context",
+           "parse_closed_loop", "parse_replay", "replay_source", "steps_of"]
 
 
-def _d(value: float) -> str:
-    """A C double literal that reads back exactly."""
+def c_double(value: float) -> str:
+    """A C double literal that reads back exactly (``HUGE_VAL`` for ``+inf``: a bound not
+    given).
+
+    Parameters
+    ----------
+    value : float
+        A finite number, or ``+inf``.
+
+    Returns
+    -------
+    str
+        ``repr`` of the double (with a ``.0`` where it has no point or exponent).
+
+    Raises
+    ------
+    ValueError
+        ``value`` is NaN or ``-inf``.
+    """
+    if math.isinf(value) and value > 0:
+        return "HUGE_VAL"
     text = repr(float(value))
     if not math.isfinite(float(value)):
         raise ValueError(f"non-finite constant {value!r}")
@@ -67,15 +87,15 @@ def _obstacles(spec: Spec) -> list[dict]:
     for u in spec.unsafe_sets:
         dims = list(u.dims)
         if u.kind == "box":
-            faces = [(d, _d(lo), _d(hi)) for d, lo, hi in zip(dims, u.shape.lower, u.shape.upper)]
+            faces = [(d, c_double(lo), c_double(hi)) for d, lo, hi in zip(dims, u.shape.lower, u.shape.upper)]
             out.append({"kind": "box", "dims": dims, "faces": faces})
         elif u.kind == "ball":
             out.append({"kind": "ball", "dims": dims,
-                        "center": [(d, _d(c)) for d, c in zip(dims, u.shape.center)],
-                        "radius": _d(u.shape.radius)})
+                        "center": [(d, c_double(c)) for d, c in zip(dims, u.shape.center)],
+                        "radius": c_double(u.shape.radius)})
         else:
             a_rows, b_vals = u.shape.halfspaces
-            facets = [([(d, _d(a)) for d, a in zip(dims, row)], _d(b))
+            facets = [([(d, c_double(a)) for d, a in zip(dims, row)], c_double(b))
                       for row, b in zip(a_rows, b_vals)]
             out.append({"kind": "polytope", "dims": dims, "facets": facets})
     return out
@@ -110,12 +130,12 @@ def loop_context(spec: Spec, design: TubeDesign, *, seed: int = 0, decimate: int
         P=prefix, U=prefix.upper(), spec_name=spec.name, real="float", n=n,
         steps=steps_of(spec, design), substeps=SUBSTEPS, decimate=int(decimate),
         terms=dist.weights.shape[1], seed=int(seed), rate_hz=f"{design.rate_hz:g}",
-        rate_hz_d=_d(design.rate_hz), t_c=_d(spec.prescribed_time),
-        ss_lo=[_d(v) for v in spec.state_space.lower], ss_hi=[_d(v) for v in spec.state_space.upper],
-        tg_lo=[_d(v) for v in spec.target_set.lower], tg_hi=[_d(v) for v in spec.target_set.upper],
-        w_amp=_d(dist.amplitude), w_c=[[_d(v) for v in r] for r in dist.weights],
-        w_omega=[[_d(v) for v in r] for r in dist.frequencies],
-        w_phi=[[_d(v) for v in r] for r in dist.phases],
+        rate_hz_d=c_double(design.rate_hz), t_c=c_double(spec.prescribed_time),
+        ss_lo=[c_double(v) for v in spec.state_space.lower], ss_hi=[c_double(v) for v in spec.state_space.upper],
+        tg_lo=[c_double(v) for v in spec.target_set.lower], tg_hi=[c_double(v) for v in spec.target_set.upper],
+        w_amp=c_double(dist.amplitude), w_c=[[c_double(v) for v in r] for r in dist.weights],
+        w_omega=[[c_double(v) for v in r] for r in dist.frequencies],
+        w_phi=[[c_double(v) for v in r] for r in dist.phases],
         replay=[int(k) for k in replay], obstacles=_obstacles(spec),
         has_obstacles=bool(spec.unsafe_sets))
 
@@ -150,7 +170,7 @@ def closed_loop_source(spec: Spec, design: TubeDesign, *, seed: int = 0, decimat
         "embedded_closed_loop.c.j2",
         **loop_context(spec, design, seed=seed, decimate=decimate, replay=replay),
         plant=spec.plant_model, plant_doc=plant_doc,
-        x0=[_d(v) for v in spec.initial_state],
+        x0=[c_double(v) for v in spec.initial_state],
         plant_rhs=c_source(plant_function(spec.plant_model, n, spec.linear_plant)).strip())
 
 
@@ -196,7 +216,8 @@ def replay_source(spec: Spec, design: TubeDesign, x, t, dt, alpha, what: str,
     rows = [float_bits(np.concatenate([x[k], [t[k], dt[k]], alpha[k]])) for k in range(len(t))]
     cascade = {"cascade": True} if spec.order == 2 else {}
     return render("embedded_replay.c.j2", P=prefix, spec_name=spec.name, real="float",
-                  n=spec.dimension, count=len(rows), rows=rows, what=what, **cascade)
+                  n=spec.dimension, nx=x.shape[1], count=len(rows), rows=rows, what=what,
+                  **cascade)
 
 
 def _f32(word: str) -> float:
@@ -263,8 +284,17 @@ _SUMMARY = re.compile(r"^closed loop: (.*)$", re.MULTILINE)
 
 @dataclass
 class ClosedLoopOutput:
-    """What the closed-loop program printed: the summary fields, the sampled states
-    ``{k: x}`` and the controller inputs at the replay steps ``{k: (t, alpha, x)}``."""
+    """What the closed-loop program printed.
+
+    Attributes
+    ----------
+    summary : dict
+        The ``closed loop:`` line's fields (numbers; ``max_abs_u`` a list).
+    states : dict of int to ndarray
+        The printed plant states, by step.
+    replay_inputs : dict of int to tuple
+        The controller's inputs ``(t, alpha, x)`` at the replay steps, by step.
+    """
 
     summary: dict
     states: dict
@@ -336,8 +366,8 @@ def judge_printed(spec: Spec, states: dict, rate_hz: float) -> dict:
         ``moving_obstacles`` (an obstacle until a task ends when the printed run meets it,
         :func:`~stt_codegen.runtime.tasks.until_met`).
     states : dict of int to ndarray
-        Step index to the printed state; its first ``spec.dimension`` entries are the
-        positions (shape (n,) or (2 n,)).
+        Step index to the printed plant state (shape (n,), (2 n,) or a base's 3), whose
+        positions :func:`~stt_codegen.runtime.state_split.positions` gives.
     rate_hz : float
         The controller's rate, Hz (a step's time is its index over it).
 
@@ -351,7 +381,7 @@ def judge_printed(spec: Spec, states: dict, rate_hz: float) -> dict:
     """
     ks = sorted(states)
     t = np.array(ks, dtype=float) / rate_hz
-    x = np.array([states[k][:spec.dimension] for k in ks])
+    x = positions(spec, np.array([states[k] for k in ks]))
     outcomes = judge_tasks(spec, t, x)
     out: dict = {"met": all(o.met for o in outcomes)}
     if spec.tasks:

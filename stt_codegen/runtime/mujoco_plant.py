@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import SpecError
 
-__all__ = ["MujocoPlant", "require_mujoco"]
+__all__ = ["DriveMujocoPlant", "MujocoPlant", "require_mujoco"]
 
 
 def require_mujoco():
@@ -220,3 +220,57 @@ class MujocoPlant:
                                               self._name(int(g1[k])), self._name(int(g2[k])))
             states[m] = self.state()
         return states, t + self.timestep * np.arange(1, steps + 1)
+
+
+class DriveMujocoPlant(MujocoPlant):
+    """A differential-drive base on MuJoCo: ``(v, omega)`` turned into wheel speeds.
+
+    The state is the base's ``(x, y, theta)``, read from three joints of the chassis (two
+    slides and the yaw hinge); the input ``u = (v, omega)`` goes to the two wheels' velocity
+    actuators as the speeds exact wheels of the nominal radius would need
+    (:meth:`~stt_codegen.spec.differential_drive.DifferentialDrive.wheel_speeds`): the
+    base's driver, as on the robot. The MJCF's own wheels, masses and contacts are the
+    plant.
+
+    Parameters
+    ----------
+    mjcf : str or pathlib.Path
+        The model file.
+    joints : sequence of str, length 3
+        The joints of ``x``, ``y`` and ``theta``.
+    actuators : sequence of str, length 2
+        The right and the left wheel's velocity actuators.
+    drive : DifferentialDrive
+        Its ``wheel_radius`` and ``track_width`` turn ``(v, omega)`` into wheel speeds.
+    timestep : float, optional
+        Overrides the model's timestep, s.
+
+    Raises
+    ------
+    SpecError
+        As :class:`MujocoPlant`.
+    """
+
+    def __init__(self, mjcf: str | Path, joints, actuators, drive,
+                 timestep: float | None = None) -> None:
+        super().__init__(mjcf, joints, actuators, 1, timestep)
+        self.drive = drive
+
+    def advance(self, t: float, u, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Hold the wheel speeds of ``u = (v, omega)`` for ``dt`` seconds of ``mj_step``.
+
+        Parameters
+        ----------
+        t : float
+            Time at the start, s.
+        u : array_like, shape (2,)
+            ``v`` (m/s) and ``omega`` (rad/s).
+        dt : float
+            The sampling period, s.
+
+        Returns
+        -------
+        states : ndarray, shape (m, 3)
+        times : ndarray, shape (m,)
+        """
+        return super().advance(t, self.drive.wheel_speeds(u), dt)

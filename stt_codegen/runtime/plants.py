@@ -22,7 +22,7 @@ from ..spec.loader import LinearPlant
 from ..spec.plants import PLANTS, MissingPlantBehaviour, dimension_mismatch, model_behaviour
 from .differential_drive import base_rhs
 from .dynamics import linear_rhs, plant_rhs
-from .mujoco_plant import MujocoPlant
+from .mujoco_plant import DriveMujocoPlant, MujocoPlant
 from .second_order_plants import model_info, second_order_rhs
 
 __all__ = ["Disturbance", "check_seed", "differential_drive_plant", "make_plant",
@@ -334,8 +334,10 @@ def spec_plant(spec, seed: int = 0) -> Any:
     SpecError
         As :func:`make_plant` and :func:`second_order_plant`.
     """
-    if spec.mujoco is not None:      # [plant] model = "mujoco": MuJoCo steps the plant
+    if spec.mujoco is not None:      # [plant] mjcf: MuJoCo steps the plant
         m = spec.mujoco
+        if spec.drive is not None:   # a base: its driver turns (v, omega) into wheel speeds
+            return DriveMujocoPlant(m.path, m.joints, m.actuators, spec.drive, m.timestep)
         return MujocoPlant(m.path, m.joints, m.actuators, spec.order, m.timestep)
     if spec.drive is not None:       # a differential-drive base: its own kinematics
         return differential_drive_plant(spec.drive, seed)

@@ -56,6 +56,9 @@ class DifferentialDrive:
         turn rate (rad/s) the ground adds, each ``>= 0``.
     heading : float
         ``theta(0)`` (``initial.heading``), rad.
+    wheel_radius : float or None
+        ``plant.wheel_radius``, m: the nominal radius that turns ``(v, omega)`` into wheel
+        speeds for a MuJoCo base (``plant.mjcf``); ``None`` without one.
     """
 
     axle_offset: float
@@ -63,6 +66,7 @@ class DifferentialDrive:
     wheel_radius_error: tuple[float, float] = (0.0, 0.0)
     slip: tuple[float, float, float] = (0.0, 0.0, 0.0)
     heading: float = 0.0
+    wheel_radius: float | None = None
 
     @property
     def mean_error(self) -> float:
@@ -73,6 +77,23 @@ class DifferentialDrive:
     def differential_error(self) -> float:
         """``d = (delta_R - delta_L) / 2``: the error that turns the base."""
         return 0.5 * (self.wheel_radius_error[0] - self.wheel_radius_error[1])
+
+    def wheel_speeds(self, u) -> list[float]:
+        """The wheels' angular speeds ``(right, left)`` that give ``u = (v, omega)`` with
+        wheels of :attr:`wheel_radius`, rad/s.
+
+        Parameters
+        ----------
+        u : sequence of float, length 2
+            ``v`` (m/s) and ``omega`` (rad/s).
+
+        Returns
+        -------
+        list of float
+            ``((v + b omega / 2) / r, (v - b omega / 2) / r)``.
+        """
+        half = 0.5 * self.track_width * float(u[1])
+        return [(float(u[0]) + half) / self.wheel_radius, (float(u[0]) - half) / self.wheel_radius]
 
     def initial_axle(self, point: tuple[float, ...]) -> tuple[float, float, float]:
         """The base's state ``(x, y, theta)`` at ``t = 0`` whose look-ahead point is

@@ -742,8 +742,7 @@ def _validate(raw: dict) -> Spec:
                                   doc.tube.method),
                 task_order=doc.task_order.order if doc.task_order is not None else "listed",
                 moving_obstacles=moving, robot=robot,
-                mujoco=(mujoco_model(doc.plant, n, plant_entry(doc.plant.model).input_count(n))
-                        if plant_entry(doc.plant.model).simulator_keys else None),
+                mujoco=_mujoco(doc.plant, n),
                 drive=drive)
 
 
@@ -803,7 +802,9 @@ def _linear_plant(table: PlantTable, n: int) -> LinearPlant | None:
               **SIMULATOR_KEYS}
     for key, models in owners.items():
         if getattr(table, key) is not None and table.model not in models:
-            raise SpecError(f"plant.{key}", f"only the {' and '.join(models)} model"
+            names = (models[0] if len(models) == 1
+                     else f"{', '.join(models[:-1])} and {models[-1]}")
+            raise SpecError(f"plant.{key}", f"only the {names} model"
                                             f"{'s' if len(models) > 1 else ''} take"
                                             f"{'' if len(models) > 1 else 's'} {key} "
                                             f"(plant.model is {table.model!r})")
@@ -1012,9 +1013,10 @@ def _differential_drive(doc: Any) -> DifferentialDrive | None:
             raise SpecError("initial.heading", f"only plant.model = \"differential-drive\" "
                                                f"takes it (plant.model is {table.model!r})")
         return None
-    for key in ("axle_offset", "track_width"):
+    for key in ("axle_offset", "track_width") + (("wheel_radius",) if table.mjcf else ()):
         if getattr(table, key) is None:
-            raise SpecError(f"plant.{key}", f"required for plant.model = {table.model!r}")
+            raise SpecError(f"plant.{key}", f"required for plant.model = {table.model!r}"
+                            + (" on MuJoCo (plant.mjcf)" if key == "wheel_radius" else ""))
     if "disturbance_amplitude" in table.model_fields_set:
         raise SpecError("plant.disturbance_amplitude", f"plant.model = {table.model!r} "
                         "takes its disturbance as plant.slip (forward, lateral, turn)")
@@ -1022,7 +1024,18 @@ def _differential_drive(doc: Any) -> DifferentialDrive | None:
         float(table.axle_offset), float(table.track_width),
         tuple(float(v) for v in table.wheel_radius_error or (0.0, 0.0)),
         tuple(float(v) for v in table.slip or (0.0, 0.0, 0.0)),
-        float(doc.initial.heading or 0.0))
+        float(doc.initial.heading or 0.0),
+        None if table.wheel_radius is None else float(table.wheel_radius))
+
+
+def _mujoco(table: Any, n: int) -> MujocoModel | None:
+    """The MuJoCo model of ``[plant]``: always for a model without equations, for a model
+    with equations (the differential drive) when ``plant.mjcf`` is given; one joint per
+    state of the plant (the differential drive's ``x, y, theta``)."""
+    entry = plant_entry(table.model)
+    if not entry.simulator_keys or (not entry.declared_bounds and table.mjcf is None):
+        return None
+    return mujoco_model(table, entry.plant_states or n, entry.input_count(n))
 
 
 def _no_fit(robot: Robot, label: str, why: str) -> SpecError:

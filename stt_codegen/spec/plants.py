@@ -116,7 +116,9 @@ PLANTS: dict[str, PlantModel] = {p.name: p for p in (
                "look-ahead point (x, y) + axle_offset (cos theta, sin theta), 2 states "
                "(plant.axle_offset, plant.track_width, plant.wheel_radius_error, plant.slip, "
                "initial.heading)", states=2, inputs=("v", "omega"),
-               parameter_keys=("axle_offset", "track_width", "wheel_radius_error", "slip"),
+               parameter_keys=("axle_offset", "track_width", "wheel_radius_error", "slip",
+                               "wheel_radius"),
+               simulator_keys=("mjcf", "joints", "actuators", "timestep"),
                variant="look-ahead", plant_states=3),
 )}
 #: The ``plant.model`` values.

@@ -234,6 +234,9 @@ class PlantTable(_Table):
         "differential-drive only: [right, left] relative radius errors of the simulated "
         "base's wheels (a wheel of radius r (1 + e) where the controller assumes r); "
         "default [0, 0]")
+    wheel_radius: Positive = _omitted(
+        "differential-drive on MuJoCo only (required there): the wheels' nominal radius, m, "
+        "to turn (v, omega) into the wheel actuators' speeds")
     slip: Annotated[list[NonNegative], Field(min_length=3, max_length=3)] = _omitted(
         "differential-drive only: amplitudes of the simulated slip [forward m/s, lateral "
         "m/s, turn rad/s]; default [0, 0, 0] (plant.disturbance_amplitude does not apply)")

@@ -22,15 +22,18 @@ __all__ = ["plant_within_assumptions"]
 
 
 def _not_checked(prefix: str, model: str, verdict: str) -> Check:
-    """The membership check of a plant without equations: passed, saying it is not checked."""
+    """The membership check of a plant without equations (or simulated on MuJoCo): passed,
+    saying it is not checked."""
     return Check(f"{prefix}.plant_within_assumptions", True,
-                 f"not checked: the {model} plant has no equations here, so {verdict} holds "
-                 "for it only if it meets the declared [assumptions]", {"declared_only": True})
+                 f"not checked: the {model} plant runs on MuJoCo, whose equations are not "
+                 f"here, so {verdict} holds for it only if it meets the [assumptions]",
+                 {"declared_only": True})
 
 
 def _first_order(spec: Spec, model: str | None) -> Check:
     model = model or spec.plant_model
-    if plant_entry(model).declared_bounds:      # no equations: nothing to compare
+    # no equations, or a MuJoCo model of the plant: nothing to compare
+    if plant_entry(model).declared_bounds or spec.mujoco is not None:
         return _not_checked("sampled", model, "the sampled verdict")
     # only a model that takes [plant] matrices or parameters is evaluated with the spec's
     b = model_bounds(model, spec.state_space.lower, spec.state_space.upper,
