@@ -124,6 +124,28 @@ def test_a_bound_the_default_design_exceeds_gets_a_slower_tube():
     assert document["input_peak"]["margin"] == pytest.approx(margin, rel=1e-12) and margin >= 0
 
 
+def test_a_bound_smooth_step_via_points_exceed_gets_cruise_segments():
+    """With ``|v1|, |v2| <= 1.4``, the paper's tube, its softer circumvents and the
+    smooth-step via tube all exceed the bound (the last asks 1.55 of v1); the via tube
+    with cruise segments (the same boxes and times, peak rate 1.25 instead of 1.875 times
+    the mean) is proved within it and certified."""
+    spec, _ = robot()
+    bound = (1.4, 1.4, 1.0)
+    spec = dataclasses.replace(spec, input_bound=bound)
+    free = dataclasses.replace(spec, input_bound=None)
+    smooth = design_tube(dataclasses.replace(free, tube=dataclasses.replace(
+        free.tube, method="via")))
+    assert {s.profile for s in smooth.tube.segments} == {"smoothstep"}
+    assert input_prover()(smooth.tube, spec).peak[0] > bound[0]
+    design = design_tube(spec)
+    assert design.method == "via" and design.certificate.passed
+    assert {s.profile for s in design.tube.segments} == {"cruise"}
+    assert design.input_proof.meets(bound)
+    # the same via boxes and times as the smooth-step tube
+    assert [(s.start, s.end, s.lower_to) for s in design.tube.segments] == [
+        (s.start, s.end, s.lower_to) for s in smooth.tube.segments]
+
+
 @pytest.mark.slow
 def test_softer_circumvents_keep_the_papers_tube():
     """Where a softer circumvent suffices the design keeps the paper's method and slows

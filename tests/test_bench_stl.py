@@ -90,6 +90,22 @@ def test_every_spec_loads(name):
             assert all(hi <= h0 for hi, h0 in zip(entry["upper"], upper))
 
 
+@pytest.mark.parametrize("name", ["EitherOr", "RandomMultitarget", "DoorPuzzle",
+                                  "NonlinearReachAvoid"])
+def test_scenarios_with_a_bound_design_within_it(name):
+    """The examples' bounds (|v| <= 1, DoorPuzzle 2; the unicycle's |v| <= 10,
+    |omega| <= 5) are kept: each design is proved to keep law (13) within them (the legs'
+    times follow their paths, the cruise profile's peak is 1.25 times its mean, the
+    shortest plan first; the unicycle's via tube with cruise segments) and certified."""
+    from stt_codegen.design.search import design_tube
+    doc = scenario_spec(name)
+    bound = tuple(doc["actuator"]["input_bound"])
+    design = design_tube(Spec.from_dict(doc))
+    assert design.certificate.passed and design.tube.input_bound == bound
+    assert design.input_proof.proved and design.input_proof.meets(bound)
+    assert max(p / b for p, b in zip(design.input_proof.peak, bound)) <= 1.0
+
+
 def test_specs_carry_the_formulas_structure():
     either = scenario_spec("EitherOr")
     (stay,) = either["tasks"]
@@ -189,7 +205,9 @@ def test_drake_branch_and_bound_runs_or_says_why():
 @pytest.mark.bench
 def test_bench_stl_every_designed_run_is_satisfied(tmp_path, monkeypatch):
     """All scenarios without stlpy's solver: each is written, and every row designed (as
-    written, or without the bound) is satisfied with C with robustness > 0 on the grid."""
+    written, or without the bound) is satisfied with C with robustness > 0 on the grid;
+    every double-integrator example with a bound is designed within it, its run's peak
+    input within it too."""
     monkeypatch.setenv("STT_CODEGEN_CACHE", str(tmp_path / "cache"))
     rows = run_stl_bench(solver=None)["rows"]
     assert {r["scenario"] for r in rows if r["written"]} == set(scenario_names())
@@ -197,3 +215,9 @@ def test_bench_stl_every_designed_run_is_satisfied(tmp_path, monkeypatch):
     assert designed
     for row in designed:
         assert row["satisfied"] and row["grid"] > 0, row["scenario"]
+    within = {r["scenario"]: r for r in designed if r["input_bound"]}
+    assert set(within) == {"EitherOr", "NarrowPassage", "RandomMultitarget", "DoorPuzzle",
+                           "NonlinearReachAvoid"}
+    assert not [r for r in rows if r["variant"] == "no bound"]   # none refused by its bound
+    for row in within.values():
+        assert all(p <= b + 1e-9 for p, b in zip(row["peak_u"], row["input_bound"]))

@@ -22,6 +22,7 @@ from stt_codegen.runtime.simulate import simulate
 from stt_codegen.runtime.tasks import judge_task, until_met
 from stt_codegen.spec.loader import Spec, load_spec
 from stt_codegen.tube import reference
+from stt_codegen.tube.parameters import CRUISE
 
 A = {"lower": [3.4, 0.6], "upper": [4.0, 1.2]}       # bottom right
 B = {"lower": [0.6, 3.4], "upper": [1.2, 4.0]}       # top left
@@ -94,6 +95,34 @@ def test_windows_that_admit_no_timing_name_the_task_and_its_window():
     spec = spec_of({**arena(2, tasks, obstacles=[], t_c=12.0), "task_order": {"order": "any"}})
     design = design_tube(spec)
     assert design.task_plan.order == (1, 0) and design.certificate.passed
+
+
+def _leg_speeds(design) -> list[float]:
+    """Per leg (between two holds, and to the target): its via boxes' centres' path length
+    (largest coordinate move per segment) over the leg's duration."""
+    edges = [0.0] + [t for k in design.task_plan.order for t in design.task_plan.holds[k]]
+    edges.append(design.spec.prescribed_time)
+    speeds = []
+    for t0, t1 in zip(edges[::2], edges[1::2]):
+        length = sum(max(abs(0.5 * (b + d) - 0.5 * (a + c)) for a, c, b, d in
+                         zip(s.lower_from, s.upper_from, s.lower_to, s.upper_to))
+                     for s in design.tube.segments if t0 <= s.start and s.end <= t1)
+        speeds.append(length / (t1 - t0))
+    return speeds
+
+
+def test_free_timing_gives_each_leg_time_in_proportion_to_its_via_path():
+    """Free windows, the first leg around the obstacle: every leg moves at the same speed
+    (its via path's length, largest coordinate moves, over its time), so no leg asks more
+    of an input than the others, and the holds' spare time is all used."""
+    tasks = [reach(C, [1.0, 13.0]), reach(B, [1.0, 13.0])]
+    design = design_tube(spec_of(arena(2, tasks, t_c=15.0)))
+    assert design.certificate.passed and design.task_plan.order == (0, 1)
+    first = [s for s in design.tube.segments if s.end <= design.task_plan.holds[0][0]]
+    assert len(first) >= 2                     # around the obstacle: via boxes
+    speeds = _leg_speeds(design)
+    assert len(speeds) == 3 and max(speeds) - min(speeds) <= 1e-9 * max(speeds), speeds
+    assert {s.profile for s in design.tube.segments} == {CRUISE}
 
 
 # --------------------------------------------------------------------------- stay duration

@@ -9,8 +9,9 @@ import pytest
 
 from stt_codegen.tube import reference as R
 from stt_codegen.tube.model import build_model
-from stt_codegen.tube.parameters import (LOWER, SMOOTHSTEP, TANH, UPPER, Circumvent,
-                                         ReachSegment, TubeDesign)
+from stt_codegen.tube.parameters import (CRUISE, CRUISE_RAMP, LOWER, SMOOTHSTEP, TANH, UPPER,
+                                         Circumvent, ReachSegment, TubeDesign,
+                                         peak_rate_factor)
 
 TOLERANCE = 1e-12
 
@@ -38,7 +39,7 @@ def times() -> np.ndarray:
     return np.sort(np.concatenate([rng.uniform(-1.0, 12.0, 2000), near]))
 
 
-@pytest.mark.parametrize("profile", [SMOOTHSTEP, TANH])
+@pytest.mark.parametrize("profile", [SMOOTHSTEP, TANH, CRUISE])
 def test_model_matches_reference_on_segments_and_open_circumvents(profile):
     design = piecewise_design(profile)
     model = build_model(design)
@@ -51,8 +52,9 @@ def test_model_matches_reference_on_segments_and_open_circumvents(profile):
             assert np.all(np.abs(a - b) <= TOLERANCE * np.maximum(1.0, np.abs(b))), name
 
 
-def test_reach_tube_and_its_rate_are_continuous_at_every_via_point():
-    design = piecewise_design(SMOOTHSTEP)
+@pytest.mark.parametrize("profile", [SMOOTHSTEP, CRUISE])
+def test_reach_tube_and_its_rate_are_continuous_at_every_via_point(profile):
+    design = piecewise_design(profile)
     for seg in design.segments:
         for when in (seg.start, seg.end):
             before = R.reach_tube(design, [when - 1e-9])
@@ -61,6 +63,33 @@ def test_reach_tube_and_its_rate_are_continuous_at_every_via_point():
                 assert np.max(np.abs(a - b)) < 1e-6, when
     # far from the ends the rate is not zero: the test above can fail
     assert np.max(np.abs(R.reach_tube(design, [1.0])[2])) > 0.1
+
+
+@pytest.mark.parametrize("profile", [SMOOTHSTEP, CRUISE])
+def test_smooth_profile_peak_rate_and_its_second_derivative(profile):
+    """The CasADi model's p_dot peaks at peak_rate_factor times the mean (1.875 for the
+    smooth step, 1 / (1 - ramp) = 1.25 for the cruise, held over the whole cruise);
+    p_ddot (from the model's p_dot) is continuous, 0 at both ends, and p is monotone."""
+    from stt_codegen.tube.pieces import progress
+    start, end = 1.0, 5.0
+    t = np.linspace(start - 0.5, end + 0.5, 200001)
+    p, p_dot = (np.array(v).ravel() for v in progress(profile).map(t.size)(t[None, :], start, end))
+    mean = 1.0 / (end - start)
+    assert abs(p_dot.max() / mean - peak_rate_factor(profile)) < 1e-9
+    assert np.all(np.diff(p) >= 0.0) and p[0] == 0.0 and p[-1] == 1.0
+    p_ddot = np.diff(p_dot) / np.diff(t)
+    assert np.max(np.abs(np.diff(p_ddot))) < 1e-3 * np.max(np.abs(p_ddot))   # no jump
+    assert np.max(np.abs(p_ddot[np.abs(t[1:] - start) < 1e-3])) < 1e-2
+    assert np.max(np.abs(p_ddot[np.abs(t[1:] - end) < 1e-3])) < 1e-2
+    if profile == CRUISE:
+        tau = (t - start) / (end - start)
+        cruise = (tau > CRUISE_RAMP + 1e-6) & (tau < 1.0 - CRUISE_RAMP - 1e-6)
+        assert np.all(np.abs(p_dot[cruise] / mean - 1.25) < 1e-12)
+        assert peak_rate_factor(CRUISE) == 1.25 and CRUISE_RAMP == 0.2
+        # a ramp covers half its length at the cruise rate: p(ramp) = 1.25 * 0.2 / 2
+        (at_ramp,) = np.array(progress(CRUISE, False)(start + CRUISE_RAMP * (end - start),
+                                                       start, end)).ravel()
+        assert abs(at_ramp - 0.125) < 1e-15
 
 
 def test_reach_tube_holds_its_boxes_outside_the_segments():
@@ -99,3 +128,59 @@ def test_open_bump_sum_is_proved_in_verify():
     check = check_open_bump_sum()
     assert check.passed, check.detail
     assert "design.open_bump_sum" in [c.name for c in lemma_checks(orders=1)]
+
+
+def test_cruise_profile_is_proved_c2_with_its_peak_rate_and_is_deployed_as_documented():
+    """SymPy: the documented cruise profile (ramp share ``a`` in (0, 1/2), symbolic) has
+    ``p``, ``p_dot``, ``p_ddot`` continuous at both joints, ``p = 0, 1`` and
+    ``p_dot = p_ddot = 0`` at the ends, rate ``1 / (1 - a)`` in the cruise and between 0
+    and that on the ramps; the deployed CasADi piece, printed and reduced on each branch,
+    is that profile at ``a = CRUISE_RAMP`` and its ``p_dot`` output is ``dp/dt`` (both to
+    the doubles' rounding of the constants, 1e-13 on every coefficient)."""
+    import sympy as sp
+
+    from stt_codegen.codegen.emit import sympy_expressions
+    from stt_codegen.tube import pieces
+    from stt_codegen.verify.deployed import exact, on_domain
+
+    a = sp.Symbol("a", positive=True)
+    tau, x = sp.symbols("tau x", real=True)
+    v = 1 / (1 - a)
+
+    def covered(y):
+        return v * a * (y**3 - y**4 / 2)
+
+    branches = (covered(tau / a), v * (tau - a / 2), 1 - covered((1 - tau) / a))
+    for k in range(3):
+        d = [sp.diff(b, tau, k) for b in branches]
+        assert sp.simplify((d[0] - d[1]).subs(tau, a)) == 0
+        assert sp.simplify((d[1] - d[2]).subs(tau, 1 - a)) == 0
+        assert sp.simplify(d[0].subs(tau, 0)) == 0
+        assert sp.simplify(d[2].subs(tau, 1) - (0 if k else 1)) == 0
+    assert sp.simplify(sp.diff(branches[1], tau) - v) == 0
+    ramp_rate = sp.simplify(sp.diff(branches[0], tau).subs(tau, a * x))
+    assert sp.simplify(ramp_rate - v * x**2 * (3 - 2 * x)) == 0
+    # on x in [0, 1]: v x^2 (3 - 2x) >= 0 and v - it = v (1 - x)^2 (1 + 2x) >= 0
+    assert sp.simplify(v - ramp_rate - v * (1 - x) ** 2 * (1 + 2 * x)) == 0
+    assert peak_rate_factor(CRUISE) == float(v.subs(a, sp.Rational(1, 5)))
+
+    t = sp.Symbol("t", real=True)
+    d_ = sp.Symbol("d", positive=True)
+    w = sp.Symbol("w", positive=True)
+    (p,), (p_dot,) = sympy_expressions(pieces.progress(CRUISE), {"t": [t], "start": [0],
+                                                                 "end": [d_]})
+    lo, hi = exact(sp.Float(CRUISE_RAMP)), exact(sp.Float(1.0 - CRUISE_RAMP))
+    domains = ({t: lo * d_ * w / (1 + w)}, {t: (lo + (hi - lo) * w / (1 + w)) * d_},
+               {t: (hi + (1 - hi) * w / (1 + w)) * d_})
+    documented = [sp.expand(b.subs(a, sp.Rational(1, 5))) for b in branches]
+
+    def gap(got, expected) -> float:      # largest coefficient of got - expected in tau
+        diff = sp.Poly(sp.expand(got - expected), tau)
+        return max(abs(float(c)) for c in diff.all_coeffs())
+
+    for domain, expected in zip(domains, documented):
+        value, rate = on_domain(p, domain), on_domain(p_dot, domain)
+        value, rate = value.subs(t, tau * d_), (rate * d_).subs(t, tau * d_)
+        assert gap(value, expected) < 1e-13
+        assert gap(rate, sp.diff(expected, tau)) < 1e-13
+    assert pieces.PROFILE_NAMES.index(CRUISE) == 2

@@ -19,7 +19,10 @@ second stage). Deterministic, in this order, the first tube that meets the bound
    paper's search fails;
 3. **via points** (``tube.method`` ``"auto"`` or ``"via"``): smooth-step segments through
    via boxes, timed in proportion to their length over all of ``t_c`` (no circumvent
-   flanks).
+   flanks);
+4. **via points with cruise segments** (the same; not for tasks, whose legs have them):
+   the same via boxes and times, each segment's rate rising to 1.25 times its mean, not
+   1.875 times.
 
 When none does, the design is refused (``DesignError``, kind ``INPUT_BOUND``) naming the
 smallest ``prescribed_time`` at which the same procedure meets the bound (a search on
@@ -37,6 +40,7 @@ from dataclasses import dataclass, replace
 
 from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
+from ..tube.parameters import CRUISE
 from .grid import grid_index, grid_value, smallest_passing
 from .failures import FailureKind
 from .input_bound import InputProof, input_prover
@@ -94,7 +98,10 @@ def slower_variants(spec: Spec, default: Design) -> list[tuple[str, Spec]]:
         Softer circumvents (the paper's tube with every ``k^j`` fixed to each ladder value
         above the default's largest), when the default is the paper's tube with
         circumvents and ``tube.circumvent_sharpness`` is free; then via points, when
-        ``tube.method`` allows them and the default is not already a via tube.
+        ``tube.method`` allows them and the default is not already a via tube; then via
+        points with ``"cruise"`` segments (peak rate 1.25 times the mean, where the smooth
+        step's is 1.875), when ``tube.method`` allows via points and the spec has no
+        tasks (whose legs are cruise segments already).
     """
     out: list[tuple[str, Spec]] = []
     if (default.method == METHOD_PAPER and default.tube.circumvents
@@ -106,6 +113,10 @@ def slower_variants(spec: Spec, default: Design) -> list[tuple[str, Spec]]:
                 for k in SHARPNESS_LADDER if k > sharpest]
     if spec.tube.method in ("auto", METHOD_VIA) and default.method != METHOD_VIA:
         out.append(("via points", replace(spec, tube=replace(spec.tube, method=METHOD_VIA))))
+    if spec.tube.method in ("auto", METHOD_VIA) and not spec.tasks:
+        out.append(("via points, cruise segments",
+                    replace(spec, tube=replace(spec.tube, method=METHOD_VIA,
+                                               via_profile=CRUISE))))
     return out
 
 

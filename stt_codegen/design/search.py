@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 import time
-from itertools import islice, product
+
 from dataclasses import replace
 
 import numpy as np
@@ -41,8 +41,7 @@ from .gain import derived_gain
 from .plant_check import plant_failure
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
 from .tracking import SMOOTHER_RATIO, centre_speed, tracking_demand, unfollowable
-from .tasks import MAX_PLANS as TASK_PLANS
-from .tasks import TaskPlan, alternatives, plan_tasks, visit_orders
+from .tasks import TaskPlan, plan_tasks, task_plans
 from .via import via_design
 from .windows import WINDOW_INFLATION, candidates, overlap_interval, progress_time
 
@@ -471,13 +470,11 @@ def _trackable(spec: Spec, base: TubeDesign, tube: TubeDesign, check: TubeCheck,
 def _tasks(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck, tuple[int, ...],
                                                  TaskPlan]:
     """The first plan through the tasks' boxes (:mod:`~stt_codegen.design.tasks`: the visit
-    orders of :func:`~stt_codegen.design.tasks.visit_orders`, each with the ``any_of``
-    alternatives in :func:`~stt_codegen.design.tasks.alternatives` order, at most
-    ``MAX_PLANS`` plans) whose tube passes :func:`check_tube`, the alternatives it took and
-    its visits."""
+    orders and ``any_of`` alternatives of :func:`~stt_codegen.design.tasks.task_plans`,
+    shortest travel first) whose tube passes :func:`check_tube`, the alternatives it took
+    and its visits."""
     failures: list[DesignError] = []
-    plans = islice(product(visit_orders(spec, base), alternatives(spec)), TASK_PLANS)
-    for order, choice in plans:
+    for order, choice in task_plans(spec, base):
         try:
             tube, plan = plan_tasks(spec, base, choice, order)
         except DesignError as exc:

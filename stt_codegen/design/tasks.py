@@ -17,11 +17,14 @@ of the via-point design (:mod:`stt_codegen.design.via`), in window order, then t
 * **Legs.** Between two holds (and from ``X-hat_0`` at 0 to the first, and from the last
   to the target box ``T-hat`` at ``t_c``), :func:`~stt_codegen.design.via.plan_via` plans
   via boxes through the free space over the leg's duration: the same grid, moves,
-  shortening and timing as a whole via design.
+  shortening and timing as a whole via design, with ``"cruise"`` segments (peak rate
+  1.25 times the mean, :data:`~stt_codegen.tube.parameters.CRUISE`). Under free timing
+  each leg's time follows its via path's length (largest coordinate moves), so every leg
+  moves at about the same speed.
 
 The certificate (:mod:`stt_codegen.design.certificate.tasks`) then proves each task for
-every ``t``; the plan only makes it likely to pass. ``any_of`` tasks are tried in
-:func:`alternatives` order (every combination, first alternatives first, at most
+every ``t``; the plan only makes it likely to pass. The plans (visit order and ``any_of``
+alternatives) are tried shortest path first (:func:`task_plans`, at most
 :data:`MAX_PLANS`); :func:`~stt_codegen.design.search.design_tube` keeps the first plan
 whose tube passes its check.
 """
@@ -30,19 +33,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from itertools import islice, permutations, product
+from math import factorial
 
 import numpy as np
 
 from ..errors import DesignError
 from ..spec.loader import Spec
 from ..spec.tasks import STAY, Task
-from ..tube.parameters import SMOOTHSTEP, ReachSegment, TubeDesign, paper_segments
+from ..tube.parameters import CRUISE, ReachSegment, TubeDesign, paper_segments
 from .failures import FailureKind
 from .swept import swept_spec
-from .via import plan_via
+from .via import ViaPlan, plan_via
 
-__all__ = ["FREE_HOLD", "MAX_PLANS", "STAY_LEAD", "TaskPlan", "alternatives", "plan_tasks", "task_schedule",
-           "visit_orders"]
+__all__ = ["FREE_HOLD", "MAX_PLANS", "STAY_LEAD", "TaskPlan", "plan_tasks", "task_plans",
+           "task_schedule", "visit_orders"]
 
 #: A waypoint box's half-width, at most this share of the task box's.
 TASK_BOX_SHARE = 0.6
@@ -54,7 +58,7 @@ TASK_ROOM = 0.2
 HOLD_LEAD = 0.25
 #: A stay task's hold starts up to this many seconds before its window opens.
 STAY_LEAD = 0.25
-#: Most combinations of ``any_of`` alternatives tried.
+#: Most plans (visit order and ``any_of`` alternatives) tried.
 MAX_PLANS = 16
 #: Free timing: a reach task's hold lasts this share of its window, at most
 #: :data:`FREE_HOLD` seconds, and is kept half as much from the window's ends.
@@ -62,31 +66,17 @@ FREE_HOLD_SHARE = 0.25
 FREE_HOLD = 0.5
 #: Free timing: the shortest leg between two holds, seconds.
 MIN_LEG = 0.25
-#: Free timing: the estimated speeds tried, multiples of the even speed (the centres'
-#: path length over the time the holds leave).
+#: Free timing: the estimated speeds tried, multiples of the even speed (the legs' path
+#: length over the time the holds leave).
 SPEED_FACTORS = (1.0, 2.0, 4.0)
 #: ``[task_order] order = "any"``: every order is tried up to this many tasks; beyond,
 #: nearest neighbour then 2-opt on the estimated travel.
 EXACT_ORDERS = 6
 #: ``order = "any"``: orders handed to the certificate at most (shortest first).
 MAX_ORDERS = 4
-
-
-def alternatives(spec: Spec) -> list[tuple[int, ...]]:
-    """The combinations of ``any_of`` alternatives to try, in order.
-
-    Parameters
-    ----------
-    spec : Spec
-
-    Returns
-    -------
-    list of tuple of int
-        One index into ``task.boxes`` per task of ``spec.tasks``; the product of the
-        alternatives in the spec's order (the first of each first), at most
-        :data:`MAX_PLANS`.
-    """
-    return list(islice(product(*(range(len(t.boxes)) for t in spec.tasks)), MAX_PLANS))
+#: Most (visit order, ``any_of`` combination) pairs ranked by their travel
+#: (:func:`task_plans`).
+MAX_COMBINATIONS = 2048
 
 
 def waypoint_box(task: Task, choice: int, previous: np.ndarray,
@@ -121,21 +111,36 @@ def _around(spec: Spec, pending: list[int]) -> Spec:
     return spec if around is None else around
 
 
-def _leg(spec: Spec, base: TubeDesign, start: tuple, goal: tuple, t0: float,
-         t1: float) -> list[ReachSegment]:
-    """Via segments from box ``start`` at ``t0`` to box ``goal`` at ``t1`` (seconds)."""
-    duration = t1 - t0
-    leg = replace(base, prescribed_time=duration,
-                  segments=paper_segments(*start, *goal, duration))
-    plan = plan_via(spec, leg)
-    times = [t0 + t for t in plan.times]
+def _distance(a: np.ndarray, b: np.ndarray) -> float:
+    """The largest coordinate move from ``a`` to ``b``, state units: the time a move
+    takes at a given peak rate of every bound (law (13) bounds each input on its own)."""
+    return float(np.max(np.abs(b - a)))
+
+
+def _leg_path(spec: Spec, base: TubeDesign, start: tuple, goal: tuple) -> ViaPlan:
+    """The via boxes from box ``start`` to box ``goal``, timed over ``[0, 1]`` (the path
+    does not depend on the leg's duration; :func:`_leg` times it)."""
+    return plan_via(spec, replace(base, prescribed_time=1.0,
+                                  segments=paper_segments(*start, *goal, 1.0)))
+
+
+def _path_length(plan: ViaPlan) -> float:
+    """The via boxes' centres' path length (:func:`_distance` per move), state units."""
+    centres = [_centre((lo, hi)) for lo, hi in zip(plan.lower, plan.upper)]
+    return sum(_distance(a, b) for a, b in zip(centres, centres[1:]))
+
+
+def _leg(plan: ViaPlan, base: TubeDesign, t0: float, t1: float) -> list[ReachSegment]:
+    """The ``"cruise"`` segments of a leg's via boxes (:func:`_leg_path`) from ``t0`` to
+    ``t1`` (seconds)."""
+    times = [t0 + (t1 - t0) * t for t in plan.times]
     times[0], times[-1] = t0, t1
     for k in range(1, len(times) - 1):
         times[k] = min(max(times[k], np.nextafter(times[k - 1], np.inf)), t1)
     if any(b <= a for a, b in zip(times, times[1:])):
         raise DesignError(f"no time for the via boxes between {t0:g} s and {t1:g} s",
                           kind=FailureKind.TASK, tried=base)
-    return list(replace(plan, times=tuple(times)).segments())
+    return list(replace(plan, times=tuple(times)).segments(CRUISE))
 
 
 @dataclass(frozen=True)
@@ -212,19 +217,26 @@ def _span(task: Task) -> tuple[float, float, float]:
     return t0 + 0.5 * hold, t1 - 0.5 * hold, hold
 
 
-def _free_holds(spec: Spec, order: tuple[int, ...], boxes: list[tuple],
-                base: TubeDesign) -> tuple[list[tuple[float, float]] | None, str]:
+def _centre_legs(base: TubeDesign, boxes: list[tuple]) -> list[float]:
+    """The legs' lengths as their centres' distances (:func:`_distance`): from ``X-hat_0``
+    through the waypoint boxes to ``T-hat``, state units."""
+    centres = [_centre((base.initial_lower, base.initial_upper))]
+    centres += [_centre(b) for b in boxes] + [_centre((base.target_lower, base.target_upper))]
+    return [_distance(a, b) for a, b in zip(centres, centres[1:])]
+
+
+def _free_holds(spec: Spec, order: tuple[int, ...], base: TubeDesign,
+                legs: list[float]) -> tuple[list[tuple[float, float]] | None, str]:
     """The holds of free timing in visit order (module notes), or ``None`` and why not in
-    the user's terms (which task, which window).
+    the user's terms (which task, which window); ``legs``: the length of each leg (one
+    more than the tasks: the last to the target), state units.
 
     With travel times at an estimated speed (the even speed, then faster), the earliest
     holds (each as soon as its window and the travel from the previous allow) and the
     latest (as late as the later ones and the target still allow) bound each hold's start;
     within them each starts when the even speed along the whole path would get there, so
-    the legs' speeds stay near it."""
-    centres = [_centre((base.initial_lower, base.initial_upper))]
-    centres += [_centre(b) for b in boxes] + [_centre((base.target_lower, base.target_upper))]
-    legs = [float(np.linalg.norm(b - a)) for a, b in zip(centres, centres[1:])]
+    the legs' speeds stay near it (with free windows, every leg at the even speed: each
+    leg's time in proportion to its length, all the time the holds leave used)."""
     length = sum(legs)
     spans = [_span(spec.tasks[k]) for k in order]
     spare = base.prescribed_time - sum(s[2] for s in spans)
@@ -267,12 +279,13 @@ def _free_holds(spec: Spec, order: tuple[int, ...], boxes: list[tuple],
 
 
 def task_schedule(spec: Spec, base: TubeDesign, order: tuple[int, ...],
-                  choice: tuple[int, ...]) -> tuple[list[tuple], list[tuple[float, float]]]:
+                  choice: tuple[int, ...], legs: list[float] | None = None
+                  ) -> tuple[list[tuple], list[tuple[float, float]]]:
     """The waypoint boxes and holds of a visit order, both in visit order.
 
     The fixed holds (the middle half of each reach window, each stay's window) when they
-    follow one another; else the free timing: each hold as early as the estimated travel
-    from the previous one allows (module notes).
+    follow one another; else the free timing: each leg's time in proportion to its length
+    where the windows allow (module notes).
 
     Parameters
     ----------
@@ -283,6 +296,10 @@ def task_schedule(spec: Spec, base: TubeDesign, order: tuple[int, ...],
         Task indices in visit order.
     choice : tuple of int
         One alternative per task, spec order.
+    legs : list of float, optional
+        Free timing: each leg's length (``len(order) + 1`` legs, the last to the target),
+        state units; default the centres' distances (the via paths' lengths are longer
+        around obstacles: :func:`plan_tasks` passes those).
 
     Returns
     -------
@@ -300,23 +317,26 @@ def task_schedule(spec: Spec, base: TubeDesign, order: tuple[int, ...],
     boxes = _boxes(spec, base, order, choice)
     holds = _listed_holds(spec, order, boxes, base, choice)
     if holds is None:
-        holds, reason = _free_holds(spec, order, boxes, base)
+        holds, reason = _free_holds(spec, order, base,
+                                    _centre_legs(base, boxes) if legs is None else legs)
         if holds is None:
             raise DesignError(reason, kind=FailureKind.TASK, tried=base)
     return boxes, holds
 
 
-def _travel(spec: Spec, base: TubeDesign, order: tuple[int, ...]) -> float:
-    """The centres' path length of a visit order (first alternatives), state units."""
-    boxes = _boxes(spec, base, order, tuple(0 for _ in spec.tasks))
-    centres = [_centre((base.initial_lower, base.initial_upper))]
-    centres += [_centre(b) for b in boxes] + [_centre((base.target_lower, base.target_upper))]
-    return sum(float(np.linalg.norm(b - a)) for a, b in zip(centres, centres[1:]))
+def _travel(spec: Spec, base: TubeDesign, order: tuple[int, ...],
+            choice: tuple[int, ...] | None = None) -> float:
+    """The centres' path length of a visit order (:func:`_distance` per move; default the
+    first alternatives), state units."""
+    choice = tuple(0 for _ in spec.tasks) if choice is None else choice
+    return sum(_centre_legs(base, _boxes(spec, base, order, choice)))
 
 
-def _feasible(spec: Spec, base: TubeDesign, order: tuple[int, ...]) -> bool:
+def _feasible(spec: Spec, base: TubeDesign, order: tuple[int, ...],
+              choice: tuple[int, ...] | None = None) -> bool:
     try:
-        task_schedule(spec, base, order, tuple(0 for _ in spec.tasks))
+        task_schedule(spec, base, order,
+                      tuple(0 for _ in spec.tasks) if choice is None else choice)
     except DesignError:
         return False
     return True
@@ -379,6 +399,41 @@ def visit_orders(spec: Spec, base: TubeDesign) -> list[tuple[int, ...]]:
         or [tuple(order)]
 
 
+def task_plans(spec: Spec, base: TubeDesign) -> list[tuple[tuple[int, ...], tuple[int, ...]]]:
+    """The plans to try, best first: pairs of a visit order and an ``any_of`` combination.
+
+    The candidate orders (the listed one; with ``order = "any"`` every order up to
+    :data:`EXACT_ORDERS` tasks, else :func:`visit_orders`) with every combination of
+    ``any_of`` alternatives (at most :data:`MAX_COMBINATIONS` pairs; beyond, the orders
+    of :func:`visit_orders`), ranked by the centres' path length (the shortest asks the
+    lowest speed of the tube) and kept when their windows admit a timing
+    (:func:`task_schedule`), at most :data:`MAX_PLANS`.
+
+    Parameters
+    ----------
+    spec : Spec
+    base : TubeDesign
+        The paper's tube of the spec (``X-hat_0``, ``T-hat``).
+
+    Returns
+    -------
+    list of (tuple of int, tuple of int)
+        ``(order, choice)``: task indices in visit order, and one alternative per task in
+        the spec's order. The first candidate order with the first alternatives when no
+        pair admits a timing (its plan then says which task and window fail).
+    """
+    listed = tuple(range(len(spec.tasks)))
+    combos = list(islice(product(*(range(len(t.boxes)) for t in spec.tasks)),
+                         MAX_COMBINATIONS))
+    exact = (spec.task_order == "any" and 2 <= len(spec.tasks) <= EXACT_ORDERS
+             and factorial(len(spec.tasks)) * len(combos) <= MAX_COMBINATIONS)
+    orders = list(permutations(listed)) if exact else visit_orders(spec, base)
+    combos = combos[:max(1, MAX_COMBINATIONS // len(orders))]
+    ranked = sorted((_travel(spec, base, o, c), o, c) for o in orders for c in combos)
+    good = [(o, c) for _, o, c in ranked if _feasible(spec, base, o, c)]
+    return good[:MAX_PLANS] or [(orders[0], combos[0])]
+
+
 def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...],
                order: tuple[int, ...] | None = None) -> tuple[TubeDesign, TaskPlan]:
     """``base`` with its reach tube through the tasks' waypoints (module notes).
@@ -391,14 +446,14 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...],
         The paper's tube of the spec (:func:`~stt_codegen.design.search.base_design`):
         its first and last reach boxes are ``X-hat_0`` and ``T-hat``.
     choice : tuple of int
-        One alternative per task (:func:`alternatives`).
+        One alternative per task, spec order (:func:`task_plans`).
     order : tuple of int, optional
         Task indices in visit order (:func:`visit_orders`); default the spec's order.
 
     Returns
     -------
     tube : TubeDesign
-        ``smoothstep`` segments, no circumvents; the gain is ``base``'s.
+        ``cruise`` segments, no circumvents; the gain is ``base``'s.
     plan : TaskPlan
         The visit order and each task's hold.
 
@@ -409,26 +464,41 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...],
         leave no timing (kind ``TASK``, naming the task and its window).
     """
     order = tuple(range(len(spec.tasks))) if order is None else order
-    boxes, holds = task_schedule(spec, base, order, choice)
-    start = (tuple(base.initial_lower), tuple(base.initial_upper))
+    paths: dict[tuple, ViaPlan] = {}
+
+    def path(start: tuple, goal: tuple, pending: list[int]) -> ViaPlan:
+        key = (start, goal, tuple(pending))
+        if key not in paths:
+            paths[key] = _leg_path(_around(spec, pending), base, start, goal)
+        return paths[key]
+
+    # obstacles until a task: the legs up to that task's hold go around the box it sweeps
+    until = [i for i, ob in enumerate(spec.moving_obstacles) if ob.until is not None]
+    boxes = _boxes(spec, base, order, choice)
+    starts = [(tuple(base.initial_lower), tuple(base.initial_upper))] + boxes
+    goal = (tuple(base.target_lower), tuple(base.target_upper))
+    pendings = [[i for i in until if spec.moving_obstacles[i].until not in order[:j]]
+                for j in range(len(order))] + [[]]
+    # free timing: each leg's time follows its via path's length (fixed holds: unused)
+    legs = None
+    if _listed_holds(spec, order, boxes, base, choice) is None:
+        legs = [_path_length(path(a, b, p)) for a, b, p in zip(starts, boxes + [goal], pendings)]
+    boxes, holds = task_schedule(spec, base, order, choice, legs)
+    start = starts[0]
     leave = 0.0
     segments: list[ReachSegment] = []
-    # obstacles until a task: the legs up to that task's hold go around the box it sweeps
-    pending = [i for i, ob in enumerate(spec.moving_obstacles) if ob.until is not None]
-    for k, box, (arrive, until) in zip(order, boxes, holds):
+    for j, (box, (arrive, until_t)) in enumerate(zip(boxes, holds)):
         if arrive == leave:        # a stay held where the tube already is
-            segments.append(ReachSegment(leave, until, *start, *start, SMOOTHSTEP))
+            segments.append(ReachSegment(leave, until_t, *start, *start, CRUISE))
         else:
-            segments += _leg(_around(spec, pending), base, start, box, leave, arrive)
-            segments.append(ReachSegment(arrive, until, *box, *box, SMOOTHSTEP))
+            segments += _leg(path(start, box, pendings[j]), base, leave, arrive)
+            segments.append(ReachSegment(arrive, until_t, *box, *box, CRUISE))
             start = box
-        leave = until
-        pending = [i for i in pending if spec.moving_obstacles[i].until != k]
-    goal = (tuple(base.target_lower), tuple(base.target_upper))
+        leave = until_t
     if not base.prescribed_time > leave:
         raise DesignError("no time to reach the target after the last task",
                           kind=FailureKind.TASK, tried=base)
-    segments += _leg(spec, base, start, goal, leave, base.prescribed_time)
+    segments += _leg(path(start, goal, []), base, leave, base.prescribed_time)
     by_task = dict(zip(order, holds))
     plan = TaskPlan(order, tuple(by_task[k] for k in range(len(spec.tasks))))
     return replace(base, segments=tuple(segments), circumvents=()), plan

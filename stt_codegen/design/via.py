@@ -37,7 +37,7 @@ from ..spec.loader import Spec
 from .failures import FailureKind
 from ..tube.parameters import SMOOTHSTEP, ReachSegment, TubeDesign
 
-__all__ = ["VIA_MARGIN", "plan_via", "via_design"]
+__all__ = ["VIA_MARGIN", "ViaPlan", "plan_via", "via_design"]
 
 #: Largest half-width of a via box, state units.
 VIA_HALF_WIDTH = 0.1
@@ -63,11 +63,21 @@ class ViaPlan:
     upper: tuple[tuple[float, ...], ...]
     times: tuple[float, ...]
 
-    def segments(self) -> tuple[ReachSegment, ...]:
-        """The ``"smoothstep"`` reach segments between consecutive via boxes."""
+    def segments(self, profile: str = SMOOTHSTEP) -> tuple[ReachSegment, ...]:
+        """The reach segments between consecutive via boxes.
+
+        Parameters
+        ----------
+        profile : {"smoothstep", "cruise"}
+            Their profile (both have zero slope at every via point).
+
+        Returns
+        -------
+        tuple of ReachSegment
+        """
         return tuple(ReachSegment(self.times[k], self.times[k + 1], self.lower[k],
                                   self.upper[k], self.lower[k + 1], self.upper[k + 1],
-                                  SMOOTHSTEP) for k in range(len(self.times) - 1))
+                                  profile) for k in range(len(self.times) - 1))
 
 
 def _meets(lower: np.ndarray, upper: np.ndarray, obstacles: np.ndarray,
@@ -304,11 +314,13 @@ def via_design(spec: Spec, base: TubeDesign) -> TubeDesign:
     Returns
     -------
     TubeDesign
-        ``base`` through the via points, without circumvents.
+        ``base`` through the via points, without circumvents, its segments of the profile
+        ``spec.tube.via_profile``.
 
     Raises
     ------
     DesignError
         :func:`plan_via` finds no path.
     """
-    return replace(base, segments=plan_via(spec, base).segments(), circumvents=())
+    return replace(base, segments=plan_via(spec, base).segments(spec.tube.via_profile),
+                   circumvents=())

@@ -170,6 +170,10 @@ class TubeParameters:
     method : {"paper", "via", "auto"}
         The reach tube: the paper's single tube (eq. (4)), via-point segments, or the
         paper's first and via points when it has no certified design (default).
+    via_profile : {"smoothstep", "cruise"}
+        The via-point segments' profile (``tube/parameters.py``). Not a key of the file:
+        ``"smoothstep"`` as loaded; the design within ``[actuator]`` tries ``"cruise"``
+        (a lower peak rate) when the other tubes exceed the bound.
     """
 
     delta_b: float
@@ -179,6 +183,7 @@ class TubeParameters:
     mu: float
     smoothness: float
     method: str = "auto"
+    via_profile: str = "smoothstep"
 
 
 @dataclass(frozen=True)

@@ -10,10 +10,10 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
-__all__ = ["Circumvent", "E_MAX", "GAMMA_D_MIN", "LOWER", "NEWTON_ITERATIONS", "NEWTON_TINY",
+__all__ = ["CRUISE", "CRUISE_RAMP", "Circumvent", "E_MAX", "GAMMA_D_MIN", "LOWER", "NEWTON_ITERATIONS", "NEWTON_TINY",
            "ReachSegment", "SMOOTHSTEP", "STATUS_INPUT_CLAMPED", "STATUS_INVALID_INPUT",
            "STATUS_OK", "STATUS_OUTSIDE_TUBE", "STATUS_OUTSIDE_VELOCITY_TUBE", "Status", "TANH",
-           "TubeDesign", "UPPER", "paper_segments"]
+           "TubeDesign", "UPPER", "paper_segments", "peak_rate_factor"]
 
 #: Largest ``|e_i|`` used to compute ``u`` in the deployed controller step: ``e`` is
 #: clamped to ``[-E_MAX, E_MAX]`` so that ``u`` is finite everywhere (1 - 2**-20, exact in
@@ -74,7 +74,45 @@ TANH = "tanh"
 #: ``sigma(tau) = tau^3 (10 - 15 tau + 6 tau^2)`` (value and first two derivatives
 #: continuous, zero slope and curvature at both ends).
 SMOOTHSTEP = "smoothstep"
-PROFILES = (TANH, SMOOTHSTEP)
+#: Profile of a reach-tube segment: a cruise between two smooth ramps. Over the first
+#: :data:`CRUISE_RAMP` of the segment ``p_dot`` rises from 0 to its peak by the cubic
+#: smooth step ``x^2 (3 - 2 x)`` (``x = tau / CRUISE_RAMP``), stays at the peak, and falls
+#: the same way over the last :data:`CRUISE_RAMP`: ``p``, ``p_dot``, ``p_ddot`` continuous,
+#: zero slope and curvature at both ends, and a peak rate ``1 / (1 - CRUISE_RAMP)`` times
+#: the mean (the quintic smooth step's is 15/8).
+CRUISE = "cruise"
+#: The cruise profile's ramps, each this share of the segment's duration.
+CRUISE_RAMP = 0.2
+PROFILES = (TANH, SMOOTHSTEP, CRUISE)
+
+
+def peak_rate_factor(profile: str) -> float:
+    """``sup_tau dp/dtau`` of a smooth profile: the peak of ``|rho_dot|`` on a segment is
+    this times ``|to - from| / (end - start)``.
+
+    Parameters
+    ----------
+    profile : {"smoothstep", "cruise"}
+
+    Returns
+    -------
+    float
+        ``15/8`` for ``"smoothstep"`` (``30 tau^2 (1 - tau)^2`` at ``tau = 1/2``);
+        ``1 / (1 - CRUISE_RAMP)`` for ``"cruise"`` (the cruise's rate: the two ramps
+        together cover half their length at the mean rate's ``1 / (1 - CRUISE_RAMP)``
+        multiple, the cruise the rest).
+
+    Raises
+    ------
+    ValueError
+        ``"tanh"`` (its peak depends on the segment: ``verify.lemma.reach_rate_bound``) or
+        an unknown profile.
+    """
+    if profile == SMOOTHSTEP:
+        return 1.875
+    if profile == CRUISE:
+        return 1.0 / (1.0 - CRUISE_RAMP)
+    raise ValueError(f"no fixed peak rate for the reach segment profile {profile!r}")
 
 
 @dataclass(frozen=True)
@@ -144,10 +182,12 @@ class ReachSegment:
         Seconds, ``start < end``.
     lower_from, upper_from, lower_to, upper_to : tuple of float
         The boxes at ``start`` and ``end``, state units, length ``n`` each.
-    profile : {"tanh", "smoothstep"}
+    profile : {"tanh", "smoothstep", "cruise"}
         ``"tanh"``: ``p = tanh(tau / (1 - tau))`` for ``tau < 1``, 1 after (eq. (4));
         ``"smoothstep"``: ``p = tau^3 (10 - 15 tau + 6 tau^2)`` (value, first and second
-        derivatives continuous at both ends, where the slope is zero).
+        derivatives continuous at both ends, where the slope is zero); ``"cruise"``: smooth
+        ramps around a constant rate (:data:`CRUISE`; the same continuity, a lower peak
+        rate).
     """
 
     start: float

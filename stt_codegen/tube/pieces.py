@@ -15,6 +15,7 @@ piece                  inputs                                       outputs
 ``progress_tanh``      t, start, end                                p, p_dot (eq. (4));
                                                                     ``_value``: p only
 ``progress_smoothstep`` t, start, end                               p, p_dot (quintic)
+``progress_cruise``    t, start, end                                p, p_dot (ramps, cruise)
 ``interpolate``        p, p_dot, from (2n), to (2n)                 rho, rho_dot (2n: [L; U]);
                                                                     ``_value``: rho only
 ``bump``               t, start, end, center, radius, sharpness,    y = B b(t), y_dot
@@ -56,7 +57,7 @@ from functools import lru_cache
 
 import casadi as ca
 
-from .parameters import E_MAX, GAMMA_D_MIN, NEWTON_TINY, SMOOTHSTEP, TANH
+from .parameters import CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, NEWTON_TINY, SMOOTHSTEP, TANH
 
 __all__ = ["EXP_ARGUMENT_BOUND", "PROFILE_NAMES", "alpha_rate", "bump", "candidates", "conflict",
            "deployed_pieces", "error_transform", "error_transform_expression", "fnu_pieces",
@@ -74,7 +75,7 @@ SMOOTH_SKIP_BASE = 34.0
 _SKIP_SCALE = 30.91
 
 #: Profile codes of the segment table, in the order of ``PROFILE_NAMES``.
-PROFILE_NAMES = (TANH, SMOOTHSTEP)
+PROFILE_NAMES = (TANH, SMOOTHSTEP, CRUISE)
 
 
 def _sym(*names: str):
@@ -86,7 +87,11 @@ def progress_expression(profile: str, t, start, end):
 
     ``"tanh"``: ``tanh((t - start) / (end - t))`` (eq. (4); only evaluated for
     ``t < end``, with a denominator that stays finite in the branch not taken);
-    ``"smoothstep"``: ``tau^3 (10 - 15 tau + 6 tau^2)``, ``tau`` clamped to ``[0, 1]``.
+    ``"smoothstep"``: ``tau^3 (10 - 15 tau + 6 tau^2)``, ``tau`` clamped to ``[0, 1]``;
+    ``"cruise"`` (:data:`~.parameters.CRUISE`, ramp share ``a``, peak rate
+    ``v = 1 / (1 - a)``): ``v a r(tau / a)`` on the first ramp, ``v (tau - a/2)`` in the
+    cruise, ``1 - v a r((1 - tau) / a)`` on the last ramp, with ``r(x) = x^3 - x^4 / 2``
+    (the integral of the cubic smooth step ``x^2 (3 - 2 x)``).
 
     Raises
     ------
@@ -98,10 +103,20 @@ def progress_expression(profile: str, t, start, end):
         gap = ca.if_else(before, end - t, 1.0)
         elapsed = t - start
         return ca.if_else(before, ca.if_else(elapsed < 0.0, 0.0, ca.tanh(elapsed / gap)), 1.0)
-    if profile != SMOOTHSTEP:
+    if profile not in (SMOOTHSTEP, CRUISE):
         raise ValueError(f"unknown reach segment profile {profile!r}")
     tau = ca.fmin(ca.fmax((t - start) / (end - start), 0.0), 1.0)
-    return tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+    if profile == SMOOTHSTEP:
+        return tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+    a = CRUISE_RAMP
+    v = 1.0 / (1.0 - a)
+
+    def ramp(x):       # v a (x^3 - x^4 / 2): the part of the way a ramp covers
+        return v * a * x * x * x * (1.0 - 0.5 * x)
+
+    return ca.if_else(tau < a, ramp(tau / a),
+                      ca.if_else(tau <= 1.0 - a, v * (tau - 0.5 * a),
+                                 1.0 - ramp((1.0 - tau) / a)))
 
 
 @lru_cache(maxsize=None)
@@ -112,8 +127,9 @@ def progress(profile: str, rates: bool = True) -> ca.Function:
     Parameters
     ----------
     profile : str
-        One of :data:`PROFILE_NAMES`: ``"tanh"`` (``tanh((t - start) / (end - t))``, eq. (4))
-        or ``"smoothstep"`` (quintic); see :func:`progress_expression`.
+        One of :data:`PROFILE_NAMES`: ``"tanh"`` (``tanh((t - start) / (end - t))``, eq. (4)),
+        ``"smoothstep"`` (quintic) or ``"cruise"`` (smooth ramps around a constant rate);
+        see :func:`progress_expression`.
     rates : bool
         Also return ``p_dot``, the derivative in ``t`` (1/s).
 

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from .parameters import (E_MAX, GAMMA_D_MIN, LOWER, SMOOTHSTEP, STATUS_INPUT_CLAMPED, STATUS_OK,
+from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, LOWER, SMOOTHSTEP, STATUS_INPUT_CLAMPED, STATUS_OK,
                          STATUS_OUTSIDE_TUBE, TANH, ReachSegment, TubeDesign)
 
 __all__ = ["adaptive_law", "adaptive_tube", "alpha_step", "bump", "circumvent",
@@ -132,7 +132,10 @@ def segment_progress(segment: ReachSegment, t) -> tuple[Array, Array]:
     ``"tanh"``: ``p = tanh((t - start) / (end - t))`` (eq. (4), ``tau / (1 - tau)`` written
     so that a segment starting at 0 evaluates exactly the paper's ``t / (t_c - t)``);
     ``"smoothstep"``: ``p = tau^3 (10 - 15 tau + 6 tau^2)``,
-    ``tau = (t - start) / (end - start)``.
+    ``tau = (t - start) / (end - start)``; ``"cruise"``: the rate ``dp/dtau`` rises as
+    ``v s(tau / a)`` (``s(x) = 3 x^2 - 2 x^3``, ``a = CRUISE_RAMP``, ``v = 1 / (1 - a)``),
+    holds ``v``, falls as ``v s((1 - tau) / a)``; ``p`` is its integral from 0, and by
+    the symmetry ``p(tau) = 1 - p(1 - tau)`` on the last ramp.
 
     Parameters
     ----------
@@ -157,12 +160,23 @@ def segment_progress(segment: ReachSegment, t) -> tuple[Array, Array]:
         sech2 = 4.0 * q / (1.0 + q) ** 2
         p_dot = np.where(active, sech2 * (end - start) / gap**2, 0.0)
         return p, p_dot
-    if segment.profile != SMOOTHSTEP:
-        raise ValueError(f"unknown reach segment profile {segment.profile!r}")
     duration = end - start
     tau = np.clip((t - start) / duration, 0.0, 1.0)
-    p = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
-    p_dot = 30.0 * tau**2 * (1.0 - tau) ** 2 / duration
+    if segment.profile == SMOOTHSTEP:
+        p = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+        p_dot = 30.0 * tau**2 * (1.0 - tau) ** 2 / duration
+        return p, p_dot
+    if segment.profile != CRUISE:
+        raise ValueError(f"unknown reach segment profile {segment.profile!r}")
+    a = CRUISE_RAMP
+    v = 1.0 / (1.0 - a)
+    rising, falling = tau < a, tau > 1.0 - a
+    x = np.where(rising, tau / a, np.where(falling, (1.0 - tau) / a, 1.0))
+    # integral of v s over a ramp's first x: v a (x^3 - x^4 / 2)
+    covered = v * a * x**3 * (1.0 - 0.5 * x)
+    p = np.where(rising, covered, np.where(falling, 1.0 - covered, v * (tau - 0.5 * a)))
+    p_dot = v * x**2 * (3.0 - 2.0 * x) / duration
+    # outside the segment tau is clamped to 0 or 1, where x = 0: the rate is 0 there
     return p, p_dot
 
 

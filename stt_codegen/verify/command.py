@@ -18,7 +18,7 @@ from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, 
 from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
 from ..spec.plants import MODELS_WITH_EQUATIONS
-from ..tube.parameters import SMOOTHSTEP, TANH, TubeDesign
+from ..tube.parameters import TANH, TubeDesign, peak_rate_factor
 from .actuator import input_bound_check, prove_input_bound
 from .adaptive import adaptive_law_checks, alpha_upper_bound
 from .assumption import assumption2_check
@@ -145,10 +145,10 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     checks = [c for c in symbolic if c.name.startswith("lemma")] + reach_checks + bump_checks
     checks += [c for c in symbolic if not c.name.startswith(("lemma", "deployed"))]
     checks += [c for c in symbolic if c.name.startswith("deployed")]
-    # smooth-step segments: sup |d/dt tau^3 (10 - 15 tau + 6 tau^2)| = 30/16 per duration
-    # (at tau = 1/2, where 30 tau^2 (1 - tau)^2 is largest)
-    smooth_rates = [abs(b - a) * 1.875 / seg.duration for seg in design.segments
-                    if seg.profile == SMOOTHSTEP
+    # smooth segments (smooth step, cruise): sup |rho_dot| = |to - from| times the
+    # profile's peak of dp/dtau per duration
+    smooth_rates = [abs(b - a) * peak_rate_factor(seg.profile) / seg.duration
+                    for seg in design.segments if seg.profile != TANH
                     for a, b in zip(seg.lower_from + seg.upper_from, seg.lower_to + seg.upper_to)]
     rho_rate = max([c.data.get("bound", 0.0) for c in reach_checks] + smooth_rates,
                    default=0.0)

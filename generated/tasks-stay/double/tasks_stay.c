@@ -43,7 +43,8 @@ static const tasks_stay_parameters TASKS_STAY_PARAMETERS = {
 static const tasks_stay_real TASKS_STAY_BOUND[TASKS_STAY_N_ALPHA] = { 0.0, 0.0, -1.2, 5.0, 5.0, 1.2 };
 
 /* Reach tube (eq. (4)), one row per segment: rho = from + (to - from) p(t) on
-   [start, end]; profile 0 = tanh (eq. (4)), 1 = smoothstep (quintic). Rows: [L; U]. */
+   [start, end]; profile 0 = tanh (eq. (4)), 1 = smoothstep (quintic),
+   2 = cruise (smooth ramps around a constant rate). Rows: [L; U]. */
 typedef struct {
   tasks_stay_real start;
   tasks_stay_real end;
@@ -54,14 +55,14 @@ typedef struct {
 
 #define TASKS_STAY_N_SEGMENTS 8
 static const tasks_stay_segment TASKS_STAY_SEGMENTS[TASKS_STAY_N_SEGMENTS] = {
-  { 0.0, 1.1585365853658534, 1, { 0.04999999999999999, 4.55, -0.05, 0.45, 4.95, 0.05 }, { 0.75, 3.75, -0.15975609756097559, 0.95, 3.95, 0.15975609756097559 } },
-  { 1.1585365853658534, 3.0894308943089426, 1, { 0.75, 3.75, -0.15975609756097559, 0.95, 3.95, 0.15975609756097559 }, { 1.75, 2.25, -0.3426829268292682, 1.9500000000000002, 2.45, 0.3426829268292682 } },
-  { 3.0894308943089426, 3.6043360433604335, 1, { 1.75, 2.25, -0.3426829268292682, 1.9500000000000002, 2.45, 0.3426829268292682 }, { 2.15, 1.8499999999999999, -0.3914634146341463, 2.35, 2.05, 0.3914634146341463 } },
-  { 3.6043360433604335, 4.75, 1, { 2.15, 1.8499999999999999, -0.3914634146341463, 2.35, 2.05, 0.3914634146341463 }, { 2.3, 0.8599999999999997, -0.5, 2.7, 1.26, 0.5 } },
-  { 4.75, 7.0, 1, { 2.3, 0.8599999999999997, -0.5, 2.7, 1.26, 0.5 }, { 2.3, 0.8599999999999997, -0.5, 2.7, 1.26, 0.5 } },
-  { 7.0, 8.747967479674797, 1, { 2.3, 0.8599999999999997, -0.5, 2.7, 1.26, 0.5 }, { 3.65, 2.25, -0.5, 3.85, 2.45, 0.5 } },
-  { 8.747967479674797, 9.154471544715447, 1, { 3.65, 2.25, -0.5, 3.85, 2.45, 0.5 }, { 3.75, 2.55, -0.5, 3.95, 2.75, 0.5 } },
-  { 9.154471544715447, 12.0, 1, { 3.75, 2.55, -0.5, 3.95, 2.75, 0.5 }, { 4.55, 4.55, -0.5, 4.95, 4.95, 0.5 } }
+  { 0.0, 1.1585365853658534, 2, { 0.04999999999999999, 4.55, -0.05, 0.45, 4.95, 0.05 }, { 0.75, 3.75, -0.15975609756097559, 0.95, 3.95, 0.15975609756097559 } },
+  { 1.1585365853658534, 3.0894308943089426, 2, { 0.75, 3.75, -0.15975609756097559, 0.95, 3.95, 0.15975609756097559 }, { 1.75, 2.25, -0.3426829268292682, 1.9500000000000002, 2.45, 0.3426829268292682 } },
+  { 3.0894308943089426, 3.604336043360433, 2, { 1.75, 2.25, -0.3426829268292682, 1.9500000000000002, 2.45, 0.3426829268292682 }, { 2.15, 1.8499999999999999, -0.3914634146341463, 2.35, 2.05, 0.3914634146341463 } },
+  { 3.604336043360433, 4.75, 2, { 2.15, 1.8499999999999999, -0.3914634146341463, 2.35, 2.05, 0.3914634146341463 }, { 2.3, 0.8599999999999997, -0.5, 2.7, 1.26, 0.5 } },
+  { 4.75, 7.0, 2, { 2.3, 0.8599999999999997, -0.5, 2.7, 1.26, 0.5 }, { 2.3, 0.8599999999999997, -0.5, 2.7, 1.26, 0.5 } },
+  { 7.0, 8.747967479674797, 2, { 2.3, 0.8599999999999997, -0.5, 2.7, 1.26, 0.5 }, { 3.65, 2.25, -0.5, 3.85, 2.45, 0.5 } },
+  { 8.747967479674797, 9.154471544715447, 2, { 3.65, 2.25, -0.5, 3.85, 2.45, 0.5 }, { 3.75, 2.55, -0.5, 3.95, 2.75, 0.5 } },
+  { 9.154471544715447, 12.0, 2, { 3.75, 2.55, -0.5, 3.95, 2.75, 0.5 }, { 4.55, 4.55, -0.5, 4.95, 4.95, 0.5 } }
 };
 
 /* Circumvents (eqs. (7)-(9)), one row per window, sorted by start: window (start, end),
@@ -84,12 +85,18 @@ typedef struct {
 
 /* ------------------------------------------------------------- emitted bodies */
 
-/* CasADi Function 'progress_smoothstep_value': 22 instructions. */
-static void body_progress_smoothstep_value(const tasks_stay_real* t, const tasks_stay_real* start, const tasks_stay_real* end, tasks_stay_real* p) {
+/* CasADi Function 'progress_cruise_value': 45 instructions. */
+static void body_progress_cruise_value(const tasks_stay_real* t, const tasks_stay_real* start, const tasks_stay_real* end, tasks_stay_real* p) {
   tasks_stay_real w0;
   tasks_stay_real w1;
   tasks_stay_real w2;
   tasks_stay_real w3;
+  tasks_stay_real w4;
+  tasks_stay_real w5;
+  tasks_stay_real w6;
+  tasks_stay_real w7;
+  tasks_stay_real w8;
+  tasks_stay_real w9;
   w0 = t[0];
   w1 = start[0];
   w0 = w0 - w1;
@@ -100,22 +107,45 @@ static void body_progress_smoothstep_value(const tasks_stay_real* t, const tasks
   w0 = (w2 > w0) ? w2 : w0;
   w2 = 1.0;
   w0 = (w2 < w0) ? w2 : w0;
-  w2 = w0 * w0;
-  w2 = w2 * w0;
-  w1 = 10.0;
-  w3 = 15.0;
-  w3 = w3 * w0;
-  w1 = w1 - w3;
-  w3 = 6.0;
-  w3 = w3 * w0;
-  w3 = w3 * w0;
-  w1 = w1 + w3;
-  w2 = w2 * w1;
-  p[0] = w2;
+  w1 = 0.2;
+  w3 = (w0 < w1) ? 1.0 : 0.0;
+  w4 = 0.25;
+  w5 = w0 / w1;
+  w6 = w4 * w5;
+  w6 = w6 * w5;
+  w6 = w6 * w5;
+  w7 = 0.5;
+  w5 = w7 * w5;
+  w5 = w2 - w5;
+  w6 = w6 * w5;
+  w6 = (w3 != 0.0) ? w6 : 0.0;
+  w3 = (w3 == 0.0) ? 1.0 : 0.0;
+  w5 = 0.8;
+  w5 = (w0 <= w5) ? 1.0 : 0.0;
+  w8 = 1.25;
+  w9 = 0.1;
+  w9 = w0 - w9;
+  w8 = w8 * w9;
+  w8 = (w5 != 0.0) ? w8 : 0.0;
+  w5 = (w5 == 0.0) ? 1.0 : 0.0;
+  w0 = w2 - w0;
+  w0 = w0 / w1;
+  w4 = w4 * w0;
+  w4 = w4 * w0;
+  w4 = w4 * w0;
+  w7 = w7 * w0;
+  w7 = w2 - w7;
+  w4 = w4 * w7;
+  w2 = w2 - w4;
+  w5 = (w5 != 0.0) ? w2 : 0.0;
+  w8 = w8 + w5;
+  w3 = (w3 != 0.0) ? w8 : 0.0;
+  w6 = w6 + w3;
+  p[0] = w6;
 }
 
-/* CasADi Function 'progress_smoothstep': 47 instructions. */
-static void body_progress_smoothstep(const tasks_stay_real* t, const tasks_stay_real* start, const tasks_stay_real* end, tasks_stay_real* p, tasks_stay_real* p_dot) {
+/* CasADi Function 'progress_cruise': 90 instructions. */
+static void body_progress_cruise(const tasks_stay_real* t, const tasks_stay_real* start, const tasks_stay_real* end, tasks_stay_real* p, tasks_stay_real* p_dot) {
   tasks_stay_real w0;
   tasks_stay_real w1;
   tasks_stay_real w2;
@@ -130,6 +160,15 @@ static void body_progress_smoothstep(const tasks_stay_real* t, const tasks_stay_
   tasks_stay_real w11;
   tasks_stay_real w12;
   tasks_stay_real w13;
+  tasks_stay_real w14;
+  tasks_stay_real w15;
+  tasks_stay_real w16;
+  tasks_stay_real w17;
+  tasks_stay_real w18;
+  tasks_stay_real w19;
+  tasks_stay_real w20;
+  tasks_stay_real w21;
+  tasks_stay_real w22;
   w0 = t[0];
   w1 = start[0];
   w0 = w0 - w1;
@@ -140,43 +179,86 @@ static void body_progress_smoothstep(const tasks_stay_real* t, const tasks_stay_
   w3 = (w1 > w0) ? w1 : w0;
   w4 = 1.0;
   w5 = (w4 < w3) ? w4 : w3;
-  w6 = w5 * w5;
-  w7 = w6 * w5;
-  w8 = 10.0;
-  w9 = 15.0;
-  w10 = w9 * w5;
-  w8 = w8 - w10;
-  w10 = 6.0;
-  w11 = w10 * w5;
-  w12 = w11 * w5;
-  w8 = w8 + w12;
-  w12 = w7 * w8;
-  p[0] = w12;
-  w12 = w5 + w5;
-  w13 = (w3 <= w4) ? 1.0 : 0.0;
+  w6 = 0.2;
+  w7 = (w5 < w6) ? 1.0 : 0.0;
+  w8 = 0.25;
+  w9 = w5 / w6;
+  w10 = w8 * w9;
+  w11 = w10 * w9;
+  w12 = w11 * w9;
+  w13 = 0.5;
+  w14 = w13 * w9;
+  w14 = w4 - w14;
+  w15 = w12 * w14;
+  w15 = (w7 != 0.0) ? w15 : 0.0;
+  w16 = (w7 == 0.0) ? 1.0 : 0.0;
+  w17 = 0.8;
+  w17 = (w5 <= w17) ? 1.0 : 0.0;
+  w18 = 1.25;
+  w19 = 0.1;
+  w19 = w5 - w19;
+  w19 = w18 * w19;
+  w19 = (w17 != 0.0) ? w19 : 0.0;
+  w20 = (w17 == 0.0) ? 1.0 : 0.0;
+  w5 = w4 - w5;
+  w5 = w5 / w6;
+  w8 = w8 * w5;
+  w6 = w8 * w5;
+  w21 = w6 * w5;
+  w13 = w13 * w5;
+  w13 = w4 - w13;
+  w22 = w21 * w13;
+  w22 = w4 - w22;
+  w22 = (w20 != 0.0) ? w22 : 0.0;
+  w19 = w19 + w22;
+  w19 = (w16 != 0.0) ? w19 : 0.0;
+  w15 = w15 + w19;
+  p[0] = w15;
+  w15 = (w3 <= w4) ? 1.0 : 0.0;
   w4 = (w4 <= w3) ? 1.0 : 0.0;
-  w4 = w13 + w4;
-  w13 = w13 / w4;
+  w4 = w15 + w4;
+  w15 = w15 / w4;
   w4 = (w1 <= w0) ? 1.0 : 0.0;
   w0 = (w0 <= w1) ? 1.0 : 0.0;
   w0 = w4 + w0;
   w4 = w4 / w0;
   w4 = w4 / w2;
-  w13 = w13 * w4;
-  w12 = w12 * w13;
-  w12 = w5 * w12;
-  w6 = w6 * w13;
-  w12 = w12 + w6;
-  w8 = w8 * w12;
-  w10 = w10 * w13;
-  w5 = w5 * w10;
-  w11 = w11 * w13;
-  w5 = w5 + w11;
-  w9 = w9 * w13;
-  w5 = w5 - w9;
-  w7 = w7 * w5;
-  w8 = w8 + w7;
-  p_dot[0] = w8;
+  w15 = w15 * w4;
+  w4 = w18 * w15;
+  w4 = w9 * w4;
+  w2 = 5.0;
+  w0 = w2 * w15;
+  w10 = w10 * w0;
+  w4 = w4 + w10;
+  w9 = w9 * w4;
+  w11 = w11 * w0;
+  w9 = w9 + w11;
+  w14 = w14 * w9;
+  w9 = 2.5;
+  w11 = w9 * w15;
+  w12 = w12 * w11;
+  w14 = w14 - w12;
+  w7 = (w7 != 0.0) ? w14 : 0.0;
+  w14 = w18 * w15;
+  w17 = (w17 != 0.0) ? w14 : 0.0;
+  w9 = w9 * w15;
+  w21 = w21 * w9;
+  w18 = w18 * w15;
+  w18 = w5 * w18;
+  w2 = w2 * w15;
+  w8 = w8 * w2;
+  w18 = w18 + w8;
+  w5 = w5 * w18;
+  w6 = w6 * w2;
+  w5 = w5 + w6;
+  w13 = w13 * w5;
+  w21 = w21 - w13;
+  w21 = -w21;
+  w20 = (w20 != 0.0) ? w21 : 0.0;
+  w17 = w17 + w20;
+  w16 = (w16 != 0.0) ? w17 : 0.0;
+  w7 = w7 + w16;
+  p_dot[0] = w7;
 }
 
 /* CasADi Function 'interpolate_value': 37 instructions. */
@@ -1023,11 +1105,11 @@ static void tasks_stay_reach(tasks_stay_real t, int rates, tasks_stay_real* rho,
       k = j;
     }
   }
-  if (TASKS_STAY_SEGMENTS[k].profile == 1) {
+  if (TASKS_STAY_SEGMENTS[k].profile == 2) {
     if (rates != 0) {
-      body_progress_smoothstep(&t, &TASKS_STAY_SEGMENTS[k].start, &TASKS_STAY_SEGMENTS[k].end, &p, &p_dot);
+      body_progress_cruise(&t, &TASKS_STAY_SEGMENTS[k].start, &TASKS_STAY_SEGMENTS[k].end, &p, &p_dot);
     } else {
-      body_progress_smoothstep_value(&t, &TASKS_STAY_SEGMENTS[k].start, &TASKS_STAY_SEGMENTS[k].end, &p);
+      body_progress_cruise_value(&t, &TASKS_STAY_SEGMENTS[k].start, &TASKS_STAY_SEGMENTS[k].end, &p);
     }
   }
   if (rates != 0) {

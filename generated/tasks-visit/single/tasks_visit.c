@@ -43,7 +43,8 @@ static const tasks_visit_parameters TASKS_VISIT_PARAMETERS = {
 static const tasks_visit_real TASKS_VISIT_BOUND[TASKS_VISIT_N_ALPHA] = { 0.0f, 0.0f, -1.2f, 5.0f, 5.0f, 1.2f };
 
 /* Reach tube (eq. (4)), one row per segment: rho = from + (to - from) p(t) on
-   [start, end]; profile 0 = tanh (eq. (4)), 1 = smoothstep (quintic). Rows: [L; U]. */
+   [start, end]; profile 0 = tanh (eq. (4)), 1 = smoothstep (quintic),
+   2 = cruise (smooth ramps around a constant rate). Rows: [L; U]. */
 typedef struct {
   tasks_visit_real start;
   tasks_visit_real end;
@@ -54,14 +55,14 @@ typedef struct {
 
 #define TASKS_VISIT_N_SEGMENTS 8
 static const tasks_visit_segment TASKS_VISIT_SEGMENTS[TASKS_VISIT_N_SEGMENTS] = {
-  { 0.0f, 1.0959885386819483f, 1, { 0.04999999999999999f, 4.55f, -0.05f, 0.45f, 4.95f, 0.05f }, { 0.75f, 3.75f, -0.16604584527220628f, 0.95f, 3.95f, 0.16604584527220628f } },
-  { 1.0959885386819483f, 2.800859598853868f, 1, { 0.75f, 3.75f, -0.16604584527220628f, 0.95f, 3.95f, 0.16604584527220628f }, { 2.15f, 3.75f, -0.3321316614420063f, 2.35f, 3.95f, 0.3321316614420063f } },
-  { 2.800859598853868f, 4.25f, 1, { 2.15f, 3.75f, -0.3321316614420063f, 2.35f, 3.95f, 0.3321316614420063f }, { 3.2600000000000002f, 3.880000000000001f, -0.5f, 3.6199999999999997f, 4.24f, 0.5f } },
-  { 4.25f, 4.75f, 1, { 3.2600000000000002f, 3.880000000000001f, -0.5f, 3.6199999999999997f, 4.24f, 0.5f }, { 3.2600000000000002f, 3.880000000000001f, -0.5f, 3.6199999999999997f, 4.24f, 0.5f } },
-  { 4.75f, 8.25f, 1, { 3.2600000000000002f, 3.880000000000001f, -0.5f, 3.6199999999999997f, 4.24f, 0.5f }, { 3.36f, 0.5800000000000001f, -0.5f, 3.72f, 0.94f, 0.5f } },
-  { 8.25f, 8.75f, 1, { 3.36f, 0.5800000000000001f, -0.5f, 3.72f, 0.94f, 0.5f }, { 3.36f, 0.5800000000000001f, -0.5f, 3.72f, 0.94f, 0.5f } },
-  { 8.75f, 10.763157894736842f, 1, { 3.36f, 0.5800000000000001f, -0.5f, 3.72f, 0.94f, 0.5f }, { 3.75f, 2.55f, -0.5f, 3.95f, 2.75f, 0.5f } },
-  { 10.763157894736842f, 13.0f, 1, { 3.75f, 2.55f, -0.5f, 3.95f, 2.75f, 0.5f }, { 4.55f, 4.55f, -0.5f, 4.95f, 4.95f, 0.5f } }
+  { 0.0f, 4.25f, 2, { 0.04999999999999999f, 4.55f, -0.05f, 0.45f, 4.95f, 0.05f }, { 0.26f, 2.3800000000000003f, -0.5f, 0.62f, 2.7399999999999998f, 0.5f } },
+  { 4.25f, 4.75f, 2, { 0.26f, 2.3800000000000003f, -0.5f, 0.62f, 2.7399999999999998f, 0.5f }, { 0.26f, 2.3800000000000003f, -0.5f, 0.62f, 2.7399999999999998f, 0.5f } },
+  { 4.75f, 6.341935483870968f, 2, { 0.26f, 2.3800000000000003f, -0.5f, 0.62f, 2.7399999999999998f, 0.5f }, { 1.75f, 2.25f, -0.5f, 1.9500000000000002f, 2.45f, 0.5f } },
+  { 6.341935483870968f, 6.793548387096774f, 2, { 1.75f, 2.25f, -0.5f, 1.9500000000000002f, 2.45f, 0.5f }, { 2.15f, 1.9499999999999997f, -0.5f, 2.35f, 2.15f, 0.5f } },
+  { 6.793548387096774f, 8.25f, 2, { 2.15f, 1.9499999999999997f, -0.5f, 2.35f, 2.15f, 0.5f }, { 3.36f, 0.5800000000000001f, -0.5f, 3.72f, 0.94f, 0.5f } },
+  { 8.25f, 8.75f, 2, { 3.36f, 0.5800000000000001f, -0.5f, 3.72f, 0.94f, 0.5f }, { 3.36f, 0.5800000000000001f, -0.5f, 3.72f, 0.94f, 0.5f } },
+  { 8.75f, 10.763157894736842f, 2, { 3.36f, 0.5800000000000001f, -0.5f, 3.72f, 0.94f, 0.5f }, { 3.75f, 2.55f, -0.5f, 3.95f, 2.75f, 0.5f } },
+  { 10.763157894736842f, 13.0f, 2, { 3.75f, 2.55f, -0.5f, 3.95f, 2.75f, 0.5f }, { 4.55f, 4.55f, -0.5f, 4.95f, 4.95f, 0.5f } }
 };
 
 /* Circumvents (eqs. (7)-(9)), one row per window, sorted by start: window (start, end),
@@ -203,12 +204,18 @@ static float stt_logf(float x) {
   return y;
 }
 
-/* CasADi Function 'progress_smoothstep_value': 22 instructions. */
-static void body_progress_smoothstep_value(const tasks_visit_real* t, const tasks_visit_real* start, const tasks_visit_real* end, tasks_visit_real* p) {
+/* CasADi Function 'progress_cruise_value': 45 instructions. */
+static void body_progress_cruise_value(const tasks_visit_real* t, const tasks_visit_real* start, const tasks_visit_real* end, tasks_visit_real* p) {
   tasks_visit_real w0;
   tasks_visit_real w1;
   tasks_visit_real w2;
   tasks_visit_real w3;
+  tasks_visit_real w4;
+  tasks_visit_real w5;
+  tasks_visit_real w6;
+  tasks_visit_real w7;
+  tasks_visit_real w8;
+  tasks_visit_real w9;
   w0 = t[0];
   w1 = start[0];
   w0 = w0 - w1;
@@ -219,22 +226,45 @@ static void body_progress_smoothstep_value(const tasks_visit_real* t, const task
   w0 = (w2 > w0) ? w2 : w0;
   w2 = 1.0f;
   w0 = (w2 < w0) ? w2 : w0;
-  w2 = w0 * w0;
-  w2 = w2 * w0;
-  w1 = 10.0f;
-  w3 = 15.0f;
-  w3 = w3 * w0;
-  w1 = w1 - w3;
-  w3 = 6.0f;
-  w3 = w3 * w0;
-  w3 = w3 * w0;
-  w1 = w1 + w3;
-  w2 = w2 * w1;
-  p[0] = w2;
+  w1 = 0.2f;
+  w3 = (w0 < w1) ? 1.0f : 0.0f;
+  w4 = 0.25f;
+  w5 = w0 / w1;
+  w6 = w4 * w5;
+  w6 = w6 * w5;
+  w6 = w6 * w5;
+  w7 = 0.5f;
+  w5 = w7 * w5;
+  w5 = w2 - w5;
+  w6 = w6 * w5;
+  w6 = (w3 != 0.0f) ? w6 : 0.0f;
+  w3 = (w3 == 0.0f) ? 1.0f : 0.0f;
+  w5 = 0.8f;
+  w5 = (w0 <= w5) ? 1.0f : 0.0f;
+  w8 = 1.25f;
+  w9 = 0.1f;
+  w9 = w0 - w9;
+  w8 = w8 * w9;
+  w8 = (w5 != 0.0f) ? w8 : 0.0f;
+  w5 = (w5 == 0.0f) ? 1.0f : 0.0f;
+  w0 = w2 - w0;
+  w0 = w0 / w1;
+  w4 = w4 * w0;
+  w4 = w4 * w0;
+  w4 = w4 * w0;
+  w7 = w7 * w0;
+  w7 = w2 - w7;
+  w4 = w4 * w7;
+  w2 = w2 - w4;
+  w5 = (w5 != 0.0f) ? w2 : 0.0f;
+  w8 = w8 + w5;
+  w3 = (w3 != 0.0f) ? w8 : 0.0f;
+  w6 = w6 + w3;
+  p[0] = w6;
 }
 
-/* CasADi Function 'progress_smoothstep': 47 instructions. */
-static void body_progress_smoothstep(const tasks_visit_real* t, const tasks_visit_real* start, const tasks_visit_real* end, tasks_visit_real* p, tasks_visit_real* p_dot) {
+/* CasADi Function 'progress_cruise': 90 instructions. */
+static void body_progress_cruise(const tasks_visit_real* t, const tasks_visit_real* start, const tasks_visit_real* end, tasks_visit_real* p, tasks_visit_real* p_dot) {
   tasks_visit_real w0;
   tasks_visit_real w1;
   tasks_visit_real w2;
@@ -249,6 +279,15 @@ static void body_progress_smoothstep(const tasks_visit_real* t, const tasks_visi
   tasks_visit_real w11;
   tasks_visit_real w12;
   tasks_visit_real w13;
+  tasks_visit_real w14;
+  tasks_visit_real w15;
+  tasks_visit_real w16;
+  tasks_visit_real w17;
+  tasks_visit_real w18;
+  tasks_visit_real w19;
+  tasks_visit_real w20;
+  tasks_visit_real w21;
+  tasks_visit_real w22;
   w0 = t[0];
   w1 = start[0];
   w0 = w0 - w1;
@@ -259,43 +298,86 @@ static void body_progress_smoothstep(const tasks_visit_real* t, const tasks_visi
   w3 = (w1 > w0) ? w1 : w0;
   w4 = 1.0f;
   w5 = (w4 < w3) ? w4 : w3;
-  w6 = w5 * w5;
-  w7 = w6 * w5;
-  w8 = 10.0f;
-  w9 = 15.0f;
-  w10 = w9 * w5;
-  w8 = w8 - w10;
-  w10 = 6.0f;
-  w11 = w10 * w5;
-  w12 = w11 * w5;
-  w8 = w8 + w12;
-  w12 = w7 * w8;
-  p[0] = w12;
-  w12 = w5 + w5;
-  w13 = (w3 <= w4) ? 1.0f : 0.0f;
+  w6 = 0.2f;
+  w7 = (w5 < w6) ? 1.0f : 0.0f;
+  w8 = 0.25f;
+  w9 = w5 / w6;
+  w10 = w8 * w9;
+  w11 = w10 * w9;
+  w12 = w11 * w9;
+  w13 = 0.5f;
+  w14 = w13 * w9;
+  w14 = w4 - w14;
+  w15 = w12 * w14;
+  w15 = (w7 != 0.0f) ? w15 : 0.0f;
+  w16 = (w7 == 0.0f) ? 1.0f : 0.0f;
+  w17 = 0.8f;
+  w17 = (w5 <= w17) ? 1.0f : 0.0f;
+  w18 = 1.25f;
+  w19 = 0.1f;
+  w19 = w5 - w19;
+  w19 = w18 * w19;
+  w19 = (w17 != 0.0f) ? w19 : 0.0f;
+  w20 = (w17 == 0.0f) ? 1.0f : 0.0f;
+  w5 = w4 - w5;
+  w5 = w5 / w6;
+  w8 = w8 * w5;
+  w6 = w8 * w5;
+  w21 = w6 * w5;
+  w13 = w13 * w5;
+  w13 = w4 - w13;
+  w22 = w21 * w13;
+  w22 = w4 - w22;
+  w22 = (w20 != 0.0f) ? w22 : 0.0f;
+  w19 = w19 + w22;
+  w19 = (w16 != 0.0f) ? w19 : 0.0f;
+  w15 = w15 + w19;
+  p[0] = w15;
+  w15 = (w3 <= w4) ? 1.0f : 0.0f;
   w4 = (w4 <= w3) ? 1.0f : 0.0f;
-  w4 = w13 + w4;
-  w13 = w13 / w4;
+  w4 = w15 + w4;
+  w15 = w15 / w4;
   w4 = (w1 <= w0) ? 1.0f : 0.0f;
   w0 = (w0 <= w1) ? 1.0f : 0.0f;
   w0 = w4 + w0;
   w4 = w4 / w0;
   w4 = w4 / w2;
-  w13 = w13 * w4;
-  w12 = w12 * w13;
-  w12 = w5 * w12;
-  w6 = w6 * w13;
-  w12 = w12 + w6;
-  w8 = w8 * w12;
-  w10 = w10 * w13;
-  w5 = w5 * w10;
-  w11 = w11 * w13;
-  w5 = w5 + w11;
-  w9 = w9 * w13;
-  w5 = w5 - w9;
-  w7 = w7 * w5;
-  w8 = w8 + w7;
-  p_dot[0] = w8;
+  w15 = w15 * w4;
+  w4 = w18 * w15;
+  w4 = w9 * w4;
+  w2 = 5.0f;
+  w0 = w2 * w15;
+  w10 = w10 * w0;
+  w4 = w4 + w10;
+  w9 = w9 * w4;
+  w11 = w11 * w0;
+  w9 = w9 + w11;
+  w14 = w14 * w9;
+  w9 = 2.5f;
+  w11 = w9 * w15;
+  w12 = w12 * w11;
+  w14 = w14 - w12;
+  w7 = (w7 != 0.0f) ? w14 : 0.0f;
+  w14 = w18 * w15;
+  w17 = (w17 != 0.0f) ? w14 : 0.0f;
+  w9 = w9 * w15;
+  w21 = w21 * w9;
+  w18 = w18 * w15;
+  w18 = w5 * w18;
+  w2 = w2 * w15;
+  w8 = w8 * w2;
+  w18 = w18 + w8;
+  w5 = w5 * w18;
+  w6 = w6 * w2;
+  w5 = w5 + w6;
+  w13 = w13 * w5;
+  w21 = w21 - w13;
+  w21 = -w21;
+  w20 = (w20 != 0.0f) ? w21 : 0.0f;
+  w17 = w17 + w20;
+  w16 = (w16 != 0.0f) ? w17 : 0.0f;
+  w7 = w7 + w16;
+  p_dot[0] = w7;
 }
 
 /* CasADi Function 'interpolate_value': 37 instructions. */
@@ -1142,11 +1224,11 @@ static void tasks_visit_reach(tasks_visit_real t, int rates, tasks_visit_real* r
       k = j;
     }
   }
-  if (TASKS_VISIT_SEGMENTS[k].profile == 1) {
+  if (TASKS_VISIT_SEGMENTS[k].profile == 2) {
     if (rates != 0) {
-      body_progress_smoothstep(&t, &TASKS_VISIT_SEGMENTS[k].start, &TASKS_VISIT_SEGMENTS[k].end, &p, &p_dot);
+      body_progress_cruise(&t, &TASKS_VISIT_SEGMENTS[k].start, &TASKS_VISIT_SEGMENTS[k].end, &p, &p_dot);
     } else {
-      body_progress_smoothstep_value(&t, &TASKS_VISIT_SEGMENTS[k].start, &TASKS_VISIT_SEGMENTS[k].end, &p);
+      body_progress_cruise_value(&t, &TASKS_VISIT_SEGMENTS[k].start, &TASKS_VISIT_SEGMENTS[k].end, &p);
     }
   }
   if (rates != 0) {
