@@ -485,13 +485,13 @@ def test_tasks_and_moving_obstacles_together():
 
 @pytest.mark.slow
 def test_a_detour_around_where_a_moving_obstacle_crosses_the_tasks_plan():
-    """Problem 53 of ``bench tasks --seed 0``: the only moving obstacle drifts across the
-    first leg's lane while that leg must be under way, so neither the tasks' plan (step 1)
-    nor any timing of its via boxes misses it, and the region it sweeps meets the start set (no swept
-    design). Planning around the box it sweeps over 1 s either side of where the plan
-    meets it, and timing that plan against it as it moves, gives a certified tube."""
+    """Problem 148 of ``bench tasks --seed 2``: the only moving obstacle drifts across a
+    leg's lane while that leg must be under way, so neither the tasks' plan (step 1) nor any
+    timing of its via boxes misses it, and the region it sweeps meets the start set (no
+    swept design). Planning around the box it sweeps over 1 s either side of where the
+    plan meets it, and timing that plan against it as it moves, gives a certified tube."""
     from stt_codegen.bench.task_arenas import task_problem
-    spec = task_problem(0, 53)
+    spec = task_problem(2, 148)
     assert len(spec.moving_obstacles) == 1 and swept_spec(spec)[0] is None
     planned = stt.design_tube(static_part(spec))
     assert not check_tube(planned.tube, spec).passed
