@@ -20,7 +20,7 @@ from stt_codegen.errors import DesignError, SpecError
 from stt_codegen.runtime.compiled import build_shared
 from stt_codegen.runtime.differential_drive import base_rhs
 from stt_codegen.tube import look_ahead_reference
-from stt_codegen.tube.look_ahead import LookAhead, base_command, look_ahead_step
+from stt_codegen.tube.look_ahead import LookAhead, look_ahead_step
 from stt_codegen.verify import look_ahead as verify_look_ahead
 
 SPEC = Path(__file__).parent / "specs" / "office-drive.toml"
@@ -137,12 +137,12 @@ def test_the_deployed_command_inverts_the_kinematics_symbolically():
 def test_a_wrong_command_fails_the_symbolic_check(monkeypatch):
     """The check is on the deployed piece: a command with the turn rate's sign flipped (a
     plausible slip in a hand derivation) is caught."""
-    state, u_point, offset = ca.SX.sym("state", 3), ca.SX.sym("u_point", 2), ca.SX.sym("l")
-    c, s = ca.cos(state[2]), ca.sin(state[2])
-    wrong = ca.Function("base_command", [state, u_point, offset],
+    heading, u_point, offset = ca.SX.sym("heading", 2), ca.SX.sym("u_point", 2), ca.SX.sym("l")
+    c, s = heading[0], heading[1]
+    wrong = ca.Function("base_command", [heading, u_point, offset],
                         [ca.vertcat(c * u_point[0] + s * u_point[1],
                                     (s * u_point[0] - c * u_point[1]) / offset)],
-                        ["state", "u_point", "axle_offset"], ["u"])
+                        ["heading", "u_point", "axle_offset"], ["u"])
     monkeypatch.setattr(verify_look_ahead, "base_command", lambda: wrong)
     assert not verify_look_ahead.look_ahead_inverse().passed
 

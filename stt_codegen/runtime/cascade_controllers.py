@@ -11,8 +11,6 @@ compiler and loaded with ``ctypes``).
 
 from __future__ import annotations
 
-import ctypes
-
 import numpy as np
 
 from ..codegen.emit import python_function
@@ -113,27 +111,17 @@ class CascadeController:
 
 
 def _compiled(design: TubeDesign, stage: SecondStage):
-    """The emitted C of the cascade step (double), compiled into the build cache
-    (:func:`~stt_codegen.runtime.compiled.build_shared`: keyed by the sources and the
-    compiler command, as the first order's) and loaded."""
+    """The emitted C of the cascade step (double), compiled into the build cache and
+    loaded (:func:`~stt_codegen.runtime.compiled.load_variant_step`)."""
     from ..codegen.cascade_source import cascade_c_files
-    from .compiled import build_shared
+    from .compiled import load_variant_step
 
-    files = cascade_c_files(design, stage, "stt_cascade", "double")
-    sources = {name: text.encode() for name, text in files.items()}
-    handle = ctypes.CDLL(str(build_shared(sources, "stt_cascade.c")))
-    entry = handle.stt_cascade_step
-    real_p = ctypes.POINTER(ctypes.c_double)
-    entry.argtypes = [real_p, ctypes.c_double, ctypes.c_double, real_p, real_p, real_p, real_p]
-    entry.restype = ctypes.c_int
     n = design.dimension
+    step = load_variant_step(cascade_c_files(design, stage, "stt_cascade", "double"),
+                             "stt_cascade", (n, 2 * n, n))
 
     def call(x, t, dt, alpha):
-        x, alpha = (np.ascontiguousarray(v, dtype=np.float64) for v in (x, alpha))
-        u, alpha_next, r = np.zeros(n), np.zeros(2 * n), np.zeros(n)
-        code = entry(x.ctypes.data_as(real_p), t, dt, alpha.ctypes.data_as(real_p),
-                     *(b.ctypes.data_as(real_p) for b in (u, alpha_next, r)))
+        u, alpha_next, _r, code = step(x, t, dt, alpha)
         return u, alpha_next, Status(code)
 
-    call.library = handle  # keep the library loaded with the closure
     return call

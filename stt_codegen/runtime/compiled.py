@@ -27,7 +27,7 @@ from ..codegen.options import Options
 from ..system import atomic_write, find_tool
 
 __all__ = ["CController", "CFLAGS", "GeneratedPythonController", "build_shared", "compiler",
-           "load_python_module"]
+           "load_python_module", "load_variant_step"]
 
 #: Flags of the shared-library build (``-ffp-contract=off``: same rounding as CasADi's VM).
 CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fPIC", "-shared", "-Wall", "-Wextra",
@@ -221,3 +221,46 @@ class GeneratedPythonController:
         u, alpha_next, status = self.module.step(list(np.asarray(x, float)), float(t), float(dt),
                                                  list(np.asarray(alpha, float)))
         return np.array(u), np.array(alpha_next), int(status)
+
+
+def load_variant_step(files: dict[str, str], prefix: str, output_sizes: tuple[int, ...]):
+    """A controller variant's generated ``<prefix>_step`` (double), compiled into the build
+    cache (:func:`build_shared`) and loaded: ``(x, t, dt, alpha) -> (outputs..., code)``.
+
+    Parameters
+    ----------
+    files : dict of str to str
+        The variant's ``<prefix>.h`` and ``<prefix>.c``.
+    prefix : str
+        The C prefix of the step, ``<prefix>_step(x, t, dt, alpha, out...)``.
+    output_sizes : tuple of int
+        The lengths of the step's output arrays, in order (``u``, ``alpha_next``, ...).
+
+    Returns
+    -------
+    callable
+        Returns the output arrays (float64) and the status code; the library stays loaded
+        with it.
+
+    Raises
+    ------
+    MissingTool, CodegenError
+        No C compiler, or it failed.
+    """
+    sources = {name: text.encode() for name, text in files.items()}
+    handle = ctypes.CDLL(str(build_shared(sources, f"{prefix}.c")))
+    entry = getattr(handle, f"{prefix}_step")
+    real_p = ctypes.POINTER(ctypes.c_double)
+    entry.argtypes = [real_p, ctypes.c_double, ctypes.c_double, real_p,
+                      *([real_p] * len(output_sizes))]
+    entry.restype = ctypes.c_int
+
+    def call(x, t, dt, alpha):
+        x, alpha = (np.ascontiguousarray(v, dtype=np.float64) for v in (x, alpha))
+        outputs = [np.zeros(size) for size in output_sizes]
+        code = entry(x.ctypes.data_as(real_p), t, dt, alpha.ctypes.data_as(real_p),
+                     *(b.ctypes.data_as(real_p) for b in outputs))
+        return (*outputs, code)
+
+    call.library = handle  # keep the library loaded with the closure
+    return call

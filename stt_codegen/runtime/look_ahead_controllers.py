@@ -10,8 +10,6 @@ status)``, here with the base's state ``x = (x, y, theta)`` and ``u = (v, omega)
 
 from __future__ import annotations
 
-import ctypes
-
 import numpy as np
 
 from ..codegen.emit import python_function
@@ -105,25 +103,16 @@ def _with_status(out: list) -> tuple[np.ndarray, np.ndarray, Status]:
 
 
 def _compiled(design: TubeDesign, look_ahead: LookAhead):
-    """The emitted C of the step (double), compiled into the build cache
-    (:func:`~stt_codegen.runtime.compiled.build_shared`) and loaded."""
+    """The emitted C of the step (double), compiled into the build cache and loaded
+    (:func:`~stt_codegen.runtime.compiled.load_variant_step`)."""
     from ..codegen.look_ahead_source import look_ahead_c_files
-    from .compiled import build_shared
+    from .compiled import load_variant_step
 
-    files = look_ahead_c_files(design, look_ahead, "stt_look_ahead", "double")
-    sources = {name: text.encode() for name, text in files.items()}
-    handle = ctypes.CDLL(str(build_shared(sources, "stt_look_ahead.c")))
-    entry = handle.stt_look_ahead_step
-    real_p = ctypes.POINTER(ctypes.c_double)
-    entry.argtypes = [real_p, ctypes.c_double, ctypes.c_double, real_p, real_p, real_p]
-    entry.restype = ctypes.c_int
+    step = load_variant_step(look_ahead_c_files(design, look_ahead, "stt_look_ahead", "double"),
+                             "stt_look_ahead", (2, 4))
 
     def call(x, t, dt, alpha):
-        x, alpha = (np.ascontiguousarray(v, dtype=np.float64) for v in (x, alpha))
-        u, alpha_next = np.zeros(2), np.zeros(4)
-        code = entry(x.ctypes.data_as(real_p), t, dt, alpha.ctypes.data_as(real_p),
-                     u.ctypes.data_as(real_p), alpha_next.ctypes.data_as(real_p))
+        u, alpha_next, code = step(x, t, dt, alpha)
         return u, alpha_next, Status(code)
 
-    call.library = handle  # keep the library loaded with the closure
     return call

@@ -73,39 +73,41 @@ class LookAhead:
 
 @lru_cache(maxsize=None)
 def look_ahead_point() -> ca.Function:
-    """``look_ahead_point(state, axle_offset) -> p``: the point the tube holds.
+    """``look_ahead_point(state, axle_offset) -> (p, heading)``: the point the tube holds.
 
     Returns
     -------
     casadi.Function
         Inputs ``state`` (3: ``x``, ``y`` in m, ``theta`` in rad) and ``axle_offset``
-        (``l``, m); output ``p`` (2, m), ``(x + l cos theta, y + l sin theta)``.
+        (``l``, m); outputs ``p`` (2, m), ``(x + l cos theta, y + l sin theta)``, and
+        ``heading`` (2), ``(cos theta, sin theta)``, which :func:`base_command` takes (the
+        step evaluates ``cos`` and ``sin`` once).
     """
     state, offset = ca.SX.sym("state", BASE_STATES), ca.SX.sym("axle_offset")
-    theta = state[2]
-    p = ca.vertcat(state[0] + offset * ca.cos(theta), state[1] + offset * ca.sin(theta))
-    return ca.Function("look_ahead_point", [state, offset], [p], ["state", "axle_offset"],
-                       ["p"])
+    heading = ca.vertcat(ca.cos(state[2]), ca.sin(state[2]))
+    p = ca.vertcat(state[0] + offset * heading[0], state[1] + offset * heading[1])
+    return ca.Function("look_ahead_point", [state, offset], [p, heading],
+                       ["state", "axle_offset"], ["p", "heading"])
 
 
 @lru_cache(maxsize=None)
 def base_command() -> ca.Function:
-    """``base_command(state, u_point, axle_offset) -> u``: the base's inputs that move the
+    """``base_command(heading, u_point, axle_offset) -> u``: the base's inputs that move the
     look-ahead point with velocity ``u_point`` (exact wheels, no slip).
 
     Returns
     -------
     casadi.Function
-        Inputs ``state`` (3; only ``theta``, rad, is used), ``u_point`` (2, m/s) and
-        ``axle_offset`` (m); output ``u`` (2): ``v`` (m/s) and ``omega`` (rad/s),
-        ``M(theta)^-1 u_point``.
+        Inputs ``heading`` (2: ``cos theta``, ``sin theta``, from
+        :func:`look_ahead_point`), ``u_point`` (2, m/s) and ``axle_offset`` (m); output
+        ``u`` (2): ``v`` (m/s) and ``omega`` (rad/s), ``M(theta)^-1 u_point``.
     """
-    state = ca.SX.sym("state", BASE_STATES)
+    heading = ca.SX.sym("heading", BASE_INPUTS)
     u_point, offset = ca.SX.sym("u_point", BASE_INPUTS), ca.SX.sym("axle_offset")
-    c, s = ca.cos(state[2]), ca.sin(state[2])
+    c, s = heading[0], heading[1]
     u = ca.vertcat(c * u_point[0] + s * u_point[1], (c * u_point[1] - s * u_point[0]) / offset)
-    return ca.Function("base_command", [state, u_point, offset], [u],
-                       ["state", "u_point", "axle_offset"], ["u"])
+    return ca.Function("base_command", [heading, u_point, offset], [u],
+                       ["heading", "u_point", "axle_offset"], ["u"])
 
 
 def look_ahead_step(design: TubeDesign, look_ahead: LookAhead) -> ca.Function:
@@ -149,9 +151,9 @@ def look_ahead_step(design: TubeDesign, look_ahead: LookAhead) -> ca.Function:
     t, dt = ca.SX.sym("t"), ca.SX.sym("dt")
     alpha = ca.SX.sym("alpha", 2 * BASE_INPUTS)
     offset = ca.SX(look_ahead.axle_offset)
-    p = look_ahead_point()(x, offset)
+    p, heading = look_ahead_point()(x, offset)
     u_point, alpha_next, inside = build_model(design)["controller_step"](p, t, dt, alpha)
-    u = base_command()(x, u_point, offset)
+    u = base_command()(heading, u_point, offset)
     outputs, names = [u, alpha_next, inside], list(LOOK_AHEAD_OUTPUTS[:3])
     if look_ahead.input_bound is not None:
         u, within = P.saturate_expression(u, ca.DM(list(look_ahead.input_bound)), BASE_INPUTS)

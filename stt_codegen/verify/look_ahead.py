@@ -51,8 +51,9 @@ def point_input_matrix(axle_offset: sp.Expr, track_width: sp.Expr,
     x, y, theta = sp.symbols("x y theta", real=True)
     u = sp.symbols("u1 u2", real=True)
     state = [x, y, theta]
-    (p,) = sympy_expressions(look_ahead_point(), {"state": state, "axle_offset": [axle_offset]})
-    (command,) = sympy_expressions(base_command(), {"state": state, "u_point": list(u),
+    p, heading = sympy_expressions(look_ahead_point(), {"state": state,
+                                                        "axle_offset": [axle_offset]})
+    (command,) = sympy_expressions(base_command(), {"heading": list(heading), "u_point": list(u),
                                                     "axle_offset": [axle_offset]})
     (state_dot,) = sympy_expressions(base_rhs(), {
         "state": state, "u": list(command), "wheel_radius_error": list(errors),
