@@ -43,10 +43,11 @@ from ..runtime.simulate import run_closed_loop
 from ..spec.assumptions import Assumptions
 from ..spec.loader import load_spec
 from ..verify.sampled import check_sampled
-from ..verify.class_search import replay, search_class, unit_skew
+from ..verify.class_search import replay, search_class, search_time_invariant, unit_skew
 
-__all__ = ["CASES", "RANGES", "draw", "plant_parameters", "own_bounds", "study_one",
-           "study_plants"]
+__all__ = ["ADVERSARIES", "CASES", "COLUMNS", "RANGES", "check_columns", "draw",
+           "own_bounds", "plant_parameters", "recheck", "study_one", "study_plants", "summary",
+           "table", "unsound"]
 
 CASES = ("omnirobot-s1", "omnirobot-s2", "omnirobot-s3")
 #: Ranges of the drawn knobs (uniform): sinusoidal drift amplitude, linear drift's spectral
@@ -138,8 +139,20 @@ def _system(p: dict, centre: np.ndarray):
     return ct.nlsys(rhs, None, inputs=n, states=n, outputs=n)
 
 
-def own_bounds(p: dict, spec) -> Assumptions:
+def own_bounds(p: dict, spec, lipschitz: bool = False) -> Assumptions:
     """The bounds a user who knew the drawn plant would declare (over the state space).
+
+    With ``lipschitz``, also the plant's Lipschitz bounds, per state ``j`` (the
+    ``[assumptions]`` keys ``input_gain_lipschitz`` and ``drift_lipschitz``):
+
+    * ``g(x) - g(y) = skew (tanh(v.x) - tanh(v.y)) K`` and ``|tanh a - tanh b| <= |a - b|``
+      (``tanh' = sech^2 <= 1``), so ``|g(x) - g(y)|_2 <= skew |K|_2 sum_j |v_j| |x_j -
+      y_j|``: ``L_j = skew |v_j| |K|_2``;
+    * ``f(x) - f(y) = int_0^1 J(y + s (x - y)) (x - y) ds`` with the Jacobian ``J(z) =
+      f_amp diag(cos(W z + phi)) W + L``, whose column ``j`` has Euclidean norm at most
+      ``f_amp |W[:, j]| + |L[:, j]|`` (``|cos| <= 1``): ``L_j`` that sum.
+
+    Both hold on all of ``R^n``, not only on the state space.
 
     Parameters
     ----------
@@ -147,13 +160,17 @@ def own_bounds(p: dict, spec) -> Assumptions:
         The plant, from :func:`plant_parameters`.
     spec : Spec
         Gives the state space the drift is bounded over.
+    lipschitz : bool, optional
+        Also set ``input_gain_lipschitz`` and ``drift_lipschitz`` (default: ``None``, the
+        class whose ``g`` and ``f`` may jump).
 
     Returns
     -------
     Assumptions
         ``input_gain`` (the extreme eigenvalues of ``S``), ``input_gain_skew``,
         ``input_gain_coupling``, ``drift_bound`` and ``disturbance_bound`` (Euclidean, over
-        the state space).
+        the state space); with ``lipschitz`` the two Lipschitz bounds, ``n`` values each
+        (``g``'s in its units per state unit, ``f``'s per second).
     """
     n = spec.dimension
     eig = np.linalg.eigvalsh(p["sym"])
@@ -163,8 +180,15 @@ def own_bounds(p: dict, spec) -> Assumptions:
                             + p["skew"] * np.linalg.norm(k_mat, axis=1)))
     half = (np.array(spec.state_space.upper) - np.array(spec.state_space.lower)) / 2
     drift = p["f_amp"] * math.sqrt(n) + np.linalg.norm(p["L"], 2) * np.linalg.norm(half)
+    rates = {}
+    if lipschitz:
+        rates = {"input_gain_lipschitz": tuple(
+                     float(v) for v in p["skew"] * np.abs(p["v"]) * np.linalg.norm(k_mat, 2)),
+                 "drift_lipschitz": tuple(
+                     float(v) for v in p["f_amp"] * np.linalg.norm(p["W"], axis=0)
+                     + np.linalg.norm(p["L"], axis=0))}
     return Assumptions((float(eig[0]), float(eig[-1])), float(p["skew"]), coupling,
-                       float(drift), float(p["w_amp"] * math.sqrt(n)))
+                       float(drift), float(p["w_amp"] * math.sqrt(n)), **rates)
 
 
 def _holds(case: str, p: dict, rate_factor: float = 1.0, gain: float | None = None) -> bool:
@@ -179,19 +203,95 @@ def _holds(case: str, p: dict, rate_factor: float = 1.0, gain: float | None = No
     return bool(result.satisfied and result.stayed_in_tube)
 
 
+def _setup(case: str, index: int, own_gain: bool | float):
+    """The design (at the plant's own gain when ``own_gain``; at that gain when a number),
+    its samples, the plant and its bounds without and with Lipschitz bounds."""
+    spec, design, samples = _designed(case)
+    p = plant_parameters(draw(case, index))
+    bounds = own_bounds(p, spec)
+    if own_gain is True:
+        design = dataclasses.replace(
+            design, gain=derived_gain(_min_width(case), design.rate_hz, bounds))
+    elif own_gain is not False:
+        design = dataclasses.replace(design, gain=float(own_gain))
+    return spec, design, samples, p, bounds, own_bounds(p, spec, lipschitz=True)
+
+
+def check_columns(case: str, index: int, gain: float) -> dict:
+    """The sampled check's verdicts on plant ``index``'s own class, without and with its
+    Lipschitz bounds (:func:`~stt_codegen.verify.sampled.check_sampled`), at ``gain``.
+
+    Cheap beside the adversaries: :func:`recheck` recomputes these columns of a saved
+    study.
+
+    Parameters
+    ----------
+    case : str
+        One of :data:`CASES`.
+    index : int
+        The plant's number within the case.
+    gain : float
+        ``k`` of law (13) (the row's ``gain``).
+
+    Returns
+    -------
+    dict
+        ``check_accepts``, ``check_s`` (s), ``check_fails_at`` (s or ``None``) for the
+        class without Lipschitz bounds, and the same keys ending ``_lipschitz`` for the
+        class with the plant's own.
+    """
+    _, design, samples, _, bounds, rated = _setup(case, index, gain)
+    row = {}
+    for suffix, b in (("", bounds), ("_lipschitz", rated)):
+        started = time.perf_counter()
+        verdict = check_sampled(design, samples, b)
+        row[f"check_accepts{suffix}"] = bool(verdict.passed)
+        row[f"check_s{suffix}"] = time.perf_counter() - started
+        row[f"check_fails_at{suffix}"] = None if verdict.passed else float(verdict.time)
+    return row
+
+
+#: The adversaries of ``--classes``, by the row's key (docs/sampled-data.md, "The wide
+#: study"): the switching one on the class that may jump, the Lipschitz one on the class
+#: with the plant's own Lipschitz bounds, the time-invariant one (``g`` and ``f`` constant).
+ADVERSARIES = ("switching", "lipschitz", "time_invariant")
+
+
+def _adversaries(design, samples, bounds: Assumptions, rated: Assumptions) -> dict:
+    """Each adversary's member that leaves the tube (figures, confirmed or not by the
+    generated C controller, and the search's time), or ``None``."""
+    out = {}
+    for key, search in (("switching", lambda: search_class(design, samples, bounds)),
+                        ("lipschitz", lambda: search_class(design, samples, rated)),
+                        ("time_invariant", lambda: search_time_invariant(design, samples,
+                                                                         bounds))):
+        started = time.perf_counter()
+        found = search()
+        seconds = time.perf_counter() - started
+        out[key] = None if found is None else {**found.to_json(),
+                                               "replayed_on_c": replay(design, found)}
+        out[f"{key}_s"] = seconds
+    return out
+
+
 def study_one(job: tuple) -> dict:
-    """One plant: whether it holds in simulation, the check's verdict on its own bounds,
-    and, when it fails, whether it holds at 2, 4 or 8 times the rate.
+    """One plant: whether it holds in simulation, the check's verdicts on its own class
+    (:func:`check_columns`), and, when it fails, whether it holds at 2, 4 or 8 times the
+    rate.
 
     ``job`` is ``(case, index)``, ``(case, index, classes)`` or ``(case, index, classes,
-    own_gain)``. With ``classes`` true, the row's ``class_counterexample`` is a member of
-    the plant's class that leaves the tube
-    (:meth:`~stt_codegen.verify.class_search.Counterexample.to_json`), or ``None`` when the
-    search finds none. With ``own_gain`` true, the gain of law (13) is the one the design
+    own_gain)``. With ``classes`` true, a plant that holds gets the members of its class
+    that leave the tube found by each of :data:`ADVERSARIES` (the switching search of
+    :func:`~stt_codegen.verify.class_search.search_class` on its own bounds; the same
+    search on its bounds with its own Lipschitz bounds, :func:`own_bounds`; and
+    :func:`~stt_codegen.verify.class_search.search_time_invariant`): each the
+    :meth:`~stt_codegen.verify.class_search.Counterexample.to_json` figures and
+    ``replayed_on_c``, or ``None`` when the search finds none, and the search's time
+    (``<key>_s``). With ``own_gain`` true, the gain of law (13) is the one the design
     derives from the plant's own bounds (:func:`~stt_codegen.design.gain.derived_gain` at
     the design's certified narrowest width), as if the user had declared them in
-    ``[assumptions]``, for the check, the search and the simulation alike; otherwise it is
-    the bundled design's (derived from the robot's bounds).
+    ``[assumptions]``, for the check, the searches and the simulation alike; otherwise it
+    is the bundled design's (derived from the robot's bounds).
 
     Parameters
     ----------
@@ -202,46 +302,61 @@ def study_one(job: tuple) -> dict:
     Returns
     -------
     dict
-        The knobs and ``held``, ``check_accepts``, ``check_s`` (s), the plant's own bounds
-        (``g_min_own``, ``g_max_own``, ``coupling``, ``push``), ``check_fails_at`` (s or
-        ``None``), ``gain``; with ``classes`` ``class_counterexample``; when it did not hold
-        ``holds_at_rate_factor`` (2, 4, 8 or ``None``).
+        The knobs and ``held``, ``gain``, the plant's own bounds (``g_min_own``,
+        ``g_max_own``, ``coupling``, ``push``, ``input_gain_lipschitz``,
+        ``drift_lipschitz``), :func:`check_columns`; with ``classes`` and when it held, the
+        keys of :data:`ADVERSARIES`; when it did not hold ``holds_at_rate_factor`` (2, 4,
+        8 or ``None``).
     """
     case, index = job[:2]
     classes, own_gain = (tuple(job[2:]) + (False, False))[:2]
-    spec, design, samples = _designed(case)
-    knobs = draw(case, index)
-    p = plant_parameters(knobs)
-    bounds = own_bounds(p, spec)
-    gain = derived_gain(_min_width(case), design.rate_hz, bounds) if own_gain else None
-    if gain is not None:
-        design = dataclasses.replace(design, gain=gain)
-    started = time.perf_counter()
-    verdict = check_sampled(design, samples, bounds)
-    check_s = time.perf_counter() - started
+    _, design, samples, p, bounds, rated = _setup(case, index, bool(own_gain))
+    gain = design.gain if own_gain else None
     held = _holds(case, p, gain=gain)
-    row = {"case": case, "index": index, **knobs, "held": held,
-           "check_accepts": verdict.passed, "check_s": check_s,
-           "g_min_own": bounds.input_gain[0], "g_max_own": bounds.input_gain[1],
-           "coupling": bounds.input_gain_coupling,
+    row = {"case": case, "index": index, **draw(case, index), "held": held,
+           "gain": design.gain, "g_min_own": bounds.input_gain[0],
+           "g_max_own": bounds.input_gain[1], "coupling": bounds.input_gain_coupling,
            "push": bounds.drift_bound + bounds.disturbance_bound,
-           "check_fails_at": None if verdict.passed else verdict.time,
-           "gain": design.gain}
-    if classes:
-        found = search_class(design, samples, bounds)
-        row["class_counterexample"] = (None if found is None else
-                                       {**found.to_json(), "replayed_on_c": replay(design, found)})
+           "input_gain_lipschitz": list(rated.input_gain_lipschitz),
+           "drift_lipschitz": list(rated.drift_lipschitz),
+           **check_columns(case, index, design.gain)}
+    if classes and held:
+        row.update(_adversaries(design, samples, bounds, rated))
     if not held:
         row["holds_at_rate_factor"] = next(
             (f for f in (2.0, 4.0, 8.0) if _holds(case, p, f, gain)), None)
     return row
 
 
+def _map(function, jobs: list, workers: int, done=None) -> list:
+    """``function`` over ``jobs`` in order, in ``workers`` processes; ``done(results so
+    far)`` after each."""
+    results = []
+    pool = ProcessPoolExecutor(workers) if workers > 1 else None
+    try:
+        for result in (pool.map(function, jobs, chunksize=1) if pool else map(function, jobs)):
+            results.append(result)
+            if done is not None:
+                done(results)
+    finally:
+        if pool is not None:
+            pool.shutdown()
+    return results
+
+
+def _in_order(rows: list[dict]) -> list[dict]:
+    return sorted(rows, key=lambda r: (CASES.index(r["case"]), r["index"]))
+
+
 def study_plants(runs: int, workers: int = 2, classes: bool = False,
-                 own_gain: bool = False) -> list[dict]:
-    """``runs`` plants per bundled case (:func:`study_one`, with the class search when
+                 own_gain: bool = False, done=None) -> list[dict]:
+    """``runs`` plants per bundled case (:func:`study_one`, with the adversaries when
     ``classes``, at the gain derived from each plant's bounds when ``own_gain``), in
     parallel.
+
+    The plants run index by index across the cases (plant 0 of each case, then plant 1,
+    ...), so that the rows done when a run is stopped are the first plants of every case,
+    the rows a shorter run gives (every plant is seeded by its case and index).
 
     Parameters
     ----------
@@ -250,51 +365,117 @@ def study_plants(runs: int, workers: int = 2, classes: bool = False,
     workers : int, optional
         Processes; 1 or fewer runs them in this process.
     classes : bool, optional
-        Search each plant's class for a counterexample.
+        Search each class that holds with the adversaries.
     own_gain : bool, optional
         Use the gain derived from each plant's own bounds.
+    done : callable, optional
+        Called with the rows so far after each plant (``main`` writes them).
 
     Returns
     -------
     list of dict
         :func:`study_one`'s rows, case by case, in index order.
     """
-    jobs = [(case, i, classes, own_gain) for case in CASES for i in range(runs)]
-    if workers <= 1:
-        return [study_one(j) for j in jobs]
-    with ProcessPoolExecutor(workers) as pool:
-        return list(pool.map(study_one, jobs, chunksize=2))
+    jobs = [(case, i, classes, own_gain) for i in range(runs) for case in CASES]
+    return _in_order(_map(study_one, jobs, workers, done))
+
+
+def _recheck_one(row: dict) -> dict:
+    return {**row, **check_columns(row["case"], row["index"], row["gain"])}
+
+
+def recheck(rows: list[dict], workers: int = 2) -> list[dict]:
+    """``rows`` with the check's columns (:func:`check_columns`) computed again, the
+    simulation and the adversaries kept (for a study saved before the check changed).
+
+    Parameters
+    ----------
+    rows : list of dict
+        :func:`study_plants`'s rows (from ``--out``).
+    workers : int, optional
+        Processes; 1 or fewer runs them in this process.
+
+    Returns
+    -------
+    list of dict
+        The same rows, in the same order, with new check columns.
+    """
+    return _map(_recheck_one, rows, workers)
+
+
+def _broken(row: dict, keys=ADVERSARIES) -> bool:
+    return any(row.get(k) is not None for k in keys)
+
+
+def unsound(rows: list[dict]) -> list[dict]:
+    """The rows whose class the check accepts although it cannot be right: the plant does
+    not hold, or an adversary of that class broke it (any of :data:`ADVERSARIES` for the
+    class that may jump; the Lipschitz and time-invariant ones, whose members obey the
+    plant's Lipschitz bounds, for the class with them). Must be empty.
+
+    Parameters
+    ----------
+    rows : list of dict
+        :func:`study_plants`'s rows.
+
+    Returns
+    -------
+    list of dict
+        The rows that contradict the check.
+    """
+    return [r for r in rows
+            if (r["check_accepts"] and (not r["held"] or _broken(r)))
+            or (r["check_accepts_lipschitz"]
+                and (not r["held"] or _broken(r, ("lipschitz", "time_invariant"))))]
+
+
+#: The columns of :func:`summary`'s table.
+COLUMNS = ("plants", "hold", "broken: switching", "broken: Lipschitz",
+           "broken: time-invariant", "broken by neither TI nor Lipschitz",
+           "check accepts", "check accepts, Lipschitz",
+           "of those unbroken, accepted with Lipschitz", "accepted but broken")
+
+
+def table(rows: list[dict]) -> list[list[int]]:
+    """:data:`COLUMNS` counted over all ``rows`` (first line) and per case; the classes
+    broken and accepted are counted among the plants that hold ("accepted but broken":
+    :func:`unsound`, over all plants)."""
+    lines = []
+    for case in (None,) + CASES:
+        sub = [r for r in rows if case is None or r["case"] == case]
+        held = [r for r in sub if r["held"]]
+        open_ = [r for r in held if not _broken(r, ("lipschitz", "time_invariant"))]
+        lines.append([len(sub), len(held),
+                      sum(r.get("switching") is not None for r in held),
+                      sum(r.get("lipschitz") is not None for r in held),
+                      sum(r.get("time_invariant") is not None for r in held),
+                      len(open_),
+                      sum(r["check_accepts"] for r in held),
+                      sum(r["check_accepts_lipschitz"] for r in held),
+                      sum(r["check_accepts_lipschitz"] for r in open_),
+                      len(unsound(sub))])
+    return lines
 
 
 def summary(rows: list[dict]) -> str:
-    """The study's figures in words."""
-    held = [r for r in rows if r["held"]]
-    accepted = [r for r in rows if r["check_accepts"]]
-    bad = [r for r in accepted if not r["held"]]
-    lines = [f"{len(rows)} plants: {len(held)} hold in simulation; the sampled check accepts "
-             f"{len(accepted)} ({len([r for r in accepted if r['held']])} of the "
-             f"{len(held)} that hold, {100 * len(accepted) / max(len(held), 1):.1f} %), "
-             f"of which {len(bad)} fail"]
-    for case in CASES:
-        sub = [r for r in rows if r["case"] == case]
-        lines.append(f"  {case}: {sum(r['held'] for r in sub)}/{len(sub)} hold, check "
-                     f"accepts {sum(r['check_accepts'] for r in sub)}")
-    if rows and all("class_counterexample" in r for r in rows):
-        open_ = [r for r in held if r["class_counterexample"] is None]
-        replayed = sum(bool(r["class_counterexample"] and r["class_counterexample"].get(
-            "replayed_on_c")) for r in held)
-        unsound = [r for r in accepted if r["class_counterexample"] is not None]
-        lines.append(
-            f"classes: {len(held) - len(open_)} of the {len(held)} plants that hold have a "
-            f"member of their own class that leaves the tube (no sound check may accept "
-            f"them); the search finds none for {len(open_)}, of which the check accepts "
-            f"{sum(r['check_accepts'] for r in open_)}; accepted classes with a "
-            f"counterexample: {len(unsound)}; counterexamples confirmed by the generated C "
-            f"controller: {replayed} of {len(held) - len(open_)}")
-        for case in CASES:
-            sub = [r for r in held if r["case"] == case]
-            lines.append(f"  {case}: {sum(r['class_counterexample'] is None for r in sub)} "
-                         f"of {len(sub)} that hold without a counterexample found")
+    """The study's figures: a Markdown table (:data:`COLUMNS`, all and per case) when the
+    rows have the adversaries, else the plants that hold and the check's verdicts."""
+    names = ("all",) + tuple(f"`{c}`" for c in CASES)
+    if rows and all(k in r for r in rows if r["held"] for k in ADVERSARIES):
+        lines = ["| | " + " | ".join(COLUMNS) + " |", "|---" * (len(COLUMNS) + 1) + "|"]
+        lines += [f"| {name} | " + " | ".join(str(v) for v in counts) + " |"
+                  for name, counts in zip(names, table(rows))]
+        confirmed = {k: sum(bool(r.get(k) and r[k]["replayed_on_c"]) for r in rows)
+                     for k in ADVERSARIES}
+        found = {k: sum(r.get(k) is not None for r in rows) for k in ADVERSARIES}
+        lines.append("members confirmed by the generated C controller: " + ", ".join(
+            f"{k} {confirmed[k]} of {found[k]}" for k in ADVERSARIES))
+        return "\n".join(lines)
+    lines = []
+    for name, counts in zip(names, table(rows)):
+        lines.append(f"{name}: {counts[0]} plants, {counts[1]} hold; the check accepts "
+                     f"{counts[6]} of those, {counts[7]} with their Lipschitz bounds; "
+                     f"accepted but not holding: {counts[9]}")
     return "\n".join(lines)
 
 
@@ -306,20 +487,33 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", default=None, help="write every row as JSON")
     parser.add_argument("--classes", action="store_true",
-                        help="also search each plant's class for a member that leaves the tube")
+                        help="also search each class that holds with the three adversaries")
     parser.add_argument("--own-gain", action="store_true",
                         help="use the gain derived from each plant's own bounds instead of "
                              "the bundled design's")
+    parser.add_argument("--recheck", default=None, metavar="ROWS_JSON",
+                        help="recompute only the check's columns of a saved study (written "
+                             "back to --out, or to ROWS_JSON)")
     args = parser.parse_args(argv)
     started = time.perf_counter()
-    rows = study_plants(args.runs, args.workers, args.classes, args.own_gain)
+    out = args.out or args.recheck
+
+    def save(rows: list[dict]) -> None:        # after every plant: a stopped run keeps them
+        if out:
+            Path(out).write_text(json.dumps(_in_order(rows), indent=1))
+
+    if args.recheck:
+        rows = recheck(json.loads(Path(args.recheck).read_text()), args.workers)
+    else:
+        rows = study_plants(args.runs, args.workers, args.classes, args.own_gain, save)
+    save(rows)
     print(summary(rows))
     print(f"({time.perf_counter() - started:.0f} s)")
-    if args.out:
-        Path(args.out).write_text(json.dumps(rows, indent=1))
-    unsound = any(r["check_accepts"] and (not r["held"] or r.get("class_counterexample"))
-                  for r in rows)
-    return 1 if unsound else 0
+    bad = unsound(rows)
+    if bad:
+        print("SOUNDNESS ALARM: the check accepts classes it cannot: " + ", ".join(
+            f"{r['case']} #{r['index']}" for r in bad))
+    return 1 if bad else 0
 
 
 if __name__ == "__main__":

@@ -58,6 +58,7 @@ study, and how much a sound check can accept").
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from dataclasses import dataclass, field
 
@@ -69,8 +70,8 @@ from ..spec.model_bounds import row_coupling, symmetric_eigen_range
 from ..tube import reference
 from ..tube.parameters import TubeDesign
 
-__all__ = ["Counterexample", "class_matrices", "replay", "search_class", "unit_skew",
-           "within_class"]
+__all__ = ["Counterexample", "class_matrices", "fixed_directions", "replay", "search_class",
+           "search_time_invariant", "unit_skew", "within_class"]
 
 #: Random rotations of the extreme eigenvalues tried per class (besides the axis-aligned
 #: arrangements).
@@ -246,93 +247,150 @@ def class_matrices(bounds: Assumptions, n: int, seed: int = 0) -> list[np.ndarra
 
 
 def _directions(e: np.ndarray, z: np.ndarray) -> np.ndarray:
-    """Unit directions of ``f + w`` tried at a sample: the axes, the normalized error and
-    ``z``, the gradient of ``W`` (law (13)'s Lyapunov function, along ``-u``), both signs;
-    (m, n)."""
-    n = len(e)
-    rows = [np.eye(n), -np.eye(n)]
+    """Unit directions of ``f + w`` tried at a sample, per path: the axes, the normalized
+    error and ``z``, the gradient of ``W`` (law (13)'s Lyapunov function, along ``-u``),
+    both signs; (P, 2n + 4, n) for ``e`` and ``z`` of shape (P, n). A zero ``e`` or ``z``
+    gives the first axis in its place (a repeat, which the greedy choice, taking the first
+    of equal values, never prefers)."""
+    p, n = e.shape
+    axes = np.broadcast_to(np.concatenate([np.eye(n), -np.eye(n)]), (p, 2 * n, n))
+    rows = [axes]
     for v in (e, z):
-        norm = np.linalg.norm(v)
-        if norm > 0.0:
-            rows.append(np.stack([v / norm, -v / norm]))
-    return np.concatenate(rows)
+        norm = np.linalg.norm(v, axis=1, keepdims=True)
+        unit = np.where(norm > 0.0, v / np.where(norm > 0.0, norm, 1.0), np.eye(n)[0])
+        rows.append(np.stack([unit, -unit], axis=1))
+    return np.concatenate(rows, axis=1)
 
 
-def _towards(current: np.ndarray, targets: np.ndarray, budget: float) -> np.ndarray:
-    """``current`` moved towards each of ``targets`` by at most ``budget`` (Euclidean norm;
-    for matrices the Frobenius norm, which bounds the spectral norm the Lipschitz bounds
-    are stated in); all of ``targets`` when ``budget`` is infinite."""
-    if not np.isfinite(budget):
-        return targets
-    step = targets - current
-    size = np.sqrt(np.sum(step.reshape(len(step), -1) ** 2, axis=1))
-    shape = (-1,) + (1,) * (step.ndim - 1)
-    scale = np.minimum(1.0, budget / np.maximum(size, 1e-300))
-    return current + scale.reshape(shape) * step
+def fixed_directions(n: int, seed: int = 0) -> np.ndarray:
+    """The directions a time-invariant drift is held in (:func:`search_time_invariant`):
+    the axes and two seeded random unit directions, both signs.
+
+    Parameters
+    ----------
+    n : int
+        States.
+    seed : int
+        Seeds the two random directions.
+
+    Returns
+    -------
+    ndarray, shape (2 n + 4, n)
+        Unit vectors, in a fixed order (10 in 3-D).
+    """
+    rng = np.random.default_rng([seed, n, 13])
+    extra = rng.normal(size=(2, n))
+    extra /= np.linalg.norm(extra, axis=1, keepdims=True)
+    return np.concatenate([np.eye(n), -np.eye(n), extra, -extra])
 
 
-def _budget(rates: tuple[float, ...] | None, move: np.ndarray | None) -> float:
-    """How far ``g`` or ``f`` may change after the state moved by ``move``: ``sum_j L_j
-    |move_j|``; infinite without rates (the class's member may jump) or before the first
-    interval."""
+def _towards(current: np.ndarray, targets: np.ndarray, budget: np.ndarray) -> np.ndarray:
+    """Each path's ``current`` (P, ...) moved towards each of ``targets`` (P or 1, M, ...)
+    by at most its ``budget`` (P,) (Euclidean norm; for matrices the Frobenius norm, which
+    bounds the spectral norm the Lipschitz bounds are stated in); all of ``targets`` where
+    ``budget`` is infinite. Shape (P, M, ...)."""
+    step = targets - current[:, None]
+    size = np.sqrt(np.sum(step.reshape(step.shape[:2] + (-1,)) ** 2, axis=2))
+    scale = np.minimum(1.0, budget[:, None] / np.maximum(size, 1e-300))
+    return current[:, None] + scale.reshape(scale.shape + (1,) * (step.ndim - 2)) * step
+
+
+def _budget(rates: tuple[float, ...] | None, move: np.ndarray | None, paths: int
+            ) -> np.ndarray:
+    """How far ``g`` or ``f`` may change on each path after the state moved by ``move``
+    (P, n): ``sum_j L_j |move_j|``; infinite without rates (the class's member may jump)
+    or before the first interval. Shape (P,)."""
     if rates is None or move is None:
-        return np.inf
-    return float(np.dot(rates, np.abs(move)))
+        return np.full(paths, np.inf)
+    return np.abs(move) @ np.asarray(rates, dtype=float)
 
 
-def _run(design: TubeDesign, samples: TubeSamples, members: list[np.ndarray],
-         bounds: Assumptions, score: str, strategy: str) -> Counterexample | None:
+def _run(design: TubeDesign, samples: TubeSamples, members: np.ndarray, bounds: Assumptions,
+         score: str, strategy: str, drifts: np.ndarray | None = None, record: bool = True
+         ) -> tuple[int, Counterexample] | None:
+    """The adversary on the sampled loop, greedy on ``score`` (``"max"`` or
+    ``"lyapunov"``), on P paths side by side.
+
+    Path ``p`` chooses its ``g`` on each interval among ``members[p]`` (shape (P, M, n,
+    n); moved towards them within ``input_gain_lipschitz`` when the class has it; one
+    member, ``M = 1``, is held for the whole run) and ``f + w`` in the directions of
+    :func:`_directions` (``f`` moved within ``drift_lipschitz`` when the class has it).
+    With ``drifts`` (P, n), path ``p`` holds ``f = drifts[p]`` and only ``w``, of norm
+    ``disturbance_bound``, is chosen. Returns the path that exits first (at the earliest
+    sample; the lowest index among those exiting there) and its counterexample
+    (``strategy`` formatted with the path's index), or ``None``; without ``record``, the
+    counterexample has no path (``gains``, ``pushes``, ``drifts`` ``None``: many paths
+    side by side would not fit in memory)."""
     lower, upper = samples.gamma_lower, samples.gamma_upper
     centre, half = 0.5 * (upper + lower), 0.5 * (upper - lower)
     dt = 1.0 / design.rate_hz
     gain = design.gain
-    x = np.array(design.initial_state, dtype=float)
-    g_all = np.stack(members)                                   # (M, n, n)
-    n = len(x)
-    separate = bounds.drift_lipschitz is not None     # f bounded apart from w
+    x0 = np.array(design.initial_state, dtype=float)
+    n = len(x0)
+    steps = len(samples.t) - 1
+    paths = len(members)
+    x = np.repeat(x0[None, :], paths, axis=0)                   # (P, n)
+    separate = drifts is not None or bounds.drift_lipschitz is not None  # f apart from w
     drift = bounds.drift_bound if separate else bounds.drift_bound + bounds.disturbance_bound
     free = bounds.disturbance_bound if separate else 0.0
-    g_now, f_now, move = None, np.zeros(n), None
-    top = 0.0
-    gains, pushes, drifts = [], [], []
+    g_now, f_now = None, (np.zeros((paths, n)) if drifts is None else
+                          np.asarray(drifts, dtype=float))
+    gains = np.empty((paths, steps, n, n)) if record else None
+    pushes = np.empty((paths, steps, n)) if record else None
+    f_path = np.empty((paths, steps, n)) if record else None
+    move = None
+    top = np.zeros(paths)
+    every = np.arange(paths)
 
-    def found(k: int, e: np.ndarray) -> Counterexample:
-        i = int(np.argmax(np.abs(e)))
-        return Counterexample(strategy, float(samples.t[k]), i, float(abs(e[i])), top,
-                              np.array(gains).reshape(k, n, n),
-                              np.array(pushes).reshape(k, n), np.array(drifts).reshape(k, n),
-                              bounds.input_gain_lipschitz is not None, separate)
+    def found(k: int, e: np.ndarray) -> tuple[int, Counterexample]:
+        p = int(np.flatnonzero(np.max(np.abs(e), axis=1) >= 1.0)[0])
+        i = int(np.argmax(np.abs(e[p])))
+        path = ((gains[p, :k].copy(), pushes[p, :k].copy(), f_path[p, :k].copy())
+                if record else (None, None, None))
+        return p, Counterexample(
+            strategy.format(p), float(samples.t[k]), i, float(abs(e[p, i])), float(top[p]),
+            *path, drifts is not None or bounds.input_gain_lipschitz is not None, separate)
 
-    for k in range(len(samples.t) - 1):
+    for k in range(steps):
         e = (x - centre[k]) / half[k]
-        worst = float(np.max(np.abs(e)))
-        if worst >= 1.0:
+        worst = np.max(np.abs(e), axis=1)
+        if np.any(worst >= 1.0):
             return found(k, e)
-        top = max(top, worst)
-        u = reference.law(gain, x[None, :], lower[k][None, :], upper[k][None, :])[0][0]
-        g_next = (g_all if g_now is None else
-                  _towards(g_now, g_all, _budget(bounds.input_gain_lipschitz, move)))
-        units = _directions(e, -u)                               # (D, n)
-        f_next = (drift * units if move is None else
-                  _towards(f_now, drift * units, _budget(bounds.drift_lipschitz, move)))
-        dirs = f_next + free * units                             # f + w, (D, n)
-        moves = g_next @ u                                       # (M, n)
-        nxt = x + dt * (moves[:, None, :] + dirs[None, :, :])    # (M, D, n)
-        e_next = (nxt - centre[k + 1]) / half[k + 1]
+        top = np.maximum(top, worst)
+        u = reference.law(gain, x, np.broadcast_to(lower[k], x.shape),
+                          np.broadcast_to(upper[k], x.shape))[0]      # (P, n)
+        units = _directions(e, -u)                                      # (P, D, n)
+        g_next = (members if g_now is None else
+                  _towards(g_now, members, _budget(bounds.input_gain_lipschitz, move, paths)))
+        if drifts is not None:
+            f_next = np.broadcast_to(f_now[:, None], units.shape)
+        elif move is None:
+            f_next = drift * units
+        else:
+            f_next = _towards(f_now, drift * units, _budget(bounds.drift_lipschitz, move, paths))
+        dirs = f_next + free * units                                    # f + w, (P, D, n)
+        moves = (g_next @ u[:, None, :, None])[..., 0]                  # (P, M, n)
+        e_moved = (x[:, None, :] + dt * moves - centre[k + 1]) / half[k + 1]
+        e_next = e_moved[:, :, None, :] + dirs[:, None, :, :] * (dt / half[k + 1])
         if score == "max":
-            value = np.max(np.abs(e_next), axis=-1)
+            value = np.abs(e_next[..., 0])        # max over the axis, without a reduction
+            for i in range(1, n):                 # over a short axis (slow in numpy)
+                np.maximum(value, np.abs(e_next[..., i]), out=value)
         else:
             value = np.sum(np.arctanh(np.clip(np.abs(e_next), 0.0, 1.0 - 1e-15)) ** 2,
                            axis=-1)
-        m, d = np.unravel_index(int(np.argmax(value)), value.shape)
-        move = nxt[m, d] - x
-        x = nxt[m, d]
-        g_now, f_now = g_next[m], f_next[d]
-        gains.append(g_now)
-        pushes.append(dirs[d])
-        drifts.append(f_now)
+        best = np.argmax(value.reshape(paths, -1), axis=1)
+        m, d = np.divmod(best, value.shape[2])
+        g_now, f_now = g_next[every, m], f_next[every, d]
+        new_x = x + dt * (moves[every, m] + dirs[every, d])
+        move = new_x - x
+        x = new_x
+        if record:
+            gains[:, k] = g_now
+            pushes[:, k] = dirs[every, d]
+            f_path[:, k] = f_now
     e = (x - centre[-1]) / half[-1]
-    return found(len(samples.t) - 1, e) if float(np.max(np.abs(e))) >= 1.0 else None
+    return found(steps, e) if float(np.max(np.abs(e))) >= 1.0 else None
 
 
 def search_class(design: TubeDesign, samples: TubeSamples, bounds: Assumptions,
@@ -367,14 +425,74 @@ def search_class(design: TubeDesign, samples: TubeSamples, bounds: Assumptions,
     rated = [name for name, rates in (("g", bounds.input_gain_lipschitz),
                                       ("f", bounds.drift_lipschitz)) if rates is not None]
     mode = f", {' and '.join(rated)} Lipschitz" if rated else ""
+    every = np.stack(members)[None]                             # one path, (1, M, n, n)
     for score in ("max", "lyapunov"):
-        found = _run(design, samples, members, bounds, score, f"greedy {score}{mode}")
+        found = _run(design, samples, every, bounds, score, f"greedy {score}{mode}")
         if found is not None:
-            return found
-    for j, g in enumerate(members[:held_runs]):
-        found = _run(design, samples, [g], bounds, "max", f"member {j} held{mode}")
+            return found[1]
+    if held_runs > 0:                      # each member held on its own path, side by side
+        found = _run(design, samples, every[0, :held_runs, None], bounds, "max",
+                     f"member {{}} held{mode}")
         if found is not None:
-            return found
+            return found[1]
+    return None
+
+
+def search_time_invariant(design: TubeDesign, samples: TubeSamples, bounds: Assumptions,
+                          seed: int = 0) -> Counterexample | None:
+    """Search the class ``bounds`` for a member with ``g`` and ``f`` constant, only ``w``
+    chosen along time, whose sampled loop leaves the tube (the time-invariant adversary).
+
+    Every pair of a member ``g`` of :func:`class_matrices` and a drift ``f`` of norm
+    ``drift_bound`` in one of :func:`fixed_directions` is held for the whole run; on each
+    interval ``w``, of norm ``disturbance_bound``, takes the direction of
+    :func:`_directions` that makes the next ``max_i |e_i|`` largest (greedy). Such a plant
+    has ``g(x) = G`` and ``f(x) = F`` everywhere: it is a member of the class with any
+    Lipschitz bounds (its rates are 0), so a class it breaks is out of reach of every sound
+    check, Lipschitz bounds declared or not. The pairs run side by side (members first);
+    the first to exit (at the earliest sample, the lowest index among those exiting there;
+    with numpy's ``log``, a screen) is run again alone, with the reference's own
+    arithmetic, to record its path, and returned. Not exhaustive: finding none
+    proves nothing.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The designed tube: its gain ``k`` of law (13), rate and ``x(0)``.
+    samples : TubeSamples
+        The deployed tube at every sample (:func:`~stt_codegen.design.samples.sample_tube`).
+    bounds : Assumptions
+        The class: its ``g`` bounds, ``drift_bound`` and ``disturbance_bound`` (its
+        Lipschitz bounds, if any, are not needed: a constant member obeys them).
+    seed : int
+        Seeds :func:`class_matrices` and :func:`fixed_directions`.
+
+    Returns
+    -------
+    Counterexample or None
+        The member found (``strategy`` ``"time-invariant pair P"``, ``P`` its index in the
+        order above; ``gains`` and ``drifts`` the same on every interval), or ``None``.
+    """
+    n = design.dimension
+    members = class_matrices(bounds, n, seed)
+    if not members:
+        return None
+    units = fixed_directions(n, seed)
+    gains = np.repeat(np.stack(members), len(units), axis=0)[:, None]     # (M D, 1, n, n)
+    drifts = np.tile(bounds.drift_bound * units, (len(members), 1))       # (M D, n)
+    start = 0
+    while start < len(gains):
+        with reference.numpy_math():          # a screen: the path found is run again
+            first = _run(design, samples, gains[start:], bounds, "max", "", drifts[start:],
+                         record=False)
+        if first is None:
+            return None
+        index = start + first[0]
+        alone = _run(design, samples, gains[index:index + 1], bounds, "max",
+                     f"time-invariant pair {index}", drifts[index:index + 1])
+        if alone is not None:
+            return alone[1]
+        start = index + 1        # rounding made the path differ alone: search on past it
     return None
 
 
