@@ -5,19 +5,29 @@ eigenvalues of the symmetric part of ``g`` in ``[0.05, 5]``, a skew part up to 1
 ``|w_i| <= 0.5``), runs the generated C controller of each bundled case (its design's gain
 and rate) against each, and asks the sampled check
 (:func:`~stt_codegen.verify.sampled.check_sampled`) whether it proves that plant's own
-bounds. A plant the check accepts must hold in simulation; the study reports how many of
-the plants that hold the check accepts.
+bounds, without and with the plant's own Lipschitz bounds (:func:`own_bounds`). A plant
+the check accepts must hold in simulation; the study reports how many of the plants that
+hold the check accepts.
 
 The plants and seeds are those of the former ``tests/study_unknown_dynamics.py`` (issue
 7), which this module replaces, so that the numbers compare. Run::
 
     python -m stt_codegen.bench.plants_study [RUNS_PER_CASE] [--workers W] [--out rows.json]
                                              [--classes] [--own-gain]
+    python -m stt_codegen.bench.plants_study --recheck rows.json [--out new.json]
 
-``--classes`` also searches each plant's class (its own bounds) for a member that leaves
-the tube (:func:`~stt_codegen.verify.class_search.search_class`): no sound check may accept
-a class with such a member, so the study then says how many of the plants that hold any
-sound check could accept at most, and how many of those the check accepts. ``--own-gain``
+``--classes`` also searches the class of each plant that holds for a member that leaves
+the tube, with three adversaries (:data:`ADVERSARIES`): the switching one
+(:func:`~stt_codegen.verify.class_search.search_class` on the plant's own bounds, ``g`` and
+``f`` may jump), the Lipschitz one (the same search with the plant's own Lipschitz bounds
+too) and the time-invariant one
+(:func:`~stt_codegen.verify.class_search.search_time_invariant`, ``g`` and ``f`` constant).
+No sound check may accept a class with such a member (a class with Lipschitz bounds: one
+the Lipschitz or the time-invariant adversary found), so the study says how many of the
+plants that hold any sound check could accept at most, and how many of those the check
+accepts (:func:`summary`). The adversaries are the expensive part; ``--recheck`` computes
+only the check's columns again, of a study saved with ``--out`` (which is written after
+every plant, so a stopped run keeps its rows). ``--own-gain``
 runs everything at the gain the design derives from each plant's own bounds, as a user who
 declared them in ``[assumptions]`` would get, instead of the bundled design's gain.
 """

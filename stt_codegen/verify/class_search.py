@@ -34,8 +34,8 @@ sets). Without a Lipschitz bound, ``g`` (or ``f``) moves freely, as before.
 
 Three strategies choose ``(G_m, d_k)`` at each sample: greedily the largest next
 ``max_i |e_i|``, greedily the largest next ``sum_i atanh(e_i)^2``, and, for each of the
-first :data:`HELD_RUNS` members held for the whole run, the direction of the largest next
-``max_i |e_i|``. A run is a counterexample when ``|e_i(t_k)| >= 1`` at a sample (the
+first :data:`HELD_RUNS` members held for the whole run (side by side, one path each), the
+direction of the largest next ``max_i |e_i|``. A run is a counterexample when ``|e_i(t_k)| >= 1`` at a sample (the
 state is outside the deployed tube there). The path is the trajectory of a member of the
 class as long as it does not pass one point twice with two different choices: then
 ``g(x)`` and ``f(x)`` are defined on the path and extended off it within the bounds (which
@@ -48,6 +48,12 @@ between any two of its points, and ``g`` is not varied within an interval), the 
 which a counterexample is "a member of the class the spec declares". The search is not
 exhaustive: finding none proves nothing.
 
+The time-invariant adversary (:func:`search_time_invariant`) holds ``g`` and ``f`` for
+the whole run, at the class's extremes (each member of :func:`class_matrices` with ``f``
+of norm ``drift_bound`` in each of :func:`fixed_directions`), and chooses only ``w`` per
+interval, greedily. Its members are constant plants, which obey any Lipschitz bound: a
+class it breaks is out of reach of a sound check with or without them.
+
 ``verify`` runs the greedy strategies when its sampled check fails on bounds that hold on
 every interval alike, and reports a member it finds, confirmed on the numpy reference of
 the deployed controller (:func:`replay`): the failure is then not the check's caution.
@@ -58,7 +64,6 @@ study, and how much a sound check can accept").
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
 from dataclasses import dataclass, field
 
