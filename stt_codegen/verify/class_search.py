@@ -35,18 +35,19 @@ sets). Without a Lipschitz bound, ``g`` (or ``f``) moves freely, as before.
 Three strategies choose ``(G_m, d_k)`` at each sample: greedily the largest next
 ``max_i |e_i|``, greedily the largest next ``sum_i atanh(e_i)^2``, and, for each of the
 first :data:`HELD_RUNS` members held for the whole run (side by side, one path each), the
-direction of the largest next ``max_i |e_i|``. A run is a counterexample when ``|e_i(t_k)| >= 1`` at a sample (the
-state is outside the deployed tube there). The path is the trajectory of a member of the
-class as long as it does not pass one point twice with two different choices: then
-``g(x)`` and ``f(x)`` are defined on the path and extended off it within the bounds (which
-are convex sets), and ``w`` is defined along time. A polyline in 3-D generically never
-meets itself, and the exits go beyond the edge by a margin (:attr:`Counterexample.depth`),
-so smoothing the switches between samples keeps them. In the Lipschitz mode the path is that of a plant whose ``g`` and ``f``
-are held on each interval and change between consecutive samples by at most the declared
-rate times the state's move: the rates hold between consecutive samples of the path (not
-between any two of its points, and ``g`` is not varied within an interval), the sense in
-which a counterexample is "a member of the class the spec declares". The search is not
-exhaustive: finding none proves nothing.
+direction of the largest next ``max_i |e_i|``. A run is a counterexample when
+``|e_i(t_k)| >= 1`` at a sample (the state is outside the deployed tube there). The path is
+the trajectory of a member of the class as long as it does not pass one point twice with two
+different choices: then ``g(x)`` and ``f(x)`` are defined on the path and extended off it
+within the bounds (which are convex sets), and ``w`` is defined along time. A polyline in
+3-D generically never meets itself, and the exits go beyond the edge by a margin
+(:attr:`Counterexample.depth`), so smoothing the switches between samples keeps them. In
+the Lipschitz mode the path is that of a plant whose ``g`` and ``f`` are held on each
+interval and change between consecutive samples by at most the declared rate times the
+state's move: the rates hold between consecutive samples of the path (not between any two
+of its points, and ``g`` is not varied within an interval), the sense in which a
+counterexample is "a member of the class the spec declares". The search is not exhaustive:
+finding none proves nothing.
 
 The time-invariant adversary (:func:`search_time_invariant`) holds ``g`` and ``f`` for
 the whole run, at the class's extremes (each member of :func:`class_matrices` with ``f``
