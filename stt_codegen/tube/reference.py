@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import functools
 import math
 
 import numpy as np
@@ -148,10 +149,15 @@ def segment_progress(segment: ReachSegment, t) -> tuple[Array, Array]:
     p, p_dot : ndarray, shape (N,)
         Dimensionless and 1/s.
     """
-    t = _time(t)
-    start, end = segment.start, segment.end
-    active = (t >= start) & (t < end)
-    if segment.profile == TANH:
+    return _progress(segment.profile, _time(t), segment.start, segment.end)
+
+
+def _progress(profile: str, t: Array, start, end) -> tuple[Array, Array]:
+    """:func:`segment_progress` of segments of one ``profile``: ``start`` and ``end`` are
+    floats or arrays shaped like ``t`` (each point's own segment); the same operations on
+    every element either way."""
+    if profile == TANH:
+        active = (t >= start) & (t < end)
         gap = np.where(active, end - t, 1.0)
         arg = np.where(active, (t - start) / gap, 0.0)
         p = np.where(t >= end, 1.0, np.where(active, tanh(arg), 0.0))
@@ -162,12 +168,12 @@ def segment_progress(segment: ReachSegment, t) -> tuple[Array, Array]:
         return p, p_dot
     duration = end - start
     tau = np.clip((t - start) / duration, 0.0, 1.0)
-    if segment.profile == SMOOTHSTEP:
+    if profile == SMOOTHSTEP:
         p = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
         p_dot = 30.0 * tau**2 * (1.0 - tau) ** 2 / duration
         return p, p_dot
-    if segment.profile != CRUISE:
-        raise ValueError(f"unknown reach segment profile {segment.profile!r}")
+    if profile != CRUISE:
+        raise ValueError(f"unknown reach segment profile {profile!r}")
     a = CRUISE_RAMP
     v = 1.0 / (1.0 - a)
     rising, falling = tau < a, tau > 1.0 - a
@@ -178,6 +184,21 @@ def segment_progress(segment: ReachSegment, t) -> tuple[Array, Array]:
     p_dot = v * x**2 * (3.0 - 2.0 * x) / duration
     # outside the segment tau is clamped to 0 or 1, where x = 0: the rate is 0 there
     return p, p_dot
+
+
+@functools.lru_cache(maxsize=64)
+def _segment_table(segments: tuple[ReachSegment, ...]) -> tuple:
+    """Per-segment arrays of :func:`reach_tube`: ends, starts (S,), and the bounds' start
+    values and moves ``to - from`` (S, n) each, lower then upper; built once per tube."""
+    starts = np.array([seg.start for seg in segments])
+    ends = np.array([seg.end for seg in segments])
+    lower_from = np.array([seg.lower_from for seg in segments], dtype=float)
+    upper_from = np.array([seg.upper_from for seg in segments], dtype=float)
+    lower_move = np.array([seg.lower_to for seg in segments], dtype=float) - lower_from
+    upper_move = np.array([seg.upper_to for seg in segments], dtype=float) - upper_from
+    for array in (starts, ends, lower_from, upper_from, lower_move, upper_move):
+        array.setflags(write=False)
+    return starts, ends, lower_from, upper_from, lower_move, upper_move
 
 
 def reach_tube(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
@@ -198,21 +219,28 @@ def reach_tube(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
     """
     t = _time(t)
     segments = design.segments
-    ends = np.array([seg.end for seg in segments])
+    starts, ends, lower_from, upper_from, lower_move, upper_move = _segment_table(segments)
+    if len(segments) == 1:
+        s, s_dot = _progress(segments[0].profile, t, segments[0].start, segments[0].end)
+        return (lower_move[0] * s[:, None] + lower_from[0],
+                upper_move[0] * s[:, None] + upper_from[0],
+                lower_move[0] * s_dot[:, None], upper_move[0] * s_dot[:, None])
     which = np.minimum(np.searchsorted(ends, t, side="right"), len(segments) - 1)
-    n = design.dimension
-    out = [np.zeros((t.size, n)) for _ in range(4)]
-    for k, seg in enumerate(segments):
-        here = which == k
-        if not here.any():
-            continue
-        s, s_dot = segment_progress(seg, t[here])
-        for pair, (a, b) in enumerate(((seg.lower_from, seg.lower_to),
-                                       (seg.upper_from, seg.upper_to))):
-            a, b = np.array(a), np.array(b)
-            out[pair][here] = (b - a) * s[:, None] + a
-            out[pair + 2][here] = (b - a) * s_dot[:, None]
-    return out[0], out[1], out[2], out[3]
+    profiles = {seg.profile for seg in segments}
+    if len(profiles) == 1:
+        # every point with its own segment's start and end: one evaluation for all
+        s, s_dot = _progress(segments[0].profile, t, starts[which], ends[which])
+    else:
+        s, s_dot = np.zeros(t.size), np.zeros(t.size)
+        for profile in sorted(profiles):
+            here = np.isin(which, [k for k, seg in enumerate(segments)
+                                   if seg.profile == profile])
+            s[here], s_dot[here] = _progress(profile, t[here], starts[which[here]],
+                                             ends[which[here]])
+    s, s_dot = s[:, None], s_dot[:, None]
+    lower_move, upper_move = lower_move[which], upper_move[which]
+    return (lower_move * s + lower_from[which], upper_move * s + upper_from[which],
+            lower_move * s_dot, upper_move * s_dot)
 
 
 def bump(t, center: float, radius: float, sharpness: float) -> tuple[Array, Array]:
