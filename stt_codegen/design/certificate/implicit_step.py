@@ -58,16 +58,18 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
     """
     pole = np.maximum(0.0, -psi)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
-        # right of the pole, f >= 0 at pole + eps: theta/eps^2 >= kappa (eps + max(-psi, 0))
         eps = np.minimum(np.cbrt(theta / (2.0 * kappa)),
                          np.sqrt(theta / (2.0 * kappa * np.maximum(-psi, 1e-300))))
-        lo, hi = pole, pole + np.cbrt(theta / kappa)
+        # right of the pole, f >= 0 at pole + eps: theta/eps^2 >= kappa (eps + max(-psi, 0))
+        lo, hi = pole.copy(), pole + np.cbrt(theta / kappa)
         # psi > 0: theta / (kappa psi^2), right of the root and close to it when a* << psi
         x = np.where(psi > 0.0, np.minimum(theta / (kappa * psi * psi), hi), pole + eps)
+        minus_two_theta = -2.0 * theta  # f' = -2 theta / z^3 - kappa
         for _ in range(100):
             z = psi + x
-            f = theta / (z * z) - kappa * x
-            newton = x - f / (-2.0 * theta / (z * z * z) - kappa)
+            zz = z * z
+            f = theta / zz - kappa * x
+            newton = x - f / (minus_two_theta / (zz * z) - kappa)
             usable = (z > 0.0) & np.isfinite(newton)        # else: x rounds onto the pole
             left = f >= 0.0                                  # x left of the root
             # right of a left iterate by twice its Newton step and a few ulps: an upper
@@ -75,9 +77,10 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
             probe = x + 2.0 * (newton - x) + 4.0 * np.spacing(x)
             z_probe = psi + probe
             above = (z_probe > 0.0) & (theta / (z_probe * z_probe) - kappa * probe <= 0.0)
-            lo = np.where(usable, np.maximum(lo, np.where(left, x, newton)), lo)
-            hi = np.where(usable, np.minimum(hi, np.where(left, np.where(above, probe, hi), x)),
-                          hi)
+            # the bracket moves only where the iterate is usable (in place)
+            new_hi = np.where(left, np.where(above, probe, hi), x)
+            np.maximum(lo, np.where(left, x, newton), out=lo, where=usable)
+            np.minimum(hi, new_hi, out=hi, where=usable)
             if np.all(hi - lo <= 1e-11 * hi + 1e-16):
                 break
             # Newton, or bisection where Newton is not usable or leaves the bracket
