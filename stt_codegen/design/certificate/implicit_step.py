@@ -333,13 +333,23 @@ class SequenceBounds:
         with np.errstate(over="ignore", under="ignore", invalid="ignore"):
             rise = s_lo - (s_lo - a_lo) * np.power(self.q_lo[rows], j0)
             fall = np.maximum(s_lo, a_lo + j1 * self.dt * self.rate_lo[rows])
-            lo = np.where(a_lo <= s_lo, np.maximum(a_lo, np.nan_to_num(rise, nan=-np.inf)),
-                          np.nan_to_num(fall, nan=-np.inf))
+            lo = np.where(a_lo <= s_lo, np.maximum(a_lo, _nan_to(rise, -np.inf)),
+                          _nan_to(fall, -np.inf))
             drop = s_hi + (a_hi - s_hi) * np.power(self.q_hi[rows], j0)
             climb = np.minimum(s_hi, a_hi + j1 * self.dt * self.rate_hi[rows])
-            hi = np.where(a_hi >= s_hi, np.nan_to_num(drop, nan=np.inf),
-                          np.nan_to_num(climb, nan=np.inf))
+            hi = np.where(a_hi >= s_hi, _nan_to(drop, np.inf), _nan_to(climb, np.inf))
         return np.maximum(lo, 0.0), hi
+
+
+#: The largest finite float: :func:`numpy.nan_to_num` maps ``-+inf`` to ``-+`` it.
+_LARGEST = float(np.finfo(float).max)
+
+
+def _nan_to(values: np.ndarray, nan: float) -> np.ndarray:
+    """``numpy.nan_to_num(values, nan=nan)`` in four ufunc calls (its Python wrapper costs
+    more than they do on small arrays): NaN to ``nan``, ``-+inf`` to the largest finite
+    floats."""
+    return np.where(np.isnan(values), nan, np.minimum(np.maximum(values, -_LARGEST), _LARGEST))
 
 
 def sequence_bounds(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,
