@@ -152,15 +152,17 @@ def segment_progress(segment: ReachSegment, t) -> tuple[Array, Array]:
     return _progress(segment.profile, _time(t), segment.start, segment.end)
 
 
-def _progress(profile: str, t: Array, start, end) -> tuple[Array, Array]:
+def _progress(profile: str, t: Array, start, end, rate: bool = True) -> tuple[Array, Array]:
     """:func:`segment_progress` of segments of one ``profile``: ``start`` and ``end`` are
     floats or arrays shaped like ``t`` (each point's own segment); the same operations on
-    every element either way."""
+    every element either way. Without ``rate``, ``p_dot`` is ``None``."""
     if profile == TANH:
         active = (t >= start) & (t < end)
         gap = np.where(active, end - t, 1.0)
         arg = np.where(active, (t - start) / gap, 0.0)
         p = np.where(t >= end, 1.0, np.where(active, tanh(arg), 0.0))
+        if not rate:
+            return p, None
         # sech^2(a) = 4 exp(-2a) / (1 + exp(-2a))^2 for a >= 0, written without cancellation.
         q = exp(-2.0 * np.abs(arg))
         sech2 = 4.0 * q / (1.0 + q) ** 2
@@ -170,6 +172,8 @@ def _progress(profile: str, t: Array, start, end) -> tuple[Array, Array]:
     tau = np.clip((t - start) / duration, 0.0, 1.0)
     if profile == SMOOTHSTEP:
         p = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+        if not rate:
+            return p, None
         p_dot = 30.0 * tau**2 * (1.0 - tau) ** 2 / duration
         return p, p_dot
     if profile != CRUISE:
@@ -181,6 +185,8 @@ def _progress(profile: str, t: Array, start, end) -> tuple[Array, Array]:
     # integral of v s over a ramp's first x: v a (x^3 - x^4 / 2)
     covered = v * a * x**3 * (1.0 - 0.5 * x)
     p = np.where(rising, covered, np.where(falling, 1.0 - covered, v * (tau - 0.5 * a)))
+    if not rate:
+        return p, None
     p_dot = v * x**2 * (3.0 - 2.0 * x) / duration
     # outside the segment tau is clamped to 0 or 1, where x = 0: the rate is 0 there
     return p, p_dot
@@ -201,7 +207,7 @@ def _segment_table(segments: tuple[ReachSegment, ...]) -> tuple:
     return starts, ends, lower_from, upper_from, lower_move, upper_move
 
 
-def reach_tube(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
+def reach_tube(design: TubeDesign, t, rates: bool = True) -> tuple[Array, Array, Array, Array]:
     """Reachability tube ``rho_L``, ``rho_U`` (eq. (4), piecewise) and their time derivatives.
 
     On segment ``k`` (the first whose ``end`` is after ``t``; the last one after every
@@ -211,6 +217,8 @@ def reach_tube(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
     ----------
     design : TubeDesign
     t : array_like, shape (N,)
+    rates : bool
+        Also the derivatives (else ``None`` in their place).
 
     Returns
     -------
@@ -221,15 +229,18 @@ def reach_tube(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
     segments = design.segments
     starts, ends, lower_from, upper_from, lower_move, upper_move = _segment_table(segments)
     if len(segments) == 1:
-        s, s_dot = _progress(segments[0].profile, t, segments[0].start, segments[0].end)
-        return (lower_move[0] * s[:, None] + lower_from[0],
-                upper_move[0] * s[:, None] + upper_from[0],
-                lower_move[0] * s_dot[:, None], upper_move[0] * s_dot[:, None])
+        s, s_dot = _progress(segments[0].profile, t, segments[0].start, segments[0].end,
+                             rates)
+        values = (lower_move[0] * s[:, None] + lower_from[0],
+                  upper_move[0] * s[:, None] + upper_from[0])
+        if not rates:
+            return values[0], values[1], None, None
+        return (*values, lower_move[0] * s_dot[:, None], upper_move[0] * s_dot[:, None])
     which = np.minimum(np.searchsorted(ends, t, side="right"), len(segments) - 1)
     profiles = {seg.profile for seg in segments}
     if len(profiles) == 1:
         # every point with its own segment's start and end: one evaluation for all
-        s, s_dot = _progress(segments[0].profile, t, starts[which], ends[which])
+        s, s_dot = _progress(segments[0].profile, t, starts[which], ends[which], rates)
     else:
         s, s_dot = np.zeros(t.size), np.zeros(t.size)
         for profile in sorted(profiles):
@@ -237,10 +248,13 @@ def reach_tube(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
                                    if seg.profile == profile])
             s[here], s_dot[here] = _progress(profile, t[here], starts[which[here]],
                                              ends[which[here]])
-    s, s_dot = s[:, None], s_dot[:, None]
+    s = s[:, None]
     lower_move, upper_move = lower_move[which], upper_move[which]
-    return (lower_move * s + lower_from[which], upper_move * s + upper_from[which],
-            lower_move * s_dot, upper_move * s_dot)
+    values = (lower_move * s + lower_from[which], upper_move * s + upper_from[which])
+    if not rates:
+        return values[0], values[1], None, None
+    s_dot = s_dot[:, None]
+    return (*values, lower_move * s_dot, upper_move * s_dot)
 
 
 def bump(t, center: float, radius: float, sharpness: float) -> tuple[Array, Array]:
@@ -323,7 +337,7 @@ def smooth_max_pair(a: Array, b: Array, nu: float) -> Array:
     return np.maximum(a, b) + log1p(exp(-nu * np.abs(a - b))) / nu
 
 
-def open_bump_sum(heights: Array, nu: float) -> tuple[Array, Array]:
+def open_bump_sum(heights: Array, nu: float, weights: bool = True) -> tuple[Array, Array]:
     """``F_nu(y) = (1/nu) ln(1 + sum_j (exp(nu y_j) - 1))``, the combination of eq. (9).
 
     Evaluated without overflow as
@@ -338,6 +352,8 @@ def open_bump_sum(heights: Array, nu: float) -> tuple[Array, Array]:
         ``y_j = B^j b^j(t) >= 0``, state units, ``m >= 1``.
     nu : float
         ``nu``, 1/state units.
+    weights : bool
+        Also the weights (else ``None`` in their place).
 
     Returns
     -------
@@ -355,11 +371,13 @@ def open_bump_sum(heights: Array, nu: float) -> tuple[Array, Array]:
         for j in range(y.shape[-1]):
             total = total + (exp(nu * (y[..., j] - top)) - floor)
         value = top + log(total) / nu
+    if not weights:
+        return value, None
     return value, exp(nu * (y - value[..., None]))
 
 
 def circumvent_from_bumps(design: TubeDesign, bumps: list,
-                          count: int) -> tuple[Array, Array, list]:
+                          count: int, weights: bool = True) -> tuple[Array, Array, list]:
     """Eq. (9) from given bump values: ``beta_L``, ``beta_U`` and each circumvent's weight.
 
     ``beta_L_i = X_i + F_nu(y)`` and ``beta_U_i = X-bar_i - F_nu(y)`` with
@@ -373,6 +391,8 @@ def circumvent_from_bumps(design: TubeDesign, bumps: list,
         The bump value of each of ``design.circumvents``, in that order.
     count : int
         ``N``.
+    weights : bool
+        Also the weights (else a list of ``None``).
 
     Returns
     -------
@@ -380,7 +400,7 @@ def circumvent_from_bumps(design: TubeDesign, bumps: list,
     weights : list of ndarray, shape (N,) each
         ``|d beta / d (B^j b^j)|``, aligned with ``design.circumvents``.
     """
-    weights: list = [None] * len(design.circumvents)
+    out_weights: list = [None] * len(design.circumvents)
     out = []
     for side, bounds, sign in ((LOWER, design.state_lower, 1.0),
                                ("upper", design.state_upper, -1.0)):
@@ -394,15 +414,15 @@ def circumvent_from_bumps(design: TubeDesign, bumps: list,
             c = design.circumvents
             y = np.stack([c[j].height * np.asarray(bumps[j], dtype=float)
                           for j in members], axis=-1)
-            f, w = open_bump_sum(y, design.smoothness)
+            f, w = open_bump_sum(y, design.smoothness, weights)
             value[:, i] = bounds[i] + sign * f
             for k, j in enumerate(members):
-                weights[j] = w[..., k]
+                out_weights[j] = None if w is None else w[..., k]
         out.append(value)
-    return out[0], out[1], weights
+    return out[0], out[1], out_weights
 
 
-def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
+def circumvent(design: TubeDesign, t, rates: bool = True) -> tuple[Array, Array, Array, Array]:
     """Holistic circumvent function ``beta_L``, ``beta_U`` of eq. (9) and derivatives.
 
     Bumps on the same bound are combined by :func:`open_bump_sum`; a bound with no bump
@@ -414,6 +434,8 @@ def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
         The tube (its circumvents and state-space bounds).
     t : float or array_like, shape (N,)
         Times, s.
+    rates : bool
+        Also the derivatives (else ``None`` in their place).
 
     Returns
     -------
@@ -422,7 +444,10 @@ def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
     t = _time(t)
     n = design.dimension
     pairs = [bump(t, c.center, c.radius, c.sharpness) for c in design.circumvents]
-    beta_l, beta_u, weights = circumvent_from_bumps(design, [b for b, _ in pairs], t.size)
+    beta_l, beta_u, weights = circumvent_from_bumps(design, [b for b, _ in pairs], t.size,
+                                                    rates)
+    if not rates:
+        return beta_l, beta_u, None, None
     rate_l, rate_u = np.zeros((t.size, n)), np.zeros((t.size, n))
     for c, (_, b_dot), w in zip(design.circumvents, pairs, weights):
         if c.side == LOWER:
@@ -447,8 +472,8 @@ def conflict_distance(design: TubeDesign, t) -> Array:
     ndarray, shape (N, 2n)
         ``psi``, state units; positive where the reach tube and the circumvent do not conflict.
     """
-    rho_l, rho_u, _, _ = reach_tube(design, t)
-    beta_l, beta_u, _, _ = circumvent(design, t)
+    rho_l, rho_u, _, _ = reach_tube(design, t, rates=False)
+    beta_l, beta_u, _, _ = circumvent(design, t, rates=False)
     return np.concatenate([beta_u - rho_l, rho_u - beta_l], axis=1)
 
 

@@ -99,9 +99,9 @@ def circumvent_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray,
     if ranges is None:
         ranges = [bump_ranges(c, t0, t1) for c in design.circumvents]
     lower_min, upper_max, _ = reference.circumvent_from_bumps(design, [r[0] for r in ranges],
-                                                              t0.size)
+                                                              t0.size, weights=False)
     lower_max, upper_min, _ = reference.circumvent_from_bumps(design, [r[1] for r in ranges],
-                                                              t0.size)
+                                                              t0.size, weights=False)
     return (lower_min, lower_max), (upper_min, upper_max)
 
 
@@ -163,7 +163,7 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool 
     points = [t0, t1] + [np.clip(e, t0, t1) for e in edges]
     value_points = len(points)
     points += [np.clip(p, t0, t1) for p in peaks]
-    rho_l, rho_u, rate_l, rate_u = reference.reach_tube(design, np.concatenate(points))
+    rho_l, rho_u, rate_l, rate_u = reference.reach_tube(design, np.concatenate(points), rates)
     shape = (len(points), t0.size, design.dimension)
     rho_l, rho_u = rho_l.reshape(shape)[:value_points], rho_u.reshape(shape)[:value_points]
     if not rates:
