@@ -142,7 +142,7 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
             previous = parent.state
             reuse_limit = cut - 1
     while True:
-        part = partition(design, points)      # i1 = -1: the tail [T, inf)
+        part = _partition(design, points)     # i1 = -1: the tail [T, inf)
         i0, i1, t0, t1, steps, pieces = (part.i0, part.i1, part.t0, part.t1, part.steps,
                                          part.pieces)
         if proven is not None:
@@ -219,6 +219,24 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
         certificate = replace(certificate, margins=certificate.margins
                               + task_margins(design, spec, enc))
     return replace(certificate, state=previous, decisive=decisive, work=work)
+
+
+#: The last partition computed (by any certificate), with the tube and points it is of:
+#: the design search certifies a complete tube right after the partial check of the same
+#: tube (:func:`~stt_codegen.design.search.paper_design`), whose first partition is the
+#: partial check's last one.
+_LAST_PARTITION: list = [None]
+
+
+def _partition(design: TubeDesign, points: list[int]):
+    """:func:`~.enclosures.partition`, or the last one computed when of the same tube and
+    points (its arrays are only read)."""
+    last = _LAST_PARTITION[0]
+    if last is not None and last[1] == points and last[0] == design:
+        return last[2]
+    part = partition(design, points)
+    _LAST_PARTITION[0] = (design, list(points), part)
+    return part
 
 
 def _cut(points: list[int], i0: np.ndarray, length: np.ndarray, split: np.ndarray) -> list[int]:
