@@ -81,7 +81,7 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
             new_hi = np.where(left, np.where(above, probe, hi), x)
             np.maximum(lo, np.where(left, x, newton), out=lo, where=usable)
             np.minimum(hi, new_hi, out=hi, where=usable)
-            if np.all(hi - lo <= 1e-11 * hi + 1e-16):
+            if (hi - lo <= 1e-11 * hi + 1e-16).all():
                 break
             # Newton, or bisection where Newton is not usable or leaves the bracket
             inside = usable & (newton >= lo) & (newton <= hi)
