@@ -57,6 +57,8 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
         ``0`` where ``theta = 0``.
     """
     pole = np.maximum(0.0, -psi)
+    if not pole.size:
+        return pole, pole.copy()
     with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
         eps = np.minimum(np.cbrt(theta / (2.0 * kappa)),
                          np.sqrt(theta / (2.0 * kappa * np.maximum(-psi, 1e-300))))
