@@ -169,7 +169,7 @@ def _progress(profile: str, t: Array, start, end, rate: bool = True) -> tuple[Ar
         p_dot = np.where(active, sech2 * (end - start) / gap**2, 0.0)
         return p, p_dot
     duration = end - start
-    tau = np.clip((t - start) / duration, 0.0, 1.0)
+    tau = np.minimum(np.maximum((t - start) / duration, 0.0), 1.0)     # clip to [0, 1]
     if profile == SMOOTHSTEP:
         p = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
         if not rate:
