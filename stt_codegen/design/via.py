@@ -122,13 +122,18 @@ def _free_columns(lower: list, upper: list, obstacles: np.ndarray, space,
     return inside
 
 
+def _largest(columns: list) -> np.ndarray:
+    """The element-wise largest of the arrays ``columns`` (the max over a short axis,
+    without the reduction's cost)."""
+    out = columns[0]
+    for column in columns[1:]:
+        out = np.maximum(out, column)
+    return out
+
+
 def _max_distance(centres: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``max_i |centres[a, i] - centres[b, i]|`` (M,), the moves' lengths (max norm)."""
-    columns = [np.abs(c[a] - c[b]) for c in np.ascontiguousarray(centres.T)]
-    length = columns[0]
-    for column in columns[1:]:
-        length = np.maximum(length, column)
-    return length
+    return _largest([np.abs(c[a] - c[b]) for c in np.ascontiguousarray(centres.T)])
 
 
 def plan_via(spec: Spec, base: TubeDesign) -> ViaPlan:
@@ -204,8 +209,8 @@ def _grid_nodes(space, grid_dims: list[int], counts: list[int], start, goal,
     for g, i in enumerate(grid_dims):
         centre[:, i] = space[0][i] + (cells[:, g] + 0.5) * extent[i] / counts[g]
     # the other dimensions progress with the share of the way done in the grid ones
-    d0 = np.max(np.abs(centre[:, grid_dims] - start_centre[grid_dims]), axis=1)
-    d1 = np.max(np.abs(goal_centre[grid_dims] - centre[:, grid_dims]), axis=1)
+    d0 = _largest([np.abs(centre[:, i] - start_centre[i]) for i in grid_dims])
+    d1 = _largest([np.abs(goal_centre[i] - centre[:, i]) for i in grid_dims])
     fraction = np.where(d0 + d1 > 0, d0 / np.maximum(d0 + d1, 1e-300), 0.5)
     lows = start_lo + (goal_lo - start_lo) * fraction[:, None]
     highs = start_hi + (goal_hi - start_hi) * fraction[:, None]
