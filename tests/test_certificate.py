@@ -120,6 +120,26 @@ def test_alpha_fixed_point_bracket_is_rigorous_and_tight():
         assert p + b > 0 and f(b, p, t) <= 0
 
 
+def test_alpha_fixed_point_bracket_is_each_element_own():
+    """Where psi > 0 (the tube's usual case, here the bench arenas' range of psi and theta),
+    an element's bracket of a* is the same to the bit alone as in any batch: the plain
+    Newton steps act on each element by itself (no iteration count shared by the batch),
+    so a partition's coefficients do not depend on which intervals are computed together."""
+    from stt_codegen.design.certificate import alpha_fixed_point
+    rng = np.random.default_rng(11)
+    psi = rng.uniform(0.1, 5.0, 300)
+    theta = 0.02 / (1 + np.exp(2 * (psi - 1)))
+    lo, hi = alpha_fixed_point(psi, theta, 5.0)
+    for k in range(0, psi.size, 7):
+        one_lo, one_hi = alpha_fixed_point(psi[k:k + 1], theta[k:k + 1], 5.0)
+        assert one_lo[0].tobytes() == lo[k].tobytes() and one_hi[0].tobytes() == hi[k].tobytes()
+    # and in a batch with elements the bracketed search takes (psi <= 0)
+    mixed_lo, mixed_hi = alpha_fixed_point(np.concatenate([psi, -psi[:20]]),
+                                           np.concatenate([theta, theta[:20]]), 5.0)
+    assert mixed_lo[:psi.size].tobytes() == lo.tobytes()
+    assert mixed_hi[:psi.size].tobytes() == hi.tobytes()
+
+
 def test_step_root_bracket_is_rigorous():
     """step_root's bracket of the implicit step's root, checked in 50-digit arithmetic."""
     mpmath = pytest.importorskip("mpmath")

@@ -20,11 +20,15 @@ import numpy as np
 from ...tube import reference
 from ...tube.parameters import TubeDesign
 
-__all__ = ["EXACT_STEPS", "Propagation", "STEP_ROOT_TOLERANCE", "SequenceBounds",
-           "alpha_fixed_point", "alpha_ranges", "sequence_bounds", "step_root"]
+__all__ = ["EXACT_STEPS", "FIXED_POINT_NEWTON_STEPS", "Propagation", "STEP_ROOT_TOLERANCE",
+           "SequenceBounds", "alpha_fixed_point", "alpha_ranges", "sequence_bounds",
+           "step_root"]
 
 #: Intervals of at most this many steps follow the extreme implicit steps one by one.
 EXACT_STEPS = 4
+#: Plain Newton steps of :func:`alpha_fixed_point` from ``a = 0`` before its bracket is
+#: checked (enough for every element of the bench's arenas; slower ones are searched).
+FIXED_POINT_NEWTON_STEPS = 6
 #: Relative width at which :func:`step_root` stops refining its (rigorous) bracket.
 STEP_ROOT_TOLERANCE = 1e-13
 
@@ -34,15 +38,20 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
     """Bracket ``[lo, hi]`` of ``a*``, the root of ``kappa a = theta / (psi + a)^2`` with ``psi + a > 0``.
 
     ``f(a) = theta / (psi + a)^2 - kappa a`` is decreasing and convex on ``a > -psi``, with
-    slope ``<= -kappa``. Newton starts at ``theta / (kappa psi^2)`` (``psi > 0``; right of
-    the root, so the first step lands left of it) or just right of the pole (``f >= 0``),
-    and from the left rises monotonically to the root. Every iterate ``x`` bounds the root:
-    from below where ``f(x) >= 0``, from above otherwise, and then its Newton point bounds
-    it from below (convexity); a probe right of a left iterate (twice its Newton step and
-    a few ulps) bounds it from above where ``f <= 0`` there. Where a Newton step would
-    leave the bracket (or ``x`` rounds onto the pole) the next point is the bracket's
-    middle. Iterates until the bracket is ``1e-11`` relative (or ``1e-16`` absolute)
-    wide; both ends are widened by ``1e-13`` relative for rounding.
+    slope ``<= -kappa``. Every point ``x`` bounds the root: from below where ``f(x) >= 0``,
+    from above otherwise, and then its Newton point bounds it from below (convexity); a
+    probe right of a left point (twice its Newton step and a few ulps) bounds it from above
+    where ``f <= 0`` there.
+
+    Where ``psi > 0``, :data:`FIXED_POINT_NEWTON_STEPS` plain Newton steps from ``a = 0``
+    (``f(0) > 0``: from the left they rise monotonically to the root, each on its own
+    element) give the point whose bracket is kept when it is ``1e-11`` relative (or
+    ``1e-16`` absolute) wide. The other elements (``psi <= 0``, or slower) take the
+    bracketed search: Newton from ``theta / (kappa psi^2)`` (``psi > 0``; right of the
+    root, so the first step lands left of it) or just right of the pole (``f >= 0``),
+    bisection where a Newton step would leave the bracket (or ``x`` rounds onto the pole),
+    until the bracket is as wide as above. Both ends are widened by ``1e-13`` relative for
+    rounding.
 
     Parameters
     ----------
@@ -59,6 +68,38 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
     pole = np.maximum(0.0, -psi)
     if not pole.size:
         return pole, pole.copy()
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        minus_two_theta = -2.0 * theta  # f' = -2 theta / z^3 - kappa
+        x = np.zeros_like(psi)
+        for _ in range(FIXED_POINT_NEWTON_STEPS):
+            z = psi + x
+            zz = z * z
+            x = x - (theta / zz - kappa * x) / (minus_two_theta / (zz * z) - kappa)
+        z = psi + x
+        zz = z * z
+        f = theta / zz - kappa * x
+        newton = x - f / (minus_two_theta / (zz * z) - kappa)
+        left = f >= 0.0
+        probe = x + 2.0 * (newton - x) + 4.0 * np.spacing(x)
+        z_probe = psi + probe
+        above = (z_probe > 0.0) & (theta / (z_probe * z_probe) - kappa * probe <= 0.0)
+        lo, hi = np.where(left, x, newton), np.where(left, probe, x)
+        # kept: psi > 0, x off the pole, a finite Newton point, an upper bound found right
+        # of a left point, and narrow
+        kept = ((psi > 0.0) & (z > 0.0) & np.isfinite(newton) & (above | ~left)
+                & (hi - lo <= 1e-11 * hi + 1e-16))
+    if not kept.all():
+        rest = ~kept
+        lo[rest], hi[rest] = _bracketed_search(psi[rest], theta[rest], kappa, pole[rest])
+    done = theta > 0.0
+    return (np.where(done, np.maximum(pole, lo * (1.0 - 1e-13)), 0.0),
+            np.where(done, hi * (1.0 + 1e-13) + 1e-300, 0.0))
+
+
+def _bracketed_search(psi: np.ndarray, theta: np.ndarray, kappa: float,
+                      pole: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The bracketed search of :func:`alpha_fixed_point` (``pole = max(0, -psi)``): the
+    bracket before its widening for rounding."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
         eps = np.minimum(np.cbrt(theta / (2.0 * kappa)),
                          np.sqrt(theta / (2.0 * kappa * np.maximum(-psi, 1e-300))))
@@ -88,9 +129,7 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
             # Newton, or bisection where Newton is not usable or leaves the bracket
             inside = usable & (newton >= lo) & (newton <= hi)
             x = np.where(inside, newton, 0.5 * (lo + hi))
-    done = theta > 0.0
-    return (np.where(done, np.maximum(pole, lo * (1.0 - 1e-13)), 0.0),
-            np.where(done, hi * (1.0 + 1e-13) + 1e-300, 0.0))
+    return lo, hi
 
 
 def _fixed_points(psi_lo: np.ndarray, psi_hi: np.ndarray, theta_lo: np.ndarray,
