@@ -121,21 +121,24 @@ def test_alpha_fixed_point_bracket_is_rigorous_and_tight():
 
 
 def test_alpha_fixed_point_bracket_is_each_element_own():
-    """Where psi > 0 (the tube's usual case, here the bench arenas' range of psi and theta),
-    an element's bracket of a* is the same to the bit alone as in any batch: the plain
-    Newton steps act on each element by itself (no iteration count shared by the batch),
-    so a partition's coefficients do not depend on which intervals are computed together."""
+    """On the range of psi and theta the tubes meet (the trigger's theta, psi from -3 to 5
+    state units), an element's bracket of a* is the same to the bit alone as in any batch:
+    the plain Newton steps act on each element by itself (no iteration count shared by the
+    batch), so a partition's coefficients do not depend on which intervals are computed
+    together."""
     from stt_codegen.design.certificate import alpha_fixed_point
     rng = np.random.default_rng(11)
-    psi = rng.uniform(0.1, 5.0, 300)
+    psi = rng.uniform(-3.0, 5.0, 400)
     theta = 0.02 / (1 + np.exp(2 * (psi - 1)))
     lo, hi = alpha_fixed_point(psi, theta, 5.0)
     for k in range(0, psi.size, 7):
         one_lo, one_hi = alpha_fixed_point(psi[k:k + 1], theta[k:k + 1], 5.0)
         assert one_lo[0].tobytes() == lo[k].tobytes() and one_hi[0].tobytes() == hi[k].tobytes()
-    # and in a batch with elements the bracketed search takes (psi <= 0)
-    mixed_lo, mixed_hi = alpha_fixed_point(np.concatenate([psi, -psi[:20]]),
-                                           np.concatenate([theta, theta[:20]]), 5.0)
+    # beside elements of every other kind (_fixed_point_cases: psi near the pole, theta
+    # down to 1e-30), which may take the bracketed search
+    other_psi, other_theta = _fixed_point_cases()
+    mixed_lo, mixed_hi = alpha_fixed_point(np.concatenate([psi, other_psi]),
+                                           np.concatenate([theta, other_theta]), 5.0)
     assert mixed_lo[:psi.size].tobytes() == lo.tobytes()
     assert mixed_hi[:psi.size].tobytes() == hi.tobytes()
 

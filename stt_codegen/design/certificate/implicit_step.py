@@ -43,15 +43,17 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
     probe right of a left point (twice its Newton step and a few ulps) bounds it from above
     where ``f <= 0`` there.
 
-    Where ``psi > 0``, :data:`FIXED_POINT_NEWTON_STEPS` plain Newton steps from ``a = 0``
-    (``f(0) > 0``: from the left they rise monotonically to the root, each on its own
-    element) give the point whose bracket is kept when it is ``1e-11`` relative (or
-    ``1e-16`` absolute) wide. The other elements (``psi <= 0``, or slower) take the
-    bracketed search: Newton from ``theta / (kappa psi^2)`` (``psi > 0``; right of the
-    root, so the first step lands left of it) or just right of the pole (``f >= 0``),
-    bisection where a Newton step would leave the bracket (or ``x`` rounds onto the pole),
-    until the bracket is as wide as above. Both ends are widened by ``1e-13`` relative for
-    rounding.
+    :data:`FIXED_POINT_NEWTON_STEPS` plain Newton steps, each element by itself, start left
+    of the root and from there rise monotonically to it (convexity): for ``psi > 0`` at the
+    largest of ``0``, ``(theta / kappa)^(1/3) - psi`` (``kappa a (psi + a)^2 < kappa (psi +
+    a)^3 <= theta``) and ``min(psi, theta / (4 kappa psi^2))`` (``(psi + a)^2 <= 4 psi^2``),
+    else just right of the pole (``f >= 0`` at ``pole + eps``, below). The last point's
+    bracket is kept where it is ``1e-11`` relative (or ``1e-16`` absolute) wide. The other
+    elements (none on the bench's arenas) take the bracketed search: Newton from
+    ``theta / (kappa psi^2)`` (``psi > 0``; right of the root, so the first step lands left
+    of it) or from ``pole + eps``, bisection where a Newton step would leave the bracket (or
+    ``x`` rounds onto the pole), until the bracket is as narrow. Both ends are widened by
+    ``1e-13`` relative for rounding.
 
     Parameters
     ----------
@@ -69,8 +71,11 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
     if not pole.size:
         return pole, pole.copy()
     with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        x = np.where(psi > 0.0,
+                     np.maximum(np.maximum(0.0, np.cbrt(theta / kappa) - psi),
+                                np.minimum(psi, theta / (4.0 * kappa * psi * psi))),
+                     pole + _pole_offset(psi, theta, kappa))
         minus_two_theta = -2.0 * theta  # f' = -2 theta / z^3 - kappa
-        x = np.zeros_like(psi)
         for _ in range(FIXED_POINT_NEWTON_STEPS):
             z = psi + x
             zz = z * z
@@ -84,10 +89,9 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
         z_probe = psi + probe
         above = (z_probe > 0.0) & (theta / (z_probe * z_probe) - kappa * probe <= 0.0)
         lo, hi = np.where(left, x, newton), np.where(left, probe, x)
-        # kept: psi > 0, x off the pole, a finite Newton point, an upper bound found right
-        # of a left point, and narrow
-        kept = ((psi > 0.0) & (z > 0.0) & np.isfinite(newton) & (above | ~left)
-                & (hi - lo <= 1e-11 * hi + 1e-16))
+        # kept: x off the pole, a finite Newton point, an upper bound found right of a left
+        # point, and narrow
+        kept = (z > 0.0) & np.isfinite(newton) & (above | ~left) & (hi - lo <= 1e-11 * hi + 1e-16)
     if not kept.all():
         rest = ~kept
         lo[rest], hi[rest] = _bracketed_search(psi[rest], theta[rest], kappa, pole[rest])
@@ -96,17 +100,22 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
             np.where(done, hi * (1.0 + 1e-13) + 1e-300, 0.0))
 
 
+def _pole_offset(psi: np.ndarray, theta: np.ndarray, kappa: float) -> np.ndarray:
+    """``eps`` with ``f >= 0`` at ``max(0, -psi) + eps``, right of the pole:
+    ``theta / eps^2 >= kappa (eps + max(-psi, 0))``."""
+    return np.minimum(np.cbrt(theta / (2.0 * kappa)),
+                      np.sqrt(theta / (2.0 * kappa * np.maximum(-psi, 1e-300))))
+
+
 def _bracketed_search(psi: np.ndarray, theta: np.ndarray, kappa: float,
                       pole: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The bracketed search of :func:`alpha_fixed_point` (``pole = max(0, -psi)``): the
     bracket before its widening for rounding."""
     with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
-        eps = np.minimum(np.cbrt(theta / (2.0 * kappa)),
-                         np.sqrt(theta / (2.0 * kappa * np.maximum(-psi, 1e-300))))
-        # right of the pole, f >= 0 at pole + eps: theta/eps^2 >= kappa (eps + max(-psi, 0))
         lo, hi = pole.copy(), pole + np.cbrt(theta / kappa)
         # psi > 0: theta / (kappa psi^2), right of the root and close to it when a* << psi
-        x = np.where(psi > 0.0, np.minimum(theta / (kappa * psi * psi), hi), pole + eps)
+        x = np.where(psi > 0.0, np.minimum(theta / (kappa * psi * psi), hi),
+                     pole + _pole_offset(psi, theta, kappa))
         minus_two_theta = -2.0 * theta  # f' = -2 theta / z^3 - kappa
         for _ in range(100):
             z = psi + x
