@@ -100,11 +100,15 @@ def _fixed_point_cases():
     return psi, theta
 
 
-def test_alpha_fixed_point_bracket_is_rigorous_and_tight():
+@pytest.mark.parametrize("newton_steps", [None, 0])
+def test_alpha_fixed_point_bracket_is_rigorous_and_tight(newton_steps, monkeypatch):
     """The Newton bracket of a* (kappa a = theta / (psi + a)^2) holds in 50-digit
-    arithmetic: f >= 0 at lo (or lo on the pole), f <= 0 right of the pole at hi."""
+    arithmetic: f >= 0 at lo (or lo on the pole), f <= 0 right of the pole at hi. With no
+    plain Newton steps (0), every element takes the bracketed search."""
     mpmath = pytest.importorskip("mpmath")
-    from stt_codegen.design.certificate import alpha_fixed_point
+    from stt_codegen.design.certificate import alpha_fixed_point, implicit_step
+    if newton_steps is not None:
+        monkeypatch.setattr(implicit_step, "FIXED_POINT_NEWTON_STEPS", newton_steps)
     mpmath.mp.dps = 50
     psi, theta = _fixed_point_cases()
     kappa = 5.0
