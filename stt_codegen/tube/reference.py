@@ -518,7 +518,11 @@ def adaptive_law(design: TubeDesign, t, alpha) -> tuple[Array, Array]:
     """
     t = _time(t)
     psi = conflict_distance(design, t)
-    alpha = _rows(alpha, t.size, psi.shape[1])
+    return _alpha_rate(design, psi, _rows(alpha, t.size, psi.shape[1]))
+
+
+def _alpha_rate(design: TubeDesign, psi: Array, alpha: Array) -> tuple[Array, Array]:
+    """:func:`adaptive_law` at given ``psi`` (N, 2n) and ``alpha`` (N, 2n)."""
     theta = trigger(design, psi)
     z = psi + alpha
     return theta / z**2 - design.kappa * alpha, -2.0 * theta / z**3 - design.kappa
@@ -547,7 +551,9 @@ def adaptive_tube(design: TubeDesign, t, alpha) -> tuple[Array, Array, Array, Ar
     rho_l, rho_u, rho_l_dot, rho_u_dot = reach_tube(design, t)
     beta_l, beta_u, beta_l_dot, beta_u_dot = circumvent(design, t)
     alpha = _rows(alpha, t.size, 2 * n)
-    alpha_dot, _ = adaptive_law(design, t, alpha)
+    # adaptive_law with the psi of the pieces at hand (conflict_distance's operations)
+    psi = np.concatenate([beta_u - rho_l, rho_u - beta_l], axis=1)
+    alpha_dot, _ = _alpha_rate(design, psi, alpha)
     nu = design.smoothness
     gamma_l, w_l = smooth_max(np.stack([rho_l - alpha[:, :n], beta_l], -1), nu)
     neg_u, w_u = smooth_max(np.stack([-(rho_u + alpha[:, n:]), -beta_u], -1), nu)
