@@ -308,12 +308,13 @@ def _shortcut(path: list, nodes: dict, obstacles: np.ndarray, space) -> list:
     """Greedy shortening: from each box, the farthest later box it can move to directly."""
     out = [path[0]]
     k = 0
+    # the boxes' corners along the path, one column per dimension
+    path_lows = list(np.array([nodes[q][0] for q in path]).T)
+    path_highs = list(np.array([nodes[q][1] for q in path]).T)
     while k < len(path) - 1:
-        lo0, hi0 = nodes[path[k]]
-        later = path[k + 1:]
-        lows = np.array([np.minimum(lo0, nodes[q][0]) for q in later])
-        highs = np.array([np.maximum(hi0, nodes[q][1]) for q in later])
-        ok = _free(lows, highs, obstacles, space)
+        lows = [np.minimum(c[k], c[k + 1:]) for c in path_lows]
+        highs = [np.maximum(c[k], c[k + 1:]) for c in path_highs]
+        ok = _free_columns(lows, highs, obstacles, space, VIA_MARGIN)
         ok[0] = True   # the path's own edge
         k = k + 1 + int(np.flatnonzero(ok)[-1])
         out.append(path[k])
