@@ -502,6 +502,12 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
             detail += (f"; and the failure is not the check's caution: a plant of the class "
                        f"leaves the tube ({how}): |e_{found.dimension}| = {found.depth:.3g} "
                        f"at t = {found.time:.4f} s ({found.strategy}; verify/class_search.py)")
+        elif a.input_gain_lipschitz is not None or a.drift_lipschitz is not None:
+            detail += ("; the check's argument holds for every plant within the bounds, "
+                       "also one whose g and f jump between samples: it does not use "
+                       "input_gain_lipschitz or drift_lipschitz, so for the plants they "
+                       "declare this failure may be the check's caution (docs/"
+                       "sampled-data.md, \"Lipschitz bounds and the check\")")
     if a.notes:
         detail += "; " + "; ".join(a.notes) + " (the declared bounds are used; they cover the model)"
     data = {**result.data, "level": result.level, "margin": result.margin,
