@@ -124,7 +124,8 @@ def test_verify_says_not_the_checks_caution_only_about_a_member_of_the_declared_
     """The robot's geometry with a wall, its true bounds for the heading range declared
     (``g = R(x3)``): without its Lipschitz bound the class has a jumping member that leaves
     the tube, and ``verify`` says so; with ``input_gain_lipschitz = [0, 0, 1]`` the same
-    verdict, but no member of that class is found, so the caution is not ruled out."""
+    verdict, but no member of that class is found, so the caution is not ruled out. Both
+    times ``verify`` adds that the model's own ``g``, evaluated on the tube, passes."""
     from stt_codegen.verify.command import verify_spec
     wall = (Path(__file__).parent / "specs" / "wall-gap-s1.toml").read_text()
     declared = ("\n[assumptions]\ninput_gain = [0.362, 1]\ninput_gain_skew = 0.933\n"
@@ -142,6 +143,12 @@ def test_verify_says_not_the_checks_caution_only_about_a_member_of_the_declared_
     assert "not the check's caution" not in kept["lipschitz"].detail
     assert "does not use input_gain_lipschitz" in kept["lipschitz"].detail
     assert "does not use input_gain_lipschitz" not in kept["jumping"].detail
+    # the model's own g, evaluated on the tube, passes: verify says so, both times
+    for check in kept.values():
+        assert ("omnidirectional model's own g, its bounds evaluated on the tube per "
+                "sampling interval, passes at 1000 Hz" in check.detail)
+        assert "drop the declared input_gain, input_gain_skew, input_gain_coupling" in \
+            check.detail
 
 
 def test_held_members_contract_where_alternating_them_grows():
