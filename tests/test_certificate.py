@@ -100,11 +100,15 @@ def _fixed_point_cases():
     return psi, theta
 
 
-def test_alpha_fixed_point_bracket_is_rigorous_and_tight():
+@pytest.mark.parametrize("newton_steps", [None, 0])
+def test_alpha_fixed_point_bracket_is_rigorous_and_tight(newton_steps, monkeypatch):
     """The Newton bracket of a* (kappa a = theta / (psi + a)^2) holds in 50-digit
-    arithmetic: f >= 0 at lo (or lo on the pole), f <= 0 right of the pole at hi."""
+    arithmetic: f >= 0 at lo (or lo on the pole), f <= 0 right of the pole at hi. With no
+    plain Newton steps (0), every element takes the bracketed search."""
     mpmath = pytest.importorskip("mpmath")
-    from stt_codegen.design.certificate import alpha_fixed_point
+    from stt_codegen.design.certificate import alpha_fixed_point, implicit_step
+    if newton_steps is not None:
+        monkeypatch.setattr(implicit_step, "FIXED_POINT_NEWTON_STEPS", newton_steps)
     mpmath.mp.dps = 50
     psi, theta = _fixed_point_cases()
     kappa = 5.0
@@ -118,6 +122,29 @@ def test_alpha_fixed_point_bracket_is_rigorous_and_tight():
         p, t, a, b = (mpmath.mpf(float(v)) for v in (p, t, a, b))
         assert p + a <= 0 or f(a, p, t) >= 0
         assert p + b > 0 and f(b, p, t) <= 0
+
+
+def test_alpha_fixed_point_bracket_is_each_element_own():
+    """On the range of psi and theta the tubes meet (the trigger's theta, psi from -3 to 5
+    state units), an element's bracket of a* is the same to the bit alone as in any batch:
+    the plain Newton steps act on each element by itself (no iteration count shared by the
+    batch), so a partition's coefficients do not depend on which intervals are computed
+    together."""
+    from stt_codegen.design.certificate import alpha_fixed_point
+    rng = np.random.default_rng(11)
+    psi = rng.uniform(-3.0, 5.0, 400)
+    theta = 0.02 / (1 + np.exp(2 * (psi - 1)))
+    lo, hi = alpha_fixed_point(psi, theta, 5.0)
+    for k in range(0, psi.size, 7):
+        one_lo, one_hi = alpha_fixed_point(psi[k:k + 1], theta[k:k + 1], 5.0)
+        assert one_lo[0].tobytes() == lo[k].tobytes() and one_hi[0].tobytes() == hi[k].tobytes()
+    # beside elements of every other kind (_fixed_point_cases: psi near the pole, theta
+    # down to 1e-30), which may take the bracketed search
+    other_psi, other_theta = _fixed_point_cases()
+    mixed_lo, mixed_hi = alpha_fixed_point(np.concatenate([psi, other_psi]),
+                                           np.concatenate([theta, other_theta]), 5.0)
+    assert mixed_lo[:psi.size].tobytes() == lo.tobytes()
+    assert mixed_hi[:psi.size].tobytes() == hi.tobytes()
 
 
 def test_step_root_bracket_is_rigorous():

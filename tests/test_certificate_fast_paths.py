@@ -5,7 +5,9 @@ component; here its bounds are compared with a transcription of the plain propag
 (coefficient lists indexed one by one) on drawn partitions, start bounds and tube
 parameters. ``smooth_max_pair`` is compared with ``smooth_max`` of the stacked values, and
 ``piece_ranges`` (each bump's ranges computed once) with ``circumvent_range`` computing its
-own.
+own; ``reach_tube`` (one evaluation over its segments) with a segment-by-segment one, and
+the other shortcuts of the design (the rates left out where unused, ``nan_to_num`` without
+its wrapper, the tracking demand's errors in one broadcast) with the plain forms.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import dataclasses
 import math
 
 import numpy as np
+import pytest
 from conftest import CASES, designed
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -22,6 +25,8 @@ from hypothesis import strategies as st
 from stt_codegen.design.certificate import (EXACT_STEPS, alpha_fixed_point,
                                             alpha_ranges, circumvent_range, piece_ranges,
                                             step_psi, step_root)
+from stt_codegen.design.search import base_design
+from stt_codegen.design.via import via_design
 from stt_codegen.tube import reference
 
 
@@ -175,3 +180,98 @@ def test_piece_ranges_beta_is_circumvent_range():
             beta_l, beta_u = circumvent_range(tube, t[:-1], t[1:])
         for got, want in zip(pieces.beta_l + pieces.beta_u, beta_l + beta_u):
             assert np.array_equal(got, want)
+
+
+def _plain_reach_tube(design, t):
+    """reach_tube written plainly: segment by segment (segment_progress on the points in
+    it), the bounds' arrays built from the segment's tuples."""
+    t = np.atleast_1d(np.asarray(t, dtype=float))
+    segments = design.segments
+    ends = np.array([seg.end for seg in segments])
+    which = np.minimum(np.searchsorted(ends, t, side="right"), len(segments) - 1)
+    out = [np.zeros((t.size, design.dimension)) for _ in range(4)]
+    for k, seg in enumerate(segments):
+        here = which == k
+        if not here.any():
+            continue
+        s, s_dot = reference.segment_progress(seg, t[here])
+        for pair, (a, b) in enumerate(((seg.lower_from, seg.lower_to),
+                                       (seg.upper_from, seg.upper_to))):
+            a, b = np.array(a), np.array(b)
+            out[pair][here] = (b - a) * s[:, None] + a
+            out[pair + 2][here] = (b - a) * s_dot[:, None]
+    return out
+
+
+@pytest.mark.parametrize("profiles", [("tanh",), ("smoothstep",), ("cruise",),
+                                      ("tanh", "smoothstep", "cruise")])
+@pytest.mark.parametrize("fast_math", [False, True])
+def test_reach_tube_is_the_plain_segment_by_segment_one(profiles, fast_math):
+    """reach_tube (each point with its own segment's start and end in one evaluation, the
+    bounds' arrays built once) gives the plain segment-by-segment numbers to the bit, with
+    and without the rates, for one profile and for mixed ones."""
+    from stt_codegen.bench.arenas import generate_arena
+    spec = generate_arena(0, 11).to_spec()
+    via = via_design(spec, base_design(spec))
+    assert len(via.segments) >= 3
+    segments = tuple(dataclasses.replace(seg, profile=profiles[k % len(profiles)])
+                     for k, seg in enumerate(via.segments))
+    tube = dataclasses.replace(via, segments=segments)
+    edges = [seg.start for seg in segments] + [seg.end for seg in segments]
+    t = np.concatenate([np.linspace(-1.0, tube.prescribed_time + 1.0, 501), edges,
+                        np.nextafter(edges, np.inf), np.nextafter(edges, -np.inf)])
+    with reference.numpy_math() if fast_math else contextlib.nullcontext():
+        plain = _plain_reach_tube(tube, t)
+        fast = reference.reach_tube(tube, t)
+        values = reference.reach_tube(tube, t, rates=False)
+        if len(segments) > 1:
+            one = dataclasses.replace(tube, segments=segments[:1])
+            plain_one, fast_one = _plain_reach_tube(one, t), reference.reach_tube(one, t)
+    for got, want in zip(fast, plain):
+        assert got.tobytes() == want.tobytes()
+    assert values[0].tobytes() == plain[0].tobytes() and values[1].tobytes() == plain[1].tobytes()
+    assert values[2] is None and values[3] is None
+    for got, want in zip(fast_one, plain_one):
+        assert got.tobytes() == want.tobytes()
+
+
+def test_circumvent_without_rates_is_its_values():
+    """circumvent(rates=False) (no weights, no rates) gives circumvent's beta to the bit."""
+    for name in CASES:
+        tube = designed(name)[1]
+        t = np.linspace(0.0, tube.prescribed_time, 301)
+        with reference.numpy_math():
+            full = reference.circumvent(tube, t)
+            values = reference.circumvent(tube, t, rates=False)
+        assert values[0].tobytes() == full[0].tobytes()
+        assert values[1].tobytes() == full[1].tobytes()
+
+
+def test_sequence_bounds_map_nan_and_infinities_as_nan_to_num():
+    """SequenceBounds.within's replacement of numpy.nan_to_num, on every special value."""
+    from stt_codegen.design.certificate.implicit_step import _nan_to
+    values = np.array([np.nan, np.inf, -np.inf, -0.0, 0.0, 1.5, -2e308, 5e-324,
+                       np.finfo(float).max, -np.finfo(float).max])
+    for nan in (np.inf, -np.inf):
+        assert _nan_to(values, nan).tobytes() == np.nan_to_num(values, nan=nan).tobytes()
+
+
+def test_tracking_demand_is_the_least_speed_over_each_error():
+    """tracking_demand's least speed over the errors e (one broadcast) is the plain loop's."""
+    from stt_codegen.design import tracking
+    for name in CASES:
+        spec, tube, check = designed(name)
+        t, g_l, g_u, rate_l, rate_u = tracking._evaluate_partition(tube, check.certificate)
+        speed = np.full(g_l.shape, np.inf)
+        for e in tracking._ERRORS:
+            speed = np.minimum(speed, np.abs((1.0 + e) * rate_u + (1.0 - e) * rate_l) / 2.0)
+        a = spec.assumptions
+        need = speed + a.disturbance_bound
+        e = tracking.TRACKING_ERROR
+        phi = math.log((1.0 + e) / (1.0 - e)) / (1.0 - e * e)
+        ratio = need * (g_u - g_l) / (4.0 * phi * 0.5 * (a.input_gain[0] + a.input_gain[1])
+                                      * tube.gain)
+        k, i = np.unravel_index(int(np.argmax(ratio)), ratio.shape)
+        demand = tracking.tracking_demand(tube, check.certificate, spec)
+        assert (demand.ratio, demand.time, demand.dimension) == (float(ratio[k, i]),
+                                                                 float(t[k]), int(i))

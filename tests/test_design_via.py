@@ -267,3 +267,28 @@ def test_box_obstacle_meeting_is_the_definition():
                     assert meets[k, b] == strict
             if count and boxes:
                 assert meets.any() and not meets.all()
+
+
+@pytest.mark.parametrize("n", [1, 2, 3])
+def test_free_boxes_and_move_lengths_are_the_row_wise_ones(n):
+    """The via planner's free-box test and move lengths, column by column, answer as the
+    row-wise formulas (all corners inside the state space, no obstacle met with the margin,
+    touching not counted; the max norm of the centres' difference), also for boxes that
+    touch an obstacle or the boundary exactly."""
+    from stt_codegen.design import via
+    rng = np.random.default_rng(5)
+    k = 3000
+    # corners on a 0.05 grid, so many boxes touch obstacles and the boundary exactly
+    lower = np.round(rng.uniform(-0.5, 5.0, (k, n)) / 0.05) * 0.05
+    upper = lower + np.round(rng.uniform(0.0, 1.0, (k, n)) / 0.05) * 0.05
+    corner = np.round(rng.uniform(0.0, 4.0, (4, n)) / 0.05) * 0.05
+    obstacles = np.stack([corner, corner + 1.0], axis=1)                 # (B, 2, n)
+    space = (np.zeros(n), np.full(n, 5.0))
+    for margin in (0.0, 0.05):
+        plain = (np.all((lower >= space[0]) & (upper <= space[1]), axis=1)
+                 & ~via._meets(lower, upper, obstacles, margin).any(axis=1))
+        assert np.array_equal(via._free(lower, upper, obstacles, space, margin), plain)
+        assert 0 < plain.sum() < k
+    a, b = rng.integers(0, k, 500), rng.integers(0, k, 500)
+    assert np.array_equal(via._max_distance(lower, a, b),
+                          np.max(np.abs(lower[a] - lower[b]), axis=1))

@@ -124,7 +124,8 @@ def test_verify_says_not_the_checks_caution_only_about_a_member_of_the_declared_
     """The robot's geometry with a wall, its true bounds for the heading range declared
     (``g = R(x3)``): without its Lipschitz bound the class has a jumping member that leaves
     the tube, and ``verify`` says so; with ``input_gain_lipschitz = [0, 0, 1]`` the same
-    verdict, but no member of that class is found, so the caution is not ruled out."""
+    verdict, but no member of that class is found, so the caution is not ruled out. Both
+    times ``verify`` adds that the model's own ``g``, evaluated on the tube, passes."""
     from stt_codegen.verify.command import verify_spec
     wall = (Path(__file__).parent / "specs" / "wall-gap-s1.toml").read_text()
     declared = ("\n[assumptions]\ninput_gain = [0.362, 1]\ninput_gain_skew = 0.933\n"
@@ -140,3 +141,41 @@ def test_verify_says_not_the_checks_caution_only_about_a_member_of_the_declared_
     assert "g on each interval an extreme member" in kept["jumping"].detail
     assert kept["lipschitz"].data["class_counterexample"] is None
     assert "not the check's caution" not in kept["lipschitz"].detail
+    assert "does not use input_gain_lipschitz" in kept["lipschitz"].detail
+    assert "does not use input_gain_lipschitz" not in kept["jumping"].detail
+    # the model's own g, evaluated on the tube, passes: verify says so, both times
+    for check in kept.values():
+        assert ("omnidirectional model's own g, its bounds evaluated on the tube per "
+                "sampling interval, passes at 1000 Hz" in check.detail)
+        assert "drop the declared input_gain, input_gain_skew, input_gain_coupling" in \
+            check.detail
+
+
+def test_held_members_contract_where_alternating_them_grows():
+    """Why a check valid for plants whose ``g`` jumps cannot pass the wall's declared class
+    (docs/sampled-data.md, "Lipschitz bounds and the check"): at ``t = 0`` two members of
+    the class, ``g13 = -g31 = -+0.933``, each make the linearized sampled step of law (13)
+    contract, and alternating them every sample makes it grow; a Lipschitz bound of 1 in
+    ``x3`` forbids the alternation (it moves ``g`` by 1.87 per sample)."""
+    from stt_codegen import design_tube
+    from stt_codegen.design.samples import sample_tube
+    from stt_codegen.verify.class_search import within_class
+    wall = (Path(__file__).parent / "specs" / "wall-gap-s1.toml").read_text()
+    declared = ("\n[assumptions]\ninput_gain = [0.362, 1]\ninput_gain_skew = 0.933\n"
+                "input_gain_coupling = 0.933\n")
+    spec = parse_spec(wall + declared)
+    tube = design_tube(spec).tube
+    samples = sample_tube(tube)
+    half = (samples.gamma_upper[0] - samples.gamma_lower[0]) / 2
+    dt = 1.0 / tube.rate_hz
+    steps = []
+    for sign in (1.0, -1.0):
+        g = np.diag([0.362, 1.0, 0.362])
+        g[0, 2], g[2, 0] = -sign * 0.933, sign * 0.933
+        assert within_class(g, spec.assumptions)
+        # e+ = e - 2 k dt H^-1 g H^-1 phi(e), phi(e) = 2 e + O(e^3)
+        steps.append(np.eye(3) - 4.0 * tube.gain * dt * (g / half[:, None]) / half[None, :])
+    held = [max(abs(np.linalg.eigvals(a))) for a in steps]
+    alternating = max(abs(np.linalg.eigvals(steps[0] @ steps[1]))) ** 0.5
+    # x2 alone contracts by 0.91 per sample, the (x1, x3) block by 0.76
+    assert max(held) < 0.92 and alternating > 1.03

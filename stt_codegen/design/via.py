@@ -95,10 +95,45 @@ def _meets(lower: np.ndarray, upper: np.ndarray, obstacles: np.ndarray,
 def _free(lower: np.ndarray, upper: np.ndarray, obstacles: np.ndarray,
           space: tuple[np.ndarray, np.ndarray], margin: float = VIA_MARGIN) -> np.ndarray:
     """Boxes (K, n) that lie in the state space and keep ``margin`` from every obstacle."""
-    inside = np.all((lower >= space[0]) & (upper <= space[1]), axis=1)
-    if not len(obstacles):
-        return inside
-    return inside & ~_meets(lower, upper, obstacles, margin).any(axis=1)
+    return _free_columns(list(lower.T), list(upper.T), obstacles, space, margin)
+
+
+def _free_columns(lower: list, upper: list, obstacles: np.ndarray, space,
+                  margin: float) -> np.ndarray:
+    """:func:`_free` of boxes given by the columns of their corners (n arrays (K,) each).
+
+    The comparisons of :func:`_meets`, one column at a time into one (K,) mask: gathers of
+    rows and reductions over the short axis of (K, n) or (K, B) arrays cost more than the
+    comparisons themselves.
+    """
+    inside = lower[0] >= space[0][0]
+    inside &= upper[0] <= space[1][0]
+    for i in range(1, len(lower)):
+        inside &= lower[i] >= space[0][i]
+        inside &= upper[i] <= space[1][i]
+    lo = [c - margin for c in lower]
+    hi = [c + margin for c in upper]
+    for b in range(obstacles.shape[0]):
+        met = (lo[0] < obstacles[b, 1, 0]) & (hi[0] > obstacles[b, 0, 0])
+        for i in range(1, len(lower)):
+            met &= lo[i] < obstacles[b, 1, i]
+            met &= hi[i] > obstacles[b, 0, i]
+        inside &= ~met
+    return inside
+
+
+def _largest(columns: list) -> np.ndarray:
+    """The element-wise largest of the arrays ``columns`` (the max over a short axis,
+    without the reduction's cost)."""
+    out = columns[0]
+    for column in columns[1:]:
+        out = np.maximum(out, column)
+    return out
+
+
+def _max_distance(centres: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``max_i |centres[a, i] - centres[b, i]|`` (M,), the moves' lengths (max norm)."""
+    return _largest([np.abs(c[a] - c[b]) for c in np.ascontiguousarray(centres.T)])
 
 
 def plan_via(spec: Spec, base: TubeDesign) -> ViaPlan:
@@ -140,11 +175,10 @@ def plan_via(spec: Spec, base: TubeDesign) -> ViaPlan:
     counts = [max(int(extent[i] / step), 1) for i in grid_dims]
     lows, highs = _grid_nodes(space, grid_dims, counts, (start_lo, start_hi),
                               (goal_lo, goal_hi), half)
-    pairs, ok = _moves(lows, highs, counts, obstacles, space, VIA_MARGIN)
-    a, b = pairs[:, 0], pairs[:, 1]
+    a, b, ok = _moves(lows, highs, counts, obstacles, space, VIA_MARGIN)
+    a, b = a[ok], b[ok]
     mids = 0.5 * (lows + highs)
-    path, dist = _shortest_path(len(lows), a[ok], b[ok],
-                                np.max(np.abs(mids[a[ok]] - mids[b[ok]]), axis=1))
+    path, dist = _shortest_path(len(lows), a, b, _max_distance(mids, a, b))
     if path is None:
         walled = _walled_off(spec, space, grid_dims, counts, obstacles)
         if walled:
@@ -175,8 +209,8 @@ def _grid_nodes(space, grid_dims: list[int], counts: list[int], start, goal,
     for g, i in enumerate(grid_dims):
         centre[:, i] = space[0][i] + (cells[:, g] + 0.5) * extent[i] / counts[g]
     # the other dimensions progress with the share of the way done in the grid ones
-    d0 = np.max(np.abs(centre[:, grid_dims] - start_centre[grid_dims]), axis=1)
-    d1 = np.max(np.abs(goal_centre[grid_dims] - centre[:, grid_dims]), axis=1)
+    d0 = _largest([np.abs(centre[:, i] - start_centre[i]) for i in grid_dims])
+    d1 = _largest([np.abs(goal_centre[i] - centre[:, i]) for i in grid_dims])
     fraction = np.where(d0 + d1 > 0, d0 / np.maximum(d0 + d1, 1e-300), 0.5)
     lows = start_lo + (goal_lo - start_lo) * fraction[:, None]
     highs = start_hi + (goal_hi - start_hi) * fraction[:, None]
@@ -186,29 +220,32 @@ def _grid_nodes(space, grid_dims: list[int], counts: list[int], start, goal,
 
 
 def _moves(lows: np.ndarray, highs: np.ndarray, counts: list[int], obstacles: np.ndarray,
-           space, margin: float) -> tuple[np.ndarray, np.ndarray]:
-    """Candidate moves between free nodes (neighbouring cells, and the start and target
-    boxes to every cell and to each other), shape (M, 2), and which are free: the
-    bounding box of the two boxes, widened by ``margin``, misses every obstacle."""
-    free = _free(lows, highs, obstacles, space, margin)
+           space, margin: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Candidate moves ``a[q] -- b[q]`` between free nodes (neighbouring cells, and the
+    start and target boxes to every cell and to each other), shape (M,) each, and which are
+    free: the bounding box of the two boxes, widened by ``margin``, misses every obstacle."""
+    low_columns = list(np.ascontiguousarray(lows.T))
+    high_columns = list(np.ascontiguousarray(highs.T))
+    free = _free_columns(low_columns, high_columns, obstacles, space, margin)
     free[:2] = True   # the spec's own boxes (checked by the loader and the certificate)
     flat = np.arange(len(lows) - 2).reshape(counts) + 2
-    pairs = []
+    first, second = [], []
     for o in product((-1, 0, 1), repeat=len(counts)):
         if not any(o) or o < (0,) * len(o):
             continue       # each neighbour pair once
         src = tuple(slice(max(0, -d), c - max(0, d)) for d, c in zip(o, counts))
         dst = tuple(slice(max(0, d), c - max(0, -d)) for d, c in zip(o, counts))
-        pairs.append(np.column_stack([flat[src].ravel(), flat[dst].ravel()]))
+        first.append(flat[src].ravel())
+        second.append(flat[dst].ravel())
     cell_ids = np.flatnonzero(free[2:]) + 2
-    pairs.append(np.column_stack([np.zeros_like(cell_ids), cell_ids]))
-    pairs.append(np.column_stack([np.ones_like(cell_ids), cell_ids]))
-    pairs.append(np.array([[0, 1]]))
-    pairs = np.vstack(pairs)
-    pairs = pairs[free[pairs[:, 0]] & free[pairs[:, 1]]]
-    a, b = pairs[:, 0], pairs[:, 1]
-    return pairs, _free(np.minimum(lows[a], lows[b]), np.maximum(highs[a], highs[b]),
-                        obstacles, space, margin)
+    first += [np.zeros_like(cell_ids), np.ones_like(cell_ids), np.array([0])]
+    second += [cell_ids, cell_ids, np.array([1])]
+    a, b = np.concatenate(first), np.concatenate(second)
+    both = free[a] & free[b]
+    a, b = a[both], b[both]
+    return a, b, _free_columns([np.minimum(c[a], c[b]) for c in low_columns],
+                               [np.maximum(c[a], c[b]) for c in high_columns],
+                               obstacles, space, margin)
 
 
 def _walled_off(spec: Spec, space, grid_dims: list[int], counts: list[int],
@@ -222,8 +259,8 @@ def _walled_off(spec: Spec, space, grid_dims: list[int], counts: list[int],
     from scipy.sparse import csgraph, csr_matrix   # on first use: paper designs never load it
     x0, eta = np.array(spec.initial_state), np.array(spec.target_center)
     lows, highs = _grid_nodes(space, grid_dims, counts, (x0, x0), (eta, eta), 0.0)
-    pairs, ok = _moves(lows, highs, counts, obstacles, space, 0.0)
-    graph = csr_matrix((np.ones(int(ok.sum())), (pairs[ok, 0], pairs[ok, 1])),
+    a, b, ok = _moves(lows, highs, counts, obstacles, space, 0.0)
+    graph = csr_matrix((np.ones(int(ok.sum())), (a[ok], b[ok])),
                        shape=(len(lows), len(lows)))
     _, labels = csgraph.connected_components(graph, directed=False)
     if labels[0] == labels[1]:
@@ -271,12 +308,13 @@ def _shortcut(path: list, nodes: dict, obstacles: np.ndarray, space) -> list:
     """Greedy shortening: from each box, the farthest later box it can move to directly."""
     out = [path[0]]
     k = 0
+    # the boxes' corners along the path, one column per dimension
+    path_lows = list(np.array([nodes[q][0] for q in path]).T)
+    path_highs = list(np.array([nodes[q][1] for q in path]).T)
     while k < len(path) - 1:
-        lo0, hi0 = nodes[path[k]]
-        later = path[k + 1:]
-        lows = np.array([np.minimum(lo0, nodes[q][0]) for q in later])
-        highs = np.array([np.maximum(hi0, nodes[q][1]) for q in later])
-        ok = _free(lows, highs, obstacles, space)
+        lows = [np.minimum(c[k], c[k + 1:]) for c in path_lows]
+        highs = [np.maximum(c[k], c[k + 1:]) for c in path_highs]
+        ok = _free_columns(lows, highs, obstacles, space, VIA_MARGIN)
         ok[0] = True   # the path's own edge
         k = k + 1 + int(np.flatnonzero(ok)[-1])
         out.append(path[k])

@@ -142,7 +142,7 @@ def candidates(design: TubeDesign, spec: Spec, j: int, delta_b: float) -> list[C
         return []
     t1, t2 = (progress_time(design, s) for s in interval)
     mid = np.array([0.5 * (t1 + t2)])
-    rho_l, rho_u, _, _ = reference.reach_tube(design, mid)
+    rho_l, rho_u, _, _ = reference.reach_tube(design, mid, rates=False)
     result = []
     for i in range(design.dimension):
         lo_x, hi_x = spec.state_space.lower[i], spec.state_space.upper[i]

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import functools
 import math
 
 import numpy as np
@@ -148,26 +149,35 @@ def segment_progress(segment: ReachSegment, t) -> tuple[Array, Array]:
     p, p_dot : ndarray, shape (N,)
         Dimensionless and 1/s.
     """
-    t = _time(t)
-    start, end = segment.start, segment.end
-    active = (t >= start) & (t < end)
-    if segment.profile == TANH:
+    return _progress(segment.profile, _time(t), segment.start, segment.end)
+
+
+def _progress(profile: str, t: Array, start, end, rate: bool = True) -> tuple[Array, Array]:
+    """:func:`segment_progress` of segments of one ``profile``: ``start`` and ``end`` are
+    floats or arrays shaped like ``t`` (each point's own segment); the same operations on
+    every element either way. Without ``rate``, ``p_dot`` is ``None``."""
+    if profile == TANH:
+        active = (t >= start) & (t < end)
         gap = np.where(active, end - t, 1.0)
         arg = np.where(active, (t - start) / gap, 0.0)
         p = np.where(t >= end, 1.0, np.where(active, tanh(arg), 0.0))
+        if not rate:
+            return p, None
         # sech^2(a) = 4 exp(-2a) / (1 + exp(-2a))^2 for a >= 0, written without cancellation.
         q = exp(-2.0 * np.abs(arg))
         sech2 = 4.0 * q / (1.0 + q) ** 2
         p_dot = np.where(active, sech2 * (end - start) / gap**2, 0.0)
         return p, p_dot
     duration = end - start
-    tau = np.clip((t - start) / duration, 0.0, 1.0)
-    if segment.profile == SMOOTHSTEP:
+    tau = np.minimum(np.maximum((t - start) / duration, 0.0), 1.0)     # clip to [0, 1]
+    if profile == SMOOTHSTEP:
         p = tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+        if not rate:
+            return p, None
         p_dot = 30.0 * tau**2 * (1.0 - tau) ** 2 / duration
         return p, p_dot
-    if segment.profile != CRUISE:
-        raise ValueError(f"unknown reach segment profile {segment.profile!r}")
+    if profile != CRUISE:
+        raise ValueError(f"unknown reach segment profile {profile!r}")
     a = CRUISE_RAMP
     v = 1.0 / (1.0 - a)
     rising, falling = tau < a, tau > 1.0 - a
@@ -175,12 +185,29 @@ def segment_progress(segment: ReachSegment, t) -> tuple[Array, Array]:
     # integral of v s over a ramp's first x: v a (x^3 - x^4 / 2)
     covered = v * a * x**3 * (1.0 - 0.5 * x)
     p = np.where(rising, covered, np.where(falling, 1.0 - covered, v * (tau - 0.5 * a)))
+    if not rate:
+        return p, None
     p_dot = v * x**2 * (3.0 - 2.0 * x) / duration
     # outside the segment tau is clamped to 0 or 1, where x = 0: the rate is 0 there
     return p, p_dot
 
 
-def reach_tube(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
+@functools.lru_cache(maxsize=64)
+def _segment_table(segments: tuple[ReachSegment, ...]) -> tuple:
+    """Per-segment arrays of :func:`reach_tube`: ends, starts (S,), and the bounds' start
+    values and moves ``to - from`` (S, n) each, lower then upper; built once per tube."""
+    starts = np.array([seg.start for seg in segments])
+    ends = np.array([seg.end for seg in segments])
+    lower_from = np.array([seg.lower_from for seg in segments], dtype=float)
+    upper_from = np.array([seg.upper_from for seg in segments], dtype=float)
+    lower_move = np.array([seg.lower_to for seg in segments], dtype=float) - lower_from
+    upper_move = np.array([seg.upper_to for seg in segments], dtype=float) - upper_from
+    for array in (starts, ends, lower_from, upper_from, lower_move, upper_move):
+        array.setflags(write=False)
+    return starts, ends, lower_from, upper_from, lower_move, upper_move
+
+
+def reach_tube(design: TubeDesign, t, rates: bool = True) -> tuple[Array, Array, Array, Array]:
     """Reachability tube ``rho_L``, ``rho_U`` (eq. (4), piecewise) and their time derivatives.
 
     On segment ``k`` (the first whose ``end`` is after ``t``; the last one after every
@@ -190,6 +217,8 @@ def reach_tube(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
     ----------
     design : TubeDesign
     t : array_like, shape (N,)
+    rates : bool
+        Also the derivatives (else ``None`` in their place).
 
     Returns
     -------
@@ -198,21 +227,34 @@ def reach_tube(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
     """
     t = _time(t)
     segments = design.segments
-    ends = np.array([seg.end for seg in segments])
+    starts, ends, lower_from, upper_from, lower_move, upper_move = _segment_table(segments)
+    if len(segments) == 1:
+        s, s_dot = _progress(segments[0].profile, t, segments[0].start, segments[0].end,
+                             rates)
+        values = (lower_move[0] * s[:, None] + lower_from[0],
+                  upper_move[0] * s[:, None] + upper_from[0])
+        if not rates:
+            return values[0], values[1], None, None
+        return (*values, lower_move[0] * s_dot[:, None], upper_move[0] * s_dot[:, None])
     which = np.minimum(np.searchsorted(ends, t, side="right"), len(segments) - 1)
-    n = design.dimension
-    out = [np.zeros((t.size, n)) for _ in range(4)]
-    for k, seg in enumerate(segments):
-        here = which == k
-        if not here.any():
-            continue
-        s, s_dot = segment_progress(seg, t[here])
-        for pair, (a, b) in enumerate(((seg.lower_from, seg.lower_to),
-                                       (seg.upper_from, seg.upper_to))):
-            a, b = np.array(a), np.array(b)
-            out[pair][here] = (b - a) * s[:, None] + a
-            out[pair + 2][here] = (b - a) * s_dot[:, None]
-    return out[0], out[1], out[2], out[3]
+    profiles = {seg.profile for seg in segments}
+    if len(profiles) == 1:
+        # every point with its own segment's start and end: one evaluation for all
+        s, s_dot = _progress(segments[0].profile, t, starts[which], ends[which], rates)
+    else:
+        s, s_dot = np.zeros(t.size), np.zeros(t.size)
+        for profile in sorted(profiles):
+            here = np.isin(which, [k for k, seg in enumerate(segments)
+                                   if seg.profile == profile])
+            s[here], s_dot[here] = _progress(profile, t[here], starts[which[here]],
+                                             ends[which[here]])
+    s = s[:, None]
+    lower_move, upper_move = lower_move[which], upper_move[which]
+    values = (lower_move * s + lower_from[which], upper_move * s + upper_from[which])
+    if not rates:
+        return values[0], values[1], None, None
+    s_dot = s_dot[:, None]
+    return (*values, lower_move * s_dot, upper_move * s_dot)
 
 
 def bump(t, center: float, radius: float, sharpness: float) -> tuple[Array, Array]:
@@ -295,7 +337,7 @@ def smooth_max_pair(a: Array, b: Array, nu: float) -> Array:
     return np.maximum(a, b) + log1p(exp(-nu * np.abs(a - b))) / nu
 
 
-def open_bump_sum(heights: Array, nu: float) -> tuple[Array, Array]:
+def open_bump_sum(heights: Array, nu: float, weights: bool = True) -> tuple[Array, Array]:
     """``F_nu(y) = (1/nu) ln(1 + sum_j (exp(nu y_j) - 1))``, the combination of eq. (9).
 
     Evaluated without overflow as
@@ -310,6 +352,8 @@ def open_bump_sum(heights: Array, nu: float) -> tuple[Array, Array]:
         ``y_j = B^j b^j(t) >= 0``, state units, ``m >= 1``.
     nu : float
         ``nu``, 1/state units.
+    weights : bool
+        Also the weights (else ``None`` in their place).
 
     Returns
     -------
@@ -327,11 +371,13 @@ def open_bump_sum(heights: Array, nu: float) -> tuple[Array, Array]:
         for j in range(y.shape[-1]):
             total = total + (exp(nu * (y[..., j] - top)) - floor)
         value = top + log(total) / nu
+    if not weights:
+        return value, None
     return value, exp(nu * (y - value[..., None]))
 
 
 def circumvent_from_bumps(design: TubeDesign, bumps: list,
-                          count: int) -> tuple[Array, Array, list]:
+                          count: int, weights: bool = True) -> tuple[Array, Array, list]:
     """Eq. (9) from given bump values: ``beta_L``, ``beta_U`` and each circumvent's weight.
 
     ``beta_L_i = X_i + F_nu(y)`` and ``beta_U_i = X-bar_i - F_nu(y)`` with
@@ -345,6 +391,8 @@ def circumvent_from_bumps(design: TubeDesign, bumps: list,
         The bump value of each of ``design.circumvents``, in that order.
     count : int
         ``N``.
+    weights : bool
+        Also the weights (else a list of ``None``).
 
     Returns
     -------
@@ -352,7 +400,7 @@ def circumvent_from_bumps(design: TubeDesign, bumps: list,
     weights : list of ndarray, shape (N,) each
         ``|d beta / d (B^j b^j)|``, aligned with ``design.circumvents``.
     """
-    weights: list = [None] * len(design.circumvents)
+    out_weights: list = [None] * len(design.circumvents)
     out = []
     for side, bounds, sign in ((LOWER, design.state_lower, 1.0),
                                ("upper", design.state_upper, -1.0)):
@@ -366,15 +414,15 @@ def circumvent_from_bumps(design: TubeDesign, bumps: list,
             c = design.circumvents
             y = np.stack([c[j].height * np.asarray(bumps[j], dtype=float)
                           for j in members], axis=-1)
-            f, w = open_bump_sum(y, design.smoothness)
+            f, w = open_bump_sum(y, design.smoothness, weights)
             value[:, i] = bounds[i] + sign * f
             for k, j in enumerate(members):
-                weights[j] = w[..., k]
+                out_weights[j] = None if w is None else w[..., k]
         out.append(value)
-    return out[0], out[1], weights
+    return out[0], out[1], out_weights
 
 
-def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
+def circumvent(design: TubeDesign, t, rates: bool = True) -> tuple[Array, Array, Array, Array]:
     """Holistic circumvent function ``beta_L``, ``beta_U`` of eq. (9) and derivatives.
 
     Bumps on the same bound are combined by :func:`open_bump_sum`; a bound with no bump
@@ -386,6 +434,8 @@ def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
         The tube (its circumvents and state-space bounds).
     t : float or array_like, shape (N,)
         Times, s.
+    rates : bool
+        Also the derivatives (else ``None`` in their place).
 
     Returns
     -------
@@ -394,7 +444,10 @@ def circumvent(design: TubeDesign, t) -> tuple[Array, Array, Array, Array]:
     t = _time(t)
     n = design.dimension
     pairs = [bump(t, c.center, c.radius, c.sharpness) for c in design.circumvents]
-    beta_l, beta_u, weights = circumvent_from_bumps(design, [b for b, _ in pairs], t.size)
+    beta_l, beta_u, weights = circumvent_from_bumps(design, [b for b, _ in pairs], t.size,
+                                                    rates)
+    if not rates:
+        return beta_l, beta_u, None, None
     rate_l, rate_u = np.zeros((t.size, n)), np.zeros((t.size, n))
     for c, (_, b_dot), w in zip(design.circumvents, pairs, weights):
         if c.side == LOWER:
@@ -419,8 +472,8 @@ def conflict_distance(design: TubeDesign, t) -> Array:
     ndarray, shape (N, 2n)
         ``psi``, state units; positive where the reach tube and the circumvent do not conflict.
     """
-    rho_l, rho_u, _, _ = reach_tube(design, t)
-    beta_l, beta_u, _, _ = circumvent(design, t)
+    rho_l, rho_u, _, _ = reach_tube(design, t, rates=False)
+    beta_l, beta_u, _, _ = circumvent(design, t, rates=False)
     return np.concatenate([beta_u - rho_l, rho_u - beta_l], axis=1)
 
 
@@ -465,7 +518,11 @@ def adaptive_law(design: TubeDesign, t, alpha) -> tuple[Array, Array]:
     """
     t = _time(t)
     psi = conflict_distance(design, t)
-    alpha = _rows(alpha, t.size, psi.shape[1])
+    return _alpha_rate(design, psi, _rows(alpha, t.size, psi.shape[1]))
+
+
+def _alpha_rate(design: TubeDesign, psi: Array, alpha: Array) -> tuple[Array, Array]:
+    """:func:`adaptive_law` at given ``psi`` (N, 2n) and ``alpha`` (N, 2n)."""
     theta = trigger(design, psi)
     z = psi + alpha
     return theta / z**2 - design.kappa * alpha, -2.0 * theta / z**3 - design.kappa
@@ -494,7 +551,9 @@ def adaptive_tube(design: TubeDesign, t, alpha) -> tuple[Array, Array, Array, Ar
     rho_l, rho_u, rho_l_dot, rho_u_dot = reach_tube(design, t)
     beta_l, beta_u, beta_l_dot, beta_u_dot = circumvent(design, t)
     alpha = _rows(alpha, t.size, 2 * n)
-    alpha_dot, _ = adaptive_law(design, t, alpha)
+    # adaptive_law with the psi of the pieces at hand (conflict_distance's operations)
+    psi = np.concatenate([beta_u - rho_l, rho_u - beta_l], axis=1)
+    alpha_dot, _ = _alpha_rate(design, psi, alpha)
     nu = design.smoothness
     gamma_l, w_l = smooth_max(np.stack([rho_l - alpha[:, :n], beta_l], -1), nu)
     neg_u, w_u = smooth_max(np.stack([-(rho_u + alpha[:, n:]), -beta_u], -1), nu)

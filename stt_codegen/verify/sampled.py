@@ -30,8 +30,9 @@ import numpy as np
 from ..design.certificate import Certificate, certify_tube, enclose_tube
 from ..design.gain import derived_gain, gain_derivation
 from ..design.samples import TubeSamples, sample_tube
-from ..spec.assumptions import Assumptions
+from ..spec.assumptions import G_KEYS, Assumptions, combine_assumptions
 from ..spec.loader import Spec
+from ..spec.model_bounds import model_bounds
 from ..spec.plants import PLANTS
 from ..tube import reference
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
@@ -502,6 +503,17 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
             detail += (f"; and the failure is not the check's caution: a plant of the class "
                        f"leaves the tube ({how}): |e_{found.dimension}| = {found.depth:.3g} "
                        f"at t = {found.time:.4f} s ({found.strategy}; verify/class_search.py)")
+        elif a.input_gain_lipschitz is not None or a.drift_lipschitz is not None:
+            detail += ("; the check's argument holds for every plant within the bounds, "
+                       "also one whose g and f jump between samples: it does not use "
+                       "input_gain_lipschitz or drift_lipschitz, so for the plants they "
+                       "declare this failure may be the check's caution (docs/"
+                       "sampled-data.md, \"Lipschitz bounds and the check\")")
+        if _model_passes(design, spec):
+            keys = ", ".join(k for k in G_KEYS if k in a.declared)
+            detail += (f"; the {a.model} model's own g, its bounds evaluated on the tube per "
+                       f"sampling interval, passes at {design.rate_hz:g} Hz: if the plant is "
+                       f"that model, drop the declared {keys}")
     if a.notes:
         detail += "; " + "; ".join(a.notes) + " (the declared bounds are used; they cover the model)"
     data = {**result.data, "level": result.level, "margin": result.margin,
@@ -510,6 +522,22 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
         data["class_counterexample"] = None if found is None else found.to_json()
     checks.append(Check("sampled.tube_kept", result.passed, detail, data))
     return checks
+
+
+def _model_passes(design: TubeDesign, spec: Spec) -> bool:
+    """Whether the check passes for the spec's plant model with its own bounds of ``g``
+    (evaluated on the tube per interval) where the spec declares wider ones; ``False``
+    when the spec declares none or its model has no ``g`` that varies on the tube."""
+    a = spec.assumptions
+    if a.g_from_model or a.model not in PLANTS or not PLANTS[a.model].gain_varies:
+        return False
+    kept = {key: getattr(a, key) for key in a.declared
+            if key not in G_KEYS and key != "input_gain_lipschitz"}
+    own = combine_assumptions(model_bounds(a.model, spec.state_space.lower,
+                                           spec.state_space.upper, spec.plant_data(a.model)),
+                              kept, spec.dimension, spec.disturbance_amplitude)
+    samples = sampled_check_of(design, spec)[0]
+    return check_sampled_first_per_axis(design, samples, plant_class(spec, own)).passed
 
 
 def _member_that_leaves(design: TubeDesign, spec: Spec, result: SampledCheck):

@@ -44,6 +44,12 @@ def _bump_peaks(sharpness: float) -> float:
     return math.sqrt(((1.0 - sharpness) + math.sqrt((1.0 - sharpness) ** 2 + 3.0)) / 3.0)
 
 
+def _clip(value, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """``numpy.clip(value, low, high)``, ``min(max(value, low), high)``, without its Python
+    wrapper (which costs more than the two ufuncs on small arrays)."""
+    return np.minimum(np.maximum(value, low), high)
+
+
 def bump_ranges(c, t0: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
     """Range of one bump and of its rate ``b_dot`` on each interval, shape (K,) each.
 
@@ -63,8 +69,8 @@ def bump_ranges(c, t0: np.ndarray, t1: np.ndarray) -> tuple[np.ndarray, ...]:
     low, high, rate_min, rate_max : ndarray, shape (K,)
     """
     z = _bump_peaks(c.sharpness)
-    points = [t0, t1, np.clip(c.center, t0, t1)] + [
-        np.clip(c.center + sign * c.radius * z, t0, t1) for sign in (-1, 1)]
+    points = [t0, t1, _clip(c.center, t0, t1)] + [
+        _clip(c.center + sign * c.radius * z, t0, t1) for sign in (-1, 1)]
     values, rates = reference.bump(np.concatenate(points), c.center, c.radius, c.sharpness)
     values = values.reshape(len(points), -1)
     rates = rates.reshape(len(points), -1)
@@ -99,9 +105,9 @@ def circumvent_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray,
     if ranges is None:
         ranges = [bump_ranges(c, t0, t1) for c in design.circumvents]
     lower_min, upper_max, _ = reference.circumvent_from_bumps(design, [r[0] for r in ranges],
-                                                              t0.size)
+                                                              t0.size, weights=False)
     lower_max, upper_min, _ = reference.circumvent_from_bumps(design, [r[1] for r in ranges],
-                                                              t0.size)
+                                                              t0.size, weights=False)
     return (lower_min, lower_max), (upper_min, upper_max)
 
 
@@ -160,10 +166,10 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool 
     edges = sorted({s.start for s in design.segments} | {s.end for s in design.segments})
     peaks = [s.start + s.duration * (_W_STAR / (1.0 + _W_STAR) if s.profile == TANH else 0.5)
              for s in design.segments] if rates else []
-    points = [t0, t1] + [np.clip(e, t0, t1) for e in edges]
+    points = [t0, t1] + [_clip(e, t0, t1) for e in edges]
     value_points = len(points)
-    points += [np.clip(p, t0, t1) for p in peaks]
-    rho_l, rho_u, rate_l, rate_u = reference.reach_tube(design, np.concatenate(points))
+    points += [_clip(p, t0, t1) for p in peaks]
+    rho_l, rho_u, rate_l, rate_u = reference.reach_tube(design, np.concatenate(points), rates)
     shape = (len(points), t0.size, design.dimension)
     rho_l, rho_u = rho_l.reshape(shape)[:value_points], rho_u.reshape(shape)[:value_points]
     if not rates:

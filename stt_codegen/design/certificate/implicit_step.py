@@ -20,11 +20,15 @@ import numpy as np
 from ...tube import reference
 from ...tube.parameters import TubeDesign
 
-__all__ = ["EXACT_STEPS", "Propagation", "STEP_ROOT_TOLERANCE", "SequenceBounds",
-           "alpha_fixed_point", "alpha_ranges", "sequence_bounds", "step_root"]
+__all__ = ["EXACT_STEPS", "FIXED_POINT_NEWTON_STEPS", "Propagation", "STEP_ROOT_TOLERANCE",
+           "SequenceBounds", "alpha_fixed_point", "alpha_ranges", "sequence_bounds",
+           "step_root"]
 
 #: Intervals of at most this many steps follow the extreme implicit steps one by one.
 EXACT_STEPS = 4
+#: Plain Newton steps of :func:`alpha_fixed_point` from ``a = 0`` before its bracket is
+#: checked (enough for every element of the bench's arenas; slower ones are searched).
+FIXED_POINT_NEWTON_STEPS = 6
 #: Relative width at which :func:`step_root` stops refining its (rigorous) bracket.
 STEP_ROOT_TOLERANCE = 1e-13
 
@@ -34,15 +38,22 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
     """Bracket ``[lo, hi]`` of ``a*``, the root of ``kappa a = theta / (psi + a)^2`` with ``psi + a > 0``.
 
     ``f(a) = theta / (psi + a)^2 - kappa a`` is decreasing and convex on ``a > -psi``, with
-    slope ``<= -kappa``. Newton starts at ``theta / (kappa psi^2)`` (``psi > 0``; right of
-    the root, so the first step lands left of it) or just right of the pole (``f >= 0``),
-    and from the left rises monotonically to the root. Every iterate ``x`` bounds the root:
-    from below where ``f(x) >= 0``, from above otherwise, and then its Newton point bounds
-    it from below (convexity); a probe right of a left iterate (twice its Newton step and
-    a few ulps) bounds it from above where ``f <= 0`` there. Where a Newton step would
-    leave the bracket (or ``x`` rounds onto the pole) the next point is the bracket's
-    middle. Iterates until the bracket is ``1e-11`` relative (or ``1e-16`` absolute)
-    wide; both ends are widened by ``1e-13`` relative for rounding.
+    slope ``<= -kappa``. Every point ``x`` bounds the root: from below where ``f(x) >= 0``,
+    from above otherwise, and then its Newton point bounds it from below (convexity); a
+    probe right of a left point (twice its Newton step and a few ulps) bounds it from above
+    where ``f <= 0`` there.
+
+    :data:`FIXED_POINT_NEWTON_STEPS` plain Newton steps, each element by itself, start left
+    of the root and from there rise monotonically to it (convexity): for ``psi > 0`` at the
+    largest of ``0``, ``(theta / kappa)^(1/3) - psi`` (``kappa a (psi + a)^2 < kappa (psi +
+    a)^3 <= theta``) and ``min(psi, theta / (4 kappa psi^2))`` (``(psi + a)^2 <= 4 psi^2``),
+    else just right of the pole (``f >= 0`` at ``pole + eps``, below). The last point's
+    bracket is kept where it is ``1e-11`` relative (or ``1e-16`` absolute) wide. The other
+    elements (none on the bench's arenas) take the bracketed search: Newton from
+    ``theta / (kappa psi^2)`` (``psi > 0``; right of the root, so the first step lands left
+    of it) or from ``pole + eps``, bisection where a Newton step would leave the bracket (or
+    ``x`` rounds onto the pole), until the bracket is as narrow. Both ends are widened by
+    ``1e-13`` relative for rounding.
 
     Parameters
     ----------
@@ -57,17 +68,60 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
         ``0`` where ``theta = 0``.
     """
     pole = np.maximum(0.0, -psi)
+    if not pole.size:
+        return pole, pole.copy()
     with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
-        # right of the pole, f >= 0 at pole + eps: theta/eps^2 >= kappa (eps + max(-psi, 0))
-        eps = np.minimum(np.cbrt(theta / (2.0 * kappa)),
-                         np.sqrt(theta / (2.0 * kappa * np.maximum(-psi, 1e-300))))
-        lo, hi = pole, pole + np.cbrt(theta / kappa)
+        x = np.where(psi > 0.0,
+                     np.maximum(np.maximum(0.0, np.cbrt(theta / kappa) - psi),
+                                np.minimum(psi, theta / (4.0 * kappa * psi * psi))),
+                     pole + _pole_offset(psi, theta, kappa))
+        minus_two_theta = -2.0 * theta  # f' = -2 theta / z^3 - kappa
+        for _ in range(FIXED_POINT_NEWTON_STEPS):
+            z = psi + x
+            zz = z * z
+            x = x - (theta / zz - kappa * x) / (minus_two_theta / (zz * z) - kappa)
+        z = psi + x
+        zz = z * z
+        f = theta / zz - kappa * x
+        newton = x - f / (minus_two_theta / (zz * z) - kappa)
+        left = f >= 0.0
+        probe = x + 2.0 * (newton - x) + 4.0 * np.spacing(x)
+        z_probe = psi + probe
+        above = (z_probe > 0.0) & (theta / (z_probe * z_probe) - kappa * probe <= 0.0)
+        lo, hi = np.where(left, x, newton), np.where(left, probe, x)
+        # kept: x off the pole, a finite Newton point, an upper bound found right of a left
+        # point, and narrow
+        kept = (z > 0.0) & np.isfinite(newton) & (above | ~left) & (hi - lo <= 1e-11 * hi + 1e-16)
+    if not kept.all():
+        rest = ~kept
+        lo[rest], hi[rest] = _bracketed_search(psi[rest], theta[rest], kappa, pole[rest])
+    done = theta > 0.0
+    return (np.where(done, np.maximum(pole, lo * (1.0 - 1e-13)), 0.0),
+            np.where(done, hi * (1.0 + 1e-13) + 1e-300, 0.0))
+
+
+def _pole_offset(psi: np.ndarray, theta: np.ndarray, kappa: float) -> np.ndarray:
+    """``eps`` with ``f >= 0`` at ``max(0, -psi) + eps``, right of the pole:
+    ``theta / eps^2 >= kappa (eps + max(-psi, 0))``."""
+    return np.minimum(np.cbrt(theta / (2.0 * kappa)),
+                      np.sqrt(theta / (2.0 * kappa * np.maximum(-psi, 1e-300))))
+
+
+def _bracketed_search(psi: np.ndarray, theta: np.ndarray, kappa: float,
+                      pole: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The bracketed search of :func:`alpha_fixed_point` (``pole = max(0, -psi)``): the
+    bracket before its widening for rounding."""
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        lo, hi = pole.copy(), pole + np.cbrt(theta / kappa)
         # psi > 0: theta / (kappa psi^2), right of the root and close to it when a* << psi
-        x = np.where(psi > 0.0, np.minimum(theta / (kappa * psi * psi), hi), pole + eps)
+        x = np.where(psi > 0.0, np.minimum(theta / (kappa * psi * psi), hi),
+                     pole + _pole_offset(psi, theta, kappa))
+        minus_two_theta = -2.0 * theta  # f' = -2 theta / z^3 - kappa
         for _ in range(100):
             z = psi + x
-            f = theta / (z * z) - kappa * x
-            newton = x - f / (-2.0 * theta / (z * z * z) - kappa)
+            zz = z * z
+            f = theta / zz - kappa * x
+            newton = x - f / (minus_two_theta / (zz * z) - kappa)
             usable = (z > 0.0) & np.isfinite(newton)        # else: x rounds onto the pole
             left = f >= 0.0                                  # x left of the root
             # right of a left iterate by twice its Newton step and a few ulps: an upper
@@ -75,17 +129,16 @@ def alpha_fixed_point(psi: np.ndarray, theta: np.ndarray, kappa: float) -> tuple
             probe = x + 2.0 * (newton - x) + 4.0 * np.spacing(x)
             z_probe = psi + probe
             above = (z_probe > 0.0) & (theta / (z_probe * z_probe) - kappa * probe <= 0.0)
-            lo = np.where(usable, np.maximum(lo, np.where(left, x, newton)), lo)
-            hi = np.where(usable, np.minimum(hi, np.where(left, np.where(above, probe, hi), x)),
-                          hi)
-            if np.all(hi - lo <= 1e-11 * hi + 1e-16):
+            # the bracket moves only where the iterate is usable (in place)
+            new_hi = np.where(left, np.where(above, probe, hi), x)
+            np.maximum(lo, np.where(left, x, newton), out=lo, where=usable)
+            np.minimum(hi, new_hi, out=hi, where=usable)
+            if (hi - lo <= 1e-11 * hi + 1e-16).all():
                 break
             # Newton, or bisection where Newton is not usable or leaves the bracket
             inside = usable & (newton >= lo) & (newton <= hi)
             x = np.where(inside, newton, 0.5 * (lo + hi))
-    done = theta > 0.0
-    return (np.where(done, np.maximum(pole, lo * (1.0 - 1e-13)), 0.0),
-            np.where(done, hi * (1.0 + 1e-13) + 1e-300, 0.0))
+    return lo, hi
 
 
 def _fixed_points(psi_lo: np.ndarray, psi_hi: np.ndarray, theta_lo: np.ndarray,
@@ -330,13 +383,23 @@ class SequenceBounds:
         with np.errstate(over="ignore", under="ignore", invalid="ignore"):
             rise = s_lo - (s_lo - a_lo) * np.power(self.q_lo[rows], j0)
             fall = np.maximum(s_lo, a_lo + j1 * self.dt * self.rate_lo[rows])
-            lo = np.where(a_lo <= s_lo, np.maximum(a_lo, np.nan_to_num(rise, nan=-np.inf)),
-                          np.nan_to_num(fall, nan=-np.inf))
+            lo = np.where(a_lo <= s_lo, np.maximum(a_lo, _nan_to(rise, -np.inf)),
+                          _nan_to(fall, -np.inf))
             drop = s_hi + (a_hi - s_hi) * np.power(self.q_hi[rows], j0)
             climb = np.minimum(s_hi, a_hi + j1 * self.dt * self.rate_hi[rows])
-            hi = np.where(a_hi >= s_hi, np.nan_to_num(drop, nan=np.inf),
-                          np.nan_to_num(climb, nan=np.inf))
+            hi = np.where(a_hi >= s_hi, _nan_to(drop, np.inf), _nan_to(climb, np.inf))
         return np.maximum(lo, 0.0), hi
+
+
+#: The largest finite float: :func:`numpy.nan_to_num` maps ``-+inf`` to ``-+`` it.
+_LARGEST = float(np.finfo(float).max)
+
+
+def _nan_to(values: np.ndarray, nan: float) -> np.ndarray:
+    """``numpy.nan_to_num(values, nan=nan)`` in four ufunc calls (its Python wrapper costs
+    more than they do on small arrays): NaN to ``nan``, ``-+inf`` to the largest finite
+    floats."""
+    return np.where(np.isnan(values), nan, np.minimum(np.maximum(values, -_LARGEST), _LARGEST))
 
 
 def sequence_bounds(design: TubeDesign, psi_lo: np.ndarray, psi_hi: np.ndarray,

@@ -122,7 +122,9 @@ def _piece_alpha(rows: np.ndarray, f0: np.ndarray, f1: np.ndarray, steps: np.nda
         j0 = np.floor(f0[many] * n_steps[many] * (1.0 + 1e-12))
         j1 = np.minimum(np.ceil(f1[many] * n_steps[many] * (1.0 - 1e-12)), n_steps[many])
         lo[many], hi[many] = inside.within(slot[rows[many]], np.minimum(j0, j1), j1)
-    return np.clip(lo, a_min, a_max), np.clip(hi, a_min, a_max)
+    # within the interval's range: min(max(., a_min), a_max), numpy.clip's order
+    return (np.minimum(np.maximum(lo, a_min), a_max),
+            np.minimum(np.maximum(hi, a_min), a_max))
 
 
 def sharpen_narrowest(design: TubeDesign, enc: Enclosure, steps: np.ndarray,

@@ -23,7 +23,7 @@ from .narrowest import sharpen_narrowest
 from .repropagate import repropagate, step_psi
 from .tasks import task_margins
 from .report import (MAX_MOVE_PER_SAMPLE, ROUNDING_MARGIN, Certificate, CertificateState, Enclosure,
-                     certificate_report, obstacle_separation, point_tube)
+                     certificate_report, point_tube)
 
 __all__ = ["MAX_INTERVALS", "MIN_INTERVAL", "SPLIT", "WIDTH_REFINE_ROUNDS", "certify_tube"]
 
@@ -65,13 +65,24 @@ def _breakpoints(design: TubeDesign) -> tuple[list[int], int]:
     return sorted(p for p in points if 0 <= p <= end), end
 
 
-def _failing(design: TubeDesign, spec: Spec, enc: Enclosure, selected, final: bool):
-    """Boolean (K,) mask of intervals on which some property is not yet proven."""
+def _box_arrays(spec: Spec) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The corners of ``spec.obstacle_boxes()`` as arrays, once per certificate."""
+    return [(np.array(box.lower), np.array(box.upper)) for box in spec.obstacle_boxes()]
+
+
+def _failing(design: TubeDesign, spec: Spec, enc: Enclosure, selected, final: bool,
+             boxes: list):
+    """Boolean (K,) mask of intervals on which some property is not yet proven
+    (``boxes``: :func:`_box_arrays`)."""
     bad = enc.width_min.min(axis=1) <= ROUNDING_MARGIN
     lo, hi = np.array(design.state_lower), np.array(design.state_upper)
     bad |= np.minimum(enc.lower_min - lo, hi - enc.upper_max).min(axis=1) < 0.0
-    for _, sep, _, _, _ in obstacle_separation(spec, enc, selected):
-        bad |= sep <= ROUNDING_MARGIN
+    # a spec obstacle's separation (report.obstacle_separation) is its member boxes' least:
+    # it is thin where one member's is
+    for b in selected:
+        box_lo, box_hi = boxes[b]
+        gap = np.maximum(box_lo - enc.upper_max, enc.lower_min - box_hi).max(axis=1)
+        bad |= gap <= ROUNDING_MARGIN
     if final:
         late = enc.t_end > design.prescribed_time
         t_lo, t_hi = np.array(spec.target_set.lower), np.array(spec.target_set.upper)
@@ -119,7 +130,8 @@ def certify_tube(design: TubeDesign, spec: Spec, obstacles: list[int] | None = N
 
 def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
              max_intervals: int, resume) -> Certificate:
-    selected = list(range(len(spec.obstacle_boxes()))) if obstacles is None else obstacles
+    boxes = _box_arrays(spec)
+    selected = list(range(len(boxes))) if obstacles is None else obstacles
     points, end = _breakpoints(design)
     dt = 1.0 / design.rate_hz
     min_steps = max(1, int(MIN_INTERVAL * design.rate_hz))
@@ -142,7 +154,7 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
             previous = parent.state
             reuse_limit = cut - 1
     while True:
-        part = partition(design, points)      # i1 = -1: the tail [T, inf)
+        part = _partition(design, points)     # i1 = -1: the tail [T, inf)
         i0, i1, t0, t1, steps, pieces = (part.i0, part.i1, part.t0, part.t1, part.steps,
                                          part.pieces)
         if proven is not None:
@@ -167,7 +179,7 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
         reuse_limit = len(previous.entries)   # from now on `previous` is this tube's own
         a_min, a_max = np.maximum(np.array(rows_lo), 0.0), np.array(rows_hi)
         enc = enclose(design, pieces, a_min, a_max, t0, t1)
-        bad = _failing(design, spec, enc, selected, final)
+        bad = _failing(design, spec, enc, selected, final, boxes)
         length = np.where(i1 < 0, 0, i1 - i0)
         splittable = length >= max(2, 2 * min_steps)
         if final and not bad.any():
@@ -200,7 +212,8 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
         failed = np.flatnonzero(single)
         if failed.size and np.any((failed == 0) | (length[np.maximum(failed - 1, 0)] <= 1)):
             break
-        decisive = _surely_failing(design, spec, t0[bad], a_min[bad], a_max[bad], selected)
+        decisive = _surely_failing(design, spec, t0[bad], a_min[bad], a_max[bad], selected,
+                                   boxes)
         if decisive:
             break             # the tube itself fails at an instant: no refinement helps
         if not split.any():
@@ -219,6 +232,24 @@ def _certify(design: TubeDesign, spec: Spec, obstacles, final: bool,
         certificate = replace(certificate, margins=certificate.margins
                               + task_margins(design, spec, enc))
     return replace(certificate, state=previous, decisive=decisive, work=work)
+
+
+#: The last partition computed (by any certificate), with the tube and points it is of:
+#: the design search certifies a complete tube right after the partial check of the same
+#: tube (:func:`~stt_codegen.design.search.paper_design`), whose first partition is the
+#: partial check's last one.
+_LAST_PARTITION: list = [None]
+
+
+def _partition(design: TubeDesign, points: list[int]):
+    """:func:`~.enclosures.partition`, or the last one computed when of the same tube and
+    points (its arrays are only read)."""
+    last = _LAST_PARTITION[0]
+    if last is not None and last[1] == points and last[0] == design:
+        return last[2]
+    part = partition(design, points)
+    _LAST_PARTITION[0] = (design, list(points), part)
+    return part
 
 
 def _cut(points: list[int], i0: np.ndarray, length: np.ndarray, split: np.ndarray) -> list[int]:
@@ -245,21 +276,20 @@ def _alpha_refinement(limited: np.ndarray, splittable: np.ndarray) -> np.ndarray
 
 
 def _surely_failing(design: TubeDesign, spec: Spec, t: np.ndarray, a_min: np.ndarray,
-                    a_max: np.ndarray, selected) -> str:
+                    a_max: np.ndarray, selected, boxes: list) -> str:
     """The property the tube certainly fails at one of the instants ``t`` ("" if none).
 
     With ``alpha`` in ``[a_min, a_max]``, the tube box at ``t`` contains the box for
     ``a_min`` (``gamma_L`` falls and ``gamma_U`` rises with ``alpha``) and is at most as
-    wide as the box for ``a_max``.
+    wide as the box for ``a_max``. ``boxes``: :func:`_box_arrays`.
     """
     if not t.size:
         return ""
     both_l, both_u = point_tube(design, np.concatenate([t, t]), np.concatenate([a_min, a_max]))
     g_l, w_l = both_l[:t.size], both_l[t.size:]
     g_u, w_u = both_u[:t.size], both_u[t.size:]
-    boxes = spec.obstacle_boxes()
     for b in selected:
-        lo, hi = np.array(boxes[b].lower), np.array(boxes[b].upper)
+        lo, hi = boxes[b]
         if np.any(np.all((g_l < hi) & (g_u > lo), axis=1)):
             return f"avoids obstacle {spec.obstacles[b].source}"
     if np.any(np.max(w_l - w_u, axis=1) > 0.0):

@@ -251,8 +251,8 @@ def point_tube(design: TubeDesign, t: np.ndarray, alpha: np.ndarray) -> tuple[np
         State units.
     """
     n = design.dimension
-    rho_l, rho_u, _, _ = reference.reach_tube(design, t)
-    beta_l, beta_u, _, _ = reference.circumvent(design, t)
+    rho_l, rho_u, _, _ = reference.reach_tube(design, t, rates=False)
+    beta_l, beta_u, _, _ = reference.circumvent(design, t, rates=False)
     nu = design.smoothness
     gamma_l = reference.smooth_max_pair(rho_l - alpha[:, :n], beta_l, nu)
     return gamma_l, -reference.smooth_max_pair(-(rho_u + alpha[:, n:]), -beta_u, nu)
