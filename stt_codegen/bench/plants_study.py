@@ -449,7 +449,19 @@ COLUMNS = ("plants", "hold", "broken: switching", "broken: Lipschitz",
 def table(rows: list[dict]) -> list[list[int]]:
     """:data:`COLUMNS` counted over all ``rows`` (first line) and per case; the classes
     broken and accepted are counted among the plants that hold ("accepted but broken":
-    :func:`unsound`, over all plants)."""
+    :func:`unsound`, over all plants).
+
+    Parameters
+    ----------
+    rows : list of dict
+        The study's rows (:func:`study_one`, with or without the adversaries).
+
+    Returns
+    -------
+    list of list of int
+        One line per group (all, then each case of :data:`CASES`), one count per column of
+        :data:`COLUMNS`.
+    """
     lines = []
     for case in (None,) + CASES:
         sub = [r for r in rows if case is None or r["case"] == case]
@@ -469,7 +481,19 @@ def table(rows: list[dict]) -> list[list[int]]:
 
 def summary(rows: list[dict]) -> str:
     """The study's figures: a Markdown table (:data:`COLUMNS`, all and per case) when the
-    rows have the adversaries, else the plants that hold and the check's verdicts."""
+    rows have the adversaries, else the plants that hold and the check's verdicts.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The study's rows (:func:`study_one`).
+
+    Returns
+    -------
+    str
+        The text printed by the command line, one line per group and, with the
+        adversaries, how many of their members the generated C controller confirmed.
+    """
     names = ("all",) + tuple(f"`{c}`" for c in CASES)
     if rows and all(k in r for r in rows if r["held"] for k in ADVERSARIES):
         lines = ["| | " + " | ".join(COLUMNS) + " |", "|---" * (len(COLUMNS) + 1) + "|"]
