@@ -3,14 +3,17 @@
 The status codes' table in docs/embedded.md is written from :class:`stt_codegen.tube.parameters.Status`
 (its docstring's ``Attributes`` section) between two markers; ``python tests/test_docs_tables.py``
 rewrites it after a change of the enum. The glossary of docs/architecture.md is written by
-hand, and every code name in it must exist in the code.
+hand, and every code name in it must exist in the code. docs/cli.md names every command and
+option of ``stt-codegen``, and nothing else.
 """
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import importlib
 import inspect
+import itertools
 import re
 import sys
 from pathlib import Path
@@ -93,6 +96,76 @@ def test_other_pages_link_to_the_status_codes():
     found = [f"{p.name}: {m.group(0)}" for p in sorted((REPO / "docs").glob("*.md"))
              if p != EMBEDDED for m in listing.finditer(p.read_text())]
     assert found == []
+
+
+def command_options(parser: argparse.ArgumentParser | None = None,
+                    path: str = "") -> dict[str, list[tuple[str, ...]]]:
+    """``{command path: the option strings of each of its options}`` of ``stt-codegen``
+    (``"design"``, ``"bench arenas"``, ``"import pointmaze"``; ``-h`` left out)."""
+    from stt_codegen.cli import COMMANDS, build_parser
+
+    if parser is None:
+        found: dict[str, list[tuple[str, ...]]] = {}
+        for name in COMMANDS:
+            found.update(command_options(build_parser([name]).get_default("command_parser"), name))
+        return found
+    found = {path: [tuple(a.option_strings) for a in parser._actions
+                    if a.option_strings and a.dest != "help"]}
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for name, sub in action.choices.items():
+                found.update(command_options(sub, f"{path} {name}"))
+    return found
+
+
+def documented_commands(markdown: str) -> dict[str, set[str]]:
+    """``{command path: the options written}`` of the code spans that start with
+    ``stt-codegen`` (outside fenced blocks); the path is the lower-case words before the
+    first argument or option."""
+    text = re.sub(r"^```.*?^```[ \t]*$", "", markdown, flags=re.S | re.M)
+    found: dict[str, set[str]] = {}
+    for span in re.findall(r"`stt-codegen ([^`]*)`", text):
+        words = span.split()
+        path = " ".join(itertools.takewhile(lambda w: re.fullmatch(r"[a-z][a-z-]*", w), words))
+        options = set(re.findall(r"(?<![\w-])(--?[a-z][\w-]*)", span))
+        found.setdefault(path, set()).update(options)
+    return found
+
+
+def undocumented(markdown: str) -> list[str]:
+    """The commands and options of ``stt-codegen`` that ``markdown`` does not write in a
+    ``stt-codegen ...`` code span, and the options it writes that do not exist."""
+    written = documented_commands(markdown)
+    commands = command_options()
+    problems = [f"{path}: no such command" for path in written if path and path not in commands]
+    for path, options in commands.items():
+        if not any(w == path or w.startswith(path + " ") for w in written):
+            problems.append(f"{path}: not documented")
+            continue
+        known = {flag for strings in options for flag in strings} | {"--help", "--version"}
+        problems += [f"{path} {strings[-1]}: not documented" for strings in options
+                     if not set(strings) & written.get(path, set())]
+        problems += [f"{path} {flag}: no such option"
+                     for flag in sorted(written.get(path, set()) - known)]
+    return problems
+
+
+def test_cli_md_names_every_command_and_option():
+    """Every subcommand (``bench`` and ``import`` ones included) and each of its options is
+    written in docs/cli.md, in a ``stt-codegen ...`` code span, and no other."""
+    assert undocumented((REPO / "docs" / "cli.md").read_text()) == []
+
+
+def test_the_cli_check_sees_what_it_forbids():
+    """A command left out, an option left out and an option that does not exist are each
+    reported."""
+    text = (REPO / "docs" / "cli.md").read_text()
+    text = text.replace("`stt-codegen schema`", "`stt-codegen schema --pretty`")
+    text = text.replace(" [--no-host]", "").replace("`stt-codegen cases`", "cases")
+    problems = undocumented(text)
+    assert "cases: not documented" in problems
+    assert "embedded --no-host: not documented" in problems
+    assert "schema --pretty: no such option" in problems
 
 
 if __name__ == "__main__":
