@@ -98,6 +98,85 @@ def test_other_pages_link_to_the_status_codes():
     assert found == []
 
 
+def glossary_rows(markdown: str) -> list[list[str]]:
+    """The cells of the glossary's rows (docs/architecture.md's section "Glossary"), the
+    header and its rule left out."""
+    section = markdown.split("## Glossary", 1)[1].split("\n## ", 1)[0]
+    rows = [line.strip().strip("|").split("|") for line in section.splitlines()
+            if line.startswith("| ")]
+    return [[cell.strip() for cell in row] for row in rows[1:]]
+
+
+def _has(owner, name: str) -> bool:
+    """Whether ``name`` is an attribute, a dataclass field or a pydantic field of ``owner``."""
+    fields = getattr(owner, "model_fields", None) or {}
+    return (hasattr(owner, name) or name in fields
+            or (dataclasses.is_dataclass(owner)
+                and name in {f.name for f in dataclasses.fields(owner)}))
+
+
+def code_name_exists(dotted: str) -> bool:
+    """Whether ``stt_codegen.<dotted>`` is a module, or a name or field inside one."""
+    parts = dotted.split(".")
+    for cut in range(len(parts), 0, -1):
+        try:
+            owner = importlib.import_module(".".join(["stt_codegen", *parts[:cut]]))
+        except ModuleNotFoundError:
+            continue
+        for name in parts[cut:]:
+            if not _has(owner, name):
+                return False
+            fields = getattr(owner, "model_fields", None) or {}
+            owner = getattr(owner, name, None) if name not in fields else fields[name]
+        return True
+    return False
+
+
+def _tables(annotation) -> list:
+    """The pydantic models an annotation holds (``list[Union[...]]``, ``Annotated``...)."""
+    import typing
+
+    if isinstance(annotation, type) and hasattr(annotation, "model_fields"):
+        return [annotation]
+    return [m for arg in typing.get_args(annotation) for m in _tables(arg)]
+
+
+def spec_key_exists(key: str) -> bool:
+    """Whether a spec key written ``name``, ``[table] name`` or ``[[table]] name`` is a field
+    of :class:`stt_codegen.spec.schema.SpecDocument` (any model of a list of tables)."""
+    from stt_codegen.spec.schema import SpecDocument
+
+    match = re.fullmatch(r"(?:\[\[?(\w+)\]\]? )?(\w+)", key)
+    if not match:
+        return False
+    table, name = match.groups()
+    if table is None:
+        return name in SpecDocument.model_fields
+    if table not in SpecDocument.model_fields:
+        return False
+    return any(name in m.model_fields for m in _tables(SpecDocument.model_fields[table].annotation))
+
+
+def test_every_name_in_the_glossary_exists():
+    """Each code name of docs/architecture.md's glossary is in the package, and each spec
+    key in the spec's schema."""
+    rows = glossary_rows(ARCHITECTURE.read_text())
+    assert len(rows) >= 20 and all(len(row) == 4 for row in rows)
+    code = [name for row in rows for name in re.findall(r"`([^`]+)`", row[2])]
+    keys = [name for row in rows for name in re.findall(r"`([^`]+)`", row[3])]
+    assert [name for name in code if not code_name_exists(name)] == []
+    assert [key for key in keys if not spec_key_exists(key)] == []
+
+
+def test_the_glossary_check_sees_missing_names():
+    assert code_name_exists("tube.parameters.TubeDesign.prescribed_time")
+    assert code_name_exists("spec.schema.TubeTable.smoothness")
+    assert not code_name_exists("tube.parameters.TubeDesign.t_c")
+    assert not code_name_exists("tube.nowhere.name")
+    assert spec_key_exists("[[obstacles]] active") and spec_key_exists("[tube] smoothness")
+    assert not spec_key_exists("[tube] nu") and not spec_key_exists("t_c")
+
+
 def command_options(parser: argparse.ArgumentParser | None = None,
                     path: str = "") -> dict[str, list[tuple[str, ...]]]:
     """``{command path: the option strings of each of its options}`` of ``stt-codegen``
