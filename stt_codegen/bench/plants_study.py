@@ -4,7 +4,7 @@ Draws plants ``x_dot = f(x) + g(x) u + w`` over wide ranges (``|f|`` up to about
 eigenvalues of the symmetric part of ``g`` in ``[0.05, 5]``, a skew part up to 1,
 ``|w_i| <= 0.5``), runs the generated C controller of each bundled case (its design's gain
 and rate) against each, and asks the sampled check
-(:func:`~stt_codegen.verify.sampled.check_sampled`) whether it proves that plant's own
+(:func:`~stt_codegen.design.certificate.sampled.check_sampled`) whether it proves that plant's own
 bounds, without and with the plant's own Lipschitz bounds (:func:`own_bounds`). A plant
 the check accepts must hold in simulation; the study reports how many of the plants that
 hold the check accepts.
@@ -18,10 +18,10 @@ The plants and seeds are those of the former ``tests/study_unknown_dynamics.py``
 
 ``--classes`` also searches the class of each plant that holds for a member that leaves
 the tube, with three adversaries (:data:`ADVERSARIES`): the switching one
-(:func:`~stt_codegen.verify.class_search.search_class` on the plant's own bounds, ``g`` and
+(:func:`~stt_codegen.verification.class_search.search_class` on the plant's own bounds, ``g`` and
 ``f`` may jump), the Lipschitz one (the same search with the plant's own Lipschitz bounds
 too) and the time-invariant one
-(:func:`~stt_codegen.verify.class_search.search_time_invariant`, ``g`` and ``f`` constant).
+(:func:`~stt_codegen.verification.class_search.search_time_invariant`, ``g`` and ``f`` constant).
 No sound check may accept a class with such a member (a class with Lipschitz bounds: one
 the Lipschitz or the time-invariant adversary found), so the study says how many of the
 plants that hold any sound check could accept at most, and how many of those the check
@@ -52,8 +52,8 @@ from ..design.search import design_tube
 from ..runtime.simulate import run_closed_loop
 from ..spec.assumptions import Assumptions
 from ..spec.loader import load_spec
-from ..verify.sampled import check_sampled
-from ..verify.class_search import replay, search_class, search_time_invariant, unit_skew
+from ..design.certificate.sampled import check_sampled
+from ..verification.class_search import replay, search_class, search_time_invariant, unit_skew
 
 __all__ = ["ADVERSARIES", "CASES", "COLUMNS", "RANGES", "check_columns", "draw",
            "own_bounds", "plant_parameters", "recheck", "study_one", "study_plants", "summary",
@@ -229,7 +229,7 @@ def _setup(case: str, index: int, own_gain: bool | float):
 
 def check_columns(case: str, index: int, gain: float) -> dict:
     """The sampled check's verdicts on plant ``index``'s own class, without and with its
-    Lipschitz bounds (:func:`~stt_codegen.verify.sampled.check_sampled`), at ``gain``.
+    Lipschitz bounds (:func:`~stt_codegen.design.certificate.sampled.check_sampled`), at ``gain``.
 
     Cheap beside the adversaries: :func:`recheck` recomputes these columns of a saved
     study.
@@ -292,10 +292,10 @@ def study_one(job: tuple) -> dict:
     ``job`` is ``(case, index)``, ``(case, index, classes)`` or ``(case, index, classes,
     own_gain)``. With ``classes`` true, a plant that holds gets the members of its class
     that leave the tube found by each of :data:`ADVERSARIES` (the switching search of
-    :func:`~stt_codegen.verify.class_search.search_class` on its own bounds; the same
+    :func:`~stt_codegen.verification.class_search.search_class` on its own bounds; the same
     search on its bounds with its own Lipschitz bounds, :func:`own_bounds`; and
-    :func:`~stt_codegen.verify.class_search.search_time_invariant`): each the
-    :meth:`~stt_codegen.verify.class_search.Counterexample.to_json` figures and
+    :func:`~stt_codegen.verification.class_search.search_time_invariant`): each the
+    :meth:`~stt_codegen.verification.class_search.Counterexample.to_json` figures and
     ``replayed_on_c``, or ``None`` when the search finds none, and the search's time
     (``<key>_s``). With ``own_gain`` true, the gain of law (13) is the one the design
     derives from the plant's own bounds (:func:`~stt_codegen.design.gain.derived_gain` at

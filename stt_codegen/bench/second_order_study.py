@@ -27,8 +27,8 @@ from ..errors import SpecError
 from ..runtime.plants import second_order_plant
 from ..runtime.simulate import run_closed_loop
 from ..spec.loader import load_spec
-from ..verify.cascade_adversary import search_cascade
-from ..verify.cascade_sampled import cascade_class
+from ..design.certificate.cascade_adversary import search_cascade
+from ..design.certificate.cascade_sampled import cascade_class
 
 __all__ = ["DRAG_MAX", "format_second_order_report", "random_parameters", "run_second_order_study"]
 
@@ -111,7 +111,7 @@ def run_second_order_study(case: str = "second-order-s1", count: int = 300, seed
         Plants at the corners of the range (:func:`random_parameters`) with the largest
         disturbance amplitude of the range (default: uniform draws).
     adversary : bool
-        Also run the adversary of :func:`~stt_codegen.verify.cascade_adversary.search_cascade`
+        Also run the adversary of :func:`~stt_codegen.design.certificate.cascade_adversary.search_cascade`
         on the class the design's certificate proves (``adversary``: the exits it found,
         which must be none for a certified design, and its seconds).
 

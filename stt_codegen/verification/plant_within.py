@@ -6,7 +6,7 @@ second stage); the spec's simulated plant is covered only if it is a member. One
 first-order model its bounds over the state space
 (:func:`~stt_codegen.spec.model_bounds.model_bounds`), for a second-order one ``g = I / m``
 and its drift within the velocity bound
-(:func:`~stt_codegen.verify.cascade_sampled.model_within_class`).
+(:func:`~stt_codegen.design.certificate.cascade_sampled.model_within_class`).
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ from ..rounding import distinct
 from ..spec.loader import Spec
 from ..spec.model_bounds import model_bounds
 from ..spec.plants import plant_entry
-from .cascade_sampled import model_within_class
-from .check import Check
+from ..design.certificate.cascade_sampled import model_within_class
+from ..proofs.check import Check
 
 __all__ = ["plant_within_assumptions"]
 

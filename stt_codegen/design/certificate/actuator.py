@@ -6,25 +6,24 @@ From the sampled-data check (:mod:`.sampled`), which proves a bound ``E_k,i`` of
 enclosure of the tube on each sampling interval (a lower bound ``W_k,i`` of its width
 there), :func:`~stt_codegen.design.input_bound.input_peak` bounds every input the
 controller computes: ``|u_k,i| <= 4 k phi(E_k,i) / max(W_k,i, GAMMA_D_MIN)``. The argument
-is in ``docs/sampled-data.md`` ("The input bound"). The design asks the same prover
-(:func:`prove_input_bound`, registered by this package) before it accepts a tube.
+is in ``docs/sampled-data.md`` ("The input bound"). The design asks this prover
+(:func:`prove_input_bound`) before it accepts a tube, and ``verify`` reports it
+(:func:`stt_codegen.verification.sampled.input_bound_check`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..design.certificate import enclose_tube
-from ..design.input_bound import InputProof, input_peak
-from ..design.samples import TubeSamples
-from ..spec.loader import Spec
-from ..tube import reference
-from ..tube.parameters import TubeDesign
-from ..rounding import distinct
-from .check import Check
+from .enclosures import enclose_tube
+from ..input_bound import InputProof, input_peak
+from ..samples import TubeSamples
+from ...spec.loader import Spec
+from ...tube import reference
+from ...tube.parameters import TubeDesign
 from .sampled import SampledCheck, sampled_check_of
 
-__all__ = ["input_bound_check", "prove_input_bound", "sampled_error_bound"]
+__all__ = ["prove_input_bound", "sampled_error_bound"]
 
 
 def sampled_error_bound(result: SampledCheck, samples: TubeSamples) -> np.ndarray | None:
@@ -75,7 +74,7 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *,
         With its gain (the input bound's clamp, if any, plays no part: the proof shows
         it never acts).
     spec : Spec
-        Its plant class (:func:`~stt_codegen.verify.plant_class.plant_class`: the model's
+        Its plant class (:func:`~stt_codegen.design.certificate.plant_class.plant_class`: the model's
         bounds evaluated on the tube per interval, and ``[assumptions]``), the one
         ``sampled.tube_kept`` judges.
     per_axis_first : bool
@@ -106,39 +105,3 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *,
     with reference.numpy_math():
         widths = certified_widths(tube, samples)
     return input_peak(tube.gain, abs_e, widths, samples.t, horizon)
-
-
-def input_bound_check(spec: Spec, proof: InputProof) -> Check:
-    """``sampled.input_bound``: every input's proved peak within ``spec.input_bound``.
-
-    Parameters
-    ----------
-    spec : Spec
-        With ``input_bound``.
-    proof : InputProof
-        :func:`prove_input_bound` of the design.
-
-    Returns
-    -------
-    Check
-        Data: ``input_bound``, ``peak``, ``time`` (per input), ``margin`` (the smallest
-        ``(bound - peak) / bound``), ``horizon``.
-    """
-    bound = spec.input_bound
-    names = spec.input_names
-    data = {"input_bound": list(bound), "peak": list(proof.peak), "time": list(proof.time),
-            "margin": proof.margin(bound), "horizon": proof.horizon, "inputs": list(names)}
-    if not proof.proved:
-        return Check("sampled.input_bound", False,
-                     f"no bound on law (13)'s input is proved: {proof.reason}", data)
-    each = ", ".join(f"|{name}| <= {distinct(p, b, 4)} (bound {b:g}, at t = {t:.3f} s)"
-                     for name, p, b, t in zip(names, proof.peak, bound, proof.time))
-    ok = proof.meets(bound)
-    detail = (f"law (13) asks at most {each} at every sample on [0, {proof.horizon:.4g}] s, "
-              f"for every plant of [assumptions] (from the sampled check's bound on |e| at "
-              f"each sample and the certified width there): margin {proof.margin(bound):.3g} "
-              "of the bound")
-    if not ok:
-        over = [name for name, p, b in zip(names, proof.peak, bound) if p > b]
-        detail += f"; beyond the bound in {', '.join(over)}"
-    return Check("sampled.input_bound", ok, detail, data)

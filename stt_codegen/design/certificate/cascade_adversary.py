@@ -39,9 +39,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..tube import cascade_reference, reference
-from ..tube.parameters import TubeDesign
-from ..tube.second_stage import SecondStage
+from ...tube import cascade_reference, reference
+from ...tube.parameters import TubeDesign
+from ...tube.second_stage import SecondStage
 from .cascade_sampled import CascadeClass
 
 __all__ = ["CascadeExit", "STRATEGIES", "SUBSTEPS", "search_cascade"]

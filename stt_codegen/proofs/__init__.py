@@ -1,13 +1,12 @@
-"""Symbolic and numeric verification of the paper's formulas (``stt-codegen verify``).
+"""SymPy proofs of the paper's formulas on the deployed expressions.
 
-The entry point is the function :func:`stt_codegen.verify.command.verify` (the front
-door's ``stt_codegen.verify``): ``verify(design)`` or ``verify(spec)`` returns a
-:class:`VerificationReport`.
+Every proof returns a :class:`Check`. They are proved on the deployed expressions: the
+pieces of :mod:`stt_codegen.tube.pieces` printed by the emitter's SymPy printer. The
+command that runs them on a design is :mod:`stt_codegen.verification` (the front door's
+``stt_codegen.verify``). The modules:
 
-Every check returns a :class:`Check`. The checks are proved on the deployed expressions:
-the pieces of :mod:`stt_codegen.tube.pieces` printed by the emitter's SymPy printer. The
-modules:
-
+* :mod:`.check` -- the result objects: one :class:`Check`, and a
+  :class:`VerificationReport`;
 * :mod:`.deployed` -- the deployed expressions as SymPy, reduced to a domain, and their
   equality with the paper's formulas (``deployed.*``);
 * :mod:`.statements` -- the paper's formulas as stated, the right-hand sides of those
@@ -19,20 +18,16 @@ modules:
 * :mod:`.assumption` -- Assumption 2 for a plant's input matrix (the named plants' from
   :mod:`stt_codegen.runtime.dynamics`);
 * :mod:`.adaptive` -- non-negativity and an explicit bound of the adaptive law (11);
-* :mod:`.sampled` -- the sampled closed loop for every plant of ``[assumptions]``;
-* :mod:`.actuator` -- the input bound of ``[actuator]`` from the sampled check's bound on
-  ``e`` (``sampled.input_bound``; registered as the design's input prover);
-* :mod:`.proofs` -- the design-independent proofs, cached on disk;
-* :mod:`.command` -- every check of one design, :func:`~.command.verify`.
+* :mod:`.cascade` -- the second-order cascade's second stage;
+* :mod:`.look_ahead` -- the differential drive's look-ahead point and base command;
+* :mod:`.design_independent` -- the design-independent proofs, cached on disk.
 """
 
 import importlib
 from typing import Any
 
-from ..design.provers import CASCADE_CERTIFICATE, INPUT_BOUND, register_prover
-
 #: Public name -> submodule that defines it; imported on first use (PEP 562), so importing
-#: this package costs nothing (``import stt_codegen`` imports it, see there).
+#: this package costs nothing.
 _LAZY: dict[str, str] = {
     **dict.fromkeys(("adaptive_law_checks", "adversarial_psi_signals", "alpha_rate_bound",
                      "alpha_upper_bound", "check_adaptive_law_numeric", "simulate_alpha"),
@@ -48,29 +43,6 @@ _LAZY: dict[str, str] = {
                      "error_transform_checks", "outer_product_difference", "xi_diagonal",
                      "xi_outer_product"), "transform"),
 }
-
-
-def _prove_input_bound(tube: Any, spec: Any, *, per_axis_first: bool = False) -> Any:
-    """:func:`.actuator.prove_input_bound`, imported on first use."""
-    from .actuator import prove_input_bound
-    return prove_input_bound(tube, spec, per_axis_first=per_axis_first)
-
-
-# The design accepts a tube under [actuator] only with this proof (the sampled-data
-# check's bound on e, verify's), and cannot import verify, which builds on it: the
-# prover is registered here, when the package is loaded (``import stt_codegen`` loads it).
-register_prover(INPUT_BOUND, _prove_input_bound)
-
-
-def _certify_cascade(tube: Any, spec: Any, stage: Any) -> tuple[bool, dict]:
-    """:func:`.cascade_sampled.certify_stage`, imported on first use."""
-    from .cascade_sampled import certify_stage
-    return certify_stage(tube, spec, stage)
-
-
-# The design keeps a second stage only when the sampled cascade is certified (verify's
-# certificate, registered here for the same reason as the input prover).
-register_prover(CASCADE_CERTIFICATE, _certify_cascade)
 
 
 def __getattr__(name: str) -> Any:

@@ -1,6 +1,6 @@
 """Members of a plant class that leave the tube: plants no sound sampled check may accept.
 
-The sampled-data check (:func:`~stt_codegen.verify.sampled.check_sampled`) proves a whole
+The sampled-data check (:func:`~stt_codegen.design.certificate.sampled.check_sampled`) proves a whole
 class of plants, the bounds of :class:`~stt_codegen.spec.assumptions.Assumptions`: every
 ``x_dot = f(x) + g(x) u + w`` whose ``g`` has the symmetric part's eigenvalues in
 ``[g_min, g_max]``, a skew part of norm at most ``input_gain_skew``, off-diagonal rows of

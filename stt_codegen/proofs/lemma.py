@@ -17,7 +17,7 @@ with SymPy for symbolic parameters:
   (:func:`check_smooth_max`).
 
 Together with the bound on ``alpha`` and ``alpha_dot`` of
-:mod:`stt_codegen.verify.adaptive`, these give Lemma 3.3 by the chain rule.
+:mod:`stt_codegen.proofs.adaptive`, these give Lemma 3.3 by the chain rule.
 
 The expressions are the deployed ones (:mod:`.deployed`: the pieces of
 :mod:`stt_codegen.tube.pieces` printed by the SymPy printer, reduced to the branch the

@@ -16,11 +16,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..design.certificate import Enclosure
-from ..spec.assumptions import Assumptions
-from ..spec.loader import LinearPlant, Spec
-from ..spec.model_bounds import EXACT_DRIFT_DIMENSIONS, model_bounds
-from ..spec.plants import PLANTS
+from .report import Enclosure
+from ...spec.assumptions import Assumptions
+from ...spec.loader import LinearPlant, Spec
+from ...spec.model_bounds import EXACT_DRIFT_DIMENSIONS, model_bounds
+from ...spec.plants import PLANTS
 
 __all__ = ["PlantClass", "IntervalBounds", "plant_class"]
 

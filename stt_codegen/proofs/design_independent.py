@@ -4,16 +4,16 @@ Most of the work of ``stt-codegen verify`` is SymPy proving facts about the depl
 expressions that no spec parameter enters: the equality of each deployed piece with the
 paper's formula (``deployed.*``), Lemma 3.3's limits and smooth max, the error transform of
 Theorem 4.1, and the symbolic parts of the rate bounds and of the adaptive law's checks
-(:func:`~stt_codegen.verify.lemma.reach_rate_form`,
-:func:`~stt_codegen.verify.lemma.bump_rate_form`,
-:func:`~stt_codegen.verify.adaptive.adaptive_law_form`). :func:`design_independent_proofs`
+(:func:`~stt_codegen.proofs.lemma.reach_rate_form`,
+:func:`~stt_codegen.proofs.lemma.bump_rate_form`,
+:func:`~stt_codegen.proofs.adaptive.adaptive_law_form`). :func:`design_independent_proofs`
 proves them and stores the outcome in ``$XDG_CACHE_HOME/stt-codegen`` (default
 ``~/.cache/stt-codegen``), one JSON file per key, written atomically.
 
 The key (:func:`proof_key`) is a SHA-256 over everything the proofs depend on:
 
 * the serialization of every CasADi piece they print
-  (:func:`~stt_codegen.verify.deployed.proved_pieces`) and the source of the printer
+  (:func:`~stt_codegen.proofs.deployed.proved_pieces`) and the source of the printer
   (every module of :mod:`stt_codegen.codegen.emit`), so a changed piece or printer misses
   the cache (the printed SymPy expressions are a function of these two);
 * the source of the modules that state and run the proofs (:mod:`.deployed`,
@@ -83,14 +83,14 @@ class Proofs:
     Attributes
     ----------
     checks : tuple of Check
-        ``deployed.*`` (:func:`~stt_codegen.verify.deployed.deployed_checks`), Lemma 3.3
-        (:func:`~stt_codegen.verify.lemma.lemma_checks`) and Theorem 4.1
-        (:func:`~stt_codegen.verify.transform.error_transform_checks`), in that order.
+        ``deployed.*`` (:func:`~stt_codegen.proofs.deployed.deployed_checks`), Lemma 3.3
+        (:func:`~stt_codegen.proofs.lemma.lemma_checks`) and Theorem 4.1
+        (:func:`~stt_codegen.proofs.transform.error_transform_checks`), in that order.
     forms : dict
         The symbolic parts of the design-dependent checks: ``reach_rate``
-        (:func:`~stt_codegen.verify.lemma.reach_rate_form`), ``bump_rate``
-        (:func:`~stt_codegen.verify.lemma.bump_rate_form`) and ``adaptive_law``
-        (:func:`~stt_codegen.verify.adaptive.adaptive_law_form`).
+        (:func:`~stt_codegen.proofs.lemma.reach_rate_form`), ``bump_rate``
+        (:func:`~stt_codegen.proofs.lemma.bump_rate_form`) and ``adaptive_law``
+        (:func:`~stt_codegen.proofs.adaptive.adaptive_law_form`).
     from_cache : bool
         Read from the cache (not compared).
     """
@@ -280,7 +280,7 @@ def design_independent_proofs(max_n: int = 3, cache: bool = True,
 
     Examples
     --------
-    >>> from stt_codegen.verify.proofs import design_independent_proofs
+    >>> from stt_codegen.proofs.design_independent import design_independent_proofs
     >>> proofs = design_independent_proofs(max_n=2)      # doctest: +SKIP
     >>> all(c.passed for c in proofs.checks)             # doctest: +SKIP
     True

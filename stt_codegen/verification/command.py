@@ -13,22 +13,22 @@ import numpy as np
 
 from ..tube import reference
 from ..design.certificate import Certificate
+from ..design.certificate.actuator import prove_input_bound
 from ..design.result import Design
 from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
 from ..spec.plants import MODELS_WITH_EQUATIONS
 from ..tube.parameters import TANH, TubeDesign, peak_rate_factor
-from .actuator import input_bound_check, prove_input_bound
-from .adaptive import adaptive_law_checks, alpha_upper_bound
-from .assumption import assumption2_check
-from .look_ahead import look_ahead_inverse
+from ..proofs.adaptive import adaptive_law_checks, alpha_upper_bound
+from ..proofs.assumption import assumption2_check
+from ..proofs.look_ahead import look_ahead_inverse
 from ..design.look_ahead import look_ahead_input_proof
 from ..rounding import distinct
-from .check import Check, VerificationReport
-from .lemma import bump_rate_bound, reach_rate_bound
-from .proofs import design_independent_proofs
-from .sampled import plant_bounds_checks, sampled_checks
+from ..proofs.check import Check, VerificationReport
+from ..proofs.lemma import bump_rate_bound, reach_rate_bound
+from ..proofs.design_independent import design_independent_proofs
+from .sampled import input_bound_check, plant_bounds_checks, sampled_checks
 
 __all__ = ["spec_for_plant", "verify", "verify_design", "verify_spec"]
 
@@ -75,7 +75,7 @@ def _deployed_alpha_check(label: str, alpha_max: float, peak: float, lowest: flo
     alpha_max``, ``psi >= psi_min`` (certified) and ``theta <= theta_sup`` it is at most the
     root at (``alpha_max``, ``psi_min``, ``theta_sup``), which is ``alpha_max`` itself
     (``kappa a (psi_min + a)^2 = theta_sup`` is the step's fixed point, and
-    :func:`~stt_codegen.verify.adaptive.alpha_upper_bound` returns a double with
+    :func:`~stt_codegen.proofs.adaptive.alpha_upper_bound` returns a double with
     ``f(alpha_max) >= theta_sup`` exactly); ``alpha_0 = 0``. Either way the figures are
     printed to ten digits, so a reader sees what was compared.
     """
@@ -108,7 +108,7 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         default the spec's.
     cache : bool
         Take the design-independent proofs from the proof cache
-        (:func:`~stt_codegen.verify.proofs.design_independent_proofs`).
+        (:func:`~stt_codegen.proofs.design_independent.design_independent_proofs`).
     progress : callable, optional
         Called with ``"<stage> (i/N)"`` before each stage.
 
@@ -119,14 +119,14 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         the paper's formula (``deployed.*``), Assumption 2 (and, for the linear
         plant, whether it meets ``[assumptions]``), the adaptive law (per component of
         ``alpha``), the tube certificate, the sampled closed loop
-        (:func:`~stt_codegen.verify.sampled.sampled_checks`) and, for a spec with
+        (:func:`~stt_codegen.verification.sampled.sampled_checks`) and, for a spec with
         ``[actuator]``, ``sampled.input_bound``
-        (:func:`~stt_codegen.verify.actuator.input_bound_check`). For a spec with
-        a second-order ``plant.model``, the cascade's lemmas (:func:`~stt_codegen.verify.cascade.cascade_checks`),
+        (:func:`~stt_codegen.verification.sampled.input_bound_check`). For a spec with
+        a second-order ``plant.model``, the cascade's lemmas (:func:`~stt_codegen.proofs.cascade.cascade_checks`),
         and the sampled cascade's certificate ``cascade.sampled``
-        (:func:`~stt_codegen.verify.cascade.sampled_cascade_check`) instead of the last
+        (:func:`~stt_codegen.verification.cascade.sampled_cascade_check`) instead of the last
         two, with ``[actuator]`` followed by ``cascade.input_bound``
-        (:func:`~stt_codegen.verify.cascade.cascade_input_bound_check`).
+        (:func:`~stt_codegen.verification.cascade.cascade_input_bound_check`).
     """
     stage = progress if isinstance(progress, _Stages) else _Stages(progress, design=False)
     if plant is not None:
@@ -210,8 +210,9 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     if spec.order == 2:
         # the deployed controller is the cascade, not law (13) on this plant: its lemmas
         # and its sampled-data certificate (docs/second-order.md)
-        from .cascade import (cascade_checks, cascade_input_bound_check,
-                              plant_within_class_check, sampled_cascade_check)
+        from ..proofs.cascade import cascade_checks
+        from .cascade import (cascade_input_bound_check, plant_within_class_check,
+                              sampled_cascade_check)
         stage("sampled loop")          # the cascade takes the sampled loop's slot
         checks += cascade_checks(min(n, 2)) + [
             plant_within_class_check(spec),
@@ -315,7 +316,7 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
     what each check proves.
 
     The proofs that depend on no spec parameter are taken from an on-disk cache keyed by a
-    hash of everything they depend on (:mod:`stt_codegen.verify.proofs`), so only the
+    hash of everything they depend on (:mod:`stt_codegen.proofs.design_independent`), so only the
     first run on a machine pays for them.
 
     Parameters
@@ -357,8 +358,8 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
     See Also
     --------
     stt_codegen.design_tube : the design to verify.
-    stt_codegen.verify.proofs.design_independent_proofs : the cached proofs.
-    stt_codegen.verify.check.VerificationReport : the result.
+    stt_codegen.proofs.design_independent.design_independent_proofs : the cached proofs.
+    stt_codegen.proofs.check.VerificationReport : the result.
 
     Examples
     --------

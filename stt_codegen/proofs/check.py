@@ -77,7 +77,7 @@ class VerificationReport:
     spec : str
         The spec's name.
     checks : tuple of Check
-        In the order of :func:`stt_codegen.verify.command.verify_design`; a spec for
+        In the order of :func:`stt_codegen.verification.command.verify_design`; a spec for
         which no tube can be designed has the single failed check ``tube.design``.
     """
 

@@ -8,7 +8,7 @@ for every plant ``x1_dot = x2``, ``x2_dot = f + g u + w`` of a :class:`CascadeCl
 ``|e2| < 1`` at and between the samples over the horizon of the tube's samples. It
 propagates, from ``(e1(0), e2(0))``, one interval per axis for each error at the samples
 and, on each sampling interval, reuses the first-order per-axis enclosure
-(:func:`~stt_codegen.verify.sampled_axis.axis_interval`) twice:
+(:func:`~stt_codegen.design.certificate.sampled_axis.axis_interval`) twice:
 
 * the **position stage** is law (13) with ``g = 1`` on ``x1_dot = x2 = r_k + d(t)``:
   ``d = z_k + (x2(t) - x2_k)`` displaces ``x1`` by at most ``tau (Z + h A / 2)`` after
@@ -30,13 +30,13 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..design.certificate import enclose_tube
-from ..design.samples import TubeSamples, sample_tube
-from ..spec.loader import Spec
-from ..spec.plants import SECOND_ORDER_PLANTS
-from ..tube import reference
-from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
-from ..tube.second_stage import SecondStage
+from .enclosures import enclose_tube
+from ..samples import TubeSamples, sample_tube
+from ...spec.loader import Spec
+from ...spec.plants import SECOND_ORDER_PLANTS
+from ...tube import reference
+from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
+from ...tube.second_stage import SecondStage
 from .sampled_axis import axis_interval, peak, phi_scalar, phi_slope_scalar
 
 __all__ = ["CascadeClass", "CascadeCheck", "cascade_check_of", "cascade_class", "model_within_class",
@@ -422,7 +422,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
 def certify_stage(tube: TubeDesign, spec: Spec, stage: SecondStage) -> tuple[bool, dict]:
     """:func:`check_cascade_sampled` for ``spec``'s declared plants (:func:`cascade_class`)
     on ``tube`` sampled at its rate: the design's certifier
-    (:func:`~stt_codegen.design.provers.register_prover`).
+    (:func:`~stt_codegen.design.cascade_gain.certified_stage` asks it).
 
     Parameters
     ----------

@@ -3,7 +3,7 @@
 Theorem 4.1 is a continuous-time result. The deployed controller reads ``x(t_k)`` at
 ``t_k = k dt``, computes ``u_k`` by law (13) with its clamps and holds it until
 ``t_{k+1}`` (zero-order hold). This module proves, for every plant of a plant class
-(:class:`~stt_codegen.verify.plant_class.PlantClass`: the spec's plant model and
+(:class:`~stt_codegen.design.certificate.plant_class.PlantClass`: the spec's plant model and
 ``[assumptions]``), that ``|e_i| < 1`` at and between samples on the whole horizon of the
 tube's certificate. The condition and its proof are in ``docs/sampled-data.md``. It
 propagates, from ``e(0)``, an enclosure of ``e(t_k)`` that is the intersection of
@@ -27,23 +27,20 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..design.certificate import Certificate, certify_tube, enclose_tube
-from ..design.gain import derived_gain, gain_derivation
-from ..design.samples import TubeSamples, sample_tube
-from ..spec.assumptions import G_KEYS, Assumptions, combine_assumptions
-from ..spec.loader import Spec
-from ..spec.model_bounds import model_bounds
-from ..spec.plants import PLANTS
-from ..tube import reference
-from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
-from ..rounding import distinct
-from .check import Check
+from .enclosures import enclose_tube
+from .refine import certify_tube
+from ..gain import derived_gain
+from ..samples import TubeSamples, sample_tube
+from ...spec.assumptions import Assumptions
+from ...spec.loader import Spec
+from ...tube import reference
+from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .lyapunov import level_after, next_level, others_max
 from .plant_class import PlantClass, plant_class
 from .sampled_axis import axis_interval, peak, phi_slope_scalar
 
-__all__ = ["SampledCheck", "check_sampled", "lowest_rate", "plant_bounds_checks",
-           "sampled_check_of", "sampled_checks"]
+__all__ = ["RATE_FACTORS", "SampledCheck", "check_sampled", "check_sampled_first_per_axis",
+           "lowest_rate", "sampled_check_of"]
 
 #: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
 RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
@@ -76,7 +73,7 @@ class SampledCheck:
         Numbers for reports.
     abs_e : ndarray or None, shape (K + 1, n)
         When passed: the proved bound of ``|e_i(t_k)|`` at every sample of ``samples``
-        (read by :func:`stt_codegen.verify.actuator.sampled_error_bound` for the input
+        (read by :func:`stt_codegen.design.certificate.actuator.sampled_error_bound` for the input
         bound); ``None`` otherwise.
     """
 
@@ -148,7 +145,7 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
         The deployed tube at the rate of ``design``
         (:func:`~stt_codegen.design.samples.sample_tube`).
     plants : Assumptions or PlantClass
-        The plant bounds (:func:`~stt_codegen.verify.plant_class.plant_class` for a spec,
+        The plant bounds (:func:`~stt_codegen.design.certificate.plant_class.plant_class` for a spec,
         which evaluates its plant model on the tube); ``input_gain[0] > 0`` is needed.
     gain : float, optional
         ``k`` to check instead of ``design.gain``.
@@ -288,7 +285,21 @@ def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,
     about four times as much). When the per-axis argument passes, its bounds are the ones
     reported, which the balls could only have tightened.
 
-    Parameters and result: those of :func:`check_sampled`.
+    Parameters
+    ----------
+    design : TubeDesign
+        As :func:`check_sampled`.
+    samples : TubeSamples
+        As :func:`check_sampled`.
+    plants : Assumptions or PlantClass
+        As :func:`check_sampled`.
+    gain : float, optional
+        As :func:`check_sampled`.
+
+    Returns
+    -------
+    SampledCheck
+        The per-axis argument's when it passes, else the whole check's.
     """
     per_axis = check_sampled(design, samples, plants, gain, lyapunov=False)
     return per_axis if per_axis.passed else check_sampled(design, samples, plants, gain)
@@ -309,7 +320,7 @@ def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
     design : TubeDesign
         With its gain.
     spec : Spec
-        Its plant class (:func:`~stt_codegen.verify.plant_class.plant_class`).
+        Its plant class (:func:`~stt_codegen.design.certificate.plant_class.plant_class`).
     per_axis_first : bool
         :func:`check_sampled_first_per_axis` (the same verdict; where the per-axis argument
         passes, its bounds, which the Lyapunov balls could only tighten) instead of
@@ -406,181 +417,3 @@ def lowest_rate(design: TubeDesign, spec: Spec, plants: Assumptions | PlantClass
         if ok:
             return design.rate_hz * factor, gain
     return design.rate_hz * above[-1], fastest_gain
-
-
-# --------------------------------------------------------------------------- verify
-
-
-def _bounds_words(a: Assumptions, refined: tuple[str, ...] = ()) -> str:
-    g_min, g_max = a.input_gain
-    if a.model and a.model in PLANTS and PLANTS[a.model].declared_bounds:
-        source = (f"declared: {', '.join(a.declared)}; the rest their defaults (the {a.model} "
-                  "plant has no equations here)")
-    elif a.model and not a.declared:
-        source = f"the {a.model} model's own bounds over the state space"
-    elif a.model:
-        source = (f"declared: {', '.join(a.declared)}; the rest from the {a.model} model "
-                  "over the state space")
-    else:
-        source = "given"
-    if refined:
-        source += f"; {', '.join(refined)} evaluated on the tube per sampling interval"
-    words = (f"eig((g + g^T)/2) in [{g_min:.6g}, {g_max:.6g}], |skew part| <= "
-             f"{a.input_gain_skew:.6g}, row coupling <= {a.input_gain_coupling:.6g}, |f| <= "
-             f"{a.drift_bound:.6g}, |w| <= {a.disturbance_bound:.3g}")
-    if len(a.blocks) > 1:
-        words += f", g block diagonal on {[list(b) for b in a.blocks]}"
-    return f"{words} ({source})"
-
-
-def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> list[Check]:
-    """The checks of ``stt-codegen verify`` for the sampled closed loop.
-
-    ``sampled.gain``: ``k`` is below the linearized stability limit at the narrowest tube
-    for ``g_max``, with the derivation (:func:`~stt_codegen.design.gain.gain_derivation`)
-    in words. ``sampled.tube_kept``: :func:`check_sampled` for the spec's plant class
-    (:func:`~stt_codegen.verify.plant_class.plant_class`), with the lowest rate that
-    passes (:func:`lowest_rate`), whether or not the spec's rate does.
-
-    Parameters
-    ----------
-    spec : Spec
-        The spec the design is for.
-    design : TubeDesign
-        With its gain set (the spec's ``controller.gain`` or the derived one); its tube is
-        sampled by :func:`sampled_check_of` (once per process).
-    certificate : Certificate
-        ``design``'s tube certificate (its ``non-empty`` margin is the width the gain is
-        derived from).
-
-    Returns
-    -------
-    list of Check
-        ``sampled.gain`` (the gain below its stability limit) and ``sampled.tube_kept``.
-    """
-    a = spec.assumptions
-    plants = plant_class(spec)
-    # the width the design derived its gain from: the certified one, rounded down
-    derivation = gain_derivation(design, certificate.min_width,
-                                 certificate.margin("non-empty").time, a, spec.gain)
-    gain_ok = derivation["gain"] < derivation["stable_gain_limit"]
-    checks = [Check("sampled.gain", gain_ok, derivation["explanation"]
-                    + ("" if gain_ok else f"; k = "
-                       f"{distinct(derivation['gain'], derivation['stable_gain_limit'], 6)} is "
-                       f"at or beyond the limit at g_max = {a.input_gain[1]:g}"), derivation)]
-    result = sampled_check_of(design, spec)[1]
-    words = _bounds_words(a, tuple(result.data.get("refined_on_the_tube", ())))
-    rate, gain = lowest_rate(design, spec, plants, spec.gain, passes_at_rate=result.passed)
-    g_max = a.input_gain[1]
-    if rate is not None:
-        lowest = f"lowest passing rate {rate / 1000:.3g} kHz (k = {gain:.4g})"
-    else:
-        lowest = (f"no rate up to {design.rate_hz * RATE_FACTORS[-1] / 1000:g} kHz passes "
-                  f"the condition at g_max = {g_max:g}")
-        if a.input_gain_coupling > 0 and "input_gain_coupling" not in a.declared:
-            lowest += (f" (row coupling {a.input_gain_coupling:g} next to g_min = "
-                       f"{a.input_gain[0]:g}: declare a smaller input_gain_coupling if the "
-                       "structure of g allows)")
-    if result.passed:
-        detail = (f"every plant with {words} stays strictly inside the tube at and between "
-                  f"samples at {design.rate_hz:g} Hz with k = {design.gain:.6g}: |e| <= "
-                  f"{result.level:.4g} at the samples, room >= {result.margin:.3g} of the "
-                  f"half-width (least at t = {result.time:.4f} s, dimension "
-                  f"{result.dimension}); {lowest}")
-    else:
-        need = (f"the condition needs {rate / 1000:.3g} kHz (k = {gain:.4g}) at g_max = "
-                f"{g_max:g}" if rate is not None else lowest)
-        label = "controller.gain" if spec.gain is not None else "the derived gain"
-        detail = (f"{result.reason}, for plants with {words} at {design.rate_hz:g} Hz and "
-                  f"k = {design.gain:.6g} ({label}); {need}")
-        found = _member_that_leaves(design, spec, result)
-        if found is not None:
-            how = ("g moving between samples by at most its Lipschitz bound times the "
-                   "state's move, towards extreme members of the class" if found.gain_rates
-                   else "g on each interval an extreme member of the class")
-            how += ("; f likewise within its Lipschitz bound and |f| at its bound, |w| at "
-                    "its bound" if found.drift_rates else ", |f + w| at its bound")
-            detail += (f"; and the failure is not the check's caution: a plant of the class "
-                       f"leaves the tube ({how}): |e_{found.dimension}| = {found.depth:.3g} "
-                       f"at t = {found.time:.4f} s ({found.strategy}; verify/class_search.py)")
-        elif a.input_gain_lipschitz is not None or a.drift_lipschitz is not None:
-            detail += ("; the check's argument holds for every plant within the bounds, "
-                       "also one whose g and f jump between samples: it does not use "
-                       "input_gain_lipschitz or drift_lipschitz, so for the plants they "
-                       "declare this failure may be the check's caution (docs/"
-                       "sampled-data.md, \"Lipschitz bounds and the check\")")
-        if _model_passes(design, spec):
-            keys = ", ".join(k for k in G_KEYS if k in a.declared)
-            detail += (f"; the {a.model} model's own g, its bounds evaluated on the tube per "
-                       f"sampling interval, passes at {design.rate_hz:g} Hz: if the plant is "
-                       f"that model, drop the declared {keys}")
-    if a.notes:
-        detail += "; " + "; ".join(a.notes) + " (the declared bounds are used; they cover the model)"
-    data = {**result.data, "level": result.level, "margin": result.margin,
-            "time": result.time, "lowest_rate_hz": rate, "lowest_rate_gain": gain}
-    if not result.passed:
-        data["class_counterexample"] = None if found is None else found.to_json()
-    checks.append(Check("sampled.tube_kept", result.passed, detail, data))
-    return checks
-
-
-def _model_passes(design: TubeDesign, spec: Spec) -> bool:
-    """Whether the check passes for the spec's plant model with its own bounds of ``g``
-    (evaluated on the tube per interval) where the spec declares wider ones; ``False``
-    when the spec declares none or its model has no ``g`` that varies on the tube."""
-    a = spec.assumptions
-    if a.g_from_model or a.model not in PLANTS or not PLANTS[a.model].gain_varies:
-        return False
-    kept = {key: getattr(a, key) for key in a.declared
-            if key not in G_KEYS and key != "input_gain_lipschitz"}
-    own = combine_assumptions(model_bounds(a.model, spec.state_space.lower,
-                                           spec.state_space.upper, spec.plant_data(a.model)),
-                              kept, spec.dimension, spec.disturbance_amplitude)
-    samples = sampled_check_of(design, spec)[0]
-    return check_sampled_first_per_axis(design, samples, plant_class(spec, own)).passed
-
-
-def _member_that_leaves(design: TubeDesign, spec: Spec, result: SampledCheck):
-    """A member of the spec's plant class that leaves the tube under the sampled law
-    (:func:`~stt_codegen.verify.class_search.search_class`, greedy strategies only),
-    confirmed on the numpy reference of the deployed controller (a member that respects
-    the class's Lipschitz bounds when the spec has them); ``None`` when the check
-    passed, when the class's bounds are evaluated on the tube per interval (the search's
-    members obey the bounds over the whole state space, which may be wider), or when none
-    is found."""
-    if result.passed or result.data.get("refined_on_the_tube") or \
-            spec.assumptions.input_gain[0] <= 0:
-        return None
-    from .class_search import replay, search_class
-    samples = sampled_check_of(design, spec)[0]
-    found = search_class(design, samples, spec.assumptions, held_runs=0)
-    return found if found is not None and replay(design, found, "reference") else None
-
-
-def plant_bounds_checks(spec: Spec, model: str | None = None) -> list[Check]:
-    """Whether the plant model meets the assumptions ``verify`` judges it against.
-
-    ``sampled.plant_within_assumptions``: the model's bounds over the state space
-    (:func:`~stt_codegen.spec.model_bounds.model_bounds`: eigenvalues of the symmetric part
-    of ``g``, norm of its skew part, row coupling, ``max |f|``) lie within
-    ``spec.assumptions``. The loader makes this hold for every spec it builds (a bound the
-    model violates is a ``SpecError``); a spec changed in Python
-    (``dataclasses.replace``) can break it, and then the sampled verdict is not about the
-    model, which this check says (:func:`~.plant_within.plant_within_assumptions`, the
-    one membership check of both orders). Assumption 2 itself is the model's own check
-    (:func:`~stt_codegen.verify.assumption.assumption2_check`).
-
-    Parameters
-    ----------
-    spec : Spec
-        The spec: its state space, linear matrices and ``[assumptions]``.
-    model : str, optional
-        Plant model, default the spec's.
-
-    Returns
-    -------
-    list of Check
-        ``sampled.plant_within_assumptions``.
-    """
-    from .plant_within import plant_within_assumptions
-    return [plant_within_assumptions(spec, model)]

@@ -590,12 +590,12 @@ def law(n: int) -> tuple:
 def proved_pieces(max_n: int = 3) -> dict[str, object]:
     """Every piece the design-independent proofs print, as CasADi Functions.
 
-    The proofs of :func:`deployed_checks`, :func:`stt_codegen.verify.lemma.lemma_checks`,
-    :func:`stt_codegen.verify.transform.error_transform_checks` (``n = 1..max_n``) and the
+    The proofs of :func:`deployed_checks`, :func:`stt_codegen.proofs.lemma.lemma_checks`,
+    :func:`stt_codegen.proofs.transform.error_transform_checks` (``n = 1..max_n``) and the
     symbolic parts of the rate bounds and the adaptive law see the deployed code only
     through these pieces, printed by :func:`stt_codegen.codegen.emit.sympy_expressions`.
     Their serialization is part of the key of the proof cache
-    (:mod:`stt_codegen.verify.proofs`): a changed piece misses the cache
+    (:mod:`stt_codegen.proofs.design_independent`): a changed piece misses the cache
     (``tests/test_verify_proofs.py`` checks that every piece printed while proving is
     listed here).
 
