@@ -6,13 +6,13 @@ import numpy as np
 import pytest
 from conftest import arena_toml
 
-from stt_codegen.bench.arena_job import (closed_loop_failure, design_failure, run_arena)
-from stt_codegen.bench.arenas import (ARENA, OBSTACLE_SIZE, START_SIZE, TARGET, generate_arena,
+from stt_codegen_bench.arena_job import (closed_loop_failure, design_failure, run_arena)
+from stt_codegen_bench.arenas import (ARENA, OBSTACLE_SIZE, START_SIZE, TARGET, generate_arena,
                                       generate_arenas)
-from stt_codegen.bench.astar import RESOLUTION, grid_graph, plan_astar
-from stt_codegen.bench.planning import MARGIN, FreeSpace
-from stt_codegen.bench.report import summarize
-from stt_codegen.bench.tracker import track
+from stt_codegen_bench.astar import RESOLUTION, grid_graph, plan_astar
+from stt_codegen_bench.planning import MARGIN, FreeSpace
+from stt_codegen_bench.report import summarize
+from stt_codegen_bench.tracker import track
 from stt_codegen.errors import SpecError
 from stt_codegen.spec.loader import load_spec, parse_spec
 

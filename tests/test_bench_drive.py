@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from stt_codegen.bench.office_arenas import (CLEARANCE, START, TARGET, format_office_report,
+from stt_codegen_bench.office_arenas import (CLEARANCE, START, TARGET, format_office_report,
                                              office_doc, run_office_bench)
 from stt_codegen.errors import SpecError
 

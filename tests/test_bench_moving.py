@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import stt_codegen as stt
-from stt_codegen.bench.arenas import generate_arena
-from stt_codegen.bench.moving import random_moving_obstacles
+from stt_codegen_bench.arenas import generate_arena
+from stt_codegen_bench.moving import random_moving_obstacles
 from stt_codegen.spec.loader import Box
 
 
@@ -56,7 +56,7 @@ def test_bad_count_is_a_spec_error():
 
 @pytest.mark.slow
 def test_the_study_reports_both_designs():
-    from stt_codegen.bench.moving_study import study_moving
+    from stt_codegen_bench.moving_study import study_moving
     result = study_moving(3, 0)
     assert result["arenas"] == 3 and result["moving_obstacles"] >= 1
     for name in ("stt", "swept_only"):

@@ -6,8 +6,8 @@ import json
 
 import pytest
 
-from stt_codegen.bench.alpha import RATE_FACTORS, format_alpha_report
-from stt_codegen.bench.covering import format_covering_report, polygons_toml
+from stt_codegen_bench.alpha import RATE_FACTORS, format_alpha_report
+from stt_codegen_bench.covering import format_covering_report, polygons_toml
 from stt_codegen.cli import main
 from stt_codegen.spec.loader import parse_spec
 from stt_codegen.tube.parameters import NEWTON_ITERATIONS

@@ -8,12 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from stt_codegen.bench.task_arenas import task_problem, task_problem_toml
-from stt_codegen.bench.task_baseline import plan_timed
-from stt_codegen.bench.task_timing import MARGIN, departure, gap, positions
+from stt_codegen_bench.task_arenas import task_problem, task_problem_toml
+from stt_codegen_bench.task_baseline import plan_timed
+from stt_codegen_bench.task_timing import MARGIN, departure, gap, positions
 from stt_codegen.spec.loader import parse_spec
 from stt_codegen.spec.motion import MovingObstacle
-from stt_codegen.bench.tasks_bench import METHODS, run_tasks_bench
+from stt_codegen_bench.tasks_bench import METHODS, run_tasks_bench
 from stt_codegen.cli import main
 from stt_codegen.errors import SpecError
 

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from stt_codegen.bench.arenas import generate_arena
+from stt_codegen_bench.arenas import generate_arena
 from stt_codegen.design.gain import derived_gain
 from stt_codegen.design.search import base_design, design_tube, paper_design
 from stt_codegen.design.tracking import (SMOOTHER_RATIO, TRACKING_ERROR, centre_speed,

@@ -17,7 +17,7 @@ import pytest
 from conftest import CASES, designed
 
 from stt_codegen.rounding import round_down
-from stt_codegen.bench.arenas import generate_arena
+from stt_codegen_bench.arenas import generate_arena
 from stt_codegen.design.certificate import (certify_tube, enclose, piece_ranges,
                                             sequence_bounds)
 from stt_codegen.design.certificate.enclosures import width_lower_bound

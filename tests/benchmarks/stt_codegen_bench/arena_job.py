@@ -29,8 +29,8 @@ import re
 import time
 from typing import Any
 
-from ..errors import DesignError
-from ..runtime.simulate import SimulationResult
+from stt_codegen.errors import DesignError
+from stt_codegen.runtime.simulate import SimulationResult
 from .arenas import generate_arena
 
 __all__ = ["LABELS", "METHODS", "closed_loop_failure", "design_failure", "loop_arena",
@@ -124,7 +124,7 @@ def _plan_stt(spec, method: str) -> dict[str, Any]:
     "reason"}``."""
     from dataclasses import replace
 
-    from ..design.search import design_tube
+    from stt_codegen.design.search import design_tube
     spec = replace(spec, tube=replace(spec.tube, method=method))
     begin = time.perf_counter()
     try:
@@ -200,7 +200,7 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
         tube, STT methods; ``None`` for the baselines)}}}``; the last five are ``None``
         without a closed loop.
     """
-    from ..runtime.simulate import run_closed_loop
+    from stt_codegen.runtime.simulate import run_closed_loop
     from .tracker import track
     arena = generate_arena(seed, index)
     spec = arena.to_spec()

@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import SpecError
-from ..spec.loader import Box, Spec, parse_spec
+from stt_codegen.errors import SpecError
+from stt_codegen.spec.loader import Box, Spec, parse_spec
 
 __all__ = ["ARENA", "OBSTACLE_SIZE", "START_SIZE", "TARGET", "generate_arena", "generate_arenas"]
 
@@ -45,7 +45,7 @@ PRESCRIBED_TIME = 9.0
 MAX_DRAWS = 10_000
 
 _TEMPLATE = """\
-# Random arena {index} of seed {seed} (stt_codegen.bench.arenas): the paper's 5 m x 5 m
+# Random arena {index} of seed {seed} (stt_codegen_bench.arenas): the paper's 5 m x 5 m
 # arena, four 1 m x 1 m obstacles at random, a random 0.5 m x 0.5 m start set, the case
 # study's target; single integrator x_dot = u + w, |w_i| <= 0.1.
 name = "{name}"

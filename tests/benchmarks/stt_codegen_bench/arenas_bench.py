@@ -6,8 +6,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from ..errors import SpecError
-from ..system import atomic_write
+from stt_codegen.errors import SpecError
+from stt_codegen.system import atomic_write
 from .arena_job import LABELS, METHODS, loop_arena, plan_arena
 from .arenas import generate_arenas
 from .parallel import run_parallel

@@ -15,9 +15,9 @@ from typing import Any
 
 import numpy as np
 
-from ..design.search import design_tube
-from ..errors import DesignError, SpecError
-from ..spec.loader import parse_spec
+from stt_codegen.design.search import design_tube
+from stt_codegen.errors import DesignError, SpecError
+from stt_codegen.spec.loader import parse_spec
 from .report import machine, machine_line, table
 
 __all__ = ["format_covering_report", "polygons_toml", "run_covering_bench"]

@@ -1,4 +1,4 @@
-"""A study of moving obstacles on random arenas: ``python -m stt_codegen.bench.moving_study``.
+"""A study of moving obstacles on random arenas: ``python -m stt_codegen_bench.moving_study``.
 
 Arena ``k`` of seed ``S`` (:func:`~.arenas.generate_arena`, four static 1 m boxes) gets 0-4
 random moving obstacles (:func:`~.moving.random_moving_obstacles`, generator
@@ -21,11 +21,11 @@ from typing import Any
 
 import numpy as np
 
-from ..design.swept import swept_spec
-from ..design.search import design_tube
-from ..errors import DesignError
-from ..runtime.simulate import simulate
-from ..spec.loader import Spec
+from stt_codegen.design.swept import swept_spec
+from stt_codegen.design.search import design_tube
+from stt_codegen.errors import DesignError
+from stt_codegen.runtime.simulate import simulate
+from stt_codegen.spec.loader import Spec
 from .arenas import generate_arena
 from .moving import random_moving_obstacles
 
@@ -91,7 +91,7 @@ def study_moving(count: int, seed: int) -> dict[str, Any]:
 
 def main(argv: list[str] | None = None) -> int:
     """Print the study for ``--count`` arenas of ``--seed``."""
-    parser = argparse.ArgumentParser(prog="python -m stt_codegen.bench.moving_study")
+    parser = argparse.ArgumentParser(prog="python -m stt_codegen_bench.moving_study")
     parser.add_argument("--count", type=int, default=50)
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)

@@ -24,10 +24,10 @@ import math
 
 import numpy as np
 
-from ..design.search import design_tube
-from ..errors import DesignError, SpecError
-from ..runtime.simulate import simulate
-from ..spec.loader import Spec
+from stt_codegen.design.search import design_tube
+from stt_codegen.errors import DesignError, SpecError
+from stt_codegen.runtime.simulate import simulate
+from stt_codegen.spec.loader import Spec
 
 __all__ = ["format_office_report", "office_doc", "run_office_bench"]
 

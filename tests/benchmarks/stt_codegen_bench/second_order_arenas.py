@@ -22,12 +22,12 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..design.cascade_gain import derived_second_stage
-from ..design.search import design_tube
-from ..errors import DesignError
-from ..runtime.simulate import run_closed_loop
-from ..spec.loader import Spec
-from ..spec.second_order import SecondOrder
+from stt_codegen.design.cascade_gain import derived_second_stage
+from stt_codegen.design.search import design_tube
+from stt_codegen.errors import DesignError
+from stt_codegen.runtime.simulate import run_closed_loop
+from stt_codegen.spec.loader import Spec
+from stt_codegen.spec.second_order import SecondOrder
 from .arenas import generate_arena
 
 __all__ = ["double_integrator_spec", "format_double_integrator_report",
@@ -130,7 +130,7 @@ def run_arena_double_integrator(seed: int, index: int) -> dict:
     else:
         # the loop reports max |e1| in a tube: the arena's design, else the base tube
         # (unchecked); the tracker never reads it
-        from ..design.search import base_design
+        from stt_codegen.design.search import base_design
         tube = design.tube if design is not None else base_design(spec)
         result = run_closed_loop(double_integrator_spec(spec), tube,
                                  backend="astar-tracker", seed=index,

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..spec.loader import Box, Spec, parse_spec
+from stt_codegen.spec.loader import Box, Spec, parse_spec
 from .arenas import generate_arena
 from .moving import random_moving_obstacles
 
@@ -80,7 +80,7 @@ def task_problem_toml(seed: int, index: int) -> str:
     avoid = list(arena.obstacles) + [Box((4.5, 4.5), (5.0, 5.0)), arena.start]
     text = arena.to_toml().replace("prescribed_time = 9.0", f"prescribed_time = {t_c!r}", 1)
     text = text.replace(f'name = "{arena.name}"', f'name = "tasks-{seed}-{index}"', 1)
-    text = text.replace("# Random arena", "# Random timed tasks (stt_codegen.bench.task_arenas) "
+    text = text.replace("# Random arena", "# Random timed tasks (stt_codegen_bench.task_arenas) "
                         "in random arena", 1)
     for j in range(m):
         centre = WINDOW_SPACING * (j + 1)

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import DesignError, SpecError
+from stt_codegen.errors import DesignError, SpecError
 from .task_arenas import task_problem
 from .task_baseline import plan_timed, track_timed
 
@@ -45,8 +45,8 @@ def run_task_problem(seed: int, index: int) -> dict[str, Any]:
         "choices" (alternative per task or None), and for STT with moving obstacles "motion" (how the tube was
         found, ``Design.motion``)}}}``.
     """
-    from ..design.search import design_tube
-    from ..runtime.simulate import run_closed_loop
+    from stt_codegen.design.search import design_tube
+    from stt_codegen.runtime.simulate import run_closed_loop
     spec = task_problem(seed, index)
     out: dict[str, Any] = {}
     try:
