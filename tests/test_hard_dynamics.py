@@ -21,7 +21,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from conftest import CASES, designed
-from stt_codegen_bench.arenas import generate_arena
+from stt_codegen_bench.arenas import arena_spec
 from stt_codegen.design.search import design_tube
 from stt_codegen.errors import DesignError
 from stt_codegen.runtime.simulate import run_closed_loop, simulate
@@ -106,7 +106,7 @@ def test_unknown_plants_on_random_arenas(index, seed, f_amp, g_min, w_amp):
     Arenas without a certifiable design are the benchmark's subject (docs/performance.md),
     not this property's: they are skipped by ``assume``.
     """
-    spec = generate_arena(seed=0, index=index).to_spec()
+    spec = arena_spec("paper", 0, index)
     try:
         design = design_tube(spec)
     except DesignError:

@@ -1,7 +1,7 @@
 """``stt-codegen bench tasks``: timed reach tasks, STT against sequential A* with waiting.
 
-On each random problem of :mod:`.task_arenas` (2-3 timed reach goals, the first with two
-alternatives, four static obstacles, 0-4 moving obstacles):
+On each random problem (kind ``"tasks"`` of :func:`~.arenas.make_arena`: 2-3 timed reach
+goals, the first with two alternatives, four static obstacles, 0-4 moving obstacles):
 
 * **STT**: :func:`~stt_codegen.design.search.design_tube` (via legs through the tasks'
   boxes, every task certified for every ``t``), then the generated C controller (backend
@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from stt_codegen.errors import DesignError, SpecError
-from .task_arenas import task_problem
+from .arenas import arena_spec
 from .task_baseline import plan_timed, track_timed
 
 __all__ = ["METHODS", "format_tasks_report", "run_tasks_bench"]
@@ -47,7 +47,7 @@ def run_task_problem(seed: int, index: int) -> dict[str, Any]:
     """
     from stt_codegen.design.search import design_tube
     from stt_codegen.runtime.simulate import run_closed_loop
-    spec = task_problem(seed, index)
+    spec = arena_spec("tasks", seed, index)
     out: dict[str, Any] = {}
     try:
         design = design_tube(spec)
