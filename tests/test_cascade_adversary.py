@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import stt_codegen as stt
-from stt_codegen.bench.second_order_study import random_parameters, run_second_order_study
+from stt_codegen_bench.second_order_study import random_parameters, run_second_order_study
 from stt_codegen.design.certificate.cascade_adversary import STRATEGIES, search_cascade
 from stt_codegen.design.certificate.cascade_sampled import cascade_class, certify_stage
 

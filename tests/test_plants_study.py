@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from conftest import designed
 
-from stt_codegen.bench import plants_study
+from stt_codegen_bench import plants_study
 from stt_codegen.design.samples import sample_tube
 from stt_codegen.spec.assumptions import Assumptions
 from stt_codegen.verification.class_search import (class_matrices, fixed_directions, replay,

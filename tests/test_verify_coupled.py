@@ -13,7 +13,7 @@ import pytest
 from conftest import CASES, designed
 from plants_helpers import plant_system, plant_within
 
-from stt_codegen.bench.plants_study import study_one
+from stt_codegen_bench.plants_study import study_one
 from stt_codegen.design.samples import sample_tube
 from stt_codegen.runtime.simulate import run_closed_loop
 from stt_codegen.spec.assumptions import Assumptions

@@ -79,6 +79,19 @@ class VerificationReport:
     checks : tuple of Check
         In the order of :func:`stt_codegen.verification.command.verify_design`; a spec for
         which no tube can be designed has the single failed check ``tube.design``.
+
+    Examples
+    --------
+    What :func:`stt_codegen.verify` returns, here built by hand:
+
+    >>> from stt_codegen.proofs.check import Check, VerificationReport
+    >>> report = VerificationReport("corridor", (
+    ...     Check("tube.contains_start", True, "x(0) inside at t = 0"),
+    ...     Check("tube.avoids_obstacle_0", False, "meets it at t = 2.1 s")))
+    >>> report.passed, [c.name for c in report.failed]
+    (False, ['tube.avoids_obstacle_0'])
+    >>> print(report["tube.contains_start"])
+    [PASS] tube.contains_start: x(0) inside at t = 0
     """
 
     spec: str

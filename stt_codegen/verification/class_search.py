@@ -59,7 +59,7 @@ class it breaks is out of reach of a sound check with or without them.
 every interval alike, and reports a member it finds, confirmed on the numpy reference of
 the deployed controller (:func:`replay`): the failure is then not the check's caution.
 The wide study runs the search on each plant's class
-(``python -m stt_codegen.bench.plants_study --classes``; docs/sampled-data.md, "The wide
+(``python -m stt_codegen_bench.plants_study --classes``; docs/sampled-data.md, "The wide
 study, and how much a sound check can accept").
 """
 

@@ -64,14 +64,14 @@ def run_step_bench(spec_arg: str, steps: int | None = None, rounds: int = ROUNDS
     BenchError
         The harness could not be built or run.
     """
-    from ..runtime.backends import make_controller
-    from ..runtime.compiled import GeneratedPythonController
-    from ..design.search import design_tube
-    from ..codegen.emit import count_operations
-    from ..errors import SpecError
-    from ..tube.model import build_model
-    from ..tube.reference import controller_step
-    from ..spec.loader import load_spec
+    from stt_codegen.runtime.backends import make_controller
+    from stt_codegen.runtime.compiled import GeneratedPythonController
+    from stt_codegen.design.search import design_tube
+    from stt_codegen.codegen.emit import count_operations
+    from stt_codegen.errors import SpecError
+    from stt_codegen.tube.model import build_model
+    from stt_codegen.tube.reference import controller_step
+    from stt_codegen.spec.loader import load_spec
 
     steps = DEFAULT_STEPS if steps is None else steps
     if steps < 1:

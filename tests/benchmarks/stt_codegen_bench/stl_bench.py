@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import DesignError, SpecError
+from stt_codegen.errors import DesignError, SpecError
 from .stl_judge import FINE_PERIOD, robustness, stlpy_robustness
 from .stl_scenarios import (ORDER_NOTE, SCENARIOS, SKIPPED, make_scenario, scenario_names,
                             scenario_spec, spec_toml, step_seconds, workspace)
@@ -198,9 +198,9 @@ def _row(name: str, variant: str) -> dict[str, Any]:
 
 def _design_and_judge(name: str, variant: str, doc: dict[str, Any], sc: Any,
                       output_dim: int) -> dict[str, Any]:
-    from ..design.search import design_tube
-    from ..runtime.simulate import simulate
-    from ..spec.loader import Spec
+    from stt_codegen.design.search import design_tube
+    from stt_codegen.runtime.simulate import simulate
+    from stt_codegen.spec.loader import Spec
     row = _row(name, variant)
     row["input_bound"] = doc.get("actuator", {}).get("input_bound")
     try:

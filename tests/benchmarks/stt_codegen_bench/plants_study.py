@@ -12,9 +12,9 @@ hold the check accepts.
 The plants and seeds are those of the former ``tests/study_unknown_dynamics.py`` (issue
 7), which this module replaces, so that the numbers compare. Run::
 
-    python -m stt_codegen.bench.plants_study [RUNS_PER_CASE] [--workers W] [--out rows.json]
+    python -m stt_codegen_bench.plants_study [RUNS_PER_CASE] [--workers W] [--out rows.json]
                                              [--classes] [--own-gain]
-    python -m stt_codegen.bench.plants_study --recheck rows.json [--out new.json]
+    python -m stt_codegen_bench.plants_study --recheck rows.json [--out new.json]
 
 ``--classes`` also searches the class of each plant that holds for a member that leaves
 the tube, with three adversaries (:data:`ADVERSARIES`): the switching one
@@ -46,14 +46,14 @@ from pathlib import Path
 
 import numpy as np
 
-from ..design.gain import derived_gain
-from ..design.samples import sample_tube
-from ..design.search import design_tube
-from ..runtime.simulate import run_closed_loop
-from ..spec.assumptions import Assumptions
-from ..spec.loader import load_spec
-from ..design.certificate.sampled import check_sampled
-from ..verification.class_search import replay, search_class, search_time_invariant, unit_skew
+from stt_codegen.design.gain import derived_gain
+from stt_codegen.design.samples import sample_tube
+from stt_codegen.design.search import design_tube
+from stt_codegen.runtime.simulate import run_closed_loop
+from stt_codegen.spec.assumptions import Assumptions
+from stt_codegen.spec.loader import load_spec
+from stt_codegen.design.certificate.sampled import check_sampled
+from stt_codegen.verification.class_search import replay, search_class, search_time_invariant, unit_skew
 
 __all__ = ["ADVERSARIES", "CASES", "COLUMNS", "RANGES", "check_columns", "draw",
            "own_bounds", "plant_parameters", "recheck", "study_one", "study_plants", "summary",
@@ -514,7 +514,7 @@ def summary(rows: list[dict]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m stt_codegen.bench.plants_study",
+    parser = argparse.ArgumentParser(prog="python -m stt_codegen_bench.plants_study",
                                      description=__doc__.split("\n\n")[0])
     parser.add_argument("runs", nargs="?", type=int, default=100,
                         help="plants per bundled case (default 100)")

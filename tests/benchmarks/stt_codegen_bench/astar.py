@@ -16,7 +16,7 @@ import time
 import networkx as nx
 import numpy as np
 
-from ..spec.loader import Spec
+from stt_codegen.spec.loader import Spec
 from .planning import FreeSpace, Plan
 
 __all__ = ["RESOLUTION", "grid_graph", "grid_path", "plan_astar"]

@@ -26,10 +26,10 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..errors import SpecError
-from ..spec.loader import Box, Spec
-from ..spec.motion import moving_obstacle
-from ..spec.schema import BoxObstacle
+from stt_codegen.errors import SpecError
+from stt_codegen.spec.loader import Box, Spec
+from stt_codegen.spec.motion import moving_obstacle
+from stt_codegen.spec.schema import BoxObstacle
 
 __all__ = ["random_moving_obstacles"]
 

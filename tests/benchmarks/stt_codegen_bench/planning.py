@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..spec.loader import Spec
+from stt_codegen.spec.loader import Spec
 
 __all__ = ["FreeSpace", "MARGIN", "Plan"]
 

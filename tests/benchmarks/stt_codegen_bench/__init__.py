@@ -11,7 +11,7 @@
 * :mod:`.alpha` - the implicit alpha step: Newton iterations, convergence in ``dt``;
 * :mod:`.report` - statistics, tables and the machine description.
 
-The ``bench`` subcommand's arguments are in :mod:`stt_codegen.cli.bench`.
+The ``bench`` subcommand's arguments are in :mod:`stt_codegen_bench.cli`.
 
 Every benchmark measures what it compares side by side in one run and reports ratios;
 the tests check structure and invariants, never speed; they count work where a

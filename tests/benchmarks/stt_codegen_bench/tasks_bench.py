@@ -1,7 +1,7 @@
 """``stt-codegen bench tasks``: timed reach tasks, STT against sequential A* with waiting.
 
-On each random problem of :mod:`.task_arenas` (2-3 timed reach goals, the first with two
-alternatives, four static obstacles, 0-4 moving obstacles):
+On each random problem (kind ``"tasks"`` of :func:`~.arenas.make_arena`: 2-3 timed reach
+goals, the first with two alternatives, four static obstacles, 0-4 moving obstacles):
 
 * **STT**: :func:`~stt_codegen.design.search.design_tube` (via legs through the tasks'
   boxes, every task certified for every ``t``), then the generated C controller (backend
@@ -24,8 +24,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import DesignError, SpecError
-from .task_arenas import task_problem
+from stt_codegen.errors import DesignError, SpecError
+from .arenas import arena_spec
 from .task_baseline import plan_timed, track_timed
 
 __all__ = ["METHODS", "format_tasks_report", "run_tasks_bench"]
@@ -45,9 +45,9 @@ def run_task_problem(seed: int, index: int) -> dict[str, Any]:
         "choices" (alternative per task or None), and for STT with moving obstacles "motion" (how the tube was
         found, ``Design.motion``)}}}``.
     """
-    from ..design.search import design_tube
-    from ..runtime.simulate import run_closed_loop
-    spec = task_problem(seed, index)
+    from stt_codegen.design.search import design_tube
+    from stt_codegen.runtime.simulate import run_closed_loop
+    spec = arena_spec("tasks", seed, index)
     out: dict[str, Any] = {}
     try:
         design = design_tube(spec)

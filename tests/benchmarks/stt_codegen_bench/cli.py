@@ -1,5 +1,5 @@
 """``stt-codegen bench arenas | tasks | drive | step | scaling | covering | alpha | second-order |
-stl``: the benchmarks and studies of :mod:`stt_codegen.bench`."""
+stl``: the benchmarks and studies of :mod:`stt_codegen_bench`."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ import argparse
 import json
 from pathlib import Path
 
-from ..errors import SpecError
-from ..spec.plants import plant_entry
-from .common import add_json_argument, add_spec_argument
+from stt_codegen.errors import SpecError
+from stt_codegen.spec.plants import plant_entry
+from stt_codegen.cli.common import add_json_argument, add_spec_argument
 
 __all__ = ["configure_bench"]
 
@@ -34,13 +34,13 @@ def _int_list(text: str, field: str) -> list[int]:
 
 def _cmd_arenas(args: argparse.Namespace) -> int:
     if plant_entry(args.plant).order == 2:    # the cascade beside A* + tracker
-        from ..bench.second_order_arenas import (format_double_integrator_report,
+        from .second_order_arenas import (format_double_integrator_report,
                                                  run_double_integrator_bench)
         report = run_double_integrator_bench(args.count, args.seed)
         print(json.dumps(report, indent=1, sort_keys=True) if args.json
               else format_double_integrator_report(report))
         return 0
-    from ..bench.arenas_bench import format_arenas_report, run_arenas_bench, write_specs
+    from .arenas_bench import format_arenas_report, run_arenas_bench, write_specs
     if args.specs:
         write_specs(Path(args.specs), args.count, args.seed)
     report = run_arenas_bench(args.count, args.seed, workers=args.workers,
@@ -53,7 +53,7 @@ def _cmd_arenas(args: argparse.Namespace) -> int:
 
 
 def _cmd_drive(args: argparse.Namespace) -> int:
-    from ..bench.office_arenas import format_office_report, run_office_bench
+    from .office_arenas import format_office_report, run_office_bench
     report = run_office_bench(args.count, args.seed)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_office_report(report))
@@ -61,7 +61,7 @@ def _cmd_drive(args: argparse.Namespace) -> int:
 
 
 def _cmd_step(args: argparse.Namespace) -> int:
-    from ..bench.step import format_step_report, run_step_bench
+    from .step import format_step_report, run_step_bench
     report = run_step_bench(args.spec, steps=args.steps)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_step_report(report))
@@ -69,7 +69,7 @@ def _cmd_step(args: argparse.Namespace) -> int:
 
 
 def _cmd_scaling(args: argparse.Namespace) -> int:
-    from ..bench.scaling import format_scaling_report, run_scaling_bench
+    from .scaling import format_scaling_report, run_scaling_bench
     report = run_scaling_bench(_int_list(args.obstacles, "obstacles"),
                                _int_list(args.dimensions, "dimensions"),
                                compile_timeout=args.compile_timeout)
@@ -79,7 +79,7 @@ def _cmd_scaling(args: argparse.Namespace) -> int:
 
 
 def _cmd_covering(args: argparse.Namespace) -> int:
-    from ..bench.covering import format_covering_report, run_covering_bench
+    from .covering import format_covering_report, run_covering_bench
     report = run_covering_bench(args.seed, args.count, args.tolerance)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_covering_report(report))
@@ -87,7 +87,7 @@ def _cmd_covering(args: argparse.Namespace) -> int:
 
 
 def _cmd_alpha(args: argparse.Namespace) -> int:
-    from ..bench.alpha import format_alpha_report, run_alpha_bench
+    from .alpha import format_alpha_report, run_alpha_bench
     report = run_alpha_bench(args.spec)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_alpha_report(report))
@@ -95,7 +95,7 @@ def _cmd_alpha(args: argparse.Namespace) -> int:
 
 
 def _cmd_tasks(args: argparse.Namespace) -> int:
-    from ..bench.tasks_bench import format_tasks_report, run_tasks_bench
+    from .tasks_bench import format_tasks_report, run_tasks_bench
     report = run_tasks_bench(args.count, args.seed, progress=not args.no_progress)
     print(json.dumps(report, indent=1, sort_keys=True, allow_nan=False) if args.json
           else format_tasks_report(report))
@@ -103,7 +103,7 @@ def _cmd_tasks(args: argparse.Namespace) -> int:
 
 
 def _cmd_second_order(args: argparse.Namespace) -> int:
-    from ..bench.second_order_study import format_second_order_report, run_second_order_study
+    from .second_order_study import format_second_order_report, run_second_order_study
     report = run_second_order_study(args.spec, args.count, args.seed, spread=args.spread,
                                     corners=args.corners, adversary=args.adversary)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
@@ -112,7 +112,7 @@ def _cmd_second_order(args: argparse.Namespace) -> int:
 
 
 def _cmd_stl(args: argparse.Namespace) -> int:
-    from ..bench.stl_bench import format_stl_report, run_stl_bench
+    from .stl_bench import format_stl_report, run_stl_bench
     names = [n.strip() for n in args.scenarios.split(",") if n.strip()] if args.scenarios \
         else None
     report = run_stl_bench(names, horizon=args.horizon,

@@ -30,12 +30,12 @@ import casadi as ca
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ..design.samples import sample_tube
-from ..design.search import design_tube
-from ..spec.loader import load_spec
-from ..tube import reference as R
-from ..tube.model import implicit_alpha_update
-from ..tube.parameters import NEWTON_ITERATIONS, TubeDesign
+from stt_codegen.design.samples import sample_tube
+from stt_codegen.design.search import design_tube
+from stt_codegen.spec.loader import load_spec
+from stt_codegen.tube import reference as R
+from stt_codegen.tube.model import implicit_alpha_update
+from stt_codegen.tube.parameters import NEWTON_ITERATIONS, TubeDesign
 from .report import machine, machine_line, table
 
 __all__ = ["RATE_FACTORS", "format_alpha_report", "run_alpha_bench"]

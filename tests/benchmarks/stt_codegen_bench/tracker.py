@@ -22,11 +22,11 @@ import math
 
 import numpy as np
 
-from ..runtime.backends import STATUS_OK, backend_names, register_backend
-from ..design.search import base_design
-from ..runtime.simulate import SimulationResult, run_closed_loop
-from ..spec.loader import Spec
-from ..tube.parameters import TubeDesign
+from stt_codegen.runtime.backends import STATUS_OK, backend_names, register_backend
+from stt_codegen.design.search import base_design
+from stt_codegen.runtime.simulate import SimulationResult, run_closed_loop
+from stt_codegen.spec.loader import Spec
+from stt_codegen.tube.parameters import TubeDesign
 
 __all__ = ["GOAL_GAIN", "PathTracker", "SPEED", "track"]
 

@@ -29,9 +29,9 @@ import re
 import time
 from typing import Any
 
-from ..errors import DesignError
-from ..runtime.simulate import SimulationResult
-from .arenas import generate_arena
+from stt_codegen.errors import DesignError
+from stt_codegen.runtime.simulate import SimulationResult
+from .arenas import arena_spec
 
 __all__ = ["LABELS", "METHODS", "closed_loop_failure", "design_failure", "loop_arena",
            "plan_arena", "run_arena"]
@@ -124,7 +124,7 @@ def _plan_stt(spec, method: str) -> dict[str, Any]:
     "reason"}``."""
     from dataclasses import replace
 
-    from ..design.search import design_tube
+    from stt_codegen.design.search import design_tube
     spec = replace(spec, tube=replace(spec.tube, method=method))
     begin = time.perf_counter()
     try:
@@ -143,7 +143,7 @@ def plan_arena(seed: int, index: int, methods: tuple[str, ...] = METHODS) -> dic
     Parameters
     ----------
     seed, index : int
-        Which arena (see :func:`~.arenas.generate_arena`).
+        Which arena (``"paper"`` of :func:`~.arenas.make_arena`).
     methods : tuple of str
         Subset of :data:`METHODS`.
 
@@ -158,7 +158,7 @@ def plan_arena(seed: int, index: int, methods: tuple[str, ...] = METHODS) -> dic
     ValueError
         A method not in :data:`METHODS`.
     """
-    spec = generate_arena(seed, index).to_spec()
+    spec = arena_spec("paper", seed, index)
     plans: dict[str, Any] = {}
     for method in methods:
         if method in ("stt-paper", "stt"):
@@ -185,7 +185,7 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
     Parameters
     ----------
     seed, index : int
-        Which arena (see :func:`~.arenas.generate_arena`), as given to :func:`plan_arena`.
+        Which arena (``"paper"`` of :func:`~.arenas.make_arena`), as given to :func:`plan_arena`.
     plans : dict
         ``plans`` of :func:`plan_arena` for this arena.
 
@@ -200,10 +200,9 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
         tube, STT methods; ``None`` for the baselines)}}}``; the last five are ``None``
         without a closed loop.
     """
-    from ..runtime.simulate import run_closed_loop
+    from stt_codegen.runtime.simulate import run_closed_loop
     from .tracker import track
-    arena = generate_arena(seed, index)
-    spec = arena.to_spec()
+    spec = arena_spec("paper", seed, index)
     out: dict[str, Any] = {}
     runs: dict = {}
     for method, planned in plans.items():
@@ -222,7 +221,7 @@ def loop_arena(seed: int, index: int, plans: dict[str, Any]) -> dict[str, Any]:
             else:
                 result = track(spec, plan.path, seed=index)
                 out[method] = _outcome(plan.seconds, closed_loop_failure(result), result)
-    return {"index": index, "name": arena.name, "methods": out}
+    return {"index": index, "name": spec.name, "methods": out}
 
 
 def run_arena(seed: int, index: int, methods: tuple[str, ...] = METHODS) -> dict[str, Any]:

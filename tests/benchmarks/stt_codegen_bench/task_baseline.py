@@ -24,10 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..design.search import base_design
-from ..runtime.backends import STATUS_OK, backend_names, register_backend
-from ..runtime.simulate import SimulationResult, run_closed_loop
-from ..spec.loader import Spec
+from stt_codegen.design.search import base_design
+from stt_codegen.runtime.backends import STATUS_OK, backend_names, register_backend
+from stt_codegen.runtime.simulate import SimulationResult, run_closed_loop
+from stt_codegen.spec.loader import Spec
 from .astar import RESOLUTION, grid_graph, grid_path
 from .planning import FreeSpace
 from .task_timing import departure

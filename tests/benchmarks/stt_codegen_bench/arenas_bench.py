@@ -6,10 +6,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from ..errors import SpecError
-from ..system import atomic_write
+from stt_codegen.errors import SpecError
+from stt_codegen.system import atomic_write
 from .arena_job import LABELS, METHODS, loop_arena, plan_arena
-from .arenas import generate_arenas
+from .arenas import make_arena
 from .parallel import run_parallel
 from .report import machine, machine_line, seconds_text, summarize, table
 from .rrtstar import ompl_available
@@ -60,9 +60,11 @@ def write_specs(folder: Path, count: int, seed: int) -> list[Path]:
     if not folder.is_dir():
         raise SpecError("specs", f"folder {str(folder)!r} does not exist")
     paths = []
-    for arena in generate_arenas(count, seed):
-        path = folder / f"{arena.name}.toml"
-        text = arena.to_toml().encode("utf-8")
+    if count < 1:
+        raise SpecError("count", f"must be at least 1, got {count}")
+    for k in range(count):
+        path = folder / f"arena-{seed}-{k}.toml"
+        text = make_arena("paper", seed, k).encode("utf-8")
         atomic_write(path, text, field="specs")
         paths.append(path)
     return paths
@@ -100,7 +102,7 @@ def run_arenas_bench(count: int, seed: int, workers: int | None = None,
     SpecError
         Bad count, seed, workers, scheduler, or an unknown method.
     """
-    generate_arenas(1, seed)  # validates the seed
+    make_arena("paper", seed)  # validates the seed
     if count < 1:
         raise SpecError("count", f"must be at least 1, got {count}")
     usable, skipped = available_methods()

@@ -20,7 +20,7 @@ from typing import Any
 
 from tqdm import tqdm
 
-from ..errors import SpecError
+from stt_codegen.errors import SpecError
 
 __all__ = ["run_parallel"]
 

@@ -22,13 +22,13 @@ import time
 
 import numpy as np
 
-from ..design.search import design_tube
-from ..errors import SpecError
-from ..runtime.plants import second_order_plant
-from ..runtime.simulate import run_closed_loop
-from ..spec.loader import load_spec
-from ..design.certificate.cascade_adversary import search_cascade
-from ..design.certificate.cascade_sampled import cascade_class
+from stt_codegen.design.search import design_tube
+from stt_codegen.errors import SpecError
+from stt_codegen.runtime.plants import second_order_plant
+from stt_codegen.runtime.simulate import run_closed_loop
+from stt_codegen.spec.loader import load_spec
+from stt_codegen.design.certificate.cascade_adversary import search_cascade
+from stt_codegen.design.certificate.cascade_sampled import cascade_class
 
 __all__ = ["DRAG_MAX", "format_second_order_report", "random_parameters", "run_second_order_study"]
 

@@ -1,10 +1,11 @@
 """``stt-codegen bench covering``: covering many polygons by boxes, and designing around them.
 
-The spec (:func:`polygons_toml`): ``count`` random convex polygons (3-7 vertices, radius
-0.05-0.2 m, centres in ``[0.9, 4.1]^2``, seeded) at one ``tolerance``, in the 5 m x 5 m
-arena with the start ``[0, 0.5]^2`` and the target ``[4.5, 5]^2``. Measured, in this
-process: the boxes of the covering, the CPU and wall seconds of ``parse_spec`` (which
-covers every polygon) and of ``design_tube`` (search and certificate). The tests count
+The spec: ``count`` random convex polygons at one ``tolerance`` (kind ``"polygons"`` of
+:func:`~.arenas.make_arena`: 3-7 vertices, radius 0.05-0.2 m, centres in ``[0.9, 4.1]^2``,
+seeded, in the 5 m x 5 m arena with the start ``[0, 0.5]^2`` and the target
+``[4.5, 5]^2``). Measured, in this process: the boxes of the covering, the CPU and wall
+seconds of ``parse_spec`` (which covers every polygon) and of ``design_tube`` (search and
+certificate). The tests count
 the covering's work instead (``tests/test_covering.py``); this command gives the seconds.
 """
 
@@ -13,50 +14,14 @@ from __future__ import annotations
 import time
 from typing import Any
 
-import numpy as np
+from stt_codegen.design.search import design_tube
+from stt_codegen.errors import DesignError, SpecError
+from stt_codegen.spec.loader import parse_spec
 
-from ..design.search import design_tube
-from ..errors import DesignError, SpecError
-from ..spec.loader import parse_spec
+from .arenas import DEFAULT_POLYGONS, DEFAULT_TOLERANCE, make_arena
 from .report import machine, machine_line, table
 
-__all__ = ["format_covering_report", "polygons_toml", "run_covering_bench"]
-
-#: The default spec: 80 polygons at tolerance 0.02 (docs/performance.md).
-DEFAULT_COUNT = 80
-DEFAULT_TOLERANCE = 0.02
-
-
-def polygons_toml(seed: int = 0, count: int = DEFAULT_COUNT,
-                  tolerance: float = DEFAULT_TOLERANCE) -> str:
-    """The text of the spec ``polygons-S-C``: ``count`` random convex polygons of seed ``seed``.
-
-    Parameters
-    ----------
-    seed : int
-        Seed of ``numpy.random.default_rng``.
-    count : int
-        Polygons, >= 0.
-    tolerance : float
-        Every polygon's covering tolerance, metres.
-
-    Returns
-    -------
-    str
-        A spec file's text (TOML).
-    """
-    rng = np.random.default_rng(seed)
-    extra = ""
-    for _ in range(count):
-        centre, radius = rng.uniform(0.9, 4.1, 2), rng.uniform(0.05, 0.2)
-        angles = np.sort(rng.uniform(0.0, 2 * np.pi, int(rng.integers(3, 8))))
-        points = centre + radius * np.c_[np.cos(angles), np.sin(angles)]
-        extra += ("[[obstacles]]\nvertices = [" + ", ".join(
-            f"[{float(x)!r}, {float(y)!r}]" for x, y in points) + f"]\ntolerance = {tolerance!r}\n")
-    return (f'\nname = "polygons-{seed}-{count}"\nprescribed_time = 9.0\n'
-            "[state_space]\nlower = [0.0, 0.0]\nupper = [5.0, 5.0]\n"
-            "[initial]\nlower = [0.0, 0.0]\nupper = [0.5, 0.5]\n"
-            "[target]\nlower = [4.5, 4.5]\nupper = [5.0, 5.0]\n" + extra)
+__all__ = ["format_covering_report", "run_covering_bench"]
 
 
 def _timed(fn):
@@ -66,14 +31,14 @@ def _timed(fn):
     return result, time.process_time() - cpu, time.perf_counter() - wall
 
 
-def run_covering_bench(seed: int = 0, count: int = DEFAULT_COUNT,
+def run_covering_bench(seed: int = 0, count: int = DEFAULT_POLYGONS,
                        tolerance: float = DEFAULT_TOLERANCE) -> dict[str, Any]:
-    """Cover and design the spec of :func:`polygons_toml`, timed.
+    """Cover and design the ``"polygons"`` arena of :func:`~.arenas.make_arena`, timed.
 
     Parameters
     ----------
     seed : int, optional
-        Seed of the polygons (:func:`polygons_toml`).
+        Seed of the polygons.
     count : int, optional
         Number of polygons, >= 0.
     tolerance : float, optional
@@ -96,7 +61,7 @@ def run_covering_bench(seed: int = 0, count: int = DEFAULT_COUNT,
         raise SpecError("count", f"must be non-negative, got {count}")
     if not tolerance > 0:
         raise SpecError("tolerance", f"must be positive, got {tolerance}")
-    text = polygons_toml(seed, count, tolerance)
+    text = make_arena("polygons", seed, polygons=count, tolerance=tolerance)
     spec, cover_cpu, cover_wall = _timed(lambda: parse_spec(text))
     reason, found = "", None
 

@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from ..spec.loader import Spec
+from stt_codegen.spec.loader import Spec
 from .planning import FreeSpace, Plan
 
 __all__ = ["ompl_available", "plan_rrtstar"]

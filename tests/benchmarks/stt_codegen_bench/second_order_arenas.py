@@ -1,7 +1,7 @@
 """``stt-codegen bench arenas --plant double-integrator``: the cascade on random arenas,
 beside a planner and a tracker for the same plant (docs/second-order.md).
 
-The arenas are :func:`~.arenas.generate_arena`'s (seeded, four 1 m obstacles, 5 m x 5 m,
+The arenas are the ``"paper"`` arenas of :func:`~.arenas.make_arena` (seeded, four 1 m obstacles, 5 m x 5 m,
 ``t_c = 9`` s). The plant is a double integrator ``x2_dot = u / m + w`` with ``m = 1`` kg
 and the arena's disturbance bound (0.1 per axis, here m/s^2), starting at rest; both
 methods run in the same loop (:func:`~stt_codegen.runtime.simulate.run_closed_loop`)
@@ -22,13 +22,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..design.cascade_gain import derived_second_stage
-from ..design.search import design_tube
-from ..errors import DesignError
-from ..runtime.simulate import run_closed_loop
-from ..spec.loader import Spec
-from ..spec.second_order import SecondOrder
-from .arenas import generate_arena
+from stt_codegen.design.cascade_gain import derived_second_stage
+from stt_codegen.design.search import design_tube
+from stt_codegen.errors import DesignError
+from stt_codegen.runtime.simulate import run_closed_loop
+from stt_codegen.spec.loader import Spec
+from stt_codegen.spec.second_order import SecondOrder
+from .arenas import arena_spec
 
 __all__ = ["double_integrator_spec", "format_double_integrator_report",
            "run_arena_double_integrator", "run_double_integrator_bench"]
@@ -66,7 +66,7 @@ def double_integrator_spec(spec: Spec) -> Spec:
     Parameters
     ----------
     spec : Spec
-        A first-order arena spec (:func:`~.arenas.generate_arena`).
+        A first-order arena spec (:func:`~.arenas.make_arena`).
 
     Returns
     -------
@@ -107,7 +107,7 @@ def run_arena_double_integrator(seed: int, index: int) -> dict:
         ``peak_u``, ``collision`` and ``in_tube``.
     """
     from .astar import plan_astar
-    spec = generate_arena(seed, index).to_spec()
+    spec = arena_spec("paper", seed, index)
     spec = replace(spec, tube=replace(spec.tube, circumvent_sharpness=SHARPNESS))
     out: dict = {"index": index}
     begin = time.perf_counter()
@@ -130,7 +130,7 @@ def run_arena_double_integrator(seed: int, index: int) -> dict:
     else:
         # the loop reports max |e1| in a tube: the arena's design, else the base tube
         # (unchecked); the tracker never reads it
-        from ..design.search import base_design
+        from stt_codegen.design.search import base_design
         tube = design.tube if design is not None else base_design(spec)
         result = run_closed_loop(double_integrator_spec(spec), tube,
                                  backend="astar-tracker", seed=index,

@@ -1,8 +1,7 @@
-"""A study of moving obstacles on random arenas: ``python -m stt_codegen.bench.moving_study``.
+"""A study of moving obstacles on random arenas: ``python -m stt_codegen_bench.moving_study``.
 
-Arena ``k`` of seed ``S`` (:func:`~.arenas.generate_arena`, four static 1 m boxes) gets 0-4
-random moving obstacles (:func:`~.moving.random_moving_obstacles`, generator
-``default_rng([S, k])``). For each, the design (:func:`stt_codegen.design_tube`: space-time,
+Arena ``k`` of seed ``S`` (kind ``"moving"`` of :func:`~.arenas.make_arena`: four static 1 m boxes and 0-4
+random moving obstacles). For each, the design (:func:`stt_codegen.design_tube`: space-time,
 re-timed via, swept) and, as the baseline a user would otherwise take, the *swept-only*
 design (every moving obstacle as the static box it sweeps,
 :func:`~stt_codegen.design.swept.swept_spec`) are run; each design found is simulated (Python backend, collisions with moving obstacles
@@ -15,19 +14,17 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
-import tomllib
 from collections import Counter
 from typing import Any
 
 import numpy as np
 
-from ..design.swept import swept_spec
-from ..design.search import design_tube
-from ..errors import DesignError
-from ..runtime.simulate import simulate
-from ..spec.loader import Spec
-from .arenas import generate_arena
-from .moving import random_moving_obstacles
+from stt_codegen.design.swept import swept_spec
+from stt_codegen.design.search import design_tube
+from stt_codegen.errors import DesignError
+from stt_codegen.runtime.simulate import simulate
+from stt_codegen.spec.loader import Spec
+from .arenas import arena_spec
 
 __all__ = ["study_moving"]
 
@@ -63,12 +60,8 @@ def study_moving(count: int, seed: int) -> dict[str, Any]:
     rows: dict[str, list[tuple[str, float, bool]]] = {"stt": [], "swept_only": []}
     drawn = 0
     for k in range(count):
-        arena = generate_arena(seed, k)
-        doc = tomllib.loads(arena.to_toml())
-        moving = random_moving_obstacles(np.random.default_rng([seed, k]), arena.to_spec())
-        drawn += len(moving)
-        doc["obstacles"] = doc.get("obstacles", []) + moving
-        spec = Spec.from_dict(doc)
+        spec = arena_spec("moving", seed, k)
+        drawn += len(spec.moving_obstacles)
         rows["stt"].append(_run(spec))
         swept, _ = swept_spec(spec) if spec.moving_obstacles else (spec, "")
         if swept is None:
@@ -91,7 +84,7 @@ def study_moving(count: int, seed: int) -> dict[str, Any]:
 
 def main(argv: list[str] | None = None) -> int:
     """Print the study for ``--count`` arenas of ``--seed``."""
-    parser = argparse.ArgumentParser(prog="python -m stt_codegen.bench.moving_study")
+    parser = argparse.ArgumentParser(prog="python -m stt_codegen_bench.moving_study")
     parser.add_argument("--count", type=int, default=50)
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args(argv)

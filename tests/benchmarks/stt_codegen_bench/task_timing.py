@@ -26,7 +26,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..spec.motion import MovingObstacle
+from stt_codegen.spec.motion import MovingObstacle
 from .planning import MARGIN
 from .tracker import SPEED
 

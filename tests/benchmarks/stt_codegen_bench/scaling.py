@@ -27,8 +27,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import SpecError
-from ..tube.parameters import LOWER, UPPER, Circumvent, TubeDesign, paper_segments
+from stt_codegen.errors import SpecError
+from stt_codegen.tube.parameters import LOWER, UPPER, Circumvent, TubeDesign, paper_segments
 from .harness import BenchError, build_harness
 from .report import machine, machine_line, seconds_text, table
 from .timing import MIN_BATCH_SECONDS
@@ -125,8 +125,8 @@ def measure(design: TubeDesign, compile_timeout: float, callgrind: bool = True,
         ``operations`` (of the CasADi ``controller_step``), ``outside_tube_inputs``;
         or, when the build fails, ``error``.
     """
-    from ..codegen.emit import count_operations
-    from ..tube.model import build_model
+    from stt_codegen.codegen.emit import count_operations
+    from stt_codegen.tube.model import build_model
     row: dict[str, Any] = {"obstacles": len(design.circumvents), "dimension": design.dimension}
     try:
         harness = build_harness(design, compile_timeout=compile_timeout)
