@@ -54,6 +54,18 @@ def demo_jobs(args: argparse.Namespace, cases: int) -> int:
     """The number of processes that run the cases: ``--jobs``, else the CPUs this process
     may use, at most 2; never more than the cases.
 
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments with ``jobs`` (an int, or ``None`` for the default).
+    cases : int
+        The number of cases to run.
+
+    Returns
+    -------
+    int
+        The number of processes, in ``[1, cases]`` (1: the cases run in this process).
+
     Raises
     ------
     SpecError
