@@ -7,8 +7,8 @@ import dataclasses
 
 import numpy as np
 import pytest
+from conftest import design_of
 
-import stt_codegen as stt
 from stt_codegen_bench.second_order_study import random_parameters, run_second_order_study
 from stt_codegen.design.certificate.cascade_adversary import STRATEGIES, search_cascade
 from stt_codegen.design.certificate.cascade_sampled import cascade_class, certify_stage
@@ -16,7 +16,7 @@ from stt_codegen.design.certificate.cascade_sampled import cascade_class, certif
 
 @pytest.fixture(scope="module")
 def s1():
-    design = stt.design_tube(stt.load_spec("second-order-s1"))
+    design = design_of("second-order-s1")
     return design, design.second_stage[0]
 
 

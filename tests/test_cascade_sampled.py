@@ -10,6 +10,7 @@ import pathlib
 
 import numpy as np
 import pytest
+from conftest import design_of
 
 import stt_codegen as stt
 from stt_codegen.design.cascade_gain import derived_second_stage
@@ -134,9 +135,10 @@ def test_umaze_at_1_khz_is_certified_and_no_adversary_leaves_a_tube(strategy) ->
     assert u <= max(certificate["peak_input"])
 
 
-@pytest.mark.parametrize("strategy", ["g_min", "g_max", "switch", "random"])
+@pytest.mark.parametrize("strategy", ["g_min", *(pytest.param(s, marks=pytest.mark.slow)
+                                                for s in ("g_max", "switch", "random"))])
 def test_s1_certificate_contains_the_adversaries(strategy) -> None:
-    design = stt.design_tube(stt.load_spec("second-order-s1"))
+    design = design_of("second-order-s1")
     stage, derivation = design.second_stage
     certificate = derivation["certificate"]
     e1, e2, u = adversary_run(design, stage, cascade_class(design.spec), strategy)
@@ -146,7 +148,7 @@ def test_s1_certificate_contains_the_adversaries(strategy) -> None:
 
 
 def test_a_mutated_gain_or_rate_is_refused() -> None:
-    design = stt.design_tube(stt.load_spec("second-order-s1"))
+    design = design_of("second-order-s1")
     stage, _ = design.second_stage
     assert cascade_check_of(design.tube, design.spec, stage).passed
     # k2 twenty times larger: the held input overshoots the velocity tube

@@ -128,6 +128,26 @@ def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
     assert again.returncode == 0, again.stderr
 
 
+def test_demo_jobs_below_one_is_bad_input_before_any_work(tmp_path):
+    out = run("demo", "--out", str(tmp_path / "demo"), "--jobs", "0")
+    assert out.returncode == 2 and out.stderr == "error: --jobs: must be at least 1, got 0\n"
+    assert not (tmp_path / "demo").exists()
+
+
+def test_demo_in_two_processes_reports_a_case_without_design(tmp_path, monkeypatch, capsys):
+    """A worker's DesignError reaches the command line as the same one line, exit 1."""
+    from stt_codegen import cases
+    from stt_codegen.cli import main
+    paths = []
+    for name in ("reversed-a", "reversed-b"):
+        paths.append(tmp_path / f"{name}.toml")
+        paths[-1].write_text(REVERSED_PLANT.replace('name = "reversed"', f'name = "{name}"'))
+    monkeypatch.setattr(cases, "bundled_cases", lambda: [str(p) for p in paths])
+    assert main(["demo", "--out", str(tmp_path / "out"), "--jobs", "2"]) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and err.count("\n") == 1 and "Traceback" not in err
+
+
 def test_atomic_write_leaves_a_normal_file_or_nothing(tmp_path):
     """The file gets the permissions of any new file (not a temporary file's 0600), and a
     writer that fails leaves nothing behind."""

@@ -122,6 +122,19 @@ def test_a_command_imports_its_module_only_when_chosen():
     assert args.languages == "c" and args.out_dir == "x" and callable(args.handler)
 
 
+def test_design_without_plot_imports_no_plotting_and_no_simulator():
+    """``stt-codegen design`` imports matplotlib only for ``--plot``, and neither MuJoCo nor
+    the simulator (python-control) for a spec whose plant has equations; ``--dims`` is
+    checked without matplotlib (docs/performance.md, command overhead; no timing)."""
+    out = _imported_after("import contextlib, io\nfrom stt_codegen.cli import main\n"
+                          "with contextlib.redirect_stdout(io.StringIO()):\n"
+                          "    assert main(['design', 'omnirobot-s1', '--dims', '1,0']) == 0\n"
+                          "print('mujoco' in sys.modules)")
+    assert {"matplotlib", "control", "sympy", "jinja2"}.isdisjoint(out["heavy"]), out["heavy"]
+    assert "casadi" in out["heavy"]                  # the probe did design (the tube's model)
+    assert out["stdout"].splitlines()[0] == "False", "design imported mujoco"
+
+
 def test_every_command_is_configured_by_an_existing_function():
     import importlib
     for name, (help_text, target) in cli.COMMANDS.items():

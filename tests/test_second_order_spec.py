@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import design_of
 
 import stt_codegen as stt
 from stt_codegen.cases import bundled_spec_bytes
@@ -275,7 +276,7 @@ def test_the_front_door_simulates_a_second_order_design_with_the_cascade(tmp_pat
     """``stt.simulate`` runs the cascade law on the spec's second-order model, in the one
     closed loop, with the one result type that ``plot_run`` draws; the command line's text
     output works."""
-    design = stt.design_tube(stt.load_spec("second-order-s1"))
+    design = design_of("second-order-s1")
     result = stt.simulate(design, horizon=0.5)
     assert isinstance(result, stt.SimulationResult) and result.tasks == []
     traj = result.trajectory

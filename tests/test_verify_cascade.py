@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from conftest import design_of
 
 from stt_codegen.proofs import cascade as V
 
@@ -39,7 +40,7 @@ def test_every_cascade_check_passes_in_two_dimensions() -> None:
 @pytest.mark.slow
 def test_verify_of_a_second_order_spec_proves_the_lemmas_and_the_sampled_cascade():
     import stt_codegen as stt
-    report = stt.verify(stt.design_tube(stt.load_spec("second-order-s1")))
+    report = stt.verify(design_of("second-order-s1"))
     names = [c.name for c in report.checks]
     assert list(report.failed) == []
     assert "cascade.lyapunov_derivative.n2" in names and "cascade.velocity_tube" in names
@@ -58,7 +59,7 @@ def test_design_document_carries_the_cascade_figures_for_second_order_specs_only
     import json
 
     import stt_codegen as stt
-    document = stt.design_tube(stt.load_spec("second-order-quadrotor")).to_json()
+    document = design_of("second-order-quadrotor").to_json()
     cascade = json.loads(json.dumps(document))["cascade"]     # JSON-ready
     assert cascade["gains"]["certificate"]["passed"]
     assert cascade["gains"]["velocity_gain"] > 0

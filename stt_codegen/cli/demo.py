@@ -3,23 +3,90 @@
 from __future__ import annotations
 
 import argparse
+import multiprocessing
+import os
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
+from typing import TYPE_CHECKING
 
+from ..errors import DesignError, SpecError, SttError, ToolchainError
 from ..system import atomic_write
 from .common import add_backend_argument, design_spec
 from .plotting import add_dims_argument, plot_dims
 from .simulate import SUMMARY_HEADER, summary_line
 
-__all__ = ["cmd_demo", "configure_demo"]
+if TYPE_CHECKING:
+    from ..spec.loader import Spec
+
+__all__ = ["cmd_demo", "configure_demo", "demo_jobs"]
+
+
+def _run_case(name: str, spec: Spec, args: argparse.Namespace,
+              dims: tuple[int, int]) -> tuple[str, bool] | tuple[None, tuple]:
+    """One case of the demo: design, generate, simulate, plot; its summary line and whether
+    it is satisfied, or ``(None, failure)`` with the :class:`SttError` it raised as plain
+    data (an error crosses a process boundary as its kind and its words)."""
+    from ..codegen.api import generate
+    from ..runtime.plots import plot_run
+    from ..runtime.simulate import simulate
+    out = Path(args.out)
+    try:
+        design = design_spec(spec, args)
+        generate(design, out / name)
+        result = simulate(design, backend=args.backend)   # the cascade's for second order
+        atomic_write(out / f"{name}.png",
+                     lambda tmp: plot_run(design, result, tmp, dims=dims))
+    except SpecError as exc:
+        return None, (SpecError, exc.field, exc.reason)
+    except DesignError as exc:
+        return None, (DesignError, str(exc))
+    except SttError as exc:
+        return None, (ToolchainError, str(exc))
+    return summary_line(result), result.satisfied
+
+
+def _raise(failure: tuple) -> None:
+    kind, *words = failure
+    raise kind(*words)
+
+
+def demo_jobs(args: argparse.Namespace, cases: int) -> int:
+    """The number of processes that run the cases: ``--jobs``, else the CPUs this process
+    may use, at most 2; never more than the cases.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments with ``jobs`` (an int, or ``None`` for the default).
+    cases : int
+        The number of cases to run.
+
+    Returns
+    -------
+    int
+        The number of processes, in ``[1, cases]`` (1: the cases run in this process).
+
+    Raises
+    ------
+    SpecError
+        Field ``jobs`` (shown as ``--jobs``): below 1.
+    """
+    jobs = args.jobs if args.jobs is not None else min(2, len(os.sched_getaffinity(0)))
+    if jobs < 1:
+        raise SpecError("jobs", f"must be at least 1, got {jobs}")
+    return max(1, min(jobs, cases))
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
     """0 every case satisfied, 1 otherwise, 3 toolchain.
 
+    The cases run in ``--jobs`` processes (forked after the library is imported, so each
+    imports nothing again); the table is printed in the order of the cases.
+
     Parameters
     ----------
     args : argparse.Namespace
-        ``out`` (the folder for code and plots, created), ``backend`` and ``dims``.
+        ``out`` (the folder for code and plots, created), ``backend``, ``dims`` and ``jobs``.
 
     Returns
     -------
@@ -31,31 +98,48 @@ def cmd_demo(args: argparse.Namespace) -> int:
     ToolchainError
         A compiler is missing or fails (exit code 3).
     SpecError
-        ``--dims`` is not two distinct dimensions of a case (exit code 2).
+        ``--dims`` is not two distinct dimensions of a case, or ``--jobs`` is below 1 (exit
+        code 2).
+    DesignError
+        A case has no design (exit code 1).
     """
     from ..cases import bundled_cases
-    from ..codegen.api import generate
-    from ..runtime.plots import plot_run
-    from ..runtime.simulate import simulate
     from ..spec.loader import load_spec
     specs = {name: load_spec(name) for name in bundled_cases()}
     dims = {name: plot_dims(args, spec) for name, spec in specs.items()}
+    jobs = demo_jobs(args, len(specs))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     print(f"For every bundled case: design the tube, generate the C and Python controllers "
           f"into {out}/<case>/, and run the {args.backend} controller in closed loop.")
-    print(SUMMARY_HEADER)
-    all_ok = True
-    for name, spec in specs.items():
-        design = design_spec(spec, args)
-        generate(design, out / name)
-        result = simulate(design, backend=args.backend)   # the cascade's for second order
-        atomic_write(out / f"{name}.png",
-                     lambda tmp: plot_run(design, result, tmp, dims=dims[name]))
-        print(summary_line(result), flush=True)
-        all_ok &= result.satisfied
+    print(SUMMARY_HEADER, flush=True)
+    # what a case needs of the arguments (the parser itself does not cross processes)
+    case_args = argparse.Namespace(out=args.out, backend=args.backend)
+    cases = [(name, spec, case_args, dims[name]) for name, spec in specs.items()]
+    if jobs == 1:
+        outcomes = (_run_case(*case) for case in cases)
+        all_ok = _print_outcomes(outcomes)
+    else:
+        # fork after the heavy imports: the workers start with the library loaded
+        from ..codegen.api import generate  # noqa: F401
+        from ..runtime.plots import plot_run  # noqa: F401
+        from ..runtime.simulate import simulate  # noqa: F401
+        context = multiprocessing.get_context("fork")
+        with ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool:
+            all_ok = _print_outcomes(pool.map(_run_case, *zip(*cases)))
     print(f"generated code in {out}/<case>/, plots in {out}/<case>.png")
     return 0 if all_ok else 1
+
+
+def _print_outcomes(outcomes) -> bool:
+    """Print each case's line in order; raise the first case's error; all satisfied?"""
+    all_ok = True
+    for line, satisfied in outcomes:
+        if line is None:
+            _raise(satisfied)
+        print(line, flush=True)
+        all_ok &= satisfied
+    return all_ok
 
 
 def configure_demo(p: argparse.ArgumentParser) -> None:
@@ -64,11 +148,13 @@ def configure_demo(p: argparse.ArgumentParser) -> None:
     Parameters
     ----------
     p : argparse.ArgumentParser
-        The subcommand's parser; gets ``--out``, ``--backend``, ``--dims`` and the ``handler``
-        :func:`cmd_demo`.
+        The subcommand's parser; gets ``--out``, ``--backend``, ``--dims``, ``--jobs`` and
+        the ``handler`` :func:`cmd_demo`.
     """
     p.add_argument("--out", default="stt-demo", metavar="DIR",
                    help="folder for the generated code and the plots (default: %(default)s)")
     add_backend_argument(p)
     add_dims_argument(p)
+    p.add_argument("--jobs", type=int, metavar="N",
+                   help="processes that run the cases (default: the CPUs, at most 2)")
     p.set_defaults(handler=cmd_demo)

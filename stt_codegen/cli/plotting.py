@@ -86,7 +86,7 @@ def plot_dims(args: argparse.Namespace, spec: Spec) -> tuple[int, int]:
         Field ``dims`` (shown as ``--dims``): not two distinct dimensions of the state
         space.
     """
-    from ..runtime.plots import parse_dims
+    from ..runtime.dims import parse_dims
     return parse_dims(args.dims, spec.dimension)
 
 

@@ -319,8 +319,13 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     count = len(enc.t_start)
     half, centre = 0.5 * (hi - lo), 0.5 * (hi + lo)
     start, floor = np.array(stage.width_start), np.array(stage.width_floor)
-    rho2 = ((start - floor)[None, :] * np.exp(-stage.decay * samples.t[:, None])
-            + floor[None, :]).tolist()
+    rho2_all = ((start - floor)[None, :] * np.exp(-stage.decay * samples.t[:, None])
+                + floor[None, :])
+    rho2 = rho2_all.tolist()
+    # the velocity stage's pull and peak on every interval at once (one bisection over the
+    # array, the same floats as one interval at a time)
+    pull2_all = 2.0 * h * k2 / rho2_all[:count]
+    peak2 = peak(rho2_all[:count] / (g_min * pull2_all)).tolist()
     pull1 = (4.0 * h * k1 / (hi - lo)).tolist()
     peak1 = peak(0.5 * (hi - lo) / (4.0 * h * k1 / (hi - lo))).tolist()
     half_l, centre_l = half.tolist(), centre.tolist()
@@ -384,8 +389,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
             dr = virtual_velocity_change(k1, h, reach1[i], e1_path, speed, move[k][i],
                                          width_min[k][i], width_max[k][i])
             # velocity stage: law (13)'s transform on |z| < rho2, the change of r on top
-            pull2 = 2.0 * h * k2 / rho_k[i]
-            s_peak = float(peak(np.array(rho_k[i] / (g_min * pull2))))
+            pull2, s_peak = 2.0 * h * k2 / rho_k[i], peak2[k][i]
             q_lo, q_hi, z_lo, z_hi = axis_interval(
                 box2[i][0], box2[i][1], 0.0, rho_k[i], pull2, g_min, g_max, s_peak,
                 h * drift, h * others, cpl, 0.0)
