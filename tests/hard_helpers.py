@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 import math
 import tomllib
+
+import numpy as np
 from importlib import resources
 
 
@@ -117,3 +119,209 @@ def plant_bounds(p: dict, spec) -> dict:
     eig = np.linalg.eigvalsh(p["sym"])
     return {"f_inf": float(f_bound), "g_sym_min": float(eig[0]), "g_sym_max": float(eig[-1]),
             "g_norm": float(eig[-1] + p["skew"]), "w_inf": p["w_amp"], "centre": centre}
+
+
+# --------------------------------------------------------------------------- the variants
+#
+# What the hardening suites (tests/test_hard_generated_api.py, test_codegen_misra.py,
+# test_codegen_fenv.py, test_codegen_null_outputs.py, test_codegen_status_boundary.py,
+# test_codegen_large_coordinates.py) need of a controller variant, in one place: its
+# bundled case, its generated files, the sizes, limits and status codes of its header, the
+# API functions the header declares (parsed from their prototypes) and the state whose
+# tube point is a given point. The suites are written once against :class:`HardCase`.
+
+#: The bundled case of each controller variant the suites run on (``spec.variant``); the
+#: differential drive's is the first bundled ``look-ahead`` case, else the test spec below.
+VARIANT_CASES = {"first-order": "omnirobot-s1", "cascade": "second-order-s1",
+                 "look-ahead": None}
+#: The differential-drive spec used while no bundled case is of that variant.
+LOOK_AHEAD_FALLBACK = "office-drive"
+#: Outputs the header allows to be NULL (not written), all other pointers are required.
+OPTIONAL_OUTPUTS = frozenset({"gamma_L_dot", "gamma_U_dot"})
+
+
+def _bundled_names() -> list[str]:
+    return sorted(p.name[:-5] for p in resources.files("stt_codegen.cases").iterdir()
+                  if p.name.endswith(".toml"))
+
+
+def look_ahead_case() -> str:
+    """The differential-drive case: a bundled one if any, else ``tests/specs/office-drive``."""
+    from pathlib import Path
+
+    from stt_codegen.spec.loader import load_spec
+    for name in _bundled_names():
+        if bundled_doc(name).get("plant", {}).get("model") == "differential-drive":
+            if load_spec(name).variant == "look-ahead":
+                return name
+    return str(Path(__file__).parent / "specs" / f"{LOOK_AHEAD_FALLBACK}.toml")
+
+
+def case_of(variant: str) -> str:
+    """The case (bundled name or spec path) the suites run ``variant`` on."""
+    return VARIANT_CASES[variant] or look_ahead_case()
+
+
+class Argument:
+    """One parameter of a generated C function: ``kind`` is ``scalar``, ``in`` or ``out``;
+    ``size`` the header macro of an array's length (without the prefix), else ``None``."""
+
+    def __init__(self, name: str, kind: str, size: str | None) -> None:
+        self.name, self.kind, self.size = name, kind, size
+
+    def __repr__(self) -> str:
+        return f"Argument({self.name!r}, {self.kind!r}, {self.size!r})"
+
+
+def prototypes(header: str, prefix: str) -> dict[str, list[Argument]]:
+    """The API functions a generated header declares: ``{"step": [Argument, ...], ...}``.
+
+    Parsed from the prototypes ``int P_name(...);`` (every API function returns a status);
+    ``const P_real a[P_SIZE]`` is an input array, ``P_real a[P_SIZE]`` an output,
+    ``P_real a`` a scalar.
+    """
+    import re
+    out = {}
+    for name, params in re.findall(rf"^int {prefix}_(\w+)\(([^;]*)\);", header, re.M):
+        args = []
+        for param in params.split(","):
+            m = re.fullmatch(rf"\s*(const )?{prefix}_real (\w+)(?:\[{prefix.upper()}_(\w+)\])?\s*",
+                             param)
+            assert m, f"unparsed parameter of {prefix}_{name}: {param!r}"
+            kind = "scalar" if m.group(3) is None else ("in" if m.group(1) else "out")
+            args.append(Argument(m.group(2), kind, m.group(3)))
+        out[name] = args
+    assert "step" in out and "tube" in out, sorted(out)
+    return out
+
+
+def header_macros(header: str, prefix: str) -> dict[str, float]:
+    """The numeric ``#define P_NAME value`` of a header, by ``NAME``."""
+    import re
+    return {k: float(v) for k, v in re.findall(
+        rf"^#define {prefix.upper()}_(\w+) ([-+0-9.eE]+)\s*$", header, re.M)}
+
+
+def _point_state(case, point):
+    return np.asarray(point, float)
+
+
+def _cascade_state(case, point):
+    """Positions at ``point``, velocities 0."""
+    return np.concatenate([np.asarray(point, float), np.zeros(case.n)])
+
+
+def _look_ahead_state(case, point):
+    """The base state ``(x, y, theta)`` whose look-ahead point is ``point``, heading 0:
+    ``(point_0 - l, point_1, 0)`` (the C computes ``x + l cos 0 = x + l``, rounded)."""
+    offset = case.design.stage.axle_offset
+    return np.array([point[0] - offset, point[1], 0.0])
+
+
+def _look_ahead_point(case, state):
+    offset = case.design.stage.axle_offset
+    return np.array([state[0] + offset * np.cos(state[2]), state[1] + offset * np.sin(state[2])])
+
+
+#: Per variant: a state whose tube point (the point the tube must hold) is a given point,
+#: and the tube point of a state.
+STATE_AT = {"first-order": _point_state, "cascade": _cascade_state,
+            "look-ahead": _look_ahead_state}
+POINT_OF = {"first-order": lambda case, x: np.asarray(x, float),
+            "cascade": lambda case, x: np.asarray(x[:case.n], float),
+            "look-ahead": _look_ahead_point}
+
+
+class HardCase:
+    """One controller variant on its case, as the hardening suites see it.
+
+    Attributes: ``variant``, ``case`` (the name given to :func:`conftest.design_of`),
+    ``design`` (the :class:`~stt_codegen.design.result.Design`), ``tube`` (its
+    :class:`~stt_codegen.tube.parameters.TubeDesign`), ``n`` (the tube's dimension).
+    """
+
+    def __init__(self, variant: str) -> None:
+        from conftest import design_of
+        self.variant = variant
+        self.case = case_of(variant)
+        self.design = design_of(self.case)
+        assert self.design.spec.variant == variant, (self.case, self.design.spec.variant)
+        self.tube = self.design.tube
+        self.n = self.tube.dimension
+        self._files: dict = {}
+
+    def __repr__(self) -> str:
+        return f"HardCase({self.variant!r}: {self.case})"
+
+    def files(self, precision: str = "double") -> dict[str, bytes]:
+        """Every generated file (C and Python) in ``precision``, cached."""
+        if precision not in self._files:
+            from stt_codegen.codegen.api import design_files
+            from stt_codegen.codegen.options import Options
+            self._files[precision] = design_files(self.design, Options(("c", "python"),
+                                                                       precision))
+        return self._files[precision]
+
+    @property
+    def prefix(self) -> str:
+        """``P``: the generated files are ``P.h``, ``P.c``, ..."""
+        (name,) = [k[:-2] for k in self.files() if k.endswith(".h")]
+        return name
+
+    @property
+    def header(self) -> str:
+        return self.files()[f"{self.prefix}.h"].decode()
+
+    @property
+    def macros(self) -> dict[str, float]:
+        """The header's numeric macros: sizes (``N``, ``N_STATE``, ``N_INPUT``,
+        ``N_ALPHA``), limits (``DT_MIN``, ``DT_MAX``, ``ALPHA_MAX``), status codes."""
+        return header_macros(self.header, self.prefix)
+
+    def size(self, name: str) -> int:
+        """A length macro of the header; ``N_STATE`` and ``N_INPUT`` default to ``N``."""
+        m = self.macros
+        return int(m.get(name, m["N"] if name in ("N_STATE", "N_INPUT") else m[name]))
+
+    @property
+    def statuses(self) -> dict[str, int]:
+        """``{"OK": 0, "OUTSIDE_TUBE": 1, ...}``: the status codes the header defines."""
+        return {k[len("STATUS_"):]: int(v) for k, v in self.macros.items()
+                if k.startswith("STATUS_")}
+
+    @property
+    def functions(self) -> dict[str, list[Argument]]:
+        """The API functions the header declares, with their parameters."""
+        return prototypes(self.header, self.prefix)
+
+    def python(self):
+        """The generated Python module (double)."""
+        from stt_codegen.runtime.compiled import load_python_module
+        return load_python_module(self.files()[f"{self.prefix}.py"], self.prefix)
+
+    def state_at(self, point):
+        """A state (``N_STATE``,) whose tube point is ``point`` (n,)."""
+        return STATE_AT[self.variant](self, point)
+
+    def point_of(self, state):
+        """The tube point (n,) of a state (``N_STATE``,), in double."""
+        return POINT_OF[self.variant](self, state)
+
+
+VARIANTS = tuple(VARIANT_CASES)
+_CASES: dict[str, HardCase] = {}
+
+
+def hard_case(variant: str) -> HardCase:
+    """The :class:`HardCase` of a variant, built once per session."""
+    if variant not in _CASES:
+        _CASES[variant] = HardCase(variant)
+    return _CASES[variant]
+
+
+def variant_params(fast=("first-order",)):
+    """``pytest.param`` of each variant: those in ``fast`` in the fast tier, the others
+    marked ``slow`` (their designs and builds are the expensive part)."""
+    import pytest
+    return [pytest.param(v, id=v, marks=() if v in fast else pytest.mark.slow)
+            for v in VARIANTS]
