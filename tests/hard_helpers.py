@@ -325,3 +325,64 @@ def variant_params(fast=("first-order",)):
     import pytest
     return [pytest.param(v, id=v, marks=() if v in fast else pytest.mark.slow)
             for v in VARIANTS]
+
+
+class CApi:
+    """ctypes view of a compiled generated library, its functions from the header.
+
+    ``call(name, **arrays_and_scalars)`` calls ``P_name`` with each parameter by name (an
+    array, a scalar, or ``None`` for a NULL pointer) and returns the status.
+    """
+
+    def __init__(self, path, case: HardCase, precision: str) -> None:
+        import ctypes
+        self.case = case
+        self.lib = ctypes.CDLL(str(path))
+        self.real = ctypes.c_double if precision == "double" else ctypes.c_float
+        self.dtype = np.float64 if precision == "double" else np.float32
+        self.functions = case.functions
+        self._pointer = ctypes.POINTER(self.real)
+        for name, args in self.functions.items():
+            fn = getattr(self.lib, f"{case.prefix}_{name}")
+            fn.argtypes = [self.real if a.kind == "scalar" else self._pointer for a in args]
+            fn.restype = ctypes.c_int
+
+    def arr(self, values=None, size=None):
+        """A contiguous array in the library's precision (zeros of ``size`` if no values)."""
+        if values is None:
+            return np.zeros(size, self.dtype)
+        return np.ascontiguousarray(np.asarray(values, dtype=self.dtype))
+
+    def nan(self, size: str):
+        """An output buffer of the header length ``size`` filled with NaN."""
+        return self.arr(np.full(self.case.size(size), math.nan))
+
+    def call(self, name: str, **given) -> int:
+        args = []
+        for a in self.functions[name]:
+            value = given[a.name]
+            if a.kind == "scalar":
+                args.append(float(value))
+            elif value is None:
+                args.append(None)
+            else:
+                assert value.dtype == self.dtype and value.flags.c_contiguous
+                args.append(value.ctypes.data_as(self._pointer))
+        return int(getattr(self.lib, f"{self.case.prefix}_{name}")(*args))
+
+
+def c_api(case: HardCase, precision: str, cc: str, root) -> CApi:
+    """Write, compile (strict warnings, ``-Werror``) and load the C of ``case`` (cached)."""
+    from pathlib import Path
+
+    from codegen_helpers import compile_shared, write
+    key = (case.variant, precision, cc, str(root))
+    if key not in _LIBS:
+        folder = write(Path(root) / f"{case.variant}-{precision}-{cc}",
+                       {k: v for k, v in case.files(precision).items() if k.endswith((".c", ".h"))
+                        and not k.endswith("_selftest.c")})
+        _LIBS[key] = CApi(compile_shared(folder, case.prefix, cc, precision), case, precision)
+    return _LIBS[key]
+
+
+_LIBS: dict = {}
