@@ -240,10 +240,10 @@ class HardCase:
     :class:`~stt_codegen.tube.parameters.TubeDesign`), ``n`` (the tube's dimension).
     """
 
-    def __init__(self, variant: str) -> None:
+    def __init__(self, variant: str, case: str | None = None) -> None:
         from conftest import design_of
         self.variant = variant
-        self.case = case_of(variant)
+        self.case = case or case_of(variant)
         self.design = design_of(self.case)
         assert self.design.spec.variant == variant, (self.case, self.design.spec.variant)
         self.tube = self.design.tube
@@ -309,14 +309,15 @@ class HardCase:
 
 
 VARIANTS = tuple(VARIANT_CASES)
-_CASES: dict[str, HardCase] = {}
+_CASES: dict[tuple, HardCase] = {}
 
 
-def hard_case(variant: str) -> HardCase:
-    """The :class:`HardCase` of a variant, built once per session."""
-    if variant not in _CASES:
-        _CASES[variant] = HardCase(variant)
-    return _CASES[variant]
+def hard_case(variant: str, case: str | None = None) -> HardCase:
+    """The :class:`HardCase` of a variant (on its case of :data:`VARIANT_CASES`, or on
+    ``case``), built once per session."""
+    if (variant, case) not in _CASES:
+        _CASES[variant, case] = HardCase(variant, case)
+    return _CASES[variant, case]
 
 
 def variant_params(fast=("first-order",)):
@@ -376,9 +377,9 @@ def c_api(case: HardCase, precision: str, cc: str, root) -> CApi:
     from pathlib import Path
 
     from codegen_helpers import compile_shared, write
-    key = (case.variant, precision, cc, str(root))
+    key = (case.variant, case.case, precision, cc, str(root))
     if key not in _LIBS:
-        folder = write(Path(root) / f"{case.variant}-{precision}-{cc}",
+        folder = write(Path(root) / f"{case.prefix}-{precision}-{cc}",
                        {k: v for k, v in case.files(precision).items() if k.endswith((".c", ".h"))
                         and not k.endswith("_selftest.c")})
         _LIBS[key] = CApi(compile_shared(folder, case.prefix, cc, precision), case, precision)
