@@ -62,23 +62,6 @@ static const second_order_s1_cascade_segment SECOND_ORDER_S1_CASCADE_SEGMENTS[SE
   { 4.3125f, 9.0f, 1, { 2.15f, 3.75f, 2.35f, 3.95f }, { 4.55f, 4.55f, 4.95f, 4.95f } }
 };
 
-/* Circumvents (eqs. (7)-(9)), one row per window, sorted by start: window (start, end),
-   center m, radius r, sharpness k, height B, running maximum of the ends (to find the open
-   windows), bound index (i: lower bound of dimension i, N + i: upper bound). */
-typedef struct {
-  second_order_s1_cascade_real start;
-  second_order_s1_cascade_real end;
-  second_order_s1_cascade_real center;
-  second_order_s1_cascade_real radius;
-  second_order_s1_cascade_real sharpness;
-  second_order_s1_cascade_real height;
-  second_order_s1_cascade_real max_end;
-  int bound;
-} second_order_s1_cascade_window;
-
-#define SECOND_ORDER_S1_CASCADE_N_WINDOWS 0
-/* most windows open at one time (size of the work arrays) */
-#define SECOND_ORDER_S1_CASCADE_MAX_OPEN 1
 
 /* ------------------------------------------------------------- emitted bodies */
 
