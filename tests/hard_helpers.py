@@ -223,6 +223,56 @@ def _look_ahead_point(case, state):
     return np.array([state[0] + offset * np.cos(state[2]), state[1] + offset * np.sin(state[2])])
 
 
+def _exact_point_state(case, point, dtype, velocity):
+    return np.asarray(point, dtype)
+
+
+def _exact_cascade_state(case, point, dtype, velocity):
+    """Positions at ``point``, velocities the virtual velocity ``r`` there (``velocity(x)``
+    computes it in the code under test): the velocity error ``x2 - r`` is exactly 0."""
+    x = np.concatenate([np.asarray(point, dtype), np.zeros(case.n, dtype)])
+    x[case.n:] = velocity(x)
+    return x
+
+
+def _exact_look_ahead_state(case, point, dtype, velocity):
+    """``(x, point_1, 0)`` with ``x + l == point_0`` exactly in ``dtype`` (heading 0: the
+    code computes ``p = (x + l cos 0, y + l sin 0) = (x + l, y)``); ``None`` when no ``x``
+    within 4 ulps of ``point_0 - l`` rounds there."""
+    offset = dtype(case.design.stage.axle_offset)
+    target = dtype(point[0])
+    start = dtype(target - offset)
+    for k in range(9):
+        x = start
+        for _ in range(k // 2 + k % 2):
+            x = np.nextafter(x, dtype(np.inf) if k % 2 else dtype(-np.inf), dtype=dtype)
+        if dtype(x + offset) == target:
+            return np.array([x, point[1], 0.0], dtype)
+    return None
+
+
+#: Per variant: a state whose tube point is a given point exactly in a given precision,
+#: with the velocity error 0 where there is one (:meth:`HardCase.exact_state`).
+EXACT_STATE = {"first-order": _exact_point_state, "cascade": _exact_cascade_state,
+               "look-ahead": _exact_look_ahead_state}
+def _first_order_step(case):
+    from stt_codegen.tube.model import build_model
+    return build_model(case.tube)["controller_step"]
+
+
+def _cascade_step(case):
+    from stt_codegen.tube.cascade import cascade_step
+    return cascade_step(case.tube, case.design.stage)
+
+
+def _look_ahead_step(case):
+    from stt_codegen.tube.look_ahead import look_ahead_step
+    return look_ahead_step(case.tube, case.design.stage)
+
+
+#: Per variant: the CasADi step the generated code is printed from.
+CASADI_STEP = {"first-order": _first_order_step, "cascade": _cascade_step,
+               "look-ahead": _look_ahead_step}
 #: Per variant: a state whose tube point (the point the tube must hold) is a given point,
 #: and the tube point of a state.
 STATE_AT = {"first-order": _point_state, "cascade": _cascade_state,
@@ -302,6 +352,18 @@ class HardCase:
     def state_at(self, point):
         """A state (``N_STATE``,) whose tube point is ``point`` (n,)."""
         return STATE_AT[self.variant](self, point)
+
+    def exact_state(self, point, dtype, velocity=None):
+        """A state (``N_STATE``,) in ``dtype`` whose tube point, as the generated code
+        computes it in that precision, is ``point`` exactly; any velocity error is 0
+        (``velocity(x)``: the cascade's virtual velocity at ``x``, by the code under
+        test). ``None`` if the variant cannot place that point exactly."""
+        return EXACT_STATE[self.variant](self, point, dtype, velocity)
+
+    def casadi_step(self):
+        """The variant's CasADi step ``(x, t, dt, alpha) -> (u, alpha_next, ...)``, whose
+        ``inside*`` outputs are 1.0 exactly when the status is OK."""
+        return CASADI_STEP[self.variant](self)
 
     def point_of(self, state):
         """The tube point (n,) of a state (``N_STATE``,), in double."""
