@@ -1,9 +1,11 @@
 """Standalone C and Python of the cascade controller for second-order plants.
 
-The entry point has the first order's argument order, ``<prefix>_step(x, t, dt, alpha,
-u, alpha_next, r) -> status`` with ``x = [x1; x2]``, and its statuses (plus
-``OUTSIDE_VELOCITY_TUBE``); it computes :func:`stt_codegen.tube.cascade.cascade_step` of a
-design and its second stage, bit for bit in double precision.
+The entry point has every variant's signature, ``<prefix>_step(x, t, dt, alpha, u,
+alpha_next) -> status`` with ``x = [x1; x2]``, and the first order's statuses (plus
+``OUTSIDE_VELOCITY_TUBE``); the virtual velocity is the accessor
+``<prefix>_virtual_velocity(x, t, alpha, r) -> status``. Both compute
+:func:`stt_codegen.tube.cascade.cascade_step` of a design and its second stage, bit for bit
+in double precision.
 
 * C: a variant of the first-order source (:func:`.generate.c_source_context`,
   ``c_source.c.j2``): the same tables and table-driven tube (only the active segment and
@@ -136,9 +138,9 @@ def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
 
 
 def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str) -> dict[str, str]:
-    """``{<prefix>.py: text}``: ``step(x, t, dt, alpha) -> (u, alpha_next, r, status)``
-    (``x = [x1; x2]``), the same function, statuses and input checks as the C (imports ``math``
-    only). The emitter's Python printer prints the composed Function; the template
+    """``{<prefix>.py: text}``: ``step(x, t, dt, alpha) -> (u, alpha_next, status)`` and
+    ``virtual_velocity(x, t, alpha) -> (r, status)`` (``x = [x1; x2]``), the same functions,
+    statuses and input checks as the C (imports ``math`` only). The emitter's Python printer prints the composed Function; the template
     ``cascade_module.py.j2`` holds the rest of the text.
 
     Parameters

@@ -23,7 +23,7 @@
  * (the input of the plant: a force, a torque).
  *
  * Shapes: x = [x1; x2] has SECOND_ORDER_S1_CASCADE_N_STATE = 2 SECOND_ORDER_S1_CASCADE_N entries (positions, then
- * velocities); u and r have SECOND_ORDER_S1_CASCADE_N entries; alpha, alpha_next have SECOND_ORDER_S1_CASCADE_N_ALPHA =
+ * velocities); u has SECOND_ORDER_S1_CASCADE_N_INPUT = SECOND_ORDER_S1_CASCADE_N entries, r SECOND_ORDER_S1_CASCADE_N; alpha, alpha_next have SECOND_ORDER_S1_CASCADE_N_ALPHA =
  * 2 SECOND_ORDER_S1_CASCADE_N entries: [alpha_L, alpha_U]. Start with alpha = 0 at t = 0 and feed
  * alpha_next back at every step.
  *
@@ -48,7 +48,7 @@
  *                                          alpha_next is valid. The prescribed-time
  *                                          guarantee no longer holds.
  *   SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT         2  a NULL pointer or an input outside the domain
- *                                          above: u = 0, r = 0, alpha_next = alpha with
+ *                                          above: u = 0 (r = 0), alpha_next = alpha with
  *                                          each non-finite entry replaced by 0 (alpha
  *                                          NULL: 0).
  *   SECOND_ORDER_S1_CASCADE_STATUS_OUTSIDE_VELOCITY_TUBE 4  x1 inside its tube, x2 - r on or outside
@@ -72,6 +72,8 @@ typedef double second_order_s1_cascade_real;
 #define SECOND_ORDER_S1_CASCADE_N 2
 /** Length of the state x = [x1; x2]: 2 n. */
 #define SECOND_ORDER_S1_CASCADE_N_STATE 4
+/** Number of inputs (entries of u): n. */
+#define SECOND_ORDER_S1_CASCADE_N_INPUT 2
 /** Length of alpha: 2 n. */
 #define SECOND_ORDER_S1_CASCADE_N_ALPHA 4
 /** Prescribed time t_c, seconds. */
@@ -111,19 +113,32 @@ int second_order_s1_cascade_alpha_step(second_order_s1_cascade_real t, second_or
     const second_order_s1_cascade_real alpha[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real alpha_next[SECOND_ORDER_S1_CASCADE_N_ALPHA]);
 
 /**
- * One controller step: u and r at (x, t, alpha) and alpha at t + dt. Call at every
- * sampling instant t_k = k dt with the measured x(t_k) = [x1; x2], hold u until t_{k+1},
- * then pass alpha_next as alpha.
+ * One controller step: u at (x, t, alpha) and alpha at t + dt. Call at every sampling
+ * instant t_k = k dt with the measured x(t_k) = [x1; x2], hold u until t_{k+1}, then pass
+ * alpha_next as alpha.
  *
  * x: [SECOND_ORDER_S1_CASCADE_N_STATE]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha:
- * [SECOND_ORDER_S1_CASCADE_N_ALPHA]. u: [SECOND_ORDER_S1_CASCADE_N] (out). alpha_next: [SECOND_ORDER_S1_CASCADE_N_ALPHA] (out, may alias
- * alpha). r: [SECOND_ORDER_S1_CASCADE_N] (out, the virtual velocity).
- * Returns OK, OUTSIDE_TUBE, OUTSIDE_VELOCITY_TUBE or INVALID_INPUT (u = 0, r = 0,
+ * [SECOND_ORDER_S1_CASCADE_N_ALPHA]. u: [SECOND_ORDER_S1_CASCADE_N_INPUT] (out). alpha_next: [SECOND_ORDER_S1_CASCADE_N_ALPHA] (out, may
+ * alias alpha).
+ * Returns OK, OUTSIDE_TUBE, OUTSIDE_VELOCITY_TUBE or INVALID_INPUT (u = 0,
  * alpha_next = alpha).
  */
 int second_order_s1_cascade_step(const second_order_s1_cascade_real x[SECOND_ORDER_S1_CASCADE_N_STATE], second_order_s1_cascade_real t, second_order_s1_cascade_real dt,
-    const second_order_s1_cascade_real alpha[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real u[SECOND_ORDER_S1_CASCADE_N],
-    second_order_s1_cascade_real alpha_next[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real r[SECOND_ORDER_S1_CASCADE_N]);
+    const second_order_s1_cascade_real alpha[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real u[SECOND_ORDER_S1_CASCADE_N_INPUT],
+    second_order_s1_cascade_real alpha_next[SECOND_ORDER_S1_CASCADE_N_ALPHA]);
+
+/**
+ * The virtual velocity r = -k1 xi1 epsilon1 at (x, t, alpha): law (13) with gain k1 on the
+ * position tube, the velocity the second stage makes x2 follow (the step computes the same
+ * r internally).
+ *
+ * x: [SECOND_ORDER_S1_CASCADE_N_STATE] (x2 is checked but not used). t: seconds, t >= 0. alpha:
+ * [SECOND_ORDER_S1_CASCADE_N_ALPHA]. r: [SECOND_ORDER_S1_CASCADE_N] (out), state units per second.
+ * Returns OK, OUTSIDE_TUBE (x1 on or outside the position tube, r finite) or
+ * INVALID_INPUT (r = 0).
+ */
+int second_order_s1_cascade_virtual_velocity(const second_order_s1_cascade_real x[SECOND_ORDER_S1_CASCADE_N_STATE], second_order_s1_cascade_real t,
+    const second_order_s1_cascade_real alpha[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real r[SECOND_ORDER_S1_CASCADE_N]);
 
 #ifdef __cplusplus
 }

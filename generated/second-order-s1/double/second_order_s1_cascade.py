@@ -7,11 +7,14 @@
 
 The same function, status codes and input checks as the C API (second_order_s1_cascade.h):
 
-* ``step(x, t, dt, alpha) -> (u, alpha_next, r, status)``
+* ``step(x, t, dt, alpha) -> (u, alpha_next, status)``
+* ``virtual_velocity(x, t, alpha) -> (r, status)``: the virtual velocity the step makes x2
+  follow (law (13) with gain k1; status OK, OUTSIDE_TUBE or INVALID_INPUT, r = 0)
 
 Units: t, dt in seconds; positions and alpha in state units; velocities and the virtual
 velocity r in state units per second; u in input units. Shapes: x = [x1; x2] has
-N_STATE = 4 entries (positions, then velocities); u and r have N = 2;
+N_STATE = 4 entries (positions, then velocities); u has N_INPUT = 2
+entries, r has N = 2;
 alpha, alpha_next have N_ALPHA = 4 ([alpha_L, alpha_U]); start with alpha = 0 at
 t = 0.
 
@@ -19,7 +22,7 @@ Input domain, as in the C header: t finite, t >= 0; DT_MIN <= dt <= DT_MAX; x an
 numbers; every alpha entry in [0, ALPHA_MAX]. Status: STATUS_OK (0), STATUS_OUTSIDE_TUBE
 (1: x1 not strictly inside the position tube; u finite), STATUS_INVALID_INPUT (2: an input
 outside the domain, a wrong length, a value that is not a number, or a result that would
-not be finite; u = 0, r = 0, alpha_next = alpha with non-finite entries 0),
+not be finite; u = 0, alpha_next = alpha with non-finite entries 0),
 STATUS_OUTSIDE_VELOCITY_TUBE (4: x1 inside, x2 - r not strictly inside (-rho2, rho2); u
 finite). Every number returned is a finite float.
 
@@ -923,6 +926,7 @@ def cascade_step(x, t, dt, alpha):
 
 N = 2
 N_STATE = 4
+N_INPUT = 2
 N_ALPHA = 4
 PRESCRIBED_TIME = 9.0
 RATE_HZ = 1000.0
@@ -991,7 +995,7 @@ def _keep_alpha(alpha):
 
 
 def step(x, t, dt, alpha):
-    """One controller step: (u (N,), alpha_next (N_ALPHA,), r (N,), status)."""
+    """One controller step: (u (N_INPUT,), alpha_next (N_ALPHA,), status)."""
     xs, t_ok, dt_ok, a = _finite(x, N_STATE), _time(t), _step_size(dt), _alpha(alpha)
     if xs is not None and t_ok is not None and dt_ok is not None and a is not None:
         u, alpha_next, r, inside_p, inside_v, *within = cascade_step(xs, [t_ok], [dt_ok], a)
@@ -1002,5 +1006,16 @@ def step(x, t, dt, alpha):
                 status = STATUS_OUTSIDE_VELOCITY_TUBE
             else:
                 status = STATUS_OK
-            return list(u), list(alpha_next), list(r), status
-    return [0.0] * N, _keep_alpha(alpha), [0.0] * N, STATUS_INVALID_INPUT
+            return list(u), list(alpha_next), status
+    return [0.0] * N_INPUT, _keep_alpha(alpha), STATUS_INVALID_INPUT
+
+
+def virtual_velocity(x, t, alpha):
+    """The virtual velocity at (x, t, alpha): (r (N,), status), status OK, OUTSIDE_TUBE or
+    INVALID_INPUT (r = 0). The same r as the step's (its dt does not enter r)."""
+    xs, t_ok, a = _finite(x, N_STATE), _time(t), _alpha(alpha)
+    if xs is not None and t_ok is not None and a is not None:
+        r, inside_p = cascade_step(xs, [t_ok], [1.0 / RATE_HZ], a)[2:4]
+        if _all_finite(r):
+            return list(r), STATUS_OK if inside_p[0] != 0.0 else STATUS_OUTSIDE_TUBE
+    return [0.0] * N, STATUS_INVALID_INPUT

@@ -1269,13 +1269,14 @@ static const second_order_s1_cascade_second_stage SECOND_ORDER_S1_CASCADE_SECOND
   { 0.44688333333333335f, 0.44688333333333335f } /* width_floor */
 };
 
-/* u and r of the cascade at (x = [x1; x2], t, a), x and a
+/* u of the cascade at (x = [x1; x2], t, a), x and a
    already checked; returns OK, OUTSIDE_TUBE, OUTSIDE_VELOCITY_TUBE, or
-   INVALID_INPUT when u or r is not finite. */
+   INVALID_INPUT when u or the virtual velocity r is not finite. */
 static int second_order_s1_cascade_law(const second_order_s1_cascade_real* x, second_order_s1_cascade_real t, const second_order_s1_cascade_real* a,
-    second_order_s1_cascade_real* u, second_order_s1_cascade_real* r) {
+    second_order_s1_cascade_real* u) {
   second_order_s1_cascade_real g_l[SECOND_ORDER_S1_CASCADE_N];
   second_order_s1_cascade_real g_u[SECOND_ORDER_S1_CASCADE_N];
+  second_order_s1_cascade_real r[SECOND_ORDER_S1_CASCADE_N];
   second_order_s1_cascade_real rho2[SECOND_ORDER_S1_CASCADE_N];
   second_order_s1_cascade_real inside_position;
   second_order_s1_cascade_real inside_velocity;
@@ -1294,6 +1295,39 @@ static int second_order_s1_cascade_law(const second_order_s1_cascade_real* x, se
     status = SECOND_ORDER_S1_CASCADE_STATUS_OUTSIDE_VELOCITY_TUBE;
   } else {
     status = SECOND_ORDER_S1_CASCADE_STATUS_OK;
+  }
+  return status;
+}
+
+int second_order_s1_cascade_virtual_velocity(const second_order_s1_cascade_real x[SECOND_ORDER_S1_CASCADE_N_STATE], second_order_s1_cascade_real t,
+    const second_order_s1_cascade_real alpha[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real r[SECOND_ORDER_S1_CASCADE_N]) {
+  int status = SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT;
+  if (r != NULL) {
+    second_order_s1_cascade_real rc[SECOND_ORDER_S1_CASCADE_N];
+    if ((x != NULL) && (alpha != NULL) && (second_order_s1_cascade_time_valid(t) != 0)
+        && (second_order_s1_cascade_finite(x, SECOND_ORDER_S1_CASCADE_N_STATE) != 0) && (second_order_s1_cascade_alpha_valid(alpha) != 0)) {
+      second_order_s1_cascade_real xc[SECOND_ORDER_S1_CASCADE_N_STATE];
+      second_order_s1_cascade_real a[SECOND_ORDER_S1_CASCADE_N_ALPHA];
+      second_order_s1_cascade_real g_l[SECOND_ORDER_S1_CASCADE_N];
+      second_order_s1_cascade_real g_u[SECOND_ORDER_S1_CASCADE_N];
+      second_order_s1_cascade_real inside;
+      second_order_s1_cascade_copy(x, xc, SECOND_ORDER_S1_CASCADE_N_STATE);
+      second_order_s1_cascade_copy(alpha, a, SECOND_ORDER_S1_CASCADE_N_ALPHA);
+      second_order_s1_cascade_gamma(t, a, g_l, g_u);
+      body_law(xc, g_l, g_u, &SECOND_ORDER_S1_CASCADE_PARAMETERS.gain, rc, &inside);
+      if (second_order_s1_cascade_finite(rc, SECOND_ORDER_S1_CASCADE_N) == 0) {
+        status = SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT;
+      } else if (inside == 0.0f) {
+        status = SECOND_ORDER_S1_CASCADE_STATUS_OUTSIDE_TUBE;
+      } else {
+        status = SECOND_ORDER_S1_CASCADE_STATUS_OK;
+      }
+    }
+    if (status == SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT) {
+      second_order_s1_cascade_zero(r, SECOND_ORDER_S1_CASCADE_N);
+    } else {
+      second_order_s1_cascade_copy(rc, r, SECOND_ORDER_S1_CASCADE_N);
+    }
   }
   return status;
 }
@@ -1389,12 +1423,11 @@ int second_order_s1_cascade_alpha_step(second_order_s1_cascade_real t, second_or
 }
 
 int second_order_s1_cascade_step(const second_order_s1_cascade_real x[SECOND_ORDER_S1_CASCADE_N_STATE], second_order_s1_cascade_real t, second_order_s1_cascade_real dt,
-    const second_order_s1_cascade_real alpha[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real u[SECOND_ORDER_S1_CASCADE_N],
-    second_order_s1_cascade_real alpha_next[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real r[SECOND_ORDER_S1_CASCADE_N]) {
+    const second_order_s1_cascade_real alpha[SECOND_ORDER_S1_CASCADE_N_ALPHA], second_order_s1_cascade_real u[SECOND_ORDER_S1_CASCADE_N_INPUT],
+    second_order_s1_cascade_real alpha_next[SECOND_ORDER_S1_CASCADE_N_ALPHA]) {
   int status = SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT;
-  if ((u != NULL) && (alpha_next != NULL) && (r != NULL)) {
-    second_order_s1_cascade_real uc[SECOND_ORDER_S1_CASCADE_N];
-    second_order_s1_cascade_real rc[SECOND_ORDER_S1_CASCADE_N];
+  if ((u != NULL) && (alpha_next != NULL)) {
+    second_order_s1_cascade_real uc[SECOND_ORDER_S1_CASCADE_N_INPUT];
     if (alpha == NULL) {
       second_order_s1_cascade_zero(alpha_next, SECOND_ORDER_S1_CASCADE_N_ALPHA);
     } else {
@@ -1405,7 +1438,7 @@ int second_order_s1_cascade_step(const second_order_s1_cascade_real x[SECOND_ORD
           && (second_order_s1_cascade_finite(x, SECOND_ORDER_S1_CASCADE_N_STATE) != 0) && (second_order_s1_cascade_alpha_valid(a) != 0)) {
         second_order_s1_cascade_real xc[SECOND_ORDER_S1_CASCADE_N_STATE];
         second_order_s1_cascade_copy(x, xc, SECOND_ORDER_S1_CASCADE_N_STATE);
-        status = second_order_s1_cascade_law(xc, t, a, uc, rc);
+        status = second_order_s1_cascade_law(xc, t, a, uc);
         if (status != SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT) {
           second_order_s1_cascade_implicit_step(t, dt, a, next);
           if (second_order_s1_cascade_finite(next, SECOND_ORDER_S1_CASCADE_N_ALPHA) == 0) {
@@ -1420,14 +1453,12 @@ int second_order_s1_cascade_step(const second_order_s1_cascade_real x[SECOND_ORD
       }
     }
     if (status == SECOND_ORDER_S1_CASCADE_STATUS_INVALID_INPUT) {
-      second_order_s1_cascade_zero(u, SECOND_ORDER_S1_CASCADE_N);
-      second_order_s1_cascade_zero(r, SECOND_ORDER_S1_CASCADE_N);
+      second_order_s1_cascade_zero(u, SECOND_ORDER_S1_CASCADE_N_INPUT);
     } else {
-      second_order_s1_cascade_copy(uc, u, SECOND_ORDER_S1_CASCADE_N);
-      second_order_s1_cascade_copy(rc, r, SECOND_ORDER_S1_CASCADE_N);
+      second_order_s1_cascade_copy(uc, u, SECOND_ORDER_S1_CASCADE_N_INPUT);
     }
   } else {
-    /* u, alpha_next or r NULL: INVALID_INPUT, the other outputs written as documented */
+    /* u or alpha_next NULL: INVALID_INPUT, the other output written as documented */
     if (alpha_next != NULL) {
       if (alpha == NULL) {
         second_order_s1_cascade_zero(alpha_next, SECOND_ORDER_S1_CASCADE_N_ALPHA);
@@ -1435,8 +1466,7 @@ int second_order_s1_cascade_step(const second_order_s1_cascade_real x[SECOND_ORD
         second_order_s1_cascade_keep_alpha(alpha, alpha_next);
       }
     }
-    second_order_s1_cascade_zero(u, SECOND_ORDER_S1_CASCADE_N);
-    second_order_s1_cascade_zero(r, SECOND_ORDER_S1_CASCADE_N);
+    second_order_s1_cascade_zero(u, SECOND_ORDER_S1_CASCADE_N_INPUT);
   }
   return status;
 }
