@@ -329,9 +329,8 @@ class HardCase:
         return header_macros(self.header, self.prefix)
 
     def size(self, name: str) -> int:
-        """A length macro of the header; ``N_STATE`` and ``N_INPUT`` default to ``N``."""
-        m = self.macros
-        return int(m.get(name, m["N"] if name in ("N_STATE", "N_INPUT") else m[name]))
+        """A length macro of the header (``N``, ``N_STATE``, ``N_INPUT``, ``N_ALPHA``)."""
+        return int(self.macros[name])
 
     @property
     def statuses(self) -> dict[str, int]:
@@ -343,6 +342,19 @@ class HardCase:
     def functions(self) -> dict[str, list[Argument]]:
         """The API functions the header declares, with their parameters."""
         return prototypes(self.header, self.prefix)
+
+    def vectors(self, precision: str) -> dict[str, list]:
+        """The inputs of the shipped test vectors (``P_vectors.json``): ``x``, ``t``,
+        ``dt``, ``alpha``, one entry per vector (columns, or rows under ``vectors`` with
+        one ``dt`` for all)."""
+        import json
+        data = json.loads(self.files(precision)[f"{self.prefix}_vectors.json"])
+        if "vectors" not in data:
+            return {k: data[k] for k in ("x", "t", "dt", "alpha")}
+        rows = data["vectors"]
+        return {"x": [r["x"] for r in rows], "t": [r["t"] for r in rows],
+                "dt": [r.get("dt", data.get("dt")) for r in rows],
+                "alpha": [r["alpha"] for r in rows]}
 
     def python(self):
         """The generated Python module (double)."""

@@ -199,12 +199,6 @@ def _parse(text: str) -> dict:
     return results
 
 
-def _define_n_state(case) -> str:
-    """``-D`` of ``P_N_STATE`` for a header that does not define it (it equals ``P_N``)."""
-    return [] if "N_STATE" in case.macros else [f"-D{case.prefix.upper()}_N_STATE="
-                                                 f"{case.prefix.upper()}_N"]
-
-
 def _run_c(tmp_path, case, rows, precision, cc):
     files = case.files(precision)
     prefix = case.prefix
@@ -217,7 +211,7 @@ def _run_c(tmp_path, case, rows, precision, cc):
                      if single else r for r in rows]
     (tmp_path / "driver.c").write_text(driver_source(case, cast_rows, single))
     exe = tmp_path / "driver"
-    build = subprocess.run([cc, *FLAGS, *SANITIZE, *_define_n_state(case), "driver.c",
+    build = subprocess.run([cc, *FLAGS, *SANITIZE, "driver.c",
                             f"{prefix}.c", "-o", str(exe), "-lm"],
                            cwd=tmp_path, capture_output=True, text=True)
     assert build.returncode == 0, build.stderr
