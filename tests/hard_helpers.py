@@ -251,6 +251,12 @@ def _exact_look_ahead_state(case, point, dtype, velocity):
     return None
 
 
+#: Per variant: hostile states beyond those of :meth:`HardCase.state_at` (the cascade's
+#: velocities far outside the velocity tube, to reach OUTSIDE_VELOCITY_TUBE).
+EXTRA_STATES = {"first-order": lambda case, point: [],
+                "cascade": lambda case, point: [
+                    np.concatenate([np.asarray(point, float), np.full(case.n, 1e3)])],
+                "look-ahead": lambda case, point: []}
 #: Per variant: a state whose tube point is a given point exactly in a given precision,
 #: with the velocity error 0 where there is one (:meth:`HardCase.exact_state`).
 EXACT_STATE = {"first-order": _exact_point_state, "cascade": _exact_cascade_state,
@@ -364,6 +370,11 @@ class HardCase:
     def state_at(self, point):
         """A state (``N_STATE``,) whose tube point is ``point`` (n,)."""
         return STATE_AT[self.variant](self, point)
+
+    def extra_states(self, point) -> list:
+        """Hostile states the variant adds at a tube point (the cascade: velocities of
+        1e3, far outside its velocity tube)."""
+        return EXTRA_STATES[self.variant](self, point)
 
     def exact_state(self, point, dtype, velocity=None):
         """A state (``N_STATE``,) in ``dtype`` whose tube point, as the generated code
