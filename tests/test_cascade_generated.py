@@ -36,12 +36,12 @@ def _folder(case: str, precision: str) -> Path:
 
 
 def _vectors(case: str, precision: str = "double") -> dict:
-    prefix = case.replace("-", "_") + "_cascade"
+    prefix = case.replace("-", "_")
     return json.loads((_folder(case, precision) / f"{prefix}_vectors.json").read_text())
 
 
 def _build(tmp_path: Path, case: str, precision: str):
-    prefix = case.replace("-", "_") + "_cascade"
+    prefix = case.replace("-", "_")
     lib = tmp_path / f"lib{prefix}_{precision}.so"
     proc = subprocess.run([CC, *STRICT, "-fPIC", "-shared",
                            str(_folder(case, precision) / f"{prefix}.c"), "-o", str(lib), "-lm"],
@@ -104,7 +104,7 @@ def test_committed_c_meets_its_vectors(tmp_path, case, precision) -> None:
 
 @pytest.mark.parametrize("case", CASES)
 def test_committed_python_meets_its_vectors(case) -> None:
-    prefix = case.replace("-", "_") + "_cascade"
+    prefix = case.replace("-", "_")
     namespace: dict = {}
     source = (_folder(case, "double") / f"{prefix}.py").read_text()
     exec(compile(source, f"{prefix}.py", "exec"), namespace)
@@ -162,7 +162,7 @@ def test_cppcheck_misra_findings_are_the_listed_deviations(tmp_path, case, preci
     import re
 
     from test_codegen_misra import DEVIATIONS
-    prefix = case.replace("-", "_") + "_cascade"
+    prefix = case.replace("-", "_")
     for suffix in (".c", ".h"):
         (tmp_path / f"{prefix}{suffix}").write_bytes(
             (_folder(case, precision) / f"{prefix}{suffix}").read_bytes())
@@ -217,7 +217,7 @@ def test_table_driven_c_is_bit_identical_to_casadi(tmp_path, case, bounded) -> N
         u = cascade_reference.cascade_step(tube, stage, state, p["t"], p["dt"], p["alpha"])[0]
         tube = dataclasses.replace(tube, input_bound=tuple(
             float(b) for b in np.maximum(np.median(np.abs(u), axis=0), 1e-3)))
-    prefix = case.replace("-", "_") + "_cascade"
+    prefix = case.replace("-", "_")
     files = cascade_c_files(tube, stage, prefix, "double")
     if not bounded:
         assert files[f"{prefix}.c"] == (_folder(case, "double") / f"{prefix}.c").read_text()
