@@ -62,6 +62,9 @@ def hostile_inputs(case) -> list[tuple]:
                   case.state_at((g_l + g_u) / 2 + 1e300), case.state_at((g_l + g_u) / 2 - 1e300),
                   np.full(n_state, 1.7e308), np.array([nan] + list(centre[1:])),
                   np.array([inf] + list(centre[1:])), *case.extra_states((g_l + g_u) / 2)]
+        if "INPUT_CLAMPED" in case.statuses:     # an actuator bound: law (13) asks for more
+            states += [case.state_at(g_u - (g_u - g_l) * 1e-3),
+                       case.state_at(g_l + (g_u - g_l) * 1e-3)]
         alphas = [alpha0, np.zeros(n_alpha), alpha0 + 1e3, np.full(n_alpha, m["ALPHA_MAX"]),
                   np.full(n_alpha, m["ALPHA_MAX"] * 1.5), -alpha0 - 1e-3,
                   np.array([-0.0] * n_alpha), np.array([nan] + list(alpha0[1:])),
