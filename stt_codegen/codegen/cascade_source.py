@@ -191,12 +191,22 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     or ``INPUT_CLAMPED`` as the oracle clamps, and only points whose clamp decision is
     certain in the precision are kept (every ``|u_i|`` of the law farther from the bound
     than its tolerance plus the bound's rounding), as for the first order.
+
+    Raises
+    ------
+    SpecError
+        ``precision``: it cannot resolve the position tube at the spec's coordinates (the
+        first order's test, :func:`.vectors.sample_inputs`, on the same tube).
     """
     import numpy as np
 
     from ..rounding import round_up_array
     from ..tube import cascade_reference, reference
     from . import tolerance as T
+    from .vectors import sample_inputs
+
+    sample_inputs(design, precision)      # raises SpecError where the precision cannot
+    #                                       resolve the position tube (its points unused)
 
     def f32(a):
         return np.asarray(a, dtype=np.float32).astype(np.float64)
