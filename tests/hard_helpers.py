@@ -1,13 +1,18 @@
-"""Helpers of the issue-7 hostile-input tests (tests/test_hard_*.py): a small TOML writer."""
+"""Helpers of the hardening tests: a small TOML writer and random plants (the hostile-input
+tests, tests/test_hard_*.py), and :class:`HardCase`, what the suites over the generated API
+need of each controller variant (see "the variants" below)."""
 
 from __future__ import annotations
 
 import json
 import math
+import re
 import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
-from importlib import resources
 
 
 def toml_value(value) -> str:
@@ -147,8 +152,6 @@ def _bundled_names() -> list[str]:
 
 def look_ahead_case() -> str:
     """The differential-drive case: a bundled one if any, else ``tests/specs/office-drive``."""
-    from pathlib import Path
-
     from stt_codegen.spec.loader import load_spec
     for name in _bundled_names():
         if bundled_doc(name).get("plant", {}).get("model") == "differential-drive":
@@ -162,15 +165,13 @@ def case_of(variant: str) -> str:
     return VARIANT_CASES[variant] or look_ahead_case()
 
 
-class Argument:
+class Argument(NamedTuple):
     """One parameter of a generated C function: ``kind`` is ``scalar``, ``in`` or ``out``;
     ``size`` the header macro of an array's length (without the prefix), else ``None``."""
 
-    def __init__(self, name: str, kind: str, size: str | None) -> None:
-        self.name, self.kind, self.size = name, kind, size
-
-    def __repr__(self) -> str:
-        return f"Argument({self.name!r}, {self.kind!r}, {self.size!r})"
+    name: str
+    kind: str
+    size: str | None
 
 
 def prototypes(header: str, prefix: str) -> dict[str, list[Argument]]:
@@ -180,7 +181,6 @@ def prototypes(header: str, prefix: str) -> dict[str, list[Argument]]:
     ``const P_real a[P_SIZE]`` is an input array, ``P_real a[P_SIZE]`` an output,
     ``P_real a`` a scalar.
     """
-    import re
     out = {}
     for name, params in re.findall(rf"^int {prefix}_(\w+)\(([^;]*)\);", header, re.M):
         args = []
@@ -197,7 +197,6 @@ def prototypes(header: str, prefix: str) -> dict[str, list[Argument]]:
 
 def header_macros(header: str, prefix: str) -> dict[str, float]:
     """The numeric ``#define P_NAME value`` of a header, by ``NAME``."""
-    import re
     return {k: float(v) for k, v in re.findall(
         rf"^#define {prefix.upper()}_(\w+) ([-+0-9.eE]+)\s*$", header, re.M)}
 
@@ -353,7 +352,6 @@ class HardCase:
         """The inputs of the shipped test vectors (``P_vectors.json``): ``x``, ``t``,
         ``dt``, ``alpha``, one entry per vector (columns, or rows under ``vectors`` with
         one ``dt`` for all)."""
-        import json
         data = json.loads(self.files(precision)[f"{self.prefix}_vectors.json"])
         if "vectors" not in data:
             return {k: data[k] for k in ("x", "t", "dt", "alpha")}
@@ -459,8 +457,6 @@ class CApi:
 
 def c_api(case: HardCase, precision: str, cc: str, root) -> CApi:
     """Write, compile (strict warnings, ``-Werror``) and load the C of ``case`` (cached)."""
-    from pathlib import Path
-
     from codegen_helpers import compile_shared, write
     key = (case.variant, case.case, precision, cc, str(root))
     if key not in _LIBS:

@@ -127,7 +127,8 @@ def driver_source(case, rows, single: bool) -> str:
         body += [f"    {real} {a.name}[{up}_{a.size}];" for a in outs]
         body.append("    int s;")
         body += [f"    fill({a.name}, {up}_{a.size});" for a in outs]
-        body.append(f"    s = {_call(prefix, name, args, {**inputs, **{a.name: a.name for a in outs}})};")
+        given = {**inputs, **{a.name: a.name for a in outs}}
+        body.append(f"    s = {_call(prefix, name, args, given)};")
         body.append(f'    printf("{name} %d %d", k, s);')
         body += [f"    show({a.name}, {up}_{a.size});" for a in outs]
         body.append('    printf("\\n");')
