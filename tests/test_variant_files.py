@@ -155,3 +155,16 @@ def test_committed_c_python_and_casadi_steps_are_bit_identical(tmp_path, case) -
         assert code == py_code
         codes.add(code)
     assert 0 in codes
+
+
+def test_the_look_ahead_single_tolerance_of_u_is_not_vacuous() -> None:
+    """The committed single-precision vectors of office-base: where the status is OK every
+    tolerance of ``(v, omega)`` is below 1 % of the value (measured: at most 0.73 %); the
+    points cover the statuses OK, OUTSIDE_TUBE and INPUT_CLAMPED (a clamped entry's
+    tolerance is the unclamped command's, as in the first order)."""
+    data = json.loads((REPO / "generated" / "office-base" / "single" /
+                       "office_base_vectors.json").read_text())
+    u, tol, status = (np.array(data[k]) for k in ("u", "tol_u", "status"))
+    ok = status == 0
+    assert set(status.tolist()) == {0, 1, 3} and len(status) >= 32 and ok.sum() >= 8
+    assert np.all(tol[ok] < 0.01 * np.abs(u[ok]))

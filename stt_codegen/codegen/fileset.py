@@ -25,7 +25,7 @@ from .render import c_real, render
 
 __all__ = ["BUILD_TEMPLATES", "GENERATOR", "MANIFEST", "TOLERANCE_DOC", "build_files",
            "c_literal_rows", "file_context", "json_bytes", "manifest", "selftest_file",
-           "with_manifest"]
+           "vector_tables", "vectors_file", "with_manifest"]
 
 MANIFEST = "manifest.json"
 GENERATOR = "stt-codegen"
@@ -152,6 +152,54 @@ def selftest_file(context: dict, inputs: dict, expected: list[tuple[str, list, i
         x=c_literal_rows(inputs["x"], single), alpha=c_literal_rows(inputs["alpha"], single),
         t=c_literal_rows([inputs["t"]], single)[0], dt=c_literal_rows([inputs["dt"]], single)[0],
         status=inputs["status"], tables=tables, tolerance_doc=TOLERANCE_DOC[precision])}
+
+
+def vector_tables(vectors: dict) -> list[tuple[str, list, int]]:
+    """The self-test's tables of vectors in the first order's layout
+    (:func:`.vectors.test_vectors`; the look-ahead variant's too): ``EXP_U``,
+    ``EXP_ALPHA_NEXT``, ``EXP_GAMMA_L``, ``EXP_GAMMA_U``, ``TOL_U``, ``TOL_ALPHA_NEXT``,
+    ``TOL_GAMMA``.
+
+    Parameters
+    ----------
+    vectors : dict
+        Keys ``u``, ``alpha_next``, ``gamma_L``, ``gamma_U``, ``tol_u``,
+        ``tol_alpha_next``, ``tol_gamma`` (rows of numbers).
+
+    Returns
+    -------
+    list of (str, list of list of float, int)
+        Name, rows, width: the ``expected`` of :func:`selftest_file`.
+    """
+    tables = [(f"EXP_{k.upper()}", vectors[k], len(vectors[k][0]))
+              for k in ("u", "alpha_next", "gamma_L", "gamma_U")]
+    return tables + [(f"TOL_{k[4:].upper()}", vectors[k], len(vectors[k][0]))
+                     for k in ("tol_u", "tol_alpha_next", "tol_gamma")]
+
+
+def vectors_file(spec, precision: str, vectors: dict, source: str) -> bytes:
+    """``P_vectors.json`` in the first order's layout: the vectors with the spec's name and
+    hash, the precision and what the tolerances are.
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec generated from.
+    precision : {"double", "single"}
+    vectors : dict
+        JSON-ready vectors (:func:`.vectors.test_vectors`).
+    source : str
+        What computed the expected values (named in the ``_generated`` line).
+
+    Returns
+    -------
+    bytes
+    """
+    return json_bytes({
+        "_generated": f"GENERATED FILE, DO NOT EDIT: test vectors of spec {spec.name!r} "
+                      f"from {source}.",
+        "spec": spec.name, "spec_sha256": spec.source_hash, "precision": precision,
+        "tolerance": TOLERANCE_DOC[precision], **vectors})
 
 
 def with_manifest(spec, options, files: dict[str, bytes]) -> dict[str, bytes]:

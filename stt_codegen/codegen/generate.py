@@ -26,8 +26,8 @@ from ..spec.loader import Spec
 from ..tube.parameters import NEWTON_ITERATIONS, TubeDesign
 from . import tolerance
 from .functions import deployed_functions
-from .fileset import (GENERATOR, MANIFEST, TOLERANCE_DOC, build_files, json_bytes,
-                      manifest, selftest_file, with_manifest)
+from .fileset import (GENERATOR, MANIFEST, build_files, manifest, selftest_file,
+                      vector_tables, vectors_file, with_manifest)
 from .options import Options
 from .render import c_identifier, c_real, render
 from .tables import design_table_rows
@@ -77,11 +77,7 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
         for name, template in ((f"{prefix}.h", "c_header.h.j2"), (f"{prefix}.c", "c_source.c.j2")):
             files[name] = render(template, filename=name, **c_ctx)
         files.update(build_files(c_ctx))
-        expected = [(f"EXP_{k.upper()}", vectors[k], len(vectors[k][0]))
-                    for k in ("u", "alpha_next", "gamma_L", "gamma_U")]
-        expected += [(f"TOL_{k[4:].upper()}", vectors[k], len(vectors[k][0]))
-                     for k in ("tol_u", "tol_alpha_next", "tol_gamma")]
-        files.update(selftest_file(c_ctx, vectors, expected, options.precision))
+        files.update(selftest_file(c_ctx, vectors, vector_tables(vectors), options.precision))
     if "python" in options.langs:
         name = f"{prefix}.py"
         programs = [dataclasses.replace(lower(f), name=f"body_{f.name()}") for f in functions]
@@ -98,11 +94,8 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
                              input_bound=(None if design.input_bound is None else
                                           [repr(float(b)) for b in design.input_bound]))
     files_bytes = {k: v.encode("ascii") for k, v in files.items()}
-    files_bytes[f"{prefix}_vectors.json"] = json_bytes({
-        "_generated": f"GENERATED FILE, DO NOT EDIT: test vectors of spec {spec.name!r} "
-                      f"from the numpy reference (stt-codegen {__version__}).",
-        "spec": spec.name, "spec_sha256": spec.source_hash, "precision": options.precision,
-        "tolerance": TOLERANCE_DOC[options.precision], **vectors})
+    files_bytes[f"{prefix}_vectors.json"] = vectors_file(
+        spec, options.precision, vectors, f"the numpy reference (stt-codegen {__version__})")
     return with_manifest(spec, options, files_bytes)
 
 

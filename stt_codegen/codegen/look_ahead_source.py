@@ -234,8 +234,8 @@ def look_ahead_generation(design, options) -> dict[str, bytes]:
     SpecError
         Not a differential-drive spec (field ``plant.model``).
     """
-    from .fileset import (TOLERANCE_DOC, build_files, file_context, json_bytes, selftest_file,
-                          with_manifest)
+    from .fileset import (build_files, file_context, selftest_file, vector_tables,
+                          vectors_file, with_manifest)
 
     look_ahead = design.look_ahead
     spec = design.spec
@@ -246,17 +246,11 @@ def look_ahead_generation(design, options) -> dict[str, bytes]:
     if "c" in options.langs:
         texts.update(look_ahead_c_files(design.tube, look_ahead, prefix, options.precision))
         texts.update(build_files(context))
-        expected = [(f"EXP_{k.upper()}", vectors[k], len(vectors[k][0]))
-                    for k in ("u", "alpha_next", "gamma_L", "gamma_U")]
-        expected += [(f"TOL_{k[4:].upper()}", vectors[k], len(vectors[k][0]))
-                     for k in ("tol_u", "tol_alpha_next", "tol_gamma")]
-        texts.update(selftest_file(context, vectors, expected, options.precision))
+        texts.update(selftest_file(context, vectors, vector_tables(vectors), options.precision))
     if "python" in options.langs:
         texts.update(look_ahead_python_file(design.tube, look_ahead, prefix))
     files = {name: text.encode() for name, text in texts.items()}
-    files[f"{prefix}_vectors.json"] = json_bytes({
-        "_generated": f"GENERATED FILE, DO NOT EDIT: test vectors of spec {spec.name!r} "
-                      f"from the numpy reference (stt_codegen.tube.look_ahead_reference).",
-        "spec": spec.name, "spec_sha256": spec.source_hash, "precision": options.precision,
-        "tolerance": TOLERANCE_DOC[options.precision], **vectors})
+    files[f"{prefix}_vectors.json"] = vectors_file(
+        spec, options.precision, vectors,
+        "the numpy reference (stt_codegen.tube.look_ahead_reference)")
     return with_manifest(spec, options, files)
