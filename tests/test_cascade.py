@@ -127,20 +127,33 @@ def _load(tmp_path, tube, precision: str):
 
 
 def _c_step(lib, precision: str = "double"):
-    """``step(x, t, dt, alpha) -> (code, u, alpha_next, r)`` of the loaded C."""
+    """``step(x, t, dt, alpha) -> (code, u, alpha_next, r)`` of the loaded C: ``P_step``
+    for the code, ``u`` and ``alpha_next``, ``P_virtual_velocity`` for ``r`` (its code
+    agrees with a valid step's on the position tube; r = 0 when it is INVALID_INPUT)."""
     real = ctypes.c_double if precision == "double" else ctypes.c_float
     dtype = np.float64 if precision == "double" else np.float32
     pointer = ctypes.POINTER(real)
     entry = lib.cascade_test_step
-    entry.argtypes = [pointer, real, real, pointer, pointer, pointer, pointer]
+    entry.argtypes = [pointer, real, real, pointer, pointer, pointer]
     entry.restype = ctypes.c_int
+    virtual = lib.cascade_test_virtual_velocity
+    virtual.argtypes = [pointer, real, pointer, pointer]
+    virtual.restype = ctypes.c_int
 
     def step(x, t, dt, alpha):
         x, alpha = (np.ascontiguousarray(v, dtype=dtype) for v in (x, alpha))
         n = x.size // 2
         u, alpha_next, r = np.full(n, 7.0, dtype), np.zeros(2 * n, dtype), np.full(n, 7.0, dtype)
         code = entry(x.ctypes.data_as(pointer), t, dt, alpha.ctypes.data_as(pointer),
-                     *(a.ctypes.data_as(pointer) for a in (u, alpha_next, r)))
+                     *(a.ctypes.data_as(pointer) for a in (u, alpha_next)))
+        r_code = virtual(x.ctypes.data_as(pointer), t, alpha.ctypes.data_as(pointer),
+                         r.ctypes.data_as(pointer))
+        if code != Status.INVALID_INPUT:
+            assert r_code == (Status.OUTSIDE_TUBE if code == Status.OUTSIDE_TUBE
+                              else Status.OK), (code, r_code)
+        assert np.all(np.isfinite(r))
+        if r_code == Status.INVALID_INPUT:
+            assert np.all(r == 0.0)
         return code, u, alpha_next, r
     return step
 
@@ -172,7 +185,10 @@ def test_emitted_c_double_is_bit_identical_and_checks_inputs(tmp_path, tube) -> 
                          (1.0, 1e-3, x, np.r_[alpha[:5], nan])):
         code, u, alpha_next, r = step(xs, t, dt, a)
         assert code == Status.INVALID_INPUT
-        assert np.all(u == 0.0) and np.all(r == 0.0)
+        assert np.all(u == 0.0)
+        # the virtual velocity takes no dt: r = 0 where x, t or alpha is outside the domain
+        assert np.all(r == 0.0) or (np.isfinite(t) and t >= 0 and np.all(np.isfinite(xs))
+                                    and np.all((a >= 0) & np.isfinite(a)))
         assert np.array_equal(alpha_next, np.where(np.isfinite(a), a, 0.0))
 
 
@@ -221,22 +237,27 @@ def test_generated_python_runs_and_matches_the_oracle(tube) -> None:
     expected = cascade_reference.cascade_step(tube, STAGE, p["state"], p["t"], p["dt"],
                                               p["alpha"])
     for k in range(30):
-        u, alpha_next, r, status = namespace["step"](p["state"][k], p["t"][k], p["dt"][k],
-                                                     p["alpha"][k])
-        assert status == namespace["STATUS_OK"] == Status.OK
+        u, alpha_next, status = namespace["step"](p["state"][k], p["t"][k], p["dt"][k],
+                                                  p["alpha"][k])
+        r, r_status = namespace["virtual_velocity"](p["state"][k], p["t"][k], p["alpha"][k])
+        assert status == r_status == namespace["STATUS_OK"] == Status.OK
         np.testing.assert_allclose(u, expected[0][k], rtol=1e-10, atol=1e-12)
         np.testing.assert_allclose(r, expected[2][k], rtol=1e-10, atol=1e-12)
     invalid = namespace["step"](p["state"][0], -1.0, 1e-3, p["alpha"][0])
-    assert invalid[3] == namespace["STATUS_INVALID_INPUT"] == Status.INVALID_INPUT
-    assert invalid[0] == [0.0] * 3 and invalid[2] == [0.0] * 3
+    assert invalid[2] == namespace["STATUS_INVALID_INPUT"] == Status.INVALID_INPUT
+    assert invalid[0] == [0.0] * 3
     assert invalid[1] == list(p["alpha"][0])
+    assert namespace["virtual_velocity"](p["state"][0], -1.0, p["alpha"][0]) == (
+        [0.0] * 3, Status.INVALID_INPUT)
     nan_x = [*p["state"][0][:5], float("nan")]
     nan_alpha = [*p["alpha"][0][:5], float("inf")]
     for args in ((nan_x, 1.0, 1e-3, p["alpha"][0]), (p["state"][0], 1.0, 1e-3, nan_alpha),
                  (p["state"][0][:5], 1.0, 1e-3, p["alpha"][0])):
-        u, alpha_next, r, status = namespace["step"](*args)
-        assert status == Status.INVALID_INPUT and u == r == [0.0] * 3
+        u, alpha_next, status = namespace["step"](*args)
+        assert status == Status.INVALID_INPUT and u == [0.0] * 3
         assert alpha_next == [v if np.isfinite(v) else 0.0 for v in args[3]]
+        assert namespace["virtual_velocity"](args[0], args[1], args[3]) == (
+            [0.0] * 3, Status.INVALID_INPUT)
 
 
 def test_the_oracles_unclamped_transform_is_the_deployed_one_inside() -> None:
@@ -347,8 +368,8 @@ def test_generated_python_with_a_bound_reports_input_clamped(tube, bounded) -> N
                                               p["alpha"])
     statuses = []
     for k in range(60):
-        u, _, _, status = namespace["step"](p["state"][k], p["t"][k], p["dt"][k],
-                                            p["alpha"][k])
+        u, _, status = namespace["step"](p["state"][k], p["t"][k], p["dt"][k],
+                                         p["alpha"][k])
         assert status == (Status.OK if expected[5][k] else Status.INPUT_CLAMPED)
         np.testing.assert_allclose(u, expected[0][k], rtol=1e-10, atol=1e-12)
         statuses.append(status)

@@ -63,4 +63,4 @@ def test_the_cascade_loop_is_a_template_sharing_the_first_orders_pieces() -> Non
         assert function(program, name) == function(first, name), name
     assert "#define NX (2 * N)" in program and "#define NX N" in first
     assert "static const double PARAMS[NPARAMS] = { 1.3 };" in program
-    assert "planar_s1_cascade_step(xf, tf, dtf, alpha, uf, alpha_next, rf)" in program
+    assert "planar_s1_cascade_step(xf, tf, dtf, alpha, uf, alpha_next)" in program

@@ -36,23 +36,33 @@ def _folder(case: str, precision: str) -> Path:
 
 
 def _vectors(case: str, precision: str = "double") -> dict:
-    prefix = case.replace("-", "_") + "_cascade"
+    prefix = case.replace("-", "_")
     return json.loads((_folder(case, precision) / f"{prefix}_vectors.json").read_text())
 
 
 def _build(tmp_path: Path, case: str, precision: str):
-    prefix = case.replace("-", "_") + "_cascade"
+    prefix = case.replace("-", "_")
     lib = tmp_path / f"lib{prefix}_{precision}.so"
     proc = subprocess.run([CC, *STRICT, "-fPIC", "-shared",
                            str(_folder(case, precision) / f"{prefix}.c"), "-o", str(lib), "-lm"],
                           capture_output=True, text=True)
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
-    step = getattr(ctypes.CDLL(str(lib)), f"{prefix}_step")
+    handle = ctypes.CDLL(str(lib))
+    step, virtual = (getattr(handle, f"{prefix}_{name}") for name in ("step", "virtual_velocity"))
     real = ctypes.c_double if precision == "double" else ctypes.c_float
     pointer = ctypes.POINTER(real)
-    step.argtypes = [pointer, real, real, pointer, pointer, pointer, pointer]
+    step.argtypes = [pointer, real, real, pointer, pointer, pointer]
     step.restype = ctypes.c_int
-    return step, real, np.float64 if precision == "double" else np.float32
+    virtual.argtypes = [pointer, real, pointer, pointer]
+    virtual.restype = ctypes.c_int
+
+    def call(x, t, dt, alpha, u, alpha_next, r):
+        """The step into u and alpha_next, the accessor into r; the step's code (the
+        accessor's checked to agree: OK where the step's is)."""
+        code = step(x, t, dt, alpha, u, alpha_next)
+        assert virtual(x, t, alpha, r) == (code if code in (0, 1, 2) else 0)
+        return code
+    return call, real, np.float64 if precision == "double" else np.float32
 
 
 @pytest.mark.skipif(CC is None, reason="no C compiler (install gcc or clang)")
@@ -94,7 +104,7 @@ def test_committed_c_meets_its_vectors(tmp_path, case, precision) -> None:
 
 @pytest.mark.parametrize("case", CASES)
 def test_committed_python_meets_its_vectors(case) -> None:
-    prefix = case.replace("-", "_") + "_cascade"
+    prefix = case.replace("-", "_")
     namespace: dict = {}
     source = (_folder(case, "double") / f"{prefix}.py").read_text()
     exec(compile(source, f"{prefix}.py", "exec"), namespace)
@@ -102,8 +112,10 @@ def test_committed_python_meets_its_vectors(case) -> None:
         == ["import math"]
     data = _vectors(case)
     for v in data["vectors"][::4]:
-        u, alpha_next, r, status = namespace["step"](v["x"], v["t"], data["dt"], v["alpha"])
-        assert status == v["status"]
+        u, alpha_next, status = namespace["step"](v["x"], v["t"], data["dt"], v["alpha"])
+        r, r_status = namespace["virtual_velocity"](v["x"], v["t"], v["alpha"])
+        assert status == r_status == v["status"]
+        np.testing.assert_allclose(r, v["r"], rtol=DOUBLE_TOLERANCE, atol=DOUBLE_TOLERANCE)
         np.testing.assert_allclose(u, v["u"], rtol=DOUBLE_TOLERANCE, atol=DOUBLE_TOLERANCE)
         np.testing.assert_allclose(alpha_next, v["alpha_next"], rtol=DOUBLE_TOLERANCE,
                                    atol=DOUBLE_TOLERANCE)
@@ -150,7 +162,7 @@ def test_cppcheck_misra_findings_are_the_listed_deviations(tmp_path, case, preci
     import re
 
     from test_codegen_misra import DEVIATIONS
-    prefix = case.replace("-", "_") + "_cascade"
+    prefix = case.replace("-", "_")
     for suffix in (".c", ".h"):
         (tmp_path / f"{prefix}{suffix}").write_bytes(
             (_folder(case, precision) / f"{prefix}{suffix}").read_bytes())
@@ -205,7 +217,7 @@ def test_table_driven_c_is_bit_identical_to_casadi(tmp_path, case, bounded) -> N
         u = cascade_reference.cascade_step(tube, stage, state, p["t"], p["dt"], p["alpha"])[0]
         tube = dataclasses.replace(tube, input_bound=tuple(
             float(b) for b in np.maximum(np.median(np.abs(u), axis=0), 1e-3)))
-    prefix = case.replace("-", "_") + "_cascade"
+    prefix = case.replace("-", "_")
     files = cascade_c_files(tube, stage, prefix, "double")
     if not bounded:
         assert files[f"{prefix}.c"] == (_folder(case, "double") / f"{prefix}.c").read_text()
@@ -215,10 +227,11 @@ def test_table_driven_c_is_bit_identical_to_casadi(tmp_path, case, bounded) -> N
     proc = subprocess.run([CC, *STRICT, "-fPIC", "-shared", str(tmp_path / f"{prefix}.c"),
                            "-o", str(lib), "-lm"], capture_output=True, text=True)
     assert proc.returncode == 0 and proc.stderr == "", proc.stderr
-    entry = getattr(ctypes.CDLL(str(lib)), f"{prefix}_step")
+    handle = ctypes.CDLL(str(lib))
+    entry, virtual = (getattr(handle, f"{prefix}_{name}") for name in ("step", "virtual_velocity"))
     pointer = ctypes.POINTER(ctypes.c_double)
-    entry.argtypes = [pointer, ctypes.c_double, ctypes.c_double, pointer, pointer, pointer,
-                      pointer]
+    entry.argtypes = [pointer, ctypes.c_double, ctypes.c_double, pointer, pointer, pointer]
+    virtual.argtypes = [pointer, ctypes.c_double, pointer, pointer]
     function = cascade.cascade_step(tube, stage)
     codes = set()
     for push in (0.0, 3.0):
@@ -229,7 +242,9 @@ def test_table_driven_c_is_bit_identical_to_casadi(tmp_path, case, bounded) -> N
             u, alpha_next, r_c = np.zeros(n), np.zeros(2 * n), np.zeros(n)
             code = entry(x.ctypes.data_as(pointer), float(p["t"][k]), float(p["dt"][k]),
                          alpha.ctypes.data_as(pointer),
-                         *(a.ctypes.data_as(pointer) for a in (u, alpha_next, r_c)))
+                         *(a.ctypes.data_as(pointer) for a in (u, alpha_next)))
+            virtual(x.ctypes.data_as(pointer), float(p["t"][k]), alpha.ctypes.data_as(pointer),
+                    r_c.ctypes.data_as(pointer))
             expected = casadi_dense(function, [x, [p["t"][k]], [p["dt"][k]], alpha])
             for got, exp in zip((u, alpha_next, r_c), expected):
                 assert all(same_double(float(a), b) for a, b in zip(got, exp)), (k, push)

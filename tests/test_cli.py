@@ -25,16 +25,19 @@ def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
 def test_cases_lists_bundled_specs():
     out = run("cases")
     assert out.returncode == 0
-    assert out.stdout.split() == ["crossing-moving", "omnirobot-s1", "omnirobot-s2",
-                                  "omnirobot-s3", "pointmaze-umaze", "second-order-quadrotor",
-                                  "second-order-s1", "tasks-stay", "tasks-visit"]
+    assert out.stdout.split() == ["crossing-moving", "office-base", "omnirobot-s1",
+                                  "omnirobot-s2", "omnirobot-s3", "pointmaze-umaze",
+                                  "second-order-quadrotor", "second-order-s1", "tasks-stay",
+                                  "tasks-visit"]
 
 
 def test_bundled_cases_are_the_paper_cases_and_the_examples():
     """The conftest's CASES (the parameters of the ``case`` fixture) are the paper's bundled
     specs; the others are the timed-task examples (TASK_CASES), the moving-obstacle and MuJoCo
-    examples (EXTRA_CASES) and the second-order cases (with tests of their own)."""
-    first_order = [c for c in bundled_cases() if not c.startswith("second-order-")]
+    examples (EXTRA_CASES), the second-order cases and the differential-drive base
+    (office-base), with tests of their own."""
+    first_order = [c for c in bundled_cases()
+                   if not c.startswith("second-order-") and c != "office-base"]
     assert first_order == sorted(CASES + TASK_CASES + EXTRA_CASES)
 
 
@@ -117,13 +120,13 @@ def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
         c_name = name.replace("-", "_")
         for suffix in (".c", ".h", ".py", "_selftest.c"):
             assert (tmp_path / "demo" / name / f"{c_name}{suffix}").is_file()
-    for name in ("second-order-s1", "second-order-quadrotor"):      # the cascade
+    for name in ("second-order-s1", "second-order-quadrotor", "office-base"):   # the variants
         assert name in out.stdout
         assert (tmp_path / "demo" / f"{name}.png").stat().st_size > 10_000
-        c_name = name.replace("-", "_") + "_cascade"
-        for suffix in (".c", ".h", ".py", "_vectors.json"):
+        c_name = name.replace("-", "_")
+        for suffix in (".c", ".h", ".py", "_selftest.c", "_vectors.json"):
             assert (tmp_path / "demo" / name / f"{c_name}{suffix}").is_file()
-    assert out.stdout.count(" yes ") == len(CASES + TASK_CASES + EXTRA_CASES) + 2
+    assert out.stdout.count(" yes ") == len(CASES + TASK_CASES + EXTRA_CASES) + 3
     again = run("demo", "--out", str(tmp_path / "demo"))     # its own files: overwritten
     assert again.returncode == 0, again.stderr
 

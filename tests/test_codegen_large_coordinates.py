@@ -1,4 +1,4 @@
-"""Large coordinates: ``generate`` finishes, double works, single says why not.
+"""Large coordinates: ``generate`` finishes, double works, single says why not, every variant.
 
 ``sample_inputs`` looked, without bound, for test points whose single-precision status is
 certain; with the tube narrower than about ``4 * 64 * 2^-24`` times the largest coordinate
@@ -6,7 +6,10 @@ none qualifies and ``generate`` never finished, in double too. Now the search is
 (``ROUNDS`` rounds of ``BATCH`` candidates: counted here, not timed), certainty is judged
 in the generated precision, and single precision on these arenas is a ``SpecError``
 naming ``precision`` (exit 2, one line, nothing written). The command-line runs are in
-the slow tier, with a generous timeout that only guards against a hang.
+the slow tier, with a generous timeout that only guards against a hang, for every
+controller variant: the arenas driven by a double integrator (``-cascade``) and by a
+differential-drive base (``-drive``, tests/specs/). The bounded search itself is the
+first order's test vectors' (:func:`stt_codegen.codegen.vectors.sample_inputs`).
 """
 
 from __future__ import annotations
@@ -26,6 +29,10 @@ from stt_codegen.spec.loader import load_spec
 
 SPECS = Path(__file__).parent / "specs"
 ARENAS = ["shifted-arena-1e6", "wide-arena-20km"]
+#: The spec name of an arena for each controller variant.
+VARIANT_SUFFIX = {"first-order": "", "cascade": "-cascade", "look-ahead": "-drive"}
+#: The specs of the command-line runs: every arena for every variant.
+SPEC_RUNS = [arena + suffix for suffix in VARIANT_SUFFIX.values() for arena in ARENAS]
 #: A command that has not finished after this many seconds hangs (they take a few).
 HANG = 600
 
@@ -67,7 +74,7 @@ def test_the_search_for_test_points_is_bounded(arena, monkeypatch):
 
 @pytest.mark.slow
 @pytest.mark.skipif(not COMPILERS, reason="no C compiler (Debian: gcc)")
-@pytest.mark.parametrize("arena", ARENAS)
+@pytest.mark.parametrize("arena", SPEC_RUNS)
 def test_double_generates_and_its_selftest_passes(arena, tmp_path):
     proc = _cli("generate", str(SPECS / f"{arena}.toml"), "-o", "out", "--precision", "double",
                 cwd=tmp_path)
@@ -79,7 +86,7 @@ def test_double_generates_and_its_selftest_passes(arena, tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("arena", ARENAS)
+@pytest.mark.parametrize("arena", SPEC_RUNS)
 def test_single_is_refused_with_the_reason(arena, tmp_path):
     proc = _cli("generate", str(SPECS / f"{arena}.toml"), "-o", "out", "--precision", "single",
                 cwd=tmp_path)
@@ -93,7 +100,7 @@ def test_single_is_refused_with_the_reason(arena, tmp_path):
 
 @pytest.mark.slow
 @pytest.mark.skipif(not COMPILERS, reason="no C compiler (Debian: gcc)")
-@pytest.mark.parametrize("arena", ARENAS)
+@pytest.mark.parametrize("arena", SPEC_RUNS)
 def test_simulate_with_the_c_backend(arena, tmp_path):
     proc = _cli("simulate", str(SPECS / f"{arena}.toml"), "--backend", "c", "--json",
                 cwd=tmp_path)

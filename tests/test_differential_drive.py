@@ -241,7 +241,7 @@ def test_generation_is_deterministic_and_names_its_source(office, tmp_path):
     assert [p.name for p in first] == [p.name for p in second]
     for a, b in zip(first, second):
         assert a.read_bytes() == b.read_bytes()
-    source = (tmp_path / "a" / "office_drive_look_ahead.c").read_text()
+    source = (tmp_path / "a" / "office_drive.c").read_text()
     assert "GENERATED FILE" in source and "look_ahead_source" in source
     assert str(tmp_path) not in source and "/work" not in source
 

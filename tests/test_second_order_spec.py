@@ -179,10 +179,11 @@ def test_generate_writes_the_cascade(tmp_path) -> None:
     out = _cli("generate", "second-order-s1", "-o", str(tmp_path / "out"))
     assert out.returncode == 0, out.stderr
     names = sorted(p.name for p in (tmp_path / "out").iterdir())
-    assert names == ["manifest.json", "second_order_s1_cascade.c", "second_order_s1_cascade.h",
-                     "second_order_s1_cascade.py", "second_order_s1_cascade_vectors.json"]
-    committed = REPO / "generated" / "second-order-s1" / "double" / "second_order_s1_cascade.c"
-    assert (tmp_path / "out" / "second_order_s1_cascade.c").read_bytes() == committed.read_bytes()
+    assert names == ["CMakeLists.txt", "Makefile", "manifest.json", "second_order_s1.c",
+                     "second_order_s1.h", "second_order_s1.py", "second_order_s1_selftest.c",
+                     "second_order_s1_vectors.json"]
+    committed = REPO / "generated" / "second-order-s1" / "double" / "second_order_s1.c"
+    assert (tmp_path / "out" / "second_order_s1.c").read_bytes() == committed.read_bytes()
 
 
 SPECS = REPO / "tests" / "specs"

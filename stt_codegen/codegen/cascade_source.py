@@ -1,9 +1,11 @@
 """Standalone C and Python of the cascade controller for second-order plants.
 
-The entry point has the first order's argument order, ``<prefix>_step(x, t, dt, alpha,
-u, alpha_next, r) -> status`` with ``x = [x1; x2]``, and its statuses (plus
-``OUTSIDE_VELOCITY_TUBE``); it computes :func:`stt_codegen.tube.cascade.cascade_step` of a
-design and its second stage, bit for bit in double precision.
+The entry point has every variant's signature, ``<prefix>_step(x, t, dt, alpha, u,
+alpha_next) -> status`` with ``x = [x1; x2]``, and the first order's statuses (plus
+``OUTSIDE_VELOCITY_TUBE``); the virtual velocity is the accessor
+``<prefix>_virtual_velocity(x, t, alpha, r) -> status``. Both compute
+:func:`stt_codegen.tube.cascade.cascade_step` of a design and its second stage, bit for bit
+in double precision.
 
 * C: a variant of the first-order source (:func:`.generate.c_source_context`,
   ``c_source.c.j2``): the same tables and table-driven tube (only the active segment and
@@ -136,9 +138,9 @@ def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
 
 
 def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str) -> dict[str, str]:
-    """``{<prefix>.py: text}``: ``step(x, t, dt, alpha) -> (u, alpha_next, r, status)``
-    (``x = [x1; x2]``), the same function, statuses and input checks as the C (imports ``math``
-    only). The emitter's Python printer prints the composed Function; the template
+    """``{<prefix>.py: text}``: ``step(x, t, dt, alpha) -> (u, alpha_next, status)`` and
+    ``virtual_velocity(x, t, alpha) -> (r, status)`` (``x = [x1; x2]``), the same functions,
+    statuses and input checks as the C (imports ``math`` only). The emitter's Python printer prints the composed Function; the template
     ``cascade_module.py.j2`` holds the rest of the text.
 
     Parameters
@@ -189,12 +191,22 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     or ``INPUT_CLAMPED`` as the oracle clamps, and only points whose clamp decision is
     certain in the precision are kept (every ``|u_i|`` of the law farther from the bound
     than its tolerance plus the bound's rounding), as for the first order.
+
+    Raises
+    ------
+    SpecError
+        ``precision``: it cannot resolve the position tube at the spec's coordinates (the
+        first order's test, :func:`.vectors.sample_inputs`, on the same tube).
     """
     import numpy as np
 
     from ..rounding import round_up_array
     from ..tube import cascade_reference, reference
     from . import tolerance as T
+    from .vectors import sample_inputs
+
+    sample_inputs(design, precision)      # raises SpecError where the precision cannot
+    #                                       resolve the position tube (its points unused)
 
     def f32(a):
         return np.asarray(a, dtype=np.float32).astype(np.float64)
@@ -254,10 +266,12 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
 def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
     """Every file of the cascade controller of a second-order design, in memory.
 
-    ``P_cascade.h``, ``P_cascade.c`` (with ``"c"`` in ``options.langs``, in
-    ``options.precision``), ``P_cascade.py`` (with ``"python"``), ``P_cascade_vectors.json``
-    and ``manifest.json``; ``P`` is the spec's C name. The second stage is the default one
-    of :attr:`stt_codegen.design.result.Design.second_stage`.
+    The file set of every variant (:mod:`.fileset`), ``P`` the spec's C name: ``P.h``,
+    ``P.c``, ``P_selftest.c`` (the vectors replayed through ``P_step``,
+    ``P_virtual_velocity`` and ``P_alpha_step``), ``Makefile`` and ``CMakeLists.txt`` (with
+    ``"c"`` in ``options.langs``, in ``options.precision``), ``P.py`` (with ``"python"``),
+    ``P_vectors.json`` (:func:`cascade_vectors`) and ``manifest.json``. The second stage is
+    the default one of :attr:`stt_codegen.design.result.Design.second_stage`.
 
     Parameters
     ----------
@@ -274,21 +288,30 @@ def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
     SpecError
         A first-order spec (field ``plant.model``).
     """
-    import json
-
-    from .generate import MANIFEST, manifest
+    from .fileset import build_files, file_context, json_bytes, selftest_file, with_manifest
 
     stage, _ = design.second_stage
-    prefix = f"{design.spec.c_name}_cascade"
+    spec = design.spec
+    context = file_context(spec, options.precision)
+    prefix = context["P"]
+    data = cascade_vectors(design.tube, stage, precision=options.precision)
     texts: dict[str, str] = {}
     if "c" in options.langs:
         texts.update(cascade_c_files(design.tube, stage, prefix, options.precision))
+        texts.update(build_files(context))
+        rows = data["vectors"]
+        inputs = {"x": [v["x"] for v in rows], "t": [v["t"] for v in rows],
+                  "dt": [data["dt"]] * len(rows), "alpha": [v["alpha"] for v in rows],
+                  "status": [v["status"] for v in rows]}
+        names = ("u", "alpha_next", "r")
+        expected = [(f"EXP_{k.upper()}", [v[k] for v in rows], len(rows[0][k])) for k in names]
+        expected += [(f"TOL_{k.upper()}", [v[f"tol_{k}"] for v in rows], len(rows[0][k]))
+                     for k in names]
+        texts.update(selftest_file(context, inputs, expected, options.precision,
+                                   "cascade_selftest.c.j2"))
     if "python" in options.langs:
         texts.update(cascade_python_file(design.tube, stage, prefix))
-    texts[f"{prefix}_vectors.json"] = json.dumps(cascade_vectors(design.tube, stage,
-                                                                 precision=options.precision),
-                                                 indent=1) + "\n"
     files = {name: text.encode() for name, text in texts.items()}
-    files[MANIFEST] = (json.dumps(manifest(design.spec, options, files), indent=2,
-                                  sort_keys=True) + "\n").encode()
-    return files
+    files[f"{prefix}_vectors.json"] = json_bytes(
+        dict(data, spec=spec.name, spec_sha256=spec.source_hash))
+    return with_manifest(spec, options, files)

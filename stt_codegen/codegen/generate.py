@@ -15,12 +15,9 @@ versions give the same bytes (no timestamps, no paths, no set iteration). Files,
 from __future__ import annotations
 
 import dataclasses
-import hashlib
-import json
 import math
 
 import casadi
-import numpy as np
 
 from ..version import __version__
 from .emit import CPrinter, lower, python_source
@@ -29,42 +26,16 @@ from ..spec.loader import Spec
 from ..tube.parameters import NEWTON_ITERATIONS, TubeDesign
 from . import tolerance
 from .functions import deployed_functions
+from .fileset import (GENERATOR, MANIFEST, build_files, manifest, selftest_file,
+                      vector_tables, vectors_file, with_manifest)
 from .options import Options
 from .render import c_identifier, c_real, render
 from .tables import design_table_rows
 from ..tube.pieces import PROFILE_NAMES
 from .vectors import test_vectors
 
-__all__ = ["GENERATOR", "MANIFEST", "Options", "c_source_context", "generate_files", "input_limits",
-           "manifest"]
-
-MANIFEST = "manifest.json"
-GENERATOR = "stt-codegen"
-
-_TOLERANCE_DOC = {
-    "double": ("max(1e-12 max(1, |ref|), B) with B the first-order rounding bound of "
-               "stt_codegen.codegen.tolerance at unit roundoff 2^-53 (covers a libm a few ulp "
-               "from glibc's on ill-conditioned points near the tube boundary)."),
-    "single": ("B, the rounding bound of stt_codegen.codegen.tolerance at unit roundoff 2^-24: "
-               "tube bounds 64 u S (S = 1 + max |state bound| + max |alpha|); u: the exact "
-               "spread of the law over the error of e; alpha_next 64 u (S + |alpha| + "
-               "|alpha_next|)."),
-}
-
-
-def _json_bytes(data: dict) -> bytes:
-    return (json.dumps(data, indent=1, sort_keys=True, allow_nan=False) + "\n").encode("ascii")
-
-
-def _sha256(data: bytes) -> str:
-    return hashlib.sha256(data).hexdigest()
-
-
-def _c_literal_rows(rows, single: bool):
-    if single:
-        return [[np.format_float_scientific(np.float32(v), unique=True, trim="0") + "f"
-                 for v in row] for row in rows]
-    return [[c_real(v, False) for v in row] for row in rows]
+__all__ = ["GENERATOR", "MANIFEST", "Options", "c_source_context", "first_order_generation",
+           "generate_files", "input_limits", "manifest"]
 
 
 def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str, bytes]:
@@ -100,24 +71,13 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
         "real": "float" if single else "double",
     }
     files: dict[str, str] = {}
-    if "c" in options.langs:
-        c_ctx = dict(common, **c_source_context(design, prefix, options.precision, functions))
-        for name, template in ((f"{prefix}.h", "c_header.h.j2"), (f"{prefix}.c", "c_source.c.j2"),
-                               ("Makefile", "Makefile.j2"),
-                               ("CMakeLists.txt", "CMakeLists.txt.j2")):
-            files[name] = render(template, filename=name, **c_ctx)
     vectors = test_vectors(design, options.precision)
     if "c" in options.langs:
-        name = f"{prefix}_selftest.c"
-        tables = [(f"EXP_{k.upper()}", _c_literal_rows(vectors[k], False), len(vectors[k][0]))
-                  for k in ("u", "alpha_next", "gamma_L", "gamma_U")]
-        tables += [(f"TOL_{k[4:].upper()}", _c_literal_rows(vectors[k], False), len(vectors[k][0]))
-                   for k in ("tol_u", "tol_alpha_next", "tol_gamma")]
-        files[name] = render(
-            "c_selftest.c.j2", filename=name, **c_ctx, count=len(vectors["t"]),
-            x=_c_literal_rows(vectors["x"], single), alpha=_c_literal_rows(vectors["alpha"], single),
-            t=_c_literal_rows([vectors["t"]], single)[0], dt=_c_literal_rows([vectors["dt"]], single)[0],
-            status=vectors["status"], tables=tables, tolerance_doc=_TOLERANCE_DOC[options.precision])
+        c_ctx = dict(common, **c_source_context(design, prefix, options.precision, functions))
+        for name, template in ((f"{prefix}.h", "c_header.h.j2"), (f"{prefix}.c", "c_source.c.j2")):
+            files[name] = render(template, filename=name, **c_ctx)
+        files.update(build_files(c_ctx))
+        files.update(selftest_file(c_ctx, vectors, vector_tables(vectors), options.precision))
     if "python" in options.langs:
         name = f"{prefix}.py"
         programs = [dataclasses.replace(lower(f), name=f"body_{f.name()}") for f in functions]
@@ -133,15 +93,29 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
                              alpha_max=repr(limits["alpha_max"]),
                              input_bound=(None if design.input_bound is None else
                                           [repr(float(b)) for b in design.input_bound]))
-    vec_name = f"{prefix}_vectors.json"
     files_bytes = {k: v.encode("ascii") for k, v in files.items()}
-    files_bytes[vec_name] = _json_bytes({
-        "_generated": f"GENERATED FILE, DO NOT EDIT: test vectors of spec {spec.name!r} "
-                      f"from the numpy reference (stt-codegen {__version__}).",
-        "spec": spec.name, "spec_sha256": spec.source_hash, "precision": options.precision,
-        "tolerance": _TOLERANCE_DOC[options.precision], **vectors})
-    files_bytes[MANIFEST] = _json_bytes(manifest(spec, options, files_bytes))
-    return dict(sorted(files_bytes.items()))
+    files_bytes[f"{prefix}_vectors.json"] = vectors_file(
+        spec, options.precision, vectors, f"the numpy reference (stt-codegen {__version__})")
+    return with_manifest(spec, options, files_bytes)
+
+
+def first_order_generation(design, options: Options) -> dict[str, bytes]:
+    """Every file of law (13)'s controller of a first-order design, in memory: the
+    generation entry point of the first order, with the cascade's and the look-ahead
+    variant's signature (``(design, options) -> files``).
+
+    Parameters
+    ----------
+    design : Design
+        Of a spec with a first-order ``plant.model``.
+    options : Options
+
+    Returns
+    -------
+    dict of str to bytes
+        :func:`generate_files` of the design's spec and tube.
+    """
+    return generate_files(design.spec, design.tube, options)
 
 
 def c_source_context(design: TubeDesign, prefix: str, precision: str,
@@ -208,32 +182,3 @@ def input_limits(design: TubeDesign) -> dict[str, float]:
     scale = 1.0 + max(abs(v) for v in (*design.state_lower, *design.state_upper))
     return {"dt_min": 2.0 ** -20, "dt_max": 2.0 ** math.ceil(math.log2(design.prescribed_time)),
             "alpha_max": 2.0 ** math.ceil(math.log2(1e6 * scale))}
-
-
-def manifest(spec: Spec, options: Options, files: dict[str, bytes]) -> dict:
-    """The manifest: versions, spec hash, options and the SHA-256 of every other file.
-
-    Parameters
-    ----------
-    spec : Spec
-        The spec generated from (its name and source hash).
-    options : Options
-        The generation's languages and precision.
-    files : dict of str to bytes
-        The generated files by name; the manifest's own entry is skipped.
-
-    Returns
-    -------
-    dict
-        JSON-ready; file hashes as hex SHA-256, in name order.
-    """
-    return {
-        "_generated": "GENERATED FILE, DO NOT EDIT: manifest of an stt-codegen generation.",
-        "generator": GENERATOR,
-        "toolkit_version": __version__,
-        "casadi_version": casadi.__version__,
-        "spec": {"name": spec.name, "sha256": spec.source_hash},
-        "options": options.to_json(),
-        "files": {name: _sha256(data) for name, data in sorted(files.items()) if name != MANIFEST},
-        "tolerance_unit_roundoff": tolerance.unit_roundoff(options.precision),
-    }

@@ -33,7 +33,8 @@ from .functions import deployed_functions
 from .generate import c_source_context, input_limits
 from .render import c_real, render
 
-__all__ = ["look_ahead_c_files", "look_ahead_generation", "look_ahead_python_file"]
+__all__ = ["look_ahead_c_files", "look_ahead_generation", "look_ahead_python_file",
+           "look_ahead_vectors"]
 
 
 def _check(design: TubeDesign, look_ahead: LookAhead, prefix: str) -> None:
@@ -131,12 +132,92 @@ def look_ahead_python_file(design: TubeDesign, look_ahead: LookAhead,
                          body=python_source(look_ahead_step(design, look_ahead)))}
 
 
+def look_ahead_vectors(design: TubeDesign, look_ahead: LookAhead, precision: str) -> dict:
+    """Test vectors of the look-ahead step from the numpy oracle (JSON-ready, deterministic),
+    in the first order's layout (:func:`.vectors.test_vectors`).
+
+    Points: the first order's inputs for the look-ahead point's tube
+    (:func:`.vectors.sample_inputs`: inside and outside points with a certain status) taken
+    as the point ``p``, a heading ``theta`` from a fixed seed, and the base's state
+    ``(p - l (cos theta, sin theta), theta)`` rounded to float32 (exact in both precisions);
+    kept where the status is still certain in the precision
+    (:func:`.tolerance.look_ahead_bounds`) and, with the base's limits, where the clamp's
+    decision is (every ``|u_i|`` farther from its limit than its tolerance plus the
+    limit's rounding). Expected ``u``, ``alpha_next``, status from
+    :func:`stt_codegen.tube.look_ahead_reference.look_ahead_status`, the tube from
+    :func:`stt_codegen.tube.reference.adaptive_tube`; tolerances ``tol_u``
+    (:func:`.tolerance.look_ahead_bounds`), ``tol_alpha_next``, ``tol_gamma`` (the first
+    order's), double ones with the floor ``1e-12 max(1, |ref|)``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The look-ahead point's tube.
+    look_ahead : LookAhead
+        The axle offset and the base's limits.
+    precision : {"double", "single"}
+
+    Returns
+    -------
+    dict
+        Keys ``x`` (N, 3), ``t``, ``dt``, ``alpha`` (N, 4), ``u`` (N, 2), ``alpha_next``,
+        ``status``, ``gamma_L``, ``gamma_U``, ``tol_u``, ``tol_alpha_next``, ``tol_gamma``,
+        ``unit_roundoff``.
+    """
+    import numpy as np
+
+    from ..rounding import round_up_array
+    from ..tube import look_ahead_reference as LR
+    from ..tube import reference
+    from . import tolerance as T
+    from .vectors import sample_inputs
+
+    def f32(a):
+        return np.asarray(a, dtype=np.float32).astype(np.float64)
+
+    p = sample_inputs(design, precision)
+    t, dt, alpha = p["t"], p["dt"], p["alpha"]
+    offset = look_ahead.axle_offset
+    theta = f32(np.random.default_rng(23).uniform(-np.pi, np.pi, t.size))
+    states = np.column_stack([f32(p["x"][:, 0] - offset * np.cos(theta)),
+                              f32(p["x"][:, 1] - offset * np.sin(theta)), theta])
+    unit = T.unit_roundoff(precision)
+    u_point = reference.law_step(design, LR.point(states, offset), t, dt, alpha)[0]
+    u_free = LR.command(states, u_point, offset)
+    tol_u, keep = T.look_ahead_bounds(design, offset, states, t, alpha, u_point, u_free, unit)
+    if look_ahead.input_bound is not None:
+        bound = np.asarray(look_ahead.input_bound, dtype=float)
+        keep &= np.all(np.abs(np.abs(u_free) - bound) > tol_u + 2.0 * unit * bound, axis=1)
+    states, t, dt, alpha, tol_u = (a[keep] for a in (states, t, dt, alpha, tol_u))
+    u, alpha_next, status = LR.look_ahead_status(design, offset, look_ahead.input_bound,
+                                                 states, t, dt, alpha)
+    g_l, g_u, _, _ = reference.adaptive_tube(design, t, alpha)
+    tol_a = T.alpha_bound(design, alpha, alpha_next, unit)
+    tol_g = np.broadcast_to(T.gamma_bound(design, alpha, unit), g_l.shape)
+    if precision == "double":
+        tol_u = T.with_double_floor(tol_u, u)
+        tol_a = T.with_double_floor(tol_a, alpha_next)
+        tol_g = T.with_double_floor(tol_g, np.maximum(np.abs(g_l), np.abs(g_u)))
+    tol_u, tol_a, tol_g = (round_up_array(tol) for tol in (tol_u, tol_a, tol_g))
+
+    def rows(a):
+        return [[float(v) for v in row] for row in np.asarray(a)]
+
+    return {"x": rows(states), "t": [float(v) for v in t], "dt": [float(v) for v in dt],
+            "alpha": rows(alpha), "u": rows(u), "alpha_next": rows(alpha_next),
+            "status": [int(s) for s in status], "gamma_L": rows(g_l), "gamma_U": rows(g_u),
+            "tol_u": rows(tol_u), "tol_alpha_next": rows(tol_a), "tol_gamma": rows(tol_g),
+            "unit_roundoff": unit}
+
+
 def look_ahead_generation(design, options) -> dict[str, bytes]:
     """Every file of the look-ahead controller of a differential-drive design, in memory.
 
-    ``P_look_ahead.h``, ``P_look_ahead.c`` (with ``"c"`` in ``options.langs``, in
-    ``options.precision``), ``P_look_ahead.py`` (with ``"python"``) and ``manifest.json``;
-    ``P`` is the spec's C name.
+    The file set of every variant (:mod:`.fileset`), ``P`` the spec's C name: ``P.h``,
+    ``P.c``, ``P_selftest.c`` (the vectors replayed through ``P_step``, ``P_alpha_step``
+    and ``P_tube``), ``Makefile`` and ``CMakeLists.txt`` (with ``"c"`` in
+    ``options.langs``, in ``options.precision``), ``P.py`` (with ``"python"``),
+    ``P_vectors.json`` (:func:`look_ahead_vectors`) and ``manifest.json``.
 
     Parameters
     ----------
@@ -153,18 +234,23 @@ def look_ahead_generation(design, options) -> dict[str, bytes]:
     SpecError
         Not a differential-drive spec (field ``plant.model``).
     """
-    import json
-
-    from .generate import MANIFEST, manifest
+    from .fileset import (build_files, file_context, selftest_file, vector_tables,
+                          vectors_file, with_manifest)
 
     look_ahead = design.look_ahead
-    prefix = f"{design.spec.c_name}_look_ahead"
+    spec = design.spec
+    context = dict(file_context(spec, options.precision), no_control=True)
+    prefix = context["P"]
+    vectors = look_ahead_vectors(design.tube, look_ahead, options.precision)
     texts: dict[str, str] = {}
     if "c" in options.langs:
         texts.update(look_ahead_c_files(design.tube, look_ahead, prefix, options.precision))
+        texts.update(build_files(context))
+        texts.update(selftest_file(context, vectors, vector_tables(vectors), options.precision))
     if "python" in options.langs:
         texts.update(look_ahead_python_file(design.tube, look_ahead, prefix))
     files = {name: text.encode() for name, text in texts.items()}
-    files[MANIFEST] = (json.dumps(manifest(design.spec, options, files), indent=2,
-                                  sort_keys=True) + "\n").encode()
-    return files
+    files[f"{prefix}_vectors.json"] = vectors_file(
+        spec, options.precision, vectors,
+        "the numpy reference (stt_codegen.tube.look_ahead_reference)")
+    return with_manifest(spec, options, files)

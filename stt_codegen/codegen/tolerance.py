@@ -30,6 +30,12 @@ libm whose functions are within a few ulp of correctly rounded (a ``log`` within
   ``unit |alpha_next|``: :data:`NEWTON_STOP_SINGLE`); the root's
   sensitivity to ``psi`` is at most 1 and to ``theta``'s relative error at most
   ``|alpha_next| + |alpha|``. Bound: ``GAMMA_FACTOR * unit * (S + |alpha| + |alpha_next|)``.
+* **The look-ahead variant** (differential-drive bases, :func:`look_ahead_bounds`): the
+  point ``p = (x + l cos theta, y + l sin theta)`` is off by ``dp = 4 unit (|p| + 4 l)``
+  (``cos``/``sin`` within 2 unit, the literal ``l``, the product and the sum, 4x margin);
+  law (13) at ``p`` as the cascade's ``r`` below with ``dp`` in the numerator of ``e``;
+  ``(v, omega) = (c u0 + s u1, (c u1 - s u0) / l)`` adds ``du0 + du1`` plus
+  ``8 unit (|u0| + |u1|)`` (and for ``omega`` divides by ``l``, plus ``2 unit |omega|``).
 * **The cascade** (second-order plants, :func:`cascade_bounds`): ``r`` is law (13) with
   gain ``k1``, bounded as ``u`` above (``dr``); the velocity error ``e2 = (x2 - r) / rho2``
   takes ``dr``, the difference's rounding and ``rho2(t)``'s error
@@ -46,8 +52,8 @@ from ..tube import reference
 from ..tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 
 __all__ = ["GAMMA_FACTOR", "LOG_ERROR_ULP", "NEWTON_STOP_SINGLE", "UNIT_SINGLE", "alpha_bound",
-           "cascade_bounds", "gamma_bound", "status_certain", "u_bound", "unit_roundoff",
-           "with_double_floor"]
+           "cascade_bounds", "gamma_bound", "look_ahead_bounds", "status_certain", "u_bound",
+           "unit_roundoff", "with_double_floor"]
 
 UNIT_DOUBLE = 2.0 ** -53
 UNIT_SINGLE = 2.0 ** -24
@@ -353,3 +359,58 @@ def cascade_bounds(design: TubeDesign, stage, x1, x2, t, alpha, r_ref, alpha_nex
     relative2 = drho / (rho2 - drho)
     tol_u = _law_error(e2, de2, 2.0 * stage.velocity_gain / rho2, relative2, unit)
     return tol_u, tol_r, alpha_bound(first, alpha, alpha_next, unit)
+
+
+def look_ahead_bounds(design: TubeDesign, axle_offset: float, states, t, alpha, u_point,
+                      u_ref, unit: float) -> tuple[np.ndarray, np.ndarray]:
+    """Bounds on the error of the look-ahead step's ``(v, omega)``, shape (N, 2), and
+    whether each point's inside/outside status is certain, shape (N,); see the module
+    docstring. Inputs exact in the precision.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The look-ahead point's tube (its gain).
+    axle_offset : float
+        ``l``, m.
+    states : array_like, shape (N, 3)
+        ``(x, y, theta)``: m, m, rad.
+    t : array_like, shape (N,)
+        Times, s.
+    alpha : array_like, shape (N, 4)
+        ``alpha`` at the points, m.
+    u_point : ndarray, shape (N, 2)
+        The reference's law (13) at the point, m/s.
+    u_ref : ndarray, shape (N, 2)
+        The reference's ``(v, omega)`` before any clamp.
+    unit : float
+        Unit roundoff of the generated code's precision.
+
+    Returns
+    -------
+    tol_u : ndarray, shape (N, 2)
+        m/s and rad/s.
+    certain : ndarray of bool, shape (N,)
+        Every ``|e_i|`` of the point clear of 1 by twice its error bound, and the tube
+        wider than four times its bounds' error.
+    """
+    from ..tube.look_ahead_reference import point
+
+    states = np.atleast_2d(states)
+    alpha = np.atleast_2d(alpha)
+    p = point(states, axle_offset)
+    gamma_l, gamma_u, _, _ = reference.adaptive_tube(design, np.atleast_1d(t), alpha)
+    dg = gamma_bound(design, alpha, unit)
+    width = np.maximum(gamma_u - gamma_l, GAMMA_D_MIN)
+    e = (2.0 * p - (gamma_u + gamma_l)) / width
+    dp = 4.0 * unit * (np.abs(p) + 4.0 * axle_offset)
+    de = _divided(2.0 * dp + 2.0 * dg + unit * (2.0 * np.abs(p) + 2.0 * np.abs(e) * width), e,
+                  width, 2.0 * dg, unit)
+    relative = np.where(width > 2.0 * dg, 2.0 * dg / np.maximum(width - 2.0 * dg, 1e-300),
+                        np.inf)
+    du = _law_error(e, de, 4.0 * design.gain / width, relative, unit)
+    spread = np.sum(du, axis=1) + 8.0 * unit * np.sum(np.abs(u_point) + du, axis=1)
+    tol = np.stack([spread, spread / axle_offset + 2.0 * unit * np.abs(u_ref[:, 1])], axis=1)
+    certain = np.all((np.abs(np.abs(e) - 1.0) > 2.0 * de) & (gamma_u - gamma_l > 4.0 * dg),
+                     axis=1)
+    return tol, certain

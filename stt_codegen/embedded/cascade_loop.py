@@ -121,7 +121,7 @@ def run_cascade_embedded(design: Design, seed: int = 0, timeout: float = 600.0) 
         A build or a run failed.
     """
     stage, _ = design.second_stage
-    prefix = f"{design.spec.c_name}_cascade"
+    prefix = design.spec.c_name
     n = design.spec.dimension
     files = cascade_c_files(design.tube, stage, prefix, "single")
     output, measured = run_variant_loop(

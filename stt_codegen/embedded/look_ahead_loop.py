@@ -115,7 +115,7 @@ def run_look_ahead_embedded(design: Design, seed: int = 0, timeout: float = 600.
     ToolchainError
         A build or a run failed.
     """
-    prefix = f"{design.spec.c_name}_look_ahead"
+    prefix = design.spec.c_name
     files = look_ahead_c_files(design.tube, design.look_ahead, prefix, "single")
     output, measured = run_variant_loop(
         design, files, prefix, lambda replay: closed_loop_program(design, prefix, seed,

@@ -184,7 +184,8 @@ def replay_source(spec: Spec, design: TubeDesign, x, t, dt, alpha, what: str,
                   prefix: str | None = None) -> str:
     """The replay program at float inputs ``x`` (N, n), ``t`` (N,), ``dt`` (N,), ``alpha`` (N, 2n).
 
-    For a second-order spec it calls the cascade's step (``x`` (N, 2n): ``[x1; x2]``).
+    Every variant's step has the same signature; ``x`` is its measured state (the
+    cascade's ``[x1; x2]``, a base's ``(x, y, theta)``).
 
     Parameters
     ----------
@@ -214,10 +215,8 @@ def replay_source(spec: Spec, design: TubeDesign, x, t, dt, alpha, what: str,
     prefix = c_identifier(spec.c_name) if prefix is None else prefix
     x = np.atleast_2d(np.asarray(x, dtype=np.float32))
     rows = [float_bits(np.concatenate([x[k], [t[k], dt[k]], alpha[k]])) for k in range(len(t))]
-    cascade = {"cascade": True} if spec.order == 2 else {}
     return render("embedded_replay.c.j2", P=prefix, spec_name=spec.name, real="float",
-                  n=spec.dimension, nx=x.shape[1], count=len(rows), rows=rows, what=what,
-                  **cascade)
+                  n=spec.dimension, nx=x.shape[1], count=len(rows), rows=rows, what=what)
 
 
 def _f32(word: str) -> float:

@@ -118,10 +118,10 @@ def _compiled(design: TubeDesign, stage: SecondStage):
 
     n = design.dimension
     step = load_variant_step(cascade_c_files(design, stage, "stt_cascade", "double"),
-                             "stt_cascade", (n, 2 * n, n))
+                             "stt_cascade", (n, 2 * n))
 
     def call(x, t, dt, alpha):
-        u, alpha_next, _r, code = step(x, t, dt, alpha)
+        u, alpha_next, code = step(x, t, dt, alpha)
         return u, alpha_next, Status(code)
 
     return call

@@ -66,6 +66,10 @@ typedef double crossing_moving_real;
 
 /** State dimension n. */
 #define CROSSING_MOVING_N 2
+/** Length of the measured state x, the same in every variant's header: n. */
+#define CROSSING_MOVING_N_STATE 2
+/** Number of inputs (entries of u), the same in every variant's header: n. */
+#define CROSSING_MOVING_N_INPUT 2
 /** Length of alpha: 2 n. */
 #define CROSSING_MOVING_N_ALPHA 4
 /** Prescribed time t_c, seconds. */
@@ -117,12 +121,12 @@ int crossing_moving_alpha_step(crossing_moving_real t, crossing_moving_real dt,
  * instant t_k = k dt with the measured x(t_k), hold u until t_{k+1}, then pass
  * alpha_next as alpha.
  *
- * x: [CROSSING_MOVING_N]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha: [CROSSING_MOVING_N_ALPHA].
- * u: [CROSSING_MOVING_N] (out). alpha_next: [CROSSING_MOVING_N_ALPHA] (out, may alias alpha).
+ * x: [CROSSING_MOVING_N_STATE]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha: [CROSSING_MOVING_N_ALPHA].
+ * u: [CROSSING_MOVING_N_INPUT] (out). alpha_next: [CROSSING_MOVING_N_ALPHA] (out, may alias alpha).
  * Returns OK, OUTSIDE_TUBE or INVALID_INPUT (u = 0, alpha_next = alpha).
  */
-int crossing_moving_step(const crossing_moving_real x[CROSSING_MOVING_N], crossing_moving_real t, crossing_moving_real dt,
-    const crossing_moving_real alpha[CROSSING_MOVING_N_ALPHA], crossing_moving_real u[CROSSING_MOVING_N],
+int crossing_moving_step(const crossing_moving_real x[CROSSING_MOVING_N_STATE], crossing_moving_real t, crossing_moving_real dt,
+    const crossing_moving_real alpha[CROSSING_MOVING_N_ALPHA], crossing_moving_real u[CROSSING_MOVING_N_INPUT],
     crossing_moving_real alpha_next[CROSSING_MOVING_N_ALPHA]);
 
 #ifdef __cplusplus

@@ -57,23 +57,6 @@ static const crossing_moving_segment CROSSING_MOVING_SEGMENTS[CROSSING_MOVING_N_
   { 2.833333333333333f, 7.833333333333333f, 1, { 0.06f, 1.6800000000000002f, 0.54f, 2.32f }, { 5.46f, 1.6800000000000002f, 5.94f, 2.32f } }
 };
 
-/* Circumvents (eqs. (7)-(9)), one row per window, sorted by start: window (start, end),
-   center m, radius r, sharpness k, height B, running maximum of the ends (to find the open
-   windows), bound index (i: lower bound of dimension i, N + i: upper bound). */
-typedef struct {
-  crossing_moving_real start;
-  crossing_moving_real end;
-  crossing_moving_real center;
-  crossing_moving_real radius;
-  crossing_moving_real sharpness;
-  crossing_moving_real height;
-  crossing_moving_real max_end;
-  int bound;
-} crossing_moving_window;
-
-#define CROSSING_MOVING_N_WINDOWS 0
-/* most windows open at one time (size of the work arrays) */
-#define CROSSING_MOVING_MAX_OPEN 1
 
 /* ------------------------------------------------------------- emitted bodies */
 

@@ -66,6 +66,10 @@ typedef double omnirobot_s2_real;
 
 /** State dimension n. */
 #define OMNIROBOT_S2_N 3
+/** Length of the measured state x, the same in every variant's header: n. */
+#define OMNIROBOT_S2_N_STATE 3
+/** Number of inputs (entries of u), the same in every variant's header: n. */
+#define OMNIROBOT_S2_N_INPUT 3
 /** Length of alpha: 2 n. */
 #define OMNIROBOT_S2_N_ALPHA 6
 /** Prescribed time t_c, seconds. */
@@ -117,12 +121,12 @@ int omnirobot_s2_alpha_step(omnirobot_s2_real t, omnirobot_s2_real dt,
  * instant t_k = k dt with the measured x(t_k), hold u until t_{k+1}, then pass
  * alpha_next as alpha.
  *
- * x: [OMNIROBOT_S2_N]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha: [OMNIROBOT_S2_N_ALPHA].
- * u: [OMNIROBOT_S2_N] (out). alpha_next: [OMNIROBOT_S2_N_ALPHA] (out, may alias alpha).
+ * x: [OMNIROBOT_S2_N_STATE]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha: [OMNIROBOT_S2_N_ALPHA].
+ * u: [OMNIROBOT_S2_N_INPUT] (out). alpha_next: [OMNIROBOT_S2_N_ALPHA] (out, may alias alpha).
  * Returns OK, OUTSIDE_TUBE or INVALID_INPUT (u = 0, alpha_next = alpha).
  */
-int omnirobot_s2_step(const omnirobot_s2_real x[OMNIROBOT_S2_N], omnirobot_s2_real t, omnirobot_s2_real dt,
-    const omnirobot_s2_real alpha[OMNIROBOT_S2_N_ALPHA], omnirobot_s2_real u[OMNIROBOT_S2_N],
+int omnirobot_s2_step(const omnirobot_s2_real x[OMNIROBOT_S2_N_STATE], omnirobot_s2_real t, omnirobot_s2_real dt,
+    const omnirobot_s2_real alpha[OMNIROBOT_S2_N_ALPHA], omnirobot_s2_real u[OMNIROBOT_S2_N_INPUT],
     omnirobot_s2_real alpha_next[OMNIROBOT_S2_N_ALPHA]);
 
 #ifdef __cplusplus

@@ -59,23 +59,6 @@ static const pointmaze_umaze_segment POINTMAZE_UMAZE_SEGMENTS[POINTMAZE_UMAZE_N_
   { 7.858114674441205, 12.0, 1, { 0.7136170212765963, -0.9136170212765958, 0.9136170212765963, -0.7136170212765959 }, { -1.2, -1.2, -0.8, -0.8 } }
 };
 
-/* Circumvents (eqs. (7)-(9)), one row per window, sorted by start: window (start, end),
-   center m, radius r, sharpness k, height B, running maximum of the ends (to find the open
-   windows), bound index (i: lower bound of dimension i, N + i: upper bound). */
-typedef struct {
-  pointmaze_umaze_real start;
-  pointmaze_umaze_real end;
-  pointmaze_umaze_real center;
-  pointmaze_umaze_real radius;
-  pointmaze_umaze_real sharpness;
-  pointmaze_umaze_real height;
-  pointmaze_umaze_real max_end;
-  int bound;
-} pointmaze_umaze_window;
-
-#define POINTMAZE_UMAZE_N_WINDOWS 0
-/* most windows open at one time (size of the work arrays) */
-#define POINTMAZE_UMAZE_MAX_OPEN 1
 
 /* ------------------------------------------------------------- emitted bodies */
 

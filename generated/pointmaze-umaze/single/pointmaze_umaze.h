@@ -66,6 +66,10 @@ typedef float pointmaze_umaze_real;
 
 /** State dimension n. */
 #define POINTMAZE_UMAZE_N 2
+/** Length of the measured state x, the same in every variant's header: n. */
+#define POINTMAZE_UMAZE_N_STATE 2
+/** Number of inputs (entries of u), the same in every variant's header: n. */
+#define POINTMAZE_UMAZE_N_INPUT 2
 /** Length of alpha: 2 n. */
 #define POINTMAZE_UMAZE_N_ALPHA 4
 /** Prescribed time t_c, seconds. */
@@ -117,12 +121,12 @@ int pointmaze_umaze_alpha_step(pointmaze_umaze_real t, pointmaze_umaze_real dt,
  * instant t_k = k dt with the measured x(t_k), hold u until t_{k+1}, then pass
  * alpha_next as alpha.
  *
- * x: [POINTMAZE_UMAZE_N]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha: [POINTMAZE_UMAZE_N_ALPHA].
- * u: [POINTMAZE_UMAZE_N] (out). alpha_next: [POINTMAZE_UMAZE_N_ALPHA] (out, may alias alpha).
+ * x: [POINTMAZE_UMAZE_N_STATE]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha: [POINTMAZE_UMAZE_N_ALPHA].
+ * u: [POINTMAZE_UMAZE_N_INPUT] (out). alpha_next: [POINTMAZE_UMAZE_N_ALPHA] (out, may alias alpha).
  * Returns OK, OUTSIDE_TUBE or INVALID_INPUT (u = 0, alpha_next = alpha).
  */
-int pointmaze_umaze_step(const pointmaze_umaze_real x[POINTMAZE_UMAZE_N], pointmaze_umaze_real t, pointmaze_umaze_real dt,
-    const pointmaze_umaze_real alpha[POINTMAZE_UMAZE_N_ALPHA], pointmaze_umaze_real u[POINTMAZE_UMAZE_N],
+int pointmaze_umaze_step(const pointmaze_umaze_real x[POINTMAZE_UMAZE_N_STATE], pointmaze_umaze_real t, pointmaze_umaze_real dt,
+    const pointmaze_umaze_real alpha[POINTMAZE_UMAZE_N_ALPHA], pointmaze_umaze_real u[POINTMAZE_UMAZE_N_INPUT],
     pointmaze_umaze_real alpha_next[POINTMAZE_UMAZE_N_ALPHA]);
 
 #ifdef __cplusplus

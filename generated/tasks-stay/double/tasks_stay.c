@@ -65,23 +65,6 @@ static const tasks_stay_segment TASKS_STAY_SEGMENTS[TASKS_STAY_N_SEGMENTS] = {
   { 9.154471544715447, 12.0, 2, { 3.75, 2.55, -0.5, 3.95, 2.75, 0.5 }, { 4.55, 4.55, -0.5, 4.95, 4.95, 0.5 } }
 };
 
-/* Circumvents (eqs. (7)-(9)), one row per window, sorted by start: window (start, end),
-   center m, radius r, sharpness k, height B, running maximum of the ends (to find the open
-   windows), bound index (i: lower bound of dimension i, N + i: upper bound). */
-typedef struct {
-  tasks_stay_real start;
-  tasks_stay_real end;
-  tasks_stay_real center;
-  tasks_stay_real radius;
-  tasks_stay_real sharpness;
-  tasks_stay_real height;
-  tasks_stay_real max_end;
-  int bound;
-} tasks_stay_window;
-
-#define TASKS_STAY_N_WINDOWS 0
-/* most windows open at one time (size of the work arrays) */
-#define TASKS_STAY_MAX_OPEN 1
 
 /* ------------------------------------------------------------- emitted bodies */
 

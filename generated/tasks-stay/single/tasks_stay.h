@@ -66,6 +66,10 @@ typedef float tasks_stay_real;
 
 /** State dimension n. */
 #define TASKS_STAY_N 3
+/** Length of the measured state x, the same in every variant's header: n. */
+#define TASKS_STAY_N_STATE 3
+/** Number of inputs (entries of u), the same in every variant's header: n. */
+#define TASKS_STAY_N_INPUT 3
 /** Length of alpha: 2 n. */
 #define TASKS_STAY_N_ALPHA 6
 /** Prescribed time t_c, seconds. */
@@ -117,12 +121,12 @@ int tasks_stay_alpha_step(tasks_stay_real t, tasks_stay_real dt,
  * instant t_k = k dt with the measured x(t_k), hold u until t_{k+1}, then pass
  * alpha_next as alpha.
  *
- * x: [TASKS_STAY_N]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha: [TASKS_STAY_N_ALPHA].
- * u: [TASKS_STAY_N] (out). alpha_next: [TASKS_STAY_N_ALPHA] (out, may alias alpha).
+ * x: [TASKS_STAY_N_STATE]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha: [TASKS_STAY_N_ALPHA].
+ * u: [TASKS_STAY_N_INPUT] (out). alpha_next: [TASKS_STAY_N_ALPHA] (out, may alias alpha).
  * Returns OK, OUTSIDE_TUBE or INVALID_INPUT (u = 0, alpha_next = alpha).
  */
-int tasks_stay_step(const tasks_stay_real x[TASKS_STAY_N], tasks_stay_real t, tasks_stay_real dt,
-    const tasks_stay_real alpha[TASKS_STAY_N_ALPHA], tasks_stay_real u[TASKS_STAY_N],
+int tasks_stay_step(const tasks_stay_real x[TASKS_STAY_N_STATE], tasks_stay_real t, tasks_stay_real dt,
+    const tasks_stay_real alpha[TASKS_STAY_N_ALPHA], tasks_stay_real u[TASKS_STAY_N_INPUT],
     tasks_stay_real alpha_next[TASKS_STAY_N_ALPHA]);
 
 #ifdef __cplusplus

@@ -65,23 +65,6 @@ static const tasks_visit_segment TASKS_VISIT_SEGMENTS[TASKS_VISIT_N_SEGMENTS] = 
   { 10.763157894736842, 13.0, 2, { 3.75, 2.55, -0.5, 3.95, 2.75, 0.5 }, { 4.55, 4.55, -0.5, 4.95, 4.95, 0.5 } }
 };
 
-/* Circumvents (eqs. (7)-(9)), one row per window, sorted by start: window (start, end),
-   center m, radius r, sharpness k, height B, running maximum of the ends (to find the open
-   windows), bound index (i: lower bound of dimension i, N + i: upper bound). */
-typedef struct {
-  tasks_visit_real start;
-  tasks_visit_real end;
-  tasks_visit_real center;
-  tasks_visit_real radius;
-  tasks_visit_real sharpness;
-  tasks_visit_real height;
-  tasks_visit_real max_end;
-  int bound;
-} tasks_visit_window;
-
-#define TASKS_VISIT_N_WINDOWS 0
-/* most windows open at one time (size of the work arrays) */
-#define TASKS_VISIT_MAX_OPEN 1
 
 /* ------------------------------------------------------------- emitted bodies */
 

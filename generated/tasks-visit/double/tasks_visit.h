@@ -66,6 +66,10 @@ typedef double tasks_visit_real;
 
 /** State dimension n. */
 #define TASKS_VISIT_N 3
+/** Length of the measured state x, the same in every variant's header: n. */
+#define TASKS_VISIT_N_STATE 3
+/** Number of inputs (entries of u), the same in every variant's header: n. */
+#define TASKS_VISIT_N_INPUT 3
 /** Length of alpha: 2 n. */
 #define TASKS_VISIT_N_ALPHA 6
 /** Prescribed time t_c, seconds. */
@@ -117,12 +121,12 @@ int tasks_visit_alpha_step(tasks_visit_real t, tasks_visit_real dt,
  * instant t_k = k dt with the measured x(t_k), hold u until t_{k+1}, then pass
  * alpha_next as alpha.
  *
- * x: [TASKS_VISIT_N]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha: [TASKS_VISIT_N_ALPHA].
- * u: [TASKS_VISIT_N] (out). alpha_next: [TASKS_VISIT_N_ALPHA] (out, may alias alpha).
+ * x: [TASKS_VISIT_N_STATE]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha: [TASKS_VISIT_N_ALPHA].
+ * u: [TASKS_VISIT_N_INPUT] (out). alpha_next: [TASKS_VISIT_N_ALPHA] (out, may alias alpha).
  * Returns OK, OUTSIDE_TUBE or INVALID_INPUT (u = 0, alpha_next = alpha).
  */
-int tasks_visit_step(const tasks_visit_real x[TASKS_VISIT_N], tasks_visit_real t, tasks_visit_real dt,
-    const tasks_visit_real alpha[TASKS_VISIT_N_ALPHA], tasks_visit_real u[TASKS_VISIT_N],
+int tasks_visit_step(const tasks_visit_real x[TASKS_VISIT_N_STATE], tasks_visit_real t, tasks_visit_real dt,
+    const tasks_visit_real alpha[TASKS_VISIT_N_ALPHA], tasks_visit_real u[TASKS_VISIT_N_INPUT],
     tasks_visit_real alpha_next[TASKS_VISIT_N_ALPHA]);
 
 #ifdef __cplusplus
