@@ -310,9 +310,9 @@ class Design:
     def _actuator_json(self) -> dict[str, Any]:
         """``input_bound`` and the proved ``input_peak`` (with where each peak is), for a
         spec with ``[actuator]`` only: without it the document is as before."""
-        if self.tube.input_bound is None or self.input_proof is None:
+        if self.spec.input_bound is None or self.input_proof is None:
             return {}
-        proof, bound = self.input_proof, self.tube.input_bound
+        proof, bound = self.input_proof, self.spec.input_bound
         return {"input_bound": list(bound),
                 "input_peak": {"peak": list(proof.peak), "time": list(proof.time),
                                "horizon": proof.horizon, "margin": proof.margin(bound)}}

@@ -1,0 +1,115 @@
+"""The faults a new user meets first (issue #42): each reproduced as it was met, then fixed."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+import stt_codegen as stt
+from stt_codegen.design.input_bound import input_prover
+
+SPECS = Path(__file__).parent / "specs"
+DRIVE = SPECS / "office-drive.toml"
+
+
+def run(*args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "stt_codegen.cli", *args], capture_output=True,
+                          text=True, timeout=600)
+
+
+def drive_doc(**tables) -> dict:
+    """The office spec (a differential drive) as a dict, with tables replaced."""
+    return {**tomllib.loads(DRIVE.read_text()), **tables}
+
+
+def toml_text(doc: dict) -> str:
+    """``doc`` as TOML (tables of scalars and lists, arrays of such tables)."""
+    def value(v):
+        if isinstance(v, str):
+            return json.dumps(v)
+        if isinstance(v, list):
+            return "[" + ", ".join(value(x) for x in v) + "]"
+        return repr(v)
+    head = [f"{k} = {value(v)}" for k, v in doc.items() if not isinstance(v, (dict, list))]
+    body = []
+    for k, v in doc.items():
+        rows = [v] if isinstance(v, dict) else v if isinstance(v, list) and v and \
+            isinstance(v[0], dict) else []
+        for row in rows:
+            body.append(f"[{k}]" if isinstance(v, dict) else f"[[{k}]]")
+            body += [f"{a} = {value(b)}" for a, b in row.items()]
+    return "\n".join(head + body) + "\n"
+
+
+# 1. A differential drive with [actuator]: the proved peaks of (v, omega) against its bound
+
+
+def test_design_reports_the_bases_proved_limits_in_text_and_json(tmp_path):
+    spec_file = tmp_path / "drive.toml"
+    spec_file.write_text(toml_text(drive_doc(actuator={"input_bound": [1.6, 16.0]})))
+    out = run("design", str(spec_file), "--plot", str(tmp_path / "drive.png"))
+    assert out.returncode == 0 and "Traceback" not in out.stderr, out.stderr
+    line = next(s for s in out.stdout.splitlines() if "input bound" in s)
+    assert "(v, omega)" in line and "|v|" in line and "<= 1.6" in line and "<= 16" in line
+    assert (tmp_path / "drive.png").stat().st_size > 0
+    out = run("design", str(spec_file), "--json")
+    assert out.returncode == 0, out.stderr
+    doc = json.loads(out.stdout)
+    assert doc["input_bound"] == [1.6, 16.0]
+    peak = doc["input_peak"]["peak"]
+    assert len(peak) == 2 and all(0 < p <= b for p, b in zip(peak, doc["input_bound"]))
+    assert peak[1] == pytest.approx(peak[0] / 0.1)            # |omega| <= |u| / l
+    assert doc["input_peak"]["margin"] >= 0
+
+
+# 2. stlpy's NonlinearReachAvoid as a differential drive: the sampled check's enclosure of e
+#    could turn empty by rounding (a ball's edge a few ulps below the box near e = 0), and
+#    phi' was then asked at |e| = -inf: math.atanh's domain error.
+
+NONLINEAR_REACH_AVOID = {
+    "name": "stlpy-nonlinear-reach-avoid-drive", "prescribed_time": 1.5,
+    "state_space": {"lower": [0.0, 0.0], "upper": [10.0, 10.0]},
+    "initial": {"lower": [0.9, 1.9], "upper": [1.1, 2.1], "state": [1.0, 2.0],
+                "heading": 0.0},
+    "target": {"lower": [6.97, 7.97], "upper": [8.03, 9.03]},
+    "obstacles": [{"center": [3.5, 5.0], "radius": 1.5}],
+    "controller": {"rate_hz": 400.0},
+    "plant": {"model": "differential-drive", "axle_offset": 0.1, "track_width": 0.16},
+}
+
+
+def test_the_input_proof_of_a_tube_whose_enclosure_touches_the_ball_by_rounding():
+    """The tube ``design_tube`` tried for the spec at ``t_c = 24 s`` (the search for the
+    ``prescribed_time`` that works) is proved, not a domain error."""
+    doc = {**NONLINEAR_REACH_AVOID, "prescribed_time": 24.0}
+    design = stt.design_tube(stt.Spec.from_dict(doc))
+    judged = stt.Spec.from_dict({**doc, "actuator": {"input_bound": [10.0, 5.0]}})
+    proof = input_prover()(design.tube, judged)
+    assert proof.proved, proof.reason
+    assert all(0 < p < math.inf for p in proof.peak)
+
+
+def test_phi_slope_is_infinite_at_and_beyond_the_tubes_edge():
+    from stt_codegen.verify.sampled_axis import phi_slope, phi_slope_scalar
+
+    assert phi_slope_scalar(0.0) == 2.0
+    assert phi_slope_scalar(0.5) == pytest.approx(float(phi_slope(0.5)), rel=1e-15)
+    for s in (1.0, -1.0, 1.5, -math.inf):
+        assert phi_slope_scalar(s) == math.inf
+
+
+@pytest.mark.slow
+def test_the_nonlinear_reach_avoid_drive_is_refused_by_a_design_error(tmp_path):
+    """``(v, omega)`` within ``[10, 5]`` in 1.5 s: no design (exit 1), named, no traceback."""
+    spec_file = tmp_path / "nra.toml"
+    spec_file.write_text(toml_text({**NONLINEAR_REACH_AVOID,
+                                    "actuator": {"input_bound": [10.0, 5.0]}}))
+    out = run("design", str(spec_file))
+    assert out.returncode == 1 and "Traceback" not in out.stderr, out.stderr
+    assert "actuator.input_bound" in out.stderr and "omega" in out.stderr
