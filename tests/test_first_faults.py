@@ -113,3 +113,40 @@ def test_the_nonlinear_reach_avoid_drive_is_refused_by_a_design_error(tmp_path):
     out = run("design", str(spec_file))
     assert out.returncode == 1 and "Traceback" not in out.stderr, out.stderr
     assert "actuator.input_bound" in out.stderr and "omega" in out.stderr
+
+
+# 3. The field named is the one to change
+
+
+def _refusal(doc: dict) -> stt.SpecError:
+    with pytest.raises(stt.SpecError) as info:
+        stt.Spec.from_dict(doc)
+    return info.value
+
+
+def test_an_axle_offset_in_millimetres_names_plant_axle_offset():
+    doc = drive_doc()
+    error = _refusal({**doc, "plant": {**doc["plant"], "axle_offset": 600}})
+    assert error.field == "plant.axle_offset"
+    assert "600.12" in error.reason and "0.12" in error.reason
+
+
+def test_a_body_too_large_for_the_room_names_robot_radius():
+    error = _refusal(drive_doc(robot={"radius": 5.0}))
+    assert error.field == "robot.radius" and "state space" in error.reason
+
+
+def test_a_start_set_at_the_wall_names_initial():
+    doc = drive_doc()
+    error = _refusal({**doc, "initial": {**doc["initial"], "lower": [0.1, 0.5],
+                                         "state": [0.5, 1.0]}})
+    assert error.field == "initial" and "boundary" in error.reason
+    assert "[0.22, 9.78] x [0.22, 7.78]" in error.reason         # where it may lie
+
+
+def test_a_start_set_reaching_an_obstacle_names_initial():
+    """The obstacle [2.5, 3.5] x [0, 2.5] inflated by 0.22 reaches x = 2.28; the set ends
+    at 2.45, its point 2.1 is clear."""
+    error = _refusal(drive_doc(initial={"lower": [2.0, 0.5], "upper": [2.45, 1.5],
+                                        "state": [2.1, 1.0], "heading": 0.0}))
+    assert error.field == "initial" and "obstacles[0]" in error.reason
