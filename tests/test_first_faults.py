@@ -150,3 +150,27 @@ def test_a_start_set_reaching_an_obstacle_names_initial():
     error = _refusal(drive_doc(initial={"lower": [2.0, 0.5], "upper": [2.45, 1.5],
                                         "state": [2.1, 1.0], "heading": 0.0}))
     assert error.field == "initial" and "obstacles[0]" in error.reason
+
+
+# 5. An unknown key gets a "did you mean" when a key is close to it
+
+
+@pytest.mark.parametrize("table, key, meant", [
+    ("plant", "axel_offset", "axle_offset"),
+    ("controller", "rate", "rate_hz"),
+    (None, "actuators", "actuator"),
+])
+def test_an_unknown_key_suggests_the_closest(table, key, meant):
+    doc = drive_doc()
+    if table is None:
+        doc[key] = {"input_bound": [1.6, 16.0]}
+    else:
+        doc[table] = {**doc[table], key: 1.0}
+    error = _refusal(doc)
+    assert error.field == (key if table is None else f"{table}.{key}")
+    assert f"did you mean {meant!r}?" in error.reason and "allowed:" in error.reason
+
+
+def test_an_unknown_key_far_from_every_key_gets_no_suggestion():
+    error = _refusal(drive_doc(controller={"rate_hz": 50.0, "zzz": 1.0}))
+    assert "did you mean" not in error.reason and "allowed: gain, rate_hz" in error.reason
