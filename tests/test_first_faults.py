@@ -174,3 +174,26 @@ def test_an_unknown_key_suggests_the_closest(table, key, meant):
 def test_an_unknown_key_far_from_every_key_gets_no_suggestion():
     error = _refusal(drive_doc(controller={"rate_hz": 50.0, "zzz": 1.0}))
     assert "did you mean" not in error.reason and "allowed: gain, rate_hz" in error.reason
+
+
+# 6. A differential drive's heading is in radians, within [-pi, pi]
+
+
+@pytest.mark.parametrize("heading, hint", [
+    (90.0, "if 90 is in degrees, it is 1.5708 rad"),
+    (-45.0, "if -45 is in degrees, it is -0.785398 rad"),
+    (3.5, "the same heading is -2.78319"),
+    (1000.0, "within [-pi, pi]"),
+])
+def test_a_heading_beyond_pi_is_refused_with_the_hint(heading, hint):
+    doc = drive_doc()
+    error = _refusal({**doc, "initial": {**doc["initial"], "heading": heading}})
+    assert error.field == "initial.heading" and "radians" in error.reason
+    assert hint in error.reason
+
+
+@pytest.mark.parametrize("heading", [math.pi, -math.pi, 1.5708, -3.0])
+def test_a_heading_within_pi_is_taken(heading):
+    doc = drive_doc()
+    spec = stt.Spec.from_dict({**doc, "initial": {**doc["initial"], "heading": heading}})
+    assert spec.drive.heading == heading

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import re
 import tomllib
@@ -1021,12 +1022,28 @@ def _differential_drive(doc: Any) -> DifferentialDrive | None:
     if "disturbance_amplitude" in table.model_fields_set:
         raise SpecError("plant.disturbance_amplitude", f"plant.model = {table.model!r} "
                         "takes its disturbance as plant.slip (forward, lateral, turn)")
+    heading = float(doc.initial.heading or 0.0)
+    if abs(heading) > math.pi:        # radians in [-pi, pi]: 90 is degrees by mistake
+        if abs(heading) <= 2.0 * math.pi:
+            hint = f"; the same heading is {number_text(_wrapped(heading), 6)}"
+        elif abs(heading) <= 360.0:
+            hint = (f"; if {number_text(heading)} is in degrees, it is "
+                    f"{number_text(_wrapped(math.radians(heading)), 6)} rad")
+        else:
+            hint = ""
+        raise SpecError("initial.heading", f"{number_text(heading)} is beyond pi in magnitude: "
+                        f"the heading is in radians, within [-pi, pi]{hint}")
     return DifferentialDrive(
         float(table.axle_offset), float(table.track_width),
         tuple(float(v) for v in table.wheel_radius_error or (0.0, 0.0)),
         tuple(float(v) for v in table.slip or (0.0, 0.0, 0.0)),
-        float(doc.initial.heading or 0.0),
+        heading,
         None if table.wheel_radius is None else float(table.wheel_radius))
+
+
+def _wrapped(angle: float) -> float:
+    """``angle`` (rad) moved by whole turns into ``[-pi, pi)``."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def _mujoco(table: Any, n: int) -> MujocoModel | None:

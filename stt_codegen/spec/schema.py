@@ -99,8 +99,9 @@ class InitialTable(BoxTable):
                                   "x(0) in X_0")
     velocity: Vector = _omitted("second-order models only: the initial velocity x2(0), one "
                                 "per position; default 0")
-    heading: Number = _omitted("differential-drive only: the heading theta(0), rad; "
-                               "default 0 (state and the box are the look-ahead point's)")
+    heading: Number = _omitted("differential-drive only: the heading theta(0), rad, in "
+                               "[-pi, pi]; default 0 (state and the box are the look-ahead "
+                               "point's)")
 
 
 class TargetTable(BoxTable):
