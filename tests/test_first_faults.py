@@ -197,3 +197,26 @@ def test_a_heading_within_pi_is_taken(heading):
     doc = drive_doc()
     spec = stt.Spec.from_dict({**doc, "initial": {**doc["initial"], "heading": heading}})
     assert spec.drive.heading == heading
+
+
+# 7. A second-order spec refused for its cascade: the position tube designed is drawn
+
+
+@pytest.mark.slow
+def test_a_refused_cascade_carries_the_position_tube_it_designed():
+    """umaze-cascade at 100 Hz: the position tube is certified, no second stage is; the
+    refusal carries that tube (``design --plot`` draws it, titled as designed)."""
+    from dataclasses import replace
+
+    from stt_codegen.design.failures import FailureKind
+    from stt_codegen.design.search import check_tube
+    from stt_codegen.runtime.plots import rejected_figure
+
+    spec = replace(stt.load_spec(str(SPECS / "umaze-cascade.toml")), rate_hz=100.0)
+    with pytest.raises(stt.DesignError) as info:
+        stt.design_tube(spec)
+    error = info.value
+    assert error.kind is FailureKind.SAMPLING_RATE and error.tried is not None
+    assert check_tube(error.tried, spec).passed          # the position tube designed
+    title = rejected_figure(spec, error).axes[0].get_title()
+    assert "the tube designed" in title and "NO DESIGN (sampling rate)" in title

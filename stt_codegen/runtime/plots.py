@@ -664,8 +664,10 @@ def rejected_figure(spec: Spec, error: DesignError,
     certificate = check_tube(error.tried, spec).certificate
     failure = certificate.first_failure()
     kind = "" if error.kind is None else f" ({error.kind.value})"
+    # a tube that passes its check was refused at a later stage (a second stage)
+    what = "the best rejected tube" if failure is not None else "the tube designed"
     return tube_figure(spec, error.tried, certificate,
-                       f"{spec.name}: NO DESIGN{kind}, the best rejected tube", dims,
+                       f"{spec.name}: NO DESIGN{kind}, {what}", dims,
                        f"no design: {error}", None if failure is None else failure.time)
 
 
