@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import subprocess
+import time
 import sys
 import tomllib
 from pathlib import Path
@@ -220,3 +221,36 @@ def test_a_refused_cascade_carries_the_position_tube_it_designed():
     assert check_tube(error.tried, spec).passed          # the position tube designed
     title = rejected_figure(spec, error).axes[0].get_title()
     assert "the tube designed" in title and "NO DESIGN (sampling rate)" in title
+
+
+# 8. design_time_s is the whole design_tube call
+
+
+def _timed_design(spec):
+    started = time.perf_counter()
+    design = stt.design_tube(spec)
+    return design, time.perf_counter() - started
+
+
+def test_design_time_includes_the_rejected_target_alternatives():
+    """The first two target boxes are walled in: their searches fail before the third
+    designs (without them, the time is about 40 % of the call's)."""
+    from test_tasks import arena, spec_of
+
+    walls = [([3.6, 3.6], [5.0, 3.9]), ([3.6, 3.9], [3.9, 5.0]), ([3.6, 1.1], [5.0, 1.4]),
+             ([3.6, 1.4], [3.9, 2.4]), ([3.6, 2.4], [5.0, 2.7])]
+    doc = arena(2, [], obstacles=[{"lower": lo, "upper": hi} for lo, hi in walls], t_c=10.0)
+    doc.pop("tasks")
+    doc["target"] = {"any_of": [{"lower": [4.4, 4.4], "upper": [5.0, 5.0]},
+                                {"lower": [4.4, 1.6], "upper": [5.0, 2.2]},
+                                {"lower": [4.4, 0.0], "upper": [5.0, 0.6]}]}
+    design, measured = _timed_design(spec_of(doc))
+    assert design.target_choice == 2
+    assert 0.9 * measured <= design.design_time_s <= measured
+
+
+@pytest.mark.slow
+def test_design_time_includes_the_cascades_certification():
+    design, measured = _timed_design(stt.load_spec("second-order-s1"))
+    assert "second_stage" in design.__dict__          # certified once, kept
+    assert 0.9 * measured <= design.design_time_s <= measured

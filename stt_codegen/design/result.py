@@ -79,8 +79,10 @@ class Design:
         The accepted tube's check (:func:`~stt_codegen.design.search.check_tube`),
         including its :class:`~stt_codegen.design.certificate.Certificate`.
     design_time_s : float
-        In-process wall time of the design and its certificate, seconds (not compared:
-        two designs of one spec are equal).
+        In-process wall time of the whole :func:`~stt_codegen.design_tube` call, seconds:
+        every alternative tried (``[target] any_of`` boxes, the slower tubes of
+        ``[actuator]``) and every stage (the cascade's certification) included (not
+        compared: two designs of one spec are equal).
     spec : Spec
         The spec the tube was designed for. ``generate``, ``simulate``, ``verify`` and the
         plots take a :class:`Design` and read its spec from here, so a tube cannot be
