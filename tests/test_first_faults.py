@@ -254,3 +254,22 @@ def test_design_time_includes_the_cascades_certification():
     design, measured = _timed_design(stt.load_spec("second-order-s1"))
     assert "second_stage" in design.__dict__          # certified once, kept
     assert 0.9 * measured <= design.design_time_s <= measured
+
+
+# 4. Numbers in messages without float noise
+
+
+def test_a_computed_bound_in_a_message_has_no_float_noise():
+    """The room around initial.state 0.5 in [0.3, 0.7] is 0.7 - 0.5 = 0.19999999999999996."""
+    error = _refusal(drive_doc(initial={"lower": [0.3, 0.5], "upper": [0.7, 1.5],
+                                        "state": [0.5, 1.0], "half_width": [0.3, 0.3]}))
+    assert error.field == "initial.half_width"
+    assert "(at most 0.2 around the point)" in error.reason
+
+
+def test_number_text_drops_the_noise_and_keeps_typed_values():
+    from stt_codegen.errors import number_text
+
+    assert number_text(0.45 - 0.1) == "0.35" and number_text(87.35000000000001) == "87.35"
+    assert number_text(1234567.5) == "1234567.5" and number_text(0.1) == "0.1"
+    assert number_text(3) == "3" and number_text(math.inf) == "inf"

@@ -399,8 +399,9 @@ def run_figure(design: Design, result: SimulationResult,
         ax.plot(traj.x[0, i], traj.x[0, j], "o", color="tab:blue", label="x(0)")
         mark_states(ax, spec, traj.t, traj.x, dims)    # at the moving obstacles' slice times
         verdict = "satisfied" if result.satisfied else "NOT satisfied"
-        ax.set_title(arena_title(spec, dims, f"{spec.name}: {verdict}, reach "
-                                             f"{result.reach_time} s"), fontsize=10)
+        reach = "-" if result.reach_time is None else f"{result.reach_time:.3f}"
+        ax.set_title(arena_title(spec, dims, f"{spec.name}: {verdict}, reach {reach} s"),
+                     fontsize=10)
         legend_below(ax)
     for i in range(n):
         ax = fig.add_subplot(grid[i, 1])

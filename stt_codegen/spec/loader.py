@@ -786,7 +786,7 @@ def _half_width(value: list[float] | None, name: str, center: tuple[float, ...],
         if d > r + 1e-12:
             raise SpecError(f"{name}.half_width",
                             f"entry {k} = {d!r} puts the box outside the {label} "
-                            f"(at most {r!r} around the point)")
+                            f"(at most {number_text(r)} around the point)")
     return width
 
 
