@@ -142,4 +142,28 @@ class ToolchainError(SttError):
     """
 
 
-__all__ = ["DesignError", "SpecError", "SttError", "ToolchainError"]
+def number_text(value: float, digits: int = 12) -> str:
+    """A number as the toolkit's messages print it: ``g`` format, ``digits`` significant
+    digits.
+
+    Twelve digits show every value a user types as typed (``0.1``, ``1234567.5``) and drop
+    the last-bit noise of arithmetic on it (``0.45 - 0.1`` is ``0.35``, not
+    ``0.35000000000000003``; ``87.35000000000001`` is ``87.35``). A message that compares
+    two numbers close enough to look equal prints them with
+    :func:`stt_codegen.rounding.distinct` instead.
+
+    Parameters
+    ----------
+    value : float
+        Any real number (an int prints as itself; ``inf`` and ``nan`` as ``inf``, ``nan``).
+    digits : int, optional
+        Significant digits at most (default 12).
+
+    Returns
+    -------
+    str
+    """
+    return f"{value:.{digits}g}"
+
+
+__all__ = ["DesignError", "SpecError", "SttError", "ToolchainError", "number_text"]

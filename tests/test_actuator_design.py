@@ -273,5 +273,6 @@ def test_the_command_line(tmp_path, capsys):
     assert _works(err) > 3.0
     path.write_text(path.read_text().replace("[1.5, 1.5]", "[3.5, 3.5]"))
     assert main(["design", str(path)]) == 0
-    peaks = ", ".join(f"{p:.4g} <= 3.5" for p in design_tube(small((3.5, 3.5))).input_proof.peak)
+    peaks = ", ".join(f"|u{i + 1}| {p:.4g} <= 3.5"
+                      for i, p in enumerate(design_tube(small((3.5, 3.5))).input_proof.peak))
     assert f"PASS  input bound: law (13) asks at most [{peaks}] (proved)" in capsys.readouterr().out

@@ -113,7 +113,7 @@ def test_the_tube_clears_the_real_obstacles_by_the_radius(design):
     ("radius = inf", "robot.radius", "finite"),
     ("radius = nan", "robot.radius", "finite"),
     ("radius = 2.6", "robot.radius", "the state space"),
-    ("radius = 0.25", "robot.radius", "initial set"),
+    ("radius = 0.25", "initial", "initial set"),     # the start set at the wall: move it
     ("radius = 0.1\ndims = [2]", "robot.dims", "dimension index"),
     ("radius = 0.1\ndims = [0, 0]", "robot.dims", "repeats"),
     ("radius = 0.1\nsize = 3", "robot.size", "unknown key"),
@@ -131,8 +131,8 @@ def test_an_inflated_obstacle_that_meets_the_target_is_refused():
     parse_spec(near.split("[robot]")[0])             # fine for a point robot
     with pytest.raises(SpecError) as info:
         parse_spec(near)
-    assert info.value.field == "robot.radius"
-    assert "no longer fits in the target set" in info.value.reason
+    assert info.value.field == "target"            # the robot fits at its centre: move it
+    assert "meets the target set" in info.value.reason
     assert "obstacles[0]" in info.value.reason
 
 

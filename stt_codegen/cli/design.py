@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from ..design.actuator import bounded_input_words
 from .common import add_json_argument, add_spec_argument, print_json
 from .plotting import add_plot_argument, design_to_plot, write_plot
 
@@ -67,11 +68,10 @@ def cmd_design(args: argparse.Namespace) -> int:
               f"planned through its box{which}{visit}")
     for m in design.certificate.margins:
         print(f"  {'PASS' if m.passed else 'FAIL'}  {m.name}: margin {m.margin:.4g}")
-    if design.input_proof is not None:          # [actuator]
-        unit = f" {spec.input_unit}" if spec.input_unit else ""
-        peaks = ", ".join(f"{p:.4g} <= {b:g}{unit}" for p, b in zip(design.input_proof.peak,
-                                                                    tube.input_bound))
-        law = "law (13)" if spec.order == 1 else "the cascade's input u"
+    if design.input_proof is not None and spec.input_bound is not None:    # [actuator]
+        law, unit = bounded_input_words(spec)
+        peaks = ", ".join(f"|{name}| {p:.4g} <= {b:g}{unit}" for name, p, b in zip(
+            spec.input_names, design.input_proof.peak, spec.input_bound))
         print(f"  PASS  input bound: {law} asks at most [{peaks}] (proved)")
     if args.plot:
         print(f"plot written to {args.plot}")

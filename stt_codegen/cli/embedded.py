@@ -83,10 +83,11 @@ def cmd_embedded(args: argparse.Namespace) -> int:
         if args.json:
             print_json(report)
         else:
+            reach = "-" if report["reach_time"] is None else f"{report['reach_time']:.3f}"
             print(f"{design.spec.name} ({design.spec.variant}) on the Cortex-M4F (QEMU "
                   "mps2-an386): "
                   f"{'satisfied' if report['satisfied'] else 'NOT satisfied'}, reach "
-                  f"{report['reach_time']} s, clearance {report['min_clearance']:.3f}"
+                  f"{reach} s, clearance {report['min_clearance']:.3f}"
                   f"{_judged(report)}, {report['instructions_per_step']} instructions per step")
         return 0 if report["satisfied"] else 1
     report = run_embedded(design, args.build_dir, seed=seed,

@@ -322,7 +322,8 @@ def second_stage_for(tube: TubeDesign, spec, min_width: float) -> tuple[SecondSt
         No shape is certified at the design's rate (kind ``SAMPLING_RATE``, naming the
         rate that is); or, with ``[actuator]``, shapes are certified but none within
         ``input_bound`` (kind ``INPUT_BOUND``; :func:`~stt_codegen.design_tube` slows the
-        tube or names the ``prescribed_time`` that works instead).
+        tube or names the ``prescribed_time`` that works instead). Its ``tried`` is
+        ``tube``, the position tube designed (for the figure of ``design --plot``).
     """
     from ..errors import SpecError
     if spec.order != 2:
@@ -349,7 +350,8 @@ def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage
             + ", ".join(f"|{name}| <= {p:.4g}{unit}"
                         for name, p in zip(spec.input_names, proof.peak))
             + "; design_tube slows the tube or names the prescribed_time that works "
-            "(docs/second-order.md, 'Force limits')", kind=FailureKind.INPUT_BOUND)
+            "(docs/second-order.md, 'Force limits')", kind=FailureKind.INPUT_BOUND,
+            tried=tube)
     rate = lowest_certified_rate(tube, spec, passes_at_rate=False)
     need = (f"controller.rate_hz = {rate:g} is certified" if rate is not None else
             f"no rate up to {tube.rate_hz * RATE_SEARCH_FACTOR:g} Hz is certified; a longer "
@@ -359,4 +361,4 @@ def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage
                       f"{tube.rate_hz:g} Hz for the declared plants with any second stage "
                       f"tried ({len(SHAPES)} shapes; with the first: {first}); {need} "
                       "(docs/second-order.md, 'The sampled cascade')",
-                      kind=FailureKind.SAMPLING_RATE)
+                      kind=FailureKind.SAMPLING_RATE, tried=tube)

@@ -79,8 +79,10 @@ class Design:
         The accepted tube's check (:func:`~stt_codegen.design.search.check_tube`),
         including its :class:`~stt_codegen.design.certificate.Certificate`.
     design_time_s : float
-        In-process wall time of the design and its certificate, seconds (not compared:
-        two designs of one spec are equal).
+        In-process wall time of the whole :func:`~stt_codegen.design_tube` call, seconds:
+        every alternative tried (``[target] any_of`` boxes, the slower tubes of
+        ``[actuator]``) and every stage (the cascade's certification) included (not
+        compared: two designs of one spec are equal).
     spec : Spec
         The spec the tube was designed for. ``generate``, ``simulate``, ``verify`` and the
         plots take a :class:`Design` and read its spec from here, so a tube cannot be
@@ -319,9 +321,9 @@ class Design:
     def _actuator_json(self) -> dict[str, Any]:
         """``input_bound`` and the proved ``input_peak`` (with where each peak is), for a
         spec with ``[actuator]`` only: without it the document is as before."""
-        if self.tube.input_bound is None or self.input_proof is None:
+        if self.spec.input_bound is None or self.input_proof is None:
             return {}
-        proof, bound = self.input_proof, self.tube.input_bound
+        proof, bound = self.input_proof, self.spec.input_bound
         return {"input_bound": list(bound),
                 "input_peak": {"peak": list(proof.peak), "time": list(proof.time),
                                "horizon": proof.horizon, "margin": proof.margin(bound)}}

@@ -309,14 +309,25 @@ def design_tube(spec: Spec) -> Design:
                 else "; load it with load_spec" if isinstance(spec, str) else "")
         raise TypeError(f"design_tube(): parameter 'spec' must be a Spec, not "
                         f"{type(spec).__name__}{hint}")
+    started = time.perf_counter()
     if spec.target_any_of:                # [target] any_of: the first box that designs
-        return _any_target(spec)
+        return _timed(_any_target(spec), started)
     design = _position_stage(spec)
     # a second-order spec: the sampled cascade must be certified on the final tube, whatever
     # path designed it (design/cascade_gain.py)
     if spec.order == 2:
         design.second_stage      # DesignError unless the sampled cascade is certified
-    return design
+    return _timed(design, started)
+
+
+def _timed(design: Design, started: float) -> Design:
+    """``design`` whose ``design_time_s`` is the wall time since ``started`` (the whole
+    :func:`design_tube` call: the alternatives rejected and the cascade's certification
+    included), its certified second stage kept (computed once)."""
+    timed = replace(design, design_time_s=time.perf_counter() - started)
+    if "second_stage" in design.__dict__:       # functools.cached_property's value
+        timed.__dict__["second_stage"] = design.__dict__["second_stage"]
+    return timed
 
 
 def _any_target(spec: Spec) -> Design:

@@ -331,8 +331,9 @@ def run_figure(design: Design, result: SimulationResult,
         ax.plot(traj.x[0, i], traj.x[0, j], "o", color="tab:blue", label="x(0)")
         mark_states(ax, spec, traj.t, traj.x, dims)    # at the moving obstacles' slice times
         verdict = "satisfied" if result.satisfied else "NOT satisfied"
-        ax.set_title(arena_title(spec, dims, f"{spec.name}: {verdict}, reach "
-                                             f"{result.reach_time} s"), fontsize=10)
+        reach = "-" if result.reach_time is None else f"{result.reach_time:.3f}"
+        ax.set_title(arena_title(spec, dims, f"{spec.name}: {verdict}, reach {reach} s"),
+                     fontsize=10)
         legend_below(ax)
     for i in range(n):
         ax = fig.add_subplot(grid[i, 1])
@@ -596,8 +597,10 @@ def rejected_figure(spec: Spec, error: DesignError,
     certificate = check_tube(error.tried, spec).certificate
     failure = certificate.first_failure()
     kind = "" if error.kind is None else f" ({error.kind.value})"
+    # a tube that passes its check was refused at a later stage (a second stage)
+    what = "the best rejected tube" if failure is not None else "the tube designed"
     return tube_figure(spec, error.tried, certificate,
-                       f"{spec.name}: NO DESIGN{kind}, the best rejected tube", dims,
+                       f"{spec.name}: NO DESIGN{kind}, {what}", dims,
                        f"no design: {error}", None if failure is None else failure.time)
 
 

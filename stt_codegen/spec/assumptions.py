@@ -28,7 +28,7 @@ import math
 from dataclasses import dataclass
 from typing import Mapping
 
-from ..errors import SpecError
+from ..errors import SpecError, number_text
 from .model_bounds import ModelBounds
 
 __all__ = ["Assumptions", "G_KEYS", "LIPSCHITZ_KEYS", "combine_assumptions"]
@@ -250,7 +250,8 @@ def _lipschitz(key: str, model_value: tuple[float, ...] | None, replaced: bool,
             if _tighter(v, m, upper=True):
                 raise _contradiction(f"{field}[{j}]", v, m, bounds, key, declared_above=False)
         if value != model_value:
-            notes.append(f"{key} {list(value)} is above the {bounds.model} model's "
-                         f"{list(model_value)}")
+            shown = [", ".join(number_text(v) for v in vs) for vs in (value, model_value)]
+            notes.append(f"{key} [{shown[0]}] is above the {bounds.model} model's "
+                         f"[{shown[1]}]")
         value = tuple(max(v, m) for v, m in zip(value, model_value))
     return value

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import re
 import tomllib
@@ -25,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from ..cases import bundled_cases, bundled_folder, bundled_spec_bytes
-from ..errors import SpecError
+from ..errors import SpecError, number_text
 from .assumptions import Assumptions, combine_assumptions
 from .model_bounds import declared_bounds, model_bounds
 from .motion import MovingObstacle, check_moving, is_moving, moving_obstacle
@@ -720,7 +721,8 @@ def _validate(raw: dict) -> Spec:
                    0.0 if drive is None else drive.axle_offset)
     if robot is not None:        # the problem of the reference point: sets inflated, X shrunk
         state_space, unsafe_sets, moving = _robot_problem(robot, state_space, initial_set,
-                                                          target_set, doc.prescribed_time)
+                                                          target_set, doc.prescribed_time,
+                                                          (x0, eta))
     obstacles = _cover_all(unsafe_sets, state_space, initial_set, target_set)
     if robot is not None:
         obstacles = _clipped(obstacles, state_space)
@@ -798,7 +800,7 @@ def _half_width(value: list[float] | None, name: str, center: tuple[float, ...],
         if d > r + 1e-12:
             raise SpecError(f"{name}.half_width",
                             f"entry {k} = {d!r} puts the box outside the {label} "
-                            f"(at most {r!r} around the point)")
+                            f"(at most {number_text(r)} around the point)")
     return width
 
 
@@ -1034,12 +1036,28 @@ def _differential_drive(doc: Any) -> DifferentialDrive | None:
     if "disturbance_amplitude" in table.model_fields_set:
         raise SpecError("plant.disturbance_amplitude", f"plant.model = {table.model!r} "
                         "takes its disturbance as plant.slip (forward, lateral, turn)")
+    heading = float(doc.initial.heading or 0.0)
+    if abs(heading) > math.pi:        # radians in [-pi, pi]: 90 is degrees by mistake
+        if abs(heading) <= 2.0 * math.pi:
+            hint = f"; the same heading is {number_text(_wrapped(heading), 6)}"
+        elif abs(heading) <= 360.0:
+            hint = (f"; if {number_text(heading)} is in degrees, it is "
+                    f"{number_text(_wrapped(math.radians(heading)), 6)} rad")
+        else:
+            hint = ""
+        raise SpecError("initial.heading", f"{number_text(heading)} is beyond pi in magnitude: "
+                        f"the heading is in radians, within [-pi, pi]{hint}")
     return DifferentialDrive(
         float(table.axle_offset), float(table.track_width),
         tuple(float(v) for v in table.wheel_radius_error or (0.0, 0.0)),
         tuple(float(v) for v in table.slip or (0.0, 0.0, 0.0)),
-        float(doc.initial.heading or 0.0),
+        heading,
         None if table.wheel_radius is None else float(table.wheel_radius))
+
+
+def _wrapped(angle: float) -> float:
+    """``angle`` (rad) moved by whole turns into ``[-pi, pi)``."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def _mujoco(table: Any, n: int) -> MujocoModel | None:
@@ -1052,52 +1070,108 @@ def _mujoco(table: Any, n: int) -> MujocoModel | None:
     return mujoco_model(table, entry.plant_states or n, entry.input_count(n))
 
 
-def _no_fit(robot: Robot, label: str, why: str) -> SpecError:
+def _robot_size(robot: Robot) -> str:
+    """The robot's radius in words, with the axle offset it includes."""
     if robot.offset:     # a differential drive: its body's radius plus the axle offset
-        body = robot.radius - robot.offset
-        return SpecError("plant.axle_offset" if body == 0 else "robot.radius",
-                         f"the robot (radius {body!r} around its axle, whose look-ahead point "
-                         f"is plant.axle_offset = {robot.offset!r} ahead: {robot.radius!r} in "
-                         f"all) no longer fits in the {label}: {why}")
-    return SpecError("robot.radius", f"the robot (radius {robot.radius!r}) no longer fits in "
-                                     f"the {label}: {why}")
+        return (f"radius {number_text(robot.radius)} (robot.radius "
+                f"{number_text(robot.radius - robot.offset)} around the axle + "
+                f"plant.axle_offset {number_text(robot.offset)} to the look-ahead point)")
+    return f"radius {number_text(robot.radius)}"
+
+
+def _radius_field(robot: Robot, fits: Any) -> str:
+    """The field to change when the robot is too large: ``plant.axle_offset`` when the
+    body alone (``fits(radius - offset)``) would fit, else ``robot.radius``."""
+    if robot.offset and fits(robot.radius - robot.offset):
+        return "plant.axle_offset"
+    return "robot.radius"
+
+
+def _grown(unsafe: UnsafeSet, dims: tuple[int, ...], r: float, j: int) -> UnsafeSet:
+    """``unsafe`` inflated by ``r`` on the robot's ``dims``."""
+    if unsafe.kind == "box":
+        return replace(unsafe, shape=Box(*inflate_bounds(unsafe.shape.lower, unsafe.shape.upper,
+                                                         unsafe.dims, dims, r)))
+    if unsafe.kind == "ball":
+        return replace(unsafe, shape=inflate_ball(unsafe.shape, unsafe.dims, dims, r))
+    from .shapes import make_polytope
+    return replace(unsafe, shape=make_polytope(inflate_polytope(
+        unsafe.shape.vertices, unsafe.dims, dims, r), f"obstacles[{j}]"))
+
+
+def _meets(grown: UnsafeSet, box: Box, space: Box) -> bool:
+    """Whether the (inflated) obstacle meets ``box`` (touching counts)."""
+    import numpy as np
+
+    if grown.kind == "box":
+        return _embed(grown.shape.lower, grown.shape.upper, grown.dims, space).meets(box)
+    return grown.shape.meets_box(np.array(box.lower)[list(grown.dims)],
+                                 np.array(box.upper)[list(grown.dims)])
 
 
 def _robot_problem(robot: Robot, state_space: Box, initial_set: Box, target_set: Box,
-                   prescribed_time: float
+                   prescribed_time: float, points: tuple[tuple[float, ...], ...]
                    ) -> tuple[Box, tuple[UnsafeSet, ...], tuple[MovingObstacle, ...]]:
     """The state space shrunk and the obstacles inflated by the robot's radius
-    (:mod:`.robot`), checked against the initial and target sets of the reference point."""
-    import numpy as np
+    (:mod:`.robot`), checked against the initial and target sets of the reference point.
 
+    The error names the field to change: the radius (``robot.radius``, or
+    ``plant.axle_offset`` when the body alone would fit) when the robot does not fit in
+    the state space, or not at the set's own point (``points``: ``initial.state`` and the
+    target's centre) beside an obstacle; the set (``initial``, ``target``) when the robot
+    fits there and only the set comes too close to the boundary or to an obstacle.
+    """
     r, dims = robot.radius, robot.dims
-    shrunk = Box(*shrink_bounds(state_space.lower, state_space.upper, dims, r))
-    for label, box in (("initial set", initial_set), ("target set", target_set)):
+    size = _robot_size(robot)
+
+    def shrunk_by(radius: float) -> Box | None:
+        try:
+            return Box(*shrink_bounds(state_space.lower, state_space.upper, dims, radius))
+        except SpecError:
+            return None
+
+    def room_for(box: Box, radius: float) -> bool:
+        """Whether ``box`` fits somewhere in the state space shrunk by ``radius``."""
+        space = shrunk_by(radius)
+        return space is not None and all(b - a <= hi - lo for a, b, lo, hi in zip(
+            box.lower, box.upper, space.lower, space.upper))
+
+    shrunk = shrunk_by(r)
+    if shrunk is None:
+        d = min(dims, key=lambda i: state_space.upper[i] - state_space.lower[i])
+        raise SpecError(_radius_field(robot, lambda q: shrunk_by(q) is not None),
+                        f"the robot of {size} no longer fits in the state space: dimension "
+                        f"{d} is [{number_text(state_space.lower[d])}, "
+                        f"{number_text(state_space.upper[d])}]")
+    sets = (("initial", "initial set", initial_set, points[0]),
+            ("target", "target set", target_set, points[1]))
+    for name, label, box, _ in sets:
         if not shrunk.contains_box(box):
-            raise _no_fit(robot, label, f"the {label} comes within the radius of the state "
-                                        "space's boundary (it must lie inside the state space "
-                                        "shrunk by the radius)")
+            # the set fits elsewhere: move it; else the radius is too large for it
+            field = name if room_for(box, r) else _radius_field(
+                robot, lambda q: room_for(box, q))
+            raise SpecError(field, f"the {label} comes within the robot's {size} of the "
+                                   "state space's boundary: it must lie inside the state space "
+                                   f"shrunk by the radius, {_box_text(shrunk)}"
+                                   + ("" if field == name else f", which it does not fit in"))
     inflated = []
     for k, unsafe in enumerate(robot.unsafe_sets):
         j = k if unsafe.source is None else unsafe.source
-        if unsafe.kind == "box":
-            lo, hi = inflate_bounds(unsafe.shape.lower, unsafe.shape.upper, unsafe.dims, dims, r)
-            grown = replace(unsafe, shape=Box(lo, hi))
-        elif unsafe.kind == "ball":
-            grown = replace(unsafe, shape=inflate_ball(unsafe.shape, unsafe.dims, dims, r))
-        else:
-            from .shapes import make_polytope
-            grown = replace(unsafe, shape=make_polytope(inflate_polytope(
-                unsafe.shape.vertices, unsafe.dims, dims, r), f"obstacles[{j}]"))
-        for label, box in (("initial set", initial_set), ("target set", target_set)):
-            if unsafe.kind == "box":
-                meets = _embed(grown.shape.lower, grown.shape.upper, grown.dims,
-                               shrunk).meets(box)
-            else:
-                meets = grown.shape.meets_box(np.array(box.lower)[list(grown.dims)],
-                                              np.array(box.upper)[list(grown.dims)])
-            if meets:
-                raise _no_fit(robot, label, f"obstacles[{j}] inflated by the radius meets it")
+        grown = _grown(unsafe, dims, r, j)
+        for name, label, box, point in sets:
+            if _meets(grown, box, shrunk):
+                at = Box(tuple(point), tuple(point))
+                if not _meets(grown, at, shrunk):
+                    field = name       # clear at its own point: move or shrink the set
+                else:
+                    field = _radius_field(robot, lambda q: not _meets(
+                        _grown(unsafe, dims, q, j), at, shrunk))
+                raise SpecError(field, (
+                    f"obstacles[{j}] inflated by the robot's {size} meets the {label}: move "
+                    f"the set (or shrink it) away from obstacles[{j}]" if field == name else
+                    f"the robot of {size} no longer fits in the {label}: obstacles[{j}] "
+                    f"inflated by the radius covers even its point {_point_text(point)} (a "
+                    f"smaller radius, or the set farther from obstacles[{j}])"))
         inflated.append(grown)
     moving = []
     for obstacle in robot.moving_obstacles:
@@ -1107,10 +1181,20 @@ def _robot_problem(robot: Robot, state_space: Box, initial_set: Box, target_set:
                          prescribed_time)
         except SpecError as exc:
             label = "initial set" if "initial" in exc.reason else "target set"
-            raise _no_fit(robot, label, f"{exc.field} inflated by the radius {exc.reason}"
-                          ) from None
+            raise SpecError(_radius_field(robot, lambda q: q == 0.0),
+                            f"the robot of {size} no longer fits in the {label}: {exc.field} "
+                            f"inflated by the radius {exc.reason}") from None
         moving.append(grown)
     return shrunk, tuple(inflated), tuple(moving)
+
+
+def _point_text(point: tuple[float, ...]) -> str:
+    return "[" + ", ".join(number_text(v) for v in point) + "]"
+
+
+def _box_text(box: Box) -> str:
+    return " x ".join(f"[{number_text(a)}, {number_text(b)}]"
+                      for a, b in zip(box.lower, box.upper))
 
 
 def _clipped(obstacles: tuple[Obstacle, ...], state_space: Box) -> tuple[Obstacle, ...]:

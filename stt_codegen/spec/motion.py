@@ -37,7 +37,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..errors import SpecError
+from ..errors import SpecError, number_text
 
 __all__ = ["MovingObstacle", "check_moving", "is_moving", "moving_obstacle"]
 
@@ -315,12 +315,17 @@ def moving_obstacle(table: Any, name: str, source: int, dims: tuple[int, ...],
         first = tuple(rows[0][1:])
         scale = max([1.0] + [abs(v) for v in centre])
         if any(abs(a - b) > CENTRE_TOLERANCE * scale for a, b in zip(first, centre)):
-            raise SpecError(f"{name}.path", f"the first row's centre {list(first)} is not the "
-                                            f"centre {list(centre)} of lower/upper")
+            raise SpecError(f"{name}.path", f"the first row's centre {_numbers(first)} is not "
+                                            f"the centre {_numbers(centre)} of lower/upper")
         centres = tuple(tuple(float(v) for v in r[1:]) for r in rows)
         return MovingObstacle(source, dims, half, times, centres, (t_on, t_off), "path", until)
     return MovingObstacle(source, dims, half, (t_on,), (centre,), (t_on, t_off), "still",
                           until)
+
+
+def _numbers(values) -> str:
+    """A list of numbers as messages print them (:func:`~stt_codegen.errors.number_text`)."""
+    return "[" + ", ".join(number_text(float(v)) for v in values) + "]"
 
 
 def check_moving(obstacle: MovingObstacle, name: str, initial_set: Any, target_set: Any,

@@ -28,7 +28,7 @@ import itertools
 from dataclasses import dataclass, replace
 from typing import Any, Sequence
 
-from ..errors import SpecError
+from ..errors import SpecError, number_text
 
 __all__ = ["Robot", "inflate_ball", "inflate_bounds", "inflate_moving", "inflate_polytope",
            "robot_dims", "robot_json", "shrink_bounds"]
@@ -122,9 +122,10 @@ def shrink_bounds(lower: Sequence[float], upper: Sequence[float], dims: Sequence
     for d in dims:
         lo[d], hi[d] = lower[d] + radius, upper[d] - radius
         if not lo[d] < hi[d]:
-            raise SpecError("robot.radius", f"the robot (radius {radius!r}) no longer fits in "
-                                            f"the state space: dimension {d} is "
-                                            f"[{lower[d]!r}, {upper[d]!r}]")
+            raise SpecError("robot.radius", f"the robot (radius {number_text(radius)}) no "
+                                            f"longer fits in the state space: dimension {d} is "
+                                            f"[{number_text(lower[d])}, "
+                                            f"{number_text(upper[d])}]")
     return tuple(lo), tuple(hi)
 
 

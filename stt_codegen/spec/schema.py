@@ -16,6 +16,7 @@ with a TOML language server validate and complete spec files with it.
 
 from __future__ import annotations
 
+import difflib
 import re
 from typing import Annotated, Any, Literal
 
@@ -98,8 +99,9 @@ class InitialTable(BoxTable):
                                   "x(0) in X_0")
     velocity: Vector = _omitted("second-order models only: the initial velocity x2(0), one "
                                 "per position; default 0")
-    heading: Number = _omitted("differential-drive only: the heading theta(0), rad; "
-                               "default 0 (state and the box are the look-ahead point's)")
+    heading: Number = _omitted("differential-drive only: the heading theta(0), rad, in "
+                               "[-pi, pi]; default 0 (state and the box are the look-ahead "
+                               "point's)")
 
 
 class TargetTable(BoxTable):
@@ -409,6 +411,14 @@ def _allowed(loc: tuple) -> list[str]:
     return sorted((tables[-1] if tables else SpecDocument).model_fields)
 
 
+def _unknown_key(key: str, allowed: list[str]) -> str:
+    """The reason for an unknown key: the allowed keys, with the closest (``difflib``) as a
+    "did you mean" when one is close."""
+    close = difflib.get_close_matches(key, allowed, n=1, cutoff=0.6)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    return f"unknown key ({hint}allowed: {', '.join(allowed)})"
+
+
 def value_kind(value: Any) -> str:
     """What a value is, in TOML's words (``"an array"``, ``"a table"``...).
 
@@ -453,7 +463,7 @@ def _reason(error: dict) -> str:
     if kind in ("list_type", "too_short", "too_long") and error["loc"][-1] == "active":
         return f"must be an array [t_on, t_off] of two numbers, got {short_repr(value)}"
     if kind == "extra_forbidden":
-        return f"unknown key (allowed: {', '.join(_allowed(error['loc']))})"
+        return _unknown_key(str(error["loc"][-1]), _allowed(error["loc"]))
     if kind == "finite_number":
         return f"must be finite, got {value!r}"
     if kind in ("float_type", "float_parsing"):

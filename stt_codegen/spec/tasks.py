@@ -27,7 +27,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Sequence
 
-from ..errors import SpecError
+from ..errors import SpecError, number_text
 
 __all__ = ["STAY", "Task", "build_tasks"]
 
@@ -120,7 +120,7 @@ def _box(lower: Sequence[float] | None, upper: Sequence[float] | None, field: st
                             f"upper[{k}] = {b!r}")
         if a < space[0][k] or b > space[1][k]:
             raise SpecError(field, f"dimension {k} [{a!r}, {b!r}] is not inside the state "
-                            f"space [{space[0][k]!r}, {space[1][k]!r}]")
+                            f"space [{number_text(space[0][k])}, {number_text(space[1][k])}]")
     return TaskBox(tuple(float(v) for v in lower), tuple(float(v) for v in upper))
 
 

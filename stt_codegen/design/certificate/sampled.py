@@ -93,6 +93,20 @@ def _atanh_reach(lo: float, hi: float) -> float:
     return math.atanh(top) if top < 1.0 else math.inf
 
 
+def _within_ball(interval: list[float], edge: float) -> list[float]:
+    """``interval`` (an enclosure of ``e_i``) cut to ``[-edge, edge]`` (the ball's bound of
+    ``|e_i|``); ``interval`` uncut where the two miss each other.
+
+    Both enclose ``e_i``, so they meet; they miss only by rounding (a ball's edge a few
+    ulps below a box near ``e = 0``, where the box's corners come from state coordinates
+    ``~1e-15`` apart). An empty cut would be an enclosure of nothing, which every later
+    step would pass vacuously (and ``|e_i| <= -inf`` would reach ``phi'``): the box alone
+    is kept.
+    """
+    low, high = max(interval[0], -edge), min(interval[1], edge)
+    return [low, high] if low <= high else interval
+
+
 def _as_class(plants: Assumptions | PlantClass) -> PlantClass:
     return plants if isinstance(plants, PlantClass) else PlantClass(plants)
 
@@ -238,7 +252,7 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
             if math.isfinite(mid):
                 edge = math.tanh(mid)
                 for i in b:
-                    path[i] = [max(path[i][0], -edge), min(path[i][1], edge)]
+                    path[i] = _within_ball(path[i], edge)
             else:
                 ball_lost += 1
             end_level[b] = end
@@ -265,7 +279,7 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
             if math.isfinite(r):
                 edge = math.tanh(r)
                 for i in b:
-                    box[i] = [max(box[i][0], -edge), min(box[i][1], edge)]
+                    box[i] = _within_ball(box[i], edge)
         top = max(top, max(max(-x, y) for x, y in box))
     data.update({"max_abs_e": top, "margin": worst, "max_level": ball_max,
                  "intervals_without_ball": int(ball_lost)})

@@ -81,8 +81,12 @@ def phi_slope_scalar(s: float) -> float:
     Returns
     -------
     float
-        ``phi'(s)``.
+        ``phi'(s)``; ``inf`` for ``|s| >= 1`` (its limit at the tube's edge, as
+        :func:`phi_slope` gives at ``+-1``: a curvature bound that holds nowhere, so an
+        argument using it fails rather than passes).
     """
+    if not abs(s) < 1.0:
+        return math.inf
     return (2.0 + 4.0 * s * math.atanh(s)) / (1.0 - s * s) ** 2
 
 
