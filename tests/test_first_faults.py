@@ -1,4 +1,4 @@
-"""The faults a new user meets first (issue #42): each reproduced as it was met, then fixed."""
+"""The faults a new user meets first: each reproduced as it was met, then fixed."""
 
 from __future__ import annotations
 
