@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 import stt_codegen as stt
-from stt_codegen.design.input_bound import input_prover
+from stt_codegen.design.certificate.actuator import prove_input_bound
 
 SPECS = Path(__file__).parent / "specs"
 DRIVE = SPECS / "office-drive.toml"
@@ -91,13 +91,13 @@ def test_the_input_proof_of_a_tube_whose_enclosure_touches_the_ball_by_rounding(
     doc = {**NONLINEAR_REACH_AVOID, "prescribed_time": 24.0}
     design = stt.design_tube(stt.Spec.from_dict(doc))
     judged = stt.Spec.from_dict({**doc, "actuator": {"input_bound": [10.0, 5.0]}})
-    proof = input_prover()(design.tube, judged)
+    proof = prove_input_bound(design.tube, judged)
     assert proof.proved, proof.reason
     assert all(0 < p < math.inf for p in proof.peak)
 
 
 def test_phi_slope_is_infinite_at_and_beyond_the_tubes_edge():
-    from stt_codegen.verify.sampled_axis import phi_slope, phi_slope_scalar
+    from stt_codegen.design.certificate.sampled_axis import phi_slope, phi_slope_scalar
 
     assert phi_slope_scalar(0.0) == 2.0
     assert phi_slope_scalar(0.5) == pytest.approx(float(phi_slope(0.5)), rel=1e-15)
