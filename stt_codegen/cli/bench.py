@@ -9,9 +9,10 @@ from pathlib import Path
 
 from ..errors import SpecError
 from ..spec.plants import plant_entry
+from ..spec.variants import variant_of
 from .common import add_json_argument, add_spec_argument
 
-__all__ = ["configure_bench"]
+__all__ = ["cascade_arenas", "configure_bench", "first_order_arenas"]
 
 
 def _non_negative_int(text: str) -> int:
@@ -33,13 +34,47 @@ def _int_list(text: str, field: str) -> list[int]:
 
 
 def _cmd_arenas(args: argparse.Namespace) -> int:
-    if plant_entry(args.plant).order == 2:    # the cascade beside A* + tracker
-        from ..bench.second_order_arenas import (format_double_integrator_report,
-                                                 run_double_integrator_bench)
-        report = run_double_integrator_bench(args.count, args.seed)
-        print(json.dumps(report, indent=1, sort_keys=True) if args.json
-              else format_double_integrator_report(report))
-        return 0
+    return variant_of(plant_entry(args.plant)).entry("arenas_bench")(args)
+
+
+def cascade_arenas(args: argparse.Namespace) -> int:
+    """``bench arenas`` for a second-order ``--plant`` (the cascade's role
+    ``arenas_bench``, :mod:`~stt_codegen.spec.variants`): the cascade beside A* and a
+    tracker on the double integrator.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``count``, ``seed``, ``json``.
+
+    Returns
+    -------
+    int
+        0.
+    """
+    from ..bench.second_order_arenas import (format_double_integrator_report,
+                                             run_double_integrator_bench)
+    report = run_double_integrator_bench(args.count, args.seed)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_double_integrator_report(report))
+    return 0
+
+
+def first_order_arenas(args: argparse.Namespace) -> int:
+    """``bench arenas`` for law (13) (role ``arenas_bench``): random arenas against A*
+    and RRT*.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``count``, ``seed``, ``specs``, ``workers``, ``scheduler``, ``methods``,
+        ``no_progress``, ``json``.
+
+    Returns
+    -------
+    int
+        0.
+    """
     from ..bench.arenas_bench import format_arenas_report, run_arenas_bench, write_specs
     if args.specs:
         write_specs(Path(args.specs), args.count, args.seed)

@@ -6,6 +6,7 @@ import argparse
 
 from .common import add_json_argument, add_spec_argument, print_json
 from .plotting import add_plot_argument, design_to_plot, write_plot
+from ..spec.variants import variant_of
 
 __all__ = ["cmd_design", "configure_design"]
 
@@ -71,7 +72,7 @@ def cmd_design(args: argparse.Namespace) -> int:
         unit = f" {spec.input_unit}" if spec.input_unit else ""
         peaks = ", ".join(f"{p:.4g} <= {b:g}{unit}" for p, b in zip(design.input_proof.peak,
                                                                     tube.input_bound))
-        law = "law (13)" if spec.order == 1 else "the cascade's input u"
+        law = variant_of(spec).input_words
         print(f"  PASS  input bound: {law} asks at most [{peaks}] (proved)")
     if args.plot:
         print(f"plot written to {args.plot}")
