@@ -40,6 +40,7 @@ from dataclasses import dataclass, replace
 
 from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
+from ..spec.variants import variant_of
 from ..tube.parameters import CRUISE
 from .grid import grid_index, grid_value, smallest_passing
 from .failures import FailureKind
@@ -218,10 +219,10 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
                        design_time_s=time.perf_counter() - started)
     proved = [c for c in tried if c.proof.proved]
     names = spec.input_names
-    # the controller in the user's words: law (13)'s input, or the cascade's force/torque
-    law, unit = {"first-order": ("law (13)", ""),
-                 "cascade": ("the cascade's input u", f" {spec.input_unit}"),
-                 "look-ahead": ("the base's command (v, omega)", "")}[spec.variant]
+    # the controller in the user's words: law (13)'s input, the cascade's force/torque, the
+    # base's command
+    law = variant_of(spec).input_words
+    unit = f" {spec.input_unit}" if spec.input_unit else ""
     if not proved:
         reasons = "; ".join(f"{c.label}: {c.proof.reason}" for c in tried)
         raise DesignError(

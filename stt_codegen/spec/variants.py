@@ -198,7 +198,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                arenas_bench=_P + "cli.bench:cascade_arenas"),
         MappingProxyType({"cascade": True})),
     "look-ahead": ControllerVariant(
-        "look-ahead", "a differential-drive base", "law (13)", 1, "",
+        "look-ahead", "a differential-drive base", "the base's command (v, omega)", 1, "",
         _roles(plant_terms=_P + "spec.loader:look_ahead_plant_terms",
                stage_class=_P + "tube.look_ahead:LookAhead",
                stage=_P + "design.result:look_ahead_stage",
