@@ -57,8 +57,10 @@ def test_the_state_layout_of_each_variant():
 def test_a_first_order_design_refuses_what_only_another_variant_has():
     design = design_of("omnirobot-s1")
     assert design.stage is None
-    with pytest.raises(SpecError, match="a look-ahead point needs a differential-drive base, "
-                                        "and the spec describes a first-order plant") as err:
+    with pytest.raises(SpecError, match="a look-ahead point needs a differential-drive base "
+                                        "\\(the look-ahead variant\\); the spec describes a "
+                                        "first-order plant \\(the first-order variant\\)"
+                       ) as err:
         design.look_ahead
     assert err.value.field == "plant.model"
     with pytest.raises(SpecError) as err:

@@ -170,7 +170,8 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
         raise SpecError("plant.model", "the firmware's closed loop needs the plant's equations; "
                                        "a MuJoCo plant runs on the host (stt-codegen simulate)")
     # another variant has its own program (role firmware): stt-codegen embedded picks it
-    require_variant(spec, "first-order", "law (13)'s firmware loop (run_embedded)")
+    require_variant(spec, "first-order", "law (13)'s firmware loop (run_embedded; "
+                                         "stt-codegen embedded runs each variant's own)")
     seed = check_seed(seed)
     message = missing_message()
     if message:

@@ -336,7 +336,8 @@ class Spec:
 
     @property
     def order(self) -> int:
-        """The plant's order: the one place that decides which controller variant runs.
+        """The plant's order (what the variant does with it: :attr:`variant`,
+        :mod:`~.variants`).
 
         Returns
         -------

@@ -329,5 +329,6 @@ def require_variant(spec: Any, name: str, what: str) -> None:
     """
     wanted, found = variant_named(name), variant_of(spec)
     if found is not wanted:
-        raise SpecError("plant.model", f"{what} needs {wanted.plant_words}, and the spec "
-                                       f"describes {found.plant_words}")
+        raise SpecError("plant.model", f"{what} needs {wanted.plant_words} (the "
+                                       f"{wanted.name} variant); the spec describes "
+                                       f"{found.plant_words} (the {found.name} variant)")
