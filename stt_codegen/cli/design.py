@@ -6,7 +6,6 @@ import argparse
 
 from .common import add_json_argument, add_spec_argument, print_json
 from .plotting import add_plot_argument, design_to_plot, write_plot
-from ..spec.variants import variant_of
 
 __all__ = ["cmd_design", "configure_design"]
 
@@ -72,6 +71,7 @@ def cmd_design(args: argparse.Namespace) -> int:
         unit = f" {spec.input_unit}" if spec.input_unit else ""
         peaks = ", ".join(f"{p:.4g} <= {b:g}{unit}" for p, b in zip(design.input_proof.peak,
                                                                     tube.input_bound))
+        from ..spec.variants import variant_of
         law = variant_of(spec).input_words
         print(f"  PASS  input bound: {law} asks at most [{peaks}] (proved)")
     if args.plot:

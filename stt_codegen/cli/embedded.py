@@ -6,7 +6,6 @@ import argparse
 from pathlib import Path
 
 from ..errors import SpecError
-from ..spec.variants import variant_of
 from .common import (add_json_argument, add_seed_argument, add_spec_argument, checked_seed,
                      load_and_design, print_json)
 
@@ -74,6 +73,7 @@ def cmd_embedded(args: argparse.Namespace) -> int:
     if args.build_dir is not None and not Path(args.build_dir).parent.is_dir():
         raise SpecError("build_dir", f"folder {str(Path(args.build_dir).parent)!r} does not exist")
     design = load_and_design(args)
+    from ..spec.variants import variant_of
     return variant_of(design.spec).entry("embedded_command")(design, args, seed)
 
 
@@ -96,6 +96,7 @@ def variant_loop_command(design, args: argparse.Namespace, seed: int) -> int:
     int
         0 if the closed loop satisfied the spec, else 1.
     """
+    from ..spec.variants import variant_of
     variant = variant_of(design.spec)
     report = variant.entry("firmware")(design, seed=seed)
     if args.json:
