@@ -440,4 +440,7 @@ def test_a_layer_resolves_only_roles_of_its_own_or_upper_layers():
             if below:
                 offenders.append(f"{module}:{line} resolves {role!r} into {below}")
     assert offenders == []
-    assert seen == set(targets), f"roles no module uses: {set(targets) - seen}"
+    # the deployed and oracle steps are for the variants' equivalence tests
+    # (tests/test_variants.py); every other role has a caller in the package
+    unused = set(targets) - seen - {"casadi_step", "oracle_step"}
+    assert not unused, f"roles no module uses: {unused}"

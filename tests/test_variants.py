@@ -89,3 +89,70 @@ def test_make_controller_follows_the_stage_and_names_the_plant_kind():
         backends.make_controller("nope", design.tube, LookAhead(0.1))
     assert backends.backend_names(variant="look-ahead") == ["reference", "casadi", "c",
                                                             "python"]
+
+
+def test_stt_codegen_embedded_runs_the_variants_own_firmware_loop(monkeypatch, capsys):
+    """The command asks the spec's variant for its firmware loop (role ``firmware``,
+    resolved on use): a differential-drive spec runs the look-ahead loop, never law
+    (13)'s ``run_embedded``."""
+    from pathlib import Path
+
+    from stt_codegen.cli import main
+    from stt_codegen.embedded import deploy, look_ahead_loop
+
+    calls = []
+
+    def loop(design, seed=0, timeout=600.0):
+        calls.append((design.spec.name, seed))
+        return {"satisfied": True, "reach_time": 1.5, "min_clearance": 0.25,
+                "instructions_per_step": 1234}
+
+    def law13(*args, **kwargs):
+        raise AssertionError("law (13)'s firmware loop run for a differential-drive spec")
+
+    monkeypatch.setattr(look_ahead_loop, "run_look_ahead_embedded", loop)
+    monkeypatch.setattr(deploy, "run_embedded", law13)
+    spec = Path(__file__).parent / "specs" / "office-drive.toml"
+    assert main(["embedded", str(spec), "--seed", "3"]) == 0
+    assert len(calls) == 1 and calls[0][1] == 3
+    assert "(look-ahead) on the Cortex-M4F" in capsys.readouterr().out
+
+
+def _variant_cases():
+    """``(variant, tube, stage, x)`` of each variant: omnirobot-s1 (law (13) and, with a
+    hand-made second stage, the cascade on its tube) and the office's base."""
+    from pathlib import Path
+
+    import stt_codegen as stt
+    from stt_codegen.runtime.state_split import initial_state
+
+    s1 = design_of("omnirobot-s1")
+    stage = SecondStage(position_gain=0.02, velocity_gain=3.0, width_start=(1.5, 1.2, 0.9),
+                        width_floor=(0.3, 0.25, 0.2), decay=2.0)
+    office = stt.design_tube(stt.load_spec(str(Path(__file__).parent / "specs"
+                                               / "office-drive.toml")))
+    x1 = np.array(s1.spec.initial_state)
+    return [("first-order", s1.tube, None, x1),
+            ("cascade", s1.tube, stage, np.concatenate([x1, [0.05, -0.02, 0.01]])),
+            ("look-ahead", office.tube, office.stage, initial_state(office.spec))]
+
+
+def test_each_variants_deployed_step_is_its_oracles():
+    """The roles ``casadi_step`` and ``oracle_step`` of each variant give the same step:
+    ``u`` and ``alpha_next`` at the start and half a second later, with ``alpha`` away
+    from zero."""
+    for name, tube, stage, x in _variant_cases():
+        variant = CONTROLLER_VARIANTS[name]
+        function = variant.entry("casadi_step")(tube, stage)
+        oracle = variant.entry("oracle_step")
+        n, dt = tube.dimension, 1.0 / tube.rate_hz
+        for t, alpha in ((0.0, np.zeros(2 * n)), (0.5, np.linspace(0.01, 0.05, 2 * n))):
+            u, alpha_next = (np.array(v, dtype=float).ravel()
+                             for v in function(x, t, dt, alpha)[:2])
+            u_ref, alpha_ref = (np.asarray(v)[0] for v in
+                                oracle(tube, stage, x[None], np.array([t]), np.array([dt]),
+                                       alpha[None])[:2])
+            assert u.shape == u_ref.shape == (len(u),) and np.any(u != 0.0), name
+            np.testing.assert_allclose(u, u_ref, rtol=1e-9, atol=1e-12, err_msg=name)
+            np.testing.assert_allclose(alpha_next, alpha_ref, rtol=1e-9, atol=1e-12,
+                                       err_msg=name)
