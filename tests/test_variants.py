@@ -156,3 +156,26 @@ def test_each_variants_deployed_step_is_its_oracles():
             np.testing.assert_allclose(u, u_ref, rtol=1e-9, atol=1e-12, err_msg=name)
             np.testing.assert_allclose(alpha_next, alpha_ref, rtol=1e-9, atol=1e-12,
                                        err_msg=name)
+
+
+def test_each_variants_status_decoding_agrees_with_its_reference_backend():
+    """The role ``status`` decodes the deployed step's flags into the status the variant's
+    ``reference`` backend (the oracle) reports: inside the tube and 100 units off it."""
+    from stt_codegen.tube.parameters import Status
+
+    for name, tube, stage, x in _variant_cases():
+        variant = CONTROLLER_VARIANTS[name]
+        function = variant.entry("casadi_step")(tube, stage)
+        reference = backends.make_controller("reference", tube, stage)
+        n, dt = tube.dimension, 1.0 / tube.rate_hz
+        away = x.copy()
+        away[:n if name != "look-ahead" else 2] += 100.0
+        seen = []
+        for state in (x, away):
+            u, alpha_next, status = variant.entry("status")(function(state, 0.0, dt,
+                                                                     np.zeros(2 * n)))
+            u_ref, _, status_ref = reference.step(state, 0.0, dt, np.zeros(2 * n))
+            assert status == status_ref, name
+            np.testing.assert_allclose(u, u_ref, rtol=1e-9, atol=1e-12, err_msg=name)
+            seen.append(status)
+        assert seen[0] != Status.OUTSIDE_TUBE and seen[1] == Status.OUTSIDE_TUBE, name

@@ -1,5 +1,5 @@
 """The controller variants' deployed and oracle steps under one signature each (the roles
-``casadi_step`` and ``oracle_step`` of :mod:`stt_codegen.spec.variants`): thin adapters
+``casadi_step``, ``oracle_step`` and ``status`` of :mod:`stt_codegen.spec.variants`): thin adapters
 where a variant's own entry takes its arguments otherwise. The cascade's entries
 (:func:`stt_codegen.tube.cascade.cascade_step`,
 :func:`stt_codegen.tube.cascade_reference.cascade_step`) and the look-ahead law's CasADi
@@ -12,9 +12,10 @@ import numpy as np
 
 from . import look_ahead_reference, reference
 from .look_ahead import LookAhead
-from .parameters import TubeDesign
+from .parameters import Status, TubeDesign
 
-__all__ = ["law13_casadi_step", "law13_oracle_step", "look_ahead_oracle_step"]
+__all__ = ["cascade_status", "law13_casadi_step", "law13_oracle_step", "law13_status",
+           "look_ahead_oracle_step"]
 
 
 def law13_casadi_step(design: TubeDesign, stage: None) -> ca.Function:
@@ -84,3 +85,56 @@ def look_ahead_oracle_step(design: TubeDesign, stage: LookAhead, x, t, dt,
     """
     return look_ahead_reference.look_ahead_status(design, stage.axle_offset,
                                                   stage.input_bound, x, t, dt, alpha)
+
+
+def _flag(value) -> bool:
+    """A step's 1.0/0.0 output (a CasADi ``DM`` or a number) as a truth value."""
+    return bool(float(np.ravel(np.asarray(value, dtype=float))[0]))
+
+
+def law13_status(outputs) -> tuple[np.ndarray, np.ndarray, Status]:
+    """The step of law (13) (or of the look-ahead law) from its CasADi outputs
+    ``(u, alpha_next, inside[, within_bound])``: the status they encode.
+
+    Parameters
+    ----------
+    outputs : sequence
+        The outputs of the variant's ``casadi_step`` Function.
+
+    Returns
+    -------
+    u : ndarray, shape (n,)
+    alpha_next : ndarray, shape (2 n,)
+    status : Status
+        ``OUTSIDE_TUBE`` if not inside, else ``INPUT_CLAMPED`` if the clamp moved the
+        input, else ``OK``.
+    """
+    u, alpha_next, inside, *within = outputs
+    status = (Status.OUTSIDE_TUBE if not _flag(inside) else
+              Status.INPUT_CLAMPED if within and not _flag(within[0]) else Status.OK)
+    return np.array(u, dtype=float).ravel(), np.array(alpha_next, dtype=float).ravel(), status
+
+
+def cascade_status(outputs) -> tuple[np.ndarray, np.ndarray, Status]:
+    """The cascade's step from its CasADi outputs ``(u, alpha_next, r, inside_position,
+    inside_velocity[, within_bound])``: the status they encode.
+
+    Parameters
+    ----------
+    outputs : sequence
+        The outputs of :func:`stt_codegen.tube.cascade.cascade_step`'s Function.
+
+    Returns
+    -------
+    u : ndarray, shape (n,)
+    alpha_next : ndarray, shape (2 n,)
+    status : Status
+        ``OUTSIDE_TUBE`` outside the position tube, else ``OUTSIDE_VELOCITY_TUBE``
+        outside the velocity tube, else ``INPUT_CLAMPED`` if the clamp moved the input,
+        else ``OK``.
+    """
+    u, alpha_next, _r, inside_position, inside_velocity, *within = outputs
+    status = (Status.OUTSIDE_TUBE if not _flag(inside_position) else
+              Status.OUTSIDE_VELOCITY_TUBE if not _flag(inside_velocity) else
+              Status.INPUT_CLAMPED if within and not _flag(within[0]) else Status.OK)
+    return np.array(u, dtype=float).ravel(), np.array(alpha_next, dtype=float).ravel(), status
