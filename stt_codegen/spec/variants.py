@@ -62,8 +62,8 @@ ROLES: Mapping[str, str] = MappingProxyType({
     "firmware": "(design, *, seed) -> report dict of the closed loop on the Cortex-M4F",
     "embedded_command": "(design, args, seed) -> exit code of stt-codegen embedded",
     "model_checks": "(spec, model) -> list of Check on the plant model",
-    "sampled_checks": "(spec, design, tube_check, stage) -> list of Check of the sampled "
-                      "loop (stage: the progress callback)",
+    "sampled_checks": "(spec, design, tube_check, progress) -> list of Check of the "
+                      "sampled loop",
     "plant_within": "(spec, model) -> Check, the plant within the certified class",
     "arenas_bench": "(args) -> exit code of stt-codegen bench arenas",
 })
