@@ -15,7 +15,7 @@ Spatiotemporal Tubes Approach". The front door, in the order of the flow (see
   Definition 2.1;
 * :func:`verify` - the paper's lemmas, the assumptions and the tube certificate of a
   design (or of a spec, designed first), as a :class:`VerificationReport`
-  (:func:`stt_codegen.verify.command.verify`);
+  (:func:`stt_codegen.verification.command.verify`);
 * :func:`plot_design`, :func:`plot_run` - figures of a design, and of a run;
 * :func:`import_pointmaze` - the spec of a maze of gymnasium-robotics' PointMaze (the
   ``mujoco`` extra);
@@ -46,14 +46,6 @@ from typing import TYPE_CHECKING, Any
 from .errors import DesignError, SpecError, SttError, ToolchainError
 from .version import __version__
 
-# ``stt_codegen.verify`` is the function (``_LAZY`` below), and ``stt_codegen/verify/`` is
-# also the package of the checks. The import system binds a subpackage to its parent's
-# attribute when it first loads it, and only then: so the (cheap) package is loaded here,
-# once, and that binding dropped. After this, ``import stt_codegen.verify.lemma`` and the
-# like never rebind the name, and ``stt_codegen.verify`` is always the function.
-from . import verify as _verify_package  # noqa: E402,F401
-globals().pop("verify", None)
-
 #: Public name -> module that defines it; imported on first attribute access.
 _LAZY: dict[str, str] = {
     "Spec": "stt_codegen.spec.loader",
@@ -67,8 +59,8 @@ _LAZY: dict[str, str] = {
     "SimulationResult": "stt_codegen.runtime.simulate",
     "plot_design": "stt_codegen.runtime.plots",
     "plot_run": "stt_codegen.runtime.plots",
-    "VerificationReport": "stt_codegen.verify.check",
-    "verify": "stt_codegen.verify.command",
+    "VerificationReport": "stt_codegen.proofs.check",
+    "verify": "stt_codegen.verification.command",
     "import_pointmaze": "stt_codegen.pointmaze",
 }
 
@@ -85,8 +77,8 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .pointmaze import import_pointmaze
     from .spec.loader import Spec, load_spec
     from .tube.parameters import TubeDesign
-    from .verify.check import VerificationReport
-    from .verify.command import verify
+    from .proofs.check import VerificationReport
+    from .verification.command import verify
 
 
 def __getattr__(name: str) -> Any:

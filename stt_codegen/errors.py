@@ -30,6 +30,17 @@ class SttError(Exception):
 
     Raise one of the three kinds below; a bare :class:`SttError` is treated as a
     :class:`ToolchainError` (an internal failure) by the command line.
+
+    Examples
+    --------
+    Catch every error the toolkit raises on purpose, whatever its kind:
+
+    >>> import stt_codegen as stt
+    >>> try:
+    ...     stt.load_spec("no-such-case")
+    ... except stt.SttError as error:
+    ...     print(type(error).__name__)
+    SpecError
     """
 
 
@@ -46,6 +57,19 @@ class SpecError(SttError, ValueError):
         ``""`` for the file as a whole.
     reason : str
         Why the value is rejected, in words.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> doc = {"name": "corridor", "prescribed_time": -5.0,
+    ...        "state_space": {"lower": [0.0, 0.0], "upper": [4.0, 1.0]},
+    ...        "initial": {"lower": [0.0, 0.0], "upper": [0.5, 1.0]},
+    ...        "target": {"lower": [3.5, 0.0], "upper": [4.0, 1.0]}}
+    >>> try:
+    ...     stt.Spec.from_dict(doc)
+    ... except stt.SpecError as error:
+    ...     print(error.field, "|", error.reason)
+    prescribed_time | must be positive, got -5.0
     """
 
     def __init__(self, field: str, reason: str) -> None:
@@ -71,6 +95,22 @@ class DesignError(SttError):
     tried : object, optional
         The best rejected tube (a ``TubeDesign``), for a plot of what was tried; ``None``
         where no tube was built.
+
+    Examples
+    --------
+    A corridor crossed in 10 ms: no tube moves that fast at 1 kHz. The kind says why
+    (:class:`~stt_codegen.design.failures.FailureKind`), the message how to change the spec:
+
+    >>> import stt_codegen as stt
+    >>> doc = {"name": "rushed", "prescribed_time": 0.01,
+    ...        "state_space": {"lower": [0.0, 0.0], "upper": [4.0, 1.0]},
+    ...        "initial": {"lower": [0.0, 0.0], "upper": [0.5, 1.0]},
+    ...        "target": {"lower": [3.5, 0.0], "upper": [4.0, 1.0]}}
+    >>> try:
+    ...     stt.design_tube(stt.Spec.from_dict(doc))
+    ... except stt.DesignError as error:
+    ...     print(error.kind.name, "|", "controller.rate_hz" in str(error))
+    SAMPLING_RATE | True
     """
 
     def __init__(self, message: str, *, kind: Any = None, tried: Any = None) -> None:
@@ -86,6 +126,19 @@ class ToolchainError(SttError):
     meeting output it does not expect. Neither the spec's fault nor a negative outcome.
     Command line: exit code 3. Subclasses: ``CodegenError``, ``EmitError``,
     ``BuildError``, ``MissingTool``, ``BenchError``, ...
+
+    Examples
+    --------
+    A tool that is not installed is a :class:`~stt_codegen.system.MissingTool`, which names
+    the Debian package:
+
+    >>> import stt_codegen as stt
+    >>> from stt_codegen.system import find_tool
+    >>> try:
+    ...     find_tool("no-such-compiler", package="gcc")
+    ... except stt.ToolchainError as error:
+    ...     print(error)
+    no-such-compiler not found; install the Debian package gcc (apt-get install -y gcc)
     """
 
 

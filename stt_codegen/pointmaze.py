@@ -266,6 +266,21 @@ def import_pointmaze(name: str, path: str | os.PathLike | None = None, *,
         gymnasium-robotics not installed, an unknown map (the message lists the names), a
         bad or walled ``start``/``goal``, cells not connected, a value the spec refuses,
         or an output folder that does not exist (the field names the argument).
+
+    Examples
+    --------
+    The bundled case ``pointmaze-umaze`` is the spec this function writes for ``"UMaze"``
+    (with the ``mujoco`` extra installed: ``stt.import_pointmaze("UMaze", "umaze.toml")``).
+    The map's name is checked first:
+
+    >>> import stt_codegen as stt
+    >>> stt.load_spec("pointmaze-umaze").dimension
+    2
+    >>> try:
+    ...     stt.import_pointmaze("NoSuchMaze")
+    ... except stt.SpecError as error:
+    ...     print(error.field)
+    name
     """
     from .spec.loader import Spec
     if name not in MAPS:

@@ -17,7 +17,7 @@ from conftest import arena_toml
 
 from stt_codegen.cli import main
 from stt_codegen.design.failures import FailureKind
-from stt_codegen.design.input_bound import input_peak, input_prover, phi
+from stt_codegen.design.input_bound import input_peak, phi
 from stt_codegen.design.search import design_tube
 from stt_codegen.design.samples import sample_tube
 from stt_codegen.errors import DesignError
@@ -25,9 +25,9 @@ from stt_codegen.runtime.simulate import run_closed_loop, simulate
 from stt_codegen.spec.loader import load_spec, parse_spec
 from stt_codegen.tube import reference as R
 from stt_codegen.tube.parameters import STATUS_INPUT_CLAMPED, STATUS_OK, STATUS_OUTSIDE_TUBE
-from stt_codegen.verify.actuator import sampled_error_bound
-from stt_codegen.verify.command import verify
-from stt_codegen.verify.sampled import check_sampled
+from stt_codegen.design.certificate.actuator import prove_input_bound, sampled_error_bound
+from stt_codegen.verification.command import verify
+from stt_codegen.design.certificate.sampled import check_sampled
 
 SPECS = Path(__file__).parent / "specs"
 ROBOT = SPECS / "actuator-s1.toml"
@@ -110,13 +110,13 @@ def test_a_bound_the_default_design_exceeds_gets_a_slower_tube():
     spec, design = robot()
     bound = spec.input_bound
     default = papers_default(spec)
-    before = input_prover()(default.tube, spec)
+    before = prove_input_bound(default.tube, spec)
     assert before.proved and before.peak[1] > 4 * bound[1]          # v2 on O1's flank
     assert design.tube.input_bound == bound and design.input_proof.meets(bound)
     assert design.method == "via" and design.tube != default.tube
     # the accepted tube is the first slower one proved within the bound: its proof is the
     # prover's on that tube, and its margin is the room left by the worst input
-    assert design.input_proof == input_prover()(design.tube, spec)
+    assert design.input_proof == prove_input_bound(design.tube, spec)
     document = design.to_json()
     assert document["input_bound"] == list(bound)
     assert document["input_peak"]["peak"] == list(design.input_proof.peak)
@@ -136,7 +136,7 @@ def test_a_bound_smooth_step_via_points_exceed_gets_cruise_segments():
     smooth = design_tube(dataclasses.replace(free, tube=dataclasses.replace(
         free.tube, method="via")))
     assert {s.profile for s in smooth.tube.segments} == {"smoothstep"}
-    assert input_prover()(smooth.tube, spec).peak[0] > bound[0]
+    assert prove_input_bound(smooth.tube, spec).peak[0] > bound[0]
     design = design_tube(spec)
     assert design.method == "via" and design.certificate.passed
     assert {s.profile for s in design.tube.segments} == {"cruise"}
@@ -154,7 +154,7 @@ def test_softer_circumvents_keep_the_papers_tube():
     default = papers_default(spec)
     design = design_tube(spec)
     assert default.method == design.method == "paper"
-    assert input_prover()(default.tube, spec).peak[0] > 3 * spec.input_bound[0]
+    assert prove_input_bound(default.tube, spec).peak[0] > 3 * spec.input_bound[0]
     before = max(c.sharpness for c in default.tube.circumvents)
     after = {c.sharpness for c in design.tube.circumvents}
     assert len(after) == 1 and after.pop() > before

@@ -2,17 +2,21 @@
 
 from __future__ import annotations
 
+import hashlib
+import json
+import tomllib
+
 import numpy as np
 import pytest
 from conftest import arena_toml
 
-from stt_codegen.bench.arena_job import (closed_loop_failure, design_failure, run_arena)
-from stt_codegen.bench.arenas import (ARENA, OBSTACLE_SIZE, START_SIZE, TARGET, generate_arena,
-                                      generate_arenas)
-from stt_codegen.bench.astar import RESOLUTION, grid_graph, plan_astar
-from stt_codegen.bench.planning import MARGIN, FreeSpace
-from stt_codegen.bench.report import summarize
-from stt_codegen.bench.tracker import track
+from stt_codegen_bench.arena_job import (closed_loop_failure, design_failure, run_arena)
+from stt_codegen_bench.arenas import (ARENA, ARENA_KINDS, OBSTACLE_SIZE, START_SIZE, TARGET,
+                                      arena_spec, make_arena)
+from stt_codegen_bench.astar import RESOLUTION, grid_graph, plan_astar
+from stt_codegen_bench.planning import MARGIN, FreeSpace
+from stt_codegen_bench.report import summarize
+from stt_codegen_bench.tracker import track
 from stt_codegen.errors import SpecError
 from stt_codegen.spec.loader import load_spec, parse_spec
 
@@ -21,39 +25,71 @@ WALL_SPEC = arena_toml("wall", extra="[[obstacles]]\nlower = [2.0, 0.0]\nupper =
 
 
 def test_arenas_follow_the_protocol():
-    for arena in generate_arenas(20, 7):
-        s = arena.start
+    for k in range(20):
+        arena = arena_spec("paper", 7, k)
+        s = arena.initial_set
         assert np.allclose(np.subtract(s.upper, s.lower), START_SIZE)
         assert ARENA.contains_box(s) and not s.meets(TARGET)
+        assert np.allclose(arena.initial_state, s.center)
         assert len(arena.obstacles) == 4
-        for o in arena.obstacles:
+        for o in (ob.box(arena.state_space) for ob in arena.obstacles):
             assert np.allclose(np.subtract(o.upper, o.lower), OBSTACLE_SIZE)
             assert ARENA.contains_box(o) and not o.meets(s) and not o.meets(TARGET)
 
 
-def test_arenas_are_seeded_and_independent_of_count():
-    assert generate_arenas(5, 3)[4] == generate_arena(3, 4) == generate_arenas(9, 3)[4]
-    assert generate_arena(3, 4) != generate_arena(4, 4)
+#: sha256 (first 16 hex digits) of the spec documents (``tomllib``, as sorted JSON) of arenas
+#: 0-4 of seeds 0 and 3 of each kind (polygons: ``5 + i`` of them at tolerance ``0.02 + 0.01
+#: i``, ``i`` = 0, 1), computed from the six generators ``make_arena`` replaced
+#: (``generate_arena``, the moving study's, ``task_problem_toml``, ``office_doc`` for both
+#: bases, ``polygons_toml``): the benchmarks' figures in docs/ were measured on these arenas.
+FORMER_DIGESTS = {
+    "paper": "e34af5fce296d0ce",
+    "moving": "5092cb19f0ce6aee",
+    "tasks": "ac5ad0e1e2bd1e89",
+    "office-drive": "2e440d01ab96cb6b",
+    "office-holonomic": "cd2032757bb3486a",
+    "polygons": "469685e589ccbeec",
+}
+
+
+@pytest.mark.parametrize("kind", ARENA_KINDS)
+def test_each_kind_draws_the_arenas_of_the_former_generator(kind):
+    digest = hashlib.sha256()
+    for seed in (0, 3):
+        for i in range(2 if kind == "polygons" else 5):
+            text = (make_arena(kind, seed, polygons=5 + i, tolerance=0.02 + 0.01 * i)
+                    if kind == "polygons" else make_arena(kind, seed, i))
+            digest.update(json.dumps(tomllib.loads(text), sort_keys=True).encode())
+            assert parse_spec(text).name in text
+    assert digest.hexdigest()[:16] == FORMER_DIGESTS[kind]
+
+
+def test_arenas_are_seeded():
+    assert make_arena("paper", 3, 4) == make_arena("paper", 3, 4) != make_arena("paper", 4, 4)
+    assert make_arena("paper", 3, 4) != make_arena("paper", 3, 5)
 
 
 def test_arena_spec_files_load(tmp_path):
-    arena = generate_arena(0, 2)
-    path = tmp_path / f"{arena.name}.toml"
-    path.write_text(arena.to_toml())
+    path = tmp_path / "arena-0-2.toml"
+    path.write_text(make_arena("paper", 0, 2))
     spec = load_spec(str(path))
-    assert spec == arena.to_spec()
+    assert spec == arena_spec("paper", 0, 2) and spec.name == "arena-0-2"
     assert spec.plant_model == "single-integrator" and spec.tube.circumvent_sharpness == 0.1
     assert spec.prescribed_time == 9.0 and spec.dimension == 2
 
 
-@pytest.mark.parametrize("seed,count", [(-1, 1), (0, 0)])
-def test_bad_seed_or_count(seed, count):
-    with pytest.raises(SpecError):
-        generate_arenas(count, seed)
+@pytest.mark.parametrize("kind,seed,index,field", [
+    ("paper", -1, 0, "seed"), ("tasks", 0, -1, "index"), ("office-tank", 0, 0, "kind"),
+    ("polygons", 0, 1, "index"),
+])
+def test_bad_kind_seed_or_index(kind, seed, index, field):
+    with pytest.raises(SpecError) as exc:
+        make_arena(kind, seed, index)
+    assert exc.value.field == field
 
 
 def test_grid_edges_join_free_neighbours_without_cutting_corners():
-    space = FreeSpace.of(generate_arena(0, 1).to_spec())
+    space = FreeSpace.of(arena_spec("paper", 0, 1))
     graph, origin = grid_graph(space)
     nodes = set(graph.nodes)
     assert space.is_free(origin + RESOLUTION * np.array(sorted(nodes), float)).all()
@@ -67,7 +103,7 @@ def test_grid_edges_join_free_neighbours_without_cutting_corners():
 
 
 def test_astar_path_keeps_the_margin_and_is_tracked():
-    spec = generate_arena(0, 1).to_spec()
+    spec = arena_spec("paper", 0, 1)
     plan = plan_astar(spec)
     assert plan.reason == "" and plan.seconds > 0
     path = plan.path

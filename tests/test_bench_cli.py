@@ -7,9 +7,9 @@ import operator
 
 import pytest
 
-from stt_codegen.bench import arenas_bench, parallel
-from stt_codegen.bench.arena_job import METHODS
-from stt_codegen.bench.parallel import run_parallel
+from stt_codegen_bench import arenas_bench, parallel
+from stt_codegen_bench.arena_job import METHODS
+from stt_codegen_bench.parallel import run_parallel
 from stt_codegen.cli import main
 from stt_codegen.errors import SpecError
 

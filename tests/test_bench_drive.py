@@ -2,11 +2,17 @@
 
 from __future__ import annotations
 
+import tomllib
+
 import pytest
 
-from stt_codegen.bench.office_arenas import (CLEARANCE, START, TARGET, format_office_report,
-                                             office_doc, run_office_bench)
+from stt_codegen_bench.arenas import OFFICE_CLEARANCE, OFFICE_START, OFFICE_TARGET, make_arena
+from stt_codegen_bench.office_arenas import format_office_report, run_office_bench
 from stt_codegen.errors import SpecError
+
+
+def office_doc(seed, index, base):
+    return tomllib.loads(make_arena(f"office-{base}", seed, index))
 
 
 def test_offices_are_seeded_and_keep_start_and_target_free():
@@ -17,14 +23,15 @@ def test_offices_are_seeded_and_keep_start_and_target_free():
     assert holonomic["plant"]["model"] == "single-integrator"
     for k in range(20):
         for ob in office_doc(1, k, "drive")["obstacles"]:
-            for box in (START, TARGET):
-                apart = any(ob["lower"][i] >= box[1][i] + CLEARANCE
-                            or box[0][i] >= ob["upper"][i] + CLEARANCE for i in range(2))
+            for box in (OFFICE_START, OFFICE_TARGET):
+                apart = any(ob["lower"][i] >= box[1][i] + OFFICE_CLEARANCE
+                            or box[0][i] >= ob["upper"][i] + OFFICE_CLEARANCE
+                            for i in range(2))
                 assert apart, (k, ob)
 
 
-def test_a_bad_method_or_count_is_refused():
-    with pytest.raises(SpecError, match="method"):
+def test_a_bad_base_or_count_is_refused():
+    with pytest.raises(SpecError, match="kind"):
         office_doc(0, 0, "tank")
     with pytest.raises(SpecError, match="count"):
         run_office_bench(0, 0)

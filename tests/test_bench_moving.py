@@ -1,4 +1,4 @@
-"""Random moving obstacles for benchmarks (stt_codegen/bench/moving.py)."""
+"""Random moving obstacles for benchmarks (stt_codegen_bench/moving.py)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import stt_codegen as stt
-from stt_codegen.bench.arenas import generate_arena
-from stt_codegen.bench.moving import random_moving_obstacles
+from stt_codegen_bench.arenas import arena_spec, make_arena
+from stt_codegen_bench.moving import random_moving_obstacles
 from stt_codegen.spec.loader import Box
 
 
@@ -20,13 +20,12 @@ def _doc(arena_spec_toml: str) -> dict:
 
 @pytest.mark.parametrize("index", range(6))
 def test_entries_load_and_keep_clear_of_start_and_target(index):
-    arena = generate_arena(0, index)
-    spec = arena.to_spec()
+    spec = arena_spec("paper", 0, index)
     keep = Box((2.0, 2.0), (2.4, 2.4))
     entries = random_moving_obstacles(np.random.default_rng([7, index]), spec, count=4,
                                       keep_clear=[keep])
     assert 1 <= len(entries) <= 4
-    doc = _doc(arena.to_toml())
+    doc = _doc(make_arena("paper", 0, index))
     doc["obstacles"] = doc.get("obstacles", []) + entries
     loaded = stt.Spec.from_dict(doc)
     assert len(loaded.moving_obstacles) == len(entries)
@@ -36,7 +35,7 @@ def test_entries_load_and_keep_clear_of_start_and_target(index):
 
 
 def test_same_generator_same_entries_and_counts_in_range():
-    spec = generate_arena(0, 0).to_spec()
+    spec = arena_spec("paper", 0, 0)
     a = random_moving_obstacles(np.random.default_rng(3), spec)
     b = random_moving_obstacles(np.random.default_rng(3), spec)
     assert a == b
@@ -48,7 +47,7 @@ def test_same_generator_same_entries_and_counts_in_range():
 
 
 def test_bad_count_is_a_spec_error():
-    spec = generate_arena(0, 0).to_spec()
+    spec = arena_spec("paper", 0, 0)
     with pytest.raises(stt.SpecError) as err:
         random_moving_obstacles(np.random.default_rng(0), spec, count=5)
     assert err.value.field == "count"
@@ -56,7 +55,7 @@ def test_bad_count_is_a_spec_error():
 
 @pytest.mark.slow
 def test_the_study_reports_both_designs():
-    from stt_codegen.bench.moving_study import study_moving
+    from stt_codegen_bench.moving_study import study_moving
     result = study_moving(3, 0)
     assert result["arenas"] == 3 and result["moving_obstacles"] >= 1
     for name in ("stt", "swept_only"):

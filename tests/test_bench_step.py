@@ -7,9 +7,9 @@ import shutil
 
 import pytest
 
-from stt_codegen.bench.harness import build_harness, harness_source
-from stt_codegen.bench.scaling import format_scaling_report, run_scaling_bench, synthetic_design
-from stt_codegen.bench.step import format_step_report, run_step_bench
+from stt_codegen_bench.harness import build_harness, harness_source
+from stt_codegen_bench.scaling import format_scaling_report, run_scaling_bench, synthetic_design
+from stt_codegen_bench.step import format_step_report, run_step_bench
 from stt_codegen.cli import main
 from stt_codegen.errors import SpecError
 from stt_codegen.tube.model import build_model

@@ -15,11 +15,11 @@ from stt_codegen.errors import SpecError
 pytest.importorskip("stlpy", reason='stlpy is not installed: pip install ".[stl]"')
 pytest.importorskip("rtamt", reason='rtamt is not installed: pip install ".[stl]"')
 
-from stt_codegen.bench.stl_bench import (judge_positions, run_stl_bench,  # noqa: E402
+from stt_codegen_bench.stl_bench import (judge_positions, run_stl_bench,  # noqa: E402
                                          solve_with_stlpy)
-from stt_codegen.bench.stl_judge import (formula_text, robustness,  # noqa: E402
+from stt_codegen_bench.stl_judge import (formula_text, robustness,  # noqa: E402
                                          stlpy_robustness)
-from stt_codegen.bench.stl_scenarios import (SKIPPED, make_scenario,  # noqa: E402
+from stt_codegen_bench.stl_scenarios import (SKIPPED, make_scenario,  # noqa: E402
                                              scenario_names, scenario_spec, spec_toml,
                                              step_seconds)
 from stt_codegen.spec.loader import Spec  # noqa: E402

@@ -6,14 +6,17 @@ import json
 
 import pytest
 
-from stt_codegen.bench.alpha import RATE_FACTORS, format_alpha_report
-from stt_codegen.bench.covering import format_covering_report, polygons_toml
+from stt_codegen_bench.alpha import RATE_FACTORS, format_alpha_report
+from stt_codegen_bench.arenas import make_arena
+from stt_codegen_bench.covering import format_covering_report
 from stt_codegen.cli import main
 from stt_codegen.spec.loader import parse_spec
 from stt_codegen.tube.parameters import NEWTON_ITERATIONS
 
 
 def test_polygons_spec_is_seeded():
+    def polygons_toml(seed, count, tolerance):
+        return make_arena("polygons", seed, polygons=count, tolerance=tolerance)
     spec = parse_spec(polygons_toml(seed=3, count=4, tolerance=0.05))
     assert spec.name == "polygons-3-4" and len(spec.unsafe_sets) == 4
     assert {u.kind for u in spec.unsafe_sets} == {"polytope"}

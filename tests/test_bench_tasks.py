@@ -8,22 +8,22 @@ import math
 import numpy as np
 import pytest
 
-from stt_codegen.bench.task_arenas import task_problem, task_problem_toml
-from stt_codegen.bench.task_baseline import plan_timed
-from stt_codegen.bench.task_timing import MARGIN, departure, gap, positions
+from stt_codegen_bench.arenas import arena_spec, make_arena
+from stt_codegen_bench.task_baseline import plan_timed
+from stt_codegen_bench.task_timing import MARGIN, departure, gap, positions
 from stt_codegen.spec.loader import parse_spec
 from stt_codegen.spec.motion import MovingObstacle
-from stt_codegen.bench.tasks_bench import METHODS, run_tasks_bench
+from stt_codegen_bench.tasks_bench import METHODS, run_tasks_bench
 from stt_codegen.cli import main
 from stt_codegen.errors import SpecError
 
 
 def test_problems_are_seeded_and_follow_the_protocol():
-    assert task_problem_toml(0, 3) == task_problem_toml(0, 3)
-    assert task_problem_toml(0, 3) != task_problem_toml(1, 3)
+    assert make_arena("tasks", 0, 3) == make_arena("tasks", 0, 3)
+    assert make_arena("tasks", 0, 3) != make_arena("tasks", 1, 3)
     counts = set()
     for k in range(12):
-        spec = task_problem(0, k)
+        spec = arena_spec("tasks", 0, k)
         m = len(spec.tasks)
         counts.add(m)
         assert m in (2, 3) and spec.prescribed_time == 4.0 * (m + 1)
@@ -36,7 +36,7 @@ def test_problems_are_seeded_and_follow_the_protocol():
 def test_problems_draw_zero_to_four_moving_obstacles_clear_of_start_target_and_tasks():
     counts = []
     for k in range(12):
-        spec = task_problem(0, k)
+        spec = arena_spec("tasks", 0, k)
         counts.append(len(spec.moving_obstacles))
         assert len(spec.obstacles) == 4           # the arena's static boxes, unchanged
         keep = [spec.initial_set, spec.target_set] + [b for t in spec.tasks for b in t.boxes]
@@ -50,8 +50,8 @@ def test_problems_draw_zero_to_four_moving_obstacles_clear_of_start_target_and_t
 def test_moving_obstacles_come_after_the_task_boxes_in_the_stream():
     """The moving obstacles are drawn after the tasks: the text before them is the
     problem without moving obstacles, whatever they are."""
-    text = task_problem_toml(0, 1)
-    spec = task_problem(0, 1)
+    text = make_arena("tasks", 0, 1)
+    spec = arena_spec("tasks", 0, 1)
     assert spec.moving_obstacles
     head = text[:text.index("\n[[obstacles]]\nlower", text.index("[[tasks]]"))]
     assert [t.boxes for t in parse_spec(head).tasks] == \
@@ -59,7 +59,7 @@ def test_moving_obstacles_come_after_the_task_boxes_in_the_stream():
 
 
 def test_baseline_plans_one_leg_per_task_and_one_to_the_target():
-    spec = task_problem(0, 3)
+    spec = arena_spec("tasks", 0, 3)
     assert not spec.moving_obstacles
     plan = plan_timed(spec)
     assert plan.reason == "" and len(plan.legs) == len(spec.tasks) + 1
@@ -127,5 +127,5 @@ def test_report_counts_what_the_problems_say():
         p["index"] for p in report["problems"]
         if p["methods"]["astar"]["satisfied"] and not p["methods"]["stt"]["satisfied"]]
     assert [p["moving"] for p in report["problems"]] == [
-        len(task_problem(0, k).moving_obstacles) for k in (0, 1)]
+        len(arena_spec("tasks", 0, k).moving_obstacles) for k in (0, 1)]
     assert report["with_moving"] == sum(p["moving"] > 0 for p in report["problems"])

@@ -1,4 +1,4 @@
-"""The adversary of the sampled cascade (verify/cascade_adversary.py): it breaks what the
+"""The adversary of the sampled cascade (design/certificate/cascade_adversary.py): it breaks what the
 certificate refuses, and never what it proves (docs/second-order.md, "The adversary")."""
 
 from __future__ import annotations
@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import stt_codegen as stt
-from stt_codegen.bench.second_order_study import random_parameters, run_second_order_study
-from stt_codegen.verify.cascade_adversary import STRATEGIES, search_cascade
-from stt_codegen.verify.cascade_sampled import cascade_class, certify_stage
+from stt_codegen_bench.second_order_study import random_parameters, run_second_order_study
+from stt_codegen.design.certificate.cascade_adversary import STRATEGIES, search_cascade
+from stt_codegen.design.certificate.cascade_sampled import cascade_class, certify_stage
 
 
 @pytest.fixture(scope="module")

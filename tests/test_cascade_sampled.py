@@ -1,4 +1,4 @@
-"""The sampled cascade's certificate (stt_codegen/verify/cascade_sampled.py,
+"""The sampled cascade's certificate (stt_codegen/design/certificate/cascade_sampled.py,
 docs/second-order.md, "The sampled cascade (certificate)"): what it accepts stays in both
 tubes under plants at the corners of the class and an adversary switching between them;
 what it refuses includes the U-maze at 100 Hz, which diverged."""
@@ -16,7 +16,7 @@ from stt_codegen.design.cascade_gain import derived_second_stage
 from stt_codegen.design.failures import FailureKind
 from stt_codegen.errors import DesignError
 from stt_codegen.tube import cascade_reference, reference
-from stt_codegen.verify.cascade_sampled import cascade_check_of, cascade_class
+from stt_codegen.design.certificate.cascade_sampled import cascade_check_of, cascade_class
 
 UMAZE = pathlib.Path(__file__).parent / "specs" / "umaze-cascade.toml"
 
@@ -165,8 +165,8 @@ def test_the_bounds_of_the_change_of_r_hold_on_random_steps() -> None:
     change of ``r = -(2 k1 / half) phi(e1)`` on seeded random steps consistent with their
     premises (the tube's centre and half-width at both ends, ``x1`` moved by ``h (r_k +
     z) + delta``)."""
-    from stt_codegen.verify.cascade_sampled import step_velocity_change, virtual_velocity_change
-    from stt_codegen.verify.sampled_axis import phi_scalar
+    from stt_codegen.design.certificate.cascade_sampled import step_velocity_change, virtual_velocity_change
+    from stt_codegen.design.certificate.sampled_axis import phi_scalar
     rng = np.random.default_rng(7)
     worst_step = worst_path = 0.0
     for _ in range(3000):
@@ -204,7 +204,7 @@ def test_the_bounds_of_the_change_of_r_hold_on_random_steps() -> None:
 
 
 def test_the_spec_s_own_plant_is_checked_against_the_class() -> None:
-    from stt_codegen.verify.cascade import plant_within_class_check
+    from stt_codegen.verification.cascade import plant_within_class_check
     for name in ("second-order-s1", "second-order-quadrotor", str(UMAZE)):
         check = plant_within_class_check(stt.load_spec(name))
         assert check.passed, check.detail

@@ -210,8 +210,8 @@ def test_reach_tube_is_the_plain_segment_by_segment_one(profiles, fast_math):
     """reach_tube (each point with its own segment's start and end in one evaluation, the
     bounds' arrays built once) gives the plain segment-by-segment numbers to the bit, with
     and without the rates, for one profile and for mixed ones."""
-    from stt_codegen.bench.arenas import generate_arena
-    spec = generate_arena(0, 11).to_spec()
+    from stt_codegen_bench.arenas import arena_spec
+    spec = arena_spec("paper", 0, 11)
     via = via_design(spec, base_design(spec))
     assert len(via.segments) >= 3
     segments = tuple(dataclasses.replace(seg, profile=profiles[k % len(profiles)])

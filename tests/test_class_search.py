@@ -1,4 +1,4 @@
-"""The class search (verify/class_search.py): members of a plant class that leave the tube.
+"""The class search (verification/class_search.py): members of a plant class that leave the tube.
 
 A counterexample is a plant of the class under the sampled law (13): its gains are members
 of the class, its push within the bound, and the deployed controller (the generated
@@ -14,12 +14,12 @@ import numpy as np
 import pytest
 from conftest import designed
 
-from stt_codegen.bench import plants_study
-from stt_codegen.verify.class_search import class_matrices, replay, search_class, within_class
+from stt_codegen_bench import plants_study
+from stt_codegen.verification.class_search import class_matrices, replay, search_class, within_class
 from stt_codegen.design.samples import sample_tube
 from stt_codegen.spec.assumptions import Assumptions
-from stt_codegen.verify.plant_class import PlantClass
-from stt_codegen.verify.sampled import check_sampled
+from stt_codegen.design.certificate.plant_class import PlantClass
+from stt_codegen.design.certificate.sampled import check_sampled
 
 _SAMPLES: dict = {}
 

@@ -194,7 +194,7 @@ def test_strict_build_for_cortex_m4(precision, tmp_path):
 @pytest.mark.parametrize("obstacles", [0, 1, 6])
 def test_strict_build_for_any_number_of_circumvents(obstacles, tmp_path):
     """No circumvent, one per bound, several per bound: strict build and self-test."""
-    from stt_codegen.bench.scaling import synthetic_design
+    from stt_codegen_bench.scaling import synthetic_design
     from stt_codegen.codegen.generate import generate_files
     from stt_codegen.codegen.options import Options
 

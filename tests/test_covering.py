@@ -300,10 +300,10 @@ def test_eighty_polygons_design_with_bounded_work(monkeypatch):
     polygons does no linear or quadratic program and its bounded count of hulls and
     distances, and the certificate stays within its interval budget.
     ``stt-codegen bench covering`` gives the seconds of this very spec."""
-    from stt_codegen.bench.covering import polygons_toml
+    from stt_codegen_bench.arenas import make_arena
     from stt_codegen.design.certificate import MAX_INTERVALS
     work = count_covering_work(monkeypatch)
-    spec = parse_spec(polygons_toml(seed=0, count=80, tolerance=0.02))
+    spec = parse_spec(make_arena("polygons", 0, polygons=80, tolerance=0.02))
     assert len(work["hulls"]) == 80
     assert_bounded_work(work)
     found = design_tube(spec)

@@ -136,10 +136,10 @@ def test_a_start_at_the_tube_edge_is_rejected():
     """Random arena 233: its first candidate's window opens before t = 0, so x(0) starts at
     the edge of the narrowed tube; deployed, the first input was 1e8 and the state left the
     arena in one period. The check refuses it, and the search finds another design."""
-    from stt_codegen.bench.arenas import generate_arena
+    from stt_codegen_bench.arenas import arena_spec
     from stt_codegen.design.search import MAX_INITIAL_ERROR
     from stt_codegen.design.windows import candidates
-    spec = generate_arena(0, 233).to_spec()
+    spec = arena_spec("paper", 0, 233)
     base = base_design(spec)
     first = candidates(base, spec, 1, spec.tube.delta_b)[0]
     assert first.start < 0
@@ -158,9 +158,9 @@ def test_the_gain_comes_from_the_tubes_width_not_from_a_loose_enclosure():
     past it (the only arena A* satisfied and the toolkit did not); from the sharpened
     bound the loop is satisfied (the paper's method; ``auto`` now reaches via points first
     on this arena, within its work budget)."""
-    from stt_codegen.bench.arenas import generate_arena
+    from stt_codegen_bench.arenas import arena_spec
     from stt_codegen.runtime.simulate import simulate
-    spec = generate_arena(0, 178).to_spec()
+    spec = arena_spec("paper", 0, 178)
     spec = dataclasses.replace(spec, tube=dataclasses.replace(spec.tube, method="paper"))
     found = design_tube(spec)
     assert found.method == "paper"

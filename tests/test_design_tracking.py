@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 
-from stt_codegen.bench.arenas import generate_arena
+from stt_codegen_bench.arenas import arena_spec
 from stt_codegen.design.gain import derived_gain
 from stt_codegen.design.search import base_design, design_tube, paper_design
 from stt_codegen.design.tracking import (SMOOTHER_RATIO, TRACKING_ERROR, centre_speed,
@@ -48,7 +48,7 @@ def test_bundled_cases_keep_the_papers_tube(case):
 
 
 @pytest.mark.slow          # about 20 s a case: closed loops of the reference
-@pytest.mark.parametrize("spec", [generate_arena(0, 7).to_spec(),
+@pytest.mark.parametrize("spec", [arena_spec("paper", 0, 7),
                                   load_spec(SPECS / "shifted-arena-1e6.toml")],
                          ids=["arena-0-7", "shifted-arena-1e6"])
 def test_a_tube_the_gain_cannot_follow_gives_way_to_via_points(spec):
@@ -83,7 +83,7 @@ def test_the_paper_method_searches_past_a_tube_the_gain_cannot_follow():
     """Arena 7 of seed 0, ``tube.method = "paper"``: the first certified tube is proved only
     to |e| <= 0.94 (its state rode at 0.93); the search goes on to a tube whose proof gives
     at most 0.7, and the closed loop stays there."""
-    spec = _method(generate_arena(0, 7).to_spec(), "paper")
+    spec = _method(arena_spec("paper", 0, 7), "paper")
     first, check = _papers_first_tube(spec)
     assert proved_error(first, spec) > TRACKING_ERROR
     assert "is proved only to |e|" in unfollowable(first, check.certificate, spec)
@@ -96,7 +96,7 @@ def test_the_paper_method_searches_past_a_tube_the_gain_cannot_follow():
 def test_the_paper_method_refuses_when_every_tube_is_one_the_gain_cannot_follow():
     """Arena 49 of seed 0: every certified choice of circumvents within the budget is proved
     only beyond |e| = 0.7 (the first one's state rode at 0.7-0.8): refused, naming it."""
-    spec = _method(generate_arena(0, 49).to_spec(), "paper")
+    spec = _method(arena_spec("paper", 0, 49), "paper")
     first, _ = _papers_first_tube(spec)
     assert proved_error(first, spec) > TRACKING_ERROR
     with pytest.raises(DesignError, match=r"is proved only to \|e\| <= 0\.7\d\d"):
@@ -108,7 +108,7 @@ def test_auto_prefers_the_smoother_via_tube_to_fast_circumvents(index):
     """Arenas 5 and 10 of seed 0: the paper's tube passes with circumvents whose flanks move
     the centre at 3.5 and 13 m/s; the via tube's centre moves at most 0.9 m/s, and auto takes
     it."""
-    spec = generate_arena(0, index).to_spec()
+    spec = arena_spec("paper", 0, index)
     paper = design_tube(_method(spec, "paper"))
     via = design_tube(_method(spec, "via"))
     assert paper.tube.circumvents
@@ -121,7 +121,7 @@ def test_auto_prefers_the_smoother_via_tube_to_fast_circumvents(index):
 def test_auto_keeps_circumvents_that_are_no_faster_than_via_points():
     """Arena 28 of seed 0: one slow circumvent (centre at 0.77 m/s, via 0.78 m/s): auto
     keeps the paper's tube."""
-    spec = generate_arena(0, 28).to_spec()
+    spec = arena_spec("paper", 0, 28)
     paper = design_tube(_method(spec, "paper"))
     via = design_tube(_method(spec, "via"))
     assert paper.tube.circumvents

@@ -21,7 +21,7 @@ from stt_codegen.runtime.compiled import build_shared
 from stt_codegen.runtime.differential_drive import base_rhs
 from stt_codegen.tube import look_ahead_reference
 from stt_codegen.tube.look_ahead import LookAhead, look_ahead_step
-from stt_codegen.verify import look_ahead as verify_look_ahead
+from stt_codegen.proofs import look_ahead as verify_look_ahead
 
 SPEC = Path(__file__).parent / "specs" / "office-drive.toml"
 

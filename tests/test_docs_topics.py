@@ -16,6 +16,9 @@ LONG_PARAGRAPH = 200
 #: Two pages sharing this many sentences of at least LONG_SENTENCE characters repeat a topic.
 SHARED_SENTENCES = 2
 LONG_SENTENCE = 40
+#: Words that narrate history, which belongs in CHANGELOG.md ("is used to" is not history).
+HISTORY = re.compile(r"\b(?:former(?:ly)?|before this change|no longer|previously|"
+                     r"(?<!\bis )(?<!\bare )(?<!\bbe )(?<!\bbeen )used to)\b", re.I)
 
 
 def pages(root: Path) -> list[Path]:
@@ -65,6 +68,18 @@ def repeated(root: Path) -> list[str]:
     return found
 
 
+def history(root: Path) -> list[str]:
+    """The phrases of :data:`HISTORY` in the prose of docs/ (outside code blocks and code
+    spans, which may quote a message), with the page and the text around them."""
+    found = []
+    for path in pages(root):
+        text = re.sub(r"^```.*?^```[ \t]*$", "", path.read_text(), flags=re.S | re.M)
+        text = " ".join(re.sub(r"`[^`]*`", "code", text).split())
+        found += [f"{path.name}: ...{text[max(m.start() - 40, 0):m.end() + 20]}..."
+                  for m in HISTORY.finditer(text)]
+    return found
+
+
 def readme_map(root: Path) -> list[str]:
     """The link targets of the README's "Documentation" section, in order."""
     readme = (root / "README.md").read_text()
@@ -78,6 +93,22 @@ def test_no_issue_numbers_outside_the_changelog():
 
 def test_no_paragraph_is_written_twice_in_docs():
     assert repeated(REPO) == []
+
+
+def test_no_history_in_docs():
+    """The docs say what is, and why; what changed and when is CHANGELOG.md's."""
+    assert history(REPO) == []
+
+
+def test_the_history_check_sees_what_it_forbids(tmp_path):
+    (tmp_path / "docs").mkdir()
+    (tmp_path / "docs" / "a.md").write_text(
+        "# A\n\nThe bound is used to derive k. The check `no longer fits` is quoted.\n\n"
+        "The step formerly took\nno longer than 2 us; Newton used to stop.\n\n"
+        "```\npreviously, in a block\n```\n")
+    found = history(tmp_path)
+    assert len(found) == 3
+    assert all(word in f for word, f in zip(["formerly", "no longer", "used to"], found))
 
 
 def test_every_page_is_on_the_readmes_map_once():

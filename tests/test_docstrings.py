@@ -1,23 +1,31 @@
-"""Every module declares its public names in ``__all__``, and every public function and class
-has a numpydoc docstring that documents its arguments and its result (in the manner of
-python-control's ``control/tests/docstrings_test.py``).
+"""The public surface a newcomer reads is documented in full, with examples that run; every
+other name has at least a one-line docstring (in the manner of python-control's
+``control/tests/docstrings_test.py``).
+
+The public surface (:data:`PUBLIC_SURFACE`) is the front door, ``stt_codegen.__all__``, and
+the documented extension points (:data:`EXTENSION_POINTS`). Every other name in a module's
+``__all__`` is internal: ``__all__`` is the list of names other modules of the package may
+import, not a promise to users (docs/architecture.md, "Public and internal names").
 
 Rules, checked per module with numpydoc's own parser:
 
 - ``__all__`` is a list of distinct strings, each defined in the module, and it names every
-  name that another module of the package imports from this one (the names used across
-  modules are the public ones; ``test_code_structure.py`` forbids private names across
-  modules).
-- A public function (one in ``__all__`` and defined in the module, not re-exported) has a
-  docstring; its ``Parameters`` section names every parameter (``self``/``cls`` excluded,
-  ``*args``/``**kwargs`` as such) and no parameter that does not exist; unless it is
-  annotated to return ``None`` it has a ``Returns`` (or ``Yields``) section.
-- A public class has a docstring covering its constructor's arguments: ``Parameters`` for a
+  name that another module of the package imports from this one (``test_code_structure.py``
+  forbids private names across modules).
+- A function or class of the public surface has a numpydoc docstring with an ``Examples``
+  section, run as a doctest (:func:`test_examples_run`, in a process and a scratch folder of
+  their own; bundled cases only, nothing slow). A function's ``Parameters`` section names every parameter
+  (``self``/``cls`` excluded, ``*args``/``**kwargs`` as such) and no parameter that does not
+  exist; unless it is annotated to return ``None`` it has a ``Returns`` (or ``Yields``)
+  section. A class's docstring covers its constructor's arguments: ``Parameters`` for a
   class with its own ``__init__``; for a data class (dataclass, NamedTuple, pydantic model),
   whose constructor arguments are its fields, ``Attributes`` (the project's style for
-  records) or ``Parameters``; a pydantic field with a ``description`` is documented by it (the
-  JSON schema's one source). A constructor inherited from outside the package (``Exception``,
-  ``object``) and enumerations have nothing to document.
+  records) or ``Parameters``; a pydantic field with a ``description`` is documented by it
+  (the JSON schema's one source). A constructor inherited from outside the package
+  (``Exception``, ``object``) and enumerations have nothing to document.
+- An internal function or class (one in ``__all__``, defined in the module) has a docstring
+  whose first line says what it is; the sections are optional, but a ``Parameters`` section
+  that is there names every parameter and no other (a stale one is worse than none).
 
 Methods are not checked. The test ids are the module names, so ``-k stt_codegen.spec`` runs
 one package.
@@ -32,6 +40,8 @@ import functools
 import importlib
 import inspect
 import pkgutil
+import subprocess
+import sys
 import textwrap
 import typing
 import warnings
@@ -58,6 +68,36 @@ def _module_names() -> list[str]:
 
 
 MODULES = _module_names()
+
+#: The documented extension points, ``"module:name"``, beside the front door: the spec and
+#: the design (also front-door names), the backend registry, the code printer of
+#: ``codegen/emit/``. The variant registry joins this list when it exists.
+EXTENSION_POINTS = [
+    "stt_codegen.spec.loader:Spec",
+    "stt_codegen.design.result:Design",
+    "stt_codegen.runtime.backends:register_backend",
+    "stt_codegen.runtime.backends:make_controller",
+    "stt_codegen.runtime.backends:backend_names",
+    "stt_codegen.codegen.emit.printer:InstructionPrinter",
+]
+
+
+def _public_surface() -> set[tuple[str, str]]:
+    """``(module, name)`` of the front door's names (where they are defined) and of
+    :data:`EXTENSION_POINTS`."""
+    surface = set()
+    for name in stt_codegen.__all__:
+        obj = getattr(stt_codegen, name)
+        if callable(obj):
+            surface.add((obj.__module__, name))
+    for point in EXTENSION_POINTS:
+        module, name = point.split(":")
+        surface.add((module, name))
+    return surface
+
+
+#: The public surface: every function and class a newcomer is shown (module notes).
+PUBLIC_SURFACE = sorted(_public_surface())
 
 
 def _module_path(name: str) -> Path:
@@ -174,11 +214,24 @@ def _returns_value(function) -> bool:
     return visit(body)
 
 
-def _function_problems(name: str, function) -> list[str]:
+def _first_line(name: str, doc: str | None) -> list[str]:
+    """The problem of a docstring without a first line saying what the name is."""
+    if not doc or not doc.strip().splitlines()[0].strip():
+        return [f"{name}: no docstring"]
+    return []
+
+
+def _examples(name: str, parsed: NumpyDocString) -> list[str]:
+    if not any(">>>" in line for line in parsed["Examples"]):
+        return [f"{name}: public, but no Examples section with a doctest (>>>)"]
+    return []
+
+
+def _function_problems(name: str, function, public: bool = True) -> list[str]:
     target = inspect.unwrap(function)
     doc = inspect.getdoc(target)
-    if not doc:
-        return [f"{name}: no docstring"]
+    if _first_line(name, doc):
+        return _first_line(name, doc)
     try:
         parsed = _parse(doc)
     except (UserWarning, ValueError) as error:
@@ -186,13 +239,15 @@ def _function_problems(name: str, function) -> list[str]:
     problems = []
     names = _parameter_names(inspect.signature(target, eval_str=False))
     missing, extra = _matches(names, _documented(parsed["Parameters"]))
-    if missing:
+    if missing and (public or parsed["Parameters"]):
         problems.append(f"{name}: Parameters does not document {missing}")
     if extra:
         problems.append(f"{name}: Parameters documents {extra}, which are no parameters")
+    if not public:
+        return problems
     if _returns_value(target) and not (parsed["Returns"] or parsed["Yields"]):
         problems.append(f"{name}: returns a value but has no Returns (or Yields) section")
-    return problems
+    return problems + _examples(name, parsed)
 
 
 def _is_data_class(cls: type) -> bool:
@@ -218,16 +273,18 @@ def _own_constructor(cls: type) -> bool:
     return False
 
 
-def _class_problems(name: str, cls: type) -> list[str]:
+def _class_problems(name: str, cls: type, public: bool = True) -> list[str]:
     doc = inspect.getdoc(cls) if cls.__doc__ else None
-    if not doc:
-        return [f"{name}: no docstring"]
+    if _first_line(name, doc):
+        return _first_line(name, doc)
     try:
         parsed = _parse(doc)
     except (UserWarning, ValueError) as error:
         return [f"{name}: numpydoc cannot parse the docstring: {error}"]
-    if issubclass(cls, enum.Enum) or getattr(cls, "_is_protocol", False):
+    if not public:
         return []
+    if issubclass(cls, enum.Enum) or getattr(cls, "_is_protocol", False):
+        return _examples(name, parsed)
     parameters = _documented(parsed["Parameters"])
     if _is_data_class(cls):
         fields, described = _data_fields(cls)
@@ -240,13 +297,13 @@ def _class_problems(name: str, cls: type) -> list[str]:
         missing, extra = _matches(names, parameters)
         section = "Parameters"
     else:
-        return []
+        return _examples(name, parsed)
     problems = []
     if missing:
         problems.append(f"{name}: {section} does not document the constructor's {missing}")
     if extra:
         problems.append(f"{name}: Parameters documents {extra}, which are no arguments")
-    return problems
+    return problems + _examples(name, parsed)
 
 
 @pytest.mark.parametrize("module_name", MODULES)
@@ -268,14 +325,51 @@ def test_module_declares_all(module_name: str) -> None:
 
 
 @pytest.mark.parametrize("module_name", MODULES)
-def test_public_docstrings(module_name: str) -> None:
+def test_docstrings(module_name: str) -> None:
     problems = []
     for name, obj in _public_objects(module_name):
+        public = (module_name, name) in PUBLIC_SURFACE
         if inspect.isclass(obj):
-            problems += _class_problems(name, obj)
+            problems += _class_problems(name, obj, public)
         else:
-            problems += _function_problems(name, obj)
+            problems += _function_problems(name, obj, public)
     assert not problems, f"{module_name}:\n  " + "\n  ".join(problems)
+
+
+def test_the_public_surface_is_defined_where_listed():
+    """Each entry names a function or class its module defines and lists in ``__all__``."""
+    for module_name, name in PUBLIC_SURFACE:
+        module = importlib.import_module(module_name)
+        assert name in module.__all__, (module_name, name)
+        assert (name, getattr(module, name)) in _public_objects(module_name), (module_name, name)
+
+
+#: Runs the ``Examples`` of ``module:name`` arguments as doctests; prints the failures and
+#: the names without an example; exits 1 if any.
+_RUN_EXAMPLES = """
+import doctest, importlib, sys
+runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+finder = doctest.DocTestFinder(recurse=False)
+missing = []
+for entry in sys.argv[1:]:
+    module_name, name = entry.split(":")
+    obj = getattr(importlib.import_module(module_name), name)
+    tests = [t for t in finder.find(obj, entry, globs={}) if t.examples]
+    missing += [] if tests else [entry]
+    for test in tests:
+        runner.run(test)
+print("without examples:", missing)
+sys.exit(1 if runner.summarize(verbose=False).failed or missing else 0)
+"""
+
+
+def test_examples_run(tmp_path):
+    """The ``Examples`` of every public name run as doctests, in one process of their own
+    (an example may register a backend or write a file) in a scratch folder."""
+    entries = [f"{module}:{name}" for module, name in PUBLIC_SURFACE]
+    done = subprocess.run([sys.executable, "-c", _RUN_EXAMPLES, *entries], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=1800)
+    assert done.returncode == 0, done.stdout[-8000:] + done.stderr[-2000:]
 
 
 # The checker itself: each rule catches what it should.
@@ -365,8 +459,57 @@ class _Plain(Exception):
     """An error with the inherited constructor."""
 
 
+def _sample_with_example(a: int) -> int:
+    """Twice ``a``.
+
+    Parameters
+    ----------
+    a : int
+        First.
+
+    Returns
+    -------
+    int
+        ``2 a``.
+
+    Examples
+    --------
+    >>> _sample_with_example(2)
+    4
+    """
+    return 2 * a
+
+
+def _internal(a: int) -> int:
+    """Twice ``a`` (internal: one line is enough)."""
+    return 2 * a
+
+
+def _no_docstring(a: int) -> int:
+    return 2 * a
+
+
 def test_the_checker_accepts_a_complete_docstring():
-    assert _function_problems("_sample", _sample) == []
+    assert _function_problems("_sample_with_example", _sample_with_example) == []
+    assert _function_problems("_sample", _sample, public=False) == []
+
+
+def test_the_checker_requires_examples_of_a_public_name_only():
+    assert any("Examples" in p for p in _function_problems("_sample", _sample))
+    assert any("Examples" in p for p in _class_problems("_Plain", _Plain))
+    assert _function_problems("_internal", _internal, public=False) == []
+    assert _class_problems("_Plain", _Plain, public=False) == []
+
+
+def test_the_checker_requires_a_docstring_of_an_internal_name():
+    assert _function_problems("_no_docstring", _no_docstring, public=False) == \
+        ["_no_docstring: no docstring"]
+    assert _function_problems("_no_docstring", _no_docstring) == ["_no_docstring: no docstring"]
+
+
+def test_the_checker_finds_a_stale_parameters_section_of_an_internal_name():
+    problems = _function_problems("_undocumented", _undocumented, public=False)
+    assert any("['c']" in p for p in problems) and any("ghost" in p for p in problems)
 
 
 def test_the_checker_finds_missing_and_extra_parameters():
@@ -385,7 +528,7 @@ def test_the_checker_covers_constructors(monkeypatch):
     monkeypatch.setattr(_WithInit, "__module__", f"{PACKAGE}.sample")
     assert any("['y']" in p for p in _class_problems("_Record", _Record))
     assert any("['q']" in p for p in _class_problems("_WithInit", _WithInit))
-    assert _class_problems("_Plain", _Plain) == []
+    assert _class_problems("_Plain", _Plain) == ["_Plain: public, but no Examples section with a doctest (>>>)"]
 
 
 def test_the_checker_refuses_an_unknown_section():

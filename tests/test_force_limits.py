@@ -22,8 +22,8 @@ from stt_codegen.design.cascade_gain import SHAPES, certified_stage
 from stt_codegen.design.failures import FailureKind
 from stt_codegen.errors import DesignError, SpecError
 from stt_codegen.spec.loader import parse_spec
-from stt_codegen.verify.cascade import cascade_input_bound_check
-from stt_codegen.verify.cascade_sampled import cascade_check_of
+from stt_codegen.verification.cascade import cascade_input_bound_check
+from stt_codegen.design.certificate.cascade_sampled import cascade_check_of
 
 UMAZE = Path(__file__).parent / "specs" / "umaze-cascade.toml"
 #: The cheap task's rate: its tube is certified there with one shape, (1.0, 5, 4).
@@ -241,7 +241,7 @@ def test_umaze_with_a_one_newton_bound_is_certified_within_it():
     tests/test_cascade_sampled.py) and the spec's own plant stay within it."""
     from test_cascade_sampled import adversary_run
 
-    from stt_codegen.verify.cascade_sampled import cascade_class
+    from stt_codegen.design.certificate.cascade_sampled import cascade_class
     design = stt.design_tube(umaze([1.0, 1.0]))
     stage, derivation = design.second_stage
     certificate = derivation["certificate"]

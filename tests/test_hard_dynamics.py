@@ -6,7 +6,7 @@ has eigenvalues in ``[g_min, g_max]`` with ``g_max <= 1`` (the default gain's as
 docs/decisions.md, decision 15) and a state-dependent skew part ``K`` of norm at most
 ``g_min / 2``,
 and ``|w_i| <= 0.2``, the sampled closed loop of every bundled case stays in the tube
-and satisfies the task. ``python -m stt_codegen.bench.plants_study`` is the larger study (wider
+and satisfies the task. ``python -m stt_codegen_bench.plants_study`` is the larger study (wider
 ranges, failures classified); its figures are in docs/guarantees.md. The properties run
 closed loops (slow tier); one plant at the edges of the assumption is in the fast tier.
 """
@@ -21,7 +21,7 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from conftest import CASES, designed
-from stt_codegen.bench.arenas import generate_arena
+from stt_codegen_bench.arenas import arena_spec
 from stt_codegen.design.search import design_tube
 from stt_codegen.errors import DesignError
 from stt_codegen.runtime.simulate import run_closed_loop, simulate
@@ -106,7 +106,7 @@ def test_unknown_plants_on_random_arenas(index, seed, f_amp, g_min, w_amp):
     Arenas without a certifiable design are the benchmark's subject (docs/performance.md),
     not this property's: they are skipped by ``assume``.
     """
-    spec = generate_arena(seed=0, index=index).to_spec()
+    spec = arena_spec("paper", 0, index)
     try:
         design = design_tube(spec)
     except DesignError:

@@ -72,7 +72,7 @@ def test_every_public_name_has_a_docstring():
     for name in ("generate", "simulate", "load_spec", "design_tube"):
         doc = getattr(stt_codegen, name).__doc__
         assert "Parameters\n" in doc and "Returns\n" in doc and "Raises\n" in doc, name
-    from stt_codegen.verify.command import verify
+    from stt_codegen.verification.command import verify
     assert "Parameters\n" in verify.__doc__ and "Examples\n" in verify.__doc__
     assert stt_codegen.Spec.from_dict.__doc__
 

@@ -126,7 +126,7 @@ def test_verify_says_not_the_checks_caution_only_about_a_member_of_the_declared_
     the tube, and ``verify`` says so; with ``input_gain_lipschitz = [0, 0, 1]`` the same
     verdict, but no member of that class is found, so the caution is not ruled out. Both
     times ``verify`` adds that the model's own ``g``, evaluated on the tube, passes."""
-    from stt_codegen.verify.command import verify_spec
+    from stt_codegen.verification.command import verify_spec
     wall = (Path(__file__).parent / "specs" / "wall-gap-s1.toml").read_text()
     declared = ("\n[assumptions]\ninput_gain = [0.362, 1]\ninput_gain_skew = 0.933\n"
                 "input_gain_coupling = 0.933\n")
@@ -159,7 +159,7 @@ def test_held_members_contract_where_alternating_them_grows():
     ``x3`` forbids the alternation (it moves ``g`` by 1.87 per sample)."""
     from stt_codegen import design_tube
     from stt_codegen.design.samples import sample_tube
-    from stt_codegen.verify.class_search import within_class
+    from stt_codegen.verification.class_search import within_class
     wall = (Path(__file__).parent / "specs" / "wall-gap-s1.toml").read_text()
     declared = ("\n[assumptions]\ninput_gain = [0.362, 1]\ninput_gain_skew = 0.933\n"
                 "input_gain_coupling = 0.933\n")

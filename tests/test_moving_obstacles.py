@@ -369,12 +369,8 @@ def test_going_around_one_moving_obstacle_and_timing_the_others():
     """Random arena 43 of seed 0 with its random moving obstacles (the moving-obstacle
     study): neither the static tube nor the swept regions give a tube; going around the
     swept region of some and timing the others does."""
-    from stt_codegen.bench.arenas import generate_arena
-    from stt_codegen.bench.moving import random_moving_obstacles
-    arena = generate_arena(0, 43)
-    doc = tomllib.loads(arena.to_toml())
-    doc["obstacles"] += random_moving_obstacles(np.random.default_rng([0, 43]), arena.to_spec())
-    spec = stt.Spec.from_dict(doc)
+    from stt_codegen_bench.arenas import arena_spec
+    spec = arena_spec("moving", 0, 43)
     assert not check_tube(stt.design_tube(static_part(spec)).tube, spec).passed
     swept, _ = swept_spec(spec)
     with pytest.raises(stt.DesignError):
@@ -490,8 +486,8 @@ def test_a_detour_around_where_a_moving_obstacle_crosses_the_tasks_plan():
     timing of its via boxes misses it, and the region it sweeps meets the start set (no
     swept design). Planning around the box it sweeps over 1 s either side of where the
     plan meets it, and timing that plan against it as it moves, gives a certified tube."""
-    from stt_codegen.bench.task_arenas import task_problem
-    spec = task_problem(2, 148)
+    from stt_codegen_bench.arenas import arena_spec
+    spec = arena_spec("tasks", 2, 148)
     assert len(spec.moving_obstacles) == 1 and swept_spec(spec)[0] is None
     planned = stt.design_tube(static_part(spec))
     assert not check_tube(planned.tube, spec).passed

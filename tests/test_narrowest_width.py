@@ -17,7 +17,7 @@ import pytest
 from conftest import CASES, designed
 
 from stt_codegen.rounding import round_down
-from stt_codegen.bench.arenas import generate_arena
+from stt_codegen_bench.arenas import arena_spec
 from stt_codegen.design.certificate import (certify_tube, enclose, piece_ranges,
                                             sequence_bounds)
 from stt_codegen.design.certificate.enclosures import width_lower_bound
@@ -90,7 +90,7 @@ def via_designs() -> tuple:
     out = []
     index = 0
     while len(out) < VIA_DESIGNS:
-        spec = generate_arena(20, index).to_spec()
+        spec = arena_spec("paper", 20, index)
         spec = dataclasses.replace(spec, tube=dataclasses.replace(spec.tube, method="via"))
         index += 1
         try:

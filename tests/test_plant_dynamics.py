@@ -18,7 +18,7 @@ from stt_codegen.embedded.programs import closed_loop_source
 from stt_codegen.runtime.dynamics import input_matrix, linear_rhs, plant_function
 from stt_codegen.runtime.plants import Disturbance, make_plant
 from stt_codegen.spec.loader import LinearPlant, load_spec
-from stt_codegen.verify.assumption import plant_input_matrix
+from stt_codegen.proofs.assumption import plant_input_matrix
 
 A = ((0.0, 1.0, 0.0), (-1.0, 0.0, 0.5), (0.0, 0.0, -0.25))
 G = ((2.0, 0.5, 0.0), (0.0, 1.0, 0.0), (0.1, 0.0, 1.0))

@@ -13,7 +13,7 @@ from stt_codegen.runtime.second_order_plants import ACCELERATIONS
 from stt_codegen.spec.model_bounds import BOX_BOUNDS
 from stt_codegen.spec.plants import (MODEL_KEYS, PLANT_MODELS, SECOND_ORDER_MODELS,
                                      MissingPlantBehaviour, model_behaviour, plant_entry)
-from stt_codegen.verify.assumption import ASSUMPTION2_CHECKS, assumption2_check
+from stt_codegen.proofs.assumption import ASSUMPTION2_CHECKS, assumption2_check
 
 
 def test_every_first_order_model_has_every_behaviour():

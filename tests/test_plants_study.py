@@ -1,5 +1,5 @@
 """The wide study (bench/plants_study.py) and its time-invariant adversary
-(verify/class_search.py): the study plants' own Lipschitz bounds, the adversary's member,
+(verification/class_search.py): the study plants' own Lipschitz bounds, the adversary's member,
 the table. docs/sampled-data.md, "The wide study, and how much a sound check can accept"."""
 
 from __future__ import annotations
@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from conftest import designed
 
-from stt_codegen.bench import plants_study
+from stt_codegen_bench import plants_study
 from stt_codegen.design.samples import sample_tube
 from stt_codegen.spec.assumptions import Assumptions
-from stt_codegen.verify.class_search import (class_matrices, fixed_directions, replay,
+from stt_codegen.verification.class_search import (class_matrices, fixed_directions, replay,
                                              search_time_invariant, unit_skew, within_class)
 
 PLANTS = [(case, i) for case in plants_study.CASES for i in (0, 1, 5)]

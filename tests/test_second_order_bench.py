@@ -7,7 +7,7 @@ import shutil
 import numpy as np
 import pytest
 
-from stt_codegen.bench.second_order_study import (DRAG_MAX, format_second_order_report,
+from stt_codegen_bench.second_order_study import (DRAG_MAX, format_second_order_report,
                                                   random_parameters, run_second_order_study)
 from stt_codegen.errors import SpecError
 
@@ -55,7 +55,7 @@ def test_small_study_counts_what_it_ran() -> None:
 @pytest.mark.slow
 @needs_cc
 def test_double_integrator_arena_runs_both_methods() -> None:
-    from stt_codegen.bench.second_order_arenas import run_arena_double_integrator
+    from stt_codegen_bench.second_order_arenas import run_arena_double_integrator
     out = run_arena_double_integrator(0, 0)
     assert out["stt"]["satisfied"] and out["stt"]["in_tube"]
     assert out["astar"]["satisfied"]

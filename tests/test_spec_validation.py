@@ -179,7 +179,7 @@ def test_plant_state_counts_come_from_the_one_registry():
     reason, by the loader, by the simulation's plant factory and by ``verify --plant``."""
     from stt_codegen.runtime.plants import make_plant
     from stt_codegen.spec.plants import PLANTS, dimension_mismatch
-    from stt_codegen.verify.command import verify
+    from stt_codegen.verification.command import verify
     fixed = [p for p in PLANTS.values() if p.states is not None]
     assert fixed and all(dimension_mismatch(p.name, p.states) is None for p in fixed)
     two_states = parse_spec(VALID)

@@ -124,7 +124,7 @@ def test_open_bump_sum_properties(nu):
 
 
 def test_open_bump_sum_is_proved_in_verify():
-    from stt_codegen.verify.lemma import check_open_bump_sum, lemma_checks
+    from stt_codegen.proofs.lemma import check_open_bump_sum, lemma_checks
     check = check_open_bump_sum()
     assert check.passed, check.detail
     assert "design.open_bump_sum" in [c.name for c in lemma_checks(orders=1)]
@@ -141,7 +141,7 @@ def test_cruise_profile_is_proved_c2_with_its_peak_rate_and_is_deployed_as_docum
 
     from stt_codegen.codegen.emit import sympy_expressions
     from stt_codegen.tube import pieces
-    from stt_codegen.verify.deployed import exact, on_domain
+    from stt_codegen.proofs.deployed import exact, on_domain
 
     a = sp.Symbol("a", positive=True)
     tau, x = sp.symbols("tau x", real=True)

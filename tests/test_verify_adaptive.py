@@ -1,4 +1,4 @@
-"""Adaptive law (11) (stt_codegen.verify.adaptive)."""
+"""Adaptive law (11) (stt_codegen.proofs.adaptive)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from stt_codegen.verify import (
+from stt_codegen.proofs import (
     adaptive_law_checks,
     adversarial_psi_signals,
     alpha_rate_bound,
@@ -16,7 +16,7 @@ from stt_codegen.verify import (
     check_adaptive_law_numeric,
     simulate_alpha,
 )
-from stt_codegen.verify.adaptive import theta, theta_zero_threshold
+from stt_codegen.proofs.adaptive import theta, theta_zero_threshold
 
 CASE = dict(theta0=0.01, kappa=5.0, mu=1.0)  # section V
 

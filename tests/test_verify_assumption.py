@@ -1,4 +1,4 @@
-"""Assumption 2 (stt_codegen.verify.assumption)."""
+"""Assumption 2 (stt_codegen.proofs.assumption)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 import sympy as sp
 from hypothesis import given, settings, strategies as st
 
-from stt_codegen.verify import (
+from stt_codegen.proofs import (
     assumption2_omnidirectional,
     assumption2_single_integrator,
     check_assumption2,

@@ -1,12 +1,12 @@
 """SymPy proofs of the cascade's second stage on the deployed expressions
-(stt_codegen/verify/cascade.py, docs/second-order.md)."""
+(stt_codegen/proofs/cascade.py, docs/second-order.md)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from stt_codegen.verify import cascade as V
+from stt_codegen.proofs import cascade as V
 
 
 def test_deployed_second_stage_equals_its_formulas_and_pushes_back() -> None:

@@ -15,7 +15,7 @@ from stt_codegen.design.search import design_tube
 from stt_codegen.errors import DesignError, SpecError
 from stt_codegen.spec.loader import parse_spec
 from stt_codegen.tube.parameters import Circumvent
-from stt_codegen.verify.command import verify_design, verify_spec
+from stt_codegen.verification.command import verify_design, verify_spec
 
 
 def run(*args: str) -> subprocess.CompletedProcess:

@@ -13,14 +13,14 @@ import pytest
 from conftest import CASES, designed
 from plants_helpers import plant_system, plant_within
 
-from stt_codegen.bench.plants_study import study_one
+from stt_codegen_bench.plants_study import study_one
 from stt_codegen.design.samples import sample_tube
 from stt_codegen.runtime.simulate import run_closed_loop
 from stt_codegen.spec.assumptions import Assumptions
 from stt_codegen.tube import reference
-from stt_codegen.verify.command import verify_design
-from stt_codegen.verify.plant_class import PlantClass, plant_class
-from stt_codegen.verify.sampled import check_sampled
+from stt_codegen.verification.command import verify_design
+from stt_codegen.design.certificate.plant_class import PlantClass, plant_class
+from stt_codegen.design.certificate.sampled import check_sampled
 
 _SAMPLES: dict = {}
 

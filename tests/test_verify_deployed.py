@@ -8,8 +8,8 @@ import pytest
 import sympy as sp
 
 from stt_codegen.tube import pieces
-from stt_codegen.verify import assumption, deployed, lemma, transform
-from stt_codegen.verify.adaptive import adaptive_law_checks
+from stt_codegen.proofs import assumption, deployed, lemma, transform
+from stt_codegen.proofs.adaptive import adaptive_law_checks
 
 
 def _clear() -> None:

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import stt_codegen as stt
 from stt_codegen.rounding import distinct
-from stt_codegen.verify.command import _deployed_alpha_check as deployed_alpha_check
+from stt_codegen.verification.command import _deployed_alpha_check as deployed_alpha_check
 
 SPECS = Path(__file__).parent / "specs"
 

@@ -1,4 +1,4 @@
-"""Lemma 3.3 pieces (stt_codegen.verify.lemma)."""
+"""Lemma 3.3 pieces (stt_codegen.proofs.lemma)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 import sympy as sp
 from hypothesis import given, settings, strategies as st
 
-from stt_codegen.verify import (
+from stt_codegen.proofs import (
     Check,
     bump_rate_bound,
     check_bump_flatness,
@@ -19,7 +19,7 @@ from stt_codegen.verify import (
     reach_rate_bound,
     reach_rate_constant,
 )
-from stt_codegen.verify.lemma import K, M, R, T, T_C, TARGET, X0
+from stt_codegen.proofs.lemma import K, M, R, T, T_C, TARGET, X0
 
 
 @pytest.fixture(scope="module")

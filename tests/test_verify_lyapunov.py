@@ -1,5 +1,5 @@
 """The Lyapunov level of the coupled sampled check, one sampling interval at a
-time: every bound of ``verify/lyapunov.py`` is compared with the exact step of plants of
+time: every bound of ``design/certificate/lyapunov.py`` is compared with the exact step of plants of
 the class, at many points of the ball (seeded: the same cases every run)."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from stt_codegen.verify.lyapunov import level_after, next_level, others_max, psi
-from stt_codegen.verify.sampled_axis import phi, phi_slope
+from stt_codegen.design.certificate.lyapunov import level_after, next_level, others_max, psi
+from stt_codegen.design.certificate.sampled_axis import phi, phi_slope
 
 CASES = 120
 

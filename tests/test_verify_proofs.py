@@ -1,4 +1,4 @@
-"""The proof cache of ``verify`` (stt_codegen.verify.proofs) and the ``verify`` function.
+"""The proof cache of ``verify`` (stt_codegen.proofs.design_independent) and the ``verify`` function.
 
 A cached run must give the report an uncached run gives; a corrupt or stale entry is
 ignored; a changed piece, proof module or library version misses the cache; every piece
@@ -19,9 +19,9 @@ import stt_codegen.cli.verify as verify_command_line
 from stt_codegen.design.search import design_tube
 from stt_codegen.spec.loader import load_spec
 from stt_codegen.tube import pieces
-from stt_codegen.verify import deployed, proofs
-from stt_codegen.verify.check import Check
-from stt_codegen.verify.command import verify
+from stt_codegen.proofs import deployed, design_independent as proofs
+from stt_codegen.proofs.check import Check
+from stt_codegen.verification.command import verify
 
 
 @pytest.fixture(autouse=True)
@@ -208,14 +208,17 @@ def test_every_printed_piece_is_in_the_key(monkeypatch):
         getattr(getattr(deployed, name), "cache_clear", lambda: None)()
 
 
-@pytest.mark.parametrize("first", ["import stt_codegen.verify.lemma", "import stt_codegen",
-                                   "from stt_codegen.verify import Check"])
+@pytest.mark.parametrize("first", ["import stt_codegen.proofs.lemma", "import stt_codegen",
+                                   "from stt_codegen.proofs import Check",
+                                   "import stt_codegen.verification.command"])
 def test_stt_codegen_verify_is_the_function_whatever_is_imported_first(first):
-    """The package ``stt_codegen/verify/`` never shadows the front door's function."""
-    code = (f"{first}\nimport stt_codegen, stt_codegen.verify.proofs\n"
-            "from stt_codegen.verify.command import verify\n"
+    """No module is named ``stt_codegen.verify``: the name is only the front door's
+    function, whatever is imported first."""
+    code = (f"{first}\nimport importlib.util, stt_codegen, stt_codegen.proofs.design_independent\n"
+            "from stt_codegen.verification.command import verify\n"
             "assert stt_codegen.verify is verify, stt_codegen.verify\n"
-            "from stt_codegen import verify as again\nassert again is verify")
+            "from stt_codegen import verify as again\nassert again is verify\n"
+            "assert importlib.util.find_spec('stt_codegen.verify') is None")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=False)
     assert run.returncode == 0, run.stderr

@@ -17,8 +17,8 @@ from stt_codegen.design.gain import derived_gain, gain_derivation
 from stt_codegen.design.samples import sample_tube
 from stt_codegen.runtime.simulate import run_closed_loop
 from stt_codegen.spec.loader import Assumptions, load_spec
-from stt_codegen.verify.command import verify_spec
-from stt_codegen.verify.sampled import check_sampled
+from stt_codegen.verification.command import verify_spec
+from stt_codegen.design.certificate.sampled import check_sampled
 
 SPECS = Path(__file__).parent / "specs"
 _SAMPLES: dict = {}
@@ -50,7 +50,7 @@ def test_derived_gain_passes_and_the_old_default_fails_with_the_rate_it_needs():
     detail = bad["sampled.tube_kept"].detail
     assert "needs 2 kHz" in detail and "g_max = 3" in detail and "controller.gain" in detail
     assert "beyond the limit at g_max = 3" in bad["sampled.gain"].detail
-    # a member of the class leaves the tube (verify/class_search.py): the check is right
+    # a member of the class leaves the tube (verification/class_search.py): the check is right
     member = bad["sampled.tube_kept"].data["class_counterexample"]
     assert member is not None and member["depth"] >= 1.0
     assert "not the check's caution" in detail and f"t = {member['time']:.4f} s" in detail

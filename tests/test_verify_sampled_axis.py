@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from stt_codegen.verify.sampled_axis import coupling_push
+from stt_codegen.design.certificate.sampled_axis import coupling_push
 
 
 def test_coupling_push_bounds_every_matrix_of_the_class():

@@ -1,4 +1,4 @@
-"""Error transform and Lyapunov identity (stt_codegen.verify.transform)."""
+"""Error transform and Lyapunov identity (stt_codegen.proofs.transform)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import pytest
 import sympy as sp
 from hypothesis import given, settings, strategies as st
 
-from stt_codegen.verify import (
+from stt_codegen.proofs import (
     check_epsilon_jacobian,
     check_lyapunov_derivative,
     error_transform_checks,

@@ -17,6 +17,14 @@ def bundled_cases() -> list[str]:
     -------
     list of str
         The case names, sorted, without the ``.toml`` suffix.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> "omnirobot-s1" in stt.bundled_cases()
+    True
+    >>> stt.load_spec(stt.bundled_cases()[0]).name
+    'crossing-moving'
     """
     folder = resources.files(__name__)
     return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))

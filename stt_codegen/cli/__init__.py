@@ -16,8 +16,10 @@ Errors are one line ``error: ...`` on standard error, no traceback.
 Subcommands are listed in :data:`COMMANDS` with their one-line help and the function that
 configures their arguments, one small module a command (:mod:`.design`, :mod:`.simulate`,
 :mod:`.demo`, :mod:`.generate`, :mod:`.check`, :mod:`.verify`, :mod:`.embedded`,
-:mod:`.bench`, :mod:`.cases`, :mod:`.schema`); what several share is in :mod:`.common`
-(arguments, the design step and its no-design document) and :mod:`.plotting` (``--plot``).
+:mod:`.cases`, :mod:`.schema`); another distribution adds one through the entry-point group
+:data:`COMMAND_GROUP` (``bench``, :data:`OPTIONAL_COMMANDS`); what several share is in
+:mod:`.common` (arguments, the design step and its no-design document) and :mod:`.plotting`
+(``--plot``).
 Only the chosen command's module is imported, so ``--help`` and ``cases`` import nothing
 heavy.
 """
@@ -25,6 +27,7 @@ heavy.
 from __future__ import annotations
 
 import argparse
+import functools
 import importlib
 import os
 import sys
@@ -34,7 +37,7 @@ from ..errors import DesignError, SpecError, SttError, ToolchainError
 from ..version import __version__
 from .parser import CommandParser
 
-__all__ = ["COMMANDS", "EXIT_CODES", "build_parser", "exit_code", "main"]
+__all__ = ["COMMANDS", "COMMAND_GROUP", "EXIT_CODES", "OPTIONAL_COMMANDS", "build_parser", "exit_code", "main"]
 
 #: Every subcommand: name -> (one-line help, ``"module:function"``). The function takes the
 #: subcommand's :class:`argparse.ArgumentParser`, adds its arguments and sets
@@ -54,14 +57,25 @@ COMMANDS: dict[str, tuple[str, str]] = {
                "stt_codegen.cli.verify:configure_verify"),
     "embedded": ("run the single-precision controller on an emulated Cortex-M4F",
                  "stt_codegen.cli.embedded:configure_embedded"),
-    "bench": ("benchmarks: random arenas vs planners, step cost, scaling",
-              "stt_codegen.cli.bench:configure_bench"),
     "design": ("design and certify the tube (no simulation)",
                "stt_codegen.cli.design:configure_design"),
     "schema": ("print the JSON Schema of spec files (for editors and tools)",
                "stt_codegen.cli.schema:configure_schema"),
     "import": ("write a spec from another tool's task (gymnasium-robotics' PointMaze)",
                "stt_codegen.cli.import_spec:configure_import"),
+}
+
+#: The entry-point group through which another distribution adds a subcommand: the entry
+#: point's name is the command, its value the ``"module:function"`` configuring it, as in
+#: :data:`COMMANDS` (the benchmarks' ``tests/benchmarks/pyproject.toml`` adds ``bench``).
+COMMAND_GROUP = "stt_codegen.commands"
+
+#: The subcommands of other distributions, listed by ``--help`` whether installed or not:
+#: name -> (one-line help, the command that installs it). Not installed, the command says
+#: how to install it and exits 3 (a missing tool).
+OPTIONAL_COMMANDS: dict[str, tuple[str, str]] = {
+    "bench": ("benchmarks: random arenas vs planners, step cost, scaling (installed apart)",
+              "python3 -m pip install ./tests/benchmarks"),
 }
 
 #: Error kind -> exit code; the first matching row wins.
@@ -79,8 +93,24 @@ def _chosen_command(argv: Sequence[str]) -> str | None:
 
 
 def _configure(parser: argparse.ArgumentParser, command: str) -> None:
-    module_name, function_name = COMMANDS[command][1].split(":")
+    if command in COMMANDS:
+        target = COMMANDS[command][1]
+    else:
+        from importlib.metadata import entry_points
+        found = entry_points(group=COMMAND_GROUP, name=command)
+        if not found:
+            parser.add_argument("rest", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
+            parser.set_defaults(handler=functools.partial(_not_installed, command))
+            return
+        target = next(iter(found)).value
+    module_name, function_name = target.split(":")
     getattr(importlib.import_module(module_name), function_name)(parser)
+
+
+def _not_installed(command: str, args: argparse.Namespace) -> int:
+    """The handler of an optional command whose distribution is not installed."""
+    raise ToolchainError(f"stt-codegen {command} is not installed; install it with "
+                         f"{OPTIONAL_COMMANDS[command][1]}")
 
 
 def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
@@ -109,7 +139,8 @@ def build_parser(argv: Sequence[str] = ()) -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
                                 parser_class=CommandParser)
     chosen = _chosen_command(argv)
-    for name, (help_text, _) in COMMANDS.items():
+    listed = {name: help_text for name, (help_text, _) in (COMMANDS | OPTIONAL_COMMANDS).items()}
+    for name, help_text in listed.items():
         p = sub.add_parser(name, help=help_text)
         if name == chosen:
             _configure(p, name)

@@ -45,7 +45,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
         No design (exit code 1).
     """
     from ..spec.loader import load_spec
-    from ..verify.command import spec_for_plant, verify
+    from ..verification.command import spec_for_plant, verify
     design = design_spec(spec_for_plant(load_spec(args.spec), args.plant), args)
     progress = None if args.json else _terminal_progress()
     try:

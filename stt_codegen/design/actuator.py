@@ -2,7 +2,7 @@
 
 :func:`design_within_bound` is what :func:`~stt_codegen.design.search.design_tube` does
 for a spec with ``[actuator]``. It accepts a tube only when the prover
-(:func:`~.input_bound.input_prover`: ``verify``'s sampled-data bound on ``e`` and the
+(:func:`~.certificate.actuator.prove_input_bound`: the sampled-data bound on ``e`` and the
 certified widths, :mod:`.input_bound`) shows that law (13) never asks any input for more
 than its bound; for a second-order spec the prover is the sampled cascade's certificate
 (:func:`~.cascade_gain.cascade_input_proof`: the peak force or torque of the certified
@@ -44,7 +44,8 @@ from ..spec.variants import variant_of
 from ..tube.parameters import CRUISE
 from .grid import grid_index, grid_value, smallest_passing
 from .failures import FailureKind
-from .input_bound import InputProof, input_prover
+from .certificate.actuator import prove_input_bound
+from .input_bound import InputProof
 from .result import METHOD_PAPER, METHOD_VIA, Design
 from .samples import HORIZON_FACTOR, STEP_BUDGET
 from .windows import SHARPNESS_LADDER
@@ -185,7 +186,7 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
         (:func:`~stt_codegen.design.search.design_tube` on a spec without ``[actuator]``).
     prove : callable, optional
         ``(Design, Spec) -> InputProof``, the proved peak of each input along a design;
-        default law (13)'s (:func:`~.input_bound.input_prover`). A second-order spec
+        default law (13)'s (:func:`~.certificate.actuator.prove_input_bound`). A second-order spec
         passes the cascade's (:func:`~.cascade_gain.cascade_input_proof`: the physical
         input of the certified second stage).
 
@@ -206,10 +207,8 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     """
     started = time.perf_counter()
     if prove is None:
-        prover = input_prover()
-
         def prove(design: Design, judged: Spec) -> InputProof:
-            return prover(design.tube, judged)
+            return prove_input_bound(design.tube, judged)
     bound = spec.input_bound
     accepted, tried = candidates(spec, design_free, prove)
     if accepted is not None:

@@ -19,8 +19,8 @@ puts
 
 The linearization only proposes numbers. :func:`certified_stage` keeps the first shape
 whose stage the sampled cascade's certificate
-(:func:`stt_codegen.verify.cascade_sampled.check_cascade_sampled`, registered through
-:func:`.provers.register_prover`: ``design`` cannot import ``verify``) accepts at the
+(:func:`.certificate.cascade_sampled.check_cascade_sampled`, through
+:func:`~.certificate.cascade_sampled.certify_stage`) accepts at the
 spec's rate, and :func:`second_stage_for` refuses the design when none is, naming the
 lowest certified rate (:func:`lowest_certified_rate`). With ``[actuator] input_bound`` (the
 physical input: force or torque) a shape is kept only when the certificate's peak input is
@@ -41,7 +41,7 @@ from ..spec.variants import require_variant
 from ..tube import reference
 from ..tube.parameters import TubeDesign
 from ..tube.second_stage import SecondStage
-from .provers import CASCADE_CERTIFICATE, registered_prover
+from .certificate.cascade_sampled import certify_stage
 from .input_bound import InputProof
 
 __all__ = ["RATE_SEARCH_FACTOR", "SHAPES", "cascade_input_proof", "certified_stage",
@@ -180,9 +180,6 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
         (the tubes kept), ``reason``, ``peak_input``, ``peak_input_time``, ``horizon``).
     """
     order = spec.second_order
-    certify = registered_prover(CASCADE_CERTIFICATE)
-    if certify is None:
-        raise RuntimeError("no cascade certifier registered: import stt_codegen first")
     # the certificate reads neither bound: one certificate per tube and stage, bound or not
     tube, spec = dataclasses.replace(tube, input_bound=None), dataclasses.replace(
         spec, input_bound=None)
@@ -191,7 +188,7 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
         stage, derivation = derived_second_stage(
             tube, min_width, order.input_gain, order.drift_bound + spec.disturbance_amplitude,
             order.initial_velocity, shape)
-        passed, report = certify(tube, spec, stage)
+        passed, report = certify_stage(tube, spec, stage)
         within = bound is None or all(p <= b for p, b in zip(report["peak_input"], bound))
         if passed and within:
             return stage, {**derivation, "certificate": report}

@@ -12,8 +12,8 @@ with factors in ``[-q, q]``, ``q = (g_max - g_min) / (g_max + g_min)``. For the 
 ``g_min = g_max = 1`` this is ``gamma_d,min^2 / (16 dt)``, the gain the toolkit has always
 used. Whether the gain and rate really keep every plant of the assumptions in the tube
 (drift, disturbance, coupling, the law's nonlinearity, the tube's motion) is decided by
-:func:`stt_codegen.verify.sampled.check_sampled`, and
-:func:`stt_codegen.verify.sampled.lowest_rate` searches the rate at which it passes (the
+:func:`stt_codegen.design.certificate.sampled.check_sampled`, and
+:func:`stt_codegen.design.certificate.sampled.lowest_rate` searches the rate at which it passes (the
 design layer never imports verify: verify builds on design).
 """
 

@@ -11,33 +11,26 @@ bound the input the deployed controller asks for at that sample:
 (the deployed law divides by the width floored at ``GAMMA_D_MIN``, and ``e`` is clamped
 to ``E_MAX``). ``docs/sampled-data.md`` ("The input bound") has the argument.
 
-The bound on ``e`` is the sampled-data check's (:mod:`stt_codegen.verify.sampled`), which
-builds on the design and so cannot be imported here; :mod:`stt_codegen.verify` registers
-its prover in the design's one registry of provers (:mod:`.provers`, kind
-``INPUT_BOUND``) when the package is loaded (``import stt_codegen`` loads it), and the
-design (:mod:`.actuator`) asks :func:`input_prover`.
-This module imports nothing heavy at import time (numpy inside its functions): the
-verify package imports it whenever ``stt_codegen`` is imported.
+The bound on ``e`` is the sampled-data check's (:mod:`.certificate.sampled`); its prover,
+:func:`~.certificate.actuator.prove_input_bound`, builds on this module, and the design
+(:mod:`.actuator`) calls it. This module imports nothing heavy at import time (numpy inside
+its functions).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from ..errors import DesignError
 from ..tube.parameters import E_MAX, GAMMA_D_MIN
-from .failures import FailureKind
-from .provers import INPUT_BOUND, registered_prover
 
 if TYPE_CHECKING:
     import numpy as np
 
     from ..spec.loader import Spec
 
-__all__ = ["InputProof", "InputProver", "input_peak", "input_prover", "phi"]
+__all__ = ["InputProof", "input_peak", "phi"]
 
 
 @dataclass(frozen=True)
@@ -135,30 +128,3 @@ def input_peak(gain: float, abs_e: "np.ndarray", width: "np.ndarray", t: "np.nda
     return InputProof(True, tuple(float(v) for v in u.max(axis=0)),
                       tuple(float(t[k]) for k in where), float(horizon),
                       max_abs_e=float(np.max(abs_e)))
-
-
-#: ``(tube, spec, *, per_axis_first=False) -> InputProof``: proves the peak inputs of a
-#: designed tube (with its gain) for the plants of ``spec.assumptions``; ``per_axis_first``
-#: bounds ``e`` by the cheaper per-axis argument where it passes (no tighter).
-InputProver = Callable[..., InputProof]
-
-
-def input_prover() -> InputProver:
-    """The registered prover.
-
-    Returns
-    -------
-    InputProver
-        The prover registered for ``INPUT_BOUND`` (:func:`.provers.register_prover`).
-
-    Raises
-    ------
-    DesignError
-        None is registered (``stt_codegen.verify`` was not loaded; ``import stt_codegen``
-        loads it), kind ``INPUT_BOUND``.
-    """
-    prover = registered_prover(INPUT_BOUND)
-    if prover is None:
-        raise DesignError("no input-bound prover is registered (import stt_codegen loads "
-                          "stt_codegen.verify, which registers it)", kind=FailureKind.INPUT_BOUND)
-    return prover

@@ -4,7 +4,7 @@ The look-ahead variant sends the base ``v = h . u`` and ``omega = (h_perp . u) /
 (13)'s ``u`` at the look-ahead point (``h`` the heading's unit vector, ``l`` the axle
 offset; docs/differential-drive.md), so ``|v| <= |u|`` and ``|omega| <= |u| / l`` with
 ``|u| <= sqrt(peak_1^2 + peak_2^2)`` at every sample, whatever the heading, from the
-per-input peaks the first-order prover (:func:`~.input_bound.input_prover`) proves for
+per-input peaks the first-order prover (:func:`~.certificate.actuator.prove_input_bound`) proves for
 the point's plant class. The input is held between samples, so the bound holds at every
 ``t``. :func:`look_ahead_input_proof` is that conversion; :func:`look_ahead_within_bound`
 the design of a differential-drive spec with ``[actuator]``: the first order's procedure
@@ -20,7 +20,8 @@ from dataclasses import replace
 
 from ..spec.loader import Spec
 from .actuator import design_within_bound
-from .input_bound import InputProof, input_prover
+from .certificate.actuator import prove_input_bound
+from .input_bound import InputProof
 from .result import Design
 
 __all__ = ["look_ahead_input_proof", "look_ahead_within_bound"]
@@ -72,11 +73,10 @@ def look_ahead_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -
     DesignError
         As :func:`~.actuator.design_within_bound` (kind ``INPUT_BOUND``).
     """
-    prover = input_prover()
     offset = spec.drive.axle_offset
 
     def prove(design: Design, judged: Spec) -> InputProof:
-        return look_ahead_input_proof(prover(design.tube, judged), offset)
+        return look_ahead_input_proof(prove_input_bound(design.tube, judged), offset)
 
     design = design_within_bound(spec, design_free, prove)
     return replace(design, tube=replace(design.tube, input_bound=None))

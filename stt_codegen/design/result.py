@@ -105,6 +105,15 @@ class Design:
     motion : str
         For a spec with moving obstacles: how the tube avoids them (``"space-time"``,
         ``"timed via"`` or ``"swept"``, :mod:`~stt_codegen.design.moving`); else ``""``.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    >>> design.spec.name, design.method, design.gain == design.tube.gain
+    ('omnirobot-s1', 'paper', True)
+    >>> design.certificate.passed, design.input_proof is None
+    (True, True)
     """
 
     tube: TubeDesign

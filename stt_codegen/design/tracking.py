@@ -1,7 +1,7 @@
 """How much of law (13)'s gain a tube needs to be followed at ``|e| <= 0.7`` (an estimate).
 
 The certificate proves the tube; whether the sampled law keeps the state well inside it is
-:func:`stt_codegen.verify.sampled.check_sampled`'s business (200-300 ms a design, too slow
+:func:`stt_codegen.design.certificate.sampled.check_sampled`'s business (200-300 ms a design, too slow
 for the search). This module estimates, cheaply, the gain a tube *asks for*: at ``|e| = E``
 (:data:`TRACKING_ERROR`) law (13) drives state ``i`` at
 
@@ -35,7 +35,7 @@ from ..spec.loader import Spec
 from ..tube import reference
 from ..tube.parameters import TubeDesign
 from .certificate import Certificate
-from .input_bound import input_prover
+from .certificate.actuator import prove_input_bound
 
 __all__ = ["SMOOTHER_RATIO", "TRACKING_ERROR", "centre_speed", "proved_error", "tracking_demand",
            "unfollowable"]
@@ -153,7 +153,8 @@ def centre_speed(design: TubeDesign, certificate: Certificate) -> float:
 @lru_cache(maxsize=32)
 def proved_error(design: TubeDesign, spec: Spec) -> float:
     """The sampled-data proof's bound of ``max |e_i(t_k)|`` over the samples of ``design``
-    for the plants of ``spec`` (``InputProof.max_abs_e`` of the registered prover), ``-inf``
+    for the plants of ``spec`` (``InputProof.max_abs_e`` of
+    :func:`~.certificate.actuator.prove_input_bound`), ``-inf``
     when the proof fails (it cannot tell). Cached per ``(design, spec)``: the same bundled
     design is asked for again and again in one process, and the proof takes 0.2-1 s.
 
@@ -168,13 +169,8 @@ def proved_error(design: TubeDesign, spec: Spec) -> float:
     -------
     float
         The bound, in ``[0, 1)`` when proved, else ``-inf``.
-
-    Raises
-    ------
-    DesignError
-        No prover is registered (``stt_codegen.verify`` not loaded), kind ``INPUT_BOUND``.
     """
-    proof = input_prover()(design, spec)
+    proof = prove_input_bound(design, spec)
     return proof.max_abs_e if proof.proved else -math.inf
 
 
@@ -183,15 +179,15 @@ def _followable_per_axis(design: TubeDesign, spec: Spec) -> bool:
     ``|e|`` no tighter than the whole check (the Lyapunov balls only cut its enclosures),
     so a yes here is the whole check's yes, at a quarter of its cost; it is also the check
     ``verify`` runs, which then finds it computed."""
-    proof = input_prover()(design, spec, per_axis_first=True)
+    proof = prove_input_bound(design, spec, per_axis_first=True)
     return proof.proved and proof.max_abs_e <= TRACKING_ERROR
 
 
 def unfollowable(design: TubeDesign, certificate: Certificate, spec: Spec) -> str:
     """Why law (13) with ``design``'s gain cannot follow the tube at ``|e| <= E``, or ``""``.
 
-    The tube is refused when the sampled-data proof (the registered prover of
-    :func:`~stt_codegen.design.input_bound.input_prover`: ``verify``'s bound of
+    The tube is refused when the sampled-data proof
+    (:func:`~stt_codegen.design.certificate.actuator.prove_input_bound`: the bound of
     ``|e_i(t_k)|`` at every sample, for every plant of the spec's class) bounds ``|e|``
     above :data:`TRACKING_ERROR` somewhere. A tube whose proof fails is not refused here
     (the proof cannot tell; ``verify`` reports it).
@@ -209,11 +205,6 @@ def unfollowable(design: TubeDesign, certificate: Certificate, spec: Spec) -> st
     -------
     str
         The reason, in numbers; empty when the tube is kept.
-
-    Raises
-    ------
-    DesignError
-        No prover is registered (``stt_codegen.verify`` not loaded), kind ``INPUT_BOUND``.
     """
     # every candidate is proved: the demand, an estimate, is no screen (arena 18 of seed 0:
     # demand 0.24, proved and simulated |e| 0.75)

@@ -221,6 +221,22 @@ def register_backend(name: str, factory: Callable[..., Controller], *, order: in
     ------
     SpecError
         ``order`` is not 1 or 2 (field ``order``), or an unknown ``variant``.
+
+    Examples
+    --------
+    A backend that logs each step around the reference, registered for first-order plants
+    (``stt.simulate(design, backend="logged")`` then runs it):
+
+    >>> from stt_codegen.runtime.backends import (ReferenceController, backend_names,
+    ...                                           register_backend)
+    >>> class Logged(ReferenceController):
+    ...     name = "logged"
+    ...     def step(self, x, t, dt, alpha):
+    ...         self.last_t = t
+    ...         return super().step(x, t, dt, alpha)
+    >>> register_backend("logged", Logged)
+    >>> backend_names()[-1]
+    'logged'
     """
     _factories(order, variant)[name] = factory
 
@@ -244,6 +260,12 @@ def backend_names(order: int = 1, variant: str | None = None) -> list[str]:
     ------
     SpecError
         ``order`` is not 1 or 2 (field ``order``), or an unknown ``variant``.
+
+    Examples
+    --------
+    >>> from stt_codegen.runtime.backends import backend_names
+    >>> backend_names()
+    ['reference', 'casadi', 'c', 'python']
     """
     return list(_factories(order, variant))
 
@@ -278,6 +300,20 @@ def make_controller(name: str, design: TubeDesign,
         Unknown backend for the plant's order (field ``backend``).
     ToolchainError
         Backend ``"c"``: no C compiler, or it failed.
+
+    Examples
+    --------
+    One step of the numpy reference at ``x(0)``, ``alpha = 0``:
+
+    >>> import numpy as np
+    >>> import stt_codegen as stt
+    >>> from stt_codegen.runtime.backends import make_controller
+    >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    >>> controller = make_controller("reference", design.tube)
+    >>> u, alpha_next, status = controller.step(np.array(design.tube.initial_state), 0.0,
+    ...                                         1e-3, np.zeros(6))
+    >>> u.shape, alpha_next.shape, status
+    ((3,), (6,), 0)
     """
     variant = variant_of_stage(stage)
     factories = variant.entry("backends")()

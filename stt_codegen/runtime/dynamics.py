@@ -13,7 +13,7 @@ omnidirectional robot of eq. (14) (``g(x) = R(x3)``, ``f = 0``) and the single i
 
 The spec's ``linear`` plant (``x_dot = a x + c + g u + w``, matrices from the spec) is
 :func:`linear_rhs`, used the same way by the simulation and the embedded closed loop
-(its Assumption 2 check is :func:`stt_codegen.verify.sampled.linear_plant_checks`, on the
+(its Assumption 2 check is :func:`stt_codegen.verification.sampled.linear_plant_checks`, on the
 spec's ``g``). :func:`plant_function` picks the one of a spec's ``[plant]``.
 """
 

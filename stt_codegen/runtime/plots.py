@@ -461,7 +461,7 @@ def plot_run(design: Design, result: SimulationResult, path: str | Path, *,
     --------
     >>> import stt_codegen as stt
     >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
-    >>> result = stt.simulate(design, backend="casadi")
+    >>> result = stt.simulate(design, backend="casadi", horizon=1.0)   # the first second
     >>> stt.plot_run(design, result, "s1-run.png").name
     's1-run.png'
     """

@@ -143,6 +143,19 @@ class SimulationResult:
         ``None`` for the other plants.
     first_contact : list or None
         ``[t, geom1, geom2]`` of the first such contact (s, geom names), else ``None``.
+
+    Examples
+    --------
+    Half a second of the closed loop: still in the tube, the target not yet reached (so
+    Definition 2.1, judged on ``[0, t_c]``, is not satisfied):
+
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    >>> result = stt.simulate(design, backend="reference", horizon=0.5)
+    >>> result.stayed_in_tube, result.collision, result.reach_time, result.satisfied
+    (True, False, None, False)
+    >>> result.trajectory.x.shape                # 0.5 s at 1 kHz, states x1, x2, x3
+    (501, 3)
     """
 
     spec: str

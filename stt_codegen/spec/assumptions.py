@@ -50,7 +50,7 @@ class Assumptions:
     space ``X`` (and ``w`` over time). They come from the spec's plant model and its
     ``[assumptions]`` (:func:`combine_assumptions`). Used to derive the default gain ``k``
     of law (13) (:mod:`stt_codegen.design.gain`) and by the sampled-data check
-    (:mod:`stt_codegen.verify.sampled`); the controller itself never sees them.
+    (:mod:`stt_codegen.design.certificate.sampled`); the controller itself never sees them.
 
     Attributes
     ----------

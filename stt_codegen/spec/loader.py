@@ -295,6 +295,20 @@ class Spec:
         :attr:`state_space` is the given one shrunk by the radius and :attr:`obstacles`,
         :attr:`unsafe_sets`, :attr:`moving_obstacles` are the given ones inflated by it:
         the sets of the reference point the tube steers. ``None``: a point robot.
+
+    Examples
+    --------
+    From a dictionary (a TOML spec file's tables, :func:`load_spec` for a file or a bundled
+    case); defaults fill in what is not given:
+
+    >>> import stt_codegen as stt
+    >>> spec = stt.Spec.from_dict({
+    ...     "name": "corridor", "prescribed_time": 5.0,
+    ...     "state_space": {"lower": [0.0, 0.0], "upper": [4.0, 1.0]},
+    ...     "initial": {"lower": [0.0, 0.0], "upper": [0.5, 1.0]},
+    ...     "target": {"lower": [3.5, 0.0], "upper": [4.0, 1.0]}})
+    >>> spec.dimension, spec.initial_state, spec.target_center, spec.plant_model
+    (2, (0.25, 0.5), (3.75, 0.5), 'single-integrator')
     """
 
     name: str

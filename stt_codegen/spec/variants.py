@@ -65,7 +65,6 @@ ROLES: Mapping[str, str] = MappingProxyType({
     "sampled_checks": "(spec, design, tube_check, progress) -> list of Check of the "
                       "sampled loop",
     "plant_within": "(spec, model) -> Check, the plant within the certified class",
-    "arenas_bench": "(args) -> exit code of stt-codegen bench arenas",
 })
 
 
@@ -177,10 +176,9 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                generation=_P + "codegen.api:first_order_files",
                firmware=_P + "embedded.deploy:run_embedded",
                embedded_command=_P + "cli.embedded:law13_command",
-               model_checks=_P + "verify.command:first_order_model_checks",
-               sampled_checks=_P + "verify.command:first_order_sampled_checks",
-               plant_within=_P + "verify.plant_within:first_order_within",
-               arenas_bench=_P + "cli.bench:first_order_arenas")),
+               model_checks=_P + "verification.command:first_order_model_checks",
+               sampled_checks=_P + "verification.command:first_order_sampled_checks",
+               plant_within=_P + "verification.plant_within:first_order_within")),
     "cascade": ControllerVariant(
         "cascade", "a second-order plant", "the cascade's input u", 2,
         " (positions, then velocities)",
@@ -203,10 +201,9 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                generation=_P + "codegen.cascade_source:cascade_generation",
                firmware=_P + "embedded.cascade_loop:run_cascade_embedded",
                embedded_command=_P + "cli.embedded:variant_loop_command",
-               model_checks=_P + "verify.command:no_model_checks",
-               sampled_checks=_P + "verify.command:cascade_sampled_checks",
-               plant_within=_P + "verify.plant_within:cascade_within",
-               arenas_bench=_P + "cli.bench:cascade_arenas"),
+               model_checks=_P + "verification.command:no_model_checks",
+               sampled_checks=_P + "verification.command:cascade_sampled_checks",
+               plant_within=_P + "verification.plant_within:cascade_within"),
         MappingProxyType({"cascade": True})),
     "look-ahead": ControllerVariant(
         "look-ahead", "a differential-drive base", "the base's command (v, omega)", 1, "",
@@ -229,10 +226,9 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                generation=_P + "codegen.look_ahead_source:look_ahead_generation",
                firmware=_P + "embedded.look_ahead_loop:run_look_ahead_embedded",
                embedded_command=_P + "cli.embedded:variant_loop_command",
-               model_checks=_P + "verify.command:look_ahead_model_checks",
-               sampled_checks=_P + "verify.command:look_ahead_sampled_checks",
-               plant_within=_P + "verify.plant_within:first_order_within",
-               arenas_bench=_P + "cli.bench:first_order_arenas")),
+               model_checks=_P + "verification.command:look_ahead_model_checks",
+               sampled_checks=_P + "verification.command:look_ahead_sampled_checks",
+               plant_within=_P + "verification.plant_within:first_order_within")),
 })
 assert tuple(CONTROLLER_VARIANTS) == VARIANTS
 

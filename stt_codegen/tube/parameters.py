@@ -263,6 +263,15 @@ class TubeDesign:
         clamps ``u_i`` to ``[-input_bound_i, input_bound_i]`` and reports
         ``STATUS_INPUT_CLAMPED`` when it did; ``None`` (default): no clamp, and the
         generated code is that of a design without actuator limits.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> tube = stt.design_tube(stt.load_spec("omnirobot-s1")).tube
+    >>> tube.prescribed_time, tube.rate_hz, tube.initial_state
+    (9.0, 1000.0, (0.25, 4.75, 0.0))
+    >>> [(c.obstacle, c.dimension, c.side) for c in tube.circumvents]
+    [(0, 1, 'upper')]
     """
 
     name: str

@@ -47,6 +47,24 @@ class InstructionPrinter:
 
     Subclasses set :attr:`language`, :attr:`known_functions`, :attr:`infix_operators`
     and implement the hooks that raise ``NotImplementedError`` here.
+
+    Examples
+    --------
+    The C and Python printers print the same instruction stream of a CasADi SX Function:
+
+    >>> import casadi as ca
+    >>> from stt_codegen.codegen.emit.c_printer import CPrinter
+    >>> x = ca.SX.sym("x")
+    >>> twice_sin = ca.Function("twice_sin", [x], [2 * ca.sin(x)], ["x"], ["y"])
+    >>> print(CPrinter().print_function(twice_sin))
+    /* CasADi Function 'twice_sin': 4 instructions. */
+    static void twice_sin(const double* x, double* y) {
+      double w0;
+      w0 = x[0];
+      w0 = sin(w0);
+      w0 = w0 + w0;
+      y[0] = w0;
+    }
     """
 
     #: Name of the target language, used in error messages.

@@ -18,7 +18,15 @@ Modules, one layer each:
 * :mod:`.refine`: the refinement loop (:func:`certify_tube`);
 * :mod:`.report`: the result types and the report of every property's margin.
 
-The public names are importable from here.
+The public names are importable from here. The certificates of the sampled closed loop,
+which the design asks before it accepts a tube, are imported from their modules:
+
+* :mod:`.sampled`: every plant of the class stays in the tube under the sampled law (13)
+  (per-axis boxes, :mod:`.sampled_axis`, cut by Lyapunov balls, :mod:`.lyapunov`; the
+  plant's bounds on each sampling interval, :mod:`.plant_class`);
+* :mod:`.actuator`: the proved peak of each input of law (13) (``[actuator]``);
+* :mod:`.cascade_sampled`: the sampled cascade of a second-order plant, and
+  :mod:`.cascade_adversary`, members of its class that the greedy strategies drive out.
 """
 
 from .enclosures import (Pieces, bump_ranges, circumvent_range, enclose, enclose_tube,

@@ -1,0 +1,107 @@
+"""``sampled.input_bound``: the deployed law (13) never asks an input for more than
+``[actuator] input_bound``.
+
+From the sampled-data check (:mod:`.sampled`), which proves a bound ``E_k,i`` of
+``|e_i(t_k)|`` at every sample for every plant of ``[assumptions]``, and the certified
+enclosure of the tube on each sampling interval (a lower bound ``W_k,i`` of its width
+there), :func:`~stt_codegen.design.input_bound.input_peak` bounds every input the
+controller computes: ``|u_k,i| <= 4 k phi(E_k,i) / max(W_k,i, GAMMA_D_MIN)``. The argument
+is in ``docs/sampled-data.md`` ("The input bound"). The design asks this prover
+(:func:`prove_input_bound`) before it accepts a tube, and ``verify`` reports it
+(:func:`stt_codegen.verification.sampled.input_bound_check`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .enclosures import enclose_tube
+from ..input_bound import InputProof, input_peak
+from ..samples import TubeSamples
+from ...spec.loader import Spec
+from ...tube import reference
+from ...tube.parameters import TubeDesign
+from .sampled import SampledCheck, sampled_check_of
+
+__all__ = ["prove_input_bound", "sampled_error_bound"]
+
+
+def sampled_error_bound(result: SampledCheck, samples: TubeSamples) -> np.ndarray | None:
+    """The sampled check's bound of ``|e_i(t_k)|``, shape (K, n), or ``None`` if it failed.
+
+    The one place that reads the sampled check's result for the input bound: its
+    per-sample bound (``abs_e``) when it gives one, else its overall bound (``max_abs_e``,
+    the largest ``|e|`` at any sample) at every sample.
+
+    Parameters
+    ----------
+    result : SampledCheck
+        The sampled closed-loop check of the design (:func:`~.sampled.check_sampled`).
+    samples : TubeSamples
+        The tube at the sampling instants ``t_k`` (K of them).
+
+    Returns
+    -------
+    ndarray, shape (K, n), or None
+        The bound of ``|e_i(t_k)|`` per sample and axis (each in ``[0, 1)``); ``None`` when
+        the check failed.
+    """
+    if not result.passed:
+        return None
+    n = samples.gamma_lower.shape[1]
+    per_sample = getattr(result, "abs_e", None)
+    if per_sample is not None and np.shape(per_sample) == (samples.t.size, n):
+        return np.asarray(per_sample, dtype=float)
+    level = float(result.data.get("max_abs_e", result.level))
+    return np.full((samples.t.size, n), level)
+
+
+def certified_widths(tube: TubeDesign, samples: TubeSamples) -> np.ndarray:
+    """A lower bound of the tube's width at every sample, shape (K, n): the certified
+    enclosure of the interval that starts there (the last sample ends the last one)."""
+    enclosure = enclose_tube(tube, samples)
+    width = enclosure.upper_min - enclosure.lower_max
+    return np.vstack([width, width[-1:]])
+
+
+def prove_input_bound(tube: TubeDesign, spec: Spec, *,
+                      per_axis_first: bool = False) -> InputProof:
+    """The proved peak of each input of law (13) along ``tube`` for the spec's plants.
+
+    Parameters
+    ----------
+    tube : TubeDesign
+        With its gain (the input bound's clamp, if any, plays no part: the proof shows
+        it never acts).
+    spec : Spec
+        Its plant class (:func:`~stt_codegen.design.certificate.plant_class.plant_class`: the model's
+        bounds evaluated on the tube per interval, and ``[assumptions]``), the one
+        ``sampled.tube_kept`` judges.
+    per_axis_first : bool
+        Bound ``e`` by the per-axis argument where it passes (``verify``'s check, cheaper;
+        bounds no tighter than the Lyapunov balls') instead of the whole check with the
+        balls everywhere (the default; the peaks of ``[actuator]`` are proved from it).
+
+    Returns
+    -------
+    InputProof
+        Not proved when the sampled-data check fails (its reason); the horizon is the
+        sampled check's, ``1.1 t_c``.
+
+    Raises
+    ------
+    SpecError
+        More samples than the step budget (as :func:`~stt_codegen.design.samples.sample_tube`).
+    """
+    # the check is computed once per (tube, spec, per_axis_first) in a process:
+    # sampled_check_of samples with the oracle's exp/log/tanh as numpy's ufuncs
+    samples, result = sampled_check_of(tube, spec, per_axis_first)
+    horizon = float(samples.t[-1])
+    abs_e = sampled_error_bound(result, samples)
+    if abs_e is None:
+        n = tube.dimension
+        return InputProof(False, (np.inf,) * n, (0.0,) * n, horizon,
+                          f"the sampled-data check fails: {result.reason}")
+    with reference.numpy_math():
+        widths = certified_widths(tube, samples)
+    return input_peak(tube.gain, abs_e, widths, samples.t, horizon)

@@ -1,0 +1,536 @@
+"""Sampled-data certificate of the cascade: the held input keeps both tubes, per interval.
+
+The deployed cascade (docs/second-order.md) reads ``x1(t_k)``, ``x2(t_k)``, computes
+``u_k = -k2 xi2 epsilon2`` and holds it until ``t_{k+1} = t_k + h``. This module proves,
+for every plant ``x1_dot = x2``, ``x2_dot = f + g u + w`` of a :class:`CascadeClass`
+(``g`` symmetric with eigenvalues in ``[g_min, g_max]``, off-diagonal rows at most
+``coupling``; ``|f_i| <= F0 + F1 |x2_i|``; ``|w_i| <= W``), that ``|e1| < 1`` and
+``|e2| < 1`` at and between the samples over the horizon of the tube's samples. It
+propagates, from ``(e1(0), e2(0))``, one interval per axis for each error at the samples
+and, on each sampling interval, reuses the first-order per-axis enclosure
+(:func:`~stt_codegen.design.certificate.sampled_axis.axis_interval`) twice:
+
+* the **position stage** is law (13) with ``g = 1`` on ``x1_dot = x2 = r_k + d(t)``:
+  ``d = z_k + (x2(t) - x2_k)`` displaces ``x1`` by at most ``tau (Z + h A / 2)`` after
+  ``tau`` seconds (``|z_k| <= Z``, ``|x2_dot| <= A``);
+* the **velocity stage** is law (13)'s transform on the tube ``|z| < rho2``, ``z = x2 -
+  r``: ``z`` moves by ``tau g u_k`` plus the drift and disturbance (at most ``tau (F +
+  W)``), the other axes' inputs through the coupling, and the change of ``r`` along the
+  trajectory, bounded by :func:`virtual_velocity_change` (uniform on the interval).
+
+The argument, its assumptions and what it does not prove: docs/second-order.md, "The
+sampled cascade (certificate)". Plain floats in the loop, like :mod:`.sampled`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+
+from .enclosures import enclose_tube
+from ..samples import TubeSamples, sample_tube
+from ...spec.loader import Spec
+from ...spec.plants import SECOND_ORDER_PLANTS
+from ...spec.variants import require_variant
+from ...tube import reference
+from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
+from ...tube.second_stage import SecondStage
+from .sampled_axis import axis_interval, peak, phi_scalar, phi_slope_scalar
+
+__all__ = ["CascadeClass", "CascadeCheck", "cascade_check_of", "cascade_class", "model_within_class",
+           "certify_stage", "check_cascade_sampled", "step_velocity_change",
+           "virtual_velocity_change"]
+
+#: Relative safety factor on the closed-form ``rho2(t_{k+1})`` the path is judged against
+#: (rounding of ``exp``; every margin reported is far above it).
+RHO_ROUNDING = 1e-12
+
+
+@dataclass(frozen=True)
+class CascadeClass:
+    """The second-order plants the certificate covers (docs/second-order.md).
+
+    Attributes
+    ----------
+    g_min, g_max : float
+        Range of the eigenvalues of the (symmetric) input matrix ``g``, ``0 < g_min <=
+        g_max`` (input units to acceleration).
+    coupling : float
+        Bound of the Euclidean norm of the off-diagonal part of a row of ``g``; 0 for a
+        model whose ``g`` is diagonal; at most ``(g_max - g_min) / 2`` for any symmetric
+        ``g`` of the range.
+    drift_bound : float
+        ``F0``: ``|f_i| <= F0 + F1 |x2_i|``, velocity units per second.
+    drift_slope : float
+        ``F1`` (e.g. damping over mass), 1/s; ``h F1 < 1`` is needed.
+    disturbance_bound : float
+        ``W >= |w_i|``, velocity units per second.
+    velocity_bound : tuple of float or None
+        ``state_space.velocity_bound``: the certificate also proves ``|x2_i|`` below it
+        (the drift bound is declared over those velocities).
+    """
+
+    g_min: float
+    g_max: float
+    coupling: float
+    drift_bound: float
+    drift_slope: float = 0.0
+    disturbance_bound: float = 0.0
+    velocity_bound: tuple[float, ...] | None = None
+
+    def words(self) -> str:
+        """The class in one phrase (for reports)."""
+        drift = f"|f_i| <= {self.drift_bound:.6g}"
+        if self.drift_slope:
+            drift += f" + {self.drift_slope:.6g} |x2_i|"
+        coupling = ("g diagonal" if self.coupling == 0.0 else
+                    f"off-diagonal rows of g <= {self.coupling:.6g}")
+        return (f"g symmetric with eigenvalues in [{self.g_min:.6g}, {self.g_max:.6g}] "
+                f"({coupling}), {drift}, |w_i| <= {self.disturbance_bound:.3g}")
+
+
+def cascade_class(spec: Spec) -> CascadeClass:
+    """The class of a spec with a second-order ``plant.model``: ``assumptions.input_gain``,
+    ``assumptions.drift_bound`` (``F1 = 0``: a velocity-dependent drift is declared at
+    ``state_space.velocity_bound``, which the certificate proves is kept),
+    ``plant.disturbance_amplitude``; coupling 0 for a model with a diagonal ``g``
+    (:attr:`~stt_codegen.spec.plants.SecondOrderModel.diagonal_input`), else ``(g_max -
+    g_min) / 2``.
+
+    Parameters
+    ----------
+    spec : Spec
+        With a second-order ``plant.model``.
+
+    Returns
+    -------
+    CascadeClass
+
+    Raises
+    ------
+    SpecError
+        The spec is not of the cascade variant (field ``plant.model``; a ``ValueError``).
+    """
+    require_variant(spec, "cascade", "cascade_class")
+    order = spec.second_order
+    g_min, g_max = order.input_gain
+    diagonal = SECOND_ORDER_PLANTS[order.model].diagonal_input
+    return CascadeClass(g_min, g_max, 0.0 if diagonal else 0.5 * (g_max - g_min),
+                        order.drift_bound, 0.0, spec.disturbance_amplitude,
+                        order.velocity_bound)
+
+
+@dataclass(frozen=True)
+class CascadeCheck:
+    """Outcome of :func:`check_cascade_sampled`.
+
+    Attributes
+    ----------
+    passed : bool
+        The sufficient condition holds on every interval of the samples.
+    reason : str
+        Empty when passed, else what fails, in numbers.
+    position_margin : float
+        Least room between the enclosure of ``x1`` and the tube's edge, over the tube's
+        half-width (negative when failed there).
+    velocity_margin : float
+        Least ``1 - max |e2|`` between samples.
+    max_abs_e1, max_abs_e2 : float
+        The proved bounds of ``|e1|``, ``|e2|`` at the samples.
+    peak_input : tuple of float
+        Per axis, the proved bound of ``|u_k,i|`` over the samples (input units), hence of
+        the held input at every instant of the horizon.
+    peak_input_time : tuple of float
+        Per axis, the sample instant where that bound is reached, seconds.
+    peak_velocity : tuple of float
+        Per axis, the proved bound of ``|x2_i|`` on the intervals.
+    time : float
+        Start of the interval where the smaller margin is least (or of the failure), s.
+    dimension : int
+        Its axis.
+    data : dict
+        JSON-ready figures.
+    """
+
+    passed: bool
+    reason: str
+    position_margin: float
+    velocity_margin: float
+    max_abs_e1: float
+    max_abs_e2: float
+    peak_input: tuple[float, ...]
+    peak_velocity: tuple[float, ...]
+    time: float
+    dimension: int
+    data: dict = field(default_factory=dict)
+    peak_input_time: tuple[float, ...] = ()
+
+
+def virtual_velocity_change(k1: float, h: float, e1_start: float, e1_path: float,
+                            speed: float, tube_move: float, width_min: float,
+                            width_max: float) -> float:
+    """A bound of ``|r(x1(t), t) - r(x1(t_k), t_k)|`` on ``[t_k, t_k + h]`` along one
+    trajectory.
+
+    ``r = -(4 k1 / gamma_d) phi(e1)`` (:func:`~.sampled_axis.phi`). With ``q = phi(e1) /
+    gamma_d``, ``|q(t) - q_k| <= phi'(E) |e1(t) - e1_k| / W_min + phi(E_k) (1 / W_min - 1 /
+    W_max)`` (mean value; ``phi'`` increases in ``|e|``), and ``e1(t) - e1_k = (2 dx1 -
+    d gamma_s - e1_k d gamma_d) / gamma_d(t)`` with ``|dx1| <= h max |x2|``, ``|d gamma_s|,
+    |d gamma_d| <= M`` (the spans of both bounds over the interval).
+
+    Parameters
+    ----------
+    k1 : float
+        Position gain.
+    h : float
+        Sampling period, s.
+    e1_start : float
+        ``E_k >= |e1(t_k)|``.
+    e1_path : float
+        ``E >= |e1(t)|`` on the interval, ``< 1``.
+    speed : float
+        Bound of ``|x2_i|`` on the interval.
+    tube_move : float
+        ``M``: span of ``gamma_L`` plus span of ``gamma_U`` over the interval.
+    width_min, width_max : float
+        Bounds of ``gamma_d`` over the interval, ``0 < width_min <= width_max``.
+
+    Returns
+    -------
+    float
+        Velocity units.
+    """
+    de1 = (2.0 * h * speed + (1.0 + e1_start) * tube_move) / width_min
+    return 4.0 * k1 * (phi_slope_scalar(e1_path) * de1 / width_min
+                       + phi_scalar(e1_start) * (1.0 / width_min - 1.0 / width_max))
+
+
+#: Pieces the range of ``e1(t_k)`` is cut into for :func:`step_velocity_change`.
+STEP_PIECES = 8
+
+
+def step_velocity_change(k1: float, h: float, a: float, b: float, shift: float,
+                         scale: float, reach: float, half_k: float, half_n: float,
+                         other: float) -> float:
+    """A bound of ``|r(x1(t_{k+1}), t_{k+1}) - r(x1(t_k), t_k)|`` along one trajectory, for
+    every ``e1(t_k)`` in ``[a, b]``, from the tube at the two samples (exact there).
+
+    With ``alpha = h_k / h_n``, ``beta = (c_k - c_n) / h_n`` (``c``, ``h``: centre and
+    half-width), ``e1(t_{k+1}) - e1(t_k) = m(e) + d``, ``m(e) = (alpha - 1) e + beta + h
+    r_k(e) / h_n`` (``r_k(e) = -(2 k1 / h_k) phi(e)``) and ``|d| <= other / h_n``
+    (``other >= h |z_k| + h^2 A / 2``). ``r_n(e') - r_k(e) = -(2 k1 / h_n) (phi(e') -
+    phi(e)) - 2 k1 phi(e) (1 / h_n - 1 / h_k)``; ``m`` is bounded on each of
+    :data:`STEP_PIECES` pieces of ``[a, b]`` by interval arithmetic (``phi`` increases),
+    ``phi'`` at the largest ``|e|`` the piece and its step reach (at most ``reach < 1``,
+    the next sample's bound of ``|e1|``).
+
+    Parameters
+    ----------
+    k1 : float
+    h : float
+        Sampling period, s.
+    a, b : float
+        Range of ``e1(t_k)``.
+    shift, scale : float
+        ``beta`` and ``alpha`` above.
+    reach : float
+        Bound of ``|e1|`` at both samples, ``< 1``.
+    half_k, half_n : float
+        Half-widths of the tube at ``t_k``, ``t_{k+1}``.
+    other : float
+        State units.
+
+    Returns
+    -------
+    float
+        Velocity units.
+    """
+    pull = 2.0 * k1 * h / half_k
+    h_ratio = 1.0 / half_n
+    worst = 0.0
+    edges = [a + (b - a) * j / STEP_PIECES for j in range(STEP_PIECES + 1)]
+    for c, d in zip(edges[:-1], edges[1:]):
+        lin = [(scale - 1.0) * c, (scale - 1.0) * d]
+        m_hi = max(lin) + shift + h_ratio * (-pull * phi_scalar(c))
+        m_lo = min(lin) + shift + h_ratio * (-pull * phi_scalar(d))
+        move = max(abs(m_hi), abs(m_lo)) + other * h_ratio
+        top = min(max(abs(c), abs(d)) + move, reach)
+        worst = max(worst, (2.0 * k1 / half_n) * phi_slope_scalar(top) * move
+                    + 2.0 * k1 * phi_scalar(max(abs(c), abs(d))) * abs(1.0 / half_n - 1.0 / half_k))
+    return worst
+
+
+def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: SecondStage,
+                          plants: CascadeClass, initial_velocity) -> CascadeCheck:
+    """Prove that the sampled cascade keeps ``|e1| < 1`` and ``|e2| < 1`` at and between
+    samples for every plant of ``plants`` (module docstring; docs/second-order.md).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The position tube (``rate_hz``, ``initial_state``).
+    samples : TubeSamples
+        The deployed tube at ``design``'s rate
+        (:func:`~stt_codegen.design.samples.sample_tube`).
+    stage : SecondStage
+        ``k1``, ``k2``, ``rho2`` to check.
+    plants : CascadeClass
+    initial_velocity : sequence of float, length n
+        ``x2(0)``.
+
+    Returns
+    -------
+    CascadeCheck
+    """
+    n = design.dimension
+    h = 1.0 / design.rate_hz
+    k1, k2 = stage.position_gain, stage.velocity_gain
+    g_min, g_max, cpl = plants.g_min, plants.g_max, plants.coupling
+    f0, f1, w_amp = plants.drift_bound, plants.drift_slope, plants.disturbance_bound
+    vbound = plants.velocity_bound
+    data = {"rate_hz": design.rate_hz, "position_gain": k1, "velocity_gain": k2,
+            "width_start": list(stage.width_start), "width_floor": list(stage.width_floor),
+            "decay": stage.decay, "class": plants.words()}
+    peak_u, peak_x2, peak_t = [0.0] * n, [0.0] * n, [0.0] * n
+    worst = {"position": math.inf, "velocity": math.inf, "least": math.inf, "t": 0.0,
+             "i": 0}
+    top = [0.0, 0.0]
+
+    def result(passed: bool, reason: str, t: float = 0.0, i: int = 0) -> CascadeCheck:
+        pm, vm = worst["position"], worst["velocity"]
+        data.update({"position_margin": pm, "velocity_margin": vm, "max_abs_e1": top[0],
+                     "max_abs_e2": top[1], "peak_input": list(peak_u),
+                     "peak_input_time": list(peak_t), "peak_velocity": list(peak_x2)})
+        return CascadeCheck(passed, reason, pm, vm, top[0], top[1], tuple(peak_u),
+                            tuple(peak_x2), worst["t"] if passed else t,
+                            worst["i"] if passed else i, data, tuple(peak_t))
+
+    if not 0.0 < g_min <= g_max or h * f1 >= 1.0:
+        return result(False, "need 0 < g_min <= g_max and h F1 < 1")
+    if min(stage.width_floor) < GAMMA_D_MIN:
+        return result(False, f"rho2_inf is below GAMMA_D_MIN = {GAMMA_D_MIN:g}")
+    lo, hi = samples.gamma_lower, samples.gamma_upper
+    if (hi - lo).min() < GAMMA_D_MIN:
+        return result(False, f"the tube is narrower than GAMMA_D_MIN = {GAMMA_D_MIN:g}")
+    enc = enclose_tube(design, samples)
+    count = len(enc.t_start)
+    half, centre = 0.5 * (hi - lo), 0.5 * (hi + lo)
+    start, floor = np.array(stage.width_start), np.array(stage.width_floor)
+    rho2 = ((start - floor)[None, :] * np.exp(-stage.decay * samples.t[:, None])
+            + floor[None, :]).tolist()
+    pull1 = (4.0 * h * k1 / (hi - lo)).tolist()
+    peak1 = peak(0.5 * (hi - lo) / (4.0 * h * k1 / (hi - lo))).tolist()
+    half_l, centre_l = half.tolist(), centre.tolist()
+    up_e = ((enc.upper_min - centre[:count]) / half[:count]).tolist()
+    low_e = ((enc.lower_max - centre[:count]) / half[:count]).tolist()
+    room_up, room_low = enc.upper_min.tolist(), enc.lower_max.tolist()
+    width_min = enc.width_min.tolist()
+    width_max = (enc.upper_max - enc.lower_min).tolist()
+    move = ((enc.lower_max - enc.lower_min) + (enc.upper_max - enc.upper_min)).tolist()
+    x1_0 = np.array(design.initial_state, dtype=float)
+    e1_0 = ((x1_0 - centre[0]) / half[0]).tolist()
+    r0 = [-(4.0 * k1 / (2.0 * half_l[0][i])) * phi_scalar(e1_0[i]) for i in range(n)]
+    x2_0 = [float(v) for v in initial_velocity]
+    e2_0 = [(x2_0[i] - r0[i]) / rho2[0][i] for i in range(n)]
+    box1 = [[v, v] for v in e1_0]
+    box2 = [[v, v] for v in e2_0]
+    spread = g_max - g_min
+    for k in range(count):
+        t = float(samples.t[k])
+        reach1 = [max(-a, b) for a, b in box1]
+        reach2 = [max(-a, b) for a, b in box2]
+        top[0], top[1] = max(top[0], max(reach1)), max(top[1], max(reach2))
+        for name, reach in (("e1", reach1), ("e2", reach2)):
+            if max(reach) > E_MAX:
+                i = int(np.argmax(reach))
+                return result(False, f"|{name}_{i}| may reach {max(reach):.6g} at t = "
+                              f"{t:.4f} s, beyond the clamp E_MAX", t, i)
+        rho_k, rho_n = rho2[k], rho2[k + 1]
+        u_abs = [2.0 * k2 / rho_k[i] * phi_scalar(reach2[i]) for i in range(n)]
+        u_sq = sum(v * v for v in u_abs)
+        next1, next2 = [], []
+        for i in range(n):
+            if u_abs[i] > peak_u[i]:
+                peak_u[i], peak_t[i] = u_abs[i], t
+            others = math.sqrt(max(u_sq - u_abs[i] ** 2, 0.0))
+            z_abs = reach2[i] * rho_k[i]
+            r_abs = 4.0 * k1 / (2.0 * half_l[k][i]) * phi_scalar(reach1[i])
+            push_free = g_max * u_abs[i] + cpl * others + f0 + w_amp   # |x2_dot| without F1
+            speed = (r_abs + z_abs + h * push_free) / (1.0 - h * f1)
+            peak_x2[i] = max(peak_x2[i], speed)
+            if vbound is not None and speed >= vbound[i]:
+                return result(False, f"|x2_{i}| may reach {speed:.4g} on [{t:.4f}, "
+                              f"{t + h:.4f}] s, beyond velocity_bound {vbound[i]:g} (the "
+                              "drift bound is declared within it)", t, i)
+            drift = f0 + f1 * speed + w_amp
+            accel = g_max * u_abs[i] + cpl * others + drift
+            # position stage: law (13) with g = 1 and a displacement <= tau (Z + h A / 2)
+            p_lo, p_hi, x_lo, x_hi = axis_interval(
+                box1[i][0], box1[i][1], centre_l[k][i], half_l[k][i], pull1[k][i], 1.0, 1.0,
+                peak1[k][i], h * z_abs + 0.5 * h * h * accel)
+            e_lo = (p_lo - centre_l[k][i]) / half_l[k][i]
+            e_hi = (p_hi - centre_l[k][i]) / half_l[k][i]
+            room = min(up_e[k][i] - e_hi, e_lo - low_e[k][i])
+            worst["position"] = min(worst["position"], room)
+            if room <= 0.0:
+                return result(False, f"the position may leave its tube in dimension {i} on "
+                              f"[{t:.4f}, {t + h:.4f}] s (the enclosure of x1 reaches "
+                              f"{-room:.3g} half-widths beyond its edge)", t, i)
+            gap = min(room_up[k][i] - p_hi, p_lo - room_low[k][i])
+            e1_path = max(1.0 - 2.0 * gap / width_max[k][i], reach1[i])
+            dr = virtual_velocity_change(k1, h, reach1[i], e1_path, speed, move[k][i],
+                                         width_min[k][i], width_max[k][i])
+            # velocity stage: law (13)'s transform on |z| < rho2, the change of r on top
+            pull2 = 2.0 * h * k2 / rho_k[i]
+            s_peak = float(peak(np.array(rho_k[i] / (g_min * pull2))))
+            q_lo, q_hi, z_lo, z_hi = axis_interval(
+                box2[i][0], box2[i][1], 0.0, rho_k[i], pull2, g_min, g_max, s_peak,
+                h * drift, h * others, cpl, 0.0)
+            edge = rho_n[i] * (1.0 - RHO_ROUNDING)
+            vroom = 1.0 - max(-(q_lo - dr), q_hi + dr) / edge
+            worst["velocity"] = min(worst["velocity"], vroom)
+            if min(room, vroom) < worst["least"]:
+                worst.update(least=min(room, vroom), t=t, i=i)
+            if vroom <= 0.0:
+                return result(False, f"the velocity error may leave its tube in dimension "
+                              f"{i} on [{t:.4f}, {t + h:.4f}] s (|e2| up to "
+                              f"{1.0 - vroom:.4g}; the change of r alone is {dr / edge:.3g} "
+                              "of rho2)", t, i)
+            box_n = [(x_lo - centre_l[k + 1][i]) / half_l[k + 1][i],
+                     (x_hi - centre_l[k + 1][i]) / half_l[k + 1][i]]
+            reach_n = max(-box_n[0], box_n[1], reach1[i])
+            if reach_n >= 1.0:
+                return result(False, f"|e1_{i}| may reach {reach_n:.6g} at t = {t + h:.4f} s",
+                              t, i)
+            dr_end = min(dr, step_velocity_change(
+                k1, h, box1[i][0], box1[i][1],
+                (centre_l[k][i] - centre_l[k + 1][i]) / half_l[k + 1][i],
+                half_l[k][i] / half_l[k + 1][i], reach_n, half_l[k][i], half_l[k + 1][i],
+                h * z_abs + 0.5 * h * h * accel))
+            next1.append(box_n)
+            next2.append([(z_lo - dr_end) / rho_n[i], (z_hi + dr_end) / rho_n[i]])
+        box1, box2 = next1, next2
+    top[0] = max(top[0], max(max(-a, b) for a, b in box1))
+    top[1] = max(top[1], max(max(-a, b) for a, b in box2))
+    data["horizon"] = float(samples.t[count])
+    return result(True, "")
+
+
+def certify_stage(tube: TubeDesign, spec: Spec, stage: SecondStage) -> tuple[bool, dict]:
+    """:func:`check_cascade_sampled` for ``spec``'s declared plants (:func:`cascade_class`)
+    on ``tube`` sampled at its rate: the design's certifier
+    (:func:`~stt_codegen.design.cascade_gain.certified_stage` asks it).
+
+    Parameters
+    ----------
+    tube : TubeDesign
+        The position tube.
+    spec : Spec
+        With a second-order ``plant.model``.
+    stage : SecondStage
+        The second stage to certify.
+
+    Returns
+    -------
+    passed : bool
+    report : dict
+        :attr:`CascadeCheck.data` with ``passed``, ``reason``, ``time``, ``dimension``.
+    """
+    check = cascade_check_of(tube, spec, stage)
+    return check.passed, {**check.data, "passed": check.passed, "reason": check.reason,
+                          "time": check.time, "dimension": check.dimension}
+
+
+@lru_cache(maxsize=64)
+def cascade_check_of(tube: TubeDesign, spec: Spec, stage: SecondStage) -> CascadeCheck:
+    """:func:`check_cascade_sampled` of ``stage`` on ``tube`` for ``spec``'s declared
+    plants, once per process (the design, ``verify`` and the rate search ask again).
+
+    Parameters
+    ----------
+    tube : TubeDesign
+        The position tube, sampled at its rate.
+    spec : Spec
+        With a second-order ``plant.model``.
+    stage : SecondStage
+        The second stage to certify.
+
+    Returns
+    -------
+    CascadeCheck
+    """
+    with reference.numpy_math():
+        samples = sample_tube(tube)
+    return check_cascade_sampled(tube, samples, stage, cascade_class(spec),
+                                 spec.second_order.initial_velocity)
+
+
+def _double_integrator_terms(p: dict, n: int) -> tuple[float, float, list[float]]:
+    return 1.0 / p["mass"], 0.0, [0.0] * n
+
+
+def _quadrotor_terms(p: dict, n: int) -> tuple[float, float, list[float]]:
+    offset = [0.0] * n
+    offset[2] = p["gravity"]
+    return 1.0 / p["mass"], p["drag"] / p["mass"], offset
+
+
+#: The second-order models with ``g = I / m`` and ``|f_i| <= slope |x2_i| + offset_i``:
+#: ``(parameters by name, n) -> (g, slope, offset)``. A model not here (the two-link arm)
+#: has no derived bounds, so its certificate covers the declared class only.
+MASS_MODEL_TERMS = {
+    "double-integrator": _double_integrator_terms,
+    "quadrotor": _quadrotor_terms,
+}
+
+
+def model_within_class(spec: Spec) -> tuple[bool, str, dict]:
+    """Whether the spec's own simulated plant (``plant.model`` with ``plant.parameters``)
+    belongs to its :func:`cascade_class`, so that the certificate covers it.
+
+    ``double-integrator``: ``g = I / m``, ``f = 0``. ``quadrotor``: ``g = I / m``, ``f =
+    -(c / m) x2 - g0 e3``, so ``|f_i| <= (c / m) |x2_i| + g0 [i = 3]``: within the drift
+    bound where ``|x2_i| < velocity_bound_i`` (which the certificate proves); without a
+    velocity bound only when ``c = 0``. ``two-link-arm``: not checked (its ``M(q)^-1`` and
+    Coriolis terms are not bounded here), so not covered.
+
+    Parameters
+    ----------
+    spec : Spec
+        With a second-order ``plant.model``.
+
+    Returns
+    -------
+    ok : bool
+    words : str
+    data : dict
+    """
+    order = spec.second_order
+    cls = cascade_class(spec)
+    p = dict(zip(SECOND_ORDER_PLANTS[order.model].parameters, order.parameters))
+    terms = MASS_MODEL_TERMS.get(order.model)
+    if terms is None:
+        return False, (f"the {order.model} model's bounds are not derived: the certificate "
+                       "covers the declared class only, not this plant"), {}
+    n = spec.dimension
+    g, slope, offset = terms(p, n)
+    if slope > 0 and cls.velocity_bound is None:
+        drift = math.inf
+    else:
+        drift = max(offset[i] + slope * (cls.velocity_bound[i] if slope > 0 else 0.0)
+                    for i in range(n))
+    bad = []
+    if not cls.g_min <= g <= cls.g_max:
+        bad.append(f"g = 1/mass = {g:.6g} outside input_gain [{cls.g_min:g}, {cls.g_max:g}]")
+    if drift > cls.drift_bound * (1 + 1e-12):
+        bad.append(f"max |f_i| = {drift:.6g} (within velocity_bound) exceeds drift_bound "
+                   f"{cls.drift_bound:g}")
+    data = {"input_gain": g, "drift": drift}
+    if bad:
+        return False, (f"the spec's {order.model} plant is outside the class the certificate "
+                       "covers: " + "; ".join(bad)), data
+    return True, (f"the spec's {order.model} plant (g = {g:.6g} I, max |f_i| = {drift:.6g} "
+                  "within velocity_bound) is in the declared class"), data

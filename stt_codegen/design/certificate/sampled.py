@@ -1,0 +1,419 @@
+"""Sampled-data check: the deployed, sampled law (13) keeps the plant in the tube.
+
+Theorem 4.1 is a continuous-time result. The deployed controller reads ``x(t_k)`` at
+``t_k = k dt``, computes ``u_k`` by law (13) with its clamps and holds it until
+``t_{k+1}`` (zero-order hold). This module proves, for every plant of a plant class
+(:class:`~stt_codegen.design.certificate.plant_class.PlantClass`: the spec's plant model and
+``[assumptions]``), that ``|e_i| < 1`` at and between samples on the whole horizon of the
+tube's certificate. The condition and its proof are in ``docs/sampled-data.md``. It
+propagates, from ``e(0)``, an enclosure of ``e(t_k)`` that is the intersection of
+
+* a box, one interval per axis (:mod:`.sampled_axis`: each axis on its own, the other
+  inputs of its block of ``g`` taken at their worst through the coupling), and
+* one Lyapunov ball per block of ``g`` (:mod:`.lyapunov`: ``sum atanh(e_i)^2 <= r^2``,
+  the level of law (13)'s own function, in which the symmetric part of ``g`` enters as a
+  matrix bound and its skew part cancels to first order).
+
+Each part bounds the other: the box gives the ball its curvature, the ball caps the
+other inputs in the box. On every interval ``x`` must stay strictly inside the
+certified enclosure of the tube (:func:`~stt_codegen.design.certificate.enclose_tube`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from functools import lru_cache
+
+import numpy as np
+
+from .enclosures import enclose_tube
+from .refine import certify_tube
+from ..gain import derived_gain
+from ..samples import TubeSamples, sample_tube
+from ...spec.assumptions import Assumptions
+from ...spec.loader import Spec
+from ...tube import reference
+from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
+from .lyapunov import level_after, next_level, others_max
+from .plant_class import PlantClass, plant_class
+from .sampled_axis import axis_interval, peak, phi_slope_scalar
+
+__all__ = ["RATE_FACTORS", "SampledCheck", "check_sampled", "check_sampled_first_per_axis",
+           "lowest_rate", "sampled_check_of"]
+
+#: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
+RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
+#: Iterations of the bootstrap of a ball's between-samples level (see :func:`_ball`).
+BALL_ITERATIONS = 12
+
+
+@dataclass(frozen=True)
+class SampledCheck:
+    """Outcome of :func:`check_sampled`.
+
+    Attributes
+    ----------
+    passed : bool
+        The sufficient condition holds: no plant of the class leaves the tube.
+    level : float
+        The proved bound of ``max_i |e_i(t_k)|`` at the samples; when failed, the bound
+        reached before the failure.
+    margin : float
+        Smallest relative room left, ``min`` over intervals and dimensions of the room to
+        the tube's edge between samples divided by the tube's half-width; negative when
+        failed.
+    time : float
+        Start of the sampling interval where the margin is smallest, seconds.
+    dimension : int
+        Dimension (0-based) where the margin is smallest.
+    reason : str
+        Empty when passed, else what fails, in numbers.
+    data : dict
+        Numbers for reports.
+    abs_e : ndarray or None, shape (K + 1, n)
+        When passed: the proved bound of ``|e_i(t_k)|`` at every sample of ``samples``
+        (read by :func:`stt_codegen.design.certificate.actuator.sampled_error_bound` for the input
+        bound); ``None`` otherwise.
+    """
+
+    passed: bool
+    level: float
+    margin: float
+    time: float
+    dimension: int
+    reason: str
+    data: dict = field(default_factory=dict)
+    abs_e: np.ndarray | None = field(default=None, compare=False, repr=False)
+
+
+def _atanh_reach(lo: float, hi: float) -> float:
+    """``max |atanh e|`` over ``e`` in ``[lo, hi]`` (``inf`` if it reaches ``|e| >= 1``)."""
+    top = max(-lo, hi)
+    return math.atanh(top) if top < 1.0 else math.inf
+
+
+def _as_class(plants: Assumptions | PlantClass) -> PlantClass:
+    return plants if isinstance(plants, PlantClass) else PlantClass(plants)
+
+
+def _ball(level: float, limits: list[float], halves: list[float], reach: list[float],
+          gain: float, dt: float, g_min: float, g_max: float, skew: float,
+          push: float) -> tuple[float, float]:
+    """``(R_mid, R_end)`` of one block's ball on one interval, or ``(inf, inf)``.
+
+    ``W <= R_mid^2`` on the whole interval and ``W <= R_end^2`` at its end, in this
+    sample's coordinates. The curvature along the step needs a bound of ``|e_i|`` along
+    it: the per-axis path range ``reach`` and a guessed level ``R``; the guess holds when
+    the level it gives is strictly below it (a first-exit argument, docs/sampled-data.md).
+    """
+    guess = level * (1.0 + 1e-3) + 1e-6
+    for _ in range(BALL_ITERATIONS):
+        top = math.tanh(guess)
+        if top > E_MAX:
+            break
+        rho = [min(r, top) for r in reach]
+        curvature = [phi_slope_scalar(x) / h ** 2 for x, h in zip(rho, halves)]
+        end_sq = level_after(level, limits, halves, curvature, gain, dt, g_min, g_max,
+                             skew, push)
+        if not math.isfinite(end_sq):
+            break
+        mid = math.sqrt(max(level * level, end_sq))
+        if mid < guess:
+            return mid, math.sqrt(max(end_sq, 0.0))
+        guess = mid + 0.5 * (mid - level) + 1e-9
+    return math.inf, math.inf
+
+
+def check_sampled(design: TubeDesign, samples: TubeSamples,
+                  plants: Assumptions | PlantClass, gain: float | None = None, *,
+                  lyapunov: bool = True) -> SampledCheck:
+    """Prove that the sampled closed loop keeps ``|e_i| < 1`` at and between samples.
+
+    A sufficient condition, checked by propagating an enclosure of ``e(t_k)`` (a box and
+    one Lyapunov ball per block of ``g``) from ``e(0)`` (``docs/sampled-data.md``): on
+    every sampling interval, for every plant ``x_dot = f(x) + g(x) u + w`` of the class and
+    every ``e(t_k)`` in the enclosure, ``x`` stays strictly inside the tube's certified
+    enclosure until ``t_{k+1}``, and ``e(t_{k+1})`` lies in the next enclosure, inside
+    ``[-E_MAX, E_MAX]``.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        Gives ``rate_hz``, ``x(0)`` and, unless ``gain`` is given, ``k`` of law (13).
+    samples : TubeSamples
+        The deployed tube at the rate of ``design``
+        (:func:`~stt_codegen.design.samples.sample_tube`).
+    plants : Assumptions or PlantClass
+        The plant bounds (:func:`~stt_codegen.design.certificate.plant_class.plant_class` for a spec,
+        which evaluates its plant model on the tube); ``input_gain[0] > 0`` is needed.
+    gain : float, optional
+        ``k`` to check instead of ``design.gain``.
+    lyapunov : bool
+        Use the Lyapunov balls (default); ``False`` keeps the per-axis argument alone,
+        without the Lyapunov level (for comparisons).
+
+    Returns
+    -------
+    SampledCheck
+        The verdict, its level and margin, the time and dimension of a failure, and the
+        bounds of ``|e|``.
+    """
+    cls = _as_class(plants)
+    a = cls.assumptions
+    k_gain = design.gain if gain is None else float(gain)
+    n = design.dimension
+    dt = 1.0 / design.rate_hz
+    blocks = a.coupled_blocks(n)
+    block_of = {i: b for b in blocks for i in b}
+    balls = [b for b in blocks if len(b) > 1] if lyapunov else []
+    lo, hi = samples.gamma_lower, samples.gamma_upper
+    width = hi - lo
+    data = {"gain": k_gain, "rate_hz": design.rate_hz, "input_gain": list(a.input_gain),
+            "input_gain_skew": a.input_gain_skew,
+            "input_gain_coupling": a.input_gain_coupling, "drift_bound": a.drift_bound,
+            "disturbance_bound": a.disturbance_bound, "blocks": [list(b) for b in blocks]}
+
+    def fail(reason: str, margin: float, t: float, i: int, level: float) -> SampledCheck:
+        return SampledCheck(False, level, margin, t, i, reason, data)
+
+    if a.input_gain[0] <= 0:
+        return fail("input_gain[0] must be positive (Assumption 2): law (13) cannot pull "
+                    "the state back otherwise", -math.inf, 0.0, 0, math.nan)
+    if width.min() < GAMMA_D_MIN:
+        return fail(f"the tube is narrower than GAMMA_D_MIN = {GAMMA_D_MIN:g} at a sample",
+                    -math.inf, 0.0, 0, math.nan)
+    enclosure = enclose_tube(design, samples)
+    count = len(enclosure.t_start)
+    bounds = cls.on_intervals(enclosure, count)
+    data["refined_on_the_tube"] = list(bounds.refined)
+    half = 0.5 * width
+    centre = 0.5 * (hi + lo)
+    pull = 4.0 * dt * k_gain / width                      # (K+1, n): dt |u| / phi per unit g
+    peak_out = peak(half[:count] / (pull[:count] * bounds.g_min[:, None])).tolist()
+    up_e = ((enclosure.upper_min - centre[:count]) / half[:count]).tolist()
+    low_e = ((enclosure.lower_max - centre[:count]) / half[:count]).tolist()
+    alpha = (half[:count] / half[1:count + 1]).tolist()
+    beta = ((centre[:count] - centre[1:count + 1]) / half[1:count + 1]).tolist()
+    half_l, centre_l, pull_l = half.tolist(), centre.tolist(), pull.tolist()
+    g_min_l, g_max_l = bounds.g_min.tolist(), bounds.g_max.tolist()
+    skew_l, coupling_l, push_l = (bounds.skew.tolist(), bounds.coupling.tolist(),
+                                  bounds.push.tolist())
+    e0 = ((np.array(design.initial_state) - centre[0]) / half[0]).tolist()
+    box = [[v, v] for v in e0]                            # enclosure of e(t_k), per dim
+    level = {b: math.sqrt(sum(math.atanh(e0[i]) ** 2 for i in b)) for b in balls}
+    worst, worst_t, worst_i = math.inf, 0.0, 0
+    top = max(abs(v) for v in e0)
+    ball_lost = ball_max = 0.0
+    abs_e = []                                            # the bound of |e(t_k)|, per sample
+    for k in range(count):
+        t = float(samples.t[k])
+        reach_e = [max(-x, y) for x, y in box]
+        abs_e.append(reach_e)
+        if max(reach_e) > E_MAX:
+            i = int(np.argmax(reach_e))
+            return fail(f"|e_{i}| may reach {max(reach_e):.6g} at t = {t:.4f} s, beyond the "
+                        f"clamp E_MAX", -math.inf, t, i, top)
+        limits = [math.atanh(v) for v in reach_e]         # max |atanh e_i| over the box
+        for b in balls:                                   # the box's corner bounds W too
+            level[b] = min(level[b], math.sqrt(sum(limits[i] ** 2 for i in b)))
+            ball_max = max(ball_max, level[b])
+        h_k = half_l[k]
+        path, ends = [], []
+        for i in range(n):
+            others = [j for j in block_of[i] if j != i]
+            z_sq = (others_max([limits[j] for j in others], level.get(block_of[i], math.inf),
+                               [h_k[j] for j in others]) if others else 0.0)
+            p_lo, p_hi, x_lo, x_hi = axis_interval(
+                box[i][0], box[i][1], centre_l[k][i], h_k[i], pull_l[k][i], g_min_l[k],
+                g_max_l[k], peak_out[k][i], dt * push_l[k], dt * 2.0 * k_gain * math.sqrt(z_sq),
+                coupling_l[k], skew_l[k])
+            path.append([(p_lo - centre_l[k][i]) / h_k[i], (p_hi - centre_l[k][i]) / h_k[i]])
+            ends.append((x_lo, x_hi))
+        end_level = {}
+        for b in balls:
+            mid, end = _ball(level[b], [limits[i] for i in b], [h_k[i] for i in b],
+                             [min(max(-path[i][0], path[i][1]), 1.0) for i in b], k_gain, dt,
+                             g_min_l[k], g_max_l[k], skew_l[k], push_l[k])
+            if math.isfinite(mid):
+                edge = math.tanh(mid)
+                for i in b:
+                    path[i] = [max(path[i][0], -edge), min(path[i][1], edge)]
+            else:
+                ball_lost += 1
+            end_level[b] = end
+        for i in range(n):
+            room = min(up_e[k][i] - path[i][1], path[i][0] - low_e[k][i])
+            if room < worst:
+                worst, worst_t, worst_i = room, t, i
+            if room <= 0.0:
+                return fail(f"a plant of the class may leave the tube in dimension {i} on "
+                            f"[{t:.4f}, {t + dt:.4f}] s (the enclosure of x reaches "
+                            f"{-room:.3g} half-widths beyond its edge)", room, t, i, top)
+        h_n, c_n = half_l[k + 1], centre_l[k + 1]
+        # |atanh e_i(t_{k+1})| in this sample's coordinates, from the per-axis end ranges
+        end_limits = [_atanh_reach((x_lo - centre_l[k][i]) / h_k[i],
+                                   (x_hi - centre_l[k][i]) / h_k[i])
+                      for i, (x_lo, x_hi) in enumerate(ends)]
+        box = [[(x_lo - c_n[i]) / h_n[i], (x_hi - c_n[i]) / h_n[i]]
+               for i, (x_lo, x_hi) in enumerate(ends)]
+        for b in balls:
+            r = (next_level(end_level[b], [alpha[k][i] for i in b], [beta[k][i] for i in b],
+                            [end_limits[i] for i in b])
+                 if math.isfinite(end_level[b]) else math.inf)
+            level[b] = r
+            if math.isfinite(r):
+                edge = math.tanh(r)
+                for i in b:
+                    box[i] = [max(box[i][0], -edge), min(box[i][1], edge)]
+        top = max(top, max(max(-x, y) for x, y in box))
+    data.update({"max_abs_e": top, "margin": worst, "max_level": ball_max,
+                 "intervals_without_ball": int(ball_lost)})
+    abs_e.append([max(-x, y) for x, y in box])
+    return SampledCheck(True, top, worst, worst_t, worst_i, "", data, np.array(abs_e))
+
+
+def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,
+                                 plants: Assumptions | PlantClass,
+                                 gain: float | None = None) -> SampledCheck:
+    """:func:`check_sampled` with the per-axis argument alone, and with the Lyapunov balls
+    only where that fails.
+
+    The balls only cut the per-axis enclosures (every step intersects with them), so a pass
+    of the per-axis argument is a pass of the whole check: the verdict is the whole
+    check's, at the cost of the per-axis argument wherever it suffices (the balls cost
+    about four times as much). When the per-axis argument passes, its bounds are the ones
+    reported, which the balls could only have tightened.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        As :func:`check_sampled`.
+    samples : TubeSamples
+        As :func:`check_sampled`.
+    plants : Assumptions or PlantClass
+        As :func:`check_sampled`.
+    gain : float, optional
+        As :func:`check_sampled`.
+
+    Returns
+    -------
+    SampledCheck
+        The per-axis argument's when it passes, else the whole check's.
+    """
+    per_axis = check_sampled(design, samples, plants, gain, lyapunov=False)
+    return per_axis if per_axis.passed else check_sampled(design, samples, plants, gain)
+
+
+def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
+                     ) -> tuple[TubeSamples, SampledCheck]:
+    """The sampled-data check of a designed tube for its spec's plant class, once per
+    process: the design's tracking proof, the ``[actuator]`` proof and ``verify`` ask for
+    the same check of the same tube (a bundled design is asked for again and again).
+
+    The tube is sampled with numpy's ufuncs for the oracle's exp/log/tanh (within an ulp
+    of libm, as the certificate does: every margin here is far above rounding), over the
+    default horizon of :func:`~stt_codegen.design.samples.sample_tube`.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        With its gain.
+    spec : Spec
+        Its plant class (:func:`~stt_codegen.design.certificate.plant_class.plant_class`).
+    per_axis_first : bool
+        :func:`check_sampled_first_per_axis` (the same verdict; where the per-axis argument
+        passes, its bounds, which the Lyapunov balls could only tighten) instead of
+        :func:`check_sampled` with the balls everywhere.
+
+    Returns
+    -------
+    samples : TubeSamples
+        The design's tube at its sampling instants.
+    check : SampledCheck
+        The verdict (cached per process).
+    """
+    return _sampled_check(design, spec, bool(per_axis_first))
+
+
+@lru_cache(maxsize=16)
+def _sampled_check(design: TubeDesign, spec: Spec, per_axis_first: bool
+                   ) -> tuple[TubeSamples, SampledCheck]:
+    """:func:`sampled_check_of`, cached on its arguments as given positionally."""
+    with reference.numpy_math():
+        samples = sample_tube(design)
+        plants = plant_class(spec)
+        check = (check_sampled_first_per_axis(design, samples, plants) if per_axis_first
+                 else check_sampled(design, samples, plants))
+    return samples, check
+
+
+def lowest_rate(design: TubeDesign, spec: Spec, plants: Assumptions | PlantClass,
+                explicit_gain: float | None = None,
+                passes_at_rate: bool | None = None) -> tuple[float | None, float | None]:
+    """The lowest of ``rate_hz`` times :data:`RATE_FACTORS` at which the design holds.
+
+    At each rate the tube keeps its circumvents and segments, is certified again
+    (:func:`~stt_codegen.design.certificate.certify_tube`: the deployed ``alpha`` and the
+    sampling-rate check depend on the rate), and the sampled check
+    (:func:`check_sampled`) must pass with the gain the design would use there:
+    ``explicit_gain`` if given, else :func:`~stt_codegen.design.gain.derived_gain` at that
+    rate's certified narrowest width. When the design holds at ``rate_hz`` the factors
+    below 1 are tried in increasing order; else the largest factor first (if it fails, no
+    factor is reported), then the others above 1 in increasing order.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The design: its tube, ``rate_hz`` and gain.
+    spec : Spec
+        For the certificate (state space, obstacles, target).
+    plants : Assumptions or PlantClass
+        The plant bounds the sampled check uses.
+    explicit_gain : float, optional
+        The gain ``k`` of law (13) at every rate (the spec's ``controller.gain``); default the
+        gain derived at each rate.
+    passes_at_rate : bool, optional
+        Whether the check already passed at ``design.rate_hz`` with its gain (saves a run);
+        default: find out.
+
+    Returns
+    -------
+    rate_hz, gain : float or None
+        The lowest rate found, Hz, and the gain used there; ``(None, None)`` when no factor
+        tried works.
+    """
+    assumptions = _as_class(plants).assumptions
+
+    def passes(factor: float) -> tuple[bool, float]:
+        trial = replace(design, rate_hz=design.rate_hz * factor)
+        certificate = certify_tube(trial, spec)
+        gain = (explicit_gain if explicit_gain is not None
+                else derived_gain(certificate.min_width, trial.rate_hz, assumptions))
+        if not certificate.passed:
+            return False, gain
+        return check_sampled_first_per_axis(trial, sample_tube(trial), plants, gain).passed, gain
+
+    below = [f for f in RATE_FACTORS if f < 1.0]
+    above = [f for f in RATE_FACTORS if f > 1.0]
+    if passes_at_rate is None:
+        passes_at_rate, gain_at_rate = passes(1.0)
+    else:
+        gain_at_rate = (explicit_gain if explicit_gain is not None
+                        else derived_gain(certify_tube(design, spec).min_width,
+                                          design.rate_hz, assumptions))
+    if passes_at_rate:
+        for factor in below:
+            ok, gain = passes(factor)
+            if ok:
+                return design.rate_hz * factor, gain
+        return design.rate_hz, gain_at_rate
+    # the fastest rate first: when even it fails, one check answers instead of all of them
+    ok, fastest_gain = passes(above[-1])
+    if not ok:
+        return None, None
+    for factor in above[:-1]:
+        ok, gain = passes(factor)
+        if ok:
+            return design.rate_hz * factor, gain
+    return design.rate_hz * above[-1], fastest_gain

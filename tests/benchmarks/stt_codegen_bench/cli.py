@@ -1,0 +1,249 @@
+"""``stt-codegen bench arenas | tasks | drive | step | scaling | covering | alpha | second-order |
+stl``: the benchmarks and studies of :mod:`stt_codegen_bench`."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from stt_codegen.errors import SpecError
+from stt_codegen.spec.plants import plant_entry
+from stt_codegen.cli.common import add_json_argument, add_spec_argument
+
+__all__ = ["configure_bench"]
+
+
+def _non_negative_int(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be non-negative, got {value}")
+    return value
+
+
+def _int_list(text: str, field: str) -> list[int]:
+    """``"1,10,100"`` as ``[1, 10, 100]``; :class:`SpecError` naming ``field`` otherwise."""
+    try:
+        values = [int(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise SpecError(field, f"expected a comma-separated list of integers, got {text!r}") from None
+    if not values:
+        raise SpecError(field, "empty list")
+    return values
+
+
+def _cmd_arenas(args: argparse.Namespace) -> int:
+    if plant_entry(args.plant).order == 2:    # the cascade beside A* + tracker
+        from .second_order_arenas import (format_double_integrator_report,
+                                                 run_double_integrator_bench)
+        report = run_double_integrator_bench(args.count, args.seed)
+        print(json.dumps(report, indent=1, sort_keys=True) if args.json
+              else format_double_integrator_report(report))
+        return 0
+    from .arenas_bench import format_arenas_report, run_arenas_bench, write_specs
+    if args.specs:
+        write_specs(Path(args.specs), args.count, args.seed)
+    report = run_arenas_bench(args.count, args.seed, workers=args.workers,
+                              scheduler=args.scheduler,
+                              methods=tuple(args.methods.split(",")) if args.methods else None,
+                              progress=not args.no_progress)
+    print(json.dumps(report, indent=1, sort_keys=True, allow_nan=False) if args.json
+          else format_arenas_report(report))
+    return 0
+
+
+def _cmd_drive(args: argparse.Namespace) -> int:
+    from .office_arenas import format_office_report, run_office_bench
+    report = run_office_bench(args.count, args.seed)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_office_report(report))
+    return 0
+
+
+def _cmd_step(args: argparse.Namespace) -> int:
+    from .step import format_step_report, run_step_bench
+    report = run_step_bench(args.spec, steps=args.steps)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_step_report(report))
+    return 0
+
+
+def _cmd_scaling(args: argparse.Namespace) -> int:
+    from .scaling import format_scaling_report, run_scaling_bench
+    report = run_scaling_bench(_int_list(args.obstacles, "obstacles"),
+                               _int_list(args.dimensions, "dimensions"),
+                               compile_timeout=args.compile_timeout)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_scaling_report(report))
+    return 0
+
+
+def _cmd_covering(args: argparse.Namespace) -> int:
+    from .covering import format_covering_report, run_covering_bench
+    report = run_covering_bench(args.seed, args.count, args.tolerance)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_covering_report(report))
+    return 0
+
+
+def _cmd_alpha(args: argparse.Namespace) -> int:
+    from .alpha import format_alpha_report, run_alpha_bench
+    report = run_alpha_bench(args.spec)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_alpha_report(report))
+    return 0
+
+
+def _cmd_tasks(args: argparse.Namespace) -> int:
+    from .tasks_bench import format_tasks_report, run_tasks_bench
+    report = run_tasks_bench(args.count, args.seed, progress=not args.no_progress)
+    print(json.dumps(report, indent=1, sort_keys=True, allow_nan=False) if args.json
+          else format_tasks_report(report))
+    return 0
+
+
+def _cmd_second_order(args: argparse.Namespace) -> int:
+    from .second_order_study import format_second_order_report, run_second_order_study
+    report = run_second_order_study(args.spec, args.count, args.seed, spread=args.spread,
+                                    corners=args.corners, adversary=args.adversary)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_second_order_report(report))
+    return 0
+
+
+def _cmd_stl(args: argparse.Namespace) -> int:
+    from .stl_bench import format_stl_report, run_stl_bench
+    names = [n.strip() for n in args.scenarios.split(",") if n.strip()] if args.scenarios \
+        else None
+    report = run_stl_bench(names, horizon=args.horizon,
+                           solver=None if args.solver == "none" else args.solver,
+                           specs=Path(args.specs) if args.specs else None)
+    if args.json:
+        report = {"rows": [{k: v for k, v in row.items() if k != "spec"}
+                           for row in report["rows"]], "order_note": report["order_note"]}
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_stl_report(report))
+    return 0
+
+
+def configure_bench(bench: argparse.ArgumentParser) -> None:
+    """Sub-subcommands ``bench arenas``, ``tasks``, ``drive``, ``step``, ``scaling``, ``covering``,
+    ``alpha``, ``second-order`` and ``stl``.
+
+    Parameters
+    ----------
+    bench : argparse.ArgumentParser
+        The parser of ``stt-codegen bench``; its sub-subcommands are added to it, each with its
+        ``handler``.
+    """
+    bench.description = ("Benchmarks. Every comparison is measured side by side in one run on "
+                         "this machine; ratios, not absolute times, are the result.")
+    sub = bench.add_subparsers(dest="bench_command", required=True, metavar="BENCH")
+
+    p = sub.add_parser("arenas", help="STT vs A* and RRT* (plus a tracker) on random arenas")
+    p.add_argument("--count", type=int, default=100, help="number of arenas (default: 100)")
+    p.add_argument("--seed", type=_non_negative_int, default=0, help="arena seed (default: 0)")
+    p.add_argument("--workers", type=int, default=None, metavar="W",
+                   help="local worker processes (default: the usable CPUs)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on an existing Dask distributed scheduler instead")
+    p.add_argument("--methods", default=None, metavar="LIST",
+                   help="comma-separated subset of stt,astar,rrtstar (default: all available)")
+    p.add_argument("--specs", default=None, metavar="DIR",
+                   help="also write the arenas as spec files into DIR")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--plant", choices=("single-integrator", "double-integrator"),
+                   default="single-integrator",
+                   help="double-integrator: the cascade law (docs/second-order.md) beside "
+                        "A* + a velocity-loop tracker, sequentially (default: %(default)s)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_arenas)
+
+    p = sub.add_parser("tasks", help="timed reach tasks: STT vs sequential A* with waiting "
+                                     "(plus the tracker) on random problems")
+    p.add_argument("--count", type=int, default=20, help="number of problems (default: 20)")
+    p.add_argument("--seed", type=_non_negative_int, default=0,
+                   help="problem seed (default: 0)")
+    p.add_argument("--no-progress", action="store_true", help="no line per problem")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_tasks)
+
+    p = sub.add_parser("drive", help="a differential-drive base beside a holonomic one on "
+                                     "random offices (docs/differential-drive.md)")
+    p.add_argument("--count", type=int, default=100, help="number of offices (default: 100)")
+    p.add_argument("--seed", type=_non_negative_int, default=0, help="office seed (default: 0)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_drive)
+
+    p = sub.add_parser("step", help="cost of one controller step: reference, CasADi, "
+                                    "generated Python, generated C")
+    add_spec_argument(p)
+    p.add_argument("--steps", type=int, default=None, metavar="N",
+                   help="C steps per timed run (default: 100000)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_step)
+
+    p = sub.add_parser("scaling", help="code size, generation time and step cost vs "
+                                       "obstacles and state dimension")
+    p.add_argument("--obstacles", default="1,10,100,1000", metavar="LIST",
+                   help="obstacle counts (default: %(default)s)")
+    p.add_argument("--dimensions", default="2,3,6,12", metavar="LIST",
+                   help="state dimensions (default: %(default)s)")
+    p.add_argument("--compile-timeout", type=float, default=900.0, metavar="S",
+                   help="give up compiling one design after S seconds (default: %(default)s)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_scaling)
+
+    p = sub.add_parser("covering", help="covering random polygons by boxes, and the design "
+                                        "around them: boxes and seconds")
+    p.add_argument("--count", type=int, default=80, help="polygons (default: %(default)s)")
+    p.add_argument("--seed", type=_non_negative_int, default=0,
+                   help="polygon seed (default: %(default)s)")
+    p.add_argument("--tolerance", type=float, default=0.02, metavar="M",
+                   help="covering tolerance of every polygon (default: %(default)s)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_covering)
+
+    p = sub.add_parser("alpha", help="the implicit alpha step: Newton iterations against "
+                                     "bisection, and convergence to a stiff solver")
+    p.add_argument("spec", metavar="SPEC", nargs="?", default="omnirobot-s1",
+                   help="bundled case name or spec file (default: %(default)s)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_alpha)
+
+    p = sub.add_parser("second-order", help="the cascade law on random second-order plants "
+                                            "within a case's declared bounds")
+    p.add_argument("spec", metavar="SPEC", nargs="?", default="second-order-s1",
+                   help="bundled case or spec file with a second-order plant.model "
+                        "(default: %(default)s)")
+    p.add_argument("--count", type=int, default=300, help="plants (default: %(default)s)")
+    p.add_argument("--seed", type=_non_negative_int, default=0, help="seed (default: 0)")
+    p.add_argument("--spread", type=float, default=1.0, metavar="F",
+                   help="draw plants F times beyond the declared bounds (default: 1, within)")
+    p.add_argument("--corners", action="store_true",
+                   help="plants at the corners of the declared bounds, with the largest "
+                        "disturbance")
+    p.add_argument("--adversary", action="store_true",
+                   help="also search the certified class for a member that leaves a tube "
+                        "(extreme members switched per sampling interval)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_second_order)
+
+    p = sub.add_parser("stl", help="stlpy's benchmark scenarios written as specs, designed, "
+                                   "run with the generated C and judged by rtamt "
+                                   '(pip install ".[stl]")')
+    p.add_argument("--scenarios", default=None, metavar="LIST",
+                   help="comma-separated subset of ReachAvoid, EitherOr, NarrowPassage, "
+                        "RandomMultitarget, DoorPuzzle, NonlinearReachAvoid, SteppingStones "
+                        "(default: all)")
+    p.add_argument("--horizon", type=int, default=None, metavar="T",
+                   help="stlpy's horizon T in steps for every scenario (default: each "
+                        "example's)")
+    p.add_argument("--solver", choices=("scipy", "drake-bnb", "none"), default="scipy",
+                   help="stlpy's solver run beside: scipy (ScipyGradientSolver), drake-bnb "
+                        "(DrakeMICPSolver with Drake's branch and bound; pip install drake) "
+                        "or none (default: %(default)s)")
+    p.add_argument("--specs", default=None, metavar="DIR",
+                   help="also write the specs into DIR")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_stl)
