@@ -26,7 +26,7 @@ from typing import Any
 from xml.etree import ElementTree
 
 from .errors import SpecError
-from .spec.plants import plant_entry
+from .spec.plants import SECOND_ORDER_PLANTS, plant_entry
 from .system import atomic_write
 
 __all__ = ["DEFAULT_CONTACT_MARGIN", "DEFAULT_RATE_HZ", "JOINTS", "SECONDS_PER_CELL", "SERVOS",
@@ -335,7 +335,7 @@ def import_pointmaze(name: str, path: str | os.PathLike | None = None, *,
                                 "relative to itself)")
     on_mujoco = plant_entry(model).declared_bounds     # model = "mujoco": the MJCF is the plant
     if on_mujoco:
-        if plant_entry(model).order != 1:
+        if model in SECOND_ORDER_PLANTS:
             raise SpecError("model", f"{model!r} is not written by the importer: it drives the "
                                      "ball through velocity servos (model = \"mujoco\"); for "
                                      "PointMaze's force motors write the second-order spec "

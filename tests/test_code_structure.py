@@ -313,3 +313,134 @@ def test_no_module_compares_plant_model_names():
         if lines:
             found[str(path.relative_to(PACKAGE))] = lines
     assert not found, f"look the model up in a per-model table instead: {found}"
+
+
+#: The module that decides the controller variant (docs/architecture.md, "Controller variants").
+VARIANT_MODULE = PACKAGE / "spec" / "variants.py"
+#: The classes of the variants' stages (``Design.stage``).
+STAGE_CLASSES = frozenset({"LookAhead", "SecondStage"})
+
+
+def _variant_branches(tree: ast.AST) -> list[int]:
+    """Lines where code decides a controller variant itself rather than asking the variant
+    object: ``<x>.order`` or ``<x>.variant`` compared with ``==``/``!=``, ``drive`` or
+    ``stage`` (a name or an attribute) compared with ``None``, ``isinstance`` on a stage
+    class."""
+    def named(node: ast.expr, names: set[str]) -> bool:
+        return (isinstance(node, ast.Name) and node.id in names) or \
+            (isinstance(node, ast.Attribute) and node.attr in names)
+    lines = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Compare):
+            sides = (node.left, *node.comparators)
+            if any(isinstance(op, (ast.Eq, ast.NotEq)) for op in node.ops) and any(
+                    isinstance(side, ast.Attribute) and side.attr in ("order", "variant")
+                    for side in sides):
+                lines.append(node.lineno)
+            elif any(named(side, {"drive", "stage"}) for side in sides) and any(
+                    isinstance(side, ast.Constant) and side.value is None for side in sides):
+                lines.append(node.lineno)
+        elif (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+              and node.func.id == "isinstance" and len(node.args) == 2):
+            kinds = node.args[1]
+            kinds = kinds.elts if isinstance(kinds, ast.Tuple) else [kinds]
+            if any(named(k, set(STAGE_CLASSES)) for k in kinds):
+                lines.append(node.lineno)
+    return sorted(lines)
+
+
+def test_variant_branches_are_found():
+    tree = ast.parse("if spec.order == 2: pass\n"
+                     "a = plant_entry(m).order != 1\n"
+                     "b = 1 if design.spec.variant == 'cascade' else 2\n"
+                     "c = spec.drive is None\n"
+                     "d = stage is not None\n"
+                     "e = isinstance(stage, LookAhead)\n"
+                     "f = isinstance(s, (int, stage_module.SecondStage))\n"
+                     "g = spec.task_order == 'any'\n"
+                     "h = variant == free\n"
+                     "i = spec.order + 1\n"
+                     "j = x is None\n")
+    assert _variant_branches(tree) == [1, 2, 3, 4, 5, 6, 7]
+
+
+def variant_branches(package: Path) -> dict[str, list[int]]:
+    """Every variant branch of a package's tree (:func:`_variant_branches`) outside its
+    variant module, by file."""
+    found = {}
+    for path in sorted(package.rglob("*.py")):
+        if path.relative_to(package) == VARIANT_MODULE.relative_to(PACKAGE):
+            continue
+        lines = _variant_branches(ast.parse(path.read_text()))
+        if lines:
+            found[str(path.relative_to(package))] = lines
+    return found
+
+
+def test_the_controller_variant_is_decided_in_one_place():
+    """What differs between law (13), the cascade and the look-ahead law is a role of the
+    variant object (``spec/variants.py``): nowhere else does the package compare
+    ``order`` or ``variant``, test ``drive`` or ``stage`` against ``None`` or ask
+    ``isinstance`` of a stage class."""
+    found = variant_branches(PACKAGE)
+    assert not found, f"ask the ControllerVariant (spec/variants.py) instead: {found}"
+
+
+def _role_calls(tree: ast.AST) -> list[tuple[int, str | None]]:
+    """``(line, role)`` of each ``<variant>.entry(role)`` call (``None``: the role is not a
+    string literal) and of each ``variant_of_stage(...)`` call (role ``stage_class``)."""
+    calls = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Call):
+            continue
+        func = node.func
+        if isinstance(func, ast.Attribute) and func.attr == "entry":
+            arg = node.args[0] if len(node.args) == 1 and not node.keywords else None
+            calls.append((node.lineno, arg.value if isinstance(arg, ast.Constant)
+                          and isinstance(arg.value, str) else None))
+        elif isinstance(func, ast.Name) and func.id == "variant_of_stage":
+            calls.append((node.lineno, "stage_class"))
+    return calls
+
+
+def test_every_role_of_every_variant_resolves():
+    """Each variant fills every role of ``ROLES`` with a reference to a callable (a
+    function, or a class for ``stage_class``) that exists."""
+    from stt_codegen.spec.plants import VARIANTS
+    from stt_codegen.spec.variants import CONTROLLER_VARIANTS, ROLES
+    assert tuple(CONTROLLER_VARIANTS) == VARIANTS
+    for name, variant in CONTROLLER_VARIANTS.items():
+        assert variant.name == name and set(variant.roles) == set(ROLES)
+        for role in ROLES:
+            assert callable(variant.entry(role)), (name, role)
+
+
+def test_a_layer_resolves_only_roles_of_its_own_or_upper_layers():
+    """The variant module names behaviour in every layer by a dotted reference, resolved
+    on first use: a module may resolve a role only if every variant's function for it is
+    in the module's own package or one above it (the import rule of
+    :func:`test_no_package_imports_a_package_below_it`, applied to what is resolved)."""
+    from stt_codegen.spec.variants import CONTROLLER_VARIANTS
+    order = [name for name, _ in stated_layers()]
+    targets = {role: {package_of(ref.split(":")[0]) for v in CONTROLLER_VARIANTS.values()
+                      for r, ref in v.roles.items() if r == role
+                      and ref.startswith("stt_codegen.")}
+               for role in next(iter(CONTROLLER_VARIANTS.values())).roles}
+    offenders, seen = [], set()
+    for module, path in MODULES.items():
+        if path == VARIANT_MODULE:
+            continue
+        for line, role in _role_calls(ast.parse(path.read_text())):
+            if role not in targets:
+                offenders.append(f"{module}:{line} resolves {role!r}, not a literal role")
+                continue
+            seen.add(role)
+            below = [t for t in targets[role]
+                     if order.index(t) > order.index(package_of(module))]
+            if below:
+                offenders.append(f"{module}:{line} resolves {role!r} into {below}")
+    assert offenders == []
+    # the deployed and oracle steps are for the variants' equivalence tests
+    # (tests/test_variants.py); every other role has a caller in the package
+    unused = set(targets) - seen - {"casadi_step", "oracle_step"}
+    assert not unused, f"roles no module uses: {unused}"

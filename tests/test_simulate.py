@@ -96,23 +96,23 @@ class _Lazy:
 
 def test_judging_reports_failures(monkeypatch):
     design = design_of("omnirobot-s1")
-    monkeypatch.setitem(backends._FACTORIES["first-order"], "idle", lambda d: _Stubborn([0.0, 0.0, 0.0]))
+    monkeypatch.setitem(backends.first_order_backends(), "idle", lambda d: _Stubborn([0.0, 0.0, 0.0]))
     idle = simulate(design, backend="idle", horizon=1.0)
     assert not idle.satisfied and not idle.reached and idle.reach_time is None
     # straight east from S1 runs into O1 = [1, 2] x [4, 5]
-    monkeypatch.setitem(backends._FACTORIES["first-order"], "east", lambda d: _Stubborn([1.0, 0.0, 0.0]))
+    monkeypatch.setitem(backends.first_order_backends(), "east", lambda d: _Stubborn([1.0, 0.0, 0.0]))
     east = simulate(design, backend="east")
     assert east.collision and not east.satisfied and east.min_obstacle_clearance < 0
     # the normalized error is the state's, in the tube (here alpha follows the deployed
     # step and the state stays put): left behind by the tube, beyond 1
-    monkeypatch.setitem(backends._FACTORIES["first-order"], "lazy", lambda d: _Lazy(d))
+    monkeypatch.setitem(backends.first_order_backends(), "lazy", lambda d: _Lazy(d))
     lazy = simulate(design, backend="lazy", horizon=2.0)
     g_l, g_u, _, _ = R.adaptive_tube(design.tube, lazy.trajectory.t, lazy.trajectory.alpha)
     e = (2 * lazy.trajectory.x - (g_u + g_l)) / (g_u - g_l)
     assert lazy.max_abs_e == pytest.approx(float(np.abs(e).max()), rel=1e-12)
     assert lazy.max_abs_e > 1.0 and not lazy.stayed_in_tube
     # straight north leaves the state space
-    monkeypatch.setitem(backends._FACTORIES["first-order"], "north", lambda d: _Stubborn([0.0, 1.0, 0.0]))
+    monkeypatch.setitem(backends.first_order_backends(), "north", lambda d: _Stubborn([0.0, 1.0, 0.0]))
     north = simulate(design, backend="north", horizon=2.0)
     assert north.left_state_space and not north.satisfied
 

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-from ..design.actuator import bounded_input_words
 from .common import add_json_argument, add_spec_argument, print_json
 from .plotting import add_plot_argument, design_to_plot, write_plot
 
@@ -69,7 +68,9 @@ def cmd_design(args: argparse.Namespace) -> int:
     for m in design.certificate.margins:
         print(f"  {'PASS' if m.passed else 'FAIL'}  {m.name}: margin {m.margin:.4g}")
     if design.input_proof is not None and spec.input_bound is not None:    # [actuator]
-        law, unit = bounded_input_words(spec)
+        from ..spec.variants import variant_of
+        law = variant_of(spec).input_words
+        unit = f" {spec.input_unit}" if spec.input_unit else ""
         peaks = ", ".join(f"|{name}| {p:.4g} <= {b:g}{unit}" for name, p, b in zip(
             spec.input_names, design.input_proof.peak, spec.input_bound))
         print(f"  PASS  input bound: {law} asks at most [{peaks}] (proved)")

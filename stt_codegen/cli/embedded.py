@@ -9,7 +9,7 @@ from ..errors import SpecError
 from .common import (add_json_argument, add_seed_argument, add_spec_argument, checked_seed,
                      load_and_design, print_json)
 
-__all__ = ["cmd_embedded", "configure_embedded"]
+__all__ = ["cmd_embedded", "configure_embedded", "law13_command", "variant_loop_command"]
 
 
 def _judged(r: dict) -> str:
@@ -69,27 +69,67 @@ def cmd_embedded(args: argparse.Namespace) -> int:
     ToolchainError
         The Arm toolchain or QEMU is missing or fails (exit code 3).
     """
-    from ..embedded.deploy import run_embedded
     seed = checked_seed(args)
     if args.build_dir is not None and not Path(args.build_dir).parent.is_dir():
         raise SpecError("build_dir", f"folder {str(Path(args.build_dir).parent)!r} does not exist")
     design = load_and_design(args)
-    if design.spec.variant != "first-order":     # the cascade or the look-ahead law
-        from ..embedded.cascade_loop import run_cascade_embedded
-        from ..embedded.look_ahead_loop import run_look_ahead_embedded
-        run = {"cascade": run_cascade_embedded,
-               "look-ahead": run_look_ahead_embedded}[design.spec.variant]
-        report = run(design, seed=seed)
-        if args.json:
-            print_json(report)
-        else:
-            reach = "-" if report["reach_time"] is None else f"{report['reach_time']:.3f}"
-            print(f"{design.spec.name} ({design.spec.variant}) on the Cortex-M4F (QEMU "
-                  "mps2-an386): "
-                  f"{'satisfied' if report['satisfied'] else 'NOT satisfied'}, reach "
-                  f"{reach} s, clearance {report['min_clearance']:.3f}"
-                  f"{_judged(report)}, {report['instructions_per_step']} instructions per step")
-        return 0 if report["satisfied"] else 1
+    from ..spec.variants import variant_of
+    return variant_of(design.spec).entry("embedded_command")(design, args, seed)
+
+
+def variant_loop_command(design, args: argparse.Namespace, seed: int) -> int:
+    """``stt-codegen embedded`` for the cascade or the look-ahead law (their role
+    ``embedded_command``, :mod:`~stt_codegen.spec.variants`): the variant's closed loop
+    on the Cortex-M4F (role ``firmware``), summarised.
+
+    Parameters
+    ----------
+    design : Design
+        The spec's design.
+    args : argparse.Namespace
+        ``json``.
+    seed : int
+        The disturbance's seed.
+
+    Returns
+    -------
+    int
+        0 if the closed loop satisfied the spec, else 1.
+    """
+    from ..spec.variants import variant_of
+    variant = variant_of(design.spec)
+    report = variant.entry("firmware")(design, seed=seed)
+    if args.json:
+        print_json(report)
+    else:
+        print(f"{design.spec.name} ({variant.name}) on the Cortex-M4F (QEMU "
+              "mps2-an386): "
+              f"{'satisfied' if report['satisfied'] else 'NOT satisfied'}, reach "
+              f"{report['reach_time']} s, clearance {report['min_clearance']:.3f}"
+              f"{_judged(report)}, {report['instructions_per_step']} instructions per step")
+    return 0 if report["satisfied"] else 1
+
+
+def law13_command(design, args: argparse.Namespace, seed: int) -> int:
+    """``stt-codegen embedded`` for law (13) (the first-order role ``embedded_command``):
+    the self-test, the footprint and the closed loop, beside the host simulation unless
+    ``--no-host``.
+
+    Parameters
+    ----------
+    design : Design
+        The spec's design.
+    args : argparse.Namespace
+        ``json``, ``build_dir``, ``no_host``.
+    seed : int
+        The disturbance's seed.
+
+    Returns
+    -------
+    int
+        0 if everything passed, else 1.
+    """
+    from ..embedded.deploy import run_embedded
     report = run_embedded(design, args.build_dir, seed=seed,
                           compare_host=not args.no_host)
     if args.json:

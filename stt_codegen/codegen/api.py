@@ -6,11 +6,12 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ..design.result import Design, require_design
+from ..spec.variants import variant_of
 from .generate import generate_files
 from .options import LANGUAGES, Options, parse_options
 from .output import write_generation
 
-__all__ = ["design_files", "generate"]
+__all__ = ["design_files", "first_order_files", "generate"]
 
 
 def design_files(design: Design, options: Options) -> dict[str, bytes]:
@@ -26,19 +27,33 @@ def design_files(design: Design, options: Options) -> dict[str, bytes]:
     Returns
     -------
     dict of str to bytes
-        File name to content: law (13)'s controller
-        (:func:`~.generate.generate_files`) for a first-order plant, the cascade
+        File name to content, by the spec's variant (role ``generation``): law (13)'s
+        controller (:func:`first_order_files`) for a first-order plant, the cascade
         controller (:func:`~.cascade_source.cascade_generation`, docs/second-order.md)
         for a second-order one, the look-ahead controller
         (:func:`~.look_ahead_source.look_ahead_generation`, docs/differential-drive.md)
         for a differential-drive base.
     """
-    if design.spec.variant == "cascade":
-        from .cascade_source import cascade_generation
-        return cascade_generation(design, options)
-    if design.spec.variant == "look-ahead":
-        from .look_ahead_source import look_ahead_generation
-        return look_ahead_generation(design, options)
+    return variant_of(design.spec).entry("generation")(design, options)
+
+
+def first_order_files(design: Design, options: Options) -> dict[str, bytes]:
+    """Law (13)'s controller files of a first-order design (the variant's role
+    ``generation``, :mod:`~stt_codegen.spec.variants`): :func:`~.generate.generate_files`
+    of its spec and tube.
+
+    Parameters
+    ----------
+    design : Design
+        A first-order design.
+    options : Options
+        Languages and precision.
+
+    Returns
+    -------
+    dict of str to bytes
+        File name to content.
+    """
     return generate_files(design.spec, design.tube, options)
 
 

@@ -40,6 +40,7 @@ from dataclasses import dataclass, replace
 
 from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
+from ..spec.variants import variant_of
 from ..tube.parameters import CRUISE
 from .grid import grid_index, grid_value, smallest_passing
 from .failures import FailureKind
@@ -49,7 +50,7 @@ from .result import METHOD_PAPER, METHOD_VIA, Design
 from .samples import HORIZON_FACTOR, STEP_BUDGET
 from .windows import SHARPNESS_LADDER
 
-__all__ = ["bounded_input_words", "design_within_bound"]
+__all__ = ["design_within_bound"]
 
 #: The ``prescribed_time`` search tries up to this many times the spec's ``t_c``.
 MAX_TIME_FACTOR = 16.0
@@ -217,7 +218,10 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
                        design_time_s=time.perf_counter() - started)
     proved = [c for c in tried if c.proof.proved]
     names = spec.input_names
-    law, unit = bounded_input_words(spec)
+    # the controller in the user's words: law (13)'s input, the cascade's force/torque, the
+    # base's command
+    law = variant_of(spec).input_words
+    unit = f" {spec.input_unit}" if spec.input_unit else ""
     if not proved:
         reasons = "; ".join(f"{c.label}: {c.proof.reason}" for c in tried)
         raise DesignError(
@@ -241,28 +245,6 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     else:
         message += f"; {why}; input_bound = {needs} works with this prescribed_time"
     raise DesignError(message, kind=FailureKind.INPUT_BOUND, tried=best.design.tube)
-
-
-def bounded_input_words(spec: Spec) -> tuple[str, str]:
-    """The input that ``[actuator] input_bound`` bounds, in the user's words, and its unit.
-
-    Parameters
-    ----------
-    spec : Spec
-        Any spec (the words depend on its controller variant only).
-
-    Returns
-    -------
-    law : str
-        ``"law (13)"``, ``"the cascade's input u"`` or ``"the base's command (v, omega)"``.
-    unit : str
-        ``" N"`` or ``" N m"`` (with its leading space) for the cascade's force or torque;
-        ``""`` otherwise (a velocity in state units per second; the base's ``v`` in m/s,
-        ``omega`` in rad/s).
-    """
-    return {"first-order": ("law (13)", ""),
-            "cascade": ("the cascade's input u", f" {spec.input_unit}"),
-            "look-ahead": ("the base's command (v, omega)", "")}[spec.variant]
 
 
 def _round_up(value: float, digits: int = 3) -> float:

@@ -37,6 +37,7 @@ import math
 import numpy as np
 
 from ..rounding import round_up
+from ..spec.variants import require_variant
 from ..tube import reference
 from ..tube.parameters import TubeDesign
 from ..tube.second_stage import SecondStage
@@ -225,8 +226,8 @@ def cascade_input_proof(tube: TubeDesign, spec, min_width: float) -> InputProof:
         proved when no shape is certified at ``tube.rate_hz`` (the first shape's reason).
     """
     bound = spec.input_bound
-    stage, derivation = certified_stage(tube, spec, min_width, bound)
-    if stage is not None:
+    certified, derivation = certified_stage(tube, spec, min_width, bound)
+    if certified is not None:      # a shape is certified (None: none is)
         report = derivation["certificate"]
         return InputProof(True, tuple(report["peak_input"]), tuple(report["peak_input_time"]),
                           float(report["horizon"]), max_abs_e=float(report["max_abs_e2"]))
@@ -325,18 +326,15 @@ def second_stage_for(tube: TubeDesign, spec, min_width: float) -> tuple[SecondSt
         tube or names the ``prescribed_time`` that works instead). Its ``tried`` is
         ``tube``, the position tube designed (for the figure of ``design --plot``).
     """
-    from ..errors import SpecError
-    if spec.order != 2:
-        raise SpecError("plant.model", "the spec describes a first-order plant (not a "
-                                       "second-order plant.model)")
+    require_variant(spec, "cascade", "the cascade's second stage")
     return _second_stage(tube, spec, min_width)
 
 
 @functools.lru_cache(maxsize=16)
 def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage, dict]:
-    stage, derivation = certified_stage(tube, spec, min_width, spec.input_bound)
-    if stage is not None:
-        return stage, derivation
+    certified, derivation = certified_stage(tube, spec, min_width, spec.input_bound)
+    if certified is not None:      # a shape is certified (None: none is)
+        return certified, derivation
     from ..errors import DesignError
     from .failures import FailureKind
     proof = (cascade_input_proof(tube, spec, min_width) if spec.input_bound is not None

@@ -7,8 +7,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
-from ..errors import SpecError
-from ..spec.plants import model_behaviour
+from ..spec.variants import require_variant, variant_of
 from ..spec.robot import robot_json
 from ..tube.look_ahead import LookAhead
 from ..tube.parameters import TubeDesign
@@ -22,7 +21,9 @@ if TYPE_CHECKING:
     from ..spec.loader import Spec
     from .tasks import TaskPlan
 
-__all__ = ["Design", "METHOD_PAPER", "METHOD_VIA", "TubeCheck", "require_design"]
+__all__ = ["Design", "METHOD_PAPER", "METHOD_VIA", "TubeCheck", "cascade_stage",
+           "cascade_stage_json", "look_ahead_stage", "no_stage", "no_stage_json",
+           "require_design"]
 
 #: The reach-tube methods a design can use (``tube.method`` of the spec picks among them).
 METHOD_PAPER = "paper"
@@ -180,9 +181,7 @@ class Design:
         SpecError
             The spec's ``plant.model`` is not a differential drive (field ``plant.model``).
         """
-        if self.spec.drive is None:
-            raise SpecError("plant.model", "only a differential-drive base has a look-ahead "
-                                           f"point (plant.model is {self.spec.plant_model!r})")
+        require_variant(self.spec, "look-ahead", "a look-ahead point")
         return LookAhead(self.spec.drive.axle_offset, self.spec.input_bound)
 
     @property
@@ -199,7 +198,7 @@ class Design:
         DesignError
             A second-order design whose second stage is not certified.
         """
-        return model_behaviour(_STAGES, self.spec.variant, "controller stage")(self)
+        return variant_of(self.spec).entry("stage")(self)
 
     def to_json(self) -> dict[str, Any]:
         """The design as plain JSON types (the ``design`` command's and ``simulate --json``'s).
@@ -258,7 +257,7 @@ class Design:
             **self._tasks_json(),
             **self._target_json(),
             **self._motion_json(),
-            **self._cascade_json(),
+            **self._stage_json(),
             **robot_json(self.spec),
         }
 
@@ -310,13 +309,11 @@ class Design:
              "margin": margins[f"avoids moving obstacle {ob.source}"].margin}
             for ob in self.spec.moving_obstacles]}
 
-    def _cascade_json(self) -> dict[str, Any]:
-        """``cascade``: the certified second stage's derivation with its sampled-data
-        certificate (``gains``), for a spec with a second-order ``plant.model`` only:
-        without it the document is as before."""
-        if self.spec.order != 2:
-            return {}
-        return {"cascade": {"gains": self.second_stage[1]}}
+    def _stage_json(self) -> dict[str, Any]:
+        """The variant's own fields (``cascade``: the certified second stage's derivation
+        with its sampled-data certificate, for a second-order spec only): without them the
+        document is as before."""
+        return variant_of(self.spec).entry("stage_json")(self)
 
     def _actuator_json(self) -> dict[str, Any]:
         """``input_bound`` and the proved ``input_peak`` (with where each peak is), for a
@@ -366,9 +363,77 @@ def require_design(value: object, function: str, parameter: str = "design") -> D
                     f"{hint}")
 
 
-#: The controller variant's data beyond the tube, per variant (:attr:`Design.stage`).
-_STAGES = {
-    "first-order": lambda design: None,
-    "cascade": lambda design: design.second_stage[0],
-    "look-ahead": lambda design: design.look_ahead,
-}
+def no_stage(design: Design) -> None:
+    """The stage of law (13) on the plant's state (the first-order variant's role
+    ``stage``, :mod:`~stt_codegen.spec.variants`): none.
+
+    Parameters
+    ----------
+    design : Design
+    """
+    return None
+
+
+def cascade_stage(design: Design) -> SecondStage:
+    """The cascade's stage: :attr:`Design.second_stage` (role ``stage``).
+
+    Parameters
+    ----------
+    design : Design
+
+    Returns
+    -------
+    SecondStage
+
+    Raises
+    ------
+    DesignError
+        The second stage is not certified.
+    """
+    return design.second_stage[0]
+
+
+def look_ahead_stage(design: Design) -> LookAhead:
+    """The look-ahead variant's stage: :attr:`Design.look_ahead` (role ``stage``).
+
+    Parameters
+    ----------
+    design : Design
+
+    Returns
+    -------
+    LookAhead
+    """
+    return design.look_ahead
+
+
+def no_stage_json(design: Design) -> dict[str, Any]:
+    """The design document's fields of a variant without a derived stage (role
+    ``stage_json``): none, so the document is as without a variant.
+
+    Parameters
+    ----------
+    design : Design
+
+    Returns
+    -------
+    dict
+        Empty.
+    """
+    return {}
+
+
+def cascade_stage_json(design: Design) -> dict[str, Any]:
+    """``cascade``: the certified second stage's derivation with its sampled-data
+    certificate (``gains``), the cascade's role ``stage_json``.
+
+    Parameters
+    ----------
+    design : Design
+
+    Returns
+    -------
+    dict
+        ``{"cascade": {"gains": ...}}``.
+    """
+    return {"cascade": {"gains": design.second_stage[1]}}

@@ -21,18 +21,18 @@ from __future__ import annotations
 
 import math
 import time
-
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
 
 from ..errors import DesignError
 from ..spec.loader import Spec
+from ..spec.variants import variant_of
 from ..tube.parameters import Circumvent, TubeDesign, paper_segments
 from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, certify_tube
 from .certificate.motion import certify_motion
 from .actuator import design_within_bound
-from .look_ahead import look_ahead_within_bound
 from .cascade_gain import cascade_input_proof
 from .failures import FailureKind, property_kind
 from .grid import grid_index, grid_value, smallest_passing
@@ -45,7 +45,8 @@ from .tasks import TaskPlan, plan_tasks, task_plans
 from .via import via_design
 from .windows import WINDOW_INFLATION, candidates, overlap_interval, progress_time
 
-__all__ = ["MAX_INITIAL_ERROR", "MAX_MOVE_PER_SAMPLE", "base_design", "check_tube", "design_tube",
+__all__ = ["MAX_INITIAL_ERROR", "MAX_MOVE_PER_SAMPLE", "base_design", "cascade_within_bound",
+           "check_tube", "design_tube",
            "paper_design"]
 
 #: Largest ``|e_i|`` of ``x(0)`` in the tube at ``t = 0``: near the tube's edge law (13)
@@ -315,8 +316,7 @@ def design_tube(spec: Spec) -> Design:
     design = _position_stage(spec)
     # a second-order spec: the sampled cascade must be certified on the final tube, whatever
     # path designed it (design/cascade_gain.py)
-    if spec.order == 2:
-        design.second_stage      # DesignError unless the sampled cascade is certified
+    design.stage      # the variant's stage: DesignError unless the sampled cascade is certified
     return _timed(design, started)
 
 
@@ -359,29 +359,45 @@ def _position_stage(spec: Spec) -> Design:
     if spec.input_bound is not None:      # [actuator]: design/actuator.py
         # the bound's proof orders the tubes there (default, softer circumvents, via
         # points): auto's estimate of the smoother tube plays no part
-        if spec.order == 2:
-            return _cascade_within_bound(spec)
-        if spec.drive is not None:        # (v, omega) of a differential drive
-            return look_ahead_within_bound(spec, lambda free: _design(free, smoother=False))
-        return design_within_bound(spec, lambda free: _design(free, smoother=False))
+        return variant_of(spec).entry("within_bound")(
+            spec, lambda free: _design(free, smoother=False))
     return _design(spec, smoother=True)
 
 
-def _cascade_within_bound(spec: Spec) -> Design:
-    """The tube of a second-order spec with ``[actuator]``: the first-order procedure
+def cascade_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> Design:
+    """The tube of a second-order spec with ``[actuator]`` (the cascade's role
+    ``within_bound``, :mod:`~stt_codegen.spec.variants`): the first-order procedure
     (:func:`~stt_codegen.design.actuator.design_within_bound`) with the sampled cascade's
     certified peak of the physical input as its proof
-    (:func:`~stt_codegen.design.cascade_gain.cascade_input_proof`)."""
+    (:func:`~stt_codegen.design.cascade_gain.cascade_input_proof`).
+
+    Parameters
+    ----------
+    spec : Spec
+        A second-order spec with ``input_bound``.
+    design_free : callable
+        ``design_free(spec) -> Design``: the tube of a spec without the bound.
+
+    Returns
+    -------
+    Design
+        Certified within ``input_bound``.
+
+    Raises
+    ------
+    DesignError
+        No tube tried keeps the bound, or no second stage is certified at the rate.
+    """
     free = replace(spec, input_bound=None)
-    default = _design(free, smoother=False)
+    default = design_free(free)
     # no second stage keeps the tubes at this rate, bound or not: the rate is what to
     # change (DesignError of kind SAMPLING_RATE naming the rate that is certified)
     default.second_stage
 
-    def design_free(variant: Spec) -> Design:
-        return default if variant == free else _design(variant, smoother=False)
+    def design_free_or_default(candidate: Spec) -> Design:
+        return default if candidate == free else design_free(candidate)
 
-    return design_within_bound(spec, design_free, prove=lambda design, judged:
+    return design_within_bound(spec, design_free_or_default, prove=lambda design, judged:
                                cascade_input_proof(design.tube, judged,
                                                    design.check.min_width))
 

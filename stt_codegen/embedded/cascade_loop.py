@@ -31,6 +31,7 @@ from ..codegen.emit import c_source
 from ..codegen.render import render
 from ..design.result import Design
 from ..errors import SpecError
+from ..spec.variants import require_variant
 from ..runtime.second_order_plants import second_order_rhs
 from .programs import c_double, loop_context
 from .variant_loop import run_report, run_variant_loop
@@ -68,8 +69,7 @@ def closed_loop_program(design: Design, prefix: str, seed: int = 0,
     """
     spec = design.spec
     order = spec.second_order
-    if spec.order != 2:
-        raise SpecError("plant.model", "the spec describes a first-order plant")
+    require_variant(spec, "cascade", "the cascade's closed loop")
     if spec.mujoco is not None:
         raise SpecError("plant.model", "the firmware's closed loop needs the plant's equations; "
                                        "a MuJoCo plant runs on the host (stt-codegen simulate)")

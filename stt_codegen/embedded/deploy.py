@@ -43,6 +43,7 @@ from ..codegen import tolerance as T
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..design.result import Design, require_design
+from ..spec.variants import require_variant
 from ..errors import SpecError, ToolchainError
 from ..runtime.plants import check_seed
 from ..tube.parameters import TubeDesign
@@ -168,10 +169,9 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
     if spec.mujoco is not None:
         raise SpecError("plant.model", "the firmware's closed loop needs the plant's equations; "
                                        "a MuJoCo plant runs on the host (stt-codegen simulate)")
-    if spec.variant != "first-order":    # its own program: stt-codegen embedded picks it
-        raise SpecError("plant.model", f"the {spec.variant} variant's firmware loop is "
-                                       "run_cascade_embedded or run_look_ahead_embedded, not "
-                                       "law (13)'s")
+    # another variant has its own program (role firmware): stt-codegen embedded picks it
+    require_variant(spec, "first-order", "law (13)'s firmware loop (run_embedded; "
+                                         "stt-codegen embedded runs each variant's own)")
     seed = check_seed(seed)
     message = missing_message()
     if message:

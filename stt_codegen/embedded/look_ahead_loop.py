@@ -24,6 +24,7 @@ from ..codegen.look_ahead_source import look_ahead_c_files
 from ..codegen.render import render
 from ..design.result import Design
 from ..errors import SpecError
+from ..spec.variants import require_variant
 from ..runtime.differential_drive import base_rhs
 from ..runtime.plants import Disturbance
 from ..runtime.state_split import initial_state
@@ -61,9 +62,8 @@ def closed_loop_program(design: Design, prefix: str, seed: int = 0,
         Not a differential-drive spec, or a base on MuJoCo (field ``plant.model``).
     """
     spec = design.spec
+    require_variant(spec, "look-ahead", "the look-ahead law's closed loop")
     drive = spec.drive
-    if drive is None:
-        raise SpecError("plant.model", "the spec does not describe a differential-drive base")
     if spec.mujoco is not None:
         raise SpecError("plant.model", "the firmware's closed loop needs the plant's equations; "
                                        "a MuJoCo plant runs on the host (stt-codegen simulate)")

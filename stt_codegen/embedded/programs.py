@@ -30,6 +30,7 @@ from ..runtime.plants import Disturbance
 from ..runtime.simulate import SUBSTEPS
 from ..runtime.tasks import judge_tasks, until_met
 from ..spec.loader import Spec
+from ..spec.variants import variant_of
 from ..tube.parameters import TubeDesign
 
 __all__ = ["ClosedLoopOutput", "c_double", "closed_loop_source", "judge_printed", "loop_context",
@@ -216,7 +217,8 @@ def replay_source(spec: Spec, design: TubeDesign, x, t, dt, alpha, what: str,
     x = np.atleast_2d(np.asarray(x, dtype=np.float32))
     rows = [float_bits(np.concatenate([x[k], [t[k], dt[k]], alpha[k]])) for k in range(len(t))]
     return render("embedded_replay.c.j2", P=prefix, spec_name=spec.name, real="float",
-                  n=spec.dimension, nx=x.shape[1], count=len(rows), rows=rows, what=what)
+                  n=spec.dimension, nx=x.shape[1], count=len(rows), rows=rows, what=what,
+                  **variant_of(spec).replay_context)
 
 
 def _f32(word: str) -> float:

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..tube import reference
 from ..errors import SpecError
+from ..spec.variants import variant_named, variant_of_order, variant_of_stage
 from ..tube.parameters import (STATUS_INPUT_CLAMPED, STATUS_INVALID_INPUT, STATUS_OK,
                                STATUS_OUTSIDE_TUBE, TubeDesign)
 from ..tube.look_ahead import LookAhead
@@ -24,7 +25,9 @@ from ..tube.second_stage import SecondStage
 
 __all__ = ["STATUS_INPUT_CLAMPED", "STATUS_INVALID_INPUT", "STATUS_OK", "STATUS_OUTSIDE_TUBE",
            "Controller",
-           "backend_names", "make_controller", "register_backend"]
+           "backend_names", "cascade_backends", "cascade_controller", "first_order_backends",
+           "first_order_controller", "look_ahead_backends", "look_ahead_controller",
+           "make_controller", "register_backend"]
 
 
 class Controller(Protocol):
@@ -58,15 +61,13 @@ class CasadiController:
     name = "casadi"
 
     def __init__(self, design: TubeDesign) -> None:
-        from ..tube.model import build_model
-        self.function = build_model(design)["controller_step"]
+        law13 = variant_named("first-order")
+        self.function = law13.entry("casadi_step")(design, None)
+        self._decode = law13.entry("status")
 
     def step(self, x, t, dt, alpha):
         # a design with an actuator bound has a fourth output, within_bound
-        u, alpha_next, inside, *within = self.function(x, t, dt, alpha)
-        status = (STATUS_OUTSIDE_TUBE if not float(inside) else
-                  STATUS_INPUT_CLAMPED if within and not float(within[0]) else STATUS_OK)
-        return np.array(u).ravel(), np.array(alpha_next).ravel(), status
+        return self._decode(self.function(x, t, dt, alpha))
 
 
 def _generated_c(design: TubeDesign) -> Controller:
@@ -93,30 +94,108 @@ def _look_ahead(backend: str) -> Callable[[TubeDesign, LookAhead], Controller]:
     return factory
 
 
-#: Factories by controller variant, then by backend name: ``"first-order"``
-#: ``factory(design)``, the others ``factory(design, stage)`` with the variant's data (the
-#: cascade's :class:`SecondStage`, the look-ahead point's :class:`LookAhead`).
-_FACTORIES: dict[str, dict[str, Callable[..., Controller]]] = {
-    "first-order": {"reference": ReferenceController,
-                    "casadi": CasadiController,
-                    "c": _generated_c,
-                    "python": _generated_python},
-    "cascade": {name: _cascade(name) for name in ("reference", "casadi", "c", "python")},
-    "look-ahead": {name: _look_ahead(name) for name in ("reference", "casadi", "c", "python")},
-}
-#: The variant of each plant order (the ``order`` keyword of the functions below).
-_ORDERS = {1: "first-order", 2: "cascade"}
+#: The backends of law (13) on the plant's state, by name: ``factory(design)``.
+_FIRST_ORDER: dict[str, Callable[..., Controller]] = {
+    "reference": ReferenceController, "casadi": CasadiController,
+    "c": _generated_c, "python": _generated_python}
+#: The cascade's backends: ``factory(design, stage)`` with its :class:`SecondStage`.
+_CASCADE = {name: _cascade(name) for name in ("reference", "casadi", "c", "python")}
+#: The look-ahead law's backends: ``factory(design, look_ahead)`` with its
+#: :class:`LookAhead`.
+_LOOK_AHEAD = {name: _look_ahead(name) for name in ("reference", "casadi", "c", "python")}
 
 
-def _order(order: int, variant: str | None = None) -> dict[str, Callable[..., Controller]]:
-    if variant is not None:
-        if variant not in _FACTORIES:
-            raise SpecError("variant", f"unknown controller variant {variant!r} (known: "
-                                       f"{', '.join(_FACTORIES)})")
-        return _FACTORIES[variant]
-    if order not in _ORDERS:
-        raise SpecError("order", f"a plant's order is 1 or 2, got {order!r}")
-    return _FACTORIES[_ORDERS[order]]
+def first_order_backends() -> dict[str, Callable[..., Controller]]:
+    """The first-order variant's registry of backends (role ``backends`` of
+    :mod:`~stt_codegen.spec.variants`): ``factory(design)`` by name.
+
+    Returns
+    -------
+    dict of str to callable
+        The registry itself (:func:`register_backend` adds to it).
+    """
+    return _FIRST_ORDER
+
+
+def cascade_backends() -> dict[str, Callable[..., Controller]]:
+    """The cascade's registry of backends (role ``backends``): ``factory(design, stage)``
+    by name, ``stage`` the :class:`SecondStage`.
+
+    Returns
+    -------
+    dict of str to callable
+        The registry itself.
+    """
+    return _CASCADE
+
+
+def look_ahead_backends() -> dict[str, Callable[..., Controller]]:
+    """The look-ahead law's registry of backends (role ``backends``):
+    ``factory(design, look_ahead)`` by name, with the :class:`LookAhead`.
+
+    Returns
+    -------
+    dict of str to callable
+        The registry itself.
+    """
+    return _LOOK_AHEAD
+
+
+def first_order_controller(name: str, design: TubeDesign, stage: None) -> Controller:
+    """The first-order variant's controller of backend ``name`` (role ``controller`` of
+    :mod:`~stt_codegen.spec.variants`): law (13) takes no stage.
+
+    Parameters
+    ----------
+    name : str
+        A name of :func:`first_order_backends`.
+    design : TubeDesign
+    stage : None
+
+    Returns
+    -------
+    Controller
+    """
+    return _FIRST_ORDER[name](design)
+
+
+def cascade_controller(name: str, design: TubeDesign, stage: SecondStage) -> Controller:
+    """The cascade's controller of backend ``name`` (role ``controller``).
+
+    Parameters
+    ----------
+    name : str
+        A name of :func:`cascade_backends`.
+    design : TubeDesign
+    stage : SecondStage
+
+    Returns
+    -------
+    Controller
+    """
+    return _CASCADE[name](design, stage)
+
+
+def look_ahead_controller(name: str, design: TubeDesign, stage: LookAhead) -> Controller:
+    """The look-ahead law's controller of backend ``name`` (role ``controller``).
+
+    Parameters
+    ----------
+    name : str
+        A name of :func:`look_ahead_backends`.
+    design : TubeDesign
+    stage : LookAhead
+
+    Returns
+    -------
+    Controller
+    """
+    return _LOOK_AHEAD[name](design, stage)
+
+
+def _factories(order: int, variant: str | None = None) -> dict[str, Callable[..., Controller]]:
+    chosen = variant_of_order(order) if variant is None else variant_named(variant)
+    return chosen.entry("backends")()
 
 
 def register_backend(name: str, factory: Callable[..., Controller], *, order: int = 1,
@@ -159,7 +238,7 @@ def register_backend(name: str, factory: Callable[..., Controller], *, order: in
     >>> backend_names()[-1]
     'logged'
     """
-    _order(order, variant)[name] = factory
+    _factories(order, variant)[name] = factory
 
 
 def backend_names(order: int = 1, variant: str | None = None) -> list[str]:
@@ -188,7 +267,7 @@ def backend_names(order: int = 1, variant: str | None = None) -> list[str]:
     >>> backend_names()
     ['reference', 'casadi', 'c', 'python']
     """
-    return list(_order(order, variant))
+    return list(_factories(order, variant))
 
 
 def make_controller(name: str, design: TubeDesign,
@@ -236,12 +315,9 @@ def make_controller(name: str, design: TubeDesign,
     >>> u.shape, alpha_next.shape, status
     ((3,), (6,), 0)
     """
-    variant = ("first-order" if stage is None else
-               "look-ahead" if isinstance(stage, LookAhead) else "cascade")
-    factories = _FACTORIES[variant]
+    variant = variant_of_stage(stage)
+    factories = variant.entry("backends")()
     if name not in factories:
-        kind = {"first-order": "a first-order plant", "cascade": "a second-order plant",
-                "look-ahead": "a differential-drive base"}[variant]
-        raise SpecError("backend", f"unknown backend {name!r} for {kind} "
+        raise SpecError("backend", f"unknown backend {name!r} for {variant.plant_words} "
                                    f"(known: {', '.join(factories)})")
-    return factories[name](design) if stage is None else factories[name](design, stage)
+    return variant.entry("controller")(name, design, stage)

@@ -126,9 +126,9 @@ class MujocoPlant:
 
     def state(self) -> np.ndarray:
         """The spec's state read from the model, shape (nstates,)."""
-        x = self.data.qpos[self._qpos]
-        return (np.array(x, dtype=float) if self.order == 1 else
-                np.concatenate([x, self.data.qvel[self._qvel]]).astype(float))
+        # the state layout's blocks: the positions, then (order 2) the velocities
+        blocks = (self.data.qpos[self._qpos], self.data.qvel[self._qvel])[:self.order]
+        return np.concatenate(blocks).astype(float)
 
     def reset(self, x0) -> np.ndarray:
         """Reset the model (``mj_resetData``) and set the spec's initial state.
@@ -147,9 +147,10 @@ class MujocoPlant:
         mj.mj_resetData(self.model, self.data)
         x0 = np.asarray(x0, dtype=float)
         n = len(self._qpos)
-        self.data.qpos[self._qpos] = x0[:n]
-        if self.order == 2:
-            self.data.qvel[self._qvel] = x0[n:]
+        # block k of the state layout: the positions, then (order 2) the velocities
+        blocks = list(zip((self.data.qpos, self.data.qvel), (self._qpos, self._qvel)))
+        for k, (values, index) in enumerate(blocks[:self.order]):
+            values[index] = x0[k * n:(k + 1) * n]
         mj.mj_forward(self.model, self.data)
         self.contact_count, self.first_contact = 0, None
         return self.state()

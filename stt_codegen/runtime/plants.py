@@ -20,13 +20,15 @@ from ..errors import SpecError
 from ..spec.differential_drive import DifferentialDrive
 from ..spec.loader import LinearPlant
 from ..spec.plants import PLANTS, MissingPlantBehaviour, dimension_mismatch, model_behaviour
+from ..spec.variants import variant_of
 from .differential_drive import base_rhs
 from .dynamics import linear_rhs, plant_rhs
 from .mujoco_plant import DriveMujocoPlant, MujocoPlant
 from .second_order_plants import model_info, second_order_rhs
 
-__all__ = ["Disturbance", "check_seed", "differential_drive_plant", "make_plant",
-           "second_order_plant", "spec_plant"]
+__all__ = ["Disturbance", "cascade_spec_plant", "check_seed", "differential_drive_plant",
+           "drive_mujoco_plant", "drive_spec_plant", "first_order_spec_plant",
+           "joint_mujoco_plant", "make_plant", "second_order_plant", "spec_plant"]
 
 #: Number of sinusoids summed in each disturbance component.
 DISTURBANCE_TERMS = 3
@@ -334,15 +336,97 @@ def spec_plant(spec, seed: int = 0) -> Any:
     SpecError
         As :func:`make_plant` and :func:`second_order_plant`.
     """
+    variant = variant_of(spec)
     if spec.mujoco is not None:      # [plant] mjcf: MuJoCo steps the plant
-        m = spec.mujoco
-        if spec.drive is not None:   # a base: its driver turns (v, omega) into wheel speeds
-            return DriveMujocoPlant(m.path, m.joints, m.actuators, spec.drive, m.timestep)
-        return MujocoPlant(m.path, m.joints, m.actuators, spec.order, m.timestep)
-    if spec.drive is not None:       # a differential-drive base: its own kinematics
-        return differential_drive_plant(spec.drive, seed)
-    if spec.order == 1:
-        return make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed,
-                          spec.linear_plant)
+        return variant.entry("mujoco_plant")(spec)
+    return variant.entry("plant")(spec, seed)
+
+
+def first_order_spec_plant(spec, seed: int = 0) -> ct.NonlinearIOSystem:
+    """The first-order plant of a spec (role ``plant`` of
+    :mod:`~stt_codegen.spec.variants`): :func:`make_plant` of its model.
+
+    Parameters
+    ----------
+    spec : Spec
+    seed : int
+        Seed of the disturbance.
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        ``n`` states.
+    """
+    return make_plant(spec.plant_model, spec.dimension, spec.disturbance_amplitude, seed,
+                      spec.linear_plant)
+
+
+def cascade_spec_plant(spec, seed: int = 0) -> ct.NonlinearIOSystem:
+    """The second-order plant of a spec (role ``plant``): :func:`second_order_plant`.
+
+    Parameters
+    ----------
+    spec : Spec
+    seed : int
+        Seed of the disturbance.
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        ``2 n`` states, positions then velocities.
+    """
     return second_order_plant(spec.second_order.model, spec.dimension,
                               spec.second_order.parameters, spec.disturbance_amplitude, seed)
+
+
+def drive_spec_plant(spec, seed: int = 0) -> ct.NonlinearIOSystem:
+    """The differential-drive base of a spec (role ``plant``): its own kinematics,
+    :func:`differential_drive_plant`.
+
+    Parameters
+    ----------
+    spec : Spec
+    seed : int
+        Seed of the slip.
+
+    Returns
+    -------
+    control.NonlinearIOSystem
+        3 states ``(x, y, theta)``.
+    """
+    return differential_drive_plant(spec.drive, seed)
+
+
+def joint_mujoco_plant(spec) -> MujocoPlant:
+    """A plant of joints stepped by MuJoCo (role ``mujoco_plant``): the state's layout is
+    the variant's (``state_blocks``: positions, or positions then velocities).
+
+    Parameters
+    ----------
+    spec : Spec
+        With ``spec.mujoco``.
+
+    Returns
+    -------
+    MujocoPlant
+    """
+    m = spec.mujoco
+    return MujocoPlant(m.path, m.joints, m.actuators, variant_of(spec).state_blocks,
+                       m.timestep)
+
+
+def drive_mujoco_plant(spec) -> DriveMujocoPlant:
+    """A differential-drive base stepped by MuJoCo (role ``mujoco_plant``): its driver
+    turns ``(v, omega)`` into wheel speeds.
+
+    Parameters
+    ----------
+    spec : Spec
+        With ``spec.mujoco`` and ``spec.drive``.
+
+    Returns
+    -------
+    DriveMujocoPlant
+    """
+    m = spec.mujoco
+    return DriveMujocoPlant(m.path, m.joints, m.actuators, spec.drive, m.timestep)

@@ -28,13 +28,16 @@ from ..errors import SpecError
 from .plants import check_seed, spec_plant
 from .state_split import initial_state, positions
 from ..spec.loader import Spec
+from ..spec.variants import variant_of, variant_of_stage
 from ..tube import cascade_reference, reference
 from ..tube.parameters import Status, TubeDesign
 from ..tube.look_ahead import LookAhead
 from ..tube.second_stage import SecondStage
 from .tasks import TaskOutcome, judge_tasks, until_met
 
-__all__ = ["SUBSTEPS", "SimulationResult", "Trajectory", "run_closed_loop", "simulate"]
+__all__ = ["SUBSTEPS", "SimulationResult", "Trajectory", "cascade_velocity_reference",
+           "no_velocity_fields", "no_velocity_reference", "run_closed_loop", "simulate",
+           "velocity_fields"]
 
 #: Runge-Kutta steps per sampling period.
 SUBSTEPS = 2
@@ -381,10 +384,11 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     steps = int(math.ceil(horizon * tube.rate_hz - 1e-9))
     check_step_budget(steps, horizon, tube.rate_hz)
     n = spec.dimension
-    if (spec.variant != "first-order") != (stage is not None) and controller is None:
-        raise SpecError("stage", f"a spec of the {spec.variant} variant runs with its "
-                                 "stage (Design.stage)" if stage is None
-                        else "a first-order spec runs law (13), which has no second stage")
+    variant = variant_of(spec)
+    if controller is None and variant_of_stage(stage) is not variant:
+        raise SpecError("stage", f"a spec of the {variant.name} variant runs {variant.input_words}"
+                                 f" with its own stage (Design.stage), not a "
+                                 f"{type(stage).__name__}")
     if controller is None:
         controller = make_controller(backend, tube, stage)
     x = initial_state(spec)
@@ -393,9 +397,7 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     elif (getattr(plant, "nstates", None), getattr(plant, "ninputs", None)) != (x.size, n):
         raise SpecError("plant", f"must be a control.NonlinearIOSystem (or a plant with "
                                  f"advance(), as MujocoPlant) with {x.size} states "
-                                 f"and {n} inputs for this spec"
-                                 + (" (positions, then velocities)" if spec.order == 2
-                                    else ""))
+                                 f"and {n} inputs for this spec{variant.state_words}")
     stepper = plant if hasattr(plant, "advance") else _RungeKutta(plant)
     x = stepper.reset(x)
     dt = 1.0 / tube.rate_hz
@@ -444,7 +446,7 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     else:
         min_clear, collision = None, False
     left = bool(np.any((within < lo) | (within > hi)))
-    velocity = _velocity_verdict(spec, tube, stage, ts, states, alphas, status, dt)
+    velocity = variant.entry("run_fields")(spec, tube, stage, ts, states, alphas, status, dt)
     contacts = stepper.contact_count
     satisfied = (reached and not collision and not left and horizon >= t_c
                  and not velocity["exceeded_velocity_bound"] and not contacts
@@ -471,20 +473,103 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
                        else list(stepper.first_contact)), **velocity)
 
 
-def _velocity_verdict(spec: Spec, tube: TubeDesign, stage: SecondStage | None,
-                      ts: np.ndarray, states: np.ndarray, alphas: np.ndarray,
-                      status: np.ndarray, dt: float) -> dict:
+def no_velocity_fields(spec: Spec, tube: TubeDesign, stage: LookAhead | None,
+                       ts: np.ndarray, states: np.ndarray, alphas: np.ndarray,
+                       status: np.ndarray, dt: float) -> dict:
+    """The second-order fields of a run of a first-order plant or a base (role
+    ``run_fields`` of :mod:`~stt_codegen.spec.variants`): none.
+
+    Parameters
+    ----------
+    spec : Spec
+    tube : TubeDesign
+    stage : LookAhead or None
+    ts : ndarray, shape (N,)
+    states : ndarray, shape (N, m)
+    alphas : ndarray, shape (N, 2 n)
+    status : ndarray, shape (N,)
+    dt : float
+
+    Returns
+    -------
+    dict
+        ``velocity``, ``r``, ``stayed_in_velocity_tube``, ``max_abs_velocity``: ``None``;
+        ``exceeded_velocity_bound``: ``False``.
+    """
+    return {"velocity": None, "r": None, "stayed_in_velocity_tube": None,
+            "max_abs_velocity": None, "exceeded_velocity_bound": False}
+
+
+def no_velocity_reference(tube: TubeDesign, stage: LookAhead | None, states: np.ndarray,
+                          ts: np.ndarray, dt: float, alphas: np.ndarray) -> None:
+    """The velocity reference ``r`` of a run without the cascade's stage (role
+    ``velocity_reference`` of the stage's variant, a custom controller's run included):
+    none.
+
+    Parameters
+    ----------
+    tube : TubeDesign
+    stage : LookAhead or None
+    states : ndarray, shape (N, m)
+    ts : ndarray, shape (N,)
+    dt : float
+    alphas : ndarray, shape (N, 2 n)
+    """
+    return None
+
+
+def cascade_velocity_reference(tube: TubeDesign, stage: SecondStage, states: np.ndarray,
+                               ts: np.ndarray, dt: float, alphas: np.ndarray) -> np.ndarray:
+    """The cascade's velocity reference ``r`` along a run, by the oracle (role
+    ``velocity_reference``).
+
+    Parameters
+    ----------
+    tube : TubeDesign
+    stage : SecondStage
+    states : ndarray, shape (N, 2 n)
+    ts : ndarray, shape (N,)
+        Sampling times, s.
+    dt : float
+        Sampling period, s.
+    alphas : ndarray, shape (N, 2 n)
+
+    Returns
+    -------
+    ndarray, shape (N, n)
+    """
+    with reference.numpy_math():
+        return cascade_reference.cascade_step(tube, stage, states, ts, dt, alphas)[2]
+
+
+def velocity_fields(spec: Spec, tube: TubeDesign, stage: SecondStage | None,
+                    ts: np.ndarray, states: np.ndarray, alphas: np.ndarray,
+                    status: np.ndarray, dt: float) -> dict:
     """The second-order fields of a run (velocities, ``r``, the velocity tube's verdict,
-    the velocity bound); empty ones for a first-order plant."""
+    the velocity bound): the cascade's role ``run_fields``.
+
+    Parameters
+    ----------
+    spec : Spec
+    tube : TubeDesign
+    stage : SecondStage or None
+        ``None`` for a custom controller's run (``r`` is then ``None``).
+    ts : ndarray, shape (N,)
+    states : ndarray, shape (N, 2 n)
+    alphas : ndarray, shape (N, 2 n)
+    status : ndarray, shape (N,)
+    dt : float
+
+    Returns
+    -------
+    dict
+        ``velocity``, ``r``, ``stayed_in_velocity_tube``, ``max_abs_velocity``,
+        ``exceeded_velocity_bound``.
+    """
     n = spec.dimension
-    if spec.order == 1:
-        return {"velocity": None, "r": None, "stayed_in_velocity_tube": None,
-                "max_abs_velocity": None, "exceeded_velocity_bound": False}
+    r = variant_of_stage(stage).entry("velocity_reference")(tube, stage, states, ts, dt,
+                                                            alphas)
     x1, x2 = states[:, :n], states[:, n:]
-    r = None
-    if stage is not None:
-        with reference.numpy_math():
-            r = cascade_reference.cascade_step(tube, stage, states, ts, dt, alphas)[2]
     bound = spec.second_order.velocity_bound
     exceeded = (bound is not None
                 and bool(np.any(np.abs(x2[ts <= spec.prescribed_time + 1e-12])

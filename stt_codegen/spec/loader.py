@@ -38,10 +38,11 @@ from .robot import (Robot, inflate_ball, inflate_bounds, inflate_moving, inflate
                     robot_dims, shrink_bounds)
 from .tasks import Task, build_tasks
 from .second_order import SecondOrder, parse_second_order
+from .variants import variant_of
 from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
                      PlantTable, PolytopeObstacle, check_document, value_kind)
 
-__all__ = ["Assumptions", "Box", "LinearPlant", "NAME_PATTERN", "Obstacle", "Spec", "UnsafeSet",
+__all__ = ["Assumptions", "Box", "LinearPlant", "law13_plant_terms", "look_ahead_plant_terms", "NAME_PATTERN", "Obstacle", "Spec", "UnsafeSet",
            "bundled_cases", "load_spec", "parse_spec"]
 
 NAME_PATTERN = re.compile(NAME_REGEX)
@@ -350,7 +351,8 @@ class Spec:
 
     @property
     def order(self) -> int:
-        """The plant's order: the one place that decides which controller variant runs.
+        """The plant's order (what the variant does with it: :attr:`variant`,
+        :mod:`~.variants`).
 
         Returns
         -------
@@ -717,8 +719,11 @@ def _validate(raw: dict) -> Spec:
                    for j, table in enumerate(doc.obstacles) if is_moving(table))
     linear = _linear_plant(doc.plant, n)      # also refuses another model's [plant] keys
     drive = _differential_drive(doc)
-    robot = _robot(doc, state_space, initial_set, target_set, unsafe_sets, moving,
-                   0.0 if drive is None else drive.axle_offset)
+    # the variant's terms: the point the robot's radius is about, the disturbance, the
+    # [plant] data the assumptions are checked on
+    offset, amplitude, plant_data = variant_of(plant_entry(doc.plant.model)).entry(
+        "plant_terms")(doc, linear, drive)
+    robot = _robot(doc, state_space, initial_set, target_set, unsafe_sets, moving, offset)
     if robot is not None:        # the problem of the reference point: sets inflated, X shrunk
         state_space, unsafe_sets, moving = _robot_problem(robot, state_space, initial_set,
                                                           target_set, doc.prescribed_time,
@@ -731,8 +736,6 @@ def _validate(raw: dict) -> Spec:
     mismatch = dimension_mismatch(model, n)
     if mismatch:
         raise SpecError("plant.model", mismatch)
-    # a differential drive's disturbance is its slip (Spec.drive)
-    amplitude = doc.plant.disturbance_amplitude if drive is None else 0.0
     second_order = _second_order(doc, n)
     if second_order is not None:
         model = "single-integrator"     # the position stage x1_dot = x2 (Spec.plant_model)
@@ -746,7 +749,7 @@ def _validate(raw: dict) -> Spec:
                 linear_plant=linear,
                 assumptions=_assumptions(doc.assumptions if second_order is None
                                          else AssumptionsTable(), n, amplitude, model,
-                                         state_space, linear if drive is None else drive),
+                                         state_space, plant_data),
                 input_bound=_input_bound(doc.actuator, doc.plant.model, n,
                                          doc.plant.actuators),
                 second_order=second_order,
@@ -845,7 +848,7 @@ def _second_order(doc: Any, n: int) -> SecondOrder | None:
     model = doc.plant.model
     given = {"plant.parameters": doc.plant.parameters, "initial.velocity": doc.initial.velocity,
              "state_space.velocity_bound": doc.state_space.velocity_bound}
-    if plant_entry(model).order == 1:
+    if model not in SECOND_ORDER_PLANTS:
         for field_name, value in given.items():
             if value is not None:
                 raise SpecError(field_name, f"only a second-order plant.model "
@@ -1016,6 +1019,58 @@ def _robot(doc: Any, state_space: Box, initial_set: Box, target_set: Box,
     dims = robot_dims(None if doc.robot is None else doc.robot.dims, len(state_space.lower))
     radius = (0.0 if doc.robot is None else float(doc.robot.radius)) + offset
     return Robot(radius, dims, state_space, unsafe_sets, moving, offset)
+
+
+def law13_plant_terms(doc: Any, linear: LinearPlant | None,
+                      drive: DifferentialDrive | None) -> tuple[float, float, Any]:
+    """The plant terms of law (13) on the plant's state (first order, and the cascade's
+    position stage): the variant's role ``plant_terms`` (:mod:`.variants`).
+
+    Parameters
+    ----------
+    doc : SpecDocument
+        The validated document.
+    linear : LinearPlant or None
+        The ``linear`` model's matrices.
+    drive : DifferentialDrive or None
+        ``None`` (no base).
+
+    Returns
+    -------
+    offset : float
+        0: the robot's radius is about the state itself, m.
+    amplitude : float
+        ``plant.disturbance_amplitude``.
+    plant_data : LinearPlant or None
+        The ``[plant]`` data the ``[assumptions]`` are checked on.
+    """
+    return 0.0, doc.plant.disturbance_amplitude, linear
+
+
+def look_ahead_plant_terms(doc: Any, linear: LinearPlant | None,
+                           drive: DifferentialDrive | None) -> tuple[float, float, Any]:
+    """The plant terms of a differential-drive base: the variant's role ``plant_terms``
+    (:mod:`.variants`).
+
+    Parameters
+    ----------
+    doc : SpecDocument
+        The validated document.
+    linear : LinearPlant or None
+        ``None`` (not a linear model).
+    drive : DifferentialDrive
+        The base.
+
+    Returns
+    -------
+    offset : float
+        The axle offset: the robot's radius is about the axle, m.
+    amplitude : float
+        0: a differential drive's disturbance is its slip (``Spec.drive``).
+    plant_data : DifferentialDrive
+        The base, the ``[plant]`` data the ``[assumptions]`` are checked on.
+    """
+    return drive.axle_offset, 0.0, drive
 
 
 def _differential_drive(doc: Any) -> DifferentialDrive | None:

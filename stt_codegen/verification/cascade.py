@@ -90,9 +90,9 @@ def judged_stage(spec, tube, min_width: float) -> tuple:
     """
     from ..design.cascade_gain import certified_stage, derived_second_stage
     for bound in ((spec.input_bound, None) if spec.input_bound is not None else (None,)):
-        stage, derivation = certified_stage(tube, spec, min_width, bound)
-        if stage is not None:
-            return stage, derivation
+        certified, derivation = certified_stage(tube, spec, min_width, bound)
+        if certified is not None:      # a shape is certified (None: none is)
+            return certified, derivation
     order = spec.second_order
     return derived_second_stage(tube, min_width, order.input_gain,
                                 order.drift_bound + spec.disturbance_amplitude,

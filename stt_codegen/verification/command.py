@@ -18,6 +18,7 @@ from ..design.result import Design
 from ..design.search import MAX_INITIAL_ERROR, MAX_MOVE_PER_SAMPLE, check_tube, design_tube
 from ..errors import DesignError, SpecError
 from ..spec.loader import Spec
+from ..spec.variants import variant_of
 from ..spec.plants import MODELS_WITH_EQUATIONS
 from ..tube.parameters import TANH, TubeDesign, peak_rate_factor
 from ..proofs.adaptive import adaptive_law_checks, alpha_upper_bound
@@ -30,7 +31,9 @@ from ..proofs.lemma import bump_rate_bound, reach_rate_bound
 from ..proofs.design_independent import design_independent_proofs
 from .sampled import input_bound_check, plant_bounds_checks, sampled_checks
 
-__all__ = ["spec_for_plant", "verify", "verify_design", "verify_spec"]
+__all__ = ["cascade_sampled_checks", "first_order_model_checks", "first_order_sampled_checks",
+           "look_ahead_model_checks", "look_ahead_sampled_checks", "no_model_checks",
+           "spec_for_plant", "verify", "verify_design", "verify_spec"]
 
 #: Dimension names used in check names.
 _SIDES = ("L", "U")
@@ -156,10 +159,8 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
 
     stage("assumption 2")
     checks.append(assumption2_check(spec, model))
-    if spec.drive is not None:     # the deployed command inverts the base's kinematics
-        checks.append(look_ahead_inverse())
-    if spec.order == 1:    # the cascade's membership check is reported with its lemmas
-        checks += plant_bounds_checks(spec, model)
+    variant = variant_of(spec)
+    checks += variant.entry("model_checks")(spec, model)
 
     stage("tube certificate")
     tube_check = check_tube(design, spec)   # not the designer's: verify certifies again
@@ -203,31 +204,149 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
             continue
         checks.append(Check(f"tube.{margin.name.replace(' ', '_')}", margin.passed,
                             margin.detail, {"margin": margin.margin, "time": margin.time}))
+    # the variant's sampled loop (law (13)'s, or the cascade's certificate and lemmas)
+    checks += variant.entry("sampled_checks")(spec, design, tube_check, stage)
+    return checks
+
+
+def first_order_model_checks(spec: Spec, model: str) -> list[Check]:
+    """The checks of law (13)'s plant model (role ``model_checks`` of
+    :mod:`~stt_codegen.spec.variants`): whether it meets ``[assumptions]``
+    (:func:`~stt_codegen.verify.sampled.plant_bounds_checks`).
+
+    Parameters
+    ----------
+    spec : Spec
+    model : str
+        The plant model judged.
+
+    Returns
+    -------
+    list of Check
+    """
+    return plant_bounds_checks(spec, model)
+
+
+def look_ahead_model_checks(spec: Spec, model: str) -> list[Check]:
+    """The checks of a differential-drive base's model (role ``model_checks``): the
+    deployed command inverts the base's kinematics, then law (13)'s.
+
+    Parameters
+    ----------
+    spec : Spec
+    model : str
+        The plant model judged.
+
+    Returns
+    -------
+    list of Check
+    """
+    return [look_ahead_inverse()] + plant_bounds_checks(spec, model)
+
+
+def no_model_checks(spec: Spec, model: str) -> list[Check]:
+    """The cascade's model checks here (role ``model_checks``): none, its membership
+    check is reported with its lemmas (:func:`cascade_sampled_checks`).
+
+    Parameters
+    ----------
+    spec : Spec
+    model : str
+
+    Returns
+    -------
+    list of Check
+        Empty.
+    """
+    return []
+
+
+def _law13_sampled(spec: Spec, design: TubeDesign, tube_check, progress,
+                   input_proof: Callable) -> list[Check]:
+    """The sampled loop of law (13) and, with ``[actuator]``, the input bound, the proof
+    of law (13)'s peaks mapped by ``input_proof(proof, spec)`` to the variant's input."""
+    progress("sampled loop")
     # the sampled loop is followed sample by sample (sample_tube refuses a horizon over its
     # step budget with a SpecError); the oracle's exp/log/tanh as numpy's ufuncs (within an
     # ulp of libm, tens of times faster), as the certificate and the input-bound prover
     # do: every margin here is far above rounding
-    if spec.order == 2:
-        # the deployed controller is the cascade, not law (13) on this plant: its lemmas
-        # and its sampled-data certificate (docs/second-order.md)
-        from ..proofs.cascade import cascade_checks
-        from .cascade import (cascade_input_bound_check, plant_within_class_check,
-                              sampled_cascade_check)
-        stage("sampled loop")          # the cascade takes the sampled loop's slot
-        checks += cascade_checks(min(n, 2)) + [
-            plant_within_class_check(spec),
-            sampled_cascade_check(spec, design, tube_check.min_width)]
-        if spec.input_bound is not None:     # the physical input u: force or torque
-            checks.append(cascade_input_bound_check(spec, design, tube_check.min_width))
-        return checks
-    stage("sampled loop")
     with reference.numpy_math():
-        checks += sampled_checks(spec, design, tube_check.certificate)
+        checks = sampled_checks(spec, design, tube_check.certificate)
     if spec.input_bound is not None:
-        proof = prove_input_bound(design, spec)
-        if spec.drive is not None:     # (v, omega) of the base from the point's peaks
-            proof = look_ahead_input_proof(proof, spec.drive.axle_offset)
-        checks.append(input_bound_check(spec, proof))
+        checks.append(input_bound_check(spec, input_proof(prove_input_bound(design, spec),
+                                                          spec)))
+    return checks
+
+
+def first_order_sampled_checks(spec: Spec, design: TubeDesign, tube_check,
+                               progress: Callable[[str], None]) -> list[Check]:
+    """The sampled closed loop of law (13) and, with ``[actuator]``, ``sampled.input_bound``
+    (role ``sampled_checks``).
+
+    Parameters
+    ----------
+    spec : Spec
+    design : TubeDesign
+    tube_check : TubeCheck
+        ``verify``'s own check of the tube.
+    progress : callable
+        Called with the stage's name.
+
+    Returns
+    -------
+    list of Check
+    """
+    return _law13_sampled(spec, design, tube_check, progress, lambda proof, _spec: proof)
+
+
+def look_ahead_sampled_checks(spec: Spec, design: TubeDesign, tube_check,
+                              progress: Callable[[str], None]) -> list[Check]:
+    """The sampled closed loop of law (13) on the look-ahead point and, with
+    ``[actuator]``, the bound of ``(v, omega)`` of the base from the point's peaks (role
+    ``sampled_checks``).
+
+    Parameters
+    ----------
+    spec : Spec
+    design : TubeDesign
+    tube_check : TubeCheck
+    progress : callable
+
+    Returns
+    -------
+    list of Check
+    """
+    return _law13_sampled(spec, design, tube_check, progress, lambda proof, base:
+                          look_ahead_input_proof(proof, base.drive.axle_offset))
+
+
+def cascade_sampled_checks(spec: Spec, design: TubeDesign, tube_check,
+                           progress: Callable[[str], None]) -> list[Check]:
+    """The deployed controller is the cascade, not law (13) on this plant: its lemmas,
+    its plant's membership in its class and its sampled-data certificate, with
+    ``[actuator]`` the bound of the physical input (role ``sampled_checks``;
+    docs/second-order.md).
+
+    Parameters
+    ----------
+    spec : Spec
+    design : TubeDesign
+    tube_check : TubeCheck
+    progress : callable
+
+    Returns
+    -------
+    list of Check
+    """
+    from ..proofs.cascade import cascade_checks
+    from .cascade import (cascade_input_bound_check, plant_within_class_check,
+                          sampled_cascade_check)
+    progress("sampled loop")          # the cascade takes the sampled loop's slot
+    checks = cascade_checks(min(design.dimension, 2)) + [
+        plant_within_class_check(spec),
+        sampled_cascade_check(spec, design, tube_check.min_width)]
+    if spec.input_bound is not None:     # the physical input u: force or torque
+        checks.append(cascade_input_bound_check(spec, design, tube_check.min_width))
     return checks
 
 

@@ -17,8 +17,9 @@ from ..spec.model_bounds import model_bounds
 from ..spec.plants import plant_entry
 from ..design.certificate.cascade_sampled import model_within_class
 from ..proofs.check import Check
+from ..spec.variants import variant_of
 
-__all__ = ["plant_within_assumptions"]
+__all__ = ["cascade_within", "first_order_within", "plant_within_assumptions"]
 
 
 def _not_checked(prefix: str, model: str, verdict: str) -> Check:
@@ -30,7 +31,21 @@ def _not_checked(prefix: str, model: str, verdict: str) -> Check:
                  {"declared_only": True})
 
 
-def _first_order(spec: Spec, model: str | None) -> Check:
+def first_order_within(spec: Spec, model: str | None) -> Check:
+    """``sampled.plant_within_assumptions`` (role ``plant_within`` of law (13) and the
+    look-ahead law, :mod:`~stt_codegen.spec.variants`): the model's bounds over the state
+    space within ``spec.assumptions``.
+
+    Parameters
+    ----------
+    spec : Spec
+    model : str or None
+        First-order plant model, default the spec's.
+
+    Returns
+    -------
+    Check
+    """
     model = model or spec.plant_model
     # no equations, or a MuJoCo model of the plant: nothing to compare
     if plant_entry(model).declared_bounds or spec.mujoco is not None:
@@ -60,15 +75,24 @@ def _first_order(spec: Spec, model: str | None) -> Check:
         "uses, so its verdict does not cover this plant: " + "; ".join(bad), found)
 
 
-def _second_order(spec: Spec, model: str | None) -> Check:
+def cascade_within(spec: Spec, model: str | None) -> Check:
+    """``cascade.plant_within_assumptions`` (the cascade's role ``plant_within``): the
+    second-order model with its parameters in the class ``cascade.sampled`` certifies.
+
+    Parameters
+    ----------
+    spec : Spec
+    model : str or None
+        Ignored (the spec's second-order model is judged).
+
+    Returns
+    -------
+    Check
+    """
     if plant_entry(spec.second_order.model).declared_bounds:     # no equations to compare
         return _not_checked("cascade", spec.second_order.model, "the cascade's certificate")
     ok, words, data = model_within_class(spec)
     return Check("cascade.plant_within_assumptions", ok, words, data)
-
-
-#: The membership check of each order (``Spec.order``).
-_BY_ORDER = {1: _first_order, 2: _second_order}
 
 
 def plant_within_assumptions(spec: Spec, model: str | None = None) -> Check:
@@ -92,4 +116,4 @@ def plant_within_assumptions(spec: Spec, model: str | None = None) -> Check:
     Check
         PASS when the model is in the class, with the model's figures.
     """
-    return _BY_ORDER[spec.order](spec, model)
+    return variant_of(spec).entry("plant_within")(spec, model)

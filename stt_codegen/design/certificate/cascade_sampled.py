@@ -34,6 +34,7 @@ from .enclosures import enclose_tube
 from ..samples import TubeSamples, sample_tube
 from ...spec.loader import Spec
 from ...spec.plants import SECOND_ORDER_PLANTS
+from ...spec.variants import require_variant
 from ...tube import reference
 from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from ...tube.second_stage import SecondStage
@@ -110,11 +111,10 @@ def cascade_class(spec: Spec) -> CascadeClass:
 
     Raises
     ------
-    ValueError
-        The spec is first order.
+    SpecError
+        The spec is not of the cascade variant (field ``plant.model``; a ``ValueError``).
     """
-    if spec.order != 2:
-        raise ValueError("cascade_class needs a spec with a second-order plant.model")
+    require_variant(spec, "cascade", "cascade_class")
     order = spec.second_order
     g_min, g_max = order.input_gain
     diagonal = SECOND_ORDER_PLANTS[order.model].diagonal_input

@@ -1,0 +1,344 @@
+"""The controller variants, registered once: what differs between law (13), the cascade and
+the look-ahead law, and the one place that decides it.
+
+A plant model names its variant (:attr:`~.plants.PlantModel.variant`, ``Spec.variant``):
+
+* ``"first-order"``: law (13) on the plant's state (system (1));
+* ``"cascade"``: a second-order plant, the cascade law on the tube of the positions
+  (docs/second-order.md);
+* ``"look-ahead"``: law (13) on the point ahead of a differential-drive base's axle, then the
+  base's command (docs/differential-drive.md).
+
+Each is one :class:`ControllerVariant` of :data:`CONTROLLER_VARIANTS`: its words for
+messages, its state layout, and its behaviour in the layers below ``spec`` (the stage the
+controller takes beyond the tube, the state split, the backends, the generated files, the
+firmware loop, the ``verify`` checks, ...) as *roles*. A role is a dotted reference
+``"package.module:function"`` resolved on first use with :mod:`importlib`, like an entry
+point, since ``spec`` may not import those layers; the three variants give one signature per
+role (:data:`ROLES`). A module resolves only roles whose functions live in its own layer or
+in layers above it (``tests/test_code_structure.py`` checks this, and that every reference
+resolves to a callable). Nothing else in the package compares ``order``, ``variant``,
+``drive`` or ``stage`` to decide a variant: it asks the variant object.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+from typing import Any
+
+from ..errors import SpecError
+from .plants import VARIANTS
+
+__all__ = ["CONTROLLER_VARIANTS", "ControllerVariant", "ROLES", "require_variant",
+           "resolve_reference", "variant_named", "variant_of", "variant_of_order",
+           "variant_of_stage"]
+
+#: Each role a variant fills, with the one signature its three functions share.
+ROLES: Mapping[str, str] = MappingProxyType({
+    "plant_terms": "(doc, linear, drive) -> (reference offset m, disturbance amplitude, "
+                   "the [plant] data of [assumptions])",
+    "stage_class": "the class of Design.stage (NoneType: no stage)",
+    "stage": "(design) -> Design.stage",
+    "casadi_step": "(tube, stage) -> casadi.Function (x, t, dt, alpha) -> (u, alpha_next, "
+                   "...), the deployed step",
+    "oracle_step": "(tube, stage, x (N, m), t (N,), dt (N,), alpha (N, 2n)) -> (u, "
+                   "alpha_next, ...), the numpy oracle's step",
+    "status": "(outputs of casadi_step) -> (u, alpha_next, Status)",
+    "stage_json": "(design) -> dict of the design document's variant fields",
+    "within_bound": "(spec, design_free) -> Design within [actuator] input_bound",
+    "initial_state": "(spec) -> ndarray, the plant's state at t = 0",
+    "positions": "(spec, states (N, m)) -> ndarray (N, n), the points the tube holds",
+    "backends": "() -> the variant's dict of backend name to controller factory",
+    "controller": "(name, tube design, stage) -> the backend's Controller",
+    "plant": "(spec, seed) -> the simulated plant with equations",
+    "mujoco_plant": "(spec) -> the plant stepped by MuJoCo",
+    "run_fields": "(spec, tube, stage, ts, states, alphas, status, dt) -> dict of "
+                  "SimulationResult's variant fields",
+    "velocity_reference": "(tube, stage, states, ts, dt, alphas) -> r along a run, or None",
+    "generation": "(design, options) -> dict of file name to bytes",
+    "firmware": "(design, *, seed) -> report dict of the closed loop on the Cortex-M4F",
+    "embedded_command": "(design, args, seed) -> exit code of stt-codegen embedded",
+    "model_checks": "(spec, model) -> list of Check on the plant model",
+    "sampled_checks": "(spec, design, tube_check, progress) -> list of Check of the "
+                      "sampled loop",
+    "plant_within": "(spec, model) -> Check, the plant within the certified class",
+})
+
+
+@dataclass(frozen=True)
+class ControllerVariant:
+    """One controller variant: its words, its state layout and its roles.
+
+    Attributes
+    ----------
+    name : str
+        The variant's name (:data:`~.plants.VARIANTS`), as ``Spec.variant``.
+    plant_words : str
+        The plants it drives, for messages (``"a second-order plant"``).
+    input_words : str
+        What computes the input, for messages (``"law (13)"``).
+    state_blocks : int
+        The plant state's layout for a plant of joints (MuJoCo): 1, the joints'
+        positions; 2, positions then velocities (``2 n`` states).
+    state_words : str
+        The layout in words, appended to messages about the state (``""`` when the state
+        is the tube's ``n`` coordinates).
+    roles : mapping of str to str
+        Each role of :data:`ROLES` to its ``"module:function"`` reference.
+    replay_context : mapping of str to bool
+        Extra variables of the firmware replay program's template
+        (``embedded_replay.c.j2``).
+    """
+
+    name: str
+    plant_words: str
+    input_words: str
+    state_blocks: int
+    state_words: str
+    roles: Mapping[str, str]
+    replay_context: Mapping[str, bool] = field(default_factory=lambda: MappingProxyType({}))
+
+    def entry(self, role: str) -> Callable[..., Any]:
+        """The variant's function (or class) for one role, imported on first use.
+
+        Parameters
+        ----------
+        role : str
+            A key of :data:`ROLES`.
+
+        Returns
+        -------
+        callable
+            The object the role's reference names, with the role's signature.
+
+        Raises
+        ------
+        KeyError
+            ``role`` is not a role of the variant.
+        """
+        return resolve_reference(self.roles[role])
+
+
+def resolve_reference(reference: str) -> Callable[..., Any]:
+    """The object a ``"package.module:name"`` reference names.
+
+    Parameters
+    ----------
+    reference : str
+        Module path, a colon, the attribute's name.
+
+    Returns
+    -------
+    callable
+        The module's attribute.
+
+    Raises
+    ------
+    ImportError
+        The module does not exist.
+    AttributeError
+        The module has no such name.
+    """
+    module, name = reference.split(":")
+    return getattr(importlib.import_module(module), name)
+
+
+def _roles(**names: str) -> Mapping[str, str]:
+    """The roles of one variant, checked to be exactly :data:`ROLES`."""
+    assert set(names) == set(ROLES), set(names) ^ set(ROLES)
+    return MappingProxyType({role: names[role] for role in ROLES})
+
+
+_P = "stt_codegen."
+#: The one registry of the controller variants, by name (:data:`~.plants.VARIANTS` order).
+CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
+    "first-order": ControllerVariant(
+        "first-order", "a first-order plant", "law (13)", 1, "",
+        _roles(plant_terms=_P + "spec.loader:law13_plant_terms",
+               stage_class="types:NoneType",
+               stage=_P + "design.result:no_stage",
+               casadi_step=_P + "tube.variant_steps:law13_casadi_step",
+               oracle_step=_P + "tube.variant_steps:law13_oracle_step",
+               status=_P + "tube.variant_steps:law13_status",
+               stage_json=_P + "design.result:no_stage_json",
+               within_bound=_P + "design.actuator:design_within_bound",
+               initial_state=_P + "runtime.state_split:tube_state_start",
+               positions=_P + "runtime.state_split:leading_positions",
+               backends=_P + "runtime.backends:first_order_backends",
+               controller=_P + "runtime.backends:first_order_controller",
+               plant=_P + "runtime.plants:first_order_spec_plant",
+               mujoco_plant=_P + "runtime.plants:joint_mujoco_plant",
+               run_fields=_P + "runtime.simulate:no_velocity_fields",
+               velocity_reference=_P + "runtime.simulate:no_velocity_reference",
+               generation=_P + "codegen.api:first_order_files",
+               firmware=_P + "embedded.deploy:run_embedded",
+               embedded_command=_P + "cli.embedded:law13_command",
+               model_checks=_P + "verification.command:first_order_model_checks",
+               sampled_checks=_P + "verification.command:first_order_sampled_checks",
+               plant_within=_P + "verification.plant_within:first_order_within")),
+    "cascade": ControllerVariant(
+        "cascade", "a second-order plant", "the cascade's input u", 2,
+        " (positions, then velocities)",
+        _roles(plant_terms=_P + "spec.loader:law13_plant_terms",
+               stage_class=_P + "tube.second_stage:SecondStage",
+               stage=_P + "design.result:cascade_stage",
+               casadi_step=_P + "tube.cascade:cascade_step",
+               oracle_step=_P + "tube.cascade_reference:cascade_step",
+               status=_P + "tube.variant_steps:cascade_status",
+               stage_json=_P + "design.result:cascade_stage_json",
+               within_bound=_P + "design.search:cascade_within_bound",
+               initial_state=_P + "runtime.state_split:cascade_start",
+               positions=_P + "runtime.state_split:leading_positions",
+               backends=_P + "runtime.backends:cascade_backends",
+               controller=_P + "runtime.backends:cascade_controller",
+               plant=_P + "runtime.plants:cascade_spec_plant",
+               mujoco_plant=_P + "runtime.plants:joint_mujoco_plant",
+               run_fields=_P + "runtime.simulate:velocity_fields",
+               velocity_reference=_P + "runtime.simulate:cascade_velocity_reference",
+               generation=_P + "codegen.cascade_source:cascade_generation",
+               firmware=_P + "embedded.cascade_loop:run_cascade_embedded",
+               embedded_command=_P + "cli.embedded:variant_loop_command",
+               model_checks=_P + "verification.command:no_model_checks",
+               sampled_checks=_P + "verification.command:cascade_sampled_checks",
+               plant_within=_P + "verification.plant_within:cascade_within"),
+        MappingProxyType({"cascade": True})),
+    "look-ahead": ControllerVariant(
+        "look-ahead", "a differential-drive base", "the base's command (v, omega)", 1, "",
+        _roles(plant_terms=_P + "spec.loader:look_ahead_plant_terms",
+               stage_class=_P + "tube.look_ahead:LookAhead",
+               stage=_P + "design.result:look_ahead_stage",
+               casadi_step=_P + "tube.look_ahead:look_ahead_step",
+               oracle_step=_P + "tube.variant_steps:look_ahead_oracle_step",
+               status=_P + "tube.variant_steps:law13_status",
+               stage_json=_P + "design.result:no_stage_json",
+               within_bound=_P + "design.look_ahead:look_ahead_within_bound",
+               initial_state=_P + "runtime.state_split:look_ahead_start",
+               positions=_P + "runtime.state_split:look_ahead_positions",
+               backends=_P + "runtime.backends:look_ahead_backends",
+               controller=_P + "runtime.backends:look_ahead_controller",
+               plant=_P + "runtime.plants:drive_spec_plant",
+               mujoco_plant=_P + "runtime.plants:drive_mujoco_plant",
+               run_fields=_P + "runtime.simulate:no_velocity_fields",
+               velocity_reference=_P + "runtime.simulate:no_velocity_reference",
+               generation=_P + "codegen.look_ahead_source:look_ahead_generation",
+               firmware=_P + "embedded.look_ahead_loop:run_look_ahead_embedded",
+               embedded_command=_P + "cli.embedded:variant_loop_command",
+               model_checks=_P + "verification.command:look_ahead_model_checks",
+               sampled_checks=_P + "verification.command:look_ahead_sampled_checks",
+               plant_within=_P + "verification.plant_within:first_order_within")),
+})
+assert tuple(CONTROLLER_VARIANTS) == VARIANTS
+
+#: The variant of each plant order (the ``order`` keyword of the backends' registry).
+_ORDERS = {1: "first-order", 2: "cascade"}
+
+
+def variant_named(name: str) -> ControllerVariant:
+    """The registered variant of a name.
+
+    Parameters
+    ----------
+    name : str
+        A name of :data:`~.plants.VARIANTS`.
+
+    Returns
+    -------
+    ControllerVariant
+
+    Raises
+    ------
+    SpecError
+        Unknown name (field ``variant``), naming the known ones.
+    """
+    if name not in CONTROLLER_VARIANTS:
+        raise SpecError("variant", f"unknown controller variant {name!r} (known: "
+                                   f"{', '.join(CONTROLLER_VARIANTS)})")
+    return CONTROLLER_VARIANTS[name]
+
+
+def variant_of(owner: Any) -> ControllerVariant:
+    """The variant of a spec or a plant model's entry (their ``variant`` name).
+
+    Parameters
+    ----------
+    owner : Spec or PlantModel or SecondOrderModel
+        Anything with a ``variant`` name.
+
+    Returns
+    -------
+    ControllerVariant
+    """
+    return variant_named(owner.variant)
+
+
+def variant_of_order(order: int) -> ControllerVariant:
+    """The variant of a plant order alone: law (13) for 1, the cascade for 2.
+
+    Parameters
+    ----------
+    order : {1, 2}
+        The plant's order.
+
+    Returns
+    -------
+    ControllerVariant
+
+    Raises
+    ------
+    SpecError
+        ``order`` is not 1 or 2 (field ``order``).
+    """
+    if order not in _ORDERS:
+        raise SpecError("order", f"a plant's order is 1 or 2, got {order!r}")
+    return CONTROLLER_VARIANTS[_ORDERS[order]]
+
+
+def variant_of_stage(stage: Any) -> ControllerVariant:
+    """The variant whose controller takes ``stage`` beyond the tube (``Design.stage``).
+
+    Parameters
+    ----------
+    stage : SecondStage, LookAhead or None
+        ``None`` for law (13) on the plant's state.
+
+    Returns
+    -------
+    ControllerVariant
+
+    Raises
+    ------
+    SpecError
+        No variant takes a stage of that type (field ``stage``).
+    """
+    for variant in CONTROLLER_VARIANTS.values():
+        if isinstance(stage, variant.entry("stage_class")):
+            return variant
+    raise SpecError("stage", f"no controller variant takes a {type(stage).__name__} "
+                             "(a SecondStage, a LookAhead or None)")
+
+
+def require_variant(spec: Any, name: str, what: str) -> None:
+    """Refuse a spec of another variant than ``name`` for something only it has.
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec.
+    name : str
+        The variant required (:data:`~.plants.VARIANTS`).
+    what : str
+        What needs it, for the message (``"the look-ahead point"``).
+
+    Raises
+    ------
+    SpecError
+        The spec's variant is another (field ``plant.model``).
+    """
+    wanted, found = variant_named(name), variant_of(spec)
+    if found is not wanted:
+        raise SpecError("plant.model", f"{what} needs {wanted.plant_words} (the "
+                                       f"{wanted.name} variant); the spec describes "
+                                       f"{found.plant_words} (the {found.name} variant)")
