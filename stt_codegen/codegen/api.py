@@ -7,11 +7,10 @@ from pathlib import Path
 
 from ..design.result import Design, require_design
 from ..spec.variants import variant_of
-from .generate import generate_files
 from .options import LANGUAGES, Options, parse_options
 from .output import write_generation
 
-__all__ = ["design_files", "first_order_files", "generate"]
+__all__ = ["design_files", "generate"]
 
 
 def design_files(design: Design, options: Options) -> dict[str, bytes]:
@@ -28,33 +27,13 @@ def design_files(design: Design, options: Options) -> dict[str, bytes]:
     -------
     dict of str to bytes
         File name to content, by the spec's variant (role ``generation``): law (13)'s
-        controller (:func:`first_order_files`) for a first-order plant, the cascade
+        controller (:func:`~.generate.first_order_generation`) for a first-order plant, the cascade
         controller (:func:`~.cascade_source.cascade_generation`, docs/second-order.md)
         for a second-order one, the look-ahead controller
         (:func:`~.look_ahead_source.look_ahead_generation`, docs/differential-drive.md)
         for a differential-drive base.
     """
     return variant_of(design.spec).entry("generation")(design, options)
-
-
-def first_order_files(design: Design, options: Options) -> dict[str, bytes]:
-    """Law (13)'s controller files of a first-order design (the variant's role
-    ``generation``, :mod:`~stt_codegen.spec.variants`): :func:`~.generate.generate_files`
-    of its spec and tube.
-
-    Parameters
-    ----------
-    design : Design
-        A first-order design.
-    options : Options
-        Languages and precision.
-
-    Returns
-    -------
-    dict of str to bytes
-        File name to content.
-    """
-    return generate_files(design.spec, design.tube, options)
 
 
 def generate(design: Design, out_dir: str | Path,

@@ -18,19 +18,12 @@ from ..errors import SpecError
 from ..tube import cascade_reference
 from ..tube.parameters import Status, TubeDesign
 from ..tube.second_stage import SecondStage
+from ..tube.variant_steps import cascade_status
 
 __all__ = ["CascadeController"]
 
 #: The backends of the cascade step, in order.
 CASCADE_BACKENDS = ("reference", "casadi", "python", "c")
-
-
-def _status(inside_position: float, inside_velocity: float, within_bound: float) -> int:
-    if not inside_position:
-        return Status.OUTSIDE_TUBE
-    if not inside_velocity:
-        return Status.OUTSIDE_VELOCITY_TUBE
-    return Status.OK if within_bound else Status.INPUT_CLAMPED
 
 
 class CascadeController:
@@ -105,9 +98,7 @@ class CascadeController:
         out = self._call(x, float(t), float(dt), np.asarray(alpha, dtype=float))
         if len(out) == 3:          # the compiled step returns its status
             return out
-        u, alpha_next, _r, inside_p, inside_v, *within = out
-        flags = [float(np.ravel(v)[0]) for v in (inside_p, inside_v, *within)]
-        return u, alpha_next, _status(*flags, *([1.0] if not within else []))
+        return cascade_status(out)       # the variant's status decoding, written once
 
 
 def _compiled(design: TubeDesign, stage: SecondStage):
