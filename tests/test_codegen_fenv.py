@@ -86,11 +86,7 @@ CASES = [*(pytest.param(*p.values, None, marks=p.marks, id=p.id) for p in varian
 
 
 #: Known faults, (variant, case, precision): reason. Strict: the test fails once fixed.
-KNOWN = {("look-ahead", None, "single"): (
-    "FE_UNDERFLOW in P_alpha_step (and P_step) on 7 of office-base's 52 single vectors: "
-    "the single-precision Newton stop test of c_source.c.j2, 6 A d^2 <= 2^-24 s c z^4, "
-    "multiplies A ~ 1e-13 by d^2 ~ 2e-30 (vector 1: t = 20.11 s, alpha = [0.051, 0.037, 0, "
-    "0]); not fixed in this branch")}
+KNOWN: dict = {}
 
 
 @pytest.mark.skipif(not COMPILERS, reason="no C compiler (install gcc or clang)")

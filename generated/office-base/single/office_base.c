@@ -1269,6 +1269,51 @@ static int office_base_law(const office_base_real* x, office_base_real t, const 
   return status;
 }
 
+/* Whether a6 d^2 <= r (a6, r >= 0): the Newton stop test without a subnormal or overflowing
+   intermediate (docs/codegen.md, "Single precision stops"). a6 and |d| are brought into
+   [2^-40, 2^40) by exact factors 2^64 or 2^-64 (n: the product's net factor 2^(64 n)), so
+   the product is in [2^-120, 2^120); r takes the same factor, or decides when it is out of
+   that range. Each rounding is the plain one times 2^(64 n): the decision is the plain
+   test's wherever the plain product is a normal number. */
+static int office_base_newton_stop(office_base_real a6, office_base_real d, office_base_real r) {
+  int n = 0;
+  if (d < 0.0f) {
+    d = -d;
+  }
+  if (a6 == 0.0f || d == 0.0f || !isfinite(a6) || !isfinite(d) || !isfinite(r)) {
+    return (a6 * (d * d)) <= r;
+  }
+  while (a6 < 0x1p-40f) {
+    a6 = a6 * 0x1p64f;
+    n = n + 1;
+  }
+  while (a6 >= 0x1p40f) {
+    a6 = a6 * 0x1p-64f;
+    n = n - 1;
+  }
+  while (d < 0x1p-40f) {
+    d = d * 0x1p64f;
+    n = n + 2;
+  }
+  while (d >= 0x1p40f) {
+    d = d * 0x1p-64f;
+    n = n - 2;
+  }
+  for (; n > 0; --n) {
+    if (r >= 0x1p56f) {
+      return 1;
+    }
+    r = r * 0x1p64f;
+  }
+  for (; n < 0; ++n) {
+    if (r < 0x1p-56f) {
+      return 0;
+    }
+    r = r * 0x1p-64f;
+  }
+  return (a6 * (d * d)) <= r;
+}
+
 /* implicit step of (11) from t to t + dt, inputs already checked (a: [N_ALPHA]) */
 static void office_base_implicit_step(office_base_real t, office_base_real dt, const office_base_real* a,
     office_base_real* next) {
@@ -1308,7 +1353,7 @@ static void office_base_implicit_step(office_base_real t, office_base_real dt, c
       const office_base_real z = psi[i] + s;
       const office_base_real z2 = z * z;
       s = s_next;
-      if (((6.0f * big_a) * (d * d)) <= (((5.960464477539063e-08f * s) * c) * (z2 * z2))) {
+      if (office_base_newton_stop(6.0f * big_a, d, ((5.960464477539063e-08f * s) * c) * (z2 * z2))) {
         k = 5;
       }
     }

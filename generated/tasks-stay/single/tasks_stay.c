@@ -1396,6 +1396,51 @@ int tasks_stay_control(const tasks_stay_real x[TASKS_STAY_N], tasks_stay_real t,
   return status;
 }
 
+/* Whether a6 d^2 <= r (a6, r >= 0): the Newton stop test without a subnormal or overflowing
+   intermediate (docs/codegen.md, "Single precision stops"). a6 and |d| are brought into
+   [2^-40, 2^40) by exact factors 2^64 or 2^-64 (n: the product's net factor 2^(64 n)), so
+   the product is in [2^-120, 2^120); r takes the same factor, or decides when it is out of
+   that range. Each rounding is the plain one times 2^(64 n): the decision is the plain
+   test's wherever the plain product is a normal number. */
+static int tasks_stay_newton_stop(tasks_stay_real a6, tasks_stay_real d, tasks_stay_real r) {
+  int n = 0;
+  if (d < 0.0f) {
+    d = -d;
+  }
+  if (a6 == 0.0f || d == 0.0f || !isfinite(a6) || !isfinite(d) || !isfinite(r)) {
+    return (a6 * (d * d)) <= r;
+  }
+  while (a6 < 0x1p-40f) {
+    a6 = a6 * 0x1p64f;
+    n = n + 1;
+  }
+  while (a6 >= 0x1p40f) {
+    a6 = a6 * 0x1p-64f;
+    n = n - 1;
+  }
+  while (d < 0x1p-40f) {
+    d = d * 0x1p64f;
+    n = n + 2;
+  }
+  while (d >= 0x1p40f) {
+    d = d * 0x1p-64f;
+    n = n - 2;
+  }
+  for (; n > 0; --n) {
+    if (r >= 0x1p56f) {
+      return 1;
+    }
+    r = r * 0x1p64f;
+  }
+  for (; n < 0; ++n) {
+    if (r < 0x1p-56f) {
+      return 0;
+    }
+    r = r * 0x1p-64f;
+  }
+  return (a6 * (d * d)) <= r;
+}
+
 /* implicit step of (11) from t to t + dt, inputs already checked (a: [N_ALPHA]) */
 static void tasks_stay_implicit_step(tasks_stay_real t, tasks_stay_real dt, const tasks_stay_real* a,
     tasks_stay_real* next) {
@@ -1435,7 +1480,7 @@ static void tasks_stay_implicit_step(tasks_stay_real t, tasks_stay_real dt, cons
       const tasks_stay_real z = psi[i] + s;
       const tasks_stay_real z2 = z * z;
       s = s_next;
-      if (((6.0f * big_a) * (d * d)) <= (((5.960464477539063e-08f * s) * c) * (z2 * z2))) {
+      if (tasks_stay_newton_stop(6.0f * big_a, d, ((5.960464477539063e-08f * s) * c) * (z2 * z2))) {
         k = 5;
       }
     }
