@@ -76,7 +76,8 @@ def _max_sampled_error(design, result) -> float:
 
 
 @pytest.mark.parametrize("case", ONE_CASE_FAST)
-@pytest.mark.parametrize("kind", ["model", "mirrored", "symmetric"])
+@pytest.mark.parametrize("kind", ["model", *(pytest.param(k, marks=pytest.mark.slow)
+                                          for k in ("mirrored", "symmetric"))])
 def test_plants_of_the_robot_class_stay_within_the_proved_error(case, kind):
     spec, design, _ = designed(case)
     result = check_sampled(design, samples_of(case), plant_class(spec))
