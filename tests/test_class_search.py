@@ -102,6 +102,7 @@ def test_a_counterexample_is_a_member_that_the_deployed_controller_reports_outsi
     assert not replay(design, early, "python")
 
 
+@pytest.mark.slow          # about 10 s; the Lipschitz counterexample's test stays fast
 def test_the_robot_class_over_the_whole_heading_range_has_a_member_that_leaves():
     """Why the check refuses the robot's bounds taken over the whole state space
     (tests/test_verify_coupled.py): a member of that class whose ``g`` may jump leaves the

@@ -229,6 +229,7 @@ def test_a_bound_too_tight_names_the_prescribed_time_that_works():
         stt.design_tube(spec)
 
 
+@pytest.mark.slow          # about 9 s; test_verify_proves_the_sampled_loop_and_the_limits stays fast
 def test_a_gain_far_above_the_derived_one_fails_the_sampled_check(office):
     bad = replace(office, tube=replace(office.tube, gain=20 * office.tube.gain))
     names = {c.name: c for c in stt.verify(bad).checks}

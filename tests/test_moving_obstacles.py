@@ -90,6 +90,7 @@ def test_a_moving_box_without_active_moves_until_it_has_left_the_state_space(vel
     assert moving.times == (0.0, t_off)
 
 
+@pytest.mark.slow          # about 20 s: a design and a closed loop; the other tests design fast
 def test_a_box_crossing_without_active_is_designed_certified_and_avoided():
     spec = stt.Spec.from_dict(with_obstacles({"lower": [2.0, 4.0], "upper": [3.0, 5.0],
                                               "velocity": [0.0, -1.0]}))

@@ -254,7 +254,7 @@ def test_run_figure_has_u_of_t_with_one_line_per_input(short_run):
 # --------------------------------------------------------------------------- no design
 
 
-@pytest.mark.parametrize("command", ["design", "simulate"])
+@pytest.mark.parametrize("command", ["design", pytest.param("simulate", marks=pytest.mark.slow)])
 def test_plot_without_a_design_shows_the_rejected_tube(command, tmp_path):
     spec_file = tmp_path / "near.toml"
     spec_file.write_text(NEAR_TARGET)

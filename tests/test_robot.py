@@ -164,6 +164,7 @@ def test_design_json_reports_the_robot(tmp_path, capsys):
     assert {o["obstacle"] for o in robot["inflated_obstacles"]} == {0, 1}
 
 
+@pytest.mark.slow          # about 25 s; test_plots.py keeps the figures' fast tests
 def test_plots_draw_the_real_obstacles_and_their_margins(design):
     from matplotlib.patches import Circle, Rectangle
     run = simulate(design, backend="reference")

@@ -189,6 +189,7 @@ def test_generate_writes_the_cascade(tmp_path) -> None:
 SPECS = REPO / "tests" / "specs"
 
 
+@pytest.mark.slow          # about 9 s; the printed states' test designs the same features fast
 def test_tasks_and_moving_obstacles_take_the_same_tube_for_a_second_order_plant():
     """A second-order spec with a timed task and a moving obstacle loads and designs: the
     tube's certificate proves the task and the moving obstacle's avoidance for the

@@ -25,12 +25,18 @@ from stt_codegen.design.certificate.sampled import check_sampled
 _SAMPLES: dict = {}
 
 
+#: The robot class's checks keep one case in the fast tier; the other two are slow.
+ONE_CASE_FAST = ["omnirobot-s1", *(pytest.param(c, marks=pytest.mark.slow)
+                                   for c in ("omnirobot-s2", "omnirobot-s3"))]
+
+
 def samples_of(case: str):
     if case not in _SAMPLES:
         _SAMPLES[case] = sample_tube(designed(case)[1])
     return _SAMPLES[case]
 
 
+@pytest.mark.parametrize("case", ONE_CASE_FAST)
 def test_the_robot_cases_pass_at_their_rate_with_the_robots_own_bounds(case):
     spec, design, _ = designed(case)
     a = spec.assumptions
@@ -69,7 +75,9 @@ def _max_sampled_error(design, result) -> float:
     return float(np.abs((2 * tr.x - (hi + lo)) / (hi - lo)).max())
 
 
-@pytest.mark.parametrize("kind", ["model", "mirrored", "symmetric"])
+@pytest.mark.parametrize("case", ONE_CASE_FAST)
+@pytest.mark.parametrize("kind", ["model", *(pytest.param(k, marks=pytest.mark.slow)
+                                          for k in ("mirrored", "symmetric"))])
 def test_plants_of_the_robot_class_stay_within_the_proved_error(case, kind):
     spec, design, _ = designed(case)
     result = check_sampled(design, samples_of(case), plant_class(spec))
