@@ -32,8 +32,8 @@ def _dispatched() -> list[str]:
     return out.stdout.split()
 
 
-@pytest.mark.parametrize("level", ["baseline",
-                                   pytest.param("below the highest", marks=pytest.mark.slow)])
+@pytest.mark.slow
+@pytest.mark.parametrize("level", ["baseline", "below the highest"])
 def test_generated_is_the_same_with_numpy_limited_to_a_lower_cpu_level(level):
     """``baseline``: every dispatched feature off (and OpenBLAS's generic core); ``below the
     highest``: the highest one off, as on a CPU one level down. ``.ci/run`` checks every

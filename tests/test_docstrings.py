@@ -363,6 +363,7 @@ sys.exit(1 if runner.summarize(verbose=False).failed or missing else 0)
 """
 
 
+@pytest.mark.slow
 def test_examples_run(tmp_path):
     """The ``Examples`` of every public name run as doctests, in one process of their own
     (an example may register a backend or write a file) in a scratch folder."""

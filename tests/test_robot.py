@@ -84,6 +84,7 @@ def _ball_gap(lo, hi, center, radius) -> float:
     return float(np.linalg.norm(nearest - center) - radius)
 
 
+@pytest.mark.slow
 def test_the_tube_clears_the_real_obstacles_by_the_radius(design):
     spec = design.spec
     names = [m.name for m in design.certificate.margins]

@@ -274,6 +274,7 @@ def test_printed_states_are_judged_on_the_tasks_and_the_moving_obstacles():
     assert not hit["met"] and hit["moving_clearance"] < 0
 
 
+@pytest.mark.slow
 def test_the_front_door_simulates_a_second_order_design_with_the_cascade(tmp_path):
     """``stt.simulate`` runs the cascade law on the spec's second-order model, in the one
     closed loop, with the one result type that ``plot_run`` draws; the command line's text

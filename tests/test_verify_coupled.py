@@ -98,6 +98,7 @@ def test_a_plant_outside_its_declared_bounds_is_not_accepted():
     assert "does not cover this plant" in within.detail
 
 
+@pytest.mark.slow
 def test_a_coupled_class_the_check_accepts_stays_within_the_proved_error():
     """A class with coupling and drift, one block of three coupled states: the check
     passes, and plants drawn within it stay below the |e| it proves. The Lyapunov balls
