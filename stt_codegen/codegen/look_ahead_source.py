@@ -166,11 +166,10 @@ def look_ahead_vectors(design: TubeDesign, look_ahead: LookAhead, precision: str
     """
     import numpy as np
 
-    from ..rounding import round_up_array
     from ..tube import look_ahead_reference as LR
     from ..tube import reference
     from . import tolerance as T
-    from .vectors import sample_inputs
+    from .vectors import sample_inputs, vector_document
 
     def f32(a):
         return np.asarray(a, dtype=np.float32).astype(np.float64)
@@ -191,23 +190,8 @@ def look_ahead_vectors(design: TubeDesign, look_ahead: LookAhead, precision: str
     states, t, dt, alpha, tol_u = (a[keep] for a in (states, t, dt, alpha, tol_u))
     u, alpha_next, status = LR.look_ahead_status(design, offset, look_ahead.input_bound,
                                                  states, t, dt, alpha)
-    g_l, g_u, _, _ = reference.adaptive_tube(design, t, alpha)
-    tol_a = T.alpha_bound(design, alpha, alpha_next, unit)
-    tol_g = np.broadcast_to(T.gamma_bound(design, alpha, unit), g_l.shape)
-    if precision == "double":
-        tol_u = T.with_double_floor(tol_u, u)
-        tol_a = T.with_double_floor(tol_a, alpha_next)
-        tol_g = T.with_double_floor(tol_g, np.maximum(np.abs(g_l), np.abs(g_u)))
-    tol_u, tol_a, tol_g = (round_up_array(tol) for tol in (tol_u, tol_a, tol_g))
-
-    def rows(a):
-        return [[float(v) for v in row] for row in np.asarray(a)]
-
-    return {"x": rows(states), "t": [float(v) for v in t], "dt": [float(v) for v in dt],
-            "alpha": rows(alpha), "u": rows(u), "alpha_next": rows(alpha_next),
-            "status": [int(s) for s in status], "gamma_L": rows(g_l), "gamma_U": rows(g_u),
-            "tol_u": rows(tol_u), "tol_alpha_next": rows(tol_a), "tol_gamma": rows(tol_g),
-            "unit_roundoff": unit}
+    return vector_document(design, precision, states, t, dt, alpha, u, alpha_next, status,
+                           tol_u)
 
 
 def look_ahead_generation(design, options) -> dict[str, bytes]:

@@ -31,7 +31,8 @@ from ..tube.parameters import TubeDesign
 from . import tolerance as T
 from .errors import CodegenError
 
-__all__ = ["BATCH", "INSIDE", "OUTSIDE", "ROUNDS", "sample_inputs", "test_vectors"]
+__all__ = ["BATCH", "INSIDE", "OUTSIDE", "ROUNDS", "sample_inputs", "test_vectors",
+           "vector_document"]
 
 INSIDE = 48
 OUTSIDE = 8
@@ -172,13 +173,41 @@ def test_vectors(design: TubeDesign, precision: str) -> dict:
     # below the term |u| 2 dg / w of the bound)
     u_law = R.law_step(design, x, t, dt, alpha)[0]
     tol_u = T.u_bound(design, x, alpha, g_l, g_u, u_law, unit)
+    return vector_document(design, precision, x, t, dt, alpha, u, alpha_next, status, tol_u)
+
+
+def vector_document(design: TubeDesign, precision: str, x, t, dt, alpha, u, alpha_next,
+                    status, tol_u) -> dict:
+    """The vectors' document of any variant: the inputs, the oracle's outputs, the tube at
+    ``t`` and every tolerance (``tol_u`` given, the others derived; a double floor in
+    double precision; rounded up to a few digits, so still bounds and the same on every
+    CPU, docs/codegen.md).
+
+    Parameters
+    ----------
+    design : TubeDesign
+    precision : str
+        ``"double"`` or ``"single"``.
+    x, t, dt, alpha : ndarray
+        The inputs, shapes (N, m), (N,), (N,), (N, 2 n).
+    u, alpha_next, status : ndarray
+        The oracle's outputs.
+    tol_u : ndarray
+        The bound on ``u``'s rounding, shape of ``u``.
+
+    Returns
+    -------
+    dict
+        As :func:`test_vectors`.
+    """
+    unit = T.unit_roundoff(precision)
+    g_l, g_u, _, _ = R.adaptive_tube(design, t, alpha)
     tol_a = T.alpha_bound(design, alpha, alpha_next, unit)
     tol_g = np.broadcast_to(T.gamma_bound(design, alpha, unit), g_l.shape)
     if precision == "double":
         tol_u = T.with_double_floor(tol_u, u)
         tol_a = T.with_double_floor(tol_a, alpha_next)
         tol_g = T.with_double_floor(tol_g, np.maximum(np.abs(g_l), np.abs(g_u)))
-    # rounded up to a few digits: still bounds, and the same on every CPU (docs/codegen.md)
     tol_u, tol_a, tol_g = (round_up_array(tol) for tol in (tol_u, tol_a, tol_g))
 
     def rows(a):
