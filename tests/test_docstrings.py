@@ -79,6 +79,8 @@ EXTENSION_POINTS = [
     "stt_codegen.runtime.backends:make_controller",
     "stt_codegen.runtime.backends:backend_names",
     "stt_codegen.codegen.emit.printer:InstructionPrinter",
+    "stt_codegen.spec.variants:ControllerVariant",
+    "stt_codegen.spec.variants:variant_of",
 ]
 
 

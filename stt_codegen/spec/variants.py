@@ -91,6 +91,17 @@ class ControllerVariant:
     replay_context : mapping of str to bool
         Extra variables of the firmware replay program's template
         (``embedded_replay.c.j2``).
+
+    Examples
+    --------
+    The differential-drive base's variant, and its role that writes the generated files:
+
+    >>> from stt_codegen.spec.variants import CONTROLLER_VARIANTS
+    >>> variant = CONTROLLER_VARIANTS["look-ahead"]
+    >>> variant.plant_words, variant.input_words
+    ('a differential-drive base', "the base's command (v, omega)")
+    >>> variant.entry("generation").__name__
+    'look_ahead_generation'
     """
 
     name: str
@@ -270,6 +281,18 @@ def variant_of(owner: Any) -> ControllerVariant:
     Returns
     -------
     ControllerVariant
+
+    Raises
+    ------
+    SpecError
+        ``owner.variant`` is not a registered variant (field ``variant``).
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> from stt_codegen.spec.variants import variant_of
+    >>> variant_of(stt.load_spec("second-order-s1")).name
+    'cascade'
     """
     return variant_named(owner.variant)
 
