@@ -1276,42 +1276,59 @@ static int office_base_law(const office_base_real* x, office_base_real t, const 
    that range. Each rounding is the plain one times 2^(64 n): the decision is the plain
    test's wherever the plain product is a normal number. */
 static int office_base_newton_stop(office_base_real a6, office_base_real d, office_base_real r) {
-  int n = 0;
-  if (d < 0.0f) {
-    d = -d;
-  }
-  if (a6 == 0.0f || d == 0.0f || !isfinite(a6) || !isfinite(d) || !isfinite(r)) {
-    return (a6 * (d * d)) <= r;
-  }
-  while (a6 < 0x1p-40f) {
-    a6 = a6 * 0x1p64f;
-    n = n + 1;
-  }
-  while (a6 >= 0x1p40f) {
-    a6 = a6 * 0x1p-64f;
-    n = n - 1;
-  }
-  while (d < 0x1p-40f) {
-    d = d * 0x1p64f;
-    n = n + 2;
-  }
-  while (d >= 0x1p40f) {
-    d = d * 0x1p-64f;
-    n = n - 2;
-  }
-  for (; n > 0; --n) {
-    if (r >= 0x1p56f) {
-      return 1;
+  int result = -1;   /* -1: not decided yet */
+  office_base_real a = a6;
+  office_base_real ad = (d < 0.0f) ? -d : d;
+  office_base_real rr = r;
+  if ((a != 0.0f) && (ad != 0.0f) && (isfinite(a) != 0) && (isfinite(ad) != 0)
+      && (isfinite(rr) != 0)) {
+    int n = 0;
+    int k;
+    /* at most 2 factors each: a finite float is in [2^-149, 2^128) */
+    for (k = 0; k < 3; ++k) {
+      if (a < 0x1p-40f) {
+        a = a * 0x1p64f;
+        n = n + 1;
+      } else if (a >= 0x1p40f) {
+        a = a * 0x1p-64f;
+        n = n - 1;
+      } else {
+        /* in range */
+      }
+      if (ad < 0x1p-40f) {
+        ad = ad * 0x1p64f;
+        n = n + 2;
+      } else if (ad >= 0x1p40f) {
+        ad = ad * 0x1p-64f;
+        n = n - 2;
+      } else {
+        /* in range */
+      }
     }
-    r = r * 0x1p64f;
-  }
-  for (; n < 0; ++n) {
-    if (r < 0x1p-56f) {
-      return 0;
+    for (; (n > 0) && (result < 0); --n) {
+      if (rr >= 0x1p56f) {
+        result = 1;
+      } else {
+        rr = rr * 0x1p64f;
+      }
     }
-    r = r * 0x1p-64f;
+    for (; (n < 0) && (result < 0); ++n) {
+      if (rr < 0x1p-56f) {
+        result = 0;
+      } else {
+        rr = rr * 0x1p-64f;
+      }
+    }
   }
-  return (a6 * (d * d)) <= r;
+  if (result < 0) {   /* zero, non-finite, or scaled into range: the plain test */
+    office_base_real product = a * (ad * ad);
+    if (product <= rr) {
+      result = 1;
+    } else {
+      result = 0;
+    }
+  }
+  return result;
 }
 
 /* implicit step of (11) from t to t + dt, inputs already checked (a: [N_ALPHA]) */
@@ -1353,7 +1370,7 @@ static void office_base_implicit_step(office_base_real t, office_base_real dt, c
       const office_base_real z = psi[i] + s;
       const office_base_real z2 = z * z;
       s = s_next;
-      if (office_base_newton_stop(6.0f * big_a, d, ((5.960464477539063e-08f * s) * c) * (z2 * z2))) {
+      if (office_base_newton_stop(6.0f * big_a, d, ((5.960464477539063e-08f * s) * c) * (z2 * z2)) != 0) {
         k = 5;
       }
     }
