@@ -1188,13 +1188,14 @@ int crossing_moving_control(const crossing_moving_real x[CROSSING_MOVING_N], cro
    [2^-40, 2^40) by exact factors 2^64 or 2^-64 (n: the product's net factor 2^(64 n)), so
    the product is in [2^-120, 2^120); r takes the same factor, or decides when it is out of
    that range. Each rounding is the plain one times 2^(64 n): the decision is the plain
-   test's wherever the plain product is a normal number. */
-static int crossing_moving_newton_stop(crossing_moving_real a6, crossing_moving_real d, crossing_moving_real r) {
+   test's wherever the plain product is a normal number. crossing_moving_newton_stop takes the plain
+   test at once when a6 and |d| are already in range (no factor: the common step). */
+static int crossing_moving_newton_stop_scaled(crossing_moving_real a6, crossing_moving_real ad, crossing_moving_real r) {
   int result = -1;   /* -1: not decided yet */
   crossing_moving_real a = a6;
-  crossing_moving_real ad = (d < 0.0f) ? -d : d;
+  crossing_moving_real ae = ad;
   crossing_moving_real rr = r;
-  if ((a != 0.0f) && (ad != 0.0f) && (isfinite(a) != 0) && (isfinite(ad) != 0)
+  if ((a != 0.0f) && (ae != 0.0f) && (isfinite(a) != 0) && (isfinite(ae) != 0)
       && (isfinite(rr) != 0)) {
     int n = 0;
     int k;
@@ -1209,11 +1210,11 @@ static int crossing_moving_newton_stop(crossing_moving_real a6, crossing_moving_
       } else {
         /* in range */
       }
-      if (ad < 0x1p-40f) {
-        ad = ad * 0x1p64f;
+      if (ae < 0x1p-40f) {
+        ae = ae * 0x1p64f;
         n = n + 2;
-      } else if (ad >= 0x1p40f) {
-        ad = ad * 0x1p-64f;
+      } else if (ae >= 0x1p40f) {
+        ae = ae * 0x1p-64f;
         n = n - 2;
       } else {
         /* in range */
@@ -1235,12 +1236,28 @@ static int crossing_moving_newton_stop(crossing_moving_real a6, crossing_moving_
     }
   }
   if (result < 0) {   /* zero, non-finite, or scaled into range: the plain test */
-    crossing_moving_real product = a * (ad * ad);
+    crossing_moving_real product = a * (ae * ae);
     if (product <= rr) {
       result = 1;
     } else {
       result = 0;
     }
+  }
+  return result;
+}
+
+static int crossing_moving_newton_stop(crossing_moving_real a6, crossing_moving_real d, crossing_moving_real r) {
+  int result;
+  crossing_moving_real ad = (d < 0.0f) ? -d : d;
+  if ((a6 >= 0x1p-40f) && (a6 < 0x1p40f) && (ad >= 0x1p-40f) && (ad < 0x1p40f)) {
+    crossing_moving_real product = a6 * (ad * ad);   /* in [2^-120, 2^120): normal */
+    if (product <= r) {
+      result = 1;
+    } else {
+      result = 0;
+    }
+  } else {
+    result = crossing_moving_newton_stop_scaled(a6, ad, r);
   }
   return result;
 }

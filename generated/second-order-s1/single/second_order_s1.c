@@ -1337,13 +1337,14 @@ int second_order_s1_virtual_velocity(const second_order_s1_real x[SECOND_ORDER_S
    [2^-40, 2^40) by exact factors 2^64 or 2^-64 (n: the product's net factor 2^(64 n)), so
    the product is in [2^-120, 2^120); r takes the same factor, or decides when it is out of
    that range. Each rounding is the plain one times 2^(64 n): the decision is the plain
-   test's wherever the plain product is a normal number. */
-static int second_order_s1_newton_stop(second_order_s1_real a6, second_order_s1_real d, second_order_s1_real r) {
+   test's wherever the plain product is a normal number. second_order_s1_newton_stop takes the plain
+   test at once when a6 and |d| are already in range (no factor: the common step). */
+static int second_order_s1_newton_stop_scaled(second_order_s1_real a6, second_order_s1_real ad, second_order_s1_real r) {
   int result = -1;   /* -1: not decided yet */
   second_order_s1_real a = a6;
-  second_order_s1_real ad = (d < 0.0f) ? -d : d;
+  second_order_s1_real ae = ad;
   second_order_s1_real rr = r;
-  if ((a != 0.0f) && (ad != 0.0f) && (isfinite(a) != 0) && (isfinite(ad) != 0)
+  if ((a != 0.0f) && (ae != 0.0f) && (isfinite(a) != 0) && (isfinite(ae) != 0)
       && (isfinite(rr) != 0)) {
     int n = 0;
     int k;
@@ -1358,11 +1359,11 @@ static int second_order_s1_newton_stop(second_order_s1_real a6, second_order_s1_
       } else {
         /* in range */
       }
-      if (ad < 0x1p-40f) {
-        ad = ad * 0x1p64f;
+      if (ae < 0x1p-40f) {
+        ae = ae * 0x1p64f;
         n = n + 2;
-      } else if (ad >= 0x1p40f) {
-        ad = ad * 0x1p-64f;
+      } else if (ae >= 0x1p40f) {
+        ae = ae * 0x1p-64f;
         n = n - 2;
       } else {
         /* in range */
@@ -1384,12 +1385,28 @@ static int second_order_s1_newton_stop(second_order_s1_real a6, second_order_s1_
     }
   }
   if (result < 0) {   /* zero, non-finite, or scaled into range: the plain test */
-    second_order_s1_real product = a * (ad * ad);
+    second_order_s1_real product = a * (ae * ae);
     if (product <= rr) {
       result = 1;
     } else {
       result = 0;
     }
+  }
+  return result;
+}
+
+static int second_order_s1_newton_stop(second_order_s1_real a6, second_order_s1_real d, second_order_s1_real r) {
+  int result;
+  second_order_s1_real ad = (d < 0.0f) ? -d : d;
+  if ((a6 >= 0x1p-40f) && (a6 < 0x1p40f) && (ad >= 0x1p-40f) && (ad < 0x1p40f)) {
+    second_order_s1_real product = a6 * (ad * ad);   /* in [2^-120, 2^120): normal */
+    if (product <= r) {
+      result = 1;
+    } else {
+      result = 0;
+    }
+  } else {
+    result = second_order_s1_newton_stop_scaled(a6, ad, r);
   }
   return result;
 }
