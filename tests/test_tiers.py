@@ -26,6 +26,12 @@ def test_the_default_run_deselects_every_tier():
     assert options[options.index("-m") + 1] == " and ".join(f"not {m}" for m in MARKERS)
 
 
+def test_the_default_run_uses_every_cpu_a_file_to_a_worker():
+    options = shlex.split(CONFIG["addopts"])
+    assert options[options.index("-n") + 1] == "auto"
+    assert options[options.index("--dist") + 1] == "loadfile"
+
+
 def test_ci_runs_the_other_tiers_after_the_readme_command():
     lines = (REPO / ".ci" / "run").read_text().splitlines()
     fast = lines.index("python3 -m pytest -q")
