@@ -95,11 +95,18 @@ class Disturbance:
         self.weights = weights / weights.sum(axis=1, keepdims=True)
         self.frequencies = rng.uniform(0.5, 5.0, (dimension, DISTURBANCE_TERMS))
         self.phases = rng.uniform(0.0, 2.0 * np.pi, (dimension, DISTURBANCE_TERMS))
+        self._last: tuple[float, np.ndarray] | None = None
 
     def __call__(self, t: float) -> np.ndarray:
-        """``w(t)``, shape (n,)."""
-        return self.amplitude * np.sum(
-            self.weights * np.sin(self.frequencies * t + self.phases), axis=1)
+        """``w(t)``, shape (n,), read-only; the last instant's value is kept, as Runge-Kutta
+        asks for each midpoint twice."""
+        if self._last is not None and self._last[0] == t:
+            return self._last[1]
+        w = self.amplitude * (self.weights * np.sin(self.frequencies * t + self.phases)
+                              ).sum(axis=1)
+        w.flags.writeable = False
+        self._last = (t, w)
+        return w
 
 
 def omnidirectional_robot(disturbance: Disturbance) -> ct.NonlinearIOSystem:

@@ -221,6 +221,10 @@ class _RungeKutta:
     def __init__(self, plant: ct.NonlinearIOSystem) -> None:
         self.plant = plant
         self.x = None
+        # ``plant.dynamics(t, x, u)`` without its per-call checks and copies (the states and
+        # the input are flat float arrays here): the same update function, the same values
+        update, params = plant.updfcn, dict(plant.params)
+        self._rhs = lambda t, x, u: np.asarray(update(t, x, u, params)).reshape(-1)
 
     def reset(self, x0: np.ndarray) -> np.ndarray:
         self.x = np.array(x0, dtype=float)
@@ -228,7 +232,7 @@ class _RungeKutta:
 
     def advance(self, t: float, u: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
         h = dt / SUBSTEPS
-        x, f = self.x, self.plant.dynamics
+        x, f = self.x, self._rhs
         points = np.empty((SUBSTEPS, x.size))
         for m in range(SUBSTEPS):
             tm = t + m * h
