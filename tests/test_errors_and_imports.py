@@ -135,6 +135,17 @@ def test_design_without_plot_imports_no_plotting_and_no_simulator():
     assert out["stdout"].splitlines()[0] == "False", "design imported mujoco"
 
 
+def test_generate_imports_neither_sympy_nor_plotting_nor_the_simulator(tmp_path):
+    """``stt-codegen generate`` prints C and Python from the pieces: SymPy (the proofs'
+    printer), matplotlib and python-control are not imported (no timing)."""
+    out = _imported_after("import contextlib, io\nfrom stt_codegen.cli import main\n"
+                          "with contextlib.redirect_stdout(io.StringIO()):\n"
+                          f"    assert main(['generate', 'omnirobot-s1', '-o', {str(tmp_path)!r}]) == 0")
+    assert {"sympy", "matplotlib", "control", "scipy"}.isdisjoint(out["heavy"]), out["heavy"]
+    assert {"casadi", "jinja2"} <= set(out["heavy"])        # the probe did generate
+    assert (tmp_path / "omnirobot_s1.c").exists()
+
+
 def test_every_command_is_configured_by_an_existing_function():
     import importlib
     for name, (help_text, target) in cli.COMMANDS.items():

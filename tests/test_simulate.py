@@ -49,6 +49,41 @@ def test_disturbance_is_bounded_deterministic_and_seeded():
     assert not np.allclose(values[:100], [Disturbance(3, 0.1, seed=5)(s) for s in t[:100]])
 
 
+def test_disturbance_kept_for_the_same_instant_is_the_value_computed_afresh():
+    """Runge-Kutta asks w at each midpoint twice: the kept value is the fresh one, bit for
+    bit, and cannot be changed by a caller."""
+    w = Disturbance(3, 0.1, seed=4)
+    for t in (0.25, 0.25, 0.5, 0.25):
+        value = w(t)
+        assert np.array_equal(value, Disturbance(3, 0.1, seed=4)(t))
+        with pytest.raises(ValueError):
+            value += 1.0
+
+
+@pytest.mark.parametrize("model", ["omnidirectional", "single-integrator"])
+def test_runge_kutta_step_equals_the_one_through_plant_dynamics(model):
+    """The stepper calls the plant's update function directly: the same floats as RK4
+    written with python-control's ``dynamics``, over several holds."""
+    n = 3 if model == "omnidirectional" else 2
+    plant = make_plant(model, n, 0.1, seed=3)
+    stepper = _RungeKutta(plant)
+    x = stepper.reset(np.linspace(0.5, 1.5, n))
+    rng = np.random.default_rng(1)
+    dt, steps = 1e-3, 2
+    for k in range(20):
+        t, u = k * dt, rng.normal(0, 2, n)
+        points, _ = stepper.advance(t, u, dt)
+        h = dt / steps
+        for m in range(steps):
+            tm = t + m * h
+            k1 = plant.dynamics(tm, x, u)
+            k2 = plant.dynamics(tm + h / 2, x + h / 2 * k1, u)
+            k3 = plant.dynamics(tm + h / 2, x + h / 2 * k2, u)
+            k4 = plant.dynamics(tm + h, x + h * k3, u)
+            x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            assert np.array_equal(points[m], x)
+
+
 def test_runge_kutta_hold_matches_an_adaptive_solver():
     """One sampling period of the plant with u held: RK4 against DOP853 at 1e-12."""
     plant = make_plant("omnidirectional", 3, 0.1, seed=1)

@@ -238,6 +238,6 @@ def sharpen_narrowest(design: TubeDesign, enc: Enclosure, steps: np.ndarray,
     all_low = np.concatenate(done_low + [np.array(tail_w)])
     all_t = np.concatenate(done_t + [np.array(tail_t)])
     k = int(np.argmin(all_low))
-    limited[np.unique(stuck)] = True
+    limited[stuck] = True                   # repeated indices set the same flag
     return Narrowest(float(all_low[k]), float(all_t[k]), float(upper), limited, interval_lower,
                      pieces)

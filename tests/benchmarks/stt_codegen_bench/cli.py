@@ -1,5 +1,5 @@
 """``stt-codegen bench arenas | tasks | drive | step | scaling | covering | alpha | second-order |
-stl``: the benchmarks and studies of :mod:`stt_codegen_bench`."""
+stl | overhead``: the benchmarks and studies of :mod:`stt_codegen_bench`."""
 
 from __future__ import annotations
 
@@ -18,6 +18,13 @@ def _non_negative_int(text: str) -> int:
     value = int(text)
     if value < 0:
         raise argparse.ArgumentTypeError(f"must be non-negative, got {value}")
+    return value
+
+
+def _positive_int(text: str) -> int:
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
     return value
 
 
@@ -126,9 +133,21 @@ def _cmd_stl(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_overhead(args: argparse.Namespace) -> int:
+    from .overhead import format_overhead_report, run_overhead_bench
+    commands = tuple(c.strip() for c in args.commands.split(",") if c.strip())
+    try:
+        report = run_overhead_bench(args.spec, commands, runs=args.runs)
+    except ValueError as exc:
+        raise SpecError("commands", str(exc)) from None
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_overhead_report(report))
+    return 0
+
+
 def configure_bench(bench: argparse.ArgumentParser) -> None:
     """Sub-subcommands ``bench arenas``, ``tasks``, ``drive``, ``step``, ``scaling``, ``covering``,
-    ``alpha``, ``second-order`` and ``stl``.
+    ``alpha``, ``second-order``, ``stl`` and ``overhead``.
 
     Parameters
     ----------
@@ -247,3 +266,15 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="also write the specs into DIR")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_stl)
+
+    p = sub.add_parser("overhead", help="CPU of a command beside the library call it makes "
+                                        "(stt-codegen design SPEC against design_tube)")
+    p.add_argument("spec", metavar="SPEC", nargs="?", default="omnirobot-s1",
+                   help="bundled case name or spec file (default: %(default)s)")
+    p.add_argument("--commands", default="design", metavar="LIST",
+                   help="comma-separated subset of design, generate, verify "
+                        "(default: %(default)s)")
+    p.add_argument("--runs", type=_positive_int, default=5, metavar="N",
+                   help="runs of each measurement, the least CPU kept (default: 5)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_overhead)
