@@ -118,6 +118,9 @@ def build_shared(sources: dict[str, bytes], c_file: str, cc: str | None = None,
 class CController:
     """Backend ``c``: the generated C (double), compiled and loaded with ``ctypes``.
 
+    The step's arrays are made once per controller (one closed loop at a time: not for
+    threads sharing a controller).
+
     Parameters
     ----------
     design : TubeDesign
@@ -162,21 +165,20 @@ class CController:
             self.functions[suffix] = f
         self.functions["step"] = self._step
 
-    def _buf(self, values, size: int) -> np.ndarray:
-        out = np.ascontiguousarray(np.asarray(values, dtype=self._dtype).reshape(size))
-        return out
-
     def _p(self, arr: np.ndarray):
         return arr.ctypes.data_as(ctypes.POINTER(self._real))
 
     def step(self, x, t, dt, alpha):
         """``(u (n,), alpha_next (2n,), status)``; see the C header."""
-        n = self.n
-        x = self._buf(x, n)
-        a = self._buf(alpha, 2 * n)
-        u = np.zeros(n, self._dtype)
-        nxt = np.zeros(2 * n, self._dtype)
-        status = self._step(self._p(x), t, dt, self._p(a), self._p(u), self._p(nxt))
+        if not hasattr(self, "_args"):   # the step's arrays, made once: x, alpha, u, next
+            arrays = [np.zeros(size, self._dtype) for size in (self.n, 2 * self.n) * 2]
+            self._args = arrays, [self._p(a) for a in arrays]
+        (xs, a, u, nxt), (px, pa, pu, pn) = self._args
+        xs[:] = np.reshape(x, self.n)
+        a[:] = np.reshape(alpha, 2 * self.n)
+        u.fill(0.0)
+        nxt.fill(0.0)
+        status = self._step(px, t, dt, pa, pu, pn)
         return u.astype(float), nxt.astype(float), int(status)
 
 
@@ -255,12 +257,15 @@ def load_variant_step(files: dict[str, str], prefix: str, output_sizes: tuple[in
                       *([real_p] * len(output_sizes))]
     entry.restype = ctypes.c_int
 
+    outputs = [np.zeros(size) for size in output_sizes]     # made once, zeroed each call
+    pointers = [b.ctypes.data_as(real_p) for b in outputs]
+
     def call(x, t, dt, alpha):
         x, alpha = (np.ascontiguousarray(v, dtype=np.float64) for v in (x, alpha))
-        outputs = [np.zeros(size) for size in output_sizes]
-        code = entry(x.ctypes.data_as(real_p), t, dt, alpha.ctypes.data_as(real_p),
-                     *(b.ctypes.data_as(real_p) for b in outputs))
-        return (*outputs, code)
+        for b in outputs:
+            b.fill(0.0)
+        code = entry(x.ctypes.data_as(real_p), t, dt, alpha.ctypes.data_as(real_p), *pointers)
+        return (*(b.copy() for b in outputs), code)
 
     call.library = handle  # keep the library loaded with the closure
     return call
