@@ -12,7 +12,7 @@ run so that they share the machine's load:
   ``verify`` after ``load_spec``, its modules imported first), from the process's own
   ``getrusage``.
 
-``command - call`` is what issue 42 bounds by 0.5 s (the interpreter, the imports, the
+``command - call`` is what the project bounds by 0.5 s (the interpreter, the imports, the
 spec's schema, the command's own work); ``command - script`` is the command line's own
 share. Wall times are not reported: the machine is shared. Whether the package's byte
 code is cached matters (``PYTHONDONTWRITEBYTECODE`` compiles every module in every
@@ -115,9 +115,10 @@ def run_overhead_bench(spec: str = "omnirobot-s1", commands: tuple[str, ...] = (
         A process failed.
     """
     unknown = [c for c in commands if c not in COMMANDS]
-    if unknown or runs < 1:
-        raise ValueError(f"commands must be among {sorted(COMMANDS)} and runs >= 1, got "
-                         f"{commands}, {runs}")
+    if unknown or not commands:
+        raise ValueError(f"unknown commands {unknown} (commands: {', '.join(COMMANDS)})")
+    if runs < 1:
+        raise ValueError(f"runs must be at least 1, got {runs}")
     load_before = os.getloadavg()[0]
     rows = []
     for name in commands:
