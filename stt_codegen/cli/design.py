@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .common import add_json_argument, add_spec_argument, print_json
+from .common import add_json_argument, add_quiet_argument, add_spec_argument, print_json
 from .plotting import add_plot_argument, design_to_plot, write_plot
 
 __all__ = ["cmd_design", "configure_design"]
@@ -85,11 +85,12 @@ def configure_design(p: argparse.ArgumentParser) -> None:
     Parameters
     ----------
     p : argparse.ArgumentParser
-        The subcommand's parser; gets ``SPEC``, ``--json``, ``--plot``, ``--dims`` and the
-        ``handler`` :func:`cmd_design`.
+        The subcommand's parser; gets ``SPEC``, ``--json``, ``--quiet``, ``--plot``,
+        ``--dims`` and the ``handler`` :func:`cmd_design`.
     """
     add_spec_argument(p)
     add_json_argument(p)
+    add_quiet_argument(p)
     add_plot_argument(p, "the designed tube (of the best rejected tube when there "
                       "is no design)")
     p.set_defaults(handler=cmd_design)
