@@ -7,8 +7,11 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from ..display import Rows, markdown, text
 from ..spec.variants import require_variant, variant_of
+from ..errors import SpecError
 from ..spec.robot import robot_json
 from ..tube.look_ahead import LookAhead
 from ..tube.parameters import TubeDesign
@@ -17,6 +20,7 @@ from .cascade_gain import second_stage_for
 from .certificate import Certificate
 from .failures import FailureKind
 from .input_bound import InputProof
+from .samples import sample_tube
 
 if TYPE_CHECKING:
     from ..spec.loader import Spec
@@ -221,6 +225,51 @@ class Design:
             A second-order design whose second stage is not certified.
         """
         return variant_of(self.spec).entry("stage")(self)
+
+    def tube_table(self, horizon: float | None = None) -> dict[str, np.ndarray]:
+        """The deployed tube at every sampling instant of the controller, as columns.
+
+        ``alpha`` follows the deployed implicit step of law (11) from ``alpha(0) = 0`` at
+        ``rate_hz`` (:func:`~stt_codegen.design.samples.sample_tube`, the tube the
+        simulation and the backends' tests use), and ``gamma`` is eq. (10) at it. What
+        ``stt-codegen design --export`` writes.
+
+        Parameters
+        ----------
+        horizon : float, optional
+            End time, s; default ``1.1 t_c`` (:data:`~stt_codegen.design.samples.HORIZON_FACTOR`).
+
+        Returns
+        -------
+        dict of str to ndarray, each of shape (N,)
+            ``"t"``: the instants ``k / rate_hz``, s, from 0, ``N = ceil(horizon rate_hz) +
+            1``; then ``"gamma_L_i"`` and ``"gamma_U_i"`` for each axis ``i = 1..n`` (the
+            tube's lower and upper bound of ``x_i``, state units), in that order.
+
+        Raises
+        ------
+        SpecError
+            ``horizon`` is not a positive number (field ``horizon``), or the table would
+            have more than :data:`~stt_codegen.design.samples.STEP_BUDGET` rows.
+
+        Examples
+        --------
+        >>> import stt_codegen as stt
+        >>> table = stt.design_tube(stt.load_spec("omnirobot-s1")).tube_table(horizon=1.0)
+        >>> list(table)[:3], table["t"].shape, table["t"][:2]
+        (['t', 'gamma_L_1', 'gamma_U_1'], (1001,), array([0.   , 0.001]))
+        """
+        if horizon is not None and not (isinstance(horizon, (int, float, np.number))
+                                        and not isinstance(horizon, bool)
+                                        and math.isfinite(horizon) and horizon > 0):
+            raise SpecError("horizon", f"must be a positive number of seconds, got "
+                                       f"{horizon!r}")
+        samples = sample_tube(self.tube, None if horizon is None else float(horizon))
+        table = {"t": samples.t}
+        for i in range(self.tube.dimension):
+            table[f"gamma_L_{i + 1}"] = samples.gamma_lower[:, i]
+            table[f"gamma_U_{i + 1}"] = samples.gamma_upper[:, i]
+        return table
 
     def summary_rows(self) -> Rows:
         """The rows of :meth:`summary`: ``(label, value)`` in words.
