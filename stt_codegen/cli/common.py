@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
@@ -87,12 +88,14 @@ def progress_bar(args: argparse.Namespace, what: str) -> Iterator[Callable[[Prog
         yield None
         return
     from tqdm import tqdm
+    started = time.monotonic()
     with tqdm(total=100, desc=what, file=sys.stderr, leave=False, delay=BAR_DELAY,
-              bar_format="{desc}: {percentage:3.0f}%|{bar:20}| {elapsed} {postfix}") as bar:
+              bar_format="{desc}: {percentage:3.0f}%|{bar:20}| {elapsed}{postfix}") as bar:
         def show(event: Progress) -> None:
             bar.n = round(100 * event.fraction)
             bar.set_postfix_str(event.message, refresh=False)
-            bar.refresh()
+            if time.monotonic() - started >= BAR_DELAY:     # short work draws no bar
+                bar.refresh()
         yield show
 
 
