@@ -25,7 +25,8 @@ def _fractions_rise_to_one(events: list[Progress]) -> None:
 
 @pytest.mark.parametrize("name, stages", [
     ("omnirobot-s1", {"reach tube", "candidate tubes"}),          # law (13), the paper's search
-    ("second-order-s1", {"candidate tubes", "via points", "cascade stage"}),    # the cascade
+    ("second-order-s1", {"candidate tubes", "via points", "cascade stage",
+                         "cascade certificate"}),                               # the cascade
 ])
 def test_design_reports_its_stages_with_rising_fractions(name, stages):
     events: list[Progress] = []
