@@ -17,6 +17,7 @@ Spatiotemporal Tubes Approach". The front door, in the order of the flow (see
   design (or of a spec, designed first), as a :class:`VerificationReport`
   (:func:`stt_codegen.verification.command.verify`);
 * :func:`plot_design`, :func:`plot_run` - figures of a design, and of a run;
+* :class:`Progress` - what ``design_tube`` and ``verify`` pass to a ``progress`` callback;
 * :func:`import_pointmaze` - the spec of a maze of gymnasium-robotics' PointMaze (the
   ``mujoco`` extra);
 * the errors, in three kinds: :class:`SpecError` (bad input), :class:`DesignError` (no
@@ -62,6 +63,7 @@ _LAZY: dict[str, str] = {
     "VerificationReport": "stt_codegen.proofs.check",
     "verify": "stt_codegen.verification.command",
     "import_pointmaze": "stt_codegen.pointmaze",
+    "Progress": "stt_codegen.progress",
 }
 
 __all__ = ["DesignError", "SpecError", "SttError", "ToolchainError", "__version__",
@@ -78,6 +80,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .spec.loader import Spec, load_spec
     from .tube.parameters import TubeDesign
     from .proofs.check import VerificationReport
+    from .progress import Progress
     from .verification.command import verify
 
 

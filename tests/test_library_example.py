@@ -27,8 +27,9 @@ def python_blocks(path: Path) -> list[str]:
 
 def test_the_document_has_the_examples():
     blocks = python_blocks(DOC)
-    assert len(blocks) == 2
+    assert len(blocks) == 3
     assert "stt.load_spec" in blocks[0] and "stt.Spec.from_dict" in blocks[1]
+    assert "progress=" in blocks[2] and "summary()" in blocks[2]
     assert ["MujocoPlant" in b for b in python_blocks(MUJOCO_DOC)] == [True]
 
 
@@ -42,7 +43,7 @@ def test_the_readme_example_is_the_documents():
     assert python_blocks_of(section)[0] == python_blocks(DOC)[0]
 
 
-@pytest.mark.parametrize("k", [0, 1])
+@pytest.mark.parametrize("k", [0, 1, 2])
 def test_library_example_runs_verbatim(k, tmp_path, monkeypatch, capsys):
     if k == 0 and shutil.which("cc") is None and shutil.which("gcc") is None:
         pytest.skip("the example compiles C: install the Debian package gcc")
@@ -54,6 +55,12 @@ def test_library_example_runs_verbatim(k, tmp_path, monkeypatch, capsys):
         assert sorted(p.name for p in (tmp_path / "omnirobot-s1-float").iterdir()) == [
             "CMakeLists.txt", "Makefile", "manifest.json", "omnirobot_s1.c", "omnirobot_s1.h",
             "omnirobot_s1_selftest.c", "omnirobot_s1_vectors.json"]
+    elif k == 2:
+        lines = out.splitlines()
+        assert lines[:3] == ["1.0 True", "[\"Design(spec='second-order-s1'\", \" variant='cascade'\"]",
+                             "0.0 True"]
+        assert lines[3] == ("Run of second-order-s1 (backend casadi, 1000 steps): "
+                            "Definition 2.1 not satisfied")
     else:
         lines = out.splitlines()
         assert lines[0] == "True"

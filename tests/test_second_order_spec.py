@@ -223,7 +223,7 @@ def test_a_second_order_task_with_a_moving_obstacle_is_satisfied_and_verified() 
     assert result.satisfied, result.to_json()
     assert all(task.met for task in result.tasks) and result.min_obstacle_clearance > 0
     assert result.stayed_in_tube and result.stayed_in_velocity_tube
-    out = _cli("verify", str(SPECS / "second-order-tasks.toml"))
+    out = _cli("verify", str(SPECS / "second-order-tasks.toml"), "--all")
     assert out.returncode == 0, out.stdout[-3000:]
     assert "PASS  cascade.sampled: proved" in out.stdout
     assert "PASS  tube.task_T1_reach" in out.stdout

@@ -48,8 +48,8 @@ def test_the_generated_c_meets_everything_and_verify_proves_it(design):
     assert all(task.met for task in result.tasks) and len(result.tasks) == 3
     assert result.min_obstacle_clearance > 0 and not result.collision
     assert all(u <= b for u, b in zip(result.max_abs_u, design.spec.input_bound))
-    out = subprocess.run([sys.executable, "-m", "stt_codegen.cli", "verify", str(SPEC)],
-                         capture_output=True, text=True, timeout=600)
+    out = subprocess.run([sys.executable, "-m", "stt_codegen.cli", "verify", str(SPEC),
+                          "--all"], capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stdout[-3000:]
     for name in ("tube.task_T1_reach", "tube.task_T2_reach", "tube.task_T3_stay",
                  "sampled.tube_kept", "sampled.input_bound"):

@@ -145,41 +145,20 @@ def test_verify_takes_a_design_or_a_spec_only():
         verify((spec, None))
 
 
-def test_progress_goes_to_a_terminal_only(monkeypatch):
-    class Terminal:
-        def __init__(self, tty):
-            self.tty, self.text = tty, ""
-
-        def isatty(self):
-            return self.tty
-
-        def write(self, text):
-            self.text += text
-
-        def flush(self):
-            pass
-
-    monkeypatch.setattr(sys, "stderr", Terminal(False))
-    assert verify_command_line._terminal_progress() is None
-    terminal = Terminal(True)
-    monkeypatch.setattr(sys, "stderr", terminal)
-    verify_command_line._terminal_progress()("lemma 3.3 (3/10)")
-    assert terminal.text == "\rverify: lemma 3.3 (3/10) ...\x1b[K"
-
-
 @pytest.mark.slow
 def test_a_cached_report_is_the_uncached_report(cache_home):
     """Same names, statuses, evidence and data, with the proofs proved, written, read."""
     spec = load_spec("omnirobot-s1")
     design = design_tube(spec)
     stages: list[str] = []
-    fresh = verify(design, cache=False, progress=stages.append)
+    fresh = verify(design, cache=False, progress=lambda event: stages.append(event.message))
     assert not cache_home.exists()                          # cache=False touches no file
-    assert stages[0] == "deployed pieces (1/9)" and stages[-1] == "sampled loop (9/9)"
+    assert stages[0] == "deployed pieces (1/9)" and stages[-2] == "sampled loop (9/9)"
+    assert stages[-1] == "done (9/9)"
     written = verify(design)                                # proves, writes the entry
     proofs._IN_PROCESS.clear()
     stages.clear()
-    cached = verify(spec, progress=stages.append)           # reads the entry
+    cached = verify(spec, progress=lambda event: stages.append(event.message))  # reads it
     assert "cached proofs (5/10)" in stages and "lemma 3.3 (3/10)" not in stages
     for report in (written, cached):
         assert [(c.name, c.passed, c.detail, c.data) for c in report.checks] == [

@@ -9,16 +9,25 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
+import time
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
 from ..errors import DesignError
 
 if TYPE_CHECKING:
     from ..design.result import Design
+    from ..progress import Progress
     from ..spec.loader import Spec
 
-__all__ = ["add_backend_argument", "add_json_argument", "add_seed_argument", "add_spec_argument",
-           "checked_seed", "design_spec", "load_and_design", "print_json"]
+__all__ = ["add_backend_argument", "add_json_argument", "add_quiet_argument",
+           "add_seed_argument", "add_spec_argument", "checked_seed", "design_spec",
+           "load_and_design", "print_json", "progress_bar"]
+
+#: Seconds of work before the progress bar appears (shorter work shows none).
+BAR_DELAY = 2.0
 
 
 def add_spec_argument(p: argparse.ArgumentParser) -> None:
@@ -43,6 +52,51 @@ def add_json_argument(p: argparse.ArgumentParser, text: str = "print one JSON ob
         The option's help text.
     """
     p.add_argument("--json", action="store_true", help=text)
+
+
+def add_quiet_argument(p: argparse.ArgumentParser) -> None:
+    """``--quiet``: no progress bar on standard error.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser; gets ``--quiet`` (``args.quiet``, a bool).
+    """
+    p.add_argument("--quiet", action="store_true",
+                   help="no progress bar on standard error (it is drawn only on a terminal)")
+
+
+@contextmanager
+def progress_bar(args: argparse.Namespace, what: str) -> Iterator[Callable[[Progress], None] | None]:
+    """A tqdm bar on standard error that draws the :class:`~stt_codegen.progress.Progress`
+    events of long work, shown after :data:`BAR_DELAY` seconds, only when standard error
+    is a terminal and without ``--quiet``; removed at the end.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments; ``quiet`` (if present) turns the bar off.
+    what : str
+        The bar's label (``"design"``).
+
+    Yields
+    ------
+    callable or None
+        The ``progress`` callback to pass to the library, ``None`` for no bar.
+    """
+    if getattr(args, "quiet", False) or not sys.stderr.isatty():
+        yield None
+        return
+    from tqdm import tqdm
+    started = time.monotonic()
+    with tqdm(total=100, desc=what, file=sys.stderr, leave=False, delay=BAR_DELAY,
+              bar_format="{desc}: {percentage:3.0f}%|{bar:20}| {elapsed}{postfix}") as bar:
+        def show(event: Progress) -> None:
+            bar.n = round(100 * event.fraction)
+            bar.set_postfix_str(event.message, refresh=False)
+            if time.monotonic() - started >= BAR_DELAY:     # short work draws no bar
+                bar.refresh()
+        yield show
 
 
 def default_backend() -> str:
@@ -134,7 +188,8 @@ def design_spec(spec: Spec, args: argparse.Namespace) -> Design:
     spec : Spec
         The loaded spec.
     args : argparse.Namespace
-        Parsed arguments; ``json`` (if present) asks for the document on no design.
+        Parsed arguments; ``json`` (if present) asks for the document on no design,
+        ``quiet`` (if present) turns the progress bar off (:func:`progress_bar`).
 
     Returns
     -------
@@ -148,7 +203,8 @@ def design_spec(spec: Spec, args: argparse.Namespace) -> Design:
     """
     from ..design.search import design_tube
     try:
-        return design_tube(spec)
+        with progress_bar(args, "design") as progress:
+            return design_tube(spec, progress=progress)
     except DesignError as exc:
         if getattr(args, "json", False):
             print_json(no_design_document(spec, exc))

@@ -3,11 +3,66 @@
 from __future__ import annotations
 
 import argparse
+import io
+from pathlib import Path
 
-from .common import add_json_argument, add_spec_argument, print_json
+from ..errors import SpecError
+from .common import add_json_argument, add_quiet_argument, add_spec_argument, print_json
 from .plotting import add_plot_argument, design_to_plot, write_plot
 
-__all__ = ["cmd_design", "configure_design"]
+__all__ = ["cmd_design", "configure_design", "export_tube"]
+
+#: What ``--export`` writes, by the file's extension.
+EXPORT_FORMATS = (".csv", ".npz")
+
+
+def _check_export(args: argparse.Namespace) -> None:
+    """Refuse an ``--export`` path of another extension or in a missing folder, before
+    any work."""
+    if args.export is None:
+        return
+    path = Path(args.export)
+    if path.suffix.lower() not in EXPORT_FORMATS:
+        raise SpecError("export", f"must end in {' or '.join(EXPORT_FORMATS)} (CSV or NumPy "
+                                  f"archive), got {args.export!r}")
+    folder = path.parent
+    if not folder.is_dir():
+        raise SpecError("export", f"folder {str(folder)!r} does not exist")
+
+
+def export_tube(design, path: str | Path) -> None:
+    """Write :meth:`~stt_codegen.design.result.Design.tube_table` to ``path``, atomically:
+    CSV (a header row ``t [s],gamma_L_1 [state units],...``, then one row an instant, 17
+    significant digits) or a NumPy ``.npz`` archive (one array a column, same names
+    without the units).
+
+    Parameters
+    ----------
+    design : Design
+        The certified design.
+    path : str or pathlib.Path
+        Ends in ``.csv`` or ``.npz``.
+
+    Raises
+    ------
+    SpecError
+        Another extension, or a missing folder (field ``export``).
+    """
+    import numpy as np
+    from ..system import atomic_write
+    table = design.tube_table()
+    buffer = io.BytesIO()
+    if Path(path).suffix.lower() == ".npz":
+        np.savez(buffer, **table)
+    elif Path(path).suffix.lower() == ".csv":
+        header = ",".join(f"{name} [{'s' if name == 't' else 'state units'}]"
+                          for name in table)
+        np.savetxt(buffer, np.column_stack(list(table.values())), fmt="%.17g",
+                   delimiter=",", header=header, comments="")
+    else:
+        raise SpecError("export", f"must end in {' or '.join(EXPORT_FORMATS)}, got "
+                                  f"{str(path)!r}")
+    atomic_write(path, buffer.getvalue(), field="export")
 
 
 def cmd_design(args: argparse.Namespace) -> int:
@@ -16,7 +71,8 @@ def cmd_design(args: argparse.Namespace) -> int:
     Parameters
     ----------
     args : argparse.Namespace
-        ``spec``, ``json``, ``plot`` and ``dims``.
+        ``spec``, ``json``, ``quiet``, ``plot``, ``dims`` and ``export`` (a ``.csv``
+        or ``.npz`` path for the tube at the controller's rate, :func:`export_tube`).
 
     Returns
     -------
@@ -26,10 +82,12 @@ def cmd_design(args: argparse.Namespace) -> int:
     Raises
     ------
     SpecError
-        A bad spec, ``--plot`` folder or ``--dims`` (exit code 2).
+        A bad spec, ``--plot`` folder, ``--dims`` or ``--export`` path (exit code 2),
+        refused before any work.
     DesignError
         No design (exit code 1).
     """
+    _check_export(args)
     design, dims = design_to_plot(args)
     spec = design.spec
 
@@ -37,6 +95,8 @@ def cmd_design(args: argparse.Namespace) -> int:
         from ..runtime.plots import plot_design
         return plot_design(design, path, dims=dims)
     write_plot(args, draw)
+    if args.export is not None:
+        export_tube(design, args.export)
     if args.json:
         print_json(design.to_json())
         return 0
@@ -76,6 +136,8 @@ def cmd_design(args: argparse.Namespace) -> int:
         print(f"  PASS  input bound: {law} asks at most [{peaks}] (proved)")
     if args.plot:
         print(f"plot written to {args.plot}")
+    if args.export is not None:
+        print(f"tube written to {args.export}")
     return 0
 
 
@@ -85,11 +147,15 @@ def configure_design(p: argparse.ArgumentParser) -> None:
     Parameters
     ----------
     p : argparse.ArgumentParser
-        The subcommand's parser; gets ``SPEC``, ``--json``, ``--plot``, ``--dims`` and the
-        ``handler`` :func:`cmd_design`.
+        The subcommand's parser; gets ``SPEC``, ``--json``, ``--quiet``, ``--export``,
+        ``--plot``, ``--dims`` and the ``handler`` :func:`cmd_design`.
     """
     add_spec_argument(p)
     add_json_argument(p)
+    add_quiet_argument(p)
+    p.add_argument("--export", metavar="PATH", default=None,
+                   help="write the tube at the controller's rate: t, gamma_L_i, gamma_U_i "
+                        "per axis (.csv with a header row with units, or .npz)")
     add_plot_argument(p, "the designed tube (of the best rejected tube when there "
                       "is no design)")
     p.set_defaults(handler=cmd_design)

@@ -42,7 +42,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     ----------
     args : argparse.Namespace
         ``spec``, ``backend``, ``horizon`` (s, or ``None`` for ``t_c``), ``seed``, ``plot``,
-        ``dims`` and ``json``.
+        ``dims``, ``log`` (an MCAP path or ``None``) and ``json``.
 
     Returns
     -------
@@ -52,16 +52,23 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     Raises
     ------
     SpecError
-        A bad spec, ``--seed``, ``--horizon``, ``--plot`` folder or ``--dims`` (exit code 2).
+        A bad spec, ``--seed``, ``--horizon``, ``--plot`` folder, ``--dims`` or ``--log``
+        (not ``.mcap``, a missing folder, ``mcap-ros2-support`` not installed), exit code 2,
+        before any work.
     DesignError
         No design (exit code 1).
     ToolchainError
         The backend's compiler is missing or fails (exit code 3).
     """
     from ..runtime.simulate import simulate
+    from ..runtime.run_log import check_log_path, write_run_log
     seed = checked_seed(args)
+    if args.log is not None:
+        check_log_path(args.log)
     design, dims = design_to_plot(args)
     result = simulate(design, backend=args.backend, horizon=args.horizon, seed=seed)
+    if args.log is not None:
+        write_run_log(design, result, args.log)
 
     def draw(path):
         from ..runtime.plots import plot_run
@@ -96,7 +103,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
                   f"{'-' if task.margin is None else f'{task.margin:.3g}'}")
         if args.plot:
             print(f"plot written to {args.plot}")
+        if args.log is not None:
+            print(f"run written to {args.log} (ROS 2 messages, docs/cli.md)")
     return 0 if result.satisfied else 1
+
 
 
 def configure_simulate(p: argparse.ArgumentParser) -> None:
@@ -106,7 +116,8 @@ def configure_simulate(p: argparse.ArgumentParser) -> None:
     ----------
     p : argparse.ArgumentParser
         The subcommand's parser; gets ``SPEC``, ``--backend``, ``--horizon``, ``--seed``,
-        ``--plot``, ``--dims``, ``--json`` and the ``handler`` :func:`cmd_simulate`.
+        ``--plot``, ``--dims``, ``--log``, ``--json`` and the ``handler``
+        :func:`cmd_simulate`.
     """
     add_spec_argument(p)
     add_backend_argument(p)
@@ -114,5 +125,8 @@ def configure_simulate(p: argparse.ArgumentParser) -> None:
                    help="simulated time in seconds (default: t_c)")
     add_seed_argument(p)
     add_plot_argument(p, "the run")
+    p.add_argument("--log", metavar="RUN.mcap", default=None,
+                   help="write the run as ROS 2 messages to an MCAP file (Foxglove, ros2 bag "
+                        "play; the optional extra ros)")
     add_json_argument(p)
     p.set_defaults(handler=cmd_simulate)

@@ -4,23 +4,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
-from collections.abc import Callable
 
-from .common import add_json_argument, add_spec_argument, design_spec
+from .common import add_json_argument, add_quiet_argument, add_spec_argument, design_spec, \
+    progress_bar
 
 __all__ = ["cmd_verify", "configure_verify"]
-
-
-def _terminal_progress() -> Callable[[str], None] | None:
-    """Progress on stderr when it is a terminal (one line, rewritten), else ``None``."""
-    if not sys.stderr.isatty():
-        return None
-
-    def show(message: str) -> None:
-        sys.stderr.write(f"\rverify: {message} ...\x1b[K")
-        sys.stderr.flush()
-    return show
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
@@ -29,8 +17,10 @@ def cmd_verify(args: argparse.Namespace) -> int:
     Parameters
     ----------
     args : argparse.Namespace
-        ``spec``, ``plant`` (a plant model or ``None`` for the spec's), ``json`` and
-        ``no_cache`` (prove the design-independent lemmas again).
+        ``spec``, ``plant`` (a plant model or ``None`` for the spec's), ``json``,
+        ``all`` (every check instead of the summary: the failures and the key figures,
+        :meth:`~stt_codegen.proofs.check.VerificationReport.summary`), ``quiet`` (no
+        progress bar) and ``no_cache`` (prove the design-independent lemmas again).
 
     Returns
     -------
@@ -47,14 +37,12 @@ def cmd_verify(args: argparse.Namespace) -> int:
     from ..spec.loader import load_spec
     from ..verification.command import spec_for_plant, verify
     design = design_spec(spec_for_plant(load_spec(args.spec), args.plant), args)
-    progress = None if args.json else _terminal_progress()
-    try:
+    with progress_bar(args, "verify") as progress:
         report = verify(design, plant=args.plant, progress=progress, cache=not args.no_cache)
-    finally:
-        if progress is not None:
-            sys.stderr.write("\r\x1b[K")
-            sys.stderr.flush()
-    print(json.dumps(report.to_json(), indent=2) if args.json else str(report))
+    if args.json:
+        print(json.dumps(report.to_json(), indent=2))
+    else:
+        print(str(report) if args.all else report.summary())
     return 0 if report.passed else 1
 
 
@@ -64,12 +52,16 @@ def configure_verify(p: argparse.ArgumentParser) -> None:
     Parameters
     ----------
     p : argparse.ArgumentParser
-        The subcommand's parser; gets ``SPEC``, ``--json``, ``--plant``, ``--no-cache`` and
-        the ``handler`` :func:`cmd_verify`.
+        The subcommand's parser; gets ``SPEC``, ``--json``, ``--all``, ``--quiet``,
+        ``--plant``, ``--no-cache`` and the ``handler`` :func:`cmd_verify`.
     """
     from ..spec.plants import MODELS_WITH_EQUATIONS
     add_spec_argument(p)
     add_json_argument(p, "print a JSON list of checks")
+    p.add_argument("--all", action="store_true",
+                   help="print every check with its evidence (default: the failures and "
+                        "the key figures)")
+    add_quiet_argument(p)
     p.add_argument("--plant", default=None, metavar="MODEL",
                    help=f"plant for Assumption 2 and the sampled check's bounds "
                         f"({', '.join(MODELS_WITH_EQUATIONS)}; default: the spec's)")

@@ -39,6 +39,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 from ..errors import DesignError, SpecError
+from ..progress import report, reporting
 from ..spec.loader import Spec
 from ..spec.variants import variant_of
 from ..tube.parameters import CRUISE
@@ -150,17 +151,24 @@ def candidates(spec: Spec, design_free: Callable[[Spec], Design],
     """
     bound = spec.input_bound
     free = replace(spec, input_bound=None)
-    default = design_free(free)
+    report("input bound", 0.0, "input bound: the default design")
+    with reporting(None, (0.0, 0.5)):
+        default = design_free(free)
     tried = [Candidate("default design", default, prove(default, spec))]
     if tried[0].proof.meets(bound):
         return tried[0], tried
     softer_failed = False
-    for label, variant in slower_variants(free, default):
+    slower = slower_variants(free, default)
+    for k, (label, variant) in enumerate(slower):
+        share = (0.5 + 0.5 * k / len(slower), 0.5 + 0.5 * (k + 1) / len(slower))
+        report("input bound", share[0], f"input bound: {label} ({k + 2} of at most "
+                                        f"{len(slower) + 1})")
         softer = variant.tube.method == METHOD_PAPER
         if softer and softer_failed:
             continue
         try:
-            design = design_free(variant)
+            with reporting(None, share):
+                design = design_free(variant)
         except DesignError:
             # a smoother bump has a longer window: once the paper's search fails with one,
             # the smoother ones are not tried (on to via points)

@@ -36,6 +36,7 @@ import math
 
 import numpy as np
 
+from ..progress import report as report_progress, reporting
 from ..rounding import round_up
 from ..spec.variants import require_variant
 from ..tube import reference
@@ -184,11 +185,14 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
     tube, spec = dataclasses.replace(tube, input_bound=None), dataclasses.replace(
         spec, input_bound=None)
     tried = []
-    for shape in SHAPES:
+    for k, shape in enumerate(SHAPES):
+        report_progress("cascade stage", k / len(SHAPES),
+                        f"the cascade's second stage: shape {k + 1} of at most {len(SHAPES)}")
         stage, derivation = derived_second_stage(
             tube, min_width, order.input_gain, order.drift_bound + spec.disturbance_amplitude,
             order.initial_velocity, shape)
-        passed, report = certify_stage(tube, spec, stage)
+        with reporting(None, (k / len(SHAPES), (k + 1) / len(SHAPES))):
+            passed, report = certify_stage(tube, spec, stage)
         within = bound is None or all(p <= b for p, b in zip(report["peak_input"], bound))
         if passed and within:
             return stage, {**derivation, "certificate": report}

@@ -7,7 +7,11 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
+from ..display import Rows, markdown, text
 from ..spec.variants import require_variant, variant_of
+from ..errors import SpecError
 from ..spec.robot import robot_json
 from ..tube.look_ahead import LookAhead
 from ..tube.parameters import TubeDesign
@@ -16,14 +20,21 @@ from .cascade_gain import second_stage_for
 from .certificate import Certificate
 from .failures import FailureKind
 from .input_bound import InputProof
+from .samples import sample_tube
 
 if TYPE_CHECKING:
     from ..spec.loader import Spec
     from .tasks import TaskPlan
 
 __all__ = ["Design", "METHOD_PAPER", "METHOD_VIA", "TubeCheck", "cascade_stage",
-           "cascade_stage_json", "look_ahead_stage", "no_stage", "no_stage_json",
+           "cascade_stage_json", "cascade_summary_rows", "look_ahead_stage",
+           "look_ahead_summary_rows", "no_stage", "no_stage_json", "no_summary_rows",
            "require_design"]
+
+#: Margins named in a summary, smallest first.
+SUMMARY_MARGINS = 3
+#: Circumvents listed in a summary; the rest are counted.
+SUMMARY_CIRCUMVENTS = 3
 
 #: The reach-tube methods a design can use (``tube.method`` of the spec picks among them).
 METHOD_PAPER = "paper"
@@ -116,6 +127,21 @@ class Design:
     ('omnirobot-s1', 'paper', True)
     >>> design.certificate.passed, design.input_proof is None
     (True, True)
+
+    What it is, in a few lines (a notebook shows the same as a table,
+    ``_repr_markdown_``):
+
+    >>> design                                      # doctest: +ELLIPSIS
+    Design(spec='omnirobot-s1', variant='first-order', method='paper', segments=1, circumvents=1, gain=0.1998, rate_hz=1000, certified=True, smallest_margin=0.0359)
+    >>> print(design.summary())                     # doctest: +ELLIPSIS
+    Design of omnirobot-s1: first-order (law (13)), the paper method, designed in ... s
+      tube:             1 reach segment (tanh) to t_c = 9 s, 3 dimensions
+      circumvents:      obstacle 0: x2 upper side on [0.321, 3.467] s, height 1.2, sharpness 0.1
+      controller:       gain k = 0.1998, 1000 Hz
+      certificate:      9 of 9 properties proved for every t >= 0 (... intervals)
+      smallest margins: 0.03591 inside target after t_c (t = 7.617 s)
+                        0.04668 non-empty (t = 0.4168 s)
+                        0.05 initial state inside (t = 0 s)
     """
 
     tube: TubeDesign
@@ -199,6 +225,147 @@ class Design:
             A second-order design whose second stage is not certified.
         """
         return variant_of(self.spec).entry("stage")(self)
+
+    def tube_table(self, horizon: float | None = None) -> dict[str, np.ndarray]:
+        """The deployed tube at every sampling instant of the controller, as columns.
+
+        ``alpha`` follows the deployed implicit step of law (11) from ``alpha(0) = 0`` at
+        ``rate_hz`` (:func:`~stt_codegen.design.samples.sample_tube`, the tube the
+        simulation and the backends' tests use), and ``gamma`` is eq. (10) at it. What
+        ``stt-codegen design --export`` writes.
+
+        Parameters
+        ----------
+        horizon : float, optional
+            End time, s; default ``1.1 t_c`` (:data:`~stt_codegen.design.samples.HORIZON_FACTOR`).
+
+        Returns
+        -------
+        dict of str to ndarray, each of shape (N,)
+            ``"t"``: the instants ``k / rate_hz``, s, from 0, ``N = ceil(horizon rate_hz) +
+            1``; then ``"gamma_L_i"`` and ``"gamma_U_i"`` for each axis ``i = 1..n`` (the
+            tube's lower and upper bound of ``x_i``, state units), in that order.
+
+        Raises
+        ------
+        SpecError
+            ``horizon`` is not a positive number (field ``horizon``), or the table would
+            have more than :data:`~stt_codegen.design.samples.STEP_BUDGET` rows.
+
+        Examples
+        --------
+        >>> import stt_codegen as stt
+        >>> table = stt.design_tube(stt.load_spec("omnirobot-s1")).tube_table(horizon=1.0)
+        >>> list(table)[:3], table["t"].shape, table["t"][:2]
+        (['t', 'gamma_L_1', 'gamma_U_1'], (1001,), array([0.   , 0.001]))
+        """
+        if horizon is not None and not (isinstance(horizon, (int, float, np.number))
+                                        and not isinstance(horizon, bool)
+                                        and math.isfinite(horizon) and horizon > 0):
+            raise SpecError("horizon", f"must be a positive number of seconds, got "
+                                       f"{horizon!r}")
+        samples = sample_tube(self.tube, None if horizon is None else float(horizon))
+        table = {"t": samples.t}
+        for i in range(self.tube.dimension):
+            table[f"gamma_L_{i + 1}"] = samples.gamma_lower[:, i]
+            table[f"gamma_U_{i + 1}"] = samples.gamma_upper[:, i]
+        return table
+
+    def summary_rows(self) -> Rows:
+        """The rows of :meth:`summary`: ``(label, value)`` in words.
+
+        Returns
+        -------
+        list of (str, str)
+            The tube, the circumvents, the controller, the certificate and its smallest
+            margins, the proved input peaks (``[actuator]``), the variant's own rows
+            (role ``summary_rows`` of :mod:`~stt_codegen.spec.variants`), the target
+            chosen, the tasks and the moving obstacles, where the design has them.
+        """
+        tube, spec, cert = self.tube, self.spec, self.certificate
+        profiles = ", ".join(sorted({s.profile for s in tube.segments}))
+        count = len(tube.segments)
+        rows = [("tube", f"{count} reach segment{'s' * (count != 1)} ({profiles}) to "
+                         f"t_c = {spec.prescribed_time:g} s, {tube.dimension} dimensions")]
+        if tube.circumvents:
+            shown = [f"obstacle {c.obstacle}: x{c.dimension + 1} {c.side} side on "
+                     f"[{c.start:.3f}, {c.end:.3f}] s, height {c.height:.3g}, sharpness "
+                     f"{c.sharpness:g}" for c in tube.circumvents[:SUMMARY_CIRCUMVENTS]]
+            more = len(tube.circumvents) - SUMMARY_CIRCUMVENTS
+            rows += [("circumvents" if k == 0 else "", line) for k, line in enumerate(shown)]
+            if more > 0:
+                rows.append(("", f"{more} more (design.tube.circumvents)"))
+        rows.append(("controller", f"gain k = {tube.gain:.4g}, {tube.rate_hz:g} Hz"))
+        proved = sum(m.passed for m in cert.margins)
+        horizon = "every t >= 0" if math.isinf(cert.horizon) else f"t <= {cert.horizon:g} s"
+        rows.append(("certificate", f"{proved} of {len(cert.margins)} properties proved for "
+                                    f"{horizon} ({cert.intervals} intervals)"))
+        smallest = sorted(cert.margins, key=lambda m: m.margin)[:SUMMARY_MARGINS]
+        rows += [("smallest margins" if k == 0 else "",
+                  f"{m.margin:.4g} {m.name} (t = {m.time:.4g} s)"
+                  + ("" if m.passed else " FAILED")) for k, m in enumerate(smallest)]
+        if self.input_proof is not None and spec.input_bound is not None:
+            unit = f" {spec.input_unit}" if spec.input_unit else ""
+            rows.append(("proved input peaks", ", ".join(
+                f"|{name}| {p:.4g} <= {b:g}{unit}" for name, p, b in
+                zip(spec.input_names, self.input_proof.peak, spec.input_bound))
+                + f" (samples to t = {self.input_proof.horizon:g} s)"))
+        rows += variant_of(spec).entry("summary_rows")(self)
+        if self.target_choice is not None:
+            rows.append(("target", f"any_of[{self.target_choice}]"))
+        if spec.tasks:
+            order = "" if self.task_plan is None else " in the order " + ", ".join(
+                spec.tasks[k].label for k in self.task_plan.order)
+            rows.append(("tasks", f"{len(spec.tasks)} planned{order}"))
+        if self.motion:
+            rows.append(("moving obstacles", f"{len(spec.moving_obstacles)} avoided "
+                                             f"({self.motion})"))
+        return rows
+
+    def summary(self) -> str:
+        """The design in at most 20 lines: the method, the tube, the circumvents, the gain
+        and rate, the certificate with its smallest margins, the proved input peaks and
+        the variant's stage.
+
+        Returns
+        -------
+        str
+            A title line, then one line a row of :meth:`summary_rows`.
+
+        Examples
+        --------
+        >>> import stt_codegen as stt
+        >>> design = stt.design_tube(stt.load_spec("second-order-s1"))
+        >>> print(design.summary())                 # doctest: +ELLIPSIS
+        Design of second-order-s1: cascade (the cascade's input u), the via method, ...
+          tube:             3 reach segments (smoothstep) to t_c = 9 s, 2 dimensions
+          controller:       gain k = 2.46, 1000 Hz
+          certificate:      9 of 9 properties proved for every t >= 0 (... intervals)
+          smallest margins: 0.03078 inside target after t_c (t = 8.708 s)
+                            0.03606 avoids obstacle 0 (t = 0 s)
+                            0.05158 inside state space (t = 0 s)
+          second stage:     k1 = 0.04724, k2 = 11.98, velocity tube rho2 from 0.4506 to ...
+          sampled cascade:  certified: position margin 0.44, velocity margin 0.772
+                            peak input |F1| 3.292 N, |F2| 5.394 N
+        """
+        return text(self._title(), self.summary_rows())
+
+    def _title(self) -> str:
+        variant = variant_of(self.spec)
+        return (f"Design of {self.spec.name}: {variant.name} ({variant.input_words}), the "
+                f"{self.method} method, designed in {self.design_time_s:.3g} s")
+
+    def _repr_markdown_(self) -> str:
+        """The summary as a Markdown table (Jupyter's rich display)."""
+        return markdown(self._title(), self.summary_rows())
+
+    def __repr__(self) -> str:
+        smallest = min((m.margin for m in self.certificate.margins), default=math.inf)
+        return (f"Design(spec={self.spec.name!r}, variant={variant_of(self.spec).name!r}, "
+                f"method={self.method!r}, segments={len(self.tube.segments)}, "
+                f"circumvents={len(self.tube.circumvents)}, gain={self.tube.gain:.4g}, "
+                f"rate_hz={self.tube.rate_hz:g}, certified={self.certificate.passed}, "
+                f"smallest_margin={smallest:.3g})")
 
     def to_json(self) -> dict[str, Any]:
         """The design as plain JSON types (the ``design`` command's and ``simulate --json``'s).
@@ -437,3 +604,66 @@ def cascade_stage_json(design: Design) -> dict[str, Any]:
         ``{"cascade": {"gains": ...}}``.
     """
     return {"cascade": {"gains": design.second_stage[1]}}
+
+
+def no_summary_rows(design: Design) -> list[tuple[str, str]]:
+    """The summary rows of a variant without a stage (role ``summary_rows``): none.
+
+    Parameters
+    ----------
+    design : Design
+
+    Returns
+    -------
+    list of (str, str)
+        Empty.
+    """
+    return []
+
+
+def cascade_summary_rows(design: Design) -> list[tuple[str, str]]:
+    """The cascade's rows of :meth:`Design.summary` (role ``summary_rows``): its certified
+    second stage and the sampled cascade's figures.
+
+    Parameters
+    ----------
+    design : Design
+
+    Returns
+    -------
+    list of (str, str)
+        ``second stage`` (``k1``, ``k2``, the velocity tube ``rho2``) and ``sampled
+        cascade`` (its margins, then the certified peak of each physical input).
+    """
+    stage, derivation = design.second_stage
+    cert = derivation["certificate"]
+    unit = f" {design.spec.input_unit}" if design.spec.input_unit else ""
+    peaks = ", ".join(f"|{name}| {p:.4g}{unit}" for name, p in
+                      zip(design.spec.input_names, cert["peak_input"]))
+    return [("second stage", f"k1 = {stage.position_gain:.4g}, k2 = "
+                             f"{stage.velocity_gain:.4g}, velocity tube rho2 from "
+                             f"{max(stage.width_start):.4g} to {max(stage.width_floor):.4g} "
+                             f"(decay {stage.decay:g} /s)"),
+            ("sampled cascade", f"certified: position margin {cert['position_margin']:.3g}, "
+                                f"velocity margin {cert['velocity_margin']:.3g}"),
+            ("", f"peak input {peaks}")]
+
+
+def look_ahead_summary_rows(design: Design) -> list[tuple[str, str]]:
+    """The look-ahead variant's row of :meth:`Design.summary` (role ``summary_rows``):
+    the point law (13) holds and the base's limits.
+
+    Parameters
+    ----------
+    design : Design
+
+    Returns
+    -------
+    list of (str, str)
+        ``look-ahead point``.
+    """
+    point = design.look_ahead
+    limits = ("no limits" if point.input_bound is None else
+              f"limits v <= {point.input_bound[0]:g}, omega <= {point.input_bound[1]:g}")
+    return [("look-ahead point", f"l = {point.axle_offset:g} ahead of the axle (law (13) "
+                                 f"holds it); the base's {limits}")]

@@ -27,6 +27,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import DesignError
+from ..progress import ProgressCallback, report, reporting
 from ..spec.loader import Spec
 from ..spec.variants import variant_of
 from ..tube.parameters import Circumvent, TubeDesign, paper_segments
@@ -244,7 +245,12 @@ def _ordered(circumvents) -> tuple[Circumvent, ...]:
     return tuple(sorted(circumvents, key=lambda c: (c.dimension, c.side, c.obstacle)))
 
 
-def design_tube(spec: Spec) -> Design:
+#: Share of a design's progress bar for the tube; the variant's stage (the cascade's
+#: certified second stage) takes the rest.
+TUBE_SHARE = 0.8
+
+
+def design_tube(spec: Spec, *, progress: ProgressCallback | None = None) -> Design:
     """Design the spatiotemporal tube of a spec and certify it.
 
     ``spec.tube.method`` picks the reach tube: ``"paper"`` (one ``tanh`` segment, eq. (4),
@@ -255,6 +261,14 @@ def design_tube(spec: Spec) -> Design:
     ----------
     spec : Spec
         From :func:`stt_codegen.load_spec` or :meth:`stt_codegen.Spec.from_dict`.
+    progress : callable, optional
+        Called with a :class:`~stt_codegen.progress.Progress` (``stage``, ``fraction`` of
+        the call done, ``message``) at the design's stages: the reach tube, each candidate
+        tube of the search and its certificate, the via points, each design tried under
+        ``[actuator]``, each shape of the cascade's second stage; the fractions never
+        decrease and the last event is ``("done", 1.0)``. The search's length is not known
+        in advance, so a fraction is the share of the stage's budget used (it jumps when
+        a stage ends early).
 
     Returns
     -------
@@ -311,13 +325,16 @@ def design_tube(spec: Spec) -> Design:
         raise TypeError(f"design_tube(): parameter 'spec' must be a Spec, not "
                         f"{type(spec).__name__}{hint}")
     started = time.perf_counter()
-    if spec.target_any_of:                # [target] any_of: the first box that designs
-        return _timed(_any_target(spec), started)
-    design = _position_stage(spec)
-    # a second-order spec: the sampled cascade must be certified on the final tube, whatever
-    # path designed it (design/cascade_gain.py)
-    design.stage      # the variant's stage: DesignError unless the sampled cascade is certified
-    return _timed(design, started)
+    with reporting(progress, final="done" if progress is not None else ""):
+        if spec.target_any_of:                # [target] any_of: the first box that designs
+            return _timed(_any_target(spec), started)
+        with reporting(None, (0.0, TUBE_SHARE)):
+            design = _position_stage(spec)
+        # a second-order spec: the sampled cascade must be certified on the final tube,
+        # whatever path designed it (design/cascade_gain.py)
+        with reporting(None, (TUBE_SHARE, 1.0)):
+            design.stage      # the variant's stage: DesignError unless the sampled cascade
+        return _timed(design, started)          # is certified
 
 
 def _timed(design: Design, started: float) -> Design:
@@ -335,9 +352,12 @@ def _any_target(spec: Spec) -> Design:
     designed and certified is kept, its spec carrying the alternatives (docs/tasks.md,
     "Or-goals")."""
     failures: list[tuple[int, DesignError]] = []
-    for q, variant in spec.target_any_of:
+    count = len(spec.target_any_of)
+    for k, (q, variant) in enumerate(spec.target_any_of):
+        report("target any_of", k / count, f"target any_of[{q}] ({k + 1} of {count})")
         try:
-            design = design_tube(replace(variant, source_hash=spec.source_hash))
+            with reporting(None, (k / count, (k + 1) / count)):
+                design = design_tube(replace(variant, source_hash=spec.source_hash))
         except DesignError as exc:
             failures.append((q, exc))
             continue
@@ -409,6 +429,7 @@ def _design(spec: Spec, smoother: bool) -> Design:
     reason = plant_failure(spec)
     if reason:
         raise DesignError(reason, kind=FailureKind.PLANT)
+    report("reach tube", 0.0, "the reach tube")
     base = base_design(spec)
     if spec.tasks:              # [[tasks]]: via points through the tasks' boxes
         tube, check, choice, plan = _tasks(spec, base)
@@ -425,13 +446,14 @@ def _design(spec: Spec, smoother: bool) -> Design:
               "auto": [(METHOD_PAPER, AUTO_CANDIDATE_CHECKS, AUTO_CANDIDATE_INTERVALS),
                        (METHOD_VIA, 0, None), full]}[method]
     errors: dict[str, DesignError] = {}
-    for used, budget, work in stages:
+    for k, (used, budget, work) in enumerate(stages):
         if used in errors and errors[used].kind is not FailureKind.SEARCH_BUDGET:
             continue          # the paper's search ended for another reason than its budget
         try:
-            tube, check = (_via(spec, base) if used == METHOD_VIA
-                           else paper_design(spec, base, budget, work,
-                                             followable=method == METHOD_PAPER))
+            with reporting(None, (k / len(stages), (k + 1) / len(stages))):
+                tube, check = (_via(spec, base) if used == METHOD_VIA
+                               else paper_design(spec, base, budget, work,
+                                                 followable=method == METHOD_PAPER))
             break
         except DesignError as exc:
             errors[used] = exc
@@ -501,7 +523,8 @@ def _tasks(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck, tuple[i
     shortest travel first) whose tube passes :func:`check_tube`, the alternatives it took
     and its visits."""
     failures: list[DesignError] = []
-    for order, choice in task_plans(spec, base):
+    for k, (order, choice) in enumerate(task_plans(spec, base)):
+        report("task plans", 0.0, f"task plan {k + 1}: visit order and any_of boxes")
         try:
             tube, plan = plan_tasks(spec, base, choice, order)
         except DesignError as exc:
@@ -519,7 +542,9 @@ def _tasks(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck, tuple[i
 
 
 def _via(spec: Spec, base: TubeDesign) -> tuple[TubeDesign, TubeCheck]:
+    report("via points", 0.0, "via points: the tube through the free space")
     tube = via_design(spec, base)
+    report("via points", 0.5, "via points: the tube's certificate")
     check = check_tube(tube, spec)
     if not check.passed:
         raise DesignError(f"the via-point tube fails its check: {check.reason}",
@@ -609,6 +634,8 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
                               + ("" if max_work is None else f" and {max_work} intervals of "
                                  "certificate work") + f" ({reasons()})",
                               kind=FailureKind.SEARCH_BUDGET, tried=best[1])
+        report("candidate tubes", 1.0 - budget[0] / max_checks,
+               f"candidate tube {max_checks - budget[0] + 1:g} of at most {max_checks}")
         budget[0] -= 1
         # the budget counts new work: the intervals resumed from the parent come free
         resume = kwargs.get("resume")

@@ -2,10 +2,17 @@
 
 from __future__ import annotations
 
+import math
+import re
 from dataclasses import dataclass, field
 from typing import Any, Iterable
 
+from ..display import Rows, markdown, shorten, text
+
 __all__ = ["Check", "VerificationReport", "all_passed", "format_report"]
+
+#: Families of checks counted on one line of :meth:`VerificationReport.summary`.
+FAMILIES_A_LINE = 6
 
 
 @dataclass(frozen=True)
@@ -92,6 +99,13 @@ class VerificationReport:
     (False, ['tube.avoids_obstacle_0'])
     >>> print(report["tube.contains_start"])
     [PASS] tube.contains_start: x(0) inside at t = 0
+    >>> report
+    VerificationReport(spec='corridor', checks=2, passed=1, failed=1)
+    >>> print(report.summary())
+    corridor: 1 of 2 checks passed, 1 FAILED
+      passed: tube 1/2
+      FAIL:   tube.avoids_obstacle_0: meets it at t = 2.1 s
+      (every check: stt-codegen verify --all, or print(report))
     """
 
     spec: str
@@ -113,6 +127,63 @@ class VerificationReport:
             if c.name == name:
                 return c
         raise KeyError(name)
+
+    def summary_rows(self) -> Rows:
+        """The rows of :meth:`summary`: the checks passed by family (the name up to its
+        first word after a dot: ``lemma3.3``, ``tube``), every failed check, and the key figures the checks carry: the smallest
+        certified margin of the tube, the tube's move per sample, and the sampled loop's
+        checks (``sampled.*``, ``cascade.sampled``, ``cascade.input_bound``).
+
+        Returns
+        -------
+        list of (str, str)
+        """
+        families: dict[str, list[bool]] = {}
+        for c in self.checks:       # "lemma3.3.reach.continuity": family "lemma3.3"
+            family = re.match(r"[^.\[]+(\.\d+)*", c.name)
+            families.setdefault(family.group(0) if family else c.name, []).append(c.passed)
+        counts = [f"{name} {sum(v)}/{len(v)}" for name, v in families.items()]
+        rows = [("passed" if k == 0 else "", ", ".join(counts[k:k + FAMILIES_A_LINE]))
+                for k in range(0, len(counts), FAMILIES_A_LINE)]
+        rows += [("FAIL", f"{c.name}: {c.detail}") for c in self.failed]
+        margins = [(c.data["margin"], c.name) for c in self.checks
+                   if c.name.startswith("tube.") and isinstance(c.data.get("margin"), float)
+                   and math.isfinite(c.data["margin"])]
+        if margins:
+            margin, name = min(margins)
+            rows.append(("smallest margin", f"{margin:.4g} ({name})"))
+        for c in self.checks:
+            if c.passed and (c.name == "tube.sampling_rate" or c.name.startswith(
+                    ("sampled.", "cascade.sampled", "cascade.input_bound"))):
+                rows.append(("PASS", f"{c.name}: {c.detail}"))
+        return rows
+
+    def summary(self) -> str:
+        """The report in a few lines: the counts, the failures and the key figures (what
+        ``stt-codegen verify`` prints; ``str(report)`` and ``--all`` have every check).
+
+        Returns
+        -------
+        str
+            A title line, then one line a row of :meth:`summary_rows` (each cut to a
+            screen's width), then where to find every check.
+        """
+        return text(self._title(), self.summary_rows()) + \
+            "\n  (every check: stt-codegen verify --all, or print(report))"
+
+    def _title(self) -> str:
+        failed = len(self.failed)
+        return (f"{self.spec}: {len(self.checks) - failed} of {len(self.checks)} checks "
+                f"passed" + (f", {failed} FAILED" if failed else ""))
+
+    def _repr_markdown_(self) -> str:
+        """The summary as a Markdown table (Jupyter's rich display)."""
+        return markdown(self._title(), self.summary_rows())
+
+    def __repr__(self) -> str:
+        failed = len(self.failed)
+        return (f"VerificationReport(spec={self.spec!r}, checks={len(self.checks)}, "
+                f"passed={len(self.checks) - failed}, failed={failed})")
 
     def to_json(self) -> list[dict[str, Any]]:
         """``[{"name", "passed", "detail"}, ...]``, the output of ``verify --json``."""

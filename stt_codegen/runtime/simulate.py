@@ -24,6 +24,7 @@ import control as ct
 from .backends import Controller, make_controller
 from ..design.result import Design, require_design
 from ..design.samples import check_step_budget
+from ..display import Rows, markdown, text
 from ..errors import SpecError
 from .plants import check_seed, spec_plant
 from .state_split import initial_state, positions
@@ -156,6 +157,14 @@ class SimulationResult:
     (True, False, None, False)
     >>> result.trajectory.x.shape                # 0.5 s at 1 kHz, states x1, x2, x3
     (501, 3)
+    >>> result                                   # doctest: +ELLIPSIS
+    SimulationResult(spec='omnirobot-s1', backend='reference', satisfied=False, reached=False, stayed_in_tube=True, collision=False, steps=500, max_abs_e=0...)
+    >>> print(result.summary())                  # doctest: +ELLIPSIS
+    Run of omnirobot-s1 (backend reference, 500 steps): Definition 2.1 not satisfied
+      target: not reached by t_c = 9 s
+      tube:   stayed inside, max |e| = 0.5...
+      safety: no collision, stayed in the state space, clearance 0.5... to the nearest obstacle
+      input:  peak |u| = [0.61..., 7.0..., 0.038...], effort 2.8...
     """
 
     spec: str
@@ -180,6 +189,67 @@ class SimulationResult:
     exceeded_velocity_bound: bool = False
     contacts: int | None = None
     first_contact: list | None = None
+
+    def summary_rows(self) -> Rows:
+        """The rows of :meth:`summary`: ``(label, value)`` in words.
+
+        Returns
+        -------
+        list of (str, str)
+            The target, the tube, safety, the input, and where the run has them the
+            velocity tube, the tasks and the MuJoCo contacts.
+        """
+        rows = [("target", f"reached at t = {self.reach_time:.4g} s (t_c = "
+                           f"{self.prescribed_time:g} s)" if self.reached else
+                           f"not reached by t_c = {self.prescribed_time:g} s")]
+        error = "" if self.max_abs_e is None else f", max |e| = {self.max_abs_e:.3g}"
+        rows.append(("tube", ("stayed inside" if self.stayed_in_tube else "LEFT it") + error))
+        clearance = ("" if self.min_obstacle_clearance is None else
+                     f", clearance {self.min_obstacle_clearance:.3g} to the nearest obstacle")
+        rows.append(("safety", ("COLLISION" if self.collision else "no collision") + ", "
+                     + ("LEFT the state space" if self.left_state_space
+                        else "stayed in the state space") + clearance))
+        peaks = ", ".join(f"{u:.4g}" for u in self.max_abs_u)
+        clamped = f", clamped at {self.clamped_steps} steps" if self.clamped_steps else ""
+        rows.append(("input", f"peak |u| = [{peaks}], effort {self.control_effort:.4g}"
+                              f"{clamped}"))
+        if self.max_abs_velocity is not None:
+            rows.append(("velocity", ("stayed in its tube" if self.stayed_in_velocity_tube
+                                      else "LEFT its tube") + ", peak |x2| = ["
+                         + ", ".join(f"{v:.4g}" for v in self.max_abs_velocity) + "]"
+                         + (", EXCEEDED the bound" if self.exceeded_velocity_bound else "")))
+        if self.tasks:
+            rows.append(("tasks", f"{sum(t.met for t in self.tasks)} of {len(self.tasks)} met"
+                         + "".join(f"; {t.task} NOT met" for t in self.tasks if not t.met)))
+        if self.contacts is not None:
+            rows.append(("contacts", f"{self.contacts} MuJoCo steps in contact"))
+        return rows
+
+    def summary(self) -> str:
+        """The run in a few lines: Definition 2.1's verdict, the target, the tube, safety,
+        the input (and the velocity tube, the tasks, the contacts where the run has them).
+
+        Returns
+        -------
+        str
+            A title line, then one line a row of :meth:`summary_rows`.
+        """
+        return text(self._title(), self.summary_rows())
+
+    def _title(self) -> str:
+        return (f"Run of {self.spec} (backend {self.backend}, {self.steps} steps): "
+                f"Definition 2.1 {'satisfied' if self.satisfied else 'not satisfied'}")
+
+    def _repr_markdown_(self) -> str:
+        """The summary as a Markdown table (Jupyter's rich display)."""
+        return markdown(self._title(), self.summary_rows())
+
+    def __repr__(self) -> str:
+        error = "None" if self.max_abs_e is None else f"{self.max_abs_e:.3g}"
+        return (f"SimulationResult(spec={self.spec!r}, backend={self.backend!r}, "
+                f"satisfied={self.satisfied}, reached={self.reached}, "
+                f"stayed_in_tube={self.stayed_in_tube}, collision={self.collision}, "
+                f"steps={self.steps}, max_abs_e={error})")
 
     def to_json(self) -> dict:
         """The result as a JSON-ready dict (without the trajectory; ``tasks`` only for a

@@ -27,6 +27,7 @@ from ..proofs.look_ahead import look_ahead_inverse
 from ..design.look_ahead import look_ahead_input_proof
 from ..rounding import distinct
 from ..proofs.check import Check, VerificationReport
+from ..progress import ProgressCallback, Reporter
 from ..proofs.lemma import bump_rate_bound, reach_rate_bound
 from ..proofs.design_independent import design_independent_proofs
 from .sampled import input_bound_check, plant_bounds_checks, sampled_checks
@@ -46,17 +47,22 @@ _CACHED = "cached proofs"
 
 
 class _Stages:
-    """``progress`` wrapped to say ``"<stage> (i/N)"`` for the stages of one run."""
+    """``progress`` wrapped to report :class:`~stt_codegen.progress.Progress` events for
+    the stages of one run: stage ``i`` of ``N`` at fraction ``(i - 1) / N``, message
+    ``"<stage> (i/N)"``; :meth:`finish` reports ``("done", 1.0)``."""
 
-    def __init__(self, progress: Callable[[str], None] | None, design: bool) -> None:
-        self.progress = progress
+    def __init__(self, progress: ProgressCallback | None, design: bool) -> None:
+        self.reporter = Reporter(progress)
         self.names = STAGES if design else STAGES[1:]
 
     def __call__(self, label: str) -> None:
-        if self.progress is None:
-            return
         index = self.names.index("rate bound forms" if label == _CACHED else label) + 1
-        self.progress(f"{label} ({index}/{len(self.names)})")
+        self.reporter(label, (index - 1) / len(self.names),
+                      f"{label} ({index}/{len(self.names)})")
+
+    def finish(self) -> None:
+        """The last event: every stage done."""
+        self.reporter("done", 1.0, f"done ({len(self.names)}/{len(self.names)})")
 
 
 def _psi_ranges(design: TubeDesign, certificate: Certificate) -> tuple[np.ndarray, np.ndarray]:
@@ -96,7 +102,7 @@ def _deployed_alpha_check(label: str, alpha_max: float, peak: float, lowest: flo
 
 def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
                   cache: bool = True,
-                  progress: Callable[[str], None] | None = None) -> list[Check]:
+                  progress: ProgressCallback | None = None) -> list[Check]:
     """Run every check on a designed tube.
 
     Parameters
@@ -113,7 +119,8 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
         Take the design-independent proofs from the proof cache
         (:func:`~stt_codegen.proofs.design_independent.design_independent_proofs`).
     progress : callable, optional
-        Called with ``"<stage> (i/N)"`` before each stage.
+        Called with a :class:`~stt_codegen.progress.Progress` before each stage (message
+        ``"<stage> (i/N)"``), as :func:`verify`.
 
     Returns
     -------
@@ -385,7 +392,7 @@ def spec_for_plant(spec: Spec, plant: str | None) -> Spec:
 
 
 def verify_spec(spec: Spec, plant: str | None = None, *, cache: bool = True,
-                progress: Callable[[str], None] | None = None) -> list[Check]:
+                progress: ProgressCallback | None = None) -> list[Check]:
     """Design the tube of a spec and run :func:`verify_design`; a design failure is a FAIL.
 
     With ``plant``, the tube is designed for that plant model instead of the spec's
@@ -409,7 +416,7 @@ def verify_spec(spec: Spec, plant: str | None = None, *, cache: bool = True,
     SpecError
         As :func:`spec_for_plant`.
     """
-    stage = _Stages(progress, design=True)
+    stage = progress if isinstance(progress, _Stages) else _Stages(progress, design=True)
     stage("design")
     try:
         design = design_tube(spec_for_plant(spec, plant))
@@ -419,7 +426,7 @@ def verify_spec(spec: Spec, plant: str | None = None, *, cache: bool = True,
 
 
 def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
-           progress: Callable[[str], None] | None = None,
+           progress: ProgressCallback | None = None,
            cache: bool = True) -> VerificationReport:
     """Check the paper's lemmas, the assumptions and the tube certificate of a design.
 
@@ -452,8 +459,11 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
         :meth:`~stt_codegen.spec.loader.Spec.with_plant_model`); default the spec's
         ``plant.model``.
     progress : callable, optional
-        Called with one string, ``"<stage> (i/N)"`` (e.g. ``"lemma 3.3 (3/10)"``),
-        before each stage; the command line prints it on a terminal.
+        Called with a :class:`~stt_codegen.progress.Progress` before each stage: its
+        ``stage`` (``"lemma 3.3"``), the ``fraction`` of the stages done and the
+        ``message`` ``"<stage> (i/N)"`` (``"lemma 3.3 (3/10)"``); the last event is
+        ``("done", 1.0)``. The command line draws them as a bar on a terminal; the same
+        type as :func:`~stt_codegen.design_tube`'s ``progress``.
     cache : bool
         Read and write the proof cache (default); ``False`` proves everything again
         and touches no file. The report is the same either way.
@@ -502,10 +512,12 @@ def verify(design_or_spec: Design | Spec, *, plant: str | None = None,
                         "stt_codegen.design_tube(spec) returned (it carries its spec), or the "
                         "Spec")
     spec_for_plant(spec, plant)     # a bad plant is refused before any work
+    stages = _Stages(progress, design=not isinstance(design_or_spec, Design))
     if isinstance(design_or_spec, Design):
         checks = verify_design(spec, design_or_spec.tube, plant, cache=cache,
-                               progress=progress)
+                               progress=stages)
     else:
-        checks = verify_spec(spec, plant, cache=cache, progress=progress)
+        checks = verify_spec(spec, plant, cache=cache, progress=stages)
+    stages.finish()
     return VerificationReport(spec.name, tuple(checks))
 

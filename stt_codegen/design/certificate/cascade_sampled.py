@@ -32,6 +32,7 @@ import numpy as np
 
 from .enclosures import enclose_tube
 from ..samples import TubeSamples, sample_tube
+from ...progress import report
 from ...spec.loader import Spec
 from ...spec.plants import SECOND_ORDER_PLANTS
 from ...spec.variants import require_variant
@@ -47,6 +48,9 @@ __all__ = ["CascadeClass", "CascadeCheck", "cascade_check_of", "cascade_class", 
 #: Relative safety factor on the closed-form ``rho2(t_{k+1})`` the path is judged against
 #: (rounding of ``exp``; every margin reported is far above it).
 RHO_ROUNDING = 1e-12
+#: Progress events the per-sample loop of :func:`check_cascade_sampled` reports at most
+#: (:mod:`stt_codegen.progress`; nothing without a receiver).
+PROGRESS_REPORTS = 50
 
 
 @dataclass(frozen=True)
@@ -343,8 +347,12 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     box1 = [[v, v] for v in e1_0]
     box2 = [[v, v] for v in e2_0]
     spread = g_max - g_min
+    every = max(1, count // PROGRESS_REPORTS)
     for k in range(count):
         t = float(samples.t[k])
+        if k % every == 0:
+            report("cascade certificate", k / count,
+                   f"the sampled cascade's certificate: t = {t:.3g} s of {samples.t[-1]:.3g} s")
         reach1 = [max(-a, b) for a, b in box1]
         reach2 = [max(-a, b) for a, b in box2]
         top[0], top[1] = max(top[0], max(reach1)), max(top[1], max(reach2))
