@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import ctypes
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -109,6 +110,19 @@ def _python_module(case: str) -> types.ModuleType:
     exec(compile((_committed(case) / f"{prefix}.py").read_text(), f"{prefix}.py", "exec"),
          module.__dict__)
     return module
+
+
+@pytest.mark.parametrize("case", sorted(VARIANTS))
+def test_the_python_module_names_the_headers_sizes(case) -> None:
+    """Every variant's ``P.py`` carries ``N_STATE``, ``N_INPUT`` and ``N_ALPHA`` equal to
+    the header's ``P_N_STATE``, ``P_N_INPUT`` and ``P_N_ALPHA`` (one API for every variant)."""
+    prefix = case.replace("-", "_")
+    header = (_committed(case) / f"{prefix}.h").read_text()
+    module = _python_module(case)
+    for name in ("N_STATE", "N_INPUT", "N_ALPHA"):
+        found = re.search(rf"#define {prefix.upper()}_{name} (\d+)", header)
+        assert found, name
+        assert getattr(module, name) == int(found.group(1)), name
 
 
 @pytest.mark.skipif(CC is None, reason="no C compiler")

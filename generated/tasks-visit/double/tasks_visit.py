@@ -11,8 +11,8 @@ The same functions, status codes and input checks as the C API (tasks_visit.h):
 * ``step(x, t, dt, alpha) -> (u, alpha_next, status)``
 
 Units: t, dt in seconds; x, gamma_*, alpha in state units; u in state units per second.
-Shapes: x, u, gamma_* have N = 3 entries; alpha, alpha_next have N_ALPHA = 6
-([alpha_L, alpha_U]); start with alpha = 0 at t = 0.
+Shapes: x, u, gamma_* have N = 3 entries (x: N_STATE, u: N_INPUT, as in every variant);
+alpha, alpha_next have N_ALPHA = 6 ([alpha_L, alpha_U]); start with alpha = 0 at t = 0.
 
 Input domain, as in the C header: t finite, t >= 0 (the tube is designed for t >= 0;
 every t >= t_c is valid, the target tube); DT_MIN <= dt <= DT_MAX; x any finite numbers;
@@ -29,6 +29,8 @@ import math
 
 N = 3
 N_ALPHA = 6
+N_STATE = 3
+N_INPUT = 3
 PRESCRIBED_TIME = 13.0
 RATE_HZ = 1000.0
 DT_MIN = 9.5367431640625e-07
