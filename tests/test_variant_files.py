@@ -72,21 +72,26 @@ def test_every_variant_writes_the_eight_files_and_its_selftest_passes(tmp_path, 
 
 
 @pytest.mark.skipif(MAKE is None or CC is None, reason="needs make and a C compiler")
-@pytest.mark.parametrize("case", ["office-base",
-                                  pytest.param("second-order-s1", marks=pytest.mark.slow)])
-def test_the_selftest_fails_on_a_wrong_expected_value(tmp_path, case) -> None:
-    """The self-test is not vacuous: one expected ``u`` moved by 1e-6 relative fails it."""
+@pytest.mark.parametrize("case, table, check", [
+    ("office-base", "EXP_U", "step u"),
+    pytest.param("second-order-s1", "EXP_U", "step u", marks=pytest.mark.slow),
+    ("second-order-s1", "EXP_GAMMA_L", "tube gamma_L"),
+    pytest.param("omnirobot-s1", "EXP_GAMMA_L", "tube gamma_L", marks=pytest.mark.slow),
+])
+def test_the_selftest_fails_on_a_wrong_expected_value(tmp_path, case, table, check) -> None:
+    """The self-test is not vacuous: one expected value (``u``, or the tube's ``gamma_L``
+    through ``P_tube``) moved by 1e-6 relative fails it."""
     out = _generate(tmp_path, case, "double")
     path = out / f"{case.replace('-', '_')}_selftest.c"
     text = path.read_text()
-    start = text.index("EXP_U[NV]")
+    start = text.index(f"{table}[NV]")
     row = text.index("{ ", text.index("{\n", start)) + 2
     end = text.index(",", row)
     value = float(text[row:end])
     path.write_text(text[:row] + repr(value * (1 + 1e-6) + 1e-9) + text[end:])
     proc = _selftest(out)
     assert proc.returncode != 0
-    assert "FAIL vector 0: step u[0]" in proc.stdout
+    assert f"FAIL vector 0: {check}[0]" in proc.stdout
     assert proc.stdout.strip().splitlines()[-1].endswith(" 1 failed")
 
 

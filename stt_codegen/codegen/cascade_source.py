@@ -184,10 +184,12 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     ``x1`` inside the position tube (``|e1| <= 0.9``), ``x2 = r + rho2 s`` with ``|s| <=
     0.9``, from a fixed seed; ``t``, ``dt``, ``x1`` and ``x2`` are float32 numbers (exact in
     both precisions, as the first-order vectors). Expected ``u``, ``r``, ``alpha_next`` and
-    status from :func:`stt_codegen.tube.cascade_reference.cascade_step`; absolute
+    status from :func:`stt_codegen.tube.cascade_reference.cascade_step`, the tube
+    ``gamma_L``, ``gamma_U`` at ``(t, alpha)`` from the oracle's adaptive tube; absolute
     tolerances ``tol_u``, ``tol_r``, ``tol_alpha_next`` from
-    :func:`stt_codegen.codegen.tolerance.cascade_bounds` for ``precision`` (double: with the
-    floor ``1e-12 max(1, |ref|)``). With an actuator bound, the expected status is ``OK``
+    :func:`stt_codegen.codegen.tolerance.cascade_bounds` and ``tol_gamma`` from
+    :func:`~stt_codegen.codegen.tolerance.gamma_bound` (the first order's) for
+    ``precision`` (double: with the floor ``1e-12 max(1, |ref|)``). With an actuator bound, the expected status is ``OK``
     or ``INPUT_CLAMPED`` as the oracle clamps, and only points whose clamp decision is
     certain in the precision are kept (every ``|u_i|`` of the law farther from the bound
     than its tolerance plus the bound's rounding), as for the first order.
@@ -235,11 +237,14 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
                                np.where(within == 0, Status.INPUT_CLAMPED, Status.OK)))
     unit = T.unit_roundoff(precision)
     tol_u, tol_r, tol_a = T.cascade_bounds(design, stage, x1, x2, t, alpha, r, alpha_next, unit)
+    # the tube's bound, as the first order's P_tube (vectors.vector_document)
+    tol_g = np.broadcast_to(T.gamma_bound(design, alpha, unit), g_l.shape)
     if precision == "double":
         tol_u, tol_r, tol_a = (T.with_double_floor(tol, ref) for tol, ref in
                                ((tol_u, u), (tol_r, r), (tol_a, alpha_next)))
+        tol_g = T.with_double_floor(tol_g, np.maximum(np.abs(g_l), np.abs(g_u)))
     # rounded up to a few digits: still bounds, and the same on every CPU (docs/codegen.md)
-    tol_u, tol_r, tol_a = (round_up_array(tol) for tol in (tol_u, tol_r, tol_a))
+    tol_u, tol_r, tol_a, tol_g = (round_up_array(tol) for tol in (tol_u, tol_r, tol_a, tol_g))
     if design.input_bound is not None:
         # only points whose clamp decision is certain in the precision: every |u_i| of the
         # law farther from the bound than its error bound plus the bound's rounding (the
@@ -248,9 +253,9 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
                                               stage, np.hstack([x1, x2]), t, dt, alpha)[0]
         bound = np.asarray(design.input_bound)
         keep = np.all(np.abs(np.abs(free) - bound) > tol_u + 2 * unit * bound, axis=1)
-        t, x1, x2, alpha, u, r, alpha_next, status, tol_u, tol_r, tol_a = (
-            a[keep] for a in (t, x1, x2, alpha, u, r, alpha_next, status, tol_u, tol_r,
-                              tol_a))
+        t, x1, x2, alpha, u, r, alpha_next, status, g_l, g_u, tol_u, tol_r, tol_a, tol_g = (
+            a[keep] for a in (t, x1, x2, alpha, u, r, alpha_next, status, g_l, g_u, tol_u,
+                              tol_r, tol_a, tol_g))
         count = t.size
     return {"_generated": "GENERATED FILE, DO NOT EDIT: cascade test vectors from the numpy "
                           "reference (stt_codegen.tube.cascade_reference).",
@@ -258,8 +263,9 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
             "vectors": [{"t": float(t[k]), "x": [*x1[k].tolist(), *x2[k].tolist()],
                          "alpha": alpha[k].tolist(), "u": u[k].tolist(), "r": r[k].tolist(),
                          "alpha_next": alpha_next[k].tolist(), "status": int(status[k]),
+                         "gamma_L": g_l[k].tolist(), "gamma_U": g_u[k].tolist(),
                          "tol_u": tol_u[k].tolist(), "tol_r": tol_r[k].tolist(),
-                         "tol_alpha_next": tol_a[k].tolist()}
+                         "tol_alpha_next": tol_a[k].tolist(), "tol_gamma": tol_g[k].tolist()}
                         for k in range(count)]}
 
 
@@ -303,10 +309,11 @@ def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
         inputs = {"x": [v["x"] for v in rows], "t": [v["t"] for v in rows],
                   "dt": [data["dt"]] * len(rows), "alpha": [v["alpha"] for v in rows],
                   "status": [v["status"] for v in rows]}
-        names = ("u", "alpha_next", "r")
+        names = ("u", "alpha_next", "r", "gamma_L", "gamma_U")
         expected = [(f"EXP_{k.upper()}", [v[k] for v in rows], len(rows[0][k])) for k in names]
-        expected += [(f"TOL_{k.upper()}", [v[f"tol_{k}"] for v in rows], len(rows[0][k]))
-                     for k in names]
+        expected += [(f"TOL_{k.upper()}", [v[f"tol_{k}"] for v in rows],
+                      len(rows[0][f"tol_{k}"]))
+                     for k in ("u", "alpha_next", "r", "gamma")]
         texts.update(selftest_file(context, inputs, expected, options.precision,
                                    "cascade_selftest.c.j2"))
     if "python" in options.langs:
