@@ -17,6 +17,8 @@ Spatiotemporal Tubes Approach". The front door, in the order of the flow (see
   design (or of a spec, designed first), as a :class:`VerificationReport`
   (:func:`stt_codegen.verification.command.verify`);
 * :func:`plot_design`, :func:`plot_run` - figures of a design, and of a run;
+* :func:`controller_system`, :func:`sampled_plant` - the sampled controller and the plant
+  over a period as discrete-time python-control systems (``ct.interconnect``);
 * :class:`Progress` - what ``design_tube`` and ``verify`` pass to a ``progress`` callback;
 * :func:`import_pointmaze` - the spec of a maze of gymnasium-robotics' PointMaze (the
   ``mujoco`` extra);
@@ -64,6 +66,8 @@ _LAZY: dict[str, str] = {
     "verify": "stt_codegen.verification.command",
     "import_pointmaze": "stt_codegen.pointmaze",
     "Progress": "stt_codegen.progress",
+    "controller_system": "stt_codegen.runtime.iosystem",
+    "sampled_plant": "stt_codegen.runtime.iosystem",
 }
 
 __all__ = ["DesignError", "SpecError", "SttError", "ToolchainError", "__version__",
@@ -73,6 +77,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .codegen.api import generate
     from .design.result import Design
     from .design.search import design_tube
+    from .runtime.iosystem import controller_system, sampled_plant
     from .runtime.plots import plot_design, plot_run
     from .runtime.simulate import SimulationResult, simulate
     from .cases import bundled_cases

@@ -27,9 +27,10 @@ def python_blocks(path: Path) -> list[str]:
 
 def test_the_document_has_the_examples():
     blocks = python_blocks(DOC)
-    assert len(blocks) == 3
+    assert len(blocks) == 4
     assert "stt.load_spec" in blocks[0] and "stt.Spec.from_dict" in blocks[1]
     assert "progress=" in blocks[2] and "summary()" in blocks[2]
+    assert "controller_system" in blocks[3] and "ct.input_output_response" in blocks[3]
     assert ["MujocoPlant" in b for b in python_blocks(MUJOCO_DOC)] == [True]
 
 
@@ -43,9 +44,9 @@ def test_the_readme_example_is_the_documents():
     assert python_blocks_of(section)[0] == python_blocks(DOC)[0]
 
 
-@pytest.mark.parametrize("k", [0, 1, 2])
+@pytest.mark.parametrize("k", [0, 1, 2, 3])
 def test_library_example_runs_verbatim(k, tmp_path, monkeypatch, capsys):
-    if k == 0 and shutil.which("cc") is None and shutil.which("gcc") is None:
+    if k in (0, 3) and shutil.which("cc") is None and shutil.which("gcc") is None:
         pytest.skip("the example compiles C: install the Debian package gcc")
     monkeypatch.chdir(tmp_path)
     exec(compile(python_blocks(DOC)[k], f"{DOC.name}[{k}]", "exec"), {})
@@ -61,6 +62,8 @@ def test_library_example_runs_verbatim(k, tmp_path, monkeypatch, capsys):
                              "0.0 True"]
         assert lines[3] == ("Run of second-order-s1 (backend casadi, 1000 steps): "
                             "Definition 2.1 not satisfied")
+    elif k == 3:     # the python-control loop is simulate's run
+        assert out.splitlines() == ["True", "True"]
     else:
         lines = out.splitlines()
         assert lines[0] == "True"

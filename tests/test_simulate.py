@@ -10,7 +10,7 @@ from scipy.integrate import solve_ivp
 from stt_codegen.runtime import backends
 from stt_codegen.errors import SpecError
 from stt_codegen.runtime.plants import Disturbance, check_seed, make_plant
-from stt_codegen.runtime.simulate import _RungeKutta, simulate
+from stt_codegen.runtime.simulate import RungeKutta, simulate
 from stt_codegen.tube import reference as R
 
 
@@ -66,7 +66,7 @@ def test_runge_kutta_step_equals_the_one_through_plant_dynamics(model):
     written with python-control's ``dynamics``, over several holds."""
     n = 3 if model == "omnidirectional" else 2
     plant = make_plant(model, n, 0.1, seed=3)
-    stepper = _RungeKutta(plant)
+    stepper = RungeKutta(plant)
     x = stepper.reset(np.linspace(0.5, 1.5, n))
     rng = np.random.default_rng(1)
     dt, steps = 1e-3, 2
@@ -94,7 +94,7 @@ def test_runge_kutta_hold_matches_an_adaptive_solver():
     for k in range(200):
         u = rng.normal(0, 5, 3)
         t = k * dt
-        stepper = _RungeKutta(plant)
+        stepper = RungeKutta(plant)
         stepper.reset(x)
         got = stepper.advance(t, u, dt)[0][-1]
         exact = solve_ivp(lambda s, y: plant.dynamics(s, y, u), (t, t + dt), x,

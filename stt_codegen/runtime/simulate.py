@@ -36,9 +36,9 @@ from ..tube.look_ahead import LookAhead
 from ..tube.second_stage import SecondStage
 from .tasks import TaskOutcome, judge_tasks, until_met
 
-__all__ = ["SUBSTEPS", "SimulationResult", "Trajectory", "cascade_velocity_reference",
-           "no_velocity_fields", "no_velocity_reference", "run_closed_loop", "simulate",
-           "velocity_fields"]
+__all__ = ["RungeKutta", "SUBSTEPS", "SimulationResult", "Trajectory",
+           "cascade_velocity_reference", "no_velocity_fields", "no_velocity_reference",
+           "run_closed_loop", "simulate", "velocity_fields"]
 
 #: Runge-Kutta steps per sampling period.
 SUBSTEPS = 2
@@ -281,7 +281,7 @@ def _seconds(horizon: object) -> float:
     return value
 
 
-class _RungeKutta:
+class RungeKutta:
     """A python-control plant integrated over each hold interval by the classical
     Runge-Kutta method, :data:`SUBSTEPS` steps (the stepping interface of
     :class:`~stt_codegen.runtime.mujoco_plant.MujocoPlant`)."""
@@ -472,7 +472,7 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
         raise SpecError("plant", f"must be a control.NonlinearIOSystem (or a plant with "
                                  f"advance(), as MujocoPlant) with {x.size} states "
                                  f"and {n} inputs for this spec{variant.state_words}")
-    stepper = plant if hasattr(plant, "advance") else _RungeKutta(plant)
+    stepper = plant if hasattr(plant, "advance") else RungeKutta(plant)
     x = stepper.reset(x)
     dt = 1.0 / tube.rate_hz
     lo, hi = np.array(spec.state_space.lower), np.array(spec.state_space.upper)
