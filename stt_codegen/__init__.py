@@ -46,7 +46,7 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from .errors import DesignError, SpecError, SttError, ToolchainError
+from .errors import DesignError, SpecError, SttError, ToolchainError, UnitWarning
 from .version import __version__
 
 #: Public name -> module that defines it; imported on first attribute access.
@@ -70,8 +70,8 @@ _LAZY: dict[str, str] = {
     "sampled_plant": "stt_codegen.runtime.iosystem",
 }
 
-__all__ = ["DesignError", "SpecError", "SttError", "ToolchainError", "__version__",
-           *sorted(_LAZY)]
+__all__ = ["DesignError", "SpecError", "SttError", "ToolchainError", "UnitWarning",
+           "__version__", *sorted(_LAZY)]
 
 if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .codegen.api import generate

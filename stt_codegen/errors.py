@@ -142,6 +142,31 @@ class ToolchainError(SttError):
     """
 
 
+class UnitWarning(UserWarning):
+    """A spec value that is valid but looks like a unit mistake (a rate in kHz, a length in
+    millimetres where the state space is in metres); raised as a warning, not an error, at
+    loading (:func:`stt_codegen.load_spec`, :meth:`stt_codegen.Spec.from_dict`).
+
+    Its message is ``"FIELD: REASON"``, as a :class:`SpecError`'s. The command line prints
+    it as one line, ``warning: FIELD: REASON``, on standard error. Silence it with
+    ``warnings.simplefilter("ignore", stt_codegen.UnitWarning)``.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> import stt_codegen as stt
+    >>> task = {"name": "slow", "prescribed_time": 8.0, "controller": {"rate_hz": 0.5},
+    ...         "state_space": {"lower": [0.0, 0.0], "upper": [5.0, 5.0]},
+    ...         "initial": {"lower": [0.0, 0.0], "upper": [0.5, 0.5]},
+    ...         "target": {"lower": [4.5, 4.5], "upper": [5.0, 5.0]}}
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     spec = stt.Spec.from_dict(task)
+    >>> print(caught[0].message)
+    controller.rate_hz: 0.5 Hz is below 1 Hz (a rate meant in kHz? 1 kHz is 1000)
+    """
+
+
 def number_text(value: float, digits: int = 12) -> str:
     """A number as the toolkit's messages print it: ``g`` format, ``digits`` significant
     digits.
@@ -166,4 +191,5 @@ def number_text(value: float, digits: int = 12) -> str:
     return f"{value:.{digits}g}"
 
 
-__all__ = ["DesignError", "SpecError", "SttError", "ToolchainError", "number_text"]
+__all__ = ["DesignError", "SpecError", "SttError", "ToolchainError", "UnitWarning",
+           "number_text"]

@@ -31,6 +31,7 @@ import functools
 import importlib
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 
 from ..errors import DesignError, SpecError, SttError, ToolchainError
@@ -195,6 +196,18 @@ def main(argv: Sequence[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser(argv)
     args = parser.parse_args(argv)
+    with warnings.catch_warnings():
+        warnings.showwarning = _one_line_warning
+        return _run(args)
+
+
+def _one_line_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A warning as one line on standard error (``warning: FIELD: REASON``), no source."""
+    print(f"warning: {message}", file=sys.stderr if file is None else file)
+
+
+def _run(args) -> int:
+    """The chosen command's handler, its errors turned into exit codes (:func:`main`)."""
     try:
         return int(args.handler(args))
     except SttError as exc:

@@ -37,6 +37,7 @@ from .plants import (MODEL_KEYS, PARAMETER_KEYS, PLANTS, SECOND_ORDER_MODELS, SE
 from .robot import (Robot, inflate_ball, inflate_bounds, inflate_moving, inflate_polytope,
                     robot_dims, shrink_bounds)
 from .tasks import Task, build_tasks
+from .units import warn_units
 from .second_order import SecondOrder, parse_second_order
 from .variants import variant_of
 from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
@@ -506,6 +507,7 @@ class Spec:
         except RecursionError:
             raise SpecError("", "nested too deeply") from None
         spec = _validate(doc)
+        warn_units(spec)
         canonical = json.dumps(doc, sort_keys=True, default=repr).encode()
         return _replace_hash(spec, hashlib.sha256(canonical).hexdigest())
 
@@ -606,6 +608,7 @@ def parse_spec(data: bytes | str) -> Spec:
     except RecursionError:
         raise SpecError("", "malformed TOML: nested too deeply") from None
     spec = _validate(doc)
+    warn_units(spec)
     return _replace_hash(spec, hashlib.sha256(raw).hexdigest())
 
 
