@@ -99,23 +99,19 @@ def progress_bar(args: argparse.Namespace, what: str) -> Iterator[Callable[[Prog
         yield show
 
 
-def default_backend() -> str:
-    """The backend ``simulate`` and ``demo`` use unless told otherwise."""
-    return "c"
-
-
 def add_backend_argument(p: argparse.ArgumentParser) -> None:
     """``--backend``: the controller implementation (``stt_codegen.runtime.backends``).
 
     Parameters
     ----------
     p : argparse.ArgumentParser
-        The subcommand's parser; gets ``--backend`` (the registered backends' names, default
-        ``"c"``).
+        The subcommand's parser; gets ``--backend`` (the registered backends' names; default
+        ``None``: the library's, :func:`stt_codegen.runtime.backends.default_backend`).
     """
     from ..runtime.backends import backend_names
-    p.add_argument("--backend", default=default_backend(), choices=backend_names(),
-                   help="controller implementation (default: %(default)s)")
+    p.add_argument("--backend", default=None, choices=backend_names(),
+                   help="controller implementation (default: c where a C compiler is "
+                        "found, else reference)")
 
 
 def print_json(data: Any) -> None:

@@ -105,6 +105,8 @@ def cmd_demo(args: argparse.Namespace) -> int:
     """
     from ..cases import bundled_cases
     from ..spec.loader import load_spec
+    from ..runtime.backends import default_backend
+    args.backend = default_backend() if args.backend is None else args.backend
     specs = {name: load_spec(name) for name in bundled_cases()}
     dims = {name: plot_dims(args, spec) for name, spec in specs.items()}
     jobs = demo_jobs(args, len(specs))

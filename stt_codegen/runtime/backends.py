@@ -25,7 +25,7 @@ from ..tube.second_stage import SecondStage
 
 __all__ = ["STATUS_INPUT_CLAMPED", "STATUS_INVALID_INPUT", "STATUS_OK", "STATUS_OUTSIDE_TUBE",
            "Controller",
-           "backend_names", "cascade_backends", "cascade_controller", "first_order_backends",
+           "backend_names", "default_backend", "cascade_backends", "cascade_controller", "first_order_backends",
            "first_order_controller", "look_ahead_backends", "look_ahead_controller",
            "make_controller", "register_backend"]
 
@@ -268,6 +268,26 @@ def backend_names(order: int = 1, variant: str | None = None) -> list[str]:
     ['reference', 'casadi', 'c', 'python']
     """
     return list(_factories(order, variant))
+
+
+def default_backend() -> str:
+    """The backend :func:`stt_codegen.simulate` and the command line use unless told:
+    ``"c"`` (the generated double C, compiled: the fastest, bit-identical to the CasADi
+    model) where a C compiler is found (``$CC``, ``cc``, ``gcc`` or ``clang``), else
+    ``"reference"`` (the numpy oracle: 30 s against 4.3 s for the C on a 4-state arm).
+
+    Returns
+    -------
+    str
+        ``"c"`` or ``"reference"``.
+    """
+    from .compiled import compiler
+    from ..errors import ToolchainError
+    try:
+        compiler()
+    except ToolchainError:
+        return "reference"
+    return "c"
 
 
 def make_controller(name: str, design: TubeDesign,

@@ -21,7 +21,7 @@ import numpy as np
 
 import control as ct
 
-from .backends import Controller, make_controller
+from .backends import Controller, default_backend, make_controller
 from ..design.result import Design, require_design
 from ..design.samples import check_step_budget
 from ..display import Rows, markdown, text
@@ -316,7 +316,7 @@ class RungeKutta:
         return points, t + h * np.arange(1, SUBSTEPS + 1)
 
 
-def simulate(design: Design, *positional: object, backend: str = "reference",
+def simulate(design: Design, *positional: object, backend: str | None = None,
              horizon: float | None = None, seed: int = 0,
              plant: ct.NonlinearIOSystem | None = None) -> SimulationResult:
     """Run the sampled controller of a design against its spec's plant; judge Definition 2.1.
@@ -341,10 +341,13 @@ def simulate(design: Design, *positional: object, backend: str = "reference",
         Nothing: a second positional argument (``simulate(spec, design)``, or a backend
         name by position) is refused with a ``TypeError`` saying how to call.
     backend : str, optional
-        Implementation of the controller step: ``"reference"`` (the numpy oracle, default),
+        Implementation of the controller step: ``"reference"`` (the numpy oracle),
         ``"casadi"`` (the CasADi model), ``"c"`` (the generated C, compiled with the
         system's C compiler) or ``"python"`` (the generated Python); see
-        :func:`stt_codegen.runtime.backends.backend_names`.
+        :func:`stt_codegen.runtime.backends.backend_names`. Default: the fastest,
+        ``"c"`` where a C compiler is found, else ``"reference"``
+        (:func:`~stt_codegen.runtime.backends.default_backend`); the result names it
+        (``result.backend``).
     horizon : float, optional
         Simulated time, seconds (a Python or numpy number); default ``t_c``.
         Definition 2.1 is judged on ``[0, min(horizon, t_c)]``; a horizon shorter than
@@ -406,6 +409,7 @@ def simulate(design: Design, *positional: object, backend: str = "reference",
                         "simulate(design, backend=..., horizon=..., seed=..., plant=...)")
     design = require_design(design, "simulate")
     stage = design.stage
+    backend = default_backend() if backend is None else backend
     return run_closed_loop(design.spec, design.tube, backend=backend, horizon=horizon,
                            seed=seed, plant=plant, stage=stage)
 
