@@ -37,6 +37,7 @@ from .plants import (MODEL_KEYS, PARAMETER_KEYS, PLANTS, SECOND_ORDER_MODELS, SE
 from .robot import (Robot, inflate_ball, inflate_bounds, inflate_moving, inflate_polytope,
                     robot_dims, shrink_bounds)
 from .tasks import Task, build_tasks
+from .state_space import with_state_space
 from .units import warn_units
 from .second_order import SecondOrder, parse_second_order
 from .variants import variant_of
@@ -464,7 +465,10 @@ class Spec:
             read the file: ``{"name": ..., "prescribed_time": ..., "state_space":
             {"lower": [...], "upper": [...]}, ...}`` (see docs/spec-format.md).
             Tuples and numpy arrays are accepted wherever a list is, numpy scalars
-            wherever a number is.
+            wherever a number is. A ``linear`` plant may be given as a continuous-time
+            python-control system, ``"plant": {"model": "linear", "system": ct.ss(A, B,
+            np.eye(n), 0)}`` (``A`` and ``B`` become ``a`` and ``g``; field
+            ``plant.system`` in errors).
 
         Returns
         -------
@@ -503,7 +507,7 @@ class Spec:
         if not isinstance(data, Mapping):
             raise SpecError("", f"a spec is a table (dict), got {value_kind(data)}")
         try:
-            doc = _as_document(data)
+            doc = _as_document(with_state_space(data))
         except RecursionError:
             raise SpecError("", "nested too deeply") from None
         spec = _validate(doc)
