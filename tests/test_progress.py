@@ -87,3 +87,17 @@ def test_the_commands_print_no_progress_when_stderr_is_not_a_terminal(tmp_path):
                              capture_output=True, text=True, timeout=900, cwd=tmp_path)
         assert out.returncode == 0 and out.stderr == "", out.stderr
         assert "%|" not in out.stdout
+
+
+def test_a_second_order_design_shows_its_progress_on_a_terminal(monkeypatch, capsys):
+    """The command itself, on a terminal (stderr a tty; the bar's 2 s delay off): the bar
+    is drawn from the design's own events, up to 100 %."""
+    from stt_codegen.cli import main
+    stderr = _Stderr(True)
+    monkeypatch.setattr(sys, "stderr", stderr)
+    monkeypatch.setattr(common, "BAR_DELAY", 0.0)
+    assert main(["design", "second-order-s1"]) == 0
+    text = stderr.getvalue()
+    assert "design:" in text and "100%" in text
+    assert "cascade" in text.lower() or "candidate" in text.lower()
+    assert "%|" not in capsys.readouterr().out          # standard output stays clean
