@@ -18,22 +18,27 @@ __all__ = ["controller_system", "sampled_plant"]
 
 
 class _LastStep:
-    """One controller step memoized on its arguments: python-control asks for the output
-    and the update of a sample separately (and for the output more than once)."""
+    """The controller step memoized on its arguments, for the last few argument sets:
+    python-control asks for the output and the update of a sample separately, and
+    resolves an interconnection's signals by evaluating the outputs more than once (first
+    with the inputs not yet known)."""
+
+    #: Argument sets kept (python-control evaluates about four per sample).
+    KEPT = 4
 
     def __init__(self, controller, dt: float) -> None:
         self.controller, self.dt = controller, dt
-        self.key: tuple | None = None
-        self.value: tuple | None = None
+        self.values: dict[tuple, tuple] = {}
 
     def __call__(self, t: float, alpha: np.ndarray, x: np.ndarray) -> tuple:
         alpha = np.asarray(alpha, dtype=float).reshape(-1)
         x = np.asarray(x, dtype=float).reshape(-1)
         key = (float(t), alpha.tobytes(), x.tobytes())
-        if key != self.key:
-            self.key = key
-            self.value = self.controller.step(x, float(t), self.dt, alpha)
-        return self.value
+        if key not in self.values:
+            if len(self.values) >= self.KEPT:
+                del self.values[next(iter(self.values))]     # the oldest
+            self.values[key] = self.controller.step(x, float(t), self.dt, alpha)
+        return self.values[key]
 
 
 def controller_system(design: Design, backend: str = "reference",
