@@ -13,6 +13,8 @@ import pytest
 
 import stt_codegen as stt
 from stt_codegen.cli import common
+from stt_codegen.design.cascade_gain import _second_stage
+from stt_codegen.design.certificate.cascade_sampled import cascade_check_of
 from stt_codegen.progress import Progress, report, reporting
 
 
@@ -29,6 +31,11 @@ def _fractions_rise_to_one(events: list[Progress]) -> None:
                          "cascade certificate"}),                               # the cascade
 ])
 def test_design_reports_its_stages_with_rising_fractions(name, stages):
+    # The cascade's stage and its certificate are computed once per process; a test run
+    # earlier in this worker may have designed the same spec, and then the stage is not
+    # computed (nor reported) again. Clear both so that this design does the work.
+    _second_stage.cache_clear()
+    cascade_check_of.cache_clear()
     events: list[Progress] = []
     design = stt.design_tube(stt.load_spec(name), progress=events.append)
     assert design == stt.design_tube(stt.load_spec(name))    # the callback changes nothing
