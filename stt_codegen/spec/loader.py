@@ -42,7 +42,7 @@ from .units import warn_units
 from .second_order import SecondOrder, parse_second_order
 from .variants import variant_of
 from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
-                     PlantTable, PolytopeObstacle, check_document, value_kind)
+                     ControllerTable, PlantTable, PolytopeObstacle, check_document, value_kind)
 
 __all__ = ["Assumptions", "Box", "LinearPlant", "law13_plant_terms", "look_ahead_plant_terms", "NAME_PATTERN", "Obstacle", "Spec", "UnsafeSet",
            "bundled_cases", "load_spec", "parse_spec"]
@@ -241,6 +241,14 @@ class Spec:
         ``k`` of law (13); ``None`` lets the design choose it.
     rate_hz : float
         Sampling rate of the deployed controller, Hz.
+    delay : float
+        ``[controller] delay``, s: the computation delay the sampled-data certificate
+        covers; the command computed from the state read at ``t_k`` acts from
+        ``t_k + delay`` until the next command acts (docs/sampled-data.md, "Computation
+        delay and jitter"). 0: applied at once.
+    jitter : float
+        ``[controller] jitter``, s: the state is read within ``jitter`` of ``k / rate_hz``
+        (the first sample at ``t = 0``); ``delay + 2 jitter <= 1 / rate_hz``.
     plant_model : str
         ``"omnidirectional"`` (eq. (14)), ``"single-integrator"`` or ``"linear"``: the
         plant ``simulate`` runs, and the source of the bounds in :attr:`assumptions`. For a
@@ -345,6 +353,8 @@ class Spec:
     robot: Robot | None = None
     mujoco: MujocoModel | None = None
     drive: DifferentialDrive | None = None
+    delay: float = 0.0
+    jitter: float = 0.0
 
     @property
     def dimension(self) -> int:
@@ -769,7 +779,28 @@ def _validate(raw: dict) -> Spec:
                 task_order=doc.task_order.order if doc.task_order is not None else "listed",
                 moving_obstacles=moving, robot=robot,
                 mujoco=_mujoco(doc.plant, n),
-                drive=drive)
+                drive=drive, **_timing(doc.controller, doc.plant.model))
+
+
+def _timing(table: ControllerTable, model: str) -> dict[str, float]:
+    """``[controller] delay`` and ``jitter``, checked against the period and the variant's
+    certificate (docs/sampled-data.md, "Computation delay and jitter")."""
+    delay, jitter = table.delay, table.jitter
+    period = 1.0 / table.rate_hz
+    if delay + 2.0 * jitter > period:
+        field_name = "controller.delay" if delay > 0.0 else "controller.jitter"
+        raise SpecError(field_name, f"delay + 2 jitter = {number_text(delay + 2.0 * jitter)} s "
+                                    f"exceeds the period 1 / rate_hz = {number_text(period)} s "
+                                    "(the proof needs each command to act within the period "
+                                    "it was computed for)")
+    variant = variant_of(plant_entry(model))
+    if (delay > 0.0 or jitter > 0.0) and not variant.timing_certified:
+        field_name = "controller.delay" if delay > 0.0 else "controller.jitter"
+        raise SpecError(field_name, f"the {variant.name} variant ({variant.plant_words}) has no "
+                                    "sampled-data certificate with a computation delay or "
+                                    "jitter yet; only first-order plants take them "
+                                    "(docs/sampled-data.md, \"Computation delay and jitter\")")
+    return {"delay": float(delay), "jitter": float(jitter)}
 
 
 def _vector(value: list[float], name: str, length: int | None) -> tuple[float, ...]:

@@ -26,7 +26,7 @@ from pydantic import (AllowInfNan, BaseModel, ConfigDict, Discriminator, Field, 
 from ..errors import SpecError
 from .plants import ALL_PLANT_MODELS, PLANTS, SECOND_ORDER_PLANTS
 
-__all__ = ["ActuatorTable", "AssumptionsTable", "BallObstacle", "BoxObstacle", "BoxTable",
+__all__ = ["ActuatorTable", "AssumptionsTable", "BallObstacle", "BoxObstacle", "BoxTable", "ControllerTable",
            "NAME_REGEX", "PlantTable", "PolytopeObstacle", "RobotTable", "check_document",
            "json_schema", "value_kind"]
 
@@ -201,6 +201,12 @@ class ControllerTable(_Table):
 
     gain: Positive = _omitted("k of law (13); default derived from the designed tube")
     rate_hz: Positive = Field(1000.0, description="sampling rate, Hz")
+    delay: NonNegative = Field(0.0, description="computation delay, s: the command computed "
+                                                "from the state read at t_k is applied from "
+                                                "t_k + delay on (delay + 2 jitter <= 1 / "
+                                                "rate_hz)")
+    jitter: NonNegative = Field(0.0, description="sampling jitter, s: the state is read at "
+                                                 "t_k within jitter of k / rate_hz")
 
 
 class PlantTable(_Table):

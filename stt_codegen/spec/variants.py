@@ -93,6 +93,10 @@ class ControllerVariant:
     replay_context : mapping of str to bool
         Extra variables of the firmware replay program's template
         (``embedded_replay.c.j2``).
+    timing_certified : bool
+        Its sampled-data certificate covers ``[controller] delay`` and ``jitter``
+        (docs/sampled-data.md, "Computation delay and jitter"); the loader refuses them
+        for a variant without.
 
     Examples
     --------
@@ -113,6 +117,7 @@ class ControllerVariant:
     state_words: str
     roles: Mapping[str, str]
     replay_context: Mapping[str, bool] = field(default_factory=lambda: MappingProxyType({}))
+    timing_certified: bool = False
 
     def entry(self, role: str) -> Callable[..., Any]:
         """The variant's function (or class) for one role, imported on first use.
@@ -192,7 +197,8 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                embedded_command=_P + "cli.embedded:law13_command",
                model_checks=_P + "verification.command:first_order_model_checks",
                sampled_checks=_P + "verification.command:first_order_sampled_checks",
-               plant_within=_P + "verification.plant_within:first_order_within")),
+               plant_within=_P + "verification.plant_within:first_order_within"),
+        timing_certified=True),
     "cascade": ControllerVariant(
         "cascade", "a second-order plant", "the cascade's input u", 2,
         " (positions, then velocities)",

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 from ..design.certificate import Certificate
 from ..design.certificate.plant_class import plant_class
-from ..design.certificate.sampled import (RATE_FACTORS, SampledCheck,
-                                          check_sampled_first_per_axis, lowest_rate,
-                                          sampled_check_of)
+from ..design.certificate.sampled import (DELAY_HALVINGS, RATE_FACTORS, SampledCheck,
+                                          check_sampled_first_per_axis, largest_delay,
+                                          lowest_rate, sampled_check_of)
 from ..design.gain import gain_derivation
 from ..design.input_bound import InputProof
 from ..rounding import distinct
@@ -24,7 +24,7 @@ from ..spec.plants import PLANTS
 from ..tube.parameters import TubeDesign
 from ..proofs.check import Check
 
-__all__ = ["input_bound_check", "plant_bounds_checks", "sampled_checks"]
+__all__ = ["delay_check", "input_bound_check", "plant_bounds_checks", "sampled_checks"]
 
 
 def _bounds_words(a: Assumptions, refined: tuple[str, ...] = ()) -> str:
@@ -138,6 +138,43 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
         data["class_counterexample"] = None if found is None else found.to_json()
     checks.append(Check("sampled.tube_kept", result.passed, detail, data))
     return checks
+
+
+def delay_check(spec: Spec, design: TubeDesign) -> Check:
+    """``sampled.delay``: the largest computation delay the sampled-data check proves at the
+    design's rate and gain (:func:`~stt_codegen.design.certificate.sampled.largest_delay`),
+    at least the spec's ``[controller] delay``.
+
+    Parameters
+    ----------
+    spec : Spec
+        Its plant class, ``delay`` and ``jitter``.
+    design : TubeDesign
+        With its gain.
+
+    Returns
+    -------
+    Check
+        Data: ``largest_delay_s`` (``None`` when the check fails without delay),
+        ``period_s``, ``delay_s``, ``jitter_s``. Fails when the largest proved delay is
+        below the spec's.
+    """
+    dt = 1.0 / design.rate_hz
+    largest = largest_delay(design, spec)
+    data = {"largest_delay_s": largest, "period_s": dt, "delay_s": spec.delay,
+            "jitter_s": spec.jitter}
+    timing = f" with jitter {spec.jitter:g} s" if spec.jitter > 0.0 else ""
+    if largest is None:
+        return Check("sampled.delay", False, "no computation delay is proved: the sampled "
+                     f"check fails without one{timing} (sampled.tube_kept)", data)
+    passed = largest >= spec.delay
+    detail = (f"a computation delay up to {largest * 1000:.4g} ms ({largest / dt:.1%} of the "
+              f"period {dt * 1000:g} ms) is tolerated: every plant of the class stays in the "
+              f"tube when each command acts up to that long after its state is read{timing}, "
+              f"at {design.rate_hz:g} Hz with k = {design.gain:.6g} (the largest the check "
+              f"proves, to 1/{2 ** DELAY_HALVINGS} of the period; controller.delay = "
+              f"{spec.delay:g} s" + (")" if passed else ", beyond it)"))
+    return Check("sampled.delay", passed, detail, data)
 
 
 def _model_passes(design: TubeDesign, spec: Spec) -> bool:

@@ -37,10 +37,10 @@ from ...tube import reference
 from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .lyapunov import level_after, next_level, others_max
 from .plant_class import PlantClass, plant_class
-from .sampled_axis import axis_interval, peak, phi_slope_scalar
+from .sampled_axis import axis_interval, peak, phi_scalar, phi_slope_scalar
 
-__all__ = ["RATE_FACTORS", "SampledCheck", "check_sampled", "check_sampled_first_per_axis",
-           "lowest_rate", "sampled_check_of"]
+__all__ = ["DELAY_HALVINGS", "RATE_FACTORS", "SampledCheck", "check_sampled",
+           "check_sampled_first_per_axis", "largest_delay", "lowest_rate", "sampled_check_of"]
 
 #: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
 RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
@@ -139,9 +139,40 @@ def _ball(level: float, limits: list[float], halves: list[float], reach: list[fl
     return math.inf, math.inf
 
 
+def _widened(values: list, count: int, jitter: bool, pick) -> list:
+    """``values[k]`` per interval, or with sampling jitter the worst (``pick``: ``min`` or
+    ``max``, elementwise for rows) of intervals ``k - 1 .. k + 1``: a measurement interval
+    ``[s_k, s_{k+1}]`` lies within ``[t_k - jitter, t_{k+1} + jitter]``."""
+    if not jitter:
+        return values
+    out = []
+    for k in range(count):
+        near = values[max(k - 1, 0):min(k + 2, count)]
+        out.append([pick(column) for column in zip(*near)] if isinstance(values[k], list)
+                   else pick(near))
+    return out
+
+
+def _old_push(k: int, i: int, block: tuple[int, ...], reach_prev: list[float] | None,
+              speed_prev: list[float], g_max: float, spread: float, skew: float,
+              coupling: float, push: float) -> float:
+    """``M_i``: a bound of ``|x_dot_i|`` while the previous command ``u_{k-1}`` acts (the
+    first ``delay`` of a measurement interval), state units per second: ``g_max |u_{k-1,i}|``
+    plus the other inputs of the block through the row's off-diagonal part (at most
+    ``min(coupling, spread / sqrt(2) + skew)``, eq. (A2)) plus ``|f + w|``. Before the first
+    command acts the input is zero (``k = 0``)."""
+    if reach_prev is None:
+        return push
+    own = speed_prev[i] * phi_scalar(reach_prev[i])
+    others = math.sqrt(sum((speed_prev[j] * phi_scalar(reach_prev[j])) ** 2
+                           for j in block if j != i))
+    return g_max * own + min(coupling, spread / math.sqrt(2.0) + skew) * others + push
+
+
 def check_sampled(design: TubeDesign, samples: TubeSamples,
                   plants: Assumptions | PlantClass, gain: float | None = None, *,
-                  lyapunov: bool = True) -> SampledCheck:
+                  lyapunov: bool = True, delay: float = 0.0,
+                  jitter: float = 0.0) -> SampledCheck:
     """Prove that the sampled closed loop keeps ``|e_i| < 1`` at and between samples.
 
     A sufficient condition, checked by propagating an enclosure of ``e(t_k)`` (a box and
@@ -165,13 +196,28 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
         ``k`` to check instead of ``design.gain``.
     lyapunov : bool
         Use the Lyapunov balls (default); ``False`` keeps the per-axis argument alone,
-        without the Lyapunov level (for comparisons).
+        without the Lyapunov level (for comparisons). With a delay or jitter the balls are
+        not used (their level assumes the interval's own command from its start).
+    delay : float
+        Largest computation delay, s (``[controller] delay``): the command computed from
+        the state read at ``s_k`` acts from ``s_k + lag``, ``lag`` in ``[0, delay]`` (any,
+        varying from sample to sample); before, the previous one acts (zero before the
+        first).
+    jitter : float
+        Sampling jitter, s (``[controller] jitter``): ``|s_k - k dt| <= jitter``, ``s_0 =
+        0``; the controller is called with the nominal ``t = k dt``. ``delay + 2 jitter``
+        must not exceed ``dt``.
 
     Returns
     -------
     SampledCheck
         The verdict, its level and margin, the time and dimension of a failure, and the
         bounds of ``|e|``.
+
+    Raises
+    ------
+    ValueError
+        ``delay`` or ``jitter`` negative, or ``delay + 2 jitter > dt``.
     """
     cls = _as_class(plants)
     a = cls.assumptions
@@ -180,10 +226,23 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     dt = 1.0 / design.rate_hz
     blocks = a.coupled_blocks(n)
     block_of = {i: b for b in blocks for i in b}
-    balls = [b for b in blocks if len(b) > 1] if lyapunov else []
+    if delay < 0.0 or jitter < 0.0 or delay + 2.0 * jitter > dt * (1.0 + 1e-12):
+        raise ValueError(f"delay = {delay!r} s and jitter = {jitter!r} s must be >= 0 with "
+                         f"delay + 2 jitter <= dt = {dt!r} s")
+    timed = delay > 0.0 or jitter > 0.0
+    # A measurement interval [s_k, s_{k+1}] lasts L in [dt - 2 jitter, dt + 2 jitter]; the
+    # previous command acts for its first `lag` in [0, delay], this one for the rest, a
+    # `share` (L - lag) / dt of a period. The bounds are affine in (L, lag) at each e(s_k),
+    # so the four corners cover every L and every delay up to `delay`.
+    corners = sorted({(max(0.0, (length - lag) / dt), lag)
+                      for length in (dt - 2.0 * jitter, dt + 2.0 * jitter)
+                      for lag in (0.0, delay)}) if timed else [(1.0, 0.0)]
+    shares = sorted({share for share, _ in corners})
+    balls = [b for b in blocks if len(b) > 1] if lyapunov and not timed else []
     lo, hi = samples.gamma_lower, samples.gamma_upper
     width = hi - lo
-    data = {"gain": k_gain, "rate_hz": design.rate_hz, "input_gain": list(a.input_gain),
+    data = {"gain": k_gain, "rate_hz": design.rate_hz, "delay": delay, "jitter": jitter,
+            "input_gain": list(a.input_gain),
             "input_gain_skew": a.input_gain_skew,
             "input_gain_coupling": a.input_gain_coupling, "drift_bound": a.drift_bound,
             "disturbance_bound": a.disturbance_bound, "blocks": [list(b) for b in blocks]}
@@ -204,15 +263,22 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     half = 0.5 * width
     centre = 0.5 * (hi + lo)
     pull = 4.0 * dt * k_gain / width                      # (K+1, n): dt |u| / phi per unit g
-    peak_out = peak(half[:count] / (pull[:count] * bounds.g_min[:, None])).tolist()
-    up_e = ((enclosure.upper_min - centre[:count]) / half[:count]).tolist()
-    low_e = ((enclosure.lower_max - centre[:count]) / half[:count]).tolist()
+    g_min_l = _widened(bounds.g_min.tolist(), count, jitter > 0.0, min)
+    ratio = half[:count] / (pull[:count] * np.array(g_min_l)[:, None])
+    # s* of each share of the period the own command acts (a share of 0: no pull, s* = 1-)
+    peaks = {share: peak(ratio / share).tolist() if share > 0.0 else
+             np.full_like(ratio, 1.0 - 1e-15).tolist() for share in shares}
+    up_e = _widened(((enclosure.upper_min - centre[:count]) / half[:count]).tolist(), count,
+                    jitter > 0.0, min)
+    low_e = _widened(((enclosure.lower_max - centre[:count]) / half[:count]).tolist(), count,
+                     jitter > 0.0, max)
     alpha = (half[:count] / half[1:count + 1]).tolist()
     beta = ((centre[:count] - centre[1:count + 1]) / half[1:count + 1]).tolist()
     half_l, centre_l, pull_l = half.tolist(), centre.tolist(), pull.tolist()
-    g_min_l, g_max_l = bounds.g_min.tolist(), bounds.g_max.tolist()
-    skew_l, coupling_l, push_l = (bounds.skew.tolist(), bounds.coupling.tolist(),
-                                  bounds.push.tolist())
+    g_max_l = _widened(bounds.g_max.tolist(), count, jitter > 0.0, max)
+    skew_l, coupling_l, push_l = (_widened(v.tolist(), count, jitter > 0.0, max) for v in
+                                  (bounds.skew, bounds.coupling, bounds.push))
+    reach_prev = None                                     # |e(s_{k-1})| bound: no command yet
     e0 = ((np.array(design.initial_state) - centre[0]) / half[0]).tolist()
     box = [[v, v] for v in e0]                            # enclosure of e(t_k), per dim
     level = {b: math.sqrt(sum(math.atanh(e0[i]) ** 2 for i in b)) for b in balls}
@@ -238,12 +304,35 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
             others = [j for j in block_of[i] if j != i]
             z_sq = (others_max([limits[j] for j in others], level.get(block_of[i], math.inf),
                                [h_k[j] for j in others]) if others else 0.0)
-            p_lo, p_hi, x_lo, x_hi = axis_interval(
-                box[i][0], box[i][1], centre_l[k][i], h_k[i], pull_l[k][i], g_min_l[k],
-                g_max_l[k], peak_out[k][i], dt * push_l[k], dt * 2.0 * k_gain * math.sqrt(z_sq),
-                coupling_l[k], skew_l[k])
+            if not timed:
+                p_lo, p_hi, x_lo, x_hi = axis_interval(
+                    box[i][0], box[i][1], centre_l[k][i], h_k[i], pull_l[k][i], g_min_l[k],
+                    g_max_l[k], peaks[1.0][k][i], dt * push_l[k],
+                    dt * 2.0 * k_gain * math.sqrt(z_sq), coupling_l[k], skew_l[k])
+            else:
+                # the previous command for `lag`, then this one for `share` periods
+                # (docs/sampled-data.md, "Computation delay and jitter")
+                speed = _old_push(k, i, block_of[i], reach_prev,
+                                  [p / dt for p in pull_l[max(k - 1, 0)]], g_max_l[k],
+                                  g_max_l[k] - g_min_l[k], skew_l[k], coupling_l[k], push_l[k])
+                p_lo = x_lo = math.inf
+                p_hi = x_hi = -math.inf
+                for share, lag in corners:
+                    a_lo, a_hi, b_lo, b_hi = axis_interval(
+                        box[i][0], box[i][1], centre_l[k][i], h_k[i], share * pull_l[k][i],
+                        g_min_l[k], g_max_l[k], peaks[share][k][i],
+                        share * dt * push_l[k] + lag * speed,
+                        share * dt * 2.0 * k_gain * math.sqrt(z_sq), coupling_l[k],
+                        skew_l[k])
+                    p_lo, p_hi = min(p_lo, a_lo), max(p_hi, a_hi)
+                    x_lo, x_hi = min(x_lo, b_lo), max(x_hi, b_hi)
+                # while the previous command acts, x moves from x(s_k) by at most this
+                old = delay * speed
+                p_lo = min(p_lo, centre_l[k][i] + box[i][0] * h_k[i] - old)
+                p_hi = max(p_hi, centre_l[k][i] + box[i][1] * h_k[i] + old)
             path.append([(p_lo - centre_l[k][i]) / h_k[i], (p_hi - centre_l[k][i]) / h_k[i]])
             ends.append((x_lo, x_hi))
+        reach_prev = reach_e
         end_level = {}
         for b in balls:
             mid, end = _ball(level[b], [limits[i] for i in b], [h_k[i] for i in b],
@@ -289,7 +378,8 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
 
 def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,
                                  plants: Assumptions | PlantClass,
-                                 gain: float | None = None) -> SampledCheck:
+                                 gain: float | None = None, *, delay: float = 0.0,
+                                 jitter: float = 0.0) -> SampledCheck:
     """:func:`check_sampled` with the per-axis argument alone, and with the Lyapunov balls
     only where that fails.
 
@@ -309,14 +399,64 @@ def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,
         As :func:`check_sampled`.
     gain : float, optional
         As :func:`check_sampled`.
+    delay, jitter : float
+        As :func:`check_sampled` (with either, the per-axis argument is the whole check).
 
     Returns
     -------
     SampledCheck
         The per-axis argument's when it passes, else the whole check's.
     """
-    per_axis = check_sampled(design, samples, plants, gain, lyapunov=False)
-    return per_axis if per_axis.passed else check_sampled(design, samples, plants, gain)
+    per_axis = check_sampled(design, samples, plants, gain, lyapunov=False, delay=delay,
+                             jitter=jitter)
+    if per_axis.passed or delay > 0.0 or jitter > 0.0:
+        return per_axis
+    return check_sampled(design, samples, plants, gain)
+
+
+#: Halvings of the bisection of :func:`largest_delay` (a resolution of ``dt / 2^6``).
+DELAY_HALVINGS = 6
+
+
+def largest_delay(design: TubeDesign, spec: Spec) -> float | None:
+    """The largest computation delay the sampled-data check proves at the design's rate and
+    gain with the spec's jitter, to ``dt / 2^DELAY_HALVINGS`` below the true limit of the
+    check (docs/sampled-data.md, "Computation delay and jitter").
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The design (its rate and gain).
+    spec : Spec
+        Its plant class and ``[controller] jitter``.
+
+    Returns
+    -------
+    float or None
+        Seconds, in ``[0, dt - 2 jitter]``: the largest delay tried with which the check
+        passes; a check with a delay proves every delay up to it. ``None`` when the check
+        fails without delay.
+    """
+    with reference.numpy_math():
+        samples = sample_tube(design)
+        plants = plant_class(spec)
+
+        def passes(delay: float) -> bool:
+            return check_sampled_first_per_axis(design, samples, plants, delay=delay,
+                                                jitter=spec.jitter).passed
+
+        top = max(0.0, 1.0 / design.rate_hz - 2.0 * spec.jitter)
+        # without delay: the spec's own check when it has no delay either (cached)
+        if not (sampled_check_of(design, spec)[1].passed if spec.delay == 0.0
+                else passes(0.0)):
+            return None
+        if passes(top):
+            return top
+        good, bad = 0.0, top
+        for _ in range(DELAY_HALVINGS):
+            mid = 0.5 * (good + bad)
+            good, bad = (mid, bad) if passes(mid) else (good, mid)
+        return good
 
 
 def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
@@ -357,8 +497,9 @@ def _sampled_check(design: TubeDesign, spec: Spec, per_axis_first: bool
     with reference.numpy_math():
         samples = sample_tube(design)
         plants = plant_class(spec)
-        check = (check_sampled_first_per_axis(design, samples, plants) if per_axis_first
-                 else check_sampled(design, samples, plants))
+        timing = {"delay": spec.delay, "jitter": spec.jitter}
+        check = (check_sampled_first_per_axis(design, samples, plants, **timing)
+                 if per_axis_first else check_sampled(design, samples, plants, **timing))
     return samples, check
 
 
@@ -404,9 +545,10 @@ def lowest_rate(design: TubeDesign, spec: Spec, plants: Assumptions | PlantClass
         certificate = certify_tube(trial, spec)
         gain = (explicit_gain if explicit_gain is not None
                 else derived_gain(certificate.min_width, trial.rate_hz, assumptions))
-        if not certificate.passed:
-            return False, gain
-        return check_sampled_first_per_axis(trial, sample_tube(trial), plants, gain).passed, gain
+        if not certificate.passed or spec.delay + 2.0 * spec.jitter > 1.0 / trial.rate_hz:
+            return False, gain         # the delay (s) and jitter must fit the shorter period
+        return check_sampled_first_per_axis(trial, sample_tube(trial), plants, gain,
+                                            delay=spec.delay, jitter=spec.jitter).passed, gain
 
     below = [f for f in RATE_FACTORS if f < 1.0]
     above = [f for f in RATE_FACTORS if f > 1.0]

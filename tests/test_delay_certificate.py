@@ -1,0 +1,174 @@
+"""A computation delay and sampling jitter in the sampled-data certificate:
+``[controller] delay`` and ``jitter`` are validated, the check proves the tube kept with them
+(docs/sampled-data.md, "Computation delay and jitter"), ``verify`` reports the largest delay
+the design tolerates, and the check fails beyond it."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import subprocess
+import sys
+
+import pytest
+from conftest import arena_toml, designed
+
+import stt_codegen as stt
+from stt_codegen.design.certificate.plant_class import plant_class
+from stt_codegen.design.certificate.sampled import (check_sampled,
+                                                    check_sampled_first_per_axis,
+                                                    largest_delay, lowest_rate)
+from stt_codegen.design.samples import sample_tube
+from stt_codegen.tube import reference
+from stt_codegen.verification.sampled import delay_check
+
+
+def _timed(spec, delay=0.0, jitter=0.0):
+    return dataclasses.replace(spec, delay=delay, jitter=jitter)
+
+
+def _check(spec, design, **timing):
+    with reference.numpy_math():
+        return check_sampled_first_per_axis(design, sample_tube(design), plant_class(spec),
+                                            **timing)
+
+
+@pytest.fixture(scope="module")
+def s1():
+    spec, design, _ = designed("omnirobot-s1")
+    with reference.numpy_math():
+        largest = largest_delay(design, spec)
+    return spec, design, largest
+
+
+def test_without_delay_the_check_is_the_one_it_was(s1):
+    spec, design, _ = s1
+    with reference.numpy_math():
+        samples, plants = sample_tube(design), plant_class(spec)
+        plain = check_sampled(design, samples, plants, lyapunov=False)
+        zero = check_sampled(design, samples, plants, lyapunov=False, delay=0.0, jitter=0.0)
+    assert (plain.passed, plain.level, plain.margin) == (zero.passed, zero.level, zero.margin)
+    assert zero.data["delay"] == 0.0 and zero.data["jitter"] == 0.0
+
+
+def test_omnirobot_s1_tolerates_a_fraction_of_its_period(s1):
+    spec, design, largest = s1
+    dt = 1.0 / design.rate_hz
+    assert largest is not None and 0.0 < largest < dt
+    assert _check(spec, design, delay=largest).passed
+
+
+def test_the_check_fails_when_the_delay_is_doubled_past_the_largest(s1):
+    """A design certified with a delay fails its sampled check beyond twice that delay:
+    the check can fail, and the largest delay is not a vacuous figure."""
+    spec, design, largest = s1
+    certified = _check(spec, design, delay=largest)
+    doubled = _check(spec, design, delay=min(2.0 * largest, 1.0 / design.rate_hz))
+    assert certified.passed
+    assert not doubled.passed and "may leave the tube" in doubled.reason
+    assert doubled.margin < 0.0 < certified.margin
+
+
+def test_a_delay_costs_margin_and_raises_the_bound_of_e(s1):
+    spec, design, largest = s1
+    plain, late = _check(spec, design), _check(spec, design, delay=0.5 * largest)
+    assert plain.passed and late.passed
+    assert late.margin < plain.margin and late.level > plain.level
+
+
+def test_jitter_is_proved_too_and_costs_delay(s1):
+    spec, design, largest = s1
+    dt = 1.0 / design.rate_hz
+    jitter = 0.02 * dt
+    assert _check(spec, design, jitter=jitter).passed
+    with reference.numpy_math():
+        with_jitter = largest_delay(design, _timed(spec, jitter=jitter))
+    assert with_jitter is not None and with_jitter <= largest
+    assert not _check(spec, design, delay=largest, jitter=0.25 * dt).passed
+
+
+def test_the_check_refuses_a_delay_beyond_the_period(s1):
+    spec, design, _ = s1
+    dt = 1.0 / design.rate_hz
+    with pytest.raises(ValueError, match="delay \\+ 2 jitter <= dt"):
+        _check(spec, design, delay=0.8 * dt, jitter=0.2 * dt)
+
+
+def test_verify_reports_the_largest_delay(s1):
+    spec, design, largest = s1
+    with reference.numpy_math():
+        check = delay_check(spec, design)
+    assert check.passed and check.name == "sampled.delay"
+    assert check.data["largest_delay_s"] == largest
+    assert f"{largest * 1000:.4g} ms" in check.detail and "tolerated" in check.detail
+    # a spec asking for more than the design tolerates fails the same check
+    with reference.numpy_math():
+        beyond = delay_check(_timed(spec, delay=min(2.0 * largest, 1.0 / design.rate_hz)),
+                             design)
+    assert not beyond.passed and "beyond it" in beyond.detail
+
+
+def test_the_lowest_rate_counts_the_delay_in_seconds(s1):
+    """A delay of 0.9 ms fits a 1 kHz period but not a shorter one: no rate above the
+    design's is named for it, and the rate named is one that passes with it."""
+    spec, design, largest = s1
+    timed = _timed(spec, delay=largest)
+    with reference.numpy_math():
+        rate, gain = lowest_rate(design, timed, plant_class(timed), None)
+    assert rate is not None and rate <= design.rate_hz
+    assert largest + 0.0 <= 1.0 / rate
+
+
+# ---------------------------------------------------------------------------------------
+# the spec's keys
+
+
+def _spec_text(controller: str, plant: str = "") -> str:
+    return arena_toml("timed", extra="[controller]\n" + controller + plant)
+
+
+@pytest.mark.parametrize("controller, field, words", [
+    ("rate_hz = 100.0\ndelay = 0.011\n", "controller.delay", "exceeds the period"),
+    ("rate_hz = 100.0\ndelay = 0.006\njitter = 0.003\n", "controller.delay",
+     "delay + 2 jitter = 0.012 s"),
+    ("rate_hz = 100.0\njitter = 0.006\n", "controller.jitter", "exceeds the period"),
+    ("rate_hz = 100.0\ndelay = -0.001\n", "controller.delay", ""),
+])
+def test_a_delay_that_does_not_fit_the_period_names_its_field(tmp_path, controller, field,
+                                                              words):
+    path = tmp_path / "timed.toml"
+    path.write_text(_spec_text(controller))
+    with pytest.raises(stt.SpecError) as raised:
+        stt.load_spec(path)
+    assert raised.value.field == field and words in str(raised.value)
+
+
+def test_the_command_line_refuses_it_with_exit_2_and_one_line(tmp_path):
+    path = tmp_path / "timed.toml"
+    path.write_text(_spec_text("rate_hz = 100.0\ndelay = 0.02\n"))
+    run = subprocess.run([sys.executable, "-m", "stt_codegen.cli", "design", str(path)],
+                         capture_output=True, text=True)
+    assert run.returncode == 2 and "Traceback" not in run.stderr
+    assert "controller.delay" in run.stderr
+
+
+@pytest.mark.parametrize("case", ["second-order-s1", "office-base"])
+def test_a_variant_whose_certificate_has_no_delay_refuses_it(case):
+    """The cascade and the look-ahead law have no delayed certificate yet: a delay is
+    refused naming the field, not silently ignored."""
+    raw = stt.load_spec(case)
+    period = 1.0 / raw.rate_hz
+    from stt_codegen.cases import bundled_spec_bytes
+    import tomllib
+    doc = tomllib.loads(bundled_spec_bytes(case).decode())
+    doc.setdefault("controller", {})["delay"] = 0.1 * period
+    with pytest.raises(stt.SpecError) as raised:
+        stt.Spec.from_dict(doc)
+    assert raised.value.field == "controller.delay"
+    assert "only first-order plants" in str(raised.value)
+
+
+def test_specs_without_delay_keep_zero():
+    spec = stt.load_spec("omnirobot-s1")
+    assert (spec.delay, spec.jitter) == (0.0, 0.0)
+    assert math.isclose(1.0 / spec.rate_hz, 1e-3)
