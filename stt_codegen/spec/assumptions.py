@@ -84,6 +84,13 @@ class Assumptions:
     drift_lipschitz : tuple of float or None
         Per state, ``L_j`` with ``|f(x) - f(y)| <= sum_j L_j |x_j - y_j|`` (per second);
         ``None``: ``f`` may jump.
+    input_gain_turn : tuple of float or None
+        ``(a, b)``: between the instant a held command was computed and any instant it
+        acts, the plant's ``g`` is ``R(phi) g_k`` with ``g_k`` within the bounds above,
+        ``R`` a rotation of the plane (two states) and ``|phi_dot| <= a |u| + b`` (rad/s,
+        ``|u|`` the Euclidean norm of the acting command): a differential-drive base turns
+        its look-ahead point's ``g`` with its heading (docs/differential-drive.md).
+        ``None``: ``g`` does not turn with the command.
     """
 
     input_gain: tuple[float, float] = (1.0, 1.0)
@@ -97,6 +104,7 @@ class Assumptions:
     notes: tuple[str, ...] = ()
     input_gain_lipschitz: tuple[float, ...] | None = None
     drift_lipschitz: tuple[float, ...] | None = None
+    input_gain_turn: tuple[float, float] | None = None
 
     def coupled_blocks(self, n: int) -> tuple[tuple[int, ...], ...]:
         """The blocks of ``g`` for ``n`` states: :attr:`blocks` when known; else one block
@@ -231,7 +239,8 @@ def combine_assumptions(bounds: ModelBounds, declared: Mapping[str, object], n: 
              "disturbance_bound", *LIPSCHITZ_KEYS)
     return Assumptions((g_min, g_max), skew, coupling, values["drift_bound"], disturbance,
                        tuple(k for k in order if k in declared), bounds.model, blocks,
-                       tuple(notes), rates["input_gain_lipschitz"], rates["drift_lipschitz"])
+                       tuple(notes), rates["input_gain_lipschitz"], rates["drift_lipschitz"],
+                       bounds.input_gain_turn)
 
 
 def _lipschitz(key: str, model_value: tuple[float, ...] | None, replaced: bool,

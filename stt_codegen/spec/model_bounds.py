@@ -76,6 +76,10 @@ class ModelBounds:
         Largest ``|w|`` the model's own parameters imply (the differential drive's slip),
         state units per second; ``None``: the spec's ``plant.disturbance_amplitude``
         decides.
+    input_gain_turn : tuple of float or None
+        How fast ``g`` turns while a held command acts
+        (:attr:`~stt_codegen.spec.assumptions.Assumptions.input_gain_turn`); ``None``: it
+        does not.
     """
 
     model: str
@@ -89,6 +93,7 @@ class ModelBounds:
     input_gain_lipschitz: tuple[float, ...] | None = None
     drift_lipschitz: tuple[float, ...] | None = None
     disturbance_bound: float | None = None
+    input_gain_turn: tuple[float, float] | None = None
 
     def words(self, key: str) -> str:
         """Where the model attains ``key`` ("" if not recorded)."""
@@ -382,7 +387,8 @@ def differential_drive_bounds(drive) -> ModelBounds:
     ModelBounds
         ``input_gain`` ``(1 + m - |d| s, 1 + m + |d| s)``, ``input_gain_skew`` ``|d| |k|``,
         ``input_gain_coupling`` ``|d| (s + |k|)``, ``drift_bound`` 0, one block, the slip's
-        ``disturbance_bound``; each widened outward by :data:`REL_PAD` (the formulas:
+        ``disturbance_bound``, ``input_gain_turn`` ``((1 + m) / l + 2 |d| / b, s_omega)``;
+        each widened outward by :data:`REL_PAD` (the formulas:
         :mod:`stt_codegen.spec.differential_drive`).
     """
     m, d = drive.mean_error, abs(drive.differential_error)
@@ -401,7 +407,11 @@ def differential_drive_bounds(drive) -> ModelBounds:
          ("drift_lipschitz", "f = 0")),
         "declare wider bounds in [assumptions], or smaller plant.wheel_radius_error",
         (0.0, 0.0) if d == 0.0 else None, (0.0, 0.0),
-        disturbance_bound=_up(math.hypot(s_v, s_lat + drive.axle_offset * s_w)))
+        disturbance_bound=_up(math.hypot(s_v, s_lat + drive.axle_offset * s_w)),
+        # the heading's rate under a held command u: |omega_act| <= ((1 + m) / l + 2 |d| / b)
+        # |u| + s_omega, since |v| <= |u| and |omega| <= |u| / l
+        input_gain_turn=(_up((1.0 + m) / drive.axle_offset + 2.0 * d / drive.track_width),
+                         _up(s_w)))
 
 
 #: The bounds over a box of each first-order model, ``(lower, upper, linear) -> bounds``:

@@ -250,7 +250,8 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                embedded_command=_P + "cli.embedded:variant_loop_command",
                model_checks=_P + "verification.command:look_ahead_model_checks",
                sampled_checks=_P + "verification.command:look_ahead_sampled_checks",
-               plant_within=_P + "verification.plant_within:first_order_within")),
+               plant_within=_P + "verification.plant_within:first_order_within"),
+        timing_certified=True),
 })
 assert tuple(CONTROLLER_VARIANTS) == VARIANTS
 

@@ -279,6 +279,7 @@ def _law13_sampled(spec: Spec, design: TubeDesign, tube_check, progress,
     # do: every margin here is far above rounding
     with reference.numpy_math():
         checks = sampled_checks(spec, design, tube_check.certificate)
+        checks.append(delay_check(spec, design))
     if spec.input_bound is not None:
         checks.append(input_bound_check(spec, input_proof(prove_input_bound(design, spec),
                                                           spec)))
@@ -303,10 +304,7 @@ def first_order_sampled_checks(spec: Spec, design: TubeDesign, tube_check,
     -------
     list of Check
     """
-    checks = _law13_sampled(spec, design, tube_check, progress, lambda proof, _spec: proof)
-    with reference.numpy_math():
-        checks.append(delay_check(spec, design))       # the variant's certificate covers it
-    return checks
+    return _law13_sampled(spec, design, tube_check, progress, lambda proof, _spec: proof)
 
 
 def look_ahead_sampled_checks(spec: Spec, design: TubeDesign, tube_check,

@@ -46,6 +46,9 @@ def _bounds_words(a: Assumptions, refined: tuple[str, ...] = ()) -> str:
              f"{a.drift_bound:.6g}, |w| <= {a.disturbance_bound:.3g}")
     if len(a.blocks) > 1:
         words += f", g block diagonal on {[list(b) for b in a.blocks]}"
+    if a.input_gain_turn is not None:
+        words += (f", g turned while a command is held by the heading's change, |omega| <= "
+                  f"{a.input_gain_turn[0]:.4g} |u| + {a.input_gain_turn[1]:.4g} rad/s")
     return f"{words} ({source})"
 
 

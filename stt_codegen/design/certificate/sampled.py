@@ -37,7 +37,7 @@ from ...tube import reference
 from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .lyapunov import level_after, next_level, others_max
 from .plant_class import PlantClass, plant_class
-from .sampled_axis import axis_interval, peak, phi_scalar, phi_slope_scalar
+from .sampled_axis import axis_interval, peak, peak_scalar, phi_scalar, phi_slope_scalar
 
 __all__ = ["DELAY_HALVINGS", "RATE_FACTORS", "SampledCheck", "check_sampled",
            "check_sampled_first_per_axis", "largest_delay", "lowest_rate", "sampled_check_of"]
@@ -279,6 +279,8 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     skew_l, coupling_l, push_l = (_widened(v.tolist(), count, jitter > 0.0, max) for v in
                                   (bounds.skew, bounds.coupling, bounds.push))
     reach_prev = None                                     # |e(s_{k-1})| bound: no command yet
+    turn = a.input_gain_turn                              # (per |u|, constant) or None
+    speeds: list[float] = []                              # bound of |u_k| per sample
     e0 = ((np.array(design.initial_state) - centre[0]) / half[0]).tolist()
     box = [[v, v] for v in e0]                            # enclosure of e(t_k), per dim
     level = {b: math.sqrt(sum(math.atanh(e0[i]) ** 2 for i in b)) for b in balls}
@@ -299,6 +301,28 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
             level[b] = min(level[b], math.sqrt(sum(limits[i] ** 2 for i in b)))
             ball_max = max(ball_max, level[b])
         h_k = half_l[k]
+        g_lo, g_hi, sk, cp = g_min_l[k], g_max_l[k], skew_l[k], coupling_l[k]
+        peak_k = {share: peaks[share][k] for share in shares}
+        if turn is not None:
+            # g turns with the heading the held command turns the base by (eq. (R1))
+            speeds.append(math.sqrt(sum((pull_l[k][i] / dt * phi_scalar(reach_e[i])) ** 2
+                                        for i in range(n))))
+            span = (dt + 2.0 * jitter) + (delay if timed else 0.0)
+            rate = turn[0] * max(speeds[-3:] if timed else speeds[-1:]) + turn[1]
+            angle = span * rate
+            norm = g_hi + sk                              # |g|_2 of the class
+            g_lo = math.cos(angle) * g_lo - math.sin(angle) * norm if angle < 0.5 * math.pi \
+                else -math.inf
+            if g_lo <= 0.0:
+                return fail(f"the heading may turn by {angle:.3g} rad in a sampling period "
+                            f"at t = {t:.4f} s (|omega| <= {rate:.3g} rad/s), which leaves no "
+                            "positive input gain for the command computed before it",
+                            -math.inf, t, 0, top)
+            g_hi, sk, cp = (g_hi + math.sin(angle) * norm, sk + math.sin(angle) * norm,
+                            cp + math.sin(angle) * norm)
+            ratio_k = [h_k[i] / (pull_l[k][i] * g_lo) for i in range(n)]
+            peak_k = {share: [peak_scalar(r / share) if share > 0.0 else 1.0 - 1e-15
+                              for r in ratio_k] for share in shares}
         path, ends = [], []
         for i in range(n):
             others = [j for j in block_of[i] if j != i]
@@ -306,24 +330,23 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
                                [h_k[j] for j in others]) if others else 0.0)
             if not timed:
                 p_lo, p_hi, x_lo, x_hi = axis_interval(
-                    box[i][0], box[i][1], centre_l[k][i], h_k[i], pull_l[k][i], g_min_l[k],
-                    g_max_l[k], peaks[1.0][k][i], dt * push_l[k],
-                    dt * 2.0 * k_gain * math.sqrt(z_sq), coupling_l[k], skew_l[k])
+                    box[i][0], box[i][1], centre_l[k][i], h_k[i], pull_l[k][i], g_lo,
+                    g_hi, peak_k[1.0][i], dt * push_l[k],
+                    dt * 2.0 * k_gain * math.sqrt(z_sq), cp, sk)
             else:
                 # the previous command for `lag`, then this one for `share` periods
                 # (docs/sampled-data.md, "Computation delay and jitter")
                 speed = _old_push(k, i, block_of[i], reach_prev,
-                                  [p / dt for p in pull_l[max(k - 1, 0)]], g_max_l[k],
-                                  g_max_l[k] - g_min_l[k], skew_l[k], coupling_l[k], push_l[k])
+                                  [p / dt for p in pull_l[max(k - 1, 0)]], g_hi,
+                                  g_hi - g_lo, sk, cp, push_l[k])
                 p_lo = x_lo = math.inf
                 p_hi = x_hi = -math.inf
                 for share, lag in corners:
                     a_lo, a_hi, b_lo, b_hi = axis_interval(
                         box[i][0], box[i][1], centre_l[k][i], h_k[i], share * pull_l[k][i],
-                        g_min_l[k], g_max_l[k], peaks[share][k][i],
+                        g_lo, g_hi, peak_k[share][i],
                         share * dt * push_l[k] + lag * speed,
-                        share * dt * 2.0 * k_gain * math.sqrt(z_sq), coupling_l[k],
-                        skew_l[k])
+                        share * dt * 2.0 * k_gain * math.sqrt(z_sq), cp, sk)
                     p_lo, p_hi = min(p_lo, a_lo), max(p_hi, a_hi)
                     x_lo, x_hi = min(x_lo, b_lo), max(x_hi, b_hi)
                 # while the previous command acts, x moves from x(s_k) by at most this
@@ -337,7 +360,7 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
         for b in balls:
             mid, end = _ball(level[b], [limits[i] for i in b], [h_k[i] for i in b],
                              [min(max(-path[i][0], path[i][1]), 1.0) for i in b], k_gain, dt,
-                             g_min_l[k], g_max_l[k], skew_l[k], push_l[k])
+                             g_lo, g_hi, sk, push_l[k])
             if math.isfinite(mid):
                 edge = math.tanh(mid)
                 for i in b:

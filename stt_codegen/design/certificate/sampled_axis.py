@@ -16,8 +16,8 @@ import math
 
 import numpy as np
 
-__all__ = ["phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "coupling_push",
-           "axis_interval"]
+__all__ = ["phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "peak_scalar",
+           "coupling_push", "axis_interval"]
 
 
 def phi(s: np.ndarray) -> np.ndarray:
@@ -110,6 +110,31 @@ def peak(ratio: np.ndarray) -> np.ndarray:
         up = phi_slope(mid) < ratio
         lo, hi = np.where(up, mid, lo), np.where(up, hi, mid)
     return np.where(ratio <= 2.0, 0.0, lo)
+
+
+def peak_scalar(ratio: float) -> float:
+    """:func:`peak` for one float.
+
+    Parameters
+    ----------
+    ratio : float
+        ``h / (g_min p)``.
+
+    Returns
+    -------
+    float
+        ``s*`` in ``[0, 1)``.
+    """
+    if not ratio > 2.0:
+        return 0.0
+    lo, hi = 0.0, 1.0 - 1e-15
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if phi_slope_scalar(mid) < ratio:
+            lo = mid
+        else:
+            hi = mid
+    return lo
 
 
 def coupling_push(others: float, coupling: float, spread: float, skew: float,
