@@ -798,7 +798,7 @@ def _timing(table: ControllerTable, model: str) -> dict[str, float]:
         field_name = "controller.delay" if delay > 0.0 else "controller.jitter"
         raise SpecError(field_name, f"the {variant.name} variant ({variant.plant_words}) has no "
                                     "sampled-data certificate with a computation delay or "
-                                    "jitter yet; only first-order plants take them "
+                                    "jitter yet; law (13)'s variants take them "
                                     "(docs/sampled-data.md, \"Computation delay and jitter\")")
     return {"delay": float(delay), "jitter": float(jitter)}
 
