@@ -11,7 +11,7 @@ from .backends import make_controller
 from ..design.result import Design, require_design
 from ..errors import SpecError
 from .plants import check_seed, spec_plant
-from .simulate import RungeKutta
+from .simulate import RungeKutta, hold_period
 from .state_split import initial_state
 
 __all__ = ["controller_system", "sampled_plant"]
@@ -116,7 +116,10 @@ def sampled_plant(design: Design, seed: int = 0, plant: ct.NonlinearIOSystem | N
     The update integrates the continuous plant over ``[t_k, t_k + dt]`` with the input
     held, by the Runge-Kutta steps :func:`stt_codegen.simulate` takes; so
     ``ct.interconnect`` of it with :func:`controller_system` is the closed loop of
-    ``simulate`` (the same floats).
+    ``simulate`` (the same floats). With a spec's ``[controller] delay`` ``d > 0`` the
+    system also keeps the previous input ``u_{k-1}`` as states (zero at ``t = 0``): the
+    update holds it on ``[t_k, t_k + d)`` and the input ``u_k`` from ``t_k + d``, as
+    ``simulate`` does, then stores ``u_k``.
 
     Parameters
     ----------
@@ -133,8 +136,10 @@ def sampled_plant(design: Design, seed: int = 0, plant: ct.NonlinearIOSystem | N
     Returns
     -------
     control.NonlinearIOSystem
-        ``dt = 1 / rate_hz``; states ``x[0] ..``, inputs ``u[0] .. u[m-1]``, outputs
-        ``x[0] ..`` (the state).
+        ``dt = 1 / rate_hz``; states ``x[0] .. x[s-1]`` (the plant's ``s`` states), then
+        with a delay ``u_prev[0] .. u_prev[m-1]`` (``s + m`` states; the initial state
+        is ``[x(0), 0]``); inputs ``u[0] .. u[m-1]``; outputs ``x[0] .. x[s-1]`` (the
+        plant's state).
 
     Raises
     ------
@@ -165,16 +170,20 @@ def sampled_plant(design: Design, seed: int = 0, plant: ct.NonlinearIOSystem | N
                                  f"spec, not {continuous.nstates} and {continuous.ninputs}")
     stepper = RungeKutta(continuous)
     dt = 1.0 / design.tube.rate_hz
+    delay = spec.delay
+    held = [f"u_prev[{j}]" for j in range(inputs)] if delay > 0.0 else []
 
-    def update(t, x, u, params):
-        stepper.reset(np.asarray(x, dtype=float).reshape(-1))
-        points, _ = stepper.advance(float(t), np.asarray(u, dtype=float).reshape(-1), dt)
-        return points[-1]
+    def update(t, state, u, params):
+        state = np.asarray(state, dtype=float).reshape(-1)
+        u = np.asarray(u, dtype=float).reshape(-1)
+        stepper.reset(state[:states])
+        points, _ = hold_period(stepper, float(t), state[states:], u, dt, delay)
+        return np.concatenate([points[-1], u]) if held else points[-1]
 
-    def output(t, x, u, params):
-        return x
+    def output(t, state, u, params):
+        return state[:states]
 
     return ct.nlsys(update, output, dt=dt, name=name,
-                    states=[f"x[{i}]" for i in range(states)],
+                    states=[*(f"x[{i}]" for i in range(states)), *held],
                     inputs=[f"u[{j}]" for j in range(inputs)],
                     outputs=[f"x[{i}]" for i in range(states)])

@@ -5,8 +5,10 @@ first-order spec the positions (``qpos`` of the named joints), for a second-orde
 positions and then the velocities (``qvel`` of the same joints). Its inputs go to the
 named actuators' ``ctrl`` (MuJoCo clamps them to a limited actuator's ``ctrlrange``, as
 the hardware would). Between two samples the held input drives ``mj_step`` at the model's
-timestep (``1 / rate_hz`` must be a whole number of timesteps). A contact of the robot with
-anything but a ground plane is recorded: the run judges it like a collision.
+timestep (``1 / rate_hz``, and a ``[controller] delay``, must be whole numbers of
+timesteps: the previous input is then held for the delay, the new one for the rest of the
+period). A contact of the robot with anything but a ground plane is recorded: the run
+judges it like a collision.
 
 ``mujoco`` is a dependency of the package; this module imports it on first use and raises
 a :class:`~stt_codegen.errors.SpecError` saying how to install it when it is absent.
@@ -173,13 +175,43 @@ class MujocoPlant:
         SpecError
             Field ``controller.rate_hz``: the period is not a whole number of timesteps.
         """
-        ratio = dt / self.timestep
-        steps = int(round(ratio))
-        if steps < 1 or abs(ratio - steps) > 1e-9 * max(1.0, ratio):
+        steps = self._whole_steps(dt)
+        if steps is None or steps < 1:
             raise SpecError("controller.rate_hz",
                             f"the sampling period {dt:g} s is not a whole number of the "
                             f"MuJoCo model's timesteps ({self.timestep:g} s)")
         return steps
+
+    def check_delay(self, delay: float, dt: float) -> None:
+        """That a computation delay splits each sampling period into whole timesteps.
+
+        Parameters
+        ----------
+        delay : float
+            ``[controller] delay``, s: the previous command is held on ``[t_k, t_k +
+            delay)``, the new one from ``t_k + delay``.
+        dt : float
+            The sampling period, s.
+
+        Raises
+        ------
+        SpecError
+            Field ``controller.rate_hz``: the period is not a whole number of timesteps;
+            field ``controller.delay``: the delay is not.
+        """
+        self.steps_per_period(dt)
+        if self._whole_steps(delay) is None:
+            raise SpecError("controller.delay",
+                            f"the computation delay {delay:g} s must be a whole number of "
+                            f"MuJoCo timesteps ({self.timestep:g} s) to be simulated on "
+                            "MuJoCo")
+
+    def _whole_steps(self, duration: float) -> int | None:
+        """``duration`` in timesteps where it is a whole number of them (to 1e-9 relative),
+        else ``None``."""
+        ratio = duration / self.timestep
+        steps = int(round(ratio))
+        return steps if abs(ratio - steps) <= 1e-9 * max(1.0, ratio) else None
 
     def _name(self, geom: int) -> str:
         name = self._mj.mj_id2name(self.model, self._mj.mjtObj.mjOBJ_GEOM, geom)
@@ -195,7 +227,8 @@ class MujocoPlant:
         u : array_like, shape (ninputs,)
             The held input, written to the actuators' ``ctrl``.
         dt : float
-            The sampling period, s (a whole number of timesteps).
+            The sampling period, s, or with a computation delay a part of it: a whole
+            number of timesteps (none for a part of length zero).
 
         Returns
         -------
@@ -203,9 +236,14 @@ class MujocoPlant:
             The state after each of the ``m`` timesteps.
         times : ndarray, shape (m,)
             Their times, s.
+
+        Raises
+        ------
+        SpecError
+            Field ``controller.rate_hz``: ``dt`` is not a whole number of timesteps.
         """
         mj = self._mj
-        steps = self.steps_per_period(dt)
+        steps = 0 if self._whole_steps(dt) == 0 else self.steps_per_period(dt)
         self.data.ctrl[self._ctrl] = np.asarray(u, dtype=float)
         states = np.empty((steps, self.nstates))
         for m in range(steps):
@@ -267,7 +305,7 @@ class DriveMujocoPlant(MujocoPlant):
         u : array_like, shape (2,)
             ``v`` (m/s) and ``omega`` (rad/s).
         dt : float
-            The sampling period, s.
+            The sampling period, s, or a part of it (as :meth:`MujocoPlant.advance`).
 
         Returns
         -------

@@ -4,7 +4,8 @@ One loop for both orders of plant. The controller runs at ``rate_hz``: at each s
 instant ``t_k`` it reads the plant's state ``x(t_k)`` (a first-order plant's ``n``
 states, or a second-order plant's positions and velocities ``[x1; x2]``), computes ``u_k``
 and its next ``alpha`` (law (13), or the cascade law of docs/second-order.md); ``u_k`` is
-held until ``t_{k+1}``. The plant, a python-control ``NonlinearIOSystem``
+held until ``t_{k+1}`` (with a ``[controller] delay`` ``d``, from ``t_k + d`` to
+``t_{k+1} + d``: :func:`hold_period`). The plant, a python-control ``NonlinearIOSystem``
 (:func:`~stt_codegen.runtime.plants.spec_plant`), is integrated over each hold interval by
 the classical Runge-Kutta method with :data:`SUBSTEPS` steps (its accuracy against an
 adaptive solver at tight tolerance is tested). Definition 2.1 is judged on the positions
@@ -26,6 +27,7 @@ from ..design.result import Design, require_design
 from ..design.samples import check_step_budget
 from ..display import Rows, markdown, text
 from ..errors import SpecError
+from .mujoco_plant import MujocoPlant
 from .plants import check_seed, spec_plant
 from .state_split import initial_state, positions
 from ..spec.loader import Spec
@@ -37,7 +39,8 @@ from ..tube.second_stage import SecondStage
 from .tasks import TaskOutcome, judge_tasks, until_met
 
 __all__ = ["RungeKutta", "SUBSTEPS", "SimulationResult", "Trajectory",
-           "cascade_velocity_reference", "no_velocity_fields", "no_velocity_reference",
+           "cascade_velocity_reference", "hold_period", "no_velocity_fields",
+           "no_velocity_reference",
            "run_closed_loop", "simulate", "velocity_fields"]
 
 #: Runge-Kutta steps per sampling period.
@@ -56,7 +59,8 @@ class Trajectory:
         The positions at ``t_k`` (the spec's state space: a first-order plant's state, a
         second-order plant's ``x1``), state units.
     u : ndarray, shape (N, n)
-        The input computed at ``t_k`` and held until ``t_{k+1}``, input units.
+        The input computed at ``t_k`` and held until ``t_{k+1}`` (with a spec's
+        ``delay``, from ``t_k + delay`` to ``t_{k+1} + delay``), input units.
     alpha : ndarray, shape (N, 2n)
         The adaptive law's ``alpha`` (eq. (11)) used at ``t_k``.
     status : ndarray of int, shape (N,)
@@ -316,6 +320,42 @@ class RungeKutta:
         return points, t + h * np.arange(1, SUBSTEPS + 1)
 
 
+def hold_period(stepper: RungeKutta | MujocoPlant, t: float, u_prev: np.ndarray, u: np.ndarray,
+                dt: float, delay: float) -> tuple[np.ndarray, np.ndarray]:
+    """Advance a plant over one sampling period ``[t, t + dt]``, the command computed at
+    ``t`` acting after a computation delay.
+
+    Parameters
+    ----------
+    stepper : RungeKutta or MujocoPlant
+        The plant, at its state ``x(t)`` (its ``advance`` is called).
+    t : float
+        The sampling instant ``t_k``, s.
+    u_prev : ndarray, shape (m,)
+        The previous command ``u_{k-1}`` (zeros before the first), held on
+        ``[t, t + delay)``; unused without a delay.
+    u : ndarray, shape (m,)
+        The command ``u_k`` computed at ``t``, held from ``t + delay`` to ``t + dt``.
+    dt : float
+        The sampling period, s.
+    delay : float
+        ``[controller] delay``, s, in ``[0, dt]``. 0: ``stepper.advance(t, u, dt)`` alone.
+
+    Returns
+    -------
+    points : ndarray, shape (p, nstates)
+        The plant's states at the dense points of the period, in time order (those of
+        the delay's part first).
+    times : ndarray, shape (p,)
+        Their times, s.
+    """
+    if delay == 0.0:
+        return stepper.advance(t, u, dt)
+    early, early_t = stepper.advance(t, u_prev, delay)
+    late, late_t = stepper.advance(t + delay, u, dt - delay)
+    return np.vstack([early, late]), np.concatenate([early_t, late_t])
+
+
 def simulate(design: Design, *positional: object, backend: str | None = None,
              horizon: float | None = None, seed: int = 0,
              plant: ct.NonlinearIOSystem | None = None) -> SimulationResult:
@@ -330,6 +370,12 @@ def simulate(design: Design, *positional: object, backend: str | None = None,
     second-order ``plant.model`` the same loop runs the cascade law (docs/second-order.md)
     with the design's second stage (:attr:`~stt_codegen.design.result.Design.second_stage`)
     on ``[x1; x2]``, from ``x2(0) = initial.velocity``.
+
+    With a spec's ``[controller] delay`` ``d > 0`` the command ``u_k`` computed from
+    ``x(t_k)`` acts from ``t_k + d`` to ``t_{k+1} + d`` (the previous command acts on
+    ``[t_k, t_k + d)``, the input is zero before ``u_0`` acts); the trajectory's ``u`` at
+    ``t_k`` is still ``u_k``, and ``control_effort`` still sums the commands. The
+    ``jitter`` is not simulated (the certificate covers it).
 
     Parameters
     ----------
@@ -380,8 +426,9 @@ def simulate(design: Design, *positional: object, backend: str | None = None,
         Unknown backend (field ``backend``), a ``plant`` without the spec's states and
         inputs (field ``plant``), a horizon that is not a positive number of
         seconds (``horizon``), a seed that is not an integer in ``[0, 2**32)``
-        (``seed``), or a run of more than
-        :data:`~stt_codegen.design.samples.STEP_BUDGET` steps.
+        (``seed``), a run of more than
+        :data:`~stt_codegen.design.samples.STEP_BUDGET` steps, or a MuJoCo plant with a
+        ``delay`` that is not a whole number of its timesteps (``controller.delay``).
     ToolchainError
         Backend ``"c"``: no C compiler, or it failed.
 
@@ -467,8 +514,6 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
         raise SpecError("stage", f"a spec of the {variant.name} variant runs {variant.input_words}"
                                  f" with its own stage (Design.stage), not a "
                                  f"{type(stage).__name__}")
-    if controller is None:
-        controller = make_controller(backend, tube, stage)
     x = initial_state(spec)
     if plant is None:
         plant = spec_plant(spec, seed)
@@ -477,8 +522,12 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
                                  f"advance(), as MujocoPlant) with {x.size} states "
                                  f"and {n} inputs for this spec{variant.state_words}")
     stepper = plant if hasattr(plant, "advance") else RungeKutta(plant)
-    x = stepper.reset(x)
     dt = 1.0 / tube.rate_hz
+    if spec.delay > 0.0 and isinstance(stepper, MujocoPlant):
+        stepper.check_delay(spec.delay, dt)
+    if controller is None:
+        controller = make_controller(backend, tube, stage)
+    x = stepper.reset(x)
     lo, hi = np.array(spec.state_space.lower), np.array(spec.state_space.upper)
     t_lo, t_hi = np.array(spec.target_set.lower), np.array(spec.target_set.upper)
 
@@ -487,7 +536,7 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     us = np.zeros((steps + 1, n))
     alphas = np.zeros((steps + 1, 2 * n))
     status = np.zeros(steps + 1, dtype=int)
-    alpha = np.zeros(2 * n)
+    alpha, u_prev = np.zeros(2 * n), np.zeros(n)
     dense = [positions(spec, x[None])]
     dense_t = [np.zeros(1)]
     for k in range(steps + 1):
@@ -497,7 +546,8 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
         us[k], status[k] = u, code
         if k == steps:
             break
-        points, times = stepper.advance(t, u, dt)
+        points, times = hold_period(stepper, t, u_prev, u, dt, spec.delay)
+        u_prev = us[k]
         x = points[-1]
         dense.append(positions(spec, points))
         dense_t.append(times)
