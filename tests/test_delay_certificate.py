@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import subprocess
 import sys
 
@@ -213,3 +214,36 @@ def test_the_look_ahead_takes_a_delay():
     assert largest is not None and 0.0 < largest < 1.0 / design.rate_hz
     assert _check(spec, design, delay=largest).passed
     assert not _check(spec, design, delay=min(2.0 * largest, 1.0 / design.rate_hz)).passed
+
+
+# ---------------------------------------------------------------------------------------
+# the design: its sampled proof must hold with the timing, else it names what works
+
+
+def _line(rate_hz: float = 100.0, delay: float = 0.0):
+    from pathlib import Path
+    spec = stt.load_spec(Path(__file__).parent / "specs" / "line-s1.toml")
+    return dataclasses.replace(spec, rate_hz=rate_hz, delay=delay)
+
+
+def test_a_design_with_a_delay_is_proved_with_it():
+    design = stt.design_tube(_line(delay=0.002))
+    assert design.spec.delay == 0.002
+    assert _check(design.spec, design.tube, delay=0.002).passed
+
+
+def test_a_delay_the_design_cannot_take_is_refused_naming_one_that_is_then_certified():
+    """A full period of delay at 100 Hz leaves line-s1's tube in simulation
+    (tests/test_delay_closed_loop.py); the design refuses it and names a delay that it
+    then certifies."""
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(_line(delay=0.01))
+    error = raised.value
+    assert error.kind.value == "timing"
+    assert "controller.delay = 0.01 s at 100 Hz" in str(error)
+    named = re.search(r"controller\.delay = ([0-9.e-]+) s is certified", str(error))
+    assert named is not None
+    delay = float(named.group(1))
+    assert 0.0 < delay < 0.01
+    design = stt.design_tube(_line(delay=delay))
+    assert _check(design.spec, design.tube, delay=delay).passed

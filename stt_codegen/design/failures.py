@@ -31,7 +31,8 @@ class FailureKind(Enum):
     docs/tasks.md). Moving obstacles (docs/moving-obstacles.md): ``MOVING_OBSTACLE``
     (the tube may meet one in space-time), ``SWEPT_AT_START`` (no design avoids them in
     space-time, and the region a moving obstacle sweeps meets the start or the target,
-    so it cannot be avoided as a static box).
+    so it cannot be avoided as a static box). ``TIMING``: with ``[controller] delay`` or
+    ``jitter``, no design's sampled-data proof holds with them (:mod:`~.timing`).
     """
 
     SAMPLING_RATE = "sampling rate"
@@ -52,6 +53,7 @@ class FailureKind(Enum):
     MOVING_OBSTACLE = "avoids moving obstacle"
     SWEPT_AT_START = "swept region at start or target"
     TRACKING = "tracking"
+    TIMING = "timing"
 
 
 def property_kind(name: str) -> FailureKind:

@@ -300,7 +300,9 @@ def design_tube(spec: Spec, *, progress: ProgressCallback | None = None) -> Desi
         (:class:`~stt_codegen.design.failures.FailureKind`) and ``tried`` the best
         rejected tube (``None`` where none was built). With ``[actuator]``: no design
         within ``t_c`` keeps the bound (kind ``INPUT_BOUND``; the message names the
-        ``prescribed_time`` that works).
+        ``prescribed_time`` that works). With ``[controller] delay`` or ``jitter``: the
+        design's sampled-data proof fails with them (kind ``TIMING``; the message names
+        the delay or the rate that is certified, :mod:`~stt_codegen.design.timing`).
 
     See Also
     --------
@@ -325,6 +327,18 @@ def design_tube(spec: Spec, *, progress: ProgressCallback | None = None) -> Desi
         raise TypeError(f"design_tube(): parameter 'spec' must be a Spec, not "
                         f"{type(spec).__name__}{hint}")
     started = time.perf_counter()
+    if spec.delay > 0.0 or spec.jitter > 0.0:      # the sampled proof must hold with them
+        from .timing import design_with_timing
+        with reporting(progress, final="done" if progress is not None else ""):
+            return _timed(design_with_timing(spec, _untimed_call), started)
+    return _untimed_call(spec, progress, started)
+
+
+def _untimed_call(spec: Spec, progress: ProgressCallback | None = None,
+                  started: float | None = None) -> Design:
+    """:func:`design_tube`'s search, whatever ``[controller] delay`` says (the tube's
+    candidates do not depend on it; the sampled proofs they pass through do)."""
+    started = time.perf_counter() if started is None else started
     with reporting(progress, final="done" if progress is not None else ""):
         if spec.target_any_of:                # [target] any_of: the first box that designs
             return _timed(_any_target(spec), started)

@@ -1,0 +1,131 @@
+"""A design for a spec with ``[controller] delay`` or ``jitter``: the sampled-data proof must
+hold with them, else a refusal that names the delay or the rate that works.
+
+The tube's candidates do not depend on the timing; the sampled proofs the search runs on
+them (the tracking screen, the ``[actuator]`` proof) read it through
+:func:`~.certificate.sampled.sampled_check_of`. A design whose own proof fails with the
+timing is refused (``verify`` would fail it); the refusal names the largest delay the
+design without the timing tolerates with ``|e| <= TRACKING_ERROR`` and the lowest rate
+that passes with the delay, each only once :func:`~.search.design_tube` has certified it
+(docs/sampled-data.md, "Computation delay and jitter").
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import replace
+
+from ..errors import DesignError, number_text
+from ..spec.loader import Spec
+from ..tube import reference
+from .certificate.plant_class import plant_class
+from .certificate.sampled import (DELAY_HALVINGS, check_sampled_first_per_axis,
+                                  lowest_rate, sampled_check_of)
+from .failures import FailureKind
+from .result import Design
+from .samples import sample_tube
+from .tracking import TRACKING_ERROR
+
+__all__ = ["design_with_timing"]
+
+
+def _timing_words(spec: Spec) -> str:
+    words = f"controller.delay = {number_text(spec.delay)} s"
+    if spec.jitter > 0.0:
+        words += f", controller.jitter = {number_text(spec.jitter)} s"
+    return words
+
+
+def _certified(spec: Spec, search: Callable[[Spec], Design]) -> Design:
+    """``search(spec)`` whose sampled-data proof holds with the spec's timing, else a
+    :class:`DesignError` of kind ``TIMING`` (or the search's own)."""
+    design = search(spec)
+    check = sampled_check_of(design.tube, spec)[1]
+    if not check.passed:
+        raise DesignError(f"the sampled-data proof fails: {check.reason}",
+                          kind=FailureKind.TIMING, tried=design.tube)
+    return design
+
+
+def _followable_delay(design: Design, spec: Spec) -> float | None:
+    """The largest delay (to ``dt / 2^DELAY_HALVINGS``) with which ``design``'s sampled
+    proof holds at ``|e| <= TRACKING_ERROR`` with the spec's jitter; ``None`` if none."""
+    tube = design.tube
+    with reference.numpy_math():
+        samples, plants = sample_tube(tube), plant_class(spec)
+
+        def passes(delay: float) -> bool:
+            check = check_sampled_first_per_axis(tube, samples, plants, delay=delay,
+                                                 jitter=spec.jitter)
+            return check.passed and check.level <= TRACKING_ERROR
+
+        top = max(0.0, 1.0 / tube.rate_hz - 2.0 * spec.jitter)
+        if not passes(0.0):
+            return None
+        good, bad = 0.0, top
+        for _ in range(DELAY_HALVINGS):
+            mid = 0.5 * (good + bad)
+            good, bad = (mid, bad) if passes(mid) else (good, mid)
+        return good
+
+
+def design_with_timing(spec: Spec, search: Callable[[Spec], Design]) -> Design:
+    """The design of a spec with ``[controller] delay`` or ``jitter`` whose sampled-data
+    proof holds with them.
+
+    Parameters
+    ----------
+    spec : Spec
+        With ``delay > 0`` or ``jitter > 0`` (a first-order or look-ahead variant).
+    search : callable
+        ``search(spec) -> Design``: the design search of
+        :func:`~stt_codegen.design.search.design_tube`, which reads no timing itself.
+
+    Returns
+    -------
+    Design
+        Its ``sampled_check_of`` passes with the spec's delay and jitter.
+
+    Raises
+    ------
+    DesignError
+        Kind ``TIMING`` when no design's proof holds with the timing; the message names
+        ``controller.delay`` (the largest that works at this rate) and
+        ``controller.rate_hz`` (the lowest that works with this delay) when
+        :func:`~stt_codegen.design.search.design_tube` certifies them; the search's own
+        error when the spec fails without the timing too.
+    """
+    try:
+        return _certified(spec, search)
+    except DesignError as failure:
+        refused = failure
+    untimed = replace(spec, delay=0.0, jitter=0.0)
+    try:
+        plain = search(untimed)
+    except DesignError:
+        raise refused from None                  # the timing is not what fails
+    works = []
+    delay = _followable_delay(plain, spec)
+    if delay is not None and delay > 0.0 and delay < spec.delay:
+        try:
+            _certified(replace(spec, delay=delay), search)
+            works.append(f"controller.delay = {number_text(delay, 3)} s is certified at "
+                         f"{number_text(spec.rate_hz)} Hz")
+        except DesignError:
+            pass
+    with reference.numpy_math():
+        rate, _ = lowest_rate(plain.tube, spec, plant_class(spec), spec.gain)
+    if rate is not None and rate != spec.rate_hz:
+        try:
+            _certified(replace(spec, rate_hz=rate), search)
+            works.append(f"controller.rate_hz = {number_text(rate)} is certified with "
+                         f"{_timing_words(spec)}")
+        except DesignError:
+            pass
+    advice = ("; " + "; ".join(works)) if works else (
+        f"; no delay up to the spec's or rate up to 16 times it is certified with the "
+        f"design without the timing (certified without it)")
+    raise DesignError(f"no design is certified with {_timing_words(spec)} at "
+                      f"{number_text(spec.rate_hz)} Hz ({refused}){advice}",
+                      kind=FailureKind.TIMING,
+                      tried=getattr(refused, "tried", None)) from None
