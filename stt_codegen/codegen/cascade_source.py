@@ -41,7 +41,7 @@ from ..version import __version__
 from ..design.result import Design
 from .emit import python_source
 from .functions import deployed_functions
-from .generate import c_source_context, input_limits
+from .generate import c_source_context, input_limits, timing_context
 from .options import Options
 from .render import c_real, render
 
@@ -72,7 +72,7 @@ def statuses(design: TubeDesign) -> list[tuple[str, int]]:
 
 
 def _context(design: TubeDesign, stage: SecondStage, prefix: str, precision: str,
-             literal) -> dict:
+             literal, timing: tuple[float, float] = (0.0, 0.0)) -> dict:
     """What every cascade template takes: the banner's fields, the names, the statuses,
     the input domain's limits (those of the first order, :func:`.generate.input_limits`)
     and the actuator bound, printed by ``literal``."""
@@ -82,13 +82,15 @@ def _context(design: TubeDesign, stage: SecondStage, prefix: str, precision: str
             "precision": precision, "P": prefix, "U": prefix.upper(),
             "n": design.dimension, "statuses": statuses(design),
             "t_c": literal(design.prescribed_time), "rate_hz": literal(design.rate_hz),
+            **timing_context(design.rate_hz, timing, literal),
             **{name: literal(value) for name, value in limits.items()},
             "input_bound": (None if design.input_bound is None else
                             [literal(b) for b in design.input_bound])}
 
 
 def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
-                    precision: str = "double") -> dict[str, str]:
+                    precision: str = "double", timing: tuple[float, float] = (0.0, 0.0)
+                    ) -> dict[str, str]:
     """``{<prefix>.h: text, <prefix>.c: text}`` of the cascade controller.
 
     The emitter's C printer prints the pieces (the first order's and the cascade's); the
@@ -104,6 +106,8 @@ def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
     prefix : str
         A C identifier: the file names and the prefix of every public name.
     precision : {"double", "single"}
+    timing : (float, float)
+        ``(delay, jitter)`` of the spec, s: the header's timing contract.
 
     Returns
     -------
@@ -127,7 +131,8 @@ def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
     functions = [*deployed_functions(build_model(first)), velocity_tube(design.dimension),
                  velocity_law(design.dimension)]
     context = dict(c_source_context(first, prefix, precision, functions),
-                   **_context(design, stage, prefix, precision, literal), cascade=True,
+                   **_context(design, stage, prefix, precision, literal, timing),
+                   cascade=True,
                    stage={"velocity_gain": literal(stage.velocity_gain),
                           "decay": literal(stage.decay),
                           "width_start": [literal(v) for v in stage.width_start],
@@ -137,7 +142,8 @@ def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
                                    (f"{prefix}.c", "cascade_source.c.j2"))}
 
 
-def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str) -> dict[str, str]:
+def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str,
+                        timing: tuple[float, float] = (0.0, 0.0)) -> dict[str, str]:
     """``{<prefix>.py: text}``: ``step(x, t, dt, alpha) -> (u, alpha_next, status)`` and
     ``virtual_velocity(x, t, alpha) -> (r, status)`` (``x = [x1; x2]``), the same functions,
     statuses and input checks as the C (imports ``math`` only). The emitter's Python printer prints the composed Function; the template
@@ -151,6 +157,8 @@ def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str) -> 
         The second stage (velocity tube and gains), of the design's dimension.
     prefix : str
         Module name, an ASCII identifier.
+    timing : (float, float)
+        ``(delay, jitter)`` of the spec, s: the module's ``DELAY`` and ``JITTER``.
 
     Returns
     -------
@@ -167,7 +175,7 @@ def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str) -> 
     name = f"{prefix}.py"
     return {name: render("cascade_module.py.j2", filename=name,
                          **_context(design, stage, prefix, "double",
-                                    lambda v: repr(float(v))),
+                                    lambda v: repr(float(v)), timing),
                          body=python_source(cascade_step(design, stage)))}
 
 
@@ -303,7 +311,8 @@ def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
     data = cascade_vectors(design.tube, stage, precision=options.precision)
     texts: dict[str, str] = {}
     if "c" in options.langs:
-        texts.update(cascade_c_files(design.tube, stage, prefix, options.precision))
+        texts.update(cascade_c_files(design.tube, stage, prefix, options.precision,
+                                     (spec.delay, spec.jitter)))
         texts.update(build_files(context))
         rows = data["vectors"]
         inputs = {"x": [v["x"] for v in rows], "t": [v["t"] for v in rows],
@@ -317,7 +326,7 @@ def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
         texts.update(selftest_file(context, inputs, expected, options.precision,
                                    "cascade_selftest.c.j2"))
     if "python" in options.langs:
-        texts.update(cascade_python_file(design.tube, stage, prefix))
+        texts.update(cascade_python_file(design.tube, stage, prefix, (spec.delay, spec.jitter)))
     files = {name: text.encode() for name, text in texts.items()}
     files[f"{prefix}_vectors.json"] = json_bytes(
         dict(data, spec=spec.name, spec_sha256=spec.source_hash))

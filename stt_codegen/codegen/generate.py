@@ -35,7 +35,7 @@ from ..tube.pieces import PROFILE_NAMES
 from .vectors import test_vectors
 
 __all__ = ["GENERATOR", "MANIFEST", "Options", "c_source_context", "first_order_generation",
-           "generate_files", "input_limits", "manifest"]
+           "generate_files", "input_limits", "manifest", "timing_context"]
 
 
 def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str, bytes]:
@@ -73,7 +73,9 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
     files: dict[str, str] = {}
     vectors = test_vectors(design, options.precision)
     if "c" in options.langs:
-        c_ctx = dict(common, **c_source_context(design, prefix, options.precision, functions))
+        c_ctx = dict(common, **c_source_context(design, prefix, options.precision, functions),
+                     **timing_context(design.rate_hz, (spec.delay, spec.jitter),
+                                      lambda v: c_real(v, single)))
         for name, template in ((f"{prefix}.h", "c_header.h.j2"), (f"{prefix}.c", "c_source.c.j2")):
             files[name] = render(template, filename=name, **c_ctx)
         files.update(build_files(c_ctx))
@@ -88,6 +90,8 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
                              profile_codes={name: k for k, name in enumerate(PROFILE_NAMES)},
                              t_c=repr(float(design.prescribed_time)),
                              rate_hz=repr(float(design.rate_hz)),
+                             **timing_context(design.rate_hz, (spec.delay, spec.jitter),
+                                              lambda v: repr(float(v))),
                              dt_min=repr(limits["dt_min"]),
                              dt_max=repr(limits["dt_max"]),
                              alpha_max=repr(limits["alpha_max"]),
@@ -155,6 +159,28 @@ def c_source_context(design: TubeDesign, prefix: str, precision: str,
                 alpha_max=c_real(limits["alpha_max"], single),
                 input_bound=(None if design.input_bound is None else
                              [c_real(b, single) for b in design.input_bound]))
+
+
+def timing_context(rate_hz: float, timing: tuple[float, float], literal) -> dict[str, str]:
+    """The timing contract's numbers, printed by ``literal``: ``period`` (``1 / rate_hz``),
+    ``delay`` and ``jitter`` (``[controller] delay`` and ``jitter``, s), the header's
+    ``PERIOD``, ``DELAY``, ``JITTER`` (``templates/_c_timing.h.j2``).
+
+    Parameters
+    ----------
+    rate_hz : float
+        The design's rate, Hz.
+    timing : (float, float)
+        ``(delay, jitter)``, s.
+    literal : callable
+        A float to its text in the target language.
+
+    Returns
+    -------
+    dict of str to str
+    """
+    return {"period": literal(1.0 / rate_hz), "delay": literal(timing[0]),
+            "jitter": literal(timing[1])}
 
 
 def input_limits(design: TubeDesign) -> dict[str, float]:

@@ -30,7 +30,7 @@ from ..tube.parameters import Status, TubeDesign
 from ..version import __version__
 from .emit import python_source
 from .functions import deployed_functions
-from .generate import c_source_context, input_limits
+from .generate import c_source_context, input_limits, timing_context
 from .render import c_real, render
 
 __all__ = ["look_ahead_c_files", "look_ahead_generation", "look_ahead_python_file",
@@ -46,7 +46,7 @@ def _check(design: TubeDesign, look_ahead: LookAhead, prefix: str) -> None:
 
 
 def _context(design: TubeDesign, look_ahead: LookAhead, prefix: str, precision: str,
-             literal) -> dict:
+             literal, timing: tuple[float, float] = (0.0, 0.0)) -> dict:
     """The banner's fields, the names, the statuses, the input domain's limits, the axle
     offset and the base's limits, printed by ``literal``."""
     limits = input_limits(design)
@@ -59,13 +59,15 @@ def _context(design: TubeDesign, look_ahead: LookAhead, prefix: str, precision: 
                          if s not in (Status.OUTSIDE_VELOCITY_TUBE, Status.INPUT_CLAMPED)
                          or (s == Status.INPUT_CLAMPED and bound is not None)],
             "t_c": literal(design.prescribed_time), "rate_hz": literal(design.rate_hz),
+            **timing_context(design.rate_hz, timing, literal),
             **{name: literal(value) for name, value in limits.items()},
             "axle_offset": literal(look_ahead.axle_offset),
             "input_bound": None if bound is None else [literal(b) for b in bound]}
 
 
 def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,
-                       precision: str = "double") -> dict[str, str]:
+                       precision: str = "double", timing: tuple[float, float] = (0.0, 0.0)
+                       ) -> dict[str, str]:
     """``{<prefix>.h: text, <prefix>.c: text}`` of the look-ahead controller.
 
     Parameters
@@ -77,6 +79,8 @@ def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,
     prefix : str
         A C identifier: the file names and the prefix of every public name.
     precision : {"double", "single"}
+    timing : (float, float)
+        ``(delay, jitter)`` of the spec, s: the header's timing contract.
 
     Returns
     -------
@@ -94,14 +98,15 @@ def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,
                  *([P.saturate(2)] if look_ahead.input_bound is not None else [])]
     context = dict(c_source_context(design, prefix, precision, functions),
                    **_context(design, look_ahead, prefix, precision,
-                              lambda v: c_real(v, single)), look_ahead=True)
+                              lambda v: c_real(v, single), timing), look_ahead=True)
     return {name: render(template, filename=name, **context)
             for name, template in ((f"{prefix}.h", "look_ahead_header.h.j2"),
                                    (f"{prefix}.c", "look_ahead_source.c.j2"))}
 
 
 def look_ahead_python_file(design: TubeDesign, look_ahead: LookAhead,
-                           prefix: str) -> dict[str, str]:
+                           prefix: str, timing: tuple[float, float] = (0.0, 0.0)
+                           ) -> dict[str, str]:
     """``{<prefix>.py: text}``: ``step(x, t, dt, alpha) -> (u, alpha_next, status)`` with
     ``x = (x, y, theta)``, the same function, statuses and input checks as the C (imports
     ``math`` only).
@@ -113,6 +118,8 @@ def look_ahead_python_file(design: TubeDesign, look_ahead: LookAhead,
     look_ahead : LookAhead
     prefix : str
         Module name, an ASCII identifier.
+    timing : (float, float)
+        ``(delay, jitter)`` of the spec, s: the module's ``DELAY`` and ``JITTER``.
 
     Returns
     -------
@@ -128,7 +135,7 @@ def look_ahead_python_file(design: TubeDesign, look_ahead: LookAhead,
     name = f"{prefix}.py"
     return {name: render("look_ahead_module.py.j2", filename=name,
                          **_context(design, look_ahead, prefix, "double",
-                                    lambda v: repr(float(v))),
+                                    lambda v: repr(float(v)), timing),
                          body=python_source(look_ahead_step(design, look_ahead)))}
 
 
@@ -228,11 +235,13 @@ def look_ahead_generation(design, options) -> dict[str, bytes]:
     vectors = look_ahead_vectors(design.tube, look_ahead, options.precision)
     texts: dict[str, str] = {}
     if "c" in options.langs:
-        texts.update(look_ahead_c_files(design.tube, look_ahead, prefix, options.precision))
+        texts.update(look_ahead_c_files(design.tube, look_ahead, prefix, options.precision,
+                                        (spec.delay, spec.jitter)))
         texts.update(build_files(context))
         texts.update(selftest_file(context, vectors, vector_tables(vectors), options.precision))
     if "python" in options.langs:
-        texts.update(look_ahead_python_file(design.tube, look_ahead, prefix))
+        texts.update(look_ahead_python_file(design.tube, look_ahead, prefix,
+                                            (spec.delay, spec.jitter)))
     files = {name: text.encode() for name, text in texts.items()}
     files[f"{prefix}_vectors.json"] = vectors_file(
         spec, options.precision, vectors,

@@ -33,6 +33,11 @@ N_STATE = 2
 N_INPUT = 2
 PRESCRIBED_TIME = 10.0
 RATE_HZ = 1000.0
+# the timing the certificate covers, s: call step at t = k PERIOD with dt = PERIOD, the state
+# read within JITTER of k PERIOD, u applied at most DELAY after the read (see the C header)
+PERIOD = 0.001
+DELAY = 0.0
+JITTER = 0.0
 DT_MIN = 9.5367431640625e-07
 DT_MAX = 16.0
 ALPHA_MAX = 8388608.0

@@ -1286,6 +1286,11 @@ N_ALPHA = 4
 AXLE_OFFSET = 0.1
 PRESCRIBED_TIME = 20.0
 RATE_HZ = 200.0
+# the timing the certificate covers, s: call step at t = k PERIOD with dt = PERIOD, the state
+# read within JITTER of k PERIOD, u applied at most DELAY after the read (see the C header)
+PERIOD = 0.005
+DELAY = 0.0
+JITTER = 0.0
 DT_MIN = 9.5367431640625e-07
 DT_MAX = 32.0
 ALPHA_MAX = 16777216.0

@@ -76,6 +76,28 @@ typedef float omnirobot_s2_real;
 #define OMNIROBOT_S2_PRESCRIBED_TIME 9.0f
 /** Sampling rate the tube was designed for, Hz (dt = 1 / rate). */
 #define OMNIROBOT_S2_RATE_HZ 1000.0f
+/**
+ * Timing contract. The proof of `stt-codegen verify` (docs/sampled-data.md, "Computation
+ * delay and jitter") holds for a loop that, with PERIOD, JITTER and DELAY the macros below,
+ *   - calls the step at every t_k = k PERIOD (k = 0, 1, ...) with the nominal t = k PERIOD
+ *     and dt = PERIOD, whatever the instant of the call;
+ *   - reads the state within JITTER seconds of k PERIOD (the first read at t = 0);
+ *   - applies u at most DELAY seconds after that read and holds it until the next u is
+ *     applied; before the first u is applied, the input is zero.
+ * The step does not measure time: it cannot see a late call or a wrong t.
+ * After t_c (PRESCRIBED_TIME) keep calling: the tube is the target tube, and the stay part
+ * of the task holds as long as the loop runs.
+ * On each status: OK: apply u. OUTSIDE_TUBE: u is finite
+ * but the guarantee is void (the plant, the timing or the measured state is outside what
+ * was proved): apply the system's fallback (stop, or hand over). INVALID_INPUT: u = 0, a
+ * software fault (a NULL pointer, a non-finite state or time): stop.
+ */
+/** The sampling period the certificate covers, s: 1 / RATE_HZ (pass it as dt). */
+#define OMNIROBOT_S2_PERIOD 0.001f
+/** The largest computation delay the certificate covers, s ([controller] delay). */
+#define OMNIROBOT_S2_DELAY 0.0f
+/** The sampling jitter the certificate covers, s ([controller] jitter). */
+#define OMNIROBOT_S2_JITTER 0.0f
 /** Smallest valid dt, seconds: 2^-20 (a sampling rate of about 1 MHz). */
 #define OMNIROBOT_S2_DT_MIN 9.5367431640625e-07f
 /** Largest valid dt, seconds: the smallest power of two >= t_c. */
