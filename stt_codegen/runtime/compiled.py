@@ -35,12 +35,14 @@ CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fPIC", "-shared", "-Wall", "
 
 
 class _DesignSpec:
-    """The two spec attributes code generation reads, for a design without its spec."""
+    """The spec attributes code generation reads, for a design without its spec (the
+    timing contract's numbers are the header's text only: the step does not read them)."""
 
     def __init__(self, design: TubeDesign) -> None:
         self.name = design.name if NAME_PATTERN.fullmatch(design.name) else "stt"
         self.c_name = self.name.replace("-", "_")
         self.source_hash = "design:" + hashlib.sha256(repr(design).encode()).hexdigest()
+        self.delay = self.jitter = 0.0
 
 
 def cache_dir() -> Path:
