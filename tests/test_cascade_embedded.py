@@ -19,6 +19,9 @@ def test_cascade_on_the_cortex_m4f_is_satisfied_like_the_host(case) -> None:
     assert report["outside_position"] == report["outside_velocity"] == report["invalid"] == 0
     assert len(report["instructions_per_step"]) == len(COUNT_FRACTIONS)
     assert all(1000 < c < 20000 for c in report["instructions_per_step"])
+    assert report["instructions_worst"] == max(report["instructions_per_step"])
+    assert report["period_share_lower"] == pytest.approx(
+        report["instructions_worst"] / 168e6 * design.spec.rate_hz)
     if case == "second-order-quadrotor":
         # the target (exact emulated counts, not time): at most 3000 on average;
         # no log or exp of these steps reaches newlib

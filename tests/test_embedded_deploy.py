@@ -58,6 +58,10 @@ def test_embedded_case(case, reports, tmp_path_factory, capsys) -> None:
     assert all(1000 < c < 50000 for c in counts)
     assert max(counts) < 1.3 * min(counts)             # branch-free body, libm varies a little
     assert r["instructions_per_step"] == round(sum(counts) / len(counts))
+    # the timing contract's budget: the worst measured step at 168 MHz, within the period
+    assert r["instructions_worst"] == max(counts) and r["steps_measured"] == len(counts)
+    assert r["period_share_lower"] == pytest.approx(max(counts) / 168e6 * 1000.0)
+    assert r["period_share_lower"] < 0.2
     # where they go: the per-function means add up to the mean count; every exp of a
     # normal step takes stt_expf's fast path (newlib's expf is never entered)
     by_function = r["instructions_detail"]["by_function"]

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..embedded.budget import budget_words
 from ..errors import SpecError
 from .common import (add_json_argument, add_seed_argument, add_spec_argument, checked_seed,
                      load_and_design, print_json)
@@ -33,7 +34,7 @@ def _print_report(r: dict) -> None:
           f"RAM {r['ram_bytes']} B, stack {r['stack_bytes']} B static "
           f"({r['stack_bytes_measured']} B measured)")
     print(f"  {r['instructions_per_step']} instructions per step "
-          f"(counts {r['instructions_detail']['counts']})")
+          f"(counts {r['instructions_detail']['counts']}); {budget_words(r)}")
     top = list(r["instructions_detail"]["by_function"].items())[:6]
     if top:
         print("  most instructions in: " + ", ".join(
@@ -106,7 +107,7 @@ def variant_loop_command(design, args: argparse.Namespace, seed: int) -> int:
               "mps2-an386): "
               f"{'satisfied' if report['satisfied'] else 'NOT satisfied'}, reach "
               f"{report['reach_time']} s, clearance {report['min_clearance']:.3f}"
-              f"{_judged(report)}, {report['instructions_per_step']} instructions per step")
+              f"{_judged(report)}; {budget_words(report)}")
     return 0 if report["satisfied"] else 1
 
 

@@ -49,6 +49,7 @@ from ..runtime.plants import check_seed
 from ..tube.parameters import TubeDesign
 from . import board
 from .footprint import elf_stack_bound, linked_sizes, measure
+from .budget import step_budget
 from .programs import (closed_loop_source, judge_printed, parse_closed_loop, parse_replay,
                        replay_source, steps_of)
 from .target import CPU_FLAGS, build_elf, run_qemu
@@ -278,6 +279,7 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
         **errors,
         **closed,
         "instructions_per_step": int(round(float(np.mean(counts)))) if counts else None,
+        **step_budget(counts, design.tube.rate_hz),
         "instructions_detail": {
             "steps": ks, "t": [float(v) for v in t_r], "counts": counts,
             "how": "exact count of emulated Thumb-2 instructions of one P_step call (argument "

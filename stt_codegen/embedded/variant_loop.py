@@ -18,6 +18,7 @@ from pathlib import Path
 from ..design.result import Design
 from ..errors import ToolchainError
 from .deploy import COUNT_FRACTIONS, function_profile
+from .budget import step_budget
 from .programs import (ClosedLoopOutput, judge_printed, parse_closed_loop, replay_source,
                        steps_of)
 from .target import build_elf, elf_sizes, run_qemu
@@ -88,6 +89,7 @@ def run_variant_loop(design: Design, files: dict[str, str], prefix: str,
         counted = run_qemu(measured.elf, timeout=timeout, count_instructions=True)
         sizes = elf_sizes(full.objects[0])
     return output, {"instructions_per_step": list(counted.instructions or []),
+                    **step_budget(list(counted.instructions or []), design.tube.rate_hz),
                     "measured_times": [float(v[0]) for v in inputs],
                     "instructions_by_function": function_profile(counted.functions or []),
                     "flash_bytes_controller": sizes}
