@@ -153,22 +153,6 @@ def test_the_command_line_refuses_it_with_exit_2_and_one_line(tmp_path):
     assert "controller.delay" in run.stderr
 
 
-@pytest.mark.parametrize("case", ["second-order-s1", "second-order-quadrotor"])
-def test_a_variant_whose_certificate_has_no_delay_refuses_it(case):
-    """The cascade has no delayed certificate yet: a delay is refused naming the field, not
-    silently ignored."""
-    raw = stt.load_spec(case)
-    period = 1.0 / raw.rate_hz
-    from stt_codegen.cases import bundled_spec_bytes
-    import tomllib
-    doc = tomllib.loads(bundled_spec_bytes(case).decode())
-    doc.setdefault("controller", {})["delay"] = 0.1 * period
-    with pytest.raises(stt.SpecError) as raised:
-        stt.Spec.from_dict(doc)
-    assert raised.value.field == "controller.delay"
-    assert "law (13)'s variants take them" in str(raised.value)
-
-
 def test_specs_without_delay_keep_zero():
     spec = stt.load_spec("omnirobot-s1")
     assert (spec.delay, spec.jitter) == (0.0, 0.0)

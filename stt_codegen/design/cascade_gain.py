@@ -46,7 +46,8 @@ from .certificate.cascade_sampled import certify_stage
 from .input_bound import InputProof
 
 __all__ = ["RATE_SEARCH_FACTOR", "SHAPES", "cascade_input_proof", "certified_stage",
-           "derived_second_stage", "lowest_certified_rate", "second_stage_for", "tube_speed"]
+           "derived_second_stage", "fastest_searched_rate", "lowest_certified_rate",
+           "second_stage_for", "tube_speed"]
 
 
 #: The shapes of the second stage the design tries, in order, until the sampled cascade's
@@ -248,8 +249,11 @@ def cascade_input_proof(tube: TubeDesign, spec, min_width: float) -> InputProof:
 
 
 def _rate_certified(tube: TubeDesign, spec, rate_hz: float) -> bool:
-    """Whether some shape is certified at ``rate_hz`` (the tube certified again there)."""
+    """Whether some shape is certified at ``rate_hz`` (the tube certified again there);
+    not where the period is shorter than ``[controller] delay + 2 jitter``."""
     from .certificate import certify_tube
+    if spec.delay + 2.0 * spec.jitter > 1.0 / rate_hz:
+        return False                   # the delay (s) and jitter must fit the period
     trial = dataclasses.replace(tube, rate_hz=rate_hz)     # the tubes kept, not the bound
     certificate = certify_tube(trial, spec)
     return bool(certificate.passed) and certified_stage(
@@ -260,12 +264,36 @@ def _rate_certified(tube: TubeDesign, spec, rate_hz: float) -> bool:
 RATE_SEARCH_FACTOR = 16.0
 
 
+def fastest_searched_rate(rate_hz: float, spec) -> float:
+    """The fastest rate :func:`lowest_certified_rate` tries upwards: ``RATE_SEARCH_FACTOR``
+    times ``rate_hz``, and no faster than ``1 / (delay + 2 jitter)`` (``[controller]``: a
+    shorter period cannot hold the delay).
+
+    Parameters
+    ----------
+    rate_hz : float
+        The rate searched from, Hz.
+    spec : Spec
+        Its ``delay`` and ``jitter``.
+
+    Returns
+    -------
+    float
+        Hz.
+    """
+    timing = spec.delay + 2.0 * spec.jitter
+    fastest = rate_hz * RATE_SEARCH_FACTOR
+    return min(fastest, 1.0 / timing) if timing > 0.0 else fastest
+
+
 def lowest_certified_rate(tube: TubeDesign, spec, passes_at_rate: bool) -> float | None:
     """The smallest rate on the two-digit grid (:mod:`.grid`) at which a shape of
     :data:`SHAPES` is certified, between ``rate / RATE_SEARCH_FACTOR`` and ``rate *
     RATE_SEARCH_FACTOR`` (bisection: a faster rate is assumed not to break the
-    certificate; every rate reported was certified). ``None`` when even the fastest
-    fails; the lowest end when it passes there.
+    certificate; every rate reported was certified). With ``[controller] delay`` or
+    ``jitter`` the search stops at the fastest rate whose period holds ``delay + 2
+    jitter`` (:func:`fastest_searched_rate`). ``None`` when even the fastest fails; the
+    lowest end when it passes there.
 
     Parameters
     ----------
@@ -291,8 +319,11 @@ def lowest_certified_rate(tube: TubeDesign, spec, passes_at_rate: bool) -> float
             return grid_value(low) if high > low else rate
         best = smallest_passing(lambda j: _rate_certified(tube, spec, grid_value(j)), low, high)
         return grid_value(best) if _rate_certified(tube, spec, grid_value(best)) else rate
-    low, high = grid_index(rate), grid_index(rate * RATE_SEARCH_FACTOR)
-    if not _rate_certified(tube, spec, grid_value(high)):
+    fastest = fastest_searched_rate(rate, spec)
+    low, high = grid_index(rate), grid_index(fastest)
+    if grid_value(high) > fastest:
+        high -= 1                      # the grid's last rate whose period holds the timing
+    if high <= low or not _rate_certified(tube, spec, grid_value(high)):
         return None
     return grid_value(smallest_passing(lambda j: _rate_certified(tube, spec, grid_value(j)),
                                        low, high))
@@ -356,8 +387,9 @@ def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage
             tried=tube)
     rate = lowest_certified_rate(tube, spec, passes_at_rate=False)
     need = (f"controller.rate_hz = {rate:g} is certified" if rate is not None else
-            f"no rate up to {tube.rate_hz * RATE_SEARCH_FACTOR:g} Hz is certified; a longer "
-            "prescribed_time (a slower tube) or a narrower assumptions.input_gain may be")
+            f"no rate up to {fastest_searched_rate(tube.rate_hz, spec):g} Hz is certified; a "
+            "longer prescribed_time (a slower tube) or a narrower assumptions.input_gain may "
+            "be")
     first = derivation["tried"][0]["reason"]
     raise DesignError(f"the sampled cascade is not certified at controller.rate_hz = "
                       f"{tube.rate_hz:g} Hz for the declared plants with any second stage "

@@ -17,6 +17,7 @@ from dataclasses import replace
 
 from ..errors import DesignError, number_text
 from ..spec.loader import Spec
+from ..spec.variants import variant_of
 from ..tube import reference
 from .certificate.plant_class import plant_class
 from .certificate.sampled import (DELAY_HALVINGS, check_sampled_first_per_axis,
@@ -76,7 +77,8 @@ def design_with_timing(spec: Spec, search: Callable[[Spec], Design]) -> Design:
     Parameters
     ----------
     spec : Spec
-        With ``delay > 0`` or ``jitter > 0`` (a first-order or look-ahead variant).
+        With ``delay > 0`` or ``jitter > 0``. A variant whose stage's certificate proves
+        the timing (``timing_in_stage``, the cascade) is designed by ``search`` alone.
     search : callable
         ``search(spec) -> Design``: the design search of
         :func:`~stt_codegen.design.search.design_tube`, which reads no timing itself.
@@ -95,6 +97,8 @@ def design_with_timing(spec: Spec, search: Callable[[Spec], Design]) -> Design:
         :func:`~stt_codegen.design.search.design_tube` certifies them; the search's own
         error when the spec fails without the timing too.
     """
+    if variant_of(spec).timing_in_stage:        # the stage's certificate reads the timing
+        return search(spec)
     try:
         return _certified(spec, search)
     except DesignError as failure:

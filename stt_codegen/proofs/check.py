@@ -132,7 +132,7 @@ class VerificationReport:
         """The rows of :meth:`summary`: the checks passed by family (the name up to its
         first word after a dot: ``lemma3.3``, ``tube``), every failed check, and the key figures the checks carry: the smallest
         certified margin of the tube, the tube's move per sample, and the sampled loop's
-        checks (``sampled.*``, ``cascade.sampled``, ``cascade.input_bound``).
+        checks (``sampled.*``, ``cascade.sampled``, ``cascade.delay``, ``cascade.input_bound``).
 
         Returns
         -------
@@ -154,7 +154,7 @@ class VerificationReport:
             rows.append(("smallest margin", f"{margin:.4g} ({name})"))
         for c in self.checks:
             if c.passed and (c.name == "tube.sampling_rate" or c.name.startswith(
-                    ("sampled.", "cascade.sampled", "cascade.input_bound"))):
+                    ("sampled.", "cascade.sampled", "cascade.delay", "cascade.input_bound"))):
                 rows.append(("PASS", f"{c.name}: {c.detail}"))
         return rows
 

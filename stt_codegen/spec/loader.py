@@ -779,12 +779,12 @@ def _validate(raw: dict) -> Spec:
                 task_order=doc.task_order.order if doc.task_order is not None else "listed",
                 moving_obstacles=moving, robot=robot,
                 mujoco=_mujoco(doc.plant, n),
-                drive=drive, **_timing(doc.controller, doc.plant.model))
+                drive=drive, **_timing(doc.controller))
 
 
-def _timing(table: ControllerTable, model: str) -> dict[str, float]:
-    """``[controller] delay`` and ``jitter``, checked against the period and the variant's
-    certificate (docs/sampled-data.md, "Computation delay and jitter")."""
+def _timing(table: ControllerTable) -> dict[str, float]:
+    """``[controller] delay`` and ``jitter``, checked against the period (docs/sampled-data.md,
+    "Computation delay and jitter")."""
     delay, jitter = table.delay, table.jitter
     period = 1.0 / table.rate_hz
     if delay + 2.0 * jitter > period:
@@ -793,13 +793,6 @@ def _timing(table: ControllerTable, model: str) -> dict[str, float]:
                                     f"exceeds the period 1 / rate_hz = {number_text(period)} s "
                                     "(the proof needs each command to act within the period "
                                     "it was computed for)")
-    variant = variant_of(plant_entry(model))
-    if (delay > 0.0 or jitter > 0.0) and not variant.timing_certified:
-        field_name = "controller.delay" if delay > 0.0 else "controller.jitter"
-        raise SpecError(field_name, f"the {variant.name} variant ({variant.plant_words}) has no "
-                                    "sampled-data certificate with a computation delay or "
-                                    "jitter yet; law (13)'s variants take them "
-                                    "(docs/sampled-data.md, \"Computation delay and jitter\")")
     return {"delay": float(delay), "jitter": float(jitter)}
 
 

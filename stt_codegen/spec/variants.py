@@ -93,10 +93,10 @@ class ControllerVariant:
     replay_context : mapping of str to bool
         Extra variables of the firmware replay program's template
         (``embedded_replay.c.j2``).
-    timing_certified : bool
-        Its sampled-data certificate covers ``[controller] delay`` and ``jitter``
-        (docs/sampled-data.md, "Computation delay and jitter"); the loader refuses them
-        for a variant without.
+    timing_in_stage : bool
+        The certificate of its stage (:attr:`~stt_codegen.design.result.Design.stage`)
+        proves ``[controller] delay`` and ``jitter`` (the cascade's); else the design's
+        sampled-data proof of law (13) must hold with them (:mod:`~stt_codegen.design.timing`).
 
     Examples
     --------
@@ -117,7 +117,7 @@ class ControllerVariant:
     state_words: str
     roles: Mapping[str, str]
     replay_context: Mapping[str, bool] = field(default_factory=lambda: MappingProxyType({}))
-    timing_certified: bool = False
+    timing_in_stage: bool = False
 
     def entry(self, role: str) -> Callable[..., Any]:
         """The variant's function (or class) for one role, imported on first use.
@@ -197,8 +197,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                embedded_command=_P + "cli.embedded:law13_command",
                model_checks=_P + "verification.command:first_order_model_checks",
                sampled_checks=_P + "verification.command:first_order_sampled_checks",
-               plant_within=_P + "verification.plant_within:first_order_within"),
-        timing_certified=True),
+               plant_within=_P + "verification.plant_within:first_order_within")),
     "cascade": ControllerVariant(
         "cascade", "a second-order plant", "the cascade's input u", 2,
         " (positions, then velocities)",
@@ -225,7 +224,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                model_checks=_P + "verification.command:no_model_checks",
                sampled_checks=_P + "verification.command:cascade_sampled_checks",
                plant_within=_P + "verification.plant_within:cascade_within"),
-        MappingProxyType({"cascade": True})),
+        MappingProxyType({"cascade": True}), timing_in_stage=True),
     "look-ahead": ControllerVariant(
         "look-ahead", "a differential-drive base", "the base's command (v, omega)", 1, "",
         _roles(plant_terms=_P + "spec.loader:look_ahead_plant_terms",
@@ -250,8 +249,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                embedded_command=_P + "cli.embedded:variant_loop_command",
                model_checks=_P + "verification.command:look_ahead_model_checks",
                sampled_checks=_P + "verification.command:look_ahead_sampled_checks",
-               plant_within=_P + "verification.plant_within:first_order_within"),
-        timing_certified=True),
+               plant_within=_P + "verification.plant_within:first_order_within")),
 })
 assert tuple(CONTROLLER_VARIANTS) == VARIANTS
 

@@ -4,16 +4,29 @@
 certificate (:mod:`stt_codegen.design.certificate.cascade_sampled`), and, with
 ``[actuator]``, ``cascade.input_bound`` (:func:`cascade_input_bound_check`) its certified
 peak of each physical input against the bound; ``cascade.plant_within_assumptions``
-(:func:`plant_within_class_check`) whether the spec's plant lies in the certified class.
-The cascade's SymPy proofs are :mod:`stt_codegen.proofs.cascade`.
+(:func:`plant_within_class_check`) whether the spec's plant lies in the certified class;
+``cascade.delay`` (:func:`cascade_delay_check`) the largest computation delay the
+certificate proves. The cascade's SymPy proofs are :mod:`stt_codegen.proofs.cascade`.
 """
 
 from __future__ import annotations
 
 from ..proofs.check import Check
 
-__all__ = ["cascade_input_bound_check", "judged_stage", "plant_within_class_check",
-           "sampled_cascade_check"]
+__all__ = ["CASCADE_DELAY_HALVINGS", "cascade_delay_check", "cascade_input_bound_check",
+           "judged_stage", "plant_within_class_check", "sampled_cascade_check"]
+
+#: Halvings of the bisection of ``cascade.delay`` (the first order's ``DELAY_HALVINGS``:
+#: a resolution of ``h / 64``).
+CASCADE_DELAY_HALVINGS = 6
+
+
+def _timing_words(spec) -> str:
+    """`` with a computation delay up to ... and jitter ...`` when the spec has them."""
+    parts = ([f"a computation delay up to {spec.delay * 1000:.4g} ms"] if spec.delay > 0.0
+             else []) + ([f"sampling jitter {spec.jitter * 1000:.4g} ms"] if spec.jitter > 0.0
+                         else [])
+    return (" with " + " and ".join(parts)) if parts else ""
 
 
 def sampled_cascade_check(spec, tube, min_width: float) -> Check:
@@ -36,18 +49,19 @@ def sampled_cascade_check(spec, tube, min_width: float) -> Check:
     Check
         PASS when the certificate holds at the spec's rate; FAIL with its figures otherwise.
     """
-    from ..design.cascade_gain import lowest_certified_rate
+    from ..design.cascade_gain import fastest_searched_rate, lowest_certified_rate
     from ..design.certificate.cascade_sampled import cascade_check_of
     stage, derivation = judged_stage(spec, tube, min_width)
     result = cascade_check_of(tube, spec, stage)
     rate = lowest_certified_rate(tube, spec, passes_at_rate=result.passed)
     lowest = (f"lowest certified rate {rate:g} Hz (on the two-digit grid, a second stage "
               "derived there)" if rate is not None else
-              f"no rate up to {tube.rate_hz * 16:g} Hz is certified")
+              f"no rate up to {fastest_searched_rate(tube.rate_hz, spec):g} Hz is certified")
     words = result.data["class"]
+    timing = _timing_words(spec)
     if result.passed:
         detail = (f"proved: every plant with {words} keeps |e1| < 1 and |e2| < 1 at and "
-                  f"between samples at {tube.rate_hz:g} Hz over [0, "
+                  f"between samples at {tube.rate_hz:g} Hz{timing} over [0, "
                   f"{result.data['horizon']:.4g}] s, with k1 = {stage.position_gain:.4g}, "
                   f"k2 = {stage.velocity_gain:.4g}, rho2 from {max(stage.width_start):.4g} "
                   f"to {min(stage.width_floor):.4g} (l = {stage.decay:.4g}): |e1| <= "
@@ -58,12 +72,59 @@ def sampled_cascade_check(spec, tube, min_width: float) -> Check:
                   f"|u_i| <= {[round(v, 4) for v in result.peak_input]}, |x2_i| <= "
                   f"{[round(v, 4) for v in result.peak_velocity]}; {lowest}")
     else:
-        detail = (f"not proved at {tube.rate_hz:g} Hz for plants with {words}: "
+        detail = (f"not proved at {tube.rate_hz:g} Hz{timing} for plants with {words}: "
                   f"{result.reason}; {lowest}")
     data = {**result.data, "passed": result.passed, "reason": result.reason,
             "time": result.time, "dimension": result.dimension, "lowest_rate_hz": rate,
             "gains": derivation}
     return Check("cascade.sampled", result.passed, detail, data)
+
+
+def cascade_delay_check(spec, tube, min_width: float,
+                        halvings: int = CASCADE_DELAY_HALVINGS) -> Check:
+    """``cascade.delay``: the largest computation delay the sampled cascade's certificate
+    proves for the deployed second stage at the design's rate with the spec's jitter
+    (:func:`~stt_codegen.design.certificate.cascade_sampled.largest_cascade_delay`), at
+    least the spec's ``[controller] delay``; the cascade's ``sampled.delay``.
+
+    Parameters
+    ----------
+    spec : Spec
+        With a second-order ``plant.model``: its plants, ``delay`` and ``jitter``.
+    tube : TubeDesign
+        The position tube; the second stage is :func:`judged_stage`'s.
+    min_width : float
+        ``gamma_d,min`` of the tube's certificate.
+    halvings : int, optional
+        Halvings of the bisection (a resolution of ``h / 2^halvings``).
+
+    Returns
+    -------
+    Check
+        Data: ``largest_delay_s`` (``None`` when the certificate fails without delay),
+        ``period_s``, ``delay_s``, ``jitter_s``. Fails when the largest proved delay is
+        below the spec's.
+    """
+    from ..design.certificate.cascade_sampled import largest_cascade_delay
+    h = 1.0 / tube.rate_hz
+    stage, _ = judged_stage(spec, tube, min_width)
+    largest = largest_cascade_delay(tube, spec, stage, halvings)
+    data = {"largest_delay_s": largest, "period_s": h, "delay_s": spec.delay,
+            "jitter_s": spec.jitter}
+    jitter = f" with jitter {spec.jitter:g} s" if spec.jitter > 0.0 else ""
+    if largest is None:
+        return Check("cascade.delay", False, "no computation delay is proved: the sampled "
+                     f"cascade's certificate fails without one{jitter} (cascade.sampled)",
+                     data)
+    passed = largest >= spec.delay
+    detail = (f"a computation delay up to {largest * 1000:.4g} ms ({largest / h:.1%} of the "
+              f"period {h * 1000:g} ms) is tolerated: every plant of the class keeps |e1| < 1 "
+              f"and |e2| < 1 when each force acts up to that long after its state is "
+              f"read{jitter}, at {tube.rate_hz:g} Hz with k1 = {stage.position_gain:.4g}, "
+              f"k2 = {stage.velocity_gain:.4g} (the largest the certificate proves, to "
+              f"1/{2 ** halvings} of the period; controller.delay = {spec.delay:g} s"
+              + (")" if passed else ", beyond it)"))
+    return Check("cascade.delay", passed, detail, data)
 
 
 def judged_stage(spec, tube, min_width: float) -> tuple:

@@ -347,12 +347,13 @@ def cascade_sampled_checks(spec: Spec, design: TubeDesign, tube_check,
     list of Check
     """
     from ..proofs.cascade import cascade_checks
-    from .cascade import (cascade_input_bound_check, plant_within_class_check,
-                          sampled_cascade_check)
+    from .cascade import (cascade_delay_check, cascade_input_bound_check,
+                          plant_within_class_check, sampled_cascade_check)
     progress("sampled loop")          # the cascade takes the sampled loop's slot
     checks = cascade_checks(min(design.dimension, 2)) + [
         plant_within_class_check(spec),
-        sampled_cascade_check(spec, design, tube_check.min_width)]
+        sampled_cascade_check(spec, design, tube_check.min_width),
+        cascade_delay_check(spec, design, tube_check.min_width)]
     if spec.input_bound is not None:     # the physical input u: force or torque
         checks.append(cascade_input_bound_check(spec, design, tube_check.min_width))
     return checks

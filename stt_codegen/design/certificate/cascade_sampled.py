@@ -18,6 +18,11 @@ and, on each sampling interval, reuses the first-order per-axis enclosure
   W)``), the other axes' inputs through the coupling, and the change of ``r`` along the
   trajectory, bounded by :func:`virtual_velocity_change` (uniform on the interval).
 
+With ``[controller] delay`` and ``jitter`` (``delay=``, ``jitter=``) the previous force
+acts for the first ``lag`` of each measurement interval and the interval's length varies;
+the check takes the corners of both, as the first order does (docs/second-order.md, "A
+computation delay and jitter").
+
 The argument, its assumptions and what it does not prove: docs/second-order.md, "The
 sampled cascade (certificate)". Plain floats in the loop, like :mod:`.sampled`.
 """
@@ -39,11 +44,12 @@ from ...spec.variants import require_variant
 from ...tube import reference
 from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from ...tube.second_stage import SecondStage
+from .sampled import DELAY_HALVINGS
 from .sampled_axis import axis_interval, peak, phi_scalar, phi_slope_scalar
 
 __all__ = ["CascadeClass", "CascadeCheck", "cascade_check_of", "cascade_class", "model_within_class",
-           "certify_stage", "check_cascade_sampled", "step_velocity_change",
-           "virtual_velocity_change"]
+           "certify_stage", "check_cascade_sampled", "largest_cascade_delay",
+           "step_velocity_change", "virtual_velocity_change"]
 
 #: Relative safety factor on the closed-form ``rho2(t_{k+1})`` the path is judged against
 #: (rounding of ``exp``; every margin reported is far above it).
@@ -267,8 +273,31 @@ def step_velocity_change(k1: float, h: float, a: float, b: float, shift: float,
     return worst
 
 
+def _union(intervals) -> tuple[float, float, float, float]:
+    """The union of :func:`~.sampled_axis.axis_interval`'s ``(path_lo, path_hi, end_lo,
+    end_hi)`` over corners."""
+    p_lo = x_lo = math.inf
+    p_hi = x_hi = -math.inf
+    for a_lo, a_hi, b_lo, b_hi in intervals:
+        p_lo, p_hi = min(p_lo, a_lo), max(p_hi, a_hi)
+        x_lo, x_hi = min(x_lo, b_lo), max(x_hi, b_hi)
+    return p_lo, p_hi, x_lo, x_hi
+
+
+def _near(values: np.ndarray, jitter: float, pick) -> np.ndarray:
+    """``values[k]`` (rows per interval), or with jitter the worst (``pick``:
+    ``np.minimum`` or ``np.maximum``) of intervals ``k - 1 .. k + 1``, as the first order's
+    sampled check widens its bounds."""
+    if not jitter > 0.0:
+        return values
+    before = np.concatenate([values[:1], values[:-1]])
+    after = np.concatenate([values[1:], values[-1:]])
+    return pick(pick(before, values), after)
+
+
 def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: SecondStage,
-                          plants: CascadeClass, initial_velocity) -> CascadeCheck:
+                          plants: CascadeClass, initial_velocity, *, delay: float = 0.0,
+                          jitter: float = 0.0) -> CascadeCheck:
     """Prove that the sampled cascade keeps ``|e1| < 1`` and ``|e2| < 1`` at and between
     samples for every plant of ``plants`` (module docstring; docs/second-order.md).
 
@@ -284,13 +313,41 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     plants : CascadeClass
     initial_velocity : sequence of float, length n
         ``x2(0)``.
+    delay : float
+        Largest computation delay, s (``[controller] delay``): the force computed from the
+        state read at ``s_k`` acts from ``s_k + lag``, ``lag`` in ``[0, delay]`` (any,
+        varying from sample to sample); before, the previous force acts (zero before the
+        first).
+    jitter : float
+        Sampling jitter, s (``[controller] jitter``): ``|s_k - k h| <= jitter``, ``s_0 =
+        0``; the controller is called with the nominal ``t = k h``. ``delay + 2 jitter``
+        must not exceed ``h``. With both 0 (the default) the check is the one without
+        timing, float for float.
 
     Returns
     -------
     CascadeCheck
+
+    Raises
+    ------
+    ValueError
+        ``delay`` or ``jitter`` negative, or ``delay + 2 jitter > h``.
     """
     n = design.dimension
     h = 1.0 / design.rate_hz
+    if delay < 0.0 or jitter < 0.0 or delay + 2.0 * jitter > h * (1.0 + 1e-12):
+        raise ValueError(f"delay = {delay!r} s and jitter = {jitter!r} s must be >= 0 with "
+                         f"delay + 2 jitter <= dt = {h!r} s")
+    timed = delay > 0.0 or jitter > 0.0
+    # a measurement interval [s_k, s_{k+1}] lasts L in [h - 2 jitter, h + 2 jitter]; the
+    # previous force acts for its first `lag` in [0, delay], this one for the rest, a
+    # `share` (L - lag) / h of a period (docs/second-order.md, "A computation delay and
+    # jitter"): the velocity stage's bounds are affine in (L, lag), the position stage's
+    # in L, so their corners cover every L and lag
+    longest = h + 2.0 * jitter
+    lengths = (h - 2.0 * jitter, longest)
+    corners = sorted({(max(0.0, (length - lag) / h), lag) for length in lengths
+                      for lag in (0.0, delay)})
     k1, k2 = stage.position_gain, stage.velocity_gain
     g_min, g_max, cpl = plants.g_min, plants.g_max, plants.coupling
     f0, f1, w_amp = plants.drift_bound, plants.drift_slope, plants.disturbance_bound
@@ -298,6 +355,8 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     data = {"rate_hz": design.rate_hz, "position_gain": k1, "velocity_gain": k2,
             "width_start": list(stage.width_start), "width_floor": list(stage.width_floor),
             "decay": stage.decay, "class": plants.words()}
+    if timed:
+        data.update({"delay": delay, "jitter": jitter})
     peak_u, peak_x2, peak_t = [0.0] * n, [0.0] * n, [0.0] * n
     worst = {"position": math.inf, "velocity": math.inf, "least": math.inf, "t": 0.0,
              "i": 0}
@@ -312,7 +371,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
                             tuple(peak_x2), worst["t"] if passed else t,
                             worst["i"] if passed else i, data, tuple(peak_t))
 
-    if not 0.0 < g_min <= g_max or h * f1 >= 1.0:
+    if not 0.0 < g_min <= g_max or (longest if timed else h) * f1 >= 1.0:
         return result(False, "need 0 < g_min <= g_max and h F1 < 1")
     if min(stage.width_floor) < GAMMA_D_MIN:
         return result(False, f"rho2_inf is below GAMMA_D_MIN = {GAMMA_D_MIN:g}")
@@ -333,12 +392,30 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     pull1 = (4.0 * h * k1 / (hi - lo)).tolist()
     peak1 = peak(0.5 * (hi - lo) / (4.0 * h * k1 / (hi - lo))).tolist()
     half_l, centre_l = half.tolist(), centre.tolist()
-    up_e = ((enc.upper_min - centre[:count]) / half[:count]).tolist()
-    low_e = ((enc.lower_max - centre[:count]) / half[:count]).tolist()
-    room_up, room_low = enc.upper_min.tolist(), enc.lower_max.tolist()
-    width_min = enc.width_min.tolist()
-    width_max = (enc.upper_max - enc.lower_min).tolist()
-    move = ((enc.lower_max - enc.lower_min) + (enc.upper_max - enc.upper_min)).tolist()
+    # with jitter an interval reaches into its neighbours: the tube's enclosure is the
+    # worst of intervals k - 1 .. k + 1, in absolute units (then in interval k's coordinates)
+    upper_min, lower_max = (_near(enc.upper_min, jitter, np.minimum),
+                            _near(enc.lower_max, jitter, np.maximum))
+    upper_max, lower_min = (_near(enc.upper_max, jitter, np.maximum),
+                            _near(enc.lower_min, jitter, np.minimum))
+    up_e = ((upper_min - centre[:count]) / half[:count]).tolist()
+    low_e = ((lower_max - centre[:count]) / half[:count]).tolist()
+    room_up, room_low = upper_min.tolist(), lower_max.tolist()
+    width_min = _near(enc.width_min, jitter, np.minimum).tolist()
+    width_max = (upper_max - lower_min).tolist()
+    move = ((lower_max - lower_min) + (upper_max - upper_min)).tolist()
+    if timed:
+        # s* of each share of a period the own force (the virtual velocity) acts
+        shares1 = sorted({length / h for length in lengths})
+        peaks1 = {share: peak(0.5 * (hi - lo) / (share * 4.0 * h * k1 / (hi - lo))).tolist()
+                  for share in shares1}
+        peaks2 = {share: peak(rho2_all[:count] / (g_min * share * pull2_all)).tolist()
+                  if share > 0.0 else np.full((count, n), 1.0 - 1e-15).tolist()
+                  for share in sorted({share for share, _ in corners})}
+        # rho2 decreases: its least on a measurement interval is at t_{k+1} + jitter
+        late = ((start - floor)[None, :] * np.exp(-stage.decay * (samples.t[1:count + 1, None]
+                                                                  + jitter))
+                + floor[None, :]).tolist()
     x1_0 = np.array(design.initial_state, dtype=float)
     e1_0 = ((x1_0 - centre[0]) / half[0]).tolist()
     r0 = [-(4.0 * k1 / (2.0 * half_l[0][i])) * phi_scalar(e1_0[i]) for i in range(n)]
@@ -346,6 +423,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     e2_0 = [(x2_0[i] - r0[i]) / rho2[0][i] for i in range(n)]
     box1 = [[v, v] for v in e1_0]
     box2 = [[v, v] for v in e2_0]
+    u_prev = [0.0] * n                                    # no force before the first
     spread = g_max - g_min
     every = max(1, count // PROGRESS_REPORTS)
     for k in range(count):
@@ -364,6 +442,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
         rho_k, rho_n = rho2[k], rho2[k + 1]
         u_abs = [2.0 * k2 / rho_k[i] * phi_scalar(reach2[i]) for i in range(n)]
         u_sq = sum(v * v for v in u_abs)
+        u_prev_sq = sum(v * v for v in u_prev)
         next1, next2 = [], []
         for i in range(n):
             if u_abs[i] > peak_u[i]:
@@ -371,19 +450,35 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
             others = math.sqrt(max(u_sq - u_abs[i] ** 2, 0.0))
             z_abs = reach2[i] * rho_k[i]
             r_abs = 4.0 * k1 / (2.0 * half_l[k][i]) * phi_scalar(reach1[i])
-            push_free = g_max * u_abs[i] + cpl * others + f0 + w_amp   # |x2_dot| without F1
-            speed = (r_abs + z_abs + h * push_free) / (1.0 - h * f1)
+            if not timed:
+                push_free = g_max * u_abs[i] + cpl * others + f0 + w_amp  # |x2_dot| w/o F1
+                speed = (r_abs + z_abs + h * push_free) / (1.0 - h * f1)
+            else:
+                # the force is u_{k-1} for the lag, then u_k: x2 moves under the larger
+                force_old = g_max * u_prev[i] + cpl * math.sqrt(
+                    max(u_prev_sq - u_prev[i] ** 2, 0.0)) if delay > 0.0 else 0.0
+                force = max(g_max * u_abs[i] + cpl * others, force_old)
+                speed = (r_abs + z_abs + longest * (force + f0 + w_amp)) / (1.0 - longest * f1)
             peak_x2[i] = max(peak_x2[i], speed)
             if vbound is not None and speed >= vbound[i]:
                 return result(False, f"|x2_{i}| may reach {speed:.4g} on [{t:.4f}, "
                               f"{t + h:.4f}] s, beyond velocity_bound {vbound[i]:g} (the "
                               "drift bound is declared within it)", t, i)
             drift = f0 + f1 * speed + w_amp
-            accel = g_max * u_abs[i] + cpl * others + drift
-            # position stage: law (13) with g = 1 and a displacement <= tau (Z + h A / 2)
-            p_lo, p_hi, x_lo, x_hi = axis_interval(
-                box1[i][0], box1[i][1], centre_l[k][i], half_l[k][i], pull1[k][i], 1.0, 1.0,
-                peak1[k][i], h * z_abs + 0.5 * h * h * accel)
+            if not timed:
+                accel = g_max * u_abs[i] + cpl * others + drift
+                # position stage: law (13) with g = 1 and a displacement <= tau (Z + h A/2)
+                shift = h * z_abs + 0.5 * h * h * accel
+                p_lo, p_hi, x_lo, x_hi = axis_interval(
+                    box1[i][0], box1[i][1], centre_l[k][i], half_l[k][i], pull1[k][i], 1.0,
+                    1.0, peak1[k][i], shift)
+            else:
+                accel = force + drift                     # the old force's and the new's
+                shift = longest * z_abs + 0.5 * longest * longest * accel
+                p_lo, p_hi, x_lo, x_hi = _union(axis_interval(
+                    box1[i][0], box1[i][1], centre_l[k][i], half_l[k][i],
+                    share * pull1[k][i], 1.0, 1.0, peaks1[share][k][i], shift)
+                    for share in shares1)
             e_lo = (p_lo - centre_l[k][i]) / half_l[k][i]
             e_hi = (p_hi - centre_l[k][i]) / half_l[k][i]
             room = min(up_e[k][i] - e_hi, e_lo - low_e[k][i])
@@ -394,14 +489,26 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
                               f"{-room:.3g} half-widths beyond its edge)", t, i)
             gap = min(room_up[k][i] - p_hi, p_lo - room_low[k][i])
             e1_path = max(1.0 - 2.0 * gap / width_max[k][i], reach1[i])
-            dr = virtual_velocity_change(k1, h, reach1[i], e1_path, speed, move[k][i],
-                                         width_min[k][i], width_max[k][i])
+            dr = virtual_velocity_change(k1, longest if timed else h, reach1[i], e1_path,
+                                         speed, move[k][i], width_min[k][i], width_max[k][i])
             # velocity stage: law (13)'s transform on |z| < rho2, the change of r on top
-            pull2, s_peak = 2.0 * h * k2 / rho_k[i], peak2[k][i]
-            q_lo, q_hi, z_lo, z_hi = axis_interval(
-                box2[i][0], box2[i][1], 0.0, rho_k[i], pull2, g_min, g_max, s_peak,
-                h * drift, h * others, cpl, 0.0)
-            edge = rho_n[i] * (1.0 - RHO_ROUNDING)
+            if not timed:
+                pull2, s_peak = 2.0 * h * k2 / rho_k[i], peak2[k][i]
+                q_lo, q_hi, z_lo, z_hi = axis_interval(
+                    box2[i][0], box2[i][1], 0.0, rho_k[i], pull2, g_min, g_max, s_peak,
+                    h * drift, h * others, cpl, 0.0)
+                edge = rho_n[i] * (1.0 - RHO_ROUNDING)
+            else:
+                pull2 = 2.0 * h * k2 / rho_k[i]
+                old = force_old + drift                   # |x2_dot| under u_{k-1}
+                q_lo, q_hi, z_lo, z_hi = _union(axis_interval(
+                    box2[i][0], box2[i][1], 0.0, rho_k[i], share * pull2, g_min, g_max,
+                    peaks2[share][k][i], share * h * drift + lag * old,
+                    share * h * others, cpl, 0.0) for share, lag in corners)
+                # while the previous force acts, z moves from z(s_k) by at most this
+                q_lo = min(q_lo, box2[i][0] * rho_k[i] - delay * old)
+                q_hi = max(q_hi, box2[i][1] * rho_k[i] + delay * old)
+                edge = late[k][i] * (1.0 - RHO_ROUNDING)
             vroom = 1.0 - max(-(q_lo - dr), q_hi + dr) / edge
             worst["velocity"] = min(worst["velocity"], vroom)
             if min(room, vroom) < worst["least"]:
@@ -417,13 +524,17 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
             if reach_n >= 1.0:
                 return result(False, f"|e1_{i}| may reach {reach_n:.6g} at t = {t + h:.4f} s",
                               t, i)
-            dr_end = min(dr, step_velocity_change(
-                k1, h, box1[i][0], box1[i][1],
+            # at the next sample: over the interval's length, h without jitter (the bound
+            # is convex in the length: its ends cover the range)
+            dr_end = min(dr, max(step_velocity_change(
+                k1, length, box1[i][0], box1[i][1],
                 (centre_l[k][i] - centre_l[k + 1][i]) / half_l[k + 1][i],
                 half_l[k][i] / half_l[k + 1][i], reach_n, half_l[k][i], half_l[k + 1][i],
-                h * z_abs + 0.5 * h * h * accel))
+                shift) for length in (sorted(set(lengths)) if timed else (h,))))
             next1.append(box_n)
             next2.append([(z_lo - dr_end) / rho_n[i], (z_hi + dr_end) / rho_n[i]])
+        if timed:
+            u_prev = u_abs
         box1, box2 = next1, next2
     top[0] = max(top[0], max(max(-a, b) for a, b in box1))
     top[1] = max(top[1], max(max(-a, b) for a, b in box2))
@@ -433,7 +544,8 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
 
 def certify_stage(tube: TubeDesign, spec: Spec, stage: SecondStage) -> tuple[bool, dict]:
     """:func:`check_cascade_sampled` for ``spec``'s declared plants (:func:`cascade_class`)
-    on ``tube`` sampled at its rate: the design's certifier
+    and its ``[controller] delay`` and ``jitter`` on ``tube`` sampled at its rate: the
+    design's certifier
     (:func:`~stt_codegen.design.cascade_gain.certified_stage` asks it).
 
     Parameters
@@ -459,14 +571,16 @@ def certify_stage(tube: TubeDesign, spec: Spec, stage: SecondStage) -> tuple[boo
 @lru_cache(maxsize=64)
 def cascade_check_of(tube: TubeDesign, spec: Spec, stage: SecondStage) -> CascadeCheck:
     """:func:`check_cascade_sampled` of ``stage`` on ``tube`` for ``spec``'s declared
-    plants, once per process (the design, ``verify`` and the rate search ask again).
+    plants and its ``[controller] delay`` and ``jitter``, once per process (the design,
+    ``verify`` and the rate search ask again).
 
     Parameters
     ----------
     tube : TubeDesign
         The position tube, sampled at its rate.
     spec : Spec
-        With a second-order ``plant.model``.
+        With a second-order ``plant.model``; its ``delay + 2 jitter`` must fit the period
+        of ``tube.rate_hz``.
     stage : SecondStage
         The second stage to certify.
 
@@ -477,7 +591,57 @@ def cascade_check_of(tube: TubeDesign, spec: Spec, stage: SecondStage) -> Cascad
     with reference.numpy_math():
         samples = sample_tube(tube)
     return check_cascade_sampled(tube, samples, stage, cascade_class(spec),
-                                 spec.second_order.initial_velocity)
+                                 spec.second_order.initial_velocity, delay=spec.delay,
+                                 jitter=spec.jitter)
+
+
+def largest_cascade_delay(tube: TubeDesign, spec: Spec, stage: SecondStage,
+                          halvings: int = DELAY_HALVINGS) -> float | None:
+    """The largest computation delay with which :func:`check_cascade_sampled` proves
+    ``stage`` on ``tube`` at its rate with the spec's jitter, to ``h / 2^halvings`` below
+    the true limit of the check (bisection; docs/second-order.md, "A computation delay
+    and jitter").
+
+    Parameters
+    ----------
+    tube : TubeDesign
+        The position tube (its rate).
+    spec : Spec
+        With a second-order ``plant.model``: its declared plants and ``[controller]
+        jitter``.
+    stage : SecondStage
+        The second stage judged.
+    halvings : int, optional
+        Halvings of the bisection on ``[0, h - 2 jitter]``; default
+        :data:`~.sampled.DELAY_HALVINGS`, as the first order.
+
+    Returns
+    -------
+    float or None
+        Seconds, in ``[0, h - 2 jitter]``: the largest delay tried with which the check
+        passes (a check with a delay proves every delay up to it); ``None`` when the check
+        fails without delay.
+    """
+    with reference.numpy_math():
+        samples = sample_tube(tube)
+    plants, start = cascade_class(spec), spec.second_order.initial_velocity
+
+    def passes(delay: float) -> bool:
+        return check_cascade_sampled(tube, samples, stage, plants, start, delay=delay,
+                                     jitter=spec.jitter).passed
+
+    top = max(0.0, 1.0 / tube.rate_hz - 2.0 * spec.jitter)
+    # without delay: the spec's own check when it has no delay either (cached)
+    if not (cascade_check_of(tube, spec, stage).passed if spec.delay == 0.0
+            else passes(0.0)):
+        return None
+    if passes(top):
+        return top
+    good, bad = 0.0, top
+    for _ in range(halvings):
+        mid = 0.5 * (good + bad)
+        good, bad = (mid, bad) if passes(mid) else (good, mid)
+    return good
 
 
 def _double_integrator_terms(p: dict, n: int) -> tuple[float, float, list[float]]:

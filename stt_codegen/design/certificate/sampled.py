@@ -268,10 +268,12 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     # s* of each share of the period the own command acts (a share of 0: no pull, s* = 1-)
     peaks = {share: peak(ratio / share).tolist() if share > 0.0 else
              np.full_like(ratio, 1.0 - 1e-15).tolist() for share in shares}
-    up_e = _widened(((enclosure.upper_min - centre[:count]) / half[:count]).tolist(), count,
-                    jitter > 0.0, min)
-    low_e = _widened(((enclosure.lower_max - centre[:count]) / half[:count]).tolist(), count,
-                     jitter > 0.0, max)
+    # the tube's inner edges over the measurement interval, in state units (with jitter the
+    # worst of the neighbouring intervals), then in interval k's coordinates
+    upper_min = np.array(_widened(enclosure.upper_min.tolist(), count, jitter > 0.0, min))
+    lower_max = np.array(_widened(enclosure.lower_max.tolist(), count, jitter > 0.0, max))
+    up_e = ((upper_min - centre[:count]) / half[:count]).tolist()
+    low_e = ((lower_max - centre[:count]) / half[:count]).tolist()
     alpha = (half[:count] / half[1:count + 1]).tolist()
     beta = ((centre[:count] - centre[1:count + 1]) / half[1:count + 1]).tolist()
     half_l, centre_l, pull_l = half.tolist(), centre.tolist(), pull.tolist()
