@@ -11,8 +11,8 @@ import pytest
 from conftest import arena_toml
 
 from stt_codegen_bench.arena_job import (closed_loop_failure, design_failure, run_arena)
-from stt_codegen_bench.arenas import (ARENA, ARENA_KINDS, OBSTACLE_SIZE, START_SIZE, TARGET,
-                                      arena_spec, make_arena)
+from stt_codegen_bench.arenas import (ARENA, ARENA_KINDS, OBSTACLE_SIZE, OFFICE_RATE_HZ,
+                                      START_SIZE, TARGET, arena_spec, make_arena)
 from stt_codegen_bench.astar import RESOLUTION, grid_graph, plan_astar
 from stt_codegen_bench.planning import MARGIN, FreeSpace
 from stt_codegen_bench.report import summarize
@@ -42,6 +42,9 @@ def test_arenas_follow_the_protocol():
 #: i``, ``i`` = 0, 1), computed from the six generators ``make_arena`` replaced
 #: (``generate_arena``, the moving study's, ``task_problem_toml``, ``office_doc`` for both
 #: bases, ``polygons_toml``): the benchmarks' figures in docs/ were measured on these arenas.
+#: The offices of the former generator ran at 50 Hz, where the look-ahead's sampled-data check
+#: certifies none of them; they run at ``OFFICE_RATE_HZ``, and their digest is taken with
+#: that rate put back to 50 Hz: the rooms, desks and headings are the former ones.
 FORMER_DIGESTS = {
     "paper": "e34af5fce296d0ce",
     "moving": "5092cb19f0ce6aee",
@@ -59,7 +62,11 @@ def test_each_kind_draws_the_arenas_of_the_former_generator(kind):
         for i in range(2 if kind == "polygons" else 5):
             text = (make_arena(kind, seed, polygons=5 + i, tolerance=0.02 + 0.01 * i)
                     if kind == "polygons" else make_arena(kind, seed, i))
-            digest.update(json.dumps(tomllib.loads(text), sort_keys=True).encode())
+            doc = tomllib.loads(text)
+            if kind.startswith("office-"):
+                assert doc["controller"]["rate_hz"] == OFFICE_RATE_HZ
+                doc["controller"]["rate_hz"] = 50.0
+            digest.update(json.dumps(doc, sort_keys=True).encode())
             assert parse_spec(text).name in text
     assert digest.hexdigest()[:16] == FORMER_DIGESTS[kind]
 
