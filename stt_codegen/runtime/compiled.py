@@ -26,7 +26,7 @@ from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..system import atomic_write, find_tool
 
-__all__ = ["CController", "CFLAGS", "GeneratedPythonController", "build_shared", "compiler",
+__all__ = ["CController", "CFLAGS", "DesignSpec", "GeneratedPythonController", "build_shared", "compiler",
            "load_python_module", "load_variant_step"]
 
 #: Flags of the shared-library build (``-ffp-contract=off``: same rounding as CasADi's VM).
@@ -34,9 +34,16 @@ CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fPIC", "-shared", "-Wall", "
           "-Wpedantic", "-Wshadow", "-Werror")
 
 
-class _DesignSpec:
-    """The spec attributes code generation reads, for a design without its spec (the
-    timing contract's numbers are the header's text only: the step does not read them)."""
+class DesignSpec:
+    """The spec attributes code generation reads (``name``, ``c_name``, ``source_hash``,
+    ``delay``, ``jitter``), for a design without its spec (the timing contract's numbers
+    are the header's text only: the step does not read them).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        Its name names the files (``"stt"`` when it is not a valid spec name).
+    """
 
     def __init__(self, design: TubeDesign) -> None:
         self.name = design.name if NAME_PATTERN.fullmatch(design.name) else "stt"
@@ -144,7 +151,7 @@ class CController:
     name = "c"
 
     def __init__(self, design: TubeDesign, precision: str = "double", cc: str | None = None) -> None:
-        spec = _DesignSpec(design)
+        spec = DesignSpec(design)
         files = generate_files(spec, design, Options(("c",), precision))
         prefix = spec.c_name
         sources = {k: v for k, v in files.items() if k in (f"{prefix}.c", f"{prefix}.h")}
@@ -216,7 +223,7 @@ class GeneratedPythonController:
     name = "python"
 
     def __init__(self, design: TubeDesign) -> None:
-        spec = _DesignSpec(design)
+        spec = DesignSpec(design)
         files = generate_files(spec, design, Options(("python",), "double"))
         self.module = load_python_module(files[f"{spec.c_name}.py"], spec.c_name)
 

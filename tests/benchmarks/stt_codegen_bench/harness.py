@@ -22,7 +22,6 @@ source separately from the harness (no inlining across them).
 
 from __future__ import annotations
 
-import hashlib
 import re
 import shutil
 import subprocess
@@ -33,11 +32,10 @@ from pathlib import Path
 
 import numpy as np
 
-from stt_codegen.runtime.compiled import compiler
+from stt_codegen.runtime.compiled import DesignSpec, compiler
 from stt_codegen.codegen.generate import generate_files
 from stt_codegen.codegen.options import Options
 from stt_codegen.errors import ToolchainError
-from stt_codegen.spec.loader import NAME_PATTERN
 from stt_codegen.system import find_tool
 from stt_codegen.tube.parameters import TubeDesign
 
@@ -46,16 +44,6 @@ __all__ = ["BenchError", "build_harness", "harness_source"]
 #: Compiler flags of the harness and the generated source (those of backend ``c``
 #: without ``-shared -fPIC``).
 CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off")
-
-
-class _GenerationName:
-    """The attributes :func:`generate_files` reads from a spec, for a design without one
-    (``name``, ``c_name``, ``source_hash``)."""
-
-    def __init__(self, design: TubeDesign) -> None:
-        self.name = design.name if NAME_PATTERN.fullmatch(design.name) else "stt"
-        self.c_name = self.name.replace("-", "_")
-        self.source_hash = "design:" + hashlib.sha256(repr(design).encode()).hexdigest()
 
 
 class BenchError(ToolchainError):
@@ -270,7 +258,7 @@ def build_harness(design: TubeDesign, compile_timeout: float = 900.0) -> Harness
     BenchError
         The compiler failed or timed out.
     """
-    spec = _GenerationName(design)
+    spec = DesignSpec(design)
     begin = time.perf_counter()
     files = generate_files(spec, design, Options(("c",), "double"))
     generate_seconds = time.perf_counter() - begin
