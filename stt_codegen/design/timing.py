@@ -20,7 +20,7 @@ from ..spec.loader import Spec
 from ..spec.variants import variant_of
 from ..tube import reference
 from .certificate.plant_class import plant_class
-from .certificate.sampled import (DELAY_HALVINGS, check_sampled_first_per_axis,
+from .certificate.sampled import (check_sampled_first_per_axis, largest_passing,
                                   lowest_rate, sampled_check_of)
 from .failures import FailureKind
 from .result import Design
@@ -48,6 +48,15 @@ def _certified(spec: Spec, search: Callable[[Spec], Design]) -> Design:
     return design
 
 
+def _passes(spec: Spec, search: Callable[[Spec], Design]) -> bool:
+    """Whether :func:`_certified` designs ``spec`` (a refusal's advice is named only then)."""
+    try:
+        _certified(spec, search)
+    except DesignError:
+        return False
+    return True
+
+
 def _followable_delay(design: Design, spec: Spec) -> float | None:
     """The largest delay (to ``dt / 2^DELAY_HALVINGS``) with which ``design``'s sampled
     proof holds at ``|e| <= TRACKING_ERROR`` with the spec's jitter; ``None`` if none."""
@@ -60,14 +69,7 @@ def _followable_delay(design: Design, spec: Spec) -> float | None:
                                                  jitter=spec.jitter)
             return check.passed and check.level <= TRACKING_ERROR
 
-        top = max(0.0, 1.0 / tube.rate_hz - 2.0 * spec.jitter)
-        if not passes(0.0):
-            return None
-        good, bad = 0.0, top
-        for _ in range(DELAY_HALVINGS):
-            mid = 0.5 * (good + bad)
-            good, bad = (mid, bad) if passes(mid) else (good, mid)
-        return good
+        return largest_passing(passes, max(0.0, 1.0 / tube.rate_hz - 2.0 * spec.jitter))
 
 
 def design_with_timing(spec: Spec, search: Callable[[Spec], Design]) -> Design:
@@ -108,27 +110,20 @@ def design_with_timing(spec: Spec, search: Callable[[Spec], Design]) -> Design:
         plain = search(untimed)
     except DesignError:
         raise refused from None                  # the timing is not what fails
-    works = []
+    trials = []
     delay = _followable_delay(plain, spec)
-    if delay is not None and delay > 0.0 and delay < spec.delay:
-        try:
-            _certified(replace(spec, delay=delay), search)
-            works.append(f"controller.delay = {number_text(delay, 3)} s is certified at "
-                         f"{number_text(spec.rate_hz)} Hz")
-        except DesignError:
-            pass
+    if delay is not None and 0.0 < delay < spec.delay:
+        trials.append((replace(spec, delay=delay), f"controller.delay = "
+                       f"{number_text(delay, 3)} s is certified at {number_text(spec.rate_hz)} Hz"))
     with reference.numpy_math():
         rate, _ = lowest_rate(plain.tube, spec, plant_class(spec), spec.gain)
     if rate is not None and rate != spec.rate_hz:
-        try:
-            _certified(replace(spec, rate_hz=rate), search)
-            works.append(f"controller.rate_hz = {number_text(rate)} is certified with "
-                         f"{_timing_words(spec)}")
-        except DesignError:
-            pass
+        trials.append((replace(spec, rate_hz=rate), f"controller.rate_hz = "
+                       f"{number_text(rate)} is certified with {_timing_words(spec)}"))
+    works = [words for trial, words in trials if _passes(trial, search)]
     advice = ("; " + "; ".join(works)) if works else (
-        f"; no delay up to the spec's or rate up to 16 times it is certified with the "
-        f"design without the timing (certified without it)")
+        "; neither a shorter delay at this rate nor a rate up to 16 times it is certified "
+        "(the design without the timing is)")
     raise DesignError(f"no design is certified with {_timing_words(spec)} at "
                       f"{number_text(spec.rate_hz)} Hz ({refused}){advice}",
                       kind=FailureKind.TIMING,

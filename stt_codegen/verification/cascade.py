@@ -106,25 +106,12 @@ def cascade_delay_check(spec, tube, min_width: float,
         below the spec's.
     """
     from ..design.certificate.cascade_sampled import largest_cascade_delay
-    h = 1.0 / tube.rate_hz
+    from .sampled import delay_result
     stage, _ = judged_stage(spec, tube, min_width)
-    largest = largest_cascade_delay(tube, spec, stage, halvings)
-    data = {"largest_delay_s": largest, "period_s": h, "delay_s": spec.delay,
-            "jitter_s": spec.jitter}
-    jitter = f" with jitter {spec.jitter:g} s" if spec.jitter > 0.0 else ""
-    if largest is None:
-        return Check("cascade.delay", False, "no computation delay is proved: the sampled "
-                     f"cascade's certificate fails without one{jitter} (cascade.sampled)",
-                     data)
-    passed = largest >= spec.delay
-    detail = (f"a computation delay up to {largest * 1000:.4g} ms ({largest / h:.1%} of the "
-              f"period {h * 1000:g} ms) is tolerated: every plant of the class keeps |e1| < 1 "
-              f"and |e2| < 1 when each force acts up to that long after its state is "
-              f"read{jitter}, at {tube.rate_hz:g} Hz with k1 = {stage.position_gain:.4g}, "
-              f"k2 = {stage.velocity_gain:.4g} (the largest the certificate proves, to "
-              f"1/{2 ** halvings} of the period; controller.delay = {spec.delay:g} s"
-              + (")" if passed else ", beyond it)"))
-    return Check("cascade.delay", passed, detail, data)
+    return delay_result("cascade.delay", largest_cascade_delay(tube, spec, stage, halvings),
+                        spec, tube.rate_hz, "keeps |e1| < 1 and |e2| < 1 when each force acts",
+                        f"k1 = {stage.position_gain:.4g}, k2 = {stage.velocity_gain:.4g}",
+                        "cascade.sampled", halvings)
 
 
 def judged_stage(spec, tube, min_width: float) -> tuple:

@@ -24,7 +24,8 @@ from ..spec.plants import PLANTS
 from ..tube.parameters import TubeDesign
 from ..proofs.check import Check
 
-__all__ = ["delay_check", "input_bound_check", "plant_bounds_checks", "sampled_checks"]
+__all__ = ["delay_check", "delay_result", "input_bound_check", "plant_bounds_checks",
+           "sampled_checks"]
 
 
 def _bounds_words(a: Assumptions, refined: tuple[str, ...] = ()) -> str:
@@ -162,22 +163,56 @@ def delay_check(spec: Spec, design: TubeDesign) -> Check:
         ``period_s``, ``delay_s``, ``jitter_s``. Fails when the largest proved delay is
         below the spec's.
     """
-    dt = 1.0 / design.rate_hz
-    largest = largest_delay(design, spec)
-    data = {"largest_delay_s": largest, "period_s": dt, "delay_s": spec.delay,
+    return delay_result("sampled.delay", largest_delay(design, spec), spec, design.rate_hz,
+                        "stays in the tube when each command acts",
+                        f"k = {design.gain:.6g}", "sampled.tube_kept", DELAY_HALVINGS)
+
+
+def delay_result(name: str, largest: float | None, spec: Spec, rate_hz: float, kept: str,
+                 gains: str, source: str, halvings: int) -> Check:
+    """The check ``name`` of a largest proved delay, in words (``sampled.delay``,
+    ``cascade.delay``).
+
+    Parameters
+    ----------
+    name : str
+        The check's name.
+    largest : float or None
+        The largest delay proved, s; ``None``: the certificate fails without delay.
+    spec : Spec
+        Its ``delay`` and ``jitter``.
+    rate_hz : float
+        The design's rate, Hz.
+    kept : str
+        What every plant of the class does under the delay, in words.
+    gains : str
+        The gains judged, in words.
+    source : str
+        The check that fails when ``largest`` is ``None``.
+    halvings : int
+        The bisection's halvings (its resolution, ``1 / 2^halvings`` of the period).
+
+    Returns
+    -------
+    Check
+        Passed when ``largest >= spec.delay``. Data: ``largest_delay_s``, ``period_s``,
+        ``delay_s``, ``jitter_s``.
+    """
+    period = 1.0 / rate_hz
+    data = {"largest_delay_s": largest, "period_s": period, "delay_s": spec.delay,
             "jitter_s": spec.jitter}
     timing = f" with jitter {spec.jitter:g} s" if spec.jitter > 0.0 else ""
     if largest is None:
-        return Check("sampled.delay", False, "no computation delay is proved: the sampled "
-                     f"check fails without one{timing} (sampled.tube_kept)", data)
+        return Check(name, False, f"no computation delay is proved: the certificate fails "
+                     f"without one{timing} ({source})", data)
     passed = largest >= spec.delay
-    detail = (f"a computation delay up to {largest * 1000:.4g} ms ({largest / dt:.1%} of the "
-              f"period {dt * 1000:g} ms) is tolerated: every plant of the class stays in the "
-              f"tube when each command acts up to that long after its state is read{timing}, "
-              f"at {design.rate_hz:g} Hz with k = {design.gain:.6g} (the largest the check "
-              f"proves, to 1/{2 ** DELAY_HALVINGS} of the period; controller.delay = "
-              f"{spec.delay:g} s" + (")" if passed else ", beyond it)"))
-    return Check("sampled.delay", passed, detail, data)
+    detail = (f"a computation delay up to {largest * 1000:.4g} ms ({largest / period:.1%} of "
+              f"the period {period * 1000:g} ms) is tolerated: every plant of the class "
+              f"{kept} up to that long after its state is read{timing}, at {rate_hz:g} Hz "
+              f"with {gains} (the largest the certificate proves, to 1/{2 ** halvings} of the "
+              f"period; controller.delay = {spec.delay:g} s"
+              + (")" if passed else ", beyond it)"))
+    return Check(name, passed, detail, data)
 
 
 def _model_passes(design: TubeDesign, spec: Spec) -> bool:

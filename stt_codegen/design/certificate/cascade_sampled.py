@@ -44,7 +44,7 @@ from ...spec.variants import require_variant
 from ...tube import reference
 from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from ...tube.second_stage import SecondStage
-from .sampled import DELAY_HALVINGS
+from .sampled import DELAY_HALVINGS, largest_passing
 from .sampled_axis import axis_interval, peak, phi_scalar, phi_slope_scalar
 
 __all__ = ["CascadeClass", "CascadeCheck", "cascade_check_of", "cascade_class", "model_within_class",
@@ -630,18 +630,10 @@ def largest_cascade_delay(tube: TubeDesign, spec: Spec, stage: SecondStage,
         return check_cascade_sampled(tube, samples, stage, plants, start, delay=delay,
                                      jitter=spec.jitter).passed
 
-    top = max(0.0, 1.0 / tube.rate_hz - 2.0 * spec.jitter)
     # without delay: the spec's own check when it has no delay either (cached)
-    if not (cascade_check_of(tube, spec, stage).passed if spec.delay == 0.0
-            else passes(0.0)):
-        return None
-    if passes(top):
-        return top
-    good, bad = 0.0, top
-    for _ in range(halvings):
-        mid = 0.5 * (good + bad)
-        good, bad = (mid, bad) if passes(mid) else (good, mid)
-    return good
+    return largest_passing(passes, max(0.0, 1.0 / tube.rate_hz - 2.0 * spec.jitter),
+                           cascade_check_of(tube, spec, stage).passed if spec.delay == 0.0
+                           else None, halvings)
 
 
 def _double_integrator_terms(p: dict, n: int) -> tuple[float, float, list[float]]:

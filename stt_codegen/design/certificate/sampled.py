@@ -22,6 +22,7 @@ certified enclosure of the tube (:func:`~stt_codegen.design.certificate.enclose_
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
@@ -40,7 +41,8 @@ from .plant_class import PlantClass, plant_class
 from .sampled_axis import axis_interval, peak, peak_scalar, phi_scalar, phi_slope_scalar
 
 __all__ = ["DELAY_HALVINGS", "RATE_FACTORS", "SampledCheck", "check_sampled",
-           "check_sampled_first_per_axis", "largest_delay", "lowest_rate", "sampled_check_of"]
+           "check_sampled_first_per_axis", "largest_delay", "largest_passing", "lowest_rate",
+           "sampled_check_of"]
 
 #: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
 RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
@@ -470,18 +472,43 @@ def largest_delay(design: TubeDesign, spec: Spec) -> float | None:
             return check_sampled_first_per_axis(design, samples, plants, delay=delay,
                                                 jitter=spec.jitter).passed
 
-        top = max(0.0, 1.0 / design.rate_hz - 2.0 * spec.jitter)
         # without delay: the spec's own check when it has no delay either (cached)
-        if not (sampled_check_of(design, spec)[1].passed if spec.delay == 0.0
-                else passes(0.0)):
-            return None
-        if passes(top):
-            return top
-        good, bad = 0.0, top
-        for _ in range(DELAY_HALVINGS):
-            mid = 0.5 * (good + bad)
-            good, bad = (mid, bad) if passes(mid) else (good, mid)
-        return good
+        return largest_passing(passes, max(0.0, 1.0 / design.rate_hz - 2.0 * spec.jitter),
+                               sampled_check_of(design, spec)[1].passed if spec.delay == 0.0
+                               else None)
+
+
+def largest_passing(passes: Callable[[float], bool], top: float,
+                    zero_passes: bool | None = None, halvings: int = DELAY_HALVINGS
+                    ) -> float | None:
+    """The largest delay in ``[0, top]`` that ``passes`` accepts, by bisection to
+    ``top / 2^halvings``: the largest one tried that passes.
+
+    Parameters
+    ----------
+    passes : callable
+        ``passes(delay) -> bool``, a certificate with that delay.
+    top : float
+        The largest delay allowed, s.
+    zero_passes : bool, optional
+        ``passes(0.0)`` when it is known (a cached check); else it is asked.
+    halvings : int
+        Halvings of the bisection.
+
+    Returns
+    -------
+    float or None
+        Seconds; ``None`` when the delay 0 fails.
+    """
+    if not (passes(0.0) if zero_passes is None else zero_passes):
+        return None
+    if passes(top):
+        return top
+    good, bad = 0.0, top
+    for _ in range(halvings):
+        mid = 0.5 * (good + bad)
+        good, bad = (mid, bad) if passes(mid) else (good, mid)
+    return good
 
 
 def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
