@@ -231,3 +231,21 @@ def test_a_delay_the_design_cannot_take_is_refused_naming_one_that_is_then_certi
     assert 0.0 < delay < 0.01
     design = stt.design_tube(_line(delay=delay))
     assert _check(design.spec, design.tube, delay=delay).passed
+
+
+@pytest.mark.slow
+def test_a_base_too_slow_for_its_turn_is_refused_naming_a_rate_then_certified():
+    """office-base at 50 Hz: no design's proof holds (the heading's turn within a period);
+    the refusal names a rate, at which the design and its sampled proof then hold."""
+    import tomllib
+    from stt_codegen.cases import bundled_spec_bytes
+    doc = tomllib.loads(bundled_spec_bytes("office-base").decode())
+    doc["controller"] = {"rate_hz": 50.0}
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(stt.Spec.from_dict(doc))
+    assert "the heading may turn by" in str(raised.value)
+    named = re.search(r"controller\.rate_hz = ([0-9.]+) is certified", str(raised.value))
+    assert named is not None and float(named.group(1)) > 50.0
+    doc["controller"] = {"rate_hz": float(named.group(1))}
+    design = stt.design_tube(stt.Spec.from_dict(doc))
+    assert _check(design.spec, design.tube).passed

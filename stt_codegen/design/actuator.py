@@ -180,8 +180,27 @@ def candidates(spec: Spec, design_free: Callable[[Spec], Design],
     return None, tried
 
 
+def _certified_rate(spec: Spec, tube) -> float | None:
+    """The lowest rate (:func:`~.certificate.sampled.lowest_rate`) at which law (13)'s
+    sampled check passes on ``tube``, if :func:`~stt_codegen.design.search.design_tube`
+    then certifies ``spec`` there; else ``None``."""
+    from ..tube import reference
+    from .certificate.plant_class import plant_class
+    from .certificate.sampled import lowest_rate
+    from .search import design_tube
+    with reference.numpy_math():
+        rate, _ = lowest_rate(tube, spec, plant_class(spec), spec.gain)
+    if rate is None or rate == spec.rate_hz:
+        return None
+    try:
+        design_tube(replace(spec, rate_hz=rate))
+    except DesignError:
+        return None
+    return rate
+
+
 def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
-                        prove: DesignProver | None = None) -> Design:
+                        prove: DesignProver | None = None, name_rate: bool = True) -> Design:
     """The certified design of ``spec`` whose controller is proved to stay within
     ``[actuator]``.
 
@@ -197,6 +216,10 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
         default law (13)'s (:func:`~.certificate.actuator.prove_input_bound`). A second-order spec
         passes the cascade's (:func:`~.cascade_gain.cascade_input_proof`: the physical
         input of the certified second stage).
+    name_rate : bool
+        When no design's proof holds, name the lowest rate at which law (13)'s sampled
+        check passes and :func:`~stt_codegen.design.search.design_tube` then certifies the
+        spec (``False`` for the cascade, whose stage names its own rate).
 
     Returns
     -------
@@ -232,9 +255,11 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     unit = f" {spec.input_unit}" if spec.input_unit else ""
     if not proved:
         reasons = "; ".join(f"{c.label}: {c.proof.reason}" for c in tried)
+        rate = _certified_rate(spec, tried[0].design.tube) if tried and name_rate else None
         raise DesignError(
             f"no bound on {law} can be proved for actuator.input_bound: the "
-            f"sampled-data check fails for every design tried ({reasons})",
+            f"sampled-data check fails for every design tried ({reasons})"
+            + (f"; controller.rate_hz = {rate:g} is certified" if rate is not None else ""),
             kind=FailureKind.INPUT_BOUND, tried=tried[0].design.tube if tried else None)
     best = min(proved, key=lambda c: c.proof.ratio(bound))
     worst = max(range(len(bound)), key=lambda i: best.proof.peak[i] / bound[i])

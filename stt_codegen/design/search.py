@@ -433,7 +433,7 @@ def cascade_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> D
 
     return design_within_bound(spec, design_free_or_default, prove=lambda design, judged:
                                cascade_input_proof(design.tube, judged,
-                                                   design.check.min_width))
+                                                   design.check.min_width), name_rate=False)
 
 
 def _design(spec: Spec, smoother: bool) -> Design:
