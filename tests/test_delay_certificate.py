@@ -109,6 +109,17 @@ def test_verify_reports_the_largest_delay(s1):
     assert not beyond.passed and "beyond it" in beyond.detail
 
 
+def test_no_delay_check_where_the_sampled_check_fails_without_one():
+    """gain-range-s2-fixed-gain fails sampled.tube_kept; sampled.delay adds no second
+    failure for it (None), where a passing design gets its figure."""
+    from pathlib import Path
+    spec = stt.load_spec(Path(__file__).parent / "specs" / "gain-range-s2-fixed-gain.toml")
+    design = stt.design_tube(spec)
+    with reference.numpy_math():
+        assert not _check(spec, design.tube).passed
+        assert delay_check(spec, design.tube) is None
+
+
 def test_the_lowest_rate_counts_the_delay_in_seconds(s1):
     """A delay of 0.9 ms fits a 1 kHz period but not a shorter one: no rate above the
     design's is named for it, and the rate named is one that passes with it."""

@@ -81,7 +81,7 @@ def sampled_cascade_check(spec, tube, min_width: float) -> Check:
 
 
 def cascade_delay_check(spec, tube, min_width: float,
-                        halvings: int = CASCADE_DELAY_HALVINGS) -> Check:
+                        halvings: int = CASCADE_DELAY_HALVINGS) -> Check | None:
     """``cascade.delay``: the largest computation delay the sampled cascade's certificate
     proves for the deployed second stage at the design's rate with the spec's jitter
     (:func:`~stt_codegen.design.certificate.cascade_sampled.largest_cascade_delay`), at
@@ -100,10 +100,10 @@ def cascade_delay_check(spec, tube, min_width: float,
 
     Returns
     -------
-    Check
-        Data: ``largest_delay_s`` (``None`` when the certificate fails without delay),
-        ``period_s``, ``delay_s``, ``jitter_s``. Fails when the largest proved delay is
-        below the spec's.
+    Check or None
+        Data: ``largest_delay_s``, ``period_s``, ``delay_s``, ``jitter_s``. Fails when the
+        largest proved delay is below the spec's. ``None`` when the certificate fails
+        without delay (``cascade.sampled`` fails then, and says why).
     """
     from ..design.certificate.cascade_sampled import largest_cascade_delay
     from .sampled import delay_result
@@ -111,7 +111,7 @@ def cascade_delay_check(spec, tube, min_width: float,
     return delay_result("cascade.delay", largest_cascade_delay(tube, spec, stage, halvings),
                         spec, tube.rate_hz, "keeps |e1| < 1 and |e2| < 1 when each force acts",
                         f"k1 = {stage.position_gain:.4g}, k2 = {stage.velocity_gain:.4g}",
-                        "cascade.sampled", halvings)
+                        halvings)
 
 
 def judged_stage(spec, tube, min_width: float) -> tuple:

@@ -279,7 +279,7 @@ def _law13_sampled(spec: Spec, design: TubeDesign, tube_check, progress,
     # do: every margin here is far above rounding
     with reference.numpy_math():
         checks = sampled_checks(spec, design, tube_check.certificate)
-        checks.append(delay_check(spec, design))
+        checks += [c for c in (delay_check(spec, design),) if c is not None]
     if spec.input_bound is not None:
         checks.append(input_bound_check(spec, input_proof(prove_input_bound(design, spec),
                                                           spec)))
@@ -352,8 +352,9 @@ def cascade_sampled_checks(spec: Spec, design: TubeDesign, tube_check,
     progress("sampled loop")          # the cascade takes the sampled loop's slot
     checks = cascade_checks(min(design.dimension, 2)) + [
         plant_within_class_check(spec),
-        sampled_cascade_check(spec, design, tube_check.min_width),
-        cascade_delay_check(spec, design, tube_check.min_width)]
+        sampled_cascade_check(spec, design, tube_check.min_width)]
+    checks += [c for c in (cascade_delay_check(spec, design, tube_check.min_width),)
+               if c is not None]
     if spec.input_bound is not None:     # the physical input u: force or torque
         checks.append(cascade_input_bound_check(spec, design, tube_check.min_width))
     return checks

@@ -144,7 +144,7 @@ def sampled_checks(spec: Spec, design: TubeDesign, certificate: Certificate) -> 
     return checks
 
 
-def delay_check(spec: Spec, design: TubeDesign) -> Check:
+def delay_check(spec: Spec, design: TubeDesign) -> Check | None:
     """``sampled.delay``: the largest computation delay the sampled-data check proves at the
     design's rate and gain (:func:`~stt_codegen.design.certificate.sampled.largest_delay`),
     at least the spec's ``[controller] delay``.
@@ -158,18 +158,18 @@ def delay_check(spec: Spec, design: TubeDesign) -> Check:
 
     Returns
     -------
-    Check
-        Data: ``largest_delay_s`` (``None`` when the check fails without delay),
-        ``period_s``, ``delay_s``, ``jitter_s``. Fails when the largest proved delay is
-        below the spec's.
+    Check or None
+        Data: ``largest_delay_s``, ``period_s``, ``delay_s``, ``jitter_s``. Fails when the
+        largest proved delay is below the spec's. ``None`` when the check fails without
+        delay (``sampled.tube_kept`` fails then, and says why).
     """
     return delay_result("sampled.delay", largest_delay(design, spec), spec, design.rate_hz,
                         "stays in the tube when each command acts",
-                        f"k = {design.gain:.6g}", "sampled.tube_kept", DELAY_HALVINGS)
+                        f"k = {design.gain:.6g}", DELAY_HALVINGS)
 
 
 def delay_result(name: str, largest: float | None, spec: Spec, rate_hz: float, kept: str,
-                 gains: str, source: str, halvings: int) -> Check:
+                 gains: str, halvings: int) -> Check | None:
     """The check ``name`` of a largest proved delay, in words (``sampled.delay``,
     ``cascade.delay``).
 
@@ -187,24 +187,22 @@ def delay_result(name: str, largest: float | None, spec: Spec, rate_hz: float, k
         What every plant of the class does under the delay, in words.
     gains : str
         The gains judged, in words.
-    source : str
-        The check that fails when ``largest`` is ``None``.
     halvings : int
         The bisection's halvings (its resolution, ``1 / 2^halvings`` of the period).
 
     Returns
     -------
-    Check
+    Check or None
         Passed when ``largest >= spec.delay``. Data: ``largest_delay_s``, ``period_s``,
-        ``delay_s``, ``jitter_s``.
+        ``delay_s``, ``jitter_s``. ``None`` when ``largest`` is: the certificate's own
+        check fails, and reports it.
     """
+    if largest is None:
+        return None
     period = 1.0 / rate_hz
     data = {"largest_delay_s": largest, "period_s": period, "delay_s": spec.delay,
             "jitter_s": spec.jitter}
     timing = f" with jitter {spec.jitter:g} s" if spec.jitter > 0.0 else ""
-    if largest is None:
-        return Check(name, False, f"no computation delay is proved: the certificate fails "
-                     f"without one{timing} ({source})", data)
     passed = largest >= spec.delay
     detail = (f"a computation delay up to {largest * 1000:.4g} ms ({largest / period:.1%} of "
               f"the period {period * 1000:g} ms) is tolerated: every plant of the class "
