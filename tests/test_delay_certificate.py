@@ -11,8 +11,11 @@ import re
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 from conftest import arena_toml, designed
+from hypothesis import HealthCheck, event, given, note, settings
+from hypothesis import strategies as st
 
 import stt_codegen as stt
 from stt_codegen.design.certificate.plant_class import plant_class
@@ -260,3 +263,60 @@ def test_a_base_too_slow_for_its_turn_is_refused_naming_a_rate_then_certified():
     doc["controller"] = {"rate_hz": float(named.group(1))}
     design = stt.design_tube(stt.Spec.from_dict(doc))
     assert _check(design.spec, design.tube).passed
+
+
+# ---------------------------------------------------------------------------------------
+# soundness: a run with the delay stays within what the check proves
+
+
+def test_the_run_with_the_largest_delay_stays_within_the_proved_bound_of_e(s1):
+    """omnirobot-s1 with the largest delay the check proves: the closed loop (the robot's
+    own plant, the generated C) keeps |e| at the samples below the check's bound of it."""
+    spec, design, largest = s1
+    late = dataclasses.replace(spec, delay=largest)
+    proved = _check(late, design, delay=largest)
+    result = stt.simulate(dataclasses.replace(stt.design_tube(spec), spec=late), backend="c")
+    assert result.stayed_in_tube
+    assert result.max_abs_e <= proved.level + 1e-9, (result.max_abs_e, proved.level)
+
+
+@pytest.mark.slow
+@settings(derandomize=True, deadline=None, database=None, max_examples=16,
+          suppress_health_check=list(HealthCheck))
+@given(seed=st.integers(0, 2**32 - 1), g_min=st.floats(0.5, 1.2), spread=st.floats(0.0, 1.0),
+       skew=st.floats(0.0, 0.1), coupling=st.floats(0.0, 0.1), drift=st.floats(0.0, 1.0),
+       disturbance=st.floats(0.0, 0.3), share=st.floats(0.05, 1.0))
+def test_no_plant_of_an_accepted_class_leaves_the_tube_with_the_delay(
+        seed, g_min, spread, skew, coupling, drift, disturbance, share):
+    """Random classes and delays: where the check passes with the delay, a random plant of
+    the class run with that delay stays in the tube, with |e| at the samples below the
+    check's bound."""
+    from plants_helpers import plant_system, plant_within
+    from stt_codegen.runtime.simulate import run_closed_loop
+    from stt_codegen.spec.assumptions import Assumptions
+    spec, design, _ = designed("omnirobot-s1")
+    a = Assumptions((g_min, g_min + spread), skew, coupling, drift, disturbance)
+    delay = share * largest_delay_of(design, spec, a)
+    with reference.numpy_math():
+        verdict = check_sampled_first_per_axis(design, sample_tube(design), a, delay=delay)
+    note(f"delay {delay:.3g} s: {verdict.passed} {verdict.reason}")
+    event("accepted" if verdict.passed else "refused")
+    if not verdict.passed:
+        return
+    plant = plant_system(plant_within(np.random.default_rng(seed), a, spec.state_space))
+    result = run_closed_loop(dataclasses.replace(spec, delay=delay), design, backend="c",
+                             plant=plant)
+    assert result.stayed_in_tube, (a, delay)
+    assert result.max_abs_e <= verdict.level + 1e-9, (a, delay)
+
+
+def largest_delay_of(design, spec, assumptions) -> float:
+    """The largest delay the check proves for a class given by hand (0 if none)."""
+    from stt_codegen.design.certificate.sampled import largest_passing
+    with reference.numpy_math():
+        samples = sample_tube(design)
+        found = largest_passing(
+            lambda d: check_sampled_first_per_axis(design, samples, assumptions,
+                                                   delay=d).passed,
+            1.0 / design.rate_hz)
+    return found or 0.0
