@@ -44,14 +44,14 @@ from ..spec.loader import Spec
 from ..spec.variants import variant_of
 from ..tube.parameters import CRUISE
 from .grid import grid_index, grid_value, smallest_passing
-from .failures import FailureKind
+from .failures import FailureKind, advice_wanted, without_advice
 from .certificate.actuator import prove_input_bound
 from .input_bound import InputProof
 from .result import METHOD_PAPER, METHOD_VIA, Design
 from .samples import HORIZON_FACTOR, STEP_BUDGET
 from .windows import SHARPNESS_LADDER
 
-__all__ = ["design_within_bound"]
+__all__ = ["MAX_TIME_FACTOR", "design_within_bound"]
 
 #: The ``prescribed_time`` search tries up to this many times the spec's ``t_c``.
 MAX_TIME_FACTOR = 16.0
@@ -180,20 +180,22 @@ def candidates(spec: Spec, design_free: Callable[[Spec], Design],
     return None, tried
 
 
-def _certified_rate(spec: Spec, tube) -> float | None:
+def _certified_rate(spec: Spec, tube, design_free: Callable[[Spec], Design],
+                    prove: DesignProver | None) -> float | None:
     """The lowest rate (:func:`~.certificate.sampled.lowest_rate`) at which law (13)'s
-    sampled check passes on ``tube``, if :func:`~stt_codegen.design.search.design_tube`
-    then certifies ``spec`` there; else ``None``."""
+    sampled check passes on ``tube``, if :func:`design_within_bound` (what
+    :func:`~stt_codegen.design.search.design_tube` runs for it) then designs ``spec``
+    there; else ``None``."""
     from ..tube import reference
     from .certificate.plant_class import plant_class
     from .certificate.sampled import lowest_rate
-    from .search import design_tube
     with reference.numpy_math():
         rate, _ = lowest_rate(tube, spec, plant_class(spec), spec.gain)
     if rate is None or rate == spec.rate_hz:
         return None
     try:
-        design_tube(replace(spec, rate_hz=rate))
+        with without_advice():
+            design_within_bound(replace(spec, rate_hz=rate), design_free, prove)
     except DesignError:
         return None
     return rate
@@ -255,7 +257,8 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     unit = f" {spec.input_unit}" if spec.input_unit else ""
     if not proved:
         reasons = "; ".join(f"{c.label}: {c.proof.reason}" for c in tried)
-        rate = _certified_rate(spec, tried[0].design.tube) if tried and name_rate else None
+        rate = (_certified_rate(spec, tried[0].design.tube, design_free, prove)
+                if tried and name_rate and advice_wanted() else None)
         raise DesignError(
             f"no bound on {law} can be proved for actuator.input_bound: the "
             f"sampled-data check fails for every design tried ({reasons})"

@@ -371,7 +371,7 @@ def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage
     if certified is not None:      # a shape is certified (None: none is)
         return certified, derivation
     from ..errors import DesignError
-    from .failures import FailureKind
+    from .failures import FailureKind, advice_wanted
     proof = (cascade_input_proof(tube, spec, min_width) if spec.input_bound is not None
              else None)
     if proof is not None and proof.proved:      # the tubes are kept, the bound is not
@@ -385,7 +385,7 @@ def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage
             + "; design_tube slows the tube or names the prescribed_time that works "
             "(docs/second-order.md, 'Force limits')", kind=FailureKind.INPUT_BOUND,
             tried=tube)
-    rate = lowest_certified_rate(tube, spec, passes_at_rate=False)
+    rate = lowest_certified_rate(tube, spec, passes_at_rate=False) if advice_wanted() else None
     need = (f"controller.rate_hz = {rate:g} is certified" if rate is not None else
             f"no rate up to {fastest_searched_rate(tube.rate_hz, spec):g} Hz is certified; a "
             "longer prescribed_time (a slower tube) or a narrower assumptions.input_gain may "

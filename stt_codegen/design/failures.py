@@ -7,9 +7,32 @@ carries one too.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from enum import Enum
 
-__all__ = ["FailureKind", "property_kind"]
+__all__ = ["FailureKind", "advice_wanted", "property_kind", "without_advice"]
+
+_ADVICE: ContextVar[bool] = ContextVar("stt_codegen_refusal_advice", default=True)
+
+
+@contextmanager
+def without_advice() -> Iterator[None]:
+    """Within the block, refusals skip the searches that name what works (a rate, a
+    delay): a search that only asks whether a trial spec designs (the deadline's) needs
+    the verdict, not the advice."""
+    token = _ADVICE.set(False)
+    try:
+        yield
+    finally:
+        _ADVICE.reset(token)
+
+
+def advice_wanted() -> bool:
+    """Whether a refusal should search for what works (``False`` within
+    :func:`without_advice`)."""
+    return _ADVICE.get()
 
 
 class FailureKind(Enum):

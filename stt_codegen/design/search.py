@@ -300,7 +300,10 @@ def design_tube(spec: Spec, *, progress: ProgressCallback | None = None) -> Desi
         (:class:`~stt_codegen.design.failures.FailureKind`) and ``tried`` the best
         rejected tube (``None`` where none was built). With ``[actuator]``: no design
         within ``t_c`` keeps the bound (kind ``INPUT_BOUND``; the message names the
-        ``prescribed_time`` that works). With ``[controller] delay`` or ``jitter``: the
+        ``prescribed_time`` that works). A tube that moves too fast for the rate (kinds
+        ``SAMPLING_RATE``, ``NON_EMPTY``): the message names the smallest
+        ``prescribed_time`` that is then certified, when one up to 16 times ``t_c`` is
+        (:mod:`~stt_codegen.design.deadline`). With ``[controller] delay`` or ``jitter``: the
         design's sampled-data proof fails with them (kind ``TIMING``; the message names
         the delay or the rate that is certified, :mod:`~stt_codegen.design.timing`).
 
@@ -326,6 +329,15 @@ def design_tube(spec: Spec, *, progress: ProgressCallback | None = None) -> Desi
                 else "; load it with load_spec" if isinstance(spec, str) else "")
         raise TypeError(f"design_tube(): parameter 'spec' must be a Spec, not "
                         f"{type(spec).__name__}{hint}")
+    try:
+        return _design_call(spec, progress)
+    except DesignError as error:
+        from .deadline import deadline_refusal    # a deadline too short: name one that works
+        raise deadline_refusal(spec, error, _design_call) from None
+
+
+def _design_call(spec: Spec, progress: ProgressCallback | None = None) -> Design:
+    """:func:`design_tube` without the deadline's advice on refusal."""
     started = time.perf_counter()
     if spec.delay > 0.0 or spec.jitter > 0.0:      # the sampled proof must hold with them
         from .timing import design_with_timing

@@ -22,7 +22,7 @@ from ..tube import reference
 from .certificate.plant_class import plant_class
 from .certificate.sampled import (check_sampled_first_per_axis, largest_passing,
                                   lowest_rate, sampled_check_of)
-from .failures import FailureKind
+from .failures import FailureKind, advice_wanted
 from .result import Design
 from .samples import sample_tube
 from .tracking import TRACKING_ERROR
@@ -104,6 +104,8 @@ def design_with_timing(spec: Spec, search: Callable[[Spec], Design]) -> Design:
     try:
         return _certified(spec, search)
     except DesignError as failure:
+        if not advice_wanted():
+            raise
         refused = failure
     untimed = replace(spec, delay=0.0, jitter=0.0)
     try:

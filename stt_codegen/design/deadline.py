@@ -1,0 +1,85 @@
+"""A refusal for a deadline too short names the ``prescribed_time`` that is then certified.
+
+When the tube moves too fast for the controller's rate (the certificate's
+``SAMPLING_RATE`` or ``NON_EMPTY`` property, or the cascade's stage at no rate), a later
+deadline is the knob that helps whatever the hardware: the search doubles ``t_c`` up to
+:data:`~.actuator.MAX_TIME_FACTOR` times it, then bisects :data:`BISECTIONS` times on the
+two-digit grid (:mod:`.grid`), and names the time at which the design search certified the
+spec (the smallest it found, within about an eighth of the doubling).
+Specs whose times are absolute (timed tasks, moving obstacles, ``[target] any_of``) are
+refused as they are: a later ``t_c`` does not move their windows.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import replace
+
+from ..errors import DesignError, number_text
+from ..spec.loader import Spec
+from .actuator import MAX_TIME_FACTOR
+from .failures import FailureKind, without_advice
+from .grid import grid_index, grid_value
+from .result import Design
+
+__all__ = ["BISECTIONS", "SLOWER_HELPS", "deadline_refusal"]
+
+#: The failures a later deadline (a slower tube) cures.
+SLOWER_HELPS = (FailureKind.SAMPLING_RATE, FailureKind.NON_EMPTY)
+#: Bisection steps after the doubling: the time named is certified and within about an
+#: eighth of the doubling's interval above the smallest on the grid (each step is a design).
+BISECTIONS = 3
+
+
+def deadline_refusal(spec: Spec, error: DesignError,
+                     search: Callable[[Spec], Design]) -> DesignError:
+    """``error``, with the smallest ``prescribed_time`` that ``search`` certifies named
+    when the failure is one a slower tube cures.
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec refused.
+    error : DesignError
+        Its refusal.
+    search : callable
+        ``search(spec) -> Design``, the design search without this advice.
+
+    Returns
+    -------
+    DesignError
+        ``error`` itself when its kind is not in :data:`SLOWER_HELPS`, when the spec's
+        times are absolute, or when no time up to ``MAX_TIME_FACTOR t_c`` is certified;
+        else a copy whose message ends with ``prescribed_time = T s is certified`` (``T``
+        was designed and certified by ``search``).
+    """
+    if (error.kind not in SLOWER_HELPS or spec.tasks or spec.moving_obstacles
+            or spec.target_any_of):
+        return error
+
+    def passes(index: int) -> bool:
+        try:
+            with without_advice():            # the verdict only
+                search(replace(spec, prescribed_time=grid_value(index)))
+        except DesignError:
+            return False
+        return True
+
+    low = grid_index(spec.prescribed_time)
+    factor, high = 2.0, None
+    while factor <= MAX_TIME_FACTOR:         # doubling: a passing time, cheaply
+        index = grid_index(factor * spec.prescribed_time)
+        if passes(index):
+            high = index
+            break
+        low, factor = index, 2.0 * factor
+    if high is None:
+        return error
+    for _ in range(BISECTIONS):               # within an eighth of the doubling, cheaply
+        if high - low <= 1:
+            break
+        mid = (low + high) // 2
+        low, high = (low, mid) if passes(mid) else (mid, high)
+    time = grid_value(high)
+    return DesignError(f"{error}; prescribed_time = {number_text(time)} s is certified",
+                       kind=error.kind, tried=error.tried)

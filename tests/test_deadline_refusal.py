@@ -1,0 +1,39 @@
+"""A deadline too short for the rate is refused naming a ``prescribed_time`` that
+``design_tube`` then certifies (design/deadline.py), for law (13) and for the cascade."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+
+import pytest
+
+import stt_codegen as stt
+from stt_codegen.design.failures import FailureKind
+
+
+@pytest.mark.parametrize("case, deadline", [("omnirobot-s1", 0.5), ("second-order-s1", 1.0)])
+def test_a_deadline_too_short_names_one_that_is_then_certified(case, deadline):
+    spec = dataclasses.replace(stt.load_spec(case), prescribed_time=deadline)
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(spec)
+    assert raised.value.kind in (FailureKind.SAMPLING_RATE, FailureKind.NON_EMPTY)
+    named = re.search(r"prescribed_time = ([0-9.]+) s is certified$", str(raised.value))
+    assert named is not None, str(raised.value)
+    later = float(named.group(1))
+    assert deadline < later <= 16 * deadline
+    design = stt.design_tube(dataclasses.replace(spec, prescribed_time=later))
+    assert design.certificate.passed and design.spec.prescribed_time == later
+
+
+def test_a_refusal_a_later_deadline_cannot_cure_is_left_as_it_is():
+    """An obstacle over the target: no deadline helps, and none is named."""
+    spec = stt.Spec.from_dict({
+        "name": "walled", "prescribed_time": 5.0,
+        "state_space": {"lower": [0.0, 0.0], "upper": [4.0, 4.0]},
+        "initial": {"lower": [0.0, 0.0], "upper": [0.5, 0.5]},
+        "target": {"lower": [3.0, 3.0], "upper": [4.0, 4.0]},
+        "obstacles": [{"lower": [2.5, 0.0], "upper": [2.8, 4.0]}]})
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(spec)
+    assert "prescribed_time =" not in str(raised.value)
