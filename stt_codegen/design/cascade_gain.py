@@ -386,10 +386,15 @@ def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage
             "(docs/second-order.md, 'Force limits')", kind=FailureKind.INPUT_BOUND,
             tried=tube)
     rate = lowest_certified_rate(tube, spec, passes_at_rate=False) if advice_wanted() else None
+    fastest = fastest_searched_rate(tube.rate_hz, spec)
+    capped = (f" (a shorter period cannot hold controller.delay + 2 jitter = "
+              f"{spec.delay + 2.0 * spec.jitter:g} s)"
+              if fastest < tube.rate_hz * RATE_SEARCH_FACTOR else "")
+    knobs = "a longer prescribed_time (a slower tube)" + (
+        ", a shorter controller.delay" if spec.delay > 0.0 else "")
     need = (f"controller.rate_hz = {rate:g} is certified" if rate is not None else
-            f"no rate up to {fastest_searched_rate(tube.rate_hz, spec):g} Hz is certified; a "
-            "longer prescribed_time (a slower tube) or a narrower assumptions.input_gain may "
-            "be")
+            f"no rate up to {fastest:g} Hz is certified{capped}; {knobs} or a narrower "
+            "assumptions.input_gain may be")
     first = derivation["tried"][0]["reason"]
     raise DesignError(f"the sampled cascade is not certified at controller.rate_hz = "
                       f"{tube.rate_hz:g} Hz for the declared plants with any second stage "
