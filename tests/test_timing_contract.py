@@ -57,3 +57,10 @@ def test_the_single_precision_header_prints_float_literals(tmp_path):
     stt.generate(stt.design_tube(spec), tmp_path / "out", languages=["c"], precision="single")
     header = (tmp_path / "out" / f"{spec.c_name}.h").read_text()
     assert re.search(r"^#define OMNIROBOT_S1_PERIOD 0\.001f$", header, flags=re.M)
+
+
+def test_the_design_document_states_the_timing():
+    spec = dataclasses.replace(stt.load_spec("omnirobot-s1"), delay=0.00005, jitter=0.000001)
+    timing = stt.design_tube(spec).to_json()["timing"]
+    assert timing == {"rate_hz": 1000.0, "period_s": 0.001, "delay_s": 0.00005,
+                      "jitter_s": 0.000001}

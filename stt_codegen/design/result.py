@@ -377,8 +377,10 @@ class Design:
             line's document for a spec with no design has ``False``), ``method``,
             ``circumvents`` (spec obstacle index, dimension, side, window start and end in
             s, height, sharpness), ``via`` (boxes and times; empty for the paper's
-            method), ``segments``, ``gain``, ``certificate`` (each property with its
-            margin and where it is smallest) and ``design_time_s``; for a spec with
+            method), ``segments``, ``gain``, ``timing`` (``rate_hz``, ``period_s``,
+            ``delay_s``, ``jitter_s``: the loop the certificate covers, as the generated
+            header's timing contract), ``certificate`` (each property with its margin and
+            where it is smallest) and ``design_time_s``; for a spec with
             ``[actuator]`` also ``input_bound`` and ``input_peak`` (the proved peak of
             each input, when it occurs, the horizon covered, the relative margin); for a
             spec with moving obstacles also ``motion`` and ``moving_obstacles`` (index,
@@ -410,6 +412,8 @@ class Design:
             "segments": [{"start": s.start, "end": s.end, "profile": s.profile}
                          for s in tube.segments],
             "gain": tube.gain,
+            "timing": {"rate_hz": tube.rate_hz, "period_s": 1.0 / tube.rate_hz,
+                       "delay_s": self.spec.delay, "jitter_s": self.spec.jitter},
             "certificate": {
                 "passed": self.certificate.passed,
                 "horizon": "inf" if math.isinf(self.certificate.horizon)
