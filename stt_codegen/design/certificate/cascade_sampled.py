@@ -44,7 +44,7 @@ from ...spec.variants import require_variant
 from ...tube import reference
 from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from ...tube.second_stage import SecondStage
-from .sampled import DELAY_HALVINGS, largest_passing
+from .sampled import DELAY_HALVINGS, largest_passing, worst_near
 from .sampled_axis import axis_interval, peak, phi_scalar, phi_slope_scalar
 
 __all__ = ["CascadeClass", "CascadeCheck", "cascade_check_of", "cascade_class", "model_within_class",
@@ -284,17 +284,6 @@ def _union(intervals) -> tuple[float, float, float, float]:
     return p_lo, p_hi, x_lo, x_hi
 
 
-def _near(values: np.ndarray, jitter: float, pick) -> np.ndarray:
-    """``values[k]`` (rows per interval), or with jitter the worst (``pick``:
-    ``np.minimum`` or ``np.maximum``) of intervals ``k - 1 .. k + 1``, as the first order's
-    sampled check widens its bounds."""
-    if not jitter > 0.0:
-        return values
-    before = np.concatenate([values[:1], values[:-1]])
-    after = np.concatenate([values[1:], values[-1:]])
-    return pick(pick(before, values), after)
-
-
 def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: SecondStage,
                           plants: CascadeClass, initial_velocity, *, delay: float = 0.0,
                           jitter: float = 0.0) -> CascadeCheck:
@@ -394,14 +383,14 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     half_l, centre_l = half.tolist(), centre.tolist()
     # with jitter an interval reaches into its neighbours: the tube's enclosure is the
     # worst of intervals k - 1 .. k + 1, in absolute units (then in interval k's coordinates)
-    upper_min, lower_max = (_near(enc.upper_min, jitter, np.minimum),
-                            _near(enc.lower_max, jitter, np.maximum))
-    upper_max, lower_min = (_near(enc.upper_max, jitter, np.maximum),
-                            _near(enc.lower_min, jitter, np.minimum))
+    upper_min, lower_max = (worst_near(enc.upper_min, jitter, np.minimum),
+                            worst_near(enc.lower_max, jitter, np.maximum))
+    upper_max, lower_min = (worst_near(enc.upper_max, jitter, np.maximum),
+                            worst_near(enc.lower_min, jitter, np.minimum))
     up_e = ((upper_min - centre[:count]) / half[:count]).tolist()
     low_e = ((lower_max - centre[:count]) / half[:count]).tolist()
     room_up, room_low = upper_min.tolist(), lower_max.tolist()
-    width_min = _near(enc.width_min, jitter, np.minimum).tolist()
+    width_min = worst_near(enc.width_min, jitter, np.minimum).tolist()
     width_max = (upper_max - lower_min).tolist()
     move = ((lower_max - lower_min) + (upper_max - upper_min)).tolist()
     if timed:

@@ -42,7 +42,7 @@ from .sampled_axis import axis_interval, peak, peak_scalar, phi_scalar, phi_slop
 
 __all__ = ["DELAY_HALVINGS", "RATE_FACTORS", "SampledCheck", "check_sampled",
            "check_sampled_first_per_axis", "largest_delay", "largest_passing", "lowest_rate",
-           "sampled_check_of"]
+           "sampled_check_of", "worst_near"]
 
 #: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
 RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
@@ -141,18 +141,31 @@ def _ball(level: float, limits: list[float], halves: list[float], reach: list[fl
     return math.inf, math.inf
 
 
-def _widened(values: list, count: int, jitter: bool, pick) -> list:
-    """``values[k]`` per interval, or with sampling jitter the worst (``pick``: ``min`` or
-    ``max``, elementwise for rows) of intervals ``k - 1 .. k + 1``: a measurement interval
-    ``[s_k, s_{k+1}]`` lies within ``[t_k - jitter, t_{k+1} + jitter]``."""
-    if not jitter:
+def worst_near(values: np.ndarray, jitter: float, pick) -> np.ndarray:
+    """``values[k]`` per interval (rows: ``values[k, :]``), or with sampling jitter the
+    worst (``pick``: ``np.minimum`` or ``np.maximum``) of intervals ``k - 1 .. k + 1``: a
+    measurement interval ``[s_k, s_{k+1}]`` lies within ``[t_k - jitter, t_{k+1} +
+    jitter]``.
+
+    Parameters
+    ----------
+    values : ndarray, shape (K,) or (K, n)
+        A bound per sampling interval.
+    jitter : float
+        ``[controller] jitter``, s; 0 returns ``values`` itself.
+    pick : numpy ufunc
+        ``np.minimum`` for a lower bound of a least value, ``np.maximum`` otherwise.
+
+    Returns
+    -------
+    ndarray
+        The shape of ``values``.
+    """
+    if not jitter > 0.0:
         return values
-    out = []
-    for k in range(count):
-        near = values[max(k - 1, 0):min(k + 2, count)]
-        out.append([pick(column) for column in zip(*near)] if isinstance(values[k], list)
-                   else pick(near))
-    return out
+    before = np.concatenate([values[:1], values[:-1]])
+    after = np.concatenate([values[1:], values[-1:]])
+    return pick(pick(before, values), after)
 
 
 def _old_push(k: int, i: int, block: tuple[int, ...], reach_prev: list[float] | None,
@@ -265,22 +278,22 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     half = 0.5 * width
     centre = 0.5 * (hi + lo)
     pull = 4.0 * dt * k_gain / width                      # (K+1, n): dt |u| / phi per unit g
-    g_min_l = _widened(bounds.g_min.tolist(), count, jitter > 0.0, min)
+    g_min_l = worst_near(bounds.g_min, jitter, np.minimum).tolist()
     ratio = half[:count] / (pull[:count] * np.array(g_min_l)[:, None])
     # s* of each share of the period the own command acts (a share of 0: no pull, s* = 1-)
     peaks = {share: peak(ratio / share).tolist() if share > 0.0 else
              np.full_like(ratio, 1.0 - 1e-15).tolist() for share in shares}
     # the tube's inner edges over the measurement interval, in state units (with jitter the
     # worst of the neighbouring intervals), then in interval k's coordinates
-    upper_min = np.array(_widened(enclosure.upper_min.tolist(), count, jitter > 0.0, min))
-    lower_max = np.array(_widened(enclosure.lower_max.tolist(), count, jitter > 0.0, max))
+    upper_min = worst_near(enclosure.upper_min, jitter, np.minimum)
+    lower_max = worst_near(enclosure.lower_max, jitter, np.maximum)
     up_e = ((upper_min - centre[:count]) / half[:count]).tolist()
     low_e = ((lower_max - centre[:count]) / half[:count]).tolist()
     alpha = (half[:count] / half[1:count + 1]).tolist()
     beta = ((centre[:count] - centre[1:count + 1]) / half[1:count + 1]).tolist()
     half_l, centre_l, pull_l = half.tolist(), centre.tolist(), pull.tolist()
-    g_max_l = _widened(bounds.g_max.tolist(), count, jitter > 0.0, max)
-    skew_l, coupling_l, push_l = (_widened(v.tolist(), count, jitter > 0.0, max) for v in
+    g_max_l = worst_near(bounds.g_max, jitter, np.maximum).tolist()
+    skew_l, coupling_l, push_l = (worst_near(v, jitter, np.maximum).tolist() for v in
                                   (bounds.skew, bounds.coupling, bounds.push))
     reach_prev = None                                     # |e(s_{k-1})| bound: no command yet
     turn = a.input_gain_turn                              # (per |u|, constant) or None
