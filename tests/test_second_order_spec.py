@@ -72,12 +72,55 @@ def test_no_second_order_table_and_the_models_are_plant_models() -> None:
 
 def test_defaults() -> None:
     data = _changed({"plant.parameters": None, "initial.velocity": None,
-                     "state_space.velocity_bound": None})
+                     "state_space.velocity_bound": [3.0, 3.0, 2.0]})
     data.pop("assumptions")
     order = stt.Spec.from_dict(data).second_order
     assert order.parameters == (1.0, 0.3, 9.81)         # the model's nominal ones
-    assert order.initial_velocity == (0.0, 0.0, 0.0) and order.velocity_bound is None
-    assert order.input_gain == (1.0, 1.0) and order.drift_bound == 0.0
+    assert order.initial_velocity == (0.0, 0.0, 0.0)
+    # the model's own class: g = 1 / mass; gravity plus the drag at the velocity bound
+    assert order.input_gain == (1.0, 1.0)
+    assert order.drift_bound == pytest.approx(max(0.3 * 3.0, 9.81 + 0.3 * 2.0), rel=1e-15)
+
+
+def test_the_quadrotors_own_class_is_derived_from_its_parameters() -> None:
+    data = _changed({"plant.parameters": [1.2, 0.3, 9.81],
+                     "state_space.velocity_bound": [3.0, 3.0, 3.0]})
+    data.pop("assumptions")
+    spec = stt.Spec.from_dict(data)
+    assert spec.second_order.input_gain == (1 / 1.2, 1 / 1.2)
+    assert spec.second_order.drift_bound == pytest.approx(9.81 + 0.3 * 3.0 / 1.2, rel=1e-15)
+    from stt_codegen.design.certificate.cascade_sampled import model_within_class
+    assert model_within_class(spec)[0]          # the simulated plant is in the class
+    # the drag grows with the velocity: without a velocity bound it must be declared
+    data["state_space"].pop("velocity_bound")
+    with pytest.raises(SpecError, match="give state_space.velocity_bound") as info:
+        stt.Spec.from_dict(data)
+    assert info.value.field == "assumptions.drift_bound"
+
+
+def test_the_arms_own_class_holds_on_a_grid_of_its_states() -> None:
+    """The arm's input gain and drift bound (convexity in cos q2, norms) against
+    ``M(q)^-1`` and ``f`` evaluated on a grid of joint angles and velocities."""
+    from stt_codegen.runtime.second_order_plants import input_matrix, second_order_rhs
+    from stt_codegen.spec.second_order import MODELS, model_bounds
+    params = (1.0, 1.2, 0.8, 1.1, 0.1, 0.07, 9.81)
+    lower, upper, vmax = (-0.4, 0.3), (2.0, 2.9), (1.5, 2.0)
+    own = model_bounds("two-link-arm", params, 2, vmax, lower, upper)
+    g_of, rhs = input_matrix("two-link-arm", 2), second_order_rhs("two-link-arm", 2)
+    eigen, drift = [], 0.0
+    for q1 in np.linspace(lower[0], upper[0], 7):
+        for q2 in np.linspace(lower[1], upper[1], 41):
+            g = np.array(g_of([q1, q2], [0.0, 0.0], params))
+            eigen += list(np.linalg.eigvalsh(0.5 * (g + g.T)))
+            for v1 in (-vmax[0], 0.0, vmax[0]):
+                for v2 in (-vmax[1], 0.0, vmax[1]):
+                    acc = np.array(rhs([q1, q2], [v1, v2], [0.0, 0.0], [0.0, 0.0], params)[1])
+                    drift = max(drift, float(np.max(np.abs(acc))))
+    g_min, g_max = own.input_gain
+    assert g_min <= min(eigen) and max(eigen) <= g_max
+    assert min(eigen) < 1.05 * g_min and max(eigen) > 0.95 * g_max      # tight at the ends
+    assert drift <= own.drift_bound
+    assert len(MODELS["two-link-arm"].parameters) == len(params)
 
 
 @pytest.mark.parametrize("change,field", [

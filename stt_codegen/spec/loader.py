@@ -894,9 +894,12 @@ def _second_order(doc: Any, n: int) -> SecondOrder | None:
                             f"a second-order plant.model ({model!r}) takes only "
                             f"{' and '.join(SECOND_ORDER_ASSUMPTIONS)} in [assumptions] "
                             "(the bounds of its second stage)")
+    declared = table.model_fields_set
     return parse_second_order(model, n, doc.plant.parameters, doc.initial.velocity,
-                              doc.state_space.velocity_bound, table.input_gain,
-                              table.drift_bound)
+                              doc.state_space.velocity_bound,
+                              table.input_gain if "input_gain" in declared else None,
+                              table.drift_bound if "drift_bound" in declared else None,
+                              (doc.state_space.lower, doc.state_space.upper))
 
 
 def _assumptions(table: AssumptionsTable, n: int, amplitude: float, model: str,

@@ -256,7 +256,7 @@ class AssumptionsTable(_Table):
     input_gain: Annotated[list[Number], Field(min_length=2, max_length=2)] = _omitted(
         "[g_min, g_max]: bounds on the eigenvalues of the symmetric part of g(x); "
         "g_min > 0 (Assumption 2); default [1, 1]. For a second-order model: of the second "
-        "stage's g")
+        "stage's g; default the model's own (1 / mass; M(q)^-1 over the state space)")
     input_gain_skew: NonNegative = Field(0.0, description="bound on the norm of the skew "
                                                           "part of g(x)")
     input_gain_coupling: NonNegative = _omitted("bound on the off-diagonal part of each row "
@@ -264,7 +264,10 @@ class AssumptionsTable(_Table):
     drift_bound: NonNegative = Field(0.0, description="bound on |f(x)|, state units per "
                                                       "second. For a second-order model: "
                                                       "on every |f_i| of the second stage, "
-                                                      "velocity units per second")
+                                                      "velocity units per second; default "
+                                                      "the model's own (gravity; drag and "
+                                                      "Coriolis within state_space."
+                                                      "velocity_bound)")
     disturbance_bound: NonNegative = _omitted("bound on |w(t)|, state units per second; "
                                               "default sqrt(n) x plant.disturbance_amplitude")
     input_gain_lipschitz: Annotated[list[NonNegative],

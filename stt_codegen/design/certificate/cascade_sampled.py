@@ -40,6 +40,7 @@ from ..samples import TubeSamples, sample_tube
 from ...progress import report
 from ...spec.loader import Spec
 from ...spec.plants import SECOND_ORDER_PLANTS
+from ...spec.second_order import model_bounds
 from ...spec.variants import require_variant
 from ...tube import reference
 from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
@@ -625,34 +626,17 @@ def largest_cascade_delay(tube: TubeDesign, spec: Spec, stage: SecondStage,
                            else None, halvings)
 
 
-def _double_integrator_terms(p: dict, n: int) -> tuple[float, float, list[float]]:
-    return 1.0 / p["mass"], 0.0, [0.0] * n
-
-
-def _quadrotor_terms(p: dict, n: int) -> tuple[float, float, list[float]]:
-    offset = [0.0] * n
-    offset[2] = p["gravity"]
-    return 1.0 / p["mass"], p["drag"] / p["mass"], offset
-
-
-#: The second-order models with ``g = I / m`` and ``|f_i| <= slope |x2_i| + offset_i``:
-#: ``(parameters by name, n) -> (g, slope, offset)``. A model not here (the two-link arm)
-#: has no derived bounds, so its certificate covers the declared class only.
-MASS_MODEL_TERMS = {
-    "double-integrator": _double_integrator_terms,
-    "quadrotor": _quadrotor_terms,
-}
-
-
 def model_within_class(spec: Spec) -> tuple[bool, str, dict]:
     """Whether the spec's own simulated plant (``plant.model`` with ``plant.parameters``)
     belongs to its :func:`cascade_class`, so that the certificate covers it.
 
-    ``double-integrator``: ``g = I / m``, ``f = 0``. ``quadrotor``: ``g = I / m``, ``f =
-    -(c / m) x2 - g0 e3``, so ``|f_i| <= (c / m) |x2_i| + g0 [i = 3]``: within the drift
-    bound where ``|x2_i| < velocity_bound_i`` (which the certificate proves); without a
-    velocity bound only when ``c = 0``. ``two-link-arm``: not checked (its ``M(q)^-1`` and
-    Coriolis terms are not bounded here), so not covered.
+    The model's own bounds over the state space are
+    :func:`~stt_codegen.spec.second_order.model_bounds`'s. ``double-integrator``: ``g = I /
+    m``, ``f = 0``. ``quadrotor``: ``g = I / m``, ``f = -(c / m) x2 - g0 e3``, so ``|f_i| <=
+    (c / m) |x2_i| + g0 [i = 3]``: within the drift bound where ``|x2_i| <
+    velocity_bound_i`` (which the certificate proves); without a velocity bound only when
+    ``c = 0``. ``two-link-arm``: the eigenvalues of ``M(q)^-1`` over the joint ranges and
+    its Coriolis and gravity terms within ``velocity_bound``.
 
     Parameters
     ----------
@@ -667,27 +651,23 @@ def model_within_class(spec: Spec) -> tuple[bool, str, dict]:
     """
     order = spec.second_order
     cls = cascade_class(spec)
-    p = dict(zip(SECOND_ORDER_PLANTS[order.model].parameters, order.parameters))
-    terms = MASS_MODEL_TERMS.get(order.model)
-    if terms is None:
-        return False, (f"the {order.model} model's bounds are not derived: the certificate "
-                       "covers the declared class only, not this plant"), {}
-    n = spec.dimension
-    g, slope, offset = terms(p, n)
-    if slope > 0 and cls.velocity_bound is None:
-        drift = math.inf
-    else:
-        drift = max(offset[i] + slope * (cls.velocity_bound[i] if slope > 0 else 0.0)
-                    for i in range(n))
+    own = model_bounds(order.model, order.parameters, spec.dimension, cls.velocity_bound,
+                       spec.state_space.lower, spec.state_space.upper)
+    if own is None:
+        return False, (f"the {order.model} model has no equations: the certificate covers "
+                       "the declared class only, not this plant"), {}
+    g_min, g_max = own.input_gain
+    drift = math.inf if own.drift_bound is None else own.drift_bound
     bad = []
-    if not cls.g_min <= g <= cls.g_max:
-        bad.append(f"g = 1/mass = {g:.6g} outside input_gain [{cls.g_min:g}, {cls.g_max:g}]")
+    if not cls.g_min <= g_min <= g_max <= cls.g_max:
+        bad.append(f"g in [{g_min:.6g}, {g_max:.6g}] outside input_gain [{cls.g_min:g}, "
+                   f"{cls.g_max:g}]")
     if drift > cls.drift_bound * (1 + 1e-12):
         bad.append(f"max |f_i| = {drift:.6g} (within velocity_bound) exceeds drift_bound "
                    f"{cls.drift_bound:g}")
-    data = {"input_gain": g, "drift": drift}
+    data = {"input_gain": [g_min, g_max], "drift": drift}
     if bad:
         return False, (f"the spec's {order.model} plant is outside the class the certificate "
                        "covers: " + "; ".join(bad)), data
-    return True, (f"the spec's {order.model} plant (g = {g:.6g} I, max |f_i| = {drift:.6g} "
+    return True, (f"the spec's {order.model} plant ({own.words}; max |f_i| <= {drift:.6g} "
                   "within velocity_bound) is in the declared class"), data
