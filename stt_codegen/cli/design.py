@@ -134,6 +134,8 @@ def cmd_design(args: argparse.Namespace) -> int:
         peaks = ", ".join(f"|{name}| {p:.4g} <= {b:g}{unit}" for name, p, b in zip(
             spec.input_names, design.input_proof.peak, spec.input_bound))
         print(f"  PASS  input bound: {law} asks at most [{peaks}] (proved)")
+    if design.output_warning is not None:
+        print(f"  warning: {design.output_warning}")
     if args.plot:
         print(f"plot written to {args.plot}")
     if args.export is not None:

@@ -43,6 +43,8 @@ def cmd_verify(args: argparse.Namespace) -> int:
         print(json.dumps(report.to_json(), indent=2))
     else:
         print(str(report) if args.all else report.summary())
+        if design.output_warning is not None:
+            print(f"  warning: {design.output_warning}")
     return 0 if report.passed else 1
 
 

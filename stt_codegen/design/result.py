@@ -192,6 +192,42 @@ class Design:
         """
         return second_stage_for(self.tube, self.spec, self.check.min_width)
 
+    @cached_property
+    def output_warning(self) -> str | None:
+        """Why the command of a design without ``[actuator]`` is not bounded by an
+        actuator's range: the peak the certificate proves inside the declared class, and
+        the deployed clamp's bound outside it (:mod:`~stt_codegen.design.output_bound`);
+        ``None`` with ``[actuator] input_bound`` or for the first order's law (13).
+
+        Returns
+        -------
+        str or None
+            One sentence, in the spec's input names and unit.
+
+        Examples
+        --------
+        >>> import stt_codegen as stt
+        >>> design = stt.design_tube(stt.load_spec("second-order-s1"))
+        >>> design.output_warning.split(":")[0]
+        'no [actuator] input_bound'
+        """
+        spec = self.spec
+        limits = (None if spec.input_bound is not None else
+                  variant_of(spec).entry("output_limits")(self))
+        if limits is None:
+            return None
+        unit = f" {spec.input_unit}" if spec.input_unit else ""
+        inside = (", ".join(f"|{name}| <= {p:.4g}{unit}" for name, p in
+                            zip(spec.input_names, limits.proved.peak))
+                  if limits.proved.proved else "no bound (the sampled check fails)")
+        outside = ", ".join(f"|{name}| <= {c:.3g}{unit}" for name, c in
+                            zip(spec.input_names, limits.clamp))
+        return (f"no [actuator] input_bound: {variant_of(spec).input_words} is proved "
+                f"{inside} only for plants of the declared class; outside it (a heavier "
+                f"plant, a contact, an undeclared delay) only the clamp of the errors "
+                f"bounds it, {outside}; give [actuator] input_bound to have it proved "
+                "within the actuator's range and clamped there")
+
     @property
     def look_ahead(self) -> LookAhead:
         """The look-ahead variant's data of a differential-drive design: the axle offset
@@ -311,6 +347,8 @@ class Design:
                 zip(spec.input_names, self.input_proof.peak, spec.input_bound))
                 + f" (samples to t = {self.input_proof.horizon:g} s)"))
         rows += variant_of(spec).entry("summary_rows")(self)
+        if self.output_warning is not None:
+            rows.append(("warning", self.output_warning))
         if self.target_choice is not None:
             rows.append(("target", f"any_of[{self.target_choice}]"))
         if spec.tasks:
@@ -390,7 +428,8 @@ class Design:
             certified second stage's derivation and its sampled-data certificate,
             :func:`~stt_codegen.design.cascade_gain.second_stage_of`); for a spec with
             ``[robot]`` also ``robot`` (the radius, the state space as given and shrunk,
-            the inflated obstacle boxes: :func:`~stt_codegen.spec.robot.robot_json`).
+            the inflated obstacle boxes: :func:`~stt_codegen.spec.robot.robot_json`);
+            ``warnings`` (a list: :attr:`output_warning` where there is one).
         """
         tube = self.tube
         via = []
@@ -424,6 +463,7 @@ class Design:
                                for m in self.certificate.margins],
             },
             "design_time_s": self.design_time_s,
+            "warnings": [] if self.output_warning is None else [self.output_warning],
             **self._actuator_json(),
             **self._tasks_json(),
             **self._target_json(),

@@ -67,6 +67,8 @@ ROLES: Mapping[str, str] = MappingProxyType({
     "sampled_checks": "(spec, design, tube_check, progress) -> list of Check of the "
                       "sampled loop",
     "plant_within": "(spec, model) -> Check, the plant within the certified class",
+    "output_limits": "(design) -> OutputLimits of its command without [actuator] (the "
+                     "proved peak and the clamp's bound), or None: no warning",
 })
 
 
@@ -197,7 +199,8 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                embedded_command=_P + "cli.embedded:law13_command",
                model_checks=_P + "verification.command:first_order_model_checks",
                sampled_checks=_P + "verification.command:first_order_sampled_checks",
-               plant_within=_P + "verification.plant_within:first_order_within")),
+               plant_within=_P + "verification.plant_within:first_order_within",
+               output_limits=_P + "design.output_bound:no_output_limits")),
     "cascade": ControllerVariant(
         "cascade", "a second-order plant", "the cascade's input u", 2,
         " (positions, then velocities)",
@@ -223,7 +226,8 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                embedded_command=_P + "cli.embedded:variant_loop_command",
                model_checks=_P + "verification.command:no_model_checks",
                sampled_checks=_P + "verification.command:cascade_sampled_checks",
-               plant_within=_P + "verification.plant_within:cascade_within"),
+               plant_within=_P + "verification.plant_within:cascade_within",
+               output_limits=_P + "design.output_bound:cascade_output_limits"),
         MappingProxyType({"cascade": True}), timing_in_stage=True),
     "look-ahead": ControllerVariant(
         "look-ahead", "a differential-drive base", "the base's command (v, omega)", 1, "",
@@ -249,7 +253,8 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                embedded_command=_P + "cli.embedded:variant_loop_command",
                model_checks=_P + "verification.command:look_ahead_model_checks",
                sampled_checks=_P + "verification.command:look_ahead_sampled_checks",
-               plant_within=_P + "verification.plant_within:first_order_within")),
+               plant_within=_P + "verification.plant_within:first_order_within",
+               output_limits=_P + "design.output_bound:look_ahead_output_limits")),
 })
 assert tuple(CONTROLLER_VARIANTS) == VARIANTS
 
