@@ -22,6 +22,7 @@ command-line flags: the command line translates a parameter name into its flag.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 
@@ -95,6 +96,10 @@ class DesignError(SttError):
     tried : object, optional
         The best rejected tube (a ``TubeDesign``), for a plot of what was tried; ``None``
         where no tube was built.
+    advice : mapping of str to float, optional
+        What the message names as certified, by spec field (``{"controller.rate_hz":
+        230.0}``): each value was designed and certified with the rest of the spec
+        unchanged, so a program can follow it. Empty when nothing is named.
 
     Examples
     --------
@@ -113,9 +118,11 @@ class DesignError(SttError):
     SAMPLING_RATE | True
     """
 
-    def __init__(self, message: str, *, kind: Any = None, tried: Any = None) -> None:
+    def __init__(self, message: str, *, kind: Any = None, tried: Any = None,
+                 advice: Mapping[str, float] | None = None) -> None:
         self.kind = kind
         self.tried = tried
+        self.advice = dict(advice or {})
         super().__init__(message)
 
 

@@ -22,6 +22,7 @@ def test_a_deadline_too_short_names_one_that_is_then_certified(case, deadline):
     assert named is not None, str(raised.value)
     later = float(named.group(1))
     assert deadline < later <= 16 * deadline
+    assert raised.value.advice["prescribed_time"] == later     # for a program to follow
     design = stt.design_tube(dataclasses.replace(spec, prescribed_time=later))
     assert design.certificate.passed and design.spec.prescribed_time == later
 
@@ -37,3 +38,4 @@ def test_a_refusal_a_later_deadline_cannot_cure_is_left_as_it_is():
     with pytest.raises(stt.DesignError) as raised:
         stt.design_tube(spec)
     assert "prescribed_time =" not in str(raised.value)
+    assert raised.value.advice == {}

@@ -278,7 +278,9 @@ def test_umaze_at_100_hz_with_a_bound_is_refused_for_the_rate_naming_one():
     with pytest.raises(DesignError) as info:
         stt.design_tube(umaze([1.0, 1.0], rate_hz=100.0))
     assert info.value.kind is FailureKind.SAMPLING_RATE
-    assert re.search(r"controller\.rate_hz = [0-9.]+ is certified", str(info.value))
+    named = re.search(r"controller\.rate_hz = ([0-9.]+) is certified", str(info.value))
+    assert named is not None
+    assert info.value.advice["controller.rate_hz"] == float(named.group(1))
 
 
 @pytest.mark.slow
@@ -295,3 +297,24 @@ def test_the_generated_cascade_with_its_clamp_keeps_the_bound_in_closed_loop():
     assert result.satisfied and result.stayed_in_velocity_tube, result.to_json()
     assert all(u <= b for u, b in zip(result.max_abs_u, design.spec.input_bound))
     assert result.clamped_steps == 0
+
+
+@pytest.mark.slow
+def test_a_rate_that_keeps_the_tubes_but_not_the_bound_is_not_named_certified():
+    """The hovercraft at 500 Hz with 1 N thrusters: the cascade's rate search finds a rate
+    for the tubes, at which no design keeps the bound; the refusal says so, advises no
+    rate, and the prescribed_time it names is then certified with the bound."""
+    spec = stt.load_spec(str(Path(__file__).parent / "specs" / "hovercraft-force.toml"))
+    with pytest.raises(DesignError) as info:
+        stt.design_tube(spec)
+    words = str(info.value)
+    rate = re.search(r"controller\.rate_hz = ([0-9.]+) keeps the tubes but no design there "
+                     r"keeps actuator\.input_bound", words)
+    assert rate is not None, words
+    assert "controller.rate_hz" not in info.value.advice
+    with pytest.raises(DesignError):          # the rate is as the refusal says
+        stt.design_tube(dataclasses.replace(spec, rate_hz=float(rate.group(1))))
+    later = info.value.advice["prescribed_time"]
+    assert f"prescribed_time = {later:g} s is certified" in words
+    design = stt.design_tube(dataclasses.replace(spec, prescribed_time=later))
+    assert design.certificate.passed and design.input_proof.meets(spec.input_bound)

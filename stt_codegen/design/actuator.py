@@ -263,7 +263,8 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
             f"no bound on {law} can be proved for actuator.input_bound: the "
             f"sampled-data check fails for every design tried ({reasons})"
             + (f"; controller.rate_hz = {rate:g} is certified" if rate is not None else ""),
-            kind=FailureKind.INPUT_BOUND, tried=tried[0].design.tube if tried else None)
+            kind=FailureKind.INPUT_BOUND, tried=tried[0].design.tube if tried else None,
+            advice={} if rate is None else {"controller.rate_hz": rate})
     best = min(proved, key=lambda c: c.proof.ratio(bound))
     worst = max(range(len(bound)), key=lambda i: best.proof.peak[i] / bound[i])
     needs = ", ".join(f"{_round_up(v):g}" for v in best.proof.peak)
@@ -272,6 +273,8 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
                f"the best ({best.label}) asks up to {best.proof.peak[worst]:.3g}{unit} of "
                f"input {names[worst]} (bound {bound[worst]:g}{unit}) at t = "
                f"{best.proof.time[worst]:.3f} s")
+    if not advice_wanted():                   # the verdict only (a probe of a search)
+        raise DesignError(message, kind=FailureKind.INPUT_BOUND, tried=best.design.tube)
     works, why = smallest_prescribed_time(spec, design_free, prove,
                                           best.proof.ratio(bound))
     needs = f"[{needs}]" + (f" ({spec.input_unit})" if unit else "")
@@ -280,7 +283,8 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
                     f"digits), or input_bound = {needs} with this prescribed_time")
     else:
         message += f"; {why}; input_bound = {needs} works with this prescribed_time"
-    raise DesignError(message, kind=FailureKind.INPUT_BOUND, tried=best.design.tube)
+    raise DesignError(message, kind=FailureKind.INPUT_BOUND, tried=best.design.tube,
+                      advice={} if works is None else {"prescribed_time": works})
 
 
 def _round_up(value: float, digits: int = 3) -> float:

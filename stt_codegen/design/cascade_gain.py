@@ -400,4 +400,5 @@ def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage
                       f"{tube.rate_hz:g} Hz for the declared plants with any second stage "
                       f"tried ({len(SHAPES)} shapes; with the first: {first}); {need} "
                       "(docs/second-order.md, 'The sampled cascade')",
-                      kind=FailureKind.SAMPLING_RATE, tried=tube)
+                      kind=FailureKind.SAMPLING_RATE, tried=tube,
+                      advice={} if rate is None else {"controller.rate_hz": rate})

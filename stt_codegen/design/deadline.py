@@ -82,4 +82,5 @@ def deadline_refusal(spec: Spec, error: DesignError,
         low, high = (low, mid) if passes(mid) else (mid, high)
     time = grid_value(high)
     return DesignError(f"{error}; prescribed_time = {number_text(time)} s is certified",
-                       kind=error.kind, tried=error.tried)
+                       kind=error.kind, tried=error.tried,
+                       advice={**error.advice, "prescribed_time": time})

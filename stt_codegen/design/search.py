@@ -35,7 +35,7 @@ from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, certify_tube
 from .certificate.motion import certify_motion
 from .actuator import design_within_bound
 from .cascade_gain import cascade_input_proof
-from .failures import FailureKind, property_kind
+from .failures import FailureKind, advice_wanted, property_kind, without_advice
 from .grid import grid_index, grid_value, smallest_passing
 from .moving import MOTION_SPACE_TIME, design_moving, moves
 from .gain import derived_gain
@@ -438,7 +438,10 @@ def cascade_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> D
     default = design_free(free)
     # no second stage keeps the tubes at this rate, bound or not: the rate is what to
     # change (DesignError of kind SAMPLING_RATE naming the rate that is certified)
-    default.second_stage
+    try:
+        default.second_stage
+    except DesignError as error:
+        raise _rate_within_bound(spec, error) from None
 
     def design_free_or_default(candidate: Spec) -> Design:
         return default if candidate == free else design_free(candidate)
@@ -446,6 +449,29 @@ def cascade_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> D
     return design_within_bound(spec, design_free_or_default, prove=lambda design, judged:
                                cascade_input_proof(design.tube, judged,
                                                    design.check.min_width), name_rate=False)
+
+
+def _rate_within_bound(spec: Spec, error: DesignError) -> DesignError:
+    """``error`` (the cascade's refusal at the spec's rate, bound or not) whose named
+    ``controller.rate_hz`` is kept only when the whole design with ``[actuator]`` is then
+    certified (the rate was found for the tubes alone); else the rate is said to keep the
+    tubes only, and a ``prescribed_time`` may be named (:mod:`.deadline`)."""
+    rate = error.advice.get("controller.rate_hz")
+    if rate is None or not advice_wanted():
+        return error
+    with without_advice():                    # the verdict only
+        try:
+            _design_call(replace(spec, rate_hz=rate))
+        except DesignError:
+            pass
+        else:
+            return error
+    named = f"controller.rate_hz = {rate:g} is certified"
+    message = str(error).replace(named, f"controller.rate_hz = {rate:g} keeps the tubes but "
+                                        "no design there keeps actuator.input_bound")
+    return DesignError(message, kind=error.kind, tried=error.tried,
+                       advice={k: v for k, v in error.advice.items()
+                               if k != "controller.rate_hz"})
 
 
 def _design(spec: Spec, smoother: bool) -> Design:

@@ -116,17 +116,21 @@ def design_with_timing(spec: Spec, search: Callable[[Spec], Design]) -> Design:
     delay = _followable_delay(plain, spec)
     if delay is not None and 0.0 < delay < spec.delay:
         trials.append((replace(spec, delay=delay), f"controller.delay = "
-                       f"{number_text(delay, 3)} s is certified at {number_text(spec.rate_hz)} Hz"))
+                       f"{number_text(delay, 3)} s is certified at {number_text(spec.rate_hz)} Hz",
+                       ("controller.delay", delay)))
     with reference.numpy_math():
         rate, _ = lowest_rate(plain.tube, spec, plant_class(spec), spec.gain)
     if rate is not None and rate != spec.rate_hz:
         trials.append((replace(spec, rate_hz=rate), f"controller.rate_hz = "
-                       f"{number_text(rate)} is certified with {_timing_words(spec)}"))
-    works = [words for trial, words in trials if _passes(trial, search)]
+                       f"{number_text(rate)} is certified with {_timing_words(spec)}",
+                       ("controller.rate_hz", rate)))
+    kept = [(words, field) for trial, words, field in trials if _passes(trial, search)]
+    works = [words for words, _ in kept]
     advice = ("; " + "; ".join(works)) if works else (
         "; neither a shorter delay at this rate nor a rate up to 16 times it is certified "
         "(the design without the timing is)")
     raise DesignError(f"no design is certified with {_timing_words(spec)} at "
                       f"{number_text(spec.rate_hz)} Hz ({refused}){advice}",
                       kind=FailureKind.TIMING,
-                      tried=getattr(refused, "tried", None)) from None
+                      tried=getattr(refused, "tried", None),
+                      advice=dict(field for _, field in kept)) from None
