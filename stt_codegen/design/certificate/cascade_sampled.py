@@ -263,14 +263,21 @@ def step_velocity_change(k1: float, h: float, a: float, b: float, shift: float,
     h_ratio = 1.0 / half_n
     worst = 0.0
     edges = [a + (b - a) * j / STEP_PIECES for j in range(STEP_PIECES + 1)]
-    for c, d in zip(edges[:-1], edges[1:]):
-        lin = [(scale - 1.0) * c, (scale - 1.0) * d]
-        m_hi = max(lin) + shift + h_ratio * (-pull * phi_scalar(c))
-        m_lo = min(lin) + shift + h_ratio * (-pull * phi_scalar(d))
-        move = max(abs(m_hi), abs(m_lo)) + other * h_ratio
-        top = min(max(abs(c), abs(d)) + move, reach)
-        worst = max(worst, (2.0 * k1 / half_n) * phi_slope_scalar(top) * move
-                    + 2.0 * k1 * phi_scalar(max(abs(c), abs(d))) * abs(1.0 / half_n - 1.0 / half_k))
+    # phi at each edge once (phi is odd: phi(|e|) = |phi(e)|); the same values as per piece
+    phis = [phi_scalar(e) for e in edges]
+    widen = abs(1.0 / half_n - 1.0 / half_k)
+    slope_k, other_n, tilt = 2.0 * k1 / half_n, other * h_ratio, scale - 1.0
+    for j in range(STEP_PIECES):
+        c, d = edges[j], edges[j + 1]
+        lin_c, lin_d = tilt * c, tilt * d
+        m_hi = (lin_c if lin_c > lin_d else lin_d) + shift + h_ratio * (-pull * phis[j])
+        m_lo = (lin_d if lin_c > lin_d else lin_c) + shift + h_ratio * (-pull * phis[j + 1])
+        move = max(abs(m_hi), abs(m_lo)) + other_n
+        wide = abs(c) if abs(c) >= abs(d) else abs(d)
+        phi_wide = abs(phis[j]) if abs(c) >= abs(d) else abs(phis[j + 1])
+        top = min(wide + move, reach)
+        worst = max(worst, slope_k * phi_slope_scalar(top) * move
+                    + 2.0 * k1 * phi_wide * widen)
     return worst
 
 
