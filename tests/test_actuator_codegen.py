@@ -26,8 +26,8 @@ from stt_codegen.runtime.compiled import load_python_module
 from stt_codegen.spec.loader import parse_spec
 from stt_codegen.tube import reference as R
 from stt_codegen.tube.model import build_model
-from stt_codegen.tube.parameters import (STATUS_INPUT_CLAMPED, STATUS_OK,
-                                         STATUS_OUTSIDE_TUBE)
+from stt_codegen.tube.parameters import (STATUS_INPUT_CLAMPED, STATUS_OFF_PERIOD, STATUS_OK,
+                                         STATUS_OUTSIDE_TUBE, step_status)
 
 POINTS = 2000
 
@@ -81,7 +81,8 @@ def test_model_and_reference_clamp_and_report_it():
     _, tube = bounded()
     p = _points(tube)
     step = casadi_outputs(build_model(tube)["controller_step"], p)
-    u_ref, next_ref, status_ref = R.controller_status(tube, p["x"], p["t"], p["dt"], p["alpha"])
+    u_ref, next_ref, status_ref = R.law_status(tube, p["x"], p["t"], p["dt"], p["alpha"])
+    timed = R.controller_status(tube, p["x"], p["t"], p["dt"], p["alpha"])[2]
     u_law = R.law_step(tube, p["x"], p["t"], p["dt"], p["alpha"])[0]
     bound = np.array(tube.input_bound)
     assert np.all(np.abs(step[0]) <= bound) and np.all(np.abs(u_ref) <= bound)
@@ -93,6 +94,10 @@ def test_model_and_reference_clamp_and_report_it():
     assert np.array_equal(u_ref[~beyond], u_law[~beyond])
     assert np.array_equal(_statuses(step), status_ref)
     assert set(status_ref) == {STATUS_OK, STATUS_OUTSIDE_TUBE, STATUS_INPUT_CLAMPED}
+    # the step's status: OFF_PERIOD in place of OK and INPUT_CLAMPED off the period
+    assert np.array_equal(timed, step_status(status_ref, p["dt"], tube.rate_hz))
+    assert set(timed) == {STATUS_OK, STATUS_OUTSIDE_TUBE, STATUS_INPUT_CLAMPED,
+                          STATUS_OFF_PERIOD}
     inside = status_ref != STATUS_OUTSIDE_TUBE
     assert np.array_equal(status_ref[inside] == STATUS_INPUT_CLAMPED, beyond[inside].any(axis=1))
     assert np.all(np.abs(step[0] - u_ref) <= 1e-12 * np.maximum(1.0, np.abs(u_ref)))
@@ -113,8 +118,8 @@ def test_double_c_and_python_equal_the_model_bit_for_bit(tmp_path):
     control = casadi_outputs(clamped_control(model), p)
     assert np.array_equal(got["u"], step[0]) and np.array_equal(got["alpha_next"], step[1])
     assert np.array_equal(got["control_u"], control[0])
-    assert np.array_equal(got["status"], _statuses(step))
-    assert np.array_equal(got["control_status"], got["status"])
+    assert np.array_equal(got["status"], step_status(_statuses(step), p["dt"], tube.rate_hz))
+    assert np.array_equal(got["control_status"], _statuses(step))
     assert np.all(np.abs(got["u"]) <= np.array(tube.input_bound))
     mod = load_python_module(files[f"{spec.c_name}.py"], spec.c_name)
     rows = [mod.step(p["x"][i], p["t"][i], p["dt"][i], p["alpha"][i]) for i in range(POINTS)]

@@ -17,7 +17,7 @@ from test_emit_python import casadi_dense, same_double
 from stt_codegen.codegen.cascade_source import cascade_c_files, cascade_python_file
 from stt_codegen.codegen.emit import python_function
 from stt_codegen.tube import cascade, cascade_reference
-from stt_codegen.tube.parameters import E_MAX, Status
+from stt_codegen.tube.parameters import E_MAX, Status, step_status
 from stt_codegen.tube.second_stage import SecondStage
 
 CC = shutil.which("gcc") or shutil.which("clang")
@@ -172,7 +172,7 @@ def test_emitted_c_double_is_bit_identical_and_checks_inputs(tmp_path, tube) -> 
         x, alpha = p["state"][k], p["alpha"][k]
         code, *got = step(x, float(p["t"][k]), float(p["dt"][k]), alpha)
         expected = casadi_dense(function, [x, [p["t"][k]], [p["dt"][k]], alpha])
-        assert code == Status.OK
+        assert code == step_status(Status.OK, p["dt"][k], tube.rate_hz)    # OFF_PERIOD off it
         for out, exp in zip(got, expected):
             assert all(same_double(float(a), b) for a, b in zip(out, exp))
     # outside the domain: INVALID_INPUT, u = 0, r = 0, alpha kept (non-finite entries 0)
@@ -240,7 +240,8 @@ def test_generated_python_runs_and_matches_the_oracle(tube) -> None:
         u, alpha_next, status = namespace["step"](p["state"][k], p["t"][k], p["dt"][k],
                                                   p["alpha"][k])
         r, r_status = namespace["virtual_velocity"](p["state"][k], p["t"][k], p["alpha"][k])
-        assert status == r_status == namespace["STATUS_OK"] == Status.OK
+        assert r_status == namespace["STATUS_OK"] == Status.OK
+        assert status == step_status(Status.OK, p["dt"][k], tube.rate_hz)
         np.testing.assert_allclose(u, expected[0][k], rtol=1e-10, atol=1e-12)
         np.testing.assert_allclose(r, expected[2][k], rtol=1e-10, atol=1e-12)
     invalid = namespace["step"](p["state"][0], -1.0, 1e-3, p["alpha"][0])
@@ -325,8 +326,11 @@ def test_emitted_c_with_a_bound_is_bit_identical_and_reports_input_clamped(tmp_p
             assert all(same_double(float(a), b) for a, b in zip(out, exp))
         inside_p, inside_v, within = (e[0] for e in expected[3:])
         assert inside_p == 1.0
-        assert code == (Status.OUTSIDE_VELOCITY_TUBE if inside_v == 0.0 else
-                        Status.INPUT_CLAMPED if within == 0.0 else Status.OK)
+        assert code == step_status(Status.OUTSIDE_VELOCITY_TUBE if inside_v == 0.0 else
+                                   Status.INPUT_CLAMPED if within == 0.0 else Status.OK,
+                                   p["dt"][k], bounded.rate_hz)
+        code = (Status.OUTSIDE_VELOCITY_TUBE if inside_v == 0.0 else     # the law's status
+                step(x, float(p["t"][k]), 1.0 / bounded.rate_hz, alpha)[0])
         assert np.all(np.abs(got[0]) <= np.array(bounded.input_bound))
         codes.append(code)
     assert {Status.OK, Status.INPUT_CLAMPED, Status.OUTSIDE_VELOCITY_TUBE} <= set(codes)
@@ -370,7 +374,10 @@ def test_generated_python_with_a_bound_reports_input_clamped(tube, bounded) -> N
     for k in range(60):
         u, _, status = namespace["step"](p["state"][k], p["t"][k], p["dt"][k],
                                          p["alpha"][k])
-        assert status == (Status.OK if expected[5][k] else Status.INPUT_CLAMPED)
+        assert status == step_status(Status.OK if expected[5][k] else Status.INPUT_CLAMPED,
+                                     p["dt"][k], bounded.rate_hz)
+        status = namespace["step"](p["state"][k], p["t"][k], namespace["PERIOD"],
+                                   p["alpha"][k])[2]                  # the law's status
         np.testing.assert_allclose(u, expected[0][k], rtol=1e-10, atol=1e-12)
         statuses.append(status)
     assert len(set(statuses)) == 2
@@ -390,7 +397,7 @@ def test_vectors_with_a_bound_cover_clamped_steps_and_the_c_meets_them(tmp_path,
     lib, _ = _load(tmp_path, bounded, precision)
     step = _c_step(lib, precision)
     for v in data["vectors"]:
-        code, u, alpha_next, r = step(v["x"], v["t"], data["dt"], v["alpha"])
+        code, u, alpha_next, r = step(v["x"], v["t"], v["dt"], v["alpha"])
         assert code == v["status"]
         assert np.all(np.abs(u) <= np.array(bounded.input_bound, dtype=u.dtype))
         for got, name in ((u, "u"), (r, "r"), (alpha_next, "alpha_next")):

@@ -58,7 +58,8 @@ def _build(tmp_path: Path, case: str, precision: str):
 
     def call(x, t, dt, alpha, u, alpha_next, r):
         """The step into u and alpha_next, the accessor into r; the step's code (the
-        accessor's checked to agree: OK where the step's is)."""
+        accessor's checked to agree: OK where the step's is OK, OUTSIDE_VELOCITY_TUBE,
+        INPUT_CLAMPED or OFF_PERIOD)."""
         code = step(x, t, dt, alpha, u, alpha_next)
         assert virtual(x, t, alpha, r) == (code if code in (0, 1, 2) else 0)
         return code
@@ -79,7 +80,7 @@ def test_committed_c_meets_its_vectors(tmp_path, case, precision) -> None:
     pointer = ctypes.POINTER(real)
     assert len(data["vectors"]) >= 32
     ratios = {"u": 0.0, "r": 0.0, "alpha_next": 0.0}
-    tight = []
+    tight, codes = [], []
     for v in data["vectors"]:
         x, alpha = (np.ascontiguousarray(v[k], dtype=dtype) for k in ("x", "alpha"))
         # the inputs are exact in the precision, as the bound assumes
@@ -87,9 +88,11 @@ def test_committed_c_meets_its_vectors(tmp_path, case, precision) -> None:
                    for a, k in ((x, "x"), (alpha, "alpha")))
         n = x.size // 2
         u, alpha_next, r = np.zeros(n, dtype), np.zeros(2 * n, dtype), np.zeros(n, dtype)
-        code = step(x.ctypes.data_as(pointer), v["t"], data["dt"], alpha.ctypes.data_as(pointer),
+        code = step(x.ctypes.data_as(pointer), v["t"], v["dt"], alpha.ctypes.data_as(pointer),
                     *(a.ctypes.data_as(pointer) for a in (u, alpha_next, r)))
-        assert code == v["status"] == 0
+        # OK at the period (the document's dt), OFF_PERIOD off it
+        assert code == v["status"] == (0 if v["dt"] == data["dt"] else 5)
+        codes.append(code)
         assert np.all(np.isfinite(u)) and np.all(np.isfinite(alpha_next))
         for got, name in ((u, "u"), (r, "r"), (alpha_next, "alpha_next")):
             error = np.abs(got.astype(np.float64) - np.array(v[name]))
@@ -98,6 +101,7 @@ def test_committed_c_meets_its_vectors(tmp_path, case, precision) -> None:
             ratios[name] = max(ratios[name], float(np.max(error / tolerance)))
         tight.extend(np.array(v["tol_u"]) < 0.1 * np.abs(v["u"]))
     assert all(ratio <= 1.0 for ratio in ratios.values()), ratios
+    assert set(codes) == {0, 5}
     if precision == "single":
         assert np.mean(tight) >= SINGLE_U_SHARE, np.mean(tight)
 
@@ -111,14 +115,17 @@ def test_committed_python_meets_its_vectors(case) -> None:
     assert [line for line in source.splitlines() if line.startswith(("import", "from"))] \
         == ["import math"]
     data = _vectors(case)
-    for v in data["vectors"][::4]:
-        u, alpha_next, status = namespace["step"](v["x"], v["t"], data["dt"], v["alpha"])
+    statuses = []
+    for v in data["vectors"][::4] + data["vectors"][-1:]:     # the last: off the period
+        u, alpha_next, status = namespace["step"](v["x"], v["t"], v["dt"], v["alpha"])
         r, r_status = namespace["virtual_velocity"](v["x"], v["t"], v["alpha"])
-        assert status == r_status == v["status"]
+        assert status == v["status"] and r_status == namespace["STATUS_OK"]
+        statuses.append(status)
         np.testing.assert_allclose(r, v["r"], rtol=DOUBLE_TOLERANCE, atol=DOUBLE_TOLERANCE)
         np.testing.assert_allclose(u, v["u"], rtol=DOUBLE_TOLERANCE, atol=DOUBLE_TOLERANCE)
         np.testing.assert_allclose(alpha_next, v["alpha_next"], rtol=DOUBLE_TOLERANCE,
                                    atol=DOUBLE_TOLERANCE)
+    assert set(statuses) == {namespace["STATUS_OK"], namespace["STATUS_OFF_PERIOD"]}
 
 
 CPPCHECK = shutil.which("cppcheck")
@@ -202,7 +209,7 @@ def test_table_driven_c_is_bit_identical_to_casadi(tmp_path, case, bounded) -> N
 
     from stt_codegen.codegen.cascade_source import cascade_c_files
     from stt_codegen.tube import cascade, cascade_reference
-    from stt_codegen.tube.parameters import Status
+    from stt_codegen.tube.parameters import Status, step_status
 
     design = design_of(case)
     stage, _ = design.second_stage
@@ -233,7 +240,7 @@ def test_table_driven_c_is_bit_identical_to_casadi(tmp_path, case, bounded) -> N
     entry.argtypes = [pointer, ctypes.c_double, ctypes.c_double, pointer, pointer, pointer]
     virtual.argtypes = [pointer, ctypes.c_double, pointer, pointer]
     function = cascade.cascade_step(tube, stage)
-    codes = set()
+    codes, timed = set(), set()
     for push in (0.0, 3.0):
         for k in range(150):
             x = np.ascontiguousarray(state[k], dtype=np.float64)
@@ -249,9 +256,12 @@ def test_table_driven_c_is_bit_identical_to_casadi(tmp_path, case, bounded) -> N
             for got, exp in zip((u, alpha_next, r_c), expected):
                 assert all(same_double(float(a), b) for a, b in zip(got, exp)), (k, push)
             flags = [e[0] for e in expected[3:]] + ([] if bounded else [1.0])
-            assert code == (Status.OUTSIDE_TUBE if flags[0] == 0.0 else
-                            Status.OUTSIDE_VELOCITY_TUBE if flags[1] == 0.0 else
-                            Status.INPUT_CLAMPED if flags[2] == 0.0 else Status.OK)
-            codes.add(code)
+            law = (Status.OUTSIDE_TUBE if flags[0] == 0.0 else
+                   Status.OUTSIDE_VELOCITY_TUBE if flags[1] == 0.0 else
+                   Status.INPUT_CLAMPED if flags[2] == 0.0 else Status.OK)
+            assert code == step_status(law, p["dt"][k], tube.rate_hz)   # OFF_PERIOD off it
+            codes.add(law)
+            timed.add(code)
     assert Status.OK in codes and Status.OUTSIDE_VELOCITY_TUBE in codes
     assert (Status.INPUT_CLAMPED in codes) == bounded
+    assert Status.OK in timed and Status.OFF_PERIOD in timed

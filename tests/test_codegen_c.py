@@ -16,6 +16,7 @@ from stt_codegen.tube import reference as R
 from stt_codegen.codegen import tolerance as T
 from stt_codegen.codegen.functions import clamped_control
 from stt_codegen.design.samples import sample_tube
+from stt_codegen.tube.parameters import Status, step_status
 
 POINTS = 10_000
 DOUBLE_TOL = 1e-12
@@ -52,7 +53,10 @@ def test_double_matches_reference_and_casadi_exactly(case, root, points):
                       ("gamma_U_dot", g_u_dot), ("u", u), ("control_u", u),
                       ("alpha_next", alpha_next), ("alpha_step", alpha_next)):
         _close(got[name], ref, name)
-    assert np.all(inside == 1.0) and np.all(got["status"] == 0)
+    # the step's OFF_PERIOD where dt is not the period; P_control takes no dt
+    assert np.all(inside == 1.0)
+    assert np.array_equal(got["status"], step_status(np.zeros(len(t), int), dt, design.rate_hz))
+    assert Status.OK in got["status"] and Status.OFF_PERIOD in got["status"]
     assert np.all(got["control_status"] == 0) and np.all(got["tube_status"] == 0)
     # CasADi's VM, same libm, -ffp-contract=off: bit for bit.
     model = model_of(case)
@@ -88,7 +92,9 @@ def test_single_within_the_stated_bound(case, root, points):
         assert ratios[name] <= 1.0, (name, ratios[name])
     certain = T.status_certain(design, x, a, g_l, g_u, unit)
     assert certain.mean() > 0.9
-    assert np.all(got["status"][certain] == np.where(inside[certain] == 1.0, 0, 1))
+    law = np.where(inside == 1.0, Status.OK, Status.OUTSIDE_TUBE)
+    assert np.all(got["status"][certain] == step_status(law, dt, design.rate_hz)[certain])
+    assert np.all(got["control_status"][certain] == law[certain])
     # the bound is not vacuous: the errors use a real part of it somewhere
     assert max(ratios.values()) > 1e-3, ratios
 

@@ -12,6 +12,7 @@ from sampling import random_points
 from test_model_equivalence import casadi_outputs
 
 from stt_codegen.tube import reference as R
+from stt_codegen.tube.parameters import step_status
 from stt_codegen.runtime.compiled import load_python_module
 from stt_codegen.codegen.functions import clamped_control
 
@@ -34,7 +35,9 @@ def test_bit_identical_to_casadi_and_close_to_reference(case):
     rows = [mod.step(p["x"][i], p["t"][i], p["dt"][i], p["alpha"][i]) for i in range(POINTS)]
     u = np.array([r[0] for r in rows])
     nxt = np.array([r[1] for r in rows])
-    assert all(r[2] == mod.STATUS_OK for r in rows)
+    # inside: OK at the period, OFF_PERIOD off it
+    assert np.array_equal([r[2] for r in rows],
+                          step_status(np.full(POINTS, mod.STATUS_OK), p["dt"], design.rate_hz))
     tubes = [mod.tube(p["t"][i], p["alpha"][i]) for i in range(POINTS)]
     controls = np.array([mod.control(p["x"][i], p["t"][i], p["alpha"][i])[0] for i in range(POINTS)])
     model = model_of(case)

@@ -10,9 +10,12 @@ the state is the one whose tube point the code computes as exactly that point
 (:meth:`hard_helpers.HardCase.exact_state`: the point itself; the cascade's positions,
 with the velocity at the virtual velocity so that the velocity error is 0; the base
 whose look-ahead point it is, heading 0). Only the points one ulp inside may report OK,
-and they must (OK, or INPUT_CLAMPED under an actuator bound: inside, ``u`` clamped); every
-API function taking ``x`` reports the step's status. In double the status and ``u`` also
-equal the variant's CasADi step (``inside*`` and ``within_bound`` outputs) bit for bit.
+and they must (OK, or INPUT_CLAMPED under an actuator bound: inside, ``u`` clamped), at
+``dt = PERIOD``; every API function taking ``x`` reports that status. At the points' own
+``dt`` the step reports the same status, ``OFF_PERIOD`` in place of ``OK`` and
+``INPUT_CLAMPED`` where ``dt`` is not the period, with the same ``u``. In double the
+status and ``u`` also equal the variant's CasADi step (``inside*`` and ``within_bound``
+outputs) bit for bit.
 """
 
 from __future__ import annotations
@@ -23,6 +26,8 @@ from codegen_helpers import COMPILERS
 from hard_helpers import c_api, hard_case, variant_params
 from sampling import random_points
 from test_model_equivalence import casadi_outputs
+
+from stt_codegen.tube.parameters import step_status
 
 #: (kind, expected status names): where the point lies relative to the bound. Strictly
 #: inside is OK, or INPUT_CLAMPED where the header has an actuator bound (inside, u clamped).
@@ -110,7 +115,12 @@ def test_c_reports_ok_only_strictly_inside(variant, precision, root):
         if x is None:
             continue
         u, nxt = lib.nan("N_INPUT"), lib.nan("N_ALPHA")
-        s = lib.call("step", x=lib.arr(x), t=t, dt=dt, alpha=a, u=u, alpha_next=nxt)
+        s = lib.call("step", x=lib.arr(x), t=t, dt=lib.dtype(1.0 / case.tube.rate_hz),
+                     alpha=a, u=u, alpha_next=nxt)
+        u_dt = lib.nan("N_INPUT")
+        s_dt = lib.call("step", x=lib.arr(x), t=t, dt=dt, alpha=a, u=u_dt, alpha_next=nxt)
+        assert s_dt == step_status(s, dt, case.tube.rate_hz), (k, s, s_dt)
+        assert np.array_equal(u_dt, u), k
         for name in others:                      # P_control, P_virtual_velocity
             outs = {b.name: lib.nan(b.size) for b in case.functions[name] if b.kind == "out"}
             assert lib.call(name, x=lib.arr(x), t=t, alpha=a, **outs) == s, (name, k)
@@ -168,7 +178,10 @@ def test_python_reports_ok_only_strictly_inside(variant, root):
         x = case.exact_state(points[k], np.float64, velocity)
         if x is None:
             continue
-        _, _, status = module.step([float(v) for v in x], t, float(p["dt"][r]), alpha)
+        u, _, status = module.step([float(v) for v in x], t, module.PERIOD, alpha)
         assert status in _codes(case, KINDS[kinds[k]][1]), (KINDS[kinds[k]][0], k, status)
+        u_dt, _, status_dt = module.step([float(v) for v in x], t, float(p["dt"][r]), alpha)
+        assert status_dt == step_status(status, p["dt"][r], case.tube.rate_hz), (k, status_dt)
+        assert u_dt == u, k
         placed += 1
     assert placed > 0.9 * len(rows)

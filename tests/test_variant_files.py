@@ -177,8 +177,9 @@ def test_committed_c_python_and_casadi_steps_are_bit_identical(tmp_path, case) -
 
 
 def test_the_look_ahead_single_tolerance_of_u_is_not_vacuous() -> None:
-    """Single precision: where the status is OK every tolerance of ``(v, omega)`` is below
-    1 % of the value; the points cover the statuses OK, OUTSIDE_TUBE and INPUT_CLAMPED (a
+    """Single precision: where the law's status is OK every tolerance of ``(v, omega)`` is
+    below 1 % of the value; the points cover the statuses OK, OUTSIDE_TUBE and INPUT_CLAMPED,
+    and the step's OFF_PERIOD off the period (a
     clamped entry's tolerance is the unclamped command's, as in the first order). The
     committed vectors of office-base hold one OK point: at 200 Hz law (13)'s gain is four
     times 50 Hz's, and nearly every point inside the tube asks more than the base's limits
@@ -187,14 +188,24 @@ def test_the_look_ahead_single_tolerance_of_u_is_not_vacuous() -> None:
     from conftest import design_of
     from stt_codegen.codegen.look_ahead_source import look_ahead_vectors
     from stt_codegen.tube.look_ahead import LookAhead
+    from stt_codegen.tube.look_ahead_reference import look_ahead_status
+    from stt_codegen.tube.parameters import step_status
 
     committed = json.loads((REPO / "generated" / "office-base" / "single" /
                             "office_base_vectors.json").read_text())
     design = design_of("office-base")
     wider = LookAhead(design.look_ahead.axle_offset,
                       tuple(4.0 * b for b in design.look_ahead.input_bound))
-    for data, least_ok in ((committed, 1), (look_ahead_vectors(design.tube, wider, "single"), 8)):
+    for data, limits, least_ok in ((committed, design.look_ahead, 1),
+                                   (look_ahead_vectors(design.tube, wider, "single"), wider, 8)):
         u, tol, status = (np.array(data[k]) for k in ("u", "tol_u", "status"))
-        ok = status == 0
-        assert set(status.tolist()) == {0, 1, 3} and len(status) >= 32 and ok.sum() >= least_ok
+        # the law's status (the step's at dt = PERIOD; the step's is OFF_PERIOD off it)
+        law = look_ahead_status(design.tube, limits.axle_offset, limits.input_bound,
+                                np.array(data["x"]), np.array(data["t"]),
+                                np.full(len(status), 1.0 / design.tube.rate_hz),
+                                np.array(data["alpha"]))[2]
+        assert np.array_equal(status, step_status(law, data["dt"], design.tube.rate_hz))
+        ok = law == 0
+        assert set(law.tolist()) == {0, 1, 3} and len(status) >= 32 and ok.sum() >= least_ok
+        assert set(status.tolist()) == {0, 1, 3, 5}
         assert np.all(tol[ok] < 0.01 * np.abs(u[ok]))

@@ -35,7 +35,7 @@ import casadi
 
 from ..tube.cascade import cascade_step, velocity_law, velocity_tube
 from ..tube.model import build_model
-from ..tube.parameters import Status, TubeDesign
+from ..tube.parameters import Status, TubeDesign, step_status
 from ..tube.second_stage import SecondStage
 from ..version import __version__
 from ..design.result import Design
@@ -188,7 +188,7 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     """Test vectors of the cascade step from the numpy oracle (JSON-ready, deterministic).
 
     Points: ``t`` spread over ``[0, 1.1 t_c]`` where the tube at ``alpha = 0`` is at least
-    1e-3 wide, ``alpha = 0``, ``dt`` the design's period,
+    1e-3 wide, ``alpha = 0``, ``dt`` the design's period (the document's ``dt``),
     ``x1`` inside the position tube (``|e1| <= 0.9``), ``x2 = r + rho2 s`` with ``|s| <=
     0.9``, from a fixed seed; ``t``, ``dt``, ``x1`` and ``x2`` are float32 numbers (exact in
     both precisions, as the first-order vectors). Expected ``u``, ``r``, ``alpha_next`` and
@@ -200,7 +200,10 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     ``precision`` (double: with the floor ``1e-12 max(1, |ref|)``). With an actuator bound, the expected status is ``OK``
     or ``INPUT_CLAMPED`` as the oracle clamps, and only points whose clamp decision is
     certain in the precision are kept (every ``|u_i|`` of the law farther from the bound
-    than its tolerance plus the bound's rounding), as for the first order.
+    than its tolerance plus the bound's rounding), as for the first order. Then the copies
+    of :func:`.vectors.period_copies`: a point of the law's status ``OK`` (and one of
+    ``INPUT_CLAMPED``) again at ``dt = 1.5 PERIOD``, the step's status ``OFF_PERIOD``; each
+    vector has its own ``dt``.
 
     Raises
     ------
@@ -213,7 +216,7 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
     from ..rounding import round_up_array
     from ..tube import cascade_reference, reference
     from . import tolerance as T
-    from .vectors import sample_inputs
+    from .vectors import period_copies, sample_inputs
 
     sample_inputs(design, precision)      # raises SpecError where the precision cannot
     #                                       resolve the position tube (its points unused)
@@ -238,21 +241,33 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
                                                  t, dt, alpha)
     rho2 = cascade_reference.velocity_tube(stage, t)
     x2 = f32(r + rho2 * rng.uniform(-0.9, 0.9, (count, n)))
-    u, alpha_next, r, inside_p, inside_v, within = cascade_reference.cascade_step(
-        design, stage, np.hstack([x1, x2]), t, dt, alpha)
-    status = np.where(inside_p == 0, Status.OUTSIDE_TUBE,
-                      np.where(inside_v == 0, Status.OUTSIDE_VELOCITY_TUBE,
-                               np.where(within == 0, Status.INPUT_CLAMPED, Status.OK)))
     unit = T.unit_roundoff(precision)
-    tol_u, tol_r, tol_a = T.cascade_bounds(design, stage, x1, x2, t, alpha, r, alpha_next, unit)
-    # the tube's bound, as the first order's P_tube (vectors.vector_document)
-    tol_g = np.broadcast_to(T.gamma_bound(design, alpha, unit), g_l.shape)
-    if precision == "double":
-        tol_u, tol_r, tol_a = (T.with_double_floor(tol, ref) for tol, ref in
-                               ((tol_u, u), (tol_r, r), (tol_a, alpha_next)))
-        tol_g = T.with_double_floor(tol_g, np.maximum(np.abs(g_l), np.abs(g_u)))
-    # rounded up to a few digits: still bounds, and the same on every CPU (docs/codegen.md)
-    tol_u, tol_r, tol_a, tol_g = (round_up_array(tol) for tol in (tol_u, tol_r, tol_a, tol_g))
+
+    def outputs(t, x1, x2, alpha, dt):
+        # the oracle's outputs, the law's and the step's status, every tolerance
+        u, alpha_next, r, inside_p, inside_v, within = cascade_reference.cascade_step(
+            design, stage, np.hstack([x1, x2]), t, dt, alpha)
+        law = np.where(inside_p == 0, Status.OUTSIDE_TUBE,
+                       np.where(inside_v == 0, Status.OUTSIDE_VELOCITY_TUBE,
+                                np.where(within == 0, Status.INPUT_CLAMPED, Status.OK)))
+        g_l, g_u, _, _ = reference.adaptive_tube(design, t, alpha)
+        tol_u, tol_r, tol_a = T.cascade_bounds(design, stage, x1, x2, t, alpha, r, alpha_next,
+                                               unit)
+        # the tube's bound, as the first order's P_tube (vectors.vector_document)
+        tol_g = np.broadcast_to(T.gamma_bound(design, alpha, unit), g_l.shape)
+        if precision == "double":
+            tol_u, tol_r, tol_a = (T.with_double_floor(tol, ref) for tol, ref in
+                                   ((tol_u, u), (tol_r, r), (tol_a, alpha_next)))
+            tol_g = T.with_double_floor(tol_g, np.maximum(np.abs(g_l), np.abs(g_u)))
+        # rounded up to a few digits: still bounds, and the same on every CPU (docs/codegen.md)
+        tol_u, tol_r, tol_a, tol_g = (round_up_array(tol) for tol in (tol_u, tol_r, tol_a, tol_g))
+        return {"t": t, "x1": x1, "x2": x2, "alpha": alpha, "dt": dt, "u": u, "r": r,
+                "alpha_next": alpha_next, "law": law,
+                "status": step_status(law, dt, design.rate_hz), "gamma_L": g_l,
+                "gamma_U": g_u, "tol_u": tol_u, "tol_r": tol_r, "tol_alpha_next": tol_a,
+                "tol_gamma": tol_g}
+
+    rows = outputs(t, x1, x2, alpha, np.full(t.shape, dt))
     if design.input_bound is not None:
         # only points whose clamp decision is certain in the precision: every |u_i| of the
         # law farther from the bound than its error bound plus the bound's rounding (the
@@ -260,20 +275,26 @@ def cascade_vectors(design: TubeDesign, stage: SecondStage, count: int = VECTOR_
         free = cascade_reference.cascade_step(dataclasses.replace(design, input_bound=None),
                                               stage, np.hstack([x1, x2]), t, dt, alpha)[0]
         bound = np.asarray(design.input_bound)
-        keep = np.all(np.abs(np.abs(free) - bound) > tol_u + 2 * unit * bound, axis=1)
-        t, x1, x2, alpha, u, r, alpha_next, status, g_l, g_u, tol_u, tol_r, tol_a, tol_g = (
-            a[keep] for a in (t, x1, x2, alpha, u, r, alpha_next, status, g_l, g_u, tol_u,
-                              tol_r, tol_a, tol_g))
-        count = t.size
+        keep = np.all(np.abs(np.abs(free) - bound) > rows["tol_u"] + 2 * unit * bound, axis=1)
+        rows = {k: v[keep] for k, v in rows.items()}
+    # every vector is at the period: copies off it (vectors.period_copies), with the same
+    # u, r and law's status, alpha_next at their dt and the step's status OFF_PERIOD
+    copied, steps = period_copies(rows["dt"], rows["law"], design.rate_hz)
+    if copied.size:
+        extra = outputs(*(rows[k][copied] for k in ("t", "x1", "x2", "alpha")), steps)
+        rows = {k: np.concatenate([v, extra[k]]) for k, v in rows.items()}
+    count = rows["t"].size
     return {"_generated": "GENERATED FILE, DO NOT EDIT: cascade test vectors from the numpy "
                           "reference (stt_codegen.tube.cascade_reference).",
             "dt": dt, "precision": precision, "unit_roundoff": unit,
-            "vectors": [{"t": float(t[k]), "x": [*x1[k].tolist(), *x2[k].tolist()],
-                         "alpha": alpha[k].tolist(), "u": u[k].tolist(), "r": r[k].tolist(),
-                         "alpha_next": alpha_next[k].tolist(), "status": int(status[k]),
-                         "gamma_L": g_l[k].tolist(), "gamma_U": g_u[k].tolist(),
-                         "tol_u": tol_u[k].tolist(), "tol_r": tol_r[k].tolist(),
-                         "tol_alpha_next": tol_a[k].tolist(), "tol_gamma": tol_g[k].tolist()}
+            "vectors": [{"t": float(rows["t"][k]), "dt": float(rows["dt"][k]),
+                         "x": [*rows["x1"][k].tolist(), *rows["x2"][k].tolist()],
+                         **{key: rows[key][k].tolist() for key in ("alpha", "u", "r",
+                                                                    "alpha_next")},
+                         "status": int(rows["status"][k]),
+                         **{key: rows[key][k].tolist() for key in (
+                             "gamma_L", "gamma_U", "tol_u", "tol_r", "tol_alpha_next",
+                             "tol_gamma")}}
                         for k in range(count)]}
 
 
@@ -316,7 +337,7 @@ def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
         texts.update(build_files(context))
         rows = data["vectors"]
         inputs = {"x": [v["x"] for v in rows], "t": [v["t"] for v in rows],
-                  "dt": [data["dt"]] * len(rows), "alpha": [v["alpha"] for v in rows],
+                  "dt": [v["dt"] for v in rows], "alpha": [v["alpha"] for v in rows],
                   "status": [v["status"] for v in rows]}
         names = ("u", "alpha_next", "r", "gamma_L", "gamma_U")
         expected = [(f"EXP_{k.upper()}", [v[k] for v in rows], len(rows[0][k])) for k in names]

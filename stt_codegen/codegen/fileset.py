@@ -132,7 +132,9 @@ def selftest_file(context: dict, inputs: dict, expected: list[tuple[str, list, i
         The C templates' variables (``P``, ``U``, the banner's fields, ``real``).
     inputs : dict
         ``x`` (N, N_STATE), ``t`` (N,), ``dt`` (N,), ``alpha`` (N, N_ALPHA) and ``status``
-        (N,): the vectors' inputs (exact in the precision) and expected statuses.
+        (N,): the vectors' inputs (exact in the precision) and the step's expected
+        statuses; with ``control_status`` (N,), ``P_control``'s (a variant with
+        ``P_control``: the law's status, no ``OFF_PERIOD``).
     expected : list of (str, list of list of float, int)
         The tables of expected values and tolerances (``EXP_U``, ``TOL_U``, ...): name, rows,
         width; kept in double.
@@ -151,7 +153,8 @@ def selftest_file(context: dict, inputs: dict, expected: list[tuple[str, list, i
         template, filename=name, **context, count=len(inputs["t"]),
         x=c_literal_rows(inputs["x"], single), alpha=c_literal_rows(inputs["alpha"], single),
         t=c_literal_rows([inputs["t"]], single)[0], dt=c_literal_rows([inputs["dt"]], single)[0],
-        status=inputs["status"], tables=tables, tolerance_doc=TOLERANCE_DOC[precision])}
+        status=inputs["status"], control_status=inputs.get("control_status"), tables=tables,
+        tolerance_doc=TOLERANCE_DOC[precision])}
 
 
 def vector_tables(vectors: dict) -> list[tuple[str, list, int]]:

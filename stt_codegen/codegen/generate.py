@@ -23,7 +23,7 @@ from ..version import __version__
 from .emit import CPrinter, lower, python_source
 from ..tube.model import build_model
 from ..spec.loader import Spec
-from ..tube.parameters import NEWTON_ITERATIONS, TubeDesign
+from ..tube.parameters import NEWTON_ITERATIONS, PERIOD_TOLERANCE, TubeDesign
 from . import tolerance
 from .functions import deployed_functions
 from .fileset import (GENERATOR, MANIFEST, build_files, manifest, selftest_file,
@@ -152,6 +152,7 @@ def c_source_context(design: TubeDesign, prefix: str, precision: str,
                 spec_tables=design_table_rows(design, lambda v: c_real(v, single), single),
                 profile_codes={name: k for k, name in enumerate(PROFILE_NAMES)},
                 guard=f"{prefix.upper()}_H", zero=c_real(0.0, single),
+                period_tolerance=c_real(PERIOD_TOLERANCE, single),
                 t_c=c_real(design.prescribed_time, single),
                 rate_hz=c_real(design.rate_hz, single),
                 dt_min=c_real(limits["dt_min"], single),

@@ -150,7 +150,9 @@ def look_ahead_vectors(design: TubeDesign, look_ahead: LookAhead, precision: str
     kept where the status is still certain in the precision
     (:func:`.tolerance.look_ahead_bounds`) and, with the base's limits, where the clamp's
     decision is (every ``|u_i|`` farther from its limit than its tolerance plus the
-    limit's rounding). Expected ``u``, ``alpha_next``, status from
+    limit's rounding); then the copies of :func:`.vectors.period_copies` (the law's
+    ``OK`` and ``INPUT_CLAMPED`` each at ``dt = PERIOD`` and off it). Expected ``u``,
+    ``alpha_next``, the step's status from
     :func:`stt_codegen.tube.look_ahead_reference.look_ahead_status`, the tube from
     :func:`stt_codegen.tube.reference.adaptive_tube`; tolerances ``tol_u``
     (:func:`.tolerance.look_ahead_bounds`), ``tol_alpha_next``, ``tol_gamma`` (the first
@@ -176,7 +178,7 @@ def look_ahead_vectors(design: TubeDesign, look_ahead: LookAhead, precision: str
     from ..tube import look_ahead_reference as LR
     from ..tube import reference
     from . import tolerance as T
-    from .vectors import sample_inputs, vector_document
+    from .vectors import period_copies, sample_inputs, vector_document, with_copies
 
     def f32(a):
         return np.asarray(a, dtype=np.float32).astype(np.float64)
@@ -194,7 +196,13 @@ def look_ahead_vectors(design: TubeDesign, look_ahead: LookAhead, precision: str
     if look_ahead.input_bound is not None:
         bound = np.asarray(look_ahead.input_bound, dtype=float)
         keep &= np.all(np.abs(np.abs(u_free) - bound) > tol_u + 2.0 * unit * bound, axis=1)
-    states, t, dt, alpha, tol_u = (a[keep] for a in (states, t, dt, alpha, tol_u))
+    kept = {"x": states, "t": t, "dt": dt, "alpha": alpha, "tol_u": tol_u}
+    kept = {k: v[keep] for k, v in kept.items()}
+    # the law's status does not depend on dt: the step's at dt = PERIOD
+    law = LR.look_ahead_status(design, offset, look_ahead.input_bound, kept["x"], kept["t"],
+                               np.full(kept["t"].shape, 1.0 / design.rate_hz), kept["alpha"])[2]
+    kept = with_copies(kept, *period_copies(kept["dt"], law, design.rate_hz))
+    states, t, dt, alpha, tol_u = (kept[k] for k in ("x", "t", "dt", "alpha", "tol_u"))
     u, alpha_next, status = LR.look_ahead_status(design, offset, look_ahead.input_bound,
                                                  states, t, dt, alpha)
     return vector_document(design, precision, states, t, dt, alpha, u, alpha_next, status,

@@ -8,8 +8,11 @@ The inputs are float32 numbers (exact in both precisions), drawn with a fixed se
 bound the inside points' status is ``OK`` or ``INPUT_CLAMPED`` as the reference clamps
 ``u``, and only points whose clamp decision is certain in the precision are kept
 (every ``|u_i|`` of law (13) farther from ``input_bound_i`` than its error bound). Times cover ``[0, 1.2 t_c]``, so
-after ``t_c`` too. Expected values are the reference's (:mod:`stt_codegen.tube.reference`)
-at those inputs; tolerances are :mod:`~stt_codegen.codegen.tolerance`'s bounds for the
+after ``t_c`` too; ``dt`` is drawn from 1e-4, 1e-3 and 1e-2 s (the adaptive law over its
+``dt`` domain), and :func:`period_copies` appends copies of a few points so that the law's
+statuses ``OK`` and ``INPUT_CLAMPED`` each have a vector at ``dt = PERIOD`` (the step's
+status is the law's) and one off it (``OFF_PERIOD``). Expected values are the reference's
+(:mod:`stt_codegen.tube.reference`) at those inputs; tolerances are :mod:`~stt_codegen.codegen.tolerance`'s bounds for the
 chosen precision (double: with the floor ``1e-12 max(1, |ref|)``).
 
 The search is bounded (:data:`ROUNDS` rounds of :data:`BATCH` candidates). A precision
@@ -27,12 +30,12 @@ import numpy as np
 from ..errors import SpecError
 from ..rounding import round_up_array
 from ..tube import reference as R
-from ..tube.parameters import TubeDesign
+from ..tube.parameters import Status, TubeDesign, off_period
 from . import tolerance as T
 from .errors import CodegenError
 
-__all__ = ["BATCH", "INSIDE", "OUTSIDE", "ROUNDS", "sample_inputs", "test_vectors",
-           "vector_document"]
+__all__ = ["BATCH", "INSIDE", "OFF_PERIOD_FACTOR", "OUTSIDE", "ROUNDS", "period_copies",
+           "sample_inputs", "test_vectors", "vector_document", "with_copies"]
 
 INSIDE = 48
 OUTSIDE = 8
@@ -46,6 +49,8 @@ ROUNDS = 200
 #: ``|e| - 1 > 4 (1 + |e|) dg / w``, so ``w > 12 dg`` at ``|e| = 2``; 16 leaves a third
 #: of the OUTSIDE draws.
 RESOLUTION = 16.0
+#: ``dt`` of the off-period copies of :func:`period_copies`, in periods.
+OFF_PERIOD_FACTOR = 1.5
 
 
 def _f32(a) -> np.ndarray:
@@ -146,6 +151,67 @@ def _clamp_certain(design: TubeDesign, x, t, alpha, g_l, g_u, unit: float) -> np
     return np.all(np.abs(np.abs(u) - bound) > tol, axis=1)
 
 
+def period_copies(dt, status, rate_hz: float) -> tuple[np.ndarray, np.ndarray]:
+    """The vectors to append so that the step's period check is tested: for each of the
+    law's statuses ``OK`` and ``INPUT_CLAMPED`` among the vectors, a copy of its first
+    vector at ``dt = PERIOD`` where none of that status is at the period, and one at
+    ``dt =`` :data:`OFF_PERIOD_FACTOR` ``PERIOD`` where none is off it (the step's status
+    ``OFF_PERIOD``). ``dt`` does not enter ``u`` or the law's status: a copy differs in
+    ``alpha_next`` and the step's status only.
+
+    Parameters
+    ----------
+    dt : ndarray, shape (N,)
+        The vectors' ``dt``, s.
+    status : ndarray of int, shape (N,)
+        The law's status of each vector (:func:`stt_codegen.tube.reference.law_status`).
+    rate_hz : float
+        The design's rate: ``PERIOD = 1 / rate_hz``.
+
+    Returns
+    -------
+    rows : ndarray of int
+        The vectors copied, in the order appended.
+    dt : ndarray
+        Each copy's ``dt``: ``PERIOD`` or ``OFF_PERIOD_FACTOR PERIOD`` rounded to float32
+        (exact in both precisions; float32's rounding of ``PERIOD`` is within the check's
+        relative ``2^-20``).
+    """
+    period = 1.0 / rate_hz
+    off = np.asarray(off_period(dt, rate_hz))
+    rows, steps = [], []
+    for law in (Status.OK, Status.INPUT_CLAMPED):
+        mine = np.flatnonzero(np.asarray(status) == law)
+        if mine.size == 0:
+            continue
+        if np.all(off[mine]):
+            rows.append(int(mine[0]))
+            steps.append(period)
+        if not np.any(off[mine]):
+            rows.append(int(mine[0]))
+            steps.append(OFF_PERIOD_FACTOR * period)
+    return np.array(rows, dtype=int), _f32(np.array(steps, dtype=float))
+
+
+def with_copies(arrays: dict, rows: np.ndarray, dt: np.ndarray) -> dict:
+    """``arrays`` (each with a leading vector axis, ``dt`` among them) with the rows
+    ``rows`` appended, their ``dt`` replaced by ``dt`` (:func:`period_copies`).
+
+    Parameters
+    ----------
+    arrays : dict of str to ndarray
+    rows : ndarray of int
+    dt : ndarray, shape of ``rows``
+
+    Returns
+    -------
+    dict of str to ndarray
+    """
+    out = {k: np.concatenate([v, np.asarray(v)[rows]]) for k, v in arrays.items()}
+    out["dt"][len(arrays["dt"]):] = dt
+    return out
+
+
 def test_vectors(design: TubeDesign, precision: str) -> dict:
     """Inputs, expected outputs and tolerances of every vector, as JSON-ready lists.
 
@@ -159,13 +225,18 @@ def test_vectors(design: TubeDesign, precision: str) -> dict:
     Returns
     -------
     dict
-        Keys ``x``, ``t``, ``dt``, ``alpha`` (inputs); ``u``, ``alpha_next``, ``status``,
-        ``gamma_L``, ``gamma_U`` (reference); ``tol_u``, ``tol_alpha_next``,
-        ``tol_gamma`` (absolute tolerances, same shapes); ``unit_roundoff``.
+        Keys ``x``, ``t``, ``dt``, ``alpha`` (inputs); ``u``, ``alpha_next``, ``status``
+        (the step's), ``control_status`` (``P_control``'s: the law's, without the
+        period check), ``gamma_L``, ``gamma_U`` (reference); ``tol_u``,
+        ``tol_alpha_next``, ``tol_gamma`` (absolute tolerances, same shapes);
+        ``unit_roundoff``.
     """
     p = sample_inputs(design, precision)
+    law = R.law_status(design, p["x"], p["t"], p["dt"], p["alpha"])[2]
+    p = with_copies(p, *period_copies(p["dt"], law, design.rate_hz))
     x, t, dt, alpha = p["x"], p["t"], p["dt"], p["alpha"]
     u, alpha_next, status = R.controller_status(design, x, t, dt, alpha)
+    control_status = R.law_status(design, x, t, dt, alpha)[2]
     g_l, g_u, _, _ = R.adaptive_tube(design, t, alpha)
     unit = T.unit_roundoff(precision)
     # the bound of law (13)'s u bounds the clamped u too (the clamp is 1-Lipschitz, and an
@@ -173,11 +244,12 @@ def test_vectors(design: TubeDesign, precision: str) -> dict:
     # below the term |u| 2 dg / w of the bound)
     u_law = R.law_step(design, x, t, dt, alpha)[0]
     tol_u = T.u_bound(design, x, alpha, g_l, g_u, u_law, unit)
-    return vector_document(design, precision, x, t, dt, alpha, u, alpha_next, status, tol_u)
+    return vector_document(design, precision, x, t, dt, alpha, u, alpha_next, status, tol_u,
+                           control_status)
 
 
 def vector_document(design: TubeDesign, precision: str, x, t, dt, alpha, u, alpha_next,
-                    status, tol_u) -> dict:
+                    status, tol_u, control_status=None) -> dict:
     """The vectors' document of any variant: the inputs, the oracle's outputs, the tube at
     ``t`` and every tolerance (``tol_u`` given, the others derived; a double floor in
     double precision; rounded up to a few digits, so still bounds and the same on every
@@ -191,9 +263,12 @@ def vector_document(design: TubeDesign, precision: str, x, t, dt, alpha, u, alph
     x, t, dt, alpha : ndarray
         The inputs, shapes (N, m), (N,), (N,), (N, 2 n).
     u, alpha_next, status : ndarray
-        The oracle's outputs.
+        The oracle's outputs (``status`` the step's).
     tol_u : ndarray
         The bound on ``u``'s rounding, shape of ``u``.
+    control_status : ndarray, optional
+        The status of the variant's ``P_control`` (the law's, no period check); ``None``:
+        a variant without ``P_control``, no key ``control_status``.
 
     Returns
     -------
@@ -213,13 +288,16 @@ def vector_document(design: TubeDesign, precision: str, x, t, dt, alpha, u, alph
     def rows(a):
         return [[float(v) for v in row] for row in np.asarray(a)]
 
-    return {
+    document = {
         "x": rows(x), "t": [float(v) for v in t], "dt": [float(v) for v in dt],
         "alpha": rows(alpha), "u": rows(u), "alpha_next": rows(alpha_next),
         "status": [int(s) for s in status], "gamma_L": rows(g_l), "gamma_U": rows(g_u),
         "tol_u": rows(tol_u), "tol_alpha_next": rows(tol_a), "tol_gamma": rows(tol_g),
         "unit_roundoff": unit,
     }
+    if control_status is not None:
+        document["control_status"] = [int(s) for s in control_status]
+    return document
 
 
 test_vectors.__test__ = False  # not a pytest test

@@ -16,7 +16,8 @@ from ..codegen.emit import python_function
 from ..errors import SpecError
 from ..tube import look_ahead_reference
 from ..tube.look_ahead import LookAhead, look_ahead_step
-from ..tube.parameters import Status, TubeDesign
+from ..tube.parameters import Status, TubeDesign, step_status
+from ..tube.variant_steps import law13_status
 
 __all__ = ["LOOK_AHEAD_BACKENDS", "LookAheadController"]
 
@@ -56,13 +57,15 @@ class LookAheadController:
         else:
             function = look_ahead_step(design, look_ahead)
             if backend == "casadi":
-                self._call = lambda *a: _with_status(
-                    [np.array(v, dtype=float).ravel() for v in function(*a)])
+                self._call = lambda x, t, dt, alpha: _with_status(
+                    [np.array(v, dtype=float).ravel() for v in function(x, t, dt, alpha)],
+                    dt, design.rate_hz)
             else:
                 printed = python_function(function)
-                self._call = lambda *a: _with_status(
+                self._call = lambda x, t, dt, alpha: _with_status(
                     [np.array(v, dtype=float).ravel()
-                     for v in printed(*[np.ravel(v).tolist() for v in a])])
+                     for v in printed(*[np.ravel(v).tolist() for v in (x, t, dt, alpha)])],
+                    dt, design.rate_hz)
 
     def _reference(self, x, t, dt, alpha):
         u, alpha_next, status = look_ahead_reference.look_ahead_status(
@@ -95,11 +98,12 @@ class LookAheadController:
                           np.asarray(alpha, dtype=float))
 
 
-def _with_status(out: list) -> tuple[np.ndarray, np.ndarray, Status]:
-    u, alpha_next, inside, *within = out
-    status = (Status.OUTSIDE_TUBE if not inside[0] else
-              Status.INPUT_CLAMPED if within and not within[0][0] else Status.OK)
-    return u, alpha_next, status
+def _with_status(out: list, dt: float, rate_hz: float) -> tuple[np.ndarray, np.ndarray, Status]:
+    """The step's outputs and status from the CasADi step's outputs: the law's status
+    (:func:`~stt_codegen.tube.variant_steps.law13_status`, the variant's role ``status``),
+    ``OFF_PERIOD`` for a ``dt`` other than ``1 / rate_hz``."""
+    u, alpha_next, status = law13_status(out)
+    return u, alpha_next, step_status(status, dt, rate_hz)
 
 
 def _compiled(design: TubeDesign, look_ahead: LookAhead):

@@ -5,7 +5,7 @@ The base at ``(x, y, theta)`` moving with ``(v, omega)`` moves the point ``p = (
 h``, ``h = (cos theta, sin theta)``, with ``p_dot = v h + l omega h_perp``, ``h_perp =
 (-sin theta, cos theta)``. Projecting a wanted ``p_dot = u`` on ``h`` and ``h_perp`` gives
 ``v = h . u`` and ``omega = (h_perp . u) / l``. Law (13) and the adaptive law are the
-first-order oracle's (:func:`stt_codegen.tube.reference.controller_status`).
+first-order oracle's (:func:`stt_codegen.tube.reference.law_status`).
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import reference
-from .parameters import STATUS_INPUT_CLAMPED, STATUS_OK, TubeDesign
+from .parameters import STATUS_INPUT_CLAMPED, STATUS_OK, TubeDesign, step_status
 
 __all__ = ["command", "look_ahead_status", "point"]
 
@@ -83,10 +83,12 @@ def look_ahead_status(design: TubeDesign, axle_offset: float,
     u : ndarray, shape (N, 2)
     alpha_next : ndarray, shape (N, 4)
     status : ndarray of int, shape (N,)
-        The first order's status at the point, ``STATUS_INPUT_CLAMPED`` where it is
-        ``STATUS_OK`` and the clamp moved an entry.
+        The first order's law status at the point, ``STATUS_INPUT_CLAMPED`` where it is
+        ``STATUS_OK`` and the clamp moved an entry; then ``STATUS_OFF_PERIOD`` in place of
+        ``OK`` and ``INPUT_CLAMPED`` where ``dt`` is not the period
+        (:func:`~stt_codegen.tube.parameters.step_status`).
     """
-    u_point, alpha_next, status = reference.controller_status(
+    u_point, alpha_next, status = reference.law_status(
         design, point(states, axle_offset), t, dt, alpha)
     u = command(states, u_point, axle_offset)
     if input_bound is not None:
@@ -95,4 +97,4 @@ def look_ahead_status(design: TubeDesign, axle_offset: float,
         moved = np.any(clamped != u, axis=1)
         u = clamped
         status = np.where((status == STATUS_OK) & moved, STATUS_INPUT_CLAMPED, status)
-    return u, alpha_next, status
+    return u, alpha_next, step_status(status, dt, design.rate_hz)

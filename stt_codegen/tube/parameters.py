@@ -10,10 +10,13 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
+import numpy as np
+
 __all__ = ["CRUISE", "CRUISE_RAMP", "Circumvent", "E_MAX", "GAMMA_D_MIN", "LOWER", "NEWTON_ITERATIONS", "NEWTON_TINY",
-           "ReachSegment", "SMOOTHSTEP", "STATUS_INPUT_CLAMPED", "STATUS_INVALID_INPUT",
-           "STATUS_OK", "STATUS_OUTSIDE_TUBE", "STATUS_OUTSIDE_VELOCITY_TUBE", "Status", "TANH",
-           "TubeDesign", "UPPER", "paper_segments", "peak_rate_factor"]
+           "PERIOD_TOLERANCE", "ReachSegment", "SMOOTHSTEP", "STATUS_INPUT_CLAMPED",
+           "STATUS_INVALID_INPUT", "STATUS_OFF_PERIOD", "STATUS_OK", "STATUS_OUTSIDE_TUBE",
+           "STATUS_OUTSIDE_VELOCITY_TUBE", "Status", "TANH", "TubeDesign", "UPPER",
+           "off_period", "paper_segments", "peak_rate_factor", "step_status"]
 
 #: Largest ``|e_i|`` used to compute ``u`` in the deployed controller step: ``e`` is
 #: clamped to ``[-E_MAX, E_MAX]`` so that ``u`` is finite everywhere (1 - 2**-20, exact in
@@ -44,11 +47,17 @@ class Status(enum.IntEnum):
     INPUT_CLAMPED : 3
         Inside the tube(s), but the law asked for more than the actuator bound
         (``[actuator] input_bound``) in some input: ``u`` was clamped to
-        ``+-input_bound``. Only designs with an input bound return it; ``OUTSIDE_TUBE``
-        and ``OUTSIDE_VELOCITY_TUBE`` take precedence.
+        ``+-input_bound``. Only designs with an input bound return it; ``OUTSIDE_TUBE``,
+        ``OUTSIDE_VELOCITY_TUBE`` and the step's ``OFF_PERIOD`` take precedence.
     OUTSIDE_VELOCITY_TUBE : 4
         Second order only: the position is inside its tube, the velocity error
         ``x2 - r`` is not inside ``(-rho2, rho2)``.
+    OFF_PERIOD : 5
+        The step was called with ``dt`` not equal to ``PERIOD`` (``1 / rate_hz``), to a
+        relative ``2^-20``: ``u`` and ``alpha_next`` are computed as usual for that ``dt``,
+        but the certificate does not cover the call. Only the step (which takes ``dt``)
+        returns it; ``INVALID_INPUT``, ``OUTSIDE_TUBE`` and ``OUTSIDE_VELOCITY_TUBE`` take
+        precedence, and it takes precedence over ``INPUT_CLAMPED``.
     """
 
     OK = 0
@@ -56,6 +65,7 @@ class Status(enum.IntEnum):
     INVALID_INPUT = 2
     INPUT_CLAMPED = 3
     OUTSIDE_VELOCITY_TUBE = 4
+    OFF_PERIOD = 5
 
 
 #: Aliases of :class:`Status` members (the names the generated code uses).
@@ -64,6 +74,61 @@ STATUS_OUTSIDE_TUBE = Status.OUTSIDE_TUBE
 STATUS_INVALID_INPUT = Status.INVALID_INPUT
 STATUS_INPUT_CLAMPED = Status.INPUT_CLAMPED
 STATUS_OUTSIDE_VELOCITY_TUBE = Status.OUTSIDE_VELOCITY_TUBE
+STATUS_OFF_PERIOD = Status.OFF_PERIOD
+
+#: Relative tolerance of the step's period check: ``|dt - PERIOD| > PERIOD * PERIOD_TOLERANCE``
+#: is :attr:`Status.OFF_PERIOD` (``2^-20``: a ``dt`` rounded to float32 from ``PERIOD`` passes,
+#: exact in float32 and float64, and ``PERIOD * PERIOD_TOLERANCE`` is exact too).
+PERIOD_TOLERANCE = 2.0 ** -20
+
+
+def off_period(dt, rate_hz: float):
+    """Whether a step's ``dt`` is not the period ``1 / rate_hz`` to a relative
+    :data:`PERIOD_TOLERANCE`, as the generated step decides it.
+
+    Parameters
+    ----------
+    dt : float or array_like
+        The steps' ``dt``, s.
+    rate_hz : float
+        The design's rate, Hz: ``PERIOD = 1 / rate_hz`` (the generated code's ``PERIOD``).
+
+    Returns
+    -------
+    bool or ndarray of bool
+        ``|dt - PERIOD| > PERIOD * PERIOD_TOLERANCE``, in double precision (the shape of
+        ``dt``).
+    """
+    period = 1.0 / rate_hz
+    return np.abs(np.asarray(dt, dtype=float) - period) > period * PERIOD_TOLERANCE
+
+
+def step_status(status, dt, rate_hz: float):
+    """The step's status from the law's: :attr:`Status.OFF_PERIOD` where ``dt`` is off the
+    period (:func:`off_period`) and the law's status is ``OK`` or ``INPUT_CLAMPED``, else
+    the law's (``INVALID_INPUT``, ``OUTSIDE_TUBE`` and ``OUTSIDE_VELOCITY_TUBE`` take
+    precedence). ``P_control``, ``P_alpha_step`` and ``P_tube`` take no period and keep the
+    law's status.
+
+    Parameters
+    ----------
+    status : Status or int or array_like of int
+        The law's status (the step's without the period check).
+    dt : float or array_like
+        The step's ``dt``, s (broadcast with ``status``).
+    rate_hz : float
+        The design's rate, Hz.
+
+    Returns
+    -------
+    Status or ndarray of int
+        A :class:`Status` for a scalar ``status``, else an array of the codes.
+    """
+    code = np.asarray(status)
+    timed = np.where(off_period(dt, rate_hz) & ((code == Status.OK)
+                                                | (code == Status.INPUT_CLAMPED)),
+                     int(Status.OFF_PERIOD), code)
+    return Status(int(timed)) if timed.ndim == 0 else timed
 
 LOWER = "lower"
 UPPER = "upper"

@@ -20,11 +20,11 @@ import math
 import numpy as np
 
 from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, LOWER, SMOOTHSTEP, STATUS_INPUT_CLAMPED, STATUS_OK,
-                         STATUS_OUTSIDE_TUBE, TANH, ReachSegment, TubeDesign)
+                         STATUS_OUTSIDE_TUBE, TANH, ReachSegment, TubeDesign, step_status)
 
 __all__ = ["adaptive_law", "adaptive_tube", "alpha_step", "bump", "circumvent",
            "circumvent_from_bumps", "conflict_distance", "control", "controller_status",
-           "controller_step", "error_transform", "exp", "implicit_alpha_root", "law", "law_step",
+           "controller_step", "error_transform", "exp", "implicit_alpha_root", "law", "law_status", "law_step",
            "log", "numpy_math", "open_bump_sum", "reach_tube", "segment_progress", "smooth_max",
            "smooth_max_pair", "trigger"]
 
@@ -807,8 +807,10 @@ def controller_step(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, 
     return saturate(design, u)[0], alpha_next, inside
 
 
-def controller_status(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, Array]:
-    """:func:`controller_step` with the status code of the generated API instead of ``inside``.
+def law_status(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, Array]:
+    """:func:`controller_step` with the law's status code instead of ``inside``: the status
+    of the generated ``P_control`` (which takes no ``dt``), the step's without its period
+    check (:func:`controller_status`).
 
     Parameters
     ----------
@@ -837,3 +839,35 @@ def controller_status(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array
     status = np.where(inside == 0.0, STATUS_OUTSIDE_TUBE,
                       np.where(within == 0.0, STATUS_INPUT_CLAMPED, STATUS_OK))
     return u_c, alpha_next, status
+
+
+def controller_status(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array, Array]:
+    """:func:`controller_step` with the status code of the generated step instead of
+    ``inside``: :func:`law_status`'s, ``STATUS_OFF_PERIOD`` in place of ``OK`` and
+    ``INPUT_CLAMPED`` where ``dt`` is not the period ``1 / rate_hz``
+    (:func:`~stt_codegen.tube.parameters.step_status`).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    x : array_like, shape (N, n)
+        State, state units.
+    t : float or array_like, shape (N,)
+        Times, s.
+    dt : float or array_like, shape (N,)
+        Steps, s, positive.
+    alpha : array_like, shape (N, 2n)
+        ``alpha`` at ``t``, state units.
+
+    Returns
+    -------
+    u : ndarray, shape (N, n)
+    alpha_next : ndarray, shape (N, 2n)
+    status : ndarray of int, shape (N,)
+        ``STATUS_OUTSIDE_TUBE`` where ``x`` is not strictly inside the tube, else
+        ``STATUS_OFF_PERIOD`` where ``dt`` is not the period, else ``STATUS_INPUT_CLAMPED``
+        where the actuator clamp moved an entry of ``u``, else ``STATUS_OK``.
+    """
+    u_c, alpha_next, status = law_status(design, x, t, dt, alpha)
+    return u_c, alpha_next, step_status(status, dt, design.rate_hz)

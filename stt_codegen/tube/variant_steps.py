@@ -107,7 +107,9 @@ def law13_status(outputs) -> tuple[np.ndarray, np.ndarray, Status]:
     alpha_next : ndarray, shape (2 n,)
     status : Status
         ``OUTSIDE_TUBE`` if not inside, else ``INPUT_CLAMPED`` if the clamp moved the
-        input, else ``OK``.
+        input, else ``OK``: the law's status. The outputs do not carry ``dt``: the step's
+        status is :func:`~stt_codegen.tube.parameters.step_status` of it (``OFF_PERIOD``
+        for a ``dt`` other than the period).
     """
     u, alpha_next, inside, *within = outputs
     status = (Status.OUTSIDE_TUBE if not _flag(inside) else
@@ -131,7 +133,8 @@ def cascade_status(outputs) -> tuple[np.ndarray, np.ndarray, Status]:
     status : Status
         ``OUTSIDE_TUBE`` outside the position tube, else ``OUTSIDE_VELOCITY_TUBE``
         outside the velocity tube, else ``INPUT_CLAMPED`` if the clamp moved the input,
-        else ``OK``.
+        else ``OK``: the law's status; the step's is
+        :func:`~stt_codegen.tube.parameters.step_status` of it.
     """
     u, alpha_next, _r, inside_position, inside_velocity, *within = outputs
     status = (Status.OUTSIDE_TUBE if not _flag(inside_position) else

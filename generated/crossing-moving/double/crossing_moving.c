@@ -837,6 +837,19 @@ static int crossing_moving_dt_valid(crossing_moving_real dt) {
   return ok;
 }
 
+/* The step's status from the law's: OFF_PERIOD in place of OK when
+   |dt - PERIOD| > PERIOD 2^-20 (the certificate covers dt = PERIOD only), else status. */
+static int crossing_moving_period_status(int status, crossing_moving_real dt) {
+  const crossing_moving_real tolerance = CROSSING_MOVING_PERIOD * 9.5367431640625e-07;
+  int timed = status;
+  if (status == CROSSING_MOVING_STATUS_OK) {
+    if (((dt - CROSSING_MOVING_PERIOD) > tolerance) || ((CROSSING_MOVING_PERIOD - dt) > tolerance)) {
+      timed = CROSSING_MOVING_STATUS_OFF_PERIOD;
+    }
+  }
+  return timed;
+}
+
 static void crossing_moving_copy(const crossing_moving_real* from, crossing_moving_real* to, int count) {
   int i;
   for (i = 0; i < count; ++i) {
@@ -1162,6 +1175,8 @@ int crossing_moving_step(const crossing_moving_real x[CROSSING_MOVING_N], crossi
           crossing_moving_implicit_step(t, dt, a, next);
           if (crossing_moving_finite(next, CROSSING_MOVING_N_ALPHA) == 0) {
             status = CROSSING_MOVING_STATUS_INVALID_INPUT;
+          } else {
+            status = crossing_moving_period_status(status, dt);
           }
         }
       }

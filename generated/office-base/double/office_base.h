@@ -49,6 +49,13 @@
  *                                  more than a limit OFFICE_BASE_INPUT_BOUND_i (v_max, then
  *                                  omega_max): u_i was clamped to +-OFFICE_BASE_INPUT_BOUND_i.
  *                                  OUTSIDE_TUBE takes precedence.
+ *   OFFICE_BASE_STATUS_OFF_PERIOD    5  returned by the step only: p strictly inside the
+ *                                  tube, but dt is not PERIOD (|dt - PERIOD| > PERIOD
+ *                                  2^-20): u and alpha_next are computed as usual for
+ *                                  that dt, but the certificate covers only calls with
+ *                                  dt = PERIOD (the timing contract below). OUTSIDE_TUBE
+ *                                  takes precedence; it takes precedence over
+ *                                  INPUT_CLAMPED.
  * Every number written is finite, whatever the inputs.
  *
  * Aliasing: inputs are copied before any output is written, so an output may alias an
@@ -84,13 +91,16 @@ typedef double office_base_real;
  *   - reads the state within JITTER seconds of k PERIOD (the first read at t = 0);
  *   - applies u at most DELAY seconds after that read and holds it until the next u is
  *     applied; before the first u is applied, the input is zero.
- * The step does not measure time: it cannot see a late call or a wrong t.
+ * The step does not measure time: it cannot see a late call or a wrong t. It reports a dt
+ * other than PERIOD (|dt - PERIOD| > PERIOD 2^-20) as OFF_PERIOD.
  * After t_c (PRESCRIBED_TIME) keep calling: the tube is the target tube, and the stay part
  * of the task holds as long as the loop runs.
  * On each status: OK, INPUT_CLAMPED: apply u. OUTSIDE_TUBE: u is finite
  * but the guarantee is void (the plant, the timing or the measured state is outside what
  * was proved): apply the system's fallback (stop, or hand over). INVALID_INPUT: u = 0, a
- * software fault (a NULL pointer, a non-finite state or time): stop.
+ * software fault (a NULL pointer, a non-finite state or time): stop. OFF_PERIOD: apply u
+ * (computed as usual for that dt), but the guarantee holds only for calls with
+ * dt = PERIOD: pass PERIOD as dt.
  */
 /** The sampling period the certificate covers, s: 1 / RATE_HZ (pass it as dt). */
 #define OFFICE_BASE_PERIOD 0.005
@@ -109,6 +119,7 @@ typedef double office_base_real;
 #define OFFICE_BASE_STATUS_OUTSIDE_TUBE 1
 #define OFFICE_BASE_STATUS_INVALID_INPUT 2
 #define OFFICE_BASE_STATUS_INPUT_CLAMPED 3
+#define OFFICE_BASE_STATUS_OFF_PERIOD 5
 
 /** The base's limits (v_max in m/s, omega_max in rad/s): every u written has
     |u_i| <= INPUT_BOUND_i. */
@@ -142,7 +153,8 @@ int office_base_alpha_step(office_base_real t, office_base_real dt,
  *
  * x: [OFFICE_BASE_N_STATE]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha:
  * [OFFICE_BASE_N_ALPHA]. u: [OFFICE_BASE_N_INPUT] (out). alpha_next: [OFFICE_BASE_N_ALPHA] (out, may alias
- * alpha). Returns OK, OUTSIDE_TUBE, INPUT_CLAMPED or INVALID_INPUT (u = 0, alpha_next = alpha).
+ * alpha). Returns OK, OUTSIDE_TUBE, INPUT_CLAMPED, OFF_PERIOD (dt not PERIOD) or INVALID_INPUT
+ * (u = 0, alpha_next = alpha).
  */
 int office_base_step(const office_base_real x[OFFICE_BASE_N_STATE], office_base_real t, office_base_real dt,
     const office_base_real alpha[OFFICE_BASE_N_ALPHA], office_base_real u[OFFICE_BASE_N_INPUT],

@@ -21,7 +21,11 @@ an input outside the domain, a wrong length, a value that is not a number, or a 
 that would not be finite; u = 0, alpha_next = alpha with non-finite entries 0),
 STATUS_INPUT_CLAMPED (3: inside the tube, but the command asked for more than a limit
 INPUT_BOUND[i], v_max then omega_max, and u[i] was clamped; OUTSIDE_TUBE takes
-precedence). Every number returned is a finite float.
+precedence), STATUS_OFF_PERIOD (5, step only: the look-ahead point inside the tube,
+but dt is not PERIOD, abs(dt - PERIOD) > PERIOD 2^-20; u and alpha_next are computed as
+usual for that dt, but the certificate covers only calls with dt = PERIOD: apply u, and
+pass PERIOD; OUTSIDE_TUBE takes precedence, and it takes precedence over
+INPUT_CLAMPED). Every number returned is a finite float.
 
 ``look_ahead_step`` below is printed by ``stt_codegen.codegen.emit.PythonPrinter`` from the
 CasADi Function the C is printed from; it reproduces CasADi's evaluation bit for bit.
@@ -1298,6 +1302,7 @@ STATUS_OK = 0
 STATUS_OUTSIDE_TUBE = 1
 STATUS_INVALID_INPUT = 2
 STATUS_INPUT_CLAMPED = 3
+STATUS_OFF_PERIOD = 5
 # the base's limits (v_max m/s, omega_max rad/s), one per entry of u
 INPUT_BOUND = [1.6, 16.0]
 
@@ -1357,6 +1362,15 @@ def _keep_alpha(alpha):
     return [v if math.isfinite(v) else 0.0 for v in a]
 
 
+def _period_status(status, dt):
+    # the step's status, as the C's: OFF_PERIOD in place of OK or INPUT_CLAMPED when dt
+    # is not PERIOD to a relative 2^-20 (the certificate covers dt = PERIOD only)
+    if (status in (STATUS_OK, STATUS_INPUT_CLAMPED)
+            and abs(dt - PERIOD) > PERIOD * 2.0 ** -20):
+        return STATUS_OFF_PERIOD
+    return status
+
+
 def step(x, t, dt, alpha):
     """One controller step: (u (N_INPUT,), alpha_next (N_ALPHA,), status)."""
     xs, t_ok, dt_ok, a = _finite(x, N_STATE), _time(t), _step_size(dt), _alpha(alpha)
@@ -1369,5 +1383,5 @@ def step(x, t, dt, alpha):
                 status = STATUS_INPUT_CLAMPED
             else:
                 status = STATUS_OK
-            return list(u), list(alpha_next), status
+            return list(u), list(alpha_next), _period_status(status, dt_ok)
     return [0.0] * N_INPUT, _keep_alpha(alpha), STATUS_INVALID_INPUT

@@ -1130,6 +1130,19 @@ static int office_base_dt_valid(office_base_real dt) {
   return ok;
 }
 
+/* The step's status from the law's: OFF_PERIOD in place of OK or INPUT_CLAMPED when
+   |dt - PERIOD| > PERIOD 2^-20 (the certificate covers dt = PERIOD only), else status. */
+static int office_base_period_status(int status, office_base_real dt) {
+  const office_base_real tolerance = OFFICE_BASE_PERIOD * 9.5367431640625e-07f;
+  int timed = status;
+  if ((status == OFFICE_BASE_STATUS_OK) || (status == OFFICE_BASE_STATUS_INPUT_CLAMPED)) {
+    if (((dt - OFFICE_BASE_PERIOD) > tolerance) || ((OFFICE_BASE_PERIOD - dt) > tolerance)) {
+      timed = OFFICE_BASE_STATUS_OFF_PERIOD;
+    }
+  }
+  return timed;
+}
+
 static void office_base_copy(const office_base_real* from, office_base_real* to, int count) {
   int i;
   for (i = 0; i < count; ++i) {
@@ -1541,6 +1554,8 @@ int office_base_step(const office_base_real x[OFFICE_BASE_N_STATE], office_base_
           office_base_implicit_step(t, dt, a, next);
           if (office_base_finite(next, OFFICE_BASE_N_ALPHA) == 0) {
             status = OFFICE_BASE_STATUS_INVALID_INPUT;
+          } else {
+            status = office_base_period_status(status, dt);
           }
         }
       }

@@ -1097,6 +1097,19 @@ static int omnirobot_s1_dt_valid(omnirobot_s1_real dt) {
   return ok;
 }
 
+/* The step's status from the law's: OFF_PERIOD in place of OK when
+   |dt - PERIOD| > PERIOD 2^-20 (the certificate covers dt = PERIOD only), else status. */
+static int omnirobot_s1_period_status(int status, omnirobot_s1_real dt) {
+  const omnirobot_s1_real tolerance = OMNIROBOT_S1_PERIOD * 9.5367431640625e-07;
+  int timed = status;
+  if (status == OMNIROBOT_S1_STATUS_OK) {
+    if (((dt - OMNIROBOT_S1_PERIOD) > tolerance) || ((OMNIROBOT_S1_PERIOD - dt) > tolerance)) {
+      timed = OMNIROBOT_S1_STATUS_OFF_PERIOD;
+    }
+  }
+  return timed;
+}
+
 static void omnirobot_s1_copy(const omnirobot_s1_real* from, omnirobot_s1_real* to, int count) {
   int i;
   for (i = 0; i < count; ++i) {
@@ -1467,6 +1480,8 @@ int omnirobot_s1_step(const omnirobot_s1_real x[OMNIROBOT_S1_N], omnirobot_s1_re
           omnirobot_s1_implicit_step(t, dt, a, next);
           if (omnirobot_s1_finite(next, OMNIROBOT_S1_N_ALPHA) == 0) {
             status = OMNIROBOT_S1_STATUS_INVALID_INPUT;
+          } else {
+            status = omnirobot_s1_period_status(status, dt);
           }
         }
       }

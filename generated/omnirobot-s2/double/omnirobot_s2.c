@@ -1098,6 +1098,19 @@ static int omnirobot_s2_dt_valid(omnirobot_s2_real dt) {
   return ok;
 }
 
+/* The step's status from the law's: OFF_PERIOD in place of OK when
+   |dt - PERIOD| > PERIOD 2^-20 (the certificate covers dt = PERIOD only), else status. */
+static int omnirobot_s2_period_status(int status, omnirobot_s2_real dt) {
+  const omnirobot_s2_real tolerance = OMNIROBOT_S2_PERIOD * 9.5367431640625e-07;
+  int timed = status;
+  if (status == OMNIROBOT_S2_STATUS_OK) {
+    if (((dt - OMNIROBOT_S2_PERIOD) > tolerance) || ((OMNIROBOT_S2_PERIOD - dt) > tolerance)) {
+      timed = OMNIROBOT_S2_STATUS_OFF_PERIOD;
+    }
+  }
+  return timed;
+}
+
 static void omnirobot_s2_copy(const omnirobot_s2_real* from, omnirobot_s2_real* to, int count) {
   int i;
   for (i = 0; i < count; ++i) {
@@ -1468,6 +1481,8 @@ int omnirobot_s2_step(const omnirobot_s2_real x[OMNIROBOT_S2_N], omnirobot_s2_re
           omnirobot_s2_implicit_step(t, dt, a, next);
           if (omnirobot_s2_finite(next, OMNIROBOT_S2_N_ALPHA) == 0) {
             status = OMNIROBOT_S2_STATUS_INVALID_INPUT;
+          } else {
+            status = omnirobot_s2_period_status(status, dt);
           }
         }
       }

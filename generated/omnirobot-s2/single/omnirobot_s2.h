@@ -49,6 +49,12 @@
  *                                  reaches at t): u = 0, alpha_next = alpha with each
  *                                  non-finite entry replaced by 0 (alpha NULL: 0),
  *                                  gamma_* = 0 (when the pointers allow).
+ *   OMNIROBOT_S2_STATUS_OFF_PERIOD    5  returned by the step only (the one function taking
+ *                                  dt): x strictly inside the tube, but dt is not PERIOD
+ *                                  (|dt - PERIOD| > PERIOD 2^-20): u and alpha_next are
+ *                                  computed as usual for that dt, but the certificate
+ *                                  covers only calls with dt = PERIOD (the timing
+ *                                  contract below). OUTSIDE_TUBE takes precedence.
  * Every number written is finite, whatever the inputs.
  *
  * Aliasing: inputs are copied before any output is written, so an output may alias an
@@ -84,13 +90,16 @@ typedef float omnirobot_s2_real;
  *   - reads the state within JITTER seconds of k PERIOD (the first read at t = 0);
  *   - applies u at most DELAY seconds after that read and holds it until the next u is
  *     applied; before the first u is applied, the input is zero.
- * The step does not measure time: it cannot see a late call or a wrong t.
+ * The step does not measure time: it cannot see a late call or a wrong t. It reports a dt
+ * other than PERIOD (|dt - PERIOD| > PERIOD 2^-20) as OFF_PERIOD.
  * After t_c (PRESCRIBED_TIME) keep calling: the tube is the target tube, and the stay part
  * of the task holds as long as the loop runs.
  * On each status: OK: apply u. OUTSIDE_TUBE: u is finite
  * but the guarantee is void (the plant, the timing or the measured state is outside what
  * was proved): apply the system's fallback (stop, or hand over). INVALID_INPUT: u = 0, a
- * software fault (a NULL pointer, a non-finite state or time): stop.
+ * software fault (a NULL pointer, a non-finite state or time): stop. OFF_PERIOD: apply u
+ * (computed as usual for that dt), but the guarantee holds only for calls with
+ * dt = PERIOD: pass PERIOD as dt.
  */
 /** The sampling period the certificate covers, s: 1 / RATE_HZ (pass it as dt). */
 #define OMNIROBOT_S2_PERIOD 0.001f
@@ -108,6 +117,7 @@ typedef float omnirobot_s2_real;
 #define OMNIROBOT_S2_STATUS_OK 0
 #define OMNIROBOT_S2_STATUS_OUTSIDE_TUBE 1
 #define OMNIROBOT_S2_STATUS_INVALID_INPUT 2
+#define OMNIROBOT_S2_STATUS_OFF_PERIOD 5
 
 /**
  * Tube bounds at time t: gamma_L, gamma_U of eq. (10) and their total time derivatives.
@@ -145,7 +155,8 @@ int omnirobot_s2_alpha_step(omnirobot_s2_real t, omnirobot_s2_real dt,
  *
  * x: [OMNIROBOT_S2_N_STATE]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha: [OMNIROBOT_S2_N_ALPHA].
  * u: [OMNIROBOT_S2_N_INPUT] (out). alpha_next: [OMNIROBOT_S2_N_ALPHA] (out, may alias alpha).
- * Returns OK, OUTSIDE_TUBE or INVALID_INPUT (u = 0, alpha_next = alpha).
+ * Returns OK, OUTSIDE_TUBE, OFF_PERIOD (dt not PERIOD) or INVALID_INPUT (u = 0,
+ * alpha_next = alpha).
  */
 int omnirobot_s2_step(const omnirobot_s2_real x[OMNIROBOT_S2_N_STATE], omnirobot_s2_real t, omnirobot_s2_real dt,
     const omnirobot_s2_real alpha[OMNIROBOT_S2_N_ALPHA], omnirobot_s2_real u[OMNIROBOT_S2_N_INPUT],

@@ -1216,6 +1216,19 @@ static int omnirobot_s3_dt_valid(omnirobot_s3_real dt) {
   return ok;
 }
 
+/* The step's status from the law's: OFF_PERIOD in place of OK when
+   |dt - PERIOD| > PERIOD 2^-20 (the certificate covers dt = PERIOD only), else status. */
+static int omnirobot_s3_period_status(int status, omnirobot_s3_real dt) {
+  const omnirobot_s3_real tolerance = OMNIROBOT_S3_PERIOD * 9.5367431640625e-07f;
+  int timed = status;
+  if (status == OMNIROBOT_S3_STATUS_OK) {
+    if (((dt - OMNIROBOT_S3_PERIOD) > tolerance) || ((OMNIROBOT_S3_PERIOD - dt) > tolerance)) {
+      timed = OMNIROBOT_S3_STATUS_OFF_PERIOD;
+    }
+  }
+  return timed;
+}
+
 static void omnirobot_s3_copy(const omnirobot_s3_real* from, omnirobot_s3_real* to, int count) {
   int i;
   for (i = 0; i < count; ++i) {
@@ -1678,6 +1691,8 @@ int omnirobot_s3_step(const omnirobot_s3_real x[OMNIROBOT_S3_N], omnirobot_s3_re
           omnirobot_s3_implicit_step(t, dt, a, next);
           if (omnirobot_s3_finite(next, OMNIROBOT_S3_N_ALPHA) == 0) {
             status = OMNIROBOT_S3_STATUS_INVALID_INPUT;
+          } else {
+            status = omnirobot_s3_period_status(status, dt);
           }
         }
       }

@@ -958,6 +958,19 @@ static int pointmaze_umaze_dt_valid(pointmaze_umaze_real dt) {
   return ok;
 }
 
+/* The step's status from the law's: OFF_PERIOD in place of OK when
+   |dt - PERIOD| > PERIOD 2^-20 (the certificate covers dt = PERIOD only), else status. */
+static int pointmaze_umaze_period_status(int status, pointmaze_umaze_real dt) {
+  const pointmaze_umaze_real tolerance = POINTMAZE_UMAZE_PERIOD * 9.5367431640625e-07f;
+  int timed = status;
+  if (status == POINTMAZE_UMAZE_STATUS_OK) {
+    if (((dt - POINTMAZE_UMAZE_PERIOD) > tolerance) || ((POINTMAZE_UMAZE_PERIOD - dt) > tolerance)) {
+      timed = POINTMAZE_UMAZE_STATUS_OFF_PERIOD;
+    }
+  }
+  return timed;
+}
+
 static void pointmaze_umaze_copy(const pointmaze_umaze_real* from, pointmaze_umaze_real* to, int count) {
   int i;
   for (i = 0; i < count; ++i) {
@@ -1375,6 +1388,8 @@ int pointmaze_umaze_step(const pointmaze_umaze_real x[POINTMAZE_UMAZE_N], pointm
           pointmaze_umaze_implicit_step(t, dt, a, next);
           if (pointmaze_umaze_finite(next, POINTMAZE_UMAZE_N_ALPHA) == 0) {
             status = POINTMAZE_UMAZE_STATUS_INVALID_INPUT;
+          } else {
+            status = pointmaze_umaze_period_status(status, dt);
           }
         }
       }

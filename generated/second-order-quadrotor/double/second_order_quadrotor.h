@@ -53,6 +53,13 @@
  *                                          NULL: 0).
  *   SECOND_ORDER_QUADROTOR_STATUS_OUTSIDE_VELOCITY_TUBE 4  x1 inside its tube, x2 - r on or outside
  *                                          (-rho2, rho2): u finite, alpha_next valid.
+ *   SECOND_ORDER_QUADROTOR_STATUS_OFF_PERIOD            5  returned by the step only: both errors
+ *                                          strictly inside their tubes, but dt is not
+ *                                          PERIOD (|dt - PERIOD| > PERIOD 2^-20): u and
+ *                                          alpha_next are computed as usual for that dt,
+ *                                          but the certificate covers only calls with
+ *                                          dt = PERIOD (the timing contract below).
+ *                                          The OUTSIDE_* statuses take precedence.
  * Every number written is finite, whatever the inputs.
  *
  * Aliasing: inputs are copied before any output is written, so an output may alias an
@@ -88,13 +95,16 @@ typedef double second_order_quadrotor_real;
  *   - reads the state within JITTER seconds of k PERIOD (the first read at t = 0);
  *   - applies u at most DELAY seconds after that read and holds it until the next u is
  *     applied; before the first u is applied, the input is zero.
- * The step does not measure time: it cannot see a late call or a wrong t.
+ * The step does not measure time: it cannot see a late call or a wrong t. It reports a dt
+ * other than PERIOD (|dt - PERIOD| > PERIOD 2^-20) as OFF_PERIOD.
  * After t_c (PRESCRIBED_TIME) keep calling: the tube is the target tube, and the stay part
  * of the task holds as long as the loop runs.
  * On each status: OK: apply u. OUTSIDE_TUBE, OUTSIDE_VELOCITY_TUBE: u is finite
  * but the guarantee is void (the plant, the timing or the measured state is outside what
  * was proved): apply the system's fallback (stop, or hand over). INVALID_INPUT: u = 0, a
- * software fault (a NULL pointer, a non-finite state or time): stop.
+ * software fault (a NULL pointer, a non-finite state or time): stop. OFF_PERIOD: apply u
+ * (computed as usual for that dt), but the guarantee holds only for calls with
+ * dt = PERIOD: pass PERIOD as dt.
  */
 /** The sampling period the certificate covers, s: 1 / RATE_HZ (pass it as dt). */
 #define SECOND_ORDER_QUADROTOR_PERIOD 0.001
@@ -113,6 +123,7 @@ typedef double second_order_quadrotor_real;
 #define SECOND_ORDER_QUADROTOR_STATUS_OUTSIDE_TUBE 1
 #define SECOND_ORDER_QUADROTOR_STATUS_INVALID_INPUT 2
 #define SECOND_ORDER_QUADROTOR_STATUS_OUTSIDE_VELOCITY_TUBE 4
+#define SECOND_ORDER_QUADROTOR_STATUS_OFF_PERIOD 5
 
 /**
  * Tube bounds at time t: gamma_L, gamma_U of eq. (10) and their total time derivatives.
@@ -142,8 +153,8 @@ int second_order_quadrotor_alpha_step(second_order_quadrotor_real t, second_orde
  * x: [SECOND_ORDER_QUADROTOR_N_STATE]. t, dt: seconds, t >= 0, DT_MIN <= dt <= DT_MAX. alpha:
  * [SECOND_ORDER_QUADROTOR_N_ALPHA]. u: [SECOND_ORDER_QUADROTOR_N_INPUT] (out). alpha_next: [SECOND_ORDER_QUADROTOR_N_ALPHA] (out, may
  * alias alpha).
- * Returns OK, OUTSIDE_TUBE, OUTSIDE_VELOCITY_TUBE or INVALID_INPUT (u = 0,
- * alpha_next = alpha).
+ * Returns OK, OUTSIDE_TUBE, OUTSIDE_VELOCITY_TUBE, OFF_PERIOD (dt not PERIOD) or
+ * INVALID_INPUT (u = 0, alpha_next = alpha).
  */
 int second_order_quadrotor_step(const second_order_quadrotor_real x[SECOND_ORDER_QUADROTOR_N_STATE], second_order_quadrotor_real t, second_order_quadrotor_real dt,
     const second_order_quadrotor_real alpha[SECOND_ORDER_QUADROTOR_N_ALPHA], second_order_quadrotor_real u[SECOND_ORDER_QUADROTOR_N_INPUT],

@@ -1417,6 +1417,19 @@ static int second_order_quadrotor_dt_valid(second_order_quadrotor_real dt) {
   return ok;
 }
 
+/* The step's status from the law's: OFF_PERIOD in place of OK when
+   |dt - PERIOD| > PERIOD 2^-20 (the certificate covers dt = PERIOD only), else status. */
+static int second_order_quadrotor_period_status(int status, second_order_quadrotor_real dt) {
+  const second_order_quadrotor_real tolerance = SECOND_ORDER_QUADROTOR_PERIOD * 9.5367431640625e-07f;
+  int timed = status;
+  if (status == SECOND_ORDER_QUADROTOR_STATUS_OK) {
+    if (((dt - SECOND_ORDER_QUADROTOR_PERIOD) > tolerance) || ((SECOND_ORDER_QUADROTOR_PERIOD - dt) > tolerance)) {
+      timed = SECOND_ORDER_QUADROTOR_STATUS_OFF_PERIOD;
+    }
+  }
+  return timed;
+}
+
 static void second_order_quadrotor_copy(const second_order_quadrotor_real* from, second_order_quadrotor_real* to, int count) {
   int i;
   for (i = 0; i < count; ++i) {
@@ -1943,6 +1956,8 @@ int second_order_quadrotor_step(const second_order_quadrotor_real x[SECOND_ORDER
           second_order_quadrotor_implicit_step(t, dt, a, next);
           if (second_order_quadrotor_finite(next, SECOND_ORDER_QUADROTOR_N_ALPHA) == 0) {
             status = SECOND_ORDER_QUADROTOR_STATUS_INVALID_INPUT;
+          } else {
+            status = second_order_quadrotor_period_status(status, dt);
           }
         }
       }

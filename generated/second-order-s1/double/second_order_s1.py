@@ -24,7 +24,11 @@ numbers; every alpha entry in [0, ALPHA_MAX]. Status: STATUS_OK (0), STATUS_OUTS
 outside the domain, a wrong length, a value that is not a number, or a result that would
 not be finite; u = 0, alpha_next = alpha with non-finite entries 0),
 STATUS_OUTSIDE_VELOCITY_TUBE (4: x1 inside, x2 - r not strictly inside (-rho2, rho2); u
-finite). Every number returned is a finite float.
+finite), STATUS_OFF_PERIOD (5, step only: inside both tubes, but dt is not PERIOD,
+abs(dt - PERIOD) > PERIOD 2^-20; u and alpha_next are computed as usual for that dt, but
+the certificate covers only calls with dt = PERIOD: apply u, and pass PERIOD; the OUTSIDE_*
+statuses take precedence).
+Every number returned is a finite float.
 
 ``cascade_step`` below is printed by ``stt_codegen.codegen.emit.PythonPrinter`` from the
 CasADi Function the C is printed from; it reproduces CasADi's evaluation bit for bit.
@@ -942,6 +946,7 @@ STATUS_OK = 0
 STATUS_OUTSIDE_TUBE = 1
 STATUS_INVALID_INPUT = 2
 STATUS_OUTSIDE_VELOCITY_TUBE = 4
+STATUS_OFF_PERIOD = 5
 
 
 def _number(value):
@@ -999,6 +1004,14 @@ def _keep_alpha(alpha):
     return [v if math.isfinite(v) else 0.0 for v in a]
 
 
+def _period_status(status, dt):
+    # the step's status, as the C's: OFF_PERIOD in place of OK when dt
+    # is not PERIOD to a relative 2^-20 (the certificate covers dt = PERIOD only)
+    if status == STATUS_OK and abs(dt - PERIOD) > PERIOD * 2.0 ** -20:
+        return STATUS_OFF_PERIOD
+    return status
+
+
 def step(x, t, dt, alpha):
     """One controller step: (u (N_INPUT,), alpha_next (N_ALPHA,), status)."""
     xs, t_ok, dt_ok, a = _finite(x, N_STATE), _time(t), _step_size(dt), _alpha(alpha)
@@ -1011,7 +1024,7 @@ def step(x, t, dt, alpha):
                 status = STATUS_OUTSIDE_VELOCITY_TUBE
             else:
                 status = STATUS_OK
-            return list(u), list(alpha_next), status
+            return list(u), list(alpha_next), _period_status(status, dt_ok)
     return [0.0] * N_INPUT, _keep_alpha(alpha), STATUS_INVALID_INPUT
 
 

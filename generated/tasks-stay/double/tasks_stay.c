@@ -1050,6 +1050,19 @@ static int tasks_stay_dt_valid(tasks_stay_real dt) {
   return ok;
 }
 
+/* The step's status from the law's: OFF_PERIOD in place of OK when
+   |dt - PERIOD| > PERIOD 2^-20 (the certificate covers dt = PERIOD only), else status. */
+static int tasks_stay_period_status(int status, tasks_stay_real dt) {
+  const tasks_stay_real tolerance = TASKS_STAY_PERIOD * 9.5367431640625e-07;
+  int timed = status;
+  if (status == TASKS_STAY_STATUS_OK) {
+    if (((dt - TASKS_STAY_PERIOD) > tolerance) || ((TASKS_STAY_PERIOD - dt) > tolerance)) {
+      timed = TASKS_STAY_STATUS_OFF_PERIOD;
+    }
+  }
+  return timed;
+}
+
 static void tasks_stay_copy(const tasks_stay_real* from, tasks_stay_real* to, int count) {
   int i;
   for (i = 0; i < count; ++i) {
@@ -1375,6 +1388,8 @@ int tasks_stay_step(const tasks_stay_real x[TASKS_STAY_N], tasks_stay_real t, ta
           tasks_stay_implicit_step(t, dt, a, next);
           if (tasks_stay_finite(next, TASKS_STAY_N_ALPHA) == 0) {
             status = TASKS_STAY_STATUS_INVALID_INPUT;
+          } else {
+            status = tasks_stay_period_status(status, dt);
           }
         }
       }

@@ -20,6 +20,10 @@ every alpha entry in [0, ALPHA_MAX]. Status: STATUS_OK (0), STATUS_OUTSIDE_TUBE 
 finite, clamped), STATUS_INVALID_INPUT (2: an input outside the domain, a wrong length,
 a value that is not a number, or a result that would not be finite; u = 0, alpha_next =
 alpha with non-finite entries 0, gamma_* = 0). Every number returned is a finite float.
+STATUS_OFF_PERIOD (5, step only: x strictly inside the tube, but dt is not PERIOD,
+abs(dt - PERIOD) > PERIOD 2^-20; u and alpha_next are computed as usual for that dt, but
+the certificate covers only calls with dt = PERIOD: apply u, and pass PERIOD).
+OUTSIDE_TUBE takes precedence.
 
 The ``body_*`` functions below are printed by ``stt_codegen.codegen.emit.PythonPrinter``,
 on the CasADi instruction stream the C printer prints too; they reproduce CasADi's
@@ -44,6 +48,7 @@ ALPHA_MAX = 8388608.0
 STATUS_OK = 0
 STATUS_OUTSIDE_TUBE = 1
 STATUS_INVALID_INPUT = 2
+STATUS_OFF_PERIOD = 5
 
 
 def _number(value):
@@ -99,6 +104,14 @@ def _keep_alpha(alpha):
     if a is None:
         return [0.0] * N_ALPHA
     return [v if math.isfinite(v) else 0.0 for v in a]
+
+
+def _period_status(status, dt):
+    # the step's status, as the C's: OFF_PERIOD in place of OK when dt
+    # is not PERIOD to a relative 2^-20 (the certificate covers dt = PERIOD only)
+    if status == STATUS_OK and abs(dt - PERIOD) > PERIOD * 2.0 ** -20:
+        return STATUS_OFF_PERIOD
+    return status
 
 
 # ------------------------------------------------------------------- spec tables
@@ -284,7 +297,8 @@ def step(x, t, dt, alpha):
         u, inside = body_law(xs, *_gamma(t_ok, a), [GAIN])
         alpha_next = _implicit_step(t_ok, dt_ok, a)
         if _all_finite(u, alpha_next):
-            return u, alpha_next, STATUS_OK if inside[0] != 0.0 else STATUS_OUTSIDE_TUBE
+            status = STATUS_OK if inside[0] != 0.0 else STATUS_OUTSIDE_TUBE
+            return u, alpha_next, _period_status(status, dt_ok)
     return [0.0] * N, _keep_alpha(alpha), STATUS_INVALID_INPUT
 
 

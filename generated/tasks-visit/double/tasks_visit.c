@@ -1050,6 +1050,19 @@ static int tasks_visit_dt_valid(tasks_visit_real dt) {
   return ok;
 }
 
+/* The step's status from the law's: OFF_PERIOD in place of OK when
+   |dt - PERIOD| > PERIOD 2^-20 (the certificate covers dt = PERIOD only), else status. */
+static int tasks_visit_period_status(int status, tasks_visit_real dt) {
+  const tasks_visit_real tolerance = TASKS_VISIT_PERIOD * 9.5367431640625e-07;
+  int timed = status;
+  if (status == TASKS_VISIT_STATUS_OK) {
+    if (((dt - TASKS_VISIT_PERIOD) > tolerance) || ((TASKS_VISIT_PERIOD - dt) > tolerance)) {
+      timed = TASKS_VISIT_STATUS_OFF_PERIOD;
+    }
+  }
+  return timed;
+}
+
 static void tasks_visit_copy(const tasks_visit_real* from, tasks_visit_real* to, int count) {
   int i;
   for (i = 0; i < count; ++i) {
@@ -1375,6 +1388,8 @@ int tasks_visit_step(const tasks_visit_real x[TASKS_VISIT_N], tasks_visit_real t
           tasks_visit_implicit_step(t, dt, a, next);
           if (tasks_visit_finite(next, TASKS_VISIT_N_ALPHA) == 0) {
             status = TASKS_VISIT_STATUS_INVALID_INPUT;
+          } else {
+            status = tasks_visit_period_status(status, dt);
           }
         }
       }
