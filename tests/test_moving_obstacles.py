@@ -500,3 +500,31 @@ def test_a_detour_around_where_a_moving_obstacle_crosses_the_tasks_plan():
     assert data["moving_obstacles"][0]["margin"] > 0
     run = stt.simulate(design, backend="reference")
     assert run.satisfied and all(t.met for t in run.tasks)
+
+
+def _crossing_with_actuator(bound: list[float]) -> stt.Spec:
+    data = tomllib.loads(bundled_spec_bytes("crossing-moving").decode())
+    data["actuator"] = {"input_bound": bound}
+    return stt.Spec.from_dict(data)
+
+
+def test_a_wait_for_a_moving_obstacle_is_kept_under_an_actuator_bound():
+    """With [actuator], the re-timed via plan (wait, then cross) is accepted with its own
+    input proof: the bundled crossing, which the static and swept designs cannot do."""
+    from stt_codegen.design.actuator import law13_input_proof
+    spec = _crossing_with_actuator([3.0, 3.0])
+    design = stt.design_tube(spec)
+    assert design.motion == MOTION_TIMED_VIA and design.certificate.passed
+    assert design.tube.input_bound == (3.0, 3.0)            # the generated code clamps
+    proof = law13_input_proof(design, spec)
+    assert design.input_proof == proof and proof.meets(spec.input_bound)
+    # the re-timed tube is not the static design's: its proof is its own
+    assert design.tube.segments[0].start > 0.0              # it waits at the start
+
+
+def test_a_re_timed_plan_beyond_the_bound_is_refused_saying_so():
+    spec = _crossing_with_actuator([1.5, 1.5])
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(spec)
+    assert ("the re-timed via tube around none fails: its input is not proved within "
+            "actuator.input_bound (|u1| <= ") in str(raised.value)

@@ -51,7 +51,7 @@ from .result import METHOD_PAPER, METHOD_VIA, Design
 from .samples import HORIZON_FACTOR, STEP_BUDGET
 from .windows import SHARPNESS_LADDER
 
-__all__ = ["MAX_TIME_FACTOR", "design_within_bound"]
+__all__ = ["MAX_TIME_FACTOR", "design_within_bound", "law13_input_proof"]
 
 #: The ``prescribed_time`` search tries up to this many times the spec's ``t_c``.
 MAX_TIME_FACTOR = 16.0
@@ -201,6 +201,24 @@ def _certified_rate(spec: Spec, tube, design_free: Callable[[Spec], Design],
     return rate
 
 
+def law13_input_proof(design: Design, spec: Spec) -> InputProof:
+    """Law (13)'s proved peak of each input along ``design`` for ``spec``'s plants (the
+    first order's role ``input_proof``).
+
+    Parameters
+    ----------
+    design : Design
+    spec : Spec
+        Its plant class is the one proved.
+
+    Returns
+    -------
+    InputProof
+        :func:`~.certificate.actuator.prove_input_bound` of the design's tube.
+    """
+    return prove_input_bound(design.tube, spec)
+
+
 def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
                         prove: DesignProver | None = None, name_rate: bool = True) -> Design:
     """The certified design of ``spec`` whose controller is proved to stay within
@@ -215,9 +233,9 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
         (:func:`~stt_codegen.design.search.design_tube` on a spec without ``[actuator]``).
     prove : callable, optional
         ``(Design, Spec) -> InputProof``, the proved peak of each input along a design;
-        default law (13)'s (:func:`~.certificate.actuator.prove_input_bound`). A second-order spec
-        passes the cascade's (:func:`~.cascade_gain.cascade_input_proof`: the physical
-        input of the certified second stage).
+        default the variant's (role ``input_proof``: law (13)'s :func:`law13_input_proof`,
+        the cascade's physical input of the certified second stage, the base's
+        ``(v, omega)``).
     name_rate : bool
         When no design's proof holds, name the lowest rate at which law (13)'s sampled
         check passes and :func:`~stt_codegen.design.search.design_tube` then certifies the
@@ -240,8 +258,7 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     """
     started = time.perf_counter()
     if prove is None:
-        def prove(design: Design, judged: Spec) -> InputProof:
-            return prove_input_bound(design.tube, judged)
+        prove = variant_of(spec).entry("input_proof")
     bound = spec.input_bound
     accepted, tried = candidates(spec, design_free, prove)
     if accepted is not None:

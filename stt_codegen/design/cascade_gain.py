@@ -45,7 +45,7 @@ from ..tube.second_stage import SecondStage
 from .certificate.cascade_sampled import certify_stage
 from .input_bound import InputProof
 
-__all__ = ["RATE_SEARCH_FACTOR", "SHAPES", "cascade_input_proof", "certified_stage",
+__all__ = ["RATE_SEARCH_FACTOR", "SHAPES", "cascade_design_proof", "cascade_input_proof", "certified_stage",
            "derived_second_stage", "fastest_searched_rate", "lowest_certified_rate",
            "second_stage_for", "tube_speed"]
 
@@ -205,6 +205,24 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
                       "peak_input_time": list(report.get("peak_input_time", [])),
                       "horizon": report.get("horizon", 0.0)})
     return None, {**derivation, "tried": tried}
+
+
+def cascade_design_proof(design, spec) -> InputProof:
+    """The cascade's certified peak of each physical input along ``design`` for ``spec``
+    (the cascade's role ``input_proof``): :func:`cascade_input_proof` on its tube and its
+    certified narrowest width.
+
+    Parameters
+    ----------
+    design : Design
+    spec : Spec
+        With a second-order ``plant.model`` and ``input_bound``.
+
+    Returns
+    -------
+    InputProof
+    """
+    return cascade_input_proof(design.tube, spec, design.check.min_width)
 
 
 def cascade_input_proof(tube: TubeDesign, spec, min_width: float) -> InputProof:

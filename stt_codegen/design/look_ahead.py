@@ -24,7 +24,7 @@ from .certificate.actuator import prove_input_bound
 from .input_bound import InputProof
 from .result import Design
 
-__all__ = ["look_ahead_input_proof", "look_ahead_within_bound"]
+__all__ = ["look_ahead_design_proof", "look_ahead_input_proof", "look_ahead_within_bound"]
 
 
 def look_ahead_input_proof(proof: InputProof, axle_offset: float) -> InputProof:
@@ -50,6 +50,25 @@ def look_ahead_input_proof(proof: InputProof, axle_offset: float) -> InputProof:
     return replace(proof, peak=(speed, speed / axle_offset), time=(when, when))
 
 
+def look_ahead_design_proof(design: Design, spec: Spec) -> InputProof:
+    """The base's proved peaks ``(|v|, |omega|)`` along ``design`` for ``spec``'s plants
+    (the look-ahead variant's role ``input_proof``).
+
+    Parameters
+    ----------
+    design : Design
+    spec : Spec
+        A differential-drive spec (its ``axle_offset``).
+
+    Returns
+    -------
+    InputProof
+        :func:`look_ahead_input_proof` of law (13)'s proof at the point.
+    """
+    return look_ahead_input_proof(prove_input_bound(design.tube, spec),
+                                  spec.drive.axle_offset)
+
+
 def look_ahead_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> Design:
     """The certified design of a differential-drive spec whose ``(v, omega)`` stay within
     ``[actuator] input_bound``, or the first order's refusal naming the
@@ -73,10 +92,5 @@ def look_ahead_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -
     DesignError
         As :func:`~.actuator.design_within_bound` (kind ``INPUT_BOUND``).
     """
-    offset = spec.drive.axle_offset
-
-    def prove(design: Design, judged: Spec) -> InputProof:
-        return look_ahead_input_proof(prove_input_bound(design.tube, judged), offset)
-
-    design = design_within_bound(spec, design_free, prove)
+    design = design_within_bound(spec, design_free)
     return replace(design, tube=replace(design.tube, input_bound=None))

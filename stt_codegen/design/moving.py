@@ -26,9 +26,11 @@ space-time disjointness from every moving obstacle, :mod:`.certificate.motion`) 
    :data:`DETOUR_SPANS` seconds either side of where that tube comes closest to it
    (:func:`partial_spec`), re-timed as in step 2 against every moving obstacle as it moves.
 
-Specs with ``[actuator]`` skip steps 2 and 4 (its input proof is the static design's),
-and so do specs with ``tube.method = "paper"`` (their tubes are via-point tubes). The
-argument and the limits: docs/moving-obstacles.md.
+With ``[actuator]`` the re-timed tubes of steps 2 and 4 (whose legs are faster or slower
+than the static design's, with waits between them) are accepted only when the variant's
+input proof (role ``input_proof``: law (13)'s, the cascade's, the base's) keeps the bound
+along them, and carry that proof. Specs with ``tube.method = "paper"`` skip steps 2 and 4
+(their tubes are via-point tubes). The argument and the limits: docs/moving-obstacles.md.
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ import numpy as np
 
 from ..errors import DesignError
 from ..spec.loader import Obstacle, Spec
+from ..spec.variants import variant_of
 from ..spec.tasks import STAY, Task
 from ..tube import reference
 from ..tube.parameters import ReachSegment, TubeDesign
@@ -382,7 +385,7 @@ def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
     reasons = [f"the {first.method} design for the static obstacles fails in space-time: "
                f"{found.reason}"]
     kind = found.kind
-    if spec.input_bound is None and spec.tube.method != METHOD_PAPER:
+    if spec.tube.method != METHOD_PAPER:
         tried: list[str] = []
         for which in routes(len(spec.moving_obstacles)):
             partial, _ = swept_spec(spec, which)
@@ -398,7 +401,7 @@ def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
             if isinstance(timed, Design):
                 return timed
             tried.append(f"the re-timed via tube around {list(which) or 'none'} fails: "
-                         f"{timed.reason}")
+                         f"{timed}")
         reasons.append("; ".join(tried) if tried else
                        f"no re-timing of the via boxes on {TIME_STEPS} time steps keeps "
                        "clear of the moving obstacles (going around none, one or more of "
@@ -418,7 +421,7 @@ def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
                 return _design(design.tube, design.method, final, spec, started,
                                MOTION_SWEPT, design)
             reasons.append(f"the swept design fails: {final.reason}")
-    if spec.input_bound is None and spec.tube.method != METHOD_PAPER:
+    if spec.tube.method != METHOD_PAPER:
         detoured, why = _detour(spec, found, design_static, check, started)
         if detoured is not None:
             return detoured
@@ -446,17 +449,18 @@ def _detour(spec: Spec, found: TubeCheck, design_static: Callable[[Spec], Design
                 return timed, ""
             tried.append(f"the re-timed via tube around moving obstacle "
                          f"{spec.moving_obstacles[position].source} over "
-                         f"[{when - span:g}, {when + span:g}] s fails: {timed.reason}")
+                         f"[{when - span:g}, {when + span:g}] s fails: {timed}")
     return None, ("; ".join(tried) if tried else "no detour around where the static tube "
                   "meets a moving obstacle is planned and re-timed")
 
 
 def _retimed(via: Design | None, timing: Spec, spec: Spec,
              check: Callable[[TubeDesign, Spec], TubeCheck],
-             started: float) -> Design | TubeCheck | None:
+             started: float) -> Design | str | None:
     """``via``'s boxes re-timed against the moving obstacles of ``timing``
-    (:func:`retime`) and checked for ``spec``: the design when the check passes, the failed
-    check otherwise, ``None`` when there is no via design or no re-timing."""
+    (:func:`retime`) and checked for ``spec`` (with ``[actuator]``, its input proof too):
+    the design when both pass, why not otherwise, ``None`` when there is no via design or
+    no re-timing."""
     if via is None:
         return None
     segments = retime(via.tube.segments, timing,
@@ -465,10 +469,19 @@ def _retimed(via: Design | None, timing: Spec, spec: Spec,
         return None
     tube = replace(via.tube, segments=segments)
     timed = check(tube, spec)
-    if timed.passed:
-        return _design(_accept(tube, timed, spec), METHOD_VIA, timed, spec, started,
-                       MOTION_TIMED_VIA, via)
-    return timed
+    if not timed.passed:
+        return timed.reason
+    design = _design(_accept(tube, timed, spec), METHOD_VIA, timed, spec, started,
+                     MOTION_TIMED_VIA, via)
+    if spec.input_bound is None:
+        return design
+    proof = variant_of(spec).entry("input_proof")(design, spec)
+    if not proof.meets(spec.input_bound):
+        peaks = ", ".join(f"|{name}| <= {p:.4g}" for name, p in
+                          zip(spec.input_names, proof.peak))
+        return (f"its input is not proved within actuator.input_bound ({peaks})"
+                if proof.proved else f"its input bound is not proved: {proof.reason}")
+    return replace(design, input_proof=proof)
 
 
 def _meetings(found: TubeCheck, spec: Spec) -> list[tuple[int, float]]:

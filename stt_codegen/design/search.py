@@ -34,7 +34,6 @@ from ..tube.parameters import Circumvent, TubeDesign, paper_segments
 from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, certify_tube
 from .certificate.motion import certify_motion
 from .actuator import design_within_bound
-from .cascade_gain import cascade_input_proof
 from .failures import FailureKind, advice_wanted, property_kind, without_advice
 from .grid import grid_index, grid_value, smallest_passing
 from .moving import MOTION_SPACE_TIME, design_moving, moves
@@ -415,7 +414,7 @@ def cascade_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> D
     ``within_bound``, :mod:`~stt_codegen.spec.variants`): the first-order procedure
     (:func:`~stt_codegen.design.actuator.design_within_bound`) with the sampled cascade's
     certified peak of the physical input as its proof
-    (:func:`~stt_codegen.design.cascade_gain.cascade_input_proof`).
+    (:func:`~stt_codegen.design.cascade_gain.cascade_design_proof`, its role ``input_proof``).
 
     Parameters
     ----------
@@ -446,9 +445,7 @@ def cascade_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> D
     def design_free_or_default(candidate: Spec) -> Design:
         return default if candidate == free else design_free(candidate)
 
-    return design_within_bound(spec, design_free_or_default, prove=lambda design, judged:
-                               cascade_input_proof(design.tube, judged,
-                                                   design.check.min_width), name_rate=False)
+    return design_within_bound(spec, design_free_or_default, name_rate=False)
 
 
 def _rate_within_bound(spec: Spec, error: DesignError) -> DesignError:

@@ -67,6 +67,8 @@ ROLES: Mapping[str, str] = MappingProxyType({
     "sampled_checks": "(spec, design, tube_check, progress) -> list of Check of the "
                       "sampled loop",
     "plant_within": "(spec, model) -> Check, the plant within the certified class",
+    "input_proof": "(design, spec) -> InputProof, the proved peak of each physical input "
+                   "along the design for the spec's plants ([actuator])",
     "output_limits": "(design) -> OutputLimits of its command without [actuator] (the "
                      "proved peak and the clamp's bound), or None: no warning",
 })
@@ -200,6 +202,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                model_checks=_P + "verification.command:first_order_model_checks",
                sampled_checks=_P + "verification.command:first_order_sampled_checks",
                plant_within=_P + "verification.plant_within:first_order_within",
+               input_proof=_P + "design.actuator:law13_input_proof",
                output_limits=_P + "design.output_bound:no_output_limits")),
     "cascade": ControllerVariant(
         "cascade", "a second-order plant", "the cascade's input u", 2,
@@ -227,6 +230,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                model_checks=_P + "verification.command:no_model_checks",
                sampled_checks=_P + "verification.command:cascade_sampled_checks",
                plant_within=_P + "verification.plant_within:cascade_within",
+               input_proof=_P + "design.cascade_gain:cascade_design_proof",
                output_limits=_P + "design.output_bound:cascade_output_limits"),
         MappingProxyType({"cascade": True}), timing_in_stage=True),
     "look-ahead": ControllerVariant(
@@ -254,6 +258,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                model_checks=_P + "verification.command:look_ahead_model_checks",
                sampled_checks=_P + "verification.command:look_ahead_sampled_checks",
                plant_within=_P + "verification.plant_within:first_order_within",
+               input_proof=_P + "design.look_ahead:look_ahead_design_proof",
                output_limits=_P + "design.output_bound:look_ahead_output_limits")),
 })
 assert tuple(CONTROLLER_VARIANTS) == VARIANTS
