@@ -58,6 +58,8 @@ def test_double_integrator_arena_runs_both_methods() -> None:
     from stt_codegen_bench.second_order_arenas import run_arena_double_integrator
     out = run_arena_double_integrator(0, 0)
     assert out["stt"]["satisfied"] and out["stt"]["in_tube"]
+    times = out["design_cpu"]
+    assert times["first_order"] > 0.0 and times["cascade"] > 0.0 and times["cascade_designed"]
     assert out["astar"]["satisfied"]
     assert "in_tube" not in out["astar"]          # a tracker has no tube to stay in
 
@@ -69,3 +71,4 @@ def test_bench_arenas_dispatches_on_the_plant(capsys) -> None:
     assert main(["bench", "arenas", "--plant", "double-integrator", "--count", "1"]) == 0
     out = capsys.readouterr().out
     assert out.startswith("double integrator, 1 arenas, seed 0: satisfied STT cascade")
+    assert "median ratio cascade / first order" in out

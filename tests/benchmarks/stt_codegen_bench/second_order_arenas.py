@@ -13,6 +13,11 @@ with the same disturbance seed (the arena index), judged by Definition 2.1:
 * ``astar``: the A* path of :func:`~.astar.plan_astar`, followed by the carrot of
   :class:`~.tracker.PathTracker` as a velocity reference, and a velocity loop
   ``u = m_nominal VELOCITY_GAIN (v_ref - x2)`` (nominal mass 1 kg).
+
+Each arena also times, in CPU seconds of this process, ``design_tube`` of the arena as a
+first-order spec and as the double integrator's spec (the position tube and the certified
+second stage): the report's ``design_ratio`` is the median of their ratio, measured side by
+side in one run.
 """
 
 from __future__ import annotations
@@ -109,7 +114,7 @@ def run_arena_double_integrator(seed: int, index: int) -> dict:
     from .astar import plan_astar
     spec = arena_spec("paper", seed, index)
     spec = replace(spec, tube=replace(spec.tube, circumvent_sharpness=SHARPNESS))
-    out: dict = {"index": index}
+    out: dict = {"index": index, "design_cpu": _design_cpu(spec)}
     begin = time.perf_counter()
     try:
         design = design_tube(spec)
@@ -141,6 +146,26 @@ def run_arena_double_integrator(seed: int, index: int) -> dict:
     return out
 
 
+def _design_cpu(spec: Spec) -> dict:
+    """CPU seconds of ``design_tube`` for the first-order arena and for its double
+    integrator (``None`` where it refuses), each from a cold start of the caches that
+    would carry one design into the other."""
+    from stt_codegen.design.cascade_gain import _second_stage
+    from stt_codegen.design.certificate.cascade_sampled import cascade_check_of
+    out = {}
+    for name, judged in (("first_order", spec), ("cascade", double_integrator_spec(spec))):
+        _second_stage.cache_clear()
+        cascade_check_of.cache_clear()
+        start = time.process_time()
+        try:
+            design_tube(judged).stage
+        except DesignError:
+            out[name], out[f"{name}_designed"] = time.process_time() - start, False
+        else:
+            out[name], out[f"{name}_designed"] = time.process_time() - start, True
+    return out
+
+
 def run_double_integrator_bench(count: int, seed: int) -> dict:
     """Every arena in turn (sequential: no timing is compared), the satisfied rates.
 
@@ -159,8 +184,16 @@ def run_double_integrator_bench(count: int, seed: int) -> dict:
     """
     arenas = [run_arena_double_integrator(seed, k) for k in range(count)]
     rates = {m: sum(a[m]["satisfied"] for a in arenas) / count for m in ("stt", "astar")}
+    times = [a["design_cpu"] for a in arenas]
+    both = [t for t in times if t["first_order_designed"] and t["cascade_designed"]]
+    ratio = float(np.median([t["cascade"] / t["first_order"] for t in both])) if both else None
     return {"plant": "double-integrator", "count": count, "seed": seed,
-            "satisfied_rate": rates, "arenas": arenas}
+            "satisfied_rate": rates, "arenas": arenas, "design_ratio": ratio,
+            "design_cpu_median": {m: float(np.median([t[m] for t in times]))
+                                  for m in ("first_order", "cascade")},
+            "design_cpu_max": {m: float(np.max([t[m] for t in times]))
+                               for m in ("first_order", "cascade")},
+            "cascade_designed": sum(t["cascade_designed"] for t in times)}
 
 
 def format_double_integrator_report(report: dict) -> str:
@@ -179,6 +212,13 @@ def format_double_integrator_report(report: dict) -> str:
     lines = [f"double integrator, {report['count']} arenas, seed {report['seed']}: satisfied "
              f"STT cascade {100 * report['satisfied_rate']['stt']:.1f} %, A* + tracker "
              f"{100 * report['satisfied_rate']['astar']:.1f} %"]
+    median, top = report["design_cpu_median"], report["design_cpu_max"]
+    ratio = report["design_ratio"]
+    lines.append(f"design_tube CPU, first order / cascade: median {median['first_order']:.2f} "
+                 f"/ {median['cascade']:.2f} s, largest {top['first_order']:.2f} / "
+                 f"{top['cascade']:.2f} s; cascade designed on {report['cascade_designed']} "
+                 f"of {report['count']}; median ratio cascade / first order "
+                 + ("n/a" if ratio is None else f"{ratio:.2f}"))
     for arena in report["arenas"]:
         for method in ("stt", "astar"):
             r = arena[method]
