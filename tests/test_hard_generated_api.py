@@ -5,7 +5,9 @@ variant's own: ``P_control`` of the first order, ``P_virtual_velocity`` of the c
 one bundled case per variant (:mod:`hard_helpers`), double and single, is called with
 NaN, infinities, huge and tiny values, states whose tube point is inside, exactly on and
 outside the tube, ``t < 0`` and far past ``t_c``, ``dt <= 0``, too small and too large,
-``alpha`` negative and beyond ``ALPHA_MAX``, NULL pointers and in-place updates. The C
+at the period and off it (every row at ``dt = PERIOD`` and at ``1.5 PERIOD``: the step's
+OFF_PERIOD), ``alpha`` negative and beyond ``ALPHA_MAX``, NULL pointers and in-place
+updates. The C
 driver is built with ``-fsanitize=address,undefined -fno-sanitize-recover=all`` by gcc
 and clang and must run clean. Checked: the status is the documented one (the input domain
 of the header), every number written is finite (outputs are pre-filled with NaN, so an
@@ -75,7 +77,13 @@ def hostile_inputs(case) -> list[tuple]:
     rng = np.random.default_rng(7)
     keep = rng.random(len(rows)) < 0.25          # a fixed quarter of the product
     keep[:200] = True
-    return [r for r, k in zip(rows, keep) if k]
+    chosen = [r for r, k in zip(rows, keep) if k]
+    # the step's period check: every row at dt = PERIOD (OK and INPUT_CLAMPED are the
+    # step's only there) and each again at 1.5 PERIOD (OFF_PERIOD), not a quarter of them
+    period = 1.0 / design.rate_hz
+    chosen += [r for r, k in zip(rows, keep) if not k and r[2] == period]
+    chosen += [(x, t, 1.5 * period, a) for x, t, dt, a in rows if dt == period]
+    return chosen
 
 
 def in_domain(case, x, t, dt, alpha, names) -> bool:
