@@ -82,3 +82,22 @@ def test_design_and_its_json_print_the_warning():
     done = subprocess.run([sys.executable, "-m", "stt_codegen.cli", "design", "second-order-s1",
                            "--json"], capture_output=True, text=True, check=True)
     assert json.loads(done.stdout)["warnings"][0].startswith("no [actuator] input_bound")
+
+
+def test_the_headers_state_the_clamps_bound_without_actuator(tmp_path):
+    """The cascade's and the base's generated headers give the clamp's bound in words when
+    no [actuator] bounds the command, and not when one does."""
+    from stt_codegen.design.output_bound import base_clamp, cascade_clamp
+    design = design_of("second-order-s1")
+    header = (Path(__file__).parents[1] / "generated" / "second-order-s1" / "double"
+              / "second_order_s1.h").read_text()
+    clamp = ", ".join(f"{c:.3g}" for c in cascade_clamp(design.second_stage[0]))
+    assert f"Whatever the inputs, |u_i| <= {clamp} (i = 0, 1, ...)" in header
+    office = (Path(__file__).parents[1] / "generated" / "office-base" / "double"
+              / "office_base.h").read_text()
+    assert "Output bound:" not in office                    # [actuator]: clamped to it
+    free = stt.design_tube(stt.load_spec(str(_free_office(tmp_path))))
+    files = stt.generate(free, tmp_path / "out", languages=("c",))
+    text = next(p for p in files if p.suffix == ".h").read_text()
+    v, omega = base_clamp(free.tube.gain, free.spec.drive.axle_offset)
+    assert f"|v| <= {v:.3g} m/s and |omega| <= {omega:.3g} rad/s" in text

@@ -38,6 +38,7 @@ from ..tube.model import build_model
 from ..tube.parameters import Status, TubeDesign, step_status
 from ..tube.second_stage import SecondStage
 from ..version import __version__
+from ..design.output_bound import cascade_clamp
 from ..design.result import Design
 from .emit import python_source
 from .functions import deployed_functions
@@ -85,7 +86,10 @@ def _context(design: TubeDesign, stage: SecondStage, prefix: str, precision: str
             **timing_context(design.rate_hz, timing, literal),
             **{name: literal(value) for name, value in limits.items()},
             "input_bound": (None if design.input_bound is None else
-                            [literal(b) for b in design.input_bound])}
+                            [literal(b) for b in design.input_bound]),
+            # without a bound: what the clamp of the errors allows, in words (3 digits)
+            "output_clamp": (None if design.input_bound is not None else
+                             [f"{c:.3g}" for c in cascade_clamp(stage)])}
 
 
 def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,

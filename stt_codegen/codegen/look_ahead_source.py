@@ -28,6 +28,7 @@ from ..tube.model import build_model
 from ..tube import pieces as P
 from ..tube.parameters import Status, TubeDesign
 from ..version import __version__
+from ..design.output_bound import base_clamp
 from .emit import python_source
 from .functions import deployed_functions
 from .generate import c_source_context, input_limits, timing_context
@@ -62,7 +63,11 @@ def _context(design: TubeDesign, look_ahead: LookAhead, prefix: str, precision: 
             **timing_context(design.rate_hz, timing, literal),
             **{name: literal(value) for name, value in limits.items()},
             "axle_offset": literal(look_ahead.axle_offset),
-            "input_bound": None if bound is None else [literal(b) for b in bound]}
+            "input_bound": None if bound is None else [literal(b) for b in bound],
+            # without limits: what the clamp of the errors allows, in words (3 digits)
+            "output_clamp": (None if bound is not None else
+                             [f"{c:.3g}" for c in base_clamp(design.gain,
+                                                             look_ahead.axle_offset)])}
 
 
 def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,

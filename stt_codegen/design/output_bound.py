@@ -31,10 +31,11 @@ from .input_bound import InputProof
 from .look_ahead import look_ahead_input_proof
 
 if TYPE_CHECKING:
+    from ..tube.second_stage import SecondStage
     from .result import Design
 
-__all__ = ["OutputLimits", "cascade_output_limits", "clamp_phi", "look_ahead_output_limits",
-           "no_output_limits", "ROUNDING"]
+__all__ = ["OutputLimits", "ROUNDING", "base_clamp", "cascade_clamp", "cascade_output_limits",
+           "clamp_phi", "look_ahead_output_limits", "no_output_limits"]
 
 
 @dataclass(frozen=True)
@@ -68,6 +69,42 @@ def clamp_phi() -> float:
     float
     """
     return (1.0 + ROUNDING) * 2.0 * math.atanh(E_MAX) / (1.0 - E_MAX * E_MAX)
+
+
+def cascade_clamp(stage: SecondStage) -> tuple[float, ...]:
+    """The cascade's ``|u_i| <= 2 k2 phi(E_MAX) / rho2_floor_i``, whatever the state and
+    the plant (input units).
+
+    Parameters
+    ----------
+    stage : SecondStage
+
+    Returns
+    -------
+    tuple of float
+        One per physical input.
+    """
+    return tuple(2.0 * stage.velocity_gain * clamp_phi() / floor for floor in stage.width_floor)
+
+
+def base_clamp(gain: float, axle_offset: float) -> tuple[float, float]:
+    """The base's ``(|v|, |omega|)`` from law (13)'s clamp at the 2-D look-ahead point,
+    ``|u_i| <= 4 k phi(E_MAX) / GAMMA_D_MIN``: ``|v| <= |u|``, ``|omega| <= |u| / l``.
+
+    Parameters
+    ----------
+    gain : float
+        ``k`` of law (13).
+    axle_offset : float
+        ``l``, m.
+
+    Returns
+    -------
+    (float, float)
+        m/s, rad/s.
+    """
+    speed = math.sqrt(2.0) * 4.0 * gain * clamp_phi() / GAMMA_D_MIN
+    return speed, speed / axle_offset
 
 
 def no_output_limits(design: Design) -> None:
@@ -106,9 +143,7 @@ def cascade_output_limits(design: Design) -> OutputLimits:
     report = derivation["certificate"]
     proved = InputProof(True, tuple(report["peak_input"]), tuple(report["peak_input_time"]),
                         float(report["horizon"]))
-    clamp = tuple(2.0 * stage.velocity_gain * clamp_phi() / floor
-                  for floor in stage.width_floor)
-    return OutputLimits(proved, clamp)
+    return OutputLimits(proved, cascade_clamp(stage))
 
 
 def look_ahead_output_limits(design: Design) -> OutputLimits:
@@ -128,6 +163,4 @@ def look_ahead_output_limits(design: Design) -> OutputLimits:
     """
     offset = design.spec.drive.axle_offset
     proved = look_ahead_input_proof(prove_input_bound(design.tube, design.spec), offset)
-    point = 4.0 * design.tube.gain * clamp_phi() / GAMMA_D_MIN
-    speed = math.sqrt(design.tube.dimension) * point
-    return OutputLimits(proved, (speed, speed / offset))
+    return OutputLimits(proved, base_clamp(design.tube.gain, offset))

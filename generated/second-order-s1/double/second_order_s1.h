@@ -62,6 +62,12 @@
  *                                          The OUTSIDE_* statuses take precedence.
  * Every number written is finite, whatever the inputs.
  *
+ * Output bound: without [actuator] input_bound nothing limits u to an actuator's range.
+ * Whatever the inputs, |u_i| <= 4.09e+08, 4.09e+08 (i = 0, 1, ...): the velocity
+ * error clamped at +-(1 - 2^-20), 2 k2 phi(E_MAX) / rho2_floor_i. `stt-codegen verify` proves
+ * a peak within an actuator's reach only for plants of the certified class; give
+ * [actuator] input_bound to have u proved within it and clamped there.
+ *
  * Aliasing: inputs are copied before any output is written, so an output may alias an
  * input (e.g. alpha_next == alpha for an in-place update).
  */
