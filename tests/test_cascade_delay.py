@@ -125,3 +125,18 @@ def test_the_loader_takes_a_delay_for_a_second_order_spec(case):
     with pytest.raises(stt.SpecError) as raised:
         stt.Spec.from_dict(doc)
     assert raised.value.field == "controller.delay"
+
+
+@pytest.mark.slow
+def test_a_delay_the_cascade_cannot_hold_names_a_shorter_one_that_is_then_certified():
+    """second-order-s1 at 1 kHz with a whole period of delay: no shape is certified and no
+    faster rate holds the delay; the refusal names the largest delay (to 1/64 of it) with
+    which a shape is certified at 1 kHz, and that design is certified."""
+    spec = dataclasses.replace(stt.load_spec("second-order-s1"), delay=1e-3)
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(spec)
+    shorter = raised.value.advice["controller.delay"]
+    assert 0.0 < shorter < 1e-3
+    assert f"controller.delay = {shorter:.3g} s is certified at 1000 Hz" in str(raised.value)
+    design = stt.design_tube(dataclasses.replace(spec, delay=shorter))
+    assert design.certificate.passed and design.stage is not None

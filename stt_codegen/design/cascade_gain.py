@@ -43,6 +43,7 @@ from ..tube import reference
 from ..tube.parameters import TubeDesign
 from ..tube.second_stage import SecondStage
 from .certificate.cascade_sampled import certify_stage
+from .certificate.sampled import largest_passing
 from .input_bound import InputProof
 
 __all__ = ["RATE_SEARCH_FACTOR", "SHAPES", "cascade_design_proof", "cascade_input_proof", "certified_stage",
@@ -266,6 +267,20 @@ def cascade_input_proof(tube: TubeDesign, spec, min_width: float) -> InputProof:
                       float(best["horizon"]))
 
 
+def _largest_stage_delay(tube: TubeDesign, spec, min_width: float) -> float | None:
+    """The largest ``[controller] delay`` below the spec's (by bisection, to ``delay /
+    2^DELAY_HALVINGS``) with which some shape is certified on ``tube`` at its rate, with the
+    spec's jitter and bound; ``None`` when none is, or only 0 (the position tube does not
+    depend on the delay, so the design is then certified whole)."""
+    def passes(delay: float) -> bool:
+        trial = dataclasses.replace(spec, delay=delay)
+        return certified_stage(tube, trial, min_width, spec.input_bound)[0] is not None
+
+    with reporting(None, (0.0, 0.0)):              # no progress events of its own
+        found = largest_passing(passes, spec.delay)
+    return found if found else None
+
+
 def _rate_certified(tube: TubeDesign, spec, rate_hz: float) -> bool:
     """Whether some shape is certified at ``rate_hz`` (the tube certified again there);
     not where the period is shorter than ``[controller] delay + 2 jitter``."""
@@ -404,6 +419,8 @@ def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage
             "(docs/second-order.md, 'Force limits')", kind=FailureKind.INPUT_BOUND,
             tried=tube)
     rate = lowest_certified_rate(tube, spec, passes_at_rate=False) if advice_wanted() else None
+    delay = (_largest_stage_delay(tube, spec, min_width)
+             if spec.delay > 0.0 and advice_wanted() else None)
     fastest = fastest_searched_rate(tube.rate_hz, spec)
     capped = (f" (a shorter period cannot hold controller.delay + 2 jitter = "
               f"{spec.delay + 2.0 * spec.jitter:g} s)"
@@ -413,10 +430,14 @@ def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage
     need = (f"controller.rate_hz = {rate:g} is certified" if rate is not None else
             f"no rate up to {fastest:g} Hz is certified{capped}; {knobs} or a narrower "
             "assumptions.input_gain may be")
+    if delay is not None:
+        need += (f"; controller.delay = {delay:.3g} s is certified at {tube.rate_hz:g} Hz "
+                 f"(of {spec.delay:.3g} s)")
     first = derivation["tried"][0]["reason"]
     raise DesignError(f"the sampled cascade is not certified at controller.rate_hz = "
                       f"{tube.rate_hz:g} Hz for the declared plants with any second stage "
                       f"tried ({len(SHAPES)} shapes; with the first: {first}); {need} "
                       "(docs/second-order.md, 'The sampled cascade')",
                       kind=FailureKind.SAMPLING_RATE, tried=tube,
-                      advice={} if rate is None else {"controller.rate_hz": rate})
+                      advice={**({} if rate is None else {"controller.rate_hz": rate}),
+                              **({} if delay is None else {"controller.delay": delay})})

@@ -7,7 +7,10 @@ deadline is the knob that helps whatever the hardware: the search doubles ``t_c`
 two-digit grid (:mod:`.grid`), and names the time at which the design search certified the
 spec (the smallest it found, within about an eighth of the doubling).
 Specs whose times are absolute (timed tasks, moving obstacles, ``[target] any_of``) are
-refused as they are: a later ``t_c`` does not move their windows.
+refused as they are: a later ``t_c`` does not move their windows. A refusal that already
+names a shorter ``controller.delay`` certified at the spec's rate (the cascade's,
+:mod:`.cascade_gain`) is left as it is too: the delay is what fails, and the search for a
+time would cost a design per trial.
 """
 
 from __future__ import annotations
@@ -49,12 +52,13 @@ def deadline_refusal(spec: Spec, error: DesignError,
     -------
     DesignError
         ``error`` itself when its kind is not in :data:`SLOWER_HELPS`, when the spec's
-        times are absolute, or when no time up to ``MAX_TIME_FACTOR t_c`` is certified;
+        times are absolute, when it names a certified ``controller.delay``, or when no
+        time up to ``MAX_TIME_FACTOR t_c`` is certified;
         else a copy whose message ends with ``prescribed_time = T s is certified`` (``T``
         was designed and certified by ``search``).
     """
     if (error.kind not in SLOWER_HELPS or spec.tasks or spec.moving_obstacles
-            or spec.target_any_of):
+            or spec.target_any_of or "controller.delay" in error.advice):
         return error
 
     def passes(index: int) -> bool:
