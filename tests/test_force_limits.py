@@ -318,3 +318,16 @@ def test_a_rate_that_keeps_the_tubes_but_not_the_bound_is_not_named_certified():
     assert f"prescribed_time = {later:g} s is certified" in words
     design = stt.design_tube(dataclasses.replace(spec, prescribed_time=later))
     assert design.certificate.passed and design.input_proof.meets(spec.input_bound)
+
+
+def test_a_bound_a_task_spec_cannot_keep_names_its_windows_not_a_later_deadline():
+    """With [[tasks]] the legs are timed by the tasks' windows: the refusal says that a
+    later prescribed_time does not slow them, and names none."""
+    data = bundled("tasks-visit")
+    data["actuator"] = {"input_bound": [0.05, 0.05, 0.05]}
+    with pytest.raises(DesignError) as info:
+        stt.design_tube(stt.Spec.from_dict(data))
+    assert info.value.kind is FailureKind.INPUT_BOUND
+    assert ("a longer prescribed_time does not slow the legs: their times are the "
+            "[[tasks]] windows") in str(info.value)
+    assert "prescribed_time" not in info.value.advice

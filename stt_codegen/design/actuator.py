@@ -337,8 +337,12 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
     prescribed_time : float or None
         Seconds.
     why : str
-        When ``None``: why the search stopped.
+        When ``None``: why the search stopped (for a spec with ``[[tasks]]`` at once: its
+        legs are timed by the tasks' windows, which a later ``t_c`` does not move).
     """
+    if spec.tasks:       # the legs' times are the tasks' windows, which t_c does not move
+        return None, ("a longer prescribed_time does not slow the legs: their times are "
+                      "the [[tasks]] windows; wider windows may")
     cap = min(MAX_TIME_FACTOR * spec.prescribed_time,
               STEP_BUDGET / (HORIZON_FACTOR * spec.rate_hz))
 
