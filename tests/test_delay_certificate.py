@@ -10,6 +10,7 @@ import math
 import re
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,12 +20,15 @@ from hypothesis import strategies as st
 
 import stt_codegen as stt
 from stt_codegen.design.certificate.plant_class import plant_class
+from stt_codegen.design.failures import FailureKind
 from stt_codegen.design.certificate.sampled import (check_sampled,
                                                     check_sampled_first_per_axis,
                                                     largest_delay, lowest_rate)
 from stt_codegen.design.samples import sample_tube
 from stt_codegen.tube import reference
 from stt_codegen.verification.sampled import delay_check
+
+SPECS = Path(__file__).parent / "specs"
 
 
 def _timed(spec, delay=0.0, jitter=0.0):
@@ -320,3 +324,18 @@ def largest_delay_of(design, spec, assumptions) -> float:
                                                    delay=d).passed,
             1.0 / design.rate_hz)
     return found or 0.0
+
+
+@pytest.mark.slow
+def test_a_base_at_50_hz_is_certified_but_not_with_a_whole_period_of_delay():
+    """The Kobuki-like base is certified at 50 Hz; with a 20 ms delay (a whole period) law
+    (13)'s check fails at every shorter delay tried, no faster rate can hold the delay, and
+    the refusal says so and why."""
+    spec = stt.load_spec(str(SPECS / "kobuki-office.toml"))
+    assert stt.design_tube(spec).certificate.passed
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(dataclasses.replace(spec, delay=0.02))
+    words = str(raised.value)
+    assert raised.value.kind is FailureKind.TIMING and raised.value.advice == {}
+    assert "nor a faster rate (its period could not hold controller.delay + 2 jitter)" in words
+    assert "a delay near a whole period is beyond law (13)'s check at any rate" in words

@@ -126,9 +126,16 @@ def design_with_timing(spec: Spec, search: Callable[[Spec], Design]) -> Design:
                        ("controller.rate_hz", rate)))
     kept = [(words, field) for trial, words, field in trials if _passes(trial, search)]
     works = [words for words, _ in kept]
+    # a faster rate must hold delay + 2 jitter in its period
+    faster = (spec.delay + 2.0 * spec.jitter) * spec.rate_hz < 1.0 - 1e-12
+    rates = ("a rate up to 16 times it" if faster else
+             "a faster rate (its period could not hold controller.delay + 2 jitter)")
+    whole = ("; a delay near a whole period is beyond law (13)'s check at any rate "
+             "(docs/sampled-data.md, 'How large a delay it can prove')"
+             if spec.delay * spec.rate_hz >= 0.5 else "")
     advice = ("; " + "; ".join(works)) if works else (
-        "; neither a shorter delay at this rate nor a rate up to 16 times it is certified "
-        "(the design without the timing is)")
+        f"; neither a shorter delay at this rate nor {rates} is certified (the design "
+        f"without the timing is){whole}")
     raise DesignError(f"no design is certified with {_timing_words(spec)} at "
                       f"{number_text(spec.rate_hz)} Hz ({refused}){advice}",
                       kind=FailureKind.TIMING,
