@@ -39,3 +39,21 @@ def test_a_refusal_a_later_deadline_cannot_cure_is_left_as_it_is():
         stt.design_tube(spec)
     assert "prescribed_time =" not in str(raised.value)
     assert raised.value.advice == {}
+
+
+@pytest.mark.slow
+def test_no_room_for_a_circumvent_and_a_via_tube_too_fast_names_a_deadline():
+    """stlpy's NonlinearReachAvoid as a differential drive: no circumvent fits, and the via
+    tube is too fast for 100 Hz; the refusal is the via tube's (a slower tube cures it) and
+    names the prescribed_time that is then certified within the base's limits."""
+    from pathlib import Path
+    spec = stt.load_spec(str(Path(__file__).parent / "specs"
+                             / "nonlinear-reach-avoid-drive.toml"))
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(spec)
+    assert raised.value.kind is FailureKind.SAMPLING_RATE
+    assert "cannot be circumvented" in str(raised.value)
+    later = raised.value.advice["prescribed_time"]
+    assert str(raised.value).endswith(f"prescribed_time = {later:g} s is certified")
+    design = stt.design_tube(dataclasses.replace(spec, prescribed_time=later))
+    assert design.certificate.passed and design.input_proof.meets(spec.input_bound)

@@ -513,9 +513,14 @@ def _design(spec: Spec, smoother: bool) -> Design:
         else:
             paper, via = errors[METHOD_PAPER], errors[METHOD_VIA]
             message, kind = f"{paper}; with via points: {via}", paper.kind
+            tried = paper.tried if paper.tried is not None else via.tried
             if via.kind is FailureKind.WALLED_OFF:   # the reason neither method can pass
                 message, kind = f"{via} (the paper's search: {paper})", via.kind
-            tried = paper.tried if paper.tried is not None else via.tried
+            elif (paper.kind is FailureKind.NO_ROOM and via.tried is not None
+                  and via.kind in (FailureKind.SAMPLING_RATE, FailureKind.NON_EMPTY)):
+                # no room for a circumvent at all: the via tube, too fast for the rate, is
+                # the design a later deadline or a faster rate can save
+                kind, tried = via.kind, via.tried
         if (kind is FailureKind.SAMPLING_RATE and tried is not None
                 and check_tube(tried, spec).kind is FailureKind.SAMPLING_RATE):
             rate = lowest_passing_rate(tried, spec)
