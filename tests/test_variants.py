@@ -172,8 +172,8 @@ def test_each_variants_status_decoding_agrees_with_its_reference_backend():
         away[:n if name != "look-ahead" else 2] += 100.0
         seen = []
         for state in (x, away):
-            u, alpha_next, status = variant.entry("status")(function(state, 0.0, dt,
-                                                                     np.zeros(2 * n)))
+            u, alpha_next, status = variant.entry("status")(
+                function(state, 0.0, dt, np.zeros(2 * n)), dt, tube.rate_hz)
             u_ref, _, status_ref = reference.step(state, 0.0, dt, np.zeros(2 * n))
             assert status == status_ref, name
             np.testing.assert_allclose(u, u_ref, rtol=1e-9, atol=1e-12, err_msg=name)

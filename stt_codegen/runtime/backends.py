@@ -19,7 +19,7 @@ from ..tube import reference
 from ..errors import SpecError
 from ..spec.variants import variant_named, variant_of_order, variant_of_stage
 from ..tube.parameters import (STATUS_INPUT_CLAMPED, STATUS_INVALID_INPUT, STATUS_OK,
-                               STATUS_OUTSIDE_TUBE, TubeDesign, step_status)
+                               STATUS_OUTSIDE_TUBE, TubeDesign)
 from ..tube.look_ahead import LookAhead
 from ..tube.second_stage import SecondStage
 
@@ -68,8 +68,7 @@ class CasadiController:
 
     def step(self, x, t, dt, alpha):
         # a design with an actuator bound has a fourth output, within_bound
-        u, alpha_next, status = self._decode(self.function(x, t, dt, alpha))
-        return u, alpha_next, step_status(status, dt, self.rate_hz)
+        return self._decode(self.function(x, t, dt, alpha), dt, self.rate_hz)
 
 
 def _generated_c(design: TubeDesign) -> Controller:

@@ -16,7 +16,7 @@ import numpy as np
 from ..codegen.emit import python_function
 from ..errors import SpecError
 from ..tube import cascade_reference
-from ..tube.parameters import Status, TubeDesign, step_status
+from ..tube.parameters import Status, TubeDesign
 from ..tube.second_stage import SecondStage
 from ..tube.variant_steps import cascade_status
 
@@ -98,8 +98,7 @@ class CascadeController:
         out = self._call(x, float(t), float(dt), np.asarray(alpha, dtype=float))
         if len(out) == 3:          # the compiled step returns its status
             return out
-        u, alpha_next, status = cascade_status(out)   # the variant's decoding, written once
-        return u, alpha_next, step_status(status, dt, self.design.rate_hz)
+        return cascade_status(out, dt, self.design.rate_hz)   # the variant's decoding, once
 
 
 def _compiled(design: TubeDesign, stage: SecondStage):

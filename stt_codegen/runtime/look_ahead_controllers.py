@@ -16,7 +16,7 @@ from ..codegen.emit import python_function
 from ..errors import SpecError
 from ..tube import look_ahead_reference
 from ..tube.look_ahead import LookAhead, look_ahead_step
-from ..tube.parameters import Status, TubeDesign, step_status
+from ..tube.parameters import Status, TubeDesign
 from ..tube.variant_steps import law13_status
 
 __all__ = ["LOOK_AHEAD_BACKENDS", "LookAheadController"]
@@ -57,12 +57,12 @@ class LookAheadController:
         else:
             function = look_ahead_step(design, look_ahead)
             if backend == "casadi":
-                self._call = lambda x, t, dt, alpha: _with_status(
+                self._call = lambda x, t, dt, alpha: law13_status(
                     [np.array(v, dtype=float).ravel() for v in function(x, t, dt, alpha)],
                     dt, design.rate_hz)
             else:
                 printed = python_function(function)
-                self._call = lambda x, t, dt, alpha: _with_status(
+                self._call = lambda x, t, dt, alpha: law13_status(
                     [np.array(v, dtype=float).ravel()
                      for v in printed(*[np.ravel(v).tolist() for v in (x, t, dt, alpha)])],
                     dt, design.rate_hz)
@@ -97,13 +97,6 @@ class LookAheadController:
         return self._call(np.asarray(x, dtype=float), float(t), float(dt),
                           np.asarray(alpha, dtype=float))
 
-
-def _with_status(out: list, dt: float, rate_hz: float) -> tuple[np.ndarray, np.ndarray, Status]:
-    """The step's outputs and status from the CasADi step's outputs: the law's status
-    (:func:`~stt_codegen.tube.variant_steps.law13_status`, the variant's role ``status``),
-    ``OFF_PERIOD`` for a ``dt`` other than ``1 / rate_hz``."""
-    u, alpha_next, status = law13_status(out)
-    return u, alpha_next, step_status(status, dt, rate_hz)
 
 
 def _compiled(design: TubeDesign, look_ahead: LookAhead):

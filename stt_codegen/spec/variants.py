@@ -46,7 +46,8 @@ ROLES: Mapping[str, str] = MappingProxyType({
                    "...), the deployed step",
     "oracle_step": "(tube, stage, x (N, m), t (N,), dt (N,), alpha (N, 2n)) -> (u, "
                    "alpha_next, ...), the numpy oracle's step",
-    "status": "(outputs of casadi_step) -> (u, alpha_next, Status)",
+    "status": "(outputs of casadi_step, dt, rate_hz) -> (u, alpha_next, Status), the step's "
+              "status (OFF_PERIOD off the period)",
     "stage_json": "(design) -> dict of the design document's variant fields",
     "summary_rows": "(design) -> list of (label, text), the variant's rows of "
                     "Design.summary()",

@@ -12,7 +12,7 @@ import numpy as np
 
 from . import look_ahead_reference, reference
 from .look_ahead import LookAhead
-from .parameters import Status, TubeDesign
+from .parameters import Status, TubeDesign, step_status
 
 __all__ = ["cascade_status", "law13_casadi_step", "law13_oracle_step", "law13_status",
            "look_ahead_oracle_step"]
@@ -92,39 +92,47 @@ def _flag(value) -> bool:
     return bool(float(np.ravel(np.asarray(value, dtype=float))[0]))
 
 
-def law13_status(outputs) -> tuple[np.ndarray, np.ndarray, Status]:
+def law13_status(outputs, dt: float, rate_hz: float) -> tuple[np.ndarray, np.ndarray, Status]:
     """The step of law (13) (or of the look-ahead law) from its CasADi outputs
-    ``(u, alpha_next, inside[, within_bound])``: the status they encode.
+    ``(u, alpha_next, inside[, within_bound])`` and the call's ``dt``: the step's status.
 
     Parameters
     ----------
     outputs : sequence
         The outputs of the variant's ``casadi_step`` Function.
+    dt : float
+        The ``dt`` the step was called with, s.
+    rate_hz : float
+        The design's rate, Hz.
 
     Returns
     -------
     u : ndarray, shape (n,)
     alpha_next : ndarray, shape (2 n,)
     status : Status
-        ``OUTSIDE_TUBE`` if not inside, else ``INPUT_CLAMPED`` if the clamp moved the
-        input, else ``OK``: the law's status. The outputs do not carry ``dt``: the step's
-        status is :func:`~stt_codegen.tube.parameters.step_status` of it (``OFF_PERIOD``
-        for a ``dt`` other than the period).
+        ``OUTSIDE_TUBE`` if not inside, else ``OFF_PERIOD`` for a ``dt`` other than the
+        period (:func:`~stt_codegen.tube.parameters.step_status`), else ``INPUT_CLAMPED``
+        if the clamp moved the input, else ``OK``.
     """
     u, alpha_next, inside, *within = outputs
     status = (Status.OUTSIDE_TUBE if not _flag(inside) else
               Status.INPUT_CLAMPED if within and not _flag(within[0]) else Status.OK)
-    return np.array(u, dtype=float).ravel(), np.array(alpha_next, dtype=float).ravel(), status
+    return (np.array(u, dtype=float).ravel(), np.array(alpha_next, dtype=float).ravel(),
+            step_status(status, dt, rate_hz))
 
 
-def cascade_status(outputs) -> tuple[np.ndarray, np.ndarray, Status]:
+def cascade_status(outputs, dt: float, rate_hz: float) -> tuple[np.ndarray, np.ndarray, Status]:
     """The cascade's step from its CasADi outputs ``(u, alpha_next, r, inside_position,
-    inside_velocity[, within_bound])``: the status they encode.
+    inside_velocity[, within_bound])`` and the call's ``dt``: the step's status.
 
     Parameters
     ----------
     outputs : sequence
         The outputs of :func:`stt_codegen.tube.cascade.cascade_step`'s Function.
+    dt : float
+        The ``dt`` the step was called with, s.
+    rate_hz : float
+        The design's rate, Hz.
 
     Returns
     -------
@@ -132,12 +140,13 @@ def cascade_status(outputs) -> tuple[np.ndarray, np.ndarray, Status]:
     alpha_next : ndarray, shape (2 n,)
     status : Status
         ``OUTSIDE_TUBE`` outside the position tube, else ``OUTSIDE_VELOCITY_TUBE``
-        outside the velocity tube, else ``INPUT_CLAMPED`` if the clamp moved the input,
-        else ``OK``: the law's status; the step's is
-        :func:`~stt_codegen.tube.parameters.step_status` of it.
+        outside the velocity tube, else ``OFF_PERIOD`` for a ``dt`` other than the period
+        (:func:`~stt_codegen.tube.parameters.step_status`), else ``INPUT_CLAMPED`` if the
+        clamp moved the input, else ``OK``.
     """
     u, alpha_next, _r, inside_position, inside_velocity, *within = outputs
     status = (Status.OUTSIDE_TUBE if not _flag(inside_position) else
               Status.OUTSIDE_VELOCITY_TUBE if not _flag(inside_velocity) else
               Status.INPUT_CLAMPED if within and not _flag(within[0]) else Status.OK)
-    return np.array(u, dtype=float).ravel(), np.array(alpha_next, dtype=float).ravel(), status
+    return (np.array(u, dtype=float).ravel(), np.array(alpha_next, dtype=float).ravel(),
+            step_status(status, dt, rate_hz))
