@@ -9,6 +9,9 @@ Spatiotemporal Tubes Approach". The front door, in the order of the flow (see
 * :func:`design_tube` - choose windows (5), circumvents (6)-(9) and the gain of law (13),
   and certify the tube (10) for every ``t``; returns a :class:`Design`, which carries
   its spec (``design.spec``) and its tube (``design.tube``, a :class:`TubeDesign`);
+* :func:`load_fleet`, :func:`design_fleet` - several robots sharing a state space
+  (:class:`FleetSpec`): each robot's tube designed to keep clear of the others' at every
+  ``t``, every pair certified (:class:`FleetDesign`, docs/fleets.md);
 * :func:`generate` - write the standalone C and Python controllers of a design into a
   folder;
 * :func:`simulate` - run a design's sampled controller in closed loop and judge
@@ -54,6 +57,11 @@ _LAZY: dict[str, str] = {
     "Spec": "stt_codegen.spec.loader",
     "load_spec": "stt_codegen.spec.loader",
     "bundled_cases": "stt_codegen.cases",
+    "bundled_fleets": "stt_codegen.cases",
+    "FleetSpec": "stt_codegen.spec.fleet",
+    "load_fleet": "stt_codegen.spec.fleet",
+    "design_fleet": "stt_codegen.design.fleet",
+    "FleetDesign": "stt_codegen.design.fleet",
     "TubeDesign": "stt_codegen.tube.parameters",
     "design_tube": "stt_codegen.design.search",
     "Design": "stt_codegen.design.result",
@@ -80,7 +88,9 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .runtime.iosystem import controller_system, sampled_plant
     from .runtime.plots import plot_design, plot_run
     from .runtime.simulate import SimulationResult, simulate
-    from .cases import bundled_cases
+    from .cases import bundled_cases, bundled_fleets
+    from .design.fleet import FleetDesign, design_fleet
+    from .spec.fleet import FleetSpec, load_fleet
     from .pointmaze import import_pointmaze
     from .spec.loader import Spec, load_spec
     from .tube.parameters import TubeDesign

@@ -6,7 +6,8 @@ from __future__ import annotations
 from importlib import resources
 from pathlib import Path
 
-__all__ = ["bundled_cases", "bundled_folder", "bundled_spec_bytes"]
+__all__ = ["bundled_cases", "bundled_fleet_bytes", "bundled_fleets", "bundled_folder",
+           "bundled_spec_bytes"]
 
 
 def bundled_cases() -> list[str]:
@@ -60,3 +61,38 @@ def bundled_spec_bytes(name: str) -> bytes:
         ``name`` is no bundled case.
     """
     return resources.files(__name__).joinpath(name + ".toml").read_bytes()
+
+
+def bundled_fleets() -> list[str]:
+    """Names of the bundled fleet specs (``warehouse-fleet``), sorted; load one with
+    :func:`stt_codegen.load_fleet`.
+
+    Returns
+    -------
+    list of str
+        The fleet names, sorted, without the ``.toml`` suffix.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> stt.bundled_fleets()
+    ['warehouse-fleet']
+    """
+    folder = resources.files(__name__).joinpath("fleets")
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def bundled_fleet_bytes(name: str) -> bytes:
+    """The bytes of the bundled fleet spec ``name`` (one of :func:`bundled_fleets`).
+
+    Parameters
+    ----------
+    name : str
+        A bundled fleet's name, without ``.toml``.
+
+    Returns
+    -------
+    bytes
+        The TOML text, as stored in the package.
+    """
+    return resources.files(__name__).joinpath("fleets", name + ".toml").read_bytes()

@@ -54,7 +54,9 @@ class FailureKind(Enum):
     docs/tasks.md). Moving obstacles (docs/moving-obstacles.md): ``MOVING_OBSTACLE``
     (the tube may meet one in space-time), ``SWEPT_AT_START`` (no design avoids them in
     space-time, and the region a moving obstacle sweeps meets the start or the target,
-    so it cannot be avoided as a static box). ``TIMING``: with ``[controller] delay`` or
+    so it cannot be avoided as a static box). ``FLEET``: no robot order gives every robot
+    of a fleet a tube apart from the others', or a pair is not certified apart
+    (docs/fleets.md). ``TIMING``: with ``[controller] delay`` or
     ``jitter``, no design's sampled-data proof holds with them (:mod:`~.timing`).
     """
 
@@ -77,6 +79,7 @@ class FailureKind(Enum):
     SWEPT_AT_START = "swept region at start or target"
     TRACKING = "tracking"
     TIMING = "timing"
+    FLEET = "fleet separation"
 
 
 def property_kind(name: str) -> FailureKind:

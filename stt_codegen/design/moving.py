@@ -38,13 +38,14 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
-from itertools import combinations
+from itertools import combinations, islice
 from dataclasses import replace
 
 import numpy as np
 
 from ..errors import DesignError
 from ..spec.loader import Obstacle, Spec
+from ..spec.motion import MovingObstacle
 from ..spec.variants import variant_of
 from ..spec.tasks import STAY, Task
 from ..tube import reference
@@ -169,8 +170,8 @@ def routes(count: int) -> list[tuple[int, ...]]:
     list of tuple of int
         Each a set of indices into ``spec.moving_obstacles``, increasing.
     """
-    out = [c for size in range(count) for c in combinations(range(count), size)]
-    return out[:MAX_ROUTES]
+    every = (c for size in range(count) for c in combinations(range(count), size))
+    return list(islice(every, MAX_ROUTES))       # lazily: 2^count sets for many obstacles
 
 
 def _clear(lower: np.ndarray, upper: np.ndarray, spec: Spec, t_a: np.ndarray,
@@ -178,12 +179,45 @@ def _clear(lower: np.ndarray, upper: np.ndarray, spec: Spec, t_a: np.ndarray,
     """Boolean (K,): box ``[lower[k], upper[k]]`` (shape (K, n)) keeps :data:`VIA_MARGIN`
     from every moving obstacle's hull over ``[t_a[k], t_b[k]]``."""
     ok = np.ones(len(t_a), dtype=bool)
-    for ob in spec.moving_obstacles:
+    still, moving = _still_boxes(spec.moving_obstacles)
+    for d, lo, hi, on, off in still:       # boxes that do not move, all at once
+        present = (np.maximum(t_a[:, None], on) <= np.minimum(t_b[:, None], off))
+        gap = np.maximum(lo - upper[:, None, d], lower[:, None, d] - hi).max(axis=2)
+        ok &= np.all(~present | (gap > VIA_MARGIN), axis=1)
+    for ob in moving:
         lo, hi, present = ob.hull(t_a, t_b)
         d = list(ob.dims)
         gap = np.maximum(lo - upper[:, d], lower[:, d] - hi).max(axis=1)
         ok &= ~present | (gap > VIA_MARGIN)
     return ok
+
+
+#: The last obstacles :func:`_still_boxes` grouped, and the groups.
+_STILL_CACHE: list = [None, None]
+
+
+def _still_boxes(obstacles: tuple[MovingObstacle, ...]) -> tuple[list, list]:
+    """The obstacles that do not move (one knot) as arrays per ``dims`` (``dims``, lower,
+    upper (M, len(dims)), ``t_on``, ``t_off`` (M,)), and the others; the last answer is
+    kept (the re-timing asks for the same obstacles many times)."""
+    if _STILL_CACHE[0] is obstacles:
+        return _STILL_CACHE[1]
+    groups: dict[tuple[int, ...], list[MovingObstacle]] = {}
+    moving = []
+    for ob in obstacles:
+        if len(ob.times) == 1:
+            groups.setdefault(ob.dims, []).append(ob)
+        else:
+            moving.append(ob)
+    still = []
+    for dims, obs in groups.items():
+        centre = np.array([ob.centres[0] for ob in obs])
+        half = np.array([ob.half_size for ob in obs])
+        still.append((list(dims), centre - half, centre + half,
+                      np.array([ob.active[0] for ob in obs]),
+                      np.array([ob.active[1] for ob in obs])))
+    _STILL_CACHE[:] = [obstacles, (still, moving)]
+    return still, moving
 
 
 def _move_clear(seg: ReachSegment, spec: Spec) -> bool:

@@ -32,7 +32,8 @@ from .report import ROUNDING_MARGIN, Certificate, CertificateState, Enclosure, M
 from .repropagate import repropagate
 from .tasks import reach_certified_by
 
-__all__ = ["MOVING_PROPERTY", "certify_motion", "until_ended"]
+__all__ = ["MOTION_INTERVALS", "MOTION_SPLIT", "MOVING_PROPERTY", "certify_motion",
+           "cut_enclosure", "until_ended"]
 
 #: Most intervals the refinement for moving obstacles may create (its own budget, on top
 #: of the partition the rest of the certificate proved).
@@ -103,9 +104,26 @@ def until_ended(design: TubeDesign, spec: Spec, enc: Enclosure) -> tuple[Spec, d
     return replace(spec, moving_obstacles=tuple(kept)), notes
 
 
-def _enclosure(design: TubeDesign, points: list[int], state: CertificateState
-               ) -> tuple[Enclosure, CertificateState]:
-    """The enclosure on a cut partition, ``alpha`` followed from ``state`` on the cuts only."""
+def cut_enclosure(design: TubeDesign, points: list[int], state: CertificateState
+                  ) -> tuple[Enclosure, CertificateState]:
+    """The enclosure on a cut partition, ``alpha`` followed from ``state`` on the cuts only.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube.
+    points : list of int
+        The cut partition's sample indices (every point of ``state`` among them).
+    state : CertificateState
+        A proven partition's ``alpha`` bounds.
+
+    Returns
+    -------
+    enc : Enclosure
+        The tube on the cut partition.
+    state : CertificateState
+        Its ``alpha`` bounds (to cut again).
+    """
     part = partition(design, points)
     state, _ = repropagate(design, part.pieces, points, part.steps, state)
     a_min = np.maximum(np.array(state.alpha_lo), 0.0)
@@ -183,7 +201,7 @@ def certify_motion(design: TubeDesign, spec: Spec, certificate: Certificate,
             cuts = {int(a + (b * q) // MOTION_SPLIT) for a, b in zip(i0[split], length[split])
                     for q in range(1, MOTION_SPLIT)}
             points = sorted(set(points) | cuts)
-            enc, state = _enclosure(design, points, state)
+            enc, state = cut_enclosure(design, points, state)
     note = (f" (the refinement budget of {max_intervals} intervals was exhausted)"
             if budget_hit else "")
     margins = []

@@ -1,0 +1,176 @@
+"""Fleets (docs/fleets.md): the fleet spec, the prioritized design and the pair certificate."""
+
+from __future__ import annotations
+
+import copy
+
+import numpy as np
+import pytest
+
+import stt_codegen as stt
+from stt_codegen.design.failures import FailureKind
+from stt_codegen.design.fleet import certify_fleet, enclosed, tube_obstacles
+from stt_codegen.design.samples import sample_tube
+
+SI = {"controller": {"rate_hz": 100.0},
+      "plant": {"model": "single-integrator", "disturbance_amplitude": 0.05}}
+
+#: Two robots swapping corners of a 12 m x 8 m floor round a block: alone, their tubes
+#: cross in the lower-left and upper-right aisles.
+TWO = {
+    "name": "two",
+    "state_space": {"lower": [0.0, 0.0], "upper": [12.0, 8.0]},
+    "obstacles": [{"lower": [3.0, 2.0], "upper": [9.0, 6.0]}],
+    "robots": [
+        {"name": "a", "radius": 0.2, "prescribed_time": 20.0, **SI,
+         "initial": {"lower": [0.4, 0.6], "upper": [1.2, 1.4]},
+         "target": {"lower": [10.8, 6.6], "upper": [11.6, 7.4]}},
+        {"name": "b", "radius": 0.2, "prescribed_time": 20.0, **SI,
+         "initial": {"lower": [10.8, 0.6], "upper": [11.6, 1.4]},
+         "target": {"lower": [0.4, 6.6], "upper": [1.2, 7.4]}},
+    ]}
+
+
+def _two(**changes) -> dict:
+    doc = copy.deepcopy(TWO)
+    for path, value in changes.items():
+        *keys, last = path.split("__")
+        table = doc
+        for key in keys:
+            table = table[int(key)] if key.isdigit() else table[key]
+        table[last] = value
+    return doc
+
+
+def _sampled_gap(designs, fleet) -> float:
+    """The smallest, over the sampling instants of both tubes (each tube at its own
+    instants, with ``alpha`` from the deployed implicit step), of the largest gap between
+    the two robots' tube boxes along a body dimension minus both reaches; an independent
+    evaluation of the tubes, not the certificate's enclosures."""
+    a, b = fleet.robots
+    sa, sb = (sample_tube(designs[r.name].tube, 1.5 * r.spec.prescribed_time)
+              for r in fleet.robots)
+    t = np.union1d(sa.t, sb.t)
+    t = t[t <= min(sa.t[-1], sb.t[-1])]
+    d = list(a.dims)
+
+    def at(s, times):   # the box of the sampling interval holding each time
+        k = np.searchsorted(s.t, times, side="right") - 1
+        return s.gamma_lower[k][:, d], s.gamma_upper[k][:, d]
+    la, ua = at(sa, t)
+    lb, ub = at(sb, t)
+    gap = np.maximum(lb - ua, la - ub).max(axis=1) - (a.reach + b.reach)
+    return float(gap.min())
+
+
+def test_a_fleet_file_is_one_single_spec_per_robot():
+    fleet = stt.load_fleet("warehouse-fleet")
+    assert len(fleet.robots) == 8
+    variants = {r.spec.variant for r in fleet.robots}
+    assert variants == {"first-order", "look-ahead"}
+    for robot in fleet.robots:
+        spec = robot.spec
+        assert spec.name == robot.name
+        assert spec.robot.radius == pytest.approx(robot.radius + spec.robot.offset)
+        # the shared obstacles, inflated by this robot's reach
+        assert len(spec.obstacles) == 3
+        assert spec.obstacles[0].lower[0] == pytest.approx(3.5 - robot.reach)
+    assert stt.bundled_fleets() == ["warehouse-fleet"]
+    assert "warehouse-fleet" not in stt.bundled_cases()
+
+
+@pytest.mark.parametrize("changes, field", [
+    ({"robots__1__target__lower": [3.5, 3.0]}, "robots[1].target.lower"),
+    ({"robots__0__radius": -1.0}, "robots[0].radius"),
+    ({"robots__1__name": "a"}, "robots[1].name"),
+    ({"robots__1__name": "1b"}, "robots[1].name"),
+    ({"robots__0__speed": 1.0}, "robots[0].speed"),
+    ({"robots__0__obstacles": []}, "robots[0].obstacles"),
+    ({"robots__1__state_space": {"lower": [0.0, 0.0]}}, "robots[1].state_space.lower"),
+    ({"robots__1__plant": {"model": "warp-drive"}}, "robots[1].plant.model"),
+    ({"robots__0__initial": {"lower": [1.0, 2.5], "upper": [3.1, 3.0]}},
+     "robots[0].initial"),
+    ({"robots": []}, "robots"),
+    ({"lanes": 2}, "lanes"),
+])
+def test_errors_name_the_robot_and_the_field(changes, field):
+    with pytest.raises(stt.SpecError) as info:
+        stt.FleetSpec.from_dict(_two(**changes))
+    assert info.value.field.startswith(field), info.value
+
+
+def test_a_missing_radius_is_named():
+    doc = _two()
+    del doc["robots"][1]["radius"]
+    with pytest.raises(stt.SpecError, match=r"^robots\[1\]\.radius: missing"):
+        stt.FleetSpec.from_dict(doc)
+
+
+def test_tube_obstacles_cover_the_tube_grown_by_both_reaches():
+    fleet = stt.FleetSpec.from_dict(TWO)
+    design = stt.design_tube(fleet.robots[0].spec)
+    tube = enclosed(design)
+    boxes = tube_obstacles(tube, 0.4, (0, 1), 10)
+    assert [b.source for b in boxes] == list(range(10, 10 + len(boxes)))
+    assert boxes[-1].active[1] == np.inf and boxes[0].active[0] == 0.0
+    assert all(b.active[1] - b.active[0] <= 0.25 + 1e-9 for b in boxes[:-1])
+    samples = sample_tube(design.tube, 30.0)
+    for t, lo, hi in zip(samples.t, samples.gamma_lower, samples.gamma_upper):
+        holding = [b for b in boxes if b.active[0] <= t <= b.active[1]]
+        assert holding
+        assert any(np.all(np.array(b.centres[0]) - b.half_size <= lo - 0.4 + 1e-9)
+                   and np.all(np.array(b.centres[0]) + b.half_size >= hi + 0.4 - 1e-9)
+                   for b in holding), t
+
+
+def test_the_fleet_certificate_refuses_tubes_that_meet_for_a_short_interval():
+    """Designed apart, each robot's tube is certified, but the two cross: the pair
+    certificate fails, naming the pair and an interval, and the tubes evaluated at their
+    sampling instants do overlap inside that interval."""
+    fleet = stt.FleetSpec.from_dict(TWO)
+    alone = {r.name: stt.design_tube(r.spec) for r in fleet.robots}
+    assert all(d.certificate.passed for d in alone.values())
+    (pair,) = certify_fleet(fleet, alone)
+    assert not pair.passed and pair.pair == ("a", "b")
+    assert pair.t_end - pair.t_start < 2.0               # a short interval
+    assert pair.t_start <= pair.t_narrowest < pair.t_end
+    assert f"a and b: their tubes, grown by both radii, may meet on [{pair.t_start:.4f}, " \
+           f"{pair.t_end:.4f}] s" in pair.detail
+    assert _sampled_gap(alone, fleet) < 0                # they really overlap
+
+
+def test_a_shifted_second_robot_is_certified_apart():
+    """The control: the same two robots, the second one's trip kept in the top aisle."""
+    fleet = stt.FleetSpec.from_dict(_two(
+        robots__1__initial={"lower": [10.8, 6.6], "upper": [11.6, 7.4]},
+        robots__1__target={"lower": [0.4, 6.6], "upper": [1.2, 7.4]},
+        robots__0__target={"lower": [10.8, 0.6], "upper": [11.6, 1.4]}))
+    alone = {r.name: stt.design_tube(r.spec) for r in fleet.robots}
+    (pair,) = certify_fleet(fleet, alone)
+    assert pair.passed and pair.margin > 0
+    assert _sampled_gap(alone, fleet) >= pair.margin - 1e-9
+
+
+def test_the_prioritized_design_separates_the_crossing_robots():
+    fleet = stt.FleetSpec.from_dict(TWO)
+    designed = stt.design_fleet(fleet)
+    assert designed.certified and designed.order == ("a", "b")
+    (pair,) = designed.pairs
+    assert pair.passed and pair.margin > 0
+    # the second robot sees the first one's tube as boxes in space-time
+    assert designed.designs["b"].motion and designed.designs["b"].spec.moving_obstacles
+    assert not designed.designs["a"].spec.moving_obstacles
+    assert _sampled_gap(designed.designs, fleet) >= pair.margin - 1e-9
+    assert "narrowest pair" in designed.summary()
+
+
+def test_a_target_on_another_robots_way_is_refused_naming_the_pair():
+    """Robot b's target is robot a's target: whatever the order, the second one's target
+    lies in the first one's tube after its t_c."""
+    fleet = stt.FleetSpec.from_dict(_two(
+        robots__1__target={"lower": [10.8, 6.6], "upper": [11.6, 7.4]}))
+    with pytest.raises(stt.DesignError) as info:
+        stt.design_fleet(fleet)
+    assert info.value.kind is FailureKind.FLEET
+    message = str(info.value)
+    assert "a and b" in message or "b and a" in message
