@@ -54,6 +54,13 @@ class InputProof:
         The bound of ``|e_i(t_k)|`` the peak is proved from, largest over the samples and
         dimensions (``inf`` when not proved); ``design_tube`` reads it to refuse a paper
         tube one gain cannot follow (:mod:`.tracking`).
+    speed : float
+        A bound of the input vector's Euclidean norm ``|u(t_k)|`` at every sample, the
+        largest over the samples of ``sqrt(sum_i bound_k,i^2)`` (input units), at most
+        ``hypot(*peak)`` and smaller where the inputs peak at different samples; ``inf``
+        when not proved or not computed (a proof built from peaks alone).
+    speed_time : float
+        The sample instant of :attr:`speed`, seconds.
     """
 
     proved: bool
@@ -62,6 +69,8 @@ class InputProof:
     horizon: float
     reason: str = ""
     max_abs_e: float = math.inf
+    speed: float = math.inf
+    speed_time: float = 0.0
 
     def ratio(self, bound: tuple[float, ...]) -> float:
         """``max_i peak_i / bound_i`` (``inf`` when not proved): at most 1 meets the bound."""
@@ -120,11 +129,15 @@ def input_peak(gain: float, abs_e: "np.ndarray", width: "np.ndarray", t: "np.nda
     -------
     InputProof
         ``peak_i = max_k 4 k phi(abs_e_k,i) / max(width_k,i, GAMMA_D_MIN)``, proved;
-        ``max_abs_e = max abs_e``.
+        ``max_abs_e = max abs_e``; ``speed = max_k sqrt(sum_i (4 k phi(abs_e_k,i) /
+        max(width_k,i, GAMMA_D_MIN))^2)``, the bound of ``|u(t_k)|`` sample by sample.
     """
     import numpy as np
     u = 4.0 * gain * phi(abs_e) / np.maximum(width, GAMMA_D_MIN)
     where = np.argmax(u, axis=0)
+    norm = np.sqrt(np.sum(u * u, axis=1))
+    fastest = int(np.argmax(norm))
     return InputProof(True, tuple(float(v) for v in u.max(axis=0)),
                       tuple(float(t[k]) for k in where), float(horizon),
-                      max_abs_e=float(np.max(abs_e)))
+                      max_abs_e=float(np.max(abs_e)), speed=float(norm[fastest]),
+                      speed_time=float(t[fastest]))

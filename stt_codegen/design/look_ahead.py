@@ -9,7 +9,11 @@ the point's plant class. The input is held between samples, so the bound holds a
 ``t``. :func:`look_ahead_input_proof` is that conversion; :func:`look_ahead_within_bound`
 the design of a differential-drive spec with ``[actuator]``: the first order's procedure
 (:func:`~.actuator.design_within_bound`: the default design, softer circumvents, via
-points, slower tubes) with it as the proof.
+points, slower tubes) with it as the proof. A refusal whose best tube keeps ``|v|`` within
+``v_max`` and asks too much of ``omega`` also names the smallest ``plant.axle_offset`` (two
+significant digits) at which the same procedure is certified within the spec's
+``prescribed_time`` (:func:`shortest_axle_offset`): ``|omega| <= |u| / l`` falls with a
+longer look-ahead, while the obstacles grow by it.
 """
 
 from __future__ import annotations
@@ -18,17 +22,29 @@ import math
 from collections.abc import Callable
 from dataclasses import replace
 
+from ..errors import DesignError, SpecError, number_text
 from ..spec.loader import Spec
 from .actuator import design_within_bound
 from .certificate.actuator import prove_input_bound
+from .failures import FailureKind, advice_wanted, without_advice
+from .grid import grid_index, grid_value, smallest_passing
 from .input_bound import InputProof
 from .result import Design
 
-__all__ = ["look_ahead_design_proof", "look_ahead_input_proof", "look_ahead_within_bound"]
+__all__ = ["MAX_OFFSET_FACTOR", "look_ahead_design_proof", "look_ahead_input_proof",
+           "look_ahead_within_bound", "shortest_axle_offset"]
+
+#: The ``plant.axle_offset`` search tries up to this many times the spec's offset.
+MAX_OFFSET_FACTOR = 8.0
 
 
 def look_ahead_input_proof(proof: InputProof, axle_offset: float) -> InputProof:
-    """The base's peaks ``(|v|, |omega|)`` from law (13)'s per-input peaks at the point.
+    """The base's peaks ``(|v|, |omega|)`` from law (13)'s proved bounds at the point.
+
+    ``|v| = |h . u| <= |u|`` and ``|omega| = |h_perp . u| / l <= |u| / l`` whatever the
+    heading, with ``|u|`` bounded sample by sample (:attr:`InputProof.speed`: the norm of
+    the per-input bounds at each sample, the largest over the samples), or by
+    ``hypot(peak_1, peak_2)`` for a proof that carries its peaks only.
 
     Parameters
     ----------
@@ -40,13 +56,23 @@ def look_ahead_input_proof(proof: InputProof, axle_offset: float) -> InputProof:
     Returns
     -------
     InputProof
-        ``peak = (|u|, |u| / l)`` with ``|u| = hypot(peak_1, peak_2)`` (m/s, rad/s), at
-        the time of the larger point peak; ``proof`` itself when not proved.
+        ``peak = (|u|, |u| / l)`` (m/s, rad/s), at the sample where the bound of ``|u|``
+        is largest; ``proof`` itself when not proved.
+
+    Examples
+    --------
+    >>> from stt_codegen.design.input_bound import InputProof
+    >>> point = InputProof(True, (0.6, 0.8), (1.0, 2.0), 11.0, speed=0.9, speed_time=1.5)
+    >>> look_ahead_input_proof(point, 0.5).peak
+    (0.9, 1.8)
     """
     if not proof.proved:
         return proof
-    speed = math.hypot(*proof.peak)
-    when = proof.time[max(range(len(proof.peak)), key=lambda i: proof.peak[i])]
+    if math.isfinite(proof.speed):
+        speed, when = proof.speed, proof.speed_time
+    else:
+        speed = math.hypot(*proof.peak)
+        when = proof.time[max(range(len(proof.peak)), key=lambda i: proof.peak[i])]
     return replace(proof, peak=(speed, speed / axle_offset), time=(when, when))
 
 
@@ -90,7 +116,90 @@ def look_ahead_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -
     Raises
     ------
     DesignError
-        As :func:`~.actuator.design_within_bound` (kind ``INPUT_BOUND``).
+        As :func:`~.actuator.design_within_bound` (kind ``INPUT_BOUND``); when ``omega``
+        is what the best tube exceeds, the message also names the ``plant.axle_offset``
+        that :func:`shortest_axle_offset` finds certified (``advice["plant.axle_offset"]``).
     """
-    design = design_within_bound(spec, design_free)
+    try:
+        design = design_within_bound(spec, design_free)
+    except DesignError as error:
+        raise _naming_axle_offset(spec, design_free, error) from None
     return replace(design, tube=replace(design.tube, input_bound=None))
+
+
+def _naming_axle_offset(spec: Spec, design_free: Callable[[Spec], Design],
+                        error: DesignError) -> DesignError:
+    """``error`` with the certified ``plant.axle_offset`` named when ``omega`` is what its
+    best tube exceeds and ``|v|`` fits (a longer offset lowers the first only)."""
+    if (error.kind is not FailureKind.INPUT_BOUND or error.tried is None
+            or not advice_wanted()):
+        return error
+    proof = look_ahead_input_proof(prove_input_bound(error.tried, spec),
+                                   spec.drive.axle_offset)
+    v_max, omega_max = spec.input_bound
+    if not proof.proved or proof.peak[0] > v_max or proof.peak[1] <= omega_max:
+        return error
+    offset = shortest_axle_offset(spec, design_free, proof.peak[1] / omega_max)
+    if offset is None:
+        return error
+    return DesignError(f"{error}; plant.axle_offset = {number_text(offset)} m is certified "
+                       "with this prescribed_time (|omega| <= |u| / axle_offset; the "
+                       "obstacles grow by it)", kind=error.kind, tried=error.tried,
+                       advice={**error.advice, "plant.axle_offset": offset})
+
+
+def shortest_axle_offset(spec: Spec, design_free: Callable[[Spec], Design],
+                         ratio: float) -> float | None:
+    """The smallest ``plant.axle_offset`` (two significant digits) above the spec's at
+    which :func:`~.actuator.design_within_bound` certifies ``spec`` (its other fields
+    unchanged), or ``None``.
+
+    The proved ``|omega| <= |u| / l`` falls about as ``1 / l`` (``|u|`` changes only
+    through the obstacles, which grow by ``l``), so the first try is the spec's offset
+    times ``ratio``, then each try 1.25 times the last, up to :data:`MAX_OFFSET_FACTOR`
+    times the spec's offset or until the robot no longer fits (:meth:`Spec.with_axle_offset`
+    refuses); once one passes, a bisection on the two-digit values between the last
+    failing and the passing one finds the smallest (the answer is a value where the
+    design passed).
+
+    Parameters
+    ----------
+    spec : Spec
+        A differential-drive spec with ``input_bound``, refused at its offset.
+    design_free : callable
+        ``Spec -> Design`` without an input bound.
+    ratio : float
+        The best tube's proved ``|omega|`` over ``omega_max`` at the spec's offset (> 1).
+
+    Returns
+    -------
+    float or None
+        Metres; ``None`` when no offset up to the cap is certified.
+    """
+    given = spec.drive.axle_offset
+
+    def passes(index: int) -> bool:
+        try:
+            trial = spec.with_axle_offset(grid_value(index))
+        except SpecError:
+            return False
+        try:
+            with without_advice():
+                design_within_bound(trial, design_free)
+        except (DesignError, SpecError):
+            return False
+        return True
+
+    low = grid_index(given)
+    if grid_value(low) > given:
+        low -= 1
+    guess = max(grid_index(given * max(ratio, 1.0)), low + 1)
+    while grid_value(guess) <= MAX_OFFSET_FACTOR * given:
+        try:
+            spec.with_axle_offset(grid_value(guess))
+        except SpecError:
+            return None                    # the robot no longer fits: longer ones neither
+        if passes(guess):
+            return grid_value(smallest_passing(passes, low, guess))
+        low, guess = guess, max(grid_index(1.25 * grid_value(guess)), guess + 1)
+    return None

@@ -464,6 +464,57 @@ class Spec:
         return replace(self, plant_model=model, assumptions=combine_assumptions(
             bounds, declared, self.dimension, self.disturbance_amplitude))
 
+    def with_axle_offset(self, axle_offset: float) -> "Spec":
+        """This differential-drive spec with another ``plant.axle_offset``: the obstacles
+        inflated and the state space shrunk by ``robot.radius`` plus the new offset, and
+        the :attr:`assumptions` the base implies derived again (the declared
+        ``[assumptions]`` keys keep their values), as :func:`load_spec` would load it.
+
+        Parameters
+        ----------
+        axle_offset : float
+            ``l``, m, positive.
+
+        Returns
+        -------
+        Spec
+            ``initial.state`` and the sets as given (they are the look-ahead point's).
+
+        Raises
+        ------
+        SpecError
+            Not a differential drive (field ``plant.model``); ``axle_offset`` not positive
+            or the robot no longer fitting (field ``plant.axle_offset``, or the set's).
+
+        Examples
+        --------
+        >>> import stt_codegen as stt
+        >>> spec = stt.load_spec("office-base")
+        >>> longer = spec.with_axle_offset(0.2)
+        >>> longer.drive.axle_offset, round(longer.state_space.lower[0], 6)
+        (0.2, 0.32)
+        """
+        if self.robot is None or not self.robot.offset:     # the offset is the base's only
+            raise SpecError("plant.model", "only a differential-drive spec has an axle_offset")
+        if not axle_offset > 0.0:
+            raise SpecError("plant.axle_offset", f"must be positive, got {axle_offset!r}")
+        given = self.robot
+        robot = replace(given, radius=given.radius - given.offset + axle_offset,
+                        offset=float(axle_offset))
+        state_space, unsafe_sets, moving = _robot_problem(
+            robot, given.state_space, self.initial_set, self.target_set,
+            self.prescribed_time, (self.initial_state, self.target_center))
+        obstacles = _clipped(_cover_all(unsafe_sets, state_space, self.initial_set,
+                                        self.target_set), state_space)
+        drive = replace(self.drive, axle_offset=float(axle_offset))
+        a = self.assumptions
+        declared = {key: getattr(a, key) for key in a.declared}
+        bounds = model_bounds(self.plant_model, state_space.lower, state_space.upper, drive)
+        return replace(self, state_space=state_space, unsafe_sets=unsafe_sets,
+                       moving_obstacles=moving, obstacles=obstacles, robot=robot, drive=drive,
+                       assumptions=combine_assumptions(bounds, declared, self.dimension,
+                                                       self.disturbance_amplitude))
+
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> "Spec":
         """Validate a spec given as a dictionary, the same document as a TOML file.
