@@ -522,8 +522,19 @@ def test_a_wait_for_a_moving_obstacle_is_kept_under_an_actuator_bound():
     assert design.tube.segments[0].start > 0.0              # it waits at the start
 
 
-def test_a_re_timed_plan_beyond_the_bound_is_refused_saying_so():
+def test_a_re_timed_plan_drives_its_legs_no_faster_than_the_bound_allows():
+    """With [actuator] the re-timing leaves out the fast segments until the proof keeps
+    the bound: at 1.5 the earliest plan (a leg at half its planned duration) is beyond
+    it, a later one with cruise segments is within it."""
     spec = _crossing_with_actuator([1.5, 1.5])
+    design = stt.design_tube(spec)
+    assert design.motion == MOTION_TIMED_VIA and design.certificate.passed
+    assert design.input_proof.meets(spec.input_bound)
+    assert {seg.profile for seg in design.tube.segments} == {"cruise"}
+
+
+def test_a_re_timed_plan_beyond_the_bound_is_refused_saying_so():
+    spec = _crossing_with_actuator([1.0, 1.0])
     with pytest.raises(stt.DesignError) as raised:
         stt.design_tube(spec)
     assert ("the re-timed via tube around none fails: its input is not proved within "

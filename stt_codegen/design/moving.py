@@ -29,7 +29,9 @@ space-time disjointness from every moving obstacle, :mod:`.certificate.motion`) 
 With ``[actuator]`` the re-timed tubes of steps 2 and 4 (whose legs are faster or slower
 than the static design's, with waits between them) are accepted only when the variant's
 input proof (role ``input_proof``: law (13)'s, the cascade's, the base's) keeps the bound
-along them, and carry that proof. Specs with ``tube.method = "paper"`` skip steps 2 and 4
+along them, and carry that proof; the re-timing then drives a smooth-step plan's legs as
+``"cruise"`` segments and leaves out the fast durations until the proof holds
+(:func:`speed_limits`). Specs with ``tube.method = "paper"`` skip steps 2 and 4
 (their tubes are via-point tubes). The argument and the limits: docs/moving-obstacles.md.
 """
 
@@ -49,7 +51,7 @@ from ..spec.motion import MovingObstacle
 from ..spec.variants import variant_of
 from ..spec.tasks import STAY, Task
 from ..tube import reference
-from ..tube.parameters import ReachSegment, TubeDesign
+from ..tube.parameters import CRUISE, SMOOTHSTEP, ReachSegment, TubeDesign
 from .failures import FailureKind
 from .gain import derived_gain
 from .certificate.motion import MOVING_PROPERTY
@@ -285,7 +287,8 @@ def _hold_ok(task: Task, start: float, end: float) -> bool:
 
 
 def retime(segments: tuple[ReachSegment, ...], spec: Spec,
-           order: Sequence[int] | None = None) -> tuple[ReachSegment, ...] | None:
+           order: Sequence[int] | None = None,
+           factors: Sequence[float] = DURATION_FACTORS) -> tuple[ReachSegment, ...] | None:
     """The via boxes of ``segments`` re-timed to miss the moving obstacles (module notes).
 
     With ``spec.tasks``, each task's hold segment (:func:`task_holds`) is not re-timed by
@@ -301,6 +304,10 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
         The spec with its moving obstacles (and tasks).
     order : sequence of int, optional
         The tasks' visit order (``TaskPlan.order``); default the spec's order.
+    factors : sequence of float, optional
+        The durations a segment may take, as multiples of its planned duration, in the
+        order tried (default :data:`DURATION_FACTORS`; with ``[actuator]`` the design
+        leaves out the fast ones the base cannot drive, :func:`speed_limits`).
 
     Returns
     -------
@@ -348,7 +355,7 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
                         frontier.append(to)
                 continue
             planned = segments[k].end - segments[k].start
-            for f in DURATION_FACTORS:
+            for f in factors:
                 d = max(1, int(math.ceil(f * planned / tau - 1e-9)))
                 to = (k + 1, i + d)
                 if to[1] > TIME_STEPS or to in parent:
@@ -497,25 +504,66 @@ def _retimed(via: Design | None, timing: Spec, spec: Spec,
     no re-timing."""
     if via is None:
         return None
-    segments = retime(via.tube.segments, timing,
-                      via.task_plan.order if via.task_plan is not None else None)
-    if segments is None:
-        return None
-    tube = replace(via.tube, segments=segments)
-    timed = check(tube, spec)
-    if not timed.passed:
-        return timed.reason
-    design = _design(_accept(tube, timed, spec), METHOD_VIA, timed, spec, started,
-                     MOTION_TIMED_VIA, via)
-    if spec.input_bound is None:
-        return design
-    proof = variant_of(spec).entry("input_proof")(design, spec)
-    if not proof.meets(spec.input_bound):
+    why = None
+    planned = via.tube.segments
+    if spec.input_bound is not None:      # the lower peak rate for the same duration
+        planned = tuple(replace(seg, profile=CRUISE) if seg.profile == SMOOTHSTEP else seg
+                        for seg in planned)
+    for factors in speed_limits(spec):
+        segments = retime(planned, timing,
+                          via.task_plan.order if via.task_plan is not None else None, factors)
+        if segments is None:
+            continue
+        tube = replace(via.tube, segments=segments)
+        timed = check(tube, spec)
+        if not timed.passed:
+            why = timed.reason
+            continue
+        design = _design(_accept(tube, timed, spec), METHOD_VIA, timed, spec, started,
+                         MOTION_TIMED_VIA, via)
+        if spec.input_bound is None:
+            return design
+        proof = variant_of(spec).entry("input_proof")(design, spec)
+        if proof.meets(spec.input_bound):
+            return replace(design, input_proof=proof)
         peaks = ", ".join(f"|{name}| <= {p:.4g}" for name, p in
                           zip(spec.input_names, proof.peak))
-        return (f"its input is not proved within actuator.input_bound ({peaks})"
-                if proof.proved else f"its input bound is not proved: {proof.reason}")
-    return replace(design, input_proof=proof)
+        why = (f"its input is not proved within actuator.input_bound ({peaks}, the "
+               f"segments at {min(factors):g} times their planned durations or slower)"
+               if proof.proved else f"its input bound is not proved: {proof.reason}")
+    return why
+
+
+def speed_limits(spec: Spec) -> list[tuple[float, ...]]:
+    """The sets of :data:`DURATION_FACTORS` the re-timing tries, in order.
+
+    Without ``[actuator]`` all of them at once. With it, a faster segment asks more of the
+    actuators, so the re-timing is tried with the factors at least each of
+    :data:`DURATION_FACTORS` in increasing order (all, then without the fastest, ...):
+    the earliest arrival of each set, and the first whose input proof keeps the bound
+    wins (a plan that waits, then drives its legs no faster than the base can). With
+    ``[actuator]`` the re-timed segments of a smooth-step plan are ``"cruise"`` segments
+    (the same boxes and durations, a peak rate 1.25 times the mean instead of 1.875).
+
+    Parameters
+    ----------
+    spec : Spec
+
+    Returns
+    -------
+    list of tuple of float
+        Each in the order of :data:`DURATION_FACTORS`.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> speed_limits(stt.load_spec("crossing-moving"))
+    [(1.0, 0.75, 1.5, 0.5, 2.0)]
+    """
+    if spec.input_bound is None:
+        return [DURATION_FACTORS]
+    return [tuple(f for f in DURATION_FACTORS if f >= slowest)
+            for slowest in sorted(set(DURATION_FACTORS))]
 
 
 def _meetings(found: TubeCheck, spec: Spec) -> list[tuple[int, float]]:
@@ -581,4 +629,5 @@ def retimed_plan(segments: Sequence[ReachSegment], spec: Spec,
 
 __all__ = ["DETOUR_SPANS", "DURATION_FACTORS", "MAX_ROUTES", "MOTION_SPACE_TIME", "MOTION_SWEPT",
            "MOTION_TIMED_VIA", "MOVE_CHECKS", "TASK_HOLD_SHARE", "TIME_STEPS", "design_moving", "moves",
-           "retime", "retimed_plan", "routes", "partial_spec", "static_part", "task_holds"]
+           "retime", "retimed_plan", "routes", "partial_spec", "speed_limits", "static_part",
+           "task_holds"]

@@ -1,0 +1,146 @@
+"""A warehouse AGV at the base's speed, and waiting for a forklift (docs/differential-drive.md,
+docs/moving-obstacles.md): the base's ``|u|`` bounded sample by sample, the refusal that
+names ``plant.axle_offset``, and the re-timed via plan kept within ``[actuator]``."""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import stt_codegen as stt
+from stt_codegen.design.input_bound import InputProof, input_peak
+from stt_codegen.design.look_ahead import look_ahead_input_proof
+from stt_codegen.design.moving import DURATION_FACTORS, MOTION_TIMED_VIA, speed_limits
+from stt_codegen.design.route import route_length
+from stt_codegen.design.search import check_tube
+from stt_codegen.errors import SpecError
+
+SPECS = Path(__file__).parent / "specs"
+AGV = SPECS / "agv-warehouse.toml"
+FORKLIFT = SPECS / "agv-forklift.toml"
+
+
+def _agv_doc(**plant) -> dict:
+    doc = tomllib.loads(AGV.read_text())
+    doc["plant"].update(plant)
+    return doc
+
+
+def test_the_norm_bound_lies_between_the_largest_peak_and_their_hypot():
+    """``speed`` is the norm of the per-input bounds at one sample: at most
+    ``hypot(*peak)`` (equal only where the inputs peak at the same sample) and at least
+    every single peak, on random bounds."""
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        abs_e = rng.uniform(0.0, 0.9, size=(40, 2))
+        width = rng.uniform(0.05, 2.0, size=(40, 2))
+        t = np.arange(40) * 0.02
+        proof = input_peak(0.3, abs_e, width, t, 1.0)
+        assert max(proof.peak) <= proof.speed <= math.hypot(*proof.peak) * (1 + 1e-12)
+        k = int(round(proof.speed_time / 0.02))
+        u = 4 * 0.3 * 2 * np.arctanh(abs_e[k]) / (1 - abs_e[k] ** 2) / width[k]
+        assert proof.speed == pytest.approx(float(np.hypot(*u)), rel=1e-12)
+
+
+def test_the_base_takes_the_norm_bound_and_falls_back_to_the_peaks():
+    with_norm = InputProof(True, (0.6, 0.8), (1.0, 2.0), 11.0, speed=0.9, speed_time=1.5)
+    assert look_ahead_input_proof(with_norm, 0.5).peak == (0.9, 1.8)
+    assert look_ahead_input_proof(with_norm, 0.5).time == (1.5, 1.5)
+    peaks_only = InputProof(True, (0.6, 0.8), (1.0, 2.0), 11.0)
+    assert look_ahead_input_proof(peaks_only, 0.5).peak == pytest.approx((1.0, 2.0))
+    assert look_ahead_input_proof(peaks_only, 0.5).time == (2.0, 2.0)
+
+
+def test_another_axle_offset_is_the_spec_loaded_with_it():
+    at_06 = stt.Spec.from_dict(_agv_doc(axle_offset=0.6))
+    at_08 = stt.Spec.from_dict(_agv_doc())
+    assert at_06.with_axle_offset(0.8) == at_08        # sets, obstacles, assumptions, base
+    assert at_08.with_axle_offset(0.6) == at_06
+    assert at_06.with_axle_offset(0.8).robot.radius == pytest.approx(1.2)
+
+
+def test_another_axle_offset_is_refused_by_field():
+    spec = stt.load_spec(str(AGV))
+    with pytest.raises(SpecError) as raised:
+        spec.with_axle_offset(1.6)          # the start set no longer fits beside the wall
+    assert raised.value.field == "initial"
+    with pytest.raises(SpecError) as raised:
+        spec.with_axle_offset(6.0)          # the robot no longer fits in the floor's 12 m
+    assert raised.value.field == "plant.axle_offset"
+    with pytest.raises(SpecError) as raised:
+        spec.with_axle_offset(0.0)
+    assert raised.value.field == "plant.axle_offset"
+    with pytest.raises(SpecError) as raised:
+        stt.load_spec("crossing-moving").with_axle_offset(0.5)
+    assert raised.value.field == "plant.model"
+
+
+def test_the_retiming_leaves_out_fast_segments_only_with_an_actuator():
+    assert speed_limits(stt.load_spec("crossing-moving")) == [DURATION_FACTORS]
+    sets = speed_limits(stt.load_spec(str(FORKLIFT)))
+    assert sets[0] == DURATION_FACTORS and sets[-1] == (max(DURATION_FACTORS),)
+    assert [min(s) for s in sets] == sorted(DURATION_FACTORS)
+
+
+def test_the_agv_is_certified_within_twice_the_straight_line_time():
+    """The AGV (v_max 1.2 m/s, omega_max 1.5 rad/s) in 40 s along a 29 m route: 1.65 times
+    the straight-line time at v_max, its (v, omega) proved within the bound."""
+    spec = stt.load_spec(str(AGV))
+    design = stt.design_tube(spec)
+    assert design.certificate.passed
+    assert design.input_proof.meets(spec.input_bound)
+    straight = route_length(design.tube, spec.initial_state) / spec.input_bound[0]
+    assert 20.0 < straight < spec.prescribed_time <= 2.0 * straight
+
+
+@pytest.mark.slow
+def test_the_agv_closed_loop_reaches_the_target_within_the_limits():
+    spec = stt.load_spec(str(AGV))
+    result = stt.simulate(stt.design_tube(spec), backend="python")
+    assert result.satisfied and not result.collision and result.stayed_in_tube
+    assert result.reach_time <= spec.prescribed_time
+    assert all(p <= b for p, b in zip(result.max_abs_u, spec.input_bound))
+
+
+@pytest.mark.slow
+def test_a_turn_rate_refusal_names_the_axle_offset_that_is_certified():
+    """At a 0.6 m look-ahead the AGV's best tube in 40 s keeps |v| but asks 1.88 rad/s:
+    the refusal names plant.axle_offset (and prescribed_time), and each, followed alone,
+    is certified."""
+    short = stt.Spec.from_dict(_agv_doc(axle_offset=0.6))
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(short)
+    words = str(raised.value)
+    offset = raised.value.advice["plant.axle_offset"]
+    assert f"plant.axle_offset = {offset:g} m is certified" in words
+    assert 0.6 < offset <= 0.8
+    assert stt.design_tube(short.with_axle_offset(offset)).input_proof.meets(
+        short.input_bound)
+    later = raised.value.advice["prescribed_time"]
+    assert stt.design_tube(replace(short, prescribed_time=later)).certificate.passed
+
+
+@pytest.mark.slow
+def test_the_agv_waits_for_the_forklift_then_crosses():
+    """The forklift crosses the AGV's cross aisle as it arrives: the static tube meets it;
+    with [actuator] the re-timed via plan (a slower first leg) lets it pass, its (v, omega)
+    proved within the bound, and the closed loop is satisfied without contact."""
+    spec = stt.load_spec(str(FORKLIFT))
+    design = stt.design_tube(spec)
+    assert design.motion == MOTION_TIMED_VIA and design.certificate.passed
+    assert design.input_proof.meets(spec.input_bound)
+    without = stt.design_tube(replace(spec, moving_obstacles=()))
+    crossing = [m for m in check_tube(without.tube, spec).certificate.margins
+                if m.name == "avoids moving obstacle 3"]
+    assert crossing and not crossing[0].passed            # it would have met the forklift
+    mine = [m for m in design.certificate.margins if m.name == "avoids moving obstacle 3"]
+    assert mine[0].passed and mine[0].margin > 0.0
+    # the tube reaches the aisle's far corner later than the static one: it let it pass
+    assert design.tube.segments[1].end > without.tube.segments[1].end
+    result = stt.simulate(design, backend="python")
+    assert result.satisfied and not result.collision and result.stayed_in_tube
