@@ -1,4 +1,4 @@
-"""``stt-codegen bench arenas | tasks | drive | step | scaling | covering | alpha | second-order |
+"""``stt-codegen bench arenas | tasks | drive | agv | step | scaling | covering | alpha | second-order |
 stl | overhead``: the benchmarks and studies of :mod:`stt_codegen_bench`."""
 
 from __future__ import annotations
@@ -64,6 +64,14 @@ def _cmd_drive(args: argparse.Namespace) -> int:
     report = run_office_bench(args.count, args.seed)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_office_report(report))
+    return 0
+
+
+def _cmd_agv(args: argparse.Namespace) -> int:
+    from .agv import format_agv_report, run_agv_bench
+    report = run_agv_bench(args.count, args.seed)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_agv_report(report))
     return 0
 
 
@@ -146,8 +154,8 @@ def _cmd_overhead(args: argparse.Namespace) -> int:
 
 
 def configure_bench(bench: argparse.ArgumentParser) -> None:
-    """Sub-subcommands ``bench arenas``, ``tasks``, ``drive``, ``step``, ``scaling``, ``covering``,
-    ``alpha``, ``second-order``, ``stl`` and ``overhead``.
+    """Sub-subcommands ``bench arenas``, ``tasks``, ``drive``, ``agv``, ``step``, ``scaling``,
+    ``covering``, ``alpha``, ``second-order``, ``stl`` and ``overhead``.
 
     Parameters
     ----------
@@ -193,6 +201,13 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=_non_negative_int, default=0, help="office seed (default: 0)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_drive)
+
+    p = sub.add_parser("agv", help="a warehouse AGV's reach time against the straight-line "
+                                   "time at v_max along its route, on seeded floors")
+    p.add_argument("--count", type=int, default=5, help="number of floors (default: 5)")
+    p.add_argument("--seed", type=_non_negative_int, default=0, help="floor seed (default: 0)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_agv)
 
     p = sub.add_parser("step", help="cost of one controller step: reference, CasADi, "
                                     "generated Python, generated C")
