@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 from stt_codegen.errors import SpecError
@@ -59,20 +60,36 @@ def _cmd_arenas(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_drive(args: argparse.Namespace) -> int:
+def _office_bench() -> tuple[Callable[[int, int], dict], Callable[[dict], str]]:
     from .office_arenas import format_office_report, run_office_bench
-    report = run_office_bench(args.count, args.seed)
-    print(json.dumps(report, indent=1, sort_keys=True) if args.json
-          else format_office_report(report))
-    return 0
+    return run_office_bench, format_office_report
 
 
-def _cmd_agv(args: argparse.Namespace) -> int:
+def _agv_bench() -> tuple[Callable[[int, int], dict], Callable[[dict], str]]:
     from .agv import format_agv_report, run_agv_bench
-    report = run_agv_bench(args.count, args.seed)
-    print(json.dumps(report, indent=1, sort_keys=True) if args.json
-          else format_agv_report(report))
-    return 0
+    return run_agv_bench, format_agv_report
+
+
+def _add_seeded(sub, name: str, help_text: str, what: str, count: int,
+                bench: Callable[[], tuple[Callable[[int, int], dict],
+                                          Callable[[dict], str]]]) -> None:
+    """A bench of ``--count`` problems of ``--seed``: ``bench()`` gives its ``run(count,
+    seed) -> report`` and ``format(report) -> str`` (imported when it runs); the report is
+    printed as its table or, with ``--json``, as JSON."""
+    p = sub.add_parser(name, help=help_text)
+    p.add_argument("--count", type=int, default=count,
+                   help=f"number of {what}s (default: {count})")
+    p.add_argument("--seed", type=_non_negative_int, default=0,
+                   help=f"{what} seed (default: 0)")
+    add_json_argument(p)
+
+    def handler(args: argparse.Namespace) -> int:
+        run, fmt = bench()
+        report = run(args.count, args.seed)
+        print(json.dumps(report, indent=1, sort_keys=True) if args.json else fmt(report))
+        return 0
+
+    p.set_defaults(handler=handler)
 
 
 def _cmd_step(args: argparse.Namespace) -> int:
@@ -195,19 +212,10 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
     add_json_argument(p)
     p.set_defaults(handler=_cmd_tasks)
 
-    p = sub.add_parser("drive", help="a differential-drive base beside a holonomic one on "
-                                     "random offices (docs/differential-drive.md)")
-    p.add_argument("--count", type=int, default=100, help="number of offices (default: 100)")
-    p.add_argument("--seed", type=_non_negative_int, default=0, help="office seed (default: 0)")
-    add_json_argument(p)
-    p.set_defaults(handler=_cmd_drive)
-
-    p = sub.add_parser("agv", help="a warehouse AGV's reach time against the straight-line "
-                                   "time at v_max along its route, on seeded floors")
-    p.add_argument("--count", type=int, default=5, help="number of floors (default: 5)")
-    p.add_argument("--seed", type=_non_negative_int, default=0, help="floor seed (default: 0)")
-    add_json_argument(p)
-    p.set_defaults(handler=_cmd_agv)
+    _add_seeded(sub, "drive", "a differential-drive base beside a holonomic one on random "
+                "offices (docs/differential-drive.md)", "office", 100, _office_bench)
+    _add_seeded(sub, "agv", "a warehouse AGV's reach time against the straight-line time "
+                "at v_max along its route, on seeded floors", "floor", 5, _agv_bench)
 
     p = sub.add_parser("step", help="cost of one controller step: reference, CasADi, "
                                     "generated Python, generated C")
