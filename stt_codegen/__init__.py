@@ -12,6 +12,8 @@ Spatiotemporal Tubes Approach". The front door, in the order of the flow (see
 * :func:`load_fleet`, :func:`design_fleet` - several robots sharing a state space
   (:class:`FleetSpec`): each robot's tube designed to keep clear of the others' at every
   ``t``, every pair certified (:class:`FleetDesign`, docs/fleets.md);
+  :func:`generate_fleet`, :func:`simulate_fleet` - a controller folder per robot, and
+  every robot's closed loop with every pair's closest approach;
 * :func:`generate` - write the standalone C and Python controllers of a design into a
   folder;
 * :func:`simulate` - run a design's sampled controller in closed loop and judge
@@ -62,6 +64,8 @@ _LAZY: dict[str, str] = {
     "load_fleet": "stt_codegen.spec.fleet",
     "design_fleet": "stt_codegen.design.fleet",
     "FleetDesign": "stt_codegen.design.fleet",
+    "generate_fleet": "stt_codegen.codegen.fleet",
+    "simulate_fleet": "stt_codegen.runtime.fleet",
     "TubeDesign": "stt_codegen.tube.parameters",
     "design_tube": "stt_codegen.design.search",
     "Design": "stt_codegen.design.result",
@@ -89,7 +93,9 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .runtime.plots import plot_design, plot_run
     from .runtime.simulate import SimulationResult, simulate
     from .cases import bundled_cases, bundled_fleets
+    from .codegen.fleet import generate_fleet
     from .design.fleet import FleetDesign, design_fleet
+    from .runtime.fleet import simulate_fleet
     from .spec.fleet import FleetSpec, load_fleet
     from .pointmaze import import_pointmaze
     from .spec.loader import Spec, load_spec

@@ -87,6 +87,10 @@ def cmd_design(args: argparse.Namespace) -> int:
     DesignError
         No design (exit code 1).
     """
+    from .fleet import fleet_design, fleet_of
+    fleet = fleet_of(args)            # a fleet file: one design per robot (docs/fleets.md)
+    if fleet is not None:
+        return fleet_design(args, fleet)
     _check_export(args)
     design, dims = design_to_plot(args)
     spec = design.spec

@@ -33,6 +33,10 @@ def cmd_generate(args: argparse.Namespace) -> int:
     ToolchainError
         The code generator failed (exit code 3).
     """
+    from .fleet import fleet_generate, fleet_of
+    fleet = fleet_of(args)            # a fleet file: one design per robot (docs/fleets.md)
+    if fleet is not None:
+        return fleet_generate(args, fleet)
     from ..codegen.api import generate
     parse_options(args.languages, args.precision)   # bad options fail before the design
     design = load_and_design(args)

@@ -60,6 +60,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     ToolchainError
         The backend's compiler is missing or fails (exit code 3).
     """
+    from .fleet import fleet_simulate, fleet_of
+    fleet = fleet_of(args)            # a fleet file: one design per robot (docs/fleets.md)
+    if fleet is not None:
+        return fleet_simulate(args, fleet, SUMMARY_HEADER, summary_line)
     from ..runtime.simulate import simulate
     from ..runtime.run_log import check_log_path, write_run_log
     seed = checked_seed(args)
