@@ -64,6 +64,16 @@ def test_another_axle_offset_is_the_spec_loaded_with_it():
     assert at_06.with_axle_offset(0.8).robot.radius == pytest.approx(1.2)
 
 
+def test_another_axle_offset_applies_to_every_target_box():
+    boxes = {"any_of": [{"lower": [17.5, 1.5], "upper": [18.5, 2.5]},
+                        {"lower": [17.5, 9.5], "upper": [18.5, 10.5]}]}
+    at_06 = stt.Spec.from_dict({**_agv_doc(axle_offset=0.6), "target": boxes})
+    at_08 = stt.Spec.from_dict({**_agv_doc(), "target": boxes})
+    longer = at_06.with_axle_offset(0.8)
+    assert [k for k, _ in longer.target_any_of] == [k for k, _ in at_08.target_any_of] == [0, 1]
+    assert all(a == b for (_, a), (_, b) in zip(longer.target_any_of, at_08.target_any_of))
+
+
 def test_another_axle_offset_is_refused_by_field():
     spec = stt.load_spec(str(AGV))
     with pytest.raises(SpecError) as raised:

@@ -478,7 +478,8 @@ class Spec:
         Returns
         -------
         Spec
-            ``initial.state`` and the sets as given (they are the look-ahead point's).
+            ``initial.state`` and the sets as given (they are the look-ahead point's);
+            each ``[target] any_of`` box's spec with the same offset.
 
         Raises
         ------
@@ -513,7 +514,9 @@ class Spec:
         return replace(self, state_space=state_space, unsafe_sets=unsafe_sets,
                        moving_obstacles=moving, obstacles=obstacles, robot=robot, drive=drive,
                        assumptions=combine_assumptions(bounds, declared, self.dimension,
-                                                       self.disturbance_amplitude))
+                                                       self.disturbance_amplitude),
+                       target_any_of=tuple((k, one.with_axle_offset(axle_offset))
+                                           for k, one in self.target_any_of))
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> "Spec":
