@@ -23,6 +23,7 @@ from ..version import __version__
 from .emit import CPrinter, lower, python_source
 from ..tube.model import build_model
 from ..spec.loader import Spec
+from ..design.prediction import delay_predictor
 from ..tube.parameters import NEWTON_ITERATIONS, PERIOD_TOLERANCE, TubeDesign
 from . import tolerance
 from .functions import deployed_functions
@@ -62,13 +63,15 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
     """
     prefix = c_identifier(spec.c_name)
     single = options.precision == "single"
-    functions = deployed_functions(build_model(design))
+    predictor = delay_predictor(spec, design, None)
+    functions = [*deployed_functions(build_model(design)),
+                 *([predictor] if predictor is not None else [])]
     limits = input_limits(design)
     common = {
         "spec_name": spec.name, "spec_hash": spec.source_hash, "casadi_version": casadi.__version__,
         "toolkit_version": __version__, "precision": options.precision, "P": prefix,
         "U": prefix.upper(), "n": design.dimension, "newton": NEWTON_ITERATIONS,
-        "real": "float" if single else "double",
+        "real": "float" if single else "double", "predict": predictor is not None,
     }
     files: dict[str, str] = {}
     vectors = test_vectors(design, options.precision)

@@ -19,6 +19,7 @@ The text is in the Jinja2 templates of the top-level ``templates/``, rendered th
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 
 import casadi
@@ -29,7 +30,8 @@ from ..tube import pieces as P
 from ..tube.parameters import Status, TubeDesign
 from ..version import __version__
 from ..design.output_bound import base_clamp
-from .emit import python_source
+from ..design.prediction import delay_predictor
+from .emit import lower, python_source
 from .functions import deployed_functions
 from .generate import c_source_context, input_limits, timing_context
 from .render import c_real, render
@@ -71,8 +73,8 @@ def _context(design: TubeDesign, look_ahead: LookAhead, prefix: str, precision: 
 
 
 def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,
-                       precision: str = "double", timing: tuple[float, float] = (0.0, 0.0)
-                       ) -> dict[str, str]:
+                       precision: str = "double", timing: tuple[float, float] = (0.0, 0.0),
+                       predictor: casadi.Function | None = None) -> dict[str, str]:
     """``{<prefix>.h: text, <prefix>.c: text}`` of the look-ahead controller.
 
     Parameters
@@ -86,6 +88,9 @@ def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,
     precision : {"double", "single"}
     timing : (float, float)
         ``(delay, jitter)`` of the spec, s: the header's timing contract.
+    predictor : casadi.Function, optional
+        With ``[controller] compensate_delay``, the spec's
+        :func:`~stt_codegen.design.prediction.delay_predictor`: ``P_predict`` is generated.
 
     Returns
     -------
@@ -100,18 +105,20 @@ def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,
     _check(design, look_ahead, prefix)
     single = precision == "single"
     functions = [*deployed_functions(build_model(design)), look_ahead_point(), base_command(),
-                 *([P.saturate(2)] if look_ahead.input_bound is not None else [])]
+                 *([P.saturate(2)] if look_ahead.input_bound is not None else []),
+                 *([predictor] if predictor is not None else [])]
     context = dict(c_source_context(design, prefix, precision, functions),
                    **_context(design, look_ahead, prefix, precision,
-                              lambda v: c_real(v, single), timing), look_ahead=True)
+                              lambda v: c_real(v, single), timing), look_ahead=True,
+                   predict=predictor is not None)
     return {name: render(template, filename=name, **context)
             for name, template in ((f"{prefix}.h", "look_ahead_header.h.j2"),
                                    (f"{prefix}.c", "look_ahead_source.c.j2"))}
 
 
 def look_ahead_python_file(design: TubeDesign, look_ahead: LookAhead,
-                           prefix: str, timing: tuple[float, float] = (0.0, 0.0)
-                           ) -> dict[str, str]:
+                           prefix: str, timing: tuple[float, float] = (0.0, 0.0),
+                           predictor: casadi.Function | None = None) -> dict[str, str]:
     """``{<prefix>.py: text}``: ``step(x, t, dt, alpha) -> (u, alpha_next, status)`` with
     ``x = (x, y, theta)``, the same function, statuses and input checks as the C (imports
     ``math`` only).
@@ -125,6 +132,8 @@ def look_ahead_python_file(design: TubeDesign, look_ahead: LookAhead,
         Module name, an ASCII identifier.
     timing : (float, float)
         ``(delay, jitter)`` of the spec, s: the module's ``DELAY`` and ``JITTER``.
+    predictor : casadi.Function, optional
+        As :func:`look_ahead_c_files`: ``predict(x, u_held)`` is generated.
 
     Returns
     -------
@@ -141,7 +150,10 @@ def look_ahead_python_file(design: TubeDesign, look_ahead: LookAhead,
     return {name: render("look_ahead_module.py.j2", filename=name,
                          **_context(design, look_ahead, prefix, "double",
                                     lambda v: repr(float(v)), timing),
-                         body=python_source(look_ahead_step(design, look_ahead)))}
+                         predict=predictor is not None,
+                         body=python_source([lower(look_ahead_step(design, look_ahead)), *(
+                             [dataclasses.replace(lower(predictor), name="body_predict")]
+                             if predictor is not None else [])]))}
 
 
 def look_ahead_vectors(design: TubeDesign, look_ahead: LookAhead, precision: str) -> dict:
@@ -243,18 +255,19 @@ def look_ahead_generation(design, options) -> dict[str, bytes]:
 
     look_ahead = design.look_ahead
     spec = design.spec
+    predictor = delay_predictor(spec, design.tube, look_ahead)
     context = dict(file_context(spec, options.precision), no_control=True)
     prefix = context["P"]
     vectors = look_ahead_vectors(design.tube, look_ahead, options.precision)
     texts: dict[str, str] = {}
     if "c" in options.langs:
         texts.update(look_ahead_c_files(design.tube, look_ahead, prefix, options.precision,
-                                        (spec.delay, spec.jitter)))
+                                        (spec.delay, spec.jitter), predictor))
         texts.update(build_files(context))
         texts.update(selftest_file(context, vectors, vector_tables(vectors), options.precision))
     if "python" in options.langs:
         texts.update(look_ahead_python_file(design.tube, look_ahead, prefix,
-                                            (spec.delay, spec.jitter)))
+                                            (spec.delay, spec.jitter), predictor))
     files = {name: text.encode() for name, text in texts.items()}
     files[f"{prefix}_vectors.json"] = vectors_file(
         spec, options.precision, vectors,

@@ -20,7 +20,7 @@ from ..spec.loader import Spec
 from ..spec.variants import variant_of
 from ..tube import reference
 from .certificate.plant_class import plant_class
-from .certificate.sampled import (check_sampled_first_per_axis, largest_passing,
+from .certificate.sampled import (check_sampled_first_per_axis, delay_room, largest_passing,
                                   lowest_rate, sampled_check_of)
 from .failures import FailureKind, advice_wanted
 from .result import Design
@@ -66,10 +66,11 @@ def _followable_delay(design: Design, spec: Spec) -> float | None:
 
         def passes(delay: float) -> bool:
             check = check_sampled_first_per_axis(tube, samples, plants, delay=delay,
-                                                 jitter=spec.jitter)
+                                                 jitter=spec.jitter,
+                                                 compensate=spec.compensate_delay)
             return check.passed and check.level <= TRACKING_ERROR
 
-        return largest_passing(passes, max(0.0, 1.0 / tube.rate_hz - 2.0 * spec.jitter))
+        return largest_passing(passes, delay_room(tube.rate_hz, spec))
 
 
 def design_with_timing(spec: Spec, search: Callable[[Spec], Design]) -> Design:
@@ -124,6 +125,12 @@ def design_with_timing(spec: Spec, search: Callable[[Spec], Design]) -> Design:
         trials.append((replace(spec, rate_hz=rate), f"controller.rate_hz = "
                        f"{number_text(rate)} is certified with {_timing_words(spec)}",
                        ("controller.rate_hz", rate)))
+    if (variant_of(spec).predicts_delay and not spec.compensate_delay and spec.jitter == 0.0
+            and spec.delay * spec.rate_hz <= 1.0):
+        trials.insert(0, (replace(spec, compensate_delay=True),
+                          f"controller.compensate_delay = true is certified with "
+                          f"{_timing_words(spec)} at {number_text(spec.rate_hz)} Hz",
+                          ("controller.compensate_delay", True)))
     kept = [(words, field) for trial, words, field in trials if _passes(trial, search)]
     works = [words for words, _ in kept]
     # a faster rate must hold delay + 2 jitter in its period

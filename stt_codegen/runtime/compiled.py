@@ -36,8 +36,9 @@ CFLAGS = ("-std=c99", "-O2", "-ffp-contract=off", "-fPIC", "-shared", "-Wall", "
 
 class DesignSpec:
     """The spec attributes code generation reads (``name``, ``c_name``, ``source_hash``,
-    ``delay``, ``jitter``), for a design without its spec (the timing contract's numbers
-    are the header's text only: the step does not read them).
+    ``delay``, ``jitter``, ``compensate_delay``), for a design without its spec (the timing
+    contract's numbers are the header's text only: the step does not read them; the loops
+    that run a backend predict the state themselves).
 
     Parameters
     ----------
@@ -50,6 +51,7 @@ class DesignSpec:
         self.c_name = self.name.replace("-", "_")
         self.source_hash = "design:" + hashlib.sha256(repr(design).encode()).hexdigest()
         self.delay = self.jitter = 0.0
+        self.compensate_delay = False
 
 
 def cache_dir() -> Path:

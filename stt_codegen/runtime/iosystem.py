@@ -8,6 +8,7 @@ import numpy as np
 import control as ct
 
 from .backends import make_controller
+from ..design.prediction import delay_predictor
 from ..design.result import Design, require_design
 from ..errors import SpecError
 from .plants import check_seed, spec_plant
@@ -65,7 +66,10 @@ def controller_system(design: Design, backend: str = "reference",
     -------
     control.NonlinearIOSystem
         ``dt = 1 / rate_hz``. States ``alpha[0] .. alpha[2n-1]`` (``[alpha_L, alpha_U]``,
-        state units, zero at ``t = 0``); inputs ``x[0] ..`` the plant's state (``n``
+        state units, zero at ``t = 0``), then with ``[controller] compensate_delay`` its
+        previous output ``u_held[0] .. u_held[m-1]`` (zero at ``t = 0``), from which it
+        predicts the state law (13) reads (docs/sampled-data.md, "Compensating a delay");
+        inputs ``x[0] ..`` the plant's state (``n``
         positions, ``2 n`` positions then velocities for a second-order plant,
         ``(x, y, theta)`` for a differential-drive base); outputs ``u[0] .. u[m-1]`` (input
         units) and ``status`` (a :class:`~stt_codegen.tube.parameters.Status` code as a
@@ -95,16 +99,29 @@ def controller_system(design: Design, backend: str = "reference",
     inputs = spec.dimension
     dt = 1.0 / tube.rate_hz
     step = _LastStep(make_controller(backend, tube, design.stage), dt)
+    predict = delay_predictor(spec, tube, design.stage)
+    held = [f"u_held[{j}]" for j in range(inputs)] if predict is not None else []
 
-    def update(t, alpha, x, params):
-        return np.asarray(step(t, alpha, x)[1], dtype=float)
+    def seen(memory, x):
+        """alpha and the state law (13) reads: x, or its prediction from the held u."""
+        memory = np.asarray(memory, dtype=float).reshape(-1)
+        if predict is None:
+            return memory, x
+        x = np.asarray(predict(np.asarray(x, dtype=float).reshape(-1),
+                               memory[2 * inputs:]), dtype=float).ravel()
+        return memory[:2 * inputs], x
 
-    def output(t, alpha, x, params):
-        u, _, status = step(t, alpha, x)
+    def update(t, memory, x, params):
+        u, alpha_next, _ = step(t, *seen(memory, x))
+        return np.concatenate([np.asarray(alpha_next, dtype=float).ravel(),
+                               np.asarray(u, dtype=float).ravel() if held else []])
+
+    def output(t, memory, x, params):
+        u, _, status = step(t, *seen(memory, x))
         return np.append(np.asarray(u, dtype=float), float(status))
 
     return ct.nlsys(update, output, dt=dt, name=name,
-                    states=[f"alpha[{i}]" for i in range(2 * inputs)],
+                    states=[*(f"alpha[{i}]" for i in range(2 * inputs)), *held],
                     inputs=[f"x[{i}]" for i in range(states)],
                     outputs=[*(f"u[{j}]" for j in range(inputs)), "status"])
 

@@ -23,6 +23,7 @@ import numpy as np
 import control as ct
 
 from .backends import Controller, default_backend, make_controller
+from ..design.prediction import delay_predictor
 from ..design.result import Design, require_design
 from ..design.samples import check_step_budget
 from ..display import Rows, markdown, text
@@ -527,6 +528,7 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
         stepper.check_delay(spec.delay, dt)
     if controller is None:
         controller = make_controller(backend, tube, stage)
+    predict = delay_predictor(spec, tube, stage)      # with [controller] compensate_delay
     x = stepper.reset(x)
     lo, hi = np.array(spec.state_space.lower), np.array(spec.state_space.upper)
     t_lo, t_hi = np.array(spec.target_set.lower), np.array(spec.target_set.upper)
@@ -542,7 +544,8 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     for k in range(steps + 1):
         t = ts[k]
         states[k], alphas[k] = x, alpha
-        u, alpha_next, code = controller.step(x, t, dt, alpha)
+        seen = x if predict is None else np.asarray(predict(x, u_prev), dtype=float).ravel()
+        u, alpha_next, code = controller.step(seen, t, dt, alpha)
         us[k], status[k] = u, code
         if k == steps:
             break

@@ -249,6 +249,11 @@ class Spec:
     jitter : float
         ``[controller] jitter``, s: the state is read within ``jitter`` of ``k / rate_hz``
         (the first sample at ``t = 0``); ``delay + 2 jitter <= 1 / rate_hz``.
+    compensate_delay : bool
+        ``[controller] compensate_delay``: law (13) is evaluated at the state predicted at
+        ``t_k + delay`` from the held command (the variant's ``predictor`` role;
+        docs/sampled-data.md, "Compensating a delay"); ``delay`` up to ``1 / rate_hz``,
+        ``jitter`` 0.
     plant_model : str
         ``"omnidirectional"`` (eq. (14)), ``"single-integrator"`` or ``"linear"``: the
         plant ``simulate`` runs, and the source of the bounds in :attr:`assumptions`. For a
@@ -355,6 +360,7 @@ class Spec:
     drive: DifferentialDrive | None = None
     delay: float = 0.0
     jitter: float = 0.0
+    compensate_delay: bool = False
 
     @property
     def dimension(self) -> int:
@@ -833,20 +839,42 @@ def _validate(raw: dict) -> Spec:
                 task_order=doc.task_order.order if doc.task_order is not None else "listed",
                 moving_obstacles=moving, robot=robot,
                 mujoco=_mujoco(doc.plant, n),
-                drive=drive, **_timing(doc.controller))
+                drive=drive, **_timing(doc.controller, doc.plant.model))
 
 
-def _timing(table: ControllerTable) -> dict[str, float]:
-    """``[controller] delay`` and ``jitter``, checked against the period (docs/sampled-data.md,
-    "Computation delay and jitter")."""
+def _timing(table: ControllerTable, model: str) -> dict[str, float | bool]:
+    """``[controller] delay``, ``jitter`` and ``compensate_delay``, checked against the period
+    and the variant (docs/sampled-data.md, "Computation delay and jitter", "Compensating a
+    delay")."""
     delay, jitter = table.delay, table.jitter
     period = 1.0 / table.rate_hz
+    variant = variant_of(plant_entry(model))
+    if table.compensate_delay:
+        if not variant.predicts_delay:
+            raise SpecError("controller.compensate_delay",
+                            f"is not available for {variant.plant_words} (the {variant.name} "
+                            "variant): its certificate covers the plain law with a delay up "
+                            "to its limit (verify reports it)")
+        if not delay > 0.0:
+            raise SpecError("controller.compensate_delay", "needs controller.delay > 0: the "
+                                                           "delay it predicts over")
+        if jitter > 0.0:
+            raise SpecError("controller.jitter", "must be 0 with controller.compensate_delay "
+                                                 "(the prediction is over exactly "
+                                                 "controller.delay)")
+        if delay > period:
+            raise SpecError("controller.delay", f"= {number_text(delay)} s exceeds the period "
+                                                f"1 / rate_hz = {number_text(period)} s (the "
+                                                "prediction covers a delay up to one period)")
+        return {"delay": float(delay), "jitter": 0.0, "compensate_delay": True}
     if delay + 2.0 * jitter > period:
         field_name = "controller.delay" if delay > 0.0 else "controller.jitter"
         raise SpecError(field_name, f"delay + 2 jitter = {number_text(delay + 2.0 * jitter)} s "
                                     f"exceeds the period 1 / rate_hz = {number_text(period)} s "
                                     "(the proof needs each command to act within the period "
-                                    "it was computed for)")
+                                    "it was computed for" + ("; controller.compensate_delay "
+                                    "covers a delay up to one period)" if
+                                    variant.predicts_delay else ")"))
     return {"delay": float(delay), "jitter": float(jitter)}
 
 

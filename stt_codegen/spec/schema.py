@@ -207,6 +207,9 @@ class ControllerTable(_Table):
                                                 "rate_hz)")
     jitter: NonNegative = Field(0.0, description="sampling jitter, s: the state is read at "
                                                  "t_k within jitter of k / rate_hz")
+    compensate_delay: bool = Field(False, description="predict the state at t_k + delay from "
+                                                      "the held command before law (13): a "
+                                                      "delay up to one period (jitter 0)")
 
 
 class PlantTable(_Table):

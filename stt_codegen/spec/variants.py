@@ -72,6 +72,9 @@ ROLES: Mapping[str, str] = MappingProxyType({
                    "along the design for the spec's plants ([actuator])",
     "output_limits": "(design) -> OutputLimits of its command without [actuator] (the "
                      "proved peak and the clamp's bound), or None: no warning",
+    "predictor": "(tube, stage, delay, mid_gain) -> casadi.Function (x, u_held) -> x_hat, "
+                 "the state law (13) is evaluated at with [controller] compensate_delay, or "
+                 "None (the variant has none: predicts_delay is False)",
 })
 
 
@@ -98,6 +101,10 @@ class ControllerVariant:
     replay_context : mapping of str to bool
         Extra variables of the firmware replay program's template
         (``embedded_replay.c.j2``).
+    predicts_delay : bool
+        ``[controller] compensate_delay`` is available: its ``predictor`` role predicts the
+        state over the delay and its sampled-data certificate proves the predicted law
+        (docs/sampled-data.md, "Compensating a delay").
     timing_in_stage : bool
         The certificate of its stage (:attr:`~stt_codegen.design.result.Design.stage`)
         proves ``[controller] delay`` and ``jitter`` (the cascade's); else the design's
@@ -123,6 +130,7 @@ class ControllerVariant:
     roles: Mapping[str, str]
     replay_context: Mapping[str, bool] = field(default_factory=lambda: MappingProxyType({}))
     timing_in_stage: bool = False
+    predicts_delay: bool = False
 
     def entry(self, role: str) -> Callable[..., Any]:
         """The variant's function (or class) for one role, imported on first use.
@@ -204,7 +212,9 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                sampled_checks=_P + "verification.command:first_order_sampled_checks",
                plant_within=_P + "verification.plant_within:first_order_within",
                input_proof=_P + "design.actuator:law13_input_proof",
-               output_limits=_P + "design.output_bound:no_output_limits")),
+               output_limits=_P + "design.output_bound:no_output_limits",
+               predictor=_P + "tube.variant_steps:law13_predictor"),
+        predicts_delay=True),
     "cascade": ControllerVariant(
         "cascade", "a second-order plant", "the cascade's input u", 2,
         " (positions, then velocities)",
@@ -232,7 +242,8 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                sampled_checks=_P + "verification.command:cascade_sampled_checks",
                plant_within=_P + "verification.plant_within:cascade_within",
                input_proof=_P + "design.cascade_gain:cascade_design_proof",
-               output_limits=_P + "design.output_bound:cascade_output_limits"),
+               output_limits=_P + "design.output_bound:cascade_output_limits",
+               predictor=_P + "tube.variant_steps:no_predictor"),
         MappingProxyType({"cascade": True}), timing_in_stage=True),
     "look-ahead": ControllerVariant(
         "look-ahead", "a differential-drive base", "the base's command (v, omega)", 1, "",
@@ -260,7 +271,9 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                sampled_checks=_P + "verification.command:look_ahead_sampled_checks",
                plant_within=_P + "verification.plant_within:first_order_within",
                input_proof=_P + "design.look_ahead:look_ahead_design_proof",
-               output_limits=_P + "design.output_bound:look_ahead_output_limits")),
+               output_limits=_P + "design.output_bound:look_ahead_output_limits",
+               predictor=_P + "tube.look_ahead:look_ahead_predictor"),
+        predicts_delay=True),
 })
 assert tuple(CONTROLLER_VARIANTS) == VARIANTS
 

@@ -31,6 +31,7 @@ from .model import build_model
 from .parameters import TubeDesign
 
 __all__ = ["LOOK_AHEAD_OUTPUTS", "LookAhead", "base_command", "look_ahead_point",
+           "look_ahead_predictor",
            "look_ahead_step"]
 
 #: Number of the base's states ``(x, y, theta)`` and of its inputs ``(v, omega)``.
@@ -160,3 +161,43 @@ def look_ahead_step(design: TubeDesign, look_ahead: LookAhead) -> ca.Function:
         outputs, names = [u, alpha_next, inside, within], list(LOOK_AHEAD_OUTPUTS)
     return ca.Function("look_ahead_step", [x, t, dt, alpha], outputs,
                        ["x", "t", "dt", "alpha"], names)
+
+
+def look_ahead_predictor(design: TubeDesign, look_ahead: LookAhead, delay: float,
+                         mid_gain: float) -> ca.Function:
+    """The base's state the look-ahead law is evaluated at with ``[controller]
+    compensate_delay``: its position moved so that the look-ahead point moves by ``delay
+    g_mid`` times the velocity the held ``(v, omega)`` gives it at the heading read at
+    ``t_k``; the heading is kept (docs/sampled-data.md, "Compensating a delay", eq. (P0')).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The look-ahead point's tube (unused: the prediction is the base's).
+    look_ahead : LookAhead
+        The axle offset ``l``.
+    delay : float
+        ``[controller] delay``, s.
+    mid_gain : float
+        ``g_mid = (g_min + g_max) / 2`` of ``[assumptions] input_gain``.
+
+    Returns
+    -------
+    casadi.Function
+        ``predict(x, u_held) -> x_hat``: ``x`` (3: m, m, rad), ``u_held`` (2: the ``(v,
+        omega)`` acting at ``t_k``, m/s, rad/s); ``x_hat = (x + s (cos theta v - sin theta l
+        omega), y + s (sin theta v + cos theta l omega), theta)`` with ``s = delay g_mid``.
+
+    Examples
+    --------
+    >>> predict = look_ahead_predictor(None, LookAhead(0.5), 0.02, 1.0)
+    >>> [round(float(v), 12) for v in predict([1.0, 2.0, 0.0], [0.5, 1.0]).full().ravel()]
+    [1.01, 2.01, 0.0]
+    """
+    x, u_held = ca.SX.sym("x", BASE_STATES), ca.SX.sym("u_held", BASE_INPUTS)
+    c, s = ca.cos(x[2]), ca.sin(x[2])
+    step = float(delay * mid_gain)
+    turn = look_ahead.axle_offset * u_held[1]
+    x_hat = ca.vertcat(x[0] + step * (c * u_held[0] - s * turn),
+                       x[1] + step * (s * u_held[0] + c * turn), x[2])
+    return ca.Function("predict", [x, u_held], [x_hat], ["x", "u_held"], ["x_hat"])

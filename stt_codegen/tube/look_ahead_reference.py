@@ -15,7 +15,7 @@ import numpy as np
 from . import reference
 from .parameters import STATUS_INPUT_CLAMPED, STATUS_OK, TubeDesign, step_status
 
-__all__ = ["command", "look_ahead_status", "point"]
+__all__ = ["command", "look_ahead_status", "point", "predicted_pose"]
 
 
 def point(states, axle_offset: float) -> np.ndarray:
@@ -98,3 +98,34 @@ def look_ahead_status(design: TubeDesign, axle_offset: float,
         u = clamped
         status = np.where((status == STATUS_OK) & moved, STATUS_INPUT_CLAMPED, status)
     return u, alpha_next, step_status(status, dt, design.rate_hz)
+
+
+def predicted_pose(states, held, axle_offset: float, step: float) -> np.ndarray:
+    """The oracle's prediction of a base's pose over a computation delay
+    (docs/sampled-data.md, "Compensating a delay", eq. (P0')): the look-ahead point moved by
+    ``step`` times the velocity the held ``(v, omega)`` gives it at the read heading, the
+    heading kept.
+
+    Parameters
+    ----------
+    states : array_like, shape (N, 3)
+        ``(x, y, theta)``, m and rad.
+    held : array_like, shape (N, 2)
+        The ``(v, omega)`` acting at the read, m/s and rad/s.
+    axle_offset : float
+        ``l``, m.
+    step : float
+        ``delay g_mid``, s.
+
+    Returns
+    -------
+    ndarray, shape (N, 3)
+    """
+    states = np.atleast_2d(np.asarray(states, dtype=float))
+    held = np.atleast_2d(np.asarray(held, dtype=float))
+    theta = states[:, 2]
+    # the point's velocity: the rotation by theta of (v, l omega)
+    forward, sideways = held[:, 0], axle_offset * held[:, 1]
+    moved = np.stack([np.cos(theta) * forward - np.sin(theta) * sideways,
+                      np.sin(theta) * forward + np.cos(theta) * sideways], axis=1)
+    return np.column_stack([states[:, :2] + step * moved, theta])

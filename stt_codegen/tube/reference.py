@@ -25,7 +25,8 @@ from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, LOWER, SMOOTHS
 __all__ = ["adaptive_law", "adaptive_tube", "alpha_step", "bump", "circumvent",
            "circumvent_from_bumps", "conflict_distance", "control", "controller_status",
            "controller_step", "error_transform", "exp", "implicit_alpha_root", "law", "law_status", "law_step",
-           "log", "numpy_math", "open_bump_sum", "reach_tube", "segment_progress", "smooth_max",
+           "log", "numpy_math", "open_bump_sum", "predicted_state", "reach_tube",
+           "segment_progress", "smooth_max",
            "smooth_max_pair", "trigger"]
 
 Array = np.ndarray
@@ -871,3 +872,23 @@ def controller_status(design: TubeDesign, x, t, dt, alpha) -> tuple[Array, Array
     """
     u_c, alpha_next, status = law_status(design, x, t, dt, alpha)
     return u_c, alpha_next, step_status(status, dt, design.rate_hz)
+
+
+def predicted_state(x, held, step: float) -> np.ndarray:
+    """The oracle's prediction of a first-order plant's state over a computation delay
+    (docs/sampled-data.md, "Compensating a delay", eq. (P0)): ``x + step u_held``.
+
+    Parameters
+    ----------
+    x : array_like, shape (N, n)
+        States, state units.
+    held : array_like, shape (N, n)
+        The command acting at the read, input units.
+    step : float
+        ``delay g_mid``, s (times the gain's units).
+
+    Returns
+    -------
+    ndarray, shape (N, n)
+    """
+    return np.asarray(x, dtype=float) + step * np.asarray(held, dtype=float)

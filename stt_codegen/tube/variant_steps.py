@@ -14,8 +14,8 @@ from . import look_ahead_reference, reference
 from .look_ahead import LookAhead
 from .parameters import Status, TubeDesign, step_status
 
-__all__ = ["cascade_status", "law13_casadi_step", "law13_oracle_step", "law13_status",
-           "look_ahead_oracle_step"]
+__all__ = ["cascade_status", "law13_casadi_step", "law13_oracle_step", "law13_predictor",
+           "law13_status", "look_ahead_oracle_step", "no_predictor"]
 
 
 def law13_casadi_step(design: TubeDesign, stage: None) -> ca.Function:
@@ -150,3 +150,56 @@ def cascade_status(outputs, dt: float, rate_hz: float) -> tuple[np.ndarray, np.n
               Status.INPUT_CLAMPED if within and not _flag(within[0]) else Status.OK)
     return (np.array(u, dtype=float).ravel(), np.array(alpha_next, dtype=float).ravel(),
             step_status(status, dt, rate_hz))
+
+
+def law13_predictor(design: TubeDesign, stage: None, delay: float,
+                    mid_gain: float) -> ca.Function:
+    """The state law (13) is evaluated at with ``[controller] compensate_delay``: ``x`` read
+    at ``t_k``, moved over the delay by the command that acts until then, at the middle of
+    the declared input gain (docs/sampled-data.md, "Compensating a delay", eq. (P0)).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        Its dimension ``n``.
+    stage : None
+        Law (13) on the plant's state takes no stage.
+    delay : float
+        ``[controller] delay``, s.
+    mid_gain : float
+        ``g_mid = (g_min + g_max) / 2`` of ``[assumptions] input_gain``.
+
+    Returns
+    -------
+    casadi.Function
+        ``predict(x, u_held) -> x_hat``: ``x`` (n, state units), ``u_held`` (n, the command
+        acting at ``t_k``, input units); ``x_hat = x + (delay g_mid) u_held`` (n).
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> tube = stt.design_tube(stt.load_spec("omnirobot-s1")).tube
+    >>> predict = law13_predictor(tube, None, 1e-3, 0.5)
+    >>> [float(v) for v in predict([1.0, 2.0, 0.0], [2.0, 0.0, -4.0]).full().ravel()]
+    [1.001, 2.0, -0.002]
+    """
+    n = design.dimension
+    x, u_held = ca.SX.sym("x", n), ca.SX.sym("u_held", n)
+    return ca.Function("predict", [x, u_held], [x + float(delay * mid_gain) * u_held],
+                       ["x", "u_held"], ["x_hat"])
+
+
+def no_predictor(design: TubeDesign, stage, delay: float, mid_gain: float) -> None:
+    """The cascade's ``predictor`` role: none (``predicts_delay`` is False; the loader
+    refuses ``[controller] compensate_delay`` for it).
+
+    Parameters
+    ----------
+    design, stage, delay, mid_gain
+        As :func:`law13_predictor`.
+
+    Returns
+    -------
+    None
+    """
+    return None

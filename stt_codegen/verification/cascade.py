@@ -109,7 +109,8 @@ def cascade_delay_check(spec, tube, min_width: float,
     from .sampled import delay_result
     stage, _ = judged_stage(spec, tube, min_width)
     return delay_result("cascade.delay", largest_cascade_delay(tube, spec, stage, halvings),
-                        spec, tube.rate_hz, "keeps |e1| < 1 and |e2| < 1 when each force acts",
+                        spec, tube.rate_hz, "keeps |e1| < 1 and |e2| < 1 when each force acts "
+                        "up to that long after its state is read",
                         f"k1 = {stage.position_gain:.4g}, k2 = {stage.velocity_gain:.4g}",
                         halvings)
 

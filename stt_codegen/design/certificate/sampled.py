@@ -38,11 +38,13 @@ from ...tube import reference
 from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .lyapunov import level_after, next_level, others_max
 from .plant_class import PlantClass, plant_class
-from .sampled_axis import axis_interval, peak, peak_scalar, phi_scalar, phi_slope_scalar
+from .predicted import check_predicted
+from .sampled_axis import (axis_interval, held_speed, peak, peak_scalar, phi_scalar,
+                           phi_slope_scalar, turn_failure, turned_gains)
 
 __all__ = ["DELAY_HALVINGS", "RATE_FACTORS", "SampledCheck", "check_sampled",
-           "check_sampled_first_per_axis", "largest_delay", "largest_passing", "lowest_rate",
-           "sampled_check_of", "worst_near"]
+           "check_sampled_first_per_axis", "delay_room", "largest_delay", "largest_passing",
+           "lowest_rate", "sampled_check_of", "worst_near"]
 
 #: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
 RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
@@ -166,22 +168,6 @@ def worst_near(values: np.ndarray, jitter: float, pick) -> np.ndarray:
     before = np.concatenate([values[:1], values[:-1]])
     after = np.concatenate([values[1:], values[-1:]])
     return pick(pick(before, values), after)
-
-
-def _old_push(k: int, i: int, block: tuple[int, ...], reach_prev: list[float] | None,
-              speed_prev: list[float], g_max: float, spread: float, skew: float,
-              coupling: float, push: float) -> float:
-    """``M_i``: a bound of ``|x_dot_i|`` while the previous command ``u_{k-1}`` acts (the
-    first ``delay`` of a measurement interval), state units per second: ``g_max |u_{k-1,i}|``
-    plus the other inputs of the block through the row's off-diagonal part (at most
-    ``min(coupling, spread / sqrt(2) + skew)``, eq. (A2)) plus ``|f + w|``. Before the first
-    command acts the input is zero (``k = 0``)."""
-    if reach_prev is None:
-        return push
-    own = speed_prev[i] * phi_scalar(reach_prev[i])
-    others = math.sqrt(sum((speed_prev[j] * phi_scalar(reach_prev[j])) ** 2
-                           for j in block if j != i))
-    return g_max * own + min(coupling, spread / math.sqrt(2.0) + skew) * others + push
 
 
 def check_sampled(design: TubeDesign, samples: TubeSamples,
@@ -326,17 +312,9 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
                                         for i in range(n))))
             span = (dt + 2.0 * jitter) + (delay if timed else 0.0)
             rate = turn[0] * max(speeds[-3:] if timed else speeds[-1:]) + turn[1]
-            angle = span * rate
-            norm = g_hi + sk                              # |g|_2 of the class
-            g_lo = math.cos(angle) * g_lo - math.sin(angle) * norm if angle < 0.5 * math.pi \
-                else -math.inf
+            g_lo, g_hi, sk, cp = turned_gains(span * rate, g_lo, g_hi, sk, cp)
             if g_lo <= 0.0:
-                return fail(f"the heading may turn by {angle:.3g} rad in a sampling period "
-                            f"at t = {t:.4f} s (|omega| <= {rate:.3g} rad/s), which leaves no "
-                            "positive input gain for the command computed before it",
-                            -math.inf, t, 0, top)
-            g_hi, sk, cp = (g_hi + math.sin(angle) * norm, sk + math.sin(angle) * norm,
-                            cp + math.sin(angle) * norm)
+                return fail(turn_failure(span * rate, rate, t), -math.inf, t, 0, top)
             ratio_k = [h_k[i] / (pull_l[k][i] * g_lo) for i in range(n)]
             peak_k = {share: [peak_scalar(r / share) if share > 0.0 else 1.0 - 1e-15
                               for r in ratio_k] for share in shares}
@@ -353,9 +331,9 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
             else:
                 # the previous command for `lag`, then this one for `share` periods
                 # (docs/sampled-data.md, "Computation delay and jitter")
-                speed = _old_push(k, i, block_of[i], reach_prev,
-                                  [p / dt for p in pull_l[max(k - 1, 0)]], g_hi,
-                                  g_hi - g_lo, sk, cp, push_l[k])
+                speed = held_speed(i, block_of[i], reach_prev,
+                                   [p / dt for p in pull_l[max(k - 1, 0)]], g_hi,
+                                   g_hi - g_lo, sk, cp, push_l[k])
                 p_lo = x_lo = math.inf
                 p_hi = x_hi = -math.inf
                 for share, lag in corners:
@@ -419,9 +397,11 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
 def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,
                                  plants: Assumptions | PlantClass,
                                  gain: float | None = None, *, delay: float = 0.0,
-                                 jitter: float = 0.0) -> SampledCheck:
+                                 jitter: float = 0.0, compensate: bool = False
+                                 ) -> SampledCheck:
     """:func:`check_sampled` with the per-axis argument alone, and with the Lyapunov balls
-    only where that fails.
+    only where that fails; with ``compensate`` and a delay, the check of the predicted law
+    (:func:`~.predicted.check_predicted`).
 
     The balls only cut the per-axis enclosures (every step intersects with them), so a pass
     of the per-axis argument is a pass of the whole check: the verdict is the whole
@@ -441,12 +421,32 @@ def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,
         As :func:`check_sampled`.
     delay, jitter : float
         As :func:`check_sampled` (with either, the per-axis argument is the whole check).
+    compensate : bool
+        ``[controller] compensate_delay``: law (13) at the state predicted over ``delay``
+        (up to ``dt``; ``jitter`` must be 0). With ``delay`` 0 the prediction is the state
+        itself and the check is the plain one.
 
     Returns
     -------
     SampledCheck
         The per-axis argument's when it passes, else the whole check's.
+
+    Raises
+    ------
+    ValueError
+        As :func:`check_sampled`; with ``compensate``, a ``jitter`` other than 0 or a
+        ``delay`` beyond ``dt``.
     """
+    if compensate and delay > 0.0:
+        if jitter != 0.0:
+            raise ValueError(f"jitter = {jitter!r} s: the predicted law is proved without "
+                             "jitter")
+        passed, level, margin, t, i, reason, abs_e = check_predicted(
+            design, samples, _as_class(plants), gain, delay=delay)
+        data = {"gain": design.gain if gain is None else float(gain),
+                "rate_hz": design.rate_hz, "delay": delay, "jitter": 0.0,
+                "compensate_delay": True, "max_abs_e": level, "margin": margin}
+        return SampledCheck(passed, level, margin, t, i, reason, data, abs_e)
     per_axis = check_sampled(design, samples, plants, gain, lyapunov=False, delay=delay,
                              jitter=jitter)
     if per_axis.passed or delay > 0.0 or jitter > 0.0:
@@ -461,19 +461,20 @@ DELAY_HALVINGS = 6
 def largest_delay(design: TubeDesign, spec: Spec) -> float | None:
     """The largest computation delay the sampled-data check proves at the design's rate and
     gain with the spec's jitter, to ``dt / 2^DELAY_HALVINGS`` below the true limit of the
-    check (docs/sampled-data.md, "Computation delay and jitter").
+    check (docs/sampled-data.md, "Computation delay and jitter"); with ``[controller]
+    compensate_delay``, of the predicted law, up to one period.
 
     Parameters
     ----------
     design : TubeDesign
         The design (its rate and gain).
     spec : Spec
-        Its plant class and ``[controller] jitter``.
+        Its plant class and ``[controller] jitter`` and ``compensate_delay``.
 
     Returns
     -------
     float or None
-        Seconds, in ``[0, dt - 2 jitter]``: the largest delay tried with which the check
+        Seconds, in ``[0, dt - 2 jitter]`` (``[0, dt]`` with ``compensate_delay``): the largest delay tried with which the check
         passes; a check with a delay proves every delay up to it. ``None`` when the check
         fails without delay.
     """
@@ -483,12 +484,32 @@ def largest_delay(design: TubeDesign, spec: Spec) -> float | None:
 
         def passes(delay: float) -> bool:
             return check_sampled_first_per_axis(design, samples, plants, delay=delay,
-                                                jitter=spec.jitter).passed
+                                                jitter=spec.jitter,
+                                                compensate=spec.compensate_delay).passed
 
         # without delay: the spec's own check when it has no delay either (cached)
-        return largest_passing(passes, max(0.0, 1.0 / design.rate_hz - 2.0 * spec.jitter),
+        return largest_passing(passes, delay_room(design.rate_hz, spec),
                                sampled_check_of(design, spec)[1].passed if spec.delay == 0.0
                                else None)
+
+
+def delay_room(rate_hz: float, spec: Spec) -> float:
+    """The largest delay the sampled-data check takes at a rate, s: ``dt - 2 jitter``, or
+    ``dt`` with ``[controller] compensate_delay``.
+
+    Parameters
+    ----------
+    rate_hz : float
+        The rate, Hz.
+    spec : Spec
+        Its ``jitter`` and ``compensate_delay``.
+
+    Returns
+    -------
+    float
+        Seconds, ``>= 0``.
+    """
+    return max(0.0, 1.0 / rate_hz - (0.0 if spec.compensate_delay else 2.0 * spec.jitter))
 
 
 def largest_passing(passes: Callable[[float], bool], top: float,
@@ -563,8 +584,10 @@ def _sampled_check(design: TubeDesign, spec: Spec, per_axis_first: bool
         samples = sample_tube(design)
         plants = plant_class(spec)
         timing = {"delay": spec.delay, "jitter": spec.jitter}
-        check = (check_sampled_first_per_axis(design, samples, plants, **timing)
-                 if per_axis_first else check_sampled(design, samples, plants, **timing))
+        check = (check_sampled_first_per_axis(design, samples, plants, **timing,
+                                              compensate=spec.compensate_delay)
+                 if per_axis_first or spec.compensate_delay
+                 else check_sampled(design, samples, plants, **timing))
     return samples, check
 
 
@@ -610,10 +633,11 @@ def lowest_rate(design: TubeDesign, spec: Spec, plants: Assumptions | PlantClass
         certificate = certify_tube(trial, spec)
         gain = (explicit_gain if explicit_gain is not None
                 else derived_gain(certificate.min_width, trial.rate_hz, assumptions))
-        if not certificate.passed or spec.delay + 2.0 * spec.jitter > 1.0 / trial.rate_hz:
+        if not certificate.passed or spec.delay > delay_room(trial.rate_hz, spec):
             return False, gain         # the delay (s) and jitter must fit the shorter period
         return check_sampled_first_per_axis(trial, sample_tube(trial), plants, gain,
-                                            delay=spec.delay, jitter=spec.jitter).passed, gain
+                                            delay=spec.delay, jitter=spec.jitter,
+                                            compensate=spec.compensate_delay).passed, gain
 
     below = [f for f in RATE_FACTORS if f < 1.0]
     above = [f for f in RATE_FACTORS if f > 1.0]

@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 __all__ = ["phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "peak_scalar",
-           "coupling_push", "axis_interval"]
+           "coupling_push", "axis_interval", "held_speed", "turned_gains", "turn_failure"]
 
 
 def phi(s: np.ndarray) -> np.ndarray:
@@ -231,3 +231,87 @@ def axis_interval(a: float, b: float, c0: float, h0: float, pull: float, g_min: 
             path_lo, path_hi = min(path_lo, -high), max(path_hi, -low)
             end_lo, end_hi = min(end_lo, -out_max), max(end_hi, -in_min)
     return path_lo, path_hi, end_lo, end_hi
+
+
+def held_speed(i: int, block: tuple[int, ...], reach_prev: list[float] | None,
+               speed_prev: list[float], gain: float, spread: float, skew: float,
+               coupling: float, push: float) -> float:
+    """``M_i``: a bound of axis ``i``'s speed under the previous command ``u_{k-1}``, state
+    units per second (docs/sampled-data.md, eq. (T1)).
+
+    ``gain |u_{k-1,i}|`` plus the other inputs of the block through the row's off-diagonal
+    part (at most ``min(coupling, spread / sqrt(2) + skew)``, eq. (A2)) plus ``|f + w|``.
+    With ``gain = g_max`` it bounds the motion while the held command acts (a computation
+    delay); with ``gain`` the largest ``|g_ii - g_mid|`` it bounds the error of a
+    prediction made with ``g_mid`` (eq. (P1)). Before the first command acts the input is
+    zero (``reach_prev`` is ``None``).
+
+    Parameters
+    ----------
+    i : int
+        The axis.
+    block : tuple of int
+        The axes of ``i``'s block of ``g``.
+    reach_prev : list of float or None
+        The bound of ``|e_j(t_{k-1})|`` per axis; ``None`` before the first command.
+    speed_prev : list of float
+        ``|u_{k-1,j}| / phi(|e_j|)`` per axis (``4 k / gamma_d``), 1/s per unit of ``phi``.
+    gain, spread, skew, coupling : float
+        The factor of the own input, ``g_max - g_min``, and the skew and row-coupling bounds
+        of ``g``.
+    push : float
+        ``|f + w|`` bound, state units per second.
+
+    Returns
+    -------
+    float
+        ``M_i``, state units per second.
+    """
+    if reach_prev is None:
+        return push
+    own = speed_prev[i] * phi_scalar(reach_prev[i])
+    others = math.sqrt(sum((speed_prev[j] * phi_scalar(reach_prev[j])) ** 2
+                           for j in block if j != i))
+    return gain * own + min(coupling, spread / math.sqrt(2.0) + skew) * others + push
+
+
+def turned_gains(angle: float, g_min: float, g_max: float, skew: float, coupling: float
+                 ) -> tuple[float, float, float, float]:
+    """The input gain's bounds for a command computed at one heading and acting while the
+    base turns by up to ``angle`` (docs/differential-drive.md, eq. (R1)).
+
+    Parameters
+    ----------
+    angle : float
+        The largest turn, rad.
+    g_min, g_max, skew, coupling : float
+        The class's bounds at the command's own heading.
+
+    Returns
+    -------
+    g_min, g_max, skew, coupling : float
+        The bounds over the turn; ``g_min <= 0`` (``-inf`` from a quarter turn on) when the
+        turn leaves no positive gain.
+    """
+    norm = g_max + skew                                   # |g|_2 of the class
+    low = math.cos(angle) * g_min - math.sin(angle) * norm if angle < 0.5 * math.pi \
+        else -math.inf
+    side = math.sin(angle) * norm
+    return low, g_max + side, skew + side, coupling + side
+
+
+def turn_failure(angle: float, rate: float, t: float) -> str:
+    """The reason a sampled check fails when :func:`turned_gains` leaves no positive gain.
+
+    Parameters
+    ----------
+    angle, rate, t : float
+        The turn, rad; the bound of ``|omega|``, rad/s; the interval's start, s.
+
+    Returns
+    -------
+    str
+    """
+    return (f"the heading may turn by {angle:.3g} rad in a sampling period at t = {t:.4f} s "
+            f"(|omega| <= {rate:.3g} rad/s), which leaves no positive input gain for the "
+            "command computed before it")
