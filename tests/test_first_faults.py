@@ -175,7 +175,7 @@ def test_an_unknown_key_suggests_the_closest(table, key, meant):
 def test_an_unknown_key_far_from_every_key_gets_no_suggestion():
     error = _refusal(drive_doc(controller={"rate_hz": 200.0, "zzz": 1.0}))
     assert "did you mean" not in error.reason
-    assert "allowed: delay, gain, jitter, rate_hz" in error.reason
+    assert "allowed: compensate_delay, delay, gain, jitter, rate_hz" in error.reason
 
 
 # 6. A differential drive's heading is in radians, within [-pi, pi]
