@@ -61,3 +61,25 @@ def test_the_firmware_loop_runs_the_delay_of_the_spec(tmp_path, case, delay, pro
     # the float controller follows the double one closely; the delay moves the run by
     # more than ten times that
     assert 10 * with_delay < without, (with_delay, without)
+
+
+@pytest.mark.parametrize("spec_file, program, state_size", [
+    ("umaze-first-compensated.toml", _law13_program, None),
+    pytest.param("kobuki-office-compensated.toml", _look_ahead_program, 3,
+                 marks=pytest.mark.slow)])
+def test_the_firmware_loop_runs_the_prediction_of_the_spec(tmp_path, spec_file, program,
+                                                           state_size):
+    """With [controller] compensate_delay the firmware calls P_predict before P_step: it
+    follows the host's predicted run, not the same delay run without the prediction."""
+    from pathlib import Path
+    design = stt.design_tube(stt.load_spec(Path(__file__).parent / "specs" / spec_file))
+    points, stdout = _firmware_points(design, program, state_size, tmp_path)
+    assert "satisfied=1" in stdout
+    predicted = stt.simulate(design, backend="c")
+    unpredicted = stt.simulate(dataclasses.replace(design, spec=dataclasses.replace(
+        design.spec, compensate_delay=False)), backend="c")
+    assert predicted.stayed_in_tube
+    with_prediction = max(np.max(np.abs(p - predicted.trajectory.x[k]))
+                          for k, p in points.items())
+    without = max(np.max(np.abs(p - unpredicted.trajectory.x[k])) for k, p in points.items())
+    assert 10 * with_prediction < without, (with_prediction, without)

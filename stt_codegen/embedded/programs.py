@@ -133,6 +133,7 @@ def loop_context(spec: Spec, design: TubeDesign, *, seed: int = 0, decimate: int
         terms=dist.weights.shape[1], seed=int(seed), rate_hz=f"{design.rate_hz:g}",
         rate_hz_d=c_double(design.rate_hz), t_c=c_double(spec.prescribed_time),
         has_delay=spec.delay > 0.0, delay=c_double(spec.delay),
+        predict=bool(spec.compensate_delay),
         ss_lo=[c_double(v) for v in spec.state_space.lower], ss_hi=[c_double(v) for v in spec.state_space.upper],
         tg_lo=[c_double(v) for v in spec.target_set.lower], tg_hi=[c_double(v) for v in spec.target_set.upper],
         w_amp=c_double(dist.amplitude), w_c=[[c_double(v) for v in r] for r in dist.weights],
