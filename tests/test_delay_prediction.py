@@ -7,6 +7,9 @@ from __future__ import annotations
 
 import ctypes
 import dataclasses
+import re
+import shutil
+import subprocess
 import types
 from functools import lru_cache
 from pathlib import Path
@@ -237,3 +240,32 @@ def test_the_single_precision_predict_compiles_strictly(tmp_path) -> None:
     files = generate_files(design.spec, design.tube, Options(("c",), "single"))
     folder = write(tmp_path, files)
     compile_shared(folder, c_identifier(design.spec.c_name), COMPILERS[0], "single")
+
+
+@pytest.mark.skipif(shutil.which("cppcheck") is None,
+                    reason="cppcheck missing: install the Debian package cppcheck")
+@pytest.mark.parametrize("path, precision", [(FIRST, "double"),
+                                             pytest.param(BASE, "single",
+                                                          marks=pytest.mark.slow)])
+def test_the_generated_predict_keeps_misra_clean(tmp_path, path, precision) -> None:
+    """cppcheck's MISRA C:2012 addon finds in P_predict only the API's own deviation
+    (tests/test_codegen_misra.py: an API function the file does not call)."""
+    from test_codegen_misra import DEVIATIONS
+    design = _design(path)
+    prefix = c_identifier(design.spec.c_name)
+    folder = tmp_path / "gen"
+    stt.generate(design, folder, ("c",), precision)
+    proc = subprocess.run(["cppcheck", "--enable=all", "--addon=misra", "--std=c99",
+                           "--suppress=missingIncludeSystem", "--quiet",
+                           "--template={file}:{line}:{id}", f"{prefix}.c"],
+                          cwd=folder, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    unused = set()
+    for name, line, check in (f.split(":") for f in proc.stderr.splitlines()
+                              if f.count(":") >= 2):
+        text = (folder / name).read_text().splitlines()[int(line) - 1]
+        assert any(d[0] == check and re.search(d[1], text) for d in DEVIATIONS), \
+            f"{name}:{line}: {check}: {text!r}"
+        if check == "unusedFunction":
+            unused.add(re.match(rf"^int {prefix}_(\w+)\(", text).group(1))
+    assert "predict" in unused                  # it is there, and clean
