@@ -127,6 +127,10 @@ def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
         for suffix in (".c", ".h", ".py", "_selftest.c", "_vectors.json"):
             assert (tmp_path / "demo" / name / f"{c_name}{suffix}").is_file()
     assert out.stdout.count(" yes ") == len(CASES + TASK_CASES + EXTRA_CASES) + 3
+    # the bundled fleet: a folder per robot, every robot satisfied, the closest approach
+    assert "fleet warehouse-fleet: 8 robots, 28 pairs certified apart" in out.stdout
+    assert "every robot satisfied, closest approach " in out.stdout
+    assert (tmp_path / "demo" / "warehouse-fleet" / "base1" / "base1.c").is_file()
     again = run("demo", "--out", str(tmp_path / "demo"))     # its own files: overwritten
     assert again.returncode == 0, again.stderr
 
@@ -146,6 +150,7 @@ def test_demo_in_two_processes_reports_a_case_without_design(tmp_path, monkeypat
         paths.append(tmp_path / f"{name}.toml")
         paths[-1].write_text(REVERSED_PLANT.replace('name = "reversed"', f'name = "{name}"'))
     monkeypatch.setattr(cases, "bundled_cases", lambda: [str(p) for p in paths])
+    monkeypatch.setattr(cases, "bundled_fleets", lambda: [])
     assert main(["demo", "--out", str(tmp_path / "out"), "--jobs", "2"]) == 1
     err = capsys.readouterr().err
     assert err.startswith("error: ") and err.count("\n") == 1 and "Traceback" not in err

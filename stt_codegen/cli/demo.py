@@ -36,13 +36,39 @@ def _run_case(name: str, spec: Spec, args: argparse.Namespace,
         result = simulate(design, backend=args.backend)   # the cascade's for second order
         atomic_write(out / f"{name}.png",
                      lambda tmp: plot_run(design, result, tmp, dims=dims))
-    except SpecError as exc:
-        return None, (SpecError, exc.field, exc.reason)
-    except DesignError as exc:
-        return None, (DesignError, str(exc))
     except SttError as exc:
-        return None, (ToolchainError, str(exc))
+        return None, _failure(exc)
     return summary_line(result), result.satisfied
+
+
+def _failure(exc: SttError) -> tuple:
+    """An error as plain data (it crosses a process boundary as its kind and its words)."""
+    if isinstance(exc, SpecError):
+        return SpecError, exc.field, exc.reason
+    return (DesignError if isinstance(exc, DesignError) else ToolchainError), str(exc)
+
+
+def _run_fleet(name: str, args: argparse.Namespace) -> tuple[str, bool] | tuple[None, tuple]:
+    """One bundled fleet in the demo: design, a folder per robot, every robot's closed
+    loop; its summary (the certified narrowest pair, the closest approach) and whether
+    it is satisfied, or ``(None, failure)`` as :func:`_run_case`."""
+    from ..codegen.fleet import generate_fleet
+    from ..design.fleet import design_fleet
+    from ..runtime.fleet import simulate_fleet
+    try:
+        designed = design_fleet(name)
+        generate_fleet(designed, Path(args.out) / name)
+        run = simulate_fleet(designed, backend=args.backend)
+    except SttError as exc:
+        return None, _failure(exc)
+    pair, closest = designed.narrowest, run.closest
+    unmet = [n for n, r in run.results.items() if not r.satisfied]
+    return (f"fleet {name}: {len(run.results)} robots, {len(designed.pairs)} pairs certified "
+            f"apart for every t (narrowest {pair.margin:.3f} m, {pair.pair[0]} and "
+            f"{pair.pair[1]}); {args.backend} closed loops: "
+            + (f"NOT satisfied by {', '.join(unmet)}" if unmet else "every robot satisfied")
+            + f", closest approach {closest.clearance:.3f} m ({closest.pair[0]} and "
+            f"{closest.pair[1]} at {closest.t:.2f} s)"), run.satisfied
 
 
 def _raise(failure: tuple) -> None:
@@ -103,7 +129,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     DesignError
         A case has no design (exit code 1).
     """
-    from ..cases import bundled_cases
+    from ..cases import bundled_cases, bundled_fleets
     from ..spec.loader import load_spec
     from ..runtime.backends import default_backend
     args.backend = default_backend() if args.backend is None else args.backend
@@ -118,9 +144,11 @@ def cmd_demo(args: argparse.Namespace) -> int:
     # what a case needs of the arguments (the parser itself does not cross processes)
     case_args = argparse.Namespace(out=args.out, backend=args.backend)
     cases = [(name, spec, case_args, dims[name]) for name, spec in specs.items()]
+    fleets = bundled_fleets()
     if jobs == 1:
         outcomes = (_run_case(*case) for case in cases)
         all_ok = _print_outcomes(outcomes)
+        all_ok &= _print_outcomes(_run_fleet(name, case_args) for name in fleets)
     else:
         # fork after the heavy imports: the workers start with the library loaded
         from ..codegen.api import generate  # noqa: F401
@@ -128,8 +156,12 @@ def cmd_demo(args: argparse.Namespace) -> int:
         from ..runtime.simulate import simulate  # noqa: F401
         context = multiprocessing.get_context("fork")
         with ProcessPoolExecutor(max_workers=jobs, mp_context=context) as pool:
+            # the fleets first: each is one long job beside the cases
+            fleet_runs = [pool.submit(_run_fleet, name, case_args) for name in fleets]
             all_ok = _print_outcomes(pool.map(_run_case, *zip(*cases)))
-    print(f"generated code in {out}/<case>/, plots in {out}/<case>.png")
+            all_ok &= _print_outcomes(f.result() for f in fleet_runs)
+    print(f"generated code in {out}/<case>/, plots in {out}/<case>.png"
+          + "".join(f"; {name}: a folder per robot in {out}/{name}/" for name in fleets))
     return 0 if all_ok else 1
 
 
