@@ -170,9 +170,17 @@ def _cmd_overhead(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_delay(args: argparse.Namespace) -> int:
+    from .delay_bench import format_delay_report, run_delay_bench
+    report = run_delay_bench()
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_delay_report(report))
+    return 0
+
+
 def configure_bench(bench: argparse.ArgumentParser) -> None:
     """Sub-subcommands ``bench arenas``, ``tasks``, ``drive``, ``agv``, ``step``, ``scaling``,
-    ``covering``, ``alpha``, ``second-order``, ``stl`` and ``overhead``.
+    ``covering``, ``alpha``, ``second-order``, ``stl``, ``overhead`` and ``delay``.
 
     Parameters
     ----------
@@ -289,6 +297,11 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="also write the specs into DIR")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_stl)
+
+    p = sub.add_parser("delay", help="the computation delay law (13) is proved to tolerate, "
+                                     "plain and with the delay-compensating prediction")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_delay)
 
     p = sub.add_parser("overhead", help="CPU of a command beside the library call it makes "
                                         "(stt-codegen design SPEC against design_tube)")
