@@ -174,3 +174,20 @@ def test_a_target_on_another_robots_way_is_refused_naming_the_pair():
     assert info.value.kind is FailureKind.FLEET
     message = str(info.value)
     assert "a and b" in message or "b and a" in message
+
+
+def test_the_fleet_schema_takes_the_bundled_fleet_and_refuses_an_unknown_robot_key():
+    import tomllib
+
+    import jsonschema
+
+    from stt_codegen.cases import bundled_fleet_bytes
+    from stt_codegen.spec.fleet import fleet_json_schema
+    schema = fleet_json_schema()
+    jsonschema.Draft7Validator.check_schema(schema)
+    doc = tomllib.loads(bundled_fleet_bytes("warehouse-fleet").decode())
+    jsonschema.validate(doc, schema)
+    jsonschema.validate(TWO, schema)
+    for bad in (_two(robots__0__speed=1.0), _two(lanes=2), _two(robots__1__radius=-1.0)):
+        with pytest.raises(jsonschema.ValidationError):
+            jsonschema.validate(bad, schema)

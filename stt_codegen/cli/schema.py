@@ -14,24 +14,31 @@ def cmd_schema(args: argparse.Namespace) -> int:
     Parameters
     ----------
     args : argparse.Namespace
-        The parsed arguments (none are read).
+        ``fleet``: the schema of fleet files instead (docs/fleets.md).
 
     Returns
     -------
     int
         0.
     """
+    if args.fleet:
+        from ..spec.fleet import fleet_json_schema
+        print(json.dumps(fleet_json_schema(), indent=2, sort_keys=True))
+        return 0
     from ..spec.schema import json_schema
     print(json.dumps(json_schema(), indent=2, sort_keys=True))
     return 0
 
 
 def configure_schema(p: argparse.ArgumentParser) -> None:
-    """Arguments of ``stt-codegen schema`` (none).
+    """Arguments of ``stt-codegen schema``: ``--fleet``.
 
     Parameters
     ----------
     p : argparse.ArgumentParser
-        The subcommand's parser; its ``handler`` is set to :func:`cmd_schema`.
+        The subcommand's parser; gets ``--fleet``, and its ``handler`` is set to
+        :func:`cmd_schema`.
     """
+    p.add_argument("--fleet", action="store_true",
+                   help="the schema of fleet files (several robots) instead")
     p.set_defaults(handler=cmd_schema)

@@ -27,7 +27,8 @@ from ..errors import SpecError
 from .loader import Spec
 from .mujoco import with_folder
 
-__all__ = ["FleetRobot", "FleetSpec", "is_fleet", "load_fleet", "parse_fleet"]
+__all__ = ["FleetRobot", "FleetSpec", "fleet_json_schema", "is_fleet", "load_fleet",
+           "parse_fleet"]
 
 #: The top-level keys of a fleet file.
 FLEET_KEYS = ("name", "state_space", "obstacles", "robots")
@@ -309,3 +310,53 @@ def _robot_field(name: str, field: str) -> str:
         return f"{field}.{name[len('robot.'):]}"
     return f"{field}.{name}" if name else field
 
+
+
+def fleet_json_schema() -> dict[str, Any]:
+    """The JSON Schema (draft 7) of a fleet file, built from the single spec's.
+
+    The shared ``name``, ``state_space`` and ``obstacles`` are the single spec's; a
+    ``[[robots]]`` entry has ``name``, ``radius`` and ``dims`` (``[robot]``'s) and the
+    single spec's tables of :data:`ROBOT_TABLES`, its ``state_space`` only the keys other
+    than ``lower`` and ``upper``. The rules between fields are the loader's, per robot.
+
+    Returns
+    -------
+    dict
+        The schema, with the single spec's ``$defs``.
+
+    Examples
+    --------
+    >>> from stt_codegen.spec.fleet import fleet_json_schema
+    >>> schema = fleet_json_schema()
+    >>> sorted(schema["properties"]), schema["required"]
+    (['name', 'obstacles', 'robots', 'state_space'], ['name', 'state_space', 'robots'])
+    """
+    from .schema import json_schema
+    single = json_schema()
+    props = single["properties"]
+    robot_table = single["$defs"]["RobotTable"]["properties"]
+    space = dict(single["$defs"]["StateSpaceTable"])
+    space_props = {k: v for k, v in space["properties"].items() if k not in ("lower", "upper")}
+    robot = {
+        "type": "object", "additionalProperties": False,
+        "description": "one robot: its name, radius, and a single spec's tables for it "
+                       "(docs/fleets.md)",
+        "properties": {
+            "name": props["name"], "radius": robot_table["radius"], "dims": robot_table["dims"],
+            "state_space": {"type": "object", "additionalProperties": False,
+                            "properties": space_props,
+                            "description": "the keys of the robot's plant only (the box "
+                                           "is the fleet's)"},
+            **{k: props[k] for k in ROBOT_TABLES}},
+        "required": ["name", "radius", "prescribed_time", "initial", "target"]}
+    return {
+        "$schema": single["$schema"], "$defs": single["$defs"], "type": "object",
+        "title": "stt-codegen fleet", "additionalProperties": False,
+        "description": "robots sharing a state space and its obstacles (docs/fleets.md)",
+        "properties": {
+            "name": props["name"], "state_space": props["state_space"],
+            "obstacles": props["obstacles"],
+            "robots": {"type": "array", "items": robot, "minItems": 1,
+                       "maxItems": MAX_ROBOTS, "description": "the robots, one table each"}},
+        "required": ["name", "state_space", "robots"]}
