@@ -130,3 +130,26 @@ def test_a_mujoco_plant_takes_a_delay_of_whole_timesteps_only() -> None:
         assert late.stayed_in_tube and not late.contacts
         assert np.array_equal(late.trajectory.u[0], plain.trajectory.u[0])
         assert not np.array_equal(late.trajectory.x, plain.trajectory.x)
+
+
+def test_the_jitter_is_drawn_seeded_within_its_bound_and_the_tube_is_kept() -> None:
+    """omnirobot-s1 with 0.2 ms of jitter (certified: the sampled check passes with it):
+    the reads move by up to the jitter, the run differs from the exact one and from another
+    seed's, and keeps the tube with |e| within the check's bound at the samples."""
+    from stt_codegen.design.certificate.sampled import sampled_check_of
+    from stt_codegen.runtime.simulate import sampling_offsets
+    design = design_of("omnirobot-s1")
+    jittery = dataclasses.replace(design, spec=dataclasses.replace(design.spec, jitter=2e-4))
+    check = sampled_check_of(design.tube, jittery.spec)[1]
+    assert check.passed
+    offsets = sampling_offsets(2e-4, 1000, 0)
+    assert offsets[0] == 0.0 and np.max(np.abs(offsets)) <= 2e-4
+    assert np.max(np.abs(offsets)) > 1.5e-4                  # the bound is reached for
+    horizon = 2.0
+    run = stt.simulate(jittery, backend="reference", horizon=horizon)
+    again = stt.simulate(jittery, backend="reference", horizon=horizon)
+    other = stt.simulate(jittery, backend="reference", horizon=horizon, seed=1)
+    exact = stt.simulate(design, backend="reference", horizon=horizon)
+    assert _same_run(run, again) and not _same_run(run, exact)
+    assert not np.array_equal(run.trajectory.x, other.trajectory.x)
+    assert run.stayed_in_tube and run.max_abs_e <= check.level

@@ -136,7 +136,8 @@ def sampled_plant(design: Design, seed: int = 0, plant: ct.NonlinearIOSystem | N
     ``simulate`` (the same floats). With a spec's ``[controller] delay`` ``d > 0`` the
     system also keeps the previous input ``u_{k-1}`` as states (zero at ``t = 0``): the
     update holds it on ``[t_k, t_k + d)`` and the input ``u_k`` from ``t_k + d``, as
-    ``simulate`` does, then stores ``u_k``.
+    ``simulate`` does, then stores ``u_k``. It samples exactly every ``dt``: a spec's
+    ``jitter``, which ``simulate`` draws, is not run here.
 
     Parameters
     ----------

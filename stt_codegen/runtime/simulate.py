@@ -41,8 +41,8 @@ from .tasks import TaskOutcome, judge_tasks, until_met
 
 __all__ = ["RungeKutta", "SUBSTEPS", "SimulationResult", "Trajectory",
            "cascade_velocity_reference", "hold_period", "no_velocity_fields",
-           "no_velocity_reference",
-           "run_closed_loop", "simulate", "velocity_fields"]
+           "no_velocity_reference", "run_closed_loop", "sampling_offsets", "simulate",
+           "velocity_fields"]
 
 #: Runge-Kutta steps per sampling period.
 SUBSTEPS = 2
@@ -357,6 +357,36 @@ def hold_period(stepper: RungeKutta | MujocoPlant, t: float, u_prev: np.ndarray,
     return np.vstack([early, late]), np.concatenate([early_t, late_t])
 
 
+def sampling_offsets(jitter: float, steps: int, seed: int) -> np.ndarray:
+    """The offsets ``o_k = s_k - k dt`` of a run's sampling instants under ``[controller]
+    jitter``: uniform in ``[-jitter, jitter]``, ``o_0 = 0``, from their own seeded stream.
+
+    Parameters
+    ----------
+    jitter : float
+        ``[controller] jitter``, s; 0 gives zeros.
+    steps : int
+        The run's steps (``steps + 1`` samples).
+    seed : int
+        The run's seed.
+
+    Returns
+    -------
+    ndarray, shape (steps + 1,)
+        Seconds.
+
+    Examples
+    --------
+    >>> offsets = sampling_offsets(1e-4, 3, 0)
+    >>> float(offsets[0]), bool(abs(offsets).max() <= 1e-4)
+    (0.0, True)
+    """
+    offsets = np.zeros(steps + 1)
+    if jitter > 0.0:
+        offsets[1:] = np.random.default_rng([seed, 0x6A17]).uniform(-jitter, jitter, steps)
+    return offsets
+
+
 def simulate(design: Design, *positional: object, backend: str | None = None,
              horizon: float | None = None, seed: int = 0,
              plant: ct.NonlinearIOSystem | None = None) -> SimulationResult:
@@ -375,8 +405,15 @@ def simulate(design: Design, *positional: object, backend: str | None = None,
     With a spec's ``[controller] delay`` ``d > 0`` the command ``u_k`` computed from
     ``x(t_k)`` acts from ``t_k + d`` to ``t_{k+1} + d`` (the previous command acts on
     ``[t_k, t_k + d)``, the input is zero before ``u_0`` acts); the trajectory's ``u`` at
-    ``t_k`` is still ``u_k``, and ``control_effort`` still sums the commands. The
-    ``jitter`` is not simulated (the certificate covers it).
+    ``t_k`` is still ``u_k``, and ``control_effort`` still sums the commands. With a
+    ``jitter`` ``j > 0`` the state is read at ``s_k = t_k + o_k``, the offsets ``o_k``
+    drawn uniformly in ``[-j, j]`` (``o_0 = 0``; seeded by ``seed``, apart from the
+    disturbance's draw), the controller still called with the nominal ``t_k`` and ``dt``,
+    and the command acting from ``s_k + d`` to ``s_{k+1} + d`` (:func:`sampling_offsets`);
+    the trajectory's ``x`` at ``t_k`` is ``x(s_k)``. A MuJoCo plant steps a fixed timestep:
+    it runs without jitter. With ``compensate_delay`` the controller is called with the
+    state predicted over ``d`` from the command acting at the read
+    (:func:`~stt_codegen.design.prediction.delay_predictor`).
 
     Parameters
     ----------
@@ -534,6 +571,11 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
     t_lo, t_hi = np.array(spec.target_set.lower), np.array(spec.target_set.upper)
 
     ts = np.arange(steps + 1) * dt
+    jitter = 0.0 if isinstance(stepper, MujocoPlant) else spec.jitter
+    reads = ts + sampling_offsets(jitter, steps, seed)
+    # each measurement interval's length: dt itself without jitter (not a difference of
+    # rounded instants)
+    lengths = np.diff(reads) if jitter > 0.0 else np.full(steps, dt)
     states = np.zeros((steps + 1, x.size))
     us = np.zeros((steps + 1, n))
     alphas = np.zeros((steps + 1, 2 * n))
@@ -549,7 +591,7 @@ def run_closed_loop(spec: Spec, tube: TubeDesign, *, backend: str = "reference",
         us[k], status[k] = u, code
         if k == steps:
             break
-        points, times = hold_period(stepper, t, u_prev, u, dt, spec.delay)
+        points, times = hold_period(stepper, reads[k], u_prev, u, lengths[k], spec.delay)
         u_prev = us[k]
         x = points[-1]
         dense.append(positions(spec, points))
