@@ -509,11 +509,13 @@ def _retimed(via: Design | None, timing: Spec, spec: Spec,
     if spec.input_bound is not None:      # the lower peak rate for the same duration
         planned = tuple(replace(seg, profile=CRUISE) if seg.profile == SMOOTHSTEP else seg
                         for seg in planned)
+    tried: set[tuple[ReachSegment, ...]] = set()
     for factors in speed_limits(spec):
         segments = retime(planned, timing,
                           via.task_plan.order if via.task_plan is not None else None, factors)
-        if segments is None:
+        if segments is None or segments in tried:     # the same timing: the same verdict
             continue
+        tried.add(segments)
         tube = replace(via.tube, segments=segments)
         timed = check(tube, spec)
         if not timed.passed:
