@@ -191,3 +191,19 @@ def test_the_fleet_schema_takes_the_bundled_fleet_and_refuses_an_unknown_robot_k
     for bad in (_two(robots__0__speed=1.0), _two(lanes=2), _two(robots__1__radius=-1.0)):
         with pytest.raises(jsonschema.ValidationError):
             jsonschema.validate(bad, schema)
+
+
+def test_a_wait_between_two_re_timed_segments_is_a_held_segment():
+    """The re-timing may wait at a via box between two segments; the tube's segments are
+    contiguous, so the wait is a segment holding that box (a fleet's random floor met it)."""
+    from stt_codegen.design.moving import _held
+    from stt_codegen.tube.parameters import ReachSegment
+    a = ReachSegment(0.0, 2.0, (0.0, 0.0), (1.0, 1.0), (2.0, 0.0), (3.0, 1.0), "smoothstep")
+    b = ReachSegment(5.0, 7.0, (2.0, 0.0), (3.0, 1.0), (4.0, 2.0), (5.0, 3.0), "smoothstep")
+    held = _held((a, b))
+    assert len(held) == 3 and held[0] == a and held[2] == b
+    wait = held[1]
+    assert (wait.start, wait.end) == (2.0, 5.0)
+    assert wait.lower_from == wait.lower_to == a.lower_to
+    assert wait.upper_from == wait.upper_to == a.upper_to
+    assert _held((a,)) == (a,)

@@ -380,7 +380,20 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
         state, seg = parent[state]
         if seg is not None:
             out.append(seg)
-    return tuple(reversed(out))
+    return _held(tuple(reversed(out)))
+
+
+def _held(segments: tuple[ReachSegment, ...]) -> tuple[ReachSegment, ...]:
+    """``segments`` with a wait between two of them as a segment that holds the box (the
+    reach tube's segments are contiguous in time)."""
+    out: list[ReachSegment] = []
+    for seg in segments:
+        if out and seg.start > out[-1].end:
+            last = out[-1]
+            out.append(replace(last, start=last.end, end=seg.start,
+                               lower_from=last.lower_to, upper_from=last.upper_to))
+        out.append(seg)
+    return tuple(out)
 
 
 def _accept(tube: TubeDesign, check: TubeCheck, spec: Spec) -> TubeDesign:
