@@ -17,14 +17,13 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
 from ..cases import bundled_fleet_bytes, bundled_fleets, bundled_folder
 from ..errors import SpecError
-from .loader import Spec
+from .loader import Spec, toml_document
 from .mujoco import with_folder
 
 __all__ = ["FleetRobot", "FleetSpec", "fleet_json_schema", "is_fleet", "load_fleet",
@@ -179,16 +178,11 @@ def parse_fleet(data: bytes | str, folder: Path | None = None) -> FleetSpec:
     Raises
     ------
     SpecError
-        Not UTF-8 or not TOML (field ``""``), or a field that fails validation.
+        Not UTF-8, not TOML or nested too deeply (field ``""``), or a field that fails
+        validation.
     """
     raw = data.encode("utf-8") if isinstance(data, str) else bytes(data)
-    try:
-        doc = tomllib.loads(raw.decode("utf-8"))
-    except UnicodeDecodeError as exc:
-        raise SpecError("", f"not UTF-8 text ({exc.reason} at byte {exc.start})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SpecError("", f"malformed TOML: {exc}") from None
-    return _validate(doc, hashlib.sha256(raw).hexdigest(), folder)
+    return _validate(toml_document(raw), hashlib.sha256(raw).hexdigest(), folder)
 
 
 def load_fleet(fleet: str | os.PathLike) -> FleetSpec:

@@ -45,7 +45,7 @@ from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, 
                      ControllerTable, PlantTable, PolytopeObstacle, check_document, value_kind)
 
 __all__ = ["Assumptions", "Box", "LinearPlant", "law13_plant_terms", "look_ahead_plant_terms", "NAME_PATTERN", "Obstacle", "Spec", "UnsafeSet",
-           "bundled_cases", "load_spec", "parse_spec"]
+           "bundled_cases", "load_spec", "parse_spec", "toml_document"]
 
 NAME_PATTERN = re.compile(NAME_REGEX)
 #: Fraction of the available room used by the default half-widths ``d_0`` and ``d_T``.
@@ -673,17 +673,36 @@ def parse_spec(data: bytes | str) -> Spec:
         (the error names the field and the reason).
     """
     raw = data.encode("utf-8") if isinstance(data, str) else bytes(data)
+    spec = _validate(toml_document(raw))
+    warn_units(spec)
+    return _replace_hash(spec, hashlib.sha256(raw).hexdigest())
+
+
+def toml_document(raw: bytes) -> dict[str, Any]:
+    """The tables of a TOML file's bytes, as :mod:`tomllib` reads them.
+
+    Parameters
+    ----------
+    raw : bytes
+        The file's bytes (UTF-8).
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    SpecError
+        Field ``""``: not UTF-8, not TOML, or nested too deeply.
+    """
     try:
-        doc = tomllib.loads(raw.decode("utf-8"))
+        return tomllib.loads(raw.decode("utf-8"))
     except UnicodeDecodeError as exc:
         raise SpecError("", f"not UTF-8 text ({exc.reason} at byte {exc.start})") from None
     except tomllib.TOMLDecodeError as exc:
         raise SpecError("", f"malformed TOML: {exc}") from None
     except RecursionError:
         raise SpecError("", "malformed TOML: nested too deeply") from None
-    spec = _validate(doc)
-    warn_units(spec)
-    return _replace_hash(spec, hashlib.sha256(raw).hexdigest())
 
 
 def _as_document(value: Any) -> Any:

@@ -1,5 +1,5 @@
 """``stt-codegen bench arenas | tasks | drive | agv | step | scaling | covering | alpha | second-order |
-stl | overhead``: the benchmarks and studies of :mod:`stt_codegen_bench`."""
+stl | overhead | delay | fleet``: the benchmarks and studies of :mod:`stt_codegen_bench`."""
 
 from __future__ import annotations
 
@@ -178,9 +178,17 @@ def _cmd_delay(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_fleet(args: argparse.Namespace) -> int:
+    from .fleet_bench import format_fleet_report, run_fleet_bench
+    report = run_fleet_bench(args.count, args.seed, robots=args.robots, simulate=args.simulate)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_fleet_report(report))
+    return 0
+
+
 def configure_bench(bench: argparse.ArgumentParser) -> None:
     """Sub-subcommands ``bench arenas``, ``tasks``, ``drive``, ``agv``, ``step``, ``scaling``,
-    ``covering``, ``alpha``, ``second-order``, ``stl``, ``overhead`` and ``delay``.
+    ``covering``, ``alpha``, ``second-order``, ``stl``, ``overhead``, ``delay`` and ``fleet``.
 
     Parameters
     ----------
@@ -314,3 +322,18 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="runs of each measurement, the least CPU kept (default: 5)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_overhead)
+
+    p = sub.add_parser("fleet", help="prioritized fleet design on seeded warehouse floors: "
+                                     "certified fraction, design time beside the robots "
+                                     "designed alone (docs/fleets.md)")
+    p.add_argument("--robots", type=_positive_int, default=8, metavar="N",
+                   help="robots per floor (default: %(default)s)")
+    p.add_argument("--count", type=_positive_int, default=5, help="number of floors "
+                                                                  "(default: %(default)s)")
+    p.add_argument("--seed", type=_non_negative_int, default=0,
+                   help="floor seed (default: 0)")
+    p.add_argument("--simulate", action="store_true",
+                   help="also run every robot's generated C in closed loop (the closest "
+                        "approach)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_fleet)

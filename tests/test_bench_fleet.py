@@ -1,0 +1,44 @@
+"""``stt-codegen bench fleet`` (docs/fleets.md): seeded warehouse floors for fleets."""
+
+from __future__ import annotations
+
+import pytest
+
+import stt_codegen as stt
+from stt_codegen.errors import SpecError
+from stt_codegen_bench.fleet_bench import fleet_floor, format_fleet_report, run_fleet_bench
+
+
+@pytest.mark.parametrize("robots", [1, 8, 32])
+def test_floors_are_seeded_fleets_with_distinct_docks(robots):
+    assert fleet_floor(0, 3, robots) == fleet_floor(0, 3, robots)
+    assert fleet_floor(0, 4, robots) != fleet_floor(0, 3, robots)
+    assert fleet_floor(1, 3, robots) != fleet_floor(0, 3, robots)
+    doc = fleet_floor(2, 0, robots)
+    fleet = stt.FleetSpec.from_dict(doc)
+    assert len(fleet.robots) == robots
+    docks = [tuple(r["initial"]["lower"]) for r in doc["robots"]]
+    docks += [tuple(r["target"]["lower"]) for r in doc["robots"]]
+    assert len(set(docks)) == 2 * robots
+    kinds = [r.spec.variant for r in fleet.robots]
+    assert kinds.count("look-ahead") == robots // 4
+
+
+def test_too_many_robots_or_floors_below_one_are_refused():
+    with pytest.raises(SpecError) as raised:
+        fleet_floor(0, 0, 0)
+    assert raised.value.field == "robots"
+    with pytest.raises(SpecError) as raised:
+        run_fleet_bench(0, 0)
+    assert raised.value.field == "count"
+
+
+@pytest.mark.slow
+def test_a_small_floor_runs_and_reports():
+    report = run_fleet_bench(1, 0, robots=2, simulate=True)
+    (floor,) = report["floors"]
+    assert floor["fleet_s"] > 0 and floor["solo_s"] > 0
+    if floor["certified"]:
+        assert floor["margin"] > 0 and floor["closest"] >= floor["margin"] - 1e-9
+    text = format_fleet_report(report)
+    assert "certified" in text and "robots alone" in text
