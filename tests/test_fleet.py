@@ -110,6 +110,10 @@ def test_tube_obstacles_cover_the_tube_grown_by_both_reaches():
     fleet = stt.FleetSpec.from_dict(TWO)
     design = stt.design_tube(fleet.robots[0].spec)
     tube = enclosed(design)
+    enc = tube.enclosure         # a partition of [0, inf), as the pair certificate needs
+    assert enc.t_start[0] == 0.0 and enc.t_end[-1] == np.inf
+    assert np.array_equal(enc.t_end[:-1], enc.t_start[1:])
+    assert np.all(enc.t_end[:-1] - enc.t_start[:-1] <= 0.25 + 1e-9)
     boxes = tube_obstacles(tube, 0.4, (0, 1), 10)
     assert [b.source for b in boxes] == list(range(10, 10 + len(boxes)))
     assert boxes[-1].active[1] == np.inf and boxes[0].active[0] == 0.0

@@ -249,12 +249,12 @@ def _against(robot: FleetRobot, placed: Placed) -> Spec:
             try:
                 check_moving(box, other.name, spec.initial_set, spec.target_set,
                              spec.prescribed_time)
-            except SpecError as exc:
+            except SpecError as exc:       # "meets the initial set at t = 0", ...
+                reason = exc.reason.replace("the ", f"{robot.name}'s ", 1)
                 raise DesignError(
                     f"robots {other.name} and {robot.name} conflict: {other.name}'s tube, "
-                    f"grown by both radii, {exc.reason.replace('the ', robot.name + chr(39) + 's ', 1)} "
-                    f"(its box on [{box.active[0]:.4f}, {box.active[1]:.4f}] s)",
-                    kind=FailureKind.FLEET) from None
+                    f"grown by both radii, {reason} (its box on [{box.active[0]:.4f}, "
+                    f"{box.active[1]:.4f}] s)", kind=FailureKind.FLEET) from None
         extra.extend(boxes)
     return replace(spec, moving_obstacles=spec.moving_obstacles + tuple(extra))
 
