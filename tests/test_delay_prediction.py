@@ -269,3 +269,39 @@ def test_the_generated_predict_keeps_misra_clean(tmp_path, path, precision) -> N
         if check == "unusedFunction":
             unused.add(re.match(rf"^int {prefix}_(\w+)\(", text).group(1))
     assert "predict" in unused                  # it is there, and clean
+
+
+def _office_at_50_hz(tmp_path, extra: str) -> Path:
+    """The bundled office-base at 50 Hz with a 20 ms delay (and ``extra`` in
+    [controller])."""
+    text = (Path(stt.__file__).parent / "cases" / "office-base.toml").read_text()
+    text = re.sub(r"rate_hz = [0-9.]+", "rate_hz = 50.0", text)
+    text = text.replace("[controller]\n", f"[controller]\ndelay = 0.02\n{extra}")
+    path = tmp_path / "office50.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.slow
+def test_the_bundled_base_at_50_hz_with_a_period_of_delay_names_what_works(tmp_path):
+    """office-base at 50 Hz is refused without delay (the held command turns too far);
+    with a 20 ms delay compensated it is refused naming the prescribed_time that is then
+    certified, and whose closed loop keeps the tube; with the plain law the refusal names
+    both."""
+    path = _office_at_50_hz(tmp_path, "compensate_delay = true\n")
+    with pytest.raises(stt.DesignError) as refused:
+        stt.design_tube(stt.load_spec(path))
+    later = refused.value.advice["prescribed_time"]
+    assert f"prescribed_time = {later:g} s is certified" in str(refused.value)
+    text = re.sub(r"prescribed_time = [0-9.]+", f"prescribed_time = {later!r}",
+                  path.read_text(), count=1)
+    path.write_text(text)
+    design = stt.design_tube(stt.load_spec(path))
+    run = stt.simulate(design, backend="reference")
+    assert run.satisfied and run.stayed_in_tube
+    assert set(run.trajectory.status.tolist()) == {int(Status.OK)}
+    plain = _office_at_50_hz(tmp_path, "")
+    with pytest.raises(stt.DesignError) as refused:
+        stt.design_tube(stt.load_spec(plain))
+    assert refused.value.advice == {"controller.compensate_delay": True,
+                                    "prescribed_time": later}

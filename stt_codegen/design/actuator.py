@@ -38,12 +38,12 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
-from ..errors import DesignError, SpecError
+from ..errors import DesignError, SpecError, number_text
 from ..progress import report, reporting
 from ..spec.loader import Spec
 from ..spec.variants import variant_of
 from ..tube.parameters import CRUISE
-from .grid import grid_index, grid_value, smallest_passing
+from .grid import MAX_TIME_FACTOR, grid_index, grid_value, smallest_passing
 from .failures import FailureKind, advice_wanted, without_advice
 from .certificate.actuator import prove_input_bound
 from .input_bound import InputProof
@@ -51,10 +51,8 @@ from .result import METHOD_PAPER, METHOD_VIA, Design
 from .samples import HORIZON_FACTOR, STEP_BUDGET
 from .windows import SHARPNESS_LADDER
 
-__all__ = ["MAX_TIME_FACTOR", "design_within_bound", "law13_input_proof"]
+__all__ = ["design_within_bound", "law13_input_proof"]
 
-#: The ``prescribed_time`` search tries up to this many times the spec's ``t_c``.
-MAX_TIME_FACTOR = 16.0
 #: A longer ``t_c`` must lower the best peak-to-bound ratio by at least this factor, or the
 #: search stops: the peak no longer falls with the tube's speed (the disturbance and drift
 #: bounds alone ask for it).
@@ -274,14 +272,26 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     unit = f" {spec.input_unit}" if spec.input_unit else ""
     if not proved:
         reasons = "; ".join(f"{c.label}: {c.proof.reason}" for c in tried)
+        named = name_rate and advice_wanted() and bool(tried)
         rate = (_certified_rate(spec, tried[0].design.tube, design_free, prove)
-                if tried and name_rate and advice_wanted() else None)
+                if named else None)
+        later = None
+        if named and rate is None and not (spec.tasks or spec.moving_obstacles
+                                           or spec.target_any_of):
+            # no rate holds (a delay no faster rate can hold, say): a slower tube asks
+            # smaller commands; name the prescribed_time at which the whole design holds
+            from .deadline import certified_time
+            later = certified_time(spec, lambda trial: design_within_bound(
+                trial, design_free, prove, name_rate=False))
         raise DesignError(
             f"no bound on {law} can be proved for actuator.input_bound: the "
             f"sampled-data check fails for every design tried ({reasons})"
-            + (f"; controller.rate_hz = {rate:g} is certified" if rate is not None else ""),
+            + (f"; controller.rate_hz = {rate:g} is certified" if rate is not None else "")
+            + (f"; prescribed_time = {number_text(later)} s is certified"
+               if later is not None else ""),
             kind=FailureKind.INPUT_BOUND, tried=tried[0].design.tube if tried else None,
-            advice={} if rate is None else {"controller.rate_hz": rate})
+            advice=({"controller.rate_hz": rate} if rate is not None else
+                    {"prescribed_time": later} if later is not None else {}))
     best = min(proved, key=lambda c: c.proof.ratio(bound))
     worst = max(range(len(bound)), key=lambda i: best.proof.peak[i] / bound[i])
     needs = ", ".join(f"{_round_up(v):g}" for v in best.proof.peak)

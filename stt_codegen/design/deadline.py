@@ -3,7 +3,7 @@
 When the tube moves too fast for the controller's rate (the certificate's
 ``SAMPLING_RATE`` or ``NON_EMPTY`` property, or the cascade's stage at no rate), a later
 deadline is the knob that helps whatever the hardware: the search doubles ``t_c`` up to
-:data:`~.actuator.MAX_TIME_FACTOR` times it, then bisects :data:`BISECTIONS` times on the
+:data:`~.grid.MAX_TIME_FACTOR` times it, then bisects :data:`BISECTIONS` times on the
 two-digit grid (:mod:`.grid`), and names the time at which the design search certified the
 spec (the smallest it found, within about an eighth of the doubling).
 Specs whose times are absolute (timed tasks, moving obstacles, ``[target] any_of``) are
@@ -20,12 +20,11 @@ from dataclasses import replace
 
 from ..errors import DesignError, number_text
 from ..spec.loader import Spec
-from .actuator import MAX_TIME_FACTOR
 from .failures import FailureKind, without_advice
-from .grid import grid_index, grid_value
+from .grid import MAX_TIME_FACTOR, grid_index, grid_value
 from .result import Design
 
-__all__ = ["BISECTIONS", "SLOWER_HELPS", "deadline_refusal"]
+__all__ = ["BISECTIONS", "SLOWER_HELPS", "certified_time", "deadline_refusal"]
 
 #: The failures a later deadline (a slower tube) cures.
 SLOWER_HELPS = (FailureKind.SAMPLING_RATE, FailureKind.NON_EMPTY)
@@ -60,7 +59,32 @@ def deadline_refusal(spec: Spec, error: DesignError,
     if (error.kind not in SLOWER_HELPS or spec.tasks or spec.moving_obstacles
             or spec.target_any_of or "controller.delay" in error.advice):
         return error
+    time = certified_time(spec, search)
+    if time is None:
+        return error
+    return DesignError(f"{error}; prescribed_time = {number_text(time)} s is certified",
+                       kind=error.kind, tried=error.tried,
+                       advice={**error.advice, "prescribed_time": time})
 
+
+def certified_time(spec: Spec, search: Callable[[Spec], Design]) -> float | None:
+    """The smallest ``prescribed_time`` above the spec's that ``search`` certifies, on the
+    two-digit grid: doubling up to :data:`~.grid.MAX_TIME_FACTOR` times ``t_c``, then
+    :data:`BISECTIONS` bisections (each trial a design, its advice off).
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec refused at its ``prescribed_time``.
+    search : callable
+        ``search(spec) -> Design``, raising :class:`DesignError` when it refuses.
+
+    Returns
+    -------
+    float or None
+        Seconds, a time ``search`` certified; ``None`` when none up to ``MAX_TIME_FACTOR
+        t_c`` is.
+    """
     def passes(index: int) -> bool:
         try:
             with without_advice():            # the verdict only
@@ -78,13 +102,10 @@ def deadline_refusal(spec: Spec, error: DesignError,
             break
         low, factor = index, 2.0 * factor
     if high is None:
-        return error
+        return None
     for _ in range(BISECTIONS):               # within an eighth of the doubling, cheaply
         if high - low <= 1:
             break
         mid = (low + high) // 2
         low, high = (low, mid) if passes(mid) else (mid, high)
-    time = grid_value(high)
-    return DesignError(f"{error}; prescribed_time = {number_text(time)} s is certified",
-                       kind=error.kind, tried=error.tried,
-                       advice={**error.advice, "prescribed_time": time})
+    return grid_value(high)

@@ -11,7 +11,10 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-__all__ = ["grid_index", "grid_value", "smallest_passing"]
+__all__ = ["MAX_TIME_FACTOR", "grid_index", "grid_value", "smallest_passing"]
+
+#: The ``prescribed_time`` search tries up to this many times the spec's ``t_c``.
+MAX_TIME_FACTOR = 16.0
 
 
 def grid_index(value: float) -> int:

@@ -73,6 +73,37 @@ def _followable_delay(design: Design, spec: Spec) -> float | None:
         return largest_passing(passes, delay_room(tube.rate_hz, spec))
 
 
+def _can_compensate(spec: Spec) -> bool:
+    """Whether ``[controller] compensate_delay`` could take the spec's timing."""
+    return (variant_of(spec).predicts_delay and not spec.compensate_delay
+            and spec.jitter == 0.0 and 0.0 < spec.delay * spec.rate_hz <= 1.0)
+
+
+def _compensated_advice(spec: Spec, search: Callable[[Spec], Design],
+                        refused: DesignError) -> DesignError:
+    """``refused``, naming ``controller.compensate_delay = true`` and what the refusal of the
+    compensated spec names (its advice, each field designed), when that spec is certified
+    with them; else ``refused`` itself."""
+    if not _can_compensate(spec):
+        return refused
+    compensated = replace(spec, compensate_delay=True)
+    try:
+        _certified(compensated, search)
+        advice: dict = {}
+    except DesignError as failure:
+        advice = dict(failure.advice)
+        if not advice:
+            return refused
+    units = {"prescribed_time": " s", "controller.delay": " s", "plant.axle_offset": " m"}
+    words = " and ".join(f"{name} = " + ("true" if value is True else
+                                          f"{number_text(value)}{units.get(name, '')}")
+                         for name, value in advice.items())
+    return DesignError(f"{refused}; controller.compensate_delay = true"
+                       + (f" with {words}" if words else "") + " is certified",
+                       kind=refused.kind, tried=getattr(refused, "tried", None),
+                       advice={"controller.compensate_delay": True, **advice})
+
+
 def design_with_timing(spec: Spec, search: Callable[[Spec], Design]) -> Design:
     """The design of a spec with ``[controller] delay`` or ``jitter`` whose sampled-data
     proof holds with them.
@@ -112,7 +143,9 @@ def design_with_timing(spec: Spec, search: Callable[[Spec], Design]) -> Design:
     try:
         plain = search(untimed)
     except DesignError:
-        raise refused from None                  # the timing is not what fails
+        # the design fails without the timing too: what the predicted law needs, if it can
+        # take the delay, else the refusal as it is
+        raise _compensated_advice(spec, search, refused) from None
     trials = []
     delay = _followable_delay(plain, spec)
     if delay is not None and 0.0 < delay < spec.delay:
@@ -125,8 +158,7 @@ def design_with_timing(spec: Spec, search: Callable[[Spec], Design]) -> Design:
         trials.append((replace(spec, rate_hz=rate), f"controller.rate_hz = "
                        f"{number_text(rate)} is certified with {_timing_words(spec)}",
                        ("controller.rate_hz", rate)))
-    if (variant_of(spec).predicts_delay and not spec.compensate_delay and spec.jitter == 0.0
-            and spec.delay * spec.rate_hz <= 1.0):
+    if _can_compensate(spec):
         trials.insert(0, (replace(spec, compensate_delay=True),
                           f"controller.compensate_delay = true is certified with "
                           f"{_timing_words(spec)} at {number_text(spec.rate_hz)} Hz",
