@@ -154,6 +154,7 @@ def test_generated_code_is_the_same_for_any_number_of_circumvents():
     class _Spec:
         name, c_name, source_hash = "synthetic", "synthetic", "0" * 64
         delay = jitter = 0.0
+        compensate_delay = False
 
     def code(m):
         files = generate_files(_Spec(), synthetic_design(m, 2, windows="sparse"),

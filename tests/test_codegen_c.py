@@ -207,6 +207,7 @@ def test_strict_build_for_any_number_of_circumvents(obstacles, tmp_path):
     class _Spec:
         name, c_name, source_hash = "synthetic", "synthetic", "0" * 64
         delay = jitter = 0.0
+        compensate_delay = False
 
     design = synthetic_design(obstacles, 2, windows="open")
     for precision in ("double", "single"):
