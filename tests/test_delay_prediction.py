@@ -53,7 +53,8 @@ def _check(design, delay: float, compensate: bool):
 
 # ---------------------------------------------------------------------- the spec's rules
 @pytest.mark.parametrize("source, edit, field", [
-    ("second-order-s1", "delay = 0.0005\ncompensate_delay = true", "controller.compensate_delay"),
+    ("second-order-s1", "delay = 0.0005\njitter = 0.0001\ncompensate_delay = true",
+     "controller.jitter"),
     ("kobuki", "compensate_delay = true", "controller.compensate_delay"),
     ("kobuki", "delay = 0.02\njitter = 0.001\ncompensate_delay = true", "controller.jitter"),
     ("kobuki", "delay = 0.03\ncompensate_delay = true", "controller.delay"),

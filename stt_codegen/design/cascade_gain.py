@@ -38,7 +38,7 @@ import numpy as np
 
 from ..progress import report as report_progress, reporting
 from ..rounding import round_up
-from ..spec.variants import require_variant
+from ..spec.variants import require_variant, variant_of
 from ..tube import reference
 from ..tube.parameters import TubeDesign
 from ..tube.second_stage import SecondStage
@@ -281,6 +281,18 @@ def _largest_stage_delay(tube: TubeDesign, spec, min_width: float) -> float | No
     return found if found else None
 
 
+def _compensated_stage(tube: TubeDesign, spec, min_width: float) -> bool:
+    """Whether ``[controller] compensate_delay`` would make some shape certified on
+    ``tube`` at its rate with the spec's delay, bound and no jitter (False when the spec
+    compensates already or its timing cannot be compensated)."""
+    if (spec.compensate_delay or spec.delay <= 0.0 or spec.jitter != 0.0
+            or spec.delay * tube.rate_hz > 1.0 or not variant_of(spec).predicts_delay):
+        return False
+    trial = dataclasses.replace(spec, compensate_delay=True)
+    with reporting(None, (0.0, 0.0)):              # no progress events of its own
+        return certified_stage(tube, trial, min_width, spec.input_bound)[0] is not None
+
+
 def _rate_certified(tube: TubeDesign, spec, rate_hz: float) -> bool:
     """Whether some shape is certified at ``rate_hz`` (the tube certified again there);
     not where the period is shorter than ``[controller] delay + 2 jitter``."""
@@ -418,16 +430,20 @@ def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage
             + "; design_tube slows the tube or names the prescribed_time that works "
             "(docs/second-order.md, 'Force limits')", kind=FailureKind.INPUT_BOUND,
             tried=tube)
-    rate = lowest_certified_rate(tube, spec, passes_at_rate=False) if advice_wanted() else None
+    compensated = _compensated_stage(tube, spec, min_width) if advice_wanted() else False
+    rate = (lowest_certified_rate(tube, spec, passes_at_rate=False)
+            if advice_wanted() and not compensated else None)
     delay = (_largest_stage_delay(tube, spec, min_width)
-             if spec.delay > 0.0 and advice_wanted() else None)
+             if spec.delay > 0.0 and advice_wanted() and not compensated else None)
     fastest = fastest_searched_rate(tube.rate_hz, spec)
     capped = (f" (a shorter period cannot hold controller.delay + 2 jitter = "
               f"{spec.delay + 2.0 * spec.jitter:g} s)"
               if fastest < tube.rate_hz * RATE_SEARCH_FACTOR else "")
     knobs = "a longer prescribed_time (a slower tube)" + (
         ", a shorter controller.delay" if spec.delay > 0.0 else "")
-    need = (f"controller.rate_hz = {rate:g} is certified" if rate is not None else
+    need = (f"controller.compensate_delay = true is certified with controller.delay = "
+            f"{spec.delay:g} s at {tube.rate_hz:g} Hz" if compensated else
+            f"controller.rate_hz = {rate:g} is certified" if rate is not None else
             f"no rate up to {fastest:g} Hz is certified{capped}; {knobs} or a narrower "
             "assumptions.input_gain may be")
     if delay is not None:
@@ -439,5 +455,7 @@ def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage
                       f"tried ({len(SHAPES)} shapes; with the first: {first}); {need} "
                       "(docs/second-order.md, 'The sampled cascade')",
                       kind=FailureKind.SAMPLING_RATE, tried=tube,
-                      advice={**({} if rate is None else {"controller.rate_hz": rate}),
+                      advice={**({"controller.compensate_delay": True} if compensated
+                                 else {}),
+                              **({} if rate is None else {"controller.rate_hz": rate}),
                               **({} if delay is None else {"controller.delay": delay})})

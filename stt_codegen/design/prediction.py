@@ -16,8 +16,10 @@ __all__ = ["delay_predictor", "mid_gain"]
 
 
 def mid_gain(spec: Spec) -> float:
-    """``g_mid = (g_min + g_max) / 2`` of the spec's ``[assumptions] input_gain``: the gain
-    the prediction moves the state with.
+    """``g_mid = (g_min + g_max) / 2`` of the input gain range of the plant class the
+    variant's certificate covers (its ``input_gain`` role: ``[assumptions] input_gain``,
+    the second-order plant's for the cascade): the gain the prediction moves the state
+    with.
 
     Parameters
     ----------
@@ -34,8 +36,8 @@ def mid_gain(spec: Spec) -> float:
     >>> mid_gain(stt.load_spec("omnirobot-s1")) > 0.0
     True
     """
-    low, high = spec.assumptions.input_gain
-    return 0.5 * (float(low) + float(high))
+    low, high = variant_of(spec).entry("input_gain")(spec)
+    return 0.5 * (low + high)
 
 
 def delay_predictor(spec: Spec, tube: TubeDesign, stage) -> ca.Function | None:

@@ -73,8 +73,10 @@ ROLES: Mapping[str, str] = MappingProxyType({
     "output_limits": "(design) -> OutputLimits of its command without [actuator] (the "
                      "proved peak and the clamp's bound), or None: no warning",
     "predictor": "(tube, stage, delay, mid_gain) -> casadi.Function (x, u_held) -> x_hat, "
-                 "the state law (13) is evaluated at with [controller] compensate_delay, or "
-                 "None (the variant has none: predicts_delay is False)",
+                 "the state the variant's law is evaluated at with [controller] "
+                 "compensate_delay",
+    "input_gain": "(spec) -> (g_min, g_max) of the plant class its certificate covers (the "
+                  "prediction moves the state at their middle)",
 })
 
 
@@ -213,7 +215,8 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                plant_within=_P + "verification.plant_within:first_order_within",
                input_proof=_P + "design.actuator:law13_input_proof",
                output_limits=_P + "design.output_bound:no_output_limits",
-               predictor=_P + "tube.variant_steps:law13_predictor"),
+               predictor=_P + "tube.variant_steps:law13_predictor",
+               input_gain=_P + "spec.input_gains:declared_input_gain"),
         predicts_delay=True),
     "cascade": ControllerVariant(
         "cascade", "a second-order plant", "the cascade's input u", 2,
@@ -243,8 +246,9 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                plant_within=_P + "verification.plant_within:cascade_within",
                input_proof=_P + "design.cascade_gain:cascade_design_proof",
                output_limits=_P + "design.output_bound:cascade_output_limits",
-               predictor=_P + "tube.variant_steps:no_predictor"),
-        MappingProxyType({"cascade": True}), timing_in_stage=True),
+               predictor=_P + "tube.cascade:cascade_predictor",
+               input_gain=_P + "spec.input_gains:cascade_input_gain"),
+        MappingProxyType({"cascade": True}), timing_in_stage=True, predicts_delay=True),
     "look-ahead": ControllerVariant(
         "look-ahead", "a differential-drive base", "the base's command (v, omega)", 1, "",
         _roles(plant_terms=_P + "spec.loader:look_ahead_plant_terms",
@@ -272,7 +276,8 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                plant_within=_P + "verification.plant_within:first_order_within",
                input_proof=_P + "design.look_ahead:look_ahead_design_proof",
                output_limits=_P + "design.output_bound:look_ahead_output_limits",
-               predictor=_P + "tube.look_ahead:look_ahead_predictor"),
+               predictor=_P + "tube.look_ahead:look_ahead_predictor",
+               input_gain=_P + "spec.input_gains:declared_input_gain"),
         predicts_delay=True),
 })
 assert tuple(CONTROLLER_VARIANTS) == VARIANTS

@@ -29,7 +29,7 @@ from .model import adaptive_tube, conflict_and_trigger, implicit_alpha_update
 from .parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .second_stage import SecondStage
 
-__all__ = ["CASCADE_OUTPUTS", "cascade_step", "velocity_law", "velocity_transform",
+__all__ = ["CASCADE_OUTPUTS", "cascade_predictor", "cascade_step", "velocity_law", "velocity_transform",
            "velocity_tube"]
 
 #: The outputs of :func:`cascade_step`, in order (``within_bound`` follows them with an
@@ -194,3 +194,45 @@ def cascade_step(design: TubeDesign, stage: SecondStage) -> ca.Function:
         outputs.append(within)
     return ca.Function("cascade_step", [x, t, dt, alpha], outputs,
                        ["x", "t", "dt", "alpha"], names)
+
+
+def cascade_predictor(design: TubeDesign, stage: SecondStage, delay: float,
+                      mid_gain: float) -> ca.Function:
+    """The state the cascade law is evaluated at with ``[controller] compensate_delay``:
+    ``x = [x1; x2]`` read at ``t_k``, moved over the delay by the force ``u_held`` that acts
+    until then, at the middle of the plant class's input gain (docs/second-order.md,
+    "Compensating a delay", eq. (P0'')).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The position tube (its dimension ``n``).
+    stage : SecondStage
+        Not read (the prediction is the plant's, not the law's).
+    delay : float
+        ``[controller] delay``, s.
+    mid_gain : float
+        ``g_mid = (g_min + g_max) / 2`` of the second-order plant's input gain.
+
+    Returns
+    -------
+    casadi.Function
+        ``predict(x, u_held) -> x_hat``: ``x`` (2n: m, then m/s), ``u_held`` (n, force
+        units, the command acting at ``t_k``); ``x_hat = [x1 + delay x2 + (delay^2 / 2)
+        g_mid u_held; x2 + delay g_mid u_held]`` (2n).
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("second-order-s1"))
+    >>> predict = cascade_predictor(design.tube, design.stage, 0.5, 2.0)
+    >>> x_hat = predict([0.0, 0.0, 1.0, 0.0], [0.0, 1.0]).full().ravel()
+    >>> [float(v) for v in x_hat]
+    [0.5, 0.25, 1.0, 1.0]
+    """
+    n = design.dimension
+    x, u_held = ca.SX.sym("x", 2 * n), ca.SX.sym("u_held", n)
+    push = float(delay * mid_gain) * u_held                 # the velocity's change
+    x_hat = ca.vertcat(x[:n] + float(delay) * x[n:] + (0.5 * float(delay)) * push,
+                       x[n:] + push)
+    return ca.Function("predict", [x, u_held], [x_hat], ["x", "u_held"], ["x_hat"])

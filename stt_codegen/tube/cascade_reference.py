@@ -18,7 +18,7 @@ from . import reference
 from .parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from .second_stage import SecondStage
 
-__all__ = ["cascade_step", "velocity_transform", "velocity_tube"]
+__all__ = ["cascade_step", "predicted_state", "velocity_transform", "velocity_tube"]
 
 Array = np.ndarray
 
@@ -119,3 +119,37 @@ def cascade_step(design: TubeDesign, stage: SecondStage, x, t, dt,
     # the reference's own clamp (numpy.clip), not the model's saturate piece
     u, within = reference.saturate(design, -stage.velocity_gain * xi * epsilon)
     return u, alpha_next, r, inside_position, inside_velocity, within
+
+
+def predicted_state(x, u_held, delay: float, mid_gain: float) -> Array:
+    """The cascade's prediction over the delay (docs/second-order.md, eq. (P0'')): the
+    double integrator ``x1_dot = x2``, ``x2_dot = g_mid u_held`` integrated exactly over
+    ``delay`` from ``x = [x1, x2]``.
+
+    Parameters
+    ----------
+    x : array_like, shape (N, 2n)
+        Positions then velocities, read at ``t_k``.
+    u_held : array_like, shape (N, n)
+        The force acting until ``t_k + delay``.
+    delay : float
+        s.
+    mid_gain : float
+        The middle of the input gain range.
+
+    Returns
+    -------
+    ndarray, shape (N, 2n)
+        ``x_hat``.
+
+    Examples
+    --------
+    >>> predicted_state([[0.0, 1.0]], [[1.0]], 0.5, 2.0).tolist()
+    [[0.75, 2.0]]
+    """
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    u_held = np.atleast_2d(np.asarray(u_held, dtype=float))
+    n = u_held.shape[1]
+    acceleration = mid_gain * u_held
+    x1 = x[:, :n] + delay * x[:, n:] + 0.5 * delay**2 * acceleration
+    return np.hstack([x1, x[:, n:] + delay * acceleration])

@@ -15,7 +15,7 @@ from .look_ahead import LookAhead
 from .parameters import Status, TubeDesign, step_status
 
 __all__ = ["cascade_status", "law13_casadi_step", "law13_oracle_step", "law13_predictor",
-           "law13_status", "look_ahead_oracle_step", "no_predictor"]
+           "law13_status", "look_ahead_oracle_step"]
 
 
 def law13_casadi_step(design: TubeDesign, stage: None) -> ca.Function:
@@ -187,19 +187,3 @@ def law13_predictor(design: TubeDesign, stage: None, delay: float,
     x, u_held = ca.SX.sym("x", n), ca.SX.sym("u_held", n)
     return ca.Function("predict", [x, u_held], [x + float(delay * mid_gain) * u_held],
                        ["x", "u_held"], ["x_hat"])
-
-
-def no_predictor(design: TubeDesign, stage, delay: float, mid_gain: float) -> None:
-    """The cascade's ``predictor`` role: none (``predicts_delay`` is False; the loader
-    refuses ``[controller] compensate_delay`` for it).
-
-    Parameters
-    ----------
-    design, stage, delay, mid_gain
-        As :func:`law13_predictor`.
-
-    Returns
-    -------
-    None
-    """
-    return None

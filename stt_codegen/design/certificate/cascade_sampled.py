@@ -35,7 +35,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .enclosures import enclose_tube
+from .enclosures import enclose_later, enclose_tube
 from ..samples import TubeSamples, sample_tube
 from ...progress import report
 from ...spec.loader import Spec
@@ -46,10 +46,12 @@ from ...tube import reference
 from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from ...tube.second_stage import SecondStage
 from .sampled import DELAY_HALVINGS, largest_passing, worst_near
-from .sampled_axis import axis_interval, peak, phi_scalar, phi_slope_scalar
+from .sampled_axis import (axis_interval, peak, peak_scalar, phi_scalar,
+                           phi_slope_scalar)
 
 __all__ = ["CascadeClass", "CascadeCheck", "cascade_check_of", "cascade_class", "model_within_class",
-           "certify_stage", "check_cascade_sampled", "largest_cascade_delay",
+           "certify_stage", "check_cascade_predicted", "check_cascade_sampled",
+           "largest_cascade_delay",
            "step_velocity_change", "virtual_velocity_change"]
 
 #: Relative safety factor on the closed-form ``rho2(t_{k+1})`` the path is judged against
@@ -294,7 +296,7 @@ def _union(intervals) -> tuple[float, float, float, float]:
 
 def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: SecondStage,
                           plants: CascadeClass, initial_velocity, *, delay: float = 0.0,
-                          jitter: float = 0.0) -> CascadeCheck:
+                          jitter: float = 0.0, compensate: bool = False) -> CascadeCheck:
     """Prove that the sampled cascade keeps ``|e1| < 1`` and ``|e2| < 1`` at and between
     samples for every plant of ``plants`` (module docstring; docs/second-order.md).
 
@@ -320,6 +322,9 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
         0``; the controller is called with the nominal ``t = k h``. ``delay + 2 jitter``
         must not exceed ``h``. With both 0 (the default) the check is the one without
         timing, float for float.
+    compensate : bool
+        ``[controller] compensate_delay``: the law at the state predicted over ``delay``
+        (:func:`check_cascade_predicted`, which this returns when ``delay > 0``).
 
     Returns
     -------
@@ -328,8 +333,14 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     Raises
     ------
     ValueError
-        ``delay`` or ``jitter`` negative, or ``delay + 2 jitter > h``.
+        ``delay`` or ``jitter`` negative, or ``delay + 2 jitter > h``; with
+        ``compensate``, a ``jitter`` other than 0.
     """
+    if compensate and delay > 0.0:
+        if jitter != 0.0:
+            raise ValueError(f"jitter = {jitter!r} s must be 0 with compensate")
+        return check_cascade_predicted(design, samples, stage, plants, initial_velocity,
+                                       delay=delay)
     n = design.dimension
     h = 1.0 / design.rate_hz
     if delay < 0.0 or jitter < 0.0 or delay + 2.0 * jitter > h * (1.0 + 1e-12):
@@ -539,6 +550,279 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     return result(True, "")
 
 
+def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: SecondStage,
+                            plants: CascadeClass, initial_velocity, *,
+                            delay: float) -> CascadeCheck:
+    """Prove that the cascade with the delay-compensating prediction keeps ``|e1| < 1`` and
+    ``|e2| < 1`` at every instant of the horizon for every plant of ``plants``.
+
+    The loop (``[controller] compensate_delay``) reads ``x(s_k)`` at ``s_k = k h``,
+    predicts the state at ``a_k = s_k + delay`` from the force ``u_{k-1}`` acting until
+    then (eq. (P0''), :func:`~stt_codegen.tube.cascade.cascade_predictor`), computes
+    ``u_k`` by the cascade law at ``(x_hat_k, t_k)`` and applies it on ``[a_k,
+    a_{k+1}]``. The argument (docs/second-order.md, "Compensating a delay", (C1)-(C4)):
+    the prediction misses ``x(a_k)`` by ``eta2 <= delay A'`` in velocity and ``eta1 <=
+    (delay^2 / 2) A'`` in position, ``A'`` the bound of ``|(g - g_mid) u_{k-1} + f + w|``
+    (C1); on the actuation interval both stages are the plain check's, started at the
+    predicted boxes, with the misses added to the position and the velocity error and
+    the change of ``r`` taken from ``(x1_hat_k, t_k)`` (C2, C3), judged against the tubes
+    over intervals ``k`` and ``k + 1``; the next predicted boxes are the true state's at
+    ``a_{k+1}`` widened by the next misses (C4). The predicted state is required inside
+    both tubes at every sample.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The position tube (``rate_hz``, ``initial_state``).
+    samples : TubeSamples
+        The deployed tube at ``design``'s rate.
+    stage : SecondStage
+        ``k1``, ``k2``, ``rho2`` to check.
+    plants : CascadeClass
+    initial_velocity : sequence of float, length n
+        ``x2(0)``.
+    delay : float
+        The computation delay, s, in ``(0, h]``.
+
+    Returns
+    -------
+    CascadeCheck
+        ``max_abs_e1``, ``max_abs_e2``: the bounds at the samples of the predicted state's
+        errors; ``peak_input``: of ``|u_k|``; ``peak_velocity``: of ``|x2|`` on the
+        actuation intervals.
+
+    Raises
+    ------
+    ValueError
+        ``delay`` outside ``(0, h]``.
+    """
+    n = design.dimension
+    h = 1.0 / design.rate_hz
+    if not 0.0 < delay <= h * (1.0 + 1e-12):
+        raise ValueError(f"delay = {delay!r} s must lie in (0, dt = {h!r}] s")
+    k1, k2 = stage.position_gain, stage.velocity_gain
+    g_min, g_max, cpl = plants.g_min, plants.g_max, plants.coupling
+    f0, f1, w_amp = plants.drift_bound, plants.drift_slope, plants.disturbance_bound
+    deviation = 0.5 * (g_max - g_min)                     # |g_ii - g_mid|
+    g_mid = 0.5 * (g_max + g_min)
+    share = 1.0 - min(delay / h, 1.0)          # of a period x_hat's step is uncertain
+    mix_lo = share * g_min + (1.0 - share) * g_mid
+    mix_hi = share * g_max + (1.0 - share) * g_mid
+    vbound = plants.velocity_bound
+    data = {"rate_hz": design.rate_hz, "position_gain": k1, "velocity_gain": k2,
+            "width_start": list(stage.width_start), "width_floor": list(stage.width_floor),
+            "decay": stage.decay, "class": plants.words(), "delay": delay, "jitter": 0.0,
+            "compensate_delay": True}
+    peak_u, peak_x2, peak_t = [0.0] * n, [0.0] * n, [0.0] * n
+    worst = {"position": math.inf, "velocity": math.inf, "least": math.inf, "t": 0.0,
+             "i": 0}
+    top = [0.0, 0.0]
+
+    def result(passed: bool, reason: str, t: float = 0.0, i: int = 0) -> CascadeCheck:
+        pm, vm = worst["position"], worst["velocity"]
+        data.update({"position_margin": pm, "velocity_margin": vm, "max_abs_e1": top[0],
+                     "max_abs_e2": top[1], "peak_input": list(peak_u),
+                     "peak_input_time": list(peak_t), "peak_velocity": list(peak_x2)})
+        return CascadeCheck(passed, reason, pm, vm, top[0], top[1], tuple(peak_u),
+                            tuple(peak_x2), worst["t"] if passed else t,
+                            worst["i"] if passed else i, data, tuple(peak_t))
+
+    def judged(room: float, vroom: float, t: float, i: int) -> None:
+        worst["position"] = min(worst["position"], room)
+        worst["velocity"] = min(worst["velocity"], vroom)
+        if min(room, vroom) < worst["least"]:
+            worst.update(least=min(room, vroom), t=t, i=i)
+
+    if not 0.0 < g_min <= g_max or h * f1 >= 1.0:
+        return result(False, "need 0 < g_min <= g_max and h F1 < 1")
+    if min(stage.width_floor) < GAMMA_D_MIN:
+        return result(False, f"rho2_inf is below GAMMA_D_MIN = {GAMMA_D_MIN:g}")
+    lo, hi = samples.gamma_lower, samples.gamma_upper
+    if (hi - lo).min() < GAMMA_D_MIN:
+        return result(False, f"the tube is narrower than GAMMA_D_MIN = {GAMMA_D_MIN:g}")
+    enc = enclose_tube(design, samples)
+    count = len(enc.t_start)
+    half, centre = 0.5 * (hi - lo), 0.5 * (hi + lo)
+    start, floor = np.array(stage.width_start), np.array(stage.width_floor)
+
+    def rho2_at(t: np.ndarray) -> np.ndarray:
+        return (start - floor)[None, :] * np.exp(-stage.decay * t[:, None]) + floor[None, :]
+
+    rho2 = rho2_at(samples.t).tolist()
+    # rho2 decreases: its least on [a_k, a_{k+1}] is at t_{k+1} + delay
+    late = rho2_at(samples.t[1:count + 1] + delay).tolist()
+    pull2_all = 2.0 * h * k2 / np.array(rho2[:count])
+    peak2 = peak(np.array(rho2[:count]) / (g_min * pull2_all)).tolist()
+    pull1 = (4.0 * h * k1 / (hi - lo)).tolist()
+    peak1 = peak(0.5 * (hi - lo) / (4.0 * h * k1 / (hi - lo))).tolist()
+    half_l, centre_l = half.tolist(), centre.tolist()
+    width_max_own = enc.upper_max - enc.lower_min
+    move_own = (enc.lower_max - enc.lower_min) + (enc.upper_max - enc.upper_min)
+    # over the actuation interval [t_k + delay, t_{k+1} + delay] (absolute units)
+    act = enclose_later(design, samples, delay, delay)
+    room_up, room_low = act.upper_min, act.lower_max
+    up_e = ((room_up - centre[:count]) / half[:count]).tolist()
+    low_e = ((room_low - centre[:count]) / half[:count]).tolist()
+    room_up, room_low = room_up.tolist(), room_low.tolist()
+    width_max_a = (act.upper_max - act.lower_min).tolist()
+    # r changes from (x1_hat_k, t_k) to (x1(t), t), t <= t_{k+1} + delay: the tube's span
+    # and widths over [t_k, t_{k+1} + delay]
+    whole = enclose_later(design, samples, 0.0, delay)
+    move_r = ((whole.lower_max - whole.lower_min) + (whole.upper_max - whole.upper_min)).tolist()
+    width_min_r = whole.width_min.tolist()
+    width_max_r = (whole.upper_max - whole.lower_min).tolist()
+    width_min, width_max, move = (enc.width_min.tolist(), width_max_own.tolist(),
+                                  move_own.tolist())
+
+    def r_of(e1: float, k: int, i: int) -> float:
+        return -(4.0 * k1 / (2.0 * half_l[k][i])) * phi_scalar(e1)
+
+    # (C0) before the first force acts: [0, delay], no force
+    x1_0 = [float(v) for v in design.initial_state]
+    x2_0 = [float(v) for v in initial_velocity]
+    edge0 = rho2_at(np.array([delay]))[0].tolist()
+    box1, box2, eta1, eta2 = [], [], [], []
+    for i in range(n):
+        speed = (abs(x2_0[i]) + delay * (f0 + w_amp)) / (1.0 - delay * f1)
+        peak_x2[i] = speed
+        if vbound is not None and speed >= vbound[i]:
+            return result(False, f"|x2_{i}| may reach {speed:.4g} on [0, {delay:.4g}] s, "
+                          f"beyond velocity_bound {vbound[i]:g}", 0.0, i)
+        accel = f0 + f1 * speed + w_amp
+        p_lo, p_hi = x1_0[i] - delay * speed, x1_0[i] + delay * speed
+        e1_0 = (x1_0[i] - centre_l[0][i]) / half_l[0][i]
+        room = min(float(enc.upper_min[0][i]) - p_hi,
+                   p_lo - float(enc.lower_max[0][i])) / half_l[0][i]
+        if room <= 0.0 or abs(e1_0) >= 1.0:
+            return result(False, f"the position may leave its tube in dimension {i} on "
+                          f"[0, {delay:.4g}] s, before the first force acts", 0.0, i)
+        gap = room * half_l[0][i]
+        dr = virtual_velocity_change(k1, 1.0, abs(e1_0),
+                                     max(1.0 - 2.0 * gap / width_max[0][i], abs(e1_0)),
+                                     delay * speed, move[0][i], width_min[0][i],
+                                     width_max[0][i])
+        z_0 = x2_0[i] - r_of(e1_0, 0, i)
+        vroom = 1.0 - (abs(z_0) + delay * accel + dr) / (edge0[i] * (1.0 - RHO_ROUNDING))
+        judged(room, vroom, 0.0, i)
+        if vroom <= 0.0:
+            return result(False, f"the velocity error may leave its tube in dimension {i} "
+                          f"on [0, {delay:.4g}] s, before the first force acts", 0.0, i)
+        # the prediction at s_0 = 0 (u_{-1} = 0) and its miss (C1)
+        e1_hat = (x1_0[i] + delay * x2_0[i] - centre_l[0][i]) / half_l[0][i]
+        if abs(e1_hat) >= 1.0:
+            return result(False, f"the predicted position leaves its tube in dimension {i} "
+                          "at t = 0", 0.0, i)
+        e2_hat = (x2_0[i] - r_of(e1_hat, 0, i)) / rho2[0][i]
+        box1.append([e1_hat, e1_hat])
+        box2.append([e2_hat, e2_hat])
+        eta2.append(delay * accel)
+        eta1.append(0.5 * delay * delay * accel)
+    every = max(1, count // PROGRESS_REPORTS)
+    for k in range(count):
+        t = float(samples.t[k])
+        if k % every == 0:
+            report("cascade certificate", k / count, "the predicted cascade's certificate: "
+                   f"t = {t:.3g} s of {samples.t[-1]:.3g} s")
+        reach1 = [max(-a, b) for a, b in box1]
+        reach2 = [max(-a, b) for a, b in box2]
+        top[0], top[1] = max(top[0], max(reach1)), max(top[1], max(reach2))
+        for name, reach in (("e1", reach1), ("e2", reach2)):
+            if max(reach) >= 1.0:
+                i = int(np.argmax(reach))
+                return result(False, f"|{name}_{i}| of the predicted state may reach "
+                              f"{max(reach):.6g} at t = {t:.4f} s (the check needs it inside "
+                              "its tube)", t, i)
+        rho_k, rho_n = rho2[k], rho2[k + 1]
+        u_abs = [2.0 * k2 / rho_k[i] * phi_scalar(reach2[i]) for i in range(n)]
+        u_sq = sum(v * v for v in u_abs)
+        next1, next2, next_eta1, next_eta2 = [], [], [], []
+        for i in range(n):
+            if u_abs[i] > peak_u[i]:
+                peak_u[i], peak_t[i] = u_abs[i], t
+            others = math.sqrt(max(u_sq - u_abs[i] ** 2, 0.0))
+            z_abs = reach2[i] * rho_k[i]
+            r_abs = 4.0 * k1 / (2.0 * half_l[k][i]) * phi_scalar(reach1[i])
+            force = g_max * u_abs[i] + cpl * others
+            # (C2) |x2| on [a_k, a_{k+1}]: from x2_hat = r_k + z_hat, the miss, the interval
+            speed = (r_abs + z_abs + eta2[i] + h * (force + f0 + w_amp)) / (1.0 - h * f1)
+            peak_x2[i] = max(peak_x2[i], speed)
+            if vbound is not None and speed >= vbound[i]:
+                return result(False, f"|x2_{i}| may reach {speed:.4g} on [{t + delay:.4f}, "
+                              f"{t + h + delay:.4f}] s, beyond velocity_bound {vbound[i]:g} "
+                              "(the drift bound is declared within it)", t, i)
+            drift = f0 + f1 * speed + w_amp
+            # (C2) the position stage: law (13) with g = 1 at x1_hat, x1(a_k) = x1_hat + miss
+            shift = h * (z_abs + eta2[i]) + 0.5 * h * h * (force + drift)
+            p_lo, p_hi, x_lo, x_hi = axis_interval(
+                box1[i][0], box1[i][1], centre_l[k][i], half_l[k][i], pull1[k][i], 1.0, 1.0,
+                peak1[k][i], shift)
+            p_lo, p_hi, x_lo, x_hi = p_lo - eta1[i], p_hi + eta1[i], x_lo - eta1[i], x_hi + eta1[i]
+            room = min(up_e[k][i] - (p_hi - centre_l[k][i]) / half_l[k][i],
+                       (p_lo - centre_l[k][i]) / half_l[k][i] - low_e[k][i])
+            if room <= 0.0:
+                judged(room, math.inf, t, i)
+                return result(False, f"the position may leave its tube in dimension {i} on "
+                              f"[{t + delay:.4f}, {t + h + delay:.4f}] s (the enclosure of x1 "
+                              f"reaches {-room:.3g} half-widths beyond its edge)", t, i)
+            gap = min(room_up[k][i] - p_hi, p_lo - room_low[k][i])
+            e1_path = max(1.0 - 2.0 * gap / width_max_a[k][i], reach1[i])
+            # (C3) |r(x1(t), t) - r(x1_hat_k, t_k)| for t in [a_k, a_{k+1}]
+            dr = virtual_velocity_change(k1, 1.0, reach1[i], e1_path, eta1[i] + h * speed,
+                                         move_r[k][i], width_min_r[k][i], width_max_r[k][i])
+            q_lo, q_hi, z_lo, z_hi = axis_interval(
+                box2[i][0], box2[i][1], 0.0, rho_k[i], 2.0 * h * k2 / rho_k[i], g_min, g_max,
+                peak2[k][i], h * drift, h * others, cpl, 0.0)
+            spread = eta2[i] + dr
+            vroom = 1.0 - max(-(q_lo - spread), q_hi + spread) / (late[k][i]
+                                                                   * (1.0 - RHO_ROUNDING))
+            judged(room, vroom, t, i)
+            if vroom <= 0.0:
+                return result(False, f"the velocity error may leave its tube in dimension "
+                              f"{i} on [{t + delay:.4f}, {t + h + delay:.4f}] s (|e2| up to "
+                              f"{1.0 - vroom:.4g}; the change of r alone is "
+                              f"{dr / late[k][i]:.3g} of rho2)", t, i)
+            # (C4) the next prediction, x_hat_{k+1} = x(s_{k+1}) + the prediction over the
+            # delay: from x_hat_k, the miss, the share of the period from a_k to s_{k+1}
+            # under the class, and the rest at g_mid exactly
+            shift_hat = (eta1[i] + h * (z_abs + eta2[i]) + 0.5 * (h * h - delay * delay)
+                         * (force + drift) + 0.5 * delay * delay * g_mid * u_abs[i])
+            _, _, xh_lo, xh_hi = axis_interval(
+                box1[i][0], box1[i][1], centre_l[k][i], half_l[k][i], pull1[k][i], 1.0, 1.0,
+                peak1[k][i], shift_hat)
+            box_n = [(xh_lo - centre_l[k + 1][i]) / half_l[k + 1][i],
+                     (xh_hi - centre_l[k + 1][i]) / half_l[k + 1][i]]
+            reach_n = max(-box_n[0], box_n[1])
+            if reach_n >= 1.0:
+                return result(False, f"|e1_{i}| of the predicted state may reach "
+                              f"{reach_n:.6g} at t = {t + h:.4f} s (the check needs it "
+                              "inside its tube)", t, i)
+            pull2 = 2.0 * h * k2 / rho_k[i]
+            _, _, zh_lo, zh_hi = axis_interval(
+                box2[i][0], box2[i][1], 0.0, rho_k[i], pull2, mix_lo, mix_hi,
+                peak_scalar(rho_k[i] / (mix_lo * pull2)), share * h * drift + eta2[i],
+                share * h * others, share * cpl, 0.0)
+            # |r(x1_hat_{k+1}, t_{k+1}) - r(x1_hat_k, t_k)|: x1_hat moves by h r_k and at
+            # most shift_hat beyond it
+            dr_end = min(virtual_velocity_change(
+                k1, 1.0, reach1[i], max(reach1[i], reach_n), h * r_abs + shift_hat,
+                move[k][i], width_min[k][i], width_max[k][i]), step_velocity_change(
+                k1, h, box1[i][0], box1[i][1],
+                (centre_l[k][i] - centre_l[k + 1][i]) / half_l[k + 1][i],
+                half_l[k][i] / half_l[k + 1][i], max(reach1[i], reach_n), half_l[k][i],
+                half_l[k + 1][i], shift_hat))
+            # the miss of that prediction, which u_k makes over [s_{k+1}, a_{k+1}] (C1)
+            miss = deviation * u_abs[i] + cpl * others + drift
+            next1.append(box_n)
+            next2.append([(zh_lo - dr_end) / rho_n[i], (zh_hi + dr_end) / rho_n[i]])
+            next_eta1.append(0.5 * delay * delay * miss)
+            next_eta2.append(delay * miss)
+        box1, box2, eta1, eta2 = next1, next2, next_eta1, next_eta2
+    top[0] = max(top[0], max(max(-a, b) for a, b in box1))
+    top[1] = max(top[1], max(max(-a, b) for a, b in box2))
+    data["horizon"] = float(samples.t[count])
+    return result(True, "")
+
+
 def certify_stage(tube: TubeDesign, spec: Spec, stage: SecondStage) -> tuple[bool, dict]:
     """:func:`check_cascade_sampled` for ``spec``'s declared plants (:func:`cascade_class`)
     and its ``[controller] delay`` and ``jitter`` on ``tube`` sampled at its rate: the
@@ -589,7 +873,7 @@ def cascade_check_of(tube: TubeDesign, spec: Spec, stage: SecondStage) -> Cascad
         samples = sample_tube(tube)
     return check_cascade_sampled(tube, samples, stage, cascade_class(spec),
                                  spec.second_order.initial_velocity, delay=spec.delay,
-                                 jitter=spec.jitter)
+                                 jitter=spec.jitter, compensate=spec.compensate_delay)
 
 
 def largest_cascade_delay(tube: TubeDesign, spec: Spec, stage: SecondStage,
@@ -625,7 +909,8 @@ def largest_cascade_delay(tube: TubeDesign, spec: Spec, stage: SecondStage,
 
     def passes(delay: float) -> bool:
         return check_cascade_sampled(tube, samples, stage, plants, start, delay=delay,
-                                     jitter=spec.jitter).passed
+                                     jitter=spec.jitter,
+                                     compensate=spec.compensate_delay).passed
 
     # without delay: the spec's own check when it has no delay either (cached)
     return largest_passing(passes, max(0.0, 1.0 / tube.rate_hz - 2.0 * spec.jitter),

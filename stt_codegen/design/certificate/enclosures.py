@@ -19,7 +19,8 @@ from ...tube import reference
 from ...tube.parameters import LOWER, TANH, TubeDesign
 from .report import Enclosure
 
-__all__ = ["Pieces", "bump_ranges", "circumvent_range", "enclose", "enclose_tube", "partition",
+__all__ = ["Pieces", "bump_ranges", "circumvent_range", "enclose", "enclose_later",
+           "enclose_tube", "partition",
            "piece_ranges", "piece_widths", "reach_range", "width_lower_bound"]
 
 
@@ -448,3 +449,35 @@ def enclose_tube(design: TubeDesign, samples) -> Enclosure:
                     t0, t1)
 
 
+
+
+
+def enclose_later(design: TubeDesign, samples, begin: float, end: float) -> Enclosure:
+    """Enclosures of ``gamma_L``, ``gamma_U`` on ``[t_k + begin, t_{k+1} + end]`` for every
+    sampling interval ``k`` of ``samples``, ``0 <= begin <= end <= t_{k+1} - t_k``: e.g.
+    the interval a command computed at ``t_k`` acts on after a computation delay
+    (``begin = end = delay``).
+
+    ``alpha`` is the deployed sequence, linearly interpolated as in :func:`enclose_tube`:
+    such an interval lies within ``[t_k, t_{k+2}]``, so ``alpha`` on it lies between the
+    least and the largest of ``alpha_k``, ``alpha_{k+1}``, ``alpha_{k+2}`` (the last
+    interval takes ``alpha`` constant after the last sample).
+
+    Parameters
+    ----------
+    design : TubeDesign
+    samples : TubeSamples
+        ``t`` (N,) and ``alpha`` (N, 2n).
+    begin, end : float
+        Seconds.
+
+    Returns
+    -------
+    Enclosure
+        ``N - 1`` intervals.
+    """
+    t0, t1 = samples.t[:-1] + begin, samples.t[1:] + end
+    a0, a1 = samples.alpha[:-1], samples.alpha[1:]
+    a2 = np.concatenate([samples.alpha[2:], samples.alpha[-1:]])
+    return enclose(design, piece_ranges(design, t0, t1), np.minimum(np.minimum(a0, a1), a2),
+                   np.maximum(np.maximum(a0, a1), a2), t0, t1)
