@@ -39,8 +39,9 @@ from ..tube.parameters import Status, TubeDesign, step_status
 from ..tube.second_stage import SecondStage
 from ..version import __version__
 from ..design.output_bound import cascade_clamp
+from ..design.prediction import delay_predictor
 from ..design.result import Design
-from .emit import python_source
+from .emit import lower, python_source
 from .functions import deployed_functions
 from .generate import c_source_context, input_limits, timing_context
 from .options import Options
@@ -93,8 +94,8 @@ def _context(design: TubeDesign, stage: SecondStage, prefix: str, precision: str
 
 
 def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
-                    precision: str = "double", timing: tuple[float, float] = (0.0, 0.0)
-                    ) -> dict[str, str]:
+                    precision: str = "double", timing: tuple[float, float] = (0.0, 0.0),
+                    predictor: casadi.Function | None = None) -> dict[str, str]:
     """``{<prefix>.h: text, <prefix>.c: text}`` of the cascade controller.
 
     The emitter's C printer prints the pieces (the first order's and the cascade's); the
@@ -112,6 +113,9 @@ def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
     precision : {"double", "single"}
     timing : (float, float)
         ``(delay, jitter)`` of the spec, s: the header's timing contract.
+    predictor : casadi.Function, optional
+        With ``[controller] compensate_delay``, the spec's
+        :func:`~stt_codegen.design.prediction.delay_predictor`: ``P_predict`` is generated.
 
     Returns
     -------
@@ -133,10 +137,11 @@ def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
     # the tube's tables carry k1 as law (13)'s gain: r is law (13) with gain k1
     first = dataclasses.replace(design, gain=stage.position_gain)
     functions = [*deployed_functions(build_model(first)), velocity_tube(design.dimension),
-                 velocity_law(design.dimension)]
+                 velocity_law(design.dimension),
+                 *([predictor] if predictor is not None else [])]
     context = dict(c_source_context(first, prefix, precision, functions),
                    **_context(design, stage, prefix, precision, literal, timing),
-                   cascade=True,
+                   cascade=True, predict=predictor is not None,
                    stage={"velocity_gain": literal(stage.velocity_gain),
                           "decay": literal(stage.decay),
                           "width_start": [literal(v) for v in stage.width_start],
@@ -147,7 +152,8 @@ def cascade_c_files(design: TubeDesign, stage: SecondStage, prefix: str,
 
 
 def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str,
-                        timing: tuple[float, float] = (0.0, 0.0)) -> dict[str, str]:
+                        timing: tuple[float, float] = (0.0, 0.0),
+                        predictor: casadi.Function | None = None) -> dict[str, str]:
     """``{<prefix>.py: text}``: ``step(x, t, dt, alpha) -> (u, alpha_next, status)`` and
     ``virtual_velocity(x, t, alpha) -> (r, status)`` (``x = [x1; x2]``), the same functions,
     statuses and input checks as the C (imports ``math`` only). The emitter's Python printer prints the composed Function; the template
@@ -163,6 +169,8 @@ def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str,
         Module name, an ASCII identifier.
     timing : (float, float)
         ``(delay, jitter)`` of the spec, s: the module's ``DELAY`` and ``JITTER``.
+    predictor : casadi.Function, optional
+        As :func:`cascade_c_files`: ``predict(x, u_held)`` is generated.
 
     Returns
     -------
@@ -180,7 +188,10 @@ def cascade_python_file(design: TubeDesign, stage: SecondStage, prefix: str,
     return {name: render("cascade_module.py.j2", filename=name,
                          **_context(design, stage, prefix, "double",
                                     lambda v: repr(float(v)), timing),
-                         body=python_source(cascade_step(design, stage)))}
+                         predict=predictor is not None,
+                         body=python_source([lower(cascade_step(design, stage)), *(
+                             [dataclasses.replace(lower(predictor), name="body_predict")]
+                             if predictor is not None else [])]))}
 
 
 #: Test vectors per generation: sample points of the cascade step.
@@ -331,13 +342,14 @@ def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
 
     stage, _ = design.second_stage
     spec = design.spec
+    predictor = delay_predictor(spec, design.tube, stage)
     context = file_context(spec, options.precision)
     prefix = context["P"]
     data = cascade_vectors(design.tube, stage, precision=options.precision)
     texts: dict[str, str] = {}
     if "c" in options.langs:
         texts.update(cascade_c_files(design.tube, stage, prefix, options.precision,
-                                     (spec.delay, spec.jitter)))
+                                     (spec.delay, spec.jitter), predictor))
         texts.update(build_files(context))
         rows = data["vectors"]
         inputs = {"x": [v["x"] for v in rows], "t": [v["t"] for v in rows],
@@ -351,7 +363,8 @@ def cascade_generation(design: Design, options: Options) -> dict[str, bytes]:
         texts.update(selftest_file(context, inputs, expected, options.precision,
                                    "cascade_selftest.c.j2"))
     if "python" in options.langs:
-        texts.update(cascade_python_file(design.tube, stage, prefix, (spec.delay, spec.jitter)))
+        texts.update(cascade_python_file(design.tube, stage, prefix, (spec.delay, spec.jitter),
+                                         predictor))
     files = {name: text.encode() for name, text in texts.items()}
     files[f"{prefix}_vectors.json"] = json_bytes(
         dict(data, spec=spec.name, spec_sha256=spec.source_hash))

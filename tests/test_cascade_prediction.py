@@ -1,0 +1,226 @@
+"""The cascade's delay-compensating prediction (``[controller] compensate_delay`` on a
+second-order plant): its certificate (which proves a whole period of delay on the U-maze at
+400 Hz where the plain cascade's cannot, and fails where it should), the refusals, the closed
+loop that runs it, and the generated ``predict`` of C and Python, bit for bit the CasADi
+predictor (docs/second-order.md, "Compensating a delay")."""
+
+from __future__ import annotations
+
+import ctypes
+import dataclasses
+import re
+import shutil
+import subprocess
+import types
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+from codegen_helpers import COMPILERS, compile_shared
+
+import control as ct
+
+import stt_codegen as stt
+from stt_codegen.codegen.render import c_identifier
+from stt_codegen.design.certificate.cascade_sampled import (cascade_check_of, cascade_class,
+                                                            check_cascade_sampled)
+from stt_codegen.design.prediction import delay_predictor, mid_gain
+from stt_codegen.design.samples import sample_tube
+from stt_codegen.runtime.state_split import initial_state
+from stt_codegen.tube import cascade_reference, reference
+from stt_codegen.tube.parameters import Status
+
+SPECS = Path(__file__).parent / "specs"
+CASCADE = SPECS / "umaze-cascade-compensated.toml"    # 400 Hz, a 2.5 ms delay, compensated
+PERIOD = 1.0 / 400.0
+
+
+@lru_cache(maxsize=None)
+def _design(path: Path):
+    return stt.design_tube(stt.load_spec(path))
+
+
+def _check(design, spec, delay: float, compensate: bool):
+    with reference.numpy_math():
+        samples = sample_tube(design.tube)
+    return check_cascade_sampled(design.tube, samples, design.stage, cascade_class(spec),
+                                 spec.second_order.initial_velocity, delay=delay,
+                                 compensate=compensate)
+
+
+def test_the_cascade_predicts_at_the_middle_of_its_own_input_gain() -> None:
+    """g_mid is the second-order plant's (the cascade's class), not [assumptions]'."""
+    spec = stt.load_spec(CASCADE)
+    low, high = spec.second_order.input_gain
+    assert mid_gain(spec) == 0.5 * (low + high)
+    assert mid_gain(spec) != 0.5 * sum(spec.assumptions.input_gain)
+
+
+# ---------------------------------------------------------------------- the certificate
+@pytest.mark.slow
+def test_a_one_period_delay_is_certified_with_the_prediction_and_not_without() -> None:
+    design = _design(CASCADE)
+    spec = design.spec
+    assert spec.compensate_delay and spec.delay == PERIOD
+    check = cascade_check_of(design.tube, spec, design.stage)
+    assert check.passed and check.data["compensate_delay"]
+    assert check.max_abs_e1 < 1.0 and check.max_abs_e2 < 1.0
+    assert check.position_margin > 0.0 and check.velocity_margin > 0.0
+    plain = _check(design, spec, PERIOD, compensate=False)
+    assert not plain.passed and "velocity error may leave its tube" in plain.reason
+
+
+@pytest.mark.slow
+def test_the_predicted_check_can_fail_and_reports_where() -> None:
+    """The same stage with a wider gain range (g_max three times g_min) and a whole period:
+    the prediction's miss grows with |g - g_mid| and the check fails, naming where."""
+    design = _design(CASCADE)
+    spec = design.spec
+    low, _ = spec.second_order.input_gain
+    wide = dataclasses.replace(cascade_class(spec), g_max=3.0 * low,
+                               coupling=0.0)
+    with reference.numpy_math():
+        samples = sample_tube(design.tube)
+    failed = check_cascade_sampled(design.tube, samples, design.stage, wide,
+                                   spec.second_order.initial_velocity, delay=PERIOD,
+                                   compensate=True)
+    assert not failed.passed
+    assert re.search(r"on \[[0-9.]+, [0-9.]+\] s", failed.reason), failed.reason
+    assert min(failed.position_margin, failed.velocity_margin) <= 0.0
+
+
+@pytest.mark.slow
+def test_a_prediction_over_a_vanishing_delay_is_the_plain_check() -> None:
+    """Over a delay of 1e-12 s the predicted check's margins are the plain check's to
+    within 1 % (the enclosures of the actuation interval tend to the sampling interval's)."""
+    design = _design(CASCADE)
+    spec = design.spec
+    predicted = _check(design, spec, 1e-12, compensate=True)
+    plain = _check(design, spec, 0.0, compensate=False)
+    assert predicted.passed and plain.passed
+    assert predicted.data["compensate_delay"] and "compensate_delay" not in plain.data
+    assert predicted.velocity_margin == pytest.approx(plain.velocity_margin, rel=1e-2)
+    assert predicted.position_margin == pytest.approx(plain.position_margin, rel=1e-2)
+
+
+@pytest.mark.slow
+def test_the_plain_cascade_with_the_delay_is_refused_naming_compensate_delay() -> None:
+    spec = dataclasses.replace(stt.load_spec(CASCADE), compensate_delay=False)
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(spec)
+    assert ("controller.compensate_delay = true is certified with controller.delay = "
+            "0.0025 s at 400 Hz") in str(raised.value)
+    assert raised.value.advice["controller.compensate_delay"] is True
+
+
+@pytest.mark.slow
+def test_at_the_plain_certified_rate_a_period_is_refused_naming_a_delay_then_certified():
+    """umaze-cascade's plain certified rate is 230 Hz; there a whole period (4.35 ms)
+    compensated is refused, naming the largest delay certified at 230 Hz, which designs."""
+    base = stt.load_spec(CASCADE)
+    spec = dataclasses.replace(base, rate_hz=230.0, delay=1.0 / 230.0)
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(spec)
+    shorter = raised.value.advice["controller.delay"]
+    assert 0.0 < shorter < spec.delay
+    assert f"controller.delay = {shorter:.3g} s is certified at 230 Hz" in str(raised.value)
+    design = stt.design_tube(dataclasses.replace(spec, delay=shorter))
+    assert cascade_check_of(design.tube, design.spec, design.stage).passed
+
+
+# ---------------------------------------------------------------------- the closed loop
+@pytest.mark.slow
+def test_the_closed_loop_with_the_delay_keeps_both_tubes() -> None:
+    design = _design(CASCADE)
+    run = stt.simulate(design, backend="reference")
+    assert run.satisfied and run.stayed_in_tube and run.stayed_in_velocity_tube
+    assert run.max_abs_e < 1.0
+    assert set(run.trajectory.status.tolist()) == {int(Status.OK)}
+    check = cascade_check_of(design.tube, design.spec, design.stage)
+    assert np.all(np.abs(run.trajectory.u) <= np.array(check.peak_input))
+
+
+@pytest.mark.slow
+def test_the_interconnected_loop_gives_simulates_run_with_the_prediction() -> None:
+    design = _design(CASCADE)
+    controller = stt.controller_system(design, backend="reference")
+    plant = stt.sampled_plant(design)
+    states, inputs, n = plant.nstates, plant.ninputs, design.spec.dimension
+    loop = ct.interconnect(
+        [controller, plant], inplist=[],
+        connections=[*([f"stt.x[{i}]", f"plant.x[{i}]"] for i in range(2 * n)),
+                     *([f"plant.u[{j}]", f"stt.u[{j}]"] for j in range(inputs))],
+        outlist=[*(f"stt.u[{j}]" for j in range(inputs)), "stt.status"])
+    steps = 100
+    dt = controller.dt
+    x0 = np.concatenate([np.zeros(controller.nstates), initial_state(design.spec),
+                         np.zeros(states - 2 * n)])
+    response = ct.input_output_response(loop, np.arange(steps + 1) * dt, 0, X0=x0)
+    run = stt.simulate(design, backend="reference", horizon=steps * dt)
+    assert np.max(np.abs(response.outputs[:inputs].T - run.trajectory.u)) <= 1e-12
+    assert np.array_equal(response.outputs[-1], run.trajectory.status.astype(float))
+
+
+# ---------------------------------------------------------------------- the generated code
+@pytest.mark.slow
+@pytest.mark.skipif(not COMPILERS, reason="needs a C compiler: apt install gcc")
+def test_the_generated_predict_is_the_predictors_bit_for_bit_and_the_oracles(tmp_path):
+    design = _design(CASCADE)
+    spec = design.spec
+    stt.generate(design, tmp_path / "out", ("c", "python"))
+    prefix = c_identifier(spec.c_name)
+    predictor = delay_predictor(spec, design.tube, design.stage)
+    lib = ctypes.CDLL(str(compile_shared(tmp_path / "out", prefix, COMPILERS[0], "double")))
+    real_p = ctypes.POINTER(ctypes.c_double)
+    predict = getattr(lib, f"{prefix}_predict")
+    predict.argtypes, predict.restype = [real_p, real_p, real_p], ctypes.c_int
+    module = types.ModuleType(prefix)
+    exec((tmp_path / "out" / f"{prefix}.py").read_text(), module.__dict__)
+    n = spec.dimension
+    rng = np.random.default_rng(13)
+    for _ in range(100):
+        x, u = rng.uniform(-3.0, 3.0, 2 * n), rng.uniform(-2.0, 2.0, n)
+        x_hat = np.zeros(2 * n)
+        code = predict(x.ctypes.data_as(real_p), u.ctypes.data_as(real_p),
+                       x_hat.ctypes.data_as(real_p))
+        model = np.array(predictor(x, u)).ravel()
+        py_hat, py_code = module.predict(list(x), list(u))
+        assert code == py_code == int(Status.OK)
+        assert np.array_equal(x_hat, model) and np.array_equal(py_hat, model)
+        oracle = cascade_reference.predicted_state(x[None], u[None], spec.delay,
+                                                   mid_gain(spec))[0]
+        np.testing.assert_allclose(x_hat, oracle, rtol=1e-14, atol=1e-14)
+    x, u = np.full(2 * n, np.nan), np.zeros(n)
+    x_hat = np.ones(2 * n)
+    assert predict(x.ctypes.data_as(real_p), u.ctypes.data_as(real_p),
+                   x_hat.ctypes.data_as(real_p)) == int(Status.INVALID_INPUT)
+    assert not x_hat.any()
+    assert module.predict(list(x), list(u)) == ([0.0] * (2 * n), int(Status.INVALID_INPUT))
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("cppcheck") is None,
+                    reason="cppcheck missing: install the Debian package cppcheck")
+def test_the_generated_cascade_predict_keeps_misra_clean(tmp_path) -> None:
+    """cppcheck's MISRA C:2012 addon finds in the cascade's P_predict only the API's own
+    deviation (tests/test_codegen_misra.py: an API function the file does not call)."""
+    from test_codegen_misra import DEVIATIONS
+    design = _design(CASCADE)
+    prefix = c_identifier(design.spec.c_name)
+    folder = tmp_path / "gen"
+    stt.generate(design, folder, ("c",), "double")
+    proc = subprocess.run(["cppcheck", "--enable=all", "--addon=misra", "--std=c99",
+                           "--suppress=missingIncludeSystem", "--quiet",
+                           "--template={file}:{line}:{id}", f"{prefix}.c"],
+                          cwd=folder, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    unused = set()
+    for name, line, check in (f.split(":") for f in proc.stderr.splitlines()
+                              if f.count(":") >= 2):
+        text = (folder / name).read_text().splitlines()[int(line) - 1]
+        assert any(d[0] == check and re.search(d[1], text) for d in DEVIATIONS), \
+            f"{name}:{line}: {check}: {text!r}"
+        if check == "unusedFunction":
+            unused.add(re.match(rf"^int {prefix}_(\w+)\(", text).group(1))
+    assert "predict" in unused                  # it is there, and clean
