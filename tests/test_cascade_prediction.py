@@ -224,3 +224,37 @@ def test_the_generated_cascade_predict_keeps_misra_clean(tmp_path) -> None:
         if check == "unusedFunction":
             unused.add(re.match(rf"^int {prefix}_(\w+)\(", text).group(1))
     assert "predict" in unused                  # it is there, and clean
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(shutil.which("gcc") is None,
+                    reason="host C compiler missing: install the Debian package gcc")
+def test_the_firmware_loop_runs_the_cascades_prediction(tmp_path) -> None:
+    """The cascade's firmware loop (single-precision controller, double plant, built for
+    the host) calls P_predict before P_step: it follows the host's predicted run, not the
+    same delayed run without the prediction."""
+    from stt_codegen.embedded import cascade_loop, programs
+    from stt_codegen.runtime.state_split import positions
+    design = _design(CASCADE)
+    spec = design.spec
+    stt.generate(design, tmp_path, languages=["c"], precision="single")
+    (tmp_path / "loop.c").write_text(cascade_loop.closed_loop_program(design, spec.c_name))
+    build = subprocess.run(["gcc", "-O2", "-o", str(tmp_path / "loop"), str(tmp_path / "loop.c"),
+                            str(tmp_path / f"{spec.c_name}.c"), "-I", str(tmp_path), "-lm"],
+                           capture_output=True, text=True)
+    assert build.returncode == 0, build.stderr
+    run = subprocess.run([str(tmp_path / "loop")], capture_output=True, text=True)
+    assert "satisfied=1" in run.stdout
+    states = programs.parse_closed_loop(run.stdout, spec.dimension, 2 * spec.dimension).states
+    points = {k: positions(spec, np.array(x)[None])[0] for k, x in states.items()}
+    predicted = stt.simulate(design, backend="c")
+    plain = dataclasses.replace(design, spec=dataclasses.replace(spec, compensate_delay=False))
+    # the same second stage (the plain cascade's certificate refuses it with the delay)
+    plain.__dict__["second_stage"] = design.second_stage
+    unpredicted = stt.simulate(plain, backend="c")
+    assert predicted.stayed_in_tube and predicted.stayed_in_velocity_tube
+    with_prediction = max(np.max(np.abs(p - positions(spec, predicted.trajectory.x[k][None])[0]))
+                          for k, p in points.items())
+    without = max(np.max(np.abs(p - positions(spec, unpredicted.trajectory.x[k][None])[0]))
+                  for k, p in points.items())
+    assert 10 * with_prediction < without, (with_prediction, without)
