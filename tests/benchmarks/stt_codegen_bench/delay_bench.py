@@ -14,6 +14,9 @@ import time
 from pathlib import Path
 
 import stt_codegen as stt
+from stt_codegen.design.certificate.cascade_sampled import (cascade_class,
+                                                            check_cascade_sampled,
+                                                            largest_cascade_delay)
 from stt_codegen.design.certificate.plant_class import plant_class
 from stt_codegen.design.certificate.sampled import check_sampled_first_per_axis, largest_delay
 from stt_codegen.design.samples import sample_tube
@@ -22,17 +25,48 @@ from stt_codegen.tube import reference
 __all__ = ["DELAY_SPECS", "format_delay_report", "run_delay_bench"]
 
 _TESTS = Path(__file__).resolve().parents[2] / "specs"
-#: The bundled first-order and differential-drive cases, and the test specs of the Kobuki-like
-#: base and the first-order U-maze (without their delay).
+#: The bundled first-order and differential-drive cases, two cascades (the bundled
+#: second-order-s1 and the test spec of the U-maze cascade at 400 Hz), and the test specs of
+#: the Kobuki-like base and the first-order U-maze (all without their delay).
 DELAY_SPECS = ("omnirobot-s1", "omnirobot-s2", "omnirobot-s3", "crossing-moving",
-               "pointmaze-umaze", "office-base", str(_TESTS / "kobuki-office.toml"),
-               str(_TESTS / "umaze-first-order.toml"))
+               "pointmaze-umaze", "office-base", "second-order-s1",
+               str(_TESTS / "umaze-cascade-compensated.toml"),
+               str(_TESTS / "kobuki-office.toml"), str(_TESTS / "umaze-first-order.toml"))
+
+
+def _cascade_row(spec, design) -> dict:
+    """:func:`_row` of a second-order spec: the cascade's certificate of the design's own
+    second stage, plain and predicted."""
+    tube, stage = design.tube, design.stage
+    dt = 1.0 / tube.rate_hz
+    predicted_spec = dataclasses.replace(spec, compensate_delay=True)
+    plain = largest_cascade_delay(tube, spec, stage)
+    predicted = largest_cascade_delay(tube, predicted_spec, stage)
+    with reference.numpy_math():
+        samples = sample_tube(tube)
+    plants, start = cascade_class(spec), spec.second_order.initial_velocity
+    whole = {compensate: check_cascade_sampled(tube, samples, stage, plants, start, delay=dt,
+                                               compensate=compensate).passed
+             for compensate in (False, True)}
+    seconds = {False: 0.0, True: 0.0}
+    for compensate in (False, True):
+        if plain:      # both checks pass there: each runs the whole horizon
+            begin = time.process_time()
+            check_cascade_sampled(tube, samples, stage, plants, start, delay=plain,
+                                  compensate=compensate)
+            seconds[compensate] = time.process_time() - begin
+    return {"spec": spec.name, "variant": spec.variant, "rate_hz": tube.rate_hz,
+            "period_s": dt, "plain_delay_s": plain, "predicted_delay_s": predicted,
+            "plain_whole_period": whole[False], "predicted_whole_period": whole[True],
+            "check_cpu_ratio": seconds[True] / seconds[False] if seconds[False] > 0 else None}
 
 
 def _row(source: str) -> dict:
     spec = stt.load_spec(source)
     spec = dataclasses.replace(spec, delay=0.0, jitter=0.0, compensate_delay=False)
     design = stt.design_tube(spec)
+    if spec.variant == "cascade":
+        return _cascade_row(spec, design)
     tube = design.tube
     dt = 1.0 / tube.rate_hz
     predicted_spec = dataclasses.replace(spec, compensate_delay=True)
@@ -63,7 +97,7 @@ def run_delay_bench(specs: tuple[str, ...] = DELAY_SPECS) -> dict:
     Parameters
     ----------
     specs : tuple of str
-        Bundled case names or spec paths (first-order or differential-drive).
+        Bundled case names or spec paths (first-order, differential-drive or second-order).
 
     Returns
     -------
