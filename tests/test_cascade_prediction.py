@@ -258,3 +258,61 @@ def test_the_firmware_loop_runs_the_cascades_prediction(tmp_path) -> None:
     without = max(np.max(np.abs(p - positions(spec, unpredicted.trajectory.x[k][None])[0]))
                   for k, p in points.items())
     assert 10 * with_prediction < without, (with_prediction, without)
+
+
+def _adversary_run(design, plants, strategy: str, seed: int = 0) -> tuple[float, ...]:
+    """The predicted cascade (numpy oracle: the reference step at the oracle's prediction)
+    on a diagonal plant with ``g_ii`` chosen per piece of each period and ``f_i + w_i`` at
+    ``+-(F + W)`` pushing the velocity error outward, integrated exactly (constant
+    acceleration on each piece: ``u_{k-1}`` over the delay, then ``u_k``).
+
+    Returns ``(max |e1|, max |e2|)`` of the predicted state at the samples and ``max |e1|``
+    of the true state there; ``inf`` once a tube is left."""
+    tube, stage, spec = design.tube, design.stage, design.spec
+    n, h, delay = tube.dimension, 1.0 / tube.rate_hz, spec.delay
+    g_mid = mid_gain(spec)
+    rng = np.random.default_rng(seed)
+    push = plants.drift_bound + plants.disturbance_bound
+    x = np.concatenate([tube.initial_state, spec.second_order.initial_velocity])[None]
+    alpha, u_prev = np.zeros((1, 2 * n)), np.zeros((1, n))
+    worst = [0.0, 0.0, 0.0]
+    with reference.numpy_math():
+        for k in range(int(np.ceil(1.1 * tube.prescribed_time * tube.rate_hz))):
+            t = k * h
+            x_hat = cascade_reference.predicted_state(x, u_prev, delay, g_mid)
+            u, alpha_next, r, inside1, inside2, _ = cascade_reference.cascade_step(
+                tube, stage, x_hat, np.array([t]), np.array([h]), alpha)
+            g_l, g_u, _, _ = reference.adaptive_tube(tube, np.array([t]), alpha)
+            e1_hat = (2 * x_hat[:, :n] - g_u - g_l) / (g_u - g_l)
+            e1 = (2 * x[:, :n] - g_u - g_l) / (g_u - g_l)
+            z = x_hat[:, n:] - r
+            if inside1[0] < 1 or inside2[0] < 1 or np.abs(e1).max() >= 1.0:
+                return np.inf, np.inf, np.inf
+            worst = [max(worst[0], float(np.abs(e1_hat).max())),
+                     max(worst[1], float(np.abs(z / cascade_reference.velocity_tube(
+                         stage, t)).max())), max(worst[2], float(np.abs(e1).max()))]
+            outward = (np.sign(z) + (z == 0))[0]
+            for force, length in ((u_prev[0], delay), (u[0], h - delay)):
+                if strategy == "random":
+                    g = rng.choice([plants.g_min, plants.g_max], size=n)
+                else:
+                    g = np.full(n, getattr(plants, strategy))
+                acc = g * force + outward * push
+                x = np.concatenate([x[0, :n] + length * x[0, n:] + 0.5 * length**2 * acc,
+                                    x[0, n:] + length * acc])[None]
+            u_prev, alpha = u, alpha_next
+    return tuple(worst)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("strategy", ["g_min", "g_max", "random"])
+def test_the_predicted_loop_on_extreme_plants_stays_within_the_certified_bounds(strategy):
+    """Plants at the corners of the class (and switching between them), the drift pushing
+    the velocity error outward: the predicted state's errors at the samples stay within
+    the certificate's bounds, and the true position inside its tube."""
+    design = _design(CASCADE)
+    plants = cascade_class(design.spec)
+    check = cascade_check_of(design.tube, design.spec, design.stage)
+    e1_hat, e2_hat, e1 = _adversary_run(design, plants, strategy, seed=3)
+    assert e1_hat <= check.max_abs_e1 + 1e-9 and e2_hat <= check.max_abs_e2 + 1e-9
+    assert e1 < 1.0

@@ -800,7 +800,7 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
             _, _, zh_lo, zh_hi = axis_interval(
                 box2[i][0], box2[i][1], 0.0, rho_k[i], pull2, mix_lo, mix_hi,
                 peak_scalar(rho_k[i] / (mix_lo * pull2)), share * h * drift + eta2[i],
-                share * h * others, share * cpl, 0.0)
+                h * others, share * cpl, 0.0)       # the other axes: share * g's rows
             # |r(x1_hat_{k+1}, t_{k+1}) - r(x1_hat_k, t_k)|: x1_hat moves by h r_k and at
             # most shift_hat beyond it
             dr_end = min(virtual_velocity_change(
