@@ -19,9 +19,9 @@ from .enclosures import enclose_tube
 from .lyapunov import others_max
 from .plant_class import PlantClass
 from .sampled_axis import (axis_interval, held_speed, peak_scalar, phi_scalar, turn_failure,
-                           turned_gains)
+                           turned_gains, unprovable)
 from ..samples import TubeSamples
-from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
+from ...tube.parameters import E_MAX, TubeDesign
 
 __all__ = ["check_predicted"]
 
@@ -93,12 +93,9 @@ def check_predicted(design: TubeDesign, samples: TubeSamples, plants: PlantClass
     def fail(reason: str, margin: float, t: float, i: int, level: float) -> tuple:
         return False, level, margin, t, i, reason, None
 
-    if a.input_gain[0] <= 0:
-        return fail("input_gain[0] must be positive (Assumption 2): law (13) cannot pull "
-                    "the state back otherwise", -math.inf, 0.0, 0, math.nan)
-    if width.min() < GAMMA_D_MIN:
-        return fail(f"the tube is narrower than GAMMA_D_MIN = {GAMMA_D_MIN:g} at a sample",
-                    -math.inf, 0.0, 0, math.nan)
+    reason = unprovable(a.input_gain[0], float(width.min()))
+    if reason is not None:
+        return fail(reason, -math.inf, 0.0, 0, math.nan)
     enclosure = enclose_tube(design, samples)
     count = len(enclosure.t_start)
     bounds = plants.on_intervals(enclosure, count)

@@ -35,12 +35,12 @@ from ..samples import TubeSamples, sample_tube
 from ...spec.assumptions import Assumptions
 from ...spec.loader import Spec
 from ...tube import reference
-from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
+from ...tube.parameters import E_MAX, TubeDesign
 from .lyapunov import level_after, next_level, others_max
 from .plant_class import PlantClass, plant_class
 from .predicted import check_predicted
 from .sampled_axis import (axis_interval, held_speed, peak, peak_scalar, phi_scalar,
-                           phi_slope_scalar, turn_failure, turned_gains)
+                           phi_slope_scalar, turn_failure, turned_gains, unprovable)
 
 __all__ = ["DELAY_HALVINGS", "RATE_FACTORS", "SampledCheck", "check_sampled",
            "check_sampled_first_per_axis", "delay_room", "largest_delay", "largest_passing",
@@ -251,12 +251,9 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     def fail(reason: str, margin: float, t: float, i: int, level: float) -> SampledCheck:
         return SampledCheck(False, level, margin, t, i, reason, data)
 
-    if a.input_gain[0] <= 0:
-        return fail("input_gain[0] must be positive (Assumption 2): law (13) cannot pull "
-                    "the state back otherwise", -math.inf, 0.0, 0, math.nan)
-    if width.min() < GAMMA_D_MIN:
-        return fail(f"the tube is narrower than GAMMA_D_MIN = {GAMMA_D_MIN:g} at a sample",
-                    -math.inf, 0.0, 0, math.nan)
+    reason = unprovable(a.input_gain[0], float(width.min()))
+    if reason is not None:
+        return fail(reason, -math.inf, 0.0, 0, math.nan)
     enclosure = enclose_tube(design, samples)
     count = len(enclosure.t_start)
     bounds = cls.on_intervals(enclosure, count)

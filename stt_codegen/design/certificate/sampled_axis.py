@@ -16,8 +16,11 @@ import math
 
 import numpy as np
 
+from ...tube.parameters import GAMMA_D_MIN
+
 __all__ = ["phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "peak_scalar",
-           "coupling_push", "axis_interval", "held_speed", "turned_gains", "turn_failure"]
+           "coupling_push", "axis_interval", "held_speed", "turned_gains", "turn_failure",
+           "unprovable"]
 
 
 def phi(s: np.ndarray) -> np.ndarray:
@@ -315,3 +318,27 @@ def turn_failure(angle: float, rate: float, t: float) -> str:
     return (f"the heading may turn by {angle:.3g} rad in a sampling period at t = {t:.4f} s "
             f"(|omega| <= {rate:.3g} rad/s), which leaves no positive input gain for the "
             "command computed before it")
+
+
+def unprovable(g_min: float, width_min: float) -> str | None:
+    """Why law (13)'s sampled check cannot even start on a tube, or ``None``.
+
+    Parameters
+    ----------
+    g_min : float
+        The class's least input gain (``input_gain[0]``).
+    width_min : float
+        The tube's least width at a sample, state units.
+
+    Returns
+    -------
+    str or None
+        The reason: a gain that is not positive (Assumption 2), or a width below
+        ``GAMMA_D_MIN``.
+    """
+    if g_min <= 0:
+        return ("input_gain[0] must be positive (Assumption 2): law (13) cannot pull the "
+                "state back otherwise")
+    if width_min < GAMMA_D_MIN:
+        return f"the tube is narrower than GAMMA_D_MIN = {GAMMA_D_MIN:g} at a sample"
+    return None
