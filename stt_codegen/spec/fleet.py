@@ -21,9 +21,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
-from ..cases import bundled_fleet_bytes, bundled_fleets, bundled_folder
+from ..cases import bundled_fleet_bytes, bundled_fleets
 from ..errors import SpecError
-from .loader import Spec, toml_document
+from .loader import Spec, file_or_bundled, toml_document
 from .mujoco import with_folder
 
 __all__ = ["FleetRobot", "FleetSpec", "fleet_json_schema", "is_fleet", "load_fleet",
@@ -209,19 +209,8 @@ def load_fleet(fleet: str | os.PathLike) -> FleetSpec:
     >>> [r.name for r in stt.load_fleet("warehouse-fleet").robots][:3]
     ['amr1', 'amr2', 'amr3']
     """
-    text = os.fspath(fleet)
-    if text in bundled_fleets() and not Path(text).exists():
-        data, folder = bundled_fleet_bytes(text), bundled_folder()
-    else:
-        path = Path(text)
-        try:
-            data = path.read_bytes()
-        except FileNotFoundError:
-            raise SpecError("", f"no bundled fleet and no file named {text!r} (bundled: "
-                                f"{', '.join(bundled_fleets())})") from None
-        except OSError as exc:
-            raise SpecError("", f"cannot read {text!r}: {exc.strerror or exc}") from None
-        folder = path.resolve().parent
+    data, folder = file_or_bundled(os.fspath(fleet), bundled_fleets(), bundled_fleet_bytes,
+                                   "fleet")
     return parse_fleet(data, folder)
 
 

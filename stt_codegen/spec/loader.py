@@ -20,7 +20,7 @@ import math
 import os
 import re
 import tomllib
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -45,7 +45,7 @@ from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, 
                      ControllerTable, PlantTable, PolytopeObstacle, check_document, value_kind)
 
 __all__ = ["Assumptions", "Box", "LinearPlant", "law13_plant_terms", "look_ahead_plant_terms", "NAME_PATTERN", "Obstacle", "Spec", "UnsafeSet",
-           "bundled_cases", "load_spec", "parse_spec", "toml_document"]
+           "bundled_cases", "file_or_bundled", "load_spec", "parse_spec", "toml_document"]
 
 NAME_PATTERN = re.compile(NAME_REGEX)
 #: Fraction of the available room used by the default half-widths ``d_0`` and ``d_T``.
@@ -637,20 +637,46 @@ def load_spec(spec: str | Path) -> Spec:
         hint = "; for a dict use Spec.from_dict" if isinstance(spec, Mapping) else ""
         raise TypeError(f"load_spec(): parameter 'spec' must be a bundled case name or a "
                         f"path, not {type(spec).__name__}{hint}")
-    text = str(spec)
-    if text in bundled_cases() and not Path(text).exists():
-        data, folder = bundled_spec_bytes(text), bundled_folder()
-    else:
-        path = Path(text)
-        folder = path.resolve().parent
-        try:
-            data = path.read_bytes()
-        except FileNotFoundError:
-            raise SpecError("", f"no bundled case and no file named {text!r} "
-                                f"(bundled: {', '.join(bundled_cases())})") from None
-        except OSError as exc:
-            raise SpecError("", f"cannot read {text!r}: {exc.strerror or exc}") from None
+    data, folder = file_or_bundled(str(spec), bundled_cases(), bundled_spec_bytes, "case")
     return with_folder(parse_spec(data), folder)
+
+
+def file_or_bundled(text: str, bundled: list[str], read: Callable[[str], bytes],
+                    kind: str) -> tuple[bytes, Path]:
+    """The bytes a bundled name or a file path names, and the folder its files are in.
+
+    Parameters
+    ----------
+    text : str
+        A name of ``bundled`` (when no such file exists) or a path.
+    bundled : list of str
+        The bundled names.
+    read : callable
+        The bytes of a bundled name.
+    kind : str
+        What is bundled, in the message (``"case"``, ``"fleet"``).
+
+    Returns
+    -------
+    data : bytes
+    folder : pathlib.Path
+        The bundled folder, or the file's.
+
+    Raises
+    ------
+    SpecError
+        Field ``""``: no such name or file, or it cannot be read.
+    """
+    if text in bundled and not Path(text).exists():
+        return read(text), bundled_folder()
+    path = Path(text)
+    try:
+        return path.read_bytes(), path.resolve().parent
+    except FileNotFoundError:
+        raise SpecError("", f"no bundled {kind} and no file named {text!r} "
+                            f"(bundled: {', '.join(bundled)})") from None
+    except OSError as exc:
+        raise SpecError("", f"cannot read {text!r}: {exc.strerror or exc}") from None
 
 
 def parse_spec(data: bytes | str) -> Spec:
