@@ -75,7 +75,7 @@ def test_a_fleet_file_is_one_single_spec_per_robot():
         # the shared obstacles, inflated by this robot's reach
         assert len(spec.obstacles) == 3
         assert spec.obstacles[0].lower[0] == pytest.approx(3.5 - robot.reach)
-    assert stt.bundled_fleets() == ["warehouse-fleet"]
+    assert stt.bundled_fleets() == ["swap-fleet", "warehouse-fleet"]
     assert "warehouse-fleet" not in stt.bundled_cases()
 
 

@@ -64,7 +64,7 @@ def bundled_spec_bytes(name: str) -> bytes:
 
 
 def bundled_fleets() -> list[str]:
-    """Names of the bundled fleet specs (``warehouse-fleet``), sorted; load one with
+    """Names of the bundled fleet specs (``swap-fleet``, ``warehouse-fleet``), sorted; load one with
     :func:`stt_codegen.load_fleet`.
 
     Returns
@@ -76,7 +76,7 @@ def bundled_fleets() -> list[str]:
     --------
     >>> import stt_codegen as stt
     >>> stt.bundled_fleets()
-    ['warehouse-fleet']
+    ['swap-fleet', 'warehouse-fleet']
     """
     folder = resources.files(__name__).joinpath("fleets")
     return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))

@@ -49,11 +49,11 @@ def generate_fleet(fleet: FleetDesign, out_dir: str | Path,
     Examples
     --------
     >>> import tempfile, stt_codegen as stt
-    >>> fleet = stt.design_fleet("warehouse-fleet")
+    >>> fleet = stt.design_fleet("swap-fleet")
     >>> with tempfile.TemporaryDirectory() as out:
     ...     written = stt.generate_fleet(fleet, out, languages="python")
-    ...     sorted(written)[:2], written["amr1"][0].parent.name
-    (['amr1', 'amr2'], 'amr1')
+    ...     sorted(written), [p.name for p in written["east"]]
+    (['east', 'west'], ['east.py', 'east_vectors.json', 'manifest.json'])
     """
     if not isinstance(fleet, FleetDesign):
         raise TypeError("generate_fleet(): parameter 'fleet' must be a FleetDesign (call "

@@ -103,10 +103,10 @@ def simulate_fleet(fleet: FleetDesign, *, backend: str | None = None,
     Examples
     --------
     >>> import stt_codegen as stt
-    >>> fleet = stt.design_fleet("warehouse-fleet")
-    >>> run = stt.simulate_fleet(fleet, backend="reference")
-    >>> run.satisfied, run.closest.clearance > 0
-    (True, True)
+    >>> fleet = stt.design_fleet("swap-fleet")
+    >>> run = stt.simulate_fleet(fleet, backend="c")
+    >>> run.satisfied, run.closest.pair, run.closest.clearance > fleet.narrowest.margin
+    (True, ('east', 'west'), True)
     """
     if not isinstance(fleet, FleetDesign):
         raise TypeError("simulate_fleet(): parameter 'fleet' must be a FleetDesign (call "

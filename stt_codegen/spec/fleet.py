@@ -129,16 +129,19 @@ class FleetSpec:
         --------
         >>> import stt_codegen as stt
         >>> robot = {"prescribed_time": 5.0, "radius": 0.1,
-        ...          "initial": {"lower": [0.0, 0.0], "upper": [0.5, 0.5]},
-        ...          "target": {"lower": [3.5, 0.0], "upper": [4.0, 0.5]}}
-        >>> fleet = stt.FleetSpec.from_dict({
-        ...     "name": "two", "state_space": {"lower": [0.0, 0.0], "upper": [4.0, 2.0]},
-        ...     "robots": [{**robot, "name": "a"},
-        ...                {**robot, "name": "b", "target": {"lower": [3.5, 3.0],
-        ...                                                  "upper": [4.0, 3.5]}}]})
+        ...          "initial": {"lower": [0.2, 0.2], "upper": [0.7, 0.7]},
+        ...          "target": {"lower": [3.3, 0.2], "upper": [3.8, 0.7]}}
+        >>> doc = {"name": "two", "state_space": {"lower": [0.0, 0.0], "upper": [4.0, 2.0]},
+        ...        "robots": [{**robot, "name": "a"},
+        ...                   {**robot, "name": "b", "initial": {"lower": [3.3, 1.3],
+        ...                                                      "upper": [3.8, 1.8]}}]}
+        >>> [r.name for r in stt.FleetSpec.from_dict(doc).robots]
+        ['a', 'b']
+        >>> doc["robots"][1]["target"] = {"lower": [3.5, 1.0], "upper": [3.0, 1.5]}
+        >>> stt.FleetSpec.from_dict(doc)
         Traceback (most recent call last):
         ...
-        stt_codegen.errors.SpecError: robots[1].target.lower: ...
+        stt_codegen.errors.SpecError: robots[1].target.lower: lower[0] = 3.5 exceeds upper[0] = 3.0
         """
         if not isinstance(data, Mapping):
             raise SpecError("", "a fleet is a table (dict)")
