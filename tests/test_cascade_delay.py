@@ -129,14 +129,29 @@ def test_the_loader_takes_a_delay_for_a_second_order_spec(case):
 
 @pytest.mark.slow
 def test_a_delay_the_cascade_cannot_hold_names_a_shorter_one_that_is_then_certified():
-    """second-order-s1 at 1 kHz with a whole period of delay: no shape is certified and no
-    faster rate holds the delay; the refusal names the largest delay (to 1/64 of it) with
-    which a shape is certified at 1 kHz, and that design is certified."""
-    spec = dataclasses.replace(stt.load_spec("second-order-s1"), delay=1e-3)
+    """second-order-s1 at 1 kHz with a delay and jitter filling the period (0.98 ms, 10 us):
+    no shape is certified and no faster rate holds the delay; the refusal names the largest
+    delay (to 1/64 of it) with which a shape is certified at 1 kHz, and that design is
+    certified."""
+    spec = dataclasses.replace(stt.load_spec("second-order-s1"), delay=0.98e-3, jitter=1e-5)
     with pytest.raises(stt.DesignError) as raised:
         stt.design_tube(spec)
     shorter = raised.value.advice["controller.delay"]
-    assert 0.0 < shorter < 1e-3
+    assert 0.0 < shorter < 0.98e-3
     assert f"controller.delay = {shorter:.3g} s is certified at 1000 Hz" in str(raised.value)
     design = stt.design_tube(dataclasses.replace(spec, delay=shorter))
+    assert design.certificate.passed and design.stage is not None
+
+
+@pytest.mark.slow
+def test_a_whole_period_the_cascade_cannot_hold_names_compensate_delay_then_certified():
+    """second-order-s1 at 1 kHz with a whole period of delay and no jitter: the refusal
+    names controller.compensate_delay = true, and that design is certified."""
+    spec = dataclasses.replace(stt.load_spec("second-order-s1"), delay=1e-3)
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(spec)
+    assert raised.value.advice == {"controller.compensate_delay": True}
+    assert ("controller.compensate_delay = true is certified with controller.delay = 0.001 s "
+            "at 1000 Hz") in str(raised.value)
+    design = stt.design_tube(dataclasses.replace(spec, compensate_delay=True))
     assert design.certificate.passed and design.stage is not None

@@ -2,7 +2,8 @@
 second-order plant): its certificate (which proves a whole period of delay on the U-maze at
 400 Hz where the plain cascade's cannot, and fails where it should), the refusals, the closed
 loop that runs it, and the generated ``predict`` of C and Python, bit for bit the CasADi
-predictor (docs/second-order.md, "Compensating a delay")."""
+predictor (its MISRA check is tests/test_delay_prediction.py's; docs/second-order.md,
+"Compensating a delay")."""
 
 from __future__ import annotations
 
@@ -197,33 +198,6 @@ def test_the_generated_predict_is_the_predictors_bit_for_bit_and_the_oracles(tmp
                    x_hat.ctypes.data_as(real_p)) == int(Status.INVALID_INPUT)
     assert not x_hat.any()
     assert module.predict(list(x), list(u)) == ([0.0] * (2 * n), int(Status.INVALID_INPUT))
-
-
-@pytest.mark.slow
-@pytest.mark.skipif(shutil.which("cppcheck") is None,
-                    reason="cppcheck missing: install the Debian package cppcheck")
-def test_the_generated_cascade_predict_keeps_misra_clean(tmp_path) -> None:
-    """cppcheck's MISRA C:2012 addon finds in the cascade's P_predict only the API's own
-    deviation (tests/test_codegen_misra.py: an API function the file does not call)."""
-    from test_codegen_misra import DEVIATIONS
-    design = _design(CASCADE)
-    prefix = c_identifier(design.spec.c_name)
-    folder = tmp_path / "gen"
-    stt.generate(design, folder, ("c",), "double")
-    proc = subprocess.run(["cppcheck", "--enable=all", "--addon=misra", "--std=c99",
-                           "--suppress=missingIncludeSystem", "--quiet",
-                           "--template={file}:{line}:{id}", f"{prefix}.c"],
-                          cwd=folder, capture_output=True, text=True, timeout=600)
-    assert proc.returncode == 0, proc.stderr
-    unused = set()
-    for name, line, check in (f.split(":") for f in proc.stderr.splitlines()
-                              if f.count(":") >= 2):
-        text = (folder / name).read_text().splitlines()[int(line) - 1]
-        assert any(d[0] == check and re.search(d[1], text) for d in DEVIATIONS), \
-            f"{name}:{line}: {check}: {text!r}"
-        if check == "unusedFunction":
-            unused.add(re.match(rf"^int {prefix}_(\w+)\(", text).group(1))
-    assert "predict" in unused                  # it is there, and clean
 
 
 @pytest.mark.slow

@@ -37,6 +37,7 @@ from stt_codegen.tube.parameters import Status
 SPECS = Path(__file__).parent / "specs"
 BASE = SPECS / "kobuki-office-compensated.toml"       # differential drive, 50 Hz, 20 ms
 FIRST = SPECS / "umaze-first-compensated.toml"        # first order, 100 Hz, 10 ms
+CASCADE = SPECS / "umaze-cascade-compensated.toml"    # the cascade, 400 Hz, 2.5 ms
 
 
 @lru_cache(maxsize=None)
@@ -247,6 +248,8 @@ def test_the_single_precision_predict_compiles_strictly(tmp_path) -> None:
                     reason="cppcheck missing: install the Debian package cppcheck")
 @pytest.mark.parametrize("path, precision", [(FIRST, "double"),
                                              pytest.param(BASE, "single",
+                                                          marks=pytest.mark.slow),
+                                             pytest.param(CASCADE, "double",
                                                           marks=pytest.mark.slow)])
 def test_the_generated_predict_keeps_misra_clean(tmp_path, path, precision) -> None:
     """cppcheck's MISRA C:2012 addon finds in P_predict only the API's own deviation

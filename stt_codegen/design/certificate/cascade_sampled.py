@@ -294,6 +294,58 @@ def _union(intervals) -> tuple[float, float, float, float]:
     return p_lo, p_hi, x_lo, x_hi
 
 
+class _Tally:
+    """The running figures of one cascade check (least margins and where, largest errors
+    at the samples, peak input and velocity per axis) and its :class:`CascadeCheck`."""
+
+    def __init__(self, design: TubeDesign, stage: SecondStage, plants: CascadeClass,
+                 timing: dict) -> None:
+        n = design.dimension
+        self.data = {"rate_hz": design.rate_hz, "position_gain": stage.position_gain,
+                     "velocity_gain": stage.velocity_gain,
+                     "width_start": list(stage.width_start),
+                     "width_floor": list(stage.width_floor), "decay": stage.decay,
+                     "class": plants.words(), **timing}
+        self.peak_u, self.peak_x2, self.peak_t = [0.0] * n, [0.0] * n, [0.0] * n
+        self.worst = {"position": math.inf, "velocity": math.inf, "least": math.inf,
+                      "t": 0.0, "i": 0}
+        self.top = [0.0, 0.0]
+
+    def judged(self, room: float, vroom: float, t: float, i: int) -> None:
+        """Take the position and velocity room of one interval and axis."""
+        worst = self.worst
+        worst["position"] = min(worst["position"], room)
+        worst["velocity"] = min(worst["velocity"], vroom)
+        if min(room, vroom) < worst["least"]:
+            worst.update(least=min(room, vroom), t=t, i=i)
+
+    def result(self, passed: bool, reason: str, t: float = 0.0, i: int = 0) -> CascadeCheck:
+        """The check's outcome; ``t``, ``i``: where it failed."""
+        worst, top = self.worst, self.top
+        pm, vm = worst["position"], worst["velocity"]
+        self.data.update({"position_margin": pm, "velocity_margin": vm,
+                          "max_abs_e1": top[0], "max_abs_e2": top[1],
+                          "peak_input": list(self.peak_u),
+                          "peak_input_time": list(self.peak_t),
+                          "peak_velocity": list(self.peak_x2)})
+        return CascadeCheck(passed, reason, pm, vm, top[0], top[1], tuple(self.peak_u),
+                            tuple(self.peak_x2), worst["t"] if passed else t,
+                            worst["i"] if passed else i, self.data, tuple(self.peak_t))
+
+
+def _unfit(stage: SecondStage, samples: TubeSamples, plants: CascadeClass,
+           longest: float) -> str:
+    """Why no interval can be checked (the class, the velocity tube's floor, the tube's
+    width; ``longest`` the longest interval, s), or ``""``."""
+    if not 0.0 < plants.g_min <= plants.g_max or longest * plants.drift_slope >= 1.0:
+        return "need 0 < g_min <= g_max and h F1 < 1"
+    if min(stage.width_floor) < GAMMA_D_MIN:
+        return f"rho2_inf is below GAMMA_D_MIN = {GAMMA_D_MIN:g}"
+    if (samples.gamma_upper - samples.gamma_lower).min() < GAMMA_D_MIN:
+        return f"the tube is narrower than GAMMA_D_MIN = {GAMMA_D_MIN:g}"
+    return ""
+
+
 def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: SecondStage,
                           plants: CascadeClass, initial_velocity, *, delay: float = 0.0,
                           jitter: float = 0.0, compensate: bool = False) -> CascadeCheck:
@@ -360,32 +412,13 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     g_min, g_max, cpl = plants.g_min, plants.g_max, plants.coupling
     f0, f1, w_amp = plants.drift_bound, plants.drift_slope, plants.disturbance_bound
     vbound = plants.velocity_bound
-    data = {"rate_hz": design.rate_hz, "position_gain": k1, "velocity_gain": k2,
-            "width_start": list(stage.width_start), "width_floor": list(stage.width_floor),
-            "decay": stage.decay, "class": plants.words()}
-    if timed:
-        data.update({"delay": delay, "jitter": jitter})
-    peak_u, peak_x2, peak_t = [0.0] * n, [0.0] * n, [0.0] * n
-    worst = {"position": math.inf, "velocity": math.inf, "least": math.inf, "t": 0.0,
-             "i": 0}
-    top = [0.0, 0.0]
-
-    def result(passed: bool, reason: str, t: float = 0.0, i: int = 0) -> CascadeCheck:
-        pm, vm = worst["position"], worst["velocity"]
-        data.update({"position_margin": pm, "velocity_margin": vm, "max_abs_e1": top[0],
-                     "max_abs_e2": top[1], "peak_input": list(peak_u),
-                     "peak_input_time": list(peak_t), "peak_velocity": list(peak_x2)})
-        return CascadeCheck(passed, reason, pm, vm, top[0], top[1], tuple(peak_u),
-                            tuple(peak_x2), worst["t"] if passed else t,
-                            worst["i"] if passed else i, data, tuple(peak_t))
-
-    if not 0.0 < g_min <= g_max or (longest if timed else h) * f1 >= 1.0:
-        return result(False, "need 0 < g_min <= g_max and h F1 < 1")
-    if min(stage.width_floor) < GAMMA_D_MIN:
-        return result(False, f"rho2_inf is below GAMMA_D_MIN = {GAMMA_D_MIN:g}")
+    tally = _Tally(design, stage, plants, {"delay": delay, "jitter": jitter} if timed else {})
+    peak_u, peak_x2, peak_t = tally.peak_u, tally.peak_x2, tally.peak_t
+    worst, top, data, result = tally.worst, tally.top, tally.data, tally.result
+    refused = _unfit(stage, samples, plants, longest if timed else h)
+    if refused:
+        return result(False, refused)
     lo, hi = samples.gamma_lower, samples.gamma_upper
-    if (hi - lo).min() < GAMMA_D_MIN:
-        return result(False, f"the tube is narrower than GAMMA_D_MIN = {GAMMA_D_MIN:g}")
     enc = enclose_tube(design, samples)
     count = len(enc.t_start)
     half, centre = 0.5 * (hi - lo), 0.5 * (hi + lo)
@@ -609,37 +642,14 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
     mix_lo = share * g_min + (1.0 - share) * g_mid
     mix_hi = share * g_max + (1.0 - share) * g_mid
     vbound = plants.velocity_bound
-    data = {"rate_hz": design.rate_hz, "position_gain": k1, "velocity_gain": k2,
-            "width_start": list(stage.width_start), "width_floor": list(stage.width_floor),
-            "decay": stage.decay, "class": plants.words(), "delay": delay, "jitter": 0.0,
-            "compensate_delay": True}
-    peak_u, peak_x2, peak_t = [0.0] * n, [0.0] * n, [0.0] * n
-    worst = {"position": math.inf, "velocity": math.inf, "least": math.inf, "t": 0.0,
-             "i": 0}
-    top = [0.0, 0.0]
-
-    def result(passed: bool, reason: str, t: float = 0.0, i: int = 0) -> CascadeCheck:
-        pm, vm = worst["position"], worst["velocity"]
-        data.update({"position_margin": pm, "velocity_margin": vm, "max_abs_e1": top[0],
-                     "max_abs_e2": top[1], "peak_input": list(peak_u),
-                     "peak_input_time": list(peak_t), "peak_velocity": list(peak_x2)})
-        return CascadeCheck(passed, reason, pm, vm, top[0], top[1], tuple(peak_u),
-                            tuple(peak_x2), worst["t"] if passed else t,
-                            worst["i"] if passed else i, data, tuple(peak_t))
-
-    def judged(room: float, vroom: float, t: float, i: int) -> None:
-        worst["position"] = min(worst["position"], room)
-        worst["velocity"] = min(worst["velocity"], vroom)
-        if min(room, vroom) < worst["least"]:
-            worst.update(least=min(room, vroom), t=t, i=i)
-
-    if not 0.0 < g_min <= g_max or h * f1 >= 1.0:
-        return result(False, "need 0 < g_min <= g_max and h F1 < 1")
-    if min(stage.width_floor) < GAMMA_D_MIN:
-        return result(False, f"rho2_inf is below GAMMA_D_MIN = {GAMMA_D_MIN:g}")
+    tally = _Tally(design, stage, plants, {"delay": delay, "jitter": 0.0,
+                                           "compensate_delay": True})
+    peak_u, peak_x2, peak_t = tally.peak_u, tally.peak_x2, tally.peak_t
+    top, result, judged = tally.top, tally.result, tally.judged
+    refused = _unfit(stage, samples, plants, h)
+    if refused:
+        return result(False, refused)
     lo, hi = samples.gamma_lower, samples.gamma_upper
-    if (hi - lo).min() < GAMMA_D_MIN:
-        return result(False, f"the tube is narrower than GAMMA_D_MIN = {GAMMA_D_MIN:g}")
     enc = enclose_tube(design, samples)
     count = len(enc.t_start)
     half, centre = 0.5 * (hi - lo), 0.5 * (hi + lo)
@@ -819,7 +829,7 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
         box1, box2, eta1, eta2 = next1, next2, next_eta1, next_eta2
     top[0] = max(top[0], max(max(-a, b) for a, b in box1))
     top[1] = max(top[1], max(max(-a, b) for a, b in box2))
-    data["horizon"] = float(samples.t[count])
+    tally.data["horizon"] = float(samples.t[count])
     return result(True, "")
 
 

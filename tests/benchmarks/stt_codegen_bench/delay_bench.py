@@ -34,31 +34,37 @@ DELAY_SPECS = ("omnirobot-s1", "omnirobot-s2", "omnirobot-s3", "crossing-moving"
                str(_TESTS / "kobuki-office.toml"), str(_TESTS / "umaze-first-order.toml"))
 
 
-def _cascade_row(spec, design) -> dict:
-    """:func:`_row` of a second-order spec: the cascade's certificate of the design's own
-    second stage, plain and predicted."""
-    tube, stage = design.tube, design.stage
+def _compared(spec, tube, plain: float | None, predicted: float | None, check) -> dict:
+    """One row: the largest delays proved, whether a whole period is (``check(delay,
+    compensate)`` runs one check and gives its verdict), and one check's CPU time of each
+    law at the plain law's largest delay, as a ratio."""
     dt = 1.0 / tube.rate_hz
-    predicted_spec = dataclasses.replace(spec, compensate_delay=True)
-    plain = largest_cascade_delay(tube, spec, stage)
-    predicted = largest_cascade_delay(tube, predicted_spec, stage)
-    with reference.numpy_math():
-        samples = sample_tube(tube)
-    plants, start = cascade_class(spec), spec.second_order.initial_velocity
-    whole = {compensate: check_cascade_sampled(tube, samples, stage, plants, start, delay=dt,
-                                               compensate=compensate).passed
-             for compensate in (False, True)}
+    whole = {compensate: check(dt, compensate) for compensate in (False, True)}
     seconds = {False: 0.0, True: 0.0}
     for compensate in (False, True):
         if plain:      # both checks pass there: each runs the whole horizon
             begin = time.process_time()
-            check_cascade_sampled(tube, samples, stage, plants, start, delay=plain,
-                                  compensate=compensate)
+            check(plain, compensate)
             seconds[compensate] = time.process_time() - begin
     return {"spec": spec.name, "variant": spec.variant, "rate_hz": tube.rate_hz,
             "period_s": dt, "plain_delay_s": plain, "predicted_delay_s": predicted,
             "plain_whole_period": whole[False], "predicted_whole_period": whole[True],
             "check_cpu_ratio": seconds[True] / seconds[False] if seconds[False] > 0 else None}
+
+
+def _cascade_row(spec, design) -> dict:
+    """:func:`_row` of a second-order spec: the cascade's certificate of the design's own
+    second stage, plain and predicted."""
+    tube, stage = design.tube, design.stage
+    plain = largest_cascade_delay(tube, spec, stage)
+    predicted = largest_cascade_delay(tube, dataclasses.replace(spec, compensate_delay=True),
+                                      stage)
+    with reference.numpy_math():
+        samples = sample_tube(tube)
+    plants, start = cascade_class(spec), spec.second_order.initial_velocity
+    return _compared(spec, tube, plain, predicted, lambda delay, compensate: (
+        check_cascade_sampled(tube, samples, stage, plants, start, delay=delay,
+                              compensate=compensate).passed))
 
 
 def _row(source: str) -> dict:
@@ -68,27 +74,15 @@ def _row(source: str) -> dict:
     if spec.variant == "cascade":
         return _cascade_row(spec, design)
     tube = design.tube
-    dt = 1.0 / tube.rate_hz
     predicted_spec = dataclasses.replace(spec, compensate_delay=True)
     with reference.numpy_math():
         samples, plants = sample_tube(tube), plant_class(spec)
         plain = largest_delay(tube, spec)
         predicted = largest_delay(tube, predicted_spec)
         # the plain check is defined up to dt - 2 jitter = dt: a whole period
-        whole = {compensate: check_sampled_first_per_axis(
-            tube, samples, plants, delay=dt, compensate=compensate).passed
-            for compensate in (False, True)}
-        seconds = {False: 0.0, True: 0.0}
-        for compensate in (False, True):
-            if plain:      # both checks pass there: each runs the whole horizon
-                begin = time.process_time()
-                check_sampled_first_per_axis(tube, samples, plants, delay=plain,
-                                             compensate=compensate)
-                seconds[compensate] = time.process_time() - begin
-    return {"spec": spec.name, "variant": spec.variant, "rate_hz": tube.rate_hz,
-            "period_s": dt, "plain_delay_s": plain, "predicted_delay_s": predicted,
-            "plain_whole_period": whole[False], "predicted_whole_period": whole[True],
-            "check_cpu_ratio": seconds[True] / seconds[False] if seconds[False] > 0 else None}
+        return _compared(spec, tube, plain, predicted, lambda delay, compensate: (
+            check_sampled_first_per_axis(tube, samples, plants, delay=delay,
+                                         compensate=compensate).passed))
 
 
 def run_delay_bench(specs: tuple[str, ...] = DELAY_SPECS) -> dict:
