@@ -57,7 +57,8 @@ def delay_predictor(spec: Spec, tube: TubeDesign, stage) -> ca.Function | None:
     -------
     casadi.Function or None
         The variant's ``predictor`` role (:func:`~stt_codegen.tube.variant_steps.law13_predictor`,
-        :func:`~stt_codegen.tube.look_ahead.look_ahead_predictor`): inputs ``x`` (the plant's
+        :func:`~stt_codegen.tube.look_ahead.look_ahead_predictor`,
+        :func:`~stt_codegen.tube.cascade.cascade_predictor`): inputs ``x`` (the plant's
         state), ``u_held`` (the command acting at the sample); output ``x_hat``.
 
     Examples
