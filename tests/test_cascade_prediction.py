@@ -128,6 +128,18 @@ def test_at_the_plain_certified_rate_a_period_is_refused_naming_a_delay_then_cer
     assert f"controller.delay = {shorter:.3g} s is certified at 230 Hz" in str(raised.value)
     design = stt.design_tube(dataclasses.replace(spec, delay=shorter))
     assert cascade_check_of(design.tube, design.spec, design.stage).passed
+    # a delay of one period of a faster rate (computed in a period, applied at the next
+    # tick): the rate named is certified with it, and its loop keeps both tubes
+    named = re.search(r"controller\.rate_hz = ([0-9.]+) with controller\.delay = ",
+                      str(raised.value))
+    assert named is not None
+    rate = float(named.group(1))
+    assert rate > 230.0
+    design = stt.design_tube(dataclasses.replace(spec, rate_hz=rate, delay=1.0 / rate))
+    assert cascade_check_of(design.tube, design.spec, design.stage).passed
+    run = stt.simulate(design, backend="reference")
+    assert run.stayed_in_tube and run.stayed_in_velocity_tube
+    assert set(run.trajectory.status.tolist()) == {int(Status.OK)}
 
 
 # ---------------------------------------------------------------------- the closed loop

@@ -293,6 +293,25 @@ def _compensated_stage(tube: TubeDesign, spec, min_width: float) -> bool:
         return certified_stage(tube, trial, min_width, spec.input_bound)[0] is not None
 
 
+def _one_period_rate(tube: TubeDesign, spec) -> float | None:
+    """With a compensated delay of one whole period (the command computed during one period
+    and applied at the next tick): the lowest rate on the two-digit grid, up to
+    ``RATE_SEARCH_FACTOR`` times the spec's, at which some shape is certified with a delay
+    of one period of that rate (bisection, as :func:`lowest_certified_rate`); ``None`` when
+    even the fastest fails."""
+    from .grid import grid_index, grid_value, smallest_passing
+
+    def passes(index: int) -> bool:
+        rate = grid_value(index)
+        trial = dataclasses.replace(spec, rate_hz=rate, delay=1.0 / rate)
+        return _rate_certified(tube, trial, rate)
+
+    low, high = grid_index(tube.rate_hz), grid_index(tube.rate_hz * RATE_SEARCH_FACTOR)
+    if high <= low or not passes(high):
+        return None
+    return grid_value(smallest_passing(passes, low, high))
+
+
 def _rate_certified(tube: TubeDesign, spec, rate_hz: float) -> bool:
     """Whether some shape is certified at ``rate_hz`` (the tube certified again there);
     not where the period is shorter than ``[controller] delay + 2 jitter``."""
@@ -449,6 +468,13 @@ def _second_stage(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage
     if delay is not None:
         need += (f"; controller.delay = {delay:.3g} s is certified at {tube.rate_hz:g} Hz "
                  f"(of {spec.delay:.3g} s)")
+    whole = (spec.compensate_delay and advice_wanted()
+             and abs(spec.delay * tube.rate_hz - 1.0) < 1e-9)
+    period_rate = _one_period_rate(tube, spec) if whole else None
+    if period_rate is not None:
+        need += (f"; if the delay is one period (computed during a period, applied at the "
+                 f"next tick), controller.rate_hz = {period_rate:g} with controller.delay = "
+                 f"{1.0 / period_rate:.3g} s is certified")
     first = derivation["tried"][0]["reason"]
     raise DesignError(f"the sampled cascade is not certified at controller.rate_hz = "
                       f"{tube.rate_hz:g} Hz for the declared plants with any second stage "
