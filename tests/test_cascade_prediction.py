@@ -7,26 +7,22 @@ predictor (its MISRA check is tests/test_delay_prediction.py's; docs/second-orde
 
 from __future__ import annotations
 
-import ctypes
 import dataclasses
 import re
 import shutil
 import subprocess
-import types
 from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 import pytest
-from codegen_helpers import COMPILERS, compile_shared
 
 import control as ct
 
 import stt_codegen as stt
-from stt_codegen.codegen.render import c_identifier
 from stt_codegen.design.certificate.cascade_sampled import (cascade_check_of, cascade_class,
                                                             check_cascade_sampled)
-from stt_codegen.design.prediction import delay_predictor, mid_gain
+from stt_codegen.design.prediction import mid_gain
 from stt_codegen.design.samples import sample_tube
 from stt_codegen.runtime.state_split import initial_state
 from stt_codegen.tube import cascade_reference, reference
@@ -177,41 +173,6 @@ def test_the_interconnected_loop_gives_simulates_run_with_the_prediction() -> No
 
 # ---------------------------------------------------------------------- the generated code
 @pytest.mark.slow
-@pytest.mark.skipif(not COMPILERS, reason="needs a C compiler: apt install gcc")
-def test_the_generated_predict_is_the_predictors_bit_for_bit_and_the_oracles(tmp_path):
-    design = _design(CASCADE)
-    spec = design.spec
-    stt.generate(design, tmp_path / "out", ("c", "python"))
-    prefix = c_identifier(spec.c_name)
-    predictor = delay_predictor(spec, design.tube, design.stage)
-    lib = ctypes.CDLL(str(compile_shared(tmp_path / "out", prefix, COMPILERS[0], "double")))
-    real_p = ctypes.POINTER(ctypes.c_double)
-    predict = getattr(lib, f"{prefix}_predict")
-    predict.argtypes, predict.restype = [real_p, real_p, real_p], ctypes.c_int
-    module = types.ModuleType(prefix)
-    exec((tmp_path / "out" / f"{prefix}.py").read_text(), module.__dict__)
-    n = spec.dimension
-    rng = np.random.default_rng(13)
-    for _ in range(100):
-        x, u = rng.uniform(-3.0, 3.0, 2 * n), rng.uniform(-2.0, 2.0, n)
-        x_hat = np.zeros(2 * n)
-        code = predict(x.ctypes.data_as(real_p), u.ctypes.data_as(real_p),
-                       x_hat.ctypes.data_as(real_p))
-        model = np.array(predictor(x, u)).ravel()
-        py_hat, py_code = module.predict(list(x), list(u))
-        assert code == py_code == int(Status.OK)
-        assert np.array_equal(x_hat, model) and np.array_equal(py_hat, model)
-        oracle = cascade_reference.predicted_state(x[None], u[None], spec.delay,
-                                                   mid_gain(spec))[0]
-        np.testing.assert_allclose(x_hat, oracle, rtol=1e-14, atol=1e-14)
-    x, u = np.full(2 * n, np.nan), np.zeros(n)
-    x_hat = np.ones(2 * n)
-    assert predict(x.ctypes.data_as(real_p), u.ctypes.data_as(real_p),
-                   x_hat.ctypes.data_as(real_p)) == int(Status.INVALID_INPUT)
-    assert not x_hat.any()
-    assert module.predict(list(x), list(u)) == ([0.0] * (2 * n), int(Status.INVALID_INPUT))
-
-
 @pytest.mark.slow
 @pytest.mark.skipif(shutil.which("gcc") is None,
                     reason="host C compiler missing: install the Debian package gcc")
