@@ -333,6 +333,13 @@ class _Tally:
                             worst["i"] if passed else i, self.data, tuple(self.peak_t))
 
 
+def _rho2(stage: SecondStage, t: np.ndarray) -> np.ndarray:
+    """The velocity tube's half-width ``rho2(t) = (rho2_0 - rho2_inf) exp(-decay t) +
+    rho2_inf`` at the times ``t`` (K,), per axis: (K, n)."""
+    start, floor = np.array(stage.width_start), np.array(stage.width_floor)
+    return (start - floor)[None, :] * np.exp(-stage.decay * t[:, None]) + floor[None, :]
+
+
 def _unfit(stage: SecondStage, samples: TubeSamples, plants: CascadeClass,
            longest: float) -> str:
     """Why no interval can be checked (the class, the velocity tube's floor, the tube's
@@ -422,9 +429,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     enc = enclose_tube(design, samples)
     count = len(enc.t_start)
     half, centre = 0.5 * (hi - lo), 0.5 * (hi + lo)
-    start, floor = np.array(stage.width_start), np.array(stage.width_floor)
-    rho2_all = ((start - floor)[None, :] * np.exp(-stage.decay * samples.t[:, None])
-                + floor[None, :])
+    rho2_all = _rho2(stage, samples.t)
     rho2 = rho2_all.tolist()
     # the velocity stage's pull and peak on every interval at once (one bisection over the
     # array, the same floats as one interval at a time)
@@ -454,9 +459,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
                   if share > 0.0 else np.full((count, n), 1.0 - 1e-15).tolist()
                   for share in sorted({share for share, _ in corners})}
         # rho2 decreases: its least on a measurement interval is at t_{k+1} + jitter
-        late = ((start - floor)[None, :] * np.exp(-stage.decay * (samples.t[1:count + 1, None]
-                                                                  + jitter))
-                + floor[None, :]).tolist()
+        late = _rho2(stage, samples.t[1:count + 1] + jitter).tolist()
     x1_0 = np.array(design.initial_state, dtype=float)
     e1_0 = ((x1_0 - centre[0]) / half[0]).tolist()
     r0 = [-(4.0 * k1 / (2.0 * half_l[0][i])) * phi_scalar(e1_0[i]) for i in range(n)]
@@ -465,7 +468,6 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     box1 = [[v, v] for v in e1_0]
     box2 = [[v, v] for v in e2_0]
     u_prev = [0.0] * n                                    # no force before the first
-    spread = g_max - g_min
     every = max(1, count // PROGRESS_REPORTS)
     for k in range(count):
         t = float(samples.t[k])
@@ -653,14 +655,9 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
     enc = enclose_tube(design, samples)
     count = len(enc.t_start)
     half, centre = 0.5 * (hi - lo), 0.5 * (hi + lo)
-    start, floor = np.array(stage.width_start), np.array(stage.width_floor)
-
-    def rho2_at(t: np.ndarray) -> np.ndarray:
-        return (start - floor)[None, :] * np.exp(-stage.decay * t[:, None]) + floor[None, :]
-
-    rho2 = rho2_at(samples.t).tolist()
+    rho2 = _rho2(stage, samples.t).tolist()
     # rho2 decreases: its least on [a_k, a_{k+1}] is at t_{k+1} + delay
-    late = rho2_at(samples.t[1:count + 1] + delay).tolist()
+    late = _rho2(stage, samples.t[1:count + 1] + delay).tolist()
     pull2_all = 2.0 * h * k2 / np.array(rho2[:count])
     peak2 = peak(np.array(rho2[:count]) / (g_min * pull2_all)).tolist()
     pull1 = (4.0 * h * k1 / (hi - lo)).tolist()
@@ -690,7 +687,7 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
     # (C0) before the first force acts: [0, delay], no force
     x1_0 = [float(v) for v in design.initial_state]
     x2_0 = [float(v) for v in initial_velocity]
-    edge0 = rho2_at(np.array([delay]))[0].tolist()
+    edge0 = _rho2(stage, np.array([delay]))[0].tolist()
     box1, box2, eta1, eta2 = [], [], [], []
     for i in range(n):
         speed = (abs(x2_0[i]) + delay * (f0 + w_amp)) / (1.0 - delay * f1)
