@@ -77,6 +77,7 @@ _LAZY: dict[str, str] = {
     "VerificationReport": "stt_codegen.proofs.check",
     "verify": "stt_codegen.verification.command",
     "import_pointmaze": "stt_codegen.pointmaze",
+    "SensedObstacle": "stt_codegen.spec.sensing",
     "Progress": "stt_codegen.progress",
     "controller_system": "stt_codegen.runtime.iosystem",
     "sampled_plant": "stt_codegen.runtime.iosystem",
@@ -98,6 +99,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .runtime.fleet import simulate_fleet
     from .spec.fleet import FleetSpec, load_fleet
     from .pointmaze import import_pointmaze
+    from .spec.sensing import SensedObstacle
     from .spec.loader import Spec, load_spec
     from .tube.parameters import TubeDesign
     from .proofs.check import VerificationReport

@@ -40,6 +40,7 @@ from .tasks import Task, build_tasks
 from .state_space import with_state_space
 from .units import warn_units
 from .second_order import SecondOrder, parse_second_order
+from .sensing import Sensing, sensing_from_table
 from .variants import variant_of
 from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
                      ControllerTable, PlantTable, PolytopeObstacle, check_document, value_kind)
@@ -311,6 +312,10 @@ class Spec:
         :attr:`state_space` is the given one shrunk by the radius and :attr:`obstacles`,
         :attr:`unsafe_sets`, :attr:`moving_obstacles` are the given ones inflated by it:
         the sets of the reference point the tube steers. ``None``: a point robot.
+    sensing : Sensing or None
+        ``[sensing]``: the envelope within which obstacles sensed at run time are avoided
+        by replanning (:mod:`~.sensing`, docs/sensing.md); ``None`` without the table. It
+        plays no part in the design of the spec itself.
 
     Examples
     --------
@@ -361,6 +366,7 @@ class Spec:
     delay: float = 0.0
     jitter: float = 0.0
     compensate_delay: bool = False
+    sensing: Sensing | None = None
 
     @property
     def dimension(self) -> int:
@@ -884,6 +890,10 @@ def _validate(raw: dict) -> Spec:
                 task_order=doc.task_order.order if doc.task_order is not None else "listed",
                 moving_obstacles=moving, robot=robot,
                 mujoco=_mujoco(doc.plant, n),
+                sensing=sensing_from_table(
+                    doc.sensing, robot.dims if robot is not None else robot_dims(None, n),
+                    variant_of(plant_entry(doc.plant.model)),
+                    robot.radius if robot is not None else 0.0),
                 drive=drive, **_timing(doc.controller, doc.plant.model))
 
 

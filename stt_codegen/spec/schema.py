@@ -27,7 +27,8 @@ from ..errors import SpecError
 from .plants import ALL_PLANT_MODELS, PLANTS, SECOND_ORDER_PLANTS
 
 __all__ = ["ActuatorTable", "AssumptionsTable", "BallObstacle", "BoxObstacle", "BoxTable", "ControllerTable",
-           "NAME_REGEX", "PlantTable", "PolytopeObstacle", "RobotTable", "check_document",
+           "NAME_REGEX", "PlantTable", "PolytopeObstacle", "RobotTable", "SensingTable",
+           "check_document",
            "json_schema", "value_kind"]
 
 #: Largest magnitude of any number in a spec.
@@ -307,6 +308,29 @@ class RobotTable(_Table):
         "state dimensions the body extends in; default the first two (the planar position)")
 
 
+class SensingTable(_Table):
+    """The sensing envelope within which obstacles sensed at run time are avoided
+    (docs/sensing.md)."""
+
+    range: Positive = Field(description="R: every obstacle with a point within this distance "
+                                        "of the robot's reference point at a measurement is "
+                                        "in it; state units of the robot's dims (metres)")
+    latency: NonNegative = Field(description="L: a measurement taken at t_m is available at "
+                                             "t_m + L, s")
+    update_rate_hz: Positive = _omitted("measurements per second (or period)")
+    period: Positive = _omitted("T_u: seconds between measurements (or update_rate_hz)")
+    max_obstacle_radius: Positive = Field(description="r_max: every obstacle fits in a ball "
+                                                      "of this radius, state units")
+    max_obstacle_speed: NonNegative = Field(description="V: the largest speed of any point "
+                                                        "of an obstacle, state units/s")
+    replan_time: NonNegative = _omitted("tau: the replanner's time budget, s; a tube planned "
+                                        "from the measurement at t_m switches in at t_m + L + "
+                                        "tau; default one period")
+    horizon: Positive = _omitted("H: how long after its switch a replanned tube is certified "
+                                 "against the sensed obstacles, s, at least one period; "
+                                 "default two periods")
+
+
 class TaskBoxTable(_Table):
     """One box of a reach task's ``any_of``."""
 
@@ -371,6 +395,8 @@ class SpecDocument(_Table):
         "order listed unless [task_order] says otherwise; omitted: none")
     task_order: TaskOrderTable = _omitted("the order of the tasks' visits; omitted: as "
                                           "listed")
+    sensing: SensingTable = _omitted("the sensing envelope of obstacles seen at run time "
+                                     "(docs/sensing.md); omitted: none")
 
 
 #: The JSON Schema dialect of :func:`json_schema`: draft 7, which TOML language servers
@@ -394,7 +420,8 @@ _TABLES: dict[str, type[_Table]] = {
     "tube": TubeTable, "controller": ControllerTable, "plant": PlantTable,
     "assumptions": AssumptionsTable, "actuator": ActuatorTable, "robot": RobotTable,
     "box": BoxObstacle, "ball": BallObstacle, "polytope": PolytopeObstacle,
-    "tasks": TaskTable, "any_of": TaskBoxTable, "task_order": TaskOrderTable}
+    "tasks": TaskTable, "any_of": TaskBoxTable, "task_order": TaskOrderTable,
+    "sensing": SensingTable}
 
 
 def key_name(key: str) -> str:

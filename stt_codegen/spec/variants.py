@@ -107,6 +107,10 @@ class ControllerVariant:
         ``[controller] compensate_delay`` is available: its ``predictor`` role predicts the
         state over the delay and its sampled-data certificate proves the predicted law
         (docs/sampled-data.md, "Compensating a delay").
+    replans_sensed : bool
+        ``[sensing]`` is available: tubes are replanned around obstacles sensed at run time
+        and switched at a sample (:mod:`stt_codegen.design.sensed`, docs/sensing.md); only
+        law (13)'s variant so far.
     timing_in_stage : bool
         The certificate of its stage (:attr:`~stt_codegen.design.result.Design.stage`)
         proves ``[controller] delay`` and ``jitter`` (the cascade's); else the design's
@@ -133,6 +137,7 @@ class ControllerVariant:
     replay_context: Mapping[str, bool] = field(default_factory=lambda: MappingProxyType({}))
     timing_in_stage: bool = False
     predicts_delay: bool = False
+    replans_sensed: bool = False
 
     def entry(self, role: str) -> Callable[..., Any]:
         """The variant's function (or class) for one role, imported on first use.
@@ -217,7 +222,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                output_limits=_P + "design.output_bound:no_output_limits",
                predictor=_P + "tube.variant_steps:law13_predictor",
                input_gain=_P + "spec.input_gains:declared_input_gain"),
-        predicts_delay=True),
+        predicts_delay=True, replans_sensed=True),
     "cascade": ControllerVariant(
         "cascade", "a second-order plant", "the cascade's input u", 2,
         " (positions, then velocities)",
