@@ -78,6 +78,10 @@ _LAZY: dict[str, str] = {
     "verify": "stt_codegen.verification.command",
     "import_pointmaze": "stt_codegen.pointmaze",
     "SensedObstacle": "stt_codegen.spec.sensing",
+    "SensedPlan": "stt_codegen.design.sensed",
+    "ReplanFailure": "stt_codegen.design.sensed",
+    "start_plan": "stt_codegen.design.sensed",
+    "replan": "stt_codegen.design.sensed",
     "Progress": "stt_codegen.progress",
     "controller_system": "stt_codegen.runtime.iosystem",
     "sampled_plant": "stt_codegen.runtime.iosystem",
@@ -100,6 +104,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .spec.fleet import FleetSpec, load_fleet
     from .pointmaze import import_pointmaze
     from .spec.sensing import SensedObstacle
+    from .design.sensed import ReplanFailure, SensedPlan, replan, start_plan
     from .spec.loader import Spec, load_spec
     from .tube.parameters import TubeDesign
     from .proofs.check import VerificationReport

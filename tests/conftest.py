@@ -18,9 +18,9 @@ from stt_codegen.spec.loader import load_spec  # noqa: E402
 CASES = ["omnirobot-s1", "omnirobot-s2", "omnirobot-s3"]
 #: The bundled examples of timed tasks (docs/tasks.md), besides the paper's.
 TASK_CASES = ["tasks-stay", "tasks-visit"]
-#: The bundled examples of moving obstacles (docs/moving-obstacles.md) and of a plant on
-#: MuJoCo (docs/mujoco.md).
-EXTRA_CASES = ["crossing-moving", "pointmaze-umaze"]
+#: The bundled examples of moving obstacles (docs/moving-obstacles.md), of a plant on
+#: MuJoCo (docs/mujoco.md) and of obstacles sensed at run time (docs/sensing.md).
+EXTRA_CASES = ["crossing-moving", "hall-crossing", "pointmaze-umaze"]
 
 # Property tests draw the same examples on every run: a fixed seed (derandomize) and no
 # example database. "ci" is the default and the only profile under CI (CI=true);

@@ -1,0 +1,623 @@
+"""Certified replanning around obstacles sensed at run time (docs/sensing.md).
+
+A spec with ``[sensing]`` (:class:`~stt_codegen.spec.sensing.Sensing`) runs a tube at a time,
+a :class:`SensedPlan`: a certified :class:`~.result.Design` in its own time, started at an
+absolute instant. From each measurement (the robot's reference point ``s`` and the
+obstacles seen at ``t_m``, :class:`~stt_codegen.spec.sensing.SensedObstacle`), available at
+``t_m + L``, :func:`replan` makes the next plan, for the switch instant
+``t_s = t_m + L + tau`` (rounded up to a sample):
+
+1. **kept**: the active tube, certified again against the new measurement over
+   ``[t_m, t_s + H]``; no switch;
+2. **switched**: else a new tube designed by :func:`~.search.design_tube` from the active
+   tube's certified box at ``t_s`` (the initial set ``X_0``, with ``x(0)`` its centre and
+   ``d_0`` its half width) to the spec's target within ``max(t_c - t_s, LATE_TIME)``,
+   avoiding the static obstacles, the known moving ones (shifted to its time) and each
+   sensed obstacle's reachable set over ``[t_s, t_s + H]`` as moving boxes over spans of
+   at most :data:`CHUNK_SECONDS` (the fleet's pattern, :mod:`.fleet`), certified for every
+   ``t`` by the design's own space-time certificate (:mod:`.certificate.motion`).
+
+Each plan is also certified to keep the robot's body, over the same span, inside the
+region no obstacle unseen at ``t_m`` can have reached: the ball of radius
+``R - V (t - t_m)`` around ``s`` (:func:`region_margin`, on the certificate's enclosure,
+cut where needed). A plan that fails either certificate is a :class:`ReplanFailure`; the
+robot then keeps its tube, whose guarantee ends at its own ``guarantee_until``. Whether
+the robot lies in the new tube at the switch is the run time's test (a state with
+``|e| <= MAX_INITIAL_ERROR`` in the new tube at its ``t = 0``), since it is only known then.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace
+from typing import Sequence
+
+import numpy as np
+
+from ..errors import DesignError, SpecError
+from ..spec.loader import Box, Spec
+from ..spec.motion import MovingObstacle
+from ..spec.sensing import SensedObstacle, Sensing
+from .certificate.fleet import RobotTube, robot_tube
+from .certificate.motion import MOVING_PROPERTY
+from .certificate.report import ROUNDING_MARGIN
+from .result import Design, require_design
+from .search import check_tube, design_tube
+
+__all__ = ["CHUNK_SECONDS", "LATE_TIME", "ReplanFailure", "SensedPlan", "reachable_boxes",
+           "region_margin", "replan", "start_plan", "switch_time", "uncertified_plan"]
+
+#: The longest time span of one box standing for a sensed obstacle's reachable set, s.
+CHUNK_SECONDS = 0.25
+#: A replanned tube reaches the target within at least this long after its switch, s (a
+#: plan after ``t_c`` or just before it is late, and says so: ``SensedPlan.arrival``).
+LATE_TIME = 2.0
+#: A new tube that leaves the region no unseen obstacle can reach is designed again to
+#: arrive this many times later (a slower tube, a late arrival), in turn.
+SLOWER = (1.0, 1.5, 2.0, 3.0)
+#: Most intervals the region certificate may cut the tube's enclosure into.
+REGION_INTERVALS = 20_000
+
+
+@dataclass(frozen=True)
+class SensedPlan:
+    """The tube a robot runs with sensed obstacles: a certified design in its own time.
+
+    Attributes
+    ----------
+    design : Design
+        The certified tube; its time ``t' = t - start``. Its spec holds the sensed
+        obstacles' reachable sets it was certified against (moving obstacles).
+    task : Spec
+        The spec as given, in absolute time (its target, ``t_c``, obstacles and
+        ``[sensing]``): what every replanned tube is designed for.
+    local : Spec
+        The task in the tube's time without the sensed obstacles: the static obstacles and
+        the known moving ones shifted by ``start`` (what the next check starts from).
+    start : float
+        The absolute instant of the tube's ``t' = 0``, s.
+    measured_at : float
+        The measurement the plan was certified against, s.
+    certified_from, guarantee_until : float
+        The absolute span over which the tube is certified to miss every sensed
+        obstacle's reachable set and to keep the body where no unseen obstacle can be,
+        s.
+    switch_at : float
+        The absolute instant the plan takes over, a sample, s (``start`` for a new tube).
+    arrival : float
+        The absolute instant from which the tube lies in the target, s (after the spec's
+        ``t_c`` when the plan is late).
+    kept : bool
+        The active tube, certified again (no switch); False: a new tube.
+    sensed : tuple of SensedObstacle
+        The measurement.
+    sensed_margin : float
+        Smallest certified separation from the sensed obstacles' reachable boxes, state
+        units (``inf``: none was sensed).
+    region_margin : float
+        Smallest certified room between the body and the region an unseen obstacle may
+        have reached, state units.
+    time_s, cpu_s : float
+        Wall and processor time of the call that made the plan, s.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("hall-crossing"))
+    >>> plan = stt.start_plan(design)
+    >>> plan.start, plan.kept, plan.guarantee_until
+    (0.0, True, 1.6)
+    """
+
+    design: Design
+    task: Spec = field(repr=False)
+    local: Spec = field(repr=False)
+    start: float
+    measured_at: float
+    certified_from: float
+    guarantee_until: float
+    switch_at: float
+    arrival: float
+    kept: bool
+    sensed: tuple[SensedObstacle, ...] = field(default=(), repr=False)
+    sensed_margin: float = math.inf
+    region_margin: float = math.inf
+    time_s: float = 0.0
+    cpu_s: float = 0.0
+
+
+@dataclass(frozen=True)
+class ReplanFailure:
+    """No certified plan from a measurement: the robot keeps its tube.
+
+    Attributes
+    ----------
+    measured_at : float
+        The measurement's instant, s.
+    reason : str
+        What failed, in words: the design's refusal, or the region certificate.
+    kind : {"design", "region", "envelope"}
+        ``design``: no tube found or certified (the design's :class:`~stt_codegen.errors.DesignError`);
+        ``region``: the tube leaves the region no unseen obstacle can reach; ``envelope``:
+        the measurement is outside the spec's envelope (a shape larger than
+        ``max_obstacle_radius``).
+    guarantee_until : float
+        Until when the plan that stays active is certified, s.
+    time_s, cpu_s : float
+        Wall and processor time of the call, s.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("hall-crossing"))
+    >>> wall = [stt.SensedObstacle.box((0.8, 0.0), (1.2, 4.0))]     # across the hall
+    >>> failed = stt.start_plan(design, wall)
+    >>> failed.kind, failed.guarantee_until
+    ('envelope', 0.0)
+    """
+
+    measured_at: float
+    reason: str
+    kind: str
+    guarantee_until: float
+    time_s: float = 0.0
+    cpu_s: float = 0.0
+
+
+def switch_time(sensing: Sensing, measured_at: float, rate_hz: float) -> float:
+    """The sample at which a tube planned from a measurement takes over.
+
+    Parameters
+    ----------
+    sensing : Sensing
+        The envelope (its latency and replanning budget).
+    measured_at : float
+        ``t_m``, s.
+    rate_hz : float
+        The controller's rate, Hz.
+
+    Returns
+    -------
+    float
+        The first sampling instant ``k / rate_hz`` at or after ``t_m + L + tau``, s.
+    """
+    k = math.ceil((measured_at + sensing.switch_delay) * rate_hz - 1e-9)
+    return k / rate_hz
+
+
+def reachable_boxes(sensed: Sequence[SensedObstacle], speed: float, reach: float,
+                    dims: Sequence[int], start: float, t_from: float, t_to: float,
+                    first_source: int, chunk: float = CHUNK_SECONDS
+                    ) -> tuple[MovingObstacle, ...]:
+    """Each sensed obstacle's reachable set, grown by the robot's radius, as boxes over spans.
+
+    Over a span ``[a, b]`` of a tube's time the box is the obstacle's shape grown by
+    ``V (start + b - seen_at)`` and by ``reach`` (the reachable set only grows), present
+    on ``[a, b]`` only (``active``, closed): together the boxes cover the reachable set
+    at every ``t`` of ``[t_from, t_to]``.
+
+    Parameters
+    ----------
+    sensed : sequence of SensedObstacle
+        The obstacles, on ``dims``.
+    speed : float
+        ``V``, state units per second.
+    reach : float
+        The robot's radius around its reference point, state units.
+    dims : sequence of int
+        The state dimensions of the obstacles.
+    start : float
+        The absolute instant of the tube's ``t' = 0``, s.
+    t_from, t_to : float
+        The span to cover, in the tube's time, s, ``t_from < t_to``.
+    first_source : int
+        The obstacle index of the first box (the next ones follow).
+    chunk : float
+        The longest span of one box, s.
+
+    Returns
+    -------
+    tuple of MovingObstacle
+        Boxes that do not move, each present over its span.
+    """
+    count = max(1, math.ceil((t_to - t_from) / chunk - 1e-9))
+    edges = np.linspace(t_from, t_to, count + 1)
+    out: list[MovingObstacle] = []
+    for ob in sensed:
+        for a, b in zip(edges[:-1], edges[1:]):
+            lo, hi = ob.reach_box(start + float(b), speed)
+            half = (hi - lo) / 2 + reach
+            out.append(MovingObstacle(
+                source=first_source + len(out), dims=tuple(int(d) for d in dims),
+                half_size=tuple(float(v) for v in half), times=(float(a),),
+                centres=(tuple(float(v) for v in (hi + lo) / 2),),
+                active=(float(a), float(b)), motion="still"))
+    return tuple(out)
+
+
+def region_margin(design: Design, sensing: Sensing, reach: float, start: float,
+                  measured_at: float, position: Sequence[float], t_from: float,
+                  t_to: float) -> tuple[float, float]:
+    """The certified room between the body and where an obstacle unseen at ``t_m`` may be.
+
+    An obstacle not in the measurement at ``t_m`` had no point within ``R`` of ``s``; by
+    ``t`` it may have come ``V (t - t_m)`` nearer. On each interval of the tube's
+    certificate enclosure that meets ``[t_from, t_to]`` the farthest corner of the tube's
+    box from ``s`` (on the sensing dimensions), plus the robot's radius, must stay below
+    ``R - V (t_end - t_m)`` (``t_end`` the interval's end, clipped to ``t_to``). Intervals
+    where it does not are cut (``alpha`` followed again on the cuts,
+    :meth:`~.certificate.fleet.RobotTube.cut`) until it does, they are single samples, or
+    :data:`REGION_INTERVALS` is reached.
+
+    Parameters
+    ----------
+    design : Design
+        The certified tube.
+    sensing : Sensing
+        The envelope.
+    reach : float
+        The robot's radius, state units.
+    start : float
+        The absolute instant of the tube's ``t' = 0``, s.
+    measured_at : float
+        ``t_m``, s.
+    position : sequence of float
+        ``s``, the reference point on ``sensing.dims`` at ``t_m``.
+    t_from, t_to : float
+        The span, in the tube's time, s.
+
+    Returns
+    -------
+    margin : float
+        The smallest room over the span, state units (positive: certified).
+    t : float
+        Where it is smallest, in the tube's time, s.
+    """
+    tube: RobotTube = robot_tube(design.tube, design.certificate)
+    s = np.asarray(position, dtype=float)
+    while True:
+        t0, t1, lo, hi = tube.boxes(sensing.dims)
+        within = (t1 >= t_from) & (t0 <= t_to)
+        end = np.minimum(t1, t_to)
+        far = np.sqrt(np.sum(np.maximum(np.abs(lo - s), np.abs(hi - s)) ** 2, axis=1))
+        room = (sensing.range - sensing.max_obstacle_speed * (start + end - measured_at)
+                - far - reach)
+        room = np.where(within, room, np.inf)
+        bad = room <= ROUNDING_MARGIN
+        if not bad.any() or t0.size > REGION_INTERVALS:
+            break
+        cut = tube.cut(bad)
+        if cut is tube:
+            break
+        tube = cut
+    k = int(np.argmin(room))
+    return float(room[k]), float(t0[k])
+
+
+def _sensed_margin(design: Design, first_source: int) -> float:
+    """The smallest certified separation from the moving boxes numbered from
+    ``first_source`` on (the sensed obstacles'), ``inf`` without any."""
+    prefix = f"{MOVING_PROPERTY} "
+    values = [m.margin for m in design.certificate.margins if m.name.startswith(prefix)
+              and int(m.name[len(prefix):]) >= first_source]
+    return min(values, default=math.inf)
+
+
+def _checked(sensed: Sequence[SensedObstacle], sensing: Sensing,
+             measured_at: float) -> tuple[SensedObstacle, ...]:
+    """The measurement, each obstacle on the sensing dimensions and seen by ``t_m``."""
+    out = tuple(sensed)
+    m = len(sensing.dims)
+    for j, ob in enumerate(out):
+        if not isinstance(ob, SensedObstacle):
+            raise SpecError(f"sensed[{j}]", f"must be a SensedObstacle, not "
+                                            f"{type(ob).__name__}")
+        if len(ob.centre) != m:
+            raise SpecError(f"sensed[{j}].centre", f"must have {m} entries (one per sensing "
+                                                   f"dimension {list(sensing.dims)}), got "
+                                                   f"{len(ob.centre)}")
+        if ob.seen_at > measured_at:
+            raise SpecError(f"sensed[{j}].seen_at", f"= {ob.seen_at!r} s is after the "
+                                                    f"measurement instant {measured_at!r} s")
+    return out
+
+
+def _too_large(sensed: Sequence[SensedObstacle], sensing: Sensing) -> str | None:
+    """Why the measurement is outside the envelope's size, or ``None``."""
+    for j, ob in enumerate(sensed):
+        if ob.extent > sensing.max_obstacle_radius * (1.0 + 1e-9):
+            return (f"sensed[{j}] has extent {ob.extent:.4g} > max_obstacle_radius "
+                    f"{sensing.max_obstacle_radius:g}: outside the envelope")
+    return None
+
+
+def _reach(spec: Spec) -> float:
+    """The robot's radius around its reference point (0: a point robot)."""
+    return 0.0 if spec.robot is None else float(spec.robot.radius)
+
+
+def _shifted(obstacles: Sequence[MovingObstacle], shift: float) -> tuple[MovingObstacle, ...]:
+    """Moving obstacles in the time of a tube started at ``shift``: every time minus it;
+    those gone before it dropped, ``active`` clipped at 0."""
+    out = []
+    for ob in obstacles:
+        t_on, t_off = ob.active[0] - shift, ob.active[1] - shift
+        if t_off < 0.0:
+            continue
+        out.append(replace(ob, times=tuple(t - shift for t in ob.times),
+                           active=(max(0.0, t_on), t_off)))
+    return tuple(out)
+
+
+def _position(spec: Spec, sensing: Sensing, position: Sequence[float] | None) -> np.ndarray:
+    """The reference point on the sensing dimensions (``x(0)``'s when ``None``)."""
+    if position is None:
+        return np.array([spec.initial_state[d] for d in sensing.dims])
+    try:
+        p = np.asarray(position, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise SpecError("position", f"must be numbers, got {position!r}") from None
+    if p.size != len(sensing.dims) or not np.all(np.isfinite(p)):
+        raise SpecError("position", f"must be {len(sensing.dims)} finite numbers (the "
+                                    f"reference point on dims {list(sensing.dims)}), got "
+                                    f"{position!r}")
+    return p
+
+
+def _certify(design: Design, local: Spec, sensing: Sensing, sensed: Sequence[SensedObstacle],
+             start: float, measured_at: float, position: np.ndarray, t_from: float,
+             t_to: float) -> tuple[Design | None, str, float, float]:
+    """``design``'s tube checked against the sensed obstacles' boxes over ``[t_from, t_to]``
+    (its time) and the region certificate: the design with that check, or ``None`` and the
+    reason, with the two margins."""
+    first = len(local.unsafe_sets) + len(local.moving_obstacles) + 1_000
+    boxes = reachable_boxes(sensed, sensing.max_obstacle_speed, _reach(local), sensing.dims,
+                            start, t_from, t_to, first)
+    spec = replace(local, moving_obstacles=local.moving_obstacles + boxes)
+    check = check_tube(design.tube, spec)
+    if not check.passed:
+        return None, check.reason, -math.inf, -math.inf
+    checked = replace(design, check=check, spec=spec)
+    sensed_margin = _sensed_margin(checked, first)
+    room, at = region_margin(checked, sensing, _reach(local), start, measured_at, position,
+                             t_from, t_to)
+    if room <= ROUNDING_MARGIN:
+        return None, (f"the tube may leave the region no unseen obstacle can reach (room "
+                      f"{room:.3g} at t = {start + at:.4f} s)"), sensed_margin, room
+    return checked, "", sensed_margin, room
+
+
+def _sensing(spec: Spec) -> Sensing:
+    """The spec's ``[sensing]``, or a :class:`SpecError` saying it has none."""
+    if spec.sensing is None:
+        raise SpecError("sensing", f"spec {spec.name!r} has no [sensing] table: the "
+                                   "envelope replanning needs (docs/sensing.md)")
+    if spec.tasks:
+        raise SpecError("sensing", "replanning a spec with [[tasks]] is not supported")
+    return spec.sensing
+
+
+def start_plan(design: Design, sensed: Sequence[SensedObstacle] = (),
+               position: Sequence[float] | None = None) -> SensedPlan | ReplanFailure:
+    """The spec's own design as the first plan, certified against a measurement at ``t = 0``.
+
+    The robot stands at ``x(0)`` until it has the measurement taken at ``t = 0``; the
+    design's tube is then certified against the obstacles seen (their reachable sets) and
+    the region no unseen obstacle can reach, over ``[0, L + tau + H]``: until the first
+    replanned tube's switch and its horizon.
+
+    Parameters
+    ----------
+    design : Design
+        :func:`~.search.design_tube` of a spec with ``[sensing]``.
+    sensed : sequence of SensedObstacle
+        The obstacles seen at ``t = 0`` (``seen_at <= 0``).
+    position : sequence of float, optional
+        The reference point on the sensing dimensions at ``t = 0``; default ``x(0)``'s.
+
+    Returns
+    -------
+    SensedPlan or ReplanFailure
+        The plan (``kept``, ``start`` 0), or why the design is not certified against the
+        measurement.
+
+    Raises
+    ------
+    TypeError
+        ``design`` is not a :class:`~.result.Design`.
+    SpecError
+        The spec has no ``[sensing]`` or has ``[[tasks]]`` (field ``sensing``); a sensed
+        obstacle not on the sensing dimensions (``sensed[j].centre``) or seen after
+        ``t = 0`` (``sensed[j].seen_at``); a bad ``position``.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("hall-crossing"))
+    >>> person = stt.SensedObstacle.ball((7.0, 3.0), 0.3)      # far ahead
+    >>> plan = stt.start_plan(design, [person])
+    >>> plan.kept, plan.guarantee_until, plan.sensed_margin > 0
+    (True, 1.6, True)
+    """
+    design = require_design(design, "start_plan")
+    spec = design.spec
+    sensing = _sensing(spec)
+    started, cpu = time.perf_counter(), time.process_time()
+    sensed = _checked(sensed, sensing, 0.0)
+    s = _position(spec, sensing, position)
+    until = sensing.switch_delay + sensing.horizon
+    local = spec
+
+    def failed(reason: str, kind: str) -> ReplanFailure:
+        return ReplanFailure(0.0, reason, kind, 0.0, time.perf_counter() - started,
+                             time.process_time() - cpu)
+
+    large = _too_large(sensed, sensing)
+    if large is not None:
+        return failed(large, "envelope")
+    checked, reason, margin, room = _certify(design, local, sensing, sensed, 0.0, 0.0, s,
+                                             0.0, until)
+    if checked is None:
+        return failed(reason, "region" if room > -math.inf else "design")
+    return SensedPlan(checked, spec, local, 0.0, 0.0, 0.0, until, 0.0, spec.prescribed_time,
+                      True, sensed, margin, room, time.perf_counter() - started,
+                      time.process_time() - cpu)
+
+
+def uncertified_plan(design: Design) -> SensedPlan:
+    """The spec's design as the active plan with no certificate against sensed obstacles
+    (``guarantee_until`` 0): what the robot runs when :func:`start_plan` fails.
+
+    Parameters
+    ----------
+    design : Design
+        :func:`~.search.design_tube` of a spec with ``[sensing]``.
+
+    Returns
+    -------
+    SensedPlan
+    """
+    design = require_design(design, "uncertified_plan")
+    _sensing(design.spec)
+    return SensedPlan(design, design.spec, design.spec, 0.0, 0.0, 0.0, 0.0, 0.0,
+                      design.spec.prescribed_time, True)
+
+
+def _box_at(plan: SensedPlan, t_local: float, state_space: Box) -> Box:
+    """The active tube's certified box at its time ``t_local`` (an interval of its
+    enclosure holding it, cut to a single sample where it can be), clipped to ``X``."""
+    tube = robot_tube(plan.design.tube, plan.design.certificate)
+    while True:
+        enc = tube.enclosure
+        k = int(np.searchsorted(enc.t_start, t_local, side="right") - 1)
+        mask = np.zeros(enc.t_start.size, dtype=bool)
+        mask[k] = True
+        cut = tube.cut(mask)
+        if cut is tube:
+            break
+        tube = cut
+    lo = np.maximum(enc.lower_min[k], state_space.lower)
+    hi = np.minimum(enc.upper_max[k], state_space.upper)
+    return Box(tuple(float(v) for v in lo), tuple(float(v) for v in hi))
+
+
+def replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
+           sensed: Sequence[SensedObstacle]) -> SensedPlan | ReplanFailure:
+    """The next certified plan from a measurement, or why there is none.
+
+    The switch instant is ``t_s = t_m + L + tau`` rounded up to a sample
+    (:func:`switch_time`). First the active tube is certified again against the
+    measurement over ``[t_m, t_s + H]`` (``kept``: no switch). Else a new tube is designed
+    from the active tube's certified box at ``t_s`` to the target, avoiding every known
+    obstacle and the sensed obstacles' reachable sets over ``[t_s, t_s + H]``, and
+    certified for every ``t``; and both plans must keep the body inside the region no
+    obstacle unseen at ``t_m`` can have reached (:func:`region_margin`). The run time
+    switches to a new tube at ``t_s`` only if the state lies in it then (docs/sensing.md).
+
+    Parameters
+    ----------
+    plan : SensedPlan
+        The active plan (:func:`start_plan`, or a previous :func:`replan`).
+    measured_at : float
+        ``t_m``, s, not before the active plan's ``measured_at``.
+    position : sequence of float
+        The robot's reference point on the sensing dimensions at ``t_m``, state units.
+    sensed : sequence of SensedObstacle
+        The obstacles seen at ``t_m`` (each ``seen_at <= t_m``).
+
+    Returns
+    -------
+    SensedPlan or ReplanFailure
+        The kept or new plan; or the failure, with the active plan's ``guarantee_until``.
+
+    Raises
+    ------
+    TypeError
+        ``plan`` is not a :class:`SensedPlan`.
+    SpecError
+        ``measured_at`` before the active plan's measurement (field ``measured_at``); a
+        sensed obstacle not on the sensing dimensions or seen after ``t_m``; a bad
+        ``position``.
+
+    Examples
+    --------
+    A person stands in the base's way; the tube from the start does not keep clear of where
+    they may be, so a new one is designed (it waits, then passes):
+
+    >>> import stt_codegen as stt
+    >>> plan = stt.start_plan(stt.design_tube(stt.load_spec("hall-crossing")))
+    >>> person = stt.SensedObstacle.ball((4.0, 2.8), 0.3, seen_at=1.0)
+    >>> new = stt.replan(plan, 1.0, (1.0, 3.0), [person])
+    >>> new.kept, new.switch_at, new.guarantee_until, new.sensed_margin > 0
+    (False, 1.6, 2.6, True)
+    """
+    if not isinstance(plan, SensedPlan):
+        raise TypeError(f"replan(): parameter 'plan' must be a SensedPlan (from start_plan "
+                        f"or replan), not {type(plan).__name__}")
+    local = plan.local
+    sensing = _sensing(plan.task)
+    started, cpu = time.perf_counter(), time.process_time()
+    try:
+        t_m = float(measured_at)
+    except (TypeError, ValueError):
+        raise SpecError("measured_at", f"must be a number of seconds, got "
+                                       f"{measured_at!r}") from None
+    if not math.isfinite(t_m) or t_m < plan.measured_at:
+        raise SpecError("measured_at", f"= {measured_at!r} s must be finite and not before "
+                                       f"the active plan's measurement at "
+                                       f"{plan.measured_at!r} s")
+    sensed = _checked(sensed, sensing, t_m)
+    s = _position(local, sensing, position)
+    t_s = switch_time(sensing, t_m, local.rate_hz)
+    until = t_s + sensing.horizon
+
+    def done(**fields) -> SensedPlan:
+        return SensedPlan(**fields, measured_at=t_m, guarantee_until=until, sensed=sensed,
+                          time_s=time.perf_counter() - started,
+                          cpu_s=time.process_time() - cpu)
+
+    def failed(reason: str, kind: str) -> ReplanFailure:
+        return ReplanFailure(t_m, reason, kind, plan.guarantee_until,
+                             time.perf_counter() - started, time.process_time() - cpu)
+
+    large = _too_large(sensed, sensing)
+    if large is not None:
+        return failed(large, "envelope")
+    # 1. the active tube, certified again from the measurement on
+    kept, _, margin, room = _certify(plan.design, local, sensing, sensed, plan.start, t_m, s,
+                                     max(0.0, t_m - plan.start), until - plan.start)
+    if kept is not None:
+        return done(design=kept, task=plan.task, local=local, start=plan.start, certified_from=t_m,
+                    switch_at=plan.switch_at, arrival=plan.arrival, kept=True,
+                    sensed_margin=margin, region_margin=room)
+    # 2. a new tube from the active tube's box at the switch
+    base = plan.task
+    box = _box_at(plan, t_s - plan.start, base.state_space)
+    remaining = max(base.prescribed_time - t_s, LATE_TIME)
+    first = len(base.unsafe_sets) + len(base.moving_obstacles) + 1_000
+    boxes = reachable_boxes(sensed, sensing.max_obstacle_speed, _reach(base), sensing.dims,
+                            t_s, 0.0, sensing.horizon, first)
+    rooms = []
+    for slower in SLOWER:
+        new_local = replace(
+            base, prescribed_time=remaining * slower, initial_set=box,
+            initial_state=box.center,
+            initial_half_width=tuple((b - a) / 2 for a, b in zip(box.lower, box.upper)),
+            moving_obstacles=_shifted(base.moving_obstacles, t_s), target_any_of=())
+        try:
+            new = design_tube(replace(new_local,
+                                      moving_obstacles=new_local.moving_obstacles + boxes))
+        except DesignError as exc:
+            return failed(f"no tube from the box at t = {t_s:.4f} s to the target within "
+                          f"{remaining * slower:.4g} s: {exc}", "design")
+        room, at = region_margin(new, sensing, _reach(base), t_s, t_m, s, 0.0,
+                                 sensing.horizon)
+        if room > ROUNDING_MARGIN:
+            return done(design=new, task=plan.task, local=new_local, start=t_s,
+                        certified_from=t_s, switch_at=t_s, arrival=t_s + remaining * slower,
+                        kept=False, sensed_margin=_sensed_margin(new, first),
+                        region_margin=room)
+        rooms.append(f"{room:.3g} at t = {t_s + at:.4f} s within {remaining * slower:.4g} s")
+    return failed("the new tube may leave the region no unseen obstacle can reach, even "
+                  "slower (room " + "; ".join(rooms) + ")", "region")

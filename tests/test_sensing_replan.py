@@ -1,0 +1,156 @@
+"""The replanner for sensed obstacles: reachable boxes, the start plan, kept and new tubes,
+the region no unseen obstacle can reach (docs/sensing.md)."""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+import stt_codegen as stt
+from stt_codegen.design.sensed import (SLOWER, reachable_boxes, region_margin, switch_time)
+from stt_codegen.tube import reference
+
+
+@pytest.fixture(scope="module")
+def hall():
+    return stt.design_tube(stt.load_spec("hall-crossing"))
+
+
+@pytest.fixture(scope="module")
+def start(hall):
+    return stt.start_plan(hall)
+
+
+def oracle_tube(tube, t_end, rate_hz):
+    """The deployed tube at every sample of ``[0, t_end]`` by the numpy oracle: ``alpha``
+    stepped from 0 by the implicit step, as the controller steps it."""
+    dt = 1.0 / rate_hz
+    ts = np.arange(int(round(t_end * rate_hz)) + 1) * dt
+    alphas = np.zeros((ts.size, 2 * tube.dimension))
+    with reference.numpy_math():
+        for k in range(ts.size - 1):
+            alphas[k + 1] = reference.alpha_step(tube, ts[k:k + 1], np.array([dt]),
+                                                 alphas[k:k + 1])[0]
+        g_l, g_u, _, _ = reference.adaptive_tube(tube, ts, alphas)
+    return ts, g_l, g_u
+
+
+def test_the_reachable_boxes_cover_the_reachable_set_at_every_instant():
+    person = stt.SensedObstacle.ball((3.0, 2.0), 0.3, seen_at=1.0)
+    crate = stt.SensedObstacle.box((5.0, 1.0), (5.4, 1.6), seen_at=0.8)
+    boxes = reachable_boxes([person, crate], 0.8, 0.25, (0, 1), start=1.5, t_from=0.2,
+                            t_to=1.2, first_source=7)
+    assert [b.source for b in boxes] == list(range(7, 7 + len(boxes)))
+    assert all(b.active[1] - b.active[0] <= 0.25 + 1e-12 for b in boxes)
+    for ob in (person, crate):
+        for t in np.linspace(0.2, 1.2, 41):             # the tube's time; absolute 1.5 + t
+            lo, hi = ob.reach_box(1.5 + t, 0.8)
+            lo, hi = lo - 0.25, hi + 0.25
+            held = [b for b in boxes if b.is_active(t)[0]
+                    and np.all(b.centre(t)[0] - b.half_size <= lo + 1e-12)
+                    and np.all(b.centre(t)[0] + b.half_size >= hi - 1e-12)]
+            assert held, (ob, t)
+    assert not any(b.is_active(1.3)[0] for b in boxes)   # nothing past the span
+
+
+def test_the_start_plan_is_certified_until_the_first_switch_and_its_horizon(start):
+    s = start.task.sensing
+    assert start.kept and start.start == 0.0
+    assert start.guarantee_until == pytest.approx(s.latency + s.replan_time + s.horizon)
+    assert start.region_margin > 0 and math.isinf(start.sensed_margin)
+    assert switch_time(s, 0.5, 100.0) == pytest.approx(1.1)
+
+
+def test_the_start_plan_fails_with_a_person_beside_the_start(hall):
+    beside = stt.start_plan(hall, [stt.SensedObstacle.ball((2.2, 3.0), 0.3)])
+    assert isinstance(beside, stt.ReplanFailure) and beside.kind == "design"
+    assert "avoids moving obstacle" in beside.reason and beside.guarantee_until == 0.0
+    wall = stt.start_plan(hall, [stt.SensedObstacle.box((5.0, 0.0), (5.4, 6.0))])
+    assert wall.kind == "envelope" and "max_obstacle_radius" in wall.reason
+
+
+def test_a_person_far_away_keeps_the_tube(start):
+    kept = stt.replan(start, 1.0, (1.0, 3.0), [stt.SensedObstacle.ball((7.5, 1.0), 0.3,
+                                                                       seen_at=1.0)])
+    assert kept.kept and kept.design.tube == start.design.tube
+    assert (kept.certified_from, kept.guarantee_until) == pytest.approx((1.0, 2.6))
+    assert kept.sensed_margin > 0 and kept.region_margin > 0
+
+
+@pytest.fixture(scope="module")
+def person():
+    return stt.SensedObstacle.ball((4.0, 2.8), 0.3, seen_at=1.0)
+
+
+@pytest.fixture(scope="module")
+def new(start, person):
+    return stt.replan(start, 1.0, (1.0, 3.0), [person])
+
+
+def test_a_person_in_the_way_gives_a_new_certified_tube(start, person, new):
+    """The new tube misses the person's reachable box at every sample of its horizon (the
+    oracle's tube, checked apart from the certificate)."""
+    sensing = start.task.sensing
+    assert not new.kept and new.start == new.switch_at == pytest.approx(1.6)
+    assert new.design.certificate.passed and new.sensed_margin > 0
+    ts, lows, highs = oracle_tube(new.design.tube, sensing.horizon, 100.0)
+    for t, lo, hi in zip(ts, lows, highs):
+        p_lo, p_hi = person.reach_box(new.start + t, sensing.max_obstacle_speed)
+        apart = np.any((hi[:2] + 0.25 < p_lo) | (lo[:2] - 0.25 > p_hi))
+        assert apart, t
+
+
+@pytest.mark.slow
+def test_the_new_tube_starts_from_a_box_holding_the_old_tube(start, new):
+    """The old tube at the switch (the oracle's) lies in the new tube's start box."""
+    old_t, old_lo, old_hi = oracle_tube(start.design.tube, 1.6, 100.0)
+    box = new.design.spec.initial_set
+    assert np.all(old_lo[-1] >= np.array(box.lower) - 1e-12)
+    assert np.all(old_hi[-1] <= np.array(box.upper) + 1e-12)
+
+
+def test_the_region_certificate_refuses_a_tube_that_outruns_the_range():
+    """A range just above what the envelope needs: the base's straight tube drives beyond
+    where it can see before the next plan, at every speed tried, so no plan is certified."""
+    doc = {"name": "corridor", "prescribed_time": 3.0,
+           "state_space": {"lower": [0.0, 0.0], "upper": [12.0, 2.0]},
+           "initial": {"lower": [0.0, 0.5], "upper": [1.0, 1.5], "half_width": [0.2, 0.2]},
+           "target": {"lower": [11.0, 0.5], "upper": [12.0, 1.5]},
+           "controller": {"rate_hz": 100.0},
+           "sensing": {"range": 2.0, "latency": 0.1, "period": 0.5,
+                       "max_obstacle_radius": 0.3, "max_obstacle_speed": 0.5}}
+    design = stt.design_tube(stt.Spec.from_dict(doc))
+    failed = stt.start_plan(design)
+    assert isinstance(failed, stt.ReplanFailure) and failed.kind == "region"
+    assert "region no unseen obstacle can reach" in failed.reason
+    slow = stt.design_tube(stt.Spec.from_dict({**copy.deepcopy(doc),
+                                               "prescribed_time": 60.0}))
+    room, _ = region_margin(slow, slow.spec.sensing, 0.0, 0.0, 0.0, (0.5, 1.0), 0.0, 1.6)
+    assert room > 0 and stt.start_plan(slow).region_margin == pytest.approx(room)
+    assert SLOWER[0] == 1.0
+
+
+def test_bad_calls_name_the_field(hall, start):
+    plain = dataclasses.replace(hall, spec=dataclasses.replace(hall.spec, sensing=None))
+    with pytest.raises(stt.SpecError) as caught:
+        stt.start_plan(plain)
+    assert caught.value.field == "sensing"
+    with pytest.raises(stt.SpecError) as caught:
+        stt.start_plan(hall, [stt.SensedObstacle.ball((1.0, 2.0, 0.0), 0.2)])
+    assert caught.value.field == "sensed[0].centre"
+    with pytest.raises(stt.SpecError) as caught:
+        stt.replan(start, 1.0, (1.0, 3.0), [stt.SensedObstacle.ball((5.0, 2.0), 0.2,
+                                                                    seen_at=2.0)])
+    assert caught.value.field == "sensed[0].seen_at"
+    with pytest.raises(stt.SpecError) as caught:
+        stt.replan(start, -1.0, (1.0, 3.0), [])
+    assert caught.value.field == "measured_at"
+    with pytest.raises(stt.SpecError) as caught:
+        stt.replan(start, 1.0, (1.0,), [])
+    assert caught.value.field == "position"
+    with pytest.raises(TypeError, match="SensedPlan"):
+        stt.replan(hall, 1.0, (1.0, 3.0), [])
