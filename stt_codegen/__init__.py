@@ -82,6 +82,7 @@ _LAZY: dict[str, str] = {
     "ReplanFailure": "stt_codegen.design.sensed",
     "start_plan": "stt_codegen.design.sensed",
     "replan": "stt_codegen.design.sensed",
+    "simulate_sensed": "stt_codegen.runtime.sensed",
     "Progress": "stt_codegen.progress",
     "controller_system": "stt_codegen.runtime.iosystem",
     "sampled_plant": "stt_codegen.runtime.iosystem",
@@ -105,6 +106,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .pointmaze import import_pointmaze
     from .spec.sensing import SensedObstacle
     from .design.sensed import ReplanFailure, SensedPlan, replan, start_plan
+    from .runtime.sensed import simulate_sensed
     from .spec.loader import Spec, load_spec
     from .tube.parameters import TubeDesign
     from .proofs.check import VerificationReport

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -73,6 +74,9 @@ class Trajectory:
         Second-order plant: the cascade's virtual velocity ``r`` at ``t_k`` (the centre of
         the velocity tube, from the numpy oracle at the run's states), state units per
         second; ``None`` for a first-order plant or a controller without a second stage.
+    tube : ndarray of int, shape (N,), or None
+        A run with sensed obstacles (:func:`~.sensed.simulate_sensed`): the tube active at
+        ``t_k`` (0: the design's, then each tube switched in); ``None`` otherwise.
     """
 
     t: np.ndarray
@@ -82,6 +86,7 @@ class Trajectory:
     status: np.ndarray
     velocity: np.ndarray | None = None
     r: np.ndarray | None = None
+    tube: np.ndarray | None = None
 
 
 @dataclass
@@ -149,6 +154,10 @@ class SimulationResult:
         ``None`` for the other plants.
     first_contact : list or None
         ``[t, geom1, geom2]`` of the first such contact (s, geom names), else ``None``.
+    sensing : SensingRecord or None
+        A run with sensed obstacles (:func:`~.sensed.simulate_sensed`): the replanning's
+        events, the spans no certificate covered, the replanner's times and the
+        envelope's violations (:class:`~.sensed.SensingRecord`); ``None`` otherwise.
 
     Examples
     --------
@@ -194,6 +203,7 @@ class SimulationResult:
     exceeded_velocity_bound: bool = False
     contacts: int | None = None
     first_contact: list | None = None
+    sensing: Any = None
 
     def summary_rows(self) -> Rows:
         """The rows of :meth:`summary`: ``(label, value)`` in words.
@@ -228,6 +238,8 @@ class SimulationResult:
                          + "".join(f"; {t.task} NOT met" for t in self.tasks if not t.met)))
         if self.contacts is not None:
             rows.append(("contacts", f"{self.contacts} MuJoCo steps in contact"))
+        if self.sensing is not None:
+            rows.append(("sensing", self.sensing.summary()))
         return rows
 
     def summary(self) -> str:
@@ -267,6 +279,8 @@ class SimulationResult:
         if data["contacts"] is None:
             data.pop("contacts")
             data.pop("first_contact")
+        if data["sensing"] is None:
+            data.pop("sensing")
         if data["max_abs_velocity"] is None:
             for key in ("stayed_in_velocity_tube", "max_abs_velocity",
                         "exceeded_velocity_bound"):

@@ -1,0 +1,142 @@
+"""The closed loop with sensed obstacles: replanning keeps the base safe within the
+envelope, an obstacle outside it is reported, a pursuer at the envelope's speed ends the
+guarantee (docs/sensing.md)."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+import stt_codegen as stt
+from stt_codegen.runtime.sensed import WalkingObstacle
+
+
+@pytest.fixture(scope="module")
+def hall():
+    return stt.design_tube(stt.load_spec("hall-crossing"))
+
+
+def events(run, kind):
+    return [e for e in run.sensing.events if e.event == kind]
+
+
+def test_a_far_obstacle_keeps_the_tube(hall):
+    """Two seconds with a person standing beyond the pillars: the tube is kept at every
+    measurement, certified throughout, and the record is JSON."""
+    run = stt.simulate_sensed(hall, [WalkingObstacle((8.0, 5.0), 0.3)], horizon=2.0)
+    record = run.sensing
+    assert record.measurements == 5 and record.switches == 0 and record.failures == 0
+    assert [e.event for e in record.events] == ["start"] + ["kept"] * 3
+    assert record.guaranteed and record.uncertified == [] and not record.outside_envelope
+    assert set(run.trajectory.tube) == {0} and run.stayed_in_tube and not run.collision
+    assert record.min_sensed_clearance > 4.0
+    assert json.loads(json.dumps(run.to_json()))["sensing"]["measurements"] == 5
+    assert "5 measurements, 0 switches" in run.summary()
+
+
+def test_a_switch_is_refused_when_the_state_is_not_in_the_new_tube(hall, monkeypatch):
+    """A new tube that starts 0.5 m off the base (planned for a base elsewhere) is refused at
+    its switch with the state's |e|; the active tube runs on and the base stays in it."""
+    from stt_codegen.runtime import sensed as run_sensed
+    elsewhere = dataclasses.replace(hall.spec, initial_state=(0.8, 3.5, 0.0),
+                                    initial_set=stt.spec.loader.Box((0.3, 3.0, -0.1),
+                                                                    (1.3, 4.0, 0.1)))
+    other = stt.start_plan(stt.design_tube(elsewhere))
+    real = run_sensed.replan
+
+    def offset(plan, t_m, s, seen):
+        made = real(other, t_m, s, [stt.SensedObstacle.ball((4.0, 3.3), 0.3, seen_at=t_m)])
+        return made if plan.start == 0.0 and not made.kept else real(plan, t_m, s, seen)
+
+    monkeypatch.setattr(run_sensed, "replan", offset)
+    run = stt.simulate_sensed(hall, [], horizon=1.7)
+    refused = events(run, "refused")
+    assert refused and run.sensing.refused == len(refused) and run.sensing.switches == 0
+    assert "|e| = " in refused[0].detail and refused[0].time == pytest.approx(1.6)
+    assert set(run.trajectory.tube) == {0} and run.stayed_in_tube
+
+
+def test_bad_input_names_the_field(hall):
+    with pytest.raises(stt.SpecError) as caught:
+        WalkingObstacle((1.0, 2.0), 0.3, velocity=(1.0, 0.0), pursuit_speed=1.0)
+    assert caught.value.field == "WalkingObstacle.pursuit_speed"
+    with pytest.raises(stt.SpecError) as caught:
+        WalkingObstacle((1.0, 2.0), 0.3, path=((1.0, 2.0, 2.0), (0.5, 3.0, 3.0)))
+    assert caught.value.field == "WalkingObstacle.path"
+    with pytest.raises(stt.SpecError) as caught:
+        stt.simulate_sensed(hall, [WalkingObstacle((1.0, 2.0, 0.0), 0.3)], horizon=0.5)
+    assert caught.value.field == "obstacles[0].start"
+    plain = dataclasses.replace(hall, spec=dataclasses.replace(hall.spec, sensing=None))
+    with pytest.raises(stt.SpecError) as caught:
+        stt.simulate_sensed(plain, [], horizon=0.5)
+    assert caught.value.field == "sensing"
+    with pytest.raises(stt.SpecError) as caught:
+        stt.simulate_sensed(hall, [], horizon=-1.0)
+    assert caught.value.field == "horizon"
+
+
+@pytest.mark.slow
+def test_people_crossing_force_replanning_and_the_base_stays_safe_in_its_tube(hall):
+    """Two people walk across the base's way within the envelope: the base switches tubes,
+    never refuses or fails, is certified throughout, stays in whichever tube is active,
+    touches no one and reaches the target by t_c."""
+    people = [WalkingObstacle((5.0, 0.5), 0.3, velocity=(0.0, 0.5)),
+              WalkingObstacle((7.0, 5.5), 0.35, path=((2.0, 7.0, 5.5), (10.0, 7.0, 0.5)))]
+    run = stt.simulate_sensed(hall, people)
+    record = run.sensing
+    assert record.switches >= 3 and record.refused == 0 and record.failures == 0
+    assert record.guaranteed and not record.outside_envelope
+    assert not record.script_outside_envelope
+    assert run.stayed_in_tube and not record.sensed_collision and not run.collision
+    assert run.satisfied and run.reach_time <= hall.spec.prescribed_time
+    assert record.min_sensed_clearance > 0.0
+    assert set(np.unique(run.trajectory.tube)) == set(range(record.switches + 1))
+    for e in events(run, "switched"):
+        assert float(e.detail.split("= ")[1].split(" ")[0]) <= 0.5      # |e| at the switch
+
+
+@pytest.mark.slow
+def test_an_obstacle_faster_than_the_envelope_collides_and_is_reported(hall):
+    """A pursuer at 2.5 m/s (the envelope says 0.8) reaches the base: the collision is in
+    the result, and the run is reported outside the envelope, never as guaranteed."""
+    run = stt.simulate_sensed(hall, [WalkingObstacle((9.0, 1.0), 0.3, pursuit_speed=2.5)])
+    record = run.sensing
+    assert record.sensed_collision and run.collision and not run.satisfied
+    assert record.outside_envelope and record.script_outside_envelope
+    assert not record.guaranteed
+    kinds = {v.kind for v in record.violations}
+    assert {"speed", "displacement"} <= kinds
+    first = min(v.time for v in record.violations)
+    hit = run.trajectory.t[np.argmax(_clearance(run, hall, 2.5) <= 0.0)]
+    assert first < hit            # reported before the collision
+
+
+@pytest.mark.slow
+def test_a_pursuer_at_the_envelopes_speed_ends_the_guarantee(hall):
+    """A pursuer at the envelope's own speed: no measurement breaks the envelope, but no
+    tube escapes it, so the replanning fails and the run reports the span no certificate
+    covered; the collision comes after the guarantee ended, never inside a certified span."""
+    run = stt.simulate_sensed(hall, [WalkingObstacle((9.0, 1.0), 0.3, pursuit_speed=0.8)])
+    record = run.sensing
+    assert not record.outside_envelope and not record.script_outside_envelope
+    assert record.failures > 0 and record.uncertified and not record.guaranteed
+    assert record.sensed_collision
+    hit = float(run.trajectory.t[np.argmax(_clearance(run, hall, 0.8) <= 0.0)])
+    assert any(a <= hit <= b for a, b in record.uncertified)
+
+
+def _clearance(run, hall, speed):
+    """The body's distance to the pursuer at each sample, its path replayed from the run's
+    positions (it heads for the point where the base was at each period's start)."""
+    p = np.array([9.0, 1.0])
+    dt = 1.0 / hall.spec.rate_hz
+    out = []
+    for x in run.trajectory.x[:, :2]:
+        out.append(np.linalg.norm(x - p) - 0.3 - 0.25)
+        gap = x - p
+        norm = np.linalg.norm(gap)
+        p = p + (gap / norm * min(speed * dt, norm) if norm > 0 else 0.0)
+    return np.array(out)
