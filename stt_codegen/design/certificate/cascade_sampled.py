@@ -35,7 +35,11 @@ from functools import lru_cache
 
 import numpy as np
 
-from .enclosures import enclose_later, enclose_tube
+from .cascade_bounds import STEP_PIECES, step_velocity_change, virtual_velocity_change
+from .cascade_step import (FIGURES, RHO_ROUNDING, predicted_step, run_steps,
+                           sampled_step)
+from .enclosures import enclose_later
+from .growing import GrowingEnclosure
 from ..samples import TubeSamples, sample_tube
 from ...progress import report
 from ...spec.loader import Spec
@@ -46,17 +50,13 @@ from ...tube import reference
 from ...tube.parameters import E_MAX, GAMMA_D_MIN, TubeDesign
 from ...tube.second_stage import SecondStage
 from .sampled import DELAY_HALVINGS, largest_passing, worst_near
-from .sampled_axis import (axis_interval, peak, peak_scalar, phi_scalar,
-                           phi_slope_scalar)
+from .sampled_axis import peak, phi_scalar
 
-__all__ = ["CascadeClass", "CascadeCheck", "cascade_check_of", "cascade_class", "model_within_class",
-           "certify_stage", "check_cascade_predicted", "check_cascade_sampled",
-           "largest_cascade_delay",
-           "step_velocity_change", "virtual_velocity_change"]
+__all__ = ["CascadeClass", "CascadeCheck", "RHO_ROUNDING", "STEP_PIECES", "cascade_check_of",
+           "cascade_class", "model_within_class", "certify_stage", "check_cascade_predicted",
+           "check_cascade_sampled", "largest_cascade_delay", "step_velocity_change",
+           "tube_figures", "virtual_velocity_change"]
 
-#: Relative safety factor on the closed-form ``rho2(t_{k+1})`` the path is judged against
-#: (rounding of ``exp``; every margin reported is far above it).
-RHO_ROUNDING = 1e-12
 #: Progress events the per-sample loop of :func:`check_cascade_sampled` reports at most
 #: (:mod:`stt_codegen.progress`; nothing without a receiver).
 PROGRESS_REPORTS = 50
@@ -182,118 +182,6 @@ class CascadeCheck:
     peak_input_time: tuple[float, ...] = ()
 
 
-def virtual_velocity_change(k1: float, h: float, e1_start: float, e1_path: float,
-                            speed: float, tube_move: float, width_min: float,
-                            width_max: float) -> float:
-    """A bound of ``|r(x1(t), t) - r(x1(t_k), t_k)|`` on ``[t_k, t_k + h]`` along one
-    trajectory.
-
-    ``r = -(4 k1 / gamma_d) phi(e1)`` (:func:`~.sampled_axis.phi`). With ``q = phi(e1) /
-    gamma_d``, ``|q(t) - q_k| <= phi'(E) |e1(t) - e1_k| / W_min + phi(E_k) (1 / W_min - 1 /
-    W_max)`` (mean value; ``phi'`` increases in ``|e|``), and ``e1(t) - e1_k = (2 dx1 -
-    d gamma_s - e1_k d gamma_d) / gamma_d(t)`` with ``|dx1| <= h max |x2|``, ``|d gamma_s|,
-    |d gamma_d| <= M`` (the spans of both bounds over the interval).
-
-    Parameters
-    ----------
-    k1 : float
-        Position gain.
-    h : float
-        Sampling period, s.
-    e1_start : float
-        ``E_k >= |e1(t_k)|``.
-    e1_path : float
-        ``E >= |e1(t)|`` on the interval, ``< 1``.
-    speed : float
-        Bound of ``|x2_i|`` on the interval.
-    tube_move : float
-        ``M``: span of ``gamma_L`` plus span of ``gamma_U`` over the interval.
-    width_min, width_max : float
-        Bounds of ``gamma_d`` over the interval, ``0 < width_min <= width_max``.
-
-    Returns
-    -------
-    float
-        Velocity units.
-    """
-    de1 = (2.0 * h * speed + (1.0 + e1_start) * tube_move) / width_min
-    return 4.0 * k1 * (phi_slope_scalar(e1_path) * de1 / width_min
-                       + phi_scalar(e1_start) * (1.0 / width_min - 1.0 / width_max))
-
-
-#: Pieces the range of ``e1(t_k)`` is cut into for :func:`step_velocity_change`.
-STEP_PIECES = 8
-
-
-def step_velocity_change(k1: float, h: float, a: float, b: float, shift: float,
-                         scale: float, reach: float, half_k: float, half_n: float,
-                         other: float) -> float:
-    """A bound of ``|r(x1(t_{k+1}), t_{k+1}) - r(x1(t_k), t_k)|`` along one trajectory, for
-    every ``e1(t_k)`` in ``[a, b]``, from the tube at the two samples (exact there).
-
-    With ``alpha = h_k / h_n``, ``beta = (c_k - c_n) / h_n`` (``c``, ``h``: centre and
-    half-width), ``e1(t_{k+1}) - e1(t_k) = m(e) + d``, ``m(e) = (alpha - 1) e + beta + h
-    r_k(e) / h_n`` (``r_k(e) = -(2 k1 / h_k) phi(e)``) and ``|d| <= other / h_n``
-    (``other >= h |z_k| + h^2 A / 2``). ``r_n(e') - r_k(e) = -(2 k1 / h_n) (phi(e') -
-    phi(e)) - 2 k1 phi(e) (1 / h_n - 1 / h_k)``; ``m`` is bounded on each of
-    :data:`STEP_PIECES` pieces of ``[a, b]`` by interval arithmetic (``phi`` increases),
-    ``phi'`` at the largest ``|e|`` the piece and its step reach (at most ``reach < 1``,
-    the next sample's bound of ``|e1|``).
-
-    Parameters
-    ----------
-    k1 : float
-    h : float
-        Sampling period, s.
-    a, b : float
-        Range of ``e1(t_k)``.
-    shift, scale : float
-        ``beta`` and ``alpha`` above.
-    reach : float
-        Bound of ``|e1|`` at both samples, ``< 1``.
-    half_k, half_n : float
-        Half-widths of the tube at ``t_k``, ``t_{k+1}``.
-    other : float
-        State units.
-
-    Returns
-    -------
-    float
-        Velocity units.
-    """
-    pull = 2.0 * k1 * h / half_k
-    h_ratio = 1.0 / half_n
-    worst = 0.0
-    edges = [a + (b - a) * j / STEP_PIECES for j in range(STEP_PIECES + 1)]
-    # phi at each edge once (phi is odd: phi(|e|) = |phi(e)|); the same values as per piece
-    phis = [phi_scalar(e) for e in edges]
-    widen = abs(1.0 / half_n - 1.0 / half_k)
-    slope_k, other_n, tilt = 2.0 * k1 / half_n, other * h_ratio, scale - 1.0
-    for j in range(STEP_PIECES):
-        c, d = edges[j], edges[j + 1]
-        lin_c, lin_d = tilt * c, tilt * d
-        m_hi = (lin_c if lin_c > lin_d else lin_d) + shift + h_ratio * (-pull * phis[j])
-        m_lo = (lin_d if lin_c > lin_d else lin_c) + shift + h_ratio * (-pull * phis[j + 1])
-        move = max(abs(m_hi), abs(m_lo)) + other_n
-        wide = abs(c) if abs(c) >= abs(d) else abs(d)
-        phi_wide = abs(phis[j]) if abs(c) >= abs(d) else abs(phis[j + 1])
-        top = min(wide + move, reach)
-        worst = max(worst, slope_k * phi_slope_scalar(top) * move
-                    + 2.0 * k1 * phi_wide * widen)
-    return worst
-
-
-def _union(intervals) -> tuple[float, float, float, float]:
-    """The union of :func:`~.sampled_axis.axis_interval`'s ``(path_lo, path_hi, end_lo,
-    end_hi)`` over corners."""
-    p_lo = x_lo = math.inf
-    p_hi = x_hi = -math.inf
-    for a_lo, a_hi, b_lo, b_hi in intervals:
-        p_lo, p_hi = min(p_lo, a_lo), max(p_hi, a_hi)
-        x_lo, x_hi = min(x_lo, b_lo), max(x_hi, b_hi)
-    return p_lo, p_hi, x_lo, x_hi
-
-
 class _Tally:
     """The running figures of one cascade check (least margins and where, largest errors
     at the samples, peak input and velocity per axis) and its :class:`CascadeCheck`."""
@@ -318,6 +206,67 @@ class _Tally:
         worst["velocity"] = min(worst["velocity"], vroom)
         if min(room, vroom) < worst["least"]:
             worst.update(least=min(room, vroom), t=t, i=i)
+
+    def absorb(self, figures: np.ndarray, times: np.ndarray,
+               failure: tuple[int, str, int] | None) -> None:
+        """Take the figures of the steps run (``(8, n, K)``,
+        :data:`~.cascade_step.FIGURES`) up to the judgement that failed (``(k, what, i)``
+        of :func:`_first_failure`, or ``None``), as the per-sample loop takes them: at a
+        sample the bounds of ``|e1|`` and ``|e2|``; then, axis by axis, the input and the
+        velocity, the position room, the velocity room (the least room of both and where,
+        first reached, only when nothing failed)."""
+        f = dict(zip(FIGURES, figures))
+        n, count = figures.shape[1], figures.shape[2]
+        steps = min(count, failure[0] + 1) if failure else count
+        done = np.zeros((n, count), dtype=bool)       # the axes judged before the failure
+        done[:, :steps] = True
+        reached = [True, True, True]                  # input and speed, room, vroom
+        axis = None                                   # the axis judged when it failed
+        if failure:
+            k, what, i = failure
+            if what in ("e1", "e2"):
+                done[:, k] = False
+            else:
+                done[i:, k] = False
+                axis = i
+                reached = [True, what != "speed", what in ("vroom", "reach")]
+        for name, place in (("reach1", 0), ("reach2", 1)):
+            self.top[place] = max(self.top[place], float(f[name][:, :steps].max()))
+
+        def taken(name: str, i: int, also: bool) -> tuple[np.ndarray, np.ndarray]:
+            mask = done[i].copy()
+            if i == axis:
+                mask[failure[0]] = also
+            return f[name][i][mask], np.flatnonzero(mask)
+
+        for i in range(n):
+            u, at = taken("u_abs", i, reached[0])
+            if u.size and u.max() > self.peak_u[i]:
+                j = int(np.argmax(u))                 # the first sample reaching it
+                self.peak_u[i], self.peak_t[i] = float(u[j]), float(times[at[j]])
+            speed, _ = taken("speed", i, reached[0])
+            if speed.size:
+                self.peak_x2[i] = max(self.peak_x2[i], float(speed.max()))
+        worst = self.worst
+        for key, name, also in (("position", "room", reached[1]),
+                                ("velocity", "vroom", reached[2])):
+            values = np.concatenate([taken(name, i, also)[0] for i in range(n)])
+            if values.size:
+                worst[key] = min(worst[key], float(values.min()))
+        if failure is None and count:
+            least = np.minimum(f["room"], f["vroom"]).T.ravel()      # (k, i) in order
+            j = int(np.argmin(least))
+            if least[j] < worst["least"]:
+                worst.update(least=float(least[j]), t=float(times[j // n]), i=j % n)
+
+    def close(self, state: np.ndarray, n: int) -> None:
+        """Take the bounds of ``|e1|``, ``|e2|`` at the last sample (``state``: the boxes of
+        ``e1`` and ``e2``, lower bounds then upper)."""
+        box = state[:4 * n].reshape(4, n)
+        self.top[0] = max(self.top[0], max(max(-a, b) for a, b in zip(box[0].tolist(),
+                                                                      box[1].tolist())))
+        self.top[1] = max(self.top[1], max(max(-a, b) for a, b in zip(box[2].tolist(),
+                                                                      box[3].tolist())))
 
     def result(self, passed: bool, reason: str, t: float = 0.0, i: int = 0) -> CascadeCheck:
         """The check's outcome; ``t``, ``i``: where it failed."""
@@ -355,7 +304,8 @@ def _unfit(stage: SecondStage, samples: TubeSamples, plants: CascadeClass,
 
 def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: SecondStage,
                           plants: CascadeClass, initial_velocity, *, delay: float = 0.0,
-                          jitter: float = 0.0, compensate: bool = False) -> CascadeCheck:
+                          jitter: float = 0.0, compensate: bool = False,
+                          enclosure: GrowingEnclosure | None = None) -> CascadeCheck:
     """Prove that the sampled cascade keeps ``|e1| < 1`` and ``|e2| < 1`` at and between
     samples for every plant of ``plants`` (module docstring; docs/second-order.md).
 
@@ -384,6 +334,9 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     compensate : bool
         ``[controller] compensate_delay``: the law at the state predicted over ``delay``
         (:func:`check_cascade_predicted`, which this returns when ``delay > 0``).
+    enclosure : GrowingEnclosure, optional
+        The enclosure of ``design``'s ``samples``, when the caller keeps it (it depends on
+        the tube only, not on the stage: :func:`tube_figures`); a new one when ``None``.
 
     Returns
     -------
@@ -399,7 +352,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
         if jitter != 0.0:
             raise ValueError(f"jitter = {jitter!r} s must be 0 with compensate")
         return check_cascade_predicted(design, samples, stage, plants, initial_velocity,
-                                       delay=delay)
+                                       delay=delay, enclosure=enclosure)
     n = design.dimension
     h = 1.0 / design.rate_hz
     if delay < 0.0 or jitter < 0.0 or delay + 2.0 * jitter > h * (1.0 + 1e-12):
@@ -420,174 +373,161 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     f0, f1, w_amp = plants.drift_bound, plants.drift_slope, plants.disturbance_bound
     vbound = plants.velocity_bound
     tally = _Tally(design, stage, plants, {"delay": delay, "jitter": jitter} if timed else {})
-    peak_u, peak_x2, peak_t = tally.peak_u, tally.peak_x2, tally.peak_t
-    worst, top, data, result = tally.worst, tally.top, tally.data, tally.result
     refused = _unfit(stage, samples, plants, longest if timed else h)
     if refused:
-        return result(False, refused)
+        return tally.result(False, refused)
     lo, hi = samples.gamma_lower, samples.gamma_upper
-    enc = enclose_tube(design, samples)
-    count = len(enc.t_start)
+    growing = GrowingEnclosure(design, samples) if enclosure is None else enclosure
+    count = growing.count
     half, centre = 0.5 * (hi - lo), 0.5 * (hi + lo)
     rho2_all = _rho2(stage, samples.t)
-    rho2 = rho2_all.tolist()
-    # the velocity stage's pull and peak on every interval at once (one bisection over the
-    # array, the same floats as one interval at a time)
-    pull2_all = 2.0 * h * k2 / rho2_all[:count]
-    peak2 = peak(rho2_all[:count] / (g_min * pull2_all)).tolist()
-    pull1 = (4.0 * h * k1 / (hi - lo)).tolist()
-    peak1 = peak(0.5 * (hi - lo) / (4.0 * h * k1 / (hi - lo))).tolist()
-    half_l, centre_l = half.tolist(), centre.tolist()
-    # with jitter an interval reaches into its neighbours: the tube's enclosure is the
-    # worst of intervals k - 1 .. k + 1, in absolute units (then in interval k's coordinates)
-    upper_min, lower_max = (worst_near(enc.upper_min, jitter, np.minimum),
-                            worst_near(enc.lower_max, jitter, np.maximum))
-    upper_max, lower_min = (worst_near(enc.upper_max, jitter, np.maximum),
-                            worst_near(enc.lower_min, jitter, np.minimum))
-    up_e = ((upper_min - centre[:count]) / half[:count]).tolist()
-    low_e = ((lower_max - centre[:count]) / half[:count]).tolist()
-    room_up, room_low = upper_min.tolist(), lower_max.tolist()
-    width_min = worst_near(enc.width_min, jitter, np.minimum).tolist()
-    width_max = (upper_max - lower_min).tolist()
-    move = ((lower_max - lower_min) + (upper_max - upper_min)).tolist()
     if timed:
-        # s* of each share of a period the own force (the virtual velocity) acts
         shares1 = sorted({length / h for length in lengths})
-        peaks1 = {share: peak(0.5 * (hi - lo) / (share * 4.0 * h * k1 / (hi - lo))).tolist()
-                  for share in shares1}
-        peaks2 = {share: peak(rho2_all[:count] / (g_min * share * pull2_all)).tolist()
-                  if share > 0.0 else np.full((count, n), 1.0 - 1e-15).tolist()
-                  for share in sorted({share for share, _ in corners})}
-        # rho2 decreases: its least on a measurement interval is at t_{k+1} + jitter
-        late = _rho2(stage, samples.t[1:count + 1] + jitter).tolist()
+        spans = sorted(set(lengths))
+    else:
+        shares1, corners, spans = [1.0], [(1.0, 0.0)], [h]
+
+    def column(a: int, b: int) -> dict:
+        """The tube's figures of intervals ``a .. b - 1`` (:data:`.cascade_step.SAMPLED_COLUMNS`),
+        each ``(b - a, n)`` or ``(b - a, copies n)``."""
+        # with jitter an interval reaches into its neighbours: the tube's enclosure is the
+        # worst of intervals k - 1 .. k + 1, in absolute units (then in interval k's
+        # coordinates); each row depends on its interval alone, so these are the rows of
+        # the whole tube's
+        enc = growing.first(b + 1)
+        upper_min, lower_max = (worst_near(enc.upper_min, jitter, np.minimum)[a:b],
+                                worst_near(enc.lower_max, jitter, np.maximum)[a:b])
+        upper_max, lower_min = (worst_near(enc.upper_max, jitter, np.maximum)[a:b],
+                                worst_near(enc.lower_min, jitter, np.minimum)[a:b])
+        width = hi[a:b] - lo[a:b]
+        rho = rho2_all[a:b]
+        # the velocity stage's pull and peak on every interval at once (one bisection over
+        # the array, the same floats as one interval at a time)
+        pull2_all = 2.0 * h * k2 / rho
+        out = {"centre": centre[a:b], "half": half[a:b],
+               "centre_next": centre[a + 1:b + 1], "half_next": half[a + 1:b + 1],
+               "pull1": 4.0 * h * k1 / width,
+               "up_e": (upper_min - centre[a:b]) / half[a:b],
+               "low_e": (lower_max - centre[a:b]) / half[a:b],
+               "room_up": upper_min, "room_low": lower_max,
+               "width_min": worst_near(enc.width_min, jitter, np.minimum)[a:b],
+               "width_max": upper_max - lower_min,
+               "move": (lower_max - lower_min) + (upper_max - upper_min),
+               "rho": rho, "rho_next": rho2_all[a + 1:b + 1]}
+        if timed:
+            # s* of each share of a period the own force (the virtual velocity) acts
+            out["peak1"] = np.hstack([peak(0.5 * width / (share * 4.0 * h * k1 / width))
+                                      for share in shares1])
+            out["peak2"] = np.hstack([peak(rho / (g_min * share * pull2_all))
+                                      if share > 0.0 else np.full((b - a, n), 1.0 - 1e-15)
+                                      for share, _ in corners])
+            # rho2 decreases: its least on a measurement interval is at t_{k+1} + jitter
+            out["edge"] = _rho2(stage, samples.t[a + 1:b + 1] + jitter)
+        else:
+            out["peak1"] = peak(0.5 * width / (4.0 * h * k1 / width))
+            out["peak2"] = peak(rho / (g_min * pull2_all))
+            out["edge"] = out["rho_next"]
+        return out
+
+    step, columns, constants = sampled_step(n, timed, delay > 0.0, len(shares1), len(corners),
+                                            len(spans))
     x1_0 = np.array(design.initial_state, dtype=float)
     e1_0 = ((x1_0 - centre[0]) / half[0]).tolist()
-    r0 = [-(4.0 * k1 / (2.0 * half_l[0][i])) * phi_scalar(e1_0[i]) for i in range(n)]
+    r0 = [-(4.0 * k1 / (2.0 * float(half[0][i]))) * phi_scalar(e1_0[i]) for i in range(n)]
     x2_0 = [float(v) for v in initial_velocity]
-    e2_0 = [(x2_0[i] - r0[i]) / rho2[0][i] for i in range(n)]
-    box1 = [[v, v] for v in e1_0]
-    box2 = [[v, v] for v in e2_0]
-    u_prev = [0.0] * n                                    # no force before the first
-    every = max(1, count // PROGRESS_REPORTS)
-    for k in range(count):
-        t = float(samples.t[k])
-        if k % every == 0:
-            report("cascade certificate", k / count,
-                   f"the sampled cascade's certificate: t = {t:.3g} s of {samples.t[-1]:.3g} s")
-        reach1 = [max(-a, b) for a, b in box1]
-        reach2 = [max(-a, b) for a, b in box2]
-        top[0], top[1] = max(top[0], max(reach1)), max(top[1], max(reach2))
-        for name, reach in (("e1", reach1), ("e2", reach2)):
-            if max(reach) > E_MAX:
-                i = int(np.argmax(reach))
-                return result(False, f"|{name}_{i}| may reach {max(reach):.6g} at t = "
-                              f"{t:.4f} s, beyond the clamp E_MAX", t, i)
-        rho_k, rho_n = rho2[k], rho2[k + 1]
-        u_abs = [2.0 * k2 / rho_k[i] * phi_scalar(reach2[i]) for i in range(n)]
-        u_sq = sum(v * v for v in u_abs)
-        u_prev_sq = sum(v * v for v in u_prev)
-        next1, next2 = [], []
-        for i in range(n):
-            if u_abs[i] > peak_u[i]:
-                peak_u[i], peak_t[i] = u_abs[i], t
-            others = math.sqrt(max(u_sq - u_abs[i] ** 2, 0.0))
-            z_abs = reach2[i] * rho_k[i]
-            r_abs = 4.0 * k1 / (2.0 * half_l[k][i]) * phi_scalar(reach1[i])
-            if not timed:
-                push_free = g_max * u_abs[i] + cpl * others + f0 + w_amp  # |x2_dot| w/o F1
-                speed = (r_abs + z_abs + h * push_free) / (1.0 - h * f1)
-            else:
-                # the force is u_{k-1} for the lag, then u_k: x2 moves under the larger
-                force_old = g_max * u_prev[i] + cpl * math.sqrt(
-                    max(u_prev_sq - u_prev[i] ** 2, 0.0)) if delay > 0.0 else 0.0
-                force = max(g_max * u_abs[i] + cpl * others, force_old)
-                speed = (r_abs + z_abs + longest * (force + f0 + w_amp)) / (1.0 - longest * f1)
-            peak_x2[i] = max(peak_x2[i], speed)
-            if vbound is not None and speed >= vbound[i]:
-                return result(False, f"|x2_{i}| may reach {speed:.4g} on [{t:.4f}, "
-                              f"{t + h:.4f}] s, beyond velocity_bound {vbound[i]:g} (the "
-                              "drift bound is declared within it)", t, i)
-            drift = f0 + f1 * speed + w_amp
-            if not timed:
-                accel = g_max * u_abs[i] + cpl * others + drift
-                # position stage: law (13) with g = 1 and a displacement <= tau (Z + h A/2)
-                shift = h * z_abs + 0.5 * h * h * accel
-                p_lo, p_hi, x_lo, x_hi = axis_interval(
-                    box1[i][0], box1[i][1], centre_l[k][i], half_l[k][i], pull1[k][i], 1.0,
-                    1.0, peak1[k][i], shift)
-            else:
-                accel = force + drift                     # the old force's and the new's
-                shift = longest * z_abs + 0.5 * longest * longest * accel
-                p_lo, p_hi, x_lo, x_hi = _union(axis_interval(
-                    box1[i][0], box1[i][1], centre_l[k][i], half_l[k][i],
-                    share * pull1[k][i], 1.0, 1.0, peaks1[share][k][i], shift)
-                    for share in shares1)
-            e_lo = (p_lo - centre_l[k][i]) / half_l[k][i]
-            e_hi = (p_hi - centre_l[k][i]) / half_l[k][i]
-            room = min(up_e[k][i] - e_hi, e_lo - low_e[k][i])
-            worst["position"] = min(worst["position"], room)
-            if room <= 0.0:
-                return result(False, f"the position may leave its tube in dimension {i} on "
-                              f"[{t:.4f}, {t + h:.4f}] s (the enclosure of x1 reaches "
-                              f"{-room:.3g} half-widths beyond its edge)", t, i)
-            gap = min(room_up[k][i] - p_hi, p_lo - room_low[k][i])
-            e1_path = max(1.0 - 2.0 * gap / width_max[k][i], reach1[i])
-            dr = virtual_velocity_change(k1, longest if timed else h, reach1[i], e1_path,
-                                         speed, move[k][i], width_min[k][i], width_max[k][i])
-            # velocity stage: law (13)'s transform on |z| < rho2, the change of r on top
-            if not timed:
-                pull2, s_peak = 2.0 * h * k2 / rho_k[i], peak2[k][i]
-                q_lo, q_hi, z_lo, z_hi = axis_interval(
-                    box2[i][0], box2[i][1], 0.0, rho_k[i], pull2, g_min, g_max, s_peak,
-                    h * drift, h * others, cpl, 0.0)
-                edge = rho_n[i] * (1.0 - RHO_ROUNDING)
-            else:
-                pull2 = 2.0 * h * k2 / rho_k[i]
-                old = force_old + drift                   # |x2_dot| under u_{k-1}
-                q_lo, q_hi, z_lo, z_hi = _union(axis_interval(
-                    box2[i][0], box2[i][1], 0.0, rho_k[i], share * pull2, g_min, g_max,
-                    peaks2[share][k][i], share * h * drift + lag * old,
-                    share * h * others, cpl, 0.0) for share, lag in corners)
-                # while the previous force acts, z moves from z(s_k) by at most this
-                q_lo = min(q_lo, box2[i][0] * rho_k[i] - delay * old)
-                q_hi = max(q_hi, box2[i][1] * rho_k[i] + delay * old)
-                edge = late[k][i] * (1.0 - RHO_ROUNDING)
-            vroom = 1.0 - max(-(q_lo - dr), q_hi + dr) / edge
-            worst["velocity"] = min(worst["velocity"], vroom)
-            if min(room, vroom) < worst["least"]:
-                worst.update(least=min(room, vroom), t=t, i=i)
-            if vroom <= 0.0:
-                return result(False, f"the velocity error may leave its tube in dimension "
-                              f"{i} on [{t:.4f}, {t + h:.4f}] s (|e2| up to "
-                              f"{1.0 - vroom:.4g}; the change of r alone is {dr / edge:.3g} "
-                              "of rho2)", t, i)
-            box_n = [(x_lo - centre_l[k + 1][i]) / half_l[k + 1][i],
-                     (x_hi - centre_l[k + 1][i]) / half_l[k + 1][i]]
-            reach_n = max(-box_n[0], box_n[1], reach1[i])
-            if reach_n >= 1.0:
-                return result(False, f"|e1_{i}| may reach {reach_n:.6g} at t = {t + h:.4f} s",
-                              t, i)
-            # at the next sample: over the interval's length, h without jitter (the bound
-            # is convex in the length: its ends cover the range)
-            dr_end = min(dr, max(step_velocity_change(
-                k1, length, box1[i][0], box1[i][1],
-                (centre_l[k][i] - centre_l[k + 1][i]) / half_l[k + 1][i],
-                half_l[k][i] / half_l[k + 1][i], reach_n, half_l[k][i], half_l[k + 1][i],
-                shift) for length in (sorted(set(lengths)) if timed else (h,))))
-            next1.append(box_n)
-            next2.append([(z_lo - dr_end) / rho_n[i], (z_hi + dr_end) / rho_n[i]])
-        if timed:
-            u_prev = u_abs
-        box1, box2 = next1, next2
-    top[0] = max(top[0], max(max(-a, b) for a, b in box1))
-    top[1] = max(top[1], max(max(-a, b) for a, b in box2))
-    data["horizon"] = float(samples.t[count])
-    return result(True, "")
+    e2_0 = [(x2_0[i] - r0[i]) / float(rho2_all[0][i]) for i in range(n)]
+    start = np.array(e1_0 + e1_0 + e2_0 + e2_0 + [0.0] * n)   # no force before the first
+    fixed = constants.pack({
+        "k1": k1, "k2": k2, "h": h, "g_min": g_min, "g_max": g_max, "coupling": cpl,
+        "f0": f0, "f1": f1, "w": w_amp, "longest": longest, "delay": delay,
+        "vbound": np.inf if vbound is None else vbound, "share": shares1,
+        "corner_share": [share for share, _ in corners],
+        "corner_lag": [lag for _, lag in corners], "length": spans})
+    figures, state = _run(step, start, lambda a, b: columns.pack(
+        {name: value.T for name, value in column(a, b).items()}, b - a), count, fixed,
+        lambda r: r <= E_MAX, vbound, samples, "the sampled cascade's")
+    failure = _first_failure(figures, lambda r: r <= E_MAX, vbound)
+    tally.absorb(figures, samples.t, failure)
+    if failure is not None:
+        k, what, i = failure
+        t, f = float(samples.t[k]), {name: float(v[i, k]) for name, v in zip(FIGURES, figures)}
+        span = f"[{t:.4f}, {t + h:.4f}] s"
+        if what in ("e1", "e2"):
+            reach = f["reach1" if what == "e1" else "reach2"]
+            reason = (f"|{what}_{i}| may reach {reach:.6g} at t = {t:.4f} s, beyond the clamp "
+                      "E_MAX")
+        else:
+            edge = float(column(k, k + 1)["edge"][0][i]) * (1.0 - RHO_ROUNDING)
+            reason = _axis_reason(what, i, f, span, vbound, f["dr"] / edge,
+                                  f"|e1_{i}| may reach {f['reach_next']:.6g} at t = "
+                                  f"{t + h:.4f} s")
+        return tally.result(False, reason, t, i)
+    tally.close(state, n)
+    tally.data["horizon"] = float(samples.t[count])
+    return tally.result(True, "")
+
+
+def _first_failure(figures: np.ndarray, inside, vbound) -> tuple[int, str, int] | None:
+    """Where the per-sample loop first fails in ``figures`` (``(8, n, K)``,
+    :data:`~.cascade_step.FIGURES`), in the order it judges: at a sample the bounds of
+    ``|e1|`` then ``|e2|`` (``inside``: what they must satisfy), then axis by axis the
+    velocity bound, the position room, the velocity room, the next ``|e1|``. A figure that
+    is not a number fails. ``(k, what, i)`` or ``None``."""
+    f = dict(zip(FIGURES, figures))
+    e1 = ~inside(f["reach1"].max(axis=0))
+    e2 = ~inside(f["reach2"].max(axis=0))
+    fast = (np.isnan(f["speed"]) if vbound is None
+            else ~(f["speed"] < np.array(vbound, dtype=float)[:, None]))
+    per_axis = np.stack([fast, ~(f["room"] > 0.0), ~(f["vroom"] > 0.0),
+                         ~(f["reach_next"] < 1.0)])
+    bad = e1 | e2 | per_axis.any(axis=(0, 1))
+    if not bad.any():
+        return None
+    k = int(np.argmax(bad))
+    if e1[k] or e2[k]:
+        name = "reach1" if e1[k] else "reach2"
+        return k, "e1" if e1[k] else "e2", int(np.argmax(f[name][:, k]))
+    i = int(np.argmax(per_axis[:, :, k].any(axis=0)))
+    return k, _STAGES[int(np.argmax(per_axis[:, i, k]))], i
+
+
+#: The judgements of one axis on one interval, in the loop's order.
+_STAGES = ("speed", "room", "vroom", "reach")
+
+
+def _run(step, start, columns, count: int, constants, inside, vbound, samples: TubeSamples,
+         whose: str):
+    """:func:`~.cascade_step.run_steps` until the first failure, reporting progress."""
+    end = float(samples.t[-1])
+
+    def progress(done: int) -> None:
+        report("cascade certificate", done / count, f"{whose} certificate: t = "
+               f"{float(samples.t[done]):.3g} s of {end:.3g} s")
+
+    return run_steps(step, start, columns, count, constants,
+                     lambda figures: _first_failure(figures, inside, vbound) is not None,
+                     progress)
+
+
+def _axis_reason(what: str, i: int, f: dict, span: str, vbound, change: float,
+                 next_words: str) -> str:
+    """The words of a failure on one axis (``f``: its figures at the failing step)."""
+    if what == "speed":
+        return (f"|x2_{i}| may reach {f['speed']:.4g} on {span}"
+                + ("" if vbound is None else f", beyond velocity_bound {vbound[i]:g} (the "
+                   "drift bound is declared within it)"))
+    if what == "room":
+        return (f"the position may leave its tube in dimension {i} on {span} (the enclosure "
+                f"of x1 reaches {-f['room']:.3g} half-widths beyond its edge)")
+    if what == "vroom":
+        return (f"the velocity error may leave its tube in dimension {i} on {span} (|e2| up "
+                f"to {1.0 - f['vroom']:.4g}; the change of r alone is {change:.3g} of rho2)")
+    return next_words
 
 
 def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: SecondStage,
-                            plants: CascadeClass, initial_velocity, *,
-                            delay: float) -> CascadeCheck:
+                            plants: CascadeClass, initial_velocity, *, delay: float,
+                            enclosure: GrowingEnclosure | None = None) -> CascadeCheck:
     """Prove that the cascade with the delay-compensating prediction keeps ``|e1| < 1`` and
     ``|e2| < 1`` at every instant of the horizon for every plant of ``plants``.
 
@@ -618,6 +558,9 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
         ``x2(0)``.
     delay : float
         The computation delay, s, in ``(0, h]``.
+    enclosure : GrowingEnclosure, optional
+        The enclosure of ``design``'s ``samples`` (:func:`tube_figures`); a new one when
+        ``None``.
 
     Returns
     -------
@@ -646,43 +589,43 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
     vbound = plants.velocity_bound
     tally = _Tally(design, stage, plants, {"delay": delay, "jitter": 0.0,
                                            "compensate_delay": True})
-    peak_u, peak_x2, peak_t = tally.peak_u, tally.peak_x2, tally.peak_t
-    top, result, judged = tally.top, tally.result, tally.judged
+    result, judged = tally.result, tally.judged
     refused = _unfit(stage, samples, plants, h)
     if refused:
         return result(False, refused)
     lo, hi = samples.gamma_lower, samples.gamma_upper
-    enc = enclose_tube(design, samples)
+    enc = (GrowingEnclosure(design, samples) if enclosure is None else enclosure).first(
+        len(samples.t) - 1)
     count = len(enc.t_start)
     half, centre = 0.5 * (hi - lo), 0.5 * (hi + lo)
-    rho2 = _rho2(stage, samples.t).tolist()
-    # rho2 decreases: its least on [a_k, a_{k+1}] is at t_{k+1} + delay
-    late = _rho2(stage, samples.t[1:count + 1] + delay).tolist()
-    pull2_all = 2.0 * h * k2 / np.array(rho2[:count])
-    peak2 = peak(np.array(rho2[:count]) / (g_min * pull2_all)).tolist()
-    pull1 = (4.0 * h * k1 / (hi - lo)).tolist()
-    peak1 = peak(0.5 * (hi - lo) / (4.0 * h * k1 / (hi - lo))).tolist()
-    half_l, centre_l = half.tolist(), centre.tolist()
-    width_max_own = enc.upper_max - enc.lower_min
-    move_own = (enc.lower_max - enc.lower_min) + (enc.upper_max - enc.upper_min)
+    rho2 = _rho2(stage, samples.t)
+    pull2_all = 2.0 * h * k2 / rho2[:count]
     # over the actuation interval [t_k + delay, t_{k+1} + delay] (absolute units)
     act = enclose_later(design, samples, delay, delay)
-    room_up, room_low = act.upper_min, act.lower_max
-    up_e = ((room_up - centre[:count]) / half[:count]).tolist()
-    low_e = ((room_low - centre[:count]) / half[:count]).tolist()
-    room_up, room_low = room_up.tolist(), room_low.tolist()
-    width_max_a = (act.upper_max - act.lower_min).tolist()
     # r changes from (x1_hat_k, t_k) to (x1(t), t), t <= t_{k+1} + delay: the tube's span
     # and widths over [t_k, t_{k+1} + delay]
     whole = enclose_later(design, samples, 0.0, delay)
-    move_r = ((whole.lower_max - whole.lower_min) + (whole.upper_max - whole.upper_min)).tolist()
-    width_min_r = whole.width_min.tolist()
-    width_max_r = (whole.upper_max - whole.lower_min).tolist()
-    width_min, width_max, move = (enc.width_min.tolist(), width_max_own.tolist(),
-                                  move_own.tolist())
+    column = {"centre": centre[:count], "half": half[:count],
+              "centre_next": centre[1:count + 1], "half_next": half[1:count + 1],
+              "pull1": (4.0 * h * k1 / (hi - lo))[:count],
+              "peak1": peak(0.5 * (hi - lo) / (4.0 * h * k1 / (hi - lo)))[:count],
+              "up_e": (act.upper_min - centre[:count]) / half[:count],
+              "low_e": (act.lower_max - centre[:count]) / half[:count],
+              "room_up": act.upper_min, "room_low": act.lower_max,
+              "width_max_a": act.upper_max - act.lower_min,
+              "move_r": (whole.lower_max - whole.lower_min) + (whole.upper_max
+                                                               - whole.upper_min),
+              "width_min_r": whole.width_min, "width_max_r": whole.upper_max - whole.lower_min,
+              "move": (enc.lower_max - enc.lower_min) + (enc.upper_max - enc.upper_min),
+              "width_min": enc.width_min, "width_max": enc.upper_max - enc.lower_min,
+              "rho": rho2[:count], "rho_next": rho2[1:count + 1],
+              "peak2": peak(rho2[:count] / (g_min * pull2_all)),
+              # rho2 decreases: its least on [a_k, a_{k+1}] is at t_{k+1} + delay
+              "late": _rho2(stage, samples.t[1:count + 1] + delay)}
+    first = {name: value[0].tolist() for name, value in column.items()}
 
-    def r_of(e1: float, k: int, i: int) -> float:
-        return -(4.0 * k1 / (2.0 * half_l[k][i])) * phi_scalar(e1)
+    def r_of(e1: float, i: int) -> float:
+        return -(4.0 * k1 / (2.0 * first["half"][i])) * phi_scalar(e1)
 
     # (C0) before the first force acts: [0, delay], no force
     x1_0 = [float(v) for v in design.initial_state]
@@ -691,141 +634,66 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
     box1, box2, eta1, eta2 = [], [], [], []
     for i in range(n):
         speed = (abs(x2_0[i]) + delay * (f0 + w_amp)) / (1.0 - delay * f1)
-        peak_x2[i] = speed
+        tally.peak_x2[i] = speed
         if vbound is not None and speed >= vbound[i]:
             return result(False, f"|x2_{i}| may reach {speed:.4g} on [0, {delay:.4g}] s, "
                           f"beyond velocity_bound {vbound[i]:g}", 0.0, i)
         accel = f0 + f1 * speed + w_amp
         p_lo, p_hi = x1_0[i] - delay * speed, x1_0[i] + delay * speed
-        e1_0 = (x1_0[i] - centre_l[0][i]) / half_l[0][i]
+        e1_0 = (x1_0[i] - first["centre"][i]) / first["half"][i]
         room = min(float(enc.upper_min[0][i]) - p_hi,
-                   p_lo - float(enc.lower_max[0][i])) / half_l[0][i]
+                   p_lo - float(enc.lower_max[0][i])) / first["half"][i]
         if room <= 0.0 or abs(e1_0) >= 1.0:
             return result(False, f"the position may leave its tube in dimension {i} on "
                           f"[0, {delay:.4g}] s, before the first force acts", 0.0, i)
-        gap = room * half_l[0][i]
+        gap = room * first["half"][i]
         dr = virtual_velocity_change(k1, 1.0, abs(e1_0),
-                                     max(1.0 - 2.0 * gap / width_max[0][i], abs(e1_0)),
-                                     delay * speed, move[0][i], width_min[0][i],
-                                     width_max[0][i])
-        z_0 = x2_0[i] - r_of(e1_0, 0, i)
+                                     max(1.0 - 2.0 * gap / first["width_max"][i], abs(e1_0)),
+                                     delay * speed, first["move"][i], first["width_min"][i],
+                                     first["width_max"][i])
+        z_0 = x2_0[i] - r_of(e1_0, i)
         vroom = 1.0 - (abs(z_0) + delay * accel + dr) / (edge0[i] * (1.0 - RHO_ROUNDING))
         judged(room, vroom, 0.0, i)
         if vroom <= 0.0:
             return result(False, f"the velocity error may leave its tube in dimension {i} "
                           f"on [0, {delay:.4g}] s, before the first force acts", 0.0, i)
         # the prediction at s_0 = 0 (u_{-1} = 0) and its miss (C1)
-        e1_hat = (x1_0[i] + delay * x2_0[i] - centre_l[0][i]) / half_l[0][i]
+        e1_hat = (x1_0[i] + delay * x2_0[i] - first["centre"][i]) / first["half"][i]
         if abs(e1_hat) >= 1.0:
             return result(False, f"the predicted position leaves its tube in dimension {i} "
                           "at t = 0", 0.0, i)
-        e2_hat = (x2_0[i] - r_of(e1_hat, 0, i)) / rho2[0][i]
-        box1.append([e1_hat, e1_hat])
-        box2.append([e2_hat, e2_hat])
+        e2_hat = (x2_0[i] - r_of(e1_hat, i)) / first["rho"][i]
+        box1.append(e1_hat)
+        box2.append(e2_hat)
         eta2.append(delay * accel)
         eta1.append(0.5 * delay * delay * accel)
-    every = max(1, count // PROGRESS_REPORTS)
-    for k in range(count):
-        t = float(samples.t[k])
-        if k % every == 0:
-            report("cascade certificate", k / count, "the predicted cascade's certificate: "
-                   f"t = {t:.3g} s of {samples.t[-1]:.3g} s")
-        reach1 = [max(-a, b) for a, b in box1]
-        reach2 = [max(-a, b) for a, b in box2]
-        top[0], top[1] = max(top[0], max(reach1)), max(top[1], max(reach2))
-        for name, reach in (("e1", reach1), ("e2", reach2)):
-            if max(reach) >= 1.0:
-                i = int(np.argmax(reach))
-                return result(False, f"|{name}_{i}| of the predicted state may reach "
-                              f"{max(reach):.6g} at t = {t:.4f} s (the check needs it inside "
-                              "its tube)", t, i)
-        rho_k, rho_n = rho2[k], rho2[k + 1]
-        u_abs = [2.0 * k2 / rho_k[i] * phi_scalar(reach2[i]) for i in range(n)]
-        u_sq = sum(v * v for v in u_abs)
-        next1, next2, next_eta1, next_eta2 = [], [], [], []
-        for i in range(n):
-            if u_abs[i] > peak_u[i]:
-                peak_u[i], peak_t[i] = u_abs[i], t
-            others = math.sqrt(max(u_sq - u_abs[i] ** 2, 0.0))
-            z_abs = reach2[i] * rho_k[i]
-            r_abs = 4.0 * k1 / (2.0 * half_l[k][i]) * phi_scalar(reach1[i])
-            force = g_max * u_abs[i] + cpl * others
-            # (C2) |x2| on [a_k, a_{k+1}]: from x2_hat = r_k + z_hat, the miss, the interval
-            speed = (r_abs + z_abs + eta2[i] + h * (force + f0 + w_amp)) / (1.0 - h * f1)
-            peak_x2[i] = max(peak_x2[i], speed)
-            if vbound is not None and speed >= vbound[i]:
-                return result(False, f"|x2_{i}| may reach {speed:.4g} on [{t + delay:.4f}, "
-                              f"{t + h + delay:.4f}] s, beyond velocity_bound {vbound[i]:g} "
-                              "(the drift bound is declared within it)", t, i)
-            drift = f0 + f1 * speed + w_amp
-            # (C2) the position stage: law (13) with g = 1 at x1_hat, x1(a_k) = x1_hat + miss
-            shift = h * (z_abs + eta2[i]) + 0.5 * h * h * (force + drift)
-            p_lo, p_hi, x_lo, x_hi = axis_interval(
-                box1[i][0], box1[i][1], centre_l[k][i], half_l[k][i], pull1[k][i], 1.0, 1.0,
-                peak1[k][i], shift)
-            p_lo, p_hi, x_lo, x_hi = p_lo - eta1[i], p_hi + eta1[i], x_lo - eta1[i], x_hi + eta1[i]
-            room = min(up_e[k][i] - (p_hi - centre_l[k][i]) / half_l[k][i],
-                       (p_lo - centre_l[k][i]) / half_l[k][i] - low_e[k][i])
-            if room <= 0.0:
-                judged(room, math.inf, t, i)
-                return result(False, f"the position may leave its tube in dimension {i} on "
-                              f"[{t + delay:.4f}, {t + h + delay:.4f}] s (the enclosure of x1 "
-                              f"reaches {-room:.3g} half-widths beyond its edge)", t, i)
-            gap = min(room_up[k][i] - p_hi, p_lo - room_low[k][i])
-            e1_path = max(1.0 - 2.0 * gap / width_max_a[k][i], reach1[i])
-            # (C3) |r(x1(t), t) - r(x1_hat_k, t_k)| for t in [a_k, a_{k+1}]
-            dr = virtual_velocity_change(k1, 1.0, reach1[i], e1_path, eta1[i] + h * speed,
-                                         move_r[k][i], width_min_r[k][i], width_max_r[k][i])
-            q_lo, q_hi, z_lo, z_hi = axis_interval(
-                box2[i][0], box2[i][1], 0.0, rho_k[i], 2.0 * h * k2 / rho_k[i], g_min, g_max,
-                peak2[k][i], h * drift, h * others, cpl, 0.0)
-            spread = eta2[i] + dr
-            vroom = 1.0 - max(-(q_lo - spread), q_hi + spread) / (late[k][i]
-                                                                   * (1.0 - RHO_ROUNDING))
-            judged(room, vroom, t, i)
-            if vroom <= 0.0:
-                return result(False, f"the velocity error may leave its tube in dimension "
-                              f"{i} on [{t + delay:.4f}, {t + h + delay:.4f}] s (|e2| up to "
-                              f"{1.0 - vroom:.4g}; the change of r alone is "
-                              f"{dr / late[k][i]:.3g} of rho2)", t, i)
-            # (C4) the next prediction, x_hat_{k+1} = x(s_{k+1}) + the prediction over the
-            # delay: from x_hat_k, the miss, the share of the period from a_k to s_{k+1}
-            # under the class, and the rest at g_mid exactly
-            shift_hat = (eta1[i] + h * (z_abs + eta2[i]) + 0.5 * (h * h - delay * delay)
-                         * (force + drift) + 0.5 * delay * delay * g_mid * u_abs[i])
-            _, _, xh_lo, xh_hi = axis_interval(
-                box1[i][0], box1[i][1], centre_l[k][i], half_l[k][i], pull1[k][i], 1.0, 1.0,
-                peak1[k][i], shift_hat)
-            box_n = [(xh_lo - centre_l[k + 1][i]) / half_l[k + 1][i],
-                     (xh_hi - centre_l[k + 1][i]) / half_l[k + 1][i]]
-            reach_n = max(-box_n[0], box_n[1])
-            if reach_n >= 1.0:
-                return result(False, f"|e1_{i}| of the predicted state may reach "
-                              f"{reach_n:.6g} at t = {t + h:.4f} s (the check needs it "
-                              "inside its tube)", t, i)
-            pull2 = 2.0 * h * k2 / rho_k[i]
-            _, _, zh_lo, zh_hi = axis_interval(
-                box2[i][0], box2[i][1], 0.0, rho_k[i], pull2, mix_lo, mix_hi,
-                peak_scalar(rho_k[i] / (mix_lo * pull2)), share * h * drift + eta2[i],
-                h * others, share * cpl, 0.0)       # the other axes: share * g's rows
-            # |r(x1_hat_{k+1}, t_{k+1}) - r(x1_hat_k, t_k)|: x1_hat moves by h r_k and at
-            # most shift_hat beyond it
-            dr_end = min(virtual_velocity_change(
-                k1, 1.0, reach1[i], max(reach1[i], reach_n), h * r_abs + shift_hat,
-                move[k][i], width_min[k][i], width_max[k][i]), step_velocity_change(
-                k1, h, box1[i][0], box1[i][1],
-                (centre_l[k][i] - centre_l[k + 1][i]) / half_l[k + 1][i],
-                half_l[k][i] / half_l[k + 1][i], max(reach1[i], reach_n), half_l[k][i],
-                half_l[k + 1][i], shift_hat))
-            # the miss of that prediction, which u_k makes over [s_{k+1}, a_{k+1}] (C1)
-            miss = deviation * u_abs[i] + cpl * others + drift
-            next1.append(box_n)
-            next2.append([(zh_lo - dr_end) / rho_n[i], (zh_hi + dr_end) / rho_n[i]])
-            next_eta1.append(0.5 * delay * delay * miss)
-            next_eta2.append(delay * miss)
-        box1, box2, eta1, eta2 = next1, next2, next_eta1, next_eta2
-    top[0] = max(top[0], max(max(-a, b) for a, b in box1))
-    top[1] = max(top[1], max(max(-a, b) for a, b in box2))
+    step, columns, constants = predicted_step(n)
+    fixed = constants.pack({
+        "k1": k1, "k2": k2, "h": h, "g_min": g_min, "g_max": g_max, "coupling": cpl,
+        "f0": f0, "f1": f1, "w": w_amp, "delay": delay, "deviation": deviation,
+        "g_mid": g_mid, "share": share, "mix_lo": mix_lo, "mix_hi": mix_hi,
+        "vbound": np.inf if vbound is None else vbound})
+    start = np.array(box1 + box1 + box2 + box2 + eta1 + eta2)
+    figures, state = _run(step, start, lambda a, b: columns.pack(
+        {name: value[a:b].T for name, value in column.items()}, b - a), count, fixed,
+        lambda r: r < 1.0, vbound, samples, "the predicted cascade's")
+    failure = _first_failure(figures, lambda r: r < 1.0, vbound)
+    tally.absorb(figures, samples.t, failure)
+    if failure is not None:
+        k, what, i = failure
+        t, f = float(samples.t[k]), {name: float(v[i, k]) for name, v in zip(FIGURES, figures)}
+        if what in ("e1", "e2"):
+            reach = f["reach1" if what == "e1" else "reach2"]
+            reason = (f"|{what}_{i}| of the predicted state may reach {reach:.6g} at t = "
+                      f"{t:.4f} s (the check needs it inside its tube)")
+        else:
+            reason = _axis_reason(what, i, f, f"[{t + delay:.4f}, {t + h + delay:.4f}] s",
+                                  vbound, f["dr"] / float(column["late"][k][i]),
+                                  f"|e1_{i}| of the predicted state may reach "
+                                  f"{f['reach_next']:.6g} at t = {t + h:.4f} s (the check "
+                                  "needs it inside its tube)")
+        return result(False, reason, t, i)
+    tally.close(state, n)
     tally.data["horizon"] = float(samples.t[count])
     return result(True, "")
 
@@ -876,11 +744,31 @@ def cascade_check_of(tube: TubeDesign, spec: Spec, stage: SecondStage) -> Cascad
     -------
     CascadeCheck
     """
-    with reference.numpy_math():
-        samples = sample_tube(tube)
+    samples, enclosure = tube_figures(tube)
     return check_cascade_sampled(tube, samples, stage, cascade_class(spec),
                                  spec.second_order.initial_velocity, delay=spec.delay,
-                                 jitter=spec.jitter, compensate=spec.compensate_delay)
+                                 jitter=spec.jitter, compensate=spec.compensate_delay,
+                                 enclosure=enclosure)
+
+
+@lru_cache(maxsize=8)
+def tube_figures(tube: TubeDesign) -> tuple[TubeSamples, GrowingEnclosure]:
+    """The deployed samples of ``tube`` at its rate and their enclosure, once per tube:
+    every second stage tried on a tube (the shapes, the delays) is checked on the same
+    ones, and the enclosure's rows are computed as far as a check reaches.
+
+    Parameters
+    ----------
+    tube : TubeDesign
+
+    Returns
+    -------
+    samples : TubeSamples
+    enclosure : GrowingEnclosure
+    """
+    with reference.numpy_math():
+        samples = sample_tube(tube)
+    return samples, GrowingEnclosure(tube, samples)
 
 
 def largest_cascade_delay(tube: TubeDesign, spec: Spec, stage: SecondStage,
@@ -910,14 +798,13 @@ def largest_cascade_delay(tube: TubeDesign, spec: Spec, stage: SecondStage,
         passes (a check with a delay proves every delay up to it); ``None`` when the check
         fails without delay.
     """
-    with reference.numpy_math():
-        samples = sample_tube(tube)
+    samples, enclosure = tube_figures(tube)
     plants, start = cascade_class(spec), spec.second_order.initial_velocity
 
     def passes(delay: float) -> bool:
         return check_cascade_sampled(tube, samples, stage, plants, start, delay=delay,
-                                     jitter=spec.jitter,
-                                     compensate=spec.compensate_delay).passed
+                                     jitter=spec.jitter, compensate=spec.compensate_delay,
+                                     enclosure=enclosure).passed
 
     # without delay: the spec's own check when it has no delay either (cached)
     return largest_passing(passes, max(0.0, 1.0 / tube.rate_hz - 2.0 * spec.jitter),

@@ -7,7 +7,8 @@ diagonal entry of ``g`` is one of its symmetric part) and ``|d_i| <= D_i`` (drif
 disturbance and the other inputs through the coupling). :func:`axis_interval` encloses
 ``x_i`` over the interval and at its end for every ``e_i(t_k)`` in an interval
 (docs/sampled-data.md, "The per-axis argument"). Plain floats: it runs once per axis and
-sampling interval.
+sampling interval; the same formulas build the compiled loop of the cascade
+(:mod:`.operations`).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import math
 import numpy as np
 
 from ...tube.parameters import GAMMA_D_MIN
+from .operations import FLOATS
 
 __all__ = ["phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "peak_scalar",
            "coupling_push", "axis_interval", "held_speed", "turned_gains", "turn_failure",
@@ -57,29 +59,33 @@ def phi_slope(s: np.ndarray) -> np.ndarray:
     return (2.0 + 4.0 * s * np.arctanh(s)) / (1.0 - s * s) ** 2
 
 
-def phi_scalar(s: float) -> float:
-    """:func:`phi` for one float.
+def phi_scalar(s: float, ops=FLOATS) -> float:
+    """:func:`phi` for one float (or one ``SX`` symbol).
 
     Parameters
     ----------
     s : float
         ``|e_i|`` in ``[0, 1)``.
+    ops : optional
+        :data:`~.operations.FLOATS` (default) or :data:`~.operations.SYMBOLS`.
 
     Returns
     -------
     float
         ``phi(s)``.
     """
-    return 2.0 * math.atanh(s) / (1.0 - s * s)
+    return 2.0 * ops.atanh(s) / (1.0 - s * s)
 
 
-def phi_slope_scalar(s: float) -> float:
-    """:func:`phi_slope` for one float.
+def phi_slope_scalar(s: float, ops=FLOATS) -> float:
+    """:func:`phi_slope` for one float (or one ``SX`` symbol).
 
     Parameters
     ----------
     s : float
         ``e_i`` in ``(-1, 1)``.
+    ops : optional
+        :data:`~.operations.FLOATS` (default) or :data:`~.operations.SYMBOLS`.
 
     Returns
     -------
@@ -88,9 +94,10 @@ def phi_slope_scalar(s: float) -> float:
         :func:`phi_slope` gives at ``+-1``: a curvature bound that holds nowhere, so an
         argument using it fails rather than passes).
     """
-    if not abs(s) < 1.0:
+    inside = abs(s) < 1.0
+    if not ops.symbolic and not inside:
         return math.inf
-    return (2.0 + 4.0 * s * math.atanh(s)) / (1.0 - s * s) ** 2
+    return ops.select(inside, (2.0 + 4.0 * s * ops.atanh(s)) / (1.0 - s * s) ** 2, math.inf)
 
 
 def peak(ratio: np.ndarray) -> np.ndarray:
@@ -107,41 +114,49 @@ def peak(ratio: np.ndarray) -> np.ndarray:
     ndarray
         ``s*`` in ``[0, 1)``, the shape of ``ratio``.
     """
-    lo, hi = np.zeros_like(ratio), np.full_like(ratio, 1.0 - 1e-15)
+    ratio = np.asarray(ratio, dtype=float)
+    # each distinct ratio once (a tube's widths repeat): the same floats, fewer halvings
+    values, where = np.unique(ratio, return_inverse=True)
+    lo, hi = np.zeros_like(values), np.full_like(values, 1.0 - 1e-15)
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        up = phi_slope(mid) < ratio
+        up = phi_slope(mid) < values
         lo, hi = np.where(up, mid, lo), np.where(up, hi, mid)
-    return np.where(ratio <= 2.0, 0.0, lo)
+    return np.where(ratio <= 2.0, 0.0, lo[where.reshape(ratio.shape)])
 
 
-def peak_scalar(ratio: float) -> float:
-    """:func:`peak` for one float.
+def peak_scalar(ratio: float, ops=FLOATS) -> float:
+    """:func:`peak` for one float (or one ``SX`` symbol).
 
     Parameters
     ----------
     ratio : float
         ``h / (g_min p)``.
+    ops : optional
+        :data:`~.operations.FLOATS` (default) or :data:`~.operations.SYMBOLS`.
 
     Returns
     -------
     float
         ``s*`` in ``[0, 1)``.
     """
-    if not ratio > 2.0:
+    if not ops.symbolic and not ratio > 2.0:
         return 0.0
     lo, hi = 0.0, 1.0 - 1e-15
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        if phi_slope_scalar(mid) < ratio:
+        up = phi_slope_scalar(mid, ops) < ratio
+        if ops.symbolic:
+            lo, hi = ops.select(up, mid, lo), ops.select(up, hi, mid)
+        elif up:
             lo = mid
         else:
             hi = mid
-    return lo
+    return ops.select(ratio > 2.0, lo, 0.0)
 
 
 def coupling_push(others: float, coupling: float, spread: float, skew: float,
-                  own: float) -> float:
+                  own: float, ops=FLOATS) -> float:
     """A bound of the displacement the other inputs cause on axis ``i`` over one interval,
     whatever ``g_ii`` is, beyond what ``g_min`` (outward) or ``g_max`` (inward) of the own
     input leaves.
@@ -158,6 +173,8 @@ def coupling_push(others: float, coupling: float, spread: float, skew: float,
     ----------
     others, coupling, spread, skew, own : float
         As above; ``spread = g_max - g_min``.
+    ops : optional
+        :data:`~.operations.FLOATS` (default) or :data:`~.operations.SYMBOLS`.
 
     Returns
     -------
@@ -165,18 +182,19 @@ def coupling_push(others: float, coupling: float, spread: float, skew: float,
         The bound, state units: the least of ``coupling others`` and the symmetric bound plus
         ``skew others``; 0 when ``others <= 0``.
     """
-    if others <= 0.0:
-        return 0.0
-    if others <= 2.0 * own:
-        symmetric = spread * others * others / (4.0 * own)
-    else:
-        symmetric = spread * (others - own)
-    return min(coupling * others, symmetric + skew * others)
+    def pushed():
+        symmetric = ops.branch(others <= 2.0 * own,
+                               lambda: spread * others * others / (4.0 * own),
+                               lambda: spread * (others - own))
+        return ops.fmin(coupling * others, symmetric + skew * others)
+
+    return ops.branch(others <= 0.0, lambda: 0.0, pushed)
 
 
 def axis_interval(a: float, b: float, c0: float, h0: float, pull: float, g_min: float,
                   g_max: float, s_peak: float, push: float, others: float = 0.0,
-                  coupling: float = 0.0, skew: float = 0.0) -> tuple[float, float, float, float]:
+                  coupling: float = 0.0, skew: float = 0.0,
+                  ops=FLOATS) -> tuple[float, float, float, float]:
     """Enclosures of ``x_i`` on ``[t_k, t_{k+1}]`` and at ``t_{k+1}``, for every
     ``e_i(t_k)`` in ``[a, b]``.
 
@@ -207,32 +225,40 @@ def axis_interval(a: float, b: float, c0: float, h0: float, pull: float, g_min: 
         ``dt |u_j|`` over the other axes of the block, bound (0: none).
     coupling, skew : float
         Row coupling and skew bound of ``g`` (see :func:`coupling_push`).
+    ops : optional
+        :data:`~.operations.FLOATS` (default) or :data:`~.operations.SYMBOLS` (a sign whose
+        range is empty is then selected away rather than skipped).
 
     Returns
     -------
     path_lo, path_hi, end_lo, end_hi : float
         ``x_i`` on the whole interval, and at ``t_{k+1}``, state units.
     """
+    fmin, fmax = ops.fmin, ops.fmax
     spread = g_max - g_min
     path_lo = end_lo = math.inf
     path_hi = end_hi = -math.inf
-    for sign, s_a, s_b in ((1.0, max(a, 0.0), b), (-1.0, max(-b, 0.0), -a)):
-        if s_b < s_a or (s_b == 0.0 and sign < 0):
+    for sign, s_a, s_b in ((1.0, fmax(a, 0.0), b), (-1.0, fmax(-b, 0.0), -a)):
+        empty = s_b < s_a if sign > 0 else ops.either(s_b < s_a, s_b == 0.0)
+        if not ops.symbolic and empty:
             continue
-        phi_a, phi_b = phi_scalar(s_a), phi_scalar(s_b)
-        extra = push + coupling_push(others, coupling, spread, skew, pull * phi_a)
+        phi_a, phi_b = phi_scalar(s_a, ops), phi_scalar(s_b, ops)
+        extra = push + coupling_push(others, coupling, spread, skew, pull * phi_a, ops)
         start_a, start_b = sign * c0 + s_a * h0, sign * c0 + s_b * h0
-        s_star = min(max(s_peak, s_a), s_b)
-        phi_star = phi_a if s_star == s_a else phi_b if s_star == s_b else phi_scalar(s_star)
+        s_star = fmin(fmax(s_peak, s_a), s_b)
+        # phi at s_star: phi_a or phi_b when it is an end (the same float)
+        phi_star = (phi_scalar(s_star, ops) if ops.symbolic else phi_a if s_star == s_a
+                    else phi_b if s_star == s_b else phi_scalar(s_star))
         out_max = sign * c0 + s_star * h0 - pull * g_min * phi_star + extra
-        in_min = min(start_a - pull * g_max * phi_a, start_b - pull * g_max * phi_b) - extra
-        low, high = min(start_a, in_min), max(start_b, out_max)
-        if sign > 0:
-            path_lo, path_hi = min(path_lo, low), max(path_hi, high)
-            end_lo, end_hi = min(end_lo, in_min), max(end_hi, out_max)
-        else:
-            path_lo, path_hi = min(path_lo, -high), max(path_hi, -low)
-            end_lo, end_hi = min(end_lo, -out_max), max(end_hi, -in_min)
+        in_min = fmin(start_a - pull * g_max * phi_a, start_b - pull * g_max * phi_b) - extra
+        low, high = fmin(start_a, in_min), fmax(start_b, out_max)
+        if sign < 0:
+            low, high, in_min, out_max = -high, -low, -out_max, -in_min
+        if ops.symbolic:       # an empty range adds nothing: its values moved to -+inf
+            pad = ops.pad(empty, math.inf)
+            low, in_min, high, out_max = low + pad, in_min + pad, high - pad, out_max - pad
+        path_lo, path_hi = fmin(path_lo, low), fmax(path_hi, high)
+        end_lo, end_hi = fmin(end_lo, in_min), fmax(end_hi, out_max)
     return path_lo, path_hi, end_lo, end_hi
 
 
