@@ -25,7 +25,7 @@ def run(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
 def test_cases_lists_bundled_specs():
     out = run("cases")
     assert out.returncode == 0
-    assert out.stdout.split() == ["crossing-moving", "office-base", "omnirobot-s1",
+    assert out.stdout.split() == ["crossing-moving", "hall-crossing", "office-base", "omnirobot-s1",
                                   "omnirobot-s2", "omnirobot-s3", "pointmaze-umaze",
                                   "second-order-quadrotor", "second-order-s1", "tasks-stay",
                                   "tasks-visit"]
