@@ -161,6 +161,7 @@ def test_softer_circumvents_keep_the_papers_tube():
     assert design.input_proof.meets(spec.input_bound)
 
 
+@pytest.mark.slow
 def test_verify_proves_the_bound():
     spec, design = robot()
     report = verify(design)

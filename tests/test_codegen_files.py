@@ -108,6 +108,7 @@ def test_output_folder_rules(tmp_path):
     assert not (tmp_path / "x").exists()
 
 
+@pytest.mark.slow
 def test_check_detects_drift(tmp_path, capsys):
     root = tmp_path / "generated"
     assert main(["check", "--root", str(root), "--update"]) == 0

@@ -90,6 +90,7 @@ def test_design_is_deterministic():
     assert design_tube(spec) == design_tube(spec)
 
 
+@pytest.mark.slow
 def test_papers_sharpness_fails_with_a_reason_naming_the_obstacle():
     spec = load_spec("omnirobot-s1")
     paper = dataclasses.replace(spec, tube=dataclasses.replace(

@@ -207,6 +207,7 @@ def test_the_office_is_satisfied_at_the_corners_of_the_wheel_errors(errors):
     assert result.min_obstacle_clearance > 0 and result.max_abs_e < 1.0
 
 
+@pytest.mark.slow
 def test_verify_proves_the_sampled_loop_and_the_limits():
     spec = stt.Spec.from_dict({**_doc(), "actuator": {"input_bound": [1.6, 16.0]}})
     design = stt.design_tube(spec)
@@ -223,6 +224,7 @@ def test_verify_proves_the_sampled_loop_and_the_limits():
     assert run.satisfied and all(u <= b for u, b in zip(run.max_abs_u, (1.6, 16.0)))
 
 
+@pytest.mark.slow
 def test_a_bound_too_tight_names_the_prescribed_time_that_works():
     """0.8 m/s is below the best design's proved 1.10 at 200 Hz (the via tube with cruise
     segments): refused, naming the prescribed_time that works."""

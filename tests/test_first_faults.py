@@ -51,6 +51,7 @@ def toml_text(doc: dict) -> str:
 # 1. A differential drive with [actuator]: the proved peaks of (v, omega) against its bound
 
 
+@pytest.mark.slow
 def test_design_reports_the_bases_proved_limits_in_text_and_json(tmp_path):
     spec_file = tmp_path / "drive.toml"
     spec_file.write_text(toml_text(drive_doc(actuator={"input_bound": [1.6, 16.0]})))

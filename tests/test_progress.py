@@ -88,6 +88,7 @@ def test_the_bar_is_drawn_on_a_terminal_without_quiet_only(monkeypatch, tty, qui
     assert (text == "") == (not drawn)
 
 
+@pytest.mark.slow
 def test_the_commands_print_no_progress_when_stderr_is_not_a_terminal(tmp_path):
     for command in (["design", "second-order-s1"], ["verify", "omnirobot-s1"]):
         out = subprocess.run([sys.executable, "-m", "stt_codegen.cli", *command],

@@ -97,6 +97,7 @@ def _verify(*options: str) -> subprocess.CompletedProcess:
                            *options], capture_output=True, text=True, timeout=900)
 
 
+@pytest.mark.slow
 def test_verify_prints_the_summary_by_default_and_every_check_with_all():
     short, every = _verify(), _verify("--all")
     assert short.returncode == every.returncode == 0, short.stderr + every.stderr

@@ -87,6 +87,7 @@ def test_plants_of_the_robot_class_stay_within_the_proved_error(case, kind):
     assert _max_sampled_error(design, run) <= result.level
 
 
+@pytest.mark.slow
 def test_a_plant_outside_its_declared_bounds_is_not_accepted():
     """A spec changed in Python to bounds its model violates: verify fails, and says why."""
     spec, design, _ = designed("omnirobot-s1")
