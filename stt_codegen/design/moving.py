@@ -449,7 +449,7 @@ def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
             via = (first if not which and first.method == METHOD_VIA else
                    _try(lambda: design_static(replace(around, tube=replace(around.tube,
                                                                            method="via")))))
-            timed = _retimed(via, partial, spec, check, started)
+            timed = retimed_design(via, partial, spec, check, started)
             if timed is None:
                 continue
             if isinstance(timed, Design):
@@ -496,7 +496,7 @@ def _detour(spec: Spec, found: TubeCheck, design_static: Callable[[Spec], Design
             planning = partial_spec(spec, position, when - span, when + span)
             via = None if planning is None else _try(lambda: design_static(
                 replace(planning, tube=replace(planning.tube, method="via"))))
-            timed = _retimed(via, spec, spec, check, started)
+            timed = retimed_design(via, spec, spec, check, started)
             if timed is None:
                 continue
             if isinstance(timed, Design):
@@ -508,13 +508,33 @@ def _detour(spec: Spec, found: TubeCheck, design_static: Callable[[Spec], Design
                   "meets a moving obstacle is planned and re-timed")
 
 
-def _retimed(via: Design | None, timing: Spec, spec: Spec,
-             check: Callable[[TubeDesign, Spec], TubeCheck],
-             started: float) -> Design | str | None:
+def retimed_design(via: Design | None, timing: Spec, spec: Spec,
+                   check: Callable[[TubeDesign, Spec], TubeCheck],
+                   started: float) -> Design | str | None:
     """``via``'s boxes re-timed against the moving obstacles of ``timing``
-    (:func:`retime`) and checked for ``spec`` (with ``[actuator]``, its input proof too):
-    the design when both pass, why not otherwise, ``None`` when there is no via design or
-    no re-timing."""
+    (:func:`retime`) and checked for ``spec`` (with ``[actuator]``, its input proof too).
+
+    Parameters
+    ----------
+    via : Design or None
+        A via-point design (its segments' boxes and, with tasks, its plan's order).
+    timing : Spec
+        Its ``moving_obstacles`` are what the re-timing keeps clear of.
+    spec : Spec
+        The spec the re-timed tube is checked and designed for.
+    check : callable
+        ``check(tube, spec) -> TubeCheck`` (:func:`~.search.check_tube`, or a check that
+        asks more of the tube, as the fleet design's).
+    started : float
+        ``time.perf_counter()`` when the design began (its ``design_time_s``).
+
+    Returns
+    -------
+    Design, str or None
+        The design (``motion`` ``"timed via"``) when the check (and the input proof)
+        pass; why not otherwise; ``None`` when ``via`` is ``None`` or no re-timing is
+        found.
+    """
     if via is None:
         return None
     why = None
@@ -644,5 +664,5 @@ def retimed_plan(segments: Sequence[ReachSegment], spec: Spec,
 
 __all__ = ["DETOUR_SPANS", "DURATION_FACTORS", "MAX_ROUTES", "MOTION_SPACE_TIME", "MOTION_SWEPT",
            "MOTION_TIMED_VIA", "MOVE_CHECKS", "TASK_HOLD_SHARE", "TIME_STEPS", "design_moving", "moves",
-           "retime", "retimed_plan", "routes", "partial_spec", "speed_limits", "static_part",
+           "retime", "retimed_design", "retimed_plan", "routes", "partial_spec", "speed_limits", "static_part",
            "task_holds"]

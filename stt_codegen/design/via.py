@@ -37,7 +37,7 @@ from ..spec.loader import Spec
 from .failures import FailureKind
 from ..tube.parameters import SMOOTHSTEP, ReachSegment, TubeDesign
 
-__all__ = ["VIA_MARGIN", "ViaPlan", "plan_via", "via_design"]
+__all__ = ["VIA_HALF_WIDTH", "VIA_MARGIN", "ViaPlan", "plan_via", "via_design"]
 
 #: Largest half-width of a via box, state units.
 VIA_HALF_WIDTH = 0.1
