@@ -1,17 +1,21 @@
 """Prioritized fleet design: each robot's tube avoids the tubes already designed (docs/fleets.md).
 
-The robots are designed one at a time in a priority order. A robot designed later sees each
-robot designed before it as moving obstacles (:class:`~stt_codegen.spec.motion.MovingObstacle`,
-docs/moving-obstacles.md): that robot's certified tube enclosure (its certificate's boxes,
-``alpha`` included, on a partition of ``[0, inf)``), merged into boxes over at most
-:data:`CHUNK_SECONDS` each, grown by both robots' reaches, each box present only over its
-time span. The single-robot design (:func:`~.search.design_tube`, with its space-time
-certificate, re-timing and waiting) then finds a tube that misses them at every ``t``.
-The order: longer trips first (straight line from ``x(0)`` to the target's centre), then
-the file's order; a robot that finds no tube is moved to the front and the fleet is
-designed again, each robot moved at most once. Every pair is then certified by
-:func:`~.certificate.fleet.pair_margin` on the robots' own certificates; nothing is
-accepted on the planner's word.
+Every robot is first designed alone (:func:`~.search.design_tube`, its own certificate and,
+with ``[actuator]``, its input proof); a robot with no tube alone is refused as such. The
+robots are then placed one at a time in a priority order (:func:`priority_order`: a robot
+whose way crosses another's target goes before it, one whose way crosses another's start
+after it, then the robots whose proofs cost most, then the longer trips). A robot keeps its
+tube designed alone when the pair certificate (:func:`~.certificate.fleet.pair_margin`)
+proves it apart from every placed tube that a space-time index (:mod:`.fleet_index`) finds
+near it; else its via boxes are re-timed (:func:`~.moving.retimed_design`: waits at its start
+box, which is its start delay, or at a via box) against the placed tubes near its way, as
+moving boxes over at most :data:`CHUNK_SECONDS` each, first through its own via boxes, then
+through via boxes planned clear of the other robots' docks; each re-timed tube is accepted
+only when its own check, its input proof and the pair certificate against every placed tube
+near it pass. A robot that finds no tube is moved to the front and the fleet is placed
+again, each robot moved at most once. Every pair of the fleet is then certified by
+:func:`certify_fleet` on the robots' own certificates; nothing is accepted on the
+planner's word.
 """
 
 from __future__ import annotations
@@ -25,20 +29,51 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from ..display import Rows, text
-from ..errors import DesignError, SpecError
+from ..errors import DesignError
 from ..spec.fleet import FleetRobot, FleetSpec, load_fleet
-from ..spec.loader import Spec
-from ..spec.motion import MovingObstacle, check_moving
+from ..spec.loader import Obstacle, Spec
+from ..spec.motion import MovingObstacle
+from ..spec.variants import variant_of
+from ..tube.parameters import CRUISE, ReachSegment
 from .certificate.fleet import PairMargin, RobotTube, pair_margin, robot_tube
-from .failures import FailureKind
-from .result import Design
-from .search import design_tube
+from .failures import FailureKind, without_advice
+from .fleet_index import Chunks, TubeIndex, chunks
+from .fleet_paths import Reservations, SpaceTimeGrid, space_time_path, space_time_segments
+from .gain import derived_gain
+from .moving import TIME_STEPS, retimed_design
+from .result import METHOD_VIA, Design, TubeCheck
+from .search import check_tube, design_tube
 
-__all__ = ["CHUNK_SECONDS", "FleetDesign", "certify_fleet", "design_fleet", "enclosed",
-           "priority_order", "tube_obstacles"]
+__all__ = ["CHUNK_SECONDS", "DETOURS", "DETOUR_SECONDS", "INDEX_CELL", "INDEX_SECONDS",
+           "LEG_METRES", "SCREEN_INTERVALS", "FleetDesign", "certify_fleet", "design_fleet",
+           "enclosed", "plan_way", "priority_order", "tube_obstacles"]
 
-#: The longest time span of one box standing for another robot's tube, seconds.
-CHUNK_SECONDS = 0.25
+#: The longest time span of one box standing for another robot's tube in a re-timing,
+#: seconds.
+CHUNK_SECONDS = 0.5
+#: The longest time span of one box of a placed tube in the space-time index, seconds.
+INDEX_SECONDS = 1.0
+#: The space-time index's grid cell, state units (metres).
+INDEX_CELL = 2.0
+#: The longest leg of a re-timed way, state units (metres): a longer leg is cut into
+#: pieces on the same line, between which the re-timing may wait.
+LEG_METRES = 2.0
+#: Detours a robot plans around the placed robots its re-timed way still meets, at most.
+DETOURS = 3
+#: A detour plans around the other robot's tube over the clash's interval widened by this
+#: much on each side, seconds.
+DETOUR_SECONDS = 2.0
+#: The space-time path's speed: this many times the robot's way's mean speed (its length
+#: over ``t_c``), within [MIN_SPEED, MAX_SPEED] (state units per second).
+SPEED_FACTOR, MIN_SPEED, MAX_SPEED = 2.0, 0.5, 1.5
+#: The placed tubes' boxes on the space-time grid span at most this long, seconds.
+STEP_SECONDS = 0.5
+#: ``Design.motion`` of a tube along a space-time path.
+MOTION_SPACE_TIME_PATH = "space-time path"
+#: The refinement budget of a pair checked while a robot is placed (a candidate the pair
+#: certificate does not prove apart within it is only a candidate lost; the fleet's own
+#: certificate, :func:`certify_fleet`, has the full budget).
+SCREEN_INTERVALS = 4000
 
 
 @dataclass(frozen=True)
@@ -113,23 +148,89 @@ class FleetDesign:
                     self.summary_rows())
 
 
-def priority_order(fleet: FleetSpec) -> list[FleetRobot]:
-    """The robots by the tool's priority rule: the longest straight trip first.
+def _trip(robot: FleetRobot) -> float:
+    """The straight distance from ``x(0)`` to the target's centre, state units."""
+    spec = robot.spec
+    return math.dist(spec.initial_state, spec.target_center)
+
+
+def _grown(box, dims: Sequence[int], grow: float) -> tuple[np.ndarray, np.ndarray]:
+    """A box (``lower``, ``upper`` over every state dimension) on ``dims``, grown."""
+    d = list(dims)
+    return np.asarray(box.lower)[d] - grow, np.asarray(box.upper)[d] + grow
+
+
+def _crosses(way: Chunks, lower: np.ndarray, upper: np.ndarray) -> bool:
+    """Whether some box of ``way`` meets ``[lower, upper]`` (in space)."""
+    return bool(np.any(np.all((way.lower <= upper) & (way.upper >= lower), axis=1)))
+
+
+def priority_order(fleet: FleetSpec,
+                   tubes: Mapping[str, RobotTube] | None = None) -> list[FleetRobot]:
+    """The robots by the tool's priority rule.
+
+    With each robot's tube designed alone: robot ``a`` goes before robot ``b`` when ``a``'s
+    tube before its ``t_c`` (its way) meets ``b``'s target box grown by both reaches (``a``
+    passes before ``b`` parks there), or when ``b``'s way after ``t = 0`` meets ``a``'s
+    start box so grown (``b`` passes after ``a`` has left); among the robots free of such
+    constraints, those with ``[actuator]`` first (re-timing them asks for a new input
+    proof, the dearest part of a design), then the longest straight trip (from ``x(0)``
+    to the target's centre), then the fleet's order. Where the constraints form a cycle
+    (no order keeps them all), the robot with the fewest constraints left goes next.
+    Without ``tubes``: the longest straight trip first, ties in the fleet's order.
 
     Parameters
     ----------
     fleet : FleetSpec
+    tubes : mapping of str to RobotTube, optional
+        Each robot's tube designed alone (:func:`enclosed`), by name.
 
     Returns
     -------
     list of FleetRobot
-        Sorted by decreasing distance from ``x(0)`` to the target's centre, ties in the
-        fleet's order.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> fleet = stt.load_fleet("swap-fleet")
+    >>> [r.name for r in priority_order(fleet)]
+    ['east', 'west']
     """
-    def trip(robot: FleetRobot) -> float:
-        spec = robot.spec
-        return math.dist(spec.initial_state, spec.target_center)
-    return sorted(fleet.robots, key=lambda r: (-round(trip(r), 9), r.index))
+    def key(robot: FleetRobot) -> tuple:
+        return (robot.spec.input_bound is None, -round(_trip(robot), 9), robot.index)
+
+    robots = list(fleet.robots)
+    if tubes is None:
+        return sorted(robots, key=lambda r: (-round(_trip(r), 9), r.index))
+    ways = {r.name: chunks(tubes[r.name], r.dims, INDEX_SECONDS) for r in robots}
+    before: dict[str, set[str]] = {r.name: set() for r in robots}   # b: the robots before b
+    for a in robots:
+        way_a = ways[a.name]
+        moving = np.isfinite(way_a.t_end)
+        way_a = Chunks(way_a.t_start[moving], way_a.t_end[moving], way_a.lower[moving],
+                       way_a.upper[moving])
+        for b in robots:
+            if b is a:
+                continue
+            grow = a.reach + b.reach
+            if _crosses(way_a, *_grown(b.spec.target_set, a.dims, grow)):
+                before[b.name].add(a.name)             # a passes b's target before b parks
+            way_b = ways[b.name]
+            later = way_b.t_start > 0.0
+            way_b = Chunks(way_b.t_start[later], way_b.t_end[later], way_b.lower[later],
+                           way_b.upper[later])
+            if _crosses(way_b, *_grown(a.spec.initial_set, a.dims, grow)):
+                before[b.name].add(a.name)             # b passes a's start after a left
+    order: list[FleetRobot] = []
+    left = sorted(robots, key=key)
+    while left:
+        done = {r.name for r in order}
+        free = [r for r in left if before[r.name] <= done]
+        nxt = free[0] if free else min(left, key=lambda r: (len(before[r.name] - done),
+                                                            key(r)))
+        order.append(nxt)
+        left.remove(nxt)
+    return order
 
 
 def enclosed(design: Design, span: float = CHUNK_SECONDS) -> RobotTube:
@@ -173,21 +274,14 @@ def tube_obstacles(tube: RobotTube, reach: float, dims: Sequence[int], first_sou
         they cover the tube grown by ``reach`` at every ``t >= 0`` (the last one until
         ``inf``).
     """
-    t0, t1, lo, hi = tube.boxes(dims)
-    out: list[MovingObstacle] = []
-    k, n = 0, t0.size
-    while k < n:
-        end = k + 1
-        while end < n and np.isfinite(t1[end]) and t1[end] - t0[k] <= chunk:
-            end += 1
-        b_lo, b_hi = lo[k:end].min(axis=0) - reach, hi[k:end].max(axis=0) + reach
-        out.append(MovingObstacle(
-            source=first_source + len(out), dims=tuple(int(d) for d in dims),
-            half_size=tuple(float(v) for v in (b_hi - b_lo) / 2), times=(float(t0[k]),),
-            centres=(tuple(float(v) for v in (b_hi + b_lo) / 2),),
-            active=(float(t0[k]), float(t1[end - 1])), motion="still"))
-        k = end
-    return tuple(out)
+    c = chunks(tube, dims, chunk)
+    lo, hi = c.lower - reach, c.upper + reach
+    return tuple(MovingObstacle(
+        source=first_source + k, dims=tuple(int(d) for d in dims),
+        half_size=tuple(float(v) for v in (hi[k] - lo[k]) / 2), times=(float(c.t_start[k]),),
+        centres=(tuple(float(v) for v in (hi[k] + lo[k]) / 2),),
+        active=(float(c.t_start[k]), float(c.t_end[k])), motion="still")
+        for k in range(c.t_start.size))
 
 
 def certify_fleet(fleet: FleetSpec, designs: Mapping[str, Design],
@@ -233,64 +327,365 @@ def certify_fleet(fleet: FleetSpec, designs: Mapping[str, Design],
     return tuple(sorted(pairs, key=lambda p: p.margin))
 
 
-Placed = Sequence[tuple[FleetRobot, RobotTube]]
+@dataclass
+class _Placing:
+    """What the placement of one order keeps: each robot's way (its planned design, by
+    name, computed once), the robots placed so far (design and enclosed tube, by name) and
+    their index."""
+
+    fleet: FleetSpec
+    ways: dict[str, tuple[Design, RobotTube]]
+    placed: dict[str, tuple[FleetRobot, Design, RobotTube]] = field(default_factory=dict)
+    index: TubeIndex = field(default_factory=lambda: TubeIndex(INDEX_CELL))
+    grids: dict[str, SpaceTimeGrid] = field(default_factory=dict)
+
+    @property
+    def widest(self) -> float:
+        """The largest reach of a placed robot (0 before the first)."""
+        return max((r.reach for r, _, _ in self.placed.values()), default=0.0)
 
 
-def _against(robot: FleetRobot, placed: Placed) -> Spec:
-    """``robot``'s spec with the placed robots' tubes as moving obstacles. A tube box over
-    the robot's start at ``t = 0`` or over its target after its ``t_c`` is a
-    :class:`DesignError` naming the pair."""
+def _free(spec: Spec) -> Spec:
+    """``spec`` without ``[actuator]``: the tube's design, whose input proof comes once, on
+    the tube kept (:func:`_proved`)."""
+    return replace(spec, input_bound=None)
+
+
+def _docks(robot: FleetRobot, fleet: FleetSpec) -> tuple[Obstacle, ...]:
+    """Every other robot's start and target box, grown by both reaches, on the body
+    dimensions, where it misses ``robot``'s own start and target (as obstacles of its
+    spec, numbered after them)."""
     spec = robot.spec
+    mine = [_grown(box, robot.dims, 0.0) for box in (spec.initial_set, spec.target_set)]
+    docks: list[Obstacle] = []
+    for other in fleet.robots:
+        if other is robot:
+            continue
+        for box in (other.spec.initial_set, other.spec.target_set):
+            lo, hi = _grown(box, robot.dims, robot.reach + other.reach)
+            if any(np.all(lo <= m_hi) and np.all(hi >= m_lo) for m_lo, m_hi in mine):
+                continue
+            docks.append(Obstacle(tuple(float(v) for v in lo), tuple(float(v) for v in hi),
+                                  tuple(robot.dims), len(spec.unsafe_sets) + len(docks)))
+    return tuple(docks)
+
+
+def plan_way(robot: FleetRobot, fleet: FleetSpec) -> Design:
+    """``robot``'s way: its via design (without ``[actuator]``; with it, cruise legs) on
+    its spec with every other robot's start and target box as obstacles (:func:`_docks`: a
+    way that crosses no dock, so no robot waiting at its start or parked at its target
+    stands in it), else its design alone without ``[actuator]``.
+
+    Parameters
+    ----------
+    robot : FleetRobot
+    fleet : FleetSpec
+
+    Returns
+    -------
+    Design
+        For ``robot.spec`` without ``[actuator]`` when the way crosses docks, or for that
+        spec with the docks as obstacles; not yet a design of ``robot.spec`` (placing it
+        checks it again, with its input proof).
+
+    Raises
+    ------
+    DesignError
+        The robot has no tube even alone (without ``[actuator]``).
+    """
+    spec = _free(robot.spec)
+    planning = replace(spec, obstacles=spec.obstacles + _docks(robot, fleet),
+                       tube=replace(spec.tube, method=METHOD_VIA,
+                                    via_profile=_profile(robot)))
+    try:
+        return design_tube(planning)
+    except DesignError:
+        pass
+    try:
+        return design_tube(spec)
+    except DesignError as exc:
+        raise DesignError(f"robot {robot.name} has no tube even alone: {exc}",
+                          kind=exc.kind, tried=exc.tried) from None
+
+
+def _clash(robot: FleetRobot, tube: RobotTube, near: Sequence[str], placing: _Placing,
+           max_intervals: int = SCREEN_INTERVALS) -> PairMargin | None:
+    """The first pair of ``robot`` (tube ``tube``) and a robot of ``near`` not certified
+    apart, or ``None``."""
+    for name in near:
+        other, _, placed = placing.placed[name]
+        m = pair_margin((other.name, robot.name), (placed, tube), (other.reach, robot.reach),
+                        robot.dims, max_intervals)
+        if not m.passed:
+            return m
+    return None
+
+
+def _timing_spec(robot: FleetRobot, via: RobotTube, placing: _Placing) -> Spec:
+    """``robot``'s spec with, as moving obstacles, the placed tubes near its via boxes
+    (``via``: the enclosed tube through them; in space, whenever) as boxes over at most
+    :data:`CHUNK_SECONDS`, each grown by both reaches and kept only where it comes near
+    those boxes (the re-timing's input)."""
+    spec = robot.spec
+    way = chunks(via, robot.dims, INDEX_SECONDS)
+    grow = robot.reach + placing.widest
     extra: list[MovingObstacle] = []
     first = len(spec.unsafe_sets) + len(spec.moving_obstacles)
-    for other, tube in placed:
-        boxes = tube_obstacles(tube, other.reach + robot.reach, robot.dims, first + len(extra))
-        for box in boxes:
-            try:
-                check_moving(box, other.name, spec.initial_set, spec.target_set,
-                             spec.prescribed_time)
-            except SpecError as exc:       # "meets the initial set at t = 0", ...
-                reason = exc.reason.replace("the ", f"{robot.name}'s ", 1)
-                raise DesignError(
-                    f"robots {other.name} and {robot.name} conflict: {other.name}'s tube, "
-                    f"grown by both radii, {reason} (its box on [{box.active[0]:.4f}, "
-                    f"{box.active[1]:.4f}] s)", kind=FailureKind.FLEET) from None
-        extra.extend(boxes)
+    dims = tuple(int(d) for d in robot.dims)
+    for name in placing.index.near(way, grow, timed=False):
+        other, _, tube = placing.placed[name]
+        c = chunks(tube, robot.dims, CHUNK_SECONDS)
+        reach = other.reach + robot.reach
+        lo, hi = c.lower - reach, c.upper + reach
+        near = np.any(np.all((way.lower[None, :, :] <= hi[:, None, :])
+                             & (way.upper[None, :, :] >= lo[:, None, :]), axis=2), axis=1)
+        for k in np.flatnonzero(near):
+            extra.append(MovingObstacle(
+                source=first + len(extra), dims=dims,
+                half_size=tuple(float(v) for v in (hi[k] - lo[k]) / 2),
+                times=(float(c.t_start[k]),),
+                centres=(tuple(float(v) for v in (hi[k] + lo[k]) / 2),),
+                active=(float(c.t_start[k]), float(c.t_end[k])), motion="still"))
     return replace(spec, moving_obstacles=spec.moving_obstacles + tuple(extra))
 
 
-def _conflicts(robot: FleetRobot, placed: Placed, reason: str) -> DesignError:
-    """The refusal of ``robot``: its tube designed alone, against each placed robot's."""
+def _profile(robot: FleetRobot) -> str:
+    """The via legs' profile: with ``[actuator]`` (and no tasks), cruise legs (peak rate
+    1.25 times the mean, not 1.875), as the bound's own procedure tries them
+    (:func:`~.actuator.slower_variants`); else the spec's."""
+    spec = robot.spec
+    return (CRUISE if spec.input_bound is not None and not spec.tasks
+            else spec.tube.via_profile)
+
+
+def _own_via(robot: FleetRobot) -> Design | None:
+    """``robot``'s via design on its own spec (no ``[actuator]``), ``None`` when there is
+    none."""
+    spec = _free(robot.spec)
     try:
-        alone = enclosed(design_tube(robot.spec))
-    except DesignError as exc:
-        return DesignError(f"robot {robot.name} has no tube even alone: {exc}",
-                           kind=exc.kind, tried=exc.tried)
-    clashes = []
+        return design_tube(replace(spec, tube=replace(spec.tube, method=METHOD_VIA,
+                                                      via_profile=_profile(robot))))
+    except DesignError:
+        return None
+
+
+def _proved(design: Design, spec: Spec) -> Design | None:
+    """``design`` as a design of ``spec`` with its ``[actuator]`` proof (the variant's
+    role ``within_bound`` on this tube alone: the bound carried as that variant carries
+    it), ``None`` when the proof fails; ``design`` for ``spec`` without ``[actuator]``."""
+    if spec.input_bound is None:
+        return replace(design, spec=spec)
+    with without_advice():
+        try:
+            return variant_of(spec).entry("within_bound")(
+                spec, lambda free: replace(design, spec=free))
+        except DesignError:
+            return None
+
+
+def _pieces(via: Design, spec: Spec) -> Design:
+    """``via`` with every leg longer than :data:`LEG_METRES` cut into pieces along the same
+    straight line (the same boxes, each piece its own profile over its share of the leg's
+    time), as long as each piece keeps at least two steps of the re-timing's grid; ``via``
+    itself for a spec with tasks (their holds are whole segments)."""
+    if spec.tasks:
+        return via
+    tau = spec.prescribed_time / TIME_STEPS
+    out: list[ReachSegment] = []
+    for seg in via.tube.segments:
+        a_lo, a_hi = np.array(seg.lower_from), np.array(seg.upper_from)
+        b_lo, b_hi = np.array(seg.lower_to), np.array(seg.upper_to)
+        length = float(np.linalg.norm((b_lo + b_hi - a_lo - a_hi) / 2))
+        count = max(1, min(math.ceil(length / LEG_METRES),
+                           math.floor((seg.end - seg.start) / (2 * tau))))
+        for j in range(count):
+            p, q = j / count, (j + 1) / count
+            out.append(replace(
+                seg, start=seg.start + p * (seg.end - seg.start),
+                end=seg.end if j == count - 1 else seg.start + q * (seg.end - seg.start),
+                lower_from=tuple(float(v) for v in a_lo + p * (b_lo - a_lo)),
+                upper_from=tuple(float(v) for v in a_hi + p * (b_hi - a_hi)),
+                lower_to=(seg.lower_to if j == count - 1 else
+                          tuple(float(v) for v in a_lo + q * (b_lo - a_lo))),
+                upper_to=(seg.upper_to if j == count - 1 else
+                          tuple(float(v) for v in a_hi + q * (b_hi - a_hi)))))
+    return replace(via, tube=replace(via.tube, segments=tuple(out)))
+
+
+def _around(robot: FleetRobot, clash: PairMargin, placing: _Placing) -> tuple[Obstacle, ...]:
+    """The placed robot of ``clash``'s tube over its interval widened by
+    :data:`DETOUR_SECONDS`, as static boxes grown by both reaches (those that miss
+    ``robot``'s start and target): what a detour plans around."""
+    other, _, tube = placing.placed[clash.pair[0]]
+    way = chunks(tube, robot.dims, INDEX_SECONDS)
+    spec = robot.spec
+    mine = [_grown(box, robot.dims, 0.0) for box in (spec.initial_set, spec.target_set)]
+    grow = robot.reach + other.reach
+    out = []
+    for t0, t1, lo, hi in zip(way.t_start, way.t_end, way.lower - grow, way.upper + grow):
+        if t1 < clash.t_start - DETOUR_SECONDS or t0 > clash.t_end + DETOUR_SECONDS:
+            continue
+        if any(np.all(lo <= m_hi) and np.all(hi >= m_lo) for m_lo, m_hi in mine):
+            continue
+        out.append(Obstacle(tuple(float(v) for v in lo), tuple(float(v) for v in hi),
+                            tuple(robot.dims), 0))
+    return tuple(out)
+
+
+def _space_time(robot: FleetRobot, way: Design, placing: _Placing,
+                check) -> tuple[Design | None, str]:
+    """``robot``'s tube along a space-time A* path among the placed tubes
+    (:mod:`.fleet_paths`), checked by ``check``; the design, or ``None`` and why not."""
+    spec = robot.spec
+    if len(robot.dims) != 2 or spec.dimension != 2:
+        return None, "no space-time path (planned on two body dimensions only)"
+    grid = placing.grids.get(robot.name)
+    if grid is None:
+        grid = placing.grids[robot.name] = SpaceTimeGrid.of(way.spec, robot.dims)
+    length = float(np.sum([np.linalg.norm(np.subtract(s.lower_to, s.lower_from))
+                           for s in way.tube.segments]))
+    speed = min(max(SPEED_FACTOR * length / spec.prescribed_time, MIN_SPEED), MAX_SPEED)
+    step = grid.cell / speed
+    placed = [(other, tube) for other, _, tube in placing.placed.values()]
+    ends = [float(np.max(t.enclosure.t_start)) for _, t in placed]
+    steps = math.ceil(max([spec.prescribed_time] + ends) / step) + 1
+    taken = Reservations(grid, step, steps)
     for other, tube in placed:
+        c = chunks(tube, robot.dims, STEP_SECONDS)
+        grow = other.reach + robot.reach
+        taken.add(c.t_start, c.t_end, c.lower - grow, c.upper + grow)
+    path = space_time_path(grid, taken, grid.index(np.array(spec.initial_state)[list(robot.dims)]),
+                           grid.index(np.array(spec.target_center)[list(robot.dims)]),
+                           math.floor(spec.prescribed_time / step))
+    if path is None:
+        return None, "no space-time path among the placed tubes"
+    tube = replace(way.tube, circumvents=(), segments=space_time_segments(
+        path, grid, way.tube, step, _profile(robot)))
+    found = check(tube, _free(spec))
+    if not found.passed:
+        return None, f"its space-time path: {found.reason}"
+    gain = (spec.gain if spec.gain is not None
+            else derived_gain(found.min_width, tube.rate_hz, spec.assumptions))
+    design = _proved(Design(replace(tube, gain=gain), METHOD_VIA, found, 0.0, spec=spec,
+                            motion=MOTION_SPACE_TIME_PATH), spec)
+    if design is None:
+        return None, "its space-time path: its input is not proved within actuator.input_bound"
+    return design, ""
+
+
+def _fit(robot: FleetRobot, placing: _Placing) -> tuple[Design, RobotTube] | str:
+    """``robot``'s design among the placed robots (module notes), or why there is none."""
+    started = time.perf_counter()
+    way, way_tube = placing.ways[robot.name]
+    grow = robot.reach + placing.widest
+    spec = robot.spec
+    clashes: list[PairMargin] = []
+    enclosures: dict[tuple, RobotTube] = {}
+
+    def check(candidate, checked: Spec) -> TubeCheck:
+        found = check_tube(candidate, checked)
+        if not found.passed:
+            return found
+        enclosure = robot_tube(candidate, found.certificate).finer(CHUNK_SECONDS)
+        around = placing.index.near(chunks(enclosure, robot.dims, INDEX_SECONDS), grow)
+        met = _clash(robot, enclosure, around, placing)
+        if met is not None:
+            clashes.append(met)
+            return replace(found, passed=False, reason=met.detail, kind=FailureKind.FLEET)
+        enclosures[candidate.segments] = enclosure
+        return found
+
+    def kept(design: Design) -> tuple[Design, RobotTube]:
+        """The design with its enclosed tube (the one its check computed)."""
+        tube = enclosures.get(design.tube.segments)
+        if tube is None:
+            return design, enclosed(design)
+        return design, RobotTube(design.tube, tube.enclosure, tube.state)
+
+    reasons = []
+    found = check(way.tube, _free(spec))
+    if found.passed:
+        design = _proved(replace(way, check=found), spec)
+        if design is not None:
+            return kept(design)
+        reasons.append("its way: its input is not proved within actuator.input_bound")
+    else:
+        reasons.append(f"its way: {found.reason}")
+
+    def timed(label: str, plan: Design | None) -> Design | None:
+        if plan is None:
+            reasons.append(f"{label}: no via design")
+            return None
+        got = retimed_design(_pieces(plan, spec), _timing_spec(
+            robot, way_tube if plan is way else enclosed(plan), placing), spec, check, started)
+        if isinstance(got, Design):
+            design = _proved(got, spec)
+            if design is not None:
+                return design
+            got = "its input is not proved within actuator.input_bound"
+        reasons.append(f"{label}: " + (got or "no re-timing keeps clear of the placed tubes"))
+        return None
+
+    design = timed("its way re-timed", way if way.method == METHOD_VIA else _own_via(robot))
+    if design is None:
+        design, why = _space_time(robot, way, placing, check)
+        if design is None:
+            reasons.append(why)
+    planning = replace(way.spec, tube=replace(way.spec.tube, method=METHOD_VIA,
+                                              via_profile=_profile(robot)))
+    avoided: set[tuple[str, float]] = set()
+    for _ in range(DETOURS if design is None else 0):
+        clash = clashes[-1] if clashes else None
+        if clash is None or (clash.pair[0], clash.t_start) in avoided:
+            break
+        avoided.add((clash.pair[0], clash.t_start))
+        extra = _around(robot, clash, placing)
+        first = len(planning.unsafe_sets) + len(planning.obstacles)
+        planning = replace(planning, obstacles=planning.obstacles + tuple(
+            replace(ob, source=first + k) for k, ob in enumerate(extra)))
+        try:
+            plan = design_tube(planning)
+        except DesignError:
+            reasons.append(f"a detour around {clash.pair[0]}: no via design")
+            break
+        design = timed(f"a detour around {clash.pair[0]} re-timed", plan)
+        if design is not None:
+            break
+    if design is None and way.spec.obstacles != _free(spec).obstacles:
+        design = timed("its own via boxes re-timed", _own_via(robot))
+    if design is not None:
+        return kept(design)
+    return "; ".join(reasons)
+
+
+def _conflicts(robot: FleetRobot, placing: _Placing, reason: str) -> DesignError:
+    """The refusal of ``robot``: its way, against each placed robot's tube."""
+    _, alone = placing.ways[robot.name]
+    clashes = []
+    for other, _, tube in placing.placed.values():
         m = pair_margin((other.name, robot.name), (tube, alone), (other.reach, robot.reach),
                         robot.dims)
         if not m.passed:
             clashes.append(f"{m.pair[0]} and {m.pair[1]} on [{m.t_start:.4f}, "
                            f"{m.t_end:.4f}] s")
     where = "; ".join(clashes) if clashes else "none of them (its tube alone misses theirs)"
+    placed = ", ".join(placing.placed) or "none"
     return DesignError(f"robot {robot.name}: no tube avoids the tubes of the robots placed "
-                       f"before it ({', '.join(o.name for o, _ in placed) or 'none'}); its "
-                       f"tube designed alone meets: {where}. Its design said: {reason}",
-                       kind=FailureKind.FLEET)
+                       f"before it ({placed}); its way meets: {where}. "
+                       f"Tried: {reason}", kind=FailureKind.FLEET)
 
 
-def _place(order: Sequence[FleetRobot]
-           ) -> tuple[list[tuple[FleetRobot, Design, RobotTube]], tuple[FleetRobot, str] | None]:
-    """The robots designed in ``order`` until one fails (that robot and the reason)."""
-    placed: list[tuple[FleetRobot, Design, RobotTube]] = []
+def _place(order: Sequence[FleetRobot], placing: _Placing) -> tuple[FleetRobot, str] | None:
+    """The robots designed in ``order`` into ``placing`` until one fails (that robot and
+    the reason), or ``None``."""
     for robot in order:
-        try:
-            design = design_tube(_against(robot, [(r, t) for r, _, t in placed]))
-        except DesignError as exc:
-            return placed, (robot, str(exc))
-        placed.append((robot, design, enclosed(design)))
-    return placed, None
+        found = _fit(robot, placing)
+        if isinstance(found, str):
+            return robot, found
+        design, tube = found
+        placing.placed[robot.name] = (robot, design, tube)
+        placing.index.add(robot.name, chunks(tube, robot.dims, INDEX_SECONDS))
+    return None
 
 
 def design_fleet(fleet: FleetSpec | str | os.PathLike) -> FleetDesign:
@@ -305,15 +700,17 @@ def design_fleet(fleet: FleetSpec | str | os.PathLike) -> FleetDesign:
     Returns
     -------
     FleetDesign
-        Each robot's certified design and every pair's certified separation.
+        Each robot's certified design (its spec its own task: the other robots' tubes are
+        certified apart by the pair certificate) and every pair's certified separation.
 
     Raises
     ------
     DesignError
-        Kind ``FailureKind.FLEET``: no order found a tube for every robot (the message
-        names the robot, the pairs its own tube conflicts with and the intervals), or a
-        pair is not certified apart (the pair and the interval); a robot with no tube even
-        alone: that design's error.
+        A robot with no tube even alone: that design's error (its kind), the message
+        starting ``robot <name> has no tube even alone``. Kind ``FailureKind.FLEET``: no
+        order found a tube for every robot (the message names the robot, the robots its
+        tube designed alone meets and on which intervals, and what was tried), or a pair
+        is not certified apart (the pair and the interval).
     SpecError
         ``fleet`` names no fleet, or a field fails validation (:func:`~stt_codegen.load_fleet`).
 
@@ -324,25 +721,30 @@ def design_fleet(fleet: FleetSpec | str | os.PathLike) -> FleetDesign:
     >>> fleet.certified, len(fleet.designs), len(fleet.pairs)
     (True, 2, 1)
     >>> print(fleet.narrowest.detail)                               # doctest: +ELLIPSIS
-    east and west: bodies apart by >= 0.3471 (narrowest on [...] s, along dimension 0; ...)
+    east and west: bodies apart by >= ... (narrowest on [...] s, along dimension ...; ...)
     """
     if not isinstance(fleet, FleetSpec):
         fleet = load_fleet(fleet)
     start = time.perf_counter()
-    order = priority_order(fleet)
+    ways = {}
+    for robot in fleet.robots:
+        way = plan_way(robot, fleet)
+        ways[robot.name] = (way, enclosed(way))
+    order = priority_order(fleet, {name: tube for name, (_, tube) in ways.items()})
     moved: list[str] = []
     while True:
-        placed, failed = _place(order)
+        placing = _Placing(fleet, ways)
+        failed = _place(order, placing)
         if failed is None:
             break
         robot, reason = failed
         if robot.name in moved or robot is order[0]:
-            raise _conflicts(robot, [(r, t) for r, _, t in placed], reason)
+            raise _conflicts(robot, placing, reason)
         moved.append(robot.name)
         order = [robot] + [r for r in order if r is not robot]
-    placed.sort(key=lambda p: p[0].index)
-    designs = {r.name: d for r, d, _ in placed}
-    pairs = certify_fleet(fleet, designs, {r.name: t for r, _, t in placed})
+    designs = {r.name: placing.placed[r.name][1] for r in fleet.robots}
+    pairs = certify_fleet(fleet, designs, {r.name: placing.placed[r.name][2]
+                                           for r in fleet.robots})
     bad = [p for p in pairs if not p.passed]
     if bad:
         raise DesignError("the fleet is not certified: " + "; ".join(p.detail for p in bad),
