@@ -213,3 +213,14 @@ def test_a_wait_between_two_re_timed_segments_is_a_held_segment():
     assert wait.lower_from == wait.lower_to == a.lower_to
     assert wait.upper_from == wait.upper_to == a.upper_to
     assert _held((a,)) == (a,)
+
+
+def test_the_space_time_baseline_plans_every_robot_along_a_path_and_is_certified():
+    from stt_codegen.design.fleet import PLANNER_SPACE_TIME
+    fleet = stt.load_fleet("swap-fleet")
+    designed = stt.design_fleet(fleet, planner=PLANNER_SPACE_TIME)
+    assert designed.certified
+    assert {d.motion for d in designed.designs.values()} == {"space-time path"}
+    assert _sampled_gap(designed.designs, fleet) >= designed.narrowest.margin - 1e-9
+    with pytest.raises(ValueError, match="planner"):
+        stt.design_fleet(fleet, planner="astar")

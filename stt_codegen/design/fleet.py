@@ -45,7 +45,7 @@ from .result import METHOD_VIA, Design, TubeCheck
 from .search import check_tube, design_tube
 
 __all__ = ["CHUNK_SECONDS", "DETOURS", "DETOUR_SECONDS", "INDEX_CELL", "INDEX_SECONDS",
-           "LEG_METRES", "SCREEN_INTERVALS", "FleetDesign", "certify_fleet", "design_fleet",
+           "LEG_METRES", "PLANNER_SPACE_TIME", "PLANNER_TUBES", "SCREEN_INTERVALS", "FleetDesign", "certify_fleet", "design_fleet",
            "enclosed", "plan_way", "priority_order", "tube_obstacles"]
 
 #: The longest time span of one box standing for another robot's tube in a re-timing,
@@ -74,6 +74,10 @@ MOTION_SPACE_TIME_PATH = "space-time path"
 #: certificate does not prove apart within it is only a candidate lost; the fleet's own
 #: certificate, :func:`certify_fleet`, has the full budget).
 SCREEN_INTERVALS = 4000
+#: ``design_fleet``'s planners: the tubes kept, re-timed or planned in space-time (the
+#: module notes), or every robot's tube along its space-time A* path only, the robots
+#: longest trip first (classic prioritized planning, the comparison's baseline).
+PLANNER_TUBES, PLANNER_SPACE_TIME = "tubes", "space-time A*"
 
 
 @dataclass(frozen=True)
@@ -338,6 +342,7 @@ class _Placing:
     placed: dict[str, tuple[FleetRobot, Design, RobotTube]] = field(default_factory=dict)
     index: TubeIndex = field(default_factory=lambda: TubeIndex(INDEX_CELL))
     grids: dict[str, SpaceTimeGrid] = field(default_factory=dict)
+    planner: str = PLANNER_TUBES
 
     @property
     def widest(self) -> float:
@@ -602,6 +607,9 @@ def _fit(robot: FleetRobot, placing: _Placing) -> tuple[Design, RobotTube] | str
             return design, enclosed(design)
         return design, RobotTube(design.tube, tube.enclosure, tube.state)
 
+    if placing.planner == PLANNER_SPACE_TIME:
+        design, why = _space_time(robot, way, placing, check)
+        return why if design is None else kept(design)
     reasons = []
     found = check(way.tube, _free(spec))
     if found.passed:
@@ -688,7 +696,8 @@ def _place(order: Sequence[FleetRobot], placing: _Placing) -> tuple[FleetRobot, 
     return None
 
 
-def design_fleet(fleet: FleetSpec | str | os.PathLike) -> FleetDesign:
+def design_fleet(fleet: FleetSpec | str | os.PathLike,
+                 planner: str = PLANNER_TUBES) -> FleetDesign:
     """Design and certify every robot's tube so that no two bodies can meet at any ``t``.
 
     Parameters
@@ -696,6 +705,10 @@ def design_fleet(fleet: FleetSpec | str | os.PathLike) -> FleetDesign:
     fleet : FleetSpec, str or path
         From :func:`stt_codegen.load_fleet` or :meth:`FleetSpec.from_dict`, or what
         :func:`~stt_codegen.load_fleet` takes (a bundled fleet's name or a fleet file).
+    planner : {"tubes", "space-time A*"}
+        :data:`PLANNER_TUBES` (module notes), or :data:`PLANNER_SPACE_TIME`: each robot,
+        longest trip first, along its space-time A* path among the placed tubes only
+        (:mod:`.fleet_paths`), checked and certified the same way.
 
     Returns
     -------
@@ -713,6 +726,8 @@ def design_fleet(fleet: FleetSpec | str | os.PathLike) -> FleetDesign:
         is not certified apart (the pair and the interval).
     SpecError
         ``fleet`` names no fleet, or a field fails validation (:func:`~stt_codegen.load_fleet`).
+    ValueError
+        ``planner`` is neither.
 
     Examples
     --------
@@ -723,6 +738,9 @@ def design_fleet(fleet: FleetSpec | str | os.PathLike) -> FleetDesign:
     >>> print(fleet.narrowest.detail)                               # doctest: +ELLIPSIS
     east and west: bodies apart by >= ... (narrowest on [...] s, along dimension ...; ...)
     """
+    if planner not in (PLANNER_TUBES, PLANNER_SPACE_TIME):
+        raise ValueError(f"planner must be {PLANNER_TUBES!r} or {PLANNER_SPACE_TIME!r}, "
+                         f"got {planner!r}")
     if not isinstance(fleet, FleetSpec):
         fleet = load_fleet(fleet)
     start = time.perf_counter()
@@ -730,10 +748,11 @@ def design_fleet(fleet: FleetSpec | str | os.PathLike) -> FleetDesign:
     for robot in fleet.robots:
         way = plan_way(robot, fleet)
         ways[robot.name] = (way, enclosed(way))
-    order = priority_order(fleet, {name: tube for name, (_, tube) in ways.items()})
+    order = (priority_order(fleet) if planner == PLANNER_SPACE_TIME else
+             priority_order(fleet, {name: tube for name, (_, tube) in ways.items()}))
     moved: list[str] = []
     while True:
-        placing = _Placing(fleet, ways)
+        placing = _Placing(fleet, ways, planner=planner)
         failed = _place(order, placing)
         if failed is None:
             break
