@@ -206,3 +206,27 @@ def test_the_grown_enclosure_is_the_whole_ones_rows():
         part = growing.first(rows)
         for field in dataclasses.fields(whole):
             assert np.array_equal(getattr(part, field.name), getattr(whole, field.name)[:rows])
+
+
+def test_an_input_limit_stops_the_check_where_the_full_check_passes_it():
+    # the design's search without advice (certified_stage) stops a shape's check where its
+    # input passes the bound: the same failure as the full check's peak says, never earlier
+    # than the full check's figures put it, and a limit above the full peak changes nothing
+    design = design_of("pointmaze-umaze")
+    with reference.numpy_math():
+        samples = sample_tube(design.tube)
+    tube, n = design.tube, design.tube.dimension
+    stage, _ = derived_second_stage(tube, design.check.min_width, (1.0, 1.0), 0.0, [0.0] * n)
+    plants = CascadeClass(1.0, 1.0, 0.0, 0.0, 0.0, 0.0, None)
+    full = check_cascade_sampled(tube, samples, stage, plants, [0.0] * n)
+    above = check_cascade_sampled(tube, samples, stage, plants, [0.0] * n,
+                                  input_limit=tuple(p * 1.01 + 1e-9 for p in full.peak_input))
+    assert above == full and above.data == full.data
+    axis = int(np.argmax(full.peak_input))
+    limit = tuple(0.5 * p if i == axis else 10.0 * p + 1.0
+                  for i, p in enumerate(full.peak_input))
+    cut = check_cascade_sampled(tube, samples, stage, plants, [0.0] * n, input_limit=limit)
+    assert not cut.passed and f"|u_{axis}| may reach" in cut.reason
+    assert "beyond the input bound" in cut.reason
+    assert limit[axis] < cut.peak_input[axis] <= full.peak_input[axis]
+    assert cut.time <= full.peak_input_time[axis] + 1e-12

@@ -44,11 +44,12 @@ from ..tube.parameters import TubeDesign
 from ..tube.second_stage import SecondStage
 from .certificate.cascade_sampled import certify_stage
 from .certificate.sampled import largest_passing
+from .failures import advice_wanted
 from .input_bound import InputProof
 
 __all__ = ["RATE_SEARCH_FACTOR", "SHAPES", "cascade_design_proof", "cascade_input_proof", "certified_stage",
            "derived_second_stage", "fastest_searched_rate", "lowest_certified_rate",
-           "second_stage_for", "tube_speed"]
+           "second_stage_for", "tube_speed", "upward_search"]
 
 
 #: The shapes of the second stage the design tries, in order, until the sampled cascade's
@@ -181,11 +182,17 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
         The accepted stage's derivation with its ``certificate``; when none: the last
         shape's, with the reports of every shape tried (``tried``: ``shape``, ``passed``
         (the tubes kept), ``reason``, ``peak_input``, ``peak_input_time``, ``horizon``).
+        Within :func:`~.failures.without_advice` (a search asking the verdict only), a
+        shape's check stops where its input passes ``bound``: the stage kept is the same,
+        but such a shape is reported as not passed, with the peak found until then.
     """
     order = spec.second_order
     # the certificate reads neither bound: one certificate per tube and stage, bound or not
     tube, spec = dataclasses.replace(tube, input_bound=None), dataclasses.replace(
         spec, input_bound=None)
+    # a search that asks the verdict only (no advice) needs no shape's whole peak: its
+    # check stops where the input passes the bound (the shape kept is the same)
+    limit = None if bound is None or advice_wanted() else tuple(bound)
     tried = []
     for k, shape in enumerate(SHAPES):
         report_progress("cascade stage", k / len(SHAPES),
@@ -194,7 +201,7 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
             tube, min_width, order.input_gain, order.drift_bound + spec.disturbance_amplitude,
             order.initial_velocity, shape)
         with reporting(None, (k / len(SHAPES), (k + 1) / len(SHAPES))):
-            passed, report = certify_stage(tube, spec, stage)
+            passed, report = certify_stage(tube, spec, stage, limit)
         within = bound is None or all(p <= b for p, b in zip(report["peak_input"], bound))
         if passed and within:
             return stage, {**derivation, "certificate": report}
@@ -299,17 +306,15 @@ def _one_period_rate(tube: TubeDesign, spec) -> float | None:
     ``RATE_SEARCH_FACTOR`` times the spec's, at which some shape is certified with a delay
     of one period of that rate (bisection, as :func:`lowest_certified_rate`); ``None`` when
     even the fastest fails."""
-    from .grid import grid_index, grid_value, smallest_passing
+    from .grid import grid_value
 
     def passes(index: int) -> bool:
         rate = grid_value(index)
         trial = dataclasses.replace(spec, rate_hz=rate, delay=1.0 / rate)
         return _rate_certified(tube, trial, rate)
 
-    low, high = grid_index(tube.rate_hz), grid_index(tube.rate_hz * RATE_SEARCH_FACTOR)
-    if high <= low or not passes(high):
-        return None
-    return grid_value(smallest_passing(passes, low, high))
+    found = upward_search(passes, tube.rate_hz, tube.rate_hz * RATE_SEARCH_FACTOR)
+    return None if found is None else grid_value(found)
 
 
 def _rate_certified(tube: TubeDesign, spec, rate_hz: float) -> bool:
@@ -353,7 +358,8 @@ def fastest_searched_rate(rate_hz: float, spec) -> float:
 def lowest_certified_rate(tube: TubeDesign, spec, passes_at_rate: bool) -> float | None:
     """The smallest rate on the two-digit grid (:mod:`.grid`) at which a shape of
     :data:`SHAPES` is certified, between ``rate / RATE_SEARCH_FACTOR`` and ``rate *
-    RATE_SEARCH_FACTOR`` (bisection: a faster rate is assumed not to break the
+    RATE_SEARCH_FACTOR`` (bisection, upwards after doubling the rate until it is
+    certified, :func:`upward_search`: a faster rate is assumed not to break the
     certificate; every rate reported was certified). With ``[controller] delay`` or
     ``jitter`` the search stops at the fastest rate whose period holds ``delay + 2
     jitter`` (:func:`fastest_searched_rate`). ``None`` when even the fastest fails; the
@@ -383,14 +389,56 @@ def lowest_certified_rate(tube: TubeDesign, spec, passes_at_rate: bool) -> float
             return grid_value(low) if high > low else rate
         best = smallest_passing(lambda j: _rate_certified(tube, spec, grid_value(j)), low, high)
         return grid_value(best) if _rate_certified(tube, spec, grid_value(best)) else rate
-    fastest = fastest_searched_rate(rate, spec)
-    low, high = grid_index(rate), grid_index(fastest)
-    if grid_value(high) > fastest:
-        high -= 1                      # the grid's last rate whose period holds the timing
-    if high <= low or not _rate_certified(tube, spec, grid_value(high)):
-        return None
-    return grid_value(smallest_passing(lambda j: _rate_certified(tube, spec, grid_value(j)),
-                                       low, high))
+    found = upward_search(lambda j: _rate_certified(tube, spec, grid_value(j)), rate,
+                          fastest_searched_rate(rate, spec))
+    return None if found is None else grid_value(found)
+
+
+def upward_search(passes, rate_hz: float, fastest: float) -> int | None:
+    """The smallest grid index above ``rate_hz`` (:mod:`.grid`), up to ``fastest``, at which
+    ``passes`` holds: tried at twice ``rate_hz``, four times, ... (the last try at
+    ``fastest``) until it holds, then a bisection between the last rate that failed and
+    that one (a faster rate is assumed not to break the certificate, as in
+    :func:`lowest_certified_rate`; the index returned passed).
+
+    A certificate at a faster rate checks more samples, so the slow rates are tried first:
+    the fastest one only when every slower doubling fails.
+
+    Parameters
+    ----------
+    passes : callable
+        ``passes(index) -> bool`` on grid indices.
+    rate_hz : float
+        The rate that fails, Hz.
+    fastest : float
+        The fastest rate tried, Hz.
+
+    Returns
+    -------
+    int or None
+        A grid index; ``None`` when no rate up to ``fastest`` passes.
+
+    Examples
+    --------
+    >>> from stt_codegen.design.grid import grid_index, grid_value
+    >>> tried = []
+    >>> def passes(index):
+    ...     tried.append(grid_value(index))
+    ...     return grid_value(index) >= 650
+    >>> grid_value(upward_search(passes, 500.0, 8000.0)), tried
+    (650.0, [1000.0, 750.0, 620.0, 680.0, 650.0, 630.0, 640.0])
+    """
+    from .grid import grid_index, grid_value, smallest_passing
+    low, top = grid_index(rate_hz), grid_index(fastest)
+    if grid_value(top) > fastest:
+        top -= 1                       # the grid's last rate whose period holds the timing
+    factor = 2.0
+    while top > low:
+        index = max(min(grid_index(factor * rate_hz), top), low + 1)
+        if passes(index):
+            return smallest_passing(passes, low, index)
+        low, factor = index, 2.0 * factor
+    return None
 
 
 def second_stage_for(tube: TubeDesign, spec, min_width: float) -> tuple[SecondStage, dict]:

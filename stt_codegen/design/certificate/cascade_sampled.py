@@ -229,7 +229,7 @@ class _Tally:
             else:
                 done[i:, k] = False
                 axis = i
-                reached = [True, what != "speed", what in ("vroom", "reach")]
+                reached = [True, what not in ("input", "speed"), what in ("vroom", "reach")]
         for name, place in (("reach1", 0), ("reach2", 1)):
             self.top[place] = max(self.top[place], float(f[name][:, :steps].max()))
 
@@ -305,7 +305,8 @@ def _unfit(stage: SecondStage, samples: TubeSamples, plants: CascadeClass,
 def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: SecondStage,
                           plants: CascadeClass, initial_velocity, *, delay: float = 0.0,
                           jitter: float = 0.0, compensate: bool = False,
-                          enclosure: GrowingEnclosure | None = None) -> CascadeCheck:
+                          enclosure: GrowingEnclosure | None = None,
+                          input_limit: tuple[float, ...] | None = None) -> CascadeCheck:
     """Prove that the sampled cascade keeps ``|e1| < 1`` and ``|e2| < 1`` at and between
     samples for every plant of ``plants`` (module docstring; docs/second-order.md).
 
@@ -337,6 +338,12 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
     enclosure : GrowingEnclosure, optional
         The enclosure of ``design``'s ``samples``, when the caller keeps it (it depends on
         the tube only, not on the stage: :func:`tube_figures`); a new one when ``None``.
+    input_limit : tuple of float, optional
+        Per axis, a bound of ``|u_k,i|`` at which the check stops and fails (reason
+        ``|u_i| may reach ...``): for a search that only asks whether the stage keeps both
+        tubes within an input bound (:func:`~..cascade_gain.certified_stage` without
+        advice). Up to that sample the figures are the full check's; a check that never
+        reaches it is the full check.
 
     Returns
     -------
@@ -352,7 +359,8 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
         if jitter != 0.0:
             raise ValueError(f"jitter = {jitter!r} s must be 0 with compensate")
         return check_cascade_predicted(design, samples, stage, plants, initial_velocity,
-                                       delay=delay, enclosure=enclosure)
+                                       delay=delay, enclosure=enclosure,
+                                       input_limit=input_limit)
     n = design.dimension
     h = 1.0 / design.rate_hz
     if delay < 0.0 or jitter < 0.0 or delay + 2.0 * jitter > h * (1.0 + 1e-12):
@@ -445,8 +453,8 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
         "corner_lag": [lag for _, lag in corners], "length": spans})
     figures, state = _run(step, start, lambda a, b: columns.pack(
         {name: value.T for name, value in column(a, b).items()}, b - a), count, fixed,
-        lambda r: r <= E_MAX, vbound, samples, "the sampled cascade's")
-    failure = _first_failure(figures, lambda r: r <= E_MAX, vbound)
+        lambda r: r <= E_MAX, vbound, input_limit, samples, "the sampled cascade's")
+    failure = _first_failure(figures, lambda r: r <= E_MAX, vbound, input_limit)
     tally.absorb(figures, samples.t, failure)
     if failure is not None:
         k, what, i = failure
@@ -460,25 +468,29 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
             edge = float(column(k, k + 1)["edge"][0][i]) * (1.0 - RHO_ROUNDING)
             reason = _axis_reason(what, i, f, span, vbound, f["dr"] / edge,
                                   f"|e1_{i}| may reach {f['reach_next']:.6g} at t = "
-                                  f"{t + h:.4f} s")
+                                  f"{t + h:.4f} s", input_limit)
         return tally.result(False, reason, t, i)
     tally.close(state, n)
     tally.data["horizon"] = float(samples.t[count])
     return tally.result(True, "")
 
 
-def _first_failure(figures: np.ndarray, inside, vbound) -> tuple[int, str, int] | None:
+def _first_failure(figures: np.ndarray, inside, vbound,
+                   limit=None) -> tuple[int, str, int] | None:
     """Where the per-sample loop first fails in ``figures`` (``(8, n, K)``,
     :data:`~.cascade_step.FIGURES`), in the order it judges: at a sample the bounds of
     ``|e1|`` then ``|e2|`` (``inside``: what they must satisfy), then axis by axis the
-    velocity bound, the position room, the velocity room, the next ``|e1|``. A figure that
-    is not a number fails. ``(k, what, i)`` or ``None``."""
+    input (above ``limit``, when given), the velocity bound, the position room, the
+    velocity room, the next ``|e1|``. A figure that is not a number fails. ``(k, what, i)``
+    or ``None``."""
     f = dict(zip(FIGURES, figures))
     e1 = ~inside(f["reach1"].max(axis=0))
     e2 = ~inside(f["reach2"].max(axis=0))
+    over = (np.zeros(f["u_abs"].shape, dtype=bool) if limit is None
+            else f["u_abs"] > np.array(limit, dtype=float)[:, None])
     fast = (np.isnan(f["speed"]) if vbound is None
             else ~(f["speed"] < np.array(vbound, dtype=float)[:, None]))
-    per_axis = np.stack([fast, ~(f["room"] > 0.0), ~(f["vroom"] > 0.0),
+    per_axis = np.stack([over, fast, ~(f["room"] > 0.0), ~(f["vroom"] > 0.0),
                          ~(f["reach_next"] < 1.0)])
     bad = e1 | e2 | per_axis.any(axis=(0, 1))
     if not bad.any():
@@ -492,11 +504,11 @@ def _first_failure(figures: np.ndarray, inside, vbound) -> tuple[int, str, int] 
 
 
 #: The judgements of one axis on one interval, in the loop's order.
-_STAGES = ("speed", "room", "vroom", "reach")
+_STAGES = ("input", "speed", "room", "vroom", "reach")
 
 
-def _run(step, start, columns, count: int, constants, inside, vbound, samples: TubeSamples,
-         whose: str):
+def _run(step, start, columns, count: int, constants, inside, vbound, limit,
+         samples: TubeSamples, whose: str):
     """:func:`~.cascade_step.run_steps` until the first failure, reporting progress."""
     end = float(samples.t[-1])
 
@@ -505,13 +517,17 @@ def _run(step, start, columns, count: int, constants, inside, vbound, samples: T
                f"{float(samples.t[done]):.3g} s of {end:.3g} s")
 
     return run_steps(step, start, columns, count, constants,
-                     lambda figures: _first_failure(figures, inside, vbound) is not None,
+                     lambda figures: _first_failure(figures, inside, vbound,
+                                                    limit) is not None,
                      progress)
 
 
 def _axis_reason(what: str, i: int, f: dict, span: str, vbound, change: float,
-                 next_words: str) -> str:
+                 next_words: str, limit=None) -> str:
     """The words of a failure on one axis (``f``: its figures at the failing step)."""
+    if what == "input":
+        return (f"|u_{i}| may reach {f['u_abs']:.4g} on {span}, beyond the input bound "
+                f"{limit[i]:g} (the check stops there)")
     if what == "speed":
         return (f"|x2_{i}| may reach {f['speed']:.4g} on {span}"
                 + ("" if vbound is None else f", beyond velocity_bound {vbound[i]:g} (the "
@@ -527,7 +543,8 @@ def _axis_reason(what: str, i: int, f: dict, span: str, vbound, change: float,
 
 def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: SecondStage,
                             plants: CascadeClass, initial_velocity, *, delay: float,
-                            enclosure: GrowingEnclosure | None = None) -> CascadeCheck:
+                            enclosure: GrowingEnclosure | None = None,
+                            input_limit: tuple[float, ...] | None = None) -> CascadeCheck:
     """Prove that the cascade with the delay-compensating prediction keeps ``|e1| < 1`` and
     ``|e2| < 1`` at every instant of the horizon for every plant of ``plants``.
 
@@ -561,6 +578,8 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
     enclosure : GrowingEnclosure, optional
         The enclosure of ``design``'s ``samples`` (:func:`tube_figures`); a new one when
         ``None``.
+    input_limit : tuple of float, optional
+        As in :func:`check_cascade_sampled`.
 
     Returns
     -------
@@ -676,8 +695,8 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
     start = np.array(box1 + box1 + box2 + box2 + eta1 + eta2)
     figures, state = _run(step, start, lambda a, b: columns.pack(
         {name: value[a:b].T for name, value in column.items()}, b - a), count, fixed,
-        lambda r: r < 1.0, vbound, samples, "the predicted cascade's")
-    failure = _first_failure(figures, lambda r: r < 1.0, vbound)
+        lambda r: r < 1.0, vbound, input_limit, samples, "the predicted cascade's")
+    failure = _first_failure(figures, lambda r: r < 1.0, vbound, input_limit)
     tally.absorb(figures, samples.t, failure)
     if failure is not None:
         k, what, i = failure
@@ -691,14 +710,15 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
                                   vbound, f["dr"] / float(column["late"][k][i]),
                                   f"|e1_{i}| of the predicted state may reach "
                                   f"{f['reach_next']:.6g} at t = {t + h:.4f} s (the check "
-                                  "needs it inside its tube)")
+                                  "needs it inside its tube)", input_limit)
         return result(False, reason, t, i)
     tally.close(state, n)
     tally.data["horizon"] = float(samples.t[count])
     return result(True, "")
 
 
-def certify_stage(tube: TubeDesign, spec: Spec, stage: SecondStage) -> tuple[bool, dict]:
+def certify_stage(tube: TubeDesign, spec: Spec, stage: SecondStage,
+                  input_limit: tuple[float, ...] | None = None) -> tuple[bool, dict]:
     """:func:`check_cascade_sampled` for ``spec``'s declared plants (:func:`cascade_class`)
     and its ``[controller] delay`` and ``jitter`` on ``tube`` sampled at its rate: the
     design's certifier
@@ -712,6 +732,8 @@ def certify_stage(tube: TubeDesign, spec: Spec, stage: SecondStage) -> tuple[boo
         With a second-order ``plant.model``.
     stage : SecondStage
         The second stage to certify.
+    input_limit : tuple of float, optional
+        Stop and fail where ``|u_i|`` passes it (:func:`check_cascade_sampled`).
 
     Returns
     -------
@@ -719,13 +741,14 @@ def certify_stage(tube: TubeDesign, spec: Spec, stage: SecondStage) -> tuple[boo
     report : dict
         :attr:`CascadeCheck.data` with ``passed``, ``reason``, ``time``, ``dimension``.
     """
-    check = cascade_check_of(tube, spec, stage)
+    check = cascade_check_of(tube, spec, stage, input_limit)
     return check.passed, {**check.data, "passed": check.passed, "reason": check.reason,
                           "time": check.time, "dimension": check.dimension}
 
 
 @lru_cache(maxsize=64)
-def cascade_check_of(tube: TubeDesign, spec: Spec, stage: SecondStage) -> CascadeCheck:
+def cascade_check_of(tube: TubeDesign, spec: Spec, stage: SecondStage,
+                     input_limit: tuple[float, ...] | None = None) -> CascadeCheck:
     """:func:`check_cascade_sampled` of ``stage`` on ``tube`` for ``spec``'s declared
     plants and its ``[controller] delay`` and ``jitter``, once per process (the design,
     ``verify`` and the rate search ask again).
@@ -739,6 +762,9 @@ def cascade_check_of(tube: TubeDesign, spec: Spec, stage: SecondStage) -> Cascad
         of ``tube.rate_hz``.
     stage : SecondStage
         The second stage to certify.
+    input_limit : tuple of float, optional
+        Stop and fail where ``|u_i|`` passes it (:func:`check_cascade_sampled`); a check
+        with a limit is kept apart from the full one.
 
     Returns
     -------
@@ -748,7 +774,7 @@ def cascade_check_of(tube: TubeDesign, spec: Spec, stage: SecondStage) -> Cascad
     return check_cascade_sampled(tube, samples, stage, cascade_class(spec),
                                  spec.second_order.initial_velocity, delay=spec.delay,
                                  jitter=spec.jitter, compensate=spec.compensate_delay,
-                                 enclosure=enclosure)
+                                 enclosure=enclosure, input_limit=input_limit)
 
 
 @lru_cache(maxsize=8)
