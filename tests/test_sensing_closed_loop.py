@@ -106,7 +106,7 @@ def test_an_obstacle_faster_than_the_envelope_collides_and_is_reported(hall):
     record = run.sensing
     assert record.sensed_collision and run.collision and not run.satisfied
     assert record.outside_envelope and record.script_outside_envelope
-    assert not record.guaranteed
+    assert not record.guaranteed and record.collision_time is not None
     kinds = {v.kind for v in record.violations}
     assert {"speed", "displacement"} <= kinds
     first = min(v.time for v in record.violations)
@@ -123,9 +123,10 @@ def test_a_pursuer_at_the_envelopes_speed_ends_the_guarantee(hall):
     record = run.sensing
     assert not record.outside_envelope and not record.script_outside_envelope
     assert record.failures > 0 and record.uncertified and not record.guaranteed
-    assert record.sensed_collision
+    assert record.sensed_collision and not record.collision_certified
     hit = float(run.trajectory.t[np.argmax(_clearance(run, hall, 0.8) <= 0.0)])
     assert any(a <= hit <= b for a, b in record.uncertified)
+    assert abs(record.collision_time - hit) <= 1.0 / hall.spec.rate_hz
 
 
 def _clearance(run, hall, speed):

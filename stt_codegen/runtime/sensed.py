@@ -180,6 +180,11 @@ class SensingRecord:
         sensed obstacles then (after failures, before the first plan).
     sensed_collision : bool
         The body met a sensed obstacle (checked at every integration point).
+    collision_time : float or None
+        When it first did, s; ``None`` without a collision.
+    collision_certified : bool
+        That instant lies in a span some certificate covered (never, while the envelope
+        holds: the proof of docs/sensing.md says so).
     min_sensed_clearance : float or None
         Smallest distance between the body and a sensed obstacle, state units.
     violations : list of EnvelopeViolation
@@ -206,6 +211,8 @@ class SensingRecord:
     over_budget: int = 0
     uncertified: list[list[float]] = field(default_factory=list)
     sensed_collision: bool = False
+    collision_time: float | None = None
+    collision_certified: bool = False
     min_sensed_clearance: float | None = None
     violations: list[EnvelopeViolation] = field(default_factory=list)
     outside_envelope: bool = False
@@ -559,6 +566,11 @@ def _judged(design, backend, horizon, ts, states, us, alphas, status, tubes, sta
         sensed_clear = float(gaps.min())
         record.sensed_collision = bool(sensed_clear <= 0.0)
         record.min_sensed_clearance = sensed_clear
+        if record.sensed_collision:
+            hit = float(path_t[int(np.argmax(gaps.min(axis=1) <= 0.0))])
+            record.collision_time = hit
+            record.collision_certified = not any(a <= hit <= b
+                                                 for a, b in record.uncertified)
         clear.append(gaps[judged].min(axis=1))
     if clear:
         min_clear = float(np.min([np.min(c) for c in clear]))

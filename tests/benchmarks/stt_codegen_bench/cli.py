@@ -1,5 +1,5 @@
 """``stt-codegen bench arenas | tasks | drive | agv | step | scaling | covering | alpha | second-order |
-stl | overhead | delay | fleet``: the benchmarks and studies of :mod:`stt_codegen_bench`."""
+stl | overhead | delay | fleet | sensed``: the benchmarks and studies of :mod:`stt_codegen_bench`."""
 
 from __future__ import annotations
 
@@ -186,9 +186,20 @@ def _cmd_fleet(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_sensed(args: argparse.Namespace) -> int:
+    from .sensed_bench import format_sensed_report, run_sensed_bench
+    report = run_sensed_bench(args.count, args.seed,
+                              tuple(_int_list(args.obstacles, "--obstacles")),
+                              adversary=args.adversary)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_sensed_report(report))
+    return 0
+
+
 def configure_bench(bench: argparse.ArgumentParser) -> None:
     """Sub-subcommands ``bench arenas``, ``tasks``, ``drive``, ``agv``, ``step``, ``scaling``,
-    ``covering``, ``alpha``, ``second-order``, ``stl``, ``overhead``, ``delay`` and ``fleet``.
+    ``covering``, ``alpha``, ``second-order``, ``stl``, ``overhead``, ``delay``, ``fleet`` and
+    ``sensed``.
 
     Parameters
     ----------
@@ -337,3 +348,17 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                         "approach)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_fleet)
+
+    p = sub.add_parser("sensed", help="obstacles sensed at run time: Real-Time STT's 2-D "
+                                      "scenario (moving circles), replanning within the "
+                                      "envelope (docs/sensing.md)")
+    p.add_argument("--count", type=_positive_int, default=10,
+                   help="episodes per obstacle count (default: %(default)s)")
+    p.add_argument("--seed", type=_non_negative_int, default=0,
+                   help="episode seed (default: 0)")
+    p.add_argument("--obstacles", default="5,20", metavar="LIST",
+                   help="comma-separated obstacle counts (default: %(default)s)")
+    p.add_argument("--adversary", action="store_true",
+                   help="add a circle heading for the robot at the envelope's speed")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_sensed)
