@@ -84,6 +84,7 @@ def test_a_delay_costs_margin_and_raises_the_bound_of_e(s1):
     assert late.margin < plain.margin and late.level > plain.level
 
 
+@pytest.mark.slow
 def test_jitter_is_proved_too_and_costs_delay(s1):
     spec, design, largest = s1
     dt = 1.0 / design.rate_hz
@@ -102,6 +103,7 @@ def test_the_check_refuses_a_delay_beyond_the_period(s1):
         _check(spec, design, delay=0.8 * dt, jitter=0.2 * dt)
 
 
+@pytest.mark.slow
 def test_verify_reports_the_largest_delay(s1):
     spec, design, largest = s1
     with reference.numpy_math():

@@ -132,6 +132,7 @@ def test_a_mujoco_plant_takes_a_delay_of_whole_timesteps_only() -> None:
         assert not np.array_equal(late.trajectory.x, plain.trajectory.x)
 
 
+@pytest.mark.slow
 def test_the_jitter_is_drawn_seeded_within_its_bound_and_the_tube_is_kept() -> None:
     """omnirobot-s1 with 0.2 ms of jitter (certified: the sampled check passes with it):
     the reads move by up to the jitter, the run differs from the exact one and from another

@@ -175,6 +175,7 @@ def test_the_gain_comes_from_the_tubes_width_not_from_a_loose_enclosure():
 # --------------------------------------------------------------------------- failures
 
 
+@pytest.mark.slow
 def test_every_refusal_carries_a_kind_and_the_tube_tried():
     """Callers branch on DesignError.kind, never on the message."""
     spec = load_spec("omnirobot-s1")

@@ -45,6 +45,7 @@ def test_design_reports_its_stages_with_rising_fractions(name, stages):
     assert all(isinstance(e, Progress) and str(e) == e.message for e in events)
 
 
+@pytest.mark.slow
 def test_verify_reports_the_same_events():
     events: list[Progress] = []
     stt.verify(stt.design_tube(stt.load_spec("omnirobot-s1")), progress=events.append)

@@ -40,6 +40,7 @@ def test_all_checks_pass_on_the_paper_cases(case):
         assert expected in names, expected
 
 
+@pytest.mark.slow
 def test_cli_json_and_exit_code():
     out = run("verify", "omnirobot-s2", "--json")
     assert out.returncode == 0, out.stderr
