@@ -13,7 +13,8 @@ Spatiotemporal Tubes Approach". The front door, in the order of the flow (see
   (:class:`FleetSpec`): each robot's tube designed to keep clear of the others' at every
   ``t``, every pair certified (:class:`FleetDesign`, docs/fleets.md);
   :func:`generate_fleet`, :func:`simulate_fleet` - a controller folder per robot, and
-  every robot's closed loop with every pair's closest approach;
+  every robot's closed loop with every pair's closest approach; :func:`verify_fleet` -
+  every robot verified and every pair certified again (:class:`FleetVerification`);
 * :func:`generate` - write the standalone C and Python controllers of a design into a
   folder;
 * :func:`simulate` - run a design's sampled controller in closed loop and judge
@@ -66,6 +67,8 @@ _LAZY: dict[str, str] = {
     "FleetDesign": "stt_codegen.design.fleet",
     "generate_fleet": "stt_codegen.codegen.fleet",
     "simulate_fleet": "stt_codegen.runtime.fleet",
+    "verify_fleet": "stt_codegen.verification.fleet",
+    "FleetVerification": "stt_codegen.verification.fleet",
     "TubeDesign": "stt_codegen.tube.parameters",
     "design_tube": "stt_codegen.design.search",
     "Design": "stt_codegen.design.result",
@@ -102,6 +105,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .codegen.fleet import generate_fleet
     from .design.fleet import FleetDesign, design_fleet
     from .runtime.fleet import simulate_fleet
+    from .verification.fleet import FleetVerification, verify_fleet
     from .spec.fleet import FleetSpec, load_fleet
     from .pointmaze import import_pointmaze
     from .spec.sensing import SensedObstacle

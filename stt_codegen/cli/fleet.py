@@ -1,15 +1,15 @@
-"""Fleet files on the command line: ``design``, ``generate`` and ``simulate`` of a fleet.
+"""Fleet files on the command line: ``design``, ``generate``, ``simulate`` and ``verify`` of
+a fleet.
 
 A ``SPEC`` that names a bundled fleet or a TOML file with ``[[robots]]`` is a fleet
-(docs/fleets.md); :func:`fleet_of` tells, and the three commands hand it to the handlers
-here, thin layers over :func:`stt_codegen.design_fleet`, :func:`stt_codegen.generate_fleet`
-and :func:`stt_codegen.simulate_fleet`.
+(docs/fleets.md); :func:`fleet_of` tells, and the four commands hand it to the handlers
+here, thin layers over :func:`stt_codegen.design_fleet`, :func:`stt_codegen.generate_fleet`,
+:func:`stt_codegen.simulate_fleet` and :func:`stt_codegen.verify_fleet`.
 """
 
 from __future__ import annotations
 
 import argparse
-import math
 import tomllib
 from pathlib import Path
 from typing import Any, Callable
@@ -17,7 +17,7 @@ from typing import Any, Callable
 from ..cases import bundled_fleets
 from .common import print_json
 
-__all__ = ["fleet_design", "fleet_generate", "fleet_of", "fleet_simulate"]
+__all__ = ["fleet_design", "fleet_generate", "fleet_of", "fleet_simulate", "fleet_verify"]
 
 
 def fleet_of(args: argparse.Namespace) -> Any:
@@ -65,9 +65,8 @@ def _designed(fleet: Any) -> Any:
 
 
 def _pair_json(p: Any) -> dict[str, Any]:
-    return {"pair": list(p.pair), "passed": p.passed, "margin": p.margin,
-            "interval": [p.t_start, p.t_end if math.isfinite(p.t_end) else None],
-            "dimension": p.dim, "intervals": p.intervals}
+    from ..verification.fleet import pair_json
+    return pair_json(p)
 
 
 def fleet_design(args: argparse.Namespace, fleet: Any) -> int:
@@ -183,3 +182,41 @@ def fleet_simulate(args: argparse.Namespace, fleet: Any, header: str,
           + ("" if closest is None else f", closest approach {closest.clearance:.3f} "
              f"({closest.pair[0]} and {closest.pair[1]} at {closest.t:.3f} s)"))
     return 0 if run.satisfied else 1
+
+
+def fleet_verify(args: argparse.Namespace, fleet: Any) -> int:
+    """``verify FLEET``: every robot's checks and every pair certified again.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        ``json``, ``all``, ``quiet``, ``no_cache``; ``plant`` must be ``None`` (each robot
+        has its own).
+    fleet : FleetSpec
+
+    Returns
+    -------
+    int
+        0 every check passed, 1 a check failed.
+
+    Raises
+    ------
+    SpecError
+        ``--plant`` given (exit code 2).
+    DesignError
+        No certified fleet design (exit code 1).
+    """
+    from ..errors import SpecError
+    from ..verification.fleet import verify_fleet
+    from .common import progress_bar
+    if getattr(args, "plant", None) is not None:
+        raise SpecError("--plant", "is for a single spec: each robot of a fleet has its own "
+                                   "plant (docs/fleets.md)")
+    designed = _designed(fleet)
+    with progress_bar(args, "verify") as progress:
+        report = verify_fleet(designed, progress=progress, cache=not args.no_cache)
+    if args.json:
+        print_json(report.to_json())
+    else:
+        print(str(report) if args.all else report.summary())
+    return 0 if report.passed else 1

@@ -36,6 +36,10 @@ def cmd_verify(args: argparse.Namespace) -> int:
     """
     from ..spec.loader import load_spec
     from ..verification.command import spec_for_plant, verify
+    from .fleet import fleet_of, fleet_verify
+    fleet = fleet_of(args)            # a fleet file: every robot and pair (docs/fleets.md)
+    if fleet is not None:
+        return fleet_verify(args, fleet)
     design = design_spec(spec_for_plant(load_spec(args.spec), args.plant), args)
     with progress_bar(args, "verify") as progress:
         report = verify(design, plant=args.plant, progress=progress, cache=not args.no_cache)
