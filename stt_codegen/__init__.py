@@ -15,6 +15,7 @@ Spatiotemporal Tubes Approach". The front door, in the order of the flow (see
   :func:`generate_fleet`, :func:`simulate_fleet` - a controller folder per robot, and
   every robot's closed loop with every pair's closest approach; :func:`verify_fleet` -
   every robot verified and every pair certified again (:class:`FleetVerification`);
+  :func:`plot_fleet` - the fleet in time slices;
 * :func:`generate` - write the standalone C and Python controllers of a design into a
   folder;
 * :func:`simulate` - run a design's sampled controller in closed loop and judge
@@ -68,6 +69,7 @@ _LAZY: dict[str, str] = {
     "generate_fleet": "stt_codegen.codegen.fleet",
     "simulate_fleet": "stt_codegen.runtime.fleet",
     "verify_fleet": "stt_codegen.verification.fleet",
+    "plot_fleet": "stt_codegen.runtime.fleet_plots",
     "FleetVerification": "stt_codegen.verification.fleet",
     "TubeDesign": "stt_codegen.tube.parameters",
     "design_tube": "stt_codegen.design.search",
@@ -106,6 +108,7 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .design.fleet import FleetDesign, design_fleet
     from .runtime.fleet import simulate_fleet
     from .verification.fleet import FleetVerification, verify_fleet
+    from .runtime.fleet_plots import plot_fleet
     from .spec.fleet import FleetSpec, load_fleet
     from .pointmaze import import_pointmaze
     from .spec.sensing import SensedObstacle

@@ -55,9 +55,26 @@ def test_a_bad_robot_is_exit_2_naming_it(fleet_file, capsys):
     assert err.startswith("error: robots[0].target.lower: ") and "Traceback" not in err
 
 
-def test_a_fleet_has_no_plot(fleet_file, capsys):
-    assert main(["design", str(fleet_file), "--plot", "x.png"]) == 2
-    assert "--plot" in capsys.readouterr().err
+def test_a_fleet_plot_in_a_missing_folder_is_exit_2_before_any_work(fleet_file, tmp_path,
+                                                                       capsys):
+    assert main(["design", str(fleet_file), "--plot", str(tmp_path / "no" / "x.png")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: --plot: folder ") and "Traceback" not in err
+
+
+def test_a_fleet_has_no_log(fleet_file, tmp_path, capsys):
+    assert main(["simulate", str(fleet_file), "--log", str(tmp_path / "x.mcap")]) == 2
+    assert "--log: is for a single spec, not a fleet" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == [fleet_file]
+
+
+@pytest.mark.slow
+def test_design_of_a_fleet_draws_it_in_time_slices(fleet_file, tmp_path, capsys):
+    out = tmp_path / "figs"
+    out.mkdir()
+    assert main(["design", str(fleet_file), "--plot", str(out / "fleet.png")]) == 0
+    assert [p.name for p in out.iterdir()] == ["fleet.png"]          # nothing half-written
+    assert (out / "fleet.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 @pytest.mark.slow

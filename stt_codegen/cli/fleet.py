@@ -50,13 +50,25 @@ def fleet_of(args: argparse.Namespace) -> Any:
     return load_fleet(name) if is_fleet(doc) else None
 
 
-def _no_figures(args: argparse.Namespace) -> None:
-    """Refuse the single spec's outputs a fleet does not have (``--plot``, ``--export``,
-    ``--log``), naming the flag."""
+def _no_figures(args: argparse.Namespace, fleet: Any) -> tuple[int, int]:
+    """Refuse the single spec's outputs a fleet does not have (``--export``, ``--log``),
+    naming the flag; check ``--plot``'s folder and ``--dims`` before any work. Returns the
+    figure's dimensions."""
     from ..errors import SpecError
-    for flag in ("plot", "export", "log"):
+    from ..runtime.dims import parse_dims
+    from .plotting import check_plot_folder
+    for flag in ("export", "log"):
         if getattr(args, flag, None):
             raise SpecError(f"--{flag}", "is for a single spec, not a fleet (docs/fleets.md)")
+    check_plot_folder(args)
+    return parse_dims(getattr(args, "dims", None), fleet.robots[0].spec.dimension)
+
+
+def _plot(args: argparse.Namespace, designed: Any, run: Any, dims: tuple[int, int]) -> None:
+    """With ``--plot``: the fleet in time slices (:func:`stt_codegen.plot_fleet`)."""
+    from ..runtime.fleet_plots import plot_fleet
+    from .plotting import write_plot
+    write_plot(args, lambda path: plot_fleet(designed, path, run, dims=dims))
 
 
 def _designed(fleet: Any) -> Any:
@@ -75,7 +87,7 @@ def fleet_design(args: argparse.Namespace, fleet: Any) -> int:
     Parameters
     ----------
     args : argparse.Namespace
-        ``json``.
+        ``json``, ``plot`` (a PNG of the fleet in time slices), ``dims``.
     fleet : FleetSpec
 
     Returns
@@ -88,8 +100,9 @@ def fleet_design(args: argparse.Namespace, fleet: Any) -> int:
     DesignError
         No certified fleet design (exit code 1).
     """
-    _no_figures(args)
+    dims = _no_figures(args, fleet)
     designed = _designed(fleet)
+    _plot(args, designed, None, dims)
     if args.json:
         print_json({"fleet": fleet.name, "certified": designed.certified,
                     "order": list(designed.order), "reordered": list(designed.reordered),
@@ -141,7 +154,8 @@ def fleet_simulate(args: argparse.Namespace, fleet: Any, header: str,
     Parameters
     ----------
     args : argparse.Namespace
-        ``backend``, ``horizon``, ``seed``, ``json``.
+        ``backend``, ``horizon``, ``seed``, ``json``, ``plot`` (a PNG of the fleet in
+        time slices with each body in the run), ``dims``.
     fleet : FleetSpec
     header : str
         The header of the robots' table (``simulate``'s).
@@ -161,9 +175,10 @@ def fleet_simulate(args: argparse.Namespace, fleet: Any, header: str,
     from ..runtime.fleet import simulate_fleet
     from .common import checked_seed
     seed = checked_seed(args)
-    _no_figures(args)
-    run = simulate_fleet(_designed(fleet), backend=args.backend, horizon=args.horizon,
-                         seed=seed)
+    dims = _no_figures(args, fleet)
+    designed = _designed(fleet)
+    run = simulate_fleet(designed, backend=args.backend, horizon=args.horizon, seed=seed)
+    _plot(args, designed, run, dims)
     if args.json:
         print_json({"fleet": fleet.name, "satisfied": run.satisfied, "horizon": run.horizon,
                     "robots": {n: r.to_json() for n, r in run.results.items()},

@@ -21,7 +21,8 @@ if TYPE_CHECKING:
     from ..errors import DesignError
     from ..spec.loader import Spec
 
-__all__ = ["add_dims_argument", "add_plot_argument", "design_to_plot", "plot_dims", "write_plot"]
+__all__ = ["add_dims_argument", "add_plot_argument", "check_plot_folder", "design_to_plot",
+           "plot_dims", "write_plot"]
 
 
 def add_dims_argument(p: argparse.ArgumentParser) -> None:

@@ -45,6 +45,7 @@ if TYPE_CHECKING:
     from ..errors import DesignError
 
 __all__ = ["OBSTACLE_LABEL", "agg_figure", "arena_figure", "design_figure", "draw_arena",
+           "draw_box", "draw_unsafe_sets",
            "plot_design", "plot_rejected", "plot_run", "rejected_figure",
            "run_figure", "save"]
 
