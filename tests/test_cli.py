@@ -131,6 +131,7 @@ def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
     assert "fleet warehouse-fleet: 8 robots, 28 pairs certified apart" in out.stdout
     assert "every robot satisfied, closest approach " in out.stdout
     assert (tmp_path / "demo" / "warehouse-fleet" / "base1" / "base1.c").is_file()
+    assert (tmp_path / "demo" / "warehouse-fleet.png").stat().st_size > 10_000
     again = run("demo", "--out", str(tmp_path / "demo"))     # its own files: overwritten
     assert again.returncode == 0, again.stderr
 

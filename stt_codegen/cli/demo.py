@@ -50,15 +50,18 @@ def _failure(exc: SttError) -> tuple:
 
 def _run_fleet(name: str, args: argparse.Namespace) -> tuple[str, bool] | tuple[None, tuple]:
     """One bundled fleet in the demo: design, a folder per robot, every robot's closed
-    loop; its summary (the certified narrowest pair, the closest approach) and whether
+    loop, its figure in time slices; its summary (the certified narrowest pair, the closest approach) and whether
     it is satisfied, or ``(None, failure)`` as :func:`_run_case`."""
     from ..codegen.fleet import generate_fleet
     from ..design.fleet import design_fleet
     from ..runtime.fleet import simulate_fleet
+    from ..runtime.fleet_plots import plot_fleet
     try:
         designed = design_fleet(name)
         generate_fleet(designed, Path(args.out) / name)
         run = simulate_fleet(designed, backend=args.backend)
+        atomic_write(Path(args.out) / f"{name}.png",
+                     lambda tmp: plot_fleet(designed, tmp, run))
     except SttError as exc:
         return None, _failure(exc)
     pair, closest = designed.narrowest, run.closest
@@ -161,7 +164,8 @@ def cmd_demo(args: argparse.Namespace) -> int:
             all_ok = _print_outcomes(pool.map(_run_case, *zip(*cases)))
             all_ok &= _print_outcomes(f.result() for f in fleet_runs)
     print(f"generated code in {out}/<case>/, plots in {out}/<case>.png"
-          + "".join(f"; {name}: a folder per robot in {out}/{name}/" for name in fleets))
+          + "".join(f"; {name}: a folder per robot in {out}/{name}/, its plot {out}/{name}.png"
+                    for name in fleets))
     return 0 if all_ok else 1
 
 
