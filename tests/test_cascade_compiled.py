@@ -164,6 +164,11 @@ def test_each_formula_on_symbols_is_its_float_original():
                   [oracle.phi_slope_scalar(v) for v in wide])
     ratio = np.concatenate([rng.uniform(0.0, 4.0, 300), np.exp(rng.uniform(0, 12, 300))])
     assert _equal(_symbolic(peak_scalar, 1)(ratio)[0], [oracle.peak_scalar(v) for v in ratio])
+    # on floats its loop is written out (no call per halving): the same doubles
+    edges = [2.0, np.nextafter(2.0, 3.0), 2.0 + 1e-9, 1e300, np.inf, np.nan, -1.0, 0.0]
+    floats = np.concatenate([ratio, 2.0 + rng.uniform(0, 1e-6, 300), edges])
+    assert _equal([peak_scalar(float(v)) for v in floats],
+                  [oracle.peak_scalar(float(v)) for v in floats])
     cp = [rng.choice([0.0, 1.0]) * rng.uniform(0, 1, m), rng.uniform(0, 1, m),
           rng.uniform(0, 2, m), rng.choice([0.0, 0.3], m), rng.uniform(0, 1, m)]
     assert _equal(_symbolic(coupling_push, 5)(*cp)[0],

@@ -125,6 +125,24 @@ def peak(ratio: np.ndarray) -> np.ndarray:
     return np.where(ratio <= 2.0, 0.0, lo[where.reshape(ratio.shape)])
 
 
+def _peak_float(ratio: float) -> float:
+    """:func:`peak_scalar` on floats: the same bisection with :func:`phi_slope_scalar`'s
+    float operations written out in the loop (``mid < 1`` always, so its ``inf`` branch is
+    never taken): the same doubles, without a call per halving (the differential drive's
+    sampled check asks it per sample and axis)."""
+    if not ratio > 2.0:
+        return 0.0
+    atanh = math.atanh
+    lo, hi = 0.0, 1.0 - 1e-15
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if (2.0 + 4.0 * mid * atanh(mid)) / (1.0 - mid * mid) ** 2 < ratio:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
 def peak_scalar(ratio: float, ops=FLOATS) -> float:
     """:func:`peak` for one float (or one ``SX`` symbol).
 
@@ -140,8 +158,8 @@ def peak_scalar(ratio: float, ops=FLOATS) -> float:
     float
         ``s*`` in ``[0, 1)``.
     """
-    if not ops.symbolic and not ratio > 2.0:
-        return 0.0
+    if not ops.symbolic:
+        return _peak_float(ratio)
     lo, hi = 0.0, 1.0 - 1e-15
     for _ in range(60):
         mid = 0.5 * (lo + hi)
