@@ -31,6 +31,20 @@ def test_too_many_robots_or_floors_below_one_are_refused():
     with pytest.raises(SpecError) as raised:
         run_fleet_bench(0, 0)
     assert raised.value.field == "count"
+    with pytest.raises(SpecError) as raised:
+        run_fleet_bench(1, 0, workers=0)
+    assert raised.value.field == "workers"
+
+
+@pytest.mark.slow
+def test_floors_in_parallel_processes_are_the_floors_in_turn():
+    # the same floors, the same verdicts and margins, whichever process designs them
+    apart = run_fleet_bench(2, 3, robots=2, workers=2)
+    turn = run_fleet_bench(2, 3, robots=2)
+    keys = ("index", "certified", "margin", "reordered", "astar_certified", "solo_failed")
+    assert [[f[k] for k in keys] for f in apart["floors"]] == \
+        [[f[k] for k in keys] for f in turn["floors"]]
+    assert all(f["fleet_s"] > 0 for f in apart["floors"])
 
 
 @pytest.mark.slow

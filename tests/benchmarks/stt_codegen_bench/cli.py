@@ -180,7 +180,8 @@ def _cmd_delay(args: argparse.Namespace) -> int:
 
 def _cmd_fleet(args: argparse.Namespace) -> int:
     from .fleet_bench import format_fleet_report, run_fleet_bench
-    report = run_fleet_bench(args.count, args.seed, robots=args.robots, simulate=args.simulate)
+    report = run_fleet_bench(args.count, args.seed, robots=args.robots, simulate=args.simulate,
+                             workers=args.workers, scheduler=args.scheduler)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_fleet_report(report))
     return 0
@@ -346,6 +347,11 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
     p.add_argument("--simulate", action="store_true",
                    help="also run every robot's generated C in closed loop (the closest "
                         "approach)")
+    p.add_argument("--workers", type=_positive_int, default=1, metavar="W",
+                   help="floors designed in W local processes at once; each floor's CPU "
+                        "time is its own process's (default: 1, in turn)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run the floors on an existing Dask distributed scheduler instead")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_fleet)
 

@@ -40,6 +40,8 @@ from stt_codegen.errors import DesignError, SpecError
 from stt_codegen.runtime.fleet import simulate_fleet
 from stt_codegen.spec.fleet import FleetSpec
 
+from .parallel import run_parallel
+
 __all__ = ["fair_floor", "fleet_floor", "floor_layout", "format_fleet_report", "run_fleet_bench"]
 
 #: The docks' spacing along the walls, m.
@@ -267,8 +269,12 @@ def _floor(seed: int, index: int, robots: int, simulate: bool) -> dict:
     return row
 
 
-def run_fleet_bench(count: int, seed: int, robots: int = 8, simulate: bool = False) -> dict:
-    """Fleet design on ``count`` seeded floors, sequentially.
+def run_fleet_bench(count: int, seed: int, robots: int = 8, simulate: bool = False,
+                    workers: int = 1, scheduler: str | None = None) -> dict:
+    """Fleet design on ``count`` seeded floors: one after another, or a floor per job on
+    local processes or a Dask scheduler (:func:`~.parallel.run_parallel`). Each floor's
+    times are the CPU of the process that designs it, so they do not depend on how many
+    run beside it (beyond the machine's load).
 
     Parameters
     ----------
@@ -280,6 +286,10 @@ def run_fleet_bench(count: int, seed: int, robots: int = 8, simulate: bool = Fal
         Robots per floor.
     simulate : bool
         Also run every robot's generated C in closed loop (the closest approach).
+    workers : int
+        Local processes; 1 (the default) designs the floors in this process, in turn.
+    scheduler : str, optional
+        Address of a running Dask scheduler: the floors are its jobs (``workers`` ignored).
 
     Returns
     -------
@@ -295,11 +305,20 @@ def run_fleet_bench(count: int, seed: int, robots: int = 8, simulate: bool = Fal
     Raises
     ------
     SpecError
-        ``count < 1`` (field ``count``), a bad ``robots``.
+        ``count < 1`` (field ``count``), a bad ``robots``, ``workers < 1`` (field
+        ``workers``), a scheduler that does not answer (field ``scheduler``).
     """
     if count < 1:
         raise SpecError("count", f"must be at least 1, got {count}")
-    floors = [_floor(seed, k, robots, simulate) for k in range(count)]
+    if workers < 1:
+        raise SpecError("workers", f"must be at least 1, got {workers}")
+    fleet_floor(seed, 0, robots)                    # a bad robots fails before any job
+    calls = [(seed, k, robots, simulate) for k in range(count)]
+    if workers == 1 and scheduler is None:
+        floors = [_floor(*call) for call in calls]
+    else:
+        floors = run_parallel(_floor, calls, workers=workers, scheduler=scheduler,
+                              progress=False, description="floors")
     return {"count": count, "seed": seed, "robots": robots, "floors": floors,
             "certified_fraction": sum(f["certified"] for f in floors) / count,
             "astar_fraction": sum(f["astar_certified"] for f in floors) / count,
