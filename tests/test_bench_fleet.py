@@ -45,6 +45,15 @@ def test_floors_in_parallel_processes_are_the_floors_in_turn():
     assert [[f[k] for k in keys] for f in apart["floors"]] == \
         [[f[k] for k in keys] for f in turn["floors"]]
     assert all(f["fleet_s"] > 0 for f in apart["floors"])
+    # every robot of a certified floor is placed once, its near robots among those placed
+    for f in turn["floors"]:
+        if f["certified"]:
+            assert len(f["placements"]) == 2
+            assert [p[0] for p in f["placements"]] == [0, 1]
+            assert all(0 <= near <= placed and cpu >= 0 for placed, near, cpu in f["placements"])
+    assert sum(b["robots"] for b in turn["by_near"]) == sum(
+        len(f.get("placements", ())) for f in turn["floors"])
+    assert "placement CPU by the placed robots near its way" in format_fleet_report(turn)
 
 
 @pytest.mark.slow

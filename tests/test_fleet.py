@@ -168,6 +168,9 @@ def test_the_prioritized_design_separates_the_crossing_robots():
         assert designed.designs[robot.name].spec == robot.spec
     assert _sampled_gap(designed.designs, fleet) >= pair.margin - 1e-9
     assert "narrowest pair" in designed.summary()
+    # the placements in order: a alone on the floor, then b with a near its way
+    assert [(p.robot, p.placed, p.near) for p in designed.placements] == [("a", 0, 0),
+                                                                          ("b", 1, 1)]
 
 
 def test_a_target_on_another_robots_way_is_refused_naming_the_pair():

@@ -45,7 +45,8 @@ from .result import METHOD_VIA, Design, TubeCheck
 from .search import check_tube, design_tube
 
 __all__ = ["CHUNK_SECONDS", "DETOURS", "DETOUR_SECONDS", "INDEX_CELL", "INDEX_SECONDS",
-           "LEG_METRES", "PLANNER_SPACE_TIME", "PLANNER_TUBES", "SCREEN_INTERVALS", "FleetDesign", "certify_fleet", "design_fleet",
+           "LEG_METRES", "PLANNER_SPACE_TIME", "PLANNER_TUBES", "SCREEN_INTERVALS", "FleetDesign",
+           "Placement", "certify_fleet", "design_fleet",
            "enclosed", "plan_way", "priority_order", "tube_obstacles"]
 
 #: The longest time span of one box standing for another robot's tube in a re-timing,
@@ -81,6 +82,30 @@ PLANNER_TUBES, PLANNER_SPACE_TIME = "tubes", "space-time A*"
 
 
 @dataclass(frozen=True)
+class Placement:
+    """The cost of placing one robot among the robots placed before it.
+
+    Attributes
+    ----------
+    robot : str
+        Its name.
+    placed : int
+        The robots placed before it (in the order that succeeded).
+    near : int
+        Those the space-time index finds near its way (its tube designed alone), whose
+        tubes its placement is checked against.
+    cpu_s : float
+        Processor time of its placement (its checks, re-timings, paths and the pair
+        certificates against the robots near it), seconds.
+    """
+
+    robot: str
+    placed: int
+    near: int
+    cpu_s: float
+
+
+@dataclass(frozen=True)
 class FleetDesign:
     """A certified design of every robot of a fleet.
 
@@ -98,6 +123,9 @@ class FleetDesign:
         Wall time of the whole design, seconds (every order tried).
     reordered : tuple of str
         The robots moved to the front after they found no tube, in turn.
+    placements : tuple of Placement
+        Per robot, in the order that succeeded, what its placement cost and how many
+        placed robots were near it.
 
     Examples
     --------
@@ -116,6 +144,7 @@ class FleetDesign:
     pairs: tuple[PairMargin, ...]
     design_time_s: float = field(default=0.0, compare=False)
     reordered: tuple[str, ...] = ()
+    placements: tuple[Placement, ...] = field(default=(), compare=False)
 
     @property
     def certified(self) -> bool:
@@ -343,6 +372,7 @@ class _Placing:
     index: TubeIndex = field(default_factory=lambda: TubeIndex(INDEX_CELL))
     grids: dict[str, SpaceTimeGrid] = field(default_factory=dict)
     planner: str = PLANNER_TUBES
+    log: list[Placement] = field(default_factory=list)
 
     @property
     def widest(self) -> float:
@@ -687,7 +717,12 @@ def _place(order: Sequence[FleetRobot], placing: _Placing) -> tuple[FleetRobot, 
     """The robots designed in ``order`` into ``placing`` until one fails (that robot and
     the reason), or ``None``."""
     for robot in order:
+        way = chunks(placing.ways[robot.name][1], robot.dims, INDEX_SECONDS)
+        near = len(placing.index.near(way, robot.reach + placing.widest))
+        cpu = time.process_time()
         found = _fit(robot, placing)
+        placing.log.append(Placement(robot.name, len(placing.placed), near,
+                                     time.process_time() - cpu))
         if isinstance(found, str):
             return robot, found
         design, tube = found
@@ -769,4 +804,4 @@ def design_fleet(fleet: FleetSpec | str | os.PathLike,
         raise DesignError("the fleet is not certified: " + "; ".join(p.detail for p in bad),
                           kind=FailureKind.FLEET)
     return FleetDesign(fleet, designs, tuple(r.name for r in order), pairs,
-                       time.perf_counter() - start, tuple(moved))
+                       time.perf_counter() - start, tuple(moved), tuple(placing.log))

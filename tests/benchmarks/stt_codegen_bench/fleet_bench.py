@@ -261,6 +261,7 @@ def _floor(seed: int, index: int, robots: int, simulate: bool) -> dict:
            "fleet_s": time.process_time() - start, "solo_s": solo,
            "solo_failed": len(refused), "reordered": len(designed.reordered),
            "margin": designed.narrowest.margin if designed.pairs else None, "reason": "",
+           "placements": [[p.placed, p.near, p.cpu_s] for p in designed.placements],
            **baseline}
     if simulate:
         run = simulate_fleet(designed, backend="c", seed=index)
@@ -324,7 +325,27 @@ def run_fleet_bench(count: int, seed: int, robots: int = 8, simulate: bool = Fal
             "astar_fraction": sum(f["astar_certified"] for f in floors) / count,
             "astar_s": float(np.median([f["astar_s"] for f in floors])),
             "fleet_s": float(np.median([f["fleet_s"] for f in floors])),
-            "ratio": float(np.median([f["fleet_s"] / f["solo_s"] for f in floors]))}
+            "ratio": float(np.median([f["fleet_s"] / f["solo_s"] for f in floors])),
+            "by_near": placement_growth(floors)}
+
+
+#: The buckets of ``near`` (placed robots near a robot's way) of :func:`placement_growth`.
+NEAR_BUCKETS = ((0, 0), (1, 2), (3, 5), (6, 10), (11, 10**9))
+
+
+def placement_growth(floors: list[dict]) -> list[dict]:
+    """A robot's placement CPU against the placed robots near its way, over every robot of
+    the certified floors: per bucket of :data:`NEAR_BUCKETS`, the robots, the median and
+    the mean CPU seconds, and the mean CPU per robot near (the growth the space-time index
+    is to keep at most linear)."""
+    rows = [p for f in floors for p in f.get("placements", ())]
+    out = []
+    for low, high in NEAR_BUCKETS:
+        cpu = [c for _, near, c in rows if low <= near <= high]
+        if cpu:
+            out.append({"near": [low, high], "robots": len(cpu),
+                        "median_s": float(np.median(cpu)), "mean_s": float(np.mean(cpu))})
+    return out
 
 
 def format_fleet_report(report: dict) -> str:
@@ -360,4 +381,11 @@ def format_fleet_report(report: dict) -> str:
                  "its robots designed alone; space-time A* (prioritized, longest trip first) "
                  f"certified {100 * report['astar_fraction']:.0f} %, median "
                  f"{report['astar_s']:.1f} s")
+    growth = "; ".join(
+        f"{b['near'][0]}" + ("" if b['near'][1] == b['near'][0] else
+                             "+" if b['near'][1] > 10**6 else f"-{b['near'][1]}")
+        + f" near: {b['robots']} robots, median {b['median_s']:.2f} s, mean {b['mean_s']:.2f} s"
+        for b in report.get("by_near", ()))
+    if growth:
+        lines.append("a robot's placement CPU by the placed robots near its way: " + growth)
     return "\n".join(lines)
