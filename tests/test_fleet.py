@@ -227,3 +227,22 @@ def test_the_space_time_baseline_plans_every_robot_along_a_path_and_is_certified
     assert _sampled_gap(designed.designs, fleet) >= designed.narrowest.margin - 1e-9
     with pytest.raises(ValueError, match="planner"):
         stt.design_fleet(fleet, planner="astar")
+
+
+@pytest.mark.slow
+def test_a_re_ordering_keeps_the_placements_that_still_hold(monkeypatch):
+    # warehouse-fleet moves two robots to the front; the robots placed before them keep
+    # their placements where they are certified apart from the moved ones, so fewer
+    # placements are designed than when every order starts afresh; certified either way
+    from stt_codegen.design import fleet as F
+    fits = []
+    real = F._fit
+    monkeypatch.setattr(F, "_fit", lambda robot, placing: fits.append(robot.name)
+                        or real(robot, placing))
+    kept = stt.design_fleet("warehouse-fleet")
+    kept_fits, fits[:] = list(fits), []
+    monkeypatch.setattr(F, "_kept_from", lambda *args: None)
+    fresh = stt.design_fleet("warehouse-fleet")
+    assert kept.certified and fresh.certified and kept.reordered == fresh.reordered != ()
+    assert len(kept_fits) < len(fits)
+    assert all(p.passed for p in kept.pairs) and len(kept.pairs) == 28

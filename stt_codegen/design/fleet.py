@@ -13,7 +13,8 @@ moving boxes over at most :data:`CHUNK_SECONDS` each, first through its own via 
 through via boxes planned clear of the other robots' docks; each re-timed tube is accepted
 only when its own check, its input proof and the pair certificate against every placed tube
 near it pass. A robot that finds no tube is moved to the front and the fleet is placed
-again, each robot moved at most once. Every pair of the fleet is then certified by
+again, each robot moved at most once; a robot placed in the order tried before keeps that
+placement where it still holds (:func:`_kept_from`). Every pair of the fleet is then certified by
 :func:`certify_fleet` on the robots' own certificates; nothing is accepted on the
 planner's word.
 """
@@ -713,14 +714,38 @@ def _conflicts(robot: FleetRobot, placing: _Placing, reason: str) -> DesignError
                        f"Tried: {reason}", kind=FailureKind.FLEET)
 
 
-def _place(order: Sequence[FleetRobot], placing: _Placing) -> tuple[FleetRobot, str] | None:
+def _kept_from(robot: FleetRobot, earlier: _Placing | None,
+               placing: _Placing) -> tuple[Design, RobotTube] | None:
+    """``robot``'s placement in the order tried before (``earlier``), when it still holds:
+    every robot placed before it then is placed now, and its tube is certified apart from
+    each robot placed now that was not placed before it then or was placed otherwise (the
+    others it was certified against then). ``None`` otherwise (it is placed again)."""
+    if earlier is None or robot.name not in earlier.placed:
+        return None
+    before = list(earlier.placed)
+    then = set(before[:before.index(robot.name)])
+    if then - set(placing.placed):
+        return None
+    new = [name for name, (_, design, _) in placing.placed.items()
+           if name not in then or design is not earlier.placed[name][1]]
+    _, design, tube = earlier.placed[robot.name]
+    near = placing.index.near(chunks(tube, robot.dims, INDEX_SECONDS),
+                              robot.reach + placing.widest)
+    if _clash(robot, tube, [name for name in near if name in new], placing) is not None:
+        return None
+    return design, tube
+
+
+def _place(order: Sequence[FleetRobot], placing: _Placing,
+           earlier: _Placing | None = None) -> tuple[FleetRobot, str] | None:
     """The robots designed in ``order`` into ``placing`` until one fails (that robot and
-    the reason), or ``None``."""
+    the reason), or ``None``. With ``earlier`` (the placement of the order tried before), a
+    robot keeps its earlier placement where it still holds (:func:`_kept_from`)."""
     for robot in order:
         way = chunks(placing.ways[robot.name][1], robot.dims, INDEX_SECONDS)
         near = len(placing.index.near(way, robot.reach + placing.widest))
         cpu = time.process_time()
-        found = _fit(robot, placing)
+        found = _kept_from(robot, earlier, placing) or _fit(robot, placing)
         placing.log.append(Placement(robot.name, len(placing.placed), near,
                                      time.process_time() - cpu))
         if isinstance(found, str):
@@ -786,9 +811,10 @@ def design_fleet(fleet: FleetSpec | str | os.PathLike,
     order = (priority_order(fleet) if planner == PLANNER_SPACE_TIME else
              priority_order(fleet, {name: tube for name, (_, tube) in ways.items()}))
     moved: list[str] = []
+    placing = None
     while True:
-        placing = _Placing(fleet, ways, planner=planner)
-        failed = _place(order, placing)
+        earlier, placing = placing, _Placing(fleet, ways, planner=planner)
+        failed = _place(order, placing, earlier)
         if failed is None:
             break
         robot, reason = failed
