@@ -418,7 +418,8 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
                       for lag in (0.0, delay)})
     k1, k2 = stage.position_gain, stage.velocity_gain
     g_min, g_max, cpl = plants.g_min, plants.g_max, plants.coupling
-    f0, f1, w_amp = plants.drift_bound, plants.drift_slope, plants.disturbance_bound
+    f1, w_amp = plants.drift_slope, plants.disturbance_bound
+    f0 = np.broadcast_to(np.asarray(plants.drift_bound, dtype=float).reshape(-1), (n,))
     vbound = plants.velocity_bound
     tally = _Tally(design, stage, plants, {"delay": delay, "jitter": jitter} if timed else {})
     peak_u, peak_x2, peak_t = tally.peak_u, tally.peak_x2, tally.peak_t
@@ -495,20 +496,21 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
             z_abs = reach2[i] * rho_k[i]
             r_abs = 4.0 * k1 / (2.0 * half_l[k][i]) * phi_scalar(reach1[i])
             if not timed:
-                push_free = g_max * u_abs[i] + cpl * others + f0 + w_amp  # |x2_dot| w/o F1
+                push_free = g_max * u_abs[i] + cpl * others + f0[i] + w_amp  # w/o F1
                 speed = (r_abs + z_abs + h * push_free) / (1.0 - h * f1)
             else:
                 # the force is u_{k-1} for the lag, then u_k: x2 moves under the larger
                 force_old = g_max * u_prev[i] + cpl * math.sqrt(
                     max(u_prev_sq - u_prev[i] ** 2, 0.0)) if delay > 0.0 else 0.0
                 force = max(g_max * u_abs[i] + cpl * others, force_old)
-                speed = (r_abs + z_abs + longest * (force + f0 + w_amp)) / (1.0 - longest * f1)
+                speed = ((r_abs + z_abs + longest * (force + f0[i] + w_amp))
+                         / (1.0 - longest * f1))
             peak_x2[i] = max(peak_x2[i], speed)
             if vbound is not None and speed >= vbound[i]:
                 return result(False, f"|x2_{i}| may reach {speed:.4g} on [{t:.4f}, "
                               f"{t + h:.4f}] s, beyond velocity_bound {vbound[i]:g} (the "
                               "drift bound is declared within it)", t, i)
-            drift = f0 + f1 * speed + w_amp
+            drift = f0[i] + f1 * speed + w_amp
             if not timed:
                 accel = g_max * u_abs[i] + cpl * others + drift
                 # position stage: law (13) with g = 1 and a displacement <= tau (Z + h A/2)
@@ -638,7 +640,8 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
         raise ValueError(f"delay = {delay!r} s must lie in (0, dt = {h!r}] s")
     k1, k2 = stage.position_gain, stage.velocity_gain
     g_min, g_max, cpl = plants.g_min, plants.g_max, plants.coupling
-    f0, f1, w_amp = plants.drift_bound, plants.drift_slope, plants.disturbance_bound
+    f1, w_amp = plants.drift_slope, plants.disturbance_bound
+    f0 = np.broadcast_to(np.asarray(plants.drift_bound, dtype=float).reshape(-1), (n,))
     deviation = 0.5 * (g_max - g_min)                     # |g_ii - g_mid|
     g_mid = 0.5 * (g_max + g_min)
     share = 1.0 - min(delay / h, 1.0)          # of a period x_hat's step is uncertain
@@ -691,12 +694,12 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
     edge0 = _rho2(stage, np.array([delay]))[0].tolist()
     box1, box2, eta1, eta2 = [], [], [], []
     for i in range(n):
-        speed = (abs(x2_0[i]) + delay * (f0 + w_amp)) / (1.0 - delay * f1)
+        speed = (abs(x2_0[i]) + delay * (f0[i] + w_amp)) / (1.0 - delay * f1)
         peak_x2[i] = speed
         if vbound is not None and speed >= vbound[i]:
             return result(False, f"|x2_{i}| may reach {speed:.4g} on [0, {delay:.4g}] s, "
                           f"beyond velocity_bound {vbound[i]:g}", 0.0, i)
-        accel = f0 + f1 * speed + w_amp
+        accel = f0[i] + f1 * speed + w_amp
         p_lo, p_hi = x1_0[i] - delay * speed, x1_0[i] + delay * speed
         e1_0 = (x1_0[i] - centre_l[0][i]) / half_l[0][i]
         room = min(float(enc.upper_min[0][i]) - p_hi,
@@ -752,13 +755,13 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
             r_abs = 4.0 * k1 / (2.0 * half_l[k][i]) * phi_scalar(reach1[i])
             force = g_max * u_abs[i] + cpl * others
             # (C2) |x2| on [a_k, a_{k+1}]: from x2_hat = r_k + z_hat, the miss, the interval
-            speed = (r_abs + z_abs + eta2[i] + h * (force + f0 + w_amp)) / (1.0 - h * f1)
+            speed = (r_abs + z_abs + eta2[i] + h * (force + f0[i] + w_amp)) / (1.0 - h * f1)
             peak_x2[i] = max(peak_x2[i], speed)
             if vbound is not None and speed >= vbound[i]:
                 return result(False, f"|x2_{i}| may reach {speed:.4g} on [{t + delay:.4f}, "
                               f"{t + h + delay:.4f}] s, beyond velocity_bound {vbound[i]:g} "
                               "(the drift bound is declared within it)", t, i)
-            drift = f0 + f1 * speed + w_amp
+            drift = f0[i] + f1 * speed + w_amp
             # (C2) the position stage: law (13) with g = 1 at x1_hat, x1(a_k) = x1_hat + miss
             shift = h * (z_abs + eta2[i]) + 0.5 * h * h * (force + drift)
             p_lo, p_hi, x_lo, x_hi = axis_interval(

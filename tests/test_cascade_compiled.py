@@ -61,13 +61,16 @@ def _random_case(rng: np.random.Generator, spec, tube, min_width: float):
     coupling = float(rng.choice([0.0, rng.uniform(0.0, 0.5 * (g_max - g_min))]))
     drift, slope = float(rng.uniform(0.0, 1.0)), float(rng.choice([0.0, rng.uniform(0, 2)]))
     velocity = None if rng.random() < 0.3 else tuple(rng.uniform(0.3, 3.0, n).tolist())
-    plants = CascadeClass(g_min, g_max, coupling, drift, slope,
+    # one drift bound on every axis, or one per axis (the largest the stage's)
+    per_axis = tuple((drift * rng.uniform(0.0, 1.0, n)).tolist()) if rng.random() < 0.5 else None
+    plants = CascadeClass(g_min, g_max, coupling, per_axis or drift, slope,
                           float(rng.choice([0.0, 0.1, 3.0])) * float(rng.random()), velocity)
     shape = (float(rng.uniform(0.2, 1.5)), float(rng.uniform(3.0, 20.0)),
              float(np.exp(rng.uniform(np.log(0.3), np.log(30.0)))))
     start = rng.uniform(-0.2, 0.2, n).tolist()
     stage, _ = derived_second_stage(tube, min_width, (g_min, g_max),
-                                    drift + plants.disturbance_bound, start, shape)
+                                    max(plants.drift_bounds(n)) + plants.disturbance_bound,
+                                    start, shape)
     h = 1.0 / tube.rate_hz
     timing = [{}, {"delay": float(rng.uniform(0, 0.5)) * h},
               {"jitter": float(rng.uniform(0, 0.2)) * h},

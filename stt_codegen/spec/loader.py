@@ -1045,6 +1045,10 @@ def _assumptions(table: AssumptionsTable, n: int, amplitude: float, model: str,
     (:func:`~.assumptions.combine_assumptions`)."""
     declared = {key: getattr(table, key) for key in AssumptionsTable.model_fields
                 if key in table.model_fields_set}
+    if isinstance(declared.get("drift_bound"), list):
+        raise SpecError("assumptions.drift_bound", "one number per position only for a "
+                        "second-order plant.model; a first-order plant's drift_bound bounds "
+                        "|f(x)|, one number")
     if _require_declared(model, declared):     # no equations: the declared bounds as they are
         bounds = declared_bounds(model, declared, n)
     else:

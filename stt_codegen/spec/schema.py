@@ -265,13 +265,13 @@ class AssumptionsTable(_Table):
                                                           "part of g(x)")
     input_gain_coupling: NonNegative = _omitted("bound on the off-diagonal part of each row "
                                                 "of g(x); default implied by the two above")
-    drift_bound: NonNegative = Field(0.0, description="bound on |f(x)|, state units per "
-                                                      "second. For a second-order model: "
-                                                      "on every |f_i| of the second stage, "
-                                                      "velocity units per second; default "
-                                                      "the model's own (gravity; drag and "
-                                                      "Coriolis within state_space."
-                                                      "velocity_bound)")
+    drift_bound: NonNegative | Annotated[list[NonNegative], Field(
+        min_length=1, max_length=MAX_DIMENSION)] = Field(
+        0.0, description="bound on |f(x)|, state units per second. For a second-order "
+                         "model: on every |f_i| of the second stage, velocity units per "
+                         "second, one number or one per position (a quadrotor's gravity "
+                         "acts on its vertical axis only); default the model's own "
+                         "(gravity; drag and Coriolis within state_space.velocity_bound)")
     disturbance_bound: NonNegative = _omitted("bound on |w(t)|, state units per second; "
                                               "default sqrt(n) x plant.disturbance_amplitude")
     input_gain_lipschitz: Annotated[list[NonNegative],
@@ -432,12 +432,32 @@ def key_name(key: str) -> str:
     return repr(key) if len(key) <= 64 else repr(key[:64]) + "..."
 
 
+def _is_number_tag(part: object) -> bool:
+    """A tag pydantic puts in ``loc`` for a member of a number-or-list union."""
+    return isinstance(part, str) and (part.startswith("constrained-")
+                                      or part.startswith("list[constrained-"))
+
+
+def _number_or_list(errors: list[dict]) -> list[dict]:
+    """The errors of a number-or-list field (``drift_bound``) for the member the input
+    meant: the list's when it was a list (its errors are then not ``list_type``), else
+    the number's."""
+    def tags(error: dict) -> list[str]:
+        return [p for p in error["loc"] if _is_number_tag(p)]
+    listed = [e for e in errors if any(t.startswith("list[") for t in tags(e))]
+    meant_list = any(e["type"] != "list_type" for e in listed)
+    return [e for e in errors if not tags(e)
+            or any(t.startswith("list[") for t in tags(e)) == meant_list]
+
+
 def _field(loc: tuple) -> str:
     """``("obstacles", 2, "ball", "radius")`` -> ``"obstacles[2].radius"`` (union tags dropped)."""
     text = ""
     for k, part in enumerate(loc):
         if isinstance(part, int):
             text += f"[{part}]"
+        elif _is_number_tag(part):
+            continue
         elif not (part in ("box", "ball", "polytope") and k and isinstance(loc[k - 1], int)):
             name = key_name(part) if k == len(loc) - 1 else part
             text += f".{name}" if text else name
@@ -588,7 +608,7 @@ def check_document(doc: Any) -> SpecDocument:
     try:
         return SpecDocument.model_validate(doc)
     except ValidationError as exc:
-        first = _row_as_array(sorted(exc.errors(include_url=False),
+        first = _row_as_array(sorted(_number_or_list(exc.errors(include_url=False)),
                                      key=_order(tuple(SpecDocument.model_fields)))[0])
         raise SpecError(_field(first["loc"]), _reason(first)) from None
     except RecursionError:

@@ -56,7 +56,10 @@ class SecondOrder:
     drift_bound : float
         ``assumptions.drift_bound``: declared bound on every ``|f_i|`` over the states of
         the task, velocity units per second (the disturbance is ``[plant]
-        disturbance_amplitude``).
+        disturbance_amplitude``); with ``drift_per_axis``, its largest entry.
+    drift_per_axis : tuple of float or None
+        ``assumptions.drift_bound`` given per axis (or the model's own per axis): ``|f_i|
+        <= drift_per_axis[i]``; ``None``: ``drift_bound`` on every axis.
     """
 
     model: str
@@ -65,6 +68,12 @@ class SecondOrder:
     velocity_bound: tuple[float, ...] | None
     input_gain: tuple[float, float]
     drift_bound: float
+    drift_per_axis: tuple[float, ...] | None = None
+
+    @property
+    def axis_drift_bound(self) -> tuple[float, ...]:
+        """The bound on ``|f_i|`` of each axis, one per position (velocity units/s)."""
+        return self.drift_per_axis or (self.drift_bound,) * len(self.initial_velocity)
 
 
 @dataclass(frozen=True)
@@ -82,21 +91,34 @@ class ModelBounds:
         ``None`` when it grows with the velocity and no ``velocity_bound`` is given.
     words : str
         How they follow from the parameters, for messages.
+    drift_per_axis : tuple of float or None
+        ``sup |f_i|`` of each axis where the model's drift differs by axis (a quadrotor's
+        gravity), ``drift_bound`` its largest entry; ``None``: ``drift_bound`` on every
+        axis.
     """
 
     input_gain: tuple[float, float]
     drift_bound: float | None
     words: str
+    drift_per_axis: tuple[float, ...] | None = None
+
+    @property
+    def axis_drift_bound(self) -> float | tuple[float, ...] | None:
+        """``drift_per_axis`` when given, else ``drift_bound``."""
+        return self.drift_per_axis or self.drift_bound
 
 
 def _mass_bounds(p: dict, offset: Sequence[float], slope: float,
                  velocity_bound: Sequence[float] | None) -> ModelBounds:
     """``g = I / m``, ``|f_i| <= slope |x2_i| + offset_i``."""
     g = 1.0 / p["mass"]
-    drift = (max(offset) if slope == 0.0 else None if velocity_bound is None else
-             max(o + slope * v for o, v in zip(offset, velocity_bound)))
+    axes = (tuple(offset) if slope == 0.0 else None if velocity_bound is None else
+            tuple(o + slope * v for o, v in zip(offset, velocity_bound)))
+    drift = None if axes is None else max(axes)
+    per_axis = axes if axes is not None and min(axes) < drift else None
     return ModelBounds((g, g), drift, f"g = I / mass = {g:.6g} I, |f_i| <= "
-                       f"{slope:.6g} |x2_i| + {max(offset):.6g}")
+                       f"{slope:.6g} |x2_i| + [{', '.join(f'{o:.6g}' for o in offset)}]_i",
+                       per_axis)
 
 
 def _double_integrator(p: dict, n: int, velocity_bound, lower, upper) -> ModelBounds:
@@ -203,7 +225,7 @@ def parse_second_order(model: str, n: int, parameters: Sequence[float] | None = 
                        velocity: Sequence[float] | None = None,
                        velocity_bound: Sequence[float] | None = None,
                        input_gain: Sequence[float] | None = None,
-                       drift_bound: float | None = None,
+                       drift_bound: float | Sequence[float] | None = None,
                        positions: tuple[Sequence[float], Sequence[float]] | None = None
                        ) -> SecondOrder:
     """The second-order plant of a spec with ``n`` positions, checked.
@@ -222,8 +244,9 @@ def parse_second_order(model: str, n: int, parameters: Sequence[float] | None = 
         ``state_space.velocity_bound`` (default none).
     input_gain : sequence of float, optional
         ``assumptions.input_gain``; default the model's own (:func:`model_bounds`).
-    drift_bound : float, optional
-        ``assumptions.drift_bound``; default the model's own.
+    drift_bound : float or sequence of float, optional
+        ``assumptions.drift_bound``: one bound on every ``|f_i|`` or one per position
+        (``n`` entries, velocity units/s); default the model's own.
     positions : (sequence of float, sequence of float), optional
         The state space's ``(lower, upper)``, over which the model's own bounds are taken;
         default ``[-pi, pi]`` in every position.
@@ -236,8 +259,9 @@ def parse_second_order(model: str, n: int, parameters: Sequence[float] | None = 
     ------
     SpecError
         ``plant.model`` of another dimension, or ``plant.parameters``,
-        ``initial.velocity``, ``state_space.velocity_bound``, ``assumptions.input_gain``
-        of the wrong length or out of range; ``assumptions.drift_bound`` left out where the
+        ``initial.velocity``, ``state_space.velocity_bound``, ``assumptions.input_gain``,
+        ``assumptions.drift_bound`` of the wrong length or out of range;
+        ``assumptions.drift_bound`` left out where the
         model's drift grows with the velocity and no ``velocity_bound`` is given; the
         field is named.
     """
@@ -267,11 +291,19 @@ def parse_second_order(model: str, n: int, parameters: Sequence[float] | None = 
                                                               "assumptions.input_gain", 2)
     if not 0 < gain[0] <= gain[1]:
         raise SpecError("assumptions.input_gain", "needs 0 < g_min <= g_max")
+    per_axis = None
     if drift_bound is None:
-        drift_bound = own.drift_bound
+        drift_bound, per_axis = own.drift_bound, own.drift_per_axis
         if drift_bound is None:
             raise SpecError("assumptions.drift_bound", f"the {info.name} model's drift "
                             "grows with the velocity (drag, Coriolis): give "
                             "state_space.velocity_bound, from which its bound is derived, "
                             "or declare assumptions.drift_bound")
-    return SecondOrder(model, params, x2, bound, (gain[0], gain[1]), float(drift_bound))
+    elif not isinstance(drift_bound, (int, float)):
+        per_axis = _numbers(drift_bound, "assumptions.drift_bound", n)
+        if min(per_axis) < 0:
+            raise SpecError("assumptions.drift_bound", "every entry must be >= 0")
+        drift_bound = max(per_axis)
+        per_axis = per_axis if min(per_axis) < drift_bound else None
+    return SecondOrder(model, params, x2, bound, (gain[0], gain[1]), float(drift_bound),
+                       per_axis)

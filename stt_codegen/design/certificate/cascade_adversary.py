@@ -91,13 +91,14 @@ def _signs(n: int) -> np.ndarray:
 def _advance(cls: CascadeClass, x1: np.ndarray, x2: np.ndarray, gu: np.ndarray,
              signs: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
     """Positions and velocities after ``h`` for rows of ``g u`` and drift signs."""
+    f0 = cls.drift_bounds(x2.shape[-1])
     if cls.drift_slope == 0.0:
-        a = gu + signs * (cls.drift_bound + cls.disturbance_bound)
+        a = gu + signs * (f0 + cls.disturbance_bound)
         return x1 + x2 * h + 0.5 * a * h * h, x2 + a * h
     step = h / SUBSTEPS
 
     def rates(v):
-        return gu + signs * (cls.drift_bound + cls.drift_slope * np.abs(v)
+        return gu + signs * (f0 + cls.drift_slope * np.abs(v)
                              + cls.disturbance_bound)
     for _ in range(SUBSTEPS):
         k1p, k1v = x2, rates(x2)

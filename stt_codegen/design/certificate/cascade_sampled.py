@@ -75,8 +75,9 @@ class CascadeClass:
         Bound of the Euclidean norm of the off-diagonal part of a row of ``g``; 0 for a
         model whose ``g`` is diagonal; at most ``(g_max - g_min) / 2`` for any symmetric
         ``g`` of the range.
-    drift_bound : float
-        ``F0``: ``|f_i| <= F0 + F1 |x2_i|``, velocity units per second.
+    drift_bound : float or tuple of float
+        ``F0``: ``|f_i| <= F0_i + F1 |x2_i|``, velocity units per second; one number for
+        every axis, or one per axis (a quadrotor's gravity acts on its vertical axis only).
     drift_slope : float
         ``F1`` (e.g. damping over mass), 1/s; ``h F1 < 1`` is needed.
     disturbance_bound : float
@@ -89,14 +90,29 @@ class CascadeClass:
     g_min: float
     g_max: float
     coupling: float
-    drift_bound: float
+    drift_bound: float | tuple[float, ...]
     drift_slope: float = 0.0
     disturbance_bound: float = 0.0
     velocity_bound: tuple[float, ...] | None = None
 
+    def drift_bounds(self, n: int) -> np.ndarray:
+        """``F0_i`` of each of ``n`` axes, shape ``(n,)``.
+
+        Raises
+        ------
+        ValueError
+            ``drift_bound`` has neither one entry nor ``n``.
+        """
+        f0 = np.asarray(self.drift_bound, dtype=float).reshape(-1)
+        if f0.size not in (1, n):
+            raise ValueError(f"drift_bound needs 1 or {n} entries, got {f0.size}")
+        return np.broadcast_to(f0, (n,)).copy()
+
     def words(self) -> str:
         """The class in one phrase (for reports)."""
-        drift = f"|f_i| <= {self.drift_bound:.6g}"
+        f0 = np.asarray(self.drift_bound, dtype=float).reshape(-1)
+        drift = (f"|f_i| <= {f0[0]:.6g}" if f0.size == 1 else
+                 "|f_i| <= [" + ", ".join(f"{v:.6g}" for v in f0) + "]_i")
         if self.drift_slope:
             drift += f" + {self.drift_slope:.6g} |x2_i|"
         coupling = ("g diagonal" if self.coupling == 0.0 else
@@ -107,7 +123,8 @@ class CascadeClass:
 
 def cascade_class(spec: Spec) -> CascadeClass:
     """The class of a spec with a second-order ``plant.model``: ``assumptions.input_gain``,
-    ``assumptions.drift_bound`` (``F1 = 0``: a velocity-dependent drift is declared at
+    ``assumptions.drift_bound`` (per axis where the spec or the model gives one per axis;
+    ``F1 = 0``: a velocity-dependent drift is declared at
     ``state_space.velocity_bound``, which the certificate proves is kept),
     ``plant.disturbance_amplitude``; coupling 0 for a model with a diagonal ``g``
     (:attr:`~stt_codegen.spec.plants.SecondOrderModel.diagonal_input`), else ``(g_max -
@@ -132,7 +149,7 @@ def cascade_class(spec: Spec) -> CascadeClass:
     g_min, g_max = order.input_gain
     diagonal = SECOND_ORDER_PLANTS[order.model].diagonal_input
     return CascadeClass(g_min, g_max, 0.0 if diagonal else 0.5 * (g_max - g_min),
-                        order.drift_bound, 0.0, spec.disturbance_amplitude,
+                        order.axis_drift_bound, 0.0, spec.disturbance_amplitude,
                         order.velocity_bound)
 
 
@@ -378,7 +395,7 @@ def check_cascade_sampled(design: TubeDesign, samples: TubeSamples, stage: Secon
                       for lag in (0.0, delay)})
     k1, k2 = stage.position_gain, stage.velocity_gain
     g_min, g_max, cpl = plants.g_min, plants.g_max, plants.coupling
-    f0, f1, w_amp = plants.drift_bound, plants.drift_slope, plants.disturbance_bound
+    f0, f1, w_amp = plants.drift_bounds(n), plants.drift_slope, plants.disturbance_bound
     vbound = plants.velocity_bound
     tally = _Tally(design, stage, plants, {"delay": delay, "jitter": jitter} if timed else {})
     refused = _unfit(stage, samples, plants, longest if timed else h)
@@ -599,7 +616,7 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
         raise ValueError(f"delay = {delay!r} s must lie in (0, dt = {h!r}] s")
     k1, k2 = stage.position_gain, stage.velocity_gain
     g_min, g_max, cpl = plants.g_min, plants.g_max, plants.coupling
-    f0, f1, w_amp = plants.drift_bound, plants.drift_slope, plants.disturbance_bound
+    f0, f1, w_amp = plants.drift_bounds(n), plants.drift_slope, plants.disturbance_bound
     deviation = 0.5 * (g_max - g_min)                     # |g_ii - g_mid|
     g_mid = 0.5 * (g_max + g_min)
     share = 1.0 - min(delay / h, 1.0)          # of a period x_hat's step is uncertain
@@ -652,12 +669,12 @@ def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: Sec
     edge0 = _rho2(stage, np.array([delay]))[0].tolist()
     box1, box2, eta1, eta2 = [], [], [], []
     for i in range(n):
-        speed = (abs(x2_0[i]) + delay * (f0 + w_amp)) / (1.0 - delay * f1)
+        speed = (abs(x2_0[i]) + delay * (f0[i] + w_amp)) / (1.0 - delay * f1)
         tally.peak_x2[i] = speed
         if vbound is not None and speed >= vbound[i]:
             return result(False, f"|x2_{i}| may reach {speed:.4g} on [0, {delay:.4g}] s, "
                           f"beyond velocity_bound {vbound[i]:g}", 0.0, i)
-        accel = f0 + f1 * speed + w_amp
+        accel = f0[i] + f1 * speed + w_amp
         p_lo, p_hi = x1_0[i] - delay * speed, x1_0[i] + delay * speed
         e1_0 = (x1_0[i] - first["centre"][i]) / first["half"][i]
         room = min(float(enc.upper_min[0][i]) - p_hi,
@@ -869,15 +886,19 @@ def model_within_class(spec: Spec) -> tuple[bool, str, dict]:
         return False, (f"the {order.model} model has no equations: the certificate covers "
                        "the declared class only, not this plant"), {}
     g_min, g_max = own.input_gain
-    drift = math.inf if own.drift_bound is None else own.drift_bound
+    n = spec.dimension
+    drift = (np.full(n, math.inf) if own.drift_bound is None else
+             np.broadcast_to(np.asarray(own.axis_drift_bound, dtype=float), (n,)))
+    declared = cls.drift_bounds(n)
     bad = []
     if not cls.g_min <= g_min <= g_max <= cls.g_max:
         bad.append(f"g in [{g_min:.6g}, {g_max:.6g}] outside input_gain [{cls.g_min:g}, "
                    f"{cls.g_max:g}]")
-    if drift > cls.drift_bound * (1 + 1e-12):
-        bad.append(f"max |f_i| = {drift:.6g} (within velocity_bound) exceeds drift_bound "
-                   f"{cls.drift_bound:g}")
-    data = {"input_gain": [g_min, g_max], "drift": drift}
+    for i in np.flatnonzero(drift > declared * (1 + 1e-12)):
+        bad.append(f"max |f_{i}| = {drift[i]:.6g} (within velocity_bound) exceeds "
+                   f"drift_bound {declared[i]:g}")
+    data = {"input_gain": [g_min, g_max], "drift": drift.tolist()}
+    drift = float(drift.max())
     if bad:
         return False, (f"the spec's {order.model} plant is outside the class the certificate "
                        "covers: " + "; ".join(bad)), data

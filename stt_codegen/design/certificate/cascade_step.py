@@ -54,7 +54,8 @@ FIGURES = ("reach1", "reach2", "u_abs", "speed", "room", "vroom", "reach_next", 
 SAMPLED_COLUMNS = ("centre", "half", "centre_next", "half_next", "pull1", "peak1", "up_e",
                    "low_e", "room_up", "room_low", "width_min", "width_max", "move", "rho",
                    "rho_next", "peak2", "edge")
-#: The constants of the plain (or timed) check (``vbound``: ``n`` of them, ``inf`` when
+#: The constants of the plain (or timed) check (``f0``, the drift bound per axis, and
+#: ``vbound``: ``n`` of them, ``vbound`` ``inf`` when
 #: none; ``share``: one per share; ``corner_share``, ``corner_lag``: one per corner;
 #: ``length``: one per interval length).
 SAMPLED_PARAMETERS = ("k1", "k2", "h", "g_min", "g_max", "coupling", "f0", "f1", "w",
@@ -66,7 +67,7 @@ PREDICTED_COLUMNS = ("centre", "half", "centre_next", "half_next", "pull1", "pea
                      "low_e", "room_up", "room_low", "width_max_a", "move_r", "width_min_r",
                      "width_max_r", "move", "width_min", "width_max", "rho", "rho_next",
                      "peak2", "late")
-#: The constants of the predicted check.
+#: The constants of the predicted check (``f0`` and ``vbound``: ``n`` of them).
 PREDICTED_PARAMETERS = ("k1", "k2", "h", "g_min", "g_max", "coupling", "f0", "f1", "w",
                         "delay", "deviation", "g_mid", "share", "mix_lo", "mix_hi", "vbound")
 
@@ -115,14 +116,15 @@ def _sampled_layouts(n: int, shares: int, corners: int, lengths: int
                      ) -> tuple[StepLayout, StepLayout]:
     sizes = {"peak1": shares * n, "peak2": corners * n}
     columns = StepLayout((name, sizes.get(name, n)) for name in SAMPLED_COLUMNS)
-    sizes = {"vbound": n, "share": shares, "corner_share": corners, "corner_lag": corners,
-             "length": lengths}
+    sizes = {"f0": n, "vbound": n, "share": shares, "corner_share": corners,
+             "corner_lag": corners, "length": lengths}
     return columns, StepLayout((name, sizes.get(name, 1)) for name in SAMPLED_PARAMETERS)
 
 
 def _predicted_layouts(n: int) -> tuple[StepLayout, StepLayout]:
     return (StepLayout((name, n) for name in PREDICTED_COLUMNS),
-            StepLayout((name, n if name == "vbound" else 1) for name in PREDICTED_PARAMETERS))
+            StepLayout((name, n if name in ("f0", "vbound") else 1)
+                       for name in PREDICTED_PARAMETERS))
 
 
 def _union(intervals, ops) -> tuple:
@@ -173,8 +175,9 @@ def sampled_step(n: int, timed: bool, delayed: bool, shares: int, corners: int,
         par = casadi.SX.sym("constants", constants.size)
         c = {name: _split(col, columns, name) for name in SAMPLED_COLUMNS}
         p = {name: _split(par, constants, name) for name in SAMPLED_PARAMETERS}
-        k1, k2, h, g_min, g_max, cpl, f0, f1, w_amp, longest, delay = (
+        k1, k2, h, g_min, g_max, cpl, _, f1, w_amp, longest, delay = (
             p[name][0] for name in SAMPLED_PARAMETERS[:11])
+        f0 = p["f0"]
         b1lo, b1hi, b2lo, b2hi, u_prev = (
             [state[j * n + i] for i in range(n)] for j in range(5))
         reach1 = [fmax(-b1lo[i], b1hi[i]) for i in range(n)]
@@ -191,15 +194,16 @@ def sampled_step(n: int, timed: bool, delayed: bool, shares: int, corners: int,
             centre, half = c["centre"][i], c["half"][i]
             r_abs = 4.0 * k1 / (2.0 * half) * phi_scalar(reach1[i], ops)
             if not timed:
-                push_free = g_max * u_abs[i] + cpl * others + f0 + w_amp  # |x2_dot| w/o F1
+                push_free = g_max * u_abs[i] + cpl * others + f0[i] + w_amp  # w/o F1
                 speed = (r_abs + z_abs + h * push_free) / (1.0 - h * f1)
             else:
                 # the force is u_{k-1} for the lag, then u_k: x2 moves under the larger
                 force_old = g_max * u_prev[i] + cpl * ops.sqrt(
                     fmax(u_prev_sq - u_prev[i] ** 2, 0.0)) if delayed else 0.0
                 force = fmax(g_max * u_abs[i] + cpl * others, force_old)
-                speed = (r_abs + z_abs + longest * (force + f0 + w_amp)) / (1.0 - longest * f1)
-            drift = f0 + f1 * speed + w_amp
+                speed = ((r_abs + z_abs + longest * (force + f0[i] + w_amp))
+                         / (1.0 - longest * f1))
+            drift = f0[i] + f1 * speed + w_amp
             if not timed:
                 accel = g_max * u_abs[i] + cpl * others + drift
                 # position stage: law (13) with g = 1 and a displacement <= tau (Z + h A/2)
@@ -299,8 +303,9 @@ def predicted_step(n: int) -> tuple[casadi.Function, StepLayout, StepLayout]:
         par = casadi.SX.sym("constants", constants.size)
         c = {name: _split(col, columns, name) for name in PREDICTED_COLUMNS}
         p = {name: _split(par, constants, name) for name in PREDICTED_PARAMETERS}
-        (k1, k2, h, g_min, g_max, cpl, f0, f1, w_amp, delay, deviation, g_mid, share,
+        (k1, k2, h, g_min, g_max, cpl, _, f1, w_amp, delay, deviation, g_mid, share,
          mix_lo, mix_hi) = (p[name][0] for name in PREDICTED_PARAMETERS[:15])
+        f0 = p["f0"]
         b1lo, b1hi, b2lo, b2hi, eta1, eta2 = (
             [state[j * n + i] for i in range(n)] for j in range(6))
         reach1 = [fmax(-b1lo[i], b1hi[i]) for i in range(n)]
@@ -317,8 +322,8 @@ def predicted_step(n: int) -> tuple[casadi.Function, StepLayout, StepLayout]:
             r_abs = 4.0 * k1 / (2.0 * half) * phi_scalar(reach1[i], ops)
             force = g_max * u_abs[i] + cpl * others
             # (C2) |x2| on [a_k, a_{k+1}]: from x2_hat = r_k + z_hat, the miss, the interval
-            speed = (r_abs + z_abs + eta2[i] + h * (force + f0 + w_amp)) / (1.0 - h * f1)
-            drift = f0 + f1 * speed + w_amp
+            speed = (r_abs + z_abs + eta2[i] + h * (force + f0[i] + w_amp)) / (1.0 - h * f1)
+            drift = f0[i] + f1 * speed + w_amp
             # (C2) the position stage: law (13) with g = 1 at x1_hat, x1(a_k) = x1_hat + miss
             shift = h * (z_abs + eta2[i]) + 0.5 * h * h * (force + drift)
             p_lo, p_hi, x_lo, x_hi = axis_interval(

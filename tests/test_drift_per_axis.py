@@ -1,0 +1,129 @@
+"""A second-order plant's drift bound per axis (``[assumptions] drift_bound = [F_1, ..,
+F_n]``, docs/second-order.md, "The class"): the spec's field, a quadrotor's own bound
+(gravity on its vertical axis only), the certificate that reads it, and the small drone
+that only it makes certifiable within its thrust."""
+
+from __future__ import annotations
+
+import dataclasses
+import pathlib
+import tomllib
+
+import numpy as np
+import pytest
+from conftest import design_of
+
+import stt_codegen as stt
+from stt_codegen.design.certificate.cascade_sampled import (CascadeClass,
+                                                            check_cascade_sampled,
+                                                            model_within_class)
+from stt_codegen.design.samples import sample_tube
+from stt_codegen.spec.second_order import model_bounds
+from stt_codegen.tube import reference
+
+DRONE = pathlib.Path(__file__).parent / "specs" / "drone-room.toml"
+
+
+def _drone(**assumptions) -> dict:
+    data = tomllib.loads(DRONE.read_text())
+    data["assumptions"].update(assumptions)
+    return data
+
+
+def test_a_list_is_one_bound_per_axis_and_its_largest_is_the_drift_bound() -> None:
+    order = stt.Spec.from_dict(_drone(drift_bound=[0.0, 0.5, 9.81])).second_order
+    assert order.drift_per_axis == (0.0, 0.5, 9.81) and order.drift_bound == 9.81
+    assert order.axis_drift_bound == (0.0, 0.5, 9.81)
+    same = stt.Spec.from_dict(_drone(drift_bound=[2.0, 2.0, 2.0])).second_order
+    assert same.drift_per_axis is None and same.axis_drift_bound == (2.0, 2.0, 2.0)
+
+
+@pytest.mark.parametrize("value,field,words", [
+    ([1.0, 2.0], "assumptions.drift_bound", "needs 3 entries"),
+    ([1.0, -2.0, 1.0], "assumptions.drift_bound[1]", "non-negative"),
+    (-1.0, "assumptions.drift_bound", "non-negative"),
+    ("9.81", "assumptions.drift_bound", "must be a number"),
+])
+def test_a_bad_drift_bound_names_the_field(value, field, words) -> None:
+    with pytest.raises(stt.SpecError) as info:
+        stt.Spec.from_dict(_drone(drift_bound=value))
+    assert info.value.field == field and words in info.value.reason
+
+
+def test_a_first_order_plant_takes_one_drift_bound() -> None:
+    data = {"name": "flat", "prescribed_time": 5.0,
+            "state_space": {"lower": [0.0, 0.0], "upper": [4.0, 4.0]},
+            "initial": {"lower": [0.2, 0.2], "upper": [0.8, 0.8]},
+            "target": {"lower": [3.0, 3.0], "upper": [3.8, 3.8]},
+            "assumptions": {"drift_bound": [0.1, 0.1]}}
+    with pytest.raises(stt.SpecError) as info:
+        stt.Spec.from_dict(data)
+    assert info.value.field == "assumptions.drift_bound"
+    assert "only for a second-order plant.model" in info.value.reason
+
+
+def test_a_quadrotors_own_drift_has_gravity_on_its_vertical_axis_only() -> None:
+    own = model_bounds("quadrotor", (1.2, 0.3, 9.81), 3, (3.0, 3.0, 2.0), (0,) * 3, (6,) * 3)
+    assert own.drift_per_axis == pytest.approx((0.75, 0.75, 9.81 + 0.5), rel=1e-15)
+    assert own.drift_bound == pytest.approx(9.81 + 0.5, rel=1e-15)
+    flat = model_bounds("double-integrator", (2.0,), 2, None, (0,) * 2, (6,) * 2)
+    assert flat.drift_per_axis is None and flat.drift_bound == 0.0
+
+
+def test_the_model_is_checked_against_each_axis_of_the_class() -> None:
+    spec = stt.Spec.from_dict(_drone(drift_bound=[0.0, 0.0, 9.81]))
+    ok, words, data = model_within_class(spec)
+    assert ok and data["drift"] == [0.0, 0.0, 9.81]
+    short = stt.Spec.from_dict(_drone(drift_bound=[0.0, 0.0, 9.0]))
+    ok, words, _ = model_within_class(short)
+    assert not ok and "max |f_2| = 9.81" in words and "f_0" not in words
+
+
+@pytest.fixture(scope="module")
+def s1():
+    design = design_of("second-order-s1")
+    with reference.numpy_math():
+        samples = sample_tube(design.tube)
+    return design, samples
+
+
+def _check(s1, drift):
+    design, samples = s1
+    plants = CascadeClass(1.0, 1.0, 0.0, drift, 0.0, design.spec.disturbance_amplitude,
+                          design.spec.second_order.velocity_bound)
+    return check_cascade_sampled(design.tube, samples, design.second_stage[0], plants,
+                                 design.spec.second_order.initial_velocity)
+
+
+def test_equal_entries_are_the_one_bound_and_a_smaller_entry_only_helps(s1) -> None:
+    """The certificate with ``(F, F)`` is the one with ``F``, figure for figure; with
+    ``(0, F)`` it is at least as good: margins no smaller, the first axis's peaks smaller,
+    the second axis's the same."""
+    one, both = _check(s1, 0.5), _check(s1, (0.5, 0.5))
+    assert one == dataclasses.replace(both, data=one.data) and one.passed
+    calm = _check(s1, (0.0, 0.5))
+    assert calm.passed
+    assert calm.position_margin >= one.position_margin
+    assert calm.velocity_margin >= one.velocity_margin
+    assert calm.peak_input[0] < one.peak_input[0] and calm.peak_velocity[0] < one.peak_velocity[0]
+    assert calm.peak_input[1] == pytest.approx(one.peak_input[1], rel=1e-9)
+    assert "[0, 0.5]_i" in calm.data["class"]
+
+
+def test_a_bound_with_the_wrong_number_of_axes_is_refused(s1) -> None:
+    with pytest.raises(ValueError, match="1 or 2 entries"):
+        _check(s1, (0.1, 0.2, 0.3))
+
+
+@pytest.mark.slow
+def test_the_drone_at_200_hz_names_a_prescribed_time_that_is_then_certified() -> None:
+    """The small drone (thrusts [4, 4, 10] N, 0.4-0.6 kg, gravity on z only) at 200 Hz:
+    refused, naming a prescribed_time; designed with it, certified within the thrusts."""
+    spec = stt.load_spec(str(DRONE))
+    with pytest.raises(stt.DesignError) as info:
+        stt.design_tube(spec)
+    named = info.value.advice["prescribed_time"]
+    assert named > spec.prescribed_time
+    design = stt.design_tube(dataclasses.replace(spec, prescribed_time=named))
+    assert design.input_proof is not None
+    assert np.all(np.asarray(design.input_proof.peak) <= np.asarray(spec.input_bound))
