@@ -149,7 +149,9 @@ def _cmd_stl(args: argparse.Namespace) -> int:
         else None
     report = run_stl_bench(names, horizon=args.horizon,
                            solver=None if args.solver == "none" else args.solver,
-                           specs=Path(args.specs) if args.specs else None)
+                           specs=Path(args.specs) if args.specs else None,
+                           orders={"both": ("first", "second")}.get(args.order,
+                                                                    (args.order,)))
     if args.json:
         report = {"rows": [{k: v for k, v in row.items() if k != "spec"}
                            for row in report["rows"]], "order_note": report["order_note"]}
@@ -315,6 +317,10 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                         "or none (default: %(default)s)")
     p.add_argument("--specs", default=None, metavar="DIR",
                    help="also write the specs into DIR")
+    p.add_argument("--order", choices=("first", "second", "both"), default="both",
+                   help="a double integrator as the first-order position law (its input the "
+                        "velocity), as itself (the cascade, the example's |u| and |v|), or "
+                        "both (default: %(default)s)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_stl)
 

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import math
 import sys
 import time
 from pathlib import Path
@@ -40,8 +41,8 @@ import numpy as np
 
 from stt_codegen.errors import DesignError, SpecError
 from .stl_judge import FINE_PERIOD, robustness, stlpy_robustness
-from .stl_scenarios import (ORDER_NOTE, SCENARIOS, SKIPPED, make_scenario, scenario_names,
-                            scenario_spec, spec_toml, step_seconds, workspace)
+from .stl_scenarios import (ORDER_NOTE, SCENARIOS, SKIPPED, double_integrators, make_scenario,
+                            scenario_names, scenario_spec, spec_toml, step_seconds, workspace)
 
 _MISSING = 'stlpy and rtamt are not installed: install the optional extra with pip install ".[stl]"'
 
@@ -193,7 +194,7 @@ def _row(name: str, variant: str) -> dict[str, Any]:
     return {"scenario": name, "variant": variant, "written": False, "designed": False,
             "satisfied": None, "samples": None, "grid": None, "stlpy_samples": None,
             "design_s": None, "peak_u": None, "input_bound": None, "choices": None,
-            "reason": ""}
+            "reason": "", "advice": {}}
 
 
 def _design_and_judge(name: str, variant: str, doc: dict[str, Any], sc: Any,
@@ -209,13 +210,16 @@ def _design_and_judge(name: str, variant: str, doc: dict[str, Any], sc: Any,
         row["reason"] = f"not written: {exc}"
         return row
     row["written"] = True
+    started = time.process_time()
     try:
         design = design_tube(spec)
     except DesignError as exc:
         row["reason"] = f"not designed: {str(exc).splitlines()[0]}"
+        row["advice"] = dict(exc.advice)
+        row["design_s"] = time.process_time() - started
         return row
     row["designed"] = True
-    row["design_s"] = design.design_time_s
+    row["design_s"] = time.process_time() - started
     row["choices"] = {"tasks": list(design.task_choices), "target": design.target_choice}
     result = simulate(design, backend="c", seed=0)
     row["satisfied"] = bool(result.satisfied)
@@ -227,9 +231,29 @@ def _design_and_judge(name: str, variant: str, doc: dict[str, Any], sc: Any,
     return row
 
 
+def _second_order_rows(name: str, horizon: int | None) -> list[dict[str, Any]]:
+    """A double integrator as itself (the cascade at the example's ``|u|`` and ``|v|``);
+    when refused naming a ``prescribed_time``, the scenario again with the horizon ``T``
+    (whole steps) that covers it, and the named time over stlpy's horizon as ``ratio``."""
+    sc = make_scenario(name, horizon)
+    doc = scenario_spec(name, horizon, order="second")
+    rows = [_design_and_judge(name, "second order", doc, sc, sc.GetSystem().p)]
+    named = rows[0]["advice"].get("prescribed_time")
+    if named is not None:
+        dt = step_seconds(sc)
+        rows[0]["ratio"] = named / (sc.T * dt)
+        longer = int(math.ceil(named / dt - 1e-9))
+        sc_long = make_scenario(name, longer)
+        rows.append(_design_and_judge(name, f"second order, T = {longer}",
+                                      scenario_spec(name, longer, order="second"), sc_long,
+                                      sc_long.GetSystem().p))
+    return rows
+
+
 def run_stl_scenario(name: str, horizon: int | None = None, solver: str | None = "scipy",
-                     ) -> list[dict[str, Any]]:
-    """One scenario: its spec as written and, if that is refused by the bound, without it.
+                     orders: tuple[str, ...] = ("first", "second")) -> list[dict[str, Any]]:
+    """One scenario: its spec as written and, if that is refused by the bound, without it;
+    a double integrator also as itself (second order).
 
     Parameters
     ----------
@@ -240,16 +264,22 @@ def run_stl_scenario(name: str, horizon: int | None = None, solver: str | None =
     solver : str or None
         Also run this solver of stlpy (:data:`SOLVERS`) and judge its plan (on the first
         row); ``None``: none.
+    orders : tuple of str
+        ``"first"``: the spec as written (a double integrator as the first-order position
+        law); ``"second"``: a double integrator as itself (:func:`_second_order_rows`).
 
     Returns
     -------
     list of dict
-        One row per variant (module notes): ``scenario``, ``variant`` (``"as written"`` or
-        ``"no bound"``), ``written``, ``designed``, ``satisfied`` (the project's judge of the
-        C run), ``samples``/``grid`` (rtamt's robustness), ``stlpy_samples`` (stlpy's own at
-        the samples), ``design_s``, ``peak_u``, ``input_bound``, ``choices``, ``reason``,
-        and on the first row ``spec`` (the TOML text) and ``solver`` (stlpy's plan judged:
-        ``{"solver", "seconds", "samples", "grid", "note"}``).
+        One row per variant (module notes): ``scenario``, ``variant`` (``"as written"``,
+        ``"no bound"``, ``"second order"``, ``"second order, T = <steps>"``), ``written``,
+        ``designed``, ``satisfied`` (the project's judge of the C run), ``samples``/``grid``
+        (rtamt's robustness), ``stlpy_samples`` (stlpy's own at the samples), ``design_s``
+        (CPU s of ``design_tube``, refusal included), ``peak_u``, ``input_bound``,
+        ``choices``, ``reason``, ``advice`` (a refusal's named values), ``ratio`` (a named
+        ``prescribed_time`` over stlpy's horizon), and on the first row ``spec`` (the TOML
+        text) and ``solver`` (stlpy's plan judged: ``{"solver", "seconds", "samples",
+        "grid", "note"}``).
     """
     if name in SKIPPED:
         row = _row(name, "skipped")
@@ -257,13 +287,21 @@ def run_stl_scenario(name: str, horizon: int | None = None, solver: str | None =
         return [row]
     sc = make_scenario(name, horizon)
     output_dim = sc.GetSystem().p
-    doc = scenario_spec(name, horizon)
-    rows = [_design_and_judge(name, "as written", doc, sc, output_dim)]
-    rows[0]["spec"] = spec_toml(doc, f"stlpy {name}, written by stt-codegen bench stl")
-    if rows[0]["written"] and not rows[0]["designed"] and "actuator" in doc:
-        unbounded = {k: v for k, v in doc.items() if k != "actuator"}
-        rows.append(_design_and_judge(name, "no bound", unbounded, sc, output_dim))
-    if solver:
+    rows = []
+    if "first" in orders:
+        doc = scenario_spec(name, horizon)
+        rows = [_design_and_judge(name, "as written", doc, sc, output_dim)]
+        rows[0]["spec"] = spec_toml(doc, f"stlpy {name}, written by stt-codegen bench stl")
+        if rows[0]["written"] and not rows[0]["designed"] and "actuator" in doc:
+            unbounded = {k: v for k, v in doc.items() if k != "actuator"}
+            rows.append(_design_and_judge(name, "no bound", unbounded, sc, output_dim))
+    if "second" in orders and name in double_integrators():
+        second = _second_order_rows(name, horizon)
+        second[0]["spec"] = spec_toml(scenario_spec(name, horizon, order="second"),
+                                      f"stlpy {name} as a double integrator, written by "
+                                      "stt-codegen bench stl")
+        rows += second
+    if solver and rows:
         plan = solve_with_stlpy(name, horizon, solver)
         judged = {"solver": plan["solver"], "seconds": plan["seconds"], "note": plan["note"],
                   "samples": None, "grid": None}
@@ -278,7 +316,7 @@ def run_stl_scenario(name: str, horizon: int | None = None, solver: str | None =
 
 def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
                   solver: str | None = "scipy", specs: Path | None = None,
-                  ) -> dict[str, Any]:
+                  orders: tuple[str, ...] = ("first", "second")) -> dict[str, Any]:
     """Every scenario (module notes), one after another in one process.
 
     Parameters
@@ -290,7 +328,10 @@ def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
     solver : str or None
         Also run this solver of stlpy on each (:data:`SOLVERS`); ``None``: none.
     specs : Path, optional
-        Also write each written spec there as ``stlpy-<scenario>.toml``.
+        Also write each written spec there as ``stlpy-<scenario>.toml`` (a double
+        integrator as itself: ``stlpy-<scenario>-second-order.toml``).
+    orders : tuple of str
+        As :func:`run_stl_scenario`.
 
     Returns
     -------
@@ -318,12 +359,13 @@ def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
                                          f"{', '.join(known)})")
     rows: list[dict[str, Any]] = []
     for name in names:
-        rows += run_stl_scenario(name, horizon, solver)
+        rows += run_stl_scenario(name, horizon, solver, orders)
     if specs is not None:
         specs.mkdir(parents=True, exist_ok=True)
         for row in rows:
             if "spec" in row:
-                (specs / f"stlpy-{row['scenario']}.toml").write_text(row["spec"])
+                tail = "-second-order" if row["variant"] == "second order" else ""
+                (specs / f"stlpy-{row['scenario']}{tail}.toml").write_text(row["spec"])
     return {"rows": rows, "order_note": ORDER_NOTE}
 
 
@@ -345,7 +387,7 @@ def format_stl_report(report: dict[str, Any]) -> str:
         The table (one row per scenario and variant) and a note per row with a reason.
     """
     head = ("| scenario | spec | written | designed | satisfied (C) | rtamt samples | "
-            "rtamt 100 Hz grid | design (s) | peak \\|u\\| | stlpy's plan: samples / grid "
+            "rtamt 100 Hz grid | design CPU (s) | peak \\|u\\| | stlpy's plan: samples / grid "
             "(solve s) |")
     lines = [head, "|" + "---|" * 10]
     notes = []
@@ -367,5 +409,7 @@ def format_stl_report(report: dict[str, Any]) -> str:
                      f"{_num(row['samples'])} | {_num(row['grid'])} | "
                      f"{_num(row['design_s'], 2)} | {peak} | {stl} |")
         if row["reason"]:
-            notes.append(f"- {row['scenario']} ({row['variant']}): {row['reason']}")
+            named = (f" (named over stlpy's horizon: {row['ratio']:.2f})"
+                     if row.get("ratio") is not None else "")
+            notes.append(f"- {row['scenario']} ({row['variant']}): {row['reason']}{named}")
     return "\n".join(lines + [""] + notes + [f"- {report['order_note']}"])

@@ -14,10 +14,15 @@ stlpy's example scripts. :data:`SCENARIOS` holds those example settings as publi
   keeps the scenario's own boxes.
 * **Initial set.** ``x0`` of the example, with :data:`INITIAL_HALF_SIDE` either side in
   every position dimension (clipped to the state space).
-* **Plant.** A double integrator is written as the project's first-order position law
-  (``single-integrator``, the stage ``p_dot = v`` whose input is the velocity) with
-  ``[actuator] input_bound`` the example's velocity bound (``x_max``'s velocity entries,
-  when the example passes state bounds to its solver); see :data:`ORDER_NOTE`. The unicycle
+* **Plant.** A double integrator is written twice. As itself (``order="second"``): the
+  ``double-integrator`` model with unit mass (stlpy's ``B = [[0], [I]]``: the input is the
+  acceleration), ``state_space.velocity_bound`` the example's ``|v|`` bound and
+  ``[actuator] input_bound`` its ``|u|`` bound (ReachAvoid's example defines ``|u| <=
+  0.5``, ``|v| <= 1`` without passing them to its solver: :data:`DEFINED_BOUNDS`). And as
+  the project's first-order position law (``single-integrator``, the stage ``p_dot = v``
+  whose input is the velocity) with ``[actuator] input_bound`` the example's velocity
+  bound (``x_max``'s velocity entries, when the example passes state bounds to its
+  solver); see :data:`ORDER_NOTE`. The unicycle
   is written as the omnidirectional robot of eq. (14) (the nearest plant the project has;
   it may also move sideways, which the unicycle may not) with ``input_bound`` the example's
   ``|v| <= 10`` for both body velocities and ``|omega| <= 5``; its heading is kept in
@@ -41,9 +46,9 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["HEADING", "INITIAL_HALF_SIDE", "ORDER_NOTE", "SCENARIOS", "SKIPPED", "ScenarioSetting",
-           "make_scenario", "scenario_names", "scenario_spec", "spec_toml", "step_seconds",
-           "workspace"]
+__all__ = ["DEFINED_BOUNDS", "HEADING", "INITIAL_HALF_SIDE", "ORDER_NOTE", "SCENARIOS", "SKIPPED",
+           "ScenarioSetting", "double_integrators", "make_scenario", "scenario_names",
+           "scenario_spec", "spec_toml", "step_seconds", "workspace"]
 
 #: Half side of the initial box around the example's ``x0``, state units.
 INITIAL_HALF_SIDE = 0.1
@@ -54,12 +59,14 @@ INITIAL_HALF_SIDE = 0.1
 #: stlpy's formula does not constrain the heading.
 HEADING = 0.3
 
-#: Which law a double-integrator scenario is written with, and why.
-ORDER_NOTE = ("double integrators are written as the first-order position law "
-              "(single-integrator: its input is the velocity, bounded by the example's |v|); "
-              "the second-order cascade with stlpy's bounds (|u| <= 0.5 N, |v| <= 1 m/s) "
-              "is not certified: ReachAvoid written so is refused after 91 s (the velocity "
-              "may reach 1.001 m/s, beyond |v| <= 1, at every rate up to 16 kHz)")
+#: How a double-integrator scenario is written.
+ORDER_NOTE = ("double integrators are written as themselves (second order: the cascade, "
+              "|u| and |v| the example's bounds) and as the first-order position law "
+              "(single-integrator: its input is the velocity, bounded by the example's |v|)")
+
+#: Bounds an example defines without passing them to its solver, ``(|u|, |v|)`` per axis:
+#: the second-order spec takes them (a cascade needs a velocity bound to be compared).
+DEFINED_BOUNDS = {"ReachAvoid": ((0.5, 0.5), (1.0, 1.0))}
 
 #: Scenarios not written, with the reason.
 SKIPPED = {"SteppingStones": "a union safe set (G[0,T] of an or of stones) cannot be a "
@@ -127,6 +134,16 @@ def scenario_names() -> list[str]:
     list of str
     """
     return list(SCENARIOS)
+
+
+def double_integrators() -> list[str]:
+    """The scenarios whose system is stlpy's double integrator (all but the unicycle).
+
+    Returns
+    -------
+    list of str
+    """
+    return [name for name in SCENARIOS if name != "NonlinearReachAvoid"]
 
 
 def make_scenario(name: str, horizon: int | None = None) -> Any:
@@ -251,7 +268,8 @@ def _parts(name: str, sc: Any, space, seconds: float, dt: float) -> dict[str, An
     raise KeyError(name)
 
 
-def scenario_spec(name: str, horizon: int | None = None) -> dict[str, Any]:
+def scenario_spec(name: str, horizon: int | None = None, order: str = "first"
+                  ) -> dict[str, Any]:
     """The spec document of one stlpy example (module notes), as :meth:`Spec.from_dict`
     takes it.
 
@@ -262,21 +280,30 @@ def scenario_spec(name: str, horizon: int | None = None) -> dict[str, Any]:
         ``RandomMultitarget``, ``DoorPuzzle``, ``NonlinearReachAvoid``).
     horizon : int, optional
         ``T`` in steps instead of the example's.
+    order : {"first", "second"}
+        A double integrator as the first-order position law or as itself (module notes).
 
     Returns
     -------
     dict
-        The spec's tables (``name`` is ``stlpy-<name>``).
+        The spec's tables (``name`` is ``stlpy-<name>``, ``stlpy-<name>-second-order``).
 
     Raises
     ------
     KeyError
         An unknown or skipped scenario (:data:`SKIPPED`).
+    ValueError
+        ``order="second"`` for a scenario that is not a double integrator, or another
+        ``order``.
     ImportError
         stlpy is not installed.
     """
     if name in SKIPPED:
         raise KeyError(f"{name}: {SKIPPED[name]}")
+    if order not in ("first", "second") or (order == "second"
+                                            and name not in double_integrators()):
+        raise ValueError(f"order {order!r} for {name}: 'first', or 'second' for a double "
+                         "integrator")
     setting = SCENARIOS[name]
     sc = make_scenario(name, horizon)
     dt = step_seconds(sc)
@@ -319,6 +346,12 @@ def scenario_spec(name: str, horizon: int | None = None) -> dict[str, Any]:
         doc["plant"] = {"model": "omnidirectional"}
         speed, turn = setting.input_bound
         doc["actuator"] = {"input_bound": [speed, speed, turn]}
+    elif order == "second":
+        force, speed = DEFINED_BOUNDS.get(name, (setting.input_bound, setting.velocity_bound))
+        doc["name"] += "-second-order"
+        doc["plant"] = {"model": "double-integrator", "parameters": [1.0]}
+        doc["state_space"]["velocity_bound"] = list(speed)
+        doc["actuator"] = {"input_bound": list(force)}
     elif setting.velocity_bound is not None:
         doc["actuator"] = {"input_bound": list(setting.velocity_bound)}
     return doc
