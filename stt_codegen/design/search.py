@@ -435,11 +435,18 @@ def cascade_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> D
     """
     free = replace(spec, input_bound=None)
     default = design_free(free)
-    # no second stage keeps the tubes at this rate, bound or not: the rate is what to
-    # change (DesignError of kind SAMPLING_RATE naming the rate that is certified)
+    # no second stage keeps the tubes on the default tube, bound or not: a slower variant
+    # of it (cruise segments: the legs timed by their lengths) may keep them and the
+    # bound; else the rate is what to change (DesignError of kind SAMPLING_RATE naming
+    # the rate that is certified)
     try:
         default.second_stage
     except DesignError as error:
+        with without_advice():                # the verdict only
+            try:
+                return design_within_bound(spec, design_free, name_rate=False)
+            except DesignError:
+                pass
         raise _rate_within_bound(spec, error) from None
 
     def design_free_or_default(candidate: Spec) -> Design:

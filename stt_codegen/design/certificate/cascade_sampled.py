@@ -149,7 +149,8 @@ def cascade_class(spec: Spec) -> CascadeClass:
     g_min, g_max = order.input_gain
     diagonal = SECOND_ORDER_PLANTS[order.model].diagonal_input
     return CascadeClass(g_min, g_max, 0.0 if diagonal else 0.5 * (g_max - g_min),
-                        order.axis_drift_bound, 0.0, spec.disturbance_amplitude,
+                        order.drift_per_axis or order.drift_bound, 0.0,
+                        spec.disturbance_amplitude,
                         order.velocity_bound)
 
 
