@@ -140,9 +140,9 @@ def verify_fleet(fleet: FleetDesign | FleetSpec | str | os.PathLike, *,
     >>> report = stt.verify_fleet("swap-fleet")
     >>> print(report.summary())                                     # doctest: +ELLIPSIS
     Fleet swap-fleet: every check passed
-      east: ... 45 of 45 checks passed
-      west: ... 45 of 45 checks passed
-      pairs: ... 1 of 1 separated for every t >= 0
+      east: ...45 of 45 checks passed
+      west: ...45 of 45 checks passed
+      pairs: ...1 of 1 separated for every t >= 0
       narrowest pair: east and west: bodies apart by >= ...
     """
     designed = fleet if isinstance(fleet, FleetDesign) else design_fleet(fleet)
