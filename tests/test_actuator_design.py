@@ -106,6 +106,7 @@ def test_a_bound_the_default_design_meets_keeps_its_tube():
     assert max(bounded.input_proof.peak) > 0.5 * 3.5
 
 
+@pytest.mark.slow
 def test_a_bound_the_default_design_exceeds_gets_a_slower_tube():
     spec, design = robot()
     bound = spec.input_bound
@@ -124,6 +125,7 @@ def test_a_bound_the_default_design_exceeds_gets_a_slower_tube():
     assert document["input_peak"]["margin"] == pytest.approx(margin, rel=1e-12) and margin >= 0
 
 
+@pytest.mark.slow
 def test_a_bound_smooth_step_via_points_exceed_gets_cruise_segments():
     """With ``|v1|, |v2| <= 1.4``, the paper's tube, its softer circumvents and the
     smooth-step via tube all exceed the bound (the last asks 1.55 of v1); the via tube
@@ -191,6 +193,7 @@ def test_verify_fails_a_tube_beyond_the_bound():
     assert check.data["margin"] == pytest.approx(1 - max(peak) / 1.5, rel=1e-12)
 
 
+@pytest.mark.slow
 def test_the_closed_loop_with_the_generated_c_stays_within_the_bound():
     spec, design = robot()
     result = simulate(design, backend="c")

@@ -37,6 +37,7 @@ def test_a_bad_base_or_count_is_refused():
         run_office_bench(0, 0)
 
 
+@pytest.mark.slow
 def test_both_bases_on_two_offices_in_one_run():
     report = run_office_bench(2, 0)
     for method in ("drive", "holonomic"):

@@ -142,6 +142,7 @@ def test_scaling_report():
     assert "obstacles (n = 2)" in text and "active windows" in text and "sparse windows" in text
 
 
+@pytest.mark.slow
 def test_generated_code_is_the_same_for_any_number_of_circumvents():
     """Only the tables (and their sizes) differ between 40 and 1000 circumvents (both with
     several circumvents on every bound: the code depends on n, the profiles and whether a

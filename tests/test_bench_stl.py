@@ -91,8 +91,9 @@ def test_every_spec_loads(name):
             assert all(hi <= h0 for hi, h0 in zip(entry["upper"], upper))
 
 
-@pytest.mark.parametrize("name", ["EitherOr", "RandomMultitarget", "DoorPuzzle",
-                                  "NonlinearReachAvoid"])
+@pytest.mark.parametrize("name", [
+    "EitherOr", pytest.param("RandomMultitarget", marks=pytest.mark.slow), "DoorPuzzle",
+    "NonlinearReachAvoid"])
 def test_scenarios_with_a_bound_design_within_it(name):
     """The examples' bounds (|v| <= 1, DoorPuzzle 2; the unicycle's |v| <= 10,
     |omega| <= 5) are kept: each design is proved to keep law (13) within them (the legs'

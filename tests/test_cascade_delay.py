@@ -82,6 +82,7 @@ def test_jitter_is_proved_too_and_costs_room(s1):
         _check(design, samples, delay=0.8 * h, jitter=0.2 * h)
 
 
+@pytest.mark.slow
 def test_the_closed_loop_with_the_proved_delay_stays_in_both_tubes(s1):
     largest = _largest(s1)
     timed = dataclasses.replace(stt.load_spec("second-order-s1"), delay=largest)

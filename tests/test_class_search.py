@@ -134,7 +134,7 @@ def _path(design, samples, found):
 
 
 @pytest.mark.parametrize("index, rates, drift_rates", [
-    (0, (0.0, 0.0, 300.0), None),
+    pytest.param(0, (0.0, 0.0, 300.0), None, marks=pytest.mark.slow),
     pytest.param(9, (0.0, 0.0, 1.0), None, marks=pytest.mark.slow),
     (9, (0.0, 0.0, 300.0), (5.0, 5.0, 5.0))])
 def test_a_lipschitz_counterexample_respects_the_declared_rates(index, rates, drift_rates):

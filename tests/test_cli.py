@@ -41,6 +41,7 @@ def test_bundled_cases_are_the_paper_cases_and_the_examples():
     assert first_order == sorted(CASES + TASK_CASES + EXTRA_CASES)
 
 
+@pytest.mark.slow
 def test_simulate_json_reports_definition_2_1():
     out = run("simulate", "omnirobot-s3", "--backend", "casadi", "--json")
     assert out.returncode == 0, out.stderr
@@ -50,6 +51,7 @@ def test_simulate_json_reports_definition_2_1():
     assert data["backend"] == "casadi" and data["steps"] == 9000
 
 
+@pytest.mark.slow
 def test_simulate_exit_1_when_not_satisfied():
     out = run("simulate", "omnirobot-s1", "--backend", "casadi", "--horizon", "2", "--json")
     assert out.returncode == 1

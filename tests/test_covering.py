@@ -42,6 +42,7 @@ def assert_valid_covering(shape, boxes, tolerance, forbidden, rng, inside_points
     assert covered.all()                     # the union contains the shape
 
 
+@pytest.mark.slow
 def test_ball_whose_bounding_box_meets_the_start_is_split_and_used():
     as_box = BESIDE + "[[obstacles]]\nlower = [0.38, 0.38]\nupper = [1.62, 1.62]\n"
     with pytest.raises(SpecError, match="meets the initial set"):
@@ -252,6 +253,7 @@ def assert_bounded_work(work: dict[str, list[int]]) -> None:
         assert 0 < hulls <= bound and 0 < corners <= bound, (hulls, corners, boxes)
 
 
+@pytest.mark.slow
 def test_eighty_polygons_are_covered_soundly_with_bounded_work(monkeypatch):
     """80 random convex polygons at tolerance 0.02 (the covering took
     about 30 s with a linear program per box hull). Every box is within the tolerance,

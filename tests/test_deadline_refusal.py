@@ -12,7 +12,8 @@ import stt_codegen as stt
 from stt_codegen.design.failures import FailureKind
 
 
-@pytest.mark.parametrize("case, deadline", [("omnirobot-s1", 0.5), ("second-order-s1", 1.0)])
+@pytest.mark.parametrize("case, deadline", [
+    pytest.param("omnirobot-s1", 0.5, marks=pytest.mark.slow), ("second-order-s1", 1.0)])
 def test_a_deadline_too_short_names_one_that_is_then_certified(case, deadline):
     spec = dataclasses.replace(stt.load_spec(case), prescribed_time=deadline)
     with pytest.raises(stt.DesignError) as raised:

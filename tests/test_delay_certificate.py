@@ -77,6 +77,7 @@ def test_the_check_fails_when_the_delay_is_doubled_past_the_largest(s1):
     assert doubled.margin < 0.0 < certified.margin
 
 
+@pytest.mark.slow
 def test_a_delay_costs_margin_and_raises_the_bound_of_e(s1):
     spec, design, largest = s1
     plain, late = _check(spec, design), _check(spec, design, delay=0.5 * largest)
@@ -129,6 +130,7 @@ def test_no_delay_check_where_the_sampled_check_fails_without_one():
         assert delay_check(spec, design.tube) is None
 
 
+@pytest.mark.slow
 def test_the_lowest_rate_counts_the_delay_in_seconds(s1):
     """A delay of 0.9 ms fits a 1 kHz period but not a shorter one: no rate above the
     design's is named for it, and the rate named is one that passes with it."""
@@ -211,6 +213,7 @@ def test_the_heading_turn_of_the_held_command_is_counted():
     assert _check(spec, design).passed
 
 
+@pytest.mark.slow
 def test_the_look_ahead_takes_a_delay():
     spec, design = _office(200.0)
     with reference.numpy_math():
@@ -275,6 +278,7 @@ def test_a_base_too_slow_for_its_turn_is_refused_naming_a_rate_then_certified():
 # soundness: a run with the delay stays within what the check proves
 
 
+@pytest.mark.slow
 def test_the_run_with_the_largest_delay_stays_within_the_proved_bound_of_e(s1):
     """omnirobot-s1 with the largest delay the check proves: the closed loop (the robot's
     own plant, the generated C) keeps |e| at the samples below the check's bound of it."""

@@ -250,7 +250,8 @@ def test_the_linear_plant_check_on_the_command_line(tmp_path):
 
 @pytest.mark.parametrize("index, kind", [(2, FailureKind.SEARCH_BUDGET),
                                          (6, FailureKind.INITIAL_STATE),
-                                         (26, FailureKind.NON_EMPTY)])
+                                         pytest.param(26, FailureKind.NON_EMPTY,
+                                                      marks=pytest.mark.slow)])
 def test_paper_search_refusals_are_typed(index, kind):
     """Random arenas the paper's method alone cannot design (seed 1): the kind says why
     (the search's budget, or the first obstacle's failure in the message), and the tube

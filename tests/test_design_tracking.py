@@ -93,6 +93,7 @@ def test_the_paper_method_searches_past_a_tube_the_gain_cannot_follow():
     assert run_closed_loop(spec, found.tube, backend="reference").max_abs_e <= TRACKING_ERROR
 
 
+@pytest.mark.slow
 def test_the_paper_method_refuses_when_every_tube_is_one_the_gain_cannot_follow():
     """Arena 49 of seed 0: every certified choice of circumvents within the budget is proved
     only beyond |e| = 0.7 (the first one's state rode at 0.7-0.8): refused, naming it."""

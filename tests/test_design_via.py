@@ -35,6 +35,7 @@ def serpentine():
     return spec, design_tube(spec)
 
 
+@pytest.mark.slow
 def test_auto_uses_via_points_where_the_papers_tube_has_no_design():
     spec, design = serpentine()
     paper = dataclasses.replace(spec, tube=dataclasses.replace(spec.tube, method="paper"))
@@ -202,6 +203,7 @@ def test_design_json_fields_and_exit_codes(tmp_path):
                    str(tmp_path / "missing" / "x.png")).returncode == 2
 
 
+@pytest.mark.slow
 def test_huge_prescribed_time_designs_and_simulate_refuses_with_exit_2(tmp_path):
     spec_text = SERPENTINE.replace("prescribed_time = 12.0", "prescribed_time = 1e9")
     path = tmp_path / "long.toml"

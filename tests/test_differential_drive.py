@@ -120,6 +120,7 @@ def test_the_derived_bounds_hold_the_sampled_g_and_are_attained(errors, offset, 
     assert a.disturbance_bound == pytest.approx(math.hypot(s_v, s_lat + offset * s_w))
 
 
+@pytest.mark.slow
 def test_wheel_errors_that_lose_assumption_2_are_refused_before_designing():
     spec = stt.Spec.from_dict(_doc(wheel_radius_error=[0.2, -0.2], axle_offset=0.02,
                                    track_width=0.5))
@@ -130,6 +131,7 @@ def test_wheel_errors_that_lose_assumption_2_are_refused_before_designing():
     assert not check.passed and "Assumption 2 fails" in check.detail
 
 
+@pytest.mark.slow
 def test_the_deployed_command_inverts_the_kinematics_symbolically():
     assert verify_look_ahead.look_ahead_inverse().passed
     assert verify_look_ahead.assumption2_differential_drive(stt.load_spec(str(SPEC))).passed

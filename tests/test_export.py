@@ -45,6 +45,7 @@ def test_the_csv_is_the_models_tube_at_the_controllers_rate(tmp_path):
         np.testing.assert_allclose(data[k, 1:], row, rtol=1e-9, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_the_npz_holds_the_same_columns(tmp_path):
     out = _design("office-base", "--export", "tube.npz", "--json", cwd=tmp_path)
     assert out.returncode == 0, out.stderr

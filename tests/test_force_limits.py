@@ -216,6 +216,7 @@ def test_verify_exits_0_and_reports_the_bound(tmp_path, capsys):
 
 # -- the closed loop --------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_the_closed_loop_stays_within_the_certified_peak_and_the_bound():
     bound = (80.0, 80.0)
     design = stt.design_tube(small(bound))
@@ -320,6 +321,7 @@ def test_a_rate_that_keeps_the_tubes_but_not_the_bound_is_not_named_certified():
     assert design.certificate.passed and design.input_proof.meets(spec.input_bound)
 
 
+@pytest.mark.slow
 def test_a_bound_a_task_spec_cannot_keep_names_its_windows_not_a_later_deadline():
     """With [[tasks]] the legs are timed by the tasks' windows: the refusal says that a
     later prescribed_time does not slow them, and names none."""

@@ -95,6 +95,7 @@ def test_numpy_scalars_are_numbers():
         stt.simulate(design, horizon="soon")
 
 
+@pytest.mark.slow
 def test_the_plots_take_the_design(tmp_path):
     design = design_of("omnirobot-s1")
     result = stt.simulate(design, backend="casadi", horizon=1.0)

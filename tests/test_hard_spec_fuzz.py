@@ -138,6 +138,7 @@ def test_byte_mutations(doc, edits):
 @given(doc=st.dictionaries(st.sampled_from(["name", "prescribed_time", "state_space",
                                             "initial", "target", "obstacles", "tube",
                                             "controller", "plant"]), values, max_size=9))
+@pytest.mark.slow
 def test_random_documents(doc):
     assert_loads_or_spec_error(dumps(doc))
 

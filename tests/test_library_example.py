@@ -44,7 +44,7 @@ def test_the_readme_example_is_the_documents():
     assert python_blocks_of(section)[0] == python_blocks(DOC)[0]
 
 
-@pytest.mark.parametrize("k", [0, 1, 2, 3])
+@pytest.mark.parametrize("k", [pytest.param(0, marks=pytest.mark.slow), 1, 2, 3])
 def test_library_example_runs_verbatim(k, tmp_path, monkeypatch, capsys):
     if k in (0, 3) and shutil.which("cc") is None and shutil.which("gcc") is None:
         pytest.skip("the example compiles C: install the Debian package gcc")

@@ -508,6 +508,7 @@ def _crossing_with_actuator(bound: list[float]) -> stt.Spec:
     return stt.Spec.from_dict(data)
 
 
+@pytest.mark.slow
 def test_a_wait_for_a_moving_obstacle_is_kept_under_an_actuator_bound():
     """With [actuator], the re-timed via plan (wait, then cross) is accepted with its own
     input proof: the bundled crossing, which the static and swept designs cannot do."""
@@ -533,6 +534,7 @@ def test_a_re_timed_plan_drives_its_legs_no_faster_than_the_bound_allows():
     assert {seg.profile for seg in design.tube.segments} == {"cruise"}
 
 
+@pytest.mark.slow
 def test_a_re_timed_plan_beyond_the_bound_is_refused_saying_so():
     spec = _crossing_with_actuator([1.0, 1.0])
     with pytest.raises(stt.DesignError) as raised:

@@ -58,6 +58,7 @@ def test_the_bundled_case_runs_on_mujoco_satisfied_without_contact(design):
     assert result.min_obstacle_clearance > 0
 
 
+@pytest.mark.slow
 def test_the_command_line_simulates_it_and_writes_the_plot(tmp_path):
     out = _cli("simulate", "pointmaze-umaze", "--plot", str(tmp_path / "run.png"))
     assert out.returncode == 0, out.stdout + out.stderr

@@ -122,6 +122,7 @@ def test_the_table_counts_each_column_and_flags_what_the_check_may_not_accept():
     assert plants_study.unsound([_row(s2, 2, held=False, accepts=True)])
 
 
+@pytest.mark.slow
 def test_recheck_recomputes_the_check_columns_only():
     case, index = "omnirobot-s3", 1
     gain = designed(case)[1].gain

@@ -220,6 +220,7 @@ def assert_legends_are_clean(fig) -> int:
 
 
 @pytest.mark.parametrize("dims", [(0, 1), pytest.param((0, 2), marks=pytest.mark.slow)])
+@pytest.mark.slow
 def test_design_legends_have_one_entry_per_thing_outside_the_axes(dims):
     for spec in (load_spec("omnirobot-s1"), mixed_3d()):
         fig = plots.design_figure(design_tube(spec), dims)
@@ -255,6 +256,7 @@ def test_run_figure_has_u_of_t_with_one_line_per_input(short_run):
 
 
 @pytest.mark.parametrize("command", ["design", pytest.param("simulate", marks=pytest.mark.slow)])
+@pytest.mark.slow
 def test_plot_without_a_design_shows_the_rejected_tube(command, tmp_path):
     spec_file = tmp_path / "near.toml"
     spec_file.write_text(NEAR_TARGET)

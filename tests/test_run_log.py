@@ -36,6 +36,7 @@ def _decoded(path) -> dict[str, list]:
     return found
 
 
+@pytest.mark.slow
 def test_the_command_writes_one_message_a_sample_on_each_topic(tmp_path):
     out = _simulate("omnirobot-s1", "--backend", "c", "--horizon", "0.5", "--log", "run.mcap",
                     cwd=tmp_path)

@@ -289,6 +289,7 @@ def test_the_second_order_task_spec_on_the_cortex_m4f() -> None:
     assert [t["met"] for t in report["tasks"]] == [True] and report["moving_clearance"] > 0
 
 
+@pytest.mark.slow
 def test_printed_states_are_judged_on_the_tasks_and_the_moving_obstacles():
     """judge_printed (the firmware runs' judge of both orders) on the states of a host run
     of the second-order task spec, every tenth step: met; the same states judged against

@@ -129,6 +129,7 @@ class _Lazy:
         return np.zeros_like(u), alpha_next, status
 
 
+@pytest.mark.slow
 def test_judging_reports_failures(monkeypatch):
     design = design_of("omnirobot-s1")
     monkeypatch.setitem(backends.first_order_backends(), "idle", lambda d: _Stubborn([0.0, 0.0, 0.0]))

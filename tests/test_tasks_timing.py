@@ -286,6 +286,7 @@ def test_free_timing_with_an_actuator_bound_keeps_the_tasks():
     assert all(margins(design.certificate)[t.name].passed for t in design.spec.tasks)
 
 
+@pytest.mark.slow
 def test_free_example_spec_picks_an_order_and_meets_every_task():
     """tests/specs/tasks-free.toml (overlapping windows, a 1 s stay, order = "any"): the
     design visits the stay first and every task is certified; the closed loop meets them."""
@@ -387,6 +388,7 @@ def test_the_wall_may_be_crossed_once_the_task_is_certified_met_inside_its_windo
     assert not late.passed and "moving obstacle 0" in late.reason, late.reason
 
 
+@pytest.mark.slow
 def test_a_door_until_its_key_with_the_whole_run_as_window_is_designed():
     """A wall with a door closed until T1 (a key left of the wall) is met, T1's window
     almost the whole run: the door exists until 11 s at the latest, too late to reach the

@@ -123,6 +123,7 @@ def test_open_bump_sum_properties(nu):
     assert np.all(R.open_bump_sum(bumped, nu)[0] >= f)
 
 
+@pytest.mark.slow
 def test_open_bump_sum_is_proved_in_verify():
     from stt_codegen.proofs.lemma import check_open_bump_sum, lemma_checks
     check = check_open_bump_sum()

@@ -27,6 +27,8 @@ def failed(checks) -> dict[str, str]:
     return {c.name: c.detail for c in checks if not c.passed}
 
 
+# about 8 s a case: the slow tier (the fast one keeps the tests of each check, tests/test_verify_*.py)
+@pytest.mark.slow
 def test_all_checks_pass_on_the_paper_cases(case):
     spec, design, _ = designed(case)
     checks = verify_design(spec, design)

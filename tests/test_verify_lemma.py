@@ -27,6 +27,7 @@ def bundle() -> list[Check]:
     return lemma_checks(orders=3, reach=[(0.0, 4.75, 9.0)], bumps=[(0.01, 1.0, 1.0)])
 
 
+@pytest.mark.slow
 def test_bundle_all_pass(bundle: list[Check]) -> None:
     names = [c.name for c in bundle]
     assert "lemma3.3.reach.continuity" in names and "lemma3.3.bump.flatness" in names
@@ -84,6 +85,7 @@ def test_reach_rate_constant_bracket() -> None:
     assert np.max((1 + ws) ** 2 / np.cosh(ws) ** 2) <= hi
 
 
+@pytest.mark.slow
 def test_reach_rate_bound_case_study(bundle: list[Check]) -> None:
     c = next(c for c in bundle if c.name == "lemma3.3.reach.rate_bound")
     assert c.data["sampled_max"] <= c.data["bound"]
@@ -99,6 +101,7 @@ def test_reach_rate_bound_rejects_bad_tc() -> None:
     assert not reach_rate_bound(0.0, 1.0, 0.0).passed
 
 
+@pytest.mark.slow
 def test_bump_rate_bound_case_study(bundle: list[Check]) -> None:
     c = next(c for c in bundle if c.name == "lemma3.3.bump.rate_bound")
     assert c.data["bound"] == pytest.approx(109.0827787, rel=1e-8)

@@ -63,6 +63,7 @@ def test_matrix_plant_spec_passes_every_check():
     assert checks["sampled.plant_within_assumptions"].passed
 
 
+@pytest.mark.slow
 def test_a_plant_outside_its_declared_bounds_is_flagged():
     spec = load_spec(SPECS / "linear-arena-s1.toml")
     wider = dataclasses.replace(spec, assumptions=dataclasses.replace(
