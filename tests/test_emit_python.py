@@ -148,8 +148,8 @@ def test_every_op_of_the_table_is_covered() -> None:
     assert set(OPS_BY_NAME) == set(OP_EXPRESSIONS) | NOT_COVERED
 
 
-@pytest.mark.parametrize("op", sorted(OP_EXPRESSIONS))
-def test_single_op_bit_identical(op: str) -> None:
+def _single_op_bit_identical(op: str, draws: int) -> None:
+    """The op alone: every pair of SPECIAL values, then ``draws`` pairs of any doubles."""
     fn = ca.Function(f"op_{op}", [a_, b_], [OP_EXPRESSIONS[op]], ["a", "b"], ["r"])
     assert op in count_operations(fn).by_op, f"{op}: CasADi simplified the expression"
     gen = python_function(fn)
@@ -157,12 +157,24 @@ def test_single_op_bit_identical(op: str) -> None:
         for y in SPECIAL:
             assert_bit_identical(fn, gen, [[x], [y]])
 
-    @settings(max_examples=400, deadline=None)
+    @settings(max_examples=draws, deadline=None)
     @given(floats, floats)
     def check(x, y):
         assert_bit_identical(fn, gen, [[x], [y]])
 
     check()
+
+
+@pytest.mark.parametrize("op", sorted(OP_EXPRESSIONS))
+def test_single_op_bit_identical(op: str) -> None:
+    _single_op_bit_identical(op, 100)
+
+
+# the same with ten times the draws (the fast tier above: about 0.3 s an op, 46 ops)
+@pytest.mark.slow
+@pytest.mark.parametrize("op", sorted(OP_EXPRESSIONS))
+def test_single_op_bit_identical_on_more_draws(op: str) -> None:
+    _single_op_bit_identical(op, 1000)
 
 
 def test_pow_special_cases() -> None:
