@@ -27,7 +27,10 @@ def test_velocity_tube_bounds_are_proved() -> None:
 def test_lyapunov_identity_holds_and_a_wrong_one_is_refused() -> None:
     assert V.check_lyapunov_derivative(1).passed
     wrong = V.check_lyapunov_derivative(1, tube_rate=False)
-    assert not wrong.passed and "Derivative" in wrong.detail
+    # what is left is the term dropped from the claim: it has rho2's rate dP1 and neither
+    # x2's nor r's (those terms cancel)
+    assert not wrong.passed and wrong.detail.startswith("difference ")
+    assert "dP1" in wrong.detail and "dX1" not in wrong.detail and "dR1" not in wrong.detail
 
 
 @pytest.mark.slow
