@@ -6,7 +6,10 @@ of ``alpha`` at them), so the enclosure of the first ``m`` intervals is the firs
 rows of the whole one, float for float. A check that follows the samples and may stop
 early (the sampled cascade's certificate refuses most stages within its first second) asks
 :class:`GrowingEnclosure` for the rows it reaches; the rows are computed once, in pieces
-that at least double, and kept for every later check of the same tube.
+that at least double, and kept for every later check of the same tube. The rows are
+computed with numpy's kernels (:func:`~stt_codegen.tube.reference.numpy_math`), as the
+other certificates compute theirs, whatever context asks for them: rows computed in
+different calls are then the same floats as one call's.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import dataclasses
 import numpy as np
 
 from ..samples import TubeSamples
+from ...tube import reference
 from ...tube.parameters import TubeDesign
 from .enclosures import enclose, piece_ranges
 from .report import Enclosure
@@ -42,10 +46,13 @@ class GrowingEnclosure:
     >>> import stt_codegen as stt
     >>> from stt_codegen.design.samples import sample_tube
     >>> from stt_codegen.design.certificate import enclose_tube
+    >>> from stt_codegen.tube.reference import numpy_math
     >>> tube = stt.design_tube(stt.load_spec("omnirobot-s1")).tube
     >>> samples = sample_tube(tube)
     >>> growing = GrowingEnclosure(tube, samples)
-    >>> bool((growing.first(50).upper_min == enclose_tube(tube, samples).upper_min[:50]).all())
+    >>> with numpy_math():
+    ...     whole = enclose_tube(tube, samples)
+    >>> bool((growing.first(50).upper_min == whole.upper_min[:50]).all())
     True
     """
 
@@ -58,8 +65,9 @@ class GrowingEnclosure:
         """:func:`~.enclosures.enclose_tube`'s rows ``start .. stop - 1``."""
         t0, t1 = self.samples.t[start:stop], self.samples.t[start + 1:stop + 1]
         a0, a1 = self.samples.alpha[start:stop], self.samples.alpha[start + 1:stop + 1]
-        return enclose(self.design, piece_ranges(self.design, t0, t1), np.minimum(a0, a1),
-                       np.maximum(a0, a1), t0, t1)
+        with reference.numpy_math():
+            return enclose(self.design, piece_ranges(self.design, t0, t1),
+                           np.minimum(a0, a1), np.maximum(a0, a1), t0, t1)
 
     def first(self, rows: int) -> Enclosure:
         """The enclosure of the first ``rows`` intervals (at most :attr:`count`).
