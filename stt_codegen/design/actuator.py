@@ -331,7 +331,9 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
     so each try grows ``t_c`` by the best peak-to-bound ratio found so far (between 1.25
     and 4); once a try passes, a bisection on the two-digit values between the last
     failing and the passing one finds the smallest (the check at each value decides; the
-    answer is a value where it passed).
+    answer is a value where it passed). The bisection asks verdicts only
+    (:func:`~.failures.without_advice`): a shape's check stops where its input passes the
+    bound, and a failing trial names nothing.
 
     Parameters
     ----------
@@ -384,4 +386,7 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
                           "[assumptions] alone ask for about that much")
         else:
             low, ratio = guess, found
-    return grid_value(smallest_passing(lambda i: passes(i)[0], low, high)), ""
+    # the bisection asks verdicts only: each shape's check stops where its input passes
+    # the bound (the verdicts are the same), and no failing trial searches for advice
+    with without_advice():
+        return grid_value(smallest_passing(lambda i: passes(i)[0], low, high)), ""
