@@ -43,5 +43,6 @@ def as_double_integrator(spec, mass: float = 1.0):
     the declared ``1/m`` range of :data:`MASS_RANGE`."""
     plant = SecondOrder(model="double-integrator", parameters=(mass,),
                         initial_velocity=(0.0,) * spec.dimension, velocity_bound=None,
-                        input_gain=(1.0 / MASS_RANGE[1], 1.0 / MASS_RANGE[0]), drift_bound=0.0)
+                        input_gain=(1.0 / MASS_RANGE[1], 1.0 / MASS_RANGE[0]),
+                        drift_bounds=(0.0,) * spec.dimension)
     return replace(spec, second_order=plant)

@@ -212,8 +212,8 @@ def test_the_spec_s_own_plant_is_checked_against_the_class() -> None:
         assert check.passed, check.detail
     spec = stt.load_spec("second-order-quadrotor")
     # gravity alone exceeds a drift bound of 5: the certificate would not cover the plant
-    low = dataclasses.replace(spec, second_order=dataclasses.replace(spec.second_order,
-                                                                     drift_bound=5.0))
+    low = dataclasses.replace(spec, second_order=dataclasses.replace(
+        spec.second_order, drift_bounds=(5.0,) * 3))
     check = plant_within_class_check(low)
     assert not check.passed and "drift_bound" in check.detail
     heavy = dataclasses.replace(spec, second_order=dataclasses.replace(

@@ -15,7 +15,7 @@ import pytest
 from conftest import design_of
 
 import stt_codegen as stt
-from stt_codegen.design.certificate.cascade_sampled import (CascadeClass,
+from stt_codegen.design.certificate.cascade_sampled import (CascadeClass, cascade_class,
                                                             check_cascade_sampled,
                                                             model_within_class)
 from stt_codegen.design.samples import sample_tube
@@ -33,10 +33,11 @@ def _drone(**assumptions) -> dict:
 
 def test_a_list_is_one_bound_per_axis_and_its_largest_is_the_drift_bound() -> None:
     order = stt.Spec.from_dict(_drone(drift_bound=[0.0, 0.5, 9.81])).second_order
-    assert order.drift_per_axis == (0.0, 0.5, 9.81) and order.drift_bound == 9.81
-    assert order.axis_drift_bound == (0.0, 0.5, 9.81)
-    same = stt.Spec.from_dict(_drone(drift_bound=[2.0, 2.0, 2.0])).second_order
-    assert same.drift_per_axis is None and same.axis_drift_bound == (2.0, 2.0, 2.0)
+    assert order.drift_bounds == (0.0, 0.5, 9.81) and order.drift_bound == 9.81
+    same = stt.Spec.from_dict(_drone(drift_bound=2.0)).second_order
+    assert same.drift_bounds == (2.0, 2.0, 2.0) and same.drift_bound == 2.0
+    assert cascade_class(stt.Spec.from_dict(_drone(drift_bound=[0.0, 0.5, 9.81]))
+                         ).drift_bounds(3).tolist() == [0.0, 0.5, 9.81]
 
 
 @pytest.mark.parametrize("value,field,words", [
@@ -65,10 +66,12 @@ def test_a_first_order_plant_takes_one_drift_bound() -> None:
 
 def test_a_quadrotors_own_drift_has_gravity_on_its_vertical_axis_only() -> None:
     own = model_bounds("quadrotor", (1.2, 0.3, 9.81), 3, (3.0, 3.0, 2.0), (0,) * 3, (6,) * 3)
-    assert own.drift_per_axis == pytest.approx((0.75, 0.75, 9.81 + 0.5), rel=1e-15)
+    assert own.drift_bounds == pytest.approx((0.75, 0.75, 9.81 + 0.5), rel=1e-15)
     assert own.drift_bound == pytest.approx(9.81 + 0.5, rel=1e-15)
     flat = model_bounds("double-integrator", (2.0,), 2, None, (0,) * 2, (6,) * 2)
-    assert flat.drift_per_axis is None and flat.drift_bound == 0.0
+    assert flat.drift_bounds == (0.0, 0.0) and flat.drift_bound == 0.0
+    dragged = model_bounds("quadrotor", (1.2, 0.3, 9.81), 3, None, (0,) * 3, (6,) * 3)
+    assert dragged.drift_bounds is None and dragged.drift_bound is None
 
 
 def test_the_model_is_checked_against_each_axis_of_the_class() -> None:

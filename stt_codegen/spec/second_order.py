@@ -53,13 +53,11 @@ class SecondOrder:
     input_gain : (float, float)
         ``assumptions.input_gain``: declared ``[g_min, g_max]`` of the symmetric part of
         ``g``, ``0 < g_min <= g_max``.
-    drift_bound : float
-        ``assumptions.drift_bound``: declared bound on every ``|f_i|`` over the states of
-        the task, velocity units per second (the disturbance is ``[plant]
-        disturbance_amplitude``); with ``drift_per_axis``, its largest entry.
-    drift_per_axis : tuple of float or None
-        ``assumptions.drift_bound`` given per axis (or the model's own per axis): ``|f_i|
-        <= drift_per_axis[i]``; ``None``: ``drift_bound`` on every axis.
+    drift_bounds : tuple of float
+        ``assumptions.drift_bound``: the declared bound on ``|f_i|`` of each axis over the
+        states of the task, velocity units per second, one per position (one number in
+        the spec is the bound of every axis; without one, the model's own per axis, from
+        its ``parameters``); the disturbance is ``[plant] disturbance_amplitude``.
     """
 
     model: str
@@ -67,13 +65,13 @@ class SecondOrder:
     initial_velocity: tuple[float, ...]
     velocity_bound: tuple[float, ...] | None
     input_gain: tuple[float, float]
-    drift_bound: float
-    drift_per_axis: tuple[float, ...] | None = None
+    drift_bounds: tuple[float, ...]
 
     @property
-    def axis_drift_bound(self) -> tuple[float, ...]:
-        """The bound on ``|f_i|`` of each axis, one per position (velocity units/s)."""
-        return self.drift_per_axis or (self.drift_bound,) * len(self.initial_velocity)
+    def drift_bound(self) -> float:
+        """The largest of :attr:`drift_bounds`: a bound on every ``|f_i|``, velocity units
+        per second."""
+        return max(self.drift_bounds)
 
 
 @dataclass(frozen=True)
@@ -85,27 +83,23 @@ class ModelBounds:
     input_gain : (float, float)
         ``(g_min, g_max)``: the extreme eigenvalues of ``g`` (symmetric) over the positions,
         ``1 / mass`` for the mass models; the default ``assumptions.input_gain``.
-    drift_bound : float or None
-        ``sup |f_i|`` over the positions and ``|x2_i| <= velocity_bound_i``, velocity units
-        per second (gravity, drag, Coriolis); the default ``assumptions.drift_bound``.
-        ``None`` when it grows with the velocity and no ``velocity_bound`` is given.
+    drift_bounds : tuple of float or None
+        ``sup |f_i|`` of each axis over the positions and ``|x2_i| <= velocity_bound_i``,
+        velocity units per second (gravity, drag, Coriolis), one per position; the default
+        ``assumptions.drift_bound``. ``None`` when it grows with the velocity and no
+        ``velocity_bound`` is given.
     words : str
         How they follow from the parameters, for messages.
-    drift_per_axis : tuple of float or None
-        ``sup |f_i|`` of each axis where the model's drift differs by axis (a quadrotor's
-        gravity), ``drift_bound`` its largest entry; ``None``: ``drift_bound`` on every
-        axis.
     """
 
     input_gain: tuple[float, float]
-    drift_bound: float | None
+    drift_bounds: tuple[float, ...] | None
     words: str
-    drift_per_axis: tuple[float, ...] | None = None
 
     @property
-    def axis_drift_bound(self) -> float | tuple[float, ...] | None:
-        """``drift_per_axis`` when given, else ``drift_bound``."""
-        return self.drift_per_axis or self.drift_bound
+    def drift_bound(self) -> float | None:
+        """The largest of :attr:`drift_bounds` (``None`` where they are ``None``)."""
+        return None if self.drift_bounds is None else max(self.drift_bounds)
 
 
 def _mass_bounds(p: dict, offset: Sequence[float], slope: float,
@@ -114,11 +108,8 @@ def _mass_bounds(p: dict, offset: Sequence[float], slope: float,
     g = 1.0 / p["mass"]
     axes = (tuple(offset) if slope == 0.0 else None if velocity_bound is None else
             tuple(o + slope * v for o, v in zip(offset, velocity_bound)))
-    drift = None if axes is None else max(axes)
-    per_axis = axes if axes is not None and min(axes) < drift else None
-    return ModelBounds((g, g), drift, f"g = I / mass = {g:.6g} I, |f_i| <= "
-                       f"{slope:.6g} |x2_i| + [{', '.join(f'{o:.6g}' for o in offset)}]_i",
-                       per_axis)
+    return ModelBounds((g, g), axes, f"g = I / mass = {g:.6g} I, |f_i| <= "
+                       f"{slope:.6g} |x2_i| + [{', '.join(f'{o:.6g}' for o in offset)}]_i")
 
 
 def _double_integrator(p: dict, n: int, velocity_bound, lower, upper) -> ModelBounds:
@@ -160,7 +151,7 @@ def _arm(p: dict, n: int, velocity_bound, lower, upper) -> ModelBounds:
     if velocity_bound is not None:
         v1, v2 = velocity_bound
         coriolis = m2 * l1 * c2 * math.hypot(2.0 * v1 * v2 + v2 * v2, v1 * v1)
-        drift = (1.0 + 1e-12) * g_max * (coriolis + gravity)
+        drift = ((1.0 + 1e-12) * g_max * (coriolis + gravity),) * n
     return ModelBounds((g_min, g_max), drift, f"eigenvalues of M(q)^-1 in [{g_min:.6g}, "
                        f"{g_max:.6g}] over the joint ranges, |f| <= g_max (|C q_dot| + |G|)")
 
@@ -291,19 +282,17 @@ def parse_second_order(model: str, n: int, parameters: Sequence[float] | None = 
                                                               "assumptions.input_gain", 2)
     if not 0 < gain[0] <= gain[1]:
         raise SpecError("assumptions.input_gain", "needs 0 < g_min <= g_max")
-    per_axis = None
     if drift_bound is None:
-        drift_bound, per_axis = own.drift_bound, own.drift_per_axis
-        if drift_bound is None:
+        drifts = own.drift_bounds
+        if drifts is None:
             raise SpecError("assumptions.drift_bound", f"the {info.name} model's drift "
                             "grows with the velocity (drag, Coriolis): give "
                             "state_space.velocity_bound, from which its bound is derived, "
                             "or declare assumptions.drift_bound")
-    elif not isinstance(drift_bound, (int, float)):
-        per_axis = _numbers(drift_bound, "assumptions.drift_bound", n)
-        if min(per_axis) < 0:
+    elif isinstance(drift_bound, (int, float)):
+        drifts = (float(drift_bound),) * n
+    else:
+        drifts = _numbers(drift_bound, "assumptions.drift_bound", n)
+        if min(drifts) < 0:
             raise SpecError("assumptions.drift_bound", "every entry must be >= 0")
-        drift_bound = max(per_axis)
-        per_axis = per_axis if min(per_axis) < drift_bound else None
-    return SecondOrder(model, params, x2, bound, (gain[0], gain[1]), float(drift_bound),
-                       per_axis)
+    return SecondOrder(model, params, x2, bound, (gain[0], gain[1]), drifts)

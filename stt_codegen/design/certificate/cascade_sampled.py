@@ -149,7 +149,7 @@ def cascade_class(spec: Spec) -> CascadeClass:
     g_min, g_max = order.input_gain
     diagonal = SECOND_ORDER_PLANTS[order.model].diagonal_input
     return CascadeClass(g_min, g_max, 0.0 if diagonal else 0.5 * (g_max - g_min),
-                        order.drift_per_axis or order.drift_bound, 0.0,
+                        order.drift_bounds, 0.0,
                         spec.disturbance_amplitude,
                         order.velocity_bound)
 
@@ -898,8 +898,8 @@ def model_within_class(spec: Spec) -> tuple[bool, str, dict]:
                        "the declared class only, not this plant"), {}
     g_min, g_max = own.input_gain
     n = spec.dimension
-    drift = (np.full(n, math.inf) if own.drift_bound is None else
-             np.broadcast_to(np.asarray(own.axis_drift_bound, dtype=float), (n,)))
+    drift = (np.full(n, math.inf) if own.drift_bounds is None else
+             np.asarray(own.drift_bounds, dtype=float))
     declared = cls.drift_bounds(n)
     bad = []
     if not cls.g_min <= g_min <= g_max <= cls.g_max:

@@ -81,7 +81,8 @@ def double_integrator_spec(spec: Spec) -> Spec:
     """
     plant = SecondOrder(model="double-integrator", parameters=(1.0,),
                         initial_velocity=(0.0,) * spec.dimension, velocity_bound=None,
-                        input_gain=INPUT_GAIN, drift_bound=0.0)
+                        input_gain=INPUT_GAIN,
+                        drift_bounds=(0.0,) * spec.dimension)
     return replace(spec, second_order=plant)
 
 
