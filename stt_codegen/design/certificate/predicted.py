@@ -18,7 +18,7 @@ import numpy as np
 from .enclosures import enclose_tube
 from .lyapunov import others_max
 from .plant_class import PlantClass
-from .sampled_axis import (axis_interval, held_speed, peak_scalar, phi_scalar, turn_failure,
+from .sampled_axis import (axis_interval, held_speed, peak_for_box, phi_scalar, turn_failure,
                            turned_gains, unprovable)
 from ..samples import TubeSamples
 from ...tube.parameters import E_MAX, TubeDesign
@@ -176,12 +176,12 @@ def check_predicted(design: TubeDesign, samples: TubeSamples, plants: PlantClass
             # (P2): x over the actuation interval, from x_hat widened by eta
             p_lo, p_hi, _, _ = axis_interval(
                 box[i][0], box[i][1], c_k[i], h_k[i], p_k[i], w_lo, w_hi,
-                peak_scalar(h_k[i] / (w_lo * p_k[i])), dt * w_push + eta,
+                peak_for_box(h_k[i] / (w_lo * p_k[i]), *box[i]), dt * w_push + eta,
                 others, w_cp, w_sk)
             # (P3): x_hat at the next sample
             _, _, x_lo, x_hi = axis_interval(
                 box[i][0], box[i][1], c_k[i], h_k[i], p_k[i], e_lo, e_hi,
-                peak_scalar(h_k[i] / (e_lo * p_k[i])), share * dt * push + eta,
+                peak_for_box(h_k[i] / (e_lo * p_k[i]), *box[i]), share * dt * push + eta,
                 others, e_cp, e_sk)
             path_e = [(p_lo - c_k[i]) / h_k[i], (p_hi - c_k[i]) / h_k[i]]
             if k == 0:

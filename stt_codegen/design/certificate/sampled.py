@@ -39,7 +39,7 @@ from ...tube.parameters import E_MAX, TubeDesign
 from .lyapunov import level_after, next_level, others_max
 from .plant_class import PlantClass, plant_class
 from .predicted import check_predicted
-from .sampled_axis import (axis_interval, held_speed, peak, peak_scalar, phi_scalar,
+from .sampled_axis import (axis_interval, held_speed, peak, peak_for_box, phi_scalar,
                            phi_slope_scalar, turn_failure, turned_gains, unprovable)
 
 __all__ = ["DELAY_HALVINGS", "RATE_FACTORS", "SampledCheck", "check_sampled",
@@ -313,8 +313,10 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
             if g_lo <= 0.0:
                 return fail(turn_failure(span * rate, rate, t), -math.inf, t, 0, top)
             ratio_k = [h_k[i] / (pull_l[k][i] * g_lo) for i in range(n)]
-            peak_k = {share: [peak_scalar(r / share) if share > 0.0 else 1.0 - 1e-15
-                              for r in ratio_k] for share in shares}
+            # s* clipped to the ranges of |e_i| as peak_scalar's, bisected only where needed
+            peak_k = {share: [peak_for_box(r / share, *box[i]) if share > 0.0
+                              else 1.0 - 1e-15 for i, r in enumerate(ratio_k)]
+                      for share in shares}
         path, ends = [], []
         for i in range(n):
             others = [j for j in block_of[i] if j != i]

@@ -21,7 +21,7 @@ from ...tube.parameters import GAMMA_D_MIN
 from .operations import FLOATS
 
 __all__ = ["phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "peak_scalar",
-           "coupling_push", "axis_interval", "held_speed", "turned_gains", "turn_failure",
+           "peak_for_box", "coupling_push", "axis_interval", "held_speed", "turned_gains", "turn_failure",
            "unprovable"]
 
 
@@ -171,6 +171,64 @@ def peak_scalar(ratio: float, ops=FLOATS) -> float:
         else:
             hi = mid
     return ops.select(ratio > 2.0, lo, 0.0)
+
+
+#: Relative room between ``phi'`` at an end of a range of ``s`` and the ratio, beyond which
+#: :func:`peak_for_box` decides on which side of the range ``s*`` lies without bisecting:
+#: far above the rounding of ``phi'``'s float formula (below ``1e-12`` relative for
+#: ``s <= PEAK_DECIDED_UP_TO``).
+PEAK_ROOM = 1e-9
+#: The largest end of a range at which :func:`peak_for_box` decides without bisecting.
+PEAK_DECIDED_UP_TO = 0.999
+
+
+def peak_for_box(ratio: float, a: float, b: float) -> float:
+    """A value of ``s*`` that :func:`axis_interval` clips to the same doubles as
+    :func:`peak_scalar` ``(ratio)`` for ``e_i(t_k)`` in ``[a, b]``, without the bisection
+    where the ranges of ``|e_i|`` of both signs lie clearly on one side of ``s*``.
+
+    :func:`axis_interval` uses ``s*`` only clipped to the range of ``s = |e_i|`` of each
+    sign, ``[max(a, 0), b]`` and ``[max(-b, 0), -a]`` (those not empty). ``phi'`` is
+    increasing, so when ``phi'`` at a range's upper end is below the ratio by a relative
+    :data:`PEAK_ROOM`, every ``s`` of the range has ``phi'(s) < ratio`` also in floats, and
+    the bisection of :func:`peak_scalar` ends above the range (it is clipped to the upper
+    end); when ``phi'`` at its lower end is above the ratio by as much, the bisection ends
+    below it (clipped to the lower end). When every range is decided, the largest upper
+    end of the ranges below ``s*`` (0 when none) is clipped to the same ends; else the
+    bisection is run.
+
+    Parameters
+    ----------
+    ratio : float
+        ``h / (g_min pull)``, as :func:`peak_scalar`.
+    a, b : float
+        ``e_i(t_k)`` lies in ``[a, b]``, inside ``(-1, 1)``.
+
+    Returns
+    -------
+    float
+        ``s`` in ``[0, 1)``: clipped to either range, the same float as
+        :func:`peak_scalar` ``(ratio)`` clipped to it.
+
+    Examples
+    --------
+    >>> from stt_codegen.design.certificate.sampled_axis import peak_for_box, peak_scalar
+    >>> peak_scalar(40.0) > 0.5, peak_for_box(40.0, -0.1, 0.2)
+    (True, 0.2)
+    """
+    if not ratio > 2.0:
+        return 0.0
+    above = 0.0
+    for s_a, s_b, empty in ((max(a, 0.0), b, b < max(a, 0.0)),
+                            (max(-b, 0.0), -a, -a < max(-b, 0.0) or -a == 0.0)):
+        if empty:
+            continue
+        if s_b <= PEAK_DECIDED_UP_TO and phi_slope_scalar(s_b) < ratio * (1.0 - PEAK_ROOM):
+            above = max(above, s_b)            # s* above the range: clipped to s_b
+        elif not phi_slope_scalar(s_a) > ratio * (1.0 + PEAK_ROOM):
+            return _peak_float(ratio)          # s* may lie in the range: bisect
+        # else s* lies below the range: any value up to s_a is clipped to s_a
+    return above
 
 
 def coupling_push(others: float, coupling: float, spread: float, skew: float,
