@@ -121,6 +121,12 @@ class CascadeClass:
                 f"({coupling}), {drift}, |w_i| <= {self.disturbance_bound:.3g}")
 
 
+def _one_or_per_axis(bounds: tuple[float, ...]) -> float | tuple[float, ...]:
+    """``bounds`` as :attr:`CascadeClass.drift_bound` holds it: one number when every axis
+    has the same, else one per axis."""
+    return bounds if min(bounds) < max(bounds) else max(bounds)
+
+
 def cascade_class(spec: Spec) -> CascadeClass:
     """The class of a spec with a second-order ``plant.model``: ``assumptions.input_gain``,
     ``assumptions.drift_bound`` (per axis where the spec or the model gives one per axis;
@@ -149,7 +155,7 @@ def cascade_class(spec: Spec) -> CascadeClass:
     g_min, g_max = order.input_gain
     diagonal = SECOND_ORDER_PLANTS[order.model].diagonal_input
     return CascadeClass(g_min, g_max, 0.0 if diagonal else 0.5 * (g_max - g_min),
-                        order.drift_bounds, 0.0,
+                        _one_or_per_axis(order.drift_bounds), 0.0,
                         spec.disturbance_amplitude,
                         order.velocity_bound)
 
