@@ -246,3 +246,54 @@ def test_a_re_ordering_keeps_the_placements_that_still_hold(monkeypatch):
     assert kept.certified and fresh.certified and kept.reordered == fresh.reordered != ()
     assert len(kept_fits) < len(fits)
     assert all(p.passed for p in kept.pairs) and len(kept.pairs) == 28
+
+
+
+#: TWO with a third robot along the lower aisle, for the re-ordering tests.
+THREE = copy.deepcopy(TWO)
+THREE["robots"].append(dict(copy.deepcopy(TWO["robots"][0]), name="c",
+                            initial={"lower": [4.0, 0.4], "upper": [4.6, 1.0]},
+                            target={"lower": [7.4, 0.4], "upper": [8.0, 1.0]}))
+
+
+def _scripted_failures(monkeypatch, failing: list[int]) -> list[list[str]]:
+    """``design.fleet._place`` made to fail, on its ``j``-th call, the robot at position
+    ``failing[j]`` of the order it is given (then the real placement); the orders it was
+    called with."""
+    from stt_codegen.design import fleet as F
+    real, orders = F._place, []
+
+    def place(order, placing, earlier=None):
+        orders.append([r.name for r in order])
+        if len(orders) <= len(failing):
+            return order[failing[len(orders) - 1]], "scripted"
+        return real(order, placing, earlier)
+
+    monkeypatch.setattr(F, "_place", place)
+    return orders
+
+
+def test_a_robot_moved_once_goes_before_the_robot_moved_after_it(monkeypatch):
+    # [p, q, r]: r fails (moved to the front), then q behind it (moved before r), then r
+    # behind q: r goes before q, an order not tried yet, and the design goes on from there
+    orders = _scripted_failures(monkeypatch, [-1, -1, 1])
+    designed = stt.design_fleet(stt.FleetSpec.from_dict(THREE))
+    p, q, r = orders[0]
+    assert orders[1:4] == [[r, p, q], [q, r, p], [r, q, p]]
+    assert designed.reordered == (r, q, r) and designed.certified
+
+
+def test_an_order_is_not_tried_twice_and_a_robot_moves_at_most_twice(monkeypatch):
+    from stt_codegen.design import fleet as F
+    # [p, q]: q fails, then p behind q: [p, q] again, tried first: refused naming p
+    orders = _scripted_failures(monkeypatch, [-1, -1])
+    with pytest.raises(stt.DesignError, match=r"robot \w+: no tube avoids") as info:
+        stt.design_fleet(stt.FleetSpec.from_dict(TWO))
+    assert len(orders) == 2 and str(info.value).startswith(f"robot {orders[0][0]}:")
+    # with one move per robot, the third failure (r behind q) is refused though [r, q, p]
+    # was not tried
+    monkeypatch.setattr(F, "MOVES_PER_ROBOT", 1)
+    orders = _scripted_failures(monkeypatch, [-1, -1, 1])
+    with pytest.raises(stt.DesignError) as info:
+        stt.design_fleet(stt.FleetSpec.from_dict(THREE))
+    assert len(orders) == 3 and str(info.value).startswith(f"robot {orders[0][2]}:")

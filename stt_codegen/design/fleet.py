@@ -13,7 +13,8 @@ moving boxes over at most :data:`CHUNK_SECONDS` each, first through its own via 
 through via boxes planned clear of the other robots' docks; each re-timed tube is accepted
 only when its own check, its input proof and the pair certificate against every placed tube
 near it pass. A robot that finds no tube is moved to the front and the fleet is placed
-again, each robot moved at most once; a robot placed in the order tried before keeps that
+again, each robot moved at most :data:`MOVES_PER_ROBOT` times and no order tried twice (a
+robot moved once that fails behind a robot moved after it goes before it); a robot placed in the order tried before keeps that
 placement where it still holds (:func:`_kept_from`). Every pair of the fleet is then certified by
 :func:`certify_fleet` on the robots' own certificates; nothing is accepted on the
 planner's word.
@@ -46,13 +47,16 @@ from .result import METHOD_VIA, Design, TubeCheck
 from .search import check_tube, design_tube
 
 __all__ = ["CHUNK_SECONDS", "DETOURS", "DETOUR_SECONDS", "INDEX_CELL", "INDEX_SECONDS",
-           "LEG_METRES", "PLANNER_SPACE_TIME", "PLANNER_TUBES", "SCREEN_INTERVALS", "FleetDesign",
-           "Placement", "certify_fleet", "design_fleet",
+           "LEG_METRES", "MOVES_PER_ROBOT", "PLANNER_SPACE_TIME", "PLANNER_TUBES",
+           "SCREEN_INTERVALS", "FleetDesign", "Placement", "certify_fleet", "design_fleet",
            "enclosed", "plan_way", "priority_order", "tube_obstacles"]
 
 #: The longest time span of one box standing for another robot's tube in a re-timing,
 #: seconds.
 CHUNK_SECONDS = 0.5
+#: How many times one robot may be moved to the front of the order (an order is never
+#: tried twice).
+MOVES_PER_ROBOT = 2
 #: The longest time span of one box of a placed tube in the space-time index, seconds.
 INDEX_SECONDS = 1.0
 #: The space-time index's grid cell, state units (metres).
@@ -811,6 +815,7 @@ def design_fleet(fleet: FleetSpec | str | os.PathLike,
     order = (priority_order(fleet) if planner == PLANNER_SPACE_TIME else
              priority_order(fleet, {name: tube for name, (_, tube) in ways.items()}))
     moved: list[str] = []
+    tried = {tuple(r.name for r in order)}
     placing = None
     while True:
         earlier, placing = placing, _Placing(fleet, ways, planner=planner)
@@ -818,10 +823,12 @@ def design_fleet(fleet: FleetSpec | str | os.PathLike,
         if failed is None:
             break
         robot, reason = failed
-        if robot.name in moved or robot is order[0]:
-            raise _conflicts(robot, placing, reason)
-        moved.append(robot.name)
         order = [robot] + [r for r in order if r is not robot]
+        names = tuple(r.name for r in order)
+        if moved.count(robot.name) >= MOVES_PER_ROBOT or names in tried:
+            raise _conflicts(robot, placing, reason)
+        tried.add(names)
+        moved.append(robot.name)
     designs = {r.name: placing.placed[r.name][1] for r in fleet.robots}
     pairs = certify_fleet(fleet, designs, {r.name: placing.placed[r.name][2]
                                            for r in fleet.robots})
