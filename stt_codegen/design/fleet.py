@@ -14,10 +14,10 @@ through via boxes planned clear of the other robots' docks; each re-timed tube i
 only when its own check, its input proof and the pair certificate against every placed tube
 near it pass. A robot that finds no tube is moved to the front and the fleet is placed
 again, each robot moved at most :data:`MOVES_PER_ROBOT` times and no order tried twice (a
-robot moved once that fails behind a robot moved after it goes before it); a robot placed in the order tried before keeps that
-placement where it still holds (:func:`_kept_from`). Every pair of the fleet is then certified by
-:func:`certify_fleet` on the robots' own certificates; nothing is accepted on the
-planner's word.
+robot moved once that fails behind a robot moved after it goes before it); a robot placed
+in the order tried before keeps that placement where it still holds (:func:`_kept_from`).
+Every pair of the fleet is then certified by :func:`certify_fleet` on the robots' own
+certificates; nothing is accepted on the planner's word.
 """
 
 from __future__ import annotations

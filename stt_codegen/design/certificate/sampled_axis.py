@@ -21,8 +21,8 @@ from ...tube.parameters import GAMMA_D_MIN
 from .operations import FLOATS
 
 __all__ = ["phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "peak_scalar",
-           "peak_for_box", "coupling_push", "axis_interval", "held_speed", "turned_gains", "turn_failure",
-           "unprovable"]
+           "peak_for_box", "coupling_push", "axis_interval", "held_speed", "turned_gains",
+           "turn_failure", "unprovable"]
 
 
 def phi(s: np.ndarray) -> np.ndarray:
