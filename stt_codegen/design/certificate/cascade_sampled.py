@@ -570,10 +570,7 @@ def _axis_reason(what: str, i: int, f: dict, span: str, vbound, change: float,
     return next_words
 
 
-# The tube's enclosures (of every interval, and of the actuation intervals with a delay)
-# are computed with numpy's kernels whatever context calls the check, as every other
-# certificate's (reference.numpy_math): one check gives the same floats from the design,
-# verify and the tests.
+# numpy's kernels for the tube's enclosures, as check_cascade_sampled
 @reference.numpy_math()
 def check_cascade_predicted(design: TubeDesign, samples: TubeSamples, stage: SecondStage,
                             plants: CascadeClass, initial_velocity, *, delay: float,
