@@ -4,9 +4,11 @@
 from __future__ import annotations
 
 import copy
+import dataclasses
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 import stt_codegen as stt
@@ -44,6 +46,14 @@ def test_the_defaults_and_the_rate():
     assert t.period == 0.25 and t.update_rate_hz == 4.0 and t.horizon == 0.5
 
 
+def test_the_acceleration_bound_and_the_velocity_error():
+    assert (ENVELOPE.max_obstacle_acceleration, ENVELOPE.velocity_error) == (None, 0.0)
+    s = spec_with(SENSING | {"max_obstacle_acceleration": 1.5}).sensing
+    assert (s.max_obstacle_acceleration, s.velocity_error) == (1.5, 0.0)
+    s = spec_with(SENSING | {"max_obstacle_acceleration": 1.5, "velocity_error": 0.1}).sensing
+    assert (s.max_obstacle_acceleration, s.velocity_error) == (1.5, 0.1)
+
+
 def test_the_robot_dims_are_the_sensing_dims():
     s = spec_with(SENSING, state_space={"lower": [0.0, 0.0, 0.0], "upper": [6.0, 4.0, 3.0]},
                   initial={"lower": [0.1, 1.6, 1.0], "upper": [0.6, 2.4, 2.0]},
@@ -62,6 +72,11 @@ def test_the_robot_dims_are_the_sensing_dims():
     ({"max_obstacle_speed": "fast"}, "sensing.max_obstacle_speed", "must be a number"),
     ({"rnage": 3.0}, "sensing.rnage", "did you mean 'range'"),
     ({"max_obstacle_radius": None}, "sensing.max_obstacle_radius", "missing"),
+    ({"velocity_error": 0.1}, "sensing.velocity_error", "only with max_obstacle_acceleration"),
+    ({"max_obstacle_acceleration": 1.0, "velocity_error": 1.3}, "sensing.velocity_error",
+     "more than twice max_obstacle_speed"),
+    ({"max_obstacle_acceleration": -1.0}, "sensing.max_obstacle_acceleration",
+     "must be non-negative"),
 ])
 def test_bad_sensing_names_the_field(change, field, words):
     table = {k: v for k, v in {**SENSING, **change}.items() if v is not None}
@@ -109,7 +124,8 @@ def test_the_json_schema_has_the_sensing_table():
     schema = json_schema()
     table = schema["$defs"]["SensingTable"]["properties"]
     assert {"range", "latency", "period", "update_rate_hz", "max_obstacle_radius",
-            "max_obstacle_speed", "replan_time", "horizon"} == set(table)
+            "max_obstacle_speed", "replan_time", "horizon", "max_obstacle_acceleration",
+            "velocity_error"} == set(table)
     assert "sensing" in schema["properties"]
 
 
@@ -171,3 +187,53 @@ def test_each_hypothesis_is_checked():
     assert kinds([ball(3.4, 2.0, label=2)], earlier=(1.0, (0.9, 2.0), before)) == ["appeared"]
     # the same obstacle without a label: it may be the earlier one, which moved
     assert kinds([ball(3.2, 2.0)], earlier=(1.0, (0.9, 2.0), before)) == []
+
+
+def test_the_acceleration_hypothesis_is_checked_on_tracked_obstacles():
+    """With ``A = 1`` and ``E = 0.05``: a person walking on at 0.5 m/s passes; one who turned
+    back within the half second (their estimate flipped, and they are 0.25 m from where
+    the last estimate put them) breaks it, twice; without the bound the same pair passes."""
+    bounded = dataclasses.replace(ENVELOPE, max_obstacle_acceleration=1.0,
+                                  velocity_error=0.05)
+    before = [ball(3.0, 2.0, t=1.0, label=1, velocity=(0.0, 0.5))]
+    walking = [ball(3.0, 2.25, label=1, velocity=(0.0, 0.5))]
+    turned = [ball(3.0, 2.0, label=1, velocity=(0.0, -0.5))]
+    earlier = (1.0, (0.9, 2.0), before)
+    assert [v.kind for v in envelope_violations(bounded, walking, (1.0, 2.0), earlier)] == []
+    found = envelope_violations(bounded, turned, (1.0, 2.0), earlier)
+    assert [v.kind for v in found] == ["acceleration", "acceleration"]
+    assert "from where its estimate put it" in found[0].detail
+    assert "velocity estimate changed by 1" in found[1].detail
+    assert kinds(turned, earlier=earlier) == []
+    # without an estimate nothing about the acceleration can be shown
+    blind = [ball(3.0, 2.0, label=1)]
+    assert envelope_violations(bounded, blind, (1.0, 2.0), earlier) == []
+
+
+def test_the_drift_box_holds_every_motion_within_the_bounds():
+    """Points of the ball that move within ``E`` of the estimate when seen and accelerate
+    at ``A`` in (seeded) random directions stay in the drift box over the span; the box is
+    smaller than the speed bound's."""
+    rng = np.random.default_rng(7)
+    accel, error, speed = 1.0, 0.1, 1.5
+    ob = stt.SensedObstacle.ball((2.0, 1.0), 0.3, seen_at=1.0, velocity=(0.8, -0.4))
+    lo, hi = ob.drift_box(1.2, 1.7, accel, error)
+    v_lo, v_hi = ob.reach_box(1.7, speed)
+    assert np.all(hi - lo < v_hi - v_lo)
+    dt = 0.01
+    for _ in range(200):
+        v = np.array(ob.velocity) + error * _unit(rng) * rng.uniform()
+        p = np.array(ob.centre) + 0.3 * _unit(rng) * rng.uniform()
+        for k in range(70):                             # t = 1.0 .. 1.7
+            t = 1.0 + k * dt
+            if t >= 1.2 - 1e-12:
+                assert np.all(p >= lo - 1e-12) and np.all(p <= hi + 1e-12), (t, p)
+            a = accel * _unit(rng)
+            p = p + v * dt + 0.5 * a * dt * dt
+            v = v + a * dt
+    assert stt.SensedObstacle.ball((0.0, 0.0), 0.3).drift_box(0.0, 1.0, accel) is None
+
+
+def _unit(rng):
+    d = rng.normal(size=2)
+    return d / np.linalg.norm(d)

@@ -329,6 +329,13 @@ class SensingTable(_Table):
     horizon: Positive = _omitted("H: how long after its switch a replanned tube is certified "
                                  "against the sensed obstacles, s, at least one period; "
                                  "default two periods")
+    max_obstacle_acceleration: NonNegative = _omitted(
+        "A: the largest acceleration of any point of an obstacle, state units/s^2; with it a "
+        "sensed obstacle's reachable set follows its velocity estimate; default none (the "
+        "set grows at max_obstacle_speed in every direction)")
+    velocity_error: NonNegative = _omitted(
+        "E: every point of an obstacle moves, at the measurement, within this much of the "
+        "velocity estimate, state units/s; only with max_obstacle_acceleration; default 0")
 
 
 class TaskBoxTable(_Table):

@@ -13,7 +13,12 @@ docs/sensing.md guarantees avoidance of obstacles it only sees while it runs:
 * ``replan_time`` ``tau`` (s, default one period): the replanner's time budget; a new tube
   switches in at ``t_m + L + tau``;
 * ``horizon`` ``H`` (s, default two periods, at least one): how long after its switch a
-  tube is certified against the sensed obstacles' reachable sets.
+  tube is certified against the sensed obstacles' reachable sets;
+* ``max_obstacle_acceleration`` ``A`` (optional) and ``velocity_error`` ``E`` (default 0):
+  no point of an obstacle accelerates faster than ``A``, and at a measurement every point
+  moves within ``E`` of the reported velocity estimate; a sensed obstacle's reachable set
+  then follows its estimate (:meth:`SensedObstacle.drift_box`) instead of growing at ``V``
+  in every direction.
 
 The table adds nothing to the design of the spec itself (its tube, its generated code and
 its ``source_hash`` do not depend on it); :mod:`stt_codegen.design.sensed` reads it when it
@@ -68,6 +73,13 @@ class Sensing:
     dims : tuple of int
         The state dimensions obstacles are sensed in: the robot's (``[robot] dims``,
         default the first two).
+    max_obstacle_acceleration : float or None
+        ``A``: the largest acceleration of any point of an obstacle (Euclidean norm on
+        :attr:`dims`), state units per second squared; ``None``: not bounded.
+    velocity_error : float
+        ``E``: at a measurement, every point of an obstacle moves within ``E`` of the
+        obstacle's velocity estimate (Euclidean norm), state units per second; used with
+        :attr:`max_obstacle_acceleration` only.
 
     Examples
     --------
@@ -86,6 +98,8 @@ class Sensing:
     replan_time: float
     horizon: float
     dims: tuple[int, ...]
+    max_obstacle_acceleration: float | None = None
+    velocity_error: float = 0.0
 
     @property
     def update_rate_hz(self) -> float:
@@ -130,7 +144,10 @@ def sensing_from_table(table: Any, dims: tuple[int, ...], variant: Any,
         ``update_rate_hz`` and ``period``; ``sensing.horizon``: shorter than one period;
         ``sensing.range``: not more than ``V (L + tau + H)`` plus the robot's radius (an
         obstacle unseen at a measurement may close that distance before the tube planned
-        from it stops being certified, and the body must still fit inside what is left).
+        from it stops being certified, and the body must still fit inside what is left);
+        ``sensing.velocity_error``: given without ``max_obstacle_acceleration``, or more
+        than ``2 V`` (an estimate that far from every velocity the speed allows says
+        nothing).
     """
     if table is None:
         return None
@@ -159,10 +176,25 @@ def sensing_from_table(table: Any, dims: tuple[int, ...], variant: Any,
                                          "an obstacle unseen at a measurement could reach "
                                          "the robot before the tube planned from it stops "
                                          "being certified")
+    acceleration = table.max_obstacle_acceleration
+    error = table.velocity_error
+    if error is not None and acceleration is None:
+        raise SpecError("sensing.velocity_error", "is the error of the velocity estimate a "
+                                                  "reachable set follows, which it does only "
+                                                  "with max_obstacle_acceleration: give that "
+                                                  "too, or leave velocity_error out")
+    if error is not None and error > 2.0 * table.max_obstacle_speed:
+        raise SpecError("sensing.velocity_error", f"= {number_text(error)} is more than twice "
+                                                  f"max_obstacle_speed "
+                                                  f"({number_text(table.max_obstacle_speed)}):"
+                                                  " the estimate would say nothing")
     return Sensing(range=float(table.range), latency=float(table.latency), period=period,
                    max_obstacle_radius=float(table.max_obstacle_radius),
                    max_obstacle_speed=float(table.max_obstacle_speed), replan_time=replan,
-                   horizon=horizon, dims=tuple(dims))
+                   horizon=horizon, dims=tuple(dims),
+                   max_obstacle_acceleration=None if acceleration is None
+                   else float(acceleration),
+                   velocity_error=0.0 if error is None else float(error))
 
 
 def _finite(values: Any, name: str, length: int | None = None,
@@ -203,7 +235,8 @@ class SensedObstacle:
         The measurement instant ``t_m``, s.
     velocity : tuple of float or None
         A velocity estimate, state units per second (checked against the envelope's
-        speed; it does not shrink the reachable set, docs/sensing.md); ``None``: none.
+        speed; with the envelope's ``max_obstacle_acceleration`` the reachable set follows
+        it, :meth:`drift_box`, docs/sensing.md); ``None``: none.
     label : int or None
         A track number, the same for the same obstacle in successive measurements (the
         envelope check follows it); ``None``: not tracked.
@@ -331,6 +364,50 @@ class SensedObstacle:
         c, h = np.asarray(self.centre), np.asarray(self.half_size) + grow
         return c - h, c + h
 
+    def drift_box(self, t_from: float, t_to: float, acceleration: float,
+                  velocity_error: float = 0.0) -> tuple[np.ndarray, np.ndarray] | None:
+        """A box holding every place the obstacle can be at every ``t`` of
+        ``[t_from, t_to]`` (both at or after :attr:`seen_at`) when its points accelerate
+        at most ``A`` and move within ``E`` of :attr:`velocity` at :attr:`seen_at`.
+
+        A point at ``q`` when seen is at ``t`` within ``E tau + A tau^2 / 2`` of
+        ``q + v tau`` (``tau = t - seen_at``, ``v`` the estimate), so the shape lies in its
+        box moved by ``v tau`` and grown by that. The box returned is the hull of the
+        centres moved to ``t_from`` and ``t_to`` (the centre moves on that segment), grown
+        by the shape's half size and the growth at ``t_to`` (the growth only increases).
+        Intersect it with :meth:`reach_box` at ``t_to``: each holds the obstacle.
+
+        Parameters
+        ----------
+        t_from, t_to : float
+            Seconds, ``seen_at <= t_from <= t_to``.
+        acceleration : float
+            ``A``, state units per second squared.
+        velocity_error : float
+            ``E``, state units per second.
+
+        Returns
+        -------
+        (lower, upper) of ndarray, shape (m,), or None
+            State units; ``None`` for an obstacle without a velocity estimate.
+
+        Examples
+        --------
+        >>> from stt_codegen import SensedObstacle
+        >>> ob = SensedObstacle.ball((0.0, 0.0), 0.5, velocity=(1.0, 0.0))
+        >>> lo, hi = ob.drift_box(1.0, 2.0, acceleration=0.5)
+        >>> lo.tolist(), hi.tolist()
+        [[-0.5, -1.5], [3.5, 1.5]]
+        """
+        if self.velocity is None:
+            return None
+        a = max(0.0, t_from - self.seen_at)
+        b = max(a, t_to - self.seen_at)
+        c, v = np.asarray(self.centre), np.asarray(self.velocity)
+        grow = velocity_error * b + 0.5 * acceleration * b * b
+        h = np.asarray(self.half_size) + grow
+        return np.minimum(c + v * a, c + v * b) - h, np.maximum(c + v * a, c + v * b) + h
+
 
 def _timing(seen_at: float, velocity: Sequence[float] | None, label: int | None,
             m: int) -> tuple[float, tuple[float, ...] | None, int | None]:
@@ -353,11 +430,14 @@ class EnvelopeViolation:
         The obstacle's position in the measurement.
     label : int or None
         Its track number.
-    kind : {"size", "speed", "displacement", "appeared"}
+    kind : {"size", "speed", "displacement", "acceleration", "appeared"}
         Larger than ``max_obstacle_radius``; a velocity estimate faster than
         ``max_obstacle_speed``; a tracked obstacle that moved farther than the speed
-        allows since its last measurement; an obstacle first seen closer than it could
-        have come unseen (it was within range at the previous measurement and not in it).
+        allows since its last measurement; with ``max_obstacle_acceleration``, a tracked
+        obstacle farther from where its last estimate put it, or with an estimate further
+        from the last one, than ``A`` and ``E`` allow; an obstacle first seen closer than
+        it could have come unseen (it was within range at the previous measurement and
+        not in it).
     time : float
         The measurement instant, s.
     detail : str
@@ -384,8 +464,10 @@ def envelope_violations(sensing: Sensing, sensed: Sequence[SensedObstacle],
     obstacle (same ``label``) moved at most ``V (t - t_1)``; an obstacle not in the previous
     measurement (an untracked one: none of that measurement's obstacles within
     ``V (t - t_1)`` plus both sizes of it) is now no nearer to ``s_1`` than
-    ``R - V (t - t_1)`` (else it was within range at ``t_1`` and unseen). An obstacle that
-    is never in range cannot be checked.
+    ``R - V (t - t_1)`` (else it was within range at ``t_1`` and unseen). With
+    ``max_obstacle_acceleration`` ``A`` and ``velocity_error`` ``E``, a tracked obstacle
+    with estimates ``v_1`` then ``v``: ``|c - (c_1 + v_1 dt)| <= E dt + A dt^2 / 2`` and
+    ``|v - v_1| <= A dt + 2 E``. An obstacle that is never in range cannot be checked.
 
     Parameters
     ----------
@@ -440,6 +522,9 @@ def envelope_violations(sensing: Sensing, sensed: Sequence[SensedObstacle],
                 report("displacement", f"moved {number_text(moved, 6)} in "
                                        f"{number_text(ob.seen_at - t1, 6)} s, more than "
                                        f"max_obstacle_speed allows ({number_text(step, 6)})")
+            if sensing.max_obstacle_acceleration is not None:
+                for kind, detail in _drift_violations(sensing, tracked[0], ob):
+                    report(kind, detail)
             continue
         could_be = [b for b in before if b.label is None or ob.label is None]
         if any(np.linalg.norm(np.subtract(ob.centre, b.centre))
@@ -451,4 +536,32 @@ def envelope_violations(sensing: Sensing, sensed: Sequence[SensedObstacle],
                                f"at the previous measurement ({number_text(t1, 6)} s): "
                                f"within range R - V dt = {number_text(sensing.range - step, 6)}"
                                ", so it was in range then and not seen")
+    return out
+
+
+def _drift_violations(sensing: Sensing, before: SensedObstacle,
+                      now: SensedObstacle) -> list[tuple[str, str]]:
+    """What two measurements of one tracked obstacle show of the acceleration hypothesis:
+    ``(kind, detail)`` pairs, kind ``"acceleration"``."""
+    if before.velocity is None or now.velocity is None:
+        return []
+    accel, error, slack = sensing.max_obstacle_acceleration, sensing.velocity_error, \
+        ENVELOPE_SLACK
+    dt = now.seen_at - before.seen_at
+    out = []
+    expected = np.add(before.centre, np.multiply(before.velocity, dt))
+    off = float(np.linalg.norm(np.subtract(now.centre, expected)))
+    room = error * dt + 0.5 * accel * dt * dt
+    if off > room * (1.0 + slack) + slack:
+        out.append(("acceleration", f"{number_text(off, 6)} from where its estimate put it "
+                                    f"{number_text(dt, 6)} s before, more than "
+                                    f"velocity_error dt + max_obstacle_acceleration dt^2 / 2 "
+                                    f"= {number_text(room, 6)}"))
+    change = float(np.linalg.norm(np.subtract(now.velocity, before.velocity)))
+    room = accel * dt + 2.0 * error
+    if change > room * (1.0 + slack) + slack:
+        out.append(("acceleration", f"velocity estimate changed by {number_text(change, 6)} "
+                                    f"in {number_text(dt, 6)} s, more than "
+                                    f"max_obstacle_acceleration dt + 2 velocity_error = "
+                                    f"{number_text(room, 6)}"))
     return out
