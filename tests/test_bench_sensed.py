@@ -9,7 +9,7 @@ import pytest
 
 import stt_codegen as stt
 from stt_codegen_bench.sensed_bench import (SCENARIO, format_sensed_report, moving_circles,
-                                            run_sensed_bench)
+                                            run_sensed_bench, scenario_with)
 
 
 def test_the_circles_are_seeded_and_drawn_by_the_generator():
@@ -27,6 +27,24 @@ def test_the_circles_are_seeded_and_drawn_by_the_generator():
         speeds = np.linalg.norm(np.diff(rows[:, 1:], axis=0), axis=1) / np.diff(rows[:, 0])
         assert np.all(speeds <= math.sqrt(2.0) + 1e-9)
     assert stt.Spec.from_dict(SCENARIO).sensing.max_obstacle_speed == math.sqrt(2.0)
+
+
+def test_turning_circles_keep_to_the_acceleration_bound():
+    """With ``acceleration`` the circles turn back before the walls instead of bouncing: no
+    faster than the generator's speed, their velocity changing by at most ``sqrt(2)``
+    times the per-axis acceleration per second (inside the envelope's ``A`` of twice it),
+    and they stay near the arena; the scenario's envelope then has ``A`` and ``E``."""
+    for ob in moving_circles(np.random.default_rng(5), 30, 17.0, acceleration=1.0):
+        rows = np.array(ob.path)
+        step = np.diff(rows[:, 0])
+        v = np.diff(rows[:, 1:], axis=0) / step[:, None]
+        assert np.all(np.linalg.norm(v, axis=1) <= math.sqrt(2.0) + 1e-9)
+        change = np.linalg.norm(np.diff(v, axis=0), axis=1) / step[1:]
+        assert np.all(change <= math.sqrt(2.0) * 1.0 + 1e-6)
+        assert np.all(rows[:, 1:] >= -0.5) and np.all(rows[:, 1:] <= 10.5)
+    sensing = stt.Spec.from_dict(scenario_with(2.0)).sensing
+    assert (sensing.max_obstacle_acceleration, sensing.velocity_error) == (2.0, 0.05)
+    assert scenario_with(None) is SCENARIO
 
 
 @pytest.mark.slow

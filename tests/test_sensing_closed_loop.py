@@ -98,6 +98,45 @@ def test_people_crossing_force_replanning_and_the_base_stays_safe_in_its_tube(ha
         assert float(e.detail.split("= ")[1].split(" ")[0]) <= 0.5      # |e| at the switch
 
 
+@pytest.fixture(scope="module")
+def bounded_hall():
+    """hall-crossing with ``max_obstacle_acceleration = 1`` and ``velocity_error = 0.05``."""
+    spec = stt.load_spec("hall-crossing")
+    sensing = dataclasses.replace(spec.sensing, max_obstacle_acceleration=1.0,
+                                  velocity_error=0.05)
+    return stt.design_tube(dataclasses.replace(spec, sensing=sensing))
+
+
+def test_a_turn_sharper_than_the_acceleration_bound_is_reported(bounded_hall):
+    """A person walking at 0.6 m/s who turns back at once (within the speed bound, not the
+    acceleration bound) is reported outside the envelope, by the monitor and by the
+    script; one who turns back at 0.8 m/s^2, and a pursuer turning at 0.9, are not."""
+    turn = WalkingObstacle((4.0, 1.2), 0.3, path=((0.0, 4.0, 1.2), (0.8, 4.0, 1.68),
+                                                  (1.6, 4.0, 1.2)))
+    run = stt.simulate_sensed(bounded_hall, [turn], horizon=2.0)
+    record = run.sensing
+    assert record.outside_envelope and record.script_outside_envelope
+    assert {v.kind for v in record.violations} == {"acceleration"}
+    assert not record.guaranteed
+    steps = np.arange(0.0, 2.5 + 1e-9, 0.01)
+    smooth = WalkingObstacle((4.0, 1.2), 0.3, path=tuple(
+        (float(t), 4.0, float(1.2 + y)) for t, y in zip(steps, _braked(steps))))
+    chaser = WalkingObstacle((8.0, 1.0), 0.3, pursuit_speed=0.5, pursuit_acceleration=0.9)
+    run = stt.simulate_sensed(bounded_hall, [smooth, chaser], horizon=2.0)
+    record = run.sensing
+    assert not record.outside_envelope and not record.script_outside_envelope, \
+        record.violations
+
+
+def _braked(t):
+    """A walk at 0.6 m/s along y, braked at 0.8 m/s^2 from 0.5 s until it has turned back
+    to -0.6 m/s (1.5 s later): the offset from the start at times ``t``."""
+    t = np.asarray(t, dtype=float)
+    brake = np.clip(t - 0.5, 0.0, 1.5)
+    after = np.clip(t - 2.0, 0.0, None)
+    return 0.6 * np.minimum(t, 0.5) + 0.6 * brake - 0.4 * brake ** 2 - 0.6 * after
+
+
 @pytest.mark.slow
 def test_an_obstacle_faster_than_the_envelope_collides_and_is_reported(hall):
     """A pursuer at 2.5 m/s (the envelope says 0.8) reaches the base: the collision is in

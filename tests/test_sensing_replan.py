@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import stt_codegen as stt
+from stt_codegen.design import sensed as sensed_module
 from stt_codegen.design.sensed import (SLOWER, reachable_boxes, region_margin, switch_time)
 from stt_codegen.tube import reference
 
@@ -55,6 +56,30 @@ def test_the_reachable_boxes_cover_the_reachable_set_at_every_instant():
                     and np.all(b.centre(t)[0] + b.half_size >= hi - 1e-12)]
             assert held, (ob, t)
     assert not any(b.is_active(1.3)[0] for b in boxes)   # nothing past the span
+
+
+def test_with_an_acceleration_bound_the_boxes_follow_the_estimate():
+    """With ``A`` the box of each span is the speed bound's box at the span's end cut by the
+    drift box over the span (each holds the obstacle there: tests/test_sensing_spec.py),
+    grown by the robot's radius; a walker's boxes are narrower than the speed bound's
+    across its way; an obstacle without an estimate keeps the speed bound's boxes."""
+    walker = stt.SensedObstacle.ball((3.0, 2.0), 0.3, seen_at=1.0, velocity=(0.7, 0.0))
+    still = stt.SensedObstacle.ball((5.0, 1.0), 0.3, seen_at=1.0)
+    args = ([walker, still], 0.8, 0.25, (0, 1))
+    span = {"start": 1.5, "t_from": 0.2, "t_to": 1.2, "first_source": 0}
+    plain = reachable_boxes(*args, **span)
+    bounded = reachable_boxes(*args, **span, acceleration=0.5, velocity_error=0.05)
+    half = len(plain) // 2
+    assert len(bounded) == len(plain) and bounded[half:] == plain[half:]
+    for b, p in zip(bounded[:half], plain[:half]):
+        a, e = b.active
+        speed_lo, speed_hi = walker.reach_box(1.5 + e, 0.8)
+        drift_lo, drift_hi = walker.drift_box(1.5 + a, 1.5 + e, 0.5, 0.05)
+        lo, hi = np.maximum(speed_lo, drift_lo) - 0.25, np.minimum(speed_hi, drift_hi) + 0.25
+        c = b.centre(a)[0]
+        assert c - b.half_size == pytest.approx(lo, abs=1e-12)
+        assert c + b.half_size == pytest.approx(hi, abs=1e-12)
+        assert b.half_size[1] < p.half_size[1]
 
 
 def test_the_start_plan_is_certified_until_the_first_switch_and_its_horizon(start):
@@ -132,6 +157,41 @@ def test_the_region_certificate_refuses_a_tube_that_outruns_the_range():
     room, _ = region_margin(slow, slow.spec.sensing, 0.0, 0.0, 0.0, (0.5, 1.0), 0.0, 1.6)
     assert room > 0 and stt.start_plan(slow).region_margin == pytest.approx(room)
     assert SLOWER[0] == 1.0
+
+
+#: A 6 m x 4 m hall crossed from left to right; people walk at most 0.6 m/s and accelerate
+#: at most 0.5 m/s^2.
+CORRIDOR = {"name": "corridor", "prescribed_time": 10.0,
+            "state_space": {"lower": [0.0, 0.0], "upper": [6.0, 4.0]},
+            "initial": {"lower": [0.2, 1.6], "upper": [0.8, 2.4]},
+            "target": {"lower": [5.2, 1.6], "upper": [5.8, 2.4]},
+            "plant": {"model": "single-integrator"}, "robot": {"radius": 0.1},
+            "sensing": {"range": 3.0, "latency": 0.1, "period": 0.5,
+                        "max_obstacle_radius": 0.4, "max_obstacle_speed": 0.6,
+                        "max_obstacle_acceleration": 0.5, "velocity_error": 0.05}}
+
+
+def test_an_escape_when_no_tube_reaches_the_target():
+    """A person walks down the hall's middle at the robot: no tube to the target keeps
+    clear of where they may be, so the robot escapes to a temporary goal beside them,
+    certified like any plan; with the hall clear again the next plan goes to the target."""
+    design = stt.design_tube(stt.Spec.from_dict(CORRIDOR))
+    plan = stt.start_plan(design)
+    here = np.asarray(sensed_module._box_at(plan, 1.0, design.spec.state_space).center)
+    person = stt.SensedObstacle.ball((2.8, 2.0), 0.35, seen_at=1.0, velocity=(-0.6, 0.0))
+    escape = stt.replan(plan, 1.0, here, [person])
+    assert isinstance(escape, stt.SensedPlan), escape.reason
+    assert escape.goal is not None and not escape.kept
+    assert escape.sensed_margin > 0 and escape.region_margin > 0
+    assert escape.arrival == pytest.approx(escape.start + sensed_module.ESCAPE_TIME)
+    goal = np.asarray(escape.goal.center)
+    # the goal lies off the person's way, out of where they may be when the robot is there
+    assert abs(goal[1] - 2.0) > 0.35 + 0.1
+    assert escape.design.spec.target_set == escape.goal
+    there = sensed_module._box_at(escape, 2.0 - escape.start, design.spec.state_space)
+    back = stt.replan(escape, 2.0, there.center, [])
+    assert isinstance(back, stt.SensedPlan) and back.goal is None and not back.kept
+    assert back.design.spec.target_set == design.spec.target_set
 
 
 def test_bad_calls_name_the_field(hall, start):

@@ -545,7 +545,7 @@ def _design(spec: Spec, smoother: bool) -> Design:
                 # no room for a circumvent at all: the via tube, too fast for the rate, is
                 # the design a later deadline or a faster rate can save
                 kind, tried = via.kind, via.tried
-        if (kind is FailureKind.SAMPLING_RATE and tried is not None
+        if (kind is FailureKind.SAMPLING_RATE and tried is not None and advice_wanted()
                 and check_tube(tried, spec).kind is FailureKind.SAMPLING_RATE):
             rate = lowest_passing_rate(tried, spec)
             message += ("; the tube tried passes its check from controller.rate_hz = "

@@ -15,7 +15,10 @@ obstacles seen at ``t_m``, :class:`~stt_codegen.spec.sensing.SensedObstacle`), a
    avoiding the static obstacles, the known moving ones (shifted to its time) and each
    sensed obstacle's reachable set over ``[t_s, t_s + H]`` as moving boxes over spans of
    at most :data:`CHUNK_SECONDS` (the fleet's pattern, :mod:`.fleet`), certified for every
-   ``t`` by the design's own space-time certificate (:mod:`.certificate.motion`).
+   ``t`` by the design's own space-time certificate (:mod:`.certificate.motion`); else
+   the same from a smaller box around where the robot will be at ``t_s``;
+3. **escape**: else a tube to a temporary goal near the robot, away from where the sensed
+   obstacles may be, certified the same way (:data:`ESCAPE_DISTANCES`).
 
 Each plan is also certified to keep the robot's body, over the same span, inside the
 region no obstacle unseen at ``t_m`` can have reached: the ball of radius
@@ -36,12 +39,13 @@ from typing import Sequence
 import numpy as np
 
 from ..errors import DesignError, SpecError
-from ..spec.loader import Box, Spec
+from ..spec.loader import DEFAULT_HALF_WIDTH_FRACTION, Box, Spec
 from ..spec.motion import MovingObstacle
 from ..spec.sensing import SensedObstacle, Sensing
 from .certificate.fleet import RobotTube, robot_tube
 from .certificate.motion import MOVING_PROPERTY
 from .certificate.report import ROUNDING_MARGIN
+from .failures import without_advice
 from .result import Design, require_design
 from .search import check_tube, design_tube
 
@@ -58,6 +62,22 @@ LATE_TIME = 2.0
 SLOWER = (1.0, 1.5, 2.0, 3.0)
 #: Most intervals the region certificate may cut the tube's enclosure into.
 REGION_INTERVALS = 20_000
+#: Seconds past the certified horizon over which a new tube to the target is first
+#: designed to keep clear of where the sensed obstacles are headed (:func:`foresight_boxes`).
+FORESIGHT = 2.0
+#: Distances (state units) of the temporary goals an escape tube may go to from where the
+#: robot will be at the switch, in the order tried; 0 holds a box around that point.
+ESCAPE_DISTANCES = (0.0, 0.6, 1.2)
+#: Directions of the temporary goals, evenly spaced on the first two sensing dimensions.
+ESCAPE_DIRECTIONS = 16
+#: Seconds an escape tube takes to reach its temporary goal (then it holds it).
+ESCAPE_TIME = 1.0
+#: Most escape tubes designed from one measurement (the best ranked first).
+MAX_ESCAPES = 6
+#: Temporary goals at least this far (state units) from where every sensed obstacle may be
+#: when the escape tube arrives plus the horizon rank equal on that count; the nearest to
+#: the target among them first.
+ESCAPE_CLEARANCE = 1.0
 
 
 @dataclass(frozen=True)
@@ -87,7 +107,7 @@ class SensedPlan:
         The absolute instant the plan takes over, a sample, s (``start`` for a new tube).
     arrival : float
         The absolute instant from which the tube lies in the target, s (after the spec's
-        ``t_c`` when the plan is late).
+        ``t_c`` when the plan is late); for an escape, when it lies in its ``goal``.
     kept : bool
         The active tube, certified again (no switch); False: a new tube.
     sensed : tuple of SensedObstacle
@@ -100,6 +120,9 @@ class SensedPlan:
         have reached, state units.
     time_s, cpu_s : float
         Wall and processor time of the call that made the plan, s.
+    goal : Box or None
+        An escape's temporary goal, which the tube reaches instead of the target and then
+        holds (the next plans try the target first); ``None``: the tube goes to the target.
 
     Examples
     --------
@@ -125,6 +148,7 @@ class SensedPlan:
     region_margin: float = math.inf
     time_s: float = 0.0
     cpu_s: float = 0.0
+    goal: Box | None = field(default=None, repr=False)
 
 
 @dataclass(frozen=True)
@@ -188,14 +212,18 @@ def switch_time(sensing: Sensing, measured_at: float, rate_hz: float) -> float:
 
 def reachable_boxes(sensed: Sequence[SensedObstacle], speed: float, reach: float,
                     dims: Sequence[int], start: float, t_from: float, t_to: float,
-                    first_source: int, chunk: float = CHUNK_SECONDS
+                    first_source: int, chunk: float = CHUNK_SECONDS, *,
+                    acceleration: float | None = None, velocity_error: float = 0.0
                     ) -> tuple[MovingObstacle, ...]:
     """Each sensed obstacle's reachable set, grown by the robot's radius, as boxes over spans.
 
     Over a span ``[a, b]`` of a tube's time the box is the obstacle's shape grown by
     ``V (start + b - seen_at)`` and by ``reach`` (the reachable set only grows), present
     on ``[a, b]`` only (``active``, closed): together the boxes cover the reachable set
-    at every ``t`` of ``[t_from, t_to]``.
+    at every ``t`` of ``[t_from, t_to]``. With ``acceleration`` (the envelope's ``A``) an
+    obstacle with a velocity estimate is also in its
+    :meth:`~stt_codegen.spec.sensing.SensedObstacle.drift_box` over the span, and the box
+    is the intersection of the two (each holds it).
 
     Parameters
     ----------
@@ -215,6 +243,10 @@ def reachable_boxes(sensed: Sequence[SensedObstacle], speed: float, reach: float
         The obstacle index of the first box (the next ones follow).
     chunk : float
         The longest span of one box, s.
+    acceleration : float, optional
+        ``A``, state units per second squared; ``None``: the speed bound alone.
+    velocity_error : float
+        ``E``, state units per second (with ``acceleration``).
 
     Returns
     -------
@@ -227,6 +259,10 @@ def reachable_boxes(sensed: Sequence[SensedObstacle], speed: float, reach: float
     for ob in sensed:
         for a, b in zip(edges[:-1], edges[1:]):
             lo, hi = ob.reach_box(start + float(b), speed)
+            drift = None if acceleration is None else ob.drift_box(
+                start + float(a), start + float(b), acceleration, velocity_error)
+            if drift is not None:
+                lo, hi = np.maximum(lo, drift[0]), np.minimum(hi, drift[1])
             half = (hi - lo) / 2 + reach
             out.append(MovingObstacle(
                 source=first_source + len(out), dims=tuple(int(d) for d in dims),
@@ -293,6 +329,12 @@ def region_margin(design: Design, sensing: Sensing, reach: float, start: float,
         tube = cut
     k = int(np.argmin(room))
     return float(room[k]), float(t0[k])
+
+
+def _drift(sensing: Sensing) -> dict:
+    """:func:`reachable_boxes`' keywords of the envelope's acceleration bound."""
+    return {"acceleration": sensing.max_obstacle_acceleration,
+            "velocity_error": sensing.velocity_error}
 
 
 def _sensed_margin(design: Design, first_source: int) -> float:
@@ -373,7 +415,7 @@ def _certify(design: Design, local: Spec, sensing: Sensing, sensed: Sequence[Sen
     reason, with the two margins."""
     first = len(local.unsafe_sets) + len(local.moving_obstacles) + 1_000
     boxes = reachable_boxes(sensed, sensing.max_obstacle_speed, _reach(local), sensing.dims,
-                            start, t_from, t_to, first)
+                            start, t_from, t_to, first, **_drift(sensing))
     spec = replace(local, moving_obstacles=local.moving_obstacles + boxes)
     check = check_tube(design.tube, spec)
     if not check.passed:
@@ -511,9 +553,13 @@ def replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     measurement over ``[t_m, t_s + H]`` (``kept``: no switch). Else a new tube is designed
     from the active tube's certified box at ``t_s`` to the target, avoiding every known
     obstacle and the sensed obstacles' reachable sets over ``[t_s, t_s + H]``, and
-    certified for every ``t``; and both plans must keep the body inside the region no
-    obstacle unseen at ``t_m`` can have reached (:func:`region_margin`). The run time
-    switches to a new tube at ``t_s`` only if the state lies in it then (docs/sensing.md).
+    certified for every ``t``, then the same from a box of the spec's ``d_0`` around where
+    the robot will be at ``t_s``; else an *escape*: a tube to a temporary goal near the
+    robot (``SensedPlan.goal``), reached in :data:`ESCAPE_TIME` and held (an escape's own
+    tube is kept only after the target has been tried again). Every plan must keep the
+    body inside the region no obstacle unseen at ``t_m`` can have reached
+    (:func:`region_margin`). The run time switches to a new tube at ``t_s`` only if the
+    state lies in it then (docs/sensing.md).
 
     Parameters
     ----------
@@ -552,6 +598,15 @@ def replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     >>> new.kept, new.switch_at, new.guarantee_until, new.sensed_margin > 0
     (False, 1.6, 2.6, True)
     """
+    # a failure needs its reason, not the rate or the time that would work (those
+    # searches take seconds)
+    with without_advice():
+        return _replan(plan, measured_at, position, sensed)
+
+
+def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
+            sensed: Sequence[SensedObstacle]) -> SensedPlan | ReplanFailure:
+    """:func:`replan`'s work."""
     if not isinstance(plan, SensedPlan):
         raise TypeError(f"replan(): parameter 'plan' must be a SensedPlan (from start_plan "
                         f"or replan), not {type(plan).__name__}")
@@ -584,40 +639,273 @@ def replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     large = _too_large(sensed, sensing)
     if large is not None:
         return failed(large, "envelope")
-    # 1. the active tube, certified again from the measurement on
-    kept, _, margin, room = _certify(plan.design, local, sensing, sensed, plan.start, t_m, s,
-                                     max(0.0, t_m - plan.start), until - plan.start)
-    if kept is not None:
-        return done(design=kept, task=plan.task, local=local, start=plan.start, certified_from=t_m,
-                    switch_at=plan.switch_at, arrival=plan.arrival, kept=True,
-                    sensed_margin=margin, region_margin=room)
-    # 2. a new tube from the active tube's box at the switch
+
+    def kept_plan() -> SensedPlan | None:
+        kept, _, margin, room = _certify(plan.design, local, sensing, sensed, plan.start,
+                                         t_m, s, max(0.0, t_m - plan.start),
+                                         until - plan.start)
+        if kept is None:
+            return None
+        return done(design=kept, task=plan.task, local=local, start=plan.start,
+                    certified_from=t_m, switch_at=plan.switch_at, arrival=plan.arrival,
+                    kept=True, sensed_margin=margin, region_margin=room, goal=plan.goal)
+
+    # 1. the active tube, certified again from the measurement on (an escape's after the
+    #    target has been tried again)
+    if plan.goal is None:
+        kept = kept_plan()
+        if kept is not None:
+            return kept
+    # 2. a new tube to the target from the active tube's box at the switch, then from a
+    #    box around where the robot will be
     base = plan.task
-    box = _box_at(plan, t_s - plan.start, base.state_space)
-    remaining = max(base.prescribed_time - t_s, LATE_TIME)
     first = len(base.unsafe_sets) + len(base.moving_obstacles) + 1_000
     boxes = reachable_boxes(sensed, sensing.max_obstacle_speed, _reach(base), sensing.dims,
-                            t_s, 0.0, sensing.horizon, first)
+                            t_s, 0.0, sensing.horizon, first, **_drift(sensing))
+    moving = _shifted(base.moving_obstacles, t_s)
+    active = _box_at(plan, t_s - plan.start, base.state_space)
+    near = _switch_box(plan, active, s, t_m, t_s, sensing)
+    remaining = max(base.prescribed_time - t_s, LATE_TIME)
+    ahead = foresight_boxes(sensed, _reach(base), sensing.dims, t_s, sensing.horizon,
+                            sensing.horizon + FORESIGHT, first + len(boxes),
+                            sensing.velocity_error)
+    outcome: tuple[str, str] | None = None
+    tries = [(active, boxes + ahead), (active, boxes)] + ([] if near is None
+                                                          else [(near, boxes)])
+    for box, avoided in tries:
+        made = _to_target(base, box, moving, avoided, sensing, s, t_m, t_s, remaining,
+                          first)
+        if isinstance(made, dict):
+            return done(task=plan.task, **made)
+        outcome = outcome or made
+    assert outcome is not None
+    # 3. an escape's tube kept, or a new escape to a temporary goal
+    if plan.goal is not None:
+        kept = kept_plan()
+        if kept is not None:
+            return kept
+    made = _escape(base, near or active, moving, boxes, sensed, sensing, s, t_m, t_s, first,
+                   _predicted(plan, active, s, t_m, t_s, sensing))
+    if isinstance(made, dict):
+        return done(task=plan.task, **made)
+    return failed(outcome[0] + f"; and no escape: {made}", outcome[1])
+
+
+def foresight_boxes(sensed: Sequence[SensedObstacle], reach: float, dims: Sequence[int],
+                    start: float, t_from: float, t_to: float, first_source: int,
+                    velocity_error: float = 0.0, chunk: float = 2 * CHUNK_SECONDS
+                    ) -> tuple[MovingObstacle, ...]:
+    """Where each sensed obstacle is headed past the certified horizon, as boxes over spans:
+    its shape moved along its velocity estimate (standing where it was seen without one),
+    grown by ``velocity_error`` times the time since it was seen and by ``reach``.
+
+    Not a reachable set: a new tube is designed to keep clear of these too, when it can,
+    so that the next measurement is less likely to find it in an obstacle's way (a plan
+    that sees only its certified horizon walks into what comes after it). Its certificate
+    proves them missed like any moving obstacle, which the plan's guarantee does not need.
+
+    Parameters
+    ----------
+    sensed : sequence of SensedObstacle
+        The obstacles, on ``dims``.
+    reach : float
+        The robot's radius, state units.
+    dims : sequence of int
+        The state dimensions of the obstacles.
+    start : float
+        The absolute instant of the tube's ``t' = 0``, s.
+    t_from, t_to : float
+        The span, in the tube's time, s.
+    first_source : int
+        The obstacle index of the first box.
+    velocity_error : float
+        ``E``, state units per second.
+    chunk : float
+        The longest span of one box, s.
+
+    Returns
+    -------
+    tuple of MovingObstacle
+    """
+    count = max(1, math.ceil((t_to - t_from) / chunk - 1e-9))
+    edges = np.linspace(t_from, t_to, count + 1)
+    out: list[MovingObstacle] = []
+    for ob in sensed:
+        moving = ob if ob.velocity is not None else replace(
+            ob, velocity=(0.0,) * len(ob.centre))
+        for a, b in zip(edges[:-1], edges[1:]):
+            lo, hi = moving.drift_box(start + float(a), start + float(b), 0.0, velocity_error)
+            half = (hi - lo) / 2 + reach
+            out.append(MovingObstacle(
+                source=first_source + len(out), dims=tuple(int(d) for d in dims),
+                half_size=tuple(float(v) for v in half), times=(float(a),),
+                centres=(tuple(float(v) for v in (hi + lo) / 2),),
+                active=(float(a), float(b)), motion="still"))
+    return tuple(out)
+
+
+def _new_local(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
+               prescribed_time: float, goal: Box | None = None) -> Spec:
+    """The task of a new tube in its time: from ``box``, within ``prescribed_time``, to the
+    target (or to ``goal``), among the known obstacles (``moving`` shifted to its time)."""
+    local = replace(base, prescribed_time=prescribed_time, initial_set=box,
+                    initial_state=box.center,
+                    initial_half_width=tuple((b - a) / 2 for a, b in zip(box.lower,
+                                                                         box.upper)),
+                    moving_obstacles=moving, target_any_of=())
+    if goal is not None:        # the tube ends in the goal's middle, as a spec's default
+        local = replace(local, target_set=goal, target_center=goal.center,
+                        target_half_width=tuple(DEFAULT_HALF_WIDTH_FRACTION * (b - a) / 2
+                                                for a, b in zip(goal.lower, goal.upper)),
+                        target_half_width_given=True)
+    return local
+
+
+def _to_target(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
+               boxes: tuple[MovingObstacle, ...], sensing: Sensing, s: np.ndarray,
+               t_m: float, t_s: float, remaining: float, first: int
+               ) -> dict | tuple[str, str]:
+    """A certified tube from ``box`` to the target (arriving later while it leaves the
+    region): the new plan's fields, or why not and the failure's kind."""
     rooms = []
     for slower in SLOWER:
-        new_local = replace(
-            base, prescribed_time=remaining * slower, initial_set=box,
-            initial_state=box.center,
-            initial_half_width=tuple((b - a) / 2 for a, b in zip(box.lower, box.upper)),
-            moving_obstacles=_shifted(base.moving_obstacles, t_s), target_any_of=())
+        new_local = _new_local(base, box, moving, remaining * slower)
         try:
             new = design_tube(replace(new_local,
                                       moving_obstacles=new_local.moving_obstacles + boxes))
         except DesignError as exc:
-            return failed(f"no tube from the box at t = {t_s:.4f} s to the target within "
-                          f"{remaining * slower:.4g} s: {exc}", "design")
+            return (f"no tube from the box at t = {t_s:.4f} s to the target within "
+                    f"{remaining * slower:.4g} s: {exc}", "design")
         room, at = region_margin(new, sensing, _reach(base), t_s, t_m, s, 0.0,
                                  sensing.horizon)
         if room > ROUNDING_MARGIN:
-            return done(design=new, task=plan.task, local=new_local, start=t_s,
-                        certified_from=t_s, switch_at=t_s, arrival=t_s + remaining * slower,
-                        kept=False, sensed_margin=_sensed_margin(new, first),
-                        region_margin=room)
+            return dict(design=new, local=new_local, start=t_s, certified_from=t_s,
+                        switch_at=t_s, arrival=t_s + remaining * slower, kept=False,
+                        sensed_margin=_sensed_margin(new, first), region_margin=room)
         rooms.append(f"{room:.3g} at t = {t_s + at:.4f} s within {remaining * slower:.4g} s")
-    return failed("the new tube may leave the region no unseen obstacle can reach, even "
-                  "slower (room " + "; ".join(rooms) + ")", "region")
+    return ("the new tube may leave the region no unseen obstacle can reach, even slower "
+            "(room " + "; ".join(rooms) + ")", "region")
+
+
+def _predicted(plan: SensedPlan, active: Box, s: np.ndarray, t_m: float, t_s: float,
+               sensing: Sensing) -> np.ndarray:
+    """Where the reference point will be at the switch: ``s`` moved as the plan's tube's
+    centre moves from ``t_m`` to ``t_s`` (the robot follows its tube); the tube's centre at
+    ``t_s`` for a plan that takes over after ``t_m`` (the robot is not on it yet)."""
+    dims = list(sensing.dims)
+    if t_m < plan.start:
+        return np.asarray(active.center, dtype=float)[dims]
+    then = _box_at(plan, t_m - plan.start, plan.task.state_space)
+    return s + (np.asarray(active.center)[dims] - np.asarray(then.center)[dims])
+
+
+def _switch_box(plan: SensedPlan, active: Box, s: np.ndarray, t_m: float, t_s: float,
+                sensing: Sensing) -> Box | None:
+    """A box around where the robot will be at the switch (:func:`_predicted`), of the
+    spec's initial half width on the sensing dimensions, inside the active tube's box
+    there; ``None`` when it is not smaller than that box. A tube from it is sound whatever
+    the prediction's error: the switch is refused where the state is not in it."""
+    point = _predicted(plan, active, s, t_m, t_s, sensing)
+    lo, hi = list(active.lower), list(active.upper)
+    for k, d in enumerate(sensing.dims):
+        w = plan.task.initial_half_width[d]
+        a, b = max(lo[d], point[k] - w), min(hi[d], point[k] + w)
+        if not b > a:
+            return None
+        lo[d], hi[d] = a, b
+    box = Box(tuple(lo), tuple(hi))
+    return None if box == active else box
+
+
+def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
+            boxes: tuple[MovingObstacle, ...], sensed: Sequence[SensedObstacle],
+            sensing: Sensing, s: np.ndarray, t_m: float, t_s: float, first: int,
+            point: np.ndarray) -> dict | str:
+    """A certified tube from ``box`` to a temporary goal near ``point`` (where the robot
+    will be at the switch), reached in :data:`ESCAPE_TIME` and then held: the plan's
+    fields, or why there is none.
+
+    Each escape is the paper's tube (``tube.method = "paper"``: one segment, with
+    circumvents, and the moving-obstacle design's swept step), not a via-point search. The
+    goals are boxes of the spec's initial half width around ``point`` and around the
+    points :data:`ESCAPE_DISTANCES` away in :data:`ESCAPE_DIRECTIONS` directions, inside
+    the state space and clear of the static obstacles, ranked by their distance from where
+    every sensed obstacle may be when the tube arrives plus the horizon and from the state
+    space's boundary (the largest first, up to :data:`ESCAPE_CLEARANCE`), then by their
+    distance to the target; at most :data:`MAX_ESCAPES` designs.
+    """
+    dims = list(sensing.dims)
+    reach = _reach(base)
+    half = np.array([base.initial_half_width[d] for d in dims])
+    target = np.asarray(base.target_center)[dims]
+    later = t_s + ESCAPE_TIME + sensing.horizon
+    ranked = []
+    for distance in ESCAPE_DISTANCES:
+        for k in range(ESCAPE_DIRECTIONS if distance > 0.0 else 1):
+            angle = 2.0 * math.pi * k / ESCAPE_DIRECTIONS
+            p = point.astype(float).copy()
+            p[0] += distance * math.cos(angle)
+            if p.size > 1:
+                p[1] += distance * math.sin(angle)
+            lo, hi = list(box.lower), list(box.upper)
+            for j, d in enumerate(dims):
+                lo[d], hi[d] = p[j] - half[j], p[j] + half[j]
+            goal = Box(tuple(lo), tuple(hi))
+            if not base.state_space.contains_box(goal) or _meets_static(base, goal, reach):
+                continue
+            clear = min((_clearance(ob, p, later, sensing) for ob in sensed),
+                        default=math.inf) - reach - float(np.linalg.norm(half))
+            # a goal near the state space's boundary leaves fewer ways out next time (a
+            # corner is a trap): its room to the boundary counts as a clearance too
+            room = min(min(p[j] - base.state_space.lower[d], base.state_space.upper[d] - p[j])
+                       for j, d in enumerate(dims))
+            clear = min(clear, room)
+            ranked.append((-min(clear, ESCAPE_CLEARANCE),
+                           float(np.linalg.norm(p - target)), len(ranked), goal))
+    ranked.sort(key=lambda r: r[:3])
+    reasons = []
+    for _, _, _, goal in ranked[:MAX_ESCAPES]:
+        # the straight tube (and its circumvents) only: a goal it cannot reach is left for
+        # the next one, not searched around (re-timings and detours take seconds)
+        local = _new_local(replace(base, tube=replace(base.tube, method="paper")), box,
+                           moving, ESCAPE_TIME, goal)
+        try:
+            new = design_tube(replace(local, moving_obstacles=local.moving_obstacles + boxes))
+        except DesignError as exc:
+            reasons.append(f"{exc.kind}")
+            continue
+        room, _ = region_margin(new, sensing, reach, t_s, t_m, s, 0.0, sensing.horizon)
+        if room > ROUNDING_MARGIN:
+            return dict(design=new, local=local, start=t_s, certified_from=t_s,
+                        switch_at=t_s, arrival=t_s + ESCAPE_TIME, kept=False,
+                        sensed_margin=_sensed_margin(new, first), region_margin=room,
+                        goal=goal)
+        reasons.append("region")
+    if not ranked:
+        return "no temporary goal inside the state space and clear of the obstacles"
+    return (f"{min(len(ranked), MAX_ESCAPES)} temporary goals tried, none certified ("
+            + ", ".join(str(r) for r in reasons) + ")")
+
+
+def _clearance(ob: SensedObstacle, point: np.ndarray, t: float, sensing: Sensing) -> float:
+    """The distance from ``point`` to where ``ob`` may be at ``t`` (a ball around its
+    estimate's prediction: with the envelope's acceleration bound, else around where it
+    was seen, grown at the speed bound), state units; negative inside."""
+    tau = max(0.0, t - ob.seen_at)
+    c = np.asarray(ob.centre, dtype=float)
+    grow = sensing.max_obstacle_speed * tau
+    accel = sensing.max_obstacle_acceleration
+    if accel is not None and ob.velocity is not None:
+        drift = sensing.velocity_error * tau + 0.5 * accel * tau * tau
+        if drift < grow:
+            c, grow = c + np.asarray(ob.velocity) * tau, drift
+    return float(np.linalg.norm(point - c)) - ob.extent - grow
+
+
+def _meets_static(spec: Spec, box: Box, reach: float) -> bool:
+    """Whether ``box`` grown by ``reach`` meets a static obstacle of ``spec``."""
+    for ob in spec.obstacles:
+        if all(box.lower[d] - reach <= hi and lo <= box.upper[d] + reach
+               for d, lo, hi in zip(ob.dims, ob.lower, ob.upper)):
+            return True
+    return False

@@ -72,6 +72,11 @@ class WalkingObstacle:
         Heads for the robot's reference point at this speed (the adversary), state units
         per second: each period it moves straight at the point where the robot was at
         the period's start.
+    pursuit_acceleration : float or None
+        With ``pursuit_speed``: the pursuer's velocity turns towards the one heading for the
+        robot at ``pursuit_speed`` by at most this much per second (an adversary within an
+        envelope's ``max_obstacle_acceleration``), state units per second squared;
+        ``None``: at once.
 
     Examples
     --------
@@ -79,6 +84,8 @@ class WalkingObstacle:
     >>> person = WalkingObstacle((5.0, 0.5), 0.3, velocity=(0.0, 0.6))
     >>> WalkingObstacle((8.0, 3.0), 0.3, pursuit_speed=0.8).pursuit_speed
     0.8
+    >>> WalkingObstacle((8.0, 3.0), 0.3, pursuit_speed=0.8, pursuit_acceleration=1.0).start
+    (8.0, 3.0)
     """
 
     start: tuple[float, ...]
@@ -86,6 +93,7 @@ class WalkingObstacle:
     velocity: tuple[float, ...] | None = None
     path: tuple[tuple[float, ...], ...] | None = None
     pursuit_speed: float | None = None
+    pursuit_acceleration: float | None = None
 
     def __post_init__(self) -> None:
         m = len(self.start)
@@ -107,6 +115,12 @@ class WalkingObstacle:
                                                         "numbers, times increasing")
         if self.pursuit_speed is not None and not self.pursuit_speed >= 0:
             raise SpecError("WalkingObstacle.pursuit_speed", "must be non-negative")
+        if self.pursuit_acceleration is not None and (
+                self.pursuit_speed is None or not math.isfinite(self.pursuit_acceleration)
+                or not self.pursuit_acceleration > 0):
+            raise SpecError("WalkingObstacle.pursuit_acceleration", "must be positive and "
+                                                                    "finite, with "
+                                                                    "pursuit_speed")
 
     def scripted(self, t: np.ndarray) -> np.ndarray:
         """The scripted centre at times ``t`` (shape (N,)), shape (N, m); a pursuer's
@@ -169,6 +183,9 @@ class SensingRecord:
     switches, refused, failures : int
         Tubes switched in; switches refused (the state not in the new tube); measurements
         with no certified plan.
+    escapes : int
+        The tubes switched in that go to a temporary goal instead of the target
+        (``SensedPlan.goal``), among ``switches``.
     replans : int
         Calls of the replanner (the start included).
     replan_cpu_max, replan_cpu_p95, replan_cpu_mean : float
@@ -192,8 +209,10 @@ class SensingRecord:
     outside_envelope : bool
         The monitor reported a violation: the run's guarantee does not hold.
     script_outside_envelope : bool
-        The obstacles as scripted left the envelope (faster than ``max_obstacle_speed``
-        or larger than ``max_obstacle_radius``), whether or not a measurement showed it.
+        The obstacles as scripted left the envelope (faster than ``max_obstacle_speed``,
+        larger than ``max_obstacle_radius``, or with ``max_obstacle_acceleration`` a
+        velocity that changed faster than it from one period to the next), whether or not
+        a measurement showed it.
     guaranteed : bool
         No uncertified span and no violation: the run was covered by the proof of
         docs/sensing.md throughout.
@@ -202,6 +221,7 @@ class SensingRecord:
     events: list[PlanEvent] = field(default_factory=list)
     measurements: int = 0
     switches: int = 0
+    escapes: int = 0
     refused: int = 0
     failures: int = 0
     replans: int = 0
@@ -226,7 +246,8 @@ class SensingRecord:
         envelope = ("; OUTSIDE the envelope (" + ", ".join(sorted({v.kind for v in
                                                                    self.violations})) + ")"
                     if self.outside_envelope else "")
-        return (f"{self.measurements} measurements, {self.switches} switches, "
+        escapes = f" ({self.escapes} escapes)" if self.escapes else ""
+        return (f"{self.measurements} measurements, {self.switches} switches{escapes}, "
                 f"{self.refused} refused, {self.failures} failed; replanning max "
                 f"{self.replan_cpu_max:.3g} s CPU (p95 {self.replan_cpu_p95:.3g}); {cover}"
                 + envelope)
@@ -235,7 +256,7 @@ class SensingRecord:
 class _World:
     """The walking obstacles' positions, advanced a period at a time."""
 
-    def __init__(self, obstacles: Sequence[WalkingObstacle], m: int) -> None:
+    def __init__(self, obstacles: Sequence[WalkingObstacle], m: int, dt: float) -> None:
         self.obstacles = list(obstacles)
         for j, ob in enumerate(self.obstacles):
             if not isinstance(ob, WalkingObstacle):
@@ -246,8 +267,15 @@ class _World:
                                                          "sensing dimension)")
         self.radius = np.array([ob.radius for ob in self.obstacles]).reshape(-1)
         self.p = (np.array([ob.scripted([0.0])[0] for ob in self.obstacles]).reshape(-1, m))
-        self.v = np.zeros_like(self.p)
-        self.fastest = 0.0
+        # the velocity before t = 0 (the first measurement's estimate): a scripted
+        # obstacle's over the first period, a pursuer's 0 (it starts at rest)
+        self.v = np.array([(ob.scripted([dt])[0] - ob.scripted([0.0])[0]) / dt
+                           if ob.pursuit_speed is None else np.zeros(m)
+                           for ob in self.obstacles]).reshape(-1, m)
+        self.fastest = float(max(np.linalg.norm(self.v, axis=1), default=0.0))
+        #: the largest change of an obstacle's velocity from one period to the next over
+        #: the period, state units per second squared
+        self.sharpest = 0.0
 
     def advance(self, t: float, dt: float, point: np.ndarray) -> np.ndarray:
         """Move every obstacle over ``[t, t + dt]`` (a pursuer towards ``point``); returns
@@ -257,13 +285,24 @@ class _World:
             if ob.pursuit_speed is not None:
                 gap = point - self.p[j]
                 norm = float(np.linalg.norm(gap))
+                if ob.pursuit_acceleration is not None:
+                    wanted = gap / norm * ob.pursuit_speed if norm > 0 else 0.0 * gap
+                    turn = wanted - self.v[j]
+                    most = ob.pursuit_acceleration * dt
+                    size = float(np.linalg.norm(turn))
+                    velocity = self.v[j] + (turn if size <= most else turn * (most / size))
+                    new[j] = self.p[j] + velocity * dt
+                    continue
                 step = min(ob.pursuit_speed * dt, norm)
                 new[j] = self.p[j] + (gap / norm * step if norm > 0 else 0.0)
             else:
                 new[j] = ob.scripted([t + dt])[0]
-        self.v = (new - self.p) / dt
-        if self.v.size:
-            self.fastest = max(self.fastest, float(np.max(np.linalg.norm(self.v, axis=1))))
+        v = (new - self.p) / dt
+        if v.size:
+            self.fastest = max(self.fastest, float(np.max(np.linalg.norm(v, axis=1))))
+            self.sharpest = max(self.sharpest,
+                                float(np.max(np.linalg.norm(v - self.v, axis=1))) / dt)
+        self.v = v
         return new
 
 
@@ -347,7 +386,7 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
     steps = int(math.ceil(horizon * rate - 1e-9))
     check_step_budget(steps, horizon, rate)
     dims = list(sensing.dims)
-    world = _World(obstacles, len(dims))
+    world = _World(obstacles, len(dims), dt)
     reach = 0.0 if spec.robot is None else float(spec.robot.radius)
     x = initial_state(spec)
     n = spec.dimension
@@ -412,7 +451,9 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
         states[k] = x
         # 1. plans whose switch is due
         for plan in [p for p in pending if p.switch_at <= t + 1e-9]:
-            pending.remove(plan)
+            if not any(p is plan for p in pending):    # dropped after a refusal
+                continue
+            pending = [p for p in pending if p is not plan]
             if plan.kept:
                 if plan.design.tube != active.design.tube:
                     record.events.append(PlanEvent(t, "dropped", len(designs) - 1,
@@ -433,6 +474,15 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
                     active.guarantee_until, plan.cpu_s,
                     f"the state is at |e| = {e:.3g} of the new tube at its start (limit "
                     f"{MAX_INITIAL_ERROR})"))
+                # the plans made after it start from its tube, which the robot does not
+                # follow: dropped, and the next plan is made from the active one
+                for later in pending:
+                    record.events.append(PlanEvent(t, "dropped", len(designs) - 1,
+                                                   later.measured_at, active.guarantee_until,
+                                                   later.cpu_s, "made from a plan refused "
+                                                   "at its switch"))
+                pending.clear()
+                latest = active
                 continue
             active = plan
             designs.append(plan.design)
@@ -440,10 +490,12 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
             predict = delay_predictor(spec, plan.design.tube, plan.design.stage)
             alpha = np.zeros(2 * n)
             record.switches += 1
+            record.escapes += plan.goal is not None
             covered.append((plan.certified_from, plan.guarantee_until))
             record.events.append(PlanEvent(t, "switched", len(designs) - 1, plan.measured_at,
                                            plan.guarantee_until, plan.cpu_s,
-                                           f"|e| = {e:.3g} in the new tube"))
+                                           f"|e| = {e:.3g} in the new tube"
+                                           + _escape_words(plan, spec)))
         # 2. a measurement: taken now, revealed after the latency
         if next_measure * sensing.period <= t + 1e-9:
             taken = measure(k)
@@ -499,13 +551,23 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
     record.over_budget = int(sum(c > sensing.replan_time for c in cpu))
     record.uncertified = _gaps(covered, min(horizon, ts[-1]))
     record.outside_envelope = bool(record.violations)
+    accel = sensing.max_obstacle_acceleration
     record.script_outside_envelope = bool(
         world.fastest > sensing.max_obstacle_speed * (1.0 + 1e-9) + 1e-12
-        or (world.radius.size and world.radius.max() > sensing.max_obstacle_radius))
+        or (world.radius.size and world.radius.max() > sensing.max_obstacle_radius)
+        or (accel is not None and world.sharpest > accel * (1.0 + 1e-9) + 1e-12))
     record.guaranteed = not record.uncertified and not record.outside_envelope
     return _judged(design, backend, horizon, ts, states, us, alphas, status, tubes, starts,
                    designs, np.vstack(dense), np.concatenate(dense_t), obstacle_path, world,
                    reach, record, stepper)
+
+
+def _escape_words(plan: SensedPlan, spec) -> str:
+    """``"; an escape to (x, y)"`` for a plan going to a temporary goal, else ``""``."""
+    if plan.goal is None:
+        return ""
+    centre = np.asarray(plan.goal.center)[list(spec.sensing.dims)]
+    return "; an escape to (" + ", ".join(f"{c:.3g}" for c in centre) + ")"
 
 
 def _horizon(value: object) -> float:

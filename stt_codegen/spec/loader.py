@@ -45,8 +45,10 @@ from .variants import variant_of
 from .schema import (NAME_REGEX, ActuatorTable, AssumptionsTable, BallObstacle, BoxObstacle, BoxTable,
                      ControllerTable, PlantTable, PolytopeObstacle, check_document, value_kind)
 
-__all__ = ["Assumptions", "Box", "LinearPlant", "law13_plant_terms", "look_ahead_plant_terms", "NAME_PATTERN", "Obstacle", "Spec", "UnsafeSet",
-           "bundled_cases", "file_or_bundled", "load_spec", "parse_spec", "toml_document"]
+__all__ = ["Assumptions", "Box", "DEFAULT_HALF_WIDTH_FRACTION", "LinearPlant",
+           "law13_plant_terms", "look_ahead_plant_terms", "NAME_PATTERN", "Obstacle", "Spec",
+           "UnsafeSet", "bundled_cases", "file_or_bundled", "load_spec", "parse_spec",
+           "toml_document"]
 
 NAME_PATTERN = re.compile(NAME_REGEX)
 #: Fraction of the available room used by the default half-widths ``d_0`` and ``d_T``.

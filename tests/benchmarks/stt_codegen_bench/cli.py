@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 from collections.abc import Callable
 from pathlib import Path
 
@@ -26,6 +27,13 @@ def _positive_int(text: str) -> int:
     value = int(text)
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be at least 1, got {value}")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    value = float(text)
+    if not (value > 0 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"must be positive and finite, got {value}")
     return value
 
 
@@ -193,7 +201,8 @@ def _cmd_sensed(args: argparse.Namespace) -> int:
     from .sensed_bench import format_sensed_report, run_sensed_bench
     report = run_sensed_bench(args.count, args.seed,
                               tuple(_int_list(args.obstacles, "--obstacles")),
-                              adversary=args.adversary)
+                              adversary=args.adversary, acceleration=args.acceleration,
+                              speed_only=args.speed_only)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_sensed_report(report))
     return 0
@@ -372,5 +381,14 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="comma-separated obstacle counts (default: %(default)s)")
     p.add_argument("--adversary", action="store_true",
                    help="add a circle heading for the robot at the envelope's speed")
+    p.add_argument("--acceleration", type=_positive_float, default=None, metavar="A",
+                   help="the envelope's max_obstacle_acceleration, m/s^2 (with velocity_error "
+                        "0.05 m/s): the circles turn back before the walls at A/2 per axis "
+                        "instead of bouncing, and the adversary turns at A (default: no "
+                        "acceleration bound, bouncing circles)")
+    p.add_argument("--speed-only", action="store_true",
+                   help="with --acceleration: the same circles and adversary, but the "
+                        "envelope without the acceleration bound (reachable sets growing at "
+                        "the speed bound), for a side-by-side comparison")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_sensed)

@@ -29,7 +29,8 @@ import numpy as np
 import stt_codegen as stt
 from stt_codegen.runtime.sensed import WalkingObstacle
 
-__all__ = ["SCENARIO", "format_sensed_report", "moving_circles", "run_sensed_bench"]
+__all__ = ["SCENARIO", "format_sensed_report", "moving_circles", "run_sensed_bench",
+           "scenario_with"]
 
 #: The arena, the robot and the envelope of the scenario (a spec dictionary).
 SCENARIO = {
@@ -45,6 +46,12 @@ SCENARIO = {
 }
 #: Circles start at least this far from the start set's centre, m.
 CLEAR_OF_START = 2.5
+#: The time step of a turning circle's path (the controller's period), s.
+TURN_STEP = 0.01
+#: The envelope's ``velocity_error`` with an acceleration bound, m/s: the estimate is the
+#: velocity over the period before the measurement, which differs from the velocity after
+#: it by at most ``A`` times the period (0.01 s).
+VELOCITY_ERROR = 0.05
 
 
 def _bouncing(start: np.ndarray, velocity: np.ndarray, radius: float, side: float,
@@ -64,8 +71,36 @@ def _bouncing(start: np.ndarray, velocity: np.ndarray, radius: float, side: floa
     return tuple(tuple(float(c) for c in r) for r in rows)
 
 
-def moving_circles(rng: np.random.Generator, count: int, until: float
-                   ) -> list[WalkingObstacle]:
+def _turning(start: np.ndarray, velocity: np.ndarray, radius: float, side: float,
+             until: float, acceleration: float) -> tuple[tuple[float, ...], ...]:
+    """Path rows (every :data:`TURN_STEP` s) of a circle moving straight and turning back
+    before the walls of ``[0, side]^2``: on each axis, once its stopping distance at
+    ``acceleration`` reaches the wall, that axis's velocity turns to its opposite at
+    ``acceleration`` (so the velocity changes by at most ``sqrt(2) acceleration`` per
+    second, and its speed never grows)."""
+    rows = [(0.0, *start)]
+    p, v = start.copy(), velocity.copy()
+    lo, hi = radius, side - radius
+    back: list[float | None] = [None, None]     # the velocity an axis turns back to
+    for k in range(1, int(math.ceil(until / TURN_STEP)) + 1):
+        a = np.zeros(2)
+        for i in range(2):
+            wall = hi - p[i] if v[i] > 0 else p[i] - lo
+            if back[i] is None and v[i] != 0.0 and v[i] * v[i] / (2.0 * acceleration) >= wall:
+                back[i] = -v[i]
+            if back[i] is not None:
+                a[i] = math.copysign(min(acceleration, abs(back[i] - v[i]) / TURN_STEP),
+                                     back[i] - v[i])
+                if abs(back[i] - v[i] - a[i] * TURN_STEP) <= 1e-12:
+                    back[i] = None
+        v = v + a * TURN_STEP
+        p = p + v * TURN_STEP
+        rows.append((k * TURN_STEP, *p))
+    return tuple(tuple(float(c) for c in r) for r in rows)
+
+
+def moving_circles(rng: np.random.Generator, count: int, until: float,
+                   acceleration: float | None = None) -> list[WalkingObstacle]:
     """``count`` circles by Real-Time STT's generator, bouncing in the arena.
 
     Parameters
@@ -76,6 +111,10 @@ def moving_circles(rng: np.random.Generator, count: int, until: float
         How many.
     until : float
         The path's length, s.
+    acceleration : float, optional
+        Turn back before the walls at this acceleration per axis (m/s^2) instead of
+        bouncing off them (a bounce changes the velocity at once: it is outside any bound
+        on the acceleration).
 
     Returns
     -------
@@ -90,13 +129,15 @@ def moving_circles(rng: np.random.Generator, count: int, until: float
         velocity = rng.uniform(-1.0, 1.0, 2)
         if np.linalg.norm(centre - start) < CLEAR_OF_START + radius:
             continue
-        out.append(WalkingObstacle(tuple(float(c) for c in centre), radius,
-                                   path=_bouncing(centre, velocity, radius, side, until)))
+        path = (_bouncing(centre, velocity, radius, side, until) if acceleration is None
+                else _turning(centre, velocity, radius, side, until, acceleration))
+        out.append(WalkingObstacle(tuple(float(c) for c in centre), radius, path=path))
     return out
 
 
 def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20),
-                     adversary: bool = False) -> dict:
+                     adversary: bool = False, acceleration: float | None = None,
+                     speed_only: bool = False) -> dict:
     """Seeded episodes of the scenario per obstacle count.
 
     Parameters
@@ -109,27 +150,38 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         The obstacle counts.
     adversary : bool
         Add a pursuer at the envelope's speed.
+    acceleration : float, optional
+        The envelope's ``max_obstacle_acceleration`` ``A`` (m/s^2), with ``velocity_error``
+        :data:`VELOCITY_ERROR`: the circles turn back before the walls at ``A / 2`` per
+        axis, and the pursuer turns at ``A``. ``None``: no acceleration bound, bouncing
+        circles, a pursuer that turns at once.
+    speed_only : bool
+        With ``acceleration``: the same obstacles, but the envelope without the
+        acceleration bound (the reachable sets grow at the speed bound).
 
     Returns
     -------
     dict
         Per count, the tallies and the replanner's times (s).
     """
-    design = stt.design_tube(stt.Spec.from_dict(SCENARIO))
+    scenario = scenario_with(None if speed_only else acceleration)
+    design = stt.design_tube(stt.Spec.from_dict(scenario))
     speed = SCENARIO["sensing"]["max_obstacle_speed"]
     t_c = SCENARIO["prescribed_time"]
     rows = []
     for count in counts:
         tally = {"obstacles": count, "episodes": episodes, "collisions": 0,
                  "collisions_certified": 0, "on_time": 0, "late": 0, "not_reached": 0,
-                 "uncertified_runs": 0, "outside_envelope": 0, "switches": 0, "refused": 0,
-                 "failures": 0, "replans": 0}
+                 "uncertified_runs": 0, "outside_envelope": 0, "switches": 0, "escapes": 0,
+                 "refused": 0, "failures": 0, "replans": 0}
         cpu, started = [], time.process_time()
         for e in range(episodes):
             rng = np.random.default_rng([seed, count, e])
-            obstacles = moving_circles(rng, count, t_c + 1.0)
+            obstacles = moving_circles(rng, count, t_c + 1.0,
+                                       None if acceleration is None else acceleration / 2.0)
             if adversary:
-                obstacles.append(WalkingObstacle((7.0, 1.0), 0.3, pursuit_speed=speed))
+                obstacles.append(WalkingObstacle((7.0, 1.0), 0.3, pursuit_speed=speed,
+                                                 pursuit_acceleration=acceleration))
             run = stt.simulate_sensed(design, obstacles, seed=e)
             record = run.sensing
             tally["collisions"] += record.sensed_collision or run.collision
@@ -142,15 +194,36 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
             tally["not_reached"] += not run.reached and not late
             tally["uncertified_runs"] += bool(record.uncertified)
             tally["outside_envelope"] += record.outside_envelope
-            for key in ("switches", "refused", "failures", "replans"):
+            for key in ("switches", "escapes", "refused", "failures", "replans"):
                 tally[key] += getattr(record, key)
             cpu += [ev.cpu_s for ev in record.events]
         tally["replan_cpu_p95_s"] = float(np.percentile(cpu, 95)) if cpu else 0.0
         tally["replan_cpu_max_s"] = float(max(cpu, default=0.0))
         tally["episode_cpu_s"] = (time.process_time() - started) / max(1, episodes)
         rows.append(tally)
-    return {"scenario": {k: SCENARIO[k] for k in ("prescribed_time", "sensing")},
-            "seed": seed, "adversary": adversary, "rows": rows}
+    return {"scenario": {k: scenario[k] for k in ("prescribed_time", "sensing")},
+            "seed": seed, "adversary": adversary, "acceleration": acceleration,
+            "speed_only": bool(speed_only and acceleration is not None), "rows": rows}
+
+
+def scenario_with(acceleration: float | None) -> dict:
+    """:data:`SCENARIO`, with ``max_obstacle_acceleration = acceleration`` and
+    ``velocity_error`` :data:`VELOCITY_ERROR` in its envelope when given.
+
+    Parameters
+    ----------
+    acceleration : float or None
+        ``A``, m/s^2.
+
+    Returns
+    -------
+    dict
+    """
+    if acceleration is None:
+        return SCENARIO
+    return {**SCENARIO, "sensing": {**SCENARIO["sensing"],
+                                    "max_obstacle_acceleration": float(acceleration),
+                                    "velocity_error": VELOCITY_ERROR}}
 
 
 def format_sensed_report(report: dict) -> str:
@@ -166,15 +239,21 @@ def format_sensed_report(report: dict) -> str:
     str
     """
     head = (f"{'N':>4} {'episodes':>8} {'collisions':>10} {'(certified)':>11} {'on time':>8} "
-            f"{'late':>5} {'uncert.':>7} {'outside':>7} {'switches':>8} {'failed':>6} "
+            f"{'late':>5} {'uncert.':>7} {'outside':>7} {'switches':>8} {'escapes':>7} "
+            f"{'failed':>6} "
             f"{'replan p95 [s]':>14} {'max [s]':>8}")
+    accel = report.get("acceleration")
     lines = [f"bench sensed: seed {report['seed']}"
-             + (", with a pursuer at the envelope's speed" if report["adversary"] else ""),
+             + (", with a pursuer at the envelope's speed" if report["adversary"] else "")
+             + ("" if accel is None else
+                (f", circles turning at {accel / 2:g} m/s^2 per axis, " +
+                 ("the envelope without its acceleration bound" if report.get("speed_only")
+                  else f"max_obstacle_acceleration {accel:g} m/s^2"))),
              head]
     for r in report["rows"]:
         lines.append(f"{r['obstacles']:>4} {r['episodes']:>8} {r['collisions']:>10} "
                      f"{r['collisions_certified']:>11} {r['on_time']:>8} {r['late']:>5} "
                      f"{r['uncertified_runs']:>7} {r['outside_envelope']:>7} "
-                     f"{r['switches']:>8} {r['failures']:>6} "
+                     f"{r['switches']:>8} {r.get('escapes', 0):>7} {r['failures']:>6} "
                      f"{r['replan_cpu_p95_s']:>14.3f} {r['replan_cpu_max_s']:>8.3f}")
     return "\n".join(lines)
