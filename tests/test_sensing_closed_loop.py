@@ -47,7 +47,10 @@ def test_a_switch_is_refused_when_the_state_is_not_in_the_new_tube(hall, monkeyp
     other = stt.start_plan(stt.design_tube(elsewhere))
     real = run_sensed.replan
 
+    calls = []
+
     def offset(plan, t_m, s, seen):
+        calls.append((t_m, plan.start))
         made = real(other, t_m, s, [stt.SensedObstacle.ball((4.0, 3.3), 0.3, seen_at=t_m)])
         return made if plan.start == 0.0 and not made.kept else real(plan, t_m, s, seen)
 
@@ -57,6 +60,9 @@ def test_a_switch_is_refused_when_the_state_is_not_in_the_new_tube(hall, monkeyp
     assert refused and run.sensing.refused == len(refused) and run.sensing.switches == 0
     assert "|e| = " in refused[0].detail and refused[0].time == pytest.approx(1.6)
     assert set(run.trajectory.tube) == {0} and run.stayed_in_tube
+    # the measurement revealed at the refusal is planned from the active plan, not from
+    # the refused one (which the robot does not follow)
+    assert calls[-1] == (pytest.approx(1.5), 0.0)
 
 
 def test_bad_input_names_the_field(hall):

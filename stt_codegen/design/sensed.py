@@ -49,8 +49,10 @@ from .failures import without_advice
 from .result import Design, require_design
 from .search import check_tube, design_tube
 
-__all__ = ["CHUNK_SECONDS", "LATE_TIME", "ReplanFailure", "SensedPlan", "reachable_boxes",
-           "region_margin", "replan", "start_plan", "switch_time", "uncertified_plan"]
+__all__ = ["CHUNK_SECONDS", "ESCAPE_CLEARANCE", "ESCAPE_DIRECTIONS", "ESCAPE_DISTANCES",
+           "ESCAPE_TIME", "FORESIGHT", "LATE_TIME", "MAX_ESCAPES", "ReplanFailure",
+           "SensedPlan", "foresight_boxes", "reachable_boxes", "region_margin", "replan",
+           "start_plan", "switch_time", "uncertified_plan"]
 
 #: The longest time span of one box standing for a sensed obstacle's reachable set, s.
 CHUNK_SECONDS = 0.25
@@ -664,7 +666,8 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
                             t_s, 0.0, sensing.horizon, first, **_drift(sensing))
     moving = _shifted(base.moving_obstacles, t_s)
     active = _box_at(plan, t_s - plan.start, base.state_space)
-    near = _switch_box(plan, active, s, t_m, t_s, sensing)
+    point = _predicted(plan, active, s, t_m, sensing)
+    near = _switch_box(base, active, point, sensing)
     remaining = max(base.prescribed_time - t_s, LATE_TIME)
     ahead = foresight_boxes(sensed, _reach(base), sensing.dims, t_s, sensing.horizon,
                             sensing.horizon + FORESIGHT, first + len(boxes),
@@ -685,7 +688,7 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
         if kept is not None:
             return kept
     made = _escape(base, near or active, moving, boxes, sensed, sensing, s, t_m, t_s, first,
-                   _predicted(plan, active, s, t_m, t_s, sensing))
+                   point)
     if isinstance(made, dict):
         return done(task=plan.task, **made)
     return failed(outcome[0] + f"; and no escape: {made}", outcome[1])
@@ -726,6 +729,18 @@ def foresight_boxes(sensed: Sequence[SensedObstacle], reach: float, dims: Sequen
     Returns
     -------
     tuple of MovingObstacle
+        Boxes that do not move, each present over its span.
+
+    Examples
+    --------
+    A person seen at 1 s walking at 0.5 m/s, from 1 to 2 s past a tube's start at 2 s:
+
+    >>> from stt_codegen import SensedObstacle
+    >>> from stt_codegen.design.sensed import foresight_boxes
+    >>> person = SensedObstacle.ball((3.0, 2.0), 0.3, seen_at=1.0, velocity=(0.5, 0.0))
+    >>> boxes = foresight_boxes([person], 0.25, (0, 1), 2.0, 1.0, 2.0, 100)
+    >>> [(b.active, b.centres[0]) for b in boxes]
+    [((1.0, 1.5), (4.125, 2.0)), ((1.5, 2.0), (4.375, 2.0))]
     """
     count = max(1, math.ceil((t_to - t_from) / chunk - 1e-9))
     edges = np.linspace(t_from, t_to, count + 1)
@@ -787,7 +802,7 @@ def _to_target(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
             "(room " + "; ".join(rooms) + ")", "region")
 
 
-def _predicted(plan: SensedPlan, active: Box, s: np.ndarray, t_m: float, t_s: float,
+def _predicted(plan: SensedPlan, active: Box, s: np.ndarray, t_m: float,
                sensing: Sensing) -> np.ndarray:
     """Where the reference point will be at the switch: ``s`` moved as the plan's tube's
     centre moves from ``t_m`` to ``t_s`` (the robot follows its tube); the tube's centre at
@@ -799,16 +814,14 @@ def _predicted(plan: SensedPlan, active: Box, s: np.ndarray, t_m: float, t_s: fl
     return s + (np.asarray(active.center)[dims] - np.asarray(then.center)[dims])
 
 
-def _switch_box(plan: SensedPlan, active: Box, s: np.ndarray, t_m: float, t_s: float,
-                sensing: Sensing) -> Box | None:
-    """A box around where the robot will be at the switch (:func:`_predicted`), of the
-    spec's initial half width on the sensing dimensions, inside the active tube's box
-    there; ``None`` when it is not smaller than that box. A tube from it is sound whatever
-    the prediction's error: the switch is refused where the state is not in it."""
-    point = _predicted(plan, active, s, t_m, t_s, sensing)
+def _switch_box(base: Spec, active: Box, point: np.ndarray, sensing: Sensing) -> Box | None:
+    """A box around ``point``, where the robot will be at the switch (:func:`_predicted`),
+    of the spec's initial half width on the sensing dimensions, inside the active tube's
+    box there; ``None`` when it is not smaller than that box. A tube from it is sound
+    whatever the prediction's error: the switch is refused where the state is not in it."""
     lo, hi = list(active.lower), list(active.upper)
     for k, d in enumerate(sensing.dims):
-        w = plan.task.initial_half_width[d]
+        w = base.initial_half_width[d]
         a, b = max(lo[d], point[k] - w), min(hi[d], point[k] + w)
         if not b > a:
             return None
