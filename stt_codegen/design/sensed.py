@@ -69,7 +69,7 @@ REGION_INTERVALS = 20_000
 FORESIGHT = 2.0
 #: Distances (state units) of the temporary goals an escape tube may go to from where the
 #: robot will be at the switch, in the order tried; 0 holds a box around that point.
-ESCAPE_DISTANCES = (0.0, 0.6, 1.2)
+ESCAPE_DISTANCES = (0.0, 0.6, 1.2, 2.4)
 #: Directions of the temporary goals, evenly spaced on the first two sensing dimensions.
 ESCAPE_DIRECTIONS = 16
 #: Seconds an escape tube takes to reach its temporary goal (then it holds it).
