@@ -255,16 +255,29 @@ def reachable_boxes(sensed: Sequence[SensedObstacle], speed: float, reach: float
     tuple of MovingObstacle
         Boxes that do not move, each present over its span.
     """
+    def box(ob: SensedObstacle, a: float, b: float) -> tuple[np.ndarray, np.ndarray]:
+        lo, hi = ob.reach_box(start + b, speed)
+        drift = None if acceleration is None else ob.drift_box(
+            start + a, start + b, acceleration, velocity_error)
+        if drift is not None:
+            lo, hi = np.maximum(lo, drift[0]), np.minimum(hi, drift[1])
+        return lo, hi
+
+    return _span_boxes(sensed, box, reach, dims, t_from, t_to, first_source, chunk)
+
+
+def _span_boxes(sensed: Sequence[SensedObstacle], box, reach: float, dims: Sequence[int],
+                t_from: float, t_to: float, first_source: int,
+                chunk: float) -> tuple[MovingObstacle, ...]:
+    """Standing boxes, one per obstacle and span of at most ``chunk`` of
+    ``[t_from, t_to]``: ``box(ob, a, b)`` (lower and upper corners over ``[a, b]``) grown
+    by ``reach``, present on ``[a, b]``, numbered from ``first_source``."""
     count = max(1, math.ceil((t_to - t_from) / chunk - 1e-9))
     edges = np.linspace(t_from, t_to, count + 1)
     out: list[MovingObstacle] = []
     for ob in sensed:
         for a, b in zip(edges[:-1], edges[1:]):
-            lo, hi = ob.reach_box(start + float(b), speed)
-            drift = None if acceleration is None else ob.drift_box(
-                start + float(a), start + float(b), acceleration, velocity_error)
-            if drift is not None:
-                lo, hi = np.maximum(lo, drift[0]), np.minimum(hi, drift[1])
+            lo, hi = box(ob, float(a), float(b))
             half = (hi - lo) / 2 + reach
             out.append(MovingObstacle(
                 source=first_source + len(out), dims=tuple(int(d) for d in dims),
@@ -742,21 +755,12 @@ def foresight_boxes(sensed: Sequence[SensedObstacle], reach: float, dims: Sequen
     >>> [(b.active, b.centres[0]) for b in boxes]
     [((1.0, 1.5), (4.125, 2.0)), ((1.5, 2.0), (4.375, 2.0))]
     """
-    count = max(1, math.ceil((t_to - t_from) / chunk - 1e-9))
-    edges = np.linspace(t_from, t_to, count + 1)
-    out: list[MovingObstacle] = []
-    for ob in sensed:
+    def box(ob: SensedObstacle, a: float, b: float) -> tuple[np.ndarray, np.ndarray]:
         moving = ob if ob.velocity is not None else replace(
             ob, velocity=(0.0,) * len(ob.centre))
-        for a, b in zip(edges[:-1], edges[1:]):
-            lo, hi = moving.drift_box(start + float(a), start + float(b), 0.0, velocity_error)
-            half = (hi - lo) / 2 + reach
-            out.append(MovingObstacle(
-                source=first_source + len(out), dims=tuple(int(d) for d in dims),
-                half_size=tuple(float(v) for v in half), times=(float(a),),
-                centres=(tuple(float(v) for v in (hi + lo) / 2),),
-                active=(float(a), float(b)), motion="still"))
-    return tuple(out)
+        return moving.drift_box(start + a, start + b, 0.0, velocity_error)
+
+    return _span_boxes(sensed, box, reach, dims, t_from, t_to, first_source, chunk)
 
 
 def _new_local(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
