@@ -788,22 +788,35 @@ def _to_target(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     region): the new plan's fields, or why not and the failure's kind."""
     rooms = []
     for slower in SLOWER:
-        new_local = _new_local(base, box, moving, remaining * slower)
+        within = remaining * slower
         try:
-            new = design_tube(replace(new_local,
-                                      moving_obstacles=new_local.moving_obstacles + boxes))
+            made = _new_plan(_new_local(base, box, moving, within), boxes, sensing, s, t_m,
+                             t_s, t_s + within, first)
         except DesignError as exc:
             return (f"no tube from the box at t = {t_s:.4f} s to the target within "
-                    f"{remaining * slower:.4g} s: {exc}", "design")
-        room, at = region_margin(new, sensing, _reach(base), t_s, t_m, s, 0.0,
-                                 sensing.horizon)
-        if room > ROUNDING_MARGIN:
-            return dict(design=new, local=new_local, start=t_s, certified_from=t_s,
-                        switch_at=t_s, arrival=t_s + remaining * slower, kept=False,
-                        sensed_margin=_sensed_margin(new, first), region_margin=room)
-        rooms.append(f"{room:.3g} at t = {t_s + at:.4f} s within {remaining * slower:.4g} s")
+                    f"{within:.4g} s: {exc}", "design")
+        if isinstance(made, dict):
+            return made
+        room, at = made
+        rooms.append(f"{room:.3g} at t = {t_s + at:.4f} s within {within:.4g} s")
     return ("the new tube may leave the region no unseen obstacle can reach, even slower "
             "(room " + "; ".join(rooms) + ")", "region")
+
+
+def _new_plan(local: Spec, boxes: tuple[MovingObstacle, ...], sensing: Sensing,
+              s: np.ndarray, t_m: float, t_s: float, arrival: float, first: int,
+              goal: Box | None = None) -> dict | tuple[float, float]:
+    """A new tube for ``local`` designed against the sensed obstacles' ``boxes`` too, held
+    to the region certificate: the plan's fields, or the room and where it is smallest
+    (in the tube's time) when the tube leaves the region. :class:`DesignError` when no
+    tube is designed."""
+    new = design_tube(replace(local, moving_obstacles=local.moving_obstacles + boxes))
+    room, at = region_margin(new, sensing, _reach(local), t_s, t_m, s, 0.0, sensing.horizon)
+    if room <= ROUNDING_MARGIN:
+        return room, at
+    return dict(design=new, local=local, start=t_s, certified_from=t_s, switch_at=t_s,
+                arrival=arrival, kept=False, sensed_margin=_sensed_margin(new, first),
+                region_margin=room, goal=goal)
 
 
 def _predicted(plan: SensedPlan, active: Box, s: np.ndarray, t_m: float,
@@ -887,16 +900,13 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
         local = _new_local(replace(base, tube=replace(base.tube, method="paper")), box,
                            moving, ESCAPE_TIME, goal)
         try:
-            new = design_tube(replace(local, moving_obstacles=local.moving_obstacles + boxes))
+            made = _new_plan(local, boxes, sensing, s, t_m, t_s, t_s + ESCAPE_TIME, first,
+                             goal)
         except DesignError as exc:
             reasons.append(f"{exc.kind}")
             continue
-        room, _ = region_margin(new, sensing, reach, t_s, t_m, s, 0.0, sensing.horizon)
-        if room > ROUNDING_MARGIN:
-            return dict(design=new, local=local, start=t_s, certified_from=t_s,
-                        switch_at=t_s, arrival=t_s + ESCAPE_TIME, kept=False,
-                        sensed_margin=_sensed_margin(new, first), region_margin=room,
-                        goal=goal)
+        if isinstance(made, dict):
+            return made
         reasons.append("region")
     if not ranked:
         return "no temporary goal inside the state space and clear of the obstacles"
