@@ -23,8 +23,8 @@ if TYPE_CHECKING:
     from ..spec.loader import Spec
 
 __all__ = ["add_backend_argument", "add_json_argument", "add_quiet_argument",
-           "add_seed_argument", "add_spec_argument", "checked_seed", "design_spec",
-           "load_and_design", "print_json", "progress_bar"]
+           "add_seed_argument", "add_spec_argument", "add_tube_data_argument", "checked_seed",
+           "design_spec", "load_and_design", "print_json", "progress_bar"]
 
 #: Seconds of work before the progress bar appears (shorter work shows none).
 BAR_DELAY = 2.0
@@ -230,3 +230,20 @@ def load_and_design(args: argparse.Namespace) -> Design:
     """
     from ..spec.loader import load_spec
     return design_spec(load_spec(args.spec), args)
+
+
+def add_tube_data_argument(p: argparse.ArgumentParser) -> None:
+    """``--tube-data [SEGMENTS,WINDOWS]`` (``generate``, ``embedded``): the C whose tube is
+    data (:mod:`stt_codegen.codegen.tube_data`); ``args.tube_data`` is ``None`` or the text.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The subcommand's parser.
+    """
+    from ..codegen.tube_data import DEFAULT_CAPACITY
+    default = f"{DEFAULT_CAPACITY.segments},{DEFAULT_CAPACITY.windows}"
+    p.add_argument("--tube-data", nargs="?", metavar="SEGMENTS,WINDOWS", const=default,
+                   help="C whose tube is data, replaced at run time by P_switch, holding up "
+                        "to SEGMENTS reach segments and WINDOWS circumvent windows "
+                        f"(default {default}; docs/sensing.md)")

@@ -6,7 +6,9 @@ import argparse
 from pathlib import Path
 
 from ..codegen.options import LANGUAGES, PRECISIONS, parse_options
-from .common import add_spec_argument, load_and_design
+from ..codegen.tube_data import parse_capacity
+from ..errors import SpecError
+from .common import add_spec_argument, add_tube_data_argument, load_and_design
 
 __all__ = ["cmd_generate", "configure_generate"]
 
@@ -17,7 +19,9 @@ def cmd_generate(args: argparse.Namespace) -> int:
     Parameters
     ----------
     args : argparse.Namespace
-        ``spec``, ``out_dir``, ``languages`` (comma-separated) and ``precision``.
+        ``spec``, ``out_dir``, ``languages`` (comma-separated; ``None``: C and Python, or C
+        alone with ``tube_data``), ``precision`` and ``tube_data`` (``None`` or
+        ``"SEGMENTS,WINDOWS"``).
 
     Returns
     -------
@@ -27,23 +31,31 @@ def cmd_generate(args: argparse.Namespace) -> int:
     Raises
     ------
     SpecError
-        A bad spec, language list or precision (exit code 2).
+        A bad spec, language list, precision or capacity (exit code 2).
     DesignError
         No design (exit code 1).
     ToolchainError
         The code generator failed (exit code 3).
     """
     from .fleet import fleet_generate, fleet_of
+    capacity = None if args.tube_data is None else parse_capacity(args.tube_data)
+    if args.languages is None:
+        args.languages = "c" if capacity is not None else ",".join(LANGUAGES)
     fleet = fleet_of(args)            # a fleet file: one design per robot (docs/fleets.md)
     if fleet is not None:
+        if capacity is not None:
+            raise SpecError("tube_data", "a fleet's robots run their designed tubes: "
+                                         "--tube-data is for one spec")
         return fleet_generate(args, fleet)
     from ..codegen.api import generate
-    parse_options(args.languages, args.precision)   # bad options fail before the design
+    parse_options(args.languages, args.precision, capacity)   # bad options fail first
     design = load_and_design(args)
     files = generate(design, Path(args.out_dir), languages=args.languages,
-                     precision=args.precision)
+                     precision=args.precision, tube_data=capacity)
+    form = "" if capacity is None else (f", the tube as data: {capacity.segments} segments, "
+                                        f"{capacity.windows} windows")
     print(f"wrote {len(files)} files for {design.spec.name} ({args.languages}, "
-          f"{args.precision}) into {args.out_dir}")
+          f"{args.precision}{form}) into {args.out_dir}")
     return 0
 
 
@@ -53,14 +65,16 @@ def configure_generate(p: argparse.ArgumentParser) -> None:
     Parameters
     ----------
     p : argparse.ArgumentParser
-        The subcommand's parser; gets ``SPEC``, ``--out``, ``--lang``, ``--precision`` and
-        the ``handler`` :func:`cmd_generate`.
+        The subcommand's parser; gets ``SPEC``, ``--out``, ``--lang``, ``--precision``,
+        ``--tube-data`` and the ``handler`` :func:`cmd_generate`.
     """
     add_spec_argument(p)
     p.add_argument("-o", "--out", dest="out_dir", required=True, metavar="DIR",
                    help="output folder (created; only files of a previous generation are replaced)")
-    p.add_argument("--lang", dest="languages", default=",".join(LANGUAGES), metavar="LANGS",
-                   help="comma-separated subset of: %(default)s")
+    p.add_argument("--lang", dest="languages", default=None, metavar="LANGS",
+                   help=f"comma-separated subset of: {','.join(LANGUAGES)} (default: both; "
+                        f"c with --tube-data)")
     p.add_argument("--precision", default="double", choices=PRECISIONS,
                    help="floating-point type of the C code (default: %(default)s)")
+    add_tube_data_argument(p)
     p.set_defaults(handler=cmd_generate)

@@ -6,8 +6,10 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ..design.result import Design, require_design
+from ..errors import SpecError
 from ..spec.variants import variant_of
 from .options import LANGUAGES, Options, parse_options
+from .tube_data import TubeCapacity
 from .output import write_generation
 
 __all__ = ["design_files", "generate"]
@@ -32,13 +34,24 @@ def design_files(design: Design, options: Options) -> dict[str, bytes]:
         for a second-order one, the look-ahead controller
         (:func:`~.look_ahead_source.look_ahead_generation`, docs/differential-drive.md)
         for a differential-drive base.
+
+    Raises
+    ------
+    SpecError
+        ``options.tube_data`` for a variant whose C does not take its tube as data (field
+        ``tube_data``).
     """
-    return variant_of(design.spec).entry("generation")(design, options)
+    variant = variant_of(design.spec)
+    if options.tube_data is not None and not variant.tube_data:
+        raise SpecError("tube_data", f"the tube as data is generated for law (13)'s "
+                                     f"controller only, not for {variant.plant_words}")
+    return variant.entry("generation")(design, options)
 
 
 def generate(design: Design, out_dir: str | Path,
              languages: str | Sequence[str] = LANGUAGES,
-             precision: str = "double") -> list[Path]:
+             precision: str = "double",
+             tube_data: bool | TubeCapacity = False) -> list[Path]:
     """Write the standalone controller of a designed tube into a folder.
 
     What ``stt-codegen generate SPEC -o DIR`` writes: for C, ``P.h`` and ``P.c`` (C99,
@@ -64,6 +77,11 @@ def generate(design: Design, out_dir: str | Path,
     precision : {"double", "single"}, optional
         Floating-point type of the C code (``double`` or ``float``); the Python module
         always computes in Python floats.
+    tube_data : bool or TubeCapacity, optional
+        C whose tube is data (``True``: 8 segments and 32 windows): every function takes
+        a ``P_tube_data``, ``P_switch`` replaces the active tube at run time where the
+        state lies in the new one (docs/sensing.md, "The tube as data"); C only, law
+        (13)'s controller only. Default ``False``: the tube in ``const`` tables.
 
     Returns
     -------
@@ -77,7 +95,8 @@ def generate(design: Design, out_dir: str | Path,
         or a ``Spec``, say): call :func:`stt_codegen.design_tube` first.
     SpecError
         Unknown language (field ``languages``) or precision (``precision``); an unusable
-        or foreign output folder (``out_dir``).
+        or foreign output folder (``out_dir``); the tube as data with Python, for another
+        variant, or smaller than the spec's tube (``tube_data``).
     ToolchainError
         ``CodegenError`` or ``EmitError``: the model could not be turned into code.
 
@@ -98,7 +117,7 @@ def generate(design: Design, out_dir: str | Path,
      'omnirobot_s1_selftest.c', 'omnirobot_s1_vectors.json']
     """
     design = require_design(design, "generate")
-    options = parse_options(languages, precision)
+    options = parse_options(languages, precision, tube_data or None)
     files = design_files(design, options)
     write_generation(out_dir, files)
     return [Path(out_dir) / name for name in sorted(files)]

@@ -34,13 +34,16 @@ from ..tube.parameters import LOWER, UPPER
 __all__ = ["clamped_control", "deployed_functions"]
 
 
-def deployed_functions(model: TubeModel) -> list[ca.Function]:
+def deployed_functions(model: TubeModel, every: bool = False) -> list[ca.Function]:
     """The deployed SX Functions of a design, in generation order.
 
     Parameters
     ----------
     model : TubeModel
         The design's CasADi model.
+    every : bool, optional
+        Every profile and both kinds of bounds, whatever the design uses: for the tube as
+        data (:mod:`.tube_data`), which runs any tube of the spec's dimension.
 
     Returns
     -------
@@ -49,6 +52,9 @@ def deployed_functions(model: TubeModel) -> list[ca.Function]:
         for the design's dimension, profiles, circumvent counts and actuator bound).
     """
     design = model.design
+    if every:
+        return P.deployed_pieces(design.dimension, P.PROFILE_NAMES,
+                                 saturated=design.input_bound is not None)
     profiles = tuple(sorted({segment.profile for segment in design.segments}))
     members = [len(design.circumvents_on(i, side)) for i in range(design.dimension)
                for side in (LOWER, UPPER)]

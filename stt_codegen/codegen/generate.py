@@ -24,6 +24,7 @@ from .emit import CPrinter, lower, python_source
 from ..tube.model import build_model
 from ..spec.loader import Spec
 from ..design.prediction import delay_predictor
+from ..design.search import MAX_INITIAL_ERROR
 from ..tube.parameters import NEWTON_ITERATIONS, PERIOD_TOLERANCE, TubeDesign
 from . import tolerance
 from .functions import deployed_functions
@@ -32,6 +33,8 @@ from .fileset import (GENERATOR, MANIFEST, build_files, manifest, selftest_file,
 from .options import Options
 from .render import c_identifier, c_real, render
 from .tables import design_table_rows
+from .tube_data import TubeCapacity, require_capacity, table_names, table_shape
+from ..tube.pieces import error_transform
 from ..tube.pieces import PROFILE_NAMES
 from .vectors import test_vectors
 
@@ -64,7 +67,11 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
     prefix = c_identifier(spec.c_name)
     single = options.precision == "single"
     predictor = delay_predictor(spec, design, None)
-    functions = [*deployed_functions(build_model(design)),
+    capacity = options.tube_data
+    if capacity is not None:
+        require_capacity(design, capacity)
+    functions = [*deployed_functions(build_model(design), capacity is not None),
+                 *([error_transform(design.dimension)] if capacity is not None else []),
                  *([predictor] if predictor is not None else [])]
     limits = input_limits(design)
     common = {
@@ -76,7 +83,8 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
     files: dict[str, str] = {}
     vectors = test_vectors(design, options.precision)
     if "c" in options.langs:
-        c_ctx = dict(common, **c_source_context(design, prefix, options.precision, functions),
+        c_ctx = dict(common, **c_source_context(design, prefix, options.precision, functions,
+                                                capacity),
                      **timing_context(design.rate_hz, (spec.delay, spec.jitter),
                                       lambda v: c_real(v, single)))
         for name, template in ((f"{prefix}.h", "c_header.h.j2"), (f"{prefix}.c", "c_source.c.j2")):
@@ -126,7 +134,7 @@ def first_order_generation(design, options: Options) -> dict[str, bytes]:
 
 
 def c_source_context(design: TubeDesign, prefix: str, precision: str,
-                     functions: list) -> dict:
+                     functions: list, capacity: TubeCapacity | None = None) -> dict:
     """The variables of ``templates/c_source.c.j2`` and ``c_header.h.j2`` that depend on the
     design: the printed bodies, the tables, the input domain, the actuator bound.
 
@@ -139,6 +147,9 @@ def c_source_context(design: TubeDesign, prefix: str, precision: str,
     precision : {"double", "single"}
     functions : list of casadi.Function
         The pieces whose bodies are printed (``body_<name>``), in order.
+    capacity : TubeCapacity, optional
+        The tube as data with these capacities (:mod:`.tube_data`); ``None`` (default): the
+        design's tube in ``const`` tables.
 
     Returns
     -------
@@ -148,11 +159,14 @@ def c_source_context(design: TubeDesign, prefix: str, precision: str,
     single = precision == "single"
     limits = input_limits(design)
     bodies = CPrinter(precision, real=f"{prefix}_real", prefix="body_")
+    tables = design_table_rows(design, lambda v: c_real(v, single), single)
     return dict(P=prefix, U=prefix.upper(), n=design.dimension, newton=NEWTON_ITERATIONS,
                 newton_stop=c_real(tolerance.NEWTON_STOP_SINGLE, True) if single else None,
                 real="float" if single else "double", precision=precision,
                 bodies=bodies.doprint(functions).rstrip("\n"),
-                spec_tables=design_table_rows(design, lambda v: c_real(v, single), single),
+                spec_tables=tables, T=table_names(prefix, capacity is not None),
+                max_initial_error=c_real(MAX_INITIAL_ERROR, single),
+                shape=table_shape(tables, capacity), capacity=capacity,
                 profile_codes={name: k for k, name in enumerate(PROFILE_NAMES)},
                 guard=f"{prefix.upper()}_H", zero=c_real(0.0, single),
                 period_tolerance=c_real(PERIOD_TOLERANCE, single),

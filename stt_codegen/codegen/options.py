@@ -1,4 +1,5 @@
-"""Options of ``stt-codegen generate``: target languages and floating-point precision."""
+"""Options of ``stt-codegen generate``: target languages, floating-point precision, and
+whether the C takes its tube as data."""
 
 from __future__ import annotations
 
@@ -6,6 +7,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ..errors import SpecError
+from .tube_data import DEFAULT_CAPACITY, TubeCapacity
 
 __all__ = ["LANGUAGES", "Options", "PRECISIONS", "parse_options"]
 
@@ -25,18 +27,26 @@ class Options:
         Subset of :data:`LANGUAGES`, canonical order, non-empty.
     precision : str
         One of :data:`PRECISIONS`; applies to the C code (and the vectors' tolerances).
+    tube_data : TubeCapacity or None
+        The C takes its tube as data, up to these sizes (:mod:`.tube_data`); ``None``
+        (default): the design's tube in ``const`` tables.
     """
 
     langs: tuple[str, ...] = LANGUAGES
     precision: str = "double"
+    tube_data: TubeCapacity | None = None
 
     def to_json(self) -> dict:
-        return {"langs": list(self.langs), "precision": self.precision}
+        out = {"langs": list(self.langs), "precision": self.precision}
+        if self.tube_data is not None:
+            out["tube_data"] = self.tube_data.to_json()
+        return out
 
 
-def parse_options(langs: str | Sequence[str] = "c,python", precision: str = "double") -> Options:
+def parse_options(langs: str | Sequence[str] = "c,python", precision: str = "double",
+                  tube_data: bool | TubeCapacity | None = None) -> Options:
     """Validate the languages (comma-separated, or a sequence such as a list, a tuple or a
-    numpy array of strings) and the precision.
+    numpy array of strings), the precision and the tube as data.
 
     Parameters
     ----------
@@ -44,17 +54,22 @@ def parse_options(langs: str | Sequence[str] = "c,python", precision: str = "dou
         Languages among :data:`LANGUAGES` (``"c"``, ``"python"``).
     precision : str
         One of :data:`PRECISIONS` (``"double"``, ``"single"``).
+    tube_data : bool or TubeCapacity, optional
+        The C takes its tube as data (``True``: :data:`~.tube_data.DEFAULT_CAPACITY`); C
+        only.
 
     Returns
     -------
     Options
-        The languages in :data:`LANGUAGES` order, without repeats, and the precision.
+        The languages in :data:`LANGUAGES` order, without repeats, the precision and the
+        tube's capacity (``None``: tables).
 
     Raises
     ------
     SpecError
         Unknown or empty language list (field ``languages``; ``--lang`` on the command
-        line), unknown precision (field ``precision``).
+        line), unknown precision (field ``precision``), the tube as data with Python
+        (field ``tube_data``).
     """
     items = [s.strip() for s in langs.split(",")] if isinstance(langs, str) else list(langs)
     if not items or any(not s for s in items):
@@ -65,4 +80,10 @@ def parse_options(langs: str | Sequence[str] = "c,python", precision: str = "dou
     if precision not in PRECISIONS:
         raise SpecError("precision", f"unknown precision {precision!r} "
                                        f"(known: {', '.join(PRECISIONS)})")
-    return Options(tuple(s for s in LANGUAGES if s in items), precision)
+    capacity = DEFAULT_CAPACITY if tube_data is True else (tube_data or None)
+    if capacity is not None and not isinstance(capacity, TubeCapacity):
+        raise SpecError("tube_data", f"expected True or a TubeCapacity, got {tube_data!r}")
+    if capacity is not None and "python" in items:
+        raise SpecError("tube_data", "the tube as data is generated in C only: use "
+                                     "languages 'c' (--lang c)")
+    return Options(tuple(s for s in LANGUAGES if s in items), precision, capacity)

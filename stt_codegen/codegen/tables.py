@@ -18,7 +18,7 @@ from ..tube.model import design_tables, segment_rows
 from ..tube.parameters import TubeDesign
 from ..tube.pieces import PROFILE_NAMES
 
-__all__ = ["design_table_rows"]
+__all__ = ["PARAMETERS", "Tables", "design_table_rows", "max_open"]
 
 #: Tube parameters in table order: (field, attribute of TubeDesign, comment).
 PARAMETERS = (

@@ -111,6 +111,10 @@ class ControllerVariant:
         ``[sensing]`` is available: tubes are replanned around obstacles sensed at run time
         and switched at a sample (:mod:`stt_codegen.design.sensed`, docs/sensing.md); only
         law (13)'s variant so far.
+    tube_data : bool
+        ``generate --tube-data`` is available: the generated C takes its tube as data and
+        switches tubes at run time (:mod:`stt_codegen.codegen.tube_data`, docs/sensing.md);
+        only law (13)'s variant so far.
     timing_in_stage : bool
         The certificate of its stage (:attr:`~stt_codegen.design.result.Design.stage`)
         proves ``[controller] delay`` and ``jitter`` (the cascade's); else the design's
@@ -138,6 +142,7 @@ class ControllerVariant:
     timing_in_stage: bool = False
     predicts_delay: bool = False
     replans_sensed: bool = False
+    tube_data: bool = False
 
     def entry(self, role: str) -> Callable[..., Any]:
         """The variant's function (or class) for one role, imported on first use.
@@ -222,7 +227,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                output_limits=_P + "design.output_bound:no_output_limits",
                predictor=_P + "tube.variant_steps:law13_predictor",
                input_gain=_P + "spec.input_gains:declared_input_gain"),
-        predicts_delay=True, replans_sensed=True),
+        predicts_delay=True, replans_sensed=True, tube_data=True),
     "cascade": ControllerVariant(
         "cascade", "a second-order plant", "the cascade's input u", 2,
         " (positions, then velocities)",

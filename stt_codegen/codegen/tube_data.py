@@ -1,0 +1,191 @@
+"""The tube as data: the generated C whose tube is an argument, replaced at run time.
+
+With a :class:`TubeCapacity` the generated C (first order) keeps no tube in ``const``
+tables: every function takes a ``const <P>_tube_data*`` (the parameters, state-space bounds,
+reach segments and circumvent windows of one tube, in the tables' order, up to the
+capacity's counts), ``<P>_tube_check`` says whether a tube is well formed, and
+``<P>_switch`` / ``<P>_run`` change the active tube at a sample where the state lies in the
+new one (docs/sensing.md, "The tube as data"). The bodies are the same pieces as the
+tables' code, composed the same way, so a tube run as data computes what the CasADi model
+of that tube computes, bit for bit in double precision.
+
+This module holds what the template needs to print either form: the names of the tables
+(:func:`table_names`) and which code paths are emitted (:func:`table_shape`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import SpecError
+from ..tube.parameters import TubeDesign
+from ..tube.pieces import PROFILE_NAMES
+from .tables import Tables
+
+__all__ = ["DEFAULT_CAPACITY", "TubeCapacity", "TableShape", "parse_capacity",
+           "require_capacity", "table_names", "table_shape"]
+
+
+@dataclass(frozen=True)
+class TubeCapacity:
+    """How large a tube the data form holds: the sizes of ``<P>_tube_data``'s arrays.
+
+    Attributes
+    ----------
+    segments : int
+        Reach segments of eq. (4) (``<P>_MAX_SEGMENTS``), at least 1.
+    windows : int
+        Circumvent windows of eqs. (7)-(9) (``<P>_MAX_WINDOWS``), at least 1; also the size
+        of the work arrays of the open windows.
+
+    Raises
+    ------
+    SpecError
+        A count below 1 or above 4096 (field ``tube_data``).
+
+    Examples
+    --------
+    >>> from stt_codegen.codegen.tube_data import TubeCapacity
+    >>> TubeCapacity(8, 32)
+    TubeCapacity(segments=8, windows=32)
+    """
+
+    segments: int = 8
+    windows: int = 32
+
+    def __post_init__(self) -> None:
+        for name in ("segments", "windows"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= 4096:
+                raise SpecError("tube_data", f"{name} must be a whole number from 1 to 4096, "
+                                             f"got {value!r}")
+
+    def to_json(self) -> dict:
+        return {"segments": self.segments, "windows": self.windows}
+
+
+#: The capacity of ``--tube-data`` without numbers.
+DEFAULT_CAPACITY = TubeCapacity()
+
+
+def parse_capacity(text: str) -> TubeCapacity:
+    """``"SEGMENTS,WINDOWS"`` (``--tube-data``) as a capacity.
+
+    Parameters
+    ----------
+    text : str
+        Two whole numbers separated by a comma.
+
+    Returns
+    -------
+    TubeCapacity
+
+    Raises
+    ------
+    SpecError
+        Not two whole numbers from 1 to 4096 (field ``tube_data``).
+
+    Examples
+    --------
+    >>> from stt_codegen.codegen.tube_data import parse_capacity
+    >>> parse_capacity("4,16")
+    TubeCapacity(segments=4, windows=16)
+    """
+    parts = [p.strip() for p in str(text).split(",")]
+    if len(parts) != 2 or not all(p.isdigit() for p in parts):
+        raise SpecError("tube_data", f"expected SEGMENTS,WINDOWS (two whole numbers), got "
+                                     f"{text!r}")
+    return TubeCapacity(int(parts[0]), int(parts[1]))
+
+
+@dataclass(frozen=True)
+class TableShape:
+    """Which code paths the composition emits.
+
+    Attributes
+    ----------
+    windows : bool
+        Some circumvent window exists (the open-window search and ``bump``).
+    single : bool
+        Some bound has exactly one circumvent (``fnu_single``).
+    multi : bool
+        Some bound has several (``F_nu``).
+    profiles : list of str
+        The reach profiles whose bodies are called.
+    """
+
+    windows: bool
+    single: bool
+    multi: bool
+    profiles: list
+
+
+def table_names(prefix: str, data: bool) -> dict[str, str]:
+    """The C text of each table the composition reads, and of the tube argument.
+
+    Parameters
+    ----------
+    prefix : str
+        The C prefix.
+    data : bool
+        The tube is data (``tube->...``), else the ``const`` tables (``<P>_...``).
+
+    Returns
+    -------
+    dict of str to str
+        ``parameters``, ``bound``, ``members``, ``n_multi``, ``multi``, ``segments``,
+        ``n_segments``, ``windows``, ``n_windows``; ``arg`` (the parameter that starts
+        every function's list), ``call`` (the argument that starts every call),
+        ``usable`` (the first test of a public function's input check) and ``design``
+        (the first argument of a call on the spec's own tube), empty for tables.
+    """
+    fields = ("parameters", "bound", "members", "n_multi", "multi", "segments", "n_segments",
+              "windows", "n_windows")
+    if not data:
+        names = {f: f"{prefix.upper()}_{f.upper()}" for f in fields}
+        return dict(names, arg="", call="", usable="", design="")
+    names = {f: f"tube->{f}" for f in fields}
+    return dict(names, arg=f"const {prefix}_tube_data* tube, ", call="tube, ",
+                usable=f"({prefix}_tube_usable(tube) != 0) && ",
+                design=f"&{prefix}_design_tube, ")
+
+
+def table_shape(tables: Tables, capacity: TubeCapacity | None) -> TableShape:
+    """The code paths of a design's tables, or every path for the data form.
+
+    Parameters
+    ----------
+    tables : Tables
+        The design's printed tables.
+    capacity : TubeCapacity or None
+        The data form's capacity, or ``None`` for the tables.
+
+    Returns
+    -------
+    TableShape
+    """
+    if capacity is not None:
+        return TableShape(True, True, True, list(PROFILE_NAMES))
+    return TableShape(bool(tables.windows), 1 in tables.members, bool(tables.multi),
+                      list(tables.profiles))
+
+
+def require_capacity(design: TubeDesign, capacity: TubeCapacity) -> None:
+    """Refuse a capacity the design's own tube does not fit in.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The spec's tube (printed as ``<P>_design_tube``).
+    capacity : TubeCapacity
+
+    Raises
+    ------
+    SpecError
+        More segments or circumvents than the capacity (field ``tube_data``).
+    """
+    for name, count in (("segments", len(design.segments)),
+                        ("windows", len(design.circumvents))):
+        if count > getattr(capacity, name):
+            raise SpecError("tube_data", f"the spec's tube has {count} {name}, more than the "
+                                         f"capacity's {getattr(capacity, name)}")
