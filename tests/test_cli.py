@@ -120,8 +120,12 @@ def test_demo_generates_code_and_runs_the_c_controller(tmp_path):
         assert name in out.stdout
         assert (tmp_path / "demo" / f"{name}.png").stat().st_size > 10_000
         c_name = name.replace("-", "_")
-        for suffix in (".c", ".h", ".py", "_selftest.c"):
+        sensed = name == "hall-crossing"        # the C with the tube as data, no Python
+        for suffix in (".c", ".h", "_selftest.c") + (() if sensed else (".py",)):
             assert (tmp_path / "demo" / name / f"{c_name}{suffix}").is_file()
+    header = (tmp_path / "demo" / "hall-crossing" / "hall_crossing.h").read_text()
+    assert "hall_crossing_switch(" in header
+    assert "hall-crossing: the C with the tube as data" in out.stdout
     for name in ("second-order-s1", "second-order-quadrotor", "office-base"):   # the variants
         assert name in out.stdout
         assert (tmp_path / "demo" / f"{name}.png").stat().st_size > 10_000

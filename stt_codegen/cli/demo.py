@@ -32,8 +32,15 @@ def _run_case(name: str, spec: Spec, args: argparse.Namespace,
     out = Path(args.out)
     try:
         design = design_spec(spec, args)
-        generate(design, out / name)
-        result = simulate(design, backend=args.backend)   # the cascade's for second order
+        if spec.sensing is None:
+            generate(design, out / name)
+            result = simulate(design, backend=args.backend)   # the cascade's for second order
+        else:
+            # the controller a robot runs when it senses obstacles: its tube is data,
+            # switched at run time; the bundled people are revealed only by sensing
+            from ..runtime.sensed import bundled_people, simulate_sensed
+            generate(design, out / name, languages="c", tube_data=True)
+            result = simulate_sensed(design, bundled_people(name), backend=args.backend)
         atomic_write(out / f"{name}.png",
                      lambda tmp: plot_run(design, result, tmp, dims=dims))
     except SttError as exc:
@@ -141,8 +148,11 @@ def cmd_demo(args: argparse.Namespace) -> int:
     jobs = demo_jobs(args, len(specs))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    sensed = [name for name, spec in specs.items() if spec.sensing is not None]
     print(f"For every bundled case: design the tube, generate the C and Python controllers "
-          f"into {out}/<case>/, and run the {args.backend} controller in closed loop.")
+          f"into {out}/<case>/, and run the {args.backend} controller in closed loop"
+          + (f" ({', '.join(sensed)}: the C with the tube as data, switched at run time "
+             f"around people sensed on the way)" if sensed else "") + ".")
     print(SUMMARY_HEADER, flush=True)
     # what a case needs of the arguments (the parser itself does not cross processes)
     case_args = argparse.Namespace(out=args.out, backend=args.backend)

@@ -300,6 +300,26 @@ def draw_inputs(ax: Axes, spec: Spec, result: SimulationResult) -> None:
     legend_right(ax)
 
 
+def draw_sensed(ax: Axes, spec: Spec, traj, dims: tuple[int, int]) -> None:
+    """The obstacles a run sensed (:func:`~.sensed.simulate_sensed`), when the arena shows
+    ``[sensing] dims``: each one's path, dotted, and its disc every 2 s with the robot's
+    place then."""
+    if traj.sensed_positions is None or spec.sensing is None \
+            or tuple(dims) != tuple(spec.sensing.dims[:2]):
+        return
+    every = max(1, int(round(2.0 * spec.rate_hz)))
+    for j, radius in enumerate(traj.sensed_radii):
+        path = traj.sensed_positions[:, j]
+        ax.plot(path[:, 0], path[:, 1], ":", color="tab:purple", lw=1.0,
+                label="sensed obstacle's path" if j == 0 else None)
+        for k in range(0, len(traj.t), every):
+            ax.add_patch(Circle(path[k], radius, fc="tab:purple", alpha=0.15, ec="none"))
+            ax.annotate(f"{traj.t[k]:.0f}", path[k], fontsize=6, ha="center", va="center")
+    for k in range(0, len(traj.t), every):
+        ax.annotate(f"{traj.t[k]:.0f}", traj.x[k, list(dims)], fontsize=6, color="k",
+                    xytext=(0, 4), textcoords="offset points", ha="center")
+
+
 def run_figure(design: Design, result: SimulationResult,
                dims: tuple[int, int] = DEFAULT_DIMS) -> Figure:
     """The figure of a closed-loop run: arena with the trajectory, the tube and the state
@@ -323,7 +343,10 @@ def run_figure(design: Design, result: SimulationResult,
     spec = design.spec
     traj = result.trajectory
     n = spec.dimension
-    g_l, g_u, _, _ = reference.adaptive_tube(design.tube, traj.t, traj.alpha)
+    if traj.gamma_L is not None:        # a run whose tube changed: the active tube's
+        g_l, g_u = traj.gamma_L, traj.gamma_U
+    else:
+        g_l, g_u, _, _ = reference.adaptive_tube(design.tube, traj.t, traj.alpha)
     fig, grid, ax = arena_figure(spec, n + 1, dims)
     if ax is not None:
         i, j = dims
@@ -331,6 +354,7 @@ def run_figure(design: Design, result: SimulationResult,
         ax.plot(traj.x[:, i], traj.x[:, j], "k--", lw=1.2, label="trajectory")
         ax.plot(traj.x[0, i], traj.x[0, j], "o", color="tab:blue", label="x(0)")
         mark_states(ax, spec, traj.t, traj.x, dims)    # at the moving obstacles' slice times
+        draw_sensed(ax, spec, traj, dims)
         verdict = "satisfied" if result.satisfied else "NOT satisfied"
         reach = "-" if result.reach_time is None else f"{result.reach_time:.3f}"
         ax.set_title(arena_title(spec, dims, f"{spec.name}: {verdict}, reach {reach} s"),

@@ -45,7 +45,7 @@ from .simulate import (RungeKutta, SimulationResult, Trajectory, hold_period,
                        sampling_offsets)
 from .state_split import initial_state, positions
 
-__all__ = ["PlanEvent", "SensingRecord", "WalkingObstacle", "simulate_sensed"]
+__all__ = ["PlanEvent", "SensingRecord", "WalkingObstacle", "bundled_people", "simulate_sensed"]
 
 
 @dataclass(frozen=True)
@@ -134,6 +134,39 @@ class WalkingObstacle:
             return np.stack([np.interp(t, rows[:, 0], rows[:, 1 + k])
                              for k in range(c.size)], axis=1)
         return np.repeat(c[None], t.size, axis=0)
+
+
+def bundled_people(name: str) -> tuple[WalkingObstacle, ...]:
+    """The people ``stt-codegen demo`` walks through a bundled case with ``[sensing]``:
+    obstacles its design does not know, revealed only by sensing.
+
+    Parameters
+    ----------
+    name : str
+        A bundled case with ``[sensing]`` (``"hall-crossing"``).
+
+    Returns
+    -------
+    tuple of WalkingObstacle
+        For ``hall-crossing``: a person (radius 0.3 m) walking up across the hall at
+        0.5 m/s from (5, 0.5), and another (0.35 m) walking down its far side from (7, 5.5)
+        at 0.625 m/s from t = 2 s, both within the envelope (0.4 m, 0.8 m/s).
+
+    Raises
+    ------
+    SpecError
+        No bundled people for that case (field ``case``).
+
+    Examples
+    --------
+    >>> from stt_codegen.runtime.sensed import bundled_people
+    >>> [p.radius for p in bundled_people("hall-crossing")]
+    [0.3, 0.35]
+    """
+    if name != "hall-crossing":
+        raise SpecError("case", f"no bundled people for {name!r} (known: hall-crossing)")
+    return (WalkingObstacle((5.0, 0.5), 0.3, velocity=(0.0, 0.5)),
+            WalkingObstacle((7.0, 5.5), 0.35, path=((2.0, 7.0, 5.5), (10.0, 7.0, 0.5))))
 
 
 @dataclass(frozen=True)
@@ -331,7 +364,9 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
         The obstacles the controller senses (on ``spec.sensing.dims``).
     backend : str
         The controller's backend (:func:`~.backends.backend_names`); default the CasADi
-        model (``"c"`` compiles a controller per tube, ``"reference"`` is ten times slower).
+        model (``"c"``: the spec's C with the tube as data, compiled once, each tube loaded
+        into it, :class:`~.data_controller.TubeDataController`; ``"reference"`` is ten
+        times slower).
     horizon : float, optional
         Simulated time, s; default ``t_c``.
     seed : int
@@ -441,7 +476,8 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
     pending: list[SensedPlan] = []
     reveals: list[tuple[int, tuple]] = []
     next_measure = 1
-    controller = make_controller(backend, active.design.tube, active.design.stage)
+    controller_of = _controllers(backend, design)
+    controller = controller_of(active.design)
     predict = delay_predictor(spec, active.design.tube, active.design.stage)
     alpha, u_prev = np.zeros(2 * n), np.zeros(n)
     dense, dense_t = [positions(spec, x[None])], [np.zeros(1)]
@@ -486,7 +522,7 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
                 continue
             active = plan
             designs.append(plan.design)
-            controller = make_controller(backend, plan.design.tube, plan.design.stage)
+            controller = controller_of(plan.design)
             predict = delay_predictor(spec, plan.design.tube, plan.design.stage)
             alpha = np.zeros(2 * n)
             record.switches += 1
@@ -562,6 +598,18 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
                    reach, record, stepper)
 
 
+def _controllers(backend: str, design: Design):
+    """``design -> controller`` of the backend: on ``c``, the spec's C with the tube as data
+    compiled once (:class:`~.data_controller.TubeDataController`) and each plan's tube loaded
+    into it, as a controller on the robot runs them; else the backend's controller of each
+    plan's tube."""
+    if backend == "c":
+        from .data_controller import TubeDataController
+        library = TubeDataController(design.tube)
+        return lambda plan_design: library.load(plan_design.tube)
+    return lambda plan_design: make_controller(backend, plan_design.tube, plan_design.stage)
+
+
 def _escape_words(plan: SensedPlan, spec) -> str:
     """``"; an escape to (x, y)"`` for a plan going to a temporary goal, else ``""``."""
     if plan.goal is None:
@@ -620,9 +668,11 @@ def _judged(design, backend, horizon, ts, states, us, alphas, status, tubes, sta
     reached = bool(in_target.any())
     clear = [u.signed_clearance(within) for u in spec.unsafe_sets]
     clear += [ob.signed_clearance(within, path_t[judged]) for ob in spec.moving_obstacles]
-    sensed_clear = None
+    sensed_clear, sampled = None, None
     if world.radius.size:
         where = np.vstack(obstacle_path).reshape(len(path_t), -1, len(dims))
+        sampled = np.stack([[np.interp(ts, path_t, where[:, j, c]) for c in range(len(dims))]
+                            for j in range(world.radius.size)]).transpose(2, 0, 1)
         gaps = (np.linalg.norm(path[:, None, dims] - where, axis=2) - world.radius[None]
                 - reach)
         sensed_clear = float(gaps.min())
@@ -643,12 +693,14 @@ def _judged(design, backend, horizon, ts, states, us, alphas, status, tubes, sta
     lo, hi = np.array(spec.state_space.lower), np.array(spec.state_space.upper)
     left = bool(np.any((within < lo) | (within > hi)))
     widths, errors = [], []
+    gamma_l, gamma_u = np.zeros_like(xs), np.zeros_like(xs)
     with reference.numpy_math():
         for q, d in enumerate(designs):
             rows = tubes == q
             if rows.any():
                 g_l, g_u, _, _ = reference.adaptive_tube(d.tube, ts[rows] - starts[rows],
                                                          alphas[rows])
+                gamma_l[rows], gamma_u[rows] = g_l, g_u
                 widths.append(g_u - g_l)
                 errors.append(np.abs(2.0 * xs[rows] - (g_u + g_l)) / (g_u - g_l))
     width = np.vstack(widths)
@@ -665,5 +717,8 @@ def _judged(design, backend, horizon, ts, states, us, alphas, status, tubes, sta
         max_abs_e=max_abs_e, max_abs_u=[float(v) for v in np.abs(us).max(axis=0)],
         steps=steps, control_effort=float(np.sum(us[:steps] ** 2) * dt),
         clamped_steps=int(np.sum(status == Status.INPUT_CLAMPED)),
-        trajectory=Trajectory(ts, xs, us, alphas, status, tube=tubes),
+        trajectory=Trajectory(ts, xs, us, alphas, status, tube=tubes, gamma_L=gamma_l,
+                              gamma_U=gamma_u, sensed_positions=sampled,
+                              sensed_radii=world.radius.copy() if sampled is not None
+                              else None),
         contacts=stepper.contact_count, sensing=record)

@@ -77,6 +77,16 @@ class Trajectory:
     tube : ndarray of int, shape (N,), or None
         A run with sensed obstacles (:func:`~.sensed.simulate_sensed`): the tube active at
         ``t_k`` (0: the design's, then each tube switched in); ``None`` otherwise.
+    gamma_L, gamma_U : ndarray, shape (N, n), or None
+        A run with sensed obstacles: the bounds of eq. (10) of the tube active at ``t_k``
+        (its own time, the run's ``alpha``; from the numpy oracle), state units; ``None``
+        otherwise (the design's tube, computed where needed).
+    sensed_positions : ndarray, shape (N, J, m), or None
+        A run with sensed obstacles: where each of the ``J`` obstacles of the world is at
+        ``t_k``, on the ``m`` dimensions ``[sensing] dims``, state units (seen or not);
+        ``None`` otherwise.
+    sensed_radii : ndarray, shape (J,), or None
+        Their radii, state units.
     """
 
     t: np.ndarray
@@ -87,6 +97,10 @@ class Trajectory:
     velocity: np.ndarray | None = None
     r: np.ndarray | None = None
     tube: np.ndarray | None = None
+    gamma_L: np.ndarray | None = None
+    gamma_U: np.ndarray | None = None
+    sensed_positions: np.ndarray | None = None
+    sensed_radii: np.ndarray | None = None
 
 
 @dataclass

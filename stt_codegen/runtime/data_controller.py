@@ -1,0 +1,176 @@
+"""Backend ``c`` for tubes that change at run time: one compiled controller, tubes as data.
+
+:class:`TubeDataController` generates the C of a spec with ``--tube-data``
+(:mod:`stt_codegen.codegen.tube_data`), compiles it once into the build cache and loads it
+with ``ctypes``; :meth:`~TubeDataController.load` packs any tube of the spec's dimension
+into the ``<P>_tube_data`` struct (the tables' order, :func:`~stt_codegen.codegen.tables.design_table_rows`)
+and returns a controller that runs it. :func:`~stt_codegen.runtime.sensed.simulate_sensed`
+runs its switched tubes this way on backend ``c``.
+"""
+
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+
+from ..codegen.generate import generate_files
+from ..codegen.options import Options
+from ..codegen.tables import PARAMETERS, design_table_rows
+from ..codegen.tube_data import TubeCapacity, require_capacity
+from ..tube.parameters import TubeDesign
+from .compiled import DesignSpec, build_shared
+
+__all__ = ["TubeDataController", "tube_struct"]
+
+
+def tube_struct(n: int, capacity: TubeCapacity, real=ctypes.c_double) -> type:
+    """The ``ctypes`` layout of ``<P>_tube_data`` (the generated header's).
+
+    Parameters
+    ----------
+    n : int
+        State dimension.
+    capacity : TubeCapacity
+        The arrays' sizes.
+    real : ctypes type, optional
+        ``c_double`` (default) or ``c_float``.
+
+    Returns
+    -------
+    type
+        A ``ctypes.Structure`` subclass.
+    """
+    m = 2 * n
+
+    class Parameters(ctypes.Structure):
+        _fields_ = [(field, real) for field, _, _ in PARAMETERS]
+
+    class Segment(ctypes.Structure):
+        _fields_ = [("start", real), ("end", real), ("profile", ctypes.c_int),
+                    ("from_", real * m), ("to", real * m)]
+
+    class Window(ctypes.Structure):
+        _fields_ = [(name, real) for name in ("start", "end", "center", "radius", "sharpness",
+                                              "height", "max_end")] + [("bound", ctypes.c_int)]
+
+    class Tube(ctypes.Structure):
+        _fields_ = [("parameters", Parameters), ("bound", real * m),
+                    ("members", ctypes.c_int * m), ("n_multi", ctypes.c_int),
+                    ("multi", ctypes.c_int * m), ("n_segments", ctypes.c_int),
+                    ("segments", Segment * capacity.segments), ("n_windows", ctypes.c_int),
+                    ("windows", Window * capacity.windows)]
+
+    return Tube
+
+
+class TubeDataController:
+    """The generated C (double) of a spec with the tube as data, compiled once.
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The spec's tube: its dimension, actuator bound and state space fix the generated
+        code; its own tube is ``<P>_design_tube``.
+    capacity : TubeCapacity, optional
+        The sizes of the tube's arrays; default 8 segments and 32 windows, or more when
+        the design has more.
+
+    Raises
+    ------
+    MissingTool, CodegenError
+        No C compiler, or it failed.
+    """
+
+    name = "c"
+
+    def __init__(self, design: TubeDesign, capacity: TubeCapacity | None = None) -> None:
+        capacity = capacity or TubeCapacity(max(8, len(design.segments)),
+                                            max(32, len(design.circumvents)))
+        spec = DesignSpec(design)
+        files = generate_files(spec, design, Options(("c",), "double", capacity))
+        prefix = spec.c_name
+        sources = {k: v for k, v in files.items() if k in (f"{prefix}.c", f"{prefix}.h")}
+        self._lib = ctypes.CDLL(str(build_shared(sources, f"{prefix}.c")))
+        self.n, self.capacity, self.design = design.dimension, capacity, design
+        self.struct = tube_struct(self.n, capacity)
+        ptr = ctypes.POINTER(ctypes.c_double)
+        tube_p = ctypes.POINTER(self.struct)
+        self._step = getattr(self._lib, f"{prefix}_step")
+        self._step.argtypes = [tube_p, ptr, ctypes.c_double, ctypes.c_double, ptr, ptr, ptr]
+        self._step.restype = ctypes.c_int
+        self._check = getattr(self._lib, f"{prefix}_tube_check")
+        self._check.argtypes, self._check.restype = [tube_p], ctypes.c_int
+        self.design_tube = self.struct.in_dll(self._lib, f"{prefix}_design_tube")
+        self._arrays = [np.zeros(size) for size in (self.n, 2 * self.n) * 2]
+
+    def pack(self, design: TubeDesign):
+        """``design`` as a ``<P>_tube_data`` (a :func:`tube_struct` instance).
+
+        Raises
+        ------
+        SpecError
+            The tube does not fit the capacity (field ``tube_data``).
+        """
+        require_capacity(design, self.capacity)
+        tables = design_table_rows(design, float, False)
+        tube = self.struct()
+        for field, value, _ in tables.parameters:
+            setattr(tube.parameters, field, value)
+        tube.bound[:] = tables.bounds
+        tube.members[:] = tables.members
+        tube.n_multi = len(tables.multi)
+        tube.multi[:len(tables.multi)] = tables.multi
+        tube.n_segments = len(tables.segments)
+        for j, row in enumerate(tables.segments):
+            s = tube.segments[j]
+            s.start, s.end, s.profile = row["start"], row["end"], row["profile"]
+            s.from_[:], s.to[:] = row["from"], row["to"]
+        tube.n_windows = len(tables.windows)
+        for j, row in enumerate(tables.windows):
+            w = tube.windows[j]
+            for name in ("start", "end", "center", "radius", "sharpness", "height", "max_end"):
+                setattr(w, name, row[name])
+            w.bound = row["bound"]
+        return tube
+
+    def check(self, tube) -> int:
+        """``<P>_tube_check`` of a packed tube (``0``: well formed)."""
+        return int(self._check(ctypes.byref(tube)))
+
+    def load(self, design: TubeDesign) -> "_Loaded":
+        """A controller running ``design``'s tube (packed, checked) on this library.
+
+        Raises
+        ------
+        SpecError
+            The tube does not fit the capacity, or ``<P>_tube_check`` refuses it (field
+            ``tube_data``).
+        """
+        from ..errors import SpecError
+        tube = self.pack(design)
+        code = self.check(tube)
+        if code != 0:
+            raise SpecError("tube_data", f"the generated C's tube check refused the tube "
+                                         f"(code {code}, docs/sensing.md)")
+        return _Loaded(self, tube)
+
+
+class _Loaded:
+    """``step(x, t, dt, alpha) -> (u, alpha_next, status)`` of one packed tube."""
+
+    name = "c"
+
+    def __init__(self, owner: TubeDataController, tube) -> None:
+        self.owner, self.tube = owner, tube
+
+    def step(self, x, t, dt, alpha):
+        o = self.owner
+        xs, a, u, nxt = o._arrays
+        xs[:] = np.reshape(x, o.n)
+        a[:] = np.reshape(alpha, 2 * o.n)
+        u.fill(0.0)
+        nxt.fill(0.0)
+        p = [v.ctypes.data_as(ctypes.POINTER(ctypes.c_double)) for v in (xs, a, u, nxt)]
+        status = o._step(ctypes.byref(self.tube), p[0], t, dt, p[1], p[2], p[3])
+        return u.copy(), nxt.copy(), int(status)
