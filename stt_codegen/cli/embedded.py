@@ -7,10 +7,11 @@ from pathlib import Path
 
 from ..embedded.budget import budget_words
 from ..errors import SpecError
-from .common import (add_json_argument, add_seed_argument, add_spec_argument, checked_seed,
-                     load_and_design, print_json)
+from .common import (add_json_argument, add_seed_argument, add_spec_argument,
+                     add_tube_data_argument, checked_seed, load_and_design, print_json)
 
-__all__ = ["cmd_embedded", "configure_embedded", "law13_command", "variant_loop_command"]
+__all__ = ["cmd_embedded", "configure_embedded", "law13_command", "tube_data_command",
+           "variant_loop_command"]
 
 
 def _judged(r: dict) -> str:
@@ -54,8 +55,9 @@ def cmd_embedded(args: argparse.Namespace) -> int:
     Parameters
     ----------
     args : argparse.Namespace
-        ``spec``, ``json``, ``seed``, ``build_dir`` (kept build folder or ``None``) and
-        ``no_host`` (skip the comparison with the host simulation).
+        ``spec``, ``json``, ``seed``, ``build_dir`` (kept build folder or ``None``),
+        ``no_host`` (skip the comparison with the host simulation) and ``tube_data``
+        (``None``, or a capacity: the tube as data's switches and steps instead).
 
     Returns
     -------
@@ -66,16 +68,66 @@ def cmd_embedded(args: argparse.Namespace) -> int:
     Raises
     ------
     SpecError
-        A bad spec, ``--seed`` or ``--build-dir`` whose folder does not exist (exit code 2).
+        A bad spec, ``--seed``, ``--tube-data`` or ``--build-dir`` whose folder does not
+        exist (exit code 2).
     ToolchainError
         The Arm toolchain or QEMU is missing or fails (exit code 3).
     """
     seed = checked_seed(args)
     if args.build_dir is not None and not Path(args.build_dir).parent.is_dir():
         raise SpecError("build_dir", f"folder {str(Path(args.build_dir).parent)!r} does not exist")
+    capacity = None
+    if args.tube_data is not None:
+        from ..codegen.tube_data import parse_capacity
+        capacity = parse_capacity(args.tube_data)
     design = load_and_design(args)
     from ..spec.variants import variant_of
-    return variant_of(design.spec).entry("embedded_command")(design, args, seed)
+    variant = variant_of(design.spec)
+    if capacity is not None:
+        if not variant.tube_data:
+            raise SpecError("tube_data", f"the tube as data is generated for law (13)'s "
+                                         f"controller only, not for {variant.plant_words}")
+        return tube_data_command(design, args, capacity)
+    return variant.entry("embedded_command")(design, args, seed)
+
+
+def tube_data_command(design, args: argparse.Namespace, capacity) -> int:
+    """``stt-codegen embedded SPEC --tube-data``: the tube as data on the Cortex-M4F
+    (:func:`~stt_codegen.embedded.tube_data_loop.run_tube_data`), summarised.
+
+    Parameters
+    ----------
+    design : Design
+        A first-order design.
+    args : argparse.Namespace
+        ``json``, ``build_dir``.
+    capacity : TubeCapacity
+        The data form's capacity.
+
+    Returns
+    -------
+    int
+        0 if the self-test passed and every switch and step was accepted, else 1.
+    """
+    from ..embedded.tube_data_loop import run_tube_data
+    r = run_tube_data(design, capacity, args.build_dir)
+    if args.json:
+        print_json(r)
+    else:
+        def span(counts):
+            return f"{round(sum(counts) / len(counts))} ({min(counts)}-{max(counts)})"
+        cost = r["cost_tube"]
+        print(f"{r['spec']}, the tube as data ({capacity.segments} segments, "
+              f"{capacity.windows} windows), on {r['target']}")
+        print(f"  self-test on the spec's tube: {r['vectors_passed']} passed, "
+              f"{r['vectors_failed']} failed; flash {r['flash_bytes']} B, RAM "
+              f"{r['ram_bytes']} B, P_run's stack {r['stack_bytes_run']} B static (P.o)")
+        print(f"  the spec's tube: switch {r['switch_design']['instructions']} instructions, "
+              f"step {span(r['steps_design']['instructions'])} instructions")
+        print(f"  a tube of {cost['segments']} segments with {cost['open_windows']} windows "
+              f"open: switch {r['switch_cost']['instructions']} instructions, step "
+              f"{span(r['steps_cost']['instructions'])} instructions")
+    return 0 if r["ok"] else 1
 
 
 def variant_loop_command(design, args: argparse.Namespace, seed: int) -> int:
@@ -147,7 +199,7 @@ def configure_embedded(p: argparse.ArgumentParser) -> None:
     ----------
     p : argparse.ArgumentParser
         The subcommand's parser; gets ``SPEC``, ``--json``, ``--seed``, ``--build-dir``,
-        ``--no-host`` and the ``handler`` :func:`cmd_embedded`.
+        ``--no-host``, ``--tube-data`` and the ``handler`` :func:`cmd_embedded`.
     """
     add_spec_argument(p)
     add_json_argument(p)
@@ -156,4 +208,5 @@ def configure_embedded(p: argparse.ArgumentParser) -> None:
                    help="keep the generated code, programs and ELFs there (default: temporary)")
     p.add_argument("--no-host", action="store_true",
                    help="skip the comparison with the host simulation")
+    add_tube_data_argument(p)
     p.set_defaults(handler=cmd_embedded)

@@ -1,0 +1,308 @@
+"""The tube as data (``generate --tube-data``, docs/sensing.md "The tube as data"): the
+generated C runs any tube of the spec's dimension passed as a ``P_tube_data``, bit for bit
+as the CasADi model of that tube; ``P_tube_check`` refuses a malformed tube naming the
+test it failed; ``P_switch`` changes the active tube only where the state lies in the new
+one; ``simulate_sensed`` on backend ``c`` switches its tubes through one compiled
+controller."""
+
+from __future__ import annotations
+
+import ctypes
+import re
+import shutil
+import dataclasses
+import subprocess
+
+import numpy as np
+import pytest
+
+import stt_codegen as stt
+from stt_codegen.codegen.api import design_files
+from stt_codegen.codegen.generate import generate_files
+from stt_codegen.codegen.options import Options, parse_options
+from stt_codegen.codegen.tube_data import TubeCapacity, parse_capacity
+from stt_codegen.errors import SpecError
+from stt_codegen.system import MissingTool
+from stt_codegen.runtime.backends import make_controller
+from stt_codegen.runtime.compiled import DesignSpec, compiler
+from stt_codegen.runtime.sensed import WalkingObstacle
+from conftest import design_of
+from test_tube_segments import piecewise_design
+
+
+@pytest.fixture(scope="module")
+def cc():
+    try:
+        return compiler()
+    except MissingTool as exc:
+        pytest.skip(f"no C compiler ({exc}): install gcc")
+
+
+@pytest.fixture(scope="module")
+def several(cc):
+    """A 2-D tube with 3 reach segments and 3 circumvents, two on one bound: every code
+    path of the data form's composition (F_nu over several windows and one alone)."""
+    from stt_codegen.runtime.data_controller import TubeDataController
+    design = piecewise_design()
+    return design, TubeDataController(design)
+
+
+def bits(values) -> list:
+    return [np.asarray(v, float).tobytes() for v in values]
+
+
+def test_a_tube_as_data_computes_the_casadi_model_bit_for_bit(several):
+    """On random (x, t, alpha) across every segment and window, the step of the tube passed
+    as data equals the CasADi model's, bits and status; so does the tube packed in Python
+    and the generated ``P_design_tube`` (the same bytes)."""
+    design, library = several
+    assert bytes(library.pack(design)) == bytes(library.design_tube)
+    ref, data = make_controller("casadi", design), library.load(design)
+    rng = np.random.default_rng(7)
+    for k in range(400):
+        x = rng.uniform(-0.5, 5.5, 2)
+        t = rng.uniform(0.0, 10.0)
+        alpha = np.abs(rng.normal(0.0, 0.2, 4)) * (k % 3 != 0)
+        expected, got = ref.step(x, t, 1e-3, alpha), data.step(x, t, 1e-3, alpha)
+        assert bits(got[:2]) == bits(expected[:2]) and got[2] == expected[2], (x, t, alpha)
+
+
+def test_one_library_runs_other_tubes_of_the_same_dimension(several):
+    """Tubes that are not the spec's (another profile, fewer circumvents, shifted times)
+    run on the same compiled library, bit for bit as their own CasADi model."""
+    design, library = several
+    others = [piecewise_design("cruise"),
+              dataclasses.replace(design, circumvents=design.circumvents[2:]),
+              dataclasses.replace(design, circumvents=())]
+    rng = np.random.default_rng(8)
+    for other in others:
+        ref, data = make_controller("casadi", other), library.load(other)
+        for _ in range(100):
+            x, t = rng.uniform(0.0, 5.0, 2), rng.uniform(0.0, 10.0)
+            alpha = np.abs(rng.normal(0.0, 0.2, 4))
+            expected, got = ref.step(x, t, 1e-3, alpha), data.step(x, t, 1e-3, alpha)
+            assert bits(got[:2]) == bits(expected[:2]) and got[2] == expected[2]
+
+
+def _broken(library, design, change):
+    tube = library.pack(design)
+    change(tube)
+    return library.check(tube)
+
+
+@pytest.mark.parametrize("change, code", [
+    (lambda t: setattr(t, "n_segments", 0), 2),
+    (lambda t: setattr(t, "n_windows", 33), 2),
+    (lambda t: setattr(t.parameters, "kappa", 0.0), 3),
+    (lambda t: setattr(t.parameters, "mu", float("nan")), 3),
+    (lambda t: t.bound.__setitem__(0, -1.0), 4),          # below the spec's state space
+    (lambda t: t.bound.__setitem__(0, 6.0), 4),           # lower above upper
+    (lambda t: setattr(t.segments[1], "end", 1.0), 5),    # ends not increasing
+    (lambda t: setattr(t.segments[0], "profile", 3), 5),  # no such profile
+    (lambda t: setattr(t.windows[1], "start", 0.5), 6),   # starts not sorted
+    (lambda t: setattr(t.windows[0], "max_end", 9.0), 6),  # not the running maximum
+    (lambda t: setattr(t.windows[2], "bound", 4), 6),     # no such bound
+    (lambda t: setattr(t.windows[2], "radius", 0.0), 6),
+    (lambda t: t.members.__setitem__(0, 1), 7),
+    (lambda t: setattr(t, "n_multi", 0), 7),
+])
+def test_a_malformed_tube_is_refused_naming_the_test(several, change, code):
+    design, library = several
+    assert library.check(library.pack(design)) == 0
+    assert _broken(library, design, change) == code
+
+
+def test_counts_out_of_range_make_every_function_refuse(several):
+    """The functions that run a tube check its counts (no read past the arrays):
+    INVALID_INPUT with u = 0."""
+    design, library = several
+    tube = library.pack(design)
+    tube.n_windows = 1000
+    from stt_codegen.runtime.data_controller import _Loaded
+    u, _, status = _Loaded(library, tube).step(np.array([0.3, 0.3]), 0.0, 1e-3, np.zeros(4))
+    assert status == 2 and not u.any()
+
+
+class Switcher:
+    """``P_active``, ``P_switch`` and ``P_run`` of a compiled data-form library."""
+
+    def __init__(self, library, prefix: str) -> None:
+        n = library.n
+        real_p = ctypes.POINTER(ctypes.c_double)
+
+        class Active(ctypes.Structure):
+            _fields_ = [("tube", ctypes.c_void_p), ("start", ctypes.c_double),
+                        ("alpha", ctypes.c_double * (2 * n)), ("switches", ctypes.c_int),
+                        ("refusal", ctypes.c_int), ("tube_check", ctypes.c_int),
+                        ("error", ctypes.c_double)]
+
+        lib = library._lib
+        self.active = Active()
+        self.init = getattr(lib, f"{prefix}_active_init")
+        self.switch = getattr(lib, f"{prefix}_switch")
+        self.switch.argtypes = [ctypes.POINTER(Active), ctypes.POINTER(library.struct),
+                                ctypes.c_double, real_p, ctypes.c_double]
+        self.run = getattr(lib, f"{prefix}_run")
+        self.run.argtypes = [ctypes.POINTER(Active), real_p, ctypes.c_double, ctypes.c_double,
+                             real_p]
+        self.init(ctypes.byref(self.active))
+
+    def to(self, tube, start, x, t) -> int:
+        x = np.ascontiguousarray(x, float)
+        return self.switch(ctypes.byref(self.active), ctypes.byref(tube), start,
+                           x.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), t)
+
+    def step(self, x, t, dt):
+        x = np.ascontiguousarray(x, float)
+        u = np.zeros(x.size)
+        p = ctypes.POINTER(ctypes.c_double)
+        status = self.run(ctypes.byref(self.active), x.ctypes.data_as(p), t, dt,
+                          u.ctypes.data_as(p))
+        return u, status
+
+
+def test_the_switch_takes_a_tube_only_where_the_state_lies_in_it(several):
+    """Refused (the active tube and alpha kept, the result and |e| recorded): a tube that
+    fails the check, a start in the future, a state at |e| > 1/2; switched (alpha reset,
+    its own time from its start): a state at its centre. ``P_run`` without a tube is
+    INVALID_INPUT."""
+    design, library = several
+    s = Switcher(library, DesignSpec(design).c_name)
+    tube = library.pack(design)
+    u, status = s.step([0.3, 0.3], 0.0, 1e-3)
+    assert status == 2 and not u.any()
+    assert s.to(tube, 0.0, [0.3, 0.3], 0.0) == 0 and s.active.switches == 1
+    for _ in range(50):                                   # the first tube runs: alpha moves
+        u, status = s.step([0.3, 0.3], 0.0, 1e-3)
+    alpha_before = list(s.active.alpha)
+    later = library.pack(dataclasses.replace(
+        design, segments=tuple(dataclasses.replace(seg, lower_from=(2.0, 2.0),
+                                                   upper_from=(2.4, 2.4))
+                               if k == 0 else seg for k, seg in enumerate(design.segments))))
+    broken = library.pack(design)
+    broken.n_multi = 0
+    assert s.to(broken, 1.0, [0.3, 0.3], 1.0) == 2 and s.active.tube_check == 7
+    assert s.to(later, 2.0, [2.2, 2.2], 1.0) == 3                       # not due
+    assert s.to(later, 1.0, [0.3, 0.3], 1.0) == 4 and s.active.error > 0.5
+    assert s.active.switches == 1 and list(s.active.alpha) == alpha_before
+    assert s.to(later, 1.0, [2.2, 2.2], 1.0) == 0 and s.active.error <= 1e-12
+    assert s.active.switches == 2 and not any(s.active.alpha) and s.active.start == 1.0
+    # the run is the step of the new tube at its own time t - start
+    expected = make_controller("casadi", dataclasses.replace(
+        design, segments=tuple(dataclasses.replace(seg, lower_from=(2.0, 2.0),
+                                                   upper_from=(2.4, 2.4))
+                               if k == 0 else seg for k, seg in enumerate(design.segments))
+    )).step(np.array([2.2, 2.2]), 0.25, 1e-3, np.zeros(4))
+    u, status = s.step([2.2, 2.2], 1.25, 1e-3)
+    assert bits([u]) == bits([expected[0]]) and status == expected[2]
+
+
+def test_people_crossing_the_hall_run_through_one_compiled_controller(cc):
+    """``simulate_sensed`` on backend ``c`` loads each switched tube into the spec's C with
+    the tube as data: the same trajectory, bit for bit, as the CasADi model's run."""
+    hall = design_of("hall-crossing")
+    people = [WalkingObstacle((5.0, 0.5), 0.3, velocity=(0.0, 0.5)),
+              WalkingObstacle((7.0, 5.5), 0.35, path=((2.0, 7.0, 5.5), (10.0, 7.0, 0.5)))]
+    runs = [stt.simulate_sensed(hall, people, backend=b, horizon=8.0) for b in ("casadi", "c")]
+    assert runs[1].sensing.switches >= 3 and runs[1].backend == "c"
+    for name in ("x", "u", "alpha", "status", "tube"):
+        assert np.array_equal(getattr(runs[0].trajectory, name),
+                              getattr(runs[1].trajectory, name)), name
+
+
+@pytest.mark.parametrize("precision", ["double", "single"])
+def test_the_generated_selftest_passes_on_the_design_tube(cc, tmp_path, precision):
+    """The data form's self-test runs the spec's vectors on ``P_design_tube`` (the shipped
+    Makefile's warnings as errors) and passes; generation is deterministic."""
+    design = piecewise_design()
+    spec = DesignSpec(design)
+    options = Options(("c",), precision, TubeCapacity(4, 8))
+    files = generate_files(spec, design, options)
+    assert files == generate_files(spec, design, options)
+    for name, data in files.items():
+        (tmp_path / name).write_bytes(data)
+    proc = subprocess.run(["make", "-s", "selftest", f"CC={cc}"], cwd=tmp_path,
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    last = proc.stdout.strip().splitlines()[-1]
+    assert last.endswith(" passed, 0 failed") and int(last.split()[0]) > 100
+    header = files[f"{spec.c_name}.h"].decode()
+    assert "#define PIECEWISE_MAX_SEGMENTS 4" in header and "the tube as data" in header
+    assert '"tube_data": {' in files["manifest.json"].decode()
+
+
+def test_bad_requests_name_the_field():
+    with pytest.raises(SpecError, match="C only"):
+        parse_options("c,python", "double", True)
+    with pytest.raises(SpecError, match="SEGMENTS,WINDOWS"):
+        parse_capacity("8")
+    with pytest.raises(SpecError, match="from 1 to 4096"):
+        parse_capacity("0,3")
+    with pytest.raises(SpecError, match="more than the capacity"):
+        generate_files(DesignSpec(piecewise_design()), piecewise_design(),
+                       Options(("c",), "double", TubeCapacity(2, 8)))
+    with pytest.raises(SpecError, match="law \\(13\\)'s controller only"):
+        design_files(design_of("second-order-s1"), parse_options("c", "double", True))
+
+
+def test_the_command_line_writes_the_data_form_or_exits_2(tmp_path):
+    from stt_codegen.cli import main
+    assert main(["generate", "omnirobot-s1", "-o", str(tmp_path / "a"), "--tube-data"]) == 0
+    assert "omnirobot_s1_tube_data" in (tmp_path / "a" / "omnirobot_s1.h").read_text()
+    assert main(["generate", "omnirobot-s1", "-o", str(tmp_path / "b"), "--tube-data",
+                 "--lang", "c,python"]) == 2
+    assert main(["generate", "omnirobot-s1", "-o", str(tmp_path / "c"),
+                 "--tube-data", "x"]) == 2
+    assert not (tmp_path / "b").exists() and not (tmp_path / "c").exists()
+
+
+@pytest.mark.embedded
+def test_on_the_cortex_m4f_the_switch_and_the_step_are_counted(tmp_path, capsys):
+    """The data form in single precision on the emulated Cortex-M4F: the self-test on the
+    spec's tube passes, every switch is taken, every step is OK, and a tube with 8
+    segments and 16 open windows costs more per step and per switch than the spec's
+    (1 segment, no window); the command prints the same report and exits 0."""
+    from stt_codegen.cli import main
+    from stt_codegen.embedded.tube_data_loop import run_tube_data
+    r = run_tube_data(design_of("hall-crossing"), TubeCapacity(8, 32), tmp_path)
+    assert r["ok"] and r["vectors_failed"] == 0 and r["vectors_passed"] > 100
+    assert r["switch_design"]["result"] == 0 and r["switch_cost"]["result"] == 0
+    assert set(r["steps_design"]["statuses"] + r["steps_cost"]["statuses"]) == {0}
+    assert min(r["steps_cost"]["instructions"]) > max(r["steps_design"]["instructions"])
+    assert r["switch_cost"]["instructions"] > r["switch_design"]["instructions"]
+    assert r["ram_bytes"] == 0
+    assert main(["embedded", "hall-crossing", "--tube-data", "--json"]) == 0
+    assert '"open_windows": 16' in capsys.readouterr().out
+    assert main(["embedded", "hall-crossing", "--tube-data", "8,8"]) == 2
+
+
+@pytest.mark.skipif(shutil.which("cppcheck") is None,
+                    reason="cppcheck missing: install the Debian package cppcheck")
+@pytest.mark.parametrize("precision", ["double", "single"])
+def test_misra_findings_are_the_listed_deviations(tmp_path, precision):
+    """cppcheck's MISRA C:2012 addon on the data form (docs/codegen.md): only the first
+    order's deviations, with the data form's API among the unused functions and rule 8.7 on
+    the two public functions the file also calls."""
+    from test_codegen_misra import DEVIATIONS
+    design = piecewise_design()
+    spec = DesignSpec(design)
+    prefix = spec.c_name
+    files = generate_files(spec, design, Options(("c",), precision, TubeCapacity(4, 8)))
+    for name in (f"{prefix}.c", f"{prefix}.h"):
+        (tmp_path / name).write_bytes(files[name])
+    proc = subprocess.run(["cppcheck", "--enable=all", "--addon=misra", "--std=c99",
+                           "--suppress=missingIncludeSystem", "--quiet",
+                           "--template={file}:{line}:{id}", f"{prefix}.c"],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    allowed = DEVIATIONS + (
+        ("unusedFunction", r"^(int|void) \w+_(active_init|switch|run)\("),
+        ("misra-c2012-8.7", r"^int \w+_(step|tube_check)\("))
+    seen = set()
+    for name, line, check in (f.split(":") for f in proc.stderr.splitlines()
+                              if f.count(":") >= 2):
+        text = (tmp_path / name).read_text().splitlines()[int(line) - 1]
+        assert any(d[0] == check and re.search(d[1], text) for d in allowed), \
+            f"{name}:{line}: {check} not on the deviation list: {text!r}"
+        seen.add(check)
+    assert {"unusedFunction", "misra-c2012-8.7"} <= seen
