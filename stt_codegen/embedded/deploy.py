@@ -47,12 +47,11 @@ from ..spec.variants import require_variant
 from ..errors import SpecError, ToolchainError
 from ..runtime.plants import check_seed
 from ..tube.parameters import TubeDesign
-from . import board
 from .footprint import elf_stack_bound, linked_sizes, measure
 from .budget import step_budget
 from .programs import (closed_loop_source, judge_printed, parse_closed_loop, parse_replay,
                        replay_source, steps_of)
-from .target import CPU_FLAGS, build_elf, run_qemu
+from .target import CPU_FLAGS, build_elf, run_checked
 from .toolchain import missing_message
 
 __all__ = ["COUNT_FRACTIONS", "compare_outputs", "function_profile", "run_embedded"]
@@ -188,12 +187,7 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
     n = spec.dimension
 
     def run(elf, **kw):
-        res = run_qemu(elf, timeout=timeout, **kw)
-        if res.timed_out:
-            raise ToolchainError(f"{elf.name}: QEMU timed out after {timeout:g} s")
-        if res.exit_code == board.FAULT_EXIT_STATUS:
-            raise ToolchainError(f"{elf.name}: fault on the target:\n{res.stderr}")
-        return res
+        return run_checked(elf, timeout, **kw)
 
     # 1. the generated self-test
     st = build_elf([lib, gen / f"{prefix}_selftest.c"], [gen], out / "selftest", name="selftest")

@@ -32,7 +32,8 @@ from stt_codegen.embedded.toolchain import ToolError, Toolchain, find_toolchain,
 from stt_codegen.errors import ToolchainError
 
 __all__ = ["BuildError", "BuildResult", "CPU_FLAGS", "RunError", "RunResult", "build_elf",
-           "count_region_instructions", "elf_sizes", "profile_regions", "run_qemu"]
+           "count_region_instructions", "elf_sizes", "profile_regions", "run_checked",
+           "run_qemu"]
 
 #: Code generation flags for the Cortex-M4F (single-precision FPU, hard-float ABI).
 CPU_FLAGS: tuple[str, ...] = (
@@ -469,3 +470,32 @@ def run_qemu(elf: Path, timeout: float = 60.0, *,
     counts = None if profile is None else [sum(v[0] for v in r.values()) for r in profile]
     return RunResult(stdout, proc.returncode, counts, stderr=stderr, command=tuple(cmd),
                      functions=profile)
+
+
+def run_checked(elf: Path, timeout: float, **kw) -> RunResult:
+    """:func:`run_qemu`, with a timeout or a fault on the target raised.
+
+    Parameters
+    ----------
+    elf : Path
+        Program built by :func:`build_elf`.
+    timeout : float
+        Seconds before QEMU is killed.
+    **kw
+        Passed to :func:`run_qemu` (``count_instructions``).
+
+    Returns
+    -------
+    RunResult
+
+    Raises
+    ------
+    ToolchainError
+        QEMU timed out, or the program faulted (the startup code's message).
+    """
+    res = run_qemu(elf, timeout=timeout, **kw)
+    if res.timed_out:
+        raise ToolchainError(f"{Path(elf).name}: QEMU timed out after {timeout:g} s")
+    if res.exit_code == board.FAULT_EXIT_STATUS:
+        raise ToolchainError(f"{Path(elf).name}: fault on the target:\n{res.stderr}")
+    return res

@@ -29,9 +29,8 @@ from ..design.result import Design
 from ..errors import ToolchainError
 from ..tube.parameters import LOWER, SMOOTHSTEP, UPPER, Circumvent, ReachSegment, TubeDesign
 from ..version import __version__
-from . import board
 from .footprint import measure
-from .target import CPU_FLAGS, build_elf, run_qemu
+from .target import CPU_FLAGS, build_elf, run_checked
 from .toolchain import missing_message
 
 __all__ = ["OPEN_WINDOWS", "cost_tube", "run_tube_data"]
@@ -139,12 +138,7 @@ def run_tube_data(design: Design, capacity: TubeCapacity, out_dir: str | Path | 
     lib = gen / f"{prefix}.c"
 
     def run(elf, **kw):
-        res = run_qemu(elf, timeout=timeout, **kw)
-        if res.timed_out:
-            raise ToolchainError(f"{elf.name}: QEMU timed out after {timeout:g} s")
-        if res.exit_code == board.FAULT_EXIT_STATUS:
-            raise ToolchainError(f"{elf.name}: fault on the target:\n{res.stderr}")
-        return res
+        return run_checked(elf, timeout, **kw)
 
     st = build_elf([lib, gen / f"{prefix}_selftest.c"], [gen], out / "selftest", name="selftest")
     found = re.search(r"^(\d+) passed, (\d+) failed$", run(st.elf).stdout, re.MULTILINE)
