@@ -137,17 +137,20 @@ def table_names(prefix: str, data: bool) -> dict[str, str]:
         ``n_segments``, ``windows``, ``n_windows``; ``arg`` (the parameter that starts
         every function's list), ``call`` (the argument that starts every call),
         ``usable`` (the first test of a public function's input check) and ``design``
-        (the first argument of a call on the spec's own tube), empty for tables.
+        (the first argument of a call on the spec's own tube), empty for tables;
+        ``cleared``: how many entries of the open windows' work arrays are cleared
+        (``MAX_OPEN``; the tube's windows for the data form, as no more can be open).
     """
     fields = ("parameters", "bound", "members", "n_multi", "multi", "segments", "n_segments",
               "windows", "n_windows")
     if not data:
         names = {f: f"{prefix.upper()}_{f.upper()}" for f in fields}
-        return dict(names, arg="", call="", usable="", design="")
+        return dict(names, arg="", call="", usable="", design="",
+                    cleared=f"{prefix.upper()}_MAX_OPEN")
     names = {f: f"tube->{f}" for f in fields}
     return dict(names, arg=f"const {prefix}_tube_data* tube, ", call="tube, ",
                 usable=f"({prefix}_tube_usable(tube) != 0) && ",
-                design=f"&{prefix}_design_tube, ")
+                design=f"&{prefix}_design_tube, ", cleared="tube->n_windows")
 
 
 def table_shape(tables: Tables, capacity: TubeCapacity | None) -> TableShape:
