@@ -148,7 +148,7 @@ def table_names(prefix: str, data: bool) -> dict[str, str]:
         return dict(names, arg="", call="", usable="", design="",
                     cleared=f"{prefix.upper()}_MAX_OPEN")
     names = {f: f"tube->{f}" for f in fields}
-    return dict(names, arg=f"const {prefix}_tube_data* tube, ", call="tube, ",
+    return dict(names, arg=f"const {prefix}_tube_data* tube,\n    ", call="tube, ",
                 usable=f"({prefix}_tube_usable(tube) != 0) && ",
                 design=f"&{prefix}_design_tube, ", cleared="tube->n_windows")
 
