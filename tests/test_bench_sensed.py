@@ -55,3 +55,21 @@ def test_one_episode_is_reported():
     assert row["collisions_certified"] == 0
     assert row["on_time"] + row["late"] + row["not_reached"] == 1
     assert "bench sensed: seed 0" in format_sensed_report(report)
+
+
+@pytest.mark.embedded
+def test_the_controller_cost_on_the_cortex_m4f_is_reported():
+    """``--cortex-m4f``: the scenario's controller with the tube as data, counted on the
+    emulated Cortex-M4F: a step with 16 windows open costs more than one on the scenario's
+    tube, and the report prints both."""
+    from stt_codegen_bench.sensed_bench import target_costs
+    costs = target_costs()
+    assert costs["self_test"] == "567/567"
+    assert costs["step_16_windows"] > costs["step"] > 0
+    assert costs["switch_16_windows"] > costs["switch"] > 0
+    text = format_sensed_report({"seed": 0, "adversary": False, "rows": [],
+                                 "cortex_m4f": costs})
+    assert "instructions per step on the scenario's tube" in text
+    missing = format_sensed_report({"seed": 0, "adversary": False, "rows": [],
+                                    "cortex_m4f": {"missing": "install qemu-system-arm"}})
+    assert "not measured (install qemu-system-arm)" in missing

@@ -203,6 +203,9 @@ def _cmd_sensed(args: argparse.Namespace) -> int:
                               tuple(_int_list(args.obstacles, "--obstacles")),
                               adversary=args.adversary, acceleration=args.acceleration,
                               speed_only=args.speed_only)
+    if args.cortex_m4f:
+        from .sensed_bench import target_costs
+        report["cortex_m4f"] = target_costs(args.acceleration)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_sensed_report(report))
     return 0
@@ -390,5 +393,9 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="with --acceleration: the same circles and adversary, but the "
                         "envelope without the acceleration bound (reachable sets growing at "
                         "the speed bound), for a side-by-side comparison")
+    p.add_argument("--cortex-m4f", action="store_true",
+                   help="also count the controller's instructions per step and per switch "
+                        "on the Cortex-M4F (QEMU), the tube as data, on the scenario's tube "
+                        "and on one with 16 windows open (stt-codegen embedded --tube-data)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_sensed)

@@ -30,7 +30,7 @@ import stt_codegen as stt
 from stt_codegen.runtime.sensed import WalkingObstacle
 
 __all__ = ["SCENARIO", "format_sensed_report", "moving_circles", "run_sensed_bench",
-           "scenario_with"]
+           "scenario_with", "target_costs"]
 
 #: The arena, the robot and the envelope of the scenario (a spec dictionary).
 SCENARIO = {
@@ -206,6 +206,39 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
             "speed_only": bool(speed_only and acceleration is not None), "rows": rows}
 
 
+def target_costs(acceleration: float | None = None) -> dict:
+    """The scenario's controller on the Cortex-M4F with the tube as data
+    (:func:`stt_codegen.embedded.tube_data_loop.run_tube_data`): instructions per switch
+    and per step on the scenario's tube and on one with 16 circumvent windows open.
+
+    Parameters
+    ----------
+    acceleration : float, optional
+        As :func:`run_sensed_bench` (the envelope does not change the controller).
+
+    Returns
+    -------
+    dict
+        ``step``, ``step_16_windows`` (mean instructions), ``switch``, ``switch_16_windows``,
+        ``self_test`` (``"passed/total"``), or ``missing`` (the tools to install) without
+        the Arm toolchain or QEMU.
+    """
+    from stt_codegen.codegen.tube_data import DEFAULT_CAPACITY
+    from stt_codegen.embedded import missing_message
+    from stt_codegen.embedded.tube_data_loop import run_tube_data
+    message = missing_message()
+    if message:
+        return {"missing": message}
+    design = stt.design_tube(stt.Spec.from_dict(scenario_with(acceleration)))
+    r = run_tube_data(design, DEFAULT_CAPACITY)
+    mean = lambda v: float(np.mean(v))   # noqa: E731
+    return {"step": mean(r["steps_design"]["instructions"]),
+            "step_16_windows": mean(r["steps_cost"]["instructions"]),
+            "switch": r["switch_design"]["instructions"],
+            "switch_16_windows": r["switch_cost"]["instructions"],
+            "self_test": f"{r['vectors_passed']}/{r['vectors_passed'] + r['vectors_failed']}"}
+
+
 def scenario_with(acceleration: float | None) -> dict:
     """:data:`SCENARIO`, with ``max_obstacle_acceleration = acceleration`` and
     ``velocity_error`` :data:`VELOCITY_ERROR` in its envelope when given.
@@ -256,4 +289,12 @@ def format_sensed_report(report: dict) -> str:
                      f"{r['uncertified_runs']:>7} {r['outside_envelope']:>7} "
                      f"{r['switches']:>8} {r.get('escapes', 0):>7} {r['failures']:>6} "
                      f"{r['replan_cpu_p95_s']:>14.3f} {r['replan_cpu_max_s']:>8.3f}")
+    target = report.get("cortex_m4f")
+    if target is not None:
+        lines.append("Cortex-M4F (QEMU), the tube as data: " + (
+            f"not measured ({target['missing']})" if "missing" in target else
+            f"{target['step']:.0f} instructions per step on the scenario's tube, "
+            f"{target['step_16_windows']:.0f} with 16 windows open; a switch "
+            f"{target['switch']} and {target['switch_16_windows']}; self-test "
+            f"{target['self_test']}"))
     return "\n".join(lines)
