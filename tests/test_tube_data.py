@@ -261,7 +261,8 @@ def test_on_the_cortex_m4f_the_switch_and_the_step_are_counted(tmp_path, capsys)
     """The data form in single precision on the emulated Cortex-M4F: the self-test on the
     spec's tube passes, every switch is taken, every step is OK, and a tube with 8
     segments and 16 open windows costs more per step and per switch than the spec's
-    (1 segment, no window); the command prints the same report and exits 0."""
+    (1 segment, no window); the bytes the host packs for it are a valid tube there; the
+    command prints the same report and exits 0."""
     from stt_codegen.cli import main
     from stt_codegen.embedded.tube_data_loop import run_tube_data
     r = run_tube_data(design_of("hall-crossing"), TubeCapacity(8, 32), tmp_path)
@@ -271,6 +272,9 @@ def test_on_the_cortex_m4f_the_switch_and_the_step_are_counted(tmp_path, capsys)
     assert min(r["steps_cost"]["instructions"]) > max(r["steps_design"]["instructions"])
     assert r["switch_cost"]["instructions"] > r["switch_design"]["instructions"]
     assert r["ram_bytes"] == 0
+    # the cost tube packed on the host and copied in on the target: well formed there,
+    # and its steps are the compiled tube's, bit for bit
+    assert r["wire"]["check"] == 0 and r["wire"]["same_steps"] and r["wire"]["bytes"] > 0
     assert main(["embedded", "hall-crossing", "--tube-data", "--json"]) == 0
     assert '"open_windows": 16' in capsys.readouterr().out
     assert main(["embedded", "hall-crossing", "--tube-data", "8,8"]) == 2

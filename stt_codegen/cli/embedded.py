@@ -127,6 +127,10 @@ def tube_data_command(design, args: argparse.Namespace, capacity) -> int:
         print(f"  a tube of {cost['segments']} segments with {cost['open_windows']} windows "
               f"open: switch {r['switch_cost']['instructions']} instructions, step "
               f"{span(r['steps_cost']['instructions'])} instructions")
+        wire = r["wire"]
+        print(f"  that tube packed on the host ({wire['bytes']} B) and copied in: check "
+              f"{wire['check']}, steps {'the same' if wire['same_steps'] else 'DIFFERENT'}"
+              f" bit for bit")
     return 0 if r["ok"] else 1
 
 

@@ -28,6 +28,7 @@ from ..codegen.tube_data import TubeCapacity
 from ..design.result import Design
 from ..errors import ToolchainError
 from ..tube.parameters import LOWER, SMOOTHSTEP, UPPER, Circumvent, ReachSegment, TubeDesign
+from ..runtime.data_controller import pack_tube
 from ..version import __version__
 from .footprint import measure
 from .target import CPU_FLAGS, build_elf, run_checked
@@ -109,7 +110,11 @@ def run_tube_data(design: Design, capacity: TubeCapacity, out_dir: str | Path | 
         ``P_run`` within ``P.o``, without libm), ``switch_design`` and
         ``switch_cost`` (``{"result", "instructions"}``), ``steps_design`` and
         ``steps_cost`` (``{"statuses", "instructions"}``, lists), ``cost_tube``
-        (``segments``, ``open_windows``), ``ok``.
+        (``segments``, ``open_windows``), ``wire`` (the cost tube packed on the host,
+        :func:`~stt_codegen.runtime.data_controller.pack_tube`, copied into a
+        ``P_tube_data`` on the target: ``bytes``, ``check`` its ``P_tube_check``,
+        ``same_steps`` whether its steps' ``u`` equal the compiled tube's bit for bit),
+        ``ok``.
 
     Raises
     ------
@@ -157,11 +162,14 @@ def run_tube_data(design: Design, capacity: TubeCapacity, out_dir: str | Path | 
         x_switch=[literal(0.5 * (a + b)) for a, b in zip(wide.segments[0].lower_from,
                                                         wide.segments[0].upper_from)],
         x_cost=[literal(v) for v in _reach_centre(wide, open_at)],
-        switch_at=literal(1.0), open_at=literal(open_at), period=literal(1.0 / tube.rate_hz))
+        switch_at=literal(1.0), open_at=literal(open_at), period=literal(1.0 / tube.rate_hz),
+        wire=[f"0x{b:02x}u" for b in bytes(pack_tube(wide, capacity, "single"))])
     (out / "tube_data.c").write_text(program)
     prog = build_elf([lib, out / "tube_data.c"], [gen], out / "program", name="tube_data")
     res = run(prog.elf, count_instructions=True)
-    lines = [line.split() for line in res.stdout.strip().splitlines()]
+    printed = [line.split() for line in res.stdout.strip().splitlines()]
+    lines = [w for w in printed if not w[0].startswith("wire-")]
+    wire = {w[0]: int(w[1]) for w in printed if w[0].startswith("wire-")}
     counts = list(res.instructions or [])
     if len(lines) != len(counts) or len(counts) != 2 * STEPS + 2:
         raise ToolchainError(f"tube_data: {len(lines)} lines and {len(counts)} counted regions "
@@ -181,8 +189,11 @@ def run_tube_data(design: Design, capacity: TubeCapacity, out_dir: str | Path | 
         "steps_cost": {"statuses": results[2 + STEPS:], "instructions": counts[2 + STEPS:]},
         "cost_tube": {"segments": capacity.segments, "open_windows": OPEN_WINDOWS,
                       "measured_at": open_at},
+        "wire": {"bytes": len(bytes(pack_tube(wide, capacity, "single"))),
+                 "check": wire.get("wire-check"), "same_steps": wire.get("wire-same") == 1},
     }
     report["ok"] = bool(failed == 0 and passed > 0 and results[0] == 0
+                        and report["wire"]["check"] == 0 and report["wire"]["same_steps"]
                         and results[1 + STEPS] == 0
                         and all(s in (0, 5) for s in results[1:1 + STEPS] + results[2 + STEPS:]))
     return report

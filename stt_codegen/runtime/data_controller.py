@@ -21,7 +21,7 @@ from ..codegen.tube_data import TubeCapacity, require_capacity
 from ..tube.parameters import TubeDesign
 from .compiled import DesignSpec, build_shared
 
-__all__ = ["TubeDataController", "tube_struct"]
+__all__ = ["TubeDataController", "pack_tube", "tube_struct"]
 
 
 def tube_struct(n: int, capacity: TubeCapacity, real=ctypes.c_double) -> type:
@@ -62,6 +62,65 @@ def tube_struct(n: int, capacity: TubeCapacity, real=ctypes.c_double) -> type:
                     ("windows", Window * capacity.windows)]
 
     return Tube
+
+
+def pack_tube(design: TubeDesign, capacity: TubeCapacity, precision: str = "double"):
+    """A tube as the ``<P>_tube_data`` struct of the generated C: what a companion computer
+    sends (``bytes(pack_tube(...))``, the C layout of this machine's ABI; an Arm EABI
+    target with 4-byte ``int`` lays it out the same, as the Cortex-M4F test shows).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube (its dimension the controller's).
+    capacity : TubeCapacity
+        The generated C's capacity.
+    precision : {"double", "single"}, optional
+        The generated C's real type.
+
+    Returns
+    -------
+    ctypes.Structure
+        A :func:`tube_struct` instance, in the order of the tables
+        (:func:`~stt_codegen.codegen.tables.design_table_rows`), rows past the counts 0.
+
+    Raises
+    ------
+    SpecError
+        The tube does not fit the capacity (field ``tube_data``).
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> from stt_codegen.codegen.tube_data import TubeCapacity
+    >>> from stt_codegen.runtime.data_controller import pack_tube
+    >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    >>> tube = pack_tube(design.tube, TubeCapacity(8, 32), "single")
+    >>> tube.n_segments, tube.n_windows, len(bytes(tube))
+    (1, 1, 1608)
+    """
+    require_capacity(design, capacity)
+    tables = design_table_rows(design, float, precision == "single")
+    tube = tube_struct(design.dimension, capacity,
+                       ctypes.c_float if precision == "single" else ctypes.c_double)()
+    for field, value, _ in tables.parameters:
+        setattr(tube.parameters, field, value)
+    tube.bound[:] = tables.bounds
+    tube.members[:] = tables.members
+    tube.n_multi = len(tables.multi)
+    tube.multi[:len(tables.multi)] = tables.multi
+    tube.n_segments = len(tables.segments)
+    for j, row in enumerate(tables.segments):
+        s = tube.segments[j]
+        s.start, s.end, s.profile = row["start"], row["end"], row["profile"]
+        s.from_[:], s.to[:] = row["from"], row["to"]
+    tube.n_windows = len(tables.windows)
+    for j, row in enumerate(tables.windows):
+        w = tube.windows[j]
+        for name in ("start", "end", "center", "radius", "sharpness", "height", "max_end"):
+            setattr(w, name, row[name])
+        w.bound = row["bound"]
+    return tube
 
 
 class TubeDataController:
@@ -105,34 +164,14 @@ class TubeDataController:
         self._arrays = [np.zeros(size) for size in (self.n, 2 * self.n) * 2]
 
     def pack(self, design: TubeDesign):
-        """``design`` as a ``<P>_tube_data`` (a :func:`tube_struct` instance).
+        """``design`` as a ``<P>_tube_data`` of this library (:func:`pack_tube`).
 
         Raises
         ------
         SpecError
             The tube does not fit the capacity (field ``tube_data``).
         """
-        require_capacity(design, self.capacity)
-        tables = design_table_rows(design, float, False)
-        tube = self.struct()
-        for field, value, _ in tables.parameters:
-            setattr(tube.parameters, field, value)
-        tube.bound[:] = tables.bounds
-        tube.members[:] = tables.members
-        tube.n_multi = len(tables.multi)
-        tube.multi[:len(tables.multi)] = tables.multi
-        tube.n_segments = len(tables.segments)
-        for j, row in enumerate(tables.segments):
-            s = tube.segments[j]
-            s.start, s.end, s.profile = row["start"], row["end"], row["profile"]
-            s.from_[:], s.to[:] = row["from"], row["to"]
-        tube.n_windows = len(tables.windows)
-        for j, row in enumerate(tables.windows):
-            w = tube.windows[j]
-            for name in ("start", "end", "center", "radius", "sharpness", "height", "max_end"):
-                setattr(w, name, row[name])
-            w.bound = row["bound"]
-        return tube
+        return pack_tube(design, self.capacity)
 
     def check(self, tube) -> int:
         """``<P>_tube_check`` of a packed tube (``0``: well formed)."""
