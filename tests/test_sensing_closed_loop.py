@@ -89,9 +89,8 @@ def test_people_crossing_force_replanning_and_the_base_stays_safe_in_its_tube(ha
     """Two people walk across the base's way within the envelope: the base switches tubes,
     never refuses or fails, is certified throughout, stays in whichever tube is active,
     touches no one and reaches the target by t_c."""
-    people = [WalkingObstacle((5.0, 0.5), 0.3, velocity=(0.0, 0.5)),
-              WalkingObstacle((7.0, 5.5), 0.35, path=((2.0, 7.0, 5.5), (10.0, 7.0, 0.5)))]
-    run = stt.simulate_sensed(hall, people)
+    from stt_codegen.runtime.sensed import bundled_people
+    run = stt.simulate_sensed(hall, bundled_people("hall-crossing"))   # the demo's people
     record = run.sensing
     assert record.switches >= 3 and record.refused == 0 and record.failures == 0
     assert record.guaranteed and not record.outside_envelope

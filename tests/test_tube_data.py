@@ -25,7 +25,7 @@ from stt_codegen.errors import SpecError
 from stt_codegen.system import MissingTool
 from stt_codegen.runtime.backends import make_controller
 from stt_codegen.runtime.compiled import DesignSpec, compiler
-from stt_codegen.runtime.sensed import WalkingObstacle
+from stt_codegen.runtime.sensed import bundled_people
 from conftest import design_of
 from test_tube_segments import piecewise_design
 
@@ -201,8 +201,7 @@ def test_people_crossing_the_hall_run_through_one_compiled_controller(cc):
     """``simulate_sensed`` on backend ``c`` loads each switched tube into the spec's C with
     the tube as data: the same trajectory, bit for bit, as the CasADi model's run."""
     hall = design_of("hall-crossing")
-    people = [WalkingObstacle((5.0, 0.5), 0.3, velocity=(0.0, 0.5)),
-              WalkingObstacle((7.0, 5.5), 0.35, path=((2.0, 7.0, 5.5), (10.0, 7.0, 0.5)))]
+    people = bundled_people("hall-crossing")
     runs = [stt.simulate_sensed(hall, people, backend=b, horizon=8.0) for b in ("casadi", "c")]
     assert runs[1].sensing.switches >= 3 and runs[1].backend == "c"
     for name in ("x", "u", "alpha", "status", "tube"):

@@ -34,8 +34,7 @@ from .options import Options
 from .render import c_identifier, c_real, render
 from .tables import design_table_rows
 from .tube_data import TubeCapacity, require_capacity, table_names, table_shape
-from ..tube.pieces import error_transform
-from ..tube.pieces import PROFILE_NAMES
+from ..tube.pieces import PROFILE_NAMES, error_transform
 from .vectors import test_vectors
 
 __all__ = ["GENERATOR", "MANIFEST", "Options", "c_source_context", "first_order_generation",
