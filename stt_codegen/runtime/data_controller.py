@@ -11,6 +11,7 @@ runs its switched tubes this way on backend ``c``.
 from __future__ import annotations
 
 import ctypes
+from functools import lru_cache
 
 import numpy as np
 
@@ -25,7 +26,8 @@ __all__ = ["TubeDataController", "pack_tube", "tube_struct"]
 
 
 def tube_struct(n: int, capacity: TubeCapacity, real=ctypes.c_double) -> type:
-    """The ``ctypes`` layout of ``<P>_tube_data`` (the generated header's).
+    """The ``ctypes`` layout of ``<P>_tube_data`` (the generated header's), one class per
+    layout (``ctypes`` takes a struct only as the class its function was declared with).
 
     Parameters
     ----------
@@ -41,6 +43,11 @@ def tube_struct(n: int, capacity: TubeCapacity, real=ctypes.c_double) -> type:
     type
         A ``ctypes.Structure`` subclass.
     """
+    return _layout(int(n), capacity, real)
+
+
+@lru_cache(maxsize=None)
+def _layout(n: int, capacity: TubeCapacity, real) -> type:
     m = 2 * n
 
     class Parameters(ctypes.Structure):
