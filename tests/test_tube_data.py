@@ -126,38 +126,23 @@ def test_counts_out_of_range_make_every_function_refuse(several):
 class Switcher:
     """``P_active``, ``P_switch`` and ``P_run`` of a compiled data-form library."""
 
-    def __init__(self, library, prefix: str) -> None:
-        n = library.n
-        real_p = ctypes.POINTER(ctypes.c_double)
-
-        class Active(ctypes.Structure):
-            _fields_ = [("tube", ctypes.c_void_p), ("start", ctypes.c_double),
-                        ("alpha", ctypes.c_double * (2 * n)), ("switches", ctypes.c_int),
-                        ("refusal", ctypes.c_int), ("tube_check", ctypes.c_int),
-                        ("error", ctypes.c_double)]
-
-        lib = library._lib
-        self.active = Active()
-        self.init = getattr(lib, f"{prefix}_active_init")
-        self.switch = getattr(lib, f"{prefix}_switch")
-        self.switch.argtypes = [ctypes.POINTER(Active), ctypes.POINTER(library.struct),
-                                ctypes.c_double, real_p, ctypes.c_double]
-        self.run = getattr(lib, f"{prefix}_run")
-        self.run.argtypes = [ctypes.POINTER(Active), real_p, ctypes.c_double, ctypes.c_double,
-                             real_p]
-        self.init(ctypes.byref(self.active))
+    def __init__(self, library) -> None:
+        self.library = library
+        self.active = library.active()
+        library.functions["active_init"](ctypes.byref(self.active))
 
     def to(self, tube, start, x, t) -> int:
         x = np.ascontiguousarray(x, float)
-        return self.switch(ctypes.byref(self.active), ctypes.byref(tube), start,
-                           x.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), t)
+        return self.library.functions["switch"](
+            ctypes.byref(self.active), ctypes.byref(tube), start,
+            x.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), t)
 
     def step(self, x, t, dt):
         x = np.ascontiguousarray(x, float)
         u = np.zeros(x.size)
         p = ctypes.POINTER(ctypes.c_double)
-        status = self.run(ctypes.byref(self.active), x.ctypes.data_as(p), t, dt,
-                          u.ctypes.data_as(p))
+        status = self.library.functions["run"](ctypes.byref(self.active), x.ctypes.data_as(p),
+                                               t, dt, u.ctypes.data_as(p))
         return u, status
 
 
@@ -167,7 +152,7 @@ def test_the_switch_takes_a_tube_only_where_the_state_lies_in_it(several):
     its own time from its start): a state at its centre. ``P_run`` without a tube is
     INVALID_INPUT."""
     design, library = several
-    s = Switcher(library, DesignSpec(design).c_name)
+    s = Switcher(library)
     tube = library.pack(design)
     u, status = s.step([0.3, 0.3], 0.0, 1e-3)
     assert status == 2 and not u.any()

@@ -11,6 +11,7 @@ runs its switched tubes this way on backend ``c``.
 from __future__ import annotations
 
 import ctypes
+import math
 from functools import lru_cache
 
 import numpy as np
@@ -22,7 +23,7 @@ from ..codegen.tube_data import TubeCapacity, require_capacity
 from ..tube.parameters import TubeDesign
 from .compiled import DesignSpec, build_shared
 
-__all__ = ["TubeDataController", "pack_tube", "tube_struct"]
+__all__ = ["TubeDataController", "active_struct", "pack_tube", "tube_struct"]
 
 
 def tube_struct(n: int, capacity: TubeCapacity, real=ctypes.c_double) -> type:
@@ -69,6 +70,30 @@ def _layout(n: int, capacity: TubeCapacity, real) -> type:
                     ("windows", Window * capacity.windows)]
 
     return Tube
+
+
+@lru_cache(maxsize=None)
+def active_struct(n: int) -> type:
+    """The ``ctypes`` layout of ``<P>_active`` (double), state dimension ``n``.
+
+    Parameters
+    ----------
+    n : int
+        State dimension.
+
+    Returns
+    -------
+    type
+        A ``ctypes.Structure`` subclass: ``tube`` (a pointer), ``start``, ``alpha``
+        (``2 n``), ``switches``, ``refusal``, ``tube_check``, ``error``.
+    """
+    class Active(ctypes.Structure):
+        _fields_ = [("tube", ctypes.c_void_p), ("start", ctypes.c_double),
+                    ("alpha", ctypes.c_double * (2 * n)), ("switches", ctypes.c_int),
+                    ("refusal", ctypes.c_int), ("tube_check", ctypes.c_int),
+                    ("error", ctypes.c_double)]
+
+    return Active
 
 
 def pack_tube(design: TubeDesign, capacity: TubeCapacity, precision: str = "double"):
@@ -168,6 +193,17 @@ class TubeDataController:
         self._check = getattr(self._lib, f"{prefix}_tube_check")
         self._check.argtypes, self._check.restype = [tube_p], ctypes.c_int
         self.design_tube = self.struct.in_dll(self._lib, f"{prefix}_design_tube")
+        self.active = active_struct(self.n)
+        active_p = ctypes.POINTER(self.active)
+        self.functions = {}
+        for name, args, result in (
+                ("active_init", [active_p], None),
+                ("switch", [active_p, tube_p, ctypes.c_double, ptr, ctypes.c_double],
+                 ctypes.c_int),
+                ("run", [active_p, ptr, ctypes.c_double, ctypes.c_double, ptr], ctypes.c_int)):
+            f = getattr(self._lib, f"{prefix}_{name}")
+            f.argtypes, f.restype = args, result
+            self.functions[name] = f
         self._arrays = [np.zeros(size) for size in (self.n, 2 * self.n) * 2]
 
     def pack(self, design: TubeDesign):
@@ -220,3 +256,15 @@ class _Loaded:
         p = [v.ctypes.data_as(ctypes.POINTER(ctypes.c_double)) for v in (xs, a, u, nxt)]
         status = o._step(ctypes.byref(self.tube), p[0], t, dt, p[1], p[2], p[3])
         return u.copy(), nxt.copy(), int(status)
+
+    def switch_error(self, x) -> float:
+        """``max_i |e_i|`` of the state ``x`` in this tube at its ``t = 0`` (``alpha = 0``),
+        as the generated ``P_switch`` computes it; ``inf`` where it refuses for another
+        reason (a state that is not finite)."""
+        o = self.owner
+        scratch = o.active()
+        o.functions["active_init"](ctypes.byref(scratch))
+        xs = np.ascontiguousarray(np.reshape(x, o.n), dtype=float)
+        code = o.functions["switch"](ctypes.byref(scratch), ctypes.byref(self.tube), 0.0,
+                                     xs.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 0.0)
+        return float(scratch.error) if code in (0, 4) else math.inf

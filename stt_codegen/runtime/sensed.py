@@ -502,7 +502,10 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
                 record.events.append(PlanEvent(t, "kept", len(designs) - 1, plan.measured_at,
                                                plan.guarantee_until, plan.cpu_s))
                 continue
-            e = _error(plan, x, spec)
+            incoming = controller_of(plan.design)
+            # the generated C decides on backend c (P_switch), the oracle elsewhere
+            e = incoming.switch_error(positions(spec, x[None])[0]) \
+                if hasattr(incoming, "switch_error") else _error(plan, x, spec)
             if e > MAX_INITIAL_ERROR:
                 record.refused += 1
                 record.events.append(PlanEvent(
@@ -522,7 +525,7 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
                 continue
             active = plan
             designs.append(plan.design)
-            controller = controller_of(plan.design)
+            controller = incoming
             predict = delay_predictor(spec, plan.design.tube, plan.design.stage)
             alpha = np.zeros(2 * n)
             record.switches += 1
