@@ -8,7 +8,7 @@ whose every switch and step is a measured region, on the spec's tube and on a *c
 ``open_windows`` circumvent windows open at once. The controller's step does not read the
 tracked obstacles: they reach it only through the tubes the replanner makes
 (docs/sensing.md); what a step costs is set by the active tube's segments and open
-windows, and what a switch costs by the capacity (``P_tube_check`` reads every row).
+windows, and what a switch costs by the new tube's rows (``P_tube_check`` reads each).
 """
 
 from __future__ import annotations
