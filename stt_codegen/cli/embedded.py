@@ -82,13 +82,9 @@ def cmd_embedded(args: argparse.Namespace) -> int:
         capacity = parse_capacity(args.tube_data)
     design = load_and_design(args)
     from ..spec.variants import variant_of
-    variant = variant_of(design.spec)
     if capacity is not None:
-        if not variant.tube_data:
-            raise SpecError("tube_data", f"the tube as data is generated for law (13)'s "
-                                         f"controller only, not for {variant.plant_words}")
         return tube_data_command(design, args, capacity)
-    return variant.entry("embedded_command")(design, args, seed)
+    return variant_of(design.spec).entry("embedded_command")(design, args, seed)
 
 
 def tube_data_command(design, args: argparse.Namespace, capacity) -> int:

@@ -6,10 +6,9 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ..design.result import Design, require_design
-from ..errors import SpecError
 from ..spec.variants import variant_of
 from .options import LANGUAGES, Options, parse_options
-from .tube_data import TubeCapacity
+from .tube_data import TubeCapacity, require_tube_data
 from .output import write_generation
 
 __all__ = ["design_files", "generate"]
@@ -41,11 +40,9 @@ def design_files(design: Design, options: Options) -> dict[str, bytes]:
         ``options.tube_data`` for a variant whose C does not take its tube as data (field
         ``tube_data``).
     """
-    variant = variant_of(design.spec)
-    if options.tube_data is not None and not variant.tube_data:
-        raise SpecError("tube_data", f"the tube as data is generated for law (13)'s "
-                                     f"controller only, not for {variant.plant_words}")
-    return variant.entry("generation")(design, options)
+    if options.tube_data is not None:
+        require_tube_data(design.spec)
+    return variant_of(design.spec).entry("generation")(design, options)
 
 
 def generate(design: Design, out_dir: str | Path,

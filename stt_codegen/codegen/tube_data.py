@@ -23,7 +23,7 @@ from ..tube.pieces import PROFILE_NAMES
 from .tables import Tables
 
 __all__ = ["DEFAULT_CAPACITY", "TubeCapacity", "TableShape", "parse_capacity",
-           "require_capacity", "table_names", "table_shape"]
+           "require_capacity", "require_tube_data", "table_names", "table_shape"]
 
 
 @dataclass(frozen=True)
@@ -171,6 +171,27 @@ def table_shape(tables: Tables, capacity: TubeCapacity | None) -> TableShape:
         return TableShape(True, True, True, list(PROFILE_NAMES))
     return TableShape(bool(tables.windows), 1 in tables.members, bool(tables.multi),
                       list(tables.profiles))
+
+
+def require_tube_data(spec) -> None:
+    """Refuse a spec whose controller variant has no tube as data (the variant decides:
+    ``ControllerVariant.tube_data``).
+
+    Parameters
+    ----------
+    spec : Spec
+        The spec to generate for.
+
+    Raises
+    ------
+    SpecError
+        Its variant does not take its tube as data (field ``tube_data``).
+    """
+    from ..spec.variants import variant_of
+    variant = variant_of(spec)
+    if not variant.tube_data:
+        raise SpecError("tube_data", f"the tube as data is generated for law (13)'s "
+                                     f"controller only, not for {variant.plant_words}")
 
 
 def require_capacity(design: TubeDesign, capacity: TubeCapacity) -> None:

@@ -51,10 +51,11 @@ from .footprint import elf_stack_bound, linked_sizes, measure
 from .budget import step_budget
 from .programs import (closed_loop_source, judge_printed, parse_closed_loop, parse_replay,
                        replay_source, steps_of)
-from .target import CPU_FLAGS, build_elf, run_checked
+from .target import TARGET_WORDS, build_elf, run_checked
 from .toolchain import missing_message
 
-__all__ = ["COUNT_FRACTIONS", "compare_outputs", "function_profile", "run_embedded"]
+__all__ = ["COUNT_FRACTIONS", "ToolsMissing", "compare_outputs", "function_profile",
+           "run_embedded", "selftest_on_target"]
 
 #: Steps whose instructions are counted: evenly spread over [0, t_c) (fractions of t_c).
 COUNT_FRACTIONS = (0.0, 0.2, 0.4, 0.6, 0.8, 0.999)
@@ -69,6 +70,50 @@ def _selftest_counts(stdout: str) -> tuple[int, int]:
     if m is None:
         raise ToolchainError(f"self-test printed no 'N passed, N failed' line:\n{stdout[-2000:]}")
     return int(m.group(1)), int(m.group(2))
+
+
+def selftest_on_target(files: dict[str, bytes], prefix: str, out_dir: str | Path | None,
+                       timeout: float) -> tuple[Path, Path, int, int]:
+    """Write a generation into ``<build folder>/generated``, build its self-test for the
+    Cortex-M4F and run it under QEMU; the tools are checked before anything is written.
+
+    Parameters
+    ----------
+    files : dict of str to bytes
+        The generated files (``generate_files``), C included.
+    prefix : str
+        The C prefix (``<prefix>.c``, ``<prefix>_selftest.c``).
+    out_dir : str or Path or None
+        The build folder; ``None``: a new temporary one.
+    timeout : float
+        Seconds for the QEMU run.
+
+    Returns
+    -------
+    out, generated : Path
+        The build folder and the folder of the generated files in it.
+    passed, failed : int
+        The self-test's last line.
+
+    Raises
+    ------
+    ToolsMissing
+        A tool is not installed (the message names the Debian packages).
+    ToolchainError
+        The build or the run failed, or the self-test printed no summary.
+    """
+    message = missing_message()
+    if message:
+        raise ToolsMissing(message)
+    out = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="stt-embedded-"))
+    gen = out / "generated"
+    gen.mkdir(parents=True, exist_ok=True)
+    for name, data in files.items():
+        (gen / name).write_bytes(data)
+    st = build_elf([gen / f"{prefix}.c", gen / f"{prefix}_selftest.c"], [gen],
+                   out / "selftest", name="selftest")
+    passed, failed = _selftest_counts(run_checked(st.elf, timeout).stdout)
+    return out, gen, passed, failed
 
 
 def compare_outputs(design: TubeDesign, x, t, dt, alpha, out) -> dict:
@@ -173,26 +218,15 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
     require_variant(spec, "first-order", "law (13)'s firmware loop (run_embedded; "
                                          "stt-codegen embedded runs each variant's own)")
     seed = check_seed(seed)
-    message = missing_message()
-    if message:
-        raise ToolsMissing(message)
-    out = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="stt-embedded-"))
-    gen = out / "generated"
-    gen.mkdir(parents=True, exist_ok=True)
-    files = generate_files(spec, tube, Options(("c",), "single"))
-    for name, data in files.items():
-        (gen / name).write_bytes(data)
     prefix = spec.c_name
+    # 1. the generated self-test
+    out, gen, passed, failed = selftest_on_target(
+        generate_files(spec, tube, Options(("c",), "single")), prefix, out_dir, timeout)
     lib = gen / f"{prefix}.c"
     n = spec.dimension
 
     def run(elf, **kw):
         return run_checked(elf, timeout, **kw)
-
-    # 1. the generated self-test
-    st = build_elf([lib, gen / f"{prefix}_selftest.c"], [gen], out / "selftest", name="selftest")
-    st_run = run(st.elf)
-    passed, failed = _selftest_counts(st_run.stdout)
 
     # 2. the vectors again, outputs compared with the reference
     vec = _vectors(gen / f"{prefix}_vectors.json")
@@ -251,7 +285,7 @@ def run_embedded(design: Design, out_dir: Path | None = None, *,
     linked = linked_sizes(cl.map_file, cl.objects[0])
     report = {
         "spec": spec.name,
-        "target": "Cortex-M4F (QEMU mps2-an386), " + " ".join(CPU_FLAGS) + " -O2, newlib",
+        "target": TARGET_WORDS,
         "precision": "single",
         "flash_bytes": fp.text + fp.rodata,
         "flash_detail": {"text": fp.text, "rodata": fp.rodata, "data": fp.data,

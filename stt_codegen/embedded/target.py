@@ -32,8 +32,8 @@ from stt_codegen.embedded.toolchain import ToolError, Toolchain, find_toolchain,
 from stt_codegen.errors import ToolchainError
 
 __all__ = ["BuildError", "BuildResult", "CPU_FLAGS", "RunError", "RunResult", "build_elf",
-           "count_region_instructions", "elf_sizes", "profile_regions", "run_checked",
-           "run_qemu"]
+           "TARGET_WORDS", "count_region_instructions", "elf_sizes", "profile_regions",
+           "run_checked", "run_qemu"]
 
 #: Code generation flags for the Cortex-M4F (single-precision FPU, hard-float ABI).
 CPU_FLAGS: tuple[str, ...] = (
@@ -49,6 +49,8 @@ LINK_FLAGS: tuple[str, ...] = (
     "--specs=rdimon.specs", "-nostartfiles", "-Wl,--gc-sections",
 )
 LINK_LIBS: tuple[str, ...] = ("-lm",)
+#: The target and its build, in a report's words.
+TARGET_WORDS = "Cortex-M4F (QEMU mps2-an386), " + " ".join(CPU_FLAGS) + " -O2, newlib"
 
 #: Flags the board's startup file is compiled with (gnu99: inline asm).
 _STARTUP_FLAGS: tuple[str, ...] = ("-std=gnu99", "-Wall", "-ffunction-sections",

@@ -14,25 +14,23 @@ windows, and what a switch costs by the new tube's rows (``P_tube_check`` reads 
 from __future__ import annotations
 
 import dataclasses
-import re
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from ..codegen.fileset import file_context
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..codegen.render import c_real, render
 from ..codegen.tables import design_table_rows
-from ..codegen.tube_data import TubeCapacity
+from ..codegen.tube_data import TubeCapacity, require_tube_data
 from ..design.result import Design
 from ..errors import ToolchainError
 from ..tube.parameters import LOWER, SMOOTHSTEP, UPPER, Circumvent, ReachSegment, TubeDesign
 from ..runtime.data_controller import pack_tube
-from ..version import __version__
+from .deploy import selftest_on_target
 from .footprint import measure
-from .target import CPU_FLAGS, build_elf, run_checked
-from .toolchain import missing_message
+from .target import TARGET_WORDS, build_elf, run_checked
 
 __all__ = ["OPEN_WINDOWS", "cost_tube", "run_tube_data"]
 
@@ -119,54 +117,39 @@ def run_tube_data(design: Design, capacity: TubeCapacity, out_dir: str | Path | 
     Raises
     ------
     ToolchainError
-        The Arm toolchain or QEMU is missing (the message names the Debian packages) or
-        failed.
+        The Arm toolchain or QEMU is missing (``ToolsMissing``, the message names the
+        Debian packages) or failed.
     SpecError
-        The capacity holds fewer windows than :data:`OPEN_WINDOWS`, or the spec's tube
-        does not fit it (field ``tube_data``).
+        The spec's variant has no tube as data, the capacity holds fewer windows than
+        :data:`OPEN_WINDOWS`, or the spec's tube does not fit it (field ``tube_data``).
     """
     from ..errors import SpecError
+    require_tube_data(design.spec)
     if capacity.windows < OPEN_WINDOWS:
         raise SpecError("tube_data", f"the cost tube opens {OPEN_WINDOWS} windows: a capacity "
                                      f"of at least {OPEN_WINDOWS} windows is needed")
-    message = missing_message()
-    if message:
-        raise ToolchainError(message)
     spec, tube = design.spec, design.tube
-    out = Path(out_dir) if out_dir is not None else Path(tempfile.mkdtemp(prefix="stt-tube-data-"))
-    gen = out / "generated"
-    gen.mkdir(parents=True, exist_ok=True)
-    files = generate_files(spec, tube, Options(("c",), "single", capacity))
-    for name, data in files.items():
-        (gen / name).write_bytes(data)
     prefix = spec.c_name
+    out, gen, passed, failed = selftest_on_target(
+        generate_files(spec, tube, Options(("c",), "single", capacity)), prefix, out_dir,
+        timeout)
     lib = gen / f"{prefix}.c"
-
-    def run(elf, **kw):
-        return run_checked(elf, timeout, **kw)
-
-    st = build_elf([lib, gen / f"{prefix}_selftest.c"], [gen], out / "selftest", name="selftest")
-    found = re.search(r"^(\d+) passed, (\d+) failed$", run(st.elf).stdout, re.MULTILINE)
-    if found is None:
-        raise ToolchainError("the self-test printed no 'N passed, N failed' line")
-    passed, failed = int(found.group(1)), int(found.group(2))
     wide, open_at = cost_tube(tube, capacity)
     literal = lambda v: c_real(v, True)   # noqa: E731
+    wire_bytes = bytes(pack_tube(wide, capacity, "single"))
     program = render(
-        "embedded_tube_data.c.j2", filename="tube_data.c", spec_name=spec.name,
-        spec_hash=spec.source_hash, casadi_version=_casadi_version(),
-        toolkit_version=__version__, precision="single", capacity=capacity, P=prefix,
-        U=prefix.upper(), n=tube.dimension, zero=literal(0.0),
+        "embedded_tube_data.c.j2", filename="tube_data.c", **file_context(spec, "single"),
+        capacity=capacity, n=tube.dimension, zero=literal(0.0),
         wide=design_table_rows(wide, literal, True), steps=list(range(STEPS)),
         x_design=[literal(v) for v in tube.initial_state],
         x_switch=[literal(0.5 * (a + b)) for a, b in zip(wide.segments[0].lower_from,
                                                         wide.segments[0].upper_from)],
         x_cost=[literal(v) for v in _reach_centre(wide, open_at)],
         switch_at=literal(1.0), open_at=literal(open_at), period=literal(1.0 / tube.rate_hz),
-        wire=[f"0x{b:02x}u" for b in bytes(pack_tube(wide, capacity, "single"))])
+        wire=[f"0x{b:02x}u" for b in wire_bytes])
     (out / "tube_data.c").write_text(program)
     prog = build_elf([lib, out / "tube_data.c"], [gen], out / "program", name="tube_data")
-    res = run(prog.elf, count_instructions=True)
+    res = run_checked(prog.elf, timeout, count_instructions=True)
     printed = [line.split() for line in res.stdout.strip().splitlines()]
     lines = [w for w in printed if not w[0].startswith("wire-")]
     wire = {w[0]: int(w[1]) for w in printed if w[0].startswith("wire-")}
@@ -178,7 +161,7 @@ def run_tube_data(design: Design, capacity: TubeCapacity, out_dir: str | Path | 
     fp = measure(prog.objects[:1], prog.su_files[:1], entry=f"{prefix}_run")
     report = {
         "spec": spec.name,
-        "target": "Cortex-M4F (QEMU mps2-an386), " + " ".join(CPU_FLAGS) + " -O2, newlib",
+        "target": TARGET_WORDS,
         "capacity": capacity.to_json(),
         "vectors_passed": passed, "vectors_failed": failed,
         "flash_bytes": fp.flash_bytes, "ram_bytes": fp.ram_bytes,
@@ -189,7 +172,7 @@ def run_tube_data(design: Design, capacity: TubeCapacity, out_dir: str | Path | 
         "steps_cost": {"statuses": results[2 + STEPS:], "instructions": counts[2 + STEPS:]},
         "cost_tube": {"segments": capacity.segments, "open_windows": OPEN_WINDOWS,
                       "measured_at": open_at},
-        "wire": {"bytes": len(bytes(pack_tube(wide, capacity, "single"))),
+        "wire": {"bytes": len(wire_bytes),
                  "check": wire.get("wire-check"), "same_steps": wire.get("wire-same") == 1},
     }
     report["ok"] = bool(failed == 0 and passed > 0 and results[0] == 0
@@ -205,8 +188,3 @@ def _reach_centre(tube: TubeDesign, t: float) -> list[float]:
     with reference.numpy_math():
         lower, upper = reference.reach_tube(tube, np.array([t]), False)[:2]
     return [float(v) for v in 0.5 * (np.ravel(lower) + np.ravel(upper))]
-
-
-def _casadi_version() -> str:
-    import casadi
-    return casadi.__version__

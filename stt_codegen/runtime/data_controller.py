@@ -19,7 +19,7 @@ import numpy as np
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..codegen.tables import PARAMETERS, design_table_rows
-from ..codegen.tube_data import TubeCapacity, require_capacity
+from ..codegen.tube_data import DEFAULT_CAPACITY, TubeCapacity, require_capacity
 from ..tube.parameters import TubeDesign
 from .compiled import DesignSpec, build_shared
 
@@ -176,8 +176,9 @@ class TubeDataController:
     name = "c"
 
     def __init__(self, design: TubeDesign, capacity: TubeCapacity | None = None) -> None:
-        capacity = capacity or TubeCapacity(max(8, len(design.segments)),
-                                            max(32, len(design.circumvents)))
+        capacity = capacity or TubeCapacity(
+            max(DEFAULT_CAPACITY.segments, len(design.segments)),
+            max(DEFAULT_CAPACITY.windows, len(design.circumvents)))
         spec = DesignSpec(design)
         files = generate_files(spec, design, Options(("c",), "double", capacity))
         prefix = spec.c_name
@@ -185,26 +186,25 @@ class TubeDataController:
         self._lib = ctypes.CDLL(str(build_shared(sources, f"{prefix}.c")))
         self.n, self.capacity, self.design = design.dimension, capacity, design
         self.struct = tube_struct(self.n, capacity)
-        ptr = ctypes.POINTER(ctypes.c_double)
+        ptr, real, integer = (ctypes.POINTER(ctypes.c_double), ctypes.c_double,
+                              ctypes.c_int)
         tube_p = ctypes.POINTER(self.struct)
-        self._step = getattr(self._lib, f"{prefix}_step")
-        self._step.argtypes = [tube_p, ptr, ctypes.c_double, ctypes.c_double, ptr, ptr, ptr]
-        self._step.restype = ctypes.c_int
-        self._check = getattr(self._lib, f"{prefix}_tube_check")
-        self._check.argtypes, self._check.restype = [tube_p], ctypes.c_int
         self.design_tube = self.struct.in_dll(self._lib, f"{prefix}_design_tube")
         self.active = active_struct(self.n)
         active_p = ctypes.POINTER(self.active)
         self.functions = {}
         for name, args, result in (
+                ("step", [tube_p, ptr, real, real, ptr, ptr, ptr], integer),
+                ("tube_check", [tube_p], integer),
                 ("active_init", [active_p], None),
-                ("switch", [active_p, tube_p, ctypes.c_double, ptr, ctypes.c_double],
-                 ctypes.c_int),
-                ("run", [active_p, ptr, ctypes.c_double, ctypes.c_double, ptr], ctypes.c_int)):
+                ("switch", [active_p, tube_p, real, ptr, real], integer),
+                ("run", [active_p, ptr, real, real, ptr], integer)):
             f = getattr(self._lib, f"{prefix}_{name}")
             f.argtypes, f.restype = args, result
             self.functions[name] = f
+        # the step's arrays and their pointers, made once: x, alpha, u, alpha_next
         self._arrays = [np.zeros(size) for size in (self.n, 2 * self.n) * 2]
+        self._pointers = [v.ctypes.data_as(ptr) for v in self._arrays]
 
     def pack(self, design: TubeDesign):
         """``design`` as a ``<P>_tube_data`` of this library (:func:`pack_tube`).
@@ -218,7 +218,7 @@ class TubeDataController:
 
     def check(self, tube) -> int:
         """``<P>_tube_check`` of a packed tube (``0``: well formed)."""
-        return int(self._check(ctypes.byref(tube)))
+        return int(self.functions["tube_check"](ctypes.byref(tube)))
 
     def load(self, design: TubeDesign) -> "_Loaded":
         """A controller running ``design``'s tube (packed, checked) on this library.
@@ -253,8 +253,8 @@ class _Loaded:
         a[:] = np.reshape(alpha, 2 * o.n)
         u.fill(0.0)
         nxt.fill(0.0)
-        p = [v.ctypes.data_as(ctypes.POINTER(ctypes.c_double)) for v in (xs, a, u, nxt)]
-        status = o._step(ctypes.byref(self.tube), p[0], t, dt, p[1], p[2], p[3])
+        px, pa, pu, pn = o._pointers
+        status = o.functions["step"](ctypes.byref(self.tube), px, t, dt, pa, pu, pn)
         return u.copy(), nxt.copy(), int(status)
 
     def switch_error(self, x) -> float:

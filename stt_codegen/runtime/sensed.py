@@ -476,8 +476,8 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
     pending: list[SensedPlan] = []
     reveals: list[tuple[int, tuple]] = []
     next_measure = 1
-    controller_of = _controllers(backend, design)
-    controller = controller_of(active.design)
+    runner = _Runner(backend, design)
+    controller = runner.controller(active.design)
     predict = delay_predictor(spec, active.design.tube, active.design.stage)
     alpha, u_prev = np.zeros(2 * n), np.zeros(n)
     dense, dense_t = [positions(spec, x[None])], [np.zeros(1)]
@@ -502,11 +502,8 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
                 record.events.append(PlanEvent(t, "kept", len(designs) - 1, plan.measured_at,
                                                plan.guarantee_until, plan.cpu_s))
                 continue
-            incoming = controller_of(plan.design)
-            # the generated C decides on backend c (P_switch), the oracle elsewhere
-            e = incoming.switch_error(positions(spec, x[None])[0]) \
-                if hasattr(incoming, "switch_error") else _error(plan, x, spec)
-            if e > MAX_INITIAL_ERROR:
+            e, incoming = runner.admit(plan, x)
+            if incoming is None:
                 record.refused += 1
                 record.events.append(PlanEvent(
                     t, "refused", len(designs) - 1, plan.measured_at,
@@ -601,16 +598,34 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
                    reach, record, stepper)
 
 
-def _controllers(backend: str, design: Design):
-    """``design -> controller`` of the backend: on ``c``, the spec's C with the tube as data
-    compiled once (:class:`~.data_controller.TubeDataController`) and each plan's tube loaded
-    into it, as a controller on the robot runs them; else the backend's controller of each
-    plan's tube."""
-    if backend == "c":
-        from .data_controller import TubeDataController
-        library = TubeDataController(design.tube)
-        return lambda plan_design: library.load(plan_design.tube)
-    return lambda plan_design: make_controller(backend, plan_design.tube, plan_design.stage)
+class _Runner:
+    """The controllers of a run and its switch test, by backend: on ``c``, the spec's C
+    with the tube as data compiled once (:class:`~.data_controller.TubeDataController`),
+    each plan's tube loaded into it and its ``P_switch`` deciding, as on a robot; else the
+    backend's controller of each tube, and the oracle's ``|e|`` (:func:`_error`)."""
+
+    def __init__(self, backend: str, design: Design) -> None:
+        self.backend, self.spec = backend, design.spec
+        self.library = None
+        if backend == "c":
+            from .data_controller import TubeDataController
+            self.library = TubeDataController(design.tube)
+
+    def controller(self, design: Design):
+        """The controller running ``design``'s tube."""
+        if self.library is not None:
+            return self.library.load(design.tube)
+        return make_controller(self.backend, design.tube, design.stage)
+
+    def admit(self, plan: SensedPlan, x: np.ndarray) -> tuple[float, object | None]:
+        """``(|e|, controller)`` of the plan's tube at its ``t = 0`` for the state ``x``;
+        the controller is ``None`` where ``|e| > MAX_INITIAL_ERROR`` (the switch refused)."""
+        if self.library is not None:
+            loaded = self.library.load(plan.design.tube)
+            e = loaded.switch_error(positions(self.spec, x[None])[0])
+            return e, (loaded if e <= MAX_INITIAL_ERROR else None)
+        e = _error(plan, x, self.spec)
+        return e, (self.controller(plan.design) if e <= MAX_INITIAL_ERROR else None)
 
 
 def _escape_words(plan: SensedPlan, spec) -> str:
