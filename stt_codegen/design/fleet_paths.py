@@ -197,9 +197,11 @@ class Reservations:
 
 def space_time_path(grid: SpaceTimeGrid, taken: Reservations, start: tuple[int, int] | None,
                     goal: tuple[int, int] | None, last_step: int,
-                    max_expansions: int = MAX_EXPANSIONS) -> list[tuple[int, int, int]] | None:
+                    max_expansions: int = MAX_EXPANSIONS,
+                    stay_steps: int | None = None) -> list[tuple[int, int, int]] | None:
     """The earliest path from ``start`` at step 0 to ``goal`` by ``last_step`` that keeps
-    clear of the taken cells, the goal clear from the arrival on.
+    clear of the taken cells, the goal clear from the arrival on (for ``stay_steps``
+    steps, or to the horizon).
 
     Parameters
     ----------
@@ -211,6 +213,9 @@ def space_time_path(grid: SpaceTimeGrid, taken: Reservations, start: tuple[int, 
         The latest arrival (the prescribed time in steps).
     max_expansions : int
         The search's budget.
+    stay_steps : int, optional
+        How many steps the goal must stay clear after the arrival; default: to the
+        horizon.
 
     Returns
     -------
@@ -231,8 +236,14 @@ def space_time_path(grid: SpaceTimeGrid, taken: Reservations, start: tuple[int, 
     horizon = taken.steps
     if start is None or goal is None or not (grid.free[start] and grid.free[goal]):
         return None
-    # the goal, once reached at step k, must stay clear to the horizon
-    clear_after = np.flip(np.cumsum(np.flip(busy[:, goal[0], goal[1]]))) == 0
+    # the goal, once reached at step k, must stay clear to the horizon (or stay_steps on)
+    at_goal = busy[:, goal[0], goal[1]]
+    if stay_steps is None:
+        clear_after = np.flip(np.cumsum(np.flip(at_goal))) == 0
+    else:
+        ahead = np.concatenate([np.cumsum(at_goal[::-1])[::-1], [0]])
+        ends = np.minimum(np.arange(at_goal.size) + stay_steps + 1, at_goal.size)
+        clear_after = ahead[:at_goal.size] - ahead[ends] == 0
     h = grid.steps_to(goal)
     if not np.isfinite(h[start]):
         return None

@@ -48,6 +48,7 @@ from .certificate.report import ROUNDING_MARGIN
 from .failures import without_advice
 from .result import Design, require_design
 from .search import check_tube, design_tube
+from .sensed_path import PREDICTION_SPAN, path_design
 
 __all__ = ["CHUNK_SECONDS", "ESCAPE_CLEARANCE", "ESCAPE_DIRECTIONS", "ESCAPE_DISTANCES",
            "ESCAPE_TIME", "FORESIGHT", "LATE_TIME", "MAX_ESCAPES", "ReplanFailure",
@@ -686,6 +687,12 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
                             sensing.horizon + FORESIGHT, first + len(boxes),
                             sensing.velocity_error)
     outcome: tuple[str, str] | None = None
+    # a way through where the sensed obstacles are headed over the whole tube, then the
+    # design for the horizon and a short foresight, then without the foresight
+    made = _along_path(base, active, moving, boxes, sensed, sensing, s, t_m, t_s, remaining,
+                       first)
+    if made is not None:
+        return done(task=plan.task, **made)
     tries = [(active, boxes + ahead), (active, boxes)] + ([] if near is None
                                                           else [(near, boxes)])
     for box, avoided in tries:
@@ -803,14 +810,36 @@ def _to_target(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
             "(room " + "; ".join(rooms) + ")", "region")
 
 
+def _along_path(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
+                boxes: tuple[MovingObstacle, ...], sensed: Sequence[SensedObstacle],
+                sensing: Sensing, s: np.ndarray, t_m: float, t_s: float, remaining: float,
+                first: int) -> dict | None:
+    """A certified tube from ``box`` to the target along a space-time path among where
+    the sensed obstacles are headed (:func:`~.sensed_path.path_design`), held to the
+    region certificate: the plan's fields, or ``None``."""
+    local = _new_local(base, box, moving, remaining)
+
+    def predict(t_to: float) -> tuple[MovingObstacle, ...]:
+        return foresight_boxes(sensed, _reach(base), sensing.dims, t_s, 0.0, t_to,
+                               first + len(boxes), sensing.velocity_error, PREDICTION_SPAN)
+
+    found = path_design(local, boxes, predict, sensing.dims)
+    if found is None:
+        return None
+    arrival = t_s + found.tube.segments[-1].end
+    made = _new_plan(local, boxes, sensing, s, t_m, t_s, arrival, first, found=found)
+    return made if isinstance(made, dict) else None
+
+
 def _new_plan(local: Spec, boxes: tuple[MovingObstacle, ...], sensing: Sensing,
               s: np.ndarray, t_m: float, t_s: float, arrival: float, first: int,
-              goal: Box | None = None) -> dict | tuple[float, float]:
-    """A new tube for ``local`` designed against the sensed obstacles' ``boxes`` too, held
-    to the region certificate: the plan's fields, or the room and where it is smallest
-    (in the tube's time) when the tube leaves the region. :class:`DesignError` when no
-    tube is designed."""
-    new = design_tube(replace(local, moving_obstacles=local.moving_obstacles + boxes))
+              goal: Box | None = None, found: Design | None = None
+              ) -> dict | tuple[float, float]:
+    """A new tube for ``local`` designed against the sensed obstacles' ``boxes`` too (or
+    ``found``, already certified against them), held to the region certificate: the
+    plan's fields, or the room and where it is smallest (in the tube's time) when the tube
+    leaves the region. :class:`DesignError` when no tube is designed."""
+    new = found or design_tube(replace(local, moving_obstacles=local.moving_obstacles + boxes))
     room, at = region_margin(new, sensing, _reach(local), t_s, t_m, s, 0.0, sensing.horizon)
     if room <= ROUNDING_MARGIN:
         return room, at

@@ -1,0 +1,67 @@
+"""The replanner's space-time path among where the sensed obstacles are headed
+(``design/sensed_path.py``, docs/sensing.md "How the next plan is made")."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import stt_codegen as stt
+from stt_codegen.design import sensed as sensed_module
+from stt_codegen.design.fleet_paths import Reservations, SpaceTimeGrid, space_time_path
+from stt_codegen.design.sensed_path import MAX_SEGMENTS, MOTION_SENSED_PATH, path_design
+from test_sensing_replan import CORRIDOR, oracle_tube
+
+
+@pytest.fixture(scope="module")
+def corridor():
+    design = stt.design_tube(stt.Spec.from_dict(CORRIDOR))
+    plan = stt.start_plan(design)
+    here = np.asarray(sensed_module._box_at(plan, 1.0, design.spec.state_space).center)
+    return design, plan, here
+
+
+#: A person standing in the hall's middle, drifting at 0.05 m/s: they stay in the way.
+STANDING = stt.SensedObstacle.ball((3.0, 2.0), 0.35, seen_at=1.0, velocity=(0.0, 0.05))
+
+
+def test_a_slow_person_in_the_way_is_gone_round_before_the_deadline(corridor):
+    """The new tube goes round where the person is headed over its whole time (the
+    prediction, at every sample until it arrives), not only over the certified horizon,
+    and arrives before ``t_c``; it is certified like every plan."""
+    design, plan, here = corridor
+    new = stt.replan(plan, 1.0, here, [STANDING])
+    assert isinstance(new, stt.SensedPlan), new.reason
+    assert new.design.motion == MOTION_SENSED_PATH and not new.kept
+    assert new.arrival <= CORRIDOR["prescribed_time"]
+    assert new.sensed_margin > 0 and new.region_margin > 0
+    assert len(new.design.tube.segments) <= MAX_SEGMENTS and not new.design.tube.circumvents
+    reach = CORRIDOR["robot"]["radius"]
+    ts, lows, highs = oracle_tube(new.design.tube, new.arrival - new.start, 100.0)
+    for t, lo, hi in zip(ts, lows, highs):
+        seen = new.start + t - STANDING.seen_at
+        centre = np.asarray(STANDING.centre) + np.asarray(STANDING.velocity) * seen
+        nearest = np.clip(centre, lo[:2], hi[:2])
+        assert np.linalg.norm(nearest - centre) > STANDING.extent + reach, t
+
+
+def test_the_path_is_not_tried_under_an_actuator_bound(corridor):
+    """Its tube carries no input proof, so a spec with ``[actuator]`` keeps the design
+    step (whose tubes carry it)."""
+    design, plan, here = corridor
+    bounded = dataclasses.replace(plan.local, input_bound=(5.0, 5.0))
+    assert path_design(bounded, (), lambda t_to: (), (0, 1)) is None
+    assert path_design(plan.local, (), lambda t_to: (), (0, 1)) is not None
+
+
+def test_the_goal_stays_clear_only_as_long_as_asked():
+    """``stay_steps``: an obstacle crossing the goal long after the arrival does not stop
+    the path; to the horizon (the default) it does, until it has crossed."""
+    grid = SpaceTimeGrid(np.zeros(2), 1.0, np.ones((5, 3), dtype=bool), (0, 1))
+    taken = Reservations(grid, 1.0, 20)
+    taken.taken[15, 4, 1] = True
+    assert space_time_path(grid, taken, (0, 1), (4, 1), 20, stay_steps=5)[-1] == (4, 1, 4)
+    assert space_time_path(grid, taken, (0, 1), (4, 1), 20)[-1] == (4, 1, 17)
+    assert space_time_path(grid, taken, (0, 1), (4, 1), 20, stay_steps=11)[-1] == (4, 1, 17)
