@@ -666,23 +666,30 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
                     certified_from=t_m, switch_at=plan.switch_at, arrival=plan.arrival,
                     kept=True, sensed_margin=margin, region_margin=room, goal=plan.goal)
 
-    # 1. the active tube, certified again from the measurement on (an escape's after the
-    #    target has been tried again)
-    if plan.goal is None:
-        kept = kept_plan()
-        if kept is not None:
-            return kept
-    # 2. a new tube to the target from the active tube's box at the switch, then from a
-    #    box around where the robot will be
     base = plan.task
     first = len(base.unsafe_sets) + len(base.moving_obstacles) + 1_000
     boxes = reachable_boxes(sensed, sensing.max_obstacle_speed, _reach(base), sensing.dims,
                             t_s, 0.0, sensing.horizon, first, **_drift(sensing))
     moving = _shifted(base.moving_obstacles, t_s)
+    remaining = max(base.prescribed_time - t_s, LATE_TIME)
+    # 1. the active tube, certified again from the measurement on (an escape's after the
+    #    target has been tried again)
+    if plan.goal is None:
+        kept = kept_plan()
+        if kept is not None:
+            # a kept tube headed where an obstacle is going: a way round it, if one is
+            # certified now (else the kept tube, certified)
+            if not _headed_into(kept, sensed, sensing, until, first):
+                return kept
+            active = _box_at(plan, t_s - plan.start, base.state_space)
+            made = _along_path(base, active, moving, boxes, sensed, sensing, s, t_m, t_s,
+                               remaining, first)
+            return kept if made is None else done(task=plan.task, **made)
+    # 2. a new tube to the target from the active tube's box at the switch, then from a
+    #    box around where the robot will be
     active = _box_at(plan, t_s - plan.start, base.state_space)
     point = _predicted(plan, active, s, t_m, sensing)
     near = _switch_box(base, active, point, sensing)
-    remaining = max(base.prescribed_time - t_s, LATE_TIME)
     ahead = foresight_boxes(sensed, _reach(base), sensing.dims, t_s, sensing.horizon,
                             sensing.horizon + FORESIGHT, first + len(boxes),
                             sensing.velocity_error)
@@ -712,6 +719,19 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     if isinstance(made, dict):
         return done(task=plan.task, **made)
     return failed(outcome[0] + f"; and no escape: {made}", outcome[1])
+
+
+def _headed_into(kept: SensedPlan, sensed: Sequence[SensedObstacle], sensing: Sensing,
+                 until: float, first: int) -> bool:
+    """Whether the kept tube may meet where a sensed obstacle is headed over the
+    :data:`FORESIGHT` after its certified horizon (``until``, absolute)."""
+    if not sensed:
+        return False
+    t_from = until - kept.start
+    ahead = foresight_boxes(sensed, _reach(kept.task), sensing.dims, kept.start, t_from,
+                            t_from + FORESIGHT, first, sensing.velocity_error)
+    spec = replace(kept.local, moving_obstacles=kept.local.moving_obstacles + ahead)
+    return not check_tube(kept.design.tube, spec).passed
 
 
 def foresight_boxes(sensed: Sequence[SensedObstacle], reach: float, dims: Sequence[int],

@@ -52,7 +52,7 @@ __all__ = ["MAX_EXPANSIONS", "MAX_SEGMENTS", "MAX_SPEED", "LATE_SECONDS", "MIN_S
 MOTION_SENSED_PATH = "sensed path"
 #: The path's speed: this times the straight line's over the prescribed time, state units
 #: per second, within [MIN_SPEED, MAX_SPEED].
-SPEED_FACTOR, MIN_SPEED, MAX_SPEED = 2.5, 0.5, 2.0
+SPEED_FACTOR, MIN_SPEED, MAX_SPEED = 2.5, 1.0, 2.0
 #: The longest span of one predicted box, s.
 PREDICTION_SPAN = 0.25
 #: The most (cell, step) states the search expands (it runs in the replanner's budget).
@@ -120,7 +120,7 @@ def path_design(local: Spec, hard: tuple[MovingObstacle, ...],
     taken.taken[:math.ceil(START_SECONDS / step) + 1, cells[0], cells[1]] = False
     path = space_time_path(grid, taken, cells, goal, last, MAX_EXPANSIONS,
                            math.ceil(STAY_SECONDS / step))
-    if path is None:
+    if path is None or len(path) < 2:        # none, or at the goal already: nothing new
         return None
     base = base_design(local)
     segments = space_time_segments(path, grid, base, step, SMOOTHSTEP)
