@@ -44,7 +44,7 @@ from ..tube.parameters import ReachSegment, TubeDesign
 from .via import VIA_HALF_WIDTH
 
 __all__ = ["CELL", "MAX_EXPANSIONS", "ROOM", "STATIC_ROOM", "Reservations", "SpaceTimeGrid",
-           "space_time_path", "space_time_segments"]
+           "shortcut", "space_time_path", "space_time_segments"]
 
 #: The grid's cell side, state units (metres).
 CELL = 0.5
@@ -282,6 +282,64 @@ def space_time_path(grid: SpaceTimeGrid, taken: Reservations, start: tuple[int, 
             parent[key] = (i, j, k)
             heapq.heappush(heap, (kk + float(h[a, b]), kk, a, b))
     return None
+
+
+def shortcut(path: Sequence[tuple[int, int, int]], grid: SpaceTimeGrid,
+             taken: Reservations) -> list[tuple[int, int, int]]:
+    """``path`` with its entries joined by straight moves where they keep clear: from each
+    kept entry, the farthest later one whose straight line, timed as a smooth-step
+    segment (``p = tau^3 (10 - 15 tau + 6 tau^2)`` of the way at the share ``tau`` of its
+    time), passes only cells that are free and not taken at each step and the next (both
+    neighbours where it lies between two).
+
+    Parameters
+    ----------
+    path : sequence of (i, j, step)
+        From :func:`space_time_path`.
+    grid : SpaceTimeGrid
+    taken : Reservations
+
+    Returns
+    -------
+    list of (i, j, step)
+        A sub-sequence of ``path`` with the same first and last entries; consecutive
+        entries need not be neighbours (a move may be slower than one cell per step, or
+        a wait and a move in one).
+
+    Examples
+    --------
+    A move, a wait and a move along one row become one slower move:
+
+    >>> import numpy as np
+    >>> grid = SpaceTimeGrid(np.zeros(2), 1.0, np.ones((5, 3), dtype=bool), (0, 1))
+    >>> taken = Reservations(grid, 1.0, 10)
+    >>> shortcut([(0, 1, 0), (1, 1, 1), (1, 1, 2), (2, 1, 3)], grid, taken)
+    [(0, 1, 0), (2, 1, 3)]
+    """
+    busy, free = taken.taken, grid.free
+    last = busy.shape[0] - 1
+
+    def clear(a: tuple[int, int, int], b: tuple[int, int, int]) -> bool:
+        for k in range(a[2], b[2] + 1):
+            tau = (k - a[2]) / (b[2] - a[2])
+            share = tau ** 3 * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+            at = np.array(a[:2], dtype=float) + share * np.subtract(b[:2], a[:2])
+            lo, hi = np.floor(at + 1e-9).astype(int), np.ceil(at - 1e-9).astype(int)
+            for i in range(lo[0], hi[0] + 1):
+                for j in range(lo[1], hi[1] + 1):
+                    if not free[i, j] or busy[k, i, j] or busy[min(k + 1, last), i, j]:
+                        return False
+        return True
+
+    out = [tuple(path[0])]
+    a = 0
+    while a < len(path) - 1:
+        b = len(path) - 1
+        while b > a + 1 and not clear(path[a], path[b]):
+            b -= 1
+        out.append(tuple(path[b]))
+        a = b
+    return out
 
 
 def space_time_segments(path: Sequence[tuple[int, int, int]], grid: SpaceTimeGrid,

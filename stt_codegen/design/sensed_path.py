@@ -39,7 +39,7 @@ from ..spec.loader import Spec
 from ..spec.motion import MovingObstacle
 from ..spec.sensing import SensedObstacle, Sensing
 from ..tube.parameters import SMOOTHSTEP
-from .fleet_paths import CELL, Reservations, SpaceTimeGrid, space_time_path, \
+from .fleet_paths import Reservations, SpaceTimeGrid, shortcut, space_time_path, \
     space_time_segments
 from .gain import derived_gain
 from .result import METHOD_VIA, Design
@@ -124,6 +124,9 @@ def path_design(local: Spec, hard: tuple[MovingObstacle, ...],
         return None
     base = base_design(local)
     segments = space_time_segments(path, grid, base, step, SMOOTHSTEP)
+    if len(segments) > MAX_SEGMENTS:     # fewer knots: straight moves where they keep clear
+        segments = space_time_segments(shortcut(path, grid, taken), grid, base, step,
+                                       SMOOTHSTEP)
     if len(segments) > MAX_SEGMENTS:
         return None
     # a path later than the prescribed time is the tube's prescribed time (a late plan)
