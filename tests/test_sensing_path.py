@@ -10,7 +10,8 @@ import pytest
 
 import stt_codegen as stt
 from stt_codegen.design import sensed as sensed_module
-from stt_codegen.design.fleet_paths import Reservations, SpaceTimeGrid, space_time_path
+from stt_codegen.design.fleet_paths import (Reservations, SpaceTimeGrid, shortcut,
+                                             space_time_path)
 from stt_codegen.design.sensed_path import MAX_SEGMENTS, MOTION_SENSED_PATH, path_design
 from test_sensing_replan import CORRIDOR, oracle_tube
 
@@ -65,3 +66,42 @@ def test_the_goal_stays_clear_only_as_long_as_asked():
     assert space_time_path(grid, taken, (0, 1), (4, 1), 20, stay_steps=5)[-1] == (4, 1, 4)
     assert space_time_path(grid, taken, (0, 1), (4, 1), 20)[-1] == (4, 1, 17)
     assert space_time_path(grid, taken, (0, 1), (4, 1), 20, stay_steps=11)[-1] == (4, 1, 17)
+
+
+def test_a_robot_waiting_in_the_target_steps_out_of_an_obstacles_way_early(corridor):
+    """In the target after ``t_c``, a person walks at it along the hall: their reachable
+    box over the horizon misses the target, so the tube could be kept, but where they are
+    headed 2 s later does not; the robot leaves along a path that keeps clear of their
+    prediction and comes back once they have passed. A person walking past far from the
+    target leaves the tube kept."""
+    design, plan, _ = corridor
+    person = stt.SensedObstacle.ball((3.0, 2.0), 0.35, seen_at=11.0, velocity=(0.6, 0.0))
+    away = stt.replan(plan, 11.0, (5.5, 2.0), [person])
+    assert isinstance(away, stt.SensedPlan), away.reason
+    assert not away.kept and away.design.motion == MOTION_SENSED_PATH
+    assert away.sensed_margin > 0 and away.region_margin > 0
+    reach = CORRIDOR["robot"]["radius"]
+    ts, lows, highs = oracle_tube(away.design.tube, away.arrival - away.start + 2.0, 100.0)
+    for t, lo, hi in zip(ts, lows, highs):
+        centre = np.asarray(person.centre) + np.asarray(person.velocity) * (
+            away.start + t - person.seen_at)
+        nearest = np.clip(centre, lo[:2], hi[:2])
+        assert np.linalg.norm(nearest - centre) > person.extent + reach, t
+    target = design.spec.target_set
+    assert np.all(lows[-1] >= np.array(target.lower)) and np.all(highs[-1] <= target.upper)
+    passing = dataclasses.replace(person, centre=(3.0, 0.45))
+    assert stt.replan(plan, 11.0, (5.5, 2.0), [passing]).kept
+
+
+def test_a_shortcut_keeps_clear_of_what_the_path_went_round():
+    """Straight moves replace the path's steps only where no taken cell lies on them."""
+    grid = SpaceTimeGrid(np.zeros(2), 1.0, np.ones((5, 3), dtype=bool), (0, 1))
+    taken = Reservations(grid, 1.0, 12)
+    taken.taken[:, 2, 1] = True                       # a post in the middle row
+    path = space_time_path(grid, taken, (0, 1), (4, 1), 12)
+    short = shortcut(path, grid, taken)
+    assert short[0] == path[0] and short[-1] == path[-1] and len(short) < len(path)
+    assert set(short) <= set(path)
+    assert not any(c[:2] == (2, 1) for c in short)
+    for a, b in zip(short, short[1:]):                # no straight move through the post
+        assert not (a[1] == b[1] == 1 and min(a[0], b[0]) < 2 < max(a[0], b[0]))

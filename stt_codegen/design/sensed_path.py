@@ -61,7 +61,7 @@ MAX_EXPANSIONS = 20_000
 #: s (an obstacle headed through the target later is met by a later plan: the tube stays).
 STAY_SECONDS = 2.0
 #: How much later than the prescribed time a path may arrive, s (the earliest is taken).
-LATE_SECONDS = 4.0
+LATE_SECONDS = 6.0
 #: How long the start's cell is left free of the reservations, s.
 START_SECONDS = 0.5
 #: The most reach segments of a path's tube.
