@@ -846,6 +846,8 @@ def _along_path(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     found = path_design(local, boxes, predict, sensing.dims)
     if found is None:
         return None
+    # a late path's task is due when it arrives (the next checks hold it to that)
+    local = replace(local, prescribed_time=found.tube.prescribed_time)
     arrival = t_s + found.tube.segments[-1].end
     made = _new_plan(local, boxes, sensing, s, t_m, t_s, arrival, first, found=found)
     return made if isinstance(made, dict) else None

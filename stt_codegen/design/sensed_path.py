@@ -9,16 +9,20 @@ prediction over the whole tube, with the fleet's space-time A* (:mod:`.fleet_pat
 * **Where each obstacle is headed.** Its shape moved along its velocity estimate
   (standing where it was seen without one), grown by the envelope's ``velocity_error``
   times the time since it was seen and by the robot's radius, over spans of
-  :data:`PREDICTION_SPAN` from the tube's start to its prescribed time
+  :data:`PREDICTION_SPAN` from the tube's start to the path's last step
   (:func:`~.sensed.foresight_boxes`). A prediction, not a bound: it only steers the path.
 * **The path.** Cells of :data:`~.fleet_paths.CELL` on the two sensing dimensions, free
-  of the static obstacles; steps of ``CELL / speed``, the speed :data:`SPEED_FACTOR`
-  times the straight line's over the prescribed time, within
-  [:data:`MIN_SPEED`, :data:`MAX_SPEED`] (a path faster than the deadline leaves time for
-  the next obstacle); the earliest arrival first, at most :data:`MAX_EXPANSIONS` states.
+  of the static obstacles, the reachable boxes and the predictions taken where and when
+  they lie (the start's cell left free for :data:`START_SECONDS`: the robot is there);
+  steps of ``CELL / speed``, the speed :data:`SPEED_FACTOR` times the free grid's shortest
+  way over the prescribed time, within [:data:`MIN_SPEED`, :data:`MAX_SPEED`] (a path
+  faster than the deadline leaves time for the next obstacle); the earliest arrival, up
+  to :data:`LATE_SECONDS` past the prescribed time, with the target's cell clear for
+  :data:`STAY_SECONDS` after it; at most :data:`MAX_EXPANSIONS` states.
 * **The tube.** Via boxes along the path's straight runs, waits held
   (:func:`~.fleet_paths.space_time_segments`), at most :data:`MAX_SEGMENTS` reach segments
-  (the default capacity of a controller with the tube as data).
+  (the default capacity of a controller with the tube as data); a path with more is
+  shortcut by straight moves that keep clear (:func:`~.fleet_paths.shortcut`).
 
 Nothing here is trusted: the tube is accepted only when its check
 (:func:`~.search.check_tube`) against the spec's obstacles and the sensed obstacles'
@@ -37,7 +41,6 @@ import numpy as np
 
 from ..spec.loader import Spec
 from ..spec.motion import MovingObstacle
-from ..spec.sensing import SensedObstacle, Sensing
 from ..tube.parameters import SMOOTHSTEP
 from .fleet_paths import Reservations, SpaceTimeGrid, shortcut, space_time_path, \
     space_time_segments
@@ -45,13 +48,14 @@ from .gain import derived_gain
 from .result import METHOD_VIA, Design
 from .search import base_design, check_tube
 
-__all__ = ["MAX_EXPANSIONS", "MAX_SEGMENTS", "MAX_SPEED", "LATE_SECONDS", "MIN_SPEED", "MOTION_SENSED_PATH",
-           "PREDICTION_SPAN", "SPEED_FACTOR", "START_SECONDS", "STAY_SECONDS", "path_design"]
+__all__ = ["LATE_SECONDS", "MAX_EXPANSIONS", "MAX_SEGMENTS", "MAX_SPEED", "MIN_SPEED",
+           "MOTION_SENSED_PATH", "PREDICTION_SPAN", "SPEED_FACTOR", "START_SECONDS",
+           "STAY_SECONDS", "path_design"]
 
 #: How a tube found by this step is named (``Design.motion``).
 MOTION_SENSED_PATH = "sensed path"
-#: The path's speed: this times the straight line's over the prescribed time, state units
-#: per second, within [MIN_SPEED, MAX_SPEED].
+#: The path's speed: this times the free grid's shortest way over the prescribed time,
+#: state units per second, within [MIN_SPEED, MAX_SPEED].
 SPEED_FACTOR, MIN_SPEED, MAX_SPEED = 2.5, 1.0, 2.0
 #: The longest span of one predicted box, s.
 PREDICTION_SPAN = 0.25
