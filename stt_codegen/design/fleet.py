@@ -41,7 +41,7 @@ from .certificate.fleet import PairMargin, RobotTube, pair_margin, robot_tube
 from .failures import FailureKind, without_advice
 from .fleet_index import Chunks, TubeIndex, chunks
 from .fleet_paths import Reservations, SpaceTimeGrid, space_time_path, space_time_segments
-from .gain import derived_gain
+from .gain import with_gain
 from .moving import TIME_STEPS, retimed_design
 from .result import METHOD_VIA, Design, TubeCheck
 from .search import check_tube, design_tube
@@ -604,10 +604,8 @@ def _space_time(robot: FleetRobot, way: Design, placing: _Placing,
     found = check(tube, _free(spec))
     if not found.passed:
         return None, f"its space-time path: {found.reason}"
-    gain = (spec.gain if spec.gain is not None
-            else derived_gain(found.min_width, tube.rate_hz, spec.assumptions))
-    design = _proved(Design(replace(tube, gain=gain), METHOD_VIA, found, 0.0, spec=spec,
-                            motion=MOTION_SPACE_TIME_PATH), spec)
+    design = _proved(Design(with_gain(tube, found.min_width, spec), METHOD_VIA, found, 0.0,
+                            spec=spec, motion=MOTION_SPACE_TIME_PATH), spec)
     if design is None:
         return None, "its space-time path: its input is not proved within actuator.input_bound"
     return design, ""

@@ -19,10 +19,12 @@ design layer never imports verify: verify builds on design).
 
 from __future__ import annotations
 
-from ..spec.loader import Assumptions
+from dataclasses import replace
+
+from ..spec.loader import Assumptions, Spec
 from ..tube.parameters import TubeDesign
 
-__all__ = ["derived_gain", "gain_derivation"]
+__all__ = ["derived_gain", "gain_derivation", "with_gain"]
 
 
 def derived_gain(min_width: float, rate_hz: float, assumptions: Assumptions) -> float:
@@ -47,6 +49,35 @@ def derived_gain(min_width: float, rate_hz: float, assumptions: Assumptions) -> 
     g_min, g_max = assumptions.input_gain
     dt = 1.0 / rate_hz
     return min_width**2 / (8.0 * dt * (g_min + g_max))  # for g = I: exactly the former default
+
+
+def with_gain(tube: TubeDesign, min_width: float, spec: Spec) -> TubeDesign:
+    """``tube`` with the spec's ``controller.gain``, or else the gain :func:`derived_gain`
+    gives for its certified narrowest width: every design path sets ``k`` this way.
+
+    Parameters
+    ----------
+    tube : TubeDesign
+    min_width : float
+        ``gamma_d,min``, the certificate's lower bound of the tube's width, state units.
+    spec : Spec
+        Its ``gain`` (``None``: derive) and ``[assumptions]``.
+
+    Returns
+    -------
+    TubeDesign
+        ``tube`` with ``gain`` set.
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> design = stt.design_tube(stt.load_spec("omnirobot-s1"))
+    >>> with_gain(design.tube, design.check.min_width, design.spec).gain == design.tube.gain
+    True
+    """
+    gain = (spec.gain if spec.gain is not None
+            else derived_gain(min_width, tube.rate_hz, spec.assumptions))
+    return replace(tube, gain=gain)
 
 
 def gain_derivation(design: TubeDesign, min_width: float, min_width_time: float,

@@ -53,7 +53,7 @@ from ..spec.tasks import STAY, Task
 from ..tube import reference
 from ..tube.parameters import CRUISE, SMOOTHSTEP, ReachSegment, TubeDesign
 from .failures import FailureKind
-from .gain import derived_gain
+from .gain import with_gain
 from .certificate.motion import MOVING_PROPERTY
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
 from .tasks import FREE_HOLD, STAY_LEAD, TaskPlan
@@ -396,12 +396,6 @@ def _held(segments: tuple[ReachSegment, ...]) -> tuple[ReachSegment, ...]:
     return tuple(out)
 
 
-def _accept(tube: TubeDesign, check: TubeCheck, spec: Spec) -> TubeDesign:
-    gain = (spec.gain if spec.gain is not None
-            else derived_gain(check.min_width, tube.rate_hz, spec.assumptions))
-    return replace(tube, gain=gain)
-
-
 def design_moving(spec: Spec, design_static: Callable[[Spec], Design],
                   check: Callable[[TubeDesign, Spec], TubeCheck]) -> Design:
     """Design a certified tube for a spec with moving obstacles (see the module notes).
@@ -554,7 +548,7 @@ def retimed_design(via: Design | None, timing: Spec, spec: Spec,
         if not timed.passed:
             why = timed.reason
             continue
-        design = _design(_accept(tube, timed, spec), METHOD_VIA, timed, spec, started,
+        design = _design(with_gain(tube, timed.min_width, spec), METHOD_VIA, timed, spec, started,
                          MOTION_TIMED_VIA, via)
         if spec.input_bound is None:
             return design

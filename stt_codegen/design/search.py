@@ -37,7 +37,7 @@ from .actuator import design_within_bound
 from .failures import FailureKind, advice_wanted, property_kind, without_advice
 from .grid import grid_index, grid_value, smallest_passing
 from .moving import MOTION_SPACE_TIME, design_moving, moves
-from .gain import derived_gain
+from .gain import with_gain
 from .plant_check import plant_failure
 from .result import METHOD_PAPER, METHOD_VIA, Design, TubeCheck
 from .tracking import SMOOTHER_RATIO, centre_speed, tracking_demand, unfollowable
@@ -507,7 +507,7 @@ def _design(spec: Spec, smoother: bool) -> Design:
     if spec.tasks:              # [[tasks]]: via points through the tasks' boxes
         tube, check, choice, plan = _tasks(spec, base)
         # obstacles until a task are certified in space-time (certificate/motion.py)
-        return Design(_with_gain(tube, check, spec), METHOD_VIA, check,
+        return Design(with_gain(tube, check.min_width, spec), METHOD_VIA, check,
                       time.perf_counter() - started, spec=spec, task_choices=choice,
                       task_plan=plan,
                       motion=MOTION_SPACE_TIME if spec.moving_obstacles else "")
@@ -553,18 +553,10 @@ def _design(spec: Spec, smoother: bool) -> Design:
                         else "; no controller.rate_hz up to "
                         f"{RATE_SEARCH_FACTOR:g} times this one makes the tube tried pass")
         raise DesignError(message, kind=kind, tried=tried)
-    tube = _with_gain(tube, check, spec)
+    tube = with_gain(tube, check.min_width, spec)
     if method == "auto" and used == METHOD_PAPER and METHOD_VIA not in errors:
         tube, used, check = _trackable(spec, base, tube, check, smoother)
     return Design(tube, used, check, time.perf_counter() - started, spec=spec)
-
-
-def _with_gain(tube: TubeDesign, check: TubeCheck, spec: Spec) -> TubeDesign:
-    """``tube`` with the spec's ``controller.gain``, or the gain derived from its certified
-    narrowest width (:func:`~stt_codegen.design.gain.derived_gain`)."""
-    gain = (spec.gain if spec.gain is not None
-            else derived_gain(check.min_width, tube.rate_hz, spec.assumptions))
-    return replace(tube, gain=gain)
 
 
 def _trackable(spec: Spec, base: TubeDesign, tube: TubeDesign, check: TubeCheck,
@@ -585,7 +577,7 @@ def _trackable(spec: Spec, base: TubeDesign, tube: TubeDesign, check: TubeCheck,
         via, via_check = _via(spec, base)
     except DesignError:
         return tube, METHOD_PAPER, check
-    via = _with_gain(via, via_check, spec)
+    via = with_gain(via, via_check.min_width, spec)
     if demand.ratio > 1.0 and tracking_demand(via, via_check.certificate, spec).ratio < demand.ratio:
         return via, METHOD_VIA, via_check
     if smoother and (centre_speed(via, via_check.certificate)
@@ -735,7 +727,7 @@ def paper_design(spec: Spec, base: TubeDesign, max_checks: int = MAX_CANDIDATE_C
             if accepted.passed:
                 # the circumvents are what one gain may not follow: a straight tube is the
                 # method's only one, and its proved |e| is far below (docs/design.md)
-                why = (unfollowable(_with_gain(design, accepted, spec), accepted.certificate,
+                why = (unfollowable(with_gain(design, accepted.min_width, spec), accepted.certificate,
                                     spec) if followable and design.circumvents else "")
                 if not why:
                     return design, accepted

@@ -44,7 +44,7 @@ from ..spec.motion import MovingObstacle
 from ..tube.parameters import SMOOTHSTEP
 from .fleet_paths import Reservations, SpaceTimeGrid, shortcut, space_time_path, \
     space_time_segments
-from .gain import derived_gain
+from .gain import with_gain
 from .result import METHOD_VIA, Design
 from .search import base_design, check_tube
 
@@ -140,7 +140,5 @@ def path_design(local: Spec, hard: tuple[MovingObstacle, ...],
     found = check_tube(tube, spec)
     if not found.passed:
         return None
-    gain = (spec.gain if spec.gain is not None
-            else derived_gain(found.min_width, tube.rate_hz, spec.assumptions))
-    return Design(replace(tube, gain=gain), METHOD_VIA, found,
+    return Design(with_gain(tube, found.min_width, spec), METHOD_VIA, found,
                   time.perf_counter() - started, spec=spec, motion=MOTION_SENSED_PATH)
