@@ -216,8 +216,9 @@ def test_the_generated_selftest_passes_on_the_design_tube(cc, tmp_path, precisio
 
 
 def test_bad_requests_name_the_field():
-    with pytest.raises(SpecError, match="C only"):
-        parse_options("c,python", "double", True)
+    assert parse_options("c,python", "double", True).tube_data == TubeCapacity(8, 32)
+    with pytest.raises(SpecError, match="expected True or a TubeCapacity"):
+        parse_options("c", "double", "8,32")
     with pytest.raises(SpecError, match="SEGMENTS,WINDOWS"):
         parse_capacity("8")
     with pytest.raises(SpecError, match="from 1 to 4096"):
@@ -233,11 +234,16 @@ def test_the_command_line_writes_the_data_form_or_exits_2(tmp_path):
     from stt_codegen.cli import main
     assert main(["generate", "omnirobot-s1", "-o", str(tmp_path / "a"), "--tube-data"]) == 0
     assert "omnirobot_s1_tube_data" in (tmp_path / "a" / "omnirobot_s1.h").read_text()
+    assert "class TubeData:" in (tmp_path / "a" / "omnirobot_s1.py").read_text()
     assert main(["generate", "omnirobot-s1", "-o", str(tmp_path / "b"), "--tube-data",
-                 "--lang", "c,python"]) == 2
+                 "--lang", "python"]) == 0
+    assert sorted(p.name for p in (tmp_path / "b").iterdir()) == [
+        "manifest.json", "omnirobot_s1.py", "omnirobot_s1_vectors.json"]
     assert main(["generate", "omnirobot-s1", "-o", str(tmp_path / "c"),
                  "--tube-data", "x"]) == 2
-    assert not (tmp_path / "b").exists() and not (tmp_path / "c").exists()
+    assert main(["generate", "omnirobot-s1", "-o", str(tmp_path / "d"),
+                 "--tube-data", "0,3"]) == 2
+    assert not (tmp_path / "c").exists() and not (tmp_path / "d").exists()
 
 
 @pytest.mark.embedded

@@ -233,8 +233,9 @@ def load_and_design(args: argparse.Namespace) -> Design:
 
 
 def add_tube_data_argument(p: argparse.ArgumentParser) -> None:
-    """``--tube-data [SEGMENTS,WINDOWS]`` (``generate``, ``embedded``): the C whose tube is
-    data (:mod:`stt_codegen.codegen.tube_data`); ``args.tube_data`` is ``None`` or the text.
+    """``--tube-data [SEGMENTS,WINDOWS]`` (``generate``, ``embedded``): the code whose tube
+    is data (:mod:`stt_codegen.codegen.tube_data`); ``args.tube_data`` is ``None`` or the
+    text.
 
     Parameters
     ----------
@@ -244,6 +245,7 @@ def add_tube_data_argument(p: argparse.ArgumentParser) -> None:
     from ..codegen.tube_data import DEFAULT_CAPACITY
     default = f"{DEFAULT_CAPACITY.segments},{DEFAULT_CAPACITY.windows}"
     p.add_argument("--tube-data", nargs="?", metavar="SEGMENTS,WINDOWS", const=default,
-                   help="C whose tube is data, replaced at run time by P_switch, holding up "
-                        "to SEGMENTS reach segments and WINDOWS circumvent windows "
+                   help="code whose tube is data (C, and Python with generate), replaced "
+                        "at run time by its switch, holding up to SEGMENTS reach segments "
+                        "and WINDOWS circumvent windows "
                         f"(default {default}; docs/sensing.md)")

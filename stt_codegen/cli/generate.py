@@ -19,9 +19,8 @@ def cmd_generate(args: argparse.Namespace) -> int:
     Parameters
     ----------
     args : argparse.Namespace
-        ``spec``, ``out_dir``, ``languages`` (comma-separated; ``None``: C and Python, or C
-        alone with ``tube_data``), ``precision`` and ``tube_data`` (``None`` or
-        ``"SEGMENTS,WINDOWS"``).
+        ``spec``, ``out_dir``, ``languages`` (comma-separated; ``None``: C and Python),
+        ``precision`` and ``tube_data`` (``None`` or ``"SEGMENTS,WINDOWS"``).
 
     Returns
     -------
@@ -40,7 +39,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     from .fleet import fleet_generate, fleet_of
     capacity = None if args.tube_data is None else parse_capacity(args.tube_data)
     if args.languages is None:
-        args.languages = "c" if capacity is not None else ",".join(LANGUAGES)
+        args.languages = ",".join(LANGUAGES)
     fleet = fleet_of(args)            # a fleet file: one design per robot (docs/fleets.md)
     if fleet is not None:
         if capacity is not None:

@@ -75,10 +75,11 @@ def generate(design: Design, out_dir: str | Path,
         Floating-point type of the C code (``double`` or ``float``); the Python module
         always computes in Python floats.
     tube_data : bool or TubeCapacity, optional
-        C whose tube is data (``True``: 8 segments and 32 windows): every function takes
-        a ``P_tube_data``, ``P_switch`` replaces the active tube at run time where the
-        state lies in the new one (docs/sensing.md, "The tube as data"); C only, law
-        (13)'s controller only. Default ``False``: the tube in ``const`` tables.
+        Code whose tube is data (``True``: 8 segments and 32 windows): every function
+        takes a ``P_tube_data`` (Python: a ``TubeData``), ``P_switch`` (``switch``)
+        replaces the active tube at run time where the state lies in the new one
+        (docs/sensing.md, "The tube as data"); C and Python, law (13)'s controller only.
+        Default ``False``: the tube in tables.
 
     Returns
     -------
@@ -92,8 +93,8 @@ def generate(design: Design, out_dir: str | Path,
         or a ``Spec``, say): call :func:`stt_codegen.design_tube` first.
     SpecError
         Unknown language (field ``languages``) or precision (``precision``); an unusable
-        or foreign output folder (``out_dir``); the tube as data with Python, for another
-        variant, or smaller than the spec's tube (``tube_data``).
+        or foreign output folder (``out_dir``); the tube as data for another variant, or
+        smaller than the spec's tube (``tube_data``).
     ToolchainError
         ``CodegenError`` or ``EmitError``: the model could not be turned into code.
 

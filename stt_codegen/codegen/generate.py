@@ -33,7 +33,8 @@ from .fileset import (GENERATOR, MANIFEST, build_files, manifest, selftest_file,
 from .options import Options
 from .render import c_identifier, c_real, render
 from .tables import design_table_rows
-from .tube_data import TubeCapacity, require_capacity, table_names, table_shape
+from .tube_data import (TubeCapacity, python_names, require_capacity, table_names,
+                        table_shape)
 from ..tube.pieces import PROFILE_NAMES, error_transform
 from .vectors import test_vectors
 
@@ -94,6 +95,8 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
         name = f"{prefix}.py"
         programs = [dataclasses.replace(lower(f), name=f"body_{f.name()}") for f in functions]
         files[name] = render("python_module.py.j2", filename=name, **common,
+                             T=python_names(capacity is not None), capacity=capacity,
+                             max_initial_error=repr(float(MAX_INITIAL_ERROR)),
                              bodies=python_source(programs).rstrip("\n"),
                              spec_tables=design_table_rows(design, lambda v: repr(float(v)),
                                                            False),

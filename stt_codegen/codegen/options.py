@@ -28,8 +28,8 @@ class Options:
     precision : str
         One of :data:`PRECISIONS`; applies to the C code (and the vectors' tolerances).
     tube_data : TubeCapacity or None
-        The C takes its tube as data, up to these sizes (:mod:`.tube_data`); ``None``
-        (default): the design's tube in ``const`` tables.
+        The generated code (C and Python) takes its tube as data, up to these sizes
+        (:mod:`.tube_data`); ``None`` (default): the design's tube in tables.
     """
 
     langs: tuple[str, ...] = LANGUAGES
@@ -55,8 +55,8 @@ def parse_options(langs: str | Sequence[str] = "c,python", precision: str = "dou
     precision : str
         One of :data:`PRECISIONS` (``"double"``, ``"single"``).
     tube_data : bool or TubeCapacity, optional
-        The C takes its tube as data (``True``: :data:`~.tube_data.DEFAULT_CAPACITY`); C
-        only.
+        The generated code takes its tube as data (``True``:
+        :data:`~.tube_data.DEFAULT_CAPACITY`), in C and in Python.
 
     Returns
     -------
@@ -68,7 +68,7 @@ def parse_options(langs: str | Sequence[str] = "c,python", precision: str = "dou
     ------
     SpecError
         Unknown or empty language list (field ``languages``; ``--lang`` on the command
-        line), unknown precision (field ``precision``), the tube as data with Python
+        line), unknown precision (field ``precision``), a ``tube_data`` that is neither
         (field ``tube_data``).
     """
     items = [s.strip() for s in langs.split(",")] if isinstance(langs, str) else list(langs)
@@ -83,7 +83,4 @@ def parse_options(langs: str | Sequence[str] = "c,python", precision: str = "dou
     capacity = DEFAULT_CAPACITY if tube_data is True else (tube_data or None)
     if capacity is not None and not isinstance(capacity, TubeCapacity):
         raise SpecError("tube_data", f"expected True or a TubeCapacity, got {tube_data!r}")
-    if capacity is not None and "python" in items:
-        raise SpecError("tube_data", "the tube as data is generated in C only: use "
-                                     "languages 'c' (--lang c)")
     return Options(tuple(s for s in LANGUAGES if s in items), precision, capacity)

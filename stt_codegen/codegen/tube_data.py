@@ -20,10 +20,11 @@ from dataclasses import dataclass
 from ..errors import SpecError
 from ..tube.parameters import TubeDesign
 from ..tube.pieces import PROFILE_NAMES
-from .tables import Tables
+from .tables import PARAMETERS, Tables
 
 __all__ = ["DEFAULT_CAPACITY", "TubeCapacity", "TableShape", "parse_capacity",
-           "require_capacity", "require_tube_data", "table_names", "table_shape"]
+           "python_names", "require_capacity", "require_tube_data", "table_names",
+           "table_shape"]
 
 
 @dataclass(frozen=True)
@@ -151,6 +152,35 @@ def table_names(prefix: str, data: bool) -> dict[str, str]:
     return dict(names, arg=f"const {prefix}_tube_data* tube,\n    ", call="tube, ",
                 usable=f"({prefix}_tube_usable(tube) != 0) && ",
                 design=f"&{prefix}_design_tube, ", cleared="tube->n_windows")
+
+
+def python_names(data: bool) -> dict[str, object]:
+    """The Python text of each table the module's composition reads, and of the tube
+    argument (:func:`table_names`' counterpart for ``python_module.py.j2``).
+
+    Parameters
+    ----------
+    data : bool
+        The tube is data (``tube.segments``, ...), else the module's tables
+        (``SEGMENTS``, ...).
+
+    Returns
+    -------
+    dict
+        ``segments``, ``windows``, ``bound``, ``members`` and each parameter of
+        :data:`~.tables.PARAMETERS` by its field name; ``arg`` (the parameter that starts
+        the list of every function reading the tube), ``call`` (the argument that starts
+        every call of one), ``usable`` (the first test of a public function's input check)
+        and ``data``.
+    """
+    fields = ("segments", "windows", "bound", "members")
+    if not data:
+        return dict({f: f.upper() for f in fields},
+                    **{f: f.upper() for f, _, _ in PARAMETERS},
+                    arg="", call="", usable="", data=False)
+    return dict({f: f"tube.{f}" for f in fields},
+                **{f: f"tube.parameters.{f}" for f, _, _ in PARAMETERS},
+                arg="tube, ", call="tube, ", usable="_usable(tube) and ", data=True)
 
 
 def table_shape(tables: Tables, capacity: TubeCapacity | None) -> TableShape:

@@ -365,8 +365,9 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
     backend : str
         The controller's backend (:func:`~.backends.backend_names`); default the CasADi
         model (``"c"``: the spec's C with the tube as data, compiled once, each tube loaded
-        into it, :class:`~.data_controller.TubeDataController`; ``"reference"`` is ten
-        times slower).
+        into it, :class:`~.data_controller.TubeDataController`; ``"python"``: its Python
+        module with the tube as data, generated once, :class:`~.data_module.TubeDataModule`;
+        ``"reference"`` is ten times slower).
     horizon : float, optional
         Simulated time, s; default ``t_c``.
     seed : int
@@ -600,9 +601,11 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
 
 class _Runner:
     """The controllers of a run and its switch test, by backend: on ``c``, the spec's C
-    with the tube as data compiled once (:class:`~.data_controller.TubeDataController`),
-    each plan's tube loaded into it and its ``P_switch`` deciding, as on a robot; else the
-    backend's controller of each tube, and the oracle's ``|e|`` (:func:`_error`)."""
+    with the tube as data compiled once (:class:`~.data_controller.TubeDataController`), on
+    ``python`` its Python module with the tube as data generated once
+    (:class:`~.data_module.TubeDataModule`): each plan's tube loaded into it and its switch
+    deciding, as on a robot; else the backend's controller of each tube, and the oracle's
+    ``|e|`` (:func:`_error`)."""
 
     def __init__(self, backend: str, design: Design) -> None:
         self.backend, self.spec = backend, design.spec
@@ -610,6 +613,9 @@ class _Runner:
         if backend == "c":
             from .data_controller import TubeDataController
             self.library = TubeDataController(design.tube)
+        elif backend == "python":
+            from .data_module import TubeDataModule
+            self.library = TubeDataModule(design.tube)
 
     def controller(self, design: Design):
         """The controller running ``design``'s tube."""
