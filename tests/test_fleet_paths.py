@@ -29,6 +29,7 @@ def _keeps_clear(path, grid, taken):
         assert kk - k == (2 if di and dj else 1)
         if di and dj:
             assert grid.free[i + di, j] and grid.free[i, j + dj]
+            assert not busy[k:kk + 1, i + di, j].any() and not busy[k:kk + 1, i, j + dj].any()
         assert not busy[k:kk + 1, i, j].any() and not busy[k:kk + 1, a, b].any()
 
 
@@ -52,6 +53,25 @@ def test_a_path_waits_or_goes_round_a_robot_crossing_its_way():
     assert path[-1][:2] == (6, 2) and path[-1][2] > 6       # it had to wait
     # no path when the arrival is due before the column clears
     assert space_time_path(grid, taken, (0, 2), (6, 2), 6) is None
+
+
+def test_a_diagonal_does_not_cut_a_taken_cells_corner():
+    """A diagonal move sweeps the corners of the two cells beside it: with one of them
+    taken over the move's steps it is not made (as beside a static obstacle); once that
+    cell is free again, it is."""
+    grid = _open(3, 3)
+    taken = Reservations(grid, 1.0, 20)
+    taken.taken[0:3, 1, 0] = True                    # beside the diagonal (0, 0) -> (1, 1)
+    path = space_time_path(grid, taken, (0, 0), (1, 1), 20)
+    _keeps_clear(path, grid, taken)
+    assert [p[:2] for p in path] == [(0, 0), (0, 1), (1, 1)] and path[-1][2] == 2
+    later = Reservations(grid, 1.0, 20)
+    later.taken[0:3, 1, 0] = True
+    later.taken[0:3, 0, 1] = True                    # both sides taken until step 2
+    path = space_time_path(grid, later, (0, 0), (1, 1), 20)
+    _keeps_clear(path, grid, later)
+    assert path[-1][2] == 5                           # waits to step 3, then the diagonal
+    assert [p[:2] for p in path][-2:] == [(0, 0), (1, 1)]
 
 
 def test_the_goal_must_stay_clear_after_the_arrival():

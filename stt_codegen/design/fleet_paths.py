@@ -279,6 +279,9 @@ def space_time_path(grid: SpaceTimeGrid, taken: Reservations, start: tuple[int, 
                 continue
             if busy[k:kk + 1, i, j].any() or busy[k:kk + 1, a, b].any():
                 continue
+            # nor a diagonal past a taken cell's corner (as past an obstacle's, above)
+            if cost == 2 and (busy[k:kk + 1, i + di, j].any() or busy[k:kk + 1, i, j + dj].any()):
+                continue
             parent[key] = (i, j, k)
             heapq.heappush(heap, (kk + float(h[a, b]), kk, a, b))
     return None
