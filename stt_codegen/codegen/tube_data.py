@@ -22,9 +22,9 @@ from ..tube.parameters import TubeDesign
 from ..tube.pieces import PROFILE_NAMES
 from .tables import PARAMETERS, Tables
 
-__all__ = ["DEFAULT_CAPACITY", "TubeCapacity", "TableShape", "parse_capacity",
-           "python_names", "require_capacity", "require_tube_data", "table_names",
-           "table_shape"]
+__all__ = ["DEFAULT_CAPACITY", "TubeCapacity", "TableShape", "fitting_capacity",
+           "parse_capacity", "python_names", "require_capacity", "require_tube_data",
+           "table_names", "table_shape"]
 
 
 @dataclass(frozen=True)
@@ -67,6 +67,22 @@ class TubeCapacity:
 
 #: The capacity of ``--tube-data`` without numbers.
 DEFAULT_CAPACITY = TubeCapacity()
+
+
+def fitting_capacity(design: TubeDesign) -> TubeCapacity:
+    """:data:`DEFAULT_CAPACITY`, or more where ``design`` has more segments or windows:
+    the capacity of a host-side controller that runs the design's tubes.
+
+    Parameters
+    ----------
+    design : TubeDesign
+
+    Returns
+    -------
+    TubeCapacity
+    """
+    return TubeCapacity(max(DEFAULT_CAPACITY.segments, len(design.segments)),
+                        max(DEFAULT_CAPACITY.windows, len(design.circumvents)))
 
 
 def parse_capacity(text: str) -> TubeCapacity:

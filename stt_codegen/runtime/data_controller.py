@@ -19,7 +19,7 @@ import numpy as np
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..codegen.tables import PARAMETERS, design_table_rows
-from ..codegen.tube_data import DEFAULT_CAPACITY, TubeCapacity, require_capacity
+from ..codegen.tube_data import TubeCapacity, fitting_capacity, require_capacity
 from ..tube.parameters import TubeDesign
 from .compiled import DesignSpec, build_shared
 
@@ -176,9 +176,7 @@ class TubeDataController:
     name = "c"
 
     def __init__(self, design: TubeDesign, capacity: TubeCapacity | None = None) -> None:
-        capacity = capacity or TubeCapacity(
-            max(DEFAULT_CAPACITY.segments, len(design.segments)),
-            max(DEFAULT_CAPACITY.windows, len(design.circumvents)))
+        capacity = capacity or fitting_capacity(design)
         spec = DesignSpec(design)
         files = generate_files(spec, design, Options(("c",), "double", capacity))
         prefix = spec.c_name

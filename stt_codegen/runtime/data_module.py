@@ -18,7 +18,7 @@ import numpy as np
 from ..codegen.generate import generate_files
 from ..codegen.options import Options
 from ..codegen.tables import design_table_rows
-from ..codegen.tube_data import DEFAULT_CAPACITY, TubeCapacity, require_capacity
+from ..codegen.tube_data import TubeCapacity, fitting_capacity, require_capacity
 from ..errors import SpecError
 from ..tube.parameters import TubeDesign
 from .compiled import DesignSpec, load_python_module
@@ -54,9 +54,7 @@ class TubeDataModule:
     name = "python"
 
     def __init__(self, design: TubeDesign, capacity: TubeCapacity | None = None) -> None:
-        capacity = capacity or TubeCapacity(
-            max(DEFAULT_CAPACITY.segments, len(design.segments)),
-            max(DEFAULT_CAPACITY.windows, len(design.circumvents)))
+        capacity = capacity or fitting_capacity(design)
         spec = DesignSpec(design)
         files = generate_files(spec, design, Options(("python",), "double", capacity))
         self.module = load_python_module(files[f"{spec.c_name}.py"], spec.c_name)
