@@ -69,7 +69,7 @@ def parse_options(langs: str | Sequence[str] = "c,python", precision: str = "dou
     SpecError
         Unknown or empty language list (field ``languages``; ``--lang`` on the command
         line), unknown precision (field ``precision``), a ``tube_data`` that is neither
-        (field ``tube_data``).
+        ``True`` nor a :class:`~.tube_data.TubeCapacity` (field ``tube_data``).
     """
     items = [s.strip() for s in langs.split(",")] if isinstance(langs, str) else list(langs)
     if not items or any(not s for s in items):

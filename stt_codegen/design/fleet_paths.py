@@ -201,7 +201,8 @@ def space_time_path(grid: SpaceTimeGrid, taken: Reservations, start: tuple[int, 
                     stay_steps: int | None = None) -> list[tuple[int, int, int]] | None:
     """The earliest path from ``start`` at step 0 to ``goal`` by ``last_step`` that keeps
     clear of the taken cells, the goal clear from the arrival on (for ``stay_steps``
-    steps, or to the horizon).
+    steps, or to the horizon). A diagonal move needs both cells beside it free and not
+    taken over its steps (the tube's box sweeps their corners).
 
     Parameters
     ----------
