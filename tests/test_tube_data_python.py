@@ -11,6 +11,7 @@ from __future__ import annotations
 import ast
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,6 +28,8 @@ from stt_codegen.runtime.sensed import bundled_people
 from stt_codegen.system import MissingTool
 from conftest import design_of
 from test_tube_segments import piecewise_design
+
+SPECS = Path(__file__).parent / "specs"
 
 
 @pytest.fixture(scope="module")
@@ -219,3 +222,20 @@ def test_a_tube_larger_than_the_capacity_is_refused_by_field(several):
     with pytest.raises(SpecError, match="capacity") as info:
         small.pack(dataclasses.replace(design, circumvents=design.circumvents * 2))
     assert info.value.field == "tube_data"
+
+
+def test_with_an_actuator_bound_the_clamp_is_the_casadi_models():
+    """A spec with ``[actuator]``: the data form's law with its clamp (status
+    INPUT_CLAMPED) is the CasADi model's, bit for bit."""
+    design = stt.design_tube(stt.load_spec(SPECS / "actuator-s1.toml")).tube
+    ref, data = make_controller("casadi", design), TubeDataModule(design).load(design)
+    rng = np.random.default_rng(1)
+    n, dt, statuses = design.dimension, 1.0 / design.rate_hz, set()
+    for _ in range(200):
+        x = np.array(design.initial_state) + rng.normal(0.0, 0.3, n)
+        t = rng.uniform(0.0, 1.1 * design.prescribed_time)
+        alpha = np.abs(rng.normal(0.0, 0.1, 2 * n))
+        expected, got = ref.step(x, t, dt, alpha), data.step(x, t, dt, alpha)
+        assert bits(got[:2]) == bits(expected[:2]) and got[2] == expected[2], (x, t)
+        statuses.add(got[2])
+    assert 3 in statuses                                   # STATUS_INPUT_CLAMPED met
