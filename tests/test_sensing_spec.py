@@ -41,6 +41,8 @@ def test_the_defaults_and_the_rate():
     s = spec_with(SENSING).sensing
     assert (s.range, s.latency, s.period) == (3.0, 0.1, 0.5)
     assert (s.replan_time, s.horizon, s.dims) == (0.5, 1.0, (0, 1))     # one, two periods
+    assert s.shortest_horizon == 0.5 and ENVELOPE.shortest_horizon == 0.5   # one period
+    assert spec_with(SENSING | {"shortest_horizon": 1.0}).sensing.shortest_horizon == 1.0
     rate = {k: v for k, v in SENSING.items() if k != "period"} | {"update_rate_hz": 4.0}
     t = spec_with(rate).sensing
     assert t.period == 0.25 and t.update_rate_hz == 4.0 and t.horizon == 0.5
@@ -66,6 +68,10 @@ def test_the_robot_dims_are_the_sensing_dims():
     ({"period": None}, "sensing.period", "give update_rate_hz or period"),
     ({"update_rate_hz": 2.0}, "sensing.period", "not both"),
     ({"horizon": 0.25}, "sensing.horizon", "shorter than one update period"),
+    ({"shortest_horizon": 0.25}, "sensing.shortest_horizon",
+     "= 0.25 s must lie between one update period (0.5 s) and the horizon (1 s)"),
+    ({"shortest_horizon": 1.5}, "sensing.shortest_horizon", "must lie between"),
+    ({"shortest_horizon": 0.0}, "sensing.shortest_horizon", "must be positive"),
     ({"range": 0.9}, "sensing.range", "horizon) = 0.96: an obstacle unseen"),
     ({"latency": -0.1}, "sensing.latency", "must be non-negative"),
     ({"range": 0.0}, "sensing.range", "must be positive"),
@@ -124,7 +130,8 @@ def test_the_json_schema_has_the_sensing_table():
     schema = json_schema()
     table = schema["$defs"]["SensingTable"]["properties"]
     assert {"range", "latency", "period", "update_rate_hz", "max_obstacle_radius",
-            "max_obstacle_speed", "replan_time", "horizon", "max_obstacle_acceleration",
+            "max_obstacle_speed", "replan_time", "horizon", "shortest_horizon",
+            "max_obstacle_acceleration",
             "velocity_error"} == set(table)
     assert "sensing" in schema["properties"]
 

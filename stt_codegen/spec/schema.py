@@ -329,6 +329,10 @@ class SensingTable(_Table):
     horizon: Positive = _omitted("H: how long after its switch a replanned tube is certified "
                                  "against the sensed obstacles, s, at least one period; "
                                  "default two periods")
+    shortest_horizon: Positive = _omitted(
+        "H_min: when no plan is certified over the horizon, one certified over this shorter "
+        "one is taken, s, from one period to the horizon; default one period (equal to the "
+        "horizon: no shorter plan)")
     max_obstacle_acceleration: NonNegative = _omitted(
         "A: the largest acceleration of any point of an obstacle, state units/s^2; with it a "
         "sensed obstacle's reachable set follows its velocity estimate; default none (the "

@@ -14,6 +14,8 @@ docs/sensing.md guarantees avoidance of obstacles it only sees while it runs:
   switches in at ``t_m + L + tau``;
 * ``horizon`` ``H`` (s, default two periods, at least one): how long after its switch a
   tube is certified against the sensed obstacles' reachable sets;
+* ``shortest_horizon`` ``H_min`` (s, default one period, from one period to ``H``): when no
+  plan is certified over ``H``, one certified over ``H_min`` is taken;
 * ``max_obstacle_acceleration`` ``A`` (optional) and ``velocity_error`` ``E`` (default 0):
   no point of an obstacle accelerates faster than ``A``, and at a measurement every point
   moves within ``E`` of the reported velocity estimate; a sensed obstacle's reachable set
@@ -73,6 +75,12 @@ class Sensing:
     dims : tuple of int
         The state dimensions obstacles are sensed in: the robot's (``[robot] dims``,
         default the first two).
+    shortest_horizon : float
+        ``H_min``, s, in ``[T_u, H]``: when no plan is certified over ``H``, the replanner
+        takes one certified over ``[t_switch, t_switch + H_min]`` (the smaller reachable sets
+        of the shorter span admit more tubes; ``H_min >= T_u`` keeps the certified spans
+        overlapping while every replanning succeeds). Equal to ``H``: no shorter plan.
+        Default (``None`` when made by hand): one period.
     max_obstacle_acceleration : float or None
         ``A``: the largest acceleration of any point of an obstacle (Euclidean norm on
         :attr:`dims`), state units per second squared; ``None``: not bounded.
@@ -100,6 +108,11 @@ class Sensing:
     dims: tuple[int, ...]
     max_obstacle_acceleration: float | None = None
     velocity_error: float = 0.0
+    shortest_horizon: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.shortest_horizon is None:
+            object.__setattr__(self, "shortest_horizon", min(self.period, self.horizon))
 
     @property
     def update_rate_hz(self) -> float:
@@ -142,6 +155,7 @@ def sensing_from_table(table: Any, dims: tuple[int, ...], variant: Any,
     SpecError
         ``sensing``: the variant does not replan; ``sensing.period``: both or neither of
         ``update_rate_hz`` and ``period``; ``sensing.horizon``: shorter than one period;
+        ``sensing.shortest_horizon``: shorter than one period or longer than the horizon;
         ``sensing.range``: not more than ``V (L + tau + H)`` plus the robot's radius (an
         obstacle unseen at a measurement may close that distance before the tube planned
         from it stops being certified, and the body must still fit inside what is left);
@@ -167,6 +181,12 @@ def sensing_from_table(table: Any, dims: tuple[int, ...], variant: Any,
                                            f"update period ({number_text(period)} s): the "
                                            "next tube could not switch in before this one's "
                                            "guarantee ends")
+    shortest = period if table.shortest_horizon is None else float(table.shortest_horizon)
+    if not period * (1.0 - ENVELOPE_SLACK) <= shortest <= horizon * (1.0 + ENVELOPE_SLACK):
+        raise SpecError("sensing.shortest_horizon", f"= {number_text(shortest)} s must lie "
+                                                    f"between one update period "
+                                                    f"({number_text(period)} s) and the "
+                                                    f"horizon ({number_text(horizon)} s)")
     closing = table.max_obstacle_speed * (table.latency + replan + horizon)
     if not table.range > closing + reach:
         body = f" + the robot's radius {number_text(reach)}" if reach else ""
@@ -194,7 +214,8 @@ def sensing_from_table(table: Any, dims: tuple[int, ...], variant: Any,
                    horizon=horizon, dims=tuple(dims),
                    max_obstacle_acceleration=None if acceleration is None
                    else float(acceleration),
-                   velocity_error=0.0 if error is None else float(error))
+                   velocity_error=0.0 if error is None else float(error),
+                   shortest_horizon=min(shortest, horizon))
 
 
 def _finite(values: Any, name: str, length: int | None = None,
