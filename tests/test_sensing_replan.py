@@ -214,3 +214,77 @@ def test_bad_calls_name_the_field(hall, start):
     assert caught.value.field == "position"
     with pytest.raises(TypeError, match="SensedPlan"):
         stt.replan(hall, 1.0, (1.0, 3.0), [])
+
+
+#: Real-Time STT's arena of ``bench sensed`` (tests/benchmarks/.../sensed_bench.py): a
+#: 10 m square at 100 Hz, measurements every 0.25 s, ``H = 0.5`` s, obstacles up to
+#: ``sqrt(2)`` m/s turning at 2 m/s^2.
+ARENA = {"name": "rtstt-2d", "prescribed_time": 16.0,
+         "state_space": {"lower": [0.0, 0.0], "upper": [10.0, 10.0]},
+         "initial": {"lower": [0.5, 0.5], "upper": [1.5, 1.5], "half_width": [0.2, 0.2]},
+         "target": {"lower": [8.5, 8.5], "upper": [9.5, 9.5]},
+         "controller": {"rate_hz": 100.0},
+         "plant": {"model": "single-integrator", "disturbance_amplitude": 0.05},
+         "robot": {"radius": 0.1},
+         "sensing": {"range": 5.0, "latency": 0.05, "period": 0.25,
+                     "max_obstacle_radius": 0.4, "max_obstacle_speed": math.sqrt(2.0),
+                     "replan_time": 0.25, "horizon": 0.5,
+                     "max_obstacle_acceleration": 2.0, "velocity_error": 0.05}}
+
+
+def arena_plan(**sensing):
+    doc = copy.deepcopy(ARENA)
+    doc["sensing"].update(sensing)
+    return stt.start_plan(stt.design_tube(stt.Spec.from_dict(doc)))
+
+
+@pytest.mark.parametrize("obstacles, kept", [
+    ([((2.24, 0.4), (-0.49, 0.52))], True),
+    ([((0.52, 1.27), (-0.19, 1.07)), ((2.75, 0.8), (0.19, 0.38))], False),
+])
+def test_a_plan_over_the_shortest_horizon_when_none_holds_over_the_horizon(obstacles, kept):
+    """No plan from this measurement is certified over ``H`` = 0.5 s (with ``H_min = H`` the
+    replanner fails); over the default ``H_min = T_u`` = 0.25 s one is (the reachable sets
+    of the shorter span are smaller), certified until ``t_s + H_min``: the kept tube or a
+    new one. The oracle's tube over that span misses each obstacle's reachable set (the
+    speed bound's box cut by the drift box), apart from the certificate."""
+    t_m = 1.0
+    plan = arena_plan()
+    sensing = plan.task.sensing
+    assert sensing.shortest_horizon == sensing.period == 0.25
+    here = np.asarray(sensed_module._box_at(plan, t_m, plan.task.state_space).center)
+    seen = [stt.SensedObstacle.ball(c, 0.4, seen_at=t_m, velocity=v) for c, v in obstacles]
+    full = stt.replan(arena_plan(shortest_horizon=0.5), t_m, here, seen)
+    assert isinstance(full, stt.ReplanFailure), full
+    assert "shortest horizon" not in full.reason
+    short = stt.replan(plan, t_m, here, seen)
+    assert isinstance(short, stt.SensedPlan), short.reason
+    t_s = switch_time(sensing, t_m, 100.0)
+    assert short.shortened and not plan.shortened and short.kept == kept
+    assert short.guarantee_until == pytest.approx(t_s + sensing.shortest_horizon)
+    assert short.sensed_margin > 0 and short.region_margin > 0
+    reach = 0.1
+    ts, lows, highs = oracle_tube(short.design.tube, short.guarantee_until - short.start,
+                                  100.0)
+    for t, lo, hi in zip(ts + short.start, lows, highs):
+        if t < short.certified_from:
+            continue
+        for ob in seen:
+            s_lo, s_hi = ob.reach_box(t, sensing.max_obstacle_speed)
+            d_lo, d_hi = ob.drift_box(t, t, sensing.max_obstacle_acceleration,
+                                      sensing.velocity_error)
+            o_lo, o_hi = np.maximum(s_lo, d_lo) - reach, np.minimum(s_hi, d_hi) + reach
+            assert np.any((hi < o_lo) | (lo > o_hi)), (t, ob)
+
+
+def test_a_failure_over_both_horizons_says_so():
+    """An obstacle standing on the robot: nothing holds over either horizon, and the
+    failure says what failed over each."""
+    t_m = 1.0
+    plan = arena_plan()
+    here = np.asarray(sensed_module._box_at(plan, t_m, plan.task.state_space).center)
+    on_it = [stt.SensedObstacle.ball(tuple(here + 0.45), 0.4, seen_at=t_m)]
+    failed = stt.replan(plan, t_m, here, on_it)
+    assert isinstance(failed, stt.ReplanFailure)
+    assert "; over the shortest horizon (0.25 s): " in failed.reason
+    assert failed.guarantee_until == plan.guarantee_until

@@ -38,7 +38,7 @@ from typing import Sequence
 
 import numpy as np
 
-from ..errors import DesignError, SpecError
+from ..errors import DesignError, SpecError, number_text
 from ..spec.loader import DEFAULT_HALF_WIDTH_FRACTION, Box, Spec
 from ..spec.motion import MovingObstacle
 from ..spec.sensing import SensedObstacle, Sensing
@@ -152,6 +152,18 @@ class SensedPlan:
     time_s: float = 0.0
     cpu_s: float = 0.0
     goal: Box | None = field(default=None, repr=False)
+
+    @property
+    def shortened(self) -> bool:
+        """Certified over the envelope's ``shortest_horizon`` ``H_min`` past its switch, not
+        over its ``horizon`` ``H``: no plan was certified over ``H`` from its measurement
+        (docs/sensing.md, "How the next plan is made"). False when ``H_min = H``."""
+        sensing = self.task.sensing
+        if sensing is None or not sensing.shortest_horizon < sensing.horizon:
+            return False
+        span = self.guarantee_until - switch_time(sensing, self.measured_at,
+                                                  self.task.rate_hz)
+        return span < 0.5 * (sensing.horizon + sensing.shortest_horizon)
 
 
 @dataclass(frozen=True)
@@ -516,6 +528,12 @@ def start_plan(design: Design, sensed: Sequence[SensedObstacle] = (),
         return failed(large, "envelope")
     checked, reason, margin, room = _certify(design, local, sensing, sensed, 0.0, 0.0, s,
                                              0.0, until)
+    if checked is None and sensing.shortest_horizon < sensing.horizon:
+        until = sensing.switch_delay + sensing.shortest_horizon
+        checked, short, margin, room = _certify(design, local, sensing, sensed, 0.0, 0.0, s,
+                                                0.0, until)
+        reason += (f"; over the shortest horizon ({number_text(sensing.shortest_horizon)} "
+                   f"s): {short}")
     if checked is None:
         return failed(reason, "region" if room > -math.inf else "design")
     return SensedPlan(checked, spec, local, 0.0, 0.0, 0.0, until, 0.0, spec.prescribed_time,
@@ -617,17 +635,30 @@ def replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     # a failure needs its reason, not the rate or the time that would work (those
     # searches take seconds)
     with without_advice():
-        return _replan(plan, measured_at, position, sensed)
+        made = _replan(plan, measured_at, position, sensed, None)
+        shortest = _sensing(plan.task).shortest_horizon
+        if not isinstance(made, ReplanFailure) or shortest >= _sensing(plan.task).horizon:
+            return made
+        short = _replan(plan, measured_at, position, sensed, shortest)
+    if isinstance(short, SensedPlan):
+        return replace(short, time_s=short.time_s + made.time_s,
+                       cpu_s=short.cpu_s + made.cpu_s)
+    return replace(made, reason=f"{made.reason}; over the shortest horizon "
+                                f"({number_text(shortest)} s): {short.reason}",
+                   time_s=short.time_s + made.time_s, cpu_s=short.cpu_s + made.cpu_s)
 
 
 def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
-            sensed: Sequence[SensedObstacle]) -> SensedPlan | ReplanFailure:
-    """:func:`replan`'s work."""
+            sensed: Sequence[SensedObstacle], horizon: float | None
+            ) -> SensedPlan | ReplanFailure:
+    """:func:`replan`'s work, certified over ``horizon`` (default the envelope's ``H``)."""
     if not isinstance(plan, SensedPlan):
         raise TypeError(f"replan(): parameter 'plan' must be a SensedPlan (from start_plan "
                         f"or replan), not {type(plan).__name__}")
     local = plan.local
     sensing = _sensing(plan.task)
+    if horizon is not None:
+        sensing = replace(sensing, horizon=horizon)
     started, cpu = time.perf_counter(), time.process_time()
     try:
         t_m = float(measured_at)

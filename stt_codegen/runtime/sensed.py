@@ -219,6 +219,10 @@ class SensingRecord:
     escapes : int
         The tubes switched in that go to a temporary goal instead of the target
         (``SensedPlan.goal``), among ``switches``.
+    shortened : int
+        The plans taken (kept or switched in) that are certified over the envelope's
+        ``shortest_horizon`` only (``SensedPlan.shortened``): none was certified over its
+        ``horizon``.
     replans : int
         Calls of the replanner (the start included).
     replan_cpu_max, replan_cpu_p95, replan_cpu_mean : float
@@ -255,6 +259,7 @@ class SensingRecord:
     measurements: int = 0
     switches: int = 0
     escapes: int = 0
+    shortened: int = 0
     refused: int = 0
     failures: int = 0
     replans: int = 0
@@ -280,8 +285,10 @@ class SensingRecord:
                                                                    self.violations})) + ")"
                     if self.outside_envelope else "")
         escapes = f" ({self.escapes} escapes)" if self.escapes else ""
+        shortened = (f", {self.shortened} over the shortest horizon" if self.shortened
+                     else "")
         return (f"{self.measurements} measurements, {self.switches} switches{escapes}, "
-                f"{self.refused} refused, {self.failures} failed; replanning max "
+                f"{self.refused} refused, {self.failures} failed{shortened}; replanning max "
                 f"{self.replan_cpu_max:.3g} s CPU (p95 {self.replan_cpu_p95:.3g}); {cover}"
                 + envelope)
 
@@ -468,6 +475,7 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
                                        first.reason))
     else:
         active = first
+        record.shortened += first.shortened
         record.events.append(PlanEvent(0.0, "start", 0, 0.0, first.guarantee_until,
                                        first.cpu_s))
     designs = [active.design]
@@ -499,6 +507,7 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
                                                    "did not take over"))
                     continue
                 active = plan
+                record.shortened += plan.shortened
                 covered.append((plan.certified_from, plan.guarantee_until))
                 record.events.append(PlanEvent(t, "kept", len(designs) - 1, plan.measured_at,
                                                plan.guarantee_until, plan.cpu_s))
@@ -528,6 +537,7 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
             alpha = np.zeros(2 * n)
             record.switches += 1
             record.escapes += plan.goal is not None
+            record.shortened += plan.shortened
             covered.append((plan.certified_from, plan.guarantee_until))
             record.events.append(PlanEvent(t, "switched", len(designs) - 1, plan.measured_at,
                                            plan.guarantee_until, plan.cpu_s,
