@@ -54,7 +54,12 @@ def test_one_episode_is_reported():
     assert row["episodes"] == 1 and row["outside_envelope"] == 0
     assert row["collisions_certified"] == 0
     assert row["on_time"] + row["late"] + row["not_reached"] == 1
+    assert len(row["collided_episodes"]) == row["collisions"]
+    assert len(row["uncertified_episodes"]) == row["uncertified_runs"]
     assert "bench sensed: seed 0" in format_sensed_report(report)
+    row = {**row, "collisions": 2, "collided_episodes": [3, 17]}
+    assert "N = 5: collisions in episodes 3, 17" in format_sensed_report(
+        {**report, "rows": [row]})
 
 
 @pytest.mark.embedded

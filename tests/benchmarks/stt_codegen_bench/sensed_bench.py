@@ -163,7 +163,8 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
     Returns
     -------
     dict
-        Per count, the tallies and the replanner's times (s).
+        Per count, the tallies, the replanner's times (s), and the episodes that collided
+        and that had uncertified spans (``e``: rerun one with the same ``seed`` and ``N``).
     """
     scenario = scenario_with(None if speed_only else acceleration)
     design = stt.design_tube(stt.Spec.from_dict(scenario))
@@ -174,7 +175,8 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         tally = {"obstacles": count, "episodes": episodes, "collisions": 0,
                  "collisions_certified": 0, "on_time": 0, "late": 0, "not_reached": 0,
                  "uncertified_runs": 0, "outside_envelope": 0, "switches": 0, "escapes": 0,
-                 "shortened": 0, "refused": 0, "failures": 0, "replans": 0}
+                 "shortened": 0, "refused": 0, "failures": 0, "replans": 0,
+                 "collided_episodes": [], "uncertified_episodes": []}
         cpu, started = [], time.process_time()
         for e in range(episodes):
             rng = np.random.default_rng([seed, count, e])
@@ -186,6 +188,10 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
             run = stt.simulate_sensed(design, obstacles, seed=e)
             record = run.sensing
             tally["collisions"] += record.sensed_collision or run.collision
+            if record.sensed_collision or run.collision:
+                tally["collided_episodes"].append(e)
+            if record.uncertified:
+                tally["uncertified_episodes"].append(e)
             tally["collisions_certified"] += record.sensed_collision and (
                 record.collision_certified or record.guaranteed)
             tally["on_time"] += run.reached
@@ -292,6 +298,10 @@ def format_sensed_report(report: dict) -> str:
                      f"{r['switches']:>8} {r.get('escapes', 0):>7} {r.get('shortened', 0):>5} "
                      f"{r['failures']:>6} "
                      f"{r['replan_cpu_p95_s']:>14.3f} {r['replan_cpu_max_s']:>8.3f}")
+    for r in report["rows"]:
+        if r.get("collided_episodes"):
+            lines.append(f"N = {r['obstacles']}: collisions in episodes "
+                         + ", ".join(str(e) for e in r["collided_episodes"]))
     target = report.get("cortex_m4f")
     if target is not None:
         lines.append("Cortex-M4F (QEMU), the tube as data: " + (
