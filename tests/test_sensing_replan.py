@@ -14,6 +14,7 @@ import stt_codegen as stt
 from stt_codegen.design import sensed as sensed_module
 from stt_codegen.design.sensed import (SLOWER, reachable_boxes, region_margin, switch_time)
 from stt_codegen.tube import reference
+from stt_codegen_bench.sensed_bench import scenario_with
 
 
 @pytest.fixture(scope="module")
@@ -216,20 +217,9 @@ def test_bad_calls_name_the_field(hall, start):
         stt.replan(hall, 1.0, (1.0, 3.0), [])
 
 
-#: Real-Time STT's arena of ``bench sensed`` (tests/benchmarks/.../sensed_bench.py): a
-#: 10 m square at 100 Hz, measurements every 0.25 s, ``H = 0.5`` s, obstacles up to
-#: ``sqrt(2)`` m/s turning at 2 m/s^2.
-ARENA = {"name": "rtstt-2d", "prescribed_time": 16.0,
-         "state_space": {"lower": [0.0, 0.0], "upper": [10.0, 10.0]},
-         "initial": {"lower": [0.5, 0.5], "upper": [1.5, 1.5], "half_width": [0.2, 0.2]},
-         "target": {"lower": [8.5, 8.5], "upper": [9.5, 9.5]},
-         "controller": {"rate_hz": 100.0},
-         "plant": {"model": "single-integrator", "disturbance_amplitude": 0.05},
-         "robot": {"radius": 0.1},
-         "sensing": {"range": 5.0, "latency": 0.05, "period": 0.25,
-                     "max_obstacle_radius": 0.4, "max_obstacle_speed": math.sqrt(2.0),
-                     "replan_time": 0.25, "horizon": 0.5,
-                     "max_obstacle_acceleration": 2.0, "velocity_error": 0.05}}
+#: Real-Time STT's arena of ``bench sensed``: a 10 m square at 100 Hz, measurements every
+#: 0.25 s, ``H = 0.5`` s, obstacles up to ``sqrt(2)`` m/s turning at 2 m/s^2.
+ARENA = scenario_with(2.0)
 
 
 def arena_plan(**sensing):
