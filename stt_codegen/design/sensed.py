@@ -18,7 +18,10 @@ obstacles seen at ``t_m``, :class:`~stt_codegen.spec.sensing.SensedObstacle`), a
    ``t`` by the design's own space-time certificate (:mod:`.certificate.motion`); else
    the same from a smaller box around where the robot will be at ``t_s``;
 3. **escape**: else a tube to a temporary goal near the robot, away from where the sensed
-   obstacles may be, certified the same way (:data:`ESCAPE_DISTANCES`).
+   obstacles may be, certified the same way (:data:`ESCAPE_DISTANCES`);
+4. **over the shortest horizon**: else steps 1-3 again with ``H_min``
+   (``[sensing] shortest_horizon``, at least ``T_u``) in place of ``H``; the reachable
+   sets of the shorter span are smaller.
 
 Each plan is also certified to keep the robot's body, over the same span, inside the
 region no obstacle unseen at ``t_m`` can have reached: the ball of radius
@@ -475,7 +478,8 @@ def start_plan(design: Design, sensed: Sequence[SensedObstacle] = (),
     The robot stands at ``x(0)`` until it has the measurement taken at ``t = 0``; the
     design's tube is then certified against the obstacles seen (their reachable sets) and
     the region no unseen obstacle can reach, over ``[0, L + tau + H]``: until the first
-    replanned tube's switch and its horizon.
+    replanned tube's switch and its horizon (else over ``[0, L + tau + H_min]``,
+    ``[sensing] shortest_horizon``).
 
     Parameters
     ----------
@@ -592,7 +596,9 @@ def replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     robot (``SensedPlan.goal``), reached in :data:`ESCAPE_TIME` and held (an escape's own
     tube is kept only after the target has been tried again). Every plan must keep the
     body inside the region no obstacle unseen at ``t_m`` can have reached
-    (:func:`region_margin`). The run time switches to a new tube at ``t_s`` only if the
+    (:func:`region_margin`). When no plan is certified over ``[t_s, t_s + H]``, the same
+    steps run over ``[t_s, t_s + H_min]`` (``[sensing] shortest_horizon``; the plan is
+    then :attr:`SensedPlan.shortened`). The run time switches to a new tube at ``t_s`` only if the
     state lies in it then (docs/sensing.md).
 
     Parameters

@@ -80,7 +80,8 @@ class Sensing:
         takes one certified over ``[t_switch, t_switch + H_min]`` (the smaller reachable sets
         of the shorter span admit more tubes; ``H_min >= T_u`` keeps the certified spans
         overlapping while every replanning succeeds). Equal to ``H``: no shorter plan.
-        Default (``None`` when made by hand): one period.
+        ``None`` (the default of the constructor) is replaced by one period (``H`` if
+        that is shorter).
     max_obstacle_acceleration : float or None
         ``A``: the largest acceleration of any point of an obstacle (Euclidean norm on
         :attr:`dims`), state units per second squared; ``None``: not bounded.
