@@ -536,8 +536,7 @@ def start_plan(design: Design, sensed: Sequence[SensedObstacle] = (),
         until = sensing.switch_delay + sensing.shortest_horizon
         checked, short, margin, room = _certify(design, local, sensing, sensed, 0.0, 0.0, s,
                                                 0.0, until)
-        reason += (f"; over the shortest horizon ({number_text(sensing.shortest_horizon)} "
-                   f"s): {short}")
+        reason = _over_both(reason, sensing.shortest_horizon, short)
     if checked is None:
         return failed(reason, "region" if room > -math.inf else "design")
     return SensedPlan(checked, spec, local, 0.0, 0.0, 0.0, until, 0.0, spec.prescribed_time,
@@ -598,8 +597,8 @@ def replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     body inside the region no obstacle unseen at ``t_m`` can have reached
     (:func:`region_margin`). When no plan is certified over ``[t_s, t_s + H]``, the same
     steps run over ``[t_s, t_s + H_min]`` (``[sensing] shortest_horizon``; the plan is
-    then :attr:`SensedPlan.shortened`). The run time switches to a new tube at ``t_s`` only if the
-    state lies in it then (docs/sensing.md).
+    then :attr:`SensedPlan.shortened`). The run time switches to a new tube at ``t_s``
+    only if the state lies in it then (docs/sensing.md).
 
     Parameters
     ----------
@@ -642,16 +641,20 @@ def replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     # searches take seconds)
     with without_advice():
         made = _replan(plan, measured_at, position, sensed, None)
-        shortest = _sensing(plan.task).shortest_horizon
-        if not isinstance(made, ReplanFailure) or shortest >= _sensing(plan.task).horizon:
+        sensing = _sensing(plan.task)
+        if not isinstance(made, ReplanFailure) or sensing.shortest_horizon >= sensing.horizon:
             return made
-        short = _replan(plan, measured_at, position, sensed, shortest)
+        short = _replan(plan, measured_at, position, sensed, sensing.shortest_horizon)
+    spent = {"time_s": short.time_s + made.time_s, "cpu_s": short.cpu_s + made.cpu_s}
     if isinstance(short, SensedPlan):
-        return replace(short, time_s=short.time_s + made.time_s,
-                       cpu_s=short.cpu_s + made.cpu_s)
-    return replace(made, reason=f"{made.reason}; over the shortest horizon "
-                                f"({number_text(shortest)} s): {short.reason}",
-                   time_s=short.time_s + made.time_s, cpu_s=short.cpu_s + made.cpu_s)
+        return replace(short, **spent)
+    return replace(made, reason=_over_both(made.reason, sensing.shortest_horizon,
+                                           short.reason), **spent)
+
+
+def _over_both(reason: str, shortest: float, short_reason: str) -> str:
+    """A failure's reason over the horizon and over the shortest horizon."""
+    return f"{reason}; over the shortest horizon ({number_text(shortest)} s): {short_reason}"
 
 
 def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
