@@ -95,6 +95,45 @@ def test_the_error_bound_is_read_from_the_sampled_check():
     assert sampled_error_bound(failed, samples) is None
 
 
+def test_a_proof_stopped_at_a_limit_keeps_the_verdict():
+    """``prove_input_bound``'s ``limit``: above the whole proof's peak the check runs whole
+    and the proof is the same; below it the check stops at the first sample over it, the
+    proof is partial (it meets no bound), its peaks those of the whole proof up to there,
+    and the sampled check's bounds up to there are the whole check's."""
+    spec = small(None)
+    tube = design_tube(spec).tube
+    whole = prove_input_bound(tube, spec)
+    top = np.array(whole.peak)
+    assert whole.complete
+    assert prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > top))) == whole
+    half = 0.5 * top
+    part = prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > half)))
+    assert part.proved and not part.complete and not part.meets(tuple(10 * top))
+    assert np.any(np.array(part.peak) > half) and np.all(np.array(part.peak) <= top)
+    assert "stopped there" in part.reason and part.horizon == whole.horizon
+    samples = sample_tube(tube)
+    full = check_sampled(tube, samples, spec.assumptions)
+    stopped = check_sampled(tube, samples, spec.assumptions, stop=lambda k, e: k == 40)
+    assert not stopped.passed and stopped.data["stopped_at"] == samples.t[40]
+    assert np.array_equal(stopped.abs_e, full.abs_e[:41])
+
+
+def test_a_search_without_advice_stops_each_proof_at_the_bound():
+    """Within ``without_advice`` (a verdict only) law (13)'s and the base's proofs stop at
+    the bound: a design the bound refuses is refused all the same ("at least"), one it
+    accepts is the same design with the same whole proof."""
+    from stt_codegen.design.failures import without_advice
+    accepted = design_tube(small((3.5, 3.5)))
+    with without_advice():
+        again = design_tube(small((3.5, 3.5)))
+        with pytest.raises(DesignError) as refused:
+            design_tube(small((0.5, 0.5), prescribed_time=3.0))
+    assert again.tube == accepted.tube and again.input_proof == accepted.input_proof
+    assert again.input_proof.complete
+    assert refused.value.kind is FailureKind.INPUT_BOUND
+    assert "asks at least" in str(refused.value)
+
+
 def test_a_bound_the_default_design_meets_keeps_its_tube():
     default = design_tube(small(None))
     bounded = design_tube(small((3.5, 3.5)))

@@ -38,6 +38,8 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from ..errors import DesignError, SpecError, number_text
 from ..progress import report, reporting
 from ..spec.loader import Spec
@@ -212,9 +214,16 @@ def law13_input_proof(design: Design, spec: Spec) -> InputProof:
     Returns
     -------
     InputProof
-        :func:`~.certificate.actuator.prove_input_bound` of the design's tube.
+        :func:`~.certificate.actuator.prove_input_bound` of the design's tube; within
+        :func:`~.failures.without_advice` (a search asking the verdict only), stopped at
+        the first sample where an input's bound passes ``spec.input_bound`` (partial:
+        it meets no bound, and a proof that meets it is the same).
     """
-    return prove_input_bound(design.tube, spec)
+    bound = spec.input_bound
+    if bound is None or advice_wanted():
+        return prove_input_bound(design.tube, spec)
+    limits = np.asarray(bound, dtype=float)
+    return prove_input_bound(design.tube, spec, limit=lambda u: bool(np.any(u > limits)))
 
 
 def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
@@ -295,9 +304,10 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     best = min(proved, key=lambda c: c.proof.ratio(bound))
     worst = max(range(len(bound)), key=lambda i: best.proof.peak[i] / bound[i])
     needs = ", ".join(f"{_round_up(v):g}" for v in best.proof.peak)
+    asks = "up to" if best.proof.complete else "at least"     # a partial proof's peak
     message = (f"no design within prescribed_time = {spec.prescribed_time:g} s keeps {law} "
                f"within actuator.input_bound = [{', '.join(f'{b:g}{unit}' for b in bound)}]: "
-               f"the best ({best.label}) asks up to {best.proof.peak[worst]:.3g}{unit} of "
+               f"the best ({best.label}) asks {asks} {best.proof.peak[worst]:.3g}{unit} of "
                f"input {names[worst]} (bound {bound[worst]:g}{unit}) at t = "
                f"{best.proof.time[worst]:.3f} s")
     if not advice_wanted():                   # the verdict only (a probe of a search)

@@ -61,6 +61,10 @@ class InputProof:
         when not proved or not computed (a proof built from peaks alone).
     speed_time : float
         The sample instant of :attr:`speed`, seconds.
+    complete : bool
+        The peaks are over the whole horizon; false for a proof that stopped at the first
+        sample over a caller's limit (``prove_input_bound``'s ``limit``): its peaks are
+        those up to that sample, lower bounds of the whole proof's, and it meets no bound.
     """
 
     proved: bool
@@ -71,6 +75,7 @@ class InputProof:
     max_abs_e: float = math.inf
     speed: float = math.inf
     speed_time: float = 0.0
+    complete: bool = True
 
     def ratio(self, bound: tuple[float, ...]) -> float:
         """``max_i peak_i / bound_i`` (``inf`` when not proved): at most 1 meets the bound."""
@@ -79,8 +84,9 @@ class InputProof:
         return max(p / b for p, b in zip(self.peak, bound))
 
     def meets(self, bound: tuple[float, ...]) -> bool:
-        """Proved, and ``peak_i <= bound_i`` for every input."""
-        return self.proved and all(p <= b for p, b in zip(self.peak, bound))
+        """Proved over the whole horizon, and ``peak_i <= bound_i`` for every input."""
+        return (self.proved and self.complete
+                and all(p <= b for p, b in zip(self.peak, bound)))
 
     def margin(self, bound: tuple[float, ...]) -> float:
         """``min_i (bound_i - peak_i) / bound_i``: the relative room left (negative:

@@ -89,10 +89,20 @@ def look_ahead_design_proof(design: Design, spec: Spec) -> InputProof:
     Returns
     -------
     InputProof
-        :func:`look_ahead_input_proof` of law (13)'s proof at the point.
+        :func:`look_ahead_input_proof` of law (13)'s proof at the point; within
+        :func:`~.failures.without_advice` (a search asking the verdict only), stopped at
+        the first sample where ``|u|`` passes ``min(v_max, omega_max l)`` (partial: it
+        meets no bound, and a proof that meets it is the same).
     """
-    return look_ahead_input_proof(prove_input_bound(design.tube, spec),
-                                  spec.drive.axle_offset)
+    offset = spec.drive.axle_offset
+    bound = spec.input_bound
+    if bound is None or advice_wanted():
+        return look_ahead_input_proof(prove_input_bound(design.tube, spec), offset)
+    # a verdict only (a search without advice): stopped at the first sample where |u|
+    # at the point passes v_max or omega_max l (as the cascade's stage check stops)
+    speed = min(bound[0], bound[1] * offset)
+    return look_ahead_input_proof(prove_input_bound(
+        design.tube, spec, limit=lambda u: math.hypot(*u) > speed), offset)
 
 
 def look_ahead_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> Design:

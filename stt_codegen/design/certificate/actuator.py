@@ -13,17 +13,25 @@ is in ``docs/sampled-data.md`` ("The input bound"). The design asks this prover
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import replace
+
 import numpy as np
 
 from .enclosures import enclose_tube
-from ..input_bound import InputProof, input_peak
-from ..samples import TubeSamples
+from ..input_bound import InputProof, input_peak, phi
+from ..samples import TubeSamples, sample_tube
 from ...spec.loader import Spec
 from ...tube import reference
-from ...tube.parameters import TubeDesign
-from .sampled import SampledCheck, sampled_check_of
+from ...tube.parameters import GAMMA_D_MIN, TubeDesign
+from .plant_class import plant_class
+from .sampled import SampledCheck, check_sampled, sampled_check_of
 
-__all__ = ["prove_input_bound", "sampled_error_bound"]
+__all__ = ["LIMIT_SLACK", "prove_input_bound", "sampled_error_bound"]
+
+#: The relative shade below a sample's bound of ``|u|`` that ``prove_input_bound``'s
+#: ``limit`` is asked (far above an ulp, far below any margin a verdict turns on).
+LIMIT_SLACK = 1e-9
 
 
 def sampled_error_bound(result: SampledCheck, samples: TubeSamples) -> np.ndarray | None:
@@ -64,8 +72,8 @@ def certified_widths(tube: TubeDesign, samples: TubeSamples) -> np.ndarray:
     return np.vstack([width, width[-1:]])
 
 
-def prove_input_bound(tube: TubeDesign, spec: Spec, *,
-                      per_axis_first: bool = False) -> InputProof:
+def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = False,
+                      limit: Callable[[np.ndarray], bool] | None = None) -> InputProof:
     """The proved peak of each input of law (13) along ``tube`` for the spec's plants.
 
     Parameters
@@ -81,6 +89,16 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *,
         Bound ``e`` by the per-axis argument where it passes (``verify``'s check, cheaper;
         bounds no tighter than the Lyapunov balls') instead of the whole check with the
         balls everywhere (the default; the peaks of ``[actuator]`` are proved from it).
+    limit : callable, optional
+        ``(bound of |u_i(t_k)|, shape (n,)) -> bool``, true where the bound at a sample
+        already breaks what the caller accepts (a verdict that needs no whole peak;
+        monotone: a larger bound breaks it too), asked a relative :data:`LIMIT_SLACK`
+        below the bound: the
+        check stops at the first such sample, and the proof is partial
+        (:attr:`~stt_codegen.design.input_bound.InputProof.complete` false: its peaks are
+        those up to that sample). The check runs whole where no sample breaks it, so a
+        proof that meets the caller's bound is the same with or without ``limit``. Not
+        with ``per_axis_first`` or ``[controller] compensate_delay`` (ignored there).
 
     Returns
     -------
@@ -93,15 +111,52 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *,
     SpecError
         More samples than the step budget (as :func:`~stt_codegen.design.samples.sample_tube`).
     """
+    if limit is not None and not per_axis_first and not spec.compensate_delay:
+        return _prove_until(tube, spec, limit)
     # the check is computed once per (tube, spec, per_axis_first) in a process:
     # sampled_check_of samples with the oracle's exp/log/tanh as numpy's ufuncs
     samples, result = sampled_check_of(tube, spec, per_axis_first)
     horizon = float(samples.t[-1])
     abs_e = sampled_error_bound(result, samples)
     if abs_e is None:
-        n = tube.dimension
-        return InputProof(False, (np.inf,) * n, (0.0,) * n, horizon,
-                          f"the sampled-data check fails: {result.reason}")
+        return _not_proved(tube, horizon, result)
     with reference.numpy_math():
         widths = certified_widths(tube, samples)
     return input_peak(tube.gain, abs_e, widths, samples.t, horizon)
+
+
+def _not_proved(tube: TubeDesign, horizon: float, result: SampledCheck) -> InputProof:
+    n = tube.dimension
+    return InputProof(False, (np.inf,) * n, (0.0,) * n, horizon,
+                      f"the sampled-data check fails: {result.reason}")
+
+
+def _prove_until(tube: TubeDesign, spec: Spec, limit: Callable[[np.ndarray], bool]
+                 ) -> InputProof:
+    """:func:`prove_input_bound` with the check stopped at the first sample whose bound of
+    ``|u|`` breaks ``limit`` (not cached: :func:`~.sampled.sampled_check_of` caches whole
+    checks only)."""
+    with reference.numpy_math():
+        samples = sample_tube(tube)
+        widths = certified_widths(tube, samples)
+        per_phi = 4.0 * tube.gain / np.maximum(widths, GAMMA_D_MIN)   # |u| per phi(|e|)
+
+        def stop(k: int, abs_e: list[float]) -> bool:
+            # a shade below the bound input_peak computes from the same numbers (numpy's
+            # atanh may differ by an ulp between one sample and the whole array): a
+            # sample stops the check only where the whole proof's bound breaks the limit
+            return bool(limit(per_phi[k] * phi(np.asarray(abs_e)) * (1.0 - LIMIT_SLACK)))
+
+        result = check_sampled(tube, samples, plant_class(spec), delay=spec.delay,
+                               jitter=spec.jitter, stop=stop)
+    horizon = float(samples.t[-1])
+    if "stopped_at" not in result.data:
+        abs_e = sampled_error_bound(result, samples)
+        if abs_e is None:
+            return _not_proved(tube, horizon, result)
+        return input_peak(tube.gain, abs_e, widths, samples.t, horizon)
+    k = len(result.abs_e)
+    return replace(input_peak(tube.gain, result.abs_e, widths[:k], samples.t[:k], horizon),
+                   complete=False, reason=f"the bound of the input passes the limit at "
+                                          f"t = {result.data['stopped_at']:.4f} s (the "
+                                          f"check stopped there)")

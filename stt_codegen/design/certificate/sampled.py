@@ -78,7 +78,8 @@ class SampledCheck:
     abs_e : ndarray or None, shape (K + 1, n)
         When passed: the proved bound of ``|e_i(t_k)|`` at every sample of ``samples``
         (read by :func:`stt_codegen.design.certificate.actuator.sampled_error_bound` for the input
-        bound); ``None`` otherwise.
+        bound); when stopped (:func:`check_sampled`'s ``stop``), those up to the sample it
+        stopped at; ``None`` otherwise.
     """
 
     passed: bool
@@ -173,7 +174,8 @@ def worst_near(values: np.ndarray, jitter: float, pick) -> np.ndarray:
 def check_sampled(design: TubeDesign, samples: TubeSamples,
                   plants: Assumptions | PlantClass, gain: float | None = None, *,
                   lyapunov: bool = True, delay: float = 0.0,
-                  jitter: float = 0.0) -> SampledCheck:
+                  jitter: float = 0.0,
+                  stop: Callable[[int, list[float]], bool] | None = None) -> SampledCheck:
     """Prove that the sampled closed loop keeps ``|e_i| < 1`` at and between samples.
 
     A sufficient condition, checked by propagating an enclosure of ``e(t_k)`` (a box and
@@ -208,6 +210,13 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
         Sampling jitter, s (``[controller] jitter``): ``|s_k - k dt| <= jitter``, ``s_0 =
         0``; the controller is called with the nominal ``t = k dt``. ``delay + 2 jitter``
         must not exceed ``dt``.
+    stop : callable, optional
+        ``(k, bound of |e_i(t_k)| per dimension) -> bool``, asked at every sample once its
+        bound is proved: where it answers true the check ends there, not passed, with
+        ``data["stopped_at"] = t_k`` and the bounds of samples ``0 .. k`` in ``abs_e`` (a
+        caller that needs only whether a bound derived from ``|e|`` holds, such as the
+        input bound's verdict, stops at the first sample that breaks it). The bounds up to
+        ``k`` are those of the whole check.
 
     Returns
     -------
@@ -296,6 +305,10 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
             i = int(np.argmax(reach_e))
             return fail(f"|e_{i}| may reach {max(reach_e):.6g} at t = {t:.4f} s, beyond the "
                         f"clamp E_MAX", -math.inf, t, i, top)
+        if stop is not None and stop(k, reach_e):
+            data["stopped_at"] = t
+            return SampledCheck(False, top, worst, t, int(np.argmax(reach_e)),
+                                f"stopped at t = {t:.4f} s", data, np.array(abs_e))
         limits = [math.atanh(v) for v in reach_e]         # max |atanh e_i| over the box
         for b in balls:                                   # the box's corner bounds W too
             level[b] = min(level[b], math.sqrt(sum(limits[i] ** 2 for i in b)))
