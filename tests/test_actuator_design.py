@@ -100,17 +100,24 @@ def test_a_proof_stopped_at_a_limit_keeps_the_verdict():
     and the proof is the same; below it the check stops at the first sample over it, the
     proof is partial (it meets no bound), its peaks those of the whole proof up to there,
     and the sampled check's bounds up to there are the whole check's."""
+    from stt_codegen.design.certificate import sampled
     spec = small(None)
     tube = design_tube(spec).tube
+    sampled._KEPT.clear()
     whole = prove_input_bound(tube, spec)
     top = np.array(whole.peak)
     assert whole.complete
+    sampled._KEPT.clear()
     assert prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > top))) == whole
     half = 0.5 * top
+    # the whole check it ran is kept: asked again, the whole proof at once
+    assert prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > half))) == whole
+    sampled._KEPT.clear()
     part = prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > half)))
     assert part.proved and not part.complete and not part.meets(tuple(10 * top))
     assert np.any(np.array(part.peak) > half) and np.all(np.array(part.peak) <= top)
     assert "stopped there" in part.reason and part.horizon == whole.horizon
+    assert sampled.cached_check(tube, spec, False) is None     # a stopped check is not kept
     samples = sample_tube(tube)
     full = check_sampled(tube, samples, spec.assumptions)
     stopped = check_sampled(tube, samples, spec.assumptions, stop=lambda k, e: k == 40)

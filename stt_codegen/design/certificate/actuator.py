@@ -25,7 +25,8 @@ from ...spec.loader import Spec
 from ...tube import reference
 from ...tube.parameters import GAMMA_D_MIN, TubeDesign
 from .plant_class import plant_class
-from .sampled import SampledCheck, check_sampled, sampled_check_of
+from .sampled import (SampledCheck, cached_check, check_sampled, keep_check,
+                      sampled_check_of)
 
 __all__ = ["LIMIT_SLACK", "prove_input_bound", "sampled_error_bound"]
 
@@ -93,12 +94,13 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
         ``(bound of |u_i(t_k)|, shape (n,)) -> bool``, true where the bound at a sample
         already breaks what the caller accepts (a verdict that needs no whole peak;
         monotone: a larger bound breaks it too), asked a relative :data:`LIMIT_SLACK`
-        below the bound: the
-        check stops at the first such sample, and the proof is partial
-        (:attr:`~stt_codegen.design.input_bound.InputProof.complete` false: its peaks are
-        those up to that sample). The check runs whole where no sample breaks it, so a
-        proof that meets the caller's bound is the same with or without ``limit``. Not
-        with ``per_axis_first`` or ``[controller] compensate_delay`` (ignored there).
+        below the bound: the check stops at the first such sample, and the proof is
+        partial (:attr:`~stt_codegen.design.input_bound.InputProof.complete` false: its
+        peaks are those up to that sample). The check runs whole where no sample breaks
+        it, so a proof that meets the caller's bound is the same with or without
+        ``limit``; where the whole check is already kept (:func:`~.sampled.cached_check`),
+        the whole proof from it. Not with ``per_axis_first`` or ``[controller]
+        compensate_delay`` (ignored there).
 
     Returns
     -------
@@ -111,7 +113,8 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
     SpecError
         More samples than the step budget (as :func:`~stt_codegen.design.samples.sample_tube`).
     """
-    if limit is not None and not per_axis_first and not spec.compensate_delay:
+    if (limit is not None and not per_axis_first and not spec.compensate_delay
+            and cached_check(tube, spec, False) is None):
         return _prove_until(tube, spec, limit)
     # the check is computed once per (tube, spec, per_axis_first) in a process:
     # sampled_check_of samples with the oracle's exp/log/tanh as numpy's ufuncs
@@ -126,6 +129,7 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
 
 
 def _not_proved(tube: TubeDesign, horizon: float, result: SampledCheck) -> InputProof:
+    """The proof of a tube whose sampled check fails: no peak."""
     n = tube.dimension
     return InputProof(False, (np.inf,) * n, (0.0,) * n, horizon,
                       f"the sampled-data check fails: {result.reason}")
@@ -134,8 +138,9 @@ def _not_proved(tube: TubeDesign, horizon: float, result: SampledCheck) -> Input
 def _prove_until(tube: TubeDesign, spec: Spec, limit: Callable[[np.ndarray], bool]
                  ) -> InputProof:
     """:func:`prove_input_bound` with the check stopped at the first sample whose bound of
-    ``|u|`` breaks ``limit`` (not cached: :func:`~.sampled.sampled_check_of` caches whole
-    checks only)."""
+    ``|u|`` breaks ``limit``; a check that runs whole is kept for
+    :func:`~.sampled.sampled_check_of` (:func:`~.sampled.keep_check`), a stopped one is
+    not."""
     with reference.numpy_math():
         samples = sample_tube(tube)
         widths = certified_widths(tube, samples)
@@ -151,6 +156,7 @@ def _prove_until(tube: TubeDesign, spec: Spec, limit: Callable[[np.ndarray], boo
                                jitter=spec.jitter, stop=stop)
     horizon = float(samples.t[-1])
     if "stopped_at" not in result.data:
+        keep_check(tube, spec, False, samples, result)
         abs_e = sampled_error_bound(result, samples)
         if abs_e is None:
             return _not_proved(tube, horizon, result)

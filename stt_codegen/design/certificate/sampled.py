@@ -22,9 +22,9 @@ certified enclosure of the tube (:func:`~stt_codegen.design.certificate.enclose_
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from functools import lru_cache
 
 import numpy as np
 
@@ -42,9 +42,10 @@ from .predicted import check_predicted
 from .sampled_axis import (axis_interval, held_speed, peak, peak_for_box, phi_scalar,
                            phi_slope_scalar, turn_failure, turned_gains, unprovable)
 
-__all__ = ["DELAY_HALVINGS", "RATE_FACTORS", "SampledCheck", "check_sampled",
-           "check_sampled_first_per_axis", "delay_room", "largest_delay", "largest_passing",
-           "lowest_rate", "sampled_check_of", "worst_near"]
+__all__ = ["DELAY_HALVINGS", "KEPT_CHECKS", "RATE_FACTORS", "SampledCheck", "cached_check",
+           "check_sampled", "check_sampled_first_per_axis", "delay_room", "keep_check",
+           "largest_delay", "largest_passing", "lowest_rate", "sampled_check_of",
+           "worst_near"]
 
 #: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
 RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
@@ -585,21 +586,51 @@ def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
     check : SampledCheck
         The verdict (cached per process).
     """
-    return _sampled_check(design, spec, bool(per_axis_first))
+    key = (design, spec, bool(per_axis_first))
+    found = cached_check(*key)
+    if found is None:
+        with reference.numpy_math():
+            samples = sample_tube(design)
+            plants = plant_class(spec)
+            timing = {"delay": spec.delay, "jitter": spec.jitter}
+            check = (check_sampled_first_per_axis(design, samples, plants, **timing,
+                                                  compensate=spec.compensate_delay)
+                     if per_axis_first or spec.compensate_delay
+                     else check_sampled(design, samples, plants, **timing))
+        found = keep_check(design, spec, bool(per_axis_first), samples, check)
+    return found
 
 
-@lru_cache(maxsize=16)
-def _sampled_check(design: TubeDesign, spec: Spec, per_axis_first: bool
-                   ) -> tuple[TubeSamples, SampledCheck]:
-    """:func:`sampled_check_of`, cached on its arguments as given positionally."""
-    with reference.numpy_math():
-        samples = sample_tube(design)
-        plants = plant_class(spec)
-        timing = {"delay": spec.delay, "jitter": spec.jitter}
-        check = (check_sampled_first_per_axis(design, samples, plants, **timing,
-                                              compensate=spec.compensate_delay)
-                 if per_axis_first or spec.compensate_delay
-                 else check_sampled(design, samples, plants, **timing))
+#: The whole checks :func:`sampled_check_of` keeps, the latest last (at most
+#: :data:`KEPT_CHECKS`).
+_KEPT: OrderedDict[tuple[TubeDesign, Spec, bool], tuple[TubeSamples, SampledCheck]] = \
+    OrderedDict()
+#: How many whole checks a process keeps.
+KEPT_CHECKS = 16
+
+
+def cached_check(design: TubeDesign, spec: Spec, per_axis_first: bool
+                 ) -> tuple[TubeSamples, SampledCheck] | None:
+    """The whole check :func:`sampled_check_of` keeps for these arguments, or ``None``
+    (nothing computed)."""
+    key = (design, spec, per_axis_first)
+    found = _KEPT.get(key)
+    if found is not None:
+        _KEPT.move_to_end(key)
+    return found
+
+
+def keep_check(design: TubeDesign, spec: Spec, per_axis_first: bool, samples: TubeSamples,
+               check: SampledCheck) -> tuple[TubeSamples, SampledCheck]:
+    """Keep a whole check of ``design`` for ``spec`` (as :func:`sampled_check_of` computes
+    it: the samples of :func:`~stt_codegen.design.samples.sample_tube` and the check
+    without ``stop``) for the next :func:`sampled_check_of`; returns it."""
+    if "stopped_at" in check.data:
+        raise ValueError("keep_check: a stopped check is not the whole check")
+    _KEPT[(design, spec, per_axis_first)] = (samples, check)
+    _KEPT.move_to_end((design, spec, per_axis_first))
+    while len(_KEPT) > KEPT_CHECKS:
+        _KEPT.popitem(last=False)
     return samples, check
 
 
