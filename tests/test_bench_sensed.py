@@ -10,6 +10,7 @@ import pytest
 import stt_codegen as stt
 from stt_codegen_bench.sensed_bench import (SCENARIO, format_sensed_report, moving_circles,
                                             run_sensed_bench, scenario_with)
+from stt_codegen_bench.sensed_warehouse import AISLES, DOOR, RACKS, WAREHOUSE, aisle_people
 
 
 def test_the_circles_are_seeded_and_drawn_by_the_generator():
@@ -45,6 +46,48 @@ def test_turning_circles_keep_to_the_acceleration_bound():
     sensing = stt.Spec.from_dict(scenario_with(2.0)).sensing
     assert (sensing.max_obstacle_acceleration, sensing.velocity_error) == (2.0, 0.05)
     assert scenario_with(None) is SCENARIO
+
+
+def test_the_warehouse_people_are_seeded_within_the_envelope_and_clear_of_the_racks():
+    """Each person walks one straight line in an aisle, door to door, at most at the
+    envelope's speed, is no larger than its ``r_max``, never overlaps a rack, and is on the
+    floor only while walking."""
+    a = aisle_people(np.random.default_rng([0, 6, 1]), 6, 40.0)
+    assert a == aisle_people(np.random.default_rng([0, 6, 1]), 6, 40.0)
+    assert a != aisle_people(np.random.default_rng([0, 6, 2]), 6, 40.0)
+    sensing = stt.Spec.from_dict(WAREHOUSE).sensing
+    t = np.linspace(0.0, 45.0, 901)
+    kinds = set()
+    for person in aisle_people(np.random.default_rng(7), 60, 40.0):
+        rows = np.array(person.path)
+        assert person.radius <= sensing.max_obstacle_radius
+        speed = np.linalg.norm(rows[1, 1:] - rows[0, 1:]) / (rows[1, 0] - rows[0, 0])
+        assert speed <= sensing.max_obstacle_speed + 1e-12 and rows[0, 0] <= 24.0
+        centre = person.scripted(t)
+        on_floor = np.all((centre >= 0.0) & (centre <= (20.0, 12.0)), axis=1)
+        assert np.all((t[on_floor] > rows[0, 0]) & (t[on_floor] < rows[1, 0]))
+        assert np.all(np.abs(centre - np.clip(centre, 0.0, (20.0, 12.0))) <= DOOR + 1e-12)
+        for lo, hi in RACKS:            # racks span y in [0, 8]
+            inside_x = (centre[:, 0] + person.radius > lo) & (centre[:, 0] - person.radius < hi)
+            assert not np.any(inside_x & (centre[:, 1] - person.radius < 8.0))
+        kinds.add("aisle" if rows[0, 1] in AISLES else "cross")
+    assert kinds == {"aisle", "cross"}
+
+
+def test_the_warehouse_refuses_an_adversary_by_its_flag(capsys):
+    from stt_codegen.cli import main
+    assert main(["bench", "sensed", "--warehouse", "--acceleration", "2"]) == 2
+    assert "--warehouse:" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_one_warehouse_episode_is_reported():
+    report = run_sensed_bench(1, 0, counts=(6,), warehouse=True)
+    row = report["rows"][0]
+    assert report["floor"] == "warehouse" and row["episodes"] == 1
+    assert row["outside_envelope"] == 0 and row["collisions_certified"] == 0
+    assert row["on_time"] + row["late"] + row["not_reached"] == 1
+    assert "the warehouse floor, people crossing its aisles" in format_sensed_report(report)
 
 
 @pytest.mark.slow

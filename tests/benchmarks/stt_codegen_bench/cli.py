@@ -199,13 +199,17 @@ def _cmd_fleet(args: argparse.Namespace) -> int:
 
 def _cmd_sensed(args: argparse.Namespace) -> int:
     from .sensed_bench import format_sensed_report, run_sensed_bench
+    if args.warehouse and (args.adversary or args.acceleration is not None):
+        raise SpecError("--warehouse", "the warehouse floor's people walk straight and "
+                                       "start at once: not with --adversary or "
+                                       "--acceleration")
     report = run_sensed_bench(args.count, args.seed,
                               tuple(_int_list(args.obstacles, "--obstacles")),
                               adversary=args.adversary, acceleration=args.acceleration,
-                              speed_only=args.speed_only)
+                              speed_only=args.speed_only, warehouse=args.warehouse)
     if args.cortex_m4f:
         from .sensed_bench import target_costs
-        report["cortex_m4f"] = target_costs(args.acceleration)
+        report["cortex_m4f"] = target_costs(args.acceleration, warehouse=args.warehouse)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_sensed_report(report))
     return 0
@@ -393,6 +397,10 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="with --acceleration: the same circles and adversary, but the "
                         "envelope without the acceleration bound (reachable sets growing at "
                         "the speed bound), for a side-by-side comparison")
+    p.add_argument("--warehouse", action="store_true",
+                   help="a warehouse floor (three racks, 20 m x 12 m) with people crossing "
+                        "its aisles at up to 1 m/s instead of the circles; --obstacles "
+                        "counts people (not with --adversary or --acceleration)")
     p.add_argument("--cortex-m4f", action="store_true",
                    help="also count the controller's instructions per step and per switch "
                         "on the Cortex-M4F (QEMU), the tube as data, on the scenario's tube "

@@ -10,7 +10,9 @@ point robot across a plane among moving circles; their generator draws radii in
 arena's walls (a path of straight pieces). The envelope (``[sensing]``): range 5 m, latency
 0.05 s, a measurement every 0.25 s, ``r_max = 0.4`` m, ``V = sqrt(2)`` m/s (the generator's
 largest speed), replanning budget 0.25 s, horizon 0.5 s. With ``--adversary`` one more
-circle (radius 0.3 m) starts 6 m away and heads for the robot at ``V``.
+circle (radius 0.3 m) starts 6 m away and heads for the robot at ``V``. With
+``--warehouse``, a warehouse floor with people crossing its aisles instead
+(:mod:`.sensed_warehouse`).
 
 Each episode is :func:`stt_codegen.simulate_sensed` (the CasADi backend). Reported per
 ``N``: collisions (and among them those at an instant some certificate covered, which must
@@ -29,6 +31,8 @@ import numpy as np
 
 import stt_codegen as stt
 from stt_codegen.runtime.sensed import WalkingObstacle
+
+from .sensed_warehouse import WAREHOUSE, aisle_people
 
 __all__ = ["SCENARIO", "format_sensed_report", "moving_circles", "run_sensed_bench",
            "scenario_with", "target_costs"]
@@ -138,7 +142,7 @@ def moving_circles(rng: np.random.Generator, count: int, until: float,
 
 def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20),
                      adversary: bool = False, acceleration: float | None = None,
-                     speed_only: bool = False) -> dict:
+                     speed_only: bool = False, warehouse: bool = False) -> dict:
     """Seeded episodes of the scenario per obstacle count.
 
     Parameters
@@ -159,6 +163,10 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
     speed_only : bool
         With ``acceleration``: the same obstacles, but the envelope without the
         acceleration bound (the reachable sets grow at the speed bound).
+    warehouse : bool
+        The warehouse floor with people crossing its aisles instead
+        (:mod:`.sensed_warehouse`; ``counts`` are people; episode ``e`` draws from
+        ``[seed, N, e]``); not with ``adversary`` or ``acceleration``.
 
     Returns
     -------
@@ -166,10 +174,14 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         Per count, the tallies, the replanner's times (s), and the episodes that collided
         and that had uncertified spans (``e``: rerun one with the same ``seed`` and ``N``).
     """
-    scenario = scenario_with(None if speed_only else acceleration)
+    if warehouse and (adversary or acceleration is not None):
+        raise ValueError("the warehouse floor has neither an adversary nor an acceleration "
+                         "bound")
+    scenario = WAREHOUSE if warehouse else scenario_with(None if speed_only else acceleration)
     design = stt.design_tube(stt.Spec.from_dict(scenario))
-    speed = SCENARIO["sensing"]["max_obstacle_speed"]
-    t_c = SCENARIO["prescribed_time"]
+    speed = scenario["sensing"]["max_obstacle_speed"]
+    t_c = scenario["prescribed_time"]
+    target = scenario["target"]
     rows = []
     for count in counts:
         tally = {"obstacles": count, "episodes": episodes, "collisions": 0,
@@ -180,8 +192,9 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         cpu, started = [], time.process_time()
         for e in range(episodes):
             rng = np.random.default_rng([seed, count, e])
-            obstacles = moving_circles(rng, count, t_c + 1.0,
-                                       None if acceleration is None else acceleration / 2.0)
+            obstacles = (aisle_people(rng, count, t_c) if warehouse else
+                         moving_circles(rng, count, t_c + 1.0,
+                                        None if acceleration is None else acceleration / 2.0))
             if adversary:
                 obstacles.append(WalkingObstacle((7.0, 1.0), 0.3, pursuit_speed=speed,
                                                  pursuit_acceleration=acceleration))
@@ -196,7 +209,8 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
                 record.collision_certified or record.guaranteed)
             tally["on_time"] += run.reached
             late = not run.reached and bool(np.any(np.all(
-                (run.trajectory.x >= 8.5) & (run.trajectory.x <= 9.5), axis=1)))
+                (run.trajectory.x >= target["lower"]) & (run.trajectory.x <= target["upper"]),
+                axis=1)))
             tally["late"] += late
             tally["not_reached"] += not run.reached and not late
             tally["uncertified_runs"] += bool(record.uncertified)
@@ -210,11 +224,12 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         tally["episode_cpu_s"] = (time.process_time() - started) / max(1, episodes)
         rows.append(tally)
     return {"scenario": {k: scenario[k] for k in ("prescribed_time", "sensing")},
+            "floor": "warehouse" if warehouse else "circles",
             "seed": seed, "adversary": adversary, "acceleration": acceleration,
             "speed_only": bool(speed_only and acceleration is not None), "rows": rows}
 
 
-def target_costs(acceleration: float | None = None) -> dict:
+def target_costs(acceleration: float | None = None, warehouse: bool = False) -> dict:
     """The scenario's controller on the Cortex-M4F with the tube as data
     (:func:`stt_codegen.embedded.tube_data_loop.run_tube_data`): instructions per switch
     and per step on the scenario's tube and on one with 16 circumvent windows open.
@@ -223,6 +238,8 @@ def target_costs(acceleration: float | None = None) -> dict:
     ----------
     acceleration : float, optional
         As :func:`run_sensed_bench` (the envelope does not change the controller).
+    warehouse : bool
+        The warehouse floor's tube instead (:mod:`.sensed_warehouse`).
 
     Returns
     -------
@@ -237,7 +254,8 @@ def target_costs(acceleration: float | None = None) -> dict:
     message = missing_message()
     if message:
         return {"missing": message}
-    design = stt.design_tube(stt.Spec.from_dict(scenario_with(acceleration)))
+    design = stt.design_tube(stt.Spec.from_dict(WAREHOUSE if warehouse
+                                                else scenario_with(acceleration)))
     r = run_tube_data(design, DEFAULT_CAPACITY)
     mean = lambda v: float(np.mean(v))   # noqa: E731
     return {"step": mean(r["steps_design"]["instructions"]),
@@ -285,6 +303,8 @@ def format_sensed_report(report: dict) -> str:
             f"{'replan p95 [s]':>14} {'max [s]':>8}")
     accel = report.get("acceleration")
     lines = [f"bench sensed: seed {report['seed']}"
+             + (", the warehouse floor, people crossing its aisles (N: people)"
+                if report.get("floor") == "warehouse" else "")
              + (", with a pursuer at the envelope's speed" if report["adversary"] else "")
              + ("" if accel is None else
                 (f", circles turning at {accel / 2:g} m/s^2 per axis, " +
