@@ -37,7 +37,6 @@ from ..design.sensed import (ReplanFailure, SensedPlan, replan, start_plan,
                              uncertified_plan)
 from ..errors import SpecError
 from ..spec.sensing import EnvelopeViolation, SensedObstacle, Sensing, envelope_violations
-from ..spec.variants import variant_of
 from ..tube import reference
 from ..tube.parameters import Status
 from .backends import make_controller
@@ -615,19 +614,16 @@ class _Runner:
     with the tube as data compiled once (:class:`~.data_controller.TubeDataController`), on
     ``python`` its Python module with the tube as data generated once
     (:class:`~.data_module.TubeDataModule`): each plan's tube loaded into it and its switch
-    deciding, as on a robot; else, and for a variant whose code does not take its tube as
-    data (``ControllerVariant.tube_data``: the base's), the backend's controller of each
-    tube (its own generated code on ``c`` and ``python``), and the oracle's ``|e|``
-    (:func:`_error`)."""
+    deciding, as on a robot; else the backend's controller of each tube, and the oracle's
+    ``|e|`` (:func:`_error`)."""
 
     def __init__(self, backend: str, design: Design) -> None:
         self.backend, self.spec = backend, design.spec
         self.library = None
-        as_data = variant_of(design.spec).tube_data
-        if as_data and backend == "c":
+        if backend == "c":
             from .data_controller import TubeDataController
             self.library = TubeDataController(design.tube)
-        elif as_data and backend == "python":
+        elif backend == "python":
             from .data_module import TubeDataModule
             self.library = TubeDataModule(design.tube)
 
