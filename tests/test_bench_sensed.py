@@ -10,7 +10,8 @@ import pytest
 import stt_codegen as stt
 from stt_codegen_bench.sensed_bench import (SCENARIO, format_sensed_report, moving_circles,
                                             run_sensed_bench, scenario_with)
-from stt_codegen_bench.sensed_warehouse import AISLES, DOOR, RACKS, WAREHOUSE, aisle_people
+from stt_codegen_bench.sensed_warehouse import (AISLES, DEPTH, DOOR, RACK_END, RACKS, WAREHOUSE,
+                                                WIDTH, aisle_people)
 
 
 def test_the_circles_are_seeded_and_drawn_by_the_generator():
@@ -64,12 +65,12 @@ def test_the_warehouse_people_are_seeded_within_the_envelope_and_clear_of_the_ra
         speed = np.linalg.norm(rows[1, 1:] - rows[0, 1:]) / (rows[1, 0] - rows[0, 0])
         assert speed <= sensing.max_obstacle_speed + 1e-12 and rows[0, 0] <= 24.0
         centre = person.scripted(t)
-        on_floor = np.all((centre >= 0.0) & (centre <= (20.0, 12.0)), axis=1)
+        on_floor = np.all((centre >= 0.0) & (centre <= (WIDTH, DEPTH)), axis=1)
         assert np.all((t[on_floor] > rows[0, 0]) & (t[on_floor] < rows[1, 0]))
-        assert np.all(np.abs(centre - np.clip(centre, 0.0, (20.0, 12.0))) <= DOOR + 1e-12)
-        for lo, hi in RACKS:            # racks span y in [0, 8]
+        assert np.all(np.abs(centre - np.clip(centre, 0.0, (WIDTH, DEPTH))) <= DOOR + 1e-12)
+        for lo, hi in RACKS:            # racks span y in [0, RACK_END]
             inside_x = (centre[:, 0] + person.radius > lo) & (centre[:, 0] - person.radius < hi)
-            assert not np.any(inside_x & (centre[:, 1] - person.radius < 8.0))
+            assert not np.any(inside_x & (centre[:, 1] - person.radius < RACK_END))
         kinds.add("aisle" if rows[0, 1] in AISLES else "cross")
     assert kinds == {"aisle", "cross"}
 

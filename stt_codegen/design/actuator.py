@@ -53,7 +53,7 @@ from .result import METHOD_PAPER, METHOD_VIA, Design
 from .samples import HORIZON_FACTOR, STEP_BUDGET
 from .windows import SHARPNESS_LADDER
 
-__all__ = ["design_within_bound", "law13_input_proof"]
+__all__ = ["design_within_bound", "law13_input_proof", "verdict_limit"]
 
 #: A longer ``t_c`` must lower the best peak-to-bound ratio by at least this factor, or the
 #: search stops: the peak no longer falls with the tube's speed (the disturbance and drift
@@ -219,11 +219,30 @@ def law13_input_proof(design: Design, spec: Spec) -> InputProof:
         the first sample where an input's bound passes ``spec.input_bound`` (partial:
         it meets no bound, and a proof that meets it is the same).
     """
-    bound = spec.input_bound
-    if bound is None or advice_wanted():
-        return prove_input_bound(design.tube, spec)
-    limits = np.asarray(bound, dtype=float)
-    return prove_input_bound(design.tube, spec, limit=lambda u: bool(np.any(u > limits)))
+    limits = np.asarray(spec.input_bound or (), dtype=float)
+    return prove_input_bound(design.tube, spec, limit=verdict_limit(
+        spec, lambda u: bool(np.any(u > limits))))
+
+
+def verdict_limit(spec: Spec, breaks: Callable[[np.ndarray], bool]
+                  ) -> Callable[[np.ndarray], bool] | None:
+    """The ``limit`` of an input proof
+    (:func:`~.certificate.actuator.prove_input_bound`): ``breaks`` (true where a
+    sample's bound of ``|u|`` breaks ``spec.input_bound``) within
+    :func:`~.failures.without_advice` for a spec with ``[actuator]``, where a search asks
+    the verdict only; else ``None`` (the whole proof, whose peaks a refusal names).
+
+    Parameters
+    ----------
+    spec : Spec
+    breaks : callable
+        ``(bound of |u_i(t_k)|, shape (n,)) -> bool``, the variant's test of the bound.
+
+    Returns
+    -------
+    callable or None
+    """
+    return breaks if spec.input_bound is not None and not advice_wanted() else None
 
 
 def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],

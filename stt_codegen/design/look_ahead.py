@@ -24,7 +24,7 @@ from dataclasses import replace
 
 from ..errors import DesignError, SpecError, number_text
 from ..spec.loader import Spec
-from .actuator import design_within_bound
+from .actuator import design_within_bound, verdict_limit
 from .certificate.actuator import prove_input_bound
 from .failures import FailureKind, advice_wanted, without_advice
 from .grid import grid_index, grid_value, smallest_passing
@@ -96,13 +96,10 @@ def look_ahead_design_proof(design: Design, spec: Spec) -> InputProof:
     """
     offset = spec.drive.axle_offset
     bound = spec.input_bound
-    if bound is None or advice_wanted():
-        return look_ahead_input_proof(prove_input_bound(design.tube, spec), offset)
-    # a verdict only (a search without advice): stopped at the first sample where |u|
-    # at the point passes v_max or omega_max l (as the cascade's stage check stops)
-    speed = min(bound[0], bound[1] * offset)
-    return look_ahead_input_proof(prove_input_bound(
-        design.tube, spec, limit=lambda u: math.hypot(*u) > speed), offset)
+    # |v| <= |u| and |omega| <= |u| / l: |u| at the point against min(v_max, omega_max l)
+    speed = math.inf if bound is None else min(bound[0], bound[1] * offset)
+    return look_ahead_input_proof(prove_input_bound(design.tube, spec, limit=verdict_limit(
+        spec, lambda u: math.hypot(*u) > speed)), offset)
 
 
 def look_ahead_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> Design:

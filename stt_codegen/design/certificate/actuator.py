@@ -20,13 +20,11 @@ import numpy as np
 
 from .enclosures import enclose_tube
 from ..input_bound import InputProof, input_peak, phi
-from ..samples import TubeSamples, sample_tube
+from ..samples import TubeSamples
 from ...spec.loader import Spec
 from ...tube import reference
 from ...tube.parameters import GAMMA_D_MIN, TubeDesign
-from .plant_class import plant_class
-from .sampled import (SampledCheck, cached_check, check_sampled, keep_check,
-                      sampled_check_of)
+from .sampled import SampledCheck, sampled_check_of
 
 __all__ = ["LIMIT_SLACK", "prove_input_bound", "sampled_error_bound"]
 
@@ -99,8 +97,8 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
         peaks are those up to that sample). The check runs whole where no sample breaks
         it, so a proof that meets the caller's bound is the same with or without
         ``limit``; where the whole check is already kept (:func:`~.sampled.cached_check`),
-        the whole proof from it. Not with ``per_axis_first`` or ``[controller]
-        compensate_delay`` (ignored there).
+        the whole proof from it (:func:`~.sampled.sampled_check_of`'s ``stop_for``). Not
+        with ``per_axis_first`` or ``[controller] compensate_delay`` (ignored there).
 
     Returns
     -------
@@ -113,56 +111,37 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
     SpecError
         More samples than the step budget (as :func:`~stt_codegen.design.samples.sample_tube`).
     """
-    if (limit is not None and not per_axis_first and not spec.compensate_delay
-            and cached_check(tube, spec, False) is None):
-        return _prove_until(tube, spec, limit)
-    # the check is computed once per (tube, spec, per_axis_first) in a process:
-    # sampled_check_of samples with the oracle's exp/log/tanh as numpy's ufuncs
-    samples, result = sampled_check_of(tube, spec, per_axis_first)
-    horizon = float(samples.t[-1])
-    abs_e = sampled_error_bound(result, samples)
-    if abs_e is None:
-        return _not_proved(tube, horizon, result)
-    with reference.numpy_math():
-        widths = certified_widths(tube, samples)
-    return input_peak(tube.gain, abs_e, widths, samples.t, horizon)
+    widths: list[np.ndarray] = []           # the certified widths, computed once
 
-
-def _not_proved(tube: TubeDesign, horizon: float, result: SampledCheck) -> InputProof:
-    """The proof of a tube whose sampled check fails: no peak."""
-    n = tube.dimension
-    return InputProof(False, (np.inf,) * n, (0.0,) * n, horizon,
-                      f"the sampled-data check fails: {result.reason}")
-
-
-def _prove_until(tube: TubeDesign, spec: Spec, limit: Callable[[np.ndarray], bool]
-                 ) -> InputProof:
-    """:func:`prove_input_bound` with the check stopped at the first sample whose bound of
-    ``|u|`` breaks ``limit``; a check that runs whole is kept for
-    :func:`~.sampled.sampled_check_of` (:func:`~.sampled.keep_check`), a stopped one is
-    not."""
-    with reference.numpy_math():
-        samples = sample_tube(tube)
-        widths = certified_widths(tube, samples)
-        per_phi = 4.0 * tube.gain / np.maximum(widths, GAMMA_D_MIN)   # |u| per phi(|e|)
+    def stop_for(samples: TubeSamples):
+        widths.append(certified_widths(tube, samples))
+        per_phi = 4.0 * tube.gain / np.maximum(widths[0], GAMMA_D_MIN)   # |u| per phi(|e|)
 
         def stop(k: int, abs_e: list[float]) -> bool:
             # a shade below the bound input_peak computes from the same numbers (numpy's
             # atanh may differ by an ulp between one sample and the whole array): a
             # sample stops the check only where the whole proof's bound breaks the limit
             return bool(limit(per_phi[k] * phi(np.asarray(abs_e)) * (1.0 - LIMIT_SLACK)))
+        return stop
 
-        result = check_sampled(tube, samples, plant_class(spec), delay=spec.delay,
-                               jitter=spec.jitter, stop=stop)
+    # the check is computed once per (tube, spec, per_axis_first) in a process:
+    # sampled_check_of samples with the oracle's exp/log/tanh as numpy's ufuncs
+    samples, result = sampled_check_of(tube, spec, per_axis_first,
+                                       None if limit is None else stop_for)
     horizon = float(samples.t[-1])
-    if "stopped_at" not in result.data:
-        keep_check(tube, spec, False, samples, result)
-        abs_e = sampled_error_bound(result, samples)
-        if abs_e is None:
-            return _not_proved(tube, horizon, result)
-        return input_peak(tube.gain, abs_e, widths, samples.t, horizon)
-    k = len(result.abs_e)
-    return replace(input_peak(tube.gain, result.abs_e, widths[:k], samples.t[:k], horizon),
-                   complete=False, reason=f"the bound of the input passes the limit at "
-                                          f"t = {result.data['stopped_at']:.4f} s (the "
-                                          f"check stopped there)")
+    if not widths:
+        with reference.numpy_math():
+            widths.append(certified_widths(tube, samples))
+    if "stopped_at" in result.data:
+        k = len(result.abs_e)
+        return replace(input_peak(tube.gain, result.abs_e, widths[0][:k], samples.t[:k],
+                                  horizon),
+                       complete=False, reason=f"the bound of the input passes the limit at "
+                                              f"t = {result.data['stopped_at']:.4f} s (the "
+                                              f"check stopped there)")
+    abs_e = sampled_error_bound(result, samples)
+    if abs_e is None:
+        n = tube.dimension
+        return InputProof(False, (np.inf,) * n, (0.0,) * n, horizon,
+                          f"the sampled-data check fails: {result.reason}")
+    return input_peak(tube.gain, abs_e, widths[0], samples.t, horizon)

@@ -43,9 +43,8 @@ from .sampled_axis import (axis_interval, held_speed, peak, peak_for_box, phi_sc
                            phi_slope_scalar, turn_failure, turned_gains, unprovable)
 
 __all__ = ["DELAY_HALVINGS", "KEPT_CHECKS", "RATE_FACTORS", "SampledCheck", "cached_check",
-           "check_sampled", "check_sampled_first_per_axis", "delay_room", "keep_check",
-           "largest_delay", "largest_passing", "lowest_rate", "sampled_check_of",
-           "worst_near"]
+           "check_sampled", "check_sampled_first_per_axis", "delay_room", "largest_delay",
+           "largest_passing", "lowest_rate", "sampled_check_of", "worst_near"]
 
 #: Sampling-rate multiples tried by :func:`lowest_rate`, in increasing order.
 RATE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0, 4.0, 6.0, 8.0, 12.0, 16.0)
@@ -558,15 +557,18 @@ def largest_passing(passes: Callable[[float], bool], top: float,
     return good
 
 
-def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
-                     ) -> tuple[TubeSamples, SampledCheck]:
+def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True,
+                     stop_for: Callable[[TubeSamples], Callable[[int, list[float]], bool]]
+                     | None = None) -> tuple[TubeSamples, SampledCheck]:
     """The sampled-data check of a designed tube for its spec's plant class, once per
     process: the design's tracking proof, the ``[actuator]`` proof and ``verify`` ask for
     the same check of the same tube (a bundled design is asked for again and again).
 
     The tube is sampled with numpy's ufuncs for the oracle's exp/log/tanh (within an ulp
     of libm, as the certificate does: every margin here is far above rounding), over the
-    default horizon of :func:`~stt_codegen.design.samples.sample_tube`.
+    default horizon of :func:`~stt_codegen.design.samples.sample_tube`. A process keeps its
+    last :data:`KEPT_CHECKS` whole checks (:func:`cached_check`); a check stopped early is
+    not kept.
 
     Parameters
     ----------
@@ -578,27 +580,39 @@ def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
         :func:`check_sampled_first_per_axis` (the same verdict; where the per-axis argument
         passes, its bounds, which the Lyapunov balls could only tighten) instead of
         :func:`check_sampled` with the balls everywhere.
+    stop_for : callable, optional
+        ``samples -> stop``: :func:`check_sampled`'s ``stop`` for the tube's samples, for a
+        caller that needs a verdict only (the input bound's); used where a check is
+        computed with the balls everywhere (not ``per_axis_first`` nor ``[controller]
+        compensate_delay``) and no whole check is kept, which is read instead.
 
     Returns
     -------
     samples : TubeSamples
         The design's tube at its sampling instants.
     check : SampledCheck
-        The verdict (cached per process).
+        The verdict (``data["stopped_at"]`` when ``stop`` ended it).
     """
     key = (design, spec, bool(per_axis_first))
     found = cached_check(*key)
-    if found is None:
-        with reference.numpy_math():
-            samples = sample_tube(design)
-            plants = plant_class(spec)
-            timing = {"delay": spec.delay, "jitter": spec.jitter}
-            check = (check_sampled_first_per_axis(design, samples, plants, **timing,
-                                                  compensate=spec.compensate_delay)
-                     if per_axis_first or spec.compensate_delay
-                     else check_sampled(design, samples, plants, **timing))
-        found = keep_check(design, spec, bool(per_axis_first), samples, check)
-    return found
+    if found is not None:
+        return found
+    with reference.numpy_math():
+        samples = sample_tube(design)
+        plants = plant_class(spec)
+        timing = {"delay": spec.delay, "jitter": spec.jitter}
+        if per_axis_first or spec.compensate_delay:
+            check = check_sampled_first_per_axis(design, samples, plants, **timing,
+                                                 compensate=spec.compensate_delay)
+        else:
+            check = check_sampled(design, samples, plants, **timing,
+                                  stop=None if stop_for is None else stop_for(samples))
+    if "stopped_at" in check.data:
+        return samples, check
+    _KEPT[key] = (samples, check)
+    while len(_KEPT) > KEPT_CHECKS:
+        _KEPT.popitem(last=False)
+    return samples, check
 
 
 #: The whole checks :func:`sampled_check_of` keeps, the latest last (at most
@@ -612,26 +626,12 @@ KEPT_CHECKS = 16
 def cached_check(design: TubeDesign, spec: Spec, per_axis_first: bool
                  ) -> tuple[TubeSamples, SampledCheck] | None:
     """The whole check :func:`sampled_check_of` keeps for these arguments, or ``None``
-    (nothing computed)."""
+    (nothing computed, or only a check stopped early)."""
     key = (design, spec, per_axis_first)
     found = _KEPT.get(key)
     if found is not None:
         _KEPT.move_to_end(key)
     return found
-
-
-def keep_check(design: TubeDesign, spec: Spec, per_axis_first: bool, samples: TubeSamples,
-               check: SampledCheck) -> tuple[TubeSamples, SampledCheck]:
-    """Keep a whole check of ``design`` for ``spec`` (as :func:`sampled_check_of` computes
-    it: the samples of :func:`~stt_codegen.design.samples.sample_tube` and the check
-    without ``stop``) for the next :func:`sampled_check_of`; returns it."""
-    if "stopped_at" in check.data:
-        raise ValueError("keep_check: a stopped check is not the whole check")
-    _KEPT[(design, spec, per_axis_first)] = (samples, check)
-    _KEPT.move_to_end((design, spec, per_axis_first))
-    while len(_KEPT) > KEPT_CHECKS:
-        _KEPT.popitem(last=False)
-    return samples, check
 
 
 def lowest_rate(design: TubeDesign, spec: Spec, plants: Assumptions | PlantClass,

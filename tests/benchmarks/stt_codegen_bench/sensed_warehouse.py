@@ -23,10 +23,15 @@ import numpy as np
 
 from stt_codegen.runtime.sensed import WalkingObstacle
 
-__all__ = ["AISLES", "DOOR", "RACKS", "WAREHOUSE", "aisle_people"]
+__all__ = ["AISLES", "DEPTH", "DOOR", "RACKS", "RACK_END", "WAREHOUSE", "WIDTH",
+           "aisle_people"]
 
-#: The racks' extents along x, m (each from y = 0 to 8 m).
+#: The floor's size, m.
+WIDTH, DEPTH = 20.0, 12.0
+#: The racks' extents along x, m (each from the south wall to :data:`RACK_END`).
 RACKS = ((4.5, 5.7), (9.4, 10.6), (14.3, 15.5))
+#: Where the racks end and the cross aisle begins, m.
+RACK_END = 8.0
 #: The middle aisles' centre lines, m (between the racks).
 AISLES = (7.55, 12.45)
 #: How far outside the floor's walls a person waits before walking in and after walking
@@ -35,10 +40,10 @@ DOOR = 1.0
 #: The floor, the base and the envelope (a spec dictionary).
 WAREHOUSE = {
     "name": "warehouse-people", "prescribed_time": 40.0,
-    "state_space": {"lower": [0.0, 0.0], "upper": [20.0, 12.0]},
+    "state_space": {"lower": [0.0, 0.0], "upper": [WIDTH, DEPTH]},
     "initial": {"lower": [1.5, 1.5], "upper": [2.5, 2.5], "half_width": [0.25, 0.25]},
     "target": {"lower": [17.5, 1.5], "upper": [18.5, 2.5]},
-    "obstacles": [{"lower": [a, 0.0], "upper": [b, 8.0]} for a, b in RACKS],
+    "obstacles": [{"lower": [a, 0.0], "upper": [b, RACK_END]} for a, b in RACKS],
     "controller": {"rate_hz": 100.0},
     "plant": {"model": "single-integrator", "disturbance_amplitude": 0.05},
     "robot": {"radius": 0.3},
@@ -79,10 +84,10 @@ def aisle_people(rng: np.random.Generator, count: int, until: float
         start = float(rng.uniform(0.0, 0.6 * until))
         if rng.uniform() < 0.5:                 # along a middle aisle, door to door
             x = float(AISLES[rng.integers(len(AISLES))])
-            a, b = (x, -DOOR), (x, 12.0 + DOOR)
-        else:                                   # along the cross aisle
-            y = float(rng.uniform(8.5, 11.5))
-            a, b = (-DOOR, y), (20.0 + DOOR, y)
+            a, b = (x, -DOOR), (x, DEPTH + DOOR)
+        else:                                   # along the cross aisle, 0.5 m off its sides
+            y = float(rng.uniform(RACK_END + 0.5, DEPTH - 0.5))
+            a, b = (-DOOR, y), (WIDTH + DOOR, y)
         if rng.uniform() < 0.5:
             a, b = b, a
         end = start + math.dist(a, b) / speed
