@@ -141,6 +141,33 @@ def test_a_search_without_advice_stops_each_proof_at_the_bound():
     assert "asks at least" in str(refused.value)
 
 
+def test_a_re_timing_searched_for_a_verdict_stops_its_proof_at_the_bound():
+    """``retimed_design`` (the fleet's and the moving obstacles' re-timing) refuses a
+    re-timed tube whose input passes the bound: with the whole proof's peaks, or within
+    ``without_advice`` (the fleet's placement) from a proof stopped at the first sample
+    over the bound, which says where it stopped; the verdict is the same."""
+    from stt_codegen.design.certificate import sampled
+    from stt_codegen.design.failures import without_advice
+    from stt_codegen.design.moving import retimed_design
+    from stt_codegen.design.search import check_tube
+    free = small(None)
+    via = design_tube(dataclasses.replace(free, tube=dataclasses.replace(free.tube,
+                                                                         method="via")))
+    spec = small((1.0, 1.0))                 # the via tube asks about 2 of each input
+    sampled._KEPT.clear()
+    whole = retimed_design(via, spec, spec, check_tube, 0.0)
+    sampled._KEPT.clear()
+    with without_advice():
+        part = retimed_design(via, spec, spec, check_tube, 0.0)
+    assert isinstance(whole, str) and isinstance(part, str)
+    assert "not proved within actuator.input_bound" in whole and "stopped" not in whole
+    peaks = [float(v) for v in re.findall(r"\|u\d\| <= ([0-9.]+)", whole)]
+    assert min(peaks) > 1.0
+    assert "not proved within actuator.input_bound" in part and "where the proof stopped" in part
+    stopped = [float(v) for v in re.findall(r"\|u\d\| <= ([0-9.]+)", part)]
+    assert max(stopped) > 1.0 and all(a <= b for a, b in zip(stopped, peaks))
+
+
 def test_a_bound_the_default_design_meets_keeps_its_tube():
     default = design_tube(small(None))
     bounded = design_tube(small((3.5, 3.5)))

@@ -155,9 +155,20 @@ def test_a_shifted_second_robot_is_certified_apart():
     assert _sampled_gap(alone, fleet) >= pair.margin - 1e-9
 
 
-def test_the_prioritized_design_separates_the_crossing_robots():
+def test_the_prioritized_design_separates_the_crossing_robots(monkeypatch):
+    from stt_codegen.design import fleet as fleet_design
+    from stt_codegen.design.failures import advice_wanted
+    retimings = []
+
+    def retimed(*args):                      # each re-timing asks for a verdict only
+        retimings.append(advice_wanted())
+        return fleet_design_retimed(*args)
+
+    fleet_design_retimed = fleet_design.retimed_design
+    monkeypatch.setattr(fleet_design, "retimed_design", retimed)
     fleet = stt.FleetSpec.from_dict(TWO)
     designed = stt.design_fleet(fleet)
+    assert retimings and not any(retimings)
     assert designed.certified and designed.order == ("a", "b")
     (pair,) = designed.pairs
     assert pair.passed and pair.margin > 0

@@ -657,8 +657,10 @@ def _fit(robot: FleetRobot, placing: _Placing) -> tuple[Design, RobotTube] | str
         if plan is None:
             reasons.append(f"{label}: no via design")
             return None
-        got = retimed_design(_pieces(plan, spec), _timing_spec(
-            robot, way_tube if plan is way else enclosed(plan), placing), spec, check, started)
+        with without_advice():              # the verdict of each re-timing's input proof
+            got = retimed_design(_pieces(plan, spec), _timing_spec(
+                robot, way_tube if plan is way else enclosed(plan), placing), spec, check,
+                started)
         if isinstance(got, Design):
             design = _proved(got, spec)
             if design is not None:

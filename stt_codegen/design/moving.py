@@ -557,6 +557,8 @@ def retimed_design(via: Design | None, timing: Spec, spec: Spec,
             return replace(design, input_proof=proof)
         peaks = ", ".join(f"|{name}| <= {p:.4g}" for name, p in
                           zip(spec.input_names, proof.peak))
+        if not proof.complete:              # stopped at the first sample over the bound
+            peaks += f" up to t = {max(proof.time):.3f} s, where the proof stopped"
         why = (f"its input is not proved within actuator.input_bound ({peaks}, the "
                f"segments at {min(factors):g} times their planned durations or slower)"
                if proof.proved else f"its input bound is not proved: {proof.reason}")
