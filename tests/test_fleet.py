@@ -240,6 +240,40 @@ def test_the_space_time_baseline_plans_every_robot_along_a_path_and_is_certified
         stt.design_fleet(fleet, planner="astar")
 
 
+def test_a_space_time_path_over_the_input_bound_is_planned_again_at_a_lower_speed(monkeypatch):
+    """With ``[actuator]``, a space-time path whose input proof fails is planned again at
+    each of ``PATH_SLOWER`` times its speed: the same path, later; the first proved one is
+    kept, and when none is, the refusal says which speeds were tried."""
+    from stt_codegen.design import fleet as fleet_design
+    doc = copy.deepcopy(TWO)
+    for entry in doc["robots"]:
+        entry["actuator"] = {"input_bound": [5.0, 5.0]}
+    fleet = stt.FleetSpec.from_dict(doc)
+    proved = fleet_design._proved
+    arrivals: list[float] = []
+
+    def refused_at_first_speed(design, spec):    # the first try of each robot "fails"
+        arrivals.append(max(s.end for s in design.tube.segments))
+        return None if len(arrivals) % 2 else proved(design, spec)
+
+    monkeypatch.setattr(fleet_design, "_proved", refused_at_first_speed)
+    designed = stt.design_fleet(fleet, planner=fleet_design.PLANNER_SPACE_TIME)
+    assert designed.certified and len(arrivals) == 4
+    assert arrivals[1] > arrivals[0] and arrivals[3] > arrivals[2]    # slower: later
+    for name in ("a", "b"):
+        assert designed.designs[name].input_proof.meets((5.0, 5.0))
+    arrivals.clear()
+    monkeypatch.setattr(fleet_design, "_proved", lambda design, spec: arrivals.append(
+        max(s.end for s in design.tube.segments)))
+    with pytest.raises(stt.DesignError) as refused:
+        stt.design_fleet(fleet, planner=fleet_design.PLANNER_SPACE_TIME)
+    # each slower speed in turn, until one has no path within prescribed_time
+    assert 2 <= len(arrivals) <= len(fleet_design.PATH_SLOWER)
+    assert arrivals == sorted(arrivals) and arrivals[0] < arrivals[-1]
+    assert "space-time path: its input is not proved within actuator.input_bound" in str(
+        refused.value)
+
+
 @pytest.mark.slow
 def test_a_re_ordering_keeps_the_placements_that_still_hold(monkeypatch):
     # warehouse-fleet moves two robots to the front; the robots placed before them keep

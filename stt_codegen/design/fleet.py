@@ -72,6 +72,9 @@ DETOUR_SECONDS = 2.0
 #: The space-time path's speed: this many times the robot's way's mean speed (its length
 #: over ``t_c``), within [MIN_SPEED, MAX_SPEED] (state units per second).
 SPEED_FACTOR, MIN_SPEED, MAX_SPEED = 2.0, 0.5, 1.5
+#: With ``[actuator]``, a space-time path whose input is not proved within the bound is
+#: planned again at these fractions of its speed, in turn (a slower path asks less).
+PATH_SLOWER = (1.0, 0.75, 0.5)
 #: The placed tubes' boxes on the space-time grid span at most this long, seconds.
 STEP_SECONDS = 0.5
 #: ``Design.motion`` of a tube along a space-time path.
@@ -575,7 +578,9 @@ def _around(robot: FleetRobot, clash: PairMargin, placing: _Placing) -> tuple[Ob
 def _space_time(robot: FleetRobot, way: Design, placing: _Placing,
                 check) -> tuple[Design | None, str]:
     """``robot``'s tube along a space-time A* path among the placed tubes
-    (:mod:`.fleet_paths`), checked by ``check``; the design, or ``None`` and why not."""
+    (:mod:`.fleet_paths`), checked by ``check``; the design, or ``None`` and why not. With
+    ``[actuator]``, a path whose input is not proved within the bound is planned again at
+    each of :data:`PATH_SLOWER` times its speed."""
     spec = robot.spec
     if len(robot.dims) != 2 or spec.dimension != 2:
         return None, "no space-time path (planned on two body dimensions only)"
@@ -585,30 +590,39 @@ def _space_time(robot: FleetRobot, way: Design, placing: _Placing,
     length = float(np.sum([np.linalg.norm(np.subtract(s.lower_to, s.lower_from))
                            for s in way.tube.segments]))
     speed = min(max(SPEED_FACTOR * length / spec.prescribed_time, MIN_SPEED), MAX_SPEED)
-    step = grid.cell / speed
     placed = [(other, tube) for other, _, tube in placing.placed.values()]
     ends = [float(np.max(t.enclosure.t_start)) for _, t in placed]
-    steps = math.ceil(max([spec.prescribed_time] + ends) / step) + 1
-    taken = Reservations(grid, step, steps)
+    boxes = []
     for other, tube in placed:
         c = chunks(tube, robot.dims, STEP_SECONDS)
         grow = other.reach + robot.reach
-        taken.add(c.t_start, c.t_end, c.lower - grow, c.upper + grow)
-    path = space_time_path(grid, taken, grid.index(np.array(spec.initial_state)[list(robot.dims)]),
-                           grid.index(np.array(spec.target_center)[list(robot.dims)]),
-                           math.floor(spec.prescribed_time / step))
-    if path is None:
-        return None, "no space-time path among the placed tubes"
-    tube = replace(way.tube, circumvents=(), segments=space_time_segments(
-        path, grid, way.tube, step, _profile(robot)))
-    found = check(tube, _free(spec))
-    if not found.passed:
-        return None, f"its space-time path: {found.reason}"
-    design = _proved(Design(with_gain(tube, found.min_width, spec), METHOD_VIA, found, 0.0,
-                            spec=spec, motion=MOTION_SPACE_TIME_PATH), spec)
-    if design is None:
-        return None, "its space-time path: its input is not proved within actuator.input_bound"
-    return design, ""
+        boxes.append((c.t_start, c.t_end, c.lower - grow, c.upper + grow))
+    start = grid.index(np.array(spec.initial_state)[list(robot.dims)])
+    goal = grid.index(np.array(spec.target_center)[list(robot.dims)])
+    factors = PATH_SLOWER if spec.input_bound is not None else PATH_SLOWER[:1]
+    for factor in factors:
+        step = grid.cell / (speed * factor)
+        steps = math.ceil(max([spec.prescribed_time] + ends) / step) + 1
+        taken = Reservations(grid, step, steps)
+        for box in boxes:
+            taken.add(*box)
+        path = space_time_path(grid, taken, start, goal, math.floor(spec.prescribed_time / step))
+        if path is None:
+            return None, ("no space-time path among the placed tubes" if factor == factors[0]
+                          else f"its space-time path: its input is not proved within "
+                               f"actuator.input_bound, and at {factor:g} times its speed "
+                               f"there is no path within prescribed_time")
+        tube = replace(way.tube, circumvents=(), segments=space_time_segments(
+            path, grid, way.tube, step, _profile(robot)))
+        found = check(tube, _free(spec))
+        if not found.passed:
+            return None, f"its space-time path: {found.reason}"
+        design = _proved(Design(with_gain(tube, found.min_width, spec), METHOD_VIA, found,
+                                0.0, spec=spec, motion=MOTION_SPACE_TIME_PATH), spec)
+        if design is not None:
+            return design, ""
+    return None, ("its space-time path: its input is not proved within actuator.input_bound "
+                  f"(at {', '.join(f'{f:g}' for f in factors)} times its speed)")
 
 
 def _fit(robot: FleetRobot, placing: _Placing) -> tuple[Design, RobotTube] | str:
