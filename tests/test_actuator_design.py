@@ -107,8 +107,6 @@ def test_a_proof_stopped_at_a_limit_keeps_the_verdict():
     whole = prove_input_bound(tube, spec)
     top = np.array(whole.peak)
     assert whole.complete
-    sampled._KEPT.clear()
-    assert prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > top))) == whole
     half = 0.5 * top
     # the whole check it ran is kept: asked again, the whole proof at once
     assert prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > half))) == whole
@@ -123,6 +121,37 @@ def test_a_proof_stopped_at_a_limit_keeps_the_verdict():
     stopped = check_sampled(tube, samples, spec.assumptions, stop=lambda k, e: k == 40)
     assert not stopped.passed and stopped.data["stopped_at"] == samples.t[40]
     assert np.array_equal(stopped.abs_e, full.abs_e[:41])
+
+
+def test_a_bases_verdict_asks_the_per_axis_argument_first():
+    """With a limit and no kept check, a base's proof (``g`` turns while a command is
+    held) asks the per-axis argument first: where its bounds keep the limit its whole
+    proof is the answer (here the same as the balls', and no check with the balls runs);
+    where they break it, the check with the balls runs, stopped there as before. A first
+    order's proof goes to the balls at once."""
+    from stt_codegen.design.certificate import sampled
+    spec = load_spec(SPECS / "office-drive.toml")
+    tube = design_tube(spec).tube
+    sampled._KEPT.clear()
+    balls = prove_input_bound(tube, spec)
+    axis = prove_input_bound(tube, spec, per_axis_first=True)
+    assert np.all(np.array(axis.peak) >= np.array(balls.peak))
+    above, below = np.array(axis.peak) * 1.01, np.array(balls.peak) * 0.5
+    sampled._KEPT.clear()
+    assert prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > above))) == axis
+    assert sampled.cached_check(tube, spec, False) is None      # no check with the balls
+    sampled._KEPT.clear()
+    part = prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > below)))
+    assert not part.complete and sampled.cached_check(tube, spec, False) is None
+    assert np.any(np.array(part.peak) > below)
+    assert np.all(np.array(part.peak) <= np.array(balls.peak))
+    s1, design = robot()
+    sampled._KEPT.clear()
+    top = np.array(prove_input_bound(design.tube, s1).peak) * 1.01
+    sampled._KEPT.clear()
+    prove_input_bound(design.tube, s1, limit=lambda u: bool(np.any(u > top)))
+    assert sampled.cached_check(design.tube, s1, False) is not None  # the balls at once
+    assert sampled.cached_check(design.tube, s1, True) is None
 
 
 def test_a_search_without_advice_stops_each_proof_at_the_bound():

@@ -92,7 +92,8 @@ def look_ahead_design_proof(design: Design, spec: Spec) -> InputProof:
         :func:`look_ahead_input_proof` of law (13)'s proof at the point; within
         :func:`~.failures.without_advice` (a search asking the verdict only), stopped at
         the first sample where ``|u|`` passes ``min(v_max, omega_max l)`` (partial: it
-        meets no bound, and a proof that meets it is the same).
+        meets no bound; a proof that meets it is whole, the per-axis argument's where its
+        bounds keep the bound, else the balls').
     """
     offset = spec.drive.axle_offset
     bound = spec.input_bound

@@ -409,7 +409,8 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
 def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,
                                  plants: Assumptions | PlantClass,
                                  gain: float | None = None, *, delay: float = 0.0,
-                                 jitter: float = 0.0, compensate: bool = False
+                                 jitter: float = 0.0, compensate: bool = False,
+                                 stop: Callable[[int, list[float]], bool] | None = None
                                  ) -> SampledCheck:
     """:func:`check_sampled` with the per-axis argument alone, and with the Lyapunov balls
     only where that fails; with ``compensate`` and a delay, the check of the predicted law
@@ -437,11 +438,15 @@ def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,
         ``[controller] compensate_delay``: law (13) at the state predicted over ``delay``
         (up to ``dt``; ``jitter`` must be 0). With ``delay`` 0 the prediction is the state
         itself and the check is the plain one.
+    stop : callable, optional
+        :func:`check_sampled`'s ``stop``, asked by the per-axis argument and, where that
+        fails, by the whole check (not with ``compensate``): a check it stops is returned
+        as stopped.
 
     Returns
     -------
     SampledCheck
-        The per-axis argument's when it passes, else the whole check's.
+        The per-axis argument's when it passes (or stops), else the whole check's.
 
     Raises
     ------
@@ -460,10 +465,10 @@ def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,
                 "compensate_delay": True, "max_abs_e": level, "margin": margin}
         return SampledCheck(passed, level, margin, t, i, reason, data, abs_e)
     per_axis = check_sampled(design, samples, plants, gain, lyapunov=False, delay=delay,
-                             jitter=jitter)
-    if per_axis.passed or delay > 0.0 or jitter > 0.0:
+                             jitter=jitter, stop=stop)
+    if per_axis.passed or delay > 0.0 or jitter > 0.0 or "stopped_at" in per_axis.data:
         return per_axis
-    return check_sampled(design, samples, plants, gain)
+    return check_sampled(design, samples, plants, gain, stop=stop)
 
 
 #: Halvings of the bisection of :func:`largest_delay` (a resolution of ``dt / 2^6``).
@@ -582,9 +587,10 @@ def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
         :func:`check_sampled` with the balls everywhere.
     stop_for : callable, optional
         ``samples -> stop``: :func:`check_sampled`'s ``stop`` for the tube's samples, for a
-        caller that needs a verdict only (the input bound's); used where a check is
-        computed with the balls everywhere (not ``per_axis_first`` nor ``[controller]
-        compensate_delay``) and no whole check is kept, which is read instead.
+        caller that needs a verdict only (the input bound's); used where no whole check
+        is kept (which is read instead) and not with ``[controller] compensate_delay``.
+        With ``per_axis_first``, the per-axis argument stops there (its bounds, looser
+        than the balls', may break a limit theirs keep).
 
     Returns
     -------
@@ -601,12 +607,12 @@ def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
         samples = sample_tube(design)
         plants = plant_class(spec)
         timing = {"delay": spec.delay, "jitter": spec.jitter}
+        stop = None if stop_for is None or spec.compensate_delay else stop_for(samples)
         if per_axis_first or spec.compensate_delay:
             check = check_sampled_first_per_axis(design, samples, plants, **timing,
-                                                 compensate=spec.compensate_delay)
+                                                 compensate=spec.compensate_delay, stop=stop)
         else:
-            check = check_sampled(design, samples, plants, **timing,
-                                  stop=None if stop_for is None else stop_for(samples))
+            check = check_sampled(design, samples, plants, **timing, stop=stop)
     if "stopped_at" in check.data:
         return samples, check
     _KEPT[key] = (samples, check)
