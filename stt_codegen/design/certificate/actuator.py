@@ -95,17 +95,17 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
         below the bound: the check stops at the first such sample, and the proof is
         partial (:attr:`~stt_codegen.design.input_bound.InputProof.complete` false: its
         peaks are those up to that sample). The check runs whole where no sample breaks
-        it, so a proof that meets the caller's bound is the same with or without
-        ``limit``; where the whole check is already kept (:func:`~.sampled.cached_check`),
-        the whole proof from it (:func:`~.sampled.sampled_check_of`'s ``stop_for``).
-        Otherwise, for a plant class whose ``g`` turns while a command is held
-        (``input_gain_turn``: a differential-drive base), the per-axis argument is asked
-        first (the check of ``per_axis_first``, about half the cost of the balls
-        everywhere, its bounds of ``|e|`` no tighter):
-        where it keeps the limit on every sample its proof is returned, whole (its peaks
-        at least the balls' and within the limit); where it stops, the check with the
-        balls everywhere runs with the same stop. So the verdict is the whole check's,
-        the proof of a tube that keeps the limit may be the per-axis one. Ignored with
+        it, so a proof that meets the caller's bound is whole; where the whole check is
+        already kept (:func:`~.sampled.cached_check`), the whole proof from it
+        (:func:`~.sampled.sampled_check_of`'s ``stop_for``). For a plant class whose
+        ``g`` turns while a command is held (``input_gain_turn``: a differential-drive
+        base), the per-axis argument is asked first (the check of ``per_axis_first``,
+        about half the cost of the balls everywhere, its bounds of ``|e|`` no tighter):
+        where it keeps the limit at every sample, its whole proof is returned (peaks at
+        least the balls', within the limit); where it stops, the check with the balls
+        everywhere runs with the same stop. So the verdict is the whole check's, and an
+        accepted base's proof may be the per-axis one; any other proof that meets the
+        caller's bound is the same with or without ``limit``. Ignored with
         ``[controller] compensate_delay``.
 
     Returns
