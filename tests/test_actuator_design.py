@@ -124,34 +124,50 @@ def test_a_proof_stopped_at_a_limit_keeps_the_verdict():
 
 
 def test_a_bases_verdict_asks_the_per_axis_argument_first():
-    """With a limit and no kept check, a base's proof (``g`` turns while a command is
-    held) asks the per-axis argument first: where its bounds keep the limit its whole
-    proof is the answer (here the same as the balls', and no check with the balls runs);
-    where they break it, the check with the balls runs, stopped there as before. A first
-    order's proof goes to the balls at once."""
+    """With a limit and no kept check, ``verdict_per_axis_first`` (the base's proof role)
+    asks the per-axis argument first: where its bounds keep the limit its whole proof is
+    the answer (here the same as the balls', and no check with the balls runs); where they
+    break it, the check with the balls runs, stopped there as before. Law (13)'s proof
+    (S1) goes to the balls at once."""
+    from stt_codegen.design import look_ahead
+    from stt_codegen.design.actuator import law13_input_proof
     from stt_codegen.design.certificate import sampled
+    from stt_codegen.design.failures import without_advice
     spec = load_spec(SPECS / "office-drive.toml")
-    tube = design_tube(spec).tube
+    base = design_tube(spec)
+    tube = base.tube
     sampled._KEPT.clear()
     balls = prove_input_bound(tube, spec)
     axis = prove_input_bound(tube, spec, per_axis_first=True)
     assert np.all(np.array(axis.peak) >= np.array(balls.peak))
     above, below = np.array(axis.peak) * 1.01, np.array(balls.peak) * 0.5
     sampled._KEPT.clear()
-    assert prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > above))) == axis
+    assert prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > above)),
+                             verdict_per_axis_first=True) == axis
     assert sampled.cached_check(tube, spec, False) is None      # no check with the balls
     sampled._KEPT.clear()
-    part = prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > below)))
+    part = prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > below)),
+                             verdict_per_axis_first=True)
     assert not part.complete and sampled.cached_check(tube, spec, False) is None
     assert np.any(np.array(part.peak) > below)
     assert np.all(np.array(part.peak) <= np.array(balls.peak))
+    # the base's role asks it so: within a verdict search, the same per-axis proof
+    sampled._KEPT.clear()
+    at_base = look_ahead.look_ahead_input_proof(axis, spec.drive.axle_offset)  # (v, omega)
+    capped = dataclasses.replace(spec, input_bound=tuple(2.0 * v for v in at_base.peak))
+    with without_advice():
+        role = look_ahead.look_ahead_design_proof(base, capped)
+    assert role == at_base
+    assert sampled.cached_check(tube, capped, False) is None
     s1, design = robot()
     sampled._KEPT.clear()
     top = np.array(prove_input_bound(design.tube, s1).peak) * 1.01
     sampled._KEPT.clear()
-    prove_input_bound(design.tube, s1, limit=lambda u: bool(np.any(u > top)))
-    assert sampled.cached_check(design.tube, s1, False) is not None  # the balls at once
-    assert sampled.cached_check(design.tube, s1, True) is None
+    bounded = dataclasses.replace(s1, input_bound=tuple(float(v) for v in top))
+    with without_advice():
+        assert law13_input_proof(design, bounded).complete
+    assert sampled.cached_check(design.tube, bounded, False) is not None  # the balls at once
+    assert sampled.cached_check(design.tube, bounded, True) is None
 
 
 def test_a_search_without_advice_stops_each_proof_at_the_bound():

@@ -217,8 +217,7 @@ def law13_input_proof(design: Design, spec: Spec) -> InputProof:
         :func:`~.certificate.actuator.prove_input_bound` of the design's tube; within
         :func:`~.failures.without_advice` (a search asking the verdict only), stopped at
         the first sample where an input's bound passes ``spec.input_bound`` (partial:
-        it meets no bound; a proof that meets it is whole, the per-axis argument's where
-        its bounds keep the bound, else the balls').
+        it meets no bound, and a proof that meets it is the same).
     """
     limits = np.asarray(spec.input_bound or (), dtype=float)
     return prove_input_bound(design.tube, spec, limit=verdict_limit(

@@ -72,7 +72,8 @@ def certified_widths(tube: TubeDesign, samples: TubeSamples) -> np.ndarray:
 
 
 def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = False,
-                      limit: Callable[[np.ndarray], bool] | None = None) -> InputProof:
+                      limit: Callable[[np.ndarray], bool] | None = None,
+                      verdict_per_axis_first: bool = False) -> InputProof:
     """The proved peak of each input of law (13) along ``tube`` for the spec's plants.
 
     Parameters
@@ -97,16 +98,18 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
         peaks are those up to that sample). The check runs whole where no sample breaks
         it, so a proof that meets the caller's bound is whole; where the whole check is
         already kept (:func:`~.sampled.cached_check`), the whole proof from it
-        (:func:`~.sampled.sampled_check_of`'s ``stop_for``). For a plant class whose
-        ``g`` turns while a command is held (``input_gain_turn``: a differential-drive
-        base), the per-axis argument is asked first (the check of ``per_axis_first``,
-        about half the cost of the balls everywhere, its bounds of ``|e|`` no tighter):
-        where it keeps the limit at every sample, its whole proof is returned (peaks at
-        least the balls', within the limit); where it stops, the check with the balls
-        everywhere runs with the same stop. So the verdict is the whole check's, and an
-        accepted base's proof may be the per-axis one; any other proof that meets the
-        caller's bound is the same with or without ``limit``. Ignored with
-        ``[controller] compensate_delay``.
+        (:func:`~.sampled.sampled_check_of`'s ``stop_for``); a proof that meets the
+        caller's bound is the same with or without ``limit``, except as
+        ``verdict_per_axis_first`` says. Ignored with ``[controller] compensate_delay``.
+    verdict_per_axis_first : bool
+        With ``limit`` (and no whole check kept), ask the per-axis argument first (the
+        check of ``per_axis_first``, about half the cost of the balls everywhere, its
+        bounds of ``|e|`` no tighter): where it keeps the limit at every sample, its whole
+        proof is returned (peaks at least the balls', within the limit); where it stops,
+        the check with the balls everywhere runs with the same stop. The verdict is the
+        whole check's either way; the proof of a tube that keeps the limit may be the
+        per-axis one. The variant's proof role chooses it (the differential drive's,
+        where the two proofs measured the same).
 
     Returns
     -------
@@ -119,50 +122,48 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
     SpecError
         More samples than the step budget (as :func:`~stt_codegen.design.samples.sample_tube`).
     """
-    widths: list[np.ndarray] = []           # the certified widths, computed once
+    kept: list[tuple[np.ndarray, np.ndarray]] = []      # (widths, |u| per phi), once
+
+    def widths(samples: TubeSamples) -> tuple[np.ndarray, np.ndarray]:
+        """The certified widths at the samples and law (13)'s ``|u|`` per ``phi(|e|)``."""
+        if not kept:
+            with reference.numpy_math():
+                width = certified_widths(tube, samples)
+            kept.append((width, 4.0 * tube.gain / np.maximum(width, GAMMA_D_MIN)))
+        return kept[0]
+
+    def breaks(per_phi: np.ndarray, abs_e) -> bool:
+        # a shade below the bound input_peak computes from the same numbers (numpy's atanh
+        # may differ by an ulp between one sample and the whole array): a sample breaks the
+        # limit only where the whole proof's bound does
+        return bool(limit(per_phi * phi(np.asarray(abs_e)) * (1.0 - LIMIT_SLACK)))
 
     def stop_for(samples: TubeSamples):
-        widths.append(certified_widths(tube, samples))
-        per_phi = 4.0 * tube.gain / np.maximum(widths[0], GAMMA_D_MIN)   # |u| per phi(|e|)
-
-        def stop(k: int, abs_e: list[float]) -> bool:
-            # a shade below the bound input_peak computes from the same numbers (numpy's
-            # atanh may differ by an ulp between one sample and the whole array): a
-            # sample stops the check only where the whole proof's bound breaks the limit
-            return bool(limit(per_phi[k] * phi(np.asarray(abs_e)) * (1.0 - LIMIT_SLACK)))
-        return stop
+        per_phi = widths(samples)[1]
+        return lambda k, abs_e: breaks(per_phi[k], abs_e)
 
     # the check is computed once per (tube, spec, per_axis_first) in a process:
     # sampled_check_of samples with the oracle's exp/log/tanh as numpy's ufuncs
     result = None
-    if (limit is not None and not per_axis_first and not spec.compensate_delay
-            and spec.assumptions.input_gain_turn is not None
-            and cached_check(tube, spec, False) is None):
-        # a base's verdict: the per-axis argument first (about half the cost); the balls
-        # only tighten its bounds, so where it keeps the limit at every sample the whole
-        # check does too; else the check with the balls, stopped at the limit. Only where
-        # g turns while a command is held (a base's): there the turned bounds of g leave
-        # the balls no tighter than the box on the bases measured, while on a first order
-        # they often are, and the per-axis prefix would be paid twice
+    if (limit is not None and verdict_per_axis_first and not per_axis_first
+            and not spec.compensate_delay and cached_check(tube, spec, False) is None):
+        # the per-axis argument first (about half the cost): the balls only tighten its
+        # bounds, so where it keeps the limit at every sample the whole check does too;
+        # else the check with the balls, stopped at the limit
         samples, quick = sampled_check_of(tube, spec, True, stop_for)
         if quick.passed and "stopped_at" not in quick.data:
-            if not widths:
-                with reference.numpy_math():
-                    widths.append(certified_widths(tube, samples))
-            per_phi = 4.0 * tube.gain / np.maximum(widths[0], GAMMA_D_MIN)
-            bounds = per_phi * phi(sampled_error_bound(quick, samples)) * (1.0 - LIMIT_SLACK)
-            if not any(limit(row) for row in bounds):
+            per_phi = widths(samples)[1]
+            abs_e = sampled_error_bound(quick, samples)
+            if not any(breaks(per_phi[k], abs_e[k]) for k in range(len(abs_e))):
                 result = quick
     if result is None:
         samples, result = sampled_check_of(tube, spec, per_axis_first,
                                            None if limit is None else stop_for)
     horizon = float(samples.t[-1])
-    if not widths:
-        with reference.numpy_math():
-            widths.append(certified_widths(tube, samples))
+    width = widths(samples)[0]
     if "stopped_at" in result.data:
         k = len(result.abs_e)
-        return replace(input_peak(tube.gain, result.abs_e, widths[0][:k], samples.t[:k],
+        return replace(input_peak(tube.gain, result.abs_e, width[:k], samples.t[:k],
                                   horizon),
                        complete=False, reason=f"the bound of the input passes the limit at "
                                               f"t = {result.data['stopped_at']:.4f} s (the "
@@ -172,4 +173,4 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
         n = tube.dimension
         return InputProof(False, (np.inf,) * n, (0.0,) * n, horizon,
                           f"the sampled-data check fails: {result.reason}")
-    return input_peak(tube.gain, abs_e, widths[0], samples.t, horizon)
+    return input_peak(tube.gain, abs_e, width, samples.t, horizon)
