@@ -25,6 +25,7 @@ from stt_codegen.design.search import check_tube
 from stt_codegen.runtime.simulate import run_closed_loop
 from stt_codegen.spec.schema import json_schema
 from stt_codegen.tube import reference
+from stt_codegen.tube.parameters import CRUISE, ReachSegment
 
 ARENA = {"name": "cross", "prescribed_time": 8.0,
          "state_space": {"lower": [0.0, 0.0], "upper": [5.0, 5.0]},
@@ -478,6 +479,36 @@ def test_tasks_and_moving_obstacles_together():
     with pytest.raises(stt.DesignError) as info:
         stt.design_tube(stt.Spec.from_dict(doc))
     assert info.value.kind is FailureKind.MOVING_OBSTACLE
+
+
+def test_with_an_actuator_the_retiming_drives_no_leg_faster_than_waiting_needs():
+    """Five 1 s legs along a lane that a box closes until t = 4 s: without [actuator] the
+    earliest arrival drives the legs after the wait at twice their planned speed; with it,
+    the timing of least speed-up waits and drives every leg at most at its planned speed,
+    and still arrives by t_c."""
+    doc = {**with_obstacles({"lower": [2.7, 1.0], "upper": [3.3, 3.0], "active": [0.0, 4.0]}),
+           "prescribed_time": 10.0,
+           "state_space": {"lower": [0.0, 0.0], "upper": [6.0, 4.0]},
+           "initial": {"lower": [0.1, 1.8], "upper": [0.5, 2.2]},
+           "target": {"lower": [5.5, 1.8], "upper": [5.9, 2.2]}}
+    xs = [0.3, 1.2, 2.1, 3.9, 4.8, 5.7]
+    legs = tuple(ReachSegment(float(k), float(k + 1), (a - 0.2, 1.8), (a + 0.2, 2.2),
+                              (b - 0.2, 1.8), (b + 0.2, 2.2), CRUISE)
+                 for k, (a, b) in enumerate(zip(xs, xs[1:])))
+    free = retime(legs, stt.Spec.from_dict(doc))
+    bounded = retime(legs, stt.Spec.from_dict({**doc, "actuator": {"input_bound": [2, 2]}}))
+
+    def moves(timing):
+        return [s for s in timing if s.lower_from != s.lower_to]
+
+    assert len(moves(free)) == len(moves(bounded)) == len(legs)
+    assert min(s.end - s.start for s in moves(free)) < 0.75      # earliest: faster legs
+    assert all(s.end - s.start >= 1.0 - 1e-9 for s in moves(bounded))
+    # both pass the box after it has gone and arrive by t_c, the bounded one later
+    for timing in (free, bounded):
+        crossing = next(s for s in timing if s.lower_from[0] < 2.7 < s.lower_to[0])
+        assert crossing.end >= 4.0 and timing[-1].end <= 10.0
+    assert bounded[-1].end > free[-1].end
 
 
 @pytest.mark.slow

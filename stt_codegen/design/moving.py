@@ -10,11 +10,12 @@ space-time disjointness from every moving obstacle, :mod:`.certificate.motion`) 
 2. **re-timed via plan** (``"timed via"``): the via boxes of the static via-point design
    (first for the static obstacles alone, then going around the swept regions of one, two,
    ... of the moving obstacles, :func:`routes`), re-timed against the others on a grid
-   of :data:`TIME_STEPS` steps over ``[0, t_c]``: a breadth-first search over (via box,
+   of :data:`TIME_STEPS` steps over ``[0, t_c]``: a search over (via box,
    time step) that may wait at a via box or take a segment at one of
    :data:`DURATION_FACTORS` times its planned duration, each move kept clear (by
    :data:`~.via.VIA_MARGIN`) of the hull of every moving obstacle over the move's time,
-   earliest arrival first (deterministic: fixed orders, no randomness); with ``[[tasks]]``
+   earliest arrival first (with ``[actuator]``: the least speed-up first, then the
+   earliest arrival; deterministic: fixed orders, no randomness); with ``[[tasks]]``
    each task's hold segment (:func:`task_holds`) may instead start at any step and last
    any number of steps that keep it in its task's window (:data:`TASK_HOLD_SHARE`), with
    free waits before and after it;
@@ -30,13 +31,14 @@ With ``[actuator]`` the re-timed tubes of steps 2 and 4 (whose legs are faster o
 than the static design's, with waits between them) are accepted only when the variant's
 input proof (role ``input_proof``: law (13)'s, the cascade's, the base's) keeps the bound
 along them, and carry that proof; the re-timing then drives a smooth-step plan's legs as
-``"cruise"`` segments and leaves out the fast durations until the proof holds
-(:func:`speed_limits`). Specs with ``tube.method = "paper"`` skip steps 2 and 4
+``"cruise"`` segments, tries the timings that drive no leg faster than planned first and
+leaves out the fast durations until the proof holds (:func:`speed_limits`). Specs with ``tube.method = "paper"`` skip steps 2 and 4
 (their tubes are via-point tubes). The argument and the limits: docs/moving-obstacles.md.
 """
 
 from __future__ import annotations
 
+import heapq
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -291,6 +293,13 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
            factors: Sequence[float] = DURATION_FACTORS) -> tuple[ReachSegment, ...] | None:
     """The via boxes of ``segments`` re-timed to miss the moving obstacles (module notes).
 
+    The search settles (via box, step) states by their speed-up, then their step: without
+    ``[actuator]`` every speed-up is 0 and the timing is the earliest arrival. With it, a
+    segment driven in ``d`` steps of ``tau`` costs ``max(0, planned / (d tau) - 1)`` (how
+    much faster than planned) and the timing is the one of least summed speed-up, then the
+    earliest arrival among those: a leg is driven faster only where waiting needs it, as
+    the input proof asks least of slow legs.
+
     With ``spec.tasks``, each task's hold segment (:func:`task_holds`) is not re-timed by
     :data:`DURATION_FACTORS`: it may start at any step and last any number of steps such
     that the held interval serves its task (:func:`_hold_ok`) and the box keeps clear over
@@ -328,46 +337,54 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
     # waits: box k over [i tau, (i + 1) tau], for every i at once
     waits = [_clear(np.tile(lo, (TIME_STEPS + 1, 1)), np.tile(hi, (TIME_STEPS + 1, 1)), spec,
                     steps * tau, (steps + 1) * tau) for lo, hi in boxes]
-    # parent[(k, i)] = (previous state, segment taken or None for a wait)
+    # parent[(k, i)] = (previous state, segment taken or None for a wait); states are
+    # settled by (summed speed-up, step, box): without [actuator] every speed-up is 0 and
+    # the first parent found is kept, a breadth-first search in time (earliest arrival)
+    speed_up = spec.input_bound is not None
     parent: dict[tuple[int, int], tuple[tuple[int, int] | None, ReachSegment | None]] = {
         (0, 0): (None, None)}
-    frontier = [(0, 0)]
+    cost = {(0, 0): 0.0}
+    heap = [(0.0, 0, 0)]
+    settled: set[tuple[int, int]] = set()
     goal = None
-    for i in range(TIME_STEPS + 1):
-        at_i = sorted(s for s in frontier if s[1] == i)
-        for k, _ in at_i:
-            if k == m:
-                goal = (k, i)
-                break
-            nxt = (k, i + 1)
-            if i < TIME_STEPS and nxt not in parent and waits[k][i]:
-                parent[nxt] = ((k, i), None)
-                frontier.append(nxt)
-            if k in holds:
-                # hold the waypoint box from step i to step j (clear: the waits' boxes)
-                for j in range(i + 1, TIME_STEPS + 1):
-                    if not waits[k][j - 1]:
-                        break
-                    to = (k + 1, j)
-                    if to not in parent and _hold_ok(holds[k], i * tau, j * tau):
-                        parent[to] = ((k, i), replace(segments[k], start=i * tau,
-                                                      end=j * tau))
-                        frontier.append(to)
-                continue
-            planned = segments[k].end - segments[k].start
-            for f in factors:
-                d = max(1, int(math.ceil(f * planned / tau - 1e-9)))
-                to = (k + 1, i + d)
-                if to[1] > TIME_STEPS or to in parent:
-                    continue
-                seg = replace(segments[k], start=i * tau, end=(i + d) * tau)
-                if to[0] == m:
-                    seg = replace(seg, end=min(seg.end, t_c))
-                if _move_clear(seg, spec):
-                    parent[to] = ((k, i), seg)
-                    frontier.append(to)
-        if goal is not None:
+
+    def reach(to: tuple[int, int], came: tuple[int, int], seg: ReachSegment | None,
+              extra: float = 0.0) -> None:
+        c = cost[came] + extra
+        if to in cost and cost[to] <= c:
+            return
+        cost[to], parent[to] = c, (came, seg)
+        heapq.heappush(heap, (c, to[1], to[0]))
+
+    while heap:
+        c, i, k = heapq.heappop(heap)
+        if (k, i) in settled or c > cost[(k, i)]:
+            continue
+        settled.add((k, i))
+        if k == m:
+            goal = (k, i)
             break
+        if i < TIME_STEPS and waits[k][i]:
+            reach((k, i + 1), (k, i), None)
+        if k in holds:
+            # hold the waypoint box from step i to step j (clear: the waits' boxes)
+            for j in range(i + 1, TIME_STEPS + 1):
+                if not waits[k][j - 1]:
+                    break
+                if _hold_ok(holds[k], i * tau, j * tau):
+                    reach((k + 1, j), (k, i), replace(segments[k], start=i * tau, end=j * tau))
+            continue
+        planned = segments[k].end - segments[k].start
+        for f in factors:
+            d = max(1, int(math.ceil(f * planned / tau - 1e-9)))
+            to = (k + 1, i + d)
+            if to[1] > TIME_STEPS or (to in cost and cost[to] <= c):
+                continue
+            seg = replace(segments[k], start=i * tau, end=(i + d) * tau)
+            if to[0] == m:
+                seg = replace(seg, end=min(seg.end, t_c))
+            if _move_clear(seg, spec):
+                reach(to, (k, i), seg, max(0.0, planned / (d * tau) - 1.0) if speed_up else 0.0)
     if goal is None:
         return None
     # the tube waits in the target box from the arrival to t_c: that wait must be clear too
@@ -537,9 +554,14 @@ def retimed_design(via: Design | None, timing: Spec, spec: Spec,
         planned = tuple(replace(seg, profile=CRUISE) if seg.profile == SMOOTHSTEP else seg
                         for seg in planned)
     tried: set[tuple[ReachSegment, ...]] = set()
+    none: list[set[float]] = []       # factor sets with no timing: none in a subset either
     for factors in speed_limits(spec):
+        if any(set(factors) <= fewer for fewer in none):
+            continue
         segments = retime(planned, timing,
                           via.task_plan.order if via.task_plan is not None else None, factors)
+        if segments is None:
+            none.append(set(factors))
         if segments is None or segments in tried:     # the same timing: the same verdict
             continue
         tried.add(segments)
@@ -570,9 +592,12 @@ def speed_limits(spec: Spec) -> list[tuple[float, ...]]:
 
     Without ``[actuator]`` all of them at once. With it, a faster segment asks more of the
     actuators, so the re-timing is tried with the factors at least each of
-    :data:`DURATION_FACTORS` in increasing order (all, then without the fastest, ...):
-    the earliest arrival of each set, and the first whose input proof keeps the bound
-    wins (a plan that waits, then drives its legs no faster than the base can). With
+    :data:`DURATION_FACTORS`: first those at least 1 in increasing order (no leg faster
+    than planned; then slower), then those below 1 in decreasing order (at least 0.75,
+    then all): the timing of least speed-up of each set (:func:`retime`), and the first
+    whose input proof keeps the bound wins (a plan that waits, then drives its legs no
+    faster than the base can). A set within one that has no timing is skipped (it has
+    none either). With
     ``[actuator]`` the re-timed segments of a smooth-step plan are ``"cruise"`` segments
     (the same boxes and durations, a peak rate 1.25 times the mean instead of 1.875).
 
@@ -593,8 +618,10 @@ def speed_limits(spec: Spec) -> list[tuple[float, ...]]:
     """
     if spec.input_bound is None:
         return [DURATION_FACTORS]
+    no_faster = sorted(f for f in set(DURATION_FACTORS) if f >= 1.0)
+    faster = sorted((f for f in set(DURATION_FACTORS) if f < 1.0), reverse=True)
     return [tuple(f for f in DURATION_FACTORS if f >= slowest)
-            for slowest in sorted(set(DURATION_FACTORS))]
+            for slowest in no_faster + faster]
 
 
 def _meetings(found: TubeCheck, spec: Spec) -> list[tuple[int, float]]:
