@@ -274,6 +274,30 @@ def test_a_space_time_path_over_the_input_bound_is_planned_again_at_a_lower_spee
         refused.value)
 
 
+def test_a_way_over_the_input_bound_gives_way_to_the_design_at_the_actuators_speed(
+        monkeypatch):
+    """A robot whose way (planned without ``[actuator]``) is not proved within the bound
+    is placed with its design with ``[actuator]`` (the bound's procedure), which carries a
+    proof within the bound; without that design it is refused with none placed."""
+    from stt_codegen.design import fleet as fleet_design
+    doc = copy.deepcopy(TWO)
+    doc["robots"] = doc["robots"][:1]
+    doc["robots"][0]["actuator"] = {"input_bound": [5.0, 5.0]}
+    fleet = stt.FleetSpec.from_dict(doc)
+    monkeypatch.setattr(fleet_design, "_proved", lambda design, spec: None)
+    designed = stt.design_fleet(fleet)
+    design = designed.designs["a"]
+    assert designed.certified and design.certificate.passed
+    assert design.input_proof.meets((5.0, 5.0))
+    assert design.spec == fleet.robots[0].spec            # not the spec it was planned on
+    monkeypatch.setattr(fleet_design, "_alone", lambda robot, placing: None)
+    with pytest.raises(stt.DesignError) as refused:
+        stt.design_fleet(fleet)
+    assert "placed before it (none)" in str(refused.value)
+    assert "its way: its input is not proved within actuator.input_bound" in str(
+        refused.value)
+
+
 @pytest.mark.slow
 def test_a_re_ordering_keeps_the_placements_that_still_hold(monkeypatch):
     # warehouse-fleet moves two robots to the front; the robots placed before them keep
