@@ -290,12 +290,41 @@ def test_a_way_over_the_input_bound_gives_way_to_the_design_at_the_actuators_spe
     assert designed.certified and design.certificate.passed
     assert design.input_proof.meets((5.0, 5.0))
     assert design.spec == fleet.robots[0].spec            # not the spec it was planned on
-    monkeypatch.setattr(fleet_design, "_alone", lambda robot, placing: None)
+    monkeypatch.setattr(fleet_design, "_alone", lambda robot, placing: ())
     with pytest.raises(stt.DesignError) as refused:
         stt.design_fleet(fleet)
     assert "placed before it (none)" in str(refused.value)
     assert "its way: its input is not proved within actuator.input_bound" in str(
         refused.value)
+
+
+def test_the_designs_at_the_actuators_speed_first_keep_clear_of_the_docks_crossed_alone():
+    """Robot b parks in the upper aisle, where robot a's design alone passes: a's first
+    design with [actuator] keeps clear of b's target box (grown by both reaches), its
+    second is its design alone, which crosses it; b's design alone crosses no dock and is
+    its only one. Each is proved within the bound."""
+    from stt_codegen.design import fleet as fleet_design
+    doc = copy.deepcopy(TWO)
+    doc["robots"][1]["target"] = {"lower": [5.6, 6.6], "upper": [6.4, 7.4]}
+    for entry in doc["robots"]:
+        entry["actuator"] = {"input_bound": [5.0, 5.0]}
+    fleet = stt.FleetSpec.from_dict(doc)
+    placing = fleet_design._Placing(fleet, {})
+    a, b = fleet.robots
+
+    def crossed(robot, design):
+        way = fleet_design.chunks(fleet_design.enclosed(design), robot.dims, 1.0)
+        return [fleet_design._crosses(way, np.array(d.lower), np.array(d.upper))
+                for d in fleet_design._docks(robot, fleet)]
+
+    first, alone = fleet_design._alone(a, placing)
+    assert crossed(a, first) == [False, False] and crossed(a, alone) == [False, True]
+    assert alone.spec == a.spec and len(first.spec.obstacles) == len(a.spec.obstacles) + 1
+    (only,) = fleet_design._alone(b, placing)
+    assert not any(crossed(b, only))
+    for design in (first, alone, only):
+        assert design.certificate.passed and design.input_proof.meets((5.0, 5.0))
+    assert fleet_design._alone(a, placing)[0] is first                  # computed once
 
 
 @pytest.mark.slow

@@ -8,7 +8,7 @@ after it, then the robots whose proofs cost most, then the longer trips). A robo
 tube designed alone when the pair certificate (:func:`~.certificate.fleet.pair_margin`)
 proves it apart from every placed tube that a space-time index (:mod:`.fleet_index`) finds
 near it (with ``[actuator]``, where that tube's input is not proved within the bound, its
-design with the bound instead, :func:`_alone`); else its via boxes are re-timed (:func:`~.moving.retimed_design`: waits at its start
+designs with the bound instead, :func:`_alone`); else its via boxes are re-timed (:func:`~.moving.retimed_design`: waits at its start
 box, which is its start delay, or at a via box) against the placed tubes near its way, as
 moving boxes over at most :data:`CHUNK_SECONDS` each, first through its own via boxes, then
 through via boxes planned clear of the other robots' docks; each re-timed tube is accepted
@@ -372,13 +372,13 @@ def certify_fleet(fleet: FleetSpec, designs: Mapping[str, Design],
 @dataclass
 class _Placing:
     """What the placement of one order keeps: each robot's way (its planned design, by
-    name, computed once), each robot's design alone with ``[actuator]`` (by name, computed
-    once when first asked, ``None`` when there is none: :func:`_alone`), the robots placed
+    name, computed once), each robot's designs with ``[actuator]`` (by name, computed
+    once when first asked: :func:`_alone`), the robots placed
     so far (design and enclosed tube, by name) and their index."""
 
     fleet: FleetSpec
     ways: dict[str, tuple[Design, RobotTube]]
-    alone: dict[str, Design | None] = field(default_factory=dict)
+    alone: dict[str, tuple[Design, ...]] = field(default_factory=dict)
     placed: dict[str, tuple[FleetRobot, Design, RobotTube]] = field(default_factory=dict)
     index: TubeIndex = field(default_factory=lambda: TubeIndex(INDEX_CELL))
     grids: dict[str, SpaceTimeGrid] = field(default_factory=dict)
@@ -515,25 +515,37 @@ def _own_via(robot: FleetRobot) -> Design | None:
         return None
 
 
-def _alone(robot: FleetRobot, placing: _Placing) -> Design | None:
-    """``robot``'s design with its ``[actuator]`` (:func:`~.search.design_tube`: the bound's
-    procedure slows the tube until its input proof keeps it): its via design clear of the
-    other robots' docks as its way is planned (:func:`plan_way`), else its design alone;
-    computed once per fleet design, ``None`` when there is neither. A design of a spec
-    with more obstacles than ``robot.spec`` (the docks), not yet one of ``robot.spec``."""
+def _alone(robot: FleetRobot, placing: _Placing) -> tuple[Design, ...]:
+    """``robot``'s designs with its ``[actuator]`` (:func:`~.search.design_tube`: the bound's
+    procedure slows the tube until its input proof keeps it), computed once per fleet
+    design: where its design alone crosses other robots' docks (:func:`_docks`), first its
+    design with those docks as obstacles (when there is one), then its design alone; none
+    when it has no design alone. The first is a design of a spec with more obstacles than
+    ``robot.spec``, not yet one of ``robot.spec``."""
     if robot.name not in placing.alone:
         spec = robot.spec
-        docked = replace(spec, obstacles=spec.obstacles + _docks(robot, placing.fleet),
-                         tube=replace(spec.tube, method=METHOD_VIA,
-                                      via_profile=_profile(robot)))
-        placing.alone[robot.name] = None
-        for planning in (docked, spec):
+        designs: list[Design] = []
+        with without_advice():                  # a refusal's advice is not read here
             try:
-                with without_advice():          # a refusal's advice is not read here
-                    placing.alone[robot.name] = design_tube(planning)
-                break
+                alone = design_tube(spec)
             except DesignError:
-                continue
+                alone = None
+            if alone is not None:
+                way = chunks(enclosed(alone), robot.dims, INDEX_SECONDS)
+                first = len(spec.unsafe_sets)
+                crossed = tuple(replace(dock, source=first + k) for k, dock in enumerate(
+                    d for d in _docks(robot, placing.fleet)
+                    if _crosses(way, np.array(d.lower), np.array(d.upper))))
+                if crossed:
+                    try:
+                        designs.append(design_tube(replace(
+                            spec, obstacles=spec.obstacles + crossed,
+                            tube=replace(spec.tube, method=METHOD_VIA,
+                                         via_profile=_profile(robot)))))
+                    except DesignError:
+                        pass
+                designs.append(alone)
+        placing.alone[robot.name] = tuple(designs)
     return placing.alone[robot.name]
 
 
@@ -689,8 +701,7 @@ def _fit(robot: FleetRobot, placing: _Placing) -> tuple[Design, RobotTube] | str
         if design is not None:
             return kept(design)
         reasons.append("its way: its input is not proved within actuator.input_bound")
-        alone = _alone(robot, placing)
-        if alone is not None:
+        for alone in _alone(robot, placing):
             found = check(alone.tube, _free(spec))
             if found.passed:
                 return kept(replace(alone, spec=spec, check=found))
@@ -860,7 +871,7 @@ def design_fleet(fleet: FleetSpec | str | os.PathLike,
     order = (priority_order(fleet) if planner == PLANNER_SPACE_TIME else
              priority_order(fleet, {name: tube for name, (_, tube) in ways.items()}))
     moved: list[str] = []
-    alone: dict[str, Design | None] = {}
+    alone: dict[str, tuple[Design, ...]] = {}
     tried = {tuple(r.name for r in order)}
     placing = None
     while True:
