@@ -481,20 +481,25 @@ def test_tasks_and_moving_obstacles_together():
     assert info.value.kind is FailureKind.MOVING_OBSTACLE
 
 
+def _lane(*obstacles: dict) -> tuple[dict, tuple[ReachSegment, ...]]:
+    """A 6 m x 4 m floor in 10 s, and five 1 s legs along its middle from the start box to
+    the target box (0.4 m boxes)."""
+    doc = {**with_obstacles(*obstacles), "prescribed_time": 10.0,
+           "state_space": {"lower": [0.0, 0.0], "upper": [6.0, 4.0]},
+           "initial": {"lower": [0.1, 1.8], "upper": [0.5, 2.2]},
+           "target": {"lower": [5.5, 1.8], "upper": [5.9, 2.2]}}
+    xs = [0.3, 1.2, 2.1, 3.9, 4.8, 5.7]
+    return doc, tuple(ReachSegment(float(k), float(k + 1), (a - 0.2, 1.8), (a + 0.2, 2.2),
+                                   (b - 0.2, 1.8), (b + 0.2, 2.2), CRUISE)
+                      for k, (a, b) in enumerate(zip(xs, xs[1:])))
+
+
 def test_with_an_actuator_the_retiming_drives_no_leg_faster_than_waiting_needs():
     """Five 1 s legs along a lane that a box closes until t = 4 s: without [actuator] the
     earliest arrival drives the legs after the wait at twice their planned speed; with it,
     the timing of least speed-up waits and drives every leg at most at its planned speed,
     and still arrives by t_c."""
-    doc = {**with_obstacles({"lower": [2.7, 1.0], "upper": [3.3, 3.0], "active": [0.0, 4.0]}),
-           "prescribed_time": 10.0,
-           "state_space": {"lower": [0.0, 0.0], "upper": [6.0, 4.0]},
-           "initial": {"lower": [0.1, 1.8], "upper": [0.5, 2.2]},
-           "target": {"lower": [5.5, 1.8], "upper": [5.9, 2.2]}}
-    xs = [0.3, 1.2, 2.1, 3.9, 4.8, 5.7]
-    legs = tuple(ReachSegment(float(k), float(k + 1), (a - 0.2, 1.8), (a + 0.2, 2.2),
-                              (b - 0.2, 1.8), (b + 0.2, 2.2), CRUISE)
-                 for k, (a, b) in enumerate(zip(xs, xs[1:])))
+    doc, legs = _lane({"lower": [2.7, 1.0], "upper": [3.3, 3.0], "active": [0.0, 4.0]})
     free = retime(legs, stt.Spec.from_dict(doc))
     bounded = retime(legs, stt.Spec.from_dict({**doc, "actuator": {"input_bound": [2, 2]}}))
 
@@ -509,6 +514,16 @@ def test_with_an_actuator_the_retiming_drives_no_leg_faster_than_waiting_needs()
         crossing = next(s for s in timing if s.lower_from[0] < 2.7 < s.lower_to[0])
         assert crossing.end >= 4.0 and timing[-1].end <= 10.0
     assert bounded[-1].end > free[-1].end
+
+
+def test_the_retiming_arrives_later_where_the_target_is_taken_after_the_earliest_arrival():
+    """A box stands on the target from 6 s to 8 s: the earliest arrival (before 6 s) would
+    wait there while it stands, so the timing arrives after it has gone (the search kept
+    no timing at all when its earliest arrival's wait was not clear)."""
+    doc, legs = _lane({"lower": [5.2, 1.4], "upper": [6.0, 2.6], "active": [6.0, 8.0]})
+    assert retime(legs, stt.Spec.from_dict(_lane()[0]))[-1].end < 6.0    # no box
+    timed = retime(legs, stt.Spec.from_dict(doc))
+    assert timed is not None and 8.0 <= timed[-1].end <= 10.0
 
 
 @pytest.mark.slow

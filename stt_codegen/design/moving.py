@@ -298,7 +298,8 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
     segment driven in ``d`` steps of ``tau`` costs ``max(0, planned / (d tau) - 1)`` (how
     much faster than planned) and the timing is the one of least summed speed-up, then the
     earliest arrival among those: a leg is driven faster only where waiting needs it, as
-    the input proof asks least of slow legs.
+    the input proof asks least of slow legs. An arrival in the target box counts only where
+    the box stays clear from it until ``t_c`` (the tube waits there).
 
     With ``spec.tasks``, each task's hold segment (:func:`task_holds`) is not re-timed by
     :data:`DURATION_FACTORS`: it may start at any step and last any number of steps such
@@ -337,6 +338,11 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
     # waits: box k over [i tau, (i + 1) tau], for every i at once
     waits = [_clear(np.tile(lo, (TIME_STEPS + 1, 1)), np.tile(hi, (TIME_STEPS + 1, 1)), spec,
                     steps * tau, (steps + 1) * tau) for lo, hi in boxes]
+    # the tube waits in the target box from its arrival to t_c: an arrival at step i is a
+    # goal only where that wait is clear
+    lo, hi = boxes[m]
+    parked = _clear(np.tile(lo, (TIME_STEPS + 1, 1)), np.tile(hi, (TIME_STEPS + 1, 1)), spec,
+                    steps * tau, np.full(TIME_STEPS + 1, t_c))
     # parent[(k, i)] = (previous state, segment taken or None for a wait); states are
     # settled by (summed speed-up, step, box): without [actuator] every speed-up is 0 and
     # the first parent found is kept, a breadth-first search in time (earliest arrival)
@@ -362,8 +368,10 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
             continue
         settled.add((k, i))
         if k == m:
-            goal = (k, i)
-            break
+            if parked[i]:
+                goal = (k, i)
+                break
+            continue
         if i < TIME_STEPS and waits[k][i]:
             reach((k, i + 1), (k, i), None)
         if k in holds:
@@ -386,10 +394,6 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
             if _move_clear(seg, spec):
                 reach(to, (k, i), seg, max(0.0, planned / (d * tau) - 1.0) if speed_up else 0.0)
     if goal is None:
-        return None
-    # the tube waits in the target box from the arrival to t_c: that wait must be clear too
-    lo, hi = boxes[m]
-    if not _clear(lo[None, :], hi[None, :], spec, np.array([goal[1] * tau]), np.array([t_c]))[0]:
         return None
     out = []
     state: tuple[int, int] | None = goal
