@@ -8,8 +8,9 @@ after it, then the robots whose proofs cost most, then the longer trips). A robo
 tube designed alone when the pair certificate (:func:`~.certificate.fleet.pair_margin`)
 proves it apart from every placed tube that a space-time index (:mod:`.fleet_index`) finds
 near it (with ``[actuator]``, where that tube's input is not proved within the bound, its
-designs with the bound instead, :func:`_alone`); else its via boxes are re-timed (:func:`~.moving.retimed_design`: waits at its start
-box, which is its start delay, or at a via box) against the placed tubes near its way, as
+designs with the bound instead, :func:`_alone`); else its via boxes are re-timed
+(:func:`~.moving.retimed_design`: waits at its start box, which is its start delay, or at a
+via box) against the placed tubes near its way, as
 moving boxes over at most :data:`CHUNK_SECONDS` each, first through its own via boxes, then
 through via boxes planned clear of the other robots' docks; each re-timed tube is accepted
 only when its own check, its input proof and the pair certificate against every placed tube

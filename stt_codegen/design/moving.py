@@ -10,8 +10,8 @@ space-time disjointness from every moving obstacle, :mod:`.certificate.motion`) 
 2. **re-timed via plan** (``"timed via"``): the via boxes of the static via-point design
    (first for the static obstacles alone, then going around the swept regions of one, two,
    ... of the moving obstacles, :func:`routes`), re-timed against the others on a grid
-   of :data:`TIME_STEPS` steps over ``[0, t_c]``: a search over (via box,
-   time step) that may wait at a via box or take a segment at one of
+   of :data:`TIME_STEPS` steps over ``[0, t_c]``: a search over (via box, time step)
+   that may wait at a via box or take a segment at one of
    :data:`DURATION_FACTORS` times its planned duration, each move kept clear (by
    :data:`~.via.VIA_MARGIN`) of the hull of every moving obstacle over the move's time,
    earliest arrival first (with ``[actuator]``: the least speed-up first, then the
@@ -32,8 +32,8 @@ than the static design's, with waits between them) are accepted only when the va
 input proof (role ``input_proof``: law (13)'s, the cascade's, the base's) keeps the bound
 along them, and carry that proof; the re-timing then drives a smooth-step plan's legs as
 ``"cruise"`` segments, tries the timings that drive no leg faster than planned first and
-leaves out the fast durations until the proof holds (:func:`speed_limits`). Specs with ``tube.method = "paper"`` skip steps 2 and 4
-(their tubes are via-point tubes). The argument and the limits: docs/moving-obstacles.md.
+leaves out the fast durations until the proof holds (:func:`speed_limits`). Specs with
+``tube.method = "paper"`` skip steps 2 and 4 (their tubes are via-point tubes). The argument and the limits: docs/moving-obstacles.md.
 """
 
 from __future__ import annotations
