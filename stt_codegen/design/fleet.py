@@ -441,11 +441,8 @@ def plan_way(robot: FleetRobot, fleet: FleetSpec) -> Design:
         The robot has no tube even alone (without ``[actuator]``).
     """
     spec = _free(robot.spec)
-    planning = replace(spec, obstacles=spec.obstacles + _docks(robot, fleet),
-                       tube=replace(spec.tube, method=METHOD_VIA,
-                                    via_profile=_profile(robot)))
     try:
-        return design_tube(planning)
+        return design_tube(_via_planning(robot, spec, _docks(robot, fleet)))
     except DesignError:
         pass
     try:
@@ -505,13 +502,20 @@ def _profile(robot: FleetRobot) -> str:
             else spec.tube.via_profile)
 
 
+def _via_planning(robot: FleetRobot, spec: Spec,
+                  obstacles: tuple[Obstacle, ...] = ()) -> Spec:
+    """``spec`` planned as a via design with ``robot``'s legs (:func:`_profile`), with
+    ``obstacles`` added (numbered after the spec's)."""
+    return replace(spec, obstacles=spec.obstacles + obstacles,
+                   tube=replace(spec.tube, method=METHOD_VIA, via_profile=_profile(robot)))
+
+
 def _own_via(robot: FleetRobot) -> Design | None:
     """``robot``'s via design on its own spec (no ``[actuator]``), ``None`` when there is
     none."""
     spec = _free(robot.spec)
     try:
-        return design_tube(replace(spec, tube=replace(spec.tube, method=METHOD_VIA,
-                                                      via_profile=_profile(robot))))
+        return design_tube(_via_planning(robot, spec))
     except DesignError:
         return None
 
@@ -539,10 +543,7 @@ def _alone(robot: FleetRobot, placing: _Placing) -> tuple[Design, ...]:
                     if _crosses(way, np.array(d.lower), np.array(d.upper))))
                 if crossed:
                     try:
-                        designs.append(design_tube(replace(
-                            spec, obstacles=spec.obstacles + crossed,
-                            tube=replace(spec.tube, method=METHOD_VIA,
-                                         via_profile=_profile(robot)))))
+                        designs.append(design_tube(_via_planning(robot, spec, crossed)))
                     except DesignError:
                         pass
                 designs.append(alone)
@@ -731,8 +732,7 @@ def _fit(robot: FleetRobot, placing: _Placing) -> tuple[Design, RobotTube] | str
         design, why = _space_time(robot, way, placing, check)
         if design is None:
             reasons.append(why)
-    planning = replace(way.spec, tube=replace(way.spec.tube, method=METHOD_VIA,
-                                              via_profile=_profile(robot)))
+    planning = _via_planning(robot, way.spec)
     avoided: set[tuple[str, float]] = set()
     for _ in range(DETOURS if design is None else 0):
         clash = clashes[-1] if clashes else None

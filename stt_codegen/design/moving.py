@@ -351,7 +351,6 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
         (0, 0): (None, None)}
     cost = {(0, 0): 0.0}
     heap = [(0.0, 0, 0)]
-    settled: set[tuple[int, int]] = set()
     goal = None
 
     def reach(to: tuple[int, int], came: tuple[int, int], seg: ReachSegment | None,
@@ -364,9 +363,8 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
 
     while heap:
         c, i, k = heapq.heappop(heap)
-        if (k, i) in settled or c > cost[(k, i)]:
+        if c > cost[(k, i)]:           # a stale entry: the state was reached cheaper since
             continue
-        settled.add((k, i))
         if k == m:
             if parked[i]:
                 goal = (k, i)
