@@ -127,7 +127,7 @@ def test_the_drone_at_200_hz_names_a_prescribed_time_that_is_then_certified() ->
     with pytest.raises(stt.DesignError) as info:
         stt.design_tube(spec)
     named = info.value.advice["prescribed_time"]
-    assert spec.prescribed_time < named <= 20.0      # 16 s: a via tube with cruise segments
+    assert spec.prescribed_time < named <= 20.0      # 12 s: via points timed for the force
     design = stt.design_tube(dataclasses.replace(spec, prescribed_time=named))
     assert design.input_proof is not None
     assert np.all(np.asarray(design.input_proof.peak) <= np.asarray(spec.input_bound))

@@ -333,3 +333,54 @@ def test_a_bound_a_task_spec_cannot_keep_names_its_windows_not_a_later_deadline(
     assert ("a longer prescribed_time does not slow the legs: their times are the "
             "[[tasks]] windows") in str(info.value)
     assert "prescribed_time" not in info.value.advice
+
+
+def test_a_cascade_tries_via_points_timed_for_the_force_and_a_first_order_spec_does_not():
+    """The cascade's input is a force: the design within [actuator] also tries via points
+    whose moves are timed for the acceleration (docs/second-order.md, "Force limits"); law
+    (13)'s input is a velocity, so a first-order spec does not."""
+    from types import SimpleNamespace
+
+    from stt_codegen.design.actuator import slower_variants
+    default = SimpleNamespace(method="via", tube=SimpleNamespace(circumvents=()))
+    cascade = dict(slower_variants(stt.load_spec(UMAZE), default))
+    assert cascade["via points timed for the force"].tube.via_timing == "acceleration"
+    assert cascade["via points timed for the force"].tube.method == "via"
+    first = dict(slower_variants(stt.load_spec("omnirobot-s1"), default))
+    assert "via points timed for the force" not in first
+    assert all(v.tube.via_timing == "length" for v in first.values())
+
+
+def _stay_then_target(prescribed_time: float) -> dict:
+    """stlpy's EitherOr as a double integrator with its bounds (|u| <= 0.5 N, |v| <= 1 m/s):
+    stay 5 s in either box within the run, then the target, around one obstacle."""
+    return {"name": "either-or-force", "prescribed_time": prescribed_time,
+            "state_space": {"lower": [0.0, 0.0], "upper": [10.0, 10.0],
+                            "velocity_bound": [1.0, 1.0]},
+            "initial": {"lower": [1.9, 1.9], "upper": [2.1, 2.1], "state": [2.0, 2.0]},
+            "target": {"lower": [7.0, 8.0], "upper": [8.0, 9.0]},
+            "obstacles": [{"lower": [3.0, 4.0], "upper": [5.0, 6.0]}],
+            "tasks": [{"kind": "stay", "window": [0.0, prescribed_time], "duration": 5.0,
+                       "any_of": [{"lower": [1.0, 6.0], "upper": [2.0, 7.0]},
+                                  {"lower": [7.0, 4.5], "upper": [8.0, 5.5]}]}],
+            "plant": {"model": "double-integrator", "parameters": [1.0]},
+            "actuator": {"input_bound": [0.5, 0.5]}}
+
+
+@pytest.mark.slow
+def test_task_legs_timed_for_the_force_keep_a_bound_the_cruise_legs_exceed(monkeypatch):
+    """At 40 s the cruise legs (timed by length) are proved to ask more than 0.5 N; the legs
+    timed for the acceleration (smooth steps, each move's time by the square root of its
+    length) are certified within it."""
+    import stt_codegen.design.actuator as actuator
+    spec = stt.Spec.from_dict(_stay_then_target(40.0))
+    design = stt.design_tube(spec)
+    assert design.certificate.passed and design.input_proof.meets(spec.input_bound)
+    moving = {s.profile for s in design.tube.segments if s.lower_from != s.lower_to}
+    assert moving == {"smoothstep"}
+    real = actuator.variant_of
+    monkeypatch.setattr(actuator, "variant_of",
+                        lambda owner: dataclasses.replace(real(owner), via_timing="length"))
+    with pytest.raises(DesignError) as info:
+        stt.design_tube(spec)
+    assert info.value.kind is FailureKind.INPUT_BOUND

@@ -5,6 +5,8 @@ duration, is rejected) and judged as stated on a run."""
 
 from __future__ import annotations
 
+import dataclasses
+import math
 import tomllib
 from itertools import permutations
 from pathlib import Path
@@ -22,7 +24,8 @@ from stt_codegen.runtime.simulate import simulate
 from stt_codegen.runtime.tasks import judge_task, until_met
 from stt_codegen.spec.loader import Spec, load_spec
 from stt_codegen.tube import reference
-from stt_codegen.tube.parameters import CRUISE
+from stt_codegen.design.via import ACCELERATION_TIMING
+from stt_codegen.tube.parameters import CRUISE, SMOOTHSTEP
 
 A = {"lower": [3.4, 0.6], "upper": [4.0, 1.2]}       # bottom right
 B = {"lower": [0.6, 3.4], "upper": [1.2, 4.0]}       # top left
@@ -123,6 +126,28 @@ def test_free_timing_gives_each_leg_time_in_proportion_to_its_via_path():
     speeds = _leg_speeds(design)
     assert len(speeds) == 3 and max(speeds) - min(speeds) <= 1e-9 * max(speeds), speeds
     assert {s.profile for s in design.tube.segments} == {CRUISE}
+
+
+def test_timed_for_the_acceleration_every_move_takes_time_by_its_square_root():
+    """The same spec timed for a force input (``via_timing = "acceleration"``): every move
+    (in every leg) lasts in proportion to the square root of its length, so each asks the
+    same peak acceleration of a smooth step; the legs are smooth steps, not cruises."""
+    spec = spec_of(arena(2, [reach(C, [1.0, 13.0]), reach(B, [1.0, 13.0])], t_c=15.0))
+    spec = dataclasses.replace(spec, tube=dataclasses.replace(
+        spec.tube, method="via", via_timing=ACCELERATION_TIMING))
+    design = design_tube(spec)
+    assert design.certificate.passed and design.task_plan.order == (0, 1)
+    moves = [(s.end - s.start, max(abs(0.5 * (b + d) - 0.5 * (a + c)) for a, c, b, d in
+                                   zip(s.lower_from, s.upper_from, s.lower_to, s.upper_to)))
+             for s in design.tube.segments]
+    moves = [(duration, length) for duration, length in moves if length > 0.0]
+    assert len(moves) >= 4                       # two legs' moves around the obstacle, ...
+    ratios = [duration / math.sqrt(length) for duration, length in moves]
+    assert max(ratios) - min(ratios) <= 1e-9 * max(ratios), ratios
+    lengths = [length for _, length in moves]
+    assert max(lengths) > 1.5 * min(lengths)     # so the square root differs from a ratio
+    assert {s.profile for s in design.tube.segments
+            if s.lower_from != s.lower_to} == {SMOOTHSTEP}
 
 
 # --------------------------------------------------------------------------- stay duration

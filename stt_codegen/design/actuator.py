@@ -20,7 +20,12 @@ second stage). Deterministic, in this order, the first tube that meets the bound
 3. **via points** (``tube.method`` ``"auto"`` or ``"via"``): smooth-step segments through
    via boxes, timed in proportion to their length over all of ``t_c`` (no circumvent
    flanks);
-4. **via points with cruise segments** (the same; not for tasks, whose legs have them):
+4. **via points timed for the force** (a variant whose input is a force, the cascade:
+   ``ControllerVariant.via_timing``; tasks too): smooth-step segments whose durations
+   follow the square roots of their lengths, so each asks about the same peak
+   acceleration (:data:`~.via.ACCELERATION_TIMING`); a task's legs are smooth-step
+   segments then, not cruise ones;
+5. **via points with cruise segments** (the same; not for tasks, whose legs have them):
    the same via boxes and times, each segment's rate rising to 1.25 times its mean, not
    1.875 times.
 
@@ -50,6 +55,7 @@ from .failures import FailureKind, advice_wanted, without_advice
 from .certificate.actuator import prove_input_bound
 from .input_bound import InputProof
 from .result import METHOD_PAPER, METHOD_VIA, Design
+from .via import ACCELERATION_TIMING
 from .samples import HORIZON_FACTOR, STEP_BUDGET
 from .windows import SHARPNESS_LADDER
 
@@ -101,7 +107,9 @@ def slower_variants(spec: Spec, default: Design) -> list[tuple[str, Spec]]:
         Softer circumvents (the paper's tube with every ``k^j`` fixed to each ladder value
         above the default's largest), when the default is the paper's tube with
         circumvents and ``tube.circumvent_sharpness`` is free; then via points, when
-        ``tube.method`` allows them and the default is not already a via tube; then via
+        ``tube.method`` allows them and the default is not already a via tube; then, for
+        a variant whose input is a force (``via_timing = "acceleration"``), via points
+        timed for the acceleration (tasks too); then via
         points with ``"cruise"`` segments (peak rate 1.25 times the mean, where the smooth
         step's is 1.875), when ``tube.method`` allows via points and the spec has no
         tasks (whose legs are cruise segments already).
@@ -116,6 +124,11 @@ def slower_variants(spec: Spec, default: Design) -> list[tuple[str, Spec]]:
                 for k in SHARPNESS_LADDER if k > sharpest]
     if spec.tube.method in ("auto", METHOD_VIA) and default.method != METHOD_VIA:
         out.append(("via points", replace(spec, tube=replace(spec.tube, method=METHOD_VIA))))
+    if (spec.tube.method in ("auto", METHOD_VIA)
+            and variant_of(spec).via_timing == ACCELERATION_TIMING):
+        out.append(("via points timed for the force",
+                    replace(spec, tube=replace(spec.tube, method=METHOD_VIA,
+                                               via_timing=ACCELERATION_TIMING))))
     if spec.tube.method in ("auto", METHOD_VIA) and not spec.tasks:
         out.append(("via points, cruise segments",
                     replace(spec, tube=replace(spec.tube, method=METHOD_VIA,

@@ -20,7 +20,12 @@ of the via-point design (:mod:`stt_codegen.design.via`), in window order, then t
   shortening and timing as a whole via design, with ``"cruise"`` segments (peak rate
   1.25 times the mean, :data:`~stt_codegen.tube.parameters.CRUISE`). Under free timing
   each leg's time follows its via path's length (largest coordinate moves), so every leg
-  moves at about the same speed.
+  moves at about the same speed. With ``spec.tube.via_timing = "acceleration"`` (a
+  second-order spec within ``[actuator]``: its input is a force) the legs are
+  ``"smoothstep"`` segments (peak acceleration ``5.77 D / T^2`` against the cruise's
+  ``9.4 D / T^2``) and every time follows the square roots of the moves' lengths
+  (:func:`~stt_codegen.design.via.move_weight`), so every move asks about the same
+  acceleration.
 
 The certificate (:mod:`stt_codegen.design.certificate.tasks`) then proves each task for
 every ``t``; the plan only makes it likely to pass. The plans (visit order and ``any_of``
@@ -40,10 +45,10 @@ import numpy as np
 from ..errors import DesignError
 from ..spec.loader import Spec
 from ..spec.tasks import STAY, Task
-from ..tube.parameters import CRUISE, ReachSegment, TubeDesign, paper_segments
+from ..tube.parameters import CRUISE, SMOOTHSTEP, ReachSegment, TubeDesign, paper_segments
 from .failures import FailureKind
 from .swept import swept_spec
-from .via import ViaPlan, plan_via
+from .via import LENGTH_TIMING, ViaPlan, move_weight, plan_via
 
 __all__ = ["FREE_HOLD", "MAX_PLANS", "STAY_LEAD", "TaskPlan", "plan_tasks", "task_plans",
            "task_schedule", "visit_orders"]
@@ -124,14 +129,22 @@ def _leg_path(spec: Spec, base: TubeDesign, start: tuple, goal: tuple) -> ViaPla
                                   segments=paper_segments(*start, *goal, 1.0)))
 
 
-def _path_length(plan: ViaPlan) -> float:
-    """The via boxes' centres' path length (:func:`_distance` per move), state units."""
+def _path_length(plan: ViaPlan, timing: str = LENGTH_TIMING) -> float:
+    """The via boxes' centres' path length (:func:`_distance` per move), state units; with
+    another ``timing`` the sum of the moves' :func:`~.via.move_weight`."""
     centres = [_centre((lo, hi)) for lo, hi in zip(plan.lower, plan.upper)]
-    return sum(_distance(a, b) for a, b in zip(centres, centres[1:]))
+    return sum(move_weight(_distance(a, b), timing) for a, b in zip(centres, centres[1:]))
 
 
-def _leg(plan: ViaPlan, base: TubeDesign, t0: float, t1: float) -> list[ReachSegment]:
-    """The ``"cruise"`` segments of a leg's via boxes (:func:`_leg_path`) from ``t0`` to
+def _leg_profile(spec: Spec) -> str:
+    """The legs' profile: ``"cruise"``, or ``"smoothstep"`` when timed for the
+    acceleration (module notes)."""
+    return CRUISE if spec.tube.via_timing == LENGTH_TIMING else SMOOTHSTEP
+
+
+def _leg(plan: ViaPlan, base: TubeDesign, t0: float, t1: float,
+         profile: str = CRUISE) -> list[ReachSegment]:
+    """The segments (``profile``) of a leg's via boxes (:func:`_leg_path`) from ``t0`` to
     ``t1`` (seconds)."""
     times = [t0 + (t1 - t0) * t for t in plan.times]
     times[0], times[-1] = t0, t1
@@ -140,7 +153,7 @@ def _leg(plan: ViaPlan, base: TubeDesign, t0: float, t1: float) -> list[ReachSeg
     if any(b <= a for a, b in zip(times, times[1:])):
         raise DesignError(f"no time for the via boxes between {t0:g} s and {t1:g} s",
                           kind=FailureKind.TASK, tried=base)
-    return list(replace(plan, times=tuple(times)).segments(CRUISE))
+    return list(replace(plan, times=tuple(times)).segments(profile))
 
 
 @dataclass(frozen=True)
@@ -299,7 +312,8 @@ def task_schedule(spec: Spec, base: TubeDesign, order: tuple[int, ...],
     legs : list of float, optional
         Free timing: each leg's length (``len(order) + 1`` legs, the last to the target),
         state units; default the centres' distances (the via paths' lengths are longer
-        around obstacles: :func:`plan_tasks` passes those).
+        around obstacles: :func:`plan_tasks` passes those, or, timed for the
+        acceleration, the sums of their moves' :func:`~.via.move_weight`).
 
     Returns
     -------
@@ -453,7 +467,8 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...],
     Returns
     -------
     tube : TubeDesign
-        ``cruise`` segments, no circumvents; the gain is ``base``'s.
+        ``cruise`` segments (``smoothstep`` timed for the acceleration: module notes), no
+        circumvents; the gain is ``base``'s.
     plan : TaskPlan
         The visit order and each task's hold.
 
@@ -482,8 +497,10 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...],
     # free timing: each leg's time follows its via path's length (fixed holds: unused)
     legs = None
     if _listed_holds(spec, order, boxes, base, choice) is None:
-        legs = [_path_length(path(a, b, p)) for a, b, p in zip(starts, boxes + [goal], pendings)]
+        legs = [_path_length(path(a, b, p), spec.tube.via_timing)
+                for a, b, p in zip(starts, boxes + [goal], pendings)]
     boxes, holds = task_schedule(spec, base, order, choice, legs)
+    profile = _leg_profile(spec)
     start = starts[0]
     leave = 0.0
     segments: list[ReachSegment] = []
@@ -491,14 +508,14 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...],
         if arrive == leave:        # a stay held where the tube already is
             segments.append(ReachSegment(leave, until_t, *start, *start, CRUISE))
         else:
-            segments += _leg(path(start, box, pendings[j]), base, leave, arrive)
+            segments += _leg(path(start, box, pendings[j]), base, leave, arrive, profile)
             segments.append(ReachSegment(arrive, until_t, *box, *box, CRUISE))
             start = box
         leave = until_t
     if not base.prescribed_time > leave:
         raise DesignError("no time to reach the target after the last task",
                           kind=FailureKind.TASK, tried=base)
-    segments += _leg(path(start, goal, []), base, leave, base.prescribed_time)
+    segments += _leg(path(start, goal, []), base, leave, base.prescribed_time, profile)
     by_task = dict(zip(order, holds))
     plan = TaskPlan(order, tuple(by_task[k] for k in range(len(spec.tasks))))
     return replace(base, segments=tuple(segments), circumvents=()), plan

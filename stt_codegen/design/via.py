@@ -18,8 +18,11 @@ boxes ``B_0 = X-hat_0, B_1, ..., B_m = T-hat`` (docs/decisions.md, decision 12):
   greedily: from each via box, the farthest later box on the path it can move to
   directly.
 * **Timing.** Durations in proportion to the centre distance (max norm), the last
-  segment ending at ``t_c`` in the target box; the profile has zero slope at every via
-  point, so ``rho`` and ``rho_dot`` are continuous there.
+  segment ending at ``t_c`` in the target box (``"length"``: every segment at the same
+  peak rate, what bounds a velocity input); or, ``spec.tube.via_timing =
+  "acceleration"``, in proportion to its square root (every segment at the same peak
+  acceleration, what bounds a force: :data:`ACCELERATION_TIMING`). The profile has zero
+  slope at every via point, so ``rho`` and ``rho_dot`` are continuous there.
 
 The tube is then certified like any other (:func:`~stt_codegen.design.certificate.certify_tube`).
 """
@@ -37,7 +40,8 @@ from ..spec.loader import Spec
 from .failures import FailureKind
 from ..tube.parameters import SMOOTHSTEP, ReachSegment, TubeDesign
 
-__all__ = ["VIA_HALF_WIDTH", "VIA_MARGIN", "ViaPlan", "plan_via", "via_design"]
+__all__ = ["ACCELERATION_TIMING", "LENGTH_TIMING", "VIA_HALF_WIDTH", "VIA_MARGIN",
+           "VIA_TIMINGS", "ViaPlan", "move_weight", "plan_via", "via_design"]
 
 #: Largest half-width of a via box, state units.
 VIA_HALF_WIDTH = 0.1
@@ -45,6 +49,42 @@ VIA_HALF_WIDTH = 0.1
 VIA_MARGIN = 0.05
 #: Most grid cells (the cell side grows until the grid fits).
 MAX_CELLS = 6000
+#: Via timing: each move's duration in proportion to its length (max norm). A profile's
+#: peak rate is then the same on every move: the timing for a velocity input (law (13)).
+LENGTH_TIMING = "length"
+#: Via timing: each move's duration in proportion to the square root of its length. A
+#: profile's peak acceleration (``5.77 D / T^2`` for the quintic smooth step) is then the
+#: same on every move: the timing for a force input (the cascade, docs/second-order.md).
+ACCELERATION_TIMING = "acceleration"
+VIA_TIMINGS = (LENGTH_TIMING, ACCELERATION_TIMING)
+
+
+def move_weight(length: float, timing: str) -> float:
+    """A move's share of time before normalisation: its duration is this over the sum of
+    its plan's (or leg's) weights times the time the plan has.
+
+    Parameters
+    ----------
+    length : float
+        The move's centre distance (max norm), state units.
+    timing : {"length", "acceleration"}
+        :data:`LENGTH_TIMING` (``length``) or :data:`ACCELERATION_TIMING`
+        (``sqrt(length)``).
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ValueError
+        An unknown timing.
+    """
+    if timing == LENGTH_TIMING:
+        return length
+    if timing == ACCELERATION_TIMING:
+        return math.sqrt(length)
+    raise ValueError(f"unknown via timing {timing!r}: one of {', '.join(VIA_TIMINGS)}")
 
 
 @dataclass(frozen=True)
@@ -193,7 +233,7 @@ def plan_via(spec: Spec, base: TubeDesign) -> ViaPlan:
             f"at ({where}); the passage is too narrow there", kind=FailureKind.NO_PASSAGE)
     nodes = {k: (lows[k], highs[k]) for k in path}
     path = _shortcut(path, nodes, obstacles, space)
-    return _timed(path, nodes, base.prescribed_time)
+    return _timed(path, nodes, base.prescribed_time, spec.tube.via_timing)
 
 
 def _grid_nodes(space, grid_dims: list[int], counts: list[int], start, goal,
@@ -321,9 +361,10 @@ def _shortcut(path: list, nodes: dict, obstacles: np.ndarray, space) -> list:
     return out
 
 
-def _timed(path: list, nodes: dict, prescribed_time: float) -> ViaPlan:
+def _timed(path: list, nodes: dict, prescribed_time: float, timing: str) -> ViaPlan:
     centres = [0.5 * (nodes[k][0] + nodes[k][1]) for k in path]
-    lengths = [float(np.max(np.abs(b - a))) for a, b in zip(centres, centres[1:])]
+    lengths = [move_weight(float(np.max(np.abs(b - a))), timing)
+               for a, b in zip(centres, centres[1:])]
     total = sum(lengths)
     times = [0.0]
     for length in lengths:

@@ -181,6 +181,12 @@ class TubeParameters:
         The via-point segments' profile (``tube/parameters.py``). Not a key of the file:
         ``"smoothstep"`` as loaded; the design within ``[actuator]`` tries ``"cruise"``
         (a lower peak rate) when the other tubes exceed the bound.
+    via_timing : {"length", "acceleration"}
+        How the via-point segments (and the legs of ``[[tasks]]``) share the time
+        (``design/via.py``): in proportion to each move's length, or to its square root
+        (the same peak acceleration on every move). Not a key of the file: ``"length"`` as
+        loaded; the design of a second-order spec within ``[actuator]`` tries
+        ``"acceleration"`` (its input is a force).
     """
 
     delta_b: float
@@ -191,6 +197,7 @@ class TubeParameters:
     smoothness: float
     method: str = "auto"
     via_profile: str = "smoothstep"
+    via_timing: str = "length"
 
 
 @dataclass(frozen=True)

@@ -115,6 +115,11 @@ class ControllerVariant:
         ``generate --tube-data`` is available: the generated C takes its tube as data and
         switches tubes at run time (:mod:`stt_codegen.codegen.tube_data`, docs/sensing.md);
         only law (13)'s variant so far.
+    via_timing : {"length", "acceleration"}
+        How the design within ``[actuator]`` times a via tube for this variant's input
+        (:mod:`stt_codegen.design.via`): ``"length"`` where the input is a velocity (law
+        (13), the base's command), ``"acceleration"`` where it is a force (the cascade):
+        the design then also tries via segments timed for the acceleration.
     timing_in_stage : bool
         The certificate of its stage (:attr:`~stt_codegen.design.result.Design.stage`)
         proves ``[controller] delay`` and ``jitter`` (the cascade's); else the design's
@@ -140,6 +145,7 @@ class ControllerVariant:
     roles: Mapping[str, str]
     replay_context: Mapping[str, bool] = field(default_factory=lambda: MappingProxyType({}))
     timing_in_stage: bool = False
+    via_timing: str = "length"
     predicts_delay: bool = False
     replans_sensed: bool = False
     tube_data: bool = False
@@ -258,7 +264,8 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                output_limits=_P + "design.output_bound:cascade_output_limits",
                predictor=_P + "tube.cascade:cascade_predictor",
                input_gain=_P + "spec.input_gains:cascade_input_gain"),
-        MappingProxyType({"cascade": True}), timing_in_stage=True, predicts_delay=True),
+        MappingProxyType({"cascade": True}), timing_in_stage=True,
+        via_timing="acceleration", predicts_delay=True),
     "look-ahead": ControllerVariant(
         "look-ahead", "a differential-drive base", "the base's command (v, omega)", 1, "",
         _roles(plant_terms=_P + "spec.loader:look_ahead_plant_terms",
