@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 import tomllib
 from itertools import permutations
 from pathlib import Path
@@ -298,6 +299,25 @@ def test_target_any_of_box_meeting_an_obstacle_is_dropped_with_a_note():
     assert design.target_choice == 1 and design.certificate.passed
     assert design.to_json()["target_choice"]["dropped"] == [{"any_of": 0,
                                                               "obstacle": "obstacles[0]"}]
+
+
+def test_a_target_any_of_refusal_names_the_nearest_time_a_box_certifies():
+    """Both target boxes too far for the bound within t_c: each box's refusal names a later
+    prescribed_time; the spec's refusal names the nearer one (the second, nearer box's,
+    said so), and the spec with it is certified within the bound."""
+    doc = {**_two_targets([]), "prescribed_time": 2.0, "actuator": {"input_bound": [1.0, 1.0]},
+           "controller": {"rate_hz": 200.0}}
+    doc["target"] = {"any_of": [{"lower": [4.4, 4.4], "upper": [5.0, 5.0]},
+                                {"lower": [0.0, 2.4], "upper": [0.6, 3.0]}]}
+    with pytest.raises(DesignError) as info:
+        design_tube(spec_of(doc))
+    named = info.value.advice["prescribed_time"]
+    words = str(info.value)
+    first = re.match(r"target any_of\[0\]: .*?prescribed_time = ([0-9.]+) s works", words)
+    assert first is not None and named < float(first.group(1)), words
+    assert f"with target any_of[1], prescribed_time = {named:g} is certified" in words
+    design = design_tube(spec_of({**doc, "prescribed_time": named}))
+    assert design.certificate.passed and design.input_proof.meets((1.0, 1.0))
 
 
 def test_free_timing_with_an_actuator_bound_keeps_the_tasks():

@@ -391,8 +391,42 @@ def _any_target(spec: Spec) -> Design:
     q, first = failures[0]
     more = (f" (and target any_of[{', '.join(str(k) for k, _ in failures[1:])}])"
             if len(failures) > 1 else "")
-    raise DesignError(f"target any_of[{q}]: {first}{more}", kind=first.kind,
-                      tried=first.tried)
+    advice, notes = _any_target_advice(spec, failures)
+    raise DesignError(f"target any_of[{q}]: {first}{more}{notes}", kind=first.kind,
+                      tried=first.tried, advice=advice)
+
+
+def _own_value(spec: Spec, key: str) -> float | None:
+    """The spec's own value of an advice key (``DesignError.advice``), if it is a number."""
+    return {"prescribed_time": spec.prescribed_time, "controller.rate_hz": spec.rate_hz,
+            "controller.delay": spec.delay,
+            "plant.axle_offset": None if spec.drive is None else spec.drive.axle_offset
+            }.get(key)
+
+
+def _any_target_advice(spec: Spec, failures: list[tuple[int, DesignError]]
+                       ) -> tuple[dict, str]:
+    """The advice of a ``[target] any_of`` refusal, and the words for the values named
+    with a later box: per key, of the values the boxes' refusals name, the nearest to the
+    spec's own (the first box's where there is no number to compare).
+
+    Each box's value was designed and certified with that box as the target and the rest
+    of the spec unchanged; the spec with it tries the boxes in the same order, each designed
+    as before, so it keeps an earlier box that is certified there or reaches that box: the
+    whole spec is certified with it."""
+    advice: dict = {}
+    source: dict = {}
+    for q, error in failures:
+        for key, value in error.advice.items():
+            own = _own_value(spec, key)
+            if key not in advice or (own is not None and not isinstance(value, bool)
+                                     and abs(value - own) < abs(advice[key] - own)):
+                advice[key], source[key] = value, q
+    first = failures[0][0]
+    notes = "".join(f"; with target any_of[{source[key]}], {key} = "
+                    f"{'true' if isinstance(value, bool) else format(value, 'g')} is certified"
+                    for key, value in advice.items() if source[key] != first)
+    return advice, notes
 
 
 def _position_stage(spec: Spec) -> Design:
