@@ -129,3 +129,20 @@ def test_auto_keeps_circumvents_that_are_no_faster_than_via_points():
     assert (centre_speed(via.tube, via.certificate)
             > SMOOTHER_RATIO * centre_speed(paper.tube, paper.certificate))
     assert design_tube(spec).tube == paper.tube
+
+
+def test_the_cascade_is_judged_by_its_stage_not_by_law_13s_tracking_proof(monkeypatch):
+    """``tube.method = "paper"`` screens a tube with circumvents by law (13)'s sampled-data
+    proof for a first-order spec; a second-order spec's tube is judged by the cascade's
+    certificate (its stage bounds ``|e1|``), so the screen is not run for it."""
+    import stt_codegen.design.search as search
+    calls = []
+    real = search.unfollowable
+    monkeypatch.setattr(search, "unfollowable", lambda *a: calls.append(a) or real(*a))
+    for name, screened in (("second-order-quadrotor", False), ("omnirobot-s1", True)):
+        spec = load_spec(name)
+        spec = dataclasses.replace(spec, tube=dataclasses.replace(spec.tube, method="paper"))
+        calls.clear()
+        design = design_tube(spec)
+        assert design.tube.circumvents and design.certificate.passed
+        assert bool(calls) is screened, name

@@ -400,8 +400,7 @@ def _own_value(spec: Spec, key: str) -> float | None:
     """The spec's own value of an advice key (``DesignError.advice``), if it is a number."""
     return {"prescribed_time": spec.prescribed_time, "controller.rate_hz": spec.rate_hz,
             "controller.delay": spec.delay,
-            "plant.axle_offset": None if spec.drive is None else spec.drive.axle_offset
-            }.get(key)
+            "plant.axle_offset": getattr(spec.drive, "axle_offset", None)}.get(key)
 
 
 def _any_target_advice(spec: Spec, failures: list[tuple[int, DesignError]]
@@ -560,7 +559,8 @@ def _design(spec: Spec, smoother: bool) -> Design:
             with reporting(None, (k / len(stages), (k + 1) / len(stages))):
                 tube, check = (_via(spec, base) if used == METHOD_VIA
                                else paper_design(spec, base, budget, work,
-                                                 followable=method == METHOD_PAPER))
+                                                 followable=method == METHOD_PAPER
+                                                 and not variant_of(spec).tracking_in_stage))
             break
         except DesignError as exc:
             errors[used] = exc

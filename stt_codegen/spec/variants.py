@@ -115,6 +115,11 @@ class ControllerVariant:
         ``generate --tube-data`` is available: the generated C takes its tube as data and
         switches tubes at run time (:mod:`stt_codegen.codegen.tube_data`, docs/sensing.md);
         only law (13)'s variant so far.
+    tracking_in_stage : bool
+        Whether the tube can be followed is judged by the certificate of its stage (the
+        cascade's, which bounds ``|e1|``); else the paper's method refuses a tube with
+        circumvents whose law (13) sampled-data proof bounds ``|e|`` above
+        ``TRACKING_ERROR`` (``design/tracking.py``, ``unfollowable``).
     via_timing : {"length", "acceleration"}
         How the design within ``[actuator]`` times a via tube for this variant's input
         (:mod:`stt_codegen.design.via`): ``"length"`` where the input is a velocity (law
@@ -145,6 +150,7 @@ class ControllerVariant:
     roles: Mapping[str, str]
     replay_context: Mapping[str, bool] = field(default_factory=lambda: MappingProxyType({}))
     timing_in_stage: bool = False
+    tracking_in_stage: bool = False
     via_timing: str = "length"
     predicts_delay: bool = False
     replans_sensed: bool = False
@@ -264,7 +270,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                output_limits=_P + "design.output_bound:cascade_output_limits",
                predictor=_P + "tube.cascade:cascade_predictor",
                input_gain=_P + "spec.input_gains:cascade_input_gain"),
-        MappingProxyType({"cascade": True}), timing_in_stage=True,
+        MappingProxyType({"cascade": True}), timing_in_stage=True, tracking_in_stage=True,
         via_timing="acceleration", predicts_delay=True),
     "look-ahead": ControllerVariant(
         "look-ahead", "a differential-drive base", "the base's command (v, omega)", 1, "",
