@@ -315,7 +315,7 @@ def test_a_target_any_of_refusal_names_the_nearest_time_a_box_certifies():
     words = str(info.value)
     first = re.match(r"target any_of\[0\]: .*?prescribed_time = ([0-9.]+) s works", words)
     assert first is not None and named < float(first.group(1)), words
-    assert f"with target any_of[1], prescribed_time = {named:g} is certified" in words
+    assert f"with target any_of[1], prescribed_time = {named:g} s is certified" in words
     design = design_tube(spec_of({**doc, "prescribed_time": named}))
     assert design.certificate.passed and design.input_proof.meets((1.0, 1.0))
 

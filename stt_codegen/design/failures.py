@@ -12,7 +12,9 @@ from contextlib import contextmanager
 from contextvars import ContextVar
 from enum import Enum
 
-__all__ = ["FailureKind", "advice_wanted", "property_kind", "without_advice"]
+from ..errors import number_text
+
+__all__ = ["FailureKind", "advice_text", "advice_wanted", "property_kind", "without_advice"]
 
 _ADVICE: ContextVar[bool] = ContextVar("stt_codegen_refusal_advice", default=True)
 
@@ -33,6 +35,17 @@ def advice_wanted() -> bool:
     """Whether a refusal should search for what works (``False`` within
     :func:`without_advice`)."""
     return _ADVICE.get()
+
+
+#: The unit each advice field is printed with (``DesignError.advice``).
+ADVICE_UNITS = {"prescribed_time": " s", "controller.delay": " s", "plant.axle_offset": " m"}
+
+
+def advice_text(name: str, value: float | bool) -> str:
+    """One advice field as a refusal's message names it: ``prescribed_time = 31 s``,
+    ``controller.compensate_delay = true``."""
+    return f"{name} = " + ("true" if value is True else
+                           f"{number_text(value)}{ADVICE_UNITS.get(name, '')}")
 
 
 class FailureKind(Enum):

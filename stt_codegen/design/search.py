@@ -34,7 +34,8 @@ from ..tube.parameters import Circumvent, TubeDesign, paper_segments
 from .certificate import MAX_INTERVALS, MAX_MOVE_PER_SAMPLE, certify_tube
 from .certificate.motion import certify_motion
 from .actuator import design_within_bound
-from .failures import FailureKind, advice_wanted, property_kind, without_advice
+from .failures import (FailureKind, advice_text, advice_wanted, property_kind,
+                       without_advice)
 from .grid import grid_index, grid_value, smallest_passing
 from .moving import MOTION_SPACE_TIME, design_moving, moves
 from .gain import with_gain
@@ -422,9 +423,8 @@ def _any_target_advice(spec: Spec, failures: list[tuple[int, DesignError]]
                                      and abs(value - own) < abs(advice[key] - own)):
                 advice[key], source[key] = value, q
     first = failures[0][0]
-    notes = "".join(f"; with target any_of[{source[key]}], {key} = "
-                    f"{'true' if isinstance(value, bool) else format(value, 'g')} is certified"
-                    for key, value in advice.items() if source[key] != first)
+    notes = "".join(f"; with target any_of[{source[key]}], {advice_text(key, value)} is "
+                    "certified" for key, value in advice.items() if source[key] != first)
     return advice, notes
 
 

@@ -22,7 +22,7 @@ from ..tube import reference
 from .certificate.plant_class import plant_class
 from .certificate.sampled import (check_sampled_first_per_axis, delay_room, largest_passing,
                                   lowest_rate, sampled_check_of)
-from .failures import FailureKind, advice_wanted
+from .failures import FailureKind, advice_text, advice_wanted
 from .result import Design
 from .samples import sample_tube
 from .tracking import TRACKING_ERROR
@@ -94,10 +94,7 @@ def _compensated_advice(spec: Spec, search: Callable[[Spec], Design],
         advice = dict(failure.advice)
         if not advice:
             return refused
-    units = {"prescribed_time": " s", "controller.delay": " s", "plant.axle_offset": " m"}
-    words = " and ".join(f"{name} = " + ("true" if value is True else
-                                          f"{number_text(value)}{units.get(name, '')}")
-                         for name, value in advice.items())
+    words = " and ".join(advice_text(name, value) for name, value in advice.items())
     return DesignError(f"{refused}; controller.compensate_delay = true"
                        + (f" with {words}" if words else "") + " is certified",
                        kind=refused.kind, tried=getattr(refused, "tried", None),
