@@ -36,9 +36,9 @@ from functools import lru_cache
 import numpy as np
 
 from .cascade_bounds import STEP_PIECES, step_velocity_change, virtual_velocity_change
-from .cascade_step import (FIGURES, RHO_ROUNDING, predicted_step, run_steps,
-                           sampled_step)
+from .cascade_step import FIGURES, RHO_ROUNDING, predicted_step, sampled_step
 from .enclosures import enclose_later
+from .folded import run_steps
 from .growing import GrowingEnclosure
 from ..samples import TubeSamples, sample_tube
 from ...progress import report
@@ -538,7 +538,7 @@ _STAGES = ("input", "speed", "room", "vroom", "reach")
 
 def _run(step, start, columns, count: int, constants, inside, vbound, limit,
          samples: TubeSamples, whose: str):
-    """:func:`~.cascade_step.run_steps` until the first failure, reporting progress."""
+    """:func:`~.folded.run_steps` until the first failure, reporting progress."""
     end = float(samples.t[-1])
 
     def progress(done: int) -> None:

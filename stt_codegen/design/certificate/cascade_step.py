@@ -9,34 +9,32 @@ This module writes one step once, with the per-axis formulas of
 :func:`~.cascade_bounds.step_velocity_change` on CasADi ``SX`` symbols
 (:data:`~.operations.SYMBOLS`, without simplifications: the same IEEE operations in the
 same order as on floats), folds it with ``mapaccum`` and lets CasADi's virtual machine run
-it over the samples (no C compiler; docs/second-order.md, "How the certificate is
-evaluated").
+it over the samples (:mod:`.folded`; no C compiler; docs/second-order.md, "How the
+certificate is evaluated").
 
 Every figure a step needs from the tube (its centre, half-width and enclosures, the
 velocity tube's half-width, the peaks ``s*``) is computed beforehand for all samples at
 once with numpy and passed as one column per step (:data:`SAMPLED_COLUMNS`,
 :data:`PREDICTED_COLUMNS`, ``n`` rows each). Each step returns the figures the check
-judges (:data:`FIGURES`, ``n`` rows each); :func:`run_steps` evaluates the steps in
-chunks and stops after the first chunk in which a judgement fails, so a refusal costs
+judges (:data:`FIGURES`, ``n`` rows each); :func:`~.folded.run_steps` evaluates the steps
+in chunks and stops after the first chunk in which a judgement fails, so a refusal costs
 about as many steps as before.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from functools import lru_cache
 
 import casadi
 import numpy as np
 
-from ...tube.parameters import E_MAX
 from .cascade_bounds import step_velocity_change, virtual_velocity_change
+from .folded import StepLayout, split
 from .operations import SYMBOLS, exact_symbols
 from .sampled_axis import axis_interval, peak_scalar, phi_scalar
 
 __all__ = ["FIGURES", "PREDICTED_COLUMNS", "PREDICTED_PARAMETERS", "RHO_ROUNDING",
-           "SAMPLED_COLUMNS", "SAMPLED_PARAMETERS", "StepLayout", "predicted_step",
-           "run_steps", "sampled_step"]
+           "SAMPLED_COLUMNS", "SAMPLED_PARAMETERS", "predicted_step", "sampled_step"]
 
 #: Relative safety factor on the closed-form ``rho2(t_{k+1})`` the path is judged against
 #: (rounding of ``exp``; every margin reported is far above it).
@@ -70,47 +68,6 @@ PREDICTED_COLUMNS = ("centre", "half", "centre_next", "half_next", "pull1", "pea
 #: The constants of the predicted check (``f0`` and ``vbound``: ``n`` of them).
 PREDICTED_PARAMETERS = ("k1", "k2", "h", "g_min", "g_max", "coupling", "f0", "f1", "w",
                         "delay", "deviation", "g_mid", "share", "mix_lo", "mix_hi", "vbound")
-
-#: Steps of the first chunk :func:`run_steps` evaluates; each next chunk is twice as long,
-#: up to :data:`LONGEST_CHUNK`.
-FIRST_CHUNK = 64
-#: The longest chunk.
-LONGEST_CHUNK = 4096
-
-
-class StepLayout:
-    """The rows of a step's columns and constants: ``layout.rows(name)`` is the slice of
-    ``name``'s rows, ``layout.size`` their number.
-
-    Parameters
-    ----------
-    blocks : sequence of (str, int)
-        Each name and its number of rows, in order.
-    """
-
-    def __init__(self, blocks) -> None:
-        self.blocks, start = {}, 0
-        for name, size in blocks:
-            self.blocks[name] = slice(start, start + size)
-            start += size
-        self.size = start
-
-    def rows(self, name: str) -> slice:
-        """The rows of ``name``."""
-        return self.blocks[name]
-
-    def pack(self, values: dict, width: int | None = None) -> np.ndarray:
-        """The column(s) of ``values`` (each ``(size,)`` or ``(size, width)``) in order."""
-        shape = (self.size,) if width is None else (self.size, width)
-        out = np.empty(shape)
-        for name, rows in self.blocks.items():
-            out[rows] = values[name]
-        return out
-
-
-def _split(symbol, layout: StepLayout, name: str) -> list:
-    return [symbol[j] for j in range(layout.rows(name).start, layout.rows(name).stop)]
-
 
 def _sampled_layouts(n: int, shares: int, corners: int, lengths: int
                      ) -> tuple[StepLayout, StepLayout]:
@@ -173,8 +130,8 @@ def sampled_step(n: int, timed: bool, delayed: bool, shares: int, corners: int,
         state = casadi.SX.sym("state", 5 * n)
         col = casadi.SX.sym("column", columns.size)
         par = casadi.SX.sym("constants", constants.size)
-        c = {name: _split(col, columns, name) for name in SAMPLED_COLUMNS}
-        p = {name: _split(par, constants, name) for name in SAMPLED_PARAMETERS}
+        c = {name: split(col, columns, name) for name in SAMPLED_COLUMNS}
+        p = {name: split(par, constants, name) for name in SAMPLED_PARAMETERS}
         k1, k2, h, g_min, g_max, cpl, _, f1, w_amp, longest, delay = (
             p[name][0] for name in SAMPLED_PARAMETERS[:11])
         f0 = p["f0"]
@@ -301,8 +258,8 @@ def predicted_step(n: int) -> tuple[casadi.Function, StepLayout, StepLayout]:
         state = casadi.SX.sym("state", 6 * n)
         col = casadi.SX.sym("column", columns.size)
         par = casadi.SX.sym("constants", constants.size)
-        c = {name: _split(col, columns, name) for name in PREDICTED_COLUMNS}
-        p = {name: _split(par, constants, name) for name in PREDICTED_PARAMETERS}
+        c = {name: split(col, columns, name) for name in PREDICTED_COLUMNS}
+        p = {name: split(par, constants, name) for name in PREDICTED_PARAMETERS}
         (k1, k2, h, g_min, g_max, cpl, _, f1, w_amp, delay, deviation, g_mid, share,
          mix_lo, mix_hi) = (p[name][0] for name in PREDICTED_PARAMETERS[:15])
         f0 = p["f0"]
@@ -380,88 +337,3 @@ def predicted_step(n: int) -> tuple[casadi.Function, StepLayout, StepLayout]:
         step = casadi.Function("cascade_predicted_step", [state, col, par],
                                casadi.cse([following, shown]))
     return step, columns, constants
-
-
-#: Steps written out one after the other in one function (:func:`_block`), which
-#: ``mapaccum`` then repeats: a call of a folded function costs about as much as a few
-#: hundred operations, once per block instead of once per step.
-UNROLLED = 16
-
-
-@lru_cache(maxsize=16)
-def _block(step: casadi.Function) -> casadi.Function:
-    """:data:`UNROLLED` steps of ``step`` in one function ``(state, columns, constants) ->
-    (state after them, the states and figures after each step)``."""
-    with exact_symbols():
-        state = casadi.SX.sym("state", step.size1_in(0))
-        columns = casadi.SX.sym("columns", step.size1_in(1), UNROLLED)
-        constants = casadi.SX.sym("constants", step.size1_in(2))
-        shown, now = [], state
-        for j in range(UNROLLED):
-            now, figures = step(now, columns[:, j], constants)
-            shown.append(casadi.vertcat(now, figures))
-        return casadi.Function(f"{step.name()}_block", [state, columns, constants],
-                               [now, casadi.horzcat(*shown)])
-
-
-@lru_cache(maxsize=64)
-def _folded(step: casadi.Function, blocks: int) -> casadi.Function:
-    return _block(step).mapaccum(f"{step.name()}_{blocks}", blocks)
-
-
-def run_steps(step: casadi.Function, start: np.ndarray,
-              columns: Callable[[int, int], np.ndarray], count: int,
-              constants: np.ndarray, failed: Callable[[np.ndarray], bool],
-              progress: Callable[[int], None] | None = None
-              ) -> tuple[np.ndarray, np.ndarray]:
-    """Run ``step`` from ``start`` over ``count`` steps, in chunks, until the end or the
-    first chunk in which ``failed`` is true.
-
-    Parameters
-    ----------
-    step : casadi.Function
-        :func:`sampled_step` or :func:`predicted_step`.
-    start : ndarray, (rows of the state,)
-        The state before the first step.
-    columns : callable
-        ``columns(a, b)``: the columns of steps ``a .. b - 1``, ``(rows of a column, b -
-        a)`` (computed when a chunk needs them: a check that fails early computes few).
-    count : int
-        Steps.
-    constants : ndarray, (rows of the constants,)
-    failed : callable
-        Given the figures of a chunk, ``(8, n, steps)`` (:data:`FIGURES` first), whether a
-        judgement fails in it.
-    progress : callable, optional
-        Called with the steps done before each chunk.
-
-    Returns
-    -------
-    figures : ndarray, (8, n, steps done)
-        :data:`FIGURES` of every step run (every step of a chunk that failed, and no more).
-    state : ndarray, (rows of the state,)
-        After the last step run.
-    """
-    rows = step.size1_in(0)
-    n = step.size1_out(1) // len(FIGURES)
-    shown, state, done, chunk = [], np.asarray(start, dtype=float), 0, FIRST_CHUNK
-    while done < count:
-        if progress is not None:
-            progress(done)
-        length = min(chunk, count - done)
-        blocks = -(-length // UNROLLED)
-        blocks = 1 << (blocks - 1).bit_length()   # a power of two: few folded functions
-        block = columns(done, done + length)
-        if blocks * UNROLLED > length:            # a shorter last chunk, padded
-            block = np.hstack([block, np.repeat(block[:, -1:], blocks * UNROLLED - length,
-                                                axis=1)])
-        _, after = _folded(step, blocks)(state, block,
-                                         np.repeat(constants[:, None], blocks, axis=1))
-        after = np.asarray(after)[:, :length]
-        state = after[:rows, -1]
-        shown.append(after[rows:].reshape(len(FIGURES), n, length))
-        done += length
-        if failed(shown[-1]):
-            break
-        chunk = min(2 * chunk, LONGEST_CHUNK)
-    return np.concatenate(shown, axis=2), state
