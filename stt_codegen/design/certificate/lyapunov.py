@@ -19,7 +19,9 @@ import itertools
 import math
 from typing import Sequence
 
-__all__ = ["psi", "others_max", "level_after", "next_level"]
+from .operations import FLOATS
+
+__all__ = ["psi", "others_box", "others_max", "level_after", "next_level"]
 
 #: Bisection steps for the price of the budget in :func:`_concave_max` (any price gives a
 #: valid bound; more steps only tighten it).
@@ -29,7 +31,7 @@ PRICE_HALVINGS = 16
 MAX_EXACT_BLOCK = 8
 
 
-def psi(a: float) -> float:
+def psi(a: float, ops=FLOATS) -> float:
     """``phi(tanh a) = 2 a cosh(a)^2``: law (13)'s ``|u_i| gamma_d,i / (4 k)`` at
     ``atanh |e_i| = a``; odd, increasing, and ``psi(sqrt(b))^2`` is convex in ``b``.
 
@@ -37,13 +39,39 @@ def psi(a: float) -> float:
     ----------
     a : float
         ``atanh |e_i|``.
+    ops : optional
+        :data:`~.operations.FLOATS` (default) or :data:`~.operations.SYMBOLS`.
 
     Returns
     -------
     float
         ``2 a cosh(a)^2``.
     """
-    return 2.0 * a * math.cosh(a) ** 2
+    return 2.0 * a * ops.cosh(a) ** 2
+
+
+def _terms(caps, halves, ops=FLOATS) -> list:
+    """``(psi(sqrt(c_j)) / h_j)^2`` per axis."""
+    return [(psi(ops.sqrt(c), ops) / h) ** 2 for c, h in zip(caps, halves)]
+
+
+def others_box(limits: Sequence[float], halves: Sequence[float], ops=FLOATS) -> float:
+    """:func:`others_max` without a ball (``level = inf``): the box's bound
+    ``sum_j psi(a_j)^2 / h_j^2`` at ``a_j = limit_j``, in the same operations.
+
+    Parameters
+    ----------
+    limits, halves : sequence of float
+        As :func:`others_max`.
+    ops : optional
+        :data:`~.operations.FLOATS` (default) or :data:`~.operations.SYMBOLS`.
+
+    Returns
+    -------
+    float
+        1/state units squared.
+    """
+    return sum(_terms([a ** 2 for a in limits], halves, ops))
 
 
 def others_max(limits: Sequence[float], level: float, halves: Sequence[float]) -> float:
@@ -71,7 +99,7 @@ def others_max(limits: Sequence[float], level: float, halves: Sequence[float]) -
         bound), 1/state units squared.
     """
     caps = [min(a, level) ** 2 for a in limits]
-    values = [(psi(math.sqrt(c)) / h) ** 2 for c, h in zip(caps, halves)]
+    values = _terms(caps, halves)
     budget = level * level
     if not math.isfinite(budget) or sum(caps) <= budget or len(caps) > MAX_EXACT_BLOCK:
         return sum(values)

@@ -3,10 +3,11 @@ floats, or CasADi ``SX`` symbols.
 
 A formula such as :func:`~.sampled_axis.axis_interval` takes ``ops=`` and is written with
 ``ops.fmin``, ``ops.fmax``, ``ops.select`` (of two values), ``ops.branch`` (of two
-functions, of which floats call one only), ``ops.sqrt``, ``ops.atanh`` (and ``+ - * /``,
-``abs``, ``**``, which both kinds of number have). With :data:`FLOATS` (the default) it is
-evaluated at once on Python floats, as before; with :data:`SYMBOLS` it builds the same
-expression tree on ``SX`` symbols, which :mod:`.cascade_step` folds into a loop that
+functions, of which floats call one only), ``ops.sqrt``, ``ops.atanh``, ``ops.cosh``,
+``ops.cos``, ``ops.sin`` (and ``+ - * /``, ``abs``, ``**``, which both kinds of number
+have). With :data:`FLOATS` (the default) it is evaluated at once on Python floats; with
+:data:`SYMBOLS` it builds the same expression tree on ``SX`` symbols, which
+:mod:`.cascade_step` and :mod:`.sampled_fold` fold into a loop (:mod:`.folded`) that
 CasADi's virtual machine evaluates (no C compiler). The tree is the formula's own sequence
 of IEEE operations, in the same order: CasADi's on-the-fly simplifications (``x - x ->
 0``, ``x * 1 -> x``, ...) are switched off while it is built (:func:`exact_symbols`), so the
@@ -33,6 +34,9 @@ class _Floats:
     fmax = staticmethod(max)
     sqrt = staticmethod(math.sqrt)
     atanh = staticmethod(math.atanh)
+    cosh = staticmethod(math.cosh)
+    cos = staticmethod(math.cos)
+    sin = staticmethod(math.sin)
     symbolic = False
 
     @staticmethod
@@ -58,6 +62,9 @@ class _Symbols:
     fmax = staticmethod(casadi.fmax)
     sqrt = staticmethod(casadi.sqrt)
     atanh = staticmethod(casadi.atanh)
+    cosh = staticmethod(casadi.cosh)
+    cos = staticmethod(casadi.cos)
+    sin = staticmethod(casadi.sin)
     symbolic = True
 
     @staticmethod

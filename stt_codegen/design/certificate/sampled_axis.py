@@ -380,8 +380,8 @@ def held_speed(i: int, block: tuple[int, ...], reach_prev: list[float] | None,
     return gain * own + min(coupling, spread / math.sqrt(2.0) + skew) * others + push
 
 
-def turned_gains(angle: float, g_min: float, g_max: float, skew: float, coupling: float
-                 ) -> tuple[float, float, float, float]:
+def turned_gains(angle: float, g_min: float, g_max: float, skew: float, coupling: float,
+                 ops=FLOATS) -> tuple[float, float, float, float]:
     """The input gain's bounds for a command computed at one heading and acting while the
     base turns by up to ``angle`` (docs/differential-drive.md, eq. (R1)).
 
@@ -391,6 +391,8 @@ def turned_gains(angle: float, g_min: float, g_max: float, skew: float, coupling
         The largest turn, rad.
     g_min, g_max, skew, coupling : float
         The class's bounds at the command's own heading.
+    ops : optional
+        :data:`~.operations.FLOATS` (default) or :data:`~.operations.SYMBOLS`.
 
     Returns
     -------
@@ -399,9 +401,9 @@ def turned_gains(angle: float, g_min: float, g_max: float, skew: float, coupling
         turn leaves no positive gain.
     """
     norm = g_max + skew                                   # |g|_2 of the class
-    low = math.cos(angle) * g_min - math.sin(angle) * norm if angle < 0.5 * math.pi \
-        else -math.inf
-    side = math.sin(angle) * norm
+    low = ops.branch(angle < 0.5 * math.pi,
+                     lambda: ops.cos(angle) * g_min - ops.sin(angle) * norm, lambda: -math.inf)
+    side = ops.sin(angle) * norm
     return low, g_max + side, skew + side, coupling + side
 
 

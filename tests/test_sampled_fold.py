@@ -1,0 +1,134 @@
+"""Law (13)'s per-axis sampled check with its per-sample step folded into CasADi's virtual
+machine (stt_codegen/design/certificate/sampled_fold.py) against the Python loop of
+``check_sampled`` (``folded=False``, its oracle): the same verdicts, reasons, margins,
+times, dimensions, bounds of ``|e|`` and report figures, float for float, on bundled
+tubes with random plant classes (a differential drive's turning gains among them), gains,
+rates and stops; the formulas written for symbols against their float originals
+(docs/sampled-data.md, "How the check is evaluated")."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import pathlib
+
+import casadi
+import numpy as np
+import pytest
+
+import stt_codegen as stt
+from stt_codegen.design.certificate.lyapunov import others_box, others_max
+from stt_codegen.design.certificate.operations import SYMBOLS, exact_symbols
+from stt_codegen.design.certificate.plant_class import plant_class
+from stt_codegen.design.certificate.sampled import check_sampled
+from stt_codegen.design.certificate.sampled_axis import turned_gains
+from stt_codegen.design.failures import without_advice
+from stt_codegen.design.samples import sample_tube
+from stt_codegen.spec.assumptions import Assumptions
+from stt_codegen.tube import reference
+
+SPECS = pathlib.Path(__file__).parent / "specs"
+
+
+def _case(name: str):
+    """``(spec, tube, samples)`` of a spec's design (without ``[actuator]``)."""
+    spec = stt.load_spec(name if "-" in name and not name.endswith(".toml")
+                         else str(SPECS / name))
+    spec = dataclasses.replace(spec, input_bound=None)
+    with without_advice():
+        tube = stt.design_tube(spec).tube
+    return spec, tube
+
+
+def _same(a, b) -> None:
+    """``a`` and ``b`` (two :class:`SampledCheck`) equal float for float."""
+    assert (a.passed, a.reason, a.dimension) == (b.passed, b.reason, b.dimension)
+    for name in ("level", "margin", "time"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert x == y or (math.isnan(x) and math.isnan(y)), (name, x, y)
+    assert (a.abs_e is None) == (b.abs_e is None)
+    if a.abs_e is not None:
+        assert a.abs_e.shape == b.abs_e.shape
+        assert np.array_equal(a.abs_e, b.abs_e)
+    assert a.data == b.data
+
+
+def _random_class(rng: np.random.Generator, base: Assumptions, turn: bool) -> Assumptions:
+    g_min = float(rng.uniform(0.3, 1.2))
+    g_max = g_min * float(rng.choice([1.0, rng.uniform(1.0, 3.0)]))
+    out = dataclasses.replace(
+        base, input_gain=(g_min, g_max),
+        input_gain_skew=float(rng.choice([0.0, rng.uniform(0.0, 0.3)])),
+        input_gain_coupling=float(rng.choice([0.0, rng.uniform(0.0, 0.5)])),
+        drift_bound=float(rng.choice([0.0, rng.uniform(0.0, 0.5)])),
+        disturbance_bound=float(rng.uniform(0.0, 0.3)))
+    if turn:
+        out = dataclasses.replace(out, input_gain_turn=(float(rng.uniform(0.5, 10.0)),
+                                                        float(rng.uniform(0.0, 1.0))))
+    return out
+
+
+# a differential drive (coupled, turning gains), a coupled omnidirectional robot, a diagonal
+# one among moving obstacles
+CASES = ("office-drive.toml", "omnirobot-s1", "crossing-moving")
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_fold_equals_loop_on_random_classes(name: str) -> None:
+    spec, tube = _case(name)
+    rng = np.random.default_rng(sum(map(ord, name)))
+    own = plant_class(spec)
+    turn = own.assumptions.input_gain_turn is not None
+    verdicts = set()
+    with reference.numpy_math():
+        for j in range(8):
+            rate = tube.rate_hz * float(rng.choice([0.25, 0.5, 1.0, 2.0]))
+            design = dataclasses.replace(tube, rate_hz=rate,
+                                         gain=tube.gain * float(rng.uniform(0.3, 3.0)))
+            samples = sample_tube(design)
+            plants = own if j == 0 else _random_class(rng, own.assumptions, turn)
+            stop_at = int(rng.integers(1, len(samples.t))) if j % 3 == 2 else None
+            stop = None if stop_at is None else (lambda k, e, at=stop_at: k >= at)
+            loop = check_sampled(design, samples, plants, lyapunov=False, stop=stop,
+                                 folded=False)
+            fold = check_sampled(design, samples, plants, lyapunov=False, stop=stop)
+            _same(loop, fold)
+            verdicts.add("stopped" if "stopped_at" in loop.data else
+                         "passed" if loop.passed else loop.reason.split(" ")[0])
+    # the draws reach a pass and a failure (the comparison is not of passes only)
+    assert "passed" in verdicts and len(verdicts) >= 2, verdicts
+
+
+def test_the_fold_is_not_used_with_balls_or_a_delay() -> None:
+    """With the Lyapunov balls (a coupled block) or a delay the loop runs: the same
+    result with ``folded`` either way."""
+    spec, tube = _case("omnirobot-s1")
+    plants = plant_class(spec)
+    dt = 1.0 / tube.rate_hz
+    with reference.numpy_math():
+        samples = sample_tube(tube)
+        for kwargs in ({}, {"lyapunov": False, "delay": 0.3 * dt}):
+            _same(check_sampled(tube, samples, plants, folded=False, **kwargs),
+                  check_sampled(tube, samples, plants, **kwargs))
+
+
+def _symbolic(f, count: int):
+    with exact_symbols():
+        args = casadi.SX.sym("a", count)
+        out = f(*[args[i] for i in range(count)])
+        outs = out if isinstance(out, tuple) else (out,)
+        return casadi.Function("f", [args], [casadi.vertcat(*outs)])
+
+
+def test_new_symbolic_formulas_equal_their_floats() -> None:
+    rng = np.random.default_rng(3)
+    turned = _symbolic(lambda *a: turned_gains(*a, ops=SYMBOLS), 5)
+    box = _symbolic(lambda a, b, h, k: others_box([a, b], [h, k], SYMBOLS), 4)
+    for _ in range(300):
+        angle = float(rng.choice([rng.uniform(0.0, 0.3), rng.uniform(1.0, 3.0)]))
+        gains = [angle, *rng.uniform(0.2, 2.0, 4).tolist()]
+        assert np.asarray(turned(gains)).ravel().tolist() == list(turned_gains(*gains))
+        limits, halves = rng.uniform(0.0, 3.0, 2).tolist(), rng.uniform(0.01, 2.0, 2).tolist()
+        expected = others_max(limits, math.inf, halves)
+        assert others_box(limits, halves) == expected
+        assert float(box(limits + halves)) == expected
