@@ -97,6 +97,17 @@ log1p = _dispatch("log1p")
 tanh = _dispatch("tanh")
 
 
+def numpy_math_active() -> bool:
+    """Whether :func:`numpy_math` is in force here (a cache of values computed with the
+    oracle's kernels keys on it).
+
+    Returns
+    -------
+    bool
+    """
+    return _USE_NUMPY.get()
+
+
 @contextlib.contextmanager
 def numpy_math():
     """Within this context, evaluate ``exp``/``log``/``log1p``/``tanh`` with numpy's ufuncs.

@@ -11,6 +11,7 @@ argument. :func:`enclose` composes them with a range of ``alpha`` into an
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 from dataclasses import dataclass
 
 import numpy as np
@@ -431,6 +432,8 @@ def enclose_tube(design: TubeDesign, samples) -> Enclosure:
     linearly interpolated, so on ``[t_k, t_{k+1}]`` it lies between ``alpha_k`` and
     ``alpha_{k+1}``; the other pieces are enclosed as in :func:`certify_tube`. Per sample:
     for checks that follow the sampled loop step by step (``verify``'s sampled check).
+    The last :data:`KEPT_ENCLOSURES` are kept, per design, samples object and kind of
+    kernels (:func:`~stt_codegen.tube.reference.numpy_math`); their arrays are read-only.
 
     Parameters
     ----------
@@ -443,10 +446,30 @@ def enclose_tube(design: TubeDesign, samples) -> Enclosure:
     Enclosure
         ``N - 1`` intervals.
     """
+    key = (design, id(samples), reference.numpy_math_active())
+    found = _ENCLOSED.get(key)
+    if found is not None and found[0] is samples:
+        _ENCLOSED.move_to_end(key)
+        return found[1]
     t0, t1 = samples.t[:-1], samples.t[1:]
     a0, a1 = samples.alpha[:-1], samples.alpha[1:]
-    return enclose(design, piece_ranges(design, t0, t1), np.minimum(a0, a1), np.maximum(a0, a1),
-                    t0, t1)
+    enclosure = enclose(design, piece_ranges(design, t0, t1), np.minimum(a0, a1),
+                        np.maximum(a0, a1), t0, t1)
+    for value in vars(enclosure).values():
+        if isinstance(value, np.ndarray):
+            value.setflags(write=False)
+    _ENCLOSED[key] = (samples, enclosure)
+    while len(_ENCLOSED) > KEPT_ENCLOSURES:
+        _ENCLOSED.popitem(last=False)
+    return enclosure
+
+
+#: The enclosures :func:`enclose_tube` keeps (the latest last), each with the samples it
+#: was computed for: a design's sampled check, the check with the balls after the per-axis
+#: argument and its input proof's widths ask for the same one.
+_ENCLOSED: OrderedDict = OrderedDict()
+#: How many enclosures a process keeps.
+KEPT_ENCLOSURES = 8
 
 
 
