@@ -249,7 +249,7 @@ def verdict_limit(spec: Spec, breaks: Callable[[np.ndarray], bool]
     ----------
     spec : Spec
     breaks : callable
-        ``(bound of |u_i(t_k)|, shape (n,)) -> bool``, the variant's test of the bound.
+        ``(bound of |u_i(t_k)|, a list of n floats) -> bool``, the variant's test of the bound.
 
     Returns
     -------

@@ -92,17 +92,18 @@ def look_ahead_design_proof(design: Design, spec: Spec) -> InputProof:
         :func:`look_ahead_input_proof` of law (13)'s proof at the point; within
         :func:`~.failures.without_advice` (a search asking the verdict only), stopped at
         the first sample where ``|u|`` passes ``min(v_max, omega_max l)`` (partial: it
-        meets no bound; a proof that meets it is whole, the per-axis argument's where its
-        bounds keep the bound, else the balls').
+        meets no bound), the per-axis argument's verdict (the balls' only where that
+        argument fails the check itself: :func:`~.certificate.actuator.prove_input_bound`'s
+        ``verdict_per_axis``).
     """
     offset = spec.drive.axle_offset
     bound = spec.input_bound
     # |v| <= |u| and |omega| <= |u| / l: |u| at the point against min(v_max, omega_max l)
     speed = math.inf if bound is None else min(bound[0], bound[1] * offset)
-    # a verdict asks the per-axis argument first: with g turned by the held command, the
+    # a verdict is the per-axis argument's: with g turned by the held command, the
     # Lyapunov balls measured no tighter than the box on every base tried (half the cost)
     return look_ahead_input_proof(prove_input_bound(design.tube, spec, limit=verdict_limit(
-        spec, lambda u: math.hypot(*u) > speed), verdict_per_axis_first=True), offset)
+        spec, lambda u: math.hypot(*u) > speed), verdict_per_axis=True), offset)
 
 
 def look_ahead_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> Design:

@@ -19,12 +19,13 @@ from dataclasses import replace
 import numpy as np
 
 from .enclosures import enclose_tube
-from ..input_bound import InputProof, input_peak, phi
+from ..input_bound import InputProof, input_peak
 from ..samples import TubeSamples
 from ...spec.loader import Spec
 from ...tube import reference
 from ...tube.parameters import GAMMA_D_MIN, TubeDesign
 from .sampled import SampledCheck, cached_check, sampled_check_of
+from .sampled_axis import phi_scalar
 
 __all__ = ["LIMIT_SLACK", "prove_input_bound", "sampled_error_bound"]
 
@@ -73,7 +74,7 @@ def certified_widths(tube: TubeDesign, samples: TubeSamples) -> np.ndarray:
 
 def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = False,
                       limit: Callable[[np.ndarray], bool] | None = None,
-                      verdict_per_axis_first: bool = False) -> InputProof:
+                      verdict_per_axis: bool = False) -> InputProof:
     """The proved peak of each input of law (13) along ``tube`` for the spec's plants.
 
     Parameters
@@ -90,7 +91,7 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
         bounds no tighter than the Lyapunov balls') instead of the whole check with the
         balls everywhere (the default; the peaks of ``[actuator]`` are proved from it).
     limit : callable, optional
-        ``(bound of |u_i(t_k)|, shape (n,)) -> bool``, true where the bound at a sample
+        ``(bound of |u_i(t_k)|, a list of n floats) -> bool``, true where the bound at a sample
         already breaks what the caller accepts (a verdict that needs no whole peak;
         monotone: a larger bound breaks it too), asked a relative :data:`LIMIT_SLACK`
         below the bound: the check stops at the first such sample, and the proof is
@@ -100,16 +101,18 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
         already kept (:func:`~.sampled.cached_check`), the whole proof from it
         (:func:`~.sampled.sampled_check_of`'s ``stop_for``); a proof that meets the
         caller's bound is the same with or without ``limit``, except as
-        ``verdict_per_axis_first`` says. Ignored with ``[controller] compensate_delay``.
-    verdict_per_axis_first : bool
-        With ``limit`` (and no whole check kept), ask the per-axis argument first (the
+        ``verdict_per_axis`` says. Ignored with ``[controller] compensate_delay``.
+    verdict_per_axis : bool
+        With ``limit`` (and no whole check kept), the per-axis argument's verdict (the
         check of ``per_axis_first``, about half the cost of the balls everywhere, its
         bounds of ``|e|`` no tighter): where it keeps the limit at every sample, its whole
-        proof is returned (peaks at least the balls', within the limit); where it stops,
-        the check with the balls everywhere runs with the same stop. The verdict is the
-        whole check's either way; the proof of a tube that keeps the limit may be the
-        per-axis one. The variant's proof role chooses it (the differential drive's,
-        where the two proofs measured the same).
+        proof (peaks at least the balls', within the limit); where its bounds break the
+        limit, its proof (stopped there: partial), without asking the balls; only where
+        the per-axis argument fails the check itself does the check with the balls run,
+        with the same stop. A tube it accepts the balls accept; one it refuses they might
+        accept (a slower tube is then designed, never an unproved one). The variant's
+        proof role chooses it (the differential drive's, where the two proofs measured
+        the same, bit for bit).
 
     Returns
     -------
@@ -132,30 +135,29 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
             kept.append((width, 4.0 * tube.gain / np.maximum(width, GAMMA_D_MIN)))
         return kept[0]
 
-    def breaks(per_phi: np.ndarray, abs_e) -> bool:
-        # a shade below the bound input_peak computes from the same numbers (numpy's atanh
-        # may differ by an ulp between one sample and the whole array): a sample breaks the
-        # limit only where the whole proof's bound does
-        return bool(limit(per_phi * phi(np.asarray(abs_e)) * (1.0 - LIMIT_SLACK)))
+    def breaks(per_phi: list[float], abs_e: list[float]) -> bool:
+        # a shade below the bound input_peak computes from the same numbers (libm's atanh
+        # here, numpy's there, may differ by an ulp): a sample breaks the limit only where
+        # the whole proof's bound does
+        return bool(limit([p * phi_scalar(s) * (1.0 - LIMIT_SLACK)
+                           for p, s in zip(per_phi, abs_e)]))
 
     def stop_for(samples: TubeSamples):
-        per_phi = widths(samples)[1]
+        per_phi = widths(samples)[1].tolist()
         return lambda k, abs_e: breaks(per_phi[k], abs_e)
 
     # the check is computed once per (tube, spec, per_axis_first) in a process:
     # sampled_check_of samples with the oracle's exp/log/tanh as numpy's ufuncs
     result = None
-    if (limit is not None and verdict_per_axis_first and not per_axis_first
+    if (limit is not None and verdict_per_axis and not per_axis_first
             and not spec.compensate_delay and cached_check(tube, spec, False) is None):
-        # the per-axis argument first (about half the cost): the balls only tighten its
-        # bounds, so where it keeps the limit at every sample the whole check does too;
-        # else the check with the balls, stopped at the limit
+        # the per-axis argument's verdict (about half the cost): the balls only tighten
+        # its bounds, so where it keeps the limit at every sample the whole check does
+        # too; where it breaks the limit, the refusal is its own; where it fails, the
+        # check with the balls, stopped at the limit
         samples, quick = sampled_check_of(tube, spec, True, stop_for)
-        if quick.passed and "stopped_at" not in quick.data:
-            per_phi = widths(samples)[1]
-            abs_e = sampled_error_bound(quick, samples)
-            if not any(breaks(per_phi[k], abs_e[k]) for k in range(len(abs_e))):
-                result = quick
+        if quick.passed or "stopped_at" in quick.data:
+            result = quick
     if result is None:
         samples, result = sampled_check_of(tube, spec, per_axis_first,
                                            None if limit is None else stop_for)
