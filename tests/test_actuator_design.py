@@ -123,12 +123,12 @@ def test_a_proof_stopped_at_a_limit_keeps_the_verdict():
     assert np.array_equal(stopped.abs_e, full.abs_e[:41])
 
 
-def test_a_bases_verdict_is_the_per_axis_arguments(monkeypatch):
-    """With a limit and no kept check, ``verdict_per_axis`` (the base's proof role) asks
-    the per-axis argument alone: where its bounds keep the limit its whole proof is the
-    answer (here the same as the balls'); where they break it, its proof stopped there;
-    no check with the balls runs in either case. Law (13)'s proof (S1) goes to the balls
-    at once."""
+def test_a_bases_proof_is_the_per_axis_arguments(monkeypatch):
+    """A base's proof (``point_proof``: ``per_axis_first``) asks the per-axis argument
+    alone where it passes, with a limit or without: where its bounds keep the limit its
+    whole proof is the answer (here the same as the balls'); where they break it, its
+    proof stopped there; no check with the balls runs in either case. Law (13)'s proof
+    (S1) goes to the balls at once."""
     from stt_codegen.design import look_ahead
     from stt_codegen.design.actuator import law13_input_proof
     from stt_codegen.design.certificate import sampled
@@ -139,7 +139,7 @@ def test_a_bases_verdict_is_the_per_axis_arguments(monkeypatch):
     sampled._KEPT.clear()
     balls = prove_input_bound(tube, spec)
     axis = prove_input_bound(tube, spec, per_axis_first=True)
-    assert np.all(np.array(axis.peak) >= np.array(balls.peak))
+    assert axis == balls                                   # the same, bit for bit
     above, below = np.array(axis.peak) * 1.01, np.array(balls.peak) * 0.5
     asked = []
     check = sampled.check_sampled
@@ -150,12 +150,12 @@ def test_a_bases_verdict_is_the_per_axis_arguments(monkeypatch):
 
     monkeypatch.setattr(sampled, "check_sampled", recorded)
     sampled._KEPT.clear()
-    assert prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > above)),
-                             verdict_per_axis=True) == axis
+    assert look_ahead.point_proof(tube, spec) == axis
     sampled._KEPT.clear()
-    part = prove_input_bound(tube, spec, limit=lambda u: bool(np.any(u > below)),
-                             verdict_per_axis=True)
-    assert asked == [False, False]                              # no check with the balls
+    assert look_ahead.point_proof(tube, spec, lambda u: bool(np.any(u > above))) == axis
+    sampled._KEPT.clear()
+    part = look_ahead.point_proof(tube, spec, lambda u: bool(np.any(u > below)))
+    assert asked == [False, False, False]                       # no check with the balls
     assert not part.complete and np.any(np.array(part.peak) > below)
     assert np.all(np.array(part.peak) <= np.array(axis.peak))
     monkeypatch.undo()

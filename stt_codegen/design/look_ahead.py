@@ -4,8 +4,9 @@ The look-ahead variant sends the base ``v = h . u`` and ``omega = (h_perp . u) /
 (13)'s ``u`` at the look-ahead point (``h`` the heading's unit vector, ``l`` the axle
 offset; docs/differential-drive.md), so ``|v| <= |u|`` and ``|omega| <= |u| / l`` with
 ``|u| <= sqrt(peak_1^2 + peak_2^2)`` at every sample, whatever the heading, from the
-per-input peaks the first-order prover (:func:`~.certificate.actuator.prove_input_bound`) proves for
-the point's plant class. The input is held between samples, so the bound holds at every
+per-input peaks the first-order prover proves for the point's plant class
+(:func:`point_proof`: :func:`~.certificate.actuator.prove_input_bound` by the per-axis
+argument). The input is held between samples, so the bound holds at every
 ``t``. :func:`look_ahead_input_proof` is that conversion; :func:`look_ahead_within_bound`
 the design of a differential-drive spec with ``[actuator]``: the first order's procedure
 (:func:`~.actuator.design_within_bound`: the default design, softer circumvents, via
@@ -30,9 +31,10 @@ from .failures import FailureKind, advice_wanted, without_advice
 from .grid import grid_index, grid_value, smallest_passing
 from .input_bound import InputProof
 from .result import Design
+from ..tube.parameters import TubeDesign
 
 __all__ = ["MAX_OFFSET_FACTOR", "look_ahead_design_proof", "look_ahead_input_proof",
-           "look_ahead_within_bound", "shortest_axle_offset"]
+           "look_ahead_within_bound", "point_proof", "shortest_axle_offset"]
 
 #: The ``plant.axle_offset`` search tries up to this many times the spec's offset.
 MAX_OFFSET_FACTOR = 8.0
@@ -76,6 +78,33 @@ def look_ahead_input_proof(proof: InputProof, axle_offset: float) -> InputProof:
     return replace(proof, peak=(speed, speed / axle_offset), time=(when, when))
 
 
+def point_proof(tube: TubeDesign, spec: Spec,
+                limit: Callable[[list[float]], bool] | None = None) -> InputProof:
+    """Law (13)'s proved peak of ``|u|`` at the base's look-ahead point along ``tube``: the
+    per-axis argument's (the Lyapunov balls only where it fails the sampled check itself).
+
+    With ``g`` turned by the held command the balls measured no tighter than the per-axis
+    boxes on every base tried, bit for bit, at about a quarter of the cost
+    (docs/sampled-data.md, "A base's proof is the per-axis argument's"), so a base's
+    design, its refusals and its output bound read this proof; ``verify`` proves the peaks
+    again with the balls everywhere (no larger).
+
+    Parameters
+    ----------
+    tube : TubeDesign
+    spec : Spec
+        A differential-drive spec (its plant class).
+    limit : callable, optional
+        :func:`~.certificate.actuator.prove_input_bound`'s ``limit`` (a verdict only).
+
+    Returns
+    -------
+    InputProof
+        Of ``u`` at the point (map it with :func:`look_ahead_input_proof`).
+    """
+    return prove_input_bound(tube, spec, per_axis_first=True, limit=limit)
+
+
 def look_ahead_design_proof(design: Design, spec: Spec) -> InputProof:
     """The base's proved peaks ``(|v|, |omega|)`` along ``design`` for ``spec``'s plants
     (the look-ahead variant's role ``input_proof``).
@@ -89,21 +118,17 @@ def look_ahead_design_proof(design: Design, spec: Spec) -> InputProof:
     Returns
     -------
     InputProof
-        :func:`look_ahead_input_proof` of law (13)'s proof at the point; within
+        :func:`look_ahead_input_proof` of :func:`point_proof`; within
         :func:`~.failures.without_advice` (a search asking the verdict only), stopped at
         the first sample where ``|u|`` passes ``min(v_max, omega_max l)`` (partial: it
-        meets no bound), the per-axis argument's verdict (the balls' only where that
-        argument fails the check itself: :func:`~.certificate.actuator.prove_input_bound`'s
-        ``verdict_per_axis``).
+        meets no bound).
     """
     offset = spec.drive.axle_offset
     bound = spec.input_bound
     # |v| <= |u| and |omega| <= |u| / l: |u| at the point against min(v_max, omega_max l)
     speed = math.inf if bound is None else min(bound[0], bound[1] * offset)
-    # a verdict is the per-axis argument's: with g turned by the held command, the
-    # Lyapunov balls measured no tighter than the box on every base tried (half the cost)
-    return look_ahead_input_proof(prove_input_bound(design.tube, spec, limit=verdict_limit(
-        spec, lambda u: math.hypot(*u) > speed), verdict_per_axis=True), offset)
+    return look_ahead_input_proof(point_proof(design.tube, spec, verdict_limit(
+        spec, lambda u: math.hypot(*u) > speed)), offset)
 
 
 def look_ahead_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> Design:
@@ -145,8 +170,7 @@ def _naming_axle_offset(spec: Spec, design_free: Callable[[Spec], Design],
     if (error.kind is not FailureKind.INPUT_BOUND or error.tried is None
             or not advice_wanted()):
         return error
-    proof = look_ahead_input_proof(prove_input_bound(error.tried, spec),
-                                   spec.drive.axle_offset)
+    proof = look_ahead_input_proof(point_proof(error.tried, spec), spec.drive.axle_offset)
     v_max, omega_max = spec.input_bound
     if not proof.proved or proof.peak[0] > v_max or proof.peak[1] <= omega_max:
         return error

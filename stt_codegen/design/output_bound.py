@@ -26,9 +26,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..tube.parameters import E_MAX, GAMMA_D_MIN
-from .certificate.actuator import prove_input_bound
 from .input_bound import InputProof
-from .look_ahead import look_ahead_input_proof
+from .look_ahead import look_ahead_input_proof, point_proof
 
 if TYPE_CHECKING:
     from ..tube.second_stage import SecondStage
@@ -162,5 +161,5 @@ def look_ahead_output_limits(design: Design) -> OutputLimits:
         ``proved`` not proved when the sampled-data check fails.
     """
     offset = design.spec.drive.axle_offset
-    proved = look_ahead_input_proof(prove_input_bound(design.tube, design.spec), offset)
+    proved = look_ahead_input_proof(point_proof(design.tube, design.spec), offset)
     return OutputLimits(proved, base_clamp(design.tube.gain, offset))

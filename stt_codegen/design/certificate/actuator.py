@@ -24,7 +24,7 @@ from ..samples import TubeSamples
 from ...spec.loader import Spec
 from ...tube import reference
 from ...tube.parameters import GAMMA_D_MIN, TubeDesign
-from .sampled import SampledCheck, cached_check, sampled_check_of
+from .sampled import SampledCheck, sampled_check_of
 from .sampled_axis import phi_scalar
 
 __all__ = ["LIMIT_SLACK", "prove_input_bound", "sampled_error_bound"]
@@ -73,8 +73,7 @@ def certified_widths(tube: TubeDesign, samples: TubeSamples) -> np.ndarray:
 
 
 def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = False,
-                      limit: Callable[[np.ndarray], bool] | None = None,
-                      verdict_per_axis: bool = False) -> InputProof:
+                      limit: Callable[[list[float]], bool] | None = None) -> InputProof:
     """The proved peak of each input of law (13) along ``tube`` for the spec's plants.
 
     Parameters
@@ -100,19 +99,9 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
         it, so a proof that meets the caller's bound is whole; where the whole check is
         already kept (:func:`~.sampled.cached_check`), the whole proof from it
         (:func:`~.sampled.sampled_check_of`'s ``stop_for``); a proof that meets the
-        caller's bound is the same with or without ``limit``, except as
-        ``verdict_per_axis`` says. Ignored with ``[controller] compensate_delay``.
-    verdict_per_axis : bool
-        With ``limit`` (and no whole check kept), the per-axis argument's verdict (the
-        check of ``per_axis_first``, about half the cost of the balls everywhere, its
-        bounds of ``|e|`` no tighter): where it keeps the limit at every sample, its whole
-        proof (peaks at least the balls', within the limit); where its bounds break the
-        limit, its proof (stopped there: partial), without asking the balls; only where
-        the per-axis argument fails the check itself does the check with the balls run,
-        with the same stop. A tube it accepts the balls accept; one it refuses they might
-        accept (a slower tube is then designed, never an unproved one). The variant's
-        proof role chooses it (the differential drive's, where the two proofs measured
-        the same, bit for bit).
+        caller's bound is the same with or without ``limit``. With ``per_axis_first``,
+        the per-axis argument stops there (the balls run only where it fails the check
+        itself). Ignored with ``[controller] compensate_delay``.
 
     Returns
     -------
@@ -148,19 +137,8 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
 
     # the check is computed once per (tube, spec, per_axis_first) in a process:
     # sampled_check_of samples with the oracle's exp/log/tanh as numpy's ufuncs
-    result = None
-    if (limit is not None and verdict_per_axis and not per_axis_first
-            and not spec.compensate_delay and cached_check(tube, spec, False) is None):
-        # the per-axis argument's verdict (about half the cost): the balls only tighten
-        # its bounds, so where it keeps the limit at every sample the whole check does
-        # too; where it breaks the limit, the refusal is its own; where it fails, the
-        # check with the balls, stopped at the limit
-        samples, quick = sampled_check_of(tube, spec, True, stop_for)
-        if quick.passed or "stopped_at" in quick.data:
-            result = quick
-    if result is None:
-        samples, result = sampled_check_of(tube, spec, per_axis_first,
-                                           None if limit is None else stop_for)
+    samples, result = sampled_check_of(tube, spec, per_axis_first,
+                                       None if limit is None else stop_for)
     horizon = float(samples.t[-1])
     width = widths(samples)[0]
     if "stopped_at" in result.data:

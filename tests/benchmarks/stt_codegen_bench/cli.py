@@ -1,5 +1,5 @@
 """``stt-codegen bench arenas | tasks | drive | agv | step | scaling | covering | alpha | second-order |
-stl | overhead | delay | fleet | sensed``: the benchmarks and studies of :mod:`stt_codegen_bench`."""
+stl | sampled | overhead | delay | fleet | sensed``: the benchmarks and studies of :mod:`stt_codegen_bench`."""
 
 from __future__ import annotations
 
@@ -180,6 +180,16 @@ def _cmd_overhead(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_sampled(args: argparse.Namespace) -> int:
+    from .sampled_bench import DEFAULT_SPECS, format_sampled_report, run_sampled_bench
+    specs = (tuple(s.strip() for s in args.specs.split(",") if s.strip()) if args.specs
+             else DEFAULT_SPECS)
+    report = run_sampled_bench(specs, runs=args.runs)
+    print(json.dumps(report, indent=1, sort_keys=True) if args.json
+          else format_sampled_report(report))
+    return 0
+
+
 def _cmd_delay(args: argparse.Namespace) -> int:
     from .delay_bench import format_delay_report, run_delay_bench
     report = run_delay_bench()
@@ -217,8 +227,8 @@ def _cmd_sensed(args: argparse.Namespace) -> int:
 
 def configure_bench(bench: argparse.ArgumentParser) -> None:
     """Sub-subcommands ``bench arenas``, ``tasks``, ``drive``, ``agv``, ``step``, ``scaling``,
-    ``covering``, ``alpha``, ``second-order``, ``stl``, ``overhead``, ``delay``, ``fleet`` and
-    ``sensed``.
+    ``covering``, ``alpha``, ``second-order``, ``stl``, ``sampled``, ``overhead``, ``delay``,
+    ``fleet`` and ``sensed``.
 
     Parameters
     ----------
@@ -344,6 +354,16 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                                      "plain and with the delay-compensating prediction")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_delay)
+
+    p = sub.add_parser("sampled", help="law (13)'s per-axis sampled check: the folded step "
+                                       "beside the Python loop it is tested against")
+    p.add_argument("--specs", default=None, metavar="LIST",
+                   help="comma-separated bundled cases or spec files (default: "
+                        "omnirobot-s3, crossing-moving, omnirobot-s1, office-base)")
+    p.add_argument("--runs", type=_positive_int, default=3, metavar="N",
+                   help="runs of each, the least CPU kept (default: %(default)s)")
+    add_json_argument(p)
+    p.set_defaults(handler=_cmd_sampled)
 
     p = sub.add_parser("overhead", help="CPU of a command beside the library call it makes "
                                         "(stt-codegen design SPEC against design_tube)")
