@@ -253,6 +253,16 @@ def space_time_path(grid: SpaceTimeGrid, taken: Reservations, start: tuple[int, 
     heap = [(float(h[start]), 0, start[0], start[1])]
     expansions = 0
     nx, ny = grid.free.shape
+    # the cell (i, j) of step q is cells[q][i * ny + j] (Python lists: an element is read
+    # in a fraction of numpy's indexing, which this loop does a few times per move)
+    cells = [row.ravel().tolist() for row in busy]
+    free = grid.free.ravel().tolist()
+    steps_to = h.ravel().tolist()
+
+    def taken(cell: int, k0: int, k1: int) -> bool:
+        """The cell is taken at a step of ``k0 .. k1`` (up to the horizon)."""
+        return any(cells[q][cell] for q in range(k0, min(k1, horizon) + 1))
+
     while heap and expansions < max_expansions:
         _, k, i, j = heapq.heappop(heap)
         if seen[k, i, j]:
@@ -266,25 +276,27 @@ def space_time_path(grid: SpaceTimeGrid, taken: Reservations, start: tuple[int, 
             return list(reversed(path))
         if k >= min(last_step, horizon):
             continue
-        if not busy[k + 1, i, j] and not seen[k + 1, i, j]:
+        here = i * ny + j
+        if not cells[k + 1][here] and not seen[k + 1, i, j]:
             parent[(i, j, k + 1)] = (i, j, k)
-            heapq.heappush(heap, (k + 1 + float(h[i, j]), k + 1, i, j))
+            heapq.heappush(heap, (k + 1 + steps_to[here], k + 1, i, j))
         for di, dj, cost in _MOVES:
             a, b, kk = i + di, j + dj, k + cost
-            if not (0 <= a < nx and 0 <= b < ny) or kk > last_step or not grid.free[a, b]:
+            there = a * ny + b
+            if not (0 <= a < nx and 0 <= b < ny) or kk > last_step or not free[there]:
                 continue
-            if cost == 2 and not (grid.free[i + di, j] and grid.free[i, j + dj]):
+            if cost == 2 and not (free[here + di * ny] and free[here + dj]):
                 continue
             key = (a, b, kk)
             if seen[kk, a, b] or key in parent:
                 continue
-            if busy[k:kk + 1, i, j].any() or busy[k:kk + 1, a, b].any():
+            if taken(here, k, kk) or taken(there, k, kk):
                 continue
             # nor a diagonal past a taken cell's corner (as past an obstacle's, above)
-            if cost == 2 and (busy[k:kk + 1, i + di, j].any() or busy[k:kk + 1, i, j + dj].any()):
+            if cost == 2 and (taken(here + di * ny, k, kk) or taken(here + dj, k, kk)):
                 continue
             parent[key] = (i, j, k)
-            heapq.heappush(heap, (kk + float(h[a, b]), kk, a, b))
+            heapq.heappush(heap, (kk + steps_to[there], kk, a, b))
     return None
 
 

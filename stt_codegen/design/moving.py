@@ -224,18 +224,26 @@ def _still_boxes(obstacles: tuple[MovingObstacle, ...]) -> tuple[list, list]:
     return still, moving
 
 
-def _move_clear(seg: ReachSegment, spec: Spec) -> bool:
-    """The reach box of ``seg`` (monotone profile) misses every moving obstacle on
-    ``[start, end]``, checked on :data:`MOVE_CHECKS` sub-intervals."""
-    cuts = np.linspace(seg.start, seg.end, MOVE_CHECKS + 1)
-    with reference.numpy_math():
-        p, _ = reference.segment_progress(seg, cuts)
-    a_lo, a_hi = np.array(seg.lower_from), np.array(seg.upper_from)
-    b_lo, b_hi = np.array(seg.lower_to), np.array(seg.upper_to)
-    p0, p1 = p[:-1, None], p[1:, None]
-    lo = np.minimum(a_lo + (b_lo - a_lo) * p0, a_lo + (b_lo - a_lo) * p1)
-    hi = np.maximum(a_hi + (b_hi - a_hi) * p0, a_hi + (b_hi - a_hi) * p1)
-    return bool(_clear(lo, hi, spec, cuts[:-1], cuts[1:]).all())
+def _moves_clear(segs: Sequence[ReachSegment], spec: Spec) -> list[bool]:
+    """Per segment of ``segs``: its reach box (monotone profile) misses every moving
+    obstacle on ``[start, end]``, checked on :data:`MOVE_CHECKS` sub-intervals (the
+    segments' boxes judged in one :func:`_clear`, row by row as one at a time)."""
+    if not segs:
+        return []
+    rows = []
+    for seg in segs:
+        cuts = np.linspace(seg.start, seg.end, MOVE_CHECKS + 1)
+        with reference.numpy_math():
+            p, _ = reference.segment_progress(seg, cuts)
+        a_lo, a_hi = np.array(seg.lower_from), np.array(seg.upper_from)
+        b_lo, b_hi = np.array(seg.lower_to), np.array(seg.upper_to)
+        p0, p1 = p[:-1, None], p[1:, None]
+        rows.append((np.minimum(a_lo + (b_lo - a_lo) * p0, a_lo + (b_lo - a_lo) * p1),
+                     np.maximum(a_hi + (b_hi - a_hi) * p0, a_hi + (b_hi - a_hi) * p1),
+                     cuts[:-1], cuts[1:]))
+    lo, hi, t_a, t_b = (np.concatenate(part) for part in zip(*rows))
+    ok = _clear(lo, hi, spec, t_a, t_b).reshape(len(segs), MOVE_CHECKS)
+    return ok.all(axis=1).tolist()
 
 
 def task_holds(segments: Sequence[ReachSegment], spec: Spec,
@@ -381,6 +389,7 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
                     reach((k + 1, j), (k, i), replace(segments[k], start=i * tau, end=j * tau))
             continue
         planned = segments[k].end - segments[k].start
+        moves = []                      # (factor's steps, target state, segment)
         for f in factors:
             d = max(1, int(math.ceil(f * planned / tau - 1e-9)))
             to = (k + 1, i + d)
@@ -389,7 +398,13 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
             seg = replace(segments[k], start=i * tau, end=(i + d) * tau)
             if to[0] == m:
                 seg = replace(seg, end=min(seg.end, t_c))
-            if _move_clear(seg, spec):
+            moves.append((d, to, seg))
+        # every move's clearance at once (reach only lowers costs: a move skipped above is
+        # skipped below too, and one judged here and skipped below costs only its check)
+        for (d, to, seg), clear in zip(moves, _moves_clear([s for _, _, s in moves], spec)):
+            if to in cost and cost[to] <= c:
+                continue
+            if clear:
                 reach(to, (k, i), seg, max(0.0, planned / (d * tau) - 1.0) if speed_up else 0.0)
     if goal is None:
         return None
