@@ -3,8 +3,8 @@ machine (stt_codegen/design/certificate/sampled_fold.py) against the Python loop
 ``check_sampled`` (``folded=False``, its oracle): the same verdicts, reasons, margins,
 times, dimensions, bounds of ``|e|`` and report figures, float for float, on bundled
 tubes with random plant classes (a differential drive's turning gains among them), gains,
-rates and stops; the formulas written for symbols against their float originals
-(docs/sampled-data.md, "How the check is evaluated")."""
+rates, delays, jitters and stops; the formulas written for symbols against their float
+originals (docs/sampled-data.md, "How the check is evaluated")."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ from stt_codegen.design.certificate.lyapunov import others_box, others_max
 from stt_codegen.design.certificate.operations import SYMBOLS, exact_symbols
 from stt_codegen.design.certificate.plant_class import plant_class
 from stt_codegen.design.certificate.sampled import check_sampled
-from stt_codegen.design.certificate.sampled_axis import turned_gains
+from stt_codegen.design.certificate.sampled_axis import held_speed, turned_gains
 from stt_codegen.design.failures import without_advice
 from stt_codegen.design.samples import sample_tube
 from stt_codegen.spec.assumptions import Assumptions
@@ -89,9 +89,15 @@ def test_fold_equals_loop_on_random_classes(name: str) -> None:
             plants = own if j == 0 else _random_class(rng, own.assumptions, turn)
             stop_at = int(rng.integers(1, len(samples.t))) if j % 3 == 2 else None
             stop = None if stop_at is None else (lambda k, e, at=stop_at: k >= at)
+            dt = 1.0 / rate
+            timing = [{}, {"delay": float(rng.uniform(0.0, 0.6)) * dt},
+                      {"jitter": float(rng.uniform(0.0, 0.2)) * dt},
+                      {"delay": float(rng.uniform(0.0, 0.4)) * dt,
+                       "jitter": float(rng.uniform(0.0, 0.2)) * dt}][j % 4]
             loop = check_sampled(design, samples, plants, lyapunov=False, stop=stop,
-                                 folded=False)
-            fold = check_sampled(design, samples, plants, lyapunov=False, stop=stop)
+                                 folded=False, **timing)
+            fold = check_sampled(design, samples, plants, lyapunov=False, stop=stop,
+                                 **timing)
             _same(loop, fold)
             verdicts.add("stopped" if "stopped_at" in loop.data else
                          "passed" if loop.passed else loop.reason.split(" ")[0])
@@ -99,15 +105,15 @@ def test_fold_equals_loop_on_random_classes(name: str) -> None:
     assert "passed" in verdicts and len(verdicts) >= 2, verdicts
 
 
-def test_the_fold_is_not_used_with_balls_or_a_delay() -> None:
-    """With the Lyapunov balls (a coupled block) or a delay the loop runs: the same
-    result with ``folded`` either way."""
+def test_with_the_balls_the_loop_runs() -> None:
+    """With the Lyapunov balls (a coupled block, no delay) the loop runs: the same result
+    with ``folded`` either way; with a delay the balls are not used and the fold runs."""
     spec, tube = _case("omnirobot-s1")
     plants = plant_class(spec)
     dt = 1.0 / tube.rate_hz
     with reference.numpy_math():
         samples = sample_tube(tube)
-        for kwargs in ({}, {"lyapunov": False, "delay": 0.3 * dt}):
+        for kwargs in ({}, {"delay": 0.3 * dt}, {"jitter": 0.1 * dt}):
             _same(check_sampled(tube, samples, plants, folded=False, **kwargs),
                   check_sampled(tube, samples, plants, **kwargs))
 
@@ -124,6 +130,8 @@ def test_new_symbolic_formulas_equal_their_floats() -> None:
     rng = np.random.default_rng(3)
     turned = _symbolic(lambda *a: turned_gains(*a, ops=SYMBOLS), 5)
     box = _symbolic(lambda a, b, h, k: others_box([a, b], [h, k], SYMBOLS), 4)
+    held = _symbolic(lambda r0, r1, s0, s1, *g: held_speed(0, (0, 1), [r0, r1], [s0, s1], *g,
+                                                           ops=SYMBOLS), 9)
     for _ in range(300):
         angle = float(rng.choice([rng.uniform(0.0, 0.3), rng.uniform(1.0, 3.0)]))
         gains = [angle, *rng.uniform(0.2, 2.0, 4).tolist()]
@@ -132,3 +140,6 @@ def test_new_symbolic_formulas_equal_their_floats() -> None:
         expected = others_max(limits, math.inf, halves)
         assert others_box(limits, halves) == expected
         assert float(box(limits + halves)) == expected
+        args = [*rng.uniform(0.0, 0.9, 2).tolist(), *rng.uniform(0.0, 50.0, 2).tolist(),
+                *rng.uniform(0.1, 2.0, 5).tolist()]
+        assert float(held(args)) == held_speed(0, (0, 1), args[:2], args[2:4], *args[4:])

@@ -220,10 +220,9 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
         input bound's verdict, stops at the first sample that breaks it). The bounds up to
         ``k`` are those of the whole check.
     folded : bool
-        Where no ball takes part and there is no delay or jitter, run the per-sample step
-        folded into CasADi's virtual machine (:mod:`.sampled_fold`; the default: the same
-        result, float for float, in a fraction of the time); ``False`` runs the Python
-        loop, the fold's oracle.
+        Where no ball takes part, run the per-sample step folded into CasADi's virtual
+        machine (:mod:`.sampled_fold`; the default: the same result, float for float, in a
+        fraction of the time); ``False`` runs the Python loop, the fold's oracle.
 
     Returns
     -------
@@ -287,15 +286,20 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     up_e_a = (upper_min - centre[:count]) / half[:count]
     low_e_a = (lower_max - centre[:count]) / half[:count]
     e0 = ((np.array(design.initial_state) - centre[0]) / half[0]).tolist()
-    if folded and not balls and not timed:
-        # the per-axis argument without delay: the folded loop (the same doubles)
+    if folded and not balls:
+        # the per-axis argument: the folded loop (the same doubles)
+        peaks_a = {share: (np.zeros_like(ratio) if turn is not None else
+                           peak(ratio / share) if share > 0.0 else
+                           np.full_like(ratio, 1.0 - 1e-15)) for share in shares}
         figures = {"centre": centre[:count], "half": half[:count], "pull": pull[:count],
-                   "peak": np.zeros_like(ratio) if turn is not None else peak(ratio / 1.0),
-                   "up_e": up_e_a, "low_e": low_e_a, "centre_next": centre[1:count + 1],
-                   "half_next": half[1:count + 1], "g_min": g_min_a, "g_max": bounds.g_max,
-                   "skew": bounds.skew, "coupling": bounds.coupling, "push": bounds.push}
+                   "peak": peaks_a, "up_e": up_e_a, "low_e": low_e_a,
+                   "centre_next": centre[1:count + 1], "half_next": half[1:count + 1],
+                   "g_min": g_min_a, **{name: worst_near(getattr(bounds, name), jitter,
+                                                         np.maximum)
+                                        for name in ("g_max", "skew", "coupling", "push")}}
         found = check_folded(n, tuple(tuple(b) for b in blocks), turn, e0, samples.t[:count],
-                             dt, k_gain, figures, stop)
+                             dt, k_gain, figures, stop, delay, jitter,
+                             tuple(corners) if timed else None)
         if found[0] == "fail":
             return fail(*found[1:])
         if found[0] == "stopped":

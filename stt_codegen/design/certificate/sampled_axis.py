@@ -340,7 +340,7 @@ def axis_interval(a: float, b: float, c0: float, h0: float, pull: float, g_min: 
 
 def held_speed(i: int, block: tuple[int, ...], reach_prev: list[float] | None,
                speed_prev: list[float], gain: float, spread: float, skew: float,
-               coupling: float, push: float) -> float:
+               coupling: float, push: float, ops=FLOATS) -> float:
     """``M_i``: a bound of axis ``i``'s speed under the previous command ``u_{k-1}``, state
     units per second (docs/sampled-data.md, eq. (T1)).
 
@@ -366,6 +366,8 @@ def held_speed(i: int, block: tuple[int, ...], reach_prev: list[float] | None,
         of ``g``.
     push : float
         ``|f + w|`` bound, state units per second.
+    ops : optional
+        :data:`~.operations.FLOATS` (default) or :data:`~.operations.SYMBOLS`.
 
     Returns
     -------
@@ -374,10 +376,10 @@ def held_speed(i: int, block: tuple[int, ...], reach_prev: list[float] | None,
     """
     if reach_prev is None:
         return push
-    own = speed_prev[i] * phi_scalar(reach_prev[i])
-    others = math.sqrt(sum((speed_prev[j] * phi_scalar(reach_prev[j])) ** 2
-                           for j in block if j != i))
-    return gain * own + min(coupling, spread / math.sqrt(2.0) + skew) * others + push
+    own = speed_prev[i] * phi_scalar(reach_prev[i], ops)
+    others = ops.sqrt(sum((speed_prev[j] * phi_scalar(reach_prev[j], ops)) ** 2
+                          for j in block if j != i))
+    return gain * own + ops.fmin(coupling, spread / math.sqrt(2.0) + skew) * others + push
 
 
 def turned_gains(angle: float, g_min: float, g_max: float, skew: float, coupling: float,

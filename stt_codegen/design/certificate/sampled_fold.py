@@ -1,11 +1,13 @@
 """Law (13)'s per-axis sampled check, its per-sample step folded into a compiled loop.
 
 :func:`~.sampled.check_sampled` propagates an enclosure of ``e(t_k)`` from sample to
-sample. Where no Lyapunov ball takes part (every block of ``g`` a single axis, or
-``lyapunov=False``: the per-axis argument) and the loop has no computation delay or
-jitter, one step is a box of ``e`` per axis in and out: :func:`axis_step` writes it once on
-CasADi ``SX`` symbols with the formulas the loop calls (:func:`~.sampled_axis.axis_interval`,
-:func:`~.lyapunov.others_box`, :func:`~.sampled_axis.turned_gains`,
+sample. Where no Lyapunov ball takes part (every block of ``g`` a single axis,
+``lyapunov=False``: the per-axis argument, or a computation delay or jitter, with which
+the balls are not used) one step is a box of ``e`` per axis in and out (with a delay or
+jitter also the bound of ``|e|`` at the sample before and a base's last speeds):
+:func:`axis_step` writes it once on CasADi ``SX`` symbols with the formulas the loop calls
+(:func:`~.sampled_axis.axis_interval`, :func:`~.lyapunov.others_box`,
+:func:`~.sampled_axis.turned_gains`, :func:`~.sampled_axis.held_speed`,
 :func:`~.sampled_axis.peak_scalar`; the same IEEE operations in the same order) and
 :func:`check_folded` runs it over the samples (:func:`~.folded.run_steps`) and judges its
 figures in the loop's order, so its verdict, margins, bounds and words are the loop's
@@ -35,37 +37,58 @@ from ...tube.parameters import E_MAX
 from .folded import StepLayout, run_steps, split
 from .lyapunov import others_box
 from .operations import SYMBOLS, exact_symbols
-from .sampled_axis import axis_interval, peak_scalar, phi_scalar, turn_failure, turned_gains
+from .sampled_axis import (axis_interval, held_speed, peak_scalar, phi_scalar, turn_failure,
+                           turned_gains)
 
 __all__ = ["AXIS_COLUMNS", "AXIS_FIGURES", "AXIS_PARAMETERS", "axis_step", "check_folded"]
 
-#: The tube's figures of one step, ``n`` rows each (``peak``: ``s*`` of the sample, unused
-#: by a turning base's step), then the class's bounds on the interval, one row each.
-AXIS_COLUMNS = ("centre", "half", "pull", "peak", "up_e", "low_e", "centre_next",
-                "half_next", "g_min", "g_max", "skew", "coupling", "push")
-#: The constants: the period, the factor ``2 dt k`` of the other inputs' pull, and a
-#: turning base's ``|omega| <= turn_per |u| + turn_const`` and the span it turns over.
-AXIS_PARAMETERS = ("dt", "pull_others", "turn_per", "turn_const", "span")
+#: The tube's figures of one step, ``n`` rows each (``peak``: ``s*`` of the sample per
+#: share of a period the own command acts, unused by a turning base's step; ``pull_prev``:
+#: the previous sample's pull), then the class's bounds on the interval and ``first`` (1 at
+#: the first sample: no command acts before it), one row each.
+AXIS_COLUMNS = ("centre", "half", "pull", "pull_prev", "peak", "up_e", "low_e",
+                "centre_next", "half_next", "g_min", "g_max", "skew", "coupling", "push",
+                "first")
+#: The constants: the period, the factor ``2 dt k`` of the other inputs' pull, a turning
+#: base's ``|omega| <= turn_per |u| + turn_const`` and the span it turns over, the delay,
+#: ``k``, the shares of a period the own command acts (sorted), and per corner of the
+#: interval's length and lag its share and lag.
+AXIS_PARAMETERS = ("dt", "pull_others", "turn_per", "turn_const", "span", "delay", "gain",
+                   "shares", "share", "lag")
 #: What a step returns per axis: the bound of ``|e_i(t_k)|``, the room to the tube's edge
 #: on the interval (half-widths), and (the same on every axis) the least input gain over
 #: the turn and the bound of ``|omega|`` (a base's; ``g_min`` and 0 otherwise).
 AXIS_FIGURES = ("reach", "room", "gain", "rate")
-_SCALARS = ("g_min", "g_max", "skew", "coupling", "push")
+_SCALARS = ("g_min", "g_max", "skew", "coupling", "push", "first")
 
 
-def _layouts(n: int) -> tuple[StepLayout, StepLayout]:
-    return (StepLayout((name, 1 if name in _SCALARS else n) for name in AXIS_COLUMNS),
-            StepLayout((name, 1) for name in AXIS_PARAMETERS))
+def _layouts(n: int, shares: int, corners: int) -> tuple[StepLayout, StepLayout]:
+    sizes = {"peak": shares * n, **{name: 1 for name in _SCALARS}}
+    counts = {"shares": shares, "share": corners, "lag": corners}
+    return (StepLayout((name, sizes.get(name, n)) for name in AXIS_COLUMNS),
+            StepLayout((name, counts.get(name, 1)) for name in AXIS_PARAMETERS))
 
 
-@lru_cache(maxsize=16)
-def axis_step(n: int, blocks: tuple[tuple[int, ...], ...], turn: bool
+def _structure(corners: tuple[tuple[float, float], ...]) -> tuple[tuple[bool, ...],
+                                                                  tuple[int, ...]]:
+    """What a step's operations depend on in the corners: per share of a period (sorted)
+    whether it is positive, and per corner the index of its share (the values are
+    constants of the step)."""
+    shares = sorted({share for share, _ in corners})
+    return (tuple(share > 0.0 for share in shares),
+            tuple(shares.index(share) for share, _ in corners))
+
+
+def axis_step(n: int, blocks: tuple[tuple[int, ...], ...], turn: bool,
+              corners: tuple[tuple[float, float], ...] | None = None
               ) -> tuple[casadi.Function, StepLayout, StepLayout]:
     """One step of the per-axis check as a CasADi function ``(state, column, constants) ->
     (next state, figures)``.
 
-    ``state`` is the box of ``e(t_k)``: its lower ends, then its upper ends (``2 n`` rows);
-    ``figures`` are :data:`AXIS_FIGURES` (``4 n`` rows).
+    ``state`` is the box of ``e(t_k)`` (its lower ends, then its upper ends), then the bound
+    of ``|e(t_{k-1})|`` and of the two speeds a base's commands asked before (``5 n``
+    rows; the last ``3 n`` serve a delay or jitter); ``figures`` are :data:`AXIS_FIGURES`
+    (``4 n`` rows).
 
     Parameters
     ----------
@@ -75,6 +98,9 @@ def axis_step(n: int, blocks: tuple[tuple[int, ...], ...], turn: bool
         The blocks of ``g`` (``Assumptions.coupled_blocks``).
     turn : bool
         A differential drive's gains, turned by the held command (``input_gain_turn``).
+    corners : tuple of (float, float), optional
+        With a delay or jitter, the corners ``(share, lag)`` of the interval's length and
+        lag, as :func:`~.sampled.check_sampled` sorts them; ``None`` without.
 
     Returns
     -------
@@ -83,56 +109,95 @@ def axis_step(n: int, blocks: tuple[tuple[int, ...], ...], turn: bool
         The rows of ``column`` (:data:`AXIS_COLUMNS`) and ``constants``
         (:data:`AXIS_PARAMETERS`).
     """
+    return _step(n, blocks, turn, None if corners is None else _structure(corners))
+
+
+@lru_cache(maxsize=16)
+def _step(n: int, blocks: tuple[tuple[int, ...], ...], turn: bool,
+          structure: tuple[tuple[bool, ...], tuple[int, ...]] | None
+          ) -> tuple[casadi.Function, StepLayout, StepLayout]:
+    """:func:`axis_step` for the corners' :func:`_structure` (``None``: no delay)."""
     ops, fmin, fmax = SYMBOLS, SYMBOLS.fmin, SYMBOLS.fmax
     block_of = {i: b for b in blocks for i in b}
-    columns, constants = _layouts(n)
+    timed = structure is not None
+    positive, share_of = structure if timed else ((True,), (0,))
+    columns, constants = _layouts(n, len(positive), len(share_of))
     with exact_symbols():
-        state = casadi.SX.sym("state", 2 * n)
+        state = casadi.SX.sym("state", 5 * n)
         col = casadi.SX.sym("column", columns.size)
         par = casadi.SX.sym("constants", constants.size)
         c = {name: split(col, columns, name) for name in AXIS_COLUMNS}
-        dt, pull_others, turn_per, turn_const, span = (split(par, constants, name)[0]
-                                                       for name in AXIS_PARAMETERS)
-        g_lo, g_hi, sk, cp, push = (c[name][0] for name in _SCALARS)
-        lo = [state[i] for i in range(n)]
-        hi = [state[n + i] for i in range(n)]
+        p = {name: split(par, constants, name) for name in AXIS_PARAMETERS}
+        dt, pull_others, turn_per, turn_const, span, delay, gain = (
+            p[name][0] for name in AXIS_PARAMETERS[:7])
+        g_lo, g_hi, sk, cp, push, first = (c[name][0] for name in _SCALARS)
+        lo, hi, reach_prev, speed_1, speed_2 = ([state[j * n + i] for i in range(n)]
+                                                for j in range(5))
         reach = [fmax(-lo[i], hi[i]) for i in range(n)]
         limits = [ops.atanh(v) for v in reach]
         h_k, pull = c["half"], c["pull"]
-        peak_k = c["peak"]
-        rate = casadi.SX(0.0)
+        peak_k = [c["peak"][j * n:(j + 1) * n] for j in range(len(positive))]
+        rate = speed = casadi.SX(0.0)
         if turn:
             # as the loop: the speed the command may ask, the turn it causes, the gains
             speed = ops.sqrt(sum((pull[i] / dt * phi_scalar(reach[i], ops)) ** 2
                                  for i in range(n)))
-            rate = turn_per * speed + turn_const
+            fastest = fmax(fmax(speed_2[0], speed_1[0]), speed) if timed else speed
+            rate = turn_per * fastest + turn_const
             g_lo, g_hi, sk, cp = turned_gains(span * rate, g_lo, g_hi, sk, cp, ops)
-            peak_k = [peak_scalar(h_k[i] / (pull[i] * g_lo) / 1.0, ops) for i in range(n)]
+            ratio = [h_k[i] / (pull[i] * g_lo) for i in range(n)]
+            peak_k = [[peak_scalar(r / p["shares"][j], ops) if positive[j] else 1.0 - 1e-15
+                       for r in ratio] for j in range(len(positive))]
         after_lo, after_hi, rooms = [], [], []
         for i in range(n):
             others = [j for j in block_of[i] if j != i]
             z_sq = (others_box([limits[j] for j in others], [h_k[j] for j in others], ops)
                     if others else 0.0)
-            p_lo, p_hi, x_lo, x_hi = axis_interval(
-                lo[i], hi[i], c["centre"][i], h_k[i], pull[i], g_lo, g_hi, peak_k[i],
-                dt * push, pull_others * ops.sqrt(z_sq), cp, sk, ops=ops)
-            path_lo = (p_lo - c["centre"][i]) / h_k[i]
-            path_hi = (p_hi - c["centre"][i]) / h_k[i]
+            centre = c["centre"][i]
+            if not timed:
+                p_lo, p_hi, x_lo, x_hi = axis_interval(
+                    lo[i], hi[i], centre, h_k[i], pull[i], g_lo, g_hi, peak_k[0][i],
+                    dt * push, pull_others * ops.sqrt(z_sq), cp, sk, ops=ops)
+            else:
+                # the previous command for `lag`, then this one for `share` periods
+                held = held_speed(i, block_of[i], reach_prev,
+                                  [q / dt for q in c["pull_prev"]], g_hi, g_hi - g_lo, sk,
+                                  cp, push, ops)
+                held = ops.select(first > 0.5, push, held)
+                p_lo = x_lo = math.inf
+                p_hi = x_hi = -math.inf
+                for j, which in enumerate(share_of):
+                    a_lo, a_hi, b_lo, b_hi = axis_interval(
+                        lo[i], hi[i], centre, h_k[i], p["share"][j] * pull[i], g_lo, g_hi,
+                        peak_k[which][i], p["share"][j] * dt * push + p["lag"][j] * held,
+                        p["share"][j] * dt * 2.0 * gain * ops.sqrt(z_sq), cp, sk, ops=ops)
+                    p_lo, p_hi = fmin(p_lo, a_lo), fmax(p_hi, a_hi)
+                    x_lo, x_hi = fmin(x_lo, b_lo), fmax(x_hi, b_hi)
+                # while the previous command acts, x moves from x(s_k) by at most this
+                old = delay * held
+                p_lo = fmin(p_lo, centre + lo[i] * h_k[i] - old)
+                p_hi = fmax(p_hi, centre + hi[i] * h_k[i] + old)
+            path_lo = (p_lo - centre) / h_k[i]
+            path_hi = (p_hi - centre) / h_k[i]
             rooms.append(fmin(c["up_e"][i] - path_hi, path_lo - c["low_e"][i]))
             after_lo.append((x_lo - c["centre_next"][i]) / c["half_next"][i])
             after_hi.append((x_hi - c["centre_next"][i]) / c["half_next"][i])
+        following = casadi.vertcat(*after_lo, *after_hi, *reach, *([speed] * n),
+                                   *([speed_1[0]] * n))
         shown = casadi.vertcat(*reach, *rooms, *([g_lo] * n), *([rate] * n))
         step = casadi.Function("axis_sampled_step", [state, col, par],
-                               casadi.cse([casadi.vertcat(*after_lo, *after_hi), shown]))
+                               casadi.cse([following, shown]))
     return step, columns, constants
 
 
 def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float, float] | None,
                  e0: list[float], times: np.ndarray, dt: float, gain: float,
                  figures: dict[str, np.ndarray],
-                 stop: Callable[[int, list[float]], bool] | None):
+                 stop: Callable[[int, list[float]], bool] | None,
+                 delay: float = 0.0, jitter: float = 0.0,
+                 corners: tuple[tuple[float, float], ...] | None = None):
     """The per-axis check over the samples: :func:`~.sampled.check_sampled`'s loop without
-    balls, delay or jitter, folded.
+    balls, folded.
 
     Parameters
     ----------
@@ -151,9 +216,15 @@ def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float,
     gain : float
         ``k`` of law (13).
     figures : dict of str to ndarray
-        The columns of :data:`AXIS_COLUMNS`, ``(K, n)`` (the class's bounds ``(K,)``).
+        The columns of :data:`AXIS_COLUMNS` but ``pull_prev`` and ``first``, ``(K, n)``
+        (the class's bounds ``(K,)``, with a jitter the worst of the neighbouring
+        intervals; ``peak``: a dict of ``(K, n)`` per share of a period).
     stop : callable or None
         :func:`~.sampled.check_sampled`'s ``stop``.
+    delay, jitter : float
+        The computation delay and the jitter, s.
+    corners : tuple of (float, float), optional
+        With either, the corners ``(share, lag)`` (:func:`axis_step`).
 
     Returns
     -------
@@ -162,13 +233,23 @@ def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float,
         t_stop, abs_e)``, or ``("passed", level, margin, t, i, abs_e)``, as the loop
         returns them.
     """
-    step, columns, constants = axis_step(n, blocks, turn is not None)
+    step, columns, constants = axis_step(n, blocks, turn is not None, corners)
     count = len(times)
+    shares = sorted({share for share, _ in corners}) if corners else [1.0]
     values = {"dt": dt, "pull_others": dt * 2.0 * gain,
               "turn_per": turn[0] if turn else 0.0, "turn_const": turn[1] if turn else 0.0,
-              "span": (dt + 2.0 * 0.0) + 0.0}
-    table = columns.pack({name: np.asarray(figures[name], dtype=float).T
-                          for name in AXIS_COLUMNS}, count)
+              "span": (dt + 2.0 * jitter) + (delay if corners else 0.0), "delay": delay,
+              "gain": gain, "shares": shares,
+              "share": [share for share, _ in corners] if corners else [1.0],
+              "lag": [lag for _, lag in corners] if corners else [0.0]}
+    pull = np.asarray(figures["pull"], dtype=float)
+    rows = {name: np.asarray(figures[name], dtype=float).T for name in AXIS_COLUMNS
+            if name not in ("peak", "pull_prev", "first")}
+    rows["pull_prev"] = np.vstack([pull[:1], pull[:-1]]).T
+    rows["peak"] = np.vstack([np.asarray(figures["peak"][share], dtype=float).T
+                              for share in shares])
+    rows["first"] = (np.arange(count) == 0).astype(float)
+    table = columns.pack(rows, count)
     judged = {"done": 0, "stop": None, "fail": None}
 
     def failed(chunk: np.ndarray) -> bool:
@@ -192,7 +273,8 @@ def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float,
             return True
         return False
 
-    start = np.concatenate([np.asarray(e0, dtype=float)] * 2)
+    start = np.concatenate([np.asarray(e0, dtype=float)] * 2
+                           + [np.zeros(n), np.full(2 * n, -math.inf)])
     shown, last = run_steps(step, start, lambda a, b: table[:, a:b], count,
                             constants.pack(values), failed, kinds=len(AXIS_FIGURES))
     reach, room = shown[0].T, shown[1].T
@@ -222,7 +304,7 @@ def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float,
                         f"[{t:.4f}, {t + dt:.4f}] s (the enclosure of x reaches "
                         f"{-float(room[k][i]):.3g} half-widths beyond its edge)",
                 float(room[k][i]), t, i, top)
-    final = np.maximum(-last[:n], last[n:])
+    final = np.maximum(-last[:n], last[n:2 * n])
     worst, worst_t, worst_i = worst_before(count)
     top = max(float(tops[-1]), float(final.max()))
     return ("passed", top, worst, worst_t, worst_i, np.vstack([reach, final[None, :]]))
