@@ -230,19 +230,21 @@ def _moves_clear(segs: Sequence[ReachSegment], spec: Spec) -> list[bool]:
     segments' boxes judged in one :func:`_clear`, row by row as one at a time)."""
     if not segs:
         return []
-    rows = []
-    for seg in segs:
-        cuts = np.linspace(seg.start, seg.end, MOVE_CHECKS + 1)
-        with reference.numpy_math():
-            p, _ = reference.segment_progress(seg, cuts)
-        a_lo, a_hi = np.array(seg.lower_from), np.array(seg.upper_from)
-        b_lo, b_hi = np.array(seg.lower_to), np.array(seg.upper_to)
-        p0, p1 = p[:-1, None], p[1:, None]
-        rows.append((np.minimum(a_lo + (b_lo - a_lo) * p0, a_lo + (b_lo - a_lo) * p1),
-                     np.maximum(a_hi + (b_hi - a_hi) * p0, a_hi + (b_hi - a_hi) * p1),
-                     cuts[:-1], cuts[1:]))
-    lo, hi, t_a, t_b = (np.concatenate(part) for part in zip(*rows))
-    ok = _clear(lo, hi, spec, t_a, t_b).reshape(len(segs), MOVE_CHECKS)
+    # np.linspace(start, end, MOVE_CHECKS + 1) of every segment, in its own operations
+    start = np.array([seg.start for seg in segs])
+    end = np.array([seg.end for seg in segs])
+    cuts = np.arange(MOVE_CHECKS + 1.0) * ((end - start) / MOVE_CHECKS)[:, None] + start[:, None]
+    cuts[:, -1] = end
+    with reference.numpy_math():
+        p = np.array([reference.segment_progress(seg, row)[0] for seg, row in zip(segs, cuts)])
+    a_lo, a_hi, b_lo, b_hi = (np.array([getattr(seg, name) for seg in segs])[:, None, :]
+                              for name in ("lower_from", "upper_from", "lower_to", "upper_to"))
+    p0, p1 = p[:, :-1, None], p[:, 1:, None]
+    lo = np.minimum(a_lo + (b_lo - a_lo) * p0, a_lo + (b_lo - a_lo) * p1)
+    hi = np.maximum(a_hi + (b_hi - a_hi) * p0, a_hi + (b_hi - a_hi) * p1)
+    n = lo.shape[2]
+    ok = _clear(lo.reshape(-1, n), hi.reshape(-1, n), spec, cuts[:, :-1].ravel(),
+                cuts[:, 1:].ravel()).reshape(len(segs), MOVE_CHECKS)
     return ok.all(axis=1).tolist()
 
 

@@ -184,7 +184,10 @@ def _cmd_sampled(args: argparse.Namespace) -> int:
     from .sampled_bench import DEFAULT_SPECS, format_sampled_report, run_sampled_bench
     specs = (tuple(s.strip() for s in args.specs.split(",") if s.strip()) if args.specs
              else DEFAULT_SPECS)
-    report = run_sampled_bench(specs, runs=args.runs)
+    if not 0.0 <= args.delay <= 1.0:
+        raise SpecError("--delay", f"must be a fraction of the period in [0, 1], got "
+                                   f"{args.delay:g}")
+    report = run_sampled_bench(specs, runs=args.runs, delay=args.delay)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_sampled_report(report))
     return 0
@@ -362,6 +365,8 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                         "omnirobot-s3, crossing-moving, omnirobot-s1, office-base)")
     p.add_argument("--runs", type=_positive_int, default=3, metavar="N",
                    help="runs of each, the least CPU kept (default: %(default)s)")
+    p.add_argument("--delay", type=float, default=0.0, metavar="FRACTION",
+                   help="a computation delay, as a fraction of the period (default: none)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_sampled)
 

@@ -38,7 +38,7 @@ def _same(a, b) -> bool:
             and (a.passed, a.reason, a.dimension) == (b.passed, b.reason, b.dimension))
 
 
-def run_sampled_bench(specs=DEFAULT_SPECS, runs: int = 3) -> dict:
+def run_sampled_bench(specs=DEFAULT_SPECS, runs: int = 3, delay: float = 0.0) -> dict:
     """Both ways of the per-axis check on each spec's tube.
 
     Parameters
@@ -47,6 +47,8 @@ def run_sampled_bench(specs=DEFAULT_SPECS, runs: int = 3) -> dict:
         Bundled case names or spec files.
     runs : int
         Runs of each, the least CPU kept.
+    delay : float
+        A computation delay, as a fraction of the period, in ``[0, 1]`` (0: none).
 
     Returns
     -------
@@ -69,27 +71,29 @@ def run_sampled_bench(specs=DEFAULT_SPECS, runs: int = 3) -> dict:
         plants = plant_class(spec)
         best = {False: math.inf, True: math.inf}
         found = {}
+        lag = delay / tube.rate_hz
         with reference.numpy_math():
             samples = sample_tube(tube)
-            check_sampled(tube, samples, plants, lyapunov=False)     # builds the functions
+            check_sampled(tube, samples, plants, lyapunov=False, delay=lag)  # builds
             for _ in range(runs):
                 for folded in (False, True):
                     start = time.process_time()
                     found[folded] = check_sampled(tube, samples, plants, lyapunov=False,
-                                                  folded=folded)
+                                                  folded=folded, delay=lag)
                     best[folded] = min(best[folded], time.process_time() - start)
         rows.append({"spec": Path(name).stem, "samples": int(len(samples.t)),
                      "turns": plants.assumptions.input_gain_turn is not None,
                      "passed": bool(found[True].passed), "loop_s": best[False],
                      "folded_s": best[True], "ratio": best[False] / best[True],
                      "same": _same(found[False], found[True])})
-    return {"runs": runs, "rows": rows}
+    return {"runs": runs, "delay": delay, "rows": rows}
 
 
 def format_sampled_report(report: dict) -> str:
     """The report as a table."""
-    lines = [f"law (13)'s per-axis sampled check, the loop beside the folded step (CPU, "
-             f"least of {report['runs']} runs each, in turn)",
+    delay = (f", a delay of {report['delay']:g} period" if report.get("delay") else "")
+    lines = [f"law (13)'s per-axis sampled check{delay}, the loop beside the folded step "
+             f"(CPU, least of {report['runs']} runs each, in turn)",
              f"{'spec':<18} {'samples':>8} {'base':>5} {'passed':>7} {'loop [s]':>9} "
              f"{'folded [s]':>11} {'ratio':>6} {'same':>5}"]
     for r in report["rows"]:
