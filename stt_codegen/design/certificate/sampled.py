@@ -40,8 +40,9 @@ from .lyapunov import level_after, next_level, others_max
 from .plant_class import PlantClass, plant_class
 from .predicted import check_predicted
 from .sampled_fold import check_folded
-from .sampled_axis import (axis_interval, held_speed, peak, peak_for_box, phi_scalar,
-                           phi_slope_scalar, turn_failure, turned_gains, unprovable)
+from .sampled_axis import (axis_interval, clamp_failure, held_speed, peak, peak_for_box,
+                           phi_scalar, phi_slope_scalar, room_failure, turn_failure,
+                           turned_gains, unprovable)
 
 __all__ = ["DELAY_HALVINGS", "KEPT_CHECKS", "RATE_FACTORS", "SampledCheck", "cached_check",
            "check_sampled", "check_sampled_first_per_axis", "delay_room", "largest_delay",
@@ -286,6 +287,8 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     up_e_a = (upper_min - centre[:count]) / half[:count]
     low_e_a = (lower_max - centre[:count]) / half[:count]
     e0 = ((np.array(design.initial_state) - centre[0]) / half[0]).tolist()
+    # the longest a command may act for (a base's turn over it)
+    span = (dt + 2.0 * jitter) + (delay if timed else 0.0)
     if folded and not balls:
         # the per-axis argument: the folded loop (the same doubles)
         peaks_a = {share: (np.zeros_like(ratio) if turn is not None else
@@ -298,7 +301,7 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
                                                          np.maximum)
                                         for name in ("g_max", "skew", "coupling", "push")}}
         found = check_folded(n, tuple(tuple(b) for b in blocks), turn, e0, samples.t[:count],
-                             dt, k_gain, figures, stop, delay, jitter,
+                             dt, k_gain, figures, stop, delay, span,
                              tuple(corners) if timed else None)
         if found[0] == "fail":
             return fail(*found[1:])
@@ -336,8 +339,7 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
         abs_e.append(reach_e)
         if max(reach_e) > E_MAX:
             i = int(np.argmax(reach_e))
-            return fail(f"|e_{i}| may reach {max(reach_e):.6g} at t = {t:.4f} s, beyond the "
-                        f"clamp E_MAX", -math.inf, t, i, top)
+            return fail(clamp_failure(i, max(reach_e), t), -math.inf, t, i, top)
         if stop is not None and stop(k, reach_e):
             data["stopped_at"] = t
             return SampledCheck(False, top, worst, t, int(np.argmax(reach_e)),
@@ -353,7 +355,6 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
             # g turns with the heading the held command turns the base by (eq. (R1))
             speeds.append(math.sqrt(sum((pull_l[k][i] / dt * phi_scalar(reach_e[i])) ** 2
                                         for i in range(n))))
-            span = (dt + 2.0 * jitter) + (delay if timed else 0.0)
             rate = turn[0] * max(speeds[-3:] if timed else speeds[-1:]) + turn[1]
             g_lo, g_hi, sk, cp = turned_gains(span * rate, g_lo, g_hi, sk, cp)
             if g_lo <= 0.0:
@@ -413,9 +414,7 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
             if room < worst:
                 worst, worst_t, worst_i = room, t, i
             if room <= 0.0:
-                return fail(f"a plant of the class may leave the tube in dimension {i} on "
-                            f"[{t:.4f}, {t + dt:.4f}] s (the enclosure of x reaches "
-                            f"{-room:.3g} half-widths beyond its edge)", room, t, i, top)
+                return fail(room_failure(i, t, dt, room), room, t, i, top)
         h_n, c_n = half_l[k + 1], centre_l[k + 1]
         # |atanh e_i(t_{k+1})| in this sample's coordinates, from the per-axis end ranges
         end_limits = [_atanh_reach((x_lo - centre_l[k][i]) / h_k[i],

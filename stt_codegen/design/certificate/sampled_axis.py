@@ -22,7 +22,7 @@ from .operations import FLOATS
 
 __all__ = ["phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "peak_scalar",
            "peak_for_box", "coupling_push", "axis_interval", "held_speed", "turned_gains",
-           "turn_failure", "unprovable"]
+           "turn_failure", "clamp_failure", "room_failure", "unprovable"]
 
 
 def phi(s: np.ndarray) -> np.ndarray:
@@ -424,6 +424,46 @@ def turn_failure(angle: float, rate: float, t: float) -> str:
     return (f"the heading may turn by {angle:.3g} rad in a sampling period at t = {t:.4f} s "
             f"(|omega| <= {rate:.3g} rad/s), which leaves no positive input gain for the "
             "command computed before it")
+
+
+def clamp_failure(i: int, reach: float, t: float) -> str:
+    """The reason a sampled check fails when the bound of ``|e_i(t_k)|`` passes ``E_MAX``.
+
+    Parameters
+    ----------
+    i : int
+        The axis.
+    reach : float
+        The bound of ``|e_i(t_k)|``.
+    t : float
+        ``t_k``, s.
+
+    Returns
+    -------
+    str
+    """
+    return f"|e_{i}| may reach {reach:.6g} at t = {t:.4f} s, beyond the clamp E_MAX"
+
+
+def room_failure(i: int, t: float, dt: float, room: float) -> str:
+    """The reason a sampled check fails when the enclosure of ``x`` reaches the tube's edge.
+
+    Parameters
+    ----------
+    i : int
+        The axis.
+    t, dt : float
+        The interval's start and length, s.
+    room : float
+        The room left, half-widths (not positive).
+
+    Returns
+    -------
+    str
+    """
+    return (f"a plant of the class may leave the tube in dimension {i} on "
+            f"[{t:.4f}, {t + dt:.4f}] s (the enclosure of x reaches {-room:.3g} half-widths "
+            "beyond its edge)")
 
 
 def unprovable(g_min: float, width_min: float) -> str | None:

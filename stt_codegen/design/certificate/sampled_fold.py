@@ -37,8 +37,8 @@ from ...tube.parameters import E_MAX
 from .folded import StepLayout, run_steps, split
 from .lyapunov import others_box
 from .operations import SYMBOLS, exact_symbols
-from .sampled_axis import (axis_interval, held_speed, peak_scalar, phi_scalar, turn_failure,
-                           turned_gains)
+from .sampled_axis import (axis_interval, clamp_failure, held_speed, peak_scalar, phi_scalar,
+                           room_failure, turn_failure, turned_gains)
 
 __all__ = ["AXIS_COLUMNS", "AXIS_FIGURES", "AXIS_PARAMETERS", "axis_step", "check_folded"]
 
@@ -194,7 +194,7 @@ def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float,
                  e0: list[float], times: np.ndarray, dt: float, gain: float,
                  figures: dict[str, np.ndarray],
                  stop: Callable[[int, list[float]], bool] | None,
-                 delay: float = 0.0, jitter: float = 0.0,
+                 delay: float = 0.0, span: float | None = None,
                  corners: tuple[tuple[float, float], ...] | None = None):
     """The per-axis check over the samples: :func:`~.sampled.check_sampled`'s loop without
     balls, folded.
@@ -221,8 +221,10 @@ def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float,
         intervals; ``peak``: a dict of ``(K, n)`` per share of a period).
     stop : callable or None
         :func:`~.sampled.check_sampled`'s ``stop``.
-    delay, jitter : float
-        The computation delay and the jitter, s.
+    delay : float
+        The computation delay, s.
+    span : float, optional
+        The longest a command acts, s (a base turns over it; default ``dt``).
     corners : tuple of (float, float), optional
         With either, the corners ``(share, lag)`` (:func:`axis_step`).
 
@@ -238,7 +240,7 @@ def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float,
     shares = sorted({share for share, _ in corners}) if corners else [1.0]
     values = {"dt": dt, "pull_others": dt * 2.0 * gain,
               "turn_per": turn[0] if turn else 0.0, "turn_const": turn[1] if turn else 0.0,
-              "span": (dt + 2.0 * jitter) + (delay if corners else 0.0), "delay": delay,
+              "span": dt if span is None else span, "delay": delay,
               "gain": gain, "shares": shares,
               "share": [share for share, _ in corners] if corners else [1.0],
               "lag": [lag for _, lag in corners] if corners else [0.0]}
@@ -294,16 +296,12 @@ def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float,
             return ("stopped", top, worst, t, int(np.argmax(reach[k])), t, reach[:k + 1])
         if reach[k].max() > E_MAX:
             i = int(np.argmax(reach[k]))
-            return ("fail", f"|e_{i}| may reach {reach[k].max():.6g} at t = {t:.4f} s, beyond "
-                            f"the clamp E_MAX", -math.inf, t, i, top)
+            return ("fail", clamp_failure(i, float(reach[k].max()), t), -math.inf, t, i, top)
         if turn is not None and shown[2][0][k] <= 0.0:
             rate = float(shown[3][0][k])
             return ("fail", turn_failure(values["span"] * rate, rate, t), -math.inf, t, 0, top)
         i = int(np.flatnonzero(room[k] <= 0.0)[0])
-        return ("fail", f"a plant of the class may leave the tube in dimension {i} on "
-                        f"[{t:.4f}, {t + dt:.4f}] s (the enclosure of x reaches "
-                        f"{-float(room[k][i]):.3g} half-widths beyond its edge)",
-                float(room[k][i]), t, i, top)
+        return ("fail", room_failure(i, t, dt, float(room[k][i])), float(room[k][i]), t, i, top)
     final = np.maximum(-last[:n], last[n:2 * n])
     worst, worst_t, worst_i = worst_before(count)
     top = max(float(tops[-1]), float(final.max()))
