@@ -29,7 +29,7 @@ import casadi
 import numpy as np
 
 from .cascade_bounds import step_velocity_change, virtual_velocity_change
-from .folded import StepLayout, split
+from .folded import StepLayout, StepSymbols
 from .operations import SYMBOLS, exact_symbols
 from .sampled_axis import axis_interval, peak_scalar, phi_scalar
 
@@ -127,11 +127,8 @@ def sampled_step(n: int, timed: bool, delayed: bool, shares: int, corners: int,
     ops, fmin, fmax = SYMBOLS, SYMBOLS.fmin, SYMBOLS.fmax
     columns, constants = _sampled_layouts(n, shares, corners, lengths)
     with exact_symbols():
-        state = casadi.SX.sym("state", 5 * n)
-        col = casadi.SX.sym("column", columns.size)
-        par = casadi.SX.sym("constants", constants.size)
-        c = {name: split(col, columns, name) for name in SAMPLED_COLUMNS}
-        p = {name: split(par, constants, name) for name in SAMPLED_PARAMETERS}
+        symbols = StepSymbols(5 * n, columns, constants)
+        state, c, p = symbols.state, symbols.c, symbols.p
         k1, k2, h, g_min, g_max, cpl, _, f1, w_amp, longest, delay = (
             p[name][0] for name in SAMPLED_PARAMETERS[:11])
         f0 = p["f0"]
@@ -225,8 +222,7 @@ def sampled_step(n: int, timed: bool, delayed: bool, shares: int, corners: int,
                                    *(u_abs if timed else u_prev))
         shown = casadi.vertcat(*(v for name in FIGURES for v in figures[name]))
         # one node per distinct operation on the same operands (the same doubles)
-        step = casadi.Function("cascade_sampled_step", [state, col, par],
-                               casadi.cse([following, shown]))
+        step = symbols.function("cascade_sampled_step", following, shown)
     return step, columns, constants
 
 
@@ -255,11 +251,8 @@ def predicted_step(n: int) -> tuple[casadi.Function, StepLayout, StepLayout]:
     ops, fmin, fmax = SYMBOLS, SYMBOLS.fmin, SYMBOLS.fmax
     columns, constants = _predicted_layouts(n)
     with exact_symbols():
-        state = casadi.SX.sym("state", 6 * n)
-        col = casadi.SX.sym("column", columns.size)
-        par = casadi.SX.sym("constants", constants.size)
-        c = {name: split(col, columns, name) for name in PREDICTED_COLUMNS}
-        p = {name: split(par, constants, name) for name in PREDICTED_PARAMETERS}
+        symbols = StepSymbols(6 * n, columns, constants)
+        state, c, p = symbols.state, symbols.c, symbols.p
         (k1, k2, h, g_min, g_max, cpl, _, f1, w_amp, delay, deviation, g_mid, share,
          mix_lo, mix_hi) = (p[name][0] for name in PREDICTED_PARAMETERS[:15])
         f0 = p["f0"]
@@ -334,6 +327,5 @@ def predicted_step(n: int) -> tuple[casadi.Function, StepLayout, StepLayout]:
                 figures[name].append(value)
         following = casadi.vertcat(*(v for block in after for v in block))
         shown = casadi.vertcat(*(v for name in FIGURES for v in figures[name]))
-        step = casadi.Function("cascade_predicted_step", [state, col, par],
-                               casadi.cse([following, shown]))
+        step = symbols.function("cascade_predicted_step", following, shown)
     return step, columns, constants

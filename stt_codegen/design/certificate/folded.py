@@ -21,7 +21,8 @@ import numpy as np
 
 from .operations import exact_symbols
 
-__all__ = ["FIRST_CHUNK", "LONGEST_CHUNK", "StepLayout", "UNROLLED", "run_steps", "split"]
+__all__ = ["FIRST_CHUNK", "LONGEST_CHUNK", "StepLayout", "StepSymbols", "UNROLLED", "run_steps",
+           "split"]
 
 #: Steps of the first chunk :func:`run_steps` evaluates; each next chunk is twice as long,
 #: up to :data:`LONGEST_CHUNK`.
@@ -63,6 +64,32 @@ class StepLayout:
 def split(symbol, layout: StepLayout, name: str) -> list:
     """The entries of ``symbol`` (a column or the constants) in ``name``'s rows."""
     return [symbol[j] for j in range(layout.rows(name).start, layout.rows(name).stop)]
+
+
+class StepSymbols:
+    """The inputs of a step, built within :func:`~.operations.exact_symbols`: ``state``
+    (``rows`` entries), ``column`` and ``constants`` (``SX``), and their entries by name,
+    ``c[name]`` of the column and ``p[name]`` of the constants (lists of ``SX``).
+
+    Parameters
+    ----------
+    rows : int
+        Rows of the state.
+    columns, constants : StepLayout
+    """
+
+    def __init__(self, rows: int, columns: StepLayout, constants: StepLayout) -> None:
+        self.state = casadi.SX.sym("state", rows)
+        self.column = casadi.SX.sym("column", columns.size)
+        self.constants = casadi.SX.sym("constants", constants.size)
+        self.c = {name: split(self.column, columns, name) for name in columns.blocks}
+        self.p = {name: split(self.constants, constants, name) for name in constants.blocks}
+
+    def function(self, name: str, following, shown) -> casadi.Function:
+        """The step ``(state, column, constants) -> (following, shown)``, one node per
+        distinct operation on the same operands (the same doubles)."""
+        return casadi.Function(name, [self.state, self.column, self.constants],
+                               casadi.cse([following, shown]))
 
 
 #: Steps written out one after the other in one function (:func:`_block`), which

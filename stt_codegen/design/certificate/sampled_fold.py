@@ -34,7 +34,7 @@ import casadi
 import numpy as np
 
 from ...tube.parameters import E_MAX
-from .folded import StepLayout, run_steps, split
+from .folded import StepLayout, StepSymbols, run_steps
 from .lyapunov import others_box
 from .operations import SYMBOLS, exact_symbols
 from .sampled_axis import (axis_interval, clamp_failure, held_speed, peak_scalar, phi_scalar,
@@ -123,11 +123,8 @@ def _step(n: int, blocks: tuple[tuple[int, ...], ...], turn: bool,
     positive, share_of = structure if timed else ((True,), (0,))
     columns, constants = _layouts(n, len(positive), len(share_of))
     with exact_symbols():
-        state = casadi.SX.sym("state", 5 * n)
-        col = casadi.SX.sym("column", columns.size)
-        par = casadi.SX.sym("constants", constants.size)
-        c = {name: split(col, columns, name) for name in AXIS_COLUMNS}
-        p = {name: split(par, constants, name) for name in AXIS_PARAMETERS}
+        symbols = StepSymbols(5 * n, columns, constants)
+        state, c, p = symbols.state, symbols.c, symbols.p
         dt, pull_others, turn_per, turn_const, span, delay, gain = (
             p[name][0] for name in AXIS_PARAMETERS[:7])
         g_lo, g_hi, sk, cp, push, first = (c[name][0] for name in _SCALARS)
@@ -185,8 +182,7 @@ def _step(n: int, blocks: tuple[tuple[int, ...], ...], turn: bool,
         following = casadi.vertcat(*after_lo, *after_hi, *reach, *([speed] * n),
                                    *([speed_1[0]] * n))
         shown = casadi.vertcat(*reach, *rooms, *([g_lo] * n), *([rate] * n))
-        step = casadi.Function("axis_sampled_step", [state, col, par],
-                               casadi.cse([following, shown]))
+        step = symbols.function("axis_sampled_step", following, shown)
     return step, columns, constants
 
 

@@ -19,6 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .report import table
+
 __all__ = ["DEFAULT_SPECS", "format_sampled_report", "run_sampled_bench"]
 
 #: Bundled cases: two diagonal omnidirectional robots, a coupled one (the per-axis
@@ -92,13 +94,10 @@ def run_sampled_bench(specs=DEFAULT_SPECS, runs: int = 3, delay: float = 0.0) ->
 def format_sampled_report(report: dict) -> str:
     """The report as a table."""
     delay = (f", a delay of {report['delay']:g} period" if report.get("delay") else "")
-    lines = [f"law (13)'s per-axis sampled check{delay}, the loop beside the folded step "
-             f"(CPU, least of {report['runs']} runs each, in turn)",
-             f"{'spec':<18} {'samples':>8} {'base':>5} {'passed':>7} {'loop [s]':>9} "
-             f"{'folded [s]':>11} {'ratio':>6} {'same':>5}"]
-    for r in report["rows"]:
-        lines.append(f"{r['spec']:<18} {r['samples']:>8} {'yes' if r['turns'] else 'no':>5} "
-                     f"{'yes' if r['passed'] else 'no':>7} {r['loop_s']:>9.3f} "
-                     f"{r['folded_s']:>11.3f} {r['ratio']:>6.1f} "
-                     f"{'yes' if r['same'] else 'NO':>5}")
-    return "\n".join(lines)
+    rows = [[r["spec"], str(r["samples"]), "yes" if r["turns"] else "no",
+             "yes" if r["passed"] else "no", f"{r['loop_s']:.3f}", f"{r['folded_s']:.3f}",
+             f"{r['ratio']:.1f}", "yes" if r["same"] else "NO"] for r in report["rows"]]
+    return "\n".join([f"law (13)'s per-axis sampled check{delay}, the loop beside the folded "
+                      f"step (CPU, least of {report['runs']} runs each, in turn)",
+                      table(["spec", "samples", "base", "passed", "loop [s]", "folded [s]",
+                             "ratio", "same"], rows)])
