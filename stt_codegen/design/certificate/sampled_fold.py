@@ -49,12 +49,11 @@ __all__ = ["AXIS_COLUMNS", "AXIS_FIGURES", "AXIS_PARAMETERS", "axis_step", "chec
 AXIS_COLUMNS = ("centre", "half", "pull", "pull_prev", "peak", "up_e", "low_e",
                 "centre_next", "half_next", "g_min", "g_max", "skew", "coupling", "push",
                 "first")
-#: The constants: the period, the factor ``2 dt k`` of the other inputs' pull, a turning
-#: base's ``|omega| <= turn_per |u| + turn_const`` and the span it turns over, the delay,
-#: ``k``, the shares of a period the own command acts (sorted), and per corner of the
-#: interval's length and lag its share and lag.
-AXIS_PARAMETERS = ("dt", "pull_others", "turn_per", "turn_const", "span", "delay", "gain",
-                   "shares", "share", "lag")
+#: The constants: the period, a turning base's ``|omega| <= turn_per |u| + turn_const`` and
+#: the span it turns over, the delay, ``k``, the shares of a period the own command acts
+#: (sorted), and per corner of the interval's length and lag its share and lag.
+AXIS_PARAMETERS = ("dt", "turn_per", "turn_const", "span", "delay", "gain", "shares", "share",
+                   "lag")
 #: What a step returns per axis: the bound of ``|e_i(t_k)|``, the room to the tube's edge
 #: on the interval (half-widths), and (the same on every axis) the least input gain over
 #: the turn and the bound of ``|omega|`` (a base's; ``g_min`` and 0 otherwise).
@@ -125,8 +124,8 @@ def _step(n: int, blocks: tuple[tuple[int, ...], ...], turn: bool,
     with exact_symbols():
         symbols = StepSymbols(5 * n, columns, constants)
         state, c, p = symbols.state, symbols.c, symbols.p
-        dt, pull_others, turn_per, turn_const, span, delay, gain = (
-            p[name][0] for name in AXIS_PARAMETERS[:7])
+        dt, turn_per, turn_const, span, delay, gain = (p[name][0]
+                                                        for name in AXIS_PARAMETERS[:6])
         g_lo, g_hi, sk, cp, push, first = (c[name][0] for name in _SCALARS)
         lo, hi, reach_prev, speed_1, speed_2 = ([state[j * n + i] for i in range(n)]
                                                 for j in range(5))
@@ -154,7 +153,7 @@ def _step(n: int, blocks: tuple[tuple[int, ...], ...], turn: bool,
             if not timed:
                 p_lo, p_hi, x_lo, x_hi = axis_interval(
                     lo[i], hi[i], centre, h_k[i], pull[i], g_lo, g_hi, peak_k[0][i],
-                    dt * push, pull_others * ops.sqrt(z_sq), cp, sk, ops=ops)
+                    dt * push, dt * 2.0 * gain * ops.sqrt(z_sq), cp, sk, ops=ops)
             else:
                 # the previous command for `lag`, then this one for `share` periods
                 held = held_speed(i, block_of[i], reach_prev,
@@ -234,7 +233,7 @@ def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float,
     step, columns, constants = axis_step(n, blocks, turn is not None, corners)
     count = len(times)
     shares = sorted({share for share, _ in corners}) if corners else [1.0]
-    values = {"dt": dt, "pull_others": dt * 2.0 * gain,
+    values = {"dt": dt,
               "turn_per": turn[0] if turn else 0.0, "turn_const": turn[1] if turn else 0.0,
               "span": dt if span is None else span, "delay": delay,
               "gain": gain, "shares": shares,
