@@ -248,26 +248,29 @@ def space_time_path(grid: SpaceTimeGrid, taken: Reservations, start: tuple[int, 
     h = grid.steps_to(goal)
     if not np.isfinite(h[start]):
         return None
-    seen = np.zeros(busy.shape, dtype=bool)
+    nx, ny = grid.free.shape
+    n = nx * ny
+    # Flat bytes, read a few times per move (an element of ``bytes`` is read in a fraction
+    # of numpy's indexing): the cell ``c`` of step ``q`` is ``q * n + c``; ``over[cost]``
+    # says whether the cell is taken at a step of ``k .. k + cost`` (up to the horizon).
+    ahead = np.concatenate([busy[1:], busy[-1:]])
+    over1 = busy | ahead
+    over = {1: over1[:-1].tobytes(),
+            2: (over1 | np.concatenate([ahead[1:], busy[-1:]]))[:-1].tobytes()}
+    seen = bytearray(busy.size)
     parent: dict[tuple[int, int, int], tuple[int, int, int]] = {}
     heap = [(float(h[start]), 0, start[0], start[1])]
     expansions = 0
-    nx, ny = grid.free.shape
-    # the cell (i, j) of step q is cells[q][i * ny + j] (Python lists: an element is read
-    # in a fraction of numpy's indexing, which this loop does a few times per move)
-    cells = [row.ravel().tolist() for row in busy]
+    cells = busy.tobytes()
     free = grid.free.ravel().tolist()
     steps_to = h.ravel().tolist()
 
-    def taken(cell: int, k0: int, k1: int) -> bool:
-        """The cell is taken at a step of ``k0 .. k1`` (up to the horizon)."""
-        return any(cells[q][cell] for q in range(k0, min(k1, horizon) + 1))
-
     while heap and expansions < max_expansions:
         _, k, i, j = heapq.heappop(heap)
-        if seen[k, i, j]:
+        here = i * ny + j
+        if seen[k * n + here]:
             continue
-        seen[k, i, j] = True
+        seen[k * n + here] = True
         expansions += 1
         if (i, j) == goal and clear_after[k]:
             path = [(i, j, k)]
@@ -276,8 +279,7 @@ def space_time_path(grid: SpaceTimeGrid, taken: Reservations, start: tuple[int, 
             return list(reversed(path))
         if k >= min(last_step, horizon):
             continue
-        here = i * ny + j
-        if not cells[k + 1][here] and not seen[k + 1, i, j]:
+        if not cells[(k + 1) * n + here] and not seen[(k + 1) * n + here]:
             parent[(i, j, k + 1)] = (i, j, k)
             heapq.heappush(heap, (k + 1 + steps_to[here], k + 1, i, j))
         for di, dj, cost in _MOVES:
@@ -288,12 +290,13 @@ def space_time_path(grid: SpaceTimeGrid, taken: Reservations, start: tuple[int, 
             if cost == 2 and not (free[here + di * ny] and free[here + dj]):
                 continue
             key = (a, b, kk)
-            if seen[kk, a, b] or key in parent:
+            if seen[kk * n + there] or key in parent:
                 continue
-            if taken(here, k, kk) or taken(there, k, kk):
+            span = over[cost]
+            if span[k * n + here] or span[k * n + there]:
                 continue
             # nor a diagonal past a taken cell's corner (as past an obstacle's, above)
-            if cost == 2 and (taken(here + di * ny, k, kk) or taken(here + dj, k, kk)):
+            if cost == 2 and (span[k * n + here + di * ny] or span[k * n + here + dj]):
                 continue
             parent[key] = (i, j, k)
             heapq.heappush(heap, (kk + steps_to[there], kk, a, b))
