@@ -16,6 +16,7 @@ import contextlib
 import contextvars
 import functools
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -26,7 +27,7 @@ __all__ = ["adaptive_law", "adaptive_tube", "alpha_step", "bump", "circumvent",
            "circumvent_from_bumps", "conflict_distance", "control", "controller_status",
            "controller_step", "error_transform", "exp", "implicit_alpha_root", "law", "law_status", "law_step",
            "log", "numpy_math", "open_bump_sum", "predicted_state", "reach_tube",
-           "segment_progress", "smooth_max",
+           "segment_progress", "segments_progress", "smooth_max",
            "smooth_max_pair", "trigger"]
 
 Array = np.ndarray
@@ -162,6 +163,35 @@ def segment_progress(segment: ReachSegment, t) -> tuple[Array, Array]:
         Dimensionless and 1/s.
     """
     return _progress(segment.profile, _time(t), segment.start, segment.end)
+
+
+def segments_progress(segments: Sequence[ReachSegment], t) -> Array:
+    """:func:`segment_progress`'s ``p`` of many segments, each at its own row of times,
+    one evaluation per profile (the same operations on every element as one segment at a
+    time).
+
+    Parameters
+    ----------
+    segments : sequence of ReachSegment, length S
+    t : array_like, shape (S, N)
+        Row ``k`` the times of segment ``k``, seconds.
+
+    Returns
+    -------
+    ndarray, shape (S, N)
+        Dimensionless.
+    """
+    t = np.asarray(t, dtype=float)
+    profiles = [seg.profile for seg in segments]
+    start = np.array([seg.start for seg in segments])[:, None]
+    end = np.array([seg.end for seg in segments])[:, None]
+    if len(set(profiles)) == 1:
+        return _progress(profiles[0], t, start, end, rate=False)[0]
+    p = np.empty(t.shape)
+    for profile in sorted(set(profiles)):
+        rows = [k for k, name in enumerate(profiles) if name == profile]
+        p[rows] = _progress(profile, t[rows], start[rows], end[rows], rate=False)[0]
+    return p
 
 
 def _progress(profile: str, t: Array, start, end, rate: bool = True) -> tuple[Array, Array]:
