@@ -191,10 +191,20 @@ class Propagation:
         self.m = psi_lo.shape[1]
         self.steps = steps.tolist()
         # per interval, per component: (psi_lo, psi_hi, theta_lo, theta_hi, a*_lo, a*_hi,
-        # decay_lo), converted to floats in one call (advance reads them one by one)
-        self.rows = np.stack([psi_lo, psi_hi, theta_lo, theta_hi, star_lo, star_hi, decay_lo],
-                             axis=-1).tolist()
+        # decay_lo); an interval's rows are converted to floats when it is first carried
+        # (advance reads them one by one; a re-propagation carries a few of the intervals)
+        self._table = np.stack([psi_lo, psi_hi, theta_lo, theta_hi, star_lo, star_hi,
+                                decay_lo], axis=-1)
+        self._rows: dict[int, list] = {}
         self.step_psi = step_psi
+
+    def row(self, k: int) -> list:
+        """Interval ``k``'s coefficients, per component ``(psi_lo, psi_hi, theta_lo,
+        theta_hi, a*_lo, a*_hi, decay_lo)``, as floats."""
+        row = self._rows.get(k)
+        if row is None:
+            row = self._rows[k] = self._table[k].tolist()
+        return row
 
     def advance(self, k: int, a_lo: list, a_hi: list) -> tuple[list, list]:
         """Carry the bounds ``a_lo``, ``a_hi`` of ``alpha`` at interval ``k``'s start to its end.
@@ -212,7 +222,7 @@ class Propagation:
             Range of ``alpha`` on the interval.
         """
         kappa, dt, c = self.kappa, self.dt, self.c
-        steps_k, row = self.steps[k], self.rows[k]
+        steps_k, row = self.steps[k], self.row(k)
         if steps_k <= EXACT_STEPS:
             return self._follow(k, int(steps_k), a_lo, a_hi)
         row_lo, row_hi = [0.0] * self.m, [0.0] * self.m
@@ -255,7 +265,7 @@ class Propagation:
         dt, c = self.dt, self.c
         own = None if self.step_psi is None else self.step_psi[k]
         row_lo, row_hi = [0.0] * self.m, [0.0] * self.m
-        for i, (pl, ph, tl, th, _, _, _) in enumerate(self.rows[k]):
+        for i, (pl, ph, tl, th, _, _, _) in enumerate(self.row(k)):
             lo_i, hi_i = a_lo[i], a_hi[i]
             low, high = lo_i, hi_i
             if own is None:          # the interval's range of psi
