@@ -236,7 +236,7 @@ def _moves_clear(segs: Sequence[ReachSegment], spec: Spec) -> list[bool]:
     cuts = np.arange(MOVE_CHECKS + 1.0) * ((end - start) / MOVE_CHECKS)[:, None] + start[:, None]
     cuts[:, -1] = end
     with reference.numpy_math():
-        p = np.array([reference.segment_progress(seg, row)[0] for seg, row in zip(segs, cuts)])
+        p = reference.segments_progress(segs, cuts)
     a_lo, a_hi, b_lo, b_hi = (np.array([getattr(seg, name) for seg in segs])[:, None, :]
                               for name in ("lower_from", "upper_from", "lower_to", "upper_to"))
     p0, p1 = p[:, :-1, None], p[:, 1:, None]
@@ -300,7 +300,8 @@ def _hold_ok(task: Task, start: float, end: float) -> bool:
 
 def retime(segments: tuple[ReachSegment, ...], spec: Spec,
            order: Sequence[int] | None = None,
-           factors: Sequence[float] = DURATION_FACTORS) -> tuple[ReachSegment, ...] | None:
+           factors: Sequence[float] = DURATION_FACTORS,
+           memo: dict | None = None) -> tuple[ReachSegment, ...] | None:
     """The via boxes of ``segments`` re-timed to miss the moving obstacles (module notes).
 
     The search settles (via box, step) states by their speed-up, then their step: without
@@ -328,6 +329,10 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
         The durations a segment may take, as multiples of its planned duration, in the
         order tried (default :data:`DURATION_FACTORS`; with ``[actuator]`` the design
         leaves out the fast ones the base cannot drive, :func:`speed_limits`).
+    memo : dict, optional
+        The moves judged so far, by (box, step, steps): a memo shared by the calls with the
+        same ``segments`` and ``spec`` (other ``factors``), which judge many of the same
+        moves; filled here.
 
     Returns
     -------
@@ -357,6 +362,7 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
     # settled by (summed speed-up, step, box): without [actuator] every speed-up is 0 and
     # the first parent found is kept, a breadth-first search in time (earliest arrival)
     speed_up = spec.input_bound is not None
+    memo = {} if memo is None else memo
     parent: dict[tuple[int, int], tuple[tuple[int, int] | None, ReachSegment | None]] = {
         (0, 0): (None, None)}
     cost = {(0, 0): 0.0}
@@ -403,10 +409,14 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
             moves.append((d, to, seg))
         # every move's clearance at once (reach only lowers costs: a move skipped above is
         # skipped below too, and one judged here and skipped below costs only its check)
-        for (d, to, seg), clear in zip(moves, _moves_clear([s for _, _, s in moves], spec)):
+        fresh = [((k, i, d), seg) for d, _, seg in moves if (k, i, d) not in memo]
+        if fresh:
+            memo.update(zip([key for key, _ in fresh], _moves_clear([seg for _, seg in fresh],
+                                                                    spec)))
+        for d, to, seg in moves:
             if to in cost and cost[to] <= c:
                 continue
-            if clear:
+            if memo[(k, i, d)]:
                 reach(to, (k, i), seg, max(0.0, planned / (d * tau) - 1.0) if speed_up else 0.0)
     if goal is None:
         return None
@@ -574,11 +584,13 @@ def retimed_design(via: Design | None, timing: Spec, spec: Spec,
                         for seg in planned)
     tried: set[tuple[ReachSegment, ...]] = set()
     none: list[set[float]] = []       # factor sets with no timing: none in a subset either
+    judged: dict = {}                 # the moves' clearances, the same for every factor set
     for factors in speed_limits(spec):
         if any(set(factors) <= fewer for fewer in none):
             continue
         segments = retime(planned, timing,
-                          via.task_plan.order if via.task_plan is not None else None, factors)
+                          via.task_plan.order if via.task_plan is not None else None, factors,
+                          judged)
         if segments is None:
             none.append(set(factors))
         if segments is None or segments in tried:     # the same timing: the same verdict
