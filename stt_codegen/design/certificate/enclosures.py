@@ -168,26 +168,39 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool 
     edges = sorted({s.start for s in design.segments} | {s.end for s in design.segments})
     peaks = [s.start + s.duration * (_W_STAR / (1.0 + _W_STAR) if s.profile == TANH else 0.5)
              for s in design.segments] if rates else []
-    points = [t0, t1] + [_clip(e, t0, t1) for e in edges]
-    value_points = len(points)
-    points += [_clip(p, t0, t1) for p in peaks]
-    rho_l, rho_u, rate_l, rate_u = reference.reach_tube(design, np.concatenate(points), rates)
-    shape = (len(points), t0.size, design.dimension)
-    rho_l, rho_u = rho_l.reshape(shape)[:value_points], rho_u.reshape(shape)[:value_points]
+    # each interval's ends, and every edge (and peak) strictly inside an interval, by
+    # interval: an edge outside clips to an end, whose values are among the ends' already
+    inner = np.array(edges + peaks)[:, None]
+    which, where = np.nonzero((t0 < inner) & (inner < t1))
+    edge = which < len(edges)
+    k = t0.size
+    rho_l, rho_u, rate_l, rate_u = reference.reach_tube(
+        design, np.concatenate([t0, t1, inner[which, 0]]), rates)
+    width = rho_u - rho_l
+    at, values = where[edge], 2 * k + np.flatnonzero(edge)
+
+    def value_range(v):
+        low, high = np.minimum(v[:k], v[k:2 * k]), np.maximum(v[:k], v[k:2 * k])
+        np.minimum.at(low, at, v[values])
+        np.maximum.at(high, at, v[values])
+        return low, high
+
+    lowest_width = value_range(width)[0]
     if not rates:
-        return ((rho_l.min(0), rho_l.max(0)), (rho_u.min(0), rho_u.max(0)), None,
-                (rho_u - rho_l).min(0))
-    rate_l, rate_u = rate_l.reshape(shape), rate_u.reshape(shape)
+        return value_range(rho_l), value_range(rho_u), None, lowest_width
     ends = np.zeros(t0.shape, dtype=bool)
     for seg in design.segments:
         ends |= (t0 < seg.end) & (seg.end <= t1)
     zero = np.where(ends[:, None], 0.0, np.nan)
 
     def span(rate):
-        return np.fmin(rate.min(0), zero), np.fmax(rate.max(0), zero)
+        low, high = np.minimum(rate[:k], rate[k:2 * k]), np.maximum(rate[:k], rate[k:2 * k])
+        np.minimum.at(low, where, rate[2 * k:])
+        np.maximum.at(high, where, rate[2 * k:])
+        return np.fmin(low, zero), np.fmax(high, zero)
 
-    return ((rho_l.min(0), rho_l.max(0)), (rho_u.min(0), rho_u.max(0)),
-            (span(rate_l), span(rate_u)), (rho_u - rho_l).min(0))
+    return (value_range(rho_l), value_range(rho_u), (span(rate_l), span(rate_u)),
+            lowest_width)
 
 
 # --------------------------------------------------------------------------- intervals
