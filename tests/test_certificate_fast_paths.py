@@ -22,6 +22,7 @@ from conftest import CASES, designed
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from stt_codegen.design.certificate import enclosures
 from stt_codegen.design.certificate import (EXACT_STEPS, alpha_fixed_point,
                                             alpha_ranges, circumvent_range, piece_ranges,
                                             step_psi, step_root)
@@ -233,6 +234,87 @@ def test_reach_tube_is_the_plain_segment_by_segment_one(profiles, fast_math):
     assert values[2] is None and values[3] is None
     for got, want in zip(fast_one, plain_one):
         assert got.tobytes() == want.tobytes()
+
+
+@pytest.mark.parametrize("fast_math", [False, True])
+def test_segments_progress_is_each_segment_on_its_own_row(fast_math):
+    """segments_progress (one evaluation per profile) gives each segment's segment_progress
+    on its own row to the bit: mixed profiles, times before, inside and after each segment."""
+    from stt_codegen_bench.arenas import arena_spec
+    spec = arena_spec("paper", 0, 11)
+    via = via_design(spec, base_design(spec))
+    rng = np.random.default_rng(3)
+    for profiles in (("tanh",), ("smoothstep", "cruise"), ("tanh", "smoothstep", "cruise")):
+        segments = [dataclasses.replace(seg, profile=profiles[k % len(profiles)])
+                    for k, seg in enumerate(via.segments)]
+        t = np.array([np.linspace(seg.start - 1.0, seg.end + 1.0, 13) for seg in segments])
+        t += rng.normal(0.0, 0.3, t.shape)
+        with reference.numpy_math() if fast_math else contextlib.nullcontext():
+            want = np.array([reference.segment_progress(seg, row)[0]
+                             for seg, row in zip(segments, t)])
+            got = reference.segments_progress(segments, t)
+        assert got.tobytes() == want.tobytes()
+        assert np.any(got == 0.0) and np.any(got == 1.0) and np.any((got > 0) & (got < 1))
+
+
+def _dense_reach_range(tube, t0, t1, rates):
+    """reach_range's ranges written densely: the tube at both ends of every interval and at
+    every segment edge (and, for the rates, peak) clipped into every interval."""
+    segments = tube.segments
+    edges = sorted({s.start for s in segments} | {s.end for s in segments})
+    w = enclosures._W_STAR
+    peaks = [s.start + s.duration * (w / (1.0 + w) if s.profile == "tanh" else 0.5)
+             for s in segments]
+    values = [t0, t1] + [np.minimum(np.maximum(e, t0), t1) for e in edges]
+    rates_at = values + [np.minimum(np.maximum(p, t0), t1) for p in peaks]
+    rho = [reference.reach_tube(tube, t) for t in values]
+    lower = np.array([r[0] for r in rho])
+    upper = np.array([r[1] for r in rho])
+    out = [(lower.min(0), lower.max(0)), (upper.min(0), upper.max(0))]
+    if rates:
+        at_ends = np.zeros(t0.shape, dtype=bool)
+        for seg in segments:
+            at_ends |= (t0 < seg.end) & (seg.end <= t1)
+        zero = np.where(at_ends[:, None], 0.0, np.nan)
+        r = [reference.reach_tube(tube, t) for t in rates_at]
+        spans = []
+        for j in (2, 3):
+            a = np.array([x[j] for x in r])
+            spans.append((np.fmin(a.min(0), zero), np.fmax(a.max(0), zero)))
+        out.append(tuple(spans))
+    else:
+        out.append(None)
+    out.append((upper - lower).min(0))
+    return out
+
+
+@pytest.mark.parametrize("rates", [True, False])
+def test_reach_range_is_the_dense_range_over_every_edge(rates):
+    """reach_range (each interval's ends and only the edges and peaks inside it) gives the
+    ranges of the tube at both ends and every edge and peak clipped into every interval, to
+    the bit: partitions whose points fall on edges, between them and outside the tube's
+    time."""
+    from stt_codegen_bench.arenas import arena_spec
+    spec = arena_spec("paper", 0, 11)
+    via = via_design(spec, base_design(spec))
+    rng = np.random.default_rng(5)
+    edges = [seg.start for seg in via.segments] + [via.segments[-1].end]
+    for profiles in (("tanh",), ("smoothstep", "cruise", "tanh")):
+        tube = dataclasses.replace(via, segments=tuple(
+            dataclasses.replace(seg, profile=profiles[k % len(profiles)])
+            for k, seg in enumerate(via.segments)))
+        for points in (np.sort(rng.uniform(-1.0, tube.prescribed_time + 2.0, 40)),
+                       np.array(edges), np.sort(np.concatenate([edges, rng.uniform(0, 5, 7)])),
+                       np.array([-1.0, tube.prescribed_time + 3.0]),
+                       np.linspace(0.1, tube.prescribed_time - 0.1, 4)):
+            t0, t1 = points[:-1], points[1:]
+            got = enclosures.reach_range(tube, t0, t1, rates)
+            want = _dense_reach_range(tube, t0, t1, rates)
+            flat = lambda x: [a for v in x for a in (flat(v) if isinstance(v, tuple) else [v])]
+            pairs = list(zip(flat(tuple(got)), flat(tuple(want))))
+            assert len(pairs) == (9 if rates else 6)
+            for a, b in pairs:
+                assert (a is None and b is None) or a.tobytes() == b.tobytes()
 
 
 def test_circumvent_without_rates_is_its_values():

@@ -94,6 +94,78 @@ def test_a_walled_goal_or_an_occupied_start_has_no_path():
     assert space_time_path(grid, taken, (0, 2), None, 30) is None
 
 
+def _earliest_arrival(grid, taken, start, goal, last_step, stay_steps):
+    """The earliest arrival step by breadth-first search over (cell, step), the moves'
+    rules written out (a wait keeps its cell clear at the next step, a move keeps both
+    cells clear over its steps, a diagonal its two side cells too, free and clear); the
+    goal clear for ``stay_steps`` steps after the arrival (to the horizon for None)."""
+    busy, free = taken.taken, grid.free
+    horizon = busy.shape[0] - 1
+    nx, ny = free.shape
+
+    def clear(cell, k0, k1):
+        return free[cell] and not busy[k0:min(k1, horizon) + 1, cell[0], cell[1]].any()
+
+    def stays(k):
+        end = horizon if stay_steps is None else min(k + stay_steps, horizon)
+        return not busy[k:end + 1, goal[0], goal[1]].any()
+
+    now = {0: {start}}
+    for k in range(0, last_step + 1):
+        for cell in sorted(now.get(k, ())):
+            if cell == goal and stays(k):
+                return k
+            if k >= min(last_step, horizon):
+                continue
+            if not busy[k + 1, cell[0], cell[1]]:
+                now.setdefault(k + 1, set()).add(cell)
+            for di in (-1, 0, 1):
+                for dj in (-1, 0, 1):
+                    a, b, cost = cell[0] + di, cell[1] + dj, 1 + (di != 0 and dj != 0)
+                    if (di, dj) == (0, 0) or not (0 <= a < nx and 0 <= b < ny) \
+                            or k + cost > last_step:
+                        continue
+                    sides = [(cell[0] + di, cell[1]), (cell[0], cell[1] + dj)] if cost == 2 else []
+                    if all(clear(c, k, k + cost) for c in [cell, (a, b)] + sides):
+                        now.setdefault(k + cost, set()).add((a, b))
+    return None
+
+
+def test_the_path_is_the_earliest_among_random_robots_and_walls():
+    """On random grids (walls, boxes of placed robots over random spans, some parked for
+    good): the search finds a path exactly when breadth-first search over (cell, step)
+    finds one, it arrives at the same earliest step, keeps clear of every taken cell and
+    leaves the goal clear as asked."""
+    rng = np.random.default_rng(11)
+    found = 0
+    for _ in range(150):
+        nx, ny = (int(v) for v in rng.integers(3, 12, 2))
+        free = rng.random((nx, ny)) > rng.uniform(0.0, 0.35)
+        grid = SpaceTimeGrid(np.zeros(2), 1.0, free, (0, 1))
+        horizon = int(rng.integers(4, 40))
+        taken = Reservations(grid, 1.0, horizon)
+        count = int(rng.integers(0, 12))
+        t_start = rng.uniform(0, horizon, count)
+        t_end = t_start + rng.uniform(0, 8, count)
+        t_end[rng.random(count) < 0.2] = np.inf
+        lower = rng.uniform(0, max(nx, ny), (count, 2))
+        taken.add(t_start, t_end, lower, lower + rng.uniform(0, 2.5, (count, 2)))
+        start = tuple(int(v) for v in rng.integers(0, (nx, ny)))
+        goal = tuple(int(v) for v in rng.integers(0, (nx, ny)))
+        last = int(rng.integers(0, horizon + 1))
+        stay = None if rng.random() < 0.5 else int(rng.integers(0, 6))
+        path = space_time_path(grid, taken, start, goal, last, stay_steps=stay)
+        want = _earliest_arrival(grid, taken, start, goal, last, stay) \
+            if free[start] and free[goal] else None
+        assert (path is None) == (want is None)
+        if path is not None:
+            found += 1
+            assert path[0] == (*start, 0) and path[-1] == (*goal, want)
+            # the start's cell may be taken at step 0 (the robot is there): from its first move
+            _keeps_clear(path if not taken.taken[0][start] else path[1:], grid, taken)
+    assert found > 30
+
+
 def test_the_grid_keeps_room_from_walls_and_obstacles():
     spec = stt.load_fleet("warehouse-fleet").robots[0].spec
     grid = SpaceTimeGrid.of(spec, (0, 1))

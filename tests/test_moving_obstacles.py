@@ -19,7 +19,8 @@ from stt_codegen.codegen.generate import generate_files
 from stt_codegen.codegen.options import Options
 from stt_codegen.design.failures import FailureKind
 from stt_codegen.design.moving import (MOTION_SPACE_TIME, MOTION_SWEPT, MOTION_TIMED_VIA,
-                                       TASK_HOLD_SHARE, static_part, retime, task_holds)
+                                       DURATION_FACTORS, TASK_HOLD_SHARE, static_part, retime,
+                                       task_holds)
 from stt_codegen.design.swept import swept_spec
 from stt_codegen.design.search import check_tube
 from stt_codegen.runtime.simulate import run_closed_loop
@@ -524,6 +525,26 @@ def test_the_retiming_arrives_later_where_the_target_is_taken_after_the_earliest
     assert retime(legs, stt.Spec.from_dict(_lane()[0]))[-1].end < 6.0    # no box
     timed = retime(legs, stt.Spec.from_dict(doc))
     assert timed is not None and 8.0 <= timed[-1].end <= 10.0
+
+
+def test_factor_sets_sharing_their_judged_moves_time_as_each_alone():
+    """The re-timings of one via design at several factor sets share one memo of judged
+    moves: each gives the timing it gives alone, and a later set judges only the moves the
+    earlier ones did not."""
+    doc, legs = _lane({"lower": [2.7, 1.0], "upper": [3.3, 3.0], "active": [0.0, 4.0]},
+                      {"lower": [5.2, 1.4], "upper": [6.0, 2.6], "active": [6.0, 7.0]})
+    spec = stt.Spec.from_dict({**doc, "actuator": {"input_bound": [2, 2]}})
+    memo: dict = {}
+    sizes = []
+    for factors in ((1.0, 1.5, 2.0), (1.0, 0.75, 1.5, 2.0), DURATION_FACTORS):
+        shared = retime(legs, spec, None, factors, memo)
+        assert shared == retime(legs, spec, None, factors)
+        assert shared is not None and shared[-1].end <= 10.0
+        sizes.append(len(memo))
+    assert 0 < sizes[0] < sizes[1] < sizes[2]
+    # a memo that says every move is clear is read, not judged again: the timing changes
+    lied = {key: True for key in memo}
+    assert retime(legs, spec, None, DURATION_FACTORS, lied) != shared
 
 
 @pytest.mark.slow
