@@ -88,6 +88,23 @@ def test_bad_input_names_the_field(hall):
     assert caught.value.field == "horizon"
 
 
+def test_a_scripted_path_is_interpolated_the_same_on_every_call():
+    """A path obstacle's centre is its path interpolated piece by piece (straight between
+    rows, held before the first and after the last), the same on every call (its rows are
+    converted once), and the obstacle stays a value: equal, hashable, picklable."""
+    import pickle
+    rows = ((0.0, 1.0, 2.0), (1.0, 2.0, 2.5), (3.0, 0.0, 0.0))
+    walker = WalkingObstacle((1.0, 2.0), 0.3, path=rows)
+    t = np.array([-1.0, 0.0, 0.25, 1.0, 2.0, 3.0, 7.0])
+    want = np.array([[1.0, 2.0], [1.0, 2.0], [1.25, 2.125], [2.0, 2.5], [1.0, 1.25],
+                     [0.0, 0.0], [0.0, 0.0]])
+    for _ in range(3):
+        assert np.array_equal(walker.scripted(t), want)
+    twin = WalkingObstacle((1.0, 2.0), 0.3, path=rows)
+    assert walker == twin and hash(walker) == hash(twin)
+    assert np.array_equal(pickle.loads(pickle.dumps(walker)).scripted(t), want)
+
+
 @pytest.mark.slow
 def test_people_crossing_force_replanning_and_the_base_stays_safe_in_its_tube(hall):
     """Two people walk across the base's way within the envelope: the base switches tubes,

@@ -21,6 +21,7 @@ with ``enforce_replan_time`` a plan over the budget is refused as it would be on
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Sequence
@@ -130,10 +131,16 @@ class WalkingObstacle:
         if self.velocity is not None:
             return c + t[:, None] * np.asarray(self.velocity)
         if self.path is not None:
-            rows = np.asarray(self.path, dtype=float)
-            return np.stack([np.interp(t, rows[:, 0], rows[:, 1 + k])
-                             for k in range(c.size)], axis=1)
+            times, centres = self._path_columns
+            return np.stack([np.interp(t, times, column) for column in centres], axis=1)
         return np.repeat(c[None], t.size, axis=0)
+
+    @functools.cached_property
+    def _path_columns(self) -> tuple[np.ndarray, tuple[np.ndarray, ...]]:
+        """``path``'s times and centre coordinates as arrays, converted once (the closed
+        loop asks for the centre at every sample)."""
+        rows = np.asarray(self.path, dtype=float)
+        return rows[:, 0], tuple(rows[:, 1 + k] for k in range(rows.shape[1] - 1))
 
 
 def bundled_people(name: str) -> tuple[WalkingObstacle, ...]:
