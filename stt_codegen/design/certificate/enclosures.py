@@ -176,16 +176,20 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool 
     k = t0.size
     rho_l, rho_u, rate_l, rate_u = reference.reach_tube(
         design, np.concatenate([t0, t1, inner[which, 0]]), rates)
-    width = rho_u - rho_l
     at, values = where[edge], 2 * k + np.flatnonzero(edge)
 
-    def value_range(v):
+    def extremes(v, intervals, inside):
+        """Per interval, the least and largest of ``v`` at its ends and of ``inside`` (its
+        values at the points inside, by ``intervals``)."""
         low, high = np.minimum(v[:k], v[k:2 * k]), np.maximum(v[:k], v[k:2 * k])
-        np.minimum.at(low, at, v[values])
-        np.maximum.at(high, at, v[values])
+        np.minimum.at(low, intervals, inside)
+        np.maximum.at(high, intervals, inside)
         return low, high
 
-    lowest_width = value_range(width)[0]
+    def value_range(v):
+        return extremes(v, at, v[values])
+
+    lowest_width = value_range(rho_u - rho_l)[0]
     if not rates:
         return value_range(rho_l), value_range(rho_u), None, lowest_width
     ends = np.zeros(t0.shape, dtype=bool)
@@ -194,9 +198,7 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool 
     zero = np.where(ends[:, None], 0.0, np.nan)
 
     def span(rate):
-        low, high = np.minimum(rate[:k], rate[k:2 * k]), np.maximum(rate[:k], rate[k:2 * k])
-        np.minimum.at(low, where, rate[2 * k:])
-        np.maximum.at(high, where, rate[2 * k:])
+        low, high = extremes(rate, where, rate[2 * k:])
         return np.fmin(low, zero), np.fmax(high, zero)
 
     return (value_range(rho_l), value_range(rho_u), (span(rate_l), span(rate_u)),
