@@ -106,6 +106,25 @@ def test_one_episode_is_reported():
         {**report, "rows": [row]})
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("episode", [249, 256])
+def test_a_robot_cornered_by_two_circles_escapes_the_way_they_are_not_headed(episode):
+    """Seed 0's episodes 249 (the start's wall) and 256 (the target's corner) of
+    ``bench sensed --acceleration 2``: two circles head into the corner where the robot
+    is. Ranked by the reachable ball, the escapes went deeper into it and the circles
+    reached the robot there after every replanning had failed; ranked by where the circles
+    are headed, the robot escapes the other way, stays certified throughout, and reaches
+    the target by t_c."""
+    design = stt.design_tube(stt.Spec.from_dict(scenario_with(2.0)))
+    circles = moving_circles(np.random.default_rng([0, 5, episode]), 5, 17.0, 1.0)
+    run = stt.simulate_sensed(design, circles, seed=episode)
+    record = run.sensing
+    assert not record.outside_envelope and not record.script_outside_envelope
+    assert record.escapes >= 1
+    assert not record.sensed_collision and not run.collision
+    assert record.guaranteed and record.uncertified == [] and run.reached
+
+
 @pytest.mark.embedded
 def test_the_controller_cost_on_the_cortex_m4f_is_reported():
     """``--cortex-m4f``: the scenario's controller with the tube as data, counted on the

@@ -195,6 +195,33 @@ def test_an_escape_when_no_tube_reaches_the_target():
     assert back.design.spec.target_set == design.spec.target_set
 
 
+def test_escape_goals_rank_by_where_the_obstacles_are_headed():
+    """A circle seen at (7, 9.3) walking at 1 m/s towards the corner (10, 10): the corner
+    ahead of it ranks below the open floor behind it, though the corner is the farther
+    from where it was seen (the reachable ball's ranking, which chose the corner before);
+    the circle stops at the wall, not beyond it; without an estimate the circle stands."""
+    spec = stt.Spec.from_dict(scenario_with(2.0))
+    sensing = spec.sensing
+    seen = stt.SensedObstacle.ball((7.0, 9.3), 0.3, seen_at=10.0, velocity=(1.0, 0.0))
+    corner, floor = np.array([9.5, 9.5]), np.array([7.5, 8.0])
+    headed = [sensed_module._headed_clearance(seen, p, 10.3, 11.8, spec.state_space, 0.1,
+                                              sensing)
+              for p in (corner, floor)]
+    assert np.linalg.norm(corner - seen.centre) > np.linalg.norm(floor - seen.centre)
+    assert headed[0] < headed[1]
+    # four seconds after it was seen the estimate puts it past the wall: it stops at
+    # x = 10 - 0.3 (the state space is the reference point's, the walls less the robot's
+    # radius 0.1)
+    late = sensed_module._headed_clearance(seen, np.array([9.7, 9.3]), 14.0, 14.0,
+                                           spec.state_space, 0.1, sensing)
+    assert late == pytest.approx(-0.3 - sensing.velocity_error * 4.0)
+    standing = dataclasses.replace(seen, velocity=None)
+    gap = sensed_module._headed_clearance(standing, floor, 10.0, 11.0, spec.state_space,
+                                          0.1, sensing)
+    assert gap == pytest.approx(np.linalg.norm(floor - seen.centre) - 0.3
+                                - sensing.velocity_error * 1.0)
+
+
 def test_bad_calls_name_the_field(hall, start):
     plain = dataclasses.replace(hall, spec=dataclasses.replace(hall.spec, sensing=None))
     with pytest.raises(stt.SpecError) as caught:

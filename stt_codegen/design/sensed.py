@@ -80,10 +80,13 @@ ESCAPE_DIRECTIONS = 16
 ESCAPE_TIME = 1.0
 #: Most escape tubes designed from one measurement (the best ranked first).
 MAX_ESCAPES = 6
-#: Temporary goals at least this far (state units) from where every sensed obstacle may be
-#: when the escape tube arrives plus the horizon rank equal on that count; the nearest to
-#: the target among them first.
+#: Temporary goals at least this far (state units) from where every sensed obstacle is
+#: headed until the escape tube has arrived plus the horizon rank equal on that count; the
+#: nearest to the target among them first.
 ESCAPE_CLEARANCE = 1.0
+#: The time step at which an escape's goal is compared with where each sensed obstacle is
+#: headed, s.
+HEADED_STEP = 0.125
 
 
 @dataclass(frozen=True)
@@ -717,13 +720,12 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     if plan.goal is None:
         kept = kept_plan()
         if kept is not None:
-            # a kept tube headed where an obstacle is going: a way round it, if one is
-            # certified now (else the kept tube, certified)
+            # a kept tube headed where an obstacle is going: a way round it, else out of
+            # its way, if one is certified now (else the kept tube, certified)
             if not _headed_into(kept, sensed, sensing, until, first):
                 return kept
-            active = _box_at(plan, t_s - plan.start, base.state_space)
-            made = _along_path(base, active, moving, boxes, sensed, sensing, s, t_m, t_s,
-                               remaining, first)
+            made = _out_of_the_way(plan, base, moving, boxes, sensed, sensing, s, t_m, t_s,
+                                   remaining, first)
             return kept if made is None else done(task=plan.task, **made)
     # 2. a new tube to the target from the active tube's box at the switch, then from a
     #    box around where the robot will be
@@ -740,8 +742,10 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
                        first)
     if made is not None:
         return done(task=plan.task, **made)
-    tries = [(active, boxes + ahead), (active, boxes)] + ([] if near is None
-                                                          else [(near, boxes)])
+    # over the shortest horizon a tube is certified for a moment only: one that heads
+    # where an obstacle is going would drive into it if the next replanning fails
+    tries = [(active, boxes + ahead)] + ([] if horizon is not None else (
+        [(active, boxes)] + ([] if near is None else [(near, boxes)])))
     for box, avoided in tries:
         made = _to_target(base, box, moving, avoided, sensing, s, t_m, t_s, remaining,
                           first)
@@ -753,12 +757,36 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     if plan.goal is not None:
         kept = kept_plan()
         if kept is not None:
-            return kept
+            if not _headed_into(kept, sensed, sensing, until, first):
+                return kept
+            made = _escape(base, near or active, moving, boxes, sensed, sensing, s, t_m,
+                           t_s, first, point)
+            return done(task=plan.task, **made) if isinstance(made, dict) else kept
     made = _escape(base, near or active, moving, boxes, sensed, sensing, s, t_m, t_s, first,
                    point)
     if isinstance(made, dict):
         return done(task=plan.task, **made)
     return failed(outcome[0] + f"; and no escape: {made}", outcome[1])
+
+
+def _out_of_the_way(plan: SensedPlan, base: Spec, moving: tuple[MovingObstacle, ...],
+                    boxes: tuple[MovingObstacle, ...], sensed: Sequence[SensedObstacle],
+                    sensing: Sensing, s: np.ndarray, t_m: float, t_s: float,
+                    remaining: float, first: int) -> dict | None:
+    """For a kept tube headed where an obstacle is going: a certified tube along a
+    space-time path to the target, else an escape (:func:`_escape`), from the active tube's
+    box at the switch (the escape from the box around where the robot will be, when there
+    is one): the plan's fields, or ``None``."""
+    active = _box_at(plan, t_s - plan.start, base.state_space)
+    made = _along_path(base, active, moving, boxes, sensed, sensing, s, t_m, t_s, remaining,
+                       first)
+    if made is not None:
+        return made
+    point = _predicted(plan, active, s, t_m, sensing)
+    near = _switch_box(base, active, point, sensing)
+    made = _escape(base, near or active, moving, boxes, sensed, sensing, s, t_m, t_s, first,
+                   point)
+    return made if isinstance(made, dict) else None
 
 
 def _headed_into(kept: SensedPlan, sensed: Sequence[SensedObstacle], sensing: Sensing,
@@ -951,9 +979,10 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     goals are boxes of the spec's initial half width around ``point`` and around the
     points :data:`ESCAPE_DISTANCES` away in :data:`ESCAPE_DIRECTIONS` directions, inside
     the state space and clear of the static obstacles, ranked by their distance from where
-    every sensed obstacle may be when the tube arrives plus the horizon and from the state
-    space's boundary (the largest first, up to :data:`ESCAPE_CLEARANCE`), then by their
-    distance to the target; at most :data:`MAX_ESCAPES` designs.
+    every sensed obstacle is headed from the switch until the tube has arrived plus the
+    horizon (:func:`_headed_clearance`) and from the state space's boundary (the largest
+    first, up to :data:`ESCAPE_CLEARANCE`), then by their distance to the target; at most
+    :data:`MAX_ESCAPES` designs.
     """
     dims = list(sensing.dims)
     reach = _reach(base)
@@ -974,7 +1003,8 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
             goal = Box(tuple(lo), tuple(hi))
             if not base.state_space.contains_box(goal) or _meets_static(base, goal, reach):
                 continue
-            clear = min((_clearance(ob, p, later, sensing) for ob in sensed),
+            clear = min((_headed_clearance(ob, p, t_s, later, base.state_space, reach,
+                                           sensing) for ob in sensed),
                         default=math.inf) - reach - float(np.linalg.norm(half))
             # a goal near the state space's boundary leaves fewer ways out next time (a
             # corner is a trap): its room to the boundary counts as a clearance too
@@ -1005,19 +1035,31 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
             + ", ".join(str(r) for r in reasons) + ")")
 
 
-def _clearance(ob: SensedObstacle, point: np.ndarray, t: float, sensing: Sensing) -> float:
-    """The distance from ``point`` to where ``ob`` may be at ``t`` (a ball around its
-    estimate's prediction: with the envelope's acceleration bound, else around where it
-    was seen, grown at the speed bound), state units; negative inside."""
-    tau = max(0.0, t - ob.seen_at)
+def _headed_clearance(ob: SensedObstacle, point: np.ndarray, t_from: float, t_to: float,
+                      state_space: Box, reach: float, sensing: Sensing) -> float:
+    """The least distance from ``point`` to where ``ob`` is headed over ``[t_from, t_to]``
+    (absolute, s), sampled every :data:`HEADED_STEP`: its centre moved along its velocity
+    estimate (standing without one) and kept inside the walls (the state space of the
+    reference point grown by the robot's radius ``reach``) shrunk by its extent,
+    less its extent and ``velocity_error`` times the time since it was seen; state units,
+    negative inside.
+
+    A ranking, not a reachable set: the distance from the reachable set at ``t_to`` (which
+    grows in every direction) ranks a corner that two obstacles are heading into above the
+    open floor they are leaving.
+    """
+    dims = list(sensing.dims)
+    lo = np.array([state_space.lower[d] for d in dims]) - reach + ob.extent
+    hi = np.array([state_space.upper[d] for d in dims]) + reach - ob.extent
     c = np.asarray(ob.centre, dtype=float)
-    grow = sensing.max_obstacle_speed * tau
-    accel = sensing.max_obstacle_acceleration
-    if accel is not None and ob.velocity is not None:
-        drift = sensing.velocity_error * tau + 0.5 * accel * tau * tau
-        if drift < grow:
-            c, grow = c + np.asarray(ob.velocity) * tau, drift
-    return float(np.linalg.norm(point - c)) - ob.extent - grow
+    v = np.zeros_like(c) if ob.velocity is None else np.asarray(ob.velocity, dtype=float)
+    steps = max(1, int(math.ceil((t_to - t_from) / HEADED_STEP)))
+    tau = np.maximum(0.0, t_from + (t_to - t_from) * np.arange(steps + 1) / steps
+                     - ob.seen_at)
+    centres = np.clip(c + tau[:, None] * v, np.minimum(lo, hi), np.maximum(lo, hi))
+    gaps = (np.linalg.norm(centres - point, axis=1) - ob.extent
+            - sensing.velocity_error * tau)
+    return float(gaps.min())
 
 
 def _meets_static(spec: Spec, box: Box, reach: float) -> bool:
