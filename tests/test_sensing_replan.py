@@ -222,6 +222,26 @@ def test_escape_goals_rank_by_where_the_obstacles_are_headed():
                                 - sensing.velocity_error * 1.0)
 
 
+def test_a_replanned_tube_due_near_t_c_gives_way_to_a_sooner_path():
+    """A replanned tube (started after 0) that arrives at t_c, with nothing in the way:
+    a space-time path that arrives at least ``EARLIER`` sooner takes over; the same tube
+    due ``EARLIER`` before t_c, and the spec's own tube (which starts at 0), are kept."""
+    design = stt.design_tube(stt.Spec.from_dict(scenario_with(2.0)))
+    own = stt.start_plan(design)
+    t_c = design.spec.prescribed_time
+    late = dataclasses.replace(own, start=0.25, switch_at=0.25, arrival=t_c)
+    here = np.asarray(sensed_module._box_at(late, 0.25, design.spec.state_space).center)
+    sooner = stt.replan(late, 0.5, here, [])
+    assert isinstance(sooner, stt.SensedPlan) and not sooner.kept, sooner
+    assert sooner.design.motion == "sensed path"
+    assert sooner.arrival <= t_c - sensed_module.EARLIER
+    assert sooner.region_margin > 0
+    due = dataclasses.replace(late, arrival=t_c - sensed_module.EARLIER)
+    assert stt.replan(due, 0.5, here, []).kept
+    here = np.asarray(sensed_module._box_at(own, 0.5, design.spec.state_space).center)
+    assert stt.replan(own, 0.5, here, []).kept
+
+
 def test_bad_calls_name_the_field(hall, start):
     plain = dataclasses.replace(hall, spec=dataclasses.replace(hall.spec, sensing=None))
     with pytest.raises(stt.SpecError) as caught:

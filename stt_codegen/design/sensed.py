@@ -68,6 +68,9 @@ LATE_TIME = 2.0
 SLOWER = (1.0, 1.5, 2.0, 3.0)
 #: Most intervals the region certificate may cut the tube's enclosure into.
 REGION_INTERVALS = 20_000
+#: A kept replanned tube that arrives later than this before ``t_c`` is replaced by a
+#: space-time path that arrives at least this much sooner, s.
+EARLIER = 1.0
 #: Seconds past the certified horizon over which a new tube to the target is first
 #: designed to keep clear of where the sensed obstacles are headed (:func:`foresight_boxes`).
 FORESIGHT = 2.0
@@ -723,7 +726,17 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
             # a kept tube headed where an obstacle is going: a way round it, else out of
             # its way, if one is certified now (else the kept tube, certified)
             if not _headed_into(kept, sensed, sensing, until, first):
-                return kept
+                # a replanned tube due near t_c or late (not the spec's own, which
+                # starts at 0 and is due at t_c): a space-time path that arrives sooner
+                if plan.start == 0.0 or plan.arrival <= max(t_s, base.prescribed_time
+                                                             - EARLIER):
+                    return kept
+                active = _box_at(plan, t_s - plan.start, base.state_space)
+                made = _along_path(base, active, moving, boxes, sensed, sensing, s, t_m,
+                                   t_s, remaining, first)
+                if made is None or made["arrival"] > plan.arrival - EARLIER:
+                    return kept
+                return done(task=plan.task, **made)
             made = _out_of_the_way(plan, base, moving, boxes, sensed, sensing, s, t_m, t_s,
                                    remaining, first)
             return kept if made is None else done(task=plan.task, **made)
