@@ -593,7 +593,10 @@ def replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
 
     The switch instant is ``t_s = t_m + L + tau`` rounded up to a sample
     (:func:`switch_time`). First the active tube is certified again against the
-    measurement over ``[t_m, t_s + H]`` (``kept``: no switch). Else a new tube is designed
+    measurement over ``[t_m, t_s + H]`` (``kept``: no switch), unless it is headed where
+    a sensed obstacle is going (then a space-time path or an escape, when one is
+    certified) or, replanned, due later than ``t_c - EARLIER`` (then a space-time path
+    that arrives :data:`EARLIER` sooner, when one is certified). Else a new tube is designed
     from the active tube's certified box at ``t_s`` to the target, avoiding every known
     obstacle and the sensed obstacles' reachable sets over ``[t_s, t_s + H]``, and
     certified for every ``t``, then the same from a box of the spec's ``d_0`` around where
