@@ -34,6 +34,7 @@ the robot lies in the new tube at the switch is the run time's test (a state wit
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass, field, replace
@@ -721,33 +722,41 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
                             t_s, 0.0, sensing.horizon, first, **_drift(sensing))
     moving = _shifted(base.moving_obstacles, t_s)
     remaining = max(base.prescribed_time - t_s, LATE_TIME)
+
+    @functools.cache
+    def at_switch() -> tuple[Box, np.ndarray, Box | None]:
+        # the active tube's box at the switch, where the robot will be then, and the
+        # spec's d_0 around it (computed once, when a new tube is looked for)
+        active = _box_at(plan, t_s - plan.start, base.state_space)
+        point = _predicted(plan, active, s, t_m, sensing)
+        return active, point, _switch_box(base, active, point, sensing)
+
+    def escape() -> dict | str:
+        active, point, near = at_switch()
+        return _escape(base, near or active, moving, boxes, sensed, sensing, s, t_m, t_s,
+                       first, point)
+
     # 1. the active tube, certified again from the measurement on (an escape's after the
     #    target has been tried again)
-    if plan.goal is None:
-        kept = kept_plan()
-        if kept is not None:
-            # a kept tube headed where an obstacle is going: a way round it, else out of
-            # its way, if one is certified now (else the kept tube, certified)
-            if not _headed_into(kept, sensed, sensing, until, first):
-                # a replanned tube due near t_c or late (not the spec's own, which
-                # starts at 0 and is due at t_c): a space-time path that arrives sooner
-                if plan.start == 0.0 or plan.arrival <= max(t_s, base.prescribed_time
-                                                             - EARLIER):
-                    return kept
-                active = _box_at(plan, t_s - plan.start, base.state_space)
-                made = _along_path(base, active, moving, boxes, sensed, sensing, s, t_m,
-                                   t_s, remaining, first)
-                if made is None or made["arrival"] > plan.arrival - EARLIER:
-                    return kept
-                return done(task=plan.task, **made)
-            made = _out_of_the_way(plan, base, moving, boxes, sensed, sensing, s, t_m, t_s,
-                                   remaining, first)
-            return kept if made is None else done(task=plan.task, **made)
+    kept = kept_plan() if plan.goal is None else None
+    if kept is not None:
+        # a kept tube headed where an obstacle is going: a way round it, else out of its
+        # way; a replanned tube due near t_c or late (not the spec's own, which starts at
+        # 0 and is due at t_c): a way that arrives sooner; each if one is certified now,
+        # else the kept tube, certified
+        headed = _headed_into(kept, sensed, sensing, until, first)
+        if not headed and (plan.start == 0.0 or plan.arrival <= max(
+                t_s, base.prescribed_time - EARLIER)):
+            return kept
+        made = _along_path(base, at_switch()[0], moving, boxes, sensed, sensing, s, t_m,
+                           t_s, remaining, first)
+        if made is not None and (headed or made["arrival"] <= plan.arrival - EARLIER):
+            return done(task=plan.task, **made)
+        made = escape() if headed else None
+        return done(task=plan.task, **made) if isinstance(made, dict) else kept
     # 2. a new tube to the target from the active tube's box at the switch, then from a
     #    box around where the robot will be
-    active = _box_at(plan, t_s - plan.start, base.state_space)
-    point = _predicted(plan, active, s, t_m, sensing)
-    near = _switch_box(base, active, point, sensing)
+    active, point, near = at_switch()
     ahead = foresight_boxes(sensed, _reach(base), sensing.dims, t_s, sensing.horizon,
                             sensing.horizon + FORESIGHT, first + len(boxes),
                             sensing.velocity_error)
@@ -769,40 +778,18 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
             return done(task=plan.task, **made)
         outcome = outcome or made
     assert outcome is not None
-    # 3. an escape's tube kept, or a new escape to a temporary goal
+    # 3. an escape's tube kept (unless headed where an obstacle is going), or a new
+    #    escape to a temporary goal, else the escape's tube kept all the same
     if plan.goal is not None:
         kept = kept_plan()
-        if kept is not None:
-            if not _headed_into(kept, sensed, sensing, until, first):
-                return kept
-            made = _escape(base, near or active, moving, boxes, sensed, sensing, s, t_m,
-                           t_s, first, point)
-            return done(task=plan.task, **made) if isinstance(made, dict) else kept
-    made = _escape(base, near or active, moving, boxes, sensed, sensing, s, t_m, t_s, first,
-                   point)
+        if kept is not None and not _headed_into(kept, sensed, sensing, until, first):
+            return kept
+    made = escape()
     if isinstance(made, dict):
         return done(task=plan.task, **made)
+    if kept is not None:
+        return kept
     return failed(outcome[0] + f"; and no escape: {made}", outcome[1])
-
-
-def _out_of_the_way(plan: SensedPlan, base: Spec, moving: tuple[MovingObstacle, ...],
-                    boxes: tuple[MovingObstacle, ...], sensed: Sequence[SensedObstacle],
-                    sensing: Sensing, s: np.ndarray, t_m: float, t_s: float,
-                    remaining: float, first: int) -> dict | None:
-    """For a kept tube headed where an obstacle is going: a certified tube along a
-    space-time path to the target, else an escape (:func:`_escape`), from the active tube's
-    box at the switch (the escape from the box around where the robot will be, when there
-    is one): the plan's fields, or ``None``."""
-    active = _box_at(plan, t_s - plan.start, base.state_space)
-    made = _along_path(base, active, moving, boxes, sensed, sensing, s, t_m, t_s, remaining,
-                       first)
-    if made is not None:
-        return made
-    point = _predicted(plan, active, s, t_m, sensing)
-    near = _switch_box(base, active, point, sensing)
-    made = _escape(base, near or active, moving, boxes, sensed, sensing, s, t_m, t_s, first,
-                   point)
-    return made if isinstance(made, dict) else None
 
 
 def _headed_into(kept: SensedPlan, sensed: Sequence[SensedObstacle], sensing: Sensing,
