@@ -10,6 +10,8 @@ import pytest
 import stt_codegen as stt
 from stt_codegen_bench.sensed_bench import (SCENARIO, format_sensed_report, moving_circles,
                                             run_sensed_bench, scenario_with)
+from stt_codegen_bench.sensed_script import (CIRCLES, HEADING_JITTER, POSITION_JITTER,
+                                             PURSUER_START, SCRIPT, script_circles)
 from stt_codegen_bench.sensed_warehouse import (AISLES, DEPTH, DOOR, RACK_END, RACKS, WAREHOUSE,
                                                 WIDTH, aisle_people)
 
@@ -47,6 +49,40 @@ def test_turning_circles_keep_to_the_acceleration_bound():
     sensing = stt.Spec.from_dict(scenario_with(2.0)).sensing
     assert (sensing.max_obstacle_acceleration, sensing.velocity_error) == (2.0, 0.05)
     assert scenario_with(None) is SCENARIO
+
+
+def test_the_script_circles_are_the_scripts_moved_and_turned_within_the_envelope():
+    """Real-Time STT's five circles: each episode moves a start by at most
+    ``POSITION_JITTER`` per axis and turns a heading by at most ``HEADING_JITTER``, keeping
+    the script's radius and speed, within the envelope's ``r_max`` and ``V``; episodes
+    differ; the target lies inside the script's disc and the pursuer starts at its
+    centre."""
+    a = script_circles(np.random.default_rng([0, 5, 1]))
+    assert a == script_circles(np.random.default_rng([0, 5, 1]))
+    assert a != script_circles(np.random.default_rng([0, 5, 2]))
+    sensing = stt.Spec.from_dict(SCRIPT).sensing
+    for e in range(50):
+        for ob, (x, y, radius, vx, vy) in zip(script_circles(np.random.default_rng(e)),
+                                               CIRCLES, strict=True):
+            assert ob.radius == radius <= sensing.max_obstacle_radius
+            assert np.all(np.abs(np.subtract(ob.start, (x, y))) <= POSITION_JITTER)
+            assert math.isclose(math.hypot(*ob.velocity), math.hypot(vx, vy))
+            assert math.hypot(*ob.velocity) <= sensing.max_obstacle_speed
+            turn = math.atan2(vx * ob.velocity[1] - vy * ob.velocity[0],
+                              vx * ob.velocity[0] + vy * ob.velocity[1])
+            assert abs(turn) <= HEADING_JITTER + 1e-12
+    corners = np.array([[SCRIPT["target"][k][0], SCRIPT["target"][j][1]]
+                        for k in ("lower", "upper") for j in ("lower", "upper")])
+    assert np.all(np.linalg.norm(corners - (7.0, 10.0), axis=1) <= 1.0)
+    assert PURSUER_START == (7.0, 10.0)
+
+
+def test_the_script_refuses_other_counts_by_its_flag(capsys):
+    from stt_codegen.cli import main
+    assert main(["bench", "sensed", "--script", "--obstacles", "5,20"]) == 2
+    assert "--script:" in capsys.readouterr().err
+    with pytest.raises(ValueError, match="script"):
+        run_sensed_bench(1, 0, counts=(5,), script=True, acceleration=2.0)
 
 
 def test_the_warehouse_people_are_seeded_within_the_envelope_and_clear_of_the_racks():
@@ -89,6 +125,16 @@ def test_one_warehouse_episode_is_reported():
     assert row["outside_envelope"] == 0 and row["collisions_certified"] == 0
     assert row["on_time"] + row["late"] + row["not_reached"] == 1
     assert "the warehouse floor, people crossing its aisles" in format_sensed_report(report)
+
+
+@pytest.mark.slow
+def test_one_script_episode_with_its_pursuer_is_reported():
+    report = run_sensed_bench(1, 0, counts=(5,), adversary=True, script=True)
+    row = report["rows"][0]
+    assert report["floor"] == "script" and row["episodes"] == 1
+    assert row["outside_envelope"] == 0 and row["collisions_certified"] == 0
+    assert row["on_time"] + row["late"] + row["not_reached"] == 1
+    assert "Real-Time STT's script" in format_sensed_report(report)
 
 
 @pytest.mark.slow

@@ -216,13 +216,20 @@ def _cmd_sensed(args: argparse.Namespace) -> int:
         raise SpecError("--warehouse", "the warehouse floor's people walk straight and "
                                        "start at once: not with --adversary or "
                                        "--acceleration")
+    if args.script and (args.warehouse or args.acceleration is not None
+                        or _int_list(args.obstacles, "--obstacles") != [5]):
+        raise SpecError("--script", "Real-Time STT's script has five circles at constant "
+                                    "velocities: --obstacles 5, not with --warehouse or "
+                                    "--acceleration")
     report = run_sensed_bench(args.count, args.seed,
                               tuple(_int_list(args.obstacles, "--obstacles")),
                               adversary=args.adversary, acceleration=args.acceleration,
-                              speed_only=args.speed_only, warehouse=args.warehouse)
+                              speed_only=args.speed_only, warehouse=args.warehouse,
+                              script=args.script)
     if args.cortex_m4f:
         from .sensed_bench import target_costs
-        report["cortex_m4f"] = target_costs(args.acceleration, warehouse=args.warehouse)
+        report["cortex_m4f"] = target_costs(args.acceleration, warehouse=args.warehouse,
+                                            script=args.script)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_sensed_report(report))
     return 0
@@ -426,6 +433,11 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="a warehouse floor (three racks, 20 m x 12 m) with people crossing "
                         "its aisles at up to 1 m/s instead of the circles; --obstacles "
                         "counts people (not with --adversary or --acceleration)")
+    p.add_argument("--script", action="store_true",
+                   help="Real-Time STT's own 2-D script instead (its arena, start, target and "
+                        "five circles at 0.2-0.45 m/s, each episode moving their starts and "
+                        "turning their headings); with --adversary the pursuer starts at the "
+                        "target; --obstacles 5, not with --warehouse or --acceleration")
     p.add_argument("--cortex-m4f", action="store_true",
                    help="also count the controller's instructions per step and per switch "
                         "on the Cortex-M4F (QEMU), the tube as data, on the scenario's tube "

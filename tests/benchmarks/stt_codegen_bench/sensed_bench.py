@@ -12,7 +12,8 @@ arena's walls (a path of straight pieces). The envelope (``[sensing]``): range 5
 largest speed), replanning budget 0.25 s, horizon 0.5 s. With ``--adversary`` one more
 circle (radius 0.3 m) starts 6 m away and heads for the robot at ``V``. With
 ``--warehouse``, a warehouse floor with people crossing its aisles instead
-(:mod:`.sensed_warehouse`).
+(:mod:`.sensed_warehouse`); with ``--script``, Real-Time STT's own script, its arena and
+its five circles, seeded (:mod:`.sensed_script`).
 
 Each episode is :func:`stt_codegen.simulate_sensed` (the CasADi backend). Reported per
 ``N``: collisions (and among them those at an instant some certificate covered, which must
@@ -32,6 +33,7 @@ import numpy as np
 import stt_codegen as stt
 from stt_codegen.runtime.sensed import WalkingObstacle
 
+from .sensed_script import PURSUER_RADIUS, PURSUER_START, SCRIPT, script_circles
 from .sensed_warehouse import WAREHOUSE, aisle_people
 
 __all__ = ["SCENARIO", "format_sensed_report", "moving_circles", "run_sensed_bench",
@@ -142,7 +144,8 @@ def moving_circles(rng: np.random.Generator, count: int, until: float,
 
 def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20),
                      adversary: bool = False, acceleration: float | None = None,
-                     speed_only: bool = False, warehouse: bool = False) -> dict:
+                     speed_only: bool = False, warehouse: bool = False,
+                     script: bool = False) -> dict:
     """Seeded episodes of the scenario per obstacle count.
 
     Parameters
@@ -167,6 +170,10 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         The warehouse floor with people crossing its aisles instead
         (:mod:`.sensed_warehouse`; ``counts`` are people; episode ``e`` draws from
         ``[seed, N, e]``); not with ``adversary`` or ``acceleration``.
+    script : bool
+        Real-Time STT's own script instead, its five circles seeded
+        (:mod:`.sensed_script`; ``counts`` must be ``(5,)``); the pursuer starts at the
+        target's centre at the script's speed bound; not with ``acceleration``.
 
     Returns
     -------
@@ -177,7 +184,11 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
     if warehouse and (adversary or acceleration is not None):
         raise ValueError("the warehouse floor has neither an adversary nor an acceleration "
                          "bound")
-    scenario = WAREHOUSE if warehouse else scenario_with(None if speed_only else acceleration)
+    if script and (warehouse or acceleration is not None or tuple(counts) != (5,)):
+        raise ValueError("Real-Time STT's script has five circles at constant velocities: "
+                         "not with the warehouse, an acceleration bound or another count")
+    scenario = (WAREHOUSE if warehouse else SCRIPT if script else
+                scenario_with(None if speed_only else acceleration))
     design = stt.design_tube(stt.Spec.from_dict(scenario))
     speed = scenario["sensing"]["max_obstacle_speed"]
     t_c = scenario["prescribed_time"]
@@ -193,10 +204,14 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         for e in range(episodes):
             rng = np.random.default_rng([seed, count, e])
             obstacles = (aisle_people(rng, count, t_c) if warehouse else
+                         script_circles(rng) if script else
                          moving_circles(rng, count, t_c + 1.0,
                                         None if acceleration is None else acceleration / 2.0))
             if adversary:
-                obstacles.append(WalkingObstacle((7.0, 1.0), 0.3, pursuit_speed=speed,
+                obstacles.append(WalkingObstacle(PURSUER_START, PURSUER_RADIUS,
+                                                 pursuit_speed=speed)
+                                 if script else
+                                 WalkingObstacle((7.0, 1.0), 0.3, pursuit_speed=speed,
                                                  pursuit_acceleration=acceleration))
             run = stt.simulate_sensed(design, obstacles, seed=e)
             record = run.sensing
@@ -224,12 +239,13 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         tally["episode_cpu_s"] = (time.process_time() - started) / max(1, episodes)
         rows.append(tally)
     return {"scenario": {k: scenario[k] for k in ("prescribed_time", "sensing")},
-            "floor": "warehouse" if warehouse else "circles",
+            "floor": "warehouse" if warehouse else "script" if script else "circles",
             "seed": seed, "adversary": adversary, "acceleration": acceleration,
             "speed_only": bool(speed_only and acceleration is not None), "rows": rows}
 
 
-def target_costs(acceleration: float | None = None, warehouse: bool = False) -> dict:
+def target_costs(acceleration: float | None = None, warehouse: bool = False,
+                 script: bool = False) -> dict:
     """The scenario's controller on the Cortex-M4F with the tube as data
     (:func:`stt_codegen.embedded.tube_data_loop.run_tube_data`): instructions per switch
     and per step on the scenario's tube and on one with 16 circumvent windows open.
@@ -240,6 +256,8 @@ def target_costs(acceleration: float | None = None, warehouse: bool = False) -> 
         As :func:`run_sensed_bench` (the envelope does not change the controller).
     warehouse : bool
         The warehouse floor's tube instead (:mod:`.sensed_warehouse`).
+    script : bool
+        Real-Time STT's script's tube instead (:mod:`.sensed_script`).
 
     Returns
     -------
@@ -254,7 +272,7 @@ def target_costs(acceleration: float | None = None, warehouse: bool = False) -> 
     message = missing_message()
     if message:
         return {"missing": message}
-    design = stt.design_tube(stt.Spec.from_dict(WAREHOUSE if warehouse
+    design = stt.design_tube(stt.Spec.from_dict(WAREHOUSE if warehouse else SCRIPT if script
                                                 else scenario_with(acceleration)))
     r = run_tube_data(design, DEFAULT_CAPACITY)
     mean = lambda v: float(np.mean(v))   # noqa: E731
@@ -304,7 +322,9 @@ def format_sensed_report(report: dict) -> str:
     accel = report.get("acceleration")
     lines = [f"bench sensed: seed {report['seed']}"
              + (", the warehouse floor, people crossing its aisles (N: people)"
-                if report.get("floor") == "warehouse" else "")
+                if report.get("floor") == "warehouse" else
+                ", Real-Time STT's script, its five circles seeded"
+                if report.get("floor") == "script" else "")
              + (", with a pursuer at the envelope's speed" if report["adversary"] else "")
              + ("" if accel is None else
                 (f", circles turning at {accel / 2:g} m/s^2 per axis, " +
