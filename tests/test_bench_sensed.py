@@ -77,6 +77,20 @@ def test_the_script_circles_are_the_scripts_moved_and_turned_within_the_envelope
     assert PURSUER_START == (7.0, 10.0)
 
 
+def test_the_script_as_written_is_crossed_certified_throughout():
+    """The script's own circles, unmoved and unturned: the robot reaches the target by t_c,
+    certified throughout, with no collision and no measurement outside the envelope."""
+    from stt_codegen.runtime.sensed import WalkingObstacle
+    circles = [WalkingObstacle((x, y), radius, velocity=(vx, vy))
+               for x, y, radius, vx, vy in CIRCLES]
+    run = stt.simulate_sensed(stt.design_tube(stt.Spec.from_dict(SCRIPT)), circles)
+    record = run.sensing
+    assert not record.outside_envelope and record.switches >= 1
+    assert record.guaranteed and record.uncertified == []
+    assert not record.sensed_collision and not run.collision
+    assert run.reached and run.reach_time <= SCRIPT["prescribed_time"]
+
+
 def test_the_script_refuses_other_counts_by_its_flag(capsys):
     from stt_codegen.cli import main
     assert main(["bench", "sensed", "--script", "--obstacles", "5,20"]) == 2
