@@ -152,6 +152,28 @@ def test_one_script_episode_with_its_pursuer_is_reported():
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("seed,episode", [(0, 16), (1, 127)])
+def test_a_robot_in_the_target_steps_away_from_a_pursuer_closing_on_it(seed, episode):
+    """Real-Time STT's script with its pursuer (0.45 m/s, from the target's centre): in
+    these two episodes the robot reached the target, stepped aside along a path planned
+    against the pursuer's straight walk, kept it while the pursuer turned after it, and
+    was reached when no tube was certified any more. Taking a slow obstacle closing on a
+    robot that has arrived to pursue it, the robot keeps away: certified throughout, no
+    collision."""
+    from stt_codegen.runtime.sensed import WalkingObstacle
+    from stt_codegen_bench.sensed_script import PURSUER_RADIUS
+    circles = script_circles(np.random.default_rng([seed, 5, episode]))
+    circles.append(WalkingObstacle(PURSUER_START, PURSUER_RADIUS,
+                                   pursuit_speed=SCRIPT["sensing"]["max_obstacle_speed"]))
+    run = stt.simulate_sensed(stt.design_tube(stt.Spec.from_dict(SCRIPT)), circles,
+                              seed=episode)
+    record = run.sensing
+    assert not record.outside_envelope and record.escapes >= 1
+    assert not record.sensed_collision and not run.collision
+    assert record.guaranteed and record.uncertified == [] and run.reached
+
+
+@pytest.mark.slow
 def test_one_episode_is_reported():
     report = run_sensed_bench(1, 0, counts=(5,))
     row = report["rows"][0]

@@ -222,6 +222,38 @@ def test_escape_goals_rank_by_where_the_obstacles_are_headed():
                                 - sensing.velocity_error * 1.0)
 
 
+def test_a_slow_obstacle_closing_on_a_robot_that_has_arrived_is_taken_to_pursue_it(
+        monkeypatch):
+    """Real-Time STT's script, the robot holding in the target at 17 s (after t_c): a circle
+    2.4 m away walking at 0.45 m/s, its heading 40 degrees off the robot, would pass beside
+    the held box on a straight walk, but catches it if it turns after the robot, so the
+    kept tube is headed into it. Not so when it is faster than ``CLOSING_SPEED`` times the
+    slowest path, heading away, or while the tube is still due by t_c."""
+    from stt_codegen_bench.sensed_script import SCRIPT
+    design = stt.design_tube(stt.Spec.from_dict(SCRIPT))
+    own = stt.start_plan(design)
+    sensing = design.spec.sensing
+    until = switch_time(sensing, 17.0, design.spec.rate_hz) + sensing.horizon
+    here = np.array([7.0, 10.0])
+    circle = stt.SensedObstacle.ball((6.18, 7.74), 0.5, seen_at=17.0,
+                                     velocity=(-0.154, 0.423))
+    assert sensed_module._closing(circle, here)
+    assert sensed_module._headed_into(own, [circle], sensing, until, 500, here)
+    with monkeypatch.context() as m:        # nobody closing: the straight walk alone
+        m.setattr(sensed_module, "CLOSING_SPEED", 0.0)
+        assert not sensed_module._headed_into(own, [circle], sensing, until, 500, here)
+    fast = dataclasses.replace(circle, velocity=(-0.154 * 3, 0.423 * 3))   # 1.35 m/s
+    away = dataclasses.replace(circle, velocity=(0.154, -0.423))
+    for ob in (fast, away):
+        assert not sensed_module._closing(ob, here)
+        assert not sensed_module._pursued(own.design, own.start, own.arrival, own.task,
+                                          [ob], sensing, until, here)
+    due = switch_time(sensing, 5.0, design.spec.rate_hz) + sensing.horizon
+    assert not sensed_module._pursued(own.design, own.start, own.arrival, own.task,
+                                      [dataclasses.replace(circle, seen_at=5.0)], sensing,
+                                      due, here)
+
+
 def test_a_replanned_tube_due_near_t_c_gives_way_to_a_sooner_path():
     """A replanned tube (started after 0) that arrives at t_c, with nothing in the way:
     a space-time path that arrives at least ``EARLIER`` sooner takes over; the same tube

@@ -52,7 +52,7 @@ from .certificate.report import ROUNDING_MARGIN
 from .failures import without_advice
 from .result import Design, require_design
 from .search import check_tube, design_tube
-from .sensed_path import PREDICTION_SPAN, path_design
+from .sensed_path import MIN_SPEED, PREDICTION_SPAN, path_design
 
 __all__ = ["CHUNK_SECONDS", "ESCAPE_CLEARANCE", "ESCAPE_DIRECTIONS", "ESCAPE_DISTANCES",
            "ESCAPE_TIME", "FORESIGHT", "LATE_TIME", "MAX_ESCAPES", "ReplanFailure",
@@ -91,6 +91,14 @@ ESCAPE_CLEARANCE = 1.0
 #: The time step at which an escape's goal is compared with where each sensed obstacle is
 #: headed, s.
 HEADED_STEP = 0.125
+#: An obstacle whose velocity estimate points within this angle (radians) of the robot, at
+#: a speed of at most :data:`CLOSING_SPEED`, is *closing*: it may turn after the robot (a
+#: pursuer), and is not taken for a straight walk (:func:`_pursued`, :func:`_escape`).
+CLOSING_ANGLE = math.pi / 4.0
+#: The fastest closing obstacle, as a share of the slowest path
+#: (:data:`~.sensed_path.MIN_SPEED`): the robot can outrun a slower one, so stepping out
+#: of its way pays; fleeing one as fast as the robot drives it into a corner.
+CLOSING_SPEED = 0.5
 
 
 @dataclass(frozen=True)
@@ -736,6 +744,12 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
         return _escape(base, near or active, moving, boxes, sensed, sensing, s, t_m, t_s,
                        first, point)
 
+    def chased(made: dict) -> bool:
+        # a new tube due late, or holding its goal, that an obstacle closing on the robot
+        # would catch were it to turn after it: certified, but kept only as a spare
+        return _pursued(made["design"], made["start"], made["arrival"], base, sensed,
+                        sensing, until, s)
+
     # 1. the active tube, certified again from the measurement on (an escape's after the
     #    target has been tried again)
     kept = kept_plan() if plan.goal is None else None
@@ -744,16 +758,20 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
         # way; a replanned tube due near t_c or late (not the spec's own, which starts at
         # 0 and is due at t_c): a way that arrives sooner; each if one is certified now,
         # else the kept tube, certified
-        headed = _headed_into(kept, sensed, sensing, until, first)
+        headed = _headed_into(kept, sensed, sensing, until, first, s)
         if not headed and (plan.start == 0.0 or plan.arrival <= max(
                 t_s, base.prescribed_time - EARLIER)):
             return kept
         made = _along_path(base, at_switch()[0], moving, boxes, sensed, sensing, s, t_m,
                            t_s, remaining, first)
+        spare = None
         if made is not None and (headed or made["arrival"] <= plan.arrival - EARLIER):
-            return done(task=plan.task, **made)
+            if not chased(made):
+                return done(task=plan.task, **made)
+            spare = made if headed else None
         made = escape() if headed else None
-        return done(task=plan.task, **made) if isinstance(made, dict) else kept
+        made = made if isinstance(made, dict) else spare
+        return done(task=plan.task, **made) if made is not None else kept
     # 2. a new tube to the target from the active tube's box at the switch, then from a
     #    box around where the robot will be
     active, point, near = at_switch()
@@ -765,8 +783,11 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     # design for the horizon and a short foresight, then without the foresight
     made = _along_path(base, active, moving, boxes, sensed, sensing, s, t_m, t_s, remaining,
                        first)
+    spare = None
     if made is not None:
-        return done(task=plan.task, **made)
+        if not chased(made):
+            return done(task=plan.task, **made)
+        spare = made
     # over the shortest horizon a tube is certified for a moment only: one that heads
     # where an obstacle is going would drive into it if the next replanning fails
     tries = [(active, boxes + ahead)] + ([] if horizon is not None else (
@@ -775,34 +796,102 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
         made = _to_target(base, box, moving, avoided, sensing, s, t_m, t_s, remaining,
                           first)
         if isinstance(made, dict):
-            return done(task=plan.task, **made)
+            if not chased(made):
+                return done(task=plan.task, **made)
+            spare = spare or made
+            continue
         outcome = outcome or made
-    assert outcome is not None
     # 3. an escape's tube kept (unless headed where an obstacle is going), or a new
     #    escape to a temporary goal, else the escape's tube kept all the same
     if plan.goal is not None:
         kept = kept_plan()
-        if kept is not None and not _headed_into(kept, sensed, sensing, until, first):
+        if kept is not None and not _headed_into(kept, sensed, sensing, until, first, s):
             return kept
     made = escape()
     if isinstance(made, dict):
         return done(task=plan.task, **made)
+    if spare is not None:
+        return done(task=plan.task, **spare)
     if kept is not None:
         return kept
+    assert outcome is not None
     return failed(outcome[0] + f"; and no escape: {made}", outcome[1])
 
 
 def _headed_into(kept: SensedPlan, sensed: Sequence[SensedObstacle], sensing: Sensing,
-                 until: float, first: int) -> bool:
+                 until: float, first: int, s: np.ndarray) -> bool:
     """Whether the kept tube may meet where a sensed obstacle is headed over the
-    :data:`FORESIGHT` after its certified horizon (``until``, absolute)."""
+    :data:`FORESIGHT` after its certified horizon (``until``, absolute); a closing one
+    (:func:`_closing`, towards ``s``) anywhere within its estimated speed too."""
     if not sensed:
         return False
     t_from = until - kept.start
-    ahead = foresight_boxes(sensed, _reach(kept.task), sensing.dims, kept.start, t_from,
+    reach = _reach(kept.task)
+    ahead = foresight_boxes(sensed, reach, sensing.dims, kept.start, t_from,
                             t_from + FORESIGHT, first, sensing.velocity_error)
     spec = replace(kept.local, moving_obstacles=kept.local.moving_obstacles + ahead)
-    return not check_tube(kept.design.tube, spec).passed
+    if not check_tube(kept.design.tube, spec).passed:
+        return True
+    return _pursued(kept.design, kept.start, kept.arrival, kept.task, sensed, sensing, until,
+                    s)
+
+
+def _pursued(design: Design, start: float, arrival: float, task: Spec,
+             sensed: Sequence[SensedObstacle], sensing: Sensing, until: float,
+             s: np.ndarray) -> bool:
+    """Whether a tube (``design`` from ``start``, due at ``arrival``, both absolute, s)
+    that is due after ``task``'s prescribed time, or holds its goal from ``until`` on, is
+    caught by an obstacle closing on the robot at ``s`` (:func:`_closing`) that heads for
+    the tube's box at every :data:`HEADED_STEP` from when it was seen, at its estimated
+    speed: its shape meets the box (grown by the robot's radius and ``velocity_error``
+    times the time since) between ``until`` and :data:`FORESIGHT` after it.
+
+    A prediction, not a bound: while a tube is due by ``t_c`` the obstacles' straight
+    walks steer it; once its arrival is lost or made, a closing obstacle is taken to turn
+    after the robot (a pursuer), and a tube that waits for it is not chosen."""
+    if arrival <= task.prescribed_time and until < arrival:
+        return False
+    closing = [ob for ob in sensed if _closing(ob, s)]
+    if not closing:
+        return False
+    dims = list(sensing.dims)
+    reach = _reach(task)
+    enc = robot_tube(design.tube, design.certificate).enclosure
+    last = enc.t_start.size - 1
+    for ob in closing:
+        p = np.asarray(ob.centre, dtype=float)
+        step = (_speed(ob) + sensing.velocity_error) * HEADED_STEP
+        t = ob.seen_at
+        while t <= until + FORESIGHT:
+            k = min(last, max(0, int(np.searchsorted(enc.t_start, t - start,
+                                                     side="right")) - 1))
+            lo, hi = enc.lower_min[k][dims], enc.upper_max[k][dims]
+            gap = float(np.linalg.norm(p - np.clip(p, lo, hi)))
+            if t >= until and gap <= ob.extent + reach + sensing.velocity_error * (
+                    t - ob.seen_at):
+                return True
+            aim = (lo + hi) / 2.0 - p
+            far = float(np.linalg.norm(aim))
+            p = p + aim * min(1.0, step / far) if far > 0.0 else p
+            t += HEADED_STEP
+    return False
+
+
+def _speed(ob: SensedObstacle) -> float:
+    """The speed of ``ob``'s velocity estimate (0 without one), state units per second."""
+    return 0.0 if ob.velocity is None else float(np.linalg.norm(ob.velocity))
+
+
+def _closing(ob: SensedObstacle, point: np.ndarray) -> bool:
+    """Whether ``ob``'s velocity estimate points within :data:`CLOSING_ANGLE` of ``point``
+    (on the sensing dimensions), at most :data:`CLOSING_SPEED` times
+    :data:`~.sensed_path.MIN_SPEED` fast."""
+    if ob.velocity is None or _speed(ob) > CLOSING_SPEED * MIN_SPEED:
+        return False
+    v = np.asarray(ob.velocity, dtype=float)
+    towards = np.asarray(point, dtype=float) - np.asarray(ob.centre, dtype=float)
+    size = float(np.linalg.norm(v) * np.linalg.norm(towards))
+    return size > 0.0 and float(v @ towards) >= math.cos(CLOSING_ANGLE) * size
 
 
 def foresight_boxes(sensed: Sequence[SensedObstacle], reach: float, dims: Sequence[int],
@@ -1007,7 +1096,7 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
             if not base.state_space.contains_box(goal) or _meets_static(base, goal, reach):
                 continue
             clear = min((_headed_clearance(ob, p, t_s, later, base.state_space, reach,
-                                           sensing) for ob in sensed),
+                                           sensing, point) for ob in sensed),
                         default=math.inf) - reach - float(np.linalg.norm(half))
             # a goal near the state space's boundary leaves fewer ways out next time (a
             # corner is a trap): its room to the boundary counts as a clearance too
@@ -1039,7 +1128,8 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
 
 
 def _headed_clearance(ob: SensedObstacle, point: np.ndarray, t_from: float, t_to: float,
-                      state_space: Box, reach: float, sensing: Sensing) -> float:
+                      state_space: Box, reach: float, sensing: Sensing,
+                      robot: np.ndarray | None = None) -> float:
     """The least distance from ``point`` to where ``ob`` is headed over ``[t_from, t_to]``
     (absolute, s), sampled every :data:`HEADED_STEP`: its centre moved along its velocity
     estimate (standing without one) and kept inside the walls (the state space of the
@@ -1062,6 +1152,10 @@ def _headed_clearance(ob: SensedObstacle, point: np.ndarray, t_from: float, t_to
     centres = np.clip(c + tau[:, None] * v, np.minimum(lo, hi), np.maximum(lo, hi))
     gaps = (np.linalg.norm(centres - point, axis=1) - ob.extent
             - sensing.velocity_error * tau)
+    if robot is not None and _closing(ob, robot):
+        # closing on the robot: anywhere within its estimated speed by t_to
+        gaps = np.append(gaps, np.linalg.norm(c - point) - ob.extent
+                         - (_speed(ob) + sensing.velocity_error) * tau[-1])
     return float(gaps.min())
 
 
