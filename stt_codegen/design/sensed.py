@@ -1072,8 +1072,9 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     points :data:`ESCAPE_DISTANCES` away in :data:`ESCAPE_DIRECTIONS` directions, inside
     the state space and clear of the static obstacles, ranked by their distance from where
     every sensed obstacle is headed from the switch until the tube has arrived plus the
-    horizon (:func:`_headed_clearance`) and from the state space's boundary (the largest
-    first, up to :data:`ESCAPE_CLEARANCE`), then by their distance to the target; at most
+    horizon (:func:`_headed_clearance`; a closing obstacle, :func:`_closing`, anywhere
+    within its estimated speed) and from the state space's boundary (the largest first, up
+    to :data:`ESCAPE_CLEARANCE`), then by their distance to the target; at most
     :data:`MAX_ESCAPES` designs.
     """
     dims = list(sensing.dims)
@@ -1135,7 +1136,10 @@ def _headed_clearance(ob: SensedObstacle, point: np.ndarray, t_from: float, t_to
     estimate (standing without one) and kept inside the walls (the state space of the
     reference point grown by the robot's radius ``reach``) shrunk by its extent,
     less its extent and ``velocity_error`` times the time since it was seen; state units,
-    negative inside.
+    negative inside. With ``robot`` (the reference point) and ``ob`` closing on it
+    (:func:`_closing`), also the distance from its centre less its estimated speed (and
+    ``velocity_error``) times the time from when it was seen to ``t_to``: it may head for
+    ``point``.
 
     A ranking, not a reachable set: the distance from the reachable set at ``t_to`` (which
     grows in every direction) ranks a corner that two obstacles are heading into above the
