@@ -132,23 +132,16 @@ def test_the_warehouse_refuses_an_adversary_by_its_flag(capsys):
 
 
 @pytest.mark.slow
-def test_one_warehouse_episode_is_reported():
-    report = run_sensed_bench(1, 0, counts=(6,), warehouse=True)
+@pytest.mark.parametrize("floor,count,options,title", [
+    ("warehouse", 6, {"warehouse": True}, "the warehouse floor, people crossing its aisles"),
+    ("script", 5, {"script": True, "adversary": True}, "Real-Time STT's script")])
+def test_one_episode_of_each_floor_is_reported(floor, count, options, title):
+    report = run_sensed_bench(1, 0, counts=(count,), **options)
     row = report["rows"][0]
-    assert report["floor"] == "warehouse" and row["episodes"] == 1
+    assert report["floor"] == floor and row["episodes"] == 1
     assert row["outside_envelope"] == 0 and row["collisions_certified"] == 0
     assert row["on_time"] + row["late"] + row["not_reached"] == 1
-    assert "the warehouse floor, people crossing its aisles" in format_sensed_report(report)
-
-
-@pytest.mark.slow
-def test_one_script_episode_with_its_pursuer_is_reported():
-    report = run_sensed_bench(1, 0, counts=(5,), adversary=True, script=True)
-    row = report["rows"][0]
-    assert report["floor"] == "script" and row["episodes"] == 1
-    assert row["outside_envelope"] == 0 and row["collisions_certified"] == 0
-    assert row["on_time"] + row["late"] + row["not_reached"] == 1
-    assert "Real-Time STT's script" in format_sensed_report(report)
+    assert title in format_sensed_report(report)
 
 
 @pytest.mark.slow
