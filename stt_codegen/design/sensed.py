@@ -1082,6 +1082,7 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     half = np.array([base.initial_half_width[d] for d in dims])
     target = np.asarray(base.target_center)[dims]
     later = t_s + ESCAPE_TIME + sensing.horizon
+    closing = [(ob, _closing(ob, point)) for ob in sensed]
     ranked = []
     for distance in ESCAPE_DISTANCES:
         for k in range(ESCAPE_DIRECTIONS if distance > 0.0 else 1):
@@ -1097,7 +1098,7 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
             if not base.state_space.contains_box(goal) or _meets_static(base, goal, reach):
                 continue
             clear = min((_headed_clearance(ob, p, t_s, later, base.state_space, reach,
-                                           sensing, point) for ob in sensed),
+                                           sensing, heads) for ob, heads in closing),
                         default=math.inf) - reach - float(np.linalg.norm(half))
             # a goal near the state space's boundary leaves fewer ways out next time (a
             # corner is a trap): its room to the boundary counts as a clearance too
@@ -1130,16 +1131,15 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
 
 def _headed_clearance(ob: SensedObstacle, point: np.ndarray, t_from: float, t_to: float,
                       state_space: Box, reach: float, sensing: Sensing,
-                      robot: np.ndarray | None = None) -> float:
+                      closing: bool = False) -> float:
     """The least distance from ``point`` to where ``ob`` is headed over ``[t_from, t_to]``
     (absolute, s), sampled every :data:`HEADED_STEP`: its centre moved along its velocity
     estimate (standing without one) and kept inside the walls (the state space of the
     reference point grown by the robot's radius ``reach``) shrunk by its extent,
     less its extent and ``velocity_error`` times the time since it was seen; state units,
-    negative inside. With ``robot`` (the reference point) and ``ob`` closing on it
-    (:func:`_closing`), also the distance from its centre less its estimated speed (and
-    ``velocity_error``) times the time from when it was seen to ``t_to``: it may head for
-    ``point``.
+    negative inside. For an obstacle ``closing`` on the robot (:func:`_closing`), also the
+    distance from its centre less its estimated speed (and ``velocity_error``) times the
+    time from when it was seen to ``t_to``: it may head for ``point``.
 
     A ranking, not a reachable set: the distance from the reachable set at ``t_to`` (which
     grows in every direction) ranks a corner that two obstacles are heading into above the
@@ -1156,7 +1156,7 @@ def _headed_clearance(ob: SensedObstacle, point: np.ndarray, t_from: float, t_to
     centres = np.clip(c + tau[:, None] * v, np.minimum(lo, hi), np.maximum(lo, hi))
     gaps = (np.linalg.norm(centres - point, axis=1) - ob.extent
             - sensing.velocity_error * tau)
-    if robot is not None and _closing(ob, robot):
+    if closing:
         # closing on the robot: anywhere within its estimated speed by t_to
         gaps = np.append(gaps, np.linalg.norm(c - point) - ob.extent
                          - (_speed(ob) + sensing.velocity_error) * tau[-1])

@@ -212,15 +212,6 @@ def _cmd_fleet(args: argparse.Namespace) -> int:
 
 def _cmd_sensed(args: argparse.Namespace) -> int:
     from .sensed_bench import format_sensed_report, run_sensed_bench
-    if args.warehouse and (args.adversary or args.acceleration is not None):
-        raise SpecError("--warehouse", "the warehouse floor's people walk straight and "
-                                       "start at once: not with --adversary or "
-                                       "--acceleration")
-    if args.script and (args.warehouse or args.acceleration is not None
-                        or _int_list(args.obstacles, "--obstacles") != [5]):
-        raise SpecError("--script", "Real-Time STT's script has five circles at constant "
-                                    "velocities: --obstacles 5, not with --warehouse or "
-                                    "--acceleration")
     report = run_sensed_bench(args.count, args.seed,
                               tuple(_int_list(args.obstacles, "--obstacles")),
                               adversary=args.adversary, acceleration=args.acceleration,

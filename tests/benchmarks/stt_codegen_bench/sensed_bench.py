@@ -31,6 +31,7 @@ import time
 import numpy as np
 
 import stt_codegen as stt
+from stt_codegen.errors import SpecError
 from stt_codegen.runtime.sensed import WalkingObstacle
 
 from .sensed_script import PURSUER_RADIUS, PURSUER_START, SCRIPT, script_circles
@@ -169,11 +170,13 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
     warehouse : bool
         The warehouse floor with people crossing its aisles instead
         (:mod:`.sensed_warehouse`; ``counts`` are people; episode ``e`` draws from
-        ``[seed, N, e]``); not with ``adversary`` or ``acceleration``.
+        ``[seed, N, e]``); not with ``adversary`` or ``acceleration``
+        (:class:`~stt_codegen.errors.SpecError`, field ``--warehouse``).
     script : bool
         Real-Time STT's own script instead, its five circles seeded
         (:mod:`.sensed_script`; ``counts`` must be ``(5,)``); the pursuer starts at the
-        target's centre at the script's speed bound; not with ``acceleration``.
+        target's centre at the script's speed bound; not with ``acceleration`` or
+        ``warehouse`` (:class:`~stt_codegen.errors.SpecError`, field ``--script``).
 
     Returns
     -------
@@ -182,15 +185,17 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         and that had uncertified spans (``e``: rerun one with the same ``seed`` and ``N``).
     """
     if warehouse and (adversary or acceleration is not None):
-        raise ValueError("the warehouse floor has neither an adversary nor an acceleration "
-                         "bound")
+        raise SpecError("--warehouse", "the warehouse floor's people walk straight and start "
+                                       "at once: not with --adversary or --acceleration")
     if script and (warehouse or acceleration is not None or tuple(counts) != (5,)):
-        raise ValueError("Real-Time STT's script has five circles at constant velocities: "
-                         "not with the warehouse, an acceleration bound or another count")
+        raise SpecError("--script", "Real-Time STT's script has five circles at constant "
+                                    "velocities: --obstacles 5, not with --warehouse or "
+                                    "--acceleration")
     scenario = (WAREHOUSE if warehouse else SCRIPT if script else
                 scenario_with(None if speed_only else acceleration))
     design = stt.design_tube(stt.Spec.from_dict(scenario))
     speed = scenario["sensing"]["max_obstacle_speed"]
+    pursuer = (PURSUER_START, PURSUER_RADIUS) if script else ((7.0, 1.0), 0.3)
     t_c = scenario["prescribed_time"]
     target = scenario["target"]
     rows = []
@@ -208,10 +213,7 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
                          moving_circles(rng, count, t_c + 1.0,
                                         None if acceleration is None else acceleration / 2.0))
             if adversary:
-                obstacles.append(WalkingObstacle(PURSUER_START, PURSUER_RADIUS,
-                                                 pursuit_speed=speed)
-                                 if script else
-                                 WalkingObstacle((7.0, 1.0), 0.3, pursuit_speed=speed,
+                obstacles.append(WalkingObstacle(*pursuer, pursuit_speed=speed,
                                                  pursuit_acceleration=acceleration))
             run = stt.simulate_sensed(design, obstacles, seed=e)
             record = run.sensing
