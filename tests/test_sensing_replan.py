@@ -249,9 +249,53 @@ def test_a_slow_obstacle_closing_on_a_robot_that_has_arrived_is_taken_to_pursue_
         assert not sensed_module._pursued(own.design, own.start, own.arrival, own.task,
                                           [ob], sensing, until, here)
     due = switch_time(sensing, 5.0, design.spec.rate_hz) + sensing.horizon
+    early = dataclasses.replace(circle, seen_at=5.0)
     assert not sensed_module._pursued(own.design, own.start, own.arrival, own.task,
-                                      [dataclasses.replace(circle, seen_at=5.0)], sensing,
-                                      due, here)
+                                      [early], sensing, due, here)
+    # a robot that has been in the target (on its way back after an escape, in a tube
+    # due by t_c) is pursued all the same
+    assert sensed_module._pursued(own.design, own.start, own.arrival, own.task, [early],
+                                  sensing, due, here, reached=True)
+
+
+def test_a_plan_remembers_that_the_robot_has_been_in_the_target():
+    """``SensedPlan.reached``: a measurement inside the target sets it, and the plans
+    replanned from one that has it keep it wherever the robot is measured next."""
+    from stt_codegen_bench.sensed_script import SCRIPT
+    design = stt.design_tube(stt.Spec.from_dict(SCRIPT))
+    own = stt.start_plan(design)
+    space = design.spec.state_space
+    first = stt.replan(own, 1.0, sensed_module._box_at(own, 1.0, space).center, [])
+    assert isinstance(first, stt.SensedPlan) and not own.reached and not first.reached
+    there = stt.replan(first, 16.0, design.spec.target_center, [])
+    assert isinstance(there, stt.SensedPlan) and there.reached
+    back = stt.replan(dataclasses.replace(first, reached=True), 1.25,
+                      sensed_module._box_at(own, 1.25, space).center, [])
+    assert isinstance(back, stt.SensedPlan) and back.reached
+
+
+def test_an_escape_from_a_pursuer_counts_its_way_there_and_the_wait():
+    """A circle of radius 0.5 at the origin, seen at 0 s, closing at 0.45 m/s on a robot at
+    (2, 0) that escapes from 0 s to a goal in 1 s and holds it until 3.5 s. Away from the
+    circle, to (2.5, 0): the circle walks after it, 28 steps of 0.125 s by 3.5 s, so the
+    least distance comes at the end, 2.5 - 28 x 0.05625 less its extent; a shorter wait
+    leaves more. Past the circle, to (-2.5, 0.3), farther from where it was seen: the way
+    passes through it, which the ball it may reach (the ranking before) does not see."""
+    from stt_codegen_bench.sensed_script import SCRIPT
+    sensing = stt.Spec.from_dict(SCRIPT).sensing
+    circle = stt.SensedObstacle.ball((0.0, 0.0), 0.5, seen_at=0.0, velocity=(0.45, 0.0))
+    here = np.array([2.0, 0.0])
+
+    def clearance(goal, until=3.5):
+        return sensed_module._pursuit_clearance(circle, here, np.asarray(goal, float), 0.0,
+                                                1.0, until, sensing)
+
+    walked = 28 * (0.45 + sensing.velocity_error) * sensed_module.HEADED_STEP
+    away = clearance((2.5, 0.0))
+    assert away == pytest.approx(2.5 - walked - 0.5 - sensing.velocity_error * 3.5)
+    assert clearance((2.5, 0.0), until=1.0) > away > 0.0
+    assert clearance((-2.5, 0.3)) < -0.25
+    assert np.hypot(-2.5, 0.3) > 2.5
 
 
 def test_a_replanned_tube_due_near_t_c_gives_way_to_a_sooner_path():

@@ -37,8 +37,8 @@ from __future__ import annotations
 import functools
 import math
 import time
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Sequence
 
 import numpy as np
 
@@ -144,6 +144,10 @@ class SensedPlan:
     goal : Box or None
         An escape's temporary goal, which the tube reaches instead of the target and then
         holds (the next plans try the target first); ``None``: the tube goes to the target.
+    reached : bool
+        The robot has been measured inside the target by this plan's measurement or an
+        earlier one in its chain of replans (an obstacle closing on it is then taken to
+        pursue it, docs/sensing.md).
 
     Examples
     --------
@@ -170,6 +174,7 @@ class SensedPlan:
     time_s: float = 0.0
     cpu_s: float = 0.0
     goal: Box | None = field(default=None, repr=False)
+    reached: bool = False
 
     @property
     def shortened(self) -> bool:
@@ -700,9 +705,13 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     s = _position(local, sensing, position)
     t_s = switch_time(sensing, t_m, local.rate_hz)
     until = t_s + sensing.horizon
+    target = plan.task.target_set
+    reached = plan.reached or all(target.lower[d] <= s[k] <= target.upper[d]
+                                  for k, d in enumerate(sensing.dims))
 
     def done(**fields) -> SensedPlan:
         return SensedPlan(**fields, measured_at=t_m, guarantee_until=until, sensed=sensed,
+                          reached=reached,
                           time_s=time.perf_counter() - started,
                           cpu_s=time.process_time() - cpu)
 
@@ -748,7 +757,7 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
         # a new tube due late, or holding its goal, that an obstacle closing on the robot
         # would catch were it to turn after it: certified, but kept only as a spare
         return _pursued(made["design"], made["start"], made["arrival"], base, sensed,
-                        sensing, until, s)
+                        sensing, until, s, reached)
 
     # 1. the active tube, certified again from the measurement on (an escape's after the
     #    target has been tried again)
@@ -833,23 +842,24 @@ def _headed_into(kept: SensedPlan, sensed: Sequence[SensedObstacle], sensing: Se
     if not check_tube(kept.design.tube, spec).passed:
         return True
     return _pursued(kept.design, kept.start, kept.arrival, kept.task, sensed, sensing, until,
-                    s)
+                    s, kept.reached)
 
 
 def _pursued(design: Design, start: float, arrival: float, task: Spec,
              sensed: Sequence[SensedObstacle], sensing: Sensing, until: float,
-             s: np.ndarray) -> bool:
+             s: np.ndarray, reached: bool = False) -> bool:
     """Whether a tube (``design`` from ``start``, due at ``arrival``, both absolute, s)
-    that is due after ``task``'s prescribed time, or holds its goal from ``until`` on, is
-    caught by an obstacle closing on the robot at ``s`` (:func:`_closing`) that heads for
-    the tube's box at every :data:`HEADED_STEP` from when it was seen, at its estimated
-    speed: its shape meets the box (grown by the robot's radius and ``velocity_error``
-    times the time since) between ``until`` and :data:`FORESIGHT` after it.
+    of a robot that has ``reached`` the target, or that is due after ``task``'s prescribed
+    time, or holds its goal from ``until`` on, is caught by an obstacle closing on the
+    robot at ``s`` (:func:`_closing`) that heads for the tube's box (:func:`_pursuit`):
+    its shape meets the box (grown by the robot's radius and ``velocity_error`` times the
+    time since) between ``until`` and :data:`FORESIGHT` after it.
 
     A prediction, not a bound: while a tube is due by ``t_c`` the obstacles' straight
-    walks steer it; once its arrival is lost or made, a closing obstacle is taken to turn
-    after the robot (a pursuer), and a tube that waits for it is not chosen."""
-    if arrival <= task.prescribed_time and until < arrival:
+    walks steer it; once its arrival is lost or made (also on the way back to the target
+    after an escape), a closing obstacle is taken to turn after the robot (a pursuer),
+    and a tube that waits for it is not chosen."""
+    if not reached and arrival <= task.prescribed_time and until < arrival:
         return False
     closing = [ob for ob in sensed if _closing(ob, s)]
     if not closing:
@@ -858,23 +868,39 @@ def _pursued(design: Design, start: float, arrival: float, task: Spec,
     reach = _reach(task)
     enc = robot_tube(design.tube, design.certificate).enclosure
     last = enc.t_start.size - 1
+
+    def box(t: float) -> tuple[np.ndarray, np.ndarray]:
+        k = min(last, max(0, int(np.searchsorted(enc.t_start, t - start, side="right")) - 1))
+        return enc.lower_min[k][dims], enc.upper_max[k][dims]
+
+    def centre(t: float) -> np.ndarray:
+        lo, hi = box(t)
+        return (lo + hi) / 2.0
+
     for ob in closing:
-        p = np.asarray(ob.centre, dtype=float)
-        step = (_speed(ob) + sensing.velocity_error) * HEADED_STEP
-        t = ob.seen_at
-        while t <= until + FORESIGHT:
-            k = min(last, max(0, int(np.searchsorted(enc.t_start, t - start,
-                                                     side="right")) - 1))
-            lo, hi = enc.lower_min[k][dims], enc.upper_max[k][dims]
+        for t, p in _pursuit(ob, sensing, until + FORESIGHT, centre):
+            lo, hi = box(t)
             gap = float(np.linalg.norm(p - np.clip(p, lo, hi)))
             if t >= until and gap <= ob.extent + reach + sensing.velocity_error * (
                     t - ob.seen_at):
                 return True
-            aim = (lo + hi) / 2.0 - p
-            far = float(np.linalg.norm(aim))
-            p = p + aim * min(1.0, step / far) if far > 0.0 else p
-            t += HEADED_STEP
     return False
+
+
+def _pursuit(ob: SensedObstacle, sensing: Sensing, t_to: float,
+             aim: Callable[[float], np.ndarray]) -> Iterator[tuple[float, np.ndarray]]:
+    """``ob`` turning after the robot: its centre at every :data:`HEADED_STEP` from when
+    it was seen until ``t_to`` (absolute, s), each step heading for ``aim(t)`` at its
+    estimated speed (and ``velocity_error``); ``(t, centre)`` pairs."""
+    p = np.asarray(ob.centre, dtype=float)
+    step = (_speed(ob) + sensing.velocity_error) * HEADED_STEP
+    t = ob.seen_at
+    while t <= t_to:
+        yield t, p
+        towards = aim(t) - p
+        far = float(np.linalg.norm(towards))
+        p = p + towards * min(1.0, step / far) if far > 0.0 else p
+        t += HEADED_STEP
 
 
 def _speed(ob: SensedObstacle) -> float:
@@ -1072,10 +1098,11 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     points :data:`ESCAPE_DISTANCES` away in :data:`ESCAPE_DIRECTIONS` directions, inside
     the state space and clear of the static obstacles, ranked by their distance from where
     every sensed obstacle is headed from the switch until the tube has arrived plus the
-    horizon (:func:`_headed_clearance`; a closing obstacle, :func:`_closing`, anywhere
-    within its estimated speed) and from the state space's boundary (the largest first, up
-    to :data:`ESCAPE_CLEARANCE`), then by their distance to the target; at most
-    :data:`MAX_ESCAPES` designs.
+    horizon (:func:`_headed_clearance`; from a closing obstacle, :func:`_closing`, taken to
+    turn after the robot on its way there and while it holds the goal for
+    :data:`FORESIGHT` more, :func:`_pursuit_clearance`) and from the state space's
+    boundary (the largest first, up to :data:`ESCAPE_CLEARANCE`), then by their distance
+    to the target; at most :data:`MAX_ESCAPES` designs.
     """
     dims = list(sensing.dims)
     reach = _reach(base)
@@ -1097,8 +1124,10 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
             goal = Box(tuple(lo), tuple(hi))
             if not base.state_space.contains_box(goal) or _meets_static(base, goal, reach):
                 continue
-            clear = min((_headed_clearance(ob, p, t_s, later, base.state_space, reach,
-                                           sensing, heads) for ob, heads in closing),
+            clear = min((_pursuit_clearance(ob, point, p, t_s, t_s + ESCAPE_TIME,
+                                            later + FORESIGHT, sensing) if heads else
+                         _headed_clearance(ob, p, t_s, later, base.state_space, reach,
+                                           sensing) for ob, heads in closing),
                         default=math.inf) - reach - float(np.linalg.norm(half))
             # a goal near the state space's boundary leaves fewer ways out next time (a
             # corner is a trap): its room to the boundary counts as a clearance too
@@ -1130,16 +1159,13 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
 
 
 def _headed_clearance(ob: SensedObstacle, point: np.ndarray, t_from: float, t_to: float,
-                      state_space: Box, reach: float, sensing: Sensing,
-                      closing: bool = False) -> float:
+                      state_space: Box, reach: float, sensing: Sensing) -> float:
     """The least distance from ``point`` to where ``ob`` is headed over ``[t_from, t_to]``
     (absolute, s), sampled every :data:`HEADED_STEP`: its centre moved along its velocity
     estimate (standing without one) and kept inside the walls (the state space of the
     reference point grown by the robot's radius ``reach``) shrunk by its extent,
     less its extent and ``velocity_error`` times the time since it was seen; state units,
-    negative inside. For an obstacle ``closing`` on the robot (:func:`_closing`), also the
-    distance from its centre less its estimated speed (and ``velocity_error``) times the
-    time from when it was seen to ``t_to``: it may head for ``point``.
+    negative inside.
 
     A ranking, not a reachable set: the distance from the reachable set at ``t_to`` (which
     grows in every direction) ranks a corner that two obstacles are heading into above the
@@ -1156,11 +1182,27 @@ def _headed_clearance(ob: SensedObstacle, point: np.ndarray, t_from: float, t_to
     centres = np.clip(c + tau[:, None] * v, np.minimum(lo, hi), np.maximum(lo, hi))
     gaps = (np.linalg.norm(centres - point, axis=1) - ob.extent
             - sensing.velocity_error * tau)
-    if closing:
-        # closing on the robot: anywhere within its estimated speed by t_to
-        gaps = np.append(gaps, np.linalg.norm(c - point) - ob.extent
-                         - (_speed(ob) + sensing.velocity_error) * tau[-1])
     return float(gaps.min())
+
+
+def _pursuit_clearance(ob: SensedObstacle, start: np.ndarray, goal: np.ndarray,
+                       t_from: float, t_goal: float, t_to: float, sensing: Sensing) -> float:
+    """The least distance between the robot's reference point, moving straight from
+    ``start`` at ``t_from`` to ``goal`` at ``t_goal`` and holding it until ``t_to``
+    (absolute, s), and ``ob`` turning after it (a pursuer, :func:`_closing`,
+    :func:`_pursuit`), less its extent and ``velocity_error`` times the time since it was
+    seen; state units, negative inside.
+
+    A ranking, not a bound: it prefers a goal the pursuer reaches late, by a way that
+    does not pass it, to the corner behind the robot."""
+    def robot(t: float) -> np.ndarray:
+        share = min(1.0, max(0.0, (t - t_from) / (t_goal - t_from)))
+        return start + share * (goal - start)
+
+    return min((float(np.linalg.norm(robot(t) - p)) - ob.extent
+                - sensing.velocity_error * (t - ob.seen_at)
+                for t, p in _pursuit(ob, sensing, t_to, robot) if t >= t_from),
+               default=math.inf)
 
 
 def _meets_static(spec: Spec, box: Box, reach: float) -> bool:
