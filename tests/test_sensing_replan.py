@@ -294,8 +294,7 @@ def test_an_escape_from_a_pursuer_counts_its_way_there_and_the_wait():
     away = clearance((2.5, 0.0))
     assert away == pytest.approx(2.5 - walked - 0.5 - sensing.velocity_error * 3.5)
     assert clearance((2.5, 0.0), until=1.0) > away > 0.0
-    assert clearance((-2.5, 0.3)) < -0.25
-    assert np.hypot(-2.5, 0.3) > 2.5
+    assert clearance((-2.5, 0.3)) < -0.25 < away
 
 
 def test_a_replanned_tube_due_near_t_c_gives_way_to_a_sooner_path():
