@@ -400,3 +400,44 @@ def test_a_failure_over_both_horizons_says_so():
     assert isinstance(failed, stt.ReplanFailure)
     assert "; over the shortest horizon (0.25 s): " in failed.reason
     assert failed.guarantee_until == plan.guarantee_until
+
+
+def test_a_failure_carries_an_uncertified_escape_away_from_the_obstacle():
+    """An obstacle closing on the robot from beside it: its reachable set already meets
+    where the robot will be at the switch, so no plan is certified over either horizon.
+    The failure carries a best-effort escape: it takes over only at the first sample the
+    active plan is no longer certified, covers no span (``guarantee_until`` is its
+    switch), and goes away from the obstacle."""
+    plan = arena_plan()
+    here = np.asarray(sensed_module._box_at(plan, 1.0, plan.task.state_space).center)
+    kept = stt.replan(plan, 1.0, here, [])
+    assert isinstance(kept, stt.SensedPlan) and kept.kept
+    t_m = 1.25
+    here = np.asarray(sensed_module._box_at(kept, t_m, plan.task.state_space).center)
+    centre = here + 0.45
+    closing = [stt.SensedObstacle.ball(tuple(centre), 0.4, seen_at=t_m,
+                                       velocity=(-0.2, -0.2))]
+    failed = stt.replan(kept, t_m, here, closing)
+    assert isinstance(failed, stt.ReplanFailure) and failed.kind == "design"
+    best = failed.fallback
+    assert best is not None and best.best_effort and best.goal is not None
+    sensing = plan.task.sensing
+    assert switch_time(sensing, t_m, plan.task.rate_hz) < kept.guarantee_until
+    assert best.switch_at == pytest.approx(kept.guarantee_until, abs=1e-12)
+    assert best.start == best.certified_from == best.guarantee_until == best.switch_at
+    assert not best.shortened and not best.kept and best.measured_at == t_m
+    assert best.cpu_s == failed.cpu_s         # the failure's time includes the escape's
+    goal = np.asarray(best.goal.center)
+    assert np.linalg.norm(goal - centre) > np.linalg.norm(here - centre) + 1.0
+    # the next measurement, with the way clear: the escape itself is certified, from
+    # that measurement on, so that its certificate covers the time since it took over
+    t_m = 1.5
+    there = np.asarray(sensed_module._box_at(best, 0.0, plan.task.state_space).center)
+    next_plan = stt.replan(best, t_m, there, [])
+    assert isinstance(next_plan, stt.SensedPlan) and next_plan.kept
+    assert not next_plan.best_effort and next_plan.goal == best.goal
+    assert next_plan.certified_from == t_m < best.switch_at < next_plan.guarantee_until
+    # a measurement outside the envelope gets no escape
+    large = [stt.SensedObstacle.ball(tuple(centre), 2.0, seen_at=t_m)]
+    outside = stt.replan(kept, t_m, here, large)
+    assert outside.kind == "envelope" and outside.fallback is None

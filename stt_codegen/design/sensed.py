@@ -148,6 +148,11 @@ class SensedPlan:
         The robot has been measured inside the target by this plan's measurement or an
         earlier one in its chain of replans (an obstacle closing on it is then taken to
         pursue it, docs/sensing.md).
+    best_effort : bool
+        No certificate against the sensed obstacles (``certified_from`` and
+        ``guarantee_until`` are its switch): the best escape found after no plan was
+        certified (:attr:`ReplanFailure.fallback`), which takes over when the certified
+        span of the plan it replaces has run out.
 
     Examples
     --------
@@ -175,6 +180,7 @@ class SensedPlan:
     cpu_s: float = 0.0
     goal: Box | None = field(default=None, repr=False)
     reached: bool = False
+    best_effort: bool = False
 
     @property
     def shortened(self) -> bool:
@@ -182,7 +188,8 @@ class SensedPlan:
         over its ``horizon`` ``H``: no plan was certified over ``H`` from its measurement
         (docs/sensing.md, "How the next plan is made"). False when ``H_min = H``."""
         sensing = self.task.sensing
-        if sensing is None or not sensing.shortest_horizon < sensing.horizon:
+        if self.best_effort or sensing is None or not (
+                sensing.shortest_horizon < sensing.horizon):
             return False
         span = self.guarantee_until - switch_time(sensing, self.measured_at,
                                                   self.task.rate_hz)
@@ -208,6 +215,13 @@ class ReplanFailure:
         Until when the plan that stays active is certified, s.
     time_s, cpu_s : float
         Wall and processor time of the call, s.
+    fallback : SensedPlan or None
+        A best-effort escape (:attr:`SensedPlan.best_effort`) for a ``design`` or
+        ``region`` failure: a temporary goal reached by a tube certified against every
+        sensed obstacle's reachable set except those that already meet the box it starts
+        from, which it avoids only where they are headed (or not at all); ``None`` when
+        none is designed. Running it leaves the robot uncertified as the failure does,
+        but moving away rather than holding its tube (docs/sensing.md).
 
     Examples
     --------
@@ -225,6 +239,7 @@ class ReplanFailure:
     guarantee_until: float
     time_s: float = 0.0
     cpu_s: float = 0.0
+    fallback: SensedPlan | None = field(default=None, repr=False)
 
 
 def switch_time(sensing: Sensing, measured_at: float, rate_hz: float) -> float:
@@ -464,7 +479,7 @@ def _certify(design: Design, local: Spec, sensing: Sensing, sensed: Sequence[Sen
     """``design``'s tube checked against the sensed obstacles' boxes over ``[t_from, t_to]``
     (its time) and the region certificate: the design with that check, or ``None`` and the
     reason, with the two margins."""
-    first = len(local.unsafe_sets) + len(local.moving_obstacles) + 1_000
+    first = _first_source(local)
     boxes = reachable_boxes(sensed, sensing.max_obstacle_speed, _reach(local), sensing.dims,
                             start, t_from, t_to, first, **_drift(sensing))
     spec = replace(local, moving_obstacles=local.moving_obstacles + boxes)
@@ -620,8 +635,10 @@ def replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     body inside the region no obstacle unseen at ``t_m`` can have reached
     (:func:`region_margin`). When no plan is certified over ``[t_s, t_s + H]``, the same
     steps run over ``[t_s, t_s + H_min]`` (``[sensing] shortest_horizon``; the plan is
-    then :attr:`SensedPlan.shortened`). The run time switches to a new tube at ``t_s``
-    only if the state lies in it then (docs/sensing.md).
+    then :attr:`SensedPlan.shortened`). When none is certified either, the failure carries
+    a best-effort escape, not certified against the reachable sets
+    (:attr:`ReplanFailure.fallback`). The run time switches to a new tube at ``t_s`` only
+    if the state lies in it then (docs/sensing.md).
 
     Parameters
     ----------
@@ -637,7 +654,8 @@ def replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     Returns
     -------
     SensedPlan or ReplanFailure
-        The kept or new plan; or the failure, with the active plan's ``guarantee_until``.
+        The kept or new plan; or the failure, with the active plan's ``guarantee_until``
+        and its ``fallback``.
 
     Raises
     ------
@@ -665,14 +683,20 @@ def replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     with without_advice():
         made = _replan(plan, measured_at, position, sensed, None)
         sensing = _sensing(plan.task)
-        if not isinstance(made, ReplanFailure) or sensing.shortest_horizon >= sensing.horizon:
+        if isinstance(made, ReplanFailure) and sensing.shortest_horizon < sensing.horizon:
+            short = _replan(plan, measured_at, position, sensed, sensing.shortest_horizon)
+            spent = {"time_s": short.time_s + made.time_s, "cpu_s": short.cpu_s + made.cpu_s}
+            made = replace(short, **spent) if isinstance(short, SensedPlan) else replace(
+                made, reason=_over_both(made.reason, sensing.shortest_horizon, short.reason),
+                **spent)
+        if not isinstance(made, ReplanFailure) or made.kind == "envelope":
             return made
-        short = _replan(plan, measured_at, position, sensed, sensing.shortest_horizon)
-    spent = {"time_s": short.time_s + made.time_s, "cpu_s": short.cpu_s + made.cpu_s}
-    if isinstance(short, SensedPlan):
-        return replace(short, **spent)
-    return replace(made, reason=_over_both(made.reason, sensing.shortest_horizon,
-                                           short.reason), **spent)
+        # no plan certified: an escape all the same, for the robot to run uncertified
+        started, cpu = time.perf_counter(), time.process_time()
+        best = _best_effort(plan, made.measured_at, position, sensed)
+    spent = {"time_s": made.time_s + time.perf_counter() - started,
+             "cpu_s": made.cpu_s + time.process_time() - cpu}
+    return replace(made, fallback=None if best is None else replace(best, **spent), **spent)
 
 
 def _over_both(reason: str, shortest: float, short_reason: str) -> str:
@@ -705,9 +729,7 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     s = _position(local, sensing, position)
     t_s = switch_time(sensing, t_m, local.rate_hz)
     until = t_s + sensing.horizon
-    target = plan.task.target_set
-    reached = plan.reached or all(target.lower[d] <= s[k] <= target.upper[d]
-                                  for k, d in enumerate(sensing.dims))
+    reached = _reached(plan, s, sensing)
 
     def done(**fields) -> SensedPlan:
         return SensedPlan(**fields, measured_at=t_m, guarantee_until=until, sensed=sensed,
@@ -734,7 +756,7 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
                     kept=True, sensed_margin=margin, region_margin=room, goal=plan.goal)
 
     base = plan.task
-    first = len(base.unsafe_sets) + len(base.moving_obstacles) + 1_000
+    first = _first_source(base)
     boxes = reachable_boxes(sensed, sensing.max_obstacle_speed, _reach(base), sensing.dims,
                             t_s, 0.0, sensing.horizon, first, **_drift(sensing))
     moving = _shifted(base.moving_obstacles, t_s)
@@ -760,8 +782,9 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
                         sensing, until, s, reached)
 
     # 1. the active tube, certified again from the measurement on (an escape's after the
-    #    target has been tried again)
-    kept = kept_plan() if plan.goal is None else None
+    #    target has been tried again; a best-effort escape's first, for its certificate to
+    #    cover the time since it took over)
+    kept = kept_plan() if plan.goal is None or plan.best_effort else None
     if kept is not None:
         # a kept tube headed where an obstacle is going: a way round it, else out of its
         # way; a replanned tube due near t_c or late (not the spec's own, which starts at
@@ -812,7 +835,7 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
         outcome = outcome or made
     # 3. an escape's tube kept (unless headed where an obstacle is going), or a new
     #    escape to a temporary goal, else the escape's tube kept all the same
-    if plan.goal is not None:
+    if plan.goal is not None and not plan.best_effort:       # (tried in step 1)
         kept = kept_plan()
         if kept is not None and not _headed_into(kept, sensed, sensing, until, first, s):
             return kept
@@ -1098,8 +1121,8 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     points :data:`ESCAPE_DISTANCES` away in :data:`ESCAPE_DIRECTIONS` directions, inside
     the state space and clear of the static obstacles, ranked by their distance from where
     every sensed obstacle is headed from the switch until the tube has arrived plus the
-    horizon (:func:`_headed_clearance`; from a closing obstacle, :func:`_closing`, taken to
-    turn after the robot on its way there and while it holds the goal for
+    horizon (:func:`_headed_clearance`; from an obstacle closing on the robot at ``s`` or at
+    ``point``, :func:`_closing`, taken to turn after the robot on its way there and while it holds the goal for
     :data:`FORESIGHT` more, :func:`_pursuit_clearance`) and from the state space's
     boundary (the largest first, up to :data:`ESCAPE_CLEARANCE`), then by their distance
     to the target; at most :data:`MAX_ESCAPES` designs.
@@ -1109,7 +1132,7 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     half = np.array([base.initial_half_width[d] for d in dims])
     target = np.asarray(base.target_center)[dims]
     later = t_s + ESCAPE_TIME + sensing.horizon
-    closing = [(ob, _closing(ob, point)) for ob in sensed]
+    closing = [(ob, _closing(ob, point) or _closing(ob, s)) for ob in sensed]
     ranked = []
     for distance in ESCAPE_DISTANCES:
         for k in range(ESCAPE_DIRECTIONS if distance > 0.0 else 1):
@@ -1156,6 +1179,69 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
         return "no temporary goal inside the state space and clear of the obstacles"
     return (f"{min(len(ranked), MAX_ESCAPES)} temporary goals tried, none certified ("
             + ", ".join(str(r) for r in reasons) + ")")
+
+
+def _best_effort(plan: SensedPlan, t_m: float, position: Sequence[float],
+                 sensed: Sequence[SensedObstacle]) -> SensedPlan | None:
+    """:attr:`ReplanFailure.fallback` for a measurement at ``t_m`` (``sensed`` and the
+    reference point at ``position``, checked by :func:`_replan`), or ``None``: an escape
+    (:func:`_escape`) that takes over at the switch ``t_s`` or, later, at the first sample
+    from which ``plan`` is no longer certified. It avoids each sensed obstacle's reachable
+    set over the horizon; where that meets the box the escape starts from (no tube avoids
+    it), where the obstacle is headed (:func:`foresight_boxes`); where that meets it too,
+    nothing (the goal's ranking alone keeps away from it). Certified against those boxes,
+    against nothing that bounds where the obstacles may be."""
+    base = plan.task
+    sensing = _sensing(base)
+    sensed = _checked(sensed, sensing, t_m)
+    s = _position(plan.local, sensing, position)
+    rate = base.rate_hz
+    t_f = max(switch_time(sensing, t_m, rate),
+              math.ceil(plan.guarantee_until * rate - 1e-9) / rate)
+    active = _box_at(plan, t_f - plan.start, base.state_space)
+    point = _predicted(plan, active, s, t_m, sensing)
+    box = _switch_box(base, active, point, sensing) or active
+    reach = _reach(base)
+    avoided: list[MovingObstacle] = []
+    for ob in sensed:
+        for kept in (reachable_boxes([ob], sensing.max_obstacle_speed, reach, sensing.dims,
+                                     t_f, 0.0, sensing.horizon, 0, **_drift(sensing)),
+                     foresight_boxes([ob], reach, sensing.dims, t_f, 0.0, sensing.horizon, 0,
+                                     sensing.velocity_error)):
+            if not _meets_start(kept, box):
+                avoided.extend(kept)
+                break
+    first = _first_source(base)
+    boxes = tuple(replace(b, source=first + k) for k, b in enumerate(avoided))
+    made = _escape(base, box, _shifted(base.moving_obstacles, t_f), boxes, sensed, sensing,
+                   s, t_m, t_f, first, point)
+    if not isinstance(made, dict):
+        return None
+    return SensedPlan(**dict(made, certified_from=t_f), task=base, measured_at=t_m,
+                      guarantee_until=t_f, sensed=sensed, best_effort=True,
+                      reached=_reached(plan, s, sensing))
+
+
+def _first_source(spec: Spec) -> int:
+    """The obstacle index of the first box standing for a sensed obstacle in a tube
+    designed or checked for ``spec`` (past its own obstacles)."""
+    return len(spec.unsafe_sets) + len(spec.moving_obstacles) + 1_000
+
+
+def _reached(plan: SensedPlan, s: np.ndarray, sensing: Sensing) -> bool:
+    """:attr:`SensedPlan.reached` for the next plan after ``plan``, the reference point
+    at ``s`` (on the sensing dimensions)."""
+    target = plan.task.target_set
+    return plan.reached or all(target.lower[d] <= s[k] <= target.upper[d]
+                               for k, d in enumerate(sensing.dims))
+
+
+def _meets_start(boxes: Sequence[MovingObstacle], box: Box) -> bool:
+    """Whether one of ``boxes`` (standing, :func:`_span_boxes`) present at ``t' = 0``
+    meets ``box``."""
+    return any(b.active[0] <= 0.0 and all(
+        abs(c - (box.lower[d] + box.upper[d]) / 2) <= h + (box.upper[d] - box.lower[d]) / 2
+        for d, c, h in zip(b.dims, b.centres[0], b.half_size)) for b in boxes)
 
 
 def _headed_clearance(ob: SensedObstacle, point: np.ndarray, t_from: float, t_to: float,

@@ -226,6 +226,10 @@ class SensingRecord:
     escapes : int
         The tubes switched in that go to a temporary goal instead of the target
         (``SensedPlan.goal``), among ``switches``.
+    best_effort : int
+        The escapes switched in with no certificate (``SensedPlan.best_effort``: a failed
+        replan's ``fallback``), among ``escapes``; the robot is uncertified while they
+        run, as it is after any failure.
     shortened : int
         The plans taken (kept or switched in) that are certified over the envelope's
         ``shortest_horizon`` only (``SensedPlan.shortened``): none was certified over its
@@ -266,6 +270,7 @@ class SensingRecord:
     measurements: int = 0
     switches: int = 0
     escapes: int = 0
+    best_effort: int = 0
     shortened: int = 0
     refused: int = 0
     failures: int = 0
@@ -291,7 +296,8 @@ class SensingRecord:
         envelope = ("; OUTSIDE the envelope (" + ", ".join(sorted({v.kind for v in
                                                                    self.violations})) + ")"
                     if self.outside_envelope else "")
-        escapes = f" ({self.escapes} escapes)" if self.escapes else ""
+        best = f", {self.best_effort} best effort" if self.best_effort else ""
+        escapes = f" ({self.escapes} escapes{best})" if self.escapes else ""
         shortened = (f", {self.shortened} over the shortest horizon" if self.shortened
                      else "")
         return (f"{self.measurements} measurements, {self.switches} switches{escapes}, "
@@ -544,6 +550,7 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
             alpha = np.zeros(2 * n)
             record.switches += 1
             record.escapes += plan.goal is not None
+            record.best_effort += plan.best_effort
             record.shortened += plan.shortened
             covered.append((plan.certified_from, plan.guarantee_until))
             record.events.append(PlanEvent(t, "switched", len(designs) - 1, plan.measured_at,
@@ -574,7 +581,9 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
                 record.events.append(PlanEvent(t, "failed", len(designs) - 1, t_m,
                                                active.guarantee_until, made.cpu_s,
                                                made.reason))
-                continue
+                if made.fallback is None:
+                    continue
+                made = made.fallback         # uncertified, but away from the obstacles
             latest = made
             pending.append(made)
         # 4. the controller of the active tube, at its own time
@@ -656,7 +665,8 @@ def _escape_words(plan: SensedPlan, spec) -> str:
     if plan.goal is None:
         return ""
     centre = np.asarray(plan.goal.center)[list(spec.sensing.dims)]
-    return "; an escape to (" + ", ".join(f"{c:.3g}" for c in centre) + ")"
+    return ("; " + ("an uncertified best-effort" if plan.best_effort else "an")
+            + " escape to (" + ", ".join(f"{c:.3g}" for c in centre) + ")")
 
 
 def _horizon(value: object) -> float:
@@ -684,7 +694,7 @@ def _error(plan: SensedPlan, x: np.ndarray, spec) -> float:
 def _gaps(covered: list[tuple[float, float]], end: float) -> list[list[float]]:
     """The spans of ``[0, end]`` outside every covered interval."""
     gaps, at = [], 0.0
-    for a, b in sorted(covered):
+    for a, b in sorted(c for c in covered if c[1] > c[0]):
         if a > at + 1e-9:
             gaps.append([at, min(a, end)])
         at = max(at, b)
