@@ -18,7 +18,8 @@ its five circles, seeded (:mod:`.sensed_script`).
 Each episode is :func:`stt_codegen.simulate_sensed` (the CasADi backend). Reported per
 ``N``: collisions (and among them those at an instant some certificate covered, which must
 be none), on-time arrivals, late ones, runs with uncertified spans (a replanning failed and
-the guarantee lapsed), runs outside the envelope, switches, escapes, plans certified over
+the guarantee lapsed), runs outside the envelope, switches, escapes (and among them the
+best-effort ones a failed replan made, run uncertified: ``best``), plans certified over
 the shortest horizon only (``short``), refusals, failed replans, and the replanner's
 processor time per call (p95 and max over all calls).
 """
@@ -203,7 +204,7 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         tally = {"obstacles": count, "episodes": episodes, "collisions": 0,
                  "collisions_certified": 0, "on_time": 0, "late": 0, "not_reached": 0,
                  "uncertified_runs": 0, "outside_envelope": 0, "switches": 0, "escapes": 0,
-                 "shortened": 0, "refused": 0, "failures": 0, "replans": 0,
+                 "best_effort": 0, "shortened": 0, "refused": 0, "failures": 0, "replans": 0,
                  "collided_episodes": [], "uncertified_episodes": []}
         cpu, started = [], time.process_time()
         for e in range(episodes):
@@ -232,8 +233,8 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
             tally["not_reached"] += not run.reached and not late
             tally["uncertified_runs"] += bool(record.uncertified)
             tally["outside_envelope"] += record.outside_envelope
-            for key in ("switches", "escapes", "shortened", "refused", "failures",
-                        "replans"):
+            for key in ("switches", "escapes", "best_effort", "shortened", "refused",
+                        "failures", "replans"):
                 tally[key] += getattr(record, key)
             cpu += [ev.cpu_s for ev in record.events]
         tally["replan_cpu_p95_s"] = float(np.percentile(cpu, 95)) if cpu else 0.0
@@ -337,7 +338,8 @@ def format_sensed_report(report: dict) -> str:
         lines.append(f"{r['obstacles']:>4} {r['episodes']:>8} {r['collisions']:>10} "
                      f"{r['collisions_certified']:>11} {r['on_time']:>8} {r['late']:>5} "
                      f"{r['uncertified_runs']:>7} {r['outside_envelope']:>7} "
-                     f"{r['switches']:>8} {r.get('escapes', 0):>7} {r.get('shortened', 0):>5} "
+                     f"{r['switches']:>8} {r.get('escapes', 0):>7} "
+                     f"{r.get('best_effort', 0):>5} {r.get('shortened', 0):>5} "
                      f"{r['failures']:>6} "
                      f"{r['replan_cpu_p95_s']:>14.3f} {r['replan_cpu_max_s']:>8.3f}")
     for r in report["rows"]:
