@@ -198,6 +198,28 @@ def test_with_no_certified_plan_the_robot_runs_from_the_pursuer_all_the_same(see
     assert all(any(a <= ev.time <= b for a, b in record.uncertified) for ev in switched)
 
 
+def test_the_report_columns_line_up():
+    """Each value of a row ends where its column's title ends (the table is read by eye
+    and copied into docs/performance.md)."""
+    import re
+    row = {"obstacles": 5, "episodes": 500, "collisions": 1, "collisions_certified": 0,
+           "on_time": 495, "late": 2, "uncertified_runs": 41, "outside_envelope": 3,
+           "switches": 6253, "escapes": 1597, "best_effort": 58, "shortened": 67,
+           "failures": 59, "replan_cpu_p95_s": 0.174, "replan_cpu_max_s": 0.965}
+    lines = format_sensed_report({"seed": 0, "adversary": True, "rows": [row]}).splitlines()
+    head, values = lines[1], lines[2]
+    titles = ["N", "episodes", "collisions", "(certified)", "on time", "late", "uncert.",
+              "outside", "switches", "escapes", "best", "short", "failed",
+              "replan p95 [s]", "max [s]"]
+    ends, at = [], 0
+    for title in titles:
+        at = head.index(title, at) + len(title)
+        ends.append(at)
+    assert ends[-1] == len(head)
+    assert [m.end() for m in re.finditer(r"\S+", values)] == ends
+    assert values.split()[9:13] == ["1597", "58", "67", "59"]
+
+
 @pytest.mark.slow
 def test_one_episode_is_reported():
     report = run_sensed_bench(1, 0, counts=(5,))

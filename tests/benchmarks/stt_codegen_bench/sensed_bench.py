@@ -320,7 +320,7 @@ def format_sensed_report(report: dict) -> str:
     """
     head = (f"{'N':>4} {'episodes':>8} {'collisions':>10} {'(certified)':>11} {'on time':>8} "
             f"{'late':>5} {'uncert.':>7} {'outside':>7} {'switches':>8} {'escapes':>7} "
-            f"{'short':>5} {'failed':>6} "
+            f"{'best':>5} {'short':>5} {'failed':>6} "
             f"{'replan p95 [s]':>14} {'max [s]':>8}")
     accel = report.get("acceleration")
     lines = [f"bench sensed: seed {report['seed']}"
