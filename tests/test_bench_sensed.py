@@ -144,6 +144,18 @@ def test_one_episode_of_each_floor_is_reported(floor, count, options, title):
     assert title in format_sensed_report(report)
 
 
+def _pursued_run(seed: int, episode: int):
+    """An episode of Real-Time STT's script with its pursuer, as ``bench sensed --script
+    --adversary`` runs it."""
+    from stt_codegen.runtime.sensed import WalkingObstacle
+    from stt_codegen_bench.sensed_script import PURSUER_RADIUS
+    circles = script_circles(np.random.default_rng([seed, 5, episode]))
+    circles.append(WalkingObstacle(PURSUER_START, PURSUER_RADIUS,
+                                   pursuit_speed=SCRIPT["sensing"]["max_obstacle_speed"]))
+    return stt.simulate_sensed(stt.design_tube(stt.Spec.from_dict(SCRIPT)), circles,
+                               seed=episode)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("seed,episode", [(0, 16), (1, 127), (1, 340), (1, 477), (0, 236)])
 def test_a_robot_in_the_target_steps_away_from_a_pursuer_closing_on_it(seed, episode):
@@ -156,13 +168,7 @@ def test_a_robot_in_the_target_steps_away_from_a_pursuer_closing_on_it(seed, epi
     alone) it came back to the target along the east wall past the pursuer. Taking a slow
     obstacle closing on a robot that has been in the target to pursue it, in its escapes
     too, the robot keeps away: certified throughout, no collision."""
-    from stt_codegen.runtime.sensed import WalkingObstacle
-    from stt_codegen_bench.sensed_script import PURSUER_RADIUS
-    circles = script_circles(np.random.default_rng([seed, 5, episode]))
-    circles.append(WalkingObstacle(PURSUER_START, PURSUER_RADIUS,
-                                   pursuit_speed=SCRIPT["sensing"]["max_obstacle_speed"]))
-    run = stt.simulate_sensed(stt.design_tube(stt.Spec.from_dict(SCRIPT)), circles,
-                              seed=episode)
+    run = _pursued_run(seed, episode)
     record = run.sensing
     assert not record.outside_envelope and record.escapes >= 1
     assert not record.sensed_collision and not run.collision
@@ -182,13 +188,7 @@ def test_with_no_certified_plan_the_robot_runs_from_the_pursuer_all_the_same(see
     robot was and not where it would be at the switch (not closing, ranked as a straight
     walk): closing on either, no collision. The spans it runs uncertified are reported as
     such."""
-    from stt_codegen.runtime.sensed import WalkingObstacle
-    from stt_codegen_bench.sensed_script import PURSUER_RADIUS
-    circles = script_circles(np.random.default_rng([seed, 5, episode]))
-    circles.append(WalkingObstacle(PURSUER_START, PURSUER_RADIUS,
-                                   pursuit_speed=SCRIPT["sensing"]["max_obstacle_speed"]))
-    run = stt.simulate_sensed(stt.design_tube(stt.Spec.from_dict(SCRIPT)), circles,
-                              seed=episode)
+    run = _pursued_run(seed, episode)
     record = run.sensing
     assert not record.outside_envelope and record.best_effort >= 1
     assert not record.sensed_collision and not run.collision and run.reached
