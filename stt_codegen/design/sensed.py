@@ -1122,8 +1122,8 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     the state space and clear of the static obstacles, ranked by their distance from where
     every sensed obstacle is headed from the switch until the tube has arrived plus the
     horizon (:func:`_headed_clearance`; from an obstacle closing on the robot at ``s`` or at
-    ``point``, :func:`_closing`, taken to turn after the robot on its way there and while it holds the goal for
-    :data:`FORESIGHT` more, :func:`_pursuit_clearance`) and from the state space's
+    ``point``, :func:`_closing`, taken to turn after the robot on its way there and while
+    it holds the goal for :data:`FORESIGHT` more, :func:`_pursuit_clearance`) and from the state space's
     boundary (the largest first, up to :data:`ESCAPE_CLEARANCE`), then by their distance
     to the target; at most :data:`MAX_ESCAPES` designs.
     """
@@ -1204,12 +1204,12 @@ def _best_effort(plan: SensedPlan, t_m: float, position: Sequence[float],
     reach = _reach(base)
     avoided: list[MovingObstacle] = []
     for ob in sensed:
-        for kept in (reachable_boxes([ob], sensing.max_obstacle_speed, reach, sensing.dims,
-                                     t_f, 0.0, sensing.horizon, 0, **_drift(sensing)),
-                     foresight_boxes([ob], reach, sensing.dims, t_f, 0.0, sensing.horizon, 0,
-                                     sensing.velocity_error)):
-            if not _meets_start(kept, box):
-                avoided.extend(kept)
+        for spans in (reachable_boxes([ob], sensing.max_obstacle_speed, reach, sensing.dims,
+                                      t_f, 0.0, sensing.horizon, 0, **_drift(sensing)),
+                      foresight_boxes([ob], reach, sensing.dims, t_f, 0.0, sensing.horizon, 0,
+                                      sensing.velocity_error)):
+            if not _meets_start(spans, box):
+                avoided.extend(spans)
                 break
     first = _first_source(base)
     boxes = tuple(replace(b, source=first + k) for k, b in enumerate(avoided))

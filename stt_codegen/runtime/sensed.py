@@ -581,7 +581,8 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
                 record.events.append(PlanEvent(t, "failed", len(designs) - 1, t_m,
                                                active.guarantee_until, made.cpu_s,
                                                made.reason))
-                if made.fallback is None:
+                if made.fallback is None or (enforce_replan_time
+                                             and made.cpu_s > sensing.replan_time):
                     continue
                 made = made.fallback         # uncertified, but away from the obstacles
             latest = made
