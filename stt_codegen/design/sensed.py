@@ -764,11 +764,8 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
 
     @functools.cache
     def at_switch() -> tuple[Box, np.ndarray, Box | None]:
-        # the active tube's box at the switch, where the robot will be then, and the
-        # spec's d_0 around it (computed once, when a new tube is looked for)
-        active = _box_at(plan, t_s - plan.start, base.state_space)
-        point = _predicted(plan, active, s, t_m, sensing)
-        return active, point, _switch_box(base, active, point, sensing)
+        # computed once, when a new tube is looked for
+        return _taking_over(plan, t_s, s, t_m, sensing)
 
     def escape() -> dict | str:
         active, point, near = at_switch()
@@ -1079,6 +1076,17 @@ def _new_plan(local: Spec, boxes: tuple[MovingObstacle, ...], sensing: Sensing,
                 region_margin=room, goal=goal)
 
 
+def _taking_over(plan: SensedPlan, t: float, s: np.ndarray, t_m: float,
+                 sensing: Sensing) -> tuple[Box, np.ndarray, Box | None]:
+    """Where a new tube taking over from ``plan`` at ``t`` (absolute, a sample) starts:
+    the active tube's box then, where the robot will be then (:func:`_predicted`, from
+    ``s`` measured at ``t_m``), and the spec's ``d_0`` around that point
+    (:func:`_switch_box`)."""
+    active = _box_at(plan, t - plan.start, plan.task.state_space)
+    point = _predicted(plan, active, s, t_m, sensing)
+    return active, point, _switch_box(plan.task, active, point, sensing)
+
+
 def _predicted(plan: SensedPlan, active: Box, s: np.ndarray, t_m: float,
                sensing: Sensing) -> np.ndarray:
     """Where the reference point will be at the switch: ``s`` moved as the plan's tube's
@@ -1198,9 +1206,8 @@ def _best_effort(plan: SensedPlan, t_m: float, position: Sequence[float],
     rate = base.rate_hz
     t_f = max(switch_time(sensing, t_m, rate),
               math.ceil(plan.guarantee_until * rate - 1e-9) / rate)
-    active = _box_at(plan, t_f - plan.start, base.state_space)
-    point = _predicted(plan, active, s, t_m, sensing)
-    box = _switch_box(base, active, point, sensing) or active
+    active, point, near = _taking_over(plan, t_f, s, t_m, sensing)
+    box = near or active
     reach = _reach(base)
     avoided: list[MovingObstacle] = []
     for ob in sensed:
@@ -1237,11 +1244,8 @@ def _reached(plan: SensedPlan, s: np.ndarray, sensing: Sensing) -> bool:
 
 
 def _meets_start(boxes: Sequence[MovingObstacle], box: Box) -> bool:
-    """Whether one of ``boxes`` (standing, :func:`_span_boxes`) present at ``t' = 0``
-    meets ``box``."""
-    return any(b.active[0] <= 0.0 and all(
-        abs(c - (box.lower[d] + box.upper[d]) / 2) <= h + (box.upper[d] - box.lower[d]) / 2
-        for d, c, h in zip(b.dims, b.centres[0], b.half_size)) for b in boxes)
+    """Whether one of ``boxes`` meets ``box`` at ``t' = 0``."""
+    return any(b.meeting_times(box.lower, box.upper, 0.0, 0.0) for b in boxes)
 
 
 def _headed_clearance(ob: SensedObstacle, point: np.ndarray, t_from: float, t_to: float,
