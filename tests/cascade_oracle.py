@@ -268,7 +268,8 @@ def step_velocity_change(k1: float, h: float, a: float, b: float, shift: float,
     edges = [a + (b - a) * j / STEP_PIECES for j in range(STEP_PIECES + 1)]
     # phi at each edge once (phi is odd: phi(|e|) = |phi(e)|); the same values as per piece
     phis = [phi_scalar(e) for e in edges]
-    widen = abs(1.0 / half_n - 1.0 / half_k)
+    stretch = 1.0 / half_n - 1.0 / half_k
+    widen = abs(stretch)
     slope_k, other_n, tilt = 2.0 * k1 / half_n, other * h_ratio, scale - 1.0
     for j in range(STEP_PIECES):
         c, d = edges[j], edges[j + 1]
@@ -279,8 +280,22 @@ def step_velocity_change(k1: float, h: float, a: float, b: float, shift: float,
         wide = abs(c) if abs(c) >= abs(d) else abs(d)
         phi_wide = abs(phis[j]) if abs(c) >= abs(d) else abs(phis[j + 1])
         top = min(wide + move, reach)
-        worst = max(worst, slope_k * phi_slope_scalar(top) * move
-                    + 2.0 * k1 * phi_wide * widen)
+        apart = slope_k * phi_slope_scalar(top) * move + 2.0 * k1 * phi_wide * widen
+        far = wide + move
+        if far >= 1.0:
+            worst = max(worst, apart)
+            continue
+        # phi(e + m) / h_n - phi(e) / h_k = phi'(xi) m / h_n + phi(e) (1 / h_n - 1 / h_k)
+        p_lo, p_hi = c + min(m_lo, 0.0), d + max(m_hi, 0.0)
+        steepest = phi_slope_scalar(far)
+        flattest = phi_slope_scalar(0.0 if p_lo * p_hi <= 0.0 else min(abs(p_lo), abs(p_hi)))
+        turned_lo = h_ratio * min(flattest * m_lo, steepest * m_lo) + min(
+            phis[j] * stretch, phis[j + 1] * stretch)
+        turned_hi = h_ratio * max(flattest * m_hi, steepest * m_hi) + max(
+            phis[j] * stretch, phis[j + 1] * stretch)
+        together = 2.0 * k1 * (max(abs(turned_lo), abs(turned_hi))
+                               + steepest * other_n * h_ratio)
+        worst = max(worst, min(apart, together))
     return worst
 
 

@@ -135,18 +135,20 @@ def test_the_drone_at_200_hz_names_a_prescribed_time_that_is_then_certified() ->
 
 @pytest.mark.slow
 def test_the_drone_at_200_hz_names_a_faster_rate_that_keeps_its_own_time() -> None:
-    """The same refusal names a rate (beyond the one that keeps the tubes alone) at which
-    the spec's own prescribed_time is certified within the thrusts."""
+    """The same refusal names a faster rate at which the spec's own prescribed_time is
+    certified within the thrusts: the rate that keeps the tubes when the whole design with
+    the bound is certified there (250 Hz), else a multiple of it (``FASTER_RATE_FACTORS``:
+    500 Hz before the change of ``r`` was bounded with its causes together)."""
     spec = stt.load_spec(str(DRONE))
     with pytest.raises(stt.DesignError) as info:
         stt.design_tube(spec)
     rate = info.value.advice["controller.rate_hz"]
     words = str(info.value)
-    assert f"controller.rate_hz = {rate:g} is certified with it" in words, words
+    assert re.search(rf"controller\.rate_hz = {rate:g} is certified\b", words), words
     kept = re.search(r"controller\.rate_hz = ([0-9.]+) keeps the tubes but no design there "
                      r"keeps actuator\.input_bound", words)
-    assert kept is not None, words
-    assert spec.rate_hz < float(kept.group(1)) < rate <= 16.0 * spec.rate_hz
+    assert kept is None or float(kept.group(1)) < rate, words
+    assert spec.rate_hz < rate <= 16.0 * spec.rate_hz
     design = stt.design_tube(dataclasses.replace(spec, rate_hz=rate))
     assert design.certificate.passed and design.spec.prescribed_time == spec.prescribed_time
     assert design.input_proof.meets(spec.input_bound)

@@ -104,7 +104,8 @@ def step_velocity_change(k1: float, h: float, a: float, b: float, shift: float,
     edges = [a + (b - a) * j / STEP_PIECES for j in range(STEP_PIECES + 1)]
     # phi at each edge once (phi is odd: phi(|e|) = |phi(e)|); the same values as per piece
     phis = [phi_scalar(e, ops) for e in edges]
-    widen = abs(1.0 / half_n - 1.0 / half_k)
+    stretch = 1.0 / half_n - 1.0 / half_k
+    widen = abs(stretch)
     slope_k, other_n, tilt = 2.0 * k1 / half_n, other * h_ratio, scale - 1.0
     for j in range(STEP_PIECES):
         c, d = edges[j], edges[j + 1]
@@ -115,6 +116,24 @@ def step_velocity_change(k1: float, h: float, a: float, b: float, shift: float,
         wide = fmax(abs(c), abs(d))
         phi_wide = select(abs(c) >= abs(d), abs(phis[j]), abs(phis[j + 1]))
         top = fmin(wide + move, reach)
-        worst = fmax(worst, slope_k * phi_slope_scalar(top, ops) * move
-                     + 2.0 * k1 * phi_wide * widen)
+        apart = slope_k * phi_slope_scalar(top, ops) * move + 2.0 * k1 * phi_wide * widen
+        # the same change with the step's two causes kept together, signs and all:
+        # phi(e + m) / h_n - phi(e) / h_k = phi'(xi) m / h_n + phi(e) (1 / h_n - 1 / h_k),
+        # xi between e and e + m, each factor by its range on the piece; then the rest of
+        # the step (|e1(t_{k+1}) - e - m| <= other / h_n) by phi' at the farthest |e| it
+        # reaches, far < 1
+        far = wide + move
+        valid = far < 1.0
+        p_lo, p_hi = c + fmin(m_lo, 0.0), d + fmax(m_hi, 0.0)
+        steepest = phi_slope_scalar(select(valid, far, 0.0), ops)
+        flattest = phi_slope_scalar(select(p_lo * p_hi <= 0.0, 0.0,
+                                           select(valid, fmin(abs(p_lo), abs(p_hi)), 0.0)),
+                                    ops)
+        turned_lo = h_ratio * fmin(flattest * m_lo, steepest * m_lo) + fmin(
+            phis[j] * stretch, phis[j + 1] * stretch)
+        turned_hi = h_ratio * fmax(flattest * m_hi, steepest * m_hi) + fmax(
+            phis[j] * stretch, phis[j + 1] * stretch)
+        together = 2.0 * k1 * (fmax(abs(turned_lo), abs(turned_hi))
+                               + steepest * other_n * h_ratio)
+        worst = fmax(worst, select(valid, fmin(apart, together), apart))
     return worst
