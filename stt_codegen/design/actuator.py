@@ -47,6 +47,7 @@ import numpy as np
 
 from ..errors import DesignError, SpecError, number_text
 from ..progress import report, reporting
+from ..spec.deadline import WINDOW_END, ending_windows, with_deadline
 from ..spec.loader import Spec
 from ..spec.variants import variant_of
 from ..tube.parameters import CRUISE
@@ -347,13 +348,19 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     works, why = smallest_prescribed_time(spec, design_free, prove,
                                           best.proof.ratio(bound))
     needs = f"[{needs}]" + (f" ({spec.input_unit})" if unit else "")
+    moved = bool(ending_windows(spec))     # a later t_c moves the windows ending at it
     if works is not None:
         message += (f"; prescribed_time = {works:g} s works (the smallest to two significant "
-                    f"digits), or input_bound = {needs} with this prescribed_time")
+                    "digits" + (f", with the [[tasks]] windows that end at "
+                                f"{spec.prescribed_time:g} s ending at it too" if moved else "")
+                    + f"), or input_bound = {needs} with this prescribed_time")
     else:
         message += f"; {why}; input_bound = {needs} works with this prescribed_time"
+    advice = {} if works is None else {"prescribed_time": works}
+    if works is not None and moved:
+        advice[WINDOW_END] = works
     raise DesignError(message, kind=FailureKind.INPUT_BOUND, tried=best.design.tube,
-                      advice={} if works is None else {"prescribed_time": works})
+                      advice=advice)
 
 
 def _round_up(value: float, digits: int = 3) -> float:
@@ -394,14 +401,16 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
         When ``None``: why the search stopped (for a spec with ``[[tasks]]`` at once: its
         legs are timed by the tasks' windows, which a later ``t_c`` does not move).
     """
-    if spec.tasks:       # the legs' times are the tasks' windows, which t_c does not move
+    if spec.tasks and not ending_windows(spec):
+        # the legs' times are the tasks' windows, and none of them moves with t_c
         return None, ("a longer prescribed_time does not slow the legs: their times are "
-                      "the [[tasks]] windows; wider windows may")
+                      "the [[tasks]] windows, none of which ends at prescribed_time; wider "
+                      "windows may")
     cap = min(MAX_TIME_FACTOR * spec.prescribed_time,
               STEP_BUDGET / (HORIZON_FACTOR * spec.rate_hz))
 
     def passes(index: int) -> tuple[bool, float]:
-        trial = replace(spec, prescribed_time=grid_value(index))
+        trial = with_deadline(spec, grid_value(index))
         try:
             accepted, tried = candidates(trial, design_free, prove)
         except (DesignError, SpecError):

@@ -38,7 +38,8 @@ def advice_wanted() -> bool:
 
 
 #: The unit each advice field is printed with (``DesignError.advice``).
-ADVICE_UNITS = {"prescribed_time": " s", "controller.delay": " s", "plant.axle_offset": " m"}
+ADVICE_UNITS = {"prescribed_time": " s", "tasks.window_end": " s", "controller.delay": " s",
+                "plant.axle_offset": " m"}
 
 
 def advice_text(name: str, value: float | bool) -> str:

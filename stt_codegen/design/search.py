@@ -28,6 +28,7 @@ import numpy as np
 
 from ..errors import DesignError
 from ..progress import ProgressCallback, report, reporting
+from ..spec.deadline import WINDOW_END
 from ..spec.loader import Spec
 from ..spec.variants import variant_of
 from ..tube.parameters import Circumvent, TubeDesign, paper_segments
@@ -399,8 +400,8 @@ def _any_target(spec: Spec) -> Design:
 
 def _own_value(spec: Spec, key: str) -> float | None:
     """The spec's own value of an advice key (``DesignError.advice``), if it is a number."""
-    return {"prescribed_time": spec.prescribed_time, "controller.rate_hz": spec.rate_hz,
-            "controller.delay": spec.delay,
+    return {"prescribed_time": spec.prescribed_time, WINDOW_END: spec.prescribed_time,
+            "controller.rate_hz": spec.rate_hz, "controller.delay": spec.delay,
             "plant.axle_offset": getattr(spec.drive, "axle_offset", None)}.get(key)
 
 
@@ -423,8 +424,13 @@ def _any_target_advice(spec: Spec, failures: list[tuple[int, DesignError]]
                                      and abs(value - own) < abs(advice[key] - own)):
                 advice[key], source[key] = value, q
     first = failures[0][0]
-    notes = "".join(f"; with target any_of[{source[key]}], {advice_text(key, value)} is "
-                    "certified" for key, value in advice.items() if source[key] != first)
+    # (the windows' end goes with prescribed_time, from the same box)
+    moved = (" (with the [[tasks]] windows that end at prescribed_time ending at it too)"
+             if WINDOW_END in advice else "")
+    notes = "".join(f"; with target any_of[{source[key]}], {advice_text(key, value)}"
+                    + (moved if key == "prescribed_time" else "") + " is certified"
+                    for key, value in advice.items() if source[key] != first
+                    and key != WINDOW_END)
     return advice, notes
 
 
