@@ -323,8 +323,9 @@ def test_a_rate_that_keeps_the_tubes_but_not_the_bound_is_not_named_certified():
 
 @pytest.mark.slow
 def test_a_bound_a_task_spec_cannot_keep_names_its_windows_not_a_later_deadline():
-    """With [[tasks]] the legs are timed by the tasks' windows: the refusal says that a
-    later prescribed_time does not slow them, and names none."""
+    """With [[tasks]] the legs are timed by the tasks' windows; where none of them ends at
+    prescribed_time (tasks-visit's end at 5 and 9 s of 13 s) a later deadline moves none:
+    the refusal says that a later prescribed_time does not slow them, and names none."""
     data = bundled("tasks-visit")
     data["actuator"] = {"input_bound": [0.05, 0.05, 0.05]}
     with pytest.raises(DesignError) as info:
