@@ -13,14 +13,16 @@ from stt_codegen.spec.deadline import WINDOW_END, ending_windows, with_deadline
 
 
 def _doors(prescribed_time: float = 20.0) -> dict:
-    """Two reach tasks (one by the deadline, one by 12 s), a door that lasts until the
-    first, and a target of two boxes."""
+    """Two reach tasks (one by the deadline, one by 12 s), two doors that last until the
+    first (one still, one moving), and a target of two boxes."""
     return {"name": "doors", "prescribed_time": prescribed_time,
             "state_space": {"lower": [0.0, 0.0], "upper": [10.0, 10.0]},
             "initial": {"lower": [1.0, 1.0], "upper": [2.0, 2.0]},
             "target": {"any_of": [{"lower": [8.0, 8.0], "upper": [9.0, 9.0]},
                                   {"lower": [8.0, 1.0], "upper": [9.0, 2.0]}]},
-            "obstacles": [{"lower": [5.0, 4.0], "upper": [6.0, 6.0], "active_until": "T1"}],
+            "obstacles": [{"lower": [5.0, 4.0], "upper": [6.0, 6.0], "active_until": "T1"},
+                          {"lower": [3.0, 6.0], "upper": [3.5, 6.5], "velocity": [0.1, 0.0],
+                           "active_until": "T1"}],
             "tasks": [{"kind": "reach", "window": [0.0, prescribed_time],
                        "lower": [1.0, 8.0], "upper": [2.0, 9.0]},
                       {"kind": "reach", "window": [2.0, 12.0],
@@ -33,8 +35,10 @@ def test_the_windows_that_end_at_the_deadline_move_with_it_and_no_other() -> Non
     later = with_deadline(spec, 30.0)
     assert later.prescribed_time == 30.0
     assert [t.window for t in later.tasks] == [(0.0, 30.0), (2.0, 12.0)]
-    # the door lasts until the first task, so until its window's new end at the latest
-    assert [ob.active for ob in later.moving_obstacles] == [(0.0, 30.0)]
+    # the doors last until the first task, so until its window's new end at the latest;
+    # the one that moves moves on until then
+    assert [ob.active for ob in later.moving_obstacles] == [(0.0, 30.0), (0.0, 30.0)]
+    assert later.moving_obstacles[1].centres[-1] == pytest.approx((3.25 + 3.0, 6.25))
     # each target box is a spec of its own, moved alike; the spec written at 30 s is the same
     written = stt.Spec.from_dict({**_doors(30.0), "tasks": [
         {**_doors()["tasks"][0], "window": [0.0, 30.0]}, _doors()["tasks"][1]]})

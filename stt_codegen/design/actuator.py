@@ -398,8 +398,10 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
     prescribed_time : float or None
         Seconds.
     why : str
-        When ``None``: why the search stopped (for a spec with ``[[tasks]]`` at once: its
-        legs are timed by the tasks' windows, which a later ``t_c`` does not move).
+        When ``None``: why the search stopped (at once for a spec with ``[[tasks]]`` none of
+        whose windows ends at ``t_c``: its legs are timed by the windows, which a later
+        ``t_c`` does not move). Each trial is :func:`~stt_codegen.spec.deadline.with_deadline`
+        of the spec: the windows that end at ``t_c`` end at the trial's.
     """
     if spec.tasks and not ending_windows(spec):
         # the legs' times are the tasks' windows, and none of them moves with t_c

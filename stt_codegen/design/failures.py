@@ -13,6 +13,7 @@ from contextvars import ContextVar
 from enum import Enum
 
 from ..errors import number_text
+from ..spec.deadline import WINDOW_END
 
 __all__ = ["FailureKind", "advice_text", "advice_wanted", "property_kind", "without_advice"]
 
@@ -38,7 +39,7 @@ def advice_wanted() -> bool:
 
 
 #: The unit each advice field is printed with (``DesignError.advice``).
-ADVICE_UNITS = {"prescribed_time": " s", "tasks.window_end": " s", "controller.delay": " s",
+ADVICE_UNITS = {"prescribed_time": " s", WINDOW_END: " s", "controller.delay": " s",
                 "plant.axle_offset": " m"}
 
 

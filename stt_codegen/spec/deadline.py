@@ -81,7 +81,7 @@ def with_deadline(spec: "Spec", prescribed_time: float) -> "Spec":
     moved = set(ending_windows(spec))
     tasks = tuple(replace(task, window=(task.window[0], float(prescribed_time)))
                   if k in moved else task for k, task in enumerate(spec.tasks))
-    obstacles = tuple(replace(ob, active=(ob.active[0], float(prescribed_time)))
+    obstacles = tuple(_lasting(ob, old, float(prescribed_time))
                       if ob.until in moved and ob.active[1] == old else ob
                       for ob in spec.moving_obstacles)
     # each box of [target] any_of is a spec of its own, with the same tasks and obstacles
@@ -89,3 +89,16 @@ def with_deadline(spec: "Spec", prescribed_time: float) -> "Spec":
                          for q, variant in spec.target_any_of)
     return replace(spec, prescribed_time=float(prescribed_time), tasks=tasks,
                    moving_obstacles=obstacles, target_any_of=alternatives)
+
+
+def _lasting(ob, old: float, new: float):
+    """The obstacle ``ob`` that lasts until ``old`` lasting until ``new``: a box that moves
+    at a constant velocity moves on until then (its path's end as the loader writes it);
+    a still box and a path (held after its last row) are only active longer."""
+    if ob.motion == "velocity":
+        t_on = ob.active[0]
+        start, end = ob.centres
+        share = (new - t_on) / (old - t_on)
+        ob = replace(ob, times=(t_on, new),
+                     centres=(start, tuple(a + (b - a) * share for a, b in zip(start, end))))
+    return replace(ob, active=(ob.active[0], new))
