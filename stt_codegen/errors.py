@@ -99,7 +99,10 @@ class DesignError(SttError):
     advice : mapping of str to float, optional
         What the message names as certified, by spec field (``{"controller.rate_hz":
         230.0}``): each value was designed and certified with the rest of the spec
-        unchanged, so a program can follow it. Empty when nothing is named.
+        unchanged, so a program can follow it; except ``prescribed_time`` given together
+        with ``tasks.window_end``, certified with the ``[[tasks]]`` windows that end at
+        the spec's ``prescribed_time`` ending at it too
+        (:func:`stt_codegen.spec.deadline.with_deadline`). Empty when nothing is named.
 
     Examples
     --------
