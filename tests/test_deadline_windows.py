@@ -77,3 +77,29 @@ def test_a_force_refusal_names_a_deadline_that_moves_the_windows_then_certified(
         stt.design_tube(stt.Spec.from_dict(doc))
     assert "prescribed_time" not in info.value.advice
     assert "none of which ends at prescribed_time" in str(info.value)
+
+
+def test_a_deadline_too_short_for_the_rate_moves_the_windows_that_end_at_it() -> None:
+    """The shared deadline search (design/deadline.py) follows the same rule as the force's:
+    a tube too fast for 1 kHz, with a task window that ends at ``t_c``, is refused naming a
+    later time with ``tasks.window_end``; the spec so moved is certified. With the window
+    ending earlier, no time is named (a later ``t_c`` does not move it)."""
+    doc = {"name": "rushed-task", "prescribed_time": 0.05,
+           "state_space": {"lower": [0.0, 0.0], "upper": [4.0, 1.0]},
+           "initial": {"lower": [0.0, 0.0], "upper": [0.5, 1.0]},
+           "target": {"lower": [3.5, 0.0], "upper": [4.0, 1.0]},
+           "tasks": [{"kind": "reach", "window": [0.0, 0.05],
+                      "lower": [2.0, 0.0], "upper": [2.5, 1.0]}]}
+    spec = stt.Spec.from_dict(doc)
+    with pytest.raises(stt.DesignError) as info:
+        stt.design_tube(spec)
+    assert info.value.kind is FailureKind.SAMPLING_RATE
+    named = info.value.advice["prescribed_time"]
+    assert info.value.advice[WINDOW_END] == named > 0.05
+    assert "windows that end at 0.05 s ending at it too is certified" in str(info.value)
+    design = stt.design_tube(with_deadline(spec, named))
+    assert design.certificate.passed and design.spec.tasks[0].window == (0.0, named)
+    doc["tasks"][0]["window"] = [0.0, 0.04]
+    with pytest.raises(stt.DesignError) as info:
+        stt.design_tube(stt.Spec.from_dict(doc))
+    assert "prescribed_time" not in info.value.advice

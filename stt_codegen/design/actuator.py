@@ -47,7 +47,7 @@ import numpy as np
 
 from ..errors import DesignError, SpecError, number_text
 from ..progress import report, reporting
-from ..spec.deadline import WINDOW_END, ending_windows, with_deadline
+from ..spec.deadline import WINDOW_END, ending_windows, fixed_in_time, moved_words, with_deadline
 from ..spec.loader import Spec
 from ..spec.variants import variant_of
 from ..tube.parameters import CRUISE
@@ -318,8 +318,7 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
         rate = (_certified_rate(spec, tried[0].design.tube, design_free, prove)
                 if named else None)
         later = None
-        if named and rate is None and not (spec.tasks or spec.moving_obstacles
-                                           or spec.target_any_of):
+        if named and rate is None and not fixed_in_time(spec):
             # no rate holds (a delay no faster rate can hold, say): a slower tube asks
             # smaller commands; name the prescribed_time at which the whole design holds
             from .deadline import certified_time
@@ -329,11 +328,11 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
             f"no bound on {law} can be proved for actuator.input_bound: the "
             f"sampled-data check fails for every design tried ({reasons})"
             + (f"; controller.rate_hz = {rate:g} is certified" if rate is not None else "")
-            + (f"; prescribed_time = {number_text(later)} s is certified"
+            + (f"; prescribed_time = {number_text(later)} s{moved_words(spec)} is certified"
                if later is not None else ""),
             kind=FailureKind.INPUT_BOUND, tried=tried[0].design.tube if tried else None,
             advice=({"controller.rate_hz": rate} if rate is not None else
-                    {"prescribed_time": later} if later is not None else {}))
+                    _later_advice(spec, later) if later is not None else {}))
     best = min(proved, key=lambda c: c.proof.ratio(bound))
     worst = max(range(len(bound)), key=lambda i: best.proof.peak[i] / bound[i])
     needs = ", ".join(f"{_round_up(v):g}" for v in best.proof.peak)
@@ -348,19 +347,20 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     works, why = smallest_prescribed_time(spec, design_free, prove,
                                           best.proof.ratio(bound))
     needs = f"[{needs}]" + (f" ({spec.input_unit})" if unit else "")
-    moved = bool(ending_windows(spec))     # a later t_c moves the windows ending at it
     if works is not None:
         message += (f"; prescribed_time = {works:g} s works (the smallest to two significant "
-                    "digits" + (f", with the [[tasks]] windows that end at "
-                                f"{spec.prescribed_time:g} s ending at it too" if moved else "")
-                    + f"), or input_bound = {needs} with this prescribed_time")
+                    f"digits{moved_words(spec)}), or input_bound = {needs} with this "
+                    "prescribed_time")
     else:
         message += f"; {why}; input_bound = {needs} works with this prescribed_time"
-    advice = {} if works is None else {"prescribed_time": works}
-    if works is not None and moved:
-        advice[WINDOW_END] = works
     raise DesignError(message, kind=FailureKind.INPUT_BOUND, tried=best.design.tube,
-                      advice=advice)
+                      advice={} if works is None else _later_advice(spec, works))
+
+
+def _later_advice(spec: Spec, later: float) -> dict:
+    """The advice for a later ``prescribed_time``: with ``tasks.window_end`` where windows
+    end at the spec's (:func:`~stt_codegen.spec.deadline.with_deadline`)."""
+    return {"prescribed_time": later, **({WINDOW_END: later} if ending_windows(spec) else {})}
 
 
 def _round_up(value: float, digits: int = 3) -> float:

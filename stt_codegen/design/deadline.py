@@ -6,8 +6,12 @@ deadline is the knob that helps whatever the hardware: the search doubles ``t_c`
 :data:`~.grid.MAX_TIME_FACTOR` times it, then bisects :data:`BISECTIONS` times on the
 two-digit grid (:mod:`.grid`), and names the time at which the design search certified the
 spec (the smallest it found, within about an eighth of the doubling).
-Specs whose times are absolute (timed tasks, moving obstacles, ``[target] any_of``) are
-refused as they are: a later ``t_c`` does not move their windows. A refusal that already
+Specs with parts fixed in absolute time (timed tasks whose windows end before ``t_c``,
+moving obstacles, ``[target] any_of``: :func:`~stt_codegen.spec.deadline.fixed_in_time`)
+are refused as they are: a later ``t_c`` does not move them. Task windows that end at
+``t_c`` (and the obstacles that last until those tasks) move with it
+(:func:`~stt_codegen.spec.deadline.with_deadline`); the advice then names the time under
+``tasks.window_end`` too. A refusal that already
 names a shorter ``controller.delay`` certified at the spec's rate (the cascade's,
 :mod:`.cascade_gain`) is left as it is too: the delay is what fails, and the search for a
 time would cost a design per trial.
@@ -16,9 +20,8 @@ time would cost a design per trial.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import replace
-
 from ..errors import DesignError, number_text
+from ..spec.deadline import WINDOW_END, ending_windows, fixed_in_time, moved_words, with_deadline
 from ..spec.loader import Spec
 from .failures import FailureKind, without_advice
 from .grid import MAX_TIME_FACTOR, grid_index, grid_value
@@ -56,20 +59,22 @@ def deadline_refusal(spec: Spec, error: DesignError,
         else a copy whose message ends with ``prescribed_time = T s is certified`` (``T``
         was designed and certified by ``search``).
     """
-    if (error.kind not in SLOWER_HELPS or spec.tasks or spec.moving_obstacles
-            or spec.target_any_of or "controller.delay" in error.advice):
+    if (error.kind not in SLOWER_HELPS or fixed_in_time(spec)
+            or "controller.delay" in error.advice):
         return error
     time = certified_time(spec, search)
     if time is None:
         return error
-    return DesignError(f"{error}; prescribed_time = {number_text(time)} s is certified",
-                       kind=error.kind, tried=error.tried,
-                       advice={**error.advice, "prescribed_time": time})
+    moved = {WINDOW_END: time} if ending_windows(spec) else {}
+    return DesignError(f"{error}; prescribed_time = {number_text(time)} s"
+                       f"{moved_words(spec)} is certified", kind=error.kind,
+                       tried=error.tried, advice={**error.advice, "prescribed_time": time,
+                                                  **moved})
 
 
 def certified_time(spec: Spec, search: Callable[[Spec], Design]) -> float | None:
-    """The smallest ``prescribed_time`` above the spec's that ``search`` certifies, on the
-    two-digit grid: doubling up to :data:`~.grid.MAX_TIME_FACTOR` times ``t_c``, then
+    """The smallest ``prescribed_time`` above the spec's that ``search`` certifies (the spec
+    moved there by :func:`~stt_codegen.spec.deadline.with_deadline`), on the two-digit grid: doubling up to :data:`~.grid.MAX_TIME_FACTOR` times ``t_c``, then
     :data:`BISECTIONS` bisections (each trial a design, its advice off).
 
     Parameters
@@ -88,7 +93,7 @@ def certified_time(spec: Spec, search: Callable[[Spec], Design]) -> float | None
     def passes(index: int) -> bool:
         try:
             with without_advice():            # the verdict only
-                search(replace(spec, prescribed_time=grid_value(index)))
+                search(with_deadline(spec, grid_value(index)))
         except DesignError:
             return False
         return True

@@ -15,8 +15,9 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from .loader import Spec
+    from .motion import MovingObstacle
 
-__all__ = ["WINDOW_END", "ending_windows", "with_deadline"]
+__all__ = ["WINDOW_END", "ending_windows", "fixed_in_time", "moved_words", "with_deadline"]
 
 #: The advice key naming the end of the ``[[tasks]]`` windows that end at
 #: ``prescribed_time``, given with ``prescribed_time`` when both move together.
@@ -37,6 +38,32 @@ def ending_windows(spec: "Spec") -> tuple[int, ...]:
     """
     return tuple(k for k, task in enumerate(spec.tasks)
                  if task.window[1] == spec.prescribed_time)
+
+
+def fixed_in_time(spec: "Spec") -> bool:
+    """Whether a later ``prescribed_time`` leaves parts of ``spec`` fixed in absolute time
+    that :func:`with_deadline` does not move: ``[[tasks]]`` none of whose windows ends at
+    ``t_c``, a moving obstacle that does not last until such a task, or ``[target]
+    any_of`` (whose boxes are searched one by one).
+
+    Parameters
+    ----------
+    spec : Spec
+
+    Returns
+    -------
+    bool
+    """
+    moved = set(ending_windows(spec))
+    return bool((spec.tasks and not moved) or spec.target_any_of
+                or any(ob.until not in moved for ob in spec.moving_obstacles))
+
+
+def moved_words(spec: "Spec") -> str:
+    """The words a refusal adds to a later ``prescribed_time`` it names: which windows
+    end at it too (empty when none ends at ``spec``'s)."""
+    return (f", with the [[tasks]] windows that end at {spec.prescribed_time:g} s ending at "
+            "it too" if ending_windows(spec) else "")
 
 
 def with_deadline(spec: "Spec", prescribed_time: float) -> "Spec":
@@ -91,7 +118,7 @@ def with_deadline(spec: "Spec", prescribed_time: float) -> "Spec":
                    moving_obstacles=obstacles, target_any_of=alternatives)
 
 
-def _lasting(ob, old: float, new: float):
+def _lasting(ob: "MovingObstacle", old: float, new: float) -> "MovingObstacle":
     """The obstacle ``ob`` that lasts until ``old`` lasting until ``new``: a box that moves
     at a constant velocity moves on until then (its path's end as the loader writes it);
     a still box and a path (held after its last row) are only active longer."""
