@@ -193,14 +193,16 @@ def test_cppcheck_misra_findings_are_the_listed_deviations(tmp_path, case, preci
 
 
 @pytest.mark.skipif(CC is None, reason="no C compiler (install gcc or clang)")
-@pytest.mark.parametrize("bounded", [False, True])
-@pytest.mark.parametrize("case", CASES)
-def test_table_driven_c_is_bit_identical_to_casadi(tmp_path, case, bounded) -> None:
+@pytest.mark.parametrize("case, bounded, profile", [
+    *((case, bounded, None) for case in CASES for bounded in (False, True)),
+    ("second-order-s1", True, "scurve")])
+def test_table_driven_c_is_bit_identical_to_casadi(tmp_path, case, bounded, profile) -> None:
     """The table-driven double C of a bundled design (the quadrotor's has two circumvents on
-    one bound: the F_nu pieces; with ``bounded``, an actuator bound near the median ``|u|``)
-    equals CasADi's ``cascade_step`` bit for bit at 150 random points inside both tubes, and
-    at the same points with the velocity pushed out of its tube; the committed C is the
-    generation without a bound."""
+    one bound: the F_nu pieces; with ``bounded``, an actuator bound near the median ``|u|``;
+    with ``profile``, its reach segments of that profile, the S-curve of the via tubes
+    timed for a force) equals CasADi's ``cascade_step`` bit for bit at 150 random points
+    inside both tubes, and at the same points with the velocity pushed out of its tube; the
+    committed C is the generation without a bound."""
     import dataclasses
 
     from conftest import design_of
@@ -214,6 +216,9 @@ def test_table_driven_c_is_bit_identical_to_casadi(tmp_path, case, bounded) -> N
     design = design_of(case)
     stage, _ = design.second_stage
     tube, n = design.tube, design.tube.dimension
+    if profile is not None:
+        tube = dataclasses.replace(tube, segments=tuple(
+            dataclasses.replace(s, profile=profile) for s in tube.segments))
     p = random_points(tube, 150, seed=3)
     rng = np.random.default_rng(4)
     state = np.hstack([p["x"], np.zeros_like(p["x"])])
@@ -226,6 +231,7 @@ def test_table_driven_c_is_bit_identical_to_casadi(tmp_path, case, bounded) -> N
             float(b) for b in np.maximum(np.median(np.abs(u), axis=0), 1e-3)))
     prefix = case.replace("-", "_")
     files = cascade_c_files(tube, stage, prefix, "double")
+    assert (profile is None) or f"body_progress_{profile}(" in files[f"{prefix}.c"]
     if not bounded:
         assert files[f"{prefix}.c"] == (_folder(case, "double") / f"{prefix}.c").read_text()
     for name, text in files.items():

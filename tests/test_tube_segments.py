@@ -9,9 +9,9 @@ import pytest
 
 from stt_codegen.tube import reference as R
 from stt_codegen.tube.model import build_model
-from stt_codegen.tube.parameters import (CRUISE, CRUISE_RAMP, LOWER, SMOOTHSTEP, TANH, UPPER,
-                                         Circumvent, ReachSegment, TubeDesign,
-                                         peak_rate_factor)
+from stt_codegen.tube.parameters import (CRUISE, CRUISE_RAMP, LOWER, SCURVE, SCURVE_TURN,
+                                         SMOOTHSTEP, TANH, UPPER, Circumvent, ReachSegment,
+                                         TubeDesign, peak_rate_factor)
 
 TOLERANCE = 1e-12
 
@@ -39,7 +39,7 @@ def times() -> np.ndarray:
     return np.sort(np.concatenate([rng.uniform(-1.0, 12.0, 2000), near]))
 
 
-@pytest.mark.parametrize("profile", [SMOOTHSTEP, TANH, CRUISE])
+@pytest.mark.parametrize("profile", [SMOOTHSTEP, TANH, CRUISE, SCURVE])
 def test_model_matches_reference_on_segments_and_open_circumvents(profile):
     design = piecewise_design(profile)
     model = build_model(design)
@@ -52,7 +52,7 @@ def test_model_matches_reference_on_segments_and_open_circumvents(profile):
             assert np.all(np.abs(a - b) <= TOLERANCE * np.maximum(1.0, np.abs(b))), name
 
 
-@pytest.mark.parametrize("profile", [SMOOTHSTEP, CRUISE])
+@pytest.mark.parametrize("profile", [SMOOTHSTEP, CRUISE, SCURVE])
 def test_reach_tube_and_its_rate_are_continuous_at_every_via_point(profile):
     design = piecewise_design(profile)
     for seg in design.segments:
@@ -65,11 +65,13 @@ def test_reach_tube_and_its_rate_are_continuous_at_every_via_point(profile):
     assert np.max(np.abs(R.reach_tube(design, [1.0])[2])) > 0.1
 
 
-@pytest.mark.parametrize("profile", [SMOOTHSTEP, CRUISE])
+@pytest.mark.parametrize("profile", [SMOOTHSTEP, CRUISE, SCURVE])
 def test_smooth_profile_peak_rate_and_its_second_derivative(profile):
     """The CasADi model's p_dot peaks at peak_rate_factor times the mean (1.875 for the
-    smooth step, 1 / (1 - ramp) = 1.25 for the cruise, held over the whole cruise);
-    p_ddot (from the model's p_dot) is continuous, 0 at both ends, and p is monotone."""
+    smooth step, 1 / (1 - ramp) = 1.25 for the cruise, held over the whole cruise, 2 for
+    the S-curve); p_ddot (from the model's p_dot) is continuous, 0 at both ends, and p is
+    monotone; the S-curve's p_ddot peaks at 4 / (1 - 2 q) / duration^2, below the quintic's
+    10 / sqrt(3)."""
     from stt_codegen.tube.pieces import progress
     start, end = 1.0, 5.0
     t = np.linspace(start - 0.5, end + 0.5, 200001)
@@ -90,6 +92,10 @@ def test_smooth_profile_peak_rate_and_its_second_derivative(profile):
         (at_ramp,) = np.array(progress(CRUISE, False)(start + CRUISE_RAMP * (end - start),
                                                        start, end)).ravel()
         assert abs(at_ramp - 0.125) < 1e-15
+    if profile == SCURVE:
+        peak = 4.0 / (1.0 - 2.0 * SCURVE_TURN) * mean**2
+        assert abs(np.max(np.abs(p_ddot)) - peak) < 1e-6 * peak
+        assert peak < 10.0 / math.sqrt(3.0) * mean**2 * 0.83
 
 
 def test_reach_tube_holds_its_boxes_outside_the_segments():
@@ -185,3 +191,76 @@ def test_cruise_profile_is_proved_c2_with_its_peak_rate_and_is_deployed_as_docum
         assert gap(value, expected) < 1e-13
         assert gap(rate, sp.diff(expected, tau)) < 1e-13
     assert pieces.PROFILE_NAMES.index(CRUISE) == 2
+
+
+def test_scurve_profile_is_proved_c2_with_its_peaks_and_is_deployed_as_documented():
+    """SymPy: the documented S-curve (turn share ``q`` in (0, 1/4), symbolic) has ``p``,
+    ``p_dot``, ``p_ddot`` continuous at every joint (``q``, ``1/2 - q``, the middle, where
+    the second half is ``1 - p(1 - tau)``), ``p = 0, 1`` and ``p_dot = p_ddot = 0`` at the
+    ends; its rate lies in ``[0, 2]`` (so ``p`` is monotone and ``peak_rate_factor`` is
+    right) and its acceleration in ``[-A, A]``, ``A = 4 / (1 - 2 q)``; the deployed CasADi
+    piece, reduced on each of its six branches, is that profile at ``q = SCURVE_TURN`` and
+    its ``p_dot`` output is ``dp/dt`` (1e-13 on every coefficient)."""
+    import sympy as sp
+
+    from stt_codegen.codegen.emit import sympy_expressions
+    from stt_codegen.tube import pieces
+    from stt_codegen.proofs.deployed import exact, on_domain
+
+    q = sp.Symbol("q", positive=True)
+    tau, x = sp.symbols("tau x", real=True)
+    peak = 4 / (1 - 2 * q)
+    half = sp.Rational(1, 2)
+
+    def first(u):                          # the first half's three pieces at u
+        w = half - u
+        return (peak * u**3 / (6 * q), peak * (u**2 / 2 - q * u / 2 + q**2 / 6),
+                half - 2 * w + peak * w**3 / (6 * q))
+
+    branches = first(tau) + tuple(1 - b for b in reversed(first(1 - tau)))
+    joints = (q, half - q, half, half + q, 1 - q)
+    for k in range(3):
+        d = [sp.diff(b, tau, k) for b in branches]
+        for j, at in enumerate(joints):
+            assert sp.simplify((d[j] - d[j + 1]).subs(tau, at)) == 0, (k, j)
+        assert sp.simplify(d[0].subs(tau, 0)) == 0
+        assert sp.simplify(d[-1].subs(tau, 1) - (0 if k else 1)) == 0
+    # on each piece of the first half (x in [0, 1] across it) the acceleration is linear
+    # in x, in [0, A] at both ends, so in [0, A] across it: the rate is non-decreasing up to
+    # the middle (and, mirrored, non-increasing after: unimodal, as the enclosures take
+    # it), its range on a piece its ends' values, within [0, 2]
+    ends = ((0, q), (q, half - q), (half - q, half))
+    at_q = {q: sp.Rational(2, 25)}
+    for b, (lo, hi) in zip(branches[:3], ends):
+        at = {tau: lo + (hi - lo) * x}
+        rate, acc = sp.diff(b, tau).subs(at), sp.diff(b, tau, 2).subs(at)
+        assert sp.degree(sp.expand(acc.subs(at_q)), x) <= 1
+        for end in (0, 1):
+            a, r = acc.subs(x, end).subs(at_q), rate.subs(x, end).subs(at_q)
+            assert 0 <= sp.simplify(a) <= sp.simplify(peak.subs(at_q))
+            assert 0 <= sp.simplify(r) <= 2
+    assert sp.simplify(sp.diff(branches[2], tau).subs(tau, half) - 2) == 0
+    assert peak_rate_factor(SCURVE) == 2.0 and SCURVE_TURN == 0.08
+
+    t = sp.Symbol("t", real=True)
+    d_ = sp.Symbol("d", positive=True)
+    w = sp.Symbol("w", positive=True)
+    (p,), (p_dot,) = sympy_expressions(pieces.progress(SCURVE), {"t": [t], "start": [0],
+                                                                 "end": [d_]})
+    # the branches' ends as the piece compares them: the doubles of q, 1/2 - q, ...
+    cuts = [sp.Integer(0)] + [exact(sp.Float(c)) for c in (
+        SCURVE_TURN, 0.5 - SCURVE_TURN, 0.5, 0.5 + SCURVE_TURN, 1.0 - SCURVE_TURN)] + [
+        sp.Integer(1)]
+    documented = [sp.expand(b.subs(q, sp.Rational(2, 25))) for b in branches]
+
+    def gap(got, expected) -> float:      # largest coefficient of got - expected in tau
+        diff = sp.Poly(sp.expand(got - expected), tau)
+        return max(abs(float(c)) for c in diff.all_coeffs())
+
+    for (lo, hi), expected in zip(zip(cuts, cuts[1:]), documented):
+        domain = {t: (lo + (hi - lo) * w / (1 + w)) * d_}
+        value, rate = on_domain(p, domain), on_domain(p_dot, domain)
+        value, rate = value.subs(t, tau * d_), (rate * d_).subs(t, tau * d_)
+        assert gap(value, expected) < 1e-13
+        assert gap(rate, sp.diff(expected, tau)) < 1e-13
+    assert pieces.PROFILE_NAMES.index(SCURVE) == 3

@@ -30,6 +30,7 @@ import casadi as ca
 from ..tube import pieces as P
 from ..tube.model import TubeModel
 from ..tube.parameters import LOWER, UPPER
+from .tube_data import DATA_PROFILES
 
 __all__ = ["clamped_control", "deployed_functions"]
 
@@ -42,8 +43,9 @@ def deployed_functions(model: TubeModel, every: bool = False) -> list[ca.Functio
     model : TubeModel
         The design's CasADi model.
     every : bool, optional
-        Every profile and both kinds of bounds, whatever the design uses: for the tube as
-        data (:mod:`.tube_data`), which runs any tube of the spec's dimension.
+        Every profile of :data:`~.tube_data.DATA_PROFILES` and both kinds of bounds,
+        whatever the design uses: for the tube as data (:mod:`.tube_data`), which runs any
+        tube of the spec's dimension with those profiles.
 
     Returns
     -------
@@ -53,7 +55,7 @@ def deployed_functions(model: TubeModel, every: bool = False) -> list[ca.Functio
     """
     design = model.design
     if every:
-        return P.deployed_pieces(design.dimension, P.PROFILE_NAMES,
+        return P.deployed_pieces(design.dimension, DATA_PROFILES,
                                  saturated=design.input_bound is not None)
     profiles = tuple(sorted({segment.profile for segment in design.segments}))
     members = [len(design.circumvents_on(i, side)) for i in range(design.dimension)

@@ -33,9 +33,9 @@ from .fileset import (GENERATOR, MANIFEST, build_files, manifest, selftest_file,
 from .options import Options
 from .render import c_identifier, c_real, render
 from .tables import design_table_rows
-from .tube_data import (TubeCapacity, python_names, require_capacity, table_names,
-                        table_shape)
-from ..tube.pieces import PROFILE_NAMES, error_transform
+from .tube_data import (TubeCapacity, profile_codes, python_names, require_capacity,
+                        table_names, table_shape)
+from ..tube.pieces import error_transform
 from .vectors import test_vectors
 
 __all__ = ["GENERATOR", "MANIFEST", "Options", "c_source_context", "first_order_generation",
@@ -100,7 +100,7 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
                              bodies=python_source(programs).rstrip("\n"),
                              spec_tables=design_table_rows(design, lambda v: repr(float(v)),
                                                            False),
-                             profile_codes={name: k for k, name in enumerate(PROFILE_NAMES)},
+                             profile_codes=profile_codes(capacity),
                              t_c=repr(float(design.prescribed_time)),
                              rate_hz=repr(float(design.rate_hz)),
                              **timing_context(design.rate_hz, (spec.delay, spec.jitter),
@@ -169,7 +169,7 @@ def c_source_context(design: TubeDesign, prefix: str, precision: str,
                 spec_tables=tables, T=table_names(prefix, capacity is not None),
                 max_initial_error=c_real(MAX_INITIAL_ERROR, single),
                 shape=table_shape(tables, capacity), capacity=capacity,
-                profile_codes={name: k for k, name in enumerate(PROFILE_NAMES)},
+                profile_codes=profile_codes(capacity),
                 guard=f"{prefix.upper()}_H", zero=c_real(0.0, single),
                 period_tolerance=c_real(PERIOD_TOLERANCE, single),
                 t_c=c_real(design.prescribed_time, single),

@@ -18,11 +18,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import SpecError
-from ..tube.parameters import TubeDesign
+from ..tube.parameters import SCURVE, TubeDesign
 from ..tube.pieces import PROFILE_NAMES
 from .tables import PARAMETERS, Tables
 
-__all__ = ["DEFAULT_CAPACITY", "TubeCapacity", "TableShape", "fitting_capacity",
+__all__ = ["DATA_PROFILES", "DEFAULT_CAPACITY", "TubeCapacity", "profile_codes", "TableShape", "fitting_capacity",
            "parse_capacity", "python_names", "require_capacity", "require_tube_data",
            "table_names", "table_shape"]
 
@@ -199,6 +199,31 @@ def python_names(data: bool) -> dict[str, object]:
                 arg="tube, ", call="tube, ", usable="_usable(tube) and ", data=True)
 
 
+#: The reach profiles a tube as data may use, coded as in ``PROFILE_NAMES`` (which lists
+#: them first): those law (13)'s designs produce. The S-curve is the cascade's (via points
+#: timed for a force), which has no tube as data; its body would cost 1.8 kB of Cortex-M4F
+#: flash. A segment of another profile fails the data's check (code 5).
+DATA_PROFILES = tuple(p for p in PROFILE_NAMES if p != SCURVE)
+assert PROFILE_NAMES[:len(DATA_PROFILES)] == DATA_PROFILES
+
+
+def profile_codes(capacity: TubeCapacity | None) -> dict[str, int]:
+    """The segment table's profile codes the generated code knows: every profile's (of
+    ``PROFILE_NAMES``) for the tables, :data:`DATA_PROFILES`' for the data form.
+
+    Parameters
+    ----------
+    capacity : TubeCapacity or None
+        The data form's capacity, or ``None`` for the tables.
+
+    Returns
+    -------
+    dict of str to int
+    """
+    names = DATA_PROFILES if capacity is not None else PROFILE_NAMES
+    return {name: k for k, name in enumerate(names)}
+
+
 def table_shape(tables: Tables, capacity: TubeCapacity | None) -> TableShape:
     """The code paths of a design's tables, or every path for the data form.
 
@@ -214,7 +239,7 @@ def table_shape(tables: Tables, capacity: TubeCapacity | None) -> TableShape:
     TableShape
     """
     if capacity is not None:
-        return TableShape(True, True, True, list(PROFILE_NAMES))
+        return TableShape(True, True, True, list(DATA_PROFILES))
     return TableShape(bool(tables.windows), 1 in tables.members, bool(tables.multi),
                       list(tables.profiles))
 
@@ -252,8 +277,13 @@ def require_capacity(design: TubeDesign, capacity: TubeCapacity) -> None:
     Raises
     ------
     SpecError
-        More segments or circumvents than the capacity (field ``tube_data``).
+        More segments or circumvents than the capacity, or a segment profile outside
+        :data:`DATA_PROFILES` (field ``tube_data``).
     """
+    unknown = sorted({s.profile for s in design.segments} - set(DATA_PROFILES))
+    if unknown:
+        raise SpecError("tube_data", f"the tube has {', '.join(unknown)} segments; the "
+                                     f"tube as data runs {', '.join(DATA_PROFILES)} ones")
     for name, count in (("segments", len(design.segments)),
                         ("windows", len(design.circumvents))):
         if count > getattr(capacity, name):

@@ -8,15 +8,17 @@ the CasADi model (:mod:`stt_codegen.tube.model`) and through it the generated co
 from __future__ import annotations
 
 import enum
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 __all__ = ["CRUISE", "CRUISE_RAMP", "Circumvent", "E_MAX", "GAMMA_D_MIN", "LOWER", "NEWTON_ITERATIONS", "NEWTON_TINY",
-           "PERIOD_TOLERANCE", "ReachSegment", "SMOOTHSTEP", "STATUS_INPUT_CLAMPED",
-           "STATUS_INVALID_INPUT", "STATUS_OFF_PERIOD", "STATUS_OK", "STATUS_OUTSIDE_TUBE",
+           "PERIOD_TOLERANCE", "ReachSegment", "SCURVE", "SCURVE_TURN", "SMOOTHSTEP",
+           "STATUS_INPUT_CLAMPED", "STATUS_INVALID_INPUT", "STATUS_OFF_PERIOD", "STATUS_OK", "STATUS_OUTSIDE_TUBE",
            "STATUS_OUTSIDE_VELOCITY_TUBE", "Status", "TANH", "TubeDesign", "UPPER",
-           "off_period", "paper_segments", "peak_rate_factor", "step_status"]
+           "off_period", "paper_segments", "peak_acceleration_factor", "peak_rate_factor",
+           "step_status"]
 
 #: Largest ``|e_i|`` used to compute ``u`` in the deployed controller step: ``e`` is
 #: clamped to ``[-E_MAX, E_MAX]`` so that ``u`` is finite everywhere (1 - 2**-20, exact in
@@ -148,7 +150,20 @@ SMOOTHSTEP = "smoothstep"
 CRUISE = "cruise"
 #: The cruise profile's ramps, each this share of the segment's duration.
 CRUISE_RAMP = 0.2
-PROFILES = (TANH, SMOOTHSTEP, CRUISE)
+#: Profile of a reach-tube segment: a jerk-limited S-curve, the profile of least peak
+#: acceleration among ours (the profile of via points timed for a force). Its acceleration
+#: ``p_ddot`` rises linearly from 0 to ``A`` over the first :data:`SCURVE_TURN` of the
+#: segment, holds ``A``, turns linearly to ``-A`` over the :data:`SCURVE_TURN` on each side
+#: of the middle, holds ``-A``, and returns to 0 over the last :data:`SCURVE_TURN`:
+#: ``p``, ``p_dot``, ``p_ddot`` continuous, zero slope and curvature at both ends, a peak
+#: rate of 2 times the mean at the middle (the quintic smooth step's 15/8) and a peak
+#: acceleration ``A = 4 / (1 - 2 SCURVE_TURN)`` times ``1 / duration^2`` (4.76; the quintic's
+#: ``10 / sqrt(3)`` = 5.77, the cruise's 9.38).
+SCURVE = "scurve"
+#: The S-curve's turns of the acceleration, each this share of the segment's duration: the
+#: largest jerk, ``A / SCURVE_TURN`` = 59.5, is then within the quintic smooth step's 60.
+SCURVE_TURN = 0.08
+PROFILES = (TANH, SMOOTHSTEP, CRUISE, SCURVE)
 
 
 def peak_rate_factor(profile: str) -> float:
@@ -157,7 +172,7 @@ def peak_rate_factor(profile: str) -> float:
 
     Parameters
     ----------
-    profile : {"smoothstep", "cruise"}
+    profile : {"smoothstep", "cruise", "scurve"}
 
     Returns
     -------
@@ -165,7 +180,8 @@ def peak_rate_factor(profile: str) -> float:
         ``15/8`` for ``"smoothstep"`` (``30 tau^2 (1 - tau)^2`` at ``tau = 1/2``);
         ``1 / (1 - CRUISE_RAMP)`` for ``"cruise"`` (the cruise's rate: the two ramps
         together cover half their length at the mean rate's ``1 / (1 - CRUISE_RAMP)``
-        multiple, the cruise the rest).
+        multiple, the cruise the rest); 2 for ``"scurve"`` (``A (1/2 - SCURVE_TURN)`` at
+        ``tau = 1/2``, whatever the turn).
 
     Raises
     ------
@@ -177,7 +193,39 @@ def peak_rate_factor(profile: str) -> float:
         return 1.875
     if profile == CRUISE:
         return 1.0 / (1.0 - CRUISE_RAMP)
+    if profile == SCURVE:
+        return 2.0
     raise ValueError(f"no fixed peak rate for the reach segment profile {profile!r}")
+
+
+def peak_acceleration_factor(profile: str) -> float:
+    """``sup_tau |d^2p/dtau^2|`` of a smooth profile: the peak of ``|rho_ddot|`` on a segment
+    is this times ``|to - from| / (end - start)^2``.
+
+    Parameters
+    ----------
+    profile : {"smoothstep", "cruise", "scurve"}
+
+    Returns
+    -------
+    float
+        ``10 / sqrt(3)`` (5.77) for ``"smoothstep"`` (at ``tau = 1/2 -+ sqrt(3)/6``);
+        ``1.5 / (a (1 - a))`` (9.38) for ``"cruise"`` (the cubic smooth step's slope 3/2
+        over a ramp of share ``a = CRUISE_RAMP`` to the rate ``1 / (1 - a)``);
+        ``4 / (1 - 2 q)`` (4.76) for ``"scurve"`` (``q = SCURVE_TURN``).
+
+    Raises
+    ------
+    ValueError
+        ``"tanh"`` (unbounded near its end) or an unknown profile.
+    """
+    if profile == SMOOTHSTEP:
+        return 10.0 / math.sqrt(3.0)
+    if profile == CRUISE:
+        return 1.5 / (CRUISE_RAMP * (1.0 - CRUISE_RAMP))
+    if profile == SCURVE:
+        return 4.0 / (1.0 - 2.0 * SCURVE_TURN)
+    raise ValueError(f"no fixed peak acceleration for the reach segment profile {profile!r}")
 
 
 @dataclass(frozen=True)

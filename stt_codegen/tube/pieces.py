@@ -57,7 +57,8 @@ from functools import lru_cache
 
 import casadi as ca
 
-from .parameters import CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, NEWTON_TINY, SMOOTHSTEP, TANH
+from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, NEWTON_TINY, SCURVE, SCURVE_TURN,
+                         SMOOTHSTEP, TANH)
 
 __all__ = ["EXP_ARGUMENT_BOUND", "PROFILE_NAMES", "alpha_rate", "bump", "candidates", "conflict",
            "deployed_pieces", "error_transform", "error_transform_expression", "fnu_pieces",
@@ -75,7 +76,7 @@ SMOOTH_SKIP_BASE = 34.0
 _SKIP_SCALE = 30.91
 
 #: Profile codes of the segment table, in the order of ``PROFILE_NAMES``.
-PROFILE_NAMES = (TANH, SMOOTHSTEP, CRUISE)
+PROFILE_NAMES = (TANH, SMOOTHSTEP, CRUISE, SCURVE)
 
 
 def _sym(*names: str):
@@ -91,7 +92,11 @@ def progress_expression(profile: str, t, start, end):
     ``"cruise"`` (:data:`~.parameters.CRUISE`, ramp share ``a``, peak rate
     ``v = 1 / (1 - a)``): ``v a r(tau / a)`` on the first ramp, ``v (tau - a/2)`` in the
     cruise, ``1 - v a r((1 - tau) / a)`` on the last ramp, with ``r(x) = x^3 - x^4 / 2``
-    (the integral of the cubic smooth step ``x^2 (3 - 2 x)``).
+    (the integral of the cubic smooth step ``x^2 (3 - 2 x)``); ``"scurve"``
+    (:data:`~.parameters.SCURVE`, turn share ``q``, peak acceleration ``A = 4 / (1 - 2
+    q)``): ``A tau^3 / (6 q)`` up to ``q``, ``A (tau^2 / 2 - q tau / 2 + q^2 / 6)`` up to
+    ``1/2 - q``, ``1/2 - 2 w + A w^3 / (6 q)`` (``w = 1/2 - tau``) up to ``1/2``, and on the
+    second half the same mirrored, ``1 - p(1 - tau)``.
 
     Raises
     ------
@@ -103,11 +108,25 @@ def progress_expression(profile: str, t, start, end):
         gap = ca.if_else(before, end - t, 1.0)
         elapsed = t - start
         return ca.if_else(before, ca.if_else(elapsed < 0.0, 0.0, ca.tanh(elapsed / gap)), 1.0)
-    if profile not in (SMOOTHSTEP, CRUISE):
+    if profile not in (SMOOTHSTEP, CRUISE, SCURVE):
         raise ValueError(f"unknown reach segment profile {profile!r}")
     tau = ca.fmin(ca.fmax((t - start) / (end - start), 0.0), 1.0)
     if profile == SMOOTHSTEP:
         return tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+    if profile == SCURVE:
+        q = SCURVE_TURN
+        peak, turn = 4.0 / (1.0 - 2.0 * q), 6.0 * q
+        w, v, u = 0.5 - tau, tau - 0.5, 1.0 - tau
+
+        def held(x):    # the piece of constant acceleration, at x from its end
+            return peak * (0.5 * x * x - 0.5 * q * x + q * q / 6.0)
+
+        return ca.if_else(tau <= q, peak * tau * tau * tau / turn,
+                          ca.if_else(tau <= 0.5 - q, held(tau),
+                          ca.if_else(tau <= 0.5, 0.5 - 2.0 * w + peak * w * w * w / turn,
+                          ca.if_else(tau <= 0.5 + q, 0.5 + 2.0 * v - peak * v * v * v / turn,
+                          ca.if_else(tau <= 1.0 - q, 1.0 - held(u),
+                                     1.0 - peak * u * u * u / turn)))))
     a = CRUISE_RAMP
     v = 1.0 / (1.0 - a)
 
@@ -128,8 +147,8 @@ def progress(profile: str, rates: bool = True) -> ca.Function:
     ----------
     profile : str
         One of :data:`PROFILE_NAMES`: ``"tanh"`` (``tanh((t - start) / (end - t))``, eq. (4)),
-        ``"smoothstep"`` (quintic) or ``"cruise"`` (smooth ramps around a constant rate);
-        see :func:`progress_expression`.
+        ``"smoothstep"`` (quintic), ``"cruise"`` (smooth ramps around a constant rate) or
+        ``"scurve"`` (jerk-limited); see :func:`progress_expression`.
     rates : bool
         Also return ``p_dot``, the derivative in ``t`` (1/s).
 

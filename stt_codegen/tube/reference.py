@@ -20,8 +20,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, LOWER, SMOOTHSTEP, STATUS_INPUT_CLAMPED, STATUS_OK,
-                         STATUS_OUTSIDE_TUBE, TANH, ReachSegment, TubeDesign, step_status)
+from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, LOWER, SCURVE, SCURVE_TURN,
+                         SMOOTHSTEP, STATUS_INPUT_CLAMPED, STATUS_OK, STATUS_OUTSIDE_TUBE, TANH, ReachSegment, TubeDesign, step_status)
 
 __all__ = ["adaptive_law", "adaptive_tube", "alpha_step", "bump", "circumvent",
            "circumvent_from_bumps", "conflict_distance", "control", "controller_status",
@@ -149,7 +149,12 @@ def segment_progress(segment: ReachSegment, t) -> tuple[Array, Array]:
     ``tau = (t - start) / (end - start)``; ``"cruise"``: the rate ``dp/dtau`` rises as
     ``v s(tau / a)`` (``s(x) = 3 x^2 - 2 x^3``, ``a = CRUISE_RAMP``, ``v = 1 / (1 - a)``),
     holds ``v``, falls as ``v s((1 - tau) / a)``; ``p`` is its integral from 0, and by
-    the symmetry ``p(tau) = 1 - p(1 - tau)`` on the last ramp.
+    the symmetry ``p(tau) = 1 - p(1 - tau)`` on the last ramp; ``"scurve"``: the
+    acceleration ``d^2p/dtau^2`` is ``A u / q`` for ``u < q``, ``A`` up to ``1/2 - q``, ``A
+    (1/2 - u) / q`` up to the middle (``u = min(tau, 1 - tau)``, ``q = SCURVE_TURN``, ``A = 4
+    / (1 - 2 q)``, negated on the second half), so the rate is ``A u^2 / (2 q)``, ``A (u -
+    q / 2)``, ``2 - A (1/2 - u)^2 / (2 q)``; ``p`` its integral, and ``1 - p(1 - tau)`` on
+    the second half.
 
     Parameters
     ----------
@@ -218,6 +223,8 @@ def _progress(profile: str, t: Array, start, end, rate: bool = True) -> tuple[Ar
             return p, None
         p_dot = 30.0 * tau**2 * (1.0 - tau) ** 2 / duration
         return p, p_dot
+    if profile == SCURVE:
+        return _scurve(tau, duration, rate)
     if profile != CRUISE:
         raise ValueError(f"unknown reach segment profile {profile!r}")
     a = CRUISE_RAMP
@@ -232,6 +239,26 @@ def _progress(profile: str, t: Array, start, end, rate: bool = True) -> tuple[Ar
     p_dot = v * x**2 * (3.0 - 2.0 * x) / duration
     # outside the segment tau is clamped to 0 or 1, where x = 0: the rate is 0 there
     return p, p_dot
+
+
+def _scurve(tau: Array, duration, rate: bool) -> tuple[Array, Array]:
+    """The ``"scurve"`` profile at ``tau`` in ``[0, 1]`` (:func:`segment_progress`), from its
+    acceleration, integrated by hand on each piece of the first half."""
+    q = SCURVE_TURN
+    peak = 4.0 / (1.0 - 2.0 * q)
+    first = tau <= 0.5
+    u = np.where(first, tau, 1.0 - tau)
+    rising, turning = u <= q, u > 0.5 - q
+    w = 0.5 - u
+    half = np.where(rising, peak * u**3 / (6.0 * q),
+                    np.where(turning, 0.5 - 2.0 * w + peak * w**3 / (6.0 * q),
+                             peak * (0.5 * u * u - 0.5 * q * u + q * q / 6.0)))
+    p = np.where(first, half, 1.0 - half)
+    if not rate:
+        return p, None
+    slope = np.where(rising, peak * u * u / (2.0 * q),
+                     np.where(turning, 2.0 - peak * w * w / (2.0 * q), peak * (u - 0.5 * q)))
+    return p, slope / duration
 
 
 @functools.lru_cache(maxsize=64)
