@@ -58,8 +58,8 @@ def test_the_windows_that_end_at_the_deadline_move_with_it_and_no_other() -> Non
 @pytest.mark.slow
 def test_a_force_refusal_names_a_deadline_that_moves_the_windows_then_certified() -> None:
     """stlpy's EitherOr as a double integrator at its own 20 s, |u| <= 0.5 N: refused for
-    the force, naming 30 s (1.5 times the horizon) with the stay window that ends at 20 s
-    ending at it; the spec so moved is certified within the bound. The same spec with the
+    the force, naming at most 30 s (1.5 times the horizon; 28 s with the S-curve legs)
+    with the stay window that ends at 20 s ending at it; the spec so moved is certified within the bound. The same spec with the
     window ending at 19 s names no time (a later deadline does not move that window)."""
     spec = stt.Spec.from_dict(_stay_then_target(20.0))
     with pytest.raises(stt.DesignError) as info:

@@ -294,3 +294,93 @@ def test_free_boxes_and_move_lengths_are_the_row_wise_ones(n):
     a, b = rng.integers(0, k, 500), rng.integers(0, k, 500)
     assert np.array_equal(via._max_distance(lower, a, b),
                           np.max(np.abs(lower[a] - lower[b]), axis=1))
+
+
+# --------------------------------------------------------------------------- timed for a force
+
+
+def _force_spec(velocity_bound: list | None, timing: str = "acceleration",
+                profile: str = "smoothstep"):
+    """A 2-D double integrator with a velocity bound, timed for the acceleration."""
+    bound = "" if velocity_bound is None else f"velocity_bound = {velocity_bound!r}\n"
+    spec = parse_spec(f"""
+name = "timed-moves"
+prescribed_time = 20.0
+[state_space]
+lower = [0.0, 0.0]
+upper = [10.0, 10.0]
+{bound}
+[initial]
+lower = [0.9, 0.9]
+upper = [1.1, 1.1]
+[target]
+lower = [8.0, 8.0]
+upper = [9.0, 9.0]
+[plant]
+model = "double-integrator"
+parameters = [1.0]
+""")
+    return dataclasses.replace(spec, tube=dataclasses.replace(
+        spec.tube, method="via", via_timing=timing, via_profile=profile))
+
+
+#: Three moves: one long enough that its smooth step in its square-root share of 20 s
+#: would pass 1 m/s, two short.
+MOVES = [np.array([0.5, 0.2]), np.array([9.0, 0.0]), np.array([0.0, 1.0])]
+
+
+def test_timed_moves_without_a_velocity_bound_are_the_square_root_shares_bit_for_bit():
+    from stt_codegen.design.via import move_weight, timed_moves
+    for spec in (_force_spec(None), _force_spec([1.0, 1.0], timing="length")):
+        durations, profiles = timed_moves(spec, MOVES, 20.0, "smoothstep")
+        weights = [move_weight(float(np.max(np.abs(m))), spec.tube.via_timing) for m in MOVES]
+        assert durations == [w / sum(weights) * 20.0 for w in weights]
+        assert profiles == ["smoothstep"] * 3
+
+
+@pytest.mark.parametrize("profile", ["smoothstep", "scurve"])
+def test_timed_moves_keep_the_velocity_bound_and_one_peak_acceleration_elsewhere(profile):
+    """Under |v_i| <= 1: each move's profile's peak rate is within the bound; the moves the
+    bound does not hold share one peak acceleration (the least that fits 20 s); a move
+    takes a profile of higher acceleration only where the earlier ones would pass the
+    bound at its duration. Without the bound the long move's smooth step would pass it:
+    the test can fail."""
+    from stt_codegen.design.via import ACCELERATION_PROFILES, timed_moves
+    from stt_codegen.tube.parameters import peak_acceleration_factor, peak_rate_factor
+    free, _ = timed_moves(_force_spec(None), MOVES, 20.0, profile)
+    assert peak_rate_factor(profile) * 9.0 / free[1] > 1.0
+    durations, profiles = timed_moves(_force_spec([1.0, 1.0]), MOVES, 20.0, profile)
+    assert abs(sum(durations) - 20.0) < 1e-12
+    tried = ACCELERATION_PROFILES[ACCELERATION_PROFILES.index(profile):]
+    accelerations = []
+    for move, d, p in zip(MOVES, durations, profiles):
+        length = float(np.max(np.abs(move)))
+        assert p in tried
+        assert peak_rate_factor(p) * length / d <= 1.0 + 1e-9
+        for earlier in tried[:tried.index(p)]:      # cheaper, but too fast at d
+            assert peak_rate_factor(earlier) * length / d > 1.0 - 1e-9
+        accelerations.append(peak_acceleration_factor(p) * length / d**2)
+    unheld = [a for a, move, d, p in zip(accelerations, MOVES, durations, profiles)
+              if peak_rate_factor(p) * float(np.max(np.abs(move))) / d < 1.0 - 1e-6]
+    assert len(unheld) >= 2 and max(unheld) - min(unheld) <= 1e-6 * max(unheld)
+    assert max(accelerations) <= max(unheld) * (1.0 + 1e-6)
+
+
+def test_a_via_tube_timed_for_a_force_keeps_its_profiles_peak_rate_within_the_bound():
+    """The via design itself: every segment's peak rate within |v| <= 0.5 (its smooth
+    steps timed by square roots alone would pass it), and the tube still ends at t_c."""
+    from stt_codegen.tube.parameters import peak_rate_factor
+    spec = _force_spec([0.5, 0.5])
+    design = via_design(spec, base_design(spec))
+    assert design.segments[-1].end == spec.prescribed_time
+    rates = []
+    for seg in design.segments:
+        move = max(abs(0.5 * (b + d) - 0.5 * (a + c)) for a, c, b, d in
+                   zip(seg.lower_from, seg.upper_from, seg.lower_to, seg.upper_to))
+        rates.append(peak_rate_factor(seg.profile) * move / (seg.end - seg.start))
+    assert max(rates) <= 0.5 * (1.0 + 1e-9)
+    free = via_design(_force_spec(None), base_design(_force_spec(None)))
+    assert max(peak_rate_factor(s.profile) * max(
+        abs(0.5 * (b + d) - 0.5 * (a + c)) for a, c, b, d in
+        zip(s.lower_from, s.upper_from, s.lower_to, s.upper_to)) / (s.end - s.start)
+        for s in free.segments) > 0.5

@@ -21,10 +21,14 @@ second stage). Deterministic, in this order, the first tube that meets the bound
    via boxes, timed in proportion to their length over all of ``t_c`` (no circumvent
    flanks);
 4. **via points timed for the force** (a variant whose input is a force, the cascade:
-   ``ControllerVariant.via_timing``; tasks too): smooth-step segments whose durations
-   follow the square roots of their lengths, so each asks about the same peak
-   acceleration (:data:`~.via.ACCELERATION_TIMING`); a task's legs are smooth-step
-   segments then, not cruise ones;
+   ``ControllerVariant.via_timing``; tasks too): smooth-step segments timed so that every
+   move asks the same peak acceleration (durations that follow the square roots of their
+   lengths, :data:`~.via.ACCELERATION_TIMING`), a move whose smooth step would pass
+   ``state_space.velocity_bound`` slowed to it, as a cruise where that is cheaper
+   (:func:`~.via.timed_moves`); a task's legs are timed and shaped so too, not as cruise
+   legs; then the same with **S-curve segments** (the least peak acceleration of the
+   profiles, :data:`~stt_codegen.tube.parameters.SCURVE`; neither of the two proves the
+   smaller force on every spec);
 5. **via points with cruise segments** (the same; not for tasks, whose legs have them):
    the same via boxes and times, each segment's rate rising to 1.25 times its mean, not
    1.875 times.
@@ -50,7 +54,7 @@ from ..progress import report, reporting
 from ..spec.deadline import WINDOW_END, ending_windows, fixed_in_time, moved_words, with_deadline
 from ..spec.loader import Spec
 from ..spec.variants import variant_of
-from ..tube.parameters import CRUISE
+from ..tube.parameters import CRUISE, SCURVE, SMOOTHSTEP
 from .grid import MAX_TIME_FACTOR, grid_index, grid_value, smallest_passing
 from .failures import FailureKind, advice_wanted, without_advice
 from .certificate.actuator import prove_input_bound
@@ -110,7 +114,8 @@ def slower_variants(spec: Spec, default: Design) -> list[tuple[str, Spec]]:
         circumvents and ``tube.circumvent_sharpness`` is free; then via points, when
         ``tube.method`` allows them and the default is not already a via tube; then, for
         a variant whose input is a force (``via_timing = "acceleration"``), via points
-        timed for the acceleration (tasks too); then via
+        timed for the acceleration (tasks too) with ``"smoothstep"`` segments, then with
+        ``"scurve"`` ones; then via
         points with ``"cruise"`` segments (peak rate 1.25 times the mean, where the smooth
         step's is 1.875), when ``tube.method`` allows via points and the spec has no
         tasks (whose legs are cruise segments already).
@@ -127,9 +132,11 @@ def slower_variants(spec: Spec, default: Design) -> list[tuple[str, Spec]]:
         out.append(("via points", replace(spec, tube=replace(spec.tube, method=METHOD_VIA))))
     if (spec.tube.method in ("auto", METHOD_VIA)
             and variant_of(spec).via_timing == ACCELERATION_TIMING):
-        out.append(("via points timed for the force",
-                    replace(spec, tube=replace(spec.tube, method=METHOD_VIA,
-                                               via_timing=ACCELERATION_TIMING))))
+        for label, profile in (("via points timed for the force", SMOOTHSTEP),
+                               ("via points timed for the force, S-curve segments", SCURVE)):
+            out.append((label, replace(spec, tube=replace(spec.tube, method=METHOD_VIA,
+                                                          via_timing=ACCELERATION_TIMING,
+                                                          via_profile=profile))))
     if spec.tube.method in ("auto", METHOD_VIA) and not spec.tasks:
         out.append(("via points, cruise segments",
                     replace(spec, tube=replace(spec.tube, method=METHOD_VIA,

@@ -22,10 +22,12 @@ of the via-point design (:mod:`stt_codegen.design.via`), in window order, then t
   each leg's time follows its via path's length (largest coordinate moves), so every leg
   moves at about the same speed. With ``spec.tube.via_timing = "acceleration"`` (a
   second-order spec within ``[actuator]``: its input is a force) the legs are
-  ``"smoothstep"`` segments (peak acceleration ``5.77 D / T^2`` against the cruise's
-  ``9.4 D / T^2``) and every time follows the square roots of the moves' lengths
+  ``spec.tube.via_profile`` segments (the smooth step, peak acceleration ``5.77 D / T^2``
+  against the cruise's ``9.4 D / T^2``, or the S-curve's ``4.76 D / T^2``) and every time
+  follows the square roots of the moves' lengths
   (:func:`~stt_codegen.design.via.move_weight`), so every move asks about the same
-  acceleration.
+  acceleration; a move whose profile would pass the velocity bound is slowed to it, as a
+  cruise where that is cheaper (:func:`~stt_codegen.design.via.timed_moves`).
 
 The certificate (:mod:`stt_codegen.design.certificate.tasks`) then proves each task for
 every ``t``; the plan only makes it likely to pass. The plans (visit order and ``any_of``
@@ -45,10 +47,10 @@ import numpy as np
 from ..errors import DesignError
 from ..spec.loader import Spec
 from ..spec.tasks import STAY, Task
-from ..tube.parameters import CRUISE, SMOOTHSTEP, ReachSegment, TubeDesign, paper_segments
+from ..tube.parameters import CRUISE, ReachSegment, TubeDesign, paper_segments
 from .failures import FailureKind
 from .swept import swept_spec
-from .via import LENGTH_TIMING, ViaPlan, move_weight, plan_via
+from .via import LENGTH_TIMING, ViaPlan, move_weight, plan_via, timed_moves
 
 __all__ = ["FREE_HOLD", "MAX_PLANS", "STAY_LEAD", "TaskPlan", "plan_tasks", "task_plans",
            "task_schedule", "visit_orders"]
@@ -136,24 +138,56 @@ def _path_length(plan: ViaPlan, timing: str = LENGTH_TIMING) -> float:
     return sum(move_weight(_distance(a, b), timing) for a, b in zip(centres, centres[1:]))
 
 
+def _moves(plan: ViaPlan) -> list[np.ndarray]:
+    """The via boxes' centres' displacements, state units, one per move."""
+    centres = [np.asarray(_centre((lo, hi))) for lo, hi in zip(plan.lower, plan.upper)]
+    return [b - a for a, b in zip(centres, centres[1:])]
+
+
+def _leg_weights(spec: Spec, plans: list[ViaPlan]) -> list[float]:
+    """The legs' shares of time under free timing: each leg's :func:`_path_length`; timed
+    for the acceleration under a velocity bound, each leg's moves' durations when all the
+    legs' moves share ``t_c`` (:func:`~.via.timed_moves`)."""
+    timing = spec.tube.via_timing
+    if timing == LENGTH_TIMING or spec.velocity_bound is None:
+        return [_path_length(plan, timing) for plan in plans]
+    moves = [_moves(plan) for plan in plans]
+    seconds, _ = timed_moves(spec, [m for leg in moves for m in leg], spec.prescribed_time,
+                             _leg_profile(spec))
+    out, k = [], 0
+    for leg in moves:
+        out.append(sum(seconds[k:k + len(leg)]))
+        k += len(leg)
+    return out
+
+
 def _leg_profile(spec: Spec) -> str:
-    """The legs' profile: ``"cruise"``, or ``"smoothstep"`` when timed for the
-    acceleration (module notes)."""
-    return CRUISE if spec.tube.via_timing == LENGTH_TIMING else SMOOTHSTEP
+    """The legs' profile: ``"cruise"``, or the spec's ``tube.via_profile`` when timed for
+    the acceleration (module notes)."""
+    return CRUISE if spec.tube.via_timing == LENGTH_TIMING else spec.tube.via_profile
 
 
 def _leg(plan: ViaPlan, base: TubeDesign, t0: float, t1: float,
-         profile: str = CRUISE) -> list[ReachSegment]:
+         profile: str = CRUISE, spec: Spec | None = None) -> list[ReachSegment]:
     """The segments (``profile``) of a leg's via boxes (:func:`_leg_path`) from ``t0`` to
-    ``t1`` (seconds)."""
-    times = [t0 + (t1 - t0) * t for t in plan.times]
+    ``t1`` (seconds); with ``spec``, its moves timed again over the leg's duration where
+    the velocity bound gives them floors (:func:`~.via.move_durations`)."""
+    profiles: tuple[str, ...] = ()
+    if spec is not None and spec.tube.via_timing != LENGTH_TIMING:
+        seconds, chosen = timed_moves(spec, _moves(plan), t1 - t0, profile)
+        times = [t0]
+        for d in seconds:
+            times.append(times[-1] + d)
+        profiles = tuple(chosen)
+    else:
+        times = [t0 + (t1 - t0) * t for t in plan.times]
     times[0], times[-1] = t0, t1
     for k in range(1, len(times) - 1):
         times[k] = min(max(times[k], np.nextafter(times[k - 1], np.inf)), t1)
     if any(b <= a for a, b in zip(times, times[1:])):
         raise DesignError(f"no time for the via boxes between {t0:g} s and {t1:g} s",
                           kind=FailureKind.TASK, tried=base)
-    return list(replace(plan, times=tuple(times)).segments(profile))
+    return list(replace(plan, times=tuple(times), profiles=profiles).segments(profile))
 
 
 @dataclass(frozen=True)
@@ -497,8 +531,8 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...],
     # free timing: each leg's time follows its via path's length (fixed holds: unused)
     legs = None
     if _listed_holds(spec, order, boxes, base, choice) is None:
-        legs = [_path_length(path(a, b, p), spec.tube.via_timing)
-                for a, b, p in zip(starts, boxes + [goal], pendings)]
+        legs = _leg_weights(spec, [path(a, b, p)
+                                   for a, b, p in zip(starts, boxes + [goal], pendings)])
     boxes, holds = task_schedule(spec, base, order, choice, legs)
     profile = _leg_profile(spec)
     start = starts[0]
@@ -508,14 +542,15 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...],
         if arrive == leave:        # a stay held where the tube already is
             segments.append(ReachSegment(leave, until_t, *start, *start, CRUISE))
         else:
-            segments += _leg(path(start, box, pendings[j]), base, leave, arrive, profile)
+            segments += _leg(path(start, box, pendings[j]), base, leave, arrive, profile,
+                             spec)
             segments.append(ReachSegment(arrive, until_t, *box, *box, CRUISE))
             start = box
         leave = until_t
     if not base.prescribed_time > leave:
         raise DesignError("no time to reach the target after the last task",
                           kind=FailureKind.TASK, tried=base)
-    segments += _leg(path(start, goal, []), base, leave, base.prescribed_time, profile)
+    segments += _leg(path(start, goal, []), base, leave, base.prescribed_time, profile, spec)
     by_task = dict(zip(order, holds))
     plan = TaskPlan(order, tuple(by_task[k] for k in range(len(spec.tasks))))
     return replace(base, segments=tuple(segments), circumvents=()), plan

@@ -38,10 +38,12 @@ import numpy as np
 from ..errors import DesignError
 from ..spec.loader import Spec
 from .failures import FailureKind
-from ..tube.parameters import SMOOTHSTEP, ReachSegment, TubeDesign
+from ..tube.parameters import (CRUISE, SCURVE, SMOOTHSTEP, ReachSegment, TubeDesign,
+                               peak_acceleration_factor, peak_rate_factor)
 
-__all__ = ["ACCELERATION_TIMING", "LENGTH_TIMING", "VIA_HALF_WIDTH", "VIA_MARGIN",
-           "VIA_TIMINGS", "ViaPlan", "move_weight", "plan_via", "via_design"]
+__all__ = ["ACCELERATION_PROFILES", "ACCELERATION_TIMING", "LENGTH_TIMING", "VIA_HALF_WIDTH",
+           "VIA_MARGIN", "VIA_TIMINGS", "ViaPlan", "move_weight", "plan_via",
+           "timed_moves", "via_design"]
 
 #: Largest half-width of a via box, state units.
 VIA_HALF_WIDTH = 0.1
@@ -53,10 +55,14 @@ MAX_CELLS = 6000
 #: peak rate is then the same on every move: the timing for a velocity input (law (13)).
 LENGTH_TIMING = "length"
 #: Via timing: each move's duration in proportion to the square root of its length. A
-#: profile's peak acceleration (``5.77 D / T^2`` for the quintic smooth step) is then the
-#: same on every move: the timing for a force input (the cascade, docs/second-order.md).
+#: profile's peak acceleration (``4.76 D / T^2`` for the S-curve it is used with, ``5.77 D /
+#: T^2`` for the quintic smooth step) is then the same on every move: the timing for a force
+#: input (the cascade, docs/second-order.md).
 ACCELERATION_TIMING = "acceleration"
 VIA_TIMINGS = (LENGTH_TIMING, ACCELERATION_TIMING)
+#: The profiles a move timed for the acceleration may take, least peak acceleration first
+#: (peak rates 2, 15/8 and 1.25 times the mean): from the spec's ``tube.via_profile`` on.
+ACCELERATION_PROFILES = (SCURVE, SMOOTHSTEP, CRUISE)
 
 
 def move_weight(length: float, timing: str) -> float:
@@ -87,6 +93,78 @@ def move_weight(length: float, timing: str) -> float:
     raise ValueError(f"unknown via timing {timing!r}: one of {', '.join(VIA_TIMINGS)}")
 
 
+def timed_moves(spec: Spec, moves: list[np.ndarray], duration: float, profile: str
+                ) -> tuple[list[float], list[str]]:
+    """The moves' durations sharing ``duration``, and each move's profile.
+
+    With the length timing, or without ``state_space.velocity_bound``, each move's share is
+    its :func:`move_weight` over their sum and every move has ``profile``. Timed for the
+    acceleration (:data:`ACCELERATION_TIMING`) under a velocity bound ``v``, the moves get
+    the least common peak acceleration ``a`` that fits: move ``k`` (largest coordinate move
+    ``L_k``, ``M_k = max_i |m_i| / v_i``) lasts ``min_p max(sqrt(c_p L_k / a), r_p M_k)``
+    over the profiles ``p`` of :data:`ACCELERATION_PROFILES` from ``profile`` on (peak
+    acceleration ``c_p L / D^2``, peak rate ``r_p L / D``): the profile of least peak
+    acceleration whose peak rate
+    stays within the bound (the certificate then proves ``|x2_i| <= v_i`` with the position
+    stage's correction on top), and a bisection on ``a`` makes the durations sum to
+    ``duration``. Where the bound cannot be
+    kept at all (the profile of least peak rate needs more than ``duration``), every move
+    has that profile, in proportion to ``M_k``.
+
+    Parameters
+    ----------
+    spec : Spec
+        Its ``tube.via_timing`` and ``velocity_bound`` (:attr:`~stt_codegen.spec.loader.Spec.velocity_bound`).
+    moves : list of ndarray, shape (n,) each
+        The moves' centre displacements, state units.
+    duration : float
+        Seconds the moves share.
+    profile : str
+        The moves' profile where the bound does not choose it.
+
+    Returns
+    -------
+    durations : list of float
+        Seconds, one per move, summing to ``duration`` (to rounding).
+    profiles : list of str
+        One per move.
+    """
+    timing = spec.tube.via_timing
+    weights = [move_weight(float(np.max(np.abs(m))), timing) for m in moves]
+    if timing != ACCELERATION_TIMING or spec.velocity_bound is None or not moves:
+        total = sum(weights)
+        return ([(w / total if total > 0 else 1.0 / len(moves)) * duration for w in weights],
+                [profile] * len(moves))
+    reach = np.asarray(spec.velocity_bound, dtype=float)
+    lengths = [float(np.max(np.abs(m))) for m in moves]
+    ratios = [float(np.max(np.abs(m) / reach)) for m in moves]
+    tried = (ACCELERATION_PROFILES[ACCELERATION_PROFILES.index(profile):]
+             if profile in ACCELERATION_PROFILES else (profile,))
+    shapes = [(peak_acceleration_factor(p), peak_rate_factor(p), p) for p in tried]
+
+    def at(accel: float) -> tuple[list[float], list[str]]:
+        out = [min((max(math.sqrt(c * length / accel), r * ratio), p) for c, r, p in shapes)
+               for length, ratio in zip(lengths, ratios)]
+        return [d for d, _ in out], [p for _, p in out]
+
+    slowest, last = min((r, p) for _, r, p in shapes)
+    if slowest * sum(ratios) >= duration:
+        total = sum(ratios)
+        return [q / total * duration for q in ratios], [last] * len(moves)
+    low, high = 1e-12, 1.0
+    while sum(at(high)[0]) > duration:
+        low, high = high, high * 4.0
+    for _ in range(200):
+        mid = math.sqrt(low * high)
+        if sum(at(mid)[0]) > duration:
+            low = mid
+        else:
+            high = mid
+    durations, profiles = at(high)
+    scale = duration / sum(durations)
+    return [d * scale for d in durations], profiles
+
+
 @dataclass(frozen=True)
 class ViaPlan:
     """The via boxes of a piecewise reach tube.
@@ -97,19 +175,23 @@ class ViaPlan:
         Box corners ``B_0 .. B_m``, shape (m + 1, n).
     times : tuple of float
         ``t_0 = 0 < t_1 < ... < t_m <= t_c``, seconds: the tube is in ``B_k`` at ``t_k``.
+    profiles : tuple of str
+        Each move's profile where :func:`timed_moves` chose it (``m`` entries), else empty.
     """
 
     lower: tuple[tuple[float, ...], ...]
     upper: tuple[tuple[float, ...], ...]
     times: tuple[float, ...]
+    profiles: tuple[str, ...] = ()
 
     def segments(self, profile: str = SMOOTHSTEP) -> tuple[ReachSegment, ...]:
         """The reach segments between consecutive via boxes.
 
         Parameters
         ----------
-        profile : {"smoothstep", "cruise"}
-            Their profile (both have zero slope at every via point).
+        profile : {"smoothstep", "cruise", "scurve"}
+            Their profile (each has zero slope at every via point), where the plan has not
+            chosen each move's (:attr:`profiles`).
 
         Returns
         -------
@@ -117,7 +199,8 @@ class ViaPlan:
         """
         return tuple(ReachSegment(self.times[k], self.times[k + 1], self.lower[k],
                                   self.upper[k], self.lower[k + 1], self.upper[k + 1],
-                                  profile) for k in range(len(self.times) - 1))
+                                  self.profiles[k] if self.profiles else profile)
+                     for k in range(len(self.times) - 1))
 
 
 def _meets(lower: np.ndarray, upper: np.ndarray, obstacles: np.ndarray,
@@ -233,7 +316,7 @@ def plan_via(spec: Spec, base: TubeDesign) -> ViaPlan:
             f"at ({where}); the passage is too narrow there", kind=FailureKind.NO_PASSAGE)
     nodes = {k: (lows[k], highs[k]) for k in path}
     path = _shortcut(path, nodes, obstacles, space)
-    return _timed(path, nodes, base.prescribed_time, spec.tube.via_timing)
+    return _timed(path, nodes, base.prescribed_time, spec)
 
 
 def _grid_nodes(space, grid_dims: list[int], counts: list[int], start, goal,
@@ -361,15 +444,13 @@ def _shortcut(path: list, nodes: dict, obstacles: np.ndarray, space) -> list:
     return out
 
 
-def _timed(path: list, nodes: dict, prescribed_time: float, timing: str) -> ViaPlan:
+def _timed(path: list, nodes: dict, prescribed_time: float, spec: Spec) -> ViaPlan:
     centres = [0.5 * (nodes[k][0] + nodes[k][1]) for k in path]
-    lengths = [move_weight(float(np.max(np.abs(b - a))), timing)
-               for a, b in zip(centres, centres[1:])]
-    total = sum(lengths)
+    durations, profiles = timed_moves(spec, [b - a for a, b in zip(centres, centres[1:])],
+                                      prescribed_time, spec.tube.via_profile)
     times = [0.0]
-    for length in lengths:
-        share = length / total if total > 0 else 1.0 / len(lengths)
-        times.append(times[-1] + share * prescribed_time)
+    for seconds in durations:
+        times.append(times[-1] + seconds)
     times[-1] = prescribed_time
     # a zero-length move (same centre, other size) still needs a positive duration
     for k in range(1, len(times)):
@@ -377,7 +458,8 @@ def _timed(path: list, nodes: dict, prescribed_time: float, timing: str) -> ViaP
             times[k] = math.nextafter(times[k - 1], math.inf)
     lower = tuple(tuple(float(v) for v in nodes[k][0]) for k in path)
     upper = tuple(tuple(float(v) for v in nodes[k][1]) for k in path)
-    return ViaPlan(lower, upper, tuple(times))
+    chosen = tuple(profiles) if any(p != spec.tube.via_profile for p in profiles) else ()
+    return ViaPlan(lower, upper, tuple(times), chosen)
 
 
 def via_design(spec: Spec, base: TubeDesign) -> TubeDesign:

@@ -177,10 +177,11 @@ class TubeParameters:
     method : {"paper", "via", "auto"}
         The reach tube: the paper's single tube (eq. (4)), via-point segments, or the
         paper's first and via points when it has no certified design (default).
-    via_profile : {"smoothstep", "cruise"}
+    via_profile : {"smoothstep", "cruise", "scurve"}
         The via-point segments' profile (``tube/parameters.py``). Not a key of the file:
-        ``"smoothstep"`` as loaded; the design within ``[actuator]`` tries ``"cruise"``
-        (a lower peak rate) when the other tubes exceed the bound.
+        ``"smoothstep"`` as loaded; the design within ``[actuator]`` tries ``"scurve"``
+        (a lower peak acceleration) with the ``"acceleration"`` timing and ``"cruise"`` (a
+        lower peak rate) when the other tubes exceed the bound.
     via_timing : {"length", "acceleration"}
         How the via-point segments (and the legs of ``[[tasks]]``) share the time
         (``design/via.py``): in proportion to each move's length, or to its square root
@@ -396,6 +397,13 @@ class Spec:
             tube of the positions ``x1``.
         """
         return 1 if self.second_order is None else 2
+
+    @property
+    def velocity_bound(self) -> tuple[float, ...] | None:
+        """``state_space.velocity_bound``: the bound of ``|x2_i|`` of a second-order plant
+        (:attr:`second_order`), velocity units (state units per second) per position; None
+        for a first-order plant or where it is not declared."""
+        return None if self.second_order is None else self.second_order.velocity_bound
 
     @property
     def variant(self) -> str:
