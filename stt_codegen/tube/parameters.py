@@ -166,6 +166,18 @@ SCURVE_TURN = 0.08
 PROFILES = (TANH, SMOOTHSTEP, CRUISE, SCURVE)
 
 
+#: ``(sup dp/dtau, sup |d^2p/dtau^2|)`` of each smooth profile (docstrings below).
+_PEAKS = {SMOOTHSTEP: (1.875, 10.0 / math.sqrt(3.0)),
+          CRUISE: (1.0 / (1.0 - CRUISE_RAMP), 1.5 / (CRUISE_RAMP * (1.0 - CRUISE_RAMP))),
+          SCURVE: (2.0, 4.0 / (1.0 - 2.0 * SCURVE_TURN))}
+
+
+def _peaks(profile: str, what: str) -> tuple[float, float]:
+    if profile not in _PEAKS:
+        raise ValueError(f"no fixed peak {what} for the reach segment profile {profile!r}")
+    return _PEAKS[profile]
+
+
 def peak_rate_factor(profile: str) -> float:
     """``sup_tau dp/dtau`` of a smooth profile: the peak of ``|rho_dot|`` on a segment is
     this times ``|to - from| / (end - start)``.
@@ -189,43 +201,19 @@ def peak_rate_factor(profile: str) -> float:
         ``"tanh"`` (its peak depends on the segment: ``verify.lemma.reach_rate_bound``) or
         an unknown profile.
     """
-    if profile == SMOOTHSTEP:
-        return 1.875
-    if profile == CRUISE:
-        return 1.0 / (1.0 - CRUISE_RAMP)
-    if profile == SCURVE:
-        return 2.0
-    raise ValueError(f"no fixed peak rate for the reach segment profile {profile!r}")
+    return _peaks(profile, "rate")[0]
 
 
 def peak_acceleration_factor(profile: str) -> float:
-    """``sup_tau |d^2p/dtau^2|`` of a smooth profile: the peak of ``|rho_ddot|`` on a segment
-    is this times ``|to - from| / (end - start)^2``.
-
-    Parameters
-    ----------
-    profile : {"smoothstep", "cruise", "scurve"}
-
-    Returns
-    -------
-    float
-        ``10 / sqrt(3)`` (5.77) for ``"smoothstep"`` (at ``tau = 1/2 -+ sqrt(3)/6``);
-        ``1.5 / (a (1 - a))`` (9.38) for ``"cruise"`` (the cubic smooth step's slope 3/2
-        over a ramp of share ``a = CRUISE_RAMP`` to the rate ``1 / (1 - a)``);
-        ``4 / (1 - 2 q)`` (4.76) for ``"scurve"`` (``q = SCURVE_TURN``).
-
-    Raises
-    ------
-    ValueError
-        ``"tanh"`` (unbounded near its end) or an unknown profile.
+    """``sup_tau |d^2p/dtau^2|``, as :func:`peak_rate_factor` for the rate: the peak of
+    ``|rho_ddot|`` on a segment is this times ``|to - from| / (end - start)^2``. It is
+    ``10 / sqrt(3)`` (5.77) for ``"smoothstep"`` (at ``tau = 1/2 -+ sqrt(3)/6``), ``1.5 / (a
+    (1 - a))`` (9.38) for ``"cruise"`` (the cubic smooth step's slope 3/2 over a ramp of
+    share ``a = CRUISE_RAMP`` up to the rate ``1 / (1 - a)``), ``4 / (1 - 2 q)`` (4.76) for
+    ``"scurve"`` (``q = SCURVE_TURN``); ``ValueError`` for ``"tanh"`` (unbounded near its
+    end) or an unknown profile.
     """
-    if profile == SMOOTHSTEP:
-        return 10.0 / math.sqrt(3.0)
-    if profile == CRUISE:
-        return 1.5 / (CRUISE_RAMP * (1.0 - CRUISE_RAMP))
-    if profile == SCURVE:
-        return 4.0 / (1.0 - 2.0 * SCURVE_TURN)
-    raise ValueError(f"no fixed peak acceleration for the reach segment profile {profile!r}")
+    return _peaks(profile, "acceleration")[1]
 
 
 @dataclass(frozen=True)
