@@ -47,7 +47,8 @@ def test_bundled_second_order_cases_parse() -> None:
     order = spec.second_order
     assert order.model == "quadrotor" and order.parameters == (1.2, 0.3, 9.81)
     assert order.velocity_bound == (3.0, 3.0, 3.0) and order.input_gain == (0.625, 1.25)
-    assert order.drift_bound == 11.31
+    assert order.drift_bounds == (1.5, 1.5, 11.31)   # gravity on the vertical axis only
+    assert order.drift_bound == 11.31                 # their largest
     # the position stage is a single integrator; [assumptions] bound the second stage only
     assert spec.plant_model == "single-integrator" and spec.assumptions.declared == ()
     s1 = stt.load_spec("second-order-s1").second_order
@@ -162,7 +163,8 @@ def test_velocity_keys_on_a_first_order_model_are_refused(key, value, model) -> 
 
 def test_a_first_order_spec_is_unchanged_by_the_second_order_keys() -> None:
     data = _changed({"plant.model": "single-integrator", "plant.parameters": None,
-                     "initial.velocity": None, "state_space.velocity_bound": None})
+                     "initial.velocity": None, "state_space.velocity_bound": None,
+                     "assumptions.drift_bound": 11.31})   # one number: |f(x)| of system (1)
     spec = stt.Spec.from_dict(data)        # [assumptions] are then the first-order ones
     assert spec.second_order is None and spec.plant_model == "single-integrator"
     assert spec.assumptions.input_gain == (0.625, 1.25)
