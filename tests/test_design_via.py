@@ -329,6 +329,13 @@ parameters = [1.0]
 MOVES = [np.array([0.5, 0.2]), np.array([9.0, 0.0]), np.array([0.0, 1.0])]
 
 
+def test_timed_moves_of_no_length_share_the_time_equally():
+    from stt_codegen.design.via import timed_moves
+    still = [np.zeros(2), np.zeros(2)]
+    assert timed_moves(_force_spec([1.0, 1.0]), still, 6.0, "scurve") == (
+        [3.0, 3.0], ["scurve", "scurve"])
+
+
 def test_timed_moves_without_a_velocity_bound_are_the_square_root_shares_bit_for_bit():
     from stt_codegen.design.via import move_weight, timed_moves
     for spec in (_force_spec(None), _force_spec([1.0, 1.0], timing="length")):

@@ -131,7 +131,8 @@ def timed_moves(spec: Spec, moves: list[np.ndarray], duration: float, profile: s
     """
     timing = spec.tube.via_timing
     weights = [move_weight(float(np.max(np.abs(m))), timing) for m in moves]
-    if timing != ACCELERATION_TIMING or spec.velocity_bound is None or not moves:
+    if (timing != ACCELERATION_TIMING or spec.velocity_bound is None or not moves
+            or not any(weights)):            # (moves of no length: equal shares)
         total = sum(weights)
         return ([(w / total if total > 0 else 1.0 / len(moves)) * duration for w in weights],
                 [profile] * len(moves))
