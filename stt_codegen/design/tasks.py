@@ -170,10 +170,12 @@ def _leg_profile(spec: Spec) -> str:
 def _leg(plan: ViaPlan, base: TubeDesign, t0: float, t1: float,
          profile: str = CRUISE, spec: Spec | None = None) -> list[ReachSegment]:
     """The segments (``profile``) of a leg's via boxes (:func:`_leg_path`) from ``t0`` to
-    ``t1`` (seconds); with ``spec``, its moves timed again over the leg's duration where
-    the velocity bound gives them floors (:func:`~.via.move_durations`)."""
+    ``t1`` (seconds); with ``spec`` timed for the acceleration under a velocity bound, its
+    moves timed again over the leg's duration (:func:`~.via.timed_moves`), else the
+    plan's shares of ``[0, 1]`` scaled."""
     profiles: tuple[str, ...] = ()
-    if spec is not None and spec.tube.via_timing != LENGTH_TIMING:
+    if (spec is not None and spec.tube.via_timing != LENGTH_TIMING
+            and spec.velocity_bound is not None):
         seconds, chosen = timed_moves(spec, _moves(plan), t1 - t0, profile)
         times = [t0]
         for d in seconds:

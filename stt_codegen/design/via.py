@@ -104,17 +104,17 @@ def timed_moves(spec: Spec, moves: list[np.ndarray], duration: float, profile: s
     ``L_k``, ``M_k = max_i |m_i| / v_i``) lasts ``min_p max(sqrt(c_p L_k / a), r_p M_k)``
     over the profiles ``p`` of :data:`ACCELERATION_PROFILES` from ``profile`` on (peak
     acceleration ``c_p L / D^2``, peak rate ``r_p L / D``): the profile of least peak
-    acceleration whose peak rate
-    stays within the bound (the certificate then proves ``|x2_i| <= v_i`` with the position
-    stage's correction on top), and a bisection on ``a`` makes the durations sum to
-    ``duration``. Where the bound cannot be
-    kept at all (the profile of least peak rate needs more than ``duration``), every move
-    has that profile, in proportion to ``M_k``.
+    acceleration whose peak rate stays within the bound (the certificate then proves
+    ``|x2_i| <= v_i`` with the position stage's correction on top), and a bisection on
+    ``a`` makes the durations sum to ``duration``. Where the bound cannot be kept at all
+    (the profile of least peak rate needs more than ``duration``), every move has that
+    profile, in proportion to ``M_k``.
 
     Parameters
     ----------
     spec : Spec
-        Its ``tube.via_timing`` and ``velocity_bound`` (:attr:`~stt_codegen.spec.loader.Spec.velocity_bound`).
+        Its ``tube.via_timing`` and
+        :attr:`~stt_codegen.spec.loader.Spec.velocity_bound`.
     moves : list of ndarray, shape (n,) each
         The moves' centre displacements, state units.
     duration : float
