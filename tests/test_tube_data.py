@@ -90,8 +90,10 @@ def test_an_s_curve_tube_is_refused_by_the_data_form(several):
     field; in the C, its code (3) fails the check on its segments (code 5); the same tube
     with cruise segments passes it."""
     from stt_codegen.codegen.tube_data import DATA_PROFILES
+    from stt_codegen.tube.pieces import PROFILE_NAMES
     _, library = several
     assert "scurve" not in DATA_PROFILES and "cruise" in DATA_PROFILES
+    assert PROFILE_NAMES[:len(DATA_PROFILES)] == DATA_PROFILES      # the same codes
     with pytest.raises(stt.SpecError, match="tube_data: the tube has scurve segments"):
         library.pack(piecewise_design("scurve"))
     tube = library.pack(piecewise_design("cruise"))
