@@ -57,8 +57,8 @@ from functools import lru_cache
 
 import casadi as ca
 
-from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, NEWTON_TINY, SCURVE, SCURVE_TURN,
-                         SMOOTHSTEP, TANH)
+from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, NEWTON_TINY, SCURVE,
+                         SCURVE_TURN, SMOOTHSTEP, TANH)
 
 __all__ = ["EXP_ARGUMENT_BOUND", "PROFILE_NAMES", "alpha_rate", "bump", "candidates", "conflict",
            "deployed_pieces", "error_transform", "error_transform_expression", "fnu_pieces",

@@ -21,7 +21,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, LOWER, SCURVE, SCURVE_TURN,
-                         SMOOTHSTEP, STATUS_INPUT_CLAMPED, STATUS_OK, STATUS_OUTSIDE_TUBE, TANH, ReachSegment, TubeDesign, step_status)
+                         SMOOTHSTEP, STATUS_INPUT_CLAMPED, STATUS_OK, STATUS_OUTSIDE_TUBE, TANH,
+                         ReachSegment, TubeDesign, step_status)
 
 __all__ = ["adaptive_law", "adaptive_tube", "alpha_step", "bump", "circumvent",
            "circumvent_from_bumps", "conflict_distance", "control", "controller_status",
