@@ -3,9 +3,9 @@
 When the tube moves too fast for the controller's rate (the certificate's
 ``SAMPLING_RATE`` or ``NON_EMPTY`` property, or the cascade's stage at no rate), a later
 deadline is the knob that helps whatever the hardware: the search doubles ``t_c`` up to
-:data:`~.grid.MAX_TIME_FACTOR` times it, then bisects :data:`BISECTIONS` times on the
-two-digit grid (:mod:`.grid`), and names the time at which the design search certified the
-spec (the smallest it found, within about an eighth of the doubling).
+:data:`~.grid.MAX_TIME_FACTOR` times it, then bisects on the two-digit grid (:mod:`.grid`)
+down to neighbouring values, and names the smallest time on the grid at which the design
+search certified the spec (where certification is monotone in ``t_c`` between the two).
 Specs with parts fixed in absolute time (timed tasks whose windows end before ``t_c``,
 moving obstacles, ``[target] any_of``: :func:`~stt_codegen.spec.deadline.fixed_in_time`)
 are refused as they are: a later ``t_c`` does not move them. Task windows that end at
@@ -24,16 +24,13 @@ from ..errors import DesignError, number_text
 from ..spec.deadline import WINDOW_END, ending_windows, fixed_in_time, moved_words, with_deadline
 from ..spec.loader import Spec
 from .failures import FailureKind, without_advice
-from .grid import MAX_TIME_FACTOR, grid_index, grid_value
+from .grid import MAX_TIME_FACTOR, grid_index, grid_value, smallest_passing
 from .result import Design
 
-__all__ = ["BISECTIONS", "SLOWER_HELPS", "certified_time", "deadline_refusal"]
+__all__ = ["SLOWER_HELPS", "certified_time", "deadline_refusal"]
 
 #: The failures a later deadline (a slower tube) cures.
 SLOWER_HELPS = (FailureKind.SAMPLING_RATE, FailureKind.NON_EMPTY)
-#: Bisection steps after the doubling: the time named is certified and within about an
-#: eighth of the doubling's interval above the smallest on the grid (each step is a design).
-BISECTIONS = 3
 
 
 def deadline_refusal(spec: Spec, error: DesignError,
@@ -75,7 +72,8 @@ def deadline_refusal(spec: Spec, error: DesignError,
 def certified_time(spec: Spec, search: Callable[[Spec], Design]) -> float | None:
     """The smallest ``prescribed_time`` above the spec's that ``search`` certifies (the spec
     moved there by :func:`~stt_codegen.spec.deadline.with_deadline`), on the two-digit grid: doubling up to :data:`~.grid.MAX_TIME_FACTOR` times ``t_c``, then
-    :data:`BISECTIONS` bisections (each trial a design, its advice off).
+    a bisection down to neighbouring grid values (:func:`~.grid.smallest_passing`; each
+    trial a design, its advice off).
 
     Parameters
     ----------
@@ -108,9 +106,4 @@ def certified_time(spec: Spec, search: Callable[[Spec], Design]) -> float | None
         low, factor = index, 2.0 * factor
     if high is None:
         return None
-    for _ in range(BISECTIONS):               # within an eighth of the doubling, cheaply
-        if high - low <= 1:
-            break
-        mid = (low + high) // 2
-        low, high = (low, mid) if passes(mid) else (mid, high)
-    return grid_value(high)
+    return grid_value(smallest_passing(passes, low, high))
