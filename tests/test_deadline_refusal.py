@@ -58,3 +58,30 @@ def test_no_room_for_a_circumvent_and_a_via_tube_too_fast_names_a_deadline():
     assert str(raised.value).endswith(f"prescribed_time = {later:g} s is certified")
     design = stt.design_tube(dataclasses.replace(spec, prescribed_time=later))
     assert design.certificate.passed and design.input_proof.meets(spec.input_bound)
+
+
+@pytest.mark.parametrize("deadline, smallest", [(10.0, 19.0), (10.0, 11.0), (7.3, 29.0),
+                                                (10.0, 160.0), (10.0, 161.0)])
+def test_the_deadline_search_names_the_smallest_grid_time_a_monotone_search_certifies(
+        deadline, smallest):
+    """certified_time on a search that certifies every t_c >= ``smallest``: doubling finds
+    a passing time, the bisection goes on to neighbouring grid values, and the time named is
+    the smallest on the two-digit grid at or above ``smallest`` (three bisection steps named
+    20 s for 19 s), or none beyond 16 times t_c; each trial is a spec moved there."""
+    from stt_codegen.design.deadline import certified_time
+    from stt_codegen.design.grid import grid_index, grid_value
+    spec = dataclasses.replace(stt.load_spec("second-order-s1"), prescribed_time=deadline)
+    tried = []
+
+    def search(trial):
+        tried.append(trial.prescribed_time)
+        if trial.prescribed_time < smallest:
+            raise stt.DesignError("too fast", kind=FailureKind.SAMPLING_RATE)
+        return None
+
+    named = certified_time(spec, search)
+    if smallest > 16 * deadline:
+        assert named is None
+    else:
+        assert named == grid_value(grid_index(smallest)) and named in tried
+        assert all(t < smallest for t in tried if t < named)
