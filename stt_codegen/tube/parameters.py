@@ -15,8 +15,8 @@ import numpy as np
 
 __all__ = ["CRUISE", "CRUISE_RAMP", "Circumvent", "E_MAX", "GAMMA_D_MIN", "LOWER", "NEWTON_ITERATIONS", "NEWTON_TINY",
            "PERIOD_TOLERANCE", "ReachSegment", "SCURVE", "SCURVE_TURN", "SMOOTHSTEP",
-           "STATUS_INPUT_CLAMPED", "STATUS_INVALID_INPUT", "STATUS_OFF_PERIOD", "STATUS_OK", "STATUS_OUTSIDE_TUBE",
-           "STATUS_OUTSIDE_VELOCITY_TUBE", "Status", "TANH", "TubeDesign", "UPPER",
+           "STATUS_INPUT_CLAMPED", "STATUS_INVALID_INPUT", "STATUS_OFF_PERIOD", "STATUS_OK",
+           "STATUS_OUTSIDE_TUBE", "STATUS_OUTSIDE_VELOCITY_TUBE", "Status", "TANH", "TubeDesign", "UPPER",
            "off_period", "paper_segments", "peak_acceleration_factor", "peak_rate_factor",
            "step_status"]
 
@@ -151,7 +151,8 @@ CRUISE = "cruise"
 #: The cruise profile's ramps, each this share of the segment's duration.
 CRUISE_RAMP = 0.2
 #: Profile of a reach-tube segment: a jerk-limited S-curve, the profile of least peak
-#: acceleration among ours (the profile of via points timed for a force). Its acceleration
+#: acceleration among ours (one of the two that via points timed for a force try, after the
+#: smooth step: ``design/actuator.py``). Its acceleration
 #: ``p_ddot`` rises linearly from 0 to ``A`` over the first :data:`SCURVE_TURN` of the
 #: segment, holds ``A``, turns linearly to ``-A`` over the :data:`SCURVE_TURN` on each side
 #: of the middle, holds ``-A``, and returns to 0 over the last :data:`SCURVE_TURN`:
