@@ -51,7 +51,8 @@ import numpy as np
 
 from ..errors import DesignError, SpecError, number_text
 from ..progress import report, reporting
-from ..spec.deadline import WINDOW_END, ending_windows, fixed_in_time, moved_words, with_deadline
+from ..spec.deadline import (ending_windows, fixed_in_time, later_advice, moved_words,
+                             with_deadline)
 from ..spec.loader import Spec
 from ..spec.variants import variant_of
 from ..tube.parameters import CRUISE, SCURVE, SMOOTHSTEP
@@ -339,7 +340,7 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
                if later is not None else ""),
             kind=FailureKind.INPUT_BOUND, tried=tried[0].design.tube if tried else None,
             advice=({"controller.rate_hz": rate} if rate is not None else
-                    _later_advice(spec, later) if later is not None else {}))
+                    later_advice(spec, later) if later is not None else {}))
     best = min(proved, key=lambda c: c.proof.ratio(bound))
     worst = max(range(len(bound)), key=lambda i: best.proof.peak[i] / bound[i])
     needs = ", ".join(f"{_round_up(v):g}" for v in best.proof.peak)
@@ -361,13 +362,8 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     else:
         message += f"; {why}; input_bound = {needs} works with this prescribed_time"
     raise DesignError(message, kind=FailureKind.INPUT_BOUND, tried=best.design.tube,
-                      advice={} if works is None else _later_advice(spec, works))
+                      advice={} if works is None else later_advice(spec, works))
 
-
-def _later_advice(spec: Spec, later: float) -> dict:
-    """The advice for a later ``prescribed_time``: with ``tasks.window_end`` where windows
-    end at the spec's (:func:`~stt_codegen.spec.deadline.with_deadline`)."""
-    return {"prescribed_time": later, **({WINDOW_END: later} if ending_windows(spec) else {})}
 
 
 def _round_up(value: float, digits: int = 3) -> float:

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from ..errors import DesignError, number_text
-from ..spec.deadline import WINDOW_END, ending_windows, fixed_in_time, moved_words, with_deadline
+from ..spec.deadline import fixed_in_time, later_advice, moved_words, with_deadline
 from ..spec.loader import Spec
 from .failures import FailureKind, without_advice
 from .grid import MAX_TIME_FACTOR, grid_index, grid_value, smallest_passing
@@ -62,17 +62,15 @@ def deadline_refusal(spec: Spec, error: DesignError,
     time = certified_time(spec, search)
     if time is None:
         return error
-    moved = {WINDOW_END: time} if ending_windows(spec) else {}
     return DesignError(f"{error}; prescribed_time = {number_text(time)} s"
                        f"{moved_words(spec)} is certified", kind=error.kind,
-                       tried=error.tried, advice={**error.advice, "prescribed_time": time,
-                                                  **moved})
+                       tried=error.tried, advice={**error.advice, **later_advice(spec, time)})
 
 
 def certified_time(spec: Spec, search: Callable[[Spec], Design]) -> float | None:
     """The smallest ``prescribed_time`` above the spec's that ``search`` certifies (the spec
-    moved there by :func:`~stt_codegen.spec.deadline.with_deadline`), on the two-digit grid: doubling up to :data:`~.grid.MAX_TIME_FACTOR` times ``t_c``, then
-    a bisection down to neighbouring grid values (:func:`~.grid.smallest_passing`; each
+    moved there by :func:`~stt_codegen.spec.deadline.with_deadline`), on the two-digit
+    grid: doubling up to :data:`~.grid.MAX_TIME_FACTOR` times ``t_c``, then a bisection down to neighbouring grid values (:func:`~.grid.smallest_passing`; each
     trial a design, its advice off).
 
     Parameters

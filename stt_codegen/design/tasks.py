@@ -134,13 +134,12 @@ def _leg_path(spec: Spec, base: TubeDesign, start: tuple, goal: tuple) -> ViaPla
 def _path_length(plan: ViaPlan, timing: str = LENGTH_TIMING) -> float:
     """The via boxes' centres' path length (:func:`_distance` per move), state units; with
     another ``timing`` the sum of the moves' :func:`~.via.move_weight`."""
-    centres = [_centre((lo, hi)) for lo, hi in zip(plan.lower, plan.upper)]
-    return sum(move_weight(_distance(a, b), timing) for a, b in zip(centres, centres[1:]))
+    return sum(move_weight(float(np.max(np.abs(m))), timing) for m in _moves(plan))
 
 
 def _moves(plan: ViaPlan) -> list[np.ndarray]:
     """The via boxes' centres' displacements, state units, one per move."""
-    centres = [np.asarray(_centre((lo, hi))) for lo, hi in zip(plan.lower, plan.upper)]
+    centres = [_centre((lo, hi)) for lo, hi in zip(plan.lower, plan.upper)]
     return [b - a for a, b in zip(centres, centres[1:])]
 
 

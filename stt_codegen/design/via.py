@@ -130,14 +130,14 @@ def timed_moves(spec: Spec, moves: list[np.ndarray], duration: float, profile: s
         One per move.
     """
     timing = spec.tube.via_timing
-    weights = [move_weight(float(np.max(np.abs(m))), timing) for m in moves]
+    lengths = [float(np.max(np.abs(m))) for m in moves]
+    weights = [move_weight(length, timing) for length in lengths]
     if (timing != ACCELERATION_TIMING or spec.velocity_bound is None or not moves
             or not any(weights)):            # (moves of no length: equal shares)
         total = sum(weights)
         return ([(w / total if total > 0 else 1.0 / len(moves)) * duration for w in weights],
                 [profile] * len(moves))
     reach = np.asarray(spec.velocity_bound, dtype=float)
-    lengths = [float(np.max(np.abs(m))) for m in moves]
     ratios = [float(np.max(np.abs(m) / reach)) for m in moves]
     tried = (ACCELERATION_PROFILES[ACCELERATION_PROFILES.index(profile):]
              if profile in ACCELERATION_PROFILES else (profile,))

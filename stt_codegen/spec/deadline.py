@@ -17,7 +17,8 @@ if TYPE_CHECKING:
     from .loader import Spec
     from .motion import MovingObstacle
 
-__all__ = ["WINDOW_END", "ending_windows", "fixed_in_time", "moved_words", "with_deadline"]
+__all__ = ["WINDOW_END", "ending_windows", "fixed_in_time", "later_advice", "moved_words",
+           "with_deadline"]
 
 #: The advice key naming the end of the ``[[tasks]]`` windows that end at
 #: ``prescribed_time``, given with ``prescribed_time`` when both move together.
@@ -57,6 +58,13 @@ def fixed_in_time(spec: "Spec") -> bool:
     moved = set(ending_windows(spec))
     return bool((spec.tasks and not moved) or spec.target_any_of
                 or any(ob.until not in moved for ob in spec.moving_obstacles))
+
+
+def later_advice(spec: "Spec", later: float) -> dict[str, float]:
+    """A refusal's advice for a later ``prescribed_time`` (``DesignError.advice``): with
+    :data:`WINDOW_END` too where task windows end at the spec's, since the time was
+    certified with them moved (:func:`with_deadline`)."""
+    return {"prescribed_time": later, **({WINDOW_END: later} if ending_windows(spec) else {})}
 
 
 def moved_words(spec: "Spec") -> str:
