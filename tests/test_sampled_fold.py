@@ -80,6 +80,7 @@ def test_fold_equals_loop_on_random_classes(name: str) -> None:
     own = plant_class(spec)
     turn = own.assumptions.input_gain_turn is not None
     verdicts = set()
+    starts = np.random.default_rng(7)          # the boxes' own draws: the others unchanged
     with reference.numpy_math():
         for j in range(8):
             rate = tube.rate_hz * float(rng.choice([0.25, 0.5, 1.0, 2.0]))
@@ -94,6 +95,10 @@ def test_fold_equals_loop_on_random_classes(name: str) -> None:
                       {"jitter": float(rng.uniform(0.0, 0.2)) * dt},
                       {"delay": float(rng.uniform(0.0, 0.4)) * dt,
                        "jitter": float(rng.uniform(0.0, 0.2)) * dt}][j % 4]
+            # every other draw from a box of e(0) (a switch's, docs/sensing.md)
+            if j % 2:
+                timing["initial_error"] = [tuple(sorted(starts.uniform(-0.3, 0.3, 2)))
+                                           for _ in range(design.dimension)]
             loop = check_sampled(design, samples, plants, lyapunov=False, stop=stop,
                                  folded=False, **timing)
             fold = check_sampled(design, samples, plants, lyapunov=False, stop=stop,
@@ -103,6 +108,32 @@ def test_fold_equals_loop_on_random_classes(name: str) -> None:
                          "passed" if loop.passed else loop.reason.split(" ")[0])
     # the draws reach a pass and a failure (the comparison is not of passes only)
     assert "passed" in verdicts and len(verdicts) >= 2, verdicts
+
+
+@pytest.mark.parametrize("lyapunov", [False, True])
+def test_a_box_of_e0_bounds_every_start_in_it(lyapunov: bool) -> None:
+    """The check from a box of ``e(0)`` holding ``e(x(0))`` proves bounds no smaller than the
+    check from ``x(0)`` at every sample, and grows with the box; a box reaching the edge
+    fails; a box that is not one interval per dimension inside (-1, 1) is refused."""
+    spec, tube = _case("office-drive.toml")
+    plants = plant_class(spec)
+    with reference.numpy_math():
+        samples = sample_tube(tube)
+        point = check_sampled(tube, samples, plants, lyapunov=lyapunov)
+        boxes = [check_sampled(tube, samples, plants, lyapunov=lyapunov,
+                               initial_error=[(-w, w)] * tube.dimension)
+                 for w in (0.05, 0.2, 0.4)]
+        edge = check_sampled(tube, samples, plants, lyapunov=lyapunov,
+                             initial_error=[(-0.999, 0.999)] * tube.dimension)
+        for bad in ([(-0.1, 0.1)], [(0.2, 0.1)] * 2, [(-1.0, 0.1)] * 2):
+            with pytest.raises(ValueError, match="initial_error"):
+                check_sampled(tube, samples, plants, initial_error=bad)
+    assert point.passed and all(b.passed for b in boxes)
+    for wide, narrow in zip(boxes, [point] + boxes[:-1]):
+        assert np.all(wide.abs_e >= narrow.abs_e) and wide.level >= narrow.level
+    assert boxes[-1].abs_e[0].max() == pytest.approx(0.4)
+    assert np.any(boxes[-1].abs_e > point.abs_e)
+    assert not edge.passed
 
 
 def test_with_the_balls_the_loop_runs() -> None:

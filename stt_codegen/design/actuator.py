@@ -223,7 +223,9 @@ def _certified_rate(spec: Spec, tube, design_free: Callable[[Spec], Design],
     return rate
 
 
-def law13_input_proof(design: Design, spec: Spec) -> InputProof:
+def law13_input_proof(design: Design, spec: Spec,
+                      initial_error: tuple[tuple[float, float], ...] | None = None
+                      ) -> InputProof:
     """Law (13)'s proved peak of each input along ``design`` for ``spec``'s plants (the
     first order's role ``input_proof``).
 
@@ -232,6 +234,8 @@ def law13_input_proof(design: Design, spec: Spec) -> InputProof:
     design : Design
     spec : Spec
         Its plant class is the one proved.
+    initial_error : tuple of (float, float), optional
+        From this box of ``e(0)`` (:func:`~.certificate.sampled.check_sampled`).
 
     Returns
     -------
@@ -243,7 +247,7 @@ def law13_input_proof(design: Design, spec: Spec) -> InputProof:
     """
     limits = np.asarray(spec.input_bound or (), dtype=float)
     return prove_input_bound(design.tube, spec, limit=verdict_limit(
-        spec, lambda u: bool(np.any(u > limits))))
+        spec, lambda u: bool(np.any(u > limits))), initial_error=initial_error)
 
 
 def verdict_limit(spec: Spec, breaks: Callable[[np.ndarray], bool]

@@ -215,7 +215,7 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
     return None, {**derivation, "tried": tried}
 
 
-def cascade_design_proof(design, spec) -> InputProof:
+def cascade_design_proof(design, spec, initial_error=None) -> InputProof:
     """The cascade's certified peak of each physical input along ``design`` for ``spec``
     (the cascade's role ``input_proof``): :func:`cascade_input_proof` on its tube and its
     certified narrowest width.
@@ -225,11 +225,20 @@ def cascade_design_proof(design, spec) -> InputProof:
     design : Design
     spec : Spec
         With a second-order ``plant.model`` and ``input_bound``.
+    initial_error : None
+        The cascade does not replan (its certificate starts from ``x(0)``).
 
     Returns
     -------
     InputProof
+
+    Raises
+    ------
+    ValueError
+        ``initial_error`` given.
     """
+    if initial_error is not None:
+        raise ValueError("the cascade's certificate starts from x(0): no initial_error")
     return cascade_input_proof(design.tube, spec, design.check.min_width)
 
 

@@ -79,7 +79,8 @@ def look_ahead_input_proof(proof: InputProof, axle_offset: float) -> InputProof:
 
 
 def point_proof(tube: TubeDesign, spec: Spec,
-                limit: Callable[[list[float]], bool] | None = None) -> InputProof:
+                limit: Callable[[list[float]], bool] | None = None,
+                initial_error: tuple[tuple[float, float], ...] | None = None) -> InputProof:
     """Law (13)'s proved peak of ``|u|`` at the base's look-ahead point along ``tube``: the
     per-axis argument's (the Lyapunov balls only where it fails the sampled check itself).
 
@@ -96,16 +97,21 @@ def point_proof(tube: TubeDesign, spec: Spec,
         A differential-drive spec (its plant class).
     limit : callable, optional
         :func:`~.certificate.actuator.prove_input_bound`'s ``limit`` (a verdict only).
+    initial_error : tuple of (float, float), optional
+        Its ``initial_error``: from this box of ``e(0)``.
 
     Returns
     -------
     InputProof
         Of ``u`` at the point (map it with :func:`look_ahead_input_proof`).
     """
-    return prove_input_bound(tube, spec, per_axis_first=True, limit=limit)
+    return prove_input_bound(tube, spec, per_axis_first=True, limit=limit,
+                             initial_error=initial_error)
 
 
-def look_ahead_design_proof(design: Design, spec: Spec) -> InputProof:
+def look_ahead_design_proof(design: Design, spec: Spec,
+                            initial_error: tuple[tuple[float, float], ...] | None = None
+                            ) -> InputProof:
     """The base's proved peaks ``(|v|, |omega|)`` along ``design`` for ``spec``'s plants
     (the look-ahead variant's role ``input_proof``).
 
@@ -114,6 +120,8 @@ def look_ahead_design_proof(design: Design, spec: Spec) -> InputProof:
     design : Design
     spec : Spec
         A differential-drive spec (its ``axle_offset``).
+    initial_error : tuple of (float, float), optional
+        From this box of ``e(0)`` at the point (:func:`point_proof`).
 
     Returns
     -------
@@ -128,7 +136,7 @@ def look_ahead_design_proof(design: Design, spec: Spec) -> InputProof:
     # |v| <= |u| and |omega| <= |u| / l: |u| at the point against min(v_max, omega_max l)
     speed = math.inf if bound is None else min(bound[0], bound[1] * offset)
     return look_ahead_input_proof(point_proof(design.tube, spec, verdict_limit(
-        spec, lambda u: math.hypot(*u) > speed)), offset)
+        spec, lambda u: math.hypot(*u) > speed), initial_error), offset)
 
 
 def look_ahead_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> Design:

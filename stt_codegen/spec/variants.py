@@ -68,8 +68,10 @@ ROLES: Mapping[str, str] = MappingProxyType({
     "sampled_checks": "(spec, design, tube_check, progress) -> list of Check of the "
                       "sampled loop",
     "plant_within": "(spec, model) -> Check, the plant within the certified class",
-    "input_proof": "(design, spec) -> InputProof, the proved peak of each physical input "
-                   "along the design for the spec's plants ([actuator])",
+    "input_proof": "(design, spec, initial_error=None) -> InputProof, the proved peak of "
+                   "each physical input along the design for the spec's plants "
+                   "([actuator]); from a box of e(0) where initial_error is given (a "
+                   "variant that replans, replans_sensed)",
     "output_limits": "(design) -> OutputLimits of its command without [actuator] (the "
                      "proved peak and the clamp's bound), or None: no warning",
     "predictor": "(tube, stage, delay, mid_gain) -> casadi.Function (x, u_held) -> x_hat, "

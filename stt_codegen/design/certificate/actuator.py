@@ -73,7 +73,9 @@ def certified_widths(tube: TubeDesign, samples: TubeSamples) -> np.ndarray:
 
 
 def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = False,
-                      limit: Callable[[list[float]], bool] | None = None) -> InputProof:
+                      limit: Callable[[list[float]], bool] | None = None,
+                      initial_error: tuple[tuple[float, float], ...] | None = None
+                      ) -> InputProof:
     """The proved peak of each input of law (13) along ``tube`` for the spec's plants.
 
     Parameters
@@ -102,6 +104,8 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
         caller's bound is the same with or without ``limit``. With ``per_axis_first``,
         the per-axis argument stops there (the balls run only where it fails the check
         itself). Ignored with ``[controller] compensate_delay``.
+    initial_error : tuple of (float, float), optional
+        The sampled check from this box of ``e(0)`` (:func:`~.sampled.check_sampled`).
 
     Returns
     -------
@@ -138,7 +142,7 @@ def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = Fa
     # the check is computed once per (tube, spec, per_axis_first) in a process:
     # sampled_check_of samples with the oracle's exp/log/tanh as numpy's ufuncs
     samples, result = sampled_check_of(tube, spec, per_axis_first,
-                                       None if limit is None else stop_for)
+                                       None if limit is None else stop_for, initial_error)
     horizon = float(samples.t[-1])
     width = widths(samples)[0]
     if "stopped_at" in result.data:

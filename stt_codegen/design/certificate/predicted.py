@@ -12,14 +12,15 @@ strictly inside the tube and ``x_hat`` inside ``[-E_MAX, E_MAX]`` of it at every
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
 from .enclosures import enclose_tube
 from .lyapunov import others_max
 from .plant_class import PlantClass
-from .sampled_axis import (axis_interval, held_speed, peak_for_box, phi_scalar, turn_failure,
-                           turned_gains, unprovable)
+from .sampled_axis import (axis_interval, held_speed, peak_for_box, phi_scalar, start_box,
+                           turn_failure, turned_gains, unprovable)
 from ..samples import TubeSamples
 from ...tube.parameters import E_MAX, TubeDesign
 
@@ -33,7 +34,8 @@ def _ahead(values: np.ndarray, pick) -> np.ndarray:
 
 
 def check_predicted(design: TubeDesign, samples: TubeSamples, plants: PlantClass,
-                    gain: float | None = None, *, delay: float) -> tuple:
+                    gain: float | None = None, *, delay: float,
+                    initial_error: Sequence[tuple[float, float]] | None = None) -> tuple:
     """Prove that law (13) with the delay-compensating prediction keeps ``|e_i| < 1``.
 
     The argument (docs/sampled-data.md, "Compensating a delay", eqs. (P1)-(P3)): the
@@ -58,6 +60,9 @@ def check_predicted(design: TubeDesign, samples: TubeSamples, plants: PlantClass
         ``k`` to check instead of ``design.gain``.
     delay : float
         The computation delay, s, in ``(0, dt]``.
+    initial_error : sequence of (float, float), optional
+        An interval of ``e_i(0)`` per dimension in place of the point ``e(x(0))``
+        (:func:`~.sampled.check_sampled`).
 
     Returns
     -------
@@ -116,13 +121,13 @@ def check_predicted(design: TubeDesign, samples: TubeSamples, plants: PlantClass
     turn = a.input_gain_turn
     speeds: list[float] = []
     reach_prev = None
-    e0 = ((np.array(design.initial_state) - centre[0]) / half[0]).tolist()
-    box = [[v, v] for v in e0]
+    box = start_box(((np.array(design.initial_state) - centre[0]) / half[0]).tolist(),
+                     initial_error)
     # before the first command acts (t in [0, delay]) the input is zero
-    start = [[v - delay * own[4][0] / half_l[0][i], v + delay * own[4][0] / half_l[0][i]]
-             for i, v in enumerate(e0)]
+    start = [[lo - delay * own[4][0] / half_l[0][i], hi + delay * own[4][0] / half_l[0][i]]
+             for i, (lo, hi) in enumerate(box)]
     worst, worst_t, worst_i = math.inf, 0.0, 0
-    top = max(abs(v) for v in e0)
+    top = max(max(-lo, hi) for lo, hi in box)
     abs_e = []
     for k in range(count):
         t = float(samples.t[k])

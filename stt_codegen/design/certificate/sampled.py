@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from collections import OrderedDict
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -41,7 +41,7 @@ from .plant_class import PlantClass, plant_class
 from .predicted import check_predicted
 from .sampled_fold import check_folded
 from .sampled_axis import (axis_interval, clamp_failure, held_speed, peak, peak_for_box,
-                           phi_scalar, phi_slope_scalar, room_failure, turn_failure,
+                           phi_scalar, start_box, phi_slope_scalar, room_failure, turn_failure,
                            turned_gains, unprovable)
 
 __all__ = ["DELAY_HALVINGS", "KEPT_CHECKS", "RATE_FACTORS", "SampledCheck", "cached_check",
@@ -178,7 +178,9 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
                   lyapunov: bool = True, delay: float = 0.0,
                   jitter: float = 0.0,
                   stop: Callable[[int, list[float]], bool] | None = None,
-                  folded: bool = True) -> SampledCheck:
+                  folded: bool = True,
+                  initial_error: Sequence[tuple[float, float]] | None = None
+                  ) -> SampledCheck:
     """Prove that the sampled closed loop keeps ``|e_i| < 1`` at and between samples.
 
     A sufficient condition, checked by propagating an enclosure of ``e(t_k)`` (a box and
@@ -224,6 +226,11 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
         Where no ball takes part, run the per-sample step folded into CasADi's virtual
         machine (:mod:`.sampled_fold`; the default: the same result, float for float, in a
         fraction of the time); ``False`` runs the Python loop, the fold's oracle.
+    initial_error : sequence of (float, float), optional
+        An interval ``[lo_i, hi_i]`` of ``e_i(0)`` per dimension (inside ``(-1, 1)``) from
+        which the check starts, in place of the point ``e(x(0))``: a tube that takes over
+        from another at a sample where the state is known only within such a box
+        (docs/sensing.md, "The switch").
 
     Returns
     -------
@@ -234,7 +241,8 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     Raises
     ------
     ValueError
-        ``delay`` or ``jitter`` negative, or ``delay + 2 jitter > dt``.
+        ``delay`` or ``jitter`` negative, or ``delay + 2 jitter > dt``; an
+        ``initial_error`` not of ``n`` intervals inside ``(-1, 1)``.
     """
     cls = _as_class(plants)
     a = cls.assumptions
@@ -286,7 +294,8 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     lower_max = worst_near(enclosure.lower_max, jitter, np.maximum)
     up_e_a = (upper_min - centre[:count]) / half[:count]
     low_e_a = (lower_max - centre[:count]) / half[:count]
-    e0 = ((np.array(design.initial_state) - centre[0]) / half[0]).tolist()
+    first_box = start_box(((np.array(design.initial_state) - centre[0]) / half[0]).tolist(),
+                          initial_error)
     # the longest a command may act for (a base's turn over it)
     span = (dt + 2.0 * jitter) + (delay if timed else 0.0)
     if folded and not balls:
@@ -300,7 +309,8 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
                    "g_min": g_min_a, **{name: worst_near(getattr(bounds, name), jitter,
                                                          np.maximum)
                                         for name in ("g_max", "skew", "coupling", "push")}}
-        found = check_folded(n, tuple(tuple(b) for b in blocks), turn, e0, samples.t[:count],
+        found = check_folded(n, tuple(tuple(b) for b in blocks), turn, first_box,
+                             samples.t[:count],
                              dt, k_gain, figures, stop, delay, span,
                              tuple(corners) if timed else None)
         if found[0] == "fail":
@@ -327,10 +337,11 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
                                   (bounds.skew, bounds.coupling, bounds.push))
     reach_prev = None                                     # |e(s_{k-1})| bound: no command yet
     speeds: list[float] = []                              # bound of |u_k| per sample
-    box = [[v, v] for v in e0]                            # enclosure of e(t_k), per dim
-    level = {b: math.sqrt(sum(math.atanh(e0[i]) ** 2 for i in b)) for b in balls}
+    box = [list(v) for v in first_box]                    # enclosure of e(t_k), per dim
+    level = {b: math.sqrt(sum(max(abs(math.atanh(v)) for v in box[i]) ** 2 for i in b))
+             for b in balls}
     worst, worst_t, worst_i = math.inf, 0.0, 0
-    top = max(abs(v) for v in e0)
+    top = max(max(-x, y) for x, y in box)
     ball_lost = ball_max = 0.0
     abs_e = []                                            # the bound of |e(t_k)|, per sample
     for k in range(count):
@@ -442,7 +453,8 @@ def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,
                                  plants: Assumptions | PlantClass,
                                  gain: float | None = None, *, delay: float = 0.0,
                                  jitter: float = 0.0, compensate: bool = False,
-                                 stop: Callable[[int, list[float]], bool] | None = None
+                                 stop: Callable[[int, list[float]], bool] | None = None,
+                                 initial_error: Sequence[tuple[float, float]] | None = None
                                  ) -> SampledCheck:
     """:func:`check_sampled` with the per-axis argument alone, and with the Lyapunov balls
     only where that fails; with ``compensate`` and a delay, the check of the predicted law
@@ -474,6 +486,8 @@ def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,
         :func:`check_sampled`'s ``stop``, asked by the per-axis argument and, where that
         fails, by the whole check (not with ``compensate``): a check it stops is returned
         as stopped.
+    initial_error : sequence of (float, float), optional
+        As :func:`check_sampled` (with ``compensate`` too).
 
     Returns
     -------
@@ -491,16 +505,18 @@ def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,
             raise ValueError(f"jitter = {jitter!r} s: the predicted law is proved without "
                              "jitter")
         passed, level, margin, t, i, reason, abs_e = check_predicted(
-            design, samples, _as_class(plants), gain, delay=delay)
+            design, samples, _as_class(plants), gain, delay=delay,
+            initial_error=initial_error)
         data = {"gain": design.gain if gain is None else float(gain),
                 "rate_hz": design.rate_hz, "delay": delay, "jitter": 0.0,
                 "compensate_delay": True, "max_abs_e": level, "margin": margin}
         return SampledCheck(passed, level, margin, t, i, reason, data, abs_e)
     per_axis = check_sampled(design, samples, plants, gain, lyapunov=False, delay=delay,
-                             jitter=jitter, stop=stop)
+                             jitter=jitter, stop=stop, initial_error=initial_error)
     if per_axis.passed or delay > 0.0 or jitter > 0.0 or "stopped_at" in per_axis.data:
         return per_axis
-    return check_sampled(design, samples, plants, gain, stop=stop)
+    return check_sampled(design, samples, plants, gain, stop=stop,
+                         initial_error=initial_error)
 
 
 #: Halvings of the bisection of :func:`largest_delay` (a resolution of ``dt / 2^6``).
@@ -596,7 +612,9 @@ def largest_passing(passes: Callable[[float], bool], top: float,
 
 def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True,
                      stop_for: Callable[[TubeSamples], Callable[[int, list[float]], bool]]
-                     | None = None) -> tuple[TubeSamples, SampledCheck]:
+                     | None = None,
+                     initial_error: tuple[tuple[float, float], ...] | None = None
+                     ) -> tuple[TubeSamples, SampledCheck]:
     """The sampled-data check of a designed tube for its spec's plant class, once per
     process: the design's tracking proof, the ``[actuator]`` proof and ``verify`` ask for
     the same check of the same tube (a bundled design is asked for again and again).
@@ -623,6 +641,8 @@ def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
         is kept (which is read instead) and not with ``[controller] compensate_delay``.
         With ``per_axis_first``, the per-axis argument stops there (its bounds, looser
         than the balls', may break a limit theirs keep).
+    initial_error : tuple of (float, float), optional
+        :func:`check_sampled`'s ``initial_error``: the check from a box of ``e(0)``.
 
     Returns
     -------
@@ -631,7 +651,7 @@ def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
     check : SampledCheck
         The verdict (``data["stopped_at"]`` when ``stop`` ended it).
     """
-    key = (design, spec, bool(per_axis_first))
+    key = (design, spec, bool(per_axis_first), initial_error)
     found = cached_check(*key)
     if found is not None:
         return found
@@ -642,9 +662,11 @@ def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
         stop = None if stop_for is None or spec.compensate_delay else stop_for(samples)
         if per_axis_first or spec.compensate_delay:
             check = check_sampled_first_per_axis(design, samples, plants, **timing,
-                                                 compensate=spec.compensate_delay, stop=stop)
+                                                 compensate=spec.compensate_delay, stop=stop,
+                                                 initial_error=initial_error)
         else:
-            check = check_sampled(design, samples, plants, **timing, stop=stop)
+            check = check_sampled(design, samples, plants, **timing, stop=stop,
+                                  initial_error=initial_error)
     if "stopped_at" in check.data:
         return samples, check
     _KEPT[key] = (samples, check)
@@ -655,17 +677,17 @@ def sampled_check_of(design: TubeDesign, spec: Spec, per_axis_first: bool = True
 
 #: The whole checks :func:`sampled_check_of` keeps, the latest last (at most
 #: :data:`KEPT_CHECKS`).
-_KEPT: OrderedDict[tuple[TubeDesign, Spec, bool], tuple[TubeSamples, SampledCheck]] = \
-    OrderedDict()
+_KEPT: OrderedDict[tuple, tuple[TubeSamples, SampledCheck]] = OrderedDict()
 #: How many whole checks a process keeps.
 KEPT_CHECKS = 16
 
 
-def cached_check(design: TubeDesign, spec: Spec, per_axis_first: bool
+def cached_check(design: TubeDesign, spec: Spec, per_axis_first: bool,
+                 initial_error: tuple[tuple[float, float], ...] | None = None
                  ) -> tuple[TubeSamples, SampledCheck] | None:
     """The whole check :func:`sampled_check_of` keeps for these arguments, or ``None``
     (nothing computed, or only a check stopped early)."""
-    key = (design, spec, per_axis_first)
+    key = (design, spec, per_axis_first, initial_error)
     found = _KEPT.get(key)
     if found is not None:
         _KEPT.move_to_end(key)

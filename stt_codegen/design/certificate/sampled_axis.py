@@ -14,13 +14,14 @@ sampling interval; the same formulas build the compiled loop of the cascade
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
 from ...tube.parameters import GAMMA_D_MIN
 from .operations import FLOATS
 
-__all__ = ["phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "peak_scalar",
+__all__ = ["start_box", "phi", "phi_scalar", "phi_slope", "phi_slope_scalar", "peak", "peak_scalar",
            "peak_for_box", "coupling_push", "axis_interval", "held_speed", "turned_gains",
            "turn_failure", "clamp_failure", "room_failure", "unprovable"]
 
@@ -488,3 +489,16 @@ def unprovable(g_min: float, width_min: float) -> str | None:
     if width_min < GAMMA_D_MIN:
         return f"the tube is narrower than GAMMA_D_MIN = {GAMMA_D_MIN:g} at a sample"
     return None
+
+
+def start_box(e0: list[float], initial_error: Sequence[tuple[float, float]] | None
+               ) -> list[list[float]]:
+    """The enclosure of ``e(0)`` a check starts from: the point ``e0``, or
+    ``initial_error`` (checked: ``n`` intervals inside ``(-1, 1)``)."""
+    if initial_error is None:
+        return [[v, v] for v in e0]
+    box = [[float(lo), float(hi)] for lo, hi in initial_error]
+    if len(box) != len(e0) or not all(-1.0 < lo <= hi < 1.0 for lo, hi in box):
+        raise ValueError(f"initial_error = {box!r}: one interval [lo, hi] per dimension "
+                         f"({len(e0)}), inside (-1, 1)")
+    return box

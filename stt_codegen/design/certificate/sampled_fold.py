@@ -186,7 +186,7 @@ def _step(n: int, blocks: tuple[tuple[int, ...], ...], turn: bool,
 
 
 def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float, float] | None,
-                 e0: list[float], times: np.ndarray, dt: float, gain: float,
+                 start_box: list[list[float]], times: np.ndarray, dt: float, gain: float,
                  figures: dict[str, np.ndarray],
                  stop: Callable[[int, list[float]], bool] | None,
                  delay: float = 0.0, span: float | None = None,
@@ -202,8 +202,8 @@ def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float,
         The blocks of ``g``.
     turn : (float, float) or None
         ``input_gain_turn``: ``|omega| <= turn[0] |u| + turn[1]`` (a base), or ``None``.
-    e0 : list of float
-        ``e(0)``.
+    start_box : list of [float, float]
+        The enclosure of ``e(0)``, one interval per axis.
     times : ndarray, (K,)
         The samples' times, s (``K`` intervals).
     dt : float
@@ -270,7 +270,8 @@ def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float,
             return True
         return False
 
-    start = np.concatenate([np.asarray(e0, dtype=float)] * 2
+    start = np.concatenate([np.array([lo for lo, _ in start_box], dtype=float),
+                            np.array([hi for _, hi in start_box], dtype=float)]
                            + [np.zeros(n), np.full(2 * n, -math.inf)])
     shown, last = run_steps(step, start, lambda a, b: table[:, a:b], count,
                             constants.pack(values), failed, kinds=len(AXIS_FIGURES))
