@@ -6,12 +6,15 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import pathlib
 
 import numpy as np
 import pytest
 
 import stt_codegen as stt
 from stt_codegen.runtime.sensed import WalkingObstacle
+
+SPECS = pathlib.Path(__file__).parent / "specs"
 
 
 @pytest.fixture(scope="module")
@@ -206,3 +209,32 @@ def _clearance(run, hall, speed):
         norm = np.linalg.norm(gap)
         p = p + (gap / norm * min(speed * dt, norm) if norm > 0 else 0.0)
     return np.array(out)
+
+
+@pytest.mark.slow
+def test_a_differential_drive_base_crosses_the_hall_among_the_people():
+    """The hall crossed by a base (tests/specs/hall-crossing-drive.toml, within its
+    [actuator]) with the demo's people: it replans its look-ahead point's tube, each new
+    tube proved from where the active one's proof leaves the state (sampled loop and
+    (v, omega) bound), is certified throughout, stays in its tubes, touches no one and
+    arrives by t_c; while the spec's tube is active, the point lies in that tube's proved
+    box at every sample. Its generated code takes no tube as data yet: the C backend is
+    refused, naming the field."""
+    from stt_codegen.design.sensed_switch import proved_error
+    from stt_codegen.runtime.sensed import bundled_people
+    design = stt.design_tube(stt.load_spec(str(SPECS / "hall-crossing-drive.toml")))
+    run = stt.simulate_sensed(design, bundled_people("hall-crossing"))
+    record = run.sensing
+    assert record.switches >= 3 and record.refused == 0 and record.failures == 0
+    assert record.guaranteed and not record.outside_envelope
+    assert run.stayed_in_tube and not record.sensed_collision and not run.collision
+    assert run.satisfied and run.reach_time <= design.spec.prescribed_time
+    assert np.all(run.max_abs_u <= np.array(design.spec.input_bound) + 1e-9)
+    (lo, hi), _ = proved_error(design, design.spec)
+    first = np.flatnonzero(run.trajectory.tube == 0)
+    point = run.trajectory.x[first]                  # the look-ahead point
+    assert first.size > 100
+    assert np.all((point >= lo[first] - 1e-9) & (point <= hi[first] + 1e-9))
+    with pytest.raises(stt.SpecError) as caught:
+        stt.simulate_sensed(design, bundled_people("hall-crossing"), backend="c")
+    assert caught.value.field == "backend"

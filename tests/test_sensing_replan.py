@@ -441,3 +441,43 @@ def test_a_failure_carries_an_uncertified_escape_away_from_the_obstacle():
     large = [stt.SensedObstacle.ball(tuple(centre), 2.0, seen_at=t_m)]
     outside = stt.replan(kept, t_m, here, large)
     assert outside.kind == "envelope" and outside.fallback is None
+
+
+def test_a_new_tube_is_proved_from_where_the_old_proof_leaves_the_state(start, new):
+    """The chain of sampled-data proofs (design/sensed_switch.py): the spec's tube is
+    proved from its x(0); a new tube from the box where the active tube's proof keeps the
+    state at the switch, cut to the switch test, so its proved box at t' = 0 holds every
+    state of that box the switch admits, and it carries its own bound to the next switch."""
+    from stt_codegen.design.sensed_switch import state_at, switch_error
+    rate = start.task.rate_hz
+    assert start.state_bounds is not None and new.state_bounds is not None
+    lo, hi = state_at(start.state_bounds, rate, new.switch_at - start.start)
+    with reference.numpy_math():
+        samples = stt.design.samples.sample_tube(new.design.tube, horizon=0.01)
+    centre = 0.5 * (samples.gamma_lower[0] + samples.gamma_upper[0])
+    half = 0.5 * (samples.gamma_upper[0] - samples.gamma_lower[0])
+    admitted_lo = np.maximum(lo, centre - 0.5 * half)
+    admitted_hi = np.minimum(hi, centre + 0.5 * half)
+    assert np.all(admitted_lo <= admitted_hi)
+    assert np.all(new.state_bounds[0][0] <= admitted_lo + 1e-12)
+    assert np.all(new.state_bounds[1][0] >= admitted_hi - 1e-12)
+    # not the point x(0): the proof starts from a box
+    assert np.all(new.state_bounds[1][0] - new.state_bounds[0][0] > 1e-3)
+    box = switch_error(new.design, (lo, hi))
+    assert all(-0.5 <= a <= b <= 0.5 for a, b in box)
+    # a state box the switch test refuses everywhere: no tube can take over from it
+    assert switch_error(new.design, (hi + 2.0 * half, hi + 3.0 * half)) is None
+    assert switch_error(new.design, None) == ((-0.5, 0.5),) * new.design.tube.dimension
+
+
+def test_a_tube_not_proved_from_the_switch_is_not_taken(start, person, new, monkeypatch):
+    """Where every new tube's sampled-data check fails from the switch's box, the replanner
+    takes none of them: the person in the way that gives a new tube (above) now leaves the
+    active tube, certified again (it is not in the person's reachable set yet)."""
+    def unproved(design, spec, initial_error=None):
+        return None, "the sampled loop is not proved from the switch: (forced)"
+    assert not new.kept
+    monkeypatch.setattr(sensed_module, "proved_error", unproved)
+    plan = stt.replan(start, 1.0, (1.0, 3.0), [person])
+    assert plan.kept and plan.design.tube == start.design.tube and plan.goal is None
+    assert plan.state_bounds is start.state_bounds

@@ -107,6 +107,16 @@ def test_other_variants_are_refused_by_their_variant():
     assert "a second-order plant (the cascade variant" in caught.value.reason
 
 
+def test_a_differential_drive_base_replans():
+    """The base's look-ahead point replans as law (13)'s robot does (its variant's
+    ``replans_sensed``); the cascade does not."""
+    spec = spec_with(SENSING, plant={"model": "differential-drive", "axle_offset": 0.1,
+                                     "track_width": 0.2},
+                     initial={"lower": [0.3, 1.6], "upper": [0.9, 2.4], "heading": 0.0},
+                     target={"lower": [5.0, 1.6], "upper": [5.6, 2.4]})
+    assert spec.sensing is not None and spec.sensing.dims == (0, 1)
+
+
 def test_sensing_changes_neither_the_design_nor_the_hash(tmp_path):
     plain, sensed = spec_with(), spec_with(SENSING)
     a, b = stt.design_tube(plain), stt.design_tube(sensed)

@@ -49,10 +49,11 @@ from ..spec.sensing import SensedObstacle, Sensing
 from .certificate.fleet import RobotTube, robot_tube
 from .certificate.motion import MOVING_PROPERTY
 from .certificate.report import ROUNDING_MARGIN
-from .failures import without_advice
+from .failures import FailureKind, without_advice
 from .result import Design, require_design
 from .search import check_tube, design_tube
 from .sensed_path import MIN_SPEED, PREDICTION_SPAN, path_design
+from .sensed_switch import proved_error, state_at, switch_error
 
 __all__ = ["CHUNK_SECONDS", "ESCAPE_CLEARANCE", "ESCAPE_DIRECTIONS", "ESCAPE_DISTANCES",
            "ESCAPE_TIME", "FORESIGHT", "LATE_TIME", "MAX_ESCAPES", "ReplanFailure",
@@ -153,6 +154,12 @@ class SensedPlan:
         ``guarantee_until`` are its switch): the best escape found after no plan was
         certified (:attr:`ReplanFailure.fallback`), which takes over when the certified
         span of the plan it replaces has run out.
+    state_bounds : (ndarray, ndarray) or None
+        Where the tube's sampled-data proof keeps the state at its samples ``t' = k /
+        rate_hz``: lower and upper corners, shape (K + 1, n) each, from where the state
+        may be at the plan's switch (:mod:`.sensed_switch`; the spec's tube from its
+        ``x(0)``); the next switch starts from it. ``None`` for a best-effort escape not
+        proved from its switch.
 
     Examples
     --------
@@ -181,6 +188,8 @@ class SensedPlan:
     goal: Box | None = field(default=None, repr=False)
     reached: bool = False
     best_effort: bool = False
+    state_bounds: tuple[np.ndarray, np.ndarray] | None = field(default=None, repr=False,
+                                                                compare=False)
 
     @property
     def shortened(self) -> bool:
@@ -576,7 +585,7 @@ def start_plan(design: Design, sensed: Sequence[SensedObstacle] = (),
         return failed(reason, "region" if room > -math.inf else "design")
     return SensedPlan(checked, spec, local, 0.0, 0.0, 0.0, until, 0.0, spec.prescribed_time,
                       True, sensed, margin, room, time.perf_counter() - started,
-                      time.process_time() - cpu)
+                      time.process_time() - cpu, state_bounds=proved_error(design, spec)[0])
 
 
 def uncertified_plan(design: Design) -> SensedPlan:
@@ -595,7 +604,8 @@ def uncertified_plan(design: Design) -> SensedPlan:
     design = require_design(design, "uncertified_plan")
     _sensing(design.spec)
     return SensedPlan(design, design.spec, design.spec, 0.0, 0.0, 0.0, 0.0, 0.0,
-                      design.spec.prescribed_time, True)
+                      design.spec.prescribed_time, True,
+                      state_bounds=proved_error(design, design.spec)[0])
 
 
 def _box_at(plan: SensedPlan, t_local: float, state_space: Box) -> Box:
@@ -753,7 +763,8 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
             return None
         return done(design=kept, task=plan.task, local=local, start=plan.start,
                     certified_from=t_m, switch_at=plan.switch_at, arrival=plan.arrival,
-                    kept=True, sensed_margin=margin, region_margin=room, goal=plan.goal)
+                    kept=True, sensed_margin=margin, region_margin=room, goal=plan.goal,
+                    state_bounds=plan.state_bounds)
 
     base = plan.task
     first = _first_source(base)
@@ -767,10 +778,13 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
         # computed once, when a new tube is looked for
         return _taking_over(plan, t_s, s, t_m, sensing)
 
+    # where the active plan's proof leaves the state at the switch
+    state = state_at(plan.state_bounds, base.rate_hz, t_s - plan.start)
+
     def escape() -> dict | str:
         active, point, near = at_switch()
         return _escape(base, near or active, moving, boxes, sensed, sensing, s, t_m, t_s,
-                       first, point)
+                       first, point, state)
 
     def chased(made: dict) -> bool:
         # a new tube due late, or holding its goal, that an obstacle closing on the robot
@@ -792,7 +806,7 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
                 t_s, base.prescribed_time - EARLIER)):
             return kept
         made = _along_path(base, at_switch()[0], moving, boxes, sensed, sensing, s, t_m,
-                           t_s, remaining, first)
+                           t_s, remaining, first, state)
         spare = None
         if made is not None and (headed or made["arrival"] <= plan.arrival - EARLIER):
             if not chased(made):
@@ -811,7 +825,7 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     # a way through where the sensed obstacles are headed over the whole tube, then the
     # design for the horizon and a short foresight, then without the foresight
     made = _along_path(base, active, moving, boxes, sensed, sensing, s, t_m, t_s, remaining,
-                       first)
+                       first, state)
     spare = None
     if made is not None:
         if not chased(made):
@@ -823,7 +837,7 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
         [(active, boxes)] + ([] if near is None else [(near, boxes)])))
     for box, avoided in tries:
         made = _to_target(base, box, moving, avoided, sensing, s, t_m, t_s, remaining,
-                          first)
+                          first, state)
         if isinstance(made, dict):
             if not chased(made):
                 return done(task=plan.task, **made)
@@ -1015,7 +1029,8 @@ def _new_local(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
 
 def _to_target(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
                boxes: tuple[MovingObstacle, ...], sensing: Sensing, s: np.ndarray,
-               t_m: float, t_s: float, remaining: float, first: int
+               t_m: float, t_s: float, remaining: float, first: int,
+               state: tuple[np.ndarray, np.ndarray] | None = None
                ) -> dict | tuple[str, str]:
     """A certified tube from ``box`` to the target (arriving later while it leaves the
     region): the new plan's fields, or why not and the failure's kind."""
@@ -1024,7 +1039,7 @@ def _to_target(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
         within = remaining * slower
         try:
             made = _new_plan(_new_local(base, box, moving, within), boxes, sensing, s, t_m,
-                             t_s, t_s + within, first)
+                             t_s, t_s + within, first, state=state)
         except DesignError as exc:
             return (f"no tube from the box at t = {t_s:.4f} s to the target within "
                     f"{within:.4g} s: {exc}", "design")
@@ -1039,7 +1054,8 @@ def _to_target(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
 def _along_path(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
                 boxes: tuple[MovingObstacle, ...], sensed: Sequence[SensedObstacle],
                 sensing: Sensing, s: np.ndarray, t_m: float, t_s: float, remaining: float,
-                first: int) -> dict | None:
+                first: int, state: tuple[np.ndarray, np.ndarray] | None = None
+                ) -> dict | None:
     """A certified tube from ``box`` to the target along a space-time path among where
     the sensed obstacles are headed (:func:`~.sensed_path.path_design`), held to the
     region certificate: the plan's fields, or ``None``."""
@@ -1055,25 +1071,39 @@ def _along_path(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     # a late path's task is due when it arrives (the next checks hold it to that)
     local = replace(local, prescribed_time=found.tube.prescribed_time)
     arrival = t_s + found.tube.segments[-1].end
-    made = _new_plan(local, boxes, sensing, s, t_m, t_s, arrival, first, found=found)
+    try:
+        made = _new_plan(local, boxes, sensing, s, t_m, t_s, arrival, first, found=found,
+                         state=state)
+    except DesignError:
+        return None
     return made if isinstance(made, dict) else None
 
 
 def _new_plan(local: Spec, boxes: tuple[MovingObstacle, ...], sensing: Sensing,
               s: np.ndarray, t_m: float, t_s: float, arrival: float, first: int,
-              goal: Box | None = None, found: Design | None = None
+              goal: Box | None = None, found: Design | None = None,
+              state: tuple[np.ndarray, np.ndarray] | None = None, proved: bool = True
               ) -> dict | tuple[float, float]:
     """A new tube for ``local`` designed against the sensed obstacles' ``boxes`` too (or
-    ``found``, already certified against them), held to the region certificate: the
-    plan's fields, or the room and where it is smallest (in the tube's time) when the tube
-    leaves the region. :class:`DesignError` when no tube is designed."""
+    ``found``, already certified against them), held to the region certificate and, from
+    where the state may be at the switch (``state``, :mod:`.sensed_switch`), to the
+    sampled-data proof: the plan's fields, or the room and where it is smallest (in the
+    tube's time) when the tube leaves the region. :class:`DesignError` when no tube is
+    designed or (``proved``) its sampled loop is not proved from the switch; without
+    ``proved`` such a tube carries no ``state_bounds``."""
     new = found or design_tube(replace(local, moving_obstacles=local.moving_obstacles + boxes))
     room, at = region_margin(new, sensing, _reach(local), t_s, t_m, s, 0.0, sensing.horizon)
     if room <= ROUNDING_MARGIN:
         return room, at
+    initial = switch_error(new, state)
+    bounds, why = (proved_error(new, local, initial) if initial is not None else
+                   (None, "the state at the switch cannot meet the switch test"))
+    if bounds is None and proved:
+        raise DesignError(f"a tube from the switch at t = {t_s:.4f} s: {why}",
+                          kind=FailureKind.SAMPLING_RATE, tried=new.tube)
     return dict(design=new, local=local, start=t_s, certified_from=t_s, switch_at=t_s,
                 arrival=arrival, kept=False, sensed_margin=_sensed_margin(new, first),
-                region_margin=room, goal=goal)
+                region_margin=room, goal=goal, state_bounds=bounds)
 
 
 def _taking_over(plan: SensedPlan, t: float, s: np.ndarray, t_m: float,
@@ -1118,7 +1148,8 @@ def _switch_box(base: Spec, active: Box, point: np.ndarray, sensing: Sensing) ->
 def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
             boxes: tuple[MovingObstacle, ...], sensed: Sequence[SensedObstacle],
             sensing: Sensing, s: np.ndarray, t_m: float, t_s: float, first: int,
-            point: np.ndarray) -> dict | str:
+            point: np.ndarray, state: tuple[np.ndarray, np.ndarray] | None = None,
+            proved: bool = True) -> dict | str:
     """A certified tube from ``box`` to a temporary goal near ``point`` (where the robot
     will be at the switch), reached in :data:`ESCAPE_TIME` and then held: the plan's
     fields, or why there is none.
@@ -1176,7 +1207,7 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
                            moving, ESCAPE_TIME, goal)
         try:
             made = _new_plan(local, boxes, sensing, s, t_m, t_s, t_s + ESCAPE_TIME, first,
-                             goal)
+                             goal, state=state, proved=proved)
         except DesignError as exc:
             reasons.append(f"{exc.kind}")
             continue
@@ -1221,7 +1252,8 @@ def _best_effort(plan: SensedPlan, t_m: float, position: Sequence[float],
     first = _first_source(base)
     boxes = tuple(replace(b, source=first + k) for k, b in enumerate(avoided))
     made = _escape(base, box, _shifted(base.moving_obstacles, t_f), boxes, sensed, sensing,
-                   s, t_m, t_f, first, point)
+                   s, t_m, t_f, first, point,
+                   state_at(plan.state_bounds, base.rate_hz, t_f - plan.start), proved=False)
     if not isinstance(made, dict):
         return None
     return SensedPlan(**dict(made, certified_from=t_f), task=base, measured_at=t_m,

@@ -37,6 +37,7 @@ from ..design.search import MAX_INITIAL_ERROR
 from ..design.sensed import (ReplanFailure, SensedPlan, replan, start_plan,
                              uncertified_plan)
 from ..errors import SpecError
+from ..spec.variants import variant_of
 from ..spec.sensing import EnvelopeViolation, SensedObstacle, Sensing, envelope_violations
 from ..tube import reference
 from ..tube.parameters import Status
@@ -435,6 +436,12 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
         raise SpecError("sensing", f"spec {spec.name!r} has no [sensing] table "
                                    "(docs/sensing.md)")
     seed = check_seed(seed)
+    variant = variant_of(spec)
+    if backend in ("c", "python") and not variant.tube_data:
+        raise SpecError("backend", f"{backend!r} runs the generated code with the tube as "
+                                   f"data, not yet generated for {variant.plant_words} (the "
+                                   f"{variant.name} variant): use 'casadi' or 'reference' "
+                                   "(docs/sensing.md)")
     t_c = spec.prescribed_time
     horizon = t_c if horizon is None else _horizon(horizon)
     rate = spec.rate_hz

@@ -168,8 +168,9 @@ def sensing_from_table(table: Any, dims: tuple[int, ...], variant: Any,
         return None
     if not variant.replans_sensed:
         raise SpecError("sensing", f"replanning around sensed obstacles is available for "
-                                   f"first-order plants only, not for {variant.plant_words} "
-                                   f"(the {variant.name} variant; docs/sensing.md)")
+                                   f"first-order plants and differential-drive bases only, "
+                                   f"not for {variant.plant_words} (the {variant.name} "
+                                   f"variant; docs/sensing.md)")
     if (table.update_rate_hz is None) == (table.period is None):
         raise SpecError("sensing.period", "give update_rate_hz or period (seconds), one of "
                                           "the two" + (", not both" if table.period is not None

@@ -111,8 +111,8 @@ class ControllerVariant:
         (docs/sampled-data.md, "Compensating a delay").
     replans_sensed : bool
         ``[sensing]`` is available: tubes are replanned around obstacles sensed at run time
-        and switched at a sample (:mod:`stt_codegen.design.sensed`, docs/sensing.md); only
-        law (13)'s variant so far.
+        and switched at a sample (:mod:`stt_codegen.design.sensed`, docs/sensing.md): law
+        (13)'s variant and the base's (its look-ahead point's tube).
     tube_data : bool
         ``generate --tube-data`` is available: the generated C takes its tube as data and
         switches tubes at run time (:mod:`stt_codegen.codegen.tube_data`, docs/sensing.md);
@@ -303,7 +303,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                output_limits=_P + "design.output_bound:look_ahead_output_limits",
                predictor=_P + "tube.look_ahead:look_ahead_predictor",
                input_gain=_P + "spec.input_gains:declared_input_gain"),
-        predicts_delay=True),
+        predicts_delay=True, replans_sensed=True),
 })
 assert tuple(CONTROLLER_VARIANTS) == VARIANTS
 
