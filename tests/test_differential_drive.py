@@ -45,6 +45,9 @@ def test_the_spec_is_the_look_ahead_points_problem():
     spec = stt.load_spec(str(SPEC))
     assert spec.variant == "look-ahead" and spec.order == 1
     assert spec.input_names == ("v", "omega")
+    # on MuJoCo too: [actuator] bounds (v, omega), not the wheels' actuators
+    assert stt.load_spec(str(SPEC.with_name("office-drive-mujoco.toml"))).input_names == (
+        "v", "omega")
     # the body's disc (radius 0.12 around the axle) lies within 0.12 + l of the point
     assert spec.robot.radius == pytest.approx(0.12 + 0.1)
     assert spec.state_space.lower == pytest.approx((0.22, 0.22))

@@ -444,8 +444,9 @@ class Spec:
         """Names of the inputs ``u`` that ``[actuator] input_bound`` bounds, in its order:
         the second-order model's physical inputs (``F1``, ``F2``, ..., the quadrotor's
         thrust, the arm's torques) for order 2, else the first-order model's; a MuJoCo
-        plant's actuators."""
-        if self.mujoco is not None:
+        plant's actuators, except a differential-drive base's (its wheels), whose bound is
+        on ``(v, omega)``."""
+        if self.mujoco is not None and self.drive is None:
             return self.mujoco.actuators
         if self.second_order is not None:
             return SECOND_ORDER_PLANTS[self.second_order.model].input_names(self.dimension)
