@@ -446,7 +446,7 @@ class Spec:
         thrust, the arm's torques) for order 2, else the first-order model's; a MuJoCo
         plant's actuators, except a differential-drive base's (its wheels), whose bound is
         on ``(v, omega)``."""
-        if self.mujoco is not None and self.drive is None:
+        if self.mujoco is not None and variant_of(self).actuator_inputs:
             return self.mujoco.actuators
         if self.second_order is not None:
             return SECOND_ORDER_PLANTS[self.second_order.model].input_names(self.dimension)

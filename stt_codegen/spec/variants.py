@@ -113,6 +113,10 @@ class ControllerVariant:
         ``[sensing]`` is available: tubes are replanned around obstacles sensed at run time
         and switched at a sample (:mod:`stt_codegen.design.sensed`, docs/sensing.md): law
         (13)'s variant and the base's (its look-ahead point's tube).
+    actuator_inputs : bool
+        On a MuJoCo plant, ``[actuator] input_bound`` bounds the MuJoCo actuators (law
+        (13)'s inputs, the cascade's forces), and they name the inputs; ``False``: it bounds
+        the base's ``(v, omega)``, which its driver turns into wheel speeds.
     tube_data : bool
         ``generate --tube-data`` is available: the generated C takes its tube as data and
         switches tubes at run time (:mod:`stt_codegen.codegen.tube_data`, docs/sensing.md);
@@ -156,6 +160,7 @@ class ControllerVariant:
     via_timing: str = "length"
     predicts_delay: bool = False
     replans_sensed: bool = False
+    actuator_inputs: bool = True
     tube_data: bool = False
 
     def entry(self, role: str) -> Callable[..., Any]:
@@ -303,7 +308,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                output_limits=_P + "design.output_bound:look_ahead_output_limits",
                predictor=_P + "tube.look_ahead:look_ahead_predictor",
                input_gain=_P + "spec.input_gains:declared_input_gain"),
-        predicts_delay=True, replans_sensed=True),
+        predicts_delay=True, replans_sensed=True, actuator_inputs=False),
 })
 assert tuple(CONTROLLER_VARIANTS) == VARIANTS
 
