@@ -41,3 +41,21 @@ def test_a_person_crossing_the_corridor_ahead_on_mujoco():
     for name in ("x", "u", "alpha", "tube"):
         assert np.array_equal(getattr(runs[0].trajectory, name),
                               getattr(run.trajectory, name)), name
+
+
+@pytest.mark.slow
+def test_a_base_on_mujoco_waits_for_a_person_crossing_the_office():
+    """The office's differential-drive base on MuJoCo (tests/specs/office-drive.xml, its
+    wheels' velocity actuators), within [actuator] [1.2 m/s, 12 rad/s], with a person
+    (0.25 m, 0.4 m/s) walking north through the gap between the desks at x = 4.25 m: the
+    base replans around them, every tube proved from where the last one's proof leaves the
+    state, certified throughout, in its tubes, no contact, at the target by t_c."""
+    spec = Path(__file__).parent / "specs" / "office-drive-mujoco-sensed.toml"
+    design = stt.design_tube(stt.load_spec(spec))
+    person = WalkingObstacle((4.25, 0.3), 0.25, velocity=(0.0, 0.4))
+    run = stt.simulate_sensed(design, [person])
+    record = run.sensing
+    assert record.guaranteed and record.uncertified == [] and not record.outside_envelope
+    assert not record.sensed_collision and not run.collision and run.stayed_in_tube
+    assert record.switches >= 3 and record.refused == 0 and record.failures == 0
+    assert run.satisfied and run.reach_time <= design.spec.prescribed_time
