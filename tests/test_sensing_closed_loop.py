@@ -218,8 +218,7 @@ def test_a_differential_drive_base_crosses_the_hall_among_the_people():
     tube proved from where the active one's proof leaves the state (sampled loop and
     (v, omega) bound), is certified throughout, stays in its tubes, touches no one and
     arrives by t_c; while the spec's tube is active, the point lies in that tube's proved
-    box at every sample. Its generated code takes no tube as data yet: the C backend is
-    refused, naming the field."""
+    box at every sample."""
     from stt_codegen.design.sensed_switch import proved_error
     from stt_codegen.runtime.sensed import bundled_people
     design = stt.design_tube(stt.load_spec(str(SPECS / "hall-crossing-drive.toml")))
@@ -235,6 +234,3 @@ def test_a_differential_drive_base_crosses_the_hall_among_the_people():
     point = run.trajectory.x[first]                  # the look-ahead point
     assert first.size > 100
     assert np.all((point >= lo[first] - 1e-9) & (point <= hi[first] + 1e-9))
-    with pytest.raises(stt.SpecError) as caught:
-        stt.simulate_sensed(design, bundled_people("hall-crossing"), backend="c")
-    assert caught.value.field == "backend"

@@ -29,6 +29,8 @@ from stt_codegen.runtime.sensed import bundled_people
 from conftest import design_of
 from test_tube_segments import piecewise_design
 
+SPECS = __import__("pathlib").Path(__file__).parent / "specs"
+
 
 @pytest.fixture(scope="module")
 def cc():
@@ -212,6 +214,68 @@ def test_people_crossing_the_hall_run_through_one_compiled_controller(cc):
                               getattr(runs[1].trajectory, name)), name
 
 
+@pytest.fixture(scope="module")
+def base(cc):
+    """The hall's differential-drive base (tests/specs/hall-crossing-drive.toml) and its
+    C with the tube as data."""
+    from stt_codegen.runtime.data_controller import look_ahead_data_controller
+    design = stt.design_tube(stt.load_spec(str(SPECS / "hall-crossing-drive.toml")))
+    return design, look_ahead_data_controller(design)
+
+
+def test_a_base_switches_at_its_look_ahead_point(base):
+    """The base's ``P_switch`` tests the look-ahead point of ``(x, y, theta)``: the axle
+    at the tube's centre facing along x puts the point ``l`` ahead, past the switch's
+    limit; the axle ``l`` behind the centre puts it at the centre (``|e|`` about 0: the
+    tube at ``t = 0`` is the initial box to rounding)."""
+    design, library = base
+    loaded = library.load(design.tube)
+    lo, hi = np.array(design.tube.initial_lower), np.array(design.tube.initial_upper)
+    centre, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    l = design.look_ahead.axle_offset
+    assert loaded.switch_error([centre[0] - l, centre[1], 0.0]) <= 1e-6
+    ahead = loaded.switch_error([centre[0], centre[1], 0.0])
+    assert ahead == pytest.approx(l / half[0], rel=1e-6) and ahead > 0.5
+    assert loaded.switch_error([centre[0], centre[1] - l, np.pi / 2]) <= 1e-6
+    assert loaded.switch_error([np.nan, 0.0, 0.0]) == np.inf
+
+
+def test_a_base_runs_its_replanned_tubes_through_one_compiled_controller(base):
+    """``simulate_sensed`` of the base on backend ``c`` loads each switched tube into the
+    look-ahead variant's C with the tube as data: the same trajectory, bit for bit, as the
+    CasADi model's run; the Python module takes no tube as data for a base (refused,
+    naming the field)."""
+    design, _ = base
+    people = bundled_people("hall-crossing")
+    runs = [stt.simulate_sensed(design, people, backend=b, horizon=8.0)
+            for b in ("casadi", "c")]
+    assert runs[1].sensing.switches >= 3 and runs[1].backend == "c"
+    for name in ("x", "u", "alpha", "status", "tube"):
+        assert np.array_equal(getattr(runs[0].trajectory, name),
+                              getattr(runs[1].trajectory, name)), name
+    with pytest.raises(SpecError) as caught:
+        stt.simulate_sensed(design, people, backend="python", horizon=1.0)
+    assert caught.value.field == "backend"
+
+
+@pytest.mark.parametrize("precision", ["double", "single"])
+def test_the_base_data_form_selftest_passes(base, cc, tmp_path, precision):
+    """The base's C with the tube as data: its self-test runs the spec's vectors on
+    ``P_design_tube`` (the shipped Makefile's warnings as errors) and passes."""
+    design, _ = base
+    files = design_files(design, Options(("c",), precision, TubeCapacity(8, 32)))
+    prefix = design.spec.c_name
+    for name, data in files.items():
+        (tmp_path / name).write_bytes(data)
+    proc = subprocess.run(["make", "-s", "selftest", f"CC={cc}"], cwd=tmp_path,
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    last = proc.stdout.strip().splitlines()[-1]
+    assert last.endswith(" passed, 0 failed") and int(last.split()[0]) > 100
+    header = files[f"{prefix}.h"].decode()
+    assert f"{prefix}_tube_data" in header and "x[HALL_CROSSING_DRIVE_N_STATE]" in header
+
+
 @pytest.mark.parametrize("precision", ["double", "single"])
 def test_the_generated_selftest_passes_on_the_design_tube(cc, tmp_path, precision):
     """The data form's self-test runs the spec's vectors on ``P_design_tube`` (the shipped
@@ -244,8 +308,11 @@ def test_bad_requests_name_the_field():
     with pytest.raises(SpecError, match="more than the capacity"):
         generate_files(DesignSpec(piecewise_design()), piecewise_design(),
                        Options(("c",), "double", TubeCapacity(2, 8)))
-    with pytest.raises(SpecError, match="law \\(13\\)'s controller only"):
+    with pytest.raises(SpecError, match="not generated in c for a second-order plant"):
         design_files(design_of("second-order-s1"), parse_options("c", "double", True))
+    base = stt.design_tube(stt.load_spec(str(SPECS / "hall-crossing-drive.toml")))
+    with pytest.raises(SpecError, match="not generated in python for a differential-drive"):
+        design_files(base, parse_options("c,python", "double", True))
 
 
 def test_the_command_line_writes_the_data_form_or_exits_2(tmp_path):

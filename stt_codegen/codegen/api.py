@@ -41,7 +41,7 @@ def design_files(design: Design, options: Options) -> dict[str, bytes]:
         ``tube_data``).
     """
     if options.tube_data is not None:
-        require_tube_data(design.spec)
+        require_tube_data(design.spec, tuple(options.langs))
     return variant_of(design.spec).entry("generation")(design, options)
 
 

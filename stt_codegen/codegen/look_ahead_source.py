@@ -35,6 +35,7 @@ from .emit import lower, python_source
 from .functions import deployed_functions
 from .generate import c_source_context, input_limits, timing_context
 from .render import c_real, render
+from .tube_data import TubeCapacity, require_capacity, table_names
 
 __all__ = ["look_ahead_c_files", "look_ahead_generation", "look_ahead_python_file",
            "look_ahead_vectors"]
@@ -74,7 +75,8 @@ def _context(design: TubeDesign, look_ahead: LookAhead, prefix: str, precision: 
 
 def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,
                        precision: str = "double", timing: tuple[float, float] = (0.0, 0.0),
-                       predictor: casadi.Function | None = None) -> dict[str, str]:
+                       predictor: casadi.Function | None = None,
+                       capacity: TubeCapacity | None = None) -> dict[str, str]:
     """``{<prefix>.h: text, <prefix>.c: text}`` of the look-ahead controller.
 
     Parameters
@@ -91,6 +93,9 @@ def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,
     predictor : casadi.Function, optional
         With ``[controller] compensate_delay``, the spec's
         :func:`~stt_codegen.design.prediction.delay_predictor`: ``P_predict`` is generated.
+    capacity : TubeCapacity, optional
+        The tube as data with these capacities (:mod:`.tube_data`; ``P_switch`` tests the
+        look-ahead point of the base's state); ``None`` (default): the design's tables.
 
     Returns
     -------
@@ -101,13 +106,19 @@ def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,
     ------
     ValueError
         ``prefix`` not a C identifier, or a tube the variant does not take.
+    SpecError
+        The design does not fit ``capacity`` (field ``tube_data``).
     """
     _check(design, look_ahead, prefix)
+    if capacity is not None:
+        require_capacity(design, capacity)
     single = precision == "single"
-    functions = [*deployed_functions(build_model(design)), look_ahead_point(), base_command(),
+    functions = [*deployed_functions(build_model(design), capacity is not None),
+                 *([P.error_transform(design.dimension)] if capacity is not None else []),
+                 look_ahead_point(), base_command(),
                  *([P.saturate(2)] if look_ahead.input_bound is not None else []),
                  *([predictor] if predictor is not None else [])]
-    context = dict(c_source_context(design, prefix, precision, functions),
+    context = dict(c_source_context(design, prefix, precision, functions, capacity),
                    **_context(design, look_ahead, prefix, precision,
                               lambda v: c_real(v, single), timing), look_ahead=True,
                    predict=predictor is not None)
@@ -258,11 +269,14 @@ def look_ahead_generation(design, options) -> dict[str, bytes]:
     predictor = delay_predictor(spec, design.tube, look_ahead)
     context = dict(file_context(spec, options.precision), no_control=True)
     prefix = context["P"]
+    if options.tube_data is not None:         # the self-test runs the design's tube as data
+        context["T"] = table_names(prefix, True)
     vectors = look_ahead_vectors(design.tube, look_ahead, options.precision)
     texts: dict[str, str] = {}
     if "c" in options.langs:
         texts.update(look_ahead_c_files(design.tube, look_ahead, prefix, options.precision,
-                                        (spec.delay, spec.jitter), predictor))
+                                        (spec.delay, spec.jitter), predictor,
+                                        options.tube_data))
         texts.update(build_files(context))
         texts.update(selftest_file(context, vectors, vector_tables(vectors), options.precision))
     if "python" in options.langs:

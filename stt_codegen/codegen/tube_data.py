@@ -243,25 +243,32 @@ def table_shape(tables: Tables, capacity: TubeCapacity | None) -> TableShape:
                       list(tables.profiles))
 
 
-def require_tube_data(spec) -> None:
-    """Refuse a spec whose controller variant has no tube as data (the variant decides:
-    ``ControllerVariant.tube_data``).
+def require_tube_data(spec, targets: tuple[str, ...] = ("c",)) -> None:
+    """Refuse a spec whose controller variant has no tube as data for ``targets`` (the
+    variant decides: ``ControllerVariant.tube_data``).
 
     Parameters
     ----------
     spec : Spec
         The spec to generate for.
+    targets : tuple of str
+        ``"c"``, ``"python"``, ``"embedded"``: where the tube as data is asked for.
 
     Raises
     ------
     SpecError
-        Its variant does not take its tube as data (field ``tube_data``).
+        Its variant does not take its tube as data in one of ``targets`` (field
+        ``tube_data``).
     """
     from ..spec.variants import variant_of
     variant = variant_of(spec)
-    if not variant.tube_data:
-        raise SpecError("tube_data", f"the tube as data is generated for law (13)'s "
-                                     f"controller only, not for {variant.plant_words}")
+    missing = [t for t in targets if t not in variant.tube_data]
+    if missing:
+        where = (f"only in {', '.join(variant.tube_data)}" if variant.tube_data
+                 else "nowhere")
+        raise SpecError("tube_data", f"the tube as data is not generated in "
+                                     f"{', '.join(missing)} for {variant.plant_words} (the "
+                                     f"{variant.name} variant: {where})")
 
 
 def require_capacity(design: TubeDesign, capacity: TubeCapacity) -> None:

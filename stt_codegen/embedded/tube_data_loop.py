@@ -124,7 +124,7 @@ def run_tube_data(design: Design, capacity: TubeCapacity, out_dir: str | Path | 
         :data:`OPEN_WINDOWS`, or the spec's tube does not fit it (field ``tube_data``).
     """
     from ..errors import SpecError
-    require_tube_data(design.spec)
+    require_tube_data(design.spec, ("embedded",))
     if capacity.windows < OPEN_WINDOWS:
         raise SpecError("tube_data", f"the cost tube opens {OPEN_WINDOWS} windows: a capacity "
                                      f"of at least {OPEN_WINDOWS} windows is needed")

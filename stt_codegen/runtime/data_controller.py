@@ -17,13 +17,16 @@ from functools import lru_cache
 import numpy as np
 
 from ..codegen.generate import generate_files
+from ..codegen.look_ahead_source import look_ahead_c_files
 from ..codegen.options import Options
 from ..codegen.tables import PARAMETERS, design_table_rows
 from ..codegen.tube_data import TubeCapacity, fitting_capacity, require_capacity
+from ..tube.look_ahead import LookAhead
 from ..tube.parameters import TubeDesign
 from .compiled import DesignSpec, build_shared
 
-__all__ = ["TubeDataController", "active_struct", "pack_tube", "tube_struct"]
+__all__ = ["TubeDataController", "active_struct", "first_order_data_controller",
+           "look_ahead_data_controller", "no_data_controller", "pack_tube", "tube_struct"]
 
 
 def tube_struct(n: int, capacity: TubeCapacity, real=ctypes.c_double) -> type:
@@ -166,6 +169,11 @@ class TubeDataController:
     capacity : TubeCapacity, optional
         The sizes of the tube's arrays; default 8 segments and 32 windows, or more when
         the design has more.
+    look_ahead : LookAhead, optional
+        A differential-drive base's axle offset and limits: the look-ahead variant's C
+        (:func:`~stt_codegen.codegen.look_ahead_source.look_ahead_c_files`), whose step
+        takes the base's state ``(x, y, theta)`` and writes ``(v, omega)``, and whose switch
+        tests the look-ahead point; default law (13)'s C.
 
     Raises
     ------
@@ -175,12 +183,20 @@ class TubeDataController:
 
     name = "c"
 
-    def __init__(self, design: TubeDesign, capacity: TubeCapacity | None = None) -> None:
+    def __init__(self, design: TubeDesign, capacity: TubeCapacity | None = None,
+                 look_ahead: LookAhead | None = None) -> None:
         capacity = capacity or fitting_capacity(design)
         spec = DesignSpec(design)
-        files = generate_files(spec, design, Options(("c",), "double", capacity))
         prefix = spec.c_name
-        sources = {k: v for k, v in files.items() if k in (f"{prefix}.c", f"{prefix}.h")}
+        if look_ahead is None:
+            files = generate_files(spec, design, Options(("c",), "double", capacity))
+            sources = {k: v for k, v in files.items() if k in (f"{prefix}.c", f"{prefix}.h")}
+            # the measured state and the command: the tube's coordinates
+            self.n_state = self.n_input = design.dimension
+        else:
+            sources = {k: v.encode() for k, v in look_ahead_c_files(
+                design, look_ahead, prefix, "double", capacity=capacity).items()}
+            self.n_state, self.n_input = 3, 2          # (x, y, theta) and (v, omega)
         self._lib = ctypes.CDLL(str(build_shared(sources, f"{prefix}.c")))
         self.n, self.capacity, self.design = design.dimension, capacity, design
         self.struct = tube_struct(self.n, capacity)
@@ -201,7 +217,8 @@ class TubeDataController:
             f.argtypes, f.restype = args, result
             self.functions[name] = f
         # the step's arrays and their pointers, made once: x, alpha, u, alpha_next
-        self._arrays = [np.zeros(size) for size in (self.n, 2 * self.n) * 2]
+        self._arrays = [np.zeros(size) for size in (self.n_state, 2 * self.n, self.n_input,
+                                                    2 * self.n)]
         self._pointers = [v.ctypes.data_as(ptr) for v in self._arrays]
 
     def pack(self, design: TubeDesign):
@@ -247,7 +264,7 @@ class _Loaded:
     def step(self, x, t, dt, alpha):
         o = self.owner
         xs, a, u, nxt = o._arrays
-        xs[:] = np.reshape(x, o.n)
+        xs[:] = np.reshape(x, o.n_state)
         a[:] = np.reshape(alpha, 2 * o.n)
         u.fill(0.0)
         nxt.fill(0.0)
@@ -262,7 +279,32 @@ class _Loaded:
         o = self.owner
         scratch = o.active()
         o.functions["active_init"](ctypes.byref(scratch))
-        xs = np.ascontiguousarray(np.reshape(x, o.n), dtype=float)
+        xs = np.ascontiguousarray(np.reshape(x, o.n_state), dtype=float)
         code = o.functions["switch"](ctypes.byref(scratch), ctypes.byref(self.tube), 0.0,
                                      xs.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), 0.0)
         return float(scratch.error) if code in (0, 4) else math.inf
+
+
+def first_order_data_controller(design) -> TubeDataController:
+    """Law (13)'s C with the tube as data for ``design`` (a Design; the variant's role
+    ``data_controller``)."""
+    return TubeDataController(design.tube)
+
+
+def look_ahead_data_controller(design) -> TubeDataController:
+    """The look-ahead variant's C with the tube as data for a differential-drive
+    ``design`` (its axle offset and limits; the variant's role ``data_controller``)."""
+    return TubeDataController(design.tube, look_ahead=design.look_ahead)
+
+
+def no_data_controller(design) -> TubeDataController:
+    """The role ``data_controller`` of a variant whose C takes no tube as data.
+
+    Raises
+    ------
+    SpecError
+        Always (field ``tube_data``, :func:`~stt_codegen.codegen.tube_data.require_tube_data`).
+    """
+    from ..codegen.tube_data import require_tube_data
+    require_tube_data(design.spec)
+    raise AssertionError("require_tube_data refuses every variant without a C tube as data")

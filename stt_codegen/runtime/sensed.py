@@ -437,11 +437,12 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
                                    "(docs/sensing.md)")
     seed = check_seed(seed)
     variant = variant_of(spec)
-    if backend in ("c", "python") and not variant.tube_data:
+    if backend in ("c", "python") and backend not in variant.tube_data:
         raise SpecError("backend", f"{backend!r} runs the generated code with the tube as "
-                                   f"data, not yet generated for {variant.plant_words} (the "
-                                   f"{variant.name} variant): use 'casadi' or 'reference' "
-                                   "(docs/sensing.md)")
+                                   f"data, not generated in {backend} for "
+                                   f"{variant.plant_words} (the {variant.name} variant): use "
+                                   f"{', '.join(repr(b) for b in variant.tube_data + ('casadi',))}"
+                                   " (docs/sensing.md)")
     t_c = spec.prescribed_time
     horizon = t_c if horizon is None else _horizon(horizon)
     rate = spec.rate_hz
@@ -645,8 +646,7 @@ class _Runner:
         self.backend, self.spec = backend, design.spec
         self.library = None
         if backend == "c":
-            from .data_controller import TubeDataController
-            self.library = TubeDataController(design.tube)
+            self.library = variant_of(design.spec).entry("data_controller")(design)
         elif backend == "python":
             from .data_module import TubeDataModule
             self.library = TubeDataModule(design.tube)
@@ -662,7 +662,7 @@ class _Runner:
         the controller is ``None`` where ``|e| > MAX_INITIAL_ERROR`` (the switch refused)."""
         if self.library is not None:
             loaded = self.library.load(plan.design.tube)
-            e = loaded.switch_error(positions(self.spec, x[None])[0])
+            e = loaded.switch_error(x)            # P_switch's test, on the measured state
             return e, (loaded if e <= MAX_INITIAL_ERROR else None)
         e = _error(plan, x, self.spec)
         return e, (self.controller(plan.design) if e <= MAX_INITIAL_ERROR else None)

@@ -62,6 +62,8 @@ ROLES: Mapping[str, str] = MappingProxyType({
                   "SimulationResult's variant fields",
     "velocity_reference": "(tube, stage, states, ts, dt, alphas) -> r along a run, or None",
     "generation": "(design, options) -> dict of file name to bytes",
+    "data_controller": "(design) -> TubeDataController, the variant's C with the tube as "
+                       "data compiled once (SpecError where tube_data has no 'c')",
     "firmware": "(design, *, seed) -> report dict of the closed loop on the Cortex-M4F",
     "embedded_command": "(design, args, seed) -> exit code of stt-codegen embedded",
     "model_checks": "(spec, model) -> list of Check on the plant model",
@@ -117,10 +119,12 @@ class ControllerVariant:
         On a MuJoCo plant, ``[actuator] input_bound`` bounds the MuJoCo actuators (law
         (13)'s inputs, the cascade's forces), and they name the inputs; ``False``: it bounds
         the base's ``(v, omega)``, which its driver turns into wheel speeds.
-    tube_data : bool
-        ``generate --tube-data`` is available: the generated C takes its tube as data and
-        switches tubes at run time (:mod:`stt_codegen.codegen.tube_data`, docs/sensing.md);
-        only law (13)'s variant so far.
+    tube_data : tuple of str
+        Where ``generate --tube-data`` is available (the generated code takes its tube as
+        data and switches tubes at run time, :mod:`stt_codegen.codegen.tube_data`,
+        docs/sensing.md): ``"c"``, ``"python"`` (the generated module) and ``"embedded"``
+        (``stt-codegen embedded --tube-data``); empty: nowhere. Law (13)'s variant: all
+        three; the base's: its C.
     tracking_in_stage : bool
         Whether the tube can be followed is judged by the certificate of its stage (the
         cascade's, which bounds ``|e1|``); else the paper's method refuses a tube with
@@ -161,7 +165,7 @@ class ControllerVariant:
     predicts_delay: bool = False
     replans_sensed: bool = False
     actuator_inputs: bool = True
-    tube_data: bool = False
+    tube_data: tuple[str, ...] = ()
 
     def entry(self, role: str) -> Callable[..., Any]:
         """The variant's function (or class) for one role, imported on first use.
@@ -231,6 +235,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                initial_state=_P + "runtime.state_split:tube_state_start",
                positions=_P + "runtime.state_split:leading_positions",
                backends=_P + "runtime.backends:first_order_backends",
+               data_controller=_P + "runtime.data_controller:first_order_data_controller",
                controller=_P + "runtime.backends:first_order_controller",
                plant=_P + "runtime.plants:first_order_spec_plant",
                mujoco_plant=_P + "runtime.plants:joint_mujoco_plant",
@@ -246,7 +251,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                output_limits=_P + "design.output_bound:no_output_limits",
                predictor=_P + "tube.variant_steps:law13_predictor",
                input_gain=_P + "spec.input_gains:declared_input_gain"),
-        predicts_delay=True, replans_sensed=True, tube_data=True),
+        predicts_delay=True, replans_sensed=True, tube_data=("c", "python", "embedded")),
     "cascade": ControllerVariant(
         "cascade", "a second-order plant", "the cascade's input u", 2,
         " (positions, then velocities)",
@@ -262,6 +267,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                initial_state=_P + "runtime.state_split:cascade_start",
                positions=_P + "runtime.state_split:leading_positions",
                backends=_P + "runtime.backends:cascade_backends",
+               data_controller=_P + "runtime.data_controller:no_data_controller",
                controller=_P + "runtime.backends:cascade_controller",
                plant=_P + "runtime.plants:cascade_spec_plant",
                mujoco_plant=_P + "runtime.plants:joint_mujoco_plant",
@@ -293,6 +299,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                initial_state=_P + "runtime.state_split:look_ahead_start",
                positions=_P + "runtime.state_split:look_ahead_positions",
                backends=_P + "runtime.backends:look_ahead_backends",
+               data_controller=_P + "runtime.data_controller:look_ahead_data_controller",
                controller=_P + "runtime.backends:look_ahead_controller",
                plant=_P + "runtime.plants:drive_spec_plant",
                mujoco_plant=_P + "runtime.plants:drive_mujoco_plant",
@@ -308,7 +315,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                output_limits=_P + "design.output_bound:look_ahead_output_limits",
                predictor=_P + "tube.look_ahead:look_ahead_predictor",
                input_gain=_P + "spec.input_gains:declared_input_gain"),
-        predicts_delay=True, replans_sensed=True, actuator_inputs=False),
+        predicts_delay=True, replans_sensed=True, actuator_inputs=False, tube_data=("c",)),
 })
 assert tuple(CONTROLLER_VARIANTS) == VARIANTS
 
