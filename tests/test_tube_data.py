@@ -358,15 +358,22 @@ def test_on_the_cortex_m4f_the_switch_and_the_step_are_counted(tmp_path, capsys)
 @pytest.mark.skipif(shutil.which("cppcheck") is None,
                     reason="cppcheck missing: install the Debian package cppcheck")
 @pytest.mark.parametrize("precision", ["double", "single"])
-def test_misra_findings_are_the_listed_deviations(tmp_path, precision):
-    """cppcheck's MISRA C:2012 addon on the data form (docs/codegen.md): only the first
-    order's deviations, with the data form's API among the unused functions and rule 8.7 on
-    the two public functions the file also calls."""
+@pytest.mark.parametrize("variant", ["law (13)", "base"])
+def test_misra_findings_are_the_listed_deviations(tmp_path, precision, variant):
+    """cppcheck's MISRA C:2012 addon on the data form (docs/codegen.md), law (13)'s and a
+    differential-drive base's: only the first order's deviations, with the data form's API
+    among the unused functions and rule 8.7 on the two public functions the file also
+    calls."""
     from test_codegen_misra import DEVIATIONS
-    design = piecewise_design()
-    spec = DesignSpec(design)
-    prefix = spec.c_name
-    files = generate_files(spec, design, Options(("c",), precision, TubeCapacity(4, 8)))
+    if variant == "base":
+        design = stt.design_tube(stt.load_spec(str(SPECS / "hall-crossing-drive.toml")))
+        prefix = design.spec.c_name
+        files = design_files(design, Options(("c",), precision, TubeCapacity(8, 32)))
+    else:
+        design = piecewise_design()
+        spec = DesignSpec(design)
+        prefix = spec.c_name
+        files = generate_files(spec, design, Options(("c",), precision, TubeCapacity(4, 8)))
     for name in (f"{prefix}.c", f"{prefix}.h"):
         (tmp_path / name).write_bytes(files[name])
     proc = subprocess.run(["cppcheck", "--enable=all", "--addon=misra", "--std=c99",
