@@ -49,6 +49,30 @@ def several(cc):
     return design, TubeDataController(design)
 
 
+def run_as_casadi(design, backend: str) -> None:
+    """The hall's people (8 s) with ``design`` on ``backend`` (the generated code with the
+    tube as data): at least three switches, and the CasADi model's run, bit for bit."""
+    people = bundled_people("hall-crossing")
+    runs = [stt.simulate_sensed(design, people, backend=b, horizon=8.0)
+            for b in ("casadi", backend)]
+    assert runs[1].sensing.switches >= 3 and runs[1].backend == backend
+    for name in ("x", "u", "alpha", "status", "tube"):
+        assert np.array_equal(getattr(runs[0].trajectory, name),
+                              getattr(runs[1].trajectory, name)), name
+
+
+def selftest_passes(files: dict, folder, cc: str) -> None:
+    """The generated files written to ``folder``: ``make selftest`` (the shipped Makefile's
+    warnings as errors) passes over 100 vectors, none failed."""
+    for name, data in files.items():
+        (folder / name).write_bytes(data)
+    proc = subprocess.run(["make", "-s", "selftest", f"CC={cc}"], cwd=folder,
+                          capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    last = proc.stdout.strip().splitlines()[-1]
+    assert last.endswith(" passed, 0 failed") and int(last.split()[0]) > 100
+
+
 def bits(values) -> list:
     return [np.asarray(v, float).tobytes() for v in values]
 
@@ -205,13 +229,7 @@ def test_the_switch_takes_a_tube_only_where_the_state_lies_in_it(several):
 def test_people_crossing_the_hall_run_through_one_compiled_controller(cc):
     """``simulate_sensed`` on backend ``c`` loads each switched tube into the spec's C with
     the tube as data: the same trajectory, bit for bit, as the CasADi model's run."""
-    hall = design_of("hall-crossing")
-    people = bundled_people("hall-crossing")
-    runs = [stt.simulate_sensed(hall, people, backend=b, horizon=8.0) for b in ("casadi", "c")]
-    assert runs[1].sensing.switches >= 3 and runs[1].backend == "c"
-    for name in ("x", "u", "alpha", "status", "tube"):
-        assert np.array_equal(getattr(runs[0].trajectory, name),
-                              getattr(runs[1].trajectory, name)), name
+    run_as_casadi(design_of("hall-crossing"), "c")
 
 
 @pytest.fixture(scope="module")
@@ -246,15 +264,10 @@ def test_a_base_runs_its_replanned_tubes_through_one_compiled_controller(base):
     CasADi model's run; the Python module takes no tube as data for a base (refused,
     naming the field)."""
     design, _ = base
-    people = bundled_people("hall-crossing")
-    runs = [stt.simulate_sensed(design, people, backend=b, horizon=8.0)
-            for b in ("casadi", "c")]
-    assert runs[1].sensing.switches >= 3 and runs[1].backend == "c"
-    for name in ("x", "u", "alpha", "status", "tube"):
-        assert np.array_equal(getattr(runs[0].trajectory, name),
-                              getattr(runs[1].trajectory, name)), name
+    run_as_casadi(design, "c")
     with pytest.raises(SpecError) as caught:
-        stt.simulate_sensed(design, people, backend="python", horizon=1.0)
+        stt.simulate_sensed(design, bundled_people("hall-crossing"), backend="python",
+                            horizon=1.0)
     assert caught.value.field == "backend"
 
 
@@ -265,13 +278,7 @@ def test_the_base_data_form_selftest_passes(base, cc, tmp_path, precision):
     design, _ = base
     files = design_files(design, Options(("c",), precision, TubeCapacity(8, 32)))
     prefix = design.spec.c_name
-    for name, data in files.items():
-        (tmp_path / name).write_bytes(data)
-    proc = subprocess.run(["make", "-s", "selftest", f"CC={cc}"], cwd=tmp_path,
-                          capture_output=True, text=True)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    last = proc.stdout.strip().splitlines()[-1]
-    assert last.endswith(" passed, 0 failed") and int(last.split()[0]) > 100
+    selftest_passes(files, tmp_path, cc)
     header = files[f"{prefix}.h"].decode()
     assert f"{prefix}_tube_data" in header and "x[HALL_CROSSING_DRIVE_N_STATE]" in header
 
@@ -285,13 +292,7 @@ def test_the_generated_selftest_passes_on_the_design_tube(cc, tmp_path, precisio
     options = Options(("c",), precision, TubeCapacity(4, 8))
     files = generate_files(spec, design, options)
     assert files == generate_files(spec, design, options)
-    for name, data in files.items():
-        (tmp_path / name).write_bytes(data)
-    proc = subprocess.run(["make", "-s", "selftest", f"CC={cc}"], cwd=tmp_path,
-                          capture_output=True, text=True)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
-    last = proc.stdout.strip().splitlines()[-1]
-    assert last.endswith(" passed, 0 failed") and int(last.split()[0]) > 100
+    selftest_passes(files, tmp_path, cc)
     header = files[f"{spec.c_name}.h"].decode()
     assert "#define PIECEWISE_MAX_SEGMENTS 4" in header and "the tube as data" in header
     assert '"tube_data": {' in files["manifest.json"].decode()
