@@ -448,7 +448,7 @@ def test_a_new_tube_is_proved_from_where_the_old_proof_leaves_the_state(start, n
     proved from its x(0); a new tube from the box where the active tube's proof keeps the
     state at the switch, cut to the switch test, so its proved box at t' = 0 holds every
     state of that box the switch admits, and it carries its own bound to the next switch."""
-    from stt_codegen.design.sensed_switch import state_at, switch_error
+    from stt_codegen.design.sensed_switch import ROUNDING, state_at, switch_error
     rate = start.task.rate_hz
     assert start.state_bounds is not None and new.state_bounds is not None
     lo, hi = state_at(start.state_bounds, rate, new.switch_at - start.start)
@@ -464,10 +464,11 @@ def test_a_new_tube_is_proved_from_where_the_old_proof_leaves_the_state(start, n
     # not the point x(0): the proof starts from a box
     assert np.all(new.state_bounds[1][0] - new.state_bounds[0][0] > 1e-3)
     box = switch_error(new.design, (lo, hi))
-    assert all(-0.5 <= a <= b <= 0.5 for a, b in box)
+    edge = 0.5 + ROUNDING
+    assert all(-edge <= a <= b <= edge for a, b in box)
     # a state box the switch test refuses everywhere: no tube can take over from it
     assert switch_error(new.design, (hi + 2.0 * half, hi + 3.0 * half)) is None
-    assert switch_error(new.design, None) == ((-0.5, 0.5),) * new.design.tube.dimension
+    assert switch_error(new.design, None) == ((-edge, edge),) * new.design.tube.dimension
 
 
 def test_a_tube_not_proved_from_the_switch_is_not_taken(start, person, new, monkeypatch):

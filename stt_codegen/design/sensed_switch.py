@@ -22,7 +22,12 @@ from .result import Design
 from .samples import sample_tube
 from .search import MAX_INITIAL_ERROR
 
-__all__ = ["proved_error", "state_at", "switch_error"]
+__all__ = ["ROUNDING", "proved_error", "state_at", "switch_error"]
+
+#: Each end of a box of ``e(0)`` is moved out by this (dimensionless): the state's box and
+#: the switch test are computed in floating point on both sides (the proof's floats here,
+#: the deployed step's there), far below every margin the check proves.
+ROUNDING = 1e-9
 
 
 def state_at(bounds: tuple[np.ndarray, np.ndarray] | None, rate_hz: float, t_local: float
@@ -57,8 +62,9 @@ def switch_error(design: Design, state: tuple[np.ndarray, np.ndarray] | None
                  ) -> tuple[tuple[float, float], ...] | None:
     """The box of ``e(0)`` of ``design``'s tube at a switch: the state's box ``state``
     (:func:`state_at`) in the tube's coordinates at ``t' = 0``, cut to the switch test's
-    ``|e_i| <= MAX_INITIAL_ERROR`` (that test alone where ``state`` is ``None``); ``None``
-    when the two do not meet (every switch to it would be refused).
+    ``|e_i| <= MAX_INITIAL_ERROR`` (that test alone where ``state`` is ``None``), each end
+    moved out by :data:`ROUNDING`; ``None`` when the two do not meet (every switch to it
+    would be refused).
 
     Parameters
     ----------
@@ -73,17 +79,18 @@ def switch_error(design: Design, state: tuple[np.ndarray, np.ndarray] | None
         One interval per dimension.
     """
     n = design.tube.dimension
-    limit = [(-MAX_INITIAL_ERROR, MAX_INITIAL_ERROR)] * n
+    # the deployed test's e and these floats may differ by rounding: widened by ROUNDING
+    edge = MAX_INITIAL_ERROR + ROUNDING
     if state is None:
-        return tuple(limit)
+        return ((-edge, edge),) * n
     with reference.numpy_math():
         samples = sample_tube(design.tube, horizon=1.0 / design.tube.rate_hz)
     lo, hi = samples.gamma_lower[0], samples.gamma_upper[0]
     centre, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
     out = []
     for i in range(n):
-        a = max(float((state[0][i] - centre[i]) / half[i]), limit[i][0])
-        b = min(float((state[1][i] - centre[i]) / half[i]), limit[i][1])
+        a = max(float((state[0][i] - centre[i]) / half[i]) - ROUNDING, -edge)
+        b = min(float((state[1][i] - centre[i]) / half[i]) + ROUNDING, edge)
         if not a <= b:
             return None
         out.append((a, b))
