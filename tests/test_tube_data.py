@@ -356,6 +356,24 @@ def test_on_the_cortex_m4f_the_switch_and_the_step_are_counted(tmp_path, capsys)
     assert main(["embedded", "hall-crossing", "--tube-data", "8,8"]) == 2
 
 
+@pytest.mark.embedded
+def test_a_base_on_the_cortex_m4f_switches_and_steps_its_tubes_as_data(tmp_path):
+    """The base's data form on the emulated Cortex-M4F (tests/specs/hall-crossing-drive.toml):
+    the self-test passes, both switches are taken at the look-ahead point of the state the
+    program gives (the axle behind each tube's point), every step keeps the point inside
+    its tube (OK, or INPUT_CLAMPED: the program holds the state still while the tube moves
+    on), the cost tube costs more, and the host-packed bytes run as the compiled tube."""
+    from stt_codegen.embedded.tube_data_loop import run_tube_data
+    design = stt.design_tube(stt.load_spec(str(SPECS / "hall-crossing-drive.toml")))
+    r = run_tube_data(design, TubeCapacity(8, 32), tmp_path)
+    assert r["ok"] and r["vectors_failed"] == 0 and r["vectors_passed"] > 100
+    assert r["switch_design"]["result"] == 0 and r["switch_cost"]["result"] == 0
+    statuses = set(r["steps_design"]["statuses"] + r["steps_cost"]["statuses"])
+    assert 0 in statuses and statuses <= {0, 3}
+    assert min(r["steps_cost"]["instructions"]) > max(r["steps_design"]["instructions"])
+    assert r["wire"]["check"] == 0 and r["wire"]["same_steps"] and r["ram_bytes"] == 0
+
+
 @pytest.mark.skipif(shutil.which("cppcheck") is None,
                     reason="cppcheck missing: install the Debian package cppcheck")
 @pytest.mark.parametrize("precision", ["double", "single"])

@@ -124,7 +124,7 @@ class ControllerVariant:
         data and switches tubes at run time, :mod:`stt_codegen.codegen.tube_data`,
         docs/sensing.md): ``"c"``, ``"python"`` (the generated module) and ``"embedded"``
         (``stt-codegen embedded --tube-data``); empty: nowhere. Law (13)'s variant: all
-        three; the base's: its C.
+        three; the base's: its C, on the host and on the Cortex-M4F.
     tracking_in_stage : bool
         Whether the tube can be followed is judged by the certificate of its stage (the
         cascade's, which bounds ``|e1|``); else the paper's method refuses a tube with
@@ -315,7 +315,8 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                output_limits=_P + "design.output_bound:look_ahead_output_limits",
                predictor=_P + "tube.look_ahead:look_ahead_predictor",
                input_gain=_P + "spec.input_gains:declared_input_gain"),
-        predicts_delay=True, replans_sensed=True, actuator_inputs=False, tube_data=("c",)),
+        predicts_delay=True, replans_sensed=True, actuator_inputs=False,
+        tube_data=("c", "embedded")),
 })
 assert tuple(CONTROLLER_VARIANTS) == VARIANTS
 
