@@ -437,12 +437,13 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
                                    "(docs/sensing.md)")
     seed = check_seed(seed)
     variant = variant_of(spec)
-    if backend in ("c", "python") and backend not in variant.tube_data:
+    generated = ("c", "python")                  # the backends that run the data form
+    if backend in generated and backend not in variant.tube_data:
+        usable = [b for b in generated if b in variant.tube_data] + ["casadi", "reference"]
         raise SpecError("backend", f"{backend!r} runs the generated code with the tube as "
                                    f"data, not generated in {backend} for "
                                    f"{variant.plant_words} (the {variant.name} variant): use "
-                                   f"{', '.join(repr(b) for b in variant.tube_data + ('casadi',))}"
-                                   " (docs/sensing.md)")
+                                   f"{', '.join(repr(b) for b in usable)} (docs/sensing.md)")
     t_c = spec.prescribed_time
     horizon = t_c if horizon is None else _horizon(horizon)
     rate = spec.rate_hz
