@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..spec.loader import Spec
+from ..spec.variants import variant_of
 from ..tube import reference
 from .certificate.sampled import sampled_check_of
 from .result import Design
@@ -122,7 +123,6 @@ def proved_error(design: Design, spec: Spec,
     reason : str
         Empty when proved.
     """
-    from ..spec.variants import variant_of
     samples, check = sampled_check_of(design.tube, spec, initial_error=initial_error)
     if not check.passed or check.abs_e is None:
         return None, f"the sampled loop is not proved from the switch: {check.reason}"
