@@ -5,7 +5,8 @@ The generated API (C: ``<prefix>_tube``, ``_control``, ``_alpha_step``, ``_step`
 tables (:mod:`stt_codegen.codegen.tables`) around the bodies of the pieces of
 :mod:`stt_codegen.tube.pieces`, whose numbers are inputs:
 
-* reach tube: find the active segment, ``progress_<profile>``, ``interpolate``;
+* reach tube: find the active segment, ``progress_<profile>``, ``interpolate``; where the
+  next segment has started (a blended corner), its ``progress_<profile>`` and ``blend``;
 * circumvents: find the open windows (binary search on the sorted starts, then back over
   the running maximum of the ends), ``bump`` for each open one, ``fnu_init``,
   ``fnu_add``, ``fnu_finish`` per bound (a closed window would add exactly 0);
@@ -62,7 +63,8 @@ def deployed_functions(model: TubeModel, every: bool = False) -> list[ca.Functio
                for side in (LOWER, UPPER)]
     return P.deployed_pieces(design.dimension, profiles, single_bounds=1 in members,
                              multi_bounds=any(m > 1 for m in members),
-                             saturated=design.input_bound is not None)
+                             saturated=design.input_bound is not None,
+                             blended=design.blends_corners)
 
 
 def clamped_control(model: TubeModel) -> ca.Function:

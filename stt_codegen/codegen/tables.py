@@ -55,6 +55,9 @@ class Tables:
         Largest number of windows open at one time (at least 1: a C array size).
     profiles : list of str
         Profile names used by the segments (those whose bodies are emitted).
+    blended : bool
+        Some segment starts before the previous one ends (a blended corner: the next
+        segment's move is added where it has started).
     """
 
     parameters: list
@@ -66,6 +69,7 @@ class Tables:
     windows: list
     max_open: int
     profiles: list
+    blended: bool = False
 
 
 def _rounded(value: float, single: bool) -> float:
@@ -127,4 +131,5 @@ def design_table_rows(design: TubeDesign, literal: Callable[[float], str],
                   [literal(v) for v in tables.signs], members,
                   [b for b, count in enumerate(members) if count > 1], segments, windows,
                   max_open(intervals),
-                  [p for p in PROFILE_NAMES if any(s.profile == p for s in tables.segments)])
+                  [p for p in PROFILE_NAMES if any(s.profile == p for s in tables.segments)],
+                  design.blends_corners)

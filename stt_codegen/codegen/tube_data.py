@@ -129,12 +129,16 @@ class TableShape:
         Some bound has several (``F_nu``).
     profiles : list of str
         The reach profiles whose bodies are called.
+    blended : bool
+        The next segment's move is added where it has started (blended corners; never in
+        the data form, which refuses such tubes).
     """
 
     windows: bool
     single: bool
     multi: bool
     profiles: list
+    blended: bool = False
 
 
 def table_names(prefix: str, data: bool) -> dict[str, str]:
@@ -240,7 +244,7 @@ def table_shape(tables: Tables, capacity: TubeCapacity | None) -> TableShape:
     if capacity is not None:
         return TableShape(True, True, True, list(DATA_PROFILES))
     return TableShape(bool(tables.windows), 1 in tables.members, bool(tables.multi),
-                      list(tables.profiles))
+                      list(tables.profiles), tables.blended)
 
 
 def require_tube_data(spec, targets: tuple[str, ...] = ("c",)) -> None:
@@ -283,9 +287,13 @@ def require_capacity(design: TubeDesign, capacity: TubeCapacity) -> None:
     Raises
     ------
     SpecError
-        More segments or circumvents than the capacity, or a segment profile outside
-        :data:`DATA_PROFILES` (field ``tube_data``).
+        More segments or circumvents than the capacity, a segment profile outside
+        :data:`DATA_PROFILES`, or blended corners (field ``tube_data``).
     """
+    if design.blends_corners:
+        raise SpecError("tube_data", "the tube blends corners (a segment starts before the "
+                                     "previous one ends); the tube as data runs one segment "
+                                     "at a time")
     unknown = sorted({s.profile for s in design.segments} - set(DATA_PROFILES))
     if unknown:
         raise SpecError("tube_data", f"the tube has {', '.join(unknown)} segments; the "

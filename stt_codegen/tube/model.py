@@ -114,7 +114,8 @@ def segment_rows(design: TubeDesign, segment) -> tuple:
 
 def reach_tube_rates(design: TubeDesign, t) -> tuple:
     """``rho`` and ``rho_dot`` (2n SX vectors ``[L; U]``) of eq. (4), piecewise over the
-    segments: the first segment whose ``end`` is after ``t`` (the last one after every end)."""
+    segments: the first segment whose ``end`` is after ``t`` (the last one after every end),
+    plus the next segment's move where it has started (a blended corner)."""
     interpolate = P.interpolate(design.dimension)
     interpolate_value = P.interpolate(design.dimension, False)
 
@@ -126,10 +127,23 @@ def reach_tube_rates(design: TubeDesign, t) -> tuple:
         p_value = P.progress(segment.profile, False)(t, segment.start, segment.end)
         return interpolate_value(p_value, ca.DM(lo), ca.DM(hi)), rate
 
-    rho, rho_dot = on(design.segments[-1])
-    for segment in reversed(design.segments[:-1]):
-        here, here_dot = on(segment)
-        sooner = t < segment.end
+    def blended(segment, following, here, here_dot):
+        # a blended corner: where the next segment has started, its move is added
+        if not following.start < segment.end:
+            return here, here_dot
+        p, p_dot = P.progress(following.profile)(t, following.start, following.end)
+        lo, hi = segment_rows(design, following)
+        _, rate = P.blend(design.dimension)(here, here_dot, p, p_dot, ca.DM(lo), ca.DM(hi))
+        p_value = P.progress(following.profile, False)(t, following.start, following.end)
+        value = P.blend(design.dimension, False)(here, p_value, ca.DM(lo), ca.DM(hi))
+        started = following.start < t
+        return ca.if_else(started, value, here), ca.if_else(started, rate, here_dot)
+
+    segments = design.segments
+    rho, rho_dot = on(segments[-1])
+    for k in range(len(segments) - 2, -1, -1):
+        here, here_dot = blended(segments[k], segments[k + 1], *on(segments[k]))
+        sooner = t < segments[k].end
         rho, rho_dot = ca.if_else(sooner, here, rho), ca.if_else(sooner, here_dot, rho_dot)
     return rho, rho_dot
 

@@ -344,9 +344,11 @@ class TubeDesign:
     state_lower, state_upper : tuple of float
         ``X`` and ``X-bar``, the state-space box.
     segments : tuple of ReachSegment
-        The reachability tube ``rho``, in time order, contiguous (each starts where and
-        when the previous ends); its first box is ``X-hat_0`` of eq. (2), its last the
-        target box ``T-hat`` of eq. (3) (see :attr:`initial_lower`, :attr:`target_lower`).
+        The reachability tube ``rho``, in time order, contiguous in box (each starts from
+        the box where the previous ends), each starting when the previous ends or, to
+        blend a corner, before (:attr:`blends_corners`; at most two at once); its first
+        box is ``X-hat_0`` of eq. (2), its last the target box ``T-hat`` of eq. (3) (see
+        :attr:`initial_lower`, :attr:`target_lower`).
     initial_state : tuple of float
         ``x(0)``.
     circumvents : tuple of Circumvent
@@ -399,9 +401,24 @@ class TubeDesign:
                 or not all(b > 0 for b in self.input_bound)):
             raise ValueError("input_bound needs one positive entry per state dimension")
         for a, b in zip(self.segments, self.segments[1:]):
-            if (b.start != a.end or b.lower_from != a.lower_to
-                    or b.upper_from != a.upper_to):
-                raise ValueError("reach segments must be contiguous in time and box")
+            if (b.lower_from != a.lower_to or b.upper_from != a.upper_to
+                    or not a.start < b.start <= a.end):
+                raise ValueError("reach segments must be contiguous in box and each start "
+                                 "after the previous one starts, at or before it ends")
+        for a, c in zip(self.segments, self.segments[2:]):
+            if c.start < a.end:
+                raise ValueError("at most two reach segments may move the tube at once: a "
+                                 "segment must start after the one two before it ends")
+
+    @property
+    def blends_corners(self) -> bool:
+        """Whether some reach segment starts before the previous one ends (blended corners).
+
+        Then on ``[start_{k+1}, end_k]`` both move the box: ``rho = from_k + (to_k - from_k)
+        p_k + (to_{k+1} - from_{k+1}) p_{k+1}``, the tube passing the via box ``B_{k+1}``
+        without stopping at it (docs/design.md, "Blended corners").
+        """
+        return any(b.start < a.end for a, b in zip(self.segments, self.segments[1:]))
 
     @property
     def dimension(self) -> int:

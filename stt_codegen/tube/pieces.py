@@ -18,6 +18,9 @@ piece                  inputs                                       outputs
 ``progress_cruise``    t, start, end                                p, p_dot (ramps, cruise)
 ``interpolate``        p, p_dot, from (2n), to (2n)                 rho, rho_dot (2n: [L; U]);
                                                                     ``_value``: rho only
+``blend``              rho, rho_dot (2n), p, p_dot, from, to        rho + (to - from) p, its
+                                                                    rate (blended corners
+                                                                    only); ``_value``: rho
 ``bump``               t, start, end, center, radius, sharpness,    y = B b(t), y_dot
                        height                                       (eqs. (7)-(8));
                                                                     ``_value``: y only
@@ -60,11 +63,12 @@ import casadi as ca
 from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, NEWTON_TINY, SCURVE,
                          SCURVE_TURN, SMOOTHSTEP, TANH)
 
-__all__ = ["EXP_ARGUMENT_BOUND", "PROFILE_NAMES", "alpha_rate", "bump", "candidates", "conflict",
-           "deployed_pieces", "error_transform", "error_transform_expression", "fnu_pieces",
-           "interpolate", "later", "law", "law_expression", "newton_iteration_expression",
-           "newton_root_start_expression", "newton_start_expression", "progress",
-           "saturate_expression", "smooth_pieces", "trigger_expression"]
+__all__ = ["EXP_ARGUMENT_BOUND", "PROFILE_NAMES", "alpha_rate", "blend", "bump", "candidates",
+           "conflict", "deployed_pieces", "error_transform", "error_transform_expression",
+           "fnu_pieces", "interpolate", "later", "law", "law_expression",
+           "newton_iteration_expression", "newton_root_start_expression",
+           "newton_start_expression", "progress", "saturate_expression", "smooth_pieces",
+           "trigger_expression"]
 
 #: Bound on the argument of ``exp`` where it could be large (the smooth max's correction
 #: and the trigger of (11)): ``exp(+-80)`` is a normal number in float32 and float64, so no
@@ -195,6 +199,39 @@ def interpolate(n: int, rates: bool = True) -> ca.Function:
                            ["p", "from", "to"], ["rho"])
     return ca.Function("interpolate", [p, p_dot, lo, hi], [(hi - lo) * p + lo, (hi - lo) * p_dot],
                        ["p", "p_dot", "from", "to"], ["rho", "rho_dot"])
+
+
+@lru_cache(maxsize=None)
+def blend(n: int, rates: bool = True) -> ca.Function:
+    """``blend(rho, rho_dot, p, p_dot, from, to) -> (rho, rho_dot)``: ``rho + (to - from) p``,
+    the next segment's move added where it starts before the active one ends (a blended
+    corner, :attr:`~stt_codegen.tube.parameters.TubeDesign.blends_corners`); without rates
+    ``blend_value(rho, p, from, to) -> rho``.
+
+    Parameters
+    ----------
+    n : int
+        State dimension; ``rho``, ``from``, ``to`` have ``2n`` entries ``[L; U]``.
+    rates : bool
+        Also take ``rho_dot`` and ``p_dot`` and return ``rho_dot + (to - from) p_dot``
+        (state units/s).
+
+    Returns
+    -------
+    casadi.Function
+        The reach tube ``rho`` (eq. (4), state units) with the next segment's progress
+        ``p`` added.
+    """
+    p, p_dot = _sym("p", "p_dot")
+    rho, rho_dot = ca.SX.sym("rho", 2 * n), ca.SX.sym("rho_dot", 2 * n)
+    lo, hi = ca.SX.sym("from", 2 * n), ca.SX.sym("to", 2 * n)
+    if not rates:
+        return ca.Function("blend_value", [rho, p, lo, hi], [rho + (hi - lo) * p],
+                           ["rho", "p", "from", "to"], ["blended"])
+    return ca.Function("blend", [rho, rho_dot, p, p_dot, lo, hi],
+                       [rho + (hi - lo) * p, rho_dot + (hi - lo) * p_dot],
+                       ["rho", "rho_dot", "p", "p_dot", "from", "to"],
+                       ["blended", "blended_dot"])
 
 
 @lru_cache(maxsize=None)
@@ -715,13 +752,16 @@ def law(n: int) -> ca.Function:
 
 
 def deployed_pieces(n: int, profiles: tuple, single_bounds: bool = True,
-                    multi_bounds: bool = True, saturated: bool = False) -> list:
+                    multi_bounds: bool = True, saturated: bool = False,
+                    blended: bool = False) -> list:
     """Every piece the generated code of a design of dimension ``n`` calls, in a fixed order.
 
     ``profiles``: the segment profiles it uses; ``single_bounds`` / ``multi_bounds``: whether
     some bound has exactly one / several circumvents (``bump`` is emitted with either, the
     ``F_nu`` pieces only with several, ``fnu_single`` only with one); ``saturated``: the
-    design has an actuator bound (``saturate`` is emitted last, only then).
+    design has an actuator bound (``saturate`` is emitted last, only then); ``blended``: some
+    segment starts before the previous one ends (``blend`` is emitted after ``interpolate``,
+    only then).
 
     Parameters
     ----------
@@ -735,6 +775,8 @@ def deployed_pieces(n: int, profiles: tuple, single_bounds: bool = True,
         Some bound has several circumvents.
     saturated : bool
         The design has an actuator bound.
+    blended : bool
+        The design blends corners (two segments move the tube at once somewhere).
 
     Returns
     -------
@@ -748,5 +790,6 @@ def deployed_pieces(n: int, profiles: tuple, single_bounds: bool = True,
     used = [p for p in PROFILE_NAMES if p in profiles]
     return [*(progress(p, False) for p in used), *(progress(p) for p in used),
             interpolate(n, False), interpolate(n),
-            *circumvents, cand, cand_rates, *smooth_pieces(), conflict(n), alpha_rate(n),
+            *([blend(n, False), blend(n)] if blended else []), *circumvents, cand, cand_rates,
+            *smooth_pieces(), conflict(n), alpha_rate(n),
             later(), *newton_pieces(), law(n), *([saturate(n)] if saturated else [])]

@@ -281,7 +281,8 @@ def reach_tube(design: TubeDesign, t, rates: bool = True) -> tuple[Array, Array,
     """Reachability tube ``rho_L``, ``rho_U`` (eq. (4), piecewise) and their time derivatives.
 
     On segment ``k`` (the first whose ``end`` is after ``t``; the last one after every
-    end) ``rho = from + (to - from) p(tau)``, see :func:`segment_progress`.
+    end) ``rho = from + (to - from) p(tau)``, see :func:`segment_progress`; where segment
+    ``k + 1`` has started (a blended corner), plus ``(to - from) p(tau)`` of segment ``k + 1``.
 
     Parameters
     ----------
@@ -319,12 +320,30 @@ def reach_tube(design: TubeDesign, t, rates: bool = True) -> tuple[Array, Array,
             s[here], s_dot[here] = _progress(profile, t[here], starts[which[here]],
                                              ends[which[here]])
     s = s[:, None]
-    lower_move, upper_move = lower_move[which], upper_move[which]
-    values = (lower_move * s + lower_from[which], upper_move * s + upper_from[which])
-    if not rates:
-        return values[0], values[1], None, None
-    s_dot = s_dot[:, None]
-    return (*values, lower_move * s_dot, upper_move * s_dot)
+    values = (lower_move[which] * s + lower_from[which], upper_move[which] * s + upper_from[which])
+    moved = (lower_move[which] * s_dot[:, None], upper_move[which] * s_dot[:, None]) \
+        if rates else (None, None)
+    if design.blends_corners:
+        _add_started(segments, t, which, (lower_move, upper_move), values, moved)
+    return (*values, *moved)
+
+
+def _add_started(segments, t: np.ndarray, which: np.ndarray, moves: tuple, values: tuple,
+                 rates: tuple) -> None:
+    """Add, in place, the move of the segment after each point's own where it has started
+    (a blended corner: ``rho = from_k + (to_k - from_k) p_k + (to_{k+1} - from_{k+1})
+    p_{k+1}`` on ``[start_{k+1}, end_k]``)."""
+    following = which + 1
+    starts = np.array([seg.start for seg in segments] + [np.inf])
+    started = np.flatnonzero(starts[following] < t)
+    for k in np.unique(following[started]):
+        here = started[following[started] == k]
+        seg = segments[k]
+        s, s_dot = _progress(seg.profile, t[here], seg.start, seg.end, rates[0] is not None)
+        for value, rate, move in zip(values, rates, moves):
+            value[here] += move[k] * s[:, None]
+            if rate is not None:
+                rate[here] += move[k] * s_dot[:, None]
 
 
 def bump(t, center: float, radius: float, sharpness: float) -> tuple[Array, Array]:

@@ -156,12 +156,17 @@ def verify_design(spec: Spec, design: TubeDesign, plant: str | None = None, *,
     checks += [c for c in symbolic if not c.name.startswith(("lemma", "deployed"))]
     checks += [c for c in symbolic if c.name.startswith("deployed")]
     # smooth segments (smooth step, cruise): sup |rho_dot| = |to - from| times the
-    # profile's peak of dp/dtau per duration
-    smooth_rates = [abs(b - a) * peak_rate_factor(seg.profile) / seg.duration
-                    for seg in design.segments if seg.profile != TANH
-                    for a, b in zip(seg.lower_from + seg.upper_from, seg.lower_to + seg.upper_to)]
-    rho_rate = max([c.data.get("bound", 0.0) for c in reach_checks] + smooth_rates,
-                   default=0.0)
+    # profile's peak of dp/dtau per duration; at a blended corner two segments move the
+    # tube at once, so their sups add
+    tanh_rate = max([c.data.get("bound", 0.0) for c in reach_checks], default=0.0)
+    segment_rates = [max((abs(b - a) * peak_rate_factor(seg.profile) / seg.duration
+                          for a, b in zip(seg.lower_from + seg.upper_from,
+                                          seg.lower_to + seg.upper_to)), default=0.0)
+                     if seg.profile != TANH else tanh_rate for seg in design.segments]
+    blended = [segment_rates[k] + segment_rates[k + 1]
+               for k, (a, b) in enumerate(zip(design.segments, design.segments[1:]))
+               if b.start < a.end]
+    rho_rate = max([tanh_rate] + segment_rates + blended)
     bump_rate = {p: chk.data.get("bound", np.inf) for p, chk in zip(bumps, bump_checks)}
 
     stage("assumption 2")

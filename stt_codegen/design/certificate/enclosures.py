@@ -148,7 +148,8 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool 
     of an interval with a segment end inside. The reach box's width
     ``rho_U - rho_L = (U_from - L_from) + ((U_to - L_to) - (U_from - L_from)) p(tau)`` is
     monotone on each segment too, so its least value on an interval is at its ends or at a
-    segment boundary inside: a box that moves keeps its width, however far it moves.
+    segment boundary inside: a box that moves keeps its width, however far it moves. A tube
+    that blends corners: :func:`_blended_reach_range`.
 
     Parameters
     ----------
@@ -165,6 +166,8 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool 
     (rate_upper_min, rate_upper_max)), width_min
         Each (K, n).
     """
+    if design.blends_corners:
+        return _blended_reach_range(design, t0, t1, rates)
     edges = sorted({s.start for s in design.segments} | {s.end for s in design.segments})
     peaks = [s.start + s.duration * (_W_STAR / (1.0 + _W_STAR) if s.profile == TANH else 0.5)
              for s in design.segments] if rates else []
@@ -203,6 +206,54 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool 
 
     return (value_range(rho_l), value_range(rho_u), (span(rate_l), span(rate_u)),
             lowest_width)
+
+
+def _blended_reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool):
+    """:func:`reach_range` of a tube that blends corners (two segments move it at once).
+
+    ``rho(t) = rho(t0) + sum_j (to_j - from_j) (p_j(t) - p_j(t0))`` on ``[t0, t1]``, where
+    every profile ``p_j`` is non-decreasing in ``t``: term ``j`` lies between 0 and ``(to_j -
+    from_j) (p_j(t1) - p_j(t0))``, so the interval sum of the terms bounds ``rho``, the width
+    likewise. ``rho_dot = sum_j (to_j - from_j) p_j_dot(t)``, each ``p_j_dot >= 0`` unimodal
+    on its segment and 0 outside: its range on an interval is between its values at the
+    ends (the smaller one, or 0 with an edge of the segment inside) and, with its peak
+    inside, the peak. ``rho(t0)`` is the deployed composition's value; the rest is exact
+    arithmetic on monotone pieces, as :func:`reach_range`'s.
+    """
+    n = design.dimension
+    segs = design.segments
+    rho_l, rho_u, _, _ = reference.reach_tube(design, t0, rates=False)
+    low_l, high_l, low_u, high_u = (rho_l.copy(), rho_l.copy(), rho_u.copy(), rho_u.copy())
+    width = rho_u - rho_l
+    rate = [np.zeros((t0.size, n)) for _ in range(4)]       # lower (min, max), upper (min, max)
+    for seg in segs:
+        p0, d0 = reference.segment_progress(seg, t0)
+        p1, d1 = reference.segment_progress(seg, t1)
+        step = (p1 - p0)[:, None]
+        move_l = np.array(seg.lower_to) - np.array(seg.lower_from)
+        move_u = np.array(seg.upper_to) - np.array(seg.upper_from)
+        for low, high, move in ((low_l, high_l, move_l), (low_u, high_u, move_u)):
+            change = move * step
+            low += np.minimum(change, 0.0)
+            high += np.maximum(change, 0.0)
+        width += np.minimum((move_u - move_l) * step, 0.0)
+        if not rates:
+            continue
+        peak_at = seg.start + seg.duration * (_W_STAR / (1.0 + _W_STAR) if seg.profile == TANH
+                                              else 0.5)
+        top = np.maximum(d0, d1)
+        inside = (t0 < peak_at) & (peak_at < t1)
+        if inside.any():
+            top[inside] = np.maximum(top[inside],
+                                     reference.segment_progress(seg, [peak_at])[1][0])
+        edge = ((t0 < seg.start) & (seg.start < t1)) | ((t0 < seg.end) & (seg.end <= t1))
+        bottom = np.where(edge, 0.0, np.minimum(d0, d1))
+        for k, move in ((0, move_l), (2, move_u)):
+            a, b = move * bottom[:, None], move * top[:, None]
+            rate[k] += np.minimum(a, b)
+            rate[k + 1] += np.maximum(a, b)
+    spans = ((rate[0], rate[1]), (rate[2], rate[3])) if rates else None
+    return (low_l, high_l), (low_u, high_u), spans, width
 
 
 # --------------------------------------------------------------------------- intervals
