@@ -28,7 +28,10 @@ second stage). Deterministic, in this order, the first tube that meets the bound
    (:func:`~.via.timed_moves`); a task's legs are timed and shaped so too, not as cruise
    legs; then the same with **S-curve segments** (the least peak acceleration of the
    profiles, :data:`~stt_codegen.tube.parameters.SCURVE`; neither of the two proves the
-   smaller force on every spec);
+   smaller force on every spec); then both again with **blended corners** (a spec
+   whose obstacles do not move, though some may exist only for a while: each move
+   starting before the previous one ends,
+   :data:`~.via.BLEND_CORNERS`, so the tube passes its via boxes without stopping);
 5. **via points with cruise segments** (the same; not for tasks, whose legs have them):
    the same via boxes and times, each segment's rate rising to 1.25 times its mean, not
    1.875 times.
@@ -57,11 +60,12 @@ from ..spec.loader import Spec
 from ..spec.variants import variant_of
 from ..tube.parameters import CRUISE, SCURVE, SMOOTHSTEP
 from .grid import MAX_TIME_FACTOR, grid_index, grid_value, smallest_passing
+from .deadline import SLOWER_HELPS
 from .failures import FailureKind, advice_wanted, without_advice
 from .certificate.actuator import prove_input_bound
 from .input_bound import InputProof
 from .result import METHOD_PAPER, METHOD_VIA, Design
-from .via import ACCELERATION_TIMING
+from .via import ACCELERATION_TIMING, BLEND_CORNERS, STOP_CORNERS
 from .samples import HORIZON_FACTOR, STEP_BUDGET
 from .windows import SHARPNESS_LADDER
 
@@ -97,15 +101,16 @@ class Candidate:
     proof: InputProof
 
 
-def slower_variants(spec: Spec, default: Design) -> list[tuple[str, Spec]]:
+def slower_variants(spec: Spec, default: Design | None) -> list[tuple[str, Spec]]:
     """The specs to design after the default one, in order, as ``(label, spec)``.
 
     Parameters
     ----------
     spec : Spec
         Without ``[actuator]``.
-    default : Design
-        Its default design.
+    default : Design or None
+        Its default design; ``None`` where it failed (too fast for the rate or the
+        velocity bound): then no softer circumvents, the via points first.
 
     Returns
     -------
@@ -116,28 +121,37 @@ def slower_variants(spec: Spec, default: Design) -> list[tuple[str, Spec]]:
         ``tube.method`` allows them and the default is not already a via tube; then, for
         a variant whose input is a force (``via_timing = "acceleration"``), via points
         timed for the acceleration (tasks too) with ``"smoothstep"`` segments, then with
-        ``"scurve"`` ones; then via
+        ``"scurve"`` ones, then both with blended corners (no obstacle that moves);
+        then via
         points with ``"cruise"`` segments (peak rate 1.25 times the mean, where the smooth
         step's is 1.875), when ``tube.method`` allows via points and the spec has no
         tasks (whose legs are cruise segments already).
     """
     out: list[tuple[str, Spec]] = []
-    if (default.method == METHOD_PAPER and default.tube.circumvents
+    if (default is not None and default.method == METHOD_PAPER and default.tube.circumvents
             and spec.tube.circumvent_sharpness is None and spec.tube.method != METHOD_VIA):
         sharpest = max(c.sharpness for c in default.tube.circumvents)
         out += [(f"softer circumvents (k = {k:g})",
                  replace(spec, tube=replace(spec.tube, circumvent_sharpness=k,
                                             method=METHOD_PAPER)))
                 for k in SHARPNESS_LADDER if k > sharpest]
-    if spec.tube.method in ("auto", METHOD_VIA) and default.method != METHOD_VIA:
+    if spec.tube.method in ("auto", METHOD_VIA) and (default is None
+                                                    or default.method != METHOD_VIA):
         out.append(("via points", replace(spec, tube=replace(spec.tube, method=METHOD_VIA))))
     if (spec.tube.method in ("auto", METHOD_VIA)
             and variant_of(spec).via_timing == ACCELERATION_TIMING):
-        for label, profile in (("via points timed for the force", SMOOTHSTEP),
-                               ("via points timed for the force, S-curve segments", SCURVE)):
-            out.append((label, replace(spec, tube=replace(spec.tube, method=METHOD_VIA,
-                                                          via_timing=ACCELERATION_TIMING,
-                                                          via_profile=profile))))
+        # obstacles that move: their timed vias and detours plan one segment at a time
+        moves = any(ob.motion != "still" for ob in spec.moving_obstacles)
+        blend = [] if moves else [BLEND_CORNERS]
+        for corners in [STOP_CORNERS, *blend]:
+            for label, profile in (("via points timed for the force", SMOOTHSTEP),
+                                   ("via points timed for the force, S-curve segments",
+                                    SCURVE)):
+                out.append((label + (", blended corners" if corners == BLEND_CORNERS else ""),
+                            replace(spec, tube=replace(spec.tube, method=METHOD_VIA,
+                                                       via_timing=ACCELERATION_TIMING,
+                                                       via_profile=profile,
+                                                       via_corners=corners))))
     if spec.tube.method in ("auto", METHOD_VIA) and not spec.tasks:
         out.append(("via points, cruise segments",
                     replace(spec, tube=replace(spec.tube, method=METHOD_VIA,
@@ -169,16 +183,38 @@ def candidates(spec: Spec, design_free: Callable[[Spec], Design],
     Raises
     ------
     DesignError
-        The default design itself fails (no tube at all, whatever the bound).
+        The default design itself fails (no tube at all, whatever the bound), and, where
+        a slower tube may cure its failure (:data:`~.deadline.SLOWER_HELPS`), no slower
+        variant is certified within the bound either: the default's refusal.
     """
     bound = spec.input_bound
     free = replace(spec, input_bound=None)
     report("input bound", 0.0, "input bound: the default design")
-    with reporting(None, (0.0, 0.5)):
-        default = design_free(free)
+    try:
+        with reporting(None, (0.0, 0.5)):
+            default = design_free(free)
+    except DesignError as error:
+        # a tube too fast for the rate or for the velocity bound: a slower one of the
+        # variants below may be certified; else the default's refusal stands
+        if error.kind not in SLOWER_HELPS:
+            raise
+        accepted, tried = _slower_candidates(spec, free, None, [], design_free, prove)
+        if accepted is None:
+            raise
+        return accepted, tried
     tried = [Candidate("default design", default, prove(default, spec))]
     if tried[0].proof.meets(bound):
         return tried[0], tried
+    return _slower_candidates(spec, free, default, tried, design_free, prove)
+
+
+def _slower_candidates(spec: Spec, free: Spec, default: Design | None, tried: list,
+                       design_free: Callable[[Spec], Design], prove: DesignProver
+                       ) -> tuple[Candidate | None, list[Candidate]]:
+    """:func:`candidates` after the default design: each of :func:`slower_variants` (of
+    ``default``, or of a default that failed, ``None``) designed and proved, until one
+    meets ``spec.input_bound``."""
+    bound = spec.input_bound
     softer_failed = False
     slower = slower_variants(free, default)
     for k, (label, variant) in enumerate(slower):

@@ -50,7 +50,7 @@ from ..spec.tasks import STAY, Task
 from ..tube.parameters import CRUISE, ReachSegment, TubeDesign, paper_segments
 from .failures import FailureKind
 from .swept import swept_spec
-from .via import LENGTH_TIMING, ViaPlan, move_weight, plan_via, timed_moves
+from .via import LENGTH_TIMING, ViaPlan, blend_plan, move_weight, plan_via, timed_moves
 
 __all__ = ["FREE_HOLD", "MAX_PLANS", "STAY_LEAD", "TaskPlan", "plan_tasks", "task_plans",
            "task_schedule", "visit_orders"]
@@ -188,7 +188,9 @@ def _leg(plan: ViaPlan, base: TubeDesign, t0: float, t1: float,
     if any(b <= a for a, b in zip(times, times[1:])):
         raise DesignError(f"no time for the via boxes between {t0:g} s and {t1:g} s",
                           kind=FailureKind.TASK, tried=base)
-    return list(replace(plan, times=tuple(times), profiles=profiles).segments(profile))
+    timed = replace(plan, times=tuple(times), profiles=profiles, starts=())
+    return list((blend_plan(timed, spec, profile) if spec is not None else timed)
+                .segments(profile))
 
 
 @dataclass(frozen=True)

@@ -41,9 +41,10 @@ from .failures import FailureKind
 from ..tube.parameters import (CRUISE, SCURVE, SMOOTHSTEP, ReachSegment, TubeDesign,
                                peak_acceleration_factor, peak_rate_factor)
 
-__all__ = ["ACCELERATION_PROFILES", "ACCELERATION_TIMING", "LENGTH_TIMING", "VIA_HALF_WIDTH",
-           "VIA_MARGIN", "VIA_TIMINGS", "ViaPlan", "move_weight", "plan_via",
-           "timed_moves", "via_design"]
+__all__ = ["ACCELERATION_PROFILES", "ACCELERATION_TIMING", "BLEND_CORNERS", "BLEND_SHARES",
+           "CORNER_SHIFTS", "LENGTH_TIMING", "OVERLAP_SAMPLES", "STOP_CORNERS", "VIA_CORNERS",
+           "VIA_HALF_WIDTH", "VIA_MARGIN", "VIA_TIMINGS", "ViaPlan", "blend_plan",
+           "blended_times", "move_weight", "plan_via", "timed_moves", "via_design"]
 
 #: Largest half-width of a via box, state units.
 VIA_HALF_WIDTH = 0.1
@@ -60,6 +61,19 @@ LENGTH_TIMING = "length"
 #: input (the cascade, docs/second-order.md).
 ACCELERATION_TIMING = "acceleration"
 VIA_TIMINGS = (LENGTH_TIMING, ACCELERATION_TIMING)
+#: Via corners: every segment starts when the previous one ends, so the tube stops at
+#: every via box (``rho_dot = 0`` there).
+STOP_CORNERS = "stop"
+#: Via corners: a segment starts before the previous one ends, by a share of the shorter
+#: of the two (:data:`BLEND_SHARES`), where the box's sweep over that overlap keeps
+#: :data:`VIA_MARGIN` from every obstacle; the tube passes the via box without stopping
+#: (:func:`blended_times`).
+BLEND_CORNERS = "blend"
+VIA_CORNERS = (STOP_CORNERS, BLEND_CORNERS)
+#: Shares of the shorter of two consecutive moves during which both may move the box, at
+#: a blended corner, largest first (:func:`blended_times` takes the largest whose sweep is
+#: free). At most 1/2, so that no three segments move the box at once.
+BLEND_SHARES = (0.5, 0.25, 0.125)
 #: The profiles a move timed for the acceleration may take, least peak acceleration first
 #: (peak rates 2, 15/8 and 1.25 times the mean): from the spec's ``tube.via_profile`` on.
 ACCELERATION_PROFILES = (SCURVE, SMOOTHSTEP, CRUISE)
@@ -175,15 +189,20 @@ class ViaPlan:
     lower, upper : tuple of tuple of float
         Box corners ``B_0 .. B_m``, shape (m + 1, n).
     times : tuple of float
-        ``t_0 = 0 < t_1 < ... < t_m <= t_c``, seconds: the tube is in ``B_k`` at ``t_k``.
+        ``t_0 = 0 < t_1 < ... < t_m <= t_c``, seconds: move ``k`` ends at ``t_{k+1}``; with
+        stopped corners the tube is in ``B_k`` at ``t_k``.
     profiles : tuple of str
         Each move's profile where :func:`timed_moves` chose it (``m`` entries), else empty.
+    starts : tuple of float
+        With blended corners (:data:`BLEND_CORNERS`), when each move starts (``m``
+        entries, ``starts[k] <= t_k``); empty: move ``k`` starts at ``t_k``.
     """
 
     lower: tuple[tuple[float, ...], ...]
     upper: tuple[tuple[float, ...], ...]
     times: tuple[float, ...]
     profiles: tuple[str, ...] = ()
+    starts: tuple[float, ...] = ()
 
     def segments(self, profile: str = SMOOTHSTEP) -> tuple[ReachSegment, ...]:
         """The reach segments between consecutive via boxes.
@@ -198,7 +217,8 @@ class ViaPlan:
         -------
         tuple of ReachSegment
         """
-        return tuple(ReachSegment(self.times[k], self.times[k + 1], self.lower[k],
+        starts = self.starts or self.times[:-1]
+        return tuple(ReachSegment(starts[k], self.times[k + 1], self.lower[k],
                                   self.upper[k], self.lower[k + 1], self.upper[k + 1],
                                   self.profiles[k] if self.profiles else profile)
                      for k in range(len(self.times) - 1))
@@ -446,21 +466,217 @@ def _shortcut(path: list, nodes: dict, obstacles: np.ndarray, space) -> list:
 
 
 def _timed(path: list, nodes: dict, prescribed_time: float, spec: Spec) -> ViaPlan:
-    centres = [0.5 * (nodes[k][0] + nodes[k][1]) for k in path]
+    lower = tuple(tuple(float(v) for v in nodes[k][0]) for k in path)
+    upper = tuple(tuple(float(v) for v in nodes[k][1]) for k in path)
+    return blend_plan(_stopped_plan(lower, upper, prescribed_time, spec), spec)
+
+
+def blend_plan(plan: ViaPlan, spec: Spec, profile: str | None = None) -> ViaPlan:
+    """``plan`` with its corners blended where ``spec.tube.via_corners`` asks it, over the
+    same time ``[plan.times[0], plan.times[-1]]``.
+
+    The via boxes of corners that cannot be blended by the largest share are moved away
+    from the obstacles first (:func:`_roomier_corners`); then :func:`blended_times`. The
+    moves then last longer than the stopped plan's (the overlaps share the time), so the
+    plan is timed again (:func:`timed_moves`, each move's profile chosen for its own
+    duration) for that much time, blended again, and scaled back into the plan's time.
+
+    Parameters
+    ----------
+    plan : ViaPlan
+        Stopped corners, timed by :func:`timed_moves` over its time.
+    spec : Spec
+        Its ``tube.via_corners``, obstacles, state space and timing.
+    profile : str, optional
+        The moves' profile where the plan has not chosen each one's; default
+        ``spec.tube.via_profile``.
+
+    Returns
+    -------
+    ViaPlan
+        ``plan`` itself with ``"stop"`` or fewer than two moves; else with ``starts``.
+    """
+    if spec.tube.via_corners != BLEND_CORNERS or len(plan.times) < 3:
+        return plan
+    profile = profile or spec.tube.via_profile
+    n = len(plan.lower[0])
+    obstacles = np.array([[b.lower, b.upper] for b in spec.obstacle_boxes()]).reshape(-1, 2, n)
+    space = (np.array(spec.state_space.lower), np.array(spec.state_space.upper))
+    first, last = plan.times[0], plan.times[-1]
+    plan = _roomier_corners(plan, obstacles, space, spec, profile)
+    starts, ends = blended_times(plan, obstacles, space, profile)
+    stretch = (ends[0] - starts[0]) / (plan.times[1] - plan.times[0])
+    if stretch > 1.0:
+        plan = _stopped_plan(plan.lower, plan.upper, (last - first) * stretch, spec, first,
+                             profile)
+        starts, ends = blended_times(plan, obstacles, space, profile)
+    scale = (last - first) / (ends[-1] - first)
+
+    def into(v: float) -> float:
+        return first + (v - first) * scale
+
+    return replace(plan, times=(first,) + tuple(into(v) for v in ends[:-1]) + (last,),
+                   starts=tuple(into(v) for v in starts))
+
+
+def _stopped_plan(lower: tuple, upper: tuple, duration: float, spec: Spec,
+                  start: float = 0.0, profile: str | None = None) -> ViaPlan:
+    """The via boxes ``lower``, ``upper`` timed by :func:`timed_moves` over ``[start, start +
+    duration]``, every corner stopped."""
+    centres = [0.5 * (np.array(lo) + np.array(hi)) for lo, hi in zip(lower, upper)]
+    profile = profile or spec.tube.via_profile
     durations, profiles = timed_moves(spec, [b - a for a, b in zip(centres, centres[1:])],
-                                      prescribed_time, spec.tube.via_profile)
-    times = [0.0]
+                                      duration, profile)
+    times = [start]
     for seconds in durations:
         times.append(times[-1] + seconds)
-    times[-1] = prescribed_time
+    times[-1] = start + duration
     # a zero-length move (same centre, other size) still needs a positive duration
     for k in range(1, len(times)):
         if times[k] <= times[k - 1]:
             times[k] = math.nextafter(times[k - 1], math.inf)
-    lower = tuple(tuple(float(v) for v in nodes[k][0]) for k in path)
-    upper = tuple(tuple(float(v) for v in nodes[k][1]) for k in path)
-    chosen = tuple(profiles) if any(p != spec.tube.via_profile for p in profiles) else ()
-    return ViaPlan(lower, upper, tuple(times), chosen)
+    chosen = tuple(profiles) if any(p != profile for p in profiles) else ()
+    return ViaPlan(tuple(lower), tuple(upper), tuple(times), chosen)
+
+
+#: Shifts of a via box away from the inside of its corner that :func:`_roomier_corners`
+#: tries, as shares of the shorter of the corner's two moves, least first.
+CORNER_SHIFTS = (0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4)
+
+
+def _roomier_corners(plan: ViaPlan, obstacles: np.ndarray, space, spec: Spec,
+                     profile: str) -> ViaPlan:
+    """``plan`` with each via box whose corner cannot be blended by the largest share moved
+    away from the inside of its turn (along ``u_in - u_out``, the difference of the unit
+    directions of its two moves), by the least of :data:`CORNER_SHIFTS` at which both
+    moves stay free (:func:`_free` of their bounding boxes) and the blend by the largest
+    share of :data:`BLEND_SHARES` is free; re-timed after every move of a box. A box no
+    shift frees stays where it is (and :func:`blended_times` takes a smaller share or
+    stops there)."""
+    lower, upper = [np.array(b) for b in plan.lower], [np.array(b) for b in plan.upper]
+    for j in range(1, len(lower) - 1):
+        durations = np.diff(np.array(plan.times, dtype=float))
+        profiles = plan.profiles or (profile,) * len(durations)
+        widest = BLEND_SHARES[0] * min(durations[j - 1], durations[j])
+        if _overlap_free(plan, j - 1, durations, profiles, widest, obstacles, space):
+            continue
+        centre = [0.5 * (lo + hi) for lo, hi in zip(lower, upper)]
+        into, out = centre[j] - centre[j - 1], centre[j + 1] - centre[j]
+        if min(np.linalg.norm(into), np.linalg.norm(out)) == 0.0:
+            continue
+        away = into / np.linalg.norm(into) - out / np.linalg.norm(out)
+        if np.linalg.norm(away) < 1e-9:
+            continue
+        away = away / np.linalg.norm(away)
+        reach = min(np.linalg.norm(into), np.linalg.norm(out))
+        for shift in CORNER_SHIFTS:
+            lo, hi = lower[j] + shift * reach * away, upper[j] + shift * reach * away
+            swept_lo = np.array([np.minimum(lower[j - 1], lo), np.minimum(lo, lower[j + 1])])
+            swept_hi = np.array([np.maximum(upper[j - 1], hi), np.maximum(hi, upper[j + 1])])
+            if not _free(swept_lo, swept_hi, obstacles, space).all():
+                continue
+            trial_lower = [*lower[:j], lo, *lower[j + 1:]]
+            trial_upper = [*upper[:j], hi, *upper[j + 1:]]
+            trial = _stopped_plan(tuple(tuple(float(v) for v in b) for b in trial_lower),
+                                  tuple(tuple(float(v) for v in b) for b in trial_upper),
+                                  plan.times[-1] - plan.times[0], spec, plan.times[0],
+                                  profile)
+            durations = np.diff(np.array(trial.times, dtype=float))
+            profiles = trial.profiles or (profile,) * len(durations)
+            widest = BLEND_SHARES[0] * min(durations[j - 1], durations[j])
+            if _overlap_free(trial, j - 1, durations, profiles, widest, obstacles, space):
+                lower, upper, plan = trial_lower, trial_upper, trial
+                break
+    return plan
+
+
+def blended_times(plan: ViaPlan, obstacles: np.ndarray, space,
+                  profile: str = SMOOTHSTEP) -> tuple[tuple, tuple]:
+    """Start and end of every move of ``plan`` with its corners blended, within its time.
+
+    Each move keeps its share of the time; the next one starts before it ends, by the
+    largest of :data:`BLEND_SHARES` (of the shorter of the two moves) over which the
+    box's sweep, widened by :data:`VIA_MARGIN`, lies in the state space and misses every
+    obstacle (:func:`_overlap_free`); by nothing where none does (the tube stops there).
+    The sweep depends on the shares only, not on the time scale, so the overlaps are
+    chosen first and then every duration is stretched by one factor until the last move
+    ends where the plan's did.
+
+    Parameters
+    ----------
+    plan : ViaPlan
+        Stopped corners (``plan.starts`` empty), ``m >= 2`` moves.
+    obstacles : ndarray, shape (B, 2, n)
+        Lower and upper corners of the obstacle boxes.
+    space : (ndarray, ndarray)
+        The state space's lower and upper corners.
+    profile : str
+        The moves' profile where the plan has not chosen each one's.
+
+    Returns
+    -------
+    starts, ends : tuple of float
+        ``m`` entries each, seconds; ``ends[-1]`` is the plan's last time.
+    """
+    times, m = plan.times, len(plan.times) - 1
+    durations = np.diff(np.array(times, dtype=float))
+    profiles = plan.profiles or (profile,) * m
+    overlap = np.zeros(m - 1)
+    for k in range(m - 1):
+        for fraction in BLEND_SHARES:
+            share = fraction * min(durations[k], durations[k + 1])
+            if share > 0.0 and _overlap_free(plan, k, durations, profiles, share, obstacles,
+                                             space):
+                overlap[k] = share
+                break
+    stretch = float(durations.sum()) / float(durations.sum() - overlap.sum())
+    starts, ends, clock = [], [], times[0]
+    for k in range(m):
+        starts.append(clock)
+        ends.append(clock + durations[k] * stretch)
+        clock = ends[-1] - (overlap[k] * stretch if k < m - 1 else 0.0)
+    ends[-1] = times[-1]
+    for k in range(1, m):      # rounding: the order TubeDesign asks for kept
+        starts[k] = max(starts[k], math.nextafter(starts[k - 1], math.inf),
+                        ends[k - 2] if k >= 2 else times[0])
+    return tuple(float(v) for v in starts), tuple(float(v) for v in ends)
+
+
+#: Samples of an overlap in :func:`_overlap_free`.
+OVERLAP_SAMPLES = 128
+
+
+def _overlap_free(plan: ViaPlan, k: int, durations: np.ndarray, profiles, share: float,
+                  obstacles: np.ndarray, space) -> bool:
+    """Whether the box's sweep while moves ``k`` and ``k + 1`` overlap by ``share`` seconds
+    keeps :data:`VIA_MARGIN` from every obstacle and stays in the state space.
+
+    On a clock where move ``k`` lasts ``[0, T_k]`` and move ``k + 1`` starts at ``T_k -
+    share``, the box is ``B_k + (B_{k+1} - B_k) p_k + (B_{k+2} - B_{k+1}) p_{k+1}``. On
+    each of :data:`OVERLAP_SAMPLES` pieces of the overlap every progress is monotone, so
+    each bound lies between its value at the piece's start and that value plus the sum
+    of each move's share of the piece (with its sign): a box that holds the sweep.
+    """
+    from ..tube import reference
+    lower, upper = np.array(plan.lower[k:k + 3]), np.array(plan.upper[k:k + 3])
+    first = ReachSegment(0.0, float(durations[k]), plan.lower[k], plan.upper[k],
+                         plan.lower[k + 1], plan.upper[k + 1], profiles[k])
+    begin = float(durations[k]) - share
+    second = ReachSegment(begin, begin + float(durations[k + 1]), plan.lower[k + 1],
+                          plan.upper[k + 1], plan.lower[k + 2], plan.upper[k + 2],
+                          profiles[k + 1])
+    t = np.linspace(begin, float(durations[k]), OVERLAP_SAMPLES + 1)
+    p1 = reference.segment_progress(first, t)[0][:, None]
+    p2 = reference.segment_progress(second, t)[0][:, None]
+    bounds = []
+    for box in (lower, upper):
+        move1, move2 = box[1] - box[0], box[2] - box[1]
+        at = box[0] + move1 * p1 + move2 * p2
+        d1, d2 = move1 * np.diff(p1, axis=0), move2 * np.diff(p2, axis=0)
+        bounds.append((at[:-1] + np.minimum(d1, 0.0) + np.minimum(d2, 0.0),
+                       at[:-1] + np.maximum(d1, 0.0) + np.maximum(d2, 0.0)))
+    (low, _), (_, high) = bounds
+    return bool(_free(low, high, obstacles, space).all())
 
 
 def via_design(spec: Spec, base: TubeDesign) -> TubeDesign:

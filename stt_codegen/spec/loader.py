@@ -189,6 +189,12 @@ class TubeParameters:
         (the same peak acceleration on every move). Not a key of the file: ``"length"`` as
         loaded; the design of a second-order spec within ``[actuator]`` tries
         ``"acceleration"`` (its input is a force).
+    via_corners : {"stop", "blend"}
+        Whether the via-point tube stops at every via box (``"stop"``: one segment at a
+        time) or passes it, each segment starting before the previous one ends
+        (``"blend"``: blended corners, ``design/via.py``). Not a key of the file:
+        ``"stop"`` as loaded; the design of a second-order spec within ``[actuator]``
+        tries ``"blend"`` after the tubes that stop.
     """
 
     delta_b: float
@@ -200,6 +206,7 @@ class TubeParameters:
     method: str = "auto"
     via_profile: str = "smoothstep"
     via_timing: str = "length"
+    via_corners: str = "stop"
 
 
 @dataclass(frozen=True)
