@@ -371,9 +371,9 @@ def _stay_then_target(prescribed_time: float) -> dict:
 @pytest.mark.slow
 def test_s_curve_legs_keep_a_bound_the_smooth_step_legs_exceed(monkeypatch):
     """At 28 s (1.4 times stlpy's horizon) the accepted design's moving legs are S-curves
-    (peak acceleration 4.76 D / T^2); with the S-curve candidate taken away the design is
-    refused for the force: the smooth-step legs (5.77 D / T^2) are proved to ask more than
-    0.5 N."""
+    (peak acceleration 4.76 D / T^2); with the S-curve candidates and the blended corners
+    taken away the design is refused for the force: the smooth-step legs (5.77 D / T^2)
+    stopped at their corners are proved to ask more than 0.5 N."""
     import stt_codegen.design.actuator as actuator
     spec = stt.Spec.from_dict(_stay_then_target(28.0))
     design = stt.design_tube(spec)
@@ -383,7 +383,7 @@ def test_s_curve_legs_keep_a_bound_the_smooth_step_legs_exceed(monkeypatch):
     real = actuator.slower_variants
     monkeypatch.setattr(actuator, "slower_variants", lambda spec, default: [
         (label, variant) for label, variant in real(spec, default)
-        if variant.tube.via_profile != "scurve"])
+        if variant.tube.via_profile != "scurve" and variant.tube.via_corners != "blend"])
     with pytest.raises(DesignError) as info:
         stt.design_tube(dataclasses.replace(spec))
     assert info.value.kind is FailureKind.INPUT_BOUND
