@@ -107,3 +107,30 @@ def built(case: str, precision: str, cc: str, root: str) -> CLib:
     folder = write(Path(root) / f"{case}-{precision}-{cc}", files_of(case, precision))
     lib = compile_shared(folder, spec.c_name, cc, precision)
     return CLib(lib, spec.c_name, design.dimension, precision)
+
+
+def self_test(folder: Path, prefix: str, cc: str, precision: str) -> str:
+    """Build ``<prefix>.c`` and its self-test in ``folder`` with every warning an error,
+    run it, assert that every check passed, and return its last line."""
+    exe = folder / "selftest"
+    proc = subprocess.run([cc, *flags(precision), f"{prefix}.c", f"{prefix}_selftest.c", "-o",
+                           str(exe), "-lm"], cwd=folder, capture_output=True, text=True)
+    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
+    run = subprocess.run([str(exe)], capture_output=True, text=True)
+    last = run.stdout.strip().splitlines()[-1]
+    assert last.endswith(" passed, 0 failed") and run.returncode == 0, run.stdout[-2000:]
+    return last
+
+
+def misra_findings(cppcheck: str, folder: Path, prefix: str) -> list[tuple[str, str, str, str]]:
+    """cppcheck's MISRA C:2012 findings on ``<prefix>.c`` in ``folder``, as ``(file, line,
+    check id, source line)``; asserts that cppcheck ran and reported something."""
+    proc = subprocess.run([cppcheck, "--enable=all", "--addon=misra", "--std=c99",
+                           "--suppress=missingIncludeSystem", "--quiet",
+                           "--template={file}:{line}:{id}", f"{prefix}.c"],
+                          cwd=folder, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    findings = [line.split(":") for line in proc.stderr.splitlines() if line.count(":") >= 2]
+    assert findings, "cppcheck reported nothing at all: the deviations must show up"
+    return [(name, line, check, (folder / name).read_text().splitlines()[int(line) - 1])
+            for name, line, check in findings]

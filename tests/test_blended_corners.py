@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from codegen_helpers import COMPILERS, CLib, compile_shared, write
+from codegen_helpers import COMPILERS, CLib, compile_shared, misra_findings, self_test, write
 from sampling import random_points
 from test_model_equivalence import casadi_outputs
 from test_tube_segments import piecewise_design
@@ -257,19 +257,8 @@ def _blended_files(precision: str) -> tuple:
 def test_blended_c_builds_strictly_and_passes_its_self_test(precision, tmp_path):
     """Every warning an error, gcc or clang; the self-test compares the C with the numpy
     oracle's vectors (the single-precision bound for float)."""
-    import subprocess
-    from codegen_helpers import flags
     spec, files = _blended_files(precision)
-    folder = write(tmp_path, files)
-    prefix = spec.c_name
-    exe = tmp_path / "selftest"
-    proc = subprocess.run([COMPILERS[-1], *flags(precision), f"{prefix}.c",
-                           f"{prefix}_selftest.c", "-o", str(exe), "-lm"], cwd=folder,
-                          capture_output=True, text=True)
-    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
-    run = subprocess.run([str(exe)], capture_output=True, text=True)
-    last = run.stdout.strip().splitlines()[-1]
-    assert last.endswith(" passed, 0 failed") and run.returncode == 0, run.stdout[-2000:]
+    self_test(write(tmp_path, files), spec.c_name, COMPILERS[-1], precision)
 
 
 @pytest.mark.parametrize("precision", ["double", "single"])
@@ -278,7 +267,6 @@ def test_blended_c_has_only_the_listed_misra_deviations(precision, tmp_path):
     the deviations of every generated C (tests/test_codegen_misra.py)."""
     import re
     import shutil
-    import subprocess
     from test_codegen_misra import DEVIATIONS
     cppcheck = shutil.which("cppcheck")
     if cppcheck is None:
@@ -287,14 +275,6 @@ def test_blended_c_has_only_the_listed_misra_deviations(precision, tmp_path):
     prefix = spec.c_name
     folder = write(tmp_path, {k: v for k, v in files.items()
                               if k in (f"{prefix}.c", f"{prefix}.h")})
-    proc = subprocess.run([cppcheck, "--enable=all", "--addon=misra", "--std=c99",
-                           "--suppress=missingIncludeSystem", "--quiet",
-                           "--template={file}:{line}:{id}", f"{prefix}.c"],
-                          cwd=folder, capture_output=True, text=True, timeout=600)
-    assert proc.returncode == 0, proc.stderr
-    findings = [line.split(":") for line in proc.stderr.splitlines() if line.count(":") >= 2]
-    assert findings, "cppcheck reported nothing at all: the deviations must show up"
-    for name, line, check in findings:
-        text = (folder / name).read_text().splitlines()[int(line) - 1]
+    for name, line, check, text in misra_findings(cppcheck, folder, prefix):
         assert any(d[0] == check and re.search(d[1], text) for d in DEVIATIONS), \
             f"{name}:{line}: {check} not on the deviation list: {text!r}"

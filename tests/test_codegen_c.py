@@ -7,7 +7,7 @@ import subprocess
 
 import numpy as np
 import pytest
-from codegen_helpers import COMPILERS, built, files_of, flags, write
+from codegen_helpers import COMPILERS, built, files_of, flags, self_test, write
 from conftest import CASES, designed, model_of
 from sampling import random_points
 from test_model_equivalence import casadi_outputs
@@ -105,14 +105,7 @@ def test_strict_build_and_self_test_pass(cc, precision, tmp_path):
     case = "omnirobot-s1" if cc == "gcc" else "omnirobot-s3"
     spec, _, _ = designed(case)
     folder = write(tmp_path, files_of(case, precision))
-    prefix = spec.c_name
-    exe = tmp_path / "selftest"
-    proc = subprocess.run([cc, *flags(precision), f"{prefix}.c", f"{prefix}_selftest.c", "-o",
-                           str(exe), "-lm"], cwd=folder, capture_output=True, text=True)
-    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
-    run = subprocess.run([str(exe)], capture_output=True, text=True)
-    last = run.stdout.strip().splitlines()[-1]
-    assert last.endswith(" passed, 0 failed") and run.returncode == 0, run.stdout[-2000:]
+    last = self_test(folder, spec.c_name, cc, precision)
     assert int(last.split()[0]) >= 56 * 10 + 7
 
 

@@ -16,10 +16,9 @@ from __future__ import annotations
 
 import re
 import shutil
-import subprocess
 
 import pytest
-from codegen_helpers import write
+from codegen_helpers import misra_findings, write
 from hard_helpers import hard_case, variant_params
 
 CPPCHECK = shutil.which("cppcheck")
@@ -40,17 +39,9 @@ def test_cppcheck_misra_findings_are_the_listed_deviations(variant, precision, t
     prefix = case.prefix
     folder = write(tmp_path, {k: v for k, v in case.files(precision).items()
                               if k in (f"{prefix}.c", f"{prefix}.h")})
-    proc = subprocess.run([CPPCHECK, "--enable=all", "--addon=misra", "--std=c99",
-                           "--suppress=missingIncludeSystem", "--quiet",
-                           "--template={file}:{line}:{id}", f"{prefix}.c"],
-                          cwd=folder, capture_output=True, text=True, timeout=600)
-    assert proc.returncode == 0, proc.stderr
-    findings = [line.split(":") for line in proc.stderr.splitlines() if line.count(":") >= 2]
-    assert findings, "cppcheck reported nothing at all: the deviations below must show up"
     seen = set()
     unused = set()
-    for name, line, check in findings:
-        text = (folder / name).read_text().splitlines()[int(line) - 1]
+    for name, line, check, text in misra_findings(CPPCHECK, folder, prefix):
         allowed = [d for d in DEVIATIONS if d[0] == check and re.search(d[1], text)]
         assert allowed, f"{name}:{line}: {check} not on the deviation list: {text!r}"
         seen.add(check)

@@ -5,12 +5,11 @@ simulation's verdict, the generated C, and 3-D as 2-D."""
 from __future__ import annotations
 
 import json
-import subprocess
 from dataclasses import replace
 
 import numpy as np
 import pytest
-from codegen_helpers import COMPILERS, flags, write
+from codegen_helpers import COMPILERS, self_test, write
 from conftest import TASK_CASES, design_of
 
 from stt_codegen.codegen.generate import Options, generate_files
@@ -299,13 +298,6 @@ def test_generated_c_of_a_task_example_passes_its_vectors(precision, tmp_path):
     files = generate_files(design.spec, design.tube, Options(("c",), precision))
     folder = write(tmp_path, files)
     prefix = design.spec.c_name
-    exe = tmp_path / "selftest"
-    proc = subprocess.run([COMPILERS[0], *flags(precision), f"{prefix}.c",
-                           f"{prefix}_selftest.c", "-o", str(exe), "-lm"], cwd=folder,
-                          capture_output=True, text=True)
-    assert proc.returncode == 0 and proc.stderr == "", proc.stderr
-    run = subprocess.run([str(exe)], capture_output=True, text=True)
-    last = run.stdout.strip().splitlines()[-1]
-    assert last.endswith(" passed, 0 failed") and run.returncode == 0, run.stdout[-2000:]
+    self_test(folder, prefix, COMPILERS[0], precision)
     # the task design's many segments are tables in the C, not new code
     assert len(design.tube.segments) > 3
