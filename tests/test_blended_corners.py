@@ -278,3 +278,20 @@ def test_blended_c_has_only_the_listed_misra_deviations(precision, tmp_path):
     for name, line, check, text in misra_findings(cppcheck, folder, prefix):
         assert any(d[0] == check and re.search(d[1], text) for d in DEVIATIONS), \
             f"{name}:{line}: {check} not on the deviation list: {text!r}"
+
+
+@pytest.mark.embedded
+def test_a_blended_cascade_runs_on_the_cortex_m4f_like_the_host() -> None:
+    """The drone room (its design blends corners) with the single-precision C on the
+    emulated Cortex-M4F: satisfied, never outside either tube, arriving and passing the
+    pillars as the double C on the host does."""
+    from stt_codegen.embedded.cascade_loop import run_cascade_embedded
+    design = stt.design_tube(stt.load_spec(str(Path(__file__).parent / "specs"
+                                               / "drone-room.toml")))
+    assert design.tube.blends_corners
+    report = run_cascade_embedded(design)
+    assert report["satisfied"], report
+    assert report["outside_position"] == report["outside_velocity"] == report["invalid"] == 0
+    host = stt.simulate(design, backend="c")
+    assert abs(report["reach_time"] - host.reach_time) <= 0.01
+    assert abs(report["min_clearance"] - host.min_obstacle_clearance) <= 1e-3
