@@ -295,3 +295,11 @@ def test_a_blended_cascade_runs_on_the_cortex_m4f_like_the_host() -> None:
     host = stt.simulate(design, backend="c")
     assert abs(report["reach_time"] - host.reach_time) <= 0.01
     assert abs(report["min_clearance"] - host.min_obstacle_clearance) <= 1e-3
+
+
+def test_verify_passes_a_blended_design_with_the_rates_added():
+    """``verify`` certifies the blended tube again and bounds ``sup |rho_dot|`` by the sum
+    of the two segments' at a blended corner (the adaptive law's checks take it)."""
+    design = stt.design_tube(blended_spec())
+    report = stt.verify(design)
+    assert report.passed, [c.name for c in report.checks if not c.passed]

@@ -28,10 +28,10 @@ second stage). Deterministic, in this order, the first tube that meets the bound
    (:func:`~.via.timed_moves`); a task's legs are timed and shaped so too, not as cruise
    legs; then the same with **S-curve segments** (the least peak acceleration of the
    profiles, :data:`~stt_codegen.tube.parameters.SCURVE`; neither of the two proves the
-   smaller force on every spec); then both again with **blended corners** (a spec
-   whose obstacles do not move, though some may exist only for a while: each move
-   starting before the previous one ends,
-   :data:`~.via.BLEND_CORNERS`, so the tube passes its via boxes without stopping);
+   smaller force on every spec); then both again with **blended corners**
+   (:data:`~.via.BLEND_CORNERS`: each move starting before the previous one ends, so the
+   tube passes its via boxes without stopping; not where an obstacle moves, though one
+   that exists only for a while is allowed);
 5. **via points with cruise segments** (the same; not for tasks, whose legs have them):
    the same via boxes and times, each segment's rate rising to 1.25 times its mean, not
    1.875 times.
@@ -121,11 +121,10 @@ def slower_variants(spec: Spec, default: Design | None) -> list[tuple[str, Spec]
         ``tube.method`` allows them and the default is not already a via tube; then, for
         a variant whose input is a force (``via_timing = "acceleration"``), via points
         timed for the acceleration (tasks too) with ``"smoothstep"`` segments, then with
-        ``"scurve"`` ones, then both with blended corners (no obstacle that moves);
-        then via
-        points with ``"cruise"`` segments (peak rate 1.25 times the mean, where the smooth
-        step's is 1.875), when ``tube.method`` allows via points and the spec has no
-        tasks (whose legs are cruise segments already).
+        ``"scurve"`` ones, then both with blended corners (no obstacle that moves); then
+        via points with ``"cruise"`` segments (peak rate 1.25 times the mean, where the
+        smooth step's is 1.875), when ``tube.method`` allows via points and the spec has
+        no tasks (whose legs are cruise segments already).
     """
     out: list[tuple[str, Spec]] = []
     if (default is not None and default.method == METHOD_PAPER and default.tube.circumvents
