@@ -144,8 +144,7 @@ def test_via_plan_blends_only_the_corners_whose_sweep_is_free():
             apart = np.any((hi + VIA_MARGIN <= np.array(box.lower))
                            | (lo - VIA_MARGIN >= np.array(box.upper)), axis=1)
             assert apart.all()
-    # a stopped corner is one whose blend would have swept an obstacle: the same spec
-    # with corners stopped has as many moves, and the tube at t_c is the same target
+    # the same spec with its corners stopped: as many moves, none overlapping
     stopped = stt.design_tube(replace(spec, tube=replace(spec.tube, via_corners="stop")))
     assert len(stopped.tube.segments) == len(segs)
     assert not stopped.tube.blends_corners
@@ -303,3 +302,18 @@ def test_verify_passes_a_blended_design_with_the_rates_added():
     design = stt.design_tube(blended_spec())
     report = stt.verify(design)
     assert report.passed, [c.name for c in report.checks if not c.passed]
+
+
+@pytest.mark.slow
+def test_a_blended_cascade_runs_alike_on_every_backend() -> None:
+    """The cascade's own templates (C and Python) compose the blended tube too: the drone
+    room's closed loop is the same, bit for bit, with its C, its Python module and the
+    CasADi model, and satisfied."""
+    design = stt.design_tube(stt.load_spec(str(Path(__file__).parent / "specs"
+                                               / "drone-room.toml")))
+    assert design.tube.blends_corners
+    runs = [stt.simulate(design, backend=b) for b in ("casadi", "c", "python")]
+    assert all(r.satisfied for r in runs)
+    for run in runs[1:]:
+        assert np.array_equal(run.trajectory.x, runs[0].trajectory.x)
+        assert np.array_equal(run.trajectory.u, runs[0].trajectory.u)

@@ -553,12 +553,16 @@ def _roomier_corners(plan: ViaPlan, obstacles: np.ndarray, space, spec: Spec,
     share of :data:`BLEND_SHARES` is free; re-timed after every move of a box. A box no
     shift frees stays where it is (and :func:`blended_times` takes a smaller share or
     stops there)."""
+    def widest_free(trial: ViaPlan, j: int) -> bool:
+        # corner j blended by the largest share on trial's timing
+        durations = np.diff(np.array(trial.times, dtype=float))
+        profiles = trial.profiles or (profile,) * len(durations)
+        widest = BLEND_SHARES[0] * min(durations[j - 1], durations[j])
+        return _overlap_free(trial, j - 1, durations, profiles, widest, obstacles, space)
+
     lower, upper = [np.array(b) for b in plan.lower], [np.array(b) for b in plan.upper]
     for j in range(1, len(lower) - 1):
-        durations = np.diff(np.array(plan.times, dtype=float))
-        profiles = plan.profiles or (profile,) * len(durations)
-        widest = BLEND_SHARES[0] * min(durations[j - 1], durations[j])
-        if _overlap_free(plan, j - 1, durations, profiles, widest, obstacles, space):
+        if widest_free(plan, j):
             continue
         centre = [0.5 * (lo + hi) for lo, hi in zip(lower, upper)]
         into, out = centre[j] - centre[j - 1], centre[j + 1] - centre[j]
@@ -581,10 +585,7 @@ def _roomier_corners(plan: ViaPlan, obstacles: np.ndarray, space, spec: Spec,
                                   tuple(tuple(float(v) for v in b) for b in trial_upper),
                                   plan.times[-1] - plan.times[0], spec, plan.times[0],
                                   profile)
-            durations = np.diff(np.array(trial.times, dtype=float))
-            profiles = trial.profiles or (profile,) * len(durations)
-            widest = BLEND_SHARES[0] * min(durations[j - 1], durations[j])
-            if _overlap_free(trial, j - 1, durations, profiles, widest, obstacles, space):
+            if widest_free(trial, j):
                 lower, upper, plan = trial_lower, trial_upper, trial
                 break
     return plan
