@@ -27,7 +27,7 @@ from stt_codegen.errors import SpecError
 from stt_codegen.runtime.compiled import load_python_module
 from stt_codegen.tube import reference as R
 from stt_codegen.tube.model import build_model
-from stt_codegen.tube.parameters import CRUISE, SCURVE, SMOOTHSTEP, TANH, TubeDesign
+from stt_codegen.tube.parameters import CRUISE, GLIDE, SCURVE, SMOOTHSTEP, TANH, TubeDesign
 
 TOLERANCE = 1e-12
 
@@ -60,7 +60,7 @@ def test_segments_may_overlap_two_at_a_time_only():
         replace(design, segments=(first, replace(second, lower_from=(0.0, 0.0)), third))
 
 
-@pytest.mark.parametrize("profile", [SMOOTHSTEP, TANH, CRUISE, SCURVE])
+@pytest.mark.parametrize("profile", [SMOOTHSTEP, TANH, CRUISE, SCURVE, GLIDE])
 def test_model_and_reference_add_the_started_segment(profile):
     design = blended(profile)
     edges = np.array([0.0, 1.2, 2.0, 4.0, 5.0, 8.0])
@@ -82,7 +82,7 @@ def test_model_and_reference_add_the_started_segment(profile):
     assert np.allclose(rho_l, np.array(first.lower_from) + move_1 * p1 + move_2 * p2)
 
 
-@pytest.mark.parametrize("profile", [SMOOTHSTEP, CRUISE, SCURVE])
+@pytest.mark.parametrize("profile", [SMOOTHSTEP, CRUISE, SCURVE, GLIDE])
 def test_reach_tube_and_rate_stay_continuous_at_blended_corners(profile):
     design = blended(profile)
     for when in (1.2, 2.0, 4.0, 5.0):
@@ -94,7 +94,7 @@ def test_reach_tube_and_rate_stay_continuous_at_blended_corners(profile):
     assert np.max(np.abs(R.reach_tube(piecewise_design(profile), [2.0])[2])) == 0.0
 
 
-@pytest.mark.parametrize("profile", [SMOOTHSTEP, TANH, SCURVE])
+@pytest.mark.parametrize("profile", [SMOOTHSTEP, TANH, SCURVE, GLIDE])
 def test_enclosures_hold_the_blended_tube_and_its_rate(profile):
     """Dense samples of every interval lie in reach_range's bounds (to rounding); an
     enclosure that ignored the started segment (the box at the interval's ends only)

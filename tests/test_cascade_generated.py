@@ -195,12 +195,12 @@ def test_cppcheck_misra_findings_are_the_listed_deviations(tmp_path, case, preci
 @pytest.mark.skipif(CC is None, reason="no C compiler (install gcc or clang)")
 @pytest.mark.parametrize("case, bounded, profile", [
     *((case, bounded, None) for case in CASES for bounded in (False, True)),
-    ("second-order-s1", True, "scurve")])
+    ("second-order-s1", True, "scurve"), ("second-order-s1", True, "glide")])
 def test_table_driven_c_is_bit_identical_to_casadi(tmp_path, case, bounded, profile) -> None:
     """The table-driven double C of a bundled design (the quadrotor's has two circumvents on
     one bound: the F_nu pieces; with ``bounded``, an actuator bound near the median ``|u|``;
-    with ``profile``, its reach segments of that profile, the S-curve of the via tubes
-    timed for a force) equals CasADi's ``cascade_step`` bit for bit at 150 random points
+    with ``profile``, its reach segments of that profile, the S-curve and the glide of the
+    via tubes timed for a force) equals CasADi's ``cascade_step`` bit for bit at 150 random points
     inside both tubes, and at the same points with the velocity pushed out of its tube; the
     committed C is the generation without a bound."""
     import dataclasses

@@ -205,7 +205,8 @@ def _plain_reach_tube(design, t):
 
 
 @pytest.mark.parametrize("profiles", [("tanh",), ("smoothstep",), ("cruise",), ("scurve",),
-                                      ("tanh", "smoothstep", "cruise", "scurve")])
+                                      ("glide",), ("tanh", "smoothstep", "cruise", "scurve",
+                                                   "glide")])
 @pytest.mark.parametrize("fast_math", [False, True])
 def test_reach_tube_is_the_plain_segment_by_segment_one(profiles, fast_math):
     """reach_tube (each point with its own segment's start and end in one evaluation, the
@@ -244,8 +245,8 @@ def test_segments_progress_is_each_segment_on_its_own_row(fast_math):
     spec = arena_spec("paper", 0, 11)
     via = via_design(spec, base_design(spec))
     rng = np.random.default_rng(3)
-    for profiles in (("tanh",), ("smoothstep", "cruise", "scurve"),
-                     ("tanh", "smoothstep", "cruise", "scurve")):
+    for profiles in (("tanh",), ("smoothstep", "cruise", "scurve", "glide"),
+                     ("tanh", "smoothstep", "cruise", "scurve", "glide")):
         segments = [dataclasses.replace(seg, profile=profiles[k % len(profiles)])
                     for k, seg in enumerate(via.segments)]
         t = np.array([np.linspace(seg.start - 1.0, seg.end + 1.0, 13) for seg in segments])
@@ -300,7 +301,7 @@ def test_reach_range_is_the_dense_range_over_every_edge(rates):
     via = via_design(spec, base_design(spec))
     rng = np.random.default_rng(5)
     edges = [seg.start for seg in via.segments] + [via.segments[-1].end]
-    for profiles in (("tanh",), ("smoothstep", "cruise", "scurve", "tanh")):
+    for profiles in (("tanh",), ("smoothstep", "cruise", "scurve", "glide", "tanh")):
         tube = dataclasses.replace(via, segments=tuple(
             dataclasses.replace(seg, profile=profiles[k % len(profiles)])
             for k, seg in enumerate(via.segments)))

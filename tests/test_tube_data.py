@@ -112,19 +112,24 @@ def test_one_library_runs_other_tubes_of_the_same_dimension(several):
 
 def test_an_s_curve_tube_is_refused_by_the_data_form(several):
     """The data form runs the profiles law (13)'s designs produce (``DATA_PROFILES``): a tube
-    of S-curve segments (the cascade's) is refused when packed on the host, naming the
-    field; in the C, its code (3) fails the check on its segments (code 5); the same tube
-    with cruise segments passes it."""
+    of S-curve or glide segments (the cascade's) is refused when packed on the host, naming
+    the field; in the C, their codes (3, 4) fail the check on its segments (code 5); the
+    same tube with cruise segments passes it."""
     from stt_codegen.codegen.tube_data import DATA_PROFILES
     from stt_codegen.tube.pieces import PROFILE_NAMES
     _, library = several
-    assert "scurve" not in DATA_PROFILES and "cruise" in DATA_PROFILES
+    assert "scurve" not in DATA_PROFILES and "glide" not in DATA_PROFILES
+    assert "cruise" in DATA_PROFILES
     assert PROFILE_NAMES[:len(DATA_PROFILES)] == DATA_PROFILES      # the same codes
     with pytest.raises(stt.SpecError, match="tube_data: the tube has scurve segments"):
         library.pack(piecewise_design("scurve"))
+    with pytest.raises(stt.SpecError, match="tube_data: the tube has glide segments"):
+        library.pack(piecewise_design("glide"))
     tube = library.pack(piecewise_design("cruise"))
     assert library.check(tube) == 0
     tube.segments[1].profile = 3                           # PROFILE_NAMES.index("scurve")
+    assert library.check(tube) == 5
+    tube.segments[1].profile = 4                           # PROFILE_NAMES.index("glide")
     assert library.check(tube) == 5
 
 

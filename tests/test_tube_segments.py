@@ -9,7 +9,7 @@ import pytest
 
 from stt_codegen.tube import reference as R
 from stt_codegen.tube.model import build_model
-from stt_codegen.tube.parameters import (CRUISE, CRUISE_RAMP, LOWER, SCURVE, SCURVE_TURN,
+from stt_codegen.tube.parameters import (CRUISE, CRUISE_RAMP, GLIDE, LOWER, SCURVE, SCURVE_TURN,
                                          SMOOTHSTEP, TANH, UPPER, Circumvent, ReachSegment,
                                          TubeDesign, peak_rate_factor)
 
@@ -65,7 +65,7 @@ def test_reach_tube_and_its_rate_are_continuous_at_every_via_point(profile):
     assert np.max(np.abs(R.reach_tube(design, [1.0])[2])) > 0.1
 
 
-@pytest.mark.parametrize("profile", [SMOOTHSTEP, CRUISE, SCURVE])
+@pytest.mark.parametrize("profile", [SMOOTHSTEP, CRUISE, SCURVE, GLIDE])
 def test_smooth_profile_peak_rate_and_its_second_derivative(profile):
     """The CasADi model's p_dot peaks at peak_rate_factor times the mean (1.875 for the
     smooth step, 1 / (1 - ramp) = 1.25 for the cruise, held over the whole cruise, 2 for

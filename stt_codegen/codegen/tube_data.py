@@ -18,7 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import SpecError
-from ..tube.parameters import SCURVE, TubeDesign
+from ..tube.parameters import GLIDE, SCURVE, TubeDesign
 from ..tube.pieces import PROFILE_NAMES
 from .tables import PARAMETERS, Tables
 
@@ -204,10 +204,11 @@ def python_names(data: bool) -> dict[str, object]:
 
 
 #: The reach profiles a tube as data may use, coded as in ``PROFILE_NAMES`` (which lists
-#: them first): those law (13)'s designs produce. The S-curve is the cascade's (via points
-#: timed for a force), which has no tube as data; its body would cost 1.8 kB of Cortex-M4F
-#: flash. A segment of another profile fails the data's check (code 5).
-DATA_PROFILES = tuple(p for p in PROFILE_NAMES if p != SCURVE)
+#: them first): those law (13)'s designs produce. The S-curve and the glide are the
+#: cascade's (via points timed for a force), which has no tube as data; the S-curve's body
+#: alone would cost 1.8 kB of Cortex-M4F flash. A segment of another profile fails the
+#: data's check (code 5).
+DATA_PROFILES = tuple(p for p in PROFILE_NAMES if p not in (SCURVE, GLIDE))
 
 
 def profile_codes(capacity: TubeCapacity | None) -> dict[str, int]:

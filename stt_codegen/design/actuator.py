@@ -27,8 +27,9 @@ second stage). Deterministic, in this order, the first tube that meets the bound
    ``state_space.velocity_bound`` slowed to it, as a cruise where that is cheaper
    (:func:`~.via.timed_moves`); a task's legs are timed and shaped so too, not as cruise
    legs; then the same with **S-curve segments** (the least peak acceleration of the
-   profiles, :data:`~stt_codegen.tube.parameters.SCURVE`; neither of the two proves the
-   smaller force on every spec); then both again with **blended corners**
+   profiles, :data:`~stt_codegen.tube.parameters.SCURVE`, and a move whose S-curve would
+   pass the velocity bound a glide, :data:`~stt_codegen.tube.parameters.GLIDE`; neither of
+   the two proves the smaller force on every spec); then both again with **blended corners**
    (:data:`~.via.BLEND_CORNERS`: each move starting before the previous one ends, so the
    tube passes its via boxes without stopping; not where an obstacle moves, though one
    that exists only for a while is allowed);

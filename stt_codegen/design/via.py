@@ -38,7 +38,7 @@ import numpy as np
 from ..errors import DesignError
 from ..spec.loader import Spec
 from .failures import FailureKind
-from ..tube.parameters import (CRUISE, SCURVE, SMOOTHSTEP, ReachSegment, TubeDesign,
+from ..tube.parameters import (CRUISE, GLIDE, SCURVE, SMOOTHSTEP, ReachSegment, TubeDesign,
                                peak_acceleration_factor, peak_rate_factor)
 
 __all__ = ["ACCELERATION_PROFILES", "ACCELERATION_TIMING", "BLEND_CORNERS", "BLEND_SHARES",
@@ -75,8 +75,11 @@ VIA_CORNERS = (STOP_CORNERS, BLEND_CORNERS)
 #: free). At most 1/2, so that no three segments move the box at once.
 BLEND_SHARES = (0.5, 0.25, 0.125)
 #: The profiles a move timed for the acceleration may take, least peak acceleration first
-#: (peak rates 2, 15/8 and 1.25 times the mean): from the spec's ``tube.via_profile`` on.
-ACCELERATION_PROFILES = (SCURVE, SMOOTHSTEP, CRUISE)
+#: (peak accelerations 4.76, 5.38, 5.77 and 9.38, peak rates 2, 5/3, 15/8 and 1.25 times the
+#: mean): from the spec's ``tube.via_profile`` on. The glide's are both below the smooth
+#: step's, so a move of a plan from ``"scurve"`` on never takes the smooth step; a plan from
+#: ``"smoothstep"`` on takes neither the S-curve nor the glide.
+ACCELERATION_PROFILES = (SCURVE, GLIDE, SMOOTHSTEP, CRUISE)
 
 
 def move_weight(length: float, timing: str) -> float:

@@ -177,12 +177,13 @@ class TubeParameters:
     method : {"paper", "via", "auto"}
         The reach tube: the paper's single tube (eq. (4)), via-point segments, or the
         paper's first and via points when it has no certified design (default).
-    via_profile : {"smoothstep", "cruise", "scurve"}
+    via_profile : {"smoothstep", "cruise", "scurve", "glide"}
         The via-point segments' profile (``tube/parameters.py``). Not a key of the file:
         ``"smoothstep"`` as loaded; the design within ``[actuator]`` tries ``"smoothstep"``
         and then ``"scurve"`` (a lower peak acceleration) with the ``"acceleration"``
-        timing, and ``"cruise"`` (a lower peak rate), when the other tubes exceed the
-        bound.
+        timing (which gives a move ``"glide"`` segments where its S-curve would pass the
+        velocity bound), and ``"cruise"`` (a lower peak rate), when the other tubes exceed
+        the bound.
     via_timing : {"length", "acceleration"}
         How the via-point segments (and the legs of ``[[tasks]]``) share the time
         (``design/via.py``): in proportion to each move's length, or to its square root

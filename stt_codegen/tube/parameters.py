@@ -13,7 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CRUISE", "CRUISE_RAMP", "Circumvent", "E_MAX", "GAMMA_D_MIN", "LOWER", "NEWTON_ITERATIONS", "NEWTON_TINY",
+__all__ = ["CRUISE", "CRUISE_RAMP", "Circumvent", "E_MAX", "GAMMA_D_MIN", "GLIDE", "GLIDE_RAMP",
+           "GLIDE_TURN", "LOWER", "NEWTON_ITERATIONS", "NEWTON_TINY",
            "PERIOD_TOLERANCE", "ReachSegment", "SCURVE", "SCURVE_TURN", "SMOOTHSTEP",
            "STATUS_INPUT_CLAMPED", "STATUS_INVALID_INPUT", "STATUS_OFF_PERIOD", "STATUS_OK",
            "STATUS_OUTSIDE_TUBE", "STATUS_OUTSIDE_VELOCITY_TUBE", "Status", "TANH", "TubeDesign", "UPPER",
@@ -164,13 +165,30 @@ SCURVE = "scurve"
 #: The S-curve's turns of the acceleration, each this share of the segment's duration: the
 #: largest jerk, ``A / SCURVE_TURN`` = 59.5, is then within the quintic smooth step's 60.
 SCURVE_TURN = 0.08
-PROFILES = (TANH, SMOOTHSTEP, CRUISE, SCURVE)
+#: Profile of a reach-tube segment: a jerk-limited glide, the S-curve with a cruise between
+#: its two halves. Over the first :data:`GLIDE_RAMP` of the segment the acceleration
+#: ``p_ddot`` rises linearly from 0 to ``A`` over :data:`GLIDE_TURN`, holds ``A``, and returns
+#: linearly to 0 over :data:`GLIDE_TURN`, so the rate reaches ``V = 1 / (1 - GLIDE_RAMP)``
+#: times the mean; the rate holds ``V``, and the last :data:`GLIDE_RAMP` mirrors the first.
+#: ``p``, ``p_dot``, ``p_ddot`` continuous, zero slope and curvature at both ends; peak rate
+#: 5/3 times the mean and peak acceleration ``A = V / (GLIDE_RAMP - GLIDE_TURN)`` (5.38) times
+#: ``1 / duration^2``: both below the quintic smooth step's (15/8 and 5.77), so a move bound
+#: by a velocity bound is shorter with it for less force (docs/design.md, "Glides").
+GLIDE = "glide"
+#: The glide's ramps, each this share of the segment's duration.
+GLIDE_RAMP = 0.4
+#: The glide's turns of the acceleration, each this share of the segment's duration: the
+#: largest jerk, ``A / GLIDE_TURN`` = 59.7, is then within the quintic smooth step's 60.
+GLIDE_TURN = 0.09
+PROFILES = (TANH, SMOOTHSTEP, CRUISE, SCURVE, GLIDE)
 
 
 #: ``(sup dp/dtau, sup |d^2p/dtau^2|)`` of each smooth profile (docstrings below).
 _PEAKS = {SMOOTHSTEP: (1.875, 10.0 / math.sqrt(3.0)),
           CRUISE: (1.0 / (1.0 - CRUISE_RAMP), 1.5 / (CRUISE_RAMP * (1.0 - CRUISE_RAMP))),
-          SCURVE: (2.0, 4.0 / (1.0 - 2.0 * SCURVE_TURN))}
+          SCURVE: (2.0, 4.0 / (1.0 - 2.0 * SCURVE_TURN)),
+          GLIDE: (1.0 / (1.0 - GLIDE_RAMP),
+                  1.0 / ((1.0 - GLIDE_RAMP) * (GLIDE_RAMP - GLIDE_TURN)))}
 
 
 def _peaks(profile: str, what: str) -> tuple[float, float]:
@@ -185,7 +203,7 @@ def peak_rate_factor(profile: str) -> float:
 
     Parameters
     ----------
-    profile : {"smoothstep", "cruise", "scurve"}
+    profile : {"smoothstep", "cruise", "scurve", "glide"}
 
     Returns
     -------
@@ -194,7 +212,8 @@ def peak_rate_factor(profile: str) -> float:
         ``1 / (1 - CRUISE_RAMP)`` for ``"cruise"`` (the cruise's rate: the two ramps
         together cover half their length at the mean rate's ``1 / (1 - CRUISE_RAMP)``
         multiple, the cruise the rest); 2 for ``"scurve"`` (``A (1/2 - SCURVE_TURN)`` at
-        ``tau = 1/2``, whatever the turn).
+        ``tau = 1/2``, whatever the turn); ``1 / (1 - GLIDE_RAMP)`` (5/3) for ``"glide"``
+        (its cruise's rate, as the cruise's).
 
     Raises
     ------
@@ -211,7 +230,8 @@ def peak_acceleration_factor(profile: str) -> float:
     ``10 / sqrt(3)`` (5.77) for ``"smoothstep"`` (at ``tau = 1/2 -+ sqrt(3)/6``), ``1.5 / (a
     (1 - a))`` (9.38) for ``"cruise"`` (the cubic smooth step's slope 3/2 over a ramp of
     share ``a = CRUISE_RAMP`` up to the rate ``1 / (1 - a)``), ``4 / (1 - 2 q)`` (4.76) for
-    ``"scurve"`` (``q = SCURVE_TURN``); ``ValueError`` for ``"tanh"`` (unbounded near its
+    ``"scurve"`` (``q = SCURVE_TURN``), ``1 / ((1 - r) (r - q))`` (5.38) for ``"glide"`` (``r =
+    GLIDE_RAMP``, ``q = GLIDE_TURN``); ``ValueError`` for ``"tanh"`` (unbounded near its
     end) or an unknown profile.
     """
     return _peaks(profile, "acceleration")[1]

@@ -60,8 +60,8 @@ from functools import lru_cache
 
 import casadi as ca
 
-from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, NEWTON_TINY, SCURVE,
-                         SCURVE_TURN, SMOOTHSTEP, TANH)
+from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, GLIDE, GLIDE_RAMP, GLIDE_TURN,
+                         NEWTON_TINY, SCURVE, SCURVE_TURN, SMOOTHSTEP, TANH)
 
 __all__ = ["EXP_ARGUMENT_BOUND", "PROFILE_NAMES", "alpha_rate", "blend", "bump", "candidates",
            "conflict", "deployed_pieces", "error_transform", "error_transform_expression",
@@ -80,7 +80,7 @@ SMOOTH_SKIP_BASE = 34.0
 _SKIP_SCALE = 30.91
 
 #: Profile codes of the segment table, in the order of ``PROFILE_NAMES``.
-PROFILE_NAMES = (TANH, SMOOTHSTEP, CRUISE, SCURVE)
+PROFILE_NAMES = (TANH, SMOOTHSTEP, CRUISE, SCURVE, GLIDE)
 
 
 def _sym(*names: str):
@@ -100,7 +100,11 @@ def progress_expression(profile: str, t, start, end):
     (:data:`~.parameters.SCURVE`, turn share ``q``, peak acceleration ``A = 4 / (1 - 2
     q)``): ``A tau^3 / (6 q)`` up to ``q``, ``A (tau^2 / 2 - q tau / 2 + q^2 / 6)`` up to
     ``1/2 - q``, ``1/2 - 2 w + A w^3 / (6 q)`` (``w = 1/2 - tau``) up to ``1/2``, and on the
-    second half the same mirrored, ``1 - p(1 - tau)``.
+    second half the same mirrored, ``1 - p(1 - tau)``; ``"glide"`` (:data:`~.parameters.GLIDE`,
+    ramp share ``r``, turn share ``q``, peak rate ``V = 1 / (1 - r)``, peak acceleration ``A =
+    V / (r - q)``), at ``u = min(tau, 1 - tau)``: ``A u^3 / (6 q)`` up to ``q``, ``A (u^2 / 2 -
+    q u / 2 + q^2 / 6)`` up to ``r - q``, ``V r / 2 - V w + A w^3 / (6 q)`` (``w = r - u``) up
+    to ``r``, ``V (u - r / 2)`` after; ``1 - p(1 - tau)`` on the second half.
 
     Raises
     ------
@@ -112,11 +116,13 @@ def progress_expression(profile: str, t, start, end):
         gap = ca.if_else(before, end - t, 1.0)
         elapsed = t - start
         return ca.if_else(before, ca.if_else(elapsed < 0.0, 0.0, ca.tanh(elapsed / gap)), 1.0)
-    if profile not in (SMOOTHSTEP, CRUISE, SCURVE):
+    if profile not in (SMOOTHSTEP, CRUISE, SCURVE, GLIDE):
         raise ValueError(f"unknown reach segment profile {profile!r}")
     tau = ca.fmin(ca.fmax((t - start) / (end - start), 0.0), 1.0)
     if profile == SMOOTHSTEP:
         return tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau)
+    if profile == GLIDE:
+        return _glide(tau)
     if profile == SCURVE:
         q = SCURVE_TURN
         peak, turn = 4.0 / (1.0 - 2.0 * q), 6.0 * q
@@ -140,6 +146,36 @@ def progress_expression(profile: str, t, start, end):
     return ca.if_else(tau < a, ramp(tau / a),
                       ca.if_else(tau <= 1.0 - a, v * (tau - 0.5 * a),
                                  1.0 - ramp((1.0 - tau) / a)))
+
+
+def _glide(tau):
+    """The ``"glide"`` profile at ``tau`` in ``[0, 1]`` (:func:`progress_expression`), one
+    branch per piece on ``tau`` (as the S-curve's), the second half ``1 - p(1 - tau)``."""
+    r, q = GLIDE_RAMP, GLIDE_TURN
+    top = 1.0 / (1.0 - r)
+    peak, turn = top / (r - q), 6.0 * q
+
+    def rising(u):
+        return peak * u * u * u / turn
+
+    def holding(u):
+        return peak * (0.5 * u * u - 0.5 * q * u + q * q / 6.0)
+
+    def easing(u):        # w = r - u from the ramp's end
+        w = r - u
+        return 0.5 * top * r - top * w + peak * w * w * w / turn
+
+    def cruising(u):
+        return top * (u - 0.5 * r)
+
+    u = 1.0 - tau
+    return ca.if_else(tau <= q, rising(tau),
+                      ca.if_else(tau <= r - q, holding(tau),
+                      ca.if_else(tau <= r, easing(tau),
+                      ca.if_else(tau <= 0.5, cruising(tau),
+                      ca.if_else(tau <= 1.0 - r, 1.0 - cruising(u),
+                      ca.if_else(tau <= 1.0 - (r - q), 1.0 - easing(u),
+                      ca.if_else(tau <= 1.0 - q, 1.0 - holding(u), 1.0 - rising(u))))))))
 
 
 @lru_cache(maxsize=None)

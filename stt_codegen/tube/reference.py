@@ -20,7 +20,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, LOWER, SCURVE, SCURVE_TURN,
+from .parameters import (CRUISE, CRUISE_RAMP, E_MAX, GAMMA_D_MIN, GLIDE, GLIDE_RAMP, GLIDE_TURN,
+                         LOWER, SCURVE, SCURVE_TURN,
                          SMOOTHSTEP, STATUS_INPUT_CLAMPED, STATUS_OK, STATUS_OUTSIDE_TUBE, TANH,
                          ReachSegment, TubeDesign, step_status)
 
@@ -155,7 +156,11 @@ def segment_progress(segment: ReachSegment, t) -> tuple[Array, Array]:
     (1/2 - u) / q`` up to the middle (``u = min(tau, 1 - tau)``, ``q = SCURVE_TURN``, ``A = 4
     / (1 - 2 q)``, negated on the second half), so the rate is ``A u^2 / (2 q)``, ``A (u -
     q / 2)``, ``2 - A (1/2 - u)^2 / (2 q)``; ``p`` its integral, and ``1 - p(1 - tau)`` on
-    the second half.
+    the second half; ``"glide"``: the acceleration is ``A u / q`` for ``u < q``, ``A`` up to
+    ``r - q``, ``A (r - u) / q`` up to ``r`` and 0 after (``r = GLIDE_RAMP``, ``q =
+    GLIDE_TURN``, ``V = 1 / (1 - r)``, ``A = V / (r - q)``, negated on the second half), so the
+    rate rises to ``V`` over the ramp and holds it; ``p`` its integral, and ``1 - p(1 - tau)``
+    on the second half.
 
     Parameters
     ----------
@@ -226,6 +231,8 @@ def _progress(profile: str, t: Array, start, end, rate: bool = True) -> tuple[Ar
         return p, p_dot
     if profile == SCURVE:
         return _scurve(tau, duration, rate)
+    if profile == GLIDE:
+        return _glide(tau, duration, rate)
     if profile != CRUISE:
         raise ValueError(f"unknown reach segment profile {profile!r}")
     a = CRUISE_RAMP
@@ -259,6 +266,29 @@ def _scurve(tau: Array, duration, rate: bool) -> tuple[Array, Array]:
         return p, None
     slope = np.where(rising, peak * u * u / (2.0 * q),
                      np.where(turning, 2.0 - peak * w * w / (2.0 * q), peak * (u - 0.5 * q)))
+    return p, slope / duration
+
+
+def _glide(tau: Array, duration, rate: bool) -> tuple[Array, Array]:
+    """The ``"glide"`` profile at ``tau`` in ``[0, 1]`` (:func:`segment_progress`): the rate
+    of each piece of the first ramp integrated by hand, the cruise at the rate ``V``."""
+    r, q = GLIDE_RAMP, GLIDE_TURN
+    top = 1.0 / (1.0 - r)
+    peak = top / (r - q)
+    first = tau <= 0.5
+    u = np.where(first, tau, 1.0 - tau)
+    rising, holding, easing = u <= q, u <= r - q, u <= r
+    w = r - u
+    half = np.where(rising, peak * u**3 / (6.0 * q),
+                    np.where(holding, peak * (0.5 * u * u - 0.5 * q * u + q * q / 6.0),
+                             np.where(easing, top * (0.5 * r - w) + peak * w**3 / (6.0 * q),
+                                      top * (u - 0.5 * r))))
+    p = np.where(first, half, 1.0 - half)
+    if not rate:
+        return p, None
+    slope = np.where(rising, peak * u * u / (2.0 * q),
+                     np.where(holding, peak * (u - 0.5 * q),
+                              np.where(easing, top - peak * w * w / (2.0 * q), top)))
     return p, slope / duration
 
 
