@@ -60,7 +60,7 @@ from ..spec.deadline import (ending_windows, fixed_in_time, later_advice, moved_
 from ..spec.loader import Spec
 from ..spec.variants import variant_of
 from ..tube.parameters import CRUISE, SCURVE, SMOOTHSTEP
-from .grid import MAX_TIME_FACTOR, grid_index, grid_value, smallest_passing
+from .grid import MAX_TIME_FACTOR, grid_index, grid_value, half_step_below, smallest_passing
 from .deadline import SLOWER_HELPS
 from .failures import FailureKind, advice_wanted, without_advice
 from .certificate.actuator import prove_input_bound
@@ -397,7 +397,7 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     needs = f"[{needs}]" + (f" ({spec.input_unit})" if unit else "")
     if works is not None:
         message += (f"; prescribed_time = {works:g} s works (the smallest to two significant "
-                    f"digits{moved_words(spec)}), or input_bound = {needs} with this "
+                    f"digits or a half step{moved_words(spec)}), or input_bound = {needs} with this "
                     "prescribed_time")
     else:
         message += f"; {why}; input_bound = {needs} works with this prescribed_time"
@@ -416,8 +416,9 @@ def _round_up(value: float, digits: int = 3) -> float:
 
 def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
                              prove: DesignProver, ratio: float) -> tuple[float | None, str]:
-    """The smallest ``prescribed_time`` (two significant digits) at which the procedure of
-    :func:`candidates` meets the bound, above the spec's ``t_c`` (which fails).
+    """The smallest ``prescribed_time`` (two significant digits, or the half step below:
+    :func:`~.grid.half_step_below`) at which the procedure of :func:`candidates` meets the
+    bound, above the spec's ``t_c`` (which fails).
 
     Law (13)'s peak input falls about as ``1 / t_c`` while the tube's speed dominates it,
     so each try grows ``t_c`` by the best peak-to-bound ratio found so far (between 1.25
@@ -454,14 +455,17 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
     cap = min(MAX_TIME_FACTOR * spec.prescribed_time,
               STEP_BUDGET / (HORIZON_FACTOR * spec.rate_hz))
 
-    def passes(index: int) -> tuple[bool, float]:
-        trial = with_deadline(spec, grid_value(index))
+    def passes_at(value: float) -> tuple[bool, float]:
+        trial = with_deadline(spec, value)
         try:
             accepted, tried = candidates(trial, design_free, prove)
         except (DesignError, SpecError):
             return False, math.inf
         best = min((c.proof.ratio(spec.input_bound) for c in tried), default=math.inf)
         return accepted is not None, best
+
+    def passes(index: int) -> tuple[bool, float]:
+        return passes_at(grid_value(index))
 
     low = grid_index(spec.prescribed_time)
     if grid_value(low) > spec.prescribed_time:
@@ -485,4 +489,6 @@ def smallest_prescribed_time(spec: Spec, design_free: Callable[[Spec], Design],
     # the bisection asks verdicts only: each shape's check stops where its input passes
     # the bound (the verdicts are the same), and no failing trial searches for advice
     with without_advice():
-        return grid_value(smallest_passing(lambda i: passes(i)[0], low, high)), ""
+        found = smallest_passing(lambda i: passes(i)[0], low, high)
+        return half_step_below(lambda value: passes_at(value)[0], found,
+                               spec.prescribed_time), ""

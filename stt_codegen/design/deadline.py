@@ -24,7 +24,7 @@ from ..errors import DesignError, number_text
 from ..spec.deadline import fixed_in_time, later_advice, moved_words, with_deadline
 from ..spec.loader import Spec
 from .failures import FailureKind, without_advice
-from .grid import MAX_TIME_FACTOR, grid_index, grid_value, smallest_passing
+from .grid import MAX_TIME_FACTOR, grid_index, grid_value, half_step_below, smallest_passing
 from .result import Design
 
 __all__ = ["SLOWER_HELPS", "certified_time", "deadline_refusal"]
@@ -70,8 +70,9 @@ def deadline_refusal(spec: Spec, error: DesignError,
 def certified_time(spec: Spec, search: Callable[[Spec], Design]) -> float | None:
     """The smallest ``prescribed_time`` above the spec's that ``search`` certifies (the spec
     moved there by :func:`~stt_codegen.spec.deadline.with_deadline`), on the two-digit
-    grid: doubling up to :data:`~.grid.MAX_TIME_FACTOR` times ``t_c``, then a bisection down to neighbouring grid values (:func:`~.grid.smallest_passing`; each
-    trial a design, its advice off).
+    grid: doubling up to :data:`~.grid.MAX_TIME_FACTOR` times ``t_c``, then a bisection down
+    to neighbouring grid values (:func:`~.grid.smallest_passing`), then the half step below
+    the one found (:func:`~.grid.half_step_below`); each trial a design, its advice off.
 
     Parameters
     ----------
@@ -86,13 +87,16 @@ def certified_time(spec: Spec, search: Callable[[Spec], Design]) -> float | None
         Seconds, a time ``search`` certified; ``None`` when none up to ``MAX_TIME_FACTOR
         t_c`` is.
     """
-    def passes(index: int) -> bool:
+    def passes_at(value: float) -> bool:
         try:
             with without_advice():            # the verdict only
-                search(with_deadline(spec, grid_value(index)))
+                search(with_deadline(spec, value))
         except DesignError:
             return False
         return True
+
+    def passes(index: int) -> bool:
+        return passes_at(grid_value(index))
 
     low = grid_index(spec.prescribed_time)
     factor, high = 2.0, None
@@ -104,4 +108,5 @@ def certified_time(spec: Spec, search: Callable[[Spec], Design]) -> float | None
         low, factor = index, 2.0 * factor
     if high is None:
         return None
-    return grid_value(smallest_passing(passes, low, high))
+    return half_step_below(passes_at, smallest_passing(passes, low, high),
+                           spec.prescribed_time)

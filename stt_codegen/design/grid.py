@@ -3,7 +3,9 @@
 A searched rate (Hz) or prescribed time (s) is reported as the smallest number
 ``m 10^e`` (``10 <= m <= 99``) that passes, so that a refusal names a value a user can
 type and two runs name the same one. The grid is indexed by integers (``90 e + m - 10``)
-so that a search can bisect on it.
+so that a search can bisect on it. A searched prescribed time is then tried once more at the
+half step below it (:func:`half_step_below`: 37.5 s between 37 and 38 s), since a time
+is compared with a horizon, where 3 % matters.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-__all__ = ["MAX_TIME_FACTOR", "grid_index", "grid_value", "smallest_passing"]
+__all__ = ["MAX_TIME_FACTOR", "grid_index", "grid_value", "half_step_below", "smallest_passing"]
 
 #: The ``prescribed_time`` search tries up to this many times the spec's ``t_c``.
 MAX_TIME_FACTOR = 16.0
@@ -79,3 +81,36 @@ def smallest_passing(passes: Callable[[int], bool], low: int, high: int) -> int:
         else:
             low = mid
     return high
+
+
+def half_step_below(passes: Callable[[float], bool], index: int, above: float) -> float:
+    """``grid_value(index)``, or the value halfway to the grid value below it where that lies
+    above ``above`` and passes (one more trial).
+
+    Parameters
+    ----------
+    passes : callable
+        ``passes(value) -> bool``.
+    index : int
+        A passing index whose predecessor fails (what :func:`smallest_passing` returns).
+    above : float
+        The half step is tried only above this (the value known to fail).
+
+    Returns
+    -------
+    float
+        A value at which ``passes`` held: the half step, three significant digits, or
+        ``grid_value(index)``.
+
+    Examples
+    --------
+    >>> half_step_below(lambda value: value >= 37.2, grid_index(38.0), 37.0)
+    37.5
+    >>> half_step_below(lambda value: value >= 37.6, grid_index(38.0), 37.0)
+    38.0
+    """
+    value = grid_value(index)
+    half = float(f"{0.5 * (grid_value(index - 1) + value):.3g}")
+    if above < half < value and passes(half):
+        return half
+    return value
