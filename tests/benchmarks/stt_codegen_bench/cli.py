@@ -159,7 +159,8 @@ def _cmd_stl(args: argparse.Namespace) -> int:
                            solver=None if args.solver == "none" else args.solver,
                            specs=Path(args.specs) if args.specs else None,
                            orders={"both": ("first", "second")}.get(args.order,
-                                                                    (args.order,)))
+                                                                    (args.order,)),
+                           disturbance=args.disturbance)
     if args.json:
         report = {"rows": [{k: v for k, v in row.items() if k != "spec"}
                            for row in report["rows"]], "order_note": report["order_note"]}
@@ -348,6 +349,9 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                    help="a double integrator as the first-order position law (its input the "
                         "velocity), as itself (the cascade, the example's |u| and |v|), or "
                         "both (default: %(default)s)")
+    p.add_argument("--disturbance", type=float, default=None, metavar="W",
+                   help="plant.disturbance_amplitude of every spec written: 0 is stlpy's "
+                        "model, which has none (default: the project's, 0.1)")
     add_json_argument(p)
     p.set_defaults(handler=_cmd_stl)
 

@@ -198,14 +198,18 @@ def _row(name: str, variant: str) -> dict[str, Any]:
 
 
 def _design_and_judge(name: str, variant: str, doc: dict[str, Any], sc: Any,
-                      output_dim: int) -> dict[str, Any]:
+                      output_dim: int, prescribed_time: float | None = None
+                      ) -> dict[str, Any]:
     from stt_codegen.design.search import design_tube
     from stt_codegen.runtime.simulate import simulate
+    from stt_codegen.spec.deadline import with_deadline
     from stt_codegen.spec.loader import Spec
     row = _row(name, variant)
     row["input_bound"] = doc.get("actuator", {}).get("input_bound")
     try:
         spec = Spec.from_dict(doc)
+        if prescribed_time is not None:       # a named time: the spec moved there, as named
+            spec = with_deadline(spec, prescribed_time)
     except SpecError as exc:
         row["reason"] = f"not written: {exc}"
         return row
@@ -231,12 +235,15 @@ def _design_and_judge(name: str, variant: str, doc: dict[str, Any], sc: Any,
     return row
 
 
-def _second_order_rows(name: str, horizon: int | None) -> list[dict[str, Any]]:
+def _second_order_rows(name: str, horizon: int | None, disturbance: float | None = None
+                       ) -> list[dict[str, Any]]:
     """A double integrator as itself (the cascade at the example's ``|u|`` and ``|v|``);
-    when refused naming a ``prescribed_time``, the scenario again with the horizon ``T``
-    (whole steps) that covers it, and the named time over stlpy's horizon as ``ratio``."""
+    when refused naming a ``prescribed_time``, the same spec moved to that time (as the
+    refusal names it: :func:`~stt_codegen.spec.deadline.with_deadline`), judged on the
+    scenario with the horizon ``T`` (whole steps) that covers it, and the named time over
+    stlpy's horizon as ``ratio``."""
     sc = make_scenario(name, horizon)
-    doc = scenario_spec(name, horizon, order="second")
+    doc = scenario_spec(name, horizon, order="second", disturbance=disturbance)
     rows = [_design_and_judge(name, "second order", doc, sc, sc.GetSystem().p)]
     named = rows[0]["advice"].get("prescribed_time")
     if named is not None:
@@ -244,14 +251,14 @@ def _second_order_rows(name: str, horizon: int | None) -> list[dict[str, Any]]:
         rows[0]["ratio"] = named / (sc.T * dt)
         longer = int(math.ceil(named / dt - 1e-9))
         sc_long = make_scenario(name, longer)
-        rows.append(_design_and_judge(name, f"second order, T = {longer}",
-                                      scenario_spec(name, longer, order="second"), sc_long,
-                                      sc_long.GetSystem().p))
+        rows.append(_design_and_judge(name, f"second order, t_c = {named:g} s", doc,
+                                      sc_long, sc_long.GetSystem().p, prescribed_time=named))
     return rows
 
 
 def run_stl_scenario(name: str, horizon: int | None = None, solver: str | None = "scipy",
-                     orders: tuple[str, ...] = ("first", "second")) -> list[dict[str, Any]]:
+                     orders: tuple[str, ...] = ("first", "second"),
+                     disturbance: float | None = None) -> list[dict[str, Any]]:
     """One scenario: its spec as written and, if that is refused by the bound, without it;
     a double integrator also as itself (second order).
 
@@ -267,12 +274,15 @@ def run_stl_scenario(name: str, horizon: int | None = None, solver: str | None =
     orders : tuple of str
         ``"first"``: the spec as written (a double integrator as the first-order position
         law); ``"second"``: a double integrator as itself (:func:`_second_order_rows`).
+    disturbance : float, optional
+        ``plant.disturbance_amplitude`` of every spec written (0: stlpy's model); ``None``:
+        the project's default.
 
     Returns
     -------
     list of dict
         One row per variant (module notes): ``scenario``, ``variant`` (``"as written"``,
-        ``"no bound"``, ``"second order"``, ``"second order, T = <steps>"``), ``written``,
+        ``"no bound"``, ``"second order"``, ``"second order, t_c = <named> s"``), ``written``,
         ``designed``, ``satisfied`` (the project's judge of the C run), ``samples``/``grid``
         (rtamt's robustness), ``stlpy_samples`` (stlpy's own at the samples), ``design_s``
         (CPU s of ``design_tube``, refusal included), ``peak_u``, ``input_bound``,
@@ -289,15 +299,16 @@ def run_stl_scenario(name: str, horizon: int | None = None, solver: str | None =
     output_dim = sc.GetSystem().p
     rows = []
     if "first" in orders:
-        doc = scenario_spec(name, horizon)
+        doc = scenario_spec(name, horizon, disturbance=disturbance)
         rows = [_design_and_judge(name, "as written", doc, sc, output_dim)]
         rows[0]["spec"] = spec_toml(doc, f"stlpy {name}, written by stt-codegen bench stl")
         if rows[0]["written"] and not rows[0]["designed"] and "actuator" in doc:
             unbounded = {k: v for k, v in doc.items() if k != "actuator"}
             rows.append(_design_and_judge(name, "no bound", unbounded, sc, output_dim))
     if "second" in orders and name in double_integrators():
-        second = _second_order_rows(name, horizon)
-        second[0]["spec"] = spec_toml(scenario_spec(name, horizon, order="second"),
+        second = _second_order_rows(name, horizon, disturbance)
+        second[0]["spec"] = spec_toml(scenario_spec(name, horizon, order="second",
+                                                    disturbance=disturbance),
                                       f"stlpy {name} as a double integrator, written by "
                                       "stt-codegen bench stl")
         rows += second
@@ -316,7 +327,8 @@ def run_stl_scenario(name: str, horizon: int | None = None, solver: str | None =
 
 def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
                   solver: str | None = "scipy", specs: Path | None = None,
-                  orders: tuple[str, ...] = ("first", "second")) -> dict[str, Any]:
+                  orders: tuple[str, ...] = ("first", "second"),
+                  disturbance: float | None = None) -> dict[str, Any]:
     """Every scenario (module notes), one after another in one process.
 
     Parameters
@@ -332,6 +344,8 @@ def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
         integrator as itself: ``stlpy-<scenario>-second-order.toml``).
     orders : tuple of str
         As :func:`run_stl_scenario`.
+    disturbance : float, optional
+        As :func:`run_stl_scenario` (``>= 0``).
 
     Returns
     -------
@@ -341,8 +355,8 @@ def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
     Raises
     ------
     SpecError
-        An unknown scenario name (field ``scenarios``); stlpy or rtamt not installed
-        (field ``stl``).
+        An unknown scenario name (field ``scenarios``); a negative ``disturbance`` (field
+        ``disturbance``); stlpy or rtamt not installed (field ``stl``).
     """
     try:
         import rtamt  # noqa: F401
@@ -353,13 +367,16 @@ def run_stl_bench(names: list[str] | None = None, horizon: int | None = None,
     names = known if names is None else list(names)
     if solver is not None and solver not in SOLVERS:
         raise SpecError("solver", f"unknown solver {solver!r} (known: {', '.join(SOLVERS)})")
+    if disturbance is not None and not disturbance >= 0.0:
+        raise SpecError("disturbance", f"must be a number >= 0 (|w_i| of the plant), not "
+                                       f"{disturbance!r}")
     for name in names:
         if name not in known:
             raise SpecError("scenarios", f"unknown scenario {name!r} (known: "
                                          f"{', '.join(known)})")
     rows: list[dict[str, Any]] = []
     for name in names:
-        rows += run_stl_scenario(name, horizon, solver, orders)
+        rows += run_stl_scenario(name, horizon, solver, orders, disturbance)
     if specs is not None:
         specs.mkdir(parents=True, exist_ok=True)
         for row in rows:

@@ -36,8 +36,8 @@ stlpy's example scripts. :data:`SCENARIOS` holds those example settings as publi
   ``[task_order] order = "any"``. A scenario whose ``F`` goals have no distinguished last
   goal (``RandomMultitarget``) takes its last group as the target.
 
-Every key not listed here takes the project's default (disturbance ``|w_i| <= 0.1``,
-``rate_hz = 1000``, ...). ``SteppingStones`` is not written (:data:`SKIPPED`).
+Every key not listed here takes the project's default (disturbance ``|w_i| <= 0.1``, which
+``disturbance`` replaces: 0 is stlpy's model, ``rate_hz = 1000``, ...). ``SteppingStones`` is not written (:data:`SKIPPED`).
 """
 
 from __future__ import annotations
@@ -268,8 +268,8 @@ def _parts(name: str, sc: Any, space, seconds: float, dt: float) -> dict[str, An
     raise KeyError(name)
 
 
-def scenario_spec(name: str, horizon: int | None = None, order: str = "first"
-                  ) -> dict[str, Any]:
+def scenario_spec(name: str, horizon: int | None = None, order: str = "first",
+                  disturbance: float | None = None) -> dict[str, Any]:
     """The spec document of one stlpy example (module notes), as :meth:`Spec.from_dict`
     takes it.
 
@@ -282,6 +282,9 @@ def scenario_spec(name: str, horizon: int | None = None, order: str = "first"
         ``T`` in steps instead of the example's.
     order : {"first", "second"}
         A double integrator as the first-order position law or as itself (module notes).
+    disturbance : float, optional
+        ``plant.disturbance_amplitude`` (``|w_i|``, state units per second; 0 is stlpy's
+        own model, which has none); ``None``: the project's default (0.1).
 
     Returns
     -------
@@ -354,6 +357,8 @@ def scenario_spec(name: str, horizon: int | None = None, order: str = "first"
         doc["actuator"] = {"input_bound": list(force)}
     elif setting.velocity_bound is not None:
         doc["actuator"] = {"input_bound": list(setting.velocity_bound)}
+    if disturbance is not None:
+        doc.setdefault("plant", {})["disturbance_amplitude"] = float(disturbance)
     return doc
 
 
