@@ -7,7 +7,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pytest
 
 from stt_codegen.tube import reference as R
 from stt_codegen.tube.parameters import (GLIDE, GLIDE_RAMP, GLIDE_TURN, SCURVE, SMOOTHSTEP,

@@ -397,8 +397,8 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     needs = f"[{needs}]" + (f" ({spec.input_unit})" if unit else "")
     if works is not None:
         message += (f"; prescribed_time = {works:g} s works (the smallest to two significant "
-                    f"digits or a half step{moved_words(spec)}), or input_bound = {needs} with this "
-                    "prescribed_time")
+                    f"digits or a half step{moved_words(spec)}), or input_bound = {needs} "
+                    "with this prescribed_time")
     else:
         message += f"; {why}; input_bound = {needs} works with this prescribed_time"
     raise DesignError(message, kind=FailureKind.INPUT_BOUND, tried=best.design.tube,

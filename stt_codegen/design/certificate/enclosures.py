@@ -145,8 +145,8 @@ def reach_range(design: TubeDesign, t0: np.ndarray, t1: np.ndarray, rates: bool 
     (peak at ``tau = w*/(1+w*)`` for ``"tanh"``, ``1/2`` for ``"smoothstep"``; for
     ``"cruise"``, ``"scurve"`` and ``"glide"`` non-decreasing up to ``1/2`` and
     non-increasing after, ``1/2`` a point of the cruise's and the glide's plateau and the
-    S-curve's peak) and 0 at a segment's end; evaluated at a boundary it is the right limit, so 0 joins the range
-    of an interval with a segment end inside. The reach box's width
+    S-curve's peak) and 0 at a segment's end; evaluated at a boundary it is the right
+    limit, so 0 joins the range of an interval with a segment end inside. The reach box's width
     ``rho_U - rho_L = (U_from - L_from) + ((U_to - L_to) - (U_from - L_from)) p(tau)`` is
     monotone on each segment too, so its least value on an interval is at its ends or at a
     segment boundary inside: a box that moves keeps its width, however far it moves. A tube

@@ -37,7 +37,8 @@ stlpy's example scripts. :data:`SCENARIOS` holds those example settings as publi
   goal (``RandomMultitarget``) takes its last group as the target.
 
 Every key not listed here takes the project's default (disturbance ``|w_i| <= 0.1``, which
-``disturbance`` replaces: 0 is stlpy's model, ``rate_hz = 1000``, ...). ``SteppingStones`` is not written (:data:`SKIPPED`).
+``disturbance`` replaces: 0 is stlpy's model, ``rate_hz = 1000``, ...). ``SteppingStones``
+is not written (:data:`SKIPPED`).
 """
 
 from __future__ import annotations
