@@ -370,12 +370,14 @@ def _stay_then_target(prescribed_time: float) -> dict:
 
 @pytest.mark.slow
 def test_s_curve_legs_keep_a_bound_the_smooth_step_legs_exceed(monkeypatch):
-    """At 28 s (1.4 times stlpy's horizon) the accepted design's moving legs are S-curves
+    """At 26 s (1.3 times stlpy's horizon) the accepted design's moving legs are S-curves
     (peak acceleration 4.76 D / T^2); with the S-curve candidates and the blended corners
     taken away the design is refused for the force: the smooth-step legs (5.77 D / T^2)
-    stopped at their corners are proved to ask more than 0.5 N."""
+    stopped at their corners are proved to ask more than 0.5 N with every second-stage
+    shape. (At 28 s the smooth-step legs are certified with the slow outer loop of the
+    last shapes.)"""
     import stt_codegen.design.actuator as actuator
-    spec = stt.Spec.from_dict(_stay_then_target(28.0))
+    spec = stt.Spec.from_dict(_stay_then_target(26.0))
     design = stt.design_tube(spec)
     assert design.certificate.passed and design.input_proof.meets(spec.input_bound)
     assert {s.profile for s in design.tube.segments if s.lower_from != s.lower_to} == {
