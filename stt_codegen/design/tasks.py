@@ -50,7 +50,8 @@ from ..spec.tasks import STAY, Task
 from ..tube.parameters import CRUISE, ReachSegment, TubeDesign, paper_segments
 from .failures import FailureKind
 from .swept import swept_spec
-from .via import LENGTH_TIMING, ViaPlan, blend_plan, move_weight, plan_via, timed_moves
+from .via import (BLEND_CORNERS, LENGTH_TIMING, ViaPlan, blend_plan, move_weight, plan_via,
+                  timed_moves)
 
 __all__ = ["FREE_HOLD", "MAX_PLANS", "STAY_LEAD", "TaskPlan", "plan_tasks", "task_plans",
            "task_schedule", "visit_orders"]
@@ -143,10 +144,11 @@ def _moves(plan: ViaPlan) -> list[np.ndarray]:
     return [b - a for a, b in zip(centres, centres[1:])]
 
 
-def _leg_weights(spec: Spec, plans: list[ViaPlan]) -> list[float]:
+def _leg_weights(spec: Spec, plans: list[ViaPlan], base: TubeDesign) -> list[float]:
     """The legs' shares of time under free timing: each leg's :func:`_path_length`; timed
     for the acceleration under a velocity bound, each leg's moves' durations when all the
-    legs' moves share ``t_c`` (:func:`~.via.timed_moves`)."""
+    legs' moves share ``t_c`` (:func:`~.via.timed_moves`); with blended corners, those
+    durations rebalanced by :func:`_blended_weights`."""
     timing = spec.tube.via_timing
     if timing == LENGTH_TIMING or spec.velocity_bound is None:
         return [_path_length(plan, timing) for plan in plans]
@@ -157,7 +159,48 @@ def _leg_weights(spec: Spec, plans: list[ViaPlan]) -> list[float]:
     for leg in moves:
         out.append(sum(seconds[k:k + len(leg)]))
         k += len(leg)
+    if spec.tube.via_corners == BLEND_CORNERS:
+        return _blended_weights(spec, plans, base, out)
     return out
+
+
+#: Samples of a leg on which :func:`_blended_weights` measures its peak acceleration.
+LEG_SAMPLES = 2001
+
+
+def _blended_weights(spec: Spec, plans: list[ViaPlan], base: TubeDesign,
+                     seconds: list[float]) -> list[float]:
+    """Each leg's time (``seconds``, the legs' moves at one common peak acceleration with
+    stopped corners) times the square root of the peak acceleration of the leg's centre
+    once its corners are blended in that time (:func:`_leg`, sampled): a leg whose corners
+    blend less (a long move after short ones) gets more time, so that the blended legs ask
+    about one peak acceleration (it falls as the square of a leg's time). Legs that do not
+    move keep their time."""
+    profile = _leg_profile(spec)
+    peaks = [_peak_acceleration(_leg(plan, base, 0.0, duration, profile, spec), duration)
+             if duration > 0.0 and len(plan.lower) > 1 else 0.0
+             for plan, duration in zip(plans, seconds)]
+    moving = [k for k, peak in enumerate(peaks) if peak > 0.0]
+    if not moving:
+        return seconds
+    weighted = {k: seconds[k] * float(np.sqrt(peaks[k])) for k in moving}
+    # the moving legs share the time they had between them
+    scale = sum(seconds[k] for k in moving) / sum(weighted.values())
+    return [weighted[k] * scale if k in weighted else d for k, d in enumerate(seconds)]
+
+
+def _peak_acceleration(segments: list[ReachSegment], duration: float) -> float:
+    """The largest ``|d^2 c_i / dt^2|`` of the centre ``c`` of ``segments`` on ``[0,
+    duration]`` over the axes, on :data:`LEG_SAMPLES` samples (the rate of each segment's
+    profile differenced), state units per second squared."""
+    from ..tube.reference import segment_progress
+    t = np.linspace(0.0, duration, LEG_SAMPLES)
+    rate = 0.0
+    for seg in segments:
+        move = 0.5 * ((np.array(seg.lower_to) + np.array(seg.upper_to))
+                      - (np.array(seg.lower_from) + np.array(seg.upper_from)))
+        rate = rate + np.outer(segment_progress(seg, t)[1], move)
+    return float(np.max(np.abs(np.diff(rate, axis=0)) / (t[1] - t[0])))
 
 
 def _leg_profile(spec: Spec) -> str:
@@ -535,7 +578,7 @@ def plan_tasks(spec: Spec, base: TubeDesign, choice: tuple[int, ...],
     legs = None
     if _listed_holds(spec, order, boxes, base, choice) is None:
         legs = _leg_weights(spec, [path(a, b, p)
-                                   for a, b, p in zip(starts, boxes + [goal], pendings)])
+                                   for a, b, p in zip(starts, boxes + [goal], pendings)], base)
     boxes, holds = task_schedule(spec, base, order, choice, legs)
     profile = _leg_profile(spec)
     start = starts[0]
