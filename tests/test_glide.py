@@ -55,9 +55,8 @@ def test_glide_is_proved_c2_with_its_peaks_and_is_deployed_as_documented():
     is that profile at ``GLIDE_RAMP``, ``GLIDE_TURN`` and its ``p_dot`` output is ``dp/dt``
     (1e-13 on every coefficient)."""
     import sympy as sp
+    from test_tube_segments import assert_deployed_as
 
-    from stt_codegen.codegen.emit import sympy_expressions
-    from stt_codegen.proofs.deployed import exact, on_domain
     from stt_codegen.tube import pieces
 
     r, q = sp.symbols("r q", positive=True)
@@ -97,28 +96,11 @@ def test_glide_is_proved_c2_with_its_peaks_and_is_deployed_as_documented():
     assert math.isclose(peak_acceleration_factor(GLIDE), float(peak.subs(values)),
                         rel_tol=1e-15)
 
-    t = sp.Symbol("t", real=True)
-    d_ = sp.Symbol("d", positive=True)
-    w = sp.Symbol("w", positive=True)
-    (p,), (p_dot,) = sympy_expressions(pieces.progress(GLIDE), {"t": [t], "start": [0],
-                                                                "end": [d_]})
     # the branches' ends as the piece compares them: the doubles of q, r - q, r, 1/2 and
     # their mirrors
     r_, q_ = GLIDE_RAMP, GLIDE_TURN
-    cuts = [sp.Integer(0)] + [exact(sp.Float(c)) for c in (
-        q_, r_ - q_, r_, 0.5, 1.0 - r_, 1.0 - (r_ - q_), 1.0 - q_)] + [sp.Integer(1)]
-    documented = [sp.expand(b.subs(values)) for b in branches]
-
-    def gap(got, expected) -> float:      # largest coefficient of got - expected in tau
-        diff = sp.Poly(sp.expand(got - expected), tau)
-        return max(abs(float(c)) for c in diff.all_coeffs())
-
-    for (lo, hi), expected in zip(zip(cuts, cuts[1:]), documented):
-        domain = {t: (lo + (hi - lo) * w / (1 + w)) * d_}
-        value, rate = on_domain(p, domain), on_domain(p_dot, domain)
-        value, rate = value.subs(t, tau * d_), (rate * d_).subs(t, tau * d_)
-        assert gap(value, expected) < 1e-13
-        assert gap(rate, sp.diff(expected, tau)) < 1e-13
+    assert_deployed_as(GLIDE, (q_, r_ - q_, r_, 0.5, 1.0 - r_, 1.0 - (r_ - q_), 1.0 - q_),
+                       [b.subs(values) for b in branches], tau)
     assert pieces.PROFILE_NAMES.index(GLIDE) == 4
 
 

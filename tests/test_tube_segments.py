@@ -203,9 +203,7 @@ def test_scurve_profile_is_proved_c2_with_its_peaks_and_is_deployed_as_documente
     its ``p_dot`` output is ``dp/dt`` (1e-13 on every coefficient)."""
     import sympy as sp
 
-    from stt_codegen.codegen.emit import sympy_expressions
     from stt_codegen.tube import pieces
-    from stt_codegen.proofs.deployed import exact, on_domain
 
     q = sp.Symbol("q", positive=True)
     tau, x = sp.symbols("tau x", real=True)
@@ -242,25 +240,39 @@ def test_scurve_profile_is_proved_c2_with_its_peaks_and_is_deployed_as_documente
     assert sp.simplify(sp.diff(branches[2], tau).subs(tau, half) - 2) == 0
     assert peak_rate_factor(SCURVE) == 2.0 and SCURVE_TURN == 0.08
 
+    # the branches' ends as the piece compares them: the doubles of q, 1/2 - q, ...
+    assert_deployed_as(SCURVE, (SCURVE_TURN, 0.5 - SCURVE_TURN, 0.5, 0.5 + SCURVE_TURN,
+                                1.0 - SCURVE_TURN),
+                       [b.subs(q, sp.Rational(2, 25)) for b in branches], tau)
+    assert pieces.PROFILE_NAMES.index(SCURVE) == 3
+
+
+def assert_deployed_as(profile: str, cuts, documented: list, tau) -> None:
+    """The deployed CasADi piece of ``profile``, reduced on each branch between the
+    doubles ``cuts`` (inner ends, in order), is the ``documented`` polynomial in ``tau`` of
+    that branch, and its ``p_dot`` output is ``dp/dt`` (1e-13 on every coefficient)."""
+    import sympy as sp
+
+    from stt_codegen.codegen.emit import sympy_expressions
+    from stt_codegen.proofs.deployed import exact, on_domain
+    from stt_codegen.tube import pieces
+
     t = sp.Symbol("t", real=True)
     d_ = sp.Symbol("d", positive=True)
     w = sp.Symbol("w", positive=True)
-    (p,), (p_dot,) = sympy_expressions(pieces.progress(SCURVE), {"t": [t], "start": [0],
-                                                                 "end": [d_]})
-    # the branches' ends as the piece compares them: the doubles of q, 1/2 - q, ...
-    cuts = [sp.Integer(0)] + [exact(sp.Float(c)) for c in (
-        SCURVE_TURN, 0.5 - SCURVE_TURN, 0.5, 0.5 + SCURVE_TURN, 1.0 - SCURVE_TURN)] + [
-        sp.Integer(1)]
-    documented = [sp.expand(b.subs(q, sp.Rational(2, 25))) for b in branches]
+    (p,), (p_dot,) = sympy_expressions(pieces.progress(profile), {"t": [t], "start": [0],
+                                                                  "end": [d_]})
+    ends = [sp.Integer(0)] + [exact(sp.Float(c)) for c in cuts] + [sp.Integer(1)]
 
     def gap(got, expected) -> float:      # largest coefficient of got - expected in tau
         diff = sp.Poly(sp.expand(got - expected), tau)
         return max(abs(float(c)) for c in diff.all_coeffs())
 
-    for (lo, hi), expected in zip(zip(cuts, cuts[1:]), documented):
+    assert len(documented) == len(ends) - 1
+    for (lo, hi), expected in zip(zip(ends, ends[1:]), documented):
+        expected = sp.expand(expected)
         domain = {t: (lo + (hi - lo) * w / (1 + w)) * d_}
         value, rate = on_domain(p, domain), on_domain(p_dot, domain)
         value, rate = value.subs(t, tau * d_), (rate * d_).subs(t, tau * d_)
         assert gap(value, expected) < 1e-13
         assert gap(rate, sp.diff(expected, tau)) < 1e-13
-    assert pieces.PROFILE_NAMES.index(SCURVE) == 3
