@@ -55,7 +55,8 @@ def test_glide_is_proved_c2_with_its_peaks_and_is_deployed_as_documented():
     is that profile at ``GLIDE_RAMP``, ``GLIDE_TURN`` and its ``p_dot`` output is ``dp/dt``
     (1e-13 on every coefficient)."""
     import sympy as sp
-    from test_tube_segments import assert_deployed_as
+    from test_tube_segments import (assert_c2_at_joints, assert_deployed_as,
+                                    assert_first_half_within)
 
     from stt_codegen.tube import pieces
 
@@ -71,26 +72,12 @@ def test_glide_is_proved_c2_with_its_peaks_and_is_deployed_as_documented():
                 top * r / 2 - top * w + peak * w**3 / (6 * q), top * (u - r / 2))
 
     branches = first(tau) + tuple(1 - b for b in reversed(first(1 - tau)))
-    joints = (q, r - q, r, half, 1 - r, 1 - r + q, 1 - q)
-    for k in range(3):
-        d = [sp.diff(b, tau, k) for b in branches]
-        for j, at in enumerate(joints):
-            assert sp.simplify((d[j] - d[j + 1]).subs(tau, at)) == 0, (k, j)
-        assert sp.simplify(d[0].subs(tau, 0)) == 0
-        assert sp.simplify(d[-1].subs(tau, 1) - (0 if k else 1)) == 0
+    assert_c2_at_joints(branches, (q, r - q, r, half, 1 - r, 1 - r + q, 1 - q), tau)
     assert sp.simplify(branches[3].subs(tau, half) - half) == 0
-    # each piece of the first half (x in [0, 1] across it): the acceleration linear in x,
-    # in [0, A] at both ends, so in [0, A] across it, and the rate in [0, V]
+    # each piece of the first half: the acceleration in [0, A], the rate in [0, V]
     values = {r: sp.Rational(2, 5), q: sp.Rational(9, 100)}
-    ends = ((0, q), (q, r - q), (r - q, r), (r, half))
-    for b, (lo, hi) in zip(branches[:4], ends):
-        at = {tau: lo + (hi - lo) * x}
-        rate, acc = sp.diff(b, tau).subs(at), sp.diff(b, tau, 2).subs(at)
-        assert sp.degree(sp.expand(acc.subs(values)), x) <= 1
-        for end in (0, 1):
-            a, v = acc.subs(x, end).subs(values), rate.subs(x, end).subs(values)
-            assert 0 <= sp.simplify(a) <= sp.simplify(peak.subs(values))
-            assert 0 <= sp.simplify(v) <= sp.simplify(top.subs(values))
+    assert_first_half_within(branches[:4], ((0, q), (q, r - q), (r - q, r), (r, half)),
+                             values, peak, top, tau, x)
     assert (GLIDE_RAMP, GLIDE_TURN) == (0.4, 0.09)
     assert math.isclose(peak_rate_factor(GLIDE), float(top.subs(values)), rel_tol=1e-15)
     assert math.isclose(peak_acceleration_factor(GLIDE), float(peak.subs(values)),

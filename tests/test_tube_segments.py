@@ -216,27 +216,11 @@ def test_scurve_profile_is_proved_c2_with_its_peaks_and_is_deployed_as_documente
                 half - 2 * w + peak * w**3 / (6 * q))
 
     branches = first(tau) + tuple(1 - b for b in reversed(first(1 - tau)))
-    joints = (q, half - q, half, half + q, 1 - q)
-    for k in range(3):
-        d = [sp.diff(b, tau, k) for b in branches]
-        for j, at in enumerate(joints):
-            assert sp.simplify((d[j] - d[j + 1]).subs(tau, at)) == 0, (k, j)
-        assert sp.simplify(d[0].subs(tau, 0)) == 0
-        assert sp.simplify(d[-1].subs(tau, 1) - (0 if k else 1)) == 0
-    # on each piece of the first half (x in [0, 1] across it) the acceleration is linear
-    # in x, in [0, A] at both ends, so in [0, A] across it: the rate is non-decreasing up to
-    # the middle (and, mirrored, non-increasing after: unimodal, as the enclosures take
-    # it), its range on a piece its ends' values, within [0, 2]
-    ends = ((0, q), (q, half - q), (half - q, half))
-    at_q = {q: sp.Rational(2, 25)}
-    for b, (lo, hi) in zip(branches[:3], ends):
-        at = {tau: lo + (hi - lo) * x}
-        rate, acc = sp.diff(b, tau).subs(at), sp.diff(b, tau, 2).subs(at)
-        assert sp.degree(sp.expand(acc.subs(at_q)), x) <= 1
-        for end in (0, 1):
-            a, r = acc.subs(x, end).subs(at_q), rate.subs(x, end).subs(at_q)
-            assert 0 <= sp.simplify(a) <= sp.simplify(peak.subs(at_q))
-            assert 0 <= sp.simplify(r) <= 2
+    assert_c2_at_joints(branches, (q, half - q, half, half + q, 1 - q), tau)
+    # the rate is non-decreasing up to the middle (and, mirrored, non-increasing after:
+    # unimodal, as the enclosures take it), its range on a piece its ends' values
+    assert_first_half_within(branches[:3], ((0, q), (q, half - q), (half - q, half)),
+                             {q: sp.Rational(2, 25)}, peak, 2, tau, x)
     assert sp.simplify(sp.diff(branches[2], tau).subs(tau, half) - 2) == 0
     assert peak_rate_factor(SCURVE) == 2.0 and SCURVE_TURN == 0.08
 
@@ -245,6 +229,34 @@ def test_scurve_profile_is_proved_c2_with_its_peaks_and_is_deployed_as_documente
                                 1.0 - SCURVE_TURN),
                        [b.subs(q, sp.Rational(2, 25)) for b in branches], tau)
     assert pieces.PROFILE_NAMES.index(SCURVE) == 3
+
+
+def assert_c2_at_joints(branches, joints, tau) -> None:
+    """A piecewise profile (SymPy, one expression in ``tau`` per branch, the branches
+    meeting at ``joints``) has ``p``, ``p_dot``, ``p_ddot`` continuous at every joint, ``p =
+    0`` and ``p = 1`` at the ends and ``p_dot = p_ddot = 0`` there."""
+    import sympy as sp
+    for k in range(3):
+        d = [sp.diff(b, tau, k) for b in branches]
+        for j, at in enumerate(joints):
+            assert sp.simplify((d[j] - d[j + 1]).subs(tau, at)) == 0, (k, j)
+        assert sp.simplify(d[0].subs(tau, 0)) == 0
+        assert sp.simplify(d[-1].subs(tau, 1) - (0 if k else 1)) == 0
+
+
+def assert_first_half_within(branches, ends, values, peak, top, tau, x) -> None:
+    """On each of the first half's ``branches`` (``x`` in ``[0, 1]`` across its ``ends``,
+    at the parameters ``values``) the acceleration is linear in ``x`` and in ``[0, peak]``
+    at both ends, so across it; the rate is in ``[0, top]`` at both ends."""
+    import sympy as sp
+    for b, (lo, hi) in zip(branches, ends):
+        at = {tau: lo + (hi - lo) * x}
+        rate, acc = sp.diff(b, tau).subs(at), sp.diff(b, tau, 2).subs(at)
+        assert sp.degree(sp.expand(acc.subs(values)), x) <= 1
+        for end in (0, 1):
+            a, v = acc.subs(x, end).subs(values), rate.subs(x, end).subs(values)
+            assert 0 <= sp.simplify(a) <= sp.simplify(sp.sympify(peak).subs(values))
+            assert 0 <= sp.simplify(v) <= sp.simplify(sp.sympify(top).subs(values))
 
 
 def assert_deployed_as(profile: str, cuts, documented: list, tau) -> None:
