@@ -259,7 +259,7 @@ def _leg_peaks(spec) -> list[float]:
             if leg:
                 t0, t1 = leg[0].start, max(s.end for s in leg)
                 shifted = [replace(s, start=s.start - t0, end=s.end - t0) for s in leg]
-                legs.append(tasks._peak_acceleration(shifted, t1 - t0))
+                legs.append(tasks._peak_acceleration(base, shifted, t1 - t0))
             leg = []
         else:
             leg.append(seg)

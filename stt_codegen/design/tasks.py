@@ -177,7 +177,8 @@ def _blended_weights(spec: Spec, plans: list[ViaPlan], base: TubeDesign,
     about one peak acceleration (it falls as the square of a leg's time). Legs that do not
     move keep their time."""
     profile = _leg_profile(spec)
-    peaks = [_peak_acceleration(_leg(plan, base, 0.0, duration, profile, spec), duration)
+    peaks = [_peak_acceleration(base, _leg(plan, base, 0.0, duration, profile, spec),
+                                duration)
              if duration > 0.0 and len(plan.lower) > 1 else 0.0
              for plan, duration in zip(plans, seconds)]
     moving = [k for k, peak in enumerate(peaks) if peak > 0.0]
@@ -189,17 +190,17 @@ def _blended_weights(spec: Spec, plans: list[ViaPlan], base: TubeDesign,
     return [weighted[k] * scale if k in weighted else d for k, d in enumerate(seconds)]
 
 
-def _peak_acceleration(segments: list[ReachSegment], duration: float) -> float:
-    """The largest ``|d^2 c_i / dt^2|`` of the centre ``c`` of ``segments`` on ``[0,
-    duration]`` over the axes, on :data:`LEG_SAMPLES` samples (the rate of each segment's
-    profile differenced), state units per second squared."""
-    from ..tube.reference import segment_progress
+def _peak_acceleration(base: TubeDesign, segments: list[ReachSegment],
+                       duration: float) -> float:
+    """The largest ``|d^2 c_i / dt^2|`` of the centre ``c`` of the reach tube of
+    ``segments`` on ``[0, duration]`` over the axes, on :data:`LEG_SAMPLES` samples (the
+    reference's ``rho_dot``, blended corners included, differenced), state units per
+    second squared."""
+    from ..tube.reference import reach_tube
     t = np.linspace(0.0, duration, LEG_SAMPLES)
-    rate = 0.0
-    for seg in segments:
-        move = 0.5 * ((np.array(seg.lower_to) + np.array(seg.upper_to))
-                      - (np.array(seg.lower_from) + np.array(seg.upper_from)))
-        rate = rate + np.outer(segment_progress(seg, t)[1], move)
+    leg = replace(base, segments=tuple(segments), circumvents=(), prescribed_time=duration)
+    _, _, rate_lower, rate_upper = reach_tube(leg, t)
+    rate = 0.5 * (rate_lower + rate_upper)
     return float(np.max(np.abs(np.diff(rate, axis=0)) / (t[1] - t[0])))
 
 
