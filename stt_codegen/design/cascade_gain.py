@@ -64,7 +64,7 @@ __all__ = ["RATE_SEARCH_FACTOR", "SHAPES", "cascade_design_proof", "cascade_inpu
 #: tube a refusal's search tries (the hovercraft at 1 kHz names its time in 14.4 s of CPU
 #: with these seven, 16.5 s with an eighth of separation 15).
 SHAPES = ((0.3, 10.0, 4.0), (1.0, 5.0, 4.0), (0.5, 10.0, 4.0), (1.4, 10.0, 4.0),
-          (0.3, 10.0, 16.0), (1.0, 20.0, 4.0), (1.0, 40.0, 8.0))
+          (0.3, 10.0, 16.0), (1.0, 20.0, 4.0), (1.0, 40.0, 8.0), (1.0, 15.0, 4.0))
 
 #: Samples of the tube's speed over ``[0, t_c]``.
 SPEED_SAMPLES = 4001
@@ -190,6 +190,10 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
         Within :func:`~.failures.without_advice` (a search asking the verdict only), a
         shape's check stops where its input passes ``bound``: the stage kept is the same,
         but such a shape is reported as not passed, with the peak found until then.
+        Otherwise, given a ``bound``, a shape tried after one that keeps the tubes stops
+        where its input passes the lowest peak-to-bound ratio found so far times the
+        bound (it cannot have a lower ratio), and is reported so too: the stage kept and
+        the tubes-kept shape of lowest ratio (:func:`cascade_input_proof`) are the same.
     """
     order = spec.second_order
     # the certificate reads neither bound: one certificate per tube and stage, bound or not
@@ -198,6 +202,9 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
     # a search that asks the verdict only (no advice) needs no shape's whole peak: its
     # check stops where the input passes the bound (the shape kept is the same)
     limit = None if bound is None or advice_wanted() else tuple(bound)
+    # with advice, the lowest peak-to-bound ratio of the shapes that keep the tubes: a
+    # shape whose input passes it times the bound cannot be lower, so its check stops there
+    lowest = math.inf
     tried = []
     for k, shape in enumerate(SHAPES):
         report_progress("cascade stage", k / len(SHAPES),
@@ -206,10 +213,13 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
             tube, min_width, order.input_gain, order.drift_bound + spec.disturbance_amplitude,
             order.initial_velocity, shape)
         with reporting(None, (k / len(SHAPES), (k + 1) / len(SHAPES))):
-            passed, report = certify_stage(tube, spec, stage, limit)
+            passed, report = certify_stage(tube, spec, stage, limit if lowest == math.inf
+                                           else tuple(lowest * b for b in bound))
         within = bound is None or all(p <= b for p, b in zip(report["peak_input"], bound))
         if passed and within:
             return stage, {**derivation, "certificate": report}
+        if passed and limit is None and bound is not None:
+            lowest = min(lowest, max(p / b for p, b in zip(report["peak_input"], bound)))
         reason = report.get("reason", "") if not passed else (
             "the certified peak input " + ", ".join(f"{p:.4g}" for p in report["peak_input"])
             + " exceeds the bound " + ", ".join(f"{b:g}" for b in bound))
