@@ -266,14 +266,9 @@ def test_a_base_switches_at_its_look_ahead_point(base):
 def test_a_base_runs_its_replanned_tubes_through_one_compiled_controller(base):
     """``simulate_sensed`` of the base on backend ``c`` loads each switched tube into the
     look-ahead variant's C with the tube as data: the same trajectory, bit for bit, as the
-    CasADi model's run; the Python module takes no tube as data for a base (refused,
-    naming the field)."""
+    CasADi model's run (its Python module's: tests/test_tube_data_python.py)."""
     design, _ = base
     run_as_casadi(design, "c")
-    with pytest.raises(SpecError) as caught:
-        stt.simulate_sensed(design, bundled_people("hall-crossing"), backend="python",
-                            horizon=1.0)
-    assert caught.value.field == "backend"
 
 
 @pytest.mark.parametrize("precision", ["double", "single"])
@@ -316,9 +311,13 @@ def test_bad_requests_name_the_field():
                        Options(("c",), "double", TubeCapacity(2, 8)))
     with pytest.raises(SpecError, match="not generated in c for a second-order plant"):
         design_files(design_of("second-order-s1"), parse_options("c", "double", True))
+    with pytest.raises(SpecError, match="not generated in python for a second-order plant"):
+        design_files(design_of("second-order-s1"), parse_options("python", "double", True))
     base = stt.design_tube(stt.load_spec(str(SPECS / "hall-crossing-drive.toml")))
-    with pytest.raises(SpecError, match="not generated in python for a differential-drive"):
-        design_files(base, parse_options("c,python", "double", True))
+    files = design_files(base, parse_options("c,python", "double", True))
+    source = files[f"{base.spec.c_name}.py"].decode()
+    assert "class TubeData:" in source and "def switch(active, tube, start, x, t):" in source
+    assert "def step(tube, x, t, dt, alpha):" in source and "N_STATE = 3" in source
 
 
 def test_the_command_line_writes_the_data_form_or_exits_2(tmp_path):

@@ -232,3 +232,81 @@ def test_with_an_actuator_bound_the_clamp_is_the_casadi_models():
         assert bits(got[:2]) == bits(expected[:2]) and got[2] == expected[2], (x, t)
         statuses.add(got[2])
     assert STATUS_INPUT_CLAMPED in statuses                # the clamp acted
+
+
+@pytest.fixture(scope="module")
+def base():
+    """The hall's differential-drive base (tests/specs/hall-crossing-drive.toml, with the
+    base's limits) and the look-ahead variant's Python module with the tube as data."""
+    from stt_codegen.runtime.data_module import look_ahead_data_module
+    design = stt.design_tube(stt.load_spec(str(SPECS / "hall-crossing-drive.toml")))
+    return design, look_ahead_data_module(design)
+
+
+def test_a_base_module_is_the_casadi_model_bit_for_bit(base):
+    """The base's module with the tube as data (``step(tube, x, t, dt, alpha)``, ``x = (x,
+    y, theta)``, ``u = (v, omega)``): on random base states around its tubes (the spec's
+    and one moved), random headings, ``alpha`` and both ``dt`` kinds, the step equals the
+    CasADi model of the look-ahead step, bits and status, every status met."""
+    design, library = base
+    assert design.look_ahead.input_bound is not None        # the clamp is in the step
+    moved = dataclasses.replace(design.tube, circumvents=design.tube.circumvents[:1])
+    rng = np.random.default_rng(11)
+    seen = set()
+    for tube in (design.tube, moved):
+        ref = make_controller("casadi", tube, design.look_ahead)
+        data = library.load(tube)
+        for k in range(200):
+            t = rng.uniform(0.0, 1.1 * tube.prescribed_time)
+            g_l, g_u = (np.ravel(v) for v in stt.tube.reference.adaptive_tube(
+                tube, np.array([t]), np.zeros((1, 4)))[:2])
+            p = g_l + (g_u - g_l) * (rng.uniform(0.48, 0.52, 2) if k % 2 else
+                                     rng.uniform(-0.1, 1.1, 2))
+            theta = rng.uniform(-np.pi, np.pi)
+            l = design.look_ahead.axle_offset
+            x = np.array([p[0] - l * np.cos(theta), p[1] - l * np.sin(theta), theta])
+            alpha = np.abs(rng.normal(0.0, 0.05, 4)) * (k % 3 != 0)
+            dt = 1.0 / tube.rate_hz if k % 4 else 2.0 / tube.rate_hz
+            expected, got = ref.step(x, t, dt, alpha), data.step(x, t, dt, alpha)
+            assert bits(got[:2]) == bits(expected[:2]) and got[2] == expected[2], (x, t)
+            seen.add(int(got[2]))
+    assert seen >= {0, 1, 3, 5}, seen
+
+
+def test_a_base_module_switches_as_the_c(base):
+    """The base's ``switch`` tests the look-ahead point of ``(x, y, theta)``: its result and
+    ``|e|`` equal the generated C's ``P_switch`` on random base states; the axle ``l``
+    behind the initial box's centre puts the point at the centre."""
+    design, library = base
+    loaded = library.load(design.tube)
+    lo, hi = np.array(design.tube.initial_lower), np.array(design.tube.initial_upper)
+    centre, l = 0.5 * (lo + hi), design.look_ahead.axle_offset
+    assert loaded.switch_error([centre[0] - l, centre[1], 0.0]) <= 1e-6
+    assert loaded.switch_error([centre[0], centre[1], 0.0]) > 0.5
+    assert loaded.switch_error([math.nan, 0.0, 0.0]) == math.inf
+    try:
+        compiler()
+    except MissingTool as exc:
+        pytest.skip(f"no C compiler ({exc}): install gcc")
+    from stt_codegen.runtime.data_controller import look_ahead_data_controller
+    c = look_ahead_data_controller(design).load(design.tube)
+    rng = np.random.default_rng(12)
+    for _ in range(100):
+        x = np.array([*(centre + rng.uniform(-1.0, 1.0, 2)), rng.uniform(-np.pi, np.pi)])
+        assert bits([loaded.switch_error(x)]) == bits([c.switch_error(x)]), x
+
+
+def test_a_base_crosses_the_hall_through_one_generated_module(base):
+    """``simulate_sensed`` of the base on backend ``python`` loads each switched tube into
+    the look-ahead variant's module with the tube as data: the CasADi model's run, bit for
+    bit."""
+    from test_tube_data import run_as_casadi
+    run_as_casadi(base[0], "python")
+
+
+def test_the_cascade_has_no_module_taking_its_tube_as_data():
+    from stt_codegen.spec.variants import variant_of
+    design = design_of("second-order-s1")
+    with pytest.raises(SpecError, match="not generated in python for a second-order") as info:
+        variant_of(design.spec).entry("data_module")(design)
+    assert info.value.field == "tube_data"

@@ -39,7 +39,8 @@ from ..tube.pieces import error_transform
 from .vectors import test_vectors
 
 __all__ = ["GENERATOR", "MANIFEST", "Options", "c_source_context", "first_order_generation",
-           "generate_files", "input_limits", "manifest", "timing_context"]
+           "generate_files", "input_limits", "manifest", "python_module_context",
+           "timing_context"]
 
 
 def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str, bytes]:
@@ -73,7 +74,6 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
     functions = [*deployed_functions(build_model(design), capacity is not None),
                  *([error_transform(design.dimension)] if capacity is not None else []),
                  *([predictor] if predictor is not None else [])]
-    limits = input_limits(design)
     common = {
         "spec_name": spec.name, "spec_hash": spec.source_hash, "casadi_version": casadi.__version__,
         "toolkit_version": __version__, "precision": options.precision, "P": prefix,
@@ -93,23 +93,9 @@ def generate_files(spec: Spec, design: TubeDesign, options: Options) -> dict[str
         files.update(selftest_file(c_ctx, vectors, vector_tables(vectors), options.precision))
     if "python" in options.langs:
         name = f"{prefix}.py"
-        programs = [dataclasses.replace(lower(f), name=f"body_{f.name()}") for f in functions]
-        files[name] = render("python_module.py.j2", filename=name, **common,
-                             T=python_names(capacity is not None), capacity=capacity,
-                             max_initial_error=repr(float(MAX_INITIAL_ERROR)),
-                             bodies=python_source(programs).rstrip("\n"),
-                             spec_tables=design_table_rows(design, lambda v: repr(float(v)),
-                                                           False),
-                             profile_codes=profile_codes(capacity),
-                             t_c=repr(float(design.prescribed_time)),
-                             rate_hz=repr(float(design.rate_hz)),
-                             **timing_context(design.rate_hz, (spec.delay, spec.jitter),
-                                              lambda v: repr(float(v))),
-                             dt_min=repr(limits["dt_min"]),
-                             dt_max=repr(limits["dt_max"]),
-                             alpha_max=repr(limits["alpha_max"]),
-                             input_bound=(None if design.input_bound is None else
-                                          [repr(float(b)) for b in design.input_bound]))
+        files[name] = render("python_module.py.j2", filename=name, **{
+            **common, **python_module_context(design, functions, capacity,
+                                              (spec.delay, spec.jitter))})
     files_bytes = {k: v.encode("ascii") for k, v in files.items()}
     files_bytes[f"{prefix}_vectors.json"] = vectors_file(
         spec, options.precision, vectors, f"the numpy reference (stt-codegen {__version__})")
@@ -133,6 +119,44 @@ def first_order_generation(design, options: Options) -> dict[str, bytes]:
         :func:`generate_files` of the design's spec and tube.
     """
     return generate_files(design.spec, design.tube, options)
+
+
+def python_module_context(design: TubeDesign, functions: list,
+                          capacity: TubeCapacity | None = None,
+                          timing: tuple[float, float] = (0.0, 0.0)) -> dict:
+    """The variables of ``templates/python_module.py.j2`` that depend on the design: its
+    tables (or the tube as data), the ``body_*`` functions printed from ``functions``, the
+    timing contract and the input domain's limits (the first order's module, and the
+    look-ahead variant's, which extends it).
+
+    Parameters
+    ----------
+    design : TubeDesign
+        The tube the module runs (for the look-ahead variant, its point's).
+    functions : list of casadi.Function
+        The pieces the module composes, each printed as ``body_<name>``.
+    capacity : TubeCapacity, optional
+        The tube as data with these capacities; ``None``: the design's tables.
+    timing : (float, float)
+        ``(delay, jitter)`` of the spec, s.
+
+    Returns
+    -------
+    dict
+    """
+    limits = input_limits(design)
+    programs = [dataclasses.replace(lower(f), name=f"body_{f.name()}") for f in functions]
+    return dict(T=python_names(capacity is not None), capacity=capacity,
+                newton=NEWTON_ITERATIONS, max_initial_error=repr(float(MAX_INITIAL_ERROR)),
+                bodies=python_source(programs).rstrip("\n"),
+                spec_tables=design_table_rows(design, lambda v: repr(float(v)), False),
+                profile_codes=profile_codes(capacity),
+                t_c=repr(float(design.prescribed_time)), rate_hz=repr(float(design.rate_hz)),
+                **timing_context(design.rate_hz, timing, lambda v: repr(float(v))),
+                dt_min=repr(limits["dt_min"]), dt_max=repr(limits["dt_max"]),
+                alpha_max=repr(limits["alpha_max"]),
+                input_bound=(None if design.input_bound is None else
+                             [repr(float(b)) for b in design.input_bound]))
 
 
 def c_source_context(design: TubeDesign, prefix: str, precision: str,

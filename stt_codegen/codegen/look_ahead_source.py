@@ -10,8 +10,8 @@ double precision.
   and input checks, with the variant's law (``look_ahead_source.c.j2``: the pieces
   ``look_ahead_point`` and ``base_command`` around the first order's ``law``, its
   ``saturate`` with the base's limits).
-* Python: the composed Function printed whole by the emitter's Python printer, behind the
-  first order's input checks (``look_ahead_module.py.j2``).
+* Python: a variant of the first-order module (:func:`.generate.python_module_context`,
+  ``python_module.py.j2``) in the same way (``look_ahead_module.py.j2``).
 
 The text is in the Jinja2 templates of the top-level ``templates/``, rendered through
 :func:`.render.render` as the other variants' files are; this module only prepares the data.
@@ -19,21 +19,19 @@ The text is in the Jinja2 templates of the top-level ``templates/``, rendered th
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 
 import casadi
 
-from ..tube.look_ahead import LookAhead, base_command, look_ahead_point, look_ahead_step
+from ..tube.look_ahead import LookAhead, base_command, look_ahead_point
 from ..tube.model import build_model
 from ..tube import pieces as P
 from ..tube.parameters import Status, TubeDesign
 from ..version import __version__
 from ..design.output_bound import base_clamp
 from ..design.prediction import delay_predictor
-from .emit import lower, python_source
 from .functions import deployed_functions
-from .generate import c_source_context, input_limits, timing_context
+from .generate import c_source_context, input_limits, python_module_context, timing_context
 from .render import c_real, render
 from .tube_data import TubeCapacity, require_capacity, table_names
 
@@ -71,6 +69,18 @@ def _context(design: TubeDesign, look_ahead: LookAhead, prefix: str, precision: 
             "output_clamp": (None if bound is not None else
                              [f"{c:.3g}" for c in base_clamp(design.gain,
                                                              look_ahead.axle_offset)])}
+
+
+def _pieces(design: TubeDesign, look_ahead: LookAhead, predictor: casadi.Function | None,
+            capacity: TubeCapacity | None) -> list:
+    """The CasADi pieces the variant's C and Python compose: the first order's, the error
+    transform of the switch (with the tube as data), the look-ahead point, the base's
+    command, the clamp (with the base's limits) and the predictor."""
+    return [*deployed_functions(build_model(design), capacity is not None),
+            *([P.error_transform(design.dimension)] if capacity is not None else []),
+            look_ahead_point(), base_command(),
+            *([P.saturate(2)] if look_ahead.input_bound is not None else []),
+            *([predictor] if predictor is not None else [])]
 
 
 def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,
@@ -113,11 +123,7 @@ def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,
     if capacity is not None:
         require_capacity(design, capacity)
     single = precision == "single"
-    functions = [*deployed_functions(build_model(design), capacity is not None),
-                 *([P.error_transform(design.dimension)] if capacity is not None else []),
-                 look_ahead_point(), base_command(),
-                 *([P.saturate(2)] if look_ahead.input_bound is not None else []),
-                 *([predictor] if predictor is not None else [])]
+    functions = _pieces(design, look_ahead, predictor, capacity)
     context = dict(c_source_context(design, prefix, precision, functions, capacity),
                    **_context(design, look_ahead, prefix, precision,
                               lambda v: c_real(v, single), timing), look_ahead=True,
@@ -129,10 +135,11 @@ def look_ahead_c_files(design: TubeDesign, look_ahead: LookAhead, prefix: str,
 
 def look_ahead_python_file(design: TubeDesign, look_ahead: LookAhead,
                            prefix: str, timing: tuple[float, float] = (0.0, 0.0),
-                           predictor: casadi.Function | None = None) -> dict[str, str]:
+                           predictor: casadi.Function | None = None,
+                           capacity: TubeCapacity | None = None) -> dict[str, str]:
     """``{<prefix>.py: text}``: ``step(x, t, dt, alpha) -> (u, alpha_next, status)`` with
-    ``x = (x, y, theta)``, the same function, statuses and input checks as the C (imports
-    ``math`` only).
+    ``x = (x, y, theta)``, ``tube`` and ``alpha_step``: the same functions, statuses and
+    input checks as the C (imports ``math`` only).
 
     Parameters
     ----------
@@ -145,6 +152,10 @@ def look_ahead_python_file(design: TubeDesign, look_ahead: LookAhead,
         ``(delay, jitter)`` of the spec, s: the module's ``DELAY`` and ``JITTER``.
     predictor : casadi.Function, optional
         As :func:`look_ahead_c_files`: ``predict(x, u_held)`` is generated.
+    capacity : TubeCapacity, optional
+        The tube as data with these capacities (``switch`` tests the look-ahead point of
+        the base's state), as :func:`look_ahead_c_files`; ``None`` (default): the design's
+        tables.
 
     Returns
     -------
@@ -155,16 +166,19 @@ def look_ahead_python_file(design: TubeDesign, look_ahead: LookAhead,
     ------
     ValueError
         ``prefix`` not an identifier, or a tube the variant does not take.
+    SpecError
+        The design does not fit ``capacity`` (field ``tube_data``).
     """
     _check(design, look_ahead, prefix)
+    if capacity is not None:
+        require_capacity(design, capacity)
     name = f"{prefix}.py"
-    return {name: render("look_ahead_module.py.j2", filename=name,
-                         **_context(design, look_ahead, prefix, "double",
-                                    lambda v: repr(float(v)), timing),
-                         predict=predictor is not None,
-                         body=python_source([lower(look_ahead_step(design, look_ahead)), *(
-                             [dataclasses.replace(lower(predictor), name="body_predict")]
-                             if predictor is not None else [])]))}
+    literal = lambda v: repr(float(v))  # noqa: E731 - Python floats, printed exactly
+    context = {**python_module_context(design, _pieces(design, look_ahead, predictor, capacity),
+                                       capacity, timing),
+               **_context(design, look_ahead, prefix, "double", literal, timing),
+               "look_ahead": True, "predict": predictor is not None}
+    return {name: render("look_ahead_module.py.j2", filename=name, **context)}
 
 
 def look_ahead_vectors(design: TubeDesign, look_ahead: LookAhead, precision: str) -> dict:
@@ -281,7 +295,8 @@ def look_ahead_generation(design, options) -> dict[str, bytes]:
         texts.update(selftest_file(context, vectors, vector_tables(vectors), options.precision))
     if "python" in options.langs:
         texts.update(look_ahead_python_file(design.tube, look_ahead, prefix,
-                                            (spec.delay, spec.jitter), predictor))
+                                            (spec.delay, spec.jitter), predictor,
+                                            options.tube_data))
     files = {name: text.encode() for name, text in texts.items()}
     files[f"{prefix}_vectors.json"] = vectors_file(
         spec, options.precision, vectors,

@@ -16,14 +16,17 @@ import math
 import numpy as np
 
 from ..codegen.generate import generate_files
+from ..codegen.look_ahead_source import look_ahead_python_file
 from ..codegen.options import Options
 from ..codegen.tables import design_table_rows
 from ..codegen.tube_data import TubeCapacity, fitting_capacity, require_capacity
 from ..errors import SpecError
+from ..tube.look_ahead import LookAhead
 from ..tube.parameters import TubeDesign
 from .compiled import DesignSpec, load_python_module
 
-__all__ = ["TubeDataModule"]
+__all__ = ["TubeDataModule", "first_order_data_module", "look_ahead_data_module",
+           "no_data_module"]
 
 
 class TubeDataModule:
@@ -40,6 +43,11 @@ class TubeDataModule:
     capacity : TubeCapacity, optional
         The most segments and windows of one tube; default 8 segments and 32 windows, or
         more when the design has more.
+    look_ahead : LookAhead, optional
+        A differential-drive base's axle offset and limits: the look-ahead variant's module
+        (:func:`~stt_codegen.codegen.look_ahead_source.look_ahead_python_file`), whose step
+        takes the base's state ``(x, y, theta)`` and returns ``(v, omega)``, and whose
+        switch tests the look-ahead point; default law (13)'s module.
 
     Examples
     --------
@@ -53,11 +61,17 @@ class TubeDataModule:
 
     name = "python"
 
-    def __init__(self, design: TubeDesign, capacity: TubeCapacity | None = None) -> None:
+    def __init__(self, design: TubeDesign, capacity: TubeCapacity | None = None,
+                 look_ahead: LookAhead | None = None) -> None:
         capacity = capacity or fitting_capacity(design)
         spec = DesignSpec(design)
-        files = generate_files(spec, design, Options(("python",), "double", capacity))
-        self.module = load_python_module(files[f"{spec.c_name}.py"], spec.c_name)
+        name = f"{spec.c_name}.py"
+        if look_ahead is None:
+            text = generate_files(spec, design, Options(("python",), "double", capacity))[name]
+        else:
+            text = look_ahead_python_file(design, look_ahead, spec.c_name,
+                                          capacity=capacity)[name].encode()
+        self.module = load_python_module(text, spec.c_name)
         self.n, self.capacity, self.design = design.dimension, capacity, design
 
     def pack(self, design: TubeDesign):
@@ -121,3 +135,30 @@ class _Loaded:
         scratch = m.Active()
         code = m.switch(scratch, self.tube, 0.0, [float(v) for v in np.ravel(x)], 0.0)
         return float(scratch.error) if code in (m.SWITCH_DONE, m.SWITCH_OUTSIDE) else math.inf
+
+
+def first_order_data_module(design) -> TubeDataModule:
+    """Law (13)'s Python module with the tube as data for a first-order ``design`` (the
+    variant's role ``data_module``)."""
+    return TubeDataModule(design.tube)
+
+
+def look_ahead_data_module(design) -> TubeDataModule:
+    """The look-ahead variant's Python module with the tube as data for a
+    differential-drive ``design`` (its axle offset and limits; the variant's role
+    ``data_module``)."""
+    return TubeDataModule(design.tube, look_ahead=design.look_ahead)
+
+
+def no_data_module(design) -> TubeDataModule:
+    """The role ``data_module`` of a variant whose Python takes no tube as data.
+
+    Raises
+    ------
+    SpecError
+        Always (field ``tube_data``, :func:`~stt_codegen.codegen.tube_data.require_tube_data`).
+    """
+    from ..codegen.tube_data import require_tube_data
+    require_tube_data(design.spec, ("python",))
+    raise AssertionError("require_tube_data refuses every variant without a Python tube as "
+                         "data")

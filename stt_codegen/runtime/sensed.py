@@ -646,11 +646,9 @@ class _Runner:
     def __init__(self, backend: str, design: Design) -> None:
         self.backend, self.spec = backend, design.spec
         self.library = None
-        if backend == "c":
-            self.library = variant_of(design.spec).entry("data_controller")(design)
-        elif backend == "python":
-            from .data_module import TubeDataModule
-            self.library = TubeDataModule(design.tube)
+        if backend in ("c", "python"):
+            role = "data_controller" if backend == "c" else "data_module"
+            self.library = variant_of(design.spec).entry(role)(design)
 
     def controller(self, design: Design):
         """The controller running ``design``'s tube."""

@@ -64,6 +64,8 @@ ROLES: Mapping[str, str] = MappingProxyType({
     "generation": "(design, options) -> dict of file name to bytes",
     "data_controller": "(design) -> TubeDataController, the variant's C with the tube as "
                        "data compiled once (SpecError where tube_data has no 'c')",
+    "data_module": "(design) -> TubeDataModule, the variant's Python with the tube as "
+                   "data generated once (SpecError where tube_data has no 'python')",
     "firmware": "(design, *, seed) -> report dict of the closed loop on the Cortex-M4F",
     "embedded_command": "(design, args, seed) -> exit code of stt-codegen embedded",
     "model_checks": "(spec, model) -> list of Check on the plant model",
@@ -236,6 +238,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                positions=_P + "runtime.state_split:leading_positions",
                backends=_P + "runtime.backends:first_order_backends",
                data_controller=_P + "runtime.data_controller:first_order_data_controller",
+               data_module=_P + "runtime.data_module:first_order_data_module",
                controller=_P + "runtime.backends:first_order_controller",
                plant=_P + "runtime.plants:first_order_spec_plant",
                mujoco_plant=_P + "runtime.plants:joint_mujoco_plant",
@@ -268,6 +271,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                positions=_P + "runtime.state_split:leading_positions",
                backends=_P + "runtime.backends:cascade_backends",
                data_controller=_P + "runtime.data_controller:no_data_controller",
+               data_module=_P + "runtime.data_module:no_data_module",
                controller=_P + "runtime.backends:cascade_controller",
                plant=_P + "runtime.plants:cascade_spec_plant",
                mujoco_plant=_P + "runtime.plants:joint_mujoco_plant",
@@ -300,6 +304,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                positions=_P + "runtime.state_split:look_ahead_positions",
                backends=_P + "runtime.backends:look_ahead_backends",
                data_controller=_P + "runtime.data_controller:look_ahead_data_controller",
+               data_module=_P + "runtime.data_module:look_ahead_data_module",
                controller=_P + "runtime.backends:look_ahead_controller",
                plant=_P + "runtime.plants:drive_spec_plant",
                mujoco_plant=_P + "runtime.plants:drive_mujoco_plant",
@@ -316,7 +321,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                predictor=_P + "tube.look_ahead:look_ahead_predictor",
                input_gain=_P + "spec.input_gains:declared_input_gain"),
         predicts_delay=True, replans_sensed=True, actuator_inputs=False,
-        tube_data=("c", "embedded")),
+        tube_data=("c", "python", "embedded")),
 })
 assert tuple(CONTROLLER_VARIANTS) == VARIANTS
 
