@@ -646,9 +646,10 @@ class _Runner:
     def __init__(self, backend: str, design: Design) -> None:
         self.backend, self.spec = backend, design.spec
         self.library = None
-        if backend in ("c", "python"):
-            role = "data_controller" if backend == "c" else "data_module"
-            self.library = variant_of(design.spec).entry(role)(design)
+        if backend == "c":
+            self.library = variant_of(design.spec).entry("data_controller")(design)
+        elif backend == "python":
+            self.library = variant_of(design.spec).entry("data_module")(design)
 
     def controller(self, design: Design):
         """The controller running ``design``'s tube."""
