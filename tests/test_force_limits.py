@@ -14,7 +14,7 @@ from functools import lru_cache
 from pathlib import Path
 
 import pytest
-from conftest import arena_toml
+from conftest import arena_toml, design_of
 
 import stt_codegen as stt
 from stt_codegen.cli import main
@@ -174,6 +174,38 @@ def test_second_stage_for_refuses_a_tube_whose_stages_exceed_the_bound():
         design.second_stage
     assert info.value.kind is FailureKind.INPUT_BOUND
     assert "actuator.input_bound = [1 N, 1 N]" in str(info.value)
+
+
+def test_a_shape_that_cannot_beat_the_lowest_ratio_stops_and_the_lowest_is_kept():
+    """With a bound no shape keeps (and advice wanted), a shape after one that keeps the
+    tubes stops where its input passes the lowest peak-to-bound ratio so far times the
+    bound (``second-order-s1``, whose tube every shape keeps, at 1 N): some are cut short,
+    and the lowest ratio and its peaks are those of the shapes run whole (each certified
+    alone, without a limit)."""
+    from stt_codegen.design.cascade_gain import cascade_input_proof, derived_second_stage
+    from stt_codegen.design.certificate.cascade_sampled import certify_stage
+    design = design_of("second-order-s1")
+    bound = (1.0, 1.0)
+    free, spec = (dataclasses.replace(design.spec, input_bound=b) for b in (None, bound))
+    order = free.second_order
+    whole = []
+    for shape in SHAPES:
+        stage, _ = derived_second_stage(design.tube, design.check.min_width, order.input_gain,
+                                        order.drift_bound + free.disturbance_amplitude,
+                                        order.initial_velocity, shape)
+        passed, report = certify_stage(design.tube, free, stage)
+        assert passed
+        whole.append(report["peak_input"])
+    assert min(max(p) for p in whole) > 1.0                  # kept by all, bound by none
+    stage, derivation = certified_stage(design.tube, spec, design.check.min_width, bound)
+    assert stage is None and len(derivation["tried"]) == len(SHAPES)
+    cut = [t for t in derivation["tried"] if not t["passed"]]
+    assert len(cut) >= 3
+    lowest = min(whole, key=max)
+    for t in cut:                                            # stopped above the lowest ratio
+        assert max(t["peak_input"]) > max(lowest)
+    proof = cascade_input_proof(design.tube, spec, design.check.min_width)
+    assert list(proof.peak) == list(lowest)
 
 
 # -- verify -----------------------------------------------------------------------------

@@ -191,10 +191,11 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
         Within :func:`~.failures.without_advice` (a search asking the verdict only), a
         shape's check stops where its input passes ``bound``: the stage kept is the same,
         but such a shape is reported as not passed, with the peak found until then.
-        Otherwise, given a ``bound``, a shape tried after one that keeps the tubes stops
-        where its input passes the lowest peak-to-bound ratio found so far times the
-        bound (it cannot have a lower ratio), and is reported so too: the stage kept and
-        the tubes-kept shape of lowest ratio (:func:`cascade_input_proof`) are the same.
+        Otherwise, given a ``bound`` (every entry positive), a shape tried after one that
+        keeps the tubes stops where its input passes the lowest peak-to-bound ratio found
+        so far times the bound (it cannot have a lower ratio), and is reported so too: the
+        stage kept and the tubes-kept shape of lowest ratio (:func:`cascade_input_proof`)
+        are the same.
     """
     order = spec.second_order
     # the certificate reads neither bound: one certificate per tube and stage, bound or not
@@ -205,6 +206,8 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
     limit = None if bound is None or advice_wanted() else tuple(bound)
     # with advice, the lowest peak-to-bound ratio of the shapes that keep the tubes: a
     # shape whose input passes it times the bound cannot be lower, so its check stops there
+    # (a bound with a zero entry has no ratio: every shape runs whole)
+    cut = limit is None and bound is not None and all(b > 0.0 for b in bound)
     lowest = math.inf
     tried = []
     for k, shape in enumerate(SHAPES):
@@ -219,7 +222,7 @@ def certified_stage(tube: TubeDesign, spec, min_width: float,
         within = bound is None or all(p <= b for p, b in zip(report["peak_input"], bound))
         if passed and within:
             return stage, {**derivation, "certificate": report}
-        if passed and limit is None and bound is not None:
+        if passed and cut:
             lowest = min(lowest, max(p / b for p, b in zip(report["peak_input"], bound)))
         reason = report.get("reason", "") if not passed else (
             "the certified peak input " + ", ".join(f"{p:.4g}" for p in report["peak_input"])
