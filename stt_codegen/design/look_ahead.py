@@ -10,11 +10,13 @@ argument). The input is held between samples, so the bound holds at every
 ``t``. :func:`look_ahead_input_proof` is that conversion; :func:`look_ahead_within_bound`
 the design of a differential-drive spec with ``[actuator]``: the first order's procedure
 (:func:`~.actuator.design_within_bound`: the default design, softer circumvents, via
-points, slower tubes) with it as the proof. A refusal whose best tube keeps ``|v|`` within
-``v_max`` and asks too much of ``omega`` also names the smallest ``plant.axle_offset`` (two
-significant digits) at which the same procedure is certified within the spec's
-``prescribed_time`` (:func:`shortest_axle_offset`): ``|omega| <= |u| / l`` falls with a
-longer look-ahead, while the obstacles grow by it.
+points, slower tubes) with it as the proof. ``omega``'s bound is then lowered to the one
+from the heading the base can have at each sample (:func:`heading_proof`,
+:mod:`.heading`), where the command acts one whole period from its sample. A refusal
+whose best tube keeps ``|v|`` within ``v_max`` and asks too much of ``omega`` also names
+the smallest ``plant.axle_offset`` (two significant digits) at which the same procedure
+is certified within the spec's ``prescribed_time`` (:func:`shortest_axle_offset`):
+``omega`` falls with a longer look-ahead, while the obstacles grow by it.
 """
 
 from __future__ import annotations
@@ -23,18 +25,22 @@ import math
 from collections.abc import Callable
 from dataclasses import replace
 
+import numpy as np
+
 from ..errors import DesignError, SpecError, number_text
 from ..spec.loader import Spec
 from .actuator import design_within_bound, verdict_limit
 from .certificate.actuator import prove_input_bound
 from .failures import FailureKind, advice_wanted, without_advice
 from .grid import grid_index, grid_value, smallest_passing
+from .heading import CommandBounds, command_bounds, corner_boxes
 from .input_bound import InputProof
 from .result import Design
 from ..tube.parameters import TubeDesign
 
-__all__ = ["MAX_OFFSET_FACTOR", "look_ahead_design_proof", "look_ahead_input_proof",
-           "look_ahead_within_bound", "point_proof", "shortest_axle_offset"]
+__all__ = ["MAX_OFFSET_FACTOR", "base_proof", "heading_bounds", "heading_known", "heading_proof",
+           "look_ahead_design_proof", "look_ahead_input_proof", "look_ahead_within_bound",
+           "point_proof", "shortest_axle_offset"]
 
 #: The ``plant.axle_offset`` search tries up to this many times the spec's offset.
 MAX_OFFSET_FACTOR = 8.0
@@ -126,17 +132,133 @@ def look_ahead_design_proof(design: Design, spec: Spec,
     Returns
     -------
     InputProof
-        :func:`look_ahead_input_proof` of :func:`point_proof`; within
+        :func:`look_ahead_input_proof` of :func:`point_proof`, with ``omega``'s peak from
+        :func:`heading_proof` where :func:`heading_known` and no ``initial_error``; within
         :func:`~.failures.without_advice` (a search asking the verdict only), stopped at
-        the first sample where ``|u|`` passes ``min(v_max, omega_max l)`` (partial: it
-        meets no bound).
+        the first sample where ``|u|`` passes ``v_max`` (``min(v_max, omega_max l)``
+        where the heading is not enclosed; partial: it meets no bound), and
+        :func:`heading_proof` asked only where the worst heading does not meet the bound.
     """
     offset = spec.drive.axle_offset
     bound = spec.input_bound
-    # |v| <= |u| and |omega| <= |u| / l: |u| at the point against min(v_max, omega_max l)
-    speed = math.inf if bound is None else min(bound[0], bound[1] * offset)
-    return look_ahead_input_proof(point_proof(design.tube, spec, verdict_limit(
+    aware = initial_error is None and heading_known(spec)
+    # |v| <= |u| always; |omega| <= |u| / l at the worst heading, lower from the heading
+    # the base can have (heading_proof): a verdict stops where |u| passes v_max, or
+    # min(v_max, omega_max l) where the heading is not enclosed
+    speed = (math.inf if bound is None else bound[0] if aware
+             else min(bound[0], bound[1] * offset))
+    proof = look_ahead_input_proof(point_proof(design.tube, spec, verdict_limit(
         spec, lambda u: math.hypot(*u) > speed), initial_error), offset)
+    if not aware or (not advice_wanted() and (bound is None or proof.meets(bound))):
+        return proof            # a verdict the worst heading already gives
+    return heading_proof(proof, design.tube, spec)
+
+
+def base_proof(point: InputProof, tube: TubeDesign, spec: Spec) -> InputProof:
+    """The base's proved peaks ``(|v|, |omega|)`` from law (13)'s proof at the point along
+    ``tube``: :func:`look_ahead_input_proof`, then :func:`heading_proof` where the heading
+    is enclosed (:func:`heading_known`).
+
+    Parameters
+    ----------
+    point : InputProof
+        Of ``u`` at the look-ahead point (:func:`point_proof`, or ``verify``'s).
+    tube : TubeDesign
+    spec : Spec
+        A differential-drive spec.
+
+    Returns
+    -------
+    InputProof
+    """
+    proof = look_ahead_input_proof(point, spec.drive.axle_offset)
+    return heading_proof(proof, tube, spec) if heading_known(spec) else proof
+
+
+def heading_known(spec: Spec) -> bool:
+    """Whether the base's heading is enclosed sample by sample (:mod:`.heading`): each
+    command acts for exactly one period (no ``[controller] delay``, ``jitter`` or
+    ``compensate_delay``)."""
+    return spec.delay == 0.0 and spec.jitter == 0.0 and not spec.compensate_delay
+
+
+def heading_bounds(tube: TubeDesign, spec: Spec) -> tuple[np.ndarray, CommandBounds] | None:
+    """The sample by sample bound of the base's ``|omega|`` and the enclosure of its heading
+    along ``tube`` (:mod:`.heading`), from the per-axis sampled check's signed box of
+    ``e`` (:func:`~.certificate.sampled.sampled_check_of`), the width's enclosure and the
+    wheel model within the declared class: the symmetric part's eigenvalues ``1 + m -+ |d|
+    s`` lie in ``input_gain``, so ``1 + m`` does and ``|d| <= (g_max - g_min) / (2 s)``;
+    ``s_omega`` is ``input_gain_turn``'s constant.
+
+    Parameters
+    ----------
+    tube : TubeDesign
+        The look-ahead point's tube.
+    spec : Spec
+        A differential-drive spec with :func:`heading_known`.
+
+    Returns
+    -------
+    (t, CommandBounds) or None
+        The samples' times, shape (K,), and the bounds; ``None`` where the check fails or
+        gives no signed box.
+    """
+    from ..tube import reference
+    from .certificate.enclosures import enclose_tube
+    from .certificate.plant_class import plant_class
+    from .certificate.sampled import sampled_check_of
+
+    samples, check = sampled_check_of(tube, spec, True)
+    if not check.passed or check.e_box is None:
+        return None
+    with reference.numpy_math():
+        enclosure = enclose_tube(tube, samples)
+    narrow = enclosure.upper_min - enclosure.lower_max
+    wide = enclosure.upper_max - enclosure.lower_min
+    count = samples.t.size
+    box = corner_boxes(check.e_box[:count], np.vstack([narrow, narrow[-1:]]),
+                       np.vstack([wide, wide[-1:]]), tube.gain)
+    drive, a = spec.drive, plant_class(spec).assumptions
+    beta = drive.track_width / (2.0 * drive.axle_offset)
+    s = 0.5 * (beta + 1.0 / beta)
+    g_min, g_max = a.input_gain
+    slip = a.input_gain_turn[1] if a.input_gain_turn is not None else 0.0
+    return samples.t, command_bounds(box, drive.heading, 1.0 / tube.rate_hz,
+                                     drive.axle_offset, drive.track_width, (g_min, g_max),
+                                     (g_max - g_min) / (2.0 * s), slip)
+
+
+def heading_proof(proof: InputProof, tube: TubeDesign, spec: Spec) -> InputProof:
+    """``proof`` (the base's peaks at the worst heading, :func:`look_ahead_input_proof`)
+    with ``omega``'s peak lowered to the largest of :func:`heading_bounds`
+    (docs/differential-drive.md, "The heading the base can have").
+
+    Parameters
+    ----------
+    proof : InputProof
+        Whole (not stopped early) and proved, else returned as it is.
+    tube : TubeDesign
+        The look-ahead point's tube.
+    spec : Spec
+        A differential-drive spec with :func:`heading_known`.
+
+    Returns
+    -------
+    InputProof
+        ``peak = (|v|, |omega|)``: ``|v|``'s is ``proof``'s (the bound of ``|u|``), and
+        ``|omega|``'s at most ``proof``'s, at the sample where it is largest.
+    """
+    if not (proof.proved and proof.complete):
+        return proof
+    found = heading_bounds(tube, spec)
+    if found is None:
+        return proof
+    t, bounds = found
+    peak = float(bounds.turn.max())
+    if peak >= proof.peak[1]:
+        return proof
+    return replace(proof, peak=(proof.peak[0], peak),
+                   time=(proof.time[0], float(t[int(np.argmax(bounds.turn))])))
 
 
 def look_ahead_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> Design:
@@ -178,7 +300,7 @@ def _naming_axle_offset(spec: Spec, design_free: Callable[[Spec], Design],
     if (error.kind is not FailureKind.INPUT_BOUND or error.tried is None
             or not advice_wanted()):
         return error
-    proof = look_ahead_input_proof(point_proof(error.tried, spec), spec.drive.axle_offset)
+    proof = base_proof(point_proof(error.tried, spec), error.tried, spec)
     v_max, omega_max = spec.input_bound
     if not proof.proved or proof.peak[0] > v_max or proof.peak[1] <= omega_max:
         return error

@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 
 from ..tube.parameters import E_MAX, GAMMA_D_MIN
 from .input_bound import InputProof
-from .look_ahead import look_ahead_input_proof, point_proof
+from .look_ahead import base_proof, point_proof
 
 if TYPE_CHECKING:
     from ..tube.second_stage import SecondStage
@@ -161,5 +161,5 @@ def look_ahead_output_limits(design: Design) -> OutputLimits:
         ``proved`` not proved when the sampled-data check fails.
     """
     offset = design.spec.drive.axle_offset
-    proved = look_ahead_input_proof(point_proof(design.tube, design.spec), offset)
+    proved = base_proof(point_proof(design.tube, design.spec), design.tube, design.spec)
     return OutputLimits(proved, base_clamp(design.tube.gain, offset))

@@ -24,7 +24,7 @@ from ..tube.parameters import TANH, TubeDesign, peak_rate_factor
 from ..proofs.adaptive import adaptive_law_checks, alpha_upper_bound
 from ..proofs.assumption import assumption2_check
 from ..proofs.look_ahead import look_ahead_inverse
-from ..design.look_ahead import look_ahead_input_proof
+from ..design.look_ahead import base_proof
 from ..rounding import distinct
 from ..proofs.check import Check, VerificationReport
 from ..progress import ProgressCallback, Reporter
@@ -330,7 +330,7 @@ def look_ahead_sampled_checks(spec: Spec, design: TubeDesign, tube_check,
     list of Check
     """
     return _law13_sampled(spec, design, tube_check, progress, lambda proof, base:
-                          look_ahead_input_proof(proof, base.drive.axle_offset))
+                          base_proof(proof, design, base))
 
 
 def cascade_sampled_checks(spec: Spec, design: TubeDesign, tube_check,

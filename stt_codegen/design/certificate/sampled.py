@@ -82,6 +82,11 @@ class SampledCheck:
         (read by :func:`stt_codegen.design.certificate.actuator.sampled_error_bound` for the input
         bound); when stopped (:func:`check_sampled`'s ``stop``), those up to the sample it
         stopped at; ``None`` otherwise.
+    e_box : ndarray or None, shape (K + 1, n, 2)
+        When passed: the proved interval ``[lo, hi]`` of the signed ``e_i(t_k)`` at every
+        sample (``abs_e`` is ``max(-lo, hi)``), from which the sign of law (13)'s command
+        is known where it excludes 0 (:mod:`stt_codegen.design.heading`); ``None``
+        otherwise, and for the predicted law's check.
     """
 
     passed: bool
@@ -92,6 +97,7 @@ class SampledCheck:
     reason: str
     data: dict = field(default_factory=dict)
     abs_e: np.ndarray | None = field(default=None, compare=False, repr=False)
+    e_box: np.ndarray | None = field(default=None, compare=False, repr=False)
 
 
 def _atanh_reach(lo: float, hi: float) -> float:
@@ -320,10 +326,10 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
             data["stopped_at"] = t_stop
             return SampledCheck(False, top, worst, t, i, f"stopped at t = {t:.4f} s", data,
                                 abs_e)
-        _, top, worst, worst_t, worst_i, abs_e = found
+        _, top, worst, worst_t, worst_i, abs_e, e_box = found
         data.update({"max_abs_e": top, "margin": worst, "max_level": 0.0,
                      "intervals_without_ball": 0})
-        return SampledCheck(True, top, worst, worst_t, worst_i, "", data, abs_e)
+        return SampledCheck(True, top, worst, worst_t, worst_i, "", data, abs_e, e_box)
     g_min_l = g_min_a.tolist()
     # s* of each share of the period the own command acts (a share of 0: no pull, s* = 1-)
     peaks = {share: peak(ratio / share).tolist() if share > 0.0 else
@@ -344,10 +350,12 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     top = max(max(-x, y) for x, y in box)
     ball_lost = ball_max = 0.0
     abs_e = []                                            # the bound of |e(t_k)|, per sample
+    boxes = []                                            # the enclosure of e(t_k), per sample
     for k in range(count):
         t = float(samples.t[k])
         reach_e = [max(-x, y) for x, y in box]
         abs_e.append(reach_e)
+        boxes.append([list(v) for v in box])
         if max(reach_e) > E_MAX:
             i = int(np.argmax(reach_e))
             return fail(clamp_failure(i, max(reach_e), t), -math.inf, t, i, top)
@@ -446,7 +454,9 @@ def check_sampled(design: TubeDesign, samples: TubeSamples,
     data.update({"max_abs_e": top, "margin": worst, "max_level": ball_max,
                  "intervals_without_ball": int(ball_lost)})
     abs_e.append([max(-x, y) for x, y in box])
-    return SampledCheck(True, top, worst, worst_t, worst_i, "", data, np.array(abs_e))
+    boxes.append([list(v) for v in box])
+    return SampledCheck(True, top, worst, worst_t, worst_i, "", data, np.array(abs_e),
+                        np.array(boxes))
 
 
 def check_sampled_first_per_axis(design: TubeDesign, samples: TubeSamples,

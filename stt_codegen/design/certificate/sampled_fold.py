@@ -55,9 +55,10 @@ AXIS_COLUMNS = ("centre", "half", "pull", "pull_prev", "peak", "up_e", "low_e",
 AXIS_PARAMETERS = ("dt", "turn_per", "turn_const", "span", "delay", "gain", "shares", "share",
                    "lag")
 #: What a step returns per axis: the bound of ``|e_i(t_k)|``, the room to the tube's edge
-#: on the interval (half-widths), and (the same on every axis) the least input gain over
-#: the turn and the bound of ``|omega|`` (a base's; ``g_min`` and 0 otherwise).
-AXIS_FIGURES = ("reach", "room", "gain", "rate")
+#: on the interval (half-widths), (the same on every axis) the least input gain over the
+#: turn and the bound of ``|omega|`` (a base's; ``g_min`` and 0 otherwise), and the box of
+#: the signed ``e_i(t_k)`` (its lower and upper ends).
+AXIS_FIGURES = ("reach", "room", "gain", "rate", "lower", "upper")
 _SCALARS = ("g_min", "g_max", "skew", "coupling", "push", "first")
 
 
@@ -87,7 +88,7 @@ def axis_step(n: int, blocks: tuple[tuple[int, ...], ...], turn: bool,
     ``state`` is the box of ``e(t_k)`` (its lower ends, then its upper ends), then the bound
     of ``|e(t_{k-1})|`` and of the two speeds a base's commands asked before (``5 n``
     rows; the last ``3 n`` serve a delay or jitter); ``figures`` are :data:`AXIS_FIGURES`
-    (``4 n`` rows).
+    (``6 n`` rows).
 
     Parameters
     ----------
@@ -180,7 +181,7 @@ def _step(n: int, blocks: tuple[tuple[int, ...], ...], turn: bool,
             after_hi.append((x_hi - c["centre_next"][i]) / c["half_next"][i])
         following = casadi.vertcat(*after_lo, *after_hi, *reach, *([speed] * n),
                                    *([speed_1[0]] * n))
-        shown = casadi.vertcat(*reach, *rooms, *([g_lo] * n), *([rate] * n))
+        shown = casadi.vertcat(*reach, *rooms, *([g_lo] * n), *([rate] * n), *lo, *hi)
         step = symbols.function("axis_sampled_step", following, shown)
     return step, columns, constants
 
@@ -227,8 +228,9 @@ def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float,
     -------
     tuple
         ``("fail", reason, margin, t, i, level)``, ``("stopped", level, margin, t, i,
-        t_stop, abs_e)``, or ``("passed", level, margin, t, i, abs_e)``, as the loop
-        returns them.
+        t_stop, abs_e)``, or ``("passed", level, margin, t, i, abs_e, e_box)``, as the
+        loop returns them (``e_box``: ``(K + 1, n, 2)``, the signed box of each
+        ``e(t_k)``).
     """
     step, columns, constants = axis_step(n, blocks, turn is not None, corners)
     count = len(times)
@@ -301,4 +303,6 @@ def check_folded(n: int, blocks: tuple[tuple[int, ...], ...], turn: tuple[float,
     final = np.maximum(-last[:n], last[n:2 * n])
     worst, worst_t, worst_i = worst_before(count)
     top = max(float(tops[-1]), float(final.max()))
-    return ("passed", top, worst, worst_t, worst_i, np.vstack([reach, final[None, :]]))
+    e_box = np.stack([np.vstack([shown[4].T, last[None, :n]]),
+                      np.vstack([shown[5].T, last[None, n:2 * n]])], axis=2)
+    return ("passed", top, worst, worst_t, worst_i, np.vstack([reach, final[None, :]]), e_box)
