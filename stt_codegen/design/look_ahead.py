@@ -308,8 +308,8 @@ def _naming_axle_offset(spec: Spec, design_free: Callable[[Spec], Design],
     if offset is None:
         return error
     return DesignError(f"{error}; plant.axle_offset = {number_text(offset)} m is certified "
-                       "with this prescribed_time (|omega| <= |u| / axle_offset; the "
-                       "obstacles grow by it)", kind=error.kind, tried=error.tried,
+                       "with this prescribed_time (omega falls with a longer look-ahead; "
+                       "the obstacles grow by it)", kind=error.kind, tried=error.tried,
                        advice={**error.advice, "plant.axle_offset": offset})
 
 
