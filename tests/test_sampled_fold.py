@@ -50,6 +50,11 @@ def _same(a, b) -> None:
     if a.abs_e is not None:
         assert a.abs_e.shape == b.abs_e.shape
         assert np.array_equal(a.abs_e, b.abs_e)
+    # the signed box of e at each sample (where passed), of which abs_e is the magnitude
+    assert (a.e_box is None) == (b.e_box is None)
+    if a.e_box is not None:
+        assert np.array_equal(a.e_box, b.e_box)
+        assert np.array_equal(np.maximum(-a.e_box[..., 0], a.e_box[..., 1]), a.abs_e)
     assert a.data == b.data
 
 
