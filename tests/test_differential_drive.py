@@ -218,7 +218,8 @@ def test_verify_proves_the_sampled_loop_and_the_limits():
     design = stt.design_tube(spec)
     assert design.tube.input_bound is None and design.look_ahead.input_bound == (1.6, 16.0)
     speed = math.hypot(*design.input_proof.peak[:1], 0.0)
-    assert design.input_proof.peak[1] == pytest.approx(speed / 0.1)
+    # omega from the heading the base can have: below the worst heading's |u| / l
+    assert design.input_proof.peak[1] < 0.9 * speed / 0.1
     report = stt.verify(design)
     names = {c.name: c for c in report.checks}
     assert report.passed, [c for c in report.checks if not c.passed]
@@ -227,6 +228,7 @@ def test_verify_proves_the_sampled_loop_and_the_limits():
         assert names[name].passed, name
     run = stt.simulate(design, backend="c")
     assert run.satisfied and all(u <= b for u, b in zip(run.max_abs_u, (1.6, 16.0)))
+    assert all(u <= p for u, p in zip(run.max_abs_u, design.input_proof.peak))
 
 
 @pytest.mark.slow
