@@ -125,8 +125,8 @@ class ControllerVariant:
         Where ``generate --tube-data`` is available (the generated code takes its tube as
         data and switches tubes at run time, :mod:`stt_codegen.codegen.tube_data`,
         docs/sensing.md): ``"c"``, ``"python"`` (the generated module) and ``"embedded"``
-        (``stt-codegen embedded --tube-data``); empty: nowhere. Law (13)'s variant: all
-        three; the base's: its C, on the host and on the Cortex-M4F.
+        (``stt-codegen embedded --tube-data``); empty: nowhere. Law (13)'s variant and the
+        base's: all three; the cascade's: none.
     tracking_in_stage : bool
         Whether the tube can be followed is judged by the certificate of its stage (the
         cascade's, which bounds ``|e1|``); else the paper's method refuses a tube with
