@@ -160,3 +160,37 @@ def test_the_agv_waits_for_the_forklift_then_crosses():
     assert arrives > corner.end
     result = stt.simulate(design, backend="python")
     assert result.satisfied and not result.collision and result.stayed_in_tube
+
+
+def test_velocity_inputs_try_blended_corners_last_and_not_where_an_obstacle_moves():
+    """Law (13) and a base (a velocity input) try via points with cruise segments and
+    blended corners last; not with an obstacle that moves (the forklift), nor with
+    ``[sensing]`` (a replanned tube and the tube as data have none)."""
+    from types import SimpleNamespace
+
+    from stt_codegen.design.actuator import slower_variants
+    default = SimpleNamespace(method="paper", tube=SimpleNamespace(circumvents=()))
+    label = "via points, cruise segments, blended corners"
+    omni = stt.load_spec("omnirobot-s1")
+    for spec in (stt.load_spec(str(AGV)), replace(omni, tube=replace(omni.tube, method="auto"))):
+        tried = slower_variants(spec, default)
+        assert tried[-1][0] == label and tried[-1][1].tube.via_corners == "blend"
+        assert tried[-1][1].tube.via_profile == "cruise"
+    assert label not in dict(slower_variants(stt.load_spec(str(FORKLIFT)), default))
+    assert label not in dict(slower_variants(stt.load_spec("hall-crossing"), default))
+
+
+@pytest.mark.slow
+def test_blended_corners_shorten_the_agvs_named_time():
+    """Asked for 30 s (refused), the AGV is named 36.5 s, where its stopped via tubes need
+    39 s: the tube with blended corners asks less speed of the same time. Followed, it is
+    certified with blended corners within [1.2 m/s, 1.5 rad/s]."""
+    short = stt.Spec.from_dict({**tomllib.loads(AGV.read_text()), "prescribed_time": 30.0})
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(short)
+    named = raised.value.advice["prescribed_time"]
+    assert named <= 37.0
+    design = stt.design_tube(replace(short, prescribed_time=named))
+    assert design.tube.blends_corners
+    assert design.input_proof.meets(short.input_bound)
+

@@ -35,7 +35,11 @@ second stage). Deterministic, in this order, the first tube that meets the bound
    that exists only for a while is allowed);
 5. **via points with cruise segments** (the same; not for tasks, whose legs have them):
    the same via boxes and times, each segment's rate rising to 1.25 times its mean, not
-   1.875 times.
+   1.875 times; then, where the input is a velocity (law (13), a base), the same with
+   **blended corners** (not where an obstacle moves, nor with ``[sensing]``): the tube
+   stops at no via box, so it asks less speed of the same time, and a base's heading
+   stays aligned with its command through the corners
+   (:mod:`~stt_codegen.design.heading`).
 
 When none does, the design is refused (``DesignError``, kind ``INPUT_BOUND``) naming the
 smallest ``prescribed_time`` at which the same procedure meets the bound (a search on
@@ -125,7 +129,9 @@ def slower_variants(spec: Spec, default: Design | None) -> list[tuple[str, Spec]
         ``"scurve"`` ones, then both with blended corners (no obstacle that moves); then
         via points with ``"cruise"`` segments (peak rate 1.25 times the mean, where the
         smooth step's is 1.875), when ``tube.method`` allows via points and the spec has
-        no tasks (whose legs are cruise segments already).
+        no tasks (whose legs are cruise segments already), and for a variant whose input
+        is a velocity, the same with blended corners (no obstacle that moves, no
+        ``[sensing]``).
     """
     out: list[tuple[str, Spec]] = []
     if (default is not None and default.method == METHOD_PAPER and default.tube.circumvents
@@ -156,6 +162,15 @@ def slower_variants(spec: Spec, default: Design | None) -> list[tuple[str, Spec]
         out.append(("via points, cruise segments",
                     replace(spec, tube=replace(spec.tube, method=METHOD_VIA,
                                                via_profile=CRUISE))))
+        # where the input is a velocity: the same with blended corners, which stop at no
+        # via box (not where an obstacle moves, nor with [sensing]: a replanned tube and
+        # the tube as data have no blends)
+        if (variant_of(spec).via_timing != ACCELERATION_TIMING and spec.sensing is None
+                and not any(ob.motion != "still" for ob in spec.moving_obstacles)):
+            out.append(("via points, cruise segments, blended corners",
+                        replace(spec, tube=replace(spec.tube, method=METHOD_VIA,
+                                                   via_profile=CRUISE,
+                                                   via_corners=BLEND_CORNERS))))
     return out
 
 
