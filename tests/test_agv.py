@@ -121,16 +121,18 @@ def test_the_agv_closed_loop_reaches_the_target_within_the_limits():
 
 @pytest.mark.slow
 def test_a_turn_rate_refusal_names_the_axle_offset_that_is_certified():
-    """At a 0.5 m look-ahead the AGV's best tube in 40 s keeps |v| but asks more than
-    1.5 rad/s even from the heading it can have: the refusal names plant.axle_offset (and
-    prescribed_time), and each, followed alone, is certified."""
-    short = stt.Spec.from_dict(_agv_doc(axle_offset=0.5))
+    """At a 0.4 m look-ahead with v_max 1.5 m/s, the AGV's best tube in 40 s keeps |v| but
+    asks more than 1.5 rad/s even from the heading it can have: the refusal names
+    plant.axle_offset (and prescribed_time), and each, followed alone, is certified."""
+    doc = _agv_doc(axle_offset=0.4)
+    doc["actuator"]["input_bound"] = [1.5, 1.5]
+    short = stt.Spec.from_dict(doc)
     with pytest.raises(stt.DesignError) as raised:
         stt.design_tube(short)
     words = str(raised.value)
     offset = raised.value.advice["plant.axle_offset"]
     assert f"plant.axle_offset = {offset:g} m is certified" in words
-    assert 0.5 < offset <= 0.8
+    assert 0.4 < offset <= 0.8
     assert stt.design_tube(short.with_axle_offset(offset)).input_proof.meets(
         short.input_bound)
     later = raised.value.advice["prescribed_time"]
@@ -192,5 +194,46 @@ def test_blended_corners_shorten_the_agvs_named_time():
     assert named <= 37.0
     design = stt.design_tube(replace(short, prescribed_time=named))
     assert design.tube.blends_corners
+    assert design.input_proof.meets(short.input_bound)
+
+
+def test_a_base_times_its_moves_for_the_turn_into_each():
+    """With ``via_timing = "turn"`` a move after a right-angle corner gains ``via_turn pi /
+    2`` of weight over the length timing; a straight run gains none. A base given its
+    bound tries it after the length-timed tubes; law (13) does not."""
+    from types import SimpleNamespace
+
+    from stt_codegen.design.actuator import slower_variants
+    from stt_codegen.design.via import timed_moves
+    spec = stt.load_spec(str(AGV))
+    moves = [np.array([4.0, 0.0]), np.array([0.0, 2.0]), np.array([0.0, 2.0])]
+    turned = replace(spec, tube=replace(spec.tube, via_timing="turn", via_turn=0.8))
+    length, _ = timed_moves(spec, moves, 8.0, "cruise")
+    turn, _ = timed_moves(turned, moves, 8.0, "cruise")
+    assert length == pytest.approx([4.0, 2.0, 2.0])
+    weights = [4.0, 2.0 + 0.8 * math.pi / 2, 2.0]
+    assert turn == pytest.approx([8.0 * w / sum(weights) for w in weights])
+    default = SimpleNamespace(method="paper", tube=SimpleNamespace(circumvents=()))
+    labels = [label for label, _ in slower_variants(spec, default, (1.2, 1.5))]
+    assert labels[-2:] == ["via points timed for the turn, cruise segments",
+                           "via points timed for the turn, cruise segments, blended corners"]
+    last = slower_variants(spec, default, (1.2, 1.5))[-2][1].tube
+    assert last.via_timing == "turn" and last.via_turn == pytest.approx(1.2 / 1.5)
+    omni = stt.load_spec("omnirobot-s1")
+    omni = replace(omni, tube=replace(omni.tube, method="auto"))
+    assert not any("turn" in label for label, _ in slower_variants(omni, default, (1.0, 1.0)))
+
+
+@pytest.mark.slow
+def test_legs_timed_for_the_turn_shorten_the_named_time_of_a_short_look_ahead():
+    """At a 0.5 m look-ahead the AGV in 40 s is refused naming 41.5 s (44.5 s with its legs
+    timed by length alone): its best tube gives the moves after the racks' corners the time
+    to turn. Followed, it is certified within [1.2 m/s, 1.5 rad/s]."""
+    short = stt.Spec.from_dict(_agv_doc(axle_offset=0.5))
+    with pytest.raises(stt.DesignError) as raised:
+        stt.design_tube(short)
+    named = raised.value.advice["prescribed_time"]
+    assert named <= 42.0 and "timed for the turn" in str(raised.value)
+    design = stt.design_tube(replace(short, prescribed_time=named))
     assert design.input_proof.meets(short.input_bound)
 

@@ -70,7 +70,7 @@ from .failures import FailureKind, advice_wanted, without_advice
 from .certificate.actuator import prove_input_bound
 from .input_bound import InputProof
 from .result import METHOD_PAPER, METHOD_VIA, Design
-from .via import ACCELERATION_TIMING, BLEND_CORNERS, STOP_CORNERS
+from .via import ACCELERATION_TIMING, BLEND_CORNERS, STOP_CORNERS, TURN_TIMING
 from .samples import HORIZON_FACTOR, STEP_BUDGET
 from .windows import SHARPNESS_LADDER
 
@@ -106,7 +106,8 @@ class Candidate:
     proof: InputProof
 
 
-def slower_variants(spec: Spec, default: Design | None) -> list[tuple[str, Spec]]:
+def slower_variants(spec: Spec, default: Design | None,
+                    bound: tuple[float, ...] | None = None) -> list[tuple[str, Spec]]:
     """The specs to design after the default one, in order, as ``(label, spec)``.
 
     Parameters
@@ -116,6 +117,9 @@ def slower_variants(spec: Spec, default: Design | None) -> list[tuple[str, Spec]
     default : Design or None
         Its default design; ``None`` where it failed (too fast for the rate or the
         velocity bound): then no softer circumvents, the via points first.
+    bound : tuple of float, optional
+        The ``[actuator] input_bound`` taken off ``spec``: a base's ``(v_max, omega_max)``
+        times its moves for the turn too.
 
     Returns
     -------
@@ -131,7 +135,10 @@ def slower_variants(spec: Spec, default: Design | None) -> list[tuple[str, Spec]
         smooth step's is 1.875), when ``tube.method`` allows via points and the spec has
         no tasks (whose legs are cruise segments already), and for a variant whose input
         is a velocity, the same with blended corners (no obstacle that moves, no
-        ``[sensing]``).
+        ``[sensing]``); then, for a variant that ``turns`` (a base, given ``bound``), via
+        points with cruise segments timed for the turn into each move
+        (``via_timing = "turn"``, ``via_turn = v_max / omega_max``), stopped, then blended
+        where blends are tried.
     """
     out: list[tuple[str, Spec]] = []
     if (default is not None and default.method == METHOD_PAPER and default.tube.circumvents
@@ -165,12 +172,22 @@ def slower_variants(spec: Spec, default: Design | None) -> list[tuple[str, Spec]
         # where the input is a velocity: the same with blended corners, which stop at no
         # via box (not where an obstacle moves, nor with [sensing]: a replanned tube and
         # the tube as data have no blends)
-        if (variant_of(spec).via_timing != ACCELERATION_TIMING and spec.sensing is None
-                and not any(ob.motion != "still" for ob in spec.moving_obstacles)):
+        blend = (variant_of(spec).via_timing != ACCELERATION_TIMING and spec.sensing is None
+                 and not any(ob.motion != "still" for ob in spec.moving_obstacles))
+        if blend:
             out.append(("via points, cruise segments, blended corners",
                         replace(spec, tube=replace(spec.tube, method=METHOD_VIA,
                                                    via_profile=CRUISE,
                                                    via_corners=BLEND_CORNERS))))
+        if variant_of(spec).turns and bound is not None:
+            # a base: each move also given the time to turn into it at omega_max
+            turned = replace(spec.tube, method=METHOD_VIA, via_profile=CRUISE,
+                             via_timing=TURN_TIMING, via_turn=bound[0] / bound[1])
+            out.append(("via points timed for the turn, cruise segments",
+                        replace(spec, tube=turned)))
+            if blend:
+                out.append(("via points timed for the turn, cruise segments, blended corners",
+                            replace(spec, tube=replace(turned, via_corners=BLEND_CORNERS))))
     return out
 
 
@@ -231,7 +248,7 @@ def _slower_candidates(spec: Spec, free: Spec, default: Design | None, tried: li
     meets ``spec.input_bound``."""
     bound = spec.input_bound
     softer_failed = False
-    slower = slower_variants(free, default)
+    slower = slower_variants(free, default, bound)
     for k, (label, variant) in enumerate(slower):
         share = (0.5 + 0.5 * k / len(slower), 0.5 + 0.5 * (k + 1) / len(slower))
         report("input bound", share[0], f"input bound: {label} ({k + 2} of at most "

@@ -42,8 +42,8 @@ from ..tube.parameters import (CRUISE, GLIDE, SCURVE, SMOOTHSTEP, ReachSegment, 
                                peak_acceleration_factor, peak_rate_factor)
 
 __all__ = ["ACCELERATION_PROFILES", "ACCELERATION_TIMING", "BLEND_CORNERS", "BLEND_SHARES",
-           "CORNER_SHIFTS", "LENGTH_TIMING", "OVERLAP_SAMPLES", "STOP_CORNERS", "VIA_CORNERS",
-           "VIA_HALF_WIDTH", "VIA_MARGIN", "VIA_TIMINGS", "ViaPlan", "blend_plan",
+           "CORNER_SHIFTS", "LENGTH_TIMING", "OVERLAP_SAMPLES", "STOP_CORNERS", "TURN_TIMING",
+           "VIA_CORNERS", "VIA_HALF_WIDTH", "VIA_MARGIN", "VIA_TIMINGS", "ViaPlan", "blend_plan",
            "blended_times", "move_weight", "plan_via", "timed_moves", "via_design"]
 
 #: Largest half-width of a via box, state units.
@@ -60,7 +60,12 @@ LENGTH_TIMING = "length"
 #: T^2`` for the quintic smooth step) is then the same on every move: the timing for a force
 #: input (the cascade, docs/second-order.md).
 ACCELERATION_TIMING = "acceleration"
-VIA_TIMINGS = (LENGTH_TIMING, ACCELERATION_TIMING)
+#: Via timing: each move's duration in proportion to its length plus ``tube.via_turn``
+#: times its turn from the move before (radians between their directions on the first two
+#: dimensions): for a base, ``v_max / omega_max``, so a move after a corner has the time
+#: to turn too (docs/differential-drive.md).
+TURN_TIMING = "turn"
+VIA_TIMINGS = (LENGTH_TIMING, ACCELERATION_TIMING, TURN_TIMING)
 #: Via corners: every segment starts when the previous one ends, so the tube stops at
 #: every via box (``rho_dot = 0`` there).
 STOP_CORNERS = "stop"
@@ -82,7 +87,7 @@ BLEND_SHARES = (0.5, 0.25, 0.125)
 ACCELERATION_PROFILES = (SCURVE, GLIDE, SMOOTHSTEP, CRUISE)
 
 
-def move_weight(length: float, timing: str) -> float:
+def move_weight(length: float, timing: str, turn: float = 0.0) -> float:
     """A move's share of time before normalisation: its duration is this over the sum of
     its plan's (or leg's) weights times the time the plan has.
 
@@ -90,9 +95,12 @@ def move_weight(length: float, timing: str) -> float:
     ----------
     length : float
         The move's centre distance (max norm), state units.
-    timing : {"length", "acceleration"}
-        :data:`LENGTH_TIMING` (``length``) or :data:`ACCELERATION_TIMING`
-        (``sqrt(length)``).
+    timing : {"length", "acceleration", "turn"}
+        :data:`LENGTH_TIMING` (``length``), :data:`ACCELERATION_TIMING`
+        (``sqrt(length)``) or :data:`TURN_TIMING` (``length + turn``).
+    turn : float
+        With :data:`TURN_TIMING`: the move's turn from the move before, in state units
+        (radians times ``tube.via_turn``).
 
     Returns
     -------
@@ -107,15 +115,27 @@ def move_weight(length: float, timing: str) -> float:
         return length
     if timing == ACCELERATION_TIMING:
         return math.sqrt(length)
+    if timing == TURN_TIMING:
+        return length + turn
     raise ValueError(f"unknown via timing {timing!r}: one of {', '.join(VIA_TIMINGS)}")
+
+
+def _turn(before: np.ndarray, after: np.ndarray) -> float:
+    """Radians between two moves' directions on the first two dimensions (0 where either
+    has no length there)."""
+    if before.size < 2 or not (np.any(before[:2]) and np.any(after[:2])):
+        return 0.0
+    angle = math.atan2(after[1], after[0]) - math.atan2(before[1], before[0])
+    return abs(math.remainder(angle, 2.0 * math.pi))
 
 
 def timed_moves(spec: Spec, moves: list[np.ndarray], duration: float, profile: str
                 ) -> tuple[list[float], list[str]]:
     """The moves' durations sharing ``duration``, and each move's profile.
 
-    With the length timing, or without ``state_space.velocity_bound``, each move's share is
-    its :func:`move_weight` over their sum and every move has ``profile``. Timed for the
+    With the length or the turn timing, or without ``state_space.velocity_bound``, each
+    move's share is its :func:`move_weight` over their sum (with the turn timing, its
+    turn from the move before times ``tube.via_turn``) and every move has ``profile``. Timed for the
     acceleration (:data:`ACCELERATION_TIMING`) under a velocity bound ``v``, the moves get
     the least common peak acceleration ``a`` that fits: move ``k`` (largest coordinate move
     ``L_k``, ``M_k = max_i |m_i| / v_i``) lasts ``min_p max(sqrt(c_p L_k / a), r_p M_k)``
@@ -148,7 +168,8 @@ def timed_moves(spec: Spec, moves: list[np.ndarray], duration: float, profile: s
     """
     timing = spec.tube.via_timing
     lengths = [float(np.max(np.abs(m))) for m in moves]
-    weights = [move_weight(length, timing) for length in lengths]
+    turns = [0.0] + [spec.tube.via_turn * _turn(a, b) for a, b in zip(moves, moves[1:])]
+    weights = [move_weight(length, timing, turn) for length, turn in zip(lengths, turns)]
     if (timing != ACCELERATION_TIMING or spec.velocity_bound is None or not moves
             or not any(weights)):            # (moves of no length: equal shares)
         total = sum(weights)

@@ -184,18 +184,24 @@ class TubeParameters:
         timing (which gives a move ``"glide"`` segments where its S-curve would pass the
         velocity bound), and ``"cruise"`` (a lower peak rate), when the other tubes exceed
         the bound.
-    via_timing : {"length", "acceleration"}
+    via_timing : {"length", "acceleration", "turn"}
         How the via-point segments (and the legs of ``[[tasks]]``) share the time
         (``design/via.py``): in proportion to each move's length, or to its square root
-        (the same peak acceleration on every move). Not a key of the file: ``"length"`` as
-        loaded; the design of a second-order spec within ``[actuator]`` tries
-        ``"acceleration"`` (its input is a force).
+        (the same peak acceleration on every move), or to its length plus ``via_turn``
+        times its turn from the move before (no tasks). Not a key of the file:
+        ``"length"`` as loaded; the design of a second-order spec within ``[actuator]``
+        tries ``"acceleration"`` (its input is a force), of a differential-drive spec
+        ``"turn"``.
     via_corners : {"stop", "blend"}
         Whether the via-point tube stops at every via box (``"stop"``: one segment at a
         time) or passes it, each segment starting before the previous one ends
         (``"blend"``: blended corners, ``design/via.py``). Not a key of the file:
-        ``"stop"`` as loaded; the design of a second-order spec within ``[actuator]``
-        tries ``"blend"`` after the tubes that stop.
+        ``"stop"`` as loaded; the design within ``[actuator]`` tries ``"blend"`` after
+        the tubes that stop.
+    via_turn : float
+        With ``via_timing = "turn"``: state units a move's weight gains per radian of its
+        turn from the move before (a base's ``v_max / omega_max``: the distance it drives
+        in the time it turns one radian). Not a key of the file: 0 as loaded.
     """
 
     delta_b: float
@@ -208,6 +214,7 @@ class TubeParameters:
     via_profile: str = "smoothstep"
     via_timing: str = "length"
     via_corners: str = "stop"
+    via_turn: float = 0.0
 
 
 @dataclass(frozen=True)

@@ -137,6 +137,11 @@ class ControllerVariant:
         (:mod:`stt_codegen.design.via`): ``"length"`` where the input is a velocity (law
         (13), the base's command), ``"acceleration"`` where it is a force (the cascade):
         the design then also tries via segments timed for the acceleration.
+    turns : bool
+        The design within ``[actuator]`` also times a via tube's moves for the turn into
+        each (``tube.via_timing = "turn"``, ``via_turn = v_max / omega_max`` of the input
+        bound; :mod:`stt_codegen.design.via`): the base's, whose limits are a speed and a
+        turn rate.
     timing_in_stage : bool
         The certificate of its stage (:attr:`~stt_codegen.design.result.Design.stage`)
         proves ``[controller] delay`` and ``jitter`` (the cascade's); else the design's
@@ -164,6 +169,7 @@ class ControllerVariant:
     timing_in_stage: bool = False
     tracking_in_stage: bool = False
     via_timing: str = "length"
+    turns: bool = False
     predicts_delay: bool = False
     replans_sensed: bool = False
     actuator_inputs: bool = True
@@ -320,7 +326,7 @@ CONTROLLER_VARIANTS: Mapping[str, ControllerVariant] = MappingProxyType({
                output_limits=_P + "design.output_bound:look_ahead_output_limits",
                predictor=_P + "tube.look_ahead:look_ahead_predictor",
                input_gain=_P + "spec.input_gains:declared_input_gain"),
-        predicts_delay=True, replans_sensed=True, actuator_inputs=False,
+        predicts_delay=True, replans_sensed=True, actuator_inputs=False, turns=True,
         tube_data=("c", "python", "embedded")),
 })
 assert tuple(CONTROLLER_VARIANTS) == VARIANTS
