@@ -66,7 +66,8 @@ def test_design_reports_the_bases_proved_limits_in_text_and_json(tmp_path):
     assert doc["input_bound"] == [1.6, 16.0]
     peak = doc["input_peak"]["peak"]
     assert len(peak) == 2 and all(0 < p <= b for p, b in zip(peak, doc["input_bound"]))
-    assert peak[1] == pytest.approx(peak[0] / 0.1)            # |omega| <= |u| / l
+    # |omega| from the heading the base can have: below the worst heading's |u| / l
+    assert peak[1] < peak[0] / 0.1
     assert doc["input_peak"]["margin"] >= 0
 
 
