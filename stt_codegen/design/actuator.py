@@ -39,7 +39,9 @@ second stage). Deterministic, in this order, the first tube that meets the bound
    **blended corners** (not where an obstacle moves, nor with ``[sensing]``): the tube
    stops at no via box, so it asks less speed of the same time, and a base's heading
    stays aligned with its command through the corners
-   (:mod:`~stt_codegen.design.heading`).
+   (:mod:`~stt_codegen.design.heading`); then, for a base, via points with cruise
+   segments **timed for the turn** into each move (:data:`~.via.TURN_TIMING`), stopped,
+   then blended.
 
 When none does, the design is refused (``DesignError``, kind ``INPUT_BOUND``) naming the
 smallest ``prescribed_time`` at which the same procedure meets the bound (a search on
