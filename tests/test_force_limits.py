@@ -415,8 +415,8 @@ def test_s_curve_legs_keep_a_bound_the_smooth_step_legs_exceed(monkeypatch):
     assert {s.profile for s in design.tube.segments if s.lower_from != s.lower_to} == {
         "scurve"}
     real = actuator.slower_variants
-    monkeypatch.setattr(actuator, "slower_variants", lambda spec, default: [
-        (label, variant) for label, variant in real(spec, default)
+    monkeypatch.setattr(actuator, "slower_variants", lambda spec, default, bound=None: [
+        (label, variant) for label, variant in real(spec, default, bound)
         if variant.tube.via_profile != "scurve" and variant.tube.via_corners != "blend"])
     with pytest.raises(DesignError) as info:
         stt.design_tube(dataclasses.replace(spec))
