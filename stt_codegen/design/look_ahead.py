@@ -147,11 +147,12 @@ def look_ahead_design_proof(design: Design, spec: Spec,
     # min(v_max, omega_max l) where the heading is not enclosed
     speed = (math.inf if bound is None else bound[0] if aware
              else min(bound[0], bound[1] * offset))
-    proof = look_ahead_input_proof(point_proof(design.tube, spec, verdict_limit(
-        spec, lambda u: math.hypot(*u) > speed), initial_error), offset)
+    point = point_proof(design.tube, spec, verdict_limit(
+        spec, lambda u: math.hypot(*u) > speed), initial_error)
+    proof = look_ahead_input_proof(point, offset)
     if not aware or (not advice_wanted() and (bound is None or proof.meets(bound))):
         return proof            # a verdict the worst heading already gives
-    return heading_proof(proof, design.tube, spec)
+    return base_proof(point, design.tube, spec)
 
 
 def base_proof(point: InputProof, tube: TubeDesign, spec: Spec) -> InputProof:
@@ -204,7 +205,7 @@ def heading_bounds(tube: TubeDesign, spec: Spec) -> tuple[np.ndarray, CommandBou
         gives no signed box.
     """
     from ..tube import reference
-    from .certificate.enclosures import enclose_tube
+    from .certificate.actuator import width_bounds
     from .certificate.plant_class import plant_class
     from .certificate.sampled import sampled_check_of
 
@@ -212,12 +213,8 @@ def heading_bounds(tube: TubeDesign, spec: Spec) -> tuple[np.ndarray, CommandBou
     if not check.passed or check.e_box is None:
         return None
     with reference.numpy_math():
-        enclosure = enclose_tube(tube, samples)
-    narrow = enclosure.upper_min - enclosure.lower_max
-    wide = enclosure.upper_max - enclosure.lower_min
-    count = samples.t.size
-    box = corner_boxes(check.e_box[:count], np.vstack([narrow, narrow[-1:]]),
-                       np.vstack([wide, wide[-1:]]), tube.gain)
+        narrow, wide = width_bounds(tube, samples)
+    box = corner_boxes(check.e_box[:samples.t.size], narrow, wide, tube.gain)
     drive, a = spec.drive, plant_class(spec).assumptions
     beta = drive.track_width / (2.0 * drive.axle_offset)
     s = 0.5 * (beta + 1.0 / beta)

@@ -27,7 +27,8 @@ from ...tube.parameters import GAMMA_D_MIN, TubeDesign
 from .sampled import SampledCheck, sampled_check_of
 from .sampled_axis import phi_scalar
 
-__all__ = ["LIMIT_SLACK", "prove_input_bound", "sampled_error_bound"]
+__all__ = ["LIMIT_SLACK", "certified_widths", "prove_input_bound", "sampled_error_bound",
+           "width_bounds"]
 
 #: The relative shade below a sample's bound of ``|u|`` that ``prove_input_bound``'s
 #: ``limit`` is asked (far above an ulp, far below any margin a verdict turns on).
@@ -64,12 +65,20 @@ def sampled_error_bound(result: SampledCheck, samples: TubeSamples) -> np.ndarra
     return np.full((samples.t.size, n), level)
 
 
-def certified_widths(tube: TubeDesign, samples: TubeSamples) -> np.ndarray:
-    """A lower bound of the tube's width at every sample, shape (K, n): the certified
-    enclosure of the interval that starts there (the last sample ends the last one)."""
+def width_bounds(tube: TubeDesign, samples: TubeSamples) -> tuple[np.ndarray, np.ndarray]:
+    """A lower and an upper bound of the tube's width at every sample, shape (K, n) each:
+    the certified enclosure of the interval that starts there (the last sample ends the
+    last one)."""
     enclosure = enclose_tube(tube, samples)
-    width = enclosure.upper_min - enclosure.lower_max
-    return np.vstack([width, width[-1:]])
+    narrow = enclosure.upper_min - enclosure.lower_max
+    wide = enclosure.upper_max - enclosure.lower_min
+    return np.vstack([narrow, narrow[-1:]]), np.vstack([wide, wide[-1:]])
+
+
+def certified_widths(tube: TubeDesign, samples: TubeSamples) -> np.ndarray:
+    """A lower bound of the tube's width at every sample, shape (K, n) (:func:`width_bounds`'
+    first)."""
+    return width_bounds(tube, samples)[0]
 
 
 def prove_input_bound(tube: TubeDesign, spec: Spec, *, per_axis_first: bool = False,
