@@ -160,10 +160,12 @@ def _points(count: int, seed: int) -> list:
              rng.uniform(0.0, 0.01, 4)) for _ in range(count)]
 
 
-# (1.6, 16): the base's limits (office-base's); the points meet the clamp and points within it
-@pytest.mark.parametrize("bound", [None, (1.6, 16.0)])
-def test_c_python_and_casadi_agree_bit_for_bit_and_with_the_oracle(office, bound):
-    look_ahead = LookAhead(0.1, bound)
+# (1.6, 16): the base's limits (office-base's); the points meet the clamp and points within it;
+# with a reverse_speed of 0.2 m/s, v is clamped from below there
+@pytest.mark.parametrize("bound, reverse", [(None, None), ((1.6, 16.0), None),
+                                            ((1.6, 16.0), 0.2)])
+def test_c_python_and_casadi_agree_bit_for_bit_and_with_the_oracle(office, bound, reverse):
+    look_ahead = LookAhead(0.1, bound, reverse)
     function = look_ahead_step(office.tube, look_ahead)
     files = look_ahead_c_files(office.tube, look_ahead, "drive")
     lib = ctypes.CDLL(str(build_shared({k: v.encode() for k, v in files.items()}, "drive.c")))
@@ -173,7 +175,7 @@ def test_c_python_and_casadi_agree_bit_for_bit_and_with_the_oracle(office, bound
     step.restype = ctypes.c_int
     module = types.ModuleType("drive")
     exec(look_ahead_python_file(office.tube, look_ahead, "drive")["drive.py"], module.__dict__)
-    statuses = set()
+    statuses, backing = set(), []
     for x, t, alpha in _points(200, seed=3):
         u, alpha_next = np.zeros(2), np.zeros(4)
         code = step(x.ctypes.data_as(real_p), t, DT, alpha.ctypes.data_as(real_p),
@@ -184,13 +186,16 @@ def test_c_python_and_casadi_agree_bit_for_bit_and_with_the_oracle(office, bound
         assert np.array_equal(u, py_u) and np.array_equal(alpha_next, py_alpha)
         assert code == py_code
         ref_u, ref_alpha, ref_code = look_ahead_reference.look_ahead_status(
-            office.tube, 0.1, bound, x[None], t, DT, alpha[None])
+            office.tube, 0.1, bound, x[None], t, DT, alpha[None], reverse)
         np.testing.assert_allclose(u, ref_u[0], rtol=1e-10, atol=1e-12)
         np.testing.assert_allclose(alpha_next, ref_alpha[0], rtol=1e-12, atol=1e-15)
         assert code == ref_code[0]
         statuses.add(code)
+        backing.append(u[0])
     # the points reach inside and outside the tube, and the clamp where there is one
     assert {0, 1} <= statuses and ((3 in statuses) == (bound is not None))
+    # v clamped from below at -reverse_speed (and backing up beyond it without one)
+    assert min(backing) == -0.2 if reverse else min(backing) < -0.2
 
 
 def test_a_command_at_the_wrong_axle_offset_differs_from_the_oracle(office):
@@ -258,8 +263,11 @@ def test_generation_is_deterministic_and_names_its_source(office, tmp_path):
     assert str(tmp_path) not in source and "/work" not in source
 
 
-def test_the_single_precision_c_compiles_strictly(office):
-    files = look_ahead_c_files(office.tube, LookAhead(0.1, (1.6, 16.0)), "drive", "single")
+@pytest.mark.parametrize("reverse", [None, 0.2])
+def test_the_single_precision_c_compiles_strictly(office, reverse):
+    files = look_ahead_c_files(office.tube, LookAhead(0.1, (1.6, 16.0), reverse), "drive",
+                               "single")
+    assert ("REVERSE_SPEED" in files["drive.h"]) == (reverse is not None)
     build_shared({k: v.encode() for k, v in files.items()}, "drive.c")
 
 

@@ -50,6 +50,7 @@ def test_the_enclosure_holds_for_bases_drawn_within_the_model(seed):
     bounds = command_bounds(boxes, heading0, dt, l, b, gains, d_max, slip)
     worst = np.hypot(*np.abs(boxes).max(axis=2).T) / l
     assert np.all(bounds.turn <= worst * (1.0 + 1e-8))
+    assert np.all(bounds.backward <= worst * l * (1.0 + 1e-8))
     for run in range(40):
         theta = heading0
         gain = rng.choice(gains) if run % 2 else rng.uniform(*gains)
@@ -62,6 +63,7 @@ def test_the_enclosure_holds_for_bases_drawn_within_the_model(seed):
             along = u[0] * math.cos(theta) + u[1] * math.sin(theta)
             across = -u[0] * math.sin(theta) + u[1] * math.cos(theta)
             assert abs(across) / l <= bounds.turn[k], (run, k)
+            assert -along <= bounds.backward[k], (run, k)
             rate = 2.0 * d / b * along + gain * across / l + rng.uniform(-slip, slip)
             theta += dt * rate
 
@@ -77,6 +79,12 @@ def test_an_aligned_command_bounds_the_turn_well_below_the_worst_heading():
     across = command_bounds(boxes, math.pi / 2, 0.01, 0.5, 0.4, (1.0, 1.0), 0.0, 0.0)
     assert across.turn[0] == pytest.approx(1.05 / 0.5, rel=1e-6)
     assert across.turn[-1] < 0.15 * 1.05 / 0.5              # it has turned to the command
+    # backing up: none facing the command (but the rounding); facing across, the command's
+    # lean of 0.05 against the heading; facing away, all of u_x
+    assert aligned.backward.max() < 1e-8
+    assert across.backward[0] == pytest.approx(0.05, rel=1e-6)
+    facing_back = command_bounds(boxes, math.pi, 0.01, 0.5, 0.4, (1.0, 1.0), 0.0, 0.0)
+    assert facing_back.backward[0] == pytest.approx(1.05, rel=1e-6)     # v = -u_x
 
 
 def test_the_command_box_holds_law_13():
@@ -154,4 +162,5 @@ def test_the_closed_loop_keeps_its_heading_and_turn_within_their_bounds(short_ag
         k = len(theta)
         assert np.all(bounds.heading[:k, 0] <= theta) and np.all(theta <= bounds.heading[:k, 1])
         assert np.all(np.abs(u[:, 1]) <= bounds.turn[:k])
+        assert np.all(-u[:, 0] <= bounds.backward[:k])
     assert np.median(bounds.turn) < 0.6 * design.input_proof.peak[0] / 0.6

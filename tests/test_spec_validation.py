@@ -117,7 +117,7 @@ BAD = [
      "must be an array of numbers"),
     (VALID + "\n[actuator]\n", "actuator.input_bound", "missing"),
     (VALID + "\n[actuator]\ninput_bound = [1.0, 1.0]\nmax_rate = 3\n", "actuator.max_rate",
-     "unknown key (allowed: input_bound)"),
+     "unknown key (allowed: input_bound, reverse_speed)"),
     ("obstacles = 5\n" + VALID.replace("[[obstacles]]\nlower = [2.0, 2.0]\nupper = [3.0, 3.0]\n", ""),
      "obstacles", "must be an array"),
 ]

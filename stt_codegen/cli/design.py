@@ -137,6 +137,9 @@ def cmd_design(args: argparse.Namespace) -> int:
         unit = f" {spec.input_unit}" if spec.input_unit else ""
         peaks = ", ".join(f"|{name}| {p:.4g} <= {b:g}{unit}" for name, p, b in zip(
             spec.input_names, design.input_proof.peak, spec.input_bound))
+        if spec.reverse_speed is not None:
+            peaks += (f", backing up {design.input_proof.backward:.4g} <= "
+                      f"{spec.reverse_speed:g} m/s")
         print(f"  PASS  input bound: {law} asks at most [{peaks}] (proved)")
     if design.output_warning is not None:
         print(f"  warning: {design.output_warning}")

@@ -9,7 +9,7 @@ double precision.
   ``c_source.c.j2``): the same tables and table-driven tube, ``P_tube``, ``P_alpha_step``
   and input checks, with the variant's law (``look_ahead_source.c.j2``: the pieces
   ``look_ahead_point`` and ``base_command`` around the first order's ``law``, its
-  ``saturate`` with the base's limits).
+  ``saturate`` with the base's limits, ``saturate_between`` with a ``reverse_speed``).
 * Python: a variant of the first-order module (:func:`.generate.python_module_context`,
   ``python_module.py.j2``) in the same way (``look_ahead_module.py.j2``).
 
@@ -65,6 +65,10 @@ def _context(design: TubeDesign, look_ahead: LookAhead, prefix: str, precision: 
             **{name: literal(value) for name, value in limits.items()},
             "axle_offset": literal(look_ahead.axle_offset),
             "input_bound": None if bound is None else [literal(b) for b in bound],
+            "input_lower": (None if look_ahead.input_lower is None
+                            else [literal(b) for b in look_ahead.input_lower]),
+            "reverse_speed": (None if look_ahead.reverse_speed is None
+                              else literal(look_ahead.reverse_speed)),
             # without limits: what the clamp of the errors allows, in words (3 digits)
             "output_clamp": (None if bound is not None else
                              [f"{c:.3g}" for c in base_clamp(design.gain,
@@ -79,7 +83,8 @@ def _pieces(design: TubeDesign, look_ahead: LookAhead, predictor: casadi.Functio
     return [*deployed_functions(build_model(design), capacity is not None),
             *([P.error_transform(design.dimension)] if capacity is not None else []),
             look_ahead_point(), base_command(),
-            *([P.saturate(2)] if look_ahead.input_bound is not None else []),
+            *([] if look_ahead.input_bound is None else [P.saturate(2)]
+              if look_ahead.input_lower is None else [P.saturate_between(2)]),
             *([predictor] if predictor is not None else [])]
 
 
@@ -237,16 +242,19 @@ def look_ahead_vectors(design: TubeDesign, look_ahead: LookAhead, precision: str
     tol_u, keep = T.look_ahead_bounds(design, offset, states, t, alpha, u_point, u_free, unit)
     if look_ahead.input_bound is not None:
         bound = np.asarray(look_ahead.input_bound, dtype=float)
-        keep &= np.all(np.abs(np.abs(u_free) - bound) > tol_u + 2.0 * unit * bound, axis=1)
+        lower = -bound if look_ahead.input_lower is None else np.asarray(look_ahead.input_lower)
+        for end in (bound, lower):           # away from either end of the clamp
+            keep &= np.all(np.abs(u_free - end) > tol_u + 2.0 * unit * bound, axis=1)
     kept = {"x": states, "t": t, "dt": dt, "alpha": alpha, "tol_u": tol_u}
     kept = {k: v[keep] for k, v in kept.items()}
     # the law's status does not depend on dt: the step's at dt = PERIOD
     law = LR.look_ahead_status(design, offset, look_ahead.input_bound, kept["x"], kept["t"],
-                               np.full(kept["t"].shape, 1.0 / design.rate_hz), kept["alpha"])[2]
+                               np.full(kept["t"].shape, 1.0 / design.rate_hz), kept["alpha"],
+                               look_ahead.reverse_speed)[2]
     kept = with_copies(kept, *period_copies(kept["dt"], law, design.rate_hz))
     states, t, dt, alpha, tol_u = (kept[k] for k in ("x", "t", "dt", "alpha", "tol_u"))
     u, alpha_next, status = LR.look_ahead_status(design, offset, look_ahead.input_bound,
-                                                 states, t, dt, alpha)
+                                                 states, t, dt, alpha, look_ahead.reverse_speed)
     return vector_document(design, precision, states, t, dt, alpha, u, alpha_next, status,
                            tol_u)
 

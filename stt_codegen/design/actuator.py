@@ -76,7 +76,7 @@ from .via import ACCELERATION_TIMING, BLEND_CORNERS, STOP_CORNERS, TURN_TIMING
 from .samples import HORIZON_FACTOR, STEP_BUDGET
 from .windows import SHARPNESS_LADDER
 
-__all__ = ["design_within_bound", "law13_input_proof", "verdict_limit"]
+__all__ = ["design_within_bound", "law13_input_proof", "reverse_speed_needed", "verdict_limit"]
 
 #: A longer ``t_c`` must lower the best peak-to-bound ratio by at least this factor, or the
 #: search stops: the peak no longer falls with the tube's speed (the disturbance and drift
@@ -415,7 +415,11 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
             kind=FailureKind.INPUT_BOUND, tried=tried[0].design.tube if tried else None,
             advice=({"controller.rate_hz": rate} if rate is not None else
                     later_advice(spec, later) if later is not None else {}))
-    best = min(proved, key=lambda c: c.proof.ratio(bound))
+    backing = _backing_up(spec, [c for c in proved if c.proof.complete
+                                 and _peak_ratio(c.proof, bound) <= 1.0], law)
+    if backing is not None:
+        raise backing
+    best = min(proved, key=lambda c: (_peak_ratio(c.proof, bound), c.proof.ratio(bound)))
     worst = max(range(len(bound)), key=lambda i: best.proof.peak[i] / bound[i])
     needs = ", ".join(f"{_round_up(v):g}" for v in best.proof.peak)
     asks = "up to" if best.proof.complete else "at least"     # a partial proof's peak
@@ -424,6 +428,10 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
                f"the best ({best.label}) asks {asks} {best.proof.peak[worst]:.3g}{unit} of "
                f"input {names[worst]} (bound {bound[worst]:g}{unit}) at t = "
                f"{best.proof.time[worst]:.3f} s")
+    if not best.proof.backs_up_within:
+        message += (f", and backs the base up at {best.proof.backward:.3g} m/s at t = "
+                    f"{best.proof.backward_time:.3f} s (actuator.reverse_speed = "
+                    f"{best.proof.reverse_limit:g} m/s)")
     if not advice_wanted():                   # the verdict only (a probe of a search)
         raise DesignError(message, kind=FailureKind.INPUT_BOUND, tried=best.design.tube)
     works, why = smallest_prescribed_time(spec, design_free, prove,
@@ -438,6 +446,40 @@ def design_within_bound(spec: Spec, design_free: Callable[[Spec], Design],
     raise DesignError(message, kind=FailureKind.INPUT_BOUND, tried=best.design.tube,
                       advice={} if works is None else later_advice(spec, works))
 
+
+
+def _peak_ratio(proof: InputProof, bound: tuple[float, ...]) -> float:
+    """``max_i peak_i / bound_i`` of a proved ``proof`` (its backing up left out)."""
+    return max(p / b for p, b in zip(proof.peak, bound)) if proof.proved else math.inf
+
+
+def _backing_up(spec: Spec, fitting: list[Candidate], law: str) -> DesignError | None:
+    """The refusal of a base whose candidates in ``fitting`` (each within
+    ``input_bound``) all back up faster than ``[actuator] reverse_speed``, naming the
+    ``reverse_speed`` the lowest of them needs; ``None`` when ``fitting`` is empty.
+
+    Following the advice designs the same candidates, in the same order, with the same
+    proofs: the first within the bound and backing up at most that fast is certified.
+    """
+    if not fitting:
+        return None
+    best = min(fitting, key=lambda c: c.proof.backward)
+    proof = best.proof
+    message = (f"no design within prescribed_time = {spec.prescribed_time:g} s keeps {law} "
+               f"within actuator.reverse_speed = {proof.reverse_limit:g} m/s: the best "
+               f"({best.label}) keeps within input_bound but backs the base up at "
+               f"{proof.backward:.3g} m/s at t = {proof.backward_time:.3f} s")
+    needs = reverse_speed_needed(proof, spec.input_bound[0])
+    return DesignError(message + f"; actuator.reverse_speed = {needs:g} m/s works with this "
+                       "prescribed_time", kind=FailureKind.INPUT_BOUND, tried=best.design.tube,
+                       advice={"actuator.reverse_speed": needs})
+
+
+def reverse_speed_needed(proof: InputProof, v_max: float) -> float:
+    """The ``[actuator] reverse_speed`` that a base's ``proof`` meets: its ``backward``
+    rounded up to two significant digits, at most ``v_max`` (m/s; a proof within
+    ``input_bound`` backs up no faster than ``v_max``)."""
+    return min(_round_up(proof.backward, 2), v_max)
 
 
 def _round_up(value: float, digits: int = 3) -> float:

@@ -40,7 +40,7 @@ def advice_wanted() -> bool:
 
 #: The unit each advice field is printed with (``DesignError.advice``).
 ADVICE_UNITS = {"prescribed_time": " s", WINDOW_END: " s", "controller.delay": " s",
-                "plant.axle_offset": " m"}
+                "plant.axle_offset": " m", "actuator.reverse_speed": " m/s"}
 
 
 def advice_text(name: str, value: float | bool) -> str:

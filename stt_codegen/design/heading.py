@@ -16,7 +16,8 @@ odd and increasing):
    the box is at a corner ``c``; at a corner, ``|h_perp(theta) . c| = |c| |sin(angle(c) -
    theta)|``, whose largest value over an interval of ``theta`` is at an end or at a right
    angle inside it. (``|v| = |h . u|`` keeps the bound of ``|u|``: a base aligned with its
-   command asks that much.)
+   command asks that much.) Backing up, ``-v = -|c| cos(angle(c) - theta)`` at a corner,
+   is largest at an end or where ``angle(c) - theta`` is an odd multiple of ``pi``.
 3. **The heading's enclosure.** Under the held command the base turns by ``theta_{k+1} =
    theta_k + dt ((2 d / b) h(theta_k) . u_k + M h_perp(theta_k) . u_k / l) + int w_omega``
    (the wheel model of docs/differential-drive.md: ``M = 1 + m``, ``|d|``, ``|w_omega| <=
@@ -63,10 +64,14 @@ class CommandBounds:
         A bound of ``|omega_k|``, rad/s (at most the bound of ``|u_k| / l``).
     heading : ndarray, shape (K, 2)
         An enclosure of ``theta(t_k)``, rad (``-inf, inf`` where unknown).
+    backward : ndarray, shape (K,)
+        A bound of ``max(0, -v_k)``, the speed the base may be asked to back up at, m/s
+        (the bound of ``|u_k|`` where the heading is unknown).
     """
 
     turn: np.ndarray
     heading: np.ndarray
+    backward: np.ndarray
 
 
 def corner_boxes(e_box: np.ndarray, width_lo: np.ndarray, width_hi: np.ndarray,
@@ -105,6 +110,15 @@ def _largest_sine(angle: float, lo: float, hi: float) -> float:
     return max(abs(math.sin(a)), abs(math.sin(b)))
 
 
+def _smallest_cosine(angle: float, lo: float, hi: float) -> float:
+    """``min cos(angle - theta)`` over ``theta`` in ``[lo, hi]`` (``hi - lo < pi``)."""
+    a, b = angle - hi, angle - lo
+    # an odd multiple of pi inside [a, b] reaches -1
+    if math.floor((b - math.pi) / (2.0 * math.pi)) >= math.ceil((a - math.pi) / (2.0 * math.pi)):
+        return -1.0
+    return min(math.cos(a), math.cos(b))
+
+
 def command_bounds(u_box: np.ndarray, heading0: float, dt: float, axle_offset: float,
                    track_width: float, mean_gain: tuple[float, float],
                    differential: float, turn_noise: float) -> CommandBounds:
@@ -136,6 +150,7 @@ def command_bounds(u_box: np.ndarray, heading0: float, dt: float, axle_offset: f
     lean = math.hypot(2.0 * differential / track_width, max(mean_gain) / axle_offset)
     signs = [(g, 2.0 * d / track_width) for g in mean_gain for d in (-differential, differential)]
     turn = np.empty(count)
+    backward = np.empty(count)
     heading = np.empty((count, 2))
     lo = hi = float(heading0)
     boxes = u_box.tolist()
@@ -144,13 +159,17 @@ def command_bounds(u_box: np.ndarray, heading0: float, dt: float, axle_offset: f
         (x_lo, x_hi), (y_lo, y_hi) = boxes[k]
         corners = ((x_lo, y_lo), (x_lo, y_hi), (x_hi, y_lo), (x_hi, y_hi))
         known = math.isfinite(lo) and math.isfinite(hi) and hi - lo < math.pi
-        largest = top = 0.0
+        largest = top = back = 0.0
         for cx, cy in corners:
             r = math.hypot(cx, cy)
             largest = max(largest, r)
-            top = max(top, r * (_largest_sine(math.atan2(cy, cx), lo, hi) if known else 1.0))
-        # a relative ROUNDING above the floats' value (sin, hypot, the products)
+            angle = math.atan2(cy, cx)
+            top = max(top, r * (_largest_sine(angle, lo, hi) if known else 1.0))
+            back = max(back, -r * (_smallest_cosine(angle, lo, hi) if known else -1.0))
+        # a relative ROUNDING above the floats' value (sin, hypot, the products); backing
+        # up also ROUNDING |u| above it, since its value crosses 0
         turn[k] = top / axle_offset * (1.0 + ROUNDING)
+        backward[k] = max(back, 0.0) * (1.0 + ROUNDING) + ROUNDING * largest
         if not (math.isfinite(lo) and math.isfinite(hi)):
             continue
         if dt * largest * lean >= 1.0:                     # not increasing: unknown
@@ -166,4 +185,4 @@ def command_bounds(u_box: np.ndarray, heading0: float, dt: float, axle_offset: f
         hi = ends[1] + dt * turn_noise + ROUNDING * (1.0 + abs(ends[1]))
         if hi - lo >= 2.0 * math.pi:
             lo, hi = -math.inf, math.inf
-    return CommandBounds(turn, heading)
+    return CommandBounds(turn, heading, backward)

@@ -65,6 +65,15 @@ class InputProof:
         The peaks are over the whole horizon; false for a proof that stopped at the first
         sample over a caller's limit (``prove_input_bound``'s ``limit``): its peaks are
         those up to that sample, lower bounds of the whole proof's, and it meets no bound.
+    backward : float
+        A differential-drive base's: a bound of the speed ``max(0, -v)`` it may be asked to
+        back up at, m/s (docs/differential-drive.md, "Backing up"); 0 for the other
+        variants.
+    backward_time : float
+        The sample instant of :attr:`backward`, seconds.
+    reverse_limit : float
+        The ``[actuator] reverse_speed`` :attr:`backward` is judged against (``inf``: none,
+        the bound of ``|v|`` covers it).
     """
 
     proved: bool
@@ -76,24 +85,42 @@ class InputProof:
     speed: float = math.inf
     speed_time: float = 0.0
     complete: bool = True
+    backward: float = 0.0
+    backward_time: float = 0.0
+    reverse_limit: float = math.inf
+
+    @property
+    def backs_up_within(self) -> bool:
+        """:attr:`backward` within :attr:`reverse_limit`."""
+        return self.backward <= self.reverse_limit
+
+    def _reverse_ratio(self) -> float:
+        """``backward / reverse_limit`` (0 without a limit or when 0, ``inf`` for a positive
+        ``backward`` over a limit of 0)."""
+        if self.backward == 0.0 or math.isinf(self.reverse_limit):
+            return 0.0
+        return math.inf if self.reverse_limit == 0.0 else self.backward / self.reverse_limit
 
     def ratio(self, bound: tuple[float, ...]) -> float:
-        """``max_i peak_i / bound_i`` (``inf`` when not proved): at most 1 meets the bound."""
+        """``max_i peak_i / bound_i`` and ``backward / reverse_limit`` (``inf`` when not
+        proved): at most 1 meets the bound."""
         if not self.proved:
             return math.inf
-        return max(p / b for p, b in zip(self.peak, bound))
+        return max(max(p / b for p, b in zip(self.peak, bound)), self._reverse_ratio())
 
     def meets(self, bound: tuple[float, ...]) -> bool:
-        """Proved over the whole horizon, and ``peak_i <= bound_i`` for every input."""
-        return (self.proved and self.complete
+        """Proved over the whole horizon, ``peak_i <= bound_i`` for every input, and
+        ``backward <= reverse_limit``."""
+        return (self.proved and self.complete and self.backs_up_within
                 and all(p <= b for p, b in zip(self.peak, bound)))
 
     def margin(self, bound: tuple[float, ...]) -> float:
-        """``min_i (bound_i - peak_i) / bound_i``: the relative room left (negative:
-        exceeded; ``-inf`` when not proved)."""
+        """``min_i (bound_i - peak_i) / bound_i``, and ``1 - backward / reverse_limit``: the
+        relative room left (negative: exceeded; ``-inf`` when not proved)."""
         if not self.proved:
             return -math.inf
-        return min((b - p) / b for p, b in zip(self.peak, bound))
+        return min(min((b - p) / b for p, b in zip(self.peak, bound)),
+                   1.0 - self._reverse_ratio())
 
 
 def phi(s: "np.ndarray") -> "np.ndarray":

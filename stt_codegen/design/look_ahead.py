@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import DesignError, SpecError, number_text
 from ..spec.loader import Spec
-from .actuator import design_within_bound, verdict_limit
+from .actuator import design_within_bound, reverse_speed_needed, verdict_limit
 from .certificate.actuator import prove_input_bound
 from .failures import FailureKind, advice_wanted, without_advice
 from .grid import grid_index, grid_value, smallest_passing
@@ -38,12 +38,18 @@ from .input_bound import InputProof
 from .result import Design
 from ..tube.parameters import TubeDesign
 
-__all__ = ["MAX_OFFSET_FACTOR", "base_proof", "heading_bounds", "heading_known", "heading_proof",
-           "look_ahead_design_proof", "look_ahead_input_proof", "look_ahead_within_bound",
-           "point_proof", "shortest_axle_offset"]
+__all__ = ["MAX_OFFSET_FACTOR", "NEVER_BACKS_UP", "base_proof", "heading_bounds", "heading_known",
+           "heading_proof", "look_ahead_design_proof", "look_ahead_input_proof",
+           "look_ahead_within_bound", "point_proof", "shortest_axle_offset"]
 
 #: The ``plant.axle_offset`` search tries up to this many times the spec's offset.
 MAX_OFFSET_FACTOR = 8.0
+
+#: Why ``[actuator] reverse_speed = 0`` is never certified (docs/differential-drive.md,
+#: "Backing up").
+NEVER_BACKS_UP = ("where the tube holds the look-ahead point still, law (13)'s command may "
+                  "point every way within its proved box, so the base may be asked to back "
+                  "up")
 
 
 def look_ahead_input_proof(proof: InputProof, axle_offset: float) -> InputProof:
@@ -150,7 +156,8 @@ def look_ahead_design_proof(design: Design, spec: Spec,
     point = point_proof(design.tube, spec, verdict_limit(
         spec, lambda u: math.hypot(*u) > speed), initial_error)
     proof = look_ahead_input_proof(point, offset)
-    if not aware or (not advice_wanted() and (bound is None or proof.meets(bound))):
+    if spec.reverse_speed is None and (not aware or (
+            not advice_wanted() and (bound is None or proof.meets(bound)))):
         return proof            # a verdict the worst heading already gives
     return base_proof(point, design.tube, spec)
 
@@ -171,8 +178,13 @@ def base_proof(point: InputProof, tube: TubeDesign, spec: Spec) -> InputProof:
     Returns
     -------
     InputProof
+        With :attr:`~.input_bound.InputProof.backward` (the bound of ``|u|`` where the
+        heading is not enclosed) judged against ``[actuator] reverse_speed``.
     """
     proof = look_ahead_input_proof(point, spec.drive.axle_offset)
+    proof = replace(proof, backward=proof.peak[0], backward_time=proof.time[0],
+                    reverse_limit=(math.inf if spec.reverse_speed is None
+                                   else spec.reverse_speed))
     return heading_proof(proof, tube, spec) if heading_known(spec) else proof
 
 
@@ -243,7 +255,8 @@ def heading_proof(proof: InputProof, tube: TubeDesign, spec: Spec) -> InputProof
     -------
     InputProof
         ``peak = (|v|, |omega|)``: ``|v|``'s is ``proof``'s (the bound of ``|u|``), and
-        ``|omega|``'s at most ``proof``'s, at the sample where it is largest.
+        ``|omega|``'s at most ``proof``'s, at the sample where it is largest; ``backward``
+        at most ``proof``'s, from the heading likewise.
     """
     if not (proof.proved and proof.complete):
         return proof
@@ -251,7 +264,10 @@ def heading_proof(proof: InputProof, tube: TubeDesign, spec: Spec) -> InputProof
     if found is None:
         return proof
     t, bounds = found
-    peak = float(bounds.turn.max())
+    peak, back = float(bounds.turn.max()), float(bounds.backward.max())
+    if back < proof.backward:
+        proof = replace(proof, backward=back,
+                        backward_time=float(t[int(np.argmax(bounds.backward))]))
     if peak >= proof.peak[1]:
         return proof
     return replace(proof, peak=(proof.peak[0], peak),
@@ -283,11 +299,33 @@ def look_ahead_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -
         is what the best tube exceeds, the message also names the ``plant.axle_offset``
         that :func:`shortest_axle_offset` finds certified (``advice["plant.axle_offset"]``).
     """
+    if spec.reverse_speed == 0.0:
+        raise _never_backing_up(spec, design_free)
     try:
         design = design_within_bound(spec, design_free)
     except DesignError as error:
         raise _naming_axle_offset(spec, design_free, error) from None
     return replace(design, tube=replace(design.tube, input_bound=None))
+
+
+def _never_backing_up(spec: Spec, design_free: Callable[[Spec], Design]) -> DesignError:
+    """The refusal of ``[actuator] reverse_speed = 0``, which no tube meets
+    (:data:`NEVER_BACKS_UP`), with what the design allowed to back up gives: the
+    ``reverse_speed`` it needs where it is certified, else its refusal (whose advice holds
+    for it, not for this spec: none is given)."""
+    allowed = replace(spec, reverse_speed=None)
+    head = f"actuator.reverse_speed = 0 is not certified: {NEVER_BACKS_UP}"
+    try:
+        design = look_ahead_within_bound(allowed, design_free)
+    except DesignError as error:
+        return DesignError(f"{head}; allowed to back up (reverse_speed omitted), {error}",
+                           kind=FailureKind.INPUT_BOUND, tried=error.tried)
+    proof = design.input_proof
+    needs = reverse_speed_needed(proof, spec.input_bound[0])
+    return DesignError(f"{head}; its tube backs the base up at {proof.backward:.3g} m/s at "
+                       f"t = {proof.backward_time:.3f} s: actuator.reverse_speed = "
+                       f"{number_text(needs)} m/s is certified", kind=FailureKind.INPUT_BOUND,
+                       tried=design.tube, advice={"actuator.reverse_speed": needs})
 
 
 def _naming_axle_offset(spec: Spec, design_free: Callable[[Spec], Design],

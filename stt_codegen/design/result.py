@@ -244,7 +244,8 @@ class Design:
             The spec's ``plant.model`` is not a differential drive (field ``plant.model``).
         """
         require_variant(self.spec, "look-ahead", "a look-ahead point")
-        return LookAhead(self.spec.drive.axle_offset, self.spec.input_bound)
+        return LookAhead(self.spec.drive.axle_offset, self.spec.input_bound,
+                         self.spec.reverse_speed)
 
     @property
     def stage(self) -> SecondStage | LookAhead | None:

@@ -402,7 +402,8 @@ def _own_value(spec: Spec, key: str) -> float | None:
     """The spec's own value of an advice key (``DesignError.advice``), if it is a number."""
     return {"prescribed_time": spec.prescribed_time, WINDOW_END: spec.prescribed_time,
             "controller.rate_hz": spec.rate_hz, "controller.delay": spec.delay,
-            "plant.axle_offset": getattr(spec.drive, "axle_offset", None)}.get(key)
+            "plant.axle_offset": getattr(spec.drive, "axle_offset", None),
+            "actuator.reverse_speed": spec.reverse_speed}.get(key)
 
 
 def _any_target_advice(spec: Spec, failures: list[tuple[int, DesignError]]

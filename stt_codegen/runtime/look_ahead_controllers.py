@@ -70,7 +70,7 @@ class LookAheadController:
     def _reference(self, x, t, dt, alpha):
         u, alpha_next, status = look_ahead_reference.look_ahead_status(
             self.design, self.look_ahead.axle_offset, self.look_ahead.input_bound, x[None],
-            t, dt, alpha[None])
+            t, dt, alpha[None], self.look_ahead.reverse_speed)
         return u[0], alpha_next[0], Status(int(status[0]))
 
     def step(self, x: np.ndarray, t: float, dt: float,

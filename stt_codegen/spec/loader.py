@@ -300,6 +300,10 @@ class Spec:
         law (13)'s ``u`` for a first-order model; for a second-order model the physical
         input (force or torque, :attr:`input_unit`) of the cascade's second stage, not the
         virtual velocity ``r``. ``None``: no ``[actuator]``, no limit.
+    reverse_speed : float or None
+        ``[actuator] reverse_speed`` of a differential-drive base: the largest speed it may
+        be asked to back up at, m/s (``v >= -reverse_speed``), at most ``v_max``; ``None``:
+        ``|v| <= v_max`` (docs/differential-drive.md, "Backing up").
     second_order : SecondOrder or None
         The second-order plant (``plant.model`` a second-order model, with
         ``plant.parameters``, ``initial.velocity``, ``state_space.velocity_bound`` and the
@@ -377,6 +381,7 @@ class Spec:
     linear_plant: LinearPlant | None = None
     assumptions: Assumptions = Assumptions()
     input_bound: tuple[float, ...] | None = None
+    reverse_speed: float | None = None
     second_order: SecondOrder | None = None
     source_hash: str = field(default="", compare=False)
     target_half_width_given: bool = True
@@ -914,6 +919,8 @@ def _validate(raw: dict) -> Spec:
                                          state_space, plant_data),
                 input_bound=_input_bound(doc.actuator, doc.plant.model, n,
                                          doc.plant.actuators),
+                reverse_speed=_reverse_speed(doc.actuator, doc.plant.model,
+                                             doc.sensing is not None),
                 second_order=second_order,
                 target_half_width_given=doc.target.half_width is not None,
                 tasks=build_tasks(doc.tasks or (), n, doc.prescribed_time,
@@ -1120,6 +1127,28 @@ def _input_bound(table: ActuatorTable | None, model: str, n: int,
                         f"must have {count} entries (one per input of the {model} plant: "
                         f"{', '.join(names)}{unit}), got {len(table.input_bound)}")
     return tuple(float(v) for v in table.input_bound)
+
+
+def _reverse_speed(table: ActuatorTable | None, model: str, sensing: bool) -> float | None:
+    """``[actuator] reverse_speed``: a differential-drive base's, at most its ``v_max``; not
+    with ``[sensing]``, whose replanned tubes start from a heading the proof does not
+    enclose."""
+    if table is None or table.reverse_speed is None:
+        return None
+    if sensing:
+        raise SpecError("actuator.reverse_speed", "is not available with [sensing]: a tube "
+                        "replanned at run time starts from a heading the proof of backing up "
+                        "does not enclose")
+    if not variant_of(plant_entry(model)).turns:
+        raise SpecError("actuator.reverse_speed", f"is for a differential-drive base (the "
+                        f"speed it may back up at); plant.model is {model!r}, whose "
+                        "input_bound already bounds each input both ways")
+    v_max = table.input_bound[0]
+    if table.reverse_speed > v_max:
+        raise SpecError("actuator.reverse_speed", f"= {number_text(table.reverse_speed)} m/s "
+                        f"exceeds input_bound's v_max = {number_text(v_max)} m/s, which "
+                        "bounds |v| both ways")
+    return float(table.reverse_speed)
 
 
 def _dims(given: list[int] | None, name: str, m: int, n: int,

@@ -295,6 +295,10 @@ class ActuatorTable(_Table):
                           "for a second-order plant the physical input, one per position: "
                           "a force in N, the two-link arm's torques in N m); positive; "
                           "one entry per input")
+    reverse_speed: NonNegative = _omitted(
+        "differential-drive only: the largest speed the base may be asked to back up at, "
+        "m/s (v >= -reverse_speed; 0: it never reverses); at most input_bound's v_max; "
+        "default v_max (|v| <= v_max)")
 
 
 class RobotTable(_Table):

@@ -51,15 +51,20 @@ class LookAhead:
     input_bound : tuple of float or None
         ``(v_max, omega_max)``: the base's limits (m/s, rad/s); the command is clamped to
         them. ``None``: no limit.
+    reverse_speed : float or None
+        With ``input_bound``: ``v`` is clamped from below at ``-reverse_speed`` (m/s, in
+        ``[0, v_max]``) in place of ``-v_max``. ``None``: at ``-v_max``.
 
     Raises
     ------
     ValueError
-        ``axle_offset`` not positive and finite, or a bound not positive and finite.
+        ``axle_offset`` not positive and finite, a bound not positive and finite, or
+        ``reverse_speed`` outside ``[0, v_max]`` or without ``input_bound``.
     """
 
     axle_offset: float
     input_bound: tuple[float, float] | None = None
+    reverse_speed: float | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.axle_offset) and self.axle_offset > 0.0):
@@ -70,6 +75,25 @@ class LookAhead:
                 and all(math.isfinite(b) and b > 0.0 for b in self.input_bound)):
             raise ValueError(f"input_bound must be two positive numbers (v, omega), got "
                              f"{self.input_bound!r}")
+        if self.reverse_speed is not None and not (
+                self.input_bound is not None and 0.0 <= self.reverse_speed <= self.input_bound[0]):
+            raise ValueError(f"reverse_speed must lie in [0, v_max] with an input_bound, got "
+                             f"{self.reverse_speed!r}")
+
+    def __repr__(self) -> str:
+        # reverse_speed named only where given: the files of a base without it keep their
+        # design hash
+        given = "" if self.reverse_speed is None else f", reverse_speed={self.reverse_speed!r}"
+        return (f"LookAhead(axle_offset={self.axle_offset!r}, "
+                f"input_bound={self.input_bound!r}{given})")
+
+    @property
+    def input_lower(self) -> tuple[float, float] | None:
+        """``(-reverse_speed, -omega_max)`` with a ``reverse_speed``, else ``None`` (the
+        clamp's lower ends are ``-input_bound``)."""
+        if self.reverse_speed is None:
+            return None
+        return (-self.reverse_speed, -self.input_bound[1])
 
 
 @lru_cache(maxsize=None)
@@ -120,7 +144,8 @@ def look_ahead_step(design: TubeDesign, look_ahead: LookAhead) -> ca.Function:
     :func:`stt_codegen.tube.model.build_model` (law (13) on the adaptive tube of eq. (10)
     and the deployed implicit step of (11)), whose ``u`` :func:`base_command` turns into
     ``(v, omega)``. With ``look_ahead.input_bound`` the command is clamped by the first
-    order's :func:`stt_codegen.tube.pieces.saturate_expression` and a fourth output,
+    order's :func:`stt_codegen.tube.pieces.saturate_expression` (``v`` from below at
+    ``-reverse_speed`` with one) and a fourth output,
     ``within_bound``, is 1.0 when no entry moved.
 
     Parameters
@@ -157,7 +182,9 @@ def look_ahead_step(design: TubeDesign, look_ahead: LookAhead) -> ca.Function:
     u = base_command()(heading, u_point, offset)
     outputs, names = [u, alpha_next, inside], list(LOOK_AHEAD_OUTPUTS[:3])
     if look_ahead.input_bound is not None:
-        u, within = P.saturate_expression(u, ca.DM(list(look_ahead.input_bound)), BASE_INPUTS)
+        lower = look_ahead.input_lower
+        u, within = P.saturate_expression(u, ca.DM(list(look_ahead.input_bound)), BASE_INPUTS,
+                                          None if lower is None else ca.DM(list(lower)))
         outputs, names = [u, alpha_next, inside, within], list(LOOK_AHEAD_OUTPUTS)
     return ca.Function("look_ahead_step", [x, t, dt, alpha], outputs,
                        ["x", "t", "dt", "alpha"], names)

@@ -62,7 +62,8 @@ def command(states, u_point, axle_offset: float) -> np.ndarray:
 
 def look_ahead_status(design: TubeDesign, axle_offset: float,
                       input_bound: tuple[float, float] | None, states, t, dt,
-                      alpha) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                      alpha, reverse_speed: float | None = None
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """One step of the variant: ``(v, omega)``, ``alpha_next`` and the status code.
 
     Parameters
@@ -77,6 +78,9 @@ def look_ahead_status(design: TubeDesign, axle_offset: float,
     t, dt : float or array_like, shape (N,)
         s.
     alpha : array_like, shape (N, 4)
+    reverse_speed : float, optional
+        With ``input_bound``: ``v`` is clamped from below at ``-reverse_speed`` (m/s)
+        rather than at ``-v_max``.
 
     Returns
     -------
@@ -93,7 +97,8 @@ def look_ahead_status(design: TubeDesign, axle_offset: float,
     u = command(states, u_point, axle_offset)
     if input_bound is not None:
         bound = np.asarray(input_bound, dtype=float)
-        clamped = np.minimum(np.maximum(u, -bound), bound)
+        low = -bound if reverse_speed is None else np.array([-reverse_speed, -bound[1]])
+        clamped = np.minimum(np.maximum(u, low), bound)
         moved = np.any(clamped != u, axis=1)
         u = clamped
         status = np.where((status == STATUS_OK) & moved, STATUS_INPUT_CLAMPED, status)

@@ -704,7 +704,7 @@ def law_expression(x, gamma_l, gamma_u, gain, n: int) -> tuple:
     return -gain * xi * epsilon, inside
 
 
-def saturate_expression(u, bound, n: int) -> tuple:
+def saturate_expression(u, bound, n: int, lower=None) -> tuple:
     """The actuator clamp: ``(u_c, within)`` (SX), ``u_c = min(max(u, -bound), bound)``
     entry by entry and ``within = 1`` when no entry was moved (``-bound_i <= u_i <= bound_i``
     for every ``i``, exact comparisons; a product of 0/1 values, exact), else 0.
@@ -721,6 +721,9 @@ def saturate_expression(u, bound, n: int) -> tuple:
         The actuator bound ``[actuator] u_max``, positive, input units.
     n : int
         Input dimension.
+    lower : casadi.SX, shape (n,), optional
+        The lower ends in place of ``-bound`` (a differential-drive base's ``v >=
+        -reverse_speed``), at most 0.
 
     Returns
     -------
@@ -731,8 +734,9 @@ def saturate_expression(u, bound, n: int) -> tuple:
     """
     within = 1.0
     for i in range(n):
-        within = within * (u[i] >= -bound[i]) * (u[i] <= bound[i])
-    return ca.fmin(ca.fmax(u, -bound), bound), within
+        within = within * (u[i] >= (-bound[i] if lower is None else lower[i])) * (
+            u[i] <= bound[i])
+    return ca.fmin(ca.fmax(u, -bound if lower is None else lower), bound), within
 
 
 @lru_cache(maxsize=None)
@@ -742,6 +746,16 @@ def saturate(n: int) -> ca.Function:
     u_c, within = saturate_expression(u, bound, n)
     return ca.Function("saturate", [u, bound], [u_c, within], ["u", "bound"],
                        ["u_c", "within"])
+
+
+@lru_cache(maxsize=None)
+def saturate_between(n: int) -> ca.Function:
+    """``saturate_between(u, lower, bound) -> (u_c, within)``: :func:`saturate_expression`
+    with its own lower ends."""
+    u, lower, bound = ca.SX.sym("u", n), ca.SX.sym("lower", n), ca.SX.sym("bound", n)
+    u_c, within = saturate_expression(u, bound, n, lower)
+    return ca.Function("saturate_between", [u, lower, bound], [u_c, within],
+                       ["u", "lower", "bound"], ["u_c", "within"])
 
 
 @lru_cache(maxsize=None)

@@ -84,7 +84,8 @@ def look_ahead_oracle_step(design: TubeDesign, stage: LookAhead, x, t, dt,
     status : ndarray of int, shape (N,)
     """
     return look_ahead_reference.look_ahead_status(design, stage.axle_offset,
-                                                  stage.input_bound, x, t, dt, alpha)
+                                                  stage.input_bound, x, t, dt, alpha,
+                                                  stage.reverse_speed)
 
 
 def _flag(value) -> bool:

@@ -9,6 +9,8 @@ the class that leaves the tube when the check fails, :mod:`.class_search`),
 
 from __future__ import annotations
 
+import math
+
 from ..design.certificate import Certificate
 from ..design.certificate.plant_class import plant_class
 from ..design.certificate.sampled import (DELAY_HALVINGS, RATE_FACTORS, SampledCheck,
@@ -319,6 +321,12 @@ def input_bound_check(spec: Spec, proof: InputProof) -> Check:
                      f"no bound on law (13)'s input is proved: {proof.reason}", data)
     each = ", ".join(f"|{name}| <= {distinct(p, b, 4)} (bound {b:g}, at t = {t:.3f} s)"
                      for name, p, b, t in zip(names, proof.peak, bound, proof.time))
+    if math.isfinite(proof.reverse_limit):
+        each += (f", backing up at most {distinct(proof.backward, proof.reverse_limit, 4)} "
+                 f"m/s (reverse_speed {proof.reverse_limit:g}, at t = "
+                 f"{proof.backward_time:.3f} s)")
+        data.update(backward=proof.backward, backward_time=proof.backward_time,
+                    reverse_speed=proof.reverse_limit)
     ok = proof.meets(bound)
     detail = (f"law (13) asks at most {each} at every sample on [0, {proof.horizon:.4g}] s, "
               f"for every plant of [assumptions] (from the sampled check's bound on |e| at "
@@ -326,5 +334,7 @@ def input_bound_check(spec: Spec, proof: InputProof) -> Check:
               "of the bound")
     if not ok:
         over = [name for name, p, b in zip(names, proof.peak, bound) if p > b]
+        if not proof.backs_up_within:
+            over.append("backing up (actuator.reverse_speed)")
         detail += f"; beyond the bound in {', '.join(over)}"
     return Check("sampled.input_bound", ok, detail, data)
