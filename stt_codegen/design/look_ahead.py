@@ -156,8 +156,10 @@ def look_ahead_design_proof(design: Design, spec: Spec,
     point = point_proof(design.tube, spec, verdict_limit(
         spec, lambda u: math.hypot(*u) > speed), initial_error)
     proof = look_ahead_input_proof(point, offset)
-    if spec.reverse_speed is None and (not aware or (
-            not advice_wanted() and (bound is None or proof.meets(bound)))):
+    if not aware:
+        return _worst_backing_up(proof, spec)         # at the worst heading
+    if spec.reverse_speed is None and not advice_wanted() and (
+            bound is None or proof.meets(bound)):
         return proof            # a verdict the worst heading already gives
     return base_proof(point, design.tube, spec)
 
@@ -181,11 +183,16 @@ def base_proof(point: InputProof, tube: TubeDesign, spec: Spec) -> InputProof:
         With :attr:`~.input_bound.InputProof.backward` (the bound of ``|u|`` where the
         heading is not enclosed) judged against ``[actuator] reverse_speed``.
     """
-    proof = look_ahead_input_proof(point, spec.drive.axle_offset)
-    proof = replace(proof, backward=proof.peak[0], backward_time=proof.time[0],
-                    reverse_limit=(math.inf if spec.reverse_speed is None
-                                   else spec.reverse_speed))
+    proof = _worst_backing_up(look_ahead_input_proof(point, spec.drive.axle_offset), spec)
     return heading_proof(proof, tube, spec) if heading_known(spec) else proof
+
+
+def _worst_backing_up(proof: InputProof, spec: Spec) -> InputProof:
+    """``proof`` with the worst heading's backing up, ``|v| <= |u|``, judged against
+    ``[actuator] reverse_speed``."""
+    return replace(proof, backward=proof.peak[0], backward_time=proof.time[0],
+                   reverse_limit=(math.inf if spec.reverse_speed is None
+                                  else spec.reverse_speed))
 
 
 def heading_known(spec: Spec) -> bool:
