@@ -34,4 +34,5 @@ def test_one_floor_is_certified_within_twice_the_straight_line_time():
     assert not floor["reason"] and floor["satisfied"]
     assert 1.0 < floor["t_c_ratio"] <= 2.0 and floor["reach_s"] <= floor["t_c"]
     assert floor["speed_per_sample"] <= floor["speed_of_peaks"]
+    assert 0.0 <= floor["backing_sim"] <= floor["backing_proved"] <= floor["proved"][0]
     assert "median t_c / straight-line time" in format_agv_report(report)

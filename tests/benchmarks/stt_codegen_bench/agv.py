@@ -28,6 +28,7 @@ import math
 import numpy as np
 
 from stt_codegen.design.certificate.actuator import prove_input_bound
+from stt_codegen.design.look_ahead import base_proof
 from stt_codegen.design.route import route_length
 from stt_codegen.design.search import design_tube
 from stt_codegen.errors import DesignError, SpecError
@@ -98,11 +99,14 @@ def _floor(seed: int, index: int) -> dict:
     straight = route_length(design.tube, spec.initial_state) / LIMITS[0]
     result = simulate(design, backend="c", seed=index)
     point = prove_input_bound(design.tube, spec)       # law (13)'s at the look-ahead point
+    backing = base_proof(point, design.tube, spec)      # from the heading the base can have
     return {"index": index, "route_m": straight * LIMITS[0], "straight_s": straight,
             "t_c": named, "reach_s": result.reach_time, "satisfied": bool(result.satisfied),
             "peak_v": float(result.max_abs_u[0]), "peak_omega": float(result.max_abs_u[1]),
             "proved": [float(p) for p in design.input_proof.peak],
             "speed_per_sample": point.speed, "speed_of_peaks": math.hypot(*point.peak),
+            "backing_proved": backing.backward,
+            "backing_sim": max(0.0, -float(np.min(result.trajectory.u[:, 0]))),
             "t_c_ratio": named / straight,
             "reach_ratio": (result.reach_time / straight
                             if result.reach_time is not None else None), "reason": ""}
@@ -125,7 +129,9 @@ def run_agv_bench(count: int, seed: int) -> dict:
         ``reach_s``, ``satisfied``, the simulated ``peak_v``, ``peak_omega`` and the
         ``proved`` peaks, the bound of ``|u|`` at the point sample by sample
         (``speed_per_sample``, the one the design uses) and from the per-input peaks
-        (``speed_of_peaks``, ``hypot(peak_1, peak_2)``), ``t_c_ratio``, ``reach_ratio``,
+        (``speed_of_peaks``, ``hypot(peak_1, peak_2)``), the speed the base is proved to
+        back up at (``backing_proved``, docs/differential-drive.md, "Backing up") and the
+        largest it backs up at in the run (``backing_sim``), ``t_c_ratio``, ``reach_ratio``,
         or ``reason``), and the medians
         ``t_c_ratio`` and ``reach_ratio`` over the floors designed.
 
@@ -159,8 +165,9 @@ def format_agv_report(report: dict) -> str:
     lines = [f"{report['count']} floors, seed {report['seed']}, v_max {LIMITS[0]:g} m/s, "
              f"omega_max {LIMITS[1]:g} rad/s, generated C, one run",
              "| floor | route | straight at v_max | certified t_c | ratio | reach (sim) | "
-             "ratio | peak v, omega (sim) | proved | proved |u| from the peaks |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "ratio | peak v, omega (sim) | proved | proved |u| from the peaks | "
+             "backing up: proved, sim |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for f in report["floors"]:
         if f["reason"]:
             lines.append(f"| {f['index']} | {f['reason']} |")
@@ -170,7 +177,8 @@ def format_agv_report(report: dict) -> str:
                      f"{'' if f['satisfied'] else ' (not satisfied)'} | "
                      f"{f['reach_ratio']:.2f} | {f['peak_v']:.2f}, {f['peak_omega']:.2f} | "
                      f"{f['proved'][0]:.2f}, {f['proved'][1]:.2f} | "
-                     f"{f['speed_of_peaks']:.2f} |")
+                     f"{f['speed_of_peaks']:.2f} | "
+                     f"{f['backing_proved']:.3f}, {f['backing_sim']:.3f} m/s |")
     if report["t_c_ratio"] is not None:
         lines.append(f"median t_c / straight-line time: {report['t_c_ratio']:.2f}; "
                      f"median reach / straight-line time: {report['reach_ratio']:.2f}")
