@@ -199,7 +199,8 @@ def test_blended_corners_shorten_the_agvs_named_time():
 
 def test_a_base_times_its_moves_for_the_turn_into_each():
     """With ``via_timing = "turn"`` a move after a right-angle corner gains ``via_turn pi /
-    2`` of weight over the length timing; a straight run gains none. A base given its
+    2`` of weight over the length timing, a straight run none, and a diagonal move weighs
+    its Euclidean length (the length timing's max norm is a per-axis bound's). A base given its
     bound tries it after the length-timed tubes; law (13) does not."""
     from types import SimpleNamespace
 
@@ -213,6 +214,12 @@ def test_a_base_times_its_moves_for_the_turn_into_each():
     assert length == pytest.approx([4.0, 2.0, 2.0])
     weights = [4.0, 2.0 + 0.8 * math.pi / 2, 2.0]
     assert turn == pytest.approx([8.0 * w / sum(weights) for w in weights])
+    # a diagonal move: its Euclidean length (the base's speed), not its max norm
+    slanted = [np.array([4.0, 0.0]), np.array([3.0, 3.0])]
+    turn, _ = timed_moves(turned, slanted, 8.0, "cruise")
+    weights = [4.0, math.hypot(3.0, 3.0) + 0.8 * math.pi / 4]
+    assert turn == pytest.approx([8.0 * w / sum(weights) for w in weights])
+    assert timed_moves(spec, slanted, 7.0, "cruise")[0] == pytest.approx([4.0, 3.0])
     default = SimpleNamespace(method="paper", tube=SimpleNamespace(circumvents=()))
     labels = [label for label, _ in slower_variants(spec, default, (1.2, 1.5))]
     assert labels[-2:] == ["via points timed for the turn, cruise segments",
@@ -226,7 +233,7 @@ def test_a_base_times_its_moves_for_the_turn_into_each():
 
 @pytest.mark.slow
 def test_legs_timed_for_the_turn_shorten_the_named_time_of_a_short_look_ahead():
-    """At a 0.5 m look-ahead the AGV in 40 s is refused naming 41.5 s (44.5 s with its legs
+    """At a 0.5 m look-ahead the AGV in 40 s is refused naming 41 s (44.5 s with its legs
     timed by length alone): its best tube gives the moves after the racks' corners the time
     to turn. Followed, it is certified within [1.2 m/s, 1.5 rad/s]."""
     short = stt.Spec.from_dict(_agv_doc(axle_offset=0.5))

@@ -94,7 +94,8 @@ def move_weight(length: float, timing: str, turn: float = 0.0) -> float:
     Parameters
     ----------
     length : float
-        The move's centre distance (max norm), state units.
+        The move's centre distance, state units: in the max norm (a bound per axis), in
+        the Euclidean norm with :data:`TURN_TIMING` (a base's speed).
     timing : {"length", "acceleration", "turn"}
         :data:`LENGTH_TIMING` (``length``), :data:`ACCELERATION_TIMING`
         (``sqrt(length)``) or :data:`TURN_TIMING` (``length + turn``).
@@ -135,7 +136,9 @@ def timed_moves(spec: Spec, moves: list[np.ndarray], duration: float, profile: s
 
     With the length or the turn timing, or without ``state_space.velocity_bound``, each
     move's share is its :func:`move_weight` over their sum (with the turn timing, its
-    turn from the move before times ``tube.via_turn``) and every move has ``profile``. Timed for the
+    Euclidean length and its turn from the move before times ``tube.via_turn``: the time
+    to drive it at ``v_max`` and to turn into it at ``omega_max``, over ``v_max``) and
+    every move has ``profile``. Timed for the
     acceleration (:data:`ACCELERATION_TIMING`) under a velocity bound ``v``, the moves get
     the least common peak acceleration ``a`` that fits: move ``k`` (largest coordinate move
     ``L_k``, ``M_k = max_i |m_i| / v_i``) lasts ``min_p max(sqrt(c_p L_k / a), r_p M_k)``
@@ -167,7 +170,10 @@ def timed_moves(spec: Spec, moves: list[np.ndarray], duration: float, profile: s
         One per move.
     """
     timing = spec.tube.via_timing
-    lengths = [float(np.max(np.abs(m))) for m in moves]
+    # a base's time (the turn timing) goes by its speed, the Euclidean distance; the other
+    # timings' by the per-axis bound, the max norm
+    lengths = [float(np.linalg.norm(m)) if timing == TURN_TIMING else float(np.max(np.abs(m)))
+               for m in moves]
     turns = [0.0] + [spec.tube.via_turn * _turn(a, b) for a, b in zip(moves, moves[1:])]
     weights = [move_weight(length, timing, turn) for length, turn in zip(lengths, turns)]
     if (timing != ACCELERATION_TIMING or spec.velocity_bound is None or not moves
