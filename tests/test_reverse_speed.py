@@ -130,3 +130,27 @@ def test_the_agv_backing_up_on_the_cortex_m4f_is_satisfied_like_the_host():
     assert report["satisfied"] and report["input_clamped"] == report["invalid"] == 0
     host = stt.simulate(design, backend="c")
     assert abs(report["reach_time"] - host.reach_time) <= 1.0 / design.tube.rate_hz
+
+
+def test_a_fleets_bases_keep_their_reverse_speed():
+    """``warehouse-fleet`` with its three bases given ``reverse_speed = 0.4``: the fleet
+    design plans each way without ``[actuator]`` (``Spec.without_actuator`` drops the key
+    with ``input_bound``), then proves each base's backing up within it; certified, each
+    base's controller clamping there."""
+    import tomllib
+
+    from stt_codegen.spec.fleet import FleetSpec
+
+    path = Path(stt.__file__).parent / "cases" / "fleets" / "warehouse-fleet.toml"
+    doc = tomllib.loads(path.read_text())
+    for robot in doc["robots"]:
+        if "actuator" in robot:
+            robot["actuator"] = dict(robot["actuator"], reverse_speed=0.4)
+    design = stt.design_fleet(FleetSpec.from_dict(doc))
+    assert design.certified
+    bases = [d for d in design.designs.values() if d.spec.reverse_speed is not None]
+    assert len(bases) == 3
+    for base in bases:
+        assert base.look_ahead.reverse_speed == 0.4
+        assert base.input_proof.reverse_limit == 0.4
+        assert 0.0 < base.input_proof.backward <= 0.4

@@ -222,7 +222,7 @@ def candidates(spec: Spec, design_free: Callable[[Spec], Design],
         variant is certified within the bound either: the default's refusal.
     """
     bound = spec.input_bound
-    free = replace(spec, input_bound=None)
+    free = spec.without_actuator()
     report("input bound", 0.0, "input bound: the default design")
     try:
         with reporting(None, (0.0, 0.5)):

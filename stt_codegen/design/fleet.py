@@ -395,7 +395,7 @@ class _Placing:
 def _free(spec: Spec) -> Spec:
     """``spec`` without ``[actuator]``: the tube's design, whose input proof comes once, on
     the tube kept (:func:`_proved`)."""
-    return replace(spec, input_bound=None)
+    return spec.without_actuator()
 
 
 def _docks(robot: FleetRobot, fleet: FleetSpec) -> tuple[Obstacle, ...]:

@@ -472,7 +472,7 @@ def cascade_within_bound(spec: Spec, design_free: Callable[[Spec], Design]) -> D
     DesignError
         No tube tried keeps the bound, or no second stage is certified at the rate.
     """
-    free = replace(spec, input_bound=None)
+    free = spec.without_actuator()
     default = design_free(free)
     # no second stage keeps the tubes on the default tube, bound or not: a slower variant
     # of it (cruise segments: the legs timed by their lengths) may keep them and the

@@ -515,6 +515,23 @@ class Spec:
         return replace(self, plant_model=model, assumptions=combine_assumptions(
             bounds, declared, self.dimension, self.disturbance_amplitude))
 
+    def without_actuator(self) -> "Spec":
+        """This spec without ``[actuator]``: no ``input_bound`` and no ``reverse_speed``
+        (the design of a tube whose proof against the limits comes after).
+
+        Returns
+        -------
+        Spec
+
+        Examples
+        --------
+        >>> import stt_codegen as stt
+        >>> spec = stt.load_spec("office-base")
+        >>> spec.input_bound, spec.without_actuator().input_bound
+        ((1.6, 16.0), None)
+        """
+        return replace(self, input_bound=None, reverse_speed=None)
+
     def with_axle_offset(self, axle_offset: float) -> "Spec":
         """This differential-drive spec with another ``plant.axle_offset``: the obstacles
         inflated and the state space shrunk by ``robot.radius`` plus the new offset, and
