@@ -244,12 +244,13 @@ def test_a_space_time_path_over_the_input_bound_is_planned_again_at_a_lower_spee
     """With ``[actuator]``, a space-time path whose input proof fails is planned again at
     each of ``PATH_SLOWER`` times its speed: the same path, later; the first proved one is
     kept, and when none is, the refusal says which speeds were tried."""
-    from stt_codegen.design import fleet as fleet_design
+    from stt_codegen.design import fleet as fleet_design, moving
     doc = copy.deepcopy(TWO)
     for entry in doc["robots"]:
         entry["actuator"] = {"input_bound": [5.0, 5.0]}
     fleet = stt.FleetSpec.from_dict(doc)
     proved = fleet_design._proved
+    monkeypatch.setattr(moving, "EASE_WINDOWS", ())      # the path's own timing: not levelled
     arrivals: list[float] = []
 
     def refused_at_first_speed(design, spec):    # the first try of each robot "fails"
@@ -272,6 +273,31 @@ def test_a_space_time_path_over_the_input_bound_is_planned_again_at_a_lower_spee
     assert arrivals == sorted(arrivals) and arrivals[0] < arrivals[-1]
     assert "space-time path: its input is not proved within actuator.input_bound" in str(
         refused.value)
+
+
+def test_a_space_time_path_under_an_input_bound_spends_its_waits_driving_slower(monkeypatch):
+    """With ``[actuator]``, a space-time path's moves (at the grid's speed, 1.5 m/s, with
+    waits) are levelled against the placed tubes: each robot arrives at its
+    ``prescribed_time`` driving slower, its proved input peak lower, still certified."""
+    from stt_codegen.design import fleet as fleet_design, moving
+    doc = copy.deepcopy(TWO)
+    for entry in doc["robots"]:
+        entry["actuator"] = {"input_bound": [5.0, 5.0]}
+    fleet = stt.FleetSpec.from_dict(doc)
+
+    def fastest(design) -> float:
+        return max(float(np.linalg.norm(np.subtract(s.lower_to, s.lower_from))) / (s.end - s.start)
+                   for s in design.tube.segments)
+
+    levelled = stt.design_fleet(fleet, planner=fleet_design.PLANNER_SPACE_TIME)
+    monkeypatch.setattr(moving, "EASE_WINDOWS", ())
+    raw = stt.design_fleet(fleet, planner=fleet_design.PLANNER_SPACE_TIME)
+    assert levelled.certified and raw.certified
+    for name in ("a", "b"):
+        slow, fast = levelled.designs[name], raw.designs[name]
+        assert slow.tube.segments[-1].end == 20.0 > fast.tube.segments[-1].end
+        assert fastest(slow) < 0.85 * fastest(fast)
+        assert max(slow.input_proof.peak) < 0.85 * max(fast.input_proof.peak)
 
 
 def test_a_way_over_the_input_bound_gives_way_to_the_design_at_the_actuators_speed(

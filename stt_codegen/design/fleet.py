@@ -44,7 +44,7 @@ from .failures import FailureKind, without_advice
 from .fleet_index import Chunks, TubeIndex, chunks
 from .fleet_paths import Reservations, SpaceTimeGrid, space_time_path, space_time_segments
 from .gain import with_gain
-from .moving import TIME_STEPS, retimed_design
+from .moving import TIME_STEPS, levelled_timing, retimed_design
 from .result import METHOD_VIA, Design, TubeCheck
 from .search import check_tube, design_tube
 
@@ -465,13 +465,12 @@ def _clash(robot: FleetRobot, tube: RobotTube, near: Sequence[str], placing: _Pl
     return None
 
 
-def _timing_spec(robot: FleetRobot, via: RobotTube, placing: _Placing) -> Spec:
+def _timing_spec(robot: FleetRobot, way: Chunks, placing: _Placing) -> Spec:
     """``robot``'s spec with, as moving obstacles, the placed tubes near its via boxes
-    (``via``: the enclosed tube through them; in space, whenever) as boxes over at most
-    :data:`CHUNK_SECONDS`, each grown by both reaches and kept only where it comes near
-    those boxes (the re-timing's input)."""
+    (``way``: boxes holding the tube through them; in space, whenever) as boxes over at
+    most :data:`CHUNK_SECONDS`, each grown by both reaches and kept only where it comes
+    near those boxes (the re-timing's input)."""
     spec = robot.spec
-    way = chunks(via, robot.dims, INDEX_SECONDS)
     grow = robot.reach + placing.widest
     extra: list[MovingObstacle] = []
     first = len(spec.unsafe_sets) + len(spec.moving_obstacles)
@@ -651,8 +650,11 @@ def _space_time(robot: FleetRobot, way: Design, placing: _Placing,
                           else f"its space-time path: its input is not proved within "
                                f"actuator.input_bound, and at {factor:g} times its speed "
                                f"there is no path within prescribed_time")
-        tube = replace(way.tube, circumvents=(), segments=space_time_segments(
-            path, grid, way.tube, step, _profile(robot)))
+        segments = space_time_segments(path, grid, way.tube, step, _profile(robot))
+        if spec.input_bound is not None:          # its waits spent driving slower
+            segments = levelled_timing(segments, _timing_spec(
+                robot, _segment_boxes(segments, robot.dims), placing))
+        tube = replace(way.tube, circumvents=(), segments=segments)
         found = check(tube, _free(spec))
         if not found.passed:
             return None, f"its space-time path: {found.reason}"
@@ -662,6 +664,16 @@ def _space_time(robot: FleetRobot, way: Design, placing: _Placing,
             return design, ""
     return None, ("its space-time path: its input is not proved within actuator.input_bound "
                   f"(at {', '.join(f'{f:g}' for f in factors)} times its speed)")
+
+
+def _segment_boxes(segments: Sequence[ReachSegment], dims: Sequence[int]) -> Chunks:
+    """The box holding each reach segment (its start and end boxes), on ``dims``."""
+    d = list(dims)
+    lower = np.array([np.minimum(s.lower_from, s.lower_to)[d] for s in segments])
+    upper = np.array([np.maximum(s.upper_from, s.upper_to)[d] for s in segments])
+    t_end = np.array([s.end for s in segments])
+    t_end[-1] = np.inf
+    return Chunks(np.array([s.start for s in segments]), t_end, lower, upper)
 
 
 def _fit(robot: FleetRobot, placing: _Placing) -> tuple[Design, RobotTube] | str:
@@ -716,9 +728,9 @@ def _fit(robot: FleetRobot, placing: _Placing) -> tuple[Design, RobotTube] | str
             reasons.append(f"{label}: no via design")
             return None
         with without_advice():              # the verdict of each re-timing's input proof
-            got = retimed_design(_pieces(plan, spec), _timing_spec(
-                robot, way_tube if plan is way else enclosed(plan), placing), spec, check,
-                started)
+            got = retimed_design(_pieces(plan, spec), _timing_spec(robot, chunks(
+                way_tube if plan is way else enclosed(plan), robot.dims, INDEX_SECONDS),
+                placing), spec, check, started)
         if isinstance(got, Design):
             design = _proved(got, spec)
             if design is not None:

@@ -72,6 +72,9 @@ TIME_STEPS = 60
 DURATION_FACTORS = (1.0, 0.75, 1.5, 0.5, 2.0)
 #: Sub-intervals on which a move is checked against the obstacles' hulls.
 MOVE_CHECKS = 8
+#: With ``[actuator]``: the windows of moves either side of a re-timed move over which its
+#: speed is levelled with theirs (:func:`_eased`), in the order tried.
+EASE_WINDOWS = (64, 16, 8, 4, 2, 1, 0)
 #: Most sets of moving obstacles to go around that the re-timing step tries (:func:`routes`).
 MAX_ROUTES = 16
 #: Half-lengths (s) of the time spans around where the static tube meets a moving obstacle
@@ -426,7 +429,108 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
         state, seg = parent[state]
         if seg is not None:
             out.append(seg)
-    return _held(tuple(reversed(out)))
+    out.reverse()
+    return _held(_eased(out, spec) if speed_up and not holds else tuple(out))
+
+
+def levelled_timing(segments: Sequence[ReachSegment], spec: Spec) -> tuple[ReachSegment, ...]:
+    """A timing's segments (contiguous, a wait a segment whose box does not change) with
+    their moves' speeds levelled against ``spec``'s moving obstacles (:func:`_eased`).
+
+    Parameters
+    ----------
+    segments : sequence of ReachSegment
+        Contiguous in time from ``t = 0``, ending by ``spec.prescribed_time``.
+    spec : Spec
+        Its ``moving_obstacles`` are what every levelled move keeps clear of.
+
+    Returns
+    -------
+    tuple of ReachSegment
+        The same moves through the same boxes, in the same order, contiguous.
+    """
+    moves = [seg for seg in segments
+             if seg.lower_from != seg.lower_to or seg.upper_from != seg.upper_to]
+    return _held(_eased(moves, spec))
+
+
+def _eased(moves: list[ReachSegment], spec: Spec) -> tuple[ReachSegment, ...]:
+    """The moves of a timing with ``[actuator]``, their speeds levelled where they keep
+    clear. A grid's timing drives a move in a whole number of steps and waits whole steps,
+    so neighbouring legs alternate between a speed below their plan and one above it; the
+    input proof asks least of the slowest legs. The fastest move first (a move's speed:
+    the longer of its box's two corners' moves over its duration): over a window of moves
+    around it (the widest of :data:`EASE_WINDOWS` moves either side first), the window's
+    time, with the waits just outside it or without them (for a move alone, also with one
+    of them or half of either: :func:`_spans`), is shared in proportion to the moves'
+    lengths (one speed; a move whose box does not move keeps its duration); the first
+    window whose moves are all judged clear as the search judges a move
+    (:func:`_moves_clear`) and whose fastest is slower than that move is kept; a move that
+    no window slows is left. A wait shortened is clear (a sub-interval of a clear one);
+    every changed move is judged again, and the tube's certificate and input proof judge
+    the whole."""
+    moves = list(moves)
+    m, t_c = len(moves), spec.prescribed_time
+    lengths = np.array([max(float(np.linalg.norm(np.subtract(s.lower_to, s.lower_from))),
+                            float(np.linalg.norm(np.subtract(s.upper_to, s.upper_from))))
+                        for s in moves])
+
+    def speed(j: int) -> float:
+        return float(lengths[j] / max(moves[j].end - moves[j].start, 1e-12))
+
+    def levelled(a: int, b: int, t0: float, t1: float) -> list[ReachSegment] | None:
+        # a move that does not move keeps its duration; the others share the rest
+        fixed = np.array([0.0 if lengths[j] > 0.0 else moves[j].end - moves[j].start
+                          for j in range(a, b + 1)])
+        share = t1 - t0 - fixed.sum()
+        if share <= 0.0 or lengths[a:b + 1].sum() <= 0.0:
+            return None
+        cuts = np.empty(b - a + 2)
+        cuts[0] = t0
+        cuts[1:] = t0 + np.cumsum(fixed + share * lengths[a:b + 1] / lengths[a:b + 1].sum())
+        cuts[-1] = t1
+        return [replace(moves[a + j], start=float(cuts[j]), end=float(cuts[j + 1]))
+                for j in range(b - a + 1)]
+
+    left = set(range(m))
+    for _ in range(2 * m):
+        if not left:
+            break
+        k = max(left, key=lambda j: (speed(j), -j))
+        fastest = speed(k)
+        for width in EASE_WINDOWS:
+            a, b = max(0, k - width), min(m - 1, k + width)
+            kept = None
+            for t0, t1 in _spans(moves[a - 1].end if a else 0.0, moves[a].start, moves[b].end,
+                                 moves[b + 1].start if b + 1 < m else t_c, a == b):
+                tried = levelled(a, b, t0, t1)
+                if tried is None:
+                    continue
+                slowed = max(lengths[a + j] / (seg.end - seg.start)
+                             for j, seg in enumerate(tried)) < fastest * (1.0 - 1e-6)
+                if slowed and all(_moves_clear(tried, spec)):
+                    kept = tried
+                    break
+            if kept is not None:
+                moves[a:b + 1] = kept
+                left |= set(range(a, b + 1))
+                break
+        else:
+            left.discard(k)
+    return tuple(moves)
+
+
+def _spans(before: float, start: float, end: float, after: float,
+           alone: bool) -> list[tuple[float, float]]:
+    """The spans a window of moves from ``start`` to ``end`` may be levelled over, between
+    the end of the move before it (``before``) and the start of the move after it
+    (``after``): the whole of both waits, or none; for a single move (``alone``) also each
+    wait or half of it on either side, longest first."""
+    if not alone:
+        return [(before, after), (start, end)]
+    ends = [(before, after, (before + start) / 2, (end + after) / 2, start, end)]
+    out = {(t0, t1) for t0 in ends[0][0::2] for t1 in ends[0][1::2]} - {(start, end)}
+    return sorted(out, key=lambda span: (span[0] - span[1], span))
 
 
 def _held(segments: tuple[ReachSegment, ...]) -> tuple[ReachSegment, ...]:
@@ -716,7 +820,7 @@ def retimed_plan(segments: Sequence[ReachSegment], spec: Spec,
     return TaskPlan(plan.order, tuple(held[j] for j in range(len(spec.tasks))))
 
 
-__all__ = ["DETOUR_SPANS", "DURATION_FACTORS", "MAX_ROUTES", "MOTION_SPACE_TIME", "MOTION_SWEPT",
-           "MOTION_TIMED_VIA", "MOVE_CHECKS", "TASK_HOLD_SHARE", "TIME_STEPS", "design_moving", "moves",
-           "retime", "retimed_design", "retimed_plan", "routes", "partial_spec", "speed_limits", "static_part",
-           "task_holds"]
+__all__ = ["DETOUR_SPANS", "DURATION_FACTORS", "EASE_WINDOWS", "MAX_ROUTES", "MOTION_SPACE_TIME",
+           "MOTION_SWEPT", "MOTION_TIMED_VIA", "MOVE_CHECKS", "TASK_HOLD_SHARE", "TIME_STEPS",
+           "design_moving", "levelled_timing", "moves", "retime", "retimed_design",
+           "retimed_plan", "routes", "partial_spec", "speed_limits", "static_part", "task_holds"]
