@@ -300,6 +300,28 @@ def test_a_space_time_path_under_an_input_bound_spends_its_waits_driving_slower(
         assert max(slow.input_proof.peak) < 0.85 * max(fast.input_proof.peak)
 
 
+def test_a_placed_tube_whose_input_proof_fails_is_proved_once(monkeypatch):
+    """The fleet proves the tube it placed: where that proof fails, the bound's procedure
+    tries its slower variants, each of which would be the same tube proved again; none is
+    tried. Within a bound it meets, the tube is proved once and carries its proof."""
+    from dataclasses import replace as replaced
+    from stt_codegen.design import actuator, fleet as fleet_design
+    doc = copy.deepcopy(TWO)
+    doc["robots"][0]["actuator"] = {"input_bound": [0.2, 0.2]}
+    robot = stt.FleetSpec.from_dict(doc).robots[0]
+    design = stt.design_tube(robot.spec.without_actuator())
+    real = actuator.law13_input_proof
+    proved: list = []
+    monkeypatch.setattr(actuator, "law13_input_proof", lambda d, spec, *args: proved.append(
+        d.tube.segments) or real(d, spec, *args))
+    assert fleet_design._proved(design, robot.spec) is None
+    assert proved == [design.tube.segments]
+    proved.clear()
+    kept = fleet_design._proved(design, replaced(robot.spec, input_bound=(50.0, 50.0)))
+    assert kept is not None and kept.input_proof.meets((50.0, 50.0))
+    assert kept.tube.segments == design.tube.segments and proved == [design.tube.segments]
+
+
 def test_a_way_over_the_input_bound_gives_way_to_the_design_at_the_actuators_speed(
         monkeypatch):
     """A robot whose way (planned without ``[actuator]``) is not proved within the bound

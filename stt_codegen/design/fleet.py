@@ -556,10 +556,20 @@ def _proved(design: Design, spec: Spec) -> Design | None:
     it), ``None`` when the proof fails; ``design`` for ``spec`` without ``[actuator]``."""
     if spec.input_bound is None:
         return replace(design, spec=spec)
+    given: list[Design] = []
+
+    def this_tube(free: Spec) -> Design:
+        # the bound's procedure tries slower variants after a proof that fails; each would
+        # be this same tube proved again, so there is none
+        if given:
+            raise DesignError("the fleet proves the tube it placed, no slower variant",
+                              kind=FailureKind.FLEET)
+        given.append(replace(design, spec=free))
+        return given[0]
+
     with without_advice():
         try:
-            return variant_of(spec).entry("within_bound")(
-                spec, lambda free: replace(design, spec=free))
+            return variant_of(spec).entry("within_bound")(spec, this_tube)
         except DesignError:
             return None
 
