@@ -300,6 +300,31 @@ def test_a_space_time_path_under_an_input_bound_spends_its_waits_driving_slower(
         assert max(slow.input_proof.peak) < 0.85 * max(fast.input_proof.peak)
 
 
+def test_a_levelled_space_time_path_that_fails_its_check_gives_way_to_the_path_as_found(
+        monkeypatch):
+    """Where a levelled space-time path (arriving at ``t_c`` = 20 s) fails the whole check,
+    the path as the search timed it is checked, and kept when it passes and its proof
+    holds."""
+    from dataclasses import replace as replaced
+    from stt_codegen.design import fleet as fleet_design
+    doc = copy.deepcopy(TWO)
+    for entry in doc["robots"]:
+        entry["actuator"] = {"input_bound": [5.0, 5.0]}
+    real = fleet_design.check_tube
+
+    def check(tube, spec):
+        found = real(tube, spec)
+        return replaced(found, passed=False) if tube.segments[-1].end == 20.0 else found
+
+    monkeypatch.setattr(fleet_design, "check_tube", check)
+    designed = stt.design_fleet(stt.FleetSpec.from_dict(doc),
+                                planner=fleet_design.PLANNER_SPACE_TIME)
+    assert designed.certified
+    for name in ("a", "b"):
+        design = designed.designs[name]
+        assert design.tube.segments[-1].end < 20.0 and design.input_proof.meets((5.0, 5.0))
+
+
 def test_a_placed_tube_whose_input_proof_fails_is_proved_once(monkeypatch):
     """The fleet proves the tube it placed: where that proof fails, the bound's procedure
     tries its slower variants, each of which would be the same tube proved again; none is

@@ -4,6 +4,7 @@ the simulation, the generated C, in 2-D and 3-D (docs/moving-obstacles.md)."""
 from __future__ import annotations
 
 import copy
+from dataclasses import replace
 import math
 import shutil
 import subprocess
@@ -632,6 +633,26 @@ def test_a_re_timed_plan_drives_its_legs_no_faster_than_the_bound_allows():
     assert design.motion == MOTION_TIMED_VIA and design.certificate.passed
     assert design.input_proof.meets(spec.input_bound)
     assert {seg.profile for seg in design.tube.segments} == {"cruise"}
+
+
+def test_a_levelled_timing_that_fails_its_check_gives_way_to_the_searched_one():
+    """Levelling judges each move as the search does, not the whole check: where the
+    levelled timing (the crossing's leg until t_c = 10 s) fails the check, the search's
+    own timing (the leg ending at 9.67 s) is checked, and kept when it passes."""
+    from stt_codegen.design.moving import design_moving
+    from stt_codegen.design.search import _position_stage
+    spec = _crossing_with_actuator([3.0, 3.0])
+    ends: list[float] = []
+
+    def check(tube, checked):
+        ends.append(tube.segments[-1].end)
+        found = check_tube(tube, checked)
+        return replace(found, passed=False) if tube.segments[-1].end == 10.0 else found
+
+    design = design_moving(spec, _position_stage, check)
+    assert design.motion == MOTION_TIMED_VIA and design.certificate.passed
+    assert design.tube.segments[-1].end == pytest.approx(9.6667, abs=1e-3)
+    assert ends.index(10.0) < ends.index(design.tube.segments[-1].end)
 
 
 @pytest.mark.slow

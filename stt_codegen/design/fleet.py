@@ -660,18 +660,26 @@ def _space_time(robot: FleetRobot, way: Design, placing: _Placing,
                           else f"its space-time path: its input is not proved within "
                                f"actuator.input_bound, and at {factor:g} times its speed "
                                f"there is no path within prescribed_time")
-        segments = space_time_segments(path, grid, way.tube, step, _profile(robot))
-        if spec.input_bound is not None:          # its waits spent driving slower
-            segments = levelled_timing(segments, _timing_spec(
-                robot, _segment_boxes(segments, robot.dims), placing))
-        tube = replace(way.tube, circumvents=(), segments=segments)
-        found = check(tube, _free(spec))
-        if not found.passed:
-            return None, f"its space-time path: {found.reason}"
-        design = _proved(Design(with_gain(tube, found.min_width, spec), METHOD_VIA, found,
-                                0.0, spec=spec, motion=MOTION_SPACE_TIME_PATH), spec)
-        if design is not None:
-            return design, ""
+        searched = space_time_segments(path, grid, way.tube, step, _profile(robot))
+        timings = [searched]
+        if spec.input_bound is not None:          # its waits spent driving slower first
+            levelled = levelled_timing(searched, _timing_spec(
+                robot, _segment_boxes(searched, robot.dims), placing))
+            timings = [levelled] + ([searched] if levelled != searched else [])
+        checked = []
+        for segments in timings:
+            tube = replace(way.tube, circumvents=(), segments=segments)
+            found = check(tube, _free(spec))
+            checked.append(found)
+            if not found.passed:
+                continue
+            design = _proved(Design(with_gain(tube, found.min_width, spec), METHOD_VIA,
+                                    found, 0.0, spec=spec, motion=MOTION_SPACE_TIME_PATH),
+                             spec)
+            if design is not None:
+                return design, ""
+        if not any(found.passed for found in checked):
+            return None, f"its space-time path: {checked[0].reason}"
     return None, ("its space-time path: its input is not proved within actuator.input_bound "
                   f"(at {', '.join(f'{f:g}' for f in factors)} times its speed)")
 

@@ -304,7 +304,7 @@ def _hold_ok(task: Task, start: float, end: float) -> bool:
 def retime(segments: tuple[ReachSegment, ...], spec: Spec,
            order: Sequence[int] | None = None,
            factors: Sequence[float] = DURATION_FACTORS,
-           memo: dict | None = None) -> tuple[ReachSegment, ...] | None:
+           memo: dict | None = None, level: bool = True) -> tuple[ReachSegment, ...] | None:
     """The via boxes of ``segments`` re-timed to miss the moving obstacles (module notes).
 
     The search settles (via box, step) states by their speed-up, then their step: without
@@ -313,7 +313,9 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
     much faster than planned) and the timing is the one of least summed speed-up, then the
     earliest arrival among those: a leg is driven faster only where waiting needs it, as
     the input proof asks least of slow legs. An arrival in the target box counts only where
-    the box stays clear from it until ``t_c`` (the tube waits there).
+    the box stays clear from it until ``t_c`` (the tube waits there). With ``[actuator]``
+    and no tasks, the timing found is then levelled (:func:`_eased`): its waits spent
+    driving slower where the moves keep clear.
 
     With ``spec.tasks``, each task's hold segment (:func:`task_holds`) is not re-timed by
     :data:`DURATION_FACTORS`: it may start at any step and last any number of steps such
@@ -336,6 +338,9 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
         The moves judged so far, by (box, step, steps): a memo shared by the calls with the
         same ``segments`` and ``spec`` (other ``factors``), which judge many of the same
         moves; filled here.
+    level : bool
+        With ``[actuator]`` (and no tasks), the timing found levelled (:func:`_eased`);
+        ``False``: the search's own.
 
     Returns
     -------
@@ -430,7 +435,7 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
         if seg is not None:
             out.append(seg)
     out.reverse()
-    return _held(_eased(out, spec) if speed_up and not holds else tuple(out))
+    return _held(_eased(out, spec) if speed_up and level and not holds else tuple(out))
 
 
 def levelled_timing(segments: Sequence[ReachSegment], spec: Spec) -> tuple[ReachSegment, ...]:
@@ -692,9 +697,8 @@ def retimed_design(via: Design | None, timing: Spec, spec: Spec,
     for factors in speed_limits(spec):
         if any(set(factors) <= fewer for fewer in none):
             continue
-        segments = retime(planned, timing,
-                          via.task_plan.order if via.task_plan is not None else None, factors,
-                          judged)
+        order = via.task_plan.order if via.task_plan is not None else None
+        segments = retime(planned, timing, order, factors, judged)
         if segments is None:
             none.append(set(factors))
         if segments is None or segments in tried:     # the same timing: the same verdict
@@ -702,6 +706,14 @@ def retimed_design(via: Design | None, timing: Spec, spec: Spec,
         tried.add(segments)
         tube = replace(via.tube, segments=segments)
         timed = check(tube, spec)
+        if not timed.passed and spec.input_bound is not None:
+            # levelled, its moves judged clear as the search judges them; the whole check
+            # failed: the search's own timing (faster legs, whose proof may still hold)
+            searched = retime(planned, timing, order, factors, judged, level=False)
+            if searched is not None and searched not in tried:
+                tried.add(searched)
+                tube = replace(via.tube, segments=searched)
+                timed = check(tube, spec)
         if not timed.passed:
             why = timed.reason
             continue
