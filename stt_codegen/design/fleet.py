@@ -44,12 +44,12 @@ from .failures import FailureKind, without_advice
 from .fleet_index import Chunks, TubeIndex, chunks
 from .fleet_paths import Reservations, SpaceTimeGrid, space_time_path, space_time_segments
 from .gain import with_gain
-from .moving import TIME_STEPS, levelled_timing, retimed_design
+from .moving import levelled_timing, retimed_design
 from .result import METHOD_VIA, Design, TubeCheck
 from .search import check_tube, design_tube
 
-__all__ = ["CHUNK_SECONDS", "DETOURS", "DETOUR_SECONDS", "INDEX_CELL", "INDEX_SECONDS",
-           "LEG_METRES", "MOVES_PER_ROBOT", "PLANNER_SPACE_TIME", "PLANNER_TUBES",
+__all__ = ["CHUNK_SECONDS", "DETOURS", "DETOUR_SECONDS", "FLEET_TIME_STEPS", "INDEX_CELL",
+           "INDEX_SECONDS", "LEG_METRES", "MOVES_PER_ROBOT", "PLANNER_SPACE_TIME", "PLANNER_TUBES",
            "SCREEN_INTERVALS", "FleetDesign", "Placement", "certify_fleet", "design_fleet",
            "enclosed", "plan_way", "priority_order", "tube_obstacles"]
 
@@ -63,6 +63,10 @@ MOVES_PER_ROBOT = 2
 INDEX_SECONDS = 1.0
 #: The space-time index's grid cell, state units (metres).
 INDEX_CELL = 2.0
+#: Steps of a placement's re-timing grid over ``[0, t_c]`` (:func:`~.moving.retime`): finer
+#: than a single spec's (:data:`~.moving.TIME_STEPS`, 60), since a robot waits for other
+#: robots' tubes that pass a point in a second or so, on trips of a minute or two.
+FLEET_TIME_STEPS = 120
 #: The longest leg of a re-timed way, state units (metres): a longer leg is cut into
 #: pieces on the same line, between which the re-timing may wait.
 LEG_METRES = 2.0
@@ -577,11 +581,12 @@ def _proved(design: Design, spec: Spec) -> Design | None:
 def _pieces(via: Design, spec: Spec) -> Design:
     """``via`` with every leg longer than :data:`LEG_METRES` cut into pieces along the same
     straight line (the same boxes, each piece its own profile over its share of the leg's
-    time), as long as each piece keeps at least two steps of the re-timing's grid; ``via``
-    itself for a spec with tasks (their holds are whole segments)."""
+    time), as long as each piece keeps at least two steps of the re-timing's grid
+    (:data:`FLEET_TIME_STEPS`); ``via`` itself for a spec with tasks (their holds are whole
+    segments)."""
     if spec.tasks:
         return via
-    tau = spec.prescribed_time / TIME_STEPS
+    tau = spec.prescribed_time / FLEET_TIME_STEPS
     out: list[ReachSegment] = []
     for seg in via.tube.segments:
         a_lo, a_hi = np.array(seg.lower_from), np.array(seg.upper_from)
@@ -748,7 +753,7 @@ def _fit(robot: FleetRobot, placing: _Placing) -> tuple[Design, RobotTube] | str
         with without_advice():              # the verdict of each re-timing's input proof
             got = retimed_design(_pieces(plan, spec), _timing_spec(robot, chunks(
                 way_tube if plan is way else enclosed(plan), robot.dims, INDEX_SECONDS),
-                placing), spec, check, started)
+                placing), spec, check, started, FLEET_TIME_STEPS)
         if isinstance(got, Design):
             design = _proved(got, spec)
             if design is not None:

@@ -304,7 +304,8 @@ def _hold_ok(task: Task, start: float, end: float) -> bool:
 def retime(segments: tuple[ReachSegment, ...], spec: Spec,
            order: Sequence[int] | None = None,
            factors: Sequence[float] = DURATION_FACTORS,
-           memo: dict | None = None, level: bool = True) -> tuple[ReachSegment, ...] | None:
+           memo: dict | None = None, level: bool = True,
+           steps: int = TIME_STEPS) -> tuple[ReachSegment, ...] | None:
     """The via boxes of ``segments`` re-timed to miss the moving obstacles (module notes).
 
     The search settles (via box, step) states by their speed-up, then their step: without
@@ -341,6 +342,9 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
     level : bool
         With ``[actuator]`` (and no tasks), the timing found levelled (:func:`_eased`);
         ``False``: the search's own.
+    steps : int
+        The grid's steps over ``[0, t_c]`` (default :data:`TIME_STEPS`; a fleet's
+        re-timings use a finer one, :data:`~.fleet.FLEET_TIME_STEPS`).
 
     Returns
     -------
@@ -350,22 +354,22 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
         finds no timing (or ``segments`` is not a plan of ``spec``'s tasks).
     """
     t_c = spec.prescribed_time
-    tau = t_c / TIME_STEPS
+    tau = t_c / steps
     m = len(segments)
     holds = task_holds(segments, spec, order)
     if holds is None:
         return None
     boxes = [(np.array(s.lower_from), np.array(s.upper_from)) for s in segments]
     boxes.append((np.array(segments[-1].lower_to), np.array(segments[-1].upper_to)))
-    steps = np.arange(TIME_STEPS + 1)
+    grid = np.arange(steps + 1)
     # waits: box k over [i tau, (i + 1) tau], for every i at once
-    waits = [_clear(np.tile(lo, (TIME_STEPS + 1, 1)), np.tile(hi, (TIME_STEPS + 1, 1)), spec,
-                    steps * tau, (steps + 1) * tau) for lo, hi in boxes]
+    waits = [_clear(np.tile(lo, (steps + 1, 1)), np.tile(hi, (steps + 1, 1)), spec,
+                    grid * tau, (grid + 1) * tau) for lo, hi in boxes]
     # the tube waits in the target box from its arrival to t_c: an arrival at step i is a
     # goal only where that wait is clear
     lo, hi = boxes[m]
-    parked = _clear(np.tile(lo, (TIME_STEPS + 1, 1)), np.tile(hi, (TIME_STEPS + 1, 1)), spec,
-                    steps * tau, np.full(TIME_STEPS + 1, t_c))
+    parked = _clear(np.tile(lo, (steps + 1, 1)), np.tile(hi, (steps + 1, 1)), spec,
+                    grid * tau, np.full(steps + 1, t_c))
     # parent[(k, i)] = (previous state, segment taken or None for a wait); states are
     # settled by (summed speed-up, step, box): without [actuator] every speed-up is 0 and
     # the first parent found is kept, a breadth-first search in time (earliest arrival)
@@ -394,11 +398,11 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
                 goal = (k, i)
                 break
             continue
-        if i < TIME_STEPS and waits[k][i]:
+        if i < steps and waits[k][i]:
             reach((k, i + 1), (k, i), None)
         if k in holds:
             # hold the waypoint box from step i to step j (clear: the waits' boxes)
-            for j in range(i + 1, TIME_STEPS + 1):
+            for j in range(i + 1, steps + 1):
                 if not waits[k][j - 1]:
                     break
                 if _hold_ok(holds[k], i * tau, j * tau):
@@ -409,7 +413,7 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
         for f in factors:
             d = max(1, int(math.ceil(f * planned / tau - 1e-9)))
             to = (k + 1, i + d)
-            if to[1] > TIME_STEPS or (to in cost and cost[to] <= c):
+            if to[1] > steps or (to in cost and cost[to] <= c):
                 continue
             seg = replace(segments[k], start=i * tau, end=(i + d) * tau)
             if to[0] == m:
@@ -659,7 +663,7 @@ def _detour(spec: Spec, found: TubeCheck, design_static: Callable[[Spec], Design
 
 def retimed_design(via: Design | None, timing: Spec, spec: Spec,
                    check: Callable[[TubeDesign, Spec], TubeCheck],
-                   started: float) -> Design | str | None:
+                   started: float, steps: int = TIME_STEPS) -> Design | str | None:
     """``via``'s boxes re-timed against the moving obstacles of ``timing``
     (:func:`retime`) and checked for ``spec`` (with ``[actuator]``, its input proof too).
 
@@ -676,6 +680,8 @@ def retimed_design(via: Design | None, timing: Spec, spec: Spec,
         asks more of the tube, as the fleet design's).
     started : float
         ``time.perf_counter()`` when the design began (its ``design_time_s``).
+    steps : int
+        The re-timing grid's steps over ``[0, t_c]`` (:func:`retime`).
 
     Returns
     -------
@@ -698,7 +704,7 @@ def retimed_design(via: Design | None, timing: Spec, spec: Spec,
         if any(set(factors) <= fewer for fewer in none):
             continue
         order = via.task_plan.order if via.task_plan is not None else None
-        segments = retime(planned, timing, order, factors, judged)
+        segments = retime(planned, timing, order, factors, judged, steps=steps)
         if segments is None:
             none.append(set(factors))
         if segments is None or segments in tried:     # the same timing: the same verdict
@@ -709,7 +715,8 @@ def retimed_design(via: Design | None, timing: Spec, spec: Spec,
         if not timed.passed and spec.input_bound is not None:
             # levelled, its moves judged clear as the search judges them; the whole check
             # failed: the search's own timing (faster legs, whose proof may still hold)
-            searched = retime(planned, timing, order, factors, judged, level=False)
+            searched = retime(planned, timing, order, factors, judged, level=False,
+                              steps=steps)
             if searched is not None and searched not in tried:
                 tried.add(searched)
                 tube = replace(via.tube, segments=searched)
