@@ -34,6 +34,9 @@ def test_too_many_robots_or_floors_below_one_are_refused():
     with pytest.raises(SpecError) as raised:
         run_fleet_bench(1, 0, workers=0)
     assert raised.value.field == "workers"
+    with pytest.raises(SpecError) as raised:
+        run_fleet_bench(1, 0, first=-1)
+    assert raised.value.field == "first"
 
 
 @pytest.mark.slow
@@ -54,6 +57,9 @@ def test_floors_in_parallel_processes_are_the_floors_in_turn():
     assert sum(b["robots"] for b in turn["by_near"]) == sum(
         len(f.get("placements", ())) for f in turn["floors"])
     assert "placement CPU by the placed robots near its way" in format_fleet_report(turn)
+    # a floor of the run designed again on its own: the same row
+    (again,) = run_fleet_bench(1, 3, robots=2, first=1)["floors"]
+    assert [again[k] for k in keys] == [turn["floors"][1][k] for k in keys]
 
 
 @pytest.mark.slow

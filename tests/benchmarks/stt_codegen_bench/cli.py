@@ -205,7 +205,7 @@ def _cmd_delay(args: argparse.Namespace) -> int:
 def _cmd_fleet(args: argparse.Namespace) -> int:
     from .fleet_bench import format_fleet_report, run_fleet_bench
     report = run_fleet_bench(args.count, args.seed, robots=args.robots, simulate=args.simulate,
-                             workers=args.workers, scheduler=args.scheduler)
+                             workers=args.workers, scheduler=args.scheduler, first=args.first)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_fleet_report(report))
     return 0
@@ -393,6 +393,8 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                                                                   "(default: %(default)s)")
     p.add_argument("--seed", type=_non_negative_int, default=0,
                    help="floor seed (default: 0)")
+    p.add_argument("--first", type=_non_negative_int, default=0, metavar="K",
+                   help="the first floor's index: floors K to K + count - 1 (default: 0)")
     p.add_argument("--simulate", action="store_true",
                    help="also run every robot's generated C in closed loop (the closest "
                         "approach)")

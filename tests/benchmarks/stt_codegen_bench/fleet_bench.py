@@ -271,7 +271,7 @@ def _floor(seed: int, index: int, robots: int, simulate: bool) -> dict:
 
 
 def run_fleet_bench(count: int, seed: int, robots: int = 8, simulate: bool = False,
-                    workers: int = 1, scheduler: str | None = None) -> dict:
+                    workers: int = 1, scheduler: str | None = None, first: int = 0) -> dict:
     """Fleet design on ``count`` seeded floors: one after another, or a floor per job on
     local processes or a Dask scheduler (:func:`~.parallel.run_parallel`). Each floor's
     times are the CPU of the process that designs it, so they do not depend on how many
@@ -291,6 +291,9 @@ def run_fleet_bench(count: int, seed: int, robots: int = 8, simulate: bool = Fal
         Local processes; 1 (the default) designs the floors in this process, in turn.
     scheduler : str, optional
         Address of a running Dask scheduler: the floors are its jobs (``workers`` ignored).
+    first : int
+        The first floor's index, >= 0: floors ``first`` to ``first + count - 1`` (one
+        floor of a long run designed again on its own).
 
     Returns
     -------
@@ -306,15 +309,18 @@ def run_fleet_bench(count: int, seed: int, robots: int = 8, simulate: bool = Fal
     Raises
     ------
     SpecError
-        ``count < 1`` (field ``count``), a bad ``robots``, ``workers < 1`` (field
-        ``workers``), a scheduler that does not answer (field ``scheduler``).
+        ``count < 1`` (field ``count``), ``first < 0`` (field ``first``), a bad
+        ``robots``, ``workers < 1`` (field ``workers``), a scheduler that does not answer
+        (field ``scheduler``).
     """
     if count < 1:
         raise SpecError("count", f"must be at least 1, got {count}")
+    if first < 0:
+        raise SpecError("first", f"must be at least 0, got {first}")
     if workers < 1:
         raise SpecError("workers", f"must be at least 1, got {workers}")
     fleet_floor(seed, 0, robots)                    # a bad robots fails before any job
-    calls = [(seed, k, robots, simulate) for k in range(count)]
+    calls = [(seed, k, robots, simulate) for k in range(first, first + count)]
     if workers == 1 and scheduler is None:
         floors = [_floor(*call) for call in calls]
     else:
