@@ -537,9 +537,10 @@ def _spans(before: float, start: float, end: float, after: float,
     wait or half of it on either side, longest first."""
     if not alone:
         return [(before, after), (start, end)]
-    ends = [(before, after, (before + start) / 2, (end + after) / 2, start, end)]
-    out = {(t0, t1) for t0 in ends[0][0::2] for t1 in ends[0][1::2]} - {(start, end)}
-    return sorted(out, key=lambda span: (span[0] - span[1], span))
+    firsts = (before, (before + start) / 2, start)
+    lasts = (after, (end + after) / 2, end)
+    spans = {(t0, t1) for t0 in firsts for t1 in lasts} - {(start, end)}
+    return sorted(spans, key=lambda span: (span[0] - span[1], span))
 
 
 def _held(segments: tuple[ReachSegment, ...]) -> tuple[ReachSegment, ...]:
