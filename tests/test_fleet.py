@@ -250,7 +250,7 @@ def test_a_space_time_path_over_the_input_bound_is_planned_again_at_a_lower_spee
         entry["actuator"] = {"input_bound": [5.0, 5.0]}
     fleet = stt.FleetSpec.from_dict(doc)
     proved = fleet_design._proved
-    monkeypatch.setattr(moving, "EASE_WINDOWS", ())      # the path's own timing: not levelled
+    monkeypatch.setattr(moving, "LEVEL_WINDOWS", ())      # the path's own timing: not levelled
     arrivals: list[float] = []
 
     def refused_at_first_speed(design, spec):    # the first try of each robot "fails"
@@ -290,7 +290,7 @@ def test_a_space_time_path_under_an_input_bound_spends_its_waits_driving_slower(
                    for s in design.tube.segments)
 
     levelled = stt.design_fleet(fleet, planner=fleet_design.PLANNER_SPACE_TIME)
-    monkeypatch.setattr(moving, "EASE_WINDOWS", ())
+    monkeypatch.setattr(moving, "LEVEL_WINDOWS", ())
     raw = stt.design_fleet(fleet, planner=fleet_design.PLANNER_SPACE_TIME)
     assert levelled.certified and raw.certified
     for name in ("a", "b"):

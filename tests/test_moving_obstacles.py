@@ -527,7 +527,7 @@ def test_with_an_actuator_the_timing_levels_its_legs_where_they_keep_clear(monke
     doc, legs = _lane({"lower": [2.7, 1.0], "upper": [3.3, 3.0], "active": [0.0, 4.0]})
     spec = stt.Spec.from_dict({**doc, "actuator": {"input_bound": [2, 2]}})
     levelled = retime(legs, spec)
-    monkeypatch.setattr(moving, "EASE_WINDOWS", ())
+    monkeypatch.setattr(moving, "LEVEL_WINDOWS", ())
     searched = retime(legs, spec)
 
     def speeds(timing):
@@ -575,7 +575,7 @@ def test_factor_sets_sharing_their_judged_moves_time_as_each_alone(monkeypatch):
     assert 0 < sizes[0] < sizes[1] < sizes[2]
     # a memo that says every move is clear is read, not judged again: the search's timing
     # changes (the levelling after the search judges its own moves: left out here)
-    monkeypatch.setattr(moving, "EASE_WINDOWS", ())
+    monkeypatch.setattr(moving, "LEVEL_WINDOWS", ())
     lied = {key: True for key in memo}
     assert retime(legs, spec, None, DURATION_FACTORS, lied) != retime(
         legs, spec, None, DURATION_FACTORS)

@@ -73,8 +73,8 @@ DURATION_FACTORS = (1.0, 0.75, 1.5, 0.5, 2.0)
 #: Sub-intervals on which a move is checked against the obstacles' hulls.
 MOVE_CHECKS = 8
 #: With ``[actuator]``: the windows of moves either side of a re-timed move over which its
-#: speed is levelled with theirs (:func:`_eased`), in the order tried.
-EASE_WINDOWS = (64, 16, 8, 4, 2, 1, 0)
+#: speed is levelled with theirs (:func:`_levelled_moves`), in the order tried.
+LEVEL_WINDOWS = (64, 16, 8, 4, 2, 1, 0)
 #: Most sets of moving obstacles to go around that the re-timing step tries (:func:`routes`).
 MAX_ROUTES = 16
 #: Half-lengths (s) of the time spans around where the static tube meets a moving obstacle
@@ -315,7 +315,7 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
     earliest arrival among those: a leg is driven faster only where waiting needs it, as
     the input proof asks least of slow legs. An arrival in the target box counts only where
     the box stays clear from it until ``t_c`` (the tube waits there). With ``[actuator]``
-    and no tasks, the timing found is then levelled (:func:`_eased`): its waits spent
+    and no tasks, the timing found is then levelled (:func:`_levelled_moves`): its waits spent
     driving slower where the moves keep clear.
 
     With ``spec.tasks``, each task's hold segment (:func:`task_holds`) is not re-timed by
@@ -340,7 +340,7 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
         same ``segments`` and ``spec`` (other ``factors``), which judge many of the same
         moves; filled here.
     level : bool
-        With ``[actuator]`` (and no tasks), the timing found levelled (:func:`_eased`);
+        With ``[actuator]`` (and no tasks), the timing found levelled (:func:`_levelled_moves`);
         ``False``: the search's own.
     steps : int
         The grid's steps over ``[0, t_c]`` (default :data:`TIME_STEPS`; a fleet's
@@ -439,12 +439,12 @@ def retime(segments: tuple[ReachSegment, ...], spec: Spec,
         if seg is not None:
             out.append(seg)
     out.reverse()
-    return _held(_eased(out, spec) if speed_up and level and not holds else tuple(out))
+    return _held(_levelled_moves(out, spec) if speed_up and level and not holds else tuple(out))
 
 
 def levelled_timing(segments: Sequence[ReachSegment], spec: Spec) -> tuple[ReachSegment, ...]:
     """A timing's segments (contiguous, a wait a segment whose box does not change) with
-    their moves' speeds levelled against ``spec``'s moving obstacles (:func:`_eased`).
+    their moves' speeds levelled against ``spec``'s moving obstacles (:func:`_levelled_moves`).
 
     Parameters
     ----------
@@ -460,16 +460,16 @@ def levelled_timing(segments: Sequence[ReachSegment], spec: Spec) -> tuple[Reach
     """
     moves = [seg for seg in segments
              if seg.lower_from != seg.lower_to or seg.upper_from != seg.upper_to]
-    return _held(_eased(moves, spec))
+    return _held(_levelled_moves(moves, spec))
 
 
-def _eased(moves: list[ReachSegment], spec: Spec) -> tuple[ReachSegment, ...]:
+def _levelled_moves(moves: list[ReachSegment], spec: Spec) -> tuple[ReachSegment, ...]:
     """The moves of a timing with ``[actuator]``, their speeds levelled where they keep
     clear. A grid's timing drives a move in a whole number of steps and waits whole steps,
     so neighbouring legs alternate between a speed below their plan and one above it; the
     input proof asks least of the slowest legs. The fastest move first (a move's speed:
     the longer of its box's two corners' moves over its duration): over a window of moves
-    around it (the widest of :data:`EASE_WINDOWS` moves either side first), the window's
+    around it (the widest of :data:`LEVEL_WINDOWS` moves either side first), the window's
     time, with the waits just outside it or without them (for a move alone, also with one
     of them or half of either: :func:`_spans`), is shared in proportion to the moves'
     lengths (one speed; a move whose box does not move keeps its duration); the first
@@ -484,8 +484,8 @@ def _eased(moves: list[ReachSegment], spec: Spec) -> tuple[ReachSegment, ...]:
                             float(np.linalg.norm(np.subtract(s.upper_to, s.upper_from))))
                         for s in moves])
 
-    def speed(j: int) -> float:
-        return float(lengths[j] / max(moves[j].end - moves[j].start, 1e-12))
+    def speed(j: int, seg: ReachSegment) -> float:
+        return float(lengths[j] / max(seg.end - seg.start, 1e-12))
 
     def levelled(a: int, b: int, t0: float, t1: float) -> list[ReachSegment] | None:
         # a move that does not move keeps its duration; the others share the rest
@@ -505,9 +505,9 @@ def _eased(moves: list[ReachSegment], spec: Spec) -> tuple[ReachSegment, ...]:
     for _ in range(2 * m):
         if not left:
             break
-        k = max(left, key=lambda j: (speed(j), -j))
-        fastest = speed(k)
-        for width in EASE_WINDOWS:
+        k = max(left, key=lambda j: (speed(j, moves[j]), -j))
+        fastest = speed(k, moves[k])
+        for width in LEVEL_WINDOWS:
             a, b = max(0, k - width), min(m - 1, k + width)
             kept = None
             for t0, t1 in _spans(moves[a - 1].end if a else 0.0, moves[a].start, moves[b].end,
@@ -515,8 +515,8 @@ def _eased(moves: list[ReachSegment], spec: Spec) -> tuple[ReachSegment, ...]:
                 tried = levelled(a, b, t0, t1)
                 if tried is None:
                     continue
-                slowed = max(lengths[a + j] / (seg.end - seg.start)
-                             for j, seg in enumerate(tried)) < fastest * (1.0 - 1e-6)
+                slowed = max(speed(a + j, seg) for j, seg in enumerate(tried)) < (
+                    fastest * (1.0 - 1e-6))
                 if slowed and all(_moves_clear(tried, spec)):
                     kept = tried
                     break
@@ -840,7 +840,7 @@ def retimed_plan(segments: Sequence[ReachSegment], spec: Spec,
     return TaskPlan(plan.order, tuple(held[j] for j in range(len(spec.tasks))))
 
 
-__all__ = ["DETOUR_SPANS", "DURATION_FACTORS", "EASE_WINDOWS", "MAX_ROUTES", "MOTION_SPACE_TIME",
+__all__ = ["DETOUR_SPANS", "DURATION_FACTORS", "LEVEL_WINDOWS", "MAX_ROUTES", "MOTION_SPACE_TIME",
            "MOTION_SWEPT", "MOTION_TIMED_VIA", "MOVE_CHECKS", "TASK_HOLD_SHARE", "TIME_STEPS",
            "design_moving", "levelled_timing", "moves", "retime", "retimed_design",
            "retimed_plan", "routes", "partial_spec", "speed_limits", "static_part", "task_holds"]
