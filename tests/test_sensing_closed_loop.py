@@ -184,17 +184,20 @@ def test_an_obstacle_faster_than_the_envelope_collides_and_is_reported(hall):
 
 @pytest.mark.slow
 def test_a_pursuer_at_the_envelopes_speed_ends_the_guarantee(hall):
-    """A pursuer at the envelope's own speed: no measurement breaks the envelope, but no
-    tube escapes it, so the replanning fails and the run reports the span no certificate
-    covered; the collision comes after the guarantee ended, never inside a certified span."""
+    """A pursuer at the envelope's own speed: no measurement breaks the envelope, but for
+    a while no tube escapes it, so the replanning fails and the run reports the span no
+    certificate covered. The escapes take it to turn after the base (a fast one over their
+    way, docs/sensing.md, step 3), and a best-effort escape gets the base away: it arrives,
+    and the pursuer (its path replayed from the run) never reaches it. Before fast closing
+    obstacles were taken to pursue, it reached the base at 9.77 s, in the uncertified
+    span."""
     run = stt.simulate_sensed(hall, [WalkingObstacle((9.0, 1.0), 0.3, pursuit_speed=0.8)])
     record = run.sensing
     assert not record.outside_envelope and not record.script_outside_envelope
     assert record.failures > 0 and record.uncertified and not record.guaranteed
-    assert record.sensed_collision and not record.collision_certified
-    hit = float(run.trajectory.t[np.argmax(_clearance(run, hall, 0.8) <= 0.0)])
-    assert any(a <= hit <= b for a, b in record.uncertified)
-    assert abs(record.collision_time - hit) <= 1.0 / hall.spec.rate_hz
+    assert record.best_effort >= 1 and run.reached
+    assert not record.sensed_collision and not run.collision
+    assert _clearance(run, hall, 0.8).min() > 0.0
 
 
 def _clearance(run, hall, speed):

@@ -69,14 +69,20 @@ def test_the_goal_stays_clear_only_as_long_as_asked():
     assert space_time_path(grid, taken, (0, 1), (4, 1), 20, stay_steps=11)[-1] == (4, 1, 17)
 
 
-def test_a_robot_waiting_in_the_target_steps_out_of_an_obstacles_way_early(corridor):
+def test_a_robot_waiting_in_the_target_steps_out_of_an_obstacles_way_early(corridor,
+                                                                          monkeypatch):
     """In the target after ``t_c``, a person walks at it along the hall: their reachable
     box over the horizon misses the target, so the tube could be kept, but where they are
-    headed 2 s later does not; the robot leaves along a path that keeps clear of their
-    prediction and comes back once they have passed. A person walking past far from the
-    target leaves the tube kept."""
+    headed 2 s later does not. Taken for a straight walk (no obstacle closing: the
+    pursuit rule of docs/sensing.md, step 1, off), the robot leaves along a path that
+    keeps clear of their prediction and comes back once they have passed. Closing on the
+    robot at 0.6 m/s, they are taken to turn after it, and the robot leaves by an escape.
+    A person walking past far from the target leaves the tube kept."""
     design, plan, _ = corridor
     person = stt.SensedObstacle.ball((3.0, 2.0), 0.35, seen_at=11.0, velocity=(0.6, 0.0))
+    fled = stt.replan(plan, 11.0, (5.5, 2.0), [person])
+    assert isinstance(fled, stt.SensedPlan) and not fled.kept and fled.goal is not None
+    monkeypatch.setattr(sensed_module, "_closing", lambda ob, point: False)
     away = stt.replan(plan, 11.0, (5.5, 2.0), [person])
     assert isinstance(away, stt.SensedPlan), away.reason
     assert not away.kept and away.design.motion == MOTION_SENSED_PATH

@@ -222,13 +222,16 @@ def test_escape_goals_rank_by_where_the_obstacles_are_headed():
                                 - sensing.velocity_error * 1.0)
 
 
-def test_a_slow_obstacle_closing_on_a_robot_that_has_arrived_is_taken_to_pursue_it(
+def test_an_obstacle_closing_on_a_robot_that_has_arrived_is_taken_to_pursue_it(
         monkeypatch):
     """Real-Time STT's script, the robot holding in the target at 17 s (after t_c): a circle
     2.4 m away walking at 0.45 m/s, its heading 40 degrees off the robot, would pass beside
     the held box on a straight walk, but catches it if it turns after the robot, so the
-    kept tube is headed into it. Not so when it is faster than ``CLOSING_SPEED`` times the
-    slowest path, heading away, or while the tube is still due by t_c."""
+    kept tube is headed into it. Not so when it heads away, or while the tube is still due
+    by t_c. A circle faster than ``CLOSING_SPEED`` times the slowest path closes only
+    within ``FAST_CLOSING_ANGLE`` (15 degrees), and is followed for ``FAST_PURSUIT`` (1 s)
+    past the horizon, not ``FORESIGHT`` (2 s): 3 m below the robot at 1.35 m/s it catches
+    the held box within that, 4 m below it does not (but would within ``FORESIGHT``)."""
     from stt_codegen_bench.sensed_script import SCRIPT
     design = stt.design_tube(stt.Spec.from_dict(SCRIPT))
     own = stt.start_plan(design)
@@ -240,14 +243,31 @@ def test_a_slow_obstacle_closing_on_a_robot_that_has_arrived_is_taken_to_pursue_
     assert sensed_module._closing(circle, here)
     assert sensed_module._headed_into(own, [circle], sensing, until, 500, here)
     with monkeypatch.context() as m:        # nobody closing: the straight walk alone
-        m.setattr(sensed_module, "CLOSING_SPEED", 0.0)
+        m.setattr(sensed_module, "CLOSING_ANGLE", 0.1)
         assert not sensed_module._headed_into(own, [circle], sensing, until, 500, here)
-    fast = dataclasses.replace(circle, velocity=(-0.154 * 3, 0.423 * 3))   # 1.35 m/s
     away = dataclasses.replace(circle, velocity=(0.154, -0.423))
-    for ob in (fast, away):
-        assert not sensed_module._closing(ob, here)
-        assert not sensed_module._pursued(own.design, own.start, own.arrival, own.task,
-                                          [ob], sensing, until, here)
+    assert not sensed_module._closing(away, here)
+    assert not sensed_module._pursued(own.design, own.start, own.arrival, own.task,
+                                      [away], sensing, until, here)
+
+    def fast(below):
+        return stt.SensedObstacle.ball((7.0, 10.0 - below), 0.5, seen_at=17.0,
+                                       velocity=(0.0, 1.35))
+
+    near, far = fast(3.0), fast(4.0)
+    assert sensed_module._closing(far, here) and sensed_module._fast(far)
+    # 40 degrees off the robot: a slow one closes, a fast one (a straight walk) does not
+    assert not sensed_module._closing(dataclasses.replace(
+        circle, velocity=(-0.154 * 3, 0.423 * 3)), here)
+    assert not sensed_module._fast(circle)
+    assert sensed_module._pursued(own.design, own.start, own.arrival, own.task, [near],
+                                  sensing, until, here)
+    assert not sensed_module._pursued(own.design, own.start, own.arrival, own.task, [far],
+                                      sensing, until, here)
+    with monkeypatch.context() as m:        # followed as long as a slow one
+        m.setattr(sensed_module, "FAST_PURSUIT", sensed_module.FORESIGHT)
+        assert sensed_module._pursued(own.design, own.start, own.arrival, own.task, [far],
+                                      sensing, until, here)
     due = switch_time(sensing, 5.0, design.spec.rate_hz) + sensing.horizon
     early = dataclasses.replace(circle, seen_at=5.0)
     assert not sensed_module._pursued(own.design, own.start, own.arrival, own.task,
@@ -482,3 +502,35 @@ def test_a_tube_not_proved_from_the_switch_is_not_taken(start, person, new, monk
     plan = stt.replan(start, 1.0, (1.0, 3.0), [person])
     assert plan.kept and plan.design.tube == start.design.tube and plan.goal is None
     assert plan.state_bounds is start.state_bounds
+
+
+def test_an_escape_counts_a_fast_pursuer_over_its_way_and_not_the_wait(monkeypatch):
+    """A goal's clearance from a closing obstacle (``_goal_clearance``): a slow one turning
+    after the robot is followed while the goal is held for ``FORESIGHT`` more, a fast one
+    (1.35 m/s, faster than ``CLOSING_SPEED`` times the slowest path) only until the
+    escape's horizon: it reaches every goal the robot would wait at, and the ranking would
+    say nothing. An obstacle that is not closing is ranked where it is headed."""
+    from stt_codegen_bench.sensed_script import SCRIPT
+    spec = stt.Spec.from_dict(SCRIPT)
+    sensing = spec.sensing
+    here, goal = np.array([2.0, 0.0]), np.array([4.4, 0.0])
+    later = 0.0 + sensed_module.ESCAPE_TIME + sensing.horizon
+    for speed in (0.45, 1.35):
+        ob = stt.SensedObstacle.ball((0.0, 0.0), 0.5, seen_at=0.0, velocity=(speed, 0.0))
+        hold = 0.0 if sensed_module._fast(ob) else sensed_module.FORESIGHT
+        assert sensed_module._fast(ob) == (speed > 1.0)
+        got = sensed_module._goal_clearance(ob, True, here, goal, 0.0, spec.state_space,
+                                            0.1, sensing)
+        assert got == pytest.approx(sensed_module._pursuit_clearance(
+            ob, here, goal, 0.0, sensed_module.ESCAPE_TIME, later + hold, sensing))
+        walked = sensed_module._goal_clearance(ob, False, here, goal, 0.0, spec.state_space,
+                                               0.1, sensing)
+        assert walked == pytest.approx(sensed_module._headed_clearance(
+            ob, goal, 0.0, later, spec.state_space, 0.1, sensing))
+    # the fast one waited for: caught at the goal; over the way alone: clear of it
+    fast = stt.SensedObstacle.ball((0.0, 0.0), 0.5, seen_at=0.0, velocity=(1.35, 0.0))
+    assert sensed_module._goal_clearance(fast, True, here, goal, 0.0, spec.state_space,
+                                         0.1, sensing) > 0.0
+    monkeypatch.setattr(sensed_module, "CLOSING_SPEED", 10.0)     # taken for a slow one
+    assert sensed_module._goal_clearance(fast, True, here, goal, 0.0, spec.state_space,
+                                         0.1, sensing) < 0.0

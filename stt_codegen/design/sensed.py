@@ -92,14 +92,24 @@ ESCAPE_CLEARANCE = 1.0
 #: The time step at which an escape's goal is compared with where each sensed obstacle is
 #: headed, s.
 HEADED_STEP = 0.125
-#: An obstacle whose velocity estimate points within this angle (radians) of the robot, at
-#: a speed of at most :data:`CLOSING_SPEED`, is *closing*: it may turn after the robot (a
-#: pursuer), and is not taken for a straight walk (:func:`_pursued`, :func:`_escape`).
+#: An obstacle whose velocity estimate points within this angle (radians) of the robot is
+#: *closing*: it may turn after the robot (a pursuer), and is not taken for a straight walk
+#: (:func:`_pursued`, :func:`_escape`); a fast one (:data:`CLOSING_SPEED`) only within
+#: :data:`FAST_CLOSING_ANGLE`.
 CLOSING_ANGLE = math.pi / 4.0
-#: The fastest closing obstacle, as a share of the slowest path
-#: (:data:`~.sensed_path.MIN_SPEED`): the robot can outrun a slower one, so stepping out
-#: of its way pays; fleeing one as fast as the robot drives it into a corner.
+#: The fastest *slow* closing obstacle, as a share of the slowest path
+#: (:data:`~.sensed_path.MIN_SPEED`): the robot outruns a slow one, so it is followed for
+#: :data:`FORESIGHT` past a tube's horizon and while an escape holds its goal; a faster one
+#: only for :data:`FAST_PURSUIT`, and over an escape's way and horizon (it reaches every
+#: goal the robot would wait at).
 CLOSING_SPEED = 0.5
+#: Seconds past a tube's certified horizon over which a fast closing obstacle (faster than
+#: :data:`CLOSING_SPEED` times the slowest path) is taken to turn after the robot.
+FAST_PURSUIT = 1.0
+#: The angle (radians) within which a fast obstacle's estimate points at the robot when it
+#: is closing: a pursuer heads for the robot; a fast straight walk taken for one (within
+#: :data:`CLOSING_ANGLE`) ranked escapes into the corner behind the robot.
+FAST_CLOSING_ANGLE = math.pi / 12.0
 
 
 @dataclass(frozen=True)
@@ -912,7 +922,8 @@ def _pursued(design: Design, start: float, arrival: float, task: Spec,
         return (lo + hi) / 2.0
 
     for ob in closing:
-        for t, p in _pursuit(ob, sensing, until + FORESIGHT, centre):
+        ahead = FAST_PURSUIT if _fast(ob) else FORESIGHT
+        for t, p in _pursuit(ob, sensing, until + ahead, centre):
             lo, hi = box(t)
             gap = float(np.linalg.norm(p - np.clip(p, lo, hi)))
             if t >= until and gap <= ob.extent + reach + sensing.velocity_error * (
@@ -942,16 +953,23 @@ def _speed(ob: SensedObstacle) -> float:
     return 0.0 if ob.velocity is None else float(np.linalg.norm(ob.velocity))
 
 
+def _fast(ob: SensedObstacle) -> bool:
+    """Whether ``ob``'s estimate is faster than :data:`CLOSING_SPEED` times
+    :data:`~.sensed_path.MIN_SPEED` (a pursuer the robot does not outrun)."""
+    return _speed(ob) > CLOSING_SPEED * MIN_SPEED
+
+
 def _closing(ob: SensedObstacle, point: np.ndarray) -> bool:
     """Whether ``ob``'s velocity estimate points within :data:`CLOSING_ANGLE` of ``point``
-    (on the sensing dimensions), at most :data:`CLOSING_SPEED` times
-    :data:`~.sensed_path.MIN_SPEED` fast."""
-    if ob.velocity is None or _speed(ob) > CLOSING_SPEED * MIN_SPEED:
+    (on the sensing dimensions); a fast one's (:func:`_fast`) within
+    :data:`FAST_CLOSING_ANGLE`."""
+    if ob.velocity is None:
         return False
     v = np.asarray(ob.velocity, dtype=float)
     towards = np.asarray(point, dtype=float) - np.asarray(ob.centre, dtype=float)
     size = float(np.linalg.norm(v) * np.linalg.norm(towards))
-    return size > 0.0 and float(v @ towards) >= math.cos(CLOSING_ANGLE) * size
+    angle = FAST_CLOSING_ANGLE if _fast(ob) else CLOSING_ANGLE
+    return size > 0.0 and float(v @ towards) >= math.cos(angle) * size
 
 
 def foresight_boxes(sensed: Sequence[SensedObstacle], reach: float, dims: Sequence[int],
@@ -1161,16 +1179,16 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     the state space and clear of the static obstacles, ranked by their distance from where
     every sensed obstacle is headed from the switch until the tube has arrived plus the
     horizon (:func:`_headed_clearance`; from an obstacle closing on the robot at ``s`` or at
-    ``point``, :func:`_closing`, taken to turn after the robot on its way there and while
-    it holds the goal for :data:`FORESIGHT` more, :func:`_pursuit_clearance`) and from the state space's
-    boundary (the largest first, up to :data:`ESCAPE_CLEARANCE`), then by their distance
-    to the target; at most :data:`MAX_ESCAPES` designs.
+    ``point``, :func:`_closing`, taken to turn after the robot on its way there and, a
+    slow one, while it holds the goal for :data:`FORESIGHT` more, :func:`_pursuit_clearance`)
+    and from the state space's boundary (the largest first, up to
+    :data:`ESCAPE_CLEARANCE`), then by their distance to the target; at most
+    :data:`MAX_ESCAPES` designs.
     """
     dims = list(sensing.dims)
     reach = _reach(base)
     half = np.array([base.initial_half_width[d] for d in dims])
     target = np.asarray(base.target_center)[dims]
-    later = t_s + ESCAPE_TIME + sensing.horizon
     closing = [(ob, _closing(ob, point) or _closing(ob, s)) for ob in sensed]
     ranked = []
     for distance in ESCAPE_DISTANCES:
@@ -1186,10 +1204,8 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
             goal = Box(tuple(lo), tuple(hi))
             if not base.state_space.contains_box(goal) or _meets_static(base, goal, reach):
                 continue
-            clear = min((_pursuit_clearance(ob, point, p, t_s, t_s + ESCAPE_TIME,
-                                            later + FORESIGHT, sensing) if heads else
-                         _headed_clearance(ob, p, t_s, later, base.state_space, reach,
-                                           sensing) for ob, heads in closing),
+            clear = min((_goal_clearance(ob, heads, point, p, t_s, base.state_space, reach,
+                                         sensing) for ob, heads in closing),
                         default=math.inf) - reach - float(np.linalg.norm(half))
             # a goal near the state space's boundary leaves fewer ways out next time (a
             # corner is a trap): its room to the boundary counts as a clearance too
@@ -1278,6 +1294,20 @@ def _reached(plan: SensedPlan, s: np.ndarray, sensing: Sensing) -> bool:
 def _meets_start(boxes: Sequence[MovingObstacle], box: Box) -> bool:
     """Whether one of ``boxes`` meets ``box`` at ``t' = 0``."""
     return any(b.meeting_times(box.lower, box.upper, 0.0, 0.0) for b in boxes)
+
+
+def _goal_clearance(ob: SensedObstacle, closing: bool, point: np.ndarray, goal: np.ndarray,
+                    t_s: float, state_space: Box, reach: float, sensing: Sensing) -> float:
+    """The least distance between an escape from ``point`` at ``t_s`` to ``goal`` (reached
+    :data:`ESCAPE_TIME` later and held) and ``ob`` until the escape's horizon: a
+    ``closing`` one turning after the robot (:func:`_pursuit_clearance`; a slow one, not
+    :func:`_fast`, also while the goal is held for :data:`FORESIGHT` more), another where
+    it is headed (:func:`_headed_clearance`); state units, negative inside. A ranking."""
+    later = t_s + ESCAPE_TIME + sensing.horizon
+    if closing:
+        return _pursuit_clearance(ob, point, goal, t_s, t_s + ESCAPE_TIME,
+                                  later + (0.0 if _fast(ob) else FORESIGHT), sensing)
+    return _headed_clearance(ob, goal, t_s, later, state_space, reach, sensing)
 
 
 def _headed_clearance(ob: SensedObstacle, point: np.ndarray, t_from: float, t_to: float,
