@@ -26,6 +26,11 @@ Spatiotemporal Tubes Approach". The front door, in the order of the flow (see
 * :func:`plot_design`, :func:`plot_run` - figures of a design, and of a run;
 * :func:`controller_system`, :func:`sampled_plant` - the sampled controller and the plant
   over a period as discrete-time python-control systems (``ct.interconnect``);
+* :func:`start_plan`, :func:`replan` - a tube replanned at run time around obstacles a
+  sensor reports (:class:`SensedObstacle`) within the spec's ``[sensing]`` envelope;
+  :func:`simulate_sensed` - the closed loop among obstacles the design does not know
+  (:class:`WalkingObstacle`, or a file of them: :func:`load_walking_obstacles`),
+  docs/sensing.md;
 * :class:`Progress` - what ``design_tube`` and ``verify`` pass to a ``progress`` callback;
 * :func:`import_pointmaze` - the spec of a maze of gymnasium-robotics' PointMaze (the
   ``mujoco`` extra);
@@ -88,6 +93,8 @@ _LAZY: dict[str, str] = {
     "start_plan": "stt_codegen.design.sensed",
     "replan": "stt_codegen.design.sensed",
     "simulate_sensed": "stt_codegen.runtime.sensed",
+    "WalkingObstacle": "stt_codegen.runtime.sensed",
+    "load_walking_obstacles": "stt_codegen.runtime.walking_file",
     "Progress": "stt_codegen.progress",
     "controller_system": "stt_codegen.runtime.iosystem",
     "sampled_plant": "stt_codegen.runtime.iosystem",
@@ -113,7 +120,8 @@ if TYPE_CHECKING:  # for type checkers and IDEs; at run time, __getattr__ below
     from .pointmaze import import_pointmaze
     from .spec.sensing import SensedObstacle
     from .design.sensed import ReplanFailure, SensedPlan, replan, start_plan
-    from .runtime.sensed import simulate_sensed
+    from .runtime.sensed import WalkingObstacle, simulate_sensed
+    from .runtime.walking_file import load_walking_obstacles
     from .spec.loader import Spec, load_spec
     from .tube.parameters import TubeDesign
     from .proofs.check import VerificationReport

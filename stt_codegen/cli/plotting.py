@@ -121,14 +121,19 @@ def write_rejected_plot(args: argparse.Namespace, spec: Spec, error: DesignError
     print(f"plot written to {args.plot}: it shows the best rejected tube", file=sys.stderr)
 
 
-def design_to_plot(args: argparse.Namespace) -> tuple[Design, tuple[int, int]]:
-    """Load ``SPEC``, check ``--plot`` and ``--dims`` before any work, and design the tube
-    (:func:`~.common.design_spec`); with no design, :func:`write_rejected_plot` first.
+def design_to_plot(args: argparse.Namespace, check: Callable[[Spec], None] | None = None
+                   ) -> tuple[Design, tuple[int, int]]:
+    """Load ``SPEC``, check ``--plot`` and ``--dims`` (and ``check``) before any work, and
+    design the tube (:func:`~.common.design_spec`); with no design,
+    :func:`write_rejected_plot` first.
 
     Parameters
     ----------
     args : argparse.Namespace
         Parsed arguments with ``spec``, ``plot``, ``dims`` and, optionally, ``json``.
+    check : callable, optional
+        ``check(spec)``, the command's own checks of the loaded spec (raising
+        :class:`~stt_codegen.errors.SpecError`), before the design.
 
     Returns
     -------
@@ -140,7 +145,7 @@ def design_to_plot(args: argparse.Namespace) -> tuple[Design, tuple[int, int]]:
     Raises
     ------
     SpecError
-        A bad spec, ``--plot`` folder or ``--dims``.
+        A bad spec, ``--plot`` folder or ``--dims``, or what ``check`` refuses.
     DesignError
         No design (exit 1).
     """
@@ -150,6 +155,8 @@ def design_to_plot(args: argparse.Namespace) -> tuple[Design, tuple[int, int]]:
     check_plot_folder(args)
     spec = load_spec(args.spec)
     dims = plot_dims(args, spec)
+    if check is not None:
+        check(spec)
     try:
         return design_spec(spec, args), dims
     except DesignError as exc:

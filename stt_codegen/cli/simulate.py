@@ -3,10 +3,16 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
+from typing import TYPE_CHECKING
 
+from ..errors import SpecError
 from .common import (add_backend_argument, add_json_argument, add_seed_argument,
                      add_spec_argument, checked_seed, print_json)
 from .plotting import add_plot_argument, design_to_plot, write_plot
+
+if TYPE_CHECKING:
+    from ..spec.loader import Spec
 
 __all__ = ["SUMMARY_HEADER", "cmd_simulate", "configure_simulate", "summary_line"]
 
@@ -42,7 +48,9 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     ----------
     args : argparse.Namespace
         ``spec``, ``backend``, ``horizon`` (s, or ``None`` for ``t_c``), ``seed``, ``plot``,
-        ``dims``, ``log`` (an MCAP path or ``None``) and ``json``.
+        ``dims``, ``log`` (an MCAP path or ``None``), ``sensed`` (a file of the obstacles a
+        spec with ``[sensing]`` meets, or ``None``: a bundled case's own people, else none;
+        :mod:`~stt_codegen.runtime.walking_file`) and ``json``.
 
     Returns
     -------
@@ -52,9 +60,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     Raises
     ------
     SpecError
-        A bad spec, ``--seed``, ``--horizon``, ``--plot`` folder, ``--dims`` or ``--log``
-        (not ``.mcap``, a missing folder, ``mcap-ros2-support`` not installed), exit code 2,
-        before any work.
+        A bad spec, ``--seed``, ``--horizon``, ``--plot`` folder, ``--dims``, ``--log``
+        (not ``.mcap``, a missing folder, ``mcap-ros2-support`` not installed) or
+        ``--sensed`` (unreadable, a bad entry, off the spec's sensing dimensions, a spec
+        without ``[sensing]`` or a fleet), exit code 2, before any work.
     DesignError
         No design (exit code 1).
     ToolchainError
@@ -63,14 +72,24 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from .fleet import fleet_simulate, fleet_of
     fleet = fleet_of(args)            # a fleet file: one design per robot (docs/fleets.md)
     if fleet is not None:
+        if args.sensed is not None:
+            raise SpecError("sensed", "a fleet's robots sense no obstacles at run time "
+                                      "(docs/fleets.md); --sensed takes a spec with "
+                                      "[sensing]")
         return fleet_simulate(args, fleet, SUMMARY_HEADER, summary_line)
     from ..runtime.simulate import simulate
     from ..runtime.run_log import check_log_path, write_run_log
     seed = checked_seed(args)
     if args.log is not None:
         check_log_path(args.log)
-    design, dims = design_to_plot(args)
-    result = simulate(design, backend=args.backend, horizon=args.horizon, seed=seed)
+    sensed = _SensedObstacles(args)
+    design, dims = design_to_plot(args, sensed.check)
+    if design.spec.sensing is None:
+        result = simulate(design, backend=args.backend, horizon=args.horizon, seed=seed)
+    else:
+        from ..runtime.sensed import simulate_sensed
+        result = simulate_sensed(design, sensed.obstacles, backend=args.backend,
+                                 horizon=args.horizon, seed=seed)
     if args.log is not None:
         write_run_log(design, result, args.log)
 
@@ -81,6 +100,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     if args.json:
         data = result.to_json()
         data["design"] = design.to_json()
+        if result.sensing is not None:
+            data["sensed_obstacles"] = {"count": len(sensed.obstacles), "source": sensed.kind}
         print_json(data)
     else:
         print(SUMMARY_HEADER)
@@ -99,6 +120,9 @@ def cmd_simulate(args: argparse.Namespace) -> int:
                      f"{result.first_contact[2]})")
             print(f"MuJoCo contacts (other than with the ground): {result.contacts} "
                   f"timesteps{first}")
+        if result.sensing is not None:            # [sensing]
+            print(f"sensed obstacles: {len(sensed.obstacles)} ({sensed.source}); "
+                  f"{result.sensing.summary()}")
         for task in result.tasks:                 # [[tasks]]
             when = "" if task.time is None else f" at {task.time:g} s"
             print(f"task {task.task} {task.kind} [{task.window[0]:g}, {task.window[1]:g}] s: "
@@ -112,6 +136,40 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     return 0 if result.satisfied else 1
 
 
+class _SensedObstacles:
+    """The obstacles a spec with ``[sensing]`` is run among: ``--sensed FILE``'s, else a
+    bundled case's own people, else none; checked against the spec before the design."""
+
+    def __init__(self, args: argparse.Namespace) -> None:
+        self.args = args
+        self.file = None
+        if args.sensed is not None:            # read before any work
+            from ..runtime.walking_file import load_walking_obstacles
+            self.file = load_walking_obstacles(args.sensed)
+        self.obstacles: tuple = ()
+        self.source = ""
+        #: where they come from: "file", "case" or "none"
+        self.kind = "none"
+
+    def check(self, spec: Spec) -> None:
+        """Refuse ``--sensed`` for a spec without ``[sensing]``, or obstacles off its
+        sensing dimensions; choose the obstacles."""
+        from ..runtime.sensed import PEOPLE_CASES, bundled_people, check_walking
+        if spec.sensing is None:
+            if self.file is not None:
+                raise SpecError("sensed", f"spec {spec.name!r} has no [sensing] table: its "
+                                          "controller senses no obstacle (docs/sensing.md)")
+            return
+        if self.file is not None:
+            check_walking(self.file, spec, "walking_obstacles")
+            self.obstacles, self.source = self.file, f"from {self.args.sensed}"
+            self.kind = "file"
+        elif spec.name in PEOPLE_CASES and not Path(self.args.spec).exists():
+            self.obstacles, self.source = bundled_people(spec.name), "the case's own people"
+            self.kind = "case"
+        else:
+            self.source = "none given: --sensed FILE lists them, docs/sensing.md"
+
 
 def configure_simulate(p: argparse.ArgumentParser) -> None:
     """Arguments of ``stt-codegen simulate``.
@@ -120,7 +178,7 @@ def configure_simulate(p: argparse.ArgumentParser) -> None:
     ----------
     p : argparse.ArgumentParser
         The subcommand's parser; gets ``SPEC``, ``--backend``, ``--horizon``, ``--seed``,
-        ``--plot``, ``--dims``, ``--log``, ``--json`` and the ``handler``
+        ``--plot``, ``--dims``, ``--log``, ``--sensed``, ``--json`` and the ``handler``
         :func:`cmd_simulate`.
     """
     add_spec_argument(p)
@@ -132,5 +190,9 @@ def configure_simulate(p: argparse.ArgumentParser) -> None:
     p.add_argument("--log", metavar="RUN.mcap", default=None,
                    help="write the run as ROS 2 messages to an MCAP file (Foxglove, ros2 bag "
                         "play; the optional extra ros)")
+    p.add_argument("--sensed", metavar="FILE", default=None,
+                   help="obstacles a spec with [sensing] meets at run time, unknown to its "
+                        "design: a TOML file of [[walking_obstacles]] (docs/sensing.md; "
+                        "default: a bundled case's own people, else none)")
     add_json_argument(p)
     p.set_defaults(handler=cmd_simulate)

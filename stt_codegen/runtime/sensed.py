@@ -37,6 +37,7 @@ from ..design.search import MAX_INITIAL_ERROR
 from ..design.sensed import (ReplanFailure, SensedPlan, replan, start_plan,
                              uncertified_plan)
 from ..errors import SpecError
+from ..spec.loader import Spec
 from ..spec.variants import variant_of
 from ..spec.sensing import EnvelopeViolation, SensedObstacle, Sensing, envelope_violations
 from ..tube import reference
@@ -47,7 +48,8 @@ from .simulate import (RungeKutta, SimulationResult, Trajectory, hold_period,
                        sampling_offsets)
 from .state_split import initial_state, positions
 
-__all__ = ["PlanEvent", "SensingRecord", "WalkingObstacle", "bundled_people", "simulate_sensed"]
+__all__ = ["PEOPLE_CASES", "PlanEvent", "SensingRecord", "WalkingObstacle", "bundled_people",
+           "check_walking", "simulate_sensed"]
 
 
 @dataclass(frozen=True)
@@ -144,6 +146,10 @@ class WalkingObstacle:
         return rows[:, 0], tuple(rows[:, 1 + k] for k in range(rows.shape[1] - 1))
 
 
+#: The bundled cases with people of their own (:func:`bundled_people`).
+PEOPLE_CASES = ("hall-crossing",)
+
+
 def bundled_people(name: str) -> tuple[WalkingObstacle, ...]:
     """The people ``stt-codegen demo`` walks through a bundled case with ``[sensing]``:
     obstacles its design does not know, revealed only by sensing.
@@ -171,10 +177,57 @@ def bundled_people(name: str) -> tuple[WalkingObstacle, ...]:
     >>> [p.radius for p in bundled_people("hall-crossing")]
     [0.3, 0.35]
     """
-    if name != "hall-crossing":
-        raise SpecError("case", f"no bundled people for {name!r} (known: hall-crossing)")
+    if name not in PEOPLE_CASES:
+        raise SpecError("case", f"no bundled people for {name!r} (known: "
+                                f"{', '.join(PEOPLE_CASES)})")
     return (WalkingObstacle((5.0, 0.5), 0.3, velocity=(0.0, 0.5)),
             WalkingObstacle((7.0, 5.5), 0.35, path=((2.0, 7.0, 5.5), (10.0, 7.0, 0.5))))
+
+
+def check_walking(obstacles: Sequence[WalkingObstacle], spec: Spec,
+                  field: str = "obstacles") -> None:
+    """Refuse obstacles :func:`simulate_sensed` cannot run ``spec`` among, before any work.
+
+    Parameters
+    ----------
+    obstacles : sequence of WalkingObstacle
+        The obstacles the controller is to sense.
+    spec : Spec
+        The spec run among them.
+    field : str
+        How the obstacles are named in an error (``"walking_obstacles"`` for a file's).
+
+    Raises
+    ------
+    SpecError
+        The spec has no ``[sensing]`` (field ``sensing``); an entry that is not a
+        :class:`WalkingObstacle` (``<field>[j]``) or whose ``start`` is not on the
+        ``[sensing] dims`` (``<field>[j].start``).
+
+    Examples
+    --------
+    >>> import stt_codegen as stt
+    >>> from stt_codegen.runtime.sensed import WalkingObstacle, check_walking
+    >>> spec = stt.load_spec("hall-crossing")
+    >>> check_walking([WalkingObstacle((5.0, 0.5), 0.3)], spec)
+    >>> try:
+    ...     check_walking([WalkingObstacle((5.0, 0.5, 0.0), 0.3)], spec)
+    ... except stt.SpecError as error:
+    ...     print(error.field, "|", error.reason)
+    obstacles[0].start | must have 2 entries (one per sensing dimension, dims [0, 1])
+    """
+    sensing = spec.sensing
+    if sensing is None:
+        raise SpecError("sensing", f"spec {spec.name!r} has no [sensing] table: its "
+                                   "controller senses no obstacle (docs/sensing.md)")
+    m = len(sensing.dims)
+    for j, ob in enumerate(obstacles):
+        if not isinstance(ob, WalkingObstacle):
+            raise SpecError(f"{field}[{j}]", f"must be a WalkingObstacle, not "
+                                             f"{type(ob).__name__}")
+        if len(ob.start) != m:
+            raise SpecError(f"{field}[{j}].start", f"must have {m} entries (one per sensing "
+                                                   f"dimension, dims {list(sensing.dims)})")
 
 
 @dataclass(frozen=True)
@@ -311,14 +364,7 @@ class _World:
     """The walking obstacles' positions, advanced a period at a time."""
 
     def __init__(self, obstacles: Sequence[WalkingObstacle], m: int, dt: float) -> None:
-        self.obstacles = list(obstacles)
-        for j, ob in enumerate(self.obstacles):
-            if not isinstance(ob, WalkingObstacle):
-                raise SpecError(f"obstacles[{j}]", f"must be a WalkingObstacle, not "
-                                                   f"{type(ob).__name__}")
-            if len(ob.start) != m:
-                raise SpecError(f"obstacles[{j}].start", f"must have {m} entries (one per "
-                                                         "sensing dimension)")
+        self.obstacles = list(obstacles)          # checked by check_walking
         self.radius = np.array([ob.radius for ob in self.obstacles]).reshape(-1)
         self.p = (np.array([ob.scripted([0.0])[0] for ob in self.obstacles]).reshape(-1, m))
         # the velocity before t = 0 (the first measurement's estimate): a scripted
@@ -431,10 +477,9 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
     """
     design = require_design(design, "simulate_sensed")
     spec = design.spec
-    sensing: Sensing | None = spec.sensing
-    if sensing is None:
-        raise SpecError("sensing", f"spec {spec.name!r} has no [sensing] table "
-                                   "(docs/sensing.md)")
+    obstacles = list(obstacles)
+    check_walking(obstacles, spec)
+    sensing: Sensing = spec.sensing
     seed = check_seed(seed)
     variant = variant_of(spec)
     generated = ("c", "python")                  # the backends that run the data form
