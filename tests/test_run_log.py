@@ -6,6 +6,7 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 from conftest import design_of
 
@@ -81,6 +82,38 @@ def test_a_plane_run_lies_at_z_0(tmp_path):
     assert {m[2].pose.position.z for m in found["/stt/state"]} == {0.0}
     tube = found["/stt/markers"][0][2].markers[0]
     assert tube.ns == "tube" and tube.scale.z > 0.0      # drawn as a thin box
+
+
+def test_a_sensed_run_draws_the_active_tube_and_the_people_where_they_are(tmp_path):
+    """With obstacles sensed at run time the tube changes: the log draws the one active at
+    each sample (not the design's), and each person as an upright cylinder where they are
+    then, across the state space's heading axis."""
+    from stt_codegen.runtime.sensed import bundled_people
+    design = design_of("hall-crossing")
+    result = stt.simulate_sensed(design, bundled_people("hall-crossing"), horizon=8.0)
+    trajectory = result.trajectory
+    write_run_log(design, result, tmp_path / "hall.mcap")
+    found = _decoded(tmp_path / "hall.mcap")
+    assert len(found["/stt/markers"]) == len(trajectory.t)
+    switched = np.flatnonzero(trajectory.tube > 0)
+    assert switched.size > 0                      # the run switched tubes before 8 s
+    g_l, g_u, _, _ = reference.adaptive_tube(design.tube, trajectory.t, trajectory.alpha)
+    k = int(switched[len(switched) // 2])
+    assert not np.allclose(g_l[k], trajectory.gamma_L[k])       # the design's is elsewhere
+    space = design.spec.state_space
+    for k in (0, k, len(trajectory.t) - 1):
+        markers = found["/stt/markers"][k][2].markers
+        tube = next(m for m in markers if m.ns == "tube")
+        centre = (trajectory.gamma_L[k] + trajectory.gamma_U[k]) / 2
+        assert [tube.pose.position.x, tube.pose.position.y, tube.pose.position.z] == \
+            pytest.approx(centre.tolist(), abs=1e-12)
+        people = [m for m in markers if m.ns == "sensed"]
+        assert [m.id for m in people] == [0, 1] and {m.type for m in people} == {3}
+        for m in people:
+            assert [m.pose.position.x, m.pose.position.y] == pytest.approx(
+                trajectory.sensed_positions[k, m.id].tolist(), abs=1e-12)
+            assert m.scale.x == pytest.approx(2 * trajectory.sensed_radii[m.id])
+            assert m.scale.z == pytest.approx(space.upper[2] - space.lower[2])
 
 
 @pytest.mark.parametrize("path, message", [("run.bag", "must end in .mcap"),

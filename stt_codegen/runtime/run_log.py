@@ -69,10 +69,11 @@ _DEFINITIONS = {
         "bool mesh_use_embedded_materials"]),
     "visualization_msgs/MarkerArray": "visualization_msgs/Marker[] markers",
 }
-_CUBE = 1
-#: Colours (r, g, b, a) of the markers: the tube, an obstacle, the target.
+_CUBE, _CYLINDER = 1, 3
+#: Colours (r, g, b, a) of the markers: the tube, an obstacle, the target, an obstacle
+#: sensed at run time.
 _COLOURS = {"tube": (1.0, 0.55, 0.0, 0.35), "obstacle": (0.45, 0.45, 0.45, 0.8),
-            "target": (0.0, 0.7, 0.2, 0.35)}
+            "target": (0.0, 0.7, 0.2, 0.35), "sensed": (0.55, 0.3, 0.75, 0.6)}
 #: Thickness of a box drawn in the plane (a state space of fewer than 3 dimensions).
 _FLAT = 0.01
 
@@ -109,13 +110,16 @@ def _pose(t: float, point) -> dict[str, Any]:
         "x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}}}
 
 
-def _box_marker(t: float, ns: str, ident: int, lower, upper, colour: str) -> dict[str, Any]:
+def _box_marker(t: float, ns: str, ident: int, lower, upper, colour: str,
+                shape: int = _CUBE) -> dict[str, Any]:
+    """A marker filling the box ``[lower, upper]`` (a ``shape`` of its size: a cube, or an
+    upright cylinder in it)."""
     lower, upper = np.asarray(lower, float), np.asarray(upper, float)
     scale = _xyz(upper - lower)
     if len(lower) < 3:
         scale["z"] = _FLAT
     r, g, b, a = _COLOURS[colour]
-    return {"header": _stamp(t), "ns": ns, "id": ident, "type": _CUBE, "action": 0,
+    return {"header": _stamp(t), "ns": ns, "id": ident, "type": shape, "action": 0,
             "pose": {"position": _xyz((lower + upper) / 2), "orientation": {
                 "x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}},
             "scale": scale, "color": {"r": r, "g": g, "b": b, "a": a},
@@ -124,6 +128,23 @@ def _box_marker(t: float, ns: str, ident: int, lower, upper, colour: str) -> dic
                 "header": _stamp(t), "format": "", "data": b""},
             "uv_coordinates": [], "text": "", "mesh_resource": "",
             "mesh_file": {"filename": "", "data": b""}, "mesh_use_embedded_materials": False}
+
+
+def _sensed_boxes(spec, trajectory) -> list[tuple[np.ndarray, np.ndarray]] | None:
+    """Per sample, the lower and upper corners (J, n) of each sensed obstacle's box: its
+    disc on the sensing dimensions, the state space on the others; ``None`` for a run
+    without sensed obstacles."""
+    if trajectory.sensed_positions is None or spec.sensing is None:
+        return None
+    dims = list(spec.sensing.dims)
+    radii = np.asarray(trajectory.sensed_radii, dtype=float)[:, None]
+    out = []
+    for centres in trajectory.sensed_positions:
+        lower = np.tile(np.asarray(spec.state_space.lower, dtype=float), (len(radii), 1))
+        upper = np.tile(np.asarray(spec.state_space.upper, dtype=float), (len(radii), 1))
+        lower[:, dims], upper[:, dims] = centres - radii, centres + radii
+        out.append((lower, upper))
+    return out
 
 
 def check_log_path(path: str | Path) -> None:
@@ -160,10 +181,14 @@ def write_run_log(design: Design, result: SimulationResult, path: str | Path) ->
     each but the path: ``/stt/state`` the point the tube holds (``PoseStamped``, its first
     three coordinates, orientation the identity); ``/stt/command`` the input ``u_k``
     (``Float64MultiArray``, input units); ``/stt/markers`` the tube ``[gamma_L,
-    gamma_U]`` of eq. (10) at the run's ``alpha`` (namespace ``tube``), the static
-    obstacles' boxes (``obstacles``) and the target (``target``) as ``CUBE`` markers
-    (``MarkerArray``); ``/stt/path`` the whole trajectory (``Path``, one message at the last
-    instant). Stamped ``t_k`` s from 0 in the frame ``map``; written atomically.
+    gamma_U]`` of eq. (10) at the run's ``alpha`` (namespace ``tube``; in a run with sensed
+    obstacles, :func:`~.sensed.simulate_sensed`, the tube active at ``t_k``), the static
+    obstacles' boxes (``obstacles``) and the target (``target``) as ``CUBE`` markers, and
+    in a run with sensed obstacles each of them where it is at ``t_k`` (``sensed``, id its
+    index, seen or not), a ``CYLINDER`` of its diameter on the ``[sensing] dims`` across
+    the state space on the other axes (``MarkerArray``); ``/stt/path`` the whole trajectory
+    (``Path``, one message at the last instant). Stamped ``t_k`` s from 0 in the frame
+    ``map``; written atomically.
 
     Parameters
     ----------
@@ -191,9 +216,14 @@ def write_run_log(design: Design, result: SimulationResult, path: str | Path) ->
     if trajectory is None:
         raise SpecError("log", "the run has no trajectory to write")
     spec = design.spec
-    g_l, g_u, _, _ = reference.adaptive_tube(design.tube, trajectory.t, trajectory.alpha)
+    if trajectory.gamma_L is not None:          # the tube active at each sample
+        g_l, g_u = trajectory.gamma_L, trajectory.gamma_U
+    else:
+        g_l, g_u, _, _ = reference.adaptive_tube(design.tube, trajectory.t,
+                                                 trajectory.alpha)
     boxes = spec.obstacle_boxes()
     target = spec.target_set
+    sensed = _sensed_boxes(spec, trajectory)
 
     def write(tmp: Path) -> None:
         with open(tmp, "wb") as stream:
@@ -219,6 +249,8 @@ def write_run_log(design: Design, result: SimulationResult, path: str | Path) ->
                             for b, box in enumerate(boxes)]
                 markers.append(_box_marker(t, "target", 0, target.lower, target.upper,
                                            "target"))
+                markers += [_box_marker(t, "sensed", j, lo, hi, "sensed", _CYLINDER)
+                            for j, (lo, hi) in enumerate(zip(*sensed[k]))] if sensed else []
                 writer.write_message("/stt/markers", schemas["/stt/markers"],
                                      {"markers": markers}, log_time=stamp,
                                      publish_time=stamp, sequence=k)
