@@ -430,6 +430,10 @@ def simulate(design: Design, *positional: object, backend: str | None = None,
     with the design's second stage (:attr:`~stt_codegen.design.result.Design.second_stage`)
     on ``[x1; x2]``, from ``x2(0) = initial.velocity``.
 
+    A spec with ``[sensing]`` runs here on its design's tube alone, among the spec's own
+    obstacles: :func:`~.sensed.simulate_sensed` runs it among obstacles sensed at run time,
+    replanning its tube (``stt-codegen simulate`` does, docs/sensing.md).
+
     With a spec's ``[controller] delay`` ``d > 0`` the command ``u_k`` computed from
     ``x(t_k)`` acts from ``t_k + d`` to ``t_{k+1} + d`` (the previous command acts on
     ``[t_k, t_k + d)``, the input is zero before ``u_0`` acts); the trajectory's ``u`` at
