@@ -136,3 +136,15 @@ def test_sensed_obstacles_where_none_are_sensed_or_no_file_is_bad_input(
     captured = capsys.readouterr()
     assert captured.err.startswith("error: " + message), captured.err
     assert captured.out == ""
+
+
+def test_design_says_how_the_tube_is_replanned_at_run_time(capsys):
+    assert main(["design", "hall-crossing"]) == 0
+    out = capsys.readouterr().out
+    # the hall's envelope: every 0.5 s, L 0.1 s, tau 0.5 s, H 1 s, V 0.8 m/s
+    assert ("sensing: this tube is the first plan, replanned every 0.5 s; each plan switches "
+            "in 0.6 s after its measurement (latency 0.1 s + budget 0.5 s), certified 1 s on "
+            "(0.5 s at least); obstacles of radius <= 0.4 m at <= 0.8 m/s, seen within 4 m "
+            "on x1, x2, close 1.28 m within a plan's 1.6 s") in out
+    assert main(["design", "omnirobot-s1"]) == 0
+    assert "sensing" not in capsys.readouterr().out

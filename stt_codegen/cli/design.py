@@ -116,6 +116,8 @@ def cmd_design(args: argparse.Namespace) -> int:
     for s in tube.segments:
         box = ", ".join(f"[{a:.3g}, {b:.3g}]" for a, b in zip(s.lower_to, s.upper_to))
         print(f"  reach segment {s.profile} [{s.start:.3f}, {s.end:.3f}] s to {box}")
+    if spec.sensing is not None:                 # [sensing]
+        print(_sensing_line(spec.sensing))
     if design.target_choice is not None:         # [target] any_of
         print(f"  target: any_of[{design.target_choice}]")
         for q, name in spec.target_dropped:
@@ -148,6 +150,21 @@ def cmd_design(args: argparse.Namespace) -> int:
     if args.export is not None:
         print(f"tube written to {args.export}")
     return 0
+
+
+def _sensing_line(sensing) -> str:
+    """What ``[sensing]`` makes of the design at run time, in one line (state units:
+    metres, as docs/sensing.md reads them)."""
+    s = sensing
+    axes = ", ".join(f"x{d + 1}" for d in s.dims)
+    span = s.latency + s.replan_time + s.horizon
+    return (f"  sensing: this tube is the first plan, replanned every {s.period:g} s; each "
+            f"plan switches in {s.switch_delay:g} s after its measurement (latency "
+            f"{s.latency:g} s + budget {s.replan_time:g} s), certified {s.horizon:g} s on "
+            f"({s.shortest_horizon:g} s at least); obstacles of radius <= "
+            f"{s.max_obstacle_radius:g} m at <= {s.max_obstacle_speed:g} m/s, seen within "
+            f"{s.range:g} m on {axes}, close {s.unseen_reach(span):.3g} m within a plan's "
+            f"{span:g} s (docs/sensing.md; simulate --sensed FILE)")
 
 
 def configure_design(p: argparse.ArgumentParser) -> None:
