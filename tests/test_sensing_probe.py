@@ -77,3 +77,15 @@ def test_no_certified_sample_meets_an_obstacle(walkers):
 @given(people())
 def test_no_certified_sample_meets_an_obstacle_in_more_worlds(walkers):
     check_run(walkers)
+
+
+def test_a_contact_counts_as_certified_wherever_a_certificate_covered_it():
+    """Every instant of contact is judged, not only the first: a run whose first contact
+    falls in an uncertified span and a later one in a certified span has a certified
+    contact (the proof failed there)."""
+    from stt_codegen.runtime.sensed import _certified_contact
+    uncertified = [[0.5, 2.0]]
+    assert not _certified_contact(np.array([1.0, 1.5]), uncertified)
+    assert _certified_contact(np.array([1.0, 5.0]), uncertified)
+    assert _certified_contact(np.array([0.2]), uncertified)
+    assert not _certified_contact(np.array([]), uncertified)

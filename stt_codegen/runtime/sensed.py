@@ -302,8 +302,8 @@ class SensingRecord:
     collision_time : float or None
         When it first did, s; ``None`` without a collision.
     collision_certified : bool
-        That instant lies in a span some certificate covered (never, while the envelope
-        holds: the proof of docs/sensing.md says so).
+        Some instant of contact (any, not only the first) lies in a span some certificate
+        covered (never, while the envelope holds: the proof of docs/sensing.md says so).
     min_sensed_clearance : float or None
         Smallest distance between the body and a sensed obstacle, state units.
     violations : list of EnvelopeViolation
@@ -758,6 +758,13 @@ def _gaps(covered: list[tuple[float, float]], end: float) -> list[list[float]]:
     return [g for g in gaps if g[1] > g[0]]
 
 
+def _certified_contact(contacts: np.ndarray, uncertified: list[list[float]]) -> bool:
+    """Whether some instant of ``contacts`` (s) lies outside every ``uncertified`` span:
+    every instant, not only the first, since a later contact may fall in a span a
+    certificate covered."""
+    return any(not any(a <= hit <= b for a, b in uncertified) for hit in contacts)
+
+
 def _judged(design, backend, horizon, ts, states, us, alphas, status, tubes, starts, designs,
             path, path_t, obstacle_path, world, reach, record, stepper) -> SimulationResult:
     """Definition 2.1 on the run, the sensed obstacles among the obstacles."""
@@ -783,10 +790,9 @@ def _judged(design, backend, horizon, ts, states, us, alphas, status, tubes, sta
         record.sensed_collision = bool(sensed_clear <= 0.0)
         record.min_sensed_clearance = sensed_clear
         if record.sensed_collision:
-            hit = float(path_t[int(np.argmax(gaps.min(axis=1) <= 0.0))])
-            record.collision_time = hit
-            record.collision_certified = not any(a <= hit <= b
-                                                 for a, b in record.uncertified)
+            contacts = path_t[gaps.min(axis=1) <= 0.0]
+            record.collision_time = float(contacts[0])
+            record.collision_certified = _certified_contact(contacts, record.uncertified)
         clear.append(gaps[judged].min(axis=1))
     if clear:
         min_clear = float(np.min([np.min(c) for c in clear]))
