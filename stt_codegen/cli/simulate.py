@@ -155,15 +155,16 @@ class _SensedObstacles:
         """Refuse ``--sensed`` for a spec without ``[sensing]``, or obstacles off its
         sensing dimensions; choose the obstacles."""
         from ..runtime.sensed import PEOPLE_CASES, bundled_people, check_walking
-        if spec.sensing is None:
-            if self.file is not None:
-                raise SpecError("sensed", f"spec {spec.name!r} has no [sensing] table: its "
-                                          "controller senses no obstacle (docs/sensing.md)")
-            return
         if self.file is not None:
-            check_walking(self.file, spec, "walking_obstacles")
+            try:
+                check_walking(self.file, spec, "walking_obstacles")
+            except SpecError as exc:        # a spec without [sensing]: the flag's fault
+                raise SpecError("sensed" if exc.field == "sensing" else exc.field,
+                                exc.reason) from None
             self.obstacles, self.source = self.file, f"from {self.args.sensed}"
             self.kind = "file"
+        elif spec.sensing is None:
+            return
         elif spec.name in PEOPLE_CASES and not Path(self.args.spec).exists():
             self.obstacles, self.source = bundled_people(spec.name), "the case's own people"
             self.kind = "case"
