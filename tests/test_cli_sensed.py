@@ -100,8 +100,7 @@ BAD = {
                  "walking_obstacles[1].start: missing"),
     "not TOML": ("[[walking_obstacles]\n", "--sensed: 'FILE': malformed TOML"),
     "a negative radius": ("[[walking_obstacles]]\nstart = [5.0, 0.5]\nradius = -0.3\n",
-                          "walking_obstacles[0]: start, radius and velocity must be finite, "
-                          "the radius positive"),
+                          "walking_obstacles[0].radius: must be positive, got -0.3"),
 }
 
 

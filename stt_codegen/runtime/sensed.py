@@ -105,10 +105,12 @@ class WalkingObstacle:
         if len(given) > 1:
             raise SpecError(f"WalkingObstacle.{given[1]}", f"give one of velocity, path, "
                                                            f"pursuit_speed, not {given}")
-        values = list(self.start) + [self.radius] + list(self.velocity or ())
-        if not all(math.isfinite(float(v)) for v in values) or not self.radius > 0:
-            raise SpecError("WalkingObstacle", "start, radius and velocity must be finite, "
-                                               "the radius positive")
+        for name, values in (("start", self.start), ("radius", (self.radius,)),
+                             ("velocity", self.velocity or ())):
+            if not all(math.isfinite(float(v)) for v in values):
+                raise SpecError(f"WalkingObstacle.{name}", "must be finite")
+        if not self.radius > 0:
+            raise SpecError("WalkingObstacle.radius", f"must be positive, got {self.radius!r}")
         if self.velocity is not None and len(self.velocity) != m:
             raise SpecError("WalkingObstacle.velocity", f"must have {m} entries")
         if self.path is not None:
