@@ -107,6 +107,16 @@ def test_other_variants_are_refused_by_their_variant():
     assert "a second-order plant (the cascade variant" in caught.value.reason
 
 
+def test_timed_tasks_are_refused_with_sensing_before_any_design():
+    """A replanned tube heads for the target only: a spec with [[tasks]] and [sensing] is
+    bad input at load, not a failure of its first replanning."""
+    with pytest.raises(stt.SpecError) as caught:
+        spec_with(SENSING, tasks=[{"kind": "reach", "lower": [2.0, 1.6],
+                                   "upper": [2.6, 2.4], "window": [2.0, 6.0]}])
+    assert caught.value.field == "sensing"
+    assert "does not take [[tasks]]" in caught.value.reason
+
+
 def test_a_differential_drive_base_replans():
     """The base's look-ahead point replans as law (13)'s robot does (its variant's
     ``replans_sensed``); the cascade does not."""

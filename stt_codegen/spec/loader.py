@@ -896,6 +896,10 @@ def _validate(raw: dict) -> Spec:
     d_t = _half_width(doc.target.half_width, "target", eta, target_set, "target set")
 
     doc = _until_tasks(doc)
+    if doc.sensing is not None and doc.tasks:
+        raise SpecError("sensing", "replanning around sensed obstacles does not take "
+                                   "[[tasks]]: a replanned tube heads for the target only "
+                                   "(docs/sensing.md)")
     unsafe_sets = tuple(_unsafe_set(table, f"obstacles[{j}]", state_space, j)
                         for j, table in enumerate(doc.obstacles) if not is_moving(table))
     moving = tuple(_moving(table, f"obstacles[{j}]", j, state_space, initial_set, target_set,
