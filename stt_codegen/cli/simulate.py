@@ -147,9 +147,14 @@ class _SensedObstacles:
             from ..runtime.walking_file import load_walking_obstacles
             self.file = load_walking_obstacles(args.sensed)
         self.obstacles: tuple = ()
-        self.source = ""
         #: where they come from: "file", "case" or "none"
         self.kind = "none"
+
+    @property
+    def source(self) -> str:
+        """Where they come from, in words."""
+        return {"file": f"from {self.args.sensed}", "case": "the case's own people",
+                "none": "none given: --sensed FILE lists them, docs/sensing.md"}[self.kind]
 
     def check(self, spec: Spec) -> None:
         """Refuse ``--sensed`` for a spec without ``[sensing]``, or obstacles off its
@@ -161,15 +166,10 @@ class _SensedObstacles:
             except SpecError as exc:        # a spec without [sensing]: the flag's fault
                 raise SpecError("sensed" if exc.field == "sensing" else exc.field,
                                 exc.reason) from None
-            self.obstacles, self.source = self.file, f"from {self.args.sensed}"
-            self.kind = "file"
-        elif spec.sensing is None:
-            return
-        elif spec.name in PEOPLE_CASES and not Path(self.args.spec).exists():
-            self.obstacles, self.source = bundled_people(spec.name), "the case's own people"
-            self.kind = "case"
-        else:
-            self.source = "none given: --sensed FILE lists them, docs/sensing.md"
+            self.obstacles, self.kind = self.file, "file"
+        elif spec.sensing is not None and spec.name in PEOPLE_CASES \
+                and not Path(self.args.spec).exists():
+            self.obstacles, self.kind = bundled_people(spec.name), "case"
 
 
 def configure_simulate(p: argparse.ArgumentParser) -> None:
