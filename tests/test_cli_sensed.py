@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from stt_codegen.cli import main
+from stt_codegen.runtime.backends import default_backend
 from stt_codegen.runtime.sensed import WalkingObstacle, bundled_people
 from stt_codegen.runtime.walking_file import load_walking_obstacles, walking_obstacles
 
@@ -56,6 +57,16 @@ def test_the_file_runs_the_same_loop_as_the_same_obstacles_given_in_python(tmp_p
     assert from_file["reach_time"] == case["reach_time"]
     assert from_file["min_obstacle_clearance"] == case["min_obstacle_clearance"]
     assert _without_times(from_file["sensing"]) == _without_times(case["sensing"])
+
+
+def test_without_backend_the_command_runs_the_default_backend_as_plain_simulate(capsys):
+    """``simulate`` of a spec with ``[sensing]`` and no ``--backend`` takes the library's
+    default, as every other spec (it was passed on as ``None``: an unknown backend)."""
+    assert main(["simulate", "hall-crossing", "--json"]) == 0
+    run = json.loads(capsys.readouterr().out)
+    assert run["backend"] == default_backend()
+    assert run["sensed_obstacles"] == {"count": 2, "source": "case"}
+    assert run["satisfied"] and run["sensing"]["switches"] > 0
 
 
 def _without_times(record: dict) -> dict:

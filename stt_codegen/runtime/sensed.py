@@ -42,7 +42,7 @@ from ..spec.variants import variant_of
 from ..spec.sensing import EnvelopeViolation, SensedObstacle, Sensing, envelope_violations
 from ..tube import reference
 from ..tube.parameters import Status
-from .backends import make_controller
+from .backends import default_backend, make_controller
 from .plants import check_seed, spec_plant
 from .simulate import (RungeKutta, SimulationResult, Trajectory, hold_period,
                        sampling_offsets)
@@ -409,8 +409,8 @@ class _World:
 
 
 def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
-                    backend: str = "casadi", horizon: float | None = None, seed: int = 0,
-                    plant: ct.NonlinearIOSystem | None = None,
+                    backend: str | None = None, horizon: float | None = None,
+                    seed: int = 0, plant: ct.NonlinearIOSystem | None = None,
                     enforce_replan_time: bool = False) -> SimulationResult:
     """Run a design with obstacles it only sees at run time, replanning its tube.
 
@@ -431,11 +431,13 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
         :func:`stt_codegen.design_tube` of a spec with ``[sensing]``.
     obstacles : sequence of WalkingObstacle
         The obstacles the controller senses (on ``spec.sensing.dims``).
-    backend : str
-        The controller's backend (:func:`~.backends.backend_names`); default the CasADi
-        model (``"c"``: the spec's C with the tube as data, compiled once, each tube loaded
-        into it, :class:`~.data_controller.TubeDataController`; ``"python"``: its Python
-        module with the tube as data, generated once, :class:`~.data_module.TubeDataModule`;
+    backend : str, optional
+        The controller's backend (:func:`~.backends.backend_names`); default
+        :func:`~.backends.default_backend`, as :func:`~.simulate.simulate`'s (``"c"``: the
+        spec's C with the tube as data, compiled once, each tube loaded into it,
+        :class:`~.data_controller.TubeDataController`, the CasADi model's run bit for bit;
+        ``"python"``: its Python module with the tube as data, generated once,
+        :class:`~.data_module.TubeDataModule`; ``"casadi"``: the CasADi model;
         ``"reference"`` is ten times slower).
     horizon : float, optional
         Simulated time, s; default ``t_c``.
@@ -483,6 +485,7 @@ def simulate_sensed(design: Design, obstacles: Sequence[WalkingObstacle], *,
     check_walking(obstacles, spec)
     sensing: Sensing = spec.sensing
     seed = check_seed(seed)
+    backend = default_backend() if backend is None else backend
     variant = variant_of(spec)
     generated = ("c", "python")                  # the backends that run the data form
     if backend in generated and backend not in variant.tube_data:

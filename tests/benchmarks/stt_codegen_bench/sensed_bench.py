@@ -216,7 +216,9 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
             if adversary:
                 obstacles.append(WalkingObstacle(*pursuer, pursuit_speed=speed,
                                                  pursuit_acceleration=acceleration))
-            run = stt.simulate_sensed(design, obstacles, seed=e)
+            # the CasADi model, as the measurements of docs/performance.md (the C's runs
+            # are the same bit for bit, where a compiler is found)
+            run = stt.simulate_sensed(design, obstacles, backend="casadi", seed=e)
             record = run.sensing
             tally["collisions"] += record.sensed_collision or run.collision
             if record.sensed_collision or run.collision:
