@@ -116,6 +116,31 @@ def test_a_sensed_run_draws_the_active_tube_and_the_people_where_they_are(tmp_pa
             assert m.scale.z == pytest.approx(space.upper[2] - space.lower[2])
 
 
+def test_balls_sensed_on_three_axes_are_drawn_as_spheres(tmp_path):
+    """A drone's sensed balls (tests/specs/drone-sensed.toml, sensed on x, y and z): each
+    a sphere of its diameter at its centre, not a column across the room."""
+    from pathlib import Path
+
+    from stt_codegen.runtime.sensed import WalkingObstacle
+    spec = Path(__file__).parent / "specs" / "drone-sensed.toml"
+    design = stt.design_tube(stt.load_spec(spec))
+    balls = [WalkingObstacle((5.0, 5.0, 3.0), 0.4, velocity=(0.0, 0.0, -0.2)),
+             WalkingObstacle((3.0, 7.0, 1.0), 0.25)]
+    result = stt.simulate_sensed(design, balls, horizon=1.0)
+    write_run_log(design, result, tmp_path / "drone.mcap")
+    found = _decoded(tmp_path / "drone.mcap")
+    trajectory = result.trajectory
+    for k in (0, len(trajectory.t) - 1):
+        drawn = [m for m in found["/stt/markers"][k][2].markers if m.ns == "sensed"]
+        assert [m.id for m in drawn] == [0, 1] and {m.type for m in drawn} == {2}
+        for m in drawn:
+            centre = trajectory.sensed_positions[k, m.id]
+            assert [m.pose.position.x, m.pose.position.y, m.pose.position.z] == \
+                pytest.approx(centre.tolist(), abs=1e-12)
+            assert [m.scale.x, m.scale.y, m.scale.z] == \
+                pytest.approx([2 * trajectory.sensed_radii[m.id]] * 3)
+
+
 @pytest.mark.parametrize("path, message", [("run.bag", "must end in .mcap"),
                                            ("missing/run.mcap", "does not exist")])
 def test_a_bad_log_path_is_refused_before_any_work(tmp_path, path, message):

@@ -301,15 +301,16 @@ def draw_inputs(ax: Axes, spec: Spec, result: SimulationResult) -> None:
 
 
 def draw_sensed(ax: Axes, spec: Spec, traj, dims: tuple[int, int]) -> None:
-    """The obstacles a run sensed (:func:`~.sensed.simulate_sensed`), when the arena shows
-    ``[sensing] dims``: each one's path, dotted, and its disc every 2 s with the robot's
-    place then."""
+    """The obstacles a run sensed (:func:`~.sensed.simulate_sensed`), when the arena's two
+    dimensions are among ``[sensing] dims``: each one's path, dotted, and its disc (a
+    ball's section through its centre) every 2 s with the robot's place then."""
     if traj.sensed_positions is None or spec.sensing is None \
-            or tuple(dims) != tuple(spec.sensing.dims[:2]):
+            or not set(dims) <= set(spec.sensing.dims):
         return
+    columns = [list(spec.sensing.dims).index(d) for d in dims]
     every = max(1, int(round(2.0 * spec.rate_hz)))
     for j, radius in enumerate(traj.sensed_radii):
-        path = traj.sensed_positions[:, j]
+        path = traj.sensed_positions[:, j][:, columns]
         ax.plot(path[:, 0], path[:, 1], ":", color="tab:purple", lw=1.0,
                 label="sensed obstacle's path" if j == 0 else None)
         for k in range(0, len(traj.t), every):

@@ -69,7 +69,7 @@ _DEFINITIONS = {
         "bool mesh_use_embedded_materials"]),
     "visualization_msgs/MarkerArray": "visualization_msgs/Marker[] markers",
 }
-_CUBE, _CYLINDER = 1, 3
+_CUBE, _SPHERE, _CYLINDER = 1, 2, 3
 #: Colours (r, g, b, a) of the markers: the tube, an obstacle, the target, an obstacle
 #: sensed at run time.
 _COLOURS = {"tube": (1.0, 0.55, 0.0, 0.35), "obstacle": (0.45, 0.45, 0.45, 0.8),
@@ -186,7 +186,8 @@ def write_run_log(design: Design, result: SimulationResult, path: str | Path) ->
     obstacles' boxes (``obstacles``) and the target (``target``) as ``CUBE`` markers, and
     in a run with sensed obstacles each of them where it is at ``t_k`` (``sensed``, id its
     index, seen or not), a ``CYLINDER`` of its diameter on the ``[sensing] dims`` across
-    the state space on the other axes (``MarkerArray``); ``/stt/path`` the whole trajectory
+    the state space on the other axes (a ``SPHERE`` when it is sensed on the three axes
+    drawn) (``MarkerArray``); ``/stt/path`` the whole trajectory
     (``Path``, one message at the last instant). Stamped ``t_k`` s from 0 in the frame
     ``map``; written atomically.
 
@@ -224,6 +225,9 @@ def write_run_log(design: Design, result: SimulationResult, path: str | Path) ->
     boxes = spec.obstacle_boxes()
     target = spec.target_set
     sensed = _sensed_boxes(spec, trajectory)
+    # a ball sensed on the three axes drawn is a sphere; on fewer, an upright cylinder
+    ball = (_SPHERE if spec.sensing is not None and {0, 1, 2} <= set(spec.sensing.dims)
+            else _CYLINDER)
 
     def write(tmp: Path) -> None:
         with open(tmp, "wb") as stream:
@@ -249,7 +253,7 @@ def write_run_log(design: Design, result: SimulationResult, path: str | Path) ->
                             for b, box in enumerate(boxes)]
                 markers.append(_box_marker(t, "target", 0, target.lower, target.upper,
                                            "target"))
-                markers += [_box_marker(t, "sensed", j, lo, hi, "sensed", _CYLINDER)
+                markers += [_box_marker(t, "sensed", j, lo, hi, "sensed", ball)
                             for j, (lo, hi) in enumerate(zip(*sensed[k]))] if sensed else []
                 writer.write_message("/stt/markers", schemas["/stt/markers"],
                                      {"markers": markers}, log_time=stamp,
