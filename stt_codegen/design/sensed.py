@@ -57,6 +57,7 @@ from .sensed_switch import proved_error, state_at, switch_error
 
 __all__ = ["CHUNK_SECONDS", "ESCAPE_CLEARANCE", "ESCAPE_DIRECTIONS", "ESCAPE_DISTANCES",
            "ESCAPE_TIME", "FORESIGHT", "LATE_TIME", "MAX_ESCAPES", "ReplanFailure",
+           "escape_directions",
            "SensedPlan", "foresight_boxes", "reachable_boxes", "region_margin", "replan",
            "start_plan", "switch_time", "uncertified_plan"]
 
@@ -1083,7 +1084,8 @@ def _along_path(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
         return foresight_boxes(sensed, _reach(base), sensing.dims, t_s, 0.0, t_to,
                                first + len(boxes), sensing.velocity_error, PREDICTION_SPAN)
 
-    found = path_design(local, boxes, predict, sensing.dims)
+    found = path_design(local, boxes, predict, sensing.dims,
+                        sensing.max_obstacle_speed * (t_s - t_m + sensing.horizon))
     if found is None:
         return None
     # a late path's task is due when it arrives (the next checks hold it to that)
@@ -1191,13 +1193,10 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     target = np.asarray(base.target_center)[dims]
     closing = [(ob, _closing(ob, point) or _closing(ob, s)) for ob in sensed]
     ranked = []
+    directions = escape_directions(len(dims))
     for distance in ESCAPE_DISTANCES:
-        for k in range(ESCAPE_DIRECTIONS if distance > 0.0 else 1):
-            angle = 2.0 * math.pi * k / ESCAPE_DIRECTIONS
-            p = point.astype(float).copy()
-            p[0] += distance * math.cos(angle)
-            if p.size > 1:
-                p[1] += distance * math.sin(angle)
+        for direction in directions if distance > 0.0 else directions[:1]:
+            p = point.astype(float) + (distance * direction if distance > 0.0 else 0.0)
             lo, hi = list(box.lower), list(box.upper)
             for j, d in enumerate(dims):
                 lo[d], hi[d] = p[j] - half[j], p[j] + half[j]
@@ -1234,6 +1233,39 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
         return "no temporary goal inside the state space and clear of the obstacles"
     return (f"{min(len(ranked), MAX_ESCAPES)} temporary goals tried, none certified ("
             + ", ".join(str(r) for r in reasons) + ")")
+
+
+def escape_directions(n: int) -> np.ndarray:
+    """The unit directions of an escape's temporary goals on ``n`` sensing dimensions
+    (:func:`_escape`): :data:`ESCAPE_DIRECTIONS` evenly spaced on the first two (their
+    first coordinates on one); with a third, as many again at 45 degrees up and down,
+    half of them each, and straight up and down it (a drone steps over or under a ball
+    as well as around it); 0 on the others.
+
+    Parameters
+    ----------
+    n : int
+        The number of sensing dimensions (``len([sensing] dims)``), at least 1.
+
+    Returns
+    -------
+    ndarray, shape (D, n)
+        ``D = ESCAPE_DIRECTIONS`` on one or two dimensions, ``2 ESCAPE_DIRECTIONS + 2`` on
+        three or more.
+    """
+    rows = [(math.cos(2.0 * math.pi * k / ESCAPE_DIRECTIONS),
+             math.sin(2.0 * math.pi * k / ESCAPE_DIRECTIONS), 0.0)
+            for k in range(ESCAPE_DIRECTIONS)]
+    if n >= 3:
+        tilt, half = math.sqrt(0.5), ESCAPE_DIRECTIONS // 2
+        for up in (1.0, -1.0):
+            rows += [(tilt * math.cos(2.0 * math.pi * k / half),
+                      tilt * math.sin(2.0 * math.pi * k / half), up * tilt)
+                     for k in range(half)]
+        rows += [(0.0, 0.0, 1.0), (0.0, 0.0, -1.0)]
+    out = np.zeros((len(rows), n))
+    out[:, :min(n, 3)] = np.array(rows)[:, :min(n, 3)]
+    return out
 
 
 def _best_effort(plan: SensedPlan, t_m: float, position: Sequence[float],
