@@ -1,4 +1,5 @@
-"""``stt-codegen bench sensed`` (docs/sensing.md): Real-Time STT's 2-D scenario."""
+"""``stt-codegen bench sensed`` (docs/sensing.md): Real-Time STT's 2-D scenario, the
+warehouse floor, Real-Time STT's script and a drone's room in 3-D."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ from stt_codegen_bench.sensed_bench import (SCENARIO, format_sensed_report, movi
                                             run_sensed_bench, scenario_with)
 from stt_codegen_bench.sensed_script import (CIRCLES, HEADING_JITTER, POSITION_JITTER,
                                              PURSUER_START, SCRIPT, script_circles)
+from stt_codegen_bench.sensed_rooms import CLEAR_OF_START, ROOM, flying_balls
 from stt_codegen_bench.sensed_warehouse import (AISLES, DEPTH, DOOR, RACK_END, RACKS, WAREHOUSE,
                                                 WIDTH, aisle_people)
 
@@ -131,9 +133,35 @@ def test_the_warehouse_refuses_an_adversary_by_its_flag(capsys):
     assert "--warehouse:" in capsys.readouterr().err
 
 
+def test_the_balls_are_seeded_within_the_envelope_and_clear_of_the_start():
+    """Each ball flies straight at under ``V``, is no larger than ``r_max``, and starts in
+    the room at least 2.5 m from the start's centre; the same seed draws the same balls."""
+    spec = stt.load_spec(ROOM)
+    space, sensing = spec.state_space, spec.sensing
+
+    def draw(*seed):
+        return flying_balls(np.random.default_rng(seed), 8, space.lower, space.upper,
+                            spec.initial_state, sensing.max_obstacle_radius)
+    assert draw(0, 8, 1) == draw(0, 8, 1) and draw(0, 8, 1) != draw(0, 8, 2)
+    for ball in draw(3):
+        centre = np.array(ball.start)
+        assert len(centre) == 3 == len(ball.velocity)
+        assert np.all((centre >= space.lower) & (centre <= space.upper))
+        assert np.linalg.norm(centre - spec.initial_state) >= CLEAR_OF_START
+        assert 0.1 <= ball.radius <= sensing.max_obstacle_radius
+        assert np.linalg.norm(ball.velocity) < sensing.max_obstacle_speed
+
+
+def test_the_rooms_refuse_an_adversary_by_their_flag(capsys):
+    from stt_codegen.cli import main
+    assert main(["bench", "sensed", "--rooms", "--adversary"]) == 2
+    assert "--rooms:" in capsys.readouterr().err
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("floor,count,options,title", [
     ("warehouse", 6, {"warehouse": True}, "the warehouse floor, people crossing its aisles"),
+    ("rooms", 5, {"rooms": True}, "a drone's room in 3-D, balls flying through it"),
     ("script", 5, {"script": True, "adversary": True}, "Real-Time STT's script")])
 def test_one_episode_of_each_floor_is_reported(floor, count, options, title):
     report = run_sensed_bench(1, 0, counts=(count,), **options)

@@ -217,11 +217,11 @@ def _cmd_sensed(args: argparse.Namespace) -> int:
                               tuple(_int_list(args.obstacles, "--obstacles")),
                               adversary=args.adversary, acceleration=args.acceleration,
                               speed_only=args.speed_only, warehouse=args.warehouse,
-                              script=args.script)
+                              script=args.script, rooms=args.rooms)
     if args.cortex_m4f:
         from .sensed_bench import target_costs
         report["cortex_m4f"] = target_costs(args.acceleration, warehouse=args.warehouse,
-                                            script=args.script)
+                                            script=args.script, rooms=args.rooms)
     print(json.dumps(report, indent=1, sort_keys=True) if args.json
           else format_sensed_report(report))
     return 0
@@ -435,6 +435,11 @@ def configure_bench(bench: argparse.ArgumentParser) -> None:
                         "five circles at 0.2-0.45 m/s, each episode moving their starts and "
                         "turning their headings); with --adversary the pursuer starts at the "
                         "target; --obstacles 5, not with --warehouse or --acceleration")
+    p.add_argument("--rooms", action="store_true",
+                   help="a drone's room in 3-D (tests/specs/drone-sensed.toml: 10 x 10 x 4 m, "
+                        "balls of radius 0.1-0.5 m flying straight at under 1 m/s) instead; "
+                        "--obstacles counts balls (not with --adversary, --acceleration, "
+                        "--warehouse or --script)")
     p.add_argument("--cortex-m4f", action="store_true",
                    help="also count the controller's instructions per step and per switch "
                         "on the Cortex-M4F (QEMU), the tube as data, on the scenario's tube "

@@ -13,7 +13,8 @@ largest speed), replanning budget 0.25 s, horizon 0.5 s. With ``--adversary`` on
 circle (radius 0.3 m) starts 6 m away and heads for the robot at ``V``. With
 ``--warehouse``, a warehouse floor with people crossing its aisles instead
 (:mod:`.sensed_warehouse`); with ``--script``, Real-Time STT's own script, its arena and
-its five circles, seeded (:mod:`.sensed_script`).
+its five circles, seeded (:mod:`.sensed_script`); with ``--rooms``, a drone's room in
+three dimensions with balls flying through it (:mod:`.sensed_rooms`).
 
 Each episode is :func:`stt_codegen.simulate_sensed` (the CasADi backend). Reported per
 ``N``: collisions (and among them those at an instant some certificate covered, which must
@@ -35,6 +36,7 @@ import stt_codegen as stt
 from stt_codegen.errors import SpecError
 from stt_codegen.runtime.sensed import WalkingObstacle
 
+from .sensed_rooms import ROOM, flying_balls
 from .sensed_script import PURSUER_RADIUS, PURSUER_START, SCRIPT, script_circles
 from .sensed_warehouse import WAREHOUSE, aisle_people
 
@@ -147,7 +149,7 @@ def moving_circles(rng: np.random.Generator, count: int, until: float,
 def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20),
                      adversary: bool = False, acceleration: float | None = None,
                      speed_only: bool = False, warehouse: bool = False,
-                     script: bool = False) -> dict:
+                     script: bool = False, rooms: bool = False) -> dict:
     """Seeded episodes of the scenario per obstacle count.
 
     Parameters
@@ -178,6 +180,10 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         (:mod:`.sensed_script`; ``counts`` must be ``(5,)``); the pursuer starts at the
         target's centre at the script's speed bound; not with ``acceleration`` or
         ``warehouse`` (:class:`~stt_codegen.errors.SpecError`, field ``--script``).
+    rooms : bool
+        A drone's room in three dimensions with balls flying through it instead
+        (:mod:`.sensed_rooms`; ``counts`` are balls); not with ``adversary``,
+        ``acceleration``, ``warehouse`` or ``script`` (field ``--rooms``).
 
     Returns
     -------
@@ -192,9 +198,21 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         raise SpecError("--script", "Real-Time STT's script has five circles at constant "
                                     "velocities: --obstacles 5, not with --warehouse or "
                                     "--acceleration")
-    scenario = (WAREHOUSE if warehouse else SCRIPT if script else
-                scenario_with(None if speed_only else acceleration))
-    design = stt.design_tube(stt.Spec.from_dict(scenario))
+    if rooms and (adversary or acceleration is not None or warehouse or script):
+        raise SpecError("--rooms", "the drone's room has balls flying straight: not with "
+                                   "--adversary, --acceleration, --warehouse or --script")
+    if rooms:
+        spec = stt.load_spec(ROOM)
+        scenario = {"prescribed_time": spec.prescribed_time, "sensing": {
+            "max_obstacle_speed": spec.sensing.max_obstacle_speed,
+            "max_obstacle_radius": spec.sensing.max_obstacle_radius},
+            "target": {"lower": list(spec.target_set.lower),
+                       "upper": list(spec.target_set.upper)}}
+    else:
+        scenario = (WAREHOUSE if warehouse else SCRIPT if script else
+                    scenario_with(None if speed_only else acceleration))
+        spec = stt.Spec.from_dict(scenario)
+    design = stt.design_tube(spec)
     speed = scenario["sensing"]["max_obstacle_speed"]
     pursuer = (PURSUER_START, PURSUER_RADIUS) if script else ((7.0, 1.0), 0.3)
     t_c = scenario["prescribed_time"]
@@ -211,6 +229,9 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
             rng = np.random.default_rng([seed, count, e])
             obstacles = (aisle_people(rng, count, t_c) if warehouse else
                          script_circles(rng) if script else
+                         flying_balls(rng, count, spec.state_space.lower,
+                                      spec.state_space.upper, spec.initial_state,
+                                      spec.sensing.max_obstacle_radius) if rooms else
                          moving_circles(rng, count, t_c + 1.0,
                                         None if acceleration is None else acceleration / 2.0))
             if adversary:
@@ -244,13 +265,14 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         tally["episode_cpu_s"] = (time.process_time() - started) / max(1, episodes)
         rows.append(tally)
     return {"scenario": {k: scenario[k] for k in ("prescribed_time", "sensing")},
-            "floor": "warehouse" if warehouse else "script" if script else "circles",
+            "floor": ("warehouse" if warehouse else "script" if script else
+                      "rooms" if rooms else "circles"),
             "seed": seed, "adversary": adversary, "acceleration": acceleration,
             "speed_only": bool(speed_only and acceleration is not None), "rows": rows}
 
 
 def target_costs(acceleration: float | None = None, warehouse: bool = False,
-                 script: bool = False) -> dict:
+                 script: bool = False, rooms: bool = False) -> dict:
     """The scenario's controller on the Cortex-M4F with the tube as data
     (:func:`stt_codegen.embedded.tube_data_loop.run_tube_data`): instructions per switch
     and per step on the scenario's tube and on one with 16 circumvent windows open.
@@ -263,6 +285,8 @@ def target_costs(acceleration: float | None = None, warehouse: bool = False,
         The warehouse floor's tube instead (:mod:`.sensed_warehouse`).
     script : bool
         Real-Time STT's script's tube instead (:mod:`.sensed_script`).
+    rooms : bool
+        The drone's tube in its 3-D room instead (:mod:`.sensed_rooms`).
 
     Returns
     -------
@@ -277,8 +301,8 @@ def target_costs(acceleration: float | None = None, warehouse: bool = False,
     message = missing_message()
     if message:
         return {"missing": message}
-    design = stt.design_tube(stt.Spec.from_dict(WAREHOUSE if warehouse else SCRIPT if script
-                                                else scenario_with(acceleration)))
+    design = stt.design_tube(stt.load_spec(ROOM) if rooms else stt.Spec.from_dict(
+        WAREHOUSE if warehouse else SCRIPT if script else scenario_with(acceleration)))
     r = run_tube_data(design, DEFAULT_CAPACITY)
     mean = lambda v: float(np.mean(v))   # noqa: E731
     return {"step": mean(r["steps_design"]["instructions"]),
@@ -329,7 +353,9 @@ def format_sensed_report(report: dict) -> str:
              + (", the warehouse floor, people crossing its aisles (N: people)"
                 if report.get("floor") == "warehouse" else
                 ", Real-Time STT's script, its five circles seeded"
-                if report.get("floor") == "script" else "")
+                if report.get("floor") == "script" else
+                ", a drone's room in 3-D, balls flying through it (N: balls)"
+                if report.get("floor") == "rooms" else "")
              + (", with a pursuer at the envelope's speed" if report["adversary"] else "")
              + ("" if accel is None else
                 (f", circles turning at {accel / 2:g} m/s^2 per axis, " +
