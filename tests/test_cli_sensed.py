@@ -69,6 +69,21 @@ def test_without_backend_the_command_runs_the_default_backend_as_plain_simulate(
     assert run["satisfied"] and run["sensing"]["switches"] > 0
 
 
+def test_generating_a_sensing_spec_without_the_tube_as_data_says_what_it_wrote(
+        tmp_path, capsys):
+    """``generate`` of a spec with ``[sensing]`` writes its designed tube unless told
+    ``--tube-data``: it says so, and names the option; with it, or for a spec without
+    ``[sensing]``, no note."""
+    for spec, extra, noted in (("hall-crossing", [], True),
+                               ("hall-crossing", ["--tube-data"], False),
+                               ("omnirobot-s1", [], False)):
+        out = tmp_path / f"{spec}{len(extra)}"
+        assert main(["generate", spec, "-o", str(out), "--lang", "python", *extra]) == 0
+        said = capsys.readouterr().out
+        assert ("note: hall-crossing has [sensing]: this controller runs its designed tube "
+                "only; --tube-data writes" in said) == noted, said
+
+
 def _without_times(record: dict) -> dict:
     """A sensing record without its processor times (they differ from run to run)."""
     events = [{k: v for k, v in event.items() if k != "cpu_s"} for event in record["events"]]

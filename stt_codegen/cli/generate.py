@@ -55,6 +55,11 @@ def cmd_generate(args: argparse.Namespace) -> int:
                                         f"{capacity.windows} windows")
     print(f"wrote {len(files)} files for {design.spec.name} ({args.languages}, "
           f"{args.precision}{form}) into {args.out_dir}")
+    if design.spec.sensing is not None and capacity is None:
+        # a spec that replans at run time, written with its designed tube only
+        print(f"note: {design.spec.name} has [sensing]: this controller runs its designed "
+              f"tube only; --tube-data writes the one that takes the tubes replanned around "
+              f"sensed obstacles (docs/sensing.md, \"The tube as data\")")
     return 0
 
 
