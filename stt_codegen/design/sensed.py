@@ -57,9 +57,8 @@ from .sensed_switch import proved_error, state_at, switch_error
 
 __all__ = ["CHUNK_SECONDS", "ESCAPE_CLEARANCE", "ESCAPE_DIRECTIONS", "ESCAPE_DISTANCES",
            "ESCAPE_TIME", "FORESIGHT", "LATE_TIME", "MAX_ESCAPES", "ReplanFailure",
-           "escape_directions",
-           "SensedPlan", "foresight_boxes", "reachable_boxes", "region_margin", "replan",
-           "start_plan", "switch_time", "uncertified_plan"]
+           "SensedPlan", "escape_directions", "foresight_boxes", "reachable_boxes",
+           "region_margin", "replan", "start_plan", "switch_time", "uncertified_plan"]
 
 #: The longest time span of one box standing for a sensed obstacle's reachable set, s.
 CHUNK_SECONDS = 0.25

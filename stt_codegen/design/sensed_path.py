@@ -39,6 +39,7 @@ import math
 import time
 from dataclasses import replace
 from collections.abc import Callable, Sequence
+from typing import NamedTuple
 
 import numpy as np
 
@@ -53,9 +54,8 @@ from .search import base_design, check_tube
 from .via import VIA_HALF_WIDTH
 
 __all__ = ["LATE_SECONDS", "LEVEL_STEP", "MAX_EXPANSIONS", "MAX_SEGMENTS", "MAX_SPEED",
-           "MIN_SPEED",
-           "MOTION_SENSED_PATH", "PREDICTION_SPAN", "SPEED_FACTOR", "START_SECONDS",
-           "STAY_SECONDS", "levels", "path_design"]
+           "MIN_SPEED", "MOTION_SENSED_PATH", "PREDICTION_SPAN", "SPEED_FACTOR",
+           "START_SECONDS", "STAY_SECONDS", "levels", "path_design"]
 
 #: How a tube found by this step is named (``Design.motion``).
 MOTION_SENSED_PATH = "sensed path"
@@ -119,20 +119,47 @@ def path_design(local: Spec, hard: tuple[MovingObstacle, ...],
     started = time.perf_counter()
     if len(dims) < 2 or local.input_bound is not None:
         return None
+    d = list(dims[:2])
+    t_c = float(local.prescribed_time)
+    grid = SpaceTimeGrid.of(local, d)
+    cells = grid.index(np.asarray(local.initial_state, dtype=float)[d])
+    goal = grid.index(np.asarray(local.target_center, dtype=float)[d])
+    if cells is None or goal is None:
+        return None
+    need = float(grid.steps_to(goal)[cells])
+    if not math.isfinite(need):
+        return None
+    # the path's speed: the free grid's shortest way in a share of the prescribed time
+    speed = min(max(SPEED_FACTOR * need * grid.cell / t_c, MIN_SPEED), MAX_SPEED)
+    step = grid.cell / speed
+    last = max(math.floor((t_c + LATE_SECONDS) / step), math.ceil(SPEED_FACTOR * need))
+    search = _Search(grid, cells, goal, speed, step, last)
     best = None
     for level in levels(local, dims):
-        found = _at_level(local, hard, predict, dims, level, growth, started)
+        found = _at_level(local, hard, predict, dims, level, growth, search, started)
         if found is not None and (best is None or found.tube.segments[-1].end
                                   < best.tube.segments[-1].end):
             best = found
     return best
 
 
+class _Search(NamedTuple):
+    """The grid of :func:`path_design`, the start's and the target's cells, the path's
+    speed (state units per second), its step (s) and its latest step."""
+
+    grid: SpaceTimeGrid
+    cells: tuple[int, int]
+    goal: tuple[int, int]
+    speed: float
+    step: float
+    last: int
+
+
 def levels(local: Spec, dims: Sequence[int]) -> list[np.ndarray]:
-    """The places of a path's via boxes off its grid, in the order tried: the start's;
-    with a third sensing dimension, then every :data:`LEVEL_STEP` across the state space
-    on it (the via box and :data:`~.fleet_paths.ROOM` inside it), the nearest the start's
-    first.
+    """The places of a path's via boxes off its grid: the start's; with a third sensing
+    dimension, also every :data:`LEVEL_STEP` across the state space on it (the via box
+    and :data:`~.fleet_paths.ROOM` inside it), the nearest the start's first (the order
+    ties are broken in).
 
     Parameters
     ----------
@@ -166,27 +193,16 @@ def levels(local: Spec, dims: Sequence[int]) -> list[np.ndarray]:
 
 def _at_level(local: Spec, hard: tuple[MovingObstacle, ...],
               predict: Callable[[float], tuple[MovingObstacle, ...]],
-              dims: Sequence[int], level: np.ndarray, growth: float,
+              dims: Sequence[int], level: np.ndarray, growth: float, search: _Search,
               started: float) -> Design | None:
     """:func:`path_design` with the via boxes at ``level`` on ``dims[2:]``: a box clear
     of the band they sweep there, grown by ``growth``, takes no cell (the check is on
     every dimension)."""
     d = list(dims[:2])
+    grid, cells, goal, speed, step, last = search
+    t_c = float(local.prescribed_time)
     room = VIA_HALF_WIDTH + ROOM + growth
     band = [(k, v - room, v + room) for k, v in zip(dims[2:], level)]
-    t_c = float(local.prescribed_time)
-    grid = SpaceTimeGrid.of(local, d)
-    cells = grid.index(np.asarray(local.initial_state, dtype=float)[d])
-    goal = grid.index(np.asarray(local.target_center, dtype=float)[d])
-    if cells is None or goal is None:
-        return None
-    need = float(grid.steps_to(goal)[cells])
-    if not math.isfinite(need):
-        return None
-    # the path's speed: the free grid's shortest way in a share of the prescribed time
-    speed = min(max(SPEED_FACTOR * need * grid.cell / t_c, MIN_SPEED), MAX_SPEED)
-    step = grid.cell / speed
-    last = max(math.floor((t_c + LATE_SECONDS) / step), math.ceil(SPEED_FACTOR * need))
     taken = Reservations(grid, step, last + 1)
     for ob in hard + predict(last * step):
         centre, half = np.asarray(ob.centres[0]), np.asarray(ob.half_size)
