@@ -18,10 +18,14 @@ from stt_codegen.design.sensed import ESCAPE_DIRECTIONS, escape_directions
 from stt_codegen.design.sensed_path import LEVEL_STEP, levels
 from stt_codegen.system import MissingTool
 from stt_codegen.runtime.sensed import WalkingObstacle
+from stt_codegen.runtime.walking_file import load_walking_obstacles
 
 matplotlib.use("Agg")
 
 SPEC = Path(__file__).parent / "specs" / "drone-sensed.toml"
+#: Lamps hanging across the room, their centres 3 m up: the drone flies under them (a
+#: file of ``--sensed``, the one of docs/sensing.md's command).
+LAMPS_FILE = Path(__file__).parent / "specs" / "drone-lamps.toml"
 
 
 def row(height: float, first: float, count: int) -> tuple[WalkingObstacle, ...]:
@@ -31,8 +35,7 @@ def row(height: float, first: float, count: int) -> tuple[WalkingObstacle, ...]:
                  for k in range(count))
 
 
-#: Lamps hanging across the room, their centres 3 m up: the drone flies under them.
-LAMPS = row(3.0, 1.0, 11)
+LAMPS = load_walking_obstacles(LAMPS_FILE)
 #: Balls across the room at the drone's own height, floor to ceiling left open.
 BARRIER = row(1.2, 0.6, 12)
 
@@ -132,6 +135,22 @@ def test_a_drone_climbs_over_a_row_at_its_height_and_the_generated_code_flies_it
             assert np.array_equal(getattr(flown.trajectory, name),
                                   getattr(run.trajectory, name)), (backend, name)
         assert [e.event for e in flown.sensing.events] == [e.event for e in record.events]
+
+
+def test_the_lamps_file_is_the_row_and_the_command_flies_under_it(capsys):
+    """``simulate SPEC --sensed FILE`` with 3-D balls: the file lists the row of lamps, and
+    the command's run is the library's (satisfied, certified throughout)."""
+    import json
+
+    from stt_codegen.cli import main
+    assert np.allclose([ob.start + (ob.radius,) for ob in LAMPS],
+                       [ob.start + (ob.radius,) for ob in row(3.0, 1.0, 11)], atol=1e-12)
+    assert all(ob.velocity is None and ob.path is None for ob in LAMPS)
+    assert main(["simulate", str(SPEC), "--sensed", str(LAMPS_FILE), "--backend", "casadi",
+                 "--json"]) == 0
+    run = json.loads(capsys.readouterr().out)
+    assert run["satisfied"] and run["sensing"]["uncertified"] == []
+    assert run["sensed_obstacles"] == {"count": 11, "source": "file"}
 
 
 @pytest.mark.parametrize("dims", [(0, 1), (0, 2), (1, 2)])
