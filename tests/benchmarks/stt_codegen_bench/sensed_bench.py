@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 import time
+import tomllib
 
 import numpy as np
 
@@ -202,21 +203,18 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
         raise SpecError("--rooms", "the drone's room has balls flying straight: not with "
                                    "--adversary, --acceleration, --warehouse or --script")
     if rooms:
+        with open(ROOM, "rb") as stream:
+            scenario = tomllib.load(stream)         # the spec file's own tables
         spec = stt.load_spec(ROOM)
-        scenario = {"prescribed_time": spec.prescribed_time, "sensing": {
-            "max_obstacle_speed": spec.sensing.max_obstacle_speed,
-            "max_obstacle_radius": spec.sensing.max_obstacle_radius},
-            "target": {"lower": list(spec.target_set.lower),
-                       "upper": list(spec.target_set.upper)}}
     else:
         scenario = (WAREHOUSE if warehouse else SCRIPT if script else
                     scenario_with(None if speed_only else acceleration))
         spec = stt.Spec.from_dict(scenario)
     design = stt.design_tube(spec)
-    speed = scenario["sensing"]["max_obstacle_speed"]
+    speed = spec.sensing.max_obstacle_speed
     pursuer = (PURSUER_START, PURSUER_RADIUS) if script else ((7.0, 1.0), 0.3)
-    t_c = scenario["prescribed_time"]
-    target = scenario["target"]
+    t_c = spec.prescribed_time
+    target = spec.target_set
     rows = []
     for count in counts:
         tally = {"obstacles": count, "episodes": episodes, "collisions": 0,
@@ -250,7 +248,7 @@ def run_sensed_bench(episodes: int, seed: int, counts: tuple[int, ...] = (5, 20)
                 record.collision_certified or record.guaranteed)
             tally["on_time"] += run.reached
             late = not run.reached and bool(np.any(np.all(
-                (run.trajectory.x >= target["lower"]) & (run.trajectory.x <= target["upper"]),
+                (run.trajectory.x >= target.lower) & (run.trajectory.x <= target.upper),
                 axis=1)))
             tally["late"] += late
             tally["not_reached"] += not run.reached and not late
