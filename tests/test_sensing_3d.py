@@ -25,7 +25,7 @@ matplotlib.use("Agg")
 SPEC = Path(__file__).parent / "specs" / "drone-sensed.toml"
 #: Lamps hanging across the room, their centres 3 m up: the drone flies under them (a
 #: file of ``--sensed``, the one of docs/sensing.md's command).
-LAMPS_FILE = Path(__file__).parent / "specs" / "drone-lamps.toml"
+LAMPS_FILE = Path(__file__).parent / "specs" / "sensed" / "drone-lamps.toml"
 
 
 def row(height: float, first: float, count: int) -> tuple[WalkingObstacle, ...]:
