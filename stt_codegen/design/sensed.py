@@ -45,7 +45,7 @@ import numpy as np
 from ..errors import DesignError, SpecError, number_text
 from ..spec.loader import DEFAULT_HALF_WIDTH_FRACTION, Box, Spec
 from ..spec.motion import MovingObstacle
-from ..spec.sensing import SensedObstacle, Sensing
+from ..spec.sensing import SensedObstacle, Sensing, on_sensing_dims
 from .certificate.fleet import RobotTube, robot_tube
 from .certificate.motion import MOVING_PROPERTY
 from .certificate.report import ROUNDING_MARGIN
@@ -434,16 +434,8 @@ def _sensed_margin(design: Design, first_source: int) -> float:
 def _checked(sensed: Sequence[SensedObstacle], sensing: Sensing,
              measured_at: float) -> tuple[SensedObstacle, ...]:
     """The measurement, each obstacle on the sensing dimensions and seen by ``t_m``."""
-    out = tuple(sensed)
-    m = len(sensing.dims)
+    out = on_sensing_dims(sensed, SensedObstacle, "centre", sensing, "sensed")
     for j, ob in enumerate(out):
-        if not isinstance(ob, SensedObstacle):
-            raise SpecError(f"sensed[{j}]", f"must be a SensedObstacle, not "
-                                            f"{type(ob).__name__}")
-        if len(ob.centre) != m:
-            raise SpecError(f"sensed[{j}].centre", f"must have {m} entries (one per sensing "
-                                                   f"dimension {list(sensing.dims)}), got "
-                                                   f"{len(ob.centre)}")
         if ob.seen_at > measured_at:
             raise SpecError(f"sensed[{j}].seen_at", f"= {ob.seen_at!r} s is after the "
                                                     f"measurement instant {measured_at!r} s")

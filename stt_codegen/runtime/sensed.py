@@ -39,7 +39,8 @@ from ..design.sensed import (ReplanFailure, SensedPlan, replan, start_plan,
 from ..errors import SpecError
 from ..spec.loader import Spec
 from ..spec.variants import variant_of
-from ..spec.sensing import EnvelopeViolation, SensedObstacle, Sensing, envelope_violations
+from ..spec.sensing import (EnvelopeViolation, SensedObstacle, Sensing, envelope_violations,
+                            on_sensing_dims)
 from ..tube import reference
 from ..tube.parameters import Status
 from .backends import default_backend, make_controller
@@ -216,20 +217,13 @@ def check_walking(obstacles: Sequence[WalkingObstacle], spec: Spec,
     ...     check_walking([WalkingObstacle((5.0, 0.5, 0.0), 0.3)], spec)
     ... except stt.SpecError as error:
     ...     print(error.field, "|", error.reason)
-    obstacles[0].start | must have 2 entries (one per sensing dimension, dims [0, 1])
+    obstacles[0].start | must have 2 entries (one per sensing dimension, dims [0, 1]), got 3
     """
     sensing = spec.sensing
     if sensing is None:
         raise SpecError("sensing", f"spec {spec.name!r} has no [sensing] table: its "
                                    "controller senses no obstacle (docs/sensing.md)")
-    m = len(sensing.dims)
-    for j, ob in enumerate(obstacles):
-        if not isinstance(ob, WalkingObstacle):
-            raise SpecError(f"{field}[{j}]", f"must be a WalkingObstacle, not "
-                                             f"{type(ob).__name__}")
-        if len(ob.start) != m:
-            raise SpecError(f"{field}[{j}].start", f"must have {m} entries (one per sensing "
-                                                   f"dimension, dims {list(sensing.dims)})")
+    on_sensing_dims(obstacles, WalkingObstacle, "start", sensing, field)
 
 
 @dataclass(frozen=True)

@@ -41,7 +41,7 @@ import numpy as np
 from ..errors import SpecError, number_text
 
 __all__ = ["EnvelopeViolation", "SensedObstacle", "Sensing", "envelope_violations",
-           "sensing_from_table"]
+           "on_sensing_dims", "sensing_from_table"]
 
 #: Relative slack of the envelope checks (the arithmetic of positions and times).
 ENVELOPE_SLACK = 1e-9
@@ -472,6 +472,48 @@ class EnvelopeViolation:
     kind: str
     time: float
     detail: str
+
+
+def on_sensing_dims(items: Sequence[Any], kind: type, attribute: str, sensing: Sensing,
+                    field: str) -> tuple:
+    """``items``, each checked to be a ``kind`` whose ``attribute`` has one entry per
+    sensing dimension: the one check of the obstacles given to the replanner
+    (:class:`SensedObstacle`, ``centre``) and to the closed loop (``WalkingObstacle``,
+    ``start``).
+
+    Parameters
+    ----------
+    items : sequence
+    kind : type
+    attribute : str
+        The coordinates' attribute of ``kind``.
+    sensing : Sensing
+        Its ``dims``.
+    field : str
+        The name of the sequence in errors (``field[j]``, ``field[j].attribute``).
+
+    Returns
+    -------
+    tuple
+        ``items``.
+
+    Raises
+    ------
+    SpecError
+        An item of another type, or with another number of coordinates.
+    """
+    out = tuple(items)
+    m = len(sensing.dims)
+    for j, item in enumerate(out):
+        if not isinstance(item, kind):
+            raise SpecError(f"{field}[{j}]", f"must be a {kind.__name__}, not "
+                                             f"{type(item).__name__}")
+        size = len(getattr(item, attribute))
+        if size != m:
+            raise SpecError(f"{field}[{j}].{attribute}",
+                            f"must have {m} entries (one per sensing dimension, dims "
+                            f"{list(sensing.dims)}), got {size}")
+    return out
 
 
 def envelope_violations(sensing: Sensing, sensed: Sequence[SensedObstacle],
