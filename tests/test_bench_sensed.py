@@ -226,6 +226,31 @@ def test_with_no_certified_plan_the_robot_runs_from_the_pursuer_all_the_same(see
     assert all(any(a <= ev.time <= b for a, b in record.uncertified) for ev in switched)
 
 
+
+@pytest.mark.parametrize("gap, meets", [(1.35, True), (1.40, False)])
+def test_a_pursuer_heading_at_the_robot_within_1_35_m_leaves_no_tube_to_certify(gap, meets):
+    """docs/sensing.md, "Not done yet" (a pursuer): under the circles' envelope with its
+    acceleration bound, the reachable box of a pursuer (radius 0.3 m, at ``V``) seen
+    heading straight at the robot meets the robot's start box (the spec's half width
+    0.2 m around it) over the first 0.25 s after the switch once it is within 1.35 m, so
+    no tube from there is certified; at 1.4 m it does not."""
+    from stt_codegen.design.sensed import reachable_boxes, switch_time
+    spec = stt.Spec.from_dict(scenario_with(2.0))
+    sensing = spec.sensing
+    speed = sensing.max_obstacle_speed
+    robot = np.array([5.0, 5.0])
+    half = np.array(spec.initial_half_width)
+    pursuer = stt.SensedObstacle.ball((5.0 + gap, 5.0), 0.3, seen_at=0.0,
+                                      velocity=(-speed, 0.0))
+    t_s = switch_time(sensing, 0.0, spec.rate_hz)
+    boxes = reachable_boxes([pursuer], speed, spec.robot.radius, sensing.dims, t_s, 0.0,
+                            sensing.horizon, 0,
+                            acceleration=sensing.max_obstacle_acceleration,
+                            velocity_error=sensing.velocity_error)
+    first = [b for b in boxes if b.active[0] == 0.0]
+    assert len(first) == 1 and first[0].active[1] == pytest.approx(0.25)
+    assert bool(first[0].meeting_times(robot - half, robot + half, 0.0, 0.0)) is meets
+
 def test_the_report_columns_line_up():
     """Each value of a row ends where its column's title ends (the table is read by eye
     and copied into docs/performance.md)."""
@@ -247,6 +272,24 @@ def test_the_report_columns_line_up():
     assert [m.end() for m in re.finditer(r"\S+", values)] == ends
     assert values.split()[9:13] == ["1597", "58", "67", "59"]
 
+
+
+def test_each_rate_is_reported_with_its_exact_interval():
+    """The report gives each rate's 95 % interval, so that two runs of the bench are
+    compared by more than their counts. With no event in ``n`` episodes the exact
+    interval's upper end is ``1 - 0.025^(1/n)`` (closed form); with every episode, the
+    lower end is ``0.025^(1/n)``."""
+    row = {"obstacles": 5, "episodes": 1000, "collisions": 0, "collisions_certified": 0,
+           "on_time": 1000, "late": 0, "uncertified_runs": 12, "outside_envelope": 0,
+           "switches": 1, "failures": 0, "replan_cpu_p95_s": 0.1, "replan_cpu_max_s": 0.1}
+    text = format_sensed_report({"seed": 0, "adversary": False, "rows": [row]})
+    line = next(x for x in text.splitlines() if x.startswith("N = 5, 95 % intervals"))
+    upper = 100.0 * (1.0 - 0.025 ** (1.0 / 1000))
+    lower = 100.0 * 0.025 ** (1.0 / 1000)
+    assert f"collisions 0.0-{upper:.1f} %" in line
+    assert f"on time {lower:.1f}-100.0 %" in line
+    low, high = (float(v) for v in line.split("uncertified ")[1].rstrip(" %").split("-"))
+    assert 0.5 < low < 1.2 < high < 2.5
 
 @pytest.mark.slow
 def test_one_episode_is_reported():
