@@ -310,3 +310,6 @@ def test_the_cascade_has_no_module_taking_its_tube_as_data():
     with pytest.raises(SpecError, match="not generated in python for a second-order") as info:
         variant_of(design.spec).entry("data_module")(design)
     assert info.value.field == "tube_data"
+    # it says where the variant takes its tube as data, and where to read about it
+    assert "the cascade variant takes its tube as data in no language" in str(info.value)
+    assert 'docs/sensing.md, "The tube as data"' in str(info.value)

@@ -270,10 +270,11 @@ def require_tube_data(spec, targets: tuple[str, ...] = ("c",)) -> None:
     missing = [t for t in targets if t not in variant.tube_data]
     if missing:
         where = (f"only in {', '.join(variant.tube_data)}" if variant.tube_data
-                 else "nowhere")
+                 else "in no language")
         raise SpecError("tube_data", f"the tube as data is not generated in "
-                                     f"{', '.join(missing)} for {variant.plant_words} (the "
-                                     f"{variant.name} variant: {where})")
+                                     f"{', '.join(missing)} for {variant.plant_words}: the "
+                                     f"{variant.name} variant takes its tube as data "
+                                     f"{where} (docs/sensing.md, \"The tube as data\")")
 
 
 def require_capacity(design: TubeDesign, capacity: TubeCapacity) -> None:
