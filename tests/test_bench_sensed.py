@@ -301,7 +301,7 @@ def test_one_episode_is_reported():
     assert len(row["collided_episodes"]) == row["collisions"]
     assert len(row["uncertified_episodes"]) == row["uncertified_runs"]
     assert "bench sensed: seed 0" in format_sensed_report(report)
-    row = {**row, "collisions": 2, "collided_episodes": [3, 17]}
+    row = {**row, "episodes": 18, "collisions": 2, "collided_episodes": [3, 17]}
     assert "N = 5: collisions in episodes 3, 17" in format_sensed_report(
         {**report, "rows": [row]})
 
