@@ -226,7 +226,6 @@ def test_with_no_certified_plan_the_robot_runs_from_the_pursuer_all_the_same(see
     assert all(any(a <= ev.time <= b for a, b in record.uncertified) for ev in switched)
 
 
-
 @pytest.mark.parametrize("gap, meets", [(1.35, True), (1.40, False)])
 def test_a_pursuer_heading_at_the_robot_within_1_35_m_leaves_no_tube_to_certify(gap, meets):
     """docs/sensing.md, "Not done yet" (a pursuer): under the circles' envelope with its
@@ -251,6 +250,7 @@ def test_a_pursuer_heading_at_the_robot_within_1_35_m_leaves_no_tube_to_certify(
     assert len(first) == 1 and first[0].active[1] == pytest.approx(0.25)
     assert bool(first[0].meeting_times(robot - half, robot + half, 0.0, 0.0)) is meets
 
+
 def test_the_report_columns_line_up():
     """Each value of a row ends where its column's title ends (the table is read by eye
     and copied into docs/performance.md)."""
@@ -273,7 +273,6 @@ def test_the_report_columns_line_up():
     assert values.split()[9:13] == ["1597", "58", "67", "59"]
 
 
-
 def test_each_rate_is_reported_with_its_exact_interval():
     """The report gives each rate's 95 % interval, so that two runs of the bench are
     compared by more than their counts. With no event in ``n`` episodes the exact
@@ -290,6 +289,7 @@ def test_each_rate_is_reported_with_its_exact_interval():
     assert f"on time {lower:.1f}-100.0 %" in line
     low, high = (float(v) for v in line.split("uncertified ")[1].rstrip(" %").split("-"))
     assert 0.5 < low < 1.2 < high < 2.5
+
 
 @pytest.mark.slow
 def test_one_episode_is_reported():
