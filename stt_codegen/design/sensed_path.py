@@ -45,7 +45,7 @@ import numpy as np
 
 from ..spec.loader import Spec
 from ..spec.motion import MovingObstacle
-from ..tube.parameters import SMOOTHSTEP
+from ..tube.parameters import SMOOTHSTEP, TubeDesign
 from .fleet_paths import ROOM, Reservations, SpaceTimeGrid, shortcut, space_time_path, \
     space_time_segments
 from .gain import with_gain
@@ -133,10 +133,12 @@ def path_design(local: Spec, hard: tuple[MovingObstacle, ...],
     speed = min(max(SPEED_FACTOR * need * grid.cell / t_c, MIN_SPEED), MAX_SPEED)
     step = grid.cell / speed
     last = max(math.floor((t_c + LATE_SECONDS) / step), math.ceil(SPEED_FACTOR * need))
-    search = _Search(grid, cells, goal, speed, step, last)
+    # the boxes the path keeps clear of, and the base design, are the same at every level
+    search = _Search(grid, cells, goal, speed, step, last, hard + predict(last * step),
+                     base_design(local))
     best = None
     for level in levels(local, dims):
-        found = _at_level(local, hard, predict, dims, level, growth, search, started)
+        found = _at_level(local, hard, dims, level, growth, search, started)
         if found is not None and (best is None or found.tube.segments[-1].end
                                   < best.tube.segments[-1].end):
             best = found
@@ -145,7 +147,8 @@ def path_design(local: Spec, hard: tuple[MovingObstacle, ...],
 
 class _Search(NamedTuple):
     """The grid of :func:`path_design`, the start's and the target's cells, the path's
-    speed (state units per second), its step (s) and its latest step."""
+    speed (state units per second), its step (s), its latest step, the boxes it keeps
+    clear of (the hard ones and the predictions) and the base design."""
 
     grid: SpaceTimeGrid
     cells: tuple[int, int]
@@ -153,6 +156,8 @@ class _Search(NamedTuple):
     speed: float
     step: float
     last: int
+    boxes: tuple[MovingObstacle, ...]
+    base: TubeDesign
 
 
 def levels(local: Spec, dims: Sequence[int]) -> list[np.ndarray]:
@@ -191,20 +196,19 @@ def levels(local: Spec, dims: Sequence[int]) -> list[np.ndarray]:
     return out
 
 
-def _at_level(local: Spec, hard: tuple[MovingObstacle, ...],
-              predict: Callable[[float], tuple[MovingObstacle, ...]],
-              dims: Sequence[int], level: np.ndarray, growth: float, search: _Search,
+def _at_level(local: Spec, hard: tuple[MovingObstacle, ...], dims: Sequence[int],
+              level: np.ndarray, growth: float, search: _Search,
               started: float) -> Design | None:
     """:func:`path_design` with the via boxes at ``level`` on ``dims[2:]``: a box clear
     of the band they sweep there, grown by ``growth``, takes no cell (the check is on
     every dimension)."""
     d = list(dims[:2])
-    grid, cells, goal, speed, step, last = search
+    grid, cells, goal, speed, step, last, boxes, base = search
     t_c = float(local.prescribed_time)
     room = VIA_HALF_WIDTH + ROOM + growth
     band = [(k, v - room, v + room) for k, v in zip(dims[2:], level)]
     taken = Reservations(grid, step, last + 1)
-    for ob in hard + predict(last * step):
+    for ob in boxes:
         centre, half = np.asarray(ob.centres[0]), np.asarray(ob.half_size)
         at = {k: j for j, k in enumerate(ob.dims)}
         if any(centre[at[k]] + half[at[k]] <= lo or centre[at[k]] - half[at[k]] >= hi
@@ -233,7 +237,6 @@ def _at_level(local: Spec, hard: tuple[MovingObstacle, ...],
         return ([(cells[0], cells[1], 0)] + [(i, j, k + climb) for i, j, k in moves]
                 if climb else moves)
 
-    base = base_design(local)
     # the via boxes take their place off the grid from the base's state (the level)
     flying = base
     if len(level):
