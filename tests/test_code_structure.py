@@ -140,7 +140,7 @@ def test_the_graph_sees_the_imports():
     assert len(graph) > 50
     assert "stt_codegen.spec.loader" in graph["stt_codegen.design.search"]
     assert "stt_codegen.codegen" in graph["stt_codegen.runtime.compiled"]   # parent package
-    assert "stt_codegen.runtime.simulate" in graph["stt_codegen.cli.simulate"]  # in a function
+    assert "stt_codegen.runtime.simulate" in graph["stt_codegen.cli.common"]  # in a function
     assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
     assert find_cycle({"a": {"b"}, "b": set()}) is None
 

@@ -11,7 +11,7 @@ import argparse
 import json
 import sys
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
@@ -20,11 +20,13 @@ from ..errors import DesignError
 if TYPE_CHECKING:
     from ..design.result import Design
     from ..progress import Progress
+    from ..runtime.sensed import WalkingObstacle
+    from ..runtime.simulate import SimulationResult
     from ..spec.loader import Spec
 
 __all__ = ["add_backend_argument", "add_json_argument", "add_quiet_argument",
            "add_seed_argument", "add_spec_argument", "add_tube_data_argument", "checked_seed",
-           "design_spec", "load_and_design", "print_json", "progress_bar"]
+           "closed_loop", "design_spec", "load_and_design", "print_json", "progress_bar"]
 
 #: Seconds of work before the progress bar appears (shorter work shows none).
 BAR_DELAY = 2.0
@@ -249,3 +251,17 @@ def add_tube_data_argument(p: argparse.ArgumentParser) -> None:
                         "at run time by its switch, holding up to SEGMENTS reach segments "
                         "and WINDOWS circumvent windows "
                         f"(default {default}; docs/sensing.md)")
+
+
+def closed_loop(design: Design, obstacles: Callable[[], Sequence[WalkingObstacle]],
+                backend: str | None, horizon: float | None = None,
+                seed: int = 0) -> SimulationResult:
+    """The closed loop a command runs for ``design``: among the obstacles ``obstacles()``
+    returns, revealed only by sensing and replanning the tube (``simulate_sensed``), for a
+    spec with ``[sensing]``; else the design's tube alone (``simulate``, the cascade's for
+    a second-order plant). ``obstacles`` is called only for a spec with ``[sensing]``."""
+    if design.spec.sensing is None:
+        from ..runtime.simulate import simulate
+        return simulate(design, backend=backend, horizon=horizon, seed=seed)
+    from ..runtime.sensed import simulate_sensed
+    return simulate_sensed(design, obstacles(), backend=backend, horizon=horizon, seed=seed)

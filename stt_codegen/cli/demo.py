@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import DesignError, SpecError, SttError, ToolchainError
 from ..system import atomic_write
-from .common import add_backend_argument, design_spec
+from .common import add_backend_argument, closed_loop, design_spec
 from .plotting import add_dims_argument, plot_dims
 from .simulate import SUMMARY_HEADER, summary_line
 
@@ -28,19 +28,17 @@ def _run_case(name: str, spec: Spec, args: argparse.Namespace,
     data (an error crosses a process boundary as its kind and its words)."""
     from ..codegen.api import generate
     from ..runtime.plots import plot_run
-    from ..runtime.simulate import simulate
+    from ..runtime.sensed import bundled_people
     out = Path(args.out)
     try:
         design = design_spec(spec, args)
         if spec.sensing is None:
             generate(design, out / name)
-            result = simulate(design, backend=args.backend)   # the cascade's for second order
         else:
             # the controller a robot runs when it senses obstacles: its tube is data,
             # switched at run time; the bundled people are revealed only by sensing
-            from ..runtime.sensed import bundled_people, simulate_sensed
             generate(design, out / name, languages="c", tube_data=True)
-            result = simulate_sensed(design, bundled_people(name), backend=args.backend)
+        result = closed_loop(design, lambda: bundled_people(name), args.backend)
         atomic_write(out / f"{name}.png",
                      lambda tmp: plot_run(design, result, tmp, dims=dims))
     except SttError as exc:

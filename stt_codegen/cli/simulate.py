@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import SpecError
 from .common import (add_backend_argument, add_json_argument, add_seed_argument,
-                     add_spec_argument, checked_seed, print_json)
+                     add_spec_argument, checked_seed, closed_loop, print_json)
 from .plotting import add_plot_argument, design_to_plot, write_plot
 
 if TYPE_CHECKING:
@@ -77,19 +77,13 @@ def cmd_simulate(args: argparse.Namespace) -> int:
                                       "(docs/fleets.md); --sensed takes a spec with "
                                       "[sensing]")
         return fleet_simulate(args, fleet, SUMMARY_HEADER, summary_line)
-    from ..runtime.simulate import simulate
     from ..runtime.run_log import check_log_path, write_run_log
     seed = checked_seed(args)
     if args.log is not None:
         check_log_path(args.log)
     sensed = _SensedObstacles(args)
     design, dims = design_to_plot(args, sensed.check)
-    if design.spec.sensing is None:
-        result = simulate(design, backend=args.backend, horizon=args.horizon, seed=seed)
-    else:
-        from ..runtime.sensed import simulate_sensed
-        result = simulate_sensed(design, sensed.obstacles, backend=args.backend,
-                                 horizon=args.horizon, seed=seed)
+    result = closed_loop(design, lambda: sensed.obstacles, args.backend, args.horizon, seed)
     if args.log is not None:
         write_run_log(design, result, args.log)
 
