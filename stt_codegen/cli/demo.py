@@ -28,8 +28,13 @@ def _run_case(name: str, spec: Spec, args: argparse.Namespace,
     data (an error crosses a process boundary as its kind and its words)."""
     from ..codegen.api import generate
     from ..runtime.plots import plot_run
-    from ..runtime.sensed import bundled_people
     out = Path(args.out)
+
+    def people():
+        # the replanner is imported only by a case that senses obstacles
+        from ..runtime.sensed import bundled_people
+        return bundled_people(name)
+
     try:
         design = design_spec(spec, args)
         if spec.sensing is None:
@@ -38,7 +43,7 @@ def _run_case(name: str, spec: Spec, args: argparse.Namespace,
             # the controller a robot runs when it senses obstacles: its tube is data,
             # switched at run time; the bundled people are revealed only by sensing
             generate(design, out / name, languages="c", tube_data=True)
-        result = closed_loop(design, lambda: bundled_people(name), args.backend)
+        result = closed_loop(design, people, args.backend)
         atomic_write(out / f"{name}.png",
                      lambda tmp: plot_run(design, result, tmp, dims=dims))
     except SttError as exc:
