@@ -110,6 +110,31 @@ def test_one_library_runs_other_tubes_of_the_same_dimension(several):
             assert bits(got[:2]) == bits(expected[:2]) and got[2] == expected[2]
 
 
+def test_a_tube_that_blends_corners_runs_as_data_bit_for_bit(several):
+    """A tube whose segments overlap two at a time (blended corners: the second starts at
+    1.2 s, before the first ends at 2 s; the third at 4 s, before the second ends at 5 s)
+    runs on the same library, bit for bit as its CasADi model, half the times inside the
+    overlaps, where both segments move the box."""
+    from test_blended_corners import blended
+    _, library = several
+    design = blended()
+    assert design.blends_corners and library.check(library.pack(design)) == 0
+    ref, data = make_controller("casadi", design), library.load(design)
+    rng = np.random.default_rng(9)
+    for k in range(300):
+        x = rng.uniform(-0.5, 5.5, 2)
+        t = rng.uniform(*((1.2, 2.0), (4.0, 5.0))[k % 2]) if k % 4 < 2 else rng.uniform(0, 10)
+        alpha = np.abs(rng.normal(0.0, 0.2, 4)) * (k % 3 != 0)
+        expected, got = ref.step(x, t, 1e-3, alpha), data.step(x, t, 1e-3, alpha)
+        assert bits(got[:2]) == bits(expected[:2]) and got[2] == expected[2], (x, t, alpha)
+
+
+def _three_at_once(tube):
+    """The second segment starting at 1 s and the third at 1.5 s, before the first ends."""
+    tube.segments[1].start = 1.0
+    tube.segments[2].start = 1.5
+
+
 def test_an_s_curve_tube_is_refused_by_the_data_form(several):
     """The data form runs the profiles law (13)'s designs produce (``DATA_PROFILES``): a tube
     of S-curve or glide segments (the cascade's) is refused when packed on the host, naming
@@ -147,6 +172,8 @@ def _broken(library, design, change):
     (lambda t: t.bound.__setitem__(0, -1.0), 4),          # below the spec's state space
     (lambda t: t.bound.__setitem__(0, 6.0), 4),           # lower above upper
     (lambda t: setattr(t.segments[1], "end", 1.0), 5),    # ends not increasing
+    (lambda t: setattr(t.segments[1], "start", 0.0), 5),  # starts not increasing
+    (_three_at_once, 5),                                  # three segments move at once
     (lambda t: setattr(t.segments[0], "profile", 3), 5),  # no such profile
     (lambda t: setattr(t.windows[1], "start", 0.5), 6),   # starts not sorted
     (lambda t: setattr(t.windows[0], "max_end", 9.0), 6),  # not the running maximum
@@ -235,6 +262,37 @@ def test_people_crossing_the_hall_run_through_one_compiled_controller(cc):
     """``simulate_sensed`` on backend ``c`` loads each switched tube into the spec's C with
     the tube as data: the same trajectory, bit for bit, as the CasADi model's run."""
     run_as_casadi(design_of("hall-crossing"), "c")
+
+
+def blended_maze():
+    """The U-maze with a sensing envelope (``specs/pointmaze-sensed.toml``, a single
+    integrator in place of MuJoCo) through via points with cruise segments and blended
+    corners: its tube turns twice without stopping."""
+    import tomllib
+    doc = tomllib.loads((SPECS / "pointmaze-sensed.toml").read_text())
+    del doc["plant"]
+    spec = stt.Spec.from_dict(doc)
+    return stt.design_tube(dataclasses.replace(spec, tube=dataclasses.replace(
+        spec.tube, method="via", via_profile="cruise", via_corners="blend")))
+
+
+def test_a_sensed_tube_that_blends_corners_runs_as_data_through_its_overlaps(cc):
+    """``simulate_sensed`` with nobody in the maze keeps the spec's blended tube (index 0)
+    all the way, through both overlaps: the generated C and Python with the tube as data
+    run the same trajectory as the CasADi model, bit for bit, and reach the target."""
+    design = blended_maze()
+    overlaps = [(b.start, a.end) for a, b in zip(design.tube.segments,
+                                                 design.tube.segments[1:]) if b.start < a.end]
+    assert len(overlaps) == 2
+    runs = [stt.simulate_sensed(design, [], backend=b, horizon=12.0)
+            for b in ("casadi", "c", "python")]
+    t = runs[0].trajectory.t
+    assert all(np.any((a < t) & (t < b)) for a, b in overlaps)
+    assert not np.any(runs[0].trajectory.tube) and runs[0].satisfied
+    for run in runs[1:]:
+        for name in ("x", "u", "alpha", "status", "tube"):
+            assert np.array_equal(getattr(runs[0].trajectory, name),
+                                  getattr(run.trajectory, name)), (run.backend, name)
 
 
 @pytest.fixture(scope="module")

@@ -59,10 +59,11 @@ def test_the_module_is_standalone_and_deterministic():
 
 
 def test_a_tube_as_data_computes_the_casadi_model_bit_for_bit(several):
-    """The spec's tube and three others (another profile, fewer circumvents, none) on one
-    module: on random (x, t, alpha) across every segment and window, the step equals the
-    CasADi model of that tube, bits and status. ``DESIGN_TUBE`` is the tube packed on the
-    host."""
+    """The spec's tube and four others (another profile, fewer circumvents, none, blended
+    corners) on one module: on random (x, t, alpha) across every segment and window, the
+    step equals the CasADi model of that tube, bits and status. ``DESIGN_TUBE`` is the tube
+    packed on the host."""
+    from test_blended_corners import blended
     design, library = several
     packed, shipped = library.pack(design), library.module.DESIGN_TUBE
     for name in ("bound", "members", "multi", "segments", "windows"):
@@ -70,11 +71,12 @@ def test_a_tube_as_data_computes_the_casadi_model_bit_for_bit(several):
     rng = np.random.default_rng(7)
     for other in (design, piecewise_design("cruise"),
                   dataclasses.replace(design, circumvents=design.circumvents[2:]),
-                  dataclasses.replace(design, circumvents=())):
+                  dataclasses.replace(design, circumvents=()), blended()):
         ref, data = make_controller("casadi", other), library.load(other)
         for k in range(150):
             x = rng.uniform(-0.5, 5.5, 2)
-            t = rng.uniform(0.0, 10.0)
+            # a third of them inside the blended tube's overlaps (both segments move it)
+            t = rng.uniform(*((1.2, 2.0), (4.0, 5.0))[k % 2]) if k % 3 == 1 else rng.uniform(0, 10)
             alpha = np.abs(rng.normal(0.0, 0.2, 4)) * (k % 3 != 0)
             expected, got = ref.step(x, t, 1e-3, alpha), data.step(x, t, 1e-3, alpha)
             assert bits(got[:2]) == bits(expected[:2]) and got[2] == expected[2], (x, t)
@@ -105,6 +107,8 @@ def _row(rows, k, position, value):
     (lambda t: {"bound": (-1.0,) + t.bound[1:]}, 4),    # below the spec's state space
     (lambda t: {"bound": (6.0,) + t.bound[1:]}, 4),     # lower above upper
     (lambda t: {"segments": _row(t.segments, 1, 1, 1.0)}, 5),   # ends not increasing
+    (lambda t: {"segments": _row(t.segments, 1, 0, 0.0)}, 5),   # starts not increasing
+    (lambda t: {"segments": _row(_row(t.segments, 1, 0, 1.0), 2, 0, 1.5)}, 5),  # 3 at once
     (lambda t: {"segments": _row(t.segments, 0, 2, 3)}, 5),     # no such profile
     (lambda t: {"windows": _row(t.windows, 1, 0, 0.5)}, 6),     # starts not sorted
     (lambda t: {"windows": _row(t.windows, 0, 6, 9.0)}, 6),     # not the running maximum

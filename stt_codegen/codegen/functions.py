@@ -57,7 +57,7 @@ def deployed_functions(model: TubeModel, every: bool = False) -> list[ca.Functio
     design = model.design
     if every:
         return P.deployed_pieces(design.dimension, DATA_PROFILES,
-                                 saturated=design.input_bound is not None)
+                                 saturated=design.input_bound is not None, blended=True)
     profiles = tuple(sorted({segment.profile for segment in design.segments}))
     members = [len(design.circumvents_on(i, side)) for i in range(design.dimension)
                for side in (LOWER, UPPER)]

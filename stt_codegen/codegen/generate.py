@@ -147,6 +147,7 @@ def python_module_context(design: TubeDesign, functions: list,
     limits = input_limits(design)
     programs = [dataclasses.replace(lower(f), name=f"body_{f.name()}") for f in functions]
     return dict(T=python_names(capacity is not None), capacity=capacity,
+                blended=capacity is not None or design.blends_corners,
                 newton=NEWTON_ITERATIONS, max_initial_error=repr(float(MAX_INITIAL_ERROR)),
                 bodies=python_source(programs).rstrip("\n"),
                 spec_tables=design_table_rows(design, lambda v: repr(float(v)), False),

@@ -130,8 +130,8 @@ class TableShape:
     profiles : list of str
         The reach profiles whose bodies are called.
     blended : bool
-        The next segment's move is added where it has started (blended corners; never in
-        the data form, which refuses such tubes).
+        The next segment's move is added where it has started (blended corners; always in
+        the data form, whose tube may blend: a tube that does not never enters the path).
     """
 
     windows: bool
@@ -243,7 +243,7 @@ def table_shape(tables: Tables, capacity: TubeCapacity | None) -> TableShape:
     TableShape
     """
     if capacity is not None:
-        return TableShape(True, True, True, list(DATA_PROFILES))
+        return TableShape(True, True, True, list(DATA_PROFILES), True)
     return TableShape(bool(tables.windows), 1 in tables.members, bool(tables.multi),
                       list(tables.profiles), tables.blended)
 
@@ -289,13 +289,11 @@ def require_capacity(design: TubeDesign, capacity: TubeCapacity) -> None:
     Raises
     ------
     SpecError
-        More segments or circumvents than the capacity, a segment profile outside
-        :data:`DATA_PROFILES`, or blended corners (field ``tube_data``).
+        More segments or circumvents than the capacity, or a segment profile outside
+        :data:`DATA_PROFILES` (field ``tube_data``). A tube that blends corners
+        (:attr:`~stt_codegen.tube.parameters.TubeDesign.blends_corners`) is taken: the data
+        form adds the next segment's move where it has started, as the model does.
     """
-    if design.blends_corners:
-        raise SpecError("tube_data", "the tube blends corners (a segment starts before the "
-                                     "previous one ends); the tube as data runs one segment "
-                                     "at a time")
     unknown = sorted({s.profile for s in design.segments} - set(DATA_PROFILES))
     if unknown:
         raise SpecError("tube_data", f"the tube has {', '.join(unknown)} segments; the "
