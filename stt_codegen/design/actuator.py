@@ -36,7 +36,7 @@ second stage). Deterministic, in this order, the first tube that meets the bound
 5. **via points with cruise segments** (the same; not for tasks, whose legs have them):
    the same via boxes and times, each segment's rate rising to 1.25 times its mean, not
    1.875 times; then, where the input is a velocity (law (13), a base), the same with
-   **blended corners** (not where an obstacle moves, nor with ``[sensing]``): the tube
+   **blended corners** (not where an obstacle moves): the tube
    stops at no via box, so it asks less speed of the same time, and a base's heading
    stays aligned with its command through the corners
    (:mod:`~stt_codegen.design.heading`); then, for a base, via points with cruise
@@ -172,9 +172,9 @@ def slower_variants(spec: Spec, default: Design | None,
                     replace(spec, tube=replace(spec.tube, method=METHOD_VIA,
                                                via_profile=CRUISE))))
         # where the input is a velocity: the same with blended corners, which stop at no
-        # via box (not where an obstacle moves, nor with [sensing]: a replanned tube and
-        # the tube as data have no blends)
-        blend = (variant_of(spec).via_timing != ACCELERATION_TIMING and spec.sensing is None
+        # via box (not where an obstacle moves; with [sensing] too: the tube as data runs
+        # them)
+        blend = (variant_of(spec).via_timing != ACCELERATION_TIMING
                  and not any(ob.motion != "still" for ob in spec.moving_obstacles))
         if blend:
             out.append(("via points, cruise segments, blended corners",
