@@ -123,6 +123,7 @@ def test_a_proof_stopped_at_a_limit_keeps_the_verdict():
     assert np.array_equal(stopped.abs_e, full.abs_e[:41])
 
 
+@pytest.mark.slow
 def test_a_bases_proof_is_the_per_axis_arguments(monkeypatch):
     """A base's proof (``point_proof``: ``per_axis_first``) asks the per-axis argument
     alone where it passes, with a limit or without: where its bounds keep the limit its

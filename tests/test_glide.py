@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from stt_codegen.tube import reference as R
 from stt_codegen.tube.parameters import (GLIDE, GLIDE_RAMP, GLIDE_TURN, SCURVE, SMOOTHSTEP,
@@ -45,6 +46,7 @@ def test_glide_model_and_oracle_agree_with_its_documented_peaks():
     assert ACCELERATION_PROFILES.index(GLIDE) == ACCELERATION_PROFILES.index(SCURVE) + 1
 
 
+@pytest.mark.slow
 def test_glide_is_proved_c2_with_its_peaks_and_is_deployed_as_documented():
     """SymPy, with the ramp share ``r`` and the turn share ``q`` symbolic (``0 < 2 q < r <
     1/2``): the documented glide has ``p``, ``p_dot``, ``p_ddot`` continuous at every joint,

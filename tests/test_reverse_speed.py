@@ -93,6 +93,7 @@ def test_the_closed_loop_backs_up_no_faster_than_proved_and_is_never_clamped():
         assert v.min() >= -design.input_proof.backward
 
 
+@pytest.mark.slow
 def test_verify_reports_the_backing_up():
     design = stt.design_tube(_agv("0.2"))
     checks = {c.name: c for c in stt.verify(design).checks}
@@ -132,6 +133,7 @@ def test_the_agv_backing_up_on_the_cortex_m4f_is_satisfied_like_the_host():
     assert abs(report["reach_time"] - host.reach_time) <= 1.0 / design.tube.rate_hz
 
 
+@pytest.mark.slow
 def test_a_fleets_bases_keep_their_reverse_speed():
     """``warehouse-fleet`` with its three bases given ``reverse_speed = 0.4``: the fleet
     design plans each way without ``[actuator]`` (``Spec.without_actuator`` drops the key

@@ -75,7 +75,8 @@ def _random_class(rng: np.random.Generator, base: Assumptions, turn: bool) -> As
 
 # a differential drive (coupled, turning gains), a coupled omnidirectional robot, a diagonal
 # one among moving obstacles
-CASES = ("office-drive.toml", "omnirobot-s1", "crossing-moving")
+CASES = ("office-drive.toml", pytest.param("omnirobot-s1", marks=pytest.mark.slow),
+         pytest.param("crossing-moving", marks=pytest.mark.slow))
 
 
 @pytest.mark.parametrize("name", CASES)
@@ -141,6 +142,7 @@ def test_a_box_of_e0_bounds_every_start_in_it(lyapunov: bool) -> None:
     assert not edge.passed
 
 
+@pytest.mark.slow
 def test_with_the_balls_the_loop_runs() -> None:
     """With the Lyapunov balls (a coupled block, no delay) the loop runs: the same result
     with ``folded`` either way; with a delay the balls are not used and the fold runs."""

@@ -108,6 +108,7 @@ def test_a_drone_flies_under_a_row_of_lamps_certified_throughout(drone, under):
     assert 0.0 < record.min_sensed_clearance <= space.min() + 1e-12
 
 
+@pytest.mark.slow
 def test_a_drone_climbs_over_a_row_at_its_height_and_the_generated_code_flies_it(drone):
     """The row at the drone's height blocks every way in plan at its level: the path
     climbs to a level above it in the start's cell, then flies over (the body's disc

@@ -94,6 +94,7 @@ def check_run(walkers: list[WalkingObstacle], world: str = "hall-crossing") -> N
     assert not record.collision_certified
 
 
+@pytest.mark.slow
 @settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(people())
 def test_no_certified_sample_meets_an_obstacle(walkers):
@@ -107,6 +108,7 @@ def test_no_certified_sample_meets_an_obstacle_in_more_worlds(walkers):
     check_run(walkers)
 
 
+@pytest.mark.slow
 @settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(balls())
 def test_no_certified_sample_meets_a_ball_in_three_dimensions(flying):

@@ -221,6 +221,7 @@ def test_a_tube_larger_than_the_capacity_is_refused_by_field(several):
     assert info.value.field == "tube_data"
 
 
+@pytest.mark.slow
 def test_with_an_actuator_bound_the_clamp_is_the_casadi_models():
     """A spec with ``[actuator]``: the data form's law with its clamp (status
     INPUT_CLAMPED) is the CasADi model's, bit for bit."""

@@ -5,6 +5,7 @@ correlated with that axis's own gain, against random matrices of the class; the 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings, strategies as st
 
 from stt_codegen.design.certificate.sampled_axis import coupling_push, peak_for_box, peak_scalar
@@ -64,6 +65,7 @@ def _clipped(s_peak: float, a: float, b: float) -> list[float]:
 @settings(max_examples=3000, deadline=None)
 @given(ratio=st.floats(0.5, 1e7), a=st.floats(-E_MAX, E_MAX), width=st.floats(0.0, 2.0),
        near=st.sampled_from([None, 0, 1]), shift=st.floats(-1e-6, 1e-6))
+@pytest.mark.slow
 def test_the_peak_for_a_box_is_clipped_as_the_bisected_peak(ratio, a, width, near, shift):
     """The shortcut of :func:`peak_for_box` gives the same doubles as the bisection wherever
     axis_interval reads them, also for ranges whose end lies at or next to ``s*``."""
