@@ -356,6 +356,21 @@ def test_the_generated_selftest_passes_on_the_design_tube(cc, tmp_path, precisio
     assert '"tube_data": {' in files["manifest.json"].decode()
 
 
+def test_the_generated_selftest_passes_on_a_blended_design_tube(cc, tmp_path):
+    """The self-test of the data form of a tube that blends corners (the piecewise tube's
+    second segment starting 0.8 s and its third 1 s before the previous one ends) passes:
+    its vectors (4 of whose 56 times fall in the overlaps) are the reference's."""
+    from test_blended_corners import blended
+
+    from stt_codegen.codegen.vectors import test_vectors
+    design = blended()
+    t = np.asarray(test_vectors(design, "double")["t"], float)
+    assert np.count_nonzero(((1.2 < t) & (t < 2.0)) | ((4.0 < t) & (t < 5.0))) >= 4
+    spec = DesignSpec(design)
+    files = generate_files(spec, design, Options(("c",), "double", TubeCapacity(4, 8)))
+    selftest_passes(files, tmp_path, cc)
+
+
 def test_bad_requests_name_the_field():
     assert parse_options("c,python", "double", True).tube_data == TubeCapacity(8, 32)
     with pytest.raises(SpecError, match="expected True or a TubeCapacity"):
