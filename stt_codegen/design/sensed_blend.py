@@ -20,11 +20,7 @@ from .result import Design
 from .search import check_tube
 from .sensed_path import MAX_SEGMENTS
 
-__all__ = ["END_GAP", "continuing"]
-
-#: How much later than the active segment the new first move must end, s: its ends stay
-#: increasing in the tube as data in single precision too (its check refuses equal ones).
-END_GAP = 1e-3
+__all__ = ["continuing"]
 
 
 def _held(segment: ReachSegment) -> bool:
@@ -49,18 +45,10 @@ def continuing(active: TubeDesign, at: float, new: Design) -> Design | None:
     -------
     Design or None
         ``None`` where there is no move to go on with (the active tube holds its box, or
-        two of its segments move it at ``at``), where the new first move does not end
-        :data:`END_GAP` after the active one (three segments would move at once), where
-        one more segment would not fit in the tube as data
-        (:data:`~.sensed_path.MAX_SEGMENTS`), or where the tube is not certified.
-
-    Examples
-    --------
-    >>> import stt_codegen as stt
-    >>> from stt_codegen.design.sensed_blend import continuing
-    >>> hall = stt.design_tube(stt.load_spec("hall-crossing"))
-    >>> continuing(hall.tube, 25.0, hall) is None   # after t_c: no move to go on with
-    True
+        two of its segments move it at ``at``), where the new first move ends before the
+        active one (three segments would move at once), where one more segment would not
+        fit in the tube as data (:data:`~.sensed_path.MAX_SEGMENTS`), or where the tube is
+        not certified.
     """
     segments = active.segments
     k = next((i for i, s in enumerate(segments) if at < s.end), None)
@@ -70,7 +58,7 @@ def continuing(active: TubeDesign, at: float, new: Design) -> Design | None:
         return None
     going = replace(segments[k], start=segments[k].start - at, end=segments[k].end - at)
     first = new.tube.segments[0]
-    if (first.start != 0.0 or _held(first) or first.end - going.end < END_GAP
+    if (first.start != 0.0 or _held(first) or not going.end < first.end
             or len(new.tube.segments) >= MAX_SEGMENTS):
         return None
     first = replace(first, lower_from=going.lower_to, upper_from=going.upper_to)
