@@ -139,35 +139,6 @@ def test_the_new_tube_starts_from_a_box_holding_the_old_tube(start, new):
     assert np.all(old_hi[-1] <= np.array(box.upper) + 1e-12)
 
 
-def test_a_new_path_goes_on_with_the_active_move(start, person, new):
-    """The path plan above, moving at its next switch (2.3 s), and a second person walking
-    towards the robot 1.6 m ahead: the new path's tube starts with the active segment
-    (begun before its time 0) and its first move starts at 0, blending with it. At the
-    switch its box and its rate are the active tube's: the robot keeps its speed. The
-    tube is certified, and the robot's box misses the second person's reachable box at
-    every sample of the horizon (the oracle's tube)."""
-    assert new.design.tube.segments[0].start == 0.0          # from the spec's tube: at rest
-    space = new.task.state_space
-    here = sensed_module._box_at(new, 1.7 - new.start, space).center[:2]
-    second = stt.SensedObstacle.ball((here[0] + 1.6, here[1]), 0.3, velocity=(-0.5, 0.0),
-                                     seen_at=1.7)
-    going = stt.replan(new, 1.7, here, [person, second])
-    tube = going.design.tube
-    assert not going.kept and going.design.certificate.passed and tube.blends_corners
-    assert tube.segments[0].start < 0.0 == tube.segments[1].start < tube.segments[0].end
-    at = np.array([going.start - new.start])
-    old, now = (reference.reach_tube(new.design.tube, at, rates=True),
-                reference.reach_tube(tube, np.zeros(1), rates=True))
-    assert np.abs(old[2][0, :2]).max() > 0.3                # the robot is moving, m/s
-    for a, b in zip(old, now):
-        assert np.allclose(a, b, rtol=0.0, atol=1e-12)
-    sensing = start.task.sensing
-    ts, lows, highs = oracle_tube(tube, sensing.horizon, 100.0)
-    for t, lo, hi in zip(ts, lows, highs):
-        p_lo, p_hi = second.reach_box(going.start + t, sensing.max_obstacle_speed)
-        assert np.any((hi[:2] + 0.25 < p_lo) | (lo[:2] - 0.25 > p_hi)), t
-
-
 def test_the_region_certificate_refuses_a_tube_that_outruns_the_range():
     """A range just above what the envelope needs: the base's straight tube drives beyond
     where it can see before the next plan, at every speed tried, so no plan is certified."""

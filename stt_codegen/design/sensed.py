@@ -46,14 +46,12 @@ from ..errors import DesignError, SpecError, number_text
 from ..spec.loader import DEFAULT_HALF_WIDTH_FRACTION, Box, Spec
 from ..spec.motion import MovingObstacle
 from ..spec.sensing import SensedObstacle, Sensing, on_sensing_dims
-from ..tube.parameters import TubeDesign
 from .certificate.fleet import RobotTube, robot_tube
 from .certificate.motion import MOVING_PROPERTY
 from .certificate.report import ROUNDING_MARGIN
 from .failures import FailureKind, without_advice
 from .result import Design, require_design
 from .search import check_tube, design_tube
-from .sensed_blend import continuing
 from .sensed_path import MIN_SPEED, PREDICTION_SPAN, path_design
 from .sensed_switch import proved_error, state_at, switch_error
 
@@ -112,9 +110,6 @@ FAST_PURSUIT = 1.0
 #: is closing: a pursuer heads for the robot; a fast straight walk taken for one (within
 #: :data:`CLOSING_ANGLE`) ranked escapes into the corner behind the robot.
 FAST_CLOSING_ANGLE = math.pi / 12.0
-#: Whether a new path's tube goes on with the active tube's move at the switch
-#: (:func:`~.sensed_blend.continuing`) when that is certified.
-CONTINUE_MOVES = True
 
 
 @dataclass(frozen=True)
@@ -787,8 +782,6 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
 
     # where the active plan's proof leaves the state at the switch
     state = state_at(plan.state_bounds, base.rate_hz, t_s - plan.start)
-    # the active tube and the switch in its time, for a new tube that goes on with its move
-    going = (plan.design.tube, t_s - plan.start) if CONTINUE_MOVES else None
 
     def escape() -> dict | str:
         active, point, near = at_switch()
@@ -815,7 +808,7 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
                 t_s, base.prescribed_time - EARLIER)):
             return kept
         made = _along_path(base, at_switch()[0], moving, boxes, sensed, sensing, s, t_m,
-                           t_s, remaining, first, state, going)
+                           t_s, remaining, first, state)
         spare = None
         if made is not None and (headed or made["arrival"] <= plan.arrival - EARLIER):
             if not chased(made):
@@ -834,7 +827,7 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     # a way through where the sensed obstacles are headed over the whole tube, then the
     # design for the horizon and a short foresight, then without the foresight
     made = _along_path(base, active, moving, boxes, sensed, sensing, s, t_m, t_s, remaining,
-                       first, state, going)
+                       first, state)
     spare = None
     if made is not None:
         if not chased(made):
@@ -1071,13 +1064,11 @@ def _to_target(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
 def _along_path(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
                 boxes: tuple[MovingObstacle, ...], sensed: Sequence[SensedObstacle],
                 sensing: Sensing, s: np.ndarray, t_m: float, t_s: float, remaining: float,
-                first: int, state: tuple[np.ndarray, np.ndarray] | None = None,
-                active: tuple[TubeDesign, float] | None = None) -> dict | None:
+                first: int, state: tuple[np.ndarray, np.ndarray] | None = None
+                ) -> dict | None:
     """A certified tube from ``box`` to the target along a space-time path among where
     the sensed obstacles are headed (:func:`~.sensed_path.path_design`), held to the
-    region certificate: the plan's fields, or ``None``. With ``active`` (the active tube
-    and the switch in its time), the path's tube going on with the active move
-    (:func:`~.sensed_blend.continuing`) first."""
+    region certificate: the plan's fields, or ``None``."""
     local = _new_local(base, box, moving, remaining)
 
     def predict(t_to: float) -> tuple[MovingObstacle, ...]:
@@ -1091,16 +1082,12 @@ def _along_path(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     # a late path's task is due when it arrives (the next checks hold it to that)
     local = replace(local, prescribed_time=found.tube.prescribed_time)
     arrival = t_s + found.tube.segments[-1].end
-    going = None if active is None else continuing(active[0], active[1], found)
-    for tube in ([going] if going is not None else []) + [found]:
-        try:
-            made = _new_plan(local, boxes, sensing, s, t_m, t_s, arrival, first, found=tube,
-                             state=state)
-        except DesignError:
-            continue
-        if isinstance(made, dict):
-            return made
-    return None
+    try:
+        made = _new_plan(local, boxes, sensing, s, t_m, t_s, arrival, first, found=found,
+                         state=state)
+    except DesignError:
+        return None
+    return made if isinstance(made, dict) else None
 
 
 def _new_plan(local: Spec, boxes: tuple[MovingObstacle, ...], sensing: Sensing,
