@@ -146,11 +146,12 @@ def python_module_context(design: TubeDesign, functions: list,
     """
     limits = input_limits(design)
     programs = [dataclasses.replace(lower(f), name=f"body_{f.name()}") for f in functions]
+    tables = design_table_rows(design, lambda v: repr(float(v)), False)
     return dict(T=python_names(capacity is not None), capacity=capacity,
-                blended=capacity is not None or design.blends_corners,
+                blended=table_shape(tables, capacity).blended,
                 newton=NEWTON_ITERATIONS, max_initial_error=repr(float(MAX_INITIAL_ERROR)),
                 bodies=python_source(programs).rstrip("\n"),
-                spec_tables=design_table_rows(design, lambda v: repr(float(v)), False),
+                spec_tables=tables,
                 profile_codes=profile_codes(capacity),
                 t_c=repr(float(design.prescribed_time)), rate_hz=repr(float(design.rate_hz)),
                 **timing_context(design.rate_hz, timing, lambda v: repr(float(v))),
