@@ -252,13 +252,24 @@ def test_a_base_module_is_the_casadi_model_bit_for_bit(base):
     """The base's module with the tube as data (``step(tube, x, t, dt, alpha)``, ``x = (x,
     y, theta)``, ``u = (v, omega)``): on random base states around its tubes (the spec's
     and one moved), random headings, ``alpha`` and both ``dt`` kinds, the step equals the
-    CasADi model of the look-ahead step, bits and status, every status met."""
+    CasADi model of the look-ahead step, bits and status, every status met. So does a
+    tube that blends a corner (the spec's move split in two at its middle box, the second
+    half starting 4 s before the first ends)."""
     design, library = base
     assert design.look_ahead.input_bound is not None        # the clamp is in the step
     moved = dataclasses.replace(design.tube, circumvents=design.tube.circumvents[:1])
+    (whole,) = design.tube.segments
+    middle = (tuple((a + b) / 2 for a, b in zip(whole.lower_from, whole.lower_to)),
+              tuple((a + b) / 2 for a, b in zip(whole.upper_from, whole.upper_to)))
+    half = (whole.start + whole.end) / 2
+    blended = dataclasses.replace(design.tube, segments=(
+        dataclasses.replace(whole, end=half, lower_to=middle[0], upper_to=middle[1]),
+        dataclasses.replace(whole, start=half - 4.0, lower_from=middle[0],
+                            upper_from=middle[1])))
+    assert blended.blends_corners
     rng = np.random.default_rng(11)
     seen = set()
-    for tube in (design.tube, moved):
+    for tube in (design.tube, moved, blended):
         ref = make_controller("casadi", tube, design.look_ahead)
         data = library.load(tube)
         for k in range(200):
