@@ -40,6 +40,18 @@ def blended(profile: str = SMOOTHSTEP) -> TubeDesign:
                                      replace(third, start=4.0)))
 
 
+def split_in_two(tube: TubeDesign, lead: float) -> TubeDesign:
+    """A one-segment tube's move split in two at its middle box, the second half starting
+    ``lead`` s before the first ends: one blended corner on the same way."""
+    (whole,) = tube.segments
+    middle = (tuple((a + b) / 2 for a, b in zip(whole.lower_from, whole.lower_to)),
+              tuple((a + b) / 2 for a, b in zip(whole.upper_from, whole.upper_to)))
+    half = (whole.start + whole.end) / 2
+    return replace(tube, segments=(
+        replace(whole, end=half, lower_to=middle[0], upper_to=middle[1]),
+        replace(whole, start=half - lead, lower_from=middle[0], upper_from=middle[1])))
+
+
 def blended_spec():
     """omnirobot-s2 through via points with blended corners (one of its three corners is
     blended; the other two would sweep the obstacles)."""

@@ -329,6 +329,33 @@ def test_a_base_runs_its_replanned_tubes_through_one_compiled_controller(base):
     run_as_casadi(design, "c")
 
 
+def test_a_base_runs_a_tube_that_blends_a_corner_bit_for_bit(base):
+    """The base's C with the tube as data runs a tube that blends a corner (the spec's move
+    split in two at its middle box, the second half starting 4 s before the first ends) as
+    the CasADi model of the look-ahead step, bits and status, half the times inside the
+    overlap (its Python module's twin: tests/test_tube_data_python.py)."""
+    from test_blended_corners import split_in_two
+    design, library = base
+    tube = split_in_two(design.tube, 4.0)
+    first, second = tube.segments
+    assert tube.blends_corners and library.check(library.pack(tube)) == 0
+    ref, data = make_controller("casadi", tube, design.look_ahead), library.load(tube)
+    rng = np.random.default_rng(12)
+    l = design.look_ahead.axle_offset
+    for k in range(200):
+        t = (rng.uniform(second.start, first.end) if k % 2
+             else rng.uniform(0.0, 1.1 * tube.prescribed_time))
+        g_l, g_u = (np.ravel(v) for v in stt.tube.reference.adaptive_tube(
+            tube, np.array([t]), np.zeros((1, 4)))[:2])
+        p = g_l + (g_u - g_l) * rng.uniform(-0.1, 1.1, 2)
+        theta = rng.uniform(-np.pi, np.pi)
+        x = np.array([p[0] - l * np.cos(theta), p[1] - l * np.sin(theta), theta])
+        alpha = np.abs(rng.normal(0.0, 0.05, 4)) * (k % 3 != 0)
+        expected, got = ref.step(x, t, 1.0 / tube.rate_hz, alpha), data.step(
+            x, t, 1.0 / tube.rate_hz, alpha)
+        assert bits(got[:2]) == bits(expected[:2]) and got[2] == expected[2], (x, t)
+
+
 @pytest.mark.parametrize("precision", ["double", "single"])
 def test_the_base_data_form_selftest_passes(base, cc, tmp_path, precision):
     """The base's C with the tube as data: its self-test runs the spec's vectors on

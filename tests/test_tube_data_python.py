@@ -258,14 +258,8 @@ def test_a_base_module_is_the_casadi_model_bit_for_bit(base):
     design, library = base
     assert design.look_ahead.input_bound is not None        # the clamp is in the step
     moved = dataclasses.replace(design.tube, circumvents=design.tube.circumvents[:1])
-    (whole,) = design.tube.segments
-    middle = (tuple((a + b) / 2 for a, b in zip(whole.lower_from, whole.lower_to)),
-              tuple((a + b) / 2 for a, b in zip(whole.upper_from, whole.upper_to)))
-    half = (whole.start + whole.end) / 2
-    blended = dataclasses.replace(design.tube, segments=(
-        dataclasses.replace(whole, end=half, lower_to=middle[0], upper_to=middle[1]),
-        dataclasses.replace(whole, start=half - 4.0, lower_from=middle[0],
-                            upper_from=middle[1])))
+    from test_blended_corners import split_in_two
+    blended = split_in_two(design.tube, 4.0)
     assert blended.blends_corners
     rng = np.random.default_rng(11)
     seen = set()
