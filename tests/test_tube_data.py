@@ -77,6 +77,17 @@ def bits(values) -> list:
     return [np.asarray(v, float).tobytes() for v in values]
 
 
+def base_state(tube, axle_offset: float, t: float, fraction, theta: float) -> np.ndarray:
+    """The base state ``(x, y, theta)`` whose look-ahead point, ``axle_offset`` ahead of
+    the axle, lies at ``fraction`` (per axis; 0 the lower side, 1 the upper) of the
+    adaptive tube's box at ``t``."""
+    g_l, g_u = (np.ravel(v) for v in stt.tube.reference.adaptive_tube(
+        tube, np.array([t]), np.zeros((1, 4)))[:2])
+    p = g_l + (g_u - g_l) * fraction
+    return np.array([p[0] - axle_offset * np.cos(theta), p[1] - axle_offset * np.sin(theta),
+                     theta])
+
+
 def test_a_tube_as_data_computes_the_casadi_model_bit_for_bit(several):
     """On random (x, t, alpha) across every segment and window, the step of the tube passed
     as data equals the CasADi model's, bits and status; so does the tube packed in Python
@@ -345,11 +356,7 @@ def test_a_base_runs_a_tube_that_blends_a_corner_bit_for_bit(base):
     for k in range(200):
         t = (rng.uniform(second.start, first.end) if k % 2
              else rng.uniform(0.0, 1.1 * tube.prescribed_time))
-        g_l, g_u = (np.ravel(v) for v in stt.tube.reference.adaptive_tube(
-            tube, np.array([t]), np.zeros((1, 4)))[:2])
-        p = g_l + (g_u - g_l) * rng.uniform(-0.1, 1.1, 2)
-        theta = rng.uniform(-np.pi, np.pi)
-        x = np.array([p[0] - l * np.cos(theta), p[1] - l * np.sin(theta), theta])
+        x = base_state(tube, l, t, rng.uniform(-0.1, 1.1, 2), rng.uniform(-np.pi, np.pi))
         alpha = np.abs(rng.normal(0.0, 0.05, 4)) * (k % 3 != 0)
         expected, got = ref.step(x, t, 1.0 / tube.rate_hz, alpha), data.step(
             x, t, 1.0 / tube.rate_hz, alpha)

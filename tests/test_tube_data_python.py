@@ -26,6 +26,7 @@ from stt_codegen.runtime.compiled import DesignSpec, compiler
 from stt_codegen.runtime.data_module import TubeDataModule
 from stt_codegen.system import MissingTool
 from conftest import design_of
+from test_tube_data import base_state, bits
 from test_tube_segments import piecewise_design
 
 SPECS = Path(__file__).parent / "specs"
@@ -37,10 +38,6 @@ def several():
     tests, and its Python module with the tube as data."""
     design = piecewise_design()
     return design, TubeDataModule(design)
-
-
-def bits(values) -> list:
-    return [np.asarray(v, float).tobytes() for v in values]
 
 
 def test_the_module_is_standalone_and_deterministic():
@@ -268,13 +265,9 @@ def test_a_base_module_is_the_casadi_model_bit_for_bit(base):
         data = library.load(tube)
         for k in range(200):
             t = rng.uniform(0.0, 1.1 * tube.prescribed_time)
-            g_l, g_u = (np.ravel(v) for v in stt.tube.reference.adaptive_tube(
-                tube, np.array([t]), np.zeros((1, 4)))[:2])
-            p = g_l + (g_u - g_l) * (rng.uniform(0.48, 0.52, 2) if k % 2 else
-                                     rng.uniform(-0.1, 1.1, 2))
-            theta = rng.uniform(-np.pi, np.pi)
-            l = design.look_ahead.axle_offset
-            x = np.array([p[0] - l * np.cos(theta), p[1] - l * np.sin(theta), theta])
+            x = base_state(tube, design.look_ahead.axle_offset, t,
+                           rng.uniform(0.48, 0.52, 2) if k % 2 else rng.uniform(-0.1, 1.1, 2),
+                           rng.uniform(-np.pi, np.pi))
             alpha = np.abs(rng.normal(0.0, 0.05, 4)) * (k % 3 != 0)
             dt = 1.0 / tube.rate_hz if k % 4 else 2.0 / tube.rate_hz
             expected, got = ref.step(x, t, dt, alpha), data.step(x, t, dt, alpha)
