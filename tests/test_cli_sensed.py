@@ -43,6 +43,7 @@ def test_a_file_reads_as_the_obstacles_it_lists(tmp_path):
     assert walking_obstacles({}) == ()
 
 
+@pytest.mark.slow
 def test_the_file_runs_the_same_loop_as_the_same_obstacles_given_in_python(tmp_path, capsys):
     """The case's own people (no ``--sensed``) and the same people from a file: the same
     run, in a different line of provenance only."""

@@ -193,6 +193,7 @@ def test_cruise_profile_is_proved_c2_with_its_peak_rate_and_is_deployed_as_docum
     assert pieces.PROFILE_NAMES.index(CRUISE) == 2
 
 
+@pytest.mark.slow
 def test_scurve_profile_is_proved_c2_with_its_peaks_and_is_deployed_as_documented():
     """SymPy: the documented S-curve (turn share ``q`` in (0, 1/4), symbolic) has ``p``,
     ``p_dot``, ``p_ddot`` continuous at every joint (``q``, ``1/2 - q``, the middle, where

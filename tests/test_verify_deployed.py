@@ -34,6 +34,7 @@ def mutate(monkeypatch):
     _clear()
 
 
+@pytest.mark.slow
 def test_every_deployed_piece_equals_the_papers_formula():
     checks = deployed.deployed_checks()
     assert [c.name for c in checks] == [

@@ -16,6 +16,7 @@ from stt_codegen.proofs import (
 )
 
 
+@pytest.mark.slow
 def test_bundle_passes() -> None:
     checks = error_transform_checks(3)
     assert len(checks) == 7
