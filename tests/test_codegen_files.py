@@ -108,6 +108,16 @@ def test_output_folder_rules(tmp_path):
     assert not (tmp_path / "x").exists()
 
 
+def test_check_outside_the_repository_names_the_missing_folder(tmp_path, capsys):
+    """Run where there is no ``generated/`` (not the repository's root), ``check`` says so
+    and exits 2, instead of reporting every file as missing and advising ``--update``."""
+    capsys.readouterr()
+    assert main(["check", "--root", str(tmp_path / "generated")]) == 2
+    err = capsys.readouterr().err
+    assert "--root: no folder" in err and "repository's root" in err
+    assert "Traceback" not in err and not (tmp_path / "generated").exists()
+
+
 @pytest.mark.slow
 def test_check_detects_drift(tmp_path, capsys):
     root = tmp_path / "generated"

@@ -6,6 +6,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from ..errors import SpecError
+
 __all__ = ["cmd_check", "configure_check"]
 
 
@@ -22,9 +24,18 @@ def cmd_check(args: argparse.Namespace) -> int:
     -------
     int
         0 identical (or rewritten), 1 drift (the differences on standard output).
+
+    Raises
+    ------
+    SpecError
+        ``--root``: no such folder to compare (exit 2; run from the repository's root).
     """
     from ..codegen.bundled import drift, update_generated, version_note
     root = Path(args.root)
+    if not args.update and not root.is_dir():
+        raise SpecError("--root", f"no folder {root.as_posix()}/ here to compare: run "
+                                  f"`stt-codegen check` from the repository's root, or name "
+                                  f"the committed output's folder with --root")
     if args.update:
         update_generated(root)
         print(f"regenerated {root}/")
