@@ -34,8 +34,8 @@ def cmd_check(args: argparse.Namespace) -> int:
     root = Path(args.root)
     if not args.update and not root.is_dir():
         raise SpecError("--root", f"no folder {root.as_posix()}/ here to compare: run "
-                                  f"`stt-codegen check` from the repository's root, or name "
-                                  f"the committed output's folder with --root")
+                                  "`stt-codegen check` from the repository's root, or name "
+                                  "the committed output's folder with --root")
     if args.update:
         update_generated(root)
         print(f"regenerated {root}/")
