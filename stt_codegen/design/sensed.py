@@ -53,12 +53,13 @@ from .failures import FailureKind, without_advice
 from .result import Design, require_design
 from .search import check_tube, design_tube
 from .sensed_blend import continuing, going_on
+from .sensed_evade import (EVADE_DISTANCES, EVADE_SAFE, EVADE_TIME, chasing,
+                           evasion_clearance, pursuers, ring_ahead)
 from .sensed_path import MIN_SPEED, PREDICTION_SPAN, path_design
 from .sensed_switch import proved_error, state_at, switch_error
 
 __all__ = ["CHUNK_SECONDS", "ESCAPE_CLEARANCE", "ESCAPE_DIRECTIONS", "ESCAPE_DISTANCES",
-           "ESCAPE_TIME", "EVADE_ANGLE", "EVADE_DISTANCE", "EVADE_DISTANCES", "EVADE_LOOK_AHEAD",
-           "EVADE_STEP", "FORESIGHT", "LATE_TIME", "MAX_ESCAPES", "ReplanFailure",
+           "ESCAPE_TIME", "FORESIGHT", "LATE_TIME", "MAX_ESCAPES", "ReplanFailure",
            "SensedPlan", "escape_directions", "foresight_boxes", "reachable_boxes",
            "region_margin", "replan", "start_plan", "switch_time", "uncertified_plan"]
 
@@ -112,44 +113,6 @@ FAST_PURSUIT = 1.0
 #: is closing: a pursuer heads for the robot; a fast straight walk taken for one (within
 #: :data:`CLOSING_ANGLE`) ranked escapes into the corner behind the robot.
 FAST_CLOSING_ANGLE = math.pi / 12.0
-#: A fast obstacle (:func:`_fast`) approaching the robot (its velocity estimate has a
-#: component towards it) whose shape comes within this distance of the robot's reference
-#: point, state units, is run from first: an *evasion* (:func:`_evasion_clearance`).
-EVADE_DISTANCE = 4.0
-#: The angle (radians) within which a fast obstacle's velocity estimate points at the robot
-#: when an evasion runs from it.
-EVADE_ANGLE = math.pi / 2.0
-#: A tracked obstacle (``SensedObstacle.label``) whose velocity estimate, between the
-#: active plan's measurement and the next, changed as the envelope's adversary's would
-#: (turning after the robot at ``max_obstacle_acceleration`` towards the envelope's speed,
-#: :func:`_chasing`) to within this fraction of that speed is taken for a pursuer from then
-#: on (:attr:`SensedPlan.chasers`).
-PURSUIT_MATCH = 0.05
-#: The sub-steps of :data:`PURSUIT_MATCH`'s prediction between two measurements.
-PURSUIT_STEPS = 10
-#: Seconds over which an evasion's temporary goals are ranked against the pursuit.
-EVADE_LOOK_AHEAD = 2.0
-#: Distances (state units) of an evasion's temporary goals from where the robot will be at
-#: the switch, each reached in :data:`ESCAPE_TIME`.
-EVADE_DISTANCES = (0.5, 0.75, 1.0)
-#: An evasion's goal counts its room to the state space's boundary times this as a
-#: clearance too (a corner is a trap).
-EVADE_ROOM = 2.0
-#: An evasion runs around a ring about the state space's centre (on the sensing
-#: dimensions) of this fraction of its smallest half side, away from the chasers.
-EVADE_RING = 0.6
-#: The angle (radians) ahead of the robot on the ring an evasion's goals are drawn towards.
-EVADE_LEAD = math.pi / 3.0
-#: A robot carried on by the move under way more than this (state units) keeps going round
-#: the ring the way it goes.
-EVADE_CARRY = 0.1
-#: An evasion's clearance counts up to this (state units): goals at least this clear are
-#: ranked by their distance to the ring's point ahead.
-EVADE_SAFE = 1.0
-#: Seconds an evasion's move takes; its next move starts a measurement later, blending.
-EVADE_TIME = 0.495
-#: The time step of the pursuit an evasion is ranked against, s.
-EVADE_STEP = 0.05
 
 
 @dataclass(frozen=True)
@@ -204,6 +167,12 @@ class SensedPlan:
         ``guarantee_until`` are its switch): the best escape found after no plan was
         certified (:attr:`ReplanFailure.fallback`), which takes over when the certified
         span of the plan it replaces has run out.
+    chasers : tuple of int
+        The track numbers (``SensedObstacle.label``) taken for pursuers by this plan's
+        measurement or an earlier one in its chain of replans: a track whose velocity
+        estimate changed as the envelope's adversary's would, turning after the robot
+        (:func:`~.sensed_evade.chasing`). A fast one approaching is run from by an
+        *evasion* (docs/sensing.md).
     state_bounds : (ndarray, ndarray) or None
         Where the tube's sampled-data proof keeps the state at its samples ``t' = k /
         rate_hz``: lower and upper corners, shape (K + 1, n) each, from where the state
@@ -783,11 +752,11 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
     t_s = switch_time(sensing, t_m, local.rate_hz)
     until = t_s + sensing.horizon
     reached = _reached(plan, s, sensing)
-    chasing = _chasing(plan, sensed, s, sensing)
+    tracked = chasing(plan.sensed, plan.chasers, sensed, s, sensing)
 
     def done(**fields) -> SensedPlan:
         return SensedPlan(**fields, measured_at=t_m, guarantee_until=until, sensed=sensed,
-                          reached=reached, chasers=chasing,
+                          reached=reached, chasers=tracked,
                           time_s=time.perf_counter() - started,
                           cpu_s=time.process_time() - cpu)
 
@@ -832,9 +801,13 @@ def _replan(plan: SensedPlan, measured_at: float, position: Sequence[float],
         return _escape(base, near or active, moving, boxes, sensed, sensing, s, t_m, t_s,
                        first, point, state)
 
-    # 0. a fast obstacle approaching the robot: an evasion, an escape ranked against its
-    #    pursuit, when one is certified
-    chasers = _pursuers([ob for ob in sensed if ob.label in chasing], s)
+    # 0. a fast track taken for a pursuer approaching the robot: an evasion, an escape
+    #    ranked against its pursuit, when one is certified (with the envelope's
+    #    acceleration bound only: a robot no faster than a pursuer that turns at once
+    #    gains nothing by turning)
+    chasers = ([] if sensing.max_obstacle_acceleration is None else
+               pursuers([ob for ob in sensed if ob.label in tracked], s,
+                        CLOSING_SPEED * MIN_SPEED))
     if chasers:
         active, point, near = at_switch()
         made = _escape(base, near or active, moving, boxes, sensed, sensing, s, t_m, t_s,
@@ -979,46 +952,19 @@ def _pursued(design: Design, start: float, arrival: float, task: Spec,
 
 
 def _pursuit(ob: SensedObstacle, sensing: Sensing, t_to: float,
-             aim: Callable[[float], np.ndarray], acceleration: float | None = None,
-             step: float = HEADED_STEP) -> Iterator[tuple[float, np.ndarray]]:
-    """``ob`` turning after the robot: its centre at every ``step`` from when it was seen
-    until ``t_to`` (absolute, s), each step heading for ``aim(t)`` at its estimated speed
-    (and ``velocity_error``); ``(t, centre)`` pairs. With ``acceleration`` (state units per
-    second squared, ``math.inf``: at once) its velocity, its estimate at first, turns
-    towards the one heading for ``aim(t)`` by at most that much per second, at that speed
-    but at most ``V`` (the adversary of ``WalkingObstacle.pursuit_acceleration``)."""
+             aim: Callable[[float], np.ndarray]) -> Iterator[tuple[float, np.ndarray]]:
+    """``ob`` turning after the robot: its centre at every :data:`HEADED_STEP` from when
+    it was seen until ``t_to`` (absolute, s), each step heading for ``aim(t)`` at its
+    estimated speed (and ``velocity_error``); ``(t, centre)`` pairs."""
     p = np.asarray(ob.centre, dtype=float)
-    if acceleration is not None:
-        yield from _turning(ob, sensing, t_to, aim, acceleration, step)
-        return
-    move = (_speed(ob) + sensing.velocity_error) * step
+    step = (_speed(ob) + sensing.velocity_error) * HEADED_STEP
     t = ob.seen_at
     while t <= t_to:
         yield t, p
         towards = aim(t) - p
         far = float(np.linalg.norm(towards))
-        p = p + towards * min(1.0, move / far) if far > 0.0 else p
-        t += step
-
-
-def _turning(ob: SensedObstacle, sensing: Sensing, t_to: float,
-             aim: Callable[[float], np.ndarray], acceleration: float,
-             step: float) -> Iterator[tuple[float, np.ndarray]]:
-    """:func:`_pursuit` with ``acceleration``."""
-    p = np.asarray(ob.centre, dtype=float)
-    v = np.zeros_like(p) if ob.velocity is None else np.asarray(ob.velocity, dtype=float)
-    top = min(sensing.max_obstacle_speed, _speed(ob) + sensing.velocity_error)
-    most = acceleration * step
-    t = ob.seen_at
-    while t <= t_to + 1e-9:
-        yield t, p
-        gap = aim(t) - p
-        far = float(np.linalg.norm(gap))
-        turn = (gap / far * top if far > 0.0 else 0.0 * gap) - v
-        size = float(np.linalg.norm(turn))
-        v = v + (turn if size <= most else turn * (most / size))
-        p = p + v * step
-        t += step
+        p = p + towards * min(1.0, step / far) if far > 0.0 else p
+        t += HEADED_STEP
 
 
 def _speed(ob: SensedObstacle) -> float:
@@ -1260,12 +1206,15 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
     :data:`ESCAPE_CLEARANCE`), then by their distance to the target; at most
     :data:`MAX_ESCAPES` designs.
 
-    An *evasion* runs from ``chasers`` (:func:`_pursuers`): its goals are
-    :data:`EVADE_DISTANCES` away, ranked by their least clearance from the chasers as the
-    robot runs on towards them (:func:`_evasion_clearance`, at the goal's distance over
-    :data:`ESCAPE_TIME`) and from the other obstacles as above, to the hundredth of a
-    state unit, with no cap and no room to the boundary (the run slides along the walls);
-    then by their distance to the target.
+    An *evasion* runs from ``chasers`` (:func:`~.sensed_evade.pursuers`): going on with
+    ``going``'s move (the active tube and the switch in its time,
+    :func:`~.sensed_blend.continuing`) where it moves, its goals are
+    :data:`~.sensed_evade.EVADE_DISTANCES` from where that move ends (else from ``point``),
+    reached in :data:`~.sensed_evade.EVADE_TIME`, ranked by their least clearance from the
+    chasers as the robot runs on past them (:func:`~.sensed_evade.evasion_clearance`) and
+    from the other obstacles as above, counted up to :data:`~.sensed_evade.EVADE_SAFE` to
+    the tenth, then by their distance to the point ahead on the evasion's ring
+    (:func:`~.sensed_evade.ring_ahead`).
     """
     dims = list(sensing.dims)
     reach = _reach(base)
@@ -1279,11 +1228,13 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
         upper = np.array([base.state_space.upper[d] for d in dims]) - half
         others = [(ob, heads) for ob, heads in closing if not any(ob is c for c in chasers)]
     on = going_on(*going) if (chasers and going is not None) else None
+    if on is not None and on.end > EVADE_TIME:
+        on = None               # a longer move than an evasion's: not gone on with
     origin = point.astype(float)
     if on is not None:
         origin = np.array([(on.lower_to[d] + on.upper_to[d]) / 2 for d in dims])
     if chasers:
-        ahead = _ring_ahead(base, dims, origin, chasers, origin - point.astype(float))
+        ahead = ring_ahead(base, dims, origin, chasers, origin - point.astype(float))
     for distance in EVADE_DISTANCES if chasers else ESCAPE_DISTANCES:
         for direction in directions if distance > 0.0 else directions[:1]:
             p = origin + (distance * direction if distance > 0.0 else 0.0)
@@ -1294,11 +1245,10 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
             if not base.state_space.contains_box(goal) or _meets_static(base, goal, reach):
                 continue
             if chasers:
-                clear = min([_evasion_clearance(ob, s, t_m, point, t_s, direction,
-                                                distance / (CHUNK_SECONDS if on is not None
-                                                            else EVADE_TIME),
-                                                lower, upper, sensing,
-                                                None if on is None else origin - point)
+                speed = distance / (sensing.period if on is not None else EVADE_TIME)
+                carry = None if on is None else (origin - point, sensing.period)
+                clear = min([evasion_clearance(ob, s, t_m, point, t_s, direction, speed,
+                                               lower, upper, sensing, carry)
                              for ob in chasers]
                             + [_goal_clearance(ob, heads, point, p, t_s, base.state_space,
                                                reach, sensing) for ob, heads in others])
@@ -1348,31 +1298,6 @@ def _escape(base: Spec, box: Box, moving: tuple[MovingObstacle, ...],
         return "no temporary goal inside the state space and clear of the obstacles"
     return (f"{min(len(ranked), MAX_ESCAPES)} temporary goals tried, none certified ("
             + ", ".join(str(r) for r in reasons) + ")")
-
-
-def _ring_ahead(base: Spec, dims: list[int], origin: np.ndarray,
-                chasers: Sequence[SensedObstacle], carry: np.ndarray) -> np.ndarray:
-    """The point :data:`EVADE_LEAD` ahead of ``origin`` on the evasion's ring
-    (:data:`EVADE_RING`), going round the way that leaves the nearest chaser behind (the target's centre on fewer
-    than two sensing dimensions)."""
-    if len(dims) < 2:
-        return np.asarray(base.target_center, dtype=float)[dims]
-    lo = np.array([base.state_space.lower[d] for d in dims], dtype=float)
-    hi = np.array([base.state_space.upper[d] for d in dims], dtype=float)
-    c = (lo + hi) / 2.0
-    radius = EVADE_RING * float(np.min(hi - lo)) / 2.0
-    near = min(chasers, key=lambda ob: float(np.linalg.norm(np.asarray(ob.centre) - origin)))
-    a = math.atan2(origin[1] - c[1], origin[0] - c[0])
-    b = math.atan2(near.centre[1] - c[1], near.centre[0] - c[0])
-    turn = float((origin[0] - c[0]) * carry[1] - (origin[1] - c[1]) * carry[0])
-    if float(np.linalg.norm(carry)) > EVADE_CARRY and abs(turn) > 1e-9:
-        way = 1.0 if turn > 0.0 else -1.0      # the way the robot is going round
-    else:
-        way = 1.0 if math.sin(a - b) >= 0.0 else -1.0
-    out = c.copy()
-    out[0] += radius * math.cos(a + way * EVADE_LEAD)
-    out[1] += radius * math.sin(a + way * EVADE_LEAD)
-    return out
 
 
 def escape_directions(n: int) -> np.ndarray:
@@ -1447,7 +1372,7 @@ def _best_effort(plan: SensedPlan, t_m: float, position: Sequence[float],
     return SensedPlan(**dict(made, certified_from=t_f), task=base, measured_at=t_m,
                       guarantee_until=t_f, sensed=sensed, best_effort=True,
                       reached=_reached(plan, s, sensing),
-                      chasers=_chasing(plan, sensed, s, sensing))
+                      chasers=chasing(plan.sensed, plan.chasers, sensed, s, sensing))
 
 
 def _first_source(spec: Spec) -> int:
@@ -1528,87 +1453,6 @@ def _pursuit_clearance(ob: SensedObstacle, start: np.ndarray, goal: np.ndarray,
                 - sensing.velocity_error * (t - ob.seen_at)
                 for t, p in _pursuit(ob, sensing, t_to, robot) if t >= t_from),
                default=math.inf)
-
-
-def _chasing(plan: SensedPlan, sensed: Sequence[SensedObstacle], s: np.ndarray,
-             sensing: Sensing) -> tuple[int, ...]:
-    """The labels of the tracks taken for pursuers, in increasing order: the active plan's
-    (:attr:`SensedPlan.chasers`) and those whose velocity estimate changed since the active
-    plan's measurement as the envelope's adversary's would, turning after the robot's
-    reference point ``s`` (:data:`PURSUIT_MATCH`).
-
-    A ranking's input, not a bound: a straight walk at the envelope's speed heading at the
-    robot matches too (and is as dangerous)."""
-    out = list(plan.chasers)
-    before = {ob.label: ob for ob in plan.sensed
-              if ob.label is not None and ob.velocity is not None}
-    top = sensing.max_obstacle_speed
-    turn = sensing.max_obstacle_acceleration
-    for ob in sensed:
-        prev = before.get(ob.label)
-        if (ob.label is None or ob.label in out or ob.velocity is None or prev is None
-                or not ob.seen_at > prev.seen_at):
-            continue
-        step = (ob.seen_at - prev.seen_at) / PURSUIT_STEPS
-        most = math.inf if turn is None else turn * step
-        p, v = np.asarray(prev.centre, dtype=float), np.asarray(prev.velocity, dtype=float)
-        for _ in range(PURSUIT_STEPS):
-            gap = s - p
-            far = float(np.linalg.norm(gap))
-            change = (gap / far * top if far > 0.0 else 0.0 * gap) - v
-            size = float(np.linalg.norm(change))
-            v = v + (change if size <= most else change * (most / size))
-            p = p + v * step
-        if float(np.linalg.norm(np.asarray(ob.velocity, dtype=float) - v)) <= (
-                PURSUIT_MATCH * top):
-            out.append(ob.label)
-    return tuple(sorted(out))
-
-
-def _pursuers(sensed: Sequence[SensedObstacle], s: np.ndarray) -> list[SensedObstacle]:
-    """The sensed obstacles an evasion runs from: fast ones (:func:`_fast`) approaching the
-    robot's reference point at ``s`` (within :data:`EVADE_ANGLE`) whose shape is within
-    :data:`EVADE_DISTANCE` of it."""
-    out = []
-    for ob in sensed:
-        if ob.velocity is None or not _fast(ob):
-            continue
-        v, towards = np.asarray(ob.velocity, dtype=float), s - np.asarray(ob.centre, dtype=float)
-        far = float(np.linalg.norm(towards))
-        if (far - ob.extent < EVADE_DISTANCE and float(v @ towards)
-                > math.cos(EVADE_ANGLE) * float(np.linalg.norm(v)) * far + 1e-12 * far):
-            out.append(ob)
-    return out
-
-
-def _evasion_clearance(ob: SensedObstacle, s: np.ndarray, t_m: float, point: np.ndarray,
-                       t_s: float, heading: np.ndarray, speed: float, lower: np.ndarray,
-                       upper: np.ndarray, sensing: Sensing,
-                       carry: np.ndarray | None = None) -> float:
-    """The least distance over :data:`EVADE_LOOK_AHEAD` after the switch ``t_s`` between
-    the robot's reference point, on its way from ``s`` at ``t_m`` to ``point`` at ``t_s``
-    and then running on along the unit ``heading`` at ``speed`` (state units per second)
-    inside ``[lower, upper]`` (sliding along its walls), and ``ob`` turning after it at the
-    envelope's ``A`` (at once without one; :func:`_pursuit`), less its extent and
-    ``velocity_error`` times the time since it was seen; state units, negative inside.
-
-    A ranking, not a bound: the robot does not stop at an evasion's goal, since the next
-    measurement's evasion takes over before it arrives (the game of a faster evader and a
-    pursuer, played a measurement at a time)."""
-    def robot(t: float) -> np.ndarray:
-        if t <= t_m:
-            return s
-        if t <= t_s:
-            return s + (point - s) * (t - t_m) / (t_s - t_m)
-        on = point if carry is None else point + carry * min(1.0, (t - t_s) / CHUNK_SECONDS)
-        return np.clip(on + heading * speed * (t - t_s), lower, upper)
-
-    turn = sensing.max_obstacle_acceleration
-    return min((float(np.linalg.norm(robot(t) - p)) - ob.extent
-                - sensing.velocity_error * (t - ob.seen_at)
-                for t, p in _pursuit(ob, sensing, t_s + EVADE_LOOK_AHEAD, robot,
-                                     math.inf if turn is None else turn, EVADE_STEP)
-                if t >= t_s - 1e-9), default=math.inf)
 
 
 def _meets_static(spec: Spec, box: Box, reach: float) -> bool:
