@@ -34,17 +34,20 @@ def measured(world, t, labels=True):
 def test_a_track_turning_as_the_envelopes_adversary_is_taken_for_a_pursuer():
     """The simulator's obstacles, the robot standing at (5, 5), measured at 0.5 and 0.75 s:
     a pursuer at ``V``, turning at ``A`` (track 0), is taken for one; a circle walking
-    past at 1 m/s (1) and one turning back before the east wall at 1 m/s^2 per axis (2, as
-    the bench's circles) are not. Known tracks are kept; untracked obstacles are not
-    taken."""
+    past at 1 m/s (1), one turning back before the east wall at 1 m/s^2 per axis (2, as
+    the bench's circles) and one walking straight at the robot at ``V`` (3: its velocity
+    does not change) are not. Known tracks are kept; untracked obstacles are not taken."""
     sensing = stt.Spec.from_dict(scenario_with(2.0)).sensing
     here = np.array([5.0, 5.0])
     walk = tuple((0.1 * k, 1.0 + 0.1 * k, 2.0) for k in range(21))
     wall = _turning(np.array([9.0, 3.0]), np.array([1.0, 0.6]), 0.3, 10.0, 2.0, 1.0)
+    speed = sensing.max_obstacle_speed
+    straight = tuple((0.1 * k, 5.0, 0.5 + speed * 0.1 * k) for k in range(21))
     obstacles = [WalkingObstacle((8.0, 8.0), 0.3, pursuit_speed=sensing.max_obstacle_speed,
                                  pursuit_acceleration=2.0),
                  WalkingObstacle((1.0, 2.0), 0.3, path=walk),
-                 WalkingObstacle((9.0, 3.0), 0.3, path=wall)]
+                 WalkingObstacle((9.0, 3.0), 0.3, path=wall),
+                 WalkingObstacle((5.0, 0.5), 0.3, path=straight)]
     world, dt, seen = _World(obstacles, 2, 0.01), 0.01, {}
     for k in range(75):
         world.p = world.advance(k * dt, dt, here)
@@ -53,6 +56,10 @@ def test_a_track_turning_as_the_envelopes_adversary_is_taken_for_a_pursuer():
     before, after = seen[50], seen[75]
     # the wall's circle is turning between the two measurements
     assert np.linalg.norm(np.subtract(after[2].velocity, before[2].velocity)) > 0.2
+    # the straight walk heads at the robot at V, as the adversary's velocity would
+    towards = here - np.asarray(after[3].centre)
+    assert np.asarray(after[3].velocity) == pytest.approx(
+        towards / np.linalg.norm(towards) * speed)
     assert evade.chasing(before, (), after, here, sensing) == (0,)
     assert evade.chasing(before, (2,), after, here, sensing) == (0, 2)
     assert evade.chasing((), (2,), after, here, sensing) == (2,)

@@ -6,7 +6,7 @@ the replanner no certified plan, and the robot then runs uncertified. The evasio
 the robot moving before that happens:
 
 - :func:`chasing` tells a pursuer from an obstacle walking past by its track: a track whose
-  velocity estimate changed between two measurements as the envelope's adversary's would
+  velocity estimate changed between two measurements, as the envelope's adversary's would
   (turning after the robot at ``max_obstacle_acceleration`` towards ``max_obstacle_speed``)
   is taken for one from then on;
 - :func:`pursuers` picks the fast ones among them approaching the robot, within
@@ -41,9 +41,10 @@ EVADE_DISTANCE = 4.0
 #: The angle (radians) within which a pursuer's velocity estimate points at the robot when
 #: an evasion runs from it (a right angle: approaching at all).
 EVADE_ANGLE = math.pi / 2.0
-#: A track's velocity estimate, predicted from the previous measurement as the envelope's
-#: adversary would turn it (:func:`chasing`), matches the next one to within this
-#: fraction of ``max_obstacle_speed``: the track is taken for a pursuer.
+#: A track's velocity estimate that changed by more than this fraction of
+#: ``max_obstacle_speed`` since the previous measurement, and to within it of the one
+#: predicted as the envelope's adversary would turn it (:func:`chasing`): the track is
+#: taken for a pursuer.
 PURSUIT_MATCH = 0.05
 #: The sub-steps of :func:`chasing`'s prediction between two measurements.
 PURSUIT_STEPS = 10
@@ -103,14 +104,16 @@ def chasing(before: Sequence[SensedObstacle], known: tuple[int, ...],
             sensed: Sequence[SensedObstacle], s: np.ndarray,
             sensing: Sensing) -> tuple[int, ...]:
     """The labels of the tracks taken for pursuers, in increasing order: ``known`` and those
-    of ``sensed`` whose velocity estimate, predicted from the same track in ``before`` (an
+    of ``sensed`` whose velocity estimate changed since the same track in ``before`` (an
     earlier measurement) as the envelope's adversary would turn it after the robot's
     reference point ``s`` (at ``max_obstacle_acceleration``, at once without one, towards
-    ``max_obstacle_speed``), matches to within :data:`PURSUIT_MATCH` of that speed.
+    ``max_obstacle_speed``): by more than :data:`PURSUIT_MATCH` of that speed, and to
+    within it of that prediction.
 
-    An obstacle walking straight at that speed right at the robot matches too (and is as
-    dangerous); one walking past, or turning for its own reasons (back from a wall), does
-    not, unless by chance."""
+    An obstacle walking straight does not change its velocity, and is not taken, even at
+    that speed right at the robot (a circle of Real-Time STT's generator walks at up to
+    1.41 m/s, and one so taken was run from into a collision); one turning for its own
+    reasons (back from a wall) is not, unless by chance."""
     out = list(known)
     previous = {ob.label: ob for ob in before
                 if ob.label is not None and ob.velocity is not None}
@@ -127,8 +130,10 @@ def chasing(before: Sequence[SensedObstacle], known: tuple[int, ...],
         for _ in range(PURSUIT_STEPS):
             v = _turned(v, s - p, top, most)
             p = p + v * step
-        if float(np.linalg.norm(np.asarray(ob.velocity, dtype=float) - v)) <= (
-                PURSUIT_MATCH * top):
+        now = np.asarray(ob.velocity, dtype=float)
+        tolerance = PURSUIT_MATCH * top
+        if (float(np.linalg.norm(now - np.asarray(prev.velocity, dtype=float))) > tolerance
+                and float(np.linalg.norm(now - v)) <= tolerance):
             out.append(ob.label)
     return tuple(sorted(out))
 
