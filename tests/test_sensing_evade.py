@@ -134,19 +134,23 @@ def test_an_evasion_ranks_a_run_along_the_wall_above_the_wall_and_the_pursuer():
     assert clearance((0.0, 1.0), (np.array([-1.0, 0.0]), 0.25)) < north
 
 
-def test_the_ring_ahead_goes_round_the_way_the_robot_is_carried_else_from_the_chaser():
+def test_the_ring_ahead_goes_round_the_way_the_robot_is_carried_unless_the_chaser_is_ahead():
     """The arena's state space is [0.1, 9.9]^2 (the robot's radius off the walls): the ring
     has radius 0.6 * 4.9 = 2.94 about (5, 5). From (8, 5), a chaser at (5, 2) (south): 60
-    degrees round, away from it; carried south-west by the move under way, the other way;
-    on one sensing dimension, the target's centre."""
+    degrees round, away from it. Carried south-west by the move under way, round towards
+    that chaser (90 degrees ahead on that way): it turns back, away from it. A chaser at
+    (2, 5), across the centre, is ahead neither way: the robot goes on the way it is
+    carried. On one sensing dimension, the target's centre."""
     spec = stt.Spec.from_dict(scenario_with(2.0))
     assert spec.state_space.lower == (0.1, 0.1) and spec.state_space.upper == (9.9, 9.9)
     chaser = stt.SensedObstacle.ball((5.0, 2.0), 0.3, seen_at=0.0, velocity=(0.0, 1.0))
-    origin = np.array([8.0, 5.0])
+    across = stt.SensedObstacle.ball((2.0, 5.0), 0.3, seen_at=0.0, velocity=(1.0, 0.0))
+    origin, south_west = np.array([8.0, 5.0]), np.array([-0.1, -0.2])
     up = (5.0 + 2.94 * math.cos(math.pi / 3), 5.0 + 2.94 * math.sin(math.pi / 3))
+    down = (up[0], 10.0 - up[1])
     assert evade.ring_ahead(spec, [0, 1], origin, [chaser], np.zeros(2)) == pytest.approx(up)
-    down = evade.ring_ahead(spec, [0, 1], origin, [chaser], np.array([-0.1, -0.2]))
-    assert down == pytest.approx((up[0], 10.0 - up[1]))
+    assert evade.ring_ahead(spec, [0, 1], origin, [chaser], south_west) == pytest.approx(up)
+    assert evade.ring_ahead(spec, [0, 1], origin, [across], south_west) == pytest.approx(down)
     assert evade.ring_ahead(spec, [0], origin[:1], [chaser], np.zeros(1)) == pytest.approx(
         np.asarray(spec.target_center)[:1])
 

@@ -14,7 +14,8 @@ the robot moving before that happens:
 - an evasion's temporary goals are ranked by :func:`evasion_clearance` (the robot running
   on past the goal, the pursuer turning after it), then by their distance to
   :func:`ring_ahead`, a point ahead on a ring about the state space's centre (going round
-  keeps the robot out of the corners, where a pursuer traps it).
+  keeps the robot out of the corners, where a pursuer traps it), the way the robot goes
+  unless the pursuer is ahead on it.
 
 All of it ranks goals; none of it is a bound. Every evasion's tube is designed and
 certified as any escape's (:mod:`.sensed`).
@@ -32,8 +33,8 @@ from ..spec.sensing import SensedObstacle, Sensing
 
 __all__ = ["EVADE_ANGLE", "EVADE_CARRY", "EVADE_DISTANCE", "EVADE_DISTANCES", "EVADE_LEAD",
            "EVADE_LOOK_AHEAD", "EVADE_RING", "EVADE_SAFE", "EVADE_STEP", "EVADE_TIME",
-           "PURSUIT_MATCH", "PURSUIT_STEPS", "chasing", "evasion_clearance", "pursuers",
-           "ring_ahead", "turning"]
+           "EVADE_TURN_BACK", "PURSUIT_MATCH", "PURSUIT_STEPS", "chasing", "evasion_clearance",
+           "pursuers", "ring_ahead", "turning"]
 
 #: A pursuer (:func:`chasing`) whose shape comes within this distance of the robot's
 #: reference point, state units, is run from.
@@ -61,6 +62,10 @@ EVADE_LEAD = math.pi / 3.0
 #: A robot carried on by the move under way more than this (state units) keeps going round
 #: the ring the way it goes.
 EVADE_CARRY = 0.1
+#: A robot carried round the ring turns back when the nearest pursuer is ahead of it on
+#: the way it goes: the sine of the angle about the centre from the robot to the pursuer,
+#: signed by the way, above this (a half: the pursuer 30 to 150 degrees ahead).
+EVADE_TURN_BACK = 0.5
 #: An evasion's clearance counts up to this (state units), to the tenth: goals at least
 #: this clear are ranked by their distance to the ring's point ahead.
 EVADE_SAFE = 1.0
@@ -193,8 +198,9 @@ def ring_ahead(spec: Spec, dims: Sequence[int], origin: np.ndarray,
     """The point :data:`EVADE_LEAD` ahead of ``origin`` (on the sensing dimensions
     ``dims``) on the ring of radius :data:`EVADE_RING` times the state space's smallest
     half side about its centre: going round the way the robot is carried (``carry``,
-    longer than :data:`EVADE_CARRY`), else the way that leaves the nearest of ``chasers``
-    behind. On fewer than two sensing dimensions, the target's centre."""
+    longer than :data:`EVADE_CARRY`) unless the nearest of ``chasers`` is ahead on that way
+    (:data:`EVADE_TURN_BACK`), else the way that leaves it behind. On fewer than two
+    sensing dimensions, the target's centre."""
     if len(dims) < 2:
         return np.asarray(spec.target_center, dtype=float)[list(dims)]
     lo = np.array([spec.state_space.lower[d] for d in dims], dtype=float)
@@ -205,10 +211,12 @@ def ring_ahead(spec: Spec, dims: Sequence[int], origin: np.ndarray,
     a = math.atan2(origin[1] - c[1], origin[0] - c[0])
     b = math.atan2(near.centre[1] - c[1], near.centre[0] - c[0])
     turn = float((origin[0] - c[0]) * carry[1] - (origin[1] - c[1]) * carry[0])
+    away = 1.0 if math.sin(a - b) >= 0.0 else -1.0
+    way = away
     if float(np.linalg.norm(carry)) > EVADE_CARRY and abs(turn) > 1e-9:
         way = 1.0 if turn > 0.0 else -1.0
-    else:
-        way = 1.0 if math.sin(a - b) >= 0.0 else -1.0
+        if way * math.sin(a - b) < -EVADE_TURN_BACK:
+            way = away          # the pursuer is ahead on the way the robot goes
     out = c.copy()
     out[0] += radius * math.cos(a + way * EVADE_LEAD)
     out[1] += radius * math.sin(a + way * EVADE_LEAD)
