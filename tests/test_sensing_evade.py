@@ -139,12 +139,13 @@ def test_the_ring_ahead_goes_round_the_way_the_robot_is_carried_unless_the_chase
     has radius 0.6 * 4.9 = 2.94 about (5, 5). From (8, 5), a chaser at (5, 2) (south): 60
     degrees round, away from it. Carried south-west by the move under way, round towards
     that chaser (90 degrees ahead on that way): it turns back, away from it. A chaser at
-    (2, 5), across the centre, is ahead neither way: the robot goes on the way it is
-    carried. On one sensing dimension, the target's centre."""
+    (2.2, 4), nearly across the centre (160 degrees ahead that way, 200 the other), is
+    not ahead: the robot goes on the way it is carried, towards the chaser's far side,
+    not away from it. On one sensing dimension, the target's centre."""
     spec = stt.Spec.from_dict(scenario_with(2.0))
     assert spec.state_space.lower == (0.1, 0.1) and spec.state_space.upper == (9.9, 9.9)
     chaser = stt.SensedObstacle.ball((5.0, 2.0), 0.3, seen_at=0.0, velocity=(0.0, 1.0))
-    across = stt.SensedObstacle.ball((2.0, 5.0), 0.3, seen_at=0.0, velocity=(1.0, 0.0))
+    across = stt.SensedObstacle.ball((2.2, 4.0), 0.3, seen_at=0.0, velocity=(1.0, 0.0))
     origin, south_west = np.array([8.0, 5.0]), np.array([-0.1, -0.2])
     up = (5.0 + 2.94 * math.cos(math.pi / 3), 5.0 + 2.94 * math.sin(math.pi / 3))
     down = (up[0], 10.0 - up[1])
