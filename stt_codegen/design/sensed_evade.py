@@ -211,11 +211,11 @@ def ring_ahead(spec: Spec, dims: Sequence[int], origin: np.ndarray,
     a = math.atan2(origin[1] - c[1], origin[0] - c[0])
     b = math.atan2(near.centre[1] - c[1], near.centre[0] - c[0])
     turn = float((origin[0] - c[0]) * carry[1] - (origin[1] - c[1]) * carry[0])
-    away = 1.0 if math.sin(a - b) >= 0.0 else -1.0
-    way = away
+    behind = math.sin(a - b)        # > 0: the pursuer is behind going anticlockwise
+    way = away = 1.0 if behind >= 0.0 else -1.0
     if float(np.linalg.norm(carry)) > EVADE_CARRY and abs(turn) > 1e-9:
         way = 1.0 if turn > 0.0 else -1.0
-        if way * math.sin(a - b) < -EVADE_TURN_BACK:
+        if way * behind < -EVADE_TURN_BACK:
             way = away          # the pursuer is ahead on the way the robot goes
     out = c.copy()
     out[0] += radius * math.cos(a + way * EVADE_LEAD)
