@@ -130,7 +130,11 @@ def _run_examples(name: str) -> doctest.TestResults:
     return runner.summarize(verbose=False)
 
 
-@pytest.mark.parametrize("name", [n for n in FRONT_DOOR if n != "verify"])
+# the two slowest (about 4 s each) in the slow tier, where test_docstrings runs every
+# public example too
+@pytest.mark.parametrize("name", [
+    pytest.param(n, marks=pytest.mark.slow) if n in ("simulate", "plot_design") else n
+    for n in FRONT_DOOR if n != "verify"])
 def test_front_door_examples_run(name, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     results = _run_examples(name)

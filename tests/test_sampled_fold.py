@@ -116,7 +116,8 @@ def test_fold_equals_loop_on_random_classes(name: str) -> None:
     assert "passed" in verdicts and len(verdicts) >= 2, verdicts
 
 
-@pytest.mark.parametrize("lyapunov", [False, True])
+# the Lyapunov form (about 5 s) in the slow tier; the other form keeps the test fast
+@pytest.mark.parametrize("lyapunov", [False, pytest.param(True, marks=pytest.mark.slow)])
 def test_a_box_of_e0_bounds_every_start_in_it(lyapunov: bool) -> None:
     """The check from a box of ``e(0)`` holding ``e(x(0))`` proves bounds no smaller than the
     check from ``x(0)`` at every sample, and grows with the box; a box reaching the edge
